@@ -1,0 +1,255 @@
+//! Enumerations carried as raw integers in the image, decoded with validation: an unknown raw
+//! value is an [`InvalidValue`] error, never undefined behaviour and never a silent default.
+
+/// A raw value from the image that is not one of its type's values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("invalid {type_name} value {raw} (0x{raw:X}); allowed: {allowed}")]
+pub struct InvalidValue {
+    /// The enumeration the value was decoded as.
+    pub type_name: &'static str,
+    /// The raw value, widened.
+    pub raw: i64,
+    /// The values that would have been accepted.
+    pub allowed: &'static str,
+}
+
+macro_rules! hli_enum {
+    (
+        $(#[doc = $doc:literal])*
+        $name:ident : $raw:ty, $st:literal {
+            $( $(#[doc = $vdoc:literal])* $variant:ident = $value:expr ),* $(,)?
+        }
+    ) => {
+        $(#[doc = $doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $( $(#[doc = $vdoc])* $variant, )*
+        }
+
+        impl $name {
+            /// Every variant, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant),*];
+
+            /// The raw value stored in the image.
+            pub const fn raw(self) -> $raw {
+                match self { $( $name::$variant => $value, )* }
+            }
+
+            /// Decodes a raw value read from the image.
+            pub fn decode(raw: $raw) -> Result<Self, InvalidValue> {
+                $( if raw == $value { return Ok($name::$variant); } )*
+                Err(InvalidValue {
+                    type_name: $st,
+                    raw: raw as i64,
+                    allowed: concat!($( stringify!($value), " " ),*),
+                })
+            }
+        }
+    };
+}
+
+hli_enum! {
+    /// `HLI_DYN_CS_*`: state of a tracking channel. Carried in a UDINT, so ERROR (-1) is
+    /// stored as 0xFFFF_FFFF.
+    DynCsState: u32, "HLI_DYN_CS_STATE" {
+        /// Not following.
+        Inactive = 0,
+        /// Coupling in softly through the filter.
+        Activating = 1,
+        /// Following the dynamic coordinate system.
+        Active = 2,
+        /// Coupling out softly.
+        Deactivating = 3,
+        /// Failed; cannot follow any more.
+        Error = u32::MAX,
+    }
+}
+
+hli_enum! {
+    /// `HLI_DYN_CS_TRANSITION.command`.
+    DynCsCommand: i32, "HLI_DYN_CS_TRANSITION.command" {
+        /// Nothing pending.
+        None = 0,
+        /// Switch tracking on.
+        Activate = 1,
+        /// Switch tracking off.
+        Deactivate = -1,
+    }
+}
+
+hli_enum! {
+    /// `HLI_DYN_CS_TRANSITION.option`.
+    DynCsOption: u32, "HLI_DYN_CS_TRANSITION.option" {
+        /// Follow translation and rotation.
+        TranslationAndRotation = 0,
+        /// Follow the translation only.
+        TranslationOnly = 1,
+    }
+}
+
+hli_enum! {
+    /// `nAxisState`: motion state of an axis. 0 and the slave states 11..13 are the values the
+    /// flying-saw specification names; the master states 1..4 are our own numbering (the
+    /// specification refers to documentation we do not have).
+    AxisState: i32, "nAxisState" {
+        /// Set-point generator not active.
+        Inactive = 0,
+        /// Master: accelerating.
+        Accelerating = 1,
+        /// Master: constant velocity.
+        ConstantVelocity = 2,
+        /// Master: decelerating.
+        Decelerating = 3,
+        /// Master: holding position at standstill under control.
+        Standstill = 4,
+        /// Slave: motion pre-phase.
+        SlavePrephase = 11,
+        /// Slave: synchronising.
+        SlaveSynchronizing = 12,
+        /// Slave: synchronous.
+        SlaveSynchronous = 13,
+    }
+}
+
+impl AxisState {
+    /// Whether the axis is a slave (`nAxisState >= 10`).
+    pub fn is_slave(self) -> bool {
+        self.raw() >= 10
+    }
+}
+
+hli_enum! {
+    /// What an axis is coupled to.
+    CouplingState: i32, "HLI_AXIS_LR_STATE.coupling_state_r" {
+        /// A free master axis.
+        Uncoupled = 0,
+        /// Slave of an electronic cam.
+        Cam = 1,
+        /// Slave of a linear gear / flying saw (velocity synchronisation).
+        GearVelocity = 2,
+        /// Slave of a flying saw (position synchronisation).
+        GearPosition = 3,
+        /// Member of a FIFO axis group.
+        Fifo = 4,
+        /// Driven by a CNC channel's interpolator.
+        Channel = 5,
+    }
+}
+
+hli_enum! {
+    /// State of a channel's program.
+    ProgramState: i32, "HLI_BAHN_STATE.program_state_r" {
+        /// No program selected or finished and reset.
+        Idle = 0,
+        /// Executing blocks.
+        Running = 1,
+        /// Waiting (synchronisation, M-function acknowledge, WAIT).
+        Waiting = 2,
+        /// Program ended with M30.
+        Finished = 3,
+        /// Stopped by an error.
+        Error = -1,
+    }
+}
+
+hli_enum! {
+    /// State of a FIFO axis group.
+    FifoGroupState: i32, "HLI_FIFO_GROUP_STATE.group_state_r" {
+        /// Not started.
+        Idle = 0,
+        /// Rows are written, not started yet.
+        Filling = 1,
+        /// Consuming rows.
+        Running = 2,
+        /// Ran out of rows or stopped; decelerating.
+        Stopping = 3,
+        /// Error.
+        Error = -1,
+    }
+}
+
+hli_enum! {
+    /// Direction output of the drive process image (`nCtrl2`, `nCtrl3`).
+    DirectionBits: u8, "nCtrl direction" {
+        /// Moving in the negative direction.
+        Minus = 0x41,
+        /// Moving in the positive direction.
+        Plus = 0x42,
+        /// Standing still.
+        Stop = 0x80,
+    }
+}
+
+hli_enum! {
+    /// Field-bus I/O state (`nStatus4` of encoder and drive inputs).
+    IoState: u8, "nStatus4" {
+        /// Process data valid.
+        Valid = 0,
+        /// Process data invalid: the axis must treat this as a fault.
+        Invalid = 1,
+    }
+}
+
+hli_enum! {
+    /// Life cycle of a segment, `HLI_SEGMENT_HEADER.segment_state`.
+    SegmentState: u32, "HLI_SEGMENT_HEADER.segment_state" {
+        /// Created, header not complete yet.
+        Initialising = 0,
+        /// The CNC runs; PLCs may attach.
+        Ready = 1,
+        /// The CNC shut down in order.
+        Closed = 2,
+    }
+}
+
+/// Bits of `HLI_AXIS_LR_STATE.status_r`.
+pub mod axis_status {
+    /// Drive enabled (MC_Power).
+    pub const ENABLED: u32 = 1 << 0;
+    /// Referenced / homed.
+    pub const HOMED: u32 = 1 << 1;
+    /// Set-point generator active.
+    pub const MOVING: u32 = 1 << 2;
+    /// Set position reached and following error within the window.
+    pub const IN_TARGET: u32 = 1 << 3;
+    /// The axis has an error (see `error_id_r`).
+    pub const ERROR: u32 = 1 << 4;
+    /// The process image reported I/O data invalid.
+    pub const IO_INVALID: u32 = 1 << 5;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn dyn_cs_state_values_match_the_specification() {
+        assert_eq!(DynCsState::Inactive.raw(), 0);
+        assert_eq!(DynCsState::Activating.raw(), 1);
+        assert_eq!(DynCsState::Active.raw(), 2);
+        assert_eq!(DynCsState::Deactivating.raw(), 3);
+        assert_eq!(DynCsState::Error.raw() as i32, -1);
+        assert_eq!(DynCsState::decode(0xFFFF_FFFF), Ok(DynCsState::Error));
+    }
+
+    #[test]
+    fn unknown_raw_value_is_a_typed_error() {
+        let err = DynCsState::decode(7).unwrap_err();
+        assert_eq!(err.raw, 7);
+        assert_eq!(err.type_name, "HLI_DYN_CS_STATE");
+        assert!(err.to_string().contains("invalid HLI_DYN_CS_STATE value 7"));
+        assert!(AxisState::decode(10).is_err());
+        assert!(DirectionBits::decode(0x40).is_err());
+    }
+
+    proptest! {
+        #[test]
+        fn decode_is_total_and_inverts_raw(raw in any::<i32>()) {
+            match AxisState::decode(raw) {
+                Ok(state) => prop_assert_eq!(state.raw(), raw),
+                Err(e) => prop_assert!(AxisState::ALL.iter().all(|s| s.raw() != raw) && e.raw == raw as i64),
+            }
+        }
+    }
+}

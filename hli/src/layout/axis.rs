@@ -1,0 +1,53 @@
+//! Per-axis part of the image: `gpAx[axis_idx]^...`.
+
+use super::axis_image::{NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut};
+use crate::hli_struct;
+
+hli_struct! {
+    /// Cyclic state of an axis ("lr" = position controller), written by the CNC every tick.
+    /// Positions in 0.1 um (linear) or 0.0001 degree (rotary).
+    #[st = "HLI_AXIS_LR_STATE", size = 48]
+    pub struct HliAxisLrState {
+        /// Actual position in the axis coordinate system.
+        pub current_position_acs_r: i32 => [0, Cnc],
+        /// Set position in the axis coordinate system.
+        pub command_position_acs_r: i32 => [4, Cnc],
+        /// Actual velocity, 0.1 um/s (0.0001 deg/s).
+        pub current_velocity_r: i32 => [8, Cnc],
+        /// Set velocity, 0.1 um/s (0.0001 deg/s).
+        pub command_velocity_r: i32 => [12, Cnc],
+        /// Set acceleration, 1 um/s^2 (0.001 deg/s^2).
+        pub command_acceleration_r: i32 => [16, Cnc],
+        /// Following error (set minus actual), 0.1 um.
+        pub following_error_r: i32 => [20, Cnc],
+        /// Motion state `nAxisState`; see [`crate::enums::AxisState`].
+        pub axis_state_r: i32 => [24, Cnc],
+        /// Coupling; see [`crate::enums::CouplingState`].
+        pub coupling_state_r: i32 => [28, Cnc],
+        /// Index of the master axis while coupled, -1 otherwise.
+        pub master_axis_r: i32 => [32, Cnc],
+        /// Error code of the axis, 0 when none.
+        pub error_id_r: u32 => [36, Cnc],
+        /// Status bits; see [`crate::enums::axis_status`].
+        pub status_r: u32 => [40, Cnc],
+        /// Padding.
+        pub fill_up_1: i32 => [44, Cnc],
+    }
+}
+
+hli_struct! {
+    /// Everything of one axis: `gpAx[axis_idx]^`.
+    #[st = "HLI_AXIS", size = 192]
+    pub struct HliAxis {
+        /// Cyclic state.
+        pub lr_state: HliAxisLrState => [0, Parent],
+        /// Encoder inputs (process image).
+        pub enc_in: NcEncoderIn => [48, Parent],
+        /// Encoder outputs (process image).
+        pub enc_out: NcEncoderOut => [88, Parent],
+        /// Drive inputs (process image).
+        pub drive_in: NcDriveIn => [120, Parent],
+        /// Drive outputs (process image).
+        pub drive_out: NcDriveOut => [160, Parent],
+    }
+}

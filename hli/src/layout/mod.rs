@@ -1,0 +1,16 @@
+//! `#[repr(C)]` layouts of every control unit and state image, each with compile-time asserts
+//! of its size and field offsets.
+
+pub mod axis;
+pub mod axis_image;
+pub mod channel;
+pub mod dyn_cs;
+pub mod fifo;
+pub mod image;
+
+pub use axis::*;
+pub use axis_image::*;
+pub use channel::*;
+pub use dyn_cs::*;
+pub use fifo::*;
+pub use image::*;

@@ -1,0 +1,28 @@
+//! The high-level interface (HLI) between the CNC and the PLC process.
+//!
+//! * [`layout`]: `#[repr(C)]` control units and state images, sizes and offsets asserted at
+//!   compile time;
+//! * [`symbols`]: every node and leaf by its ST path; [`c_header`]: the same layout for C;
+//! * [`segment`]: the shared-memory object (create, attach, validate, heartbeats);
+//! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
+//!   PLC's side of an image;
+//! * [`events`]: iceoryx2 wake-ups; [`rpc`]: acyclic calls over iceoryx2 request-response;
+//! * [`units`], [`enums`]: HLI units and validated enumerations.
+//!
+//! All `unsafe` code is in [`raw`]. The crate has no motion logic.
+
+pub mod c_header;
+pub mod desc;
+pub mod enums;
+pub mod events;
+pub mod handshake;
+pub mod layout;
+pub mod raw;
+pub mod rpc;
+pub mod segment;
+pub mod symbols;
+pub mod units;
+pub mod views;
+
+pub use desc::{Bool, HliType, PlaceExt, Writer as SymbolWriter};
+pub use raw::{ImageMemory, Place};

@@ -1,0 +1,662 @@
+//! The shared segment: one POSIX shared-memory object per CNC instance, created by the CNC and
+//! opened read-write by the PLC, through iceoryx2's own shared-memory layer
+//! (`iceoryx2-bb-posix`). Owner-only permissions.
+//!
+//! ```text
+//!  CNC start ──create exclusive──┬─ ok ───────────────────────────────► header Initialising
+//!                                └─ exists ─ owner process alive? ─ yes ─► Err(InUse)
+//!                                                       │ no (crashed)
+//!                                                       └─ remove, create ─► (stale replaced)
+//!  header complete ─► Ready ─► PLC may attach (magic, version, hash, size checked)
+//!  CNC drop ─► Closed, object unlinked
+//! ```
+
+use crate::desc::{HliType, PlaceExt};
+use crate::enums::SegmentState;
+use crate::layout::{HliImage, HliSegmentHeader, HLI_MAX_AXES, HLI_MAX_CHANNELS};
+use crate::raw::{ImageMemory, Place};
+use crate::symbols::SymbolTable;
+use core::mem::{offset_of, size_of};
+use iceoryx2_bb_posix::shared_memory::{
+    AccessMode, CreationMode, Permission, SharedMemory, SharedMemoryBuilder,
+    SharedMemoryCreationError,
+};
+use iceoryx2_bb_system_types::file_name::{FileName, SemanticString};
+
+/// "HLI-SEG1" as a little-endian u64.
+pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");
+/// Bumped whenever the meaning of the image changes without its layout changing.
+pub const LAYOUT_VERSION: u32 = 1;
+/// Size of the image in bytes.
+pub const IMAGE_SIZE: usize = size_of::<HliImage>();
+const HEADER_SIZE: usize = size_of::<HliSegmentHeader>();
+
+/// What a peer expects the segment to be; both sides compare theirs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LayoutIdentity {
+    /// [`LAYOUT_VERSION`].
+    pub version: u32,
+    /// [`SymbolTable::layout_hash`].
+    pub hash: u64,
+    /// Image size in bytes.
+    pub size: u64,
+}
+
+impl LayoutIdentity {
+    /// The identity of this build.
+    pub fn current() -> Self {
+        Self {
+            version: LAYOUT_VERSION,
+            hash: SymbolTable::global().layout_hash(),
+            size: IMAGE_SIZE as u64,
+        }
+    }
+}
+
+/// Why a segment could not be created.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CreateError {
+    /// The instance name is not usable as a shared-memory name.
+    #[error("invalid instance name {name:?}: use 1..=48 characters of [A-Za-z0-9_.-]")]
+    InvalidName {
+        /// The name given.
+        name: String,
+    },
+    /// Channel or axis count above the image's capacity.
+    #[error("{what} count {requested} exceeds the image capacity {capacity}")]
+    TooMany {
+        /// "channel" or "axis".
+        what: &'static str,
+        /// Requested count.
+        requested: u32,
+        /// Capacity.
+        capacity: u32,
+    },
+    /// A live CNC already owns this instance.
+    #[error("segment {name} is owned by the running CNC process {pid}")]
+    InUse {
+        /// Segment name.
+        name: String,
+        /// The owner's process id.
+        pid: u32,
+    },
+    /// The operating system refused.
+    #[error("creating segment {name} failed: {reason}")]
+    Os {
+        /// Segment name.
+        name: String,
+        /// iceoryx2's error.
+        reason: String,
+    },
+}
+
+/// Why attaching to a segment failed. Every mismatch names the CNC's and the PLC's value.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum AttachError {
+    /// The instance name is not usable as a shared-memory name.
+    #[error("invalid instance name {name:?}: use 1..=48 characters of [A-Za-z0-9_.-]")]
+    InvalidName {
+        /// The name given.
+        name: String,
+    },
+    /// No segment of that name.
+    #[error("no segment {name}: is the CNC running?")]
+    NotFound {
+        /// Segment name.
+        name: String,
+    },
+    /// The object is smaller than the layout needs.
+    #[error("segment {name} is truncated: {found} bytes, the layout needs {expected}")]
+    Truncated {
+        /// Segment name.
+        name: String,
+        /// Bytes this build needs.
+        expected: u64,
+        /// Bytes found.
+        found: u64,
+    },
+    /// Not an HLI segment.
+    #[error("segment {name} has magic 0x{cnc:016X}, expected 0x{plc:016X}")]
+    BadMagic {
+        /// Segment name.
+        name: String,
+        /// Found in the segment.
+        cnc: u64,
+        /// Expected by this build.
+        plc: u64,
+    },
+    /// Layout version differs.
+    #[error("layout version mismatch: CNC has {cnc}, PLC has {plc}")]
+    VersionMismatch {
+        /// The segment's.
+        cnc: u32,
+        /// This build's.
+        plc: u32,
+    },
+    /// Layout hash differs (the structs differ).
+    #[error("layout hash mismatch: CNC has 0x{cnc:016X}, PLC has 0x{plc:016X}")]
+    LayoutMismatch {
+        /// The segment's.
+        cnc: u64,
+        /// This build's.
+        plc: u64,
+    },
+    /// Image size differs.
+    #[error("image size mismatch: CNC has {cnc} bytes, PLC has {plc} bytes")]
+    SizeMismatch {
+        /// The segment's.
+        cnc: u64,
+        /// This build's.
+        plc: u64,
+    },
+    /// Header counts outside the capacity.
+    #[error("segment header claims {channels} channels / {axes} axes (capacity 12 / 32)")]
+    InvalidCounts {
+        /// Claimed channels.
+        channels: u32,
+        /// Claimed axes.
+        axes: u32,
+    },
+    /// The CNC has not finished creating the segment, or has shut down.
+    #[error("segment {name} is not ready (state {state})")]
+    NotReady {
+        /// Segment name.
+        name: String,
+        /// Raw state.
+        state: u32,
+    },
+    /// The operating system refused.
+    #[error("opening segment {name} failed: {reason}")]
+    Os {
+        /// Segment name.
+        name: String,
+        /// iceoryx2's error.
+        reason: String,
+    },
+}
+
+/// The shared-memory object name of an instance.
+pub fn segment_name(instance: &str) -> Option<String> {
+    let ok = !instance.is_empty()
+        && instance.len() <= 48
+        && instance
+            .bytes()
+            .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b));
+    ok.then(|| format!("cncplc_{instance}.hli"))
+}
+
+fn file_name(name: &str) -> FileName {
+    FileName::new(name.as_bytes()).expect("segment_name yields a valid file name")
+}
+
+/// Start time of a process (clock ticks since boot) and whether it is still running, from
+/// `/proc`; `None` where there is no such process. Tells a live owner from a reused pid.
+fn process_start_stamp(pid: u32) -> Option<u64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may contain spaces.
+    let after_name = &stat[stat.rfind(')')? + 2..];
+    let mut fields = after_name.split_whitespace();
+    let state = fields.next()?;
+    if state == "Z" || state == "X" {
+        return None; // exited, not yet reaped
+    }
+    // After the state come fields 4.., the start time is field 22.
+    fields.nth(22 - 4)?.parse().ok()
+}
+
+/// A previous owner's segment that was found dead and replaced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StaleSegment {
+    /// The dead owner's process id (0 when the header was unreadable).
+    pub pid: u32,
+}
+
+/// The CNC's side of a segment: creates it, owns it, removes it when dropped.
+pub struct CncSegment {
+    memory: ImageMemory,
+    name: String,
+    replaced: Option<StaleSegment>,
+}
+
+impl core::fmt::Debug for CncSegment {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("CncSegment")
+            .field("name", &self.name)
+            .finish()
+    }
+}
+
+impl CncSegment {
+    /// Creates the segment of `instance` for `channels` channels and `axes` axes. A segment
+    /// left behind by a crashed CNC is replaced; one whose owner is alive is refused.
+    pub fn create(instance: &str, channels: u32, axes: u32) -> Result<Self, CreateError> {
+        let name = segment_name(instance).ok_or_else(|| CreateError::InvalidName {
+            name: instance.to_string(),
+        })?;
+        for (what, requested, capacity) in [
+            ("channel", channels, HLI_MAX_CHANNELS),
+            ("axis", axes, HLI_MAX_AXES),
+        ] {
+            if requested as usize > capacity {
+                return Err(CreateError::TooMany {
+                    what,
+                    requested,
+                    capacity: capacity as u32,
+                });
+            }
+        }
+        let fname = file_name(&name);
+        let mut replaced = None;
+        let shm = match Self::create_exclusive(&fname) {
+            Ok(shm) => shm,
+            Err(SharedMemoryCreationError::AlreadyExist) => {
+                let stale = Self::inspect_existing(&fname, &name)?;
+                SharedMemory::remove(&fname).map_err(|e| CreateError::Os {
+                    name: name.clone(),
+                    reason: format!("removing stale segment: {e:?}"),
+                })?;
+                replaced = Some(stale);
+                Self::create_exclusive(&fname).map_err(|e| CreateError::Os {
+                    name: name.clone(),
+                    reason: format!("{e:?}"),
+                })?
+            }
+            Err(e) => {
+                return Err(CreateError::Os {
+                    name,
+                    reason: format!("{e:?}"),
+                })
+            }
+        };
+        let segment = Self {
+            memory: ImageMemory::shared(shm),
+            name,
+            replaced,
+        };
+        segment.write_header(channels, axes);
+        Ok(segment)
+    }
+
+    fn create_exclusive(fname: &FileName) -> Result<SharedMemory, SharedMemoryCreationError> {
+        SharedMemoryBuilder::new(fname)
+            .is_memory_locked(false)
+            .creation_mode(CreationMode::CreateExclusive)
+            .size(IMAGE_SIZE)
+            .permission(Permission::OWNER_READ_WRITE)
+            .zero_memory(true)
+            .create()
+    }
+
+    /// Decides whether an existing object may be replaced: only when no live CNC owns it.
+    fn inspect_existing(fname: &FileName, name: &str) -> Result<StaleSegment, CreateError> {
+        let Ok(shm) = SharedMemoryBuilder::new(fname)
+            .is_memory_locked(false)
+            .open_existing(AccessMode::ReadWrite)
+        else {
+            return Ok(StaleSegment { pid: 0 });
+        };
+        if shm.size() < HEADER_SIZE {
+            return Ok(StaleSegment { pid: 0 });
+        }
+        let memory = ImageMemory::shared(shm);
+        let header: HliSegmentHeader = memory.place::<HliSegmentHeader>(0).read();
+        drop(memory); // unmaps; an opened (not created) object is not unlinked
+        let owner_alive = header.magic == SEGMENT_MAGIC
+            && header.segment_state != SegmentState::Closed.raw()
+            && process_start_stamp(header.cnc_pid) == Some(header.cnc_start_stamp);
+        if owner_alive {
+            return Err(CreateError::InUse {
+                name: name.to_string(),
+                pid: header.cnc_pid,
+            });
+        }
+        Ok(StaleSegment {
+            pid: header.cnc_pid,
+        })
+    }
+
+    fn write_header(&self, channels: u32, axes: u32) {
+        let identity = LayoutIdentity::current();
+        let pid = std::process::id();
+        let header = self.header();
+        header.write(&HliSegmentHeader {
+            magic: SEGMENT_MAGIC,
+            layout_version: identity.version,
+            header_size: HEADER_SIZE as u32,
+            layout_hash: identity.hash,
+            image_size: identity.size,
+            channel_count: channels,
+            axis_count: axes,
+            cnc_pid: pid,
+            segment_state: SegmentState::Initialising.raw(),
+            cnc_start_stamp: process_start_stamp(pid).unwrap_or(0),
+            ..bytemuck::Zeroable::zeroed()
+        });
+        header
+            .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
+            .store_release(SegmentState::Ready.raw());
+    }
+
+    /// The segment's shared-memory name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// The stale segment this one replaced, if any.
+    pub fn replaced_stale(&self) -> Option<StaleSegment> {
+        self.replaced
+    }
+
+    /// The whole image.
+    pub fn image(&self) -> Place<'_, HliImage> {
+        self.memory.place(0)
+    }
+
+    /// The header.
+    pub fn header(&self) -> Place<'_, HliSegmentHeader> {
+        self.memory.place(0)
+    }
+
+    /// The raw memory (symbol-table access, snapshots).
+    pub fn memory(&self) -> &ImageMemory {
+        &self.memory
+    }
+
+    /// Marks one more CNC tick; returns the new heartbeat.
+    pub fn beat(&self) -> u64 {
+        self.header()
+            .field::<u64>(offset_of!(HliSegmentHeader, cnc_heartbeat))
+            .increment()
+    }
+
+    /// The PLC's heartbeat.
+    pub fn plc_heartbeat(&self) -> u64 {
+        self.header()
+            .field::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat))
+            .load_acquire()
+    }
+
+    /// Size of the mapping in bytes.
+    pub fn mapped_size(&self) -> usize {
+        self.memory.len()
+    }
+}
+
+impl Drop for CncSegment {
+    fn drop(&mut self) {
+        self.header()
+            .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
+            .store_release(SegmentState::Closed.raw());
+        // `memory` owns the object and unlinks it when dropped.
+    }
+}
+
+/// The PLC's side: an attached segment, validated against this build's layout.
+pub struct PlcSegment {
+    memory: ImageMemory,
+    name: String,
+    channels: u32,
+    axes: u32,
+}
+
+impl core::fmt::Debug for PlcSegment {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PlcSegment")
+            .field("name", &self.name)
+            .finish()
+    }
+}
+
+impl PlcSegment {
+    /// Attaches to the segment of `instance`, which must match this build's layout.
+    pub fn attach(instance: &str) -> Result<Self, AttachError> {
+        Self::attach_expecting(instance, LayoutIdentity::current())
+    }
+
+    /// Attaches expecting `expected` (a PLC built against another layout passes its own).
+    pub fn attach_expecting(instance: &str, expected: LayoutIdentity) -> Result<Self, AttachError> {
+        let name = segment_name(instance).ok_or_else(|| AttachError::InvalidName {
+            name: instance.to_string(),
+        })?;
+        let shm = match SharedMemoryBuilder::new(&file_name(&name))
+            .is_memory_locked(false)
+            .open_existing(AccessMode::ReadWrite)
+        {
+            Ok(shm) => shm,
+            Err(SharedMemoryCreationError::DoesNotExist) => {
+                return Err(AttachError::NotFound { name })
+            }
+            Err(e) => {
+                return Err(AttachError::Os {
+                    name,
+                    reason: format!("{e:?}"),
+                })
+            }
+        };
+        let found = shm.size() as u64;
+        if found < HEADER_SIZE as u64 {
+            return Err(AttachError::Truncated {
+                name,
+                expected: expected.size,
+                found,
+            });
+        }
+        let memory = ImageMemory::shared(shm);
+        let header = memory.place::<HliSegmentHeader>(0);
+        let state = header
+            .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
+            .load_acquire();
+        let h: HliSegmentHeader = header.read();
+        if h.magic != SEGMENT_MAGIC {
+            return Err(AttachError::BadMagic {
+                name,
+                cnc: h.magic,
+                plc: SEGMENT_MAGIC,
+            });
+        }
+        if state != SegmentState::Ready.raw() {
+            return Err(AttachError::NotReady { name, state });
+        }
+        if h.layout_version != expected.version {
+            return Err(AttachError::VersionMismatch {
+                cnc: h.layout_version,
+                plc: expected.version,
+            });
+        }
+        if h.image_size != expected.size {
+            return Err(AttachError::SizeMismatch {
+                cnc: h.image_size,
+                plc: expected.size,
+            });
+        }
+        if h.layout_hash != expected.hash {
+            return Err(AttachError::LayoutMismatch {
+                cnc: h.layout_hash,
+                plc: expected.hash,
+            });
+        }
+        if found < expected.size || expected.size < IMAGE_SIZE as u64 {
+            return Err(AttachError::Truncated {
+                name,
+                expected: expected.size,
+                found,
+            });
+        }
+        if h.channel_count as usize > HLI_MAX_CHANNELS || h.axis_count as usize > HLI_MAX_AXES {
+            return Err(AttachError::InvalidCounts {
+                channels: h.channel_count,
+                axes: h.axis_count,
+            });
+        }
+        header
+            .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
+            .store(std::process::id());
+        Ok(Self {
+            memory,
+            name,
+            channels: h.channel_count,
+            axes: h.axis_count,
+        })
+    }
+
+    /// The whole image.
+    pub fn image(&self) -> Place<'_, HliImage> {
+        self.memory.place(0)
+    }
+
+    /// The header.
+    pub fn header(&self) -> Place<'_, HliSegmentHeader> {
+        self.memory.place(0)
+    }
+
+    /// The raw memory.
+    pub fn memory(&self) -> &ImageMemory {
+        &self.memory
+    }
+
+    /// Channels the CNC configured.
+    pub fn channel_count(&self) -> u32 {
+        self.channels
+    }
+
+    /// Axes the CNC configured.
+    pub fn axis_count(&self) -> u32 {
+        self.axes
+    }
+
+    /// Marks one more PLC cycle; returns the new heartbeat.
+    pub fn beat(&self) -> u64 {
+        self.header()
+            .field::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat))
+            .increment()
+    }
+
+    /// The CNC's heartbeat.
+    pub fn cnc_heartbeat(&self) -> u64 {
+        self.header()
+            .field::<u64>(offset_of!(HliSegmentHeader, cnc_heartbeat))
+            .load_acquire()
+    }
+
+    /// The CNC's segment state (`Closed` after an orderly shutdown).
+    pub fn cnc_state(&self) -> Result<SegmentState, crate::enums::InvalidValue> {
+        SegmentState::decode(
+            self.header()
+                .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
+                .load_acquire(),
+        )
+    }
+
+    /// Whether the CNC process that created the segment still runs.
+    pub fn cnc_process_alive(&self) -> bool {
+        let h: HliSegmentHeader = self.header().read();
+        process_start_stamp(h.cnc_pid) == Some(h.cnc_start_stamp)
+    }
+}
+
+/// Watches a peer's heartbeat from one's own cycle: the peer is lost when its counter has not
+/// moved for `limit` consecutive observations. No clocks, no sleeps: the observer's own cycle
+/// is the time base.
+#[derive(Debug, Clone)]
+pub struct HeartbeatWatch {
+    last: Option<u64>,
+    unchanged: u32,
+    limit: u32,
+}
+
+/// Verdict of a [`HeartbeatWatch`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PeerLiveness {
+    /// The counter moved recently.
+    Alive,
+    /// The counter has not moved yet since the watch started.
+    NotStarted,
+    /// The counter stood still for `limit` observations.
+    Lost,
+}
+
+impl HeartbeatWatch {
+    /// A watch that declares the peer lost after `limit` unchanged observations.
+    pub fn new(limit: u32) -> Self {
+        Self {
+            last: None,
+            unchanged: 0,
+            limit: limit.max(1),
+        }
+    }
+
+    /// Feeds the current heartbeat value.
+    pub fn observe(&mut self, value: u64) -> PeerLiveness {
+        match self.last {
+            Some(last) if last == value => {
+                self.unchanged = self.unchanged.saturating_add(1);
+            }
+            Some(_) => self.unchanged = 0,
+            None => {
+                self.last = Some(value);
+                return PeerLiveness::NotStarted;
+            }
+        }
+        self.last = Some(value);
+        if self.unchanged >= self.limit {
+            PeerLiveness::Lost
+        } else {
+            PeerLiveness::Alive
+        }
+    }
+}
+
+/// A heap-backed image with a valid header, for in-process mode and unit tests.
+pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
+    let memory = ImageMemory::heap(IMAGE_SIZE);
+    let identity = LayoutIdentity::current();
+    memory.place::<HliSegmentHeader>(0).write(&HliSegmentHeader {
+        magic: SEGMENT_MAGIC,
+        layout_version: identity.version,
+        header_size: HEADER_SIZE as u32,
+        layout_hash: identity.hash,
+        image_size: identity.size,
+        channel_count: channels,
+        axis_count: axes,
+        cnc_pid: std::process::id(),
+        segment_state: SegmentState::Ready.raw(),
+        ..bytemuck::Zeroable::zeroed()
+    });
+    memory
+}
+
+const _: () = assert!(IMAGE_SIZE % 8 == 0);
+#[allow(dead_code)]
+fn _assert_image_type_is_described() -> crate::desc::TypeDesc {
+    HliImage::desc()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn heartbeat_watch_declares_loss_after_limit() {
+        let mut w = HeartbeatWatch::new(3);
+        assert_eq!(w.observe(5), PeerLiveness::NotStarted);
+        assert_eq!(w.observe(6), PeerLiveness::Alive);
+        assert_eq!(w.observe(6), PeerLiveness::Alive);
+        assert_eq!(w.observe(6), PeerLiveness::Alive);
+        assert_eq!(w.observe(6), PeerLiveness::Lost);
+        assert_eq!(w.observe(7), PeerLiveness::Alive);
+    }
+
+    #[test]
+    fn names_are_checked() {
+        assert_eq!(segment_name("demo-1").as_deref(), Some("cncplc_demo-1.hli"));
+        assert!(segment_name("").is_none());
+        assert!(segment_name("a/b").is_none());
+        assert!(segment_name(&"x".repeat(49)).is_none());
+    }
+
+    #[test]
+    fn own_process_has_a_start_stamp() {
+        assert!(process_start_stamp(std::process::id()).is_some());
+        assert!(process_start_stamp(u32::MAX).is_none());
+    }
+}

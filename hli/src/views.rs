@@ -1,0 +1,364 @@
+//! Side-typed views of an image. The CNC's view hands out the reading end of commands and the
+//! writing end of requests; the PLC's view the opposite. A handle of the wrong direction cannot
+//! be obtained, so the protocol's direction is checked by the compiler:
+//!
+//! ```compile_fail
+//! # let mem = hli::segment::heap_image(1, 0);
+//! let cnc = hli::views::CncView::new(&mem);
+//! // The CNC consumes dyn-CS commands; it cannot get their writing end.
+//! let sender: hli::handshake::Writer<'_, hli::layout::HliCoordinateSystemInt> =
+//!     cnc.dyn_cs_command(0).unwrap();
+//! ```
+//!
+//! Indices are checked against the counts in the segment header: an out-of-range channel or
+//! axis is an [`IndexError`], never an access outside the configured part of the image.
+
+use crate::desc::{Bool, PlaceExt};
+use crate::enums::{DynCsState, InvalidValue};
+use crate::handshake::{Reader, TransitionReader, TransitionWriter, Writer};
+use crate::layout::*;
+use crate::raw::{ImageMemory, Place};
+use core::mem::offset_of;
+
+/// A channel or axis index outside the configured range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("{what} index {index} out of range (configured: {count})")]
+pub struct IndexError {
+    /// "channel", "axis" or "FIFO group".
+    pub what: &'static str,
+    /// The index given.
+    pub index: usize,
+    /// How many are configured.
+    pub count: usize,
+}
+
+/// Navigation shared by both views.
+#[derive(Debug, Clone, Copy)]
+struct Nav<'m> {
+    image: Place<'m, HliImage>,
+    channels: usize,
+    axes: usize,
+}
+
+impl<'m> Nav<'m> {
+    fn new(memory: &'m ImageMemory) -> Self {
+        let image = memory.place::<HliImage>(0);
+        let header = image.field::<HliSegmentHeader>(offset_of!(HliImage, header));
+        let channels = header
+            .field::<u32>(offset_of!(HliSegmentHeader, channel_count))
+            .load() as usize;
+        let axes = header
+            .field::<u32>(offset_of!(HliSegmentHeader, axis_count))
+            .load() as usize;
+        Self {
+            image,
+            channels: channels.min(HLI_MAX_CHANNELS),
+            axes: axes.min(HLI_MAX_AXES),
+        }
+    }
+
+    fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
+        if index >= self.channels {
+            return Err(IndexError {
+                what: "channel",
+                index,
+                count: self.channels,
+            });
+        }
+        Ok(self
+            .image
+            .field::<[HliChannel; HLI_MAX_CHANNELS]>(offset_of!(HliImage, gpCh))
+            .at(index))
+    }
+
+    fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
+        if index >= self.axes {
+            return Err(IndexError {
+                what: "axis",
+                index,
+                count: self.axes,
+            });
+        }
+        Ok(self
+            .image
+            .field::<[HliAxis; HLI_MAX_AXES]>(offset_of!(HliImage, gpAx))
+            .at(index))
+    }
+
+    fn fifo_group(&self, index: usize) -> Result<Place<'m, HliFifoGroupState>, IndexError> {
+        self.image
+            .field::<[HliFifoGroupState; HLI_MAX_FIFO_GROUPS]>(offset_of!(HliImage, gpFifo))
+            .get(index)
+            .ok_or(IndexError {
+                what: "FIFO group",
+                index,
+                count: HLI_MAX_FIFO_GROUPS,
+            })
+    }
+
+    fn dyn_cs(&self, channel: usize) -> Result<Place<'m, McControlDynCsUnit>, IndexError> {
+        Ok(self
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field(offset_of!(HliChannelMcControl, dyn_cs)))
+    }
+
+    fn m_function(&self, channel: usize) -> Result<Place<'m, HliMFunctionUnit>, IndexError> {
+        Ok(self
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field(offset_of!(HliChannelMcControl, m_function)))
+    }
+}
+
+macro_rules! unit_field {
+    ($unit:expr, $ty:ty, $field:ident) => {
+        $unit.field::<_>(offset_of!($ty, $field))
+    };
+}
+
+/// The CNC's view of an image.
+#[derive(Debug, Clone, Copy)]
+pub struct CncView<'m> {
+    nav: Nav<'m>,
+}
+
+impl<'m> CncView<'m> {
+    /// View of `memory` (a segment's or a heap image).
+    pub fn new(memory: &'m ImageMemory) -> Self {
+        Self {
+            nav: Nav::new(memory),
+        }
+    }
+
+    /// Configured channels.
+    pub fn channel_count(&self) -> usize {
+        self.nav.channels
+    }
+
+    /// Configured axes.
+    pub fn axis_count(&self) -> usize {
+        self.nav.axes
+    }
+
+    /// Channel block `gpCh[index]^`.
+    pub fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
+        self.nav.channel(index)
+    }
+
+    /// Axis block `gpAx[index]^`.
+    pub fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
+        self.nav.axis(index)
+    }
+
+    /// FIFO group status `gpFifo[index]^`.
+    pub fn fifo_group(&self, index: usize) -> Result<Place<'m, HliFifoGroupState>, IndexError> {
+        self.nav.fifo_group(index)
+    }
+
+    /// The dynamic-CS unit of a channel (for values without a handshake).
+    pub fn dyn_cs_unit(&self, channel: usize) -> Result<Place<'m, McControlDynCsUnit>, IndexError> {
+        self.nav.dyn_cs(channel)
+    }
+
+    /// Consumes `command_w` (command pattern).
+    pub fn dyn_cs_command(
+        &self,
+        channel: usize,
+    ) -> Result<Reader<'m, HliCoordinateSystemInt>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(Reader::new(
+            unit_field!(unit, McControlDynCsUnit, command_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, command_w),
+        ))
+    }
+
+    /// Publishes `request_r` (request pattern).
+    pub fn dyn_cs_request(
+        &self,
+        channel: usize,
+    ) -> Result<Writer<'m, HliCoordinateSystemInt>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(Writer::new(
+            unit_field!(unit, McControlDynCsUnit, request_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, request_r),
+        ))
+    }
+
+    /// Takes `transition_w`.
+    pub fn dyn_cs_transition(&self, channel: usize) -> Result<TransitionReader<'m>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(TransitionReader::new(unit_field!(
+            unit,
+            McControlDynCsUnit,
+            transition_w
+        )))
+    }
+
+    /// Whether the PLC took over the unit (`enable_w`); `Err(raw)` for a garbage byte.
+    pub fn dyn_cs_enabled(&self, channel: usize) -> Result<Result<bool, u8>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        let raw = unit
+            .field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
+            .cast::<u8>()
+            .load_acquire();
+        Ok(Bool(raw).get())
+    }
+
+    /// Reports the tracking state in `state_r`.
+    pub fn set_dyn_cs_state(&self, channel: usize, state: DynCsState) -> Result<(), IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        unit
+            .field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
+            .field::<u32>(offset_of!(HliDynCsState, actual_state))
+            .store_release(state.raw());
+        Ok(())
+    }
+
+    /// Announces M functions (request pattern).
+    pub fn m_function_request(
+        &self,
+        channel: usize,
+    ) -> Result<Writer<'m, HliMFunctionRequest>, IndexError> {
+        let unit = self.nav.m_function(channel)?;
+        Ok(Writer::new(
+            unit_field!(unit, HliMFunctionUnit, request_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, request_r),
+        ))
+    }
+
+    /// Takes M-function acknowledges (command pattern).
+    pub fn m_function_ack(
+        &self,
+        channel: usize,
+    ) -> Result<Reader<'m, HliMFunctionAck>, IndexError> {
+        let unit = self.nav.m_function(channel)?;
+        Ok(Reader::new(
+            unit_field!(unit, HliMFunctionUnit, ack_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, ack_w),
+        ))
+    }
+}
+
+/// The PLC's view of an image.
+#[derive(Debug, Clone, Copy)]
+pub struct PlcView<'m> {
+    nav: Nav<'m>,
+}
+
+impl<'m> PlcView<'m> {
+    /// View of `memory`.
+    pub fn new(memory: &'m ImageMemory) -> Self {
+        Self {
+            nav: Nav::new(memory),
+        }
+    }
+
+    /// Configured channels.
+    pub fn channel_count(&self) -> usize {
+        self.nav.channels
+    }
+
+    /// Configured axes.
+    pub fn axis_count(&self) -> usize {
+        self.nav.axes
+    }
+
+    /// Channel block `gpCh[index]^` (read its `_r` values; write only `_w` values).
+    pub fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
+        self.nav.channel(index)
+    }
+
+    /// Axis block `gpAx[index]^`.
+    pub fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
+        self.nav.axis(index)
+    }
+
+    /// Writes `command_w` (command pattern).
+    pub fn dyn_cs_command(
+        &self,
+        channel: usize,
+    ) -> Result<Writer<'m, HliCoordinateSystemInt>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(Writer::new(
+            unit_field!(unit, McControlDynCsUnit, command_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, command_w),
+        ))
+    }
+
+    /// Reads `request_r` (request pattern).
+    pub fn dyn_cs_request(
+        &self,
+        channel: usize,
+    ) -> Result<Reader<'m, HliCoordinateSystemInt>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(Reader::new(
+            unit_field!(unit, McControlDynCsUnit, request_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, request_r),
+        ))
+    }
+
+    /// Writes `transition_w`.
+    pub fn dyn_cs_transition(&self, channel: usize) -> Result<TransitionWriter<'m>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        Ok(TransitionWriter::new(unit_field!(
+            unit,
+            McControlDynCsUnit,
+            transition_w
+        )))
+    }
+
+    /// Takes over (or releases) the unit: `enable_w`.
+    pub fn set_dyn_cs_enabled(&self, channel: usize, enabled: bool) -> Result<(), IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        unit
+            .field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
+            .cast::<u8>()
+            .store_release(u8::from(enabled));
+        Ok(())
+    }
+
+    /// The tracking state `state_r`, validated.
+    pub fn dyn_cs_state(
+        &self,
+        channel: usize,
+    ) -> Result<Result<DynCsState, InvalidValue>, IndexError> {
+        let unit = self.nav.dyn_cs(channel)?;
+        let raw = unit
+            .field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
+            .field::<u32>(offset_of!(HliDynCsState, actual_state))
+            .load_acquire();
+        Ok(DynCsState::decode(raw))
+    }
+
+    /// Reads M-function announcements (request pattern).
+    pub fn m_function_request(
+        &self,
+        channel: usize,
+    ) -> Result<Reader<'m, HliMFunctionRequest>, IndexError> {
+        let unit = self.nav.m_function(channel)?;
+        Ok(Reader::new(
+            unit_field!(unit, HliMFunctionUnit, request_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, request_r),
+        ))
+    }
+
+    /// Acknowledges M functions (command pattern).
+    pub fn m_function_ack(&self, channel: usize) -> Result<Writer<'m, HliMFunctionAck>, IndexError> {
+        let unit = self.nav.m_function(channel)?;
+        Ok(Writer::new(
+            unit_field!(unit, HliMFunctionUnit, ack_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, ack_w),
+        ))
+    }
+
+    /// The axis cyclic state, copied out.
+    pub fn axis_state(&self, axis: usize) -> Result<HliAxisLrState, IndexError> {
+        Ok(self
+            .nav
+            .axis(axis)?
+            .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
+            .read())
+    }
+}
+
