@@ -1,0 +1,52 @@
+//! The cyclic operations of the HLI (handshakes, heartbeats, views) allocate nothing.
+
+use hli::segment::heap_image;
+use hli::views::{CncView, PlcView};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn handshake_cycle_does_not_allocate() {
+    let mem = heap_image(2, 4);
+    let cnc = CncView::new(&mem);
+    let plc = PlcView::new(&mem);
+    let tx = plc.dyn_cs_command(1).unwrap();
+    let mut rx = cnc.dyn_cs_command(1).unwrap();
+    let req_tx = cnc.dyn_cs_request(1).unwrap();
+    let mut req_rx = plc.dyn_cs_request(1).unwrap();
+    let mut payload: hli::layout::HliCoordinateSystemInt = bytemuck::Zeroable::zeroed();
+
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    for i in 0..10_000 {
+        payload.translation[0] = i;
+        tx.try_send(&payload).unwrap();
+        let got = rx.try_take().unwrap().unwrap();
+        req_tx.try_send(&got).unwrap();
+        let back = req_rx.try_take().unwrap().unwrap();
+        assert_eq!(back.translation[0], i);
+        let _ = cnc.set_dyn_cs_state(1, hli::enums::DynCsState::Active);
+        let _ = plc.dyn_cs_state(1).unwrap().unwrap();
+        let _ = plc.axis_state(3).unwrap();
+    }
+    let after = ALLOCATIONS.load(Ordering::Relaxed);
+    assert_eq!(after - before, 0, "allocations in the handshake cycle");
+}
