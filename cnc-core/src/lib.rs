@@ -1,1 +1,5 @@
-//! placeholder
+//! The CNC process. This first version holds the cyclic HLI demo (`cnc demo`) and the HLI
+//! tooling (`cnc hli symbols`, `cnc hli header`); channels, interpolation and axes follow.
+
+pub mod demo;
+pub mod stats;

@@ -26,3 +26,9 @@ pub mod views;
 
 pub use desc::{Bool, HliType, PlaceExt, Writer as SymbolWriter};
 pub use raw::{ImageMemory, Place};
+
+/// Quiets iceoryx2's own logging to errors unless `IOX2_LOG_LEVEL` says otherwise (it warns
+/// about running without a config file, which is our normal case). Call once at start-up.
+pub fn init_logging() {
+    iceoryx2::prelude::set_log_level_from_env_or(iceoryx2::prelude::LogLevel::Error);
+}

@@ -1,1 +1,9 @@
-//! placeholder
+//! The PLC process: attaches to a CNC's HLI segment and runs a PLC program once per cycle,
+//! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
+//! the acyclic request-response service.
+
+pub mod cli;
+pub mod programs;
+pub mod runtime;
+
+pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

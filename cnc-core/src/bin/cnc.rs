@@ -1,0 +1,62 @@
+//! The `cnc` binary.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Debug, Parser)]
+#[command(name = "cnc", about = "CNC process of the CNC/PLC runtime", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the demo: CNC and a spawned PLC process exchanging control units.
+    Demo(cnc_core::demo::DemoArgs),
+    /// HLI tooling.
+    Hli {
+        #[command(subcommand)]
+        what: HliCommand,
+    },
+    /// Run the PLC process (what `cnc demo` spawns; same as the `plc` binary).
+    #[command(hide = true)]
+    Plc(plc_shim::cli::PlcArgs),
+}
+
+#[derive(Debug, Subcommand)]
+enum HliCommand {
+    /// Print the symbol table: PATH OFFSET SIZE TYPE WRITER, one line per node and leaf.
+    Symbols,
+    /// Print a C header of the whole image (sizes and offsets asserted).
+    Header,
+}
+
+fn main() -> ExitCode {
+    hli::init_logging();
+    match Cli::parse().command {
+        Command::Demo(args) => cnc_core::demo::main(args),
+        Command::Hli { what } => {
+            let text = match what {
+                HliCommand::Symbols => hli::symbols::format_table(hli::symbols::SymbolTable::global()),
+                HliCommand::Header => hli::c_header::generate(),
+            };
+            print_or_fail(&text)
+        }
+        Command::Plc(args) => plc_shim::cli::main(args),
+    }
+}
+
+/// Prints `text`; a closed pipe (`cnc hli symbols | head`) is not an error worth a panic.
+fn print_or_fail(text: &str) -> ExitCode {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("cnc: {e}");
+            ExitCode::from(1)
+        }
+    }
+}

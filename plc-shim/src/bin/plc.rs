@@ -1,0 +1,9 @@
+//! The `plc` binary: attaches to a running CNC instance and runs a built-in PLC program.
+
+use clap::Parser;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    hli::init_logging();
+    plc_shim::cli::main(plc_shim::cli::PlcArgs::parse())
+}

@@ -1,0 +1,61 @@
+//! Command line of the PLC process, shared by the `plc` binary and `cnc plc` (which the
+//! demo spawns, so that the single `cargo run -p cnc-core` builds everything it needs).
+
+use crate::programs::RotaryTableMaster;
+use crate::runtime::{PlcProgram, PlcRuntime};
+use core::time::Duration;
+use std::process::ExitCode;
+
+/// Arguments of the PLC process.
+#[derive(Debug, Clone, clap::Parser)]
+#[command(name = "plc", about = "PLC process attached to a CNC's HLI segment")]
+pub struct PlcArgs {
+    /// CNC instance to attach to.
+    #[arg(long)]
+    pub instance: String,
+    /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0).
+    #[arg(long, default_value = "rotary-table")]
+    pub program: String,
+    /// Table speed of `rotary-table`, degree per cycle.
+    #[arg(long, default_value_t = 0.01)]
+    pub deg_per_cycle: f64,
+    /// Watchdog: wait steps of 10 ms without a CNC heartbeat before the CNC counts as lost.
+    #[arg(long, default_value_t = 100)]
+    pub watchdog_cycles: u32,
+    /// Stop after this many cycles.
+    #[arg(long)]
+    pub max_cycles: Option<u64>,
+}
+
+/// Runs the PLC process; exit code 0 when the CNC closed in order.
+pub fn main(args: PlcArgs) -> ExitCode {
+    let mut program: Box<dyn PlcProgram> = match args.program.as_str() {
+        "rotary-table" => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
+        other => {
+            eprintln!("plc: unknown program {other:?} (known: rotary-table)");
+            return ExitCode::from(2);
+        }
+    };
+    let mut runtime =
+        match PlcRuntime::attach(&args.instance, args.watchdog_cycles, Duration::from_millis(10)) {
+            Ok(runtime) => runtime,
+            Err(e) => {
+                eprintln!("plc: {e}");
+                return ExitCode::from(1);
+            }
+        };
+    match runtime.run(program.as_mut(), args.max_cycles) {
+        Ok(summary) => {
+            println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);
+            println!("{}", program.summary());
+            match summary.end {
+                crate::runtime::RunEnd::CncLost => ExitCode::from(3),
+                _ => ExitCode::SUCCESS,
+            }
+        }
+        Err(e) => {
+            eprintln!("plc: {e}");
+            ExitCode::from(1)
+        }
+    }
+}

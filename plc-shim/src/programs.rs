@@ -1,0 +1,152 @@
+//! Example PLC programs.
+
+use crate::runtime::{PlcIo, PlcProgram};
+use core::time::Duration;
+use hli::enums::{DynCsCommand, DynCsState};
+use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition, HliMFunctionAck};
+use hli::rpc::ReadAxisState;
+use hli::units::deg_to_hli;
+use hli::Bool;
+
+/// The PLC as master of a dynamic coordinate system: a rotary table turning at a constant
+/// speed (the seed's example 4, PLC-only variant). Every cycle it commands the table frame
+/// through `MC_CONTROL_DYN_CS_UNIT.command_w`, switches tracking on through `transition_w`,
+/// reads back `request_r`, acknowledges M functions and reads the table axis acyclically.
+#[derive(Debug, Default)]
+pub struct RotaryTableMaster {
+    /// Channel whose unit the PLC drives.
+    pub channel: usize,
+    /// Table speed, degree per PLC cycle.
+    pub deg_per_cycle: f64,
+    /// Filter ticks sent with the activation.
+    pub filter_ticks: u32,
+    /// Commands the CNC consumed (sent while free).
+    pub commands_sent: u64,
+    /// Commands refused because the previous one was pending.
+    pub commands_busy: u64,
+    /// Requests read back.
+    pub requests_read: u64,
+    /// Transitions sent.
+    pub transitions_sent: u64,
+    /// M functions acknowledged.
+    pub m_functions_acked: u64,
+    /// Acyclic axis reads answered.
+    pub acyclic_replies: u64,
+    /// Acyclic calls that failed.
+    pub acyclic_errors: u64,
+    /// Protocol or decoding problems seen.
+    pub errors: u64,
+    /// Last tracking state seen.
+    pub last_state: Option<DynCsState>,
+    pending_ack: Option<HliMFunctionAck>,
+}
+
+impl RotaryTableMaster {
+    /// A table on `channel` turning `deg_per_cycle` per cycle.
+    pub fn new(channel: usize, deg_per_cycle: f64, filter_ticks: u32) -> Self {
+        Self {
+            channel,
+            deg_per_cycle,
+            filter_ticks,
+            ..Self::default()
+        }
+    }
+}
+
+impl PlcProgram for RotaryTableMaster {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let view = io.view;
+        let ch = self.channel;
+        if io.cycle == 0 && view.set_dyn_cs_enabled(ch, true).is_err() {
+            self.errors += 1;
+            return;
+        }
+        // The table frame: rotation about Z, wrapped to one turn.
+        let angle = (io.cycle as f64 * self.deg_per_cycle) % 360.0;
+        let frame = HliCoordinateSystemInt {
+            translation: [0; 3],
+            fill_up_2: 0,
+            rotation: [0, 0, deg_to_hli(angle).unwrap_or(0)],
+            fill_up_1: 0,
+        };
+        match view.dyn_cs_command(ch).map(|tx| tx.try_send(&frame)) {
+            Ok(Ok(())) => self.commands_sent += 1,
+            Ok(Err(hli::handshake::SendError::Busy)) => self.commands_busy += 1,
+            _ => self.errors += 1,
+        }
+        if io.cycle == 1 {
+            let params = HliDynCsTransition {
+                command: 0,
+                filter_max_ticks: self.filter_ticks,
+                option: 0,
+                f_wait: Bool::FALSE,
+                f_set_zero: Bool::FALSE,
+                f_kin_base: Bool::FALSE,
+                f_rot_trans: Bool::FALSE,
+                kinematic_base_cs: bytemuck::Zeroable::zeroed(),
+            };
+            match view
+                .dyn_cs_transition(ch)
+                .map(|tx| tx.try_send(DynCsCommand::Activate, &params))
+            {
+                Ok(Ok(())) => self.transitions_sent += 1,
+                _ => self.errors += 1,
+            }
+        }
+        if let Ok(mut rx) = view.dyn_cs_request(ch) {
+            match rx.try_take() {
+                Ok(Some(_)) => self.requests_read += 1,
+                Ok(None) => {}
+                Err(_) => self.errors += 1,
+            }
+        }
+        match view.dyn_cs_state(ch) {
+            Ok(Ok(state)) => self.last_state = Some(state),
+            _ => self.errors += 1,
+        }
+        // M functions: read the announcement, acknowledge it (possibly a later cycle).
+        if let Ok(mut rx) = view.m_function_request(ch) {
+            match rx.try_take() {
+                Ok(Some(request)) => {
+                    self.pending_ack = Some(HliMFunctionAck {
+                        m_code: request.m_code,
+                        request_id: request.request_id,
+                    })
+                }
+                Ok(None) => {}
+                Err(_) => self.errors += 1,
+            }
+        }
+        if let Some(ack) = self.pending_ack {
+            if let Ok(Ok(())) = view.m_function_ack(ch).map(|tx| tx.try_send(&ack)) {
+                self.pending_ack = None;
+                self.m_functions_acked += 1;
+            }
+        }
+        // Acyclic read of the table axis now and then (waits for the CNC's next tick).
+        if io.cycle % 500 == 250 && view.axis_count() > 0 {
+            match io
+                .acyclic
+                .call(0, &ReadAxisState::default(), Duration::from_millis(200))
+            {
+                Ok(_) => self.acyclic_replies += 1,
+                Err(_) => self.acyclic_errors += 1,
+            }
+        }
+    }
+
+    fn summary(&self) -> String {
+        format!(
+            "plc: commands {} (busy {}), requests read {}, transitions {}, M acks {}, acyclic replies {} (errors {}), protocol errors {}, last state {:?}",
+            self.commands_sent,
+            self.commands_busy,
+            self.requests_read,
+            self.transitions_sent,
+            self.m_functions_acked,
+            self.acyclic_replies,
+            self.acyclic_errors,
+            self.errors,
+            self.last_state
+        )
+    }
+}
