@@ -606,6 +606,27 @@ impl HeartbeatWatch {
     }
 }
 
+/// Creates a zeroed shared-memory object of `size` bytes under the full object `name`
+/// (see [`segment_name`]), owned by the result. For tests and tools that need what a foreign
+/// or broken program would leave behind (truncated objects, wrong magic).
+pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateError> {
+    let fname = FileName::new(name.as_bytes()).map_err(|_| CreateError::InvalidName {
+        name: name.to_string(),
+    })?;
+    SharedMemoryBuilder::new(&fname)
+        .is_memory_locked(false)
+        .creation_mode(CreationMode::PurgeAndCreate)
+        .size(size)
+        .permission(Permission::OWNER_READ_WRITE)
+        .zero_memory(true)
+        .create()
+        .map(ImageMemory::shared)
+        .map_err(|e| CreateError::Os {
+            name: name.to_string(),
+            reason: format!("{e:?}"),
+        })
+}
+
 /// A heap-backed image with a valid header, for in-process mode and unit tests.
 pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
     let memory = ImageMemory::heap(IMAGE_SIZE);

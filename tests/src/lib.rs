@@ -1,1 +1,74 @@
-//! placeholder
+//! Shared helpers of the integration tests: unique instance names, payloads with checksums,
+//! and a watchdog for child processes. Nothing here is used by production code.
+
+use hli::layout::HliCoordinateSystemInt;
+use std::process::Child;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// A shared-memory instance name no other test (or test run) uses.
+pub fn unique_instance(test: &str) -> String {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    format!(
+        "t{}-{}-{}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed),
+        test
+    )
+}
+
+/// A payload carrying `seq` and a checksum over it (in `fill_up_1`).
+pub fn payload(seq: u32) -> HliCoordinateSystemInt {
+    let s = seq as i32;
+    let mut p = HliCoordinateSystemInt {
+        translation: [s, s.wrapping_mul(-3), s ^ 0x0F0F_0F0F],
+        fill_up_2: 0,
+        rotation: [s.wrapping_add(17), s.rotate_left(7), !s],
+        fill_up_1: 0,
+    };
+    p.fill_up_1 = checksum(&p);
+    p
+}
+
+/// FNV-style checksum over the six words.
+pub fn checksum(p: &HliCoordinateSystemInt) -> i32 {
+    p.translation
+        .iter()
+        .chain(p.rotation.iter())
+        .fold(0x811c_9dc5u32, |h, &w| (h ^ w as u32).wrapping_mul(16_777_619)) as i32
+}
+
+/// The sequence number of a whole payload; `None` when it is torn or corrupt.
+pub fn verify(p: &HliCoordinateSystemInt) -> Option<u32> {
+    let seq = p.translation[0] as u32;
+    (payload(seq) == *p).then_some(seq)
+}
+
+/// Kills `child` when dropped unless it has exited: a hung child never outlives its test.
+pub struct ChildGuard(pub Child);
+
+impl ChildGuard {
+    /// Waits for the child to exit, up to `limit`; kills it and returns `None` on expiry.
+    pub fn wait_with_watchdog(&mut self, limit: Duration) -> Option<std::process::ExitStatus> {
+        let deadline = Instant::now() + limit;
+        loop {
+            if let Ok(Some(status)) = self.0.try_wait() {
+                return Some(status);
+            }
+            if Instant::now() > deadline {
+                let _ = self.0.kill();
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+}
+
+impl Drop for ChildGuard {
+    fn drop(&mut self) {
+        if let Ok(None) = self.0.try_wait() {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
+}

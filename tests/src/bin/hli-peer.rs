@@ -1,0 +1,98 @@
+//! Child process for the multi-process tests. Modes:
+//!
+//! * `plc-handshakes INSTANCE N`: attach as PLC; send N commands and read N requests, checking
+//!   order and checksums; exit 0 when all N of each were whole and in order.
+//! * `cnc-crash INSTANCE`: create the segment, print `ready`, then abort (no cleanup).
+//! * `cnc-beat INSTANCE`: create the segment, print `ready`, beat every millisecond until
+//!   stdin closes.
+
+use hli::segment::{CncSegment, PlcSegment};
+use hli::views::PlcView;
+use std::io::{BufRead, Write};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    hli::init_logging();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+        ["plc-handshakes", instance, n] => plc_handshakes(instance, n.parse().expect("count")),
+        ["cnc-crash", instance] => {
+            let _segment = CncSegment::create(instance, 1, 1).expect("create");
+            println!("ready");
+            std::io::stdout().flush().ok();
+            std::process::abort();
+        }
+        ["cnc-beat", instance] => {
+            let segment = CncSegment::create(instance, 1, 1).expect("create");
+            println!("ready");
+            std::io::stdout().flush().ok();
+            let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let flag = stop.clone();
+            std::thread::spawn(move || {
+                let _ = std::io::stdin().lock().lines().count();
+                flag.store(true, std::sync::atomic::Ordering::Release);
+            });
+            while !stop.load(std::sync::atomic::Ordering::Acquire) {
+                segment.beat();
+                std::thread::sleep(std::time::Duration::from_millis(1));
+            }
+            ExitCode::SUCCESS
+        }
+        other => {
+            eprintln!("hli-peer: unknown arguments {other:?}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn plc_handshakes(instance: &str, n: u32) -> ExitCode {
+    let segment = match PlcSegment::attach(instance) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("attach: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    let view = PlcView::new(segment.memory());
+    let tx = view.dyn_cs_command(0).expect("channel 0");
+    let mut rx = view.dyn_cs_request(0).expect("channel 0");
+    let (mut sent, mut read, mut spins) = (0u32, 0u32, 0u32);
+    while sent < n || read < n {
+        let mut progressed = false;
+        if sent < n && tx.try_send(&tests::payload(sent)).is_ok() {
+            sent += 1;
+            progressed = true;
+        }
+        if read < n {
+            match rx.try_take() {
+                Ok(Some(p)) => {
+                    if tests::verify(&p) != Some(read) {
+                        eprintln!("request {read}: got {p:?}");
+                        return ExitCode::from(4);
+                    }
+                    read += 1;
+                    progressed = true;
+                }
+                Ok(None) => {}
+                Err(e) => {
+                    eprintln!("request {read}: {e}");
+                    return ExitCode::from(5);
+                }
+            }
+        }
+        if progressed {
+            spins = 0;
+        } else {
+            spins += 1;
+            if spins % 64 == 0 {
+                std::thread::yield_now();
+            }
+        }
+    }
+    println!("sent {sent} read {read} violations {}", rx.stats().violations());
+    if rx.stats().violations() == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(6)
+    }
+}

@@ -1,0 +1,144 @@
+//! Segment life cycle across processes: stale segments are replaced, live ones refused,
+//! mismatching layouts refused with both values named, a dead CNC's heartbeat stops.
+
+use hli::segment::{
+    AttachError, CncSegment, CreateError, HeartbeatWatch, LayoutIdentity, PeerLiveness,
+    PlcSegment,
+};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+use tests::{unique_instance, ChildGuard};
+
+fn spawn_peer(mode: &str, instance: &str) -> ChildGuard {
+    let mut child = ChildGuard(
+        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
+            .args([mode, instance])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let mut line = String::new();
+    BufReader::new(child.0.stdout.as_mut().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    assert_eq!(line.trim(), "ready");
+    child
+}
+
+#[test]
+fn stale_segment_of_a_crashed_cnc_is_replaced() {
+    let instance = unique_instance("stale");
+    let mut child = spawn_peer("cnc-crash", &instance);
+    let pid = child.0.id();
+    let status = child.wait_with_watchdog(Duration::from_secs(30)).unwrap();
+    assert!(!status.success(), "the peer aborts");
+    // The object is still there, left behind by the crash.
+    assert!(matches!(PlcSegment::attach(&instance), Ok(_) | Err(AttachError::NotReady { .. })));
+    let segment = CncSegment::create(&instance, 2, 3).unwrap();
+    assert_eq!(segment.replaced_stale().map(|s| s.pid), Some(pid));
+    let plc = PlcSegment::attach(&instance).unwrap();
+    assert_eq!((plc.channel_count(), plc.axis_count()), (2, 3));
+}
+
+#[test]
+fn live_segment_is_not_taken_over_and_its_heartbeat_stops_when_the_cnc_dies() {
+    let instance = unique_instance("live");
+    let mut child = spawn_peer("cnc-beat", &instance);
+    match CncSegment::create(&instance, 1, 1) {
+        Err(CreateError::InUse { pid, .. }) => assert_eq!(pid, child.0.id()),
+        other => panic!("expected InUse, got {other:?}"),
+    }
+    let plc = PlcSegment::attach(&instance).unwrap();
+    assert!(plc.cnc_process_alive());
+    let mut watch = HeartbeatWatch::new(5);
+    // Observe until the beat moves (bounded by the child's watchdog via ChildGuard).
+    let mut liveness = watch.observe(plc.cnc_heartbeat());
+    for _ in 0..10_000 {
+        if liveness == PeerLiveness::Alive {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(1));
+        liveness = watch.observe(plc.cnc_heartbeat());
+    }
+    assert_eq!(liveness, PeerLiveness::Alive);
+
+    child.0.kill().unwrap();
+    child.0.wait().unwrap();
+    let verdicts: Vec<_> = (0..6).map(|_| watch.observe(plc.cnc_heartbeat())).collect();
+    assert_eq!(verdicts.last(), Some(&PeerLiveness::Lost), "{verdicts:?}");
+    assert!(!plc.cnc_process_alive());
+}
+
+#[test]
+fn mismatching_layouts_are_refused_naming_both_values() {
+    let instance = unique_instance("mismatch");
+    let _segment = CncSegment::create(&instance, 1, 1).unwrap();
+    let current = LayoutIdentity::current();
+
+    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { version: 99, ..current })
+        .unwrap_err();
+    assert_eq!(err, AttachError::VersionMismatch { cnc: current.version, plc: 99 });
+    assert!(err.to_string().contains(&format!("CNC has {}, PLC has 99", current.version)));
+
+    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { hash: 0xDEAD, ..current })
+        .unwrap_err();
+    assert_eq!(err, AttachError::LayoutMismatch { cnc: current.hash, plc: 0xDEAD });
+
+    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { size: 4096, ..current })
+        .unwrap_err();
+    assert_eq!(err, AttachError::SizeMismatch { cnc: current.size, plc: 4096 });
+
+    assert!(PlcSegment::attach(&instance).is_ok());
+}
+
+#[test]
+fn missing_and_truncated_segments_are_typed_errors() {
+    let create_raw = |name: &str, size| hli::segment::create_raw_object(name, size).unwrap();
+    let instance = unique_instance("trunc");
+    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::NotFound { .. })));
+    assert!(matches!(PlcSegment::attach("bad/name"), Err(AttachError::InvalidName { .. })));
+
+    // Another program left a small object under the segment's name.
+    let _small = create_raw(&hli::segment::segment_name(&instance).unwrap(), 64);
+    match PlcSegment::attach(&instance) {
+        Err(AttachError::Truncated { found, expected, .. }) => {
+            assert_eq!(found, 64);
+            assert_eq!(expected, hli::segment::IMAGE_SIZE as u64);
+        }
+        other => panic!("expected Truncated, got {other:?}"),
+    }
+
+    let instance = unique_instance("magic");
+    let _junk = create_raw(&hli::segment::segment_name(&instance).unwrap(), 1 << 16);
+    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::BadMagic { cnc: 0, .. })));
+}
+
+#[test]
+fn segment_is_owner_only_and_removed_on_drop() {
+    use std::os::unix::fs::PermissionsExt;
+    let instance = unique_instance("perm");
+    let segment = CncSegment::create(&instance, 1, 1).unwrap();
+    let path = format!("/dev/shm/{}", segment.name());
+    let mode = std::fs::metadata(&path).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600);
+    drop(segment);
+    assert!(std::fs::metadata(&path).is_err());
+    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::NotFound { .. })));
+}
+
+#[test]
+fn too_many_channels_or_axes_are_refused() {
+    let instance = unique_instance("counts");
+    assert!(matches!(
+        CncSegment::create(&instance, 13, 1),
+        Err(CreateError::TooMany { what: "channel", requested: 13, capacity: 12 })
+    ));
+    assert!(matches!(
+        CncSegment::create(&instance, 1, 33),
+        Err(CreateError::TooMany { what: "axis", .. })
+    ));
+}
+
