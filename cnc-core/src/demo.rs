@@ -78,7 +78,9 @@ impl TrackingRamp {
         match self.state {
             DynCsState::Active => 1.0,
             DynCsState::Activating => f64::from(self.progress) / f64::from(self.filter.max(1)),
-            DynCsState::Deactivating => 1.0 - f64::from(self.progress) / f64::from(self.filter.max(1)),
+            DynCsState::Deactivating => {
+                1.0 - f64::from(self.progress) / f64::from(self.filter.max(1))
+            }
             DynCsState::Inactive | DynCsState::Error => 0.0,
         }
     }
@@ -94,7 +96,10 @@ impl TrackingRamp {
     }
 
     fn step(&mut self) {
-        if matches!(self.state, DynCsState::Activating | DynCsState::Deactivating) {
+        if matches!(
+            self.state,
+            DynCsState::Activating | DynCsState::Deactivating
+        ) {
             self.progress += 1;
             if self.progress >= self.filter {
                 self.state = match self.state {
@@ -162,7 +167,8 @@ fn run(args: &DemoArgs) -> Result<(), String> {
     let mut tick_ns = vec![0u64; ticks];
     let mut late_ns = vec![0u64; ticks];
     let mut state_changes: Vec<(u64, DynCsState)> = Vec::with_capacity(64);
-    let mut ack_latency_ticks: Vec<u64> = Vec::with_capacity(ticks / args.m_every.max(1) as usize + 1);
+    let mut ack_latency_ticks: Vec<u64> =
+        Vec::with_capacity(ticks / args.m_every.max(1) as usize + 1);
     let mut counters = Counters::default();
     let mut ramp = TrackingRamp {
         state: DynCsState::Inactive,
@@ -185,6 +191,7 @@ fn run(args: &DemoArgs) -> Result<(), String> {
         late_ns[tick as usize] = t0.saturating_duration_since(deadline).as_nanos() as u64;
         segment.beat();
 
+        let before = ramp.state;
         match transition_rx.try_take() {
             Ok(Some((command, params))) => {
                 counters.transitions += 1;
@@ -193,12 +200,9 @@ fn run(args: &DemoArgs) -> Result<(), String> {
             Ok(None) => {}
             Err(_) => counters.violations += 1,
         }
-        let before = ramp.state;
         ramp.step();
-        if ramp.state != before || state_changes.is_empty() && ramp.state != DynCsState::Inactive {
-            if state_changes.len() < state_changes.capacity() {
-                state_changes.push((tick, ramp.state));
-            }
+        if ramp.state != before && state_changes.len() < state_changes.capacity() {
+            state_changes.push((tick, ramp.state));
         }
         let _ = view.set_dyn_cs_state(0, ramp.state);
 

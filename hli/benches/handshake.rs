@@ -63,7 +63,10 @@ impl Method {
         Self::ALL.into_iter().find(|m| m.key() == key)
     }
     fn polling(self) -> bool {
-        matches!(self, Method::Flag | Method::HliPoll | Method::Iox2PubSub | Method::Uds)
+        matches!(
+            self,
+            Method::Flag | Method::HliPoll | Method::Iox2PubSub | Method::Uds
+        )
     }
 }
 
@@ -80,7 +83,7 @@ fn cs(seq: u32) -> HliCoordinateSystemInt {
 #[inline]
 fn spin(spins: &mut u32) {
     *spins += 1;
-    if *spins % 1024 == 0 {
+    if (*spins).is_multiple_of(1024) {
         std::thread::yield_now();
     } else {
         std::hint::spin_loop();
@@ -112,7 +115,8 @@ fn peer_main(method: Method, name: &str, count: usize) {
             let view = CncView::new(segment.memory());
             let mut rx = view.dyn_cs_command(0).unwrap();
             let tx = view.dyn_cs_request(0).unwrap();
-            let events = (method == Method::HliEvent).then(|| EventLink::open(name, Side::Cnc).unwrap());
+            let events =
+                (method == Method::HliEvent).then(|| EventLink::open(name, Side::Cnc).unwrap());
             ready();
             for _ in 0..total {
                 let mut s = 0;
@@ -248,7 +252,8 @@ fn measure(method: Method, count: usize, tag: &str) -> Vec<u64> {
         Method::HliPoll | Method::HliEvent => {
             let segment = CncSegment::create(&name, 1, 1).unwrap();
             // The measuring side plays the PLC.
-            let events = (method == Method::HliEvent).then(|| EventLink::open(&name, Side::Plc).unwrap());
+            let events =
+                (method == Method::HliEvent).then(|| EventLink::open(&name, Side::Plc).unwrap());
             let mut child = spawn_peer(method, &name, count);
             let view = PlcView::new(segment.memory());
             let tx = view.dyn_cs_command(0).unwrap();
@@ -346,7 +351,8 @@ struct Summary {
 
 fn summarize(mut samples: Vec<u64>) -> Summary {
     samples.sort_unstable();
-    let at = |q: f64| samples[((q * samples.len() as f64).ceil() as usize).clamp(1, samples.len()) - 1];
+    let at =
+        |q: f64| samples[((q * samples.len() as f64).ceil() as usize).clamp(1, samples.len()) - 1];
     Summary {
         p50: at(0.5),
         p99: at(0.99),
@@ -371,7 +377,11 @@ fn main() {
     hli::init_logging();
     let quick = std::env::args().any(|a| a == "--quick");
     let repeats = if quick { 3 } else { 5 };
-    let (poll_count, event_count) = if quick { (20_000, 3_000) } else { (200_000, 20_000) };
+    let (poll_count, event_count) = if quick {
+        (20_000, 3_000)
+    } else {
+        (200_000, 20_000)
+    };
 
     println!(
         "cross-process round trip, 32-byte payload there and back; {repeats} repeats, median of each statistic; {} cores",
@@ -379,7 +389,11 @@ fn main() {
     );
     let mut results = Vec::new();
     for method in Method::ALL {
-        let count = if method.polling() { poll_count } else { event_count };
+        let count = if method.polling() {
+            poll_count
+        } else {
+            event_count
+        };
         let runs: Vec<Summary> = (0..repeats)
             .map(|r| summarize(measure(method, count, &r.to_string())))
             .collect();

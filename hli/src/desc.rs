@@ -147,7 +147,11 @@ impl TypeDesc {
             Kind::Scalar(s) => s.st_name().to_string(),
             Kind::Struct { name, .. } => name.to_string(),
             Kind::Array { elem, len } => {
-                format!("ARRAY[0..{}]OF({})", len.saturating_sub(1), elem().st_name())
+                format!(
+                    "ARRAY[0..{}]OF({})",
+                    len.saturating_sub(1),
+                    elem().st_name()
+                )
             }
         }
     }

@@ -196,7 +196,11 @@ impl<'m> TransitionWriter<'m> {
 
     /// Writes the parameters of `transition`, then its command (which must not be `None`).
     /// Refused while the CNC has not taken the previous transition.
-    pub fn try_send(&self, command: DynCsCommand, params: &HliDynCsTransition) -> Result<(), SendError> {
+    pub fn try_send(
+        &self,
+        command: DynCsCommand,
+        params: &HliDynCsTransition,
+    ) -> Result<(), SendError> {
         match self.command().load_acquire() {
             0 => {}
             1 | -1 => return Err(SendError::Busy),

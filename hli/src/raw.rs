@@ -14,10 +14,10 @@
 
 use core::marker::PhantomData;
 use core::ptr::NonNull;
-use iceoryx2_bb_posix::shared_memory::SharedMemory;
 use core::sync::atomic::{
     AtomicI16, AtomicI32, AtomicI64, AtomicI8, AtomicU16, AtomicU32, AtomicU64, AtomicU8, Ordering,
 };
+use iceoryx2_bb_posix::shared_memory::SharedMemory;
 
 /// Memory that holds one HLI image: either a mapped shared-memory segment or a heap buffer (for
 /// in-process mode and tests). The owner keeps the mapping alive for as long as `self` lives.
@@ -30,7 +30,7 @@ pub struct ImageMemory {
 
 enum Backing {
     Heap(#[allow(dead_code)] Box<[AtomicU64]>),
-    Shared(SharedMemory),
+    Shared(Box<SharedMemory>),
 }
 
 impl core::fmt::Debug for ImageMemory {
@@ -78,14 +78,14 @@ impl ImageMemory {
         Self {
             base,
             len: shm.size(),
-            backing: Backing::Shared(shm),
+            backing: Backing::Shared(Box::new(shm)),
         }
     }
 
     /// The shared-memory object behind the image, if it is one.
     pub fn shared_memory(&self) -> Option<&SharedMemory> {
         match &self.backing {
-            Backing::Shared(shm) => Some(shm),
+            Backing::Shared(shm) => Some(shm.as_ref()),
             Backing::Heap(_) => None,
         }
     }
@@ -138,8 +138,11 @@ impl ImageMemory {
 pub struct Place<'m, T> {
     base: NonNull<u8>,
     offset: usize,
-    _marker: PhantomData<(&'m ImageMemory, fn() -> T)>,
+    _marker: PhantomData<PlaceMarker<'m, T>>,
 }
+
+/// Ties a place to its image's lifetime; `fn() -> T` keeps `Place` Send/Sync-neutral in `T`.
+type PlaceMarker<'m, T> = (&'m ImageMemory, fn() -> T);
 
 impl<T> Clone for Place<'_, T> {
     fn clone(&self) -> Self {

@@ -205,7 +205,10 @@ fn open_service(
     >,
     CallError,
 > {
-    let name: ServiceName = service_name(instance).as_str().try_into().map_err(transport)?;
+    let name: ServiceName = service_name(instance)
+        .as_str()
+        .try_into()
+        .map_err(transport)?;
     node.service_builder(&name)
         .request_response::<AcyclicRequest, AcyclicResponse>()
         .max_active_requests_per_client(4)

@@ -11,7 +11,7 @@
 //!  CNC drop ─► Closed, object unlinked
 //! ```
 
-use crate::desc::{HliType, PlaceExt};
+use crate::desc::PlaceExt;
 use crate::enums::SegmentState;
 use crate::layout::{HliImage, HliSegmentHeader, HLI_MAX_AXES, HLI_MAX_CHANNELS};
 use crate::raw::{ImageMemory, Place};
@@ -631,26 +631,24 @@ pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateE
 pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
     let memory = ImageMemory::heap(IMAGE_SIZE);
     let identity = LayoutIdentity::current();
-    memory.place::<HliSegmentHeader>(0).write(&HliSegmentHeader {
-        magic: SEGMENT_MAGIC,
-        layout_version: identity.version,
-        header_size: HEADER_SIZE as u32,
-        layout_hash: identity.hash,
-        image_size: identity.size,
-        channel_count: channels,
-        axis_count: axes,
-        cnc_pid: std::process::id(),
-        segment_state: SegmentState::Ready.raw(),
-        ..bytemuck::Zeroable::zeroed()
-    });
+    memory
+        .place::<HliSegmentHeader>(0)
+        .write(&HliSegmentHeader {
+            magic: SEGMENT_MAGIC,
+            layout_version: identity.version,
+            header_size: HEADER_SIZE as u32,
+            layout_hash: identity.hash,
+            image_size: identity.size,
+            channel_count: channels,
+            axis_count: axes,
+            cnc_pid: std::process::id(),
+            segment_state: SegmentState::Ready.raw(),
+            ..bytemuck::Zeroable::zeroed()
+        });
     memory
 }
 
-const _: () = assert!(IMAGE_SIZE % 8 == 0);
-#[allow(dead_code)]
-fn _assert_image_type_is_described() -> crate::desc::TypeDesc {
-    HliImage::desc()
-}
+const _: () = assert!(IMAGE_SIZE.is_multiple_of(8));
 
 #[cfg(test)]
 mod tests {

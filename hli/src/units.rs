@@ -92,9 +92,18 @@ mod tests {
 
     #[test]
     fn refuses_what_does_not_fit() {
-        assert!(matches!(mm_to_hli(f64::NAN), Err(UnitError::NotFinite { .. })));
-        assert!(matches!(deg_to_hli(f64::INFINITY), Err(UnitError::NotFinite { .. })));
-        assert!(matches!(mm_to_hli(214_749.0), Err(UnitError::OutOfRange { .. })));
+        assert!(matches!(
+            mm_to_hli(f64::NAN),
+            Err(UnitError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            deg_to_hli(f64::INFINITY),
+            Err(UnitError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            mm_to_hli(214_749.0),
+            Err(UnitError::OutOfRange { .. })
+        ));
         assert!(mm_to_hli(214_748.0).is_ok());
     }
 

@@ -208,8 +208,7 @@ impl<'m> CncView<'m> {
     /// Reports the tracking state in `state_r`.
     pub fn set_dyn_cs_state(&self, channel: usize, state: DynCsState) -> Result<(), IndexError> {
         let unit = self.nav.dyn_cs(channel)?;
-        unit
-            .field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
+        unit.field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
             .field::<u32>(offset_of!(HliDynCsState, actual_state))
             .store_release(state.raw());
         Ok(())
@@ -311,8 +310,7 @@ impl<'m> PlcView<'m> {
     /// Takes over (or releases) the unit: `enable_w`.
     pub fn set_dyn_cs_enabled(&self, channel: usize, enabled: bool) -> Result<(), IndexError> {
         let unit = self.nav.dyn_cs(channel)?;
-        unit
-            .field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
+        unit.field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
             .cast::<u8>()
             .store_release(u8::from(enabled));
         Ok(())
@@ -344,7 +342,10 @@ impl<'m> PlcView<'m> {
     }
 
     /// Acknowledges M functions (command pattern).
-    pub fn m_function_ack(&self, channel: usize) -> Result<Writer<'m, HliMFunctionAck>, IndexError> {
+    pub fn m_function_ack(
+        &self,
+        channel: usize,
+    ) -> Result<Writer<'m, HliMFunctionAck>, IndexError> {
         let unit = self.nav.m_function(channel)?;
         Ok(Writer::new(
             unit_field!(unit, HliMFunctionUnit, ack_semaphore_rw),
@@ -361,4 +362,3 @@ impl<'m> PlcView<'m> {
             .read())
     }
 }
-

@@ -32,9 +32,9 @@ fn checksum(p: &HliCoordinateSystemInt) -> i32 {
         p.rotation[1],
         p.rotation[2],
     ];
-    words
-        .iter()
-        .fold(0x811c_9dc5u32 as i32, |h, w| (h ^ w).wrapping_mul(16_777_619))
+    words.iter().fold(0x811c_9dc5u32 as i32, |h, w| {
+        (h ^ w).wrapping_mul(16_777_619)
+    })
 }
 
 fn is_whole(p: &HliCoordinateSystemInt) -> bool {

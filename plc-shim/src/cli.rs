@@ -36,14 +36,17 @@ pub fn main(args: PlcArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let mut runtime =
-        match PlcRuntime::attach(&args.instance, args.watchdog_cycles, Duration::from_millis(10)) {
-            Ok(runtime) => runtime,
-            Err(e) => {
-                eprintln!("plc: {e}");
-                return ExitCode::from(1);
-            }
-        };
+    let mut runtime = match PlcRuntime::attach(
+        &args.instance,
+        args.watchdog_cycles,
+        Duration::from_millis(10),
+    ) {
+        Ok(runtime) => runtime,
+        Err(e) => {
+            eprintln!("plc: {e}");
+            return ExitCode::from(1);
+        }
+    };
     match runtime.run(program.as_mut(), args.max_cycles) {
         Ok(summary) => {
             println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);

@@ -35,7 +35,9 @@ pub fn checksum(p: &HliCoordinateSystemInt) -> i32 {
     p.translation
         .iter()
         .chain(p.rotation.iter())
-        .fold(0x811c_9dc5u32, |h, &w| (h ^ w as u32).wrapping_mul(16_777_619)) as i32
+        .fold(0x811c_9dc5u32, |h, &w| {
+            (h ^ w as u32).wrapping_mul(16_777_619)
+        }) as i32
 }
 
 /// The sequence number of a whole payload; `None` when it is torn or corrupt.

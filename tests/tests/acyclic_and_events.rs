@@ -68,9 +68,24 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
     let state = ok.unwrap();
     assert_eq!(state.current_position_acs_r, 123_456);
     assert_eq!(state.axis_state_r, 13);
-    assert_eq!(bad_index, Err(CallError::Refused { code: ErrorCode::InvalidTarget }));
-    assert_eq!(bad_data, Err(CallError::Refused { code: ErrorCode::InvalidData }));
-    assert_eq!(bad_size, Err(CallError::Refused { code: ErrorCode::InvalidSize }));
+    assert_eq!(
+        bad_index,
+        Err(CallError::Refused {
+            code: ErrorCode::InvalidTarget
+        })
+    );
+    assert_eq!(
+        bad_data,
+        Err(CallError::Refused {
+            code: ErrorCode::InvalidData
+        })
+    );
+    assert_eq!(
+        bad_size,
+        Err(CallError::Refused {
+            code: ErrorCode::InvalidSize
+        })
+    );
     assert_eq!(answered, 4);
 }
 

@@ -2,8 +2,7 @@
 //! mismatching layouts refused with both values named, a dead CNC's heartbeat stops.
 
 use hli::segment::{
-    AttachError, CncSegment, CreateError, HeartbeatWatch, LayoutIdentity, PeerLiveness,
-    PlcSegment,
+    AttachError, CncSegment, CreateError, HeartbeatWatch, LayoutIdentity, PeerLiveness, PlcSegment,
 };
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -36,7 +35,10 @@ fn stale_segment_of_a_crashed_cnc_is_replaced() {
     let status = child.wait_with_watchdog(Duration::from_secs(30)).unwrap();
     assert!(!status.success(), "the peer aborts");
     // The object is still there, left behind by the crash.
-    assert!(matches!(PlcSegment::attach(&instance), Ok(_) | Err(AttachError::NotReady { .. })));
+    assert!(matches!(
+        PlcSegment::attach(&instance),
+        Ok(_) | Err(AttachError::NotReady { .. })
+    ));
     let segment = CncSegment::create(&instance, 2, 3).unwrap();
     assert_eq!(segment.replaced_stale().map(|s| s.pid), Some(pid));
     let plc = PlcSegment::attach(&instance).unwrap();
@@ -78,18 +80,56 @@ fn mismatching_layouts_are_refused_naming_both_values() {
     let _segment = CncSegment::create(&instance, 1, 1).unwrap();
     let current = LayoutIdentity::current();
 
-    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { version: 99, ..current })
-        .unwrap_err();
-    assert_eq!(err, AttachError::VersionMismatch { cnc: current.version, plc: 99 });
-    assert!(err.to_string().contains(&format!("CNC has {}, PLC has 99", current.version)));
+    let err = PlcSegment::attach_expecting(
+        &instance,
+        LayoutIdentity {
+            version: 99,
+            ..current
+        },
+    )
+    .unwrap_err();
+    assert_eq!(
+        err,
+        AttachError::VersionMismatch {
+            cnc: current.version,
+            plc: 99
+        }
+    );
+    assert!(err
+        .to_string()
+        .contains(&format!("CNC has {}, PLC has 99", current.version)));
 
-    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { hash: 0xDEAD, ..current })
-        .unwrap_err();
-    assert_eq!(err, AttachError::LayoutMismatch { cnc: current.hash, plc: 0xDEAD });
+    let err = PlcSegment::attach_expecting(
+        &instance,
+        LayoutIdentity {
+            hash: 0xDEAD,
+            ..current
+        },
+    )
+    .unwrap_err();
+    assert_eq!(
+        err,
+        AttachError::LayoutMismatch {
+            cnc: current.hash,
+            plc: 0xDEAD
+        }
+    );
 
-    let err = PlcSegment::attach_expecting(&instance, LayoutIdentity { size: 4096, ..current })
-        .unwrap_err();
-    assert_eq!(err, AttachError::SizeMismatch { cnc: current.size, plc: 4096 });
+    let err = PlcSegment::attach_expecting(
+        &instance,
+        LayoutIdentity {
+            size: 4096,
+            ..current
+        },
+    )
+    .unwrap_err();
+    assert_eq!(
+        err,
+        AttachError::SizeMismatch {
+            cnc: current.size,
+            plc: 4096
+        }
+    );
 
     assert!(PlcSegment::attach(&instance).is_ok());
 }
@@ -98,13 +138,21 @@ fn mismatching_layouts_are_refused_naming_both_values() {
 fn missing_and_truncated_segments_are_typed_errors() {
     let create_raw = |name: &str, size| hli::segment::create_raw_object(name, size).unwrap();
     let instance = unique_instance("trunc");
-    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::NotFound { .. })));
-    assert!(matches!(PlcSegment::attach("bad/name"), Err(AttachError::InvalidName { .. })));
+    assert!(matches!(
+        PlcSegment::attach(&instance),
+        Err(AttachError::NotFound { .. })
+    ));
+    assert!(matches!(
+        PlcSegment::attach("bad/name"),
+        Err(AttachError::InvalidName { .. })
+    ));
 
     // Another program left a small object under the segment's name.
     let _small = create_raw(&hli::segment::segment_name(&instance).unwrap(), 64);
     match PlcSegment::attach(&instance) {
-        Err(AttachError::Truncated { found, expected, .. }) => {
+        Err(AttachError::Truncated {
+            found, expected, ..
+        }) => {
             assert_eq!(found, 64);
             assert_eq!(expected, hli::segment::IMAGE_SIZE as u64);
         }
@@ -113,7 +161,10 @@ fn missing_and_truncated_segments_are_typed_errors() {
 
     let instance = unique_instance("magic");
     let _junk = create_raw(&hli::segment::segment_name(&instance).unwrap(), 1 << 16);
-    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::BadMagic { cnc: 0, .. })));
+    assert!(matches!(
+        PlcSegment::attach(&instance),
+        Err(AttachError::BadMagic { cnc: 0, .. })
+    ));
 }
 
 #[test]
@@ -126,7 +177,10 @@ fn segment_is_owner_only_and_removed_on_drop() {
     assert_eq!(mode, 0o600);
     drop(segment);
     assert!(std::fs::metadata(&path).is_err());
-    assert!(matches!(PlcSegment::attach(&instance), Err(AttachError::NotFound { .. })));
+    assert!(matches!(
+        PlcSegment::attach(&instance),
+        Err(AttachError::NotFound { .. })
+    ));
 }
 
 #[test]
@@ -134,11 +188,14 @@ fn too_many_channels_or_axes_are_refused() {
     let instance = unique_instance("counts");
     assert!(matches!(
         CncSegment::create(&instance, 13, 1),
-        Err(CreateError::TooMany { what: "channel", requested: 13, capacity: 12 })
+        Err(CreateError::TooMany {
+            what: "channel",
+            requested: 13,
+            capacity: 12
+        })
     ));
     assert!(matches!(
         CncSegment::create(&instance, 1, 33),
         Err(CreateError::TooMany { what: "axis", .. })
     ));
 }
-

@@ -31,7 +31,11 @@ fn a_million_handshakes_each_way_are_exact() {
         let mut progressed = false;
         match rx.try_take() {
             Ok(Some(p)) => {
-                assert_eq!(verify(&p), Some(taken), "command {taken} lost, duplicated or torn");
+                assert_eq!(
+                    verify(&p),
+                    Some(taken),
+                    "command {taken} lost, duplicated or torn"
+                );
                 taken += 1;
                 progressed = true;
             }
@@ -49,11 +53,16 @@ fn a_million_handshakes_each_way_are_exact() {
                 if let Ok(Some(status)) = child.0.try_wait() {
                     panic!("PLC child exited early ({status}) at {taken}/{published}");
                 }
-                assert!(Instant::now() < watchdog, "watchdog: stuck at {taken}/{published}");
+                assert!(
+                    Instant::now() < watchdog,
+                    "watchdog: stuck at {taken}/{published}"
+                );
             }
         }
     }
-    let status = child.wait_with_watchdog(Duration::from_secs(60)).expect("child exits");
+    let status = child
+        .wait_with_watchdog(Duration::from_secs(60))
+        .expect("child exits");
     assert!(status.success(), "PLC side reported a mismatch: {status}");
     assert_eq!(rx.stats().taken, u64::from(HANDSHAKES));
     assert_eq!(rx.stats().violations(), 0);

@@ -38,7 +38,9 @@ fn main() -> ExitCode {
         Command::Demo(args) => cnc_core::demo::main(args),
         Command::Hli { what } => {
             let text = match what {
-                HliCommand::Symbols => hli::symbols::format_table(hli::symbols::SymbolTable::global()),
+                HliCommand::Symbols => {
+                    hli::symbols::format_table(hli::symbols::SymbolTable::global())
+                }
                 HliCommand::Header => hli::c_header::generate(),
             };
             print_or_fail(&text)

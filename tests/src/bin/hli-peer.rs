@@ -14,7 +14,12 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     hli::init_logging();
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+    match args
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>()
+        .as_slice()
+    {
         ["plc-handshakes", instance, n] => plc_handshakes(instance, n.parse().expect("count")),
         ["cnc-crash", instance] => {
             let _segment = CncSegment::create(instance, 1, 1).expect("create");
@@ -89,7 +94,10 @@ fn plc_handshakes(instance: &str, n: u32) -> ExitCode {
             }
         }
     }
-    println!("sent {sent} read {read} violations {}", rx.stats().violations());
+    println!(
+        "sent {sent} read {read} violations {}",
+        rx.stats().violations()
+    );
     if rx.stats().violations() == 0 {
         ExitCode::SUCCESS
     } else {
