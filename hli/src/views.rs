@@ -117,6 +117,36 @@ macro_rules! unit_field {
     };
 }
 
+/// Path override and feed hold as the PLC commands them, validated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PathOverride {
+    /// Feed override, 0.1 % (0..=2000).
+    pub feed_permille: u32,
+    /// Rapid override, 0.1 % (0..=1000).
+    pub rapid_permille: u32,
+    /// Feed hold.
+    pub feed_hold: bool,
+}
+
+/// A PLC-written override value outside its range.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum OverrideError {
+    /// Feed override above 200.0 %.
+    #[error("feed_override_w {0} above 2000 (0.1 %)")]
+    Feed(u32),
+    /// Rapid override above 100.0 %.
+    #[error("rapid_override_w {0} above 1000 (0.1 %)")]
+    Rapid(u32),
+    /// Feed-hold byte neither FALSE nor TRUE.
+    #[error("feed_hold_w byte {0} is neither FALSE nor TRUE")]
+    FeedHold(u8),
+}
+
+/// Largest feed override, 0.1 %.
+pub const MAX_FEED_OVERRIDE: u32 = 2000;
+/// Largest rapid override, 0.1 %.
+pub const MAX_RAPID_OVERRIDE: u32 = 1000;
+
 /// The CNC's view of an image.
 #[derive(Debug, Clone, Copy)]
 pub struct CncView<'m> {
@@ -212,6 +242,21 @@ impl<'m> CncView<'m> {
             .field::<u32>(offset_of!(HliDynCsState, actual_state))
             .store_release(state.raw());
         Ok(())
+    }
+
+    /// Reads and validates the PLC's override and feed hold; the caller keeps its last valid
+    /// value (or stops) on an error.
+    pub fn path_override(
+        &self,
+        channel: usize,
+    ) -> Result<Result<PathOverride, OverrideError>, IndexError> {
+        let unit: HliChannelOverrideUnit = self
+            .nav
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
+            .read();
+        Ok(validate_override(&unit))
     }
 
     /// Announces M functions (request pattern).
@@ -360,5 +405,93 @@ impl<'m> PlcView<'m> {
             .axis(axis)?
             .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
             .read())
+    }
+}
+
+fn validate_override(unit: &HliChannelOverrideUnit) -> Result<PathOverride, OverrideError> {
+    if unit.feed_override_w > MAX_FEED_OVERRIDE {
+        return Err(OverrideError::Feed(unit.feed_override_w));
+    }
+    if unit.rapid_override_w > MAX_RAPID_OVERRIDE {
+        return Err(OverrideError::Rapid(unit.rapid_override_w));
+    }
+    let feed_hold = unit.feed_hold_w.get().map_err(OverrideError::FeedHold)?;
+    Ok(PathOverride {
+        feed_permille: unit.feed_override_w,
+        rapid_permille: unit.rapid_override_w,
+        feed_hold,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::segment::heap_image;
+
+    #[test]
+    fn indices_outside_the_configured_counts_are_errors() {
+        let mem = heap_image(2, 3);
+        let cnc = CncView::new(&mem);
+        let plc = PlcView::new(&mem);
+        assert!(cnc.channel(1).is_ok());
+        assert_eq!(
+            cnc.channel(2).unwrap_err(),
+            IndexError {
+                what: "channel",
+                index: 2,
+                count: 2
+            }
+        );
+        assert_eq!(plc.axis_state(3).unwrap_err().what, "axis");
+        assert!(plc.dyn_cs_command(12).is_err());
+        assert!(cnc.fifo_group(8).is_err());
+    }
+
+    #[test]
+    fn override_values_are_validated() {
+        let mem = heap_image(1, 0);
+        let cnc = CncView::new(&mem);
+        let unit = cnc
+            .channel(0)
+            .unwrap()
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override));
+        let mut value = HliChannelOverrideUnit {
+            feed_override_w: 1000,
+            rapid_override_w: 500,
+            feed_hold_w: Bool::TRUE,
+            fill_up_1: 0,
+            fill_up_2: 0,
+            feed_override_r: 0,
+        };
+        unit.write(&value);
+        assert_eq!(
+            cnc.path_override(0).unwrap(),
+            Ok(PathOverride {
+                feed_permille: 1000,
+                rapid_permille: 500,
+                feed_hold: true
+            })
+        );
+        value.feed_override_w = 2001;
+        unit.write(&value);
+        assert_eq!(
+            cnc.path_override(0).unwrap(),
+            Err(OverrideError::Feed(2001))
+        );
+        value.feed_override_w = 0;
+        value.rapid_override_w = 1001;
+        unit.write(&value);
+        assert_eq!(
+            cnc.path_override(0).unwrap(),
+            Err(OverrideError::Rapid(1001))
+        );
+        value.rapid_override_w = 0;
+        value.feed_hold_w = Bool(9);
+        unit.write(&value);
+        assert_eq!(
+            cnc.path_override(0).unwrap(),
+            Err(OverrideError::FeedHold(9))
+        );
     }
 }

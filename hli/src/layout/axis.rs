@@ -6,6 +6,8 @@ use crate::hli_struct;
 hli_struct! {
     /// Cyclic state of an axis ("lr" = position controller), written by the CNC every tick.
     /// Positions in 0.1 um (linear) or 0.0001 degree (rotary).
+    ///
+    /// ST path: `gpAx[i]^lr_state`.
     #[st = "HLI_AXIS_LR_STATE", size = 48]
     pub struct HliAxisLrState {
         /// Actual position in the axis coordinate system.
@@ -37,6 +39,8 @@ hli_struct! {
 
 hli_struct! {
     /// Everything of one axis: `gpAx[axis_idx]^`.
+    ///
+    /// ST path: `gpAx[i]^`.
     #[st = "HLI_AXIS", size = 192]
     pub struct HliAxis {
         /// Cyclic state.

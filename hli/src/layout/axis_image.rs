@@ -9,6 +9,8 @@ use crate::hli_struct;
 
 hli_struct! {
     /// Encoder inputs: what the encoder (or the drive's position feedback) delivers to the NC.
+    ///
+    /// ST path: `gpAx[i]^enc_in`.
     #[st = "NC_ENCODER_PI_IN", size = 40]
     pub struct NcEncoderIn {
         /// Actual position in increments; the NC counts its overflows.
@@ -48,6 +50,8 @@ hli_struct! {
 
 hli_struct! {
     /// Encoder outputs: what the NC sends to the encoder.
+    ///
+    /// ST path: `gpAx[i]^enc_out`.
     #[st = "NC_ENCODER_PI_OUT", size = 32]
     pub struct NcEncoderOut {
         /// Mirror of the encoder input `nInData1`, copied by the NC every tick.
@@ -83,6 +87,8 @@ hli_struct! {
 
 hli_struct! {
     /// Drive inputs: what the drive reports to the NC.
+    ///
+    /// ST path: `gpAx[i]^drive_in`.
     #[st = "NC_DRIVE_PI_IN", size = 40]
     pub struct NcDriveIn {
         /// Optional following error of the drive in increments (cyclic position mode).
@@ -122,6 +128,8 @@ hli_struct! {
 
 hli_struct! {
     /// Drive outputs: the set-point the NC sends to the drive.
+    ///
+    /// ST path: `gpAx[i]^drive_out`.
     #[st = "NC_DRIVE_PI_OUT", size = 32]
     pub struct NcDriveOut {
         /// Set velocity or set position in increments; for the universal drive the signed total

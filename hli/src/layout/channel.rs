@@ -10,6 +10,8 @@ pub const HLI_CHANNEL_AXES: usize = 32;
 
 hli_struct! {
     /// Per-axis display values of a channel, updated every interpolation tick.
+    ///
+    /// ST path: `gpCh[i]^bahn_state.coord_r[axis_idx]`.
     #[st = "HLI_COORD_STATE", size = 16]
     pub struct HliCoordState {
         /// Tool-centre-point set position in the machine coordinate system, 0.1 um (0.0001 deg
@@ -26,6 +28,8 @@ hli_struct! {
 
 hli_struct! {
     /// Path ("Bahn") state of a channel.
+    ///
+    /// ST path: `gpCh[i]^bahn_state`.
     #[st = "HLI_BAHN_STATE", size = 536]
     pub struct HliBahnState {
         /// Display values per path axis.
@@ -45,6 +49,8 @@ hli_struct! {
 
 hli_struct! {
     /// An M function the CNC announces to the PLC.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.m_function.request_r`.
     #[st = "HLI_M_FUNCTION_REQUEST", size = 12]
     pub struct HliMFunctionRequest {
         /// M code number.
@@ -58,6 +64,8 @@ hli_struct! {
 
 hli_struct! {
     /// The PLC's acknowledge of an announced M function.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.m_function.ack_w`.
     #[st = "HLI_M_FUNCTION_ACK", size = 8]
     pub struct HliMFunctionAck {
         /// M code acknowledged.
@@ -72,6 +80,8 @@ hli_struct! {
     /// M function with the request pattern (`request_semaphore_rw`, CNC TRUE / PLC FALSE) and
     /// the PLC acknowledges it with the command pattern (`ack_semaphore_rw`, PLC TRUE / CNC
     /// FALSE), echoing the request id so a stale acknowledge cannot release a later block.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.m_function`.
     #[st = "HLI_M_FUNCTION_UNIT", size = 24]
     pub struct HliMFunctionUnit {
         /// Flow control of the announcement.
@@ -91,6 +101,8 @@ hli_struct! {
 
 hli_struct! {
     /// Path override and feed hold, level values the PLC writes every cycle.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.path_override`.
     #[st = "HLI_CHANNEL_OVERRIDE_UNIT", size = 16]
     pub struct HliChannelOverrideUnit {
         /// Feed override in 0.1 % (0..=2000); out-of-range values are rejected by the CNC.
@@ -110,6 +122,8 @@ hli_struct! {
 
 hli_struct! {
     /// Control units of a channel.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control`.
     #[st = "HLI_CHANNEL_MC_CONTROL", size = 168]
     pub struct HliChannelMcControl {
         /// Dynamic coordinate system (PLC as master, tracking switch).
@@ -124,6 +138,8 @@ hli_struct! {
 hli_struct! {
     /// The dynamic coordinate system a master channel publishes (`#CHANNEL INTERFACE ON
     /// [DYN_CS]`), read by tracking slave channels and by the PLC.
+    ///
+    /// ST path: `gpCh[i]^channel_interface.dyn_cs`.
     #[st = "HLI_DYN_CS_CHANNEL_INTERFACE", size = 40]
     pub struct HliDynCsChannelInterface {
         /// The channel publishes a dynamic coordinate system.
@@ -143,6 +159,8 @@ hli_struct! {
 
 hli_struct! {
     /// Interfaces a channel offers to other channels.
+    ///
+    /// ST path: `gpCh[i]^channel_interface`.
     #[st = "HLI_CHANNEL_INTERFACE", size = 40]
     pub struct HliChannelInterface {
         /// Dynamic-coordinate-system output.
@@ -152,6 +170,8 @@ hli_struct! {
 
 hli_struct! {
     /// Everything of one channel: `gpCh[channel_idx]^`.
+    ///
+    /// ST path: `gpCh[i]^`.
     #[st = "HLI_CHANNEL", size = 744]
     pub struct HliChannel {
         /// Path state and display values.

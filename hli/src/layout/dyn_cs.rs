@@ -11,6 +11,8 @@ pub const HLI_CS_AXES: usize = HLI_CS_AXES_MAXIDX + 1;
 
 hli_struct! {
     /// A coordinate system as integers: translation in 0.1 um, rotation A/B/C in 0.0001 degree.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.dyn_cs.command_w` / `.request_r` / `.transition_w.kinematic_base_cs`.
     #[st = "HLI_COORDINATE_SYSTEM_INT", size = 32]
     pub struct HliCoordinateSystemInt {
         /// X/Y/Z translation in 0.1 um.
@@ -26,6 +28,8 @@ hli_struct! {
 
 hli_struct! {
     /// State of the tracking (slave) channel as the CNC reports it.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.dyn_cs.state_r`.
     #[st = "HLI_DYN_CS_STATE", size = 8]
     pub struct HliDynCsState {
         /// Raw `HLI_DYN_CS_*` value; decode with [`crate::enums::DynCsState::decode`]. The
@@ -40,6 +44,8 @@ hli_struct! {
     /// A switching request from the PLC, equivalent to `#TRACK CS ON/OFF [ID=0 ...]`. The PLC
     /// fills every parameter first and writes `command` last; the CNC takes the transition when
     /// `command` is +1 or -1 and then resets `command` to 0.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.dyn_cs.transition_w`.
     #[st = "HLI_DYN_CS_TRANSITION", size = 48]
     pub struct HliDynCsTransition {
         /// -1 deactivate, +1 activate, 0 nothing pending.
@@ -64,6 +70,8 @@ hli_struct! {
 hli_struct! {
     /// The control unit through which the PLC acts as master of a channel's dynamic coordinate
     /// system and switches its tracking.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.dyn_cs`.
     #[st = "MC_CONTROL_DYN_CS_UNIT", size = 128]
     pub struct McControlDynCsUnit {
         /// The PLC takes over the unit (redirection).

@@ -4,6 +4,8 @@ use crate::hli_struct;
 
 hli_struct! {
     /// Status the CNC publishes for one FIFO axis group every tick.
+    ///
+    /// ST path: `gpFifo[i]^`.
     #[st = "HLI_FIFO_GROUP_STATE", size = 40]
     pub struct HliFifoGroupState {
         /// Raw [`crate::enums::FifoGroupState`].

@@ -15,6 +15,8 @@ pub const HLI_MAX_FIFO_GROUPS: usize = 8;
 hli_struct! {
     /// Identity and liveness of a segment. The two heartbeats sit on their own cache lines so
     /// each side's increments do not disturb the other.
+    ///
+    /// ST path: `header`.
     #[st = "HLI_SEGMENT_HEADER", size = 192]
     pub struct HliSegmentHeader {
         /// [`crate::segment::SEGMENT_MAGIC`].
@@ -56,6 +58,8 @@ hli_struct! {
 
 hli_struct! {
     /// The complete HLI image as it lies in the shared segment.
+    ///
+    /// ST path: the image root (`header`, `gpCh[..]`, `gpAx[..]`, `gpFifo[..]`).
     #[st = "HLI_IMAGE", size = 15584]
     pub struct HliImage {
         /// Identity and heartbeats.
