@@ -1,4 +1,4 @@
-//! Type descriptions of the image, generated next to each struct by [`hli_struct!`].
+//! Type descriptions of the image, generated next to each struct by [`crate::hli_struct!`].
 //!
 //! One description drives four things, so they can never disagree: the symbol table (ST paths,
 //! offsets, writers), the layout hash in the segment header, the generated C header, and the

@@ -134,7 +134,7 @@ impl ImageMemory {
 /// A `T` that lives at a fixed offset inside an [`ImageMemory`].
 ///
 /// A `Place` is a capability, not a reference: it never yields `&T`. Leaves are loaded and
-/// stored atomically; structs are copied leaf by leaf through [`crate::desc::AtomicCopy`].
+/// stored atomically; structs are copied leaf by leaf through [`crate::desc::HliType`].
 pub struct Place<'m, T> {
     base: NonNull<u8>,
     offset: usize,
