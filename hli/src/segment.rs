@@ -316,22 +316,14 @@ impl CncSegment {
     }
 
     fn write_header(&self, channels: u32, axes: u32) {
-        let identity = LayoutIdentity::current();
         let pid = std::process::id();
         let header = self.header();
-        header.write(&HliSegmentHeader {
-            magic: SEGMENT_MAGIC,
-            layout_version: identity.version,
-            header_size: HEADER_SIZE as u32,
-            layout_hash: identity.hash,
-            image_size: identity.size,
-            channel_count: channels,
-            axis_count: axes,
-            cnc_pid: pid,
-            segment_state: SegmentState::Initialising.raw(),
-            cnc_start_stamp: process_start_stamp(pid).unwrap_or(0),
-            ..bytemuck::Zeroable::zeroed()
-        });
+        header.write(&initial_header(
+            channels,
+            axes,
+            SegmentState::Initialising,
+            process_start_stamp(pid).unwrap_or(0),
+        ));
         header
             .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
             .store_release(SegmentState::Ready.raw());
@@ -627,24 +619,38 @@ pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateE
         })
 }
 
+/// The header a CNC of this build writes when it creates an image.
+fn initial_header(
+    channels: u32,
+    axes: u32,
+    state: SegmentState,
+    start_stamp: u64,
+) -> HliSegmentHeader {
+    let identity = LayoutIdentity::current();
+    HliSegmentHeader {
+        magic: SEGMENT_MAGIC,
+        layout_version: identity.version,
+        header_size: HEADER_SIZE as u32,
+        layout_hash: identity.hash,
+        image_size: identity.size,
+        channel_count: channels,
+        axis_count: axes,
+        cnc_pid: std::process::id(),
+        segment_state: state.raw(),
+        cnc_start_stamp: start_stamp,
+        ..bytemuck::Zeroable::zeroed()
+    }
+}
+
 /// A heap-backed image with a valid header, for in-process mode and unit tests.
 pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
     let memory = ImageMemory::heap(IMAGE_SIZE);
-    let identity = LayoutIdentity::current();
-    memory
-        .place::<HliSegmentHeader>(0)
-        .write(&HliSegmentHeader {
-            magic: SEGMENT_MAGIC,
-            layout_version: identity.version,
-            header_size: HEADER_SIZE as u32,
-            layout_hash: identity.hash,
-            image_size: identity.size,
-            channel_count: channels,
-            axis_count: axes,
-            cnc_pid: std::process::id(),
-            segment_state: SegmentState::Ready.raw(),
-            ..bytemuck::Zeroable::zeroed()
-        });
+    memory.place::<HliSegmentHeader>(0).write(&initial_header(
+        channels,
+        axes,
+        SegmentState::Ready,
+        0,
+    ));
     memory
 }
 

@@ -2,7 +2,8 @@
 //! and a watchdog for child processes. Nothing here is used by production code.
 
 use hli::layout::HliCoordinateSystemInt;
-use std::process::Child;
+use std::io::{BufRead, BufReader};
+use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
@@ -73,4 +74,24 @@ impl Drop for ChildGuard {
             let _ = self.0.wait();
         }
     }
+}
+
+/// Starts the `hli-peer` helper binary (path from the calling test's `CARGO_BIN_EXE_hli-peer`)
+/// in `mode` for `instance` and waits for its `ready` line.
+pub fn spawn_ready_peer(peer_exe: &str, mode: &str, instance: &str) -> ChildGuard {
+    let mut child = ChildGuard(
+        Command::new(peer_exe)
+            .args([mode, instance])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("spawn hli-peer"),
+    );
+    let mut line = String::new();
+    BufReader::new(child.0.stdout.as_mut().expect("piped stdout"))
+        .read_line(&mut line)
+        .expect("read the peer's ready line");
+    assert_eq!(line.trim(), "ready", "hli-peer {mode} did not start");
+    child
 }

@@ -1,10 +1,8 @@
 //! The PLC runtime stops by itself when the CNC process dies (heartbeat watchdog).
 
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime, RunEnd};
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
 use std::time::Duration;
-use tests::{unique_instance, ChildGuard};
+use tests::unique_instance;
 
 struct Idle;
 impl PlcProgram for Idle {
@@ -15,19 +13,7 @@ impl PlcProgram for Idle {
 fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     hli::init_logging();
     let instance = unique_instance("plc-lost");
-    let mut child = ChildGuard(
-        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
-            .args(["cnc-beat", &instance])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    );
-    let mut line = String::new();
-    BufReader::new(child.0.stdout.as_mut().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    assert_eq!(line.trim(), "ready");
+    let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
     let mut runtime = PlcRuntime::attach(&instance, 5, Duration::from_millis(5)).unwrap();
     child.0.kill().unwrap();
     child.0.wait().unwrap();

@@ -4,27 +4,11 @@
 use hli::segment::{
     AttachError, CncSegment, CreateError, HeartbeatWatch, LayoutIdentity, PeerLiveness, PlcSegment,
 };
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
 use std::time::Duration;
 use tests::{unique_instance, ChildGuard};
 
 fn spawn_peer(mode: &str, instance: &str) -> ChildGuard {
-    let mut child = ChildGuard(
-        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
-            .args([mode, instance])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
-    );
-    let mut line = String::new();
-    BufReader::new(child.0.stdout.as_mut().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    assert_eq!(line.trim(), "ready");
-    child
+    tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), mode, instance)
 }
 
 #[test]
