@@ -1,0 +1,291 @@
+//! Frames (`Isometry3<f64>`, mm and radians inside) and the controller's orientation
+//! conventions for A/B/C words (degrees).
+//!
+//! | convention | rotation | where |
+//! | --- | --- | --- |
+//! | [`RotationOrder::YawPitchRoll`] | `Rz(C) * Ry(-B) * Rx(A)` | channel parameter `ori_rotation_angle` = 0 (default) |
+//! | [`RotationOrder::EulerZyz`] | `Rz(A) * Ry(B) * Rz(C)` | `ori_rotation_angle` = 1 (Euler Z-Y'-Z'') |
+//! | [`RotationOrder::Cba`] | `Rz(A) * Ry(B) * Rx(C)` | `ori_rotation_angle` = 2 |
+//! | [`RotationOrder::Zyx`] | `Rz(C) * Ry(B) * Rx(A)` | static offsets of `#TRACK CS` (always Z, then Y, then X), `#CS` frames, HLI frames |
+//!
+//! Note the default convention's negated B: a frame given in it is reproduced by a Z-Y-X frame
+//! with `-B`, which is why NC programs write `#CS ON [..., -V.G.TRACK_CS.B, ...]`.
+
+use crate::error::KinError;
+use hli::layout::HliCoordinateSystemInt;
+use hli::units::{deg_from_hli, deg_to_hli, mm_from_hli, mm_to_hli};
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+
+/// How three angles A, B, C (degrees) make a rotation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum RotationOrder {
+    /// `Rz(C) * Ry(-B) * Rx(A)`, the channel default.
+    #[default]
+    YawPitchRoll,
+    /// `Rz(A) * Ry(B) * Rz(C)`.
+    EulerZyz,
+    /// `Rz(A) * Ry(B) * Rx(C)`.
+    Cba,
+    /// `Rz(C) * Ry(B) * Rx(A)`.
+    Zyx,
+}
+
+impl RotationOrder {
+    /// The convention selected by the channel parameter `ori_rotation_angle`.
+    pub fn from_channel_parameter(value: u32) -> Result<Self, KinError> {
+        match value {
+            0 => Ok(RotationOrder::YawPitchRoll),
+            1 => Ok(RotationOrder::EulerZyz),
+            2 => Ok(RotationOrder::Cba),
+            other => Err(KinError::BadParameter {
+                name: "ori_rotation_angle",
+                value: f64::from(other),
+                reason: "must be 0, 1 or 2",
+            }),
+        }
+    }
+
+    /// The rotation of angles `[a, b, c]` in degrees.
+    pub fn rotation(self, abc_deg: [f64; 3]) -> Rotation3<f64> {
+        let [a, b, c] = abc_deg.map(f64::to_radians);
+        let (rx, ry, rz) = (
+            |t: f64| Rotation3::from_axis_angle(&Vector3::x_axis(), t),
+            |t: f64| Rotation3::from_axis_angle(&Vector3::y_axis(), t),
+            |t: f64| Rotation3::from_axis_angle(&Vector3::z_axis(), t),
+        );
+        match self {
+            RotationOrder::YawPitchRoll => rz(c) * ry(-b) * rx(a),
+            RotationOrder::EulerZyz => rz(a) * ry(b) * rz(c),
+            RotationOrder::Cba => rz(a) * ry(b) * rx(c),
+            RotationOrder::Zyx => rz(c) * ry(b) * rx(a),
+        }
+    }
+
+    /// The angles `[a, b, c]` in degrees of a rotation. In a gimbal-locked position (the middle
+    /// rotation at +-90 degree, or 0/180 for Z-Y-Z) the first angle is set to 0.
+    pub fn angles(self, rotation: &Rotation3<f64>) -> [f64; 3] {
+        let m = rotation.matrix();
+        let deg = |v: [f64; 3]| v.map(f64::to_degrees);
+        match self {
+            RotationOrder::YawPitchRoll => {
+                let [x, y, z] = zyx_angles(m);
+                deg([x, -y, z])
+            }
+            RotationOrder::Zyx => deg(zyx_angles(m)),
+            RotationOrder::Cba => {
+                let [x, y, z] = zyx_angles(m);
+                deg([z, y, x])
+            }
+            RotationOrder::EulerZyz => {
+                let sb = m[(0, 2)].hypot(m[(1, 2)]);
+                let b = sb.atan2(m[(2, 2)]);
+                if sb < GIMBAL_EPS {
+                    deg([0.0, b, m[(1, 0)].atan2(m[(1, 1)])])
+                } else {
+                    deg([m[(1, 2)].atan2(m[(0, 2)]), b, m[(2, 1)].atan2(-m[(2, 0)])])
+                }
+            }
+        }
+    }
+}
+
+const GIMBAL_EPS: f64 = 1e-12;
+
+/// Angles `[x, y, z]` (radians) of `Rz(z) * Ry(y) * Rx(x)`.
+fn zyx_angles(m: &Matrix3<f64>) -> [f64; 3] {
+    let cy = m[(0, 0)].hypot(m[(1, 0)]);
+    let y = (-m[(2, 0)]).atan2(cy);
+    if cy < GIMBAL_EPS {
+        // x and z turn about the same axis: put everything into z.
+        [0.0, y, (-m[(0, 1)]).atan2(m[(1, 1)])]
+    } else {
+        [m[(2, 1)].atan2(m[(2, 2)]), y, m[(1, 0)].atan2(m[(0, 0)])]
+    }
+}
+
+/// A pose as the NC writes it: X, Y, Z in mm and A, B, C in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PoseWords {
+    /// Translation, mm.
+    pub xyz: [f64; 3],
+    /// Orientation angles, degrees, in some [`RotationOrder`].
+    pub abc: [f64; 3],
+}
+
+impl PoseWords {
+    /// The frame of these words.
+    pub fn to_frame(&self, order: RotationOrder) -> Result<Isometry3<f64>, KinError> {
+        check_finite(&self.xyz)?;
+        check_finite(&self.abc)?;
+        Ok(Isometry3::from_parts(
+            Translation3::new(self.xyz[0], self.xyz[1], self.xyz[2]),
+            UnitQuaternion::from_rotation_matrix(&order.rotation(self.abc)),
+        ))
+    }
+
+    /// The words of a frame.
+    pub fn from_frame(frame: &Isometry3<f64>, order: RotationOrder) -> Self {
+        let t = frame.translation.vector;
+        Self {
+            xyz: [t.x, t.y, t.z],
+            abc: order.angles(&frame.rotation.to_rotation_matrix()),
+        }
+    }
+}
+
+/// Refuses NaN and infinities.
+pub fn check_finite(values: &[f64]) -> Result<(), KinError> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(KinError::NotFinite { index }),
+        None => Ok(()),
+    }
+}
+
+/// A static offset frame as `#TRACK CS` and `#CS` give it: translation X, Y, Z (mm) and
+/// rotation A, B, C (degrees) about Z, then Y, then X. By default the translation is measured
+/// in the unrotated frame (`Trans * Rot`); with `rotated_translation` (ROT_TRANS) it is measured
+/// in the already rotated frame (`Rot * Trans`).
+pub fn offset_frame(words: &PoseWords, rotated_translation: bool) -> Result<Isometry3<f64>, KinError> {
+    let frame = words.to_frame(RotationOrder::Zyx)?;
+    if rotated_translation {
+        Ok(Isometry3::from_parts(
+            Translation3::from(frame.rotation * frame.translation.vector),
+            frame.rotation,
+        ))
+    } else {
+        Ok(frame)
+    }
+}
+
+/// The frame of an HLI coordinate system (translation 0.1 um, rotation 0.0001 degree, angles
+/// in `order`; the dynamic CS uses [`RotationOrder::Zyx`]).
+pub fn frame_from_hli(cs: &HliCoordinateSystemInt, order: RotationOrder) -> Isometry3<f64> {
+    let words = PoseWords {
+        xyz: cs.translation.map(mm_from_hli),
+        abc: cs.rotation.map(deg_from_hli),
+    };
+    words.to_frame(order).expect("integers are finite")
+}
+
+/// The HLI coordinate system of a frame, rounded to the HLI units.
+pub fn frame_to_hli(frame: &Isometry3<f64>, order: RotationOrder) -> Result<HliCoordinateSystemInt, KinError> {
+    let words = PoseWords::from_frame(frame, order);
+    let mut cs = HliCoordinateSystemInt {
+        translation: [0; 3],
+        fill_up_2: 0,
+        rotation: [0; 3],
+        fill_up_1: 0,
+    };
+    for i in 0..3 {
+        cs.translation[i] = mm_to_hli(words.xyz[i]).map_err(KinError::Units)?;
+        cs.rotation[i] = deg_to_hli(words.abc[i]).map_err(KinError::Units)?;
+    }
+    Ok(cs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const ORDERS: [RotationOrder; 4] = [
+        RotationOrder::YawPitchRoll,
+        RotationOrder::EulerZyz,
+        RotationOrder::Cba,
+        RotationOrder::Zyx,
+    ];
+
+    fn rot_close(a: &Rotation3<f64>, b: &Rotation3<f64>, tol: f64) -> bool {
+        (a.matrix() - b.matrix()).abs().max() <= tol
+    }
+
+    #[test]
+    fn default_convention_negates_b() {
+        // B = 90 in yaw-pitch-roll turns +X down onto -Z... by Ry(-90): x -> +z.
+        let r = RotationOrder::YawPitchRoll.rotation([0.0, 90.0, 0.0]);
+        let x = r * Vector3::x();
+        assert!((x - Vector3::z()).norm() < 1e-15, "{x}");
+        // The same frame in Z-Y-X order needs -B.
+        let r2 = RotationOrder::Zyx.rotation([10.0, -30.0, 45.0]);
+        let r1 = RotationOrder::YawPitchRoll.rotation([10.0, 30.0, 45.0]);
+        assert!(rot_close(&r1, &r2, 1e-15));
+    }
+
+    #[test]
+    fn known_rotations() {
+        let c90 = RotationOrder::Zyx.rotation([0.0, 0.0, 90.0]);
+        assert!(((c90 * Vector3::x()) - Vector3::y()).norm() < 1e-15);
+        let zyz = RotationOrder::EulerZyz.rotation([90.0, 90.0, 0.0]);
+        // Ry(90) takes +Z to +X, then Rz(90) takes +X to +Y.
+        assert!(((zyz * Vector3::z()) - Vector3::y()).norm() < 1e-15);
+        let cba = RotationOrder::Cba.rotation([90.0, 0.0, 0.0]);
+        assert!(rot_close(&cba, &c90, 1e-15));
+    }
+
+    #[test]
+    fn channel_parameter_selects_the_convention() {
+        assert_eq!(RotationOrder::from_channel_parameter(0).unwrap(), RotationOrder::YawPitchRoll);
+        assert_eq!(RotationOrder::from_channel_parameter(1).unwrap(), RotationOrder::EulerZyz);
+        assert_eq!(RotationOrder::from_channel_parameter(2).unwrap(), RotationOrder::Cba);
+        assert!(RotationOrder::from_channel_parameter(3).is_err());
+    }
+
+    #[test]
+    fn gimbal_lock_keeps_the_rotation() {
+        for order in ORDERS {
+            for mid in [90.0, -90.0, 0.0, 180.0] {
+                let r = order.rotation([25.0, mid, -40.0]);
+                let back = order.rotation(order.angles(&r));
+                assert!(rot_close(&r, &back, 1e-12), "{order:?} {mid}");
+            }
+        }
+    }
+
+    #[test]
+    fn hli_integers_round_trip_exactly() {
+        let cs = HliCoordinateSystemInt {
+            translation: [13_059_200, -1, 8_000_000],
+            fill_up_2: 0,
+            rotation: [100_000, -450_000, 1_799_999],
+            fill_up_1: 0,
+        };
+        let frame = frame_from_hli(&cs, RotationOrder::Zyx);
+        assert_eq!(frame_to_hli(&frame, RotationOrder::Zyx).unwrap(), cs);
+        assert!((frame.translation.vector.x - 1305.92).abs() < 1e-12);
+    }
+
+    #[test]
+    fn offsets_with_and_without_rot_trans() {
+        let words = PoseWords { xyz: [400.0, 700.0, 0.0], abc: [0.0, 0.0, -90.0] };
+        let plain = offset_frame(&words, false).unwrap();
+        assert!((plain.translation.vector - Vector3::new(400.0, 700.0, 0.0)).norm() < 1e-12);
+        let rotated = offset_frame(&words, true).unwrap();
+        // Translation measured in the frame turned by -90 about Z: (400, 700) -> (700, -400).
+        assert!((rotated.translation.vector - Vector3::new(700.0, -400.0, 0.0)).norm() < 1e-9);
+        assert!(offset_frame(&PoseWords { xyz: [f64::NAN, 0.0, 0.0], abc: [0.0; 3] }, false).is_err());
+    }
+
+    proptest! {
+        #[test]
+        fn angles_round_trip_in_principal_ranges(a in -179.0f64..179.0, b in -89.0f64..89.0, c in -179.0f64..179.0, zb in 1.0f64..179.0) {
+            for order in [RotationOrder::YawPitchRoll, RotationOrder::Cba, RotationOrder::Zyx] {
+                let back = order.angles(&order.rotation([a, b, c]));
+                for (x, y) in back.iter().zip([a, b, c]) {
+                    prop_assert!((x - y).abs() < 1e-12, "{:?}: {:?} vs {:?}", order, back, [a, b, c]);
+                }
+            }
+            let back = RotationOrder::EulerZyz.angles(&RotationOrder::EulerZyz.rotation([a, zb, c]));
+            for (x, y) in back.iter().zip([a, zb, c]) {
+                prop_assert!((x - y).abs() < 1e-12, "zyz {:?}", back);
+            }
+        }
+
+        #[test]
+        fn rotations_round_trip_everywhere(a in -360.0f64..360.0, b in -360.0f64..360.0, c in -360.0f64..360.0) {
+            for order in ORDERS {
+                let r = order.rotation([a, b, c]);
+                prop_assert!(rot_close(&r, &order.rotation(order.angles(&r)), 1e-12));
+            }
+        }
+    }
+}
