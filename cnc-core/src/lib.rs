@@ -1,5 +1,6 @@
 //! The CNC process. This first version holds the cyclic HLI demo (`cnc demo`) and the HLI
-//! tooling (`cnc hli symbols`, `cnc hli header`); channels, interpolation and axes follow.
+//! tooling (`cnc hli symbols`, `cnc hli header`) and kinematics from the command line (`cnc kin`); channels, interpolation and axes follow.
 
 pub mod demo;
+pub mod kin_cli;
 pub mod stats;

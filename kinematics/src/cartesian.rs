@@ -19,7 +19,11 @@ pub struct Cartesian {
 
 impl Cartesian {
     /// Cartesian axes with orientation words in `order` and a tool offset (Z-Y-X angles).
-    pub fn new(order: RotationOrder, tool: &PoseWords, limits: [JointLimit; 6]) -> Result<Self, KinError> {
+    pub fn new(
+        order: RotationOrder,
+        tool: &PoseWords,
+        limits: [JointLimit; 6],
+    ) -> Result<Self, KinError> {
         let tool = offset_frame(tool, false)?;
         Ok(Self {
             order,
@@ -32,8 +36,12 @@ impl Cartesian {
 
 impl Default for Cartesian {
     fn default() -> Self {
-        Self::new(RotationOrder::default(), &PoseWords::default(), [JointLimit::NONE; 6])
-            .expect("zero tool is valid")
+        Self::new(
+            RotationOrder::default(),
+            &PoseWords::default(),
+            [JointLimit::NONE; 6],
+        )
+        .expect("zero tool is valid")
     }
 }
 
@@ -66,7 +74,14 @@ impl Kinematics for Cartesian {
         let mut solutions = Solutions::default();
         let mut violation = None;
         for abc in [[a, b, c], alternative] {
-            let mut joints = [words.xyz[0], words.xyz[1], words.xyz[2], abc[0], abc[1], abc[2]];
+            let mut joints = [
+                words.xyz[0],
+                words.xyz[1],
+                words.xyz[2],
+                abc[0],
+                abc[1],
+                abc[2],
+            ];
             let mut ok = true;
             for i in 0..6 {
                 let fitted = if i < 3 {
@@ -93,7 +108,9 @@ impl Kinematics for Cartesian {
             }
         }
         if solutions.is_empty() {
-            return Err(violation.unwrap_or(KinError::Unreachable { reason: "no solution" }));
+            return Err(violation.unwrap_or(KinError::Unreachable {
+                reason: "no solution",
+            }));
         }
         Ok(solutions)
     }

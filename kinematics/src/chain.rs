@@ -95,13 +95,14 @@ impl SerialChain {
                 JointKind::Revolute => ((q[i] + row.theta).to_radians(), row.d),
                 JointKind::Prismatic => (row.theta.to_radians(), row.d + q[i]),
             };
-            t = t * Isometry3::from_parts(
-                Translation3::identity(),
-                UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta),
-            ) * Isometry3::from_parts(
-                Translation3::new(row.a, 0.0, d),
-                UnitQuaternion::from_axis_angle(&Vector3::x_axis(), row.alpha.to_radians()),
-            );
+            t =
+                t * Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&Vector3::z_axis(), theta),
+                ) * Isometry3::from_parts(
+                    Translation3::new(row.a, 0.0, d),
+                    UnitQuaternion::from_axis_angle(&Vector3::x_axis(), row.alpha.to_radians()),
+                );
         }
         (axes, t * self.tool)
     }

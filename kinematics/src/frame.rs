@@ -145,7 +145,10 @@ pub fn check_finite(values: &[f64]) -> Result<(), KinError> {
 /// rotation A, B, C (degrees) about Z, then Y, then X. By default the translation is measured
 /// in the unrotated frame (`Trans * Rot`); with `rotated_translation` (ROT_TRANS) it is measured
 /// in the already rotated frame (`Rot * Trans`).
-pub fn offset_frame(words: &PoseWords, rotated_translation: bool) -> Result<Isometry3<f64>, KinError> {
+pub fn offset_frame(
+    words: &PoseWords,
+    rotated_translation: bool,
+) -> Result<Isometry3<f64>, KinError> {
     let frame = words.to_frame(RotationOrder::Zyx)?;
     if rotated_translation {
         Ok(Isometry3::from_parts(
@@ -168,7 +171,10 @@ pub fn frame_from_hli(cs: &HliCoordinateSystemInt, order: RotationOrder) -> Isom
 }
 
 /// The HLI coordinate system of a frame, rounded to the HLI units.
-pub fn frame_to_hli(frame: &Isometry3<f64>, order: RotationOrder) -> Result<HliCoordinateSystemInt, KinError> {
+pub fn frame_to_hli(
+    frame: &Isometry3<f64>,
+    order: RotationOrder,
+) -> Result<HliCoordinateSystemInt, KinError> {
     let words = PoseWords::from_frame(frame, order);
     let mut cs = HliCoordinateSystemInt {
         translation: [0; 3],
@@ -224,9 +230,18 @@ mod tests {
 
     #[test]
     fn channel_parameter_selects_the_convention() {
-        assert_eq!(RotationOrder::from_channel_parameter(0).unwrap(), RotationOrder::YawPitchRoll);
-        assert_eq!(RotationOrder::from_channel_parameter(1).unwrap(), RotationOrder::EulerZyz);
-        assert_eq!(RotationOrder::from_channel_parameter(2).unwrap(), RotationOrder::Cba);
+        assert_eq!(
+            RotationOrder::from_channel_parameter(0).unwrap(),
+            RotationOrder::YawPitchRoll
+        );
+        assert_eq!(
+            RotationOrder::from_channel_parameter(1).unwrap(),
+            RotationOrder::EulerZyz
+        );
+        assert_eq!(
+            RotationOrder::from_channel_parameter(2).unwrap(),
+            RotationOrder::Cba
+        );
         assert!(RotationOrder::from_channel_parameter(3).is_err());
     }
 
@@ -256,13 +271,23 @@ mod tests {
 
     #[test]
     fn offsets_with_and_without_rot_trans() {
-        let words = PoseWords { xyz: [400.0, 700.0, 0.0], abc: [0.0, 0.0, -90.0] };
+        let words = PoseWords {
+            xyz: [400.0, 700.0, 0.0],
+            abc: [0.0, 0.0, -90.0],
+        };
         let plain = offset_frame(&words, false).unwrap();
         assert!((plain.translation.vector - Vector3::new(400.0, 700.0, 0.0)).norm() < 1e-12);
         let rotated = offset_frame(&words, true).unwrap();
         // Translation measured in the frame turned by -90 about Z: (400, 700) -> (700, -400).
         assert!((rotated.translation.vector - Vector3::new(700.0, -400.0, 0.0)).norm() < 1e-9);
-        assert!(offset_frame(&PoseWords { xyz: [f64::NAN, 0.0, 0.0], abc: [0.0; 3] }, false).is_err());
+        assert!(offset_frame(
+            &PoseWords {
+                xyz: [f64::NAN, 0.0, 0.0],
+                abc: [0.0; 3]
+            },
+            false
+        )
+        .is_err());
     }
 
     proptest! {

@@ -161,12 +161,15 @@ fn limits(pairs: [(f64, f64); 6]) -> [JointLimit; 6] {
 #[derive(Debug, Clone, Copy)]
 struct Geometry {
     a1: f64,
-    a2: f64,
     b: f64,
     c1: f64,
     c2: f64,
-    c3: f64,
     c4: f64,
+    /// Distance joint 3 -> wrist centre, and its angle against the forearm.
+    k: f64,
+    psi3: f64,
+    sin_psi3: f64,
+    cos_psi3: f64,
     offsets_rad: [f64; 6],
     signs: [f64; 6],
 }
@@ -225,16 +228,27 @@ impl Robot45 {
                 });
             }
         }
+        let a2 = -params.j3_to_j5_z;
+        let k = a2.hypot(params.j3_to_j5_x);
         let geometry = Geometry {
+            k,
+            psi3: a2.atan2(params.j3_to_j5_x),
+            sin_psi3: a2 / k,
+            cos_psi3: params.j3_to_j5_x / k,
             a1: params.base_to_j2_x,
-            a2: -params.j3_to_j5_z,
             b: params.lateral_offset,
             c1: params.base_to_j2_z,
             c2: params.j2_to_j3_z,
-            c3: params.j3_to_j5_x,
             c4: params.j5_to_flange,
-            offsets_rad: [0.0, params.j2_zero_offset, params.j3_zero_offset, 0.0, 0.0, 0.0]
-                .map(f64::to_radians),
+            offsets_rad: [
+                0.0,
+                params.j2_zero_offset,
+                params.j3_zero_offset,
+                0.0,
+                0.0,
+                0.0,
+            ]
+            .map(f64::to_radians),
             signs: params.directions,
         };
         let tool = crate::frame::offset_frame(&params.tool, false)?;
@@ -264,11 +278,11 @@ impl Robot45 {
     /// Flange pose of model angles (radians).
     fn flange(&self, q: &[f64; 6]) -> Isometry3<f64> {
         let g = &self.geometry;
-        let psi3 = g.a2.atan2(g.c3);
-        let k = g.a2.hypot(g.c3);
-        let cx1 = g.c2 * q[1].sin() + k * (q[1] + q[2] + psi3).sin() + g.a1;
+        let (sin2, cos2) = q[1].sin_cos();
+        let (sin_w, cos_w) = (q[1] + q[2] + g.psi3).sin_cos();
+        let cx1 = g.c2 * sin2 + g.k * sin_w + g.a1;
         let cy1 = g.b;
-        let cz1 = g.c2 * q[1].cos() + k * (q[1] + q[2] + psi3).cos();
+        let cz1 = g.c2 * cos2 + g.k * cos_w;
         let (s1, c1) = q[0].sin_cos();
         let centre = Vector3::new(cx1 * c1 - cy1 * s1, cx1 * s1 + cy1 * c1, cz1 + g.c1);
         let r = arm_rotation(q[0], q[1], q[2]) * wrist_rotation(q[3], q[4], q[5]);
@@ -279,108 +293,201 @@ impl Robot45 {
         )
     }
 
-    /// All model-angle solutions (radians) for a flange pose; `current` in model angles
-    /// resolves singular configurations.
-    fn solve(&self, flange: &Isometry3<f64>, current: &[f64; 6], out: &mut [[f64; 6]; 8]) -> usize {
+    /// The up to four arm configurations (joints 1-3, model radians) that put the wrist
+    /// centre of `flange` in place; `current` (model angles) resolves the shoulder singularity.
+    ///
+    /// Speed: sines and cosines of the arm angles come from the triangle's sides by the
+    /// angle-addition formulas instead of trigonometric calls; only the output angles
+    /// themselves cost an `acos`/`atan2`.
+    fn arm_configs(
+        &self,
+        flange: &Isometry3<f64>,
+        current: &[f64; 6],
+        out: &mut [ArmConfig; 4],
+    ) -> usize {
         let g = &self.geometry;
-        let r = flange.rotation.to_rotation_matrix().into_inner();
-        let z = r.column(2);
-        let centre = flange.translation.vector - g.c4 * z;
+        let centre = flange.translation.vector - g.c4 * (flange.rotation * Vector3::z());
         let (cx, cy, cz) = (centre.x, centre.y, centre.z);
 
-        let radial_sq = cx * cx + cy * cy - g.b * g.b;
+        let rho = (cx * cx + cy * cy).sqrt();
+        let radial_sq = rho * rho - g.b * g.b;
         if radial_sq < 0.0 {
             return 0;
         }
         let nx1 = radial_sq.sqrt() - g.a1;
-        let shoulder_singular = cx.hypot(cy) < 1e-9 && g.b.abs() < 1e-12;
-        let (theta1_i, theta1_ii) = if shoulder_singular {
-            (current[0], current[0] - core::f64::consts::PI)
+        // Joint 1 of the first shoulder configuration, with its sine and cosine; the second
+        // configuration is turned by a further 2*lateral - pi.
+        let (theta1_i, sin1, cos1, theta1_ii, sin1_ii, cos1_ii) = if rho < 1e-9 && g.b.abs() < 1e-12
+        {
+            let (s, c) = current[0].sin_cos();
+            (current[0], s, c, current[0] - core::f64::consts::PI, -s, -c)
+        } else if g.b == 0.0 {
+            let (s, c) = (cy / rho, cx / rho);
+            let t = cy.atan2(cx);
+            (t, s, c, t - core::f64::consts::PI, -s, -c)
         } else {
             let base = cy.atan2(cx);
             let lateral = g.b.atan2(nx1 + g.a1);
-            (base - lateral, base + lateral - core::f64::consts::PI)
+            let (t1, t2) = (base - lateral, base + lateral - core::f64::consts::PI);
+            let ((s1, c1), (s2, c2)) = (t1.sin_cos(), t2.sin_cos());
+            (t1, s1, c1, t2, s2, c2)
         };
 
         let dz = cz - g.c1;
-        let s1_sq = nx1 * nx1 + dz * dz;
-        let s2_sq = (nx1 + 2.0 * g.a1).powi(2) + dz * dz;
-        let k_sq = g.a2 * g.a2 + g.c3 * g.c3;
-        let (s1, s2, k) = (s1_sq.sqrt(), s2_sq.sqrt(), k_sq.sqrt());
-        let psi3 = g.a2.atan2(g.c3);
-
-        let acos_checked = |x: f64| -> Option<f64> {
-            // Tolerate rounding at the workspace boundary; beyond it there is no solution.
-            if x.abs() > 1.0 + 1e-12 {
-                None
-            } else {
-                Some(x.clamp(-1.0, 1.0).acos())
-            }
-        };
-
+        let k_sq = g.k * g.k;
         let mut n = 0;
         let arms = [
-            (theta1_i, s1, s1_sq, nx1, 1.0),
-            (theta1_ii, s2, s2_sq, nx1 + 2.0 * g.a1, -1.0),
+            (theta1_i, sin1, cos1, nx1, 1.0),
+            (theta1_ii, sin1_ii, cos1_ii, nx1 + 2.0 * g.a1, -1.0),
         ];
-        for (theta1, s, s_sq, reach_x, side) in arms {
-            let (Some(alpha), Some(beta)) = (
-                acos_checked((s_sq + g.c2 * g.c2 - k_sq) / (2.0 * s * g.c2)),
-                acos_checked((s_sq - g.c2 * g.c2 - k_sq) / (2.0 * g.c2 * k)),
-            ) else {
+        for (theta1, sin_t1, cos_t1, reach_x, side) in arms {
+            let s_sq = reach_x * reach_x + dz * dz;
+            let s = s_sq.sqrt();
+            if s < 1e-12 {
+                continue; // wrist centre on joint 2: not a configuration of this arm
+            }
+            let cos_alpha = (s_sq + g.c2 * g.c2 - k_sq) / (2.0 * s * g.c2);
+            let cos_beta = (s_sq - g.c2 * g.c2 - k_sq) / (2.0 * g.c2 * g.k);
+            // Tolerate rounding at the workspace boundary; beyond it there is no solution.
+            if cos_alpha.abs() > 1.0 + 1e-12 || cos_beta.abs() > 1.0 + 1e-12 {
                 continue;
-            };
+            }
+            let (cos_alpha, cos_beta) = (cos_alpha.clamp(-1.0, 1.0), cos_beta.clamp(-1.0, 1.0));
+            let sin_alpha = (1.0 - cos_alpha * cos_alpha).sqrt();
+            let sin_beta = (1.0 - cos_beta * cos_beta).sqrt();
+            let (alpha, beta) = (cos_alpha.acos(), cos_beta.acos());
             let phi = reach_x.atan2(dz);
+            let (sin_phi, cos_phi) = (side * reach_x / s, dz / s); // of side * phi
             for elbow in [-1.0, 1.0] {
-                let theta2 = elbow * alpha + side * phi;
-                let theta3 = -elbow * beta - psi3;
-                for wrist in self.wrist(&r, theta1, theta2, theta3, current) {
-                    out[n] = [theta1, theta2, theta3, wrist[0], wrist[1], wrist[2]];
-                    n += 1;
-                }
+                // theta2 + theta3 = elbow * (alpha - beta) + side * phi - psi3
+                let sin_d = elbow * (sin_alpha * cos_beta - cos_alpha * sin_beta);
+                let cos_d = cos_alpha * cos_beta + sin_alpha * sin_beta;
+                let (sin_e, cos_e) = (
+                    sin_d * cos_phi + cos_d * sin_phi,
+                    cos_d * cos_phi - sin_d * sin_phi,
+                );
+                out[n] = ArmConfig {
+                    angles: [theta1, elbow * alpha + side * phi, -elbow * beta - g.psi3],
+                    rotation: arm_rotation_sc(
+                        sin_t1,
+                        cos_t1,
+                        sin_e * g.cos_psi3 - cos_e * g.sin_psi3,
+                        cos_e * g.cos_psi3 + sin_e * g.sin_psi3,
+                    ),
+                };
+                n += 1;
             }
         }
         n
     }
 
-    /// The two wrist solutions (theta4, theta5, theta6) for an arm configuration.
-    fn wrist(&self, r: &Matrix3<f64>, t1: f64, t2: f64, t3: f64, current: &[f64; 6]) -> [[f64; 3]; 2] {
-        let r_ce = arm_rotation(t1, t2, t3).transpose() * r;
-        let m = r_ce[(2, 2)].clamp(-1.0, 1.0);
-        // |sin(theta5)| from the other two entries of the column: sqrt(1 - m^2) would lose half
-        // the digits near the wrist singularity.
-        let sin5 = r_ce[(0, 2)].hypot(r_ce[(1, 2)]);
-        if sin5 < 1e-9 {
-            // Wrist singular: joints 4 and 6 share an axis. Keep joint 4, give joint 6 the rest.
-            let phi = r_ce[(1, 0)].atan2(r_ce[(0, 0)]);
-            let t5 = if m > 0.0 { 0.0 } else { core::f64::consts::PI };
-            let t4 = current[3];
-            let t6 = if m > 0.0 {
-                phi - t4
-            } else {
-                t4 - phi + core::f64::consts::PI
-            };
-            return [[t4, t5, t6], [t4, t5, t6]];
+    /// Joint values of model angles, each turned to lie nearest `current` within its limits;
+    /// `Err((joint index, value))` for the first joint that fits no turn.
+    fn finish(&self, model: &[f64; 6], current: &Joints) -> Result<Joints, (usize, f64)> {
+        let mut joints = self.from_model(model);
+        for i in 0..6 {
+            joints[i] = nearest_turn(joints[i], current[i], &self.params.limits[i])
+                .ok_or((i, joints[i]))?;
         }
-        let t5 = sin5.atan2(m);
-        let t4 = r_ce[(1, 2)].atan2(r_ce[(0, 2)]);
-        let t6 = r_ce[(2, 1)].atan2(-r_ce[(2, 0)]);
-        [
-            [t4, t5, t6],
-            [t4 + core::f64::consts::PI, -t5, t6 - core::f64::consts::PI],
-        ]
+        Ok(joints)
     }
+
+    fn limit_error(&self, (joint, value): (usize, f64)) -> KinError {
+        let l = self.params.limits[joint];
+        KinError::JointLimit {
+            joint: joint + 1,
+            value,
+            min: l.min,
+            max: l.max,
+        }
+    }
+
+    /// Shared start of both inverses: validated input, flange pose, arm configurations.
+    fn prepare(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Prepared, KinError> {
+        check_pose(pose)?;
+        check_finite(current)?;
+        let flange = pose * self.tool_inverse;
+        let current_model = self.to_model(current);
+        let mut arms = [ArmConfig::default(); 4];
+        let count = self.arm_configs(&flange, &current_model, &mut arms);
+        if count == 0 {
+            return Err(KinError::Unreachable {
+                reason: "outside the arm's reach",
+            });
+        }
+        Ok(Prepared {
+            rotation: flange.rotation.to_rotation_matrix().into_inner(),
+            current4: current_model[3],
+            arms,
+            count,
+        })
+    }
+}
+
+/// Joints 1-3 of one arm configuration (model radians) and their rotation.
+#[derive(Debug, Clone, Copy, Default)]
+struct ArmConfig {
+    angles: [f64; 3],
+    rotation: Matrix3<f64>,
+}
+
+#[derive(Debug)]
+struct Prepared {
+    rotation: Matrix3<f64>,
+    current4: f64,
+    arms: [ArmConfig; 4],
+    count: usize,
+}
+
+/// The two wrist solutions (theta4, theta5, theta6) for an arm rotation.
+fn wrist_solutions(arm: &Matrix3<f64>, r: &Matrix3<f64>, current4: f64) -> [[f64; 3]; 2] {
+    let r_ce = arm.transpose() * r;
+    let m = r_ce[(2, 2)].clamp(-1.0, 1.0);
+    // |sin(theta5)| from the other two entries of the column: sqrt(1 - m^2) would lose half
+    // the digits near the wrist singularity.
+    let sin5 = (r_ce[(0, 2)] * r_ce[(0, 2)] + r_ce[(1, 2)] * r_ce[(1, 2)]).sqrt();
+    if sin5 < 1e-9 {
+        // Wrist singular: joints 4 and 6 share an axis. Keep joint 4, give joint 6 the rest.
+        let phi = r_ce[(1, 0)].atan2(r_ce[(0, 0)]);
+        let (t5, t6) = if m > 0.0 {
+            (0.0, phi - current4)
+        } else {
+            (
+                core::f64::consts::PI,
+                current4 - phi + core::f64::consts::PI,
+            )
+        };
+        return [[current4, t5, t6], [current4, t5, t6]];
+    }
+    let t5 = sin5.atan2(m);
+    let t4 = r_ce[(1, 2)].atan2(r_ce[(0, 2)]);
+    let t6 = r_ce[(2, 1)].atan2(-r_ce[(2, 0)]);
+    [
+        [t4, t5, t6],
+        [t4 + core::f64::consts::PI, -t5, t6 - core::f64::consts::PI],
+    ]
+}
+
+/// Rotation of the arm (joints 1-3) from sin/cos of joint 1 and of joints 2+3.
+fn arm_rotation_sc(s1: f64, c1: f64, s23: f64, c23: f64) -> Matrix3<f64> {
+    Matrix3::new(
+        c1 * c23,
+        -s1,
+        c1 * s23, //
+        s1 * c23,
+        c1,
+        s1 * s23, //
+        -s23,
+        0.0,
+        c23,
+    )
 }
 
 /// Rotation of the arm (joints 1-3) in the model.
 fn arm_rotation(q1: f64, q2: f64, q3: f64) -> Matrix3<f64> {
     let (s1, c1) = q1.sin_cos();
     let (s23, c23) = (q2 + q3).sin_cos();
-    Matrix3::new(
-        c1 * c23, -s1, c1 * s23, //
-        s1 * c23, c1, s1 * s23, //
-        -s23, 0.0, c23,
-    )
+    arm_rotation_sc(s1, c1, s23, c23)
 }
 
 /// Rotation of the spherical wrist (Z-Y-Z).
@@ -412,52 +519,100 @@ impl Kinematics for Robot45 {
     }
 
     fn inverse_all(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Solutions, KinError> {
-        check_pose(pose)?;
-        check_finite(current)?;
-        let flange = pose * self.tool_inverse;
-        let current_model = self.to_model(current);
-        let mut raw = [[0.0; 6]; 8];
-        let n = self.solve(&flange, &current_model, &mut raw);
-        if n == 0 {
-            return Err(KinError::Unreachable {
-                reason: "outside the arm's reach",
-            });
-        }
+        let prepared = self.prepare(pose, current)?;
         let mut solutions = Solutions::default();
-        let mut nearest_violation: Option<(f64, KinError)> = None;
-        'candidates: for model in &raw[..n] {
-            let mut joints = self.from_model(model);
-            for i in 0..6 {
-                match nearest_turn(joints[i], current[i], &self.params.limits[i]) {
-                    Some(v) => joints[i] = v,
-                    None => {
-                        let d = distance_sq(&joints, current);
-                        if nearest_violation.is_none_or(|(best, _)| d < best) {
-                            let l = self.params.limits[i];
-                            nearest_violation = Some((
-                                d,
-                                KinError::JointLimit {
-                                    joint: i + 1,
-                                    value: joints[i],
-                                    min: l.min,
-                                    max: l.max,
-                                },
-                            ));
+        let mut nearest_violation: Option<(f64, (usize, f64))> = None;
+        for arm in &prepared.arms[..prepared.count] {
+            for wrist in wrist_solutions(&arm.rotation, &prepared.rotation, prepared.current4) {
+                let model = [
+                    arm.angles[0],
+                    arm.angles[1],
+                    arm.angles[2],
+                    wrist[0],
+                    wrist[1],
+                    wrist[2],
+                ];
+                match self.finish(&model, current) {
+                    Ok(joints) => {
+                        if !solutions
+                            .as_slice()
+                            .iter()
+                            .any(|s| distance_sq(s, &joints) < 1e-18)
+                        {
+                            solutions.push(joints);
                         }
-                        continue 'candidates;
+                    }
+                    Err(violation) => {
+                        let d = distance_sq(&self.from_model(&model), current);
+                        if nearest_violation.is_none_or(|(best, _)| d < best) {
+                            nearest_violation = Some((d, violation));
+                        }
                     }
                 }
             }
-            if !solutions.as_slice().iter().any(|s| distance_sq(s, &joints) < 1e-18) {
-                solutions.push(joints);
-            }
         }
         if solutions.is_empty() {
-            return Err(nearest_violation.map(|(_, e)| e).unwrap_or(KinError::Unreachable {
-                reason: "no solution within the joint limits",
-            }));
+            return Err(match nearest_violation {
+                Some((_, violation)) => self.limit_error(violation),
+                None => KinError::Unreachable {
+                    reason: "no solution within the joint limits",
+                },
+            });
         }
         Ok(solutions)
+    }
+
+    /// The nearest solution without computing every wrist: arm configurations are visited in
+    /// order of their joint 1-3 distance, and one whose arm distance alone exceeds the best
+    /// complete solution so far cannot win. Same result as the minimum over `inverse_all`.
+    fn inverse(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Joints, KinError> {
+        let prepared = self.prepare(pose, current)?;
+        let mut order = [(f64::INFINITY, 0usize); 4];
+        for (i, arm) in prepared.arms[..prepared.count].iter().enumerate() {
+            let model = [arm.angles[0], arm.angles[1], arm.angles[2], 0.0, 0.0, 0.0];
+            let joints = self.from_model(&model);
+            let mut d = 0.0;
+            for j in 0..3 {
+                d += match nearest_turn(joints[j], current[j], &self.params.limits[j]) {
+                    Some(v) => (v - current[j]) * (v - current[j]),
+                    None => f64::INFINITY,
+                };
+            }
+            order[i] = (d, i);
+        }
+        order[..prepared.count].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let mut best: Option<(f64, Joints)> = None;
+        let mut violation = None;
+        for &(arm_distance, index) in &order[..prepared.count] {
+            if best.is_some_and(|(d, _)| arm_distance >= d) {
+                break;
+            }
+            let arm = &prepared.arms[index];
+            for wrist in wrist_solutions(&arm.rotation, &prepared.rotation, prepared.current4) {
+                let model = [
+                    arm.angles[0],
+                    arm.angles[1],
+                    arm.angles[2],
+                    wrist[0],
+                    wrist[1],
+                    wrist[2],
+                ];
+                match self.finish(&model, current) {
+                    Ok(joints) => {
+                        let d = distance_sq(&joints, current);
+                        if best.is_none_or(|(b, _)| d < b) {
+                            best = Some((d, joints));
+                        }
+                    }
+                    Err(v) => violation = violation.or(Some(v)),
+                }
+            }
+        }
+        match (best, violation) {
+            (Some((_, joints)), _) => Ok(joints),
+            // Fall back to the exhaustive search for its error (nearest violation).
+            _ => self.inverse_all(pose, current).map(|s| s.as_slice()[0]),
+        }
     }
 }
 

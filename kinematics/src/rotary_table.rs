@@ -40,7 +40,10 @@ impl Kinematics for RotaryTable {
         check_finite(joints)?;
         let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -joints[3].to_radians());
         let relative = Vector3::new(joints[0], joints[1], joints[2]) - self.centre;
-        Ok(Isometry3::from_parts(Translation3::from(turn * relative), turn))
+        Ok(Isometry3::from_parts(
+            Translation3::from(turn * relative),
+            turn,
+        ))
     }
 
     fn inverse_all(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Solutions, KinError> {
@@ -54,12 +57,13 @@ impl Kinematics for RotaryTable {
         }
         let m = pose.rotation.to_rotation_matrix();
         let yaw = m[(1, 0)].atan2(m[(0, 0)]).to_degrees();
-        let table = nearest_turn(-yaw, current[3], &self.table_limit).ok_or(KinError::JointLimit {
-            joint: 4,
-            value: -yaw,
-            min: self.table_limit.min,
-            max: self.table_limit.max,
-        })?;
+        let table =
+            nearest_turn(-yaw, current[3], &self.table_limit).ok_or(KinError::JointLimit {
+                joint: 4,
+                value: -yaw,
+                min: self.table_limit.min,
+                max: self.table_limit.max,
+            })?;
         let turn = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), table.to_radians());
         let machine = self.centre + turn * pose.translation.vector;
         let mut solutions = Solutions::default();

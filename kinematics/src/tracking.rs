@@ -118,16 +118,24 @@ impl Tracking {
 fn apply_option(option: TrackingOption, frame: &Isometry3<f64>) -> Isometry3<f64> {
     match option {
         TrackingOption::Full => *frame,
-        TrackingOption::TranslationOnly => {
-            Isometry3::from_parts(Translation3::from(frame.translation.vector), UnitQuaternion::identity())
-        }
+        TrackingOption::TranslationOnly => Isometry3::from_parts(
+            Translation3::from(frame.translation.vector),
+            UnitQuaternion::identity(),
+        ),
     }
 }
 
 /// `V.G.TRACK_CS.X, Y, Z, A, B, C` of a master frame, angles in the channel's convention.
 pub fn track_cs_values(master: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
     let words = PoseWords::from_frame(master, order);
-    [words.xyz[0], words.xyz[1], words.xyz[2], words.abc[0], words.abc[1], words.abc[2]]
+    [
+        words.xyz[0],
+        words.xyz[1],
+        words.xyz[2],
+        words.abc[0],
+        words.abc[1],
+        words.abc[2],
+    ]
 }
 
 /// `#TRACK CS ABS`: programmed axis values plus the per-axis zero taken from the master.

@@ -32,9 +32,34 @@ static GLOBAL: Counting = Counting;
 fn kinematic_calls_do_not_allocate() {
     let robot = Robot45::new(Robot45Params::kuka_kr6_r900_sixx()).unwrap();
     let cartesian = Cartesian::default();
-    let row = |a, alpha, d| DhJoint { a, alpha, d, theta: 0.0, kind: JointKind::Revolute, limit: JointLimit::NONE };
-    let chain = SerialChain::new(&[row(25.0, -90.0, 400.0), row(455.0, 0.0, 0.0), row(35.0, -90.0, 0.0), row(0.0, 90.0, 420.0), row(0.0, -90.0, 0.0), row(0.0, 0.0, 80.0)], &PoseWords::default()).unwrap();
-    let tracking = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &PoseWords::default(), false, None).unwrap();
+    let row = |a, alpha, d| DhJoint {
+        a,
+        alpha,
+        d,
+        theta: 0.0,
+        kind: JointKind::Revolute,
+        limit: JointLimit::NONE,
+    };
+    let chain = SerialChain::new(
+        &[
+            row(25.0, -90.0, 400.0),
+            row(455.0, 0.0, 0.0),
+            row(35.0, -90.0, 0.0),
+            row(0.0, 90.0, 420.0),
+            row(0.0, -90.0, 0.0),
+            row(0.0, 0.0, 80.0),
+        ],
+        &PoseWords::default(),
+    )
+    .unwrap();
+    let tracking = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &PoseWords::default(),
+        false,
+        None,
+    )
+    .unwrap();
     let joints = [10.0, -80.0, 70.0, 20.0, 30.0, 40.0];
 
     let before = ALLOCATIONS.load(Ordering::Relaxed);

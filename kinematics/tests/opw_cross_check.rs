@@ -34,12 +34,18 @@ fn cases_file() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(std::env::var_os("HOME").expect("HOME")).join(".cargo"));
     let registry = home.join("registry").join("src");
     for index in std::fs::read_dir(&registry).expect("cargo registry sources") {
-        let path = index.unwrap().path().join("rs-opw-kinematics-3.0.0/src/tests/data/cases.yaml");
+        let path = index
+            .unwrap()
+            .path()
+            .join("rs-opw-kinematics-3.0.0/src/tests/data/cases.yaml");
         if path.exists() {
             return path;
         }
     }
-    panic!("rs-opw-kinematics 3.0.0 sources not found under {}", registry.display());
+    panic!(
+        "rs-opw-kinematics 3.0.0 sources not found under {}",
+        registry.display()
+    );
 }
 
 fn load_cases() -> Vec<Case> {
@@ -47,8 +53,15 @@ fn load_cases() -> Vec<Case> {
     let mut cases = Vec::new();
     let mut lines = text.lines().map(str::trim);
     while let Some(line) = lines.next() {
-        let Some(id) = line.strip_prefix("- id:") else { continue };
-        let robot = lines.next().unwrap().trim_start_matches("parameters:").trim().to_string();
+        let Some(id) = line.strip_prefix("- id:") else {
+            continue;
+        };
+        let robot = lines
+            .next()
+            .unwrap()
+            .trim_start_matches("parameters:")
+            .trim()
+            .to_string();
         let joints = numbers(lines.next().unwrap());
         let pose_line = lines.next().unwrap();
         let (t, q) = pose_line.split_once("quaternion").unwrap();
@@ -72,7 +85,11 @@ fn ours(robot: &str) -> Robot45 {
         other => panic!("unexpected robot {other}"),
     };
     // The published cases ignore joint limits.
-    Robot45::new(Robot45Params { limits: [JointLimit::NONE; 6], ..params }).unwrap()
+    Robot45::new(Robot45Params {
+        limits: [JointLimit::NONE; 6],
+        ..params
+    })
+    .unwrap()
 }
 
 fn theirs(robot: &str) -> OPWKinematics {
@@ -102,15 +119,28 @@ fn forward_and_inverse_agree_with_rs_opw_kinematics_on_its_cases() {
         let pose = robot.forward(&case.joints).unwrap();
         let t = pose.translation.vector / 1000.0;
         for (i, expected) in case.translation_m.iter().enumerate() {
-            assert!((t[i] - expected).abs() < 1e-9, "case {}: translation {t} vs {:?}", case.id, case.translation_m);
+            assert!(
+                (t[i] - expected).abs() < 1e-9,
+                "case {}: translation {t} vs {:?}",
+                case.id,
+                case.translation_m
+            );
         }
         let [x, y, z, w] = case.quaternion_xyzw;
         let published = UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z));
-        assert!(pose.rotation.angle_to(&published) < 1e-9, "case {}: rotation", case.id);
+        assert!(
+            pose.rotation.angle_to(&published) < 1e-9,
+            "case {}: rotation",
+            case.id
+        );
 
         // Inverse: our solution set against the crate's, both from the published pose.
         let target = Isometry3::from_parts(
-            Translation3::new(case.translation_m[0] * 1000.0, case.translation_m[1] * 1000.0, case.translation_m[2] * 1000.0),
+            Translation3::new(
+                case.translation_m[0] * 1000.0,
+                case.translation_m[1] * 1000.0,
+                case.translation_m[2] * 1000.0,
+            ),
             published,
         );
         let mine = robot.inverse_all(&target, &[0.0; 6]).unwrap();
@@ -123,7 +153,9 @@ fn forward_and_inverse_agree_with_rs_opw_kinematics_on_its_cases() {
             .into_iter()
             .map(|s| s.map(f64::to_degrees))
             .collect();
-        let wrist_singular = peer_solutions.iter().any(|p| p[4].to_radians().sin().abs() < 1e-6);
+        let wrist_singular = peer_solutions
+            .iter()
+            .any(|p| p[4].to_radians().sin().abs() < 1e-6);
         if wrist_singular {
             // Joints 4 and 6 share (or nearly share) an axis: infinitely many solutions, each
             // solver picks its own representatives, and the problem is ill-conditioned. Ours
@@ -131,17 +163,40 @@ fn forward_and_inverse_agree_with_rs_opw_kinematics_on_its_cases() {
             singular_cases += 1;
             for m in mine.as_slice() {
                 let back = robot.forward(m).unwrap();
-                assert!((back.translation.vector - target.translation.vector).norm() < 1e-7, "case {}: {m:?} gives {} vs {}", case.id, back.translation.vector, target.translation.vector);
-                assert!(back.rotation.angle_to(&target.rotation) < 1e-9, "case {}", case.id);
+                assert!(
+                    (back.translation.vector - target.translation.vector).norm() < 1e-7,
+                    "case {}: {m:?} gives {} vs {}",
+                    case.id,
+                    back.translation.vector,
+                    target.translation.vector
+                );
+                assert!(
+                    back.rotation.angle_to(&target.rotation) < 1e-9,
+                    "case {}",
+                    case.id
+                );
             }
             continue;
         }
-        assert_eq!(mine.len(), peer_solutions.len(), "case {}: solution count, ours {:?} theirs {:?}", case.id, mine.as_slice(), peer_solutions);
+        assert_eq!(
+            mine.len(),
+            peer_solutions.len(),
+            "case {}: solution count, ours {:?} theirs {:?}",
+            case.id,
+            mine.as_slice(),
+            peer_solutions
+        );
         for p in &peer_solutions {
-            let matched = mine.as_slice().iter().any(|m| {
-                m.iter().zip(p).all(|(a, b)| angle_diff(*a, *b) < 1e-9)
-            });
-            assert!(matched, "case {}: peer solution {p:?} not among ours {:?}", case.id, mine.as_slice());
+            let matched = mine
+                .as_slice()
+                .iter()
+                .any(|m| m.iter().zip(p).all(|(a, b)| angle_diff(*a, *b) < 1e-9));
+            assert!(
+                matched,
+                "case {}: peer solution {p:?} not among ours {:?}",
+                case.id,
+                mine.as_slice()
+            );
             compared_solutions += 1;
         }
     }

@@ -14,7 +14,14 @@ fn pose_close(a: &Isometry3<f64>, b: &Isometry3<f64>, tol_mm: f64) -> bool {
 }
 
 fn kuka_like_chain() -> SerialChain {
-    let row = |a, alpha, d| DhJoint { a, alpha, d, theta: 0.0, kind: JointKind::Revolute, limit: JointLimit::NONE };
+    let row = |a, alpha, d| DhJoint {
+        a,
+        alpha,
+        d,
+        theta: 0.0,
+        kind: JointKind::Revolute,
+        limit: JointLimit::NONE,
+    };
     SerialChain::new(
         &[
             row(25.0, -90.0, 400.0),
@@ -24,14 +31,22 @@ fn kuka_like_chain() -> SerialChain {
             row(0.0, -90.0, 0.0),
             row(0.0, 0.0, 80.0),
         ],
-        &PoseWords { xyz: [0.0, 0.0, 50.0], abc: [0.0, 0.0, 0.0] },
+        &PoseWords {
+            xyz: [0.0, 0.0, 50.0],
+            abc: [0.0, 0.0, 0.0],
+        },
     )
     .unwrap()
 }
 
 #[test]
 fn ids_decode() {
-    for id in [KinematicId::Cartesian, KinematicId::Robot45, KinematicId::GenericChain, KinematicId::RotaryTable] {
+    for id in [
+        KinematicId::Cartesian,
+        KinematicId::Robot45,
+        KinematicId::GenericChain,
+        KinematicId::RotaryTable,
+    ] {
         assert_eq!(KinematicId::from_raw(id.raw()).unwrap(), id);
     }
     assert!(KinematicId::from_raw(46).is_err());
@@ -39,26 +54,58 @@ fn ids_decode() {
 
 #[test]
 fn planar_chain_forward_by_hand() {
-    let link = |a| DhJoint { a, alpha: 0.0, d: 0.0, theta: 0.0, kind: JointKind::Revolute, limit: JointLimit::NONE };
+    let link = |a| DhJoint {
+        a,
+        alpha: 0.0,
+        d: 0.0,
+        theta: 0.0,
+        kind: JointKind::Revolute,
+        limit: JointLimit::NONE,
+    };
     let chain = SerialChain::new(&[link(100.0), link(50.0)], &PoseWords::default()).unwrap();
     let pose = chain.forward(&[90.0, 0.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
     assert!((pose.translation.vector - Vector3::new(0.0, 150.0, 0.0)).norm() < 1e-12);
     let pose = chain.forward(&[90.0, -90.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
     assert!((pose.translation.vector - Vector3::new(50.0, 100.0, 0.0)).norm() < 1e-12);
-    let slide = DhJoint { a: 0.0, alpha: 0.0, d: 10.0, theta: 0.0, kind: JointKind::Prismatic, limit: JointLimit { min: 0.0, max: 500.0 } };
+    let slide = DhJoint {
+        a: 0.0,
+        alpha: 0.0,
+        d: 10.0,
+        theta: 0.0,
+        kind: JointKind::Prismatic,
+        limit: JointLimit {
+            min: 0.0,
+            max: 500.0,
+        },
+    };
     let lift = SerialChain::new(&[slide], &PoseWords::default()).unwrap();
-    let up = Isometry3::from_parts(Translation3::new(0.0, 0.0, 210.0), UnitQuaternion::identity());
+    let up = Isometry3::from_parts(
+        Translation3::new(0.0, 0.0, 210.0),
+        UnitQuaternion::identity(),
+    );
     let q = lift.inverse(&up, &[0.0; 6]).unwrap();
     assert!((q[0] - 200.0).abs() < 1e-9);
-    let too_high = Isometry3::from_parts(Translation3::new(0.0, 0.0, 900.0), UnitQuaternion::identity());
-    assert!(matches!(lift.inverse(&too_high, &[0.0; 6]), Err(KinError::JointLimit { joint: 1, .. })));
+    let too_high = Isometry3::from_parts(
+        Translation3::new(0.0, 0.0, 900.0),
+        UnitQuaternion::identity(),
+    );
+    assert!(matches!(
+        lift.inverse(&too_high, &[0.0; 6]),
+        Err(KinError::JointLimit { joint: 1, .. })
+    ));
 }
 
 #[test]
 fn chain_refuses_bad_tables_and_unreachable_targets() {
-    assert!(matches!(SerialChain::new(&[], &PoseWords::default()), Err(KinError::BadParameter { .. })));
+    assert!(matches!(
+        SerialChain::new(&[], &PoseWords::default()),
+        Err(KinError::BadParameter { .. })
+    ));
     let chain = kuka_like_chain();
-    let far = Isometry3::from_parts(Translation3::new(4000.0, 0.0, 0.0), UnitQuaternion::identity());
+    let far = Isometry3::from_parts(
+        Translation3::new(4000.0, 0.0, 0.0),
+        UnitQuaternion::identity(),
+    );
     assert!(chain.inverse(&far, &[0.0; 6]).is_err());
 }
 
@@ -96,13 +143,26 @@ fn rotary_table_by_hand() {
     let table = RotaryTable::new([1000.0, 0.0, 0.0], JointLimit::NONE).unwrap();
     let pose = table.forward(&[1100.0, 0.0, 50.0, 90.0, 0.0, 0.0]).unwrap();
     assert!((pose.translation.vector - Vector3::new(0.0, -100.0, 50.0)).norm() < 1e-12);
-    let back = table.inverse(&pose, &[0.0, 0.0, 0.0, 80.0, 0.0, 0.0]).unwrap();
-    assert!((back[0] - 1100.0).abs() < 1e-9 && back[1].abs() < 1e-9 && (back[3] - 90.0).abs() < 1e-9, "{back:?}");
+    let back = table
+        .inverse(&pose, &[0.0, 0.0, 0.0, 80.0, 0.0, 0.0])
+        .unwrap();
+    assert!(
+        (back[0] - 1100.0).abs() < 1e-9 && back[1].abs() < 1e-9 && (back[3] - 90.0).abs() < 1e-9,
+        "{back:?}"
+    );
     // Multi-turn table: the nearest turn to the current angle.
-    let back = table.inverse(&pose, &[0.0, 0.0, 0.0, 440.0, 0.0, 0.0]).unwrap();
+    let back = table
+        .inverse(&pose, &[0.0, 0.0, 0.0, 440.0, 0.0, 0.0])
+        .unwrap();
     assert!((back[3] - 450.0).abs() < 1e-9);
-    let tilted = Isometry3::from_parts(Translation3::new(0.0, 0.0, 0.0), UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.1));
-    assert!(matches!(table.inverse(&tilted, &[0.0; 6]), Err(KinError::Unreachable { .. })));
+    let tilted = Isometry3::from_parts(
+        Translation3::new(0.0, 0.0, 0.0),
+        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.1),
+    );
+    assert!(matches!(
+        table.inverse(&tilted, &[0.0; 6]),
+        Err(KinError::Unreachable { .. })
+    ));
 }
 
 proptest! {

@@ -48,7 +48,11 @@ fn kuka_joint_directions_follow_the_manufacturer() {
     // KUKA A2 = -90 lifts the upper arm vertical; with A3 = 0 the whole arm points up.
     let lifted = robot.forward(&[0.0, -90.0, 0.0, 0.0, 0.0, 0.0]).unwrap();
     let expected = Vector3::new(25.0 - 35.0, 0.0, 400.0 + 455.0 + 420.0 + 80.0);
-    assert!((lifted.translation.vector - expected).norm() < 1e-9, "{}", lifted.translation.vector);
+    assert!(
+        (lifted.translation.vector - expected).norm() < 1e-9,
+        "{}",
+        lifted.translation.vector
+    );
     assert!(((lifted.rotation * Vector3::z()) - Vector3::z()).norm() < 1e-12);
 }
 
@@ -76,7 +80,10 @@ fn wrist_singularity_keeps_joint_4() {
 fn shoulder_singularity_keeps_joint_1() {
     let robot = Robot45::new(Robot45Params::kuka_kr6_r900_sixx()).unwrap();
     // Wrist centre on the joint-1 axis, tool pointing up.
-    let pose = Isometry3::from_parts(Translation3::new(0.0, 0.0, 880.0), UnitQuaternion::identity());
+    let pose = Isometry3::from_parts(
+        Translation3::new(0.0, 0.0, 880.0),
+        UnitQuaternion::identity(),
+    );
     let current = [30.0, -100.0, 60.0, 0.0, 30.0, 0.0];
     let solution = robot.inverse(&pose, &current).unwrap();
     assert!((solution[0] - 30.0).abs() < 1e-9, "{solution:?}");
@@ -86,22 +93,55 @@ fn shoulder_singularity_keeps_joint_1() {
 #[test]
 fn bad_input_gives_typed_errors() {
     let robot = Robot45::new(Robot45Params::kuka_kr6_r900_sixx()).unwrap();
-    let far = Isometry3::from_parts(Translation3::new(5000.0, 0.0, 0.0), UnitQuaternion::identity());
-    assert!(matches!(robot.inverse(&far, &[0.0; 6]), Err(KinError::Unreachable { .. })));
-    let nan = Isometry3::from_parts(Translation3::new(f64::NAN, 0.0, 0.0), UnitQuaternion::identity());
-    assert!(matches!(robot.inverse(&nan, &[0.0; 6]), Err(KinError::NotFinite { .. })));
-    assert!(matches!(robot.forward(&[0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0]), Err(KinError::NotFinite { index: 1 })));
-    let negative = Robot45Params { j2_to_j3_z: -455.0, ..Robot45Params::kuka_kr6_r900_sixx() };
-    assert!(matches!(Robot45::new(negative), Err(KinError::BadParameter { name: "j2_to_j3_z", .. })));
-    let direction = Robot45Params { directions: [1.0, 1.0, 0.5, 1.0, 1.0, 1.0], ..Robot45Params::kuka_kr6_r900_sixx() };
+    let far = Isometry3::from_parts(
+        Translation3::new(5000.0, 0.0, 0.0),
+        UnitQuaternion::identity(),
+    );
+    assert!(matches!(
+        robot.inverse(&far, &[0.0; 6]),
+        Err(KinError::Unreachable { .. })
+    ));
+    let nan = Isometry3::from_parts(
+        Translation3::new(f64::NAN, 0.0, 0.0),
+        UnitQuaternion::identity(),
+    );
+    assert!(matches!(
+        robot.inverse(&nan, &[0.0; 6]),
+        Err(KinError::NotFinite { .. })
+    ));
+    assert!(matches!(
+        robot.forward(&[0.0, f64::INFINITY, 0.0, 0.0, 0.0, 0.0]),
+        Err(KinError::NotFinite { index: 1 })
+    ));
+    let negative = Robot45Params {
+        j2_to_j3_z: -455.0,
+        ..Robot45Params::kuka_kr6_r900_sixx()
+    };
+    assert!(matches!(
+        Robot45::new(negative),
+        Err(KinError::BadParameter {
+            name: "j2_to_j3_z",
+            ..
+        })
+    ));
+    let direction = Robot45Params {
+        directions: [1.0, 1.0, 0.5, 1.0, 1.0, 1.0],
+        ..Robot45Params::kuka_kr6_r900_sixx()
+    };
     assert!(Robot45::new(direction).is_err());
 
     let mut narrow = Robot45Params::kuka_kr6_r900_sixx();
-    narrow.limits[0] = JointLimit { min: -10.0, max: 10.0 };
+    narrow.limits[0] = JointLimit {
+        min: -10.0,
+        max: 10.0,
+    };
     let wide = Robot45::new(Robot45Params::kuka_kr6_r900_sixx()).unwrap();
     let pose = wide.forward(&[90.0, -90.0, 90.0, 0.0, 45.0, 0.0]).unwrap();
     let narrow = Robot45::new(narrow).unwrap();
-    assert!(matches!(narrow.inverse(&pose, &[0.0; 6]), Err(KinError::JointLimit { joint: 1, .. })));
+    assert!(matches!(
+        narrow.inverse(&pose, &[0.0; 6]),
+        Err(KinError::JointLimit { joint: 1, .. })
+    ));
 }
 
 fn joints_within(params: Robot45Params) -> impl Strategy<Value = Joints> {
@@ -145,5 +185,22 @@ proptest! {
         prop_assert!(solutions.as_slice().iter().any(|s| same_angles(s, &joints, 1e-7)));
         let nearest = robot.inverse(&pose, &joints).unwrap();
         prop_assert!(same_angles(&nearest, &joints, 1e-7), "{name}: {nearest:?} vs {joints:?}");
+    }
+
+    /// The pruned nearest-solution search returns exactly the minimum over all solutions, from
+    /// any current configuration.
+    #[test]
+    fn pruned_nearest_equals_the_exhaustive_minimum(
+        (which, joints) in preset_and_joints(),
+        current in prop::array::uniform6(-170.0f64..170.0),
+    ) {
+        let robot = Robot45::new(presets()[which].1).unwrap();
+        let pose = robot.forward(&joints).unwrap();
+        let all = robot.inverse_all(&pose, &current).unwrap();
+        let best = all.as_slice().iter().copied().min_by(|a, b| {
+            let d = |s: &Joints| s.iter().zip(&current).map(|(x, y)| (x - y) * (x - y)).sum::<f64>();
+            d(a).total_cmp(&d(b))
+        }).unwrap();
+        prop_assert_eq!(robot.inverse(&pose, &current).unwrap(), best);
     }
 }

@@ -14,21 +14,42 @@ fn rz(deg: f64) -> UnitQuaternion<f64> {
 }
 
 fn close(a: &Isometry3<f64>, b: &Isometry3<f64>) -> bool {
-    (a.translation.vector - b.translation.vector).norm() < 1e-9 && a.rotation.angle_to(&b.rotation) < 1e-12
+    (a.translation.vector - b.translation.vector).norm() < 1e-9
+        && a.rotation.angle_to(&b.rotation) < 1e-12
 }
 
 #[test]
 fn moving_workpiece_absolute_applies_the_master_frame() {
-    let tracking = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &PoseWords::default(), false, None).unwrap();
+    let tracking = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &PoseWords::default(),
+        false,
+        None,
+    )
+    .unwrap();
     let master = Isometry3::from_parts(Translation3::new(100.0, 0.0, 0.0), rz(90.0));
     let out = tracking.compose(&master, &at(10.0, 0.0, 0.0));
-    assert!(close(&out, &Isometry3::from_parts(Translation3::new(100.0, 10.0, 0.0), rz(90.0))), "{out}");
+    assert!(
+        close(
+            &out,
+            &Isometry3::from_parts(Translation3::new(100.0, 10.0, 0.0), rz(90.0))
+        ),
+        "{out}"
+    );
 }
 
 #[test]
 fn set_zero_follows_only_the_motion_since_switch_on() {
     let m0 = Isometry3::from_parts(Translation3::new(720.0, 0.0, 450.0), rz(45.0));
-    let tracking = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &PoseWords::default(), false, Some(&m0)).unwrap();
+    let tracking = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &PoseWords::default(),
+        false,
+        Some(&m0),
+    )
+    .unwrap();
     let p = at(300.0, 20.0, 100.0);
     // At switch-on nothing moves: no setpoint jump.
     assert!(close(&tracking.compose(&m0, &p), &p));
@@ -38,16 +59,30 @@ fn set_zero_follows_only_the_motion_since_switch_on() {
     // The master turns 90 degree about its own TCP: the point turns about that TCP.
     let m2 = Isometry3::from_parts(Translation3::new(720.0, 0.0, 450.0), rz(135.0));
     let out = tracking.compose(&m2, &p);
-    let expected = Point3::new(720.0, 0.0, 450.0) + rz(90.0) * (Vector3::new(300.0, 20.0, 100.0) - Vector3::new(720.0, 0.0, 450.0));
-    assert!((out.translation.vector - expected.coords).norm() < 1e-9, "{out}");
+    let expected = Point3::new(720.0, 0.0, 450.0)
+        + rz(90.0) * (Vector3::new(300.0, 20.0, 100.0) - Vector3::new(720.0, 0.0, 450.0));
+    assert!(
+        (out.translation.vector - expected.coords).norm() < 1e-9,
+        "{out}"
+    );
 }
 
 #[test]
 fn static_offset_maps_master_motion_into_slave_coordinates() {
     // The seed's example 3: the master's base seen from the slave at X=400 Y=700 C=-90.
-    let offset = PoseWords { xyz: [400.0, 700.0, 0.0], abc: [0.0, 0.0, -90.0] };
+    let offset = PoseWords {
+        xyz: [400.0, 700.0, 0.0],
+        abc: [0.0, 0.0, -90.0],
+    };
     let m0 = at(720.0, 0.0, 450.0);
-    let tracking = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &offset, false, Some(&m0)).unwrap();
+    let tracking = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &offset,
+        false,
+        Some(&m0),
+    )
+    .unwrap();
     let p = at(1000.0, 300.0, 450.0);
     // The master moves +100 along its Y: in the slave's frame, turned by -90, that is +100 X.
     let out = tracking.compose(&at(720.0, 100.0, 450.0), &p);
@@ -57,33 +92,79 @@ fn static_offset_maps_master_motion_into_slave_coordinates() {
 #[test]
 fn kin_base_holds_the_tool_against_a_base_rotation_about_the_error_point() {
     // Error point (table centre) 1305.92 mm in -X of the kinematic base; error: 10 degree about Z.
-    let shift = PoseWords { xyz: [-1305.92, 0.0, 0.0], abc: [0.0; 3] };
-    let tracking = Tracking::new(TrackingMode::KinematicBase, TrackingOption::Full, &shift, false, None).unwrap();
+    let shift = PoseWords {
+        xyz: [-1305.92, 0.0, 0.0],
+        abc: [0.0; 3],
+    };
+    let tracking = Tracking::new(
+        TrackingMode::KinematicBase,
+        TrackingOption::Full,
+        &shift,
+        false,
+        None,
+    )
+    .unwrap();
     let error = Isometry3::from_parts(Translation3::identity(), rz(10.0));
     let p = at(-1305.92 + 100.0, 0.0, 0.0);
     let out = tracking.compose(&error, &p);
     let a = 10f64.to_radians();
     let expected = at(-1305.92 + 100.0 * a.cos(), -100.0 * a.sin(), 0.0);
-    assert!((out.translation.vector - expected.translation.vector).norm() < 1e-9, "{out}");
+    assert!(
+        (out.translation.vector - expected.translation.vector).norm() < 1e-9,
+        "{out}"
+    );
     // Physically: the displaced base S E S^-1 carries the commanded pose back onto P.
     let s = at(-1305.92, 0.0, 0.0);
     let actual_base = s * error * s.inverse();
-    assert!((actual_base * out).translation.vector.metric_distance(&p.translation.vector) < 1e-9);
+    assert!(
+        (actual_base * out)
+            .translation
+            .vector
+            .metric_distance(&p.translation.vector)
+            < 1e-9
+    );
 }
 
 #[test]
 fn translation_only_ignores_the_master_rotation() {
-    let tracking = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::TranslationOnly, &PoseWords::default(), false, None).unwrap();
+    let tracking = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::TranslationOnly,
+        &PoseWords::default(),
+        false,
+        None,
+    )
+    .unwrap();
     let master = Isometry3::from_parts(Translation3::new(5.0, 6.0, 7.0), rz(30.0));
-    assert!(close(&tracking.compose(&master, &at(1.0, 0.0, 0.0)), &at(6.0, 6.0, 7.0)));
+    assert!(close(
+        &tracking.compose(&master, &at(1.0, 0.0, 0.0)),
+        &at(6.0, 6.0, 7.0)
+    ));
     assert!(TrackingOption::from_raw(2).is_err());
 }
 
 #[test]
 fn rot_trans_measures_the_offset_translation_in_the_rotated_frame() {
-    let offset = PoseWords { xyz: [100.0, 0.0, 0.0], abc: [0.0, 0.0, 90.0] };
-    let plain = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &offset, false, None).unwrap();
-    let rotated = Tracking::new(TrackingMode::MovingWorkpiece, TrackingOption::Full, &offset, true, None).unwrap();
+    let offset = PoseWords {
+        xyz: [100.0, 0.0, 0.0],
+        abc: [0.0, 0.0, 90.0],
+    };
+    let plain = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &offset,
+        false,
+        None,
+    )
+    .unwrap();
+    let rotated = Tracking::new(
+        TrackingMode::MovingWorkpiece,
+        TrackingOption::Full,
+        &offset,
+        true,
+        None,
+    )
+    .unwrap();
     // The master turns 90 degree about its base origin; where the slave's origin goes depends
     // on where that base origin is seen from the slave: (100, 0) or, turned, (0, 100).
     let master = Isometry3::from_parts(Translation3::identity(), rz(90.0));
@@ -96,14 +177,28 @@ fn rot_trans_measures_the_offset_translation_in_the_rotated_frame() {
 
 #[test]
 fn set_zero_values_and_track_cs_abs() {
-    let m0 = Isometry3::from_parts(Translation3::new(720.0, 0.0, 450.0), UnitQuaternion::from_euler_angles(0.0, 0.3, 0.785));
+    let m0 = Isometry3::from_parts(
+        Translation3::new(720.0, 0.0, 450.0),
+        UnitQuaternion::from_euler_angles(0.0, 0.3, 0.785),
+    );
     let v = track_cs_values(&m0, RotationOrder::YawPitchRoll);
     // `#CS ON [X, Y, Z, A, -B, C]` (Z-Y-X frame) rebuilds the master frame.
-    let cs = PoseWords { xyz: [v[0], v[1], v[2]], abc: [v[3], -v[4], v[5]] }.to_frame(RotationOrder::Zyx).unwrap();
+    let cs = PoseWords {
+        xyz: [v[0], v[1], v[2]],
+        abc: [v[3], -v[4], v[5]],
+    }
+    .to_frame(RotationOrder::Zyx)
+    .unwrap();
     assert!(close(&cs, &m0));
     // `#TRACK CS ABS`: programming zero on every axis reaches the centre of the dynamic CS.
     assert_eq!(track_cs_abs(&[0.0; 6], &v), v);
-    assert_eq!(track_cs_abs(&[1.0, 2.0, 3.0, 0.0, 0.0, 0.0], &[10.0, 20.0, 30.0, 0.0, 0.0, 5.0]), [11.0, 22.0, 33.0, 0.0, 0.0, 5.0]);
+    assert_eq!(
+        track_cs_abs(
+            &[1.0, 2.0, 3.0, 0.0, 0.0, 0.0],
+            &[10.0, 20.0, 30.0, 0.0, 0.0, 5.0]
+        ),
+        [11.0, 22.0, 33.0, 0.0, 0.0, 5.0]
+    );
 }
 
 proptest! {

@@ -19,6 +19,11 @@ enum Command {
         #[command(subcommand)]
         what: HliCommand,
     },
+    /// Kinematics: forward and inverse transformation.
+    Kin {
+        #[command(subcommand)]
+        what: cnc_core::kin_cli::KinCommand,
+    },
     /// Run the PLC process (what `cnc demo` spawns; same as the `plc` binary).
     #[command(hide = true)]
     Plc(plc_shim::cli::PlcArgs),
@@ -45,6 +50,7 @@ fn main() -> ExitCode {
             };
             print_or_fail(&text)
         }
+        Command::Kin { what } => cnc_core::kin_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }
 }
