@@ -220,7 +220,7 @@ impl Robot45 {
             }
         }
         for l in params.limits {
-            if !(l.min <= l.max) {
+            if l.min > l.max || l.min.is_nan() || l.max.is_nan() {
                 return Err(KinError::BadParameter {
                     name: "limits",
                     value: l.min,
@@ -265,12 +265,12 @@ impl Robot45 {
         &self.params
     }
 
-    fn to_model(&self, joints: &Joints) -> [f64; 6] {
+    fn model_of_joints(&self, joints: &Joints) -> [f64; 6] {
         let g = &self.geometry;
         core::array::from_fn(|i| joints[i].to_radians() * g.signs[i] - g.offsets_rad[i])
     }
 
-    fn from_model(&self, model: &[f64; 6]) -> Joints {
+    fn joints_of_model(&self, model: &[f64; 6]) -> Joints {
         let g = &self.geometry;
         core::array::from_fn(|i| ((model[i] + g.offsets_rad[i]) * g.signs[i]).to_degrees())
     }
@@ -384,7 +384,7 @@ impl Robot45 {
     /// Joint values of model angles, each turned to lie nearest `current` within its limits;
     /// `Err((joint index, value))` for the first joint that fits no turn.
     fn finish(&self, model: &[f64; 6], current: &Joints) -> Result<Joints, (usize, f64)> {
-        let mut joints = self.from_model(model);
+        let mut joints = self.joints_of_model(model);
         for i in 0..6 {
             joints[i] = nearest_turn(joints[i], current[i], &self.params.limits[i])
                 .ok_or((i, joints[i]))?;
@@ -407,7 +407,7 @@ impl Robot45 {
         check_pose(pose)?;
         check_finite(current)?;
         let flange = pose * self.tool_inverse;
-        let current_model = self.to_model(current);
+        let current_model = self.model_of_joints(current);
         let mut arms = [ArmConfig::default(); 4];
         let count = self.arm_configs(&flange, &current_model, &mut arms);
         if count == 0 {
@@ -515,7 +515,7 @@ impl Kinematics for Robot45 {
 
     fn forward(&self, joints: &Joints) -> Result<Isometry3<f64>, KinError> {
         check_finite(joints)?;
-        Ok(self.flange(&self.to_model(joints)) * self.tool)
+        Ok(self.flange(&self.model_of_joints(joints)) * self.tool)
     }
 
     fn inverse_all(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Solutions, KinError> {
@@ -543,7 +543,7 @@ impl Kinematics for Robot45 {
                         }
                     }
                     Err(violation) => {
-                        let d = distance_sq(&self.from_model(&model), current);
+                        let d = distance_sq(&self.joints_of_model(&model), current);
                         if nearest_violation.is_none_or(|(best, _)| d < best) {
                             nearest_violation = Some((d, violation));
                         }
@@ -570,7 +570,7 @@ impl Kinematics for Robot45 {
         let mut order = [(f64::INFINITY, 0usize); 4];
         for (i, arm) in prepared.arms[..prepared.count].iter().enumerate() {
             let model = [arm.angles[0], arm.angles[1], arm.angles[2], 0.0, 0.0, 0.0];
-            let joints = self.from_model(&model);
+            let joints = self.joints_of_model(&model);
             let mut d = 0.0;
             for j in 0..3 {
                 d += match nearest_turn(joints[j], current[j], &self.params.limits[j]) {
