@@ -439,6 +439,22 @@ struct Prepared {
     count: usize,
 }
 
+impl Prepared {
+    /// The two complete model-angle solutions (both wrist flips) of one arm configuration.
+    fn complete(&self, arm: &ArmConfig) -> [[f64; 6]; 2] {
+        wrist_solutions(&arm.rotation, &self.rotation, self.current4).map(|w| {
+            [
+                arm.angles[0],
+                arm.angles[1],
+                arm.angles[2],
+                w[0],
+                w[1],
+                w[2],
+            ]
+        })
+    }
+}
+
 /// The two wrist solutions (theta4, theta5, theta6) for an arm rotation.
 fn wrist_solutions(arm: &Matrix3<f64>, r: &Matrix3<f64>, current4: f64) -> [[f64; 3]; 2] {
     let r_ce = arm.transpose() * r;
@@ -523,15 +539,7 @@ impl Kinematics for Robot45 {
         let mut solutions = Solutions::default();
         let mut nearest_violation: Option<(f64, (usize, f64))> = None;
         for arm in &prepared.arms[..prepared.count] {
-            for wrist in wrist_solutions(&arm.rotation, &prepared.rotation, prepared.current4) {
-                let model = [
-                    arm.angles[0],
-                    arm.angles[1],
-                    arm.angles[2],
-                    wrist[0],
-                    wrist[1],
-                    wrist[2],
-                ];
+            for model in prepared.complete(arm) {
                 match self.finish(&model, current) {
                     Ok(joints) => {
                         if !solutions
@@ -588,15 +596,7 @@ impl Kinematics for Robot45 {
                 break;
             }
             let arm = &prepared.arms[index];
-            for wrist in wrist_solutions(&arm.rotation, &prepared.rotation, prepared.current4) {
-                let model = [
-                    arm.angles[0],
-                    arm.angles[1],
-                    arm.angles[2],
-                    wrist[0],
-                    wrist[1],
-                    wrist[2],
-                ];
+            for model in prepared.complete(arm) {
                 match self.finish(&model, current) {
                     Ok(joints) => {
                         let d = distance_sq(&joints, current);
