@@ -59,12 +59,7 @@ fn build(id: u32, robot: Option<&str>) -> Result<Box<dyn Kinematics>, String> {
     }
 }
 
-/// A number for JSON: rounded to 1e-9 so that 979.9999999999999 prints as 980, no `-0`.
-fn num(value: f64) -> String {
-    let rounded = (value * 1e9).round() / 1e9;
-    let rounded = if rounded == 0.0 { 0.0 } else { rounded };
-    format!("{rounded}")
-}
+use crate::json::number as num;
 
 fn joints_json(j: &Joints, count: usize) -> String {
     let items: Vec<String> = j[..count].iter().map(|v| num(*v)).collect();

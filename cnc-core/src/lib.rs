@@ -1,6 +1,9 @@
 //! The CNC process. This first version holds the cyclic HLI demo (`cnc demo`) and the HLI
 //! tooling (`cnc hli symbols`, `cnc hli header`) and kinematics from the command line (`cnc kin`); channels, interpolation and axes follow.
 
+pub mod check_cli;
 pub mod demo;
+pub mod json;
 pub mod kin_cli;
+pub mod nc;
 pub mod stats;

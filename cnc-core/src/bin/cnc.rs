@@ -19,6 +19,8 @@ enum Command {
         #[command(subcommand)]
         what: HliCommand,
     },
+    /// Check NC programs: parse, decode, report FILE:LINE:COL diagnostics.
+    Check(cnc_core::check_cli::CheckArgs),
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
             };
             print_or_fail(&text)
         }
+        Command::Check(args) => cnc_core::check_cli::main(args),
         Command::Kin { what } => cnc_core::kin_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }

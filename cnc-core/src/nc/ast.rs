@@ -1,0 +1,271 @@
+//! The program tree. Spans locate every node in the source; they do not take part in tree
+//! equality, so a re-parsed printout compares equal to the original.
+
+/// A source range with its line and column (1-based, columns in characters).
+#[derive(Debug, Clone, Copy, Default, Eq)]
+pub struct Span {
+    /// Byte offset of the first character.
+    pub start: usize,
+    /// Byte offset after the last character.
+    pub end: usize,
+    /// Line of `start`.
+    pub line: u32,
+    /// Column of `start`.
+    pub col: u32,
+}
+
+impl PartialEq for Span {
+    /// Spans are locations, not content: any two compare equal.
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
+}
+
+/// Binary operators of expressions.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BinOp {
+    /// `+`
+    Add,
+    /// `-`
+    Sub,
+    /// `*`
+    Mul,
+    /// `/`
+    Div,
+    /// `==`
+    Eq,
+    /// `!=`
+    Ne,
+    /// `<`
+    Lt,
+    /// `<=`
+    Le,
+    /// `>`
+    Gt,
+    /// `>=`
+    Ge,
+}
+
+impl BinOp {
+    /// Source spelling.
+    pub fn symbol(self) -> &'static str {
+        match self {
+            BinOp::Add => "+",
+            BinOp::Sub => "-",
+            BinOp::Mul => "*",
+            BinOp::Div => "/",
+            BinOp::Eq => "==",
+            BinOp::Ne => "!=",
+            BinOp::Lt => "<",
+            BinOp::Le => "<=",
+            BinOp::Gt => ">",
+            BinOp::Ge => ">=",
+        }
+    }
+
+    /// Binding strength (higher binds tighter).
+    pub fn precedence(self) -> u8 {
+        match self {
+            BinOp::Mul | BinOp::Div => 3,
+            BinOp::Add | BinOp::Sub => 2,
+            _ => 1,
+        }
+    }
+}
+
+/// An arithmetic expression.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Expr {
+    /// A literal number.
+    Num(f64),
+    /// A variable such as `V.G.TRACK_CS.X`.
+    Var(String),
+    /// Unary minus.
+    Neg(Box<Expr>),
+    /// A binary operation.
+    Bin(BinOp, Box<Expr>, Box<Expr>),
+}
+
+/// One entry of a bracketed list: `KEY`, `KEY=expr`, `KEY3` (number glued to the key, as in
+/// `ID3 COUNT1`), or a bare expression (value lists of `#CS`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Entry {
+    /// The key, upper case, if the entry has one.
+    pub key: Option<String>,
+    /// A number glued to the key (`ID3` -> 3, `G01` -> 1).
+    pub glued: Option<f64>,
+    /// The value after `=`, or the bare expression.
+    pub value: Option<Expr>,
+    /// A quoted string value (`LOG_FILE="..."`).
+    pub text: Option<String>,
+    /// Where the entry stands.
+    pub span: Span,
+}
+
+/// An NC command (`#...`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Command {
+    /// `#TRACK CS ON|OFF [options]` (also spelled `#TRACK_CS`).
+    TrackCs {
+        /// ON or OFF.
+        on: bool,
+        /// The options in the brackets.
+        options: Vec<Entry>,
+    },
+    /// `#TRACK CS ABS`.
+    TrackCsAbs,
+    /// `#CHANNEL INTERFACE ON|OFF [DYN_CS|TRACK_CS]`.
+    ChannelInterface {
+        /// ON or OFF.
+        on: bool,
+        /// The interface named in the brackets.
+        kind: Option<String>,
+    },
+    /// `#CS ON [name] [values]`, `#CS ON [values]`, `#CS OFF [name]`.
+    Cs {
+        /// ON or OFF.
+        on: bool,
+        /// The coordinate system's name, if given.
+        name: Option<String>,
+        /// X Y Z A B C values.
+        values: Vec<Expr>,
+    },
+    /// `#TRAFO ON`, `#TRAFO OFF`, `#TRAFO [id]`, `#TRAFO ON [id]`.
+    Trafo {
+        /// ON (Some(true)), OFF (Some(false)) or just an id.
+        on: Option<bool>,
+        /// Kinematic id in brackets.
+        id: Option<Expr>,
+    },
+    /// `#KIN ID [id]`.
+    KinId {
+        /// The kinematic id.
+        id: Expr,
+    },
+    /// `#SIGNAL SYN [ID.. COUNT..]`.
+    SignalSyn {
+        /// The options.
+        options: Vec<Entry>,
+    },
+    /// `#WAIT SYN [ID..]`.
+    WaitSyn {
+        /// The options.
+        options: Vec<Entry>,
+    },
+    /// `#WAIT INDP ALL`.
+    WaitIndpAll,
+    /// `#FLUSH WAIT` (true) or `#FLUSH CONTINUE` (false).
+    Flush {
+        /// WAIT.
+        wait: bool,
+    },
+    /// `#PSET axis=value ...` (or axis words).
+    Pset {
+        /// Axis assignments.
+        axes: Vec<AxisWord>,
+    },
+    /// `#PRESET` (all axes) or `#PRESET axis ...`.
+    Preset {
+        /// Axes whose preset is removed; empty = all.
+        axes: Vec<String>,
+    },
+}
+
+/// An axis with its value: `X10`, `AB=90`, `X=V.G.TRACK_CS.X`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisWord {
+    /// Axis name, upper case.
+    pub name: String,
+    /// The value.
+    pub value: Expr,
+    /// Whether it was written with `=` (printing keeps the form).
+    pub assigned: bool,
+    /// Where it stands.
+    pub span: Span,
+}
+
+/// One item of a block.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Item {
+    /// `G<n>`.
+    G {
+        /// The code (leading zeros dropped).
+        code: u32,
+        /// Where it stands.
+        span: Span,
+    },
+    /// `F<value>` / `F=expr`.
+    Feed {
+        /// The value.
+        value: Expr,
+        /// Where it stands.
+        span: Span,
+    },
+    /// `M<n>`.
+    M {
+        /// The M code.
+        code: u32,
+        /// Where it stands.
+        span: Span,
+    },
+    /// An axis word.
+    Axis(AxisWord),
+    /// An independent axis command `X1[INDP_ASYN POS=-90 G01 F500 G90]`.
+    IndependentAxis {
+        /// Axis name.
+        name: String,
+        /// The entries in the brackets.
+        options: Vec<Entry>,
+        /// Where it stands.
+        span: Span,
+    },
+    /// A `#` command.
+    Command {
+        /// The command.
+        command: Command,
+        /// Where it stands.
+        span: Span,
+    },
+    /// `$WHILE expr`, `$ENDWHILE`, `$IF expr`, `$ELSE`, `$ENDIF`.
+    Control {
+        /// The control statement.
+        control: Control,
+        /// Where it stands.
+        span: Span,
+    },
+}
+
+/// Control flow.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Control {
+    /// `$WHILE cond`.
+    While(Expr),
+    /// `$ENDWHILE`.
+    EndWhile,
+    /// `$IF cond`.
+    If(Expr),
+    /// `$ELSE`.
+    Else,
+    /// `$ENDIF`.
+    EndIf,
+}
+
+/// One block (a logical line, continuation lines joined).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Block {
+    /// Block number `N..`.
+    pub number: Option<u32>,
+    /// Items in source order.
+    pub items: Vec<Item>,
+    /// Where the block starts.
+    pub span: Span,
+}
+
+/// A parsed program.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Program {
+    /// `%name`.
+    pub name: Option<String>,
+    /// Blocks that hold anything (empty and comment-only lines are not kept).
+    pub blocks: Vec<Block>,
+}

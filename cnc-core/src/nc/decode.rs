@@ -1,0 +1,889 @@
+//! The decoder: program tree to the typed block stream a channel executes, with the semantic
+//! checks the grammar cannot make.
+//!
+//! Coordinates follow this controller, not RS274:
+//! * G90/G91 select absolute/incremental axis values (modal, G90 at start);
+//! * `G92 X..` sets an additive reference-point offset for the axis (the value is the offset; set
+//!   under G90, added under G91; `G92 X0` removes it). It moves nothing and takes effect with
+//!   the axis's next absolute position: target = value + G92 offset + PSET offset;
+//! * `#PSET X..` declares the current position to be X.. (an offset that makes it so);
+//!   `#PRESET` (all axes) or `#PRESET X ..` removes it;
+//! * G0/G1 are modal (G0 at start), F is modal (0 at start; G1 needs a positive feed).
+//!
+//! Variables (`V.G.TRACK_CS.X`...) are read from a [`Vars`] source when the block is decoded;
+//! the channel decodes a block after the values it depends on are known.
+
+use super::ast::*;
+use super::Diagnostic;
+
+/// Values of NC variables at decode time.
+pub trait Vars {
+    /// The value of `name` (upper case, e.g. `V.G.TRACK_CS.X`); `None` if there is no such
+    /// variable.
+    fn get(&self, name: &str) -> Option<f64>;
+}
+
+/// The channel variables known to the decoder, all 0: what `cnc check` uses.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ZeroVars;
+
+/// The variables the language defines.
+pub const KNOWN_VARIABLES: &[&str] = &[
+    "V.G.TRACK_CS.X",
+    "V.G.TRACK_CS.Y",
+    "V.G.TRACK_CS.Z",
+    "V.G.TRACK_CS.A",
+    "V.G.TRACK_CS.B",
+    "V.G.TRACK_CS.C",
+];
+
+impl Vars for ZeroVars {
+    fn get(&self, name: &str) -> Option<f64> {
+        KNOWN_VARIABLES.contains(&name).then_some(0.0)
+    }
+}
+
+/// G0 or G1.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MotionMode {
+    /// G0: rapid.
+    Rapid,
+    /// G1: linear at the programmed feed.
+    Linear,
+}
+
+impl MotionMode {
+    /// "G0" / "G1".
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionMode::Rapid => "G0",
+            MotionMode::Linear => "G1",
+        }
+    }
+}
+
+/// A path motion with absolute targets for every axis of the channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MotionBlock {
+    /// Source line.
+    pub line: u32,
+    /// Block number.
+    pub number: Option<u32>,
+    /// G0 or G1.
+    pub motion: MotionMode,
+    /// Feed (mm/min).
+    pub feed: f64,
+    /// Target per channel axis, in channel order.
+    pub target: Vec<f64>,
+}
+
+/// Where a tracking channel takes its dynamic coordinate system from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TrackSource {
+    /// `CH=n`: channel n's interface.
+    Channel(u8),
+    /// `ID=0`: the PLC; `ID=n`: master channel n.
+    Id(u8),
+}
+
+/// `#TRACK CS ON|OFF [...]`, checked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackCommand {
+    /// ON or OFF.
+    pub on: bool,
+    /// Source (required for ON; optional for OFF).
+    pub source: Option<TrackSource>,
+    /// SET_ZERO / ABSOLUTE.
+    pub set_zero: bool,
+    /// OPTION (0 translation and rotation, 1 translation only).
+    pub option: u32,
+    /// KIN_BASE.
+    pub kin_base: bool,
+    /// FILTER in ticks (200 when not given).
+    pub filter_ticks: u32,
+    /// WAIT.
+    pub wait: bool,
+    /// ROT_TRANS.
+    pub rot_trans: bool,
+    /// RELATIVE.
+    pub relative: bool,
+    /// X Y Z A B C offset.
+    pub offset: [f64; 6],
+    /// SIMU.
+    pub simu: bool,
+    /// LOG_FILE.
+    pub log_file: Option<String>,
+}
+
+/// Default tracking filter, ticks.
+pub const DEFAULT_FILTER_TICKS: u32 = 200;
+
+/// One decoded block element.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Decoded {
+    /// Path motion.
+    Motion(MotionBlock),
+    /// An independent axis move `X1[INDP_ASYN POS=..]`.
+    IndependentMove {
+        /// Source line.
+        line: u32,
+        /// Channel axis index.
+        axis: usize,
+        /// Absolute target.
+        target: f64,
+        /// Feed.
+        feed: f64,
+        /// G0 or G1.
+        motion: MotionMode,
+        /// INDP_ASYN (true) or INDP_SYN.
+        asynchronous: bool,
+    },
+    /// `#WAIT INDP ALL`.
+    WaitIndependent {
+        /// Source line.
+        line: u32,
+    },
+    /// An M function.
+    MFunction {
+        /// Source line.
+        line: u32,
+        /// Code.
+        code: u32,
+    },
+    /// `#TRACK CS ON|OFF`.
+    Track {
+        /// Source line.
+        line: u32,
+        /// The command.
+        command: TrackCommand,
+    },
+    /// `#TRACK CS ABS`.
+    TrackAbs {
+        /// Source line.
+        line: u32,
+    },
+    /// `#CHANNEL INTERFACE ON|OFF`.
+    ChannelInterface {
+        /// Source line.
+        line: u32,
+        /// ON or OFF.
+        on: bool,
+    },
+    /// `#CS ON|OFF`.
+    Cs {
+        /// Source line.
+        line: u32,
+        /// ON or OFF.
+        on: bool,
+        /// Name, if given.
+        name: Option<String>,
+        /// X Y Z A B C (missing values 0).
+        frame: [f64; 6],
+    },
+    /// `#TRAFO` / `#KIN ID`.
+    Trafo {
+        /// Source line.
+        line: u32,
+        /// Transformation on (Some), off, or only the id selected (None).
+        on: Option<bool>,
+        /// Kinematic id.
+        id: Option<u32>,
+    },
+    /// `#SIGNAL SYN`.
+    SignalSyn {
+        /// Source line.
+        line: u32,
+        /// Signal id.
+        id: u32,
+        /// How many channels it counts for.
+        count: u32,
+    },
+    /// `#WAIT SYN`.
+    WaitSyn {
+        /// Source line.
+        line: u32,
+        /// Signal ids waited for.
+        ids: Vec<u32>,
+    },
+    /// `#FLUSH WAIT|CONTINUE`.
+    Flush {
+        /// Source line.
+        line: u32,
+        /// WAIT.
+        wait: bool,
+    },
+    /// Control flow with its matching block positions (indices into the decoded stream).
+    Control {
+        /// Source line.
+        line: u32,
+        /// The statement.
+        op: ControlOp,
+    },
+}
+
+/// Control flow, resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ControlOp {
+    /// Evaluate; when false continue after `end`.
+    While {
+        /// Condition.
+        cond: Expr,
+        /// Index of the matching `EndWhile`.
+        end: usize,
+    },
+    /// Jump back to `start` (the `While`).
+    EndWhile {
+        /// Index of the `While`.
+        start: usize,
+    },
+    /// Evaluate; when false continue after `next` (the `Else` or `EndIf`).
+    If {
+        /// Condition.
+        cond: Expr,
+        /// Index of the `Else` or `EndIf`.
+        next: usize,
+    },
+    /// Reached from the true branch: continue after `end`.
+    Else {
+        /// Index of the `EndIf`.
+        end: usize,
+    },
+    /// End of an `If`.
+    EndIf,
+}
+
+/// The decoder's modal state.
+#[derive(Debug, Clone)]
+pub struct DecoderState {
+    axes: Vec<String>,
+    position: Vec<f64>,
+    g92: Vec<f64>,
+    pset: Vec<f64>,
+    absolute: bool,
+    motion: MotionMode,
+    feed: f64,
+}
+
+struct Ctx<'a> {
+    src: &'a str,
+    vars: &'a dyn Vars,
+    diags: Vec<Diagnostic>,
+}
+
+impl Ctx<'_> {
+    fn error(&mut self, span: Span, message: impl Into<String>) {
+        self.diags
+            .push(Diagnostic::new(span, message.into(), self.src));
+    }
+
+    fn eval(&mut self, e: &Expr, span: Span) -> Option<f64> {
+        match e {
+            Expr::Num(v) => Some(*v),
+            Expr::Var(name) => match self.vars.get(name) {
+                Some(v) => Some(v),
+                None => {
+                    self.error(
+                        span,
+                        format!(
+                            "unknown variable \"{name}\" (known: {})",
+                            KNOWN_VARIABLES.join(", ")
+                        ),
+                    );
+                    None
+                }
+            },
+            Expr::Neg(inner) => self.eval(inner, span).map(|v| -v),
+            Expr::Bin(op, a, b) => {
+                let (a, b) = (self.eval(a, span)?, self.eval(b, span)?);
+                let bool_val = |c: bool| if c { 1.0 } else { 0.0 };
+                Some(match op {
+                    BinOp::Add => a + b,
+                    BinOp::Sub => a - b,
+                    BinOp::Mul => a * b,
+                    BinOp::Div => {
+                        if b == 0.0 {
+                            self.error(span, "division by zero");
+                            return None;
+                        }
+                        a / b
+                    }
+                    BinOp::Eq => bool_val(a == b),
+                    BinOp::Ne => bool_val(a != b),
+                    BinOp::Lt => bool_val(a < b),
+                    BinOp::Le => bool_val(a <= b),
+                    BinOp::Gt => bool_val(a > b),
+                    BinOp::Ge => bool_val(a >= b),
+                })
+            }
+        }
+    }
+
+    /// A whole number within `range`, else an error naming `what`.
+    fn whole(&mut self, e: &Expr, span: Span, what: &str, min: f64, max: f64) -> Option<u32> {
+        let v = self.eval(e, span)?;
+        if v.fract() != 0.0 || v < min || v > max {
+            self.error(
+                span,
+                format!("{what} must be a whole number in {min}..={max}, found {v}"),
+            );
+            return None;
+        }
+        Some(v as u32)
+    }
+}
+
+impl DecoderState {
+    /// A channel with these axis names (upper case), at position 0, G0 G90, feed 0.
+    pub fn new(axes: &[String]) -> Self {
+        let n = axes.len();
+        Self {
+            axes: axes.to_vec(),
+            position: vec![0.0; n],
+            g92: vec![0.0; n],
+            pset: vec![0.0; n],
+            absolute: true,
+            motion: MotionMode::Rapid,
+            feed: 0.0,
+        }
+    }
+
+    /// The channel's axis names.
+    pub fn axes(&self) -> &[String] {
+        &self.axes
+    }
+
+    fn axis_index(&self, name: &str) -> Option<usize> {
+        self.axes.iter().position(|a| a == name)
+    }
+
+    /// Decodes one block; `out` receives its elements. Control statements are emitted with
+    /// unresolved indices (0); [`decode_program`] resolves them.
+    fn block(&mut self, block: &Block, ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
+        let line = block.span.line;
+        let mut g92 = false;
+        let mut motion_code: Option<(u32, Span)> = None;
+        let mut axis_words: Vec<(usize, f64, Span)> = Vec::new();
+        let mut tail: Vec<Decoded> = Vec::new();
+        for item in &block.items {
+            match item {
+                Item::G { code, span } => match code {
+                    0 | 1 => {
+                        if let Some((other, _)) = motion_code.filter(|(c, _)| c != code) {
+                            ctx.error(
+                                *span,
+                                format!("G{code} and G{other} in one block: choose one motion"),
+                            );
+                        }
+                        motion_code = Some((*code, *span));
+                    }
+                    90 => self.absolute = true,
+                    91 => self.absolute = false,
+                    92 => g92 = true,
+                    other => ctx.error(
+                        *span,
+                        format!("unknown G code G{other} (known: G0, G1, G90, G91, G92)"),
+                    ),
+                },
+                Item::Feed { value, span } => {
+                    if let Some(f) = ctx.eval(value, *span) {
+                        if f > 0.0 && f.is_finite() {
+                            self.feed = f;
+                        } else {
+                            ctx.error(*span, format!("feed must be positive, found {f}"));
+                        }
+                    }
+                }
+                Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
+                Item::Axis(word) => {
+                    let Some(i) = self.axis_index(&word.name) else {
+                        ctx.error(
+                            word.span,
+                            format!(
+                                "unknown axis \"{}\" for this channel (axes: {})",
+                                word.name,
+                                self.axes.join(" ")
+                            ),
+                        );
+                        continue;
+                    };
+                    if axis_words.iter().any(|(j, _, _)| *j == i) {
+                        ctx.error(
+                            word.span,
+                            format!("axis {} programmed twice in one block", word.name),
+                        );
+                        continue;
+                    }
+                    if let Some(v) = ctx.eval(&word.value, word.span) {
+                        axis_words.push((i, v, word.span));
+                    }
+                }
+                Item::IndependentAxis {
+                    name,
+                    options,
+                    span,
+                } => {
+                    if let Some(d) = self.independent(line, name, options, *span, ctx) {
+                        tail.push(d);
+                    }
+                }
+                Item::Command { command, span } => {
+                    if let Some(d) = self.command(line, command, *span, ctx) {
+                        tail.push(d);
+                    }
+                }
+                Item::Control { control, span: _ } => {
+                    let op = match control {
+                        Control::While(c) => ControlOp::While {
+                            cond: c.clone(),
+                            end: 0,
+                        },
+                        Control::EndWhile => ControlOp::EndWhile { start: 0 },
+                        Control::If(c) => ControlOp::If {
+                            cond: c.clone(),
+                            next: 0,
+                        },
+                        Control::Else => ControlOp::Else { end: 0 },
+                        Control::EndIf => ControlOp::EndIf,
+                    };
+                    if block.items.len() > 1 {
+                        ctx.error(block.span, "a $ statement stands alone in its block");
+                    }
+                    tail.push(Decoded::Control { line, op });
+                }
+            }
+        }
+        if let Some((code, _)) = motion_code {
+            self.motion = if code == 0 {
+                MotionMode::Rapid
+            } else {
+                MotionMode::Linear
+            };
+        }
+        if g92 {
+            for (i, v, _) in &axis_words {
+                self.g92[*i] = if self.absolute { *v } else { self.g92[*i] + v };
+            }
+        } else if !axis_words.is_empty() {
+            if self.motion == MotionMode::Linear && self.feed <= 0.0 {
+                ctx.error(block.span, "G1 motion without a feed: program F.. first");
+            }
+            for (i, v, _) in &axis_words {
+                self.position[*i] = if self.absolute {
+                    v + self.g92[*i] + self.pset[*i]
+                } else {
+                    self.position[*i] + v
+                };
+            }
+            out.push(Decoded::Motion(MotionBlock {
+                line,
+                number: block.number,
+                motion: self.motion,
+                feed: self.feed,
+                target: self.position.clone(),
+            }));
+        }
+        out.extend(tail);
+    }
+
+    fn independent(
+        &mut self,
+        line: u32,
+        name: &str,
+        options: &[Entry],
+        span: Span,
+        ctx: &mut Ctx<'_>,
+    ) -> Option<Decoded> {
+        let Some(axis) = self.axis_index(name) else {
+            ctx.error(
+                span,
+                format!(
+                    "unknown axis \"{name}\" for this channel (axes: {})",
+                    self.axes.join(" ")
+                ),
+            );
+            return None;
+        };
+        let (mut asynchronous, mut pos, mut feed, mut motion, mut absolute) =
+            (None, None, self.feed, MotionMode::Linear, true);
+        for e in options {
+            match (e.key.as_deref(), e.glued, &e.value) {
+                (Some("INDP_ASYN"), None, None) => asynchronous = Some(true),
+                (Some("INDP_SYN"), None, None) => asynchronous = Some(false),
+                (Some("POS"), None, Some(v)) => pos = ctx.eval(v, e.span),
+                (Some("F"), Some(f), None) => feed = f,
+                (Some("F"), None, Some(v)) => feed = ctx.eval(v, e.span)?,
+                (Some("G"), Some(g), None) if g == 0.0 => motion = MotionMode::Rapid,
+                (Some("G"), Some(g), None) if g == 1.0 => motion = MotionMode::Linear,
+                (Some("G"), Some(g), None) if g == 90.0 => absolute = true,
+                (Some("G"), Some(g), None) if g == 91.0 => absolute = false,
+                _ => ctx.error(e.span, "independent axis: expected INDP_ASYN, INDP_SYN, POS=.., G0, G1, G90, G91 or F.."),
+            }
+        }
+        let Some(asynchronous) = asynchronous else {
+            ctx.error(span, "independent axis: expected INDP_ASYN or INDP_SYN");
+            return None;
+        };
+        let Some(pos) = pos else {
+            ctx.error(span, "independent axis: expected POS=..");
+            return None;
+        };
+        if motion == MotionMode::Linear && feed <= 0.0 {
+            ctx.error(span, "independent axis: G1 needs a positive feed F..");
+            return None;
+        }
+        let target = if absolute {
+            pos + self.g92[axis] + self.pset[axis]
+        } else {
+            self.position[axis] + pos
+        };
+        self.position[axis] = target;
+        Some(Decoded::IndependentMove {
+            line,
+            axis,
+            target,
+            feed,
+            motion,
+            asynchronous,
+        })
+    }
+
+    fn command(
+        &mut self,
+        line: u32,
+        command: &Command,
+        span: Span,
+        ctx: &mut Ctx<'_>,
+    ) -> Option<Decoded> {
+        match command {
+            Command::TrackCs { on, options } => {
+                track(*on, options, span, ctx).map(|command| Decoded::Track { line, command })
+            }
+            Command::TrackCsAbs => Some(Decoded::TrackAbs { line }),
+            Command::ChannelInterface { on, .. } => {
+                Some(Decoded::ChannelInterface { line, on: *on })
+            }
+            Command::Cs { on, name, values } => {
+                if values.len() > 6 {
+                    ctx.error(
+                        span,
+                        format!(
+                            "#CS takes at most 6 values (X Y Z A B C), found {}",
+                            values.len()
+                        ),
+                    );
+                    return None;
+                }
+                if !on && !values.is_empty() {
+                    ctx.error(span, "#CS OFF takes no values");
+                    return None;
+                }
+                let mut frame = [0.0; 6];
+                for (i, v) in values.iter().enumerate() {
+                    frame[i] = ctx.eval(v, span)?;
+                }
+                Some(Decoded::Cs {
+                    line,
+                    on: *on,
+                    name: name.clone(),
+                    frame,
+                })
+            }
+            Command::Trafo { on, id } => {
+                let id = match id {
+                    Some(e) => Some(ctx.whole(e, span, "kinematic id", 0.0, 65535.0)?),
+                    None => None,
+                };
+                Some(Decoded::Trafo { line, on: *on, id })
+            }
+            Command::KinId { id } => {
+                let id = ctx.whole(id, span, "kinematic id", 0.0, 65535.0)?;
+                Some(Decoded::Trafo {
+                    line,
+                    on: None,
+                    id: Some(id),
+                })
+            }
+            Command::SignalSyn { options } => {
+                let mut id = None;
+                let mut count = None;
+                for e in options {
+                    let v = entry_number(e, ctx)?;
+                    let whole = ctx.whole(
+                        &Expr::Num(v),
+                        e.span,
+                        e.key.as_deref().unwrap_or("value"),
+                        1.0,
+                        65535.0,
+                    )?;
+                    match e.key.as_deref() {
+                        Some("ID") => id = Some(whole),
+                        _ => count = Some(whole),
+                    }
+                }
+                match (id, count) {
+                    (Some(id), Some(count)) => Some(Decoded::SignalSyn { line, id, count }),
+                    _ => {
+                        ctx.error(span, "#SIGNAL SYN needs ID.. and COUNT..");
+                        None
+                    }
+                }
+            }
+            Command::WaitSyn { options } => {
+                let mut ids = Vec::new();
+                for e in options {
+                    let v = entry_number(e, ctx)?;
+                    ids.push(ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?);
+                }
+                if ids.is_empty() {
+                    ctx.error(span, "#WAIT SYN needs at least one ID..");
+                    return None;
+                }
+                Some(Decoded::WaitSyn { line, ids })
+            }
+            Command::WaitIndpAll => Some(Decoded::WaitIndependent { line }),
+            Command::Flush { wait } => Some(Decoded::Flush { line, wait: *wait }),
+            Command::Pset { axes } => {
+                for word in axes {
+                    let Some(i) = self.axis_index(&word.name) else {
+                        ctx.error(
+                            word.span,
+                            format!(
+                                "unknown axis \"{}\" for this channel (axes: {})",
+                                word.name,
+                                self.axes.join(" ")
+                            ),
+                        );
+                        continue;
+                    };
+                    if let Some(v) = ctx.eval(&word.value, word.span) {
+                        self.pset[i] = self.position[i] - v - self.g92[i];
+                    }
+                }
+                None
+            }
+            Command::Preset { axes } => {
+                if axes.is_empty() {
+                    self.pset.iter_mut().for_each(|p| *p = 0.0);
+                }
+                for name in axes {
+                    match self.axis_index(name) {
+                        Some(i) => self.pset[i] = 0.0,
+                        None => ctx.error(
+                            span,
+                            format!(
+                                "unknown axis \"{name}\" for this channel (axes: {})",
+                                self.axes.join(" ")
+                            ),
+                        ),
+                    }
+                }
+                None
+            }
+        }
+    }
+}
+
+fn entry_number(e: &Entry, ctx: &mut Ctx<'_>) -> Option<f64> {
+    match (e.glued, &e.value) {
+        (Some(v), None) => Some(v),
+        (None, Some(v)) => ctx.eval(v, e.span),
+        _ => {
+            ctx.error(e.span, "expected a value");
+            None
+        }
+    }
+}
+
+fn whole_entry(e: &Entry, ctx: &mut Ctx<'_>, what: &str, min: f64, max: f64) -> Option<u32> {
+    let v = entry_number(e, ctx)?;
+    ctx.whole(&Expr::Num(v), e.span, what, min, max)
+}
+
+const OFF_OPTIONS: &[&str] = &["WAIT", "FILTER", "ID", "CH"];
+
+fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<TrackCommand> {
+    let mut t = TrackCommand {
+        on,
+        source: None,
+        set_zero: false,
+        option: 0,
+        kin_base: false,
+        filter_ticks: DEFAULT_FILTER_TICKS,
+        wait: false,
+        rot_trans: false,
+        relative: false,
+        offset: [0.0; 6],
+        simu: false,
+        log_file: None,
+    };
+    let mut seen: Vec<&str> = Vec::new();
+    let mut ok = true;
+    for e in options {
+        let key = e.key.as_deref().unwrap_or("");
+        if seen.contains(&key) {
+            ctx.error(e.span, format!("#TRACK CS: option {key} given twice"));
+            ok = false;
+            continue;
+        }
+        seen.push(key);
+        if !on && !OFF_OPTIONS.contains(&key) {
+            ctx.error(e.span, format!("#TRACK CS OFF: option {key} is only allowed with ON (OFF takes WAIT, FILTER, ID, CH)"));
+            ok = false;
+            continue;
+        }
+        let value = |ctx: &mut Ctx<'_>| entry_number(e, ctx);
+        match key {
+            "CH" => {
+                t.source =
+                    whole_entry(e, ctx, "CH", 1.0, 12.0).map(|v| TrackSource::Channel(v as u8))
+            }
+            "ID" => {
+                t.source = whole_entry(e, ctx, "ID", 0.0, 12.0).map(|v| TrackSource::Id(v as u8))
+            }
+            "OPTION" => t.option = whole_entry(e, ctx, "OPTION", 0.0, 1.0)?,
+            "FILTER" => t.filter_ticks = whole_entry(e, ctx, "FILTER", 0.0, f64::from(u32::MAX))?,
+            "SET_ZERO" | "ABSOLUTE" => t.set_zero = true,
+            "KIN_BASE" => t.kin_base = true,
+            "WAIT" => t.wait = true,
+            "ROT_TRANS" => t.rot_trans = true,
+            "RELATIVE" => t.relative = true,
+            "SIMU" => t.simu = true,
+            "LOG_FILE" => t.log_file = e.text.clone().or_else(|| Some(String::new())),
+            "X" | "Y" | "Z" | "A" | "B" | "C" => {
+                let i = ["X", "Y", "Z", "A", "B", "C"]
+                    .iter()
+                    .position(|k| *k == key)
+                    .unwrap_or(0);
+                t.offset[i] = value(ctx)?;
+            }
+            _ => {
+                ctx.error(e.span, format!("#TRACK CS: unknown option \"{key}\""));
+                ok = false;
+            }
+        }
+    }
+    if seen.contains(&"CH") && seen.contains(&"ID") {
+        ctx.error(
+            span,
+            "#TRACK CS: give the source as CH=.. or ID=.., not both",
+        );
+        ok = false;
+    }
+    if on && !seen.contains(&"CH") && !seen.contains(&"ID") {
+        ctx.error(span, "#TRACK CS ON: expected a source, CH=.. or ID=..");
+        ok = false;
+    }
+    if t.kin_base && t.rot_trans {
+        ctx.error(span, "#TRACK CS: ROT_TRANS applies to the master-slave offset and cannot be combined with KIN_BASE");
+        ok = false;
+    }
+    if seen.contains(&"SET_ZERO") && seen.contains(&"ABSOLUTE") {
+        ctx.error(
+            span,
+            "#TRACK CS: SET_ZERO and ABSOLUTE are the same option; give one",
+        );
+        ok = false;
+    }
+    (ok && (t.source.is_some() || !on)).then_some(t)
+}
+
+/// Decodes a whole program for a channel with `axes`, reading variables from `vars`; control
+/// statements get their matching positions. The block stream is only meaningful when the
+/// diagnostics are empty: a program with errors must not be executed.
+pub fn decode_program(
+    program: &Program,
+    src: &str,
+    axes: &[String],
+    vars: &dyn Vars,
+) -> (Vec<Decoded>, Vec<Diagnostic>) {
+    let mut state = DecoderState::new(axes);
+    let mut ctx = Ctx {
+        src,
+        vars,
+        diags: Vec::new(),
+    };
+    let mut out = Vec::with_capacity(program.blocks.len());
+    let mut spans = Vec::new();
+    for block in &program.blocks {
+        let before = out.len();
+        state.block(block, &mut ctx, &mut out);
+        spans.resize(out.len().max(before), block.span);
+    }
+    resolve_control(&mut out, &spans, &mut ctx);
+    (out, ctx.diags)
+}
+
+fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
+    // Stack of open statements: (index, is_while, else_index).
+    let mut open: Vec<(usize, bool, Option<usize>)> = Vec::new();
+    for i in 0..out.len() {
+        let Decoded::Control { op, .. } = &out[i] else {
+            continue;
+        };
+        match op {
+            ControlOp::While { .. } => open.push((i, true, None)),
+            ControlOp::If { .. } => open.push((i, false, None)),
+            ControlOp::Else { .. } => match open.last_mut() {
+                Some((_, false, else_at @ None)) => *else_at = Some(i),
+                _ => ctx.error(spans[i], "$ELSE without a matching $IF"),
+            },
+            ControlOp::EndWhile { .. } => match open.pop() {
+                Some((start, true, _)) => {
+                    set_op(out, start, |op| {
+                        if let ControlOp::While { end, .. } = op {
+                            *end = i
+                        }
+                    });
+                    set_op(out, i, |op| {
+                        if let ControlOp::EndWhile { start: s } = op {
+                            *s = start
+                        }
+                    });
+                }
+                other => {
+                    ctx.error(spans[i], "$ENDWHILE without a matching $WHILE");
+                    if let Some(o) = other {
+                        open.push(o);
+                    }
+                }
+            },
+            ControlOp::EndIf => match open.pop() {
+                Some((start, false, else_at)) => {
+                    let next = else_at.unwrap_or(i);
+                    set_op(out, start, |op| {
+                        if let ControlOp::If { next: n, .. } = op {
+                            *n = next
+                        }
+                    });
+                    if let Some(e) = else_at {
+                        set_op(out, e, |op| {
+                            if let ControlOp::Else { end } = op {
+                                *end = i
+                            }
+                        });
+                    }
+                }
+                other => {
+                    ctx.error(spans[i], "$ENDIF without a matching $IF");
+                    if let Some(o) = other {
+                        open.push(o);
+                    }
+                }
+            },
+        }
+    }
+    for (i, is_while, _) in open {
+        let what = if is_while {
+            "$WHILE without $ENDWHILE"
+        } else {
+            "$IF without $ENDIF"
+        };
+        ctx.error(spans[i], what);
+    }
+}
+
+fn set_op(out: &mut [Decoded], i: usize, f: impl FnOnce(&mut ControlOp)) {
+    if let Decoded::Control { op, .. } = &mut out[i] {
+        f(op);
+    }
+}

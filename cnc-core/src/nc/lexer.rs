@@ -1,0 +1,299 @@
+//! Tokens of NC programs. Comments (`;` to the end of the line, `( ... )`) are dropped; a `\`
+//! at the end of a line and a line break inside `[ ]` continue the block, any other line break
+//! ends it.
+
+use super::ast::Span;
+
+/// What a token is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Tok {
+    /// Letters and underscores, upper-cased (`G`, `X`, `TRACK_CS`, `SET_ZERO`).
+    Word(String),
+    /// A variable with dots, as written (`V.G.TRACK_CS.X`).
+    Var(String),
+    /// A number, with its source text (leading zeros matter for nothing but printing).
+    Num(f64),
+    /// A double-quoted string.
+    Str(String),
+    /// `%name` up to the end of the line.
+    Percent(String),
+    /// One of `# $ = [ ] , + - * / < > == != <= >=`.
+    Punct(&'static str),
+    /// End of a block.
+    Newline,
+    /// A character that belongs to nothing.
+    Bad(char),
+}
+
+/// A token with its place.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Token {
+    /// The token.
+    pub tok: Tok,
+    /// Where it stands.
+    pub span: Span,
+    /// Whether white space (or a comment) separates it from the previous token.
+    pub spaced: bool,
+}
+
+/// A diagnostic of the lexer (unterminated comment or string).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LexError {
+    /// Where.
+    pub span: Span,
+    /// What.
+    pub message: String,
+}
+
+struct Cursor<'a> {
+    src: &'a str,
+    pos: usize,
+    line: u32,
+    col: u32,
+}
+
+impl Cursor<'_> {
+    fn peek(&self) -> Option<char> {
+        self.src[self.pos..].chars().next()
+    }
+    fn peek2(&self) -> Option<char> {
+        let mut it = self.src[self.pos..].chars();
+        it.next();
+        it.next()
+    }
+    fn bump(&mut self) -> Option<char> {
+        let c = self.peek()?;
+        self.pos += c.len_utf8();
+        if c == '\n' {
+            self.line += 1;
+            self.col = 1;
+        } else {
+            self.col += 1;
+        }
+        Some(c)
+    }
+    fn mark(&self) -> Span {
+        Span {
+            start: self.pos,
+            end: self.pos,
+            line: self.line,
+            col: self.col,
+        }
+    }
+    fn close(&self, mut span: Span) -> Span {
+        span.end = self.pos;
+        span
+    }
+}
+
+/// Splits `src` into tokens; never fails, reports problems in `errors`.
+pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
+    let mut c = Cursor {
+        src,
+        pos: 0,
+        line: 1,
+        col: 1,
+    };
+    let mut out: Vec<Token> = Vec::with_capacity(src.len() / 3);
+    let mut depth = 0usize;
+    let mut spaced = true;
+    while let Some(ch) = c.peek() {
+        let start = c.mark();
+        match ch {
+            ' ' | '\t' | '\r' => {
+                c.bump();
+                spaced = true;
+            }
+            '\n' => {
+                c.bump();
+                if depth == 0 {
+                    push(&mut out, Tok::Newline, c.close(start), true);
+                }
+                spaced = true;
+            }
+            ';' => {
+                while c.peek().is_some_and(|x| x != '\n') {
+                    c.bump();
+                }
+                spaced = true;
+            }
+            '(' => {
+                let mut closed = false;
+                while let Some(x) = c.bump() {
+                    if x == ')' {
+                        closed = true;
+                        break;
+                    }
+                    if x == '\n' && depth == 0 {
+                        break;
+                    }
+                }
+                if !closed {
+                    errors.push(LexError {
+                        span: c.close(start),
+                        message: "comment \"(\" is not closed by \")\" on its line".into(),
+                    });
+                }
+                spaced = true;
+            }
+            '\\' => {
+                // Continuation: the rest of the line must be blank (or a comment).
+                c.bump();
+                let rest_blank = {
+                    let tail = &src[c.pos..];
+                    let line = tail.split('\n').next().unwrap_or("");
+                    let code = line.split(';').next().unwrap_or("");
+                    code.trim().is_empty()
+                };
+                if rest_blank {
+                    while c.peek().is_some_and(|x| x != '\n') {
+                        c.bump();
+                    }
+                    c.bump();
+                } else {
+                    push(&mut out, Tok::Bad('\\'), c.close(start), spaced);
+                }
+                spaced = true;
+            }
+            '%' => {
+                c.bump();
+                let mut name = String::new();
+                while let Some(x) = c.peek() {
+                    if x.is_whitespace() || x == ';' || x == '(' {
+                        break;
+                    }
+                    name.push(x);
+                    c.bump();
+                }
+                push(&mut out, Tok::Percent(name), c.close(start), spaced);
+                spaced = false;
+            }
+            '"' => {
+                c.bump();
+                let mut text = String::new();
+                let mut closed = false;
+                while let Some(x) = c.peek() {
+                    if x == '\n' {
+                        break;
+                    }
+                    c.bump();
+                    if x == '"' {
+                        closed = true;
+                        break;
+                    }
+                    text.push(x);
+                }
+                if !closed {
+                    errors.push(LexError {
+                        span: c.close(start),
+                        message: "string is not closed by '\"' on its line".into(),
+                    });
+                }
+                push(&mut out, Tok::Str(text), c.close(start), spaced);
+                spaced = false;
+            }
+            '0'..='9' | '.' if ch != '.' || c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
+                let mut text = String::new();
+                while let Some(x) = c.peek() {
+                    if x.is_ascii_digit() || x == '.' {
+                        text.push(x);
+                        c.bump();
+                    } else {
+                        break;
+                    }
+                }
+                match text.parse::<f64>() {
+                    Ok(v) => push(&mut out, Tok::Num(v), c.close(start), spaced),
+                    Err(_) => {
+                        errors.push(LexError {
+                            span: c.close(start),
+                            message: format!("malformed number \"{text}\""),
+                        });
+                        push(&mut out, Tok::Num(0.0), c.close(start), spaced);
+                    }
+                }
+                spaced = false;
+            }
+            x if x.is_ascii_alphabetic() || x == '_' => {
+                let mut text = String::new();
+                while let Some(y) = c.peek() {
+                    if y.is_ascii_alphabetic() || y == '_' {
+                        text.push(y.to_ascii_uppercase());
+                        c.bump();
+                    } else {
+                        break;
+                    }
+                }
+                // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
+                if c.peek() == Some('.')
+                    && c.peek2()
+                        .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_')
+                {
+                    let mut var = text;
+                    while let Some(y) = c.peek() {
+                        if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
+                            var.push(y.to_ascii_uppercase());
+                            c.bump();
+                        } else {
+                            break;
+                        }
+                    }
+                    push(&mut out, Tok::Var(var), c.close(start), spaced);
+                } else {
+                    push(&mut out, Tok::Word(text), c.close(start), spaced);
+                }
+                spaced = false;
+            }
+            _ => {
+                c.bump();
+                let next = c.peek();
+                let punct: Option<&'static str> = match (ch, next) {
+                    ('=', Some('=')) => Some("=="),
+                    ('!', Some('=')) => Some("!="),
+                    ('<', Some('=')) => Some("<="),
+                    ('>', Some('=')) => Some(">="),
+                    _ => None,
+                };
+                let tok = if let Some(p) = punct {
+                    c.bump();
+                    Tok::Punct(p)
+                } else {
+                    match ch {
+                        '#' => Tok::Punct("#"),
+                        '$' => Tok::Punct("$"),
+                        '=' => Tok::Punct("="),
+                        '[' => {
+                            depth += 1;
+                            Tok::Punct("[")
+                        }
+                        ']' => {
+                            depth = depth.saturating_sub(1);
+                            Tok::Punct("]")
+                        }
+                        ',' => Tok::Punct(","),
+                        '+' => Tok::Punct("+"),
+                        '-' => Tok::Punct("-"),
+                        '*' => Tok::Punct("*"),
+                        '/' => Tok::Punct("/"),
+                        '<' => Tok::Punct("<"),
+                        '>' => Tok::Punct(">"),
+                        other => Tok::Bad(other),
+                    }
+                };
+                push(&mut out, tok, c.close(start), spaced);
+                spaced = false;
+            }
+        }
+    }
+    let end = c.mark();
+    push(&mut out, Tok::Newline, end, true);
+    out
+}
+
+fn push(out: &mut Vec<Token>, tok: Tok, span: Span, spaced: bool) {
+    // Collapse runs of newlines: empty lines make no blocks.
+    if tok == Tok::Newline && out.last().is_none_or(|t| t.tok == Tok::Newline) {
+        return;
+    }
+    out.push(Token { tok, span, spaced });
+}
