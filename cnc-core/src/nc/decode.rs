@@ -756,10 +756,8 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
                     .unwrap_or(0);
                 t.offset[i] = value(ctx)?;
             }
-            _ => {
-                ctx.error(e.span, format!("#TRACK CS: unknown option \"{key}\""));
-                ok = false;
-            }
+            // The parser has reported unknown options already.
+            _ => ok = false,
         }
     }
     if seen.contains(&"CH") && seen.contains(&"ID") {

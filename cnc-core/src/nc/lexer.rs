@@ -106,6 +106,11 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
             }
             '\n' => {
                 c.bump();
+                // Inside `[ ]` a list may run on over the next line, unless that line plainly
+                // starts a new block: then the bracket was left open and the block ends here.
+                if depth > 0 && starts_new_block(&src[c.pos..]) {
+                    depth = 0;
+                }
                 if depth == 0 {
                     push(&mut out, Tok::Newline, c.close(start), true);
                 }
@@ -288,6 +293,17 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
     let end = c.mark();
     push(&mut out, Tok::Newline, end, true);
     out
+}
+
+/// Whether a line begins a block of its own: empty, or a block number, `#`, `$` or `%`.
+fn starts_new_block(rest: &str) -> bool {
+    let line = rest.split('\n').next().unwrap_or("").trim_start();
+    let mut chars = line.chars();
+    match chars.next() {
+        None | Some('#' | '$' | '%') => true,
+        Some('N' | 'n') => chars.next().is_some_and(|c| c.is_ascii_digit()),
+        _ => false,
+    }
 }
 
 fn push(out: &mut Vec<Token>, tok: Tok, span: Span, spaced: bool) {

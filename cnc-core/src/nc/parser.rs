@@ -63,6 +63,27 @@ impl Parser<'_> {
         }
         t
     }
+    /// `span` extended to the end of the last token consumed.
+    fn extend(&self, mut span: Span) -> Span {
+        if self.pos > 0 {
+            let last = self.tokens[self.pos - 1].span;
+            if last.end > span.end {
+                span.end = last.end;
+            }
+        }
+        span
+    }
+    /// `span` extended to the end of the block's last token.
+    fn to_block_end(&self, mut span: Span) -> Span {
+        let mut i = self.pos;
+        while i < self.tokens.len() && self.tokens[i].tok != Tok::Newline {
+            i += 1;
+        }
+        if i > 0 && self.tokens[i - 1].span.end > span.end {
+            span.end = self.tokens[i - 1].span.end;
+        }
+        span
+    }
     fn at_end_of_block(&self) -> bool {
         matches!(self.peek(), Tok::Newline)
     }
@@ -176,6 +197,7 @@ impl Parser<'_> {
                 self.bump();
             }
         }
+        block.span = self.extend(block.span);
         (block.number.is_some() || !block.items.is_empty()).then_some(block)
     }
 
@@ -183,16 +205,31 @@ impl Parser<'_> {
         let span = self.span();
         match self.peek().clone() {
             Tok::Punct("#") => {
+                let full = self.to_block_end(span);
                 self.bump();
-                let command = self.command(span)?;
+                let command = self.command(full)?;
+                let span = self.extend(span);
                 Some(Item::Command { command, span })
             }
             Tok::Punct("$") => {
+                let full = self.to_block_end(span);
                 self.bump();
-                let control = self.control(span)?;
+                let control = self.control(full)?;
+                let span = self.extend(span);
                 Some(Item::Control { control, span })
             }
-            Tok::Word(w) => self.word_item(w, span),
+            Tok::Word(w) => {
+                let item = self.word_item(w, span)?;
+                let end = self.extend(span);
+                Some(match item {
+                    Item::G { code, .. } => Item::G { code, span: end },
+                    Item::M { code, .. } => Item::M { code, span: end },
+                    Item::Feed { value, .. } => Item::Feed { value, span: end },
+                    Item::Axis(a) => Item::Axis(AxisWord { span: end, ..a }),
+                    Item::IndependentAxis { name, options, .. } => Item::IndependentAxis { name, options, span: end },
+                    other => other,
+                })
+            }
             Tok::Percent(_) => {
                 self.bump();
                 self.error(
@@ -666,7 +703,7 @@ impl Parser<'_> {
                         glued,
                         value,
                         text,
-                        span,
+                        span: self.extend(span),
                     });
                 }
                 _ => {
@@ -677,7 +714,7 @@ impl Parser<'_> {
                         glued: None,
                         value: Some(value),
                         text: None,
-                        span,
+                        span: self.extend(span),
                     });
                 }
             }

@@ -1,0 +1,8 @@
+N10 G1 X F100
+N20 #TRACK CS ON [ID=0
+N30 G5 X1
+N40 X10 ~ Y2
+(unterminated comment
+N60 $WHILE 1 X1
+N70 F0
+%late
