@@ -290,8 +290,14 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
             }
         }
     }
-    let end = c.mark();
-    push(&mut out, Tok::Newline, end, true);
+    // The stream always ends with a newline, even for empty input.
+    if out.last().is_none_or(|t| t.tok != Tok::Newline) {
+        out.push(Token {
+            tok: Tok::Newline,
+            span: c.mark(),
+            spaced: true,
+        });
+    }
     out
 }
 
