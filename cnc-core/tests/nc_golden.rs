@@ -28,7 +28,11 @@ fn render(case: &Path, ok: bool) -> String {
             }
         }
     } else {
-        assert!(!diags.is_empty(), "{}: expected diagnostics", case.display());
+        assert!(
+            !diags.is_empty(),
+            "{}: expected diagnostics",
+            case.display()
+        );
         for d in &diags {
             out.push_str(&d.render("FILE"));
             out.push('\n');
@@ -38,7 +42,9 @@ fn render(case: &Path, ok: bool) -> String {
 }
 
 fn check(dir: &str, ok: bool) {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("test_data").join(dir);
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("test_data")
+        .join(dir);
     let mut cases: Vec<PathBuf> = std::fs::read_dir(&root)
         .unwrap()
         .map(|e| e.unwrap().path())

@@ -16,11 +16,15 @@ fn span() -> Span {
 }
 
 fn number() -> impl Strategy<Value = f64> {
-    prop_oneof![(0u32..100_000).prop_map(f64::from), (0u32..10_000_000).prop_map(|v| f64::from(v) / 1000.0)]
+    prop_oneof![
+        (0u32..100_000).prop_map(f64::from),
+        (0u32..10_000_000).prop_map(|v| f64::from(v) / 1000.0)
+    ]
 }
 
 fn variable() -> impl Strategy<Value = String> {
-    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C"]).prop_map(|a| format!("V.G.TRACK_CS.{a}"))
+    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C"])
+        .prop_map(|a| format!("V.G.TRACK_CS.{a}"))
 }
 
 fn atom() -> impl Strategy<Value = Expr> {
@@ -33,34 +37,70 @@ fn expr() -> impl Strategy<Value = Expr> {
     fn term() -> impl Strategy<Value = Expr> {
         (atom(), any::<bool>()).prop_map(|(a, neg)| if neg { Expr::Neg(Box::new(a)) } else { a })
     }
-    (term(), prop::collection::vec((prop::sample::select(vec![BinOp::Add, BinOp::Sub]), term()), 0..3))
-        .prop_map(|(first, rest)| rest.into_iter().fold(first, |acc, (op, t)| Expr::Bin(op, Box::new(acc), Box::new(t))))
+    (
+        term(),
+        prop::collection::vec(
+            (prop::sample::select(vec![BinOp::Add, BinOp::Sub]), term()),
+            0..3,
+        ),
+    )
+        .prop_map(|(first, rest)| {
+            rest.into_iter().fold(first, |acc, (op, t)| {
+                Expr::Bin(op, Box::new(acc), Box::new(t))
+            })
+        })
 }
 
 fn axis_name() -> impl Strategy<Value = String> {
-    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"]).prop_map(String::from)
+    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"])
+        .prop_map(String::from)
 }
 
 fn axis_word() -> impl Strategy<Value = AxisWord> {
     prop_oneof![
-        (axis_name(), number()).prop_map(|(name, v)| AxisWord { name, value: Expr::Num(v), assigned: false, span: span() }),
-        (axis_name(), expr()).prop_map(|(name, value)| AxisWord { name, value, assigned: true, span: span() }),
+        (axis_name(), number()).prop_map(|(name, v)| AxisWord {
+            name,
+            value: Expr::Num(v),
+            assigned: false,
+            span: span()
+        }),
+        (axis_name(), expr()).prop_map(|(name, value)| AxisWord {
+            name,
+            value,
+            assigned: true,
+            span: span()
+        }),
     ]
 }
 
 fn flag(key: &str) -> Entry {
-    Entry { key: Some(key.into()), glued: None, value: None, text: None, span: span() }
+    Entry {
+        key: Some(key.into()),
+        glued: None,
+        value: None,
+        text: None,
+        span: span(),
+    }
 }
 
 fn valued(key: &str, value: Expr) -> Entry {
-    Entry { key: Some(key.into()), glued: None, value: Some(value), text: None, span: span() }
+    Entry {
+        key: Some(key.into()),
+        glued: None,
+        value: Some(value),
+        text: None,
+        span: span(),
+    }
 }
 
 fn track_options() -> impl Strategy<Value = Vec<Entry>> {
     (
         prop::sample::select(vec!["ID", "CH"]),
         0u32..13,
-        prop::collection::vec(prop::sample::select(vec!["SET_ZERO", "KIN_BASE", "WAIT", "SIMU", "RELATIVE"]), 0..3),
+        prop::collection::vec(
+            prop::sample::select(vec!["SET_ZERO", "KIN_BASE", "WAIT", "SIMU", "RELATIVE"]),
+            0..3,
+        ),
         prop::option::of(0u32..2000),
         prop::option::of(expr()),
     )
@@ -85,20 +125,66 @@ fn track_options() -> impl Strategy<Value = Vec<Entry>> {
 
 fn command() -> impl Strategy<Value = Command> {
     prop_oneof![
-        (any::<bool>(), track_options()).prop_map(|(on, options)| Command::TrackCs { on, options: if on { options } else { vec![flag("WAIT")] } }),
+        (any::<bool>(), track_options()).prop_map(|(on, options)| Command::TrackCs {
+            on,
+            options: if on { options } else { vec![flag("WAIT")] }
+        }),
         Just(Command::TrackCsAbs),
-        (any::<bool>(), prop::sample::select(vec!["DYN_CS", "TRACK_CS"])).prop_map(|(on, k)| Command::ChannelInterface { on, kind: Some(k.into()) }),
-        prop::collection::vec(expr(), 1..7).prop_map(|values| Command::Cs { on: true, name: Some("OFFS".into()), values }),
-        Just(Command::Cs { on: false, name: None, values: vec![] }),
-        (0u32..300).prop_map(|id| Command::Trafo { on: None, id: Some(Expr::Num(f64::from(id))) }),
-        any::<bool>().prop_map(|on| Command::Trafo { on: Some(on), id: None }),
-        (1u32..20, 1u32..5).prop_map(|(id, count)| Command::SignalSyn { options: vec![
-            Entry { key: Some("ID".into()), glued: Some(f64::from(id)), value: None, text: None, span: span() },
-            Entry { key: Some("COUNT".into()), glued: Some(f64::from(count)), value: None, text: None, span: span() },
-        ] }),
+        (
+            any::<bool>(),
+            prop::sample::select(vec!["DYN_CS", "TRACK_CS"])
+        )
+            .prop_map(|(on, k)| Command::ChannelInterface {
+                on,
+                kind: Some(k.into())
+            }),
+        prop::collection::vec(expr(), 1..7).prop_map(|values| Command::Cs {
+            on: true,
+            name: Some("OFFS".into()),
+            values
+        }),
+        Just(Command::Cs {
+            on: false,
+            name: None,
+            values: vec![]
+        }),
+        (0u32..300).prop_map(|id| Command::Trafo {
+            on: None,
+            id: Some(Expr::Num(f64::from(id)))
+        }),
+        any::<bool>().prop_map(|on| Command::Trafo {
+            on: Some(on),
+            id: None
+        }),
+        (1u32..20, 1u32..5).prop_map(|(id, count)| Command::SignalSyn {
+            options: vec![
+                Entry {
+                    key: Some("ID".into()),
+                    glued: Some(f64::from(id)),
+                    value: None,
+                    text: None,
+                    span: span()
+                },
+                Entry {
+                    key: Some("COUNT".into()),
+                    glued: Some(f64::from(count)),
+                    value: None,
+                    text: None,
+                    span: span()
+                },
+            ]
+        }),
         Just(Command::WaitIndpAll),
         any::<bool>().prop_map(|wait| Command::Flush { wait }),
-        prop::collection::vec(axis_word(), 1..3).prop_map(|axes| Command::Pset { axes: axes.into_iter().map(|a| AxisWord { assigned: true, ..a }).collect() }),
+        prop::collection::vec(axis_word(), 1..3).prop_map(|axes| Command::Pset {
+            axes: axes
+                .into_iter()
+                .map(|a| AxisWord {
+                    assigned: true,
+                    ..a
+                })
+                .collect()
+        }),
         Just(Command::Preset { axes: vec![] }),
     ]
 }
@@ -123,7 +209,10 @@ fn motion_block() -> impl Strategy<Value = Vec<Item>> {
                 }
             }
             if let Some(f) = feed {
-                items.push(Item::Feed { value: Expr::Num(f), span: span() });
+                items.push(Item::Feed {
+                    value: Expr::Num(f),
+                    span: span(),
+                });
             }
             if let Some(code) = m {
                 items.push(Item::M { code, span: span() });
@@ -135,14 +224,29 @@ fn motion_block() -> impl Strategy<Value = Vec<Item>> {
 fn block() -> impl Strategy<Value = Block> {
     (
         prop::option::of(0u32..100_000),
-        prop_oneof![motion_block(), command().prop_map(|command| vec![Item::Command { command, span: span() }])],
+        prop_oneof![
+            motion_block(),
+            command().prop_map(|command| vec![Item::Command {
+                command,
+                span: span()
+            }])
+        ],
     )
-        .prop_filter("blocks hold something", |(n, items)| n.is_some() || !items.is_empty())
-        .prop_map(|(number, items)| Block { number, items, span: span() })
+        .prop_filter("blocks hold something", |(n, items)| {
+            n.is_some() || !items.is_empty()
+        })
+        .prop_map(|(number, items)| Block {
+            number,
+            items,
+            span: span(),
+        })
 }
 
 fn program() -> impl Strategy<Value = Program> {
-    (prop::option::of("[A-Za-z][A-Za-z0-9_-]{0,12}"), prop::collection::vec(block(), 0..40))
+    (
+        prop::option::of("[A-Za-z][A-Za-z0-9_-]{0,12}"),
+        prop::collection::vec(block(), 0..40),
+    )
         .prop_map(|(name, blocks)| Program { name, blocks })
 }
 

@@ -226,7 +226,11 @@ impl Parser<'_> {
                     Item::M { code, .. } => Item::M { code, span: end },
                     Item::Feed { value, .. } => Item::Feed { value, span: end },
                     Item::Axis(a) => Item::Axis(AxisWord { span: end, ..a }),
-                    Item::IndependentAxis { name, options, .. } => Item::IndependentAxis { name, options, span: end },
+                    Item::IndependentAxis { name, options, .. } => Item::IndependentAxis {
+                        name,
+                        options,
+                        span: end,
+                    },
                     other => other,
                 })
             }

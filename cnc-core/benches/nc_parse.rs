@@ -1,0 +1,116 @@
+//! Parse + decode of a generated 100,000-block program, against LinuxCNC's standalone
+//! interpreter `rs274 -g` on the same file in the same run (skipped, and said so, when `rs274`
+//! is not installed; Debian package `linuxcnc-uspace`).
+//!
+//! Run: `cargo bench -p cnc-core --bench nc_parse`. Reports medians over repeats.
+
+use cnc_core::nc::decode::ZeroVars;
+use cnc_core::nc::{decode_program, parse};
+use std::hint::black_box;
+use std::process::{Command, Stdio};
+use std::time::Instant;
+
+const BLOCKS: usize = 100_000;
+
+fn program() -> String {
+    let mut s = String::with_capacity(BLOCKS * 48);
+    let mut seed = 0x1234_5678_9abc_def0u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 40) as f64 / (1u64 << 24) as f64
+    };
+    for i in 0..BLOCKS {
+        s.push_str(&format!(
+            "N{} G1 X{:.3} Y{:.3} Z{:.3} F{}\n",
+            (i + 1) * 10,
+            next() * 500.0,
+            next() * 500.0 - 250.0,
+            next() * 100.0,
+            500 + (i % 7) * 100
+        ));
+    }
+    s.push_str("M2\n");
+    s
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let src = program();
+    let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();
+    let mut ours = Vec::new();
+    for _ in 0..9 {
+        let t0 = Instant::now();
+        let (tree, diags) = parse(black_box(&src));
+        let (decoded, semantic) = decode_program(&tree, &src, &axes, &ZeroVars);
+        let elapsed = t0.elapsed().as_secs_f64();
+        assert!(diags.is_empty() && semantic.is_empty());
+        assert_eq!(decoded.len(), BLOCKS + 1);
+        ours.push(elapsed);
+    }
+    let ours = median(ours);
+    println!(
+        "program: {BLOCKS} blocks `N.. G1 X.. Y.. Z.. F..`, {} bytes",
+        src.len()
+    );
+    println!("| interpreter | median s | blocks/s | time ratio to ours |\n|---|---:|---:|---:|");
+    println!(
+        "| cnc-core parse + decode (9 runs) | {ours:.4} | {:.0} | 1.0 |",
+        BLOCKS as f64 / ours
+    );
+
+    let path = std::env::temp_dir().join(format!("nc-bench-{}.ngc", std::process::id()));
+    std::fs::write(&path, &src).unwrap();
+    let have_rs274 = Command::new("rs274")
+        .arg("-h")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok();
+    let rate = BLOCKS as f64 / ours;
+    let verdict = |ok: bool| if ok { "met" } else { "MISSED" };
+    if have_rs274 {
+        let mut runs = Vec::new();
+        for _ in 0..3 {
+            let t0 = Instant::now();
+            let status = Command::new("rs274")
+                .arg("-g")
+                .arg(&path)
+                .arg("/dev/null")
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .status()
+                .expect("run rs274");
+            runs.push(t0.elapsed().as_secs_f64());
+            assert!(status.success(), "rs274 failed on the program");
+        }
+        let theirs = median(runs);
+        println!(
+            "| LinuxCNC rs274 -g (3 runs) | {theirs:.4} | {:.0} | {:.1} |",
+            BLOCKS as f64 / theirs,
+            theirs / ours
+        );
+        println!(
+            "target >= 20x faster than rs274: {:.1}x -> {}; >= 2 million blocks/s: {:.2} M -> {}",
+            theirs / ours,
+            verdict(theirs / ours >= 20.0),
+            rate / 1e6,
+            verdict(rate >= 2e6)
+        );
+    } else {
+        println!("rs274 not installed (Debian package linuxcnc-uspace): comparison skipped");
+        println!(
+            "target >= 2 million blocks/s: {:.2} M -> {}",
+            rate / 1e6,
+            verdict(rate >= 2e6)
+        );
+    }
+    let _ = std::fs::remove_file(&path);
+}
