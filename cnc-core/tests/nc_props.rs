@@ -22,9 +22,9 @@ fn number() -> impl Strategy<Value = f64> {
     ]
 }
 
-fn variable() -> impl Strategy<Value = String> {
+fn variable() -> impl Strategy<Value = Name> {
     prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C"])
-        .prop_map(|a| format!("V.G.TRACK_CS.{a}"))
+        .prop_map(|a| Name::from(format!("V.G.TRACK_CS.{a}").as_str()))
 }
 
 fn atom() -> impl Strategy<Value = Expr> {
@@ -51,9 +51,9 @@ fn expr() -> impl Strategy<Value = Expr> {
         })
 }
 
-fn axis_name() -> impl Strategy<Value = String> {
+fn axis_name() -> impl Strategy<Value = Name> {
     prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"])
-        .prop_map(String::from)
+        .prop_map(Name::from)
 }
 
 fn axis_word() -> impl Strategy<Value = AxisWord> {
@@ -204,7 +204,7 @@ fn motion_block() -> impl Strategy<Value = Vec<Item>> {
             let mut names = Vec::new();
             for a in axes {
                 if !names.contains(&a.name) {
-                    names.push(a.name.clone());
+                    names.push(a.name);
                     items.push(Item::Axis(a));
                 }
             }

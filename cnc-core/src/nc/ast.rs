@@ -1,6 +1,107 @@
 //! The program tree. Spans locate every node in the source; they do not take part in tree
 //! equality, so a re-parsed printout compares equal to the original.
 
+/// A word or variable name of at most [`Name::CAPACITY`] bytes, stored inline so tokens
+/// need no heap allocation.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub struct Name {
+    len: u8,
+    bytes: [u8; Name::CAPACITY],
+}
+
+impl Name {
+    /// Longest name the lexer keeps whole.
+    pub const CAPACITY: usize = 30;
+
+    /// An empty name.
+    pub fn new() -> Self {
+        Self {
+            len: 0,
+            bytes: [0; Self::CAPACITY],
+        }
+    }
+
+    /// Appends an ASCII byte; `false` when full.
+    pub fn push(&mut self, b: u8) -> bool {
+        if (self.len as usize) < Self::CAPACITY {
+            self.bytes[self.len as usize] = b;
+            self.len += 1;
+            true
+        } else {
+            false
+        }
+    }
+
+    /// The text.
+    pub fn as_str(&self) -> &str {
+        // Only ASCII bytes are ever pushed.
+        core::str::from_utf8(&self.bytes[..self.len as usize]).unwrap_or("")
+    }
+}
+
+impl core::fmt::Debug for Name {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
+impl core::fmt::Display for Name {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl PartialEq<str> for Name {
+    fn eq(&self, other: &str) -> bool {
+        &self.bytes[..self.len as usize] == other.as_bytes()
+    }
+}
+impl PartialEq<&str> for Name {
+    fn eq(&self, other: &&str) -> bool {
+        &self.bytes[..self.len as usize] == other.as_bytes()
+    }
+}
+
+impl Default for Name {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Name {
+    /// The name of `text` (upper-cased ASCII), `None` when it is longer than the capacity or
+    /// not ASCII.
+    pub fn parse(text: &str) -> Option<Self> {
+        let mut name = Self::new();
+        for b in text.bytes() {
+            if !b.is_ascii() || !name.push(b.to_ascii_uppercase()) {
+                return None;
+            }
+        }
+        Some(name)
+    }
+}
+
+impl From<&str> for Name {
+    /// For names known to fit (constants, tests); longer text is cut at the capacity.
+    fn from(text: &str) -> Self {
+        let mut name = Self::new();
+        for b in text.bytes().filter(u8::is_ascii) {
+            if !name.push(b.to_ascii_uppercase()) {
+                break;
+            }
+        }
+        name
+    }
+}
+
+impl core::ops::Deref for Name {
+    type Target = str;
+    fn deref(&self) -> &str {
+        self.as_str()
+    }
+}
+
 /// A source range with its line and column (1-based, columns in characters).
 #[derive(Debug, Clone, Copy, Default, Eq)]
 pub struct Span {
@@ -79,7 +180,7 @@ pub enum Expr {
     /// A literal number.
     Num(f64),
     /// A variable such as `V.G.TRACK_CS.X`.
-    Var(String),
+    Var(Name),
     /// Unary minus.
     Neg(Box<Expr>),
     /// A binary operation.
@@ -91,7 +192,7 @@ pub enum Expr {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Entry {
     /// The key, upper case, if the entry has one.
-    pub key: Option<String>,
+    pub key: Option<Name>,
     /// A number glued to the key (`ID3` -> 3, `G01` -> 1).
     pub glued: Option<f64>,
     /// The value after `=`, or the bare expression.
@@ -119,14 +220,14 @@ pub enum Command {
         /// ON or OFF.
         on: bool,
         /// The interface named in the brackets.
-        kind: Option<String>,
+        kind: Option<Name>,
     },
     /// `#CS ON [name] [values]`, `#CS ON [values]`, `#CS OFF [name]`.
     Cs {
         /// ON or OFF.
         on: bool,
         /// The coordinate system's name, if given.
-        name: Option<String>,
+        name: Option<Name>,
         /// X Y Z A B C values.
         values: Vec<Expr>,
     },
@@ -167,7 +268,7 @@ pub enum Command {
     /// `#PRESET` (all axes) or `#PRESET axis ...`.
     Preset {
         /// Axes whose preset is removed; empty = all.
-        axes: Vec<String>,
+        axes: Vec<Name>,
     },
 }
 
@@ -175,7 +276,7 @@ pub enum Command {
 #[derive(Debug, Clone, PartialEq)]
 pub struct AxisWord {
     /// Axis name, upper case.
-    pub name: String,
+    pub name: Name,
     /// The value.
     pub value: Expr,
     /// Whether it was written with `=` (printing keeps the form).
@@ -213,7 +314,7 @@ pub enum Item {
     /// An independent axis command `X1[INDP_ASYN POS=-90 G01 F500 G90]`.
     IndependentAxis {
         /// Axis name.
-        name: String,
+        name: Name,
         /// The entries in the brackets.
         options: Vec<Entry>,
         /// Where it stands.

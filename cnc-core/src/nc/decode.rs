@@ -584,7 +584,7 @@ impl DecoderState {
                 Some(Decoded::Cs {
                     line,
                     on: *on,
-                    name: name.clone(),
+                    name: name.map(|n| n.to_string()),
                     frame,
                 })
             }

@@ -2,15 +2,16 @@
 //! at the end of a line and a line break inside `[ ]` continue the block, any other line break
 //! ends it.
 
+pub use super::ast::Name;
 use super::ast::Span;
 
 /// What a token is.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Tok {
     /// Letters and underscores, upper-cased (`G`, `X`, `TRACK_CS`, `SET_ZERO`).
-    Word(String),
-    /// A variable with dots, as written (`V.G.TRACK_CS.X`).
-    Var(String),
+    Word(Name),
+    /// A variable with dots, upper-cased (`V.G.TRACK_CS.X`).
+    Var(Name),
     /// A number, with its source text (leading zeros matter for nothing but printing).
     Num(f64),
     /// A double-quoted string.
@@ -54,12 +55,25 @@ struct Cursor<'a> {
 
 impl Cursor<'_> {
     fn peek(&self) -> Option<char> {
-        self.src[self.pos..].chars().next()
+        match self.src.as_bytes().get(self.pos) {
+            Some(&b) if b.is_ascii() => Some(b as char),
+            Some(_) => self.src[self.pos..].chars().next(),
+            None => None,
+        }
     }
     fn peek2(&self) -> Option<char> {
-        let mut it = self.src[self.pos..].chars();
-        it.next();
-        it.next()
+        match self.src.as_bytes().get(self.pos) {
+            Some(&b) if b.is_ascii() => match self.src.as_bytes().get(self.pos + 1) {
+                Some(&c) if c.is_ascii() => Some(c as char),
+                Some(_) => self.src[self.pos + 1..].chars().next(),
+                None => None,
+            },
+            _ => {
+                let mut it = self.src[self.pos..].chars();
+                it.next();
+                it.next()
+            }
+        }
     }
     fn bump(&mut self) -> Option<char> {
         let c = self.peek()?;
@@ -198,15 +212,11 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                 spaced = false;
             }
             '0'..='9' | '.' if ch != '.' || c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
-                let mut text = String::new();
-                while let Some(x) = c.peek() {
-                    if x.is_ascii_digit() || x == '.' {
-                        text.push(x);
-                        c.bump();
-                    } else {
-                        break;
-                    }
+                let from = c.pos;
+                while c.peek().is_some_and(|x| x.is_ascii_digit() || x == '.') {
+                    c.bump();
                 }
+                let text = &src[from..c.pos];
                 match text.parse::<f64>() {
                     Ok(v) => push(&mut out, Tok::Num(v), c.close(start), spaced),
                     Err(_) => {
@@ -220,33 +230,42 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                 spaced = false;
             }
             x if x.is_ascii_alphabetic() || x == '_' => {
-                let mut text = String::new();
+                let mut name = Name::new();
+                let mut fits = true;
                 while let Some(y) = c.peek() {
                     if y.is_ascii_alphabetic() || y == '_' {
-                        text.push(y.to_ascii_uppercase());
+                        fits &= name.push(y.to_ascii_uppercase() as u8);
                         c.bump();
                     } else {
                         break;
                     }
                 }
                 // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
-                if c.peek() == Some('.')
+                let is_var = c.peek() == Some('.')
                     && c.peek2()
-                        .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_')
-                {
-                    let mut var = text;
+                        .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
+                if is_var {
                     while let Some(y) = c.peek() {
                         if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
-                            var.push(y.to_ascii_uppercase());
+                            fits &= name.push(y.to_ascii_uppercase() as u8);
                             c.bump();
                         } else {
                             break;
                         }
                     }
-                    push(&mut out, Tok::Var(var), c.close(start), spaced);
-                } else {
-                    push(&mut out, Tok::Word(text), c.close(start), spaced);
                 }
+                if !fits {
+                    errors.push(LexError {
+                        span: c.close(start),
+                        message: format!("name longer than {} characters", Name::CAPACITY),
+                    });
+                }
+                let tok = if is_var {
+                    Tok::Var(name)
+                } else {
+                    Tok::Word(name)
+                };
+                push(&mut out, tok, c.close(start), spaced);
                 spaced = false;
             }
             _ => {

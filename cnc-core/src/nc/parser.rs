@@ -2,7 +2,7 @@
 //! span and what was expected, skipped, and parsing goes on with the next item.
 
 use super::ast::*;
-use super::lexer::{tokenize, Tok, Token};
+use super::lexer::{tokenize, Name, Tok, Token};
 use super::Diagnostic;
 
 /// Parses `src`; the tree holds everything that could be understood.
@@ -56,12 +56,15 @@ impl Parser<'_> {
     fn span(&self) -> Span {
         self.tokens[self.pos].span
     }
-    fn bump(&mut self) -> Token {
-        let t = self.tokens[self.pos].clone();
+    fn bump(&mut self) {
         if self.pos + 1 < self.tokens.len() {
             self.pos += 1;
         }
-        t
+    }
+    /// The current token's kind without borrowing the parser (names are Copy; strings are
+    /// rare and cloned).
+    fn current(&self) -> Tok {
+        self.tokens[self.pos].tok.clone()
     }
     /// `span` extended to the end of the last token consumed.
     fn extend(&self, mut span: Span) -> Span {
@@ -177,7 +180,8 @@ impl Parser<'_> {
             && !self.tokens[self.pos + 1].spaced
         {
             self.bump();
-            if let Tok::Num(n) = self.bump().tok {
+            if let Tok::Num(n) = self.current() {
+                self.bump();
                 if n.fract() == 0.0 && n >= 0.0 && n <= f64::from(u32::MAX) {
                     block.number = Some(n as u32);
                 } else {
@@ -255,7 +259,7 @@ impl Parser<'_> {
     }
 
     /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
-    fn word_item(&mut self, word: String, span: Span) -> Option<Item> {
+    fn word_item(&mut self, word: Name, span: Span) -> Option<Item> {
         self.bump();
         let glued = match self.peek() {
             Tok::Num(n) if !self.token().spaced => {
@@ -265,7 +269,7 @@ impl Parser<'_> {
             }
             _ => None,
         };
-        let glued_name = |n: f64| format!("{word}{}", n as u64);
+        let glued_name = |n: f64| Name::from(format!("{word}{}", n as u64).as_str());
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
             let name = match glued {
@@ -275,7 +279,7 @@ impl Parser<'_> {
                     self.recover();
                     return None;
                 }
-                None => word.clone(),
+                None => word,
             };
             self.bump();
             let value = self.expr()?;
@@ -300,7 +304,7 @@ impl Parser<'_> {
         if self.is_punct("[") {
             let name = match glued {
                 Some(n) if n.fract() == 0.0 => glued_name(n),
-                _ => word.clone(),
+                _ => word,
             };
             let options = self.bracket_list()?;
             return Some(Item::IndependentAxis {

@@ -156,7 +156,10 @@ fn item(i: &Item) -> String {
                 format!("#PSET {}", a.join(" "))
             }
             Command::Preset { axes } if axes.is_empty() => "#PRESET".into(),
-            Command::Preset { axes } => format!("#PRESET {}", axes.join(" ")),
+            Command::Preset { axes } => {
+                let names: Vec<&str> = axes.iter().map(|a| a.as_str()).collect();
+                format!("#PRESET {}", names.join(" "))
+            }
         },
     }
 }
