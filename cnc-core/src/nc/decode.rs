@@ -512,10 +512,10 @@ impl DecoderState {
                 (Some("POS"), None, Some(v)) => pos = ctx.eval(v, e.span),
                 (Some("F"), Some(f), None) => feed = f,
                 (Some("F"), None, Some(v)) => feed = ctx.eval(v, e.span)?,
-                (Some("G"), Some(g), None) if g == 0.0 => motion = MotionMode::Rapid,
-                (Some("G"), Some(g), None) if g == 1.0 => motion = MotionMode::Linear,
-                (Some("G"), Some(g), None) if g == 90.0 => absolute = true,
-                (Some("G"), Some(g), None) if g == 91.0 => absolute = false,
+                (Some("G"), Some(0.0), None) => motion = MotionMode::Rapid,
+                (Some("G"), Some(1.0), None) => motion = MotionMode::Linear,
+                (Some("G"), Some(90.0), None) => absolute = true,
+                (Some("G"), Some(91.0), None) => absolute = false,
                 _ => ctx.error(e.span, "independent axis: expected INDP_ASYN, INDP_SYN, POS=.., G0, G1, G90, G91 or F.."),
             }
         }

@@ -442,7 +442,7 @@ impl Parser<'_> {
                     for e in entries {
                         match (&e.key, &e.value, e.glued) {
                             (Some(k), None, None) if k == "DYN_CS" || k == "TRACK_CS" => {
-                                if kind.replace(k.clone()).is_some() {
+                                if kind.replace(*k).is_some() {
                                     self.error(
                                         e.span,
                                         "#CHANNEL INTERFACE names its interface once",
@@ -469,7 +469,7 @@ impl Parser<'_> {
                         && entries[0].value.is_none()
                         && entries[0].glued.is_none();
                     if is_name && name.is_none() && values.is_empty() {
-                        name = entries[0].key.clone();
+                        name = entries[0].key;
                     } else {
                         for e in entries {
                             match (e.key, e.value) {
@@ -777,33 +777,36 @@ impl Parser<'_> {
 
     fn binary(&mut self, min_prec: u8) -> Option<Expr> {
         let mut lhs = self.unary()?;
-        loop {
-            let op = match self.peek() {
-                Tok::Punct(p) => match *p {
-                    "+" => BinOp::Add,
-                    "-" => BinOp::Sub,
-                    "*" => BinOp::Mul,
-                    "/" => BinOp::Div,
-                    "==" => BinOp::Eq,
-                    "!=" => BinOp::Ne,
-                    "<" => BinOp::Lt,
-                    "<=" => BinOp::Le,
-                    ">" => BinOp::Gt,
-                    ">=" => BinOp::Ge,
-                    _ => break,
-                },
-                _ => break,
-            };
-            // In a list, `X=1 -2` would be ambiguous; a spaced sign before a spaced-off operand
-            // starts a new entry only after `,` or in value lists, so accept it as binary here.
-            if op.precedence() < min_prec {
-                break;
-            }
+        // `X=1 -2` reads as one expression: whitespace does not separate list entries from a
+        // following operator.
+        while let Some(op) = self
+            .binary_operator()
+            .filter(|op| op.precedence() >= min_prec)
+        {
             self.bump();
             let rhs = self.binary(op.precedence() + 1)?;
             lhs = Expr::Bin(op, Box::new(lhs), Box::new(rhs));
         }
         Some(lhs)
+    }
+
+    fn binary_operator(&self) -> Option<BinOp> {
+        let Tok::Punct(p) = self.peek() else {
+            return None;
+        };
+        Some(match *p {
+            "+" => BinOp::Add,
+            "-" => BinOp::Sub,
+            "*" => BinOp::Mul,
+            "/" => BinOp::Div,
+            "==" => BinOp::Eq,
+            "!=" => BinOp::Ne,
+            "<" => BinOp::Lt,
+            "<=" => BinOp::Le,
+            ">" => BinOp::Gt,
+            ">=" => BinOp::Ge,
+            _ => return None,
+        })
     }
 
     fn unary(&mut self) -> Option<Expr> {
