@@ -86,6 +86,20 @@ impl Cursor<'_> {
         }
         Some(c)
     }
+    /// Skips ASCII bytes (never a newline) while `keep` holds.
+    fn skip_ascii_while(&mut self, keep: impl Fn(u8) -> bool) {
+        let bytes = self.src.as_bytes();
+        let from = self.pos;
+        while self.pos < bytes.len()
+            && bytes[self.pos] != b'\n'
+            && bytes[self.pos].is_ascii()
+            && keep(bytes[self.pos])
+        {
+            self.pos += 1;
+        }
+        self.col += (self.pos - from) as u32;
+    }
+
     fn mark(&self) -> Span {
         Span {
             start: self.pos,
@@ -115,7 +129,7 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
         let start = c.mark();
         match ch {
             ' ' | '\t' | '\r' => {
-                c.bump();
+                c.skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
                 spaced = true;
             }
             '\n' => {
@@ -213,11 +227,9 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
             }
             '0'..='9' | '.' if ch != '.' || c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
                 let from = c.pos;
-                while c.peek().is_some_and(|x| x.is_ascii_digit() || x == '.') {
-                    c.bump();
-                }
+                c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
                 let text = &src[from..c.pos];
-                match text.parse::<f64>() {
+                match parse_decimal(text) {
                     Ok(v) => push(&mut out, Tok::Num(v), c.close(start), spaced),
                     Err(_) => {
                         errors.push(LexError {
@@ -231,14 +243,11 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
             }
             x if x.is_ascii_alphabetic() || x == '_' => {
                 let mut name = Name::new();
+                let from = c.pos;
+                c.skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
                 let mut fits = true;
-                while let Some(y) = c.peek() {
-                    if y.is_ascii_alphabetic() || y == '_' {
-                        fits &= name.push(y.to_ascii_uppercase() as u8);
-                        c.bump();
-                    } else {
-                        break;
-                    }
+                for &b in &src.as_bytes()[from..c.pos] {
+                    fits &= name.push(b.to_ascii_uppercase());
                 }
                 // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
                 let is_var = c.peek() == Some('.')
@@ -320,6 +329,36 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
     out
 }
 
+/// Parses `digits[.digits]`. Short numbers take the exact fast path (mantissa below 2^53 and
+/// a power of ten below 10^22 are exact doubles, so one division rounds correctly); anything
+/// else goes to the standard library.
+fn parse_decimal(text: &str) -> Result<f64, core::num::ParseFloatError> {
+    const POW10: [f64; 16] = [
+        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let mut mantissa: u64 = 0;
+    let mut digits = 0usize;
+    let mut fraction: Option<usize> = None;
+    for &b in text.as_bytes() {
+        match b {
+            b'0'..=b'9' => {
+                // Wrapping: more than 15 digits take the slow path below anyway.
+                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(b - b'0'));
+                digits += 1;
+                if let Some(f) = fraction.as_mut() {
+                    *f += 1;
+                }
+            }
+            b'.' if fraction.is_none() => fraction = Some(0),
+            _ => return text.parse(),
+        }
+    }
+    if digits == 0 || digits > 15 {
+        return text.parse();
+    }
+    Ok(mantissa as f64 / POW10[fraction.unwrap_or(0)])
+}
+
 /// Whether a line begins a block of its own: empty, or a block number, `#`, `$` or `%`.
 fn starts_new_block(rest: &str) -> bool {
     let line = rest.split('\n').next().unwrap_or("").trim_start();
@@ -337,4 +376,34 @@ fn push(out: &mut Vec<Token>, tok: Tok, span: Span, spaced: bool) {
         return;
     }
     out.push(Token { tok, span, spaced });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_decimal;
+    use proptest::prelude::*;
+
+    #[test]
+    fn decimal_fast_path_edges() {
+        assert_eq!(parse_decimal("0").unwrap(), 0.0);
+        assert_eq!(parse_decimal("00860").unwrap(), 860.0);
+        assert_eq!(parse_decimal("1305.92").unwrap(), 1305.92);
+        assert_eq!(parse_decimal(".5").unwrap(), 0.5);
+        assert_eq!(parse_decimal("5.").unwrap(), 5.0);
+        assert_eq!(
+            parse_decimal("12345678901234567890").unwrap(),
+            12345678901234567890.0
+        );
+        assert!(parse_decimal("1.2.3").is_err());
+        assert!(parse_decimal(".").is_err());
+    }
+
+    proptest! {
+        /// The fast path agrees with the standard library bit for bit.
+        #[test]
+        fn decimal_parsing_matches_std(int in 0u64..10_000_000_000, frac in 0u64..1_000_000, frac_digits in 0usize..7) {
+            let text = if frac_digits == 0 { format!("{int}") } else { format!("{int}.{:0width$}", frac % 10u64.pow(frac_digits as u32), width = frac_digits) };
+            prop_assert_eq!(parse_decimal(&text).unwrap().to_bits(), text.parse::<f64>().unwrap().to_bits(), "{}", text);
+        }
+    }
 }

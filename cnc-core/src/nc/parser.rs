@@ -172,7 +172,7 @@ impl Parser<'_> {
         let span = self.span();
         let mut block = Block {
             number: None,
-            items: Vec::new(),
+            items: Vec::with_capacity(8),
             span,
         };
         if self.is_word("N")
