@@ -352,6 +352,16 @@ impl DecoderState {
         &self.axes
     }
 
+    fn unknown_axis(&self, ctx: &mut Ctx<'_>, span: Span, name: &str) {
+        ctx.error(
+            span,
+            format!(
+                "unknown axis \"{name}\" for this channel (axes: {})",
+                self.axes.join(" ")
+            ),
+        );
+    }
+
     fn axis_index(&self, name: &str) -> Option<usize> {
         self.axes.iter().position(|a| a == name)
     }
@@ -396,14 +406,7 @@ impl DecoderState {
                 Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
                 Item::Axis(word) => {
                     let Some(i) = self.axis_index(&word.name) else {
-                        ctx.error(
-                            word.span,
-                            format!(
-                                "unknown axis \"{}\" for this channel (axes: {})",
-                                word.name,
-                                self.axes.join(" ")
-                            ),
-                        );
+                        self.unknown_axis(ctx, word.span, &word.name);
                         continue;
                     };
                     if axis_words.iter().any(|(j, _, _)| *j == i) {
@@ -494,13 +497,7 @@ impl DecoderState {
         ctx: &mut Ctx<'_>,
     ) -> Option<Decoded> {
         let Some(axis) = self.axis_index(name) else {
-            ctx.error(
-                span,
-                format!(
-                    "unknown axis \"{name}\" for this channel (axes: {})",
-                    self.axes.join(" ")
-                ),
-            );
+            self.unknown_axis(ctx, span, name);
             return None;
         };
         let (mut asynchronous, mut pos, mut feed, mut motion, mut absolute) =
@@ -645,14 +642,7 @@ impl DecoderState {
             Command::Pset { axes } => {
                 for word in axes {
                     let Some(i) = self.axis_index(&word.name) else {
-                        ctx.error(
-                            word.span,
-                            format!(
-                                "unknown axis \"{}\" for this channel (axes: {})",
-                                word.name,
-                                self.axes.join(" ")
-                            ),
-                        );
+                        self.unknown_axis(ctx, word.span, &word.name);
                         continue;
                     };
                     if let Some(v) = ctx.eval(&word.value, word.span) {
@@ -668,13 +658,7 @@ impl DecoderState {
                 for name in axes {
                     match self.axis_index(name) {
                         Some(i) => self.pset[i] = 0.0,
-                        None => ctx.error(
-                            span,
-                            format!(
-                                "unknown axis \"{name}\" for this channel (axes: {})",
-                                self.axes.join(" ")
-                            ),
-                        ),
+                        None => self.unknown_axis(ctx, span, name),
                     }
                 }
                 None

@@ -258,17 +258,22 @@ impl Parser<'_> {
         }
     }
 
-    /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
-    fn word_item(&mut self, word: Name, span: Span) -> Option<Item> {
-        self.bump();
-        let glued = match self.peek() {
+    /// A number written directly after a word (`G01`, `ID3`), consumed.
+    fn glued_number(&mut self) -> Option<f64> {
+        match self.peek() {
             Tok::Num(n) if !self.token().spaced => {
                 let n = *n;
                 self.bump();
                 Some(n)
             }
             _ => None,
-        };
+        }
+    }
+
+    /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
+    fn word_item(&mut self, word: Name, span: Span) -> Option<Item> {
+        self.bump();
+        let glued = self.glued_number();
         let glued_name = |n: f64| Name::from(format!("{word}{}", n as u64).as_str());
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
@@ -688,14 +693,7 @@ impl Parser<'_> {
                 Tok::Word(w) => {
                     let span = self.span();
                     self.bump();
-                    let glued = match self.peek() {
-                        Tok::Num(n) if !self.token().spaced => {
-                            let n = *n;
-                            self.bump();
-                            Some(n)
-                        }
-                        _ => None,
-                    };
+                    let glued = self.glued_number();
                     let (mut value, mut text) = (None, None);
                     if self.is_punct("=") {
                         self.bump();
