@@ -114,102 +114,146 @@ impl Cursor<'_> {
     }
 }
 
-/// Splits `src` into tokens; never fails, reports problems in `errors`.
+/// Splits `src` into tokens; never fails, reports problems in `errors`. (The parser streams
+/// block by block through [`Lexer`]; this collects everything, for tests and tools.)
 pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
-    let mut c = Cursor {
-        src,
-        pos: 0,
-        line: 1,
-        col: 1,
-    };
-    let mut out: Vec<Token> = Vec::with_capacity(src.len() / 3);
-    let mut depth = 0usize;
-    let mut spaced = true;
-    while let Some(ch) = c.peek() {
-        let start = c.mark();
+    let mut lexer = Lexer::new(src);
+    let mut all = Vec::new();
+    let mut block = Vec::new();
+    while lexer.next_block(&mut block) {
+        all.append(&mut block);
+    }
+    if all.is_empty() {
+        all.push(Token {
+            tok: Tok::Newline,
+            span: lexer.c.mark(),
+            spaced: true,
+        });
+    }
+    errors.append(&mut lexer.errors);
+    all
+}
+
+/// A lexer that hands out one block (logical line) at a time, so the parser works on a small
+/// buffer instead of a token vector of the whole file.
+pub struct Lexer<'a> {
+    c: Cursor<'a>,
+    depth: usize,
+    spaced: bool,
+    finished: bool,
+    /// Problems found so far (unterminated comments and strings, malformed numbers).
+    pub errors: Vec<LexError>,
+}
+
+impl<'a> Lexer<'a> {
+    /// A lexer at the start of `src`.
+    pub fn new(src: &'a str) -> Self {
+        Self {
+            c: Cursor {
+                src,
+                pos: 0,
+                line: 1,
+                col: 1,
+            },
+            depth: 0,
+            spaced: true,
+            finished: false,
+            errors: Vec::new(),
+        }
+    }
+
+    /// Replaces `out` with the tokens of the next non-empty block, ending with a newline
+    /// token; `false` when the input is exhausted.
+    pub fn next_block(&mut self, out: &mut Vec<Token>) -> bool {
+        out.clear();
+        if self.finished {
+            return false;
+        }
+        while let Some(ch) = self.c.peek() {
+        let start = self.c.mark();
         match ch {
             ' ' | '\t' | '\r' => {
-                c.skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
-                spaced = true;
+                self.c.skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
+                self.spaced = true;
             }
             '\n' => {
-                c.bump();
+                self.c.bump();
                 // Inside `[ ]` a list may run on over the next line, unless that line plainly
                 // starts a new block: then the bracket was left open and the block ends here.
-                if depth > 0 && starts_new_block(&src[c.pos..]) {
-                    depth = 0;
+                if self.depth > 0 && starts_new_block(&self.c.src[self.c.pos..]) {
+                    self.depth = 0;
                 }
-                if depth == 0 {
-                    push(&mut out, Tok::Newline, c.close(start), true);
+                if self.depth == 0 {
+                    push(out, Tok::Newline, self.c.close(start), true);
                 }
-                spaced = true;
+                self.spaced = true;
             }
             ';' => {
-                while c.peek().is_some_and(|x| x != '\n') {
-                    c.bump();
+                while self.c.peek().is_some_and(|x| x != '\n') {
+                    self.c.bump();
                 }
-                spaced = true;
+                self.spaced = true;
             }
             '(' => {
                 let mut closed = false;
-                while let Some(x) = c.bump() {
+                while let Some(x) = self.c.bump() {
                     if x == ')' {
                         closed = true;
                         break;
                     }
-                    if x == '\n' && depth == 0 {
+                    if x == '\n' && self.depth == 0 {
                         break;
                     }
                 }
                 if !closed {
-                    errors.push(LexError {
-                        span: c.close(start),
+                    self.errors.push(LexError {
+                        span: self.c.close(start),
                         message: "comment \"(\" is not closed by \")\" on its line".into(),
                     });
                 }
-                spaced = true;
+                self.spaced = true;
             }
             '\\' => {
                 // Continuation: the rest of the line must be blank (or a comment).
-                c.bump();
+                self.c.bump();
                 let rest_blank = {
-                    let tail = &src[c.pos..];
+                    let tail = &self.c.src[self.c.pos..];
                     let line = tail.split('\n').next().unwrap_or("");
                     let code = line.split(';').next().unwrap_or("");
                     code.trim().is_empty()
                 };
                 if rest_blank {
-                    while c.peek().is_some_and(|x| x != '\n') {
-                        c.bump();
+                    while self.c.peek().is_some_and(|x| x != '\n') {
+                        self.c.bump();
                     }
-                    c.bump();
+                    self.c.bump();
                 } else {
-                    push(&mut out, Tok::Bad('\\'), c.close(start), spaced);
+                    push(out, Tok::Bad('\\'), self.c.close(start), self.spaced);
                 }
-                spaced = true;
+                self.spaced = true;
             }
             '%' => {
-                c.bump();
+                self.c.bump();
                 let mut name = String::new();
-                while let Some(x) = c.peek() {
+                while let Some(x) = self.c.peek() {
                     if x.is_whitespace() || x == ';' || x == '(' {
                         break;
                     }
                     name.push(x);
-                    c.bump();
+                    self.c.bump();
                 }
-                push(&mut out, Tok::Percent(name), c.close(start), spaced);
-                spaced = false;
+                push(out, Tok::Percent(name), self.c.close(start), self.spaced);
+                self.spaced = false;
             }
             '"' => {
-                c.bump();
+                self.c.bump();
                 let mut text = String::new();
                 let mut closed = false;
-                while let Some(x) = c.peek() {
+                while let Some(x) = self.c.peek() {
                     if x == '\n' {
                         break;
                     }
-                    c.bump();
+                    self.c.bump();
                     if x == '"' {
                         closed = true;
                         break;
@@ -217,55 +261,55 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                     text.push(x);
                 }
                 if !closed {
-                    errors.push(LexError {
-                        span: c.close(start),
+                    self.errors.push(LexError {
+                        span: self.c.close(start),
                         message: "string is not closed by '\"' on its line".into(),
                     });
                 }
-                push(&mut out, Tok::Str(text), c.close(start), spaced);
-                spaced = false;
+                push(out, Tok::Str(text), self.c.close(start), self.spaced);
+                self.spaced = false;
             }
-            '0'..='9' | '.' if ch != '.' || c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
-                let from = c.pos;
-                c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
-                let text = &src[from..c.pos];
+            '0'..='9' | '.' if ch != '.' || self.c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
+                let from = self.c.pos;
+                self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
+                let text = &self.c.src[from..self.c.pos];
                 match parse_decimal(text) {
-                    Ok(v) => push(&mut out, Tok::Num(v), c.close(start), spaced),
+                    Ok(v) => push(out, Tok::Num(v), self.c.close(start), self.spaced),
                     Err(_) => {
-                        errors.push(LexError {
-                            span: c.close(start),
+                        self.errors.push(LexError {
+                            span: self.c.close(start),
                             message: format!("malformed number \"{text}\""),
                         });
-                        push(&mut out, Tok::Num(0.0), c.close(start), spaced);
+                        push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
                     }
                 }
-                spaced = false;
+                self.spaced = false;
             }
             x if x.is_ascii_alphabetic() || x == '_' => {
                 let mut name = Name::new();
-                let from = c.pos;
-                c.skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
+                let from = self.c.pos;
+                self.c.skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
                 let mut fits = true;
-                for &b in &src.as_bytes()[from..c.pos] {
+                for &b in &self.c.src.as_bytes()[from..self.c.pos] {
                     fits &= name.push(b.to_ascii_uppercase());
                 }
                 // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
-                let is_var = c.peek() == Some('.')
-                    && c.peek2()
+                let is_var = self.c.peek() == Some('.')
+                    && self.c.peek2()
                         .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
                 if is_var {
-                    while let Some(y) = c.peek() {
+                    while let Some(y) = self.c.peek() {
                         if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
                             fits &= name.push(y.to_ascii_uppercase() as u8);
-                            c.bump();
+                            self.c.bump();
                         } else {
                             break;
                         }
                     }
                 }
                 if !fits {
-                    errors.push(LexError {
-                        span: c.close(start),
+                    self.errors.push(LexError {
+                        span: self.c.close(start),
                         message: format!("name longer than {} characters", Name::CAPACITY),
                     });
                 }
@@ -274,12 +318,12 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                 } else {
                     Tok::Word(name)
                 };
-                push(&mut out, tok, c.close(start), spaced);
-                spaced = false;
+                push(out, tok, self.c.close(start), self.spaced);
+                self.spaced = false;
             }
             _ => {
-                c.bump();
-                let next = c.peek();
+                self.c.bump();
+                let next = self.c.peek();
                 let punct: Option<&'static str> = match (ch, next) {
                     ('=', Some('=')) => Some("=="),
                     ('!', Some('=')) => Some("!="),
@@ -288,7 +332,7 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                     _ => None,
                 };
                 let tok = if let Some(p) = punct {
-                    c.bump();
+                    self.c.bump();
                     Tok::Punct(p)
                 } else {
                     match ch {
@@ -296,11 +340,11 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                         '$' => Tok::Punct("$"),
                         '=' => Tok::Punct("="),
                         '[' => {
-                            depth += 1;
+                            self.depth += 1;
                             Tok::Punct("[")
                         }
                         ']' => {
-                            depth = depth.saturating_sub(1);
+                            self.depth = self.depth.saturating_sub(1);
                             Tok::Punct("]")
                         }
                         ',' => Tok::Punct(","),
@@ -313,20 +357,25 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
                         other => Tok::Bad(other),
                     }
                 };
-                push(&mut out, tok, c.close(start), spaced);
-                spaced = false;
+                push(out, tok, self.c.close(start), self.spaced);
+                self.spaced = false;
             }
         }
-    }
-    // The stream always ends with a newline, even for empty input.
-    if out.last().is_none_or(|t| t.tok != Tok::Newline) {
+                if out.last().is_some_and(|t| t.tok == Tok::Newline) {
+                return true;
+            }
+        }
+        self.finished = true;
+        if out.is_empty() {
+            return false;
+        }
         out.push(Token {
             tok: Tok::Newline,
-            span: c.mark(),
+            span: self.c.mark(),
             spaced: true,
         });
+        true
     }
-    out
 }
 
 /// Parses `digits[.digits]`. Short numbers take the exact fast path (mantissa below 2^53 and

@@ -2,28 +2,35 @@
 //! span and what was expected, skipped, and parsing goes on with the next item.
 
 use super::ast::*;
-use super::lexer::{tokenize, Name, Tok, Token};
+use super::lexer::{Lexer, Name, Tok, Token};
 use super::Diagnostic;
 
 /// Parses `src`; the tree holds everything that could be understood.
 pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
-    let mut lex_errors = Vec::new();
-    let tokens = tokenize(src, &mut lex_errors);
     let mut p = Parser {
         src,
-        tokens,
+        lexer: Lexer::new(src),
+        tokens: Vec::with_capacity(32),
         pos: 0,
-        diags: lex_errors
-            .into_iter()
-            .map(|e| Diagnostic::new(e.span, e.message, src))
-            .collect(),
+        diags: Vec::new(),
     };
     let program = p.program();
-    (program, p.diags)
+    let mut diags: Vec<Diagnostic> = p
+        .lexer
+        .errors
+        .drain(..)
+        .map(|e| Diagnostic::new(e.span, e.message, src))
+        .collect();
+    diags.append(&mut p.diags);
+    diags.sort_by_key(|d| (d.line, d.col));
+    (program, diags)
 }
 
+/// The parser works on one block at a time: `tokens` holds the current block, ending with a
+/// newline token.
 struct Parser<'a> {
     src: &'a str,
+    lexer: Lexer<'a>,
     tokens: Vec<Token>,
     pos: usize,
     diags: Vec<Diagnostic>,
@@ -129,11 +136,8 @@ impl Parser<'_> {
 
     fn program(&mut self) -> Program {
         let mut program = Program::default();
-        while self.pos + 1 < self.tokens.len() || !self.at_end_of_block() {
-            if self.at_end_of_block() {
-                self.bump();
-                continue;
-            }
+        while self.lexer.next_block(&mut self.tokens) {
+            self.pos = 0;
             if let Tok::Percent(name) = self.peek().clone() {
                 let span = self.span();
                 self.bump();
@@ -154,15 +158,11 @@ impl Parser<'_> {
                         s,
                         format!("expected end of line after the program header, found {found}"),
                     );
-                    self.recover();
                 }
                 continue;
             }
             if let Some(block) = self.block() {
                 program.blocks.push(block);
-            }
-            if self.pos + 1 >= self.tokens.len() {
-                break;
             }
         }
         program
