@@ -155,7 +155,7 @@ pub enum Decoded {
         /// Source line.
         line: u32,
         /// The command.
-        command: TrackCommand,
+        command: Box<TrackCommand>,
     },
     /// `#TRACK CS ABS`.
     TrackAbs {
@@ -262,6 +262,8 @@ pub struct DecoderState {
     absolute: bool,
     motion: MotionMode,
     feed: f64,
+    /// Reused per block: the axis words being decoded.
+    scratch: Vec<(usize, f64, Span)>,
 }
 
 struct Ctx<'a> {
@@ -344,6 +346,7 @@ impl DecoderState {
             absolute: true,
             motion: MotionMode::Rapid,
             feed: 0.0,
+            scratch: Vec::with_capacity(8),
         }
     }
 
@@ -372,7 +375,8 @@ impl DecoderState {
         let line = block.span.line;
         let mut g92 = false;
         let mut motion_code: Option<(u32, Span)> = None;
-        let mut axis_words: Vec<(usize, f64, Span)> = Vec::new();
+        let mut axis_words = core::mem::take(&mut self.scratch);
+        axis_words.clear();
         let mut tail: Vec<Decoded> = Vec::new();
         for item in &block.items {
             match item {
@@ -486,6 +490,7 @@ impl DecoderState {
             }));
         }
         out.extend(tail);
+        self.scratch = axis_words;
     }
 
     fn independent(
@@ -553,7 +558,10 @@ impl DecoderState {
     ) -> Option<Decoded> {
         match command {
             Command::TrackCs { on, options } => {
-                track(*on, options, span, ctx).map(|command| Decoded::Track { line, command })
+                track(*on, options, span, ctx).map(|command| Decoded::Track {
+                    line,
+                    command: Box::new(command),
+                })
             }
             Command::TrackCsAbs => Some(Decoded::TrackAbs { line }),
             Command::ChannelInterface { on, .. } => {
@@ -785,17 +793,28 @@ pub fn decode_program(
         diags: Vec::new(),
     };
     let mut out = Vec::with_capacity(program.blocks.len());
-    let mut spans = Vec::new();
+    // Spans of control statements only, by stream index, for the matching errors.
+    let mut control_spans: Vec<(usize, Span)> = Vec::new();
     for block in &program.blocks {
         let before = out.len();
         state.block(block, &mut ctx, &mut out);
-        spans.resize(out.len().max(before), block.span);
+        for (i, d) in out.iter().enumerate().skip(before) {
+            if matches!(d, Decoded::Control { .. }) {
+                control_spans.push((i, block.span));
+            }
+        }
     }
-    resolve_control(&mut out, &spans, &mut ctx);
+    resolve_control(&mut out, &control_spans, &mut ctx);
     (out, ctx.diags)
 }
 
-fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
+fn resolve_control(out: &mut [Decoded], control_spans: &[(usize, Span)], ctx: &mut Ctx<'_>) {
+    let span_of = |i: usize| {
+        control_spans
+            .binary_search_by_key(&i, |(j, _)| *j)
+            .map(|k| control_spans[k].1)
+            .unwrap_or_default()
+    };
     // Stack of open statements: (index, is_while, else_index).
     let mut open: Vec<(usize, bool, Option<usize>)> = Vec::new();
     for i in 0..out.len() {
@@ -807,7 +826,7 @@ fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
             ControlOp::If { .. } => open.push((i, false, None)),
             ControlOp::Else { .. } => match open.last_mut() {
                 Some((_, false, else_at @ None)) => *else_at = Some(i),
-                _ => ctx.error(spans[i], "$ELSE without a matching $IF"),
+                _ => ctx.error(span_of(i), "$ELSE without a matching $IF"),
             },
             ControlOp::EndWhile { .. } => match open.pop() {
                 Some((start, true, _)) => {
@@ -823,7 +842,7 @@ fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
                     });
                 }
                 other => {
-                    ctx.error(spans[i], "$ENDWHILE without a matching $WHILE");
+                    ctx.error(span_of(i), "$ENDWHILE without a matching $WHILE");
                     if let Some(o) = other {
                         open.push(o);
                     }
@@ -846,7 +865,7 @@ fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
                     }
                 }
                 other => {
-                    ctx.error(spans[i], "$ENDIF without a matching $IF");
+                    ctx.error(span_of(i), "$ENDIF without a matching $IF");
                     if let Some(o) = other {
                         open.push(o);
                     }
@@ -860,7 +879,7 @@ fn resolve_control(out: &mut [Decoded], spans: &[Span], ctx: &mut Ctx<'_>) {
         } else {
             "$IF without $ENDIF"
         };
-        ctx.error(spans[i], what);
+        ctx.error(span_of(i), what);
     }
 }
 

@@ -170,198 +170,204 @@ impl<'a> Lexer<'a> {
             return false;
         }
         while let Some(ch) = self.c.peek() {
-        let start = self.c.mark();
-        match ch {
-            ' ' | '\t' | '\r' => {
-                self.c.skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
-                self.spaced = true;
-            }
-            '\n' => {
-                self.c.bump();
-                // Inside `[ ]` a list may run on over the next line, unless that line plainly
-                // starts a new block: then the bracket was left open and the block ends here.
-                if self.depth > 0 && starts_new_block(&self.c.src[self.c.pos..]) {
-                    self.depth = 0;
+            let start = self.c.mark();
+            match ch {
+                ' ' | '\t' | '\r' => {
+                    self.c
+                        .skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
+                    self.spaced = true;
                 }
-                if self.depth == 0 {
-                    push(out, Tok::Newline, self.c.close(start), true);
-                }
-                self.spaced = true;
-            }
-            ';' => {
-                while self.c.peek().is_some_and(|x| x != '\n') {
+                '\n' => {
                     self.c.bump();
-                }
-                self.spaced = true;
-            }
-            '(' => {
-                let mut closed = false;
-                while let Some(x) = self.c.bump() {
-                    if x == ')' {
-                        closed = true;
-                        break;
+                    // Inside `[ ]` a list may run on over the next line, unless that line plainly
+                    // starts a new block: then the bracket was left open and the block ends here.
+                    if self.depth > 0 && starts_new_block(&self.c.src[self.c.pos..]) {
+                        self.depth = 0;
                     }
-                    if x == '\n' && self.depth == 0 {
-                        break;
+                    if self.depth == 0 {
+                        push(out, Tok::Newline, self.c.close(start), true);
                     }
+                    self.spaced = true;
                 }
-                if !closed {
-                    self.errors.push(LexError {
-                        span: self.c.close(start),
-                        message: "comment \"(\" is not closed by \")\" on its line".into(),
-                    });
-                }
-                self.spaced = true;
-            }
-            '\\' => {
-                // Continuation: the rest of the line must be blank (or a comment).
-                self.c.bump();
-                let rest_blank = {
-                    let tail = &self.c.src[self.c.pos..];
-                    let line = tail.split('\n').next().unwrap_or("");
-                    let code = line.split(';').next().unwrap_or("");
-                    code.trim().is_empty()
-                };
-                if rest_blank {
+                ';' => {
                     while self.c.peek().is_some_and(|x| x != '\n') {
                         self.c.bump();
                     }
-                    self.c.bump();
-                } else {
-                    push(out, Tok::Bad('\\'), self.c.close(start), self.spaced);
+                    self.spaced = true;
                 }
-                self.spaced = true;
-            }
-            '%' => {
-                self.c.bump();
-                let mut name = String::new();
-                while let Some(x) = self.c.peek() {
-                    if x.is_whitespace() || x == ';' || x == '(' {
-                        break;
-                    }
-                    name.push(x);
-                    self.c.bump();
-                }
-                push(out, Tok::Percent(name), self.c.close(start), self.spaced);
-                self.spaced = false;
-            }
-            '"' => {
-                self.c.bump();
-                let mut text = String::new();
-                let mut closed = false;
-                while let Some(x) = self.c.peek() {
-                    if x == '\n' {
-                        break;
-                    }
-                    self.c.bump();
-                    if x == '"' {
-                        closed = true;
-                        break;
-                    }
-                    text.push(x);
-                }
-                if !closed {
-                    self.errors.push(LexError {
-                        span: self.c.close(start),
-                        message: "string is not closed by '\"' on its line".into(),
-                    });
-                }
-                push(out, Tok::Str(text), self.c.close(start), self.spaced);
-                self.spaced = false;
-            }
-            '0'..='9' | '.' if ch != '.' || self.c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
-                let from = self.c.pos;
-                self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
-                let text = &self.c.src[from..self.c.pos];
-                match parse_decimal(text) {
-                    Ok(v) => push(out, Tok::Num(v), self.c.close(start), self.spaced),
-                    Err(_) => {
-                        self.errors.push(LexError {
-                            span: self.c.close(start),
-                            message: format!("malformed number \"{text}\""),
-                        });
-                        push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
-                    }
-                }
-                self.spaced = false;
-            }
-            x if x.is_ascii_alphabetic() || x == '_' => {
-                let mut name = Name::new();
-                let from = self.c.pos;
-                self.c.skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
-                let mut fits = true;
-                for &b in &self.c.src.as_bytes()[from..self.c.pos] {
-                    fits &= name.push(b.to_ascii_uppercase());
-                }
-                // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
-                let is_var = self.c.peek() == Some('.')
-                    && self.c.peek2()
-                        .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
-                if is_var {
-                    while let Some(y) = self.c.peek() {
-                        if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
-                            fits &= name.push(y.to_ascii_uppercase() as u8);
-                            self.c.bump();
-                        } else {
+                '(' => {
+                    let mut closed = false;
+                    while let Some(x) = self.c.bump() {
+                        if x == ')' {
+                            closed = true;
+                            break;
+                        }
+                        if x == '\n' && self.depth == 0 {
                             break;
                         }
                     }
-                }
-                if !fits {
-                    self.errors.push(LexError {
-                        span: self.c.close(start),
-                        message: format!("name longer than {} characters", Name::CAPACITY),
-                    });
-                }
-                let tok = if is_var {
-                    Tok::Var(name)
-                } else {
-                    Tok::Word(name)
-                };
-                push(out, tok, self.c.close(start), self.spaced);
-                self.spaced = false;
-            }
-            _ => {
-                self.c.bump();
-                let next = self.c.peek();
-                let punct: Option<&'static str> = match (ch, next) {
-                    ('=', Some('=')) => Some("=="),
-                    ('!', Some('=')) => Some("!="),
-                    ('<', Some('=')) => Some("<="),
-                    ('>', Some('=')) => Some(">="),
-                    _ => None,
-                };
-                let tok = if let Some(p) = punct {
-                    self.c.bump();
-                    Tok::Punct(p)
-                } else {
-                    match ch {
-                        '#' => Tok::Punct("#"),
-                        '$' => Tok::Punct("$"),
-                        '=' => Tok::Punct("="),
-                        '[' => {
-                            self.depth += 1;
-                            Tok::Punct("[")
-                        }
-                        ']' => {
-                            self.depth = self.depth.saturating_sub(1);
-                            Tok::Punct("]")
-                        }
-                        ',' => Tok::Punct(","),
-                        '+' => Tok::Punct("+"),
-                        '-' => Tok::Punct("-"),
-                        '*' => Tok::Punct("*"),
-                        '/' => Tok::Punct("/"),
-                        '<' => Tok::Punct("<"),
-                        '>' => Tok::Punct(">"),
-                        other => Tok::Bad(other),
+                    if !closed {
+                        self.errors.push(LexError {
+                            span: self.c.close(start),
+                            message: "comment \"(\" is not closed by \")\" on its line".into(),
+                        });
                     }
-                };
-                push(out, tok, self.c.close(start), self.spaced);
-                self.spaced = false;
+                    self.spaced = true;
+                }
+                '\\' => {
+                    // Continuation: the rest of the line must be blank (or a comment).
+                    self.c.bump();
+                    let rest_blank = {
+                        let tail = &self.c.src[self.c.pos..];
+                        let line = tail.split('\n').next().unwrap_or("");
+                        let code = line.split(';').next().unwrap_or("");
+                        code.trim().is_empty()
+                    };
+                    if rest_blank {
+                        while self.c.peek().is_some_and(|x| x != '\n') {
+                            self.c.bump();
+                        }
+                        self.c.bump();
+                    } else {
+                        push(out, Tok::Bad('\\'), self.c.close(start), self.spaced);
+                    }
+                    self.spaced = true;
+                }
+                '%' => {
+                    self.c.bump();
+                    let mut name = String::new();
+                    while let Some(x) = self.c.peek() {
+                        if x.is_whitespace() || x == ';' || x == '(' {
+                            break;
+                        }
+                        name.push(x);
+                        self.c.bump();
+                    }
+                    push(out, Tok::Percent(name), self.c.close(start), self.spaced);
+                    self.spaced = false;
+                }
+                '"' => {
+                    self.c.bump();
+                    let mut text = String::new();
+                    let mut closed = false;
+                    while let Some(x) = self.c.peek() {
+                        if x == '\n' {
+                            break;
+                        }
+                        self.c.bump();
+                        if x == '"' {
+                            closed = true;
+                            break;
+                        }
+                        text.push(x);
+                    }
+                    if !closed {
+                        self.errors.push(LexError {
+                            span: self.c.close(start),
+                            message: "string is not closed by '\"' on its line".into(),
+                        });
+                    }
+                    push(out, Tok::Str(text), self.c.close(start), self.spaced);
+                    self.spaced = false;
+                }
+                '0'..='9' | '.'
+                    if ch != '.' || self.c.peek2().is_some_and(|d| d.is_ascii_digit()) =>
+                {
+                    let from = self.c.pos;
+                    self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
+                    let text = &self.c.src[from..self.c.pos];
+                    match parse_decimal(text) {
+                        Ok(v) => push(out, Tok::Num(v), self.c.close(start), self.spaced),
+                        Err(_) => {
+                            self.errors.push(LexError {
+                                span: self.c.close(start),
+                                message: format!("malformed number \"{text}\""),
+                            });
+                            push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
+                        }
+                    }
+                    self.spaced = false;
+                }
+                x if x.is_ascii_alphabetic() || x == '_' => {
+                    let mut name = Name::new();
+                    let from = self.c.pos;
+                    self.c
+                        .skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
+                    let mut fits = true;
+                    for &b in &self.c.src.as_bytes()[from..self.c.pos] {
+                        fits &= name.push(b.to_ascii_uppercase());
+                    }
+                    // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
+                    let is_var = self.c.peek() == Some('.')
+                        && self
+                            .c
+                            .peek2()
+                            .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
+                    if is_var {
+                        while let Some(y) = self.c.peek() {
+                            if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
+                                fits &= name.push(y.to_ascii_uppercase() as u8);
+                                self.c.bump();
+                            } else {
+                                break;
+                            }
+                        }
+                    }
+                    if !fits {
+                        self.errors.push(LexError {
+                            span: self.c.close(start),
+                            message: format!("name longer than {} characters", Name::CAPACITY),
+                        });
+                    }
+                    let tok = if is_var {
+                        Tok::Var(name)
+                    } else {
+                        Tok::Word(name)
+                    };
+                    push(out, tok, self.c.close(start), self.spaced);
+                    self.spaced = false;
+                }
+                _ => {
+                    self.c.bump();
+                    let next = self.c.peek();
+                    let punct: Option<&'static str> = match (ch, next) {
+                        ('=', Some('=')) => Some("=="),
+                        ('!', Some('=')) => Some("!="),
+                        ('<', Some('=')) => Some("<="),
+                        ('>', Some('=')) => Some(">="),
+                        _ => None,
+                    };
+                    let tok = if let Some(p) = punct {
+                        self.c.bump();
+                        Tok::Punct(p)
+                    } else {
+                        match ch {
+                            '#' => Tok::Punct("#"),
+                            '$' => Tok::Punct("$"),
+                            '=' => Tok::Punct("="),
+                            '[' => {
+                                self.depth += 1;
+                                Tok::Punct("[")
+                            }
+                            ']' => {
+                                self.depth = self.depth.saturating_sub(1);
+                                Tok::Punct("]")
+                            }
+                            ',' => Tok::Punct(","),
+                            '+' => Tok::Punct("+"),
+                            '-' => Tok::Punct("-"),
+                            '*' => Tok::Punct("*"),
+                            '/' => Tok::Punct("/"),
+                            '<' => Tok::Punct("<"),
+                            '>' => Tok::Punct(">"),
+                            other => Tok::Bad(other),
+                        }
+                    };
+                    push(out, tok, self.c.close(start), self.spaced);
+                    self.spaced = false;
+                }
             }
-        }
-                if out.last().is_some_and(|t| t.tok == Tok::Newline) {
+            if out.last().is_some_and(|t| t.tok == Tok::Newline) {
                 return true;
             }
         }
