@@ -32,6 +32,11 @@ impl Name {
         }
     }
 
+    /// The bytes (ASCII), without the UTF-8 check of [`Name::as_str`].
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes[..self.len as usize]
+    }
+
     /// The text.
     pub fn as_str(&self) -> &str {
         // Only ASCII bytes are ever pushed.

@@ -369,6 +369,13 @@ impl DecoderState {
         self.axes.iter().position(|a| a == name)
     }
 
+    /// Axis lookup for names straight from the tree (byte comparison, no UTF-8 check).
+    fn axis_of(&self, name: &Name) -> Option<usize> {
+        self.axes
+            .iter()
+            .position(|a| a.as_bytes() == name.as_bytes())
+    }
+
     /// Decodes one block; `out` receives its elements. Control statements are emitted with
     /// unresolved indices (0); [`decode_program`] resolves them.
     fn block(&mut self, block: &Block, ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
@@ -409,7 +416,7 @@ impl DecoderState {
                 }
                 Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
                 Item::Axis(word) => {
-                    let Some(i) = self.axis_index(&word.name) else {
+                    let Some(i) = self.axis_of(&word.name) else {
                         self.unknown_axis(ctx, word.span, &word.name);
                         continue;
                     };
@@ -649,7 +656,7 @@ impl DecoderState {
             Command::Flush { wait } => Some(Decoded::Flush { line, wait: *wait }),
             Command::Pset { axes } => {
                 for word in axes {
-                    let Some(i) = self.axis_index(&word.name) else {
+                    let Some(i) = self.axis_of(&word.name) else {
                         self.unknown_axis(ctx, word.span, &word.name);
                         continue;
                     };

@@ -345,8 +345,8 @@ impl Parser<'_> {
             );
             return None;
         };
-        match word.as_str() {
-            "G" | "M" => {
+        match word.as_bytes() {
+            b"G" | b"M" => {
                 if value.fract() != 0.0 || value < 0.0 {
                     self.error(
                         span,
@@ -355,17 +355,17 @@ impl Parser<'_> {
                     return None;
                 }
                 let code = value as u32;
-                Some(if word == "G" {
+                Some(if word.as_bytes() == b"G" {
                     Item::G { code, span }
                 } else {
                     Item::M { code, span }
                 })
             }
-            "F" => Some(Item::Feed {
+            b"F" => Some(Item::Feed {
                 value: Expr::Num(value),
                 span,
             }),
-            "N" => {
+            b"N" => {
                 self.error(span, "a block number N must come first in its block");
                 None
             }
