@@ -11,6 +11,7 @@ pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
         src,
         lexer: Lexer::new(src),
         tokens: Vec::with_capacity(32),
+        items: Vec::with_capacity(16),
         pos: 0,
         diags: Vec::new(),
     };
@@ -32,6 +33,8 @@ struct Parser<'a> {
     src: &'a str,
     lexer: Lexer<'a>,
     tokens: Vec<Token>,
+    /// Reused buffer for the items of the block being parsed.
+    items: Vec<Item>,
     pos: usize,
     diags: Vec<Diagnostic>,
 }
@@ -172,7 +175,7 @@ impl Parser<'_> {
         let span = self.span();
         let mut block = Block {
             number: None,
-            items: Vec::with_capacity(8),
+            items: Vec::new(),
             span,
         };
         if self.is_word("N")
@@ -192,15 +195,21 @@ impl Parser<'_> {
                 }
             }
         }
+        // Items gather in a reused buffer; the block keeps an exactly sized copy (a block's
+        // worth of capacity slack would double the tree's memory).
+        let mut items = core::mem::take(&mut self.items);
+        items.clear();
         while !self.at_end_of_block() {
             let before = self.pos;
             if let Some(item) = self.item() {
-                block.items.push(item);
+                items.push(item);
             }
             if self.pos == before {
                 self.bump();
             }
         }
+        block.items = items.drain(..).collect();
+        self.items = items;
         block.span = self.extend(block.span);
         (block.number.is_some() || !block.items.is_empty()).then_some(block)
     }
