@@ -11,7 +11,7 @@ pub struct Name {
 
 impl Name {
     /// Longest name the lexer keeps whole.
-    pub const CAPACITY: usize = 30;
+    pub const CAPACITY: usize = 23;
 
     /// An empty name.
     pub fn new() -> Self {
@@ -110,10 +110,10 @@ impl core::ops::Deref for Name {
 /// A source range with its line and column (1-based, columns in characters).
 #[derive(Debug, Clone, Copy, Default, Eq)]
 pub struct Span {
-    /// Byte offset of the first character.
-    pub start: usize,
+    /// Byte offset of the first character (programs are far below 4 GiB; larger offsets saturate).
+    pub start: u32,
     /// Byte offset after the last character.
-    pub end: usize,
+    pub end: u32,
     /// Line of `start`.
     pub line: u32,
     /// Column of `start`.

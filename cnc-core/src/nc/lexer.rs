@@ -102,14 +102,14 @@ impl Cursor<'_> {
 
     fn mark(&self) -> Span {
         Span {
-            start: self.pos,
-            end: self.pos,
+            start: offset(self.pos),
+            end: offset(self.pos),
             line: self.line,
             col: self.col,
         }
     }
     fn close(&self, mut span: Span) -> Span {
-        span.end = self.pos;
+        span.end = offset(self.pos);
         span
     }
 }
@@ -382,6 +382,10 @@ impl<'a> Lexer<'a> {
         });
         true
     }
+}
+
+fn offset(pos: usize) -> u32 {
+    u32::try_from(pos).unwrap_or(u32::MAX)
 }
 
 /// Parses `digits[.digits]`. Short numbers take the exact fast path (mantissa below 2^53 and

@@ -29,8 +29,9 @@ pub struct Diagnostic {
 impl Diagnostic {
     /// A diagnostic at `span` of `src`.
     pub fn new(span: Span, message: String, src: &str) -> Self {
-        let end = span.end.max(span.start).min(src.len());
-        let found = src.get(span.start..end).unwrap_or("").trim().to_string();
+        let start = span.start as usize;
+        let end = (span.end as usize).max(start).min(src.len());
+        let found = src.get(start..end).unwrap_or("").trim().to_string();
         Self {
             line: span.line,
             col: span.col,

@@ -115,7 +115,10 @@ impl Parser<'_> {
             Tok::Newline => "end of block".into(),
             _ => {
                 let s = self.span();
-                format!("\"{}\"", &self.src[s.start..s.end])
+                format!(
+                    "\"{}\"",
+                    self.src.get(s.start as usize..s.end as usize).unwrap_or("")
+                )
             }
         }
     }
