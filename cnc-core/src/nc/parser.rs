@@ -211,7 +211,8 @@ impl Parser<'_> {
                 self.bump();
             }
         }
-        block.items = items.drain(..).collect();
+        block.items = Vec::with_capacity(items.len());
+        block.items.append(&mut items);
         self.items = items;
         block.span = self.extend(block.span);
         (block.number.is_some() || !block.items.is_empty()).then_some(block)
