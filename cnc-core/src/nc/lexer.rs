@@ -162,6 +162,86 @@ impl<'a> Lexer<'a> {
         }
     }
 
+    /// The common tokens in one pass over their bytes: blanks, plain words (not variables)
+    /// and plain decimal numbers. Returns `false` (having consumed nothing) for anything else,
+    /// which the general path below handles.
+    fn fast_token(&mut self, out: &mut Vec<Token>) -> bool {
+        let bytes = self.c.src.as_bytes();
+        let start = self.c.pos;
+        let Some(&first) = bytes.get(start) else {
+            return false;
+        };
+        let mut p = start;
+        let tok = match first {
+            b' ' | b'\t' | b'\r' => {
+                while p < bytes.len() && matches!(bytes[p], b' ' | b'\t' | b'\r') {
+                    p += 1;
+                }
+                self.c.col += (p - start) as u32;
+                self.c.pos = p;
+                self.spaced = true;
+                return true;
+            }
+            b'A'..=b'Z' | b'a'..=b'z' | b'_' => {
+                let mut name = Name::new();
+                while p < bytes.len() && (bytes[p].is_ascii_alphabetic() || bytes[p] == b'_') {
+                    if !name.push(bytes[p].to_ascii_uppercase()) {
+                        return false; // too long: the general path reports it
+                    }
+                    p += 1;
+                }
+                if bytes.get(p) == Some(&b'.') {
+                    return false; // a variable
+                }
+                Tok::Word(name)
+            }
+            b'0'..=b'9' => {
+                let mut mantissa: u64 = 0;
+                let mut digits = 0u32;
+                let mut fraction: Option<usize> = None;
+                while p < bytes.len() {
+                    match bytes[p] {
+                        d @ b'0'..=b'9' => {
+                            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
+                            digits += 1;
+                            if let Some(f) = fraction.as_mut() {
+                                *f += 1;
+                            }
+                        }
+                        b'.' if fraction.is_none() => fraction = Some(0),
+                        b'.' => return false, // malformed: the general path reports it
+                        _ => break,
+                    }
+                    p += 1;
+                }
+                if digits > 15 {
+                    return false;
+                }
+                const POW10: [f64; 16] = [
+                    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14,
+                    1e15,
+                ];
+                Tok::Num(mantissa as f64 / POW10[fraction.unwrap_or(0)])
+            }
+            _ => return false,
+        };
+        let span = Span {
+            start: offset(start),
+            end: offset(p),
+            line: self.c.line,
+            col: self.c.col,
+        };
+        self.c.col += (p - start) as u32;
+        self.c.pos = p;
+        out.push(Token {
+            tok,
+            span,
+            spaced: self.spaced,
+        });
+        self.spaced = false;
+        true
+    }
+
     /// Replaces `out` with the tokens of the next non-empty block, ending with a newline
     /// token; `false` when the input is exhausted.
     pub fn next_block(&mut self, out: &mut Vec<Token>) -> bool {
@@ -170,6 +250,9 @@ impl<'a> Lexer<'a> {
             return false;
         }
         while let Some(ch) = self.c.peek() {
+            if self.fast_token(out) {
+                continue;
+            }
             let start = self.c.mark();
             match ch {
                 ' ' | '\t' | '\r' => {
