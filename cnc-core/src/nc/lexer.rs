@@ -468,7 +468,7 @@ impl<'a> Lexer<'a> {
 }
 
 fn offset(pos: usize) -> u32 {
-    u32::try_from(pos).unwrap_or(u32::MAX)
+    pos.min(u32::MAX as usize) as u32
 }
 
 /// Parses `digits[.digits]`. Short numbers take the exact fast path (mantissa below 2^53 and

@@ -235,22 +235,7 @@ impl Parser<'_> {
                 let span = self.extend(span);
                 Some(Item::Control { control, span })
             }
-            Tok::Word(w) => {
-                let item = self.word_item(w, span)?;
-                let end = self.extend(span);
-                Some(match item {
-                    Item::G { code, .. } => Item::G { code, span: end },
-                    Item::M { code, .. } => Item::M { code, span: end },
-                    Item::Feed { value, .. } => Item::Feed { value, span: end },
-                    Item::Axis(a) => Item::Axis(AxisWord { span: end, ..a }),
-                    Item::IndependentAxis { name, options, .. } => Item::IndependentAxis {
-                        name,
-                        options,
-                        span: end,
-                    },
-                    other => other,
-                })
-            }
+            Tok::Word(w) => self.word_item(w, span),
             Tok::Percent(_) => {
                 self.bump();
                 self.error(
@@ -302,7 +287,10 @@ impl Parser<'_> {
             self.bump();
             let value = self.expr()?;
             return Some(match name.as_str() {
-                "F" => Item::Feed { value, span },
+                "F" => Item::Feed {
+                    value,
+                    span: self.extend(span),
+                },
                 "G" | "M" | "N" => {
                     self.error(
                         span,
@@ -314,7 +302,7 @@ impl Parser<'_> {
                     name,
                     value,
                     assigned: true,
-                    span,
+                    span: self.extend(span),
                 }),
             });
         }
@@ -328,7 +316,7 @@ impl Parser<'_> {
             return Some(Item::IndependentAxis {
                 name,
                 options,
-                span,
+                span: self.extend(span),
             });
         }
         // `X-60`: a signed number glued to the address.
@@ -368,6 +356,7 @@ impl Parser<'_> {
                     return None;
                 }
                 let code = value as u32;
+                let span = self.extend(span);
                 Some(if word.as_bytes() == b"G" {
                     Item::G { code, span }
                 } else {
@@ -376,7 +365,7 @@ impl Parser<'_> {
             }
             b"F" => Some(Item::Feed {
                 value: Expr::Num(value),
-                span,
+                span: self.extend(span),
             }),
             b"N" => {
                 self.error(span, "a block number N must come first in its block");
@@ -386,7 +375,7 @@ impl Parser<'_> {
                 name: word,
                 value: Expr::Num(value),
                 assigned: false,
-                span,
+                span: self.extend(span),
             })),
         }
     }
