@@ -256,6 +256,8 @@ pub enum ControlOp {
 #[derive(Debug, Clone)]
 pub struct DecoderState {
     axes: Vec<String>,
+    /// The same names for fast comparison with names from the tree.
+    axis_names: Vec<Name>,
     position: Vec<f64>,
     g92: Vec<f64>,
     pset: Vec<f64>,
@@ -340,6 +342,7 @@ impl DecoderState {
         let n = axes.len();
         Self {
             axes: axes.to_vec(),
+            axis_names: axes.iter().map(|a| Name::from(a.as_str())).collect(),
             position: vec![0.0; n],
             g92: vec![0.0; n],
             pset: vec![0.0; n],
@@ -371,9 +374,7 @@ impl DecoderState {
 
     /// Axis lookup for names straight from the tree (byte comparison, no UTF-8 check).
     fn axis_of(&self, name: &Name) -> Option<usize> {
-        self.axes
-            .iter()
-            .position(|a| a.as_bytes() == name.as_bytes())
+        self.axis_names.iter().position(|a| a == name)
     }
 
     /// Decodes one block; `out` receives its elements. Control statements are emitted with

@@ -101,7 +101,8 @@ impl Parser<'_> {
         matches!(self.peek(), Tok::Newline)
     }
     fn is_punct(&self, p: &str) -> bool {
-        matches!(self.peek(), Tok::Punct(q) if *q == p)
+        // Byte loop instead of `==`: the strings are one or two bytes, a memcmp call is not.
+        matches!(self.peek(), Tok::Punct(q) if q.len() == p.len() && q.bytes().zip(p.bytes()).all(|(a, b)| a == b))
     }
     fn is_word(&self, w: &str) -> bool {
         matches!(self.peek(), Tok::Word(x) if x == w)
