@@ -14,6 +14,9 @@ pub enum Tok {
     Var(Name),
     /// A number, with its source text (leading zeros matter for nothing but printing).
     Num(f64),
+    /// A word with a plain number glued to it (`G01`, `X10.5`, `N00860`, `ID3`): the parser
+    /// reads it exactly like the word followed by an unspaced number.
+    Addr(Name, f64),
     /// A double-quoted string.
     Str(String),
     /// `%name` up to the end of the line.
@@ -193,7 +196,16 @@ impl<'a> Lexer<'a> {
                 if bytes.get(p) == Some(&b'.') {
                     return false; // a variable
                 }
-                Tok::Word(name)
+                match bytes.get(p) {
+                    Some(b'0'..=b'9') => match plain_number(&bytes[p..]) {
+                        Some((value, len)) => {
+                            p += len;
+                            Tok::Addr(name, value)
+                        }
+                        None => Tok::Word(name),
+                    },
+                    _ => Tok::Word(name),
+                }
             }
             b'0'..=b'9' => {
                 let mut mantissa: u64 = 0;
@@ -465,6 +477,38 @@ impl<'a> Lexer<'a> {
         });
         true
     }
+}
+
+/// A plain decimal `digits[.digits]` at the start of `bytes` with at most 15 digits: its exact
+/// value (see [`parse_decimal`]) and length. `None` for anything the general path must judge
+/// (a second dot, more digits).
+fn plain_number(bytes: &[u8]) -> Option<(f64, usize)> {
+    const POW10: [f64; 16] = [
+        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let mut mantissa: u64 = 0;
+    let mut digits = 0u32;
+    let mut fraction: Option<usize> = None;
+    let mut p = 0;
+    while p < bytes.len() {
+        match bytes[p] {
+            d @ b'0'..=b'9' => {
+                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
+                digits += 1;
+                if let Some(f) = fraction.as_mut() {
+                    *f += 1;
+                }
+            }
+            b'.' if fraction.is_none() => fraction = Some(0),
+            b'.' => return None,
+            _ => break,
+        }
+        p += 1;
+    }
+    if digits == 0 || digits > 15 {
+        return None;
+    }
+    Some((mantissa as f64 / POW10[fraction.unwrap_or(0)], p))
 }
 
 fn offset(pos: usize) -> u32 {

@@ -182,7 +182,19 @@ impl Parser<'_> {
             items: Vec::new(),
             span,
         };
-        if self.is_word("N")
+        if let Tok::Addr(n, value) = *self.peek() {
+            if n == "N" {
+                self.bump();
+                if value.fract() == 0.0 && value >= 0.0 && value <= f64::from(u32::MAX) {
+                    block.number = Some(value as u32);
+                } else {
+                    self.error(
+                        span,
+                        format!("block number must be a whole number, found {value}"),
+                    );
+                }
+            }
+        } else if self.is_word("N")
             && matches!(self.peek_at(1), Tok::Num(_))
             && !self.tokens[self.pos + 1].spaced
         {
@@ -236,7 +248,7 @@ impl Parser<'_> {
                 let span = self.extend(span);
                 Some(Item::Control { control, span })
             }
-            Tok::Word(w) => self.word_item(w, span),
+            Tok::Word(_) | Tok::Addr(..) => self.word_item(span),
             Tok::Percent(_) => {
                 self.bump();
                 self.error(
@@ -257,6 +269,22 @@ impl Parser<'_> {
         }
     }
 
+    /// The word at the cursor with the number glued to it, if any (`G01` arrives as one
+    /// address token from the lexer, `G 01` never glues); consumed. `None` if no word is there.
+    fn take_word(&mut self) -> Option<(Name, Option<f64>)> {
+        match *self.peek() {
+            Tok::Word(w) => {
+                self.bump();
+                Some((w, self.glued_number()))
+            }
+            Tok::Addr(w, n) => {
+                self.bump();
+                Some((w, Some(n)))
+            }
+            _ => None,
+        }
+    }
+
     /// A number written directly after a word (`G01`, `ID3`), consumed.
     fn glued_number(&mut self) -> Option<f64> {
         match self.peek() {
@@ -270,9 +298,8 @@ impl Parser<'_> {
     }
 
     /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
-    fn word_item(&mut self, word: Name, span: Span) -> Option<Item> {
-        self.bump();
-        let glued = self.glued_number();
+    fn word_item(&mut self, span: Span) -> Option<Item> {
+        let (word, glued) = self.take_word()?;
         let glued_name = |n: f64| Name::from(format!("{word}{}", n as u64).as_str());
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
@@ -591,9 +618,9 @@ impl Parser<'_> {
             },
             "PSET" => {
                 let mut axes = Vec::new();
-                while let Tok::Word(w) = self.peek().clone() {
+                while matches!(self.peek(), Tok::Word(_) | Tok::Addr(..)) {
                     let s = self.span();
-                    match self.word_item(w, s) {
+                    match self.word_item(s) {
                         Some(Item::Axis(a)) => axes.push(a),
                         _ => self.error(s, "#PSET: expected axis assignments such as X=10"),
                     }
@@ -605,9 +632,11 @@ impl Parser<'_> {
             }
             "PRESET" => {
                 let mut axes = Vec::new();
-                while let Tok::Word(w) = self.peek().clone() {
-                    self.bump();
-                    axes.push(w);
+                while let Some((w, glued)) = self.take_word() {
+                    axes.push(match glued {
+                        Some(n) => Name::from(format!("{w}{}", n as u64).as_str()),
+                        None => w,
+                    });
                 }
                 Some(Command::Preset { axes })
             }
@@ -693,10 +722,9 @@ impl Parser<'_> {
                     self.error(open, "\"[\" is not closed by \"]\"");
                     return None;
                 }
-                Tok::Word(w) => {
+                Tok::Word(_) | Tok::Addr(..) => {
                     let span = self.span();
-                    self.bump();
-                    let glued = self.glued_number();
+                    let (w, glued) = self.take_word()?;
                     let (mut value, mut text) = (None, None);
                     if self.is_punct("=") {
                         self.bump();
