@@ -196,11 +196,17 @@ impl<'a> Lexer<'a> {
                 if bytes.get(p) == Some(&b'.') {
                     return false; // a variable
                 }
-                match bytes.get(p) {
-                    Some(b'0'..=b'9') => match plain_number(&bytes[p..]) {
+                // A signed number glued to an address (`X-60`) belongs to it as well.
+                let (sign, digits_at) = match bytes.get(p) {
+                    Some(b'-') => (-1.0, p + 1),
+                    Some(b'+') => (1.0, p + 1),
+                    _ => (1.0, p),
+                };
+                match bytes.get(digits_at) {
+                    Some(b'0'..=b'9') => match plain_number(&bytes[digits_at..]) {
                         Some((value, len)) => {
-                            p += len;
-                            Tok::Addr(name, value)
+                            p = digits_at + len;
+                            Tok::Addr(name, sign * value)
                         }
                         None => Tok::Word(name),
                     },

@@ -304,9 +304,12 @@ impl Parser<'_> {
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
             let name = match glued {
-                Some(n) if n.fract() == 0.0 => glued_name(n),
+                Some(n) if n.fract() == 0.0 && n >= 0.0 => glued_name(n),
                 Some(_) => {
-                    self.error(span, "an axis name cannot contain a decimal point");
+                    self.error(
+                        span,
+                        "an axis name is letters and digits only (no sign, no decimal point)",
+                    );
                     self.recover();
                     return None;
                 }
@@ -337,8 +340,16 @@ impl Parser<'_> {
         // `X1[INDP_ASYN ...]`
         if self.is_punct("[") {
             let name = match glued {
-                Some(n) if n.fract() == 0.0 => glued_name(n),
-                _ => word,
+                Some(n) if n.fract() == 0.0 && n >= 0.0 => glued_name(n),
+                Some(_) => {
+                    self.error(
+                        span,
+                        "an axis name is letters and digits only (no sign, no decimal point)",
+                    );
+                    self.recover();
+                    return None;
+                }
+                None => word,
             };
             let options = self.bracket_list()?;
             return Some(Item::IndependentAxis {
