@@ -213,34 +213,13 @@ impl<'a> Lexer<'a> {
                     _ => Tok::Word(name),
                 }
             }
-            b'0'..=b'9' => {
-                let mut mantissa: u64 = 0;
-                let mut digits = 0u32;
-                let mut fraction: Option<usize> = None;
-                while p < bytes.len() {
-                    match bytes[p] {
-                        d @ b'0'..=b'9' => {
-                            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
-                            digits += 1;
-                            if let Some(f) = fraction.as_mut() {
-                                *f += 1;
-                            }
-                        }
-                        b'.' if fraction.is_none() => fraction = Some(0),
-                        b'.' => return false, // malformed: the general path reports it
-                        _ => break,
-                    }
-                    p += 1;
+            b'0'..=b'9' => match plain_number(&bytes[p..]) {
+                Some((value, len)) => {
+                    p += len;
+                    Tok::Num(value)
                 }
-                if digits > 15 {
-                    return false;
-                }
-                const POW10: [f64; 16] = [
-                    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14,
-                    1e15,
-                ];
-                Tok::Num(mantissa as f64 / POW10[fraction.unwrap_or(0)])
-            }
+                None => return false, // long or malformed: the general path judges it
+            },
             _ => return false,
         };
         let span = Span {
@@ -525,30 +504,10 @@ fn offset(pos: usize) -> u32 {
 /// a power of ten below 10^22 are exact doubles, so one division rounds correctly); anything
 /// else goes to the standard library.
 fn parse_decimal(text: &str) -> Result<f64, core::num::ParseFloatError> {
-    const POW10: [f64; 16] = [
-        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-    ];
-    let mut mantissa: u64 = 0;
-    let mut digits = 0usize;
-    let mut fraction: Option<usize> = None;
-    for &b in text.as_bytes() {
-        match b {
-            b'0'..=b'9' => {
-                // Wrapping: more than 15 digits take the slow path below anyway.
-                mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(b - b'0'));
-                digits += 1;
-                if let Some(f) = fraction.as_mut() {
-                    *f += 1;
-                }
-            }
-            b'.' if fraction.is_none() => fraction = Some(0),
-            _ => return text.parse(),
-        }
+    match plain_number(text.as_bytes()) {
+        Some((value, len)) if len == text.len() => Ok(value),
+        _ => text.parse(),
     }
-    if digits == 0 || digits > 15 {
-        return text.parse();
-    }
-    Ok(mantissa as f64 / POW10[fraction.unwrap_or(0)])
 }
 
 /// Whether a line begins a block of its own: empty, or a block number, `#`, `$` or `%`.

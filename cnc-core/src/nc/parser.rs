@@ -297,24 +297,31 @@ impl Parser<'_> {
         }
     }
 
+    /// The axis name of a word with an optional glued whole number (`X`, `X1`); a sign or a
+    /// decimal point is reported and the block skipped.
+    fn axis_name(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Name> {
+        match glued {
+            None => Some(word),
+            Some(n) if n.fract() == 0.0 && n >= 0.0 => {
+                Some(Name::from(format!("{word}{}", n as u64).as_str()))
+            }
+            Some(_) => {
+                self.error(
+                    span,
+                    "an axis name is letters and digits only (no sign, no decimal point)",
+                );
+                self.recover();
+                None
+            }
+        }
+    }
+
     /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
     fn word_item(&mut self, span: Span) -> Option<Item> {
         let (word, glued) = self.take_word()?;
-        let glued_name = |n: f64| Name::from(format!("{word}{}", n as u64).as_str());
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
-            let name = match glued {
-                Some(n) if n.fract() == 0.0 && n >= 0.0 => glued_name(n),
-                Some(_) => {
-                    self.error(
-                        span,
-                        "an axis name is letters and digits only (no sign, no decimal point)",
-                    );
-                    self.recover();
-                    return None;
-                }
-                None => word,
-            };
+            let name = self.axis_name(word, glued, span)?;
             self.bump();
             let value = self.expr()?;
             return Some(match name.as_str() {
@@ -339,18 +346,7 @@ impl Parser<'_> {
         }
         // `X1[INDP_ASYN ...]`
         if self.is_punct("[") {
-            let name = match glued {
-                Some(n) if n.fract() == 0.0 && n >= 0.0 => glued_name(n),
-                Some(_) => {
-                    self.error(
-                        span,
-                        "an axis name is letters and digits only (no sign, no decimal point)",
-                    );
-                    self.recover();
-                    return None;
-                }
-                None => word,
-            };
+            let name = self.axis_name(word, glued, span)?;
             let options = self.bracket_list()?;
             return Some(Item::IndependentAxis {
                 name,
@@ -644,10 +640,8 @@ impl Parser<'_> {
             "PRESET" => {
                 let mut axes = Vec::new();
                 while let Some((w, glued)) = self.take_word() {
-                    axes.push(match glued {
-                        Some(n) => Name::from(format!("{w}{}", n as u64).as_str()),
-                        None => w,
-                    });
+                    let s = self.span();
+                    axes.push(self.axis_name(w, glued, s)?);
                 }
                 Some(Command::Preset { axes })
             }
