@@ -262,6 +262,8 @@ fn run(args: &DemoArgs) -> Result<(), String> {
         counters.acyclic_answered += server
             .poll(|kind, request| match kind {
                 CallKind::ReadAxisState => handle_read_axis_state(&view, request),
+                // The demo has no axis layer yet.
+                CallKind::AxisCommand => Err(hli::rpc::ErrorCode::ServiceNotSupported),
             })
             .unwrap_or(0) as u64;
 

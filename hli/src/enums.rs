@@ -202,6 +202,86 @@ hli_enum! {
     }
 }
 
+hli_enum! {
+    /// The PLCopen-style motion commands an axis takes over the acyclic service.
+    AxisCommandKind: u32, "AxisCommandKind" {
+        /// MC_Power: enable (flag 1) or disable (flag 0) the axis.
+        Power = 1,
+        /// MC_Reset: clear the axis error once its cause is gone.
+        Reset = 2,
+        /// MC_MoveAbsolute: go to a position.
+        MoveAbsolute = 3,
+        /// MC_MoveRelative: go a distance from the current set position.
+        MoveRelative = 4,
+        /// MC_MoveVelocity: run endlessly at a velocity.
+        MoveVelocity = 5,
+        /// MC_Halt: brake to standstill; can be overridden by another move.
+        Halt = 6,
+        /// MC_Stop: brake to standstill and lock the axis until released.
+        Stop = 7,
+        /// Releases the lock of MC_Stop (its Execute input fell).
+        StopRelease = 8,
+    }
+}
+
+hli_enum! {
+    /// How a command ended (`HLI_AXIS_COMMAND_OUTCOME.result`).
+    CommandResult: u32, "HLI_AXIS_COMMAND_OUTCOME.result" {
+        /// Empty slot.
+        None = 0,
+        /// Reached its goal.
+        Done = 1,
+        /// Replaced by a newer command before reaching its goal.
+        Aborted = 2,
+        /// Ended with an error (see `error_id`).
+        Error = 3,
+    }
+}
+
+hli_enum! {
+    /// Error codes of the axis layer: why a command was refused or an axis stopped. The
+    /// specification leaves the numbers to the NC's error list, which it does not include; these
+    /// are ours, grouped by cause.
+    AxisError: u32, "AxisError" {
+        /// Velocity not above zero, not finite, or above the axis maximum.
+        InvalidVelocity = 0x4221,
+        /// Acceleration not above zero, not finite, or above the axis maximum.
+        InvalidAcceleration = 0x4222,
+        /// Deceleration not above zero, not finite, or above the axis maximum.
+        InvalidDeceleration = 0x4223,
+        /// Jerk not above zero, not finite, or above the axis maximum.
+        InvalidJerk = 0x4224,
+        /// Target position not finite or outside the software limits.
+        TargetOutsideLimits = 0x4225,
+        /// Direction of MC_MoveVelocity is neither positive (1) nor negative (-1).
+        InvalidDirection = 0x4226,
+        /// Unknown flag bits or a reserved field not zero.
+        InvalidParameter = 0x4227,
+        /// The axis is not enabled (MC_Power).
+        NotEnabled = 0x4230,
+        /// The axis is a slave of a coupling (cam, gear, FIFO group, channel).
+        Coupled = 0x4231,
+        /// The axis is locked by MC_Stop.
+        StopActive = 0x4232,
+        /// The axis is in an error state; MC_Reset first.
+        AxisInError = 0x4233,
+        /// MC_Power off while the axis moves at speed is refused; stop first.
+        MovingWhileDisable = 0x4234,
+        /// The following error exceeded its limit.
+        FollowingError = 0x4240,
+        /// The encoder's process data are invalid (`nStatus4`).
+        EncoderIoInvalid = 0x4241,
+        /// The drive's process data are invalid (`nStatus4`).
+        DriveIoInvalid = 0x4242,
+        /// A velocity move ran into a software limit and was stopped at it.
+        SoftwareLimitReached = 0x4243,
+        /// The set-point generator found no trajectory.
+        GeneratorFailed = 0x4250,
+        /// MC_Reset while the cause of the error is still present.
+        ResetRefused = 0x4251,
+    }
+}
+
 /// Bits of `HLI_AXIS_LR_STATE.status_r`.
 pub mod axis_status {
     /// Drive enabled (MC_Power).

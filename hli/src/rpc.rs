@@ -102,6 +102,8 @@ codes! {
 pub enum CallKind {
     /// [`ReadAxisState`].
     ReadAxisState,
+    /// [`AxisCommandCall`].
+    AxisCommand,
 }
 
 impl CallKind {
@@ -109,6 +111,7 @@ impl CallKind {
     pub fn raw(self) -> u32 {
         match self {
             CallKind::ReadAxisState => 1,
+            CallKind::AxisCommand => 2,
         }
     }
 
@@ -116,6 +119,7 @@ impl CallKind {
     pub fn decode(raw: u32) -> Option<Self> {
         match raw {
             1 => Some(CallKind::ReadAxisState),
+            2 => Some(CallKind::AxisCommand),
             _ => None,
         }
     }
@@ -143,6 +147,118 @@ impl AcyclicCall for ReadAxisState {
 }
 
 const _: () = assert!(core::mem::size_of::<HliAxisLrState>() <= ACYCLIC_BODY_SIZE);
+
+/// A motion command for the axis given as `target` (what MC_Power, MC_MoveAbsolute ... send
+/// on their Execute edge). Units are the axis's (mm or degree, per second...).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct AxisCommandCall {
+    /// Raw [`crate::enums::AxisCommandKind`].
+    pub command: u32,
+    /// MC_Power: 1 enable, 0 disable. Others: 0.
+    pub enable: u32,
+    /// MC_MoveVelocity: 1 positive, -1 negative. Others: 0.
+    pub direction: i32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Target position (absolute) or distance (relative).
+    pub position: f64,
+    /// Velocity limit of the move (or the velocity of MC_MoveVelocity), > 0.
+    pub velocity: f64,
+    /// Acceleration limit, > 0.
+    pub acceleration: f64,
+    /// Deceleration limit, > 0 (also of MC_Halt and MC_Stop).
+    pub deceleration: f64,
+    /// Jerk limit, > 0 (also of MC_Halt and MC_Stop).
+    pub jerk: f64,
+}
+
+impl AxisCommandCall {
+    fn motion(kind: crate::enums::AxisCommandKind) -> Self {
+        Self {
+            command: kind.raw(),
+            ..Self::default()
+        }
+    }
+    /// MC_Power with `enable`.
+    pub fn power(enable: bool) -> Self {
+        Self {
+            enable: u32::from(enable),
+            ..Self::motion(crate::enums::AxisCommandKind::Power)
+        }
+    }
+    /// MC_Reset.
+    pub fn reset() -> Self {
+        Self::motion(crate::enums::AxisCommandKind::Reset)
+    }
+    /// MC_MoveAbsolute to `position` with the limits `[velocity, acceleration, deceleration,
+    /// jerk]`.
+    pub fn move_absolute(position: f64, limits: [f64; 4]) -> Self {
+        Self {
+            position,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveAbsolute).with_limits(limits)
+        }
+    }
+    /// MC_MoveRelative by `distance` with the limits `[velocity, acceleration, deceleration,
+    /// jerk]`.
+    pub fn move_relative(distance: f64, limits: [f64; 4]) -> Self {
+        Self {
+            position: distance,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveRelative).with_limits(limits)
+        }
+    }
+    /// MC_MoveVelocity in `direction` (1 or -1) at `limits[0]`.
+    pub fn move_velocity(direction: i32, limits: [f64; 4]) -> Self {
+        Self {
+            direction,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveVelocity).with_limits(limits)
+        }
+    }
+    /// MC_Halt with `deceleration` and `jerk`.
+    pub fn halt(deceleration: f64, jerk: f64) -> Self {
+        Self {
+            deceleration,
+            jerk,
+            ..Self::motion(crate::enums::AxisCommandKind::Halt)
+        }
+    }
+    /// MC_Stop with `deceleration` and `jerk`.
+    pub fn stop(deceleration: f64, jerk: f64) -> Self {
+        Self {
+            deceleration,
+            jerk,
+            ..Self::motion(crate::enums::AxisCommandKind::Stop)
+        }
+    }
+    /// Releases MC_Stop's lock.
+    pub fn stop_release() -> Self {
+        Self::motion(crate::enums::AxisCommandKind::StopRelease)
+    }
+    fn with_limits(self, [velocity, acceleration, deceleration, jerk]: [f64; 4]) -> Self {
+        Self {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..self
+        }
+    }
+}
+
+/// The reply to an [`AxisCommandCall`]: the command's id, or why the axis refused it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct AxisCommandReply {
+    /// Id the axis gave the command (see `HLI_AXIS_COMMAND_STATE`), 0 when refused.
+    pub command_id: u32,
+    /// 0 when accepted, else the raw [`crate::enums::AxisError`] of the refusal.
+    pub error_id: u32,
+}
+
+impl AcyclicCall for AxisCommandCall {
+    const KIND: CallKind = CallKind::AxisCommand;
+    type Reply = AxisCommandReply;
+}
 
 /// Why a call did not produce a reply.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -211,7 +327,8 @@ fn open_service(
         .map_err(transport)?;
     node.service_builder(&name)
         .request_response::<AcyclicRequest, AcyclicResponse>()
-        .max_active_requests_per_client(4)
+        // One pending call per PLC block and axis: 32 axes with a move and a power block each.
+        .max_active_requests_per_client(64)
         .open_or_create()
         .map_err(transport)
 }
@@ -253,6 +370,26 @@ impl AcyclicClient {
         call: &C,
         timeout: Duration,
     ) -> Result<C::Reply, CallError> {
+        let pending = self.start(target, call)?;
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(result) = pending.poll() {
+                return result;
+            }
+            if Instant::now() >= deadline {
+                return Err(CallError::Timeout(timeout));
+            }
+            std::thread::yield_now();
+        }
+    }
+
+    /// Sends `call` to `target` without waiting: a PLC block sends on its Execute edge and
+    /// polls the returned [`PendingCall`] in the following cycles (it stays Busy meanwhile).
+    pub fn start<C: AcyclicCall>(
+        &mut self,
+        target: u32,
+        call: &C,
+    ) -> Result<PendingCall<C>, CallError> {
         let (body, body_len) = encode_body(call);
         let invoke_id = self.next_invoke_id;
         self.next_invoke_id = self.next_invoke_id.wrapping_add(1);
@@ -266,39 +403,74 @@ impl AcyclicClient {
                 body,
             })
             .map_err(transport)?;
-        let deadline = Instant::now() + timeout;
-        loop {
-            if let Some(response) = pending.receive().map_err(transport)? {
-                let response: &AcyclicResponse = response.payload();
-                if response.invoke_id != invoke_id || response.kind != C::KIND.raw() {
-                    return Err(CallError::Malformed(format!(
-                        "response id/kind {}/{} for request {}/{}",
-                        response.invoke_id,
-                        response.kind,
-                        invoke_id,
-                        C::KIND.raw()
-                    )));
-                }
-                if response.error_code != 0 {
-                    let code = ErrorCode::decode(response.error_code)
-                        .map_err(|e| CallError::Malformed(e.to_string()))?;
-                    return Err(CallError::Refused { code });
-                }
-                let len = response.body_len as usize;
-                if len != core::mem::size_of::<C::Reply>() {
-                    return Err(CallError::Malformed(format!(
-                        "reply body of {len} bytes, expected {}",
-                        core::mem::size_of::<C::Reply>()
-                    )));
-                }
-                return Ok(bytemuck::pod_read_unaligned(&response.body[..len]));
-            }
-            if Instant::now() >= deadline {
-                return Err(CallError::Timeout(timeout));
-            }
-            std::thread::yield_now();
-        }
+        Ok(PendingCall {
+            pending,
+            invoke_id,
+            _call: core::marker::PhantomData,
+        })
     }
+}
+
+type PendingPort = iceoryx2::pending_response::PendingResponse<
+    ipc::Service,
+    AcyclicRequest,
+    (),
+    AcyclicResponse,
+    (),
+>;
+
+/// A call on its way: poll it until it yields the reply or the refusal.
+pub struct PendingCall<C: AcyclicCall> {
+    pending: PendingPort,
+    invoke_id: u32,
+    _call: core::marker::PhantomData<C>,
+}
+
+impl<C: AcyclicCall> core::fmt::Debug for PendingCall<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "PendingCall({})", self.invoke_id)
+    }
+}
+
+impl<C: AcyclicCall> PendingCall<C> {
+    /// The reply (or refusal) once the server has answered, `None` while it has not.
+    pub fn poll(&self) -> Option<Result<C::Reply, CallError>> {
+        let response = match self.pending.receive() {
+            Ok(Some(response)) => response,
+            Ok(None) => return None,
+            Err(e) => return Some(Err(transport(e))),
+        };
+        let response: &AcyclicResponse = response.payload();
+        Some(decode_response::<C>(response, self.invoke_id))
+    }
+}
+
+fn decode_response<C: AcyclicCall>(
+    response: &AcyclicResponse,
+    invoke_id: u32,
+) -> Result<C::Reply, CallError> {
+    if response.invoke_id != invoke_id || response.kind != C::KIND.raw() {
+        return Err(CallError::Malformed(format!(
+            "response id/kind {}/{} for request {}/{}",
+            response.invoke_id,
+            response.kind,
+            invoke_id,
+            C::KIND.raw()
+        )));
+    }
+    if response.error_code != 0 {
+        let code = ErrorCode::decode(response.error_code)
+            .map_err(|e| CallError::Malformed(e.to_string()))?;
+        return Err(CallError::Refused { code });
+    }
+    let len = response.body_len as usize;
+    if len != core::mem::size_of::<C::Reply>() {
+        return Err(CallError::Malformed(format!(
+            "reply body of {len} bytes, expected {}",
+            core::mem::size_of::<C::Reply>()
+        )));
+    }
+    Ok(bytemuck::pod_read_unaligned(&response.body[..len]))
 }
 
 /// A reply a handler produces: the encoded body or a refusal.

@@ -26,7 +26,7 @@ use iceoryx2_bb_system_types::file_name::{FileName, SemanticString};
 /// "HLI-SEG1" as a little-endian u64.
 pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");
 /// Bumped whenever the meaning of the image changes without its layout changing.
-pub const LAYOUT_VERSION: u32 = 1;
+pub const LAYOUT_VERSION: u32 = 2;
 /// Size of the image in bytes.
 pub const IMAGE_SIZE: usize = size_of::<HliImage>();
 const HEADER_SIZE: usize = size_of::<HliSegmentHeader>();

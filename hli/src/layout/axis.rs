@@ -38,10 +38,52 @@ hli_struct! {
 }
 
 hli_struct! {
+    /// How one motion command of an axis ended.
+    ///
+    /// ST path: `gpAx[i]^command_state.outcomes_r[k]`.
+    #[st = "HLI_AXIS_COMMAND_OUTCOME", size = 16]
+    pub struct HliAxisCommandOutcome {
+        /// Id of the command (as returned when it was accepted), 0 for an empty slot.
+        pub command_id: u32 => [0, Cnc],
+        /// Raw [`crate::enums::CommandResult`].
+        pub result: u32 => [4, Cnc],
+        /// Error code when the result is an error, else 0; see [`crate::enums::AxisError`].
+        pub error_id: u32 => [8, Cnc],
+        /// Raw [`crate::enums::AxisCommandKind`] of the command.
+        pub kind: u32 => [12, Cnc],
+    }
+}
+
+/// Outcome slots per axis: the last four finished commands.
+pub const HLI_AXIS_OUTCOMES: usize = 4;
+
+hli_struct! {
+    /// The command book of an axis, written by the CNC every tick: which command owns the
+    /// set-point generator and how the last ones ended. A PLC block that holds a command id
+    /// derives Busy / Done / CommandAborted / Error from it without an acyclic call.
+    ///
+    /// ST path: `gpAx[i]^command_state`.
+    #[st = "HLI_AXIS_COMMAND_STATE", size = 80]
+    pub struct HliAxisCommandState {
+        /// Id of the last accepted command (ids count up from 1 per axis).
+        pub issued_id_r: u32 => [0, Cnc],
+        /// Id of the command that owns the set-point generator, 0 when none.
+        pub active_id_r: u32 => [4, Cnc],
+        /// Whether the active command has reached its goal while still owning the axis
+        /// (MC_MoveVelocity: in velocity; MC_Stop: stopped and held). 0 or 1.
+        pub active_reached_r: u32 => [8, Cnc],
+        /// Slot of `outcomes_r` written last.
+        pub last_outcome_r: u32 => [12, Cnc],
+        /// Ring of the last finished commands.
+        pub outcomes_r: [HliAxisCommandOutcome; HLI_AXIS_OUTCOMES] => [16, Cnc],
+    }
+}
+
+hli_struct! {
     /// Everything of one axis: `gpAx[axis_idx]^`.
     ///
     /// ST path: `gpAx[i]^`.
-    #[st = "HLI_AXIS", size = 192]
+    #[st = "HLI_AXIS", size = 272]
     pub struct HliAxis {
         /// Cyclic state.
         pub lr_state: HliAxisLrState => [0, Parent],
@@ -53,5 +95,7 @@ hli_struct! {
         pub drive_in: NcDriveIn => [120, Parent],
         /// Drive outputs (process image).
         pub drive_out: NcDriveOut => [160, Parent],
+        /// The command book.
+        pub command_state: HliAxisCommandState => [192, Parent],
     }
 }

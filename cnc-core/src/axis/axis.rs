@@ -1,0 +1,554 @@
+//! One axis: command validation, set-point generation, actual position from the encoder,
+//! following-error monitoring, the position controller and the drive outputs.
+
+use super::commands::CommandBook;
+use super::config::{AxisConfig, DriveMode};
+use super::generator::{Goal, Kinematic, MoveLimits, Progress, SetpointGenerator};
+use super::increments::IncrementCounter;
+use hli::enums::{
+    axis_status, AxisCommandKind, AxisError, AxisState, CommandResult, CouplingState,
+    DirectionBits, IoState,
+};
+use hli::layout::{
+    HliAxisCommandState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
+};
+use hli::rpc::AxisCommandCall;
+
+/// A coupling that drives the axis instead of its own generator (cam, gear, FIFO group,
+/// channel): the engine hands in a set-point every tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coupling {
+    /// What the axis is coupled to.
+    pub kind: CouplingState,
+    /// Index of the master axis, -1 when the master is not an axis.
+    pub master: i32,
+    /// Slave phase shown in `nAxisState` (11, 12, 13).
+    pub phase: AxisState,
+}
+
+/// Everything the axis writes to the image in one tick.
+#[derive(Debug, Clone, Copy)]
+pub struct AxisOutputs {
+    /// Cyclic state.
+    pub lr_state: HliAxisLrState,
+    /// Drive outputs.
+    pub drive_out: NcDriveOut,
+    /// Encoder outputs.
+    pub enc_out: NcEncoderOut,
+    /// Command book.
+    pub command_state: HliAxisCommandState,
+}
+
+/// An axis.
+#[derive(Debug)]
+pub struct Axis {
+    config: AxisConfig,
+    cycle_s: f64,
+    generator: SetpointGenerator,
+    counter: IncrementCounter,
+    book: CommandBook,
+    enabled: bool,
+    stop_lock: bool,
+    error: Option<AxisError>,
+    coupling: Option<Coupling>,
+    coupled_setpoint: Kinematic,
+    io_fault: Option<AxisError>,
+    actual: f64,
+    actual_velocity: f64,
+    following_error: f64,
+    output_velocity: f64,
+}
+
+fn saturate(value: f64) -> i32 {
+    value.round().clamp(i32::MIN as f64, i32::MAX as f64) as i32
+}
+
+fn direction(value_in_increments: f64) -> DirectionBits {
+    if value_in_increments >= 0.5 {
+        DirectionBits::Plus
+    } else if value_in_increments <= -0.5 {
+        DirectionBits::Minus
+    } else {
+        DirectionBits::Stop
+    }
+}
+
+impl Axis {
+    /// An axis from a validated configuration, standing where it is (its first encoder reading
+    /// sets the set-point), disabled.
+    pub fn new(config: AxisConfig, cycle_s: f64) -> Self {
+        let mut generator = SetpointGenerator::new(cycle_s, 0.0);
+        generator.set_jerk_ceiling(config.dynamics.jerk);
+        Self {
+            counter: IncrementCounter::new(config.encoder_width),
+            generator,
+            config,
+            cycle_s,
+            book: CommandBook::default(),
+            enabled: false,
+            stop_lock: false,
+            error: None,
+            coupling: None,
+            coupled_setpoint: Kinematic::default(),
+            io_fault: None,
+            actual: 0.0,
+            actual_velocity: 0.0,
+            following_error: 0.0,
+            output_velocity: 0.0,
+        }
+    }
+
+    /// Its configuration.
+    pub fn config(&self) -> &AxisConfig {
+        &self.config
+    }
+    /// The set-point of the last tick.
+    pub fn setpoint(&self) -> Kinematic {
+        match self.coupling {
+            Some(_) => self.coupled_setpoint,
+            None => self.generator.state(),
+        }
+    }
+    /// The actual position of the last tick.
+    pub fn actual(&self) -> f64 {
+        self.actual
+    }
+    /// Set minus actual position of the last tick.
+    pub fn following_error(&self) -> f64 {
+        self.following_error
+    }
+    /// The error that stopped the axis, if any.
+    pub fn error(&self) -> Option<AxisError> {
+        self.error
+    }
+    /// Whether the axis is enabled.
+    pub fn enabled(&self) -> bool {
+        self.enabled
+    }
+    /// The command book.
+    pub fn book(&self) -> &CommandBook {
+        &self.book
+    }
+
+    /// Takes a command; returns its id or why it was refused. A refused command changes
+    /// nothing: a move in progress goes on.
+    pub fn command(&mut self, call: &AxisCommandCall) -> Result<u32, AxisError> {
+        let kind =
+            AxisCommandKind::decode(call.command).map_err(|_| AxisError::InvalidParameter)?;
+        if call.reserved != 0 {
+            return Err(AxisError::InvalidParameter);
+        }
+        match kind {
+            AxisCommandKind::Power => self.power(call.enable),
+            AxisCommandKind::Reset => self.reset(),
+            AxisCommandKind::StopRelease => {
+                self.stop_lock = false;
+                Ok(self.book.instant(kind))
+            }
+            AxisCommandKind::Stop => {
+                self.may_move(false)?;
+                let (dec, jerk) = self.braking(call)?;
+                self.generator.brake(dec, jerk);
+                self.stop_lock = true;
+                Ok(self.book.begin(kind))
+            }
+            AxisCommandKind::Halt => {
+                self.may_move(true)?;
+                let (dec, jerk) = self.braking(call)?;
+                self.generator.brake(dec, jerk);
+                Ok(self.book.begin(kind))
+            }
+            AxisCommandKind::MoveAbsolute | AxisCommandKind::MoveRelative => {
+                self.may_move(true)?;
+                let limits = self.move_limits(call)?;
+                let target = if kind == AxisCommandKind::MoveAbsolute {
+                    call.position
+                } else {
+                    self.generator.state().position + call.position
+                };
+                self.check_target(target)?;
+                self.generator.move_to(target, limits);
+                Ok(self.book.begin(kind))
+            }
+            AxisCommandKind::MoveVelocity => {
+                self.may_move(true)?;
+                let limits = self.move_limits(call)?;
+                let sign = match call.direction {
+                    1 => 1.0,
+                    -1 => -1.0,
+                    _ => return Err(AxisError::InvalidDirection),
+                };
+                self.generator.run_at(sign * limits.velocity, limits);
+                Ok(self.book.begin(kind))
+            }
+        }
+    }
+
+    fn power(&mut self, enable: u32) -> Result<u32, AxisError> {
+        match enable {
+            1 => {
+                if self.error.is_some() {
+                    return Err(AxisError::AxisInError);
+                }
+                if !self.enabled {
+                    // Take over where the axis stands, without a jump.
+                    self.generator.hold(self.actual);
+                }
+                self.enabled = true;
+            }
+            0 => {
+                if self.generator.goal() != Goal::Hold && self.coupling.is_none() {
+                    return Err(AxisError::MovingWhileDisable);
+                }
+                self.enabled = false;
+                self.book.finish(CommandResult::Aborted, None);
+            }
+            _ => return Err(AxisError::InvalidParameter),
+        }
+        Ok(self.book.instant(AxisCommandKind::Power))
+    }
+
+    fn reset(&mut self) -> Result<u32, AxisError> {
+        if self.io_fault.is_some() {
+            return Err(AxisError::ResetRefused);
+        }
+        self.error = None;
+        self.generator.hold(self.actual);
+        Ok(self.book.instant(AxisCommandKind::Reset))
+    }
+
+    fn may_move(&self, respect_stop_lock: bool) -> Result<(), AxisError> {
+        if self.error.is_some() {
+            return Err(AxisError::AxisInError);
+        }
+        if !self.enabled {
+            return Err(AxisError::NotEnabled);
+        }
+        if self.coupling.is_some() {
+            return Err(AxisError::Coupled);
+        }
+        if respect_stop_lock && self.stop_lock {
+            return Err(AxisError::StopActive);
+        }
+        Ok(())
+    }
+
+    fn within(value: f64, max: f64) -> bool {
+        value > 0.0 && value <= max && value.is_finite()
+    }
+
+    fn braking(&self, call: &AxisCommandCall) -> Result<(f64, f64), AxisError> {
+        let d = self.config.dynamics;
+        if !Self::within(call.deceleration, d.deceleration) {
+            return Err(AxisError::InvalidDeceleration);
+        }
+        if !Self::within(call.jerk, d.jerk) {
+            return Err(AxisError::InvalidJerk);
+        }
+        Ok((call.deceleration, call.jerk))
+    }
+
+    fn move_limits(&self, call: &AxisCommandCall) -> Result<MoveLimits, AxisError> {
+        let d = self.config.dynamics;
+        if !Self::within(call.velocity, d.velocity) {
+            return Err(AxisError::InvalidVelocity);
+        }
+        if !Self::within(call.acceleration, d.acceleration) {
+            return Err(AxisError::InvalidAcceleration);
+        }
+        let (deceleration, jerk) = self.braking(call)?;
+        Ok(MoveLimits {
+            velocity: call.velocity,
+            acceleration: call.acceleration,
+            deceleration,
+            jerk,
+        })
+    }
+
+    fn check_target(&self, target: f64) -> Result<(), AxisError> {
+        let inside = match self.config.soft_limits {
+            Some([min, max]) => (min..=max).contains(&target),
+            None => target.is_finite(),
+        };
+        if inside {
+            Ok(())
+        } else {
+            Err(AxisError::TargetOutsideLimits)
+        }
+    }
+
+    /// Couples the axis to an engine that hands in set-points with [`Axis::drive_coupled`].
+    /// Refused while another command owns the axis is not needed: the coupling aborts it.
+    pub fn couple(&mut self, coupling: Coupling) -> Result<(), AxisError> {
+        self.may_move(true)?;
+        self.book.finish(CommandResult::Aborted, None);
+        self.coupled_setpoint = self.generator.state();
+        self.coupling = Some(coupling);
+        Ok(())
+    }
+
+    /// The coupled engine's set-point for this tick (ignored when not coupled).
+    pub fn drive_coupled(&mut self, setpoint: Kinematic, phase: AxisState) {
+        if let Some(c) = self.coupling.as_mut() {
+            c.phase = phase;
+            self.coupled_setpoint = setpoint;
+        }
+    }
+
+    /// Ends a coupling (MC_GearOut, MC_CamOut): the axis becomes a free master and goes on at
+    /// the velocity it had, acceleration-free, as after MC_MoveVelocity, until MC_Halt or
+    /// MC_Stop.
+    pub fn decouple(&mut self) {
+        if self.coupling.take().is_none() {
+            return;
+        }
+        let s = self.coupled_setpoint;
+        let d = self.config.dynamics;
+        // Resume from the coupled state: position, velocity and acceleration carry over.
+        if s.velocity == 0.0 {
+            self.generator.hold(s.position);
+        } else {
+            self.generator.resume_from(s);
+            self.generator.run_at(
+                s.velocity,
+                MoveLimits {
+                    velocity: d.velocity,
+                    acceleration: d.acceleration,
+                    deceleration: d.deceleration,
+                    jerk: d.jerk,
+                },
+            );
+        }
+    }
+
+    fn fault(&mut self, error: AxisError) {
+        if self.error.is_none() {
+            self.error = Some(error);
+        }
+        self.book.finish(CommandResult::Error, Some(error));
+        self.coupling = None;
+        self.stop_lock = false;
+        // A safe set-point: stand where the axis is; the output velocity is zero.
+        self.generator.hold(self.actual);
+    }
+
+    /// One tick: reads the inputs, generates, monitors, controls and returns the outputs.
+    pub fn tick(&mut self, enc_in: &NcEncoderIn, drive_in: &NcDriveIn) -> AxisOutputs {
+        let scale = self.config.increments_per_unit;
+        // Inputs: a status byte that is not a valid IoState counts as invalid too.
+        let encoder_ok = IoState::decode(enc_in.nStatus4) == Ok(IoState::Valid);
+        let drive_ok = IoState::decode(drive_in.nStatus4) == Ok(IoState::Valid);
+        self.io_fault = if !encoder_ok {
+            Some(AxisError::EncoderIoInvalid)
+        } else if !drive_ok {
+            Some(AxisError::DriveIoInvalid)
+        } else {
+            None
+        };
+        if encoder_ok {
+            let first = !self.counter.started();
+            let previous = self.actual;
+            self.actual = self.counter.update(enc_in.nInData1) as f64 / scale;
+            self.actual_velocity = if first {
+                0.0
+            } else {
+                (self.actual - previous) / self.cycle_s
+            };
+            if first {
+                self.generator.hold(self.actual);
+            }
+        }
+        if let Some(cause) = self.io_fault {
+            if self.enabled && self.error.is_none() {
+                self.fault(cause);
+            }
+        }
+        // The actual position belongs to the set-point of the previous tick; this tick's
+        // generator step produces the set-point for the end of the coming tick.
+        let previous = self.setpoint();
+        if !self.enabled {
+            self.generator.hold(self.actual);
+        } else if self.error.is_none() {
+            self.generate();
+        }
+        self.following_error = previous.position - self.actual;
+        if self.enabled
+            && self.error.is_none()
+            && self.following_error.abs() > self.config.following_error_limit
+        {
+            self.fault(AxisError::FollowingError);
+        }
+        let set = self.setpoint();
+        let active = self.enabled && self.error.is_none();
+        // Feed-forward of the mean velocity over the coming tick: with an ideal drive the
+        // actual position lands on the set-point exactly.
+        let mean_velocity = (set.position - previous.position) / self.cycle_s;
+        self.output_velocity = if active {
+            self.config.feed_forward * mean_velocity
+                + self.config.position_gain * (previous.position - self.actual)
+        } else {
+            0.0
+        };
+        self.outputs(enc_in, set)
+    }
+
+    fn generate(&mut self) {
+        if self.coupling.is_some() {
+            return;
+        }
+        let progress = match self.generator.step() {
+            Ok(p) => p,
+            Err(_) => return self.fault(AxisError::GeneratorFailed),
+        };
+        let stopping = self.book.active().map(|a| a.kind) == Some(AxisCommandKind::Stop);
+        match progress {
+            Progress::Reached if stopping => self.book.mark_reached(),
+            Progress::Reached => match self.generator.goal() {
+                Goal::Velocity(v) if v != 0.0 => self.book.mark_reached(),
+                _ => self.book.finish(CommandResult::Done, None),
+            },
+            Progress::Idle | Progress::Moving | Progress::AtVelocity => {}
+        }
+        if stopping && !self.stop_lock {
+            // Released (Execute fell) after standstill, or released early: the stop is over.
+            if self.generator.goal() == Goal::Hold {
+                self.book.finish(CommandResult::Done, None);
+            }
+        }
+        self.guard_soft_limits();
+    }
+
+    /// A velocity move brakes so that it comes to rest on a software limit, and ends with an
+    /// error there.
+    fn guard_soft_limits(&mut self) {
+        let (Some([min, max]), Goal::Velocity(v)) =
+            (self.config.soft_limits, self.generator.goal())
+        else {
+            return;
+        };
+        if v == 0.0 {
+            return;
+        }
+        let s = self.generator.state();
+        let d = self.config.dynamics;
+        // Braking distance with the axis's deceleration, plus the jerk phase, plus one tick.
+        let speed = s.velocity.abs();
+        let reach = speed * speed / (2.0 * d.deceleration)
+            + speed * (d.deceleration / d.jerk)
+            + speed * self.cycle_s;
+        let limit = if v > 0.0 { max } else { min };
+        if (limit - s.position).abs() <= reach || (v > 0.0) == (s.position > limit) {
+            self.generator.move_to(
+                limit,
+                MoveLimits {
+                    velocity: speed.max(f64::MIN_POSITIVE),
+                    acceleration: d.acceleration,
+                    deceleration: d.deceleration,
+                    jerk: d.jerk,
+                },
+            );
+            // The command ends with the error; the braking move runs on, owned by no command,
+            // and the axis takes new commands (inside the limits) at once.
+            self.book
+                .finish(CommandResult::Error, Some(AxisError::SoftwareLimitReached));
+        }
+    }
+
+    fn outputs(&self, enc_in: &NcEncoderIn, set: Kinematic) -> AxisOutputs {
+        let cfg = &self.config;
+        let vscale = cfg.velocity_increments_per_unit;
+        let out_velocity = self.output_velocity * vscale;
+        let set_direction = direction(set.velocity * vscale);
+        let total_direction = direction(out_velocity);
+        let (data1, data2) = match cfg.drive_mode {
+            DriveMode::Position => {
+                let count = (set.position * cfg.increments_per_unit).round() as i64;
+                (cfg.encoder_width.wrap(count), 0)
+            }
+            DriveMode::Velocity => (saturate(out_velocity), 0),
+            DriveMode::Universal => {
+                let v = saturate(out_velocity);
+                (v, v.saturating_abs())
+            }
+        };
+        let drive_out = NcDriveOut {
+            nOutData1: data1,
+            nOutData2: data2,
+            nCtrl1: u8::from(self.enabled),
+            nCtrl2: set_direction.raw(),
+            nCtrl3: total_direction.raw(),
+            nOutData3: saturate(set.acceleration * cfg.acceleration_increments_per_unit),
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let enc_out = NcEncoderOut {
+            nOutData1: enc_in.nInData1,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let display = |p: f64| match cfg.modulo() {
+            Some(m) => p.rem_euclid(m),
+            None => p,
+        };
+        let hli_scale = hli::units::HLI_LENGTH_PER_MM;
+        let mut status = 0;
+        if self.enabled {
+            status |= axis_status::ENABLED;
+        }
+        let moving = set.velocity != 0.0 || self.generator.goal() != Goal::Hold;
+        if moving {
+            status |= axis_status::MOVING;
+        }
+        if !moving && self.following_error.abs() <= cfg.in_target_window {
+            status |= axis_status::IN_TARGET;
+        }
+        if self.error.is_some() {
+            status |= axis_status::ERROR;
+        }
+        if self.io_fault.is_some() {
+            status |= axis_status::IO_INVALID;
+        }
+        let lr_state = HliAxisLrState {
+            current_position_acs_r: saturate(display(self.actual) * hli_scale),
+            command_position_acs_r: saturate(display(set.position) * hli_scale),
+            current_velocity_r: saturate(self.actual_velocity * hli_scale),
+            command_velocity_r: saturate(set.velocity * hli_scale),
+            command_acceleration_r: saturate(set.acceleration * 1000.0),
+            following_error_r: saturate(self.following_error * hli_scale),
+            axis_state_r: self.motion_state(set).raw(),
+            coupling_state_r: self
+                .coupling
+                .map_or(CouplingState::Uncoupled, |c| c.kind)
+                .raw(),
+            master_axis_r: self.coupling.map_or(-1, |c| c.master),
+            error_id_r: self.error.map_or(0, AxisError::raw),
+            status_r: status,
+            fill_up_1: 0,
+        };
+        AxisOutputs {
+            lr_state,
+            drive_out,
+            enc_out,
+            command_state: self.book.image(),
+        }
+    }
+
+    /// `nAxisState`: the slave phase while coupled, else the master state of the set-point.
+    pub fn motion_state(&self, set: Kinematic) -> AxisState {
+        if let Some(c) = self.coupling {
+            return c.phase;
+        }
+        if !self.enabled || self.error.is_some() {
+            return AxisState::Inactive;
+        }
+        if set.velocity == 0.0 && set.acceleration == 0.0 {
+            return AxisState::Standstill;
+        }
+        let trend = set.acceleration * set.velocity;
+        if trend > 0.0 || (set.velocity == 0.0 && set.acceleration != 0.0) {
+            AxisState::Accelerating
+        } else if trend < 0.0 {
+            AxisState::Decelerating
+        } else {
+            AxisState::ConstantVelocity
+        }
+    }
+}

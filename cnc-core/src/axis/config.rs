@@ -1,0 +1,275 @@
+//! Configuration of an axis: identity, kind, scaling, limits, dynamics, control and drive.
+
+use super::increments::CounterWidth;
+use super::sim_drive::SimDriveConfig;
+use serde::{Deserialize, Serialize};
+
+/// Linear or rotary.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "type")]
+pub enum AxisKind {
+    /// A linear axis in mm.
+    Linear,
+    /// A rotary axis in degree. With `modulo > 0` it turns endlessly: its displayed positions
+    /// wrap into `[0, modulo)` and it has no software limits.
+    Rotary {
+        /// Modulo period in degree, 0 for none.
+        modulo: f64,
+    },
+}
+
+/// How the drive takes its set-point (`nOutData1`/`nOutData2`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DriveMode {
+    /// Cyclic position: the set position in increments (wrapping like the encoder).
+    Position,
+    /// Cyclic velocity: the total velocity (feed-forward + position controller) in
+    /// velocity increments.
+    #[default]
+    Velocity,
+    /// Universal drive: signed total velocity in `nOutData1`, its magnitude in `nOutData2`.
+    Universal,
+}
+
+/// Where the process image goes.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "type")]
+pub enum DriveLink {
+    /// The built-in simulation closes the loop through the image.
+    Simulated(SimDriveConfig),
+    /// Something else (a field-bus task, a test) writes the inputs.
+    External,
+}
+
+/// The limits of an axis and the defaults of its moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Dynamics {
+    /// Maximum velocity, units/s.
+    pub velocity: f64,
+    /// Maximum acceleration, units/s^2.
+    pub acceleration: f64,
+    /// Maximum deceleration, units/s^2.
+    pub deceleration: f64,
+    /// Maximum jerk, units/s^3.
+    pub jerk: f64,
+}
+
+/// Everything that configures an axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AxisConfig {
+    /// Name (`X`, `Table`).
+    pub name: String,
+    /// Id of the axis (1-based, as in the PLC's axis references).
+    pub id: u32,
+    /// Linear or rotary.
+    pub kind: AxisKind,
+    /// Encoder scaling: increments per mm (or per degree).
+    pub increments_per_unit: f64,
+    /// Width of the encoder counter.
+    #[serde(default)]
+    pub encoder_width: CounterWidth,
+    /// How the drive takes its set-point.
+    #[serde(default)]
+    pub drive_mode: DriveMode,
+    /// Output scaling of velocity: velocity increments per unit/s.
+    pub velocity_increments_per_unit: f64,
+    /// Output scaling of acceleration (`nOutData3`): increments per unit/s^2.
+    pub acceleration_increments_per_unit: f64,
+    /// Software limits `[min, max]`, none when absent.
+    pub soft_limits: Option<[f64; 2]>,
+    /// Limits of every move.
+    pub dynamics: Dynamics,
+    /// Largest |set - actual| before the axis stops with an error, units.
+    pub following_error_limit: f64,
+    /// Window around the target within which a move counts as in target, units.
+    pub in_target_window: f64,
+    /// Proportional gain of the position controller (Kv), 1/s.
+    pub position_gain: f64,
+    /// Velocity feed-forward weight, 0..=1.
+    pub feed_forward: f64,
+    /// Simulated or external drive.
+    pub drive: DriveLink,
+}
+
+/// A configuration value out of its range.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("axis {axis}: {field} = {value} is invalid: {reason}")]
+pub struct ConfigError {
+    /// Axis name.
+    pub axis: String,
+    /// Which setting.
+    pub field: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// What it must be.
+    pub reason: &'static str,
+}
+
+impl AxisConfig {
+    /// A linear axis `name` with a simulated ideal drive and moderate dynamics (a typical
+    /// machine-tool axis: 1 m/s, 10 m/s^2, 0.1 um resolution).
+    pub fn linear(name: &str, id: u32) -> Self {
+        Self {
+            name: name.into(),
+            id,
+            kind: AxisKind::Linear,
+            increments_per_unit: 10_000.0,
+            encoder_width: CounterWidth::Bits32,
+            drive_mode: DriveMode::Velocity,
+            velocity_increments_per_unit: 10_000.0,
+            acceleration_increments_per_unit: 1_000.0,
+            soft_limits: Some([-1000.0, 1000.0]),
+            dynamics: Dynamics {
+                velocity: 1000.0,
+                acceleration: 10_000.0,
+                deceleration: 10_000.0,
+                jerk: 200_000.0,
+            },
+            following_error_limit: 5.0,
+            in_target_window: 0.001,
+            position_gain: 50.0,
+            feed_forward: 1.0,
+            drive: DriveLink::Simulated(SimDriveConfig::default()),
+        }
+    }
+
+    /// A rotary axis `name` turning endlessly (modulo 360).
+    pub fn rotary(name: &str, id: u32) -> Self {
+        Self {
+            kind: AxisKind::Rotary { modulo: 360.0 },
+            soft_limits: None,
+            dynamics: Dynamics {
+                velocity: 3600.0,
+                acceleration: 36_000.0,
+                deceleration: 36_000.0,
+                jerk: 720_000.0,
+            },
+            ..Self::linear(name, id)
+        }
+    }
+
+    fn check(
+        &self,
+        field: &'static str,
+        value: f64,
+        ok: bool,
+        reason: &'static str,
+    ) -> Result<(), ConfigError> {
+        if ok && value.is_finite() {
+            Ok(())
+        } else {
+            Err(ConfigError {
+                axis: self.name.clone(),
+                field,
+                value,
+                reason,
+            })
+        }
+    }
+
+    /// Checks every value; the first one out of range is the error.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let positive = "must be a finite number above 0";
+        self.check(
+            "increments_per_unit",
+            self.increments_per_unit,
+            self.increments_per_unit > 0.0,
+            positive,
+        )?;
+        self.check(
+            "velocity_increments_per_unit",
+            self.velocity_increments_per_unit,
+            self.velocity_increments_per_unit > 0.0,
+            positive,
+        )?;
+        self.check(
+            "acceleration_increments_per_unit",
+            self.acceleration_increments_per_unit,
+            self.acceleration_increments_per_unit > 0.0,
+            positive,
+        )?;
+        let d = self.dynamics;
+        self.check("dynamics.velocity", d.velocity, d.velocity > 0.0, positive)?;
+        self.check(
+            "dynamics.acceleration",
+            d.acceleration,
+            d.acceleration > 0.0,
+            positive,
+        )?;
+        self.check(
+            "dynamics.deceleration",
+            d.deceleration,
+            d.deceleration > 0.0,
+            positive,
+        )?;
+        self.check("dynamics.jerk", d.jerk, d.jerk > 0.0, positive)?;
+        self.check(
+            "following_error_limit",
+            self.following_error_limit,
+            self.following_error_limit > 0.0,
+            positive,
+        )?;
+        self.check(
+            "in_target_window",
+            self.in_target_window,
+            self.in_target_window > 0.0,
+            positive,
+        )?;
+        self.check(
+            "position_gain",
+            self.position_gain,
+            self.position_gain >= 0.0,
+            "must be finite and not negative",
+        )?;
+        self.check(
+            "feed_forward",
+            self.feed_forward,
+            (0.0..=1.0).contains(&self.feed_forward),
+            "must lie in 0..=1",
+        )?;
+        if let AxisKind::Rotary { modulo } = self.kind {
+            self.check(
+                "kind.modulo",
+                modulo,
+                modulo >= 0.0,
+                "must be finite and not negative",
+            )?;
+            if modulo > 0.0 && self.soft_limits.is_some() {
+                return Err(ConfigError {
+                    axis: self.name.clone(),
+                    field: "soft_limits",
+                    value: modulo,
+                    reason: "an endless (modulo) axis has no software limits",
+                });
+            }
+        }
+        if let Some([min, max]) = self.soft_limits {
+            self.check(
+                "soft_limits[0]",
+                min,
+                min < max,
+                "must be below the upper limit",
+            )?;
+            self.check("soft_limits[1]", max, true, "must be finite")?;
+        }
+        if let DriveLink::Simulated(sim) = self.drive {
+            sim.validate()
+                .map_err(|(field, value, reason)| ConfigError {
+                    axis: self.name.clone(),
+                    field,
+                    value,
+                    reason,
+                })?;
+        }
+        Ok(())
+    }
+
+    /// The modulo period, when the axis turns endlessly.
+    pub fn modulo(&self) -> Option<f64> {
+        match self.kind {
+            AxisKind::Rotary { modulo } if modulo > 0.0 => Some(modulo),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,327 @@
+//! The jerk-limited set-point generator of one axis, on top of the Ruckig algorithm
+//! (`rsruckig`): time-optimal third-order profiles ("7 phases": jerk up, constant acceleration,
+//! jerk down, cruise, and the mirror image) from *any* current state, so a move can be
+//! re-targeted, sped up, slowed down or braked while it runs without a step in position,
+//! velocity or acceleration.
+//!
+//! Limits honoured on every tick: |v| <= the command's velocity, |j| <= its jerk, and the
+//! acceleration stays between -deceleration and +acceleration in the direction of travel (for
+//! a move towards negative positions the two swap). When a new command starts above its
+//! velocity limit, the generator first brakes within those limits. One exception keeps a
+//! re-target safe: if the current acceleration cannot be taken out with the new command's
+//! jerk before its velocity limit is passed, that move uses the axis's maximum jerk (see
+//! [`SetpointGenerator::set_jerk_ceiling`]); a state reached under the axis limits then never
+//! leads above the axis's maximum velocity.
+
+use rsruckig::prelude::*;
+
+/// Position, velocity, acceleration and jerk of a set-point.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Kinematic {
+    /// Position (mm or degree).
+    pub position: f64,
+    /// Velocity per second.
+    pub velocity: f64,
+    /// Acceleration per second squared.
+    pub acceleration: f64,
+    /// Jerk per second cubed.
+    pub jerk: f64,
+}
+
+/// The limits of one move, all strictly positive.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MoveLimits {
+    /// Velocity limit (or the velocity of a velocity move).
+    pub velocity: f64,
+    /// Acceleration limit.
+    pub acceleration: f64,
+    /// Deceleration limit.
+    pub deceleration: f64,
+    /// Jerk limit.
+    pub jerk: f64,
+}
+
+/// What the generator is doing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Goal {
+    /// Holding a position at rest.
+    Hold,
+    /// Moving to a position.
+    Position(f64),
+    /// Running at a signed velocity.
+    Velocity(f64),
+}
+
+/// What one step produced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress {
+    /// Standing still, nothing to do.
+    Idle,
+    /// On the way to the goal.
+    Moving,
+    /// The goal was reached this step (position reached, or velocity reached).
+    Reached,
+    /// Moving at the goal velocity.
+    AtVelocity,
+}
+
+/// The generator found no trajectory for the goal from the current state.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("set-point generator found no trajectory: {0}")]
+pub struct GeneratorError(pub String);
+
+/// Set-point generator of one axis.
+pub struct SetpointGenerator {
+    otg: Ruckig<1, ThrowErrorHandler>,
+    input: InputParameter<1>,
+    output: OutputParameter<1>,
+    state: Kinematic,
+    goal: Goal,
+    reached: bool,
+    jerk_ceiling: f64,
+}
+
+impl core::fmt::Debug for SetpointGenerator {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("SetpointGenerator")
+            .field("state", &self.state)
+            .field("goal", &self.goal)
+            .finish()
+    }
+}
+
+fn one(value: f64) -> DataArrayOrVec<f64, 1> {
+    DataArrayOrVec::Stack([value])
+}
+
+impl SetpointGenerator {
+    /// A generator holding `position`, stepping `cycle_s` seconds per tick.
+    pub fn new(cycle_s: f64, position: f64) -> Self {
+        let mut generator = Self {
+            otg: Ruckig::new(None, cycle_s),
+            input: InputParameter::new(None),
+            output: OutputParameter::new(None),
+            state: Kinematic::default(),
+            goal: Goal::Hold,
+            reached: true,
+            jerk_ceiling: 0.0,
+        };
+        generator.hold(position);
+        generator
+    }
+
+    /// The axis's maximum jerk: a re-target that cannot take the current acceleration out
+    /// with its own (smaller) jerk before passing its velocity limit uses this one instead,
+    /// so the axis never runs away from a command with gentler limits.
+    pub fn set_jerk_ceiling(&mut self, jerk: f64) {
+        self.jerk_ceiling = jerk;
+    }
+
+    /// The set-point of the last step.
+    pub fn state(&self) -> Kinematic {
+        self.state
+    }
+
+    /// The current goal.
+    pub fn goal(&self) -> Goal {
+        self.goal
+    }
+
+    /// Stops generating and holds `position` at rest (the axis is disabled or its set-point
+    /// follows the actual position).
+    pub fn hold(&mut self, position: f64) {
+        self.state = Kinematic {
+            position,
+            ..Kinematic::default()
+        };
+        self.goal = Goal::Hold;
+        self.reached = true;
+    }
+
+    /// Takes over a set-point produced elsewhere (a coupling that ends) and holds it until
+    /// the next goal; a following [`SetpointGenerator::run_at`] starts from its velocity and
+    /// acceleration without a step.
+    pub fn resume_from(&mut self, state: Kinematic) {
+        self.state = state;
+        self.goal = Goal::Hold;
+        self.reached = true;
+    }
+
+    /// Re-targets to `target` with `limits`, starting from the current set-point.
+    pub fn move_to(&mut self, target: f64, limits: MoveLimits) {
+        self.prepare(
+            ControlInterface::Position,
+            limits,
+            target - self.state.position,
+        );
+        self.input.target_position = one(target);
+        self.input.target_velocity = one(0.0);
+        self.goal = Goal::Position(target);
+    }
+
+    /// Re-targets to a constant signed `velocity` (|velocity| is `limits.velocity`' role here).
+    pub fn run_at(&mut self, velocity: f64, limits: MoveLimits) {
+        let limits = MoveLimits {
+            velocity: limits.velocity.max(velocity.abs()),
+            ..limits
+        };
+        self.prepare(ControlInterface::Velocity, limits, velocity);
+        self.input.target_velocity = one(velocity);
+        self.goal = Goal::Velocity(velocity);
+    }
+
+    /// Brakes to standstill with `deceleration` and `jerk` (MC_Halt, MC_Stop).
+    pub fn brake(&mut self, deceleration: f64, jerk: f64) {
+        let limits = MoveLimits {
+            velocity: self.state.velocity.abs().max(f64::MIN_POSITIVE),
+            acceleration: deceleration,
+            deceleration,
+            jerk,
+        };
+        self.prepare(ControlInterface::Velocity, limits, self.state.velocity);
+        self.input.target_velocity = one(0.0);
+        self.goal = Goal::Velocity(0.0);
+    }
+
+    fn prepare(&mut self, interface: ControlInterface, limits: MoveLimits, travel: f64) {
+        let s = self.state;
+        self.input.control_interface = interface;
+        self.input.current_position = one(s.position);
+        self.input.current_velocity = one(s.velocity);
+        self.input.current_acceleration = one(s.acceleration);
+        self.input.target_acceleration = one(0.0);
+        self.input.max_velocity = one(limits.velocity);
+        // Taking out an acceleration `a` with jerk `j` adds a^2 / 2j of velocity first.
+        let overshoot = if s.acceleration * s.velocity > 0.0 {
+            s.acceleration * s.acceleration / (2.0 * limits.jerk)
+        } else {
+            0.0
+        };
+        let jerk = if s.velocity.abs() + overshoot > limits.velocity {
+            limits.jerk.max(self.jerk_ceiling)
+        } else {
+            limits.jerk
+        };
+        self.input.max_jerk = one(jerk);
+        // Deceleration is the acceleration against the direction of travel.
+        let (up, down) = if travel >= 0.0 {
+            (limits.acceleration, limits.deceleration)
+        } else {
+            (limits.deceleration, limits.acceleration)
+        };
+        self.input.max_acceleration = one(up);
+        self.input.min_acceleration = Some(one(-down));
+        self.reached = false;
+    }
+
+    fn min_acceleration(&self) -> f64 {
+        self.input
+            .min_acceleration
+            .as_ref()
+            .map_or(-self.input.max_acceleration[0], |m| m[0])
+    }
+
+    fn asymmetric(&self) -> bool {
+        self.input.max_acceleration[0] != -self.min_acceleration()
+    }
+
+    /// Advances one tick.
+    pub fn step(&mut self) -> Result<Progress, GeneratorError> {
+        if self.goal == Goal::Hold {
+            return Ok(Progress::Idle);
+        }
+        let result = match self.otg.update(&self.input, &mut self.output) {
+            Ok(r) => r,
+            Err(_) if self.asymmetric() => {
+                // rsruckig 3.0.1 finds no profile for some asymmetric acceleration limits
+                // (0 -> 25 with +5000/-4000, say). The smaller of the two in both directions
+                // honours both limits, at the cost of a slightly longer move.
+                let smaller = self.input.max_acceleration[0].min(-self.min_acceleration());
+                self.input.max_acceleration = one(smaller);
+                self.input.min_acceleration = Some(one(-smaller));
+                self.otg
+                    .update(&self.input, &mut self.output)
+                    .map_err(|e| GeneratorError(e.to_string()))?
+            }
+            Err(e) => return Err(GeneratorError(e.to_string())),
+        };
+        let finished = match result {
+            RuckigResult::Working => false,
+            RuckigResult::Finished => true,
+            other => return Err(GeneratorError(format!("{other:?}"))),
+        };
+        self.output.pass_to_input(&mut self.input);
+        self.state = Kinematic {
+            position: self.output.new_position[0],
+            velocity: self.output.new_velocity[0],
+            acceleration: self.output.new_acceleration[0],
+            jerk: self.output.new_jerk[0],
+        };
+        if !finished {
+            return Ok(Progress::Moving);
+        }
+        let first = !self.reached;
+        self.reached = true;
+        match self.goal {
+            Goal::Position(target) => {
+                // Land exactly: the profile ends on the target at rest.
+                self.hold(target);
+                Ok(Progress::Reached)
+            }
+            Goal::Velocity(0.0) => {
+                let position = self.state.position;
+                self.hold(position);
+                Ok(Progress::Reached)
+            }
+            Goal::Velocity(v) => {
+                // Cruise: constant velocity from here on, integrated exactly.
+                self.state.acceleration = 0.0;
+                self.state.jerk = 0.0;
+                self.state.velocity = v;
+                Ok(if first {
+                    Progress::Reached
+                } else {
+                    Progress::AtVelocity
+                })
+            }
+            Goal::Hold => Ok(Progress::Idle),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(from: f64, to: f64, l: MoveLimits) -> Result<usize, GeneratorError> {
+        let mut g = SetpointGenerator::new(0.001, from);
+        g.move_to(to, l);
+        let mut n = 0;
+        while g.step()? != Progress::Reached {
+            n += 1;
+            assert!(n < 100_000);
+        }
+        Ok(n)
+    }
+
+    #[test]
+    fn asymmetric_limits_that_trip_the_library_still_move() {
+        let l = MoveLimits {
+            velocity: 500.0,
+            acceleration: 5000.0,
+            deceleration: 4000.0,
+            jerk: 100_000.0,
+        };
+        for (a, b) in [
+            (0.0, -15.0),
+            (10.0, -15.0),
+            (10.0, 0.0),
+            (0.0, 25.0),
+            (-15.0, 10.0),
+            (0.0, -25.0),
+            (0.0, -100.0),
+        ] {
+            assert!(run(a, b, l).is_ok(), "{a} -> {b}");
+        }
+    }
+}

@@ -1,0 +1,168 @@
+//! All axes of the CNC bound to the HLI image: the cyclic tick and the handler of the PLC's
+//! axis commands.
+
+use super::axis::Axis;
+use super::config::{AxisConfig, ConfigError, DriveLink};
+use super::sim_drive::{SimScaling, SimulatedDrive};
+use core::mem::offset_of;
+use hli::layout::{
+    HliAxis, HliAxisCommandState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
+    HLI_MAX_AXES,
+};
+use hli::rpc::{
+    decode_body, reply, AcyclicRequest, AxisCommandCall, AxisCommandReply, ErrorCode, HandlerResult,
+};
+use hli::views::CncView;
+use hli::PlaceExt;
+
+/// Why a set of axes cannot be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AxisSetError {
+    /// More axes than the image holds.
+    #[error("{0} axes configured, the image holds at most {HLI_MAX_AXES}")]
+    TooMany(usize),
+    /// A value out of range.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// Two axes share a name or id.
+    #[error("axis {0:?} is configured twice (name or id)")]
+    Duplicate(String),
+}
+
+/// The axes with their simulated drives.
+#[derive(Debug)]
+pub struct AxisSet {
+    axes: Vec<Axis>,
+    drives: Vec<Option<SimulatedDrive>>,
+}
+
+impl AxisSet {
+    /// Builds the axes (validating every configuration) for a tick of `cycle_s` seconds.
+    pub fn new(configs: Vec<AxisConfig>, cycle_s: f64) -> Result<Self, AxisSetError> {
+        if configs.len() > HLI_MAX_AXES {
+            return Err(AxisSetError::TooMany(configs.len()));
+        }
+        for (i, c) in configs.iter().enumerate() {
+            c.validate()?;
+            if configs[..i]
+                .iter()
+                .any(|o| o.name == c.name || o.id == c.id)
+            {
+                return Err(AxisSetError::Duplicate(c.name.clone()));
+            }
+        }
+        let drives = configs
+            .iter()
+            .map(|c| match c.drive {
+                DriveLink::Simulated(sim) => Some(SimulatedDrive::new(
+                    sim,
+                    SimScaling {
+                        increments_per_unit: c.increments_per_unit,
+                        velocity_increments_per_unit: c.velocity_increments_per_unit,
+                        acceleration_increments_per_unit: c.acceleration_increments_per_unit,
+                        width: c.encoder_width,
+                        mode: c.drive_mode,
+                    },
+                    cycle_s,
+                )),
+                DriveLink::External => None,
+            })
+            .collect();
+        let axes = configs.into_iter().map(|c| Axis::new(c, cycle_s)).collect();
+        Ok(Self { axes, drives })
+    }
+
+    /// Number of axes.
+    pub fn len(&self) -> usize {
+        self.axes.len()
+    }
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.axes.is_empty()
+    }
+    /// Axis `i`.
+    pub fn axis(&self, i: usize) -> Option<&Axis> {
+        self.axes.get(i)
+    }
+    /// Axis `i`, mutable (for couplings and tests).
+    pub fn axis_mut(&mut self, i: usize) -> Option<&mut Axis> {
+        self.axes.get_mut(i)
+    }
+    /// The simulated drive of axis `i`, if it has one.
+    pub fn drive_mut(&mut self, i: usize) -> Option<&mut SimulatedDrive> {
+        self.drives.get_mut(i).and_then(Option::as_mut)
+    }
+    /// Index of the axis named `name`.
+    pub fn index_of(&self, name: &str) -> Option<usize> {
+        self.axes.iter().position(|a| a.config().name == name)
+    }
+
+    /// Writes the simulated encoders' first readings into the image (before the first tick).
+    pub fn prime(&self, view: &CncView<'_>) {
+        for (i, drive) in self.drives.iter().enumerate() {
+            if let (Some(drive), Ok(place)) = (drive, view.axis(i)) {
+                place
+                    .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
+                    .write(&drive.encoder_in());
+                place
+                    .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
+                    .write(&bytemuck::Zeroable::zeroed());
+            }
+        }
+    }
+
+    /// One tick of every axis against the image. Does not allocate.
+    pub fn tick(&mut self, view: &CncView<'_>) {
+        for (i, (axis, drive)) in self.axes.iter_mut().zip(self.drives.iter_mut()).enumerate() {
+            let Ok(place) = view.axis(i) else { continue };
+            let enc_in: NcEncoderIn = place
+                .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
+                .read();
+            let drive_in: NcDriveIn = place
+                .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
+                .read();
+            let out = axis.tick(&enc_in, &drive_in);
+            place
+                .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
+                .write(&out.lr_state);
+            place
+                .field::<NcDriveOut>(offset_of!(HliAxis, drive_out))
+                .write(&out.drive_out);
+            place
+                .field::<NcEncoderOut>(offset_of!(HliAxis, enc_out))
+                .write(&out.enc_out);
+            place
+                .field::<HliAxisCommandState>(offset_of!(HliAxis, command_state))
+                .write(&out.command_state);
+            if let Some(drive) = drive {
+                let drive_in = drive.step(&out.drive_out);
+                place
+                    .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
+                    .write(&drive_in);
+                place
+                    .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
+                    .write(&drive.encoder_in());
+            }
+        }
+    }
+
+    /// Answers an [`AxisCommandCall`] addressed to axis `request.target`.
+    pub fn handle_command(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: AxisCommandCall = decode_body(request)?;
+        let axis = self
+            .axes
+            .get_mut(request.target as usize)
+            .ok_or(ErrorCode::InvalidTarget)?;
+        let answer = match axis.command(&call) {
+            Ok(command_id) => AxisCommandReply {
+                command_id,
+                error_id: 0,
+            },
+            Err(e) => AxisCommandReply {
+                command_id: 0,
+                error_id: e.raw(),
+            },
+        };
+        reply(&answer)
+    }
+}

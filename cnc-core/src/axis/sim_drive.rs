@@ -1,0 +1,252 @@
+//! The simulated drive and encoder: the embedded default in place of hardware. It reads the
+//! drive outputs of the process image, moves a model motor with a configurable dynamic and
+//! writes the encoder (and drive) inputs back, so the whole chain set-point -> increments ->
+//! drive -> encoder -> overflow counting -> position controller runs as with a real axis.
+
+use super::config::DriveMode;
+use super::increments::{CounterWidth, IncrementCounter};
+use hli::layout::{NcDriveIn, NcDriveOut, NcEncoderIn};
+use serde::{Deserialize, Serialize};
+
+/// Longest dead time the simulation holds, in ticks.
+pub const MAX_DEAD_TIME_TICKS: u32 = 64;
+
+/// How the motor answers its command.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case", tag = "type")]
+pub enum Dynamic {
+    /// Follows the command exactly.
+    #[default]
+    Ideal,
+    /// First-order lag with time constant `t1_s`.
+    Pt1 {
+        /// Time constant in seconds.
+        t1_s: f64,
+    },
+    /// Second-order lag with natural frequency and damping.
+    Pt2 {
+        /// Natural frequency in Hz.
+        frequency_hz: f64,
+        /// Damping ratio (1 = critically damped).
+        damping: f64,
+    },
+}
+
+/// Configuration of a simulated drive.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+pub struct SimDriveConfig {
+    /// The motor's answer to its command (to the velocity in velocity modes, to the position
+    /// in position mode).
+    #[serde(default)]
+    pub dynamic: Dynamic,
+    /// Ticks between the command and the motor seeing it.
+    #[serde(default)]
+    pub dead_time_ticks: u32,
+    /// Position of the motor at start, units.
+    #[serde(default)]
+    pub start_position: f64,
+}
+
+impl SimDriveConfig {
+    /// Checks the values: `(field, value, reason)` of the first bad one.
+    pub fn validate(&self) -> Result<(), (&'static str, f64, &'static str)> {
+        match self.dynamic {
+            Dynamic::Ideal => {}
+            Dynamic::Pt1 { t1_s } if !(t1_s > 0.0 && t1_s.is_finite()) => {
+                return Err((
+                    "drive.dynamic.t1_s",
+                    t1_s,
+                    "must be a finite number above 0",
+                ))
+            }
+            Dynamic::Pt2 {
+                frequency_hz,
+                damping,
+            } => {
+                if !(frequency_hz > 0.0 && frequency_hz.is_finite()) {
+                    return Err((
+                        "drive.dynamic.frequency_hz",
+                        frequency_hz,
+                        "must be a finite number above 0",
+                    ));
+                }
+                if !(damping > 0.0 && damping.is_finite()) {
+                    return Err((
+                        "drive.dynamic.damping",
+                        damping,
+                        "must be a finite number above 0",
+                    ));
+                }
+            }
+            Dynamic::Pt1 { .. } => {}
+        }
+        if self.dead_time_ticks > MAX_DEAD_TIME_TICKS {
+            return Err((
+                "drive.dead_time_ticks",
+                f64::from(self.dead_time_ticks),
+                "must be at most 64",
+            ));
+        }
+        if !self.start_position.is_finite() {
+            return Err((
+                "drive.start_position",
+                self.start_position,
+                "must be finite",
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Scaling the simulation shares with the axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimScaling {
+    /// Encoder increments per unit.
+    pub increments_per_unit: f64,
+    /// Velocity increments per unit/s.
+    pub velocity_increments_per_unit: f64,
+    /// Acceleration increments per unit/s^2.
+    pub acceleration_increments_per_unit: f64,
+    /// Encoder counter width.
+    pub width: CounterWidth,
+    /// How the drive reads its set-point.
+    pub mode: DriveMode,
+}
+
+/// A simulated drive with its encoder.
+#[derive(Debug, Clone)]
+pub struct SimulatedDrive {
+    config: SimDriveConfig,
+    scaling: SimScaling,
+    dt: f64,
+    /// Motor position, velocity and acceleration.
+    position: f64,
+    velocity: f64,
+    acceleration: f64,
+    /// Rate of the quantity a PT2 follows (its own state).
+    pt2_rate: f64,
+    /// The command as the drive sees it, delayed.
+    delay: [f64; MAX_DEAD_TIME_TICKS as usize + 1],
+    delay_head: usize,
+    /// Unwraps the position set-point of a position-mode drive.
+    set_counter: IncrementCounter,
+    /// Fault injection: report I/O data invalid on the encoder or drive.
+    pub encoder_io_invalid: bool,
+    /// Fault injection: report I/O data invalid on the drive.
+    pub drive_io_invalid: bool,
+}
+
+impl SimulatedDrive {
+    /// A drive standing at its configured start position.
+    pub fn new(config: SimDriveConfig, scaling: SimScaling, cycle_s: f64) -> Self {
+        let start_command = match scaling.mode {
+            DriveMode::Position => config.start_position,
+            DriveMode::Velocity | DriveMode::Universal => 0.0,
+        };
+        Self {
+            config,
+            scaling,
+            dt: cycle_s,
+            position: config.start_position,
+            velocity: 0.0,
+            acceleration: 0.0,
+            pt2_rate: 0.0,
+            delay: [start_command; MAX_DEAD_TIME_TICKS as usize + 1],
+            delay_head: 0,
+            set_counter: IncrementCounter::new(scaling.width),
+            encoder_io_invalid: false,
+            drive_io_invalid: false,
+        }
+    }
+
+    /// The motor's true position.
+    pub fn position(&self) -> f64 {
+        self.position
+    }
+
+    /// The motor's true velocity.
+    pub fn velocity(&self) -> f64 {
+        self.velocity
+    }
+
+    /// The encoder inputs of the motor's current position (what the NC reads next tick).
+    pub fn encoder_in(&self) -> NcEncoderIn {
+        let count = (self.position * self.scaling.increments_per_unit).round() as i64;
+        NcEncoderIn {
+            nInData1: self.scaling.width.wrap(count),
+            nStatus4: u8::from(self.encoder_io_invalid),
+            ..bytemuck::Zeroable::zeroed()
+        }
+    }
+
+    /// Takes the drive outputs of this tick, advances the motor one tick and returns the drive
+    /// inputs.
+    pub fn step(&mut self, out: &NcDriveOut) -> NcDriveIn {
+        let command = match self.scaling.mode {
+            DriveMode::Position => {
+                self.set_counter.update(out.nOutData1) as f64 / self.scaling.increments_per_unit
+            }
+            DriveMode::Velocity | DriveMode::Universal => {
+                f64::from(out.nOutData1) / self.scaling.velocity_increments_per_unit
+            }
+        };
+        // Dead time: the command enters a ring and leaves `dead_time_ticks` later.
+        let len = self.config.dead_time_ticks as usize + 1;
+        self.delay[self.delay_head] = command;
+        self.delay_head = (self.delay_head + 1) % len;
+        let seen = self.delay[self.delay_head];
+        let before = self.velocity;
+        match self.scaling.mode {
+            DriveMode::Position => {
+                let old = self.position;
+                self.position = self.follow(self.position, seen);
+                self.velocity = (self.position - old) / self.dt;
+            }
+            DriveMode::Velocity | DriveMode::Universal => {
+                self.velocity = self.follow(self.velocity, seen);
+                self.position += self.velocity * self.dt;
+            }
+        }
+        self.acceleration = (self.velocity - before) / self.dt;
+        let following = match self.scaling.mode {
+            DriveMode::Position => {
+                ((seen - self.position) * self.scaling.increments_per_unit).round() as i32
+            }
+            _ => 0,
+        };
+        NcDriveIn {
+            nInData1: following,
+            nStatus4: u8::from(self.drive_io_invalid),
+            nInData3: (self.acceleration * self.scaling.acceleration_increments_per_unit)
+                .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            ..bytemuck::Zeroable::zeroed()
+        }
+    }
+
+    /// One tick of the dynamic from `value` towards `command`.
+    fn follow(&mut self, value: f64, command: f64) -> f64 {
+        match self.config.dynamic {
+            Dynamic::Ideal => command,
+            Dynamic::Pt1 { t1_s } => {
+                let alpha = 1.0 - (-self.dt / t1_s).exp();
+                value + alpha * (command - value)
+            }
+            Dynamic::Pt2 {
+                frequency_hz,
+                damping,
+            } => {
+                // Semi-implicit Euler in 8 sub-steps: stable for w*h < 2.
+                let w = 2.0 * core::f64::consts::PI * frequency_hz;
+                let h = self.dt / 8.0;
+                let mut x = value;
+                let mut rate = self.pt2_rate;
+                for _ in 0..8 {
+                    rate += h * (w * w * (command - x) - 2.0 * damping * w * rate);
+                    x += h * rate;
+                }
+                self.pt2_rate = rate;
+                x
+            }
+        }
+    }
+}

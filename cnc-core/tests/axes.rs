@@ -1,0 +1,709 @@
+//! The axis layer against its contract: PTP moves within their limits, halt and stop, the
+//! process image (increments, wraps, direction bits, drive modes), following error, I/O faults
+//! and refused commands.
+
+use cnc_core::axis::commands::{view_command, CommandView};
+use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
+use cnc_core::axis::generator::Kinematic;
+use cnc_core::axis::increments::CounterWidth;
+use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
+use cnc_core::axis::{AxisSet, Coupling};
+use hli::enums::{AxisError, AxisState, CouplingState, DirectionBits};
+use hli::layout::{HliAxis, NcDriveOut, NcEncoderIn};
+use hli::raw::ImageMemory;
+use hli::rpc::AxisCommandCall;
+use hli::views::CncView;
+use hli::PlaceExt;
+use proptest::prelude::*;
+
+const CYCLE: f64 = 0.001;
+
+struct Rig {
+    memory: ImageMemory,
+    set: AxisSet,
+}
+
+impl Rig {
+    fn new(configs: Vec<AxisConfig>) -> Self {
+        let memory = hli::segment::heap_image(1, configs.len() as u32);
+        let set = AxisSet::new(configs, CYCLE).unwrap();
+        set.prime(&CncView::new(&memory));
+        Self { memory, set }
+    }
+    fn tick(&mut self) {
+        self.set.tick(&CncView::new(&self.memory));
+    }
+    fn ticks(&mut self, n: usize) {
+        for _ in 0..n {
+            self.tick();
+        }
+    }
+    fn call(&mut self, axis: usize, call: AxisCommandCall) -> Result<u32, AxisError> {
+        self.set.axis_mut(axis).unwrap().command(&call)
+    }
+    fn enable(&mut self, axis: usize) {
+        self.tick();
+        self.call(axis, AxisCommandCall::power(true)).unwrap();
+    }
+    fn set_point(&self, axis: usize) -> Kinematic {
+        self.set.axis(axis).unwrap().setpoint()
+    }
+    fn view(&self, axis: usize, id: u32) -> CommandView {
+        view_command(&self.set.axis(axis).unwrap().book().image(), id)
+    }
+    fn drive_out(&self, axis: usize) -> NcDriveOut {
+        CncView::new(&self.memory)
+            .axis(axis)
+            .unwrap()
+            .field::<NcDriveOut>(core::mem::offset_of!(HliAxis, drive_out))
+            .read()
+    }
+    fn enc_in(&self, axis: usize) -> NcEncoderIn {
+        CncView::new(&self.memory)
+            .axis(axis)
+            .unwrap()
+            .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in))
+            .read()
+    }
+    /// Ticks until `done` or a watchdog of `max` ticks (a hang fails the test, it does not
+    /// time it).
+    fn until(&mut self, max: usize, mut done: impl FnMut(&Self) -> bool) -> usize {
+        for n in 0..max {
+            if done(self) {
+                return n;
+            }
+            self.tick();
+        }
+        panic!("watchdog: condition not met within {max} ticks");
+    }
+}
+
+const LIMITS: [f64; 4] = [500.0, 5000.0, 4000.0, 100_000.0];
+
+#[test]
+fn move_absolute_reaches_its_target_exactly_and_reports_done() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let id = rig
+        .call(0, AxisCommandCall::move_absolute(123.456, LIMITS))
+        .unwrap();
+    assert_eq!(rig.view(0, id), CommandView::Busy(false));
+    rig.until(5_000, |r| r.view(0, id) == CommandView::Done);
+    let axis = rig.set.axis(0).unwrap();
+    assert_eq!(axis.setpoint().position, 123.456);
+    assert!(
+        (axis.actual() - 123.456).abs() < 1e-4,
+        "actual {}",
+        axis.actual()
+    );
+    let lr = CncView::new(&rig.memory)
+        .axis(0)
+        .unwrap()
+        .field::<hli::layout::HliAxisLrState>(0)
+        .read();
+    assert_eq!(lr.command_position_acs_r, 1_234_560);
+    assert_eq!(lr.axis_state_r, AxisState::Standstill.raw());
+}
+
+#[test]
+fn move_relative_counts_from_the_set_position() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let a = rig
+        .call(0, AxisCommandCall::move_absolute(10.0, LIMITS))
+        .unwrap();
+    rig.until(5_000, |r| r.view(0, a) == CommandView::Done);
+    let b = rig
+        .call(0, AxisCommandCall::move_relative(-25.0, LIMITS))
+        .unwrap();
+    rig.until(5_000, |r| r.view(0, b) == CommandView::Done);
+    assert_eq!(rig.set_point(0).position, -15.0);
+}
+
+/// Checks one tick of a set-point against the limits of a move in direction `sign`.
+fn within(k: Kinematic, l: [f64; 4], sign: f64) -> Result<(), String> {
+    let eps = 1e-6;
+    let [v, acc, dec, jerk] = l;
+    let (up, down) = if sign >= 0.0 { (acc, dec) } else { (dec, acc) };
+    if k.velocity.abs() > v * (1.0 + eps) {
+        return Err(format!("velocity {} above {v}", k.velocity));
+    }
+    if k.acceleration > up * (1.0 + eps) || k.acceleration < -down * (1.0 + eps) {
+        return Err(format!(
+            "acceleration {} outside [-{down}, {up}]",
+            k.acceleration
+        ));
+    }
+    if k.jerk.abs() > jerk * (1.0 + eps) {
+        return Err(format!("jerk {} above {jerk}", k.jerk));
+    }
+    Ok(())
+}
+
+/// A generous tick budget for a move of `distance` under `limits` (a watchdog, not a bound).
+fn budget(distance: f64, [v, a, d, j]: [f64; 4]) -> usize {
+    let seconds = distance / v + 2.0 * v / a.min(d) + 4.0 * a.max(d) / j + 1.0;
+    (2.0 * seconds / CYCLE) as usize
+}
+
+fn limits_strategy() -> impl Strategy<Value = [f64; 4]> {
+    (
+        20.0..1000.0f64,
+        50.0..10_000.0f64,
+        50.0..10_000.0f64,
+        1_000.0..200_000.0f64,
+    )
+        .prop_map(|(v, a, d, j)| [v, a, d, j])
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// A move from rest never leaves its velocity, acceleration/deceleration and jerk limits,
+    /// and lands exactly on the target.
+    #[test]
+    fn a_move_stays_within_its_limits(target in -900.0..900.0f64, limits in limits_strategy()) {
+        let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+        rig.enable(0);
+        let id = rig.call(0, AxisCommandCall::move_absolute(target, limits)).unwrap();
+        let sign = target.signum();
+        for _ in 0..budget(1800.0, limits) {
+            rig.tick();
+            let k = rig.set_point(0);
+            within(k, limits, sign).map_err(TestCaseError::fail)?;
+            if rig.view(0, id) == CommandView::Done { break; }
+        }
+        prop_assert_eq!(rig.view(0, id), CommandView::Done);
+        prop_assert_eq!(rig.set_point(0).position, target);
+    }
+
+    /// Re-targeting while moving (new targets and new limits at random ticks) keeps the
+    /// set-point continuous and within the axis's maximum dynamics, and the last move lands.
+    #[test]
+    fn retargets_stay_within_the_axis_limits(
+        moves in proptest::collection::vec((-900.0..900.0f64, limits_strategy(), 1usize..400), 1..6)
+    ) {
+        let config = AxisConfig::linear("X", 1);
+        let d = config.dynamics;
+        let max = [d.velocity, d.acceleration.max(d.deceleration), d.acceleration.max(d.deceleration), d.jerk];
+        let mut rig = Rig::new(vec![config]);
+        rig.enable(0);
+        let mut last = None;
+        let mut before = rig.set_point(0);
+        for (target, limits, after) in &moves {
+            let id = rig.call(0, AxisCommandCall::move_absolute(*target, *limits)).unwrap();
+            last = Some((id, *target));
+            for _ in 0..*after {
+                rig.tick();
+                let k = rig.set_point(0);
+                within(k, max, 1.0).map_err(TestCaseError::fail)?;
+                // Continuity: no position step beyond what the velocity explains.
+                prop_assert!((k.position - before.position).abs() <= max[0] * CYCLE * 1.0001);
+                before = k;
+            }
+        }
+        let (id, target) = last.unwrap();
+        let slowest = moves.last().unwrap().1;
+        rig.until(budget(3600.0, slowest), |r| r.view(0, id) == CommandView::Done);
+        prop_assert_eq!(rig.set_point(0).position, target);
+    }
+}
+
+#[test]
+fn halt_brakes_to_standstill_and_aborts_the_velocity_move() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let run = rig
+        .call(0, AxisCommandCall::move_velocity(1, LIMITS))
+        .unwrap();
+    rig.until(2_000, |r| r.view(0, run) == CommandView::Busy(true));
+    assert_eq!(rig.set_point(0).velocity, 500.0);
+    let halt = rig
+        .call(0, AxisCommandCall::halt(4000.0, 100_000.0))
+        .unwrap();
+    assert_eq!(rig.view(0, run), CommandView::Aborted);
+    let mut previous = rig.set_point(0).velocity;
+    rig.until(2_000, |r| r.view(0, halt) == CommandView::Done);
+    let mut ticks = 0;
+    while ticks < 10 {
+        rig.tick();
+        let v = rig.set_point(0).velocity;
+        assert!(v <= previous + 1e-9, "velocity rose while halted");
+        previous = v;
+        ticks += 1;
+    }
+    assert_eq!(rig.set_point(0).velocity, 0.0);
+    // After a halt the axis takes moves at once.
+    assert!(rig
+        .call(0, AxisCommandCall::move_absolute(0.0, LIMITS))
+        .is_ok());
+}
+
+#[test]
+fn stop_locks_the_axis_until_released() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let run = rig
+        .call(0, AxisCommandCall::move_velocity(-1, LIMITS))
+        .unwrap();
+    rig.ticks(50);
+    assert!(rig.set_point(0).velocity < 0.0);
+    let stop = rig
+        .call(0, AxisCommandCall::stop(4000.0, 100_000.0))
+        .unwrap();
+    assert_eq!(rig.view(0, run), CommandView::Aborted);
+    assert_eq!(
+        rig.call(0, AxisCommandCall::move_absolute(0.0, LIMITS)),
+        Err(AxisError::StopActive)
+    );
+    assert_eq!(
+        rig.call(0, AxisCommandCall::halt(4000.0, 100_000.0)),
+        Err(AxisError::StopActive)
+    );
+    rig.until(2_000, |r| r.view(0, stop) == CommandView::Busy(true));
+    assert_eq!(rig.set_point(0).velocity, 0.0);
+    rig.ticks(20);
+    assert_eq!(
+        rig.view(0, stop),
+        CommandView::Busy(true),
+        "held while Execute stays high"
+    );
+    rig.call(0, AxisCommandCall::stop_release()).unwrap();
+    rig.tick();
+    assert_eq!(rig.view(0, stop), CommandView::Done);
+    assert!(rig
+        .call(0, AxisCommandCall::move_absolute(0.0, LIMITS))
+        .is_ok());
+}
+
+#[test]
+fn direction_bits_follow_the_set_point_and_the_total_output() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    rig.tick();
+    assert_eq!(rig.drive_out(0).nCtrl2, DirectionBits::Stop.raw());
+    assert_eq!(rig.drive_out(0).nCtrl3, DirectionBits::Stop.raw());
+    let a = rig
+        .call(0, AxisCommandCall::move_absolute(50.0, LIMITS))
+        .unwrap();
+    rig.ticks(30);
+    assert_eq!(rig.drive_out(0).nCtrl2, 0x42);
+    assert_eq!(rig.drive_out(0).nCtrl3, 0x42);
+    assert!(rig.drive_out(0).nOutData1 > 0);
+    rig.until(5_000, |r| r.view(0, a) == CommandView::Done);
+    let b = rig
+        .call(0, AxisCommandCall::move_absolute(-50.0, LIMITS))
+        .unwrap();
+    rig.ticks(30);
+    assert_eq!(rig.drive_out(0).nCtrl2, 0x41);
+    assert_eq!(rig.drive_out(0).nCtrl3, 0x41);
+    assert!(rig.drive_out(0).nOutData1 < 0);
+    assert!(
+        rig.drive_out(0).nOutData3 != 0,
+        "set acceleration is output"
+    );
+    rig.until(5_000, |r| r.view(0, b) == CommandView::Done);
+    rig.tick();
+    assert_eq!(rig.drive_out(0).nCtrl2, 0x80);
+}
+
+#[test]
+fn universal_drive_outputs_signed_velocity_and_its_magnitude() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.drive_mode = DriveMode::Universal;
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    rig.call(0, AxisCommandCall::move_velocity(-1, LIMITS))
+        .unwrap();
+    rig.ticks(200);
+    let out = rig.drive_out(0);
+    assert!(out.nOutData1 < 0);
+    assert_eq!(out.nOutData2, -out.nOutData1);
+    assert_eq!(
+        out.nOutData1, -5_000_000,
+        "500 mm/s at 10000 increments per mm/s"
+    );
+}
+
+/// Runs a 16- or 32-bit encoder through many wraps forth and back; the actual position follows
+/// the set-point throughout and the encoder output mirrors the input.
+fn wraps(width: CounterWidth, increments_per_unit: f64, distance: f64, mode: DriveMode) {
+    let mut config = AxisConfig::linear("X", 1);
+    config.encoder_width = width;
+    config.increments_per_unit = increments_per_unit;
+    config.drive_mode = mode;
+    config.soft_limits = Some([-5000.0, 5000.0]);
+    let wrap_units = match width {
+        CounterWidth::Bits16 => 65_536.0,
+        CounterWidth::Bits32 => 4_294_967_296.0,
+    } / increments_per_unit;
+    assert!(
+        distance / wrap_units >= 4.0,
+        "the test must cross several wraps"
+    );
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    let limits = [1000.0, 10_000.0, 10_000.0, 200_000.0];
+    for target in [distance, -distance, 0.0] {
+        let id = rig
+            .call(0, AxisCommandCall::move_absolute(target, limits))
+            .unwrap();
+        let mut worst: f64 = 0.0;
+        rig.until(100_000, |r| {
+            let axis = r.set.axis(0).unwrap();
+            worst = worst.max(axis.following_error().abs());
+            let enc = r.enc_in(0);
+            let raw_ok = match width {
+                CounterWidth::Bits16 => (0..=65_535).contains(&enc.nInData1),
+                CounterWidth::Bits32 => true,
+            };
+            assert!(raw_ok);
+            r.view(0, id) == CommandView::Done
+        });
+        rig.ticks(50);
+        let axis = rig.set.axis(0).unwrap();
+        assert!(
+            (axis.actual() - target).abs() <= 1e-5,
+            "{width:?} {mode:?}: at {} for {target}",
+            axis.actual()
+        );
+        assert!(
+            worst < 1.0,
+            "following error {worst} (the controller lost the wraps)"
+        );
+        assert_eq!(axis.error(), None);
+    }
+}
+
+#[test]
+fn sixteen_bit_encoder_wraps_many_times_in_both_directions() {
+    wraps(CounterWidth::Bits16, 10_000.0, 100.0, DriveMode::Velocity);
+    wraps(CounterWidth::Bits16, 10_000.0, 100.0, DriveMode::Position);
+}
+
+#[test]
+fn thirty_two_bit_encoder_wraps_many_times_in_both_directions() {
+    wraps(CounterWidth::Bits32, 1.0e7, 2000.0, DriveMode::Velocity);
+    wraps(CounterWidth::Bits32, 1.0e7, 2000.0, DriveMode::Position);
+}
+
+fn lagging(limit: f64) -> AxisConfig {
+    let mut config = AxisConfig::linear("X", 1);
+    config.feed_forward = 0.0;
+    config.position_gain = 20.0;
+    config.following_error_limit = limit;
+    config.drive = DriveLink::Simulated(SimDriveConfig {
+        dynamic: Dynamic::Pt1 { t1_s: 0.02 },
+        dead_time_ticks: 3,
+        start_position: 0.0,
+    });
+    config
+}
+
+#[test]
+fn a_lagging_drive_builds_following_error_and_a_tight_limit_stops_the_axis() {
+    // Generous limit: the move completes with a following error about v / Kv.
+    let mut rig = Rig::new(vec![lagging(100.0)]);
+    rig.enable(0);
+    let id = rig
+        .call(0, AxisCommandCall::move_absolute(400.0, LIMITS))
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    rig.until(20_000, |r| {
+        worst = worst.max(r.set.axis(0).unwrap().following_error().abs());
+        r.view(0, id) == CommandView::Done
+    });
+    let steady = 500.0 / 20.0; // v / Kv
+    assert!(
+        worst > 0.8 * steady && worst < 1.5 * steady,
+        "following error {worst}, expected about {steady}"
+    );
+    rig.ticks(2_000);
+    assert!((rig.set.axis(0).unwrap().actual() - 400.0).abs() < 0.01);
+
+    // Tight limit: the axis stops with the following-error code on axis and command.
+    let mut rig = Rig::new(vec![lagging(5.0)]);
+    rig.enable(0);
+    let id = rig
+        .call(0, AxisCommandCall::move_absolute(400.0, LIMITS))
+        .unwrap();
+    rig.until(5_000, |r| r.set.axis(0).unwrap().error().is_some());
+    assert_eq!(
+        rig.set.axis(0).unwrap().error(),
+        Some(AxisError::FollowingError)
+    );
+    assert_eq!(rig.view(0, id), CommandView::Error(0x4240));
+    rig.tick();
+    assert_eq!(rig.drive_out(0).nOutData1, 0, "no output after the fault");
+    assert_eq!(rig.drive_out(0).nCtrl3, DirectionBits::Stop.raw());
+    assert_eq!(
+        rig.call(0, AxisCommandCall::move_absolute(0.0, LIMITS)),
+        Err(AxisError::AxisInError)
+    );
+    rig.call(0, AxisCommandCall::reset()).unwrap();
+    assert!(rig
+        .call(
+            0,
+            AxisCommandCall::move_absolute(0.0, [10.0, 100.0, 100.0, 1000.0])
+        )
+        .is_ok());
+}
+
+#[test]
+fn io_invalid_stops_the_axis_with_an_error_until_reset() {
+    for encoder in [true, false] {
+        let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+        rig.enable(0);
+        let id = rig
+            .call(0, AxisCommandCall::move_velocity(1, LIMITS))
+            .unwrap();
+        rig.ticks(100);
+        let drive = rig.set.drive_mut(0).unwrap();
+        if encoder {
+            drive.encoder_io_invalid = true;
+        } else {
+            drive.drive_io_invalid = true;
+        }
+        rig.ticks(2);
+        let expected = if encoder {
+            AxisError::EncoderIoInvalid
+        } else {
+            AxisError::DriveIoInvalid
+        };
+        assert_eq!(rig.set.axis(0).unwrap().error(), Some(expected));
+        assert_eq!(rig.view(0, id), CommandView::Error(expected.raw()));
+        rig.tick();
+        assert_eq!(rig.drive_out(0).nOutData1, 0);
+        assert_eq!(
+            rig.call(0, AxisCommandCall::reset()),
+            Err(AxisError::ResetRefused)
+        );
+        let drive = rig.set.drive_mut(0).unwrap();
+        drive.encoder_io_invalid = false;
+        drive.drive_io_invalid = false;
+        rig.ticks(2);
+        rig.call(0, AxisCommandCall::reset()).unwrap();
+        assert_eq!(rig.set.axis(0).unwrap().error(), None);
+    }
+}
+
+#[test]
+fn a_status_byte_that_is_neither_valid_nor_invalid_counts_as_invalid() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.drive = DriveLink::External;
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    let enc = CncView::new(&rig.memory)
+        .axis(0)
+        .unwrap()
+        .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in));
+    enc.write(&NcEncoderIn {
+        nStatus4: 7,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.tick();
+    assert_eq!(
+        rig.set.axis(0).unwrap().error(),
+        Some(AxisError::EncoderIoInvalid)
+    );
+}
+
+#[test]
+fn velocity_move_stops_on_the_software_limit() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.soft_limits = Some([-20.0, 20.0]);
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    let id = rig
+        .call(0, AxisCommandCall::move_velocity(1, LIMITS))
+        .unwrap();
+    let mut highest: f64 = 0.0;
+    rig.until(10_000, |r| {
+        highest = highest.max(r.set_point(0).position);
+        r.view(0, id) == CommandView::Error(AxisError::SoftwareLimitReached.raw())
+    });
+    rig.ticks(1_000);
+    highest = highest.max(rig.set_point(0).position);
+    assert_eq!(rig.set_point(0).position, 20.0);
+    assert!(highest <= 20.0, "overshot the limit to {highest}");
+}
+
+/// Bad commands are refused with their codes and leave a running move exactly as an
+/// undisturbed twin runs.
+#[test]
+fn bad_commands_are_refused_and_do_not_disturb_a_running_move() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1), AxisConfig::linear("Y", 2)]);
+    rig.enable(0);
+    rig.call(1, AxisCommandCall::power(true)).unwrap();
+    rig.call(0, AxisCommandCall::move_absolute(300.0, LIMITS))
+        .unwrap();
+    rig.call(1, AxisCommandCall::move_absolute(300.0, LIMITS))
+        .unwrap();
+    rig.ticks(100);
+    let nan = f64::NAN;
+    let refused = [
+        (
+            AxisCommandCall::move_absolute(5000.0, LIMITS),
+            AxisError::TargetOutsideLimits,
+        ),
+        (
+            AxisCommandCall::move_absolute(nan, LIMITS),
+            AxisError::TargetOutsideLimits,
+        ),
+        (
+            AxisCommandCall::move_relative(-2000.0, LIMITS),
+            AxisError::TargetOutsideLimits,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [0.0, 1.0, 1.0, 1.0]),
+            AxisError::InvalidVelocity,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [-5.0, 1.0, 1.0, 1.0]),
+            AxisError::InvalidVelocity,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [5000.0, 1.0, 1.0, 1.0]),
+            AxisError::InvalidVelocity,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [5.0, 0.0, 1.0, 1.0]),
+            AxisError::InvalidAcceleration,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [5.0, 1.0, -1.0, 1.0]),
+            AxisError::InvalidDeceleration,
+        ),
+        (
+            AxisCommandCall::move_absolute(1.0, [5.0, 1.0, 1.0, nan]),
+            AxisError::InvalidJerk,
+        ),
+        (
+            AxisCommandCall::move_velocity(0, LIMITS),
+            AxisError::InvalidDirection,
+        ),
+        (
+            AxisCommandCall::halt(0.0, 1.0),
+            AxisError::InvalidDeceleration,
+        ),
+        (
+            AxisCommandCall {
+                command: 99,
+                ..AxisCommandCall::default()
+            },
+            AxisError::InvalidParameter,
+        ),
+        (
+            AxisCommandCall {
+                reserved: 1,
+                ..AxisCommandCall::reset()
+            },
+            AxisError::InvalidParameter,
+        ),
+        (AxisCommandCall::power(false), AxisError::MovingWhileDisable),
+    ];
+    for (call, code) in refused {
+        assert_eq!(rig.call(0, call), Err(code), "{call:?}");
+        rig.tick();
+        assert_eq!(
+            rig.set_point(0),
+            rig.set_point(1),
+            "the refused {call:?} disturbed the move"
+        );
+    }
+    // A disabled axis and a coupled one refuse moves.
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.tick();
+    assert_eq!(
+        rig.call(0, AxisCommandCall::move_absolute(1.0, LIMITS)),
+        Err(AxisError::NotEnabled)
+    );
+    rig.call(0, AxisCommandCall::power(true)).unwrap();
+    let axis = rig.set.axis_mut(0).unwrap();
+    axis.couple(Coupling {
+        kind: CouplingState::Cam,
+        master: 1,
+        phase: AxisState::SlaveSynchronizing,
+    })
+    .unwrap();
+    assert_eq!(
+        rig.call(0, AxisCommandCall::move_absolute(1.0, LIMITS)),
+        Err(AxisError::Coupled)
+    );
+    assert_eq!(
+        rig.call(0, AxisCommandCall::halt(10.0, 100.0)),
+        Err(AxisError::Coupled)
+    );
+}
+
+#[test]
+fn a_decoupled_slave_goes_on_at_constant_velocity() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    rig.set
+        .axis_mut(0)
+        .unwrap()
+        .couple(Coupling {
+            kind: CouplingState::GearVelocity,
+            master: 1,
+            phase: AxisState::SlaveSynchronous,
+        })
+        .unwrap();
+    // The coupled engine moves the slave at 100 mm/s.
+    for n in 0..200 {
+        let p = n as f64 * 0.1;
+        rig.set.axis_mut(0).unwrap().drive_coupled(
+            Kinematic {
+                position: p,
+                velocity: 100.0,
+                acceleration: 0.0,
+                jerk: 0.0,
+            },
+            AxisState::SlaveSynchronous,
+        );
+        rig.tick();
+    }
+    let lr = CncView::new(&rig.memory)
+        .axis(0)
+        .unwrap()
+        .field::<hli::layout::HliAxisLrState>(0)
+        .read();
+    assert_eq!(lr.axis_state_r, 13);
+    assert_eq!(lr.coupling_state_r, CouplingState::GearVelocity.raw());
+    rig.set.axis_mut(0).unwrap().decouple();
+    rig.ticks(500);
+    let k = rig.set_point(0);
+    assert!((k.velocity - 100.0).abs() < 1e-9, "velocity {}", k.velocity);
+    assert_eq!(k.acceleration, 0.0);
+    assert!(
+        (k.position - (19.9 + 0.5 * 100.0)).abs() < 1e-6,
+        "position {}",
+        k.position
+    );
+    let lr = CncView::new(&rig.memory)
+        .axis(0)
+        .unwrap()
+        .field::<hli::layout::HliAxisLrState>(0)
+        .read();
+    assert_eq!(lr.axis_state_r, AxisState::ConstantVelocity.raw());
+}
+
+#[test]
+fn configurations_out_of_range_are_refused_by_name() {
+    let mut bad = AxisConfig::linear("X", 1);
+    bad.dynamics.jerk = 0.0;
+    let err = AxisSet::new(vec![bad], CYCLE).unwrap_err();
+    assert!(err.to_string().contains("dynamics.jerk = 0"), "{err}");
+    let mut bad = AxisConfig::linear("X", 1);
+    bad.drive = DriveLink::Simulated(SimDriveConfig {
+        dead_time_ticks: 65,
+        ..SimDriveConfig::default()
+    });
+    assert!(AxisSet::new(vec![bad], CYCLE).is_err());
+    let twins = vec![AxisConfig::linear("X", 1), AxisConfig::linear("X", 2)];
+    assert!(AxisSet::new(twins, CYCLE).is_err());
+    let many = (0..33)
+        .map(|i| AxisConfig::linear(&format!("A{i}"), i + 1))
+        .collect();
+    assert!(AxisSet::new(many, CYCLE).is_err());
+}
