@@ -191,7 +191,8 @@ proptest! {
         let mut last = None;
         let mut before = rig.set_point(0);
         for (target, limits, after) in &moves {
-            let id = rig.call(0, AxisCommandCall::move_absolute(*target, *limits)).unwrap();
+            let id = rig.call(0, AxisCommandCall::move_absolute(*target, *limits));
+            let id = id.map_err(|e| TestCaseError::fail(format!("{e:?}: axis error {:?} at {:?}", rig.set.axis(0).unwrap().error(), rig.set_point(0))))?;
             last = Some((id, *target));
             for _ in 0..*after {
                 rig.tick();

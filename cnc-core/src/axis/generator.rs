@@ -90,6 +90,10 @@ impl core::fmt::Debug for SetpointGenerator {
     }
 }
 
+fn usable(result: &RuckigResult) -> bool {
+    matches!(result, RuckigResult::Working | RuckigResult::Finished)
+}
+
 fn one(value: f64) -> DataArrayOrVec<f64, 1> {
     DataArrayOrVec::Stack([value])
 }
@@ -191,13 +195,11 @@ impl SetpointGenerator {
         self.input.current_acceleration = one(s.acceleration);
         self.input.target_acceleration = one(0.0);
         self.input.max_velocity = one(limits.velocity);
-        // Taking out an acceleration `a` with jerk `j` adds a^2 / 2j of velocity first.
-        let overshoot = if s.acceleration * s.velocity > 0.0 {
-            s.acceleration * s.acceleration / (2.0 * limits.jerk)
-        } else {
-            0.0
-        };
-        let jerk = if s.velocity.abs() + overshoot > limits.velocity {
+        // Taking out an acceleration `a` with jerk `j` changes the velocity by a|a| / 2j
+        // first; past the velocity limit that would run away, so use the axis's jerk.
+        let velocity_after =
+            s.velocity + s.acceleration * s.acceleration.abs() / (2.0 * limits.jerk);
+        let jerk = if velocity_after.abs() > limits.velocity.max(s.velocity.abs()) {
             limits.jerk.max(self.jerk_ceiling)
         } else {
             limits.jerk
@@ -211,18 +213,51 @@ impl SetpointGenerator {
         };
         self.input.max_acceleration = one(up);
         self.input.min_acceleration = Some(one(-down));
+        // rsruckig 3.0.1 reuses the profile of the previous trajectory as scratch space, and
+        // its stale brake phase can make the next calculation fail; start from a clean one
+        // (in place: no allocation).
+        for section in self.output.trajectory.profiles.iter_mut() {
+            section[0] = Profile::default();
+        }
         self.reached = false;
     }
 
-    fn min_acceleration(&self) -> f64 {
-        self.input
-            .min_acceleration
-            .as_ref()
-            .map_or(-self.input.max_acceleration[0], |m| m[0])
-    }
-
-    fn asymmetric(&self) -> bool {
-        self.input.max_acceleration[0] != -self.min_acceleration()
+    /// One update; when the library finds no profile, a few slightly gentler variants of the
+    /// limits (never higher ones) are tried before giving up. rsruckig 3.0.1 misses profiles
+    /// on numerical knife edges (for instance 0 -> 25 with +5000/-4000 mm/s^2, or some
+    /// re-targets at full deceleration) that a 0.1 % smaller limit solves.
+    fn update_with_retries(&mut self) -> Result<RuckigResult, GeneratorError> {
+        const VARIANTS: [(f64, bool); 5] = [
+            (1.0, true),
+            (0.999, false),
+            (0.999, true),
+            (0.99, false),
+            (0.99, true),
+        ];
+        let first = match self.otg.update(&self.input, &mut self.output) {
+            Ok(result) if usable(&result) => return Ok(result),
+            Ok(result) => GeneratorError(format!("{result:?}")),
+            Err(e) => GeneratorError(e.to_string()),
+        };
+        let up = self.input.max_acceleration[0];
+        let down = self.input.min_acceleration.as_ref().map_or(up, |m| -m[0]);
+        let velocity = self.input.max_velocity[0];
+        for (scale, symmetric) in VARIANTS {
+            let (u, d) = if symmetric {
+                (up.min(down), up.min(down))
+            } else {
+                (up, down)
+            };
+            self.input.max_acceleration = one(u * scale);
+            self.input.min_acceleration = Some(one(-d * scale));
+            self.input.max_velocity = one(velocity * scale);
+            if let Ok(result) = self.otg.update(&self.input, &mut self.output) {
+                if usable(&result) {
+                    return Ok(result);
+                }
+            }
+        }
+        Err(first)
     }
 
     /// Advances one tick.
@@ -230,25 +265,10 @@ impl SetpointGenerator {
         if self.goal == Goal::Hold {
             return Ok(Progress::Idle);
         }
-        let result = match self.otg.update(&self.input, &mut self.output) {
-            Ok(r) => r,
-            Err(_) if self.asymmetric() => {
-                // rsruckig 3.0.1 finds no profile for some asymmetric acceleration limits
-                // (0 -> 25 with +5000/-4000, say). The smaller of the two in both directions
-                // honours both limits, at the cost of a slightly longer move.
-                let smaller = self.input.max_acceleration[0].min(-self.min_acceleration());
-                self.input.max_acceleration = one(smaller);
-                self.input.min_acceleration = Some(one(-smaller));
-                self.otg
-                    .update(&self.input, &mut self.output)
-                    .map_err(|e| GeneratorError(e.to_string()))?
-            }
-            Err(e) => return Err(GeneratorError(e.to_string())),
-        };
+        let result = self.update_with_retries()?;
         let finished = match result {
-            RuckigResult::Working => false,
             RuckigResult::Finished => true,
-            other => return Err(GeneratorError(format!("{other:?}"))),
+            _ => false,
         };
         self.output.pass_to_input(&mut self.input);
         self.state = Kinematic {
@@ -302,6 +322,35 @@ mod tests {
             assert!(n < 100_000);
         }
         Ok(n)
+    }
+
+    #[test]
+    fn a_knife_edge_retarget_still_finds_a_profile() {
+        let mut g = SetpointGenerator::new(0.001, 0.0);
+        g.set_jerk_ceiling(200_000.0);
+        let first = MoveLimits {
+            velocity: 460.74781648558354,
+            acceleration: 5204.042272881033,
+            deceleration: 8614.688363408739,
+            jerk: 184719.09022780522,
+        };
+        g.move_to(-77.90457864321381, first);
+        for _ in 0..218 {
+            g.step().unwrap();
+        }
+        let second = MoveLimits {
+            velocity: 722.222359667801,
+            acceleration: 8430.952228104466,
+            deceleration: 8127.029675668488,
+            jerk: 196414.45591088082,
+        };
+        g.move_to(-895.1502189081375, second);
+        let mut n = 0;
+        while g.step().unwrap() != Progress::Reached {
+            n += 1;
+            assert!(n < 10_000);
+        }
+        assert_eq!(g.state().position, -895.1502189081375);
     }
 
     #[test]
