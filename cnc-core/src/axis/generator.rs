@@ -266,10 +266,7 @@ impl SetpointGenerator {
             return Ok(Progress::Idle);
         }
         let result = self.update_with_retries()?;
-        let finished = match result {
-            RuckigResult::Finished => true,
-            _ => false,
-        };
+        let finished = result == RuckigResult::Finished;
         self.output.pass_to_input(&mut self.input);
         self.state = Kinematic {
             position: self.output.new_position[0],
