@@ -12,6 +12,7 @@
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
 
 pub mod c_header;
+pub mod command_book;
 pub mod desc;
 pub mod enums;
 pub mod events;

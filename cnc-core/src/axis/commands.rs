@@ -1,6 +1,7 @@
 //! The command book of an axis: ids for accepted commands, which one owns the set-point
 //! generator, and how the last ones ended, in the HLI layout the PLC reads.
 
+pub use hli::command_book::{view_command, CommandView};
 use hli::enums::{AxisCommandKind, AxisError, CommandResult};
 use hli::layout::{HliAxisCommandOutcome, HliAxisCommandState, HLI_AXIS_OUTCOMES};
 
@@ -106,41 +107,10 @@ impl CommandBook {
     }
 }
 
-/// What a PLC block holding command `id` makes of the book it reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum CommandView {
-    /// Still owns the axis; `true` once its goal is reached (in velocity, stopped and held).
-    Busy(bool),
-    /// Reached its goal.
-    Done,
-    /// Replaced by a newer command.
-    Aborted,
-    /// Failed with this code.
-    Error(u32),
-    /// Neither active nor in the ring: ended too long ago to tell.
-    Unknown,
-}
-
-/// Reads the state of command `id` from a book image.
-pub fn view_command(book: &HliAxisCommandState, id: u32) -> CommandView {
-    if id != 0 && book.active_id_r == id {
-        return CommandView::Busy(book.active_reached_r != 0);
-    }
-    let outcome = book
-        .outcomes_r
-        .iter()
-        .find(|o| o.command_id == id && id != 0);
-    match outcome.map(|o| (CommandResult::decode(o.result), o.error_id)) {
-        Some((Ok(CommandResult::Done), _)) => CommandView::Done,
-        Some((Ok(CommandResult::Aborted), _)) => CommandView::Aborted,
-        Some((Ok(CommandResult::Error), code)) => CommandView::Error(code),
-        _ => CommandView::Unknown,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hli::command_book::{view_command, CommandView};
 
     #[test]
     fn a_new_motion_aborts_the_active_one_and_instants_leave_it() {

@@ -74,7 +74,12 @@ pub struct GeneratorError(pub String);
 pub struct SetpointGenerator {
     otg: Ruckig<1, ThrowErrorHandler>,
     input: InputParameter<1>,
-    output: OutputParameter<1>,
+    trajectory: Trajectory<1>,
+    cycle_s: f64,
+    /// Time along `trajectory`.
+    time: f64,
+    /// The goal changed: compute a new trajectory on the next step.
+    stale: bool,
     state: Kinematic,
     goal: Goal,
     reached: bool,
@@ -104,7 +109,10 @@ impl SetpointGenerator {
         let mut generator = Self {
             otg: Ruckig::new(None, cycle_s),
             input: InputParameter::new(None),
-            output: OutputParameter::new(None),
+            trajectory: Trajectory::new(None),
+            cycle_s,
+            time: 0.0,
+            stale: false,
             state: Kinematic::default(),
             goal: Goal::Hold,
             reached: true,
@@ -213,20 +221,15 @@ impl SetpointGenerator {
         };
         self.input.max_acceleration = one(up);
         self.input.min_acceleration = Some(one(-down));
-        // rsruckig 3.0.1 reuses the profile of the previous trajectory as scratch space, and
-        // its stale brake phase can make the next calculation fail; start from a clean one
-        // (in place: no allocation).
-        for section in self.output.trajectory.profiles.iter_mut() {
-            section[0] = Profile::default();
-        }
+        self.stale = true;
         self.reached = false;
     }
 
-    /// One update; when the library finds no profile, a few slightly gentler variants of the
+    /// One calculation; when the library finds no profile, a few slightly gentler variants of the
     /// limits (never higher ones) are tried before giving up. rsruckig 3.0.1 misses profiles
     /// on numerical knife edges (for instance 0 -> 25 with +5000/-4000 mm/s^2, or some
     /// re-targets at full deceleration) that a 0.1 % smaller limit solves.
-    fn update_with_retries(&mut self) -> Result<RuckigResult, GeneratorError> {
+    fn calculate_with_retries(&mut self) -> Result<RuckigResult, GeneratorError> {
         const VARIANTS: [(f64, bool); 5] = [
             (1.0, true),
             (0.999, false),
@@ -234,7 +237,7 @@ impl SetpointGenerator {
             (0.99, false),
             (0.99, true),
         ];
-        let first = match self.otg.update(&self.input, &mut self.output) {
+        let first = match self.otg.calculate(&self.input, &mut self.trajectory) {
             Ok(result) if usable(&result) => return Ok(result),
             Ok(result) => GeneratorError(format!("{result:?}")),
             Err(e) => GeneratorError(e.to_string()),
@@ -251,7 +254,7 @@ impl SetpointGenerator {
             self.input.max_acceleration = one(u * scale);
             self.input.min_acceleration = Some(one(-d * scale));
             self.input.max_velocity = one(velocity * scale);
-            if let Ok(result) = self.otg.update(&self.input, &mut self.output) {
+            if let Ok(result) = self.otg.calculate(&self.input, &mut self.trajectory) {
                 if usable(&result) {
                     return Ok(result);
                 }
@@ -265,15 +268,30 @@ impl SetpointGenerator {
         if self.goal == Goal::Hold {
             return Ok(Progress::Idle);
         }
-        let result = self.update_with_retries()?;
-        let finished = result == RuckigResult::Finished;
-        self.output.pass_to_input(&mut self.input);
+        if self.stale {
+            // A new goal: one calculation, then the profile is only sampled.
+            self.calculate_with_retries()?;
+            self.stale = false;
+            self.time = 0.0;
+        }
+        self.time += self.cycle_s;
+        let (mut p, mut v, mut a, mut j) = (one(0.0), one(0.0), one(0.0), one(0.0));
+        let mut section = Some(0);
+        self.trajectory.at_time(
+            self.time,
+            &mut Some(&mut p),
+            &mut Some(&mut v),
+            &mut Some(&mut a),
+            &mut Some(&mut j),
+            &mut section,
+        );
         self.state = Kinematic {
-            position: self.output.new_position[0],
-            velocity: self.output.new_velocity[0],
-            acceleration: self.output.new_acceleration[0],
-            jerk: self.output.new_jerk[0],
+            position: p[0],
+            velocity: v[0],
+            acceleration: a[0],
+            jerk: j[0],
         };
+        let finished = self.time > self.trajectory.get_duration();
         if !finished {
             return Ok(Progress::Moving);
         }

@@ -1,0 +1,117 @@
+//! The axis tick (set-point generation, re-targets, process image, simulated drives) and the
+//! command handler allocate nothing once the axes are built.
+//!
+//! The counting allocator needs an `unsafe impl GlobalAlloc`; it only forwards to the system
+//! allocator (the one place outside `hli::raw` with unsafe code, test-only).
+
+use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
+use cnc_core::axis::increments::CounterWidth;
+use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
+use cnc_core::axis::AxisSet;
+use hli::rpc::{AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind, ACYCLIC_BODY_SIZE};
+use hli::views::CncView;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator unchanged; only counts calls.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {
+    let bytes = bytemuck::bytes_of(call);
+    let mut body = [0u8; ACYCLIC_BODY_SIZE];
+    body[..bytes.len()].copy_from_slice(bytes);
+    AcyclicRequest {
+        invoke_id: 1,
+        kind: CallKind::AxisCommand.raw(),
+        target,
+        body_len: bytes.len() as u32,
+        body,
+    }
+}
+
+#[test]
+fn thirty_two_axes_tick_and_take_commands_without_allocating() {
+    let configs: Vec<AxisConfig> = (0..32)
+        .map(|i| {
+            let mut c = AxisConfig::linear(&format!("A{i}"), i + 1);
+            match i % 4 {
+                0 => {}
+                1 => c.drive_mode = DriveMode::Position,
+                2 => c.encoder_width = CounterWidth::Bits16,
+                _ => {
+                    c.drive = DriveLink::Simulated(SimDriveConfig {
+                        dynamic: Dynamic::Pt2 {
+                            frequency_hz: 80.0,
+                            damping: 0.8,
+                        },
+                        dead_time_ticks: 2,
+                        start_position: 1.0,
+                    })
+                }
+            }
+            c
+        })
+        .collect();
+    let memory = hli::segment::heap_image(1, 32);
+    let view = CncView::new(&memory);
+    let mut set = AxisSet::new(configs, 0.001).unwrap();
+    set.prime(&view);
+    set.tick(&view);
+    let limits = [400.0, 4000.0, 4000.0, 100_000.0];
+    let calls = [
+        AxisCommandCall::power(true),
+        AxisCommandCall::move_absolute(50.0, limits),
+        AxisCommandCall::move_relative(-20.0, limits),
+        AxisCommandCall::move_velocity(1, limits),
+        AxisCommandCall::halt(3000.0, 80_000.0),
+        AxisCommandCall::move_absolute(5000.0, limits), // refused: outside the limits
+        AxisCommandCall::stop(4000.0, 100_000.0),
+        AxisCommandCall::stop_release(),
+    ];
+    // Warm up once through every command kind so lazily initialised statics (if any) are set.
+    for (n, call) in calls.iter().enumerate() {
+        let _ = set.handle_command(&request(0, call));
+        for _ in 0..(50 + n) {
+            set.tick(&view);
+        }
+    }
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let mut accepted = 0;
+    for round in 0..20 {
+        for (n, call) in calls.iter().enumerate() {
+            for axis in 0..32u32 {
+                let (body, _) = set.handle_command(&request(axis, call)).unwrap();
+                let reply: AxisCommandReply = bytemuck::pod_read_unaligned(&body[..8]);
+                accepted += u32::from(reply.error_id == 0);
+            }
+            for _ in 0..(37 + round + n) {
+                set.tick(&view);
+            }
+        }
+    }
+    let allocations = ALLOCATIONS.load(Ordering::Relaxed) - before;
+    assert!(
+        accepted > 4000,
+        "the commands must really run ({accepted} accepted)"
+    );
+    assert_eq!(
+        allocations, 0,
+        "allocations in the axis tick or the command handler"
+    );
+}

@@ -1,0 +1,362 @@
+//! PLCopen-style motion blocks for the PLC program: MC_Power, MC_Reset, MC_MoveAbsolute,
+//! MC_MoveRelative, MC_MoveVelocity, MC_Halt and MC_Stop. Each is called once per PLC cycle
+//! with its axis (the index in `gpAx`). On a rising Execute edge a block sends its command
+//! over the acyclic service without waiting; it stays Busy until the CNC answers with a
+//! command id, then follows that id in the axis's command book in the image (no further
+//! calls). Outputs follow PLCopen: Busy while the command runs; then exactly one of Done,
+//! CommandAborted, Error (with ErrorID), held while Execute stays TRUE, or for one cycle if
+//! Execute already fell.
+
+use crate::runtime::PlcIo;
+use hli::command_book::{view_command, CommandView};
+use hli::enums::axis_status;
+use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
+use hli::rpc::{AxisCommandCall, CallError, PendingCall};
+use hli::PlaceExt;
+
+/// Error id of a block whose call failed in transport (no CNC answer).
+pub const ERROR_NO_ANSWER: u32 = 0x745;
+
+/// Outputs of an Execute-driven motion block.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BlockOutputs {
+    /// The command reached its goal.
+    pub done: bool,
+    /// The command has not finished yet.
+    pub busy: bool,
+    /// The command owns the axis (accepted and not finished).
+    pub active: bool,
+    /// A newer command replaced this one.
+    pub command_aborted: bool,
+    /// The command failed; see `error_id`.
+    pub error: bool,
+    /// Why it failed: an axis error code, an acyclic error code, or [`ERROR_NO_ANSWER`].
+    pub error_id: u32,
+    /// MC_MoveVelocity: the commanded velocity is reached.
+    pub in_velocity: bool,
+}
+
+enum Phase {
+    Idle,
+    Sent(PendingCall<AxisCommandCall>),
+    Following(u32),
+    Finished,
+}
+
+/// The Execute/Busy/Done machinery shared by the blocks.
+pub struct CommandCore {
+    execute_before: bool,
+    phase: Phase,
+    out: BlockOutputs,
+    show_once: bool,
+}
+
+impl Default for CommandCore {
+    fn default() -> Self {
+        Self {
+            execute_before: false,
+            phase: Phase::Idle,
+            out: BlockOutputs::default(),
+            show_once: false,
+        }
+    }
+}
+
+impl core::fmt::Debug for CommandCore {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("CommandCore")
+            .field("out", &self.out)
+            .finish()
+    }
+}
+
+fn fail(code: u32) -> BlockOutputs {
+    BlockOutputs {
+        error: true,
+        error_id: code,
+        ..BlockOutputs::default()
+    }
+}
+
+impl CommandCore {
+    /// One cycle: `call` is sent on a rising edge of `execute`. Returns the block's outputs.
+    /// `finished_when_reached`: the command counts as Done once its goal is reached although it
+    /// keeps the axis (MC_Stop).
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        axis: u32,
+        execute: bool,
+        call: impl FnOnce() -> AxisCommandCall,
+        finished_when_reached: bool,
+    ) -> BlockOutputs {
+        let rising = execute && !self.execute_before;
+        self.execute_before = execute;
+        if rising {
+            self.out = BlockOutputs::default();
+            self.phase = match io.acyclic.start(axis, &call()) {
+                Ok(pending) => Phase::Sent(pending),
+                Err(_) => {
+                    self.out = fail(ERROR_NO_ANSWER);
+                    Phase::Finished
+                }
+            };
+        }
+        if let Phase::Sent(pending) = &self.phase {
+            match pending.poll() {
+                None => self.out.busy = true,
+                Some(Ok(reply)) if reply.error_id != 0 => {
+                    self.out = fail(reply.error_id);
+                    self.phase = Phase::Finished;
+                }
+                Some(Ok(reply)) => self.phase = Phase::Following(reply.command_id),
+                Some(Err(CallError::Refused { code })) => {
+                    self.out = fail(code.raw());
+                    self.phase = Phase::Finished;
+                }
+                Some(Err(_)) => {
+                    self.out = fail(ERROR_NO_ANSWER);
+                    self.phase = Phase::Finished;
+                }
+            }
+        }
+        if let Phase::Following(id) = self.phase {
+            let book: HliAxisCommandState = match io.view.axis(axis as usize) {
+                Ok(place) => place
+                    .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
+                    .read(),
+                Err(_) => {
+                    self.out = fail(hli::rpc::ErrorCode::InvalidTarget.raw());
+                    self.phase = Phase::Finished;
+                    return self.finish_cycle(execute);
+                }
+            };
+            let view = view_command(&book, id);
+            self.out = match view {
+                CommandView::Busy(reached) if reached && finished_when_reached => BlockOutputs {
+                    done: true,
+                    active: true,
+                    ..BlockOutputs::default()
+                },
+                CommandView::Busy(reached) => BlockOutputs {
+                    busy: true,
+                    active: true,
+                    in_velocity: reached,
+                    ..BlockOutputs::default()
+                },
+                CommandView::Done => BlockOutputs {
+                    done: true,
+                    ..BlockOutputs::default()
+                },
+                CommandView::Aborted | CommandView::Unknown => BlockOutputs {
+                    command_aborted: true,
+                    ..BlockOutputs::default()
+                },
+                CommandView::Error(code) => fail(code),
+            };
+            if !matches!(view, CommandView::Busy(_)) {
+                self.phase = Phase::Finished;
+            }
+        }
+        self.finish_cycle(execute)
+    }
+
+    fn finish_cycle(&mut self, execute: bool) -> BlockOutputs {
+        let running = matches!(self.phase, Phase::Sent(_) | Phase::Following(_));
+        if !execute && !running {
+            // Execute fell: show a result that arrived meanwhile once, then clear.
+            if self.show_once {
+                self.show_once = false;
+                return self.out;
+            }
+            self.out = BlockOutputs::default();
+            self.phase = Phase::Idle;
+        }
+        if !execute && running {
+            self.show_once = true;
+        }
+        self.out
+    }
+}
+
+/// MC_Power: enables the axis while `enable` is TRUE.
+#[derive(Debug, Default)]
+pub struct McPower {
+    /// Input: enable the axis.
+    pub enable: bool,
+    /// Output: the axis reports enabled.
+    pub status: bool,
+    /// Output: the last enable/disable was refused.
+    pub error: bool,
+    /// Output: why.
+    pub error_id: u32,
+    core: CommandCore,
+    sent: Option<bool>,
+}
+
+impl McPower {
+    /// One cycle for `axis`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
+        if self.sent != Some(self.enable) {
+            // A new level: send it (the core sends on its rising edge).
+            self.core = CommandCore::default();
+            self.sent = Some(self.enable);
+        }
+        let enable = self.enable;
+        let out = self
+            .core
+            .cycle(io, axis, true, || AxisCommandCall::power(enable), false);
+        self.error = out.error;
+        self.error_id = out.error_id;
+        self.status = io
+            .view
+            .axis_state(axis as usize)
+            .map(|s: HliAxisLrState| s.status_r & axis_status::ENABLED != 0)
+            .unwrap_or(false);
+    }
+}
+
+macro_rules! execute_block {
+    ($(#[doc = $doc:literal])* $name:ident { $($(#[doc = $fdoc:literal])* $field:ident),* } => |$s:ident| $build:expr, reached_is_done = $reached:expr) => {
+        $(#[doc = $doc])*
+        #[derive(Debug, Default)]
+        pub struct $name {
+            /// Input: a rising edge starts the command.
+            pub execute: bool,
+            $($(#[doc = $fdoc])* pub $field: f64,)*
+            /// Outputs of the last call.
+            pub out: BlockOutputs,
+            core: CommandCore,
+        }
+
+        impl $name {
+            /// One cycle for `axis`.
+            pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
+                let $s = &*self;
+                let call = $build;
+                self.out = self.core.cycle(io, axis, self.execute, || call, $reached);
+            }
+        }
+    };
+}
+
+execute_block! {
+    /// MC_Reset: clears the axis error once its cause is gone.
+    McReset {} => |_s| AxisCommandCall::reset(), reached_is_done = false
+}
+
+execute_block! {
+    /// MC_MoveAbsolute: moves to `position`.
+    McMoveAbsolute {
+        /// Input: target position.
+        position,
+        /// Input: velocity limit.
+        velocity,
+        /// Input: acceleration limit.
+        acceleration,
+        /// Input: deceleration limit.
+        deceleration,
+        /// Input: jerk limit.
+        jerk
+    } => |s| AxisCommandCall::move_absolute(s.position, [s.velocity, s.acceleration, s.deceleration, s.jerk]),
+    reached_is_done = false
+}
+
+execute_block! {
+    /// MC_MoveRelative: moves by `distance` from the set position.
+    McMoveRelative {
+        /// Input: distance.
+        distance,
+        /// Input: velocity limit.
+        velocity,
+        /// Input: acceleration limit.
+        acceleration,
+        /// Input: deceleration limit.
+        deceleration,
+        /// Input: jerk limit.
+        jerk
+    } => |s| AxisCommandCall::move_relative(s.distance, [s.velocity, s.acceleration, s.deceleration, s.jerk]),
+    reached_is_done = false
+}
+
+/// MC_MoveVelocity: runs endlessly at `velocity` in `direction`; InVelocity once reached.
+#[derive(Debug, Default)]
+pub struct McMoveVelocity {
+    /// Input: a rising edge starts the command.
+    pub execute: bool,
+    /// Input: 1 positive, -1 negative.
+    pub direction: i32,
+    /// Input: velocity (> 0).
+    pub velocity: f64,
+    /// Input: acceleration limit.
+    pub acceleration: f64,
+    /// Input: deceleration limit.
+    pub deceleration: f64,
+    /// Input: jerk limit.
+    pub jerk: f64,
+    /// Outputs of the last call.
+    pub out: BlockOutputs,
+    core: CommandCore,
+}
+
+impl McMoveVelocity {
+    /// One cycle for `axis`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
+        let call = AxisCommandCall::move_velocity(
+            self.direction,
+            [
+                self.velocity,
+                self.acceleration,
+                self.deceleration,
+                self.jerk,
+            ],
+        );
+        self.out = self.core.cycle(io, axis, self.execute, || call, false);
+    }
+}
+
+execute_block! {
+    /// MC_Halt: brakes to standstill; another move may take over.
+    McHalt {
+        /// Input: deceleration.
+        deceleration,
+        /// Input: jerk.
+        jerk
+    } => |s| AxisCommandCall::halt(s.deceleration, s.jerk), reached_is_done = false
+}
+
+/// MC_Stop: brakes to standstill and keeps the axis locked while Execute stays TRUE.
+#[derive(Debug, Default)]
+pub struct McStop {
+    /// Input: a rising edge stops; the falling edge releases the lock.
+    pub execute: bool,
+    /// Input: deceleration.
+    pub deceleration: f64,
+    /// Input: jerk.
+    pub jerk: f64,
+    /// Outputs of the last call.
+    pub out: BlockOutputs,
+    core: CommandCore,
+    release: Option<PendingCall<AxisCommandCall>>,
+    execute_before: bool,
+}
+
+impl McStop {
+    /// One cycle for `axis`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
+        let call = AxisCommandCall::stop(self.deceleration, self.jerk);
+        self.out = self.core.cycle(io, axis, self.execute, || call, true);
+        if self.execute_before && !self.execute {
+            self.release = io
+                .acyclic
+                .start(axis, &AxisCommandCall::stop_release())
+                .ok();
+        }
+        if let Some(pending) = &self.release {
+            if pending.poll().is_some() {
+                self.release = None;
+            }
+        }
+        self.execute_before = self.execute;
+    }
+}
