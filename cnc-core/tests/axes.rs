@@ -708,3 +708,37 @@ fn configurations_out_of_range_are_refused_by_name() {
         .collect();
     assert!(AxisSet::new(many, CYCLE).is_err());
 }
+
+#[test]
+fn an_endless_rotary_axis_wraps_its_displayed_positions() {
+    let mut rig = Rig::new(vec![AxisConfig::rotary("C", 1)]);
+    rig.enable(0);
+    rig.call(
+        0,
+        AxisCommandCall::move_velocity(1, [3600.0, 36_000.0, 36_000.0, 720_000.0]),
+    )
+    .unwrap();
+    let mut seen_wrap = false;
+    let mut last = 0;
+    for _ in 0..2_000 {
+        rig.tick();
+        let lr = CncView::new(&rig.memory)
+            .axis(0)
+            .unwrap()
+            .field::<hli::layout::HliAxisLrState>(0)
+            .read();
+        assert!(
+            (0..3_600_000).contains(&lr.command_position_acs_r),
+            "{}",
+            lr.command_position_acs_r
+        );
+        seen_wrap |= lr.command_position_acs_r < last;
+        last = lr.command_position_acs_r;
+    }
+    assert!(seen_wrap);
+    assert!(
+        rig.set_point(0).position > 3600.0,
+        "ten turns and more, unbounded inside"
+    );
+    assert_eq!(rig.set.axis(0).unwrap().error(), None);
+}

@@ -484,11 +484,15 @@ impl Axis {
             nOutData1: enc_in.nInData1,
             ..bytemuck::Zeroable::zeroed()
         };
-        let display = |p: f64| match cfg.modulo() {
-            Some(m) => p.rem_euclid(m),
-            None => p,
-        };
         let hli_scale = hli::units::HLI_LENGTH_PER_MM;
+        // Wrapped in whole HLI units, so rounding never shows the period itself.
+        let display = |p: f64| match cfg.modulo() {
+            Some(m) => {
+                let raw = (p * hli_scale).round() as i64;
+                saturate(raw.rem_euclid((m * hli_scale).round() as i64) as f64)
+            }
+            None => saturate(p * hli_scale),
+        };
         let mut status = 0;
         if self.enabled {
             status |= axis_status::ENABLED;
@@ -507,8 +511,8 @@ impl Axis {
             status |= axis_status::IO_INVALID;
         }
         let lr_state = HliAxisLrState {
-            current_position_acs_r: saturate(display(self.actual) * hli_scale),
-            command_position_acs_r: saturate(display(set.position) * hli_scale),
+            current_position_acs_r: display(self.actual),
+            command_position_acs_r: display(set.position),
             current_velocity_r: saturate(self.actual_velocity * hli_scale),
             command_velocity_r: saturate(set.velocity * hli_scale),
             command_acceleration_r: saturate(set.acceleration * 1000.0),

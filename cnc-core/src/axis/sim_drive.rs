@@ -250,3 +250,83 @@ impl SimulatedDrive {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn drive(dynamic: Dynamic, dead_time_ticks: u32) -> SimulatedDrive {
+        let config = SimDriveConfig {
+            dynamic,
+            dead_time_ticks,
+            start_position: 0.0,
+        };
+        let scaling = SimScaling {
+            increments_per_unit: 10_000.0,
+            velocity_increments_per_unit: 10_000.0,
+            acceleration_increments_per_unit: 1_000.0,
+            width: CounterWidth::Bits32,
+            mode: DriveMode::Velocity,
+        };
+        SimulatedDrive::new(config, scaling, 0.001)
+    }
+
+    fn velocity_step(d: &mut SimulatedDrive, ticks: usize) -> Vec<f64> {
+        let out = NcDriveOut {
+            nOutData1: 1_000_000,
+            ..bytemuck::Zeroable::zeroed()
+        }; // 100 mm/s
+        (0..ticks)
+            .map(|_| {
+                d.step(&out);
+                d.velocity()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn dead_time_delays_the_command_by_whole_ticks() {
+        let v = velocity_step(&mut drive(Dynamic::Ideal, 3), 6);
+        assert_eq!(v, [0.0, 0.0, 0.0, 100.0, 100.0, 100.0]);
+    }
+
+    #[test]
+    fn pt1_reaches_63_percent_after_one_time_constant() {
+        let v = velocity_step(&mut drive(Dynamic::Pt1 { t1_s: 0.02 }, 0), 20);
+        assert!(
+            (v[19] - 100.0 * (1.0 - (-1.0f64).exp())).abs() < 0.01,
+            "{}",
+            v[19]
+        );
+    }
+
+    #[test]
+    fn underdamped_pt2_overshoots_as_its_damping_says_and_settles() {
+        let v = velocity_step(
+            &mut drive(
+                Dynamic::Pt2 {
+                    frequency_hz: 20.0,
+                    damping: 0.5,
+                },
+                0,
+            ),
+            1000,
+        );
+        let peak = v.iter().cloned().fold(f64::MIN, f64::max);
+        // Overshoot of a second-order step: exp(-pi z / sqrt(1 - z^2)) = 16.3 % for z = 0.5.
+        let expected = 100.0 * (1.0 + (-core::f64::consts::PI * 0.5 / 0.75f64.sqrt()).exp());
+        assert!(
+            (peak - expected).abs() < 0.5,
+            "peak {peak}, expected {expected}"
+        );
+        assert!((v[999] - 100.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn encoder_reports_io_invalid_when_told() {
+        let mut d = drive(Dynamic::Ideal, 0);
+        assert_eq!(d.encoder_in().nStatus4, 0);
+        d.encoder_io_invalid = true;
+        assert_eq!(d.encoder_in().nStatus4, 1);
+    }
+}
