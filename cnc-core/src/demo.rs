@@ -7,6 +7,7 @@
 //! calls. Channels, kinematics and the tracking filter proper arrive with the channel issue;
 //! here the CNC's part of the tracking is a plain ramp so that every handshake is exercised.
 
+use crate::axis::{AxisConfig, AxisSet};
 use crate::stats::Percentiles;
 use hli::enums::{DynCsCommand, DynCsState};
 use hli::layout::{HliAxis, HliAxisLrState, HliCoordinateSystemInt, HliMFunctionRequest};
@@ -161,6 +162,13 @@ fn run(args: &DemoArgs) -> Result<(), String> {
         .axis(0)
         .map_err(|e| e.to_string())?
         .field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state));
+    // The rotary table: a real axis (simulated drive) that the PLC powers and turns.
+    let mut axes = AxisSet::new(
+        vec![AxisConfig::rotary("C", 1)],
+        args.cycle_us.max(1) as f64 * 1e-6,
+    )
+    .map_err(|e| e.to_string())?;
+    axes.prime(&view);
 
     let ticks = args.ticks as usize;
     let mut trace = vec![TraceRow::default(); ticks];
@@ -221,16 +229,11 @@ fn run(args: &DemoArgs) -> Result<(), String> {
             Err(_) => counters.requests_not_taken += 1,
         }
 
-        // The table axis follows the commanded angle; the display shows the tracked share.
+        // The table axis turns under the PLC's commands; the display shows the tracked share.
+        axes.tick(&view);
+        let table = lr_state.read();
         let commanded_c = applied.rotation[2];
         let display_c = (f64::from(commanded_c) * ramp.weight()).round() as i32;
-        lr_state.write(&HliAxisLrState {
-            current_position_acs_r: commanded_c,
-            command_position_acs_r: commanded_c,
-            axis_state_r: hli::enums::AxisState::ConstantVelocity.raw(),
-            master_axis_r: -1,
-            ..bytemuck::Zeroable::zeroed()
-        });
 
         if args.m_every > 0 && tick % args.m_every == args.m_every - 1 && outstanding_m.is_none() {
             let id = (counters.m_announced + 1) as u32;
@@ -262,8 +265,7 @@ fn run(args: &DemoArgs) -> Result<(), String> {
         counters.acyclic_answered += server
             .poll(|kind, request| match kind {
                 CallKind::ReadAxisState => handle_read_axis_state(&view, request),
-                // The demo has no axis layer yet.
-                CallKind::AxisCommand => Err(hli::rpc::ErrorCode::ServiceNotSupported),
+                CallKind::AxisCommand => axes.handle_command(request),
             })
             .unwrap_or(0) as u64;
 
@@ -271,7 +273,7 @@ fn run(args: &DemoArgs) -> Result<(), String> {
             tick,
             time_ns: t0.duration_since(start).as_nanos() as u64,
             commanded_c,
-            table_axis: commanded_c,
+            table_axis: table.current_position_acs_r,
             display_c,
             state: ramp.state.raw(),
         };
@@ -280,6 +282,7 @@ fn run(args: &DemoArgs) -> Result<(), String> {
     }
 
     counters.violations += command_rx.stats().violations() + transition_rx.stats().violations();
+    let table = lr_state.read();
     drop(segment); // marks the segment closed: the PLC stops
     let plc_output = wait_for_exit(child)?;
 
@@ -311,6 +314,13 @@ fn run(args: &DemoArgs) -> Result<(), String> {
     println!(
         "tick duration: p50 {} ns, p99 {} ns, max {} ns; wake-up lateness: p50 {} ns, p99 {} ns, max {} ns ({} ticks of {} us)",
         tick.p50, tick.p99, tick.max, late.p50, late.p99, late.max, args.ticks, args.cycle_us
+    );
+    println!(
+        "table axis C: at {:.4} deg, {:.1} deg/s, nAxisState {}, error 0x{:X}",
+        hli::units::deg_from_hli(table.current_position_acs_r),
+        hli::units::deg_from_hli(table.current_velocity_r),
+        table.axis_state_r,
+        table.error_id_r
     );
     print!("{plc_output}");
     println!("trace: {}", trace_path.display());

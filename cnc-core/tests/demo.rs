@@ -37,6 +37,9 @@ fn demo_exchanges_every_unit_with_a_spawned_plc() {
     );
     assert!(stdout.contains("ended by CncClosed"), "{stdout}");
     assert!(stdout.contains("protocol errors 0"), "{stdout}");
+    // The table axis: powered and turned by the PLC's motion blocks, without an axis error.
+    assert!(stdout.contains("table in velocity true"), "{stdout}");
+    assert!(stdout.contains("nAxisState 2, error 0x0"), "{stdout}");
     let trace = std::fs::read_to_string(out_dir.join("trace.csv")).unwrap();
     let mut lines = trace.lines();
     assert!(lines.next().unwrap().starts_with("tick,time,"));

@@ -24,6 +24,11 @@ pub fn view_command(book: &HliAxisCommandState, id: u32) -> CommandView {
     if id != 0 && book.active_id_r == id {
         return CommandView::Busy(book.active_reached_r != 0);
     }
+    // The reply can overtake the image by a tick: an id newer than the last one the image
+    // shows was accepted but is not written yet (ids count up, wrapping).
+    if id != 0 && (id.wrapping_sub(book.issued_id_r) as i32) > 0 {
+        return CommandView::Busy(false);
+    }
     let outcome = book
         .outcomes_r
         .iter()
@@ -33,5 +38,25 @@ pub fn view_command(book: &HliAxisCommandState, id: u32) -> CommandView {
         Some((Ok(CommandResult::Aborted), _)) => CommandView::Aborted,
         Some((Ok(CommandResult::Error), code)) => CommandView::Error(code),
         _ => CommandView::Unknown,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reply_that_overtakes_the_image_reads_as_busy() {
+        let mut book: HliAxisCommandState = bytemuck::Zeroable::zeroed();
+        book.issued_id_r = 1;
+        assert_eq!(view_command(&book, 2), CommandView::Busy(false));
+        assert_eq!(view_command(&book, 1), CommandView::Unknown);
+        book.issued_id_r = u32::MAX;
+        assert_eq!(
+            view_command(&book, 1),
+            CommandView::Busy(false),
+            "across the wrap"
+        );
+        assert_eq!(view_command(&book, 0), CommandView::Unknown);
     }
 }

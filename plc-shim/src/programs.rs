@@ -1,15 +1,21 @@
 //! Example PLC programs.
 
+use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
-use core::time::Duration;
 use hli::enums::{DynCsCommand, DynCsState};
 use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition, HliMFunctionAck};
-use hli::rpc::ReadAxisState;
-use hli::units::deg_to_hli;
+use hli::rpc::{PendingCall, ReadAxisState};
 use hli::Bool;
 
+/// The table axis (index in `gpAx`).
+const TABLE_AXIS: u32 = 0;
+/// PLC cycle the table speed is given for.
+const NOMINAL_CYCLE_S: f64 = 0.001;
+
 /// The PLC as master of a dynamic coordinate system: a rotary table turning at a constant
-/// speed (the seed's example 4, PLC-only variant). Every cycle it commands the table frame
+/// speed (the seed's example 4, PLC-only variant). It powers the table axis and turns it with
+/// MC_MoveVelocity; every cycle it commands the table frame (rotation = the axis's actual
+/// position)
 /// through `MC_CONTROL_DYN_CS_UNIT.command_w`, switches tracking on through `transition_w`,
 /// reads back `request_r`, acknowledges M functions and reads the table axis acyclically.
 #[derive(Debug, Default)]
@@ -38,7 +44,14 @@ pub struct RotaryTableMaster {
     pub errors: u64,
     /// Last tracking state seen.
     pub last_state: Option<DynCsState>,
+    /// The table axis reached its velocity.
+    pub table_in_velocity: bool,
+    /// Last table position read from the image, 0.0001 degree.
+    pub table_position: i32,
     pending_ack: Option<HliMFunctionAck>,
+    power: McPower,
+    turn: McMoveVelocity,
+    read: Option<PendingCall<ReadAxisState>>,
 }
 
 impl RotaryTableMaster {
@@ -61,12 +74,30 @@ impl PlcProgram for RotaryTableMaster {
             self.errors += 1;
             return;
         }
-        // The table frame: rotation about Z, wrapped to one turn.
-        let angle = (io.cycle as f64 * self.deg_per_cycle) % 360.0;
+        // The table axis: powered, then turning at the configured speed.
+        self.power.enable = true;
+        self.power.call(io, TABLE_AXIS);
+        if self.power.status && !self.turn.execute {
+            self.turn.direction = 1;
+            self.turn.velocity = self.deg_per_cycle / NOMINAL_CYCLE_S;
+            self.turn.acceleration = 10.0 * self.turn.velocity;
+            self.turn.deceleration = self.turn.acceleration;
+            self.turn.jerk = 100.0 * self.turn.velocity;
+            self.turn.execute = true;
+        }
+        self.turn.call(io, TABLE_AXIS);
+        self.table_in_velocity |= self.turn.out.in_velocity;
+        if self.turn.out.error || self.power.error {
+            self.errors += 1;
+        }
+        // The table frame: rotation about Z by the table's actual position (wrapped to a turn).
+        if let Ok(axis) = view.axis_state(TABLE_AXIS as usize) {
+            self.table_position = axis.current_position_acs_r;
+        }
         let frame = HliCoordinateSystemInt {
             translation: [0; 3],
             fill_up_2: 0,
-            rotation: [0, 0, deg_to_hli(angle).unwrap_or(0)],
+            rotation: [0, 0, self.table_position],
             fill_up_1: 0,
         };
         match view.dyn_cs_command(ch).map(|tx| tx.try_send(&frame)) {
@@ -123,21 +154,25 @@ impl PlcProgram for RotaryTableMaster {
                 self.m_functions_acked += 1;
             }
         }
-        // Acyclic read of the table axis now and then (waits for the CNC's next tick).
-        if io.cycle % 500 == 250 && view.axis_count() > 0 {
-            match io
-                .acyclic
-                .call(0, &ReadAxisState::default(), Duration::from_millis(200))
-            {
+        // Acyclic read of the table axis now and then, without blocking the cycle.
+        if io.cycle % 500 == 250 && view.axis_count() > 0 && self.read.is_none() {
+            match io.acyclic.start(TABLE_AXIS, &ReadAxisState::default()) {
+                Ok(pending) => self.read = Some(pending),
+                Err(_) => self.acyclic_errors += 1,
+            }
+        }
+        if let Some(result) = self.read.as_ref().and_then(PendingCall::poll) {
+            match result {
                 Ok(_) => self.acyclic_replies += 1,
                 Err(_) => self.acyclic_errors += 1,
             }
+            self.read = None;
         }
     }
 
     fn summary(&self) -> String {
         format!(
-            "plc: commands {} (busy {}), requests read {}, transitions {}, M acks {}, acyclic replies {} (errors {}), protocol errors {}, last state {:?}",
+            "plc: commands {} (busy {}), requests read {}, transitions {}, M acks {}, acyclic replies {} (errors {}), protocol errors {}, last state {:?}, table in velocity {}",
             self.commands_sent,
             self.commands_busy,
             self.requests_read,
@@ -146,7 +181,8 @@ impl PlcProgram for RotaryTableMaster {
             self.acyclic_replies,
             self.acyclic_errors,
             self.errors,
-            self.last_state
+            self.last_state,
+            self.table_in_velocity
         )
     }
 }
