@@ -3,15 +3,23 @@
 use hli::segment::heap_image;
 use hli::views::{CncView, PlcView};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Allocations made by this thread: the test harness's own threads may allocate while a
+    /// test runs, which says nothing about the code under test.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
 
 // SAFETY: forwards to the system allocator unchanged; only counts calls.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
         // SAFETY: same contract as the caller's.
         unsafe { System.alloc(layout) }
     }
@@ -35,7 +43,7 @@ fn handshake_cycle_does_not_allocate() {
     let mut req_rx = plc.dyn_cs_request(1).unwrap();
     let mut payload: hli::layout::HliCoordinateSystemInt = bytemuck::Zeroable::zeroed();
 
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     for i in 0..10_000 {
         payload.translation[0] = i;
         tx.try_send(&payload).unwrap();
@@ -47,6 +55,6 @@ fn handshake_cycle_does_not_allocate() {
         let _ = plc.dyn_cs_state(1).unwrap().unwrap();
         let _ = plc.axis_state(3).unwrap();
     }
-    let after = ALLOCATIONS.load(Ordering::Relaxed);
+    let after = allocations();
     assert_eq!(after - before, 0, "allocations in the handshake cycle");
 }

@@ -7,15 +7,23 @@ use kinematics::opw::{Robot45, Robot45Params};
 use kinematics::tracking::{Tracking, TrackingMode, TrackingOption};
 use kinematics::{Kinematics, PoseWords};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Allocations made by this thread: the test harness's own threads may allocate while a
+    /// test runs, which says nothing about the code under test.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
 
 // SAFETY: forwards to the system allocator unchanged; only counts calls.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
         // SAFETY: same contract as the caller's.
         unsafe { System.alloc(layout) }
     }
@@ -62,7 +70,7 @@ fn kinematic_calls_do_not_allocate() {
     .unwrap();
     let joints = [10.0, -80.0, 70.0, 20.0, 30.0, 40.0];
 
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = allocations();
     let mut checksum = 0.0;
     for i in 0..1000 {
         let mut q = joints;
@@ -76,7 +84,7 @@ fn kinematic_calls_do_not_allocate() {
         checksum += chain.inverse(&t, &q).unwrap()[0];
         checksum += tracking.compose(&pose, &c).translation.vector.x;
     }
-    let after = ALLOCATIONS.load(Ordering::Relaxed);
+    let after = allocations();
     assert!(checksum.is_finite());
     assert_eq!(after - before, 0, "allocations in forward/inverse/compose");
 }
