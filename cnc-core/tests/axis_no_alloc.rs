@@ -1,8 +1,5 @@
 //! The axis tick (set-point generation, re-targets, process image, simulated drives) and the
 //! command handler allocate nothing once the axes are built.
-//!
-//! The counting allocator needs an `unsafe impl GlobalAlloc`; it only forwards to the system
-//! allocator (the one place outside `hli::raw` with unsafe code, test-only).
 
 use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
 use cnc_core::axis::increments::CounterWidth;
@@ -10,35 +7,10 @@ use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
 use hli::rpc::{AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind, ACYCLIC_BODY_SIZE};
 use hli::views::CncView;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
-struct Counting;
-thread_local! {
-    /// Allocations made by this thread: the test harness's own threads may allocate while a
-    /// test runs, which says nothing about the code under test.
-    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
-}
-
-fn allocations() -> usize {
-    ALLOCATIONS.with(Cell::get)
-}
-
-// SAFETY: forwards to the system allocator unchanged; only counts calls.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
-
-#[global_allocator]
-static GLOBAL: Counting = Counting;
+#[path = "../../tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
 
 fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {
     let bytes = bytemuck::bytes_of(call);
