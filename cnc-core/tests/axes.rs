@@ -742,3 +742,24 @@ fn an_endless_rotary_axis_wraps_its_displayed_positions() {
     );
     assert_eq!(rig.set.axis(0).unwrap().error(), None);
 }
+
+#[test]
+fn a_velocity_move_from_the_soft_limit_outwards_ends_at_once_without_moving() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.soft_limits = Some([-20.0, 20.0]);
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    let to_limit = rig
+        .call(0, AxisCommandCall::move_absolute(20.0, LIMITS))
+        .unwrap();
+    rig.until(5_000, |r| r.view(0, to_limit) == CommandView::Done);
+    let out = rig
+        .call(0, AxisCommandCall::move_velocity(1, LIMITS))
+        .unwrap();
+    rig.until(100, |r| {
+        r.view(0, out) == CommandView::Error(AxisError::SoftwareLimitReached.raw())
+    });
+    rig.ticks(200);
+    assert!(rig.set_point(0).position <= 20.0);
+    assert_eq!(rig.set.axis(0).unwrap().error(), None);
+}

@@ -441,7 +441,7 @@ impl Axis {
             self.generator.move_to(
                 limit,
                 MoveLimits {
-                    velocity: speed.max(f64::MIN_POSITIVE),
+                    velocity: v.abs(),
                     acceleration: d.acceleration,
                     deceleration: d.deceleration,
                     jerk: d.jerk,
