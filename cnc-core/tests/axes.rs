@@ -701,6 +701,12 @@ fn configurations_out_of_range_are_refused_by_name() {
         ..SimDriveConfig::default()
     });
     assert!(AxisSet::new(vec![bad], CYCLE).is_err());
+    let mut tiny = AxisConfig::rotary("C", 1);
+    tiny.kind = cnc_core::axis::AxisKind::Rotary { modulo: 0.00001 };
+    assert!(
+        AxisSet::new(vec![tiny], CYCLE).is_err(),
+        "a modulo below one HLI unit"
+    );
     let twins = vec![AxisConfig::linear("X", 1), AxisConfig::linear("X", 2)];
     assert!(AxisSet::new(twins, CYCLE).is_err());
     let many = (0..33)
@@ -762,4 +768,94 @@ fn a_velocity_move_from_the_soft_limit_outwards_ends_at_once_without_moving() {
     rig.ticks(200);
     assert!(rig.set_point(0).position <= 20.0);
     assert_eq!(rig.set.axis(0).unwrap().error(), None);
+}
+
+#[test]
+fn reset_without_an_error_leaves_a_running_move_alone() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1), AxisConfig::linear("Y", 2)]);
+    rig.enable(0);
+    rig.call(1, AxisCommandCall::power(true)).unwrap();
+    let id = rig
+        .call(0, AxisCommandCall::move_absolute(200.0, LIMITS))
+        .unwrap();
+    rig.call(1, AxisCommandCall::move_absolute(200.0, LIMITS))
+        .unwrap();
+    rig.ticks(100);
+    rig.call(0, AxisCommandCall::reset()).unwrap();
+    for _ in 0..50 {
+        rig.tick();
+        assert_eq!(rig.set_point(0), rig.set_point(1));
+    }
+    rig.until(5_000, |r| r.view(0, id) == CommandView::Done);
+}
+
+#[test]
+fn power_off_ends_a_coupling_at_rest_and_is_refused_at_speed() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let slave = Coupling {
+        kind: CouplingState::Cam,
+        master: 1,
+        phase: AxisState::SlaveSynchronous,
+    };
+    rig.set.axis_mut(0).unwrap().couple(slave).unwrap();
+    let moving = Kinematic {
+        position: 0.0,
+        velocity: 10.0,
+        acceleration: 0.0,
+        jerk: 0.0,
+    };
+    rig.set
+        .axis_mut(0)
+        .unwrap()
+        .drive_coupled(moving, AxisState::SlaveSynchronous);
+    rig.tick();
+    assert_eq!(
+        rig.call(0, AxisCommandCall::power(false)),
+        Err(AxisError::MovingWhileDisable)
+    );
+    let resting = Kinematic {
+        velocity: 0.0,
+        ..moving
+    };
+    rig.set
+        .axis_mut(0)
+        .unwrap()
+        .drive_coupled(resting, AxisState::SlaveSynchronous);
+    rig.tick();
+    rig.call(0, AxisCommandCall::power(false)).unwrap();
+    rig.tick();
+    let lr = CncView::new(&rig.memory)
+        .axis(0)
+        .unwrap()
+        .field::<hli::layout::HliAxisLrState>(0)
+        .read();
+    assert_eq!(lr.coupling_state_r, CouplingState::Uncoupled.raw());
+    assert_eq!(lr.axis_state_r, AxisState::Inactive.raw());
+}
+
+#[test]
+fn a_sixteen_bit_position_drive_starting_far_from_zero_does_not_jump() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.encoder_width = CounterWidth::Bits16;
+    config.drive_mode = DriveMode::Position;
+    config.drive = DriveLink::Simulated(SimDriveConfig {
+        dynamic: Dynamic::Pt1 { t1_s: 0.01 },
+        dead_time_ticks: 0,
+        start_position: 5.0,
+    });
+    let mut rig = Rig::new(vec![config]);
+    rig.enable(0);
+    rig.ticks(200);
+    // The motor stays where it started; the NC reads the 16-bit counter as a signed first value
+    // (an incremental counter knows no absolute position before homing): one wrap apart.
+    let motor = rig.set.drive_mut(0).unwrap().position();
+    assert!((motor - 5.0).abs() < 1e-9, "motor moved to {motor}");
+    let axis = rig.set.axis(0).unwrap();
+    assert!(
+        (axis.actual() - (5.0 - 6.5536)).abs() < 1e-9,
+        "actual {}",
+        axis.actual()
+    );
+    assert_eq!(axis.error(), None);
 }

@@ -94,6 +94,7 @@ impl CommandCore {
         self.execute_before = execute;
         if rising {
             self.out = BlockOutputs::default();
+            self.show_once = false;
             self.phase = match io.acyclic.start(axis, &call()) {
                 Ok(pending) => Phase::Sent(pending),
                 Err(_) => {
@@ -154,7 +155,9 @@ impl CommandCore {
                 },
                 CommandView::Error(code) => fail(code),
             };
-            if !matches!(view, CommandView::Busy(_)) {
+            // Finished, or (MC_Stop) Done once reached: the outputs hold from here on, whatever
+            // later happens to the command on the axis.
+            if !matches!(view, CommandView::Busy(_)) || self.out.done {
                 self.phase = Phase::Finished;
             }
         }
@@ -179,7 +182,8 @@ impl CommandCore {
     }
 }
 
-/// MC_Power: enables the axis while `enable` is TRUE.
+/// MC_Power: enables the axis while `enable` is TRUE. A refused level is sent again once the
+/// axis reports no error and stands (the causes of a refusal).
 #[derive(Debug, Default)]
 pub struct McPower {
     /// Input: enable the axis.
@@ -197,7 +201,11 @@ pub struct McPower {
 impl McPower {
     /// One cycle for `axis`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
-        if self.sent != Some(self.enable) {
+        let state = io.view.axis_state(axis as usize).ok();
+        let refusal_gone = state.is_some_and(|s: HliAxisLrState| {
+            s.error_id_r == 0 && s.status_r & axis_status::MOVING == 0
+        });
+        if self.sent != Some(self.enable) || (self.error && refusal_gone) {
             // A new level: send it (the core sends on its rising edge).
             self.core = CommandCore::default();
             self.sent = Some(self.enable);
@@ -208,11 +216,7 @@ impl McPower {
             .cycle(io, axis, true, || AxisCommandCall::power(enable), false);
         self.error = out.error;
         self.error_id = out.error_id;
-        self.status = io
-            .view
-            .axis_state(axis as usize)
-            .map(|s: HliAxisLrState| s.status_r & axis_status::ENABLED != 0)
-            .unwrap_or(false);
+        self.status = state.is_some_and(|s| s.status_r & axis_status::ENABLED != 0);
     }
 }
 
@@ -338,6 +342,7 @@ pub struct McStop {
     pub out: BlockOutputs,
     core: CommandCore,
     release: Option<PendingCall<AxisCommandCall>>,
+    release_due: bool,
     execute_before: bool,
 }
 
@@ -347,16 +352,21 @@ impl McStop {
         let call = AxisCommandCall::stop(self.deceleration, self.jerk);
         self.out = self.core.cycle(io, axis, self.execute, || call, true);
         if self.execute_before && !self.execute {
+            self.release_due = true;
+        }
+        self.execute_before = self.execute;
+        // The release is sent until the CNC has taken it: a lost one would lock the axis.
+        if self.release_due && self.release.is_none() {
             self.release = io
                 .acyclic
                 .start(axis, &AxisCommandCall::stop_release())
                 .ok();
         }
-        if let Some(pending) = &self.release {
-            if pending.poll().is_some() {
-                self.release = None;
+        if let Some(result) = self.release.as_ref().and_then(PendingCall::poll) {
+            self.release = None;
+            if result.is_ok_and(|reply| reply.error_id == 0) {
+                self.release_due = false;
             }
         }
-        self.execute_before = self.execute;
     }
 }

@@ -51,6 +51,7 @@ pub struct RotaryTableMaster {
     pending_ack: Option<HliMFunctionAck>,
     power: McPower,
     turn: McMoveVelocity,
+    axis_failing: bool,
     read: Option<PendingCall<ReadAxisState>>,
 }
 
@@ -87,9 +88,11 @@ impl PlcProgram for RotaryTableMaster {
         }
         self.turn.call(io, TABLE_AXIS);
         self.table_in_velocity |= self.turn.out.in_velocity;
-        if self.turn.out.error || self.power.error {
-            self.errors += 1;
+        let failing = self.turn.out.error || self.power.error;
+        if failing && !self.axis_failing {
+            self.errors += 1; // once per refusal, not per cycle it stays shown
         }
+        self.axis_failing = failing;
         // The table frame: rotation about Z by the table's actual position (wrapped to a turn).
         if let Ok(axis) = view.axis_state(TABLE_AXIS as usize) {
             self.table_position = axis.current_position_acs_r;

@@ -148,14 +148,18 @@ impl Axis {
             AxisCommandKind::Stop => {
                 self.may_move(false)?;
                 let (dec, jerk) = self.braking(call)?;
-                self.generator.brake(dec, jerk);
+                self.generator
+                    .brake(dec, jerk)
+                    .map_err(|_| AxisError::GeneratorFailed)?;
                 self.stop_lock = true;
                 Ok(self.book.begin(kind))
             }
             AxisCommandKind::Halt => {
                 self.may_move(true)?;
                 let (dec, jerk) = self.braking(call)?;
-                self.generator.brake(dec, jerk);
+                self.generator
+                    .brake(dec, jerk)
+                    .map_err(|_| AxisError::GeneratorFailed)?;
                 Ok(self.book.begin(kind))
             }
             AxisCommandKind::MoveAbsolute | AxisCommandKind::MoveRelative => {
@@ -167,7 +171,9 @@ impl Axis {
                     self.generator.state().position + call.position
                 };
                 self.check_target(target)?;
-                self.generator.move_to(target, limits);
+                self.generator
+                    .move_to(target, limits)
+                    .map_err(|_| AxisError::GeneratorFailed)?;
                 Ok(self.book.begin(kind))
             }
             AxisCommandKind::MoveVelocity => {
@@ -178,7 +184,9 @@ impl Axis {
                     -1 => -1.0,
                     _ => return Err(AxisError::InvalidDirection),
                 };
-                self.generator.run_at(sign * limits.velocity, limits);
+                self.generator
+                    .run_at(sign * limits.velocity, limits)
+                    .map_err(|_| AxisError::GeneratorFailed)?;
                 Ok(self.book.begin(kind))
             }
         }
@@ -197,9 +205,16 @@ impl Axis {
                 self.enabled = true;
             }
             0 => {
-                if self.generator.goal() != Goal::Hold && self.coupling.is_none() {
+                let moving = match self.coupling {
+                    Some(_) => self.coupled_setpoint.velocity != 0.0,
+                    None => self.generator.goal() != Goal::Hold,
+                };
+                if moving {
                     return Err(AxisError::MovingWhileDisable);
                 }
+                // A disabled axis is nobody's slave: the coupling ends with the power.
+                self.coupling = None;
+                self.stop_lock = false;
                 self.enabled = false;
                 self.book.finish(CommandResult::Aborted, None);
             }
@@ -212,8 +227,10 @@ impl Axis {
         if self.io_fault.is_some() {
             return Err(AxisError::ResetRefused);
         }
-        self.error = None;
-        self.generator.hold(self.actual);
+        // Without an error there is nothing to reset: a moving axis goes on undisturbed.
+        if self.error.take().is_some() {
+            self.generator.hold(self.actual);
+        }
         Ok(self.book.instant(AxisCommandKind::Reset))
     }
 
@@ -309,7 +326,7 @@ impl Axis {
             self.generator.hold(s.position);
         } else {
             self.generator.resume_from(s);
-            self.generator.run_at(
+            let resumed = self.generator.run_at(
                 s.velocity,
                 MoveLimits {
                     velocity: d.velocity,
@@ -318,6 +335,9 @@ impl Axis {
                     jerk: d.jerk,
                 },
             );
+            if resumed.is_err() {
+                self.fault(AxisError::GeneratorFailed);
+            }
         }
     }
 
@@ -396,10 +416,7 @@ impl Axis {
         if self.coupling.is_some() {
             return;
         }
-        let progress = match self.generator.step() {
-            Ok(p) => p,
-            Err(_) => return self.fault(AxisError::GeneratorFailed),
-        };
+        let progress = self.generator.step();
         let stopping = self.book.active().map(|a| a.kind) == Some(AxisCommandKind::Stop);
         match progress {
             Progress::Reached if stopping => self.book.mark_reached(),
@@ -438,7 +455,7 @@ impl Axis {
             + speed * self.cycle_s;
         let limit = if v > 0.0 { max } else { min };
         if (limit - s.position).abs() <= reach || (v > 0.0) == (s.position > limit) {
-            self.generator.move_to(
+            let braked = self.generator.move_to(
                 limit,
                 MoveLimits {
                     velocity: v.abs(),
@@ -447,6 +464,9 @@ impl Axis {
                     jerk: d.jerk,
                 },
             );
+            if braked.is_err() {
+                return self.fault(AxisError::GeneratorFailed);
+            }
             // The command ends with the error; the braking move runs on, owned by no command,
             // and the axis takes new commands (inside the limits) at once.
             self.book
@@ -497,7 +517,10 @@ impl Axis {
         if self.enabled {
             status |= axis_status::ENABLED;
         }
-        let moving = set.velocity != 0.0 || self.generator.goal() != Goal::Hold;
+        let moving = match self.coupling {
+            Some(_) => set.velocity != 0.0,
+            None => set.velocity != 0.0 || self.generator.goal() != Goal::Hold,
+        };
         if moving {
             status |= axis_status::MOVING;
         }

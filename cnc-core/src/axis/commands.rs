@@ -84,7 +84,7 @@ impl CommandBook {
 
     /// Marks the active command as having reached its goal while it keeps the axis.
     pub fn mark_reached(&mut self) {
-        self.reached = true;
+        self.reached = self.active.is_some();
     }
 
     /// Ends the active command (if any) with `result`.

@@ -232,8 +232,8 @@ impl AxisConfig {
             self.check(
                 "kind.modulo",
                 modulo,
-                modulo >= 0.0,
-                "must be finite and not negative",
+                modulo == 0.0 || modulo >= 0.001,
+                "must be 0 (none) or at least 0.001 degree (ten HLI units)",
             )?;
             if modulo > 0.0 && self.soft_limits.is_some() {
                 return Err(ConfigError {

@@ -65,21 +65,23 @@ pub enum Progress {
     AtVelocity,
 }
 
-/// The generator found no trajectory for the goal from the current state.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("set-point generator found no trajectory: {0}")]
-pub struct GeneratorError(pub String);
+/// The generator found no trajectory for the goal from the current state (the goal is then
+/// refused and the running one goes on).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("set-point generator found no trajectory")]
+pub struct GeneratorError;
 
 /// Set-point generator of one axis.
 pub struct SetpointGenerator {
     otg: Ruckig<1, ThrowErrorHandler>,
     input: InputParameter<1>,
     trajectory: Trajectory<1>,
+    /// A new goal is planned here and swapped in only when a profile was found.
+    candidate_input: InputParameter<1>,
+    candidate: Trajectory<1>,
     cycle_s: f64,
     /// Time along `trajectory`.
     time: f64,
-    /// The goal changed: compute a new trajectory on the next step.
-    stale: bool,
     state: Kinematic,
     goal: Goal,
     reached: bool,
@@ -110,9 +112,10 @@ impl SetpointGenerator {
             otg: Ruckig::new(None, cycle_s),
             input: InputParameter::new(None),
             trajectory: Trajectory::new(None),
+            candidate_input: InputParameter::new(None),
+            candidate: Trajectory::new(None),
             cycle_s,
             time: 0.0,
-            stale: false,
             state: Kinematic::default(),
             goal: Goal::Hold,
             reached: true,
@@ -159,31 +162,33 @@ impl SetpointGenerator {
         self.reached = true;
     }
 
-    /// Re-targets to `target` with `limits`, starting from the current set-point.
-    pub fn move_to(&mut self, target: f64, limits: MoveLimits) {
+    /// Re-targets to `target` with `limits`, starting from the current set-point. On an error
+    /// nothing changes.
+    pub fn move_to(&mut self, target: f64, limits: MoveLimits) -> Result<(), GeneratorError> {
         self.prepare(
             ControlInterface::Position,
             limits,
             target - self.state.position,
         );
-        self.input.target_position = one(target);
-        self.input.target_velocity = one(0.0);
-        self.goal = Goal::Position(target);
+        self.candidate_input.target_position = one(target);
+        self.candidate_input.target_velocity = one(0.0);
+        self.commit(Goal::Position(target))
     }
 
-    /// Re-targets to a constant signed `velocity` (|velocity| is `limits.velocity`' role here).
-    pub fn run_at(&mut self, velocity: f64, limits: MoveLimits) {
+    /// Re-targets to a constant signed `velocity`. On an error nothing changes.
+    pub fn run_at(&mut self, velocity: f64, limits: MoveLimits) -> Result<(), GeneratorError> {
         let limits = MoveLimits {
             velocity: limits.velocity.max(velocity.abs()),
             ..limits
         };
         self.prepare(ControlInterface::Velocity, limits, velocity);
-        self.input.target_velocity = one(velocity);
-        self.goal = Goal::Velocity(velocity);
+        self.candidate_input.target_velocity = one(velocity);
+        self.commit(Goal::Velocity(velocity))
     }
 
-    /// Brakes to standstill with `deceleration` and `jerk` (MC_Halt, MC_Stop).
-    pub fn brake(&mut self, deceleration: f64, jerk: f64) {
+    /// Brakes to standstill with `deceleration` and `jerk` (MC_Halt, MC_Stop). On an error
+    /// nothing changes.
+    pub fn brake(&mut self, deceleration: f64, jerk: f64) -> Result<(), GeneratorError> {
         let limits = MoveLimits {
             velocity: self.state.velocity.abs().max(f64::MIN_POSITIVE),
             acceleration: deceleration,
@@ -191,18 +196,20 @@ impl SetpointGenerator {
             jerk,
         };
         self.prepare(ControlInterface::Velocity, limits, self.state.velocity);
-        self.input.target_velocity = one(0.0);
-        self.goal = Goal::Velocity(0.0);
+        self.candidate_input.target_velocity = one(0.0);
+        self.commit(Goal::Velocity(0.0))
     }
 
+    /// Fills the candidate input for a goal from the current set-point.
     fn prepare(&mut self, interface: ControlInterface, limits: MoveLimits, travel: f64) {
         let s = self.state;
-        self.input.control_interface = interface;
-        self.input.current_position = one(s.position);
-        self.input.current_velocity = one(s.velocity);
-        self.input.current_acceleration = one(s.acceleration);
-        self.input.target_acceleration = one(0.0);
-        self.input.max_velocity = one(limits.velocity);
+        let input = &mut self.candidate_input;
+        input.control_interface = interface;
+        input.current_position = one(s.position);
+        input.current_velocity = one(s.velocity);
+        input.current_acceleration = one(s.acceleration);
+        input.target_acceleration = one(0.0);
+        input.max_velocity = one(limits.velocity);
         // Taking out an acceleration `a` with jerk `j` changes the velocity by a|a| / 2j
         // first; past the velocity limit that would run away, so use the axis's jerk.
         let velocity_after =
@@ -212,67 +219,67 @@ impl SetpointGenerator {
         } else {
             limits.jerk
         };
-        self.input.max_jerk = one(jerk);
+        input.max_jerk = one(jerk);
         // Deceleration is the acceleration against the direction of travel.
         let (up, down) = if travel >= 0.0 {
             (limits.acceleration, limits.deceleration)
         } else {
             (limits.deceleration, limits.acceleration)
         };
-        self.input.max_acceleration = one(up);
-        self.input.min_acceleration = Some(one(-down));
-        self.stale = true;
+        input.max_acceleration = one(up);
+        input.min_acceleration = Some(one(-down));
+    }
+
+    /// Plans the candidate; when a profile is found it becomes the running one.
+    fn commit(&mut self, goal: Goal) -> Result<(), GeneratorError> {
+        self.calculate_with_retries()?;
+        core::mem::swap(&mut self.input, &mut self.candidate_input);
+        core::mem::swap(&mut self.trajectory, &mut self.candidate);
+        self.time = 0.0;
+        self.goal = goal;
         self.reached = false;
+        Ok(())
     }
 
     /// One calculation; when the library finds no profile, a few slightly gentler variants of the
     /// limits (never higher ones) are tried before giving up. rsruckig 3.0.1 misses profiles
     /// on numerical knife edges (for instance 0 -> 25 with +5000/-4000 mm/s^2, or some
     /// re-targets at full deceleration) that a 0.1 % smaller limit solves.
-    fn calculate_with_retries(&mut self) -> Result<RuckigResult, GeneratorError> {
-        const VARIANTS: [(f64, bool); 5] = [
+    fn calculate_with_retries(&mut self) -> Result<(), GeneratorError> {
+        const VARIANTS: [(f64, bool); 6] = [
+            (1.0, false),
             (1.0, true),
             (0.999, false),
             (0.999, true),
             (0.99, false),
             (0.99, true),
         ];
-        let first = match self.otg.calculate(&self.input, &mut self.trajectory) {
-            Ok(result) if usable(&result) => return Ok(result),
-            Ok(result) => GeneratorError(format!("{result:?}")),
-            Err(e) => GeneratorError(e.to_string()),
-        };
-        let up = self.input.max_acceleration[0];
-        let down = self.input.min_acceleration.as_ref().map_or(up, |m| -m[0]);
-        let velocity = self.input.max_velocity[0];
+        let input = &mut self.candidate_input;
+        let up = input.max_acceleration[0];
+        let down = input.min_acceleration.as_ref().map_or(up, |m| -m[0]);
+        let velocity = input.max_velocity[0];
         for (scale, symmetric) in VARIANTS {
             let (u, d) = if symmetric {
                 (up.min(down), up.min(down))
             } else {
                 (up, down)
             };
-            self.input.max_acceleration = one(u * scale);
-            self.input.min_acceleration = Some(one(-d * scale));
-            self.input.max_velocity = one(velocity * scale);
-            if let Ok(result) = self.otg.calculate(&self.input, &mut self.trajectory) {
+            input.max_acceleration = one(u * scale);
+            input.min_acceleration = Some(one(-d * scale));
+            input.max_velocity = one(velocity * scale);
+            if let Ok(result) = self.otg.calculate(input, &mut self.candidate) {
                 if usable(&result) {
-                    return Ok(result);
+                    return Ok(());
                 }
             }
         }
-        Err(first)
+        Err(GeneratorError)
     }
 
     /// Advances one tick.
-    pub fn step(&mut self) -> Result<Progress, GeneratorError> {
+    pub fn step(&mut self) -> Progress {
         if self.goal == Goal::Hold {
-            return Ok(Progress::Idle);
-        }
-        if self.stale {
-            // A new goal: one calculation, then the profile is only sampled.
-            self.calculate_with_retries()?;
-            self.stale = false;
-            self.time = 0.0;
+            return Progress::Idle;
         }
         self.time += self.cycle_s;
         let (mut p, mut v, mut a, mut j) = (one(0.0), one(0.0), one(0.0), one(0.0));
@@ -293,7 +300,7 @@ impl SetpointGenerator {
         };
         let finished = self.time > self.trajectory.get_duration();
         if !finished {
-            return Ok(Progress::Moving);
+            return Progress::Moving;
         }
         let first = !self.reached;
         self.reached = true;
@@ -301,25 +308,25 @@ impl SetpointGenerator {
             Goal::Position(target) => {
                 // Land exactly: the profile ends on the target at rest.
                 self.hold(target);
-                Ok(Progress::Reached)
+                Progress::Reached
             }
             Goal::Velocity(0.0) => {
                 let position = self.state.position;
                 self.hold(position);
-                Ok(Progress::Reached)
+                Progress::Reached
             }
             Goal::Velocity(v) => {
                 // Cruise: constant velocity from here on, integrated exactly.
                 self.state.acceleration = 0.0;
                 self.state.jerk = 0.0;
                 self.state.velocity = v;
-                Ok(if first {
+                if first {
                     Progress::Reached
                 } else {
                     Progress::AtVelocity
-                })
+                }
             }
-            Goal::Hold => Ok(Progress::Idle),
+            Goal::Hold => Progress::Idle,
         }
     }
 }
@@ -330,9 +337,9 @@ mod tests {
 
     fn run(from: f64, to: f64, l: MoveLimits) -> Result<usize, GeneratorError> {
         let mut g = SetpointGenerator::new(0.001, from);
-        g.move_to(to, l);
+        g.move_to(to, l)?;
         let mut n = 0;
-        while g.step()? != Progress::Reached {
+        while g.step() != Progress::Reached {
             n += 1;
             assert!(n < 100_000);
         }
@@ -349,9 +356,9 @@ mod tests {
             deceleration: 8614.688363408739,
             jerk: 184719.09022780522,
         };
-        g.move_to(-77.90457864321381, first);
+        g.move_to(-77.90457864321381, first).unwrap();
         for _ in 0..218 {
-            g.step().unwrap();
+            g.step();
         }
         let second = MoveLimits {
             velocity: 722.222359667801,
@@ -359,9 +366,9 @@ mod tests {
             deceleration: 8127.029675668488,
             jerk: 196414.45591088082,
         };
-        g.move_to(-895.1502189081375, second);
+        g.move_to(-895.1502189081375, second).unwrap();
         let mut n = 0;
-        while g.step().unwrap() != Progress::Reached {
+        while g.step() != Progress::Reached {
             n += 1;
             assert!(n < 10_000);
         }

@@ -33,14 +33,6 @@ impl CounterWidth {
             CounterWidth::Bits16 => i64::from((new as u16).wrapping_sub(old as u16) as i16),
         }
     }
-
-    /// The largest change per tick the counting can tell apart from a wrap.
-    pub fn half_range(self) -> i64 {
-        match self {
-            CounterWidth::Bits32 => 1 << 31,
-            CounterWidth::Bits16 => 1 << 15,
-        }
-    }
 }
 
 /// Counts the wraps of an encoder's raw increments into an unbounded count.
@@ -77,9 +69,11 @@ impl IncrementCounter {
         self.count
     }
 
-    /// The count after the last reading.
-    pub fn count(&self) -> i64 {
-        self.count
+    /// Starts from a known `count` whose raw image is `raw` (instead of taking the first
+    /// reading as the start).
+    pub fn seed(&mut self, count: i64, raw: i32) {
+        self.count = count;
+        self.last_raw = Some(raw);
     }
 
     /// Whether a reading has been taken.
@@ -116,7 +110,10 @@ mod tests {
                              steps in proptest::collection::vec(-30_000i64..30_000, 1..400),
                              scale in 1i64..70_000, sixteen in any::<bool>()) {
             let width = if sixteen { CounterWidth::Bits16 } else { CounterWidth::Bits32 };
-            let limit = width.half_range() - 1;
+            let limit = match width {
+                CounterWidth::Bits32 => (1i64 << 31) - 1,
+                CounterWidth::Bits16 => (1i64 << 15) - 1,
+            };
             let mut c = IncrementCounter::new(width);
             let mut truth = match width {
                 CounterWidth::Bits32 => i64::from(start as i32),

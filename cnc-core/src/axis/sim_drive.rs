@@ -153,7 +153,14 @@ impl SimulatedDrive {
             pt2_rate: 0.0,
             delay: [start_command; MAX_DEAD_TIME_TICKS as usize + 1],
             delay_head: 0,
-            set_counter: IncrementCounter::new(scaling.width),
+            set_counter: {
+                // Seeded with the start position, so a 16-bit set-point far from zero is not
+                // read as a sign-extended first value.
+                let mut counter = IncrementCounter::new(scaling.width);
+                let start = (config.start_position * scaling.increments_per_unit).round() as i64;
+                counter.seed(start, scaling.width.wrap(start));
+                counter
+            },
             encoder_io_invalid: false,
             drive_io_invalid: false,
         }
