@@ -225,13 +225,11 @@ fn halt_brakes_to_standstill_and_aborts_the_velocity_move() {
     assert_eq!(rig.view(0, run), CommandView::Aborted);
     let mut previous = rig.set_point(0).velocity;
     rig.until(2_000, |r| r.view(0, halt) == CommandView::Done);
-    let mut ticks = 0;
-    while ticks < 10 {
+    for _ in 0..10 {
         rig.tick();
         let v = rig.set_point(0).velocity;
         assert!(v <= previous + 1e-9, "velocity rose while halted");
         previous = v;
-        ticks += 1;
     }
     assert_eq!(rig.set_point(0).velocity, 0.0);
     // After a halt the axis takes moves at once.

@@ -37,15 +37,18 @@ pub struct BlockOutputs {
 }
 
 enum Phase {
+    /// Nothing running: before the first edge, or the command has ended (outputs hold).
     Idle,
+    /// Sent, no reply yet.
     Sent(PendingCall<AxisCommandCall>),
+    /// Accepted with this id; followed in the command book.
     Following(u32),
-    Finished,
 }
 
 /// The Execute/Busy/Done machinery shared by the blocks.
 pub struct CommandCore {
     execute_before: bool,
+    fell: bool,
     phase: Phase,
     out: BlockOutputs,
     show_once: bool,
@@ -55,6 +58,7 @@ impl Default for CommandCore {
     fn default() -> Self {
         Self {
             execute_before: false,
+            fell: false,
             phase: Phase::Idle,
             out: BlockOutputs::default(),
             show_once: false,
@@ -91,6 +95,7 @@ impl CommandCore {
         finished_when_reached: bool,
     ) -> BlockOutputs {
         let rising = execute && !self.execute_before;
+        self.fell = !execute && self.execute_before;
         self.execute_before = execute;
         if rising {
             self.out = BlockOutputs::default();
@@ -99,7 +104,7 @@ impl CommandCore {
                 Ok(pending) => Phase::Sent(pending),
                 Err(_) => {
                     self.out = fail(ERROR_NO_ANSWER);
-                    Phase::Finished
+                    Phase::Idle
                 }
             };
         }
@@ -108,16 +113,16 @@ impl CommandCore {
                 None => self.out.busy = true,
                 Some(Ok(reply)) if reply.error_id != 0 => {
                     self.out = fail(reply.error_id);
-                    self.phase = Phase::Finished;
+                    self.phase = Phase::Idle;
                 }
                 Some(Ok(reply)) => self.phase = Phase::Following(reply.command_id),
                 Some(Err(CallError::Refused { code })) => {
                     self.out = fail(code.raw());
-                    self.phase = Phase::Finished;
+                    self.phase = Phase::Idle;
                 }
                 Some(Err(_)) => {
                     self.out = fail(ERROR_NO_ANSWER);
-                    self.phase = Phase::Finished;
+                    self.phase = Phase::Idle;
                 }
             }
         }
@@ -128,7 +133,7 @@ impl CommandCore {
                     .read(),
                 Err(_) => {
                     self.out = fail(hli::rpc::ErrorCode::InvalidTarget.raw());
-                    self.phase = Phase::Finished;
+                    self.phase = Phase::Idle;
                     return self.finish_cycle(execute);
                 }
             };
@@ -158,10 +163,15 @@ impl CommandCore {
             // Finished, or (MC_Stop) Done once reached: the outputs hold from here on, whatever
             // later happens to the command on the axis.
             if !matches!(view, CommandView::Busy(_)) || self.out.done {
-                self.phase = Phase::Finished;
+                self.phase = Phase::Idle;
             }
         }
         self.finish_cycle(execute)
+    }
+
+    /// Whether Execute fell in the last cycle.
+    pub fn fell(&self) -> bool {
+        self.fell
     }
 
     fn finish_cycle(&mut self, execute: bool) -> BlockOutputs {
@@ -343,7 +353,6 @@ pub struct McStop {
     core: CommandCore,
     release: Option<PendingCall<AxisCommandCall>>,
     release_due: bool,
-    execute_before: bool,
 }
 
 impl McStop {
@@ -351,10 +360,7 @@ impl McStop {
     pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
         let call = AxisCommandCall::stop(self.deceleration, self.jerk);
         self.out = self.core.cycle(io, axis, self.execute, || call, true);
-        if self.execute_before && !self.execute {
-            self.release_due = true;
-        }
-        self.execute_before = self.execute;
+        self.release_due |= self.core.fell();
         // The release is sent until the CNC has taken it: a lost one would lock the axis.
         if self.release_due && self.release.is_none() {
             self.release = io
