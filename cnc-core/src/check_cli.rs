@@ -2,7 +2,7 @@
 //! `FILE:LINE:COL: error: MESSAGE`, optionally print the decoded motion blocks as JSON lines.
 
 use crate::json::number;
-use crate::nc::decode::ZeroVars;
+use crate::nc::decode::{check_channel_axes, ZeroVars};
 use crate::nc::{decode_program, parse, Decoded, Diagnostic};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -35,7 +35,7 @@ pub fn check_source(src: &str, axes: &[String]) -> (Vec<Diagnostic>, Vec<Decoded
 pub fn motion_json(block: &crate::nc::MotionBlock, axes: &[String]) -> String {
     let target: Vec<String> = axes
         .iter()
-        .zip(&block.target)
+        .zip(block.target.iter())
         .map(|(name, v)| format!("\"{name}\":{}", number(*v)))
         .collect();
     format!(
@@ -54,6 +54,10 @@ pub fn main(args: CheckArgs) -> ExitCode {
         .iter()
         .map(|a| a.trim().to_ascii_uppercase())
         .collect();
+    if let Err(message) = check_channel_axes(&axes) {
+        eprintln!("error: --axes: {message}");
+        return ExitCode::from(2);
+    }
     let mut failed = false;
     let mut out = String::new();
     for file in &args.files {

@@ -104,3 +104,18 @@ fn several_files_and_unreadable_ones() {
         "{err}"
     );
 }
+
+#[test]
+fn bad_axis_lists_are_refused_before_any_file() {
+    let file = write("axes_list.nc", "N10 G1 X1 F100\n");
+    for (axes, why) in [
+        ("X,Y,X", "given twice"),
+        ("X,1Y", "upper-case letters then digits"),
+        ("A,B,C,D,E,F,G,H,I,J,K,L,M,N,O,P,Q", "1 to 16 axes"),
+    ] {
+        let (code, out, err) = cnc(&["check", "--axes", axes, &file]);
+        assert_eq!(code, 2, "{axes}: {out}{err}");
+        assert!(err.contains(why), "{axes}: {err}");
+        assert!(out.is_empty());
+    }
+}

@@ -8,7 +8,7 @@
 
 use cnc_core::nc::ast::*;
 use cnc_core::nc::decode::ZeroVars;
-use cnc_core::nc::{decode_program, parse, print};
+use cnc_core::nc::{decode_program, parse, parse_general, print};
 use proptest::prelude::*;
 
 fn span() -> Span {
@@ -28,7 +28,10 @@ fn variable() -> impl Strategy<Value = Name> {
 }
 
 fn atom() -> impl Strategy<Value = Expr> {
-    prop_oneof![number().prop_map(Expr::Num), variable().prop_map(Expr::Var)]
+    prop_oneof![
+        number().prop_map(Expr::Num),
+        variable().prop_map(|v| Expr::Var(Box::new(v)))
+    ]
 }
 
 /// Expressions in the shapes the parser produces: left-associative chains with precedence,
@@ -45,9 +48,8 @@ fn expr() -> impl Strategy<Value = Expr> {
         ),
     )
         .prop_map(|(first, rest)| {
-            rest.into_iter().fold(first, |acc, (op, t)| {
-                Expr::Bin(op, Box::new(acc), Box::new(t))
-            })
+            rest.into_iter()
+                .fold(first, |acc, (op, t)| Expr::Bin(Box::new((op, acc, t))))
         })
 }
 
@@ -221,24 +223,19 @@ fn motion_block() -> impl Strategy<Value = Vec<Item>> {
         })
 }
 
-fn block() -> impl Strategy<Value = Block> {
+fn block() -> impl Strategy<Value = (Option<u32>, Vec<Item>)> {
     (
         prop::option::of(0u32..100_000),
         prop_oneof![
             motion_block(),
             command().prop_map(|command| vec![Item::Command {
-                command,
+                command: Box::new(command),
                 span: span()
             }])
         ],
     )
         .prop_filter("blocks hold something", |(n, items)| {
             n.is_some() || !items.is_empty()
-        })
-        .prop_map(|(number, items)| Block {
-            number,
-            items,
-            span: span(),
         })
 }
 
@@ -247,7 +244,16 @@ fn program() -> impl Strategy<Value = Program> {
         prop::option::of("[A-Za-z][A-Za-z0-9_-]{0,12}"),
         prop::collection::vec(block(), 0..40),
     )
-        .prop_map(|(name, blocks)| Program { name, blocks })
+        .prop_map(|(name, blocks)| {
+            let mut program = Program {
+                name,
+                ..Program::default()
+            };
+            for (number, items) in blocks {
+                program.push_block(number, items, span());
+            }
+            program
+        })
 }
 
 proptest! {
@@ -292,5 +298,60 @@ proptest! {
         }
         let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"].map(String::from).to_vec();
         let _ = decode_program(&tree, &text, &axes, &ZeroVars);
+    }
+}
+
+/// Pieces of lines near the fast lane's edges: plain words, and everything that must send a
+/// line to the general path.
+fn fragment() -> impl Strategy<Value = String> {
+    prop_oneof![
+        4 => prop::sample::select(vec![
+            "N10", "n00860", "N4294967295", "N4294967296", "N-3", "N1.5", "G1", "G01", "g0",
+            "G1.5", "G-1", "M30", "M3.0", "F500", "f-5", "X10", "X-60", "x+2.5", "Y.5",
+            "Z1.", "Z1..2", "AB90", "X1", "ABCDEFGHIJKLMNOPQRSTUVWXYZ1", "X1234567890123456",
+            "X123456789012345", "X12.345678901234", "E3", "X1E3", "X1Y2", "X", "X 10", "N",
+        ]).prop_map(String::from),
+        1 => prop::sample::select(vec![
+            " ", "  ", "\t", "\r", ";", "; note", "(c)", "=", "[", "]", "#", "$", "%p", "_",
+            "V.G.TRACK_CS.X", "\\", "\"s\"", "ä", "-", "+", ".", "1",
+        ]).prop_map(String::from),
+    ]
+}
+
+fn fragment_lines() -> impl Strategy<Value = String> {
+    prop::collection::vec(
+        (
+            prop::collection::vec((fragment(), prop::bool::weighted(0.8)), 0..7),
+            prop::bool::weighted(0.9),
+        ),
+        0..6,
+    )
+    .prop_map(|lines| {
+        let mut text = String::new();
+        for (parts, newline) in lines {
+            for (part, space) in parts {
+                text.push_str(&part);
+                if space {
+                    text.push(' ');
+                }
+            }
+            if newline {
+                text.push('\n');
+            }
+        }
+        text
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(2048))]
+
+    /// The fast lane for plain blocks gives the very tree (spans included: the debug form
+    /// prints them, unlike tree equality) and diagnostics that the general path gives.
+    #[test]
+    fn fast_lane_matches_general_path(text in fragment_lines()) {
+        let fast = parse(&text);
+        let general = parse_general(&text);
+        prop_assert_eq!(format!("{fast:#?}"), format!("{general:#?}"), "{:?}", text);
     }
 }

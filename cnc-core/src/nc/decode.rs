@@ -62,6 +62,81 @@ impl MotionMode {
     }
 }
 
+/// Most axes one channel can have.
+pub const MAX_CHANNEL_AXES: usize = 16;
+
+/// One value per channel axis, in channel order, stored inline: a decoded block needs no heap
+/// allocation, and the channel's tick can copy targets freely.
+#[derive(Clone, Copy, PartialEq)]
+pub struct AxisValues {
+    len: u8,
+    /// Slots beyond `len` stay 0, so the derived equality compares only the used ones.
+    values: [f64; MAX_CHANNEL_AXES],
+}
+
+impl AxisValues {
+    /// `n` zeros; `n` is cut to [`MAX_CHANNEL_AXES`] ([`check_channel_axes`] refuses more).
+    pub fn zeros(n: usize) -> Self {
+        Self {
+            len: n.min(MAX_CHANNEL_AXES) as u8,
+            values: [0.0; MAX_CHANNEL_AXES],
+        }
+    }
+
+    /// The values of `slice` (cut to [`MAX_CHANNEL_AXES`]).
+    pub fn from_slice(slice: &[f64]) -> Self {
+        let mut v = Self::zeros(slice.len());
+        let n = v.len();
+        v.values[..n].copy_from_slice(&slice[..n]);
+        v
+    }
+}
+
+impl core::ops::Deref for AxisValues {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        &self.values[..self.len as usize]
+    }
+}
+
+impl core::ops::DerefMut for AxisValues {
+    fn deref_mut(&mut self) -> &mut [f64] {
+        &mut self.values[..self.len as usize]
+    }
+}
+
+impl core::fmt::Debug for AxisValues {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
+}
+
+/// Checks a channel's axis names: 1 to [`MAX_CHANNEL_AXES`] of them, each a letter followed by
+/// letters or digits (`X`, `AB`, `X1`), none twice.
+pub fn check_channel_axes(axes: &[String]) -> Result<(), String> {
+    if axes.is_empty() || axes.len() > MAX_CHANNEL_AXES {
+        return Err(format!(
+            "a channel has 1 to {MAX_CHANNEL_AXES} axes, found {}",
+            axes.len()
+        ));
+    }
+    for (i, a) in axes.iter().enumerate() {
+        let mut chars = a.chars();
+        let well_formed = chars.next().is_some_and(|c| c.is_ascii_uppercase())
+            && chars.all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
+            && a.len() <= Name::CAPACITY;
+        if !well_formed {
+            return Err(format!(
+                "axis name \"{a}\" must be upper-case letters then digits (e.g. X, AB, X1)"
+            ));
+        }
+        if axes[..i].contains(a) {
+            return Err(format!("axis name \"{a}\" is given twice"));
+        }
+    }
+    Ok(())
+}
+
 /// A path motion with absolute targets for every axis of the channel.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MotionBlock {
@@ -74,7 +149,7 @@ pub struct MotionBlock {
     /// Feed (mm/min).
     pub feed: f64,
     /// Target per channel axis, in channel order.
-    pub target: Vec<f64>,
+    pub target: AxisValues,
 }
 
 /// Where a tracking channel takes its dynamic coordinate system from.
@@ -258,9 +333,9 @@ pub struct DecoderState {
     axes: Vec<String>,
     /// The same names for fast comparison with names from the tree.
     axis_names: Vec<Name>,
-    position: Vec<f64>,
-    g92: Vec<f64>,
-    pset: Vec<f64>,
+    position: AxisValues,
+    g92: AxisValues,
+    pset: AxisValues,
     absolute: bool,
     motion: MotionMode,
     feed: f64,
@@ -297,7 +372,8 @@ impl Ctx<'_> {
                 }
             },
             Expr::Neg(inner) => self.eval(inner, span).map(|v| -v),
-            Expr::Bin(op, a, b) => {
+            Expr::Bin(bin) => {
+                let (op, a, b) = &**bin;
                 let (a, b) = (self.eval(a, span)?, self.eval(b, span)?);
                 let bool_val = |c: bool| if c { 1.0 } else { 0.0 };
                 Some(match op {
@@ -343,14 +419,37 @@ impl DecoderState {
         Self {
             axes: axes.to_vec(),
             axis_names: axes.iter().map(|a| Name::from(a.as_str())).collect(),
-            position: vec![0.0; n],
-            g92: vec![0.0; n],
-            pset: vec![0.0; n],
+            position: AxisValues::zeros(n),
+            g92: AxisValues::zeros(n),
+            pset: AxisValues::zeros(n),
             absolute: true,
             motion: MotionMode::Rapid,
             feed: 0.0,
             scratch: Vec::with_capacity(8),
         }
+    }
+
+    /// Decodes block `index` of `program` (parsed from `src`) with the variable values of
+    /// `vars` now, appending its elements to `out`: how a channel consumes its program, one
+    /// block when it reaches it. Returns the block's diagnostics (empty when it decoded
+    /// cleanly; nothing is allocated then). Control statements carry unresolved positions (0).
+    pub fn decode_block(
+        &mut self,
+        program: &Program,
+        index: usize,
+        src: &str,
+        vars: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Vec<Diagnostic> {
+        let mut ctx = Ctx {
+            src,
+            vars,
+            diags: Vec::new(),
+        };
+        if let Some(block) = program.blocks.get(index) {
+            self.block(block, program.items_of(block), &mut ctx, out);
+        }
+        ctx.diags
     }
 
     /// The channel's axis names.
@@ -379,14 +478,14 @@ impl DecoderState {
 
     /// Decodes one block; `out` receives its elements. Control statements are emitted with
     /// unresolved indices (0); [`decode_program`] resolves them.
-    fn block(&mut self, block: &Block, ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
+    fn block(&mut self, block: &Block, items: &[Item], ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
         let line = block.span.line;
         let mut g92 = false;
         let mut motion_code: Option<(u32, Span)> = None;
         let mut axis_words = core::mem::take(&mut self.scratch);
         axis_words.clear();
         let mut tail: Vec<Decoded> = Vec::new();
-        for item in &block.items {
+        for item in items {
             match item {
                 Item::G { code, span } => match code {
                     0 | 1 => {
@@ -460,7 +559,7 @@ impl DecoderState {
                         Control::Else => ControlOp::Else { end: 0 },
                         Control::EndIf => ControlOp::EndIf,
                     };
-                    if block.items.len() > 1 {
+                    if items.len() > 1 {
                         ctx.error(block.span, "a $ statement stands alone in its block");
                     }
                     tail.push(Decoded::Control { line, op });
@@ -494,7 +593,7 @@ impl DecoderState {
                 number: block.number,
                 motion: self.motion,
                 feed: self.feed,
-                target: self.position.clone(),
+                target: self.position,
             }));
         }
         out.extend(tail);
@@ -794,18 +893,27 @@ pub fn decode_program(
     axes: &[String],
     vars: &dyn Vars,
 ) -> (Vec<Decoded>, Vec<Diagnostic>) {
-    let mut state = DecoderState::new(axes);
     let mut ctx = Ctx {
         src,
         vars,
         diags: Vec::new(),
     };
+    if let Err(message) = check_channel_axes(axes) {
+        let first_line = Span {
+            line: 1,
+            col: 1,
+            ..Span::default()
+        };
+        ctx.error(first_line, message);
+        return (Vec::new(), ctx.diags);
+    }
+    let mut state = DecoderState::new(axes);
     let mut out = Vec::with_capacity(program.blocks.len());
     // Spans of control statements only, by stream index, for the matching errors.
     let mut control_spans: Vec<(usize, Span)> = Vec::new();
     for block in &program.blocks {
         let before = out.len();
-        state.block(block, &mut ctx, &mut out);
+        state.block(block, program.items_of(block), &mut ctx, &mut out);
         for (i, d) in out.iter().enumerate().skip(before) {
             if matches!(d, Decoded::Control { .. }) {
                 control_spans.push((i, block.span));

@@ -49,11 +49,11 @@ pub struct LexError {
     pub message: String,
 }
 
-struct Cursor<'a> {
-    src: &'a str,
-    pos: usize,
-    line: u32,
-    col: u32,
+pub(super) struct Cursor<'a> {
+    pub(super) src: &'a str,
+    pub(super) pos: usize,
+    pub(super) line: u32,
+    pub(super) col: u32,
 }
 
 impl Cursor<'_> {
@@ -140,10 +140,11 @@ pub fn tokenize(src: &str, errors: &mut Vec<LexError>) -> Vec<Token> {
 /// A lexer that hands out one block (logical line) at a time, so the parser works on a small
 /// buffer instead of a token vector of the whole file.
 pub struct Lexer<'a> {
-    c: Cursor<'a>,
-    depth: usize,
-    spaced: bool,
-    finished: bool,
+    pub(super) c: Cursor<'a>,
+    /// Open `[` brackets.
+    pub(super) depth: usize,
+    pub(super) spaced: bool,
+    pub(super) finished: bool,
     /// Problems found so far (unterminated comments and strings, malformed numbers).
     pub errors: Vec<LexError>,
 }
@@ -467,7 +468,7 @@ impl<'a> Lexer<'a> {
 /// A plain decimal `digits[.digits]` at the start of `bytes` with at most 15 digits: its exact
 /// value (see [`parse_decimal`]) and length. `None` for anything the general path must judge
 /// (a second dot, more digits).
-fn plain_number(bytes: &[u8]) -> Option<(f64, usize)> {
+pub(super) fn plain_number(bytes: &[u8]) -> Option<(f64, usize)> {
     const POW10: [f64; 16] = [
         1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     ];
@@ -496,7 +497,7 @@ fn plain_number(bytes: &[u8]) -> Option<(f64, usize)> {
     Some((mantissa as f64 / POW10[fraction.unwrap_or(0)], p))
 }
 
-fn offset(pos: usize) -> u32 {
+pub(super) fn offset(pos: usize) -> u32 {
     pos.min(u32::MAX as usize) as u32
 }
 

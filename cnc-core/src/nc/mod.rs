@@ -3,12 +3,13 @@
 
 pub mod ast;
 pub mod decode;
+mod fast_lane;
 pub mod lexer;
 pub mod parser;
 pub mod printer;
 
 pub use decode::{decode_program, Decoded, DecoderState, MotionBlock, MotionMode};
-pub use parser::parse;
+pub use parser::{parse, parse_general};
 pub use printer::print;
 
 use ast::Span;

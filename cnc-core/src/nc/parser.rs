@@ -1,17 +1,28 @@
 //! The parser: tokens to the program tree. It never gives up: a bad item is reported with its
 //! span and what was expected, skipped, and parsing goes on with the next item.
 
+use super::ast::arena_index;
 use super::ast::*;
 use super::lexer::{Lexer, Name, Tok, Token};
 use super::Diagnostic;
 
 /// Parses `src`; the tree holds everything that could be understood.
 pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
+    parse_with(src, true)
+}
+
+/// [`parse`] without the fast lane for plain blocks: every line through the general lexer and
+/// parser. The same result, slower; for the tests that hold the fast lane to it.
+pub fn parse_general(src: &str) -> (Program, Vec<Diagnostic>) {
+    parse_with(src, false)
+}
+
+fn parse_with(src: &str, fast_lane: bool) -> (Program, Vec<Diagnostic>) {
     let mut p = Parser {
         src,
+        fast_lane,
         lexer: Lexer::new(src),
         tokens: Vec::with_capacity(32),
-        items: Vec::with_capacity(16),
         pos: 0,
         diags: Vec::new(),
     };
@@ -31,10 +42,10 @@ pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
 /// newline token.
 struct Parser<'a> {
     src: &'a str,
+    /// Whether plain blocks take the fast lane (see `fast_lane.rs`).
+    fast_lane: bool,
     lexer: Lexer<'a>,
     tokens: Vec<Token>,
-    /// Reused buffer for the items of the block being parsed.
-    items: Vec<Item>,
     pos: usize,
     diags: Vec<Diagnostic>,
 }
@@ -143,7 +154,24 @@ impl Parser<'_> {
 
     fn program(&mut self) -> Program {
         let mut program = Program::default();
-        while self.lexer.next_block(&mut self.tokens) {
+        // Reserving for one block per line saves the copies of growing (a count of newlines
+        // is cheap next to lexing them). Capped: beyond it, growth is amortised anyway, and a
+        // file of blank lines must not reserve gigabytes.
+        const RESERVE_CAP: usize = 1 << 20;
+        let lines = self.src.bytes().filter(|&b| b == b'\n').count() + 1;
+        program.blocks.reserve(lines.min(RESERVE_CAP));
+        // An item takes a few source bytes at least (`X1 `).
+        program.items.reserve((self.src.len() / 4).min(RESERVE_CAP));
+        loop {
+            if self.fast_lane {
+                if let Some(block) = self.lexer.simple_block(&mut program.items) {
+                    program.blocks.push(block);
+                    continue;
+                }
+            }
+            if !self.lexer.next_block(&mut self.tokens) {
+                break;
+            }
             self.pos = 0;
             if let Tok::Percent(name) = self.peek().clone() {
                 let span = self.span();
@@ -168,18 +196,21 @@ impl Parser<'_> {
                 }
                 continue;
             }
-            if let Some(block) = self.block() {
+            let items_before = program.items.len();
+            if let Some(block) = self.block(&mut program.items) {
                 program.blocks.push(block);
+            } else {
+                program.items.truncate(items_before);
             }
         }
         program
     }
 
-    fn block(&mut self) -> Option<Block> {
+    fn block(&mut self, arena: &mut Vec<Item>) -> Option<Block> {
         let span = self.span();
         let mut block = Block {
             number: None,
-            items: Vec::new(),
+            items: 0..0,
             span,
         };
         if let Tok::Addr(n, value) = *self.peek() {
@@ -211,22 +242,17 @@ impl Parser<'_> {
                 }
             }
         }
-        // Items gather in a reused buffer; the block keeps an exactly sized copy (a block's
-        // worth of capacity slack would double the tree's memory).
-        let mut items = core::mem::take(&mut self.items);
-        items.clear();
+        let first = arena.len();
         while !self.at_end_of_block() {
             let before = self.pos;
             if let Some(item) = self.item() {
-                items.push(item);
+                arena.push(item);
             }
             if self.pos == before {
                 self.bump();
             }
         }
-        block.items = Vec::with_capacity(items.len());
-        block.items.append(&mut items);
-        self.items = items;
+        block.items = arena_index(first)..arena_index(arena.len());
         block.span = self.extend(block.span);
         (block.number.is_some() || !block.items.is_empty()).then_some(block)
     }
@@ -239,7 +265,10 @@ impl Parser<'_> {
                 self.bump();
                 let command = self.command(full)?;
                 let span = self.extend(span);
-                Some(Item::Command { command, span })
+                Some(Item::Command {
+                    command: Box::new(command),
+                    span,
+                })
             }
             Tok::Punct("$") => {
                 let full = self.to_block_end(span);
@@ -350,7 +379,7 @@ impl Parser<'_> {
             let options = self.bracket_list()?;
             return Some(Item::IndependentAxis {
                 name,
-                options,
+                options: options.into(),
                 span: self.extend(span),
             });
         }
@@ -819,7 +848,7 @@ impl Parser<'_> {
         {
             self.bump();
             let rhs = self.binary(op.precedence() + 1)?;
-            lhs = Expr::Bin(op, Box::new(lhs), Box::new(rhs));
+            lhs = Expr::Bin(Box::new((op, lhs, rhs)));
         }
         Some(lhs)
     }
@@ -859,7 +888,7 @@ impl Parser<'_> {
             }
             Tok::Var(v) => {
                 self.bump();
-                Some(Expr::Var(v))
+                Some(Expr::Var(Box::new(v)))
             }
             _ => {
                 let (span, found) = (self.span(), self.describe());

@@ -14,7 +14,7 @@ pub fn print(program: &Program) -> String {
         if let Some(n) = block.number {
             parts.push(format!("N{n}"));
         }
-        parts.extend(block.items.iter().map(item));
+        parts.extend(program.items_of(block).iter().map(item));
         let _ = writeln!(out, "{}", parts.join(" "));
     }
     out
@@ -38,7 +38,8 @@ pub fn expr(e: &Expr) -> String {
                 out.push('-');
                 go(inner, out, 4, false);
             }
-            Expr::Bin(op, a, b) => {
+            Expr::Bin(bin) => {
+                let (op, a, b) = &**bin;
                 let prec = op.precedence();
                 // Without grouping brackets in the language, only trees the precedence rules
                 // produce are printable exactly; others print in that shape.
@@ -111,7 +112,7 @@ fn item(i: &Item) -> String {
             Control::Else => "$ELSE".into(),
             Control::EndIf => "$ENDIF".into(),
         },
-        Item::Command { command, .. } => match command {
+        Item::Command { command, .. } => match command.as_ref() {
             Command::TrackCs { on, options } if options.is_empty() => {
                 format!("#TRACK CS {}", on_off(*on))
             }
