@@ -452,6 +452,26 @@ impl DecoderState {
         ctx.diags
     }
 
+    /// The programmed position per axis (after offsets), as the next incremental block sees it.
+    pub fn position(&self) -> &AxisValues {
+        &self.position
+    }
+
+    /// Sets the programmed position of `axis` (the channel re-expresses its position when a
+    /// transformation or coordinate system is switched).
+    pub fn set_position(&mut self, axis: usize, value: f64) {
+        if let Some(p) = self.position.get_mut(axis) {
+            *p = value;
+        }
+    }
+
+    /// Sets the additive G92 offset of `axis` (`#TRACK CS ABS` uses it like `G92 X=...`).
+    pub fn set_g92(&mut self, axis: usize, value: f64) {
+        if let Some(p) = self.g92.get_mut(axis) {
+            *p = value;
+        }
+    }
+
     /// The channel's axis names.
     pub fn axes(&self) -> &[String] {
         &self.axes
@@ -705,7 +725,9 @@ impl DecoderState {
                     Some(e) => Some(ctx.whole(e, span, "kinematic id", 0.0, 65535.0)?),
                     None => None,
                 };
-                Some(Decoded::Trafo { line, on: *on, id })
+                // `#TRAFO [45]` switches on with that id (as the seed's programs use it).
+                let on = on.or(id.map(|_| true));
+                Some(Decoded::Trafo { line, on, id })
             }
             Command::KinId { id } => {
                 let id = ctx.whole(id, span, "kinematic id", 0.0, 65535.0)?;
@@ -882,6 +904,17 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         ok = false;
     }
     (ok && (t.source.is_some() || !on)).then_some(t)
+}
+
+/// Evaluates `expr` with the variables of `vars` (a `$WHILE`/`$IF` condition at run time);
+/// `None` for an unknown variable or a division by zero.
+pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
+    let mut ctx = Ctx {
+        src: "",
+        vars,
+        diags: Vec::new(),
+    };
+    ctx.eval(expr, Span::default())
 }
 
 /// Decodes a whole program for a channel with `axes`, reading variables from `vars`; control

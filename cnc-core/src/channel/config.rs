@@ -1,0 +1,247 @@
+//! Channel configuration, under the controller's parameter names where the seed documents one:
+//! `provide_channel_interface.track_cs` (P-CHAN-00399), `kin_trafo_display` (P-CHAN-00145) and
+//! the start-up parameter `configuration.channel[i].interpolator.dyn_cs_history_max`
+//! (P-STUP-00074, default 20).
+
+use super::path::AxisLimits;
+use crate::nc::decode::check_channel_axes;
+use kinematics::cartesian::Cartesian;
+use kinematics::opw::{Robot45, Robot45Params};
+use kinematics::{JointLimit, KinematicId, Kinematics, PoseWords, RotationOrder};
+use serde::Deserialize;
+
+/// One channel.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChannelConfig {
+    /// Name for messages and traces.
+    pub name: String,
+    /// Axis names in channel order; with a kinematic transformation the first six are the
+    /// robot's joints (and X Y Z A B C of the tool pose when the transformation is on).
+    pub axes: Vec<String>,
+    /// The channel's kinematics.
+    #[serde(default)]
+    pub kinematics: KinematicsConfig,
+    /// Dynamic limits of every programmed coordinate (mm or degrees per second).
+    #[serde(default = "default_limits")]
+    pub limits: AxisLimits,
+    /// Axis values at start (joints for a robot), in channel order; missing ones are 0.
+    #[serde(default)]
+    pub start: Vec<f64>,
+    /// P-CHAN-00399.
+    #[serde(default)]
+    pub provide_channel_interface: ProvideChannelInterface,
+    /// P-CHAN-00145: 0 off, 1 (or 2) display the TCP position in `w0_position_r`.
+    #[serde(default)]
+    pub kin_trafo_display: u16,
+    /// Orientation convention of A B C: 0 yaw-pitch-roll, 1 Euler Z-Y'-Z'', 2 CBA.
+    #[serde(default)]
+    pub ori_rotation_angle: u32,
+    /// Start-up parameters of the channel's interpolator.
+    #[serde(default)]
+    pub interpolator: InterpolatorConfig,
+}
+
+/// `provide_channel_interface.*`.
+#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProvideChannelInterface {
+    /// Publish the dynamic CS from program start, as `#CHANNEL INTERFACE ON [DYN_CS]` would.
+    #[serde(default)]
+    pub track_cs: bool,
+}
+
+/// `configuration.channel[i].interpolator.*`.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InterpolatorConfig {
+    /// Entries of the dynamic-CS diagnosis history.
+    #[serde(default = "default_history")]
+    pub dyn_cs_history_max: u32,
+}
+
+impl Default for InterpolatorConfig {
+    fn default() -> Self {
+        Self {
+            dyn_cs_history_max: default_history(),
+        }
+    }
+}
+
+fn default_history() -> u32 {
+    20
+}
+
+fn default_limits() -> AxisLimits {
+    AxisLimits {
+        velocity: 1000.0,
+        acceleration: 5000.0,
+        jerk: 50_000.0,
+    }
+}
+
+/// The kinematic transformation of a channel.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KinematicsConfig {
+    /// Kinematic id: 0 Cartesian, 45 six-axis robot.
+    #[serde(default)]
+    pub id: u32,
+    /// For id 45: a preset (`kr6r900sixx`, `kr6r700sixx`, `irb2400`).
+    #[serde(default)]
+    pub preset: Option<String>,
+    /// Tool offset X Y Z (mm) A B C (degrees, Z-Y-X) for id 0.
+    #[serde(default)]
+    pub tool: [f64; 6],
+}
+
+/// A configuration that cannot run.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ChannelConfigError {
+    /// Bad axis list.
+    #[error("channel {channel}: axes: {reason}")]
+    Axes {
+        /// Channel name.
+        channel: String,
+        /// Why.
+        reason: String,
+    },
+    /// A transformation needs six axes.
+    #[error("channel {channel}: kinematic {id} needs at least 6 axes, found {found}")]
+    TooFewAxes {
+        /// Channel name.
+        channel: String,
+        /// Kinematic id.
+        id: u32,
+        /// Axes configured.
+        found: usize,
+    },
+    /// Bad kinematics.
+    #[error("channel {channel}: kinematics: {reason}")]
+    Kinematics {
+        /// Channel name.
+        channel: String,
+        /// Why.
+        reason: String,
+    },
+    /// A parameter outside its range.
+    #[error("channel {channel}: {name} = {value}: {reason}")]
+    Parameter {
+        /// Channel name.
+        channel: String,
+        /// Parameter name.
+        name: &'static str,
+        /// Value.
+        value: f64,
+        /// Why.
+        reason: &'static str,
+    },
+}
+
+impl ChannelConfig {
+    /// A channel with `axes` and defaults for everything else.
+    pub fn new(name: &str, axes: &[&str]) -> Self {
+        Self {
+            name: name.to_string(),
+            axes: axes.iter().map(|a| a.to_string()).collect(),
+            kinematics: KinematicsConfig::default(),
+            limits: default_limits(),
+            start: Vec::new(),
+            provide_channel_interface: ProvideChannelInterface::default(),
+            kin_trafo_display: 0,
+            ori_rotation_angle: 0,
+            interpolator: InterpolatorConfig::default(),
+        }
+    }
+
+    /// The orientation convention.
+    pub fn order(&self) -> Result<RotationOrder, ChannelConfigError> {
+        RotationOrder::from_channel_parameter(self.ori_rotation_angle).map_err(|_| {
+            ChannelConfigError::Parameter {
+                channel: self.name.clone(),
+                name: "ori_rotation_angle",
+                value: f64::from(self.ori_rotation_angle),
+                reason: "must be 0, 1 or 2",
+            }
+        })
+    }
+
+    /// Checks everything and builds the kinematics.
+    pub fn build_kinematics(&self) -> Result<Box<dyn Kinematics + Send>, ChannelConfigError> {
+        let channel = self.name.clone();
+        check_channel_axes(&self.axes).map_err(|reason| ChannelConfigError::Axes {
+            channel: channel.clone(),
+            reason,
+        })?;
+        let parameter = |name, value: f64, reason| ChannelConfigError::Parameter {
+            channel: channel.clone(),
+            name,
+            value,
+            reason,
+        };
+        for (name, v) in [
+            ("limits.velocity", self.limits.velocity),
+            ("limits.acceleration", self.limits.acceleration),
+            ("limits.jerk", self.limits.jerk),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(parameter(name, v, "must be positive and finite"));
+            }
+        }
+        if self.kin_trafo_display > 2 {
+            return Err(parameter(
+                "kin_trafo_display",
+                f64::from(self.kin_trafo_display),
+                "must be 0, 1 or 2",
+            ));
+        }
+        if self.start.len() > self.axes.len() || self.start.iter().any(|v| !v.is_finite()) {
+            return Err(parameter(
+                "start",
+                self.start.len() as f64,
+                "at most one finite value per axis",
+            ));
+        }
+        let order = self.order()?;
+        let kin_error = |reason: String| ChannelConfigError::Kinematics {
+            channel: channel.clone(),
+            reason,
+        };
+        let id = KinematicId::from_raw(self.kinematics.id).map_err(|e| kin_error(e.to_string()))?;
+        if self.axes.len() < 6 {
+            return Err(ChannelConfigError::TooFewAxes {
+                channel: channel.clone(),
+                id: self.kinematics.id,
+                found: self.axes.len(),
+            });
+        }
+        match id {
+            KinematicId::Cartesian => {
+                let t = self.kinematics.tool;
+                let tool = PoseWords {
+                    xyz: [t[0], t[1], t[2]],
+                    abc: [t[3], t[4], t[5]],
+                };
+                Ok(Box::new(
+                    Cartesian::new(order, &tool, [JointLimit::NONE; 6])
+                        .map_err(|e| kin_error(e.to_string()))?,
+                ))
+            }
+            KinematicId::Robot45 => {
+                let name = self.kinematics.preset.as_deref().unwrap_or("kr6r900sixx");
+                let params = Robot45Params::preset(name).ok_or_else(|| {
+                    kin_error(format!(
+                        "unknown preset \"{name}\" (known: kr6r900sixx, kr6r700sixx, irb2400)"
+                    ))
+                })?;
+                Ok(Box::new(
+                    Robot45::new(params).map_err(|e| kin_error(e.to_string()))?,
+                ))
+            }
+            other => Err(kin_error(format!(
+                "kinematic {} is not available in channels yet (0 and 45 are)",
+                other.raw()
+            ))),
+        }
+    }
+}

@@ -1,0 +1,67 @@
+//! The channels of a controller ticking together on one image: masters before the channels
+//! that follow them, so a slave sees its master's frame of the same tick.
+
+use super::dyn_cs::MasterSample;
+use super::run::{Channel, MAX_CHANNELS};
+use super::sync::SyncBoard;
+use hli::views::CncView;
+
+/// All channels.
+#[derive(Debug)]
+pub struct Controller {
+    channels: Vec<Channel>,
+    masters: [Option<MasterSample>; MAX_CHANNELS],
+    sync: SyncBoard,
+    order: [usize; MAX_CHANNELS],
+}
+
+/// More channels than a controller has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("at most {MAX_CHANNELS} channels, found {0}")]
+pub struct TooManyChannels(pub usize);
+
+impl Controller {
+    /// The channels, index = position.
+    pub fn new(channels: Vec<Channel>) -> Result<Self, TooManyChannels> {
+        if channels.len() > MAX_CHANNELS {
+            return Err(TooManyChannels(channels.len()));
+        }
+        Ok(Self {
+            channels,
+            masters: [None; MAX_CHANNELS],
+            sync: SyncBoard::default(),
+            order: core::array::from_fn(|i| i),
+        })
+    }
+
+    /// The channels.
+    pub fn channels(&self) -> &[Channel] {
+        &self.channels
+    }
+
+    /// One channel, mutable (to start programs).
+    pub fn channel_mut(&mut self, index: usize) -> Option<&mut Channel> {
+        self.channels.get_mut(index)
+    }
+
+    /// One tick of every channel.
+    pub fn tick(&mut self, view: &CncView<'_>) {
+        let n = self.channels.len();
+        // Channels that follow no other channel first, then the followers in index order.
+        let mut k = 0;
+        for pass in 0..2 {
+            for i in 0..n {
+                let follows = self.channels[i].follows_channel().is_some();
+                if follows == (pass == 1) {
+                    self.order[k] = i;
+                    k += 1;
+                }
+            }
+        }
+        for k in 0..n {
+            let i = self.order[k];
+            self.channels[i].tick(view, &self.masters, &mut self.sync);
+            self.masters[i] = self.channels[i].published();
+        }
+    }
+}

@@ -1,0 +1,88 @@
+//! The dynamic-CS diagnosis as text tables in the layout of the controller's listings: the
+//! per-tick history (P-STUP-00074 entries) and the switching log.
+
+use super::dyn_cs::MasterSource;
+use super::dyn_cs::{TrackEvent, Tracker};
+use std::fmt::Write as _;
+
+fn list(values: &[i64]) -> String {
+    values
+        .iter()
+        .map(i64::to_string)
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+/// Renders the history and the log of channel `index` (0-based; printed 1-based).
+pub fn render(index: usize, tracker: &Tracker) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "BAHN : DYNAMIC CS, CHANNEL-NR.: {}", index + 1);
+    let _ = writeln!(out, "=====");
+    let _ = writeln!(
+        out,
+        "TIME STATE POSITION_IN CS_TRANSLATION CS_ROTATION POSITION_OUT"
+    );
+    for (n, e) in tracker.history().enumerate() {
+        let _ = writeln!(
+            out,
+            "{} {}) {} ({}) ({}) ({}) ({})",
+            e.tick,
+            n + 1,
+            e.state,
+            list(&e.input),
+            list(&e.translation),
+            list(&e.rotation),
+            list(&e.output)
+        );
+    }
+    let _ = writeln!(out);
+    let _ = writeln!(out, "BAHN LOGGING KANAL-NR.: {}", index + 1);
+    let _ = writeln!(out, "=====");
+    let _ = writeln!(out, "time message");
+    let _ = writeln!(out, "-----");
+    let um = |v: f64| (v * 10_000.0).round() as i64;
+    for (tick, event) in tracker.log() {
+        let message = match event {
+            TrackEvent::On {
+                source,
+                filter_ticks,
+                wait,
+                master,
+            } => {
+                let source = match source {
+                    MasterSource::Plc => "PLC=1".to_string(),
+                    MasterSource::Channel(c) => format!("CH={}", c + 1),
+                };
+                format!(
+                    "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE T({}, {}, {}) R({}, {}, {})",
+                    u8::from(*wait),
+                    um(master[0]),
+                    um(master[1]),
+                    um(master[2]),
+                    um(master[3]),
+                    um(master[4]),
+                    um(master[5])
+                )
+            }
+            TrackEvent::Active => "dynCS: is on = ACTIVE".to_string(),
+            TrackEvent::Off {
+                filter_ticks,
+                applied,
+            } => format!(
+                "dynCS: cmd=OFF FILTER={filter_ticks}\n{tick} dynCS: VALUE T({}, {}, {}) R({}, {}, {})",
+                um(applied[0]),
+                um(applied[1]),
+                um(applied[2]),
+                um(applied[3]),
+                um(applied[4]),
+                um(applied[5])
+            ),
+            TrackEvent::Inactive => "dynCS: is off = INACTIVE".to_string(),
+            TrackEvent::MasterFrozen => "dynCS: master frozen, holding".to_string(),
+            TrackEvent::MasterResumed => "dynCS: master resumed, soft take-over".to_string(),
+            TrackEvent::Error(e) => format!("dynCS: ERROR: {e}"),
+        };
+        let _ = writeln!(out, "{tick} {message}");
+    }
+    out
+}

@@ -1,0 +1,537 @@
+//! The tracking (slave) side of the dynamic coordinate system: the `#TRACK CS` state machine
+//! with soft in- and out-coupling, take-over after a master FREEZE, the diagnosis history and
+//! the switching log.
+//!
+//! The tracker turns the master's frame `M` into a *compensation* frame `C` that the channel
+//! puts in front of its programmed pose: `P_out = C * P`. Fully coupled, `C` is
+//! `O * D * O^-1` (moving workpiece) or `O * D^-1 * O^-1` (kinematic base), with `D` the
+//! displacement of the dynamic CS (see `kinematics::tracking`). While coupling in, out, or
+//! re-taking the master after a FREEZE, the applied compensation runs from where it was to
+//! where it must be over the filter's ticks: translation linearly, rotation along the shortest
+//! arc, in equal steps. Without a filter (FILTER=0) the change is immediate.
+//!
+//! States (reported in `state_r`): INACTIVE, ACTIVATING (coupling in, or re-taking the master
+//! after a FREEZE), ACTIVE, DEACTIVATING, ERROR (the compensation is held where it was: the
+//! channel keeps a safe set-point).
+
+use hli::enums::DynCsState;
+use kinematics::tracking::{track_cs_values, Tracking, TrackingMode, TrackingOption};
+use kinematics::{PoseWords, RotationOrder};
+use nalgebra::{Isometry3, Translation3};
+
+/// Where a tracking channel takes the dynamic CS from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MasterSource {
+    /// The PLC, through the channel's own `MC_CONTROL_DYN_CS_UNIT` (`ID=0`).
+    Plc,
+    /// The channel interface of another channel (index from 0; `CH=n`/`ID=n` is channel n-1).
+    Channel(usize),
+}
+
+/// Everything `#TRACK CS ON [...]` or a PLC transition +1 fixes at switch-on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackSetup {
+    /// The master.
+    pub source: MasterSource,
+    /// SET_ZERO/ABSOLUTE: the master frame at switch-on is the reference (`D = M * M0^-1`) and
+    /// is handed to the program as `V.G.TRACK_CS.X..C`.
+    pub set_zero: bool,
+    /// OPTION=1: translation only.
+    pub translation_only: bool,
+    /// KIN_BASE: compensate an error of the kinematic base instead of following a workpiece.
+    pub kin_base: bool,
+    /// FILTER: ticks of the soft coupling (0 = immediate).
+    pub filter_ticks: u32,
+    /// WAIT: the program waits until the coupling is complete.
+    pub wait: bool,
+    /// ROT_TRANS: the offset's translation is measured in the rotated frame.
+    pub rot_trans: bool,
+    /// X..C: static offset between master and slave (or error point and kinematic base).
+    pub offset: [f64; 6],
+}
+
+/// A state change or refusal of the tracker, kept in the switching log.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum TrackEvent {
+    /// Switched on (tick, setup, master frame words at switch-on).
+    On {
+        /// Source.
+        source: MasterSource,
+        /// Filter ticks.
+        filter_ticks: u32,
+        /// WAIT.
+        wait: bool,
+        /// Master frame X..C at switch-on.
+        master: [f64; 6],
+    },
+    /// Coupling complete.
+    Active,
+    /// Switched off.
+    Off {
+        /// Filter ticks of the out-coupling.
+        filter_ticks: u32,
+        /// The compensation X..C when switched off.
+        applied: [f64; 6],
+    },
+    /// Coupling released completely.
+    #[default]
+    Inactive,
+    /// The master froze (or its values became invalid): compensation held.
+    MasterFrozen,
+    /// The master resumed: taken over softly.
+    MasterResumed,
+    /// An error: state ERROR.
+    Error(TrackError),
+}
+
+/// Why tracking went to ERROR (or a switching request was refused).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum TrackError {
+    /// `#TRACK CS ON` while tracking is on.
+    #[error("tracking is already on: switch it off first")]
+    AlreadyOn,
+    /// The master channel publishes no dynamic CS.
+    #[error("master channel {0} provides no DYN_CS interface (#CHANNEL INTERFACE ON [DYN_CS] or provide_channel_interface.track_cs)")]
+    NoMasterInterface(usize),
+    /// The master channel does not exist.
+    #[error("master channel {0} does not exist")]
+    NoSuchChannel(usize),
+    /// A channel cannot track itself.
+    #[error("a channel cannot track its own interface")]
+    OwnChannel,
+    /// The PLC commanded while the unit was not enabled.
+    #[error("PLC command while enable_w is FALSE")]
+    PlcNotEnabled,
+    /// A transition with invalid parameters.
+    #[error("invalid transition parameter: {0}")]
+    BadTransition(&'static str),
+    /// The compensation could not be computed (non-finite frame).
+    #[error("invalid master frame")]
+    BadFrame,
+}
+
+/// One line of the diagnosis history: what went in and out of the dynamic CS in one tick.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct HistoryEntry {
+    /// Tick.
+    pub tick: u64,
+    /// Raw `HLI_DYN_CS_*` state.
+    pub state: i32,
+    /// Pose before the dynamic CS (X..C, 0.1 um / 0.0001 degree).
+    pub input: [i64; 6],
+    /// Compensation translation (0.1 um).
+    pub translation: [i64; 3],
+    /// Compensation rotation (0.0001 degree, Z-Y-X).
+    pub rotation: [i64; 3],
+    /// Pose after the dynamic CS.
+    pub output: [i64; 6],
+}
+
+/// A ring of fixed capacity, filled at start-up (no allocation afterwards).
+#[derive(Debug, Clone)]
+pub struct Ring<T: Copy + Default> {
+    entries: Vec<T>,
+    next: usize,
+    len: usize,
+}
+
+impl<T: Copy + Default> Ring<T> {
+    /// A ring of `capacity` entries (0 keeps nothing).
+    pub fn new(capacity: usize) -> Self {
+        Self {
+            entries: vec![T::default(); capacity],
+            next: 0,
+            len: 0,
+        }
+    }
+
+    /// Appends, dropping the oldest entry when full.
+    pub fn push(&mut self, value: T) {
+        if self.entries.is_empty() {
+            return;
+        }
+        self.entries[self.next] = value;
+        self.next = (self.next + 1) % self.entries.len();
+        self.len = (self.len + 1).min(self.entries.len());
+    }
+
+    /// Oldest first.
+    pub fn iter(&self) -> impl Iterator<Item = &T> {
+        let cap = self.entries.len();
+        let start = (self.next + cap - self.len) % cap.max(1);
+        (0..self.len).map(move |i| &self.entries[(start + i) % cap])
+    }
+
+    /// Number of entries kept.
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Whether nothing is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+}
+
+/// What the master offers this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MasterSample {
+    /// The frame (mm, Z-Y-X as on the HLI).
+    pub frame: Isometry3<f64>,
+    /// The values are valid and updated (not frozen).
+    pub live: bool,
+}
+
+/// A soft transition of the applied compensation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Blend {
+    from: Isometry3<f64>,
+    /// Ticks done and total.
+    done: u32,
+    total: u32,
+}
+
+impl Blend {
+    fn weight(&self) -> f64 {
+        if self.total == 0 {
+            1.0
+        } else {
+            f64::from(self.done) / f64::from(self.total)
+        }
+    }
+}
+
+/// Interpolates between two frames: translation linearly, rotation along the shortest arc.
+pub fn interpolate(a: &Isometry3<f64>, b: &Isometry3<f64>, w: f64) -> Isometry3<f64> {
+    let t = a.translation.vector.lerp(&b.translation.vector, w);
+    let r = a
+        .rotation
+        .try_slerp(&b.rotation, w, 1e-12)
+        .unwrap_or(if w < 0.5 { a.rotation } else { b.rotation });
+    Isometry3::from_parts(Translation3::from(t), r)
+}
+
+/// The tracker of one channel.
+#[derive(Debug, Clone)]
+pub struct Tracker {
+    state: DynCsState,
+    setup: Option<TrackSetup>,
+    tracking: Option<Tracking>,
+    /// The compensation applied in the last tick.
+    applied: Isometry3<f64>,
+    blend: Option<Blend>,
+    /// The last live master frame (held while the master is frozen).
+    last_master: Option<Isometry3<f64>>,
+    master_live: bool,
+    /// `V.G.TRACK_CS.X..C` (SET_ZERO), in the channel's orientation convention.
+    zero_values: [f64; 6],
+    order: RotationOrder,
+    history: Ring<HistoryEntry>,
+    log: Ring<(u64, TrackEvent)>,
+    tick: u64,
+}
+
+/// Entries of the switching log.
+pub const LOG_CAPACITY: usize = 64;
+
+impl Tracker {
+    /// An inactive tracker; `history` entries of diagnosis (`dyn_cs_history_max`), angles of
+    /// `V.G.TRACK_CS` in `order`.
+    pub fn new(history: usize, order: RotationOrder) -> Self {
+        Self {
+            state: DynCsState::Inactive,
+            setup: None,
+            tracking: None,
+            applied: Isometry3::identity(),
+            blend: None,
+            last_master: None,
+            master_live: false,
+            zero_values: [0.0; 6],
+            order,
+            history: Ring::new(history),
+            log: Ring::new(LOG_CAPACITY),
+            tick: 0,
+        }
+    }
+
+    /// The state as `state_r` reports it.
+    pub fn state(&self) -> DynCsState {
+        self.state
+    }
+
+    /// The setup while on.
+    pub fn setup(&self) -> Option<&TrackSetup> {
+        self.setup.as_ref()
+    }
+
+    /// The master this tracker follows (while on or coupling out).
+    pub fn source(&self) -> Option<MasterSource> {
+        self.setup.map(|s| s.source)
+    }
+
+    /// `V.G.TRACK_CS.X..C`.
+    pub fn zero_values(&self) -> [f64; 6] {
+        self.zero_values
+    }
+
+    /// The compensation applied in the last tick.
+    pub fn applied(&self) -> &Isometry3<f64> {
+        &self.applied
+    }
+
+    /// Whether a WAIT switching is complete (ON: ACTIVE; OFF: INACTIVE; ERROR ends a wait too).
+    pub fn settled(&self) -> bool {
+        matches!(
+            self.state,
+            DynCsState::Active | DynCsState::Inactive | DynCsState::Error
+        ) && self.blend.is_none()
+    }
+
+    /// The diagnosis history, oldest first.
+    pub fn history(&self) -> impl Iterator<Item = &HistoryEntry> {
+        self.history.iter()
+    }
+
+    /// The switching log, oldest first.
+    pub fn log(&self) -> impl Iterator<Item = &(u64, TrackEvent)> {
+        self.log.iter()
+    }
+
+    fn event(&mut self, event: TrackEvent) {
+        self.log.push((self.tick, event));
+    }
+
+    /// Goes to ERROR for `error`, holding the applied compensation.
+    pub fn fail(&mut self, error: TrackError) {
+        self.state = DynCsState::Error;
+        self.blend = None;
+        self.event(TrackEvent::Error(error));
+    }
+
+    /// Switches tracking on with the master's current `master` frame (`None` when the master
+    /// offers none yet: the reference is then taken from its first live frame).
+    pub fn switch_on(
+        &mut self,
+        setup: TrackSetup,
+        master: Option<&Isometry3<f64>>,
+    ) -> Result<(), TrackError> {
+        if matches!(
+            self.state,
+            DynCsState::Activating | DynCsState::Active | DynCsState::Error
+        ) {
+            self.fail(TrackError::AlreadyOn);
+            return Err(TrackError::AlreadyOn);
+        }
+        let mode = if setup.kin_base {
+            TrackingMode::KinematicBase
+        } else {
+            TrackingMode::MovingWorkpiece
+        };
+        let option = if setup.translation_only {
+            TrackingOption::TranslationOnly
+        } else {
+            TrackingOption::Full
+        };
+        let offset = PoseWords {
+            xyz: [setup.offset[0], setup.offset[1], setup.offset[2]],
+            abc: [setup.offset[3], setup.offset[4], setup.offset[5]],
+        };
+        let reference = master.copied().unwrap_or_else(Isometry3::identity);
+        let tracking = Tracking::new(
+            mode,
+            option,
+            &offset,
+            setup.rot_trans,
+            setup.set_zero.then_some(&reference),
+        )
+        .map_err(|_| TrackError::BadTransition("offset X..C is not finite"))?;
+        if setup.set_zero {
+            self.zero_values = track_cs_values(&reference, self.order);
+        }
+        self.event(TrackEvent::On {
+            source: setup.source,
+            filter_ticks: setup.filter_ticks,
+            wait: setup.wait,
+            master: words(&reference),
+        });
+        self.tracking = Some(tracking);
+        self.setup = Some(setup);
+        self.last_master = master.copied();
+        self.master_live = master.is_some();
+        self.state = DynCsState::Activating;
+        self.blend = Some(Blend {
+            from: self.applied,
+            done: 0,
+            total: setup.filter_ticks,
+        });
+        Ok(())
+    }
+
+    /// Switches tracking off over `filter_ticks` (`None`: the switch-on filter). From ERROR
+    /// this releases the held compensation the same way.
+    pub fn switch_off(&mut self, filter_ticks: Option<u32>) {
+        if self.state == DynCsState::Inactive {
+            return;
+        }
+        let total = filter_ticks
+            .or(self.setup.map(|s| s.filter_ticks))
+            .unwrap_or(0);
+        self.event(TrackEvent::Off {
+            filter_ticks: total,
+            applied: words(&self.applied),
+        });
+        self.state = DynCsState::Deactivating;
+        self.blend = Some(Blend {
+            from: self.applied,
+            done: 0,
+            total,
+        });
+    }
+
+    /// One tick: the compensation to apply, given the master's sample (`None` when the source
+    /// offers nothing). `input` and `output` poses are recorded by [`Tracker::record`].
+    pub fn tick(&mut self, master: Option<MasterSample>) -> Isometry3<f64> {
+        self.tick += 1;
+        match self.state {
+            DynCsState::Inactive | DynCsState::Error => return self.applied,
+            _ => {}
+        }
+        // The master's frame, held while it is frozen; a resume is taken over softly.
+        let live = master.filter(|m| m.live);
+        match (live, self.master_live) {
+            (Some(m), false) => {
+                self.master_live = true;
+                if self.last_master.is_some() && self.state == DynCsState::Active {
+                    self.event(TrackEvent::MasterResumed);
+                    self.state = DynCsState::Activating;
+                    self.blend = Some(Blend {
+                        from: self.applied,
+                        done: 0,
+                        total: self.setup.map_or(0, |s| s.filter_ticks),
+                    });
+                }
+                if self.last_master.is_none() && self.setup.is_some_and(|s| s.set_zero) {
+                    // No frame at switch-on: the first live one is the reference.
+                    if let Some(setup) = self.setup {
+                        self.tracking = None;
+                        let _ = self.rebuild_reference(setup, &m.frame);
+                    }
+                }
+                self.last_master = Some(m.frame);
+            }
+            (Some(m), true) => self.last_master = Some(m.frame),
+            (None, true) => {
+                self.master_live = false;
+                self.event(TrackEvent::MasterFrozen);
+            }
+            (None, false) => {}
+        }
+        let target = match (self.state, &self.tracking, &self.last_master) {
+            (DynCsState::Deactivating, _, _) => Isometry3::identity(),
+            (_, Some(tracking), Some(m)) => tracking.compose(m, &Isometry3::identity()),
+            _ => self.applied,
+        };
+        if !target.translation.vector.iter().all(|v| v.is_finite())
+            || !target.rotation.coords.iter().all(|v| v.is_finite())
+        {
+            self.fail(TrackError::BadFrame);
+            return self.applied;
+        }
+        self.applied = match self.blend.as_mut() {
+            Some(blend) => {
+                blend.done = (blend.done + 1).min(blend.total);
+                let w = blend.weight();
+                let from = blend.from;
+                if blend.done >= blend.total {
+                    self.blend = None;
+                }
+                interpolate(&from, &target, w)
+            }
+            None => target,
+        };
+        if self.blend.is_none() {
+            match self.state {
+                DynCsState::Activating => {
+                    self.state = DynCsState::Active;
+                    self.event(TrackEvent::Active);
+                }
+                DynCsState::Deactivating => {
+                    self.state = DynCsState::Inactive;
+                    self.applied = Isometry3::identity();
+                    self.setup = None;
+                    self.tracking = None;
+                    self.last_master = None;
+                    self.master_live = false;
+                    self.event(TrackEvent::Inactive);
+                }
+                _ => {}
+            }
+        }
+        self.applied
+    }
+
+    fn rebuild_reference(
+        &mut self,
+        setup: TrackSetup,
+        reference: &Isometry3<f64>,
+    ) -> Result<(), TrackError> {
+        let mode = if setup.kin_base {
+            TrackingMode::KinematicBase
+        } else {
+            TrackingMode::MovingWorkpiece
+        };
+        let option = if setup.translation_only {
+            TrackingOption::TranslationOnly
+        } else {
+            TrackingOption::Full
+        };
+        let offset = PoseWords {
+            xyz: [setup.offset[0], setup.offset[1], setup.offset[2]],
+            abc: [setup.offset[3], setup.offset[4], setup.offset[5]],
+        };
+        self.tracking = Some(
+            Tracking::new(mode, option, &offset, setup.rot_trans, Some(reference))
+                .map_err(|_| TrackError::BadFrame)?,
+        );
+        self.zero_values = track_cs_values(reference, self.order);
+        Ok(())
+    }
+
+    /// Records one tick of the diagnosis history.
+    pub fn record(&mut self, input: &[f64; 6], output: &[f64; 6]) {
+        if self.state == DynCsState::Inactive {
+            return;
+        }
+        let w = words(&self.applied);
+        let mut entry = HistoryEntry {
+            tick: self.tick,
+            state: self.state.raw() as i32,
+            ..HistoryEntry::default()
+        };
+        for i in 0..6 {
+            entry.input[i] = hli_units(input[i]);
+            entry.output[i] = hli_units(output[i]);
+        }
+        for i in 0..3 {
+            entry.translation[i] = hli_units(w[i]);
+            entry.rotation[i] = hli_units(w[3 + i]);
+        }
+        self.history.push(entry);
+    }
+}
+
+/// X..C words of a frame (Z-Y-X, as on the HLI).
+pub fn words(frame: &Isometry3<f64>) -> [f64; 6] {
+    let w = PoseWords::from_frame(frame, RotationOrder::Zyx);
+    [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
+}
+
+/// mm or degree to 0.1 um / 0.0001 degree, saturating (diagnosis only).
+fn hli_units(value: f64) -> i64 {
+    let v = (value * 10_000.0).round();
+    if v.is_finite() {
+        v as i64
+    } else {
+        0
+    }
+}

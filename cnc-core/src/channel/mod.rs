@@ -1,0 +1,19 @@
+//! CNC channels: the interpreter and interpolator that run NC programs, the `#CS` frames and
+//! the kinematic transformation, and the dynamic coordinate system of seed 003 (a channel
+//! publishing its frame with `#CHANNEL INTERFACE`, the PLC as master through
+//! `MC_CONTROL_DYN_CS_UNIT`, and tracking slaves with `#TRACK CS`).
+
+pub mod config;
+pub mod controller;
+mod diagnosis;
+pub mod dyn_cs;
+pub mod path;
+pub mod program;
+pub mod run;
+pub mod sync;
+
+pub use config::{ChannelConfig, ChannelConfigError};
+pub use controller::Controller;
+pub use dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
+pub use program::{LoadedProgram, ProgramError};
+pub use run::{Channel, ChannelError, RunState, MAX_CHANNELS};

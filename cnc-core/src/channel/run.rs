@@ -1,0 +1,961 @@
+//! One channel: runs its program block by block (decoding each block when it is reached, with
+//! the variables known then), interpolates the motion, applies coordinate systems, the
+//! dynamic CS and the kinematic transformation, and talks to the PLC through its HLI units.
+//!
+//! Execution model: no look-ahead. A block starts when the previous one has finished, so every
+//! `#FLUSH` is satisfied by construction and `SET_ZERO` always happens at standstill. Per tick:
+//!
+//! 1. PLC inputs of the channel's dynamic-CS unit (enable, `command_w`, `transition_w`);
+//! 2. the interpreter runs blocks until one moves or waits (at most [`BLOCKS_PER_TICK`]);
+//! 3. the path block and independent axes advance one tick;
+//! 4. pose pipeline: programmed words -> `#CS` frames -> dynamic CS -> inverse kinematics
+//!    (with `#TRAFO` on), or per-axis compensation (off);
+//! 5. HLI outputs: display values, state, `request_r`, the channel interface.
+
+use super::config::{ChannelConfig, ChannelConfigError};
+use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
+use super::path::{AxisLimits, PathMove};
+use super::program::{Jump, LoadedProgram};
+use super::sync::SyncBoard;
+use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
+use crate::nc::ast::{Control, Item};
+use crate::nc::decode::{evaluate, AxisValues, TrackSource, Vars, KNOWN_VARIABLES};
+use crate::nc::{Decoded, DecoderState, MotionMode};
+use hli::enums::{DynCsCommand, DynCsState};
+use hli::layout::{
+    HliBahnState, HliChannel, HliChannelInterface, HliCoordState, HliDynCsChannelInterface,
+    HliMFunctionAck, HliMFunctionRequest,
+};
+use hli::views::CncView;
+use hli::{Bool, PlaceExt};
+use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
+use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
+use nalgebra::Isometry3;
+
+/// Most channels of a controller.
+pub const MAX_CHANNELS: usize = 12;
+/// Blocks without motion the interpreter runs in one tick before it yields (an endless loop of
+/// non-moving blocks must not hang the tick).
+pub const BLOCKS_PER_TICK: usize = 32;
+/// Depth of the `#CS` stack.
+pub const CS_DEPTH: usize = 8;
+
+/// What a channel is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunState {
+    /// No program, or not started.
+    Idle,
+    /// Executing.
+    Running,
+    /// Program ended (M30/M2 or its last block).
+    Finished,
+    /// Stopped by an error (see [`Channel::error`]).
+    Error,
+}
+
+/// What the interpreter waits for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Wait {
+    /// The PLC's acknowledge of M function `code` announced with `id`.
+    MFunction { code: u32, id: u32 },
+    /// The announcement of `code` could not be posted yet (the previous one is unread).
+    MAnnounce { code: u32 },
+    /// `#WAIT SYN` for the ids in `wait_ids`.
+    Sync,
+    /// `#TRACK CS ... WAIT`.
+    Tracking,
+    /// `#WAIT INDP ALL` or an `INDP_SYN` move.
+    Independent,
+}
+
+/// Why a channel stopped: the block and the reason.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ChannelError {
+    /// Source line of the block.
+    pub line: u32,
+    /// What went wrong.
+    pub message: String,
+}
+
+/// The variables a block sees when it is decoded.
+struct ChannelVars {
+    track_cs: [f64; 6],
+}
+
+impl Vars for ChannelVars {
+    fn get(&self, name: &str) -> Option<f64> {
+        KNOWN_VARIABLES
+            .iter()
+            .position(|v| *v == name)
+            .map(|i| self.track_cs[i])
+    }
+}
+
+/// One channel.
+pub struct Channel {
+    index: usize,
+    config: ChannelConfig,
+    cycle_s: f64,
+    limits: AxisLimits,
+    order: RotationOrder,
+    kinematics: Box<dyn Kinematics + Send>,
+    program: Option<LoadedProgram>,
+    decoder: DecoderState,
+    next_block: usize,
+    line: u32,
+    pending: Vec<Decoded>,
+    pending_at: usize,
+    state: RunState,
+    wait: Option<Wait>,
+    wait_ids: Vec<u32>,
+    error: Option<ChannelError>,
+    /// Programmed position (channel coordinates, after offsets).
+    programmed: AxisValues,
+    path: Option<PathMove>,
+    independent: Vec<Option<SetpointGenerator>>,
+    trafo: bool,
+    cs_stack: [Isometry3<f64>; CS_DEPTH],
+    cs_len: usize,
+    tracker: Tracker,
+    interface_on: bool,
+    /// Set-points of the channel's axes (joints first under a transformation).
+    set_points: AxisValues,
+    joints: Joints,
+    /// Tool pose before and after the dynamic CS (base coordinates).
+    pose_in: Isometry3<f64>,
+    pose_out: Isometry3<f64>,
+    published: Option<MasterSample>,
+    plc_frame: Option<Isometry3<f64>>,
+    plc_enabled: bool,
+    m_next_id: u32,
+    tick: u64,
+}
+
+impl core::fmt::Debug for Channel {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Channel")
+            .field("name", &self.config.name)
+            .field("state", &self.state)
+            .field("line", &self.line)
+            .finish()
+    }
+}
+
+impl Channel {
+    /// Channel `index` (0-based) of `config`, ticking every `cycle_s` seconds.
+    pub fn new(
+        index: usize,
+        config: ChannelConfig,
+        cycle_s: f64,
+    ) -> Result<Self, ChannelConfigError> {
+        let kinematics = config.build_kinematics()?;
+        let order = config.order()?;
+        let n = config.axes.len();
+        let mut set_points = AxisValues::zeros(n);
+        set_points[..config.start.len()].copy_from_slice(&config.start);
+        let mut joints = [0.0; 6];
+        joints.copy_from_slice(&set_points[..6]);
+        let decoder = DecoderState::new(&config.axes);
+        let mut channel = Self {
+            index,
+            cycle_s,
+            limits: config.limits,
+            order,
+            kinematics,
+            program: None,
+            decoder,
+            next_block: 0,
+            line: 0,
+            pending: Vec::with_capacity(16),
+            pending_at: 0,
+            state: RunState::Idle,
+            wait: None,
+            wait_ids: Vec::with_capacity(16),
+            error: None,
+            programmed: set_points,
+            path: None,
+            independent: (0..n).map(|_| None).collect(),
+            trafo: false,
+            cs_stack: [Isometry3::identity(); CS_DEPTH],
+            cs_len: 0,
+            tracker: Tracker::new(config.interpolator.dyn_cs_history_max as usize, order),
+            interface_on: false,
+            set_points,
+            joints,
+            pose_in: Isometry3::identity(),
+            pose_out: Isometry3::identity(),
+            published: None,
+            plc_frame: None,
+            plc_enabled: false,
+            m_next_id: 0,
+            tick: 0,
+            config,
+        };
+        for i in 0..n {
+            channel.decoder.set_position(i, set_points[i]);
+        }
+        channel.update_pose();
+        Ok(channel)
+    }
+
+    /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
+    pub fn start(&mut self, program: LoadedProgram) {
+        self.program = Some(program);
+        self.next_block = 0;
+        self.pending.clear();
+        self.pending_at = 0;
+        self.state = RunState::Running;
+        self.wait = None;
+        self.error = None;
+        if self.config.provide_channel_interface.track_cs {
+            self.interface_on = true;
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &ChannelConfig {
+        &self.config
+    }
+
+    /// Run state.
+    pub fn state(&self) -> RunState {
+        self.state
+    }
+
+    /// The error that stopped the channel.
+    pub fn error(&self) -> Option<&ChannelError> {
+        self.error.as_ref()
+    }
+
+    /// Line of the block executing.
+    pub fn line(&self) -> u32 {
+        self.line
+    }
+
+    /// Set-points of the channel's axes.
+    pub fn set_points(&self) -> &AxisValues {
+        &self.set_points
+    }
+
+    /// Programmed position (channel coordinates).
+    pub fn programmed(&self) -> &AxisValues {
+        &self.programmed
+    }
+
+    /// Tool pose commanded (after the dynamic CS), base coordinates.
+    pub fn pose_out(&self) -> &Isometry3<f64> {
+        &self.pose_out
+    }
+
+    /// Tool pose before the dynamic CS.
+    pub fn pose_in(&self) -> &Isometry3<f64> {
+        &self.pose_in
+    }
+
+    /// The tool pose of the current set-points by forward kinematics.
+    pub fn tool_pose(&self) -> Option<Isometry3<f64>> {
+        self.kinematics.forward(&self.joints).ok()
+    }
+
+    /// The tracker.
+    pub fn tracker(&self) -> &Tracker {
+        &self.tracker
+    }
+
+    /// What this channel publishes on its interface this tick.
+    pub fn published(&self) -> Option<MasterSample> {
+        self.published
+    }
+
+    /// Whether the channel follows another channel's interface (it must tick after it).
+    pub fn follows_channel(&self) -> Option<usize> {
+        match self.tracker.source() {
+            Some(MasterSource::Channel(c)) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// Whether a motion or wait is in progress.
+    pub fn is_moving(&self) -> bool {
+        self.path.is_some() || self.independent.iter().any(Option::is_some)
+    }
+
+    fn fail(&mut self, message: String) {
+        self.error = Some(ChannelError {
+            line: self.line,
+            message,
+        });
+        self.state = RunState::Error;
+        self.path = None;
+        self.wait = None;
+        for g in &mut self.independent {
+            *g = None;
+        }
+    }
+
+    /// One tick. `masters` holds what every channel publishes (this tick for the channels
+    /// that ticked before, else the last tick).
+    pub fn tick(
+        &mut self,
+        view: &CncView<'_>,
+        masters: &[Option<MasterSample>; MAX_CHANNELS],
+        sync: &mut SyncBoard,
+    ) {
+        self.tick += 1;
+        self.plc_inputs(view);
+        if self.state == RunState::Running {
+            self.interpret(view, masters, sync);
+        }
+        self.advance();
+        let master = self.master_sample(masters);
+        self.tracker.tick(master);
+        self.update_pose();
+        self.outputs(view);
+    }
+
+    fn master_sample(
+        &self,
+        masters: &[Option<MasterSample>; MAX_CHANNELS],
+    ) -> Option<MasterSample> {
+        match self.tracker.source()? {
+            MasterSource::Plc => self.plc_frame.map(|frame| MasterSample {
+                frame,
+                live: self.plc_enabled,
+            }),
+            MasterSource::Channel(c) => masters.get(c).copied().flatten(),
+        }
+    }
+
+    /// The PLC's side of the dynamic-CS unit.
+    fn plc_inputs(&mut self, view: &CncView<'_>) {
+        let enabled = match view.dyn_cs_enabled(self.index) {
+            Ok(Ok(e)) => e,
+            // A garbage byte reads as "not enabled".
+            _ => false,
+        };
+        self.plc_enabled = enabled;
+        if let Ok(mut reader) = view.dyn_cs_command(self.index) {
+            if let Ok(Some(cs)) = reader.try_take() {
+                if enabled {
+                    self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
+                } else {
+                    self.tracker.fail(TrackError::PlcNotEnabled);
+                }
+            }
+        }
+        let Ok(mut transition) = view.dyn_cs_transition(self.index) else {
+            return;
+        };
+        let taken = match transition.try_take() {
+            Ok(Some(t)) => t,
+            Ok(None) => return,
+            Err(_) => {
+                self.tracker
+                    .fail(TrackError::BadTransition("command word is not -1, 0 or +1"));
+                return;
+            }
+        };
+        if !enabled {
+            self.tracker.fail(TrackError::PlcNotEnabled);
+            return;
+        }
+        let (command, params) = taken;
+        match command {
+            DynCsCommand::Activate => {
+                let flags = [
+                    params.f_wait.get(),
+                    params.f_set_zero.get(),
+                    params.f_kin_base.get(),
+                    params.f_rot_trans.get(),
+                ];
+                let [Ok(wait), Ok(set_zero), Ok(kin_base), Ok(rot_trans)] = flags else {
+                    self.tracker.fail(TrackError::BadTransition(
+                        "a flag byte is neither FALSE nor TRUE",
+                    ));
+                    return;
+                };
+                if params.option > 1 {
+                    self.tracker
+                        .fail(TrackError::BadTransition("option must be 0 or 1"));
+                    return;
+                }
+                let kb = frame_from_hli(&params.kinematic_base_cs, RotationOrder::Zyx);
+                let w = words(&kb);
+                let setup = TrackSetup {
+                    source: MasterSource::Plc,
+                    set_zero,
+                    translation_only: params.option == 1,
+                    kin_base,
+                    filter_ticks: params.filter_max_ticks,
+                    wait,
+                    rot_trans,
+                    offset: w,
+                };
+                let master = self.plc_frame;
+                let _ = self.tracker.switch_on(setup, master.as_ref());
+            }
+            DynCsCommand::Deactivate => self.tracker.switch_off(Some(params.filter_max_ticks)),
+            DynCsCommand::None => {}
+        }
+    }
+
+    /// Runs blocks until one moves or waits.
+    fn interpret(
+        &mut self,
+        view: &CncView<'_>,
+        masters: &[Option<MasterSample>; MAX_CHANNELS],
+        sync: &mut SyncBoard,
+    ) {
+        for _ in 0..BLOCKS_PER_TICK {
+            if let Some(wait) = self.wait {
+                if !self.wait_done(wait, view, sync) {
+                    return;
+                }
+                self.wait = None;
+            }
+            if self.path.is_some() || self.state != RunState::Running {
+                return;
+            }
+            if self.pending_at < self.pending.len() {
+                let element = core::mem::replace(
+                    &mut self.pending[self.pending_at],
+                    Decoded::Flush {
+                        line: 0,
+                        wait: false,
+                    },
+                );
+                self.pending_at += 1;
+                self.execute(element, view, masters, sync);
+                continue;
+            }
+            self.pending.clear();
+            self.pending_at = 0;
+            if !self.next_block_decoded() {
+                return;
+            }
+        }
+    }
+
+    /// Decodes the next block into `pending` (control statements jump); `false` when the
+    /// program ended or failed.
+    fn next_block_decoded(&mut self) -> bool {
+        let Some(program) = self.program.as_ref() else {
+            self.state = RunState::Finished;
+            return false;
+        };
+        let Some(block) = program.tree.blocks.get(self.next_block) else {
+            self.state = RunState::Finished;
+            return false;
+        };
+        self.line = block.span.line;
+        let index = self.next_block;
+        let vars = ChannelVars {
+            track_cs: self.tracker.zero_values(),
+        };
+        if let Some(jump) = program.jumps.get(index).copied().flatten() {
+            let condition = program
+                .tree
+                .items_of(block)
+                .iter()
+                .find_map(|item| match item {
+                    Item::Control {
+                        control: Control::While(c) | Control::If(c),
+                        ..
+                    } => Some(c),
+                    _ => None,
+                });
+            let holds = |c: Option<&crate::nc::ast::Expr>| -> Option<bool> {
+                c.map_or(Some(true), |c| evaluate(c, &vars).map(|v| v != 0.0))
+            };
+            self.next_block = match jump {
+                Jump::While { end } => match holds(condition) {
+                    Some(true) => index + 1,
+                    Some(false) => end + 1,
+                    None => {
+                        self.fail("condition cannot be evaluated".to_string());
+                        return false;
+                    }
+                },
+                Jump::EndWhile { start } => start,
+                Jump::If { next } => match holds(condition) {
+                    Some(true) => index + 1,
+                    Some(false) => next + 1,
+                    None => {
+                        self.fail("condition cannot be evaluated".to_string());
+                        return false;
+                    }
+                },
+                Jump::Else { end } => end + 1,
+            };
+            return true;
+        }
+        let diagnostics =
+            self.decoder
+                .decode_block(&program.tree, index, &program.src, &vars, &mut self.pending);
+        self.next_block += 1;
+        if let Some(d) = diagnostics.first() {
+            let message = d.message.clone();
+            self.fail(message);
+            return false;
+        }
+        true
+    }
+
+    fn wait_done(&mut self, wait: Wait, view: &CncView<'_>, sync: &mut SyncBoard) -> bool {
+        match wait {
+            Wait::MFunction { code, id } => {
+                let Ok(mut reader) = view.m_function_ack(self.index) else {
+                    return true;
+                };
+                match reader.try_take() {
+                    Ok(Some(HliMFunctionAck { m_code, request_id })) => {
+                        // A stale acknowledge (other id) is consumed and ignored.
+                        request_id == id && m_code == code as i32
+                    }
+                    _ => false,
+                }
+            }
+            Wait::MAnnounce { code } => {
+                if self.announce(code, view) {
+                    self.wait = Some(Wait::MFunction {
+                        code,
+                        id: self.m_next_id,
+                    });
+                }
+                false
+            }
+            Wait::Sync => sync.try_wait(&self.wait_ids),
+            Wait::Tracking => self.tracker.settled(),
+            Wait::Independent => self.independent.iter().all(Option::is_none),
+        }
+    }
+
+    /// Posts an M-function announcement; `false` while the PLC has not read the previous one.
+    fn announce(&mut self, code: u32, view: &CncView<'_>) -> bool {
+        let Ok(writer) = view.m_function_request(self.index) else {
+            return true;
+        };
+        let id = self.m_next_id.wrapping_add(1).max(1);
+        let request = HliMFunctionRequest {
+            m_code: code as i32,
+            block_nr: self.line as i32,
+            request_id: id,
+        };
+        if writer.try_send(&request).is_ok() {
+            self.m_next_id = id;
+            true
+        } else {
+            false
+        }
+    }
+
+    fn execute(
+        &mut self,
+        element: Decoded,
+        view: &CncView<'_>,
+        masters: &[Option<MasterSample>; MAX_CHANNELS],
+        sync: &mut SyncBoard,
+    ) {
+        match element {
+            Decoded::Motion(m) => self.start_path(&m.target, m.motion, m.feed),
+            Decoded::IndependentMove {
+                axis,
+                target,
+                feed,
+                motion,
+                asynchronous,
+                ..
+            } => {
+                let limits = self.limits;
+                let velocity = match motion {
+                    MotionMode::Rapid => limits.velocity,
+                    MotionMode::Linear => (feed / 60.0).min(limits.velocity),
+                };
+                let mut generator = SetpointGenerator::new(self.cycle_s, self.programmed[axis]);
+                let planned = generator.move_to(
+                    target,
+                    MoveLimits {
+                        velocity,
+                        acceleration: limits.acceleration,
+                        deceleration: limits.acceleration,
+                        jerk: limits.jerk,
+                    },
+                );
+                if planned.is_err() {
+                    self.fail(format!(
+                        "independent axis {}: no profile",
+                        self.config.axes[axis]
+                    ));
+                    return;
+                }
+                self.independent[axis] = Some(generator);
+                if !asynchronous {
+                    self.wait = Some(Wait::Independent);
+                }
+            }
+            Decoded::WaitIndependent { .. } => self.wait = Some(Wait::Independent),
+            Decoded::MFunction { code, .. } => {
+                if code == 30 || code == 2 {
+                    self.state = RunState::Finished;
+                    return;
+                }
+                if self.announce(code, view) {
+                    self.wait = Some(Wait::MFunction {
+                        code,
+                        id: self.m_next_id,
+                    });
+                } else {
+                    self.wait = Some(Wait::MAnnounce { code });
+                }
+            }
+            Decoded::Track { command, .. } => {
+                if !command.on {
+                    self.tracker.switch_off(Some(command.filter_ticks));
+                    if command.wait {
+                        self.wait = Some(Wait::Tracking);
+                    }
+                    return;
+                }
+                let source = match command.source {
+                    Some(TrackSource::Id(0)) => MasterSource::Plc,
+                    Some(TrackSource::Id(n) | TrackSource::Channel(n)) => {
+                        MasterSource::Channel(usize::from(n).saturating_sub(1))
+                    }
+                    None => MasterSource::Plc,
+                };
+                let master = match source {
+                    MasterSource::Plc => self.plc_frame,
+                    MasterSource::Channel(c) => {
+                        let refusal = if c == self.index {
+                            Some(TrackError::OwnChannel)
+                        } else if c >= MAX_CHANNELS {
+                            Some(TrackError::NoSuchChannel(c + 1))
+                        } else if masters[c].is_none() {
+                            Some(TrackError::NoMasterInterface(c + 1))
+                        } else {
+                            None
+                        };
+                        if let Some(error) = refusal {
+                            self.tracker.fail(error);
+                            self.fail(format!("#TRACK CS ON: {error}"));
+                            return;
+                        }
+                        masters[c].map(|m| m.frame)
+                    }
+                };
+                let setup = TrackSetup {
+                    source,
+                    set_zero: command.set_zero,
+                    translation_only: command.option == 1,
+                    kin_base: command.kin_base,
+                    filter_ticks: command.filter_ticks,
+                    wait: command.wait,
+                    rot_trans: command.rot_trans,
+                    offset: command.offset,
+                };
+                if let Err(error) = self.tracker.switch_on(setup, master.as_ref()) {
+                    self.fail(format!("#TRACK CS ON: {error}"));
+                    return;
+                }
+                if command.wait {
+                    self.wait = Some(Wait::Tracking);
+                }
+            }
+            Decoded::TrackAbs { .. } => {
+                let zero = self.tracker.zero_values();
+                for (i, z) in zero.iter().enumerate().take(self.programmed.len()) {
+                    self.decoder.set_g92(i, *z);
+                }
+            }
+            Decoded::ChannelInterface { on, .. } => self.interface_on = on,
+            Decoded::Cs { on, frame, .. } => {
+                if !self.trafo {
+                    self.fail("#CS needs an active transformation (#TRAFO ON)".to_string());
+                    return;
+                }
+                let before = self.cs_frame();
+                if on {
+                    if self.cs_len == CS_DEPTH {
+                        self.fail(format!("more than {CS_DEPTH} coordinate systems active"));
+                        return;
+                    }
+                    let words = PoseWords {
+                        xyz: [frame[0], frame[1], frame[2]],
+                        abc: [frame[3], frame[4], frame[5]],
+                    };
+                    match offset_frame(&words, false) {
+                        Ok(f) => {
+                            self.cs_stack[self.cs_len] = f;
+                            self.cs_len += 1;
+                        }
+                        Err(e) => {
+                            self.fail(format!("#CS: {e}"));
+                            return;
+                        }
+                    }
+                } else {
+                    self.cs_len = self.cs_len.saturating_sub(1);
+                }
+                // The tool stays where it is; its programmed words change.
+                let base = before * self.programmed_frame();
+                self.set_programmed_pose(&(self.cs_frame().inverse() * base));
+            }
+            Decoded::Trafo { on, id, .. } => {
+                if let Some(id) = id {
+                    if id != self.config.kinematics.id {
+                        self.fail(format!(
+                            "kinematic {id} is not configured for this channel (configured: {})",
+                            self.config.kinematics.id
+                        ));
+                        return;
+                    }
+                }
+                match on {
+                    Some(true) if !self.trafo => {
+                        let Ok(tool) = self.kinematics.forward(&self.joints) else {
+                            self.fail("#TRAFO ON: forward kinematics failed".to_string());
+                            return;
+                        };
+                        self.trafo = true;
+                        let programmed = self.cs_frame().inverse() * tool;
+                        self.set_programmed_pose(&programmed);
+                    }
+                    Some(false) if self.trafo => {
+                        self.trafo = false;
+                        self.cs_len = 0;
+                        for i in 0..6 {
+                            self.programmed[i] = self.joints[i];
+                            self.decoder.set_position(i, self.joints[i]);
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            Decoded::SignalSyn { id, count, .. } => {
+                if sync.signal(id, count).is_err() {
+                    self.fail("#SIGNAL SYN: too many synchronisation ids pending".to_string());
+                }
+            }
+            Decoded::WaitSyn { ids, .. } => {
+                self.wait_ids.clear();
+                self.wait_ids.extend_from_slice(&ids);
+                self.wait = Some(Wait::Sync);
+            }
+            Decoded::Flush { .. } | Decoded::Control { .. } => {}
+        }
+    }
+
+    fn cs_frame(&self) -> Isometry3<f64> {
+        self.cs_stack[..self.cs_len]
+            .iter()
+            .fold(Isometry3::identity(), |acc, f| acc * f)
+    }
+
+    /// The programmed X..C words as a frame (channel orientation convention).
+    fn programmed_frame(&self) -> Isometry3<f64> {
+        let p = &self.programmed;
+        PoseWords {
+            xyz: [p[0], p[1], p[2]],
+            abc: [p[3], p[4], p[5]],
+        }
+        .to_frame(self.order)
+        .unwrap_or_else(|_| Isometry3::identity())
+    }
+
+    fn set_programmed_pose(&mut self, pose: &Isometry3<f64>) {
+        let w = PoseWords::from_frame(pose, self.order);
+        let values = [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]];
+        for (i, v) in values.iter().enumerate() {
+            self.programmed[i] = *v;
+            self.decoder.set_position(i, *v);
+        }
+    }
+
+    fn start_path(&mut self, target: &AxisValues, motion: MotionMode, feed: f64) {
+        let mut target = *target;
+        // Axes moving independently are left to their own move.
+        for (i, g) in self.independent.iter().enumerate() {
+            if g.is_some() {
+                target[i] = self.programmed[i];
+            }
+        }
+        let limits = [self.limits; crate::nc::decode::MAX_CHANNEL_AXES];
+        match PathMove::plan(
+            &self.programmed,
+            &target,
+            motion,
+            feed,
+            &limits[..self.programmed.len()],
+            self.cycle_s,
+        ) {
+            Ok(path) => self.path = path,
+            Err(e) => self.fail(e.to_string()),
+        }
+    }
+
+    fn advance(&mut self) {
+        if let Some(path) = self.path.as_mut() {
+            if path.step(&mut self.programmed) {
+                self.path = None;
+            }
+        }
+        for (i, slot) in self.independent.iter_mut().enumerate() {
+            if let Some(g) = slot.as_mut() {
+                let progress = g.step();
+                self.programmed[i] = g.state().position;
+                if matches!(progress, Progress::Reached | Progress::Idle) {
+                    *slot = None;
+                }
+            }
+        }
+    }
+
+    fn update_pose(&mut self) {
+        let n = self.programmed.len();
+        let compensation = *self.tracker.applied();
+        if self.trafo {
+            self.pose_in = self.cs_frame() * self.programmed_frame();
+            self.pose_out = compensation * self.pose_in;
+            match self.kinematics.inverse(&self.pose_out, &self.joints) {
+                Ok(j) => self.joints = j,
+                Err(e) => {
+                    if self.state == RunState::Running {
+                        self.fail(format!("pose unreachable: {e}"));
+                    }
+                }
+            }
+            self.set_points[..6].copy_from_slice(&self.joints);
+        } else {
+            let c = if self.tracker.state() == DynCsState::Inactive {
+                [0.0; 6]
+            } else {
+                words(&compensation)
+            };
+            for (i, c) in c.iter().enumerate() {
+                self.set_points[i] = self.programmed[i] + c;
+                self.joints[i] = self.set_points[i];
+            }
+            let mut plain = [0.0; 6];
+            plain.copy_from_slice(&self.programmed[..6]);
+            self.pose_in = self.kinematics.forward(&plain).unwrap_or(self.pose_in);
+            self.pose_out = self
+                .kinematics
+                .forward(&self.joints)
+                .unwrap_or(self.pose_out);
+        }
+        self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
+        let input = words(&self.pose_in);
+        let output = words(&self.pose_out);
+        self.tracker.record(&input, &output);
+        self.published = self.interface_on.then(|| MasterSample {
+            frame: self
+                .kinematics
+                .forward(&self.joints)
+                .unwrap_or(self.pose_out),
+            live: self.state != RunState::Error,
+        });
+    }
+
+    fn outputs(&mut self, view: &CncView<'_>) {
+        let _ = view.set_dyn_cs_state(self.index, self.tracker.state());
+        if let Ok(writer) = view.dyn_cs_request(self.index) {
+            if let Ok(cs) = frame_to_hli(self.tracker.applied(), RotationOrder::Zyx) {
+                // Request pattern: posted only when the PLC has read the last one.
+                let _ = writer.try_send(&cs);
+            }
+        }
+        let Ok(channel) = view.channel(self.index) else {
+            return;
+        };
+        let bahn = channel.field::<HliBahnState>(core::mem::offset_of!(HliChannel, bahn_state));
+        let coords = bahn.field::<[HliCoordState; hli::layout::HLI_CHANNEL_AXES]>(
+            core::mem::offset_of!(HliBahnState, coord_r),
+        );
+        let w0 = self
+            .kinematics
+            .forward(&self.joints)
+            .map(|f| words_in(&f, self.order))
+            .unwrap_or([0.0; 6]);
+        let dyncs = words_in(&self.pose_out, self.order);
+        for i in 0..self.programmed.len() {
+            let Some(coord) = coords.get(i) else { break };
+            let angle = (3..6).contains(&i);
+            let to_hli = |v: f64| hli_value(v, angle);
+            let state = HliCoordState {
+                w0_position_r: if self.config.kin_trafo_display > 0 && i < 6 {
+                    to_hli(w0[i])
+                } else {
+                    0
+                },
+                position_dyncs_r: if i < 6 {
+                    to_hli(dyncs[i])
+                } else {
+                    to_hli(self.set_points[i])
+                },
+                command_position_r: to_hli(self.programmed[i]),
+                fill_up_1: 0,
+            };
+            coord.write(&state);
+        }
+        bahn.field::<i32>(core::mem::offset_of!(HliBahnState, active_block_nr_r))
+            .store(self.line as i32);
+        bahn.field::<u64>(core::mem::offset_of!(HliBahnState, tick_counter_r))
+            .store(self.tick);
+        let interface = channel
+            .field::<HliChannelInterface>(core::mem::offset_of!(HliChannel, channel_interface))
+            .field::<HliDynCsChannelInterface>(core::mem::offset_of!(HliChannelInterface, dyn_cs));
+        let (enabled, valid, cs) = match self.published {
+            Some(sample) => match frame_to_hli(&sample.frame, RotationOrder::Zyx) {
+                Ok(cs) => (true, sample.live, Some(cs)),
+                Err(_) => (true, false, None),
+            },
+            None => (false, false, None),
+        };
+        let counter = interface
+            .field::<u32>(core::mem::offset_of!(
+                HliDynCsChannelInterface,
+                update_counter_r
+            ))
+            .load();
+        let mut out = HliDynCsChannelInterface {
+            enabled_r: Bool::from(enabled),
+            valid_r: Bool::from(valid),
+            freeze_r: Bool::from(enabled && !valid),
+            fill_up_1: 0,
+            update_counter_r: counter,
+            cs_r: interface
+                .field::<hli::layout::HliCoordinateSystemInt>(core::mem::offset_of!(
+                    HliDynCsChannelInterface,
+                    cs_r
+                ))
+                .read(),
+        };
+        if let Some(cs) = cs.filter(|_| valid) {
+            out.cs_r = cs;
+            out.update_counter_r = counter.wrapping_add(1);
+        }
+        interface.write(&out);
+    }
+
+    /// The dynamic-CS diagnosis as the text tables of the controller: the history (tick,
+    /// state, input position, CS translation and rotation, output position) and the switching
+    /// log.
+    pub fn dyn_cs_diagnosis(&self) -> String {
+        super::diagnosis::render(self.index, &self.tracker)
+    }
+}
+
+fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
+    let w = PoseWords::from_frame(frame, order);
+    [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
+}
+
+/// mm (or degree for angles) to the HLI's 0.1 um (0.0001 degree), saturating.
+fn hli_value(v: f64, angle: bool) -> i32 {
+    let raw = if angle {
+        hli::units::deg_to_hli(v)
+    } else {
+        hli::units::mm_to_hli(v)
+    };
+    raw.unwrap_or(if v < 0.0 { i32::MIN } else { i32::MAX })
+}

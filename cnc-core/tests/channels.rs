@@ -1,0 +1,400 @@
+//! Channels in-process on a heap image: interpolation, the dynamic CS with a master channel
+//! (the seed's example 3 geometry), the PLC as master through `MC_CONTROL_DYN_CS_UNIT`, and
+//! the refusals that put tracking into ERROR.
+
+use cnc_core::channel::{
+    Channel, ChannelConfig, Controller, LoadedProgram, RunState, MAX_CHANNELS,
+};
+use hli::enums::{DynCsCommand, DynCsState};
+use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition};
+use hli::segment::heap_image;
+use hli::views::{CncView, PlcView};
+use hli::{Bool, ImageMemory};
+use kinematics::frame::offset_frame;
+use kinematics::PoseWords;
+
+const CYCLE: f64 = 0.001;
+const ROBOT_HOME: [f64; 6] = [0.0, -60.0, 90.0, 0.0, 60.0, 0.0];
+
+fn robot(name: &str) -> ChannelConfig {
+    let mut c = ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]);
+    c.kinematics.id = 45;
+    c.kinematics.preset = Some("kr6r900sixx".into());
+    c.start = ROBOT_HOME.to_vec();
+    c
+}
+
+fn cartesian(name: &str) -> ChannelConfig {
+    ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"])
+}
+
+fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
+    let mut channels = Vec::new();
+    for (i, (config, src)) in configs.into_iter().enumerate() {
+        let program =
+            LoadedProgram::load(&config.name, src, &config.axes).unwrap_or_else(|e| panic!("{e}"));
+        let mut channel = Channel::new(i, config, CYCLE).unwrap();
+        channel.start(program);
+        channels.push(channel);
+    }
+    Controller::new(channels).unwrap()
+}
+
+fn image(channels: usize) -> ImageMemory {
+    heap_image(channels as u32, 8)
+}
+
+/// Runs until `done` or the watchdog of `limit` ticks trips (then fails).
+fn run_until(
+    ctl: &mut Controller,
+    memory: &ImageMemory,
+    limit: u32,
+    mut each: impl FnMut(&Controller, u32),
+    done: impl Fn(&Controller) -> bool,
+) -> u32 {
+    let view = CncView::new(memory);
+    for tick in 0..limit {
+        ctl.tick(&view);
+        for c in ctl.channels() {
+            assert_ne!(
+                c.state(),
+                RunState::Error,
+                "channel {} stopped: {:?}",
+                c.config().name,
+                c.error()
+            );
+        }
+        each(ctl, tick);
+        if done(ctl) {
+            return tick;
+        }
+    }
+    panic!("watchdog: not done after {limit} ticks");
+}
+
+#[test]
+fn a_linear_block_reaches_its_target_within_feed_and_limits() {
+    let mut ctl = controller(vec![(
+        cartesian("c"),
+        "G1 X100 Y50 F6000\nG91 X-10 Z5\nG0 G90 X0 Y0 Z0\nM30\n",
+    )]);
+    let memory = image(1);
+    let mut last = [0.0f64; 3];
+    let mut max_speed: f64 = 0.0;
+    let mut first_block_end = None;
+    run_until(
+        &mut ctl,
+        &memory,
+        20_000,
+        |ctl, tick| {
+            let p = ctl.channels()[0].programmed();
+            let d =
+                ((p[0] - last[0]).powi(2) + (p[1] - last[1]).powi(2) + (p[2] - last[2]).powi(2))
+                    .sqrt();
+            if first_block_end.is_none() {
+                max_speed = max_speed.max(d / CYCLE);
+                if (p[0] - 100.0).abs() < 1e-12 && (p[1] - 50.0).abs() < 1e-12 {
+                    first_block_end = Some(tick);
+                }
+            }
+            last = [p[0], p[1], p[2]];
+        },
+        |ctl| ctl.channels()[0].state() == RunState::Finished,
+    );
+    assert!(first_block_end.is_some(), "X100 Y50 was reached exactly");
+    assert!(
+        max_speed <= 100.0 + 1e-6,
+        "feed 6000 mm/min = 100 mm/s, ran {max_speed}"
+    );
+    assert!(max_speed > 99.0, "the block reached its feed: {max_speed}");
+    let p = ctl.channels()[0].programmed();
+    assert_eq!(&p[..3], &[0.0, 0.0, 0.0]);
+}
+
+/// The seed's example 3 with our own programs: the master robot (channel 1) carries the
+/// workpiece and publishes its tool frame; the slave (channel 2) stands at X=400 Y=700 C=-90
+/// relative to it, tracks with SET_ZERO, puts its zero on the master's tool with `#CS` and holds
+/// X0 Y0 Z0 there while the master moves.
+#[test]
+fn example_3_the_slave_tool_stays_on_the_moving_workpiece() {
+    let master = "%master
+#TRAFO [45]
+#CHANNEL INTERFACE ON [DYN_CS]
+#WAIT SYN [ID1]
+G1 X680 Y40 Z560 F3000
+G1 X600 Y-40 Z520 C170 F3000
+G1 B10 F1200
+#SIGNAL SYN [ID2 COUNT1]
+M30
+";
+    let slave = "%slave
+#TRAFO [45]
+#CS ON [OFFS] [400, 700, 0, 0, 0, -90]
+#TRACK CS ON [ID=1 SET_ZERO X=400 Y=700 C=-90 FILTER=0 WAIT]
+#CS ON [V.G.TRACK_CS.X, V.G.TRACK_CS.Y, V.G.TRACK_CS.Z, V.G.TRACK_CS.A, -V.G.TRACK_CS.B, V.G.TRACK_CS.C]
+G1 X0 Y0 Z0 A0 B0 C0 F3000
+#SIGNAL SYN [ID1 COUNT1]
+#WAIT SYN [ID2]
+#TRACK CS OFF [FILTER=0]
+#CS OFF
+#CS OFF
+M30
+";
+    let mut ctl = controller(vec![(robot("master"), master), (robot("slave"), slave)]);
+    let memory = image(2);
+    let offset = offset_frame(
+        &PoseWords {
+            xyz: [400.0, 700.0, 0.0],
+            abc: [0.0, 0.0, -90.0],
+        },
+        false,
+    )
+    .unwrap();
+    let mut checked = 0;
+    let mut worst: f64 = 0.0;
+    let mut master_travel: f64 = 0.0;
+    let mut last_master: Option<nalgebra::Vector3<f64>> = None;
+    run_until(
+        &mut ctl,
+        &memory,
+        60_000,
+        |ctl, _| {
+            let (m, s) = (&ctl.channels()[0], &ctl.channels()[1]);
+            let master_tool = m.tool_pose().unwrap();
+            // Measure only while the slave holds the workpiece point (after its approach, before
+            // the master signals the end).
+            if s.tracker().state() == DynCsState::Active && !s.is_moving() && m.is_moving() {
+                let slave_tool = s.tool_pose().unwrap();
+                let expected = offset * master_tool;
+                let miss = (slave_tool.translation.vector - expected.translation.vector).norm();
+                let turn = slave_tool.rotation.angle_to(&expected.rotation);
+                worst = worst.max(miss);
+                assert!(turn < 1e-6, "orientation off by {turn} rad");
+                checked += 1;
+                if let Some(last) = last_master {
+                    master_travel += (master_tool.translation.vector - last).norm();
+                }
+                last_master = Some(master_tool.translation.vector);
+            }
+        },
+        |ctl| {
+            ctl.channels()
+                .iter()
+                .all(|c| c.state() == RunState::Finished)
+        },
+    );
+    assert!(checked > 1000, "the master moved for {checked} ticks");
+    assert!(master_travel > 100.0, "the master moved {master_travel} mm");
+    assert!(
+        worst < 1e-3,
+        "the slave's tool left the workpiece by {worst} mm"
+    );
+}
+
+fn cs(translation: [i32; 3]) -> HliCoordinateSystemInt {
+    HliCoordinateSystemInt {
+        translation,
+        fill_up_2: 0,
+        rotation: [0; 3],
+        fill_up_1: 0,
+    }
+}
+
+/// The PLC as master: the program switches tracking on with `ID=0 FILTER=50`, the "PLC"
+/// (this test, through its view) enables the unit and commands a moving translation. The
+/// channel couples in softly (state ACTIVATING, per-tick step bounded by the filter), then
+/// follows the commanded translation exactly (axis-specific, no transformation).
+#[test]
+fn plc_as_master_couples_in_softly_then_follows_exactly() {
+    let mut ctl = controller(vec![(
+        cartesian("slave"),
+        "#TRACK CS ON [ID=0 FILTER=50 WAIT]\nG1 X10 F600\n#TRACK CS OFF [FILTER=50 WAIT]\nM30\n",
+    )]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    // 20 mm in X at switch-on, then moving 1 um per tick in Y.
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs([200_000, 0, 0]))
+        .unwrap();
+    let view = CncView::new(&memory);
+    let mut states = Vec::new();
+    let mut last_x = 0.0;
+    let mut max_step: f64 = 0.0;
+    let mut y_um = 0;
+    for tick in 0..20_000u32 {
+        if plc
+            .dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([200_000, y_um * 10, 0]))
+            .is_ok()
+        {
+            y_um += 1;
+        }
+        ctl.tick(&view);
+        let ch = &ctl.channels()[0];
+        assert_ne!(ch.state(), RunState::Error, "{:?}", ch.error());
+        let state = plc.dyn_cs_state(0).unwrap().unwrap();
+        if states.last() != Some(&state) {
+            states.push(state);
+        }
+        let set = ch.set_points();
+        let programmed = ch.programmed();
+        let x_comp = set[0] - programmed[0];
+        max_step = max_step.max((x_comp - last_x).abs());
+        last_x = x_comp;
+        if state == DynCsState::Active {
+            let y_comp = set[1] - programmed[1];
+            // The command taken this tick is the one sent before it; follow it to 1 um.
+            let commanded_y = f64::from((y_um - 1) * 10) / 10_000.0;
+            assert!((x_comp - 20.0).abs() < 1e-9, "tick {tick}: x comp {x_comp}");
+            assert!(
+                (y_comp - commanded_y).abs() < 1e-3,
+                "tick {tick}: y {y_comp} vs {commanded_y}"
+            );
+        }
+        if ch.state() == RunState::Finished {
+            break;
+        }
+    }
+    assert_eq!(
+        states,
+        vec![
+            DynCsState::Activating,
+            DynCsState::Active,
+            DynCsState::Deactivating,
+            DynCsState::Inactive
+        ]
+    );
+    // 20 mm over 50 ticks is 0.4 mm per tick; the Y motion adds 1 um per tick.
+    assert!(
+        max_step <= 20.0 / 50.0 + 1e-9,
+        "largest per-tick step {max_step}"
+    );
+    assert!(max_step > 0.39);
+    assert_eq!(ctl.channels()[0].state(), RunState::Finished);
+    let diagnosis = ctl.channels()[0].dyn_cs_diagnosis();
+    assert!(
+        diagnosis.contains("dynCS: cmd=ON PLC=1 FILTER=50 WAIT=1"),
+        "{diagnosis}"
+    );
+    assert!(
+        diagnosis.contains("dynCS: is off = INACTIVE"),
+        "{diagnosis}"
+    );
+    // 20 history entries by default (P-STUP-00074).
+    let history = diagnosis
+        .lines()
+        .filter(|l| l.contains(") 3 (") || l.contains(") 2 ("))
+        .count();
+    assert_eq!(history, 20, "{diagnosis}");
+}
+
+#[test]
+fn tracking_a_channel_without_interface_is_an_error_of_that_channel_only() {
+    let mut ctl = controller(vec![
+        (cartesian("quiet"), "G1 X5 F600\nM30\n"),
+        (cartesian("slave"), "#TRACK CS ON [CH=1]\nG1 X1 F600\nM30\n"),
+    ]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    for _ in 0..2000 {
+        ctl.tick(&view);
+    }
+    let (quiet, slave) = (&ctl.channels()[0], &ctl.channels()[1]);
+    assert_eq!(quiet.state(), RunState::Finished);
+    assert_eq!(slave.state(), RunState::Error);
+    let error = slave.error().unwrap();
+    assert_eq!(error.line, 1);
+    assert!(
+        error.message.contains("provides no DYN_CS"),
+        "{}",
+        error.message
+    );
+    assert_eq!(slave.tracker().state(), DynCsState::Error);
+    assert_eq!(slave.programmed()[0], 0.0, "no block after the error ran");
+    let plc = PlcView::new(&memory);
+    assert_eq!(plc.dyn_cs_state(1).unwrap().unwrap(), DynCsState::Error);
+}
+
+#[test]
+fn switching_on_twice_is_an_error_and_keeps_the_setpoint() {
+    let mut ctl = controller(vec![(
+        cartesian("slave"),
+        "#TRACK CS ON [ID=0 FILTER=0]\n#TRACK CS ON [ID=0 FILTER=0]\nG1 X1 F600\nM30\n",
+    )]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs([10_000, 0, 0]))
+        .unwrap();
+    let view = CncView::new(&memory);
+    for _ in 0..100 {
+        ctl.tick(&view);
+    }
+    let ch = &ctl.channels()[0];
+    assert_eq!(ch.state(), RunState::Error);
+    assert!(ch.error().unwrap().message.contains("already on"));
+    assert_eq!(ch.error().unwrap().line, 2);
+    assert_eq!(ch.tracker().state(), DynCsState::Error);
+}
+
+#[test]
+fn a_plc_transition_while_not_enabled_is_refused_with_error() {
+    let mut ctl = controller(vec![(cartesian("slave"), "G1 X1 F600\nM30\n")]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    let params = HliDynCsTransition {
+        command: 0,
+        filter_max_ticks: 10,
+        option: 0,
+        f_wait: Bool::FALSE,
+        f_set_zero: Bool::FALSE,
+        f_kin_base: Bool::FALSE,
+        f_rot_trans: Bool::FALSE,
+        kinematic_base_cs: cs([0; 3]),
+    };
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Activate, &params)
+        .unwrap();
+    let view = CncView::new(&memory);
+    ctl.tick(&view);
+    assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Error);
+    let log = ctl.channels()[0].dyn_cs_diagnosis();
+    assert!(
+        log.contains("ERROR: PLC command while enable_w is FALSE"),
+        "{log}"
+    );
+    // A bad option with the unit enabled is refused the same way.
+    let mut ctl = controller(vec![(cartesian("slave"), "G1 X1 F600\nM30\n")]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(
+            DynCsCommand::Activate,
+            &HliDynCsTransition {
+                option: 7,
+                ..params
+            },
+        )
+        .unwrap();
+    ctl.tick(&CncView::new(&memory));
+    assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Error);
+    assert!(ctl.channels()[0]
+        .dyn_cs_diagnosis()
+        .contains("option must be 0 or 1"));
+}
+
+#[test]
+fn programs_with_errors_are_refused_at_load() {
+    let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
+    let err = LoadedProgram::load("bad.nc", "G1 X1 F100\nG1 Q5\n", &axes).unwrap_err();
+    assert!(err.to_string().starts_with("bad.nc:2:"), "{err}");
+    assert_eq!(MAX_CHANNELS, 12);
+}
