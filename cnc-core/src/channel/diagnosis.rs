@@ -40,7 +40,13 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
     let _ = writeln!(out, "=====");
     let _ = writeln!(out, "time message");
     let _ = writeln!(out, "-----");
-    let um = |v: f64| (v * 10_000.0).round() as i64;
+    let frame = |w: &[f64; 6]| {
+        let u = w.map(|v| (v * 10_000.0).round() as i64);
+        format!(
+            "T({}, {}, {}) R({}, {}, {})",
+            u[0], u[1], u[2], u[3], u[4], u[5]
+        )
+    };
     for (tick, event) in tracker.log() {
         let message = match event {
             TrackEvent::On {
@@ -54,14 +60,9 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
                     MasterSource::Channel(c) => format!("CH={}", c + 1),
                 };
                 format!(
-                    "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE T({}, {}, {}) R({}, {}, {})",
+                    "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE {}",
                     u8::from(*wait),
-                    um(master[0]),
-                    um(master[1]),
-                    um(master[2]),
-                    um(master[3]),
-                    um(master[4]),
-                    um(master[5])
+                    frame(master)
                 )
             }
             TrackEvent::Active => "dynCS: is on = ACTIVE".to_string(),
@@ -69,13 +70,8 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
                 filter_ticks,
                 applied,
             } => format!(
-                "dynCS: cmd=OFF FILTER={filter_ticks}\n{tick} dynCS: VALUE T({}, {}, {}) R({}, {}, {})",
-                um(applied[0]),
-                um(applied[1]),
-                um(applied[2]),
-                um(applied[3]),
-                um(applied[4]),
-                um(applied[5])
+                "dynCS: cmd=OFF FILTER={filter_ticks}\n{tick} dynCS: VALUE {}",
+                frame(applied)
             ),
             TrackEvent::Inactive => "dynCS: is off = INACTIVE".to_string(),
             TrackEvent::MasterFrozen => "dynCS: master frozen, holding".to_string(),

@@ -322,29 +322,8 @@ impl Tracker {
             self.fail(TrackError::AlreadyOn);
             return Err(TrackError::AlreadyOn);
         }
-        let mode = if setup.kin_base {
-            TrackingMode::KinematicBase
-        } else {
-            TrackingMode::MovingWorkpiece
-        };
-        let option = if setup.translation_only {
-            TrackingOption::TranslationOnly
-        } else {
-            TrackingOption::Full
-        };
-        let offset = PoseWords {
-            xyz: [setup.offset[0], setup.offset[1], setup.offset[2]],
-            abc: [setup.offset[3], setup.offset[4], setup.offset[5]],
-        };
         let reference = master.copied().unwrap_or_else(Isometry3::identity);
-        let tracking = Tracking::new(
-            mode,
-            option,
-            &offset,
-            setup.rot_trans,
-            setup.set_zero.then_some(&reference),
-        )
-        .map_err(|_| TrackError::BadTransition("offset X..C is not finite"))?;
+        let tracking = build_tracking(&setup, setup.set_zero.then_some(&reference))?;
         if setup.set_zero {
             self.zero_values = track_cs_values(&reference, self.order);
         }
@@ -475,24 +454,7 @@ impl Tracker {
         setup: TrackSetup,
         reference: &Isometry3<f64>,
     ) -> Result<(), TrackError> {
-        let mode = if setup.kin_base {
-            TrackingMode::KinematicBase
-        } else {
-            TrackingMode::MovingWorkpiece
-        };
-        let option = if setup.translation_only {
-            TrackingOption::TranslationOnly
-        } else {
-            TrackingOption::Full
-        };
-        let offset = PoseWords {
-            xyz: [setup.offset[0], setup.offset[1], setup.offset[2]],
-            abc: [setup.offset[3], setup.offset[4], setup.offset[5]],
-        };
-        self.tracking = Some(
-            Tracking::new(mode, option, &offset, setup.rot_trans, Some(reference))
-                .map_err(|_| TrackError::BadFrame)?,
-        );
+        self.tracking = Some(build_tracking(&setup, Some(reference))?);
         self.zero_values = track_cs_values(reference, self.order);
         Ok(())
     }
@@ -518,6 +480,30 @@ impl Tracker {
         }
         self.history.push(entry);
     }
+}
+
+/// The frame composition of `setup`, with the SET_ZERO reference when given.
+fn build_tracking(
+    setup: &TrackSetup,
+    reference: Option<&Isometry3<f64>>,
+) -> Result<Tracking, TrackError> {
+    let mode = if setup.kin_base {
+        TrackingMode::KinematicBase
+    } else {
+        TrackingMode::MovingWorkpiece
+    };
+    let option = if setup.translation_only {
+        TrackingOption::TranslationOnly
+    } else {
+        TrackingOption::Full
+    };
+    let o = setup.offset;
+    let offset = PoseWords {
+        xyz: [o[0], o[1], o[2]],
+        abc: [o[3], o[4], o[5]],
+    };
+    Tracking::new(mode, option, &offset, setup.rot_trans, reference)
+        .map_err(|_| TrackError::BadTransition("offset X..C is not finite"))
 }
 
 /// X..C words of a frame (Z-Y-X, as on the HLI).
