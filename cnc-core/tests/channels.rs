@@ -160,11 +160,11 @@ M30
         60_000,
         |ctl, _| {
             let (m, s) = (&ctl.channels()[0], &ctl.channels()[1]);
-            let master_tool = m.tool_pose().unwrap();
+            let master_tool = m.tool_pose();
             // Measure only while the slave holds the workpiece point (after its approach, before
             // the master signals the end).
             if s.tracker().state() == DynCsState::Active && !s.is_moving() && m.is_moving() {
-                let slave_tool = s.tool_pose().unwrap();
+                let slave_tool = s.tool_pose();
                 let expected = offset * master_tool;
                 let miss = (slave_tool.translation.vector - expected.translation.vector).norm();
                 let turn = slave_tool.rotation.angle_to(&expected.rotation);

@@ -459,11 +459,13 @@ impl Tracker {
         Ok(())
     }
 
-    /// Records one tick of the diagnosis history.
-    pub fn record(&mut self, input: &[f64; 6], output: &[f64; 6]) {
+    /// Records one tick of the diagnosis history: the pose before and after the dynamic CS
+    /// (nothing is computed while tracking is inactive).
+    pub fn record(&mut self, before: &Isometry3<f64>, after: &Isometry3<f64>) {
         if self.state == DynCsState::Inactive {
             return;
         }
+        let (input, output) = (words(before), words(after));
         let w = words(&self.applied);
         let mut entry = HistoryEntry {
             tick: self.tick,

@@ -124,6 +124,8 @@ pub struct Channel {
     /// Tool pose before and after the dynamic CS (base coordinates).
     pose_in: Isometry3<f64>,
     pose_out: Isometry3<f64>,
+    /// Tool pose of the set-points (forward kinematics, once per tick).
+    tool: Isometry3<f64>,
     published: Option<MasterSample>,
     plc_frame: Option<Isometry3<f64>>,
     plc_enabled: bool,
@@ -184,6 +186,7 @@ impl Channel {
             joints,
             pose_in: Isometry3::identity(),
             pose_out: Isometry3::identity(),
+            tool: Isometry3::identity(),
             published: None,
             plc_frame: None,
             plc_enabled: false,
@@ -253,8 +256,8 @@ impl Channel {
     }
 
     /// The tool pose of the current set-points by forward kinematics.
-    pub fn tool_pose(&self) -> Option<Isometry3<f64>> {
-        self.kinematics.forward(&self.joints).ok()
+    pub fn tool_pose(&self) -> Isometry3<f64> {
+        self.tool
     }
 
     /// The tracker.
@@ -712,12 +715,8 @@ impl Channel {
                 }
                 match on {
                     Some(true) if !self.trafo => {
-                        let Ok(tool) = self.kinematics.forward(&self.joints) else {
-                            self.fail("#TRAFO ON: forward kinematics failed".to_string());
-                            return;
-                        };
                         self.trafo = true;
-                        let programmed = self.cs_frame().inverse() * tool;
+                        let programmed = self.cs_frame().inverse() * self.tool;
                         self.set_programmed_pose(&programmed);
                     }
                     Some(false) if self.trafo => {
@@ -835,23 +834,24 @@ impl Channel {
                 self.set_points[i] = self.programmed[i] + c;
                 self.joints[i] = self.set_points[i];
             }
-            let mut plain = [0.0; 6];
-            plain.copy_from_slice(&self.programmed[..6]);
-            self.pose_in = self.kinematics.forward(&plain).unwrap_or(self.pose_in);
-            self.pose_out = self
-                .kinematics
-                .forward(&self.joints)
-                .unwrap_or(self.pose_out);
+            if self.tracker.state() != DynCsState::Inactive {
+                let mut plain = [0.0; 6];
+                plain.copy_from_slice(&self.programmed[..6]);
+                self.pose_in = self.kinematics.forward(&plain).unwrap_or(self.pose_in);
+            }
         }
         self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
-        let input = words(&self.pose_in);
-        let output = words(&self.pose_out);
-        self.tracker.record(&input, &output);
-        self.published = self.interface_on.then(|| MasterSample {
-            frame: self
-                .kinematics
-                .forward(&self.joints)
-                .unwrap_or(self.pose_out),
+        self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
+        if !self.trafo {
+            self.pose_out = self.tool;
+            if self.tracker.state() == DynCsState::Inactive {
+                // No compensation: the pose before the dynamic CS is the tool pose.
+                self.pose_in = self.tool;
+            }
+        }
+        self.tracker.record(&self.pose_in, &self.pose_out);
+        self.published = self.interface_on.then_some(MasterSample {
+            frame: self.tool,
             live: self.state != RunState::Error,
         });
     }
@@ -871,11 +871,7 @@ impl Channel {
         let coords = bahn.field::<[HliCoordState; hli::layout::HLI_CHANNEL_AXES]>(
             core::mem::offset_of!(HliBahnState, coord_r),
         );
-        let w0 = self
-            .kinematics
-            .forward(&self.joints)
-            .map(|f| words_in(&f, self.order))
-            .unwrap_or([0.0; 6]);
+        let w0 = words_in(&self.tool, self.order);
         let dyncs = words_in(&self.pose_out, self.order);
         for i in 0..self.programmed.len() {
             let Some(coord) = coords.get(i) else { break };
