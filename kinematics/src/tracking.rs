@@ -4,21 +4,24 @@
 //! publishes it), `M0` the master's frame when tracking was switched on, `P` the programmed
 //! tool pose of the tracking (slave) channel after its own offsets, `O` the static offset
 //! `X Y Z A B C` (angles Z, then Y, then X; translation in the unrotated frame, or with
-//! ROT_TRANS in the rotated one). `T(M)` keeps only the translation of `M`.
+//! ROT_TRANS in the rotated one).
 //!
 //! 1. **Displacement** of the dynamic CS, the motion the slave has to follow:
 //!    `D = M` (absolute), or `D = M * M0^-1` when the master position was taken over at
-//!    switch-on (SET_ZERO); with OPTION=1 (translation only) `M` and `M0` are replaced by
-//!    `T(M)` and `T(M0)` first.
+//!    switch-on (SET_ZERO).
 //! 2. **Moving workpiece** (default): `O` is the master's base frame expressed in the slave's
 //!    base frame (the seed's example 3 gives it as `X=400 Y=700 C=-90`). A point fixed on the
-//!    workpiece moves by `D` in master coordinates, so the slave commands
-//!    `P_out = O * D * O^-1 * P`.
+//!    workpiece moves by `D` in master coordinates, so the compensation is `C = O * D * O^-1`.
 //! 3. **Kinematic-base error** (KIN_BASE): `D` is the measured error of the base, acting at the
-//!    error point whose frame relative to the kinematic base is `S` (the `X..C` of the
-//!    command). The real base then sits at `S * D * S^-1` in the nominal base frame; to keep
-//!    the tool on the programmed point the slave commands `P_out = S * D^-1 * S^-1 * P`.
-//! 4. **SET_ZERO / `#TRACK CS ABS`**: at switch-on the master frame `M0` is handed to the NC
+//!    error point. `O` says where the kinematic base lies seen from the error point (the
+//!    seed's example 4 gives the robot base as `X=-1305.92` from the turntable's centre and
+//!    moves the tool to `X1305.92` to reach that centre), so the error point lies at `S = O^-1`
+//!    in the kinematic base. The real base sits at `S * D * S^-1` in the nominal base frame;
+//!    to keep the tool on the programmed point the compensation is `C = S * D^-1 * S^-1`.
+//! 4. **OPTION**: 0 commands `C * P`; 1 follows only with the tool point: the position of
+//!    `C * P` with the programmed orientation of `P` (the seed's turntable example: the tool
+//!    circles with the table but keeps its orientation). See [`TrackingOption::apply`].
+//! 5. **SET_ZERO / `#TRACK CS ABS`**: at switch-on the master frame `M0` is handed to the NC
 //!    program as `V.G.TRACK_CS.X..C` ([`track_cs_values`], in the channel's orientation
 //!    convention). `#TRACK CS ABS` uses them as additive per-axis zero offsets
 //!    ([`track_cs_abs`]): programming 0 on every axis reaches the centre of the dynamic CS; a
@@ -28,7 +31,7 @@
 
 use crate::error::KinError;
 use crate::frame::{offset_frame, PoseWords, RotationOrder};
-use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use nalgebra::{Isometry3, Point3, Translation3};
 
 /// What the tracking compensates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,11 +47,27 @@ pub enum TrackingMode {
 pub enum TrackingOption {
     /// 0: translation and rotation.
     Full,
-    /// 1: translation only.
+    /// 1: translation only: the tool point follows, its orientation stays as programmed.
     TranslationOnly,
 }
 
 impl TrackingOption {
+    /// The pose commanded for programmed pose `pose` under compensation `compensation`.
+    pub fn apply(self, compensation: &Isometry3<f64>, pose: &Isometry3<f64>) -> Isometry3<f64> {
+        match self {
+            TrackingOption::Full => compensation * pose,
+            TrackingOption::TranslationOnly => Isometry3::from_parts(
+                // A point, not a vector: the compensation's translation applies too.
+                Translation3::from(
+                    compensation
+                        .transform_point(&Point3::from(pose.translation.vector))
+                        .coords,
+                ),
+                pose.rotation,
+            ),
+        }
+    }
+
     /// Decodes `OPTION=` / `transition_w.option`.
     pub fn from_raw(raw: u32) -> Result<Self, KinError> {
         match raw {
@@ -84,7 +103,7 @@ impl Tracking {
         set_zero_reference: Option<&Isometry3<f64>>,
     ) -> Result<Self, KinError> {
         let offset = offset_frame(offset, rotated_translation)?;
-        let reference_inverse = set_zero_reference.map(|m0| apply_option(option, m0).inverse());
+        let reference_inverse = set_zero_reference.map(|m0| m0.inverse());
         Ok(Self {
             mode,
             option,
@@ -96,32 +115,29 @@ impl Tracking {
 
     /// The displacement `D` of the dynamic CS for master frame `master` (formula 1).
     pub fn displacement(&self, master: &Isometry3<f64>) -> Isometry3<f64> {
-        let m = apply_option(self.option, master);
         match self.reference_inverse {
-            Some(m0_inverse) => m * m0_inverse,
-            None => m,
+            Some(m0_inverse) => master * m0_inverse,
+            None => *master,
         }
     }
 
-    /// The pose the slave commands for programmed pose `programmed` (formulas 2 and 3).
-    pub fn compose(&self, master: &Isometry3<f64>, programmed: &Isometry3<f64>) -> Isometry3<f64> {
+    /// The compensation `C` for master frame `master` (formulas 2 and 3).
+    pub fn compensation(&self, master: &Isometry3<f64>) -> Isometry3<f64> {
         let d = self.displacement(master);
         match self.mode {
-            TrackingMode::MovingWorkpiece => self.offset * d * self.offset_inverse * programmed,
-            TrackingMode::KinematicBase => {
-                self.offset * d.inverse() * self.offset_inverse * programmed
-            }
+            TrackingMode::MovingWorkpiece => self.offset * d * self.offset_inverse,
+            TrackingMode::KinematicBase => self.offset_inverse * d.inverse() * self.offset,
         }
     }
-}
 
-fn apply_option(option: TrackingOption, frame: &Isometry3<f64>) -> Isometry3<f64> {
-    match option {
-        TrackingOption::Full => *frame,
-        TrackingOption::TranslationOnly => Isometry3::from_parts(
-            Translation3::from(frame.translation.vector),
-            UnitQuaternion::identity(),
-        ),
+    /// The pose the slave commands for programmed pose `programmed` (formulas 2 to 4).
+    pub fn compose(&self, master: &Isometry3<f64>, programmed: &Isometry3<f64>) -> Isometry3<f64> {
+        self.option.apply(&self.compensation(master), programmed)
+    }
+
+    /// OPTION of this tracking.
+    pub fn option(&self) -> TrackingOption {
+        self.option
     }
 }
 

@@ -91,30 +91,32 @@ fn static_offset_maps_master_motion_into_slave_coordinates() {
 
 #[test]
 fn kin_base_holds_the_tool_against_a_base_rotation_about_the_error_point() {
-    // Error point (table centre) 1305.92 mm in -X of the kinematic base; error: 10 degree about Z.
-    let shift = PoseWords {
+    // The seed's turntable: the kinematic base lies 1305.92 mm in -X seen from the table's
+    // centre (the error point), so the centre is at +1305.92 in the base. Error: 10 degree
+    // about Z.
+    let base_seen_from_error_point = PoseWords {
         xyz: [-1305.92, 0.0, 0.0],
         abc: [0.0; 3],
     };
     let tracking = Tracking::new(
         TrackingMode::KinematicBase,
         TrackingOption::Full,
-        &shift,
+        &base_seen_from_error_point,
         false,
         None,
     )
     .unwrap();
     let error = Isometry3::from_parts(Translation3::identity(), rz(10.0));
-    let p = at(-1305.92 + 100.0, 0.0, 0.0);
+    let p = at(1305.92 + 100.0, 0.0, 0.0);
     let out = tracking.compose(&error, &p);
     let a = 10f64.to_radians();
-    let expected = at(-1305.92 + 100.0 * a.cos(), -100.0 * a.sin(), 0.0);
+    let expected = at(1305.92 + 100.0 * a.cos(), -100.0 * a.sin(), 0.0);
     assert!(
         (out.translation.vector - expected.translation.vector).norm() < 1e-9,
         "{out}"
     );
     // Physically: the displaced base S E S^-1 carries the commanded pose back onto P.
-    let s = at(-1305.92, 0.0, 0.0);
+    let s = at(1305.92, 0.0, 0.0);
     let actual_base = s * error * s.inverse();
     assert!(
         (actual_base * out)
@@ -126,7 +128,7 @@ fn kin_base_holds_the_tool_against_a_base_rotation_about_the_error_point() {
 }
 
 #[test]
-fn translation_only_ignores_the_master_rotation() {
+fn translation_only_moves_the_tool_point_and_keeps_its_orientation() {
     let tracking = Tracking::new(
         TrackingMode::MovingWorkpiece,
         TrackingOption::TranslationOnly,
@@ -136,10 +138,14 @@ fn translation_only_ignores_the_master_rotation() {
     )
     .unwrap();
     let master = Isometry3::from_parts(Translation3::new(5.0, 6.0, 7.0), rz(30.0));
-    assert!(close(
-        &tracking.compose(&master, &at(1.0, 0.0, 0.0)),
-        &at(6.0, 6.0, 7.0)
-    ));
+    let out = tracking.compose(&master, &at(1.0, 0.0, 0.0));
+    let c = 30f64.to_radians();
+    assert!(
+        close(&out, &at(5.0 + c.cos(), 6.0 + c.sin(), 7.0)),
+        "{out}"
+    );
+    let full = TrackingOption::Full.apply(&master, &at(1.0, 0.0, 0.0));
+    assert!((full.rotation.angle() - c).abs() < 1e-12);
     assert!(TrackingOption::from_raw(2).is_err());
 }
 

@@ -269,6 +269,14 @@ impl Tracker {
         self.setup.map(|s| s.source)
     }
 
+    /// How the compensation acts on the tool pose (OPTION; full while off).
+    pub fn option(&self) -> TrackingOption {
+        match self.setup {
+            Some(s) if s.translation_only => TrackingOption::TranslationOnly,
+            _ => TrackingOption::Full,
+        }
+    }
+
     /// `V.G.TRACK_CS.X..C`.
     pub fn zero_values(&self) -> [f64; 6] {
         self.zero_values
@@ -407,7 +415,7 @@ impl Tracker {
         }
         let target = match (self.state, &self.tracking, &self.last_master) {
             (DynCsState::Deactivating, _, _) => Isometry3::identity(),
-            (_, Some(tracking), Some(m)) => tracking.compose(m, &Isometry3::identity()),
+            (_, Some(tracking), Some(m)) => tracking.compensation(m),
             _ => self.applied,
         };
         if !target.translation.vector.iter().all(|v| v.is_finite())
