@@ -2,7 +2,8 @@
 //!
 //! * [`layout`]: `#[repr(C)]` control units and state images, sizes and offsets asserted at
 //!   compile time;
-//! * [`symbols`]: every node and leaf by its ST path; [`c_header`]: the same layout for C;
+//! * [`symbols`]: every node and leaf by its ST path; [`access`]: one leaf read or written by
+//!   its path; [`c_header`]: the same layout for C;
 //! * [`segment`]: the shared-memory object (create, attach, validate, heartbeats);
 //! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
 //!   PLC's side of an image;
@@ -11,6 +12,7 @@
 //!
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
 
+pub mod access;
 pub mod c_header;
 pub mod command_book;
 pub mod desc;
