@@ -3,6 +3,7 @@
 
 use crate::programs::RotaryTableMaster;
 use crate::runtime::{PlcProgram, PlcRuntime};
+use crate::timeline::Timeline;
 use core::time::Duration;
 use std::process::ExitCode;
 
@@ -16,6 +17,9 @@ pub struct PlcArgs {
     /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0).
     #[arg(long, default_value = "rotary-table")]
     pub program: String,
+    /// Run this timeline (TOML, see `plc_shim::timeline`) instead of a built-in program.
+    #[arg(long)]
+    pub timeline: Option<std::path::PathBuf>,
     /// Table speed of `rotary-table`, degree per cycle.
     #[arg(long, default_value_t = 0.01)]
     pub deg_per_cycle: f64,
@@ -27,12 +31,22 @@ pub struct PlcArgs {
     pub max_cycles: Option<u64>,
 }
 
+/// Names of the built-in programs.
+pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table"];
+
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn main(args: PlcArgs) -> ExitCode {
-    let mut program: Box<dyn PlcProgram> = match args.program.as_str() {
-        "rotary-table" => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
-        other => {
-            eprintln!("plc: unknown program {other:?} (known: rotary-table)");
+    let mut program: Box<dyn PlcProgram> = match (&args.timeline, args.program.as_str()) {
+        (Some(path), _) => match Timeline::load(path) {
+            Ok(t) => Box::new(t),
+            Err(e) => {
+                eprintln!("plc: {e}");
+                return ExitCode::from(2);
+            }
+        },
+        (None, "rotary-table") => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
+        (None, other) => {
+            eprintln!("plc: unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})");
             return ExitCode::from(2);
         }
     };

@@ -6,5 +6,6 @@ pub mod cli;
 pub mod motion;
 pub mod programs;
 pub mod runtime;
+pub mod timeline;
 
 pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

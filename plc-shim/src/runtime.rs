@@ -33,6 +33,8 @@ pub enum RuntimeError {
 pub struct PlcIo<'a> {
     /// The PLC's side of the image.
     pub view: PlcView<'a>,
+    /// The image itself, for leaves reached by ST path ([`hli::access`]).
+    pub memory: &'a hli::ImageMemory,
     /// Acyclic calls to the CNC (use sparingly: each call waits for the CNC's next tick).
     pub acyclic: &'a mut AcyclicClient,
     /// Cycles run so far (0 in the first cycle).
@@ -139,6 +141,7 @@ impl PlcRuntime {
             last_cnc_beat = beat;
             let mut io = PlcIo {
                 view: PlcView::new(self.segment.memory()),
+                memory: self.segment.memory(),
                 acyclic: &mut self.acyclic,
                 cycle: cycles,
             };
