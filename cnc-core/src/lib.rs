@@ -8,4 +8,5 @@ pub mod demo;
 pub mod json;
 pub mod kin_cli;
 pub mod nc;
+pub mod scenario;
 pub mod stats;

@@ -37,7 +37,7 @@ fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
         channel.start(program);
         channels.push(channel);
     }
-    Controller::new(channels).unwrap()
+    Controller::new(channels, CYCLE).unwrap()
 }
 
 fn image(channels: usize) -> ImageMemory {

@@ -140,10 +140,7 @@ fn translation_only_moves_the_tool_point_and_keeps_its_orientation() {
     let master = Isometry3::from_parts(Translation3::new(5.0, 6.0, 7.0), rz(30.0));
     let out = tracking.compose(&master, &at(1.0, 0.0, 0.0));
     let c = 30f64.to_radians();
-    assert!(
-        close(&out, &at(5.0 + c.cos(), 6.0 + c.sin(), 7.0)),
-        "{out}"
-    );
+    assert!(close(&out, &at(5.0 + c.cos(), 6.0 + c.sin(), 7.0)), "{out}");
     let full = TrackingOption::Full.apply(&master, &at(1.0, 0.0, 0.0));
     assert!((full.rotation.angle() - c).abs() < 1e-12);
     assert!(TrackingOption::from_raw(2).is_err());

@@ -113,7 +113,9 @@ impl PlcRuntime {
     ) -> Result<RunSummary, RuntimeError> {
         let mut watch = HeartbeatWatch::new(self.watchdog_cycles);
         let mut cycles = 0u64;
-        let mut last_cnc_beat = self.segment.cnc_heartbeat();
+        // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
+        // its cycle (lockstep waits for exactly that cycle).
+        let mut last_cnc_beat = 0;
         loop {
             if max_cycles.is_some_and(|max| cycles >= max) {
                 return Ok(RunSummary {

@@ -172,7 +172,12 @@ fn parse_condition(text: &str) -> Result<Vec<Comparison>, String> {
         let (at, len, op) = ops
             .iter()
             .find_map(|(sym, op)| part.find(sym).map(|at| (at, sym.len(), *op)))
-            .ok_or_else(|| format!("`{}` compares nothing (use ==, !=, <, <=, >, >=)", part.trim()))?;
+            .ok_or_else(|| {
+                format!(
+                    "`{}` compares nothing (use ==, !=, <, <=, >, >=)",
+                    part.trim()
+                )
+            })?;
         let left = Operand::parse(&part[..at]).map_err(|e| e.to_string())?;
         let right = Operand::parse(&part[at + len..]).map_err(|e| e.to_string())?;
         out.push(Comparison { left, op, right });
@@ -383,7 +388,9 @@ impl Step {
             let Some(path) = path else { return Ok(None) };
             let leaf = Leaf::resolve(path).map_err(|e| e.to_string())?;
             if leaf.scalar != Scalar::Bool || leaf.writer != hli::SymbolWriter::Both {
-                return Err(format!("`{path}` is not a semaphore (a BOOL both sides write)"));
+                return Err(format!(
+                    "`{path}` is not a semaphore (a BOOL both sides write)"
+                ));
             }
             Ok(Some(leaf))
         };
@@ -465,7 +472,9 @@ commit = "{SEM}"
         assert_eq!(Leaf::resolve(ROT).unwrap().read(&memory), Value::Int(-1234));
         t.cycle(&memory); // semaphore still TRUE: no second command
         assert_eq!(t.records()[1].fired, 1);
-        Leaf::resolve(SEM).unwrap().write(&memory, Value::Unsigned(0)); // CNC took it
+        Leaf::resolve(SEM)
+            .unwrap()
+            .write(&memory, Value::Unsigned(0)); // CNC took it
         t.cycle(&memory);
         assert_eq!(t.records()[1].fired, 2);
     }
@@ -476,7 +485,9 @@ commit = "{SEM}"
 [[step]]
 set = { "gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state" = 2 }
 "#;
-        let e = Timeline::parse("t.toml", cnc_owned).unwrap_err().to_string();
+        let e = Timeline::parse("t.toml", cnc_owned)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("step 1") && e.contains("CNC"), "{e}");
         let bad_cond = "[[step]]\nwhen = \"gpCh[0]^nothing == 1\"\n";
         assert!(Timeline::parse("t.toml", bad_cond).is_err());

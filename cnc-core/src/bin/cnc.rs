@@ -14,6 +14,8 @@ struct Cli {
 enum Command {
     /// Run the demo: CNC and a spawned PLC process exchanging control units.
     Demo(cnc_core::demo::DemoArgs),
+    /// Run a scenario: machine configuration, NC programs, PLC timeline, trace.
+    Run(cnc_core::scenario::runner::RunArgs),
     /// HLI tooling.
     Hli {
         #[command(subcommand)]
@@ -43,6 +45,7 @@ fn main() -> ExitCode {
     hli::init_logging();
     match Cli::parse().command {
         Command::Demo(args) => cnc_core::demo::main(args),
+        Command::Run(args) => cnc_core::scenario::runner::main(args),
         Command::Hli { what } => {
             let text = match what {
                 HliCommand::Symbols => {

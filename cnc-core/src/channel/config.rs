@@ -40,6 +40,9 @@ pub struct ChannelConfig {
     /// Start-up parameters of the channel's interpolator.
     #[serde(default)]
     pub interpolator: InterpolatorConfig,
+    /// NC program the channel starts with, a path relative to the configuration file.
+    #[serde(default)]
+    pub program: Option<String>,
 }
 
 /// `provide_channel_interface.*`.
@@ -151,6 +154,7 @@ impl ChannelConfig {
             kin_trafo_display: 0,
             ori_rotation_angle: 0,
             interpolator: InterpolatorConfig::default(),
+            program: None,
         }
     }
 

@@ -1,33 +1,54 @@
 //! The channels of a controller ticking together on one image: masters before the channels
-//! that follow them, so a slave sees its master's frame of the same tick.
+//! that follow them, so a slave sees its master's frame of the same tick. Each channel's axes
+//! take the next free axis images (`gpAx[k]^`), in channel order.
 
+use super::axes_out::AxisPublisher;
 use super::dyn_cs::MasterSample;
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
+use hli::layout::HLI_MAX_AXES;
 use hli::views::CncView;
 
 /// All channels.
 #[derive(Debug)]
 pub struct Controller {
     channels: Vec<Channel>,
+    axes: Vec<AxisPublisher>,
     masters: [Option<MasterSample>; MAX_CHANNELS],
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
 }
 
-/// More channels than a controller has.
+/// A set of channels the controller cannot hold.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("at most {MAX_CHANNELS} channels, found {0}")]
-pub struct TooManyChannels(pub usize);
+pub enum ControllerError {
+    /// More channels than the image has.
+    #[error("at most {MAX_CHANNELS} channels, found {0}")]
+    TooManyChannels(usize),
+    /// More channel axes than the image has axis blocks.
+    #[error("the channels have {0} axes together; the image holds {HLI_MAX_AXES}")]
+    TooManyAxes(usize),
+}
 
 impl Controller {
     /// The channels, index = position.
-    pub fn new(channels: Vec<Channel>) -> Result<Self, TooManyChannels> {
+    pub fn new(channels: Vec<Channel>, cycle_s: f64) -> Result<Self, ControllerError> {
         if channels.len() > MAX_CHANNELS {
-            return Err(TooManyChannels(channels.len()));
+            return Err(ControllerError::TooManyChannels(channels.len()));
+        }
+        let mut axes = Vec::with_capacity(channels.len());
+        let mut first = 0;
+        for c in &channels {
+            let n = c.config().axes.len();
+            axes.push(AxisPublisher::new(first, n, cycle_s));
+            first += n;
+        }
+        if first > HLI_MAX_AXES {
+            return Err(ControllerError::TooManyAxes(first));
         }
         Ok(Self {
             channels,
+            axes,
             masters: [None; MAX_CHANNELS],
             sync: SyncBoard::default(),
             order: core::array::from_fn(|i| i),
@@ -37,6 +58,11 @@ impl Controller {
     /// The channels.
     pub fn channels(&self) -> &[Channel] {
         &self.channels
+    }
+
+    /// Index of the first axis image of channel `index`.
+    pub fn first_axis(&self, index: usize) -> Option<usize> {
+        self.axes.get(index).map(AxisPublisher::first)
     }
 
     /// One channel, mutable (to start programs).
@@ -62,6 +88,7 @@ impl Controller {
             let i = self.order[k];
             self.channels[i].tick(view, &self.masters, &mut self.sync);
             self.masters[i] = self.channels[i].published();
+            self.axes[i].publish(view, self.channels[i].set_points());
         }
     }
 }

@@ -3,6 +3,7 @@
 //! publishing its frame with `#CHANNEL INTERFACE`, the PLC as master through
 //! `MC_CONTROL_DYN_CS_UNIT`, and tracking slaves with `#TRACK CS`).
 
+pub mod axes_out;
 pub mod config;
 pub mod controller;
 mod diagnosis;
@@ -13,7 +14,7 @@ pub mod run;
 pub mod sync;
 
 pub use config::{ChannelConfig, ChannelConfigError};
-pub use controller::Controller;
+pub use controller::{Controller, ControllerError};
 pub use dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 pub use program::{LoadedProgram, ProgramError};
 pub use run::{Channel, ChannelError, RunState, MAX_CHANNELS};

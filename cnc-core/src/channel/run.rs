@@ -29,6 +29,7 @@ use hli::layout::{
 use hli::views::CncView;
 use hli::{Bool, PlaceExt};
 use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
+use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
 use nalgebra::Isometry3;
 
@@ -130,6 +131,7 @@ pub struct Channel {
     plc_frame: Option<Isometry3<f64>>,
     plc_enabled: bool,
     m_next_id: u32,
+    m_functions_acked: u64,
     tick: u64,
 }
 
@@ -191,6 +193,7 @@ impl Channel {
             plc_frame: None,
             plc_enabled: false,
             m_next_id: 0,
+            m_functions_acked: 0,
             tick: 0,
             config,
         };
@@ -258,6 +261,11 @@ impl Channel {
     /// The tool pose of the current set-points by forward kinematics.
     pub fn tool_pose(&self) -> Isometry3<f64> {
         self.tool
+    }
+
+    /// M functions the PLC acknowledged (completed handshakes).
+    pub fn m_functions_acked(&self) -> u64 {
+        self.m_functions_acked
     }
 
     /// The tracker.
@@ -513,7 +521,9 @@ impl Channel {
                 match reader.try_take() {
                     Ok(Some(HliMFunctionAck { m_code, request_id })) => {
                         // A stale acknowledge (other id) is consumed and ignored.
-                        request_id == id && m_code == code as i32
+                        let done = request_id == id && m_code == code as i32;
+                        self.m_functions_acked += u64::from(done);
+                        done
                     }
                     _ => false,
                 }
@@ -814,7 +824,7 @@ impl Channel {
         let compensation = *self.tracker.applied();
         if self.trafo {
             self.pose_in = self.cs_frame() * self.programmed_frame();
-            self.pose_out = compensation * self.pose_in;
+            self.pose_out = self.tracker.option().apply(&compensation, &self.pose_in);
             match self.kinematics.inverse(&self.pose_out, &self.joints) {
                 Ok(j) => self.joints = j,
                 Err(e) => {
@@ -825,11 +835,14 @@ impl Channel {
             }
             self.set_points[..6].copy_from_slice(&self.joints);
         } else {
-            let c = if self.tracker.state() == DynCsState::Inactive {
+            let mut c = if self.tracker.state() == DynCsState::Inactive {
                 [0.0; 6]
             } else {
                 words(&compensation)
             };
+            if self.tracker.option() == TrackingOption::TranslationOnly {
+                c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
+            }
             for (i, c) in c.iter().enumerate() {
                 self.set_points[i] = self.programmed[i] + c;
                 self.joints[i] = self.set_points[i];

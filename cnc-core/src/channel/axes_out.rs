@@ -1,0 +1,87 @@
+//! The channel's axes in the axis images: each channel axis occupies one `gpAx[k]^` block and
+//! shows the channel's set-point there (`lr_state`), so the PLC reads a table axis that an NC
+//! program turns, as in the seed's example 4 (`gpAx[6]^lr_state.current_position_acs_r`).
+//!
+//! The axes run on ideal drives in this version: the actual position is the set-point and
+//! the following error is zero. Coupling channel axes to the simulated drives of
+//! [`crate::axis`] (with their lag and monitoring) is a later step.
+
+use crate::nc::decode::AxisValues;
+use hli::enums::{AxisState, CouplingState};
+use hli::layout::{HliAxis, HliAxisLrState};
+use hli::views::CncView;
+use hli::PlaceExt;
+
+/// Writes one channel's axes into consecutive axis images.
+#[derive(Debug, Clone)]
+pub struct AxisPublisher {
+    first: usize,
+    last: AxisValues,
+    last_velocity: AxisValues,
+    cycle_s: f64,
+    primed: bool,
+}
+
+impl AxisPublisher {
+    /// Axes `first..first + axes` of the image, ticking every `cycle_s`.
+    pub fn new(first: usize, axes: usize, cycle_s: f64) -> Self {
+        Self {
+            first,
+            last: AxisValues::zeros(axes),
+            last_velocity: AxisValues::zeros(axes),
+            cycle_s,
+            primed: false,
+        }
+    }
+
+    /// First axis image used.
+    pub fn first(&self) -> usize {
+        self.first
+    }
+
+    /// Publishes `set_points` (channel order). Does not allocate.
+    pub fn publish(&mut self, view: &CncView<'_>, set_points: &AxisValues) {
+        if !self.primed {
+            self.last.copy_from_slice(set_points);
+            self.primed = true;
+        }
+        for (i, &p) in set_points.iter().enumerate() {
+            let Ok(axis) = view.axis(self.first + i) else {
+                break;
+            };
+            let v = (p - self.last[i]) / self.cycle_s;
+            let a = (v - self.last_velocity[i]) / self.cycle_s;
+            let state = if v == 0.0 {
+                AxisState::Standstill
+            } else if a.abs() < 1e-9 {
+                AxisState::ConstantVelocity
+            } else if a * v > 0.0 {
+                AxisState::Accelerating
+            } else {
+                AxisState::Decelerating
+            };
+            // Linear units (0.1 um) and angle units (0.0001 degree) scale alike.
+            let raw = |x: f64| {
+                hli::units::mm_to_hli(x).unwrap_or(if x < 0.0 { i32::MIN } else { i32::MAX })
+            };
+            let position = raw(p);
+            axis.field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
+                .write(&HliAxisLrState {
+                    current_position_acs_r: position,
+                    command_position_acs_r: position,
+                    current_velocity_r: raw(v),
+                    command_velocity_r: raw(v),
+                    command_acceleration_r: raw(a),
+                    following_error_r: 0,
+                    axis_state_r: state.raw(),
+                    coupling_state_r: CouplingState::Channel.raw(),
+                    master_axis_r: -1,
+                    error_id_r: 0,
+                    status_r: 0,
+                    fill_up_1: 0,
+                });
+            self.last[i] = p;
+            self.last_velocity[i] = v;
+        }
+    }
+}

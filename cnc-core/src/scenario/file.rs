@@ -1,0 +1,219 @@
+//! The scenario file: a machine configuration (cycle time, channels under the controller's
+//! parameter names) plus what to run on it (NC programs, a PLC timeline or built-in program)
+//! and what to trace.
+//!
+//! ```toml
+//! cycle_ms = 1.0
+//! ticks = 12000                   # default run length (`--ticks` overrides)
+//! [[channel]]
+//! name = "master"
+//! axes = ["X", "Y", "Z", "A", "B", "C"]
+//! kinematics = { id = 45, preset = "kr6r900sixx" }
+//! program = "master.nc"           # relative to this file
+//! [plc]
+//! timeline = "plc.toml"           # or: program = "rotary-table"
+//! [trace]
+//! signals = ["gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state"]
+//! ```
+
+use crate::channel::{ChannelConfig, LoadedProgram};
+use hli::access::Leaf;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Why a scenario cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// A file could not be read.
+    #[error("{file}: {message}")]
+    Read {
+        /// The file.
+        file: String,
+        /// The OS error.
+        message: String,
+    },
+    /// The TOML did not parse, has unknown fields or values out of range.
+    #[error("{file}: {message}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong (with line and column where the parser knows them).
+        message: String,
+    },
+    /// An NC program was refused (its diagnostics, FILE:LINE:COL each).
+    #[error("{0}")]
+    Program(#[from] crate::channel::ProgramError),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    #[serde(default = "default_cycle_ms")]
+    cycle_ms: f64,
+    ticks: Option<u64>,
+    channel: Vec<ChannelConfig>,
+    plc: Option<PlcFile>,
+    #[serde(default)]
+    trace: TraceFile,
+}
+
+fn default_cycle_ms() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlcFile {
+    timeline: Option<String>,
+    program: Option<String>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TraceFile {
+    #[serde(default)]
+    signals: Vec<String>,
+}
+
+/// What runs in the PLC process.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum PlcSetup {
+    /// No PLC.
+    None,
+    /// A timeline: its path (as given, resolved) and its text.
+    Timeline {
+        /// Where it came from.
+        path: PathBuf,
+        /// The TOML text.
+        text: String,
+    },
+    /// A built-in program of `plc-shim` by name.
+    Program(String),
+}
+
+/// A checked scenario, every file read.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// Where the scenario came from (for messages).
+    pub name: String,
+    /// Tick period, seconds.
+    pub cycle_s: f64,
+    /// Default run length.
+    pub ticks: Option<u64>,
+    /// The channels.
+    pub channels: Vec<ChannelConfig>,
+    /// Their programs, checked (None: the channel stays idle).
+    pub programs: Vec<Option<LoadedProgram>>,
+    /// The PLC.
+    pub plc: PlcSetup,
+    /// Trace signals: ST path and resolved leaf.
+    pub signals: Vec<(String, Leaf)>,
+}
+
+impl Scenario {
+    /// Loads `path` and the files it names.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let read = |p: &Path| {
+            std::fs::read_to_string(p).map_err(|e| ScenarioError::Read {
+                file: p.display().to_string(),
+                message: e.to_string(),
+            })
+        };
+        let text = read(path)?;
+        Scenario::parse(&path.display().to_string(), &text, |relative| {
+            let p = dir.join(relative);
+            read(&p).map(|text| (p, text))
+        })
+    }
+
+    /// Parses scenario `text`; `open` reads a file named in it (relative path) and returns
+    /// its resolved path and text. The demo passes files embedded in the binary this way.
+    pub fn parse(
+        name: &str,
+        text: &str,
+        open: impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+    ) -> Result<Scenario, ScenarioError> {
+        let invalid = |message: String| ScenarioError::Invalid {
+            file: name.to_string(),
+            message,
+        };
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        if !(file.cycle_ms.is_finite() && (0.05..=100.0).contains(&file.cycle_ms)) {
+            return Err(invalid(format!(
+                "cycle_ms = {}: must lie in 0.05..=100",
+                file.cycle_ms
+            )));
+        }
+        if file.channel.is_empty() || file.channel.len() > crate::channel::MAX_CHANNELS {
+            return Err(invalid(format!(
+                "{} channels: a scenario has 1 to {}",
+                file.channel.len(),
+                crate::channel::MAX_CHANNELS
+            )));
+        }
+        let mut programs = Vec::with_capacity(file.channel.len());
+        for c in &file.channel {
+            programs.push(match &c.program {
+                Some(p) => {
+                    let (path, src) = open(p)?;
+                    Some(LoadedProgram::load(
+                        &path.display().to_string(),
+                        &src,
+                        &c.axes,
+                    )?)
+                }
+                None => None,
+            });
+        }
+        let plc = match file.plc {
+            None => PlcSetup::None,
+            Some(PlcFile {
+                timeline: Some(t),
+                program: None,
+            }) => {
+                let (path, text) = open(&t)?;
+                // Checked here too, so a bad timeline fails before any process starts.
+                plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
+                    .map_err(|e| invalid(e.to_string()))?;
+                PlcSetup::Timeline { path, text }
+            }
+            Some(PlcFile {
+                timeline: None,
+                program: Some(p),
+            }) => {
+                if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p.as_str()) {
+                    return Err(invalid(format!(
+                        "[plc] program {p:?}: known are {:?}",
+                        plc_shim::cli::BUILT_IN_PROGRAMS
+                    )));
+                }
+                PlcSetup::Program(p)
+            }
+            Some(_) => {
+                return Err(invalid(
+                    "[plc] takes exactly one of `timeline` and `program`".into(),
+                ))
+            }
+        };
+        let mut signals = Vec::with_capacity(file.trace.signals.len());
+        for s in file.trace.signals {
+            let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;
+            signals.push((s, leaf));
+        }
+        Ok(Scenario {
+            name: name.to_string(),
+            cycle_s: file.cycle_ms * 1e-3,
+            ticks: file.ticks,
+            channels: file.channel,
+            programs,
+            plc,
+            signals,
+        })
+    }
+
+    /// Axis images the channels need together.
+    pub fn axis_count(&self) -> usize {
+        self.channels.iter().map(|c| c.axes.len()).sum()
+    }
+}

@@ -1,0 +1,394 @@
+//! `cnc run`: the CNC process of a scenario. It creates the HLI segment, spawns the PLC
+//! process (a timeline or a built-in program) and ticks the channels, in one of two modes:
+//!
+//! * **real-time**: tick N starts at the absolute deadline `start + N * cycle` on
+//!   CLOCK_MONOTONIC; the PLC runs its cycles as the CNC's "tick done" events wake it;
+//! * **lockstep**: tick N starts only once the PLC has run its cycle after tick N-1, so both
+//!   sides see each other's writes at fixed ticks and identical runs give bit-identical
+//!   traces (the trace time is then the nominal `N * cycle`).
+//!
+//! ```text
+//! create segment ─► spawn plc ─► wait attach ─► for each tick:
+//!   [real-time: sleep to deadline | lockstep: wait PLC heartbeat == N]
+//!   channels tick ─► heartbeat ─► trace sample ─► answer acyclic calls ─► notify "tick done"
+//! ```
+
+use super::file::{PlcSetup, Scenario};
+use super::machine::Machine;
+use super::trace::Trace;
+use crate::stats::Percentiles;
+use core::time::Duration;
+use hli::events::{EventLink, Side};
+use hli::raw::monotonic;
+use hli::rpc::{handle_read_axis_state, AcyclicServer, CallKind, ErrorCode};
+use hli::segment::CncSegment;
+use hli::views::CncView;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitCode, Stdio};
+
+/// Ticks run when neither `--ticks` nor the scenario says: until every channel is idle, at
+/// most this many.
+pub const DEFAULT_TICK_LIMIT: u64 = 120_000;
+/// How long lockstep waits for one PLC cycle before it gives up.
+const PLC_CYCLE_WATCHDOG: Duration = Duration::from_secs(10);
+
+/// Arguments of `cnc run`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RunArgs {
+    /// The scenario (TOML).
+    pub scenario: PathBuf,
+    /// Write the trace CSV here.
+    #[arg(long)]
+    pub trace: Option<PathBuf>,
+    /// Run exactly N ticks (channels that finish earlier stay idle).
+    #[arg(long)]
+    pub ticks: Option<u64>,
+    /// Lockstep mode: tick N waits for the PLC's cycle; runs are reproducible bit for bit.
+    #[arg(long)]
+    pub lockstep: bool,
+    /// Instance name of the segment (default: run-<pid>).
+    #[arg(long)]
+    pub instance: Option<String>,
+    /// Print the dynamic-CS diagnosis tables (history and switching log) at the end.
+    #[arg(long)]
+    pub diagnosis: bool,
+}
+
+/// How to run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Exactly this many ticks, or until idle (at most [`DEFAULT_TICK_LIMIT`]).
+    pub ticks: Option<u64>,
+    /// Lockstep instead of real-time.
+    pub lockstep: bool,
+    /// Segment instance name.
+    pub instance: String,
+    /// Where a timeline that exists only in memory is written for the PLC process.
+    pub scratch: PathBuf,
+}
+
+/// One channel at the end of a run.
+#[derive(Debug, Clone)]
+pub struct ChannelReport {
+    /// Name.
+    pub name: String,
+    /// Final run state and, on error, the line and reason.
+    pub outcome: String,
+    /// Tracking switching log: tick and event.
+    pub tracking: Vec<(u64, String)>,
+    /// See [`Machine::max_tracking_error`].
+    pub max_tracking_error_mm: f64,
+    /// M-function handshakes completed.
+    pub m_functions_acked: u64,
+    /// The diagnosis tables.
+    pub diagnosis: String,
+}
+
+/// What a run did.
+#[derive(Debug)]
+pub struct RunReport {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Compute time of a tick, ns.
+    pub tick_ns: Percentiles,
+    /// How late a tick started after its deadline (real-time mode), ns.
+    pub late_ns: Percentiles,
+    /// Per channel.
+    pub channels: Vec<ChannelReport>,
+    /// Acyclic calls answered.
+    pub acyclic_answered: u64,
+    /// What the PLC process printed.
+    pub plc_output: String,
+    /// The trace.
+    pub trace: Trace,
+}
+
+/// `cnc run`.
+pub fn main(args: RunArgs) -> ExitCode {
+    let scenario = match Scenario::load(&args.scenario) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("cnc run: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let instance = args
+        .instance
+        .clone()
+        .unwrap_or_else(|| format!("run-{}", std::process::id()));
+    let options = RunOptions {
+        ticks: args.ticks,
+        lockstep: args.lockstep,
+        scratch: std::env::temp_dir(),
+        instance,
+    };
+    match run(&scenario, &options) {
+        Ok(report) => {
+            print!("{}", report.render(args.diagnosis));
+            if let Some(path) = &args.trace {
+                if let Err(e) = report.trace.save(path) {
+                    eprintln!("cnc run: trace: {e}");
+                    return ExitCode::from(1);
+                }
+                println!("trace: {}", path.display());
+            }
+            if report
+                .channels
+                .iter()
+                .any(|c| c.outcome.starts_with("error"))
+            {
+                ExitCode::from(3)
+            } else {
+                ExitCode::SUCCESS
+            }
+        }
+        Err(e) => {
+            eprintln!("cnc run: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Runs `scenario` as a CNC process with a spawned PLC process.
+pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, String> {
+    let mut machine = Machine::new(scenario).map_err(|e| e.to_string())?;
+    let segment = CncSegment::create(
+        &options.instance,
+        scenario.channels.len() as u32,
+        scenario.axis_count().max(1) as u32,
+    )
+    .map_err(|e| e.to_string())?;
+    let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
+    let server = AcyclicServer::open(&options.instance).map_err(|e| e.to_string())?;
+    let mut child = spawn_plc(scenario, options)?;
+    if let Some(child) = child.as_mut() {
+        wait_for_attach(&segment, child)?;
+    }
+
+    let limit = options
+        .ticks
+        .or(scenario.ticks)
+        .unwrap_or(DEFAULT_TICK_LIMIT);
+    let rows = usize::try_from(limit).map_err(|_| "--ticks too large".to_string())?;
+    let mut trace = Trace::new(&scenario.signals, rows);
+    let mut tick_ns = Vec::with_capacity(rows);
+    let mut late_ns = Vec::with_capacity(rows);
+    let mut acyclic_answered = 0u64;
+    let memory = segment.memory();
+    let view = CncView::new(memory);
+    let period = Duration::from_secs_f64(scenario.cycle_s);
+    let start = monotonic::now();
+    let mut result = Ok(());
+
+    for tick in 0..limit {
+        if options.ticks.is_none() && scenario.ticks.is_none() && machine.idle() {
+            break;
+        }
+        let deadline = start + period * (tick as u32);
+        if options.lockstep {
+            if let Some(child) = child.as_mut() {
+                if let Err(e) = wait_for_plc_cycle(&segment, &events, child, tick) {
+                    result = Err(e);
+                    break;
+                }
+            }
+        } else {
+            monotonic::sleep_until(deadline);
+        }
+        let t0 = monotonic::now();
+        machine.tick(memory);
+        let time = if options.lockstep {
+            tick as f64 * scenario.cycle_s
+        } else {
+            (t0 - start).as_secs_f64()
+        };
+        trace.record(memory, tick, time);
+        acyclic_answered += server
+            .poll(|kind, request| match kind {
+                CallKind::ReadAxisState => handle_read_axis_state(&view, request),
+                CallKind::AxisCommand => Err(ErrorCode::ServiceNotSupported),
+            })
+            .unwrap_or(0) as u64;
+        let _ = events.notify();
+        tick_ns.push((monotonic::now() - t0).as_nanos() as u64);
+        late_ns.push(t0.saturating_sub(deadline).as_nanos() as u64);
+    }
+
+    let ticks = machine.ticks();
+    drop(segment); // marks the segment closed: the PLC stops
+    let plc_output = match child {
+        Some(child) => wait_for_exit(child)?,
+        None => String::new(),
+    };
+    result?;
+    Ok(RunReport {
+        ticks,
+        tick_ns: Percentiles::of(&mut tick_ns),
+        late_ns: if options.lockstep {
+            Percentiles::default()
+        } else {
+            Percentiles::of(&mut late_ns)
+        },
+        channels: channel_reports(&machine),
+        acyclic_answered,
+        plc_output,
+        trace,
+    })
+}
+
+/// The per-channel part of the report.
+pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
+    machine
+        .controller()
+        .channels()
+        .iter()
+        .zip(machine.max_tracking_error())
+        .map(|(c, &err)| ChannelReport {
+            name: c.config().name.clone(),
+            outcome: match c.error() {
+                Some(e) => format!("error at line {}: {}", e.line, e.message),
+                None => format!("{:?}", c.state()).to_lowercase(),
+            },
+            tracking: c
+                .tracker()
+                .log()
+                .map(|(tick, event)| (*tick, format!("{event:?}")))
+                .collect(),
+            max_tracking_error_mm: err,
+            m_functions_acked: c.m_functions_acked(),
+            diagnosis: c.dyn_cs_diagnosis(),
+        })
+        .collect()
+}
+
+impl RunReport {
+    /// The summary printed at the end of a run.
+    pub fn render(&self, diagnosis: bool) -> String {
+        let mut out = String::new();
+        for c in &self.channels {
+            out.push_str(&format!(
+                "channel {}: {}; M functions acknowledged {}; max tracking error {:.6} mm\n",
+                c.name, c.outcome, c.m_functions_acked, c.max_tracking_error_mm
+            ));
+            for (tick, event) in &c.tracking {
+                out.push_str(&format!("  tick {tick}: {event}\n"));
+            }
+            if diagnosis && !c.tracking.is_empty() {
+                out.push_str(&c.diagnosis);
+            }
+        }
+        out.push_str(&format!(
+            "ticks {}; tick compute p50 {} ns, p99 {} ns, max {} ns; start lateness p50 {} ns, p99 {} ns, max {} ns; acyclic calls answered {}\n",
+            self.ticks,
+            self.tick_ns.p50,
+            self.tick_ns.p99,
+            self.tick_ns.max,
+            self.late_ns.p50,
+            self.late_ns.p99,
+            self.late_ns.max,
+            self.acyclic_answered
+        ));
+        out.push_str(&self.plc_output);
+        out
+    }
+}
+
+fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>, String> {
+    let mut command = Command::new(std::env::current_exe().map_err(|e| e.to_string())?);
+    command.args(["plc", "--instance", &options.instance]);
+    match &scenario.plc {
+        PlcSetup::None => return Ok(None),
+        PlcSetup::Timeline { path, text } => {
+            let file = if path.is_file() {
+                path.clone()
+            } else {
+                // Embedded scenario: hand the PLC process a copy on disk.
+                let file = options
+                    .scratch
+                    .join(format!("{}-timeline.toml", options.instance));
+                write_file(&file, text)?;
+                file
+            };
+            command.arg("--timeline").arg(file);
+        }
+        PlcSetup::Program(p) => {
+            command.args(["--program", p]);
+        }
+    }
+    command
+        .stdout(Stdio::piped())
+        .stdin(Stdio::null())
+        .spawn()
+        .map(Some)
+        .map_err(|e| format!("spawning the PLC: {e}"))
+}
+
+fn write_file(path: &Path, text: &str) -> Result<(), String> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
+    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Lockstep: waits until the PLC has run its cycle after tick `tick - 1`.
+fn wait_for_plc_cycle(
+    segment: &CncSegment,
+    events: &EventLink,
+    child: &mut Child,
+    tick: u64,
+) -> Result<(), String> {
+    let watchdog = monotonic::now() + PLC_CYCLE_WATCHDOG;
+    while segment.plc_heartbeat() < tick {
+        let _ = events.wait(Duration::from_millis(5));
+        if let Ok(Some(status)) = child.try_wait() {
+            return Err(format!("the PLC process exited at tick {tick}: {status}"));
+        }
+        if monotonic::now() > watchdog {
+            return Err(format!(
+                "lockstep: the PLC did not finish its cycle for tick {tick} within {PLC_CYCLE_WATCHDOG:?}"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Waits (bounded) until the PLC process has attached to the segment.
+pub fn wait_for_attach(segment: &CncSegment, child: &mut Child) -> Result<(), String> {
+    let watchdog = monotonic::now() + Duration::from_secs(20);
+    let plc_pid = core::mem::offset_of!(hli::layout::HliSegmentHeader, plc_pid);
+    loop {
+        if segment.header().field::<u32>(plc_pid).load() != 0 {
+            return Ok(());
+        }
+        if let Ok(Some(status)) = child.try_wait() {
+            return Err(format!("the PLC process exited before attaching: {status}"));
+        }
+        if monotonic::now() > watchdog {
+            let _ = child.kill();
+            return Err("the PLC process did not attach within 20 s".into());
+        }
+        monotonic::sleep_until(monotonic::now() + Duration::from_millis(1));
+    }
+}
+
+/// Waits (bounded) for the PLC process to stop and returns what it printed.
+pub fn wait_for_exit(mut child: Child) -> Result<String, String> {
+    let watchdog = monotonic::now() + Duration::from_secs(10);
+    loop {
+        match child.try_wait() {
+            Ok(Some(_)) => break,
+            Ok(None) if monotonic::now() > watchdog => {
+                let _ = child.kill();
+                return Err("the PLC process did not stop within 10 s of the CNC closing".into());
+            }
+            Ok(None) => monotonic::sleep_until(monotonic::now() + Duration::from_millis(2)),
+            Err(e) => return Err(e.to_string()),
+        }
+    }
+    let mut text = String::new();
+    if let Some(mut out) = child.stdout.take() {
+        use std::io::Read;
+        let _ = out.read_to_string(&mut text);
+    }
+    Ok(text)
+}
