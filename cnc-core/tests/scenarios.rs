@@ -6,7 +6,7 @@ use cnc_core::scenario::{InProcess, Scenario};
 use hli::enums::DynCsState;
 use kinematics::frame::offset_frame;
 use kinematics::PoseWords;
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use std::path::PathBuf;
 
 fn scenario(name: &str) -> Scenario {
@@ -195,7 +195,94 @@ fn lockstep_runs_are_identical() {
     assert_eq!(csv(&a), csv(&b));
 }
 
-#[allow(dead_code)]
-fn translation(x: f64, y: f64, z: f64) -> Isometry3<f64> {
-    Isometry3::from_parts(Translation3::new(x, y, z), UnitQuaternion::identity())
+/// Example 2: the PLC reports a base error D; with KIN_BASE the channel commands D^-1, so the
+/// real tool (the swayed base D carrying the commanded pose) is on the programmed point. The
+/// compensation comes in over FILTER=1000 ticks and goes over the default 200, never faster.
+#[test]
+fn example_2_the_base_error_is_compensated_and_switched_softly() {
+    let s = scenario("example2-kin-base");
+    let base_error = frame([1.5, -0.8, 0.3], [0.2, -0.1, 0.5]);
+    let full_shift = base_error.inverse().translation.vector.norm();
+    let mut last_comp = Isometry3::identity();
+    let (mut active, mut inactive_after, mut worst) = (0, 0, 0.0f64);
+    let mut max_step = [0.0f64; 2]; // ACTIVATING, DEACTIVATING
+    let mut was_on = false;
+    run(&s, 60_000, None, |run, _| {
+        let robot = channel(run, "robot");
+        let comp = *robot.tracker().applied();
+        let step = (comp.translation.vector - last_comp.translation.vector).norm();
+        last_comp = comp;
+        match robot.tracker().state() {
+            DynCsState::Activating => max_step[0] = max_step[0].max(step),
+            DynCsState::Deactivating => max_step[1] = max_step[1].max(step),
+            DynCsState::Active => {
+                was_on = true;
+                let real_tool = base_error * robot.tool_pose();
+                let programmed = robot.pose_in();
+                worst = worst
+                    .max((real_tool.translation.vector - programmed.translation.vector).norm());
+                assert!(real_tool.rotation.angle_to(&programmed.rotation) < 1e-6);
+                active += 1;
+            }
+            DynCsState::Inactive if was_on => {
+                // Off again: the tool is on the programmed point of the nominal base.
+                let miss = (robot.tool_pose().translation.vector
+                    - robot.pose_in().translation.vector)
+                    .norm();
+                assert!(miss < 1e-6, "uncompensated tool off by {miss}");
+                inactive_after += 1;
+            }
+            _ => {}
+        }
+    });
+    assert!(active > 3000, "compensated for {active} ticks");
+    assert!(inactive_after > 1000);
+    assert!(
+        worst < 1e-3,
+        "the real tool missed the programmed point by {worst} mm"
+    );
+    assert!(max_step[0] <= full_shift / 1000.0 + 1e-9, "{max_step:?}");
+    assert!(max_step[1] <= full_shift / 200.0 + 1e-9, "{max_step:?}");
+    assert!(max_step[0] > 0.0 && max_step[1] > 0.0);
+}
+
+/// Example 1: after SET_ZERO and `#TRACK CS ABS` the gripper's zero is the carriage's position
+/// at switch-on; while tracking, each gripper axis follows the same carriage axis, so the
+/// gripper holds its grip (X0, Z25.44 above the carriage) while the carriage travels.
+#[test]
+fn example_1_the_gripper_follows_the_carriage_axis_by_axis() {
+    let s = scenario("example1-axis-following");
+    let (mut checked, mut worst, mut travel) = (0, 0.0f64, 0.0f64);
+    let mut last_x: Option<f64> = None;
+    let mut cycles = 0;
+    let mut was_active = false;
+    let done = run(&s, 60_000, s.ticks, |run, _| {
+        let (g, c) = (channel(run, "gripper"), channel(run, "carriage"));
+        let active = g.tracker().state() == DynCsState::Active;
+        if active && !was_active {
+            cycles += 1;
+        }
+        was_active = active;
+        if !(active && !g.is_moving() && c.is_moving()) {
+            return;
+        }
+        let (gs, cs) = (g.set_points(), c.set_points());
+        worst = worst
+            .max((gs[0] - cs[0]).abs())
+            .max((gs[2] - (cs[2] + 25.44)).abs())
+            .max(gs[1].abs());
+        if let Some(x) = last_x {
+            travel += (cs[0] - x).abs();
+        }
+        last_x = Some(cs[0]);
+        checked += 1;
+    });
+    assert!(cycles >= 3, "{cycles} transfer cycles");
+    assert!(checked > 1000, "followed for {checked} ticks");
+    assert!(
+        travel > 200.0,
+        "the carriage travelled {travel} mm while followed"
+    );
+    assert!(worst < 1e-3, "the grip slipped by {worst} mm");
+    assert!(channel(&done, "carriage").m_functions_acked() >= 3);
 }

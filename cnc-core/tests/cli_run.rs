@@ -1,0 +1,129 @@
+//! `cnc run` as two processes (the CNC and the PLC it spawns) on a real shared-memory segment:
+//! lockstep runs are bit-identical to each other and to the in-process run; a real-time run
+//! completes; bad scenarios are refused before anything starts.
+
+use cnc_core::scenario::{InProcess, Scenario};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scenario_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios")
+        .join(name)
+        .join("scenario.toml")
+}
+
+fn cnc_run(args: &[&str], instance: &str, trace: &Path) -> std::process::Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .args(args)
+        .args(["--instance", instance, "--trace"])
+        .arg(trace)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "cnc run {args:?}: {}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+#[test]
+fn lockstep_traces_are_bit_identical_across_runs_and_match_in_process() {
+    let dir = std::env::temp_dir().join(format!("cli-run-{}", std::process::id()));
+    let path = scenario_path("example4-turntable-plc");
+    let scenario = path.to_str().unwrap();
+    let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
+    let pid = std::process::id();
+    let args = [scenario, "--lockstep", "--ticks", "4000"];
+    let first = cnc_run(&args, &format!("clirun-a-{pid}"), &a);
+    cnc_run(&args, &format!("clirun-b-{pid}"), &b);
+    let (ta, tb) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_eq!(ta, tb, "two lockstep runs differ");
+    let text = String::from_utf8(ta.clone()).unwrap();
+    assert_eq!(text.lines().count(), 4001, "header and 4000 ticks");
+    assert!(text.starts_with("tick,time,gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state,"));
+    // The PLC process switched the tracking on: state 2 appears in the trace.
+    assert!(text.lines().any(|l| l.split(',').nth(2) == Some("2")));
+    let stdout = String::from_utf8_lossy(&first.stdout);
+    assert!(stdout.contains("M functions acknowledged 1"), "{stdout}");
+
+    // The in-process lockstep run of the same scenario gives the same bytes.
+    let s = Scenario::load(&path).unwrap();
+    let mut run = InProcess::new(&s, 4000).unwrap();
+    for _ in 0..4000 {
+        run.step(s.cycle_s);
+    }
+    let mut in_process = Vec::new();
+    run.trace.write_csv(&mut in_process).unwrap();
+    assert_eq!(in_process, ta, "in-process and two-process lockstep differ");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn a_real_time_run_completes_with_its_plc() {
+    let dir = std::env::temp_dir().join(format!("cli-run-rt-{}", std::process::id()));
+    let path = scenario_path("example4-turntable-hybrid");
+    let trace = dir.join("rt.csv");
+    let out = cnc_run(
+        &[path.to_str().unwrap(), "--ticks", "300"],
+        &format!("clirun-rt-{}", std::process::id()),
+        &trace,
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("ticks 300;"), "{stdout}");
+    assert!(stdout.contains("ended by CncClosed"), "{stdout}");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    assert_eq!(text.lines().count(), 301);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_scenarios_are_refused_with_their_file() {
+    let dir = std::env::temp_dir().join(format!("cli-run-bad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cases = [
+        (
+            "cycle_ms = 1.0\n[[channel]]\nname = \"a\"\naxes = [\"X\"]\nbogus = 1\n",
+            "bogus",
+        ),
+        (
+            "[[channel]]\nname = \"a\"\naxes = [\"X\"]\nprogram = \"p.nc\"\n",
+            "p.nc",
+        ),
+        (
+            "[[channel]]\nname = \"a\"\naxes = [\"X\"]\n[trace]\nsignals = [\"gpCh[0]^nothing\"]\n",
+            "nothing",
+        ),
+    ];
+    for (i, (text, needle)) in cases.iter().enumerate() {
+        let file = dir.join(format!("bad{i}.toml"));
+        std::fs::write(&file, text).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+            .arg("run")
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "case {i}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "case {i}: {err}");
+    }
+    // An NC error names FILE:LINE:COL.
+    std::fs::write(dir.join("p.nc"), "G1 X1 F100\nG1 Q5\n").unwrap();
+    let file = dir.join("bad_program.toml");
+    std::fs::write(
+        &file,
+        "[[channel]]\nname = \"a\"\naxes = [\"X\"]\nprogram = \"p.nc\"\n",
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("p.nc:2:"), "{err}");
+    let _ = std::fs::remove_dir_all(dir);
+}
