@@ -5,6 +5,7 @@ pub mod axis;
 pub mod channel;
 pub mod check_cli;
 pub mod demo;
+pub mod hli_demo;
 pub mod json;
 pub mod kin_cli;
 pub mod nc;

@@ -40,6 +40,14 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
     let _ = writeln!(out, "=====");
     let _ = writeln!(out, "time message");
     let _ = writeln!(out, "-----");
+    for (tick, event) in tracker.log() {
+        let _ = writeln!(out, "{tick} {}", log_message(*tick, event));
+    }
+    out
+}
+
+/// One switching-log message (a switch-on or -off message holds a second, tick-stamped line).
+pub(crate) fn log_message(tick: u64, event: &TrackEvent) -> String {
     let frame = |w: &[f64; 6]| {
         let u = w.map(|v| (v * 10_000.0).round() as i64);
         format!(
@@ -47,38 +55,34 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
             u[0], u[1], u[2], u[3], u[4], u[5]
         )
     };
-    for (tick, event) in tracker.log() {
-        let message = match event {
-            TrackEvent::On {
-                source,
-                filter_ticks,
-                wait,
-                master,
-            } => {
-                let source = match source {
-                    MasterSource::Plc => "PLC=1".to_string(),
-                    MasterSource::Channel(c) => format!("CH={}", c + 1),
-                };
-                format!(
-                    "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE {}",
-                    u8::from(*wait),
-                    frame(master)
-                )
-            }
-            TrackEvent::Active => "dynCS: is on = ACTIVE".to_string(),
-            TrackEvent::Off {
-                filter_ticks,
-                applied,
-            } => format!(
-                "dynCS: cmd=OFF FILTER={filter_ticks}\n{tick} dynCS: VALUE {}",
-                frame(applied)
-            ),
-            TrackEvent::Inactive => "dynCS: is off = INACTIVE".to_string(),
-            TrackEvent::MasterFrozen => "dynCS: master frozen, holding".to_string(),
-            TrackEvent::MasterResumed => "dynCS: master resumed, soft take-over".to_string(),
-            TrackEvent::Error(e) => format!("dynCS: ERROR: {e}"),
-        };
-        let _ = writeln!(out, "{tick} {message}");
+    match event {
+        TrackEvent::On {
+            source,
+            filter_ticks,
+            wait,
+            master,
+        } => {
+            let source = match source {
+                MasterSource::Plc => "PLC=1".to_string(),
+                MasterSource::Channel(c) => format!("CH={}", c + 1),
+            };
+            format!(
+                "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE {}",
+                u8::from(*wait),
+                frame(master)
+            )
+        }
+        TrackEvent::Active => "dynCS: is on = ACTIVE".to_string(),
+        TrackEvent::Off {
+            filter_ticks,
+            applied,
+        } => format!(
+            "dynCS: cmd=OFF FILTER={filter_ticks}\n{tick} dynCS: VALUE {}",
+            frame(applied)
+        ),
+        TrackEvent::Inactive => "dynCS: is off = INACTIVE".to_string(),
+        TrackEvent::MasterFrozen => "dynCS: master frozen, holding".to_string(),
+        TrackEvent::MasterResumed => "dynCS: master resumed, soft take-over".to_string(),
+        TrackEvent::Error(e) => format!("dynCS: ERROR: {e}"),
     }
-    out
 }

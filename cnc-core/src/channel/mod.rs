@@ -6,7 +6,7 @@
 pub mod axes_out;
 pub mod config;
 pub mod controller;
-mod diagnosis;
+pub(crate) mod diagnosis;
 pub mod dyn_cs;
 pub mod path;
 pub mod program;

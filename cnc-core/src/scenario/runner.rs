@@ -16,6 +16,7 @@
 use super::file::{PlcSetup, Scenario};
 use super::machine::Machine;
 use super::trace::Trace;
+use crate::channel::diagnosis::log_message;
 use crate::stats::Percentiles;
 use core::time::Duration;
 use hli::events::{EventLink, Side};
@@ -252,7 +253,7 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
             tracking: c
                 .tracker()
                 .log()
-                .map(|(tick, event)| (*tick, format!("{event:?}")))
+                .map(|(tick, event)| (*tick, log_message(*tick, event)))
                 .collect(),
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),
@@ -267,11 +268,11 @@ impl RunReport {
         let mut out = String::new();
         for c in &self.channels {
             out.push_str(&format!(
-                "channel {}: {}; M functions acknowledged {}; max tracking error {:.6} mm\n",
+                "channel {}: {}; M functions acknowledged {}; max tracking error (realised vs commanded tool point, ideal drives) {:.6} mm\n",
                 c.name, c.outcome, c.m_functions_acked, c.max_tracking_error_mm
             ));
             for (tick, event) in &c.tracking {
-                out.push_str(&format!("  tick {tick}: {event}\n"));
+                out.push_str(&format!("  {tick} {}\n", event.replace('\n', "\n  ")));
             }
             if diagnosis && !c.tracking.is_empty() {
                 out.push_str(&c.diagnosis);
