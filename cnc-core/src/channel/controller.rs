@@ -13,7 +13,7 @@ use hli::views::CncView;
 #[derive(Debug)]
 pub struct Controller {
     channels: Vec<Channel>,
-    axes: Vec<AxisPublisher>,
+    axes: Vec<Option<AxisPublisher>>,
     masters: [Option<MasterSample>; MAX_CHANNELS],
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
@@ -25,9 +25,6 @@ pub enum ControllerError {
     /// More channels than the image has.
     #[error("at most {MAX_CHANNELS} channels, found {0}")]
     TooManyChannels(usize),
-    /// More channel axes than the image has axis blocks.
-    #[error("the channels have {0} axes together; the image holds {HLI_MAX_AXES}")]
-    TooManyAxes(usize),
 }
 
 impl Controller {
@@ -40,11 +37,11 @@ impl Controller {
         let mut first = 0;
         for c in &channels {
             let n = c.config().axes.len();
-            axes.push(AxisPublisher::new(first, n, cycle_s));
-            first += n;
-        }
-        if first > HLI_MAX_AXES {
-            return Err(ControllerError::TooManyAxes(first));
+            let fits = first + n <= HLI_MAX_AXES;
+            axes.push(fits.then(|| AxisPublisher::new(first, n, cycle_s)));
+            if fits {
+                first += n;
+            }
         }
         Ok(Self {
             channels,
@@ -60,9 +57,9 @@ impl Controller {
         &self.channels
     }
 
-    /// Index of the first axis image of channel `index`.
+    /// Index of the first axis image of channel `index` (None: no room left in the image).
     pub fn first_axis(&self, index: usize) -> Option<usize> {
-        self.axes.get(index).map(AxisPublisher::first)
+        self.axes.get(index)?.as_ref().map(AxisPublisher::first)
     }
 
     /// One channel, mutable (to start programs).
@@ -88,7 +85,9 @@ impl Controller {
             let i = self.order[k];
             self.channels[i].tick(view, &self.masters, &mut self.sync);
             self.masters[i] = self.channels[i].published();
-            self.axes[i].publish(view, self.channels[i].set_points());
+            if let Some(axes) = self.axes[i].as_mut() {
+                axes.publish(view, self.channels[i].set_points());
+            }
         }
     }
 }

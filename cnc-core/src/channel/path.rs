@@ -11,6 +11,9 @@
 //! * `L` is the length in X, Y, Z (mm) when they move, else the largest other move (degrees
 //!   or mm), so a pure orientation or auxiliary-axis move runs at the feed in its own units;
 //! * G1 caps the path velocity at `F` (mm/min -> mm/s); G0 runs at the axis limits.
+//!
+//! The channel owns one generator for its path and hands it to every block: building a
+//! generator allocates (rsruckig's buffers), re-targeting one does not.
 
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::decode::AxisValues;
@@ -34,7 +37,6 @@ pub struct PathMove {
     start: AxisValues,
     delta: AxisValues,
     length: f64,
-    generator: SetpointGenerator,
     done: bool,
 }
 
@@ -50,14 +52,15 @@ pub enum PathError {
 }
 
 impl PathMove {
-    /// Plans the block from `start` to `target` (same axes). `None` when nothing moves.
+    /// Plans the block from `start` to `target` (same axes) on `generator`, which runs the
+    /// path parameter from 0. `None` when nothing moves.
     pub fn plan(
         start: &AxisValues,
         target: &AxisValues,
         motion: MotionMode,
         feed_mm_min: f64,
         limits: &[AxisLimits],
-        cycle_s: f64,
+        generator: &mut SetpointGenerator,
     ) -> Result<Option<Self>, PathError> {
         let mut delta = *start;
         for (i, d) in delta.iter_mut().enumerate() {
@@ -105,7 +108,7 @@ impl PathMove {
         if !finite {
             return Err(PathError::NoProfile);
         }
-        let mut generator = SetpointGenerator::new(cycle_s, 0.0);
+        generator.hold(0.0);
         generator
             .move_to(length, path)
             .map_err(|_| PathError::NoProfile)?;
@@ -113,21 +116,21 @@ impl PathMove {
             start: *start,
             delta,
             length,
-            generator,
             done: false,
         }))
     }
 
-    /// One tick: writes the interpolated position into `position`; `true` when the block
-    /// has ended (the position is then exactly the target).
-    pub fn step(&mut self, position: &mut AxisValues) -> bool {
+    /// One tick of `generator` (the one the block was planned on): writes the interpolated
+    /// position into `position`; `true` when the block has ended (the position is then
+    /// exactly the target).
+    pub fn step(&mut self, generator: &mut SetpointGenerator, position: &mut AxisValues) -> bool {
         if !self.done {
-            self.done = matches!(self.generator.step(), Progress::Reached | Progress::Idle);
+            self.done = matches!(generator.step(), Progress::Reached | Progress::Idle);
         }
         let s = if self.done {
             1.0
         } else {
-            (self.generator.state().position / self.length).clamp(0.0, 1.0)
+            (generator.state().position / self.length).clamp(0.0, 1.0)
         };
         for (i, p) in position.iter_mut().enumerate() {
             *p = if self.done {
@@ -137,15 +140,6 @@ impl PathMove {
             };
         }
         self.done
-    }
-
-    /// Path velocity now (mm/s or the leading axis's unit).
-    pub fn velocity(&self) -> f64 {
-        if self.done {
-            0.0
-        } else {
-            self.generator.state().velocity
-        }
     }
 
     /// Block length.

@@ -113,7 +113,10 @@ pub struct Channel {
     /// Programmed position (channel coordinates, after offsets).
     programmed: AxisValues,
     path: Option<PathMove>,
-    independent: Vec<Option<SetpointGenerator>>,
+    /// Runs the path parameter of every block (one generator, re-targeted: no allocation).
+    path_generator: SetpointGenerator,
+    /// Per axis: its generator for independent moves and whether one is under way.
+    independent: Vec<(SetpointGenerator, bool)>,
     trafo: bool,
     cs_stack: [Isometry3<f64>; CS_DEPTH],
     cs_len: usize,
@@ -178,7 +181,10 @@ impl Channel {
             error: None,
             programmed: set_points,
             path: None,
-            independent: (0..n).map(|_| None).collect(),
+            path_generator: SetpointGenerator::new(cycle_s, 0.0),
+            independent: (0..n)
+                .map(|_| (SetpointGenerator::new(cycle_s, 0.0), false))
+                .collect(),
             trafo: false,
             cs_stack: [Isometry3::identity(); CS_DEPTH],
             cs_len: 0,
@@ -288,7 +294,7 @@ impl Channel {
 
     /// Whether a motion or wait is in progress.
     pub fn is_moving(&self) -> bool {
-        self.path.is_some() || self.independent.iter().any(Option::is_some)
+        self.path.is_some() || self.independent.iter().any(|(_, active)| *active)
     }
 
     fn fail(&mut self, message: String) {
@@ -299,8 +305,8 @@ impl Channel {
         self.state = RunState::Error;
         self.path = None;
         self.wait = None;
-        for g in &mut self.independent {
-            *g = None;
+        for (_, active) in &mut self.independent {
+            *active = false;
         }
     }
 
@@ -539,7 +545,7 @@ impl Channel {
             }
             Wait::Sync => sync.try_wait(&self.wait_ids),
             Wait::Tracking => self.tracker.settled(),
-            Wait::Independent => self.independent.iter().all(Option::is_none),
+            Wait::Independent => self.independent.iter().all(|(_, active)| !*active),
         }
     }
 
@@ -584,7 +590,8 @@ impl Channel {
                     MotionMode::Rapid => limits.velocity,
                     MotionMode::Linear => (feed / 60.0).min(limits.velocity),
                 };
-                let mut generator = SetpointGenerator::new(self.cycle_s, self.programmed[axis]);
+                let (generator, active) = &mut self.independent[axis];
+                generator.hold(self.programmed[axis]);
                 let planned = generator.move_to(
                     target,
                     MoveLimits {
@@ -594,6 +601,7 @@ impl Channel {
                         jerk: limits.jerk,
                     },
                 );
+                *active = planned.is_ok();
                 if planned.is_err() {
                     self.fail(format!(
                         "independent axis {}: no profile",
@@ -601,7 +609,6 @@ impl Channel {
                     ));
                     return;
                 }
-                self.independent[axis] = Some(generator);
                 if !asynchronous {
                     self.wait = Some(Wait::Independent);
                 }
@@ -783,8 +790,8 @@ impl Channel {
     fn start_path(&mut self, target: &AxisValues, motion: MotionMode, feed: f64) {
         let mut target = *target;
         // Axes moving independently are left to their own move.
-        for (i, g) in self.independent.iter().enumerate() {
-            if g.is_some() {
+        for (i, (_, active)) in self.independent.iter().enumerate() {
+            if *active {
                 target[i] = self.programmed[i];
             }
         }
@@ -795,7 +802,7 @@ impl Channel {
             motion,
             feed,
             &limits[..self.programmed.len()],
-            self.cycle_s,
+            &mut self.path_generator,
         ) {
             Ok(path) => self.path = path,
             Err(e) => self.fail(e.to_string()),
@@ -804,16 +811,16 @@ impl Channel {
 
     fn advance(&mut self) {
         if let Some(path) = self.path.as_mut() {
-            if path.step(&mut self.programmed) {
+            if path.step(&mut self.path_generator, &mut self.programmed) {
                 self.path = None;
             }
         }
-        for (i, slot) in self.independent.iter_mut().enumerate() {
-            if let Some(g) = slot.as_mut() {
+        for (i, (g, active)) in self.independent.iter_mut().enumerate() {
+            if *active {
                 let progress = g.step();
                 self.programmed[i] = g.state().position;
                 if matches!(progress, Progress::Reached | Progress::Idle) {
-                    *slot = None;
+                    *active = false;
                 }
             }
         }

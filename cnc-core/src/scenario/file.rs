@@ -212,8 +212,15 @@ impl Scenario {
         })
     }
 
-    /// Axis images the channels need together.
+    /// Axis images the channels use together (channels that do not fit get none, see
+    /// [`crate::channel::Controller::new`]).
     pub fn axis_count(&self) -> usize {
-        self.channels.iter().map(|c| c.axes.len()).sum()
+        let mut used = 0;
+        for c in &self.channels {
+            if used + c.axes.len() <= hli::layout::HLI_MAX_AXES {
+                used += c.axes.len();
+            }
+        }
+        used
     }
 }

@@ -2,6 +2,7 @@
 //! `cnc run` (two processes, real-time or lockstep) or in-process by tests.
 
 pub mod file;
+pub mod fleet;
 pub mod machine;
 pub mod runner;
 pub mod trace;
