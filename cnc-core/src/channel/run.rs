@@ -96,7 +96,6 @@ impl Vars for ChannelVars {
 pub struct Channel {
     index: usize,
     config: ChannelConfig,
-    cycle_s: f64,
     limits: AxisLimits,
     order: RotationOrder,
     kinematics: Box<dyn Kinematics + Send>,
@@ -165,7 +164,6 @@ impl Channel {
         let decoder = DecoderState::new(&config.axes);
         let mut channel = Self {
             index,
-            cycle_s,
             limits: config.limits,
             order,
             kinematics,
