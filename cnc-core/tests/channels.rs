@@ -392,6 +392,25 @@ fn a_plc_transition_while_not_enabled_is_refused_with_error() {
 }
 
 #[test]
+fn track_options_not_implemented_stop_the_channel_with_their_name() {
+    for option in ["SIMU", "RELATIVE", "LOG_FILE=\"t.log\""] {
+        let src = format!("G1 X1 F600\n#TRACK CS ON [ID=0 {option}]\nM30\n");
+        let mut ctl = controller(vec![(cartesian("slave"), &src)]);
+        let memory = image(1);
+        let view = CncView::new(&memory);
+        for _ in 0..2000 {
+            ctl.tick(&view);
+        }
+        let ch = &ctl.channels()[0];
+        assert_eq!(ch.state(), RunState::Error, "{option}");
+        let error = ch.error().unwrap();
+        assert_eq!(error.line, 2);
+        let name = option.split('=').next().unwrap();
+        assert!(error.message.contains(name), "{}", error.message);
+    }
+}
+
+#[test]
 fn programs_with_errors_are_refused_at_load() {
     let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
     let err = LoadedProgram::load("bad.nc", "G1 X1 F100\nG1 Q5\n", &axes).unwrap_err();

@@ -17,8 +17,14 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     let mut runtime = PlcRuntime::attach(&instance, 5, Duration::from_millis(5)).unwrap();
     child.0.kill().unwrap();
     child.0.wait().unwrap();
-    // The max_cycles bound is a watchdog; no cycles run without CNC ticks anyway.
+    // The max_cycles bound is a watchdog. The PLC gets one cycle for the last tick the CNC
+    // finished before the loop started (lockstep needs that cycle); without new ticks no
+    // further cycle runs.
     let summary = runtime.run(&mut Idle, Some(1_000)).unwrap();
     assert_eq!(summary.end, RunEnd::CncLost);
-    assert_eq!(summary.cycles, 0);
+    assert!(
+        summary.cycles <= 1,
+        "{} cycles without CNC ticks",
+        summary.cycles
+    );
 }

@@ -634,6 +634,16 @@ impl Channel {
                     }
                     return;
                 }
+                // Parsed, but not implemented yet: refused rather than silently ignored.
+                let unsupported = [
+                    (command.relative, "RELATIVE"),
+                    (command.simu, "SIMU"),
+                    (command.log_file.is_some(), "LOG_FILE"),
+                ];
+                if let Some((_, name)) = unsupported.iter().find(|(set, _)| *set) {
+                    self.fail(format!("#TRACK CS ON: {name} is not supported yet"));
+                    return;
+                }
                 let source = match command.source {
                     Some(TrackSource::Id(0)) => MasterSource::Plc,
                     Some(TrackSource::Id(n) | TrackSource::Channel(n)) => {

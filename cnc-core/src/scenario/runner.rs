@@ -106,7 +106,9 @@ pub struct RunReport {
 
 /// `cnc run`.
 pub fn main(args: RunArgs) -> ExitCode {
-    let scenario = match Scenario::load(&args.scenario) {
+    // A scenario whose files or channels are refused is a usage error (exit 2), checked
+    // before any process starts.
+    let scenario = match Scenario::load(&args.scenario).and_then(|s| Machine::new(&s).map(|_| s)) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("cnc run: {e}");
