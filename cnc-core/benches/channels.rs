@@ -11,10 +11,8 @@
 //! Run: `cargo bench -p cnc-core --bench channels`.
 
 use cnc_core::channel::{Channel, Controller};
-use cnc_core::scenario::fleet::{plc_setup, tracking_robots};
-use cnc_core::scenario::InProcess;
-use hli::enums::DynCsState;
-use hli::views::{CncView, PlcView};
+use cnc_core::scenario::fleet::{running, tracking_robots};
+use hli::views::CncView;
 use std::time::Instant;
 
 const TICKS: usize = 5_000;
@@ -40,20 +38,7 @@ fn time(mut tick: impl FnMut()) -> f64 {
 }
 
 fn tracking(n: usize) -> f64 {
-    let s = tracking_robots(n).expect("fleet scenario");
-    let mut run = InProcess::new(&s, 0).expect("in-process run");
-    plc_setup(&PlcView::new(&run.memory));
-    for _ in 0..WARM_UP {
-        run.machine.tick(&run.memory);
-    }
-    for c in run.machine.controller().channels() {
-        assert_eq!(
-            c.tracker().state(),
-            DynCsState::Active,
-            "{}",
-            c.config().name
-        );
-    }
+    let mut run = running(n, WARM_UP).expect("fleet running");
     time(|| run.machine.tick(&run.memory))
 }
 

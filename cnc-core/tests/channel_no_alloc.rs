@@ -2,10 +2,7 @@
 //! kinematic transformation both ways, dynamic CS, HLI outputs, axis images) allocates nothing
 //! once the programs run.
 
-use cnc_core::scenario::fleet::{plc_setup, tracking_robots};
-use cnc_core::scenario::InProcess;
-use hli::enums::DynCsState;
-use hli::views::PlcView;
+use cnc_core::scenario::fleet::running;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -13,22 +10,8 @@ use counting_alloc::allocations;
 
 #[test]
 fn twelve_tracking_robots_tick_without_allocating() {
-    let s = tracking_robots(12).unwrap();
-    let mut run = InProcess::new(&s, 0).unwrap();
-    plc_setup(&PlcView::new(&run.memory));
     // Start-up: programs begin, tracking switches on, the loops run once.
-    for _ in 0..3000 {
-        run.machine.tick(&run.memory);
-    }
-    for c in run.machine.controller().channels() {
-        assert_eq!(
-            c.tracker().state(),
-            DynCsState::Active,
-            "{}",
-            c.config().name
-        );
-        assert!(c.error().is_none(), "{:?}", c.error());
-    }
+    let mut run = running(12, 3000).unwrap();
     let before = allocations();
     for _ in 0..5000 {
         run.machine.tick(&run.memory);

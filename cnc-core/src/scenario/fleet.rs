@@ -4,6 +4,8 @@
 //! Every robot moves in an endless loop, so the load never ends.
 
 use super::file::{Scenario, ScenarioError};
+use super::machine::InProcess;
+use hli::enums::DynCsState;
 use hli::layout::HliCoordinateSystemInt;
 use hli::views::PlcView;
 use std::path::PathBuf;
@@ -57,4 +59,26 @@ pub fn plc_setup(view: &PlcView<'_>) {
             fill_up_1: 0,
         });
     }
+}
+
+/// The fleet of `n` robots on a heap image, ticked `warm_up` times so the programs run and
+/// every channel tracks; an error names the first channel that does not.
+pub fn running(n: usize, warm_up: usize) -> Result<InProcess, String> {
+    let s = tracking_robots(n).map_err(|e| e.to_string())?;
+    let mut run = InProcess::new(&s, 0).map_err(|e| e.to_string())?;
+    plc_setup(&PlcView::new(&run.memory));
+    for _ in 0..warm_up {
+        run.machine.tick(&run.memory);
+    }
+    for c in run.machine.controller().channels() {
+        if c.tracker().state() != DynCsState::Active || c.error().is_some() {
+            return Err(format!(
+                "{} not tracking after {warm_up} ticks: {:?} {:?}",
+                c.config().name,
+                c.tracker().state(),
+                c.error()
+            ));
+        }
+    }
+    Ok(run)
 }
