@@ -6,6 +6,7 @@
 //! the following error is zero. Coupling channel axes to the simulated drives of
 //! [`crate::axis`] (with their lag and monitoring) is a later step.
 
+use super::run::hli_value;
 use crate::nc::decode::AxisValues;
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::{HliAxis, HliAxisLrState};
@@ -19,18 +20,17 @@ pub struct AxisPublisher {
     last: AxisValues,
     last_velocity: AxisValues,
     cycle_s: f64,
-    primed: bool,
 }
 
 impl AxisPublisher {
-    /// Axes `first..first + axes` of the image, ticking every `cycle_s`.
-    pub fn new(first: usize, axes: usize, cycle_s: f64) -> Self {
+    /// Axes `first..first + start.len()` of the image, standing at `start` (the channel's
+    /// set-points at start-up), ticking every `cycle_s`.
+    pub fn new(first: usize, start: &AxisValues, cycle_s: f64) -> Self {
         Self {
             first,
-            last: AxisValues::zeros(axes),
-            last_velocity: AxisValues::zeros(axes),
+            last: *start,
+            last_velocity: AxisValues::zeros(start.len()),
             cycle_s,
-            primed: false,
         }
     }
 
@@ -41,10 +41,6 @@ impl AxisPublisher {
 
     /// Publishes `set_points` (channel order). Does not allocate.
     pub fn publish(&mut self, view: &CncView<'_>, set_points: &AxisValues) {
-        if !self.primed {
-            self.last.copy_from_slice(set_points);
-            self.primed = true;
-        }
         for (i, &p) in set_points.iter().enumerate() {
             let Ok(axis) = view.axis(self.first + i) else {
                 break;
@@ -61,9 +57,7 @@ impl AxisPublisher {
                 AxisState::Decelerating
             };
             // Linear units (0.1 um) and angle units (0.0001 degree) scale alike.
-            let raw = |x: f64| {
-                hli::units::mm_to_hli(x).unwrap_or(if x < 0.0 { i32::MIN } else { i32::MAX })
-            };
+            let raw = |x: f64| hli_value(x, false);
             let position = raw(p);
             axis.field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
                 .write(&HliAxisLrState {

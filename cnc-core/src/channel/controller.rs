@@ -14,6 +14,7 @@ use hli::views::CncView;
 pub struct Controller {
     channels: Vec<Channel>,
     axes: Vec<Option<AxisPublisher>>,
+    axis_images: usize,
     masters: [Option<MasterSample>; MAX_CHANNELS],
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
@@ -38,7 +39,7 @@ impl Controller {
         for c in &channels {
             let n = c.config().axes.len();
             let fits = first + n <= HLI_MAX_AXES;
-            axes.push(fits.then(|| AxisPublisher::new(first, n, cycle_s)));
+            axes.push(fits.then(|| AxisPublisher::new(first, c.set_points(), cycle_s)));
             if fits {
                 first += n;
             }
@@ -46,6 +47,7 @@ impl Controller {
         Ok(Self {
             channels,
             axes,
+            axis_images: first,
             masters: [None; MAX_CHANNELS],
             sync: SyncBoard::default(),
             order: core::array::from_fn(|i| i),
@@ -55,6 +57,11 @@ impl Controller {
     /// The channels.
     pub fn channels(&self) -> &[Channel] {
         &self.channels
+    }
+
+    /// Axis images the channels use together.
+    pub fn axis_images(&self) -> usize {
+        self.axis_images
     }
 
     /// Index of the first axis image of channel `index` (None: no room left in the image).

@@ -975,7 +975,8 @@ fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
 }
 
 /// mm (or degree for angles) to the HLI's 0.1 um (0.0001 degree), saturating.
-fn hli_value(v: f64, angle: bool) -> i32 {
+/// mm or degree to the HLI's 0.1 um / 0.0001 degree, saturating at the DINT range.
+pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
     let raw = if angle {
         hli::units::deg_to_hli(v)
     } else {

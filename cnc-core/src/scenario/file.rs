@@ -76,16 +76,19 @@ struct TraceFile {
 }
 
 /// What runs in the PLC process.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub enum PlcSetup {
     /// No PLC.
     None,
-    /// A timeline: its path (as given, resolved) and its text.
+    /// A timeline: its path (as given, resolved), its text (for the PLC process) and the
+    /// parsed, checked timeline (for in-process runs).
     Timeline {
         /// Where it came from.
         path: PathBuf,
         /// The TOML text.
         text: String,
+        /// The parsed timeline.
+        timeline: Box<plc_shim::timeline::Timeline>,
     },
     /// A built-in program of `plc-shim` by name.
     Program(String),
@@ -173,10 +176,15 @@ impl Scenario {
                 program: None,
             }) => {
                 let (path, text) = open(&t)?;
-                // Checked here too, so a bad timeline fails before any process starts.
-                plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
-                    .map_err(|e| invalid(e.to_string()))?;
-                PlcSetup::Timeline { path, text }
+                // Checked here, so a bad timeline fails before any process starts.
+                let timeline =
+                    plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
+                        .map_err(|e| invalid(e.to_string()))?;
+                PlcSetup::Timeline {
+                    path,
+                    text,
+                    timeline: Box::new(timeline),
+                }
             }
             Some(PlcFile {
                 timeline: None,
@@ -210,17 +218,5 @@ impl Scenario {
             plc,
             signals,
         })
-    }
-
-    /// Axis images the channels use together (channels that do not fit get none, see
-    /// [`crate::channel::Controller::new`]).
-    pub fn axis_count(&self) -> usize {
-        let mut used = 0;
-        for c in &self.channels {
-            if used + c.axes.len() <= hli::layout::HLI_MAX_AXES {
-                used += c.axes.len();
-            }
-        }
-        used
     }
 }

@@ -75,6 +75,11 @@ impl Machine {
         self.ticks
     }
 
+    /// Axis images the channels use (the image's axis count; at least 1).
+    pub fn axis_images(&self) -> usize {
+        self.controller.axis_images().max(1)
+    }
+
     /// The channels.
     pub fn controller(&self) -> &Controller {
         &self.controller
@@ -108,14 +113,7 @@ impl InProcess {
     pub fn new(scenario: &Scenario, rows: usize) -> Result<InProcess, ScenarioError> {
         let timeline = match &scenario.plc {
             PlcSetup::None => None,
-            PlcSetup::Timeline { path, text } => Some(
-                Timeline::parse(&path.display().to_string(), text).map_err(|e| {
-                    ScenarioError::Invalid {
-                        file: scenario.name.clone(),
-                        message: e.to_string(),
-                    }
-                })?,
-            ),
+            PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
             PlcSetup::Program(p) => {
                 return Err(ScenarioError::Invalid {
                     file: scenario.name.clone(),
@@ -123,12 +121,11 @@ impl InProcess {
                 })
             }
         };
-        let memory = hli::segment::heap_image(
-            scenario.channels.len() as u32,
-            scenario.axis_count().max(1) as u32,
-        );
+        let machine = Machine::new(scenario)?;
+        let memory =
+            hli::segment::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
         Ok(InProcess {
-            machine: Machine::new(scenario)?,
+            machine,
             memory,
             timeline,
             trace: Trace::new(&scenario.signals, rows),

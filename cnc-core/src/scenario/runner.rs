@@ -13,7 +13,7 @@
 //!   channels tick ─► heartbeat ─► trace sample ─► answer acyclic calls ─► notify "tick done"
 //! ```
 
-use super::file::{PlcSetup, Scenario};
+use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::machine::Machine;
 use super::trace::Trace;
 use crate::channel::diagnosis::log_message;
@@ -85,6 +85,17 @@ pub struct ChannelReport {
     pub diagnosis: String,
 }
 
+/// Why a run did not happen or did not finish.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scenario's channels were refused before anything started.
+    #[error(transparent)]
+    Refused(#[from] ScenarioError),
+    /// The segment, the PLC process or the lockstep handshake failed.
+    #[error("{0}")]
+    Process(String),
+}
+
 /// What a run did.
 #[derive(Debug)]
 pub struct RunReport {
@@ -106,9 +117,7 @@ pub struct RunReport {
 
 /// `cnc run`.
 pub fn main(args: RunArgs) -> ExitCode {
-    // A scenario whose files or channels are refused is a usage error (exit 2), checked
-    // before any process starts.
-    let scenario = match Scenario::load(&args.scenario).and_then(|s| Machine::new(&s).map(|_| s)) {
+    let scenario = match Scenario::load(&args.scenario) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("cnc run: {e}");
@@ -147,18 +156,31 @@ pub fn main(args: RunArgs) -> ExitCode {
         }
         Err(e) => {
             eprintln!("cnc run: {e}");
-            ExitCode::from(1)
+            // A refused scenario is a usage error, found before any process started.
+            ExitCode::from(if matches!(e, RunError::Refused(_)) {
+                2
+            } else {
+                1
+            })
         }
     }
 }
 
 /// Runs `scenario` as a CNC process with a spawned PLC process.
-pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, String> {
-    let mut machine = Machine::new(scenario).map_err(|e| e.to_string())?;
+pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, RunError> {
+    let mut machine = Machine::new(scenario)?;
+    run_machine(scenario, &mut machine, options).map_err(RunError::Process)
+}
+
+fn run_machine(
+    scenario: &Scenario,
+    machine: &mut Machine,
+    options: &RunOptions,
+) -> Result<RunReport, String> {
     let segment = CncSegment::create(
         &options.instance,
         scenario.channels.len() as u32,
-        scenario.axis_count().max(1) as u32,
+        machine.axis_images() as u32,
     )
     .map_err(|e| e.to_string())?;
     let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
@@ -232,7 +254,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Strin
         } else {
             Percentiles::of(&mut late_ns)
         },
-        channels: channel_reports(&machine),
+        channels: channel_reports(machine),
         acyclic_answered,
         plc_output,
         trace,
@@ -301,7 +323,7 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
     command.args(["plc", "--instance", &options.instance]);
     match &scenario.plc {
         PlcSetup::None => return Ok(None),
-        PlcSetup::Timeline { path, text } => {
+        PlcSetup::Timeline { path, text, .. } => {
             let file = if path.is_file() {
                 path.clone()
             } else {
