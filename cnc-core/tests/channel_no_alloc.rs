@@ -26,3 +26,63 @@ fn twelve_tracking_robots_tick_without_allocating() {
         .iter()
         .all(|c| c.is_moving()));
 }
+
+/// A robot that switches tracking on and off, with every option, in an endless loop: the
+/// blocks are decoded in the tick, so decoding a `#TRACK CS`, `#CS`, `G92` or synchronisation
+/// block must not allocate either.
+const SWITCHING: &str = "%switching
+#TRAFO [45]
+$WHILE 1
+#TRACK CS ON [ID=0 FILTER=20 WAIT KIN_BASE X=1 Y=2 Z=3 A=0.1 B=0.2 C=0.3]
+G1 X640 Y10 Z530 F3000
+#TRACK CS OFF [WAIT]
+#TRACK CS ON [ID=0 SET_ZERO FILTER=0 OPTION=1 ROT_TRANS]
+#TRACK CS ABS
+G1 X630 Y-10 Z530 F3000
+#TRACK CS OFF [FILTER=5 WAIT]
+G92 X0 Y0 Z0
+#SIGNAL SYN [ID1 COUNT1]
+#WAIT SYN [ID1]
+#FLUSH WAIT
+#CS ON [10, 0, 0, 0, 0, 5]
+G1 X635 Y0 Z530 F3000
+#CS OFF
+$ENDWHILE
+";
+
+#[test]
+fn switching_tracking_on_and_off_decodes_without_allocating() {
+    use cnc_core::scenario::file::Scenario;
+    use cnc_core::scenario::machine::InProcess;
+    use hli::enums::DynCsState;
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"switcher\"\n\
+        axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+        kinematics = { id = 45, preset = \"kr6r900sixx\" }\n\
+        start = [0.0, -60.0, 90.0, 0.0, 60.0, 0.0]\nprogram = \"switching.nc\"\n";
+    let scenario = Scenario::parse("switching", toml, |file| {
+        Ok((std::path::PathBuf::from(file), SWITCHING.to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&scenario, 0).unwrap();
+    cnc_core::scenario::fleet::plc_setup(&hli::views::PlcView::new(&run.memory));
+    // One pass of the loop first (the first pass may size buffers).
+    for _ in 0..3000 {
+        run.machine.tick(&run.memory);
+    }
+    let before = allocations();
+    let mut switched = 0;
+    let mut last = DynCsState::Inactive;
+    for _ in 0..6000 {
+        run.machine.tick(&run.memory);
+        let state = run.machine.controller().channels()[0].tracker().state();
+        if state != last {
+            switched += 1;
+            last = state;
+        }
+    }
+    let made = allocations() - before;
+    let channel = &run.machine.controller().channels()[0];
+    assert!(channel.error().is_none(), "{:?}", channel.error());
+    assert!(switched >= 8, "only {switched} state changes in 6000 ticks");
+    assert_eq!(made, 0, "{made} allocations in 6000 ticks of switching");
+}

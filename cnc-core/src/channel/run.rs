@@ -19,7 +19,7 @@ use super::program::{Jump, LoadedProgram};
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::ast::{Control, Item};
-use crate::nc::decode::{evaluate, AxisValues, TrackSource, Vars, KNOWN_VARIABLES};
+use crate::nc::decode::{evaluate, AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
 use crate::nc::{Decoded, DecoderState, MotionMode};
 use hli::enums::{DynCsCommand, DynCsState};
 use hli::layout::{
@@ -107,7 +107,7 @@ pub struct Channel {
     pending_at: usize,
     state: RunState,
     wait: Option<Wait>,
-    wait_ids: Vec<u32>,
+    wait_ids: SyncIds,
     error: Option<ChannelError>,
     /// Programmed position (channel coordinates, after offsets).
     programmed: AxisValues,
@@ -175,7 +175,7 @@ impl Channel {
             pending_at: 0,
             state: RunState::Idle,
             wait: None,
-            wait_ids: Vec::with_capacity(16),
+            wait_ids: SyncIds::default(),
             error: None,
             programmed: set_points,
             path: None,
@@ -541,7 +541,7 @@ impl Channel {
                 }
                 false
             }
-            Wait::Sync => sync.try_wait(&self.wait_ids),
+            Wait::Sync => sync.try_wait(self.wait_ids.as_slice()),
             Wait::Tracking => self.tracker.settled(),
             Wait::Independent => self.independent.iter().all(|(_, active)| !*active),
         }
@@ -761,8 +761,7 @@ impl Channel {
                 }
             }
             Decoded::WaitSyn { ids, .. } => {
-                self.wait_ids.clear();
-                self.wait_ids.extend_from_slice(&ids);
+                self.wait_ids = ids;
                 self.wait = Some(Wait::Sync);
             }
             Decoded::Flush { .. } | Decoded::Control { .. } => {}
@@ -974,7 +973,6 @@ fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
     [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
 }
 
-/// mm (or degree for angles) to the HLI's 0.1 um (0.0001 degree), saturating.
 /// mm or degree to the HLI's 0.1 um / 0.0001 degree, saturating at the DINT range.
 pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
     let raw = if angle {

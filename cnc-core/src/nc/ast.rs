@@ -203,8 +203,9 @@ pub struct Entry {
     pub glued: Option<f64>,
     /// The value after `=`, or the bare expression.
     pub value: Option<Expr>,
-    /// A quoted string value (`LOG_FILE="..."`).
-    pub text: Option<String>,
+    /// A quoted string value (`LOG_FILE="..."`), shared so decoded blocks can refer to it
+    /// without allocating.
+    pub text: Option<std::sync::Arc<str>>,
     /// Where the entry stands.
     pub span: Span,
 }

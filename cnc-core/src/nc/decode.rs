@@ -15,6 +15,7 @@
 
 use super::ast::*;
 use super::Diagnostic;
+use std::sync::Arc;
 
 /// Values of NC variables at decode time.
 pub trait Vars {
@@ -186,8 +187,36 @@ pub struct TrackCommand {
     pub offset: [f64; 6],
     /// SIMU.
     pub simu: bool,
-    /// LOG_FILE.
-    pub log_file: Option<String>,
+    /// LOG_FILE: the file the diagnosis is written to (shared with the tree, so decoding the
+    /// block in the tick does not allocate).
+    pub log_file: Option<Arc<str>>,
+}
+
+/// The signal ids of one `#WAIT SYN`, inline (decoding allocates nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SyncIds {
+    ids: [u32; SyncIds::CAPACITY],
+    len: u8,
+}
+
+impl SyncIds {
+    /// Most ids one `#WAIT SYN` names.
+    pub const CAPACITY: usize = 8;
+
+    /// Adds `id`; false when full.
+    pub fn push(&mut self, id: u32) -> bool {
+        let Some(slot) = self.ids.get_mut(usize::from(self.len)) else {
+            return false;
+        };
+        *slot = id;
+        self.len += 1;
+        true
+    }
+
+    /// The ids in the order given.
+    pub fn as_slice(&self) -> &[u32] {
+        &self.ids[..usize::from(self.len)]
+    }
 }
 
 /// Default tracking filter, ticks.
@@ -230,7 +259,7 @@ pub enum Decoded {
         /// Source line.
         line: u32,
         /// The command.
-        command: Box<TrackCommand>,
+        command: TrackCommand,
     },
     /// `#TRACK CS ABS`.
     TrackAbs {
@@ -251,7 +280,7 @@ pub enum Decoded {
         /// ON or OFF.
         on: bool,
         /// Name, if given.
-        name: Option<String>,
+        name: Option<Name>,
         /// X Y Z A B C (missing values 0).
         frame: [f64; 6],
     },
@@ -278,7 +307,7 @@ pub enum Decoded {
         /// Source line.
         line: u32,
         /// Signal ids waited for.
-        ids: Vec<u32>,
+        ids: SyncIds,
     },
     /// `#FLUSH WAIT|CONTINUE`.
     Flush {
@@ -341,6 +370,8 @@ pub struct DecoderState {
     feed: f64,
     /// Reused per block: the axis words being decoded.
     scratch: Vec<(usize, f64, Span)>,
+    /// Non-motion elements of the block being decoded (kept to reuse its capacity).
+    tail: Vec<Decoded>,
 }
 
 struct Ctx<'a> {
@@ -426,6 +457,7 @@ impl DecoderState {
             motion: MotionMode::Rapid,
             feed: 0.0,
             scratch: Vec::with_capacity(8),
+            tail: Vec::with_capacity(4),
         }
     }
 
@@ -504,7 +536,9 @@ impl DecoderState {
         let mut motion_code: Option<(u32, Span)> = None;
         let mut axis_words = core::mem::take(&mut self.scratch);
         axis_words.clear();
-        let mut tail: Vec<Decoded> = Vec::new();
+        // Elements that follow the block's motion, in a buffer kept across blocks.
+        let mut tail = core::mem::take(&mut self.tail);
+        tail.clear();
         for item in items {
             match item {
                 Item::G { code, span } => match code {
@@ -616,8 +650,9 @@ impl DecoderState {
                 target: self.position,
             }));
         }
-        out.extend(tail);
+        out.append(&mut tail);
         self.scratch = axis_words;
+        self.tail = tail;
     }
 
     fn independent(
@@ -685,10 +720,7 @@ impl DecoderState {
     ) -> Option<Decoded> {
         match command {
             Command::TrackCs { on, options } => {
-                track(*on, options, span, ctx).map(|command| Decoded::Track {
-                    line,
-                    command: Box::new(command),
-                })
+                track(*on, options, span, ctx).map(|command| Decoded::Track { line, command })
             }
             Command::TrackCsAbs => Some(Decoded::TrackAbs { line }),
             Command::ChannelInterface { on, .. } => {
@@ -716,7 +748,7 @@ impl DecoderState {
                 Some(Decoded::Cs {
                     line,
                     on: *on,
-                    name: name.map(|n| n.to_string()),
+                    name: *name,
                     frame,
                 })
             }
@@ -763,12 +795,19 @@ impl DecoderState {
                 }
             }
             Command::WaitSyn { options } => {
-                let mut ids = Vec::new();
+                let mut ids = SyncIds::default();
                 for e in options {
                     let v = entry_number(e, ctx)?;
-                    ids.push(ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?);
+                    let id = ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?;
+                    if !ids.push(id) {
+                        ctx.error(
+                            e.span,
+                            format!("#WAIT SYN waits for at most {} ids", SyncIds::CAPACITY),
+                        );
+                        return None;
+                    }
                 }
-                if ids.is_empty() {
+                if ids.as_slice().is_empty() {
                     ctx.error(span, "#WAIT SYN needs at least one ID..");
                     return None;
                 }
@@ -822,6 +861,35 @@ fn whole_entry(e: &Entry, ctx: &mut Ctx<'_>, what: &str, min: f64, max: f64) -> 
 
 const OFF_OPTIONS: &[&str] = &["WAIT", "FILTER", "ID", "CH"];
 
+/// Every `#TRACK CS` option, for the "given twice" check (SET_ZERO and ABSOLUTE are one).
+const TRACK_OPTIONS: &[&str] = &[
+    "CH",
+    "ID",
+    "SET_ZERO",
+    "ABSOLUTE",
+    "OPTION",
+    "KIN_BASE",
+    "FILTER",
+    "WAIT",
+    "ROT_TRANS",
+    "RELATIVE",
+    "X",
+    "Y",
+    "Z",
+    "A",
+    "B",
+    "C",
+    "SIMU",
+    "LOG_FILE",
+];
+
+fn option_bit(key: &str) -> u32 {
+    TRACK_OPTIONS
+        .iter()
+        .position(|o| *o == key)
+        .map_or(0, |i| 1 << i)
+}
+
 fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<TrackCommand> {
     let mut t = TrackCommand {
         on,
@@ -837,16 +905,18 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         simu: false,
         log_file: None,
     };
-    let mut seen: Vec<&str> = Vec::new();
+    // Options seen so far, one bit per entry of TRACK_OPTIONS (no allocation in the tick).
+    let mut seen = 0u32;
     let mut ok = true;
     for e in options {
         let key = e.key.as_deref().unwrap_or("");
-        if seen.contains(&key) {
+        let bit = option_bit(key);
+        if seen & bit != 0 {
             ctx.error(e.span, format!("#TRACK CS: option {key} given twice"));
             ok = false;
             continue;
         }
-        seen.push(key);
+        seen |= bit;
         if !on && !OFF_OPTIONS.contains(&key) {
             ctx.error(e.span, format!("#TRACK CS OFF: option {key} is only allowed with ON (OFF takes WAIT, FILTER, ID, CH)"));
             ok = false;
@@ -869,7 +939,13 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
             "ROT_TRANS" => t.rot_trans = true,
             "RELATIVE" => t.relative = true,
             "SIMU" => t.simu = true,
-            "LOG_FILE" => t.log_file = e.text.clone().or_else(|| Some(String::new())),
+            "LOG_FILE" => match &e.text {
+                Some(name) if !name.trim().is_empty() => t.log_file = Some(Arc::clone(name)),
+                _ => {
+                    ctx.error(e.span, "#TRACK CS: LOG_FILE needs a file name in quotes, e.g. LOG_FILE=\"dyncs.log\"");
+                    ok = false;
+                }
+            },
             "X" | "Y" | "Z" | "A" | "B" | "C" => {
                 let i = ["X", "Y", "Z", "A", "B", "C"]
                     .iter()
@@ -881,14 +957,15 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
             _ => ok = false,
         }
     }
-    if seen.contains(&"CH") && seen.contains(&"ID") {
+    let given = |key: &str| seen & option_bit(key) != 0;
+    if given("CH") && given("ID") {
         ctx.error(
             span,
             "#TRACK CS: give the source as CH=.. or ID=.., not both",
         );
         ok = false;
     }
-    if on && !seen.contains(&"CH") && !seen.contains(&"ID") {
+    if on && !given("CH") && !given("ID") {
         ctx.error(span, "#TRACK CS ON: expected a source, CH=.. or ID=..");
         ok = false;
     }
@@ -896,7 +973,7 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         ctx.error(span, "#TRACK CS: ROT_TRANS applies to the master-slave offset and cannot be combined with KIN_BASE");
         ok = false;
     }
-    if seen.contains(&"SET_ZERO") && seen.contains(&"ABSOLUTE") {
+    if given("SET_ZERO") && given("ABSOLUTE") {
         ctx.error(
             span,
             "#TRACK CS: SET_ZERO and ABSOLUTE are the same option; give one",

@@ -764,7 +764,7 @@ impl Parser<'_> {
                         self.bump();
                         if let Tok::Str(s) = self.peek().clone() {
                             self.bump();
-                            text = Some(s);
+                            text = Some(std::sync::Arc::from(s));
                         } else {
                             value = Some(self.expr()?);
                         }
