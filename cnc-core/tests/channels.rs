@@ -391,22 +391,195 @@ fn a_plc_transition_while_not_enabled_is_refused_with_error() {
         .contains("option must be 0 or 1"));
 }
 
-#[test]
-fn track_options_not_implemented_stop_the_channel_with_their_name() {
-    for option in ["SIMU", "RELATIVE", "LOG_FILE=\"t.log\""] {
-        let src = format!("G1 X1 F600\n#TRACK CS ON [ID=0 {option}]\nM30\n");
-        let mut ctl = controller(vec![(cartesian("slave"), &src)]);
-        let memory = image(1);
-        let view = CncView::new(&memory);
-        for _ in 0..2000 {
-            ctl.tick(&view);
-        }
+/// One tick of a single-channel run with the PLC as master.
+#[derive(Debug, Clone, Copy)]
+struct PlcTrackingTick {
+    state: DynCsState,
+    /// Set-point minus programmed value, X and Y (mm).
+    applied: [f64; 2],
+    /// `position_dyncs_r` of X (mm).
+    dyncs_x: f64,
+    /// The PLC's Y translation the channel took this tick (mm).
+    master_y: f64,
+}
+
+/// Runs `program` on a Cartesian channel while the PLC enables the unit, stands its frame at
+/// X=20 mm and moves it 1 um per tick in Y; returns the channel and every tick.
+fn track_plc(program: &str) -> (Controller, Vec<PlcTrackingTick>) {
+    let mut ctl = controller(vec![(cartesian("slave"), program)]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    let dyncs_x =
+        hli::access::Leaf::resolve("gpCh[0]^bahn_state.coord_r[0].position_dyncs_r").unwrap();
+    let view = CncView::new(&memory);
+    let mut ticks = Vec::new();
+    let mut y_um = 0;
+    for _ in 0..20_000u32 {
+        let sent = plc
+            .dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([200_000, y_um * 10, 0]))
+            .is_ok();
+        let master_y = f64::from(y_um) / 1000.0;
+        y_um += i32::from(sent);
+        ctl.tick(&view);
         let ch = &ctl.channels()[0];
-        assert_eq!(ch.state(), RunState::Error, "{option}");
-        let error = ch.error().unwrap();
-        assert_eq!(error.line, 2);
-        let name = option.split('=').next().unwrap();
-        assert!(error.message.contains(name), "{}", error.message);
+        assert_ne!(ch.state(), RunState::Error, "{:?}", ch.error());
+        let (set, programmed) = (ch.set_points(), ch.programmed());
+        ticks.push(PlcTrackingTick {
+            state: plc.dyn_cs_state(0).unwrap().unwrap(),
+            applied: [set[0] - programmed[0], set[1] - programmed[1]],
+            dyncs_x: dyncs_x.read(&memory).as_f64() / 10_000.0,
+            master_y,
+        });
+        if ch.state() == RunState::Finished {
+            return (ctl, ticks);
+        }
+    }
+    panic!("watchdog: the program did not finish in 20000 ticks");
+}
+
+/// RELATIVE: the displacement counts from the master frame at switch-on, so switching on
+/// without a filter does not move the set-point, and the slave then follows only what the
+/// master moved since. Without RELATIVE the same switch-on jumps onto the master's 20 mm.
+#[test]
+fn relative_tracking_follows_the_master_from_where_it_stood_at_switch_on() {
+    let program = "G1 X5 F600\n#TRACK CS ON [ID=0 RELATIVE FILTER=0]\nG1 X10 F600\n\
+                   #TRACK CS OFF [FILTER=0]\nM30\n";
+    let (ctl, ticks) = track_plc(program);
+    let on = ticks
+        .iter()
+        .position(|t| t.state != DynCsState::Inactive)
+        .unwrap();
+    let y0 = ticks[on].master_y;
+    let mut active = 0;
+    for t in ticks.iter().filter(|t| t.state == DynCsState::Active) {
+        assert!(t.applied[0].abs() < 1e-9, "no X jump: {:?}", t);
+        assert!(
+            (t.applied[1] - (t.master_y - y0)).abs() < 1e-9,
+            "Y follows the master's motion since switch-on: {:?} (y0 {y0})",
+            t
+        );
+        active += 1;
+    }
+    assert!(active > 500, "tracked for {active} ticks");
+    assert!(
+        ticks.last().unwrap().applied[1] == 0.0,
+        "switched off: compensation released"
+    );
+    // RELATIVE hands nothing to the program (that is SET_ZERO's job).
+    assert_eq!(ctl.channels()[0].tracker().zero_values(), [0.0; 6]);
+    let diagnosis = ctl.channels()[0].dyn_cs_diagnosis();
+    assert!(
+        diagnosis.contains("FILTER=0 WAIT=0 RELATIVE"),
+        "{diagnosis}"
+    );
+
+    // The same switch-on without RELATIVE takes the master's absolute frame at once.
+    let (_, absolute) = track_plc(&program.replace(" RELATIVE", ""));
+    let first_active = absolute
+        .iter()
+        .find(|t| t.state == DynCsState::Active)
+        .unwrap();
+    assert!(
+        (first_active.applied[0] - 20.0).abs() < 1e-9,
+        "{first_active:?}"
+    );
+}
+
+/// SIMU: tracking runs through its states and shows the tracked pose in `position_dyncs_r`
+/// and the history, but the set-points stay on the programmed path.
+#[test]
+fn simulated_tracking_shows_the_compensation_without_moving_the_axes() {
+    let (ctl, ticks) = track_plc(
+        "#TRACK CS ON [ID=0 SIMU FILTER=10 WAIT]\nG1 X10 F600\n#TRACK CS OFF [FILTER=10 WAIT]\nM30\n",
+    );
+    let mut states: Vec<DynCsState> = Vec::new();
+    for t in &ticks {
+        if states.last() != Some(&t.state) {
+            states.push(t.state);
+        }
+        assert_eq!(t.applied, [0.0, 0.0], "SIMU never moves the axes: {t:?}");
+    }
+    assert_eq!(
+        states,
+        vec![
+            DynCsState::Activating,
+            DynCsState::Active,
+            DynCsState::Deactivating,
+            DynCsState::Inactive
+        ]
+    );
+    // While ACTIVE, the display shows the programmed X shifted by the master's 20 mm.
+    let programmed_x_end = 10.0;
+    let last_active = ticks
+        .iter()
+        .rev()
+        .find(|t| t.state == DynCsState::Active)
+        .unwrap();
+    assert!(
+        (last_active.dyncs_x - (programmed_x_end + 20.0)).abs() < 1e-3,
+        "{last_active:?}"
+    );
+    let diagnosis = ctl.channels()[0].dyn_cs_diagnosis();
+    assert!(diagnosis.contains(" SIMU\n"), "{diagnosis}");
+    // The history's CS translation is the compensation the channel did not apply.
+    assert!(diagnosis.contains("(200000,"), "{diagnosis}");
+}
+
+/// SIMU on a robot: the joints (and the real tool) stay on the untracked path.
+#[test]
+fn simulated_tracking_on_a_robot_keeps_the_joints_on_the_programmed_pose() {
+    let program = |simu: &str| {
+        format!("#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=0 {simu}]\nG1 X640 Y10 Z530 F3000\nM30\n")
+    };
+    let run = |src: &str| {
+        let mut ctl = controller(vec![(robot("r"), src)]);
+        let memory = image(1);
+        let plc = PlcView::new(&memory);
+        plc.set_dyn_cs_enabled(0, true).unwrap();
+        plc.dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([50_000, 0, 0]))
+            .unwrap();
+        run_until(
+            &mut ctl,
+            &memory,
+            20_000,
+            |_, _| {},
+            |ctl| ctl.channels()[0].state() == RunState::Finished,
+        );
+        let ch = &ctl.channels()[0];
+        (ch.set_points().to_vec(), ch.tool_pose().translation.vector)
+    };
+    let (plain_joints, plain_tool) =
+        run(&program("").replace("#TRACK CS ON [ID=0 FILTER=0 ]\n", ""));
+    let (simu_joints, simu_tool) = run(&program("SIMU"));
+    let (_, tracked_tool) = run(&program(""));
+    assert_eq!(simu_joints, plain_joints);
+    assert!((simu_tool - plain_tool).norm() < 1e-9);
+    assert!(
+        ((tracked_tool - plain_tool).x - 5.0).abs() < 1e-6,
+        "without SIMU the tool moves 5 mm: {:?}",
+        tracked_tool - plain_tool
+    );
+}
+
+/// LOG_FILE names the file the process writes the diagnosis to after the run; the channel
+/// keeps the name (the tick does no IO). A LOG_FILE without a quoted name is refused at load.
+#[test]
+fn log_file_is_kept_for_the_process_and_needs_a_quoted_name() {
+    let (ctl, _) = track_plc(
+        "#TRACK CS ON [ID=0 FILTER=0 LOG_FILE=\"slave-dyncs.log\"]\nG1 X1 F600\n#TRACK CS OFF\nM30\n",
+    );
+    assert_eq!(ctl.channels()[0].log_file(), Some("slave-dyncs.log"));
+    let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
+    for bad in ["LOG_FILE", "LOG_FILE=3", "LOG_FILE=\"  \""] {
+        let src = format!("#TRACK CS ON [ID=0 {bad}]\nM30\n");
+        let err = LoadedProgram::load("log.nc", &src, &axes).unwrap_err();
+        assert!(err.to_string().starts_with("log.nc:1:"), "{bad}: {err}");
+        assert!(err.to_string().contains("LOG_FILE"), "{bad}: {err}");
     }
 }
 

@@ -127,3 +127,59 @@ fn bad_scenarios_are_refused_with_their_file() {
     assert!(err.contains("p.nc:2:"), "{err}");
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// `#TRACK CS ON [LOG_FILE=..]`: after the run, `cnc run` writes the channel's diagnosis
+/// (history and switching log) to the named file under `--log-dir`.
+#[test]
+fn a_log_file_named_in_the_program_receives_the_diagnosis() {
+    let dir = std::env::temp_dir().join(format!("cli-run-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("master.nc"),
+        "#CHANNEL INTERFACE ON [DYN_CS]\nG1 X20 F1200\nM30\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("slave.nc"),
+        "#TRACK CS ON [CH=1 RELATIVE FILTER=10 WAIT LOG_FILE=\"logs/slave.log\"]\n\
+         G1 Y5 F1200\n#TRACK CS OFF [WAIT]\nM30\n",
+    )
+    .unwrap();
+    let scenario = dir.join("scenario.toml");
+    std::fs::write(
+        &scenario,
+        "cycle_ms = 1.0\n\
+         [[channel]]\nname = \"master\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"master.nc\"\n\
+         [[channel]]\nname = \"slave\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"slave.nc\"\n\
+         [trace]\nsignals = [\"gpCh[1]^channel_mc_control.dyn_cs.state_r.actual_state\"]\n",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .arg(&scenario)
+        .arg("--log-dir")
+        .arg(&out_dir)
+        .args(["--instance", &format!("clirun-log-{}", std::process::id())])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = out_dir.join("logs/slave.log");
+    assert!(stdout.contains("dynamic-CS log: "), "{stdout}");
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        text.starts_with("BAHN : DYNAMIC CS, CHANNEL-NR.: 2"),
+        "{text}"
+    );
+    assert!(
+        text.contains("dynCS: cmd=ON CH=1 FILTER=10 WAIT=1 RELATIVE"),
+        "{text}"
+    );
+    assert!(text.contains("dynCS: is off = INACTIVE"), "{text}");
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -60,14 +60,22 @@ pub(crate) fn log_message(tick: u64, event: &TrackEvent) -> String {
             source,
             filter_ticks,
             wait,
+            relative,
+            simu,
             master,
         } => {
             let source = match source {
                 MasterSource::Plc => "PLC=1".to_string(),
                 MasterSource::Channel(c) => format!("CH={}", c + 1),
             };
+            let flags = match (relative, simu) {
+                (false, false) => "",
+                (true, false) => " RELATIVE",
+                (false, true) => " SIMU",
+                (true, true) => " RELATIVE SIMU",
+            };
             format!(
-                "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}\n{tick} dynCS: ON, VALUE {}",
+                "dynCS: cmd=ON {source} FILTER={filter_ticks} WAIT={}{flags}\n{tick} dynCS: ON, VALUE {}",
                 u8::from(*wait),
                 frame(master)
             )

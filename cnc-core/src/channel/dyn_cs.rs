@@ -48,6 +48,20 @@ pub struct TrackSetup {
     pub rot_trans: bool,
     /// X..C: static offset between master and slave (or error point and kinematic base).
     pub offset: [f64; 6],
+    /// RELATIVE: the displacement counts from the master frame at switch-on
+    /// (`D = M * M0^-1`, as with SET_ZERO), without handing the frame to the program and
+    /// without needing standstill.
+    pub relative: bool,
+    /// SIMU: the tracker runs (states, history, display values) but the channel does not
+    /// apply the compensation to its set-points.
+    pub simu: bool,
+}
+
+impl TrackSetup {
+    /// Whether the master frame at switch-on is the reference of the displacement.
+    fn counts_from_switch_on(&self) -> bool {
+        self.set_zero || self.relative
+    }
 }
 
 /// A state change or refusal of the tracker, kept in the switching log.
@@ -61,6 +75,10 @@ pub enum TrackEvent {
         filter_ticks: u32,
         /// WAIT.
         wait: bool,
+        /// RELATIVE.
+        relative: bool,
+        /// SIMU.
+        simu: bool,
         /// Master frame X..C at switch-on.
         master: [f64; 6],
     },
@@ -277,6 +295,11 @@ impl Tracker {
         }
     }
 
+    /// SIMU: the compensation is computed and shown but not applied.
+    pub fn simulating(&self) -> bool {
+        self.setup.is_some_and(|s| s.simu)
+    }
+
     /// `V.G.TRACK_CS.X..C`.
     pub fn zero_values(&self) -> [f64; 6] {
         self.zero_values
@@ -331,7 +354,7 @@ impl Tracker {
             return Err(TrackError::AlreadyOn);
         }
         let reference = master.copied().unwrap_or_else(Isometry3::identity);
-        let tracking = build_tracking(&setup, setup.set_zero.then_some(&reference))?;
+        let tracking = build_tracking(&setup, setup.counts_from_switch_on().then_some(&reference))?;
         if setup.set_zero {
             self.zero_values = track_cs_values(&reference, self.order);
         }
@@ -339,6 +362,8 @@ impl Tracker {
             source: setup.source,
             filter_ticks: setup.filter_ticks,
             wait: setup.wait,
+            relative: setup.relative,
+            simu: setup.simu,
             master: words(&reference),
         });
         self.tracking = Some(tracking);
@@ -397,7 +422,9 @@ impl Tracker {
                         total: self.setup.map_or(0, |s| s.filter_ticks),
                     });
                 }
-                if self.last_master.is_none() && self.setup.is_some_and(|s| s.set_zero) {
+                if self.last_master.is_none()
+                    && self.setup.is_some_and(|s| s.counts_from_switch_on())
+                {
                     // No frame at switch-on: the first live one is the reference.
                     if let Some(setup) = self.setup {
                         self.tracking = None;
@@ -463,7 +490,9 @@ impl Tracker {
         reference: &Isometry3<f64>,
     ) -> Result<(), TrackError> {
         self.tracking = Some(build_tracking(&setup, Some(reference))?);
-        self.zero_values = track_cs_values(reference, self.order);
+        if setup.set_zero {
+            self.zero_values = track_cs_values(reference, self.order);
+        }
         Ok(())
     }
 

@@ -32,6 +32,7 @@ use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
 use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
 use nalgebra::Isometry3;
+use std::sync::Arc;
 
 /// Most channels of a controller.
 pub const MAX_CHANNELS: usize = 12;
@@ -108,6 +109,8 @@ pub struct Channel {
     state: RunState,
     wait: Option<Wait>,
     wait_ids: SyncIds,
+    /// The last `#TRACK CS ON [LOG_FILE=..]` of the program.
+    log_file: Option<Arc<str>>,
     error: Option<ChannelError>,
     /// Programmed position (channel coordinates, after offsets).
     programmed: AxisValues,
@@ -176,6 +179,7 @@ impl Channel {
             state: RunState::Idle,
             wait: None,
             wait_ids: SyncIds::default(),
+            log_file: None,
             error: None,
             programmed: set_points,
             path: None,
@@ -270,6 +274,12 @@ impl Channel {
     /// M functions the PLC acknowledged (completed handshakes).
     pub fn m_functions_acked(&self) -> u64 {
         self.m_functions_acked
+    }
+
+    /// The file the program asked the dynamic-CS diagnosis to be written to
+    /// (`#TRACK CS ON [LOG_FILE=..]`; the last one named).
+    pub fn log_file(&self) -> Option<&str> {
+        self.log_file.as_deref()
     }
 
     /// The tracker.
@@ -405,6 +415,9 @@ impl Channel {
                     wait,
                     rot_trans,
                     offset: w,
+                    // The transition has no flags for these: NC command only.
+                    relative: false,
+                    simu: false,
                 };
                 let master = self.plc_frame;
                 let _ = self.tracker.switch_on(setup, master.as_ref());
@@ -634,16 +647,6 @@ impl Channel {
                     }
                     return;
                 }
-                // Parsed, but not implemented yet: refused rather than silently ignored.
-                let unsupported = [
-                    (command.relative, "RELATIVE"),
-                    (command.simu, "SIMU"),
-                    (command.log_file.is_some(), "LOG_FILE"),
-                ];
-                if let Some((_, name)) = unsupported.iter().find(|(set, _)| *set) {
-                    self.fail(format!("#TRACK CS ON: {name} is not supported yet"));
-                    return;
-                }
                 let source = match command.source {
                     Some(TrackSource::Id(0)) => MasterSource::Plc,
                     Some(TrackSource::Id(n) | TrackSource::Channel(n)) => {
@@ -680,10 +683,16 @@ impl Channel {
                     wait: command.wait,
                     rot_trans: command.rot_trans,
                     offset: command.offset,
+                    relative: command.relative,
+                    simu: command.simu,
                 };
                 if let Err(error) = self.tracker.switch_on(setup, master.as_ref()) {
                     self.fail(format!("#TRACK CS ON: {error}"));
                     return;
+                }
+                if command.log_file.is_some() {
+                    // Written by the process after the run: no IO in the tick.
+                    self.log_file = command.log_file;
                 }
                 if command.wait {
                     self.wait = Some(Wait::Tracking);
@@ -833,13 +842,21 @@ impl Channel {
         }
     }
 
+    /// The pose pipeline. Under SIMU the tracked pose is computed and shown (history,
+    /// `position_dyncs_r`) while the set-points stay on the untracked pose.
     fn update_pose(&mut self) {
         let n = self.programmed.len();
         let compensation = *self.tracker.applied();
+        let simulating = self.tracker.simulating();
         if self.trafo {
             self.pose_in = self.cs_frame() * self.programmed_frame();
             self.pose_out = self.tracker.option().apply(&compensation, &self.pose_in);
-            match self.kinematics.inverse(&self.pose_out, &self.joints) {
+            let commanded = if simulating {
+                self.pose_in
+            } else {
+                self.pose_out
+            };
+            match self.kinematics.inverse(&commanded, &self.joints) {
                 Ok(j) => self.joints = j,
                 Err(e) => {
                     if self.state == RunState::Running {
@@ -848,34 +865,44 @@ impl Channel {
                 }
             }
             self.set_points[..6].copy_from_slice(&self.joints);
+            self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
         } else {
-            let mut c = if self.tracker.state() == DynCsState::Inactive {
-                [0.0; 6]
-            } else {
+            let tracking = self.tracker.state() != DynCsState::Inactive;
+            let mut c = if tracking {
                 words(&compensation)
+            } else {
+                [0.0; 6]
             };
             if self.tracker.option() == TrackingOption::TranslationOnly {
                 c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
             }
+            let mut tracked = [0.0; 6];
             for (i, c) in c.iter().enumerate() {
-                self.set_points[i] = self.programmed[i] + c;
+                tracked[i] = self.programmed[i] + c;
+                self.set_points[i] = if simulating {
+                    self.programmed[i]
+                } else {
+                    tracked[i]
+                };
                 self.joints[i] = self.set_points[i];
             }
-            if self.tracker.state() != DynCsState::Inactive {
+            if tracking {
                 let mut plain = [0.0; 6];
                 plain.copy_from_slice(&self.programmed[..6]);
                 self.pose_in = self.kinematics.forward(&plain).unwrap_or(self.pose_in);
             }
-        }
-        self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
-        self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
-        if !self.trafo {
-            self.pose_out = self.tool;
-            if self.tracker.state() == DynCsState::Inactive {
+            self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
+            self.pose_out = if simulating {
+                self.kinematics.forward(&tracked).unwrap_or(self.tool)
+            } else {
+                self.tool
+            };
+            if !tracking {
                 // No compensation: the pose before the dynamic CS is the tool pose.
                 self.pose_in = self.tool;
             }
         }
+        self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
         self.tracker.record(&self.pose_in, &self.pose_out);
         self.published = self.interface_on.then_some(MasterSample {
             frame: self.tool,

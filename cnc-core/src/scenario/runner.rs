@@ -53,6 +53,9 @@ pub struct RunArgs {
     /// Print the dynamic-CS diagnosis tables (history and switching log) at the end.
     #[arg(long)]
     pub diagnosis: bool,
+    /// Where `#TRACK CS ON [LOG_FILE=..]` files with a relative name are written.
+    #[arg(long, default_value = ".")]
+    pub log_dir: PathBuf,
 }
 
 /// How to run.
@@ -83,6 +86,8 @@ pub struct ChannelReport {
     pub m_functions_acked: u64,
     /// The diagnosis tables.
     pub diagnosis: String,
+    /// `#TRACK CS ON [LOG_FILE=..]`: where the program asked the diagnosis to go.
+    pub log_file: Option<String>,
 }
 
 /// Why a run did not happen or did not finish.
@@ -143,6 +148,17 @@ pub fn main(args: RunArgs) -> ExitCode {
                     return ExitCode::from(1);
                 }
                 println!("trace: {}", path.display());
+            }
+            match report.write_log_files(&args.log_dir) {
+                Ok(files) => {
+                    for file in files {
+                        println!("dynamic-CS log: {}", file.display());
+                    }
+                }
+                Err(e) => {
+                    eprintln!("cnc run: LOG_FILE: {e}");
+                    return ExitCode::from(1);
+                }
             }
             if report
                 .channels
@@ -282,11 +298,35 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),
             diagnosis: c.dyn_cs_diagnosis(),
+            log_file: c.log_file().map(str::to_string),
         })
         .collect()
 }
 
 impl RunReport {
+    /// Writes the diagnosis of every channel whose program named a `LOG_FILE` (relative names
+    /// under `dir`; channels naming the same file share it, in channel order). Returns the
+    /// files written.
+    pub fn write_log_files(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
+        let mut files: Vec<(PathBuf, String)> = Vec::new();
+        for c in &self.channels {
+            let Some(name) = &c.log_file else { continue };
+            let path = dir.join(name);
+            match files.iter_mut().find(|(p, _)| *p == path) {
+                Some((_, text)) => text.push_str(&c.diagnosis),
+                None => files.push((path, c.diagnosis.clone())),
+            }
+        }
+        for (path, text) in &files {
+            if let Some(parent) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+                std::fs::create_dir_all(parent)
+                    .map_err(|e| format!("{}: {e}", parent.display()))?;
+            }
+            std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        }
+        Ok(files.into_iter().map(|(p, _)| p).collect())
+    }
+
     /// The summary printed at the end of a run.
     pub fn render(&self, diagnosis: bool) -> String {
         let mut out = String::new();
