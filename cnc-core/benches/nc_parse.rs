@@ -42,9 +42,11 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Parses the program, then decodes it block by block into a reused buffer, the way a channel
 /// consumes it (and the way rs274 interprets: block after block, nothing kept).
-fn parse_and_decode(src: &str, axes: &[String]) -> f64 {
+/// Returns the whole time and the part spent parsing.
+fn parse_and_decode(src: &str, axes: &[String]) -> (f64, f64) {
     let t0 = Instant::now();
     let (tree, diags) = parse(black_box(src));
+    let parsed = t0.elapsed().as_secs_f64();
     let mut decoder = DecoderState::new(axes);
     let mut out = Vec::with_capacity(8);
     let mut motions = 0usize;
@@ -61,7 +63,7 @@ fn parse_and_decode(src: &str, axes: &[String]) -> f64 {
     let elapsed = t0.elapsed().as_secs_f64();
     assert!(diags.is_empty());
     assert_eq!(motions, BLOCKS);
-    elapsed
+    (elapsed, parsed)
 }
 
 fn run_rs274(path: &std::path::Path) -> f64 {
@@ -80,27 +82,38 @@ fn run_rs274(path: &std::path::Path) -> f64 {
 }
 
 fn main() {
-    const ROUNDS: usize = 7;
+    // NC_BENCH_ROUNDS=1 runs one round of one parse (for profilers: callgrind, perf).
+    let rounds: usize = std::env::var("NC_BENCH_ROUNDS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(7);
+    let tries = if rounds == 1 { 1 } else { 3 };
     let src = program();
     let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();
     let path = std::env::temp_dir().join(format!("nc-bench-{}.ngc", std::process::id()));
     std::fs::write(&path, &src).unwrap();
-    let have_rs274 = Command::new("rs274")
-        .arg("-h")
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok();
+    // NC_BENCH_SKIP_PEER=1 times ours alone (for quick iterations; the report says so).
+    let skip_peer = std::env::var_os("NC_BENCH_SKIP_PEER").is_some();
+    let have_rs274 = !skip_peer
+        && Command::new("rs274")
+            .arg("-h")
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .is_ok();
 
     // Interleaved rounds: each round times ours (best of 3) and, where present, rs274 once,
     // so both see the same machine state; the ratio is taken per round.
     let (mut ours, mut theirs, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
-    for _ in 0..ROUNDS {
-        let mine = (0..3)
-            .map(|_| parse_and_decode(&src, &axes))
-            .fold(f64::INFINITY, f64::min);
+    let mut parse_shares = Vec::new();
+    for _ in 0..rounds {
+        let (mine, parsed) = (0..tries).map(|_| parse_and_decode(&src, &axes)).fold(
+            (f64::INFINITY, 0.0),
+            |best, t| if t.0 < best.0 { t } else { best },
+        );
         ours.push(mine);
+        parse_shares.push(parsed / mine);
         if have_rs274 {
             let peer = run_rs274(&path);
             theirs.push(peer);
@@ -108,15 +121,21 @@ fn main() {
         }
     }
     let _ = std::fs::remove_file(&path);
+    let ours_best = ours.iter().copied().fold(f64::INFINITY, f64::min);
     let ours_median = median(ours);
     let rate = BLOCKS as f64 / ours_median;
     let verdict = |ok: bool| if ok { "met" } else { "MISSED" };
     println!(
-        "program: {BLOCKS} blocks `N.. G1 X.. Y.. Z.. F..`, {} bytes; {ROUNDS} interleaved rounds",
+        "program: {BLOCKS} blocks `N.. G1 X.. Y.. Z.. F..`, {} bytes; {rounds} interleaved rounds",
         src.len()
     );
     println!("| interpreter | median s | blocks/s |\n|---|---:|---:|");
     println!("| cnc-core parse + decode | {ours_median:.4} | {rate:.0} |");
+    let parse_share = median(parse_shares);
+    println!(
+        "fastest round: {ours_best:.4} s, {:.0} blocks/s",
+        BLOCKS as f64 / ours_best
+    );
     if have_rs274 {
         let theirs_median = median(theirs);
         let ratio = median(ratios.clone());
@@ -138,11 +157,19 @@ fn main() {
             verdict(rate >= 2e6)
         );
     } else {
-        println!("rs274 not installed (Debian package linuxcnc-uspace): comparison skipped");
+        if skip_peer {
+            println!("rs274 skipped (NC_BENCH_SKIP_PEER is set)");
+        } else {
+            println!("rs274 not installed (Debian package linuxcnc-uspace): comparison skipped");
+        }
         println!(
             "target >= 2 million blocks/s: {:.2} M -> {}",
             rate / 1e6,
             verdict(rate >= 2e6)
         );
     }
+    println!(
+        "of our time, parsing (source to tree) takes {:.0}%, decoding the rest",
+        parse_share * 100.0
+    );
 }

@@ -386,7 +386,17 @@ impl Ctx<'_> {
             .push(Diagnostic::new(span, message.into(), self.src));
     }
 
+    /// The value of `e`: a literal at once (nearly every word of a program), anything else
+    /// through [`Ctx::eval_expr`].
+    #[inline(always)]
     fn eval(&mut self, e: &Expr, span: Span) -> Option<f64> {
+        match e {
+            Expr::Num(v) => Some(*v),
+            _ => self.eval_expr(e, span),
+        }
+    }
+
+    fn eval_expr(&mut self, e: &Expr, span: Span) -> Option<f64> {
         match e {
             Expr::Num(v) => Some(*v),
             Expr::Var(name) => match self.vars.get(name) {

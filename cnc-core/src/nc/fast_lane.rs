@@ -155,13 +155,85 @@ impl Lexer<'_> {
 }
 
 /// `digits[.digits]` with at most 15 digits at the start of `bytes`: the same value and length
-/// as the lexer's `plain_number` (mantissa / 10^fraction digits, exact for these sizes), in two
-/// tight loops instead of one with a state check per digit. `None` when there are too many
-/// digits; a second dot stops the number (the caller then refuses the word).
+/// as the lexer's `plain_number` (mantissa / 10^fraction digits, exact for these sizes).
+/// Integer and fraction part are read eight bytes at a time (parts of 8 digits or more take
+/// the digit-by-digit loop). `None` when there are too many digits; a second dot stops the
+/// number (the caller then refuses the word).
+#[inline(always)]
 fn decimal(bytes: &[u8]) -> Option<(f64, usize)> {
-    const POW10: [f64; 16] = [
-        1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-    ];
+    let whole = eight_bytes(bytes, 0);
+    let int_digits = leading_digits(whole);
+    if int_digits == 8 {
+        return decimal_by_digit(bytes);
+    }
+    let mut mantissa = digits_value(whole, int_digits);
+    let mut p = int_digits;
+    let mut fraction = 0;
+    if bytes.get(p) == Some(&b'.') {
+        let part = eight_bytes(bytes, p + 1);
+        fraction = leading_digits(part);
+        if fraction == 8 {
+            return decimal_by_digit(bytes);
+        }
+        mantissa = mantissa * POW10_INT[fraction] + digits_value(part, fraction);
+        p += 1 + fraction;
+    }
+    if int_digits + fraction == 0 {
+        return None;
+    }
+    // Whole numbers (N, G, M, most feeds) need no division, the slowest step here.
+    let value = if fraction == 0 {
+        mantissa as f64
+    } else {
+        mantissa as f64 / POW10[fraction]
+    };
+    Some((value, p))
+}
+
+const POW10: [f64; 16] = [
+    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+];
+const POW10_INT: [u64; 8] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000];
+
+/// The eight bytes from `at` as a little-endian word (the first byte lowest), zero-padded past
+/// the end of `bytes`.
+fn eight_bytes(bytes: &[u8], at: usize) -> u64 {
+    if let Some(&chunk) = bytes.get(at..at + 8).and_then(|c| c.first_chunk::<8>()) {
+        return u64::from_le_bytes(chunk);
+    }
+    let mut word = [0u8; 8];
+    let rest = bytes.get(at..).unwrap_or(&[]);
+    let n = rest.len().min(8);
+    word[..n].copy_from_slice(&rest[..n]);
+    u64::from_le_bytes(word)
+}
+
+/// How many of the word's bytes, from the first, are ASCII digits (0..=8).
+fn leading_digits(word: u64) -> usize {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    // Digits become 0..=9. Adding 0x76 sets the high bit of every byte of 10 or more (a byte
+    // of 0x8A or more has it already, hence the OR); a digit byte stays below 0x80 and carries
+    // nothing into the next byte, so the lowest flagged byte is the first non-digit exactly.
+    let x = word ^ (ONES * u64::from(b'0'));
+    let non_digit = (x.wrapping_add(ONES * 0x76) | x) & (ONES * 0x80);
+    (non_digit.trailing_zeros() / 8) as usize
+}
+
+/// The value of the first `n` (0..=8) bytes of `word`, all ASCII digits, first most significant.
+fn digits_value(word: u64, n: usize) -> u64 {
+    if n == 0 {
+        return 0;
+    }
+    // Keep the n digits (as 0..=9) and move them to the top: the freed low bytes are leading
+    // zeros. Then combine neighbours pairwise: 2 digits per 16 bits, 4 per 32, 8 per 64.
+    let digits = (word & 0x0F0F_0F0F_0F0F_0F0F) << (8 * (8 - n));
+    let pairs = (digits.wrapping_mul(10 << 8 | 1) >> 8) & 0x00FF_00FF_00FF_00FF;
+    let quads = (pairs.wrapping_mul(100 << 16 | 1) >> 16) & 0x0000_FFFF_0000_FFFF;
+    quads.wrapping_mul(10_000 << 32 | 1) >> 32
+}
+
+/// [`decimal`] one digit at a time, for parts of eight digits or more.
+fn decimal_by_digit(bytes: &[u8]) -> Option<(f64, usize)> {
     let mut mantissa: u64 = 0;
     let mut p = 0;
     while let Some(&d) = bytes.get(p).filter(|d| d.is_ascii_digit()) {
@@ -184,4 +256,43 @@ fn decimal(bytes: &[u8]) -> Option<(f64, usize)> {
         return None;
     }
     Some((mantissa as f64 / POW10[fraction], p))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{decimal, decimal_by_digit, digits_value, leading_digits};
+    use proptest::prelude::*;
+
+    #[test]
+    fn eight_digits_at_a_time() {
+        assert_eq!(leading_digits(u64::from_le_bytes(*b"1234567x")), 7);
+        assert_eq!(leading_digits(u64::from_le_bytes(*b"12345678")), 8);
+        assert_eq!(leading_digits(u64::from_le_bytes(*b"x2345678")), 0);
+        assert_eq!(leading_digits(u64::from_le_bytes(*b"9\xff000000")), 1);
+        assert_eq!(
+            digits_value(u64::from_le_bytes(*b"12345678"), 8),
+            12_345_678
+        );
+        assert_eq!(digits_value(u64::from_le_bytes(*b"0860 X1."), 4), 860);
+        assert_eq!(decimal(b"123.456 "), Some((123.456, 7)));
+        assert_eq!(decimal(b"5."), Some((5.0, 2)));
+        assert_eq!(decimal(b"1.2.3"), Some((1.2, 3)));
+        assert_eq!(
+            decimal(b"123456789012.345"),
+            Some((123_456_789_012.345, 16))
+        );
+        assert_eq!(decimal(b"1234567890123456"), None);
+    }
+
+    proptest! {
+        /// Word at a time and digit at a time agree on every input.
+        #[test]
+        fn word_at_a_time_matches_digit_at_a_time(
+            text in "[0-9]{0,18}(\\.[0-9]{0,18})?[ .x\n-]?[0-9]{0,3}",
+            raw in proptest::collection::vec(any::<u8>(), 0..24),
+        ) {
+            prop_assert_eq!(decimal(text.as_bytes()), decimal_by_digit(text.as_bytes()));
+            prop_assert_eq!(decimal(&raw), decimal_by_digit(&raw));
+        }
+    }
 }
