@@ -21,6 +21,17 @@ impl Name {
         }
     }
 
+    /// The name of the first `len` (at most 8) bytes of `packed`, first byte lowest; the
+    /// bytes above `len` must be zero (as [`Name::push`] leaves them).
+    pub(crate) fn from_packed(packed: u64, len: usize) -> Self {
+        let mut bytes = [0; Self::CAPACITY];
+        bytes[..8].copy_from_slice(&packed.to_le_bytes());
+        Self {
+            len: len.min(8) as u8,
+            bytes,
+        }
+    }
+
     /// Appends an ASCII byte; `false` when full.
     pub fn push(&mut self, b: u8) -> bool {
         if (self.len as usize) < Self::CAPACITY {

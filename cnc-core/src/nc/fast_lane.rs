@@ -116,13 +116,14 @@ impl Lexer<'_> {
     /// Letters, an optional glued sign, a plain number, then a blank or the line break.
     fn word(&self, bytes: &[u8], line_start: usize, p: &mut usize) -> Option<Word> {
         let start = *p;
-        let mut name = Name::new();
-        while bytes.get(*p).is_some_and(u8::is_ascii_alphabetic) {
-            if !name.push(bytes[*p].to_ascii_uppercase()) {
-                return None;
-            }
-            *p += 1;
+        // The letters in one register: names of eight letters or more take the general path.
+        let chunk = eight_bytes(bytes, start);
+        let letters = leading_letters(chunk);
+        if letters == 8 {
+            return None;
         }
+        let name = Name::from_packed(upper_case(chunk, letters), letters);
+        *p += letters;
         // Exactly as the lexer glues a signed number to its address (`X-60`).
         let sign = match bytes.get(*p) {
             Some(b'-') => -1.0,
@@ -219,6 +220,27 @@ fn leading_digits(word: u64) -> usize {
     (non_digit.trailing_zeros() / 8) as usize
 }
 
+/// How many of the word's bytes, from the first, are ASCII letters (0..=8).
+fn leading_letters(word: u64) -> usize {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    const HIGH: u64 = ONES * 0x80;
+    // Folded to lower case, a letter is a byte in 0x61..=0x7A. Adding 0x1F (0x05) sets the
+    // high bit of a byte of 0x61 (0x7B) or more; below 0x80 nothing carries into the next
+    // byte, and a byte of 0x80 or more is a non-letter anyway, so the lowest flagged byte is
+    // the first non-letter exactly.
+    let lower = word | (ONES * 0x20);
+    let at_least_a = lower.wrapping_add(ONES * 0x1F) & HIGH;
+    let past_z = lower.wrapping_add(ONES * 0x05) & HIGH;
+    let non_letter = (!at_least_a | past_z | word) & HIGH;
+    (non_letter.trailing_zeros() / 8) as usize
+}
+
+/// The first `n` (0..8) bytes of `word`, letters, in upper case; the bytes above are zero.
+fn upper_case(word: u64, n: usize) -> u64 {
+    let keep = (1u64 << (8 * n)) - 1;
+    (word & keep) & !(0x2020_2020_2020_2020 & keep)
+}
+
 /// The value of the first `n` (0..=8) bytes of `word`, all ASCII digits, first most significant.
 fn digits_value(word: u64, n: usize) -> u64 {
     if n == 0 {
@@ -260,7 +282,9 @@ fn decimal_by_digit(bytes: &[u8]) -> Option<(f64, usize)> {
 
 #[cfg(test)]
 mod tests {
-    use super::{decimal, decimal_by_digit, digits_value, leading_digits};
+    use super::{
+        decimal, decimal_by_digit, digits_value, leading_digits, leading_letters, upper_case,
+    };
     use proptest::prelude::*;
 
     #[test]
@@ -282,9 +306,34 @@ mod tests {
             Some((123_456_789_012.345, 16))
         );
         assert_eq!(decimal(b"1234567890123456"), None);
+        let word = |text: &[u8; 8]| u64::from_le_bytes(*text);
+        assert_eq!(leading_letters(word(b"X12.5 Y1")), 1);
+        assert_eq!(leading_letters(word(b"ab=90 X1")), 2);
+        assert_eq!(leading_letters(word(b"AzZa@[`{")), 4);
+        assert_eq!(leading_letters(word(b"INDPASYN")), 8);
+        assert_eq!(leading_letters(word(b"\xe1bc00000")), 0);
+        assert_eq!(
+            upper_case(word(b"ab=90 X1"), 2),
+            u64::from(u16::from_le_bytes(*b"AB"))
+        );
     }
 
     proptest! {
+        /// Letters in one register agree with byte-by-byte classification.
+        #[test]
+        fn letters_in_a_register_match_byte_by_byte(raw in any::<[u8; 8]>()) {
+            let expected = raw.iter().take_while(|b| b.is_ascii_alphabetic()).count();
+            let word = u64::from_le_bytes(raw);
+            prop_assert_eq!(leading_letters(word), expected);
+            if expected < 8 {
+                let mut upper = [0u8; 8];
+                for (u, b) in upper.iter_mut().zip(&raw).take(expected) {
+                    *u = b.to_ascii_uppercase();
+                }
+                prop_assert_eq!(upper_case(word, expected), u64::from_le_bytes(upper));
+            }
+        }
+
         /// Word at a time and digit at a time agree on every input.
         #[test]
         fn word_at_a_time_matches_digit_at_a_time(
