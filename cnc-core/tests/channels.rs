@@ -191,6 +191,14 @@ M30
     );
 }
 
+/// The states of a complete switch-on and switch-off, in order.
+const SWITCHED_ON_AND_OFF: [DynCsState; 4] = [
+    DynCsState::Activating,
+    DynCsState::Active,
+    DynCsState::Deactivating,
+    DynCsState::Inactive,
+];
+
 fn cs(translation: [i32; 3]) -> HliCoordinateSystemInt {
     HliCoordinateSystemInt {
         translation,
@@ -258,15 +266,7 @@ fn plc_as_master_couples_in_softly_then_follows_exactly() {
             break;
         }
     }
-    assert_eq!(
-        states,
-        vec![
-            DynCsState::Activating,
-            DynCsState::Active,
-            DynCsState::Deactivating,
-            DynCsState::Inactive
-        ]
-    );
+    assert_eq!(states, SWITCHED_ON_AND_OFF);
     // 20 mm over 50 ticks is 0.4 mm per tick; the Y motion adds 1 um per tick.
     assert!(
         max_step <= 20.0 / 50.0 + 1e-9,
@@ -502,15 +502,7 @@ fn simulated_tracking_shows_the_compensation_without_moving_the_axes() {
         }
         assert_eq!(t.applied, [0.0, 0.0], "SIMU never moves the axes: {t:?}");
     }
-    assert_eq!(
-        states,
-        vec![
-            DynCsState::Activating,
-            DynCsState::Active,
-            DynCsState::Deactivating,
-            DynCsState::Inactive
-        ]
-    );
+    assert_eq!(states, SWITCHED_ON_AND_OFF);
     // While ACTIVE, the display shows the programmed X shifted by the master's 20 mm.
     let programmed_x_end = 10.0;
     let last_active = ticks

@@ -871,7 +871,8 @@ fn whole_entry(e: &Entry, ctx: &mut Ctx<'_>, what: &str, min: f64, max: f64) -> 
 
 const OFF_OPTIONS: &[&str] = &["WAIT", "FILTER", "ID", "CH"];
 
-/// Every `#TRACK CS` option, for the "given twice" check (SET_ZERO and ABSOLUTE are one).
+/// Every `#TRACK CS` option, one bit each for the "given twice" check (SET_ZERO and ABSOLUTE
+/// have a bit each, so that giving both is reported as such; unknown keys have none).
 const TRACK_OPTIONS: &[&str] = &[
     "CH",
     "ID",
