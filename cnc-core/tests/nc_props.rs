@@ -53,9 +53,9 @@ fn expr() -> impl Strategy<Value = Expr> {
         })
 }
 
-fn axis_name() -> impl Strategy<Value = Name> {
+fn axis_name() -> impl Strategy<Value = AxisName> {
     prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"])
-        .prop_map(Name::from)
+        .prop_map(AxisName::from)
 }
 
 fn axis_word() -> impl Strategy<Value = AxisWord> {
@@ -250,7 +250,7 @@ fn program() -> impl Strategy<Value = Program> {
                 ..Program::default()
             };
             for (number, items) in blocks {
-                program.push_block(number, items, span());
+                program.push_block(number, items, span(), 0);
             }
             program
         })

@@ -74,6 +74,7 @@ impl LoadedProgram {
                 col: 1,
                 message,
                 found: String::new(),
+                offset: 0,
             }]));
         }
         let (tree, mut diagnostics) = parse(src);

@@ -475,7 +475,7 @@ impl Channel {
             self.state = RunState::Finished;
             return false;
         };
-        self.line = block.span.line;
+        self.line = block.line;
         let index = self.next_block;
         let vars = ChannelVars {
             track_cs: self.tracker.zero_values(),

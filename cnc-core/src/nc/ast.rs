@@ -21,17 +21,6 @@ impl Name {
         }
     }
 
-    /// The name of the first `len` (at most 8) bytes of `packed`, first byte lowest; the
-    /// bytes above `len` must be zero (as [`Name::push`] leaves them).
-    pub(crate) fn from_packed(packed: u64, len: usize) -> Self {
-        let mut bytes = [0; Self::CAPACITY];
-        bytes[..8].copy_from_slice(&packed.to_le_bytes());
-        Self {
-            len: len.min(8) as u8,
-            bytes,
-        }
-    }
-
     /// Appends an ASCII byte; `false` when full.
     pub fn push(&mut self, b: u8) -> bool {
         if (self.len as usize) < Self::CAPACITY {
@@ -118,17 +107,95 @@ impl core::ops::Deref for Name {
     }
 }
 
-/// A source range with its line and column (1-based, columns in characters).
+/// An axis name (`X`, `AB`, `X1`): at most [`AxisName::CAPACITY`] ASCII bytes in one machine
+/// word, so that axis words, by far the most common items, stay small and compare in one step.
+#[derive(Clone, Copy, PartialEq, Eq, Default)]
+pub struct AxisName {
+    /// Upper-case ASCII bytes, zero padded (a name never contains a zero byte).
+    bytes: [u8; AxisName::CAPACITY],
+}
+
+impl AxisName {
+    /// Longest axis name.
+    pub const CAPACITY: usize = 8;
+
+    /// The name of `name`, `None` when it is longer than [`AxisName::CAPACITY`].
+    pub fn new(name: &Name) -> Option<Self> {
+        let text = name.as_bytes();
+        let mut bytes = [0; Self::CAPACITY];
+        bytes.get_mut(..text.len())?.copy_from_slice(text);
+        Some(Self { bytes })
+    }
+
+    /// The name packed by the fast lane: the first `len` (at most 8) bytes of `packed`, first
+    /// byte lowest, the bytes above zero.
+    pub(crate) fn from_packed(packed: u64) -> Self {
+        Self {
+            bytes: packed.to_le_bytes(),
+        }
+    }
+
+    /// The bytes as one word, first byte lowest (for comparisons and matching).
+    pub fn packed(self) -> u64 {
+        u64::from_le_bytes(self.bytes)
+    }
+
+    /// The bytes (ASCII).
+    pub fn as_bytes(&self) -> &[u8] {
+        let len = self
+            .bytes
+            .iter()
+            .position(|&b| b == 0)
+            .unwrap_or(Self::CAPACITY);
+        &self.bytes[..len]
+    }
+
+    /// The text.
+    pub fn as_str(&self) -> &str {
+        // Only ASCII bytes are ever stored.
+        core::str::from_utf8(self.as_bytes()).unwrap_or("")
+    }
+}
+
+impl core::fmt::Debug for AxisName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{:?}", self.as_str())
+    }
+}
+
+impl core::fmt::Display for AxisName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl PartialEq<str> for AxisName {
+    fn eq(&self, other: &str) -> bool {
+        self.as_bytes() == other.as_bytes()
+    }
+}
+
+impl From<&str> for AxisName {
+    /// For names known to fit (constants, tests); longer text is cut at the capacity.
+    fn from(text: &str) -> Self {
+        let mut bytes = [0; Self::CAPACITY];
+        let ascii = text.bytes().filter(|&b| b.is_ascii() && b != 0);
+        for (slot, b) in bytes.iter_mut().zip(ascii) {
+            *slot = b.to_ascii_uppercase();
+        }
+        Self { bytes }
+    }
+}
+
+/// A source range as byte offsets. Lines and columns are counted only when a diagnostic
+/// needs them (see [`super::Diagnostic`]): keeping them in every node made the tree half
+/// again as large, and the tree's size is what parsing a long program mostly pays for.
 #[derive(Debug, Clone, Copy, Default, Eq)]
 pub struct Span {
     /// Byte offset of the first character (programs are far below 4 GiB; larger offsets saturate).
     pub start: u32,
     /// Byte offset after the last character.
     pub end: u32,
-    /// Line of `start`.
-    pub line: u32,
-    /// Column of `start`.
-    pub col: u32,
 }
 
 impl PartialEq for Span {
@@ -286,7 +353,7 @@ pub enum Command {
     /// `#PRESET` (all axes) or `#PRESET axis ...`.
     Preset {
         /// Axes whose preset is removed; empty = all.
-        axes: Vec<Name>,
+        axes: Vec<AxisName>,
     },
 }
 
@@ -294,7 +361,7 @@ pub enum Command {
 #[derive(Debug, Clone, PartialEq)]
 pub struct AxisWord {
     /// Axis name, upper case.
-    pub name: Name,
+    pub name: AxisName,
     /// The value.
     pub value: Expr,
     /// Whether it was written with `=` (printing keeps the form).
@@ -332,7 +399,7 @@ pub enum Item {
     /// An independent axis command `X1[INDP_ASYN POS=-90 G01 F500 G90]`.
     IndependentAxis {
         /// Axis name.
-        name: Name,
+        name: AxisName,
         /// The entries in the brackets (a boxed slice, so that this rare item does not make
         /// every item larger).
         options: Box<[Entry]>,
@@ -373,14 +440,23 @@ pub enum Control {
 /// One block (a logical line, continuation lines joined). Its items live in the program's
 /// item arena ([`Program::items_of`]): one allocation for the whole program instead of one
 /// per block, which was a fifth of the parse time.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Block {
     /// Block number `N..`.
     pub number: Option<u32>,
     /// The block's items: this range of [`Program::items`], in source order.
     pub items: core::ops::Range<u32>,
-    /// Where the block starts.
+    /// Where the block stands.
     pub span: Span,
+    /// The line the block starts on, 1-based.
+    pub line: u32,
+}
+
+impl PartialEq for Block {
+    /// Like spans, the line is a location, not content: it takes no part in equality.
+    fn eq(&self, other: &Self) -> bool {
+        self.number == other.number && self.items == other.items
+    }
 }
 
 /// A parsed program.
@@ -403,7 +479,7 @@ impl Program {
     }
 
     /// Appends a block with `items`.
-    pub fn push_block(&mut self, number: Option<u32>, items: Vec<Item>, span: Span) {
+    pub fn push_block(&mut self, number: Option<u32>, items: Vec<Item>, span: Span, line: u32) {
         let start = arena_index(self.items.len());
         self.items.extend(items);
         let end = arena_index(self.items.len());
@@ -411,6 +487,7 @@ impl Program {
             number,
             items: start..end,
             span,
+            line,
         });
     }
 }
@@ -420,3 +497,10 @@ impl Program {
 pub(crate) fn arena_index(len: usize) -> u32 {
     u32::try_from(len).unwrap_or(u32::MAX)
 }
+
+// The tree's size is what parsing a long program mostly pays for (memory to fault in and
+// fill): keep the common nodes small.
+const _: () = assert!(core::mem::size_of::<Span>() == 8);
+const _: () = assert!(core::mem::size_of::<Expr>() == 16);
+const _: () = assert!(core::mem::size_of::<Item>() == 40);
+const _: () = assert!(core::mem::size_of::<Block>() == 28);

@@ -125,7 +125,7 @@ pub fn check_channel_axes(axes: &[String]) -> Result<(), String> {
         let mut chars = a.chars();
         let well_formed = chars.next().is_some_and(|c| c.is_ascii_uppercase())
             && chars.all(|c| c.is_ascii_uppercase() || c.is_ascii_digit())
-            && a.len() <= Name::CAPACITY;
+            && a.len() <= AxisName::CAPACITY;
         if !well_formed {
             return Err(format!(
                 "axis name \"{a}\" must be upper-case letters then digits (e.g. X, AB, X1)"
@@ -361,7 +361,7 @@ pub enum ControlOp {
 pub struct DecoderState {
     axes: Vec<String>,
     /// The same names for fast comparison with names from the tree.
-    axis_names: Vec<Name>,
+    axis_names: Vec<AxisName>,
     position: AxisValues,
     g92: AxisValues,
     pset: AxisValues,
@@ -459,7 +459,7 @@ impl DecoderState {
         let n = axes.len();
         Self {
             axes: axes.to_vec(),
-            axis_names: axes.iter().map(|a| Name::from(a.as_str())).collect(),
+            axis_names: axes.iter().map(|a| AxisName::from(a.as_str())).collect(),
             position: AxisValues::zeros(n),
             g92: AxisValues::zeros(n),
             pset: AxisValues::zeros(n),
@@ -491,6 +491,7 @@ impl DecoderState {
         if let Some(block) = program.blocks.get(index) {
             self.block(block, program.items_of(block), &mut ctx, out);
         }
+        super::locate(&mut ctx.diags, src);
         ctx.diags
     }
 
@@ -534,14 +535,15 @@ impl DecoderState {
     }
 
     /// Axis lookup for names straight from the tree (byte comparison, no UTF-8 check).
-    fn axis_of(&self, name: &Name) -> Option<usize> {
-        self.axis_names.iter().position(|a| a == name)
+    fn axis_of(&self, name: &AxisName) -> Option<usize> {
+        let packed = name.packed();
+        self.axis_names.iter().position(|a| a.packed() == packed)
     }
 
     /// Decodes one block; `out` receives its elements. Control statements are emitted with
     /// unresolved indices (0); [`decode_program`] resolves them.
     fn block(&mut self, block: &Block, items: &[Item], ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
-        let line = block.span.line;
+        let line = block.line;
         let mut g92 = false;
         let mut motion_code: Option<(u32, Span)> = None;
         let mut axis_words = core::mem::take(&mut self.scratch);
@@ -581,7 +583,7 @@ impl DecoderState {
                 Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
                 Item::Axis(word) => {
                     let Some(i) = self.axis_of(&word.name) else {
-                        self.unknown_axis(ctx, word.span, &word.name);
+                        self.unknown_axis(ctx, word.span, word.name.as_str());
                         continue;
                     };
                     if axis_words.iter().any(|(j, _, _)| *j == i) {
@@ -600,7 +602,7 @@ impl DecoderState {
                     options,
                     span,
                 } => {
-                    if let Some(d) = self.independent(line, name, options, *span, ctx) {
+                    if let Some(d) = self.independent(line, name.as_str(), options, *span, ctx) {
                         tail.push(d);
                     }
                 }
@@ -828,7 +830,7 @@ impl DecoderState {
             Command::Pset { axes } => {
                 for word in axes {
                     let Some(i) = self.axis_of(&word.name) else {
-                        self.unknown_axis(ctx, word.span, &word.name);
+                        self.unknown_axis(ctx, word.span, word.name.as_str());
                         continue;
                     };
                     if let Some(v) = ctx.eval(&word.value, word.span) {
@@ -842,9 +844,9 @@ impl DecoderState {
                     self.pset.iter_mut().for_each(|p| *p = 0.0);
                 }
                 for name in axes {
-                    match self.axis_index(name) {
+                    match self.axis_index(name.as_str()) {
                         Some(i) => self.pset[i] = 0.0,
-                        None => self.unknown_axis(ctx, span, name),
+                        None => self.unknown_axis(ctx, span, name.as_str()),
                     }
                 }
                 None
@@ -1020,12 +1022,8 @@ pub fn decode_program(
         diags: Vec::new(),
     };
     if let Err(message) = check_channel_axes(axes) {
-        let first_line = Span {
-            line: 1,
-            col: 1,
-            ..Span::default()
-        };
-        ctx.error(first_line, message);
+        ctx.error(Span::default(), message);
+        super::locate(&mut ctx.diags, src);
         return (Vec::new(), ctx.diags);
     }
     let mut state = DecoderState::new(axes);
@@ -1042,6 +1040,7 @@ pub fn decode_program(
         }
     }
     resolve_control(&mut out, &control_spans, &mut ctx);
+    super::locate(&mut ctx.diags, src);
     (out, ctx.diags)
 }
 

@@ -5,15 +5,14 @@
 //! lexer and parser, which also report all errors. The fast lane must give the very tree,
 //! spans included, that the general path gives; a property test holds it to that.
 
-use super::ast::{arena_index, AxisWord, Block, Expr, Item, Name, Span};
+use super::ast::{arena_index, AxisName, AxisWord, Block, Expr, Item, Span};
 use super::lexer::{offset, Lexer};
 
-/// One address word read by the fast lane.
-struct Word {
-    name: Name,
-    value: f64,
-    span: Span,
-}
+/// Packed names of the addresses the fast lane knows (see [`upper_case`]).
+const N: u64 = b'N' as u64;
+const G: u64 = b'G' as u64;
+const M: u64 = b'M' as u64;
+const F: u64 = b'F' as u64;
 
 impl Lexer<'_> {
     /// Reads the next block through the fast lane into `arena`; `None` (having consumed and
@@ -32,9 +31,8 @@ impl Lexer<'_> {
 
     fn simple_line(&mut self, arena: &mut Vec<Item>) -> Option<Block> {
         let bytes = self.c.src.as_bytes();
-        let line_start = self.c.pos;
         let first_item = arena_index(arena.len());
-        let mut p = line_start;
+        let mut p = self.c.pos;
         let mut number = None;
         let mut block_span: Option<Span> = None;
         loop {
@@ -53,106 +51,94 @@ impl Lexer<'_> {
                 b if b.is_ascii_alphabetic() => {}
                 _ => return None,
             }
-            let word = self.word(bytes, line_start, &mut p)?;
-            let first = block_span.is_none();
+            let start = p;
+            let (name, value) = word(bytes, &mut p)?;
+            let span = Span {
+                start: offset(start),
+                end: offset(p),
+            };
             match block_span.as_mut() {
-                None => block_span = Some(word.span),
-                Some(span) => span.end = word.span.end,
+                None => {
+                    block_span = Some(span);
+                    if name == N {
+                        // The saturating conversion and the comparison refuse fractions,
+                        // negative numbers and numbers beyond u32 at once.
+                        let n = value as u32;
+                        if f64::from(n) != value {
+                            return None;
+                        }
+                        number = Some(n);
+                        continue;
+                    }
+                }
+                Some(block) => block.end = span.end,
             }
-            arena.push(match word.name.as_bytes() {
-                b"N" if first => {
-                    let whole = word.value.fract() == 0.0
-                        && word.value >= 0.0
-                        && word.value <= f64::from(u32::MAX);
-                    if !whole {
+            arena.push(match name {
+                G | M => {
+                    let code = value as u32;
+                    if f64::from(code) != value {
                         return None;
                     }
-                    number = Some(word.value as u32);
-                    continue;
-                }
-                b"N" => return None,
-                b"G" | b"M" => {
-                    if word.value.fract() != 0.0 || word.value < 0.0 {
-                        return None;
-                    }
-                    let code = word.value as u32;
-                    if word.name.as_bytes() == b"G" {
-                        Item::G {
-                            code,
-                            span: word.span,
-                        }
+                    if name == G {
+                        Item::G { code, span }
                     } else {
-                        Item::M {
-                            code,
-                            span: word.span,
-                        }
+                        Item::M { code, span }
                     }
                 }
-                b"F" => Item::Feed {
-                    value: Expr::Num(word.value),
-                    span: word.span,
+                F => Item::Feed {
+                    value: Expr::Num(value),
+                    span,
                 },
+                N => return None,
                 _ => Item::Axis(AxisWord {
-                    name: word.name,
-                    value: Expr::Num(word.value),
+                    name: AxisName::from_packed(name),
+                    value: Expr::Num(value),
                     assigned: false,
-                    span: word.span,
+                    span,
                 }),
             });
         }
         let span = block_span?;
         // Past the line break: the lexer stands where the general path would after the block.
+        let line = self.c.line;
         self.c.pos = p + 1;
         self.c.line += 1;
-        self.c.col = 1;
         self.spaced = true;
         Some(Block {
             number,
             items: first_item..arena_index(arena.len()),
             span,
+            line,
         })
     }
+}
 
-    /// Letters, an optional glued sign, a plain number, then a blank or the line break.
-    fn word(&self, bytes: &[u8], line_start: usize, p: &mut usize) -> Option<Word> {
-        let start = *p;
-        // The letters in one register: names of eight letters or more take the general path.
-        let chunk = eight_bytes(bytes, start);
-        let letters = leading_letters(chunk);
-        if letters == 8 {
-            return None;
-        }
-        let name = Name::from_packed(upper_case(chunk, letters), letters);
-        *p += letters;
-        // Exactly as the lexer glues a signed number to its address (`X-60`).
-        let sign = match bytes.get(*p) {
-            Some(b'-') => -1.0,
-            _ => 1.0,
-        };
-        if matches!(bytes.get(*p), Some(b'-' | b'+')) {
-            *p += 1;
-        }
-        if !bytes.get(*p).is_some_and(u8::is_ascii_digit) {
-            return None;
-        }
-        let (magnitude, len) = decimal(&bytes[*p..])?;
-        *p += len;
-        if !matches!(bytes.get(*p), Some(b' ' | b'\t' | b'\r' | b'\n')) {
-            return None;
-        }
-        let value = sign * magnitude;
-        Some(Word {
-            name,
-            value,
-            span: Span {
-                start: offset(start),
-                end: offset(*p),
-                line: self.c.line,
-                // The line is ASCII up to here, so characters are bytes.
-                col: self.c.col + (start - line_start) as u32,
-            },
-        })
+/// Letters, an optional glued sign, a plain number, then a blank or the line break: the name
+/// (upper case, packed as by [`upper_case`]) and the value; `p` moves past the word.
+#[inline(always)]
+fn word(bytes: &[u8], p: &mut usize) -> Option<(u64, f64)> {
+    // The letters in one register: names of eight letters or more take the general path.
+    let chunk = eight_bytes(bytes, *p);
+    let letters = leading_letters(chunk);
+    if letters == 8 {
+        return None;
     }
+    let name = upper_case(chunk, letters);
+    *p += letters;
+    // Exactly as the lexer glues a signed number to its address (`X-60`).
+    let negative = bytes.get(*p) == Some(&b'-');
+    if matches!(bytes.get(*p), Some(b'-' | b'+')) {
+        *p += 1;
+    }
+    if !bytes.get(*p).is_some_and(u8::is_ascii_digit) {
+        return None;
+    }
+    let (magnitude, len) = decimal(&bytes[*p..])?;
+    *p += len;
+    if !matches!(bytes.get(*p), Some(b' ' | b'\t' | b'\r' | b'\n')) {
+        return None;
+    }
+    Some((name, if negative { -magnitude } else { magnitude }))
 }
 
 /// `digits[.digits]` with at most 15 digits at the start of `bytes`: the same value and length

@@ -53,7 +53,6 @@ pub(super) struct Cursor<'a> {
     pub(super) src: &'a str,
     pub(super) pos: usize,
     pub(super) line: u32,
-    pub(super) col: u32,
 }
 
 impl Cursor<'_> {
@@ -83,16 +82,12 @@ impl Cursor<'_> {
         self.pos += c.len_utf8();
         if c == '\n' {
             self.line += 1;
-            self.col = 1;
-        } else {
-            self.col += 1;
         }
         Some(c)
     }
     /// Skips ASCII bytes (never a newline) while `keep` holds.
     fn skip_ascii_while(&mut self, keep: impl Fn(u8) -> bool) {
         let bytes = self.src.as_bytes();
-        let from = self.pos;
         while self.pos < bytes.len()
             && bytes[self.pos] != b'\n'
             && bytes[self.pos].is_ascii()
@@ -100,15 +95,12 @@ impl Cursor<'_> {
         {
             self.pos += 1;
         }
-        self.col += (self.pos - from) as u32;
     }
 
     fn mark(&self) -> Span {
         Span {
             start: offset(self.pos),
             end: offset(self.pos),
-            line: self.line,
-            col: self.col,
         }
     }
     fn close(&self, mut span: Span) -> Span {
@@ -145,6 +137,8 @@ pub struct Lexer<'a> {
     pub(super) depth: usize,
     pub(super) spaced: bool,
     pub(super) finished: bool,
+    /// The line of the first token of the block last handed out.
+    pub(super) block_line: u32,
     /// Problems found so far (unterminated comments and strings, malformed numbers).
     pub errors: Vec<LexError>,
 }
@@ -157,11 +151,11 @@ impl<'a> Lexer<'a> {
                 src,
                 pos: 0,
                 line: 1,
-                col: 1,
             },
             depth: 0,
             spaced: true,
             finished: false,
+            block_line: 1,
             errors: Vec::new(),
         }
     }
@@ -181,7 +175,6 @@ impl<'a> Lexer<'a> {
                 while p < bytes.len() && matches!(bytes[p], b' ' | b'\t' | b'\r') {
                     p += 1;
                 }
-                self.c.col += (p - start) as u32;
                 self.c.pos = p;
                 self.spaced = true;
                 return true;
@@ -226,10 +219,7 @@ impl<'a> Lexer<'a> {
         let span = Span {
             start: offset(start),
             end: offset(p),
-            line: self.c.line,
-            col: self.c.col,
         };
-        self.c.col += (p - start) as u32;
         self.c.pos = p;
         out.push(Token {
             tok,
@@ -248,6 +238,10 @@ impl<'a> Lexer<'a> {
             return false;
         }
         while let Some(ch) = self.c.peek() {
+            if out.is_empty() {
+                // Tokens never span a line break, so the first token's line is this one.
+                self.block_line = self.c.line;
+            }
             if self.fast_token(out) {
                 continue;
             }

@@ -19,25 +19,30 @@ use ast::Span;
 pub struct Diagnostic {
     /// Line, 1-based.
     pub line: u32,
-    /// Column, 1-based.
+    /// Column, 1-based, in characters.
     pub col: u32,
     /// What is wrong (and what was expected).
     pub message: String,
     /// The offending source text (may be empty at the end of a block).
     pub found: String,
+    /// Byte offset in the source, from which [`locate`] counts line and column.
+    pub(crate) offset: u32,
 }
 
 impl Diagnostic {
-    /// A diagnostic at `span` of `src`.
+    /// A diagnostic at `span` of `src`. Its line and column are 0 until [`locate`] counts
+    /// them: the tree keeps byte offsets only, and counting lines once for all diagnostics
+    /// costs nothing when a program is clean.
     pub fn new(span: Span, message: String, src: &str) -> Self {
         let start = span.start as usize;
         let end = (span.end as usize).max(start).min(src.len());
         let found = src.get(start..end).unwrap_or("").trim().to_string();
         Self {
-            line: span.line,
-            col: span.col,
+            line: 0,
+            col: 0,
             message,
             found,
+            offset: span.start,
         }
     }
 
@@ -52,4 +57,29 @@ impl Diagnostic {
             )
         }
     }
+}
+
+/// Gives each diagnostic of `src` without a line yet its line and column (in characters),
+/// counting through the source once, then orders them by position.
+pub(crate) fn locate(diags: &mut [Diagnostic], src: &str) {
+    let mut order: Vec<usize> = (0..diags.len()).filter(|&i| diags[i].line == 0).collect();
+    order.sort_by_key(|&i| diags[i].offset);
+    let bytes = src.as_bytes();
+    let (mut line, mut line_start, mut pos) = (1u32, 0usize, 0usize);
+    for i in order {
+        let target = (diags[i].offset as usize).min(bytes.len());
+        while pos < target {
+            if bytes[pos] == b'\n' {
+                line += 1;
+                line_start = pos + 1;
+            }
+            pos += 1;
+        }
+        let before = &bytes[line_start..target];
+        // Columns count characters: continuation bytes of UTF-8 start with 0b10.
+        let chars = before.iter().filter(|&&b| b & 0xC0 != 0x80).count();
+        diags[i].line = line;
+        diags[i].col = u32::try_from(chars + 1).unwrap_or(u32::MAX);
+    }
+    diags.sort_by_key(|d| (d.line, d.col));
 }

@@ -34,7 +34,7 @@ fn parse_with(src: &str, fast_lane: bool) -> (Program, Vec<Diagnostic>) {
         .map(|e| Diagnostic::new(e.span, e.message, src))
         .collect();
     diags.append(&mut p.diags);
-    diags.sort_by_key(|d| (d.line, d.col));
+    super::locate(&mut diags, src);
     (program, diags)
 }
 
@@ -214,6 +214,7 @@ impl Parser<'_> {
             number: None,
             items: 0..0,
             span,
+            line: self.lexer.block_line,
         };
         if let Tok::Addr(n, value) = *self.peek() {
             if n == "N" {
@@ -330,11 +331,13 @@ impl Parser<'_> {
 
     /// The axis name of a word with an optional glued whole number (`X`, `X1`); a sign or a
     /// decimal point is reported and the block skipped.
-    fn axis_name(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Name> {
-        match glued {
-            None => Some(word),
+    fn axis_name(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<AxisName> {
+        let with_number;
+        let name = match glued {
+            None => word.as_str(),
             Some(n) if n.fract() == 0.0 && n >= 0.0 => {
-                Some(Name::from(format!("{word}{}", n as u64).as_str()))
+                with_number = format!("{word}{}", n as u64);
+                &with_number
             }
             Some(_) => {
                 self.error(
@@ -342,9 +345,20 @@ impl Parser<'_> {
                     "an axis name is letters and digits only (no sign, no decimal point)",
                 );
                 self.recover();
-                None
+                return None;
             }
+        };
+        let axis = (name.len() <= AxisName::CAPACITY).then(|| AxisName::from(name));
+        if axis.is_none() {
+            self.error(
+                span,
+                format!(
+                    "axis name \"{name}\" is longer than {} characters",
+                    AxisName::CAPACITY
+                ),
+            );
         }
+        axis
     }
 
     /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
@@ -352,9 +366,15 @@ impl Parser<'_> {
         let (word, glued) = self.take_word()?;
         // `NAME=expr` / `NAME3=expr`
         if self.is_punct("=") {
-            let name = self.axis_name(word, glued, span)?;
+            // A name that is too long is reported; its value is still read, so that the
+            // rest of the block is checked as usual.
+            let name = self.axis_name(word, glued, span);
+            if name.is_none() && self.at_end_of_block() {
+                return None;
+            }
             self.bump();
-            let value = self.expr()?;
+            let value = self.expr();
+            let (name, value) = (name?, value?);
             return Some(match name.as_str() {
                 "F" => Item::Feed {
                     value,
@@ -377,8 +397,12 @@ impl Parser<'_> {
         }
         // `X1[INDP_ASYN ...]`
         if self.is_punct("[") {
-            let name = self.axis_name(word, glued, span)?;
-            let options = self.bracket_list()?;
+            let name = self.axis_name(word, glued, span);
+            if name.is_none() && self.at_end_of_block() {
+                return None;
+            }
+            let options = self.bracket_list();
+            let (name, options) = (name?, options?);
             return Some(Item::IndependentAxis {
                 name,
                 options: options.into(),
@@ -438,7 +462,7 @@ impl Parser<'_> {
                 None
             }
             _ => Some(Item::Axis(AxisWord {
-                name: word,
+                name: self.axis_name(word, None, span)?,
                 value: Expr::Num(value),
                 assigned: false,
                 span: self.extend(span),
