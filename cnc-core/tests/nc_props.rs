@@ -310,7 +310,11 @@ fn fragment() -> impl Strategy<Value = String> {
             "G1.5", "G-1", "M30", "M3.0", "F500", "f-5", "X10", "X-60", "x+2.5", "Y.5",
             "Z1.", "Z1..2", "AB90", "X1", "ABCDEFGHIJKLMNOPQRSTUVWXYZ1", "X1234567890123456",
             "X123456789012345", "X12.345678901234", "E3", "X1E3", "X1Y2", "X", "X 10", "N",
+            "X1234567.1234567", "X12345678", "X1.12345678", "ABCDEFG-1234567.1234567",
+            "X1.2.3", "X7.", "N1234567",
         ]).prop_map(String::from),
+        // Words of every length around the register edges (7 and 8 letters or digits).
+        2 => "[A-Za-z]{1,8}[-+]?[0-9]{0,9}(\\.[0-9]{0,9})?",
         1 => prop::sample::select(vec![
             " ", "  ", "\t", "\r", ";", "; note", "(c)", "=", "[", "]", "#", "$", "%p", "_",
             "V.G.TRACK_CS.X", "\\", "\"s\"", "ä", "-", "+", ".", "1",

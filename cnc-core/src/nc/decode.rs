@@ -368,8 +368,9 @@ pub struct DecoderState {
     absolute: bool,
     motion: MotionMode,
     feed: f64,
-    /// Reused per block: the axis words being decoded.
-    scratch: Vec<(usize, f64, Span)>,
+    /// Per block: the values of its axis words by axis (valid where [`DecoderState::block`]
+    /// marks the axis as programmed).
+    words: [f64; MAX_CHANNEL_AXES],
     /// Non-motion elements of the block being decoded (kept to reuse its capacity).
     tail: Vec<Decoded>,
 }
@@ -453,6 +454,22 @@ impl Ctx<'_> {
     }
 }
 
+/// The indices of the set bits of a mask, lowest first.
+#[derive(Clone, Copy)]
+struct BitIndices(u32);
+
+impl Iterator for BitIndices {
+    type Item = usize;
+    fn next(&mut self) -> Option<usize> {
+        if self.0 == 0 {
+            return None;
+        }
+        let i = self.0.trailing_zeros();
+        self.0 &= self.0 - 1;
+        Some(i as usize)
+    }
+}
+
 impl DecoderState {
     /// A channel with these axis names (upper case), at position 0, G0 G90, feed 0.
     pub fn new(axes: &[String]) -> Self {
@@ -466,7 +483,7 @@ impl DecoderState {
             absolute: true,
             motion: MotionMode::Rapid,
             feed: 0.0,
-            scratch: Vec::with_capacity(8),
+            words: [0.0; MAX_CHANNEL_AXES],
             tail: Vec::with_capacity(4),
         }
     }
@@ -546,8 +563,8 @@ impl DecoderState {
         let line = block.line;
         let mut g92 = false;
         let mut motion_code: Option<(u32, Span)> = None;
-        let mut axis_words = core::mem::take(&mut self.scratch);
-        axis_words.clear();
+        // One bit per axis with a word in this block (axis indices are below 16).
+        let mut programmed: u32 = 0;
         // Elements that follow the block's motion, in a buffer kept across blocks.
         let mut tail = core::mem::take(&mut self.tail);
         tail.clear();
@@ -586,7 +603,7 @@ impl DecoderState {
                         self.unknown_axis(ctx, word.span, word.name.as_str());
                         continue;
                     };
-                    if axis_words.iter().any(|(j, _, _)| *j == i) {
+                    if programmed & (1 << i) != 0 {
                         ctx.error(
                             word.span,
                             format!("axis {} programmed twice in one block", word.name),
@@ -594,7 +611,8 @@ impl DecoderState {
                         continue;
                     }
                     if let Some(v) = ctx.eval(&word.value, word.span) {
-                        axis_words.push((i, v, word.span));
+                        self.words[i] = v;
+                        programmed |= 1 << i;
                     }
                 }
                 Item::IndependentAxis {
@@ -639,19 +657,22 @@ impl DecoderState {
                 MotionMode::Linear
             };
         }
+        let axes = BitIndices(programmed);
         if g92 {
-            for (i, v, _) in &axis_words {
-                self.g92[*i] = if self.absolute { *v } else { self.g92[*i] + v };
+            for i in axes {
+                let v = self.words[i];
+                self.g92[i] = if self.absolute { v } else { self.g92[i] + v };
             }
-        } else if !axis_words.is_empty() {
+        } else if programmed != 0 {
             if self.motion == MotionMode::Linear && self.feed <= 0.0 {
                 ctx.error(block.span, "G1 motion without a feed: program F.. first");
             }
-            for (i, v, _) in &axis_words {
-                self.position[*i] = if self.absolute {
-                    v + self.g92[*i] + self.pset[*i]
+            for i in axes {
+                let v = self.words[i];
+                self.position[i] = if self.absolute {
+                    v + self.g92[i] + self.pset[i]
                 } else {
-                    self.position[*i] + v
+                    self.position[i] + v
                 };
             }
             out.push(Decoded::Motion(MotionBlock {
@@ -662,8 +683,9 @@ impl DecoderState {
                 target: self.position,
             }));
         }
-        out.append(&mut tail);
-        self.scratch = axis_words;
+        if !tail.is_empty() {
+            out.append(&mut tail);
+        }
         self.tail = tail;
     }
 

@@ -73,30 +73,33 @@ impl Lexer<'_> {
                 }
                 Some(block) => block.end = span.end,
             }
-            arena.push(match name {
+            // One push per kind: a single push after the match made the compiler assemble
+            // every item on the stack and copy it, and the copy stalled on the narrower
+            // stores that had just built it.
+            match name {
                 G | M => {
                     let code = value as u32;
                     if f64::from(code) != value {
                         return None;
                     }
                     if name == G {
-                        Item::G { code, span }
+                        arena.push(Item::G { code, span });
                     } else {
-                        Item::M { code, span }
+                        arena.push(Item::M { code, span });
                     }
                 }
-                F => Item::Feed {
+                F => arena.push(Item::Feed {
                     value: Expr::Num(value),
                     span,
-                },
+                }),
                 N => return None,
-                _ => Item::Axis(AxisWord {
+                _ => arena.push(Item::Axis(AxisWord {
                     name: AxisName::from_packed(name),
                     value: Expr::Num(value),
                     assigned: false,
                     span,
-                }),
-            });
+                })),
+            }
         }
         let span = block_span?;
         // Past the line break: the lexer stands where the general path would after the block.
@@ -115,84 +118,85 @@ impl Lexer<'_> {
 
 /// Letters, an optional glued sign, a plain number, then a blank or the line break: the name
 /// (upper case, packed as by [`upper_case`]) and the value; `p` moves past the word.
+///
+/// The word is read from one 16-byte window: its parts are found by shifting the window, not
+/// by stepping through bytes. A word that does not fit (eight letters or more, eight digits
+/// or more in a part) takes the general path.
 #[inline(always)]
 fn word(bytes: &[u8], p: &mut usize) -> Option<(u64, f64)> {
-    // The letters in one register: names of eight letters or more take the general path.
-    let chunk = eight_bytes(bytes, *p);
-    let letters = leading_letters(chunk);
+    let window = sixteen_bytes(bytes, *p);
+    let letters = leading_letters(window as u64);
     if letters == 8 {
         return None;
     }
-    let name = upper_case(chunk, letters);
-    *p += letters;
+    let name = upper_case(window as u64, letters);
+    let mut rest = window >> (8 * letters);
+    let mut len = letters;
     // Exactly as the lexer glues a signed number to its address (`X-60`).
-    let negative = bytes.get(*p) == Some(&b'-');
-    if matches!(bytes.get(*p), Some(b'-' | b'+')) {
-        *p += 1;
+    let sign = rest as u8;
+    if sign == b'-' || sign == b'+' {
+        rest >>= 8;
+        len += 1;
     }
-    if !bytes.get(*p).is_some_and(u8::is_ascii_digit) {
+    let (magnitude, digits_len) = decimal(rest)?;
+    len += digits_len;
+    let after = (rest >> (8 * digits_len)) as u8;
+    if !matches!(after, b' ' | b'\t' | b'\r' | b'\n') {
         return None;
     }
-    let (magnitude, len) = decimal(&bytes[*p..])?;
     *p += len;
-    if !matches!(bytes.get(*p), Some(b' ' | b'\t' | b'\r' | b'\n')) {
-        return None;
-    }
-    Some((name, if negative { -magnitude } else { magnitude }))
+    Some((name, if sign == b'-' { -magnitude } else { magnitude }))
 }
 
-/// `digits[.digits]` with at most 15 digits at the start of `bytes`: the same value and length
-/// as the lexer's `plain_number` (mantissa / 10^fraction digits, exact for these sizes).
-/// Integer and fraction part are read eight bytes at a time (parts of 8 digits or more take
-/// the digit-by-digit loop). `None` when there are too many digits; a second dot stops the
-/// number (the caller then refuses the word).
+/// `digits[.digits]` at the start of `window` (first byte lowest), each part shorter than 8
+/// digits and the integer part not empty: the same value and length as the lexer's
+/// `plain_number` (mantissa / 10^fraction digits, exact for these sizes). `None` otherwise; a
+/// second dot ends the number (the caller then refuses the word).
 #[inline(always)]
-fn decimal(bytes: &[u8]) -> Option<(f64, usize)> {
-    let whole = eight_bytes(bytes, 0);
-    let int_digits = leading_digits(whole);
-    if int_digits == 8 {
-        return decimal_by_digit(bytes);
-    }
-    let mut mantissa = digits_value(whole, int_digits);
-    let mut p = int_digits;
-    let mut fraction = 0;
-    if bytes.get(p) == Some(&b'.') {
-        let part = eight_bytes(bytes, p + 1);
-        fraction = leading_digits(part);
-        if fraction == 8 {
-            return decimal_by_digit(bytes);
-        }
-        mantissa = mantissa * POW10_INT[fraction] + digits_value(part, fraction);
-        p += 1 + fraction;
-    }
-    if int_digits + fraction == 0 {
+fn decimal(window: u128) -> Option<(f64, usize)> {
+    let int_part = window as u64;
+    let int_digits = leading_digits(int_part);
+    if int_digits == 0 || int_digits == 8 {
         return None;
     }
-    // Whole numbers (N, G, M, most feeds) need no division, the slowest step here.
-    let value = if fraction == 0 {
-        mantissa as f64
+    let after_int = window >> (8 * int_digits);
+    if after_int as u8 != b'.' {
+        // Whole numbers (N, G, M, most feeds) need no division, the slowest step here.
+        return Some((digits_value(int_part, int_digits) as f64, int_digits));
+    }
+    let fraction_part = (after_int >> 8) as u64;
+    let fraction = leading_digits(fraction_part);
+    if fraction == 8 {
+        return None;
+    }
+    let all = int_digits + fraction;
+    let mantissa = if all <= 8 {
+        // Both parts in one register: the integer digits, then the fraction's in place of
+        // the dot and after it.
+        let int_only = int_part & ((1u64 << (8 * int_digits)) - 1);
+        digits_value(int_only | (fraction_part << (8 * int_digits)), all)
     } else {
-        mantissa as f64 / POW10[fraction]
+        digits_value(int_part, int_digits) * POW10_INT[fraction]
+            + digits_value(fraction_part, fraction)
     };
-    Some((value, p))
+    Some((mantissa as f64 / POW10[fraction], int_digits + 1 + fraction))
 }
 
-const POW10: [f64; 16] = [
-    1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-];
+const POW10: [f64; 8] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7];
 const POW10_INT: [u64; 8] = [1, 10, 100, 1_000, 10_000, 100_000, 1_000_000, 10_000_000];
 
-/// The eight bytes from `at` as a little-endian word (the first byte lowest), zero-padded past
-/// the end of `bytes`.
-fn eight_bytes(bytes: &[u8], at: usize) -> u64 {
-    if let Some(&chunk) = bytes.get(at..at + 8).and_then(|c| c.first_chunk::<8>()) {
-        return u64::from_le_bytes(chunk);
+/// The sixteen bytes from `at` as a little-endian number (the first byte lowest), zero-padded
+/// past the end of `bytes`.
+#[inline(always)]
+fn sixteen_bytes(bytes: &[u8], at: usize) -> u128 {
+    if let Some(&chunk) = bytes.get(at..at + 16).and_then(|c| c.first_chunk::<16>()) {
+        return u128::from_le_bytes(chunk);
     }
-    let mut word = [0u8; 8];
+    let mut word = [0u8; 16];
     let rest = bytes.get(at..).unwrap_or(&[]);
-    let n = rest.len().min(8);
+    let n = rest.len().min(16);
     word[..n].copy_from_slice(&rest[..n]);
-    u64::from_le_bytes(word)
+    u128::from_le_bytes(word)
 }
 
 /// How many of the word's bytes, from the first, are ASCII digits (0..=8).
@@ -240,38 +244,39 @@ fn digits_value(word: u64, n: usize) -> u64 {
     quads.wrapping_mul(10_000 << 32 | 1) >> 32
 }
 
-/// [`decimal`] one digit at a time, for parts of eight digits or more.
-fn decimal_by_digit(bytes: &[u8]) -> Option<(f64, usize)> {
-    let mut mantissa: u64 = 0;
-    let mut p = 0;
-    while let Some(&d) = bytes.get(p).filter(|d| d.is_ascii_digit()) {
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
-        p += 1;
-    }
-    let mut digits = p;
-    let mut fraction = 0;
-    if bytes.get(p) == Some(&b'.') {
-        p += 1;
-        let from = p;
-        while let Some(&d) = bytes.get(p).filter(|d| d.is_ascii_digit()) {
-            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d - b'0'));
-            p += 1;
-        }
-        fraction = p - from;
-        digits += fraction;
-    }
-    if digits == 0 || digits > 15 {
-        return None;
-    }
-    Some((mantissa as f64 / POW10[fraction], p))
-}
-
 #[cfg(test)]
 mod tests {
     use super::{
-        decimal, decimal_by_digit, digits_value, leading_digits, leading_letters, upper_case,
+        decimal, digits_value, leading_digits, leading_letters, sixteen_bytes, upper_case, word,
     };
     use proptest::prelude::*;
+
+    /// The reference: `plain_number` of the lexer one digit at a time, limited to what the
+    /// fast lane takes (an integer part of 1 to 7 digits, a fraction of at most 7).
+    fn decimal_by_digit(bytes: &[u8]) -> Option<(f64, usize)> {
+        let int_digits = bytes.iter().take_while(|b| b.is_ascii_digit()).count();
+        let mut p = int_digits;
+        let mut fraction = 0;
+        if bytes.get(p) == Some(&b'.') {
+            fraction = bytes[p + 1..]
+                .iter()
+                .take_while(|b| b.is_ascii_digit())
+                .count();
+            p += 1 + fraction;
+        }
+        if !(1..=7).contains(&int_digits) || fraction > 7 {
+            return None;
+        }
+        let mantissa = bytes[..p]
+            .iter()
+            .filter(|b| b.is_ascii_digit())
+            .fold(0u64, |m, &d| m * 10 + u64::from(d - b'0'));
+        Some((mantissa as f64 / 10f64.powi(fraction as i32), p))
+    }
+
+    fn window(text: &[u8]) -> u128 {
+        sixteen_bytes(text, 0)
+    }
 
     #[test]
     fn eight_digits_at_a_time() {
@@ -284,23 +289,37 @@ mod tests {
             12_345_678
         );
         assert_eq!(digits_value(u64::from_le_bytes(*b"0860 X1."), 4), 860);
-        assert_eq!(decimal(b"123.456 "), Some((123.456, 7)));
-        assert_eq!(decimal(b"5."), Some((5.0, 2)));
-        assert_eq!(decimal(b"1.2.3"), Some((1.2, 3)));
+        assert_eq!(decimal(window(b"123.456 ")), Some((123.456, 7)));
+        assert_eq!(decimal(window(b"5.")), Some((5.0, 2)));
+        assert_eq!(decimal(window(b"1.2.3")), Some((1.2, 3)));
         assert_eq!(
-            decimal(b"123456789012.345"),
-            Some((123_456_789_012.345, 16))
+            decimal(window(b"1234567.1234567 ")),
+            Some((1_234_567.123_456_7, 15))
         );
-        assert_eq!(decimal(b"1234567890123456"), None);
-        let word = |text: &[u8; 8]| u64::from_le_bytes(*text);
-        assert_eq!(leading_letters(word(b"X12.5 Y1")), 1);
-        assert_eq!(leading_letters(word(b"ab=90 X1")), 2);
-        assert_eq!(leading_letters(word(b"AzZa@[`{")), 4);
-        assert_eq!(leading_letters(word(b"INDPASYN")), 8);
-        assert_eq!(leading_letters(word(b"\xe1bc00000")), 0);
+        assert_eq!(decimal(window(b"12345678")), None);
+        assert_eq!(decimal(window(b"1.12345678")), None);
+        assert_eq!(decimal(window(b".5")), None);
+        let word_of = |text: &[u8; 8]| u64::from_le_bytes(*text);
+        assert_eq!(leading_letters(word_of(b"X12.5 Y1")), 1);
+        assert_eq!(leading_letters(word_of(b"ab=90 X1")), 2);
+        assert_eq!(leading_letters(word_of(b"AzZa@[`{")), 4);
+        assert_eq!(leading_letters(word_of(b"INDPASYN")), 8);
+        assert_eq!(leading_letters(word_of(b"\xe1bc00000")), 0);
         assert_eq!(
-            upper_case(word(b"ab=90 X1"), 2),
+            upper_case(word_of(b"ab=90 X1"), 2),
             u64::from(u16::from_le_bytes(*b"AB"))
+        );
+        let mut p = 4;
+        assert_eq!(
+            word(b"N10 x-12.5\n", &mut p),
+            Some((u64::from(b'X'), -12.5))
+        );
+        assert_eq!(p, 10);
+        assert_eq!(word(b"X1.2.3 ", &mut 0), None);
+        assert_eq!(
+            word(b"X12", &mut 0),
+            None,
+            "no blank or line break after it"
         );
     }
 
@@ -320,14 +339,14 @@ mod tests {
             }
         }
 
-        /// Word at a time and digit at a time agree on every input.
+        /// The number read from a register agrees with reading it digit by digit.
         #[test]
-        fn word_at_a_time_matches_digit_at_a_time(
-            text in "[0-9]{0,18}(\\.[0-9]{0,18})?[ .x\n-]?[0-9]{0,3}",
+        fn register_matches_digit_by_digit(
+            text in "[0-9]{0,9}(\\.[0-9]{0,9})?[ .x\n-]?[0-9]{0,3}",
             raw in proptest::collection::vec(any::<u8>(), 0..24),
         ) {
-            prop_assert_eq!(decimal(text.as_bytes()), decimal_by_digit(text.as_bytes()));
-            prop_assert_eq!(decimal(&raw), decimal_by_digit(&raw));
+            prop_assert_eq!(decimal(window(text.as_bytes())), decimal_by_digit(text.as_bytes()));
+            prop_assert_eq!(decimal(window(&raw)), decimal_by_digit(&raw));
         }
     }
 }

@@ -62,6 +62,9 @@ impl Diagnostic {
 /// Gives each diagnostic of `src` without a line yet its line and column (in characters),
 /// counting through the source once, then orders them by position.
 pub(crate) fn locate(diags: &mut [Diagnostic], src: &str) {
+    if diags.is_empty() {
+        return;
+    }
     let mut order: Vec<usize> = (0..diags.len()).filter(|&i| diags[i].line == 0).collect();
     order.sort_by_key(|&i| diags[i].offset);
     let bytes = src.as_bytes();
