@@ -63,13 +63,11 @@ fn axis_word() -> impl Strategy<Value = AxisWord> {
         (axis_name(), number()).prop_map(|(name, v)| AxisWord {
             name,
             value: Expr::Num(v),
-            assigned: false,
             span: span()
         }),
         (axis_name(), expr()).prop_map(|(name, value)| AxisWord {
             name,
             value,
-            assigned: true,
             span: span()
         }),
     ]
@@ -178,15 +176,7 @@ fn command() -> impl Strategy<Value = Command> {
         }),
         Just(Command::WaitIndpAll),
         any::<bool>().prop_map(|wait| Command::Flush { wait }),
-        prop::collection::vec(axis_word(), 1..3).prop_map(|axes| Command::Pset {
-            axes: axes
-                .into_iter()
-                .map(|a| AxisWord {
-                    assigned: true,
-                    ..a
-                })
-                .collect()
-        }),
+        prop::collection::vec(axis_word(), 1..3).prop_map(|axes| Command::Pset { axes }),
         Just(Command::Preset { axes: vec![] }),
     ]
 }

@@ -115,7 +115,7 @@ fn resolve_jumps(tree: &Program) -> Vec<Option<Jump>> {
             let Item::Control { control, .. } = item else {
                 continue;
             };
-            match control {
+            match control.as_ref() {
                 Control::While(_) => open.push((b, true, None)),
                 Control::If(_) => open.push((b, false, None)),
                 Control::Else => {

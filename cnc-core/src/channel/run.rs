@@ -486,10 +486,10 @@ impl Channel {
                 .items_of(block)
                 .iter()
                 .find_map(|item| match item {
-                    Item::Control {
-                        control: Control::While(c) | Control::If(c),
-                        ..
-                    } => Some(c),
+                    Item::Control { control, .. } => match control.as_ref() {
+                        Control::While(c) | Control::If(c) => Some(c),
+                        _ => None,
+                    },
                     _ => None,
                 });
             let holds = |c: Option<&crate::nc::ast::Expr>| -> Option<bool> {

@@ -362,12 +362,20 @@ pub enum Command {
 pub struct AxisWord {
     /// Axis name, upper case.
     pub name: AxisName,
-    /// The value.
+    /// The value. (Whether it was written `X10` or `X=10` is not kept: the printer chooses
+    /// the form, and leaving the flag out keeps items at 32 bytes.)
     pub value: Expr,
-    /// Whether it was written with `=` (printing keeps the form).
-    pub assigned: bool,
     /// Where it stands.
     pub span: Span,
+}
+
+/// The contents of an independent axis command `X1[INDP_ASYN POS=-90 G01 F500 G90]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IndependentAxis {
+    /// Axis name.
+    pub name: AxisName,
+    /// The entries in the brackets.
+    pub options: Vec<Entry>,
 }
 
 /// One item of a block.
@@ -398,11 +406,9 @@ pub enum Item {
     Axis(AxisWord),
     /// An independent axis command `X1[INDP_ASYN POS=-90 G01 F500 G90]`.
     IndependentAxis {
-        /// Axis name.
-        name: AxisName,
-        /// The entries in the brackets (a boxed slice, so that this rare item does not make
-        /// every item larger).
-        options: Box<[Entry]>,
+        /// The axis and its entries (boxed, so that this rare item does not make every item
+        /// larger).
+        axis: Box<IndependentAxis>,
         /// Where it stands.
         span: Span,
     },
@@ -415,8 +421,8 @@ pub enum Item {
     },
     /// `$WHILE expr`, `$ENDWHILE`, `$IF expr`, `$ELSE`, `$ENDIF`.
     Control {
-        /// The control statement.
-        control: Control,
+        /// The control statement (boxed, so the common items stay small).
+        control: Box<Control>,
         /// Where it stands.
         span: Span,
     },
@@ -502,5 +508,5 @@ pub(crate) fn arena_index(len: usize) -> u32 {
 // fill): keep the common nodes small.
 const _: () = assert!(core::mem::size_of::<Span>() == 8);
 const _: () = assert!(core::mem::size_of::<Expr>() == 16);
-const _: () = assert!(core::mem::size_of::<Item>() == 40);
+const _: () = assert!(core::mem::size_of::<Item>() == 32);
 const _: () = assert!(core::mem::size_of::<Block>() == 28);

@@ -615,12 +615,9 @@ impl DecoderState {
                         programmed |= 1 << i;
                     }
                 }
-                Item::IndependentAxis {
-                    name,
-                    options,
-                    span,
-                } => {
-                    if let Some(d) = self.independent(line, name.as_str(), options, *span, ctx) {
+                Item::IndependentAxis { axis, span } => {
+                    let (name, options) = (axis.name.as_str(), &axis.options);
+                    if let Some(d) = self.independent(line, name, options, *span, ctx) {
                         tail.push(d);
                     }
                 }
@@ -630,7 +627,7 @@ impl DecoderState {
                     }
                 }
                 Item::Control { control, span: _ } => {
-                    let op = match control {
+                    let op = match control.as_ref() {
                         Control::While(c) => ControlOp::While {
                             cond: c.clone(),
                             end: 0,

@@ -96,7 +96,6 @@ impl Lexer<'_> {
                 _ => arena.push(Item::Axis(AxisWord {
                     name: AxisName::from_packed(name),
                     value: Expr::Num(value),
-                    assigned: false,
                     span,
                 })),
             }

@@ -278,7 +278,10 @@ impl Parser<'_> {
                 self.bump();
                 let control = self.control(full)?;
                 let span = self.extend(span);
-                Some(Item::Control { control, span })
+                Some(Item::Control {
+                    control: Box::new(control),
+                    span,
+                })
             }
             Tok::Word(_) | Tok::Addr(..) => self.word_item(span),
             Tok::Percent(_) => {
@@ -390,7 +393,6 @@ impl Parser<'_> {
                 _ => Item::Axis(AxisWord {
                     name,
                     value,
-                    assigned: true,
                     span: self.extend(span),
                 }),
             });
@@ -404,8 +406,7 @@ impl Parser<'_> {
             let options = self.bracket_list();
             let (name, options) = (name?, options?);
             return Some(Item::IndependentAxis {
-                name,
-                options: options.into(),
+                axis: Box::new(IndependentAxis { name, options }),
                 span: self.extend(span),
             });
         }
@@ -464,7 +465,6 @@ impl Parser<'_> {
             _ => Some(Item::Axis(AxisWord {
                 name: self.axis_name(word, None, span)?,
                 value: Expr::Num(value),
-                assigned: false,
                 span: self.extend(span),
             })),
         }

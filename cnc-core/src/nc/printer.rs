@@ -87,10 +87,13 @@ fn on_off(on: bool) -> &'static str {
     }
 }
 
-fn axis(a: &AxisWord) -> String {
-    match (&a.value, a.assigned) {
-        (Expr::Num(v), false) => format!("{}{}", a.name, num(*v)),
-        (v, _) => format!("{}={}", a.name, expr(v)),
+/// `X10` for a number, `X=expr` otherwise; always `=` after a name that ends in a digit
+/// (`X1=5`, not `X15`) and where `assigned` asks for it (`#PSET`).
+fn axis_word(a: &AxisWord, assigned: bool) -> String {
+    let digit_last = a.name.as_bytes().last().is_some_and(u8::is_ascii_digit);
+    match &a.value {
+        Expr::Num(v) if !assigned && !digit_last => format!("{}{}", a.name, num(*v)),
+        v => format!("{}={}", a.name, expr(v)),
     }
 }
 
@@ -103,9 +106,9 @@ fn item(i: &Item) -> String {
             ..
         } if *v >= 0.0 => format!("F{}", num(*v)),
         Item::Feed { value, .. } => format!("F={}", expr(value)),
-        Item::Axis(a) => axis(a),
-        Item::IndependentAxis { name, options, .. } => format!("{name}{}", list(options)),
-        Item::Control { control, .. } => match control {
+        Item::Axis(a) => axis_word(a, false),
+        Item::IndependentAxis { axis, .. } => format!("{}{}", axis.name, list(&axis.options)),
+        Item::Control { control, .. } => match control.as_ref() {
             Control::While(c) => format!("$WHILE {}", expr(c)),
             Control::EndWhile => "$ENDWHILE".into(),
             Control::If(c) => format!("$IF {}", expr(c)),
@@ -153,7 +156,7 @@ fn item(i: &Item) -> String {
                 format!("#FLUSH {}", if *wait { "WAIT" } else { "CONTINUE" })
             }
             Command::Pset { axes } => {
-                let a: Vec<String> = axes.iter().map(axis).collect();
+                let a: Vec<String> = axes.iter().map(|a| axis_word(a, true)).collect();
                 format!("#PSET {}", a.join(" "))
             }
             Command::Preset { axes } if axes.is_empty() => "#PRESET".into(),
