@@ -54,8 +54,11 @@ fn expr() -> impl Strategy<Value = Expr> {
 }
 
 fn axis_name() -> impl Strategy<Value = AxisName> {
-    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"])
-        .prop_map(AxisName::from)
+    // Names ending in a digit print as `X1=5`, never glued (`X15` is another word).
+    prop::sample::select(vec![
+        "X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA", "X1", "Q12", "AXIS7",
+    ])
+    .prop_map(AxisName::from)
 }
 
 fn axis_word() -> impl Strategy<Value = AxisWord> {
