@@ -119,16 +119,15 @@ impl AxisName {
     /// Longest axis name.
     pub const CAPACITY: usize = 8;
 
-    /// The name of `name`, `None` when it is longer than [`AxisName::CAPACITY`].
-    pub fn new(name: &Name) -> Option<Self> {
-        let text = name.as_bytes();
-        let mut bytes = [0; Self::CAPACITY];
-        bytes.get_mut(..text.len())?.copy_from_slice(text);
-        Some(Self { bytes })
+    /// The name of `text` (upper-cased), `None` when it is longer than
+    /// [`AxisName::CAPACITY`] or not ASCII.
+    pub fn parse(text: &str) -> Option<Self> {
+        let fits = text.len() <= Self::CAPACITY && text.bytes().all(|b| b.is_ascii() && b != 0);
+        fits.then(|| Self::from(text))
     }
 
-    /// The name packed by the fast lane: the first `len` (at most 8) bytes of `packed`, first
-    /// byte lowest, the bytes above zero.
+    /// The name packed by the fast lane: its bytes in `packed`, first byte lowest, the unused
+    /// high bytes zero.
     pub(crate) fn from_packed(packed: u64) -> Self {
         Self {
             bytes: packed.to_le_bytes(),

@@ -73,32 +73,29 @@ impl Lexer<'_> {
                 }
                 Some(block) => block.end = span.end,
             }
-            // One push per kind: a single push after the match made the compiler assemble
-            // every item on the stack and copy it, and the copy stalled on the narrower
-            // stores that had just built it.
-            match name {
+            arena.push(match name {
                 G | M => {
                     let code = value as u32;
                     if f64::from(code) != value {
                         return None;
                     }
                     if name == G {
-                        arena.push(Item::G { code, span });
+                        Item::G { code, span }
                     } else {
-                        arena.push(Item::M { code, span });
+                        Item::M { code, span }
                     }
                 }
-                F => arena.push(Item::Feed {
+                F => Item::Feed {
                     value: Expr::Num(value),
                     span,
-                }),
+                },
                 N => return None,
-                _ => arena.push(Item::Axis(AxisWord {
+                _ => Item::Axis(AxisWord {
                     name: AxisName::from_packed(name),
                     value: Expr::Num(value),
                     span,
-                })),
-            }
+                }),
+            });
         }
         let span = block_span?;
         // Past the line break: the lexer stands where the general path would after the block.

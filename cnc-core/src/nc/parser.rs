@@ -337,7 +337,8 @@ impl Parser<'_> {
     }
 
     /// The axis name of a word with an optional glued whole number (`X`, `X1`); a sign or a
-    /// decimal point is reported and the block skipped.
+    /// decimal point is reported and the block skipped, a name longer than
+    /// [`AxisName::CAPACITY`] is reported.
     fn axis_name(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<AxisName> {
         let with_number;
         let name = match glued {
@@ -355,7 +356,7 @@ impl Parser<'_> {
                 return None;
             }
         };
-        let axis = (name.len() <= AxisName::CAPACITY).then(|| AxisName::from(name));
+        let axis = AxisName::parse(name);
         if axis.is_none() {
             self.error(
                 span,
