@@ -2,6 +2,7 @@
 //! tooling (`cnc hli symbols`, `cnc hli header`) and kinematics from the command line (`cnc kin`); channels, interpolation and axes follow.
 
 pub mod axis;
+pub mod cam;
 pub mod channel;
 pub mod check_cli;
 pub mod demo;
