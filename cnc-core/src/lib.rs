@@ -3,6 +3,7 @@
 
 pub mod axis;
 pub mod cam;
+pub mod cam_cli;
 pub mod channel;
 pub mod check_cli;
 pub mod demo;

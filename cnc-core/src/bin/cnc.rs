@@ -25,6 +25,11 @@ enum Command {
     },
     /// Check NC programs: parse, decode, report FILE:LINE:COL diagnostics.
     Check(cnc_core::check_cli::CheckArgs),
+    /// Cam profiles: evaluate, characteristic values, plot.
+    Cam {
+        #[command(subcommand)]
+        what: cnc_core::cam_cli::CamCommand,
+    },
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
@@ -60,6 +65,7 @@ fn main() -> ExitCode {
         }
         Command::Check(args) => cnc_core::check_cli::main(args),
         Command::Kin { what } => cnc_core::kin_cli::main(what),
+        Command::Cam { what } => cnc_core::cam_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }
 }

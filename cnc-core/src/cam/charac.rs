@@ -159,6 +159,18 @@ impl CharacValues {
         });
         let (m0, m1) = profile.master_range();
         let span = (m1 - m0).abs();
+        // A step at the very end is a position the last piece's formula does not reach.
+        let end = Extreme {
+            value: profile.end_position(),
+            at: m1,
+            velocity: last[1],
+        };
+        if lo[0].is_none_or(|m| end.value < m.value) {
+            lo[0] = Some(end);
+        }
+        if hi[0].is_none_or(|m| end.value > m.value) {
+            hi[0] = Some(end);
+        }
         let first = first.unwrap_or_default();
         let get = |e: Option<Extreme>| {
             e.unwrap_or(Extreme {

@@ -25,7 +25,7 @@ pub mod piece;
 pub mod table;
 
 pub use charac::CharacValues;
-pub use error::{CamError, TableErrorCode};
+pub use error::{CamError, Field, TableErrorCode};
 pub use law::FunctionType;
 pub use motion_function::{MotionFunction, MotionFunctionPoint, PointType};
 pub use table::{Interpolation, PositionTable, TableType};

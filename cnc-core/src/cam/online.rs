@@ -156,9 +156,11 @@ impl OnlineChangeQueue {
         let due = match pending.mode {
             ActivationMode::Instantaneous => true,
             ActivationMode::AtMasterAxisPos(p) => crossed(now.axis, p),
-            ActivationMode::AtMasterCamPos(p) => {
-                crossed(now.cam, p) || (now.cycle_changed && (now.cam.0 < p || p <= now.cam.1))
+            ActivationMode::AtMasterCamPos(p) if now.cycle_changed => {
+                // Across the wrap: passed at the end of the old cycle or the start of the new.
+                p > now.cam.0 || p <= now.cam.1
             }
+            ActivationMode::AtMasterCamPos(p) => crossed(now.cam, p),
             ActivationMode::NextCycle => now.cycle_changed,
             ActivationMode::AsSoonAsPossible => !pending
                 .changed

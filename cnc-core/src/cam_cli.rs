@@ -1,0 +1,248 @@
+//! `cnc cam eval|charac|plot`: a cam file (JSON motion function or table, or the binary table
+//! format) evaluated, characterised or drawn from the command line.
+
+use crate::cam::file::{self, BinaryOptions, LoadError};
+use crate::cam::{CamProfile, CharacValues, Interpolation, ProfileCursor, Sample};
+use crate::json::number as num;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Options for reading a binary table (JSON files say this themselves).
+#[derive(Debug, Clone, clap::Args)]
+pub struct BinaryArgs {
+    /// Interpolation of a binary table: linear, 4point or spline.
+    #[arg(long, default_value = "linear", value_parser = parse_interpolation)]
+    interpolation: Interpolation,
+    /// A binary table continues cyclically (master period, slave stroke).
+    #[arg(long)]
+    periodic: bool,
+}
+
+fn parse_interpolation(s: &str) -> Result<Interpolation, String> {
+    match s {
+        "linear" => Ok(Interpolation::Linear),
+        "4point" => Ok(Interpolation::FourPoint),
+        "spline" => Ok(Interpolation::Spline),
+        _ => Err(format!("{s:?}: linear, 4point or spline")),
+    }
+}
+
+/// `cnc cam ...`.
+#[derive(Debug, Clone, clap::Subcommand)]
+pub enum CamCommand {
+    /// Print `master,position,velocity,acceleration,jerk` (CSV) of the raw cam.
+    Eval {
+        /// Cam file.
+        file: PathBuf,
+        /// First master position.
+        #[arg(long, allow_negative_numbers = true)]
+        from: f64,
+        /// Last master position.
+        #[arg(long, allow_negative_numbers = true)]
+        to: f64,
+        /// Master step (its sign must lead from --from to --to).
+        #[arg(long, allow_negative_numbers = true)]
+        step: f64,
+        /// How to read a binary table.
+        #[command(flatten)]
+        binary: BinaryArgs,
+    },
+    /// Print the characteristic values (MC_TableCharacValues field names) as JSON.
+    Charac {
+        /// Cam file.
+        file: PathBuf,
+        /// Constant master velocity the dynamic values refer to (default 1: normed).
+        #[arg(long, default_value_t = 1.0)]
+        master_velocity: f64,
+        /// How to read a binary table.
+        #[command(flatten)]
+        binary: BinaryArgs,
+    },
+    /// Draw position, velocity and acceleration over the master as SVG.
+    Plot {
+        /// Cam file.
+        file: PathBuf,
+        /// Output SVG.
+        #[arg(short = 'o', long)]
+        out: PathBuf,
+        /// Samples drawn.
+        #[arg(long, default_value_t = 2000)]
+        samples: usize,
+        /// How to read a binary table.
+        #[command(flatten)]
+        binary: BinaryArgs,
+    },
+}
+
+/// Runs `cnc cam`: exit 0, 1 for a refused file or request, 2 for a file that cannot be read.
+pub fn main(command: CamCommand) -> ExitCode {
+    match run(&command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Pipe) => ExitCode::SUCCESS,
+        Err(CliError::Message(code, text)) => {
+            eprintln!("cnc cam: {text}");
+            ExitCode::from(code)
+        }
+    }
+}
+
+enum CliError {
+    Pipe,
+    Message(u8, String),
+}
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            CliError::Pipe
+        } else {
+            CliError::Message(2, e.to_string())
+        }
+    }
+}
+
+fn load(path: &Path, binary: &BinaryArgs) -> Result<CamProfile, CliError> {
+    let options = BinaryOptions {
+        interpolation: binary.interpolation,
+        periodic: binary.periodic,
+    };
+    file::load(path, options)
+        .map(|f| f.profile)
+        .map_err(|e| match e {
+            LoadError::Cam(_) => CliError::Message(1, format!("{}: {e}", path.display())),
+            other => CliError::Message(2, format!("{}: {other}", path.display())),
+        })
+}
+
+fn run(command: &CamCommand) -> Result<(), CliError> {
+    match command {
+        CamCommand::Eval {
+            file,
+            from,
+            to,
+            step,
+            binary,
+        } => {
+            let profile = load(file, binary)?;
+            let rows =
+                crate::cam::charac::value_table(&profile, 15, *from, *to, *step).map_err(|e| {
+                    CliError::Message(
+                        1,
+                        format!("error {:#06X} ({}): {e}", e.code() as u32, e.code().name()),
+                    )
+                })?;
+            let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+            writeln!(out, "master,position,velocity,acceleration,jerk")?;
+            for r in rows {
+                let cells: Vec<String> = r.iter().map(|v| num(*v)).collect();
+                writeln!(out, "{}", cells.join(","))?;
+            }
+            out.flush()?;
+            Ok(())
+        }
+        CamCommand::Charac {
+            file,
+            master_velocity,
+            binary,
+        } => {
+            if !(master_velocity.is_finite() && *master_velocity > 0.0) {
+                return Err(CliError::Message(
+                    1,
+                    format!("--master-velocity {master_velocity}: a positive finite velocity"),
+                ));
+            }
+            let profile = load(file, binary)?;
+            let values = CharacValues::normed(&profile).rescaled(*master_velocity);
+            let body: Vec<String> = values
+                .fields()
+                .iter()
+                .map(|(name, value)| format!("\"{name}\":{}", num(*value)))
+                .collect();
+            let mut out = std::io::stdout().lock();
+            writeln!(out, "{{{}}}", body.join(","))?;
+            Ok(())
+        }
+        CamCommand::Plot {
+            file,
+            out,
+            samples,
+            binary,
+        } => {
+            let profile = load(file, binary)?;
+            plot(&profile, out, (*samples).clamp(2, 1_000_000))
+                .map_err(|e| CliError::Message(2, format!("{}: {e}", out.display())))
+        }
+    }
+}
+
+/// Position, velocity and acceleration over the master, stacked, as SVG.
+pub fn plot(profile: &CamProfile, out: &Path, samples: usize) -> Result<(), String> {
+    use plotters::prelude::*;
+    let (m0, m1) = profile.master_range();
+    let (lo, hi) = (m0.min(m1), m0.max(m1));
+    let mut cursor = ProfileCursor::default();
+    let points: Vec<(f64, Sample)> = (0..samples)
+        .map(|i| {
+            let x = lo + (hi - lo) * i as f64 / (samples - 1) as f64;
+            (x, profile.eval(x, &mut cursor))
+        })
+        .collect();
+    let root = SVGBackend::new(out, (900, 900)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let panels = root.split_evenly((3, 1));
+    let series: [(&str, &str, fn(&Sample) -> f64, RGBColor); 3] = [
+        ("slave position", "position", |s| s.position, BLUE),
+        (
+            "slave velocity",
+            "velocity per master unit",
+            |s| s.velocity,
+            RED,
+        ),
+        (
+            "slave acceleration",
+            "acceleration per master unit^2",
+            |s| s.acceleration,
+            GREEN,
+        ),
+    ];
+    for (panel, (title, unit, get, colour)) in panels.iter().zip(series) {
+        let values: Vec<f64> = points.iter().map(|(_, s)| get(s)).collect();
+        let (mut y0, mut y1) = values
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                (a.min(*v), b.max(*v))
+            });
+        let pad = ((y1 - y0) * 0.08).max(1e-9);
+        y0 -= pad;
+        y1 += pad;
+        let mut chart = ChartBuilder::on(panel)
+            .caption(title, ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(36)
+            .y_label_area_size(70)
+            .build_cartesian_2d(lo..hi, y0..y1)
+            .map_err(|e| e.to_string())?;
+        chart
+            .configure_mesh()
+            .x_desc("master position")
+            .y_desc(unit)
+            .draw()
+            .map_err(|e| e.to_string())?;
+        chart
+            .draw_series(LineSeries::new(
+                points.iter().zip(&values).map(|((x, _), v)| (*x, *v)),
+                colour.stroke_width(2),
+            ))
+            .map_err(|e| e.to_string())?
+            .label(title)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.8))
+            .draw()
+            .map_err(|e| e.to_string())?;
+    }
+    root.present().map_err(|e| e.to_string())
+}

@@ -1,0 +1,305 @@
+//! Position tables: support points, cubic reproduction, cyclic continuation, edges, the
+//! seed's interval conventions, the binary file.
+
+use cnc_core::cam::file::{self, BinaryOptions};
+use cnc_core::cam::table::TableCursor;
+use cnc_core::cam::{
+    CamError, CamProfile, Interpolation, PositionTable, TableErrorCode, TableType,
+};
+
+const ALL: [Interpolation; 3] = [
+    Interpolation::Linear,
+    Interpolation::FourPoint,
+    Interpolation::Spline,
+];
+
+fn cubic(x: f64) -> (f64, f64) {
+    (
+        0.02 * x * x * x - 0.3 * x * x + 0.5 * x + 1.0,
+        0.06 * x * x - 0.6 * x + 0.5,
+    )
+}
+
+fn rows_of(masters: &[f64], f: impl Fn(f64) -> f64) -> Vec<[f64; 2]> {
+    masters.iter().map(|m| [*m, f(*m)]).collect()
+}
+
+fn equidistant(n: usize, step: f64) -> Vec<f64> {
+    (0..n).map(|i| i as f64 * step).collect()
+}
+
+fn uneven(n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| i as f64 + 0.3 * ((i * 7 % 5) as f64) / 5.0)
+        .collect()
+}
+
+#[test]
+fn every_interpolation_reproduces_its_support_points() {
+    let wavy = |x: f64| (0.7 * x).sin() * 3.0 + 0.1 * x;
+    for periodic in [false, true] {
+        for interpolation in ALL {
+            let types: &[TableType] = if interpolation == Interpolation::FourPoint {
+                &[TableType::Equidistant]
+            } else {
+                &[TableType::Equidistant, TableType::NonEquidistant]
+            };
+            for ty in types {
+                let masters = if *ty == TableType::Equidistant {
+                    equidistant(25, 0.5)
+                } else {
+                    uneven(25)
+                };
+                let rows = rows_of(&masters, wavy);
+                let t = PositionTable::new(&rows, *ty, interpolation, periodic).unwrap();
+                let mut c = TableCursor::default();
+                for r in &rows {
+                    let s = t.eval(r[0], &mut c).sample;
+                    assert!(
+                        (s.position - r[1]).abs() < 1e-12,
+                        "{interpolation:?} {ty:?} periodic {periodic} at {}",
+                        r[0]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn four_point_and_spline_reproduce_a_cubic() {
+    for (interpolation, masters, ty) in [
+        (
+            Interpolation::FourPoint,
+            equidistant(30, 0.4),
+            TableType::Equidistant,
+        ),
+        (
+            Interpolation::Spline,
+            equidistant(30, 0.4),
+            TableType::Equidistant,
+        ),
+        (Interpolation::Spline, uneven(30), TableType::NonEquidistant),
+    ] {
+        let t = PositionTable::new(&rows_of(&masters, |x| cubic(x).0), ty, interpolation, false)
+            .unwrap();
+        let mut c = TableCursor::default();
+        let (lo, hi) = t.master_range();
+        for i in 0..=1000 {
+            let x = lo + (hi - lo) * i as f64 / 1000.0;
+            let s = t.eval(x, &mut c).sample;
+            let (y, v) = cubic(x);
+            assert!(
+                (s.position - y).abs() < 1e-9,
+                "{interpolation:?} {ty:?} y({x}) = {} != {y}",
+                s.position
+            );
+            assert!(
+                (s.velocity - v).abs() < 1e-8,
+                "{interpolation:?} {ty:?} v({x}) = {} != {v}",
+                s.velocity
+            );
+            assert!(
+                (s.acceleration - (0.12 * x - 0.6)).abs() < 1e-7,
+                "{interpolation:?} {ty:?} a({x})"
+            );
+        }
+    }
+    // Linear interpolation does not (it is exact for lines only).
+    let t = PositionTable::new(
+        &rows_of(&equidistant(30, 0.4), |x| cubic(x).0),
+        TableType::Equidistant,
+        Interpolation::Linear,
+        false,
+    )
+    .unwrap();
+    let s = t.eval(1.0, &mut TableCursor::default()).sample;
+    assert!((s.position - cubic(1.0).0).abs() > 1e-4);
+}
+
+#[test]
+fn cyclic_tables_continue_with_stroke_and_cycle_counter_without_drift() {
+    // One master period of 360 with a slave stroke of 10 per period.
+    let masters = equidistant(37, 10.0);
+    let rows = rows_of(&masters, |x| x / 36.0 + 2.0 * (x.to_radians()).sin());
+    for interpolation in ALL {
+        let t = PositionTable::new(&rows, TableType::Equidistant, interpolation, true).unwrap();
+        assert_eq!((t.period(), t.stroke()), (360.0, 10.0));
+        let mut c = TableCursor::default();
+        let base = t.eval(5.0, &mut c);
+        let next = t.eval(365.0, &mut c);
+        assert_eq!(next.cycle, 1);
+        assert!((next.sample.position - base.sample.position - 10.0).abs() < 1e-12);
+        let before = t.eval(-355.0, &mut c);
+        assert_eq!(before.cycle, -1);
+        assert!((before.sample.position - base.sample.position + 10.0).abs() < 1e-12);
+        // Ten thousand periods on: the counter counts them, the position does not drift.
+        let far = t.eval(5.0 + 360.0 * 10_000.0, &mut c);
+        assert_eq!(far.cycle, 10_000);
+        assert!(
+            (far.sample.position - base.sample.position - 100_000.0).abs() < 1e-8,
+            "{interpolation:?}"
+        );
+        assert!((far.sample.velocity - base.sample.velocity).abs() < 1e-9);
+    }
+    // The periodic spline is smooth across the period boundary.
+    let t = PositionTable::new(&rows, TableType::Equidistant, Interpolation::Spline, true).unwrap();
+    let mut c = TableCursor::default();
+    let (l, r) = (
+        t.eval(360.0 - 1e-9, &mut c).sample,
+        t.eval(360.0 + 1e-9, &mut c).sample,
+    );
+    assert!(
+        (l.velocity - r.velocity).abs() < 1e-9 && (l.acceleration - r.acceleration).abs() < 1e-7
+    );
+}
+
+#[test]
+fn linear_tables_hold_their_edge_values_outside() {
+    let rows = [[0.0, 1.0], [10.0, 3.0], [20.0, 2.0]];
+    let t =
+        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    let mut c = TableCursor::default();
+    for (x, y) in [(-5.0, 1.0), (25.0, 2.0), (5.0, 2.0), (15.0, 2.5)] {
+        let s = t.eval(x, &mut c);
+        assert_eq!((s.sample.position, s.cycle), (y, 0), "at {x}");
+    }
+    assert_eq!(t.eval(-5.0, &mut c).sample.velocity, 0.0);
+}
+
+#[test]
+fn a_support_point_belongs_to_the_interval_the_seed_names() {
+    // Equidistant: T[k] <= x < T[k+1]; non-equidistant: T[k] < x <= T[k+1].
+    let rows = [[0.0, 0.0], [1.0, 1.0], [2.0, 3.0]];
+    let mut c = TableCursor::default();
+    let eq =
+        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    assert_eq!(
+        eq.eval(1.0, &mut c).sample.velocity,
+        2.0,
+        "equidistant: the interval above"
+    );
+    let ne = PositionTable::new(
+        &rows,
+        TableType::NonEquidistant,
+        Interpolation::Linear,
+        false,
+    )
+    .unwrap();
+    assert_eq!(
+        ne.eval(1.0, &mut c).sample.velocity,
+        1.0,
+        "non-equidistant: the interval below"
+    );
+}
+
+#[test]
+fn the_binary_file_round_trips() {
+    let rows = rows_of(&uneven(200), |x| x.sqrt());
+    let bytes = file::write_binary(&rows).unwrap();
+    assert_eq!(bytes.len(), 4 + 200 * 16);
+    assert_eq!(
+        &bytes[..4],
+        &[200, 0, 2, 0],
+        "header: rows, columns as unsigned shorts"
+    );
+    assert_eq!(file::read_binary(&bytes).unwrap(), rows);
+    let loaded = file::parse(&bytes, BinaryOptions::default()).unwrap();
+    let CamProfile::Table(t) = loaded.profile else {
+        panic!("a table")
+    };
+    assert_eq!(t.table_type(), TableType::NonEquidistant);
+    assert_eq!(t.rows().collect::<Vec<_>>(), rows);
+    let even = file::write_binary(&rows_of(&equidistant(5, 2.0), |x| x)).unwrap();
+    let CamProfile::Table(t) = file::parse(&even, BinaryOptions::default())
+        .unwrap()
+        .profile
+    else {
+        panic!()
+    };
+    assert_eq!(t.table_type(), TableType::Equidistant);
+}
+
+#[test]
+fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
+    let code = |e: CamError| e.code();
+    let good = rows_of(&equidistant(5, 1.0), |x| x);
+    let mut bytes = file::write_binary(&good).unwrap();
+    bytes.pop();
+    assert_eq!(
+        code(file::read_binary(&bytes).unwrap_err()),
+        TableErrorCode::ArraySizeInvalid
+    );
+    let mut three = file::write_binary(&good).unwrap();
+    three[2] = 3;
+    assert_eq!(
+        file::read_binary(&three).unwrap_err(),
+        CamError::Columns { row: 0, cols: 3 }
+    );
+    assert_eq!(
+        code(file::read_binary(&[]).unwrap_err()),
+        TableErrorCode::PointerInvalid
+    );
+
+    let mut back = good.clone();
+    back[3][0] = 1.5;
+    let e = PositionTable::new(
+        &back,
+        TableType::NonEquidistant,
+        Interpolation::Linear,
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(
+        e,
+        CamError::RowNotAscending {
+            row: 3,
+            master: 1.5,
+            previous: 2.0
+        }
+    );
+    assert_eq!(e.code(), TableErrorCode::IncrementInvalid);
+
+    let e = PositionTable::new(
+        &rows_of(&uneven(6), |x| x),
+        TableType::Equidistant,
+        Interpolation::Linear,
+        false,
+    )
+    .unwrap_err();
+    assert!(matches!(e, CamError::NotEquidistant { .. }), "{e}");
+
+    let mut nan = good.clone();
+    nan[2][1] = f64::NAN;
+    let e =
+        PositionTable::new(&nan, TableType::Equidistant, Interpolation::Linear, false).unwrap_err();
+    assert_eq!(e.code(), TableErrorCode::NumRowsInvalid);
+    assert!(e.to_string().contains("row 2"));
+
+    let e = PositionTable::new(
+        &good[..3],
+        TableType::Equidistant,
+        Interpolation::FourPoint,
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(e.code(), TableErrorCode::NumRowsInvalid);
+    let e = PositionTable::new(
+        &rows_of(&uneven(6), |x| x),
+        TableType::NonEquidistant,
+        Interpolation::FourPoint,
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(e.code(), TableErrorCode::McTableTypeInvalid);
+
+    let json = br#"{"kind":"table","table_type":"equidistant","rows":[[0,0],[1,1,5]]}"#;
+    let e = file::parse(json, BinaryOptions::default()).unwrap_err();
+    assert!(
+        e.to_string().contains("0x4B37") && e.to_string().contains("row 1"),
+        "{e}"
+    );
+    let json = br#"{"kind":"table","id":256,"table_type":"equidistant","rows":[[0,0],[1,1]]}"#;
+    let e = file::parse(json, BinaryOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("0x4B32"), "{e}");
+}
