@@ -234,14 +234,6 @@ pub fn plot(profile: &CamProfile, out: &Path, samples: usize) -> Result<(), Stri
                 points.iter().zip(&values).map(|((x, _), v)| (*x, *v)),
                 colour.stroke_width(2),
             ))
-            .map_err(|e| e.to_string())?
-            .label(title)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-        chart
-            .configure_series_labels()
-            .border_style(BLACK)
-            .background_style(WHITE.mix(0.8))
-            .draw()
             .map_err(|e| e.to_string())?;
     }
     root.present().map_err(|e| e.to_string())

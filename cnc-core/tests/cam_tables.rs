@@ -303,3 +303,33 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
     let e = file::parse(json, BinaryOptions::default()).unwrap_err();
     assert!(e.to_string().contains("0x4B32"), "{e}");
 }
+
+mod lookup {
+    use cnc_core::cam::table::TableCursor;
+    use cnc_core::cam::{Interpolation, PositionTable, TableType};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// However the master jumps, the cursor's walk and gallop find the interval a plain
+        /// scan finds (the seed's convention: T[k] < x <= T[k+1]), so the value agrees.
+        #[test]
+        fn a_kept_cursor_finds_what_a_scan_finds(
+            steps in proptest::collection::vec(0.01f64..5.0, 2..400),
+            queries in proptest::collection::vec(-0.1f64..1.1, 1..200),
+        ) {
+            let mut x = 0.0;
+            let rows: Vec<[f64; 2]> = steps.iter().enumerate().map(|(i, s)| { x += s; [x, (i as f64 * 0.37).sin()] }).collect();
+            let t = PositionTable::new(&rows, TableType::NonEquidistant, Interpolation::Linear, false).unwrap();
+            let (lo, hi) = t.master_range();
+            let mut cursor = TableCursor::default();
+            for q in queries {
+                let x = (lo + (hi - lo) * q).clamp(lo, hi);
+                let got = t.eval(x, &mut cursor).sample;
+                let k = rows.windows(2).position(|w| w[0][0] < x && x <= w[1][0]).unwrap_or(0);
+                let slope = (rows[k + 1][1] - rows[k][1]) / (rows[k + 1][0] - rows[k][0]);
+                prop_assert!((got.velocity - slope).abs() < 1e-12, "interval at {}", x);
+                prop_assert!((got.position - (rows[k][1] + slope * (x - rows[k][0]))).abs() < 1e-9);
+            }
+        }
+    }
+}

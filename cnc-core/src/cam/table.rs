@@ -36,8 +36,8 @@ pub struct PositionTable {
     table_type: TableType,
     interpolation: Interpolation,
     periodic: bool,
-    /// Equidistant step (0 for non-equidistant tables).
-    step: f64,
+    /// 1 / equidistant step (0 for non-equidistant tables).
+    inverse_step: f64,
     /// Second derivatives at the rows for the spline.
     curvature: Vec<f64>,
 }
@@ -122,7 +122,7 @@ impl PositionTable {
             table_type,
             interpolation,
             periodic,
-            step,
+            inverse_step: if step > 0.0 { 1.0 / step } else { 0.0 },
             curvature: Vec::new(),
         };
         if interpolation == Interpolation::Spline {
@@ -249,8 +249,9 @@ impl PositionTable {
     fn interval(&self, x: f64, cursor: &TableCursor) -> usize {
         let n = self.master.len();
         if self.table_type == TableType::Equidistant {
-            let k = ((x - self.master[0]) / self.step).floor();
-            return (k.max(0.0) as usize).min(n - 2);
+            // Truncation is floor for the non-negative offsets inside the table.
+            let k = (x - self.master[0]) * self.inverse_step;
+            return if k > 0.0 { (k as usize).min(n - 2) } else { 0 };
         }
         let m = &self.master;
         let fits = |k: usize| (m[k] < x || k == 0) && x <= m[k + 1];
@@ -271,7 +272,30 @@ impl PositionTable {
         if fits(k) {
             return k;
         }
-        m.partition_point(|v| *v < x).clamp(1, n - 1) - 1
+        // Gallop from the cursor (cost grows with the log of the distance), then bisect.
+        let (mut lo, mut hi) = if x > m[k + 1] {
+            let mut step = 1;
+            while k + step + 1 < n - 1 && m[k + step + 1] < x {
+                step *= 2;
+            }
+            (k + step / 2, (k + step + 1).min(n - 1))
+        } else {
+            let mut step = 1;
+            while step < k && m[k - step] >= x {
+                step *= 2;
+            }
+            (k.saturating_sub(step), k)
+        };
+        // Invariant: the wanted interval lies within rows lo..=hi.
+        while hi - lo > 1 {
+            let mid = (lo + hi) / 2;
+            if m[mid] < x {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo.min(n - 2)
     }
 
     /// Row `i` (may lie outside the table for a periodic one: continued by period and stroke).
@@ -293,14 +317,39 @@ impl PositionTable {
         )
     }
 
+    /// The cubic through rows k-1..=k+2 (shifted inward at the ends of a linear table,
+    /// continued by period and stroke for a cyclic one), in closed form for equal steps.
     fn four_point(&self, k: usize, x: f64) -> Sample {
-        let n = self.master.len() as isize;
-        let mut first = k as isize - 1;
-        if !self.periodic {
-            first = first.clamp(0, n - 4);
+        let n = self.master.len();
+        let first = if self.periodic {
+            k as isize - 1
+        } else {
+            (k as isize - 1).clamp(0, n as isize - 4)
+        };
+        let y: [f64; 4] = if first >= 0 && first as usize + 3 < n {
+            let f = first as usize;
+            [
+                self.slave[f],
+                self.slave[f + 1],
+                self.slave[f + 2],
+                self.slave[f + 3],
+            ]
+        } else {
+            std::array::from_fn(|i| self.row(first + i as isize).1)
+        };
+        // t = 0 at row first+1; the cubic through t = -1, 0, 1, 2.
+        let origin = self.row(first + 1).0;
+        let t = (x - origin) * self.inverse_step;
+        let a1 = -y[0] / 3.0 - y[1] / 2.0 + y[2] - y[3] / 6.0;
+        let a2 = (y[0] + y[2]) / 2.0 - y[1];
+        let a3 = (y[3] - y[0]) / 6.0 + (y[1] - y[2]) / 2.0;
+        let k1 = self.inverse_step;
+        Sample {
+            position: y[1] + t * (a1 + t * (a2 + t * a3)),
+            velocity: (a1 + t * (2.0 * a2 + 3.0 * t * a3)) * k1,
+            acceleration: (2.0 * a2 + 6.0 * t * a3) * k1 * k1,
+            jerk: 6.0 * a3 * k1 * k1 * k1,
         }
-        let pts: [(f64, f64); 4] = std::array::from_fn(|i| self.row(first + i as isize));
-        lagrange4(&pts, x)
     }
 
     fn spline(&self, k: usize, x: f64) -> Sample {
