@@ -191,7 +191,8 @@ pub fn plot(profile: &CamProfile, out: &Path, samples: usize) -> Result<(), Stri
     let root = SVGBackend::new(out, (900, 900)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let panels = root.split_evenly((3, 1));
-    let series: [(&str, &str, fn(&Sample) -> f64, RGBColor); 3] = [
+    type Series = (&'static str, &'static str, fn(&Sample) -> f64, RGBColor);
+    let series: [Series; 3] = [
         ("slave position", "position", |s| s.position, BLUE),
         (
             "slave velocity",

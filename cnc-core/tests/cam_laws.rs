@@ -365,3 +365,40 @@ fn falling_master_positions_mirror_the_rising_function() {
         );
     }
 }
+
+#[test]
+fn the_value_table_selects_its_columns_by_mask() {
+    use cnc_core::cam::charac::value_table;
+    let p = unit(FunctionType::Polynom5, 0.0);
+    // Position and acceleration: master plus two columns.
+    let rows = value_table(&p, 1 | 4, 0.0, 1.0, 0.25).unwrap();
+    assert_eq!(rows.len(), 5);
+    assert!(rows.iter().all(|r| r.len() == 3));
+    assert_eq!(rows[2][0], 0.5);
+    assert!((rows[2][1] - 0.5).abs() < 1e-12 && rows[2][2].abs() < 1e-9);
+    // Jerk alone; a falling sweep.
+    let rows = value_table(&p, 8, 1.0, 0.0, -0.5).unwrap();
+    assert_eq!(
+        rows.iter().map(|r| r[0]).collect::<Vec<_>>(),
+        vec![1.0, 0.5, 0.0]
+    );
+    assert!(
+        (rows[1][1] + 30.0).abs() < 1e-9,
+        "P5 jerk at the middle is -30"
+    );
+    for (mask, from, to, inc) in [
+        (0, 0.0, 1.0, 0.1),
+        (16, 0.0, 1.0, 0.1),
+        (1, 0.0, 1.0, 0.0),
+        (1, 0.0, 1.0, -0.1),
+        (1, 0.0, 1e9, 1e-3),
+    ] {
+        let e = value_table(&p, mask, from, to, inc).unwrap_err();
+        let want = if mask == 0 || mask > 15 {
+            TableErrorCode::NumColumnsInvalid
+        } else {
+            TableErrorCode::IncrementInvalid
+        };
+        assert_eq!(e.code(), want, "{mask} {from} {to} {inc}");
+    }
+}

@@ -492,10 +492,10 @@ fn motion_polynomial(law: FunctionType, a: [f64; 4], b: [f64; 4]) -> Option<Vec<
     let n = rows.len();
     let mut m = vec![vec![0.0; n + 1]; n];
     for (r, (order, z, value)) in rows.iter().enumerate() {
-        for i in *order..n {
+        for (i, cell) in m[r].iter_mut().enumerate().take(n).skip(*order) {
             // d^order/dz^order z^i = i!/(i-order)! z^(i-order)
             let falling: f64 = ((i - order + 1)..=i).map(|f| f as f64).product();
-            m[r][i] = falling * z.powi((i - order) as i32);
+            *cell = falling * z.powi((i - order) as i32);
         }
         m[r][n] = *value;
     }
@@ -511,11 +511,12 @@ fn solve(mut m: Vec<Vec<f64>>) -> Option<Vec<f64>> {
             return None;
         }
         m.swap(col, pivot);
-        for r in 0..n {
+        let pivot_row = m[col].clone();
+        for (r, row) in m.iter_mut().enumerate() {
             if r != col {
-                let f = m[r][col] / m[col][col];
-                for c in col..=n {
-                    m[r][c] -= f * m[col][c];
+                let f = row[col] / pivot_row[col];
+                for (cell, p) in row.iter_mut().zip(&pivot_row).skip(col) {
+                    *cell -= f * p;
                 }
             }
         }

@@ -53,6 +53,12 @@ impl Sample {
     }
 }
 
+/// Value and four derivatives of one closed-form piece at a master position.
+pub(crate) type PieceEval<'a> = &'a dyn Fn(f64) -> [f64; 5];
+
+/// Visits each piece: its master range (ascending) and its evaluation.
+pub(crate) type PieceVisitor<'a> = dyn FnMut(f64, f64, PieceEval<'_>) + 'a;
+
 /// A cam profile: a motion function or a position table.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CamProfile {
@@ -106,7 +112,7 @@ impl CamProfile {
 
     /// Every closed-form piece over the master range (in ascending master order) with a
     /// function giving value and four derivatives.
-    pub(crate) fn for_each_piece(&self, f: &mut dyn FnMut(f64, f64, &dyn Fn(f64) -> [f64; 5])) {
+    pub(crate) fn for_each_piece(&self, f: &mut PieceVisitor<'_>) {
         match self {
             CamProfile::MotionFunction(mf) => mf.for_each_piece(f),
             CamProfile::Table(t) => {

@@ -264,7 +264,8 @@ impl MotionFunction {
             -1.0
         };
         for w in active.windows(2) {
-            if !((w[1].0.master - w[0].0.master) * sign > 0.0) {
+            // Finite by now: a plain comparison is exact.
+            if (w[1].0.master - w[0].0.master) * sign <= 0.0 {
                 return Err(CamError::MasterNotMonotonic {
                     point: w[1].0.index,
                     master: w[1].0.master,
@@ -279,7 +280,7 @@ impl MotionFunction {
             let (p, law, _) = w[0];
             let q = w[1].0;
             let symmetry = if law.has_symmetry() { p.jerk } else { 0.0 };
-            if law.has_symmetry() && !(symmetry.abs() < 0.5) {
+            if law.has_symmetry() && symmetry.abs() >= 0.5 {
                 return Err(CamError::Symmetry {
                     point: p.index,
                     value: p.jerk,
@@ -372,7 +373,7 @@ impl MotionFunction {
 
     /// The pieces with their master ranges in the original direction, each with a function
     /// that evaluates it (value and four derivatives), for characteristic values.
-    pub(crate) fn for_each_piece(&self, mut f: impl FnMut(f64, f64, &dyn Fn(f64) -> [f64; 5])) {
+    pub(crate) fn for_each_piece(&self, f: &mut super::PieceVisitor<'_>) {
         let s = self.sign;
         let mut ordered: Vec<&Piece> = self.pieces.iter().collect();
         if s < 0.0 {

@@ -88,7 +88,8 @@ impl PositionTable {
                     return Err(CamError::RowNotFinite { row, field });
                 }
             }
-            if row > 0 && !(r[0] > rows[row - 1][0]) {
+            // Both finite here (earlier rows were checked first).
+            if row > 0 && r[0] <= rows[row - 1][0] {
                 return Err(CamError::RowNotAscending {
                     row,
                     master: r[0],
