@@ -125,18 +125,27 @@ fn run(command: &CamCommand) -> Result<(), CliError> {
             binary,
         } => {
             let profile = load(file, binary)?;
-            let rows =
-                crate::cam::charac::value_table(&profile, 15, *from, *to, *step).map_err(|e| {
-                    CliError::Message(
-                        1,
-                        format!("error {:#06X} ({}): {e}", e.code() as u32, e.code().name()),
-                    )
+            // Streamed: the command line may ask for more rows than a PLC value table holds.
+            let rows = crate::cam::charac::sample_count(*from, *to, *step, 1_000_000_000)
+                .map_err(|e| {
+                    let code = e.code();
+                    CliError::Message(1, format!("error {:#06X} ({}): {e}", code as u32, code.name()))
                 })?;
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             writeln!(out, "master,position,velocity,acceleration,jerk")?;
-            for r in rows {
-                let cells: Vec<String> = r.iter().map(|v| num(*v)).collect();
-                writeln!(out, "{}", cells.join(","))?;
+            let mut cursor = ProfileCursor::default();
+            for i in 0..rows {
+                let x = from + step * i as f64;
+                let s = profile.eval(x, &mut cursor);
+                writeln!(
+                    out,
+                    "{},{},{},{},{}",
+                    num(x),
+                    num(s.position),
+                    num(s.velocity),
+                    num(s.acceleration),
+                    num(s.jerk)
+                )?;
             }
             out.flush()?;
             Ok(())

@@ -313,6 +313,25 @@ pub mod value_mask {
 /// Most rows of a value table.
 pub const MAX_VALUE_ROWS: usize = 1_000_000;
 
+/// Master positions from `from` to `to` (inclusive) in steps of `increment`: how many, or
+/// the refusal (zero step, a step away from `to`, more than `max_rows`).
+pub fn sample_count(from: f64, to: f64, increment: f64, max_rows: usize) -> Result<usize, CamError> {
+    let bad = CamError::Increment {
+        from,
+        to,
+        increment,
+        max_rows,
+    };
+    if !(from.is_finite() && to.is_finite() && increment.is_finite()) || increment == 0.0 {
+        return Err(bad);
+    }
+    let steps = (to - from) / increment;
+    if steps < -1e-9 || steps + 1.0 > max_rows as f64 {
+        return Err(bad);
+    }
+    Ok((steps + 1e-9).floor() as usize + 1)
+}
+
 /// `MC_ReadMotionFunctionValues`: rows `[master, selected values...]` from `from` to `to`
 /// (inclusive) in steps of `increment`; the columns are those of `mask`, in the order
 /// position, velocity, acceleration, jerk.
@@ -326,20 +345,7 @@ pub fn value_table(
     if mask == 0 || mask > 15 {
         return Err(CamError::ValueMask { mask });
     }
-    let bad = CamError::Increment {
-        from,
-        to,
-        increment,
-        max_rows: MAX_VALUE_ROWS,
-    };
-    if !(from.is_finite() && to.is_finite() && increment.is_finite()) || increment == 0.0 {
-        return Err(bad);
-    }
-    let steps = (to - from) / increment;
-    if steps < -1e-9 || steps + 1.0 > MAX_VALUE_ROWS as f64 {
-        return Err(bad);
-    }
-    let rows = (steps + 1e-9).floor() as usize + 1;
+    let rows = sample_count(from, to, increment, MAX_VALUE_ROWS)?;
     let mut cursor = super::ProfileCursor::default();
     Ok((0..rows)
         .map(|i| {
