@@ -126,11 +126,15 @@ fn run(command: &CamCommand) -> Result<(), CliError> {
         } => {
             let profile = load(file, binary)?;
             // Streamed: the command line may ask for more rows than a PLC value table holds.
-            let rows = crate::cam::charac::sample_count(*from, *to, *step, 1_000_000_000)
-                .map_err(|e| {
+            let rows = crate::cam::charac::sample_count(*from, *to, *step, 1_000_000_000).map_err(
+                |e| {
                     let code = e.code();
-                    CliError::Message(1, format!("error {:#06X} ({}): {e}", code as u32, code.name()))
-                })?;
+                    CliError::Message(
+                        1,
+                        format!("error {:#06X} ({}): {e}", code as u32, code.name()),
+                    )
+                },
+            )?;
             let mut out = std::io::BufWriter::new(std::io::stdout().lock());
             writeln!(out, "master,position,velocity,acceleration,jerk")?;
             let mut cursor = ProfileCursor::default();

@@ -181,16 +181,32 @@ fn a_closed_pipe_ends_eval_quietly() {
     use std::io::{BufRead, BufReader};
     use std::process::Stdio;
     let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["cam", "eval", &example("seed_example.json"), "--from", "0", "--to", "360", "--step", "0.0001"])
+        .args([
+            "cam",
+            "eval",
+            &example("seed_example.json"),
+            "--from",
+            "0",
+            "--to",
+            "360",
+            "--step",
+            "0.0001",
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let mut first = String::new();
-    BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
     assert_eq!(first.trim(), "master,position,velocity,acceleration,jerk");
     // The reader is gone: the 3.6 million rows behind it meet a closed pipe.
     let out = child.wait_with_output().unwrap();
     assert!(out.status.success(), "{:?}", out.status);
-    assert!(out.stderr.is_empty(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

@@ -315,7 +315,12 @@ pub const MAX_VALUE_ROWS: usize = 1_000_000;
 
 /// Master positions from `from` to `to` (inclusive) in steps of `increment`: how many, or
 /// the refusal (zero step, a step away from `to`, more than `max_rows`).
-pub fn sample_count(from: f64, to: f64, increment: f64, max_rows: usize) -> Result<usize, CamError> {
+pub fn sample_count(
+    from: f64,
+    to: f64,
+    increment: f64,
+    max_rows: usize,
+) -> Result<usize, CamError> {
     let bad = CamError::Increment {
         from,
         to,
