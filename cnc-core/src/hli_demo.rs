@@ -8,7 +8,7 @@
 //! axis commands are exercised without channels; `cnc demo` runs the real channels.
 
 use crate::axis::{AxisConfig, AxisSet};
-use crate::scenario::runner::{wait_for_attach, wait_for_exit};
+use crate::scenario::runner::{wait_for_attach, wait_for_exit, wait_for_first_cycle};
 use crate::stats::Percentiles;
 use hli::enums::{DynCsCommand, DynCsState};
 use hli::layout::{HliAxis, HliAxisLrState, HliCoordinateSystemInt, HliMFunctionRequest};
@@ -152,6 +152,7 @@ fn run(args: &DemoArgs) -> Result<(), String> {
         child.id()
     );
     wait_for_attach(&segment, &mut child)?;
+    wait_for_first_cycle(&segment, &events, &mut child)?;
 
     let view = CncView::new(segment.memory());
     let mut command_rx = view.dyn_cs_command(0).map_err(|e| e.to_string())?;

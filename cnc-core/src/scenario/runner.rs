@@ -436,6 +436,32 @@ pub fn wait_for_attach(segment: &CncSegment, child: &mut Child) -> Result<(), St
     }
 }
 
+/// Real-time start: beats and announces ticks until the PLC has run its first cycle, so the
+/// timed loop does not start while the PLC is still opening its services (attaching comes
+/// before that, and under load the gap can be longer than a short run).
+pub fn wait_for_first_cycle(
+    segment: &CncSegment,
+    events: &EventLink,
+    child: &mut Child,
+) -> Result<(), String> {
+    let watchdog = monotonic::now() + Duration::from_secs(20);
+    while segment.plc_heartbeat() == 0 {
+        segment.beat();
+        let _ = events.notify();
+        if let Ok(Some(status)) = child.try_wait() {
+            return Err(format!(
+                "the PLC process exited before its first cycle: {status}"
+            ));
+        }
+        if monotonic::now() > watchdog {
+            let _ = child.kill();
+            return Err("the PLC process did not run a cycle within 20 s of attaching".into());
+        }
+        let _ = events.wait(Duration::from_millis(1));
+    }
+    Ok(())
+}
+
 /// Waits (bounded) for the PLC process to stop and returns what it printed.
 pub fn wait_for_exit(mut child: Child) -> Result<String, String> {
     let watchdog = monotonic::now() + Duration::from_secs(10);
