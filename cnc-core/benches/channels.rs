@@ -50,8 +50,8 @@ fn idle(n: usize) -> f64 {
         .enumerate()
         .map(|(i, c)| Channel::new(i, c.clone(), s.cycle_s).expect("channel"))
         .collect();
-    let mut controller = Controller::new(channels, s.cycle_s).expect("controller");
-    let memory = hli::segment::heap_image(n as u32, controller.axis_images() as u32);
+    let mut controller = Controller::new(channels).expect("controller");
+    let memory = hli::segment::heap_image(n as u32, 32);
     let view = CncView::new(&memory);
     time(|| controller.tick(&view))
 }

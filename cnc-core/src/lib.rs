@@ -10,6 +10,7 @@ pub mod demo;
 pub mod hli_demo;
 pub mod json;
 pub mod kin_cli;
+pub mod machine;
 pub mod nc;
 pub mod scenario;
 pub mod stats;

@@ -37,7 +37,7 @@ fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
         channel.start(program);
         channels.push(channel);
     }
-    Controller::new(channels, CYCLE).unwrap()
+    Controller::new(channels).unwrap()
 }
 
 fn image(channels: usize) -> ImageMemory {

@@ -52,6 +52,8 @@ pub struct Axis {
     error: Option<AxisError>,
     coupling: Option<Coupling>,
     coupled_setpoint: Kinematic,
+    /// The set-point handed out by the last tick (what the actual position must match now).
+    last_set: Kinematic,
     io_fault: Option<AxisError>,
     actual: f64,
     actual_velocity: f64,
@@ -90,6 +92,7 @@ impl Axis {
             error: None,
             coupling: None,
             coupled_setpoint: Kinematic::default(),
+            last_set: Kinematic::default(),
             io_fault: None,
             actual: 0.0,
             actual_velocity: 0.0,
@@ -124,6 +127,10 @@ impl Axis {
     /// Whether the axis is enabled.
     pub fn enabled(&self) -> bool {
         self.enabled
+    }
+    /// The coupling that drives the axis, if any.
+    pub fn coupling(&self) -> Option<Coupling> {
+        self.coupling
     }
     /// The command book.
     pub fn book(&self) -> &CommandBook {
@@ -294,6 +301,11 @@ impl Axis {
         }
     }
 
+    /// Enables the axis as MC_Power would (for axes the CNC itself owns: channel axes).
+    pub fn switch_on(&mut self) -> Result<(), AxisError> {
+        self.power(1).map(|_| ())
+    }
+
     /// Couples the axis to an engine that hands in set-points with [`Axis::drive_coupled`].
     /// Refused while another command owns the axis is not needed: the coupling aborts it.
     pub fn couple(&mut self, coupling: Coupling) -> Result<(), AxisError> {
@@ -376,6 +388,10 @@ impl Axis {
             };
             if first {
                 self.generator.hold(self.actual);
+                self.last_set = Kinematic {
+                    position: self.actual,
+                    ..Kinematic::default()
+                };
             }
         }
         if let Some(cause) = self.io_fault {
@@ -384,8 +400,9 @@ impl Axis {
             }
         }
         // The actual position belongs to the set-point of the previous tick; this tick's
-        // generator step produces the set-point for the end of the coming tick.
-        let previous = self.setpoint();
+        // generator step (or the coupled engine, before this call) produces the set-point
+        // for the end of the coming tick.
+        let previous = self.last_set;
         if !self.enabled {
             self.generator.hold(self.actual);
         } else if self.error.is_none() {
@@ -409,6 +426,7 @@ impl Axis {
         } else {
             0.0
         };
+        self.last_set = set;
         self.outputs(enc_in, set)
     }
 

@@ -1,20 +1,16 @@
 //! The channels of a controller ticking together on one image: masters before the channels
-//! that follow them, so a slave sees its master's frame of the same tick. Each channel's axes
-//! take the next free axis images (`gpAx[k]^`), in channel order.
+//! that follow them, so a slave sees its master's frame of the same tick. Their axes live in
+//! the machine's axis set (`crate::machine`), which hands each channel's set-points on.
 
-use super::axes_out::AxisPublisher;
 use super::dyn_cs::MasterSample;
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
-use hli::layout::HLI_MAX_AXES;
 use hli::views::CncView;
 
 /// All channels.
 #[derive(Debug)]
 pub struct Controller {
     channels: Vec<Channel>,
-    axes: Vec<Option<AxisPublisher>>,
-    axis_images: usize,
     masters: [Option<MasterSample>; MAX_CHANNELS],
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
@@ -30,24 +26,12 @@ pub enum ControllerError {
 
 impl Controller {
     /// The channels, index = position.
-    pub fn new(channels: Vec<Channel>, cycle_s: f64) -> Result<Self, ControllerError> {
+    pub fn new(channels: Vec<Channel>) -> Result<Self, ControllerError> {
         if channels.len() > MAX_CHANNELS {
             return Err(ControllerError::TooManyChannels(channels.len()));
         }
-        let mut axes = Vec::with_capacity(channels.len());
-        let mut first = 0;
-        for c in &channels {
-            let n = c.config().axes.len();
-            let fits = first + n <= HLI_MAX_AXES;
-            axes.push(fits.then(|| AxisPublisher::new(first, c.set_points(), cycle_s)));
-            if fits {
-                first += n;
-            }
-        }
         Ok(Self {
             channels,
-            axes,
-            axis_images: first,
             masters: [None; MAX_CHANNELS],
             sync: SyncBoard::default(),
             order: core::array::from_fn(|i| i),
@@ -57,16 +41,6 @@ impl Controller {
     /// The channels.
     pub fn channels(&self) -> &[Channel] {
         &self.channels
-    }
-
-    /// Axis images the channels use together.
-    pub fn axis_images(&self) -> usize {
-        self.axis_images
-    }
-
-    /// Index of the first axis image of channel `index` (None: no room left in the image).
-    pub fn first_axis(&self, index: usize) -> Option<usize> {
-        self.axes.get(index)?.as_ref().map(AxisPublisher::first)
     }
 
     /// One channel, mutable (to start programs).
@@ -92,9 +66,6 @@ impl Controller {
             let i = self.order[k];
             self.channels[i].tick(view, &self.masters, &mut self.sync);
             self.masters[i] = self.channels[i].published();
-            if let Some(axes) = self.axes[i].as_mut() {
-                axes.publish(view, self.channels[i].set_points());
-            }
         }
     }
 }

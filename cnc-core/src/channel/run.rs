@@ -271,6 +271,14 @@ impl Channel {
         self.tool
     }
 
+    /// The tool pose that the given actual axis positions (channel order) realise.
+    pub fn realised_tool(&self, actual: &[f64]) -> Option<Isometry3<f64>> {
+        let mut j = [0.0; 6];
+        let n = actual.len().min(6);
+        j[..n].copy_from_slice(&actual[..n]);
+        self.kinematics.forward(&j).ok()
+    }
+
     /// M functions the PLC acknowledged (completed handshakes).
     pub fn m_functions_acked(&self) -> u64 {
         self.m_functions_acked

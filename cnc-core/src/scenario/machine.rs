@@ -4,94 +4,36 @@
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::trace::Trace;
-use crate::channel::{Channel, Controller, RunState};
-use hli::access::Leaf;
-use hli::enums::DynCsState;
-use hli::views::CncView;
+use crate::channel::Channel;
+pub use crate::machine::Machine;
+use crate::machine::MachineSetup;
 use hli::ImageMemory;
 use plc_shim::timeline::Timeline;
 
-/// The channels of a scenario, programs started.
-#[derive(Debug)]
-pub struct Machine {
-    controller: Controller,
-    heartbeat: Leaf,
-    ticks: u64,
-    max_tracking_error: Vec<f64>,
-}
-
-impl Machine {
-    /// Builds the channels and starts their programs.
-    pub fn new(scenario: &Scenario) -> Result<Machine, ScenarioError> {
-        let invalid = |message: String| ScenarioError::Invalid {
-            file: scenario.name.clone(),
-            message,
-        };
-        let mut channels = Vec::with_capacity(scenario.channels.len());
-        for (i, (config, program)) in scenario.channels.iter().zip(&scenario.programs).enumerate() {
-            let mut channel = Channel::new(i, config.clone(), scenario.cycle_s)
-                .map_err(|e| invalid(e.to_string()))?;
-            if let Some(p) = program {
-                channel.start(p.clone());
-            }
-            channels.push(channel);
+/// Builds the machine of a scenario: its channels with their programs started, channel axes
+/// on ideal drives.
+pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
+    let invalid = |message: String| ScenarioError::Invalid {
+        file: scenario.name.clone(),
+        message,
+    };
+    let mut channels = Vec::with_capacity(scenario.channels.len());
+    for (i, (config, program)) in scenario.channels.iter().zip(&scenario.programs).enumerate() {
+        let mut channel = Channel::new(i, config.clone(), scenario.cycle_s)
+            .map_err(|e| invalid(e.to_string()))?;
+        if let Some(p) = program {
+            channel.start(p.clone());
         }
-        let controller =
-            Controller::new(channels, scenario.cycle_s).map_err(|e| invalid(e.to_string()))?;
-        Ok(Machine {
-            controller,
-            heartbeat: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
-            ticks: 0,
-            max_tracking_error: vec![0.0; scenario.channels.len()],
-        })
+        channels.push(channel);
     }
-
-    /// One tick of every channel, then the heartbeat (the PLC's "a tick is done").
-    pub fn tick(&mut self, memory: &ImageMemory) {
-        self.controller.tick(&CncView::new(memory));
-        memory.place::<u64>(self.heartbeat.offset).increment();
-        self.ticks += 1;
-        for (c, max) in self
-            .controller
-            .channels()
-            .iter()
-            .zip(self.max_tracking_error.iter_mut())
-        {
-            if c.tracker().state() == DynCsState::Active {
-                let e = (c.tool_pose().translation.vector - c.pose_out().translation.vector).norm();
-                *max = max.max(e);
-            }
-        }
-    }
-
-    /// Per channel, the largest distance (mm) in ACTIVE between the tool point the joints
-    /// realise and the point on the moving workpiece it must be at, in the same tick.
-    pub fn max_tracking_error(&self) -> &[f64] {
-        &self.max_tracking_error
-    }
-
-    /// Ticks done.
-    pub fn ticks(&self) -> u64 {
-        self.ticks
-    }
-
-    /// Axis images the channels use (the image's axis count; at least 1).
-    pub fn axis_images(&self) -> usize {
-        self.controller.axis_images().max(1)
-    }
-
-    /// The channels.
-    pub fn controller(&self) -> &Controller {
-        &self.controller
-    }
-
-    /// Whether no channel runs a program any more.
-    pub fn idle(&self) -> bool {
-        self.controller
-            .channels()
-            .iter()
-            .all(|c| c.state() != RunState::Running)
-    }
+    Machine::new(MachineSetup {
+        channel_drives: vec![None; channels.len()],
+        channels,
+        axes: Vec::new(),
+        engines: Vec::new(),
+        cycle_s: scenario.cycle_s,
+    })
+    .map_err(|e| invalid(e.to_string()))
 }
 
 /// An in-process run: the machine, its image, the PLC timeline and the trace.
@@ -121,7 +63,7 @@ impl InProcess {
                 })
             }
         };
-        let machine = Machine::new(scenario)?;
+        let machine = build(scenario)?;
         let memory =
             hli::segment::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
         Ok(InProcess {

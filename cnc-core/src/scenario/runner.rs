@@ -14,14 +14,14 @@
 //! ```
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
-use super::machine::Machine;
+use super::machine::{build, Machine};
 use super::trace::Trace;
 use crate::channel::diagnosis::log_message;
 use crate::stats::Percentiles;
 use core::time::Duration;
 use hli::events::{EventLink, Side};
 use hli::raw::monotonic;
-use hli::rpc::{handle_read_axis_state, AcyclicServer, CallKind, ErrorCode};
+use hli::rpc::AcyclicServer;
 use hli::segment::CncSegment;
 use hli::views::CncView;
 use std::path::{Path, PathBuf};
@@ -184,7 +184,7 @@ pub fn main(args: RunArgs) -> ExitCode {
 
 /// Runs `scenario` as a CNC process with a spawned PLC process.
 pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, RunError> {
-    let mut machine = Machine::new(scenario)?;
+    let mut machine = build(scenario)?;
     run_machine(scenario, &mut machine, options).map_err(RunError::Process)
 }
 
@@ -245,10 +245,7 @@ fn run_machine(
         };
         trace.record(memory, tick, time);
         acyclic_answered += server
-            .poll(|kind, request| match kind {
-                CallKind::ReadAxisState => handle_read_axis_state(&view, request),
-                CallKind::AxisCommand => Err(ErrorCode::ServiceNotSupported),
-            })
+            .poll(|kind, request| machine.dispatch(&view, kind, request))
             .unwrap_or(0) as u64;
         let _ = events.notify();
         tick_ns.push((monotonic::now() - t0).as_nanos() as u64);

@@ -1,0 +1,121 @@
+//! A channel's axes on the axis layer: each channel axis is an `Axis` coupled to its channel
+//! (coupling kind `Channel`), fed the channel's set-point every tick with velocity and
+//! acceleration from differences, so it has a drive (ideal or simulated), a following error
+//! and an actual position like every other axis.
+
+use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
+use crate::axis::generator::Kinematic;
+use crate::axis::sim_drive::SimDriveConfig;
+use crate::axis::{AxisSet, Coupling};
+use crate::channel::config::ChannelConfig;
+use crate::nc::decode::AxisValues;
+use hli::enums::{AxisState, CouplingState};
+
+/// The link from one channel to its axes `first..first + count` of the axis set.
+#[derive(Debug, Clone)]
+pub struct ChannelAxes {
+    first: usize,
+    count: usize,
+    last: AxisValues,
+    last_velocity: AxisValues,
+    cycle_s: f64,
+}
+
+/// The axis configuration of channel axis `i` of `channel`: named `CHANNEL.AXIS`, standing at
+/// the channel's start position, no software limits of its own (the channel has them), the
+/// channel's dynamics for a stop after decoupling, and the given drive.
+pub fn axis_config(
+    channel: &ChannelConfig,
+    i: usize,
+    id: u32,
+    drive: SimDriveConfig,
+) -> AxisConfig {
+    let mut c = AxisConfig::linear(&format!("{}.{}", channel.name, channel.axes[i]), id);
+    c.soft_limits = None;
+    let l = channel.limits;
+    let usable = |v: f64| v.is_finite() && v > 0.0;
+    if usable(l.velocity) && usable(l.acceleration) && usable(l.jerk) {
+        c.dynamics = Dynamics {
+            velocity: l.velocity,
+            acceleration: l.acceleration,
+            deceleration: l.acceleration,
+            jerk: l.jerk,
+        };
+    }
+    c.drive = DriveLink::Simulated(SimDriveConfig {
+        start_position: channel.start.get(i).copied().unwrap_or(0.0),
+        ..drive
+    });
+    c
+}
+
+impl ChannelAxes {
+    /// Axes `first..first + start.len()`, standing at `start`.
+    pub fn new(first: usize, start: &AxisValues, cycle_s: f64) -> ChannelAxes {
+        ChannelAxes {
+            first,
+            count: start.len(),
+            last: *start,
+            last_velocity: AxisValues::zeros(start.len()),
+            cycle_s,
+        }
+    }
+
+    /// First axis of the channel in the axis set.
+    pub fn first(&self) -> usize {
+        self.first
+    }
+
+    /// Powers the channel's axes and couples them to the channel (before the first tick).
+    pub fn couple(&self, axes: &mut AxisSet) {
+        for i in self.first..self.first + self.count {
+            if let Some(axis) = axes.axis_mut(i) {
+                let _ = axis.switch_on();
+                let _ = axis.couple(Coupling {
+                    kind: CouplingState::Channel,
+                    master: -1,
+                    phase: AxisState::Standstill,
+                });
+            }
+        }
+    }
+
+    /// Hands the channel's set-points of this tick to its axes. Does not allocate.
+    pub fn drive(&mut self, axes: &mut AxisSet, set_points: &AxisValues) {
+        for (i, &p) in set_points.iter().enumerate().take(self.count) {
+            let v = (p - self.last[i]) / self.cycle_s;
+            let a = (v - self.last_velocity[i]) / self.cycle_s;
+            let phase = if v == 0.0 {
+                AxisState::Standstill
+            } else if a.abs() < 1e-9 {
+                AxisState::ConstantVelocity
+            } else if a * v > 0.0 {
+                AxisState::Accelerating
+            } else {
+                AxisState::Decelerating
+            };
+            if let Some(axis) = axes.axis_mut(self.first + i) {
+                axis.drive_coupled(
+                    Kinematic {
+                        position: p,
+                        velocity: v,
+                        acceleration: a,
+                        jerk: 0.0,
+                    },
+                    phase,
+                );
+            }
+            self.last[i] = p;
+            self.last_velocity[i] = v;
+        }
+    }
+
+    /// The actual positions of the channel's axes (channel order).
+    pub fn actual(&self, axes: &AxisSet) -> AxisValues {
+        let mut out = AxisValues::zeros(self.count);
+        for (i, v) in out.iter_mut().enumerate() {
+            *v = axes.axis(self.first + i).map_or(0.0, |a| a.actual());
+        }
+        out
+    }
+}

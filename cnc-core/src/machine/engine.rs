@@ -1,0 +1,45 @@
+//! The seam every motion engine plugs into (cams, FIFO groups, flying saw, gears): a tick
+//! with the HLI view and the axis set, the acyclic calls it owns, and its reaction to a fault.
+//!
+//! An engine never writes an axis block itself. It couples the axes it drives
+//! (`Axis::couple`) and hands each of them its set-point for the tick (`Axis::drive_coupled`);
+//! the axis stage then runs limits, following-error monitoring, the position controller and
+//! the drive, and is the only writer of `gpAx[k]^`.
+
+use crate::axis::AxisSet;
+use hli::rpc::{AcyclicRequest, CallKind, HandlerResult};
+use hli::views::CncView;
+
+/// What an engine sees in its tick.
+pub struct EngineIo<'a, 'm> {
+    /// The CNC side of the image (the engine's own HLI unit lives here).
+    pub view: &'a CncView<'m>,
+    /// Every axis of the machine: channel axes first, then single axes.
+    pub axes: &'a mut AxisSet,
+    /// Ticks done before this one.
+    pub tick: u64,
+}
+
+/// A motion engine in the machine tick.
+pub trait Engine: std::fmt::Debug + Send {
+    /// A short name for reports.
+    fn name(&self) -> &'static str;
+
+    /// One tick, after the channels and before the axes. Must not allocate, lock or do IO.
+    fn tick(&mut self, io: &mut EngineIo<'_, '_>);
+
+    /// An acyclic call this engine owns, answered; `None` when the call is not its own.
+    fn handle(
+        &mut self,
+        kind: CallKind,
+        request: &AcyclicRequest,
+        axes: &mut AxisSet,
+    ) -> Option<HandlerResult> {
+        let _ = (kind, request, axes);
+        None
+    }
+
+    /// The machine stops on a fault (lost PLC, signal): release every coupled axis so that
+    /// each stops with its own deceleration.
+    fn reset(&mut self, axes: &mut AxisSet);
+}

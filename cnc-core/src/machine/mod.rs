@@ -1,0 +1,287 @@
+//! One machine, one tick: the channels, every axis (channel axes and single axes in one
+//! `AxisSet`) and the engines, run in fixed stages once per CNC cycle.
+//!
+//! ```text
+//! tick N:
+//!   1 channels     masters before followers; each reads its PLC units (dyn-CS command and
+//!                  transition, M-function acknowledge) and writes its channel state
+//!   2 hand-over    each channel's set-points to its coupled axes (Axis::drive_coupled)
+//!   3 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
+//!   4 axes         every axis: inputs, generator or coupled set-point, following error,
+//!                  controller, drive; the only writer of the axis blocks gpAx[k]^
+//!   5 CNC units    heartbeat; tracking error measured on the actual axis positions
+//! between ticks:  acyclic calls (`dispatch`): engines first, then the axis commands
+//! ```
+//!
+//! The machine is library code: it knows no PLC program and no process. `cnc run`, the demo,
+//! the in-process runs, the benchmark and the no-allocation tests all drive this one `tick`.
+
+mod channel_axes;
+pub mod engine;
+pub mod gear;
+
+pub use channel_axes::ChannelAxes;
+pub use engine::{Engine, EngineIo};
+
+use crate::axis::config::AxisConfig;
+use crate::axis::set::AxisSetError;
+use crate::axis::sim_drive::SimDriveConfig;
+use crate::axis::AxisSet;
+use crate::channel::{Channel, Controller, ControllerError, RunState};
+use hli::access::Leaf;
+use hli::enums::DynCsState;
+use hli::layout::HLI_MAX_AXES;
+use hli::rpc::{
+    handle_read_axis_state, reply, AcyclicRequest, AxisCommandReply, CallKind, ErrorCode,
+    HandlerResult,
+};
+use hli::views::CncView;
+use hli::ImageMemory;
+use nalgebra::Isometry3;
+
+/// Why a machine cannot be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MachineError {
+    /// The channels.
+    #[error(transparent)]
+    Channels(#[from] ControllerError),
+    /// The axes.
+    #[error(transparent)]
+    Axes(#[from] AxisSetError),
+    /// Single axes that do not fit behind the channel axes.
+    #[error(
+        "{channel_axes} channel axes and {single} single axes: the image holds {HLI_MAX_AXES}"
+    )]
+    TooManyAxes {
+        /// Axis images the channels take.
+        channel_axes: usize,
+        /// Single axes configured.
+        single: usize,
+    },
+}
+
+/// What a machine is built from.
+#[derive(Debug)]
+pub struct MachineSetup {
+    /// The channels, programs started or not.
+    pub channels: Vec<Channel>,
+    /// Per channel, the drive its axes have (ideal when `None`).
+    pub channel_drives: Vec<Option<SimDriveConfig>>,
+    /// Single axes, behind the channel axes in the axis set and the image.
+    pub axes: Vec<AxisConfig>,
+    /// Engines, ticked in this order.
+    pub engines: Vec<Box<dyn Engine>>,
+    /// Tick, s.
+    pub cycle_s: f64,
+}
+
+/// Channels, axes and engines of one CNC.
+#[derive(Debug)]
+pub struct Machine {
+    controller: Controller,
+    axes: AxisSet,
+    links: Vec<Option<ChannelAxes>>,
+    single_axes: usize,
+    engines: Vec<Box<dyn Engine>>,
+    heartbeat: Leaf,
+    ticks: u64,
+    commanded: Vec<Isometry3<f64>>,
+    max_tracking_error: Vec<f64>,
+}
+
+impl Machine {
+    /// Builds the machine: channel axes take the first axis images (channel by channel, while
+    /// they fit), single axes follow.
+    pub fn new(setup: MachineSetup) -> Result<Machine, MachineError> {
+        let MachineSetup {
+            channels,
+            channel_drives,
+            axes,
+            engines,
+            cycle_s,
+        } = setup;
+        let mut configs = Vec::new();
+        let mut links = Vec::with_capacity(channels.len());
+        for (c, channel) in channels.iter().enumerate() {
+            let config = channel.config();
+            let n = config.axes.len();
+            if configs.len() + n > HLI_MAX_AXES {
+                links.push(None);
+                continue;
+            }
+            let drive = channel_drives.get(c).copied().flatten().unwrap_or_default();
+            links.push(Some(ChannelAxes::new(
+                configs.len(),
+                channel.set_points(),
+                cycle_s,
+            )));
+            for i in 0..n {
+                let id = configs.len() as u32 + 1;
+                configs.push(channel_axes::axis_config(config, i, id, drive));
+            }
+        }
+        let channel_axes = configs.len();
+        if channel_axes + axes.len() > HLI_MAX_AXES {
+            return Err(MachineError::TooManyAxes {
+                channel_axes,
+                single: axes.len(),
+            });
+        }
+        let single_axes = axes.len();
+        configs.extend(axes);
+        let mut axis_set = AxisSet::new(configs, cycle_s)?;
+        for link in links.iter().flatten() {
+            link.couple(&mut axis_set);
+        }
+        let n = channels.len();
+        Ok(Machine {
+            controller: Controller::new(channels)?,
+            axes: axis_set,
+            links,
+            single_axes,
+            engines,
+            heartbeat: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
+            ticks: 0,
+            commanded: vec![Isometry3::identity(); n],
+            max_tracking_error: vec![0.0; n],
+        })
+    }
+
+    /// Writes the simulated encoders' first readings (call once on a fresh image).
+    pub fn prime(&self, memory: &ImageMemory) {
+        self.axes.prime(&CncView::new(memory));
+    }
+
+    /// One tick of the whole machine (see the module docs for the stages). Does not allocate.
+    pub fn tick(&mut self, memory: &ImageMemory) {
+        let view = CncView::new(memory);
+        if self.ticks == 0 {
+            self.axes.prime(&view);
+        }
+        // 1 channels
+        self.controller.tick(&view);
+        // 2 hand-over
+        for (channel, link) in self.controller.channels().iter().zip(self.links.iter_mut()) {
+            if let Some(link) = link {
+                link.drive(&mut self.axes, channel.set_points());
+            }
+        }
+        // 3 engines
+        for engine in &mut self.engines {
+            engine.tick(&mut EngineIo {
+                view: &view,
+                axes: &mut self.axes,
+                tick: self.ticks,
+            });
+        }
+        // 4 axes
+        self.axes.tick(&view);
+        // 5 CNC units
+        memory.place::<u64>(self.heartbeat.offset).increment();
+        self.measure_tracking();
+        self.ticks += 1;
+    }
+
+    /// The tool point the actual joints realise against the commanded point of the tick the
+    /// drives were asked to reach (the previous one: an actual position belongs to the
+    /// previous set-point).
+    fn measure_tracking(&mut self) {
+        for (c, channel) in self.controller.channels().iter().enumerate() {
+            let Some(link) = &self.links[c] else { continue };
+            if channel.tracker().state() == DynCsState::Active && self.ticks > 0 {
+                let actual = link.actual(&self.axes);
+                if let Some(realised) = channel.realised_tool(&actual) {
+                    let e =
+                        (realised.translation.vector - self.commanded[c].translation.vector).norm();
+                    self.max_tracking_error[c] = self.max_tracking_error[c].max(e);
+                }
+            }
+            self.commanded[c] = *channel.pose_out();
+        }
+    }
+
+    /// Answers one acyclic call: an engine that owns it, else the axis layer. Commands to a
+    /// channel's axes are refused (`Coupled`): the channel owns them.
+    pub fn dispatch(
+        &mut self,
+        view: &CncView<'_>,
+        kind: CallKind,
+        request: &AcyclicRequest,
+    ) -> HandlerResult {
+        for engine in &mut self.engines {
+            if let Some(result) = engine.handle(kind, request, &mut self.axes) {
+                return result;
+            }
+        }
+        match kind {
+            CallKind::ReadAxisState => handle_read_axis_state(view, request),
+            CallKind::AxisCommand => {
+                let target = request.target as usize;
+                if target < self.channel_axes() {
+                    return reply(&AxisCommandReply {
+                        command_id: 0,
+                        error_id: hli::enums::AxisError::Coupled.raw(),
+                    });
+                }
+                if target >= self.axes.len() {
+                    return Err(ErrorCode::InvalidTarget);
+                }
+                self.axes.handle_command(request)
+            }
+        }
+    }
+
+    /// Per channel, the largest distance (mm) in ACTIVE between the tool point the actual
+    /// joint positions realise and the commanded point on the moving workpiece.
+    pub fn max_tracking_error(&self) -> &[f64] {
+        &self.max_tracking_error
+    }
+
+    /// Ticks done.
+    pub fn ticks(&self) -> u64 {
+        self.ticks
+    }
+
+    /// Axis images in use (at least 1).
+    pub fn axis_images(&self) -> usize {
+        self.axes.len().max(1)
+    }
+
+    /// Axis images the channels take (the single axes follow them).
+    pub fn channel_axes(&self) -> usize {
+        self.axes.len() - self.single_axes
+    }
+
+    /// First axis image of channel `index` (None: its axes did not fit in the image).
+    pub fn first_axis(&self, index: usize) -> Option<usize> {
+        self.links.get(index)?.as_ref().map(ChannelAxes::first)
+    }
+
+    /// The channels.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+
+    /// Every axis.
+    pub fn axes(&self) -> &AxisSet {
+        &self.axes
+    }
+
+    /// Every axis, mutable (tests and tools).
+    pub fn axes_mut(&mut self) -> &mut AxisSet {
+        &mut self.axes
+    }
+
+    /// The engines.
+    pub fn engines(&self) -> &[Box<dyn Engine>] {
+        &self.engines
+    }
+
+    /// Whether no channel runs a program any more.
+    pub fn idle(&self) -> bool {
+        self.controller
+            .channels()
+            .iter()
+            .all(|c| c.state() != RunState::Running)
+    }
+}
