@@ -128,6 +128,10 @@ impl Axis {
     pub fn enabled(&self) -> bool {
         self.enabled
     }
+    /// Whether the axis has read its encoder once (before that its position is unknown).
+    pub fn has_position(&self) -> bool {
+        self.counter.started()
+    }
     /// The coupling that drives the axis, if any.
     pub fn coupling(&self) -> Option<Coupling> {
         self.coupling

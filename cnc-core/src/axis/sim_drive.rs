@@ -32,6 +32,72 @@ pub enum Dynamic {
     },
 }
 
+/// A drive as machine files name it: a simulated model or an external drive.
+///
+/// ```toml
+/// drive = { model = "pt2", frequency_hz = 80.0, damping = 0.7, dead_time_ticks = 1 }
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "model", deny_unknown_fields)]
+pub enum DriveModel {
+    /// Simulated, follows its command exactly.
+    Ideal {
+        /// Ticks between command and motor.
+        #[serde(default)]
+        dead_time_ticks: u32,
+    },
+    /// Simulated first-order lag.
+    Pt1 {
+        /// Time constant, ms.
+        t1_ms: f64,
+        /// Ticks between command and motor.
+        #[serde(default)]
+        dead_time_ticks: u32,
+    },
+    /// Simulated second-order lag.
+    Pt2 {
+        /// Natural frequency, Hz.
+        frequency_hz: f64,
+        /// Damping ratio (1 = critically damped).
+        damping: f64,
+        /// Ticks between command and motor.
+        #[serde(default)]
+        dead_time_ticks: u32,
+    },
+    /// Something else writes the drive and encoder inputs (a field-bus task, a test).
+    External,
+}
+
+impl DriveModel {
+    /// The simulated drive of this model starting at `start` (None for an external drive).
+    pub fn simulated(self, start: f64) -> Option<SimDriveConfig> {
+        let (dynamic, dead_time_ticks) = match self {
+            DriveModel::Ideal { dead_time_ticks } => (Dynamic::Ideal, dead_time_ticks),
+            DriveModel::Pt1 {
+                t1_ms,
+                dead_time_ticks,
+            } => (Dynamic::Pt1 { t1_s: t1_ms * 1e-3 }, dead_time_ticks),
+            DriveModel::Pt2 {
+                frequency_hz,
+                damping,
+                dead_time_ticks,
+            } => (
+                Dynamic::Pt2 {
+                    frequency_hz,
+                    damping,
+                },
+                dead_time_ticks,
+            ),
+            DriveModel::External => return None,
+        };
+        Some(SimDriveConfig {
+            dynamic,
+            dead_time_ticks,
+            start_position: start,
+        })
+    }
+}
+
 /// Configuration of a simulated drive.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 pub struct SimDriveConfig {

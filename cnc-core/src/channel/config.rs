@@ -43,6 +43,9 @@ pub struct ChannelConfig {
     /// NC program the channel starts with, a path relative to the configuration file.
     #[serde(default)]
     pub program: Option<String>,
+    /// The drive of every axis of the channel (simulated ideal when absent).
+    #[serde(default)]
+    pub drive: Option<crate::axis::sim_drive::DriveModel>,
 }
 
 /// `provide_channel_interface.*`.
@@ -155,6 +158,7 @@ impl ChannelConfig {
             ori_rotation_angle: 0,
             interpolator: InterpolatorConfig::default(),
             program: None,
+            drive: None,
         }
     }
 

@@ -5,7 +5,7 @@
 
 use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
 use crate::axis::generator::Kinematic;
-use crate::axis::sim_drive::SimDriveConfig;
+use crate::axis::sim_drive::DriveModel;
 use crate::axis::{AxisSet, Coupling};
 use crate::channel::config::ChannelConfig;
 use crate::nc::decode::AxisValues;
@@ -23,13 +23,9 @@ pub struct ChannelAxes {
 
 /// The axis configuration of channel axis `i` of `channel`: named `CHANNEL.AXIS`, standing at
 /// the channel's start position, no software limits of its own (the channel has them), the
-/// channel's dynamics for a stop after decoupling, and the given drive.
-pub fn axis_config(
-    channel: &ChannelConfig,
-    i: usize,
-    id: u32,
-    drive: SimDriveConfig,
-) -> AxisConfig {
+/// channel's dynamics for a stop after decoupling, and the channel's drive (ideal when the
+/// configuration names none).
+pub fn axis_config(channel: &ChannelConfig, i: usize, id: u32) -> AxisConfig {
     let mut c = AxisConfig::linear(&format!("{}.{}", channel.name, channel.axes[i]), id);
     c.soft_limits = None;
     let l = channel.limits;
@@ -42,10 +38,14 @@ pub fn axis_config(
             jerk: l.jerk,
         };
     }
-    c.drive = DriveLink::Simulated(SimDriveConfig {
-        start_position: channel.start.get(i).copied().unwrap_or(0.0),
-        ..drive
-    });
+    let start = channel.start.get(i).copied().unwrap_or(0.0);
+    let model = channel
+        .drive
+        .unwrap_or(DriveModel::Ideal { dead_time_ticks: 0 });
+    c.drive = match model.simulated(start) {
+        Some(sim) => DriveLink::Simulated(sim),
+        None => DriveLink::External,
+    };
     c
 }
 

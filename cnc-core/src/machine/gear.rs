@@ -112,7 +112,11 @@ impl Engine for GearEngine {
                     master: master as i32,
                     phase: AxisState::SlaveSynchronous,
                 };
-                if !axis.enabled() || axis.error().is_some() || axis.couple(coupling).is_err() {
+                if !axis.enabled()
+                    || !axis.has_position()
+                    || axis.error().is_some()
+                    || axis.couple(coupling).is_err()
+                {
                     continue;
                 }
                 gear.origin = Some((m.position, axis.setpoint().position));

@@ -25,7 +25,6 @@ pub use engine::{Engine, EngineIo};
 
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
-use crate::axis::sim_drive::SimDriveConfig;
 use crate::axis::AxisSet;
 use crate::channel::{Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
@@ -65,8 +64,6 @@ pub enum MachineError {
 pub struct MachineSetup {
     /// The channels, programs started or not.
     pub channels: Vec<Channel>,
-    /// Per channel, the drive its axes have (ideal when `None`).
-    pub channel_drives: Vec<Option<SimDriveConfig>>,
     /// Single axes, behind the channel axes in the axis set and the image.
     pub axes: Vec<AxisConfig>,
     /// Engines, ticked in this order.
@@ -95,21 +92,19 @@ impl Machine {
     pub fn new(setup: MachineSetup) -> Result<Machine, MachineError> {
         let MachineSetup {
             channels,
-            channel_drives,
             axes,
             engines,
             cycle_s,
         } = setup;
         let mut configs = Vec::new();
         let mut links = Vec::with_capacity(channels.len());
-        for (c, channel) in channels.iter().enumerate() {
+        for channel in &channels {
             let config = channel.config();
             let n = config.axes.len();
             if configs.len() + n > HLI_MAX_AXES {
                 links.push(None);
                 continue;
             }
-            let drive = channel_drives.get(c).copied().flatten().unwrap_or_default();
             links.push(Some(ChannelAxes::new(
                 configs.len(),
                 channel.set_points(),
@@ -117,7 +112,7 @@ impl Machine {
             )));
             for i in 0..n {
                 let id = configs.len() as u32 + 1;
-                configs.push(channel_axes::axis_config(config, i, id, drive));
+                configs.push(channel_axes::axis_config(config, i, id));
             }
         }
         let channel_axes = configs.len();

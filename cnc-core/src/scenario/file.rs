@@ -52,6 +52,10 @@ struct ScenarioFile {
     cycle_ms: f64,
     ticks: Option<u64>,
     channel: Vec<ChannelConfig>,
+    #[serde(default)]
+    axis: Vec<super::axes::AxisFile>,
+    #[serde(default)]
+    gear: Vec<super::axes::GearFile>,
     plc: Option<PlcFile>,
     #[serde(default)]
     trace: TraceFile,
@@ -107,6 +111,10 @@ pub struct Scenario {
     pub channels: Vec<ChannelConfig>,
     /// Their programs, checked (None: the channel stays idle).
     pub programs: Vec<Option<LoadedProgram>>,
+    /// Single axes, behind the channel axes.
+    pub axes: Vec<super::axes::ScenarioAxis>,
+    /// Gear couplings between axes (indices in the machine's axis set).
+    pub gears: Vec<crate::machine::gear::GearSpec>,
     /// The PLC.
     pub plc: PlcSetup,
     /// Trace signals: ST path and resolved leaf.
@@ -204,6 +212,19 @@ impl Scenario {
                 ))
             }
         };
+        let channel_axes = super::axes::axis_names(&file.channel, &[]).len();
+        let axes = super::axes::axes(&file.axis, channel_axes as u32 + 1).map_err(&invalid)?;
+        if channel_axes + axes.len() > hli::layout::HLI_MAX_AXES {
+            return Err(invalid(format!(
+                "{channel_axes} channel axes and {} [[axis]]: the image holds {}",
+                axes.len(),
+                hli::layout::HLI_MAX_AXES
+            )));
+        }
+        let names = super::axes::axis_names(&file.channel, &axes);
+        let gears = super::axes::gears(&file.gear, &names).map_err(&invalid)?;
+        crate::machine::gear::GearEngine::new(&gears, names.len())
+            .map_err(|e| invalid(e.to_string()))?;
         let mut signals = Vec::with_capacity(file.trace.signals.len());
         for s in file.trace.signals {
             let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;
@@ -215,6 +236,8 @@ impl Scenario {
             ticks: file.ticks,
             channels: file.channel,
             programs,
+            axes,
+            gears,
             plc,
             signals,
         })

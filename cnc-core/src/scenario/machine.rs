@@ -5,6 +5,7 @@
 use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::trace::Trace;
 use crate::channel::Channel;
+use crate::machine::gear::GearEngine;
 pub use crate::machine::Machine;
 use crate::machine::MachineSetup;
 use hli::ImageMemory;
@@ -26,14 +27,29 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         }
         channels.push(channel);
     }
-    Machine::new(MachineSetup {
-        channel_drives: vec![None; channels.len()],
+    let mut engines: Vec<Box<dyn crate::machine::Engine>> = Vec::new();
+    let channel_axes = super::axes::axis_names(&scenario.channels, &[]).len();
+    if !scenario.gears.is_empty() {
+        let total = channel_axes + scenario.axes.len();
+        let gears = GearEngine::new(&scenario.gears, total).map_err(|e| invalid(e.to_string()))?;
+        engines.push(Box::new(gears));
+    }
+    let mut machine = Machine::new(MachineSetup {
         channels,
-        axes: Vec::new(),
-        engines: Vec::new(),
+        axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),
+        engines,
         cycle_s: scenario.cycle_s,
     })
-    .map_err(|e| invalid(e.to_string()))
+    .map_err(|e| invalid(e.to_string()))?;
+    for (i, a) in scenario.axes.iter().enumerate() {
+        if a.power {
+            if let Some(axis) = machine.axes_mut().axis_mut(channel_axes + i) {
+                axis.switch_on()
+                    .map_err(|e| invalid(format!("[[axis]] {:?}: power: {e:?}", a.config.name)))?;
+            }
+        }
+    }
+    Ok(machine)
 }
 
 /// An in-process run: the machine, its image, the PLC timeline and the trace.

@@ -1,6 +1,7 @@
 //! Scenarios: a machine configuration with programs, a PLC part and a trace, run by
 //! `cnc run` (two processes, real-time or lockstep) or in-process by tests.
 
+pub mod axes;
 pub mod file;
 pub mod fleet;
 pub mod machine;

@@ -1,0 +1,114 @@
+//! The machine tick: channel axes on the axis layer, single axes and an engine (gears) in one
+//! tick; scenario `[[axis]]` and `[[gear]]` tables, refused with file, key and reason.
+
+use cnc_core::scenario::{InProcess, Scenario, ScenarioError};
+use hli::enums::CouplingState;
+use hli::layout::{HliAxis, HliAxisLrState};
+use hli::views::CncView;
+use hli::PlaceExt;
+use std::path::PathBuf;
+
+/// Channel axes take images 0..6; the single axis follows.
+const FEED: usize = 6;
+
+const PROGRAM: &str = "%conveyor\nG1 X100 F6000\nG1 X40 F3000\nM30\n";
+
+fn scenario(extra: &str) -> Result<Scenario, ScenarioError> {
+    let toml = format!(
+        "cycle_ms = 1.0\n[[channel]]\nname = \"conveyor\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"c.nc\"\n\
+         drive = {{ model = \"pt1\", t1_ms = 2.0 }}\n{extra}"
+    );
+    Scenario::parse("machine.toml", &toml, |f| {
+        Ok((PathBuf::from(f), PROGRAM.to_string()))
+    })
+}
+
+fn lr(memory: &hli::ImageMemory, axis: usize) -> HliAxisLrState {
+    CncView::new(memory)
+        .axis(axis)
+        .unwrap()
+        .field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
+        .read()
+}
+
+const GEARED: &str =
+    "[[axis]]\nname = \"Feed\"\npower = true\nstart = 5.0\nsoft_limits = [-500.0, 500.0]\n\
+    drive = { model = \"pt2\", frequency_hz = 60.0, damping = 0.9 }\n\
+    [[gear]]\nmaster = \"conveyor.X\"\nslave = \"Feed\"\nratio = -2.0\n";
+
+#[test]
+fn a_gear_slave_follows_a_channel_axis_through_simulated_drives() {
+    let s = scenario(GEARED).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut max_fe: f64 = 0.0;
+    let mut ticks = 0;
+    let mut last: Option<(f64, f64, bool)> = None;
+    while !run.machine.idle() || ticks < 3000 {
+        run.step(s.cycle_s);
+        ticks += 1;
+        assert!(ticks < 20_000, "watchdog: the program did not end");
+        let feed = run.machine.axes().axis(FEED).unwrap();
+        assert!(feed.error().is_none(), "{:?}", feed.error());
+        max_fe = max_fe.max(feed.following_error().abs());
+        // Once coupled, the slave's set-point moves by -2 times the master's, tick by tick.
+        let m = run.machine.axes().axis(0).unwrap().setpoint().position;
+        let f = feed.setpoint().position;
+        if let Some((m0, f0, coupled)) = last {
+            if coupled {
+                assert!(((f - f0) + 2.0 * (m - m0)).abs() < 1e-9, "tick {ticks}");
+            }
+        }
+        last = Some((m, f, feed.coupling().is_some()));
+    }
+    // The conveyor stands at X40, so the slave at 5 - 80; both drives settled on it.
+    let conveyor = run.machine.axes().axis(0).unwrap();
+    let feed = run.machine.axes().axis(FEED).unwrap();
+    assert!(
+        (conveyor.actual() - 40.0).abs() < 1e-3,
+        "{}",
+        conveyor.actual()
+    );
+    assert!((feed.actual() + 75.0).abs() < 1e-3, "{}", feed.actual());
+    // The drives lag: a following error shows while moving (ideal drives show none).
+    assert!(max_fe > 0.01, "max following error {max_fe}");
+    let image = lr(&run.memory, FEED);
+    assert_eq!(image.coupling_state_r, CouplingState::GearVelocity.raw());
+    assert_eq!(image.master_axis_r, 0);
+    assert_eq!(
+        lr(&run.memory, 0).coupling_state_r,
+        CouplingState::Channel.raw()
+    );
+}
+
+#[test]
+fn an_unpowered_gear_slave_stays_uncoupled() {
+    let s = scenario(&GEARED.replace("power = true\n", "")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..500 {
+        run.step(s.cycle_s);
+    }
+    let feed = run.machine.axes().axis(FEED).unwrap();
+    assert!(feed.coupling().is_none());
+    assert_eq!(feed.actual(), 5.0);
+}
+
+#[test]
+fn bad_axes_and_gears_are_refused_with_key_and_reason() {
+    for (extra, expect) in [
+        ("[[axis]]\nkind = \"linear\"\n", "missing field `name`"),
+        ("[[axis]]\nname = \"A\"\nmodulo = 360.0\n", "\"A\": modulo"),
+        ("[[axis]]\nname = \"A\"\nkind = \"rotary\"\nsoft_limits = [0.0, 1.0]\n", "\"A\": soft_limits"),
+        ("[[axis]]\nname = \"A\"\nsoft_limits = [5.0, 1.0]\n", "minimum must lie below"),
+        ("[[axis]]\nname = \"A\"\nvelocity = -1.0\n", "dynamics.velocity"),
+        ("[[axis]]\nname = \"A\"\nspeed = 1.0\n", "unknown field `speed`"),
+        ("[[axis]]\nname = \"A\"\n[[axis]]\nname = \"A\"\n", "given twice"),
+        ("[[axis]]\nname = \"A\"\ndrive = { model = \"pt3\" }\n", "pt3"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.Q\"\nslave = \"A\"\nratio = 1.0\n", "master \"conveyor.Q\": no such axis"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"A\"\nratio = 1.0\n", "its own master"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.X\"\nslave = \"A\"\nratio = 0.0\n", "ratio 0"),
+    ] {
+        let e = scenario(extra).expect_err(extra).to_string();
+        assert!(e.starts_with("machine.toml:"), "{e}");
+        assert!(e.contains(expect), "{extra}: {e}");
+    }
+}
