@@ -86,7 +86,12 @@ pub fn main(args: DemoArgs) -> ExitCode {
         .clone()
         .unwrap_or_else(|| format!("demo-{}", std::process::id()));
     let mut failed = false;
+    let mut stopped = None;
+    hli::signals::capture();
     for (i, example) in EXAMPLES.iter().enumerate() {
+        if stopped.is_some() {
+            break;
+        }
         println!(
             "== {} ({} mode)",
             example.name,
@@ -108,10 +113,13 @@ pub fn main(args: DemoArgs) -> ExitCode {
             lockstep: args.lockstep,
             instance: format!("{prefix}-{i}"),
             scratch: args.out.clone(),
+            plc_watchdog_ticks: None,
         };
         match run(&scenario, &options) {
             Ok(report) => {
                 print!("{}", report.render(false));
+                // A stop (signal, lost PLC) ends the demo after this example's trace.
+                stopped = report.stop.as_ref().map(|c| c.exit_code());
                 failed |= report
                     .channels
                     .iter()
@@ -133,7 +141,9 @@ pub fn main(args: DemoArgs) -> ExitCode {
     }
     let folder = std::fs::canonicalize(&args.out).unwrap_or(args.out);
     println!("traces written to {}", folder.display());
-    if failed {
+    if let Some(code) = stopped {
+        ExitCode::from(code)
+    } else if failed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

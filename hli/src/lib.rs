@@ -23,6 +23,7 @@ pub mod layout;
 pub mod raw;
 pub mod rpc;
 pub mod segment;
+pub mod signals;
 pub mod symbols;
 pub mod units;
 pub mod views;

@@ -126,6 +126,9 @@ pub enum TrackError {
     /// The compensation could not be computed (non-finite frame).
     #[error("invalid master frame")]
     BadFrame,
+    /// The machine stopped (its PLC was lost, or a stop was requested).
+    #[error("machine stop")]
+    MachineStop,
 }
 
 /// One line of the diagnosis history: what went in and out of the dynamic CS in one tick.

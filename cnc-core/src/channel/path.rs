@@ -38,6 +38,8 @@ pub struct PathMove {
     delta: AxisValues,
     length: f64,
     done: bool,
+    /// Stopped by `brake`: the block ends where the path stands.
+    braked: bool,
 }
 
 /// Why a block cannot be interpolated.
@@ -117,6 +119,7 @@ impl PathMove {
             delta,
             length,
             done: false,
+            braked: false,
         }))
     }
 
@@ -127,19 +130,27 @@ impl PathMove {
         if !self.done {
             self.done = matches!(generator.step(), Progress::Reached | Progress::Idle);
         }
-        let s = if self.done {
+        let s = if self.done && !self.braked {
             1.0
         } else {
             (generator.state().position / self.length).clamp(0.0, 1.0)
         };
         for (i, p) in position.iter_mut().enumerate() {
-            *p = if self.done {
+            *p = if self.done && !self.braked {
                 self.start[i] + self.delta[i]
             } else {
                 self.start[i] + self.delta[i] * s
             };
         }
         self.done
+    }
+
+    /// Brakes along the block to a standstill with `deceleration` and `jerk` (path units);
+    /// the block then ends where the path came to rest, short of its target.
+    pub fn brake(&mut self, generator: &mut SetpointGenerator, deceleration: f64, jerk: f64) {
+        if !self.done && generator.brake(deceleration, jerk).is_ok() {
+            self.braked = true;
+        }
     }
 
     /// Block length.

@@ -119,6 +119,8 @@ pub struct Channel {
     path_generator: SetpointGenerator,
     /// Per axis: its generator for independent moves and whether one is under way.
     independent: Vec<(SetpointGenerator, bool)>,
+    /// A controlled stop in progress, with the reason the channel will end with.
+    stopping: Option<&'static str>,
     trafo: bool,
     cs_stack: [Isometry3<f64>; CS_DEPTH],
     cs_len: usize,
@@ -184,6 +186,7 @@ impl Channel {
             programmed: set_points,
             path: None,
             path_generator: SetpointGenerator::new(cycle_s, 0.0),
+            stopping: None,
             independent: (0..n)
                 .map(|_| (SetpointGenerator::new(cycle_s, 0.0), false))
                 .collect(),
@@ -313,6 +316,34 @@ impl Channel {
         self.path.is_some() || self.independent.iter().any(|(_, active)| *active)
     }
 
+    /// A controlled stop (supervision, signals): the path brakes along its block with the
+    /// channel's acceleration and jerk, independent axes brake, tracking goes to ERROR holding
+    /// its compensation, no further block starts; at rest the channel ends in ERROR with
+    /// `reason`. Does not allocate until the channel is at rest.
+    pub fn stop(&mut self, reason: &'static str) {
+        if self.stopping.is_some() {
+            return;
+        }
+        let (dec, jerk) = (self.limits.acceleration, self.limits.jerk);
+        if let Some(path) = self.path.as_mut() {
+            path.brake(&mut self.path_generator, dec, jerk);
+        }
+        for (g, active) in &mut self.independent {
+            if *active && g.brake(dec, jerk).is_err() {
+                *active = false;
+            }
+        }
+        if self.tracker.state() != DynCsState::Inactive {
+            self.tracker.fail(TrackError::MachineStop);
+        }
+        self.stopping = Some(reason);
+    }
+
+    /// Whether a stop was requested and the channel has not come to rest yet.
+    pub fn stopping(&self) -> bool {
+        self.stopping.is_some() && self.is_moving()
+    }
+
     fn fail(&mut self, message: String) {
         self.error = Some(ChannelError {
             line: self.line,
@@ -336,10 +367,15 @@ impl Channel {
     ) {
         self.tick += 1;
         self.plc_inputs(view);
-        if self.state == RunState::Running {
+        if self.state == RunState::Running && self.stopping.is_none() {
             self.interpret(view, masters, sync);
         }
         self.advance();
+        if let Some(reason) = self.stopping {
+            if self.state == RunState::Running && !self.is_moving() {
+                self.fail(reason.to_string());
+            }
+        }
         let master = self.master_sample(masters);
         self.tracker.tick(master);
         self.update_pose();

@@ -31,8 +31,8 @@ use hli::access::Leaf;
 use hli::enums::DynCsState;
 use hli::layout::HLI_MAX_AXES;
 use hli::rpc::{
-    handle_read_axis_state, reply, AcyclicRequest, AxisCommandReply, CallKind, ErrorCode,
-    HandlerResult,
+    handle_read_axis_state, reply, AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind,
+    ErrorCode, HandlerResult,
 };
 use hli::views::CncView;
 use hli::ImageMemory;
@@ -224,6 +224,39 @@ impl Machine {
                 self.axes.handle_command(request)
             }
         }
+    }
+
+    /// Brings the machine to a safe state (supervision, signals): every channel stops on
+    /// its path with its deceleration and its tracking goes to ERROR holding the last frame;
+    /// engines release their axes; every single axis stops with its own deceleration and
+    /// jerk (MC_Stop, which keeps the axis locked). Ticks go on until `at_rest`.
+    pub fn stop(&mut self, reason: &'static str) {
+        for i in 0..self.controller.channels().len() {
+            if let Some(c) = self.controller.channel_mut(i) {
+                c.stop(reason);
+            }
+        }
+        for engine in &mut self.engines {
+            engine.reset(&mut self.axes);
+        }
+        for i in self.channel_axes()..self.axes.len() {
+            if let Some(axis) = self.axes.axis_mut(i) {
+                let d = axis.config().dynamics;
+                // Refused only by an axis that is disabled or in error: it stands already.
+                let _ = axis.command(&AxisCommandCall::stop(d.deceleration, d.jerk));
+            }
+        }
+    }
+
+    /// Whether every channel and every axis has come to rest (set-point velocity 0).
+    pub fn at_rest(&self) -> bool {
+        let channels = self.controller.channels().iter().all(|c| !c.stopping());
+        let axes = (0..self.axes.len()).all(|i| {
+            self.axes
+                .axis(i)
+                .is_none_or(|a| a.setpoint().velocity == 0.0)
+        });
+        channels && axes
     }
 
     /// Per channel, the largest distance (mm) in ACTIVE between the tool point the actual

@@ -113,7 +113,7 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
             other => return Err(key(&format!("kind {other:?}: \"linear\" or \"rotary\""))),
         };
         if let Some(l) = f.soft_limits {
-            if !(l[0] < l[1]) {
+            if l[0].partial_cmp(&l[1]) != Some(std::cmp::Ordering::Less) {
                 return Err(key(&format!(
                     "soft_limits {l:?}: the minimum must lie below the maximum"
                 )));

@@ -51,6 +51,7 @@ struct ScenarioFile {
     #[serde(default = "default_cycle_ms")]
     cycle_ms: f64,
     ticks: Option<u64>,
+    plc_watchdog_ticks: Option<u64>,
     channel: Vec<ChannelConfig>,
     #[serde(default)]
     axis: Vec<super::axes::AxisFile>,
@@ -107,6 +108,8 @@ pub struct Scenario {
     pub cycle_s: f64,
     /// Default run length.
     pub ticks: Option<u64>,
+    /// Ticks without a PLC cycle before the PLC counts as lost.
+    pub plc_watchdog_ticks: Option<u64>,
     /// The channels.
     pub channels: Vec<ChannelConfig>,
     /// Their programs, checked (None: the channel stays idle).
@@ -234,6 +237,7 @@ impl Scenario {
             name: name.to_string(),
             cycle_s: file.cycle_ms * 1e-3,
             ticks: file.ticks,
+            plc_watchdog_ticks: file.plc_watchdog_ticks,
             channels: file.channel,
             programs,
             axes,

@@ -56,6 +56,10 @@ pub struct RunArgs {
     /// Where `#TRACK CS ON [LOG_FILE=..]` files with a relative name are written.
     #[arg(long, default_value = ".")]
     pub log_dir: PathBuf,
+    /// Ticks without a PLC cycle before the CNC declares the PLC lost and stops the machine
+    /// (default: the scenario's `plc_watchdog_ticks`, else 100).
+    #[arg(long)]
+    pub plc_watchdog_ticks: Option<u64>,
 }
 
 /// How to run.
@@ -69,7 +73,55 @@ pub struct RunOptions {
     pub instance: String,
     /// Where a timeline that exists only in memory is written for the PLC process.
     pub scratch: PathBuf,
+    /// See [`RunArgs::plc_watchdog_ticks`].
+    pub plc_watchdog_ticks: Option<u64>,
 }
+
+/// Why a run stopped before its end.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StopCause {
+    /// The PLC stopped cycling.
+    PlcLost {
+        /// The tick the CNC noticed it.
+        tick: u64,
+        /// What happened to the PLC process.
+        detail: String,
+    },
+    /// SIGINT or SIGTERM.
+    Signal {
+        /// The tick it was noticed at.
+        tick: u64,
+        /// Which.
+        signal: hli::signals::Termination,
+    },
+}
+
+impl StopCause {
+    /// The exit code `cnc run` ends with: 4 for a lost PLC, 128 + signal for a signal.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            StopCause::PlcLost { .. } => 4,
+            StopCause::Signal { signal, .. } => signal.exit_code(),
+        }
+    }
+
+    /// The one line logged when the stop begins.
+    pub fn message(&self) -> String {
+        match self {
+            StopCause::PlcLost { tick, detail } => {
+                format!("PLC lost at tick {tick}: {detail}; stopping the machine")
+            }
+            StopCause::Signal { tick, signal } => {
+                format!("{} at tick {tick}: stopping the machine", signal.name())
+            }
+        }
+    }
+}
+
+/// Default of `plc_watchdog_ticks`.
+pub const DEFAULT_PLC_WATCHDOG_TICKS: u64 = 100;
+/// Longest controlled stop before the run ends anyway, seconds of ticks.
+const STOP_LIMIT_S: f64 = 10.0;
 
 /// One channel at the end of a run.
 #[derive(Debug, Clone)]
@@ -118,6 +170,11 @@ pub struct RunReport {
     pub plc_output: String,
     /// The trace.
     pub trace: Trace,
+    /// Why the run stopped early, if it did.
+    pub stop: Option<StopCause>,
+    /// Ticks from the stop until every channel and axis stood still (None: not within the
+    /// stop limit).
+    pub rest_after: Option<u64>,
 }
 
 /// `cnc run`.
@@ -138,7 +195,9 @@ pub fn main(args: RunArgs) -> ExitCode {
         lockstep: args.lockstep,
         scratch: std::env::temp_dir(),
         instance,
+        plc_watchdog_ticks: args.plc_watchdog_ticks,
     };
+    hli::signals::capture();
     match run(&scenario, &options) {
         Ok(report) => {
             print!("{}", report.render(args.diagnosis));
@@ -160,7 +219,9 @@ pub fn main(args: RunArgs) -> ExitCode {
                     return ExitCode::from(1);
                 }
             }
-            if report
+            if let Some(cause) = &report.stop {
+                ExitCode::from(cause.exit_code())
+            } else if report
                 .channels
                 .iter()
                 .any(|c| c.outcome.starts_with("error"))
@@ -211,6 +272,12 @@ fn run_machine(
         .or(scenario.ticks)
         .unwrap_or(DEFAULT_TICK_LIMIT);
     let rows = usize::try_from(limit).map_err(|_| "--ticks too large".to_string())?;
+    let watchdog = options
+        .plc_watchdog_ticks
+        .or(scenario.plc_watchdog_ticks)
+        .unwrap_or(DEFAULT_PLC_WATCHDOG_TICKS)
+        .max(1);
+    let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
     let mut trace = Trace::new(&scenario.signals, rows);
     let mut tick_ns = Vec::with_capacity(rows);
     let mut late_ns = Vec::with_capacity(rows);
@@ -219,21 +286,36 @@ fn run_machine(
     let view = CncView::new(memory);
     let period = Duration::from_secs_f64(scenario.cycle_s);
     let start = monotonic::now();
-    let mut result = Ok(());
+    let mut stop: Option<(StopCause, u64)> = None;
+    let mut plc_seen = (segment.plc_heartbeat(), 0u64);
 
+    let mut rest_after = None;
     for tick in 0..limit {
-        if options.ticks.is_none() && scenario.ticks.is_none() && machine.idle() {
-            break;
+        match &stop {
+            Some((_, since)) if machine.at_rest() => {
+                rest_after = Some(tick - since);
+                break;
+            }
+            Some((_, since)) if tick - since > stop_limit => break,
+            Some(_) => {}
+            None if options.ticks.is_none() && scenario.ticks.is_none() && machine.idle() => break,
+            None => {}
         }
         let deadline = start + period * (tick as u32);
-        if options.lockstep {
+        let plc_alive = stop.is_none() && child.is_some();
+        if options.lockstep && plc_alive {
             if let Some(child) = child.as_mut() {
-                if let Err(e) = wait_for_plc_cycle(&segment, &events, child, tick) {
-                    result = Err(e);
-                    break;
+                match wait_for_plc_cycle(&segment, &events, child, tick, watchdog, period) {
+                    Ok(()) => {}
+                    Err(PlcWait::Lost(detail)) => {
+                        let cause = StopCause::PlcLost { tick, detail };
+                        eprintln!("cnc run: {}", cause.message());
+                        machine.stop(STOP_REASON_PLC);
+                        stop = Some((cause, tick));
+                    }
                 }
             }
-        } else {
+        } else if !options.lockstep {
             monotonic::sleep_until(deadline);
         }
         let t0 = monotonic::now();
@@ -250,15 +332,60 @@ fn run_machine(
         let _ = events.notify();
         tick_ns.push((monotonic::now() - t0).as_nanos() as u64);
         late_ns.push(t0.saturating_sub(deadline).as_nanos() as u64);
+
+        // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on it
+        // above), its process now and then, and termination requests.
+        if stop.is_none() && !options.lockstep {
+            if let Some(child) = child.as_mut() {
+                let beat = segment.plc_heartbeat();
+                if beat != plc_seen.0 {
+                    plc_seen = (beat, tick);
+                }
+                let exited = if tick % 64 == 0 {
+                    child.try_wait().ok().flatten()
+                } else {
+                    None
+                };
+                if exited.is_some() || tick - plc_seen.1 > watchdog {
+                    let detail = describe_plc(child, exited, tick - plc_seen.1);
+                    let cause = StopCause::PlcLost { tick, detail };
+                    eprintln!("cnc run: {}", cause.message());
+                    machine.stop(STOP_REASON_PLC);
+                    stop = Some((cause, tick));
+                }
+            }
+        }
+        if tick % 16 == 0 {
+            if let Some(signal) = hli::signals::take() {
+                match &stop {
+                    // A second request while stopping: out at once.
+                    Some((StopCause::Signal { .. }, _)) => {
+                        eprintln!("cnc run: second {}: exiting at once", signal.name());
+                        std::process::exit(i32::from(signal.exit_code()));
+                    }
+                    _ => {
+                        let cause = StopCause::Signal { tick, signal };
+                        eprintln!("cnc run: {}", cause.message());
+                        machine.stop(STOP_REASON_SIGNAL);
+                        stop = Some((cause, tick));
+                    }
+                }
+            }
+        }
     }
 
     let ticks = machine.ticks();
     drop(segment); // marks the segment closed: the PLC stops
     let plc_output = match child {
-        Some(child) => wait_for_exit(child)?,
+        Some(mut child) => {
+            if matches!(stop, Some((StopCause::PlcLost { .. }, _))) {
+                // A lost PLC may be hung: it would never see the segment close.
+                let _ = child.kill();
+            }
+            wait_for_exit(child)?
+        }
         None => String::new(),
     };
-    result?;
     Ok(RunReport {
         ticks,
         tick_ns: Percentiles::of(&mut tick_ns),
@@ -271,6 +398,8 @@ fn run_machine(
         acyclic_answered,
         plc_output,
         trace,
+        stop: stop.map(|(cause, _)| cause),
+        rest_after,
     })
 }
 
@@ -350,6 +479,13 @@ impl RunReport {
             self.late_ns.max,
             self.acyclic_answered
         ));
+        if let Some(cause) = &self.stop {
+            let rest = match self.rest_after {
+                Some(n) => format!("machine at rest {n} ticks after the stop"),
+                None => "machine NOT at rest when the stop limit ran out".into(),
+            };
+            out.push_str(&format!("stopped: {}; {rest}\n", cause.message()));
+        }
         out.push_str(&self.plc_output);
         out
     }
@@ -392,26 +528,54 @@ fn write_file(path: &Path, text: &str) -> Result<(), String> {
     std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// Lockstep: waits until the PLC has run its cycle after tick `tick - 1`.
+/// Why lockstep stopped waiting for the PLC.
+enum PlcWait {
+    /// Exited, or no cycle within the watchdog.
+    Lost(String),
+}
+
+/// The channel reason for a stop on a lost PLC.
+const STOP_REASON_PLC: &str = "machine stop: PLC lost";
+/// The channel reason for a stop on SIGINT/SIGTERM.
+const STOP_REASON_SIGNAL: &str = "machine stop: termination requested";
+
+/// Lockstep: waits until the PLC has run its cycle after tick `tick - 1`; a PLC that exits
+/// or runs no cycle for `watchdog` ticks' time (at least 10 s, so a loaded machine is not
+/// mistaken for a dead PLC) is lost.
 fn wait_for_plc_cycle(
     segment: &CncSegment,
     events: &EventLink,
     child: &mut Child,
     tick: u64,
-) -> Result<(), String> {
-    let watchdog = monotonic::now() + PLC_CYCLE_WATCHDOG;
+    watchdog: u64,
+    period: Duration,
+) -> Result<(), PlcWait> {
+    let patience = (period * watchdog.min(u64::from(u32::MAX)) as u32).max(PLC_CYCLE_WATCHDOG);
+    let deadline = monotonic::now() + patience;
     while segment.plc_heartbeat() < tick {
         let _ = events.wait(Duration::from_millis(5));
         if let Ok(Some(status)) = child.try_wait() {
-            return Err(format!("the PLC process exited at tick {tick}: {status}"));
+            return Err(PlcWait::Lost(format!("the PLC process exited ({status})")));
         }
-        if monotonic::now() > watchdog {
-            return Err(format!(
-                "lockstep: the PLC did not finish its cycle for tick {tick} within {PLC_CYCLE_WATCHDOG:?}"
-            ));
+        if monotonic::now() > deadline {
+            return Err(PlcWait::Lost(format!(
+                "no PLC cycle for {patience:?}, the process is alive (hung)"
+            )));
         }
     }
     Ok(())
+}
+
+/// What became of the PLC process: exited (how), or alive without cycling.
+fn describe_plc(
+    child: &mut Child,
+    exited: Option<std::process::ExitStatus>,
+    silent: u64,
+) -> String {
+    match exited.or_else(|| child.try_wait().ok().flatten()) {
+        Some(status) => format!("the PLC process exited ({status})"),
+        None => format!("no PLC cycle for {silent} ticks, the process is alive (hung)"),
+    }
 }
 
 /// Waits (bounded) until the PLC process has attached to the segment.

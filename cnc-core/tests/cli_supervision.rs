@@ -1,0 +1,210 @@
+//! Supervision and signals of `cnc run`: a PLC killed or hung, SIGINT and SIGTERM. Each
+//! ends in a controlled stop (channels brake on their path, single axes brake with their
+//! deceleration), with the documented exit code, the report and the trace, and no segment
+//! left behind. Waits are polls with watchdogs.
+
+use hli::access::Leaf;
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn scenario() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/supervision/scenario.toml")
+}
+
+fn start(instance: &str, trace: &std::path::Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args([
+            "run",
+            scenario().to_str().unwrap(),
+            "--instance",
+            instance,
+            "--trace",
+        ])
+        .arg(trace)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn segment(instance: &str) -> PathBuf {
+    PathBuf::from(format!("/dev/shm/cncplc_{instance}.hli"))
+}
+
+/// The PLC heartbeat, read from the segment file.
+fn plc_heartbeat(instance: &str) -> Option<u64> {
+    let offset = Leaf::resolve("header.plc_heartbeat").unwrap().offset;
+    let bytes = std::fs::read(segment(instance)).ok()?;
+    Some(u64::from_le_bytes(
+        bytes.get(offset..offset + 8)?.try_into().ok()?,
+    ))
+}
+
+/// Waits (watchdog 30 s) until the PLC has cycled `n` times: the run is in the middle of its
+/// first move then.
+fn wait_for_plc_cycles(instance: &str, n: u64) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while plc_heartbeat(instance).unwrap_or(0) < n {
+        assert!(
+            Instant::now() < deadline,
+            "watchdog: the PLC of {instance} did not cycle"
+        );
+        // A poll, not a synchronisation: the watchdog above bounds it.
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// The PLC process of `instance` (found in /proc by its command line).
+fn plc_pid(instance: &str) -> i32 {
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<i32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(entry.path().join("cmdline")) else {
+            continue;
+        };
+        let cmd = String::from_utf8_lossy(&cmd).replace('\0', " ");
+        if cmd.contains(" plc ") && cmd.contains(&format!("--instance {instance} ")) {
+            return pid;
+        }
+    }
+    panic!("no PLC process for {instance}");
+}
+
+fn signal(pid: u32, name: &str) {
+    let ok = Command::new("kill")
+        .args([&format!("-{name}"), &pid.to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+}
+
+/// Waits for `child` (watchdog 60 s), returns exit code and stdout + stderr.
+fn finish(child: Child) -> (i32, String) {
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        ),
+    )
+}
+
+/// Ticks the report says the machine needed to come to rest.
+fn rest_ticks(report: &str) -> u64 {
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("stopped:"))
+        .unwrap_or_else(|| panic!("{report}"));
+    let at = line
+        .find("machine at rest ")
+        .unwrap_or_else(|| panic!("{line}"));
+    line[at + 16..].split(' ').next().unwrap().parse().unwrap()
+}
+
+/// The last trace row's commanded velocities (HLI units) of the channel X and the follower.
+fn last_velocities(trace: &std::path::Path) -> (i64, i64) {
+    let text = std::fs::read_to_string(trace).unwrap();
+    let last = text.lines().last().unwrap();
+    let cells: Vec<i64> = last
+        .split(',')
+        .skip(2)
+        .map(|c| c.parse().unwrap())
+        .collect();
+    (cells[0], cells[1])
+}
+
+fn check_controlled_stop(
+    instance: &str,
+    trace: &std::path::Path,
+    code: i32,
+    expect_code: i32,
+    report: &str,
+    cause: &str,
+) {
+    assert_eq!(code, expect_code, "{report}");
+    assert!(report.contains(cause), "{report}");
+    assert!(
+        report.contains("error at line") && report.contains("machine stop"),
+        "{report}"
+    );
+    // Both axes brake from at most 200 mm/s (follower 300) at 1000 (2000) mm/s^2, jerk-limited:
+    // well under half a second; the watchdog or the signal poll adds at most 64 ticks.
+    let rest = rest_ticks(report);
+    assert!(rest <= 500, "{rest} ticks to rest\n{report}");
+    assert_eq!(
+        last_velocities(trace),
+        (0, 0),
+        "standing at the end of the trace"
+    );
+    assert!(!segment(instance).exists(), "segment left behind");
+}
+
+#[test]
+fn a_killed_plc_stops_the_machine_with_exit_4() {
+    let instance = format!("sup-kill-{}", std::process::id());
+    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let child = start(&instance, &trace);
+    wait_for_plc_cycles(&instance, 300);
+    signal(plc_pid(&instance) as u32, "KILL");
+    let (code, report) = finish(child);
+    check_controlled_stop(
+        &instance,
+        &trace,
+        code,
+        4,
+        &report,
+        "the PLC process exited (signal: 9",
+    );
+}
+
+#[test]
+fn a_hung_plc_is_reported_after_the_watchdog() {
+    let instance = format!("sup-hang-{}", std::process::id());
+    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let child = start(&instance, &trace);
+    wait_for_plc_cycles(&instance, 300);
+    let pid = plc_pid(&instance) as u32;
+    signal(pid, "STOP");
+    let (code, report) = finish(child);
+    // The CNC killed the hung PLC itself; make sure in any case.
+    let _ = Command::new("kill")
+        .args(["-KILL", &pid.to_string()])
+        .stderr(Stdio::null())
+        .status();
+    check_controlled_stop(
+        &instance,
+        &trace,
+        code,
+        4,
+        &report,
+        "no PLC cycle for 51 ticks, the process is alive (hung)",
+    );
+}
+
+#[test]
+fn sigint_and_sigterm_stop_the_machine_and_write_the_trace() {
+    for (name, code) in [("INT", 130), ("TERM", 143)] {
+        let instance = format!("sup-{}-{}", name.to_lowercase(), std::process::id());
+        let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+        let child = start(&instance, &trace);
+        wait_for_plc_cycles(&instance, 300);
+        signal(child.id(), name);
+        let (exit, report) = finish(child);
+        check_controlled_stop(
+            &instance,
+            &trace,
+            exit,
+            code,
+            &report,
+            &format!("SIG{name} at tick"),
+        );
+        assert!(
+            report.contains("ended by CncClosed"),
+            "the PLC stopped cleanly too\n{report}"
+        );
+    }
+}
