@@ -2,6 +2,7 @@
 //! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
 //! the acyclic request-response service.
 
+pub mod blocks;
 pub mod cli;
 pub mod motion;
 pub mod programs;

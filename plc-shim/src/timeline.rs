@@ -68,6 +68,8 @@ struct StepFile {
     take: Option<String>,
     #[serde(default)]
     repeat: bool,
+    call: Option<toml::Table>,
+    wait: Option<String>,
 }
 
 /// A value source: a constant or a leaf read when the step fires.
@@ -201,6 +203,8 @@ struct Step {
     commit: Option<Leaf>,
     take: Option<Leaf>,
     repeat: bool,
+    call: Option<crate::blocks::Call>,
+    wait: Option<(usize, crate::blocks::Output)>,
 }
 
 /// What happened to one step.
@@ -223,6 +227,7 @@ pub struct Timeline {
     records: Vec<StepRecord>,
     values: Vec<Value>,
     cnc_tick: Leaf,
+    instances: crate::blocks::Instances,
 }
 
 impl Timeline {
@@ -233,13 +238,26 @@ impl Timeline {
             message: e.to_string(),
         })?;
         let mut steps = Vec::with_capacity(parsed.step.len());
+        let mut instances = crate::blocks::Instances::default();
         for (i, s) in parsed.step.into_iter().enumerate() {
             let fail = |reason: String| TimelineError::Step {
                 file: file.to_string(),
                 step: i + 1,
                 reason,
             };
-            steps.push(Step::build(s).map_err(fail)?);
+            // The wait names instances called by earlier steps; then this step's call.
+            let wait = match &s.wait {
+                Some(w) => Some(instances.parse_wait(w).map_err(fail)?),
+                None => None,
+            };
+            let call = match &s.call {
+                Some(table) => Some(instances.parse_call(table).map_err(fail)?),
+                None => None,
+            };
+            let mut step = Step::build(s).map_err(fail)?;
+            step.wait = wait;
+            step.call = call;
+            steps.push(step);
         }
         let most_values = steps.iter().map(|s| s.set.len()).max().unwrap_or(0);
         let n = steps.len();
@@ -250,6 +268,7 @@ impl Timeline {
             records: vec![StepRecord::default(); n],
             values: Vec::with_capacity(most_values),
             cnc_tick: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
+            instances,
         })
     }
 
@@ -283,8 +302,27 @@ impl Timeline {
         self.steps.is_empty()
     }
 
-    /// One PLC cycle against `memory`. Does not allocate.
-    pub fn cycle(&mut self, memory: &ImageMemory) {
+    /// Whether steps call function blocks (they need the PLC process's acyclic service).
+    pub fn calls_blocks(&self) -> bool {
+        !self.instances.is_empty()
+    }
+
+    /// The axis (gpAx index) of every block instance, with the instance name.
+    pub fn block_axes(&self) -> impl Iterator<Item = (&str, u32)> {
+        self.instances.axes()
+    }
+
+    /// One PLC cycle with block calls: Execute edges due, the steps, then every instance.
+    /// Does not allocate.
+    pub fn cycle_io(&mut self, io: &mut crate::runtime::PlcIo<'_>) {
+        self.instances.begin_cycle();
+        let tick = self.cycle(io.memory);
+        self.instances.call_all(io, tick);
+    }
+
+    /// One PLC cycle against `memory` without block calls (in-process runs); returns the CNC
+    /// tick it saw. Does not allocate.
+    pub fn cycle(&mut self, memory: &ImageMemory) -> u64 {
         let tick = match self.cnc_tick.read(memory) {
             Value::Unsigned(t) => t,
             other => other.as_f64() as u64,
@@ -303,11 +341,12 @@ impl Timeline {
             }
             self.next += 1;
         }
+        tick
     }
 
     fn try_fire(&mut self, i: usize, memory: &ImageMemory, tick: u64) -> bool {
         let step = &self.steps[i];
-        if !step.ready(memory, tick) {
+        if !step.ready(memory, tick) || !step.wait.is_none_or(|w| self.instances.holds(w)) {
             return false;
         }
         self.values.clear();
@@ -325,6 +364,9 @@ impl Timeline {
         }
         if let Some(commit) = step.commit {
             commit.write(memory, Value::Unsigned(1));
+        }
+        if let Some(call) = &step.call {
+            self.instances.apply(call);
         }
         record.fired += 1;
         record.first_fired_at.get_or_insert(tick);
@@ -349,6 +391,7 @@ impl Timeline {
                 }
             ));
         }
+        out.push_str(&self.instances.summary());
         out
     }
 }
@@ -396,9 +439,16 @@ impl Step {
         };
         let commit = semaphore(&s.commit)?;
         let take = semaphore(&s.take)?;
-        if s.at_tick.is_none() && when.is_empty() && commit.is_none() && take.is_none() && s.repeat
+        if s.at_tick.is_none()
+            && when.is_empty()
+            && commit.is_none()
+            && take.is_none()
+            && s.wait.is_none()
+            && s.repeat
         {
-            return Err("a repeating step needs `at_tick`, `when`, `commit` or `take`".into());
+            return Err(
+                "a repeating step needs `at_tick`, `when`, `wait`, `commit` or `take`".into(),
+            );
         }
         Ok(Step {
             at_tick: s.at_tick,
@@ -407,6 +457,8 @@ impl Step {
             commit,
             take,
             repeat: s.repeat,
+            call: None,
+            wait: None,
         })
     }
 
@@ -424,7 +476,7 @@ impl Step {
 
 impl crate::runtime::PlcProgram for Timeline {
     fn cycle(&mut self, io: &mut crate::runtime::PlcIo<'_>) {
-        Timeline::cycle(self, io.memory);
+        self.cycle_io(io);
     }
     fn summary(&self) -> String {
         Timeline::summary(self)

@@ -52,6 +52,7 @@ struct ScenarioFile {
     cycle_ms: f64,
     ticks: Option<u64>,
     plc_watchdog_ticks: Option<u64>,
+    #[serde(default)]
     channel: Vec<ChannelConfig>,
     #[serde(default)]
     axis: Vec<super::axes::AxisFile>,
@@ -159,9 +160,10 @@ impl Scenario {
                 file.cycle_ms
             )));
         }
-        if file.channel.is_empty() || file.channel.len() > crate::channel::MAX_CHANNELS {
+        let no_machine = file.channel.is_empty() && file.axis.is_empty();
+        if no_machine || file.channel.len() > crate::channel::MAX_CHANNELS {
             return Err(invalid(format!(
-                "{} channels: a scenario has 1 to {}",
+                "{} channels: a scenario has 0 to {} (and at least one [[channel]] or [[axis]])",
                 file.channel.len(),
                 crate::channel::MAX_CHANNELS
             )));
@@ -228,6 +230,18 @@ impl Scenario {
         let gears = super::axes::gears(&file.gear, &names).map_err(&invalid)?;
         crate::machine::gear::GearEngine::new(&gears, names.len())
             .map_err(|e| invalid(e.to_string()))?;
+        if let PlcSetup::Timeline { timeline, path, .. } = &plc {
+            for (instance, axis) in timeline.block_axes() {
+                if axis as usize >= names.len() {
+                    return Err(invalid(format!(
+                        "{}: block {instance:?}: axis {axis} does not exist (the machine has {} axes: {})",
+                        path.display(),
+                        names.len(),
+                        names.join(", ")
+                    )));
+                }
+            }
+        }
         let mut signals = Vec::with_capacity(file.trace.signals.len());
         for s in file.trace.signals {
             let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;

@@ -71,6 +71,12 @@ impl InProcess {
     pub fn new(scenario: &Scenario, rows: usize) -> Result<InProcess, ScenarioError> {
         let timeline = match &scenario.plc {
             PlcSetup::None => None,
+            PlcSetup::Timeline { timeline, .. } if timeline.calls_blocks() => {
+                return Err(ScenarioError::Invalid {
+                    file: scenario.name.clone(),
+                    message: "the PLC timeline calls function blocks: they need the PLC process (cnc run)".into(),
+                })
+            }
             PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
             PlcSetup::Program(p) => {
                 return Err(ScenarioError::Invalid {

@@ -1,0 +1,477 @@
+//! Function-block instances a timeline calls by name: the PLCopen motion blocks of
+//! [`crate::motion`], each instance bound to one axis, called once per PLC cycle like a PLC
+//! program calls its instances, with the edges of its outputs recorded for the report.
+//!
+//! ```toml
+//! [[step]]
+//! call = { block = "MC_Power", instance = "power_x", axis = 0, enable = true }
+//! [[step]]
+//! wait = "power_x.Status"                  # ready once this output is TRUE
+//! call = { block = "MC_MoveAbsolute", instance = "move_x", axis = 0, position = 100.0,
+//!          velocity = 200.0, acceleration = 2000.0, deceleration = 2000.0, jerk = 50000.0 }
+//! ```
+//!
+//! A call sets the given inputs and a rising edge on Execute (`execute = false` lowers it
+//! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
+//! FALSE for one cycle first, so every call is a new edge.
+
+use crate::motion::{
+    BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
+};
+use crate::runtime::PlcIo;
+
+/// The blocks a timeline can call.
+pub const BLOCKS: [&str; 7] = [
+    "MC_Power",
+    "MC_Reset",
+    "MC_MoveAbsolute",
+    "MC_MoveRelative",
+    "MC_MoveVelocity",
+    "MC_Halt",
+    "MC_Stop",
+];
+
+/// The outputs a `wait` can name.
+pub const OUTPUTS: [&str; 7] = [
+    "Done",
+    "Busy",
+    "Active",
+    "CommandAborted",
+    "Error",
+    "InVelocity",
+    "Status",
+];
+
+#[derive(Debug)]
+enum Block {
+    Power(McPower),
+    Reset(McReset),
+    MoveAbsolute(McMoveAbsolute),
+    MoveRelative(McMoveRelative),
+    MoveVelocity(McMoveVelocity),
+    Halt(McHalt),
+    Stop(McStop),
+}
+
+/// A boolean output of a block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output(usize);
+
+/// One input value of a call.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Input {
+    Enable(bool),
+    Position(f64),
+    Distance(f64),
+    Velocity(f64),
+    Acceleration(f64),
+    Deceleration(f64),
+    Jerk(f64),
+    Direction(i32),
+}
+
+/// A call of an instance, checked.
+#[derive(Debug, Clone)]
+pub struct Call {
+    instance: usize,
+    inputs: Vec<Input>,
+    execute: bool,
+}
+
+/// Where an output rose first, and how often.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Edge {
+    /// CNC tick of the first rising edge.
+    pub first: Option<u64>,
+    /// Rising edges seen.
+    pub count: u64,
+}
+
+#[derive(Debug)]
+struct Instance {
+    name: String,
+    kind: &'static str,
+    axis: u32,
+    block: Block,
+    raise_next_cycle: bool,
+    last: [bool; 7],
+    edges: [Edge; 7],
+    error_id: u32,
+}
+
+/// The instances of a timeline.
+#[derive(Debug, Default)]
+pub struct Instances {
+    list: Vec<Instance>,
+}
+
+fn number(value: &toml::Value) -> Option<f64> {
+    match value {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+impl Instances {
+    /// Checks a `call` table and registers its instance (created on its first call); `Err`
+    /// says which key is wrong.
+    pub fn parse_call(&mut self, table: &toml::Table) -> Result<Call, String> {
+        let text = |key: &str| -> Result<&str, String> {
+            table
+                .get(key)
+                .and_then(toml::Value::as_str)
+                .ok_or_else(|| format!("call: `{key}` (a string) is missing"))
+        };
+        let block = text("block")?;
+        let kind = *BLOCKS
+            .iter()
+            .find(|b| b.eq_ignore_ascii_case(block))
+            .ok_or_else(|| {
+                format!(
+                    "call: unknown block {block:?} (known: {})",
+                    BLOCKS.join(", ")
+                )
+            })?;
+        let name = table
+            .get("instance")
+            .and_then(toml::Value::as_str)
+            .unwrap_or(kind);
+        let axis = match table.get("axis").and_then(toml::Value::as_integer) {
+            Some(a) if (0..i64::from(u32::MAX)).contains(&a) => a as u32,
+            Some(a) => return Err(format!("call: axis {a} is not an axis index")),
+            None => return Err("call: `axis` (the gpAx index) is missing".into()),
+        };
+        let allowed: &[&str] = match kind {
+            "MC_Power" => &["enable"],
+            "MC_Reset" => &[],
+            "MC_MoveAbsolute" => &[
+                "position",
+                "velocity",
+                "acceleration",
+                "deceleration",
+                "jerk",
+            ],
+            "MC_MoveRelative" => &[
+                "distance",
+                "velocity",
+                "acceleration",
+                "deceleration",
+                "jerk",
+            ],
+            "MC_MoveVelocity" => &[
+                "velocity",
+                "direction",
+                "acceleration",
+                "deceleration",
+                "jerk",
+            ],
+            _ => &["deceleration", "jerk"],
+        };
+        let mut inputs = Vec::new();
+        let mut execute = true;
+        for (key, value) in table {
+            if ["block", "instance", "axis"].contains(&key.as_str()) {
+                continue;
+            }
+            if key == "execute" && kind != "MC_Power" {
+                execute = value
+                    .as_bool()
+                    .ok_or_else(|| "call: `execute` must be true or false".to_string())?;
+                continue;
+            }
+            if !allowed.contains(&key.as_str()) {
+                return Err(format!(
+                    "call: {kind} has no input `{key}` (inputs: {})",
+                    if allowed.is_empty() {
+                        "none".to_string()
+                    } else {
+                        allowed.join(", ")
+                    }
+                ));
+            }
+            let bad = || format!("call: {kind} input `{key}` = {value} is not valid");
+            let input = match key.as_str() {
+                "enable" => Input::Enable(value.as_bool().ok_or_else(bad)?),
+                "direction" => match value.as_integer() {
+                    Some(d @ (-1 | 1)) => Input::Direction(d as i32),
+                    _ => return Err(format!("call: `direction` = {value}: 1 or -1")),
+                },
+                other => {
+                    let v = number(value).filter(|v| v.is_finite()).ok_or_else(bad)?;
+                    match other {
+                        "position" => Input::Position(v),
+                        "distance" => Input::Distance(v),
+                        "velocity" => Input::Velocity(v),
+                        "acceleration" => Input::Acceleration(v),
+                        "deceleration" => Input::Deceleration(v),
+                        _ => Input::Jerk(v),
+                    }
+                }
+            };
+            inputs.push(input);
+        }
+        let instance = match self.list.iter().position(|i| i.name == name) {
+            Some(i) if self.list[i].kind != kind || self.list[i].axis != axis => {
+                return Err(format!(
+                    "call: instance {name:?} is a {} on axis {}, not a {kind} on axis {axis}",
+                    self.list[i].kind, self.list[i].axis
+                ))
+            }
+            Some(i) => i,
+            None => {
+                self.list.push(Instance {
+                    name: name.to_string(),
+                    kind,
+                    axis,
+                    block: new_block(kind),
+                    raise_next_cycle: false,
+                    last: [false; 7],
+                    edges: [Edge::default(); 7],
+                    error_id: 0,
+                });
+                self.list.len() - 1
+            }
+        };
+        Ok(Call {
+            instance,
+            inputs,
+            execute,
+        })
+    }
+
+    /// Checks a `wait` (`INSTANCE.OUTPUT`) against the instances called so far.
+    pub fn parse_wait(&self, text: &str) -> Result<(usize, Output), String> {
+        let (name, output) = text
+            .trim()
+            .split_once('.')
+            .ok_or_else(|| format!("wait {text:?}: INSTANCE.OUTPUT"))?;
+        let instance = self
+            .list
+            .iter()
+            .position(|i| i.name == name)
+            .ok_or_else(|| format!("wait: no instance {name:?} is called before this step"))?;
+        let output = OUTPUTS
+            .iter()
+            .position(|o| o.eq_ignore_ascii_case(output))
+            .ok_or_else(|| {
+                format!(
+                    "wait: unknown output {output:?} (known: {})",
+                    OUTPUTS.join(", ")
+                )
+            })?;
+        Ok((instance, Output(output)))
+    }
+
+    /// Whether there are any.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The axes the instances use, with their instance names.
+    pub fn axes(&self) -> impl Iterator<Item = (&str, u32)> {
+        self.list.iter().map(|i| (i.name.as_str(), i.axis))
+    }
+
+    /// Whether `output` of `instance` was TRUE after the last cycle.
+    pub fn holds(&self, (instance, Output(output)): (usize, Output)) -> bool {
+        self.list[instance].last[output]
+    }
+
+    /// Applies a fired call: inputs now, the Execute edge in this or the next cycle.
+    pub fn apply(&mut self, call: &Call) {
+        let inst = &mut self.list[call.instance];
+        for input in &call.inputs {
+            set_input(&mut inst.block, *input);
+        }
+        match execute_of(&mut inst.block) {
+            Some(execute) if call.execute && *execute => {
+                *execute = false;
+                inst.raise_next_cycle = true;
+            }
+            Some(execute) => *execute = call.execute,
+            None => {}
+        }
+    }
+
+    /// Raises the Execute edges due from the last cycle (call before the steps fire).
+    pub fn begin_cycle(&mut self) {
+        for inst in &mut self.list {
+            if inst.raise_next_cycle {
+                inst.raise_next_cycle = false;
+                if let Some(e) = execute_of(&mut inst.block) {
+                    *e = true;
+                }
+            }
+        }
+    }
+
+    /// Calls every instance once and records its output edges at CNC tick `tick`.
+    pub fn call_all(&mut self, io: &mut PlcIo<'_>, tick: u64) {
+        for inst in &mut self.list {
+            let axis = inst.axis;
+            let (out, status) = match &mut inst.block {
+                Block::Power(b) => {
+                    b.call(io, axis);
+                    let out = BlockOutputs {
+                        error: b.error,
+                        error_id: b.error_id,
+                        ..BlockOutputs::default()
+                    };
+                    (out, b.status)
+                }
+                Block::Reset(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+                Block::MoveAbsolute(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+                Block::MoveRelative(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+                Block::MoveVelocity(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+                Block::Halt(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+                Block::Stop(b) => {
+                    b.call(io, axis);
+                    (b.out, false)
+                }
+            };
+            let now = [
+                out.done,
+                out.busy,
+                out.active,
+                out.command_aborted,
+                out.error,
+                out.in_velocity,
+                status,
+            ];
+            for ((is, was), edge) in now.iter().zip(inst.last).zip(inst.edges.iter_mut()) {
+                if *is && !was {
+                    edge.count += 1;
+                    edge.first.get_or_insert(tick);
+                }
+            }
+            if out.error {
+                inst.error_id = out.error_id;
+            }
+            inst.last = now;
+        }
+    }
+
+    /// One line per instance: its block and axis, and the first rising edge of every output
+    /// that rose (`Busy 12 (x1), Done 341 (x1)`), with the last error id.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for inst in &self.list {
+            let edges: Vec<String> = OUTPUTS
+                .iter()
+                .zip(&inst.edges)
+                .filter_map(|(name, e)| e.first.map(|t| format!("{name} {t} (x{})", e.count)))
+                .collect();
+            out.push_str(&format!(
+                "block {} ({} on gpAx[{}]): {}{}\n",
+                inst.name,
+                inst.kind,
+                inst.axis,
+                if edges.is_empty() {
+                    "no output rose".to_string()
+                } else {
+                    edges.join(", ")
+                },
+                if inst.error_id != 0 {
+                    format!(", ErrorID {:#06x}", inst.error_id)
+                } else {
+                    String::new()
+                }
+            ));
+        }
+        out
+    }
+}
+
+/// A clone has the same instances with fresh block states (a timeline is cloned before it
+/// runs).
+impl Clone for Instances {
+    fn clone(&self) -> Self {
+        Instances {
+            list: self
+                .list
+                .iter()
+                .map(|i| Instance {
+                    name: i.name.clone(),
+                    kind: i.kind,
+                    axis: i.axis,
+                    block: new_block(i.kind),
+                    raise_next_cycle: false,
+                    last: [false; 7],
+                    edges: [Edge::default(); 7],
+                    error_id: 0,
+                })
+                .collect(),
+        }
+    }
+}
+
+fn new_block(kind: &str) -> Block {
+    match kind {
+        "MC_Power" => Block::Power(McPower::default()),
+        "MC_Reset" => Block::Reset(McReset::default()),
+        "MC_MoveAbsolute" => Block::MoveAbsolute(McMoveAbsolute::default()),
+        "MC_MoveRelative" => Block::MoveRelative(McMoveRelative::default()),
+        "MC_MoveVelocity" => {
+            let mut b = McMoveVelocity::default();
+            b.direction = 1;
+            Block::MoveVelocity(b)
+        }
+        "MC_Halt" => Block::Halt(McHalt::default()),
+        _ => Block::Stop(McStop::default()),
+    }
+}
+
+fn execute_of(block: &mut Block) -> Option<&mut bool> {
+    match block {
+        Block::Power(_) => None,
+        Block::Reset(b) => Some(&mut b.execute),
+        Block::MoveAbsolute(b) => Some(&mut b.execute),
+        Block::MoveRelative(b) => Some(&mut b.execute),
+        Block::MoveVelocity(b) => Some(&mut b.execute),
+        Block::Halt(b) => Some(&mut b.execute),
+        Block::Stop(b) => Some(&mut b.execute),
+    }
+}
+
+fn set_input(block: &mut Block, input: Input) {
+    match (block, input) {
+        (Block::Power(b), Input::Enable(e)) => b.enable = e,
+        (Block::MoveAbsolute(b), Input::Position(v)) => b.position = v,
+        (Block::MoveAbsolute(b), Input::Velocity(v)) => b.velocity = v,
+        (Block::MoveAbsolute(b), Input::Acceleration(v)) => b.acceleration = v,
+        (Block::MoveAbsolute(b), Input::Deceleration(v)) => b.deceleration = v,
+        (Block::MoveAbsolute(b), Input::Jerk(v)) => b.jerk = v,
+        (Block::MoveRelative(b), Input::Distance(v)) => b.distance = v,
+        (Block::MoveRelative(b), Input::Velocity(v)) => b.velocity = v,
+        (Block::MoveRelative(b), Input::Acceleration(v)) => b.acceleration = v,
+        (Block::MoveRelative(b), Input::Deceleration(v)) => b.deceleration = v,
+        (Block::MoveRelative(b), Input::Jerk(v)) => b.jerk = v,
+        (Block::MoveVelocity(b), Input::Velocity(v)) => b.velocity = v,
+        (Block::MoveVelocity(b), Input::Direction(d)) => b.direction = d,
+        (Block::MoveVelocity(b), Input::Acceleration(v)) => b.acceleration = v,
+        (Block::MoveVelocity(b), Input::Deceleration(v)) => b.deceleration = v,
+        (Block::MoveVelocity(b), Input::Jerk(v)) => b.jerk = v,
+        (Block::Halt(b), Input::Deceleration(v)) => b.deceleration = v,
+        (Block::Halt(b), Input::Jerk(v)) => b.jerk = v,
+        (Block::Stop(b), Input::Deceleration(v)) => b.deceleration = v,
+        (Block::Stop(b), Input::Jerk(v)) => b.jerk = v,
+        // parse_call admits only the inputs of the block.
+        _ => {}
+    }
+}
