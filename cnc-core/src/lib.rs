@@ -7,7 +7,6 @@ pub mod cam_cli;
 pub mod channel;
 pub mod check_cli;
 pub mod demo;
-pub mod hli_demo;
 pub mod json;
 pub mod kin_cli;
 pub mod machine;

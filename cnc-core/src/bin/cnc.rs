@@ -14,8 +14,6 @@ struct Cli {
 enum Command {
     /// Run the demo: the seed's examples 3 and 4 end to end in real time, with a PLC process.
     Demo(cnc_core::demo::DemoArgs),
-    /// Exercise every HLI unit and the axis commands with a spawned PLC (no channels).
-    HliDemo(cnc_core::hli_demo::DemoArgs),
     /// Run a scenario: machine configuration, NC programs, PLC timeline, trace.
     Run(cnc_core::scenario::runner::RunArgs),
     /// HLI tooling.
@@ -52,7 +50,6 @@ fn main() -> ExitCode {
     hli::init_logging();
     match Cli::parse().command {
         Command::Demo(args) => cnc_core::demo::main(args),
-        Command::HliDemo(args) => cnc_core::hli_demo::main(args),
         Command::Run(args) => cnc_core::scenario::runner::main(args),
         Command::Hli { what } => {
             let text = match what {

@@ -265,6 +265,10 @@ fn run_machine(
     let mut child = spawn_plc(scenario, options)?;
     if let Some(child) = child.as_mut() {
         wait_for_attach(&segment, child)?;
+        if !options.lockstep {
+            // The heartbeat watchdog starts with the loop: the PLC must be cycling by then.
+            wait_for_first_cycle(&segment, &events, child)?;
+        }
     }
 
     let limit = options
