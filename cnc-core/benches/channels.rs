@@ -8,11 +8,19 @@
 //! the same run: the same channels ticking without any program and without tracking (the
 //! fixed cost of outputs and bookkeeping), so the ratio says what the motion work adds.
 //! Target: <= 5 us per channel-tick, linear in channels.
+//!
+//! Also in the same run: the whole machine tick with the robots' axes on simulated PT2 drives,
+//! and the path before the machine tick (channels plus set-points written straight into the
+//! axis images, no axis layer) as the baseline the machine tick is compared with.
+//! Axis images hold 32 axes: the first five robots' axes are on the axis layer, the others
+//! have none (as before).
 //! Run: `cargo bench -p cnc-core --bench channels`.
 
+use cnc_core::channel::axes_out::AxisPublisher;
 use cnc_core::channel::{Channel, Controller};
-use cnc_core::scenario::fleet::{running, tracking_robots};
+use cnc_core::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
 use hli::views::CncView;
+use hli::views::PlcView;
 use std::time::Instant;
 
 const TICKS: usize = 5_000;
@@ -42,6 +50,49 @@ fn tracking(n: usize) -> f64 {
     time(|| run.machine.tick(&run.memory))
 }
 
+fn tracking_pt2(n: usize) -> f64 {
+    let drive = "{ model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }";
+    let mut run = running_on(n, Some(drive), WARM_UP).expect("fleet running on PT2 drives");
+    time(|| run.machine.tick(&run.memory))
+}
+
+/// The path before the machine tick: channels, then each channel's set-points written into
+/// its axis images (while they last), the CNC heartbeat not counted.
+fn before_machine(n: usize) -> f64 {
+    let s = tracking_robots(n).expect("fleet scenario");
+    let mut channels: Vec<Channel> = Vec::new();
+    for (i, (c, p)) in s.channels.iter().zip(&s.programs).enumerate() {
+        let mut ch = Channel::new(i, c.clone(), s.cycle_s).expect("channel");
+        ch.start(p.clone().expect("a program"));
+        channels.push(ch);
+    }
+    let mut publishers: Vec<Option<AxisPublisher>> = Vec::new();
+    let mut first = 0;
+    for c in &channels {
+        let fits = first + 6 <= 32;
+        publishers.push(fits.then(|| AxisPublisher::new(first, c.set_points(), s.cycle_s)));
+        if fits {
+            first += 6;
+        }
+    }
+    let mut controller = Controller::new(channels).expect("controller");
+    let memory = hli::segment::heap_image(n as u32, 32);
+    plc_setup(&PlcView::new(&memory));
+    let view = CncView::new(&memory);
+    let mut tick = || {
+        controller.tick(&view);
+        for (c, p) in controller.channels().iter().zip(publishers.iter_mut()) {
+            if let Some(p) = p {
+                p.publish(&view, c.set_points());
+            }
+        }
+    };
+    for _ in 0..WARM_UP {
+        tick();
+    }
+    time(tick)
+}
+
 fn idle(n: usize) -> f64 {
     let s = tracking_robots(n).expect("fleet scenario");
     let channels = s
@@ -57,18 +108,23 @@ fn idle(n: usize) -> f64 {
 }
 
 fn main() {
-    println!("channels | tracking: ns/tick | ns/channel-tick | vs 1 channel | idle baseline ns/channel-tick | tracking / idle");
+    println!("channels | tracking: ns/tick | ns/channel-tick | vs 1 channel | idle baseline ns/channel-tick | tracking / idle | PT2 drives ns/channel-tick | before machine ns/channel-tick | machine / before");
     let mut one = None;
     for n in [1usize, 4, 12] {
         let t = tracking(n);
         let b = idle(n);
+        let d = tracking_pt2(n);
+        let old = before_machine(n);
         let per = t / n as f64;
         let base = *one.get_or_insert(per);
         println!(
-            "{n:>8} | {t:>17.0} | {per:>15.0} | {:>12.2} | {:>29.0} | {:>15.1}",
+            "{n:>8} | {t:>17.0} | {per:>15.0} | {:>12.2} | {:>29.0} | {:>15.1} | {:>26.0} | {:>31.0} | {:>16.2}",
             per / base,
             b / n as f64,
-            t / b
+            t / b,
+            d / n as f64,
+            old / n as f64,
+            t / old
         );
     }
     println!("(medians of {REPEATS} runs of {TICKS} ticks; target <= 5000 ns per channel-tick)");

@@ -1,10 +1,7 @@
-//! The channel's axes in the axis images: each channel axis occupies one `gpAx[k]^` block and
-//! shows the channel's set-point there (`lr_state`), so the PLC reads a table axis that an NC
-//! program turns, as in the seed's example 4 (`gpAx[6]^lr_state.current_position_acs_r`).
-//!
-//! The axes run on ideal drives in this version: the actual position is the set-point and
-//! the following error is zero. Coupling channel axes to the simulated drives of
-//! [`crate::axis`] (with their lag and monitoring) is a later step.
+//! The former way channel axes reached the axis images, kept only as the baseline of the
+//! `channels` benchmark while the machine tick replaces it (remove with that baseline): each
+//! channel axis's `gpAx[k]^lr_state` written straight from the channel's set-point, no axis
+//! layer, no drive. The machine (`crate::machine`) now runs channel axes as `Axis` objects.
 
 use super::run::hli_value;
 use crate::nc::decode::AxisValues;

@@ -29,8 +29,14 @@ G1 X630 Y-10 Z530 F1200
 $ENDWHILE
 ";
 
-/// The scenario of `n` robots (1..=12).
+/// The scenario of `n` robots (1..=12) on ideal drives.
 pub fn tracking_robots(n: usize) -> Result<Scenario, ScenarioError> {
+    tracking_robots_on(n, None)
+}
+
+/// The scenario of `n` robots whose axes have `drive` (a TOML drive model, e.g.
+/// `{ model = "pt2", frequency_hz = 80.0, damping = 0.9 }`).
+pub fn tracking_robots_on(n: usize, drive: Option<&str>) -> Result<Scenario, ScenarioError> {
     let mut toml = String::from("cycle_ms = 1.0\n");
     for i in 0..n {
         toml.push_str(&format!(
@@ -41,6 +47,9 @@ pub fn tracking_robots(n: usize) -> Result<Scenario, ScenarioError> {
             i + 1,
             if i == 0 { "lead.nc" } else { "follower.nc" }
         ));
+        if let Some(d) = drive {
+            toml.push_str(&format!("drive = {d}\n"));
+        }
     }
     Scenario::parse("fleet", &toml, |file| {
         let text = if file == "lead.nc" { LEAD } else { FOLLOWER };
@@ -64,7 +73,12 @@ pub fn plc_setup(view: &PlcView<'_>) {
 /// The fleet of `n` robots on a heap image, ticked `warm_up` times so the programs run and
 /// every channel tracks; an error names the first channel that does not.
 pub fn running(n: usize, warm_up: usize) -> Result<InProcess, String> {
-    let s = tracking_robots(n).map_err(|e| e.to_string())?;
+    running_on(n, None, warm_up)
+}
+
+/// [`running`] with the robots' axes on `drive` (see [`tracking_robots_on`]).
+pub fn running_on(n: usize, drive: Option<&str>, warm_up: usize) -> Result<InProcess, String> {
+    let s = tracking_robots_on(n, drive).map_err(|e| e.to_string())?;
     let mut run = InProcess::new(&s, 0).map_err(|e| e.to_string())?;
     plc_setup(&PlcView::new(&run.memory));
     for _ in 0..warm_up {
