@@ -462,7 +462,7 @@ impl RunReport {
         let mut out = String::new();
         for c in &self.channels {
             out.push_str(&format!(
-                "channel {}: {}; M functions acknowledged {}; max tracking error (realised vs commanded tool point, ideal drives) {:.6} mm\n",
+                "channel {}: {}; M functions acknowledged {}; max tracking error (tool point of the actual joints vs the commanded one) {:.6} mm\n",
                 c.name, c.outcome, c.m_functions_acked, c.max_tracking_error_mm
             ));
             for (tick, event) in &c.tracking {
