@@ -16,9 +16,9 @@
 //! have none (as before).
 //! Run: `cargo bench -p cnc-core --bench channels`.
 
+use cnc_core::app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
 use cnc_core::channel::axes_out::AxisPublisher;
 use cnc_core::channel::{Channel, Controller};
-use cnc_core::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
 use hli::views::CncView;
 use hli::views::PlcView;
 use std::time::Instant;

@@ -1,15 +1,15 @@
-//! The CNC process. This first version holds the cyclic HLI demo (`cnc demo`) and the HLI
-//! tooling (`cnc hli symbols`, `cnc hli header`) and kinematics from the command line (`cnc kin`); channels, interpolation and axes follow.
+//! The CNC side of the runtime.
+//!
+//! The library: `machine` (one tick for channels, axes and engines), `channel` (NC channels
+//! and the dynamic CS), `axis` (the axis layer and the process image), `cam` (cam profiles),
+//! `nc` (the NC language). It knows no PLC program and no process.
+//!
+//! The application: `app` (scenarios and `cnc run`, the demo, the command-line tools), which
+//! may use the PLC crate; the `cnc` binary sits on top of it.
 
+pub mod app;
 pub mod axis;
 pub mod cam;
-pub mod cam_cli;
 pub mod channel;
-pub mod check_cli;
-pub mod demo;
-pub mod json;
-pub mod kin_cli;
 pub mod machine;
 pub mod nc;
-pub mod scenario;
-pub mod stats;

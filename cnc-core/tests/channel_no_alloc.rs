@@ -2,7 +2,7 @@
 //! kinematic transformation both ways, dynamic CS, HLI outputs, axis images) allocates nothing
 //! once the programs run.
 
-use cnc_core::scenario::fleet::running;
+use cnc_core::app::scenario::fleet::running;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -52,8 +52,8 @@ $ENDWHILE
 
 #[test]
 fn switching_tracking_on_and_off_decodes_without_allocating() {
-    use cnc_core::scenario::file::Scenario;
-    use cnc_core::scenario::machine::InProcess;
+    use cnc_core::app::scenario::file::Scenario;
+    use cnc_core::app::scenario::machine::InProcess;
     use hli::enums::DynCsState;
     let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"switcher\"\n\
         axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
@@ -64,7 +64,7 @@ fn switching_tracking_on_and_off_decodes_without_allocating() {
     })
     .unwrap();
     let mut run = InProcess::new(&scenario, 0).unwrap();
-    cnc_core::scenario::fleet::plc_setup(&hli::views::PlcView::new(&run.memory));
+    cnc_core::app::scenario::fleet::plc_setup(&hli::views::PlcView::new(&run.memory));
     // One pass of the loop first (the first pass may size buffers).
     for _ in 0..3000 {
         run.machine.tick(&run.memory);

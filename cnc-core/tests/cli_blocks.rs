@@ -1,7 +1,7 @@
 //! PLC timelines that call PLCopen blocks on scenario axes, with a real PLC process, in
 //! lockstep (tick-exact, reproducible) and in real time; bad calls refused before start.
 
-use cnc_core::scenario::{InProcess, Scenario};
+use cnc_core::app::scenario::{InProcess, Scenario};
 use std::path::PathBuf;
 use std::process::Command;
 

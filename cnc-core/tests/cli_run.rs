@@ -2,7 +2,7 @@
 //! lockstep runs are bit-identical to each other and to the in-process run; a real-time run
 //! completes; bad scenarios are refused before anything starts.
 
-use cnc_core::scenario::{InProcess, Scenario};
+use cnc_core::app::scenario::{InProcess, Scenario};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

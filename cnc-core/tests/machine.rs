@@ -1,7 +1,7 @@
 //! The machine tick: channel axes on the axis layer, single axes and an engine (gears) in one
 //! tick; scenario `[[axis]]` and `[[gear]]` tables, refused with file, key and reason.
 
-use cnc_core::scenario::{InProcess, Scenario, ScenarioError};
+use cnc_core::app::scenario::{InProcess, Scenario, ScenarioError};
 use hli::enums::CouplingState;
 use hli::layout::{HliAxis, HliAxisLrState};
 use hli::views::CncView;

@@ -1,8 +1,8 @@
 //! The seed's four application examples as scenarios (`scenarios/`), run in-process in
 //! lockstep (CNC tick, trace sample, PLC timeline cycle), each checked on its physical outcome.
 
+use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::channel::{Channel, RunState};
-use cnc_core::scenario::{InProcess, Scenario};
 use hli::enums::DynCsState;
 use kinematics::frame::offset_frame;
 use kinematics::PoseWords;

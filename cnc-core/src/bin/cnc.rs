@@ -13,25 +13,25 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Run the demo: the seed's examples 3 and 4 end to end in real time, with a PLC process.
-    Demo(cnc_core::demo::DemoArgs),
+    Demo(cnc_core::app::demo::DemoArgs),
     /// Run a scenario: machine configuration, NC programs, PLC timeline, trace.
-    Run(cnc_core::scenario::runner::RunArgs),
+    Run(cnc_core::app::scenario::runner::RunArgs),
     /// HLI tooling.
     Hli {
         #[command(subcommand)]
         what: HliCommand,
     },
     /// Check NC programs: parse, decode, report FILE:LINE:COL diagnostics.
-    Check(cnc_core::check_cli::CheckArgs),
+    Check(cnc_core::app::check_cli::CheckArgs),
     /// Cam profiles: evaluate, characteristic values, plot.
     Cam {
         #[command(subcommand)]
-        what: cnc_core::cam_cli::CamCommand,
+        what: cnc_core::app::cam_cli::CamCommand,
     },
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
-        what: cnc_core::kin_cli::KinCommand,
+        what: cnc_core::app::kin_cli::KinCommand,
     },
     /// Run the PLC process (what `cnc demo` spawns; same as the `plc` binary).
     #[command(hide = true)]
@@ -49,8 +49,8 @@ enum HliCommand {
 fn main() -> ExitCode {
     hli::init_logging();
     match Cli::parse().command {
-        Command::Demo(args) => cnc_core::demo::main(args),
-        Command::Run(args) => cnc_core::scenario::runner::main(args),
+        Command::Demo(args) => cnc_core::app::demo::main(args),
+        Command::Run(args) => cnc_core::app::scenario::runner::main(args),
         Command::Hli { what } => {
             let text = match what {
                 HliCommand::Symbols => {
@@ -60,9 +60,9 @@ fn main() -> ExitCode {
             };
             print_or_fail(&text)
         }
-        Command::Check(args) => cnc_core::check_cli::main(args),
-        Command::Kin { what } => cnc_core::kin_cli::main(what),
-        Command::Cam { what } => cnc_core::cam_cli::main(what),
+        Command::Check(args) => cnc_core::app::check_cli::main(args),
+        Command::Kin { what } => cnc_core::app::kin_cli::main(what),
+        Command::Cam { what } => cnc_core::app::cam_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }
 }

@@ -1,7 +1,7 @@
 //! `cnc check`: parse and decode NC programs, report every problem as
 //! `FILE:LINE:COL: error: MESSAGE`, optionally print the decoded motion blocks as JSON lines.
 
-use crate::json::number;
+use crate::app::json::number;
 use crate::nc::decode::{check_channel_axes, ZeroVars};
 use crate::nc::{decode_program, parse, Decoded, Diagnostic};
 use std::path::PathBuf;

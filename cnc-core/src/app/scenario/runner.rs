@@ -16,8 +16,8 @@
 use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::machine::{build, Machine};
 use super::trace::Trace;
+use crate::app::stats::Percentiles;
 use crate::channel::diagnosis::log_message;
-use crate::stats::Percentiles;
 use core::time::Duration;
 use hli::events::{EventLink, Side};
 use hli::raw::monotonic;

@@ -59,7 +59,7 @@ fn build(id: u32, robot: Option<&str>) -> Result<Box<dyn Kinematics>, String> {
     }
 }
 
-use crate::json::number as num;
+use crate::app::json::number as num;
 
 fn joints_json(j: &Joints, count: usize) -> String {
     let items: Vec<String> = j[..count].iter().map(|v| num(*v)).collect();

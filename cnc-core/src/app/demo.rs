@@ -11,8 +11,8 @@
 //! M-function handshakes completed, the tick compute time and start lateness (p50/p99/max) and
 //! what the PLC did; the traces go to the folder `--out` names.
 
-use crate::scenario::runner::{run, RunOptions};
-use crate::scenario::{Scenario, ScenarioError};
+use crate::app::scenario::runner::{run, RunOptions};
+use crate::app::scenario::{Scenario, ScenarioError};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -41,7 +41,7 @@ struct Embedded {
 
 macro_rules! embed {
     ($dir:literal: $($file:literal),+) => {
-        &[$(($file, include_str!(concat!("../../scenarios/", $dir, "/", $file)))),+]
+        &[$(($file, include_str!(concat!("../../../scenarios/", $dir, "/", $file)))),+]
     };
 }
 

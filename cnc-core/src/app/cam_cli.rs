@@ -1,9 +1,9 @@
 //! `cnc cam eval|charac|plot`: a cam file (JSON motion function or table, or the binary table
 //! format) evaluated, characterised or drawn from the command line.
 
+use crate::app::json::number as num;
 use crate::cam::file::{self, BinaryOptions, LoadError};
 use crate::cam::{CamProfile, CharacValues, Interpolation, ProfileCursor, Sample};
-use crate::json::number as num;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

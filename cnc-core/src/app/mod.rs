@@ -1,0 +1,12 @@
+//! The `cnc` application around the library: scenarios and `cnc run` (the CNC process with
+//! its spawned PLC), the demo, and the command-line tools. This tree may use the PLC crate
+//! (`plc-shim`: timelines, the PLC process); the library modules beside it (`machine`,
+//! `channel`, `axis`, `cam`, `nc`) do not.
+
+pub mod cam_cli;
+pub mod check_cli;
+pub mod demo;
+pub mod json;
+pub mod kin_cli;
+pub mod scenario;
+pub mod stats;
