@@ -5,7 +5,7 @@
 //! A path is resolved once into a [`Leaf`] (offset, type, writer); reading and writing a
 //! resolved leaf does not allocate and goes through the atomic accessors of [`crate::raw`].
 
-use crate::desc::{Scalar, Writer};
+use crate::desc::{Scalar, SymbolWriter};
 use crate::raw::ImageMemory;
 use crate::symbols::{SymbolKind, SymbolTable};
 
@@ -17,7 +17,7 @@ pub struct Leaf {
     /// Elementary type.
     pub scalar: Scalar,
     /// Who writes it.
-    pub writer: Writer,
+    pub writer: SymbolWriter,
 }
 
 /// A raw value of a leaf, widened without loss.
@@ -92,7 +92,7 @@ impl Leaf {
 
     /// Whether the PLC may write this leaf (PLC-owned or a shared semaphore/command word).
     pub fn plc_writable(&self) -> bool {
-        matches!(self.writer, Writer::Plc | Writer::Both)
+        matches!(self.writer, SymbolWriter::Plc | SymbolWriter::Both)
     }
 
     /// Reads the leaf (acquire: a semaphore read orders the payload reads after it).

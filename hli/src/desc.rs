@@ -4,12 +4,12 @@
 //! offsets, writers), the layout hash in the segment header, the generated C header, and the
 //! leaf-by-leaf atomic copies between shared memory and process-local values.
 
-use crate::raw::{Leaf, Place};
+use crate::raw::{AtomicLeaf, Place};
 use bytemuck::Pod;
 
 /// Which side of the HLI writes a value. Everything else only reads it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Writer {
+pub enum SymbolWriter {
     /// The CNC process writes (`*_r` elements, state images).
     Cnc,
     /// The PLC process writes (`*_w` elements, commands).
@@ -22,15 +22,15 @@ pub enum Writer {
     Parent,
 }
 
-impl Writer {
+impl SymbolWriter {
     /// Name printed in the symbol table.
     pub fn label(self) -> &'static str {
         match self {
-            Writer::Cnc => "CNC",
-            Writer::Plc => "PLC",
-            Writer::Both => "CNC+PLC",
-            Writer::Io => "IO",
-            Writer::Parent => "MIXED",
+            SymbolWriter::Cnc => "CNC",
+            SymbolWriter::Plc => "PLC",
+            SymbolWriter::Both => "CNC+PLC",
+            SymbolWriter::Io => "IO",
+            SymbolWriter::Parent => "MIXED",
         }
     }
 }
@@ -167,7 +167,7 @@ pub struct FieldDesc {
     /// The field's type.
     pub ty: fn() -> TypeDesc,
     /// Who writes it.
-    pub writer: Writer,
+    pub writer: SymbolWriter,
 }
 
 /// A type that can live in the HLI image: plain old data with a description, copied to and
@@ -188,9 +188,9 @@ macro_rules! scalar_types {
                 TypeDesc { size: core::mem::size_of::<$t>(), align: core::mem::align_of::<$t>(),
                            kind: Kind::Scalar(Scalar::$s) }
             }
-            fn load(place: Place<'_, Self>) -> Self { Leaf::load_at(place, core::sync::atomic::Ordering::Relaxed) }
+            fn load(place: Place<'_, Self>) -> Self { AtomicLeaf::load_at(place, core::sync::atomic::Ordering::Relaxed) }
             fn store(place: Place<'_, Self>, value: &Self) {
-                Leaf::store_at(place, *value, core::sync::atomic::Ordering::Relaxed)
+                AtomicLeaf::store_at(place, *value, core::sync::atomic::Ordering::Relaxed)
             }
         }
     )*};
@@ -314,7 +314,7 @@ impl<T: HliType> PlaceExt<T> for Place<'_, T> {
 
 /// Defines an image struct: `#[repr(C)]`, Pod/Zeroable, a description for the symbol table and
 /// C header, field-wise atomic copies, and compile-time asserts of its size and every field
-/// offset (the `[N, Writer]` after each field).
+/// offset (the `[N, SymbolWriter]` after each field).
 #[macro_export]
 macro_rules! hli_struct {
     (
@@ -353,7 +353,7 @@ macro_rules! hli_struct {
                         name: stringify!($field),
                         offset: core::mem::offset_of!($name, $field),
                         ty: <$fty as $crate::desc::HliType>::desc,
-                        writer: $crate::desc::Writer::$writer,
+                        writer: $crate::desc::SymbolWriter::$writer,
                     }, )*
                 ];
                 $crate::desc::TypeDesc {

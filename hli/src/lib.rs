@@ -7,13 +7,15 @@
 //! * [`segment`]: the shared-memory object (create, attach, validate, heartbeats);
 //! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
 //!   PLC's side of an image;
-//! * [`events`]: iceoryx2 wake-ups; [`rpc`]: acyclic calls over iceoryx2 request-response;
+//! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (kinds,
+//!   bodies, codes), [`rpc`] (the iceoryx2 request-response transport; re-exports both);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
 
 pub mod access;
 pub mod c_header;
+pub mod calls;
 pub mod command_book;
 pub mod desc;
 pub mod enums;
@@ -27,8 +29,9 @@ pub mod signals;
 pub mod symbols;
 pub mod units;
 pub mod views;
+pub mod wire;
 
-pub use desc::{Bool, HliType, PlaceExt, Writer as SymbolWriter};
+pub use desc::{Bool, HliType, PlaceExt, SymbolWriter};
 pub use raw::{ImageMemory, Place};
 
 /// Quiets iceoryx2's own logging to errors unless `IOX2_LOG_LEVEL` says otherwise (it warns

@@ -138,7 +138,7 @@ impl ImageMemory {
 /// A `T` that lives at a fixed offset inside an [`ImageMemory`].
 ///
 /// A `Place` is a capability, not a reference: it never yields `&T`. Leaves are loaded and
-/// stored atomically; structs are copied leaf by leaf through [`crate::desc::HliType`].
+/// stored atomically; structs are copied leaf by leaf by the `desc` layer above.
 pub struct Place<'m, T> {
     base: NonNull<u8>,
     offset: usize,
@@ -210,7 +210,7 @@ impl<'m, E, const N: usize> Place<'m, [E; N]> {
 }
 
 /// A scalar that lives in shared memory and is accessed with an atomic of its own size.
-pub trait Leaf: Copy + sealed::Sealed {
+pub trait AtomicLeaf: Copy + sealed::Sealed {
     /// Atomic load of the value at `place`.
     fn load_at(place: Place<'_, Self>, order: Ordering) -> Self;
     /// Atomic store of `value` at `place`.
@@ -224,7 +224,7 @@ mod sealed {
 macro_rules! leaf_via_atomic {
     ($($t:ty => $atomic:ty),* $(,)?) => {$(
         impl sealed::Sealed for $t {}
-        impl Leaf for $t {
+        impl AtomicLeaf for $t {
             fn load_at(place: Place<'_, Self>, order: Ordering) -> Self {
                 // SAFETY: the place is in bounds and aligned for `$t` (checked on derivation),
                 // `$atomic` has the same size and alignment as `$t`, and the memory is only ever
@@ -249,12 +249,12 @@ leaf_via_atomic!(
 macro_rules! float_leaf {
     ($($t:ty => $bits:ty),* $(,)?) => {$(
         impl sealed::Sealed for $t {}
-        impl Leaf for $t {
+        impl AtomicLeaf for $t {
             fn load_at(place: Place<'_, Self>, order: Ordering) -> Self {
-                <$t>::from_bits(<$bits as Leaf>::load_at(place.cast(), order))
+                <$t>::from_bits(<$bits as AtomicLeaf>::load_at(place.cast(), order))
             }
             fn store_at(place: Place<'_, Self>, value: Self, order: Ordering) {
-                <$bits as Leaf>::store_at(place.cast(), value.to_bits(), order)
+                <$bits as AtomicLeaf>::store_at(place.cast(), value.to_bits(), order)
             }
         }
     )*};
@@ -262,7 +262,7 @@ macro_rules! float_leaf {
 
 float_leaf!(f32 => u32, f64 => u64);
 
-impl<T: Leaf> Place<'_, T> {
+impl<T: AtomicLeaf> Place<'_, T> {
     /// Relaxed atomic load (payload words; ordering comes from the semaphore).
     pub fn load(self) -> T {
         T::load_at(self, Ordering::Relaxed)
@@ -284,28 +284,29 @@ impl<T: Leaf> Place<'_, T> {
 impl Place<'_, u64> {
     /// Atomic increment (heartbeats); returns the new value.
     pub fn increment(self) -> u64 {
-        // SAFETY: as in `Leaf::load_at` for u64.
+        // SAFETY: as in `AtomicLeaf::load_at` for u64.
         let atomic = unsafe { AtomicU64::from_ptr(self.address().cast()) };
         atomic.fetch_add(1, Ordering::Release).wrapping_add(1)
     }
 }
 
-// iceoryx2 moves these types between processes by copying their bytes into shared memory.
-mod zero_copy {
-    use crate::layout::HliCoordinateSystemInt;
-    use crate::rpc::{AcyclicRequest, AcyclicResponse};
-    use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;
-
-    macro_rules! zero_copy_send {
-        ($($t:ty),*) => {$(
-            // SAFETY: `$t` is `#[repr(C)]` plain old data (bytemuck `Pod`): no pointers, no
-            // references, no process-local handles, every bit pattern valid. Both processes
-            // are built from this crate, so the default type name identifies the same layout.
-            unsafe impl ZeroCopySend for $t {}
-        )*};
-    }
-    zero_copy_send!(AcyclicRequest, AcyclicResponse, HliCoordinateSystemInt);
+/// `ZeroCopySend` for plain-data types iceoryx2 moves between processes by copying their bytes
+/// into shared memory. Invoked where the types are defined (`wire`, `layout`); the type must
+/// be bytemuck `Pod`, which the expansion checks.
+macro_rules! zero_copy_send {
+    ($($t:ty),*) => {$(
+        const _: fn() = || {
+            fn plain_data<T: bytemuck::Pod>() {}
+            plain_data::<$t>();
+        };
+        // SAFETY: `$t` is `#[repr(C)]` plain old data (bytemuck `Pod`, checked above): no
+        // pointers, no references, no process-local handles, every bit pattern valid. Both
+        // processes are built from this crate, so the default type name identifies the same
+        // layout.
+        unsafe impl iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend for $t {}
+    )*};
 }
+pub(crate) use zero_copy_send;
 
 /// The CNC's tick clock: CLOCK_MONOTONIC, with a sleep to an absolute deadline so that the
 /// tick period does not drift by the time spent computing a sleep duration (the thread can be

@@ -5,7 +5,7 @@
 //! through pointer arrays, `gpCh[0]^channel_mc_control.dyn_cs.command_w.translation[1]`,
 //! `gpAx[6]^lr_state.current_position_acs_r`; the header is `header.magic`.
 
-use crate::desc::{HliType, Kind, Scalar, TypeDesc, Writer};
+use crate::desc::{HliType, Kind, Scalar, SymbolWriter, TypeDesc};
 use crate::layout::HliImage;
 use std::collections::HashMap;
 use std::sync::OnceLock;
@@ -32,8 +32,8 @@ pub struct Symbol {
     pub size: usize,
     /// ST type name.
     pub type_name: String,
-    /// Who writes it; [`Writer::Parent`] (printed MIXED) for a node whose leaves differ.
-    pub writer: Writer,
+    /// Who writes it; [`SymbolWriter::Parent`] (printed MIXED) for a node whose leaves differ.
+    pub writer: SymbolWriter,
     /// Leaf, struct or array.
     pub kind: SymbolKind,
 }
@@ -101,9 +101,9 @@ impl SymbolTable {
     }
 }
 
-fn own_writer(field: Writer, inherited: Option<Writer>) -> Option<Writer> {
+fn own_writer(field: SymbolWriter, inherited: Option<SymbolWriter>) -> Option<SymbolWriter> {
     match field {
-        Writer::Parent => inherited,
+        SymbolWriter::Parent => inherited,
         explicit => Some(explicit),
     }
 }
@@ -113,7 +113,7 @@ fn walk(
     path: String,
     offset: usize,
     ty: &TypeDesc,
-    writer: Option<Writer>,
+    writer: Option<SymbolWriter>,
     deref_elements: bool,
 ) {
     let index = out.len();
@@ -122,7 +122,7 @@ fn walk(
         offset,
         size: ty.size,
         type_name: ty.st_name(),
-        writer: writer.unwrap_or(Writer::Parent),
+        writer: writer.unwrap_or(SymbolWriter::Parent),
         kind: match ty.kind {
             Kind::Scalar(s) => SymbolKind::Leaf(s),
             Kind::Struct { .. } => SymbolKind::Struct,
@@ -231,12 +231,12 @@ mod tests {
         assert_eq!(s.offset, dyn_cs + 40 + 4);
         assert_eq!(s.size, 4);
         assert_eq!(s.type_name, "DINT");
-        assert_eq!(s.writer, Writer::Plc);
+        assert_eq!(s.writer, SymbolWriter::Plc);
 
         let ax6 = offset_of!(HliImage, gpAx) + 6 * size_of::<HliAxis>();
         let s = sym("gpAx[6]^lr_state.current_position_acs_r");
         assert_eq!(s.offset, ax6);
-        assert_eq!(s.writer, Writer::Cnc);
+        assert_eq!(s.writer, SymbolWriter::Cnc);
     }
 
     #[test]
@@ -245,29 +245,29 @@ mod tests {
         assert_eq!(unit.type_name, "MC_CONTROL_DYN_CS_UNIT");
         assert_eq!(unit.size, 128);
         assert_eq!(unit.kind, SymbolKind::Struct);
-        assert_eq!(unit.writer, Writer::Parent, "mixed writers");
+        assert_eq!(unit.writer, SymbolWriter::Parent, "mixed writers");
         assert_eq!(
             sym("gpCh[3]^channel_mc_control.dyn_cs.command_semaphore_rw").writer,
-            Writer::Both
+            SymbolWriter::Both
         );
         assert_eq!(
             sym("gpCh[3]^channel_mc_control.dyn_cs.transition_w.command").writer,
-            Writer::Both
+            SymbolWriter::Both
         );
         assert_eq!(
             sym("gpCh[3]^channel_mc_control.dyn_cs.transition_w.f_wait").writer,
-            Writer::Plc
+            SymbolWriter::Plc
         );
         assert_eq!(
             sym("gpCh[3]^channel_mc_control.dyn_cs.request_r").writer,
-            Writer::Cnc
+            SymbolWriter::Cnc
         );
         assert_eq!(
             sym("gpCh[11]^bahn_state.coord_r[31].position_dyncs_r").type_name,
             "DINT"
         );
         assert_eq!(sym("gpAx[31]^enc_in.nStatus4").type_name, "USINT");
-        assert_eq!(sym("gpAx[31]^enc_in").writer, Writer::Io);
+        assert_eq!(sym("gpAx[31]^enc_in").writer, SymbolWriter::Io);
         assert_eq!(sym("gpFifo[7]^rows_consumed_r").type_name, "ULINT");
         assert_eq!(
             sym("gpCh[0]^channel_mc_control.dyn_cs.request_r.translation").type_name,

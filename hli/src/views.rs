@@ -423,6 +423,25 @@ fn validate_override(unit: &HliChannelOverrideUnit) -> Result<PathOverride, Over
     })
 }
 
+/// The standard handler for [`crate::calls::ReadAxisState`] over a CNC view: validates the index.
+pub fn handle_read_axis_state(
+    view: &CncView<'_>,
+    request: &crate::wire::AcyclicRequest,
+) -> crate::calls::HandlerResult {
+    let body: crate::calls::ReadAxisState = crate::calls::decode_body(request)?;
+    if body.reserved != 0 {
+        return Err(crate::calls::ErrorCode::InvalidData);
+    }
+    let axis = view
+        .axis(request.target as usize)
+        .map_err(|_| crate::calls::ErrorCode::InvalidTarget)?;
+    let state: crate::layout::HliAxisLrState =
+        crate::desc::PlaceExt::read(axis.field::<crate::layout::HliAxisLrState>(
+            core::mem::offset_of!(crate::layout::HliAxis, lr_state),
+        ));
+    crate::calls::reply(&state)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

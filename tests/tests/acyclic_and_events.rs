@@ -5,10 +5,10 @@ use hli::enums::AxisState;
 use hli::events::{EventLink, Side};
 use hli::layout::{HliAxis, HliAxisLrState};
 use hli::rpc::{
-    handle_read_axis_state, AcyclicCall, AcyclicClient, AcyclicServer, CallError, CallKind,
-    ErrorCode, ReadAxisState,
+    AcyclicCall, AcyclicClient, AcyclicServer, CallError, CallKind, ErrorCode, ReadAxisState,
 };
 use hli::segment::CncSegment;
+use hli::views::handle_read_axis_state;
 use hli::views::CncView;
 use hli::PlaceExt;
 use std::sync::atomic::{AtomicBool, Ordering};

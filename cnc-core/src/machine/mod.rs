@@ -28,13 +28,11 @@ use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
 use crate::channel::{Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
+use hli::calls::{reply, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::DynCsState;
 use hli::layout::HLI_MAX_AXES;
-use hli::rpc::{
-    handle_read_axis_state, reply, AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind,
-    ErrorCode, HandlerResult,
-};
-use hli::views::CncView;
+use hli::views::{handle_read_axis_state, CncView};
+use hli::wire::AcyclicRequest;
 use hli::ImageMemory;
 use nalgebra::Isometry3;
 

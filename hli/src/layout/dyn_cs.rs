@@ -26,6 +26,9 @@ hli_struct! {
     }
 }
 
+// Published as an iceoryx2 sample by the handshake benchmark's baseline.
+crate::raw::zero_copy_send!(HliCoordinateSystemInt);
+
 hli_struct! {
     /// State of the tracking (slave) channel as the CNC reports it.
     ///

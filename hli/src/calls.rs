@@ -1,0 +1,240 @@
+//! The vocabulary of the acyclic calls: the call kinds, each kind's typed request and reply
+//! body ([`AcyclicCall`]), the ADS-style refusal codes, and the body decoding a handler uses.
+//! The engines add their kinds to [`CallKind`].
+
+use crate::enums::InvalidValue;
+use crate::layout::HliAxisLrState;
+use crate::wire::{encode_body, AcyclicRequest, ACYCLIC_BODY_SIZE};
+use bytemuck::{Pod, Zeroable};
+use core::time::Duration;
+
+macro_rules! codes {
+    ($( $(#[doc = $d:literal])* $name:ident = $v:literal ),* $(,)?) => {
+        /// Why a call was refused: ADS-style device error codes.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum ErrorCode { $( $(#[doc = $d])* $name, )* }
+        impl ErrorCode {
+            /// The numeric code.
+            pub fn raw(self) -> u32 { match self { $( ErrorCode::$name => $v, )* } }
+            /// Decodes a numeric code.
+            pub fn decode(raw: u32) -> Result<Self, InvalidValue> {
+                $( if raw == $v { return Ok(ErrorCode::$name); } )*
+                Err(InvalidValue { type_name: "ErrorCode", raw: raw as i64,
+                                   allowed: concat!($(stringify!($v), " "),*) })
+            }
+        }
+    };
+}
+
+codes! {
+    /// The call kind is not known to the server (0x701, service not supported).
+    ServiceNotSupported = 0x701,
+    /// The target (axis, channel, table) does not exist (0x703, invalid index offset).
+    InvalidTarget = 0x703,
+    /// The body has the wrong size for the kind (0x705, invalid size).
+    InvalidSize = 0x705,
+    /// The body's values are not acceptable (0x706, invalid data).
+    InvalidData = 0x706,
+    /// The addressed object is busy or in a state that refuses the call (0x712, busy).
+    Busy = 0x712,
+}
+
+/// Numbers of the call kinds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CallKind {
+    /// [`ReadAxisState`].
+    ReadAxisState,
+    /// [`AxisCommandCall`].
+    AxisCommand,
+}
+
+impl CallKind {
+    /// The raw kind number.
+    pub fn raw(self) -> u32 {
+        match self {
+            CallKind::ReadAxisState => 1,
+            CallKind::AxisCommand => 2,
+        }
+    }
+
+    /// Decodes a raw kind number.
+    pub fn decode(raw: u32) -> Option<Self> {
+        match raw {
+            1 => Some(CallKind::ReadAxisState),
+            2 => Some(CallKind::AxisCommand),
+            _ => None,
+        }
+    }
+}
+
+/// A typed call: request body `Self`, reply body `Reply`.
+pub trait AcyclicCall: Pod {
+    /// The kind number.
+    const KIND: CallKind;
+    /// The reply body.
+    type Reply: Pod;
+}
+
+/// Reads the cyclic state of the axis given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct ReadAxisState {
+    /// Reserved, must be 0.
+    pub reserved: u32,
+}
+
+impl AcyclicCall for ReadAxisState {
+    const KIND: CallKind = CallKind::ReadAxisState;
+    type Reply = HliAxisLrState;
+}
+
+const _: () = assert!(core::mem::size_of::<HliAxisLrState>() <= ACYCLIC_BODY_SIZE);
+
+/// A motion command for the axis given as `target` (what MC_Power, MC_MoveAbsolute ... send
+/// on their Execute edge). Units are the axis's (mm or degree, per second...).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct AxisCommandCall {
+    /// Raw [`crate::enums::AxisCommandKind`].
+    pub command: u32,
+    /// MC_Power: 1 enable, 0 disable. Others: 0.
+    pub enable: u32,
+    /// MC_MoveVelocity: 1 positive, -1 negative. Others: 0.
+    pub direction: i32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Target position (absolute) or distance (relative).
+    pub position: f64,
+    /// Velocity limit of the move (or the velocity of MC_MoveVelocity), > 0.
+    pub velocity: f64,
+    /// Acceleration limit, > 0.
+    pub acceleration: f64,
+    /// Deceleration limit, > 0 (also of MC_Halt and MC_Stop).
+    pub deceleration: f64,
+    /// Jerk limit, > 0 (also of MC_Halt and MC_Stop).
+    pub jerk: f64,
+}
+
+impl AxisCommandCall {
+    fn motion(kind: crate::enums::AxisCommandKind) -> Self {
+        Self {
+            command: kind.raw(),
+            ..Self::default()
+        }
+    }
+    /// MC_Power with `enable`.
+    pub fn power(enable: bool) -> Self {
+        Self {
+            enable: u32::from(enable),
+            ..Self::motion(crate::enums::AxisCommandKind::Power)
+        }
+    }
+    /// MC_Reset.
+    pub fn reset() -> Self {
+        Self::motion(crate::enums::AxisCommandKind::Reset)
+    }
+    /// MC_MoveAbsolute to `position` with the limits `[velocity, acceleration, deceleration,
+    /// jerk]`.
+    pub fn move_absolute(position: f64, limits: [f64; 4]) -> Self {
+        Self {
+            position,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveAbsolute).with_limits(limits)
+        }
+    }
+    /// MC_MoveRelative by `distance` with the limits `[velocity, acceleration, deceleration,
+    /// jerk]`.
+    pub fn move_relative(distance: f64, limits: [f64; 4]) -> Self {
+        Self {
+            position: distance,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveRelative).with_limits(limits)
+        }
+    }
+    /// MC_MoveVelocity in `direction` (1 or -1) at `limits[0]`.
+    pub fn move_velocity(direction: i32, limits: [f64; 4]) -> Self {
+        Self {
+            direction,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveVelocity).with_limits(limits)
+        }
+    }
+    /// MC_Halt with `deceleration` and `jerk`.
+    pub fn halt(deceleration: f64, jerk: f64) -> Self {
+        Self {
+            deceleration,
+            jerk,
+            ..Self::motion(crate::enums::AxisCommandKind::Halt)
+        }
+    }
+    /// MC_Stop with `deceleration` and `jerk`.
+    pub fn stop(deceleration: f64, jerk: f64) -> Self {
+        Self {
+            deceleration,
+            jerk,
+            ..Self::motion(crate::enums::AxisCommandKind::Stop)
+        }
+    }
+    /// Releases MC_Stop's lock.
+    pub fn stop_release() -> Self {
+        Self::motion(crate::enums::AxisCommandKind::StopRelease)
+    }
+    fn with_limits(self, [velocity, acceleration, deceleration, jerk]: [f64; 4]) -> Self {
+        Self {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+            ..self
+        }
+    }
+}
+
+/// The reply to an [`AxisCommandCall`]: the command's id, or why the axis refused it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct AxisCommandReply {
+    /// Id the axis gave the command (see `HLI_AXIS_COMMAND_STATE`), 0 when refused.
+    pub command_id: u32,
+    /// 0 when accepted, else the raw [`crate::enums::AxisError`] of the refusal.
+    pub error_id: u32,
+}
+
+impl AcyclicCall for AxisCommandCall {
+    const KIND: CallKind = CallKind::AxisCommand;
+    type Reply = AxisCommandReply;
+}
+
+/// Why a call did not produce a reply.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum CallError {
+    /// The server refused it.
+    #[error("refused with error 0x{:X} ({code:?})", code.raw())]
+    Refused {
+        /// The server's code.
+        code: ErrorCode,
+    },
+    /// The server answered with something that does not decode.
+    #[error("malformed response: {0}")]
+    Malformed(String),
+    /// No answer within the timeout.
+    #[error("no response within {0:?}")]
+    Timeout(Duration),
+    /// iceoryx2 failed.
+    #[error("request-response service: {0}")]
+    Transport(String),
+}
+
+/// Decodes a request body as `T`; a size mismatch is [`ErrorCode::InvalidSize`].
+pub fn decode_body<T: Pod>(request: &AcyclicRequest) -> Result<T, ErrorCode> {
+    let len = request.body_len as usize;
+    if len != core::mem::size_of::<T>() {
+        return Err(ErrorCode::InvalidSize);
+    }
+    Ok(bytemuck::pod_read_unaligned(&request.body[..len]))
+}
+
+/// A reply a handler produces: the encoded body or a refusal.
+pub type HandlerResult = Result<([u8; ACYCLIC_BODY_SIZE], u32), ErrorCode>;
+
+/// Encodes a typed reply for a handler.
+pub fn reply<T: Pod>(value: &T) -> HandlerResult {
+    Ok(encode_body(value))
+}
