@@ -13,7 +13,7 @@ pub const ACYCLIC_BODY_SIZE: usize = 240;
 pub struct AcyclicRequest {
     /// Caller's running id, echoed in the response.
     pub invoke_id: u32,
-    /// Raw [`CallKind`].
+    /// Raw [`crate::calls::CallKind`].
     pub kind: u32,
     /// Addressed object (axis, channel, table id), kind-specific.
     pub target: u32,
@@ -31,7 +31,7 @@ pub struct AcyclicResponse {
     pub invoke_id: u32,
     /// Echo of the request's kind.
     pub kind: u32,
-    /// 0 on success, else an [`ErrorCode`].
+    /// 0 on success, else an [`crate::calls::ErrorCode`].
     pub error_code: u32,
     /// Valid bytes in `body`.
     pub body_len: u32,
