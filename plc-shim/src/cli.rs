@@ -29,6 +29,9 @@ pub struct PlcArgs {
     /// Stop after this many cycles.
     #[arg(long)]
     pub max_cycles: Option<u64>,
+    /// Real-time options of the PLC's cycle.
+    #[command(flatten)]
+    pub realtime: crate::realtime::RealtimeOptions,
 }
 
 /// Names of the built-in programs.
@@ -61,6 +64,10 @@ pub fn main(args: PlcArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     };
+    let realtime = args.realtime.apply("plc");
+    if !realtime.is_empty() {
+        println!("plc: real-time {}", realtime.join(", "));
+    }
     match runtime.run(program.as_mut(), args.max_cycles) {
         Ok(summary) => {
             println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);

@@ -6,6 +6,7 @@ pub mod blocks;
 pub mod cli;
 pub mod motion;
 pub mod programs;
+pub mod realtime;
 pub mod runtime;
 pub mod timeline;
 

@@ -31,6 +31,9 @@ pub struct DemoArgs {
     /// Lockstep instead of real time (reproducible traces).
     #[arg(long)]
     pub lockstep: bool,
+    /// Real-time options of the CNC's tick loop.
+    #[command(flatten)]
+    pub realtime: plc_shim::realtime::RealtimeOptions,
 }
 
 /// A scenario built into the binary: its name and its files (scenario first).
@@ -114,6 +117,7 @@ pub fn main(args: DemoArgs) -> ExitCode {
             instance: format!("{prefix}-{i}"),
             scratch: args.out.clone(),
             plc_watchdog_ticks: None,
+            realtime: args.realtime.clone(),
         };
         match run(&scenario, &options) {
             Ok(report) => {

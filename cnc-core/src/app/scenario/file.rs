@@ -61,6 +61,10 @@ struct ScenarioFile {
     plc: Option<PlcFile>,
     #[serde(default)]
     trace: TraceFile,
+    #[serde(default)]
+    realtime: plc_shim::realtime::RealtimeOptions,
+    #[serde(default)]
+    realtime_plc: plc_shim::realtime::RealtimeOptions,
 }
 
 fn default_cycle_ms() -> f64 {
@@ -123,6 +127,10 @@ pub struct Scenario {
     pub plc: PlcSetup,
     /// Trace signals: ST path and resolved leaf.
     pub signals: Vec<(String, Leaf)>,
+    /// Real-time options of the CNC's tick loop (`[realtime]`).
+    pub realtime: plc_shim::realtime::RealtimeOptions,
+    /// Real-time options of the spawned PLC (`[realtime_plc]`).
+    pub realtime_plc: plc_shim::realtime::RealtimeOptions,
 }
 
 impl Scenario {
@@ -258,6 +266,8 @@ impl Scenario {
             gears,
             plc,
             signals,
+            realtime: file.realtime,
+            realtime_plc: file.realtime_plc,
         })
     }
 }

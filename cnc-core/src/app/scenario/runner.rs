@@ -60,6 +60,9 @@ pub struct RunArgs {
     /// (default: the scenario's `plc_watchdog_ticks`, else 100).
     #[arg(long)]
     pub plc_watchdog_ticks: Option<u64>,
+    /// Real-time options of the tick loop (over the scenario's `[realtime]`).
+    #[command(flatten)]
+    pub realtime: plc_shim::realtime::RealtimeOptions,
 }
 
 /// How to run.
@@ -75,6 +78,8 @@ pub struct RunOptions {
     pub scratch: PathBuf,
     /// See [`RunArgs::plc_watchdog_ticks`].
     pub plc_watchdog_ticks: Option<u64>,
+    /// Real-time options of the tick loop (over the scenario's).
+    pub realtime: plc_shim::realtime::RealtimeOptions,
 }
 
 /// Why a run stopped before its end.
@@ -175,6 +180,8 @@ pub struct RunReport {
     /// Ticks from the stop until every channel and axis stood still (None: not within the
     /// stop limit).
     pub rest_after: Option<u64>,
+    /// Real-time options in force in the tick loop.
+    pub realtime: Vec<String>,
 }
 
 /// `cnc run`.
@@ -196,6 +203,7 @@ pub fn main(args: RunArgs) -> ExitCode {
         scratch: std::env::temp_dir(),
         instance,
         plc_watchdog_ticks: args.plc_watchdog_ticks,
+        realtime: args.realtime.clone(),
     };
     hli::signals::capture();
     match run(&scenario, &options) {
@@ -271,6 +279,8 @@ fn run_machine(
         }
     }
 
+    // After spawning: the PLC must not inherit the CNC's scheduling and CPU.
+    let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
     let limit = options
         .ticks
         .or(scenario.ticks)
@@ -404,6 +414,7 @@ fn run_machine(
         trace,
         stop: stop.map(|(cause, _)| cause),
         rest_after,
+        realtime,
     })
 }
 
@@ -483,6 +494,9 @@ impl RunReport {
             self.late_ns.max,
             self.acyclic_answered
         ));
+        if !self.realtime.is_empty() {
+            out.push_str(&format!("real-time: {}\n", self.realtime.join(", ")));
+        }
         if let Some(cause) = &self.stop {
             let rest = match self.rest_after {
                 Some(n) => format!("machine at rest {n} ticks after the stop"),
@@ -517,6 +531,7 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
             command.args(["--program", p]);
         }
     }
+    command.args(scenario.realtime_plc.to_args());
     command
         .stdout(Stdio::piped())
         .stdin(Stdio::null())

@@ -1,0 +1,145 @@
+//! Real-time options of a cyclic process (the CNC's tick loop, the PLC's cycle): SCHED_FIFO
+//! priority, CPU pinning, locked memory with a pre-faulted stack, timer slack. They come from
+//! the machine configuration and from flags (flags win); each one the system refuses is left
+//! out with one warning, and the process runs on without it.
+
+use serde::Deserialize;
+
+/// Stack pre-faulted when memory is locked.
+const PREFAULT_STACK: usize = 512 * 1024;
+
+/// The options; all off by default.
+#[derive(Debug, Clone, Default, PartialEq, Eq, clap::Args, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RealtimeOptions {
+    /// Run the cyclic thread under SCHED_FIFO at this priority (1..=99).
+    #[arg(long = "rt-priority")]
+    pub priority: Option<i32>,
+    /// Pin the cyclic thread to this CPU.
+    #[arg(long = "rt-cpu")]
+    pub cpu: Option<usize>,
+    /// Lock all memory (mlockall) and pre-fault the stack.
+    #[arg(long = "rt-lock-memory")]
+    #[serde(default)]
+    pub lock_memory: bool,
+    /// Timer slack of the cyclic thread, ns (1 is the least).
+    #[arg(long = "rt-timer-slack-ns")]
+    pub timer_slack_ns: Option<u64>,
+}
+
+impl RealtimeOptions {
+    /// These options where set, `file`'s elsewhere.
+    pub fn over(&self, file: &RealtimeOptions) -> RealtimeOptions {
+        RealtimeOptions {
+            priority: self.priority.or(file.priority),
+            cpu: self.cpu.or(file.cpu),
+            lock_memory: self.lock_memory || file.lock_memory,
+            timer_slack_ns: self.timer_slack_ns.or(file.timer_slack_ns),
+        }
+    }
+
+    /// Whether any option is set.
+    pub fn any(&self) -> bool {
+        *self != RealtimeOptions::default()
+    }
+
+    /// The same options as command-line flags (for a process this one spawns).
+    pub fn to_args(&self) -> Vec<String> {
+        let mut args = Vec::new();
+        if let Some(p) = self.priority {
+            args.extend(["--rt-priority".to_string(), p.to_string()]);
+        }
+        if let Some(c) = self.cpu {
+            args.extend(["--rt-cpu".to_string(), c.to_string()]);
+        }
+        if self.lock_memory {
+            args.push("--rt-lock-memory".into());
+        }
+        if let Some(t) = self.timer_slack_ns {
+            args.extend(["--rt-timer-slack-ns".to_string(), t.to_string()]);
+        }
+        args
+    }
+
+    /// Applies the options to the calling thread and process. Each refused one is left out
+    /// with one warning on stderr naming `who`; returns the ones in force, for the report.
+    pub fn apply(&self, who: &str) -> Vec<String> {
+        let mut applied = Vec::new();
+        #[cfg(target_os = "linux")]
+        {
+            use hli::raw::realtime as rt;
+            let mut attempt = |name: String, result: std::io::Result<()>| match result {
+                Ok(()) => applied.push(name),
+                Err(e) => {
+                    eprintln!("{who}: real-time option {name} refused ({e}); running without it")
+                }
+            };
+            if self.lock_memory {
+                let locked = rt::lock_memory();
+                if locked.is_ok() {
+                    rt::prefault_stack(PREFAULT_STACK);
+                }
+                attempt("locked memory".into(), locked);
+            }
+            if let Some(ns) = self.timer_slack_ns {
+                attempt(format!("timer slack {ns} ns"), rt::set_timer_slack(ns));
+            }
+            if let Some(cpu) = self.cpu {
+                attempt(format!("CPU {cpu}"), rt::pin_to_cpu(cpu));
+            }
+            if let Some(p) = self.priority {
+                attempt(format!("SCHED_FIFO {p}"), rt::set_fifo_priority(p));
+            }
+        }
+        #[cfg(not(target_os = "linux"))]
+        if self.any() {
+            eprintln!("{who}: real-time options need Linux; running without them");
+        }
+        applied
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flags_win_over_the_file_and_round_trip_as_arguments() {
+        let file = RealtimeOptions {
+            priority: Some(70),
+            cpu: Some(1),
+            lock_memory: false,
+            timer_slack_ns: Some(1000),
+        };
+        let flags = RealtimeOptions {
+            priority: Some(80),
+            ..RealtimeOptions::default()
+        };
+        let o = flags.over(&file);
+        assert_eq!(
+            (o.priority, o.cpu, o.timer_slack_ns),
+            (Some(80), Some(1), Some(1000))
+        );
+        assert_eq!(
+            o.to_args(),
+            [
+                "--rt-priority",
+                "80",
+                "--rt-cpu",
+                "1",
+                "--rt-timer-slack-ns",
+                "1000"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_refused_option_is_left_out_and_the_rest_applies() {
+        let o = RealtimeOptions {
+            priority: Some(1000),
+            timer_slack_ns: Some(50_000),
+            ..RealtimeOptions::default()
+        };
+        assert_eq!(o.apply("test"), vec!["timer slack 50000 ns".to_string()]);
+    }
+}
