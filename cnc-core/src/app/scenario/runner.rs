@@ -165,6 +165,8 @@ pub struct RunReport {
     pub ticks: u64,
     /// Compute time of a tick, ns.
     pub tick_ns: Percentiles,
+    /// Median ns of the tick's parts: machine tick, trace sample, acyclic calls, event.
+    pub stage_p50_ns: [u64; 4],
     /// How late a tick started after its deadline (real-time mode), ns.
     pub late_ns: Percentiles,
     /// Per channel.
@@ -295,6 +297,8 @@ fn run_machine(
     let mut trace = Trace::new(&scenario.signals, rows);
     let mut tick_ns = Vec::with_capacity(rows);
     let mut late_ns = Vec::with_capacity(rows);
+    // Where a tick's time goes: machine tick, trace sample, acyclic calls, "tick done" event.
+    let mut stage_ns: [Vec<u64>; 4] = core::array::from_fn(|_| Vec::with_capacity(rows));
     let mut acyclic_answered = 0u64;
     let memory = segment.memory();
     let view = CncView::new(memory);
@@ -334,17 +338,27 @@ fn run_machine(
         }
         let t0 = monotonic::now();
         machine.tick(memory);
+        let t1 = monotonic::now();
         let time = if options.lockstep {
             tick as f64 * scenario.cycle_s
         } else {
             (t0 - start).as_secs_f64()
         };
         trace.record(memory, tick, time);
+        let t2 = monotonic::now();
         acyclic_answered += server
             .poll(|kind, request| machine.dispatch(&view, kind, request))
             .unwrap_or(0) as u64;
+        let t3 = monotonic::now();
         let _ = events.notify();
-        tick_ns.push((monotonic::now() - t0).as_nanos() as u64);
+        let t4 = monotonic::now();
+        tick_ns.push((t4 - t0).as_nanos() as u64);
+        for (stage, (a, b)) in stage_ns
+            .iter_mut()
+            .zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)])
+        {
+            stage.push((b - a).as_nanos() as u64);
+        }
         late_ns.push(t0.saturating_sub(deadline).as_nanos() as u64);
 
         // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on it
@@ -403,6 +417,7 @@ fn run_machine(
     Ok(RunReport {
         ticks,
         tick_ns: Percentiles::of(&mut tick_ns),
+        stage_p50_ns: stage_ns.map(|mut v| Percentiles::of(&mut v).p50),
         late_ns: if options.lockstep {
             Percentiles::default()
         } else {
@@ -483,6 +498,10 @@ impl RunReport {
                 out.push_str(&c.diagnosis);
             }
         }
+        let [machine, trace, acyclic, event] = self.stage_p50_ns;
+        out.push_str(&format!(
+            "tick parts p50: machine {machine} ns, trace {trace} ns, acyclic calls {acyclic} ns, tick-done event {event} ns\n"
+        ));
         out.push_str(&format!(
             "ticks {}; tick compute p50 {} ns, p99 {} ns, max {} ns; start lateness p50 {} ns, p99 {} ns, max {} ns; acyclic calls answered {}\n",
             self.ticks,
