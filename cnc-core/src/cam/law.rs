@@ -215,20 +215,9 @@ impl FunctionType {
     }
 
     /// Whether the start point's jerk field sets the law's symmetry (seed: the rest-to-rest
-    /// laws whose jerk at the ends is not a boundary value).
+    /// laws whose jerk at the ends is not a boundary value; every one but the step).
     pub fn has_symmetry(self) -> bool {
-        use FunctionType::*;
-        matches!(
-            self,
-            Polynom3
-                | Polynom5
-                | Polynom8
-                | SineLine
-                | ModifiedSineLine
-                | Bestehorn
-                | AccelerationTrapezoid
-                | SineStraightCombination
-        )
+        self.ends() == (EndKind::Rest, EndKind::Rest) && self != FunctionType::Step
     }
 }
 
