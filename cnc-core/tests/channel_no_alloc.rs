@@ -86,3 +86,56 @@ fn switching_tracking_on_and_off_decodes_without_allocating() {
     assert!(switched >= 8, "only {switched} state changes in 6000 ticks");
     assert_eq!(made, 0, "{made} allocations in 6000 ticks of switching");
 }
+
+/// The whole machine tick: a channel looping moves on PT2 drives, a gear engine driving a
+/// single axis from it, a second single axis moving under MC_MoveVelocity-like commands, and
+/// a PLC timeline cycling against the same image.
+#[test]
+fn the_machine_tick_with_single_axes_an_engine_and_a_plc_allocates_nothing() {
+    use cnc_core::app::scenario::file::Scenario;
+    use cnc_core::app::scenario::machine::InProcess;
+    use hli::rpc::AxisCommandCall;
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"portal\"\n\
+        axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"loop.nc\"\n\
+        drive = { model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }\n\
+        [[axis]]\nname = \"Follower\"\npower = true\n\
+        [[axis]]\nname = \"Spindle\"\nkind = \"rotary\"\npower = true\n\
+        drive = { model = \"pt1\", t1_ms = 2.0 }\n\
+        [[gear]]\nmaster = \"portal.X\"\nslave = \"Follower\"\nratio = -0.5\n\
+        [plc]\ntimeline = \"plc.toml\"\n";
+    let program = "%loop\n$WHILE 1\nG1 X200 Y20 F12000\nG1 X0 Y0 F12000\n$ENDWHILE\n";
+    let timeline = "[[step]]\nrepeat = true\nwhen = \"gpAx[0]^lr_state.command_velocity_r > 0\"\n\
+        set = { \"gpCh[0]^channel_mc_control.dyn_cs.enable_w\" = false }\n";
+    let s = Scenario::parse("alloc.toml", toml, |f| {
+        let text = if f == "loop.nc" { program } else { timeline };
+        Ok((std::path::PathBuf::from(f), text.to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..500 {
+        run.step(s.cycle_s);
+    }
+    let spindle = run.machine.channel_axes() + 1;
+    let call = AxisCommandCall::move_velocity(1, [90.0, 900.0, 900.0, 9000.0]);
+    run.machine
+        .axes_mut()
+        .axis_mut(spindle)
+        .unwrap()
+        .command(&call)
+        .expect("the spindle runs");
+    for _ in 0..500 {
+        run.step(s.cycle_s);
+    }
+    let before = allocations();
+    for _ in 0..5000 {
+        run.step(s.cycle_s);
+    }
+    let made = allocations() - before;
+    assert_eq!(made, 0, "{made} allocations in 5000 machine ticks and PLC cycles");
+    // Everything moved in the measured ticks.
+    let axes = run.machine.axes();
+    let follower = axes.axis(run.machine.channel_axes()).unwrap();
+    assert!(follower.coupling().is_some() && follower.error().is_none());
+    assert!(axes.axis(spindle).unwrap().setpoint().velocity > 89.0);
+    assert!(run.timeline.as_ref().unwrap().records()[0].fired > 1000);
+}
