@@ -131,7 +131,10 @@ fn the_machine_tick_with_single_axes_an_engine_and_a_plc_allocates_nothing() {
         run.step(s.cycle_s);
     }
     let made = allocations() - before;
-    assert_eq!(made, 0, "{made} allocations in 5000 machine ticks and PLC cycles");
+    assert_eq!(
+        made, 0,
+        "{made} allocations in 5000 machine ticks and PLC cycles"
+    );
     // Everything moved in the measured ticks.
     let axes = run.machine.axes();
     let follower = axes.axis(run.machine.channel_axes()).unwrap();
