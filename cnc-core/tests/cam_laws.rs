@@ -164,7 +164,7 @@ fn characteristic_values_match_the_published_coefficients() {
             FunctionType::ModifiedSineLine,
             4.0 * PI / (4.0 + PI),
             4.0 * PI * PI / (4.0 + PI),
-            0.0,
+            16.0 * PI * PI * PI / (4.0 + PI),
         ),
         (FunctionType::Polynom3, 1.5, 6.0, 12.0),
     ];
@@ -274,7 +274,10 @@ fn characteristic_values_agree_with_a_fine_sweep_for_every_law() {
 #[test]
 fn rescaling_to_a_master_velocity_scales_each_order() {
     let c = CharacValues::normed(&unit(FunctionType::Polynom5, 0.0));
-    let r = c.rescaled(3.0);
+    let r = c.rescaled(3.0).unwrap();
+    assert!(
+        c.rescaled(0.0).is_none() && c.rescaled(-1.0).is_none() && c.rescaled(f64::NAN).is_none()
+    );
     assert_eq!(r.fMasterVeloNom, 3.0);
     assert!((r.fSlaveVeloMax - 3.0 * c.fSlaveVeloMax).abs() < 1e-12);
     assert!((r.fSlaveAccMax - 9.0 * c.fSlaveAccMax).abs() < 1e-12);
@@ -401,4 +404,42 @@ fn the_value_table_selects_its_columns_by_mask() {
         };
         assert_eq!(e.code(), want, "{mask} {from} {to} {inc}");
     }
+}
+
+#[test]
+fn a_falling_master_starts_at_its_first_point_in_the_characteristic_values() {
+    let points = [
+        MotionFunctionPoint::new(1, FunctionType::Polynom5, PointType::Rest, 0.0, 0.0),
+        MotionFunctionPoint::new(2, FunctionType::Polynom1, PointType::Rest, -100.0, 30.0),
+    ];
+    let c = CharacValues::normed(&CamProfile::MotionFunction(
+        MotionFunction::new(&points).unwrap(),
+    ));
+    assert_eq!((c.fMasterPosStart, c.fSlavePosStart), (0.0, 0.0));
+    assert_eq!((c.fMasterPosEnd, c.fSlavePosEnd), (-100.0, 30.0));
+    // Peak velocity mid-way, negative: the slave rises while the master falls.
+    assert!(
+        (c.fSlaveVeloMin + 1.875 * 30.0 / 100.0).abs() < 1e-9,
+        "{}",
+        c.fSlaveVeloMin
+    );
+    assert!((c.fMPosAtSVeloMin + 50.0).abs() < 1e-9);
+    assert!((c.fSlaveVeloMean - 0.3).abs() < 1e-9);
+}
+
+#[test]
+fn ignored_points_are_ignored_completely() {
+    let mut points = vec![
+        MotionFunctionPoint::new(1, FunctionType::Polynom5, PointType::Rest, 0.0, 0.0),
+        MotionFunctionPoint::new(2, FunctionType::Polynom5, PointType::Ignore, 50.0, 10.0),
+        MotionFunctionPoint::new(3, FunctionType::Polynom1, PointType::Rest, 100.0, 1.0),
+    ];
+    // An ignored point with an undefined function type and a NaN takes no part.
+    points[1].function = 0;
+    points[1].slave = f64::NAN;
+    // The last point's function type is not used either.
+    points[2].function = 0;
+    let f = MotionFunction::new(&points).expect("the ignored point does not count");
+    assert_eq!(f.segments().len(), 1);
+    assert!((at(&f, 50.0).position - 0.5).abs() < 1e-12);
 }

@@ -69,10 +69,21 @@ fn at_master_positions_the_change_waits_for_the_crossing() {
         e,
         CamError::ActivationPassed {
             position: 250.0,
-            master: 250.0
+            master: 260.0
         }
     );
     assert!(!q.is_queued());
+    // Written in the very tick the master crosses the position: passed already (the
+    // crossing would never be seen again).
+    let e = q
+        .write(&f, 5, &[change()], moving(249.0, 251.0))
+        .unwrap_err();
+    assert!(matches!(e, CamError::ActivationPassed { .. }), "{e}");
+    // A falling master has passed 250 once it is below it.
+    q.write(&f, 5, &[change()], moving(300.0, 290.0)).unwrap();
+    assert!(q.take_due(moving(251.0, 249.0)).is_some());
+    q.set_mode(ActivationMode::AtMasterAxisPos(250.0));
+    assert!(q.write(&f, 5, &[change()], moving(251.0, 249.0)).is_err());
     // Cam position: taken at the crossing within a later cycle too.
     q.set_mode(ActivationMode::AtMasterCamPos(50.0));
     q.write(&f, 5, &[change()], moving(300.0, 301.0)).unwrap();
@@ -87,6 +98,26 @@ fn at_master_positions_the_change_waits_for_the_crossing() {
         "50 not yet reached after the wrap"
     );
     assert!(q.take_due(moving(49.0, 51.0)).is_some());
+    // A falling master wraps from the start of the cam to its end: 200 is not crossed by
+    // the wrap 1 -> 399, 390 is.
+    q.set_mode(ActivationMode::AtMasterCamPos(200.0));
+    q.write(&f, 5, &[change()], moving(10.0, 9.0)).unwrap();
+    let falling_wrap = MasterNow {
+        axis: (401.0, 399.0),
+        cam: (1.0, 399.0),
+        cycle_changed: true,
+    };
+    assert!(
+        q.take_due(falling_wrap).is_none(),
+        "200 not crossed by a falling wrap"
+    );
+    q.delete_queued();
+    q.set_mode(ActivationMode::AtMasterCamPos(399.5));
+    q.write(&f, 5, &[change()], moving(10.0, 9.0)).unwrap();
+    assert!(
+        q.take_due(falling_wrap).is_some(),
+        "399.5 crossed by the falling wrap"
+    );
     // Next cycle: at the wrap.
     q.set_mode(ActivationMode::NextCycle);
     q.write(&f, 5, &[change()], moving(0.0, 1.0)).unwrap();

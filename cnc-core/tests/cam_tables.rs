@@ -333,3 +333,118 @@ mod lookup {
         }
     }
 }
+
+#[test]
+fn near_equidistant_and_degenerate_rows_are_refused() {
+    // Off by 0.0009 at a step of 0.001: not equidistant (the tolerance is 1e-9 of the step
+    // plus rounding, not 1e-9 of the position).
+    let rows = [[1e6, 0.0], [1e6 + 0.0019, 1.0], [1e6 + 0.002, 2.0]];
+    let e = PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false)
+        .unwrap_err();
+    assert!(matches!(e, CamError::NotEquidistant { row: 1, .. }), "{e}");
+    let even = file::write_binary(&rows).unwrap();
+    let CamProfile::Table(t) = file::parse(&even, BinaryOptions::default())
+        .unwrap()
+        .profile
+    else {
+        panic!()
+    };
+    assert_eq!(
+        t.table_type(),
+        TableType::NonEquidistant,
+        "binary auto-detection agrees"
+    );
+    // Rows closer than the arithmetic resolves: an infinite slope is refused, not passed on.
+    let e = PositionTable::new(
+        &[[0.0, 0.0], [5e-324, 1.0]],
+        TableType::NonEquidistant,
+        Interpolation::Linear,
+        false,
+    )
+    .unwrap_err();
+    assert_eq!(e, CamError::NotInterpolable { row: 1 });
+    assert_eq!(e.code(), TableErrorCode::IncrementInvalid);
+    let e = PositionTable::new(
+        &[[-1e308, 0.0], [1e308, 1.0]],
+        TableType::Equidistant,
+        Interpolation::Linear,
+        true,
+    )
+    .unwrap_err();
+    assert!(matches!(e, CamError::NotInterpolable { .. }), "{e}");
+}
+
+#[test]
+fn an_equidistant_row_belongs_to_the_interval_above_it_despite_rounding() {
+    // Steps of 1/3 do not add up exactly: every row must still open its own interval.
+    let rows: Vec<[f64; 2]> = (0..50).map(|i| [i as f64 / 3.0, (i * i) as f64]).collect();
+    let t =
+        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    let mut c = TableCursor::default();
+    for k in 0..48 {
+        let s = t.eval(rows[k][0], &mut c).sample;
+        let slope = (rows[k + 1][1] - rows[k][1]) / (rows[k + 1][0] - rows[k][0]);
+        assert!(
+            (s.velocity - slope).abs() < 1e-6 * slope.abs().max(1.0),
+            "row {k}: {} vs {slope}",
+            s.velocity
+        );
+    }
+}
+
+#[test]
+fn splines_are_smooth_at_every_row_and_periodic_ones_reproduce_a_periodic_function() {
+    let masters = uneven(40);
+    for periodic in [false, true] {
+        let rows = if periodic {
+            let period = masters[39] - masters[0];
+            masters
+                .iter()
+                .map(|m| {
+                    [
+                        *m,
+                        (2.0 * std::f64::consts::PI * (m - masters[0]) / period).sin(),
+                    ]
+                })
+                .collect::<Vec<_>>()
+        } else {
+            rows_of(&masters, |x| (0.3 * x).sin())
+        };
+        let t = PositionTable::new(
+            &rows,
+            TableType::NonEquidistant,
+            Interpolation::Spline,
+            periodic,
+        )
+        .unwrap();
+        let mut c = TableCursor::default();
+        for r in &rows[1..39] {
+            let (l, h) = (
+                t.eval(r[0] - 1e-9, &mut c).sample,
+                t.eval(r[0] + 1e-9, &mut c).sample,
+            );
+            assert!(
+                (l.velocity - h.velocity).abs() < 1e-6,
+                "velocity step at {}",
+                r[0]
+            );
+            assert!(
+                (l.acceleration - h.acceleration).abs() < 1e-5,
+                "acceleration step at {}",
+                r[0]
+            );
+        }
+        if periodic {
+            // Between the rows the spline stays close to the sine it samples.
+            let period = masters[39] - masters[0];
+            for i in 0..200 {
+                let x = masters[0] + period * i as f64 / 200.0;
+                let want = (2.0 * std::f64::consts::PI * (x - masters[0]) / period).sin();
+                assert!(
+                    (t.eval(x, &mut c).sample.position - want).abs() < 2e-3,
+                    "at {x}"
+                );
+            }
+        }
+    }
+}

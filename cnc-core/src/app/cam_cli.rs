@@ -166,7 +166,9 @@ fn run(command: &CamCommand) -> Result<(), CliError> {
                 ));
             }
             let profile = load(file, binary)?;
-            let values = CharacValues::normed(&profile).rescaled(*master_velocity);
+            let values = CharacValues::normed(&profile)
+                .rescaled(*master_velocity)
+                .expect("--master-velocity checked above");
             let body: Vec<String> = values
                 .fields()
                 .iter()

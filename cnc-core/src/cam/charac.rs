@@ -104,16 +104,14 @@ impl CharacValues {
         let mut hi = [None::<Extreme>; 4];
         let mut travel = 0.0;
         let mut acc_square = 0.0;
-        let mut first: Option<[f64; 5]> = None;
-        let mut last = [0.0; 5];
+        let mut piece_end = [0.0; 5];
         let samples = match profile {
             CamProfile::MotionFunction(_) => SAMPLES_PER_PIECE,
             CamProfile::Table(_) => SAMPLES_PER_ROW,
         };
         profile.for_each_piece(&mut |a: f64, b: f64, eval: &dyn Fn(f64) -> [f64; 5]| {
             let start = eval(a);
-            first.get_or_insert(start);
-            last = eval(b);
+            piece_end = eval(b);
             let mut note = |x: f64, d: &[f64; 5]| {
                 for k in 0..4 {
                     let e = Extreme {
@@ -139,6 +137,11 @@ impl CharacValues {
                 let x = if i == samples { b } else { a + dx * i as f64 };
                 let d = eval(x);
                 note(x, &d);
+                // A velocity that is exactly zero at a sample is a turn there.
+                if d[1] == 0.0 && prev[1] != 0.0 {
+                    travel += (d[0] - turn_y).abs();
+                    turn_y = d[0];
+                }
                 for k in 0..4 {
                     // A sign change of derivative k+1: derivative k has an extreme inside.
                     if prev[k + 1] * d[k + 1] < 0.0 {
@@ -155,13 +158,20 @@ impl CharacValues {
                 prev_x = x;
                 prev = d;
             }
-            travel += (last[0] - turn_y).abs();
+            travel += (piece_end[0] - turn_y).abs();
         });
         let (m0, m1) = profile.master_range();
         let span = (m1 - m0).abs();
+        // Start and end in the profile's own direction (a falling master starts high).
+        let mut cursor = super::ProfileCursor::default();
+        let at = |x: f64, cursor: &mut super::ProfileCursor| {
+            let s = profile.eval(x, cursor);
+            [s.position, s.velocity, s.acceleration, s.jerk, 0.0]
+        };
+        let (first, last) = (at(m0, &mut cursor), at(m1, &mut cursor));
         // A step at the very end is a position the last piece's formula does not reach.
         let end = Extreme {
-            value: profile.end_position(),
+            value: last[0],
             at: m1,
             velocity: last[1],
         };
@@ -171,7 +181,6 @@ impl CharacValues {
         if hi[0].is_none_or(|m| end.value > m.value) {
             hi[0] = Some(end);
         }
-        let first = first.unwrap_or_default();
         let get = |e: Option<Extreme>| {
             e.unwrap_or(Extreme {
                 value: 0.0,
@@ -189,7 +198,7 @@ impl CharacValues {
             fSlaveAccStart: first[2],
             fSlaveJerkStart: first[3],
             fMasterPosEnd: m1,
-            fSlavePosEnd: profile.end_position(),
+            fSlavePosEnd: last[0],
             fSlaveVeloEnd: last[1],
             fSlaveAccEnd: last[2],
             fSlaveJerkEnd: last[3],
@@ -221,8 +230,12 @@ impl CharacValues {
     }
 
     /// The same values for a master at constant velocity `v` (the normed values scale with
-    /// powers of `v`; positions do not change).
-    pub fn rescaled(&self, v: f64) -> CharacValues {
+    /// powers of `v`; positions do not change). `None` for a velocity that is not a finite
+    /// number above 0 (minimum and maximum would trade places).
+    pub fn rescaled(&self, v: f64) -> Option<CharacValues> {
+        if !(v.is_finite() && v > 0.0 && self.fMasterVeloNom > 0.0) {
+            return None;
+        }
         let k = v / self.fMasterVeloNom;
         let (k2, k3) = (k * k, k * k * k);
         let mut c = *self;
@@ -255,7 +268,7 @@ impl CharacValues {
         ] {
             *f *= k3;
         }
-        c
+        Some(c)
     }
 }
 

@@ -164,6 +164,13 @@ pub enum CamError {
         /// The first step.
         expected: f64,
     },
+    /// Rows whose step, slope, period or spline is not a finite number (rows closer than
+    /// the arithmetic resolves, or a range wider than it holds).
+    #[error("row {row}: the rows around it cannot be interpolated (step or slope not finite)")]
+    NotInterpolable {
+        /// The row, counted from 0.
+        row: usize,
+    },
     /// Fewer than two active points.
     #[error("a motion function needs at least 2 active points, found {active}")]
     TooFewPoints {
@@ -331,6 +338,7 @@ impl CamError {
             CamError::MasterNotMonotonic { .. }
             | CamError::RowNotAscending { .. }
             | CamError::NotEquidistant { .. }
+            | CamError::NotInterpolable { .. }
             | CamError::Increment { .. }
             | CamError::ActivationPassed { .. } => C::IncrementInvalid,
             CamError::TooFewPoints { .. } => C::NumPointsInvalid,

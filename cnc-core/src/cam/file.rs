@@ -266,8 +266,9 @@ fn is_equidistant(rows: &[[f64; 2]]) -> bool {
     }
     let step = (rows[n - 1][0] - rows[0][0]) / (n - 1) as f64;
     step > 0.0
+        && step.is_finite()
         && rows.iter().enumerate().all(|(i, r)| {
             let expected = rows[0][0] + step * i as f64;
-            (r[0] - expected).abs() <= 1e-9 * step.max(expected.abs())
+            (r[0] - expected).abs() <= super::table::equidistance_tolerance(step, expected)
         })
 }

@@ -215,7 +215,8 @@ impl MotionFunction {
         if points.is_empty() {
             return Err(CamError::TooFewPoints { active: 0 });
         }
-        let mut active: Vec<(MotionFunctionPoint, FunctionType, PointType)> = Vec::new();
+        // Points in order; an IGNORE point takes no part beyond its index and type.
+        let mut kept: Vec<(MotionFunctionPoint, PointType)> = Vec::new();
         for (i, p) in points.iter().enumerate() {
             let expected = 1 + i as u32;
             if p.index != expected {
@@ -224,16 +225,14 @@ impl MotionFunction {
                     expected,
                 });
             }
-            let function =
-                FunctionType::from_raw(p.function).ok_or(CamError::UnknownFunctionType {
-                    point: p.index,
-                    raw: p.function,
-                })?;
             let point_type =
                 PointType::from_raw(p.point_type).ok_or(CamError::UnknownPointType {
                     point: p.index,
                     raw: p.point_type,
                 })?;
+            if point_type == PointType::Ignore {
+                continue;
+            }
             for (value, field) in [
                 (p.master, Field::Master),
                 (p.slave, Field::Slave),
@@ -248,15 +247,28 @@ impl MotionFunction {
                     });
                 }
             }
-            if point_type != PointType::Ignore {
-                check_rel_index(points, i)?;
-                active.push((*p, function, point_type));
-            }
+            check_rel_index(points, i)?;
+            kept.push((*p, point_type));
         }
-        if active.len() < 2 {
-            return Err(CamError::TooFewPoints {
-                active: active.len(),
-            });
+        if kept.len() < 2 {
+            return Err(CamError::TooFewPoints { active: kept.len() });
+        }
+        // Every active point but the last starts a segment: its law must be known. The last
+        // one's function type is not used.
+        let mut active: Vec<(MotionFunctionPoint, FunctionType, PointType)> =
+            Vec::with_capacity(kept.len());
+        for (k, (p, point_type)) in kept.iter().enumerate() {
+            let function = match FunctionType::from_raw(p.function) {
+                Some(f) => f,
+                None if k + 1 == kept.len() => FunctionType::Polynom1,
+                None => {
+                    return Err(CamError::UnknownFunctionType {
+                        point: p.index,
+                        raw: p.function,
+                    })
+                }
+            };
+            active.push((*p, function, *point_type));
         }
         let sign = if active[1].0.master > active[0].0.master {
             1.0

@@ -44,9 +44,9 @@ impl ActivationMode {
 /// The master's position in the tick a queued change is checked in.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MasterNow {
-    /// Absolute master axis position now and one tick before.
+    /// Absolute master axis position: (one tick before, now).
     pub axis: (f64, f64),
-    /// Master position within the cam now and one tick before.
+    /// Master position within the cam: (one tick before, now).
     pub cam: (f64, f64),
     /// Whether a cam cycle boundary was crossed since the last tick.
     pub cycle_changed: bool,
@@ -129,10 +129,17 @@ impl OnlineChangeQueue {
             return Ok(WriteOutcome::Ignored);
         }
         if let ActivationMode::AtMasterAxisPos(position) = self.mode {
-            if now.axis.0 >= position {
+            // Passed already in the direction the master moves (rising when it stands).
+            let (before, at) = now.axis;
+            let passed = if at < before {
+                at <= position
+            } else {
+                at >= position
+            };
+            if passed {
                 return Err(CamError::ActivationPassed {
                     position,
-                    master: now.axis.0,
+                    master: at,
                 });
             }
         }
@@ -157,8 +164,13 @@ impl OnlineChangeQueue {
             ActivationMode::Instantaneous => true,
             ActivationMode::AtMasterAxisPos(p) => crossed(now.axis, p),
             ActivationMode::AtMasterCamPos(p) if now.cycle_changed => {
-                // Across the wrap: passed at the end of the old cycle or the start of the new.
-                p > now.cam.0 || p <= now.cam.1
+                // Across the wrap: passed at the end of the old cycle or the start of the new,
+                // in the direction the master axis moves.
+                if now.axis.1 >= now.axis.0 {
+                    p > now.cam.0 || p <= now.cam.1
+                } else {
+                    p < now.cam.0 || p >= now.cam.1
+                }
             }
             ActivationMode::AtMasterCamPos(p) => crossed(now.cam, p),
             ActivationMode::NextCycle => now.cycle_changed,

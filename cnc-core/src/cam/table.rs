@@ -106,7 +106,7 @@ impl PositionTable {
                 let step = (master[n - 1] - master[0]) / (n - 1) as f64;
                 for row in 1..n {
                     let expected = master[0] + step * row as f64;
-                    if (master[row] - expected).abs() > 1e-9 * step.max(expected.abs()) {
+                    if (master[row] - expected).abs() > equidistance_tolerance(step, expected) {
                         return Err(CamError::NotEquidistant {
                             row,
                             step: master[row] - master[row - 1],
@@ -126,12 +126,30 @@ impl PositionTable {
             inverse_step: if step > 0.0 { 1.0 / step } else { 0.0 },
             curvature: Vec::new(),
         };
+        // Rows so close (or a range so wide) that a slope, the step or the period is not a
+        // finite number cannot be interpolated.
+        let degenerate = |row: usize| CamError::NotInterpolable { row };
+        for (k, w) in table.master.windows(2).enumerate() {
+            let slope = (table.slave[k + 1] - table.slave[k]) / (w[1] - w[0]);
+            if !(slope.is_finite() && (w[1] - w[0]).is_finite()) {
+                return Err(degenerate(k + 1));
+            }
+        }
+        if !(table.period().is_finite() && table.stroke().is_finite()) {
+            return Err(degenerate(n - 1));
+        }
+        if table_type == TableType::Equidistant && !table.inverse_step.is_finite() {
+            return Err(degenerate(1));
+        }
         if interpolation == Interpolation::Spline {
             table.curvature = if periodic {
                 table.periodic_curvature()
             } else {
                 table.clamped_curvature()
             };
+            if let Some(row) = table.curvature.iter().position(|c| !c.is_finite()) {
+                return Err(degenerate(row));
+            }
         }
         Ok(table)
     }
@@ -250,9 +268,17 @@ impl PositionTable {
     fn interval(&self, x: f64, cursor: &TableCursor) -> usize {
         let n = self.master.len();
         if self.table_type == TableType::Equidistant {
-            // Truncation is floor for the non-negative offsets inside the table.
+            // Truncation is floor for the non-negative offsets inside the table; a row the
+            // multiplication rounds below belongs to the interval above it.
             let k = (x - self.master[0]) * self.inverse_step;
-            return if k > 0.0 { (k as usize).min(n - 2) } else { 0 };
+            let k = if k > 0.0 { (k as usize).min(n - 2) } else { 0 };
+            return if k + 2 < n && x >= self.master[k + 1] {
+                k + 1
+            } else if k > 0 && x < self.master[k] {
+                k - 1
+            } else {
+                k
+            };
         }
         let m = &self.master;
         let fits = |k: usize| (m[k] < x || k == 0) && x <= m[k + 1];
@@ -427,6 +453,12 @@ impl PositionTable {
         c.push(c[0]);
         c
     }
+}
+
+/// How far an equidistant table's master position may lie from `first + row * step`: a
+/// billionth of the step, plus a few rounding steps of the position itself.
+pub(crate) fn equidistance_tolerance(step: f64, expected: f64) -> f64 {
+    1e-9 * step + 4.0 * f64::EPSILON * expected.abs()
 }
 
 /// The cubic through four points and its derivatives at `x`.
