@@ -181,7 +181,7 @@ fn a_hung_plc_is_reported_after_the_watchdog() {
         code,
         4,
         &report,
-        "no PLC cycle for 51 ticks, the process is alive (hung)",
+        "ticks, the process is alive (hung)",
     );
 }
 
@@ -207,4 +207,42 @@ fn sigint_and_sigterm_stop_the_machine_and_write_the_trace() {
             "the PLC stopped cleanly too\n{report}"
         );
     }
+}
+
+#[test]
+fn a_second_signal_during_the_stop_ends_at_once_and_still_cleans_up() {
+    use std::io::{BufRead, BufReader};
+    let instance = format!("sup-twice-{}", std::process::id());
+    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let mut child = start(&instance, &trace);
+    wait_for_plc_cycles(&instance, 300);
+    let plc = plc_pid(&instance);
+    signal(child.id(), "INT");
+    // Once the CNC says it stops (the stop takes hundreds of ticks), the second signal.
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut line = String::new();
+    while !line.contains("stopping the machine") {
+        line.clear();
+        assert!(
+            err.read_line(&mut line).unwrap() > 0,
+            "the CNC ended before saying it stops"
+        );
+    }
+    signal(child.id(), "INT");
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(130), "{rest}");
+    assert!(
+        rest.contains("SIGINT during the stop: ending at once"),
+        "{rest}"
+    );
+    assert!(!segment(&instance).exists(), "segment left behind");
+    assert!(
+        !std::path::Path::new(&format!("/proc/{plc}")).exists() || {
+            let stat = std::fs::read_to_string(format!("/proc/{plc}/stat")).unwrap_or_default();
+            stat.contains(") Z ")
+        },
+        "the PLC process is gone"
+    );
 }

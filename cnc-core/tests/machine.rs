@@ -112,3 +112,76 @@ fn bad_axes_and_gears_are_refused_with_key_and_reason() {
         assert!(e.contains(expect), "{extra}: {e}");
     }
 }
+
+#[test]
+fn a_channel_whose_axis_faults_stops_in_error() {
+    // A slow drive (10 Hz) cannot follow fast moves: the following error passes the limit.
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+        program = \"c.nc\"\nlimits = { velocity = 1000.0, acceleration = 20000.0, jerk = 2000000.0 }\n\
+        drive = { model = \"pt2\", frequency_hz = 2.0, damping = 0.3 }\n";
+    let s = Scenario::parse("fault.toml", toml, |f| {
+        Ok((
+            PathBuf::from(f),
+            "%c\nG0 X400\nG0 X0\nG0 X400\nM30\n".to_string(),
+        ))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..5000 {
+        run.step(s.cycle_s);
+    }
+    let c = &run.machine.controller().channels()[0];
+    let error = c
+        .error()
+        .expect("the channel ended in error")
+        .message
+        .clone();
+    assert!(error.contains("a channel axis faulted"), "{error}");
+    assert!(run.machine.axes().axis(0).unwrap().error().is_some());
+}
+
+#[test]
+fn gears_drive_single_axes_only_and_names_stay_apart() {
+    for (extra, expect) in [
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"conveyor.Y\"\nratio = 1.0\n", "a channel axis is driven by its channel"),
+        ("[[axis]]\nname = \"conveyor.Q\"\n", "without '.'"),
+    ] {
+        let e = scenario(extra).expect_err(extra).to_string();
+        assert!(e.contains(expect), "{extra}: {e}");
+    }
+    let e = Scenario::parse("axes.toml", "[[axis]]\nname = \"A\"\n", |_| unreachable!())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("needs `ticks`"), "{e}");
+}
+
+#[test]
+fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest() {
+    // The channel waits for an M-function acknowledge nobody gives.
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"c.nc\"\n";
+    let s = Scenario::parse("wait.toml", toml, |f| {
+        Ok((
+            PathBuf::from(f),
+            "%c\nG1 X1 F600\nM100\nG1 X2 F600\nM30\n".to_string(),
+        ))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..1000 {
+        run.step(s.cycle_s);
+    }
+    assert!(run.machine.controller().channels()[0].error().is_none());
+    run.machine.stop("machine stop: test");
+    assert!(
+        !run.machine.at_rest(),
+        "the waiting channel has not ended yet"
+    );
+    run.step(s.cycle_s);
+    let c = &run.machine.controller().channels()[0];
+    assert_eq!(
+        c.error().map(|e| e.message.as_str()),
+        Some("machine stop: test")
+    );
+    assert!(run.machine.at_rest());
+    assert!(run.machine.stopped());
+}

@@ -278,18 +278,24 @@ impl Instances {
         self.list[instance].last[output]
     }
 
-    /// Applies a fired call: inputs now, the Execute edge in this or the next cycle.
+    /// Applies a fired call: inputs now, the Execute edge in this or the next cycle. The
+    /// outputs seen so far are forgotten, so a later `wait` sees only this call's.
     pub fn apply(&mut self, call: &Call) {
         let inst = &mut self.list[call.instance];
         for input in &call.inputs {
             set_input(&mut inst.block, *input);
         }
+        inst.last = [false; 7];
         match execute_of(&mut inst.block) {
-            Some(execute) if call.execute && *execute => {
+            // Execute is (or is about to be) TRUE: hold it FALSE for a cycle, then raise it.
+            Some(execute) if call.execute && (*execute || inst.raise_next_cycle) => {
                 *execute = false;
                 inst.raise_next_cycle = true;
             }
-            Some(execute) => *execute = call.execute,
+            Some(execute) => {
+                *execute = call.execute;
+                inst.raise_next_cycle = false;
+            }
             None => {}
         }
     }
@@ -473,5 +479,57 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::Stop(b), Input::Jerk(v)) => b.jerk = v,
         // parse_call admits only the inputs of the block.
         _ => {}
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table(text: &str) -> toml::Table {
+        toml::from_str(text).unwrap()
+    }
+
+    fn execute(i: &Instances) -> bool {
+        match &i.list[0].block {
+            Block::MoveAbsolute(b) => b.execute,
+            _ => unreachable!(),
+        }
+    }
+
+    /// Every call is its own edge, a `wait` sees only the latest call's outputs, and
+    /// `execute = false` cancels a pending re-trigger.
+    #[test]
+    fn calls_make_edges_and_forget_old_outputs() {
+        let mut i = Instances::default();
+        let call = i
+            .parse_call(&table(
+                "block = \"MC_MoveAbsolute\"\ninstance = \"m\"\naxis = 0\nposition = 1.0",
+            ))
+            .unwrap();
+        let lower = i
+            .parse_call(&table(
+                "block = \"MC_MoveAbsolute\"\ninstance = \"m\"\naxis = 0\nexecute = false",
+            ))
+            .unwrap();
+        let done = i.parse_wait("m.Done").unwrap();
+        i.apply(&call);
+        assert!(execute(&i), "first call: rising edge now");
+        i.list[0].last[0] = true; // the move finished: Done
+        assert!(i.holds(done));
+        i.apply(&call);
+        assert!(!i.holds(done), "a new call forgets the old Done");
+        assert!(
+            !execute(&i) && i.list[0].raise_next_cycle,
+            "FALSE for a cycle first"
+        );
+        i.apply(&call); // again in the same cycle: still one edge to come
+        assert!(!execute(&i) && i.list[0].raise_next_cycle);
+        i.begin_cycle();
+        assert!(execute(&i));
+        i.apply(&call);
+        i.apply(&lower); // lowered before the edge came: no edge
+        i.begin_cycle();
+        assert!(!execute(&i) && !i.list[0].raise_next_cycle);
     }
 }

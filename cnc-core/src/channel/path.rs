@@ -40,6 +40,8 @@ pub struct PathMove {
     done: bool,
     /// Stopped by `brake`: the block ends where the path stands.
     braked: bool,
+    /// The path limits the block was planned with.
+    limits: MoveLimits,
 }
 
 /// Why a block cannot be interpolated.
@@ -120,6 +122,7 @@ impl PathMove {
             length,
             done: false,
             braked: false,
+            limits: path,
         }))
     }
 
@@ -145,10 +148,22 @@ impl PathMove {
         self.done
     }
 
-    /// Brakes along the block to a standstill with `deceleration` and `jerk` (path units);
-    /// the block then ends where the path came to rest, short of its target.
-    pub fn brake(&mut self, generator: &mut SetpointGenerator, deceleration: f64, jerk: f64) {
-        if !self.done && generator.brake(deceleration, jerk).is_ok() {
+    /// Brakes along the block to a standstill with the block's own deceleration and jerk;
+    /// the block then ends where the path came to rest, short of its target. When the rest of
+    /// the block is shorter than the braking distance, the block runs to its end (where it
+    /// comes to rest anyway) instead of being cut off.
+    pub fn brake(&mut self, generator: &mut SetpointGenerator) {
+        if self.done {
+            return;
+        }
+        let s = generator.state();
+        let (dec, jerk) = (self.limits.deceleration, self.limits.jerk);
+        let v = s.velocity.abs();
+        let braking = v * v / (2.0 * dec) + v * dec / jerk;
+        if self.length - s.position <= braking {
+            return;
+        }
+        if generator.brake(dec, jerk).is_ok() {
             self.braked = true;
         }
     }

@@ -326,7 +326,7 @@ impl Channel {
         }
         let (dec, jerk) = (self.limits.acceleration, self.limits.jerk);
         if let Some(path) = self.path.as_mut() {
-            path.brake(&mut self.path_generator, dec, jerk);
+            path.brake(&mut self.path_generator);
         }
         for (g, active) in &mut self.independent {
             if *active && g.brake(dec, jerk).is_err() {
@@ -339,9 +339,10 @@ impl Channel {
         self.stopping = Some(reason);
     }
 
-    /// Whether a stop was requested and the channel has not come to rest yet.
+    /// Whether a stop was requested and the channel has not ended yet (moving, or waiting
+    /// to end in ERROR at its next tick).
     pub fn stopping(&self) -> bool {
-        self.stopping.is_some() && self.is_moving()
+        self.stopping.is_some() && (self.is_moving() || self.state == RunState::Running)
     }
 
     fn fail(&mut self, message: String) {
@@ -395,8 +396,12 @@ impl Channel {
         }
     }
 
-    /// The PLC's side of the dynamic-CS unit.
+    /// The PLC's side of the dynamic-CS unit (not read during a stop: the PLC must not move
+    /// the compensation of a machine that stops).
     fn plc_inputs(&mut self, view: &CncView<'_>) {
+        if self.stopping.is_some() {
+            return;
+        }
         let enabled = match view.dyn_cs_enabled(self.index) {
             Ok(Ok(e)) => e,
             // A garbage byte reads as "not enabled".

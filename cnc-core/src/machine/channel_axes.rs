@@ -110,6 +110,12 @@ impl ChannelAxes {
         }
     }
 
+    /// Whether one of the channel's axes is in error (it has dropped its coupling).
+    pub fn faulted(&self, axes: &AxisSet) -> bool {
+        (self.first..self.first + self.count)
+            .any(|i| axes.axis(i).is_some_and(|a| a.error().is_some()))
+    }
+
     /// The actual positions of the channel's axes (channel order).
     pub fn actual(&self, axes: &AxisSet) -> AxisValues {
         let mut out = AxisValues::zeros(self.count);

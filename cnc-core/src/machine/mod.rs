@@ -36,6 +36,9 @@ use hli::wire::AcyclicRequest;
 use hli::ImageMemory;
 use nalgebra::Isometry3;
 
+/// The reason a channel ends with when one of its axes faulted.
+pub const STOP_REASON_AXIS: &str = "machine stop: a channel axis faulted (see its error_id_r)";
+
 /// Why a machine cannot be built.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum MachineError {
@@ -82,6 +85,7 @@ pub struct Machine {
     ticks: u64,
     commanded: Vec<Isometry3<f64>>,
     max_tracking_error: Vec<f64>,
+    stopped: bool,
 }
 
 impl Machine {
@@ -137,6 +141,7 @@ impl Machine {
             ticks: 0,
             commanded: vec![Isometry3::identity(); n],
             max_tracking_error: vec![0.0; n],
+            stopped: false,
         })
     }
 
@@ -169,6 +174,15 @@ impl Machine {
         }
         // 4 axes
         self.axes.tick(&view);
+        // A channel whose axis faulted (following error, I/O) has lost it: it stops.
+        for (c, link) in self.links.iter().enumerate() {
+            let Some(link) = link else { continue };
+            if link.faulted(&self.axes) {
+                if let Some(channel) = self.controller.channel_mut(c) {
+                    channel.stop(STOP_REASON_AXIS);
+                }
+            }
+        }
         // 5 CNC units
         memory.place::<u64>(self.heartbeat.offset).increment();
         self.measure_tracking();
@@ -208,6 +222,8 @@ impl Machine {
         }
         match kind {
             CallKind::ReadAxisState => handle_read_axis_state(view, request),
+            // A stopped machine takes no motion commands (a PLC must not undo the stop).
+            CallKind::AxisCommand if self.stopped => Err(ErrorCode::Busy),
             CallKind::AxisCommand => {
                 let target = request.target as usize;
                 if target < self.channel_axes() {
@@ -229,6 +245,7 @@ impl Machine {
     /// engines release their axes; every single axis stops with its own deceleration and
     /// jerk (MC_Stop, which keeps the axis locked). Ticks go on until `at_rest`.
     pub fn stop(&mut self, reason: &'static str) {
+        self.stopped = true;
         for i in 0..self.controller.channels().len() {
             if let Some(c) = self.controller.channel_mut(i) {
                 c.stop(reason);
@@ -249,10 +266,12 @@ impl Machine {
     /// Whether every channel and every axis has come to rest (set-point velocity 0).
     pub fn at_rest(&self) -> bool {
         let channels = self.controller.channels().iter().all(|c| !c.stopping());
+        // Set-points at rest and the drives arrived (following error inside the window).
         let axes = (0..self.axes.len()).all(|i| {
-            self.axes
-                .axis(i)
-                .is_none_or(|a| a.setpoint().velocity == 0.0)
+            self.axes.axis(i).is_none_or(|a| {
+                a.setpoint().velocity == 0.0
+                    && a.following_error().abs() <= a.config().in_target_window
+            })
         });
         channels && axes
     }
@@ -301,6 +320,11 @@ impl Machine {
     /// The engines.
     pub fn engines(&self) -> &[Box<dyn Engine>] {
         &self.engines
+    }
+
+    /// Whether `stop` was called.
+    pub fn stopped(&self) -> bool {
+        self.stopped
     }
 
     /// Whether no channel runs a program any more.

@@ -88,6 +88,11 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
     let mut out = Vec::with_capacity(files.len());
     for (i, f) in files.iter().enumerate() {
         let key = |k: &str| format!("[[axis]] {:?}: {k}", f.name);
+        if f.name.is_empty() || f.name.contains('.') {
+            return Err(key(
+                "name: not empty, without '.' (CHANNEL.AXIS names channel axes)",
+            ));
+        }
         let id = first_id + i as u32;
         let mut c = match f.kind.as_str() {
             "linear" => {
@@ -192,8 +197,13 @@ pub fn axis_names(channels: &[ChannelConfig], single: &[ScenarioAxis]) -> Vec<St
     names
 }
 
-/// Resolves gears by axis name.
-pub fn gears(files: &[GearFile], names: &[String]) -> Result<Vec<GearSpec>, String> {
+/// Resolves gears by axis name; a slave must be a single axis (the first `channel_axes`
+/// names are the channels' axes, which their channels drive).
+pub fn gears(
+    files: &[GearFile],
+    names: &[String],
+    channel_axes: usize,
+) -> Result<Vec<GearSpec>, String> {
     let index = |n: &str, key: &str| {
         names.iter().position(|m| m == n).ok_or_else(|| {
             format!(
@@ -205,9 +215,16 @@ pub fn gears(files: &[GearFile], names: &[String]) -> Result<Vec<GearSpec>, Stri
     files
         .iter()
         .map(|g| {
+            let slave = index(&g.slave, "slave")?;
+            if slave < channel_axes {
+                return Err(format!(
+                    "[[gear]] slave {:?}: a channel axis is driven by its channel, not by a gear",
+                    g.slave
+                ));
+            }
             Ok(GearSpec {
                 master: index(&g.master, "master")?,
-                slave: index(&g.slave, "slave")?,
+                slave,
                 ratio: g.ratio,
             })
         })

@@ -225,6 +225,11 @@ impl Scenario {
                 ))
             }
         };
+        if file.channel.is_empty() && file.ticks.is_none() {
+            return Err(invalid(
+                "a scenario without channels needs `ticks` (no program says when it ends)".into(),
+            ));
+        }
         let channel_axes = super::axes::axis_names(&file.channel, &[]).len();
         let axes = super::axes::axes(&file.axis, channel_axes as u32 + 1).map_err(&invalid)?;
         if channel_axes + axes.len() > hli::layout::HLI_MAX_AXES {
@@ -235,11 +240,18 @@ impl Scenario {
             )));
         }
         let names = super::axes::axis_names(&file.channel, &axes);
-        let gears = super::axes::gears(&file.gear, &names).map_err(&invalid)?;
+        let gears = super::axes::gears(&file.gear, &names, channel_axes).map_err(&invalid)?;
         crate::machine::gear::GearEngine::new(&gears, names.len())
             .map_err(|e| invalid(e.to_string()))?;
         if let PlcSetup::Timeline { timeline, path, .. } = &plc {
             for (instance, axis) in timeline.block_axes() {
+                if (axis as usize) < channel_axes {
+                    return Err(invalid(format!(
+                        "{}: block {instance:?}: axis {axis} ({}) is a channel axis, commanded by its channel",
+                        path.display(),
+                        names[axis as usize]
+                    )));
+                }
                 if axis as usize >= names.len() {
                     return Err(invalid(format!(
                         "{}: block {instance:?}: axis {axis} does not exist (the machine has {} axes: {})",

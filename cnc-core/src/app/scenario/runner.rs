@@ -287,13 +287,15 @@ fn run_machine(
         .ticks
         .or(scenario.ticks)
         .unwrap_or(DEFAULT_TICK_LIMIT);
-    let rows = usize::try_from(limit).map_err(|_| "--ticks too large".to_string())?;
+    let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
+    // Room for a stop that starts at the last tick.
+    let rows = usize::try_from(limit.saturating_add(stop_limit))
+        .map_err(|_| "--ticks too large".to_string())?;
     let watchdog = options
         .plc_watchdog_ticks
         .or(scenario.plc_watchdog_ticks)
         .unwrap_or(DEFAULT_PLC_WATCHDOG_TICKS)
         .max(1);
-    let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
     let mut trace = Trace::new(&scenario.signals, rows);
     let mut tick_ns = Vec::with_capacity(rows);
     let mut late_ns = Vec::with_capacity(rows);
@@ -305,10 +307,14 @@ fn run_machine(
     let period = Duration::from_secs_f64(scenario.cycle_s);
     let start = monotonic::now();
     let mut stop: Option<(StopCause, u64)> = None;
-    let mut plc_seen = (segment.plc_heartbeat(), 0u64);
+    // The PLC heartbeat last seen to change, and when (wall clock: a CNC that stalled and
+    // catches up in a burst must not take the PLC for dead).
+    let mut plc_seen = (segment.plc_heartbeat(), monotonic::now());
+    let watchdog_time = period * watchdog.min(u64::from(u32::MAX)) as u32;
+    let mut forced = false;
 
     let mut rest_after = None;
-    for tick in 0..limit {
+    for tick in 0.. {
         match &stop {
             Some((_, since)) if machine.at_rest() => {
                 rest_after = Some(tick - since);
@@ -316,6 +322,7 @@ fn run_machine(
             }
             Some((_, since)) if tick - since > stop_limit => break,
             Some(_) => {}
+            None if tick >= limit => break,
             None if options.ticks.is_none() && scenario.ticks.is_none() && machine.idle() => break,
             None => {}
         }
@@ -366,16 +373,19 @@ fn run_machine(
         if stop.is_none() && !options.lockstep {
             if let Some(child) = child.as_mut() {
                 let beat = segment.plc_heartbeat();
+                let now = monotonic::now();
                 if beat != plc_seen.0 {
-                    plc_seen = (beat, tick);
+                    plc_seen = (beat, now);
                 }
                 let exited = if tick % 64 == 0 {
                     child.try_wait().ok().flatten()
                 } else {
                     None
                 };
-                if exited.is_some() || tick - plc_seen.1 > watchdog {
-                    let detail = describe_plc(child, exited, tick - plc_seen.1);
+                let silent = now.saturating_sub(plc_seen.1);
+                if exited.is_some() || silent > watchdog_time {
+                    let silent_ticks = (silent.as_secs_f64() / scenario.cycle_s) as u64;
+                    let detail = describe_plc(child, exited, silent_ticks);
                     let cause = StopCause::PlcLost { tick, detail };
                     eprintln!("cnc run: {}", cause.message());
                     machine.stop(STOP_REASON_PLC);
@@ -385,19 +395,17 @@ fn run_machine(
         }
         if tick % 16 == 0 {
             if let Some(signal) = hli::signals::take() {
-                match &stop {
-                    // A second request while stopping: out at once.
-                    Some((StopCause::Signal { .. }, _)) => {
-                        eprintln!("cnc run: second {}: exiting at once", signal.name());
-                        std::process::exit(i32::from(signal.exit_code()));
-                    }
-                    _ => {
-                        let cause = StopCause::Signal { tick, signal };
-                        eprintln!("cnc run: {}", cause.message());
-                        machine.stop(STOP_REASON_SIGNAL);
-                        stop = Some((cause, tick));
-                    }
+                if stop.is_some() {
+                    // A request during a stop: end now (the segment is still removed and the
+                    // PLC still reaped below); the first cause stays the reported one.
+                    eprintln!("cnc run: {} during the stop: ending at once", signal.name());
+                    forced = true;
+                    break;
                 }
+                let cause = StopCause::Signal { tick, signal };
+                eprintln!("cnc run: {}", cause.message());
+                machine.stop(STOP_REASON_SIGNAL);
+                stop = Some((cause, tick));
             }
         }
     }
@@ -406,7 +414,7 @@ fn run_machine(
     drop(segment); // marks the segment closed: the PLC stops
     let plc_output = match child {
         Some(mut child) => {
-            if matches!(stop, Some((StopCause::PlcLost { .. }, _))) {
+            if forced || matches!(stop, Some((StopCause::PlcLost { .. }, _))) {
                 // A lost PLC may be hung: it would never see the segment close.
                 let _ = child.kill();
             }
@@ -668,8 +676,11 @@ pub fn wait_for_exit(mut child: Child) -> Result<String, String> {
         match child.try_wait() {
             Ok(Some(_)) => break,
             Ok(None) if monotonic::now() > watchdog => {
+                // Killed, and the run still reports: what the PLC printed is not worth the
+                // CNC's report and trace.
                 let _ = child.kill();
-                return Err("the PLC process did not stop within 10 s of the CNC closing".into());
+                let _ = child.wait();
+                return Ok("plc: did not stop within 10 s of the CNC closing; killed\n".into());
             }
             Ok(None) => monotonic::sleep_until(monotonic::now() + Duration::from_millis(2)),
             Err(e) => return Err(e.to_string()),
