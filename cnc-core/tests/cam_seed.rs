@@ -53,7 +53,7 @@ fn example_points(text: &str) -> Vec<MotionFunctionPoint> {
         .collect()
 }
 
-/// A changed point of the seed's "Änderung" listings: one line of values, the rest of the
+/// A changed point of the seed's two change listings: one line of values, the rest of the
 /// function name on the next line.
 fn changed_point(text: &str, prefix: &str) -> MotionFunctionPoint {
     let lines: Vec<&str> = text.lines().collect();
