@@ -588,16 +588,28 @@ impl Axis {
         if !self.enabled || self.error.is_some() {
             return AxisState::Inactive;
         }
-        if set.velocity == 0.0 && set.acceleration == 0.0 {
-            return AxisState::Standstill;
-        }
-        let trend = set.acceleration * set.velocity;
-        if trend > 0.0 || (set.velocity == 0.0 && set.acceleration != 0.0) {
-            AxisState::Accelerating
-        } else if trend < 0.0 {
-            AxisState::Decelerating
-        } else {
-            AxisState::ConstantVelocity
-        }
+        motion_phase(set.velocity, set.acceleration)
+    }
+}
+
+/// The master motion state of a set-point: standstill, accelerating, decelerating or
+/// constant velocity. An acceleration below 1e-9 counts as none (set-points differenced
+/// from positions carry that much noise at constant velocity).
+pub fn motion_phase(velocity: f64, acceleration: f64) -> AxisState {
+    let acceleration = if acceleration.abs() < 1e-9 {
+        0.0
+    } else {
+        acceleration
+    };
+    if velocity == 0.0 && acceleration == 0.0 {
+        return AxisState::Standstill;
+    }
+    let trend = acceleration * velocity;
+    if trend > 0.0 || (velocity == 0.0 && acceleration != 0.0) {
+        AxisState::Accelerating
+    } else if trend < 0.0 {
+        AxisState::Decelerating
+    } else {
+        AxisState::ConstantVelocity
     }
 }

@@ -16,6 +16,6 @@ pub mod increments;
 pub mod set;
 pub mod sim_drive;
 
-pub use axis::{Axis, AxisOutputs, Coupling};
+pub use axis::{motion_phase, Axis, AxisOutputs, Coupling};
 pub use config::{AxisConfig, AxisKind, ConfigError, DriveLink, DriveMode, Dynamics};
 pub use set::AxisSet;

@@ -5,7 +5,7 @@
 
 use super::run::hli_value;
 use crate::nc::decode::AxisValues;
-use hli::enums::{AxisState, CouplingState};
+use hli::enums::CouplingState;
 use hli::layout::{HliAxis, HliAxisLrState};
 use hli::views::CncView;
 use hli::PlaceExt;
@@ -44,15 +44,7 @@ impl AxisPublisher {
             };
             let v = (p - self.last[i]) / self.cycle_s;
             let a = (v - self.last_velocity[i]) / self.cycle_s;
-            let state = if v == 0.0 {
-                AxisState::Standstill
-            } else if a.abs() < 1e-9 {
-                AxisState::ConstantVelocity
-            } else if a * v > 0.0 {
-                AxisState::Accelerating
-            } else {
-                AxisState::Decelerating
-            };
+            let state = crate::axis::motion_phase(v, a);
             // Linear units (0.1 um) and angle units (0.0001 degree) scale alike.
             let raw = |x: f64| hli_value(x, false);
             let position = raw(p);

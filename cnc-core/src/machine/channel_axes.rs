@@ -6,7 +6,7 @@
 use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
 use crate::axis::generator::Kinematic;
 use crate::axis::sim_drive::DriveModel;
-use crate::axis::{AxisSet, Coupling};
+use crate::axis::{motion_phase, AxisSet, Coupling};
 use crate::channel::config::ChannelConfig;
 use crate::nc::decode::AxisValues;
 use hli::enums::{AxisState, CouplingState};
@@ -85,15 +85,7 @@ impl ChannelAxes {
         for (i, &p) in set_points.iter().enumerate().take(self.count) {
             let v = (p - self.last[i]) / self.cycle_s;
             let a = (v - self.last_velocity[i]) / self.cycle_s;
-            let phase = if v == 0.0 {
-                AxisState::Standstill
-            } else if a.abs() < 1e-9 {
-                AxisState::ConstantVelocity
-            } else if a * v > 0.0 {
-                AxisState::Accelerating
-            } else {
-                AxisState::Decelerating
-            };
+            let phase = motion_phase(v, a);
             if let Some(axis) = axes.axis_mut(self.first + i) {
                 axis.drive_coupled(
                     Kinematic {

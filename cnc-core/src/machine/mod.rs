@@ -145,11 +145,6 @@ impl Machine {
         })
     }
 
-    /// Writes the simulated encoders' first readings (call once on a fresh image).
-    pub fn prime(&self, memory: &ImageMemory) {
-        self.axes.prime(&CncView::new(memory));
-    }
-
     /// One tick of the whole machine (see the module docs for the stages). Does not allocate.
     pub fn tick(&mut self, memory: &ImageMemory) {
         let view = CncView::new(memory);
