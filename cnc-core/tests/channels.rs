@@ -582,3 +582,43 @@ fn programs_with_errors_are_refused_at_load() {
     assert!(err.to_string().starts_with("bad.nc:2:"), "{err}");
     assert_eq!(MAX_CHANNELS, 12);
 }
+
+#[test]
+fn unmatched_control_statements_are_refused_at_load_where_they_stand() {
+    let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
+    let err = LoadedProgram::load("flow.nc", "G1 X1 F100\n$IF 1\nX2\n$ENDWHILE\n", &axes)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("flow.nc:4:1: error: $ENDWHILE without a matching $WHILE"),
+        "{err}"
+    );
+    assert!(
+        err.contains("flow.nc:2:1: error: $IF without $ENDIF"),
+        "{err}"
+    );
+}
+
+#[test]
+fn branches_and_loops_follow_the_jump_table_matched_at_load() {
+    // $IF 0 takes the $ELSE branch; the $WHILE 0 body never runs; the nested $IF 1 inside the
+    // taken branch runs its first part and skips its $ELSE.
+    let program = "$IF 0\nG1 X10 F6000\n$ELSE\n$IF 1\nG1 X20 F6000\n$ELSE\nG1 X30 F6000\n$ENDIF\n\
+                   $ENDIF\n$WHILE 0\nG1 Y99 F6000\n$ENDWHILE\nG1 Z5 F6000\nM30\n";
+    let mut ctl = controller(vec![(cartesian("c"), program)]);
+    let memory = image(1);
+    let mut visited_x = Vec::new();
+    run_until(
+        &mut ctl,
+        &memory,
+        20_000,
+        |c, _| visited_x.push(c.channels()[0].programmed()[0]),
+        |c| c.channels()[0].state() == RunState::Finished,
+    );
+    let p = ctl.channels()[0].programmed();
+    assert_eq!([p[0], p[1], p[2]], [20.0, 0.0, 5.0]);
+    assert!(
+        visited_x.iter().all(|x| *x <= 20.0),
+        "the X30 and X10 blocks never ran"
+    );
+}

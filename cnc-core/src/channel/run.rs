@@ -18,7 +18,8 @@ use super::path::{AxisLimits, PathMove};
 use super::program::{Jump, LoadedProgram};
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
-use crate::nc::ast::{Control, Item};
+use crate::nc::ast::Control;
+use crate::nc::control::control_of;
 use crate::nc::decode::{evaluate, AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
 use crate::nc::{Decoded, DecoderState, MotionMode};
 use hli::enums::{DynCsCommand, DynCsState};
@@ -530,17 +531,10 @@ impl Channel {
             track_cs: self.tracker.zero_values(),
         };
         if let Some(jump) = program.jumps.get(index).copied().flatten() {
-            let condition = program
-                .tree
-                .items_of(block)
-                .iter()
-                .find_map(|item| match item {
-                    Item::Control { control, .. } => match control.as_ref() {
-                        Control::While(c) | Control::If(c) => Some(c),
-                        _ => None,
-                    },
-                    _ => None,
-                });
+            let condition = match control_of(&program.tree, index) {
+                Some(Control::While(c) | Control::If(c)) => Some(c),
+                _ => None,
+            };
             let holds = |c: Option<&crate::nc::ast::Expr>| -> Option<bool> {
                 c.map_or(Some(true), |c| evaluate(c, &vars).map(|v| v != 0.0))
             };

@@ -14,6 +14,7 @@
 //! the channel decodes a block after the values it depends on are known.
 
 use super::ast::*;
+use super::control::{match_control, Jump};
 use super::Diagnostic;
 use std::sync::Arc;
 
@@ -316,7 +317,7 @@ pub enum Decoded {
         /// WAIT.
         wait: bool,
     },
-    /// Control flow with its matching block positions (indices into the decoded stream).
+    /// A control statement (its jump is in the program's jump table).
     Control {
         /// Source line.
         line: u32,
@@ -325,34 +326,25 @@ pub enum Decoded {
     },
 }
 
-/// Control flow, resolved.
+/// A control statement. Where it goes is not here: the program's jump table
+/// ([`super::control::match_control`]) holds that, matched once per program.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ControlOp {
-    /// Evaluate; when false continue after `end`.
+    /// `$WHILE`: evaluate the condition.
     While {
         /// Condition.
         cond: Expr,
-        /// Index of the matching `EndWhile`.
-        end: usize,
     },
-    /// Jump back to `start` (the `While`).
-    EndWhile {
-        /// Index of the `While`.
-        start: usize,
-    },
-    /// Evaluate; when false continue after `next` (the `Else` or `EndIf`).
+    /// `$ENDWHILE`.
+    EndWhile,
+    /// `$IF`: evaluate the condition.
     If {
         /// Condition.
         cond: Expr,
-        /// Index of the `Else` or `EndIf`.
-        next: usize,
     },
-    /// Reached from the true branch: continue after `end`.
-    Else {
-        /// Index of the `EndIf`.
-        end: usize,
-    },
-    /// End of an `If`.
+    /// `$ELSE`.
+    Else,
+    /// `$ENDIF`.
     EndIf,
 }
 
@@ -628,16 +620,10 @@ impl DecoderState {
                 }
                 Item::Control { control, span: _ } => {
                     let op = match control.as_ref() {
-                        Control::While(c) => ControlOp::While {
-                            cond: c.clone(),
-                            end: 0,
-                        },
-                        Control::EndWhile => ControlOp::EndWhile { start: 0 },
-                        Control::If(c) => ControlOp::If {
-                            cond: c.clone(),
-                            next: 0,
-                        },
-                        Control::Else => ControlOp::Else { end: 0 },
+                        Control::While(c) => ControlOp::While { cond: c.clone() },
+                        Control::EndWhile => ControlOp::EndWhile,
+                        Control::If(c) => ControlOp::If { cond: c.clone() },
+                        Control::Else => ControlOp::Else,
                         Control::EndIf => ControlOp::EndIf,
                     };
                     if items.len() > 1 {
@@ -1026,15 +1012,43 @@ pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
     ctx.eval(expr, Span::default())
 }
 
-/// Decodes a whole program for a channel with `axes`, reading variables from `vars`; control
-/// statements get their matching positions. The block stream is only meaningful when the
-/// diagnostics are empty: a program with errors must not be executed.
+/// Decodes a whole program for a channel with `axes`, reading variables from `vars`: the block
+/// stream `cnc check --blocks` prints. The stream is only meaningful when the diagnostics are
+/// empty: a program with errors must not be executed.
 pub fn decode_program(
     program: &Program,
     src: &str,
     axes: &[String],
     vars: &dyn Vars,
 ) -> (Vec<Decoded>, Vec<Diagnostic>) {
+    let mut out = Vec::with_capacity(program.blocks.len());
+    let (_, diagnostics) = walk(program, src, axes, vars, Some(&mut out));
+    (out, diagnostics)
+}
+
+/// Checks a whole program for a channel with `axes` as it is loaded: every block's semantics
+/// (with `vars`), and its control flow, matched once into the jump table the channel follows.
+/// Nothing decoded is kept: the channel decodes each block when it reaches it, with the
+/// variables and positions of that moment. The table is only complete when the diagnostics
+/// are empty.
+pub fn check_program(
+    program: &Program,
+    src: &str,
+    axes: &[String],
+    vars: &dyn Vars,
+) -> (Vec<Option<Jump>>, Vec<Diagnostic>) {
+    walk(program, src, axes, vars, None)
+}
+
+/// One pass over `program`: each block decoded (into `keep`, or into one scratch buffer reused
+/// block by block), then the control statements matched.
+fn walk(
+    program: &Program,
+    src: &str,
+    axes: &[String],
+    vars: &dyn Vars,
+    keep: Option<&mut Vec<Decoded>>,
+) -> (Vec<Option<Jump>>, Vec<Diagnostic>) {
     let mut ctx = Ctx {
         src,
         vars,
@@ -1043,103 +1057,22 @@ pub fn decode_program(
     if let Err(message) = check_channel_axes(axes) {
         ctx.error(Span::default(), message);
         super::locate(&mut ctx.diags, src);
-        return (Vec::new(), ctx.diags);
+        return (vec![None; program.blocks.len()], ctx.diags);
     }
     let mut state = DecoderState::new(axes);
-    let mut out = Vec::with_capacity(program.blocks.len());
-    // Spans of control statements only, by stream index, for the matching errors.
-    let mut control_spans: Vec<(usize, Span)> = Vec::new();
+    let mut scratch = Vec::new();
+    let keeping = keep.is_some();
+    let out = keep.unwrap_or(&mut scratch);
     for block in &program.blocks {
-        let before = out.len();
-        state.block(block, program.items_of(block), &mut ctx, &mut out);
-        for (i, d) in out.iter().enumerate().skip(before) {
-            if matches!(d, Decoded::Control { .. }) {
-                control_spans.push((i, block.span));
-            }
+        state.block(block, program.items_of(block), &mut ctx, out);
+        if !keeping {
+            out.clear();
         }
     }
-    resolve_control(&mut out, &control_spans, &mut ctx);
+    let (jumps, unmatched) = match_control(program);
+    for u in unmatched {
+        ctx.error(u.span, u.message);
+    }
     super::locate(&mut ctx.diags, src);
-    (out, ctx.diags)
-}
-
-fn resolve_control(out: &mut [Decoded], control_spans: &[(usize, Span)], ctx: &mut Ctx<'_>) {
-    let span_of = |i: usize| {
-        control_spans
-            .binary_search_by_key(&i, |(j, _)| *j)
-            .map(|k| control_spans[k].1)
-            .unwrap_or_default()
-    };
-    // Stack of open statements: (index, is_while, else_index).
-    let mut open: Vec<(usize, bool, Option<usize>)> = Vec::new();
-    for i in 0..out.len() {
-        let Decoded::Control { op, .. } = &out[i] else {
-            continue;
-        };
-        match op {
-            ControlOp::While { .. } => open.push((i, true, None)),
-            ControlOp::If { .. } => open.push((i, false, None)),
-            ControlOp::Else { .. } => match open.last_mut() {
-                Some((_, false, else_at @ None)) => *else_at = Some(i),
-                _ => ctx.error(span_of(i), "$ELSE without a matching $IF"),
-            },
-            ControlOp::EndWhile { .. } => match open.pop() {
-                Some((start, true, _)) => {
-                    set_op(out, start, |op| {
-                        if let ControlOp::While { end, .. } = op {
-                            *end = i
-                        }
-                    });
-                    set_op(out, i, |op| {
-                        if let ControlOp::EndWhile { start: s } = op {
-                            *s = start
-                        }
-                    });
-                }
-                other => {
-                    ctx.error(span_of(i), "$ENDWHILE without a matching $WHILE");
-                    if let Some(o) = other {
-                        open.push(o);
-                    }
-                }
-            },
-            ControlOp::EndIf => match open.pop() {
-                Some((start, false, else_at)) => {
-                    let next = else_at.unwrap_or(i);
-                    set_op(out, start, |op| {
-                        if let ControlOp::If { next: n, .. } = op {
-                            *n = next
-                        }
-                    });
-                    if let Some(e) = else_at {
-                        set_op(out, e, |op| {
-                            if let ControlOp::Else { end } = op {
-                                *end = i
-                            }
-                        });
-                    }
-                }
-                other => {
-                    ctx.error(span_of(i), "$ENDIF without a matching $IF");
-                    if let Some(o) = other {
-                        open.push(o);
-                    }
-                }
-            },
-        }
-    }
-    for (i, is_while, _) in open {
-        let what = if is_while {
-            "$WHILE without $ENDWHILE"
-        } else {
-            "$IF without $ENDIF"
-        };
-        ctx.error(span_of(i), what);
-    }
-}
-
-fn set_op(out: &mut [Decoded], i: usize, f: impl FnOnce(&mut ControlOp)) {
-    if let Decoded::Control { op, .. } = &mut out[i] {
-        f(op);
-    }
+    (jumps, ctx.diags)
 }

@@ -2,13 +2,14 @@
 //! canonical source) and [`decode`] (tree to the typed block stream a channel executes).
 
 pub mod ast;
+pub mod control;
 pub mod decode;
 mod fast_lane;
 pub mod lexer;
 pub mod parser;
 pub mod printer;
 
-pub use decode::{decode_program, Decoded, DecoderState, MotionBlock, MotionMode};
+pub use decode::{check_program, decode_program, Decoded, DecoderState, MotionBlock, MotionMode};
 pub use parser::{parse, parse_general};
 pub use printer::print;
 
