@@ -40,7 +40,7 @@ pub struct Unmatched {
 
 /// The control statement of a block (a `$` statement stands alone in its block; the decoder
 /// refuses a block where it does not).
-pub fn control_of<'p>(program: &'p Program, block: usize) -> Option<&'p Control> {
+pub fn control_of(program: &Program, block: usize) -> Option<&Control> {
     let block = program.blocks.get(block)?;
     program.items_of(block).iter().find_map(|item| match item {
         Item::Control { control, .. } => Some(control.as_ref()),
