@@ -622,3 +622,59 @@ fn branches_and_loops_follow_the_jump_table_matched_at_load() {
         "the X30 and X10 blocks never ran"
     );
 }
+
+#[test]
+fn program_state_and_m_function_announcement_reach_the_plc_through_the_stages() {
+    use hli::enums::ProgramState;
+    use hli::layout::HliMFunctionAck;
+    let mut ctl = controller(vec![(
+        cartesian("c"),
+        "G1 X5 F6000\nM100\nG1 X0 F6000\nM30\n",
+    )]);
+    let memory = image(1);
+    let plc = PlcView::new(&memory);
+    let state = |m: &ImageMemory| PlcView::new(m).program_state(0).unwrap().unwrap();
+    let view = CncView::new(&memory);
+    ctl.tick(&view);
+    assert_eq!(state(&memory), ProgramState::Running);
+    // Run until the announcement appears; the channel then waits and says so.
+    let mut request = None;
+    for _ in 0..10_000 {
+        ctl.tick(&view);
+        if let Some(r) = plc.m_function_request(0).unwrap().try_take().unwrap() {
+            request = Some(r);
+            break;
+        }
+    }
+    let request = request.expect("M100 announced");
+    assert_eq!((request.m_code, request.block_nr), (100, 2));
+    for _ in 0..5 {
+        ctl.tick(&view);
+        assert_eq!(state(&memory), ProgramState::Waiting);
+        assert_eq!(ctl.channels()[0].programmed()[0], 5.0);
+    }
+    // A stale acknowledge is consumed and ignored; the right one releases the channel.
+    let ack = |id| {
+        plc.m_function_ack(0)
+            .unwrap()
+            .try_send(&HliMFunctionAck {
+                m_code: 100,
+                request_id: id,
+            })
+            .unwrap()
+    };
+    ack(request.request_id + 7);
+    ctl.tick(&view);
+    assert_eq!(state(&memory), ProgramState::Waiting);
+    ack(request.request_id);
+    run_until(
+        &mut ctl,
+        &memory,
+        10_000,
+        |_, _| {},
+        |c| c.channels()[0].state() == RunState::Finished,
+    );
+    ctl.tick(&view);
+    assert_eq!(state(&memory), ProgramState::Finished);
+    assert_eq!(ctl.channels()[0].m_functions_acked(), 1);
+}

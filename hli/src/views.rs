@@ -244,6 +244,67 @@ impl<'m> CncView<'m> {
         Ok(())
     }
 
+    /// Writes the display values of path axis `axis` (`bahn_state.coord_r[axis]`); an axis
+    /// beyond the image's path axes is an [`IndexError`].
+    pub fn write_coord_state(
+        &self,
+        channel: usize,
+        axis: usize,
+        state: &HliCoordState,
+    ) -> Result<(), IndexError> {
+        if axis >= HLI_CHANNEL_AXES {
+            return Err(IndexError {
+                what: "path axis",
+                index: axis,
+                count: HLI_CHANNEL_AXES,
+            });
+        }
+        self.bahn_state(channel)?
+            .field::<HliCoordState>(
+                offset_of!(HliBahnState, coord_r) + axis * core::mem::size_of::<HliCoordState>(),
+            )
+            .write(state);
+        Ok(())
+    }
+
+    /// Writes the block progress of a channel: the block's number, the program state and the
+    /// interpolation tick (`bahn_state`, the display values aside).
+    pub fn write_block_progress(
+        &self,
+        channel: usize,
+        block_nr: i32,
+        program_state: crate::enums::ProgramState,
+        tick: u64,
+    ) -> Result<(), IndexError> {
+        let bahn = self.bahn_state(channel)?;
+        unit_field!(bahn, HliBahnState, active_block_nr_r).store(block_nr);
+        unit_field!(bahn, HliBahnState, program_state_r).store(program_state.raw());
+        unit_field!(bahn, HliBahnState, tick_counter_r).store(tick);
+        Ok(())
+    }
+
+    /// Writes the dynamic-CS part of a channel's interface (what tracking channels and the PLC
+    /// read of this channel's published frame).
+    pub fn write_channel_interface(
+        &self,
+        channel: usize,
+        interface: &HliDynCsChannelInterface,
+    ) -> Result<(), IndexError> {
+        self.nav
+            .channel(channel)?
+            .field::<HliChannelInterface>(offset_of!(HliChannel, channel_interface))
+            .field::<HliDynCsChannelInterface>(offset_of!(HliChannelInterface, dyn_cs))
+            .write(interface);
+        Ok(())
+    }
+
+    fn bahn_state(&self, channel: usize) -> Result<Place<'m, HliBahnState>, IndexError> {
+        Ok(self
+            .nav
+            .channel(channel)?
+            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state)))
+    }
+
     /// Reads and validates the PLC's override and feed hold; the caller keeps its last valid
     /// value (or stops) on an error.
     pub fn path_override(
@@ -372,6 +433,20 @@ impl<'m> PlcView<'m> {
             .field::<u32>(offset_of!(HliDynCsState, actual_state))
             .load_acquire();
         Ok(DynCsState::decode(raw))
+    }
+
+    /// A channel's program state `program_state_r`, validated.
+    pub fn program_state(
+        &self,
+        channel: usize,
+    ) -> Result<Result<crate::enums::ProgramState, InvalidValue>, IndexError> {
+        let raw = self
+            .nav
+            .channel(channel)?
+            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
+            .field::<i32>(offset_of!(HliBahnState, program_state_r))
+            .load();
+        Ok(crate::enums::ProgramState::decode(raw))
     }
 
     /// Reads M-function announcements (request pattern).

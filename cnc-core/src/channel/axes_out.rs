@@ -3,7 +3,7 @@
 //! channel axis's `gpAx[k]^lr_state` written straight from the channel's set-point, no axis
 //! layer, no drive. The machine (`crate::machine`) now runs channel axes as `Axis` objects.
 
-use super::run::hli_value;
+use super::plc_io::hli_value;
 use crate::nc::decode::AxisValues;
 use hli::enums::CouplingState;
 use hli::layout::{HliAxis, HliAxisLrState};

@@ -3,6 +3,7 @@
 //! the machine's axis set (`crate::machine`), which hands each channel's set-points on.
 
 use super::dyn_cs::MasterSample;
+use super::plc_io::{read_inputs, write_outputs, ChannelInputs};
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
 use hli::views::CncView;
@@ -12,6 +13,7 @@ use hli::views::CncView;
 pub struct Controller {
     channels: Vec<Channel>,
     masters: [Option<MasterSample>; MAX_CHANNELS],
+    inputs: [ChannelInputs; MAX_CHANNELS],
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
 }
@@ -33,6 +35,7 @@ impl Controller {
         Ok(Self {
             channels,
             masters: [None; MAX_CHANNELS],
+            inputs: [ChannelInputs::default(); MAX_CHANNELS],
             sync: SyncBoard::default(),
             order: core::array::from_fn(|i| i),
         })
@@ -48,10 +51,26 @@ impl Controller {
         self.channels.get_mut(index)
     }
 
-    /// One tick of every channel.
+    /// One tick of every channel with its PLC units: [`Controller::read_plc`],
+    /// [`Controller::tick_channels`], [`Controller::write_plc`] (a machine runs the three as
+    /// stages of its own tick, with its axes and engines between).
     pub fn tick(&mut self, view: &CncView<'_>) {
+        self.read_plc(view);
+        self.tick_channels();
+        self.write_plc(view);
+    }
+
+    /// Reads what the PLC gave each channel.
+    pub fn read_plc(&mut self, view: &CncView<'_>) {
+        for (i, channel) in self.channels.iter().enumerate() {
+            read_inputs(view, channel.index(), channel.wanted(), &mut self.inputs[i]);
+        }
+    }
+
+    /// One tick of every channel on the inputs read last: channels that follow no other
+    /// channel first, then the followers in index order.
+    pub fn tick_channels(&mut self) {
         let n = self.channels.len();
-        // Channels that follow no other channel first, then the followers in index order.
         let mut k = 0;
         for pass in 0..2 {
             for i in 0..n {
@@ -64,8 +83,16 @@ impl Controller {
         }
         for k in 0..n {
             let i = self.order[k];
-            self.channels[i].tick(view, &self.masters, &mut self.sync);
+            self.channels[i].tick(&self.inputs[i], &self.masters, &mut self.sync);
             self.masters[i] = self.channels[i].published();
+        }
+    }
+
+    /// Writes what each channel shows the PLC.
+    pub fn write_plc(&mut self, view: &CncView<'_>) {
+        for channel in &mut self.channels {
+            let index = channel.index();
+            write_outputs(view, index, channel.outputs_mut());
         }
     }
 }

@@ -9,6 +9,7 @@ pub mod controller;
 pub(crate) mod diagnosis;
 pub mod dyn_cs;
 pub mod path;
+pub mod plc_io;
 pub mod program;
 pub mod run;
 pub mod sync;

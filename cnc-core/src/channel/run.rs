@@ -5,16 +5,21 @@
 //! Execution model: no look-ahead. A block starts when the previous one has finished, so every
 //! `#FLUSH` is satisfied by construction and `SET_ZERO` always happens at standstill. Per tick:
 //!
-//! 1. PLC inputs of the channel's dynamic-CS unit (enable, `command_w`, `transition_w`);
+//! 1. PLC inputs of the channel's dynamic-CS unit (enable, `command_w`, `transition_w`), as
+//!    the machine read them ([`super::plc_io`]);
 //! 2. the interpreter runs blocks until one moves or waits (at most [`BLOCKS_PER_TICK`]);
 //! 3. the path block and independent axes advance one tick;
 //! 4. pose pipeline: programmed words -> `#CS` frames -> dynamic CS -> inverse kinematics
 //!    (with `#TRAFO` on), or per-axis compensation (off);
-//! 5. HLI outputs: display values, state, `request_r`, the channel interface.
+//! 5. HLI outputs, as values the machine writes: display values, state, `request_r`, the
+//!    channel interface, an M-function announcement.
 
 use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::path::{AxisLimits, PathMove};
+use super::plc_io::{
+    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, Transition, Wanted,
+};
 use super::program::{Jump, LoadedProgram};
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
@@ -22,13 +27,8 @@ use crate::nc::ast::Control;
 use crate::nc::control::control_of;
 use crate::nc::decode::{evaluate, AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
 use crate::nc::{Decoded, DecoderState, MotionMode};
-use hli::enums::{DynCsCommand, DynCsState};
-use hli::layout::{
-    HliBahnState, HliChannel, HliChannelInterface, HliCoordState, HliDynCsChannelInterface,
-    HliMFunctionAck, HliMFunctionRequest,
-};
-use hli::views::CncView;
-use hli::{Bool, PlaceExt};
+use hli::enums::{DynCsCommand, DynCsState, ProgramState};
+use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
 use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
 use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
@@ -141,6 +141,9 @@ pub struct Channel {
     m_next_id: u32,
     m_functions_acked: u64,
     tick: u64,
+    /// What the PLC gave this tick (copied in at the start of the tick).
+    inputs: ChannelInputs,
+    outputs: ChannelOutputs,
 }
 
 impl core::fmt::Debug for Channel {
@@ -207,6 +210,8 @@ impl Channel {
             m_next_id: 0,
             m_functions_acked: 0,
             tick: 0,
+            inputs: ChannelInputs::default(),
+            outputs: ChannelOutputs::default(),
             config,
         };
         for i in 0..n {
@@ -228,6 +233,11 @@ impl Channel {
         if self.config.provide_channel_interface.track_cs {
             self.interface_on = true;
         }
+    }
+
+    /// The channel's index (its units in the image).
+    pub fn index(&self) -> usize {
+        self.index
     }
 
     /// The configuration.
@@ -359,18 +369,33 @@ impl Channel {
         }
     }
 
-    /// One tick. `masters` holds what every channel publishes (this tick for the channels
-    /// that ticked before, else the last tick).
+    /// What this channel takes from the PLC this tick (see [`super::plc_io::read_inputs`]).
+    pub fn wanted(&self) -> Wanted {
+        Wanted {
+            dyn_cs: self.stopping.is_none(),
+            m_ack: matches!(self.wait, Some(Wait::MFunction { .. })),
+        }
+    }
+
+    /// What the channel shows the PLC after its last tick, for the machine to write
+    /// ([`super::plc_io::write_outputs`]).
+    pub fn outputs_mut(&mut self) -> &mut ChannelOutputs {
+        &mut self.outputs
+    }
+
+    /// One tick on what the PLC gave (`inputs`). `masters` holds what every channel publishes
+    /// (this tick for the channels that ticked before, else the last tick).
     pub fn tick(
         &mut self,
-        view: &CncView<'_>,
+        inputs: &ChannelInputs,
         masters: &[Option<MasterSample>; MAX_CHANNELS],
         sync: &mut SyncBoard,
     ) {
         self.tick += 1;
-        self.plc_inputs(view);
+        self.inputs = *inputs;
+        self.plc_inputs();
         if self.state == RunState::Running && self.stopping.is_none() {
-            self.interpret(view, masters, sync);
+            self.interpret(masters, sync);
         }
         self.advance();
         if let Some(reason) = self.stopping {
@@ -381,7 +406,7 @@ impl Channel {
         let master = self.master_sample(masters);
         self.tracker.tick(master);
         self.update_pose();
-        self.outputs(view);
+        self.fill_outputs();
     }
 
     fn master_sample(
@@ -397,34 +422,24 @@ impl Channel {
         }
     }
 
-    /// The PLC's side of the dynamic-CS unit (not read during a stop: the PLC must not move
-    /// the compensation of a machine that stops).
-    fn plc_inputs(&mut self, view: &CncView<'_>) {
+    /// The PLC's side of the dynamic-CS unit (not taken during a stop: see [`Wanted`]).
+    fn plc_inputs(&mut self) {
         if self.stopping.is_some() {
             return;
         }
-        let enabled = match view.dyn_cs_enabled(self.index) {
-            Ok(Ok(e)) => e,
-            // A garbage byte reads as "not enabled".
-            _ => false,
-        };
+        let enabled = self.inputs.dyn_cs_enabled;
         self.plc_enabled = enabled;
-        if let Ok(mut reader) = view.dyn_cs_command(self.index) {
-            if let Ok(Some(cs)) = reader.try_take() {
-                if enabled {
-                    self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
-                } else {
-                    self.tracker.fail(TrackError::PlcNotEnabled);
-                }
+        if let Some(cs) = self.inputs.dyn_cs_command {
+            if enabled {
+                self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
+            } else {
+                self.tracker.fail(TrackError::PlcNotEnabled);
             }
         }
-        let Ok(mut transition) = view.dyn_cs_transition(self.index) else {
-            return;
-        };
-        let taken = match transition.try_take() {
-            Ok(Some(t)) => t,
-            Ok(None) => return,
-            Err(_) => {
+        let taken = match self.inputs.transition {
+            Some(Transition::Taken(command, params)) => (command, params),
+            None => return,
+            Some(Transition::Garbage) => {
                 self.tracker
                     .fail(TrackError::BadTransition("command word is not -1, 0 or +1"));
                 return;
@@ -478,15 +493,10 @@ impl Channel {
     }
 
     /// Runs blocks until one moves or waits.
-    fn interpret(
-        &mut self,
-        view: &CncView<'_>,
-        masters: &[Option<MasterSample>; MAX_CHANNELS],
-        sync: &mut SyncBoard,
-    ) {
+    fn interpret(&mut self, masters: &[Option<MasterSample>; MAX_CHANNELS], sync: &mut SyncBoard) {
         for _ in 0..BLOCKS_PER_TICK {
             if let Some(wait) = self.wait {
-                if !self.wait_done(wait, view, sync) {
+                if !self.wait_done(wait, sync) {
                     return;
                 }
                 self.wait = None;
@@ -503,7 +513,7 @@ impl Channel {
                     },
                 );
                 self.pending_at += 1;
-                self.execute(element, view, masters, sync);
+                self.execute(element, masters, sync);
                 continue;
             }
             self.pending.clear();
@@ -572,24 +582,24 @@ impl Channel {
         true
     }
 
-    fn wait_done(&mut self, wait: Wait, view: &CncView<'_>, sync: &mut SyncBoard) -> bool {
+    fn wait_done(&mut self, wait: Wait, sync: &mut SyncBoard) -> bool {
         match wait {
             Wait::MFunction { code, id } => {
-                let Ok(mut reader) = view.m_function_ack(self.index) else {
+                if !self.inputs.has_m_unit {
                     return true;
-                };
-                match reader.try_take() {
-                    Ok(Some(HliMFunctionAck { m_code, request_id })) => {
+                }
+                match self.inputs.m_ack.take() {
+                    Some(HliMFunctionAck { m_code, request_id }) => {
                         // A stale acknowledge (other id) is consumed and ignored.
                         let done = request_id == id && m_code == code as i32;
                         self.m_functions_acked += u64::from(done);
                         done
                     }
-                    _ => false,
+                    None => false,
                 }
             }
             Wait::MAnnounce { code } => {
-                if self.announce(code, view) {
+                if self.announce(code) {
                     self.wait = Some(Wait::MFunction {
                         code,
                         id: self.m_next_id,
@@ -603,29 +613,29 @@ impl Channel {
         }
     }
 
-    /// Posts an M-function announcement; `false` while the PLC has not read the previous one.
-    fn announce(&mut self, code: u32, view: &CncView<'_>) -> bool {
-        let Ok(writer) = view.m_function_request(self.index) else {
+    /// Queues an M-function announcement for the machine to post; `false` while the PLC has
+    /// not read the previous one.
+    fn announce(&mut self, code: u32) -> bool {
+        if !self.inputs.has_m_unit {
             return true;
-        };
+        }
+        if !self.inputs.m_request_free || self.outputs.m_request.is_some() {
+            return false;
+        }
         let id = self.m_next_id.wrapping_add(1).max(1);
-        let request = HliMFunctionRequest {
+        self.outputs.m_request = Some(HliMFunctionRequest {
             m_code: code as i32,
             block_nr: self.line as i32,
             request_id: id,
-        };
-        if writer.try_send(&request).is_ok() {
-            self.m_next_id = id;
-            true
-        } else {
-            false
-        }
+        });
+        self.inputs.m_request_free = false;
+        self.m_next_id = id;
+        true
     }
 
     fn execute(
         &mut self,
         element: Decoded,
-        view: &CncView<'_>,
         masters: &[Option<MasterSample>; MAX_CHANNELS],
         sync: &mut SyncBoard,
     ) {
@@ -673,7 +683,7 @@ impl Channel {
                     self.state = RunState::Finished;
                     return;
                 }
-                if self.announce(code, view) {
+                if self.announce(code) {
                     self.wait = Some(Wait::MFunction {
                         code,
                         id: self.m_next_id,
@@ -953,28 +963,17 @@ impl Channel {
         });
     }
 
-    fn outputs(&mut self, view: &CncView<'_>) {
-        let _ = view.set_dyn_cs_state(self.index, self.tracker.state());
-        if let Ok(writer) = view.dyn_cs_request(self.index) {
-            if let Ok(cs) = frame_to_hli(self.tracker.applied(), RotationOrder::Zyx) {
-                // Request pattern: posted only when the PLC has read the last one.
-                let _ = writer.try_send(&cs);
-            }
-        }
-        let Ok(channel) = view.channel(self.index) else {
-            return;
-        };
-        let bahn = channel.field::<HliBahnState>(core::mem::offset_of!(HliChannel, bahn_state));
-        let coords = bahn.field::<[HliCoordState; hli::layout::HLI_CHANNEL_AXES]>(
-            core::mem::offset_of!(HliBahnState, coord_r),
-        );
+    fn fill_outputs(&mut self) {
+        let out = &mut self.outputs;
+        out.dyn_cs_state = self.tracker.state();
+        out.dyn_cs_request = frame_to_hli(self.tracker.applied(), RotationOrder::Zyx).ok();
         let w0 = words_in(&self.tool, self.order);
         let dyncs = words_in(&self.pose_out, self.order);
-        for i in 0..self.programmed.len() {
-            let Some(coord) = coords.get(i) else { break };
+        out.coord_count = self.programmed.len().min(out.coords.len());
+        for i in 0..out.coord_count {
             let angle = (3..6).contains(&i);
             let to_hli = |v: f64| hli_value(v, angle);
-            let state = HliCoordState {
+            out.coords[i] = HliCoordState {
                 w0_position_r: if self.config.kin_trafo_display > 0 && i < 6 {
                     to_hli(w0[i])
                 } else {
@@ -988,46 +987,20 @@ impl Channel {
                 command_position_r: to_hli(self.programmed[i]),
                 fill_up_1: 0,
             };
-            coord.write(&state);
         }
-        bahn.field::<i32>(core::mem::offset_of!(HliBahnState, active_block_nr_r))
-            .store(self.line as i32);
-        bahn.field::<u64>(core::mem::offset_of!(HliBahnState, tick_counter_r))
-            .store(self.tick);
-        let interface = channel
-            .field::<HliChannelInterface>(core::mem::offset_of!(HliChannel, channel_interface))
-            .field::<HliDynCsChannelInterface>(core::mem::offset_of!(HliChannelInterface, dyn_cs));
-        let (enabled, valid, cs) = match self.published {
-            Some(sample) => match frame_to_hli(&sample.frame, RotationOrder::Zyx) {
-                Ok(cs) => (true, sample.live, Some(cs)),
-                Err(_) => (true, false, None),
-            },
-            None => (false, false, None),
+        out.block_nr = self.line as i32;
+        out.program_state = match self.state {
+            RunState::Idle => ProgramState::Idle,
+            RunState::Running if self.wait.is_some() => ProgramState::Waiting,
+            RunState::Running => ProgramState::Running,
+            RunState::Finished => ProgramState::Finished,
+            RunState::Error => ProgramState::Error,
         };
-        let counter = interface
-            .field::<u32>(core::mem::offset_of!(
-                HliDynCsChannelInterface,
-                update_counter_r
-            ))
-            .load();
-        let mut out = HliDynCsChannelInterface {
-            enabled_r: Bool::from(enabled),
-            valid_r: Bool::from(valid),
-            freeze_r: Bool::from(enabled && !valid),
-            fill_up_1: 0,
-            update_counter_r: counter,
-            cs_r: interface
-                .field::<hli::layout::HliCoordinateSystemInt>(core::mem::offset_of!(
-                    HliDynCsChannelInterface,
-                    cs_r
-                ))
-                .read(),
-        };
-        if let Some(cs) = cs.filter(|_| valid) {
-            out.cs_r = cs;
-            out.update_counter_r = counter.wrapping_add(1);
-        }
-        interface.write(&out);
+        out.tick = self.tick;
+        out.interface = next_interface(
+            &out.interface,
+            self.published.map(|sample| (sample.frame, sample.live)),
+        );
     }
 
     /// The dynamic-CS diagnosis as the text tables of the controller: the history (tick,
@@ -1036,19 +1009,4 @@ impl Channel {
     pub fn dyn_cs_diagnosis(&self) -> String {
         super::diagnosis::render(self.index, &self.tracker)
     }
-}
-
-fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
-    let w = PoseWords::from_frame(frame, order);
-    [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
-}
-
-/// mm or degree to the HLI's 0.1 um / 0.0001 degree, saturating at the DINT range.
-pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
-    let raw = if angle {
-        hli::units::deg_to_hli(v)
-    } else {
-        hli::units::mm_to_hli(v)
-    };
-    raw.unwrap_or(if v < 0.0 { i32::MIN } else { i32::MAX })
 }

@@ -3,13 +3,15 @@
 //!
 //! ```text
 //! tick N:
-//!   1 channels     masters before followers; each reads its PLC units (dyn-CS command and
-//!                  transition, M-function acknowledge) and writes its channel state
-//!   2 hand-over    each channel's set-points to its coupled axes (Axis::drive_coupled)
-//!   3 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
-//!   4 axes         every axis: inputs, generator or coupled set-point, following error,
+//!   1 PLC units    each channel's units read into plain values (dyn-CS enable, command and
+//!                  transition; the M-function acknowledge it awaits)
+//!   2 channels     masters before followers, on those values only
+//!   3 hand-over    each channel's set-points to its coupled axes (Axis::drive_coupled)
+//!   4 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
+//!   5 axes         every axis: inputs, generator or coupled set-point, following error,
 //!                  controller, drive; the only writer of the axis blocks gpAx[k]^
-//!   5 CNC units    heartbeat; tracking error measured on the actual axis positions
+//!   6 CNC units    each channel's display values, state, requests and interface; heartbeat;
+//!                  tracking error measured on the actual axis positions
 //! between ticks:  acyclic calls (`dispatch`): engines first, then the axis commands
 //! ```
 //!
@@ -151,15 +153,17 @@ impl Machine {
         if self.ticks == 0 {
             self.axes.prime(&view);
         }
-        // 1 channels
-        self.controller.tick(&view);
-        // 2 hand-over
+        // 1 PLC units
+        self.controller.read_plc(&view);
+        // 2 channels
+        self.controller.tick_channels();
+        // 3 hand-over
         for (channel, link) in self.controller.channels().iter().zip(self.links.iter_mut()) {
             if let Some(link) = link {
                 link.drive(&mut self.axes, channel.set_points());
             }
         }
-        // 3 engines
+        // 4 engines
         for engine in &mut self.engines {
             engine.tick(&mut EngineIo {
                 view: &view,
@@ -167,7 +171,7 @@ impl Machine {
                 tick: self.ticks,
             });
         }
-        // 4 axes
+        // 5 axes
         self.axes.tick(&view);
         // A channel whose axis faulted (following error, I/O) has lost it: it stops.
         for (c, link) in self.links.iter().enumerate() {
@@ -178,7 +182,8 @@ impl Machine {
                 }
             }
         }
-        // 5 CNC units
+        // 6 CNC units
+        self.controller.write_plc(&view);
         memory.place::<u64>(self.heartbeat.offset).increment();
         self.measure_tracking();
         self.ticks += 1;

@@ -1,0 +1,184 @@
+//! A channel's HLI units as plain values. The machine's first stage reads what the PLC gave
+//! each channel ([`read_inputs`]), the channel ticks on those values alone, and the machine's
+//! last stage writes what the channel produced ([`write_outputs`]). The channel never touches
+//! the image itself, so a tick reads the PLC once and a channel can be ticked without one.
+
+use hli::enums::{DynCsCommand, DynCsState, ProgramState};
+use hli::layout::{
+    HliCoordState, HliCoordinateSystemInt, HliDynCsChannelInterface, HliDynCsTransition,
+    HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
+};
+use hli::views::CncView;
+use hli::Bool;
+use kinematics::{PoseWords, RotationOrder};
+use nalgebra::Isometry3;
+
+/// What the channel should take from the PLC this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Wanted {
+    /// The dynamic-CS command and transition (not during a stop: the PLC must not move the
+    /// compensation of a machine that stops; the handshakes stay pending).
+    pub dyn_cs: bool,
+    /// An M-function acknowledge (only while one is awaited, like a PLC reads it).
+    pub m_ack: bool,
+}
+
+/// A transition the PLC posted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Transition {
+    /// Taken: the command and its parameters.
+    Taken(DynCsCommand, HliDynCsTransition),
+    /// The command word was garbage (reset by the reader).
+    Garbage,
+}
+
+/// What the PLC gave a channel this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ChannelInputs {
+    /// `enable_w` (a garbage byte reads as not enabled).
+    pub dyn_cs_enabled: bool,
+    /// A new frame taken from `command_w`.
+    pub dyn_cs_command: Option<HliCoordinateSystemInt>,
+    /// A transition taken from `transition_w`.
+    pub transition: Option<Transition>,
+    /// An acknowledge taken from `ack_w`.
+    pub m_ack: Option<HliMFunctionAck>,
+    /// Whether the PLC has read the last M-function announcement (a new one may be posted).
+    pub m_request_free: bool,
+    /// Whether the image has this channel's M-function unit (without one, M functions are
+    /// not announced and not waited for).
+    pub has_m_unit: bool,
+}
+
+/// What a channel shows the PLC after its tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelOutputs {
+    /// `state_r` of the dynamic-CS unit.
+    pub dyn_cs_state: DynCsState,
+    /// The applied compensation for `request_r` (posted when the PLC read the last one).
+    pub dyn_cs_request: Option<HliCoordinateSystemInt>,
+    /// Display values of the path axes; the first `coord_count` are written.
+    pub coords: [HliCoordState; HLI_CHANNEL_AXES],
+    /// Path axes of the channel.
+    pub coord_count: usize,
+    /// Source line of the block executing.
+    pub block_nr: i32,
+    /// Program state.
+    pub program_state: ProgramState,
+    /// Channel ticks so far.
+    pub tick: u64,
+    /// The channel's published frame.
+    pub interface: HliDynCsChannelInterface,
+    /// An M function to announce (kept until it is posted).
+    pub m_request: Option<HliMFunctionRequest>,
+}
+
+impl Default for ChannelOutputs {
+    fn default() -> Self {
+        Self {
+            dyn_cs_state: DynCsState::Inactive,
+            dyn_cs_request: None,
+            coords: [bytemuck::Zeroable::zeroed(); HLI_CHANNEL_AXES],
+            coord_count: 0,
+            block_nr: 0,
+            program_state: ProgramState::Idle,
+            tick: 0,
+            interface: bytemuck::Zeroable::zeroed(),
+            m_request: None,
+        }
+    }
+}
+
+/// Reads channel `index`'s PLC units into `inputs` (everything not wanted is left pending in
+/// the image). An index outside the image reads as a PLC that gives nothing.
+pub fn read_inputs(view: &CncView<'_>, index: usize, wanted: Wanted, inputs: &mut ChannelInputs) {
+    let request = view.m_function_request(index);
+    *inputs = ChannelInputs {
+        m_request_free: request.as_ref().is_ok_and(|w| w.is_free().unwrap_or(false)),
+        has_m_unit: request.is_ok(),
+        ..ChannelInputs::default()
+    };
+    if wanted.dyn_cs {
+        inputs.dyn_cs_enabled = matches!(view.dyn_cs_enabled(index), Ok(Ok(true)));
+        if let Ok(mut reader) = view.dyn_cs_command(index) {
+            inputs.dyn_cs_command = reader.try_take().ok().flatten();
+        }
+        if let Ok(mut reader) = view.dyn_cs_transition(index) {
+            inputs.transition = match reader.try_take() {
+                Ok(Some((command, params))) => Some(Transition::Taken(command, params)),
+                Ok(None) => None,
+                Err(hli::handshake::ProtocolViolation::TornPayload) => None, // next tick
+                Err(_) => Some(Transition::Garbage),
+            };
+        }
+    }
+    if wanted.m_ack {
+        if let Ok(mut reader) = view.m_function_ack(index) {
+            inputs.m_ack = reader.try_take().ok().flatten();
+        }
+    }
+}
+
+/// Writes channel `index`'s outputs; the M-function announcement is cleared once posted.
+pub fn write_outputs(view: &CncView<'_>, index: usize, outputs: &mut ChannelOutputs) {
+    let _ = view.set_dyn_cs_state(index, outputs.dyn_cs_state);
+    if let (Ok(writer), Some(cs)) = (view.dyn_cs_request(index), outputs.dyn_cs_request) {
+        // Request pattern: posted only when the PLC has read the last one.
+        let _ = writer.try_send(&cs);
+    }
+    if let (Ok(writer), Some(request)) = (view.m_function_request(index), outputs.m_request) {
+        if writer.try_send(&request).is_ok() {
+            outputs.m_request = None;
+        }
+    }
+    for (i, coord) in outputs.coords[..outputs.coord_count].iter().enumerate() {
+        let _ = view.write_coord_state(index, i, coord);
+    }
+    let _ = view.write_block_progress(index, outputs.block_nr, outputs.program_state, outputs.tick);
+    let _ = view.write_channel_interface(index, &outputs.interface);
+}
+
+/// The interface of a channel after one tick: a valid published frame updates the frame and
+/// counts up; otherwise the last frame is held (frozen when the channel publishes but its
+/// frame is not valid).
+pub fn next_interface(
+    last: &HliDynCsChannelInterface,
+    published: Option<(Isometry3<f64>, bool)>,
+) -> HliDynCsChannelInterface {
+    let (enabled, valid, cs) = match published {
+        Some((frame, live)) => match kinematics::frame::frame_to_hli(&frame, RotationOrder::Zyx) {
+            Ok(cs) => (true, live, Some(cs)),
+            Err(_) => (true, false, None),
+        },
+        None => (false, false, None),
+    };
+    let mut out = HliDynCsChannelInterface {
+        enabled_r: Bool::from(enabled),
+        valid_r: Bool::from(valid),
+        freeze_r: Bool::from(enabled && !valid),
+        fill_up_1: 0,
+        update_counter_r: last.update_counter_r,
+        cs_r: last.cs_r,
+    };
+    if let Some(cs) = cs.filter(|_| valid) {
+        out.cs_r = cs;
+        out.update_counter_r = last.update_counter_r.wrapping_add(1);
+    }
+    out
+}
+
+/// X..C words of a frame in the channel's orientation convention.
+pub(super) fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6] {
+    let w = PoseWords::from_frame(frame, order);
+    [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
+}
+
+/// mm or degree to the HLI's 0.1 um / 0.0001 degree, saturating at the DINT range.
+pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
+    let raw = if angle {
+        hli::units::deg_to_hli(v)
+    } else {
+        hli::units::mm_to_hli(v)
+    };
+    raw.unwrap_or(if v < 0.0 { i32::MIN } else { i32::MAX })
+}
