@@ -1,5 +1,6 @@
 //! PLC timelines that call PLCopen blocks on scenario axes, with a real PLC process, in
-//! lockstep (tick-exact, reproducible) and in real time; bad calls refused before start.
+//! lockstep (tick-exact, reproducible) and in real time, and in-process (the same trace and
+//! block edges as the two-process lockstep run); bad calls refused before start.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
 use std::path::PathBuf;
@@ -101,6 +102,30 @@ fn blocks_move_single_axes_in_lockstep_tick_exact() {
             .map(|r| r[2..].to_vec())
             .collect::<Vec<_>>()
     );
+
+    // In-process, the same timeline calls the same blocks through an acyclic service of its
+    // own: the same trace rows and the same block edges, tick for tick.
+    let s = Scenario::load(&scenario_path()).unwrap();
+    let ticks = s.ticks.expect("the scenario has ticks") as usize;
+    let mut run_in = InProcess::new(&s, ticks).unwrap();
+    for _ in 0..ticks {
+        run_in.step(s.cycle_s);
+    }
+    let mut csv = Vec::new();
+    run_in.trace.write_csv(&mut csv).unwrap();
+    let in_rows: Vec<Vec<f64>> = String::from_utf8(csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|c| c.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(
+        in_rows, rows,
+        "in-process and two-process lockstep traces differ"
+    );
+    let in_report = run_in.timeline.as_ref().unwrap().summary();
+    assert_eq!(blocks(&in_report), blocks(&report));
+    check(&in_report, &in_rows);
 }
 
 #[test]
@@ -111,11 +136,7 @@ fn blocks_move_single_axes_in_real_time() {
 }
 
 #[test]
-fn in_process_runs_refuse_block_calls_and_bad_calls_are_refused_before_start() {
-    let s = Scenario::load(&scenario_path()).unwrap();
-    let e = InProcess::new(&s, 0).unwrap_err().to_string();
-    assert!(e.contains("need the PLC process"), "{e}");
-
+fn bad_calls_are_refused_before_start() {
     let dir = std::env::temp_dir().join(format!("blocks-bad-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let base = std::fs::read_to_string(scenario_path()).unwrap();

@@ -95,3 +95,16 @@ pub fn spawn_ready_peer(peer_exe: &str, mode: &str, instance: &str) -> ChildGuar
     assert_eq!(line.trim(), "ready", "hli-peer {mode} did not start");
     child
 }
+
+/// Removes the segment a killed CNC peer left behind: takes it over as stale (its process is
+/// gone) and drops it, which unlinks it. Tests that SIGKILL a CNC call this last, so a test
+/// run leaves nothing in /dev/shm.
+pub fn remove_stale_segment(instance: &str) {
+    match hli::segment::CncSegment::create(instance, 1, 1) {
+        Ok(segment) => assert!(
+            segment.replaced_stale().is_some(),
+            "{instance}: the segment was expected to be stale"
+        ),
+        Err(e) => panic!("{instance}: the stale segment could not be taken over: {e}"),
+    }
+}

@@ -27,4 +27,6 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
         "{} cycles without CNC ticks",
         summary.cycles
     );
+    drop(runtime);
+    tests::remove_stale_segment(&instance);
 }

@@ -56,6 +56,8 @@ fn live_segment_is_not_taken_over_and_its_heartbeat_stops_when_the_cnc_dies() {
     let verdicts: Vec<_> = (0..6).map(|_| watch.observe(plc.cnc_heartbeat())).collect();
     assert_eq!(verdicts.last(), Some(&PeerLiveness::Lost), "{verdicts:?}");
     assert!(!plc.cnc_process_alive());
+    drop(plc);
+    tests::remove_stale_segment(&instance);
 }
 
 #[test]

@@ -1,6 +1,9 @@
 //! The CNC side of a scenario: its channels on one image, ticking; and the in-process run
 //! that alternates CNC ticks and PLC timeline cycles on a heap image exactly as lockstep mode
 //! alternates the two processes (tests use it; `cnc run --lockstep` gives the same trace).
+//! A timeline that calls function blocks gets the same acyclic service as the PLC process,
+//! opened in this process under a name of its own, and the machine answers it between the
+//! tick and the PLC cycle, as `cnc run` does.
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::trace::Trace;
@@ -8,8 +11,12 @@ use crate::channel::Channel;
 use crate::machine::gear::GearEngine;
 pub use crate::machine::Machine;
 use crate::machine::MachineSetup;
+use hli::rpc::{AcyclicClient, AcyclicServer};
+use hli::views::{CncView, PlcView};
 use hli::ImageMemory;
+use plc_shim::runtime::PlcIo;
 use plc_shim::timeline::Timeline;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Builds the machine of a scenario: its channels with their programs started, channel axes
 /// on ideal drives.
@@ -63,27 +70,44 @@ pub struct InProcess {
     pub timeline: Option<Timeline>,
     /// The trace.
     pub trace: Trace,
+    /// The acyclic service of a timeline that calls blocks: the CNC's and the PLC's end.
+    acyclic: Option<(AcyclicServer, AcyclicClient)>,
+    plc_cycles: u64,
 }
+
+/// Numbers the acyclic services of in-process runs (several may run in one process).
+static IN_PROCESS_SERVICES: AtomicU32 = AtomicU32::new(0);
 
 impl InProcess {
     /// Sets up `scenario` on a heap image with room for `rows` trace rows. A built-in PLC
     /// program is refused: those run only in the PLC process.
     pub fn new(scenario: &Scenario, rows: usize) -> Result<InProcess, ScenarioError> {
+        let invalid = |message: String| ScenarioError::Invalid {
+            file: scenario.name.clone(),
+            message,
+        };
         let timeline = match &scenario.plc {
             PlcSetup::None => None,
-            PlcSetup::Timeline { timeline, .. } if timeline.calls_blocks() => {
-                return Err(ScenarioError::Invalid {
-                    file: scenario.name.clone(),
-                    message: "the PLC timeline calls function blocks: they need the PLC process (cnc run)".into(),
-                })
-            }
             PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
             PlcSetup::Program(p) => {
-                return Err(ScenarioError::Invalid {
-                    file: scenario.name.clone(),
-                    message: format!("built-in PLC program {p:?} runs only in the PLC process"),
-                })
+                return Err(invalid(format!(
+                    "built-in PLC program {p:?} runs only in the PLC process"
+                )))
             }
+        };
+        let acyclic = match &timeline {
+            Some(t) if t.calls_blocks() => {
+                let instance = format!(
+                    "inproc-{}-{}",
+                    std::process::id(),
+                    IN_PROCESS_SERVICES.fetch_add(1, Ordering::Relaxed)
+                );
+                let refused = |e: hli::rpc::CallError| invalid(format!("acyclic service: {e}"));
+                let server = AcyclicServer::open(&instance).map_err(refused)?;
+                let client = AcyclicClient::open(&instance).map_err(refused)?;
+                Some((server, client))
+            }
+            _ => None,
         };
         let machine = build(scenario)?;
         let memory =
@@ -93,16 +117,36 @@ impl InProcess {
             memory,
             timeline,
             trace: Trace::new(&scenario.signals, rows),
+            acyclic,
+            plc_cycles: 0,
         })
     }
 
-    /// One lockstep step: CNC tick, trace sample, PLC cycle. `cycle_s` gives the trace time.
+    /// One lockstep step: CNC tick, trace sample, acyclic calls answered, PLC cycle (the
+    /// order of `cnc run --lockstep`). `cycle_s` gives the trace time.
     pub fn step(&mut self, cycle_s: f64) {
         let tick = self.machine.ticks();
         self.machine.tick(&self.memory);
         self.trace.record(&self.memory, tick, tick as f64 * cycle_s);
-        if let Some(t) = self.timeline.as_mut() {
-            t.cycle(&self.memory);
+        let Some(timeline) = self.timeline.as_mut() else {
+            return;
+        };
+        match self.acyclic.as_mut() {
+            Some((server, client)) => {
+                let view = CncView::new(&self.memory);
+                let machine = &mut self.machine;
+                let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
+                timeline.cycle_io(&mut PlcIo {
+                    view: PlcView::new(&self.memory),
+                    memory: &self.memory,
+                    acyclic: client,
+                    cycle: self.plc_cycles,
+                });
+            }
+            None => {
+                timeline.cycle(&self.memory);
+            }
         }
+        self.plc_cycles += 1;
     }
 }
