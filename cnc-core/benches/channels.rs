@@ -3,7 +3,7 @@
 //! running an endless loop of moves: interpreter, interpolation, inverse and forward
 //! transformation, dynamic CS, HLI outputs and axis images.
 //!
-//! Reported: median over repeats of the time per tick and per channel-tick, and the ratio of
+//! Reported: median over interleaved repeats of the time per tick and per channel-tick, and the ratio of
 //! the per-channel-tick cost to the 1-channel run of the same process (linearity). Baseline in
 //! the same run: the same channels ticking without any program and without tracking (the
 //! fixed cost of outputs and bookkeeping), so the ratio says what the motion work adds.
@@ -32,33 +32,41 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// Median ns per tick of `tick`, over REPEATS runs of TICKS ticks.
-fn time(mut tick: impl FnMut()) -> f64 {
-    let mut samples = Vec::with_capacity(REPEATS);
-    for _ in 0..REPEATS {
-        let t0 = Instant::now();
-        for _ in 0..TICKS {
-            tick();
-        }
-        samples.push(t0.elapsed().as_nanos() as f64 / TICKS as f64);
+/// One sample: ns per tick over TICKS ticks.
+fn sample(tick: &mut dyn FnMut()) -> f64 {
+    let t0 = Instant::now();
+    for _ in 0..TICKS {
+        tick();
     }
-    median(samples)
+    t0.elapsed().as_nanos() as f64 / TICKS as f64
 }
 
-fn tracking(n: usize) -> f64 {
+/// Median ns per tick of each contender, the repeats interleaved (contender 1, 2, .., 1, 2,
+/// ..) so a slow phase of the machine hits all of them alike.
+fn interleaved(contenders: &mut [Box<dyn FnMut() + '_>]) -> Vec<f64> {
+    let mut samples = vec![Vec::with_capacity(REPEATS); contenders.len()];
+    for _ in 0..REPEATS {
+        for (c, tick) in contenders.iter_mut().enumerate() {
+            samples[c].push(sample(tick.as_mut()));
+        }
+    }
+    samples.into_iter().map(median).collect()
+}
+
+fn tracking(n: usize) -> Box<dyn FnMut()> {
     let mut run = running(n, WARM_UP).expect("fleet running");
-    time(|| run.machine.tick(&run.memory))
+    Box::new(move || run.machine.tick(&run.memory))
 }
 
-fn tracking_pt2(n: usize) -> f64 {
+fn tracking_pt2(n: usize) -> Box<dyn FnMut()> {
     let drive = "{ model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }";
     let mut run = running_on(n, Some(drive), WARM_UP).expect("fleet running on PT2 drives");
-    time(|| run.machine.tick(&run.memory))
+    Box::new(move || run.machine.tick(&run.memory))
 }
 
 /// The path before the machine tick: channels, then each channel's set-points written into
 /// its axis images (while they last), the CNC heartbeat not counted.
-fn before_machine(n: usize) -> f64 {
+fn before_machine(n: usize) -> Box<dyn FnMut()> {
     let s = tracking_robots(n).expect("fleet scenario");
     let mut channels: Vec<Channel> = Vec::new();
     for (i, (c, p)) in s.channels.iter().zip(&s.programs).enumerate() {
@@ -78,8 +86,8 @@ fn before_machine(n: usize) -> f64 {
     let mut controller = Controller::new(channels).expect("controller");
     let memory = hli::segment::heap_image(n as u32, 32);
     plc_setup(&PlcView::new(&memory));
-    let view = CncView::new(&memory);
-    let mut tick = || {
+    let mut tick = move || {
+        let view = CncView::new(&memory);
         controller.tick(&view);
         for (c, p) in controller.channels().iter().zip(publishers.iter_mut()) {
             if let Some(p) = p {
@@ -90,10 +98,10 @@ fn before_machine(n: usize) -> f64 {
     for _ in 0..WARM_UP {
         tick();
     }
-    time(tick)
+    Box::new(tick)
 }
 
-fn idle(n: usize) -> f64 {
+fn idle(n: usize) -> Box<dyn FnMut()> {
     let s = tracking_robots(n).expect("fleet scenario");
     let channels = s
         .channels
@@ -103,18 +111,27 @@ fn idle(n: usize) -> f64 {
         .collect();
     let mut controller = Controller::new(channels).expect("controller");
     let memory = hli::segment::heap_image(n as u32, 32);
-    let view = CncView::new(&memory);
-    time(|| controller.tick(&view))
+    Box::new(move || controller.tick(&CncView::new(&memory)))
 }
 
 fn main() {
+    // `-- profile N`: only the machine tick of N robots, for a profiler.
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(at) = args.iter().position(|a| a == "profile") {
+        let n = args.get(at + 1).and_then(|a| a.parse().ok()).unwrap_or(1);
+        let mut tick = tracking(n);
+        for _ in 0..200_000 / n {
+            tick();
+        }
+        return;
+    }
     println!("channels | tracking: ns/tick | ns/channel-tick | vs 1 channel | idle baseline ns/channel-tick | tracking / idle | PT2 drives ns/channel-tick | before machine ns/channel-tick | machine / before");
     let mut one = None;
     for n in [1usize, 4, 12] {
-        let t = tracking(n);
-        let b = idle(n);
-        let d = tracking_pt2(n);
-        let old = before_machine(n);
+        let mut contenders = [tracking(n), idle(n), tracking_pt2(n), before_machine(n)];
+        let [t, b, d, old] = interleaved(&mut contenders)[..] else {
+            unreachable!("four contenders")
+        };
         let per = t / n as f64;
         let base = *one.get_or_insert(per);
         println!(
@@ -127,5 +144,5 @@ fn main() {
             t / old
         );
     }
-    println!("(medians of {REPEATS} runs of {TICKS} ticks; target <= 5000 ns per channel-tick)");
+    println!("(medians of {REPEATS} interleaved runs of {TICKS} ticks each; target <= 5000 ns per channel-tick)");
 }
