@@ -185,3 +185,46 @@ fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest()
     assert!(run.machine.at_rest());
     assert!(run.machine.stopped());
 }
+
+#[test]
+fn a_gear_on_a_single_axis_master_follows_it_in_the_same_tick() {
+    // Master and slave are both single axes; the PLC moves the master with MC_MoveAbsolute.
+    // Free axes run their generators before the engines, so the gear sees the master's
+    // set-point of the same tick: no lag, in acceleration as at constant velocity.
+    let toml = "cycle_ms = 1.0\nticks = 2000\n\
+        [[axis]]\nname = \"Master\"\npower = true\n\
+        [[axis]]\nname = \"Slave\"\npower = true\nstart = 3.0\n\
+        [[gear]]\nmaster = \"Master\"\nslave = \"Slave\"\nratio = 0.5\n\
+        [plc]\ntimeline = \"plc.toml\"\n";
+    let timeline = "[[step]]\nat_tick = 10\ncall = { block = \"MC_MoveAbsolute\", instance = \"m\", axis = 0, \
+        position = 200.0, velocity = 300.0, acceleration = 3000.0, deceleration = 3000.0, jerk = 30000.0 }\n";
+    let s = Scenario::parse("single.toml", toml, |_| {
+        Ok((PathBuf::from("plc.toml"), timeline.to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut moved = 0;
+    for _ in 0..2000 {
+        run.step(s.cycle_s);
+        let m = run.machine.axes().axis(0).unwrap().setpoint();
+        let f = run.machine.axes().axis(1).unwrap().setpoint();
+        assert!(
+            (f.position - (3.0 + 0.5 * m.position)).abs() < 1e-9,
+            "tick {}: slave {} for master {}",
+            run.machine.ticks(),
+            f.position,
+            m.position
+        );
+        assert!((f.velocity - 0.5 * m.velocity).abs() < 1e-9);
+        moved += usize::from(m.velocity != 0.0);
+    }
+    assert!(moved > 500, "the master moved for {moved} ticks");
+    let master = run.machine.axes().axis(0).unwrap();
+    assert!(
+        (master.actual() - 200.0).abs() < 1e-3,
+        "{}",
+        master.actual()
+    );
+    let slave = run.machine.axes().axis(1).unwrap();
+    assert!((slave.actual() - 103.0).abs() < 1e-3, "{}", slave.actual());
+}

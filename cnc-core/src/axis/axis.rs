@@ -54,6 +54,8 @@ pub struct Axis {
     coupled_setpoint: Kinematic,
     /// The set-point handed out by the last tick (what the actual position must match now).
     last_set: Kinematic,
+    /// The encoder count read in `sense`, mirrored to `enc_out` in `act`.
+    encoder_echo: i32,
     io_fault: Option<AxisError>,
     actual: f64,
     actual_velocity: f64,
@@ -93,6 +95,7 @@ impl Axis {
             coupling: None,
             coupled_setpoint: Kinematic::default(),
             last_set: Kinematic::default(),
+            encoder_echo: 0,
             io_fault: None,
             actual: 0.0,
             actual_velocity: 0.0,
@@ -368,8 +371,16 @@ impl Axis {
         self.generator.hold(self.actual);
     }
 
-    /// One tick: reads the inputs, generates, monitors, controls and returns the outputs.
+    /// One tick: [`Axis::sense`] then [`Axis::act`] (an engine that couples this axis hands
+    /// its set-point in between).
     pub fn tick(&mut self, enc_in: &NcEncoderIn, drive_in: &NcDriveIn) -> AxisOutputs {
+        self.sense(enc_in, drive_in);
+        self.act()
+    }
+
+    /// First half of a tick: reads the inputs and, on a free axis, runs the generator one
+    /// step, so engines coupled to this axis see its set-point of this tick.
+    pub fn sense(&mut self, enc_in: &NcEncoderIn, drive_in: &NcDriveIn) {
         let scale = self.config.increments_per_unit;
         // Inputs: a status byte that is not a valid IoState counts as invalid too.
         let encoder_ok = IoState::decode(enc_in.nStatus4) == Ok(IoState::Valid);
@@ -403,15 +414,21 @@ impl Axis {
                 self.fault(cause);
             }
         }
-        // The actual position belongs to the set-point of the previous tick; this tick's
-        // generator step (or the coupled engine, before this call) produces the set-point
-        // for the end of the coming tick.
-        let previous = self.last_set;
+        self.encoder_echo = enc_in.nInData1;
+        // This tick's generator step (or the coupled engine, between `sense` and `act`)
+        // produces the set-point for the end of the coming tick.
         if !self.enabled {
             self.generator.hold(self.actual);
         } else if self.error.is_none() {
             self.generate();
         }
+    }
+
+    /// Second half of a tick: monitors the following error, runs the position controller on
+    /// this tick's set-point and returns the outputs.
+    pub fn act(&mut self) -> AxisOutputs {
+        // The actual position belongs to the set-point of the previous tick.
+        let previous = self.last_set;
         self.following_error = previous.position - self.actual;
         if self.enabled
             && self.error.is_none()
@@ -431,7 +448,7 @@ impl Axis {
             0.0
         };
         self.last_set = set;
-        self.outputs(enc_in, set)
+        self.outputs(set)
     }
 
     fn generate(&mut self) {
@@ -496,7 +513,7 @@ impl Axis {
         }
     }
 
-    fn outputs(&self, enc_in: &NcEncoderIn, set: Kinematic) -> AxisOutputs {
+    fn outputs(&self, set: Kinematic) -> AxisOutputs {
         let cfg = &self.config;
         let vscale = cfg.velocity_increments_per_unit;
         let out_velocity = self.output_velocity * vscale;
@@ -523,7 +540,7 @@ impl Axis {
             ..bytemuck::Zeroable::zeroed()
         };
         let enc_out = NcEncoderOut {
-            nOutData1: enc_in.nInData1,
+            nOutData1: self.encoder_echo,
             ..bytemuck::Zeroable::zeroed()
         };
         let hli_scale = hli::units::HLI_LENGTH_PER_MM;

@@ -111,9 +111,16 @@ impl AxisSet {
         }
     }
 
-    /// One tick of every axis against the image. Does not allocate.
+    /// One tick of every axis: [`AxisSet::sense`] then [`AxisSet::act`].
     pub fn tick(&mut self, view: &CncView<'_>) {
-        for (i, (axis, drive)) in self.axes.iter_mut().zip(self.drives.iter_mut()).enumerate() {
+        self.sense(view);
+        self.act(view);
+    }
+
+    /// First half of the axis stage: every axis reads its inputs and free axes run their
+    /// generators, so engines see this tick's set-points of their masters.
+    pub fn sense(&mut self, view: &CncView<'_>) {
+        for (i, axis) in self.axes.iter_mut().enumerate() {
             let Ok(place) = view.axis(i) else { continue };
             let enc_in: NcEncoderIn = place
                 .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
@@ -121,7 +128,16 @@ impl AxisSet {
             let drive_in: NcDriveIn = place
                 .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
                 .read();
-            let out = axis.tick(&enc_in, &drive_in);
+            axis.sense(&enc_in, &drive_in);
+        }
+    }
+
+    /// Second half: every axis monitors, controls and writes its block; simulated drives
+    /// take the outputs and answer with the next inputs.
+    pub fn act(&mut self, view: &CncView<'_>) {
+        for (i, (axis, drive)) in self.axes.iter_mut().zip(self.drives.iter_mut()).enumerate() {
+            let Ok(place) = view.axis(i) else { continue };
+            let out = axis.act();
             place
                 .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
                 .write(&out.lr_state);

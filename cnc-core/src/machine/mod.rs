@@ -7,10 +7,12 @@
 //!                  transition; the M-function acknowledge it awaits)
 //!   2 channels     masters before followers, on those values only
 //!   3 hand-over    each channel's set-points to its coupled axes (Axis::drive_coupled)
-//!   4 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
-//!   5 axes         every axis: inputs, generator or coupled set-point, following error,
-//!                  controller, drive; the only writer of the axis blocks gpAx[k]^
-//!   6 CNC units    each channel's display values, state, requests and interface; heartbeat;
+//!   4 axes sense   every axis reads its encoder and drive inputs; free axes run their
+//!                  generators, so engines see this tick's set-points of their masters
+//!   5 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
+//!   6 axes act     every axis: following error, controller, drive; the only writer of the
+//!                  axis blocks gpAx[k]^
+//!   7 CNC units    each channel's display values, state, requests and interface; heartbeat;
 //!                  tracking error measured on the actual axis positions
 //! between ticks:  acyclic calls (`dispatch`): engines first, then the axis commands
 //! ```
@@ -163,7 +165,9 @@ impl Machine {
                 link.drive(&mut self.axes, channel.set_points());
             }
         }
-        // 4 engines
+        // 4 axes sense
+        self.axes.sense(&view);
+        // 5 engines
         for engine in &mut self.engines {
             engine.tick(&mut EngineIo {
                 view: &view,
@@ -171,8 +175,8 @@ impl Machine {
                 tick: self.ticks,
             });
         }
-        // 5 axes
-        self.axes.tick(&view);
+        // 6 axes act
+        self.axes.act(&view);
         // A channel whose axis faulted (following error, I/O) has lost it: it stops.
         for (c, link) in self.links.iter().enumerate() {
             let Some(link) = link else { continue };
@@ -182,7 +186,7 @@ impl Machine {
                 }
             }
         }
-        // 6 CNC units
+        // 7 CNC units
         self.controller.write_plc(&view);
         memory.place::<u64>(self.heartbeat.offset).increment();
         self.measure_tracking();
