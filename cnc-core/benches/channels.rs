@@ -14,9 +14,14 @@
 //! axis images, no axis layer) as the baseline the machine tick is compared with.
 //! Axis images hold 32 axes: the first five robots' axes are on the axis layer, the others
 //! have none (as before).
+//!
+//! Last, the demo's two scenarios in-process and hot (no sleep between ticks): the p50 of
+//! the machine tick over the whole run, timed per tick as `cnc demo` times it, so the demo's
+//! reported `machine` p50 (after a 1 ms sleep each tick) compares with it like for like.
 //! Run: `cargo bench -p cnc-core --bench channels`.
 
 use cnc_core::app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
+use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::channel::axes_out::AxisPublisher;
 use cnc_core::channel::{Channel, Controller};
 use hli::views::CncView;
@@ -145,4 +150,37 @@ fn main() {
         );
     }
     println!("(medians of {REPEATS} interleaved runs of {TICKS} ticks each; target <= 5000 ns per channel-tick)");
+    println!();
+    println!("demo scenario, hot in-process | ticks | machine tick p50 ns | p99 ns");
+    for name in ["example3-moving-workpiece", "example4-turntable-plc"] {
+        let (ticks, p50, p99) = demo_hot(name);
+        println!("{name:>29} | {ticks:>5} | {p50:>19} | {p99:>6}");
+    }
+    println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs)");
+}
+
+/// One scenario of the demo in-process, every tick timed: (ticks, p50 ns, p99 ns) of the
+/// last of REPEATS runs (the earlier ones warm the caches and the allocator up).
+fn demo_hot(name: &str) -> (usize, u64, u64) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios")
+        .join(name)
+        .join("scenario.toml");
+    let scenario = Scenario::load(&path).expect("demo scenario");
+    let mut times = Vec::with_capacity(20_000);
+    for _ in 0..REPEATS {
+        times.clear();
+        let mut run = InProcess::new(&scenario, 0).expect("in-process run");
+        while times.len() < 100_000 && (times.len() < 10 || !run.machine.idle()) {
+            let t0 = Instant::now();
+            run.machine.tick(&run.memory);
+            times.push(t0.elapsed().as_nanos() as u64);
+            if let Some(t) = run.timeline.as_mut() {
+                t.cycle(&run.memory);
+            }
+        }
+    }
+    times.sort_unstable();
+    let at = |q: f64| times[((times.len() - 1) as f64 * q) as usize];
+    (times.len(), at(0.5), at(0.99))
 }
