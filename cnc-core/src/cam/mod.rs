@@ -9,6 +9,8 @@
 //! * `table` — position tables and their interpolations;
 //! * `charac` — characteristic values and value tables;
 //! * `online` — queued point changes, validated whole before they apply;
+//! * `coupling` — the coupling law of a slave to a master through a cam, activation and
+//!   scaling modes;
 //! * `file` — the JSON cam file and the binary table file;
 //! * `error` — refusals with the seed's error codes.
 //!
@@ -16,6 +18,7 @@
 //! sweeps, through a cursor the caller keeps.
 
 pub mod charac;
+pub mod coupling;
 pub mod error;
 pub mod file;
 pub mod law;

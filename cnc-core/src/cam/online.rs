@@ -39,6 +39,44 @@ impl ActivationMode {
             _ => return Err(CamError::ActivationMode { mode: raw }),
         })
     }
+
+    /// Whether an axis-position activation lies behind the master in its direction of
+    /// travel (rising when it stands): it would never come. Other modes never pass.
+    pub fn passed(self, now: MasterNow) -> bool {
+        let ActivationMode::AtMasterAxisPos(position) = self else {
+            return false;
+        };
+        let (before, at) = now.axis;
+        if at < before {
+            at <= position
+        } else {
+            at >= position
+        }
+    }
+
+    /// Whether the master's move in `now` reaches this activation (AsSoonAsPossible depends
+    /// on the change and is decided by the queue; Off never comes).
+    pub fn due(self, now: MasterNow) -> bool {
+        let crossed = |(before, after): (f64, f64), at: f64| {
+            (before < at && at <= after) || (after <= at && at < before)
+        };
+        match self {
+            ActivationMode::Instantaneous => true,
+            ActivationMode::AtMasterAxisPos(p) => crossed(now.axis, p),
+            ActivationMode::AtMasterCamPos(p) if now.cycle_changed => {
+                // Across the wrap: passed at the end of the old cycle or the start of the new,
+                // in the direction the master axis moves.
+                if now.axis.1 >= now.axis.0 {
+                    p > now.cam.0 || p <= now.cam.1
+                } else {
+                    p < now.cam.0 || p >= now.cam.1
+                }
+            }
+            ActivationMode::AtMasterCamPos(p) => crossed(now.cam, p),
+            ActivationMode::NextCycle => now.cycle_changed,
+            ActivationMode::AsSoonAsPossible | ActivationMode::Off => false,
+        }
+    }
 }
 
 /// The master's position in the tick a queued change is checked in.
@@ -129,17 +167,10 @@ impl OnlineChangeQueue {
             return Ok(WriteOutcome::Ignored);
         }
         if let ActivationMode::AtMasterAxisPos(position) = self.mode {
-            // Passed already in the direction the master moves (rising when it stands).
-            let (before, at) = now.axis;
-            let passed = if at < before {
-                at <= position
-            } else {
-                at >= position
-            };
-            if passed {
+            if self.mode.passed(now) {
                 return Err(CamError::ActivationPassed {
                     position,
-                    master: at,
+                    master: now.axis.1,
                 });
             }
         }
@@ -157,28 +188,12 @@ impl OnlineChangeQueue {
     /// The queued function if it is due now (and then no longer queued).
     pub fn take_due(&mut self, now: MasterNow) -> Option<MotionFunction> {
         let pending = self.pending.as_ref()?;
-        let crossed = |(before, after): (f64, f64), at: f64| {
-            (before < at && at <= after) || (after <= at && at < before)
-        };
         let due = match pending.mode {
-            ActivationMode::Instantaneous => true,
-            ActivationMode::AtMasterAxisPos(p) => crossed(now.axis, p),
-            ActivationMode::AtMasterCamPos(p) if now.cycle_changed => {
-                // Across the wrap: passed at the end of the old cycle or the start of the new,
-                // in the direction the master axis moves.
-                if now.axis.1 >= now.axis.0 {
-                    p > now.cam.0 || p <= now.cam.1
-                } else {
-                    p < now.cam.0 || p >= now.cam.1
-                }
-            }
-            ActivationMode::AtMasterCamPos(p) => crossed(now.cam, p),
-            ActivationMode::NextCycle => now.cycle_changed,
             ActivationMode::AsSoonAsPossible => !pending
                 .changed
                 .iter()
                 .any(|(a, b)| now.cam.1 >= *a && now.cam.1 <= *b),
-            ActivationMode::Off => false,
+            mode => mode.due(now),
         };
         if due {
             self.pending.take().map(|p| p.function)

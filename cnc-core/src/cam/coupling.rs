@@ -1,0 +1,552 @@
+//! How a cam couples a slave to a master (seed 000, chapters 4.3 to 4.5 and 5.1.4, the data
+//! types of 5.1.16): the master position is offset, measured from the coupling position when
+//! the master is relative, divided by the master scaling, and (cyclic cams) folded into the
+//! cam's master period with a cycle counter; the profile gives the raw slave value, which is
+//! multiplied by the slave scaling (the stroke per period too), offset, and measured from the
+//! slave's coupling position when the slave is relative:
+//!
+//! ```text
+//! x      = (MO + Pm - [Pmc]) / MS            cam master coordinate (unwrapped)
+//! local  = x folded into [first, first + period), cycle = how many periods were folded
+//! Ps     = [Psc] + SO + SS * (T(local) + SH * cycle)
+//! ```
+//!
+//! Velocity, acceleration and jerk follow from the chain rule with the master's own
+//! derivatives, so a coupled slave moves as smoothly as its master and its profile allow.
+//! Also here: which activation mode goes with which start and scaling mode (5.1.16.13), and
+//! the automatic offsets that keep the master's place in the cam and the slave's position
+//! when a coupling is switched or rescaled (5.1.16.14). Pure computation: the cam engine
+//! (`crate::machine::cams`) feeds in the axes.
+
+use super::online::{ActivationMode, MasterNow};
+use super::{CamProfile, ProfileCursor};
+use crate::axis::generator::Kinematic;
+
+/// `MC_StartMode`: whether the cam's master and slave coordinates are absolute or measured
+/// from the axes' positions at coupling (or switching).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StartMode {
+    /// 1: both absolute.
+    Absolute,
+    /// 2: both relative.
+    Relative,
+    /// 3: master absolute, slave relative.
+    MasterAbsSlaveRel,
+    /// 4: master relative, slave absolute.
+    MasterRelSlaveAbs,
+}
+
+impl StartMode {
+    /// From the raw value (1..=4).
+    pub fn from_raw(raw: u32) -> Option<StartMode> {
+        Some(match raw {
+            1 => StartMode::Absolute,
+            2 => StartMode::Relative,
+            3 => StartMode::MasterAbsSlaveRel,
+            4 => StartMode::MasterRelSlaveAbs,
+            _ => return None,
+        })
+    }
+
+    /// The raw value.
+    pub fn raw(self) -> u32 {
+        match self {
+            StartMode::Absolute => 1,
+            StartMode::Relative => 2,
+            StartMode::MasterAbsSlaveRel => 3,
+            StartMode::MasterRelSlaveAbs => 4,
+        }
+    }
+
+    /// Whether the master coordinate is measured from the coupling position.
+    pub fn master_relative(self) -> bool {
+        matches!(self, StartMode::Relative | StartMode::MasterRelSlaveAbs)
+    }
+
+    /// Whether the slave coordinate is measured from the coupling position.
+    pub fn slave_relative(self) -> bool {
+        matches!(self, StartMode::Relative | StartMode::MasterAbsSlaveRel)
+    }
+}
+
+/// `MC_CamScalingMode` of one side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ScalingMode {
+    /// 0: scaling and offset taken as given.
+    UserDefined,
+    /// 1: scaling taken, offset computed so that nothing jumps.
+    AutoOffset,
+    /// 2: this side's scaling and offset stay as they are.
+    Off,
+}
+
+impl ScalingMode {
+    /// From the raw value (0..=2).
+    pub fn from_raw(raw: u32) -> Option<ScalingMode> {
+        Some(match raw {
+            0 => ScalingMode::UserDefined,
+            1 => ScalingMode::AutoOffset,
+            2 => ScalingMode::Off,
+            _ => return None,
+        })
+    }
+}
+
+/// `MC_CamActivationMode` as couplings and scalings use it (the online change of points uses
+/// [`ActivationMode`], without the deletion).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Activation {
+    /// 0: at once (in the next tick).
+    Instantaneous,
+    /// 1: when the master's position within the cam passes this value (in any cycle).
+    AtMasterCamPos(f64),
+    /// 2: when the master axis passes this absolute position.
+    AtMasterAxisPos(f64),
+    /// 3: at the next cycle boundary (a cyclic cam) or range edge (a linear one).
+    NextCycle,
+    /// 4: the seed marks it "not yet implemented"; refused.
+    NextCycleOnce,
+    /// 5: for point data only.
+    AsSoonAsPossible,
+    /// 6: nothing is changed.
+    Off,
+    /// 7: a queued, not yet active switch is dropped.
+    DeleteQueuedData,
+}
+
+impl Activation {
+    /// From the raw mode and its position.
+    pub fn from_raw(raw: u32, position: f64) -> Option<Activation> {
+        Some(match raw {
+            0 => Activation::Instantaneous,
+            1 => Activation::AtMasterCamPos(position),
+            2 => Activation::AtMasterAxisPos(position),
+            3 => Activation::NextCycle,
+            4 => Activation::NextCycleOnce,
+            5 => Activation::AsSoonAsPossible,
+            6 => Activation::Off,
+            7 => Activation::DeleteQueuedData,
+            _ => return None,
+        })
+    }
+
+    /// The timing rule, for the modes that wait (`None` for the others).
+    pub fn timing(self) -> Option<ActivationMode> {
+        Some(match self {
+            Activation::Instantaneous => ActivationMode::Instantaneous,
+            Activation::AtMasterCamPos(p) => ActivationMode::AtMasterCamPos(p),
+            Activation::AtMasterAxisPos(p) => ActivationMode::AtMasterAxisPos(p),
+            Activation::NextCycle => ActivationMode::NextCycle,
+            _ => return None,
+        })
+    }
+}
+
+/// Why a coupling, switch or scaling is refused before anything changes.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum CouplingError {
+    /// A scaling or offset that is NaN or infinite, or a master scaling of 0.
+    #[error("{what} {value} is not usable (finite, master scaling not 0)")]
+    Parameter {
+        /// Which value.
+        what: &'static str,
+        /// The value.
+        value: f64,
+    },
+    /// The seed's tables forbid this combination (5.1.16.3, 5.1.16.13, 5.1.16.14).
+    #[error("activation mode {activation} with start mode {start} (master auto-offset {master_auto}) is not allowed when {when}")]
+    Combination {
+        /// Raw activation mode.
+        activation: u32,
+        /// Raw start mode.
+        start: u32,
+        /// Whether the master offset was to be computed.
+        master_auto: bool,
+        /// "coupling", "switching" or "scaling".
+        when: &'static str,
+    },
+    /// An activation position the master has passed already in its direction of travel.
+    #[error("activation position {position} already passed (master at {master})")]
+    Passed {
+        /// The activation position.
+        position: f64,
+        /// The master now.
+        master: f64,
+    },
+}
+
+/// Offsets and scalings of a coupling.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Scaling {
+    /// MO, added to the master position first.
+    pub master_offset: f64,
+    /// SO, added to the slave position last.
+    pub slave_offset: f64,
+    /// MS, divides the master position (not 0).
+    pub master_scaling: f64,
+    /// SS, multiplies the slave values and the stroke.
+    pub slave_scaling: f64,
+}
+
+impl Default for Scaling {
+    fn default() -> Self {
+        Scaling {
+            master_offset: 0.0,
+            slave_offset: 0.0,
+            master_scaling: 1.0,
+            slave_scaling: 1.0,
+        }
+    }
+}
+
+impl Scaling {
+    /// Refuses non-finite values and a master scaling of 0.
+    pub fn check(&self) -> Result<(), CouplingError> {
+        let values = [
+            ("master offset", self.master_offset),
+            ("slave offset", self.slave_offset),
+            ("master scaling", self.master_scaling),
+            ("slave scaling", self.slave_scaling),
+        ];
+        for (what, value) in values {
+            if !value.is_finite() || (what == "master scaling" && value == 0.0) {
+                return Err(CouplingError::Parameter { what, value });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Where the master stands in a cam.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CamPosition {
+    /// Cam master coordinate, not folded.
+    pub x: f64,
+    /// Folded into the master range (cyclic), or `x` itself (linear).
+    pub local: f64,
+    /// Periods folded (cyclic), 0 for a linear cam.
+    pub cycle: i64,
+}
+
+/// One coupling: the law `Ps(Pm)` of the module docs, with the profile's geometry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CamLaw {
+    /// Offsets and scalings.
+    pub scaling: Scaling,
+    /// Absolute or relative, per side.
+    pub start: StartMode,
+    /// Cyclic (continued period by period) or linear (held at its edges).
+    pub periodic: bool,
+    /// Pmc: the master position at coupling (0 when the master is absolute).
+    pub master_origin: f64,
+    /// Psc: the slave position at coupling (0 when the slave is absolute).
+    pub slave_origin: f64,
+    first: f64,
+    period: f64,
+    stroke: f64,
+}
+
+impl CamLaw {
+    /// The law for `profile` coupled with the master at `master` and the slave at `slave`
+    /// (the origins of the relative sides).
+    pub fn new(
+        profile: &CamProfile,
+        scaling: Scaling,
+        start: StartMode,
+        periodic: bool,
+        master: f64,
+        slave: f64,
+    ) -> CamLaw {
+        let mut law = CamLaw {
+            scaling,
+            start,
+            periodic,
+            master_origin: if start.master_relative() { master } else { 0.0 },
+            slave_origin: if start.slave_relative() { slave } else { 0.0 },
+            first: 0.0,
+            period: 0.0,
+            stroke: 0.0,
+        };
+        law.take_geometry(profile);
+        law
+    }
+
+    /// Reads the master range and the stroke of `profile` (again after an online change).
+    pub fn take_geometry(&mut self, profile: &CamProfile) {
+        let (a, b) = profile.master_range();
+        let (first, last) = (a.min(b), a.max(b));
+        let mut cursor = ProfileCursor::default();
+        let y0 = profile.eval(first, &mut cursor).position;
+        let y1 = profile.eval(last, &mut cursor).position;
+        self.first = first;
+        self.period = last - first;
+        self.stroke = y1 - y0;
+    }
+
+    /// First master position of the cam and its master period (range).
+    pub fn range(&self) -> (f64, f64) {
+        (self.first, self.period)
+    }
+
+    /// Slave stroke per master period (raw, before the slave scaling).
+    pub fn stroke(&self) -> f64 {
+        self.stroke
+    }
+
+    /// Where master position `master` lies in the cam.
+    pub fn locate(&self, master: f64) -> CamPosition {
+        let s = &self.scaling;
+        let x = (s.master_offset + master - self.master_origin) / s.master_scaling;
+        if !self.periodic || self.period <= 0.0 {
+            return CamPosition {
+                x,
+                local: x,
+                cycle: 0,
+            };
+        }
+        let mut cycle = ((x - self.first) / self.period).floor();
+        let mut local = x - cycle * self.period;
+        // Rounding may leave `local` a hair outside the period.
+        if local >= self.first + self.period {
+            cycle += 1.0;
+            local -= self.period;
+        } else if local < self.first {
+            cycle -= 1.0;
+            local += self.period;
+        }
+        CamPosition {
+            x,
+            local,
+            cycle: cycle as i64,
+        }
+    }
+
+    /// The slave set-point for the master set-point `master`, and where the master lies in
+    /// the cam. A linear cam holds the slave at its edge value outside its range.
+    pub fn slave(
+        &self,
+        profile: &CamProfile,
+        cursor: &mut ProfileCursor,
+        master: &Kinematic,
+    ) -> (Kinematic, CamPosition) {
+        let at = self.locate(master.position);
+        let s = &self.scaling;
+        let last = self.first + self.period;
+        let raw = if !self.periodic && (at.local < self.first || at.local > last) {
+            let edge = at.local.clamp(self.first, last);
+            super::Sample::at_rest(profile.eval(edge, cursor).position)
+        } else {
+            profile.eval(at.local, cursor)
+        };
+        let y = raw.position + self.stroke * at.cycle as f64;
+        // Derivatives of the cam master coordinate in time.
+        let xd = master.velocity / s.master_scaling;
+        let xdd = master.acceleration / s.master_scaling;
+        let xddd = master.jerk / s.master_scaling;
+        let ss = s.slave_scaling;
+        let slave = Kinematic {
+            position: self.slave_origin + s.slave_offset + ss * y,
+            velocity: ss * raw.velocity * xd,
+            acceleration: ss * (raw.acceleration * xd * xd + raw.velocity * xdd),
+            jerk: ss
+                * (raw.jerk * xd * xd * xd
+                    + 3.0 * raw.acceleration * xd * xdd
+                    + raw.velocity * xddd),
+        };
+        (slave, at)
+    }
+
+    /// The master's motion in the cam over one tick, for activation rules.
+    pub fn master_now(&self, before: f64, now: f64) -> MasterNow {
+        let (a, b) = (self.locate(before), self.locate(now));
+        let last = self.first + self.period;
+        let cycle_changed = if self.periodic {
+            a.cycle != b.cycle
+        } else {
+            // A linear cam's "cycle" ends at its range edges.
+            let crossed = |edge: f64| (a.x < edge && edge <= b.x) || (b.x <= edge && edge < a.x);
+            crossed(self.first) || crossed(last)
+        };
+        MasterNow {
+            axis: (before, now),
+            cam: (a.local, b.local),
+            cycle_changed,
+        }
+    }
+
+    /// The law after a switch to `profile` or a rescaling with `requested` at master
+    /// position `master`, with the slave at `slave`: each side's scaling mode decides what
+    /// is taken (Off keeps the side as it is); master auto-offset keeps the master's share of
+    /// the cam's cycle, slave auto-offset keeps the slave's position (master first, then
+    /// slave, as the seed orders them). A relative side takes its new origin from here.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rescaled(
+        &self,
+        profile: &CamProfile,
+        requested: Scaling,
+        modes: (ScalingMode, ScalingMode),
+        start: StartMode,
+        periodic: bool,
+        master: f64,
+        slave: f64,
+        switched: bool,
+    ) -> CamLaw {
+        let (master_mode, slave_mode) = modes;
+        let mut scaling = self.scaling;
+        if master_mode != ScalingMode::Off {
+            scaling.master_offset = requested.master_offset;
+            scaling.master_scaling = requested.master_scaling;
+        }
+        if slave_mode != ScalingMode::Off {
+            scaling.slave_offset = requested.slave_offset;
+            scaling.slave_scaling = requested.slave_scaling;
+        }
+        // A switch re-anchors relative sides here; a rescaling keeps the coupling's origins.
+        let (start, master_at, slave_at) = if switched {
+            (start, master, slave)
+        } else {
+            (self.start, self.master_origin, self.slave_origin)
+        };
+        let mut law = CamLaw::new(profile, scaling, start, periodic, master_at, slave_at);
+        if !switched {
+            law.master_origin = self.master_origin;
+            law.slave_origin = self.slave_origin;
+        }
+        if master_mode == ScalingMode::AutoOffset {
+            let old = self.locate(master);
+            let share = self.share_of_cycle(old);
+            let x = law.first + share * law.period;
+            let s = &mut law.scaling;
+            s.master_offset = x * s.master_scaling - master + law.master_origin;
+        }
+        if slave_mode == ScalingMode::AutoOffset {
+            let mut cursor = ProfileCursor::default();
+            let standing = Kinematic {
+                position: master,
+                ..Kinematic::default()
+            };
+            let (now, _) = law.slave(profile, &mut cursor, &standing);
+            law.scaling.slave_offset += slave - now.position;
+        }
+        law
+    }
+
+    /// Periods travelled from the cam's first master position, with the fraction (a linear
+    /// cam passed at its end continues from the beginning of the next).
+    fn share_of_cycle(&self, at: CamPosition) -> f64 {
+        if self.period <= 0.0 {
+            return 0.0;
+        }
+        let share = (at.local - self.first) / self.period;
+        if self.periodic {
+            at.cycle as f64 + share
+        } else if share > 1.0 {
+            share - 1.0
+        } else {
+            share
+        }
+    }
+}
+
+/// Whether `activation` may couple an uncoupled slave with `start` (seed 5.1.16.13, table
+/// "coupling with cam tables"): never with master auto-offset; the cam-position and
+/// next-cycle modes only with an absolute master (a relative master has no cam coordinate
+/// before it is coupled).
+pub fn check_couple(
+    activation: Activation,
+    start: StartMode,
+    master_auto: bool,
+) -> Result<(), CouplingError> {
+    let allowed = !master_auto
+        && match activation {
+            Activation::Instantaneous | Activation::AtMasterAxisPos(_) => true,
+            Activation::AtMasterCamPos(_) | Activation::NextCycle => !start.master_relative(),
+            _ => false,
+        };
+    refuse_unless(allowed, activation, start, master_auto, "coupling")
+}
+
+/// Whether `activation` may switch a coupled slave to another cam with `start` (table
+/// "switching of cam tables"): every timed mode and the deletion; master auto-offset only
+/// with an absolute master.
+pub fn check_switch(
+    activation: Activation,
+    start: StartMode,
+    master_auto: bool,
+) -> Result<(), CouplingError> {
+    let allowed = !(master_auto && start.master_relative())
+        && matches!(
+            activation,
+            Activation::Instantaneous
+                | Activation::AtMasterCamPos(_)
+                | Activation::AtMasterAxisPos(_)
+                | Activation::NextCycle
+                | Activation::DeleteQueuedData
+        );
+    refuse_unless(allowed, activation, start, master_auto, "switching")
+}
+
+/// Whether `activation` may rescale a coupling (5.1.16.13, "scaling of cam tables"); master
+/// auto-offset contradicts a relative master here too (5.1.16.3).
+pub fn check_scaling(
+    activation: Activation,
+    start: StartMode,
+    master_auto: bool,
+) -> Result<(), CouplingError> {
+    let allowed = !(master_auto && start.master_relative())
+        && matches!(
+            activation,
+            Activation::Instantaneous
+                | Activation::AtMasterCamPos(_)
+                | Activation::AtMasterAxisPos(_)
+                | Activation::NextCycle
+                | Activation::Off
+        );
+    refuse_unless(allowed, activation, start, master_auto, "scaling")
+}
+
+fn refuse_unless(
+    allowed: bool,
+    activation: Activation,
+    start: StartMode,
+    master_auto: bool,
+    when: &'static str,
+) -> Result<(), CouplingError> {
+    if allowed {
+        return Ok(());
+    }
+    Err(CouplingError::Combination {
+        activation: activation_raw(activation),
+        start: start.raw(),
+        master_auto,
+        when,
+    })
+}
+
+/// The raw number of an activation mode.
+pub fn activation_raw(activation: Activation) -> u32 {
+    match activation {
+        Activation::Instantaneous => 0,
+        Activation::AtMasterCamPos(_) => 1,
+        Activation::AtMasterAxisPos(_) => 2,
+        Activation::NextCycle => 3,
+        Activation::NextCycleOnce => 4,
+        Activation::AsSoonAsPossible => 5,
+        Activation::Off => 6,
+        Activation::DeleteQueuedData => 7,
+    }
+}
+
+/// Refuses an axis-position activation the master has passed in its direction of travel
+/// (rising when it stands), as the seed does for `AtMasterAxisPos`.
+pub fn check_not_passed(activation: Activation, now: MasterNow) -> Result<(), CouplingError> {
+    if let Activation::AtMasterAxisPos(position) = activation {
+        if ActivationMode::AtMasterAxisPos(position).passed(now) {
+            return Err(CouplingError::Passed {
+                position,
+                master: now.axis.1,
+            });
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,389 @@
+//! The coupling law of chapter 4.3 against hand-computed values (every start mode, linear and
+//! cyclic with stroke, offsets and scalings), the chain rule for the slave's derivatives, a
+//! cyclic cam over many periods without drift, the validity tables of 5.1.16.13, and the
+//! automatic offsets of 5.1.16.14.
+
+use cnc_core::axis::generator::Kinematic;
+use cnc_core::cam::coupling::{
+    check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
+    Scaling, ScalingMode, StartMode,
+};
+use cnc_core::cam::online::MasterNow;
+use cnc_core::cam::{CamProfile, Interpolation, PositionTable, ProfileCursor, TableType};
+use proptest::prelude::*;
+
+/// T(x) = x / 2 on 0..100: period 100, stroke 50.
+fn ramp() -> CamProfile {
+    CamProfile::Table(
+        PositionTable::new(
+            &[[0.0, 0.0], [100.0, 50.0]],
+            TableType::Equidistant,
+            Interpolation::Linear,
+            false,
+        )
+        .unwrap(),
+    )
+}
+
+/// One period of a sine-like stroke-free cam on 0..360 (a motion-law free table).
+fn wave() -> CamProfile {
+    let rows: Vec<[f64; 2]> = (0..=36)
+        .map(|i| {
+            let x = i as f64 * 10.0;
+            [x, 20.0 * (x.to_radians()).sin()]
+        })
+        .collect();
+    CamProfile::Table(
+        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Spline, false).unwrap(),
+    )
+}
+
+const SCALED: Scaling = Scaling {
+    master_offset: 10.0,
+    slave_offset: 5.0,
+    master_scaling: 2.0,
+    slave_scaling: 3.0,
+};
+
+fn at(position: f64) -> Kinematic {
+    Kinematic {
+        position,
+        ..Kinematic::default()
+    }
+}
+
+fn slave(law: &CamLaw, profile: &CamProfile, master: Kinematic) -> Kinematic {
+    law.slave(profile, &mut ProfileCursor::default(), &master).0
+}
+
+#[test]
+fn linear_law_in_every_start_mode_by_hand() {
+    let p = ramp();
+    // Coupled with the master at 20 and the slave at 7 (used by the relative sides only).
+    let law = |start| CamLaw::new(&p, SCALED, start, false, 20.0, 7.0);
+    // Master absolute: x = (10 + 50) / 2 = 30, T = 15. Relative: x = (10 + 50 - 20) / 2 = 20.
+    let cases = [
+        (StartMode::Absolute, 5.0 + 3.0 * 15.0),
+        (StartMode::MasterRelSlaveAbs, 5.0 + 3.0 * 10.0),
+        (StartMode::MasterAbsSlaveRel, 7.0 + 5.0 + 3.0 * 15.0),
+        (StartMode::Relative, 7.0 + 5.0 + 3.0 * 10.0),
+    ];
+    for (start, expected) in cases {
+        assert_eq!(
+            slave(&law(start), &p, at(50.0)).position,
+            expected,
+            "{start:?}"
+        );
+    }
+    // Outside the range a linear cam holds its edge value, at rest: x = 130 -> T(100) = 50.
+    let edge = slave(&law(StartMode::Absolute), &p, at(250.0));
+    assert_eq!((edge.position, edge.velocity), (5.0 + 150.0, 0.0));
+    let below = slave(&law(StartMode::Absolute), &p, at(-100.0));
+    assert_eq!(below.position, 5.0);
+}
+
+#[test]
+fn cyclic_law_adds_the_scaled_stroke_per_cycle_by_hand() {
+    let p = ramp();
+    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    // x = (10 + 250) / 2 = 130: cycle 1, local 30, T = 15 + 50.
+    let (s, c) = law.slave(&p, &mut ProfileCursor::default(), &at(250.0));
+    assert_eq!((c.cycle, c.local), (1, 30.0));
+    assert_eq!(s.position, 5.0 + 3.0 * 65.0);
+    // x = (10 - 100) / 2 = -45: cycle -1, local 55, T = 27.5 - 50.
+    let (s, c) = law.slave(&p, &mut ProfileCursor::default(), &at(-100.0));
+    assert_eq!((c.cycle, c.local), (-1, 55.0));
+    assert_eq!(s.position, 5.0 + 3.0 * -22.5);
+    // Relative master and slave: measured from the coupling positions 20 and 7.
+    let rel = CamLaw::new(&p, SCALED, StartMode::Relative, true, 20.0, 7.0);
+    // x = (10 + 250 - 20) / 2 = 120: cycle 1, local 20, T = 10 + 50.
+    assert_eq!(slave(&rel, &p, at(250.0)).position, 7.0 + 5.0 + 3.0 * 60.0);
+}
+
+#[test]
+fn the_slave_derivatives_follow_the_chain_rule() {
+    let p = wave();
+    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    let master = Kinematic {
+        position: 123.0,
+        velocity: 40.0,
+        acceleration: -300.0,
+        jerk: 5000.0,
+    };
+    let s = slave(&law, &p, master);
+    // Central differences of the position along the master's own Taylor expansion.
+    let h = 1e-4;
+    let along = |t: f64| {
+        let m = master.position
+            + master.velocity * t
+            + master.acceleration * t * t / 2.0
+            + master.jerk * t * t * t / 6.0;
+        slave(&law, &p, at(m)).position
+    };
+    let v = (along(h) - along(-h)) / (2.0 * h);
+    let a = (along(h) - 2.0 * along(0.0) + along(-h)) / (h * h);
+    assert!(
+        (s.velocity - v).abs() < 1e-6 * v.abs().max(1.0),
+        "{} vs {v}",
+        s.velocity
+    );
+    assert!(
+        (s.acceleration - a).abs() < 1e-3 * a.abs().max(1.0),
+        "{} vs {a}",
+        s.acceleration
+    );
+}
+
+#[test]
+fn a_cyclic_cam_over_ten_thousand_periods_keeps_its_count_and_does_not_drift() {
+    let p = ramp();
+    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    let mut cursor = ProfileCursor::default();
+    // 1 ms ticks at 2000 units/s: x advances 1 per tick; 10_000 periods of 100.
+    let mut last_cycle = i64::MIN;
+    for tick in 0..1_000_000u64 {
+        let m = tick as f64 * 2.0 - 10.0;
+        let (s, c) = law.slave(&p, &mut cursor, &at(m));
+        let x = (10.0 + m) / 2.0;
+        // T(local) + 50 * cycle is x / 2 here: the closed form.
+        assert!((s.position - (5.0 + 1.5 * x)).abs() < 1e-9, "tick {tick}");
+        assert!(c.cycle >= last_cycle);
+        assert_eq!(c.cycle, (x / 100.0).floor() as i64);
+        last_cycle = c.cycle;
+    }
+    assert_eq!(last_cycle, 9_999);
+}
+
+proptest! {
+    #[test]
+    fn a_cyclic_slave_is_continuous_in_the_master(
+        m in -5000.0f64..5000.0,
+        dm in -0.5f64..0.5,
+        mo in -400.0f64..400.0,
+        ms in prop_oneof![0.25f64..4.0, -4.0f64..-0.25],
+        ss in -3.0f64..3.0,
+    ) {
+        let p = ramp();
+        let scaling = Scaling { master_offset: mo, slave_offset: 1.0, master_scaling: ms, slave_scaling: ss };
+        let law = CamLaw::new(&p, scaling, StartMode::Absolute, true, 0.0, 0.0);
+        let a = slave(&law, &p, at(m)).position;
+        let b = slave(&law, &p, at(m + dm)).position;
+        // Slope 0.5 of the cam, scaled: no jump at any cycle boundary.
+        let bound = 0.5 * (ss / ms).abs() * dm.abs() + 1e-9 * (1.0 + a.abs());
+        prop_assert!((b - a).abs() <= bound, "{a} -> {b} over {dm}");
+    }
+}
+
+#[test]
+fn coupling_modes_follow_the_seeds_table() {
+    use Activation::*;
+    let abs = StartMode::Absolute;
+    let rel = StartMode::Relative;
+    let modes = [
+        Instantaneous,
+        AtMasterAxisPos(1.0),
+        AtMasterCamPos(1.0),
+        NextCycle,
+        DeleteQueuedData,
+    ];
+    // Rows: the modes above; columns: absolute, relative (no master auto-offset).
+    let couple = [
+        (true, true),
+        (true, true),
+        (true, false),
+        (true, false),
+        (false, false),
+    ];
+    let switch = [(true, true); 5];
+    for (mode, (a, r)) in modes.iter().zip(couple) {
+        assert_eq!(
+            check_couple(*mode, abs, false).is_ok(),
+            a,
+            "couple {mode:?} abs"
+        );
+        assert_eq!(
+            check_couple(*mode, rel, false).is_ok(),
+            r,
+            "couple {mode:?} rel"
+        );
+        // With master auto-offset nothing couples.
+        assert!(check_couple(*mode, abs, true).is_err());
+        assert!(check_couple(*mode, rel, true).is_err());
+    }
+    for (mode, (a, r)) in modes.iter().zip(switch) {
+        assert_eq!(
+            check_switch(*mode, abs, false).is_ok(),
+            a,
+            "switch {mode:?} abs"
+        );
+        assert_eq!(
+            check_switch(*mode, rel, false).is_ok(),
+            r,
+            "switch {mode:?} rel"
+        );
+        // With master auto-offset: absolute only.
+        assert!(check_switch(*mode, abs, true).is_ok());
+        assert!(check_switch(*mode, rel, true).is_err());
+    }
+    // The master-relative start modes count as relative, the master-absolute ones not.
+    assert!(check_couple(NextCycle, StartMode::MasterRelSlaveAbs, false).is_err());
+    assert!(check_couple(NextCycle, StartMode::MasterAbsSlaveRel, false).is_ok());
+    // Scaling: the five modes of its table; the others refused with the combination.
+    for mode in [
+        Instantaneous,
+        AtMasterCamPos(0.0),
+        AtMasterAxisPos(0.0),
+        NextCycle,
+        Off,
+    ] {
+        assert!(check_scaling(mode, abs, true).is_ok(), "{mode:?}");
+    }
+    for mode in [NextCycleOnce, AsSoonAsPossible, DeleteQueuedData] {
+        assert_eq!(
+            check_scaling(mode, abs, false),
+            Err(CouplingError::Combination {
+                activation: cnc_core::cam::coupling::activation_raw(mode),
+                start: 1,
+                master_auto: false,
+                when: "scaling",
+            })
+        );
+    }
+    assert!(check_scaling(Instantaneous, rel, true).is_err());
+}
+
+#[test]
+fn an_axis_position_behind_the_master_is_refused() {
+    let moving_up = MasterNow {
+        axis: (99.0, 100.0),
+        ..MasterNow::default()
+    };
+    assert!(check_not_passed(Activation::AtMasterAxisPos(150.0), moving_up).is_ok());
+    assert_eq!(
+        check_not_passed(Activation::AtMasterAxisPos(50.0), moving_up),
+        Err(CouplingError::Passed {
+            position: 50.0,
+            master: 100.0
+        })
+    );
+    let moving_down = MasterNow {
+        axis: (101.0, 100.0),
+        ..MasterNow::default()
+    };
+    assert!(check_not_passed(Activation::AtMasterAxisPos(50.0), moving_down).is_ok());
+}
+
+#[test]
+fn master_auto_offset_keeps_the_share_of_the_cycle() {
+    // The seed's example: a 360 cam scaled by 2 at 90 (25 %) stays at 25 % of its now 720.
+    let p = wave();
+    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let twice = Scaling {
+        master_scaling: 2.0,
+        ..Scaling::default()
+    };
+    let modes = (ScalingMode::AutoOffset, ScalingMode::Off);
+    let scaled = law.rescaled(
+        &p,
+        twice,
+        modes,
+        StartMode::Absolute,
+        true,
+        90.0,
+        0.0,
+        false,
+    );
+    assert_eq!(scaled.locate(90.0).local, 90.0);
+    // From here the master needs 720 to run through the cam once: 180 more to the middle.
+    assert!((scaled.locate(90.0 + 270.0).local - 225.0).abs() < 1e-9);
+    assert_eq!(scaled.scaling.master_offset, 90.0);
+}
+
+#[test]
+fn slave_auto_offset_keeps_the_slave_where_it_is() {
+    let p = wave();
+    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let before = slave(&law, &p, at(200.0)).position;
+    // The seed's second example: MasterOffset 10 (a phase shift) with slave auto-offset.
+    let shifted = Scaling {
+        master_offset: 10.0,
+        ..Scaling::default()
+    };
+    let modes = (ScalingMode::UserDefined, ScalingMode::AutoOffset);
+    let after = law.rescaled(
+        &p,
+        shifted,
+        modes,
+        StartMode::Absolute,
+        true,
+        200.0,
+        before,
+        false,
+    );
+    assert_eq!(after.scaling.master_offset, 10.0);
+    assert!((slave(&after, &p, at(200.0)).position - before).abs() < 1e-12);
+    // Without it the slave would jump by T(210) - T(200).
+    let user = law.rescaled(
+        &p,
+        shifted,
+        (ScalingMode::UserDefined, ScalingMode::UserDefined),
+        StartMode::Absolute,
+        true,
+        200.0,
+        before,
+        false,
+    );
+    assert!((slave(&user, &p, at(200.0)).position - before).abs() > 1.0);
+    // Slave scaling 0 with Off on the master stops the slave's motion while coupled (the
+    // seed's first example): the position holds wherever the master goes.
+    let frozen = Scaling {
+        slave_scaling: 0.0,
+        ..Scaling::default()
+    };
+    let held = law.rescaled(
+        &p,
+        frozen,
+        (ScalingMode::Off, ScalingMode::AutoOffset),
+        StartMode::Absolute,
+        true,
+        200.0,
+        before,
+        false,
+    );
+    for m in [200.0, 250.0, 1000.0] {
+        assert!((slave(&held, &p, at(m)).position - before).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn bad_scalings_are_refused_with_the_value() {
+    for (s, what) in [
+        (
+            Scaling {
+                master_scaling: 0.0,
+                ..Scaling::default()
+            },
+            "master scaling",
+        ),
+        (
+            Scaling {
+                slave_offset: f64::NAN,
+                ..Scaling::default()
+            },
+            "slave offset",
+        ),
+        (
+            Scaling {
+                master_offset: f64::INFINITY,
+                ..Scaling::default()
+            },
+            "master offset",
+        ),
+    ] {
+        match s.check() {
+            Err(CouplingError::Parameter { what: w, .. }) => assert_eq!(w, what),
+            other => panic!("{other:?}"),
+        }
+    }
+    assert!(SCALED.check().is_ok());
+}
