@@ -857,3 +857,47 @@ fn a_sixteen_bit_position_drive_starting_far_from_zero_does_not_jump() {
     );
     assert_eq!(axis.error(), None);
 }
+
+#[test]
+fn decoupling_inside_an_engines_tick_keeps_the_motion_going() {
+    // A slave coupled at 100 units/s; an engine decouples it between sense and act: the
+    // set-point of that very tick moves on by one tick's travel, no stall.
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    rig.set
+        .axis_mut(0)
+        .unwrap()
+        .couple(Coupling {
+            kind: CouplingState::Cam,
+            master: -1,
+            phase: AxisState::SlaveSynchronous,
+        })
+        .unwrap();
+    let view = CncView::new(&rig.memory);
+    for k in 1..=50 {
+        rig.set.sense(&view);
+        rig.set.axis_mut(0).unwrap().drive_coupled(
+            Kinematic {
+                position: 0.1 * k as f64,
+                velocity: 100.0,
+                ..Kinematic::default()
+            },
+            AxisState::SlaveSynchronous,
+        );
+        rig.set.act(&view);
+    }
+    let before = rig.set_point(0).position;
+    rig.set.sense(&view);
+    rig.set.axis_mut(0).unwrap().decouple();
+    rig.set.act(&view);
+    let after = rig.set_point(0);
+    assert!(
+        ((after.position - before) - 0.1).abs() < 1e-9,
+        "moved {} in the decoupling tick",
+        after.position - before
+    );
+    assert!((after.velocity - 100.0).abs() < 1e-9);
+    // Between ticks the generator takes over with the next tick (no double step).
+    rig.tick();
+    assert!((rig.set_point(0).position - after.position - 0.1).abs() < 1e-9);
+}

@@ -607,20 +607,23 @@ fn branches_and_loops_follow_the_jump_table_matched_at_load() {
                    $ENDIF\n$WHILE 0\nG1 Y99 F6000\n$ENDWHILE\nG1 Z5 F6000\nM30\n";
     let mut ctl = controller(vec![(cartesian("c"), program)]);
     let memory = image(1);
-    let mut visited_x = Vec::new();
+    let mut lines = std::collections::BTreeSet::new();
     run_until(
         &mut ctl,
         &memory,
         20_000,
-        |c, _| visited_x.push(c.channels()[0].programmed()[0]),
+        |c, _| {
+            lines.insert(c.channels()[0].line());
+        },
         |c| c.channels()[0].state() == RunState::Finished,
     );
     let p = ctl.channels()[0].programmed();
     assert_eq!([p[0], p[1], p[2]], [20.0, 0.0, 5.0]);
-    assert!(
-        visited_x.iter().all(|x| *x <= 20.0),
-        "the X30 and X10 blocks never ran"
-    );
+    // Lines 2 (X10), 7 (X30) and 11 (Y99) never ran; 5 (X20) and 13 (Z5) did.
+    for skipped in [2, 7, 11] {
+        assert!(!lines.contains(&skipped), "line {skipped} ran: {lines:?}");
+    }
+    assert!(lines.contains(&5) && lines.contains(&13), "{lines:?}");
 }
 
 #[test]

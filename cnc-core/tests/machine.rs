@@ -172,6 +172,29 @@ fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest()
     }
     assert!(run.machine.controller().channels()[0].error().is_none());
     run.machine.stop("machine stop: test");
+    // An acknowledge the PLC gives during the stop stays pending: a stopping channel takes
+    // nothing from it.
+    let plc = hli::views::PlcView::new(&run.memory);
+    let request = plc
+        .m_function_request(0)
+        .unwrap()
+        .try_take()
+        .unwrap()
+        .unwrap();
+    let ack_free = |m: &hli::ImageMemory| {
+        hli::views::PlcView::new(m)
+            .m_function_ack(0)
+            .unwrap()
+            .is_free()
+            .unwrap()
+    };
+    plc.m_function_ack(0)
+        .unwrap()
+        .try_send(&hli::layout::HliMFunctionAck {
+            m_code: 100,
+            request_id: request.request_id,
+        })
+        .unwrap();
     assert!(
         !run.machine.at_rest(),
         "the waiting channel has not ended yet"
@@ -184,6 +207,14 @@ fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest()
     );
     assert!(run.machine.at_rest());
     assert!(run.machine.stopped());
+    assert!(
+        !ack_free(&run.memory),
+        "the acknowledge was taken during the stop"
+    );
+    assert_eq!(
+        run.machine.controller().channels()[0].m_functions_acked(),
+        0
+    );
 }
 
 #[test]

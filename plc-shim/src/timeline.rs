@@ -320,8 +320,9 @@ impl Timeline {
         self.instances.call_all(io, tick);
     }
 
-    /// One PLC cycle against `memory` without block calls (in-process runs); returns the CNC
-    /// tick it saw. Does not allocate.
+    /// One PLC cycle against `memory` without block calls (in-process runs of timelines that
+    /// call no blocks; [`Timeline::cycle_io`] runs the blocks too); returns the CNC tick it
+    /// saw. Does not allocate.
     pub fn cycle(&mut self, memory: &ImageMemory) -> u64 {
         let tick = match self.cnc_tick.read(memory) {
             Value::Unsigned(t) => t,

@@ -56,6 +56,8 @@ pub struct Axis {
     last_set: Kinematic,
     /// The encoder count read in `sense`, mirrored to `enc_out` in `act`.
     encoder_echo: i32,
+    /// Between `sense` and `act` of a tick (an engine decoupling now steps the generator).
+    sensed: bool,
     io_fault: Option<AxisError>,
     actual: f64,
     actual_velocity: f64,
@@ -96,6 +98,7 @@ impl Axis {
             coupled_setpoint: Kinematic::default(),
             last_set: Kinematic::default(),
             encoder_echo: 0,
+            sensed: false,
             io_fault: None,
             actual: 0.0,
             actual_velocity: 0.0,
@@ -334,10 +337,22 @@ impl Axis {
     /// Ends a coupling (MC_GearOut, MC_CamOut): the axis becomes a free master and goes on at
     /// the velocity it had, acceleration-free, as after MC_MoveVelocity, until MC_Halt or
     /// MC_Stop.
+    ///
+    /// Between ticks (`handle`, `reset`) the generator takes over with the next tick. Inside
+    /// an engine's tick (between `sense` and `act`, in place of this tick's `drive_coupled`)
+    /// it steps at once from the last coupled set-point, so the motion goes on without a
+    /// one-tick stall.
     pub fn decouple(&mut self) {
         if self.coupling.take().is_none() {
             return;
         }
+        self.resume_free();
+        if self.sensed && self.enabled && self.error.is_none() {
+            self.generate();
+        }
+    }
+
+    fn resume_free(&mut self) {
         let s = self.coupled_setpoint;
         let d = self.config.dynamics;
         // Resume from the coupled state: position, velocity and acceleration carry over.
@@ -415,6 +430,7 @@ impl Axis {
             }
         }
         self.encoder_echo = enc_in.nInData1;
+        self.sensed = true;
         // This tick's generator step (or the coupled engine, between `sense` and `act`)
         // produces the set-point for the end of the coming tick.
         if !self.enabled {
@@ -427,6 +443,7 @@ impl Axis {
     /// Second half of a tick: monitors the following error, runs the position controller on
     /// this tick's set-point and returns the outputs.
     pub fn act(&mut self) -> AxisOutputs {
+        self.sensed = false;
         // The actual position belongs to the set-point of the previous tick.
         let previous = self.last_set;
         self.following_error = previous.position - self.actual;

@@ -373,7 +373,9 @@ impl Channel {
     pub fn wanted(&self) -> Wanted {
         Wanted {
             dyn_cs: self.stopping.is_none(),
-            m_ack: matches!(self.wait, Some(Wait::MFunction { .. })),
+            // Not during a stop: the channel interprets nothing then, and an acknowledge taken
+            // now would be lost to the PLC's handshake.
+            m_ack: self.stopping.is_none() && matches!(self.wait, Some(Wait::MFunction { .. })),
         }
     }
 

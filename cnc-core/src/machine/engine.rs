@@ -25,7 +25,11 @@ pub trait Engine: std::fmt::Debug + Send {
     /// A short name for reports.
     fn name(&self) -> &'static str;
 
-    /// One tick, after the channels and before the axes. Must not allocate, lock or do IO.
+    /// One tick, between the axes' sense (inputs read, free axes' generators stepped: a
+    /// master's set-point is this tick's) and act (following error, controller, outputs).
+    /// An engine may couple an axis here (`Axis::couple`, then `drive_coupled`); a decoupled
+    /// axis steps its own generator this tick (`Axis::decouple`). Must not allocate, lock or
+    /// do IO.
     fn tick(&mut self, io: &mut EngineIo<'_, '_>);
 
     /// An acyclic call this engine owns, answered; `None` when the call is not its own.

@@ -483,7 +483,8 @@ impl DecoderState {
     /// Decodes block `index` of `program` (parsed from `src`) with the variable values of
     /// `vars` now, appending its elements to `out`: how a channel consumes its program, one
     /// block when it reaches it. Returns the block's diagnostics (empty when it decoded
-    /// cleanly; nothing is allocated then). Control statements carry unresolved positions (0).
+    /// cleanly; nothing is allocated then). Where a control statement goes is in the
+    /// program's jump table ([`super::control::match_control`]).
     pub fn decode_block(
         &mut self,
         program: &Program,
@@ -549,8 +550,8 @@ impl DecoderState {
         self.axis_names.iter().position(|a| a.packed() == packed)
     }
 
-    /// Decodes one block; `out` receives its elements. Control statements are emitted with
-    /// unresolved indices (0); [`decode_program`] resolves them.
+    /// Decodes one block; `out` receives its elements (a control statement as its kind and
+    /// condition; the jump table says where it goes).
     fn block(&mut self, block: &Block, items: &[Item], ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
         let line = block.line;
         let mut g92 = false;
