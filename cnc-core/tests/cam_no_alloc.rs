@@ -70,3 +70,64 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
     assert_eq!(allocations() - before, 0, "allocations while evaluating");
     assert!(sum.is_finite());
 }
+
+/// The machine tick with a cam slave coupled to a running conveyor, through a rescaling that
+/// activates at a cycle boundary inside the measured ticks, allocates nothing.
+#[test]
+fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
+    use cnc_core::app::scenario::{InProcess, Scenario};
+    use hli::calls::{AcyclicCall, CamScalingCall};
+    use hli::enums::AxisState;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/cam-conveyor/scenario.toml");
+    let s = Scenario::load(&path).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    // The PLC couples the lifter and starts the conveyor within the first ticks.
+    for _ in 0..300 {
+        run.step(s.cycle_s);
+    }
+    let slave = run.machine.axes().axis(1).unwrap();
+    assert_eq!(
+        slave.motion_state(slave.setpoint()),
+        AxisState::SlaveSynchronous
+    );
+    // A rescaling for the next cycle, queued before the measured ticks.
+    let scaling = CamScalingCall {
+        activation_mode: 3,
+        master_scaling_mode: 2,
+        slave_scaling_mode: 1,
+        slave_scaling: 0.5,
+        master_scaling: 1.0,
+        ..CamScalingCall::default()
+    };
+    let (body, body_len) = hli::wire::encode_body(&scaling);
+    let request = hli::wire::AcyclicRequest {
+        invoke_id: 9,
+        kind: CamScalingCall::KIND.raw(),
+        target: 1,
+        body_len,
+        body,
+    };
+    let view = hli::views::CncView::new(&run.memory);
+    run.machine
+        .dispatch(&view, CamScalingCall::KIND, &request)
+        .unwrap();
+    let before = allocations();
+    let mut top: f64 = 0.0;
+    for tick in 0..3000 {
+        run.machine.tick(&run.memory);
+        if tick >= 2000 {
+            top = top.max(run.machine.axes().axis(1).unwrap().setpoint().position);
+        }
+    }
+    let made = allocations() - before;
+    assert_eq!(made, 0, "{made} allocations in 3000 machine ticks");
+    // The full stroke reaches about 42; the halved one about 21.
+    assert!(top > 15.0 && top < 25.0, "top of the last turn {top}");
+    // Three turns of the conveyor went by, the stroke halved on the way.
+    let lifter = run.machine.axes().axis(1).unwrap();
+    assert_eq!(
+        lifter.motion_state(lifter.setpoint()),
+        AxisState::SlaveSynchronous
+    );
+}

@@ -226,7 +226,10 @@ fn the_store_checks_ids_and_keeps_a_table_whose_write_is_refused() {
         .write_points(7, 5, &[change()], MasterNow::standing(0.0))
         .unwrap();
     assert_eq!(store.get(7).unwrap(), &before, "not before the tick");
-    assert!(store.apply_due(7, MasterNow::standing(0.0)).unwrap());
+    assert!(store
+        .apply_due(7, MasterNow::standing(0.0))
+        .unwrap()
+        .is_some());
     assert_ne!(store.get(7).unwrap(), &before);
     assert_eq!(store.get(8).unwrap_err(), CamError::NoSuchTable { id: 8 });
 }

@@ -46,6 +46,14 @@ pub enum CallKind {
     ReadAxisState,
     /// [`AxisCommandCall`].
     AxisCommand,
+    /// [`CamTableSelectCall`].
+    CamTableSelect,
+    /// [`CamInCall`].
+    CamIn,
+    /// [`CamOutCall`].
+    CamOut,
+    /// [`CamScalingCall`].
+    CamScaling,
 }
 
 impl CallKind {
@@ -54,6 +62,10 @@ impl CallKind {
         match self {
             CallKind::ReadAxisState => 1,
             CallKind::AxisCommand => 2,
+            CallKind::CamTableSelect => 10,
+            CallKind::CamIn => 11,
+            CallKind::CamOut => 12,
+            CallKind::CamScaling => 13,
         }
     }
 
@@ -62,6 +74,10 @@ impl CallKind {
         match raw {
             1 => Some(CallKind::ReadAxisState),
             2 => Some(CallKind::AxisCommand),
+            10 => Some(CallKind::CamTableSelect),
+            11 => Some(CallKind::CamIn),
+            12 => Some(CallKind::CamOut),
+            13 => Some(CallKind::CamScaling),
             _ => None,
         }
     }
@@ -200,6 +216,117 @@ pub struct AxisCommandReply {
 impl AcyclicCall for AxisCommandCall {
     const KIND: CallKind = CallKind::AxisCommand;
     type Reply = AxisCommandReply;
+}
+
+/// MC_CamTableSelect for the table given as `target` (its ID, 1..=255): how couplings
+/// through it run when MC_CamIn does not say otherwise.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamTableSelectCall {
+    /// 1: continued period by period (cyclic); 0: linear.
+    pub periodic: u32,
+    /// 1: master coordinates absolute; 0: relative to the coupling position.
+    pub master_absolute: u32,
+    /// 1: slave coordinates absolute; 0: relative to the coupling position.
+    pub slave_absolute: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// MC_CamIn (`extended` 0) or MC_CamInExt (`extended` 1) for the slave axis given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamInCall {
+    /// Master axis index.
+    pub master: u32,
+    /// Cam table ID.
+    pub table_id: u32,
+    /// Raw `MC_StartMode` (1..=4).
+    pub start_mode: u32,
+    /// Raw `MC_CamActivationMode` (MC_CamInExt; 0 for MC_CamIn).
+    pub activation_mode: u32,
+    /// Raw `MC_CamScalingMode` of the master (MC_CamInExt; 0 for MC_CamIn).
+    pub master_scaling_mode: u32,
+    /// Raw `MC_CamScalingMode` of the slave (MC_CamInExt; 0 for MC_CamIn).
+    pub slave_scaling_mode: u32,
+    /// Raw `MC_InterpolationType` (tables only; 0 keeps the table's own).
+    pub interpolation: u32,
+    /// 1 for MC_CamInExt: the coupling may later switch to another cam.
+    pub extended: u32,
+    /// Activation position of the positional activation modes.
+    pub activation_position: f64,
+    /// Master offset.
+    pub master_offset: f64,
+    /// Slave offset.
+    pub slave_offset: f64,
+    /// Master scaling (not 0).
+    pub master_scaling: f64,
+    /// Slave scaling.
+    pub slave_scaling: f64,
+}
+
+/// MC_CamOut for the slave axis given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamOutCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// MC_CamScaling for the slave axis given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamScalingCall {
+    /// Raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Raw `MC_CamScalingMode` of the master.
+    pub master_scaling_mode: u32,
+    /// Raw `MC_CamScalingMode` of the slave.
+    pub slave_scaling_mode: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Activation position of the positional activation modes.
+    pub activation_position: f64,
+    /// Master offset.
+    pub master_offset: f64,
+    /// Slave offset.
+    pub slave_offset: f64,
+    /// Master scaling (not 0).
+    pub master_scaling: f64,
+    /// Slave scaling.
+    pub slave_scaling: f64,
+}
+
+/// The reply to every cam call: 0 when accepted, else the error code of the refusal (the
+/// seed's table codes 0x4B30.., [`crate::enums::AxisError`] or
+/// [`crate::enums::CamCouplingError`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamReply {
+    /// 0 when accepted.
+    pub error_id: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+impl AcyclicCall for CamTableSelectCall {
+    const KIND: CallKind = CallKind::CamTableSelect;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamInCall {
+    const KIND: CallKind = CallKind::CamIn;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamOutCall {
+    const KIND: CallKind = CallKind::CamOut;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamScalingCall {
+    const KIND: CallKind = CallKind::CamScaling;
+    type Reply = CamReply;
 }
 
 /// Why a call did not produce a reply.

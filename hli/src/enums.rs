@@ -137,6 +137,30 @@ hli_enum! {
 }
 
 hli_enum! {
+    /// Why the cam engine refused a coupling command (beside the seed's table codes for an
+    /// unknown table and the axis layer's codes for a slave that cannot be coupled). The
+    /// seed does not number these; they are ours.
+    CamCouplingError: u32, "CamCouplingError" {
+        /// The master axis does not exist.
+        NoSuchMaster = 0x4260,
+        /// The master is the slave itself.
+        MasterIsSlave = 0x4261,
+        /// Activation, start and scaling mode do not go together (seed 5.1.16.13/14).
+        ModeCombination = 0x4262,
+        /// The activation position lies behind the master in its direction of travel.
+        ActivationPassed = 0x4263,
+        /// MC_CamOut or MC_CamScaling on a slave no cam couples.
+        NotCamCoupled = 0x4264,
+        /// A coupling made with MC_CamIn cannot switch cams (MC_CamInExt can).
+        NotSwitchable = 0x4265,
+        /// An offset or scaling that is not finite, or a master scaling of 0.
+        BadParameter = 0x4266,
+        /// An unknown start, activation or scaling mode number.
+        UnknownMode = 0x4267,
+    }
+}
+
+hli_enum! {
     /// State of a channel's program.
     ProgramState: i32, "HLI_BAHN_STATE.program_state_r" {
         /// No program selected or finished and reset.

@@ -11,17 +11,29 @@
 //!          velocity = 200.0, acceleration = 2000.0, deceleration = 2000.0, jerk = 50000.0 }
 //! ```
 //!
+//! The cam blocks of [`crate::cam`] take the slave as `axis` and name the master and the
+//! table; modes are given by number or by name:
+//!
+//! ```toml
+//! [[step]]
+//! call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1,
+//!          start_mode = "absolute", slave_scaling = 2.0 }
+//! [[step]]
+//! wait = "cam.InSync"
+//! ```
+//!
 //! A call sets the given inputs and a rising edge on Execute (`execute = false` lowers it
 //! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
 //! FALSE for one cycle first, so every call is a new edge.
 
+use crate::cam::{CamOutputs, McCamIn, McCamOut, McCamScaling, McCamTableSelect};
 use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
 use crate::runtime::PlcIo;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 7] = [
+pub const BLOCKS: [&str; 12] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -29,10 +41,15 @@ pub const BLOCKS: [&str; 7] = [
     "MC_MoveVelocity",
     "MC_Halt",
     "MC_Stop",
+    "MC_CamTableSelect",
+    "MC_CamIn",
+    "MC_CamInExt",
+    "MC_CamOut",
+    "MC_CamScaling",
 ];
 
 /// The outputs a `wait` can name.
-pub const OUTPUTS: [&str; 7] = [
+pub const OUTPUTS: [&str; 8] = [
     "Done",
     "Busy",
     "Active",
@@ -40,6 +57,7 @@ pub const OUTPUTS: [&str; 7] = [
     "Error",
     "InVelocity",
     "Status",
+    "InSync",
 ];
 
 #[derive(Debug)]
@@ -51,6 +69,10 @@ enum Block {
     MoveVelocity(McMoveVelocity),
     Halt(McHalt),
     Stop(McStop),
+    CamTableSelect(McCamTableSelect),
+    CamIn(Box<McCamIn>),
+    CamOut(McCamOut),
+    CamScaling(Box<McCamScaling>),
 }
 
 /// A boolean output of a block.
@@ -68,6 +90,62 @@ enum Input {
     Deceleration(f64),
     Jerk(f64),
     Direction(i32),
+    /// Cam blocks: master axis, table ID, mode numbers.
+    Master(u32),
+    Table(u32),
+    StartMode(u32),
+    ActivationMode(u32),
+    MasterScalingMode(u32),
+    SlaveScalingMode(u32),
+    Interpolation(u32),
+    ActivationPosition(f64),
+    MasterOffset(f64),
+    SlaveOffset(f64),
+    MasterScaling(f64),
+    SlaveScaling(f64),
+    Periodic(bool),
+    MasterAbsolute(bool),
+    SlaveAbsolute(bool),
+}
+
+/// A mode input by number or by its name.
+fn mode(key: &str, value: &toml::Value) -> Result<u32, String> {
+    let names: &[(&str, u32)] = match key {
+        "start_mode" => &[
+            ("absolute", 1),
+            ("relative", 2),
+            ("master_abs_slave_rel", 3),
+            ("master_rel_slave_abs", 4),
+        ],
+        "activation_mode" => &[
+            ("instantaneous", 0),
+            ("at_master_cam_pos", 1),
+            ("at_master_axis_pos", 2),
+            ("next_cycle", 3),
+            ("next_cycle_once", 4),
+            ("as_soon_as_possible", 5),
+            ("off", 6),
+            ("delete_queued_data", 7),
+        ],
+        "interpolation" => &[("linear", 0), ("4point", 1), ("spline", 2)],
+        _ => &[("user_defined", 0), ("auto_offset", 1), ("off", 2)],
+    };
+    let known = || {
+        names
+            .iter()
+            .map(|(n, v)| format!("{n} ({v})"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match value {
+        toml::Value::String(name) => names
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(name))
+            .map(|(_, v)| *v)
+            .ok_or_else(|| format!("call: `{key}` = {name:?}: known are {}", known())),
+        toml::Value::Integer(i) if names.iter().any(|(_, v)| i64::from(*v) == *i) => Ok(*i as u32),
+        _ => Err(format!("call: `{key}` = {value}: known are {}", known())),
+    }
 }
 
 /// A call of an instance, checked.
@@ -94,8 +172,8 @@ struct Instance {
     axis: u32,
     block: Block,
     raise_next_cycle: bool,
-    last: [bool; 7],
-    edges: [Edge; 7],
+    last: [bool; 8],
+    edges: [Edge; 8],
     error_id: u32,
 }
 
@@ -166,7 +244,43 @@ impl Instances {
                 "deceleration",
                 "jerk",
             ],
-            _ => &["deceleration", "jerk"],
+            "MC_Halt" | "MC_Stop" => &["deceleration", "jerk"],
+            "MC_CamTableSelect" => &["table", "periodic", "master_absolute", "slave_absolute"],
+            "MC_CamIn" => &[
+                "master",
+                "table",
+                "start_mode",
+                "master_offset",
+                "slave_offset",
+                "master_scaling",
+                "slave_scaling",
+                "interpolation",
+            ],
+            "MC_CamInExt" => &[
+                "master",
+                "table",
+                "start_mode",
+                "activation_mode",
+                "activation_position",
+                "master_scaling_mode",
+                "slave_scaling_mode",
+                "master_offset",
+                "slave_offset",
+                "master_scaling",
+                "slave_scaling",
+                "interpolation",
+            ],
+            "MC_CamScaling" => &[
+                "activation_mode",
+                "activation_position",
+                "master_scaling_mode",
+                "slave_scaling_mode",
+                "master_offset",
+                "slave_offset",
+                "master_scaling",
+                "slave_scaling",
+            ],
+            _ => &[],
         };
         let mut inputs = Vec::new();
         let mut execute = true;
@@ -197,6 +311,25 @@ impl Instances {
                     Some(d @ (-1 | 1)) => Input::Direction(d as i32),
                     _ => return Err(format!("call: `direction` = {value}: 1 or -1")),
                 },
+                "master" | "table" => {
+                    let v = value
+                        .as_integer()
+                        .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                        .ok_or_else(bad)? as u32;
+                    if key == "master" {
+                        Input::Master(v)
+                    } else {
+                        Input::Table(v)
+                    }
+                }
+                "start_mode" => Input::StartMode(mode(key, value)?),
+                "activation_mode" => Input::ActivationMode(mode(key, value)?),
+                "master_scaling_mode" => Input::MasterScalingMode(mode(key, value)?),
+                "slave_scaling_mode" => Input::SlaveScalingMode(mode(key, value)?),
+                "interpolation" => Input::Interpolation(mode(key, value)?),
+                "periodic" => Input::Periodic(value.as_bool().ok_or_else(bad)?),
+                "master_absolute" => Input::MasterAbsolute(value.as_bool().ok_or_else(bad)?),
+                "slave_absolute" => Input::SlaveAbsolute(value.as_bool().ok_or_else(bad)?),
                 other => {
                     let v = number(value).filter(|v| v.is_finite()).ok_or_else(bad)?;
                     match other {
@@ -205,6 +338,11 @@ impl Instances {
                         "velocity" => Input::Velocity(v),
                         "acceleration" => Input::Acceleration(v),
                         "deceleration" => Input::Deceleration(v),
+                        "activation_position" => Input::ActivationPosition(v),
+                        "master_offset" => Input::MasterOffset(v),
+                        "slave_offset" => Input::SlaveOffset(v),
+                        "master_scaling" => Input::MasterScaling(v),
+                        "slave_scaling" => Input::SlaveScaling(v),
                         _ => Input::Jerk(v),
                     }
                 }
@@ -226,8 +364,8 @@ impl Instances {
                     axis,
                     block: new_block(kind),
                     raise_next_cycle: false,
-                    last: [false; 7],
-                    edges: [Edge::default(); 7],
+                    last: [false; 8],
+                    edges: [Edge::default(); 8],
                     error_id: 0,
                 });
                 self.list.len() - 1
@@ -285,7 +423,7 @@ impl Instances {
         for input in &call.inputs {
             set_input(&mut inst.block, *input);
         }
-        inst.last = [false; 7];
+        inst.last = [false; 8];
         match execute_of(&mut inst.block) {
             // Execute is (or is about to be) TRUE: hold it FALSE for a cycle, then raise it.
             Some(execute) if call.execute && (*execute || inst.raise_next_cycle) => {
@@ -350,6 +488,26 @@ impl Instances {
                     b.call(io, axis);
                     (b.out, false)
                 }
+                Block::CamTableSelect(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
+                Block::CamIn(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
+                Block::CamOut(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
+                Block::CamScaling(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
+            };
+            let in_sync = match &inst.block {
+                Block::CamIn(b) => b.out.in_sync,
+                _ => false,
             };
             let now = [
                 out.done,
@@ -359,6 +517,7 @@ impl Instances {
                 out.error,
                 out.in_velocity,
                 status,
+                in_sync,
             ];
             for ((is, was), edge) in now.iter().zip(inst.last).zip(inst.edges.iter_mut()) {
                 if *is && !was {
@@ -418,12 +577,25 @@ impl Clone for Instances {
                     axis: i.axis,
                     block: new_block(i.kind),
                     raise_next_cycle: false,
-                    last: [false; 7],
-                    edges: [Edge::default(); 7],
+                    last: [false; 8],
+                    edges: [Edge::default(); 8],
                     error_id: 0,
                 })
                 .collect(),
         }
+    }
+}
+
+/// A cam block's outputs in the motion blocks' shape (InSync is recorded beside them).
+fn cam_outputs(out: CamOutputs) -> BlockOutputs {
+    BlockOutputs {
+        done: out.done,
+        busy: out.busy,
+        active: false,
+        command_aborted: out.command_aborted,
+        error: out.error,
+        error_id: out.error_id,
+        in_velocity: false,
     }
 }
 
@@ -439,6 +611,15 @@ fn new_block(kind: &str) -> Block {
             Block::MoveVelocity(b)
         }
         "MC_Halt" => Block::Halt(McHalt::default()),
+        "MC_CamTableSelect" => Block::CamTableSelect(McCamTableSelect::default()),
+        "MC_CamIn" => Block::CamIn(Box::default()),
+        "MC_CamInExt" => {
+            let mut b = Box::<McCamIn>::default();
+            b.extended = true;
+            Block::CamIn(b)
+        }
+        "MC_CamOut" => Block::CamOut(McCamOut::default()),
+        "MC_CamScaling" => Block::CamScaling(Box::default()),
         _ => Block::Stop(McStop::default()),
     }
 }
@@ -452,6 +633,10 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::MoveVelocity(b) => Some(&mut b.execute),
         Block::Halt(b) => Some(&mut b.execute),
         Block::Stop(b) => Some(&mut b.execute),
+        Block::CamTableSelect(b) => Some(&mut b.execute),
+        Block::CamIn(b) => Some(&mut b.execute),
+        Block::CamOut(b) => Some(&mut b.execute),
+        Block::CamScaling(b) => Some(&mut b.execute),
     }
 }
 
@@ -477,6 +662,30 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::Halt(b), Input::Jerk(v)) => b.jerk = v,
         (Block::Stop(b), Input::Deceleration(v)) => b.deceleration = v,
         (Block::Stop(b), Input::Jerk(v)) => b.jerk = v,
+        (Block::CamTableSelect(b), Input::Table(v)) => b.table = v,
+        (Block::CamTableSelect(b), Input::Periodic(v)) => b.periodic = v,
+        (Block::CamTableSelect(b), Input::MasterAbsolute(v)) => b.master_absolute = v,
+        (Block::CamTableSelect(b), Input::SlaveAbsolute(v)) => b.slave_absolute = v,
+        (Block::CamIn(b), Input::Master(v)) => b.master = v,
+        (Block::CamIn(b), Input::Table(v)) => b.table = v,
+        (Block::CamIn(b), Input::StartMode(v)) => b.start_mode = v,
+        (Block::CamIn(b), Input::ActivationMode(v)) => b.activation_mode = v,
+        (Block::CamIn(b), Input::ActivationPosition(v)) => b.activation_position = v,
+        (Block::CamIn(b), Input::MasterScalingMode(v)) => b.master_scaling_mode = v,
+        (Block::CamIn(b), Input::SlaveScalingMode(v)) => b.slave_scaling_mode = v,
+        (Block::CamIn(b), Input::MasterOffset(v)) => b.master_offset = v,
+        (Block::CamIn(b), Input::SlaveOffset(v)) => b.slave_offset = v,
+        (Block::CamIn(b), Input::MasterScaling(v)) => b.master_scaling = v,
+        (Block::CamIn(b), Input::SlaveScaling(v)) => b.slave_scaling = v,
+        (Block::CamIn(b), Input::Interpolation(v)) => b.interpolation = v,
+        (Block::CamScaling(b), Input::ActivationMode(v)) => b.activation_mode = v,
+        (Block::CamScaling(b), Input::ActivationPosition(v)) => b.activation_position = v,
+        (Block::CamScaling(b), Input::MasterScalingMode(v)) => b.master_scaling_mode = v,
+        (Block::CamScaling(b), Input::SlaveScalingMode(v)) => b.slave_scaling_mode = v,
+        (Block::CamScaling(b), Input::MasterOffset(v)) => b.master_offset = v,
+        (Block::CamScaling(b), Input::SlaveOffset(v)) => b.slave_offset = v,
+        (Block::CamScaling(b), Input::MasterScaling(v)) => b.master_scaling = v,
+        (Block::CamScaling(b), Input::SlaveScaling(v)) => b.slave_scaling = v,
         // parse_call admits only the inputs of the block.
         _ => {}
     }

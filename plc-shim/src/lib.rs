@@ -3,6 +3,7 @@
 //! the acyclic request-response service.
 
 pub mod blocks;
+pub mod cam;
 pub mod cli;
 pub mod motion;
 pub mod programs;

@@ -60,7 +60,7 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
         answered += server
             .poll(|kind, request| match kind {
                 CallKind::ReadAxisState => handle_read_axis_state(&view, request),
-                CallKind::AxisCommand => Err(ErrorCode::ServiceNotSupported),
+                _ => Err(ErrorCode::ServiceNotSupported),
             })
             .unwrap();
         std::thread::yield_now();

@@ -190,6 +190,7 @@ fn plc_motion_blocks_drive_simulated_axes_through_the_segment() {
                 .poll(|kind, request| match kind {
                     CallKind::AxisCommand => axes.handle_command(request),
                     CallKind::ReadAxisState => handle_read_axis_state(&view, request),
+                    _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
                 })
                 .unwrap();
             axes.tick(&view);

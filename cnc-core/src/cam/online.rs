@@ -322,17 +322,14 @@ impl CamStore {
         queue.write(current, first, points, now)
     }
 
-    /// Applies the queued change of table `id` if it is due; true if it was applied.
-    pub fn apply_due(&mut self, id: u32, now: MasterNow) -> Result<bool, CamError> {
+    /// Applies the queued change of table `id` if it is due; the profile it replaced when it
+    /// was applied (handed back so that a cyclic caller can free it outside its cycle).
+    pub fn apply_due(&mut self, id: u32, now: MasterNow) -> Result<Option<CamProfile>, CamError> {
         let (profile, queue) = self.tables[slot(id)?]
             .as_mut()
             .ok_or(CamError::NoSuchTable { id })?;
-        match queue.take_due(now) {
-            Some(f) => {
-                *profile = CamProfile::MotionFunction(f);
-                Ok(true)
-            }
-            None => Ok(false),
-        }
+        Ok(queue
+            .take_due(now)
+            .map(|f| core::mem::replace(profile, CamProfile::MotionFunction(f))))
     }
 }

@@ -20,6 +20,7 @@
 //! The machine is library code: it knows no PLC program and no process. `cnc run`, the demo,
 //! the in-process runs, the benchmark and the no-allocation tests all drive this one `tick`.
 
+pub mod cams;
 mod channel_axes;
 pub mod engine;
 pub mod gear;
@@ -219,6 +220,10 @@ impl Machine {
         kind: CallKind,
         request: &AcyclicRequest,
     ) -> HandlerResult {
+        // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
+        if self.stopped && kind != CallKind::ReadAxisState {
+            return Err(ErrorCode::Busy);
+        }
         for engine in &mut self.engines {
             if let Some(result) = engine.handle(kind, request, &mut self.axes) {
                 return result;
@@ -226,8 +231,6 @@ impl Machine {
         }
         match kind {
             CallKind::ReadAxisState => handle_read_axis_state(view, request),
-            // A stopped machine takes no motion commands (a PLC must not undo the stop).
-            CallKind::AxisCommand if self.stopped => Err(ErrorCode::Busy),
             CallKind::AxisCommand => {
                 let target = request.target as usize;
                 if target < self.channel_axes() {
@@ -241,6 +244,8 @@ impl Machine {
                 }
                 self.axes.handle_command(request)
             }
+            // A kind of an engine this machine does not have.
+            _ => Err(ErrorCode::ServiceNotSupported),
         }
     }
 

@@ -10,6 +10,9 @@
 //! axes = ["X", "Y", "Z", "A", "B", "C"]
 //! kinematics = { id = 45, preset = "kr6r900sixx" }
 //! program = "master.nc"           # relative to this file
+//! [[cam_table]]
+//! file = "../cams/seed_example.json"  # a JSON cam file (docs/cams.md); its `id`, or:
+//! id = 1
 //! [plc]
 //! timeline = "plc.toml"           # or: program = "rotary-table"
 //! [trace]
@@ -58,6 +61,8 @@ struct ScenarioFile {
     axis: Vec<super::axes::AxisFile>,
     #[serde(default)]
     gear: Vec<super::axes::GearFile>,
+    #[serde(default)]
+    cam_table: Vec<CamTableFile>,
     plc: Option<PlcFile>,
     #[serde(default)]
     trace: TraceFile,
@@ -69,6 +74,13 @@ struct ScenarioFile {
 
 fn default_cycle_ms() -> f64 {
     1.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CamTableFile {
+    file: String,
+    id: Option<u32>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -123,6 +135,8 @@ pub struct Scenario {
     pub axes: Vec<super::axes::ScenarioAxis>,
     /// Gear couplings between axes (indices in the machine's axis set).
     pub gears: Vec<crate::machine::gear::GearSpec>,
+    /// Cam tables by ID, loaded into the cam engine at start.
+    pub cam_tables: Vec<(u32, crate::cam::CamProfile)>,
     /// The PLC.
     pub plc: PlcSetup,
     /// Trace signals: ST path and resolved leaf.
@@ -262,6 +276,42 @@ impl Scenario {
                 }
             }
         }
+        let mut cam_tables: Vec<(u32, crate::cam::CamProfile)> = Vec::new();
+        for t in &file.cam_table {
+            let (path, text) = open(&t.file)?;
+            let at = path.display();
+            if !text.trim_start().starts_with('{') {
+                return Err(invalid(format!(
+                    "[[cam_table]] {at}: a scenario takes JSON cam files (docs/cams.md)"
+                )));
+            }
+            let cam = crate::cam::file::parse(text.as_bytes(), Default::default())
+                .map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
+            let id = match (cam.id, t.id) {
+                (Some(a), Some(b)) if a != b => {
+                    return Err(invalid(format!(
+                        "[[cam_table]] {at}: the file has id {a}, the scenario says {b}"
+                    )))
+                }
+                (Some(id), _) | (None, Some(id)) => id,
+                (None, None) => {
+                    return Err(invalid(format!(
+                        "[[cam_table]] {at}: no id (give `id = 1..255`)"
+                    )))
+                }
+            };
+            if !(1..=255).contains(&id) {
+                return Err(invalid(format!(
+                    "[[cam_table]] {at}: id {id} is outside 1..255"
+                )));
+            }
+            if cam_tables.iter().any(|(other, _)| *other == id) {
+                return Err(invalid(format!(
+                    "[[cam_table]] {at}: id {id} is taken by another table"
+                )));
+            }
+            cam_tables.push((id, cam.profile));
+        }
         let mut signals = Vec::with_capacity(file.trace.signals.len());
         for s in file.trace.signals {
             let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;
@@ -276,6 +326,7 @@ impl Scenario {
             programs,
             axes,
             gears,
+            cam_tables,
             plc,
             signals,
             realtime: file.realtime,

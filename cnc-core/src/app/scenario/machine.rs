@@ -41,6 +41,16 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         let gears = GearEngine::new(&scenario.gears, total).map_err(|e| invalid(e.to_string()))?;
         engines.push(Box::new(gears));
     }
+    if !scenario.cam_tables.is_empty() {
+        let mut store = crate::cam::online::CamStore::new();
+        for (id, profile) in &scenario.cam_tables {
+            store
+                .insert(*id, profile.clone())
+                .map_err(|e| invalid(format!("[[cam_table]] {id}: {e}")))?;
+        }
+        let total = channel_axes + scenario.axes.len();
+        engines.push(Box::new(crate::machine::cams::CamEngine::new(store, total)));
+    }
     let mut machine = Machine::new(MachineSetup {
         channels,
         axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),

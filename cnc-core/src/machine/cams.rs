@@ -1,0 +1,593 @@
+//! The cam engine: slave axes coupled to a master axis through a cam profile (seed 000,
+//! chapters 4.3 to 4.5 and 5.1.1 to 5.1.6). Each tick, for every coupled slave, it takes the
+//! master's set-point of this tick, applies queued online changes of the cam's points, a due
+//! switch or rescaling, and hands the slave its set-point through the coupling law
+//! ([`crate::cam::coupling::CamLaw`]); the axis stage does the rest (limits, following
+//! error, drive).
+//!
+//! Commands arrive as acyclic calls between ticks: MC_CamTableSelect (per table: cyclic,
+//! master and slave absolute), MC_CamIn / MC_CamInExt (couple, or with Ext switch cams),
+//! MC_CamOut (the slave goes on at its velocity as a free axis) and MC_CamScaling. A refused
+//! call leaves every axis doing what it did.
+//!
+//! A first coupling with a waiting activation mode couples the slave at once but holds it
+//! (`nAxisState` 11, pre-phase) until the master reaches the activation; then the slave
+//! follows the cam (13, synchronous) and jumps to the cam's position if it does not stand
+//! there, as the seed says (5.1.4).
+
+use super::engine::{Engine, EngineIo};
+use crate::axis::generator::Kinematic;
+use crate::axis::{AxisSet, Coupling};
+use crate::cam::coupling::{
+    check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
+    Scaling, ScalingMode, StartMode,
+};
+use crate::cam::online::{ActivationMode, CamStore, MasterNow};
+use crate::cam::{CamProfile, Interpolation, PositionTable, ProfileCursor, TableErrorCode};
+use hli::calls::{
+    decode_body, reply, CallKind, CamInCall, CamOutCall, CamReply, CamScalingCall,
+    CamTableSelectCall, ErrorCode, HandlerResult,
+};
+use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
+use hli::wire::AcyclicRequest;
+
+/// Table IDs run 1..=255.
+const TABLE_SLOTS: usize = 256;
+
+/// MC_CamTableSelect's settings of a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Select {
+    periodic: bool,
+}
+
+/// What a coupling waits for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Queued {
+    /// The first coupling: the slave holds until the activation comes.
+    Couple(ActivationMode),
+    /// A switch to another cam (MC_CamInExt while coupled).
+    Switch {
+        table: u32,
+        scaling: Scaling,
+        modes: (ScalingMode, ScalingMode),
+        start: StartMode,
+        activation: ActivationMode,
+    },
+    /// A rescaling (MC_CamScaling).
+    Scale {
+        scaling: Scaling,
+        modes: (ScalingMode, ScalingMode),
+        activation: ActivationMode,
+    },
+}
+
+/// One coupled slave.
+#[derive(Debug)]
+struct Slave {
+    master: usize,
+    table: u32,
+    /// The table interpolated as the coupling asked, when that differs from the stored one.
+    own: Option<CamProfile>,
+    /// The same for the cam a queued switch goes to.
+    switch_own: Option<CamProfile>,
+    law: CamLaw,
+    cursor: ProfileCursor,
+    /// False while a first coupling waits for its activation.
+    active: bool,
+    /// Coupled with MC_CamInExt: may switch cams.
+    extended: bool,
+    queued: Option<Queued>,
+    /// The master's set-point of the last tick.
+    master_before: f64,
+    /// Where the slave holds while it waits.
+    hold: f64,
+}
+
+/// Cam couplings of a machine.
+#[derive(Debug)]
+pub struct CamEngine {
+    store: CamStore,
+    selects: Vec<Option<Select>>,
+    slaves: Vec<Option<Slave>>,
+    /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
+    retired: Vec<CamProfile>,
+}
+
+/// A refusal as the code the block reports.
+fn code(e: u32) -> HandlerResult {
+    reply(&CamReply {
+        error_id: e,
+        reserved: 0,
+    })
+}
+
+fn accepted() -> HandlerResult {
+    code(0)
+}
+
+fn coupling_code(e: CouplingError) -> u32 {
+    match e {
+        CouplingError::Parameter { .. } => CamCouplingError::BadParameter.raw(),
+        CouplingError::Combination { .. } => CamCouplingError::ModeCombination.raw(),
+        CouplingError::Passed { .. } => CamCouplingError::ActivationPassed.raw(),
+    }
+}
+
+const TABLE_INVALID: u32 = TableErrorCode::CamTableIdInvalid as u32;
+
+impl CamEngine {
+    /// An engine for a machine of `axes` axes with the tables of `store`.
+    pub fn new(store: CamStore, axes: usize) -> CamEngine {
+        CamEngine {
+            store,
+            selects: vec![None; TABLE_SLOTS],
+            slaves: (0..axes).map(|_| None).collect(),
+            retired: Vec::with_capacity(8),
+        }
+    }
+
+    /// The tables.
+    pub fn store(&self) -> &CamStore {
+        &self.store
+    }
+
+    /// The tables, to write points or change modes.
+    pub fn store_mut(&mut self) -> &mut CamStore {
+        &mut self.store
+    }
+
+    /// Whether axis `slave` is coupled through a cam and following it (not waiting).
+    pub fn in_sync(&self, slave: usize) -> bool {
+        self.slaves
+            .get(slave)
+            .and_then(Option::as_ref)
+            .is_some_and(|s| s.active)
+    }
+
+    /// The cycle counter and the master's place in the cam of axis `slave`'s coupling.
+    pub fn cam_position(&self, slave: usize) -> Option<crate::cam::coupling::CamPosition> {
+        let s = self.slaves.get(slave)?.as_ref()?;
+        Some(s.law.locate(s.master_before))
+    }
+
+    fn retire(&mut self, profile: CamProfile) {
+        // Beyond the reserved room this frees in the tick; it never comes to that with one
+        // change per call and calls freeing the room first.
+        self.retired.push(profile);
+    }
+
+    fn select_periodic(&self, table: u32, profile: &CamProfile) -> bool {
+        match self.selects.get(table as usize).copied().flatten() {
+            Some(select) => select.periodic,
+            None => match profile {
+                CamProfile::Table(t) => t.periodic(),
+                CamProfile::MotionFunction(_) => false,
+            },
+        }
+    }
+
+    fn table_select(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamTableSelectCall = decode_body(request)?;
+        let id = request.target;
+        if self.store.get(id).is_err() {
+            return code(TABLE_INVALID);
+        }
+        if call.periodic > 1 || call.master_absolute > 1 || call.slave_absolute > 1 {
+            return code(CamCouplingError::UnknownMode.raw());
+        }
+        self.selects[id as usize] = Some(Select {
+            periodic: call.periodic == 1,
+        });
+        accepted()
+    }
+
+    /// The profile a coupling uses: the stored one, or a copy interpolated as requested.
+    fn profile_for(&self, table: u32, interpolation: u32) -> Result<Option<CamProfile>, u32> {
+        let profile = self.store.get(table).map_err(|_| TABLE_INVALID)?;
+        let CamProfile::Table(t) = profile else {
+            // Motion functions carry their own laws: the interpolation does not apply.
+            return Ok(None);
+        };
+        let wanted = match interpolation {
+            0 => Interpolation::Linear,
+            1 => Interpolation::FourPoint,
+            2 => Interpolation::Spline,
+            _ => return Err(CamCouplingError::UnknownMode.raw()),
+        };
+        if wanted == t.interpolation() {
+            return Ok(None);
+        }
+        let rows: Vec<[f64; 2]> = t.rows().collect();
+        PositionTable::new(&rows, t.table_type(), wanted, t.periodic())
+            .map(|t| Some(CamProfile::Table(t)))
+            .map_err(|e| e.code() as u32)
+    }
+
+    fn cam_in(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
+        let call: CamInCall = decode_body(request)?;
+        let slave = request.target as usize;
+        let master = call.master as usize;
+        if slave >= axes.len() {
+            return Err(ErrorCode::InvalidTarget);
+        }
+        if master >= axes.len() {
+            return code(CamCouplingError::NoSuchMaster.raw());
+        }
+        if master == slave {
+            return code(CamCouplingError::MasterIsSlave.raw());
+        }
+        let (Some(start), Some(activation), Some(master_mode), Some(slave_mode)) = (
+            StartMode::from_raw(call.start_mode),
+            Activation::from_raw(call.activation_mode, call.activation_position),
+            ScalingMode::from_raw(call.master_scaling_mode),
+            ScalingMode::from_raw(call.slave_scaling_mode),
+        ) else {
+            return code(CamCouplingError::UnknownMode.raw());
+        };
+        if call.extended > 1 || !call.activation_position.is_finite() {
+            return code(CamCouplingError::BadParameter.raw());
+        }
+        let scaling = Scaling {
+            master_offset: call.master_offset,
+            slave_offset: call.slave_offset,
+            master_scaling: call.master_scaling,
+            slave_scaling: call.slave_scaling,
+        };
+        if let Err(e) = scaling.check() {
+            return code(coupling_code(e));
+        }
+        let own = match self.profile_for(call.table_id, call.interpolation) {
+            Ok(own) => own,
+            Err(e) => return code(e),
+        };
+        let master_set = match axes.axis(master) {
+            Some(a) => a.setpoint(),
+            None => return code(CamCouplingError::NoSuchMaster.raw()),
+        };
+        let master_auto = master_mode == ScalingMode::AutoOffset;
+        // The master's direction of travel decides whether an axis position lies behind it.
+        let now = MasterNow {
+            axis: (
+                master_set.position - master_set.velocity,
+                master_set.position,
+            ),
+            ..MasterNow::default()
+        };
+        let Some(axis) = axes.axis(slave) else {
+            return Err(ErrorCode::InvalidTarget);
+        };
+        let coupled = axis.coupling();
+        let ours = self.slaves[slave].as_ref();
+        match (coupled, ours) {
+            // Coupled through a cam already: a switch (MC_CamInExt both times) or a refusal.
+            (Some(c), Some(current)) if c.kind == CouplingState::Cam => {
+                if !(current.extended && call.extended == 1) {
+                    return code(CamCouplingError::NotSwitchable.raw());
+                }
+                if current.master != master {
+                    return code(CamCouplingError::NoSuchMaster.raw());
+                }
+                if let Err(e) = check_switch(activation, start, master_auto)
+                    .and_then(|()| check_not_passed(activation, now))
+                {
+                    return code(coupling_code(e));
+                }
+                let current = self.slaves[slave].as_mut().expect("checked above");
+                if activation == Activation::DeleteQueuedData {
+                    if matches!(current.queued, Some(Queued::Switch { .. })) {
+                        current.queued = None;
+                        if let Some(old) = current.switch_own.take() {
+                            self.retire(old);
+                        }
+                    }
+                    return accepted();
+                }
+                if let Some(old) = core::mem::replace(&mut current.switch_own, own) {
+                    self.retire(old);
+                }
+                let current = self.slaves[slave].as_mut().expect("checked above");
+                current.queued = Some(Queued::Switch {
+                    table: call.table_id,
+                    scaling,
+                    modes: (master_mode, slave_mode),
+                    start,
+                    activation: activation.timing().expect("checked: a timed mode"),
+                });
+                accepted()
+            }
+            (Some(_), _) => code(AxisError::Coupled.raw()),
+            (None, _) => {
+                if let Err(e) = check_couple(activation, start, master_auto)
+                    .and_then(|()| check_not_passed(activation, now))
+                {
+                    return code(coupling_code(e));
+                }
+                let profile = match &own {
+                    Some(p) => p,
+                    None => self
+                        .store
+                        .get(call.table_id)
+                        .map_err(|_| ErrorCode::InvalidData)?,
+                };
+                let periodic = self.select_periodic(call.table_id, profile);
+                let hold = axis.setpoint().position;
+                let law = CamLaw::new(profile, scaling, start, periodic, master_set.position, hold);
+                let Some(axis) = axes.axis_mut(slave) else {
+                    return Err(ErrorCode::InvalidTarget);
+                };
+                let coupling = Coupling {
+                    kind: CouplingState::Cam,
+                    master: master as i32,
+                    phase: AxisState::SlavePrephase,
+                };
+                if let Err(e) = axis.couple(coupling) {
+                    return code(e.raw());
+                }
+                axis.drive_coupled(
+                    Kinematic {
+                        position: hold,
+                        ..Kinematic::default()
+                    },
+                    AxisState::SlavePrephase,
+                );
+                let timing = activation.timing().expect("checked: a timed mode");
+                self.slaves[slave] = Some(Slave {
+                    master,
+                    table: call.table_id,
+                    own,
+                    switch_own: None,
+                    law,
+                    cursor: ProfileCursor::default(),
+                    active: false,
+                    extended: call.extended == 1,
+                    queued: Some(Queued::Couple(timing)),
+                    master_before: master_set.position,
+                    hold,
+                });
+                accepted()
+            }
+        }
+    }
+
+    fn cam_out(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
+        let _: CamOutCall = decode_body(request)?;
+        let slave = request.target as usize;
+        if slave >= axes.len() {
+            return Err(ErrorCode::InvalidTarget);
+        }
+        let cam_coupled = axes
+            .axis(slave)
+            .and_then(|a| a.coupling())
+            .is_some_and(|c| c.kind == CouplingState::Cam);
+        let Some(state) = self.slaves[slave].take().filter(|_| cam_coupled) else {
+            return code(CamCouplingError::NotCamCoupled.raw());
+        };
+        if let Some(axis) = axes.axis_mut(slave) {
+            axis.decouple();
+        }
+        drop(state);
+        accepted()
+    }
+
+    fn cam_scaling(&mut self, request: &AcyclicRequest, axes: &AxisSet) -> HandlerResult {
+        let call: CamScalingCall = decode_body(request)?;
+        let slave = request.target as usize;
+        if slave >= axes.len() {
+            return Err(ErrorCode::InvalidTarget);
+        }
+        let (Some(activation), Some(master_mode), Some(slave_mode)) = (
+            Activation::from_raw(call.activation_mode, call.activation_position),
+            ScalingMode::from_raw(call.master_scaling_mode),
+            ScalingMode::from_raw(call.slave_scaling_mode),
+        ) else {
+            return code(CamCouplingError::UnknownMode.raw());
+        };
+        let Some(state) = self.slaves[slave].as_mut() else {
+            return code(CamCouplingError::NotCamCoupled.raw());
+        };
+        if let Err(e) = check_scaling(
+            activation,
+            state.law.start,
+            master_mode == ScalingMode::AutoOffset,
+        ) {
+            return code(coupling_code(e));
+        }
+        if activation == Activation::Off {
+            return accepted();
+        }
+        // Only the sides that take part must be usable.
+        let mut scaling = state.law.scaling;
+        if master_mode != ScalingMode::Off {
+            scaling.master_offset = call.master_offset;
+            scaling.master_scaling = call.master_scaling;
+        }
+        if slave_mode != ScalingMode::Off {
+            scaling.slave_offset = call.slave_offset;
+            scaling.slave_scaling = call.slave_scaling;
+        }
+        if let Err(e) = scaling.check() {
+            return code(coupling_code(e));
+        }
+        if !call.activation_position.is_finite() {
+            return code(CamCouplingError::BadParameter.raw());
+        }
+        let master = axes.axis(state.master).map(|a| a.setpoint());
+        let Some(master) = master else {
+            return code(CamCouplingError::NoSuchMaster.raw());
+        };
+        let now = MasterNow {
+            axis: (master.position - master.velocity, master.position),
+            ..MasterNow::default()
+        };
+        if let Err(e) = check_not_passed(activation, now) {
+            return code(coupling_code(e));
+        }
+        state.queued = Some(Queued::Scale {
+            scaling,
+            modes: (master_mode, slave_mode),
+            activation: activation.timing().expect("checked: a timed mode"),
+        });
+        accepted()
+    }
+}
+
+impl Engine for CamEngine {
+    fn name(&self) -> &'static str {
+        "cam"
+    }
+
+    fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
+        for i in 0..self.slaves.len() {
+            let Some(state) = self.slaves[i].as_mut() else {
+                continue;
+            };
+            // A slave that lost its coupling (fault, power off) is free again.
+            let still = io
+                .axes
+                .axis(i)
+                .and_then(|a| a.coupling())
+                .is_some_and(|c| c.kind == CouplingState::Cam);
+            let master = io.axes.axis(state.master).map(|a| a.setpoint());
+            let (true, Some(master)) = (still, master) else {
+                if let Some(gone) = self.slaves[i].take() {
+                    self.retired.extend(gone.own);
+                    self.retired.extend(gone.switch_own);
+                }
+                continue;
+            };
+            let now = state.law.master_now(state.master_before, master.position);
+            // Online changes of the cam's points (motion functions) under their own mode.
+            if state.own.is_none() {
+                if let Ok(Some(old)) = self.store.apply_due(state.table, now) {
+                    self.retired.push(old);
+                    if let Ok(p) = self.store.get(state.table) {
+                        state.law.take_geometry(p);
+                    }
+                }
+            }
+            let Ok(stored) = self.store.get(state.table) else {
+                continue;
+            };
+            let profile = state.own.as_ref().unwrap_or(stored);
+            let (mut set, _) = state.law.slave(profile, &mut state.cursor, &master);
+            match state.queued {
+                Some(Queued::Couple(timing)) if timing.due(now) => {
+                    // Relative sides start from here.
+                    state.law = CamLaw::new(
+                        profile,
+                        state.law.scaling,
+                        state.law.start,
+                        state.law.periodic,
+                        master.position,
+                        state.hold,
+                    );
+                    state.active = true;
+                    state.queued = None;
+                    set = state.law.slave(profile, &mut state.cursor, &master).0;
+                }
+                Some(Queued::Scale {
+                    scaling,
+                    modes,
+                    activation,
+                }) if activation.due(now) && state.active => {
+                    let law = state.law;
+                    state.law = law.rescaled(
+                        profile,
+                        scaling,
+                        modes,
+                        law.start,
+                        law.periodic,
+                        master.position,
+                        set.position,
+                        false,
+                    );
+                    state.queued = None;
+                    set = state.law.slave(profile, &mut state.cursor, &master).0;
+                }
+                Some(Queued::Switch {
+                    table,
+                    scaling,
+                    modes,
+                    start,
+                    activation,
+                }) if activation.due(now) && state.active => {
+                    let stored_next = self.store.get(table).ok();
+                    if let Some(next) = state.switch_own.as_ref().or(stored_next) {
+                        let periodic = match self.selects[table as usize] {
+                            Some(s) => s.periodic,
+                            None => match next {
+                                CamProfile::Table(t) => t.periodic(),
+                                CamProfile::MotionFunction(_) => false,
+                            },
+                        };
+                        let law = state.law;
+                        state.law = law.rescaled(
+                            next,
+                            scaling,
+                            modes,
+                            start,
+                            periodic,
+                            master.position,
+                            set.position,
+                            true,
+                        );
+                        state.table = table;
+                        state.cursor = ProfileCursor::default();
+                        set = state.law.slave(next, &mut state.cursor, &master).0;
+                        // The switched-to cam's own copy becomes the coupling's.
+                        let next_own = state.switch_own.take();
+                        if let Some(old) = core::mem::replace(&mut state.own, next_own) {
+                            self.retired.push(old);
+                        }
+                    }
+                    state.queued = None;
+                }
+                _ => {}
+            }
+            let (set, phase) = if state.active {
+                (set, AxisState::SlaveSynchronous)
+            } else {
+                (
+                    Kinematic {
+                        position: state.hold,
+                        ..Kinematic::default()
+                    },
+                    AxisState::SlavePrephase,
+                )
+            };
+            if let Some(axis) = io.axes.axis_mut(i) {
+                axis.drive_coupled(set, phase);
+            }
+            state.master_before = master.position;
+        }
+    }
+
+    fn handle(
+        &mut self,
+        kind: CallKind,
+        request: &AcyclicRequest,
+        axes: &mut AxisSet,
+    ) -> Option<HandlerResult> {
+        // Between ticks: free what the ticks retired.
+        self.retired.clear();
+        Some(match kind {
+            CallKind::CamTableSelect => self.table_select(request),
+            CallKind::CamIn => self.cam_in(request, axes),
+            CallKind::CamOut => self.cam_out(request, axes),
+            CallKind::CamScaling => self.cam_scaling(request, axes),
+            _ => return None,
+        })
+    }
+
+    fn reset(&mut self, axes: &mut AxisSet) {
+        for (i, slot) in self.slaves.iter_mut().enumerate() {
+            if let Some(state) = slot.take() {
+                if let Some(axis) = axes.axis_mut(i) {
+                    axis.decouple();
+                }
+                self.retired.extend(state.own);
+                self.retired.extend(state.switch_own);
+            }
+        }
+    }
+}
