@@ -112,22 +112,37 @@ fn law_at(law: &CamLaw, profile: &CamProfile, master: Kinematic) -> Kinematic {
     law.slave(profile, &mut ProfileCursor::default(), &master).0
 }
 
+/// The seed cam with point 4 at 30 instead of 40, as the conveyor's PLC writes it.
+fn changed_cam(profile: &CamProfile) -> CamProfile {
+    let CamProfile::MotionFunction(f) = profile else {
+        unreachable!("the seed cam is a motion function")
+    };
+    let mut p4 = f.points()[3];
+    p4.slave = 30.0;
+    CamProfile::MotionFunction(f.with_points_written(4, &[p4]).unwrap())
+}
+
 #[test]
-fn the_conveyor_scenario_follows_the_law_scales_without_a_jump_and_decouples() {
+fn the_conveyor_scenario_follows_the_law_scales_changes_a_point_and_decouples() {
     let s = Scenario::load(&scenarios().join("cam-conveyor/scenario.toml")).unwrap();
     let mut run = InProcess::new(&s, 0).unwrap();
-    let profile = seed_cam();
-    let full = CamLaw::new(
-        &profile,
+    let original = seed_cam();
+    let changed = changed_cam(&original);
+    let law = CamLaw::new(
+        &original,
         Scaling::default(),
         StartMode::Absolute,
         true,
         0.0,
         0.0,
     );
+    // The three phases: scaling 1 with the original cam, 0.5 with it, 0.5 with the changed
+    // one. Each switch happens where the laws before and after agree (the rest at the cycle
+    // start), so the phase a tick belongs to is the first that explains it from the last.
+    let phases = [(1.0, &original), (0.5, &original), (0.5, &changed)];
+    let mut phase = 0;
+    let mut entered = [None; 3];
     let mut synced_ticks = 0;
-    let mut scaled_at = None;
-    let mut last_full_cycle = None;
     let mut last: Option<f64> = None;
     let mut max_step: f64 = 0.0;
     for tick in 0..s.ticks.unwrap() {
@@ -137,42 +152,38 @@ fn the_conveyor_scenario_follows_the_law_scales_without_a_jump_and_decouples() {
             max_step = max_step.max((slave.position - p).abs());
         }
         last = Some(slave.position);
-        if phase(&run, SLAVE) != AxisState::SlaveSynchronous {
+        if run.machine.axes().axis(SLAVE).unwrap().coupling().is_none()
+            || self::phase(&run, SLAVE) != AxisState::SlaveSynchronous
+        {
             continue;
         }
         synced_ticks += 1;
         let master = set(&run, MASTER);
-        let expected = law_at(&full, &profile, master);
-        let at = full.locate(master.position);
-        if scaled_at.is_none() && (slave.position - expected.position).abs() > 1e-9 {
-            scaled_at = Some((tick, at));
+        let fits = |(ss, profile): (f64, &CamProfile)| {
+            let expected = law_at(&law, profile, master);
+            (slave.position - ss * expected.position).abs() < 1e-9
+                && (slave.velocity - ss * expected.velocity).abs() < 1e-6
+        };
+        while !fits(phases[phase]) {
+            phase += 1;
+            assert!(
+                phase < 3,
+                "tick {tick}: slave {slave:?} for master {master:?} fits no phase"
+            );
+            entered[phase] = Some((tick, law.locate(master.position)));
         }
-        if scaled_at.is_none() && expected.position != 0.0 {
-            last_full_cycle = Some(at.cycle);
-        }
-        // Before the scaling: the law with scaling 1; after it: half the stroke, the slave
-        // offset chosen at the cycle boundary where the cam stands at 0 (so 0 here).
-        let ss = if scaled_at.is_some() { 0.5 } else { 1.0 };
-        assert!(
-            (slave.position - ss * expected.position).abs() < 1e-9,
-            "tick {tick}: slave {} for master {}",
-            slave.position,
-            master.position
-        );
-        assert!((slave.velocity - ss * expected.velocity).abs() < 1e-6);
     }
     assert!(synced_ticks > 3000, "synchronous for {synced_ticks} ticks");
-    // The scaling (sent at tick 1700 for the next cycle) took effect as the master entered a
-    // new cam cycle.
-    // (In the cam's first 30 degrees it rests at 0, where both laws agree.)
-    let (tick, at) = scaled_at.expect("the scaling took effect");
-    assert!(tick > 1700, "tick {tick}");
-    assert!(at.local <= 30.5, "at {} degrees into the cycle", at.local);
-    assert_eq!(
-        Some(at.cycle - 1),
-        last_full_cycle,
-        "the first cycle after the command"
-    );
+    // Both changes took effect after they were sent (1700, 2602), each in the cam's first 30
+    // degrees of a new turn (where it rests and the phases agree, they cannot be told apart).
+    for (k, sent) in [(1, 1700), (2, 2602)] {
+        let (tick, at) = entered[k].unwrap_or_else(|| panic!("phase {k} never came"));
+        assert!(tick > sent, "phase {k} at tick {tick}");
+        assert!(at.local <= 30.5, "phase {k} at {} degrees", at.local);
+    }
+    let (t1, a1) = entered[1].unwrap();
+    let (t2, a2) = entered[2].unwrap();
+    assert!(t2 > t1 && a2.cycle > a1.cycle);
     // No jump anywhere: at most one tick's travel at the cam's top speed.
     assert!(max_step < 0.35, "largest step {max_step} mm");
     // Decoupled in a rest phase: free, at rest, where the cam left it.
@@ -184,6 +195,10 @@ fn the_conveyor_scenario_follows_the_law_scales_without_a_jump_and_decouples() {
     assert!(report.contains("InSync"), "{report}");
     assert!(
         report.contains("block out (MC_CamOut on gpAx[1]): Done"),
+        "{report}"
+    );
+    assert!(
+        report.contains("block point (MC_WriteMotionFunctionPoint on gpAx[1]): Done"),
         "{report}"
     );
 }
@@ -446,4 +461,159 @@ fn the_machine_tick_with_a_coupled_cam_slave_keeps_its_cycle_count_over_many_tur
             .map(|c| c.kind),
         Some(CouplingState::Cam)
     );
+}
+
+fn dispatch_raw<C: AcyclicCall>(run: &mut InProcess, target: u32, body: &C) -> Vec<u8> {
+    let (body, body_len) = encode_body(body);
+    let request = AcyclicRequest {
+        invoke_id: 3,
+        kind: C::KIND.raw(),
+        target,
+        body_len,
+        body,
+    };
+    let view = CncView::new(&run.memory);
+    let (reply, len) = run.machine.dispatch(&view, C::KIND, &request).unwrap();
+    reply[..len as usize].to_vec()
+}
+
+fn rows_chunk(
+    rows: &[[f64; 2]],
+    first: usize,
+    total: usize,
+    last: bool,
+) -> hli::calls::CamRowsWriteCall {
+    let mut call = hli::calls::CamRowsWriteCall {
+        first_row: first as u32,
+        count: rows.len() as u32,
+        flags: if last { hli::calls::CAM_CHUNK_LAST } else { 0 },
+        total: total as u32,
+        table_type: 10,
+        interpolation: 0,
+        periodic: 1,
+        ..Default::default()
+    };
+    call.rows[..rows.len()].copy_from_slice(rows);
+    call
+}
+
+#[test]
+fn a_table_of_100000_rows_arrives_in_chunks_and_a_coupling_runs_on_it() {
+    let mut run = machine("");
+    run.step(0.001);
+    let total = 100_000;
+    let rows: Vec<[f64; 2]> = (0..total)
+        .map(|i| {
+            [
+                i as f64 * 0.0036,
+                5.0 * (i as f64 / (total - 1) as f64 * std::f64::consts::TAU).sin(),
+            ]
+        })
+        .collect();
+    let chunks: Vec<&[[f64; 2]]> = rows.chunks(hli::calls::CAM_ROWS_PER_CALL).collect();
+    for (k, chunk) in chunks.iter().enumerate() {
+        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+        let last = k + 1 == chunks.len();
+        let reply = dispatch_raw(&mut run, 5, &rows_chunk(chunk, first, total, last));
+        let reply: CamReply = bytemuck::pod_read_unaligned(&reply);
+        assert_eq!(reply.error_id, 0, "chunk {k}");
+        if k % 1000 == 0 {
+            // The machine ticks on between chunks: the upload never holds a tick up.
+            run.step(0.001);
+        }
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(5)), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..3000 {
+        run.step(0.001);
+        assert!(run.machine.axes().axis(SLAVE).unwrap().error().is_none());
+    }
+    // The slave follows the uploaded wave (period 360, amplitude 5).
+    let m = set(&run, MASTER).position;
+    let expected = 5.0 * ((m.rem_euclid(360.0)) / 360.0 * std::f64::consts::TAU).sin();
+    assert!(
+        (set(&run, SLAVE).position - expected).abs() < 1e-3,
+        "{} vs {expected}",
+        set(&run, SLAVE).position
+    );
+    // A coupled table is not replaced.
+    let one = rows_chunk(&rows[..13], 0, 13, true);
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 5, &one));
+    assert_eq!(reply.error_id, CamCouplingError::TableInUse.raw());
+}
+
+#[test]
+fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
+    let mut run = machine("");
+    run.step(0.001);
+    let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.0]).collect();
+    let first = rows_chunk(&rows[..13], 0, 26, false);
+    let skipped = rows_chunk(&rows[..13], 20, 26, true);
+    let answer = |run: &mut InProcess, c: &hli::calls::CamRowsWriteCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
+    };
+    assert_eq!(answer(&mut run, &first), 0);
+    assert_eq!(
+        answer(&mut run, &skipped),
+        CamCouplingError::ChunkOutOfOrder.raw()
+    );
+    // Nothing was stored: table 7 does not exist.
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(7)), 0x4B32);
+    // A table whose masters do not rise: refused with the table code, nothing stored.
+    let mut bad = rows.clone();
+    bad[5][0] = 1.0;
+    assert_eq!(answer(&mut run, &rows_chunk(&bad[..13], 0, 26, false)), 0);
+    let reply = answer(&mut run, &rows_chunk(&bad[13..], 13, 26, true));
+    assert!((0x4B30..=0x4B38).contains(&reply), "{reply:#x}");
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(7)), 0x4B32);
+}
+
+#[test]
+fn points_read_back_and_a_refused_write_leaves_the_function() {
+    use hli::calls::{
+        CamPointsReadCall, CamPointsReply, CamPointsWriteCall, McMotionFunctionPoint,
+    };
+    let mut run = machine("");
+    run.step(0.001);
+    let read = |run: &mut InProcess, first: u32| -> CamPointsReply {
+        bytemuck::pod_read_unaligned(&dispatch_raw(
+            run,
+            1,
+            &CamPointsReadCall { first, count: 0 },
+        ))
+    };
+    let r = read(&mut run, 1);
+    assert_eq!((r.error_id, r.count, r.total), (0, 4, 6));
+    assert_eq!(r.points[3].master_pos, 240.0);
+    assert_eq!(r.points[3].slave_pos, 40.0);
+    let r = read(&mut run, 5);
+    assert_eq!((r.count, r.points[1].master_pos), (2, 360.0));
+    assert_eq!(read(&mut run, 7).error_id, 0x4B33);
+    // A point whose master position breaks the monotonic order: refused whole.
+    let mut p4: McMotionFunctionPoint = read(&mut run, 4).points[0];
+    p4.master_pos = 400.0;
+    let mut points = [McMotionFunctionPoint::default(); 4];
+    points[0] = p4;
+    let write = CamPointsWriteCall {
+        first: 4,
+        count: 1,
+        flags: hli::calls::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert!(
+        (0x4B30..=0x4B38).contains(&reply.error_id),
+        "{:#x}",
+        reply.error_id
+    );
+    run.step(0.001);
+    assert_eq!(read(&mut run, 4).points[0].master_pos, 240.0);
+    // A good one applies (instantaneous mode, nothing coupled).
+    points[0].master_pos = 250.0;
+    let write = CamPointsWriteCall { points, ..write };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert_eq!(reply.error_id, 0);
+    run.step(0.001);
+    assert_eq!(read(&mut run, 4).points[0].master_pos, 250.0);
 }

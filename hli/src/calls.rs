@@ -54,6 +54,14 @@ pub enum CallKind {
     CamOut,
     /// [`CamScalingCall`].
     CamScaling,
+    /// [`CamPointsWriteCall`].
+    CamPointsWrite,
+    /// [`CamPointsReadCall`].
+    CamPointsRead,
+    /// [`CamOnlineModeCall`].
+    CamOnlineMode,
+    /// [`CamRowsWriteCall`].
+    CamRowsWrite,
 }
 
 impl CallKind {
@@ -66,6 +74,10 @@ impl CallKind {
             CallKind::CamIn => 11,
             CallKind::CamOut => 12,
             CallKind::CamScaling => 13,
+            CallKind::CamPointsWrite => 14,
+            CallKind::CamPointsRead => 15,
+            CallKind::CamOnlineMode => 16,
+            CallKind::CamRowsWrite => 17,
         }
     }
 
@@ -78,6 +90,10 @@ impl CallKind {
             11 => Some(CallKind::CamIn),
             12 => Some(CallKind::CamOut),
             13 => Some(CallKind::CamScaling),
+            14 => Some(CallKind::CamPointsWrite),
+            15 => Some(CallKind::CamPointsRead),
+            16 => Some(CallKind::CamOnlineMode),
+            17 => Some(CallKind::CamRowsWrite),
             _ => None,
         }
     }
@@ -328,6 +344,160 @@ impl AcyclicCall for CamScalingCall {
     const KIND: CallKind = CallKind::CamScaling;
     type Reply = CamReply;
 }
+
+/// One point of a motion function as the PLC holds it (`MC_MotionFunctionPoint`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct McMotionFunctionPoint {
+    /// Absolute index, 1, 2, 3, ...
+    pub point_index: u32,
+    /// Raw `MC_MotionFunctionType` of the segment that starts here.
+    pub function_type: u32,
+    /// Raw `MC_MotionPointType`.
+    pub point_type: u32,
+    /// Relative index of the next point (normally 1).
+    pub rel_index_next_point: u32,
+    /// Master position.
+    pub master_pos: f64,
+    /// Slave position.
+    pub slave_pos: f64,
+    /// Slave velocity.
+    pub slave_velo: f64,
+    /// Slave acceleration.
+    pub slave_acc: f64,
+    /// Slave jerk (or the symmetry of the laws that have one).
+    pub slave_jerk: f64,
+}
+
+/// Points that fit one call.
+pub const CAM_POINTS_PER_CALL: usize = 4;
+
+/// Bit of [`CamPointsWriteCall::flags`] and [`CamRowsWriteCall::flags`]: the last chunk of
+/// the transfer; the CNC checks and takes the whole transfer now.
+pub const CAM_CHUNK_LAST: u32 = 1;
+/// Bit of [`CamPointsWriteCall::flags`]: the points make a new motion function under the
+/// table ID (MC_CamTableSelect with data) instead of changing points of the existing one.
+pub const CAM_POINTS_CREATE: u32 = 2;
+
+/// A chunk of MC_WriteMotionFunction(Point) (or of a new motion function) for the table
+/// given as `target`. A transfer is `total` points from point `first` on, sent in chunks in
+/// order; nothing changes before its last chunk, which the CNC checks whole.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamPointsWriteCall {
+    /// Index of the first point of this chunk.
+    pub first: u32,
+    /// Points in this chunk (1..=4).
+    pub count: u32,
+    /// [`CAM_CHUNK_LAST`], [`CAM_POINTS_CREATE`].
+    pub flags: u32,
+    /// Points of the whole transfer.
+    pub total: u32,
+    /// The points; the first `count` are used.
+    pub points: [McMotionFunctionPoint; CAM_POINTS_PER_CALL],
+}
+
+/// MC_ReadMotionFunction(Point) for the table given as `target`: up to four points from
+/// `first` on.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamPointsReadCall {
+    /// Index of the first point to read.
+    pub first: u32,
+    /// Points wanted (0 or more than 4 reads as many as fit, up to 4).
+    pub count: u32,
+}
+
+/// The reply to a [`CamPointsReadCall`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamPointsReply {
+    /// 0 when read, else the error code.
+    pub error_id: u32,
+    /// Points read.
+    pub count: u32,
+    /// Points the function has.
+    pub total: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// The points read.
+    pub points: [McMotionFunctionPoint; CAM_POINTS_PER_CALL],
+}
+
+/// MC_SetCamOnlineChangeMode for the table given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamOnlineModeCall {
+    /// Raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Raw `MC_CamScalingMode` of the master when a change applies.
+    pub master_scaling_mode: u32,
+    /// Raw `MC_CamScalingMode` of the slave when a change applies.
+    pub slave_scaling_mode: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Activation position of the positional modes.
+    pub activation_position: f64,
+}
+
+/// Rows of a position table that fit one call.
+pub const CAM_ROWS_PER_CALL: usize = 13;
+
+/// A chunk of a position table for the table ID given as `target` (MC_CamTableSelect with
+/// data): `total` rows of `[master, slave]` from row 0 on, sent in order; the table is built
+/// and checked whole with the last chunk.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamRowsWriteCall {
+    /// Index (0-based) of the first row of this chunk.
+    pub first_row: u32,
+    /// Rows in this chunk (1..=13).
+    pub count: u32,
+    /// [`CAM_CHUNK_LAST`].
+    pub flags: u32,
+    /// Rows of the whole table.
+    pub total: u32,
+    /// Raw `MC_TableType` (10 equidistant, 11 non-equidistant).
+    pub table_type: u32,
+    /// Raw `MC_InterpolationType` the table keeps by default.
+    pub interpolation: u32,
+    /// 1: continued period by period.
+    pub periodic: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// The rows; the first `count` are used.
+    pub rows: [[f64; 2]; CAM_ROWS_PER_CALL],
+}
+
+impl AcyclicCall for CamPointsWriteCall {
+    const KIND: CallKind = CallKind::CamPointsWrite;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamPointsReadCall {
+    const KIND: CallKind = CallKind::CamPointsRead;
+    type Reply = CamPointsReply;
+}
+
+impl AcyclicCall for CamOnlineModeCall {
+    const KIND: CallKind = CallKind::CamOnlineMode;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamRowsWriteCall {
+    const KIND: CallKind = CallKind::CamRowsWrite;
+    type Reply = CamReply;
+}
+
+// Every body fits one frame.
+const _: () = {
+    assert!(core::mem::size_of::<McMotionFunctionPoint>() == 56);
+    assert!(core::mem::size_of::<CamPointsWriteCall>() <= ACYCLIC_BODY_SIZE);
+    assert!(core::mem::size_of::<CamPointsReply>() <= ACYCLIC_BODY_SIZE);
+    assert!(core::mem::size_of::<CamRowsWriteCall>() <= ACYCLIC_BODY_SIZE);
+    assert!(core::mem::size_of::<CamInCall>() <= ACYCLIC_BODY_SIZE);
+    assert!(core::mem::size_of::<CamScalingCall>() <= ACYCLIC_BODY_SIZE);
+};
 
 /// Why a call did not produce a reply.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

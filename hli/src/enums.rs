@@ -157,6 +157,10 @@ hli_enum! {
         BadParameter = 0x4266,
         /// An unknown start, activation or scaling mode number.
         UnknownMode = 0x4267,
+        /// A table a coupling uses cannot be replaced.
+        TableInUse = 0x4268,
+        /// A chunk that does not continue its transfer (order, count, total).
+        ChunkOutOfOrder = 0x4269,
     }
 }
 

@@ -26,14 +26,17 @@
 //! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
 //! FALSE for one cycle first, so every call is a new edge.
 
-use crate::cam::{CamOutputs, McCamIn, McCamOut, McCamScaling, McCamTableSelect};
+use crate::cam::{
+    CamOutputs, McCamIn, McCamOut, McCamScaling, McCamTableSelect, McSetCamOnlineChangeMode,
+    McWriteMotionFunctionPoint,
+};
 use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
 use crate::runtime::PlcIo;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 12] = [
+pub const BLOCKS: [&str; 14] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -46,6 +49,8 @@ pub const BLOCKS: [&str; 12] = [
     "MC_CamInExt",
     "MC_CamOut",
     "MC_CamScaling",
+    "MC_WriteMotionFunctionPoint",
+    "MC_SetCamOnlineChangeMode",
 ];
 
 /// The outputs a `wait` can name.
@@ -73,6 +78,8 @@ enum Block {
     CamIn(Box<McCamIn>),
     CamOut(McCamOut),
     CamScaling(Box<McCamScaling>),
+    WritePoint(Box<McWriteMotionFunctionPoint>),
+    OnlineMode(Box<McSetCamOnlineChangeMode>),
 }
 
 /// A boolean output of a block.
@@ -106,6 +113,16 @@ enum Input {
     Periodic(bool),
     MasterAbsolute(bool),
     SlaveAbsolute(bool),
+    /// MC_WriteMotionFunctionPoint: the point's fields.
+    PointIndex(u32),
+    FunctionType(u32),
+    PointType(u32),
+    RelIndexNext(u32),
+    MasterPos(f64),
+    SlavePos(f64),
+    SlaveVelo(f64),
+    SlaveAcc(f64),
+    SlaveJerk(f64),
 }
 
 /// A mode input by number or by its name.
@@ -280,6 +297,25 @@ impl Instances {
                 "master_scaling",
                 "slave_scaling",
             ],
+            "MC_WriteMotionFunctionPoint" => &[
+                "table",
+                "point_index",
+                "function_type",
+                "point_type",
+                "rel_index_next",
+                "master_pos",
+                "slave_pos",
+                "slave_velo",
+                "slave_acc",
+                "slave_jerk",
+            ],
+            "MC_SetCamOnlineChangeMode" => &[
+                "table",
+                "activation_mode",
+                "activation_position",
+                "master_scaling_mode",
+                "slave_scaling_mode",
+            ],
             _ => &[],
         };
         let mut inputs = Vec::new();
@@ -311,6 +347,18 @@ impl Instances {
                     Some(d @ (-1 | 1)) => Input::Direction(d as i32),
                     _ => return Err(format!("call: `direction` = {value}: 1 or -1")),
                 },
+                "point_index" | "function_type" | "point_type" | "rel_index_next" => {
+                    let v = value
+                        .as_integer()
+                        .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                        .ok_or_else(bad)? as u32;
+                    match key.as_str() {
+                        "point_index" => Input::PointIndex(v),
+                        "function_type" => Input::FunctionType(v),
+                        "point_type" => Input::PointType(v),
+                        _ => Input::RelIndexNext(v),
+                    }
+                }
                 "master" | "table" => {
                     let v = value
                         .as_integer()
@@ -343,6 +391,11 @@ impl Instances {
                         "slave_offset" => Input::SlaveOffset(v),
                         "master_scaling" => Input::MasterScaling(v),
                         "slave_scaling" => Input::SlaveScaling(v),
+                        "master_pos" => Input::MasterPos(v),
+                        "slave_pos" => Input::SlavePos(v),
+                        "slave_velo" => Input::SlaveVelo(v),
+                        "slave_acc" => Input::SlaveAcc(v),
+                        "slave_jerk" => Input::SlaveJerk(v),
                         _ => Input::Jerk(v),
                     }
                 }
@@ -504,6 +557,14 @@ impl Instances {
                     b.call(io, axis);
                     (cam_outputs(b.out), false)
                 }
+                Block::WritePoint(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
+                Block::OnlineMode(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
@@ -620,6 +681,8 @@ fn new_block(kind: &str) -> Block {
         }
         "MC_CamOut" => Block::CamOut(McCamOut::default()),
         "MC_CamScaling" => Block::CamScaling(Box::default()),
+        "MC_WriteMotionFunctionPoint" => Block::WritePoint(Box::default()),
+        "MC_SetCamOnlineChangeMode" => Block::OnlineMode(Box::default()),
         _ => Block::Stop(McStop::default()),
     }
 }
@@ -637,6 +700,8 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::CamIn(b) => Some(&mut b.execute),
         Block::CamOut(b) => Some(&mut b.execute),
         Block::CamScaling(b) => Some(&mut b.execute),
+        Block::WritePoint(b) => Some(&mut b.execute),
+        Block::OnlineMode(b) => Some(&mut b.execute),
     }
 }
 
@@ -686,6 +751,21 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::CamScaling(b), Input::SlaveOffset(v)) => b.slave_offset = v,
         (Block::CamScaling(b), Input::MasterScaling(v)) => b.master_scaling = v,
         (Block::CamScaling(b), Input::SlaveScaling(v)) => b.slave_scaling = v,
+        (Block::WritePoint(b), Input::Table(v)) => b.table = v,
+        (Block::WritePoint(b), Input::PointIndex(v)) => b.point.point_index = v,
+        (Block::WritePoint(b), Input::FunctionType(v)) => b.point.function_type = v,
+        (Block::WritePoint(b), Input::PointType(v)) => b.point.point_type = v,
+        (Block::WritePoint(b), Input::RelIndexNext(v)) => b.point.rel_index_next_point = v,
+        (Block::WritePoint(b), Input::MasterPos(v)) => b.point.master_pos = v,
+        (Block::WritePoint(b), Input::SlavePos(v)) => b.point.slave_pos = v,
+        (Block::WritePoint(b), Input::SlaveVelo(v)) => b.point.slave_velo = v,
+        (Block::WritePoint(b), Input::SlaveAcc(v)) => b.point.slave_acc = v,
+        (Block::WritePoint(b), Input::SlaveJerk(v)) => b.point.slave_jerk = v,
+        (Block::OnlineMode(b), Input::Table(v)) => b.table = v,
+        (Block::OnlineMode(b), Input::ActivationMode(v)) => b.activation_mode = v,
+        (Block::OnlineMode(b), Input::ActivationPosition(v)) => b.activation_position = v,
+        (Block::OnlineMode(b), Input::MasterScalingMode(v)) => b.master_scaling_mode = v,
+        (Block::OnlineMode(b), Input::SlaveScalingMode(v)) => b.slave_scaling_mode = v,
         // parse_call admits only the inputs of the block.
         _ => {}
     }

@@ -352,3 +352,70 @@ impl McCamScaling {
         self.out = self.core.cycle(io, self.execute, slave, || call, None);
     }
 }
+
+/// MC_WriteMotionFunctionPoint: one point of the motion function `table` changed, under the
+/// table's online-change mode (MC_SetCamOnlineChangeMode). Done when the CNC took it (checked
+/// whole with the function it changes; queued when its activation is still to come).
+#[derive(Debug, Default)]
+pub struct McWriteMotionFunctionPoint {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the point.
+    pub point: hli::calls::McMotionFunctionPoint,
+    /// Outputs of the last call.
+    pub out: CamOutputs,
+    core: CamCore<hli::calls::CamPointsWriteCall>,
+}
+
+impl McWriteMotionFunctionPoint {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
+        points[0] = self.point;
+        let call = hli::calls::CamPointsWriteCall {
+            first: self.point.point_index,
+            count: 1,
+            flags: hli::calls::CAM_CHUNK_LAST,
+            total: 1,
+            points,
+        };
+        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}
+
+/// MC_SetCamOnlineChangeMode: when point changes of `table` apply, and whether the master
+/// and slave offsets follow so that nothing jumps.
+#[derive(Debug, Default)]
+pub struct McSetCamOnlineChangeMode {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Input: the activation position.
+    pub activation_position: f64,
+    /// Input: raw `MC_CamScalingMode` of the master.
+    pub master_scaling_mode: u32,
+    /// Input: raw `MC_CamScalingMode` of the slave.
+    pub slave_scaling_mode: u32,
+    /// Outputs of the last call.
+    pub out: CamOutputs,
+    core: CamCore<hli::calls::CamOnlineModeCall>,
+}
+
+impl McSetCamOnlineChangeMode {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let call = hli::calls::CamOnlineModeCall {
+            activation_mode: self.activation_mode,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+            reserved: 0,
+            activation_position: self.activation_position,
+        };
+        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}

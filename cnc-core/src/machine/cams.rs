@@ -7,8 +7,10 @@
 //!
 //! Commands arrive as acyclic calls between ticks: MC_CamTableSelect (per table: cyclic,
 //! master and slave absolute), MC_CamIn / MC_CamInExt (couple, or with Ext switch cams),
-//! MC_CamOut (the slave goes on at its velocity as a free axis) and MC_CamScaling. A refused
-//! call leaves every axis doing what it did.
+//! MC_CamOut (the slave goes on at its velocity as a free axis) and MC_CamScaling; and the
+//! data: motion-function points written (a change under the table's online-change mode, or
+//! a new function) and read, position tables written, each in chunks that change nothing
+//! until the last one is checked whole. A refused call leaves every axis and table as it was.
 //!
 //! A first coupling with a waiting activation mode couples the slave at once but holds it
 //! (`nAxisState` 11, pre-phase) until the master reaches the activation; then the slave
@@ -23,10 +25,15 @@ use crate::cam::coupling::{
     Scaling, ScalingMode, StartMode,
 };
 use crate::cam::online::{ActivationMode, CamStore, MasterNow};
-use crate::cam::{CamProfile, Interpolation, PositionTable, ProfileCursor, TableErrorCode};
+use crate::cam::{
+    CamProfile, Interpolation, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor,
+    TableErrorCode, TableType,
+};
 use hli::calls::{
-    decode_body, reply, CallKind, CamInCall, CamOutCall, CamReply, CamScalingCall,
-    CamTableSelectCall, ErrorCode, HandlerResult,
+    decode_body, reply, CallKind, CamInCall, CamOnlineModeCall, CamOutCall, CamPointsReadCall,
+    CamPointsReply, CamPointsWriteCall, CamReply, CamRowsWriteCall, CamScalingCall,
+    CamTableSelectCall, ErrorCode, HandlerResult, McMotionFunctionPoint, CAM_CHUNK_LAST,
+    CAM_POINTS_CREATE, CAM_POINTS_PER_CALL, CAM_ROWS_PER_CALL,
 };
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
@@ -83,11 +90,34 @@ struct Slave {
     hold: f64,
 }
 
+/// Points of a transfer received so far.
+#[derive(Debug)]
+struct PointsTransfer {
+    first: u32,
+    total: u32,
+    create: bool,
+    points: Vec<MotionFunctionPoint>,
+}
+
+/// Rows of a table transfer received so far.
+#[derive(Debug)]
+struct RowsTransfer {
+    total: u32,
+    table_type: u32,
+    interpolation: u32,
+    periodic: u32,
+    rows: Vec<[f64; 2]>,
+}
+
 /// Cam couplings of a machine.
 #[derive(Debug)]
 pub struct CamEngine {
     store: CamStore,
     selects: Vec<Option<Select>>,
+    /// Per table: how a point change that applies treats the master and slave offsets.
+    online_scaling: Vec<(ScalingMode, ScalingMode)>,
+    points_in: Vec<Option<PointsTransfer>>,
+    rows_in: Vec<Option<RowsTransfer>>,
     slaves: Vec<Option<Slave>>,
     /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
     retired: Vec<CamProfile>,
@@ -121,6 +151,9 @@ impl CamEngine {
         CamEngine {
             store,
             selects: vec![None; TABLE_SLOTS],
+            online_scaling: vec![(ScalingMode::UserDefined, ScalingMode::UserDefined); TABLE_SLOTS],
+            points_in: (0..TABLE_SLOTS).map(|_| None).collect(),
+            rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             slaves: (0..axes).map(|_| None).collect(),
             retired: Vec::with_capacity(8),
         }
@@ -349,6 +382,224 @@ impl CamEngine {
         }
     }
 
+    /// Whether a coupling uses table `id` or switches to it.
+    fn in_use(&self, id: u32) -> bool {
+        self.slaves.iter().flatten().any(|s| {
+            s.table == id || matches!(s.queued, Some(Queued::Switch { table, .. }) if table == id)
+        })
+    }
+
+    /// The master's motion over the last tick in the cam of a coupling that uses table `id`
+    /// (standing at 0 when none does): what an online change's activation is checked against.
+    fn master_now_of(&self, id: u32, axes: &AxisSet) -> MasterNow {
+        for s in self.slaves.iter().flatten().filter(|s| s.table == id) {
+            if let Some(m) = axes.axis(s.master) {
+                return s.law.master_now(s.master_before, m.setpoint().position);
+            }
+        }
+        MasterNow::standing(0.0)
+    }
+
+    fn points_write(&mut self, request: &AcyclicRequest, axes: &AxisSet) -> HandlerResult {
+        let call: CamPointsWriteCall = decode_body(request)?;
+        let id = request.target;
+        if !(1..=255).contains(&id) {
+            return code(TABLE_INVALID);
+        }
+        let slot = id as usize;
+        let count = call.count as usize;
+        if count == 0 || count > CAM_POINTS_PER_CALL || call.total == 0 {
+            self.points_in[slot] = None;
+            return code(TableErrorCode::NumPointsInvalid as u32);
+        }
+        let create = call.flags & CAM_POINTS_CREATE != 0;
+        let transfer = self.points_in[slot].get_or_insert_with(|| PointsTransfer {
+            first: call.first,
+            total: call.total,
+            create,
+            points: Vec::with_capacity(call.total.min(1 << 16) as usize),
+        });
+        let continues = transfer.total == call.total
+            && transfer.create == create
+            && call.first == transfer.first + transfer.points.len() as u32
+            && transfer.points.len() + count <= call.total as usize;
+        if !continues {
+            self.points_in[slot] = None;
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        }
+        transfer
+            .points
+            .extend(call.points[..count].iter().map(point_from_plc));
+        if call.flags & CAM_CHUNK_LAST == 0 {
+            return accepted();
+        }
+        let transfer = self.points_in[slot].take().expect("filled above");
+        if transfer.points.len() != transfer.total as usize {
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        }
+        if transfer.create {
+            if self.in_use(id) {
+                return code(CamCouplingError::TableInUse.raw());
+            }
+            return match MotionFunction::new(&transfer.points) {
+                Ok(f) => {
+                    let _ = self.store.insert(id, CamProfile::MotionFunction(f));
+                    self.selects[slot] = None;
+                    accepted()
+                }
+                Err(e) => code(e.code() as u32),
+            };
+        }
+        let now = self.master_now_of(id, axes);
+        match self
+            .store
+            .write_points(id, transfer.first, &transfer.points, now)
+        {
+            Ok(_) => {
+                // A table no coupling uses takes an instantaneous change here (the ticks
+                // apply changes to coupled tables); a positional one waits for a coupling.
+                if !self.in_use(id) {
+                    if let Ok(Some(old)) = self.store.apply_due(id, now) {
+                        drop(old);
+                    }
+                }
+                accepted()
+            }
+            Err(e) => code(e.code() as u32),
+        }
+    }
+
+    fn points_read(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamPointsReadCall = decode_body(request)?;
+        let refuse = |e: u32| {
+            reply(&CamPointsReply {
+                error_id: e,
+                ..CamPointsReply::default()
+            })
+        };
+        let function = match self.store.get(request.target) {
+            Ok(CamProfile::MotionFunction(f)) => f,
+            Ok(_) => return refuse(TableErrorCode::McTableTypeInvalid as u32),
+            Err(_) => return refuse(TABLE_INVALID),
+        };
+        let all = function.points();
+        let total = all.len() as u32;
+        if call.first == 0 || call.first > total {
+            return refuse(TableErrorCode::PointIdInvalid as u32);
+        }
+        let wanted = match call.count as usize {
+            0 => CAM_POINTS_PER_CALL,
+            n => n.min(CAM_POINTS_PER_CALL),
+        };
+        let from = call.first as usize - 1;
+        let chunk = &all[from..(from + wanted).min(all.len())];
+        let mut out = CamPointsReply {
+            count: chunk.len() as u32,
+            total,
+            ..CamPointsReply::default()
+        };
+        for (o, p) in out.points.iter_mut().zip(chunk) {
+            *o = point_to_plc(p);
+        }
+        reply(&out)
+    }
+
+    fn online_mode(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamOnlineModeCall = decode_body(request)?;
+        let id = request.target;
+        let (Some(master_mode), Some(slave_mode)) = (
+            ScalingMode::from_raw(call.master_scaling_mode),
+            ScalingMode::from_raw(call.slave_scaling_mode),
+        ) else {
+            return code(CamCouplingError::UnknownMode.raw());
+        };
+        if !call.activation_position.is_finite() {
+            return code(CamCouplingError::BadParameter.raw());
+        }
+        let Ok(queue) = self.store.queue_mut(id) else {
+            return code(TABLE_INVALID);
+        };
+        if call.activation_mode == 7 {
+            queue.delete_queued();
+            return accepted();
+        }
+        match ActivationMode::from_raw(call.activation_mode, call.activation_position) {
+            Ok(mode) => queue.set_mode(mode),
+            Err(_) => return code(CamCouplingError::ModeCombination.raw()),
+        }
+        self.online_scaling[id as usize] = (master_mode, slave_mode);
+        accepted()
+    }
+
+    fn rows_write(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamRowsWriteCall = decode_body(request)?;
+        let id = request.target;
+        if !(1..=255).contains(&id) {
+            return code(TABLE_INVALID);
+        }
+        let slot = id as usize;
+        let count = call.count as usize;
+        if count == 0 || count > CAM_ROWS_PER_CALL || call.total == 0 {
+            self.rows_in[slot] = None;
+            return code(TableErrorCode::NumRowsInvalid as u32);
+        }
+        let transfer = self.rows_in[slot].get_or_insert_with(|| RowsTransfer {
+            total: call.total,
+            table_type: call.table_type,
+            interpolation: call.interpolation,
+            periodic: call.periodic,
+            rows: Vec::with_capacity(call.total.min(1 << 20) as usize),
+        });
+        let continues = transfer.total == call.total
+            && transfer.table_type == call.table_type
+            && transfer.interpolation == call.interpolation
+            && transfer.periodic == call.periodic
+            && call.first_row as usize == transfer.rows.len()
+            && transfer.rows.len() + count <= call.total as usize;
+        if !continues {
+            self.rows_in[slot] = None;
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        }
+        transfer.rows.extend_from_slice(&call.rows[..count]);
+        if call.flags & CAM_CHUNK_LAST == 0 {
+            return accepted();
+        }
+        let transfer = self.rows_in[slot].take().expect("filled above");
+        if transfer.rows.len() != transfer.total as usize {
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        }
+        let table_type = match transfer.table_type {
+            10 => TableType::Equidistant,
+            11 => TableType::NonEquidistant,
+            _ => return code(TableErrorCode::McTableTypeInvalid as u32),
+        };
+        let interpolation = match transfer.interpolation {
+            0 => Interpolation::Linear,
+            1 => Interpolation::FourPoint,
+            2 => Interpolation::Spline,
+            _ => return code(CamCouplingError::UnknownMode.raw()),
+        };
+        if transfer.periodic > 1 {
+            return code(CamCouplingError::UnknownMode.raw());
+        }
+        if self.in_use(id) {
+            return code(CamCouplingError::TableInUse.raw());
+        }
+        match PositionTable::new(
+            &transfer.rows,
+            table_type,
+            interpolation,
+            transfer.periodic == 1,
+        ) {
+            Ok(t) => {
+                let _ = self.store.insert(id, CamProfile::Table(t));
+                self.selects[slot] = None;
+                accepted()
+            }
+            Err(e) => code(e.code() as u32),
+        }
+    }
+
     fn cam_out(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
         let _: CamOutCall = decode_body(request)?;
         let slave = request.target as usize;
@@ -456,13 +707,28 @@ impl Engine for CamEngine {
                 continue;
             };
             let now = state.law.master_now(state.master_before, master.position);
-            // Online changes of the cam's points (motion functions) under their own mode.
+            // Online changes of the cam's points (motion functions) under their own mode; the
+            // table's scaling modes decide whether offsets keep the master's place and the
+            // slave's position across the change.
             if state.own.is_none() {
                 if let Ok(Some(old)) = self.store.apply_due(state.table, now) {
-                    self.retired.push(old);
+                    let (before, _) = state.law.slave(&old, &mut state.cursor, &master);
                     if let Ok(p) = self.store.get(state.table) {
-                        state.law.take_geometry(p);
+                        let law = state.law;
+                        let modes = self.online_scaling[state.table as usize];
+                        state.law = law.rescaled(
+                            p,
+                            law.scaling,
+                            modes,
+                            law.start,
+                            law.periodic,
+                            master.position,
+                            before.position,
+                            false,
+                        );
                     }
+                    state.cursor = ProfileCursor::default();
+                    self.retired.push(old);
                 }
             }
             let Ok(stored) = self.store.get(state.table) else {
@@ -575,6 +841,10 @@ impl Engine for CamEngine {
             CallKind::CamIn => self.cam_in(request, axes),
             CallKind::CamOut => self.cam_out(request, axes),
             CallKind::CamScaling => self.cam_scaling(request, axes),
+            CallKind::CamPointsWrite => self.points_write(request, axes),
+            CallKind::CamPointsRead => self.points_read(request),
+            CallKind::CamOnlineMode => self.online_mode(request),
+            CallKind::CamRowsWrite => self.rows_write(request),
             _ => return None,
         })
     }
@@ -589,5 +859,33 @@ impl Engine for CamEngine {
                 self.retired.extend(state.switch_own);
             }
         }
+    }
+}
+
+fn point_from_plc(p: &McMotionFunctionPoint) -> MotionFunctionPoint {
+    MotionFunctionPoint {
+        index: p.point_index,
+        function: p.function_type,
+        point_type: p.point_type,
+        rel_index_next: i64::from(p.rel_index_next_point),
+        master: p.master_pos,
+        slave: p.slave_pos,
+        velocity: p.slave_velo,
+        acceleration: p.slave_acc,
+        jerk: p.slave_jerk,
+    }
+}
+
+fn point_to_plc(p: &MotionFunctionPoint) -> McMotionFunctionPoint {
+    McMotionFunctionPoint {
+        point_index: p.index,
+        function_type: p.function,
+        point_type: p.point_type,
+        rel_index_next_point: u32::try_from(p.rel_index_next.max(0)).unwrap_or(u32::MAX),
+        master_pos: p.master,
+        slave_pos: p.slave,
+        slave_velo: p.velocity,
+        slave_acc: p.acceleration,
+        slave_jerk: p.jerk,
     }
 }
