@@ -617,3 +617,136 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     run.step(0.001);
     assert_eq!(read(&mut run, 4).points[0].master_pos, 250.0);
 }
+
+/// Every part of a read, joined.
+fn read_all(run: &mut InProcess, target: u32, call: hli::calls::CamReadCall) -> (Vec<f64>, u32) {
+    let mut values = Vec::new();
+    let mut columns = 1;
+    for part in 0.. {
+        let reply: hli::calls::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+            run,
+            target,
+            &hli::calls::CamReadCall { part, ..call },
+        ));
+        assert_eq!(reply.error_id, 0, "part {part}");
+        values.extend_from_slice(&reply.values[..reply.count as usize]);
+        columns = reply.columns;
+        if values.len() >= reply.total as usize {
+            break;
+        }
+    }
+    (values, columns)
+}
+
+#[test]
+fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
+    use hli::calls::{
+        CamReadCall, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
+        CAM_READ_VALUES,
+    };
+    let mut run = machine("");
+    run.step(0.001);
+    let seed = seed_cam();
+    // Slave dynamics of the motion function: position, velocity, acceleration of the raw cam.
+    let (v, _) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_SLAVE_DYNAMICS,
+            a: 90.0,
+            ..Default::default()
+        },
+    );
+    let s = seed.eval(90.0, &mut ProfileCursor::default());
+    assert_eq!(v, vec![s.position, s.velocity, s.acceleration]);
+    // An equidistant table gives no acceleration (seed 5.1.7).
+    let (v, _) = read_all(
+        &mut run,
+        2,
+        CamReadCall {
+            what: CAM_READ_SLAVE_DYNAMICS,
+            a: 100.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v[2], 0.0);
+    assert!(v[1] != 0.0);
+    // Characteristics: the 31 values of MC_TableCharacValues, in two parts.
+    let (v, _) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_CHARACTERISTICS,
+            ..Default::default()
+        },
+    );
+    let expected: Vec<f64> = cnc_core::cam::CharacValues::normed(&seed)
+        .fields()
+        .iter()
+        .map(|(_, v)| *v)
+        .collect();
+    assert_eq!(v, expected);
+    // A value table of position and velocity from 0 to 360 in steps of 10: 37 rows of 3.
+    let (v, columns) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_VALUES,
+            mask: 3,
+            a: 0.0,
+            b: 360.0,
+            c: 10.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!((v.len(), columns), (111, 3));
+    for row in v.chunks(3) {
+        let s = seed.eval(row[0], &mut ProfileCursor::default());
+        assert_eq!([row[1], row[2]], [s.position, s.velocity], "at {}", row[0]);
+    }
+    // The coupling info of a scaled coupling, at a master position given.
+    let scaled = CamInCall {
+        slave_scaling: 2.0,
+        slave_offset: 1.0,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, scaled), 0);
+    run.step(0.001);
+    let (v, _) = read_all(
+        &mut run,
+        SLAVE as u32,
+        CamReadCall {
+            what: CAM_READ_INFO,
+            flags: 1,
+            a: 90.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v.len(), 40);
+    assert_eq!(v[0], 1.0, "table");
+    assert_eq!(v[1], 22.0, "a motion function");
+    assert_eq!((v[4], v[5]), (6.0, 1.0), "points, columns");
+    assert_eq!((v[6], v[8]), (0.0, 360.0), "master start, period");
+    assert_eq!((v[15], v[17]), (1.0, 2.0), "slave offset, scaling");
+    assert_eq!(v[20], 90.0, "at the master position given");
+    assert_eq!(
+        v[21],
+        1.0 + 2.0 * s_at(&seed, 90.0),
+        "slave set-point there"
+    );
+    assert_eq!(v[22], 90.0, "cam master coordinate");
+    // Not coupled: refused.
+    let reply: hli::calls::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+        &mut run,
+        2,
+        &CamReadCall {
+            what: CAM_READ_INFO,
+            ..Default::default()
+        },
+    ));
+    assert_eq!(reply.error_id, CamCouplingError::NotCamCoupled.raw());
+}
+
+fn s_at(p: &CamProfile, x: f64) -> f64 {
+    p.eval(x, &mut ProfileCursor::default()).position
+}

@@ -62,6 +62,8 @@ pub enum CallKind {
     CamOnlineMode,
     /// [`CamRowsWriteCall`].
     CamRowsWrite,
+    /// [`CamReadCall`].
+    CamRead,
 }
 
 impl CallKind {
@@ -78,6 +80,7 @@ impl CallKind {
             CallKind::CamPointsRead => 15,
             CallKind::CamOnlineMode => 16,
             CallKind::CamRowsWrite => 17,
+            CallKind::CamRead => 18,
         }
     }
 
@@ -94,6 +97,7 @@ impl CallKind {
             15 => Some(CallKind::CamPointsRead),
             16 => Some(CallKind::CamOnlineMode),
             17 => Some(CallKind::CamRowsWrite),
+            18 => Some(CallKind::CamRead),
             _ => None,
         }
     }
@@ -469,6 +473,66 @@ pub struct CamRowsWriteCall {
     pub rows: [[f64; 2]; CAM_ROWS_PER_CALL],
 }
 
+/// [`CamReadCall::what`]: MC_ReadCamTableSlaveDynamics of the table given as `target` at
+/// master position `a`: slave position, velocity, acceleration (what the table type gives).
+pub const CAM_READ_SLAVE_DYNAMICS: u32 = 1;
+/// [`CamReadCall::what`]: MC_ReadCamTableCharacteristics of the table given as `target`: the
+/// 31 values of `MC_TableCharacValues` in their order.
+pub const CAM_READ_CHARACTERISTICS: u32 = 2;
+/// [`CamReadCall::what`]: MC_ReadMotionFunctionValues of the table given as `target`: rows
+/// `[master, the columns of mask]` from `a` to `b` in steps of `c`, row after row.
+pub const CAM_READ_VALUES: u32 = 3;
+/// [`CamReadCall::what`]: MC_CamInfo of the slave axis given as `target` (at master
+/// position `a` when `flags` bit 0 is set): the 40 values of `MC_CamInfoData` in their order
+/// (booleans 0 or 1, IDs and modes as numbers).
+pub const CAM_READ_INFO: u32 = 4;
+/// Values in one [`CamValuesReply`].
+pub const CAM_VALUES_PER_REPLY: usize = 28;
+
+/// A read of cam data, answered as numbers in parts of [`CAM_VALUES_PER_REPLY`]: part `k`
+/// holds values `28 k ..` of the whole answer.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamReadCall {
+    /// [`CAM_READ_SLAVE_DYNAMICS`], [`CAM_READ_CHARACTERISTICS`], [`CAM_READ_VALUES`],
+    /// [`CAM_READ_INFO`].
+    pub what: u32,
+    /// Which part of the answer.
+    pub part: u32,
+    /// `MC_ValueSelectType` mask of a values read (1 position, 2 velocity, 4 acceleration,
+    /// 8 jerk).
+    pub mask: u32,
+    /// Bit 0 of an info read: at master position `a` rather than the master's position now.
+    pub flags: u32,
+    /// First parameter (master position; start of a values read).
+    pub a: f64,
+    /// End of a values read.
+    pub b: f64,
+    /// Increment of a values read.
+    pub c: f64,
+}
+
+/// The answer to a [`CamReadCall`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamValuesReply {
+    /// 0 when read, else the error code.
+    pub error_id: u32,
+    /// Values in this part.
+    pub count: u32,
+    /// Values of the whole answer.
+    pub total: u32,
+    /// Columns per row of a values read (else 1).
+    pub columns: u32,
+    /// The values.
+    pub values: [f64; CAM_VALUES_PER_REPLY],
+}
+
+impl AcyclicCall for CamReadCall {
+    const KIND: CallKind = CallKind::CamRead;
+    type Reply = CamValuesReply;
+}
+
 impl AcyclicCall for CamPointsWriteCall {
     const KIND: CallKind = CallKind::CamPointsWrite;
     type Reply = CamReply;
@@ -495,6 +559,7 @@ const _: () = {
     assert!(core::mem::size_of::<CamPointsWriteCall>() <= ACYCLIC_BODY_SIZE);
     assert!(core::mem::size_of::<CamPointsReply>() <= ACYCLIC_BODY_SIZE);
     assert!(core::mem::size_of::<CamRowsWriteCall>() <= ACYCLIC_BODY_SIZE);
+    assert!(core::mem::size_of::<CamValuesReply>() <= ACYCLIC_BODY_SIZE);
     assert!(core::mem::size_of::<CamInCall>() <= ACYCLIC_BODY_SIZE);
     assert!(core::mem::size_of::<CamScalingCall>() <= ACYCLIC_BODY_SIZE);
 };

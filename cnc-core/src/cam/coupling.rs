@@ -90,6 +90,15 @@ impl ScalingMode {
             _ => return None,
         })
     }
+
+    /// The raw value.
+    pub fn raw(self) -> u32 {
+        match self {
+            ScalingMode::UserDefined => 0,
+            ScalingMode::AutoOffset => 1,
+            ScalingMode::Off => 2,
+        }
+    }
 }
 
 /// `MC_CamActivationMode` as couplings and scalings use it (the online change of points uses

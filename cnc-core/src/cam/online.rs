@@ -40,6 +40,18 @@ impl ActivationMode {
         })
     }
 
+    /// The raw mode number and its position (0 for the modes without one).
+    pub fn raw(self) -> (u32, f64) {
+        match self {
+            ActivationMode::Instantaneous => (0, 0.0),
+            ActivationMode::AtMasterCamPos(p) => (1, p),
+            ActivationMode::AtMasterAxisPos(p) => (2, p),
+            ActivationMode::NextCycle => (3, 0.0),
+            ActivationMode::AsSoonAsPossible => (5, 0.0),
+            ActivationMode::Off => (6, 0.0),
+        }
+    }
+
     /// Whether an axis-position activation lies behind the master in its direction of
     /// travel (rising when it stands): it would never come. Other modes never pass.
     pub fn passed(self, now: MasterNow) -> bool {
@@ -137,6 +149,11 @@ impl OnlineChangeQueue {
     /// `MC_SetCamOnlineChangeMode`: the rule for writes from now on.
     pub fn set_mode(&mut self, mode: ActivationMode) {
         self.mode = mode;
+    }
+
+    /// The rule for writes.
+    pub fn mode(&self) -> ActivationMode {
+        self.mode
     }
 
     /// `MC_CAMACTIVATION_DELETEQUEUEDDATA`: drops what is queued; the running cam is untouched.
@@ -277,6 +294,14 @@ impl CamStore {
         let i = slot(id)?;
         self.tables[i] = Some((profile, OnlineChangeQueue::default()));
         Ok(())
+    }
+
+    /// The online-change state of table `id`, to look at.
+    pub fn queue(&self, id: u32) -> Result<&OnlineChangeQueue, CamError> {
+        self.tables[slot(id)?]
+            .as_ref()
+            .map(|(_, q)| q)
+            .ok_or(CamError::NoSuchTable { id })
     }
 
     /// The profile under `id`.
