@@ -750,3 +750,69 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
 fn s_at(p: &CamProfile, x: f64) -> f64 {
     p.eval(x, &mut ProfileCursor::default()).position
 }
+
+/// The numbers of a read block in the PLC's report.
+fn read_values(report: &str, instance: &str) -> Vec<f64> {
+    let mut lines = report.lines();
+    lines
+        .find(|l| l.starts_with(&format!("block {instance} ")))
+        .unwrap_or_else(|| panic!("no block {instance}\n{report}"));
+    let line = lines.next().unwrap_or("");
+    let (_, values) = line
+        .split_once(": ")
+        .unwrap_or_else(|| panic!("{instance}: {line}"));
+    values
+        .split(", ")
+        .filter(|v| *v != "...")
+        .map(|v| v.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn the_data_scenario_loads_reads_and_writes_through_the_blocks() {
+    let s = Scenario::load(&scenarios().join("cam-data/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut followed = 0;
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        if phase(&run, SLAVE) == AxisState::SlaveSynchronous {
+            // The uploaded zigzag (0, 10, 0, -10, 0 every 90 degrees), linear, cyclic.
+            let m = set(&run, MASTER).position.rem_euclid(360.0);
+            let expected = match m {
+                x if x < 90.0 => x / 9.0,
+                x if x < 270.0 => 10.0 - (x - 90.0) / 9.0,
+                x => -10.0 + (x - 270.0) / 9.0,
+            };
+            assert!(
+                (set(&run, SLAVE).position - expected).abs() < 1e-9,
+                "at {m}"
+            );
+            followed += 1;
+        }
+    }
+    assert!(followed > 1000);
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    let seed = seed_cam();
+    let s90 = seed.eval(90.0, &mut ProfileCursor::default());
+    assert_eq!(
+        read_values(&report, "dynamics"),
+        vec![s90.position, s90.velocity, s90.acceleration]
+    );
+    // Positions every 45 degrees: 9 rows of master and slave (the first 12 numbers shown).
+    let values = read_values(&report, "values");
+    for row in values.chunks(2) {
+        assert_eq!(
+            row[1],
+            seed.eval(row[0], &mut ProfileCursor::default()).position
+        );
+    }
+    // Point 4 after MC_WriteMotionFunction: index, master, slave.
+    assert_eq!(read_values(&report, "point4"), vec![4.0, 240.0, 30.0]);
+    // MC_CamInfo: table 3, equidistant (10), cyclic, linear, 5 rows of 2 columns.
+    assert_eq!(
+        read_values(&report, "info")[..6],
+        [3.0, 10.0, 1.0, 0.0, 5.0, 2.0]
+    );
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+}

@@ -27,16 +27,19 @@
 //! FALSE for one cycle first, so every call is a new edge.
 
 use crate::cam::{
-    CamOutputs, McCamIn, McCamOut, McCamScaling, McCamTableSelect, McSetCamOnlineChangeMode,
-    McWriteMotionFunctionPoint,
+    CamData, CamOutputs, McCamIn, McCamOut, McCamRead, McCamScaling, McCamTableSelect,
+    McReadMotionFunction, McSetCamOnlineChangeMode, McWriteMotionFunction,
+    McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
 };
 use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
 use crate::runtime::PlcIo;
+use hli::calls::McMotionFunctionPoint;
+use std::sync::Arc;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 14] = [
+pub const BLOCKS: [&str; 21] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -51,6 +54,13 @@ pub const BLOCKS: [&str; 14] = [
     "MC_CamScaling",
     "MC_WriteMotionFunctionPoint",
     "MC_SetCamOnlineChangeMode",
+    "MC_WriteMotionFunction",
+    "MC_ReadMotionFunction",
+    "MC_ReadMotionFunctionPoint",
+    "MC_ReadCamTableSlaveDynamics",
+    "MC_ReadCamTableCharacteristics",
+    "MC_ReadMotionFunctionValues",
+    "MC_CamInfo",
 ];
 
 /// The outputs a `wait` can name.
@@ -80,6 +90,9 @@ enum Block {
     CamScaling(Box<McCamScaling>),
     WritePoint(Box<McWriteMotionFunctionPoint>),
     OnlineMode(Box<McSetCamOnlineChangeMode>),
+    WriteFunction(Box<McWriteMotionFunction>),
+    ReadFunction(Box<McReadMotionFunction>),
+    Read(Box<McCamRead>),
 }
 
 /// A boolean output of a block.
@@ -87,7 +100,7 @@ enum Block {
 pub struct Output(usize);
 
 /// One input value of a call.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 enum Input {
     Enable(bool),
     Position(f64),
@@ -123,6 +136,98 @@ enum Input {
     SlaveVelo(f64),
     SlaveAcc(f64),
     SlaveJerk(f64),
+    /// Table data: rows, or motion-function points.
+    Rows(Arc<[[f64; 2]]>),
+    Points(Arc<[McMotionFunctionPoint]>),
+    TableType(u32),
+    /// Reads.
+    NumPoints(u32),
+    Room(usize),
+    ValueSelectMask(u32),
+    StartPosMaster(f64),
+    EndPosMaster(f64),
+    Increment(f64),
+    MasterPosition(f64),
+    AtMasterPosition(bool),
+}
+
+/// `rows = [[master, slave], ...]`.
+fn rows_of(value: &toml::Value) -> Result<Arc<[[f64; 2]]>, String> {
+    let bad = || "call: `rows` must be [[master, slave], ...] of finite numbers".to_string();
+    let list = value.as_array().ok_or_else(bad)?;
+    list.iter()
+        .map(|row| match row.as_array().map(|r| r.as_slice()) {
+            Some([m, s]) => match (number(m), number(s)) {
+                (Some(m), Some(s)) if m.is_finite() && s.is_finite() => Ok([m, s]),
+                _ => Err(bad()),
+            },
+            _ => Err(bad()),
+        })
+        .collect()
+}
+
+/// `points = [{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0, ... }, ...]`.
+fn points_of(value: &toml::Value) -> Result<Arc<[McMotionFunctionPoint]>, String> {
+    let list = value
+        .as_array()
+        .ok_or("call: `points` must be an array of point tables")?;
+    list.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let t = p
+                .as_table()
+                .ok_or_else(|| format!("call: points[{i}] is not a table"))?;
+            let int = |k: &str, default: Option<u32>| -> Result<u32, String> {
+                match t.get(k) {
+                    Some(v) => v
+                        .as_integer()
+                        .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                        .map(|v| v as u32)
+                        .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+                    None => default.ok_or_else(|| format!("call: points[{i}].{k} is missing")),
+                }
+            };
+            let num = |k: &str, required: bool| -> Result<f64, String> {
+                match t.get(k) {
+                    Some(v) => number(v)
+                        .filter(|v| v.is_finite())
+                        .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+                    None if required => Err(format!("call: points[{i}].{k} is missing")),
+                    None => Ok(0.0),
+                }
+            };
+            for key in t.keys() {
+                let known = [
+                    "index",
+                    "function",
+                    "type",
+                    "rel_index_next",
+                    "master",
+                    "slave",
+                    "velocity",
+                    "acceleration",
+                    "jerk",
+                ];
+                if !known.contains(&key.as_str()) {
+                    return Err(format!(
+                        "call: points[{i}] has no field `{key}` (fields: {})",
+                        known.join(", ")
+                    ));
+                }
+            }
+            Ok(McMotionFunctionPoint {
+                point_index: int("index", None)?,
+                function_type: int("function", None)?,
+                point_type: int("type", None)?,
+                rel_index_next_point: int("rel_index_next", Some(1))?,
+                master_pos: num("master", true)?,
+                slave_pos: num("slave", true)?,
+                slave_velo: num("velocity", false)?,
+                slave_acc: num("acceleration", false)?,
+                slave_jerk: num("jerk", false)?,
+            })
+        })
+        .collect()
 }
 
 /// A mode input by number or by its name.
@@ -192,6 +297,8 @@ struct Instance {
     last: [bool; 8],
     edges: [Edge; 8],
     error_id: u32,
+    /// Room of a read block's answer (made with the instance, never in a cycle).
+    room: Option<usize>,
 }
 
 /// The instances of a timeline.
@@ -262,7 +369,30 @@ impl Instances {
                 "jerk",
             ],
             "MC_Halt" | "MC_Stop" => &["deceleration", "jerk"],
-            "MC_CamTableSelect" => &["table", "periodic", "master_absolute", "slave_absolute"],
+            "MC_CamTableSelect" => &[
+                "table",
+                "periodic",
+                "master_absolute",
+                "slave_absolute",
+                "rows",
+                "points",
+                "table_type",
+                "interpolation",
+            ],
+            "MC_WriteMotionFunction" => &["table", "points"],
+            "MC_ReadMotionFunction" => &["table", "point_index", "num_points", "room"],
+            "MC_ReadMotionFunctionPoint" => &["table", "point_index"],
+            "MC_ReadCamTableSlaveDynamics" => &["table", "master_position"],
+            "MC_ReadCamTableCharacteristics" => &["table"],
+            "MC_ReadMotionFunctionValues" => &[
+                "table",
+                "value_select_mask",
+                "start_pos_master",
+                "end_pos_master",
+                "increment",
+                "room",
+            ],
+            "MC_CamInfo" => &["at_master_position", "master_position"],
             "MC_CamIn" => &[
                 "master",
                 "table",
@@ -359,6 +489,33 @@ impl Instances {
                         _ => Input::RelIndexNext(v),
                     }
                 }
+                "rows" => Input::Rows(rows_of(value)?),
+                "points" => Input::Points(points_of(value)?),
+                "table_type" => match value.as_integer() {
+                    Some(t @ (10 | 11)) => Input::TableType(t as u32),
+                    _ => return Err(format!(
+                        "call: `table_type` = {value}: 10 (equidistant) or 11 (non-equidistant)"
+                    )),
+                },
+                "num_points" | "value_select_mask" => {
+                    let v = value
+                        .as_integer()
+                        .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                        .ok_or_else(bad)? as u32;
+                    if key == "num_points" {
+                        Input::NumPoints(v)
+                    } else {
+                        Input::ValueSelectMask(v)
+                    }
+                }
+                "room" => Input::Room(
+                    value
+                        .as_integer()
+                        .filter(|v| (1..=1 << 20).contains(v))
+                        .ok_or_else(|| format!("call: `room` = {value}: 1..=1048576"))?
+                        as usize,
+                ),
+                "at_master_position" => Input::AtMasterPosition(value.as_bool().ok_or_else(bad)?),
                 "master" | "table" => {
                     let v = value
                         .as_integer()
@@ -396,12 +553,22 @@ impl Instances {
                         "slave_velo" => Input::SlaveVelo(v),
                         "slave_acc" => Input::SlaveAcc(v),
                         "slave_jerk" => Input::SlaveJerk(v),
+                        "start_pos_master" => Input::StartPosMaster(v),
+                        "end_pos_master" => Input::EndPosMaster(v),
+                        "increment" => Input::Increment(v),
+                        "master_position" => Input::MasterPosition(v),
                         _ => Input::Jerk(v),
                     }
                 }
             };
             inputs.push(input);
         }
+        // The room of a read's answer is the instance's, made now (never in a PLC cycle).
+        let room = inputs.iter().find_map(|i| match i {
+            Input::Room(r) => Some(*r),
+            _ => None,
+        });
+        inputs.retain(|i| !matches!(i, Input::Room(_)));
         let instance = match self.list.iter().position(|i| i.name == name) {
             Some(i) if self.list[i].kind != kind || self.list[i].axis != axis => {
                 return Err(format!(
@@ -409,17 +576,24 @@ impl Instances {
                     self.list[i].kind, self.list[i].axis
                 ))
             }
-            Some(i) => i,
+            Some(i) => {
+                if let Some(r) = room.filter(|r| Some(*r) > self.list[i].room) {
+                    self.list[i].room = Some(r);
+                    self.list[i].block = new_block(kind, Some(r));
+                }
+                i
+            }
             None => {
                 self.list.push(Instance {
                     name: name.to_string(),
                     kind,
                     axis,
-                    block: new_block(kind),
+                    block: new_block(kind, room),
                     raise_next_cycle: false,
                     last: [false; 8],
                     edges: [Edge::default(); 8],
                     error_id: 0,
+                    room,
                 });
                 self.list.len() - 1
             }
@@ -474,7 +648,7 @@ impl Instances {
     pub fn apply(&mut self, call: &Call) {
         let inst = &mut self.list[call.instance];
         for input in &call.inputs {
-            set_input(&mut inst.block, *input);
+            set_input(&mut inst.block, input.clone());
         }
         inst.last = [false; 8];
         match execute_of(&mut inst.block) {
@@ -565,6 +739,21 @@ impl Instances {
                     b.call(io);
                     (cam_outputs(b.out), false)
                 }
+                Block::WriteFunction(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
+                Block::ReadFunction(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
+                Block::Read(b) => {
+                    if b.request.what == hli::calls::CAM_READ_INFO {
+                        b.target = axis;
+                    }
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
@@ -617,8 +806,28 @@ impl Instances {
                     format!(", ErrorID {:#06x}", inst.error_id)
                 } else {
                     String::new()
-                }
+                },
             ));
+            // What a read block read, as it stands after the last cycle.
+            let read: Option<Vec<f64>> = match &inst.block {
+                Block::Read(b) => Some(b.values.clone()),
+                Block::ReadFunction(b) => Some(
+                    b.points
+                        .iter()
+                        .flat_map(|p| [p.point_index as f64, p.master_pos, p.slave_pos])
+                        .collect(),
+                ),
+                _ => None,
+            };
+            if let Some(values) = read.filter(|v| !v.is_empty()) {
+                let shown: Vec<String> = values.iter().take(12).map(|v| format!("{v}")).collect();
+                out.push_str(&format!(
+                    "  read {} value(s): {}{}\n",
+                    values.len(),
+                    shown.join(", "),
+                    if values.len() > 12 { ", ..." } else { "" }
+                ));
+            }
         }
         out
     }
@@ -636,11 +845,12 @@ impl Clone for Instances {
                     name: i.name.clone(),
                     kind: i.kind,
                     axis: i.axis,
-                    block: new_block(i.kind),
+                    block: new_block(i.kind, i.room),
                     raise_next_cycle: false,
                     last: [false; 8],
                     edges: [Edge::default(); 8],
                     error_id: 0,
+                    room: i.room,
                 })
                 .collect(),
         }
@@ -660,7 +870,8 @@ fn cam_outputs(out: CamOutputs) -> BlockOutputs {
     }
 }
 
-fn new_block(kind: &str) -> Block {
+fn new_block(kind: &str, room: Option<usize>) -> Block {
+    let room = room.unwrap_or(DEFAULT_READ_ROOM);
     match kind {
         "MC_Power" => Block::Power(McPower::default()),
         "MC_Reset" => Block::Reset(McReset::default()),
@@ -683,6 +894,25 @@ fn new_block(kind: &str) -> Block {
         "MC_CamScaling" => Block::CamScaling(Box::default()),
         "MC_WriteMotionFunctionPoint" => Block::WritePoint(Box::default()),
         "MC_SetCamOnlineChangeMode" => Block::OnlineMode(Box::default()),
+        "MC_WriteMotionFunction" => Block::WriteFunction(Box::default()),
+        "MC_ReadMotionFunction" => Block::ReadFunction(Box::new(McReadMotionFunction::new(room))),
+        "MC_ReadMotionFunctionPoint" => {
+            let mut b = McReadMotionFunction::new(1);
+            b.count = 1;
+            Block::ReadFunction(Box::new(b))
+        }
+        "MC_ReadCamTableSlaveDynamics" => Block::Read(Box::new(McCamRead::new(
+            hli::calls::CAM_READ_SLAVE_DYNAMICS,
+            3,
+        ))),
+        "MC_ReadCamTableCharacteristics" => Block::Read(Box::new(McCamRead::new(
+            hli::calls::CAM_READ_CHARACTERISTICS,
+            31,
+        ))),
+        "MC_ReadMotionFunctionValues" => {
+            Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_VALUES, room)))
+        }
+        "MC_CamInfo" => Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_INFO, 40))),
         _ => Block::Stop(McStop::default()),
     }
 }
@@ -702,6 +932,9 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::CamScaling(b) => Some(&mut b.execute),
         Block::WritePoint(b) => Some(&mut b.execute),
         Block::OnlineMode(b) => Some(&mut b.execute),
+        Block::WriteFunction(b) => Some(&mut b.execute),
+        Block::ReadFunction(b) => Some(&mut b.execute),
+        Block::Read(b) => Some(&mut b.execute),
     }
 }
 
@@ -766,6 +999,30 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::OnlineMode(b), Input::ActivationPosition(v)) => b.activation_position = v,
         (Block::OnlineMode(b), Input::MasterScalingMode(v)) => b.master_scaling_mode = v,
         (Block::OnlineMode(b), Input::SlaveScalingMode(v)) => b.slave_scaling_mode = v,
+        (Block::CamTableSelect(b), Input::Rows(rows)) => {
+            b.data = CamData::Rows {
+                rows,
+                table_type: 10,
+                interpolation: 0,
+            }
+        }
+        (Block::CamTableSelect(b), Input::Points(points)) => b.data = CamData::Points(points),
+        (Block::CamTableSelect(b), Input::TableType(v)) => b.table_type = v,
+        (Block::CamTableSelect(b), Input::Interpolation(v)) => b.interpolation = v,
+        (Block::WriteFunction(b), Input::Table(v)) => b.table = v,
+        (Block::WriteFunction(b), Input::Points(points)) => b.points = CamData::Points(points),
+        (Block::ReadFunction(b), Input::Table(v)) => b.table = v,
+        (Block::ReadFunction(b), Input::PointIndex(v)) => b.first = v,
+        (Block::ReadFunction(b), Input::NumPoints(v)) => b.count = v,
+
+        (Block::Read(b), Input::Table(v)) => b.target = v,
+        (Block::Read(b), Input::MasterPosition(v)) => b.request.a = v,
+        (Block::Read(b), Input::AtMasterPosition(v)) => b.request.flags = u32::from(v),
+        (Block::Read(b), Input::ValueSelectMask(v)) => b.request.mask = v,
+        (Block::Read(b), Input::StartPosMaster(v)) => b.request.a = v,
+        (Block::Read(b), Input::EndPosMaster(v)) => b.request.b = v,
+        (Block::Read(b), Input::Increment(v)) => b.request.c = v,
+
         // parse_call admits only the inputs of the block.
         _ => {}
     }

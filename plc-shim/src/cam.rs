@@ -171,14 +171,64 @@ pub struct McCamTableSelect {
     pub master_absolute: bool,
     /// Input: slave coordinates absolute.
     pub slave_absolute: bool,
+    /// Input: the table's data, loaded into the CNC first (none: a table the CNC has).
+    pub data: CamData,
+    /// Input: raw `MC_TableType` of rows sent (10 equidistant, 11 non-equidistant; 0: 10).
+    pub table_type: u32,
+    /// Input: raw `MC_InterpolationType` of rows sent.
+    pub interpolation: u32,
     /// Outputs of the last call.
     pub out: CamOutputs,
     core: CamCore<CamTableSelectCall>,
+    chunker: Chunker,
+    execute_before: bool,
+    loading: bool,
 }
 
 impl McCamTableSelect {
-    /// One cycle.
+    /// One cycle: the data in chunks (if any), then the selection.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let rising = self.execute && !self.execute_before;
+        self.execute_before = self.execute;
+        if rising && !matches!(self.data, CamData::None) {
+            if let CamData::Rows {
+                table_type,
+                interpolation,
+                ..
+            } = &mut self.data
+            {
+                *table_type = if self.table_type == 0 {
+                    10
+                } else {
+                    self.table_type
+                };
+                *interpolation = self.interpolation;
+            }
+            self.chunker.reset();
+            self.loading = true;
+            self.core = CamCore::default();
+        }
+        if self.loading {
+            match self
+                .chunker
+                .cycle(io, self.table, &self.data, true, self.periodic)
+            {
+                Transfer::Running => {
+                    self.out = CamOutputs {
+                        busy: true,
+                        ..CamOutputs::default()
+                    };
+                    return;
+                }
+                Transfer::Failed(code) => {
+                    self.loading = false;
+                    self.out = failed(code);
+                    return;
+                }
+                // Loaded: the selection goes out with a rising edge of its own core.
+                Transfer::Done => self.loading = false,
+            }
+        }
         let call = CamTableSelectCall {
             periodic: u32::from(self.periodic),
             master_absolute: u32::from(self.master_absolute),
@@ -417,5 +467,437 @@ impl McSetCamOnlineChangeMode {
             activation_position: self.activation_position,
         };
         self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}
+
+/// A transfer of table data in chunks, one chunk in flight: what MC_CamTableSelect with data
+/// and MC_WriteMotionFunction send before they are done.
+#[derive(Debug, Clone, Default)]
+pub enum CamData {
+    /// Nothing to send.
+    #[default]
+    None,
+    /// A position table: `[master, slave]` rows.
+    Rows {
+        /// The rows.
+        rows: std::sync::Arc<[[f64; 2]]>,
+        /// Raw `MC_TableType` (10, 11).
+        table_type: u32,
+        /// Raw `MC_InterpolationType`.
+        interpolation: u32,
+    },
+    /// Motion-function points.
+    Points(std::sync::Arc<[hli::calls::McMotionFunctionPoint]>),
+}
+
+enum Pending {
+    Rows(PendingCall<hli::calls::CamRowsWriteCall>),
+    Points(PendingCall<hli::calls::CamPointsWriteCall>),
+}
+
+/// Sends [`CamData`] chunk by chunk, one per cycle at most (a PLC cycle never waits).
+#[derive(Default)]
+pub struct Chunker {
+    pending: Option<Pending>,
+    next: usize,
+    done: bool,
+}
+
+impl core::fmt::Debug for Chunker {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Chunker")
+            .field("next", &self.next)
+            .field("done", &self.done)
+            .finish()
+    }
+}
+
+/// Where a transfer stands after a cycle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Transfer {
+    /// Chunks still to go.
+    Running,
+    /// Every chunk taken.
+    Done,
+    /// Refused with this code (or no answer).
+    Failed(u32),
+}
+
+impl Chunker {
+    /// Starts over.
+    pub fn reset(&mut self) {
+        *self = Chunker::default();
+    }
+
+    /// One cycle of the transfer of `data` to table `table` (`create`: the points make a new
+    /// function; `periodic` for rows).
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        table: u32,
+        data: &CamData,
+        create: bool,
+        periodic: bool,
+    ) -> Transfer {
+        if self.done {
+            return Transfer::Done;
+        }
+        let answered = match &self.pending {
+            None => None,
+            Some(Pending::Rows(p)) => p.poll().map(|r| r.map(|r| r.error_id)),
+            Some(Pending::Points(p)) => p.poll().map(|r| r.map(|r| r.error_id)),
+        };
+        match answered {
+            Some(Ok(0)) => self.pending = None,
+            Some(Ok(code)) => return Transfer::Failed(code),
+            Some(Err(CallError::Refused { code })) => return Transfer::Failed(code.raw()),
+            Some(Err(_)) => return Transfer::Failed(crate::motion::ERROR_NO_ANSWER),
+            None if self.pending.is_some() => return Transfer::Running,
+            None => {}
+        }
+        let sent = match data {
+            CamData::None => {
+                self.done = true;
+                return Transfer::Done;
+            }
+            CamData::Rows {
+                rows,
+                table_type,
+                interpolation,
+            } => {
+                let per = hli::calls::CAM_ROWS_PER_CALL;
+                if self.next >= rows.len() {
+                    self.done = true;
+                    return Transfer::Done;
+                }
+                let chunk = &rows[self.next..(self.next + per).min(rows.len())];
+                let mut call = hli::calls::CamRowsWriteCall {
+                    first_row: self.next as u32,
+                    count: chunk.len() as u32,
+                    flags: if self.next + chunk.len() == rows.len() {
+                        hli::calls::CAM_CHUNK_LAST
+                    } else {
+                        0
+                    },
+                    total: rows.len() as u32,
+                    table_type: *table_type,
+                    interpolation: *interpolation,
+                    periodic: u32::from(periodic),
+                    ..Default::default()
+                };
+                call.rows[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                io.acyclic.start(table, &call).map(Pending::Rows)
+            }
+            CamData::Points(points) => {
+                let per = hli::calls::CAM_POINTS_PER_CALL;
+                if self.next >= points.len() {
+                    self.done = true;
+                    return Transfer::Done;
+                }
+                let chunk = &points[self.next..(self.next + per).min(points.len())];
+                let mut call = hli::calls::CamPointsWriteCall {
+                    first: chunk[0].point_index,
+                    count: chunk.len() as u32,
+                    flags: (if self.next + chunk.len() == points.len() {
+                        hli::calls::CAM_CHUNK_LAST
+                    } else {
+                        0
+                    }) | if create {
+                        hli::calls::CAM_POINTS_CREATE
+                    } else {
+                        0
+                    },
+                    total: points.len() as u32,
+                    ..Default::default()
+                };
+                call.points[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                io.acyclic.start(table, &call).map(Pending::Points)
+            }
+        };
+        match sent {
+            Ok(p) => {
+                self.pending = Some(p);
+                Transfer::Running
+            }
+            Err(_) => Transfer::Failed(crate::motion::ERROR_NO_ANSWER),
+        }
+    }
+}
+
+/// MC_WriteMotionFunction: several points of the motion function `table` (the first one's
+/// index says where they go), sent in chunks and taken whole with the last.
+#[derive(Debug, Default)]
+pub struct McWriteMotionFunction {
+    /// Input: a rising edge starts the transfer.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the points.
+    pub points: CamData,
+    /// Outputs of the last call.
+    pub out: CamOutputs,
+    execute_before: bool,
+    chunker: Chunker,
+    running: bool,
+}
+
+impl McWriteMotionFunction {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let rising = self.execute && !self.execute_before;
+        self.execute_before = self.execute;
+        if rising {
+            self.chunker.reset();
+            self.running = true;
+            self.out = CamOutputs::default();
+        }
+        if self.running {
+            self.out = match self
+                .chunker
+                .cycle(io, self.table, &self.points, false, false)
+            {
+                Transfer::Running => CamOutputs {
+                    busy: true,
+                    ..CamOutputs::default()
+                },
+                Transfer::Done => {
+                    self.running = false;
+                    CamOutputs {
+                        done: true,
+                        ..CamOutputs::default()
+                    }
+                }
+                Transfer::Failed(code) => {
+                    self.running = false;
+                    failed(code)
+                }
+            };
+        } else if !self.execute {
+            self.out = CamOutputs::default();
+        }
+    }
+}
+
+/// The reads of chapter 5.1 (MC_ReadCamTableSlaveDynamics, MC_ReadCamTableCharacteristics,
+/// MC_ReadMotionFunctionValues, MC_CamInfo): the answer comes in parts of 28 numbers, one
+/// part per cycle, into `values`, whose room is set when the instance is made (like the
+/// array an MC_CAM_REF points to); an answer that does not fit is refused with
+/// MC_ERROR_ARRAYSIZE_INVALID.
+#[derive(Debug)]
+pub struct McCamRead {
+    /// Input: a rising edge starts the read.
+    pub execute: bool,
+    /// What is read and its parameters (the target is set by [`McCamRead::target`]).
+    pub request: hli::calls::CamReadCall,
+    /// Table ID, or the slave axis of MC_CamInfo.
+    pub target: u32,
+    /// Output: the numbers read.
+    pub values: Vec<f64>,
+    /// Output: columns per row of a value table.
+    pub columns: u32,
+    /// Outputs of the last call.
+    pub out: CamOutputs,
+    execute_before: bool,
+    pending: Option<PendingCall<hli::calls::CamReadCall>>,
+    part: u32,
+}
+
+/// Room of a read block's answer when the timeline does not say.
+pub const DEFAULT_READ_ROOM: usize = 1024;
+
+impl McCamRead {
+    /// A read of kind `what` with room for `room` numbers.
+    pub fn new(what: u32, room: usize) -> McCamRead {
+        McCamRead {
+            execute: false,
+            request: hli::calls::CamReadCall {
+                what,
+                ..Default::default()
+            },
+            target: 0,
+            values: Vec::with_capacity(room),
+            columns: 1,
+            out: CamOutputs::default(),
+            execute_before: false,
+            pending: None,
+            part: 0,
+        }
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let rising = self.execute && !self.execute_before;
+        self.execute_before = self.execute;
+        if rising {
+            self.values.clear();
+            self.part = 0;
+            self.out = CamOutputs {
+                busy: true,
+                ..CamOutputs::default()
+            };
+            self.send(io);
+            return;
+        }
+        let Some(pending) = &self.pending else {
+            if !self.execute {
+                self.out = CamOutputs::default();
+            }
+            return;
+        };
+        match pending.poll() {
+            None => {}
+            Some(Ok(reply)) if reply.error_id != 0 => {
+                self.pending = None;
+                self.out = failed(reply.error_id);
+            }
+            Some(Ok(reply)) => {
+                self.pending = None;
+                let count = reply.count as usize;
+                if self.values.len() + count > self.values.capacity()
+                    || reply.total as usize > self.values.capacity()
+                {
+                    self.out = failed(0x4B31);
+                    return;
+                }
+                self.values.extend_from_slice(&reply.values[..count]);
+                self.columns = reply.columns;
+                if self.values.len() >= reply.total as usize || count == 0 {
+                    self.out = CamOutputs {
+                        done: true,
+                        ..CamOutputs::default()
+                    };
+                } else {
+                    self.part += 1;
+                    self.send(io);
+                }
+            }
+            Some(Err(CallError::Refused { code })) => {
+                self.pending = None;
+                self.out = failed(code.raw());
+            }
+            Some(Err(_)) => {
+                self.pending = None;
+                self.out = failed(crate::motion::ERROR_NO_ANSWER);
+            }
+        }
+    }
+
+    fn send(&mut self, io: &mut PlcIo<'_>) {
+        let call = hli::calls::CamReadCall {
+            part: self.part,
+            ..self.request
+        };
+        match io.acyclic.start(self.target, &call) {
+            Ok(p) => self.pending = Some(p),
+            Err(_) => self.out = failed(crate::motion::ERROR_NO_ANSWER),
+        }
+    }
+}
+
+/// MC_ReadMotionFunction / MC_ReadMotionFunctionPoint: points of the motion function
+/// `table` from `first` on (`count` 0: to the end), four per cycle, into `points`, whose room
+/// is set when the instance is made.
+#[derive(Debug)]
+pub struct McReadMotionFunction {
+    /// Input: a rising edge starts the read.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the first point.
+    pub first: u32,
+    /// Input: points wanted (0: all from `first`).
+    pub count: u32,
+    /// Output: the points read.
+    pub points: Vec<hli::calls::McMotionFunctionPoint>,
+    /// Outputs of the last call.
+    pub out: CamOutputs,
+    execute_before: bool,
+    pending: Option<PendingCall<hli::calls::CamPointsReadCall>>,
+}
+
+impl McReadMotionFunction {
+    /// A reader with room for `room` points.
+    pub fn new(room: usize) -> McReadMotionFunction {
+        McReadMotionFunction {
+            execute: false,
+            table: 0,
+            first: 1,
+            count: 0,
+            points: Vec::with_capacity(room),
+            out: CamOutputs::default(),
+            execute_before: false,
+            pending: None,
+        }
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let rising = self.execute && !self.execute_before;
+        self.execute_before = self.execute;
+        if rising {
+            self.points.clear();
+            self.out = CamOutputs {
+                busy: true,
+                ..CamOutputs::default()
+            };
+            self.send(io);
+            return;
+        }
+        let Some(pending) = &self.pending else {
+            if !self.execute {
+                self.out = CamOutputs::default();
+            }
+            return;
+        };
+        match pending.poll() {
+            None => {}
+            Some(Ok(reply)) if reply.error_id != 0 => {
+                self.pending = None;
+                self.out = failed(reply.error_id);
+            }
+            Some(Ok(reply)) => {
+                self.pending = None;
+                let wanted = if self.count == 0 {
+                    (reply.total + 1).saturating_sub(self.first) as usize
+                } else {
+                    self.count as usize
+                };
+                if wanted > self.points.capacity() {
+                    self.out = failed(0x4B31);
+                    return;
+                }
+                let take = (reply.count as usize).min(wanted - self.points.len());
+                self.points.extend_from_slice(&reply.points[..take]);
+                if self.points.len() >= wanted || reply.count == 0 {
+                    self.out = CamOutputs {
+                        done: true,
+                        ..CamOutputs::default()
+                    };
+                } else {
+                    self.send(io);
+                }
+            }
+            Some(Err(CallError::Refused { code })) => {
+                self.pending = None;
+                self.out = failed(code.raw());
+            }
+            Some(Err(_)) => {
+                self.pending = None;
+                self.out = failed(crate::motion::ERROR_NO_ANSWER);
+            }
+        }
+    }
+
+    fn send(&mut self, io: &mut PlcIo<'_>) {
+        let call = hli::calls::CamPointsReadCall {
+            first: self.first + self.points.len() as u32,
+            count: 0,
+        };
+        match io.acyclic.start(self.table, &call) {
+            Ok(p) => self.pending = Some(p),
+            Err(_) => self.out = failed(crate::motion::ERROR_NO_ANSWER),
+        }
     }
 }
