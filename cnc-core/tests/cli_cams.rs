@@ -51,9 +51,41 @@ fn a_plc_process_couples_scales_changes_and_decouples_a_cam_slave() {
     }
     let mut in_process = Vec::new();
     run.trace.write_csv(&mut in_process).unwrap();
-    assert_eq!(in_process, two_process, "in-process and two-process traces differ");
+    assert_eq!(
+        in_process, two_process,
+        "in-process and two-process traces differ"
+    );
     assert_eq!(
         blocks(&run.timeline.as_ref().unwrap().summary()),
         blocks(&report)
     );
+}
+
+#[test]
+fn the_plc_program_does_what_the_timeline_does_tick_for_tick() {
+    let pid = std::process::id();
+    let run = |scenario: &str, tag: &str| {
+        let trace = std::env::temp_dir().join(format!("cli-cams-{tag}-{pid}.csv"));
+        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join(format!("../scenarios/{scenario}/scenario.toml"));
+        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+            .args(["run", path.to_str().unwrap(), "--lockstep"])
+            .args(["--instance", &format!("cli-cams-{tag}-{pid}"), "--trace"])
+            .arg(&trace)
+            .output()
+            .unwrap();
+        let report = String::from_utf8_lossy(&out.stdout).into_owned()
+            + &String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{report}");
+        let rows = std::fs::read(&trace).unwrap();
+        let _ = std::fs::remove_file(&trace);
+        (report, rows)
+    };
+    let (report, program) = run("cam-conveyor-program", "program");
+    assert!(
+        report.contains("cam-conveyor: Finished; Select at cycle 0, Couple at cycle 5"),
+        "{report}"
+    );
+    let (_, timeline) = run("cam-conveyor", "timeline");
+    assert_eq!(program, timeline, "the program and the timeline differ");
 }

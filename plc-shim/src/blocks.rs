@@ -493,9 +493,11 @@ impl Instances {
                 "points" => Input::Points(points_of(value)?),
                 "table_type" => match value.as_integer() {
                     Some(t @ (10 | 11)) => Input::TableType(t as u32),
-                    _ => return Err(format!(
+                    _ => {
+                        return Err(format!(
                         "call: `table_type` = {value}: 10 (equidistant) or 11 (non-equidistant)"
-                    )),
+                    ))
+                    }
                 },
                 "num_points" | "value_select_mask" => {
                     let v = value

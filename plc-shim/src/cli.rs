@@ -35,7 +35,7 @@ pub struct PlcArgs {
 }
 
 /// Names of the built-in programs.
-pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table"];
+pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor"];
 
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn main(args: PlcArgs) -> ExitCode {
@@ -48,6 +48,7 @@ pub fn main(args: PlcArgs) -> ExitCode {
             }
         },
         (None, "rotary-table") => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
+        (None, "cam-conveyor") => Box::new(crate::programs::cam_conveyor::CamConveyor::new()),
         (None, other) => {
             eprintln!("plc: unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})");
             return ExitCode::from(2);

@@ -1,4 +1,7 @@
-//! Example PLC programs.
+//! Example PLC programs: the rotary table as dynamic-CS master (here) and the cam conveyor
+//! ([`cam_conveyor`]).
+
+pub mod cam_conveyor;
 
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};

@@ -1,0 +1,242 @@
+//! The cam conveyor as a PLC program, step by step as structured text would write it (a
+//! CASE over steps, each calling its blocks every cycle and moving on when their outputs
+//! say so): the seed's usage of the cam blocks (chapter 5.1) re-expressed for
+//! `scenarios/cam-conveyor-program`.
+//!
+//! ```text
+//! Select   MC_CamTableSelect table 1, cyclic, absolute            -> Done
+//! Couple   MC_CamIn lifter to conveyor through table 1            -> InSync
+//! Run      MC_MoveVelocity conveyor at 360 deg/s; from cycle 1700 on ->
+//! Scale    MC_CamScaling: half the stroke at the next cycle, slave auto-offset -> Done
+//! Mode     from cycle 2600: MC_SetCamOnlineChangeMode table 1, next cycle      -> Done
+//! Change   MC_WriteMotionFunctionPoint: point 4 to 30                          -> Done
+//! Out      from cycle 4000, in the rest phase (350..360 deg): MC_CamOut        -> Done
+//! Halt     MC_Halt conveyor                                                    -> Done
+//! ```
+//!
+//! Any Error stops the sequence in `Failed` with the block and its ErrorID.
+
+use crate::cam::{
+    McCamIn, McCamOut, McCamScaling, McCamTableSelect, McSetCamOnlineChangeMode,
+    McWriteMotionFunctionPoint,
+};
+use crate::motion::{McHalt, McMoveVelocity};
+use crate::runtime::{PlcIo, PlcProgram};
+use hli::calls::McMotionFunctionPoint;
+
+const CONVEYOR: u32 = 0;
+const LIFTER: u32 = 1;
+const TABLE: u32 = 1;
+/// MC_CamActivationMode NextCycle; MC_CamScalingMode AutoOffset and Off.
+const NEXT_CYCLE: u32 = 3;
+const AUTO_OFFSET: u32 = 1;
+const OFF: u32 = 2;
+
+/// The steps of the sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Step {
+    /// MC_CamTableSelect.
+    #[default]
+    Select,
+    /// MC_CamIn.
+    Couple,
+    /// MC_MoveVelocity of the conveyor.
+    Run,
+    /// MC_CamScaling.
+    Scale,
+    /// MC_SetCamOnlineChangeMode.
+    Mode,
+    /// MC_WriteMotionFunctionPoint.
+    Change,
+    /// MC_CamOut in a rest phase.
+    Out,
+    /// MC_Halt of the conveyor.
+    Halt,
+    /// The sequence ran through.
+    Finished,
+    /// A block reported an error.
+    Failed {
+        /// The step it failed in.
+        at: u8,
+        /// The block's ErrorID.
+        error_id: u32,
+    },
+}
+
+/// The program's state: its step, its block instances and what it saw.
+#[derive(Debug, Default)]
+pub struct CamConveyor {
+    /// Where the sequence stands.
+    pub step: Step,
+    /// PLC cycle each step was entered in.
+    pub entered: Vec<(Step, u64)>,
+    select: McCamTableSelect,
+    cam_in: McCamIn,
+    run: McMoveVelocity,
+    scale: McCamScaling,
+    mode: McSetCamOnlineChangeMode,
+    change: McWriteMotionFunctionPoint,
+    out: McCamOut,
+    halt: McHalt,
+}
+
+impl CamConveyor {
+    /// The program before its first cycle.
+    pub fn new() -> CamConveyor {
+        let mut p = CamConveyor::default();
+        p.entered.reserve(16);
+        p.entered.push((Step::Select, 0));
+        p
+    }
+
+    fn go(&mut self, step: Step, cycle: u64) {
+        self.step = step;
+        if self.entered.len() < self.entered.capacity() {
+            self.entered.push((step, cycle));
+        }
+    }
+
+    fn fail(&mut self, error_id: u32) {
+        let at = self.entered.len() as u8;
+        self.step = Step::Failed { at, error_id };
+    }
+}
+
+impl PlcProgram for CamConveyor {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let cycle = io.cycle;
+        match self.step {
+            Step::Select => {
+                self.select.table = TABLE;
+                self.select.periodic = true;
+                self.select.master_absolute = true;
+                self.select.slave_absolute = true;
+                self.select.execute = cycle >= 4;
+                self.select.call(io);
+                if self.select.out.error {
+                    self.fail(self.select.out.error_id);
+                } else if self.select.out.done {
+                    self.go(Step::Couple, cycle);
+                }
+            }
+            Step::Couple => {
+                self.cam_in.master = CONVEYOR;
+                self.cam_in.table = TABLE;
+                self.cam_in.start_mode = 1;
+                self.cam_in.execute = true;
+                self.cam_in.call(io, LIFTER);
+                if self.cam_in.out.error {
+                    self.fail(self.cam_in.out.error_id);
+                } else if self.cam_in.out.in_sync {
+                    self.go(Step::Run, cycle);
+                }
+            }
+            Step::Run | Step::Scale | Step::Mode | Step::Change | Step::Out | Step::Halt => {
+                // The coupling and the conveyor's move are called every cycle while they run.
+                self.cam_in.call(io, LIFTER);
+                self.run.velocity = 360.0;
+                self.run.direction = 1;
+                self.run.acceleration = 3600.0;
+                self.run.deceleration = 3600.0;
+                self.run.jerk = 36000.0;
+                self.run.execute = self.step != Step::Halt;
+                self.run.call(io, CONVEYOR);
+                if self.run.out.error {
+                    return self.fail(self.run.out.error_id);
+                }
+                self.sequence(io, cycle);
+            }
+            Step::Finished | Step::Failed { .. } => {}
+        }
+    }
+
+    fn summary(&self) -> String {
+        let steps: Vec<String> = self
+            .entered
+            .iter()
+            .map(|(s, c)| format!("{s:?} at cycle {c}"))
+            .collect();
+        format!("cam-conveyor: {:?}; {}", self.step, steps.join(", "))
+    }
+}
+
+impl CamConveyor {
+    /// The steps after the conveyor runs.
+    fn sequence(&mut self, io: &mut PlcIo<'_>, cycle: u64) {
+        match self.step {
+            Step::Run if cycle >= 1700 && self.run.out.in_velocity => {
+                self.go(Step::Scale, cycle);
+            }
+            Step::Scale => {
+                self.scale.activation_mode = NEXT_CYCLE;
+                self.scale.master_scaling_mode = OFF;
+                self.scale.slave_scaling_mode = AUTO_OFFSET;
+                self.scale.slave_scaling = 0.5;
+                self.scale.execute = true;
+                self.scale.call(io, LIFTER);
+                if self.scale.out.error {
+                    self.fail(self.scale.out.error_id);
+                } else if self.scale.out.done && cycle >= 2600 {
+                    self.go(Step::Mode, cycle);
+                }
+            }
+            Step::Mode => {
+                self.mode.table = TABLE;
+                self.mode.activation_mode = NEXT_CYCLE;
+                self.mode.execute = true;
+                self.mode.call(io);
+                if self.mode.out.error {
+                    self.fail(self.mode.out.error_id);
+                } else if self.mode.out.done {
+                    self.go(Step::Change, cycle);
+                }
+            }
+            Step::Change => {
+                self.change.table = TABLE;
+                // Point 4 of the seed's example: POLYNOM5_MM (15) from a velocity point (2).
+                self.change.point = McMotionFunctionPoint {
+                    point_index: 4,
+                    function_type: 15,
+                    point_type: 2,
+                    rel_index_next_point: 1,
+                    master_pos: 240.0,
+                    slave_pos: 30.0,
+                    ..McMotionFunctionPoint::default()
+                };
+                self.change.execute = true;
+                self.change.call(io);
+                if self.change.out.error {
+                    self.fail(self.change.out.error_id);
+                } else if self.change.out.done {
+                    self.go(Step::Out, cycle);
+                }
+            }
+            Step::Out => {
+                // In the cam's last rest (350..360 degrees of the conveyor's turn).
+                let at_rest = io
+                    .view
+                    .axis_state(CONVEYOR as usize)
+                    .is_ok_and(|s| s.command_position_acs_r > 3_500_000);
+                self.out.execute = cycle >= 4000 && at_rest || self.out.execute;
+                self.out.call(io, LIFTER);
+                if self.out.out.error {
+                    self.fail(self.out.out.error_id);
+                } else if self.out.out.done {
+                    self.go(Step::Halt, cycle);
+                }
+            }
+            Step::Halt => {
+                self.halt.deceleration = 3600.0;
+                self.halt.jerk = 36000.0;
+                self.halt.execute = true;
+                self.halt.call(io, CONVEYOR);
+                if self.halt.out.error {
+                    self.fail(self.halt.out.error_id);
+                } else if self.halt.out.done {
+                    self.go(Step::Finished, cycle);
+                }
+            }
+            _ => {}
+        }
+    }
+}
