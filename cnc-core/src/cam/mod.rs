@@ -11,6 +11,7 @@
 //! * `online` — queued point changes, validated whole before they apply;
 //! * `coupling` — the coupling law of a slave to a master through a cam, activation and
 //!   scaling modes;
+//! * `multi_table` — the multi-table slave: profile tables in series, corrections beside;
 //! * `file` — the JSON cam file and the binary table file;
 //! * `error` — refusals with the seed's error codes.
 //!
@@ -23,6 +24,7 @@ pub mod error;
 pub mod file;
 pub mod law;
 pub mod motion_function;
+pub mod multi_table;
 pub mod online;
 pub mod piece;
 pub mod table;
