@@ -273,7 +273,9 @@ impl MultiTableLaw {
                     continue;
                 };
                 let Some(p) = cam(e.table) else { continue };
-                if !e.profile || !(e.w.range_low <= m.position && m.position < e.w.range_high) {
+                let counts =
+                    e.profile && e.w.range_low <= m.position && m.position < e.w.range_high;
+                if !counts {
                     continue;
                 }
                 let (c, cycle) = contribution(&mut e, p, m);
