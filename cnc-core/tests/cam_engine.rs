@@ -816,3 +816,45 @@ fn the_data_scenario_loads_reads_and_writes_through_the_blocks() {
     );
     assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
 }
+
+#[test]
+fn the_multi_table_scenario_runs_start_work_correction_and_stop_tables() {
+    let s = Scenario::load(&scenarios().join("cam-multi-table/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    // By hand: the start table 0.2 per unit to 100; the work table 0.4 per unit from 20;
+    // the correction bump (+0.2 per unit for 10, back for 10) from 350; the work table ends
+    // at its boundary at 500 (the stop came at about 489) and the stop table adds 0.2 per
+    // unit for 50 units from 180; then the feeder stands at 190.
+    let bump = |d: f64| match d {
+        d if (0.0..10.0).contains(&d) => 0.2 * d,
+        d if (10.0..20.0).contains(&d) => 2.0 - 0.2 * (d - 10.0),
+        _ => 0.0,
+    };
+    let expected = |pm: f64| match pm {
+        pm if pm < 100.0 => 0.2 * pm,
+        pm if pm < 500.0 => 20.0 + 0.4 * (pm - 100.0) + bump(pm - 350.0),
+        pm if pm < 550.0 => 180.0 + 0.2 * (pm - 500.0),
+        _ => 190.0,
+    };
+    let mut coupled_ticks = 0;
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let feeder = run.machine.axes().axis(SLAVE).unwrap();
+        if feeder.coupling().map(|c| c.kind) != Some(CouplingState::Cam) {
+            continue;
+        }
+        coupled_ticks += 1;
+        let pm = set(&run, MASTER).position;
+        let f = set(&run, SLAVE).position;
+        assert!(
+            (f - expected(pm)).abs() < 1e-9,
+            "line {pm}: feeder {f}, expected {}",
+            expected(pm)
+        );
+    }
+    assert!(coupled_ticks > 7000, "{coupled_ticks}");
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    assert_eq!(set(&run, SLAVE).position, 190.0);
+}

@@ -64,6 +64,12 @@ pub enum CallKind {
     CamRowsWrite,
     /// [`CamReadCall`].
     CamRead,
+    /// [`CamTableWeightCall`].
+    CamTableWeight,
+    /// [`CamMultiCoupleCall`].
+    CamMultiCouple,
+    /// [`CamMultiTableCall`].
+    CamMultiTable,
 }
 
 impl CallKind {
@@ -81,6 +87,9 @@ impl CallKind {
             CallKind::CamOnlineMode => 16,
             CallKind::CamRowsWrite => 17,
             CallKind::CamRead => 18,
+            CallKind::CamTableWeight => 19,
+            CallKind::CamMultiCouple => 20,
+            CallKind::CamMultiTable => 21,
         }
     }
 
@@ -98,6 +107,9 @@ impl CallKind {
             16 => Some(CallKind::CamOnlineMode),
             17 => Some(CallKind::CamRowsWrite),
             18 => Some(CallKind::CamRead),
+            19 => Some(CallKind::CamTableWeight),
+            20 => Some(CallKind::CamMultiCouple),
+            21 => Some(CallKind::CamMultiTable),
             _ => None,
         }
     }
@@ -531,6 +543,85 @@ pub struct CamValuesReply {
 impl AcyclicCall for CamReadCall {
     const KIND: CallKind = CallKind::CamRead;
     type Reply = CamValuesReply;
+}
+
+/// CamTableSetWeight for the table given as `target`: how it counts in a multi-table slave.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamTableWeightCall {
+    /// Weight W (> 0).
+    pub weight: f64,
+    /// Master offset MO.
+    pub master_offset: f64,
+    /// Master slope MS (multiplies the master position; not 0).
+    pub master_slope: f64,
+    /// Slave offset SO.
+    pub slave_offset: f64,
+    /// Slave slope SS.
+    pub slave_slope: f64,
+    /// Lower end RL of the master range in which a profile table counts.
+    pub range_low: f64,
+    /// Upper end RH (RL < RH).
+    pub range_high: f64,
+}
+
+/// Tables of a multi-table slave.
+pub const CAM_MULTI_TABLES: usize = 8;
+
+/// CamTableCoupleAxesMultiTables for the slave axis given as `target`: couple (`on` 1) to
+/// `master` through `tables` tables, the first `profiles` of them profile tables and the
+/// others corrections; or decouple (`on` 0, the rest unused).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamMultiCoupleCall {
+    /// Master axis index.
+    pub master: u32,
+    /// 1 couple, 0 decouple.
+    pub on: u32,
+    /// Tables used (1..=8).
+    pub tables: u32,
+    /// Profile tables among them (1..=tables), the first ones.
+    pub profiles: u32,
+    /// Table IDs.
+    pub table_ids: [u32; CAM_MULTI_TABLES],
+}
+
+/// [`CamMultiTableCall::op`]: CamTableEnableCorrectionTable.
+pub const CAM_MULTI_ENABLE_CORRECTION: u32 = 1;
+/// [`CamMultiTableCall::op`]: CamTableDeactivateCyclicTable.
+pub const CAM_MULTI_STOP_CYCLIC: u32 = 2;
+
+/// A table of the multi-table slave given as `target`: start a correction (at once, or when
+/// the master passes `position` if `flags` bit 0) or end a cyclic profile table at its next
+/// cycle boundary.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct CamMultiTableCall {
+    /// [`CAM_MULTI_ENABLE_CORRECTION`] or [`CAM_MULTI_STOP_CYCLIC`].
+    pub op: u32,
+    /// The table ID.
+    pub table: u32,
+    /// Bit 0: a correction starts at `position` rather than at once.
+    pub flags: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// Activation position of a correction.
+    pub position: f64,
+}
+
+impl AcyclicCall for CamTableWeightCall {
+    const KIND: CallKind = CallKind::CamTableWeight;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamMultiCoupleCall {
+    const KIND: CallKind = CallKind::CamMultiCouple;
+    type Reply = CamReply;
+}
+
+impl AcyclicCall for CamMultiTableCall {
+    const KIND: CallKind = CallKind::CamMultiTable;
+    type Reply = CamReply;
 }
 
 impl AcyclicCall for CamPointsWriteCall {

@@ -27,9 +27,9 @@
 //! FALSE for one cycle first, so every call is a new edge.
 
 use crate::cam::{
-    CamData, CamOutputs, McCamIn, McCamOut, McCamRead, McCamScaling, McCamTableSelect,
-    McReadMotionFunction, McSetCamOnlineChangeMode, McWriteMotionFunction,
-    McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
+    CamData, CamMultiTable, CamOutputs, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn,
+    McCamOut, McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction,
+    McSetCamOnlineChangeMode, McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
 };
 use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
@@ -39,7 +39,7 @@ use hli::calls::McMotionFunctionPoint;
 use std::sync::Arc;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 21] = [
+pub const BLOCKS: [&str; 25] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -61,6 +61,10 @@ pub const BLOCKS: [&str; 21] = [
     "MC_ReadCamTableCharacteristics",
     "MC_ReadMotionFunctionValues",
     "MC_CamInfo",
+    "CamTableSetWeight",
+    "CamTableCoupleAxesMultiTables",
+    "CamTableEnableCorrectionTable",
+    "CamTableDeactivateCyclicTable",
 ];
 
 /// The outputs a `wait` can name.
@@ -93,6 +97,9 @@ enum Block {
     WriteFunction(Box<McWriteMotionFunction>),
     ReadFunction(Box<McReadMotionFunction>),
     Read(Box<McCamRead>),
+    SetWeight(Box<CamTableSetWeight>),
+    MultiCouple(Box<CamTableCoupleAxesMultiTables>),
+    MultiTable(Box<CamMultiTable>),
 }
 
 /// A boolean output of a block.
@@ -149,6 +156,16 @@ enum Input {
     Increment(f64),
     MasterPosition(f64),
     AtMasterPosition(bool),
+    /// Multi-table blocks.
+    Weight(f64),
+    MasterSlope(f64),
+    SlaveSlope(f64),
+    RangeLow(f64),
+    RangeHigh(f64),
+    TableIds([u32; 8], u32),
+    Profiles(u32),
+    On(bool),
+    AtPosition(bool),
 }
 
 /// `rows = [[master, slave], ...]`.
@@ -393,6 +410,19 @@ impl Instances {
                 "room",
             ],
             "MC_CamInfo" => &["at_master_position", "master_position"],
+            "CamTableSetWeight" => &[
+                "table",
+                "weight",
+                "master_offset",
+                "master_slope",
+                "slave_offset",
+                "slave_slope",
+                "range_low",
+                "range_high",
+            ],
+            "CamTableCoupleAxesMultiTables" => &["master", "tables", "profiles", "on"],
+            "CamTableEnableCorrectionTable" => &["table", "at_position", "position"],
+            "CamTableDeactivateCyclicTable" => &["table"],
             "MC_CamIn" => &[
                 "master",
                 "table",
@@ -518,6 +548,30 @@ impl Instances {
                         as usize,
                 ),
                 "at_master_position" => Input::AtMasterPosition(value.as_bool().ok_or_else(bad)?),
+                "on" => Input::On(value.as_bool().ok_or_else(bad)?),
+                "at_position" => Input::AtPosition(value.as_bool().ok_or_else(bad)?),
+                "profiles" => Input::Profiles(
+                    value
+                        .as_integer()
+                        .filter(|v| (1..=8).contains(v))
+                        .ok_or_else(|| format!("call: `profiles` = {value}: 1..=8"))?
+                        as u32,
+                ),
+                "tables" => {
+                    let list = value
+                        .as_array()
+                        .filter(|l| (1..=8).contains(&l.len()))
+                        .ok_or_else(|| format!("call: `tables` = {value}: 1 to 8 table IDs"))?;
+                    let mut ids = [0u32; 8];
+                    for (slot, v) in ids.iter_mut().zip(list) {
+                        *slot = v
+                            .as_integer()
+                            .filter(|v| (1..=255).contains(v))
+                            .ok_or_else(|| format!("call: `tables`: {v} is not a table ID"))?
+                            as u32;
+                    }
+                    Input::TableIds(ids, list.len() as u32)
+                }
                 "master" | "table" => {
                     let v = value
                         .as_integer()
@@ -559,6 +613,11 @@ impl Instances {
                         "end_pos_master" => Input::EndPosMaster(v),
                         "increment" => Input::Increment(v),
                         "master_position" => Input::MasterPosition(v),
+                        "weight" => Input::Weight(v),
+                        "master_slope" => Input::MasterSlope(v),
+                        "slave_slope" => Input::SlaveSlope(v),
+                        "range_low" => Input::RangeLow(v),
+                        "range_high" => Input::RangeHigh(v),
                         _ => Input::Jerk(v),
                     }
                 }
@@ -756,6 +815,18 @@ impl Instances {
                     b.call(io);
                     (cam_outputs(b.out), false)
                 }
+                Block::SetWeight(b) => {
+                    b.call(io);
+                    (cam_outputs(b.out), false)
+                }
+                Block::MultiCouple(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
+                Block::MultiTable(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
@@ -915,6 +986,22 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
             Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_VALUES, room)))
         }
         "MC_CamInfo" => Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_INFO, 40))),
+        "CamTableSetWeight" => Block::SetWeight(Box::default()),
+        "CamTableCoupleAxesMultiTables" => {
+            let mut b = Box::<CamTableCoupleAxesMultiTables>::default();
+            b.on = true;
+            Block::MultiCouple(b)
+        }
+        "CamTableEnableCorrectionTable" => {
+            let mut b = Box::<CamMultiTable>::default();
+            b.op = hli::calls::CAM_MULTI_ENABLE_CORRECTION;
+            Block::MultiTable(b)
+        }
+        "CamTableDeactivateCyclicTable" => {
+            let mut b = Box::<CamMultiTable>::default();
+            b.op = hli::calls::CAM_MULTI_STOP_CYCLIC;
+            Block::MultiTable(b)
+        }
         _ => Block::Stop(McStop::default()),
     }
 }
@@ -937,6 +1024,9 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::WriteFunction(b) => Some(&mut b.execute),
         Block::ReadFunction(b) => Some(&mut b.execute),
         Block::Read(b) => Some(&mut b.execute),
+        Block::SetWeight(b) => Some(&mut b.execute),
+        Block::MultiCouple(b) => Some(&mut b.execute),
+        Block::MultiTable(b) => Some(&mut b.execute),
     }
 }
 
@@ -1024,6 +1114,27 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::Read(b), Input::StartPosMaster(v)) => b.request.a = v,
         (Block::Read(b), Input::EndPosMaster(v)) => b.request.b = v,
         (Block::Read(b), Input::Increment(v)) => b.request.c = v,
+        (Block::SetWeight(b), Input::Table(v)) => b.table = v,
+        (Block::SetWeight(b), Input::Weight(v)) => b.weight.weight = v,
+        (Block::SetWeight(b), Input::MasterOffset(v)) => b.weight.master_offset = v,
+        (Block::SetWeight(b), Input::MasterSlope(v)) => b.weight.master_slope = v,
+        (Block::SetWeight(b), Input::SlaveOffset(v)) => b.weight.slave_offset = v,
+        (Block::SetWeight(b), Input::SlaveSlope(v)) => b.weight.slave_slope = v,
+        (Block::SetWeight(b), Input::RangeLow(v)) => b.weight.range_low = v,
+        (Block::SetWeight(b), Input::RangeHigh(v)) => b.weight.range_high = v,
+        (Block::MultiCouple(b), Input::Master(v)) => b.master = v,
+        (Block::MultiCouple(b), Input::TableIds(ids, n)) => {
+            b.tables = ids;
+            b.count = n;
+            if b.profiles == 0 || b.profiles > n {
+                b.profiles = n;
+            }
+        }
+        (Block::MultiCouple(b), Input::Profiles(v)) => b.profiles = v,
+        (Block::MultiCouple(b), Input::On(v)) => b.on = v,
+        (Block::MultiTable(b), Input::Table(v)) => b.table = v,
+        (Block::MultiTable(b), Input::AtPosition(v)) => b.at_position = v,
+        (Block::MultiTable(b), Input::Position(v)) => b.position = v,
 
         // parse_call admits only the inputs of the block.
         _ => {}

@@ -24,18 +24,20 @@ use crate::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
     Scaling, ScalingMode, StartMode,
 };
+use crate::cam::multi_table::{MultiTableError, MultiTableLaw, TableSpec, TableWeight};
 use crate::cam::online::{ActivationMode, CamStore, MasterNow};
 use crate::cam::{
     CamProfile, Interpolation, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor,
     TableErrorCode, TableType,
 };
 use hli::calls::{
-    decode_body, reply, CallKind, CamInCall, CamOnlineModeCall, CamOutCall, CamPointsReadCall,
-    CamPointsReply, CamPointsWriteCall, CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall,
-    CamTableSelectCall, CamValuesReply, ErrorCode, HandlerResult, McMotionFunctionPoint,
-    CAM_CHUNK_LAST, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL, CAM_READ_CHARACTERISTICS,
-    CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES, CAM_ROWS_PER_CALL,
-    CAM_VALUES_PER_REPLY,
+    decode_body, reply, CallKind, CamInCall, CamMultiCoupleCall, CamMultiTableCall,
+    CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
+    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableSelectCall,
+    CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult, McMotionFunctionPoint,
+    CAM_CHUNK_LAST, CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE,
+    CAM_POINTS_PER_CALL, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
+    CAM_READ_VALUES, CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
 };
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
@@ -113,9 +115,20 @@ struct RowsTransfer {
     rows: Vec<[f64; 2]>,
 }
 
+/// A multi-table slave (chapter 4.6).
+#[derive(Debug)]
+struct MultiSlave {
+    master: usize,
+    law: MultiTableLaw,
+}
+
 /// Cam couplings of a machine.
 #[derive(Debug)]
 pub struct CamEngine {
+    /// Per table: its weight and scaling in a multi-table slave (CamTableSetWeight).
+    weights: Vec<TableWeight>,
+    /// Multi-table slaves by axis.
+    multis: Vec<Option<MultiSlave>>,
     store: CamStore,
     selects: Vec<Option<Select>>,
     /// Per table: how a point change that applies treats the master and slave offsets.
@@ -153,6 +166,8 @@ impl CamEngine {
     /// An engine for a machine of `axes` axes with the tables of `store`.
     pub fn new(store: CamStore, axes: usize) -> CamEngine {
         CamEngine {
+            weights: vec![TableWeight::default(); TABLE_SLOTS],
+            multis: (0..axes).map(|_| None).collect(),
             store,
             selects: vec![None; TABLE_SLOTS],
             online_scaling: vec![(ScalingMode::UserDefined, ScalingMode::UserDefined); TABLE_SLOTS],
@@ -391,7 +406,132 @@ impl CamEngine {
     fn in_use(&self, id: u32) -> bool {
         self.slaves.iter().flatten().any(|s| {
             s.table == id || matches!(s.queued, Some(Queued::Switch { table, .. }) if table == id)
-        })
+        }) || self
+            .multis
+            .iter()
+            .flatten()
+            .any(|m| m.law.tables().any(|t| t == id))
+    }
+
+    fn table_weight(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamTableWeightCall = decode_body(request)?;
+        let id = request.target;
+        if !(1..=255).contains(&id) {
+            return code(TABLE_INVALID);
+        }
+        let w = TableWeight {
+            weight: call.weight,
+            master_offset: call.master_offset,
+            master_slope: call.master_slope,
+            slave_offset: call.slave_offset,
+            slave_slope: call.slave_slope,
+            range_low: call.range_low,
+            range_high: call.range_high,
+        };
+        if w.check().is_err() {
+            return code(CamCouplingError::BadParameter.raw());
+        }
+        // The seed: weights are set before a table becomes active, not while it is.
+        if self
+            .multis
+            .iter()
+            .flatten()
+            .any(|m| m.law.tables().any(|t| t == id))
+        {
+            return code(CamCouplingError::TableInUse.raw());
+        }
+        self.weights[id as usize] = w;
+        accepted()
+    }
+
+    fn multi_couple(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
+        let call: CamMultiCoupleCall = decode_body(request)?;
+        let slave = request.target as usize;
+        if slave >= axes.len() {
+            return Err(ErrorCode::InvalidTarget);
+        }
+        if call.on == 0 {
+            if self.multis[slave].take().is_none() {
+                return code(CamCouplingError::NotCamCoupled.raw());
+            }
+            if let Some(axis) = axes.axis_mut(slave) {
+                axis.decouple();
+            }
+            return accepted();
+        }
+        let master = call.master as usize;
+        if master >= axes.len() {
+            return code(CamCouplingError::NoSuchMaster.raw());
+        }
+        if master == slave {
+            return code(CamCouplingError::MasterIsSlave.raw());
+        }
+        let (n, profiles) = (call.tables as usize, call.profiles as usize);
+        if !(1..=8).contains(&n) || !(1..=n).contains(&profiles) {
+            return code(CamCouplingError::UnknownMode.raw());
+        }
+        let mut specs = Vec::with_capacity(n);
+        for (k, &id) in call.table_ids[..n].iter().enumerate() {
+            let Ok(cam) = self.store.get(id) else {
+                return code(TABLE_INVALID);
+            };
+            specs.push(TableSpec {
+                table: id,
+                profile: k < profiles,
+                periodic: self.select_periodic(id, cam),
+                weight: self.weights[id as usize],
+                cam,
+            });
+        }
+        let Some(m) = axes.axis(master).map(|a| a.setpoint()) else {
+            return code(CamCouplingError::NoSuchMaster.raw());
+        };
+        let law = match MultiTableLaw::new(&specs, m.position) {
+            Ok(law) => law,
+            Err(MultiTableError::Parameter { .. }) => {
+                return code(CamCouplingError::BadParameter.raw())
+            }
+            Err(_) => return code(CamCouplingError::UnknownMode.raw()),
+        };
+        let Some(axis) = axes.axis_mut(slave) else {
+            return Err(ErrorCode::InvalidTarget);
+        };
+        let coupling = Coupling {
+            kind: CouplingState::Cam,
+            master: master as i32,
+            phase: AxisState::SlaveSynchronous,
+        };
+        if let Err(e) = axis.couple(coupling) {
+            return code(e.raw());
+        }
+        self.multis[slave] = Some(MultiSlave { master, law });
+        accepted()
+    }
+
+    fn multi_table(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let call: CamMultiTableCall = decode_body(request)?;
+        let Some(m) = self
+            .multis
+            .get_mut(request.target as usize)
+            .and_then(Option::as_mut)
+        else {
+            return code(CamCouplingError::NotCamCoupled.raw());
+        };
+        let done = match call.op {
+            CAM_MULTI_ENABLE_CORRECTION => {
+                if call.flags & 1 != 0 && !call.position.is_finite() {
+                    return code(CamCouplingError::BadParameter.raw());
+                }
+                let at = (call.flags & 1 != 0).then_some(call.position);
+                m.law.enable_correction(call.table, at)
+            }
+            CAM_MULTI_STOP_CYCLIC => m.law.stop_cyclic(call.table),
+            _ => return code(CamCouplingError::UnknownMode.raw()),
+        };
+        match done {
+            Ok(()) => accepted(),
+            Err(_) => code(TABLE_INVALID),
+        }
     }
 
     /// The master's motion over the last tick in the cam of a coupling that uses table `id`
@@ -850,6 +990,12 @@ impl CamEngine {
             .axis(slave)
             .and_then(|a| a.coupling())
             .is_some_and(|c| c.kind == CouplingState::Cam);
+        if cam_coupled && self.multis[slave].take().is_some() {
+            if let Some(axis) = axes.axis_mut(slave) {
+                axis.decouple();
+            }
+            return accepted();
+        }
         let Some(state) = self.slaves[slave].take().filter(|_| cam_coupled) else {
             return code(CamCouplingError::NotCamCoupled.raw());
         };
@@ -928,6 +1074,25 @@ impl Engine for CamEngine {
     }
 
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
+        for i in 0..self.multis.len() {
+            let Some(multi) = self.multis[i].as_mut() else {
+                continue;
+            };
+            let still = io
+                .axes
+                .axis(i)
+                .and_then(|a| a.coupling())
+                .is_some_and(|c| c.kind == CouplingState::Cam);
+            let master = io.axes.axis(multi.master).map(|a| a.setpoint());
+            let (true, Some(master)) = (still, master) else {
+                self.multis[i] = None;
+                continue;
+            };
+            let set = multi.law.slave(&self.store, &master);
+            if let Some(axis) = io.axes.axis_mut(i) {
+                axis.drive_coupled(set, AxisState::SlaveSynchronous);
+            }
+        }
         for i in 0..self.slaves.len() {
             let Some(state) = self.slaves[i].as_mut() else {
                 continue;
@@ -1087,11 +1252,21 @@ impl Engine for CamEngine {
             CallKind::CamOnlineMode => self.online_mode(request),
             CallKind::CamRowsWrite => self.rows_write(request),
             CallKind::CamRead => self.read(request, axes),
+            CallKind::CamTableWeight => self.table_weight(request),
+            CallKind::CamMultiCouple => self.multi_couple(request, axes),
+            CallKind::CamMultiTable => self.multi_table(request),
             _ => return None,
         })
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
+        for (i, slot) in self.multis.iter_mut().enumerate() {
+            if slot.take().is_some() {
+                if let Some(axis) = axes.axis_mut(i) {
+                    axis.decouple();
+                }
+            }
+        }
         for (i, slot) in self.slaves.iter_mut().enumerate() {
             if let Some(state) = slot.take() {
                 if let Some(axis) = axes.axis_mut(i) {

@@ -41,7 +41,9 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         let gears = GearEngine::new(&scenario.gears, total).map_err(|e| invalid(e.to_string()))?;
         engines.push(Box::new(gears));
     }
-    if !scenario.cam_tables.is_empty() {
+    // Every machine with single axes has the cam engine: a PLC may load tables and couple
+    // any time (an idle engine costs a pass over empty slots).
+    if !scenario.cam_tables.is_empty() || !scenario.axes.is_empty() {
         let mut store = crate::cam::online::CamStore::new();
         for (id, profile) in &scenario.cam_tables {
             store
