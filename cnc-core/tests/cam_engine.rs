@@ -858,3 +858,52 @@ fn the_multi_table_scenario_runs_start_work_correction_and_stop_tables() {
     assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
     assert_eq!(set(&run, SLAVE).position, 190.0);
 }
+
+#[test]
+fn the_compatibility_blocks_make_read_couple_rescale_and_delete() {
+    let s = Scenario::load(&scenarios().join("cam-compat/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    // The generated zigzag, linear: +-9 per turn, doubled, shifted by 0.5 from tick 1500.
+    let zigzag = |m: f64| {
+        let m = m.rem_euclid(360.0);
+        match m {
+            m if m < 90.0 => m / 10.0,
+            m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
+            m => -9.0 + (m - 270.0) / 10.0,
+        }
+    };
+    let mut checked = 0;
+    for tick in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let coupled = run.machine.axes().axis(SLAVE).unwrap().coupling().is_some();
+        if coupled && (1600..3000).contains(&tick) {
+            let m = set(&run, MASTER).position;
+            let expected = 0.5 + 2.0 * zigzag(m);
+            assert!(
+                (set(&run, SLAVE).position - expected).abs() < 1e-9,
+                "tick {tick}, drum {m}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 1400);
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert_eq!(
+        read_values(&report, "read"),
+        vec![0.0, 0.0, 40.0, 4.0, 100.0, 5.0]
+    );
+    // Non-equidistant: the slave position only (seed 5.1.7).
+    assert_eq!(read_values(&report, "slavepos"), vec![2.0, 0.0, 0.0]);
+    for (done, kind) in [
+        ("release", "CamTableCoupleAxes"),
+        ("delete21", "CamTableDelete"),
+        ("delete22", "CamTableDelete"),
+    ] {
+        assert!(
+            report.contains(&format!("block {done} ({kind} on gpAx[1]): Done")),
+            "{report}"
+        );
+    }
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+}

@@ -70,6 +70,8 @@ pub enum CallKind {
     CamMultiCouple,
     /// [`CamMultiTableCall`].
     CamMultiTable,
+    /// [`CamTableDeleteCall`].
+    CamTableDelete,
 }
 
 impl CallKind {
@@ -90,6 +92,7 @@ impl CallKind {
             CallKind::CamTableWeight => 19,
             CallKind::CamMultiCouple => 20,
             CallKind::CamMultiTable => 21,
+            CallKind::CamTableDelete => 22,
         }
     }
 
@@ -110,6 +113,7 @@ impl CallKind {
             19 => Some(CallKind::CamTableWeight),
             20 => Some(CallKind::CamMultiCouple),
             21 => Some(CallKind::CamMultiTable),
+            22 => Some(CallKind::CamTableDelete),
             _ => None,
         }
     }
@@ -315,7 +319,7 @@ pub struct CamScalingCall {
     pub master_scaling_mode: u32,
     /// Raw `MC_CamScalingMode` of the slave.
     pub slave_scaling_mode: u32,
-    /// Reserved, 0.
+    /// Values left as they are ([`CAM_KEEP_MASTER_SCALING`] ...); 0 for MC_CamScaling.
     pub reserved: u32,
     /// Activation position of the positional activation modes.
     pub activation_position: f64,
@@ -454,6 +458,39 @@ pub struct CamOnlineModeCall {
     pub reserved: u32,
     /// Activation position of the positional modes.
     pub activation_position: f64,
+}
+
+/// Bit of [`CamRowsWriteCall::flags`]: with `count` 0, declares table `target` (type,
+/// cyclic, `total` rows) for rows that follow with `table_type` 0 (CamTableCreate, then
+/// CamTableWriteData).
+pub const CAM_ROWS_DECLARE: u32 = 2;
+
+/// Bits of [`CamScalingCall::reserved`]: values the call leaves as they are (the
+/// compatibility blocks that change offsets or scalings alone): master scaling, slave
+/// scaling, master offset, slave offset.
+pub const CAM_KEEP_MASTER_SCALING: u32 = 1;
+/// See [`CAM_KEEP_MASTER_SCALING`].
+pub const CAM_KEEP_SLAVE_SCALING: u32 = 2;
+/// See [`CAM_KEEP_MASTER_SCALING`].
+pub const CAM_KEEP_MASTER_OFFSET: u32 = 4;
+/// See [`CAM_KEEP_MASTER_SCALING`].
+pub const CAM_KEEP_SLAVE_OFFSET: u32 = 8;
+
+/// [`CamReadCall::what`]: CamTableReadData of the table given as `target`: its rows
+/// `[master, slave]`, row after row (position tables only).
+pub const CAM_READ_ROWS: u32 = 5;
+
+/// CamTableDelete for the table given as `target` (refused while a coupling uses it).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct CamTableDeleteCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+impl AcyclicCall for CamTableDeleteCall {
+    const KIND: CallKind = CallKind::CamTableDelete;
+    type Reply = CamReply;
 }
 
 /// Rows of a position table that fit one call.

@@ -31,6 +31,7 @@ use crate::cam::{
     McCamOut, McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction,
     McSetCamOnlineChangeMode, McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
 };
+use crate::cam_compat::{CompatBlock, CompatConfig};
 use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
@@ -39,7 +40,7 @@ use hli::calls::McMotionFunctionPoint;
 use std::sync::Arc;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 25] = [
+pub const BLOCKS: [&str; 36] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -65,6 +66,17 @@ pub const BLOCKS: [&str; 25] = [
     "CamTableCoupleAxesMultiTables",
     "CamTableEnableCorrectionTable",
     "CamTableDeactivateCyclicTable",
+    "CamTableGenerate",
+    "CamTableCreate",
+    "CamTableWriteData",
+    "CamTableReadData",
+    "CamTableReadSlavePos",
+    "CamTableDelete",
+    "CamTableCoupleAxes",
+    "CamTableCoupleAxesIpol",
+    "CamTableOffsetChange",
+    "CamTableSetSlaveScale",
+    "CamTableSetMasterSlaveScale",
 ];
 
 /// The outputs a `wait` can name.
@@ -100,6 +112,7 @@ enum Block {
     SetWeight(Box<CamTableSetWeight>),
     MultiCouple(Box<CamTableCoupleAxesMultiTables>),
     MultiTable(Box<CamMultiTable>),
+    Compat(Box<CompatBlock>),
 }
 
 /// A boolean output of a block.
@@ -166,10 +179,12 @@ enum Input {
     Profiles(u32),
     On(bool),
     AtPosition(bool),
+    /// A compatibility block's whole configuration.
+    Compat(Arc<CompatConfig>),
 }
 
 /// `rows = [[master, slave], ...]`.
-fn rows_of(value: &toml::Value) -> Result<Arc<[[f64; 2]]>, String> {
+pub(crate) fn rows_of(value: &toml::Value) -> Result<Arc<[[f64; 2]]>, String> {
     let bad = || "call: `rows` must be [[master, slave], ...] of finite numbers".to_string();
     let list = value.as_array().ok_or_else(bad)?;
     list.iter()
@@ -480,9 +495,24 @@ impl Instances {
         };
         let mut inputs = Vec::new();
         let mut execute = true;
+        let compat = crate::cam_compat::COMPAT_BLOCKS
+            .iter()
+            .chain([crate::cam_compat::COMPAT_MASTER_SLAVE_SCALE].iter())
+            .find(|b| **b == kind)
+            .copied();
+        if let Some(kind) = compat {
+            let config = crate::cam_compat::parse(kind, table)?;
+            if kind == "CamTableReadData" {
+                inputs.push(Input::Room(config.room));
+            }
+            inputs.push(Input::Compat(Arc::new(config)));
+        }
         for (key, value) in table {
             if ["block", "instance", "axis"].contains(&key.as_str()) {
                 continue;
+            }
+            if compat.is_some() && key != "execute" {
+                continue; // checked by cam_compat::parse
             }
             if key == "execute" && kind != "MC_Power" {
                 execute = value
@@ -827,6 +857,10 @@ impl Instances {
                     b.call(io, axis);
                     (cam_outputs(b.out), false)
                 }
+                Block::Compat(b) => {
+                    b.call(io, axis);
+                    (cam_outputs(b.out), false)
+                }
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
@@ -884,6 +918,7 @@ impl Instances {
             // What a read block read, as it stands after the last cycle.
             let read: Option<Vec<f64>> = match &inst.block {
                 Block::Read(b) => Some(b.values.clone()),
+                Block::Compat(b) => Some(b.read.values.clone()),
                 Block::ReadFunction(b) => Some(
                     b.points
                         .iter()
@@ -1002,6 +1037,16 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
             b.op = hli::calls::CAM_MULTI_STOP_CYCLIC;
             Block::MultiTable(b)
         }
+        compat if compat.starts_with("CamTable") => {
+            let kind = BLOCKS
+                .iter()
+                .find(|b| **b == compat)
+                .copied()
+                .unwrap_or("CamTableDelete");
+            let mut config = CompatConfig::new(kind);
+            config.room = room;
+            Block::Compat(Box::new(CompatBlock::new(Arc::new(config))))
+        }
         _ => Block::Stop(McStop::default()),
     }
 }
@@ -1027,6 +1072,7 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::SetWeight(b) => Some(&mut b.execute),
         Block::MultiCouple(b) => Some(&mut b.execute),
         Block::MultiTable(b) => Some(&mut b.execute),
+        Block::Compat(b) => Some(&mut b.execute),
     }
 }
 
@@ -1135,6 +1181,7 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::MultiTable(b), Input::Table(v)) => b.table = v,
         (Block::MultiTable(b), Input::AtPosition(v)) => b.at_position = v,
         (Block::MultiTable(b), Input::Position(v)) => b.position = v,
+        (Block::Compat(b), Input::Compat(config)) => b.config = config,
 
         // parse_call admits only the inputs of the block.
         _ => {}

@@ -4,6 +4,7 @@
 
 pub mod blocks;
 pub mod cam;
+pub mod cam_compat;
 pub mod cli;
 pub mod motion;
 pub mod programs;

@@ -159,6 +159,11 @@ impl PositionTable {
         self.master.iter().zip(&self.slave).map(|(m, s)| [*m, *s])
     }
 
+    /// Row `i`, if there is one.
+    pub fn row_at(&self, i: usize) -> Option<[f64; 2]> {
+        Some([*self.master.get(i)?, *self.slave.get(i)?])
+    }
+
     /// Number of rows.
     pub fn len(&self) -> usize {
         self.master.len()

@@ -33,11 +33,13 @@ use crate::cam::{
 use hli::calls::{
     decode_body, reply, CallKind, CamInCall, CamMultiCoupleCall, CamMultiTableCall,
     CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
-    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableSelectCall,
-    CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult, McMotionFunctionPoint,
-    CAM_CHUNK_LAST, CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE,
-    CAM_POINTS_PER_CALL, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
-    CAM_READ_VALUES, CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
+    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
+    CamTableSelectCall, CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult,
+    McMotionFunctionPoint, CAM_CHUNK_LAST, CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING,
+    CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING, CAM_MULTI_ENABLE_CORRECTION,
+    CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL, CAM_READ_CHARACTERISTICS,
+    CAM_READ_INFO, CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES, CAM_ROWS_DECLARE,
+    CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
 };
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
@@ -135,6 +137,9 @@ pub struct CamEngine {
     online_scaling: Vec<(ScalingMode, ScalingMode)>,
     points_in: Vec<Option<PointsTransfer>>,
     rows_in: Vec<Option<RowsTransfer>>,
+    /// Tables declared (CamTableCreate) for rows that follow: type, interpolation, cyclic,
+    /// rows.
+    declared: Vec<Option<(u32, u32, u32, u32)>>,
     slaves: Vec<Option<Slave>>,
     /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
     retired: Vec<CamProfile>,
@@ -173,6 +178,7 @@ impl CamEngine {
             online_scaling: vec![(ScalingMode::UserDefined, ScalingMode::UserDefined); TABLE_SLOTS],
             points_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
+            declared: vec![None; TABLE_SLOTS],
             slaves: (0..axes).map(|_| None).collect(),
             retired: Vec::with_capacity(8),
         }
@@ -677,12 +683,41 @@ impl CamEngine {
     }
 
     fn rows_write(&mut self, request: &AcyclicRequest) -> HandlerResult {
-        let call: CamRowsWriteCall = decode_body(request)?;
+        let mut call: CamRowsWriteCall = decode_body(request)?;
         let id = request.target;
         if !(1..=255).contains(&id) {
             return code(TABLE_INVALID);
         }
         let slot = id as usize;
+        if call.flags & CAM_ROWS_DECLARE != 0 {
+            // CamTableCreate: the table's type and size, for the rows that follow.
+            if call.count != 0 || call.total < 2 {
+                return code(TableErrorCode::NumRowsInvalid as u32);
+            }
+            if !matches!(call.table_type, 10 | 11) {
+                return code(TableErrorCode::McTableTypeInvalid as u32);
+            }
+            self.declared[slot] = Some((
+                call.table_type,
+                call.interpolation,
+                call.periodic,
+                call.total,
+            ));
+            self.rows_in[slot] = None;
+            return accepted();
+        }
+        if call.table_type == 0 {
+            // Rows for a declared table (CamTableWriteData).
+            let Some((table_type, interpolation, periodic, total)) = self.declared[slot] else {
+                return code(TableErrorCode::McTableTypeInvalid as u32);
+            };
+            if call.total > total {
+                return code(TableErrorCode::NumRowsInvalid as u32);
+            }
+            call.table_type = table_type;
+            call.interpolation = interpolation;
+            call.periodic = periodic;
+        }
         let count = call.count as usize;
         if count == 0 || count > CAM_ROWS_PER_CALL || call.total == 0 {
             self.rows_in[slot] = None;
@@ -827,6 +862,20 @@ impl CamEngine {
                 made_from = skip;
                 Ok((values, total))
             }),
+            CAM_READ_ROWS => match profile(id) {
+                Ok(CamProfile::Table(t)) => {
+                    let total = t.len() * 2;
+                    columns = 2;
+                    made_from = skip;
+                    // Only the rows of this part.
+                    let values: Vec<f64> = (skip..(skip + CAM_VALUES_PER_REPLY).min(total))
+                        .filter_map(|i| t.row_at(i / 2).map(|r| r[i % 2]))
+                        .collect();
+                    Ok((values, total))
+                }
+                Ok(_) => Err(TableErrorCode::McTableTypeInvalid as u32),
+                Err(e) => Err(e),
+            },
             CAM_READ_INFO => self.info(id as usize, &call, axes).map(|v| {
                 let n = v.len();
                 (v, n)
@@ -980,6 +1029,25 @@ impl CamEngine {
         ])
     }
 
+    fn table_delete(&mut self, request: &AcyclicRequest) -> HandlerResult {
+        let _: CamTableDeleteCall = decode_body(request)?;
+        let id = request.target;
+        if self.store.get(id).is_err() {
+            return code(TABLE_INVALID);
+        }
+        if self.in_use(id) {
+            return code(CamCouplingError::TableInUse.raw());
+        }
+        if let Ok(old) = self.store.remove(id) {
+            drop(old);
+        }
+        let slot = id as usize;
+        self.selects[slot] = None;
+        self.declared[slot] = None;
+        self.weights[slot] = TableWeight::default();
+        accepted()
+    }
+
     fn cam_out(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
         let _: CamOutCall = decode_body(request)?;
         let slave = request.target as usize;
@@ -1032,15 +1100,25 @@ impl CamEngine {
         if activation == Activation::Off {
             return accepted();
         }
-        // Only the sides that take part must be usable.
+        // Only the sides that take part must be usable; the keep bits (the compatibility
+        // blocks) leave single values as they are.
         let mut scaling = state.law.scaling;
+        let keep = |bit: u32| call.reserved & bit != 0;
         if master_mode != ScalingMode::Off {
-            scaling.master_offset = call.master_offset;
-            scaling.master_scaling = call.master_scaling;
+            if !keep(CAM_KEEP_MASTER_OFFSET) {
+                scaling.master_offset = call.master_offset;
+            }
+            if !keep(CAM_KEEP_MASTER_SCALING) {
+                scaling.master_scaling = call.master_scaling;
+            }
         }
         if slave_mode != ScalingMode::Off {
-            scaling.slave_offset = call.slave_offset;
-            scaling.slave_scaling = call.slave_scaling;
+            if !keep(CAM_KEEP_SLAVE_OFFSET) {
+                scaling.slave_offset = call.slave_offset;
+            }
+            if !keep(CAM_KEEP_SLAVE_SCALING) {
+                scaling.slave_scaling = call.slave_scaling;
+            }
         }
         if let Err(e) = scaling.check() {
             return code(coupling_code(e));
@@ -1255,6 +1333,7 @@ impl Engine for CamEngine {
             CallKind::CamTableWeight => self.table_weight(request),
             CallKind::CamMultiCouple => self.multi_couple(request, axes),
             CallKind::CamMultiTable => self.multi_table(request),
+            CallKind::CamTableDelete => self.table_delete(request),
             _ => return None,
         })
     }

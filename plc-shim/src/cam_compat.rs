@@ -1,0 +1,370 @@
+//! The compatibility blocks of seed 000, chapter 5.2.1 and 5.2.2 (the older CamTable...
+//! blocks), as thin wrappers over the calls of the chapter 5.1 blocks: each sends on its
+//! rising edge (bExecute, or bCoupleOn / bCoupleOff) and reports Busy, Err and ErrId. The
+//! multi-table blocks of 5.2.3 live with the others in [`crate::cam`].
+//!
+//! | block | what it sends |
+//! | --- | --- |
+//! | CamTableGenerate | the rows, in chunks (type 1..4: equidistant or not, linear or cyclic) |
+//! | CamTableCreate | the table's type and size, for the rows of CamTableWriteData |
+//! | CamTableWriteData | the rows of a created table, in chunks |
+//! | CamTableReadData | a read of the table's rows |
+//! | CamTableReadSlavePos | a read of the slave position at a master position |
+//! | CamTableDelete | the deletion |
+//! | CamTableCoupleAxes(Ipol) | MC_CamIn (start mode from the two absolute flags) / MC_CamOut |
+//! | CamTableOffsetChange | MC_CamScaling of the two offsets, at once |
+//! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
+//! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
+
+use crate::cam::{CamCore, CamData, CamOutputs, Chunker, McCamRead, Transfer};
+use crate::runtime::PlcIo;
+use hli::calls::{
+    CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
+    CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
+    CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,
+};
+use std::sync::Arc;
+
+/// The names, for the timeline.
+pub const COMPAT_BLOCKS: [&str; 10] = [
+    "CamTableGenerate",
+    "CamTableCreate",
+    "CamTableWriteData",
+    "CamTableReadData",
+    "CamTableReadSlavePos",
+    "CamTableDelete",
+    "CamTableCoupleAxes",
+    "CamTableCoupleAxesIpol",
+    "CamTableOffsetChange",
+    "CamTableSetSlaveScale",
+];
+
+/// One more: listed apart so the array above stays readable.
+pub const COMPAT_MASTER_SLAVE_SCALE: &str = "CamTableSetMasterSlaveScale";
+
+/// What a compatibility block is told, checked when the timeline is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompatConfig {
+    /// Which block.
+    pub kind: &'static str,
+    /// iTableId.
+    pub table: u32,
+    /// iTableType 1..4 (equidistant linear, equidistant cyclic, non-equidistant linear,
+    /// non-equidistant cyclic).
+    pub table_type: u32,
+    /// iNrOfRows of CamTableCreate.
+    pub rows_declared: u32,
+    /// The rows of CamTableGenerate and CamTableWriteData.
+    pub rows: Option<Arc<[[f64; 2]]>>,
+    /// iMasterId.
+    pub master: u32,
+    /// Offsets, slopes (scalings) and the master position of a read.
+    pub master_offset: f64,
+    /// Slave offset.
+    pub slave_offset: f64,
+    /// Master slope (scaling).
+    pub master_slope: f64,
+    /// Slave slope (scaling).
+    pub slave_slope: f64,
+    /// fMasterPos of CamTableReadSlavePos.
+    pub master_pos: f64,
+    /// bMasterAbsolut, bSlaveAbsolut.
+    pub master_absolute: bool,
+    /// See `master_absolute`.
+    pub slave_absolute: bool,
+    /// iIpolType.
+    pub interpolation: u32,
+    /// CoupleOn (TRUE) or CoupleOff (FALSE) for the coupling blocks.
+    pub on: bool,
+    /// Room for a read's numbers.
+    pub room: usize,
+}
+
+impl CompatConfig {
+    /// The defaults of block `kind` (absolute, slopes 1, default read room).
+    pub fn new(kind: &'static str) -> CompatConfig {
+        CompatConfig {
+            kind,
+            table: 0,
+            table_type: 3,
+            rows_declared: 0,
+            rows: None,
+            master: 0,
+            master_offset: 0.0,
+            slave_offset: 0.0,
+            master_slope: 1.0,
+            slave_slope: 1.0,
+            master_pos: 0.0,
+            master_absolute: true,
+            slave_absolute: true,
+            interpolation: 0,
+            on: true,
+            room: crate::cam::DEFAULT_READ_ROOM,
+        }
+    }
+}
+
+fn number(value: &toml::Value) -> Option<f64> {
+    match value {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+/// Checks the inputs of compatibility block `kind` in a timeline `call` table.
+pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, String> {
+    let allowed: &[&str] = match kind {
+        "CamTableGenerate" => &["table", "table_type", "rows"],
+        "CamTableCreate" => &["table", "table_type", "num_rows"],
+        "CamTableWriteData" => &["table", "rows"],
+        "CamTableReadData" => &["table", "room"],
+        "CamTableReadSlavePos" => &["table", "master_pos"],
+        "CamTableDelete" => &["table"],
+        "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => &[
+            "master",
+            "table",
+            "master_offset",
+            "slave_offset",
+            "master_absolute",
+            "slave_absolute",
+            "interpolation",
+            "on",
+        ],
+        "CamTableOffsetChange" => &["master_offset", "slave_offset"],
+        "CamTableSetSlaveScale" => &["slave_slope"],
+        _ => &[
+            "master_offset",
+            "slave_offset",
+            "master_slope",
+            "slave_slope",
+        ],
+    };
+    let mut c = CompatConfig::new(kind);
+    for (key, value) in table {
+        if ["block", "instance", "axis", "execute"].contains(&key.as_str()) {
+            continue;
+        }
+        if !allowed.contains(&key.as_str())
+            || (key == "interpolation" && kind == "CamTableCoupleAxes")
+        {
+            return Err(format!(
+                "call: {kind} has no input `{key}` (inputs: {})",
+                allowed.join(", ")
+            ));
+        }
+        let bad = || format!("call: {kind} input `{key}` = {value} is not valid");
+        let int = |lo: i64, hi: i64| {
+            value
+                .as_integer()
+                .filter(|v| (lo..=hi).contains(v))
+                .map(|v| v as u32)
+                .ok_or_else(bad)
+        };
+        let num = || number(value).filter(|v| v.is_finite()).ok_or_else(bad);
+        let flag = || value.as_bool().ok_or_else(bad);
+        match key.as_str() {
+            "table" => c.table = int(1, 255)?,
+            "table_type" => c.table_type = int(1, 4)?,
+            "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
+            "rows" => c.rows = Some(crate::blocks::rows_of(value)?),
+            "room" => c.room = int(1, 1 << 20)? as usize,
+            "master" => c.master = int(0, i64::from(u32::MAX))?,
+            "master_offset" => c.master_offset = num()?,
+            "slave_offset" => c.slave_offset = num()?,
+            "master_slope" => c.master_slope = num()?,
+            "slave_slope" => c.slave_slope = num()?,
+            "master_pos" => c.master_pos = num()?,
+            "master_absolute" => c.master_absolute = flag()?,
+            "slave_absolute" => c.slave_absolute = flag()?,
+            "interpolation" => c.interpolation = int(0, 2)?,
+            _ => c.on = flag()?,
+        }
+    }
+    Ok(c)
+}
+
+/// A compatibility block in a timeline: its configuration and its running state.
+#[derive(Debug)]
+pub struct CompatBlock {
+    /// Input: the edge (bExecute, or bCoupleOn / bCoupleOff by `config.on`).
+    pub execute: bool,
+    /// What it was told by the last call.
+    pub config: Arc<CompatConfig>,
+    /// Outputs (bBusy, bErr, iErrId; Done when finished).
+    pub out: CamOutputs,
+    /// A read's numbers (CamTableReadData: master, slave per row; ReadSlavePos: the slave
+    /// position first).
+    pub read: McCamRead,
+    execute_before: bool,
+    chunker: Chunker,
+    transferring: bool,
+    declare: CamCore<CamRowsWriteCall>,
+    delete: CamCore<CamTableDeleteCall>,
+    couple: CamCore<CamInCall>,
+    decouple: CamCore<CamOutCall>,
+    scale: CamCore<CamScalingCall>,
+}
+
+/// `iTableType` to the table type and whether it is cyclic.
+fn type_of(t: u32) -> (u32, bool) {
+    match t {
+        1 => (10, false),
+        2 => (10, true),
+        4 => (11, true),
+        _ => (11, false),
+    }
+}
+
+impl CompatBlock {
+    /// A block of `config`'s kind.
+    pub fn new(config: Arc<CompatConfig>) -> CompatBlock {
+        let (what, room) = match config.kind {
+            "CamTableReadSlavePos" => (CAM_READ_SLAVE_DYNAMICS, 3),
+            _ => (CAM_READ_ROWS, config.room.max(2)),
+        };
+        CompatBlock {
+            execute: false,
+            read: McCamRead::new(what, room),
+            config,
+            out: CamOutputs::default(),
+            execute_before: false,
+            chunker: Chunker::default(),
+            transferring: false,
+            declare: CamCore::default(),
+            delete: CamCore::default(),
+            couple: CamCore::default(),
+            decouple: CamCore::default(),
+            scale: CamCore::default(),
+        }
+    }
+
+    /// One cycle for slave axis `slave` (the coupling and scaling blocks' axis).
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let c = Arc::clone(&self.config);
+        let rising = self.execute && !self.execute_before;
+        self.execute_before = self.execute;
+        match c.kind {
+            "CamTableGenerate" | "CamTableWriteData" => {
+                if rising {
+                    self.chunker.reset();
+                    self.transferring = true;
+                }
+                if !self.transferring {
+                    if !self.execute {
+                        self.out = CamOutputs::default();
+                    }
+                    return;
+                }
+                let (table_type, periodic) = if c.kind == "CamTableGenerate" {
+                    type_of(c.table_type)
+                } else {
+                    (0, false) // as declared by CamTableCreate
+                };
+                let data = match &c.rows {
+                    Some(rows) => CamData::Rows {
+                        rows: Arc::clone(rows),
+                        table_type,
+                        interpolation: 0,
+                    },
+                    None => CamData::None,
+                };
+                self.out = match self.chunker.cycle(io, c.table, &data, false, periodic) {
+                    Transfer::Running => CamOutputs {
+                        busy: true,
+                        ..CamOutputs::default()
+                    },
+                    Transfer::Done => {
+                        self.transferring = false;
+                        CamOutputs {
+                            done: true,
+                            ..CamOutputs::default()
+                        }
+                    }
+                    Transfer::Failed(code) => {
+                        self.transferring = false;
+                        CamOutputs {
+                            error: true,
+                            error_id: code,
+                            ..CamOutputs::default()
+                        }
+                    }
+                };
+            }
+            "CamTableCreate" => {
+                let (table_type, periodic) = type_of(c.table_type);
+                let call = CamRowsWriteCall {
+                    flags: CAM_ROWS_DECLARE,
+                    total: c.rows_declared,
+                    table_type,
+                    periodic: u32::from(periodic),
+                    ..CamRowsWriteCall::default()
+                };
+                self.out = self.declare.cycle(io, self.execute, c.table, || call, None);
+            }
+            "CamTableDelete" => {
+                self.out =
+                    self.delete
+                        .cycle(io, self.execute, c.table, CamTableDeleteCall::default, None);
+            }
+            "CamTableReadData" | "CamTableReadSlavePos" => {
+                self.read.execute = self.execute;
+                self.read.target = c.table;
+                self.read.request.a = c.master_pos;
+                self.read.call(io);
+                self.out = self.read.out;
+            }
+            "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => {
+                let start_mode = match (c.master_absolute, c.slave_absolute) {
+                    (true, true) => 1,
+                    (false, false) => 2,
+                    (true, false) => 3,
+                    (false, true) => 4,
+                };
+                let call = CamInCall {
+                    master: c.master,
+                    table_id: c.table,
+                    start_mode,
+                    interpolation: c.interpolation,
+                    master_offset: c.master_offset,
+                    slave_offset: c.slave_offset,
+                    master_scaling: 1.0,
+                    slave_scaling: 1.0,
+                    ..CamInCall::default()
+                };
+                self.out = if c.on {
+                    let mut o = self
+                        .couple
+                        .cycle(io, self.execute, slave, || call, Some(slave));
+                    // The old block is done once the coupling stands (no InSync output).
+                    o.done = o.in_sync;
+                    o
+                } else {
+                    self.decouple
+                        .cycle(io, self.execute, slave, CamOutCall::default, None)
+                };
+            }
+            kind => {
+                let keep = match kind {
+                    "CamTableOffsetChange" => CAM_KEEP_MASTER_SCALING | CAM_KEEP_SLAVE_SCALING,
+                    "CamTableSetSlaveScale" => {
+                        CAM_KEEP_MASTER_SCALING | CAM_KEEP_MASTER_OFFSET | CAM_KEEP_SLAVE_OFFSET
+                    }
+                    _ => 0,
+                };
+                let call = CamScalingCall {
+                    activation_mode: 0,
+                    master_scaling_mode: 0,
+                    slave_scaling_mode: 0,
+                    reserved: keep,
+                    activation_position: 0.0,
+                    master_offset: c.master_offset,
+                    slave_offset: c.slave_offset,
+                    master_scaling: c.master_slope,
+                    slave_scaling: c.slave_slope,
+                };
+                self.out = self.scale.cycle(io, self.execute, slave, || call, None);
+            }
+        }
+    }
+}
