@@ -907,3 +907,131 @@ fn the_compatibility_blocks_make_read_couple_rescale_and_delete() {
     }
     assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
 }
+
+#[test]
+fn a_slave_may_follow_the_masters_actual_position() {
+    let mut run = machine("");
+    run.step(0.001);
+    let actual = CamInCall {
+        master_source: 1,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, actual), 0);
+    run_master(&mut run, 360.0);
+    let law = CamLaw::new(
+        &seed_cam(),
+        Scaling::default(),
+        StartMode::Absolute,
+        false,
+        0.0,
+        0.0,
+    );
+    let profile = seed_cam();
+    let mut differs = 0;
+    for _ in 0..300 {
+        run.step(0.001);
+        let master = run.machine.axes().axis(MASTER).unwrap();
+        let on_actual = law_at(
+            &law,
+            &profile,
+            Kinematic {
+                position: master.actual(),
+                ..Kinematic::default()
+            },
+        );
+        assert!((set(&run, SLAVE).position - on_actual.position).abs() < 1e-9);
+        let on_set = law_at(&law, &profile, master.setpoint());
+        differs += usize::from((on_set.position - on_actual.position).abs() > 1e-6);
+    }
+    assert!(
+        differs > 100,
+        "the actual position lags the set-point: {differs}"
+    );
+    let bad = CamInCall {
+        master_source: 2,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, 2, bad), CamCouplingError::BadParameter.raw());
+}
+
+#[test]
+fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
+    use hli::calls::CamScalingCall;
+    // (mode, position, the master position from which the new scaling must show)
+    let cases = [
+        (0u32, 0.0, 0.0),
+        (1, 200.0, 200.0),
+        (2, 560.0, 560.0),
+        (3, 0.0, 360.0),
+    ];
+    for (mode, position, from) in cases {
+        let mut run = machine("");
+        run.step(0.001);
+        let select = CamTableSelectCall {
+            periodic: 1,
+            master_absolute: 1,
+            slave_absolute: 1,
+            reserved: 0,
+        };
+        assert_eq!(call(&mut run, 1, select), 0);
+        assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+        run_master(&mut run, 360.0);
+        for _ in 0..400 {
+            run.step(0.001);
+        }
+        let m0 = set(&run, MASTER).position;
+        // Slave scaling 0.5 with slave auto-offset: no jump at the activation.
+        let scaling = CamScalingCall {
+            activation_mode: mode,
+            activation_position: position,
+            master_scaling_mode: 2,
+            slave_scaling_mode: 1,
+            master_scaling: 1.0,
+            slave_scaling: 0.5,
+            ..CamScalingCall::default()
+        };
+        assert_eq!(call(&mut run, SLAVE as u32, scaling), 0, "mode {mode}");
+        let law = CamLaw::new(
+            &seed_cam(),
+            Scaling::default(),
+            StartMode::Absolute,
+            true,
+            0.0,
+            0.0,
+        );
+        let profile = seed_cam();
+        let mut last = set(&run, SLAVE).position;
+        let mut switched_at = None;
+        for _ in 0..1500 {
+            run.step(0.001);
+            let m = set(&run, MASTER);
+            let p = set(&run, SLAVE).position;
+            assert!(
+                (p - last).abs() < 0.35,
+                "mode {mode}: jump {} at {}",
+                p - last,
+                m.position
+            );
+            last = p;
+            let full = law_at(&law, &profile, m).position;
+            if switched_at.is_none() && (p - full).abs() > 1e-9 {
+                switched_at = Some(m.position);
+            }
+        }
+        let at = switched_at.unwrap_or_else(|| panic!("mode {mode} never took effect"));
+        // The master was at m0 when the command came; the change shows from `from` on (within
+        // the cam's flat stretches it cannot show earlier than it is seen).
+        let due = if mode == 0 { m0 } else { from };
+        let cam_at = |x: f64| x.rem_euclid(360.0);
+        let seen = if mode == 1 { cam_at(at) } else { at };
+        let expected = if mode == 1 { cam_at(due) } else { due };
+        assert!(
+            seen >= expected - 1e-9,
+            "mode {mode}: took effect at {at}, due at {due}"
+        );
+        assert!(
+            seen < expected + 60.0,
+            "mode {mode}: took effect at {at}, due at {due}"
+        );
+    }
+}

@@ -299,6 +299,11 @@ pub struct CamInCall {
     pub master_scaling: f64,
     /// Slave scaling.
     pub slave_scaling: f64,
+    /// What of the master the slave follows: 0 its set-point (the seed's rule, 5.1.4), 1 its
+    /// actual position (a master moved by hand or by a foreign drive).
+    pub master_source: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
 }
 
 /// MC_CamOut for the slave axis given as `target`.

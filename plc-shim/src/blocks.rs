@@ -179,6 +179,8 @@ enum Input {
     Profiles(u32),
     On(bool),
     AtPosition(bool),
+    /// MC_CamIn(Ext): follow the master's actual position.
+    MasterActual(bool),
     /// A compatibility block's whole configuration.
     Compat(Arc<CompatConfig>),
 }
@@ -439,6 +441,7 @@ impl Instances {
             "CamTableEnableCorrectionTable" => &["table", "at_position", "position"],
             "CamTableDeactivateCyclicTable" => &["table"],
             "MC_CamIn" => &[
+                "master_source",
                 "master",
                 "table",
                 "start_mode",
@@ -449,6 +452,7 @@ impl Instances {
                 "interpolation",
             ],
             "MC_CamInExt" => &[
+                "master_source",
                 "master",
                 "table",
                 "start_mode",
@@ -579,6 +583,15 @@ impl Instances {
                 ),
                 "at_master_position" => Input::AtMasterPosition(value.as_bool().ok_or_else(bad)?),
                 "on" => Input::On(value.as_bool().ok_or_else(bad)?),
+                "master_source" => match value.as_str() {
+                    Some("set_point") => Input::MasterActual(false),
+                    Some("actual") => Input::MasterActual(true),
+                    _ => {
+                        return Err(format!(
+                            "call: `master_source` = {value}: \"set_point\" or \"actual\""
+                        ))
+                    }
+                },
                 "at_position" => Input::AtPosition(value.as_bool().ok_or_else(bad)?),
                 "profiles" => Input::Profiles(
                     value
@@ -1114,6 +1127,7 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::CamIn(b), Input::MasterScaling(v)) => b.master_scaling = v,
         (Block::CamIn(b), Input::SlaveScaling(v)) => b.slave_scaling = v,
         (Block::CamIn(b), Input::Interpolation(v)) => b.interpolation = v,
+        (Block::CamIn(b), Input::MasterActual(v)) => b.master_actual = v,
         (Block::CamScaling(b), Input::ActivationMode(v)) => b.activation_mode = v,
         (Block::CamScaling(b), Input::ActivationPosition(v)) => b.activation_position = v,
         (Block::CamScaling(b), Input::MasterScalingMode(v)) => b.master_scaling_mode = v,

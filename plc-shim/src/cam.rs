@@ -270,6 +270,8 @@ pub struct McCamIn {
     pub interpolation: u32,
     /// MC_CamInExt rather than MC_CamIn.
     pub extended: bool,
+    /// Input: follow the master's actual position (else its set-point).
+    pub master_actual: bool,
     /// Outputs of the last call.
     pub out: CamOutputs,
     core: CamCore<CamInCall>,
@@ -292,6 +294,7 @@ impl Default for McCamIn {
             slave_scaling: 1.0,
             interpolation: 0,
             extended: false,
+            master_actual: false,
             out: CamOutputs::default(),
             core: CamCore::default(),
         }
@@ -315,6 +318,8 @@ impl McCamIn {
             slave_offset: self.slave_offset,
             master_scaling: self.master_scaling,
             slave_scaling: self.slave_scaling,
+            master_source: u32::from(self.master_actual),
+            reserved: 0,
         };
         self.out = self
             .core

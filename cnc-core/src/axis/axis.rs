@@ -122,6 +122,10 @@ impl Axis {
     pub fn actual(&self) -> f64 {
         self.actual
     }
+    /// The actual velocity (from the last two encoder readings).
+    pub fn actual_velocity(&self) -> f64 {
+        self.actual_velocity
+    }
     /// Set minus actual position of the last tick.
     pub fn following_error(&self) -> f64 {
         self.following_error

@@ -96,6 +96,23 @@ struct Slave {
     hold: f64,
     /// Master and slave set-points when the coupling became active (or was made).
     coupled_at: (f64, f64),
+    /// Follows the master's actual position rather than its set-point.
+    follow_actual: bool,
+}
+
+/// What of the master a slave follows: its set-point (the seed's rule) or its actual
+/// position and velocity.
+fn master_of(axes: &AxisSet, master: usize, actual: bool) -> Option<Kinematic> {
+    let a = axes.axis(master)?;
+    Some(if actual {
+        Kinematic {
+            position: a.actual(),
+            velocity: a.actual_velocity(),
+            ..Kinematic::default()
+        }
+    } else {
+        a.setpoint()
+    })
 }
 
 /// Points of a transfer received so far.
@@ -282,7 +299,7 @@ impl CamEngine {
         ) else {
             return code(CamCouplingError::UnknownMode.raw());
         };
-        if call.extended > 1 || !call.activation_position.is_finite() {
+        if call.extended > 1 || call.master_source > 1 || !call.activation_position.is_finite() {
             return code(CamCouplingError::BadParameter.raw());
         }
         let scaling = Scaling {
@@ -298,9 +315,9 @@ impl CamEngine {
             Ok(own) => own,
             Err(e) => return code(e),
         };
-        let master_set = match axes.axis(master) {
-            Some(a) => a.setpoint(),
-            None => return code(CamCouplingError::NoSuchMaster.raw()),
+        let follow_actual = call.master_source == 1;
+        let Some(master_set) = master_of(axes, master, follow_actual) else {
+            return code(CamCouplingError::NoSuchMaster.raw());
         };
         let master_auto = master_mode == ScalingMode::AutoOffset;
         // The master's direction of travel decides whether an axis position lies behind it.
@@ -402,6 +419,7 @@ impl CamEngine {
                     master_before: master_set.position,
                     hold,
                     coupled_at: (master_set.position, hold),
+                    follow_actual,
                 });
                 accepted()
             }
@@ -1181,7 +1199,7 @@ impl Engine for CamEngine {
                 .axis(i)
                 .and_then(|a| a.coupling())
                 .is_some_and(|c| c.kind == CouplingState::Cam);
-            let master = io.axes.axis(state.master).map(|a| a.setpoint());
+            let master = master_of(io.axes, state.master, state.follow_actual);
             let (true, Some(master)) = (still, master) else {
                 if let Some(gone) = self.slaves[i].take() {
                     self.retired.extend(gone.own);
