@@ -387,3 +387,24 @@ fn bad_scalings_are_refused_with_the_value() {
     }
     assert!(SCALED.check().is_ok());
 }
+
+#[test]
+fn a_slave_couples_in_the_base_cycle_wherever_the_master_stands() {
+    // Seed 5.1.4: coupled with the master three periods on, the stroke counts from there.
+    let p = ramp();
+    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 650.0, 0.0);
+    // x = (10 + 650) / 2 = 330: cycle 3, local 30; at coupling no stroke is added.
+    assert_eq!(slave(&law, &p, at(650.0)).position, 5.0 + 3.0 * 15.0);
+    assert_eq!(law.cycles_since_coupling(650.0), 0);
+    // One period later (200 master units): one stroke of 50, scaled.
+    assert_eq!(
+        slave(&law, &p, at(850.0)).position,
+        5.0 + 3.0 * (15.0 + 50.0)
+    );
+    assert_eq!(law.cycles_since_coupling(850.0), 1);
+    // Before the coupling position: the cycle before the base one.
+    assert_eq!(
+        slave(&law, &p, at(450.0)).position,
+        5.0 + 3.0 * (15.0 - 50.0)
+    );
+}

@@ -274,8 +274,9 @@ fn refusals_carry_their_code_and_leave_the_axes_alone() {
         call(&mut run, SLAVE as u32, ext),
         CamCouplingError::NotSwitchable.raw()
     );
-    // A scaling mode combination the seed forbids (master auto-offset with a relative
-    // master is checked in the law; here: an activation mode scalings do not take).
+    // Before the coupling is active (its activation comes with the next tick) a scaling is
+    // refused as pending; then a mode combination the seed forbids (an activation mode
+    // scalings do not take) with its own code.
     let bad_scaling = CamScalingCall {
         activation_mode: 7,
         master_scaling: 1.0,
@@ -284,7 +285,22 @@ fn refusals_carry_their_code_and_leave_the_axes_alone() {
     };
     assert_eq!(
         call(&mut run, SLAVE as u32, bad_scaling),
+        CamCouplingError::CouplingPending.raw()
+    );
+    run.step(0.001);
+    assert_eq!(
+        call(&mut run, SLAVE as u32, bad_scaling),
         CamCouplingError::ModeCombination.raw()
+    );
+    // The gear slave (axis 2) kept following its master through all of this.
+    assert_eq!(
+        run.machine
+            .axes()
+            .axis(2)
+            .unwrap()
+            .coupling()
+            .map(|c| c.kind),
+        Some(CouplingState::GearVelocity)
     );
 }
 
@@ -411,46 +427,31 @@ fn switching_cams_mid_cycle_with_auto_offsets_keeps_the_slave_continuous() {
 fn the_machine_tick_with_a_coupled_cam_slave_keeps_its_cycle_count_over_many_turns() {
     let mut run = machine("");
     run.step(0.001);
-    // The table's own spline, asked for by the coupling (the default is linear).
-    let spline = CamInCall {
-        interpolation: 2,
-        ..cam_in(2)
-    };
-    assert_eq!(call(&mut run, SLAVE as u32, spline), 0);
-    let select = CamTableSelectCall {
-        periodic: 1,
-        master_absolute: 1,
-        slave_absolute: 1,
-        reserved: 0,
-    };
-    assert_eq!(call(&mut run, 2, select), 0);
+    // A cyclic table with a stroke: 0..360 -> 0..10, linear, loaded over the acyclic service.
+    let rows: Vec<[f64; 2]> = (0..=36)
+        .map(|i| [i as f64 * 10.0, i as f64 * 10.0 / 36.0])
+        .collect();
+    for (k, chunk) in rows.chunks(hli::calls::CAM_ROWS_PER_CALL).enumerate() {
+        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+        let last = first + chunk.len() == rows.len();
+        let call = rows_chunk(chunk, first, rows.len(), last);
+        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 9, &call));
+        assert_eq!(reply.error_id, 0);
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(9)), 0);
     run_master(&mut run, 720.0);
     for _ in 0..60_000 {
         run.step(0.001);
     }
-    // 60 s at 720 deg/s after the ramp: about 120 turns; the stroke-free table keeps the
-    // slave within its range, following the law exactly.
+    // 60 s at 720 deg/s: about 120 turns. The slave climbed 10 per turn from the coupling
+    // (at the master's 0), exactly: the cycle counter neither lost nor gained a turn.
     let m = set(&run, MASTER);
     assert!(m.position > 360.0 * 100.0, "{}", m.position);
-    let text = std::fs::read(scenarios().join("cams/stroke_table.json")).unwrap();
-    let table = cnc_core::cam::file::parse(&text, Default::default())
-        .unwrap()
-        .profile;
-    let law = CamLaw::new(
-        &table,
-        Scaling::default(),
-        StartMode::Absolute,
-        true,
-        0.0,
-        0.0,
-    );
-    let expected = law_at(&law, &table, m).position;
+    let expected = m.position / 36.0;
     assert!(
-        (set(&run, SLAVE).position - expected).abs() < 1e-9,
-        "slave {} expected {expected} master {:?} error {:?}",
-        set(&run, SLAVE).position,
-        m,
-        run.machine.axes().axis(SLAVE).unwrap().error()
+        (set(&run, SLAVE).position - expected).abs() < 1e-6,
+        "slave {} expected {expected}",
+        set(&run, SLAVE).position
     );
     assert_eq!(
         run.machine
@@ -486,7 +487,12 @@ fn rows_chunk(
     let mut call = hli::calls::CamRowsWriteCall {
         first_row: first as u32,
         count: rows.len() as u32,
-        flags: if last { hli::calls::CAM_CHUNK_LAST } else { 0 },
+        flags: if last { hli::calls::CAM_CHUNK_LAST } else { 0 }
+            | if first == 0 {
+                hli::calls::CAM_CHUNK_FIRST
+            } else {
+                0
+            },
         total: total as u32,
         table_type: 10,
         interpolation: 0,
@@ -597,7 +603,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     let write = CamPointsWriteCall {
         first: 4,
         count: 1,
-        flags: hli::calls::CAM_CHUNK_LAST,
+        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
         total: 1,
         points,
     };

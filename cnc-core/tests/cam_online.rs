@@ -47,7 +47,7 @@ fn as_soon_as_possible_waits_for_an_untouched_segment() {
     // The slave is in the changed fall: not yet.
     assert!(q.take_due(moving(350.0, 360.0)).is_none());
     // Next cycle, in the first rest: applied.
-    let g = q.take_due(moving(5.0, 10.0)).expect("safe segment");
+    let (g, _) = q.take_due(moving(5.0, 10.0)).expect("safe segment");
     assert!(!q.is_queued());
     assert_eq!(g.segments()[3].end.y, -5.0);
 }
@@ -193,7 +193,7 @@ fn writes_build_on_what_is_queued() {
         cam: (399.0, 1.0),
         cycle_changed: true,
     };
-    let g = q.take_due(wrap).unwrap();
+    let (g, _) = q.take_due(wrap).unwrap();
     let ys: Vec<f64> = g.points().iter().map(|p| p.slave).collect();
     assert_eq!(
         ys,

@@ -144,7 +144,7 @@ fn writing_one_point_changes_the_whole_cam() {
         .write(&f, 4, &[change], MasterNow::standing(0.0))
         .unwrap();
     assert_eq!(outcome, WriteOutcome::Queued);
-    let g = queue
+    let (g, _) = queue
         .take_due(MasterNow::standing(0.0))
         .expect("instantaneous");
     // The line now climbs 40 over 90.

@@ -400,13 +400,17 @@ pub const CAM_POINTS_PER_CALL: usize = 4;
 /// Bit of [`CamPointsWriteCall::flags`] and [`CamRowsWriteCall::flags`]: the last chunk of
 /// the transfer; the CNC checks and takes the whole transfer now.
 pub const CAM_CHUNK_LAST: u32 = 1;
+/// Bit of [`CamPointsWriteCall::flags`] and [`CamRowsWriteCall::flags`]: the first chunk of
+/// a transfer; whatever an earlier transfer to the table left unfinished is dropped.
+pub const CAM_CHUNK_FIRST: u32 = 4;
 /// Bit of [`CamPointsWriteCall::flags`]: the points make a new motion function under the
 /// table ID (MC_CamTableSelect with data) instead of changing points of the existing one.
 pub const CAM_POINTS_CREATE: u32 = 2;
 
 /// A chunk of MC_WriteMotionFunction(Point) (or of a new motion function) for the table
 /// given as `target`. A transfer is `total` points from point `first` on, sent in chunks in
-/// order; nothing changes before its last chunk, which the CNC checks whole.
+/// order, the first flagged [`CAM_CHUNK_FIRST`]; nothing changes before its last chunk, which
+/// the CNC checks whole.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamPointsWriteCall {
@@ -414,7 +418,7 @@ pub struct CamPointsWriteCall {
     pub first: u32,
     /// Points in this chunk (1..=4).
     pub count: u32,
-    /// [`CAM_CHUNK_LAST`], [`CAM_POINTS_CREATE`].
+    /// [`CAM_CHUNK_FIRST`], [`CAM_CHUNK_LAST`], [`CAM_POINTS_CREATE`].
     pub flags: u32,
     /// Points of the whole transfer.
     pub total: u32,

@@ -161,6 +161,8 @@ hli_enum! {
         TableInUse = 0x4268,
         /// A chunk that does not continue its transfer (order, count, total).
         ChunkOutOfOrder = 0x4269,
+        /// MC_CamScaling or a switch while the first coupling still waits for its activation.
+        CouplingPending = 0x426A,
     }
 }
 

@@ -432,7 +432,7 @@ impl McWriteMotionFunctionPoint {
         let call = hli::calls::CamPointsWriteCall {
             first: self.point.point_index,
             count: 1,
-            flags: hli::calls::CAM_CHUNK_LAST,
+            flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
             total: 1,
             points,
         };
@@ -579,8 +579,12 @@ impl Chunker {
                 let mut call = hli::calls::CamRowsWriteCall {
                     first_row: self.next as u32,
                     count: chunk.len() as u32,
-                    flags: if self.next + chunk.len() == rows.len() {
+                    flags: (if self.next + chunk.len() == rows.len() {
                         hli::calls::CAM_CHUNK_LAST
+                    } else {
+                        0
+                    }) | if self.next == 0 {
+                        hli::calls::CAM_CHUNK_FIRST
                     } else {
                         0
                     },
@@ -610,6 +614,10 @@ impl Chunker {
                         0
                     }) | if create {
                         hli::calls::CAM_POINTS_CREATE
+                    } else {
+                        0
+                    } | if self.next == 0 {
+                        hli::calls::CAM_CHUNK_FIRST
                     } else {
                         0
                     },
@@ -873,7 +881,7 @@ impl McReadMotionFunction {
                     self.out = failed(0x4B31);
                     return;
                 }
-                let take = (reply.count as usize).min(wanted - self.points.len());
+                let take = (reply.count as usize).min(wanted.saturating_sub(self.points.len()));
                 self.points.extend_from_slice(&reply.points[..take]);
                 if self.points.len() >= wanted || reply.count == 0 {
                     self.out = CamOutputs {

@@ -8,8 +8,11 @@
 //! ```text
 //! x      = (MO + Pm - [Pmc]) / MS            cam master coordinate (unwrapped)
 //! local  = x folded into [first, first + period), cycle = how many periods were folded
-//! Ps     = [Psc] + SO + SS * (T(local) + SH * cycle)
+//! Ps     = [Psc] + SO + SS * (T(local) + SH * (cycle - cycle at coupling))
 //! ```
+//!
+//! The stroke counts from the coupling on: a slave always couples in the cam's base cycle
+//! (seed 5.1.4), wherever the master stands, and falls back into it when it couples again.
 //!
 //! Velocity, acceleration and jerk follow from the chain rule with the master's own
 //! derivatives, so a coupled slave moves as smoothly as its master and its profile allow.
@@ -253,6 +256,8 @@ pub struct CamLaw {
     first: f64,
     period: f64,
     stroke: f64,
+    /// The cycle the master was in at coupling (the base cycle).
+    cycle0: i64,
 }
 
 impl CamLaw {
@@ -275,8 +280,10 @@ impl CamLaw {
             first: 0.0,
             period: 0.0,
             stroke: 0.0,
+            cycle0: 0,
         };
         law.take_geometry(profile);
+        law.cycle0 = law.locate(master).cycle;
         law
     }
 
@@ -295,6 +302,11 @@ impl CamLaw {
     /// First master position of the cam and its master period (range).
     pub fn range(&self) -> (f64, f64) {
         (self.first, self.period)
+    }
+
+    /// Cycles of the cam since the coupling (the stroke counter) at master position `master`.
+    pub fn cycles_since_coupling(&self, master: f64) -> i64 {
+        self.locate(master).cycle - self.cycle0
     }
 
     /// Slave stroke per master period (raw, before the slave scaling).
@@ -347,7 +359,7 @@ impl CamLaw {
         } else {
             profile.eval(at.local, cursor)
         };
-        let y = raw.position + self.stroke * at.cycle as f64;
+        let y = raw.position + self.stroke * (at.cycle - self.cycle0) as f64;
         // Derivatives of the cam master coordinate in time.
         let xd = master.velocity / s.master_scaling;
         let xdd = master.acceleration / s.master_scaling;
@@ -420,6 +432,7 @@ impl CamLaw {
         if !switched {
             law.master_origin = self.master_origin;
             law.slave_origin = self.slave_origin;
+            law.cycle0 = self.cycle0;
         }
         if master_mode == ScalingMode::AutoOffset {
             let old = self.locate(master);
@@ -427,6 +440,9 @@ impl CamLaw {
             let x = law.first + share * law.period;
             let s = &mut law.scaling;
             s.master_offset = x * s.master_scaling - master + law.master_origin;
+            // The master's cycle in the new cam continues the count of the old one.
+            let old_cycles = self.locate(master).cycle - self.cycle0;
+            law.cycle0 = law.locate(master).cycle - old_cycles;
         }
         if slave_mode == ScalingMode::AutoOffset {
             let mut cursor = ProfileCursor::default();

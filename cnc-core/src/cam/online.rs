@@ -202,8 +202,9 @@ impl OnlineChangeQueue {
         Ok(WriteOutcome::Queued)
     }
 
-    /// The queued function if it is due now (and then no longer queued).
-    pub fn take_due(&mut self, now: MasterNow) -> Option<MotionFunction> {
+    /// The queued change if it is due now (and then no longer queued): the new function and
+    /// the ranges it changed (handed out whole, so a cyclic caller frees nothing).
+    pub fn take_due(&mut self, now: MasterNow) -> Option<(MotionFunction, Vec<(f64, f64)>)> {
         let pending = self.pending.as_ref()?;
         let due = match pending.mode {
             ActivationMode::AsSoonAsPossible => !pending
@@ -213,7 +214,7 @@ impl OnlineChangeQueue {
             mode => mode.due(now),
         };
         if due {
-            self.pending.take().map(|p| p.function)
+            self.pending.take().map(|p| (p.function, p.changed))
         } else {
             None
         }
@@ -265,6 +266,15 @@ pub fn changed_ranges(old: &MotionFunction, new: &MotionFunction) -> Vec<(f64, f
         }
     }
     out
+}
+
+/// What an applied change replaced: the old profile and the change's record.
+#[derive(Debug)]
+pub struct Replaced {
+    /// The profile before the change.
+    pub profile: CamProfile,
+    /// The master ranges the change touched.
+    pub changed: Vec<(f64, f64)>,
 }
 
 /// Cam tables by ID (1..=255), as the NC keeps them.
@@ -347,14 +357,15 @@ impl CamStore {
         queue.write(current, first, points, now)
     }
 
-    /// Applies the queued change of table `id` if it is due; the profile it replaced when it
-    /// was applied (handed back so that a cyclic caller can free it outside its cycle).
-    pub fn apply_due(&mut self, id: u32, now: MasterNow) -> Result<Option<CamProfile>, CamError> {
+    /// Applies the queued change of table `id` if it is due; what it replaced when it was
+    /// applied (handed back so that a cyclic caller can free it outside its cycle).
+    pub fn apply_due(&mut self, id: u32, now: MasterNow) -> Result<Option<Replaced>, CamError> {
         let (profile, queue) = self.tables[slot(id)?]
             .as_mut()
             .ok_or(CamError::NoSuchTable { id })?;
-        Ok(queue
-            .take_due(now)
-            .map(|f| core::mem::replace(profile, CamProfile::MotionFunction(f))))
+        Ok(queue.take_due(now).map(|(f, changed)| Replaced {
+            profile: core::mem::replace(profile, CamProfile::MotionFunction(f)),
+            changed,
+        }))
     }
 }

@@ -35,11 +35,11 @@ use hli::calls::{
     CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
     CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CamTableSelectCall, CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult,
-    McMotionFunctionPoint, CAM_CHUNK_LAST, CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING,
-    CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING, CAM_MULTI_ENABLE_CORRECTION,
-    CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL, CAM_READ_CHARACTERISTICS,
-    CAM_READ_INFO, CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES, CAM_ROWS_DECLARE,
-    CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
+    McMotionFunctionPoint, CAM_CHUNK_FIRST, CAM_CHUNK_LAST, CAM_KEEP_MASTER_OFFSET,
+    CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
+    CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL,
+    CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS,
+    CAM_READ_VALUES, CAM_ROWS_DECLARE, CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
 };
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
@@ -53,11 +53,10 @@ struct Select {
     periodic: bool,
 }
 
-/// What a coupling waits for.
+/// A change a coupling waits for (each kind in its own slot: a scaling does not drop a
+/// queued switch, nor the reverse).
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Queued {
-    /// The first coupling: the slave holds until the activation comes.
-    Couple(ActivationMode),
     /// A switch to another cam (MC_CamInExt while coupled).
     Switch {
         table: u32,
@@ -89,7 +88,12 @@ struct Slave {
     active: bool,
     /// Coupled with MC_CamInExt: may switch cams.
     extended: bool,
-    queued: Option<Queued>,
+    /// The first coupling's activation, while it waits (the slave holds).
+    waiting: Option<ActivationMode>,
+    /// A queued switch (`Queued::Switch`).
+    switch: Option<Queued>,
+    /// A queued rescaling (`Queued::Scale`).
+    scale: Option<Queued>,
     /// The master's set-point of the last tick.
     master_before: f64,
     /// Where the slave holds while it waits.
@@ -160,6 +164,8 @@ pub struct CamEngine {
     slaves: Vec<Option<Slave>>,
     /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
     retired: Vec<CamProfile>,
+    /// Motion functions a point change replaced, with their change records, freed alike.
+    retired_changes: Vec<crate::cam::online::Replaced>,
 }
 
 /// A refusal as the code the block reports.
@@ -197,7 +203,10 @@ impl CamEngine {
             rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             declared: vec![None; TABLE_SLOTS],
             slaves: (0..axes).map(|_| None).collect(),
-            retired: Vec::with_capacity(8),
+            // Room for every retirement between two calls: each slave lost (two profiles), a
+            // switch per slave, a point change per table in use.
+            retired: Vec::with_capacity(4 * axes + 8),
+            retired_changes: Vec::with_capacity(axes + 8),
         }
     }
 
@@ -339,6 +348,9 @@ impl CamEngine {
                 if !(current.extended && call.extended == 1) {
                     return code(CamCouplingError::NotSwitchable.raw());
                 }
+                if !current.active {
+                    return code(CamCouplingError::CouplingPending.raw());
+                }
                 if current.master != master {
                     return code(CamCouplingError::NoSuchMaster.raw());
                 }
@@ -349,8 +361,7 @@ impl CamEngine {
                 }
                 let current = self.slaves[slave].as_mut().expect("checked above");
                 if activation == Activation::DeleteQueuedData {
-                    if matches!(current.queued, Some(Queued::Switch { .. })) {
-                        current.queued = None;
+                    if current.switch.take().is_some() {
                         if let Some(old) = current.switch_own.take() {
                             self.retire(old);
                         }
@@ -361,7 +372,7 @@ impl CamEngine {
                     self.retire(old);
                 }
                 let current = self.slaves[slave].as_mut().expect("checked above");
-                current.queued = Some(Queued::Switch {
+                current.switch = Some(Queued::Switch {
                     table: call.table_id,
                     scaling,
                     modes: (master_mode, slave_mode),
@@ -372,6 +383,9 @@ impl CamEngine {
             }
             (Some(_), _) => code(AxisError::Coupled.raw()),
             (None, _) => {
+                // Whatever the engine still held for this axis is stale: the axis layer
+                // dropped the coupling (a fault, power off).
+                self.multis[slave] = None;
                 if let Err(e) = check_couple(activation, start, master_auto)
                     .and_then(|()| check_not_passed(activation, now))
                 {
@@ -415,7 +429,9 @@ impl CamEngine {
                     cursor: ProfileCursor::default(),
                     active: false,
                     extended: call.extended == 1,
-                    queued: Some(Queued::Couple(timing)),
+                    waiting: Some(timing),
+                    switch: None,
+                    scale: None,
                     master_before: master_set.position,
                     hold,
                     coupled_at: (master_set.position, hold),
@@ -429,7 +445,7 @@ impl CamEngine {
     /// Whether a coupling uses table `id` or switches to it.
     fn in_use(&self, id: u32) -> bool {
         self.slaves.iter().flatten().any(|s| {
-            s.table == id || matches!(s.queued, Some(Queued::Switch { table, .. }) if table == id)
+            s.table == id || matches!(s.switch, Some(Queued::Switch { table, .. }) if table == id)
         }) || self
             .multis
             .iter()
@@ -528,6 +544,10 @@ impl CamEngine {
         if let Err(e) = axis.couple(coupling) {
             return code(e.raw());
         }
+        if let Some(stale) = self.slaves[slave].take() {
+            self.retired.extend(stale.own);
+            self.retired.extend(stale.switch_own);
+        }
         self.multis[slave] = Some(MultiSlave { master, law });
         accepted()
     }
@@ -562,8 +582,9 @@ impl CamEngine {
     /// (standing at 0 when none does): what an online change's activation is checked against.
     fn master_now_of(&self, id: u32, axes: &AxisSet) -> MasterNow {
         for s in self.slaves.iter().flatten().filter(|s| s.table == id) {
-            if let Some(m) = axes.axis(s.master) {
-                return s.law.master_now(s.master_before, m.setpoint().position);
+            if let Some(m) = master_of(axes, s.master, s.follow_actual) {
+                // Between ticks the master's direction comes from its velocity.
+                return s.law.master_now(m.position - m.velocity * 1e-3, m.position);
             }
         }
         MasterNow::standing(0.0)
@@ -582,12 +603,22 @@ impl CamEngine {
             return code(TableErrorCode::NumPointsInvalid as u32);
         }
         let create = call.flags & CAM_POINTS_CREATE != 0;
-        let transfer = self.points_in[slot].get_or_insert_with(|| PointsTransfer {
-            first: call.first,
-            total: call.total,
-            create,
-            points: Vec::with_capacity(call.total.min(1 << 16) as usize),
-        });
+        if call.flags & CAM_CHUNK_FIRST != 0 {
+            // A new transfer: whatever an earlier one left unfinished goes.
+            if create && self.in_use(id) {
+                self.points_in[slot] = None;
+                return code(CamCouplingError::TableInUse.raw());
+            }
+            self.points_in[slot] = Some(PointsTransfer {
+                first: call.first,
+                total: call.total,
+                create,
+                points: Vec::with_capacity(call.total.min(1 << 16) as usize),
+            });
+        }
+        let Some(transfer) = self.points_in[slot].as_mut() else {
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        };
         let continues = transfer.total == call.total
             && transfer.create == create
             && call.first == transfer.first + transfer.points.len() as u32
@@ -628,8 +659,8 @@ impl CamEngine {
                 // A table no coupling uses takes an instantaneous change here (the ticks
                 // apply changes to coupled tables); a positional one waits for a coupling.
                 if !self.in_use(id) {
-                    if let Ok(Some(old)) = self.store.apply_due(id, now) {
-                        drop(old);
+                    if let Ok(Some(replaced)) = self.store.apply_due(id, now) {
+                        drop(replaced);
                     }
                 }
                 accepted()
@@ -741,13 +772,23 @@ impl CamEngine {
             self.rows_in[slot] = None;
             return code(TableErrorCode::NumRowsInvalid as u32);
         }
-        let transfer = self.rows_in[slot].get_or_insert_with(|| RowsTransfer {
-            total: call.total,
-            table_type: call.table_type,
-            interpolation: call.interpolation,
-            periodic: call.periodic,
-            rows: Vec::with_capacity(call.total.min(1 << 20) as usize),
-        });
+        if call.flags & CAM_CHUNK_FIRST != 0 {
+            // A new transfer, refused at once for a table in use.
+            if self.in_use(id) {
+                self.rows_in[slot] = None;
+                return code(CamCouplingError::TableInUse.raw());
+            }
+            self.rows_in[slot] = Some(RowsTransfer {
+                total: call.total,
+                table_type: call.table_type,
+                interpolation: call.interpolation,
+                periodic: call.periodic,
+                rows: Vec::with_capacity(call.total.min(1 << 20) as usize),
+            });
+        }
+        let Some(transfer) = self.rows_in[slot].as_mut() else {
+            return code(CamCouplingError::ChunkOutOfOrder.raw());
+        };
         let continues = transfer.total == call.total
             && transfer.table_type == call.table_type
             && transfer.interpolation == call.interpolation
@@ -973,7 +1014,7 @@ impl CamEngine {
             } else {
                 1.0
             };
-        let (scale_q, scale_mode, scale_modes) = match s.queued {
+        let (scale_q, scale_mode, scale_modes) = match s.scale {
             Some(Queued::Scale {
                 activation, modes, ..
             }) => (true, activation.raw(), modes),
@@ -989,7 +1030,7 @@ impl CamEngine {
             .map(|q| (q.is_queued(), q.mode().raw()))
             .unwrap_or((false, (0, 0.0)));
         let online = self.online_scaling[s.table as usize];
-        let (switch_q, switch_id, switch_mode, switch_modes) = match s.queued {
+        let (switch_q, switch_id, switch_mode, switch_modes) = match s.switch {
             Some(Queued::Switch {
                 table,
                 activation,
@@ -1108,6 +1149,9 @@ impl CamEngine {
         let Some(state) = self.slaves[slave].as_mut() else {
             return code(CamCouplingError::NotCamCoupled.raw());
         };
+        if !state.active {
+            return code(CamCouplingError::CouplingPending.raw());
+        }
         if let Err(e) = check_scaling(
             activation,
             state.law.start,
@@ -1155,12 +1199,66 @@ impl CamEngine {
         if let Err(e) = check_not_passed(activation, now) {
             return code(coupling_code(e));
         }
-        state.queued = Some(Queued::Scale {
+        state.scale = Some(Queued::Scale {
             scaling,
             modes: (master_mode, slave_mode),
             activation: activation.timing().expect("checked: a timed mode"),
         });
         accepted()
+    }
+}
+
+impl CamEngine {
+    /// Online changes of the motion functions coupled slaves run on, under each table's
+    /// mode: a change is due by the master of the first slave on its table and then taken by
+    /// every slave on it at once, each law rebuilt with the table's scaling modes (offsets
+    /// keep the master's place and the slave's position when they say so).
+    fn apply_point_changes(&mut self, axes: &AxisSet) {
+        for i in 0..self.slaves.len() {
+            let Some(s) = self.slaves[i].as_ref() else {
+                continue;
+            };
+            let table = s.table;
+            let queued = self.store.queue(table).is_ok_and(|q| q.is_queued());
+            if s.own.is_some() || !queued {
+                continue;
+            }
+            let Some(master) = master_of(axes, s.master, s.follow_actual) else {
+                continue;
+            };
+            let now = s.law.master_now(s.master_before, master.position);
+            let Ok(Some(old)) = self.store.apply_due(table, now) else {
+                continue;
+            };
+            let Ok(new) = self.store.get(table) else {
+                continue;
+            };
+            let modes = self.online_scaling[table as usize];
+            for other in self.slaves.iter_mut().flatten() {
+                if other.table != table || other.own.is_some() {
+                    continue;
+                }
+                let Some(m) = master_of(axes, other.master, other.follow_actual) else {
+                    continue;
+                };
+                let (before, _) = other
+                    .law
+                    .slave(&old.profile, &mut ProfileCursor::default(), &m);
+                let law = other.law;
+                other.law = law.rescaled(
+                    new,
+                    law.scaling,
+                    modes,
+                    law.start,
+                    law.periodic,
+                    m.position,
+                    before.position,
+                    false,
+                );
+                other.cursor = ProfileCursor::default();
+            }
+            self.retired_changes.push(old);
+        }
     }
 }
 
@@ -1189,6 +1287,7 @@ impl Engine for CamEngine {
                 axis.drive_coupled(set, AxisState::SlaveSynchronous);
             }
         }
+        self.apply_point_changes(io.axes);
         for i in 0..self.slaves.len() {
             let Some(state) = self.slaves[i].as_mut() else {
                 continue;
@@ -1208,56 +1307,33 @@ impl Engine for CamEngine {
                 continue;
             };
             let now = state.law.master_now(state.master_before, master.position);
-            // Online changes of the cam's points (motion functions) under their own mode; the
-            // table's scaling modes decide whether offsets keep the master's place and the
-            // slave's position across the change.
-            if state.own.is_none() {
-                if let Ok(Some(old)) = self.store.apply_due(state.table, now) {
-                    let (before, _) = state.law.slave(&old, &mut state.cursor, &master);
-                    if let Ok(p) = self.store.get(state.table) {
-                        let law = state.law;
-                        let modes = self.online_scaling[state.table as usize];
-                        state.law = law.rescaled(
-                            p,
-                            law.scaling,
-                            modes,
-                            law.start,
-                            law.periodic,
-                            master.position,
-                            before.position,
-                            false,
-                        );
-                    }
-                    state.cursor = ProfileCursor::default();
-                    self.retired.push(old);
-                }
-            }
             let Ok(stored) = self.store.get(state.table) else {
                 continue;
             };
             let profile = state.own.as_ref().unwrap_or(stored);
             let (mut set, _) = state.law.slave(profile, &mut state.cursor, &master);
-            match state.queued {
-                Some(Queued::Couple(timing)) if timing.due(now) => {
-                    // Relative sides start from here.
-                    state.law = CamLaw::new(
-                        profile,
-                        state.law.scaling,
-                        state.law.start,
-                        state.law.periodic,
-                        master.position,
-                        state.hold,
-                    );
-                    state.active = true;
-                    state.queued = None;
-                    state.coupled_at = (master.position, state.hold);
-                    set = state.law.slave(profile, &mut state.cursor, &master).0;
-                }
-                Some(Queued::Scale {
-                    scaling,
-                    modes,
-                    activation,
-                }) if activation.due(now) && state.active => {
+            if state.waiting.is_some_and(|t| t.due(now)) {
+                // Relative sides start from here; the cycle counter too.
+                state.law = CamLaw::new(
+                    profile,
+                    state.law.scaling,
+                    state.law.start,
+                    state.law.periodic,
+                    master.position,
+                    state.hold,
+                );
+                state.active = true;
+                state.waiting = None;
+                state.coupled_at = (master.position, state.hold);
+                set = state.law.slave(profile, &mut state.cursor, &master).0;
+            }
+            if let Some(Queued::Scale {
+                scaling,
+                modes,
+                activation,
+            }) = state.scale.filter(|_| state.active)
+            {
+                if activation.due(now) {
                     let law = state.law;
                     state.law = law.rescaled(
                         profile,
@@ -1269,16 +1345,19 @@ impl Engine for CamEngine {
                         set.position,
                         false,
                     );
-                    state.queued = None;
+                    state.scale = None;
                     set = state.law.slave(profile, &mut state.cursor, &master).0;
                 }
-                Some(Queued::Switch {
-                    table,
-                    scaling,
-                    modes,
-                    start,
-                    activation,
-                }) if activation.due(now) && state.active => {
+            }
+            if let Some(Queued::Switch {
+                table,
+                scaling,
+                modes,
+                start,
+                activation,
+            }) = state.switch.filter(|_| state.active)
+            {
+                if activation.due(now) {
                     let stored_next = self.store.get(table).ok();
                     if let Some(next) = state.switch_own.as_ref().or(stored_next) {
                         let periodic = match self.selects[table as usize] {
@@ -1308,9 +1387,20 @@ impl Engine for CamEngine {
                             self.retired.push(old);
                         }
                     }
-                    state.queued = None;
+                    state.switch = None;
                 }
-                _ => {}
+            }
+            // A law that cannot give a finite set-point (extreme scalings) releases the
+            // slave rather than pass the number on.
+            let finite = set.position.is_finite()
+                && set.velocity.is_finite()
+                && set.acceleration.is_finite()
+                && set.jerk.is_finite();
+            if !finite {
+                if let Some(axis) = io.axes.axis_mut(i) {
+                    axis.decouple();
+                }
+                continue;
             }
             let (set, phase) = if state.active {
                 (set, AxisState::SlaveSynchronous)
@@ -1338,6 +1428,7 @@ impl Engine for CamEngine {
     ) -> Option<HandlerResult> {
         // Between ticks: free what the ticks retired.
         self.retired.clear();
+        self.retired_changes.clear();
         Some(match kind {
             CallKind::CamTableSelect => self.table_select(request),
             CallKind::CamIn => self.cam_in(request, axes),
