@@ -408,3 +408,40 @@ fn a_slave_couples_in_the_base_cycle_wherever_the_master_stands() {
         5.0 + 3.0 * (15.0 - 50.0)
     );
 }
+
+#[test]
+fn master_auto_offset_keeps_the_share_when_switching_to_another_period() {
+    // From a 360 cam at 90 (25 % into its second cycle) to a 100 cam scaled by 2 (200 of the
+    // master per cycle): the master stands 25 % into the new cam's cycle, cycles counted on.
+    let p = wave();
+    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let master = 360.0 + 90.0;
+    let next = ramp();
+    let scaling = Scaling {
+        master_scaling: 2.0,
+        ..Scaling::default()
+    };
+    let modes = (ScalingMode::AutoOffset, ScalingMode::AutoOffset);
+    let before = slave(&law, &p, at(master)).position;
+    let switched = law.rescaled(
+        &next,
+        scaling,
+        modes,
+        StartMode::Absolute,
+        true,
+        master,
+        before,
+        true,
+    );
+    let c = switched.locate(master);
+    assert!((c.local - 25.0).abs() < 1e-9, "{c:?}");
+    assert_eq!(switched.cycles_since_coupling(master), 1);
+    // The slave does not jump, and the new cam runs 0.25 of a slave unit per master unit.
+    assert!((slave(&switched, &next, at(master)).position - before).abs() < 1e-9);
+    let later = slave(&switched, &next, at(master + 20.0)).position;
+    assert!(
+        (later - before - 20.0 * 0.5 / 2.0).abs() < 1e-9,
+        "{}",
+        later - before
+    );
+}

@@ -1027,16 +1027,19 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
         let at = switched_at.unwrap_or_else(|| panic!("mode {mode} never took effect"));
         // The master was at m0 when the command came; the change shows from `from` on (within
         // the cam's flat stretches it cannot show earlier than it is seen).
-        let due = if mode == 0 { m0 } else { from };
-        let cam_at = |x: f64| x.rem_euclid(360.0);
-        let seen = if mode == 1 { cam_at(at) } else { at };
-        let expected = if mode == 1 { cam_at(due) } else { due };
+        // AtMasterCamPos: the first time after the command that the master's place in the
+        // cam is `position` (in absolute master terms).
+        let due = match mode {
+            0 => m0,
+            1 => m0 + (position - m0.rem_euclid(360.0)).rem_euclid(360.0),
+            _ => from,
+        };
         assert!(
-            seen >= expected - 1e-9,
+            at >= due - 1e-9,
             "mode {mode}: took effect at {at}, due at {due}"
         );
         assert!(
-            seen < expected + 60.0,
+            at < due + 60.0,
             "mode {mode}: took effect at {at}, due at {due}"
         );
     }

@@ -82,6 +82,7 @@ fn profile_tables_in_series_and_in_parallel_give_the_weighted_sum() {
             spec(&s, 2, true, false, second),
         ],
         0.0,
+        0.0,
     )
     .unwrap();
     // Pm = 40: u = 30, T = 15, Ps = 2 (1 + 45) = 92; velocity 2 * 3 * 0.5 * 0.5 * 10.
@@ -102,6 +103,7 @@ fn profile_tables_in_series_and_in_parallel_give_the_weighted_sum() {
     let mut law = MultiTableLaw::new(
         &[spec(&s, 1, true, false, a), spec(&s, 2, true, false, b)],
         0.0,
+        0.0,
     )
     .unwrap();
     // Pm = 60: 0.25 * 30 + 0.75 * 6.
@@ -112,7 +114,7 @@ fn profile_tables_in_series_and_in_parallel_give_the_weighted_sum() {
         range_high: 50.0,
         ..TableWeight::default()
     };
-    let mut law = MultiTableLaw::new(&[spec(&s, 1, true, false, narrow)], 0.0).unwrap();
+    let mut law = MultiTableLaw::new(&[spec(&s, 1, true, false, narrow)], 0.0, 0.0).unwrap();
     let last = law.slave(&s, &at(49.0)).position;
     let beyond = law.slave(&s, &at(80.0));
     assert_eq!((beyond.position, beyond.velocity), (last, 0.0));
@@ -126,6 +128,7 @@ fn corrections_start_at_their_first_row_and_keep_what_they_added() {
             spec(&s, 1, true, false, TableWeight::default()),
             spec(&s, 3, false, false, TableWeight::default()),
         ],
+        0.0,
         0.0,
     )
     .unwrap();
@@ -163,6 +166,7 @@ fn a_cyclic_work_table_ends_at_its_boundary_and_the_stop_table_takes_over() {
             spec(&s, 2, true, true, TableWeight::default()),
             spec(&s, 4, true, false, stop),
         ],
+        0.0,
         0.0,
     )
     .unwrap();
@@ -232,16 +236,60 @@ fn bad_weights_and_counts_are_refused() {
             "range low",
         ),
     ] {
-        match MultiTableLaw::new(&[spec(&s, 1, true, false, w)], 0.0) {
+        match MultiTableLaw::new(&[spec(&s, 1, true, false, w)], 0.0, 0.0) {
             Err(MultiTableError::Parameter { what: got, .. }) => assert_eq!(got, what),
             other => panic!("{what}: {other:?}"),
         }
     }
     assert!(matches!(
-        MultiTableLaw::new(&[spec(&s, 3, false, false, TableWeight::default())], 0.0),
+        MultiTableLaw::new(
+            &[spec(&s, 3, false, false, TableWeight::default())],
+            0.0,
+            0.0
+        ),
         Err(MultiTableError::Count {
             tables: 1,
             profiles: 0
         })
     ));
+}
+
+#[test]
+fn a_correction_with_a_falling_slope_runs_its_table_backwards() {
+    let mut s = store();
+    s.insert(5, table(&[[0.0, 0.0], [5.0, 1.0], [10.0, 0.0]]))
+        .unwrap();
+    let backwards = TableWeight {
+        master_slope: -1.0,
+        ..TableWeight::default()
+    };
+    let mut law = MultiTableLaw::new(
+        &[
+            spec(&s, 1, true, false, TableWeight::default()),
+            spec(&s, 5, false, false, backwards),
+        ],
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    law.slave(&s, &at(10.0));
+    law.enable_correction(5, None).unwrap();
+    // From 10 on it runs from its last row down: +0.6 after 3 units, +1 after 5, gone after 10.
+    assert_eq!(law.slave(&s, &at(10.0)).position, 5.0);
+    assert!((law.slave(&s, &at(13.0)).position - (6.5 + 0.6)).abs() < 1e-12);
+    assert!((law.slave(&s, &at(15.0)).position - (7.5 + 1.0)).abs() < 1e-12);
+    assert!((law.slave(&s, &at(21.0)).position - 10.5).abs() < 1e-12);
+}
+
+#[test]
+fn coupled_outside_every_range_the_slave_stands_where_it_stood() {
+    let s = store();
+    let later = TableWeight {
+        range_low: 100.0,
+        range_high: 200.0,
+        ..TableWeight::default()
+    };
+    let mut law = MultiTableLaw::new(&[spec(&s, 1, true, false, later)], 0.0, 7.5).unwrap();
+    let p = law.slave(&s, &at(50.0));
+    assert_eq!((p.position, p.velocity), (7.5, 0.0));
 }

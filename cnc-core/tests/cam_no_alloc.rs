@@ -8,7 +8,7 @@ use cnc_core::cam::{
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
-use counting_alloc::allocations;
+use counting_alloc::{allocations, deallocations};
 
 #[test]
 fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
@@ -71,8 +71,9 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
     assert!(sum.is_finite());
 }
 
-/// The machine tick with a cam slave coupled to a running conveyor, through a rescaling that
-/// activates at a cycle boundary inside the measured ticks, allocates nothing.
+/// The machine tick with a cam slave coupled to a running conveyor, through a rescaling and
+/// an online point change that both apply at cycle boundaries inside the measured ticks,
+/// allocates and frees nothing (what a change replaces is freed with the next call).
 #[test]
 fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     use cnc_core::app::scenario::{InProcess, Scenario};
@@ -112,7 +113,56 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     run.machine
         .dispatch(&view, CamScalingCall::KIND, &request)
         .unwrap();
+    // A point change for the next cycle: point 4 of the seed's cam to 30.
+    let send =
+        |run: &mut InProcess, kind: hli::calls::CallKind, target: u32, body: ([u8; 240], u32)| {
+            let request = hli::wire::AcyclicRequest {
+                invoke_id: 10,
+                kind: kind.raw(),
+                target,
+                body_len: body.1,
+                body: body.0,
+            };
+            let view = hli::views::CncView::new(&run.memory);
+            let (reply, len) = run.machine.dispatch(&view, kind, &request).unwrap();
+            let reply: hli::calls::CamReply = bytemuck::pod_read_unaligned(&reply[..len as usize]);
+            assert_eq!(reply.error_id, 0);
+        };
+    let mode = hli::calls::CamOnlineModeCall {
+        activation_mode: 3,
+        ..Default::default()
+    };
+    send(
+        &mut run,
+        hli::calls::CallKind::CamOnlineMode,
+        1,
+        hli::wire::encode_body(&mode),
+    );
+    let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
+    points[0] = hli::calls::McMotionFunctionPoint {
+        point_index: 4,
+        function_type: 15,
+        point_type: 2,
+        rel_index_next_point: 1,
+        master_pos: 240.0,
+        slave_pos: 30.0,
+        ..Default::default()
+    };
+    let write = hli::calls::CamPointsWriteCall {
+        first: 4,
+        count: 1,
+        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    };
+    send(
+        &mut run,
+        hli::calls::CallKind::CamPointsWrite,
+        1,
+        hli::wire::encode_body(&write),
+    );
     let before = allocations();
+    let freed_before = deallocations();
     let mut top: f64 = 0.0;
     for tick in 0..3000 {
         run.machine.tick(&run.memory);
@@ -121,9 +171,11 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         }
     }
     let made = allocations() - before;
+    let freed = deallocations() - freed_before;
     assert_eq!(made, 0, "{made} allocations in 3000 machine ticks");
-    // The full stroke reaches about 42; the halved one about 21.
-    assert!(top > 15.0 && top < 25.0, "top of the last turn {top}");
+    assert_eq!(freed, 0, "{freed} frees in 3000 machine ticks");
+    // The full stroke reaches about 42; halved about 21; halved with point 4 at 30 about 15.
+    assert!(top > 12.0 && top < 17.0, "top of the last turn {top}");
     // Three turns of the conveyor went by, the stroke halved on the way.
     let lifter = run.machine.axes().axis(1).unwrap();
     assert_eq!(

@@ -285,7 +285,8 @@ pub struct CamInCall {
     pub master_scaling_mode: u32,
     /// Raw `MC_CamScalingMode` of the slave (MC_CamInExt; 0 for MC_CamIn).
     pub slave_scaling_mode: u32,
-    /// Raw `MC_InterpolationType` (tables only; 0 keeps the table's own).
+    /// Raw `MC_InterpolationType` of a table (0 linear, the seed's default; one other than
+    /// the stored table's gives the coupling its own copy). Motion functions ignore it.
     pub interpolation: u32,
     /// 1 for MC_CamInExt: the coupling may later switch to another cam.
     pub extended: u32,

@@ -11,6 +11,14 @@ thread_local! {
     /// Allocations made by this thread: the test harness's own threads may allocate while a
     /// test runs, which says nothing about the code under test.
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+    /// Frees made by this thread (a free in a cyclic path may take a lock as well).
+    static DEALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+/// Frees the current thread has made so far.
+#[allow(dead_code)] // not every test that includes this file counts frees
+pub fn deallocations() -> usize {
+    DEALLOCATIONS.with(Cell::get)
 }
 
 /// Allocations the current thread has made so far.
@@ -26,6 +34,7 @@ unsafe impl GlobalAlloc for Counting {
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        let _ = DEALLOCATIONS.try_with(|n| n.set(n.get() + 1));
         // SAFETY: same contract as the caller's.
         unsafe { System.dealloc(ptr, layout) }
     }

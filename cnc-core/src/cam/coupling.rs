@@ -212,16 +212,19 @@ impl Default for Scaling {
 }
 
 impl Scaling {
-    /// Refuses non-finite values and a master scaling of 0.
+    /// Refuses values that are not finite or so extreme that the law could overflow: offsets
+    /// beyond 1e12, a master scaling below 1e-6 or above 1e6 in magnitude (0 included), a
+    /// slave scaling above 1e6 in magnitude.
     pub fn check(&self) -> Result<(), CouplingError> {
         let values = [
-            ("master offset", self.master_offset),
-            ("slave offset", self.slave_offset),
-            ("master scaling", self.master_scaling),
-            ("slave scaling", self.slave_scaling),
+            ("master offset", self.master_offset, 0.0, 1e12),
+            ("slave offset", self.slave_offset, 0.0, 1e12),
+            ("master scaling", self.master_scaling, 1e-6, 1e6),
+            ("slave scaling", self.slave_scaling, 0.0, 1e6),
         ];
-        for (what, value) in values {
-            if !value.is_finite() || (what == "master scaling" && value == 0.0) {
+        for (what, value, min, max) in values {
+            let magnitude = value.abs();
+            if !(value.is_finite() && magnitude >= min && magnitude <= max) {
                 return Err(CouplingError::Parameter { what, value });
             }
         }

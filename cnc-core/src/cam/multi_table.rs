@@ -86,17 +86,19 @@ pub enum MultiTableError {
 
 impl TableWeight {
     /// Refuses NaN, a weight not above 0, a master slope of 0 and RL not below RH (ranges
-    /// may be open: infinite).
+    /// may be open: infinite), and magnitudes the law could overflow with (as
+    /// `coupling::Scaling::check`).
     pub fn check(&self) -> Result<(), MultiTableError> {
-        let finite = [
-            ("weight", self.weight),
-            ("master offset", self.master_offset),
-            ("master slope", self.master_slope),
-            ("slave offset", self.slave_offset),
-            ("slave slope", self.slave_slope),
+        let bounded = [
+            ("weight", self.weight, 0.0, 1e6),
+            ("master offset", self.master_offset, 0.0, 1e12),
+            ("master slope", self.master_slope, 0.0, 1e6),
+            ("slave offset", self.slave_offset, 0.0, 1e12),
+            ("slave slope", self.slave_slope, 0.0, 1e6),
         ];
-        for (what, value) in finite {
-            if !value.is_finite() {
+        for (what, value, min, max) in bounded {
+            let magnitude = value.abs();
+            if !(value.is_finite() && magnitude >= min && magnitude <= max) {
                 return Err(MultiTableError::Parameter { what, value });
             }
         }
@@ -104,7 +106,7 @@ impl TableWeight {
         if self.weight <= 0.0 {
             return refuse("weight", self.weight);
         }
-        if self.master_slope == 0.0 {
+        if self.master_slope.abs() < 1e-6 {
             return refuse("master slope", self.master_slope);
         }
         if self.range_low.is_nan() || self.range_high.is_nan() || self.range_low >= self.range_high
@@ -170,8 +172,13 @@ pub struct TableSpec<'a> {
 }
 
 impl MultiTableLaw {
-    /// The coupling of `tables` (profile tables first), with the master at `master`.
-    pub fn new(tables: &[TableSpec<'_>], master: f64) -> Result<MultiTableLaw, MultiTableError> {
+    /// The coupling of `tables` (profile tables first), with the master at `master` and the
+    /// slave at `slave` (where it stands while no profile table's range holds the master).
+    pub fn new(
+        tables: &[TableSpec<'_>],
+        master: f64,
+        slave: f64,
+    ) -> Result<MultiTableLaw, MultiTableError> {
         let profiles = tables.iter().filter(|t| t.profile).count();
         if tables.is_empty() || tables.len() > MAX_MULTI_TABLES || profiles == 0 {
             return Err(MultiTableError::Count {
@@ -208,7 +215,7 @@ impl MultiTableLaw {
         }
         Ok(MultiTableLaw {
             entries,
-            held: 0.0,
+            held: slave,
             kept: 0.0,
             master_before: master,
         })
@@ -273,9 +280,14 @@ impl MultiTableLaw {
                     continue;
                 };
                 let Some(p) = cam(e.table) else { continue };
-                let counts =
-                    e.profile && e.w.range_low <= m.position && m.position < e.w.range_high;
-                if !counts {
+                if !e.profile {
+                    continue;
+                }
+                if !(e.w.range_low <= m.position && m.position < e.w.range_high) {
+                    // Out of its range: its cycle count starts afresh when it comes back.
+                    if let Some(out) = self.entries[i].as_mut() {
+                        out.last_cycle = None;
+                    }
                     continue;
                 }
                 let (c, cycle) = contribution(&mut e, p, m);
@@ -341,7 +353,14 @@ impl MultiTableLaw {
             if e.run == Run::Running {
                 let u = e.w.master_offset + e.w.master_slope * m.position;
                 let (c, _) = contribution(&mut e, p, m);
-                if u >= e.first + e.period || u < e.first {
+                // Run through in the direction it runs: past its last row (rising slope) or
+                // its first (falling slope).
+                let through = if e.w.master_slope > 0.0 {
+                    u >= e.first + e.period
+                } else {
+                    u <= e.first
+                };
+                if through {
                     // Run through: what it added stays.
                     self.kept += c.position;
                     e.run = Run::Idle;
@@ -369,6 +388,10 @@ impl MultiTableLaw {
             return;
         };
         let Ok(p) = store.get(e.table) else { return };
+        if e.w.range_low <= at && at < e.w.range_high {
+            // Counting already (in parallel): it goes on as it is.
+            return;
+        }
         e.w.range_low = at;
         if e.w.range_high <= at {
             e.w.range_high = f64::INFINITY;

@@ -5,8 +5,8 @@
 //! ([`crate::cam::coupling::CamLaw`]); the axis stage does the rest (limits, following
 //! error, drive).
 //!
-//! Commands arrive as acyclic calls between ticks: MC_CamTableSelect (per table: cyclic,
-//! master and slave absolute), MC_CamIn / MC_CamInExt (couple, or with Ext switch cams),
+//! Commands arrive as acyclic calls between ticks: MC_CamTableSelect (per table: cyclic; its
+//! absolute flags are checked, MC_CamIn's start mode decides), MC_CamIn / MC_CamInExt (couple, or with Ext switch cams),
 //! MC_CamOut (the slave goes on at its velocity as a free axis) and MC_CamScaling; and the
 //! data: motion-function points written (a change under the table's online-change mode, or
 //! a new function) and read, position tables written, each in chunks that change nothing
@@ -515,6 +515,10 @@ impl CamEngine {
             let Ok(cam) = self.store.get(id) else {
                 return code(TABLE_INVALID);
             };
+            // Multi-table slaves run on position tables (seed 4.6.2).
+            if matches!(cam, CamProfile::MotionFunction(_)) {
+                return code(TableErrorCode::McTableTypeInvalid as u32);
+            }
             specs.push(TableSpec {
                 table: id,
                 profile: k < profiles,
@@ -526,7 +530,8 @@ impl CamEngine {
         let Some(m) = axes.axis(master).map(|a| a.setpoint()) else {
             return code(CamCouplingError::NoSuchMaster.raw());
         };
-        let law = match MultiTableLaw::new(&specs, m.position) {
+        let slave_at = axes.axis(slave).map_or(0.0, |a| a.setpoint().position);
+        let law = match MultiTableLaw::new(&specs, m.position, slave_at) {
             Ok(law) => law,
             Err(MultiTableError::Parameter { .. }) => {
                 return code(CamCouplingError::BadParameter.raw())

@@ -221,7 +221,11 @@ impl Machine {
         request: &AcyclicRequest,
     ) -> HandlerResult {
         // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
-        if self.stopped && kind != CallKind::ReadAxisState {
+        let read = matches!(
+            kind,
+            CallKind::ReadAxisState | CallKind::CamRead | CallKind::CamPointsRead
+        );
+        if self.stopped && !read {
             return Err(ErrorCode::Busy);
         }
         for engine in &mut self.engines {
