@@ -1044,3 +1044,60 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
         );
     }
 }
+
+#[test]
+fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
+    // (activation mode, position, start mode, expected: Ok(master position of the start) or
+    // Err(code))
+    let relative = CamCouplingError::ModeCombination.raw();
+    let cases: [(u32, f64, u32, Result<f64, u32>); 4] = [
+        (1, 100.0, 1, Ok(100.0)),
+        (3, 0.0, 1, Ok(360.0)),
+        (1, 100.0, 2, Err(relative)),
+        (3, 0.0, 4, Err(relative)),
+    ];
+    for (mode, position, start, expected) in cases {
+        let mut run = machine("");
+        run.step(0.001);
+        let select = CamTableSelectCall {
+            periodic: 1,
+            master_absolute: 1,
+            slave_absolute: 1,
+            reserved: 0,
+        };
+        assert_eq!(call(&mut run, 1, select), 0);
+        let coupling = CamInCall {
+            extended: 1,
+            activation_mode: mode,
+            activation_position: position,
+            start_mode: start,
+            ..cam_in(1)
+        };
+        let reply = call(&mut run, SLAVE as u32, coupling);
+        match expected {
+            Err(code) => {
+                assert_eq!(reply, code, "mode {mode} start {start}");
+                assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+                continue;
+            }
+            Ok(from) => {
+                assert_eq!(reply, 0, "mode {mode}");
+                run_master(&mut run, 360.0);
+                let mut started = None;
+                for _ in 0..1500 {
+                    run.step(0.001);
+                    if phase(&run, SLAVE) == AxisState::SlaveSynchronous {
+                        started.get_or_insert(set(&run, MASTER).position);
+                    } else {
+                        assert_eq!(set(&run, SLAVE).position, 0.0, "holds while waiting");
+                    }
+                }
+                let at = started.unwrap_or_else(|| panic!("mode {mode} never started"));
+                assert!(
+                    (from..from + 0.5).contains(&at),
+                    "mode {mode}: started at {at}"
+                );
+            }
+        }
+    }
+}

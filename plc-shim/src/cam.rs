@@ -158,6 +158,25 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
     }
 }
 
+/// What a pending call gave this cycle, with a transport failure or a refusal as its code.
+enum Polled<R> {
+    /// No answer yet.
+    Waiting,
+    /// The reply body.
+    Reply(R),
+    /// Refused or not answered: the code the block reports.
+    Failed(u32),
+}
+
+fn poll<C: AcyclicCall>(pending: &PendingCall<C>) -> Polled<C::Reply> {
+    match pending.poll() {
+        None => Polled::Waiting,
+        Some(Ok(reply)) => Polled::Reply(reply),
+        Some(Err(CallError::Refused { code })) => Polled::Failed(code.raw()),
+        Some(Err(_)) => Polled::Failed(crate::motion::ERROR_NO_ANSWER),
+    }
+}
+
 /// MC_CamTableSelect: how couplings through table `table` run (cyclic or linear).
 #[derive(Debug, Default)]
 pub struct McCamTableSelect {
@@ -759,13 +778,13 @@ impl McCamRead {
             }
             return;
         };
-        match pending.poll() {
-            None => {}
-            Some(Ok(reply)) if reply.error_id != 0 => {
+        match poll(pending) {
+            Polled::Waiting => {}
+            Polled::Reply(reply) if reply.error_id != 0 => {
                 self.pending = None;
                 self.out = failed(reply.error_id);
             }
-            Some(Ok(reply)) => {
+            Polled::Reply(reply) => {
                 self.pending = None;
                 let count = reply.count as usize;
                 if self.values.len() + count > self.values.capacity()
@@ -786,13 +805,9 @@ impl McCamRead {
                     self.send(io);
                 }
             }
-            Some(Err(CallError::Refused { code })) => {
+            Polled::Failed(code) => {
                 self.pending = None;
-                self.out = failed(code.raw());
-            }
-            Some(Err(_)) => {
-                self.pending = None;
-                self.out = failed(crate::motion::ERROR_NO_ANSWER);
+                self.out = failed(code);
             }
         }
     }
@@ -864,13 +879,13 @@ impl McReadMotionFunction {
             }
             return;
         };
-        match pending.poll() {
-            None => {}
-            Some(Ok(reply)) if reply.error_id != 0 => {
+        match poll(pending) {
+            Polled::Waiting => {}
+            Polled::Reply(reply) if reply.error_id != 0 => {
                 self.pending = None;
                 self.out = failed(reply.error_id);
             }
-            Some(Ok(reply)) => {
+            Polled::Reply(reply) => {
                 self.pending = None;
                 let wanted = if self.count == 0 {
                     (reply.total + 1).saturating_sub(self.first) as usize
@@ -892,13 +907,9 @@ impl McReadMotionFunction {
                     self.send(io);
                 }
             }
-            Some(Err(CallError::Refused { code })) => {
+            Polled::Failed(code) => {
                 self.pending = None;
-                self.out = failed(code.raw());
-            }
-            Some(Err(_)) => {
-                self.pending = None;
-                self.out = failed(crate::motion::ERROR_NO_ANSWER);
+                self.out = failed(code);
             }
         }
     }

@@ -104,6 +104,24 @@ struct Slave {
     follow_actual: bool,
 }
 
+/// Couples axis `slave` to `master` as a cam slave in `phase`; the axis layer's refusal code.
+fn couple_cam(
+    axes: &mut AxisSet,
+    slave: usize,
+    master: usize,
+    phase: AxisState,
+) -> Result<(), u32> {
+    let axis = axes
+        .axis_mut(slave)
+        .ok_or(CamCouplingError::NotCamCoupled.raw())?;
+    axis.couple(Coupling {
+        kind: CouplingState::Cam,
+        master: master as i32,
+        phase,
+    })
+    .map_err(AxisError::raw)
+}
+
 /// What of the master a slave follows: its set-point (the seed's rule) or its actual
 /// position and velocity.
 fn master_of(axes: &AxisSet, master: usize, actual: bool) -> Option<Kinematic> {
@@ -401,17 +419,12 @@ impl CamEngine {
                 let periodic = self.select_periodic(call.table_id, profile);
                 let hold = axis.setpoint().position;
                 let law = CamLaw::new(profile, scaling, start, periodic, master_set.position, hold);
+                if let Err(e) = couple_cam(axes, slave, master, AxisState::SlavePrephase) {
+                    return code(e);
+                }
                 let Some(axis) = axes.axis_mut(slave) else {
                     return Err(ErrorCode::InvalidTarget);
                 };
-                let coupling = Coupling {
-                    kind: CouplingState::Cam,
-                    master: master as i32,
-                    phase: AxisState::SlavePrephase,
-                };
-                if let Err(e) = axis.couple(coupling) {
-                    return code(e.raw());
-                }
                 axis.drive_coupled(
                     Kinematic {
                         position: hold,
@@ -538,16 +551,8 @@ impl CamEngine {
             }
             Err(_) => return code(CamCouplingError::UnknownMode.raw()),
         };
-        let Some(axis) = axes.axis_mut(slave) else {
-            return Err(ErrorCode::InvalidTarget);
-        };
-        let coupling = Coupling {
-            kind: CouplingState::Cam,
-            master: master as i32,
-            phase: AxisState::SlaveSynchronous,
-        };
-        if let Err(e) = axis.couple(coupling) {
-            return code(e.raw());
+        if let Err(e) = couple_cam(axes, slave, master, AxisState::SlaveSynchronous) {
+            return code(e);
         }
         if let Some(stale) = self.slaves[slave].take() {
             self.retired.extend(stale.own);
