@@ -1101,3 +1101,133 @@ fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
         }
     }
 }
+
+#[test]
+fn a_first_chunk_drops_an_unfinished_transfer() {
+    let mut run = machine("");
+    run.step(0.001);
+    let answer = |run: &mut InProcess, c: &hli::calls::CamRowsWriteCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
+    };
+    let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.5 * i as f64]).collect();
+    // A transfer left half-done (the PLC re-triggered its block) ...
+    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    // ... does not block the next one, which starts over.
+    let whole: Vec<[f64; 2]> = (0..13).map(|i| [i as f64 * 10.0, 1.0]).collect();
+    assert_eq!(answer(&mut run, &rows_chunk(&whole, 0, 13, true)), 0);
+    let (v, _) = read_all(
+        &mut run,
+        7,
+        hli::calls::CamReadCall {
+            what: hli::calls::CAM_READ_ROWS,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v.len(), 26);
+    assert_eq!((v[2], v[3]), (10.0, 1.0));
+}
+
+#[test]
+fn a_slave_coupled_later_starts_in_the_base_cycle() {
+    let mut run = machine("");
+    run.step(0.001);
+    let rows: Vec<[f64; 2]> = (0..=36)
+        .map(|i| [i as f64 * 10.0, i as f64 * 10.0 / 36.0])
+        .collect();
+    for (k, chunk) in rows.chunks(hli::calls::CAM_ROWS_PER_CALL).enumerate() {
+        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+        let call = rows_chunk(chunk, first, rows.len(), first + chunk.len() == rows.len());
+        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 9, &call));
+        assert_eq!(reply.error_id, 0);
+    }
+    run_master(&mut run, 360.0);
+    for _ in 0..1500 {
+        run.step(0.001);
+    }
+    // The master is more than a turn on; coupled now, the slave takes the cam's value at
+    // the master's place in its turn, without the strokes of the turns before (seed 5.1.4).
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(9)), 0);
+    run.step(0.001);
+    let m = set(&run, MASTER).position;
+    assert!(m > 400.0, "{m}");
+    let expected = m.rem_euclid(360.0) / 36.0;
+    assert!(
+        (set(&run, SLAVE).position - expected).abs() < 1e-9,
+        "slave {} at master {m}, expected {expected}",
+        set(&run, SLAVE).position
+    );
+}
+
+#[test]
+fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
+    use hli::calls::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    let mut run = machine("");
+    run.step(0.001);
+    let select = CamTableSelectCall {
+        periodic: 1,
+        master_absolute: 1,
+        slave_absolute: 1,
+        reserved: 0,
+    };
+    assert_eq!(call(&mut run, 1, select), 0);
+    // Two slaves on table 1: the lifter, and the third axis 20 degrees ahead.
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+    let ahead = CamInCall {
+        master_offset: 20.0,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, 2, ahead), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..500 {
+        run.step(0.001);
+    }
+    let mode = CamOnlineModeCall {
+        activation_mode: 5,
+        ..Default::default()
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &mode));
+    assert_eq!(reply.error_id, 0);
+    // Point 4 (the fall's start, 240) from 40 to 30: the segments from 30 to 340 change (the
+    // rise's end slope too), so both slaves are clear of them only while the lifter is
+    // between 340 and 10 degrees.
+    let mut points = [McMotionFunctionPoint::default(); 4];
+    points[0] = McMotionFunctionPoint {
+        point_index: 4,
+        function_type: 15,
+        point_type: 2,
+        rel_index_next_point: 1,
+        master_pos: 240.0,
+        slave_pos: 30.0,
+        ..Default::default()
+    };
+    let write = CamPointsWriteCall {
+        first: 4,
+        count: 1,
+        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert_eq!(reply.error_id, 0);
+    let mut last = [set(&run, SLAVE).position, set(&run, 2).position];
+    let mut top = [0.0f64; 2];
+    for tick in 0..2000 {
+        run.step(0.001);
+        for (k, axis) in [SLAVE, 2].into_iter().enumerate() {
+            let p = set(&run, axis).position;
+            assert!(
+                (p - last[k]).abs() < 0.35,
+                "axis {axis} jumped {} at tick {tick}",
+                p - last[k]
+            );
+            last[k] = p;
+            if tick >= 1000 {
+                top[k] = top[k].max(p);
+            }
+        }
+    }
+    // The change came (the tops are now about 31, no longer about 42) without a jump.
+    for t in top {
+        assert!(t > 25.0 && t < 35.0, "top {t}");
+    }
+}

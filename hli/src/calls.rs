@@ -516,7 +516,7 @@ pub struct CamRowsWriteCall {
     pub first_row: u32,
     /// Rows in this chunk (1..=13).
     pub count: u32,
-    /// [`CAM_CHUNK_LAST`].
+    /// [`CAM_CHUNK_FIRST`], [`CAM_CHUNK_LAST`], [`CAM_ROWS_DECLARE`].
     pub flags: u32,
     /// Rows of the whole table.
     pub total: u32,

@@ -12,7 +12,8 @@
 //! ```
 //!
 //! The stroke counts from the coupling on: a slave always couples in the cam's base cycle
-//! (seed 5.1.4), wherever the master stands, and falls back into it when it couples again.
+//! (seed 5.1.4), wherever the master stands, and falls back into it when it couples again;
+//! switches and rescalings carry the count on.
 //!
 //! Velocity, acceleration and jerk follow from the chain rule with the master's own
 //! derivatives, so a coupled slave moves as smoothly as its master and its profile allow.
@@ -435,7 +436,6 @@ impl CamLaw {
         if !switched {
             law.master_origin = self.master_origin;
             law.slave_origin = self.slave_origin;
-            law.cycle0 = self.cycle0;
         }
         if master_mode == ScalingMode::AutoOffset {
             let old = self.locate(master);
@@ -443,10 +443,11 @@ impl CamLaw {
             let x = law.first + share * law.period;
             let s = &mut law.scaling;
             s.master_offset = x * s.master_scaling - master + law.master_origin;
-            // The master's cycle in the new cam continues the count of the old one.
-            let old_cycles = self.locate(master).cycle - self.cycle0;
-            law.cycle0 = law.locate(master).cycle - old_cycles;
         }
+        // The stroke count goes on across a switch or a rescaling: the cycles since the
+        // coupling stay what they were (only coupling anew starts in the base cycle).
+        let cycles = self.locate(master).cycle - self.cycle0;
+        law.cycle0 = law.locate(master).cycle - cycles;
         if slave_mode == ScalingMode::AutoOffset {
             let mut cursor = ProfileCursor::default();
             let standing = Kinematic {
@@ -459,16 +460,15 @@ impl CamLaw {
         law
     }
 
-    /// Periods travelled from the cam's first master position, with the fraction (a linear
-    /// cam passed at its end continues from the beginning of the next).
+    /// How far into its cycle the master is, as a fraction of the period (a linear cam
+    /// passed at its end continues from the beginning of the next). The cycles themselves
+    /// are counted apart (`cycle0`).
     fn share_of_cycle(&self, at: CamPosition) -> f64 {
         if self.period <= 0.0 {
             return 0.0;
         }
         let share = (at.local - self.first) / self.period;
-        if self.periodic {
-            at.cycle as f64 + share
-        } else if share > 1.0 {
+        if share > 1.0 {
             share - 1.0
         } else {
             share

@@ -389,7 +389,9 @@ impl MultiTableLaw {
         };
         let Ok(p) = store.get(e.table) else { return };
         if e.w.range_low <= at && at < e.w.range_high {
-            // Counting already (in parallel): it goes on as it is.
+            // Counting already (in parallel): it goes on as it is, and what the ended table
+            // reached stays in the position.
+            self.kept += reached;
             return;
         }
         e.w.range_low = at;

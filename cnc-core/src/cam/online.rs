@@ -166,6 +166,19 @@ impl OnlineChangeQueue {
         self.pending.is_some()
     }
 
+    /// The activation mode of the queued change, if one is queued.
+    pub fn pending_mode(&self) -> Option<ActivationMode> {
+        self.pending.as_ref().map(|p| p.mode)
+    }
+
+    /// Whether the master in `now` stands in a segment the queued change touches (what
+    /// AsSoonAsPossible waits out; false when nothing is queued).
+    pub fn touches(&self, now: MasterNow) -> bool {
+        self.changed_ranges()
+            .iter()
+            .any(|(a, b)| now.cam.1 >= *a && now.cam.1 <= *b)
+    }
+
     /// Master ranges of the segments the queued change touches.
     pub fn changed_ranges(&self) -> &[(f64, f64)] {
         self.pending.as_ref().map_or(&[], |p| &p.changed)

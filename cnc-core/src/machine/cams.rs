@@ -65,9 +65,11 @@ enum Queued {
         start: StartMode,
         activation: ActivationMode,
     },
-    /// A rescaling (MC_CamScaling).
+    /// A rescaling (MC_CamScaling): the values asked for, and the keep bits of the ones
+    /// that stay as the coupling has them when it applies (after a switch, too).
     Scale {
-        scaling: Scaling,
+        requested: Scaling,
+        keep: u32,
         modes: (ScalingMode, ScalingMode),
         activation: ActivationMode,
     },
@@ -102,6 +104,41 @@ struct Slave {
     coupled_at: (f64, f64),
     /// Follows the master's actual position rather than its set-point.
     follow_actual: bool,
+}
+
+/// The scaling a rescaling gives: the values asked for, except those of a side whose mode is
+/// Off and those the keep bits name, which stay as `current` has them.
+fn merged_scaling(
+    current: Scaling,
+    requested: Scaling,
+    keep: u32,
+    (master_mode, slave_mode): (ScalingMode, ScalingMode),
+) -> Scaling {
+    let take = |bit: u32, on: bool| on && keep & bit == 0;
+    let master_on = master_mode != ScalingMode::Off;
+    let slave_on = slave_mode != ScalingMode::Off;
+    Scaling {
+        master_offset: if take(CAM_KEEP_MASTER_OFFSET, master_on) {
+            requested.master_offset
+        } else {
+            current.master_offset
+        },
+        master_scaling: if take(CAM_KEEP_MASTER_SCALING, master_on) {
+            requested.master_scaling
+        } else {
+            current.master_scaling
+        },
+        slave_offset: if take(CAM_KEEP_SLAVE_OFFSET, slave_on) {
+            requested.slave_offset
+        } else {
+            current.slave_offset
+        },
+        slave_scaling: if take(CAM_KEEP_SLAVE_SCALING, slave_on) {
+            requested.slave_scaling
+        } else {
+            current.slave_scaling
+        },
+    }
 }
 
 /// Couples axis `slave` to `master` as a cam slave in `phase`; the axis layer's refusal code.
@@ -224,7 +261,7 @@ impl CamEngine {
             // Room for every retirement between two calls: each slave lost (two profiles), a
             // switch per slave, a point change per table in use.
             retired: Vec::with_capacity(4 * axes + 8),
-            retired_changes: Vec::with_capacity(axes + 8),
+            retired_changes: Vec::with_capacity(2 * axes + 8),
         }
     }
 
@@ -246,7 +283,8 @@ impl CamEngine {
             .is_some_and(|s| s.active)
     }
 
-    /// The cycle counter and the master's place in the cam of axis `slave`'s coupling.
+    /// The master's place in the cam of axis `slave`'s coupling (its `cycle` is the cam's
+    /// absolute cycle; `CamLaw::cycles_since_coupling` counts the strokes).
     pub fn cam_position(&self, slave: usize) -> Option<crate::cam::coupling::CamPosition> {
         let s = self.slaves.get(slave)?.as_ref()?;
         Some(s.law.locate(s.master_before))
@@ -1073,7 +1111,7 @@ impl CamEngine {
             sc.slave_offset,
             sc.master_scaling,
             sc.slave_scaling,
-            sc.slave_scaling * s.law.stroke() * cam.cycle as f64,
+            sc.slave_scaling * s.law.stroke() * s.law.cycles_since_coupling(at) as f64,
             0.0,
             at,
             slave_set.position,
@@ -1172,26 +1210,20 @@ impl CamEngine {
         if activation == Activation::Off {
             return accepted();
         }
-        // Only the sides that take part must be usable; the keep bits (the compatibility
-        // blocks) leave single values as they are.
-        let mut scaling = state.law.scaling;
-        let keep = |bit: u32| call.reserved & bit != 0;
-        if master_mode != ScalingMode::Off {
-            if !keep(CAM_KEEP_MASTER_OFFSET) {
-                scaling.master_offset = call.master_offset;
-            }
-            if !keep(CAM_KEEP_MASTER_SCALING) {
-                scaling.master_scaling = call.master_scaling;
-            }
-        }
-        if slave_mode != ScalingMode::Off {
-            if !keep(CAM_KEEP_SLAVE_OFFSET) {
-                scaling.slave_offset = call.slave_offset;
-            }
-            if !keep(CAM_KEEP_SLAVE_SCALING) {
-                scaling.slave_scaling = call.slave_scaling;
-            }
-        }
+        // Only the values that take part must be usable (the keep bits of the compatibility
+        // blocks leave single values as they are); they merge again when it applies.
+        let requested = Scaling {
+            master_offset: call.master_offset,
+            slave_offset: call.slave_offset,
+            master_scaling: call.master_scaling,
+            slave_scaling: call.slave_scaling,
+        };
+        let scaling = merged_scaling(
+            state.law.scaling,
+            requested,
+            call.reserved,
+            (master_mode, slave_mode),
+        );
         if let Err(e) = scaling.check() {
             return code(coupling_code(e));
         }
@@ -1210,7 +1242,13 @@ impl CamEngine {
             return code(coupling_code(e));
         }
         state.scale = Some(Queued::Scale {
-            scaling,
+            requested: Scaling {
+                master_offset: call.master_offset,
+                slave_offset: call.slave_offset,
+                master_scaling: call.master_scaling,
+                slave_scaling: call.slave_scaling,
+            },
+            keep: call.reserved,
             modes: (master_mode, slave_mode),
             activation: activation.timing().expect("checked: a timed mode"),
         });
@@ -1220,9 +1258,11 @@ impl CamEngine {
 
 impl CamEngine {
     /// Online changes of the motion functions coupled slaves run on, under each table's
-    /// mode: a change is due by the master of the first slave on its table and then taken by
-    /// every slave on it at once, each law rebuilt with the table's scaling modes (offsets
-    /// keep the master's place and the slave's position when they say so).
+    /// mode. A change is timed by the first slave on its table (the lowest axis); with
+    /// AsSoonAsPossible it waits until no slave on the table stands in a segment it touches.
+    /// Every slave on the table then takes it at once, each law rebuilt with the table's
+    /// scaling modes (offsets keep the master's place and the slave's position when they say
+    /// so); a slave still waiting for its activation only takes the new geometry.
     fn apply_point_changes(&mut self, axes: &AxisSet) {
         for i in 0..self.slaves.len() {
             let Some(s) = self.slaves[i].as_ref() else {
@@ -1237,6 +1277,20 @@ impl CamEngine {
                 continue;
             };
             let now = s.law.master_now(s.master_before, master.position);
+            if let Ok(queue) = self.store.queue(table) {
+                if queue.pending_mode() == Some(ActivationMode::AsSoonAsPossible) {
+                    let touched = self.slaves.iter().flatten().any(|o| {
+                        o.table == table
+                            && o.own.is_none()
+                            && master_of(axes, o.master, o.follow_actual).is_some_and(|m| {
+                                queue.touches(o.law.master_now(o.master_before, m.position))
+                            })
+                    });
+                    if touched {
+                        continue;
+                    }
+                }
+            }
             let Ok(Some(old)) = self.store.apply_due(table, now) else {
                 continue;
             };
@@ -1246,6 +1300,11 @@ impl CamEngine {
             let modes = self.online_scaling[table as usize];
             for other in self.slaves.iter_mut().flatten() {
                 if other.table != table || other.own.is_some() {
+                    continue;
+                }
+                other.cursor = ProfileCursor::default();
+                if !other.active {
+                    other.law.take_geometry(new);
                     continue;
                 }
                 let Some(m) = master_of(axes, other.master, other.follow_actual) else {
@@ -1338,13 +1397,15 @@ impl Engine for CamEngine {
                 set = state.law.slave(profile, &mut state.cursor, &master).0;
             }
             if let Some(Queued::Scale {
-                scaling,
+                requested,
+                keep,
                 modes,
                 activation,
             }) = state.scale.filter(|_| state.active)
             {
                 if activation.due(now) {
                     let law = state.law;
+                    let scaling = merged_scaling(law.scaling, requested, keep, modes);
                     state.law = law.rescaled(
                         profile,
                         scaling,
