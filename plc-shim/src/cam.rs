@@ -31,6 +31,34 @@ pub struct CamOutputs {
     pub error_id: u32,
 }
 
+impl CamOutputs {
+    /// Sent, not finished.
+    pub const BUSY: CamOutputs = CamOutputs {
+        done: false,
+        busy: true,
+        in_sync: false,
+        command_aborted: false,
+        error: false,
+        error_id: 0,
+    };
+    /// Finished.
+    pub const DONE: CamOutputs = CamOutputs {
+        done: true,
+        busy: false,
+        in_sync: false,
+        command_aborted: false,
+        error: false,
+        error_id: 0,
+    };
+}
+
+/// Whether `execute` rose since the last cycle (and remembers it for the next).
+pub(crate) fn rose(before: &mut bool, execute: bool) -> bool {
+    let rising = execute && !*before;
+    *before = execute;
+    rising
+}
+
 enum Phase<C: AcyclicCall> {
     Idle,
     Sent(PendingCall<C>),
@@ -63,7 +91,7 @@ impl<C: AcyclicCall> core::fmt::Debug for CamCore<C> {
     }
 }
 
-fn failed(code: u32) -> CamOutputs {
+pub(crate) fn failed(code: u32) -> CamOutputs {
     CamOutputs {
         error: true,
         error_id: code,
@@ -82,8 +110,7 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         call: impl FnOnce() -> C,
         couples: Option<u32>,
     ) -> CamOutputs {
-        let rising = execute && !self.execute_before;
-        self.execute_before = execute;
+        let rising = rose(&mut self.execute_before, execute);
         if rising {
             self.out = CamOutputs::default();
             self.phase = match io.acyclic.start(target, &call()) {
@@ -104,10 +131,7 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
                 Some(Ok(_)) => match couples {
                     Some(_) => self.phase = Phase::Following { seen: false },
                     None => {
-                        self.out = CamOutputs {
-                            done: true,
-                            ..CamOutputs::default()
-                        };
+                        self.out = CamOutputs::DONE;
                         self.phase = Phase::Idle;
                     }
                 },
@@ -207,8 +231,7 @@ pub struct McCamTableSelect {
 impl McCamTableSelect {
     /// One cycle: the data in chunks (if any), then the selection.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
+        let rising = rose(&mut self.execute_before, self.execute);
         if rising && !matches!(self.data, CamData::None) {
             if let CamData::Rows {
                 table_type,
@@ -233,10 +256,7 @@ impl McCamTableSelect {
                 .cycle(io, self.table, &self.data, true, self.periodic)
             {
                 Transfer::Running => {
-                    self.out = CamOutputs {
-                        busy: true,
-                        ..CamOutputs::default()
-                    };
+                    self.out = CamOutputs::BUSY;
                     return;
                 }
                 Transfer::Failed(code) => {
@@ -547,6 +567,17 @@ pub enum Transfer {
     Failed(u32),
 }
 
+impl Transfer {
+    /// The block outputs it shows, and whether the transfer still runs.
+    pub fn outputs(self) -> (CamOutputs, bool) {
+        match self {
+            Transfer::Running => (CamOutputs::BUSY, true),
+            Transfer::Done => (CamOutputs::DONE, false),
+            Transfer::Failed(code) => (failed(code), false),
+        }
+    }
+}
+
 impl Chunker {
     /// Starts over.
     pub fn reset(&mut self) {
@@ -678,34 +709,17 @@ pub struct McWriteMotionFunction {
 impl McWriteMotionFunction {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
+        let rising = rose(&mut self.execute_before, self.execute);
         if rising {
             self.chunker.reset();
             self.running = true;
             self.out = CamOutputs::default();
         }
         if self.running {
-            self.out = match self
+            let transfer = self
                 .chunker
-                .cycle(io, self.table, &self.points, false, false)
-            {
-                Transfer::Running => CamOutputs {
-                    busy: true,
-                    ..CamOutputs::default()
-                },
-                Transfer::Done => {
-                    self.running = false;
-                    CamOutputs {
-                        done: true,
-                        ..CamOutputs::default()
-                    }
-                }
-                Transfer::Failed(code) => {
-                    self.running = false;
-                    failed(code)
-                }
-            };
+                .cycle(io, self.table, &self.points, false, false);
+            (self.out, self.running) = transfer.outputs();
         } else if !self.execute {
             self.out = CamOutputs::default();
         }
@@ -760,15 +774,11 @@ impl McCamRead {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
+        let rising = rose(&mut self.execute_before, self.execute);
         if rising {
             self.values.clear();
             self.part = 0;
-            self.out = CamOutputs {
-                busy: true,
-                ..CamOutputs::default()
-            };
+            self.out = CamOutputs::BUSY;
             self.send(io);
             return;
         }
@@ -796,10 +806,7 @@ impl McCamRead {
                 self.values.extend_from_slice(&reply.values[..count]);
                 self.columns = reply.columns;
                 if self.values.len() >= reply.total as usize || count == 0 {
-                    self.out = CamOutputs {
-                        done: true,
-                        ..CamOutputs::default()
-                    };
+                    self.out = CamOutputs::DONE;
                 } else {
                     self.part += 1;
                     self.send(io);
@@ -862,14 +869,10 @@ impl McReadMotionFunction {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
+        let rising = rose(&mut self.execute_before, self.execute);
         if rising {
             self.points.clear();
-            self.out = CamOutputs {
-                busy: true,
-                ..CamOutputs::default()
-            };
+            self.out = CamOutputs::BUSY;
             self.send(io);
             return;
         }
@@ -899,10 +902,7 @@ impl McReadMotionFunction {
                 let take = (reply.count as usize).min(wanted.saturating_sub(self.points.len()));
                 self.points.extend_from_slice(&reply.points[..take]);
                 if self.points.len() >= wanted || reply.count == 0 {
-                    self.out = CamOutputs {
-                        done: true,
-                        ..CamOutputs::default()
-                    };
+                    self.out = CamOutputs::DONE;
                 } else {
                     self.send(io);
                 }

@@ -16,7 +16,7 @@
 //! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
-use crate::cam::{CamCore, CamData, CamOutputs, Chunker, McCamRead, Transfer};
+use crate::cam::{rose, CamCore, CamData, CamOutputs, Chunker, McCamRead};
 use crate::runtime::PlcIo;
 use hli::calls::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
@@ -242,8 +242,7 @@ impl CompatBlock {
     /// One cycle for slave axis `slave` (the coupling and scaling blocks' axis).
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let c = Arc::clone(&self.config);
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
+        let rising = rose(&mut self.execute_before, self.execute);
         match c.kind {
             "CamTableGenerate" | "CamTableWriteData" => {
                 if rising {
@@ -269,27 +268,8 @@ impl CompatBlock {
                     },
                     None => CamData::None,
                 };
-                self.out = match self.chunker.cycle(io, c.table, &data, false, periodic) {
-                    Transfer::Running => CamOutputs {
-                        busy: true,
-                        ..CamOutputs::default()
-                    },
-                    Transfer::Done => {
-                        self.transferring = false;
-                        CamOutputs {
-                            done: true,
-                            ..CamOutputs::default()
-                        }
-                    }
-                    Transfer::Failed(code) => {
-                        self.transferring = false;
-                        CamOutputs {
-                            error: true,
-                            error_id: code,
-                            ..CamOutputs::default()
-                        }
-                    }
-                };
+                let transfer = self.chunker.cycle(io, c.table, &data, false, periodic);
+                (self.out, self.transferring) = transfer.outputs();
             }
             "CamTableCreate" => {
                 let (table_type, periodic) = type_of(c.table_type);

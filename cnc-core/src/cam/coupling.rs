@@ -426,17 +426,14 @@ impl CamLaw {
             scaling.slave_offset = requested.slave_offset;
             scaling.slave_scaling = requested.slave_scaling;
         }
-        // A switch re-anchors relative sides here; a rescaling keeps the coupling's origins.
+        // A switch re-anchors relative sides here; a rescaling keeps the coupling's origins
+        // (a relative side's origin is its position at coupling, an absolute side's is 0).
         let (start, master_at, slave_at) = if switched {
             (start, master, slave)
         } else {
             (self.start, self.master_origin, self.slave_origin)
         };
         let mut law = CamLaw::new(profile, scaling, start, periodic, master_at, slave_at);
-        if !switched {
-            law.master_origin = self.master_origin;
-            law.slave_origin = self.slave_origin;
-        }
         if master_mode == ScalingMode::AutoOffset {
             let old = self.locate(master);
             let share = self.share_of_cycle(old);

@@ -141,6 +141,18 @@ fn merged_scaling(
     }
 }
 
+/// Whether couplings through `table` run cyclic: MC_CamTableSelect's choice, else the
+/// table's own flag (a motion function: linear).
+fn periodic_of(selects: &[Option<Select>], table: u32, profile: &CamProfile) -> bool {
+    match selects.get(table as usize).copied().flatten() {
+        Some(select) => select.periodic,
+        None => match profile {
+            CamProfile::Table(t) => t.periodic(),
+            CamProfile::MotionFunction(_) => false,
+        },
+    }
+}
+
 /// Couples axis `slave` to `master` as a cam slave in `phase`; the axis layer's refusal code.
 fn couple_cam(
     axes: &mut AxisSet,
@@ -265,45 +277,8 @@ impl CamEngine {
         }
     }
 
-    /// The tables.
-    pub fn store(&self) -> &CamStore {
-        &self.store
-    }
-
-    /// The tables, to write points or change modes.
-    pub fn store_mut(&mut self) -> &mut CamStore {
-        &mut self.store
-    }
-
-    /// Whether axis `slave` is coupled through a cam and following it (not waiting).
-    pub fn in_sync(&self, slave: usize) -> bool {
-        self.slaves
-            .get(slave)
-            .and_then(Option::as_ref)
-            .is_some_and(|s| s.active)
-    }
-
-    /// The master's place in the cam of axis `slave`'s coupling (its `cycle` is the cam's
-    /// absolute cycle; `CamLaw::cycles_since_coupling` counts the strokes).
-    pub fn cam_position(&self, slave: usize) -> Option<crate::cam::coupling::CamPosition> {
-        let s = self.slaves.get(slave)?.as_ref()?;
-        Some(s.law.locate(s.master_before))
-    }
-
-    fn retire(&mut self, profile: CamProfile) {
-        // Beyond the reserved room this frees in the tick; it never comes to that with one
-        // change per call and calls freeing the room first.
-        self.retired.push(profile);
-    }
-
     fn select_periodic(&self, table: u32, profile: &CamProfile) -> bool {
-        match self.selects.get(table as usize).copied().flatten() {
-            Some(select) => select.periodic,
-            None => match profile {
-                CamProfile::Table(t) => t.periodic(),
-                CamProfile::MotionFunction(_) => false,
-            },
-        }
+        periodic_of(&self.selects, table, profile)
     }
 
     fn table_select(&mut self, request: &AcyclicRequest) -> HandlerResult {
@@ -419,13 +394,13 @@ impl CamEngine {
                 if activation == Activation::DeleteQueuedData {
                     if current.switch.take().is_some() {
                         if let Some(old) = current.switch_own.take() {
-                            self.retire(old);
+                            self.retired.push(old);
                         }
                     }
                     return accepted();
                 }
                 if let Some(old) = core::mem::replace(&mut current.switch_own, own) {
-                    self.retire(old);
+                    self.retired.push(old);
                 }
                 let current = self.slaves[slave].as_mut().expect("checked above");
                 current.switch = Some(Queued::Switch {
@@ -1431,13 +1406,7 @@ impl Engine for CamEngine {
                 if activation.due(now) {
                     let stored_next = self.store.get(table).ok();
                     if let Some(next) = state.switch_own.as_ref().or(stored_next) {
-                        let periodic = match self.selects[table as usize] {
-                            Some(s) => s.periodic,
-                            None => match next {
-                                CamProfile::Table(t) => t.periodic(),
-                                CamProfile::MotionFunction(_) => false,
-                            },
-                        };
+                        let periodic = periodic_of(&self.selects, table, next);
                         let law = state.law;
                         state.law = law.rescaled(
                             next,
