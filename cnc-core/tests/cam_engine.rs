@@ -68,6 +68,17 @@ fn call<C: AcyclicCall<Reply = CamReply>>(run: &mut InProcess, target: u32, body
     reply.error_id
 }
 
+/// MC_CamTableSelect: couplings through `table` run cyclic, absolute.
+fn select_cyclic(run: &mut InProcess, table: u32) {
+    let select = CamTableSelectCall {
+        periodic: 1,
+        master_absolute: 1,
+        slave_absolute: 1,
+        reserved: 0,
+    };
+    assert_eq!(call(run, table, select), 0);
+}
+
 fn cam_in(table: u32) -> CamInCall {
     CamInCall {
         master: MASTER as u32,
@@ -308,13 +319,7 @@ fn refusals_carry_their_code_and_leave_the_axes_alone() {
 fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
     let mut run = machine("");
     run.step(0.001);
-    let select = CamTableSelectCall {
-        periodic: 1,
-        master_absolute: 1,
-        slave_absolute: 1,
-        reserved: 0,
-    };
-    assert_eq!(call(&mut run, 1, select), 0);
+    select_cyclic(&mut run, 1);
     let at_axis = CamInCall {
         activation_mode: 2,
         activation_position: 100.0,
@@ -369,13 +374,7 @@ fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
 fn switching_cams_mid_cycle_with_auto_offsets_keeps_the_slave_continuous() {
     let mut run = machine("");
     run.step(0.001);
-    let select = CamTableSelectCall {
-        periodic: 1,
-        master_absolute: 1,
-        slave_absolute: 1,
-        reserved: 0,
-    };
-    assert_eq!(call(&mut run, 1, select), 0);
+    select_cyclic(&mut run, 1);
     let ext = CamInCall {
         extended: 1,
         ..cam_in(1)
@@ -973,13 +972,7 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
     for (mode, position, from) in cases {
         let mut run = machine("");
         run.step(0.001);
-        let select = CamTableSelectCall {
-            periodic: 1,
-            master_absolute: 1,
-            slave_absolute: 1,
-            reserved: 0,
-        };
-        assert_eq!(call(&mut run, 1, select), 0);
+        select_cyclic(&mut run, 1);
         assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
         run_master(&mut run, 360.0);
         for _ in 0..400 {
@@ -1059,13 +1052,7 @@ fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
     for (mode, position, start, expected) in cases {
         let mut run = machine("");
         run.step(0.001);
-        let select = CamTableSelectCall {
-            periodic: 1,
-            master_absolute: 1,
-            slave_absolute: 1,
-            reserved: 0,
-        };
-        assert_eq!(call(&mut run, 1, select), 0);
+        select_cyclic(&mut run, 1);
         let coupling = CamInCall {
             extended: 1,
             activation_mode: mode,
@@ -1163,13 +1150,7 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
     use hli::calls::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
     let mut run = machine("");
     run.step(0.001);
-    let select = CamTableSelectCall {
-        periodic: 1,
-        master_absolute: 1,
-        slave_absolute: 1,
-        reserved: 0,
-    };
-    assert_eq!(call(&mut run, 1, select), 0);
+    select_cyclic(&mut run, 1);
     // Two slaves on table 1: the lifter, and the third axis 20 degrees ahead.
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
     let ahead = CamInCall {
