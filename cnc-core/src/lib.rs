@@ -1,7 +1,7 @@
 //! The CNC side of the runtime.
 //!
 //! The library: `machine` (one tick for channels, axes and engines), `channel` (NC channels
-//! and the dynamic CS), `axis` (the axis layer and the process image), `cam` (cam profiles),
+//! and the dynamic CS), `axis` (the axis layer and the process image), `cam` (cam profiles), `fifo` (FIFO groups: rows, override, set-points),
 //! `nc` (the NC language). It knows no PLC program and no process.
 //!
 //! The application: `app` (scenarios and `cnc run`, the demo, the command-line tools), which
@@ -11,5 +11,6 @@ pub mod app;
 pub mod axis;
 pub mod cam;
 pub mod channel;
+pub mod fifo;
 pub mod machine;
 pub mod nc;

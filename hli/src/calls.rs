@@ -72,6 +72,20 @@ pub enum CallKind {
     CamMultiTable,
     /// [`CamTableDeleteCall`].
     CamTableDelete,
+    /// [`crate::fifo_calls::FifoDimensionCall`].
+    FifoDimension,
+    /// [`crate::fifo_calls::FifoIntegrateCall`].
+    FifoIntegrate,
+    /// [`crate::fifo_calls::FifoDisintegrateCall`].
+    FifoDisintegrate,
+    /// [`crate::fifo_calls::FifoStartCall`].
+    FifoStart,
+    /// [`crate::fifo_calls::FifoStopCall`].
+    FifoStop,
+    /// [`crate::fifo_calls::FifoOverrideCall`].
+    FifoOverride,
+    /// [`crate::fifo_calls::FifoParametersCall`].
+    FifoParameters,
 }
 
 impl CallKind {
@@ -93,6 +107,13 @@ impl CallKind {
             CallKind::CamMultiCouple => 20,
             CallKind::CamMultiTable => 21,
             CallKind::CamTableDelete => 22,
+            CallKind::FifoDimension => 30,
+            CallKind::FifoIntegrate => 31,
+            CallKind::FifoDisintegrate => 32,
+            CallKind::FifoStart => 33,
+            CallKind::FifoStop => 34,
+            CallKind::FifoOverride => 35,
+            CallKind::FifoParameters => 36,
         }
     }
 
@@ -114,6 +135,13 @@ impl CallKind {
             20 => Some(CallKind::CamMultiCouple),
             21 => Some(CallKind::CamMultiTable),
             22 => Some(CallKind::CamTableDelete),
+            30 => Some(CallKind::FifoDimension),
+            31 => Some(CallKind::FifoIntegrate),
+            32 => Some(CallKind::FifoDisintegrate),
+            33 => Some(CallKind::FifoStart),
+            34 => Some(CallKind::FifoStop),
+            35 => Some(CallKind::FifoOverride),
+            36 => Some(CallKind::FifoParameters),
             _ => None,
         }
     }

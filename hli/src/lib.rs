@@ -8,7 +8,8 @@
 //! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
 //!   PLC's side of an image;
 //! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (kinds,
-//!   bodies, codes), [`rpc`] (the iceoryx2 request-response transport; re-exports both);
+//!   bodies, codes), [`fifo_calls`] (the FIFO group's calls and row blocks), [`rpc`] (the
+//!   iceoryx2 request-response transports; re-exports all three);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
@@ -20,6 +21,7 @@ pub mod command_book;
 pub mod desc;
 pub mod enums;
 pub mod events;
+pub mod fifo_calls;
 pub mod handshake;
 pub mod layout;
 pub mod raw;

@@ -6,6 +6,7 @@
 //! ([`crate::views::handle_read_axis_state`]) and in the engines.
 
 pub use crate::calls::*;
+pub use crate::fifo_calls::*;
 pub use crate::wire::*;
 use core::time::Duration;
 use iceoryx2::node::Node;
@@ -19,8 +20,17 @@ pub fn service_name(instance: &str) -> String {
     format!("cncplc/{instance}/acyclic")
 }
 
+/// Service name of an instance's FIFO row blocks.
+pub fn rows_service_name(instance: &str) -> String {
+    format!("cncplc/{instance}/fifo-rows")
+}
+
 type AcyclicClientPort = Client<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
 type AcyclicServerPort = Server<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
+type RowsClientPort = Client<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
+type RowsServerPort = Server<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
+type RowsPendingPort =
+    iceoryx2::pending_response::PendingResponse<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
 
 fn transport(e: impl core::fmt::Debug) -> CallError {
     CallError::Transport(format!("{e:?}"))
@@ -51,10 +61,38 @@ fn open_service(
         .map_err(transport)
 }
 
-/// The PLC's end: sends calls and waits for their replies.
+fn open_rows_service(
+    node: &Node<ipc::Service>,
+    instance: &str,
+) -> Result<
+    iceoryx2::service::port_factory::request_response::PortFactory<
+        ipc::Service,
+        [f64],
+        FifoRowsHeader,
+        FifoReply,
+        (),
+    >,
+    CallError,
+> {
+    let name: ServiceName = rows_service_name(instance)
+        .as_str()
+        .try_into()
+        .map_err(transport)?;
+    node.service_builder(&name)
+        .request_response::<[f64], FifoReply>()
+        .request_user_header::<FifoRowsHeader>()
+        // A few FiFoWrite/FiFoOverwrite instances per group, each with one block on its way.
+        .max_active_requests_per_client(16)
+        .max_loaned_requests(4)
+        .open_or_create()
+        .map_err(transport)
+}
+
+/// The PLC's end: sends calls and waits for their replies; sends FIFO row blocks.
 pub struct AcyclicClient {
     _node: Node<ipc::Service>,
     port: AcyclicClientPort,
+    rows: RowsClientPort,
     next_invoke_id: u32,
 }
 
@@ -74,11 +112,34 @@ impl AcyclicClient {
             .client_builder()
             .create()
             .map_err(transport)?;
+        let rows = open_rows_service(&node, instance)?
+            .client_builder()
+            .initial_max_slice_len(FIFO_BLOCK_VALUES)
+            .create()
+            .map_err(transport)?;
         Ok(Self {
             _node: node,
             port,
+            rows,
             next_invoke_id: 1,
         })
+    }
+
+    /// Sends a FIFO row block (`FiFoWrite`, `FiFoOverwrite`): `values` holds
+    /// `header.rows x header.columns` values, row after row, and is written once, straight
+    /// into the shared memory the CNC reads it from. Poll the returned [`PendingRows`].
+    pub fn start_rows(
+        &mut self,
+        header: FifoRowsHeader,
+        values: &[f64],
+    ) -> Result<PendingRows, CallError> {
+        let mut loan = self
+            .rows
+            .loan_slice_uninit(values.len())
+            .map_err(transport)?;
+        *loan.user_header_mut() = header;
+        let pending = loan.write_from_slice(values).send().map_err(transport)?;
+        Ok(PendingRows { pending })
     }
 
     /// Sends `call` to `target` and waits up to `timeout` for the reply.
@@ -191,10 +252,34 @@ fn decode_response<C: AcyclicCall>(
     Ok(bytemuck::pod_read_unaligned(&response.body[..len]))
 }
 
-/// The CNC's end: answers pending calls when polled (once per tick, outside the motion path).
+/// A row block on its way: poll it until it yields the CNC's reply.
+pub struct PendingRows {
+    pending: RowsPendingPort,
+}
+
+impl core::fmt::Debug for PendingRows {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("PendingRows")
+    }
+}
+
+impl PendingRows {
+    /// The CNC's reply once it has answered, `None` while it has not.
+    pub fn poll(&self) -> Option<Result<FifoReply, CallError>> {
+        match self.pending.receive() {
+            Ok(Some(response)) => Some(Ok(*response.payload())),
+            Ok(None) => None,
+            Err(e) => Some(Err(transport(e))),
+        }
+    }
+}
+
+/// The CNC's end: answers pending calls and row blocks when polled (once per tick, outside
+/// the motion path).
 pub struct AcyclicServer {
     _node: Node<ipc::Service>,
     port: AcyclicServerPort,
+    rows: RowsServerPort,
 }
 
 impl core::fmt::Debug for AcyclicServer {
@@ -213,7 +298,41 @@ impl AcyclicServer {
             .server_builder()
             .create()
             .map_err(transport)?;
-        Ok(Self { _node: node, port })
+        let rows = open_rows_service(&node, instance)?
+            .server_builder()
+            .create()
+            .map_err(transport)?;
+        Ok(Self {
+            _node: node,
+            port,
+            rows,
+        })
+    }
+
+    /// Answers every pending row block with `handler(header, values)`; a block whose
+    /// payload is not `rows x columns` values is refused as a wrong column count before the
+    /// handler sees it. Returns how many blocks were answered.
+    pub fn poll_rows(
+        &self,
+        mut handler: impl FnMut(&FifoRowsHeader, &[f64]) -> FifoReply,
+    ) -> Result<usize, CallError> {
+        let mut answered = 0;
+        while let Some(active) = self.rows.receive().map_err(transport)? {
+            let header = *active.user_header();
+            let values: &[f64] = active.payload();
+            let expected = (header.rows as usize).checked_mul(header.columns as usize);
+            let reply = if expected == Some(values.len()) {
+                handler(&header, values)
+            } else {
+                FifoReply {
+                    error_id: crate::enums::FifoError::Columns.raw(),
+                    ..FifoReply::default()
+                }
+            };
+            active.send_copy(reply).map_err(transport)?;
+            answered += 1;
+        }
+        Ok(answered)
     }
 
     /// Answers every pending request with `handler(kind, request)`. Unknown kinds are refused

@@ -435,7 +435,14 @@ impl<'m> PlcView<'m> {
         Ok(DynCsState::decode(raw))
     }
 
-    /// A channel's program state `program_state_r`, validated.
+    /// FIFO group status `gpFifo[index]^` as the CNC published it (the fill level a
+    /// PLC keeps a FIFO filled by; decode `group_state_r` with
+    /// [`crate::enums::FifoGroupState::decode`]).
+    pub fn fifo_group(&self, index: usize) -> Result<HliFifoGroupState, IndexError> {
+        Ok(self.nav.fifo_group(index)?.read())
+    }
+
+    /// The program state the CNC published for `channel` (`program_state_r`), validated.
     pub fn program_state(
         &self,
         channel: usize,

@@ -60,7 +60,7 @@ hli_struct! {
     /// The complete HLI image as it lies in the shared segment.
     ///
     /// ST path: the image root (`header`, `gpCh[..]`, `gpAx[..]`, `gpFifo[..]`).
-    #[st = "HLI_IMAGE", size = 18144]
+    #[st = "HLI_IMAGE", size = 18400]
     pub struct HliImage {
         /// Identity and heartbeats.
         pub header: HliSegmentHeader => [0, Parent],

@@ -1,0 +1,221 @@
+//! The FIFO set-point generator (seed 002, chapter 5): each tick the job time advances by
+//! `tick x override`; the generator passes the rows whose time is over, interpolates the
+//! position linearly between the pair of rows around the job time, and takes velocity and
+//! acceleration as differences of its own set-points over the tick (so the velocity
+//! integrates exactly to the positions; they are coarse, as the seed warns, when T_f is
+//! much longer than the tick).
+//!
+//! When the job time reaches the last queued row the axes hold its positions and the
+//! job time waits there: if the rows asked for motion beyond it, that is an *underrun* (the
+//! axes stop at once, the group goes on as soon as rows come); if the last rows stand, the
+//! content has brought the axes to rest: the *end* of the job.
+
+use super::ring::RowRing;
+
+/// What one step found.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct GeneratorStatus {
+    /// Rows passed in this step.
+    pub rows_passed: u32,
+    /// The FIFO ran dry while the rows asked for motion: the axes hold the last row.
+    pub underrun: bool,
+    /// Every queued row is executed and the last ones stand: the axes are at rest.
+    pub at_end: bool,
+}
+
+/// Set-points of the N axes of a group.
+#[derive(Debug, Clone)]
+pub struct FifoGenerator {
+    tick_s: f64,
+    fifo_cycle_s: f64,
+    /// Job time past the front row, s, in [0, T_f).
+    offset: f64,
+    rows_passed: u64,
+    last_segment_moving: bool,
+    position: Vec<f64>,
+    velocity: Vec<f64>,
+    acceleration: Vec<f64>,
+}
+
+impl FifoGenerator {
+    /// A generator for `dimension` axes (allocates here, never in a step).
+    pub fn new(dimension: usize, tick_s: f64, fifo_cycle_s: f64) -> FifoGenerator {
+        FifoGenerator {
+            tick_s,
+            fifo_cycle_s,
+            offset: 0.0,
+            rows_passed: 0,
+            last_segment_moving: false,
+            position: vec![0.0; dimension],
+            velocity: vec![0.0; dimension],
+            acceleration: vec![0.0; dimension],
+        }
+    }
+
+    /// A new T_f (between jobs).
+    pub fn set_fifo_cycle(&mut self, fifo_cycle_s: f64) {
+        self.fifo_cycle_s = fifo_cycle_s;
+    }
+
+    /// T_f.
+    pub fn fifo_cycle(&self) -> f64 {
+        self.fifo_cycle_s
+    }
+
+    /// A job starts at the front row (which the caller has checked against the axes):
+    /// positions there, at rest, job time 0.
+    pub fn start(&mut self, ring: &RowRing) {
+        self.offset = 0.0;
+        self.rows_passed = 0;
+        self.last_segment_moving = false;
+        if let Some(row) = ring.row(0) {
+            self.position.copy_from_slice(row);
+        }
+        self.velocity.fill(0.0);
+        self.acceleration.fill(0.0);
+    }
+
+    /// One tick at `override_value` (0..=1); `ring` loses the rows passed.
+    pub fn step(&mut self, ring: &mut RowRing, override_value: f64) -> GeneratorStatus {
+        let mut status = GeneratorStatus::default();
+        self.offset += self.tick_s * override_value;
+        while ring.len() >= 2 && self.offset >= self.fifo_cycle_s {
+            self.last_segment_moving = ring.row(0) != ring.row(1);
+            ring.pop_front();
+            self.offset -= self.fifo_cycle_s;
+            self.rows_passed += 1;
+            status.rows_passed += 1;
+        }
+        if ring.len() <= 1 {
+            // Nothing ahead: hold the last row; the job time waits for rows.
+            if self.offset > 0.0 {
+                status.underrun = self.last_segment_moving;
+                self.offset = 0.0;
+            }
+            status.at_end = !self.last_segment_moving;
+        }
+        let fraction = self.offset / self.fifo_cycle_s;
+        let (Some(low), high) = (ring.row(0), ring.row(1)) else {
+            return status;
+        };
+        for c in 0..self.position.len() {
+            let p = match high {
+                Some(high) => low[c] + fraction * (high[c] - low[c]),
+                None => low[c],
+            };
+            let v = (p - self.position[c]) / self.tick_s;
+            self.acceleration[c] = (v - self.velocity[c]) / self.tick_s;
+            self.velocity[c] = v;
+            self.position[c] = p;
+        }
+        status
+    }
+
+    /// Job time, s on the FIFO's time base.
+    pub fn job_time(&self) -> f64 {
+        self.rows_passed as f64 * self.fifo_cycle_s + self.offset
+    }
+
+    /// Rows passed since the start.
+    pub fn rows_passed(&self) -> u64 {
+        self.rows_passed
+    }
+
+    /// Position set-points.
+    pub fn position(&self) -> &[f64] {
+        &self.position
+    }
+
+    /// Velocity set-points (position difference over the tick).
+    pub fn velocity(&self) -> &[f64] {
+        &self.velocity
+    }
+
+    /// Acceleration set-points (velocity difference over the tick).
+    pub fn acceleration(&self) -> &[f64] {
+        &self.acceleration
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn ring_of(rows: &[f64]) -> RowRing {
+        let mut ring = RowRing::new(1, rows.len() + 4);
+        ring.push_block(rows).unwrap();
+        ring
+    }
+
+    #[test]
+    fn fine_interpolation_walks_the_pair() {
+        // T_f = 4 ticks: three set-points between two rows, on the straight line.
+        let mut ring = ring_of(&[0.0, 4.0, 4.0]);
+        let mut g = FifoGenerator::new(1, 0.001, 0.004);
+        g.start(&ring);
+        let mut seen = Vec::new();
+        for _ in 0..6 {
+            g.step(&mut ring, 1.0);
+            seen.push(g.position()[0]);
+        }
+        for (got, want) in seen.iter().zip([1.0, 2.0, 3.0, 4.0, 4.0, 4.0]) {
+            assert!((got - want).abs() < 1e-12, "{seen:?}");
+        }
+        assert!((g.velocity()[0] - 0.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn underrun_holds_and_resumes_end_stands() {
+        let mut ring = ring_of(&[0.0, 1.0]);
+        let mut g = FifoGenerator::new(1, 0.001, 0.001);
+        g.start(&ring);
+        let s = g.step(&mut ring, 1.0);
+        assert_eq!((s.rows_passed, s.underrun), (1, false));
+        assert_eq!(g.position()[0], 1.0);
+        let s = g.step(&mut ring, 1.0);
+        assert!(s.underrun && !s.at_end, "{s:?}");
+        assert_eq!((g.position()[0], g.velocity()[0]), (1.0, 0.0));
+        // Rows arrive: the job goes on from the held row, no jump.
+        ring.push_block(&[2.0, 2.0]).unwrap();
+        g.step(&mut ring, 1.0);
+        assert_eq!(g.position()[0], 2.0);
+        let s = g.step(&mut ring, 1.0);
+        let s2 = g.step(&mut ring, 1.0);
+        assert!(!s.underrun && s.at_end && s2.at_end, "{s:?} {s2:?}");
+        assert_eq!(g.rows_passed(), 3);
+    }
+
+    proptest! {
+        /// With T_f = k x tick every k-th set-point is a row; with any ratio every set-point
+        /// lies on the straight line of its pair at the job time, and the velocities sum
+        /// (x tick) to the distance travelled.
+        #[test]
+        fn set_points_lie_on_the_rows(rows in proptest::collection::vec(-100.0f64..100.0, 2..40),
+                                      ratio in 0.1f64..7.3, ov in 0.05f64..=1.0) {
+            let tick = 0.001;
+            let t_f = tick * ratio;
+            let mut ring = ring_of(&rows);
+            let mut g = FifoGenerator::new(1, tick, t_f);
+            g.start(&ring);
+            let mut travelled = 0.0;
+            let steps = ((rows.len() - 1) as f64 * ratio / ov).ceil() as usize + 3;
+            for n in 1..=steps {
+                g.step(&mut ring, ov);
+                travelled += g.velocity()[0] * tick;
+                let t = (n as f64 * tick * ov).min((rows.len() - 1) as f64 * t_f);
+                let k = ((t / t_f).floor() as usize).min(rows.len() - 1);
+                let want = if k + 1 < rows.len() {
+                    rows[k] + (t / t_f - k as f64) * (rows[k + 1] - rows[k])
+                } else {
+                    rows[k]
+                };
+                // Rounding of t / T_f near a row moves the pair, not the point.
+                prop_assert!((g.position()[0] - want).abs() < 1e-6 * (1.0 + want.abs()),
+                    "step {n}: {} vs {want}", g.position()[0]);
+            }
+            prop_assert!((travelled - (rows[rows.len() - 1] - rows[0])).abs() < 1e-9);
+            prop_assert_eq!(g.rows_passed(), rows.len() as u64 - 1);
+        }
+    }
+}

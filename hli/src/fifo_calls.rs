@@ -1,0 +1,158 @@
+//! The FIFO group's calls (seed 002, chapter 7): the one-frame commands over the acyclic
+//! service (`FiFoGetDimension`, `FiFoGroupIntegrate`, `FiFoGroupDisintegrate`, `FiFoStart`,
+//! `FiFoStop`, `FiFoSetChannelOverride`, and the parameters a PLC may set), and the row
+//! blocks of `FiFoWrite`/`FiFoOverwrite`, which travel on a request-response service of
+//! their own: a header plus a slice of `f64` the PLC writes in place into shared memory
+//! (no copy on the way), answered with the same [`FifoReply`].
+//!
+//! Every call addresses its group by index (`target`, 0-based, `gpFifo[target]^`); axes are
+//! addressed by their `gpAx` index as in the other calls; group positions count from 1 as in
+//! the seed.
+
+use crate::calls::{AcyclicCall, CallKind};
+use crate::wire::ACYCLIC_BODY_SIZE;
+use bytemuck::{Pod, Zeroable};
+
+/// Values (rows x columns) one row block may carry: 64 KiB of `f64`, the buffer size of the
+/// seed's sample program.
+pub const FIFO_BLOCK_VALUES: usize = 8192;
+
+/// Axes a FIFO group may have.
+pub const FIFO_MAX_DIMENSION: u32 = 16;
+
+/// Rows a FIFO may hold.
+pub const FIFO_MAX_ROWS: u32 = 1 << 20;
+
+/// [`FifoParametersCall::override_type`]: the override changes at once.
+pub const FIFO_OVERRIDE_INSTANT: u32 = 0;
+/// [`FifoParametersCall::override_type`]: the override follows a PT-2 lag (damping 1.001).
+pub const FIFO_OVERRIDE_PT2: u32 = 1;
+
+/// The reply to every FIFO call and row block: 0 when accepted, else a raw
+/// [`crate::enums::FifoError`] or [`crate::enums::AxisError`]; and the FIFO's state after it.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoReply {
+    /// 0 when accepted.
+    pub error_id: u32,
+    /// Raw [`crate::enums::FifoGroupState`] after the call.
+    pub group_state: i32,
+    /// Rows queued after the call.
+    pub entries: u32,
+    /// Rows a block may bring now.
+    pub free: u32,
+    /// Dimension N (FiFoGetDimension: iNoOfAxes).
+    pub dimension: u32,
+    /// Length Z (FiFoGetDimension: iNoOfFifoEntries).
+    pub capacity: u32,
+    /// A refused block: the row (0-based) of the first bad value; rows accepted otherwise.
+    pub row: u32,
+    /// A refused block: the column of the first bad value.
+    pub column: u32,
+}
+
+/// FiFoGetDimension.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoDimensionCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// FiFoGroupIntegrate: a standing single axis joins the group at a position.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoIntegrateCall {
+    /// The axis, its `gpAx` index.
+    pub axis: u32,
+    /// Its column in the rows, 1..=N.
+    pub group_position: u32,
+}
+
+/// FiFoGroupDisintegrate: every axis leaves the group and is a free PTP axis again.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoDisintegrateCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// FiFoStart.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoStartCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// FiFoStop: the override goes to 0 (with the group's override type); then the job ends,
+/// the rows still queued are dropped and the group is Idle with its axes standing.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoStopCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// FiFoSetChannelOverride.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoOverrideCall {
+    /// Override, ppm (1,000,000 = 100 %; at most 100 %).
+    pub override_ppm: u32,
+}
+
+/// The group's parameters a PLC may set while the group is not running (the rest, N and Z,
+/// is configuration).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct FifoParametersCall {
+    /// FIFO cycle T_f, s (> 0).
+    pub fifo_cycle_s: f64,
+    /// PT-2 time constant T0, s (> 0; used by [`FIFO_OVERRIDE_PT2`]).
+    pub pt2_t0_s: f64,
+    /// [`FIFO_OVERRIDE_INSTANT`] or [`FIFO_OVERRIDE_PT2`].
+    pub override_type: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// The header of a row block (`FiFoWrite`, `FiFoOverwrite`); the payload is `rows x columns`
+/// values, row after row.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoRowsHeader {
+    /// The group, `gpFifo` index.
+    pub group: u32,
+    /// Values per row (must be the group's N).
+    pub columns: u32,
+    /// Rows in the block.
+    pub rows: u32,
+    /// 1: FiFoOverwrite (replace the rows queued behind the pair in use), 0: FiFoWrite.
+    pub overwrite: u32,
+}
+
+crate::raw::zero_copy_send!(FifoRowsHeader, FifoReply);
+
+macro_rules! fifo_calls {
+    ($($call:ty => $kind:ident),* $(,)?) => {$(
+        impl AcyclicCall for $call {
+            const KIND: CallKind = CallKind::$kind;
+            type Reply = FifoReply;
+        }
+        const _: () = assert!(core::mem::size_of::<$call>() <= ACYCLIC_BODY_SIZE);
+    )*};
+}
+
+fifo_calls! {
+    FifoDimensionCall => FifoDimension,
+    FifoIntegrateCall => FifoIntegrate,
+    FifoDisintegrateCall => FifoDisintegrate,
+    FifoStartCall => FifoStart,
+    FifoStopCall => FifoStop,
+    FifoOverrideCall => FifoOverride,
+    FifoParametersCall => FifoParameters,
+}
+
+const _: () = assert!(core::mem::size_of::<FifoReply>() == 32);
+const _: () = assert!(core::mem::size_of::<FifoRowsHeader>() == 16);
