@@ -6,6 +6,7 @@ pub mod blocks;
 pub mod cam;
 pub mod cam_compat;
 pub mod cli;
+pub mod fifo;
 pub mod motion;
 pub mod programs;
 pub mod realtime;

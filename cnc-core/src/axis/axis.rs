@@ -457,6 +457,14 @@ impl Axis {
         {
             self.fault(AxisError::FollowingError);
         }
+        // A coupled axis (cam, gear, FIFO, channel) follows set-points no generator braked
+        // for: one beyond a software limit is a fault, the axis stops where it is.
+        if let (Some(_), Some([min, max])) = (self.coupling, self.config.soft_limits) {
+            let p = self.coupled_setpoint.position;
+            if self.enabled && self.error.is_none() && !(min..=max).contains(&p) {
+                self.fault(AxisError::SoftwareLimitReached);
+            }
+        }
         let set = self.setpoint();
         let active = self.enabled && self.error.is_none();
         // Feed-forward of the mean velocity over the coming tick: with an ideal drive the

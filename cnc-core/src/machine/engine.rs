@@ -7,6 +7,7 @@
 //! the drive, and is the only writer of `gpAx[k]^`.
 
 use crate::axis::AxisSet;
+use hli::fifo_calls::{FifoReply, FifoRowsHeader};
 use hli::rpc::{AcyclicRequest, CallKind, HandlerResult};
 use hli::views::CncView;
 
@@ -40,6 +41,13 @@ pub trait Engine: std::fmt::Debug + Send {
         axes: &mut AxisSet,
     ) -> Option<HandlerResult> {
         let _ = (kind, request, axes);
+        None
+    }
+
+    /// A FIFO row block (the bulk data of the row service) this engine owns, answered;
+    /// `None` when it is not its own.
+    fn handle_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
+        let _ = (header, values);
         None
     }
 

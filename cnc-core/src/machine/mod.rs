@@ -9,7 +9,7 @@
 //!   3 hand-over    each channel's set-points to its coupled axes (Axis::drive_coupled)
 //!   4 axes sense   every axis reads its encoder and drive inputs; free axes run their
 //!                  generators, so engines see this tick's set-points of their masters
-//!   5 engines      gears (cams, FIFO groups and the flying saw next) drive their coupled axes
+//!   5 engines      gears, cams and FIFO groups (the flying saw next) drive their coupled axes
 //!   6 axes act     every axis: following error, controller, drive; the only writer of the
 //!                  axis blocks gpAx[k]^
 //!   7 CNC units    each channel's display values, state, requests and interface; heartbeat;
@@ -23,6 +23,7 @@
 pub mod cams;
 mod channel_axes;
 pub mod engine;
+pub mod fifo;
 pub mod gear;
 
 pub use channel_axes::ChannelAxes;
@@ -35,6 +36,7 @@ use crate::channel::{Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::{reply, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::DynCsState;
+use hli::fifo_calls::{FifoReply, FifoRowsHeader};
 use hli::layout::HLI_MAX_AXES;
 use hli::views::{handle_read_axis_state, CncView};
 use hli::wire::AcyclicRequest;
@@ -223,7 +225,10 @@ impl Machine {
         // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
         let read = matches!(
             kind,
-            CallKind::ReadAxisState | CallKind::CamRead | CallKind::CamPointsRead
+            CallKind::ReadAxisState
+                | CallKind::CamRead
+                | CallKind::CamPointsRead
+                | CallKind::FifoDimension
         );
         if self.stopped && !read {
             return Err(ErrorCode::Busy);
@@ -250,6 +255,26 @@ impl Machine {
             }
             // A kind of an engine this machine does not have.
             _ => Err(ErrorCode::ServiceNotSupported),
+        }
+    }
+
+    /// Answers one FIFO row block: the engine that owns it (the FIFO engine), else it is
+    /// refused as addressing no group. A stopped machine takes no rows.
+    pub fn dispatch_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> FifoReply {
+        if self.stopped {
+            return FifoReply {
+                error_id: ErrorCode::Busy.raw(),
+                ..FifoReply::default()
+            };
+        }
+        for engine in &mut self.engines {
+            if let Some(reply) = engine.handle_rows(header, values) {
+                return reply;
+            }
+        }
+        FifoReply {
+            error_id: hli::enums::FifoError::NoSuchGroup.raw(),
+            ..FifoReply::default()
         }
     }
 

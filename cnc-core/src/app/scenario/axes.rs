@@ -64,6 +64,66 @@ fn linear() -> String {
     "linear".into()
 }
 
+/// One `[[fifo_group]]` table: `gpFifo[i]^` in file order.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FifoGroupFile {
+    /// N.
+    dimension: usize,
+    /// Z.
+    rows: usize,
+    /// T_f, ms.
+    fifo_cycle_ms: f64,
+    /// "instant" (default) or "pt2".
+    #[serde(default = "instant", rename = "override")]
+    override_type: String,
+    /// T0 of the PT-2, ms.
+    pt2_t0_ms: Option<f64>,
+}
+
+fn instant() -> String {
+    "instant".into()
+}
+
+/// The FIFO groups' parameters, checked: `Err` names the group and what is wrong.
+pub fn fifo_groups(files: &[FifoGroupFile]) -> Result<Vec<crate::fifo::FifoParams>, String> {
+    use crate::fifo::{FifoParams, OverrideType};
+    if files.len() > hli::layout::HLI_MAX_FIFO_GROUPS {
+        return Err(format!(
+            "{} [[fifo_group]]: the image holds {}",
+            files.len(),
+            hli::layout::HLI_MAX_FIFO_GROUPS
+        ));
+    }
+    files
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let kind = match (f.override_type.as_str(), f.pt2_t0_ms) {
+                ("instant", None) => OverrideType::Instant,
+                ("pt2", Some(t0)) => OverrideType::Pt2 { t0_s: t0 * 1e-3 },
+                ("pt2", None) => {
+                    return Err(format!(
+                        "[[fifo_group]] {i}: override = \"pt2\" needs pt2_t0_ms"
+                    ))
+                }
+                ("instant", Some(_)) => {
+                    return Err(format!(
+                        "[[fifo_group]] {i}: pt2_t0_ms belongs to override = \"pt2\""
+                    ))
+                }
+                (other, _) => {
+                    return Err(format!(
+                        "[[fifo_group]] {i}: override = {other:?}: \"instant\" or \"pt2\""
+                    ))
+                }
+            };
+            FifoParams::new(f.dimension, f.rows, f.fifo_cycle_ms * 1e-3, kind)
+                .map_err(|e| format!("[[fifo_group]] {i}: {e}"))
+        })
+        .collect()
+}
+
 /// One `[[gear]]` table.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -13,6 +13,12 @@
 //! [[cam_table]]
 //! file = "../cams/seed_example.json"  # a JSON cam file (docs/cams.md); its `id`, or:
 //! id = 1
+//! [[fifo_group]]                  # gpFifo[0]^: N axes, Z rows, T_f (docs/fifo.md)
+//! dimension = 3
+//! rows = 500
+//! fifo_cycle_ms = 2.0
+//! override = "pt2"                # or "instant" (default)
+//! pt2_t0_ms = 40.0
 //! [plc]
 //! timeline = "plc.toml"           # or: program = "rotary-table"
 //! [trace]
@@ -63,6 +69,8 @@ struct ScenarioFile {
     gear: Vec<super::axes::GearFile>,
     #[serde(default)]
     cam_table: Vec<CamTableFile>,
+    #[serde(default)]
+    fifo_group: Vec<super::axes::FifoGroupFile>,
     plc: Option<PlcFile>,
     #[serde(default)]
     trace: TraceFile,
@@ -137,6 +145,8 @@ pub struct Scenario {
     pub gears: Vec<crate::machine::gear::GearSpec>,
     /// Cam tables by ID, loaded into the cam engine at start.
     pub cam_tables: Vec<(u32, crate::cam::CamProfile)>,
+    /// FIFO groups, `gpFifo[0..]` (the FIFO engine exists when there is one).
+    pub fifo_groups: Vec<crate::fifo::FifoParams>,
     /// The PLC.
     pub plc: PlcSetup,
     /// Trace signals: ST path and resolved leaf.
@@ -312,6 +322,7 @@ impl Scenario {
             }
             cam_tables.push((id, cam.profile));
         }
+        let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
         let mut signals = Vec::with_capacity(file.trace.signals.len());
         for s in file.trace.signals {
             let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;
@@ -327,6 +338,7 @@ impl Scenario {
             axes,
             gears,
             cam_tables,
+            fifo_groups,
             plc,
             signals,
             realtime: file.realtime,

@@ -53,6 +53,11 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         let total = channel_axes + scenario.axes.len();
         engines.push(Box::new(crate::machine::cams::CamEngine::new(store, total)));
     }
+    if !scenario.fifo_groups.is_empty() {
+        let fifo = crate::machine::fifo::FifoEngine::new(&scenario.fifo_groups, scenario.cycle_s)
+            .map_err(|e| invalid(e.to_string()))?;
+        engines.push(Box::new(fifo));
+    }
     let mut machine = Machine::new(MachineSetup {
         channels,
         axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),
@@ -148,6 +153,7 @@ impl InProcess {
                 let view = CncView::new(&self.memory);
                 let machine = &mut self.machine;
                 let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
+                let _ = server.poll_rows(|header, values| machine.dispatch_rows(header, values));
                 timeline.cycle_io(&mut PlcIo {
                     view: PlcView::new(&self.memory),
                     memory: &self.memory,

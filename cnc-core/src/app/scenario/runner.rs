@@ -356,6 +356,9 @@ fn run_machine(
         acyclic_answered += server
             .poll(|kind, request| machine.dispatch(&view, kind, request))
             .unwrap_or(0) as u64;
+        acyclic_answered += server
+            .poll_rows(|header, values| machine.dispatch_rows(header, values))
+            .unwrap_or(0) as u64;
         let t3 = monotonic::now();
         let _ = events.notify();
         let t4 = monotonic::now();

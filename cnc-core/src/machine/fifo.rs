@@ -1,0 +1,558 @@
+//! The FIFO engine (seed 002): groups of single axes driven by rows the PLC streams in.
+//!
+//! A standing, enabled axis joins a group at a column (FiFoGroupIntegrate) and is coupled to
+//! the group from then on: it holds its position and refuses PTP commands until the group
+//! is dissolved (FiFoGroupDisintegrate). Rows arrive in blocks between ticks, each queued
+//! whole or refused whole ([`crate::fifo::RowRing`]); FiFoStart checks that the group is
+//! complete, standing, and that the first row is where the axes stand; then each tick the
+//! generator ([`crate::fifo::FifoGenerator`]) advances by `tick x override` and hands every
+//! axis its set-point. FiFoStop pulls the override to 0 (PT-2 or at once); when it is there
+//! the job ends, the rows left are dropped and the group is Idle with its axes standing.
+//!
+//! If an axis of a running group faults (following error, drive, power), the job ends: the
+//! group goes to Error, its other axes leave the group and stop with their own
+//! deceleration (MC_Halt), and the PLC reads `AxisFault` in `gpFifo[i]^error_id_r`.
+//!
+//! Every tick the engine publishes each group's state, fill level, override and counters in
+//! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
+//! are sized when the engine is built.
+
+use super::engine::{Engine, EngineIo};
+use crate::axis::generator::Kinematic;
+use crate::axis::{AxisSet, Coupling};
+use crate::fifo::{
+    BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
+};
+use hli::calls::{decode_body, reply, AxisCommandCall, CallKind, HandlerResult};
+use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
+use hli::fifo_calls::{
+    FifoIntegrateCall, FifoOverrideCall, FifoParametersCall, FifoReply, FifoRowsHeader,
+    FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
+};
+use hli::layout::{
+    HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
+    FIFO_OVERRIDE_FULL, HLI_MAX_FIFO_GROUPS,
+};
+use hli::wire::AcyclicRequest;
+use hli::PlaceExt;
+
+/// Why the engine cannot be built.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum FifoConfigError {
+    /// More groups than the image holds.
+    #[error("{0} FIFO groups: the image holds {HLI_MAX_FIFO_GROUPS}")]
+    TooManyGroups(usize),
+    /// A group's parameters.
+    #[error("FIFO group {group}: {error}")]
+    Params {
+        /// The group index.
+        group: usize,
+        /// What is wrong.
+        error: ParamError,
+    },
+}
+
+/// One group.
+#[derive(Debug)]
+struct Group {
+    params: FifoParams,
+    /// Axis index per column (group position - 1).
+    members: Vec<Option<usize>>,
+    ring: RowRing,
+    generator: FifoGenerator,
+    ovr: OverrideFilter,
+    state: FifoGroupState,
+    error: Option<FifoError>,
+    flags: u32,
+    rows_written: u64,
+    underrun_ticks: u32,
+    /// The override target before FiFoStop, in effect again once the stop has ended the job.
+    before_stop: f64,
+}
+
+const MEMBER: Coupling = Coupling {
+    kind: CouplingState::Fifo,
+    master: -1,
+    phase: AxisState::SlaveSynchronous,
+};
+
+fn is_member(axes: &AxisSet, axis: usize) -> bool {
+    axes.axis(axis)
+        .and_then(|a| a.coupling())
+        .is_some_and(|c| c.kind == CouplingState::Fifo)
+}
+
+fn ppm(value: f64) -> u32 {
+    (value * f64::from(FIFO_OVERRIDE_FULL)).round() as u32
+}
+
+impl Group {
+    fn new(params: FifoParams, tick_s: f64) -> Group {
+        Group {
+            members: vec![None; params.dimension],
+            ring: RowRing::new(params.dimension, params.rows),
+            generator: FifoGenerator::new(params.dimension, tick_s, params.fifo_cycle_s),
+            ovr: OverrideFilter::new(params.override_type, tick_s),
+            state: FifoGroupState::Idle,
+            error: None,
+            flags: 0,
+            rows_written: 0,
+            underrun_ticks: 0,
+            before_stop: 1.0,
+            params,
+        }
+    }
+
+    fn running(&self) -> bool {
+        matches!(
+            self.state,
+            FifoGroupState::Running | FifoGroupState::Stopping
+        )
+    }
+
+    fn reply(&self, error: Option<u32>) -> FifoReply {
+        FifoReply {
+            error_id: error.unwrap_or(0),
+            group_state: self.state.raw(),
+            entries: self.ring.len() as u32,
+            free: self.ring.free() as u32,
+            dimension: self.params.dimension as u32,
+            capacity: self.params.rows as u32,
+            row: 0,
+            column: 0,
+        }
+    }
+
+    fn refuse(&self, error: FifoError) -> FifoReply {
+        self.reply(Some(error.raw()))
+    }
+
+    /// The job is over (stopped, or ended by a fault): no rows, counters for the next.
+    fn end_job(&mut self, state: FifoGroupState) {
+        self.ring.clear();
+        self.state = state;
+        self.rows_written = 0;
+        self.underrun_ticks = 0;
+        self.flags = 0;
+    }
+
+    fn image(&self) -> HliFifoGroupState {
+        let mut flags = self.flags;
+        if self.ovr.settled() {
+            flags |= FIFO_FLAG_OVERRIDE_SETTLED;
+        }
+        HliFifoGroupState {
+            group_state_r: self.state.raw(),
+            dimension_r: self.params.dimension as u32,
+            axis_count_r: self.members.iter().flatten().count() as u32,
+            capacity_r: self.params.rows as u32,
+            entries_r: self.ring.len() as u32,
+            free_r: self.ring.free() as u32,
+            error_id_r: self.error.map_or(0, FifoError::raw),
+            flags_r: flags,
+            override_r: ppm(self.ovr.value()),
+            override_target_r: ppm(self.ovr.target()),
+            rows_written_r: self.rows_written,
+            rows_consumed_r: self.generator.rows_passed(),
+            underrun_ticks_r: self.underrun_ticks,
+            fill_up_1: 0,
+            job_time_r: if self.running() {
+                self.generator.job_time()
+            } else {
+                0.0
+            },
+        }
+    }
+
+    /// A member faulted while the group ran: the job ends, the others stop on their own.
+    fn fault(&mut self, axes: &mut AxisSet) {
+        for axis in self.members.iter_mut().filter_map(Option::take) {
+            if let Some(a) = axes.axis_mut(axis) {
+                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
+                    a.decouple();
+                    let d = a.config().dynamics;
+                    // MC_Halt, not MC_Stop: the axis must not stay locked for the PLC that
+                    // regroups it. Refused only by an axis that stands already.
+                    let _ = a.command(&AxisCommandCall::halt(d.deceleration, d.jerk));
+                }
+            }
+        }
+        self.error = Some(FifoError::AxisFault);
+        self.end_job(FifoGroupState::Error);
+    }
+
+    fn tick(&mut self, axes: &mut AxisSet) {
+        if !self.running() {
+            // Members stand where they are; one that lost its coupling (power off, fault,
+            // reset) has left the group.
+            for slot in &mut self.members {
+                let Some(axis) = *slot else { continue };
+                if !is_member(axes, axis) {
+                    *slot = None;
+                    continue;
+                }
+                if let Some(a) = axes.axis_mut(axis) {
+                    let hold = Kinematic {
+                        position: a.setpoint().position,
+                        ..Kinematic::default()
+                    };
+                    a.drive_coupled(hold, AxisState::SlaveSynchronous);
+                }
+            }
+            return;
+        }
+        if self
+            .members
+            .iter()
+            .any(|m| !m.is_some_and(|axis| is_member(axes, axis)))
+        {
+            self.fault(axes);
+            return;
+        }
+        let ov = self.ovr.step();
+        let status = self.generator.step(&mut self.ring, ov);
+        for (c, axis) in self.members.iter().enumerate() {
+            let Some(a) = axis.and_then(|axis| axes.axis_mut(axis)) else {
+                continue;
+            };
+            a.drive_coupled(
+                Kinematic {
+                    position: self.generator.position()[c],
+                    velocity: self.generator.velocity()[c],
+                    acceleration: self.generator.acceleration()[c],
+                    jerk: 0.0,
+                },
+                AxisState::SlaveSynchronous,
+            );
+        }
+        self.flags = 0;
+        if status.underrun {
+            self.flags |= FIFO_FLAG_UNDERRUN;
+            self.underrun_ticks = self.underrun_ticks.saturating_add(1);
+        }
+        if status.at_end {
+            self.flags |= FIFO_FLAG_AT_END;
+        }
+        if self.state == FifoGroupState::Stopping && self.ovr.settled() && ov == 0.0 {
+            self.end_job(FifoGroupState::Idle);
+            self.ovr.reset(self.before_stop);
+        }
+    }
+
+    fn integrate(&mut self, call: FifoIntegrateCall, axes: &mut AxisSet) -> FifoReply {
+        if self.running() {
+            return self.refuse(FifoError::Running);
+        }
+        let column = call.group_position as usize;
+        if !(1..=self.params.dimension).contains(&column) {
+            return self.refuse(FifoError::GroupPosition);
+        }
+        let axis = call.axis as usize;
+        let Some(a) = axes.axis_mut(axis) else {
+            return self.refuse(FifoError::NoSuchAxis);
+        };
+        match a.coupling().map(|c| c.kind) {
+            Some(CouplingState::Fifo) => return self.refuse(FifoError::AxisInGroup),
+            Some(_) => return self.refuse(FifoError::AxisCoupled),
+            None => {}
+        }
+        if self.members[column - 1].is_some() {
+            return self.refuse(FifoError::PositionTaken);
+        }
+        if a.setpoint().velocity != 0.0 {
+            return self.refuse(FifoError::AxisMoving);
+        }
+        if let Err(e) = a.couple(MEMBER) {
+            return self.reply(Some(e.raw()));
+        }
+        self.members[column - 1] = Some(axis);
+        if self.state == FifoGroupState::Error {
+            self.error = None;
+            self.state = FifoGroupState::Idle;
+        }
+        self.reply(None)
+    }
+
+    fn disintegrate(&mut self, axes: &mut AxisSet) -> FifoReply {
+        if self.running() {
+            return self.refuse(FifoError::Running);
+        }
+        for axis in self.members.iter_mut().filter_map(Option::take) {
+            if let Some(a) = axes.axis_mut(axis) {
+                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
+                    a.decouple();
+                }
+            }
+        }
+        if self.state == FifoGroupState::Error {
+            self.error = None;
+            self.state = FifoGroupState::Idle;
+        }
+        self.reply(None)
+    }
+
+    fn start(&mut self, axes: &AxisSet) -> FifoReply {
+        if self.running() {
+            return self.refuse(FifoError::Running);
+        }
+        if self.state == FifoGroupState::Error {
+            return self.refuse(FifoError::AxisFault);
+        }
+        if self
+            .members
+            .iter()
+            .any(|m| !m.is_some_and(|axis| is_member(axes, axis)))
+        {
+            return self.refuse(FifoError::GroupIncomplete);
+        }
+        let Some(first) = self.ring.row(0) else {
+            return self.refuse(FifoError::Empty);
+        };
+        for (c, axis) in self.members.iter().enumerate() {
+            let Some(a) = axis.and_then(|axis| axes.axis(axis)) else {
+                continue;
+            };
+            let set = a.setpoint();
+            if set.velocity != 0.0 {
+                return self.refuse(FifoError::AxisMoving);
+            }
+            if (first[c] - set.position).abs() > a.config().in_target_window {
+                let mut r = self.refuse(FifoError::StartMismatch);
+                r.column = c as u32;
+                return r;
+            }
+        }
+        self.generator.start(&self.ring);
+        // An override set before the start is in effect from the first tick.
+        self.ovr.reset(self.ovr.target());
+        self.state = FifoGroupState::Running;
+        self.flags = 0;
+        self.underrun_ticks = 0;
+        self.reply(None)
+    }
+
+    fn stop(&mut self) -> FifoReply {
+        if self.state == FifoGroupState::Running {
+            self.before_stop = self.ovr.target();
+            self.ovr.set_target(0.0);
+            self.state = FifoGroupState::Stopping;
+        } else if self.state == FifoGroupState::Stopping {
+        } else if self.state != FifoGroupState::Error {
+            self.end_job(FifoGroupState::Idle);
+        }
+        self.reply(None)
+    }
+
+    fn set_override(&mut self, call: FifoOverrideCall) -> FifoReply {
+        if self.state == FifoGroupState::Stopping {
+            return self.refuse(FifoError::Stopping);
+        }
+        if call.override_ppm > FIFO_OVERRIDE_FULL {
+            return self.refuse(FifoError::Override);
+        }
+        let value = f64::from(call.override_ppm) / f64::from(FIFO_OVERRIDE_FULL);
+        if self.running() {
+            self.ovr.set_target(value);
+        } else {
+            self.ovr.reset(value);
+        }
+        self.reply(None)
+    }
+
+    fn set_parameters(&mut self, call: FifoParametersCall, tick_s: f64) -> FifoReply {
+        if self.running() {
+            return self.refuse(FifoError::Running);
+        }
+        let kind = match call.override_type {
+            FIFO_OVERRIDE_INSTANT => OverrideType::Instant,
+            FIFO_OVERRIDE_PT2 => OverrideType::Pt2 {
+                t0_s: call.pt2_t0_s,
+            },
+            _ => return self.refuse(FifoError::Parameter),
+        };
+        let Ok(params) = FifoParams::new(
+            self.params.dimension,
+            self.params.rows,
+            call.fifo_cycle_s,
+            kind,
+        ) else {
+            return self.refuse(FifoError::Parameter);
+        };
+        self.params = params;
+        self.generator.set_fifo_cycle(params.fifo_cycle_s);
+        let value = self.ovr.target();
+        self.ovr = OverrideFilter::new(kind, tick_s);
+        self.ovr.reset(value);
+        self.reply(None)
+    }
+
+    fn write(&mut self, header: &FifoRowsHeader, values: &[f64]) -> FifoReply {
+        match self.state {
+            FifoGroupState::Stopping => return self.refuse(FifoError::Stopping),
+            FifoGroupState::Error => return self.refuse(FifoError::AxisFault),
+            _ => {}
+        }
+        if header.columns as usize != self.params.dimension {
+            return self.refuse(FifoError::Columns);
+        }
+        let result = if header.overwrite != 0 {
+            // A running group keeps the pair it interpolates between.
+            let keep = if self.running() { 2 } else { 0 };
+            self.ring.replace_after(keep, values)
+        } else {
+            self.ring.push_block(values)
+        };
+        match result {
+            Ok(rows) => {
+                self.rows_written += rows as u64;
+                if self.state == FifoGroupState::Idle {
+                    self.state = FifoGroupState::Filling;
+                }
+                let mut r = self.reply(None);
+                r.row = rows as u32;
+                r
+            }
+            Err(BlockError::Full { .. }) => self.refuse(FifoError::Full),
+            Err(BlockError::Columns { .. }) => self.refuse(FifoError::Columns),
+            Err(BlockError::Empty) => self.refuse(FifoError::BlockSize),
+            Err(BlockError::NonFinite { row, column, .. }) => {
+                let mut r = self.refuse(FifoError::NonFinite);
+                r.row = row as u32;
+                r.column = column as u32;
+                r
+            }
+        }
+    }
+
+    /// The machine stops: the job ends, every member leaves the group (the machine then
+    /// stops each axis with its own deceleration).
+    fn reset(&mut self, axes: &mut AxisSet) {
+        for axis in self.members.iter_mut().filter_map(Option::take) {
+            if let Some(a) = axes.axis_mut(axis) {
+                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
+                    a.decouple();
+                }
+            }
+        }
+        self.error = None;
+        self.end_job(FifoGroupState::Idle);
+    }
+}
+
+/// The FIFO groups of a machine.
+#[derive(Debug)]
+pub struct FifoEngine {
+    groups: Vec<Group>,
+    tick_s: f64,
+}
+
+impl FifoEngine {
+    /// Groups `gpFifo[0..]` with these parameters, for a tick of `tick_s`.
+    pub fn new(groups: &[FifoParams], tick_s: f64) -> Result<FifoEngine, FifoConfigError> {
+        if groups.len() > HLI_MAX_FIFO_GROUPS {
+            return Err(FifoConfigError::TooManyGroups(groups.len()));
+        }
+        for (group, p) in groups.iter().enumerate() {
+            FifoParams::new(p.dimension, p.rows, p.fifo_cycle_s, p.override_type)
+                .map_err(|error| FifoConfigError::Params { group, error })?;
+        }
+        Ok(FifoEngine {
+            groups: groups.iter().map(|&p| Group::new(p, tick_s)).collect(),
+            tick_s,
+        })
+    }
+
+    /// Groups configured.
+    pub fn len(&self) -> usize {
+        self.groups.len()
+    }
+
+    /// Whether no group is configured.
+    pub fn is_empty(&self) -> bool {
+        self.groups.is_empty()
+    }
+
+    /// The status group `index` publishes (as in `gpFifo[index]^`).
+    pub fn status(&self, index: usize) -> Option<HliFifoGroupState> {
+        self.groups.get(index).map(Group::image)
+    }
+
+    fn call(&mut self, kind: CallKind, request: &AcyclicRequest, axes: &mut AxisSet) -> FifoReply {
+        let tick_s = self.tick_s;
+        let Some(group) = self.groups.get_mut(request.target as usize) else {
+            return FifoReply {
+                error_id: FifoError::NoSuchGroup.raw(),
+                ..FifoReply::default()
+            };
+        };
+        match kind {
+            CallKind::FifoIntegrate => match decode_body(request) {
+                Ok(call) => group.integrate(call, axes),
+                Err(_) => group.refuse(FifoError::Parameter),
+            },
+            CallKind::FifoDisintegrate => group.disintegrate(axes),
+            CallKind::FifoStart => group.start(axes),
+            CallKind::FifoStop => group.stop(),
+            CallKind::FifoOverride => match decode_body(request) {
+                Ok(call) => group.set_override(call),
+                Err(_) => group.refuse(FifoError::Parameter),
+            },
+            CallKind::FifoParameters => match decode_body(request) {
+                Ok(call) => group.set_parameters(call, tick_s),
+                Err(_) => group.refuse(FifoError::Parameter),
+            },
+            // FiFoGetDimension, and nothing else reaches here.
+            _ => group.reply(None),
+        }
+    }
+}
+
+impl Engine for FifoEngine {
+    fn name(&self) -> &'static str {
+        "fifo"
+    }
+
+    fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
+        for (i, group) in self.groups.iter_mut().enumerate() {
+            group.tick(io.axes);
+            if let Ok(place) = io.view.fifo_group(i) {
+                place.write(&group.image());
+            }
+        }
+    }
+
+    fn handle(
+        &mut self,
+        kind: CallKind,
+        request: &AcyclicRequest,
+        axes: &mut AxisSet,
+    ) -> Option<HandlerResult> {
+        let fifo = matches!(
+            kind,
+            CallKind::FifoDimension
+                | CallKind::FifoIntegrate
+                | CallKind::FifoDisintegrate
+                | CallKind::FifoStart
+                | CallKind::FifoStop
+                | CallKind::FifoOverride
+                | CallKind::FifoParameters
+        );
+        fifo.then(|| reply(&self.call(kind, request, axes)))
+    }
+
+    fn handle_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
+        Some(match self.groups.get_mut(header.group as usize) {
+            Some(group) => group.write(header, values),
+            None => FifoReply {
+                error_id: FifoError::NoSuchGroup.raw(),
+                ..FifoReply::default()
+            },
+        })
+    }
+
+    fn reset(&mut self, axes: &mut AxisSet) {
+        for group in &mut self.groups {
+            group.reset(axes);
+        }
+    }
+}

@@ -1,0 +1,217 @@
+//! The FIFO blocks of seed 002 chapter 7 for the PLC program: FiFoGetDimension,
+//! FiFoGroupIntegrate, FiFoGroupDisintegrate, FiFoWrite, FiFoOverwrite, FiFoStart, FiFoStop,
+//! FiFoSetChannelOverride, our FiFoSetParameters, and the library version function. Each
+//! sends on the rising Execute edge without waiting, is Busy until the CNC answers, then
+//! Done or Error (with the CNC's code, [`hli::enums::FifoError`] or
+//! [`hli::enums::AxisError`]); the outputs clear one cycle after Execute falls.
+//!
+//! FiFoWrite and FiFoOverwrite send a row block on the row service: the rows are written
+//! once, straight into the shared memory the CNC reads (seed: `AdrdataArray`, `iColDim`,
+//! `iRowsToWrite`). A block the FIFO cannot take whole is refused whole (`Full`): offer it
+//! again later; [`PlcView::fifo_group`](hli::views::PlcView::fifo_group) tells the free rows.
+
+use crate::cam::rose;
+use crate::motion::ERROR_NO_ANSWER;
+use crate::runtime::PlcIo;
+use hli::calls::{AcyclicCall, CallError};
+use hli::fifo_calls::{
+    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
+    FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
+};
+use hli::rpc::{PendingCall, PendingRows};
+
+/// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).
+pub fn fifo_library_version() -> &'static str {
+    concat!("cncplc-fifo ", env!("CARGO_PKG_VERSION"))
+}
+
+/// Error id of a row block that does not fit one call (more than
+/// [`FIFO_BLOCK_VALUES`] values, or rows x columns not the slice given): refused in the PLC.
+pub const ERROR_BLOCK_SIZE: u32 = hli::enums::FifoError::BlockSize as u32;
+
+/// Outputs of a FIFO block.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FifoOutputs {
+    /// The CNC took the call.
+    pub done: bool,
+    /// Sent, not answered.
+    pub busy: bool,
+    /// Refused or failed; see `error_id`.
+    pub error: bool,
+    /// The CNC's code (or [`ERROR_NO_ANSWER`]).
+    pub error_id: u32,
+    /// The CNC's reply: the FIFO's state, fill level, and FiFoGetDimension's values.
+    pub reply: FifoReply,
+}
+
+fn failed(error_id: u32, reply: FifoReply) -> FifoOutputs {
+    FifoOutputs {
+        error: true,
+        error_id,
+        reply,
+        ..FifoOutputs::default()
+    }
+}
+
+fn answered(reply: FifoReply) -> FifoOutputs {
+    if reply.error_id != 0 {
+        failed(reply.error_id, reply)
+    } else {
+        FifoOutputs {
+            done: true,
+            reply,
+            ..FifoOutputs::default()
+        }
+    }
+}
+
+fn polled(result: Option<Result<FifoReply, CallError>>) -> Option<FifoOutputs> {
+    Some(match result? {
+        Ok(reply) => answered(reply),
+        Err(CallError::Refused { code }) => failed(code.raw(), FifoReply::default()),
+        Err(_) => failed(ERROR_NO_ANSWER, FifoReply::default()),
+    })
+}
+
+/// Edge, pending answer and outputs of a one-frame FIFO block.
+pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
+    execute_before: bool,
+    pending: Option<PendingCall<C>>,
+    out: FifoOutputs,
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
+    fn default() -> Self {
+        Self {
+            execute_before: false,
+            pending: None,
+            out: FifoOutputs::default(),
+        }
+    }
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> core::fmt::Debug for FifoBlock<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FifoBlock").field("out", &self.out).finish()
+    }
+}
+
+/// Clears the outputs one cycle after Execute fell with nothing pending.
+fn settle(out: &mut FifoOutputs, execute: bool, idle: bool) -> FifoOutputs {
+    let shown = *out;
+    if !execute && idle {
+        *out = FifoOutputs::default();
+    }
+    shown
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
+    /// One cycle: on a rising `execute`, `call()` goes to FIFO group `group`.
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        group: u32,
+        call: impl FnOnce() -> C,
+    ) -> FifoOutputs {
+        if rose(&mut self.execute_before, execute) {
+            self.out = FifoOutputs::default();
+            match io.acyclic.start(group, &call()) {
+                Ok(p) => self.pending = Some(p),
+                Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
+            }
+        }
+        if let Some(p) = &self.pending {
+            match polled(p.poll()) {
+                None => self.out.busy = true,
+                Some(out) => {
+                    self.out = out;
+                    self.pending = None;
+                }
+            }
+        }
+        settle(&mut self.out, execute, self.pending.is_none())
+    }
+}
+
+/// FiFoGetDimension: `reply.dimension` (iNoOfAxes) and `reply.capacity` (iNoOfFifoEntries).
+pub type FifoGetDimension = FifoBlock<FifoDimensionCall>;
+/// FiFoGroupIntegrate.
+pub type FifoGroupIntegrate = FifoBlock<FifoIntegrateCall>;
+/// FiFoGroupDisintegrate.
+pub type FifoGroupDisintegrate = FifoBlock<FifoDisintegrateCall>;
+/// FiFoStart.
+pub type FifoStart = FifoBlock<FifoStartCall>;
+/// FiFoStop.
+pub type FifoStop = FifoBlock<FifoStopCall>;
+/// FiFoSetChannelOverride (ppm, 1,000,000 = 100 %).
+pub type FifoSetChannelOverride = FifoBlock<FifoOverrideCall>;
+/// FiFoSetParameters (ours): T_f and the override type while the group is not running.
+pub type FifoSetParameters = FifoBlock<FifoParametersCall>;
+
+/// FiFoWrite (`overwrite` false) or FiFoOverwrite (true).
+#[derive(Debug, Default)]
+pub struct FifoWrite {
+    /// FiFoOverwrite: replace the rows queued behind the pair in use.
+    pub overwrite: bool,
+    execute_before: bool,
+    pending: Option<PendingRows>,
+    out: FifoOutputs,
+}
+
+impl FifoWrite {
+    /// FiFoOverwrite.
+    pub fn overwrite() -> FifoWrite {
+        FifoWrite {
+            overwrite: true,
+            ..FifoWrite::default()
+        }
+    }
+
+    /// One cycle: on a rising `execute`, the first `rows` rows of `data` (rows of `columns`
+    /// values, row after row: iColDim, iRowsToWrite) go to group `group`.
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        group: u32,
+        data: &[f64],
+        columns: u32,
+        rows: u32,
+    ) -> FifoOutputs {
+        if rose(&mut self.execute_before, execute) {
+            self.out = FifoOutputs::default();
+            let values = (columns as usize).checked_mul(rows as usize);
+            match values {
+                Some(n) if n <= data.len() && n <= FIFO_BLOCK_VALUES => {
+                    let header = FifoRowsHeader {
+                        group,
+                        columns,
+                        rows,
+                        overwrite: u32::from(self.overwrite),
+                    };
+                    match io.acyclic.start_rows(header, &data[..n]) {
+                        Ok(p) => self.pending = Some(p),
+                        Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
+                    }
+                }
+                _ => self.out = failed(ERROR_BLOCK_SIZE, FifoReply::default()),
+            }
+        }
+        if let Some(p) = &self.pending {
+            match polled(p.poll()) {
+                None => self.out.busy = true,
+                Some(out) => {
+                    self.out = out;
+                    self.pending = None;
+                }
+            }
+        }
+        settle(&mut self.out, execute, self.pending.is_none())
+    }
+
+    /// Whether a block is on its way.
+    pub fn busy(&self) -> bool {
+        self.pending.is_some()
+    }
+}
