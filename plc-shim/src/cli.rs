@@ -20,6 +20,15 @@ pub struct PlcArgs {
     /// Run this timeline (TOML, see `plc_shim::timeline`) instead of a built-in program.
     #[arg(long)]
     pub timeline: Option<std::path::PathBuf>,
+    /// Position file of `fifo-stream` (CSV, or binary `.fifo`; see `plc_shim::fifo_file`).
+    #[arg(long)]
+    pub file: Option<std::path::PathBuf>,
+    /// FIFO group of `fifo-stream`.
+    #[arg(long, default_value_t = 0)]
+    pub fifo_group: u32,
+    /// Override `fifo-stream` sets before the start, percent.
+    #[arg(long)]
+    pub fifo_override: Option<f64>,
     /// Table speed of `rotary-table`, degree per cycle.
     #[arg(long, default_value_t = 0.01)]
     pub deg_per_cycle: f64,
@@ -35,7 +44,7 @@ pub struct PlcArgs {
 }
 
 /// Names of the built-in programs.
-pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor"];
+pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor", "fifo-stream"];
 
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn main(args: PlcArgs) -> ExitCode {
@@ -49,6 +58,13 @@ pub fn main(args: PlcArgs) -> ExitCode {
         },
         (None, "rotary-table") => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
         (None, "cam-conveyor") => Box::new(crate::programs::cam_conveyor::CamConveyor::new()),
+        (None, "fifo-stream") => match fifo_stream(&args) {
+            Ok(p) => Box::new(p),
+            Err(e) => {
+                eprintln!("plc: fifo-stream: {e}");
+                return ExitCode::from(2);
+            }
+        },
         (None, other) => {
             eprintln!("plc: unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})");
             return ExitCode::from(2);
@@ -83,4 +99,20 @@ pub fn main(args: PlcArgs) -> ExitCode {
             ExitCode::from(1)
         }
     }
+}
+
+fn fifo_stream(args: &PlcArgs) -> Result<crate::programs::fifo_stream::FifoStream, String> {
+    let file = args
+        .file
+        .as_ref()
+        .ok_or("needs --file (the position file)")?;
+    let mut p = crate::programs::fifo_stream::FifoStream::new(file, args.fifo_group)
+        .map_err(|e| e.to_string())?;
+    if let Some(percent) = args.fifo_override {
+        if !(0.0..=100.0).contains(&percent) {
+            return Err(format!("--fifo-override {percent}: 0 to 100 percent"));
+        }
+        p.override_ppm = Some((percent * 1e4).round() as u32);
+    }
+    Ok(p)
 }

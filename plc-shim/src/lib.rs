@@ -7,6 +7,7 @@ pub mod cam;
 pub mod cam_compat;
 pub mod cli;
 pub mod fifo;
+pub mod fifo_file;
 pub mod motion;
 pub mod programs;
 pub mod realtime;

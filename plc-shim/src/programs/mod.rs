@@ -1,7 +1,8 @@
-//! Example PLC programs: the rotary table as dynamic-CS master (here) and the cam conveyor
-//! ([`cam_conveyor`]).
+//! Example PLC programs: the rotary table as dynamic-CS master (here), the cam conveyor
+//! ([`cam_conveyor`]) and a position file streamed through a FIFO group ([`fifo_stream`]).
 
 pub mod cam_conveyor;
+pub mod fifo_stream;
 
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};

@@ -20,7 +20,8 @@
 //! override = "pt2"                # or "instant" (default)
 //! pt2_t0_ms = 40.0
 //! [plc]
-//! timeline = "plc.toml"           # or: program = "rotary-table"
+//! timeline = "plc.toml"           # or: program = "rotary-table"; program = "fifo-stream"
+//!                                 # with file = "contour.csv" (and fifo_override = 80.0)
 //! [trace]
 //! signals = ["gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state"]
 //! ```
@@ -96,6 +97,10 @@ struct CamTableFile {
 struct PlcFile {
     timeline: Option<String>,
     program: Option<String>,
+    /// A built-in program's data file (fifo-stream's positions), relative to the scenario.
+    file: Option<String>,
+    /// fifo-stream's override before the start, percent.
+    fifo_override: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -120,8 +125,8 @@ pub enum PlcSetup {
         /// The parsed timeline.
         timeline: Box<plc_shim::timeline::Timeline>,
     },
-    /// A built-in program of `plc-shim` by name.
-    Program(String),
+    /// A built-in program of `plc-shim` by name, with its arguments (`--file PATH`...).
+    Program(String, Vec<String>),
 }
 
 /// A checked scenario, every file read.
@@ -219,6 +224,8 @@ impl Scenario {
             Some(PlcFile {
                 timeline: Some(t),
                 program: None,
+                file: None,
+                fifo_override: None,
             }) => {
                 let (path, text) = open(&t)?;
                 // Checked here, so a bad timeline fails before any process starts.
@@ -234,6 +241,8 @@ impl Scenario {
             Some(PlcFile {
                 timeline: None,
                 program: Some(p),
+                file,
+                fifo_override,
             }) => {
                 if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p.as_str()) {
                     return Err(invalid(format!(
@@ -241,7 +250,33 @@ impl Scenario {
                         plc_shim::cli::BUILT_IN_PROGRAMS
                     )));
                 }
-                PlcSetup::Program(p)
+                let mut args = Vec::new();
+                if let Some(f) = file {
+                    // Resolved beside the scenario and checked (header or first row) now.
+                    let path = Path::new(name).parent().unwrap_or(Path::new(".")).join(&f);
+                    plc_shim::fifo_file::RowReader::open(&path)
+                        .map_err(|e| invalid(format!("[plc] file: {e}")))?;
+                    let path = std::fs::canonicalize(&path).unwrap_or(path);
+                    args.extend(["--file".to_string(), path.display().to_string()]);
+                }
+                if let Some(o) = fifo_override {
+                    if !(0.0..=100.0).contains(&o) {
+                        return Err(invalid(format!(
+                            "[plc] fifo_override = {o}: 0 to 100 percent"
+                        )));
+                    }
+                    args.extend(["--fifo-override".to_string(), o.to_string()]);
+                }
+                PlcSetup::Program(p, args)
+            }
+            Some(PlcFile {
+                timeline: Some(_),
+                program: None,
+                ..
+            }) => {
+                return Err(invalid(
+                    "[plc] `file` and `fifo_override` belong to a built-in program".into(),
+                ))
             }
             Some(_) => {
                 return Err(invalid(

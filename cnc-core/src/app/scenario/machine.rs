@@ -106,7 +106,7 @@ impl InProcess {
         let timeline = match &scenario.plc {
             PlcSetup::None => None,
             PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
-            PlcSetup::Program(p) => {
+            PlcSetup::Program(p, _) => {
                 return Err(invalid(format!(
                     "built-in PLC program {p:?} runs only in the PLC process"
                 )))

@@ -557,8 +557,8 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
             };
             command.arg("--timeline").arg(file);
         }
-        PlcSetup::Program(p) => {
-            command.args(["--program", p]);
+        PlcSetup::Program(p, args) => {
+            command.args(["--program", p]).args(args);
         }
     }
     command.args(scenario.realtime_plc.to_args());

@@ -36,11 +36,14 @@ use crate::motion::{
     BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
 use crate::runtime::PlcIo;
+use fifo::{FifoInputs, FifoInstance, FIFO_BLOCKS};
 use hli::calls::McMotionFunctionPoint;
 use std::sync::Arc;
 
+mod fifo;
+
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 36] = [
+pub const BLOCKS: [&str; 45] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -77,6 +80,15 @@ pub const BLOCKS: [&str; 36] = [
     "CamTableOffsetChange",
     "CamTableSetSlaveScale",
     "CamTableSetMasterSlaveScale",
+    "FiFoGetDimension",
+    "FiFoGroupIntegrate",
+    "FiFoGroupDisintegrate",
+    "FiFoWrite",
+    "FiFoOverwrite",
+    "FiFoStart",
+    "FiFoStop",
+    "FiFoSetChannelOverride",
+    "FiFoSetParameters",
 ];
 
 /// The outputs a `wait` can name.
@@ -113,6 +125,7 @@ enum Block {
     MultiCouple(Box<CamTableCoupleAxesMultiTables>),
     MultiTable(Box<CamMultiTable>),
     Compat(Box<CompatBlock>),
+    Fifo(Box<FifoInstance>),
 }
 
 /// A boolean output of a block.
@@ -183,6 +196,8 @@ enum Input {
     MasterActual(bool),
     /// A compatibility block's whole configuration.
     Compat(Arc<CompatConfig>),
+    /// A FIFO block's inputs.
+    Fifo(Arc<FifoInputs>),
 }
 
 /// `rows = [[master, slave], ...]`.
@@ -326,6 +341,8 @@ struct Instance {
     name: String,
     kind: &'static str,
     axis: u32,
+    /// False for FIFO blocks that address a group only.
+    uses_axis: bool,
     block: Block,
     raise_next_cycle: bool,
     last: [bool; 8],
@@ -373,10 +390,15 @@ impl Instances {
             .get("instance")
             .and_then(toml::Value::as_str)
             .unwrap_or(kind);
+        // The FIFO blocks address a group; of them only FiFoGroupIntegrate names an axis.
+        let fifo = FIFO_BLOCKS.contains(&kind);
+        let uses_axis = !fifo || kind == "FiFoGroupIntegrate";
         let axis = match table.get("axis").and_then(toml::Value::as_integer) {
-            Some(a) if (0..i64::from(u32::MAX)).contains(&a) => a as u32,
-            Some(a) => return Err(format!("call: axis {a} is not an axis index")),
-            None => return Err("call: `axis` (the gpAx index) is missing".into()),
+            Some(a) if (0..i64::from(u32::MAX)).contains(&a) && uses_axis => a as u32,
+            Some(a) if uses_axis => return Err(format!("call: axis {a} is not an axis index")),
+            Some(_) => return Err(format!("call: {kind} addresses a FIFO group: no `axis`")),
+            None if uses_axis => return Err("call: `axis` (the gpAx index) is missing".into()),
+            None => 0,
         };
         let allowed: &[&str] = match kind {
             "MC_Power" => &["enable"],
@@ -504,6 +526,9 @@ impl Instances {
             .chain([crate::cam_compat::COMPAT_MASTER_SLAVE_SCALE].iter())
             .find(|b| **b == kind)
             .copied();
+        if fifo {
+            inputs.push(Input::Fifo(Arc::new(fifo::parse(kind, table)?)));
+        }
         if let Some(kind) = compat {
             let config = crate::cam_compat::parse(kind, table)?;
             if kind == "CamTableReadData" {
@@ -515,8 +540,8 @@ impl Instances {
             if ["block", "instance", "axis"].contains(&key.as_str()) {
                 continue;
             }
-            if compat.is_some() && key != "execute" {
-                continue; // checked by cam_compat::parse
+            if (compat.is_some() || fifo) && key != "execute" {
+                continue; // checked by cam_compat::parse or fifo::parse
             }
             if key == "execute" && kind != "MC_Power" {
                 execute = value
@@ -692,6 +717,7 @@ impl Instances {
                     name: name.to_string(),
                     kind,
                     axis,
+                    uses_axis,
                     block: new_block(kind, room),
                     raise_next_cycle: false,
                     last: [false; 8],
@@ -739,7 +765,10 @@ impl Instances {
 
     /// The axes the instances use, with their instance names.
     pub fn axes(&self) -> impl Iterator<Item = (&str, u32)> {
-        self.list.iter().map(|i| (i.name.as_str(), i.axis))
+        self.list
+            .iter()
+            .filter(|i| i.uses_axis)
+            .map(|i| (i.name.as_str(), i.axis))
     }
 
     /// Whether `output` of `instance` was TRUE after the last cycle.
@@ -874,6 +903,17 @@ impl Instances {
                     b.call(io, axis);
                     (cam_outputs(b.out), false)
                 }
+                Block::Fifo(b) => {
+                    let out = b.call(io, axis);
+                    let out = BlockOutputs {
+                        done: out.done,
+                        busy: out.busy,
+                        error: out.error,
+                        error_id: out.error_id,
+                        ..BlockOutputs::default()
+                    };
+                    (out, false)
+                }
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
@@ -912,11 +952,15 @@ impl Instances {
                 .zip(&inst.edges)
                 .filter_map(|(name, e)| e.first.map(|t| format!("{name} {t} (x{})", e.count)))
                 .collect();
+            let target = if inst.uses_axis {
+                format!(" on gpAx[{}]", inst.axis)
+            } else {
+                String::new()
+            };
             out.push_str(&format!(
-                "block {} ({} on gpAx[{}]): {}{}\n",
+                "block {} ({}{target}): {}{}\n",
                 inst.name,
                 inst.kind,
-                inst.axis,
                 if edges.is_empty() {
                     "no output rose".to_string()
                 } else {
@@ -966,6 +1010,7 @@ impl Clone for Instances {
                     name: i.name.clone(),
                     kind: i.kind,
                     axis: i.axis,
+                    uses_axis: i.uses_axis,
                     block: new_block(i.kind, i.room),
                     raise_next_cycle: false,
                     last: [false; 8],
@@ -1050,6 +1095,7 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
             b.op = hli::calls::CAM_MULTI_STOP_CYCLIC;
             Block::MultiTable(b)
         }
+        fifo if FIFO_BLOCKS.contains(&fifo) => Block::Fifo(Box::new(FifoInstance::new(fifo))),
         compat if compat.starts_with("CamTable") => {
             let kind = BLOCKS
                 .iter()
@@ -1086,6 +1132,7 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::MultiCouple(b) => Some(&mut b.execute),
         Block::MultiTable(b) => Some(&mut b.execute),
         Block::Compat(b) => Some(&mut b.execute),
+        Block::Fifo(b) => Some(&mut b.execute),
     }
 }
 
@@ -1196,6 +1243,7 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::MultiTable(b), Input::AtPosition(v)) => b.at_position = v,
         (Block::MultiTable(b), Input::Position(v)) => b.position = v,
         (Block::Compat(b), Input::Compat(config)) => b.config = config,
+        (Block::Fifo(b), Input::Fifo(inputs)) => b.inputs = inputs,
 
         // parse_call admits only the inputs of the block.
         _ => {}
