@@ -166,3 +166,106 @@ fn a_hundred_thousand_rows_arrive_whole_and_in_order() {
         assert_eq!(y[start + t], -5.0 * row, "tick {t} of the job");
     }
 }
+
+/// `cnc fifo run`: the trace's columns, the set-points on the rows (T_f = 3 ticks), the
+/// override on the velocity, and refusals with their exit codes.
+#[test]
+fn cnc_fifo_run_traces_the_set_points() {
+    let pid = std::process::id();
+    let dir = std::env::temp_dir().join(format!("cli-fifo-run-{pid}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("rows.csv");
+    // X climbs 3 per row for 10 rows, then stands; Y stands at 5.
+    let mut text = String::from("x,y\n");
+    for k in 0..14 {
+        text.push_str(&format!("{},5\n", 3 * k.min(10)));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let trace = dir.join("trace.csv");
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["fifo", "run", "--rows", csv.to_str().unwrap()])
+        .args([
+            "--tf",
+            "0.003",
+            "--cycle",
+            "0.001",
+            "--override",
+            "50",
+            "--trace",
+        ])
+        .arg(&trace)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("14 rows x 2 axes"), "{stdout}");
+    assert!(stdout.contains("end at [30.0000, 5.0000]"), "{stdout}");
+    let t = Trace::read(&trace);
+    assert_eq!(
+        t.names,
+        [
+            "time",
+            "fill",
+            "override",
+            "a0_position",
+            "a0_velocity",
+            "a0_acceleration",
+            "a0_direction",
+            "a1_position",
+            "a1_velocity",
+            "a1_acceleration",
+            "a1_direction"
+        ]
+    );
+    let x = t.column("a0_position");
+    let v = t.column("a0_velocity");
+    // At 50 % a row lasts 6 ticks: X moves 0.5 per tick, at 500 /s.
+    for (n, p) in x.iter().take(50).enumerate() {
+        assert!((p - 0.5 * (n + 1) as f64).abs() < 1e-9, "tick {n}: {p}");
+        assert!((v[n] - 500.0).abs() < 1e-6);
+    }
+    assert_eq!(t.column("a0_direction")[10], 1.0);
+    assert_eq!(t.column("a1_direction")[10], 0.0);
+    assert_eq!(t.column("override")[0], 50.0);
+    for (args, code) in [
+        (vec!["--tf", "0"], 1),
+        (vec!["--tf", "0.001", "--override", "0"], 1),
+        (vec!["--tf", "0.001", "--fifo-rows", "1"], 1),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+            .args([
+                "fifo",
+                "run",
+                "--rows",
+                csv.to_str().unwrap(),
+                "--cycle",
+                "0.001",
+            ])
+            .args(&args)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(code), "{args:?}");
+    }
+    std::fs::write(&csv, "1,2\n3,nan\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args([
+            "fifo",
+            "run",
+            "--rows",
+            csv.to_str().unwrap(),
+            "--cycle",
+            "0.001",
+            "--tf",
+            "0.001",
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("rows.csv:2:3"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -28,6 +28,11 @@ enum Command {
         #[command(subcommand)]
         what: cnc_core::app::cam_cli::CamCommand,
     },
+    /// FIFO groups: run a position file through a group and trace the set-points.
+    Fifo {
+        #[command(subcommand)]
+        what: cnc_core::app::fifo_cli::FifoCommand,
+    },
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
@@ -63,6 +68,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cnc_core::app::check_cli::main(args),
         Command::Kin { what } => cnc_core::app::kin_cli::main(what),
         Command::Cam { what } => cnc_core::app::cam_cli::main(what),
+        Command::Fifo { what } => cnc_core::app::fifo_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }
 }
