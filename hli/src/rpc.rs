@@ -125,6 +125,20 @@ impl AcyclicClient {
         })
     }
 
+    /// Loans a row block of `values` values in the shared memory the CNC will read: the PLC
+    /// computes its rows straight into it ([`RowsLoan::values_mut`]) and sends it whole
+    /// ([`RowsLoan::send`]). A loan that is dropped, or whose process dies before the send,
+    /// never reaches the CNC: there is no half block.
+    pub fn loan_rows(
+        &mut self,
+        header: FifoRowsHeader,
+        values: usize,
+    ) -> Result<RowsLoan, CallError> {
+        let mut loan = self.rows.loan_slice(values).map_err(transport)?;
+        *loan.user_header_mut() = header;
+        Ok(RowsLoan { loan })
+    }
+
     /// Sends a FIFO row block (`FiFoWrite`, `FiFoOverwrite`): `values` holds
     /// `header.rows x header.columns` values, row after row, and is written once, straight
     /// into the shared memory the CNC reads it from. Poll the returned [`PendingRows`].
@@ -250,6 +264,33 @@ fn decode_response<C: AcyclicCall>(
         )));
     }
     Ok(bytemuck::pod_read_unaligned(&response.body[..len]))
+}
+
+type RowsLoanPort =
+    iceoryx2::request_mut::RequestMut<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
+
+/// A row block being written in place (see [`AcyclicClient::loan_rows`]).
+pub struct RowsLoan {
+    loan: RowsLoanPort,
+}
+
+impl core::fmt::Debug for RowsLoan {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("RowsLoan")
+    }
+}
+
+impl RowsLoan {
+    /// The block's values, row after row (zero until written).
+    pub fn values_mut(&mut self) -> &mut [f64] {
+        self.loan.payload_mut()
+    }
+
+    /// Sends the block whole.
+    pub fn send(self) -> Result<PendingRows, CallError> {
+        let pending = self.loan.send().map_err(transport)?;
+        Ok(PendingRows { pending })
+    }
 }
 
 /// A row block on its way: poll it until it yields the CNC's reply.

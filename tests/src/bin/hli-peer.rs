@@ -5,6 +5,8 @@
 //! * `cnc-crash INSTANCE`: create the segment, print `ready`, then abort (no cleanup).
 //! * `cnc-beat INSTANCE`: create the segment, print `ready`, beat every millisecond until
 //!   stdin closes.
+//! * `plc-half-block INSTANCE`: send a whole FIFO row block of 10 rows x 3, then loan a
+//!   second, write half of it, print `half`, and abort (a PLC dying mid-write).
 
 use hli::segment::{CncSegment, PlcSegment};
 use hli::views::PlcView;
@@ -42,6 +44,24 @@ fn main() -> ExitCode {
                 std::thread::sleep(std::time::Duration::from_millis(1));
             }
             ExitCode::SUCCESS
+        }
+        ["plc-half-block", instance] => {
+            let mut client = hli::rpc::AcyclicClient::open(instance).expect("client");
+            let header = hli::fifo_calls::FifoRowsHeader {
+                group: 0,
+                columns: 3,
+                rows: 10,
+                overwrite: 0,
+            };
+            let whole: Vec<f64> = (0..30).map(f64::from).collect();
+            let _sent = client.start_rows(header, &whole).expect("send");
+            let mut loan = client.loan_rows(header, 30).expect("loan");
+            for (i, v) in loan.values_mut().iter_mut().take(15).enumerate() {
+                *v = 100.0 + i as f64;
+            }
+            println!("half");
+            std::io::stdout().flush().ok();
+            std::process::abort();
         }
         other => {
             eprintln!("hli-peer: unknown arguments {other:?}");

@@ -1,0 +1,91 @@
+//! FIFO row blocks between processes: a PLC that dies while writing a block leaves no half
+//! block; the block it had sent before arrives whole.
+
+use hli::fifo_calls::FifoReply;
+use hli::rpc::{AcyclicClient, AcyclicServer};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use tests::{unique_instance, ChildGuard};
+
+#[test]
+fn a_plc_dying_mid_write_leaves_no_half_block() {
+    hli::init_logging();
+    let instance = unique_instance("half-block");
+    let server = AcyclicServer::open(&instance).unwrap();
+    let mut child = ChildGuard(
+        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
+            .args(["plc-half-block", &instance])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap(),
+    );
+    let mut line = String::new();
+    BufReader::new(child.0.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    assert_eq!(line.trim(), "half");
+    let status = child
+        .wait_with_watchdog(Duration::from_secs(30))
+        .expect("child ended");
+    assert!(!status.success(), "the child aborted");
+    // Everything that reached the service: one whole block, never the half-written loan.
+    let mut blocks = Vec::new();
+    let deadline = Instant::now() + Duration::from_secs(5);
+    while Instant::now() < deadline {
+        server
+            .poll_rows(|header, values| {
+                blocks.push((*header, values.to_vec()));
+                FifoReply::default()
+            })
+            .unwrap();
+        if !blocks.is_empty() {
+            break;
+        }
+        std::thread::yield_now();
+    }
+    // A few more polls: nothing else may arrive.
+    for _ in 0..100 {
+        server
+            .poll_rows(|header, values| {
+                blocks.push((*header, values.to_vec()));
+                FifoReply::default()
+            })
+            .unwrap();
+    }
+    assert_eq!(blocks.len(), 1, "{blocks:?}");
+    let (header, values) = &blocks[0];
+    assert_eq!((header.rows, header.columns), (10, 3));
+    assert_eq!(*values, (0..30).map(f64::from).collect::<Vec<_>>());
+    // The service goes on for the next PLC.
+    let mut client = AcyclicClient::open(&instance).unwrap();
+    let header = hli::fifo_calls::FifoRowsHeader {
+        group: 0,
+        columns: 1,
+        rows: 2,
+        overwrite: 0,
+    };
+    let pending = client.start_rows(header, &[7.0, 8.0]).unwrap();
+    let mut got = Vec::new();
+    let reply = loop {
+        server
+            .poll_rows(|_, values| {
+                got.extend_from_slice(values);
+                FifoReply {
+                    row: 2,
+                    ..FifoReply::default()
+                }
+            })
+            .unwrap();
+        if let Some(reply) = pending.poll() {
+            break reply.unwrap();
+        }
+        assert!(
+            Instant::now() < deadline + Duration::from_secs(30),
+            "watchdog"
+        );
+        std::thread::yield_now();
+    };
+    assert_eq!((got, reply.row), (vec![7.0, 8.0], 2));
+}
