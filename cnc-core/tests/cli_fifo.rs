@@ -269,3 +269,52 @@ fn cnc_fifo_run_traces_the_set_points() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("rows.csv:2:3"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The FIFO blocks from a timeline: the same trace and block edges in-process and with a
+/// PLC process; FiFoOverwrite changed the end point; X is a free axis again at the end.
+#[test]
+fn the_fifo_blocks_from_a_timeline_run_alike_in_one_and_two_processes() {
+    use cnc_core::app::scenario::{InProcess, Scenario};
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/fifo-blocks/scenario.toml");
+    let pid = std::process::id();
+    let trace_path = std::env::temp_dir().join(format!("cli-fifo-blocks-{pid}.csv"));
+    let report = run(&path, &format!("cli-fifo-blocks-{pid}"), &trace_path);
+    let two_process = std::fs::read(&trace_path).unwrap();
+    let blocks = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| l.starts_with("block "))
+            .map(str::to_string)
+            .collect()
+    };
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert!(
+        report.contains("block back (MC_MoveAbsolute on gpAx[0]): Done"),
+        "{report}"
+    );
+    let s = Scenario::load(&path).unwrap();
+    let ticks = s.ticks.unwrap() as usize;
+    let mut run = InProcess::new(&s, ticks).unwrap();
+    for _ in 0..ticks {
+        run.step(s.cycle_s);
+    }
+    let mut in_process = Vec::new();
+    run.trace.write_csv(&mut in_process).unwrap();
+    assert_eq!(
+        in_process, two_process,
+        "in-process and two-process traces differ"
+    );
+    assert_eq!(
+        blocks(&run.timeline.as_ref().unwrap().summary()),
+        blocks(&report)
+    );
+    let t = Trace::read(&trace_path);
+    let x = t.column("gpAx[0]^lr_state.command_position_acs_r");
+    let top = x.iter().cloned().fold(f64::MIN, f64::max);
+    assert_eq!(top, 80_000.0, "the overwritten rows end at X = 8");
+    assert!(
+        x.last().unwrap().abs() < 1.0,
+        "X moved back as a free axis: {}",
+        x.last().unwrap()
+    );
+}
