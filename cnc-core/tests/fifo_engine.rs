@@ -407,11 +407,13 @@ fn refusals_leave_the_rows_alone() {
         (r.error_id, r.row, r.column),
         (FifoError::NonFinite.raw(), 1, 2)
     );
+    assert_eq!(entries(&mut run), 2);
     bad[1][2] = f64::INFINITY;
     assert_eq!(
-        write(&mut run, &bad, false).error_id,
+        write(&mut run, &bad, true).error_id,
         FifoError::NonFinite.raw()
     );
+    assert_eq!(entries(&mut run), 2, "a refused overwrite drops nothing");
     let header = FifoRowsHeader {
         group: 0,
         columns: 2,
@@ -420,6 +422,7 @@ fn refusals_leave_the_rows_alone() {
     };
     let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
     assert_eq!(r.error_id, FifoError::Columns.raw());
+    assert_eq!(entries(&mut run), 2);
     let header = FifoRowsHeader { group: 5, ..header };
     let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
     assert_eq!(r.error_id, FifoError::NoSuchGroup.raw());
@@ -427,6 +430,7 @@ fn refusals_leave_the_rows_alone() {
         write(&mut run, &[], false).error_id,
         FifoError::BlockSize.raw()
     );
+    assert_eq!(entries(&mut run), 2);
     let r = call(&mut run, 3, FifoStartCall::default());
     assert_eq!(r.error_id, FifoError::NoSuchGroup.raw());
     for (t_f, t0, kind) in [
@@ -435,6 +439,8 @@ fn refusals_leave_the_rows_alone() {
         (f64::NAN, 0.01, 0),
         (0.001, 0.0, 1),
         (0.001, 0.01, 7),
+        (0.001, 1e-300, 1),
+        (0.001, 1e20, 1),
     ] {
         let r = call(
             &mut run,
@@ -448,6 +454,7 @@ fn refusals_leave_the_rows_alone() {
         );
         assert_eq!(r.error_id, FifoError::Parameter.raw(), "{t_f} {t0} {kind}");
     }
+    assert_eq!(entries(&mut run), 2);
 
     // Integration: taken positions, a group member, a coupled axis, a moving axis, no axis.
     let integrate_call = |axis, group_position| FifoIntegrateCall {
@@ -633,4 +640,121 @@ fn get_dimension() {
         write(&mut run, &[[0.0; 3]], false).error_id,
         hli::calls::ErrorCode::Busy.raw()
     );
+}
+
+/// FiFoOverwrite on a group not started replaces every queued row; on a running group that
+/// holds its last row (dry), it keeps that row.
+#[test]
+fn overwrite_before_the_start_and_when_dry() {
+    let mut run = machine(&instant(16, 1.0));
+    integrate(&mut run);
+    write(&mut run, &[[0.0; 3], [5.0; 3], [9.0; 3]], false);
+    let r = write(&mut run, &[[0.0; 3], [1.0; 3]], true);
+    assert_eq!((r.error_id, r.entries), (0, 2));
+    start(&mut run);
+    run.step(TICK);
+    run.step(TICK);
+    assert_eq!(position(&run, 0), 1.0, "the replaced rows, not 5 and 9");
+    // Dry: one row (1.0) held; an overwrite keeps it and goes on from it.
+    let r = write(&mut run, &[[1.5; 3], [2.0; 3]], true);
+    assert_eq!((r.error_id, r.entries), (0, 3));
+    run.step(TICK);
+    assert_eq!(position(&run, 0), 1.5);
+    let s = status_after_tick(&mut run);
+    assert!(s.rows_written_r >= s.rows_consumed_r);
+    assert_eq!(s.rows_written_r, 4, "0, 1 and the two overwritten rows");
+}
+
+/// A stop that ends by a fault or a machine stop gives the override back as well; a new job
+/// starts with its counters at 0; dissolving drops the queued rows.
+#[test]
+fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
+    let mut run = machine_y(&instant(600, 1.0), "soft_limits = [-10.0, 1.0]");
+    pt2(&mut run, 0.5);
+    integrate(&mut run);
+    let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
+    write(&mut run, &rows, false);
+    call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 900_000,
+        },
+    );
+    start(&mut run);
+    for _ in 0..15 {
+        run.step(TICK);
+    }
+    assert_eq!(call(&mut run, 0, FifoStopCall::default()).error_id, 0);
+    // The slow PT-2 stop still moves Y past its limit of 1.0: the fault ends the job.
+    let mut ticks = 0;
+    while status(&run).group_state_r != FifoGroupState::Error.raw() {
+        run.step(TICK);
+        ticks += 1;
+        assert!(ticks < 2000, "no fault");
+    }
+    let s = status(&run);
+    assert_eq!(
+        (s.override_target_r, s.rows_consumed_r, s.rows_written_r),
+        (900_000, 0, 0)
+    );
+    // Machine stop while stopping.
+    let mut run = machine(&instant(600, 1.0));
+    pt2(&mut run, 0.5);
+    integrate(&mut run);
+    write(&mut run, &rows, false);
+    call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 700_000,
+        },
+    );
+    start(&mut run);
+    for _ in 0..15 {
+        run.step(TICK);
+    }
+    call(&mut run, 0, FifoStopCall::default());
+    run.step(TICK);
+    run.machine.stop("test");
+    let s = status_after_tick(&mut run);
+    assert_eq!(s.group_state_r, FifoGroupState::Idle.raw());
+    assert_eq!((s.override_target_r, s.rows_consumed_r), (700_000, 0));
+    // Dissolving drops rows.
+    let mut run = machine(&instant(16, 1.0));
+    integrate(&mut run);
+    write(&mut run, &[[0.0; 3], [1.0; 3]], false);
+    let r = call(&mut run, 0, FifoDisintegrateCall::default());
+    assert_eq!((r.error_id, r.entries), (0, 0));
+    let s = status_after_tick(&mut run);
+    assert_eq!(s.group_state_r, FifoGroupState::Idle.raw());
+}
+
+/// An axis with a command that has not moved it yet does not join (coupling would abort the
+/// command without a word).
+#[test]
+fn an_axis_with_an_active_command_does_not_join() {
+    let mut run = machine(&instant(16, 1.0));
+    let command = AxisCommandCall::move_absolute(5.0, [50.0, 1000.0, 1000.0, 10000.0]);
+    let (body, body_len) = encode_body(&command);
+    let request = AcyclicRequest {
+        invoke_id: 5,
+        kind: CallKind::AxisCommand.raw(),
+        target: FREE as u32,
+        body_len,
+        body,
+    };
+    let view = CncView::new(&run.memory);
+    run.machine
+        .dispatch(&view, CallKind::AxisCommand, &request)
+        .unwrap();
+    let r = call(
+        &mut run,
+        0,
+        FifoIntegrateCall {
+            axis: FREE as u32,
+            group_position: 1,
+        },
+    );
+    assert_eq!(r.error_id, FifoError::AxisMoving.raw());
 }

@@ -172,7 +172,8 @@ hli_enum! {
     FifoError: u32, "FifoError" {
         /// The group index is not a configured FIFO group.
         NoSuchGroup = 0x4300,
-        /// The axis is not a single axis of the machine (channel axes belong to their channel).
+        /// The axis is not an axis of the machine (channel axes are refused as coupled: they
+        /// belong to their channel).
         NoSuchAxis = 0x4301,
         /// The group position is outside 1..=N.
         GroupPosition = 0x4302,

@@ -3,7 +3,10 @@
 //! FiFoSetChannelOverride, our FiFoSetParameters, and the library version function. Each
 //! sends on the rising Execute edge without waiting, is Busy until the CNC answers, then
 //! Done or Error (with the CNC's code, [`hli::enums::FifoError`] or
-//! [`hli::enums::AxisError`]); the outputs clear one cycle after Execute falls.
+//! [`hli::enums::AxisError`]); the outputs clear one cycle after Execute falls. An edge while
+//! Busy is ignored (the call on its way keeps its answer). No answer within `timeout_cycles`
+//! PLC cycles (the seed's tTimeout; default 1000) is an Error with
+//! [`ERROR_NO_ANSWER`]: the call may still have been executed.
 //!
 //! FiFoWrite and FiFoOverwrite send a row block on the row service: the rows are written
 //! once, straight into the shared memory the CNC reads (seed: `AdrdataArray`, `iColDim`,
@@ -65,24 +68,37 @@ fn answered(reply: FifoReply) -> FifoOutputs {
     }
 }
 
-fn polled(result: Option<Result<FifoReply, CallError>>) -> Option<FifoOutputs> {
-    Some(match result? {
-        Ok(reply) => answered(reply),
-        Err(CallError::Refused { code }) => failed(code.raw(), FifoReply::default()),
-        Err(_) => failed(ERROR_NO_ANSWER, FifoReply::default()),
+/// The outputs an answer gives, or a timeout after `waited` of `timeout` cycles.
+fn answer(
+    result: Option<Result<FifoReply, CallError>>,
+    waited: u64,
+    timeout: u64,
+) -> Option<FifoOutputs> {
+    Some(match result {
+        None if waited > timeout => failed(ERROR_NO_ANSWER, FifoReply::default()),
+        None => return None,
+        Some(Ok(reply)) => answered(reply),
+        Some(Err(CallError::Refused { code })) => failed(code.raw(), FifoReply::default()),
+        Some(Err(_)) => failed(ERROR_NO_ANSWER, FifoReply::default()),
     })
 }
 
+/// PLC cycles a block waits for its answer by default (1 s at a 1 ms cycle).
+pub const DEFAULT_TIMEOUT_CYCLES: u64 = 1000;
+
 /// Edge, pending answer and outputs of a one-frame FIFO block.
 pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub timeout_cycles: u64,
     execute_before: bool,
-    pending: Option<PendingCall<C>>,
+    pending: Option<(PendingCall<C>, u64)>,
     out: FifoOutputs,
 }
 
 impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
     fn default() -> Self {
         Self {
+            timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
             execute_before: false,
             pending: None,
             out: FifoOutputs::default(),
@@ -114,15 +130,19 @@ impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
         group: u32,
         call: impl FnOnce() -> C,
     ) -> FifoOutputs {
-        if rose(&mut self.execute_before, execute) {
+        if rose(&mut self.execute_before, execute) && self.pending.is_none() {
             self.out = FifoOutputs::default();
             match io.acyclic.start(group, &call()) {
-                Ok(p) => self.pending = Some(p),
+                Ok(p) => self.pending = Some((p, io.cycle)),
                 Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
             }
         }
-        if let Some(p) = &self.pending {
-            match polled(p.poll()) {
+        if let Some((p, sent)) = &self.pending {
+            match answer(
+                p.poll(),
+                io.cycle.saturating_sub(*sent),
+                self.timeout_cycles,
+            ) {
                 None => self.out.busy = true,
                 Some(out) => {
                     self.out = out;
@@ -150,13 +170,27 @@ pub type FifoSetChannelOverride = FifoBlock<FifoOverrideCall>;
 pub type FifoSetParameters = FifoBlock<FifoParametersCall>;
 
 /// FiFoWrite (`overwrite` false) or FiFoOverwrite (true).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct FifoWrite {
     /// FiFoOverwrite: replace the rows queued behind the pair in use.
     pub overwrite: bool,
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub timeout_cycles: u64,
     execute_before: bool,
-    pending: Option<PendingRows>,
+    pending: Option<(PendingRows, u64)>,
     out: FifoOutputs,
+}
+
+impl Default for FifoWrite {
+    fn default() -> Self {
+        FifoWrite {
+            overwrite: false,
+            timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
+            execute_before: false,
+            pending: None,
+            out: FifoOutputs::default(),
+        }
+    }
 }
 
 impl FifoWrite {
@@ -179,7 +213,7 @@ impl FifoWrite {
         columns: u32,
         rows: u32,
     ) -> FifoOutputs {
-        if rose(&mut self.execute_before, execute) {
+        if rose(&mut self.execute_before, execute) && self.pending.is_none() {
             self.out = FifoOutputs::default();
             let values = (columns as usize).checked_mul(rows as usize);
             match values {
@@ -191,15 +225,19 @@ impl FifoWrite {
                         overwrite: u32::from(self.overwrite),
                     };
                     match io.acyclic.start_rows(header, &data[..n]) {
-                        Ok(p) => self.pending = Some(p),
+                        Ok(p) => self.pending = Some((p, io.cycle)),
                         Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
                     }
                 }
                 _ => self.out = failed(ERROR_BLOCK_SIZE, FifoReply::default()),
             }
         }
-        if let Some(p) = &self.pending {
-            match polled(p.poll()) {
+        if let Some((p, sent)) = &self.pending {
+            match answer(
+                p.poll(),
+                io.cycle.saturating_sub(*sent),
+                self.timeout_cycles,
+            ) {
                 None => self.out.busy = true,
                 Some(out) => {
                     self.out = out;

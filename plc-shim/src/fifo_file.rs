@@ -10,13 +10,12 @@
 //!
 //! A bad value is refused with its place (`FILE:LINE:COL` for CSV, row and column for
 //! binary), never passed on. [`Feeder`] reads the file on a thread of its own into two
-//! buffers that it hands to the PLC cycle and takes back over bounded channels, so the cycle
+//! buffers that it hands to the PLC cycle and takes back over wait-free rings, so the cycle
 //! never waits for the disk, allocates or locks (the seed's sample program reads its file
 //! into two alternating buffers in the same way).
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::{Path, PathBuf};
-use std::sync::mpsc::{sync_channel, Receiver, SyncSender, TryRecvError};
 
 /// The binary format's magic.
 pub const BINARY_MAGIC: &[u8; 8] = b"CNCFIFO1";
@@ -321,12 +320,17 @@ enum Message {
     Failed(FileError),
 }
 
-/// Reads a position file on its own thread into two alternating buffers.
+/// How long the reader thread sleeps when both buffers are with the cycle.
+const READER_NAP: std::time::Duration = std::time::Duration::from_micros(500);
+
+/// Reads a position file on its own thread into two alternating buffers. The buffers go to
+/// the cycle and back through two wait-free rings (`rtrb`): the cycle never waits, locks or
+/// allocates; the reader naps while both buffers are with the cycle.
 pub struct Feeder {
     path: PathBuf,
     columns: usize,
-    full: Receiver<Message>,
-    empty: SyncSender<Buffer>,
+    full: rtrb::Consumer<Message>,
+    empty: rtrb::Producer<Buffer>,
     ended: bool,
     _thread: std::thread::JoinHandle<()>,
 }
@@ -342,35 +346,39 @@ impl Feeder {
     pub fn start(path: &Path) -> Result<Feeder, FileError> {
         let mut reader = RowReader::open(path)?;
         let columns = reader.columns();
-        let (full_tx, full) = sync_channel::<Message>(2);
-        let (empty, empty_rx) = sync_channel::<Buffer>(2);
+        // Two buffers full at most, then the end or a failure.
+        let (mut full_tx, full) = rtrb::RingBuffer::<Message>::new(3);
+        let (mut empty, mut empty_rx) = rtrb::RingBuffer::<Buffer>::new(2);
         for _ in 0..2 {
-            let _ = empty.send(Buffer {
+            let _ = empty.push(Buffer {
                 values: vec![0.0; FEEDER_BUFFER_VALUES],
                 len: 0,
             });
         }
         let thread = std::thread::Builder::new()
             .name("fifo-feeder".into())
-            .spawn(move || {
-                // Fill each buffer that comes back until the file ends or fails.
-                while let Ok(mut buffer) = empty_rx.recv() {
-                    match reader.read_rows(&mut buffer.values) {
-                        Ok(0) => {
-                            let _ = full_tx.send(Message::End);
-                            return;
-                        }
-                        Ok(n) => {
-                            buffer.len = n;
-                            if full_tx.send(Message::Rows(buffer)).is_err() {
-                                return;
-                            }
-                        }
-                        Err(e) => {
-                            let _ = full_tx.send(Message::Failed(e));
-                            return;
-                        }
+            .spawn(move || loop {
+                // Fill each buffer that comes back until the file ends or fails, or the
+                // feeder is dropped.
+                let mut buffer = match empty_rx.pop() {
+                    Ok(b) => b,
+                    Err(_) if empty_rx.is_abandoned() => return,
+                    Err(_) => {
+                        std::thread::sleep(READER_NAP);
+                        continue;
                     }
+                };
+                let message = match reader.read_rows(&mut buffer.values) {
+                    Ok(0) => Message::End,
+                    Ok(n) => {
+                        buffer.len = n;
+                        Message::Rows(buffer)
+                    }
+                    Err(e) => Message::Failed(e),
+                };
+                let last = !matches!(message, Message::Rows(_));
+                if full_tx.push(message).is_err() || last {
+                    return;
                 }
             })
             .map_err(|e| FileError::Io {
@@ -397,9 +405,9 @@ impl Feeder {
         if self.ended {
             return Fed::End;
         }
-        match self.full.try_recv() {
+        match self.full.pop() {
             Ok(Message::Rows(b)) => Fed::Rows(b),
-            Ok(Message::End) | Err(TryRecvError::Disconnected) => {
+            Ok(Message::End) => {
                 self.ended = true;
                 Fed::End
             }
@@ -407,14 +415,19 @@ impl Feeder {
                 self.ended = true;
                 Fed::Failed(e)
             }
-            Err(TryRecvError::Empty) => Fed::NotYet,
+            Err(_) if self.full.is_abandoned() => {
+                self.ended = true;
+                Fed::End
+            }
+            Err(_) => Fed::NotYet,
         }
     }
 
     /// Hands a drained buffer back for the reader to fill.
     pub fn give_back(&mut self, mut buffer: Buffer) {
         buffer.len = 0;
-        let _ = self.empty.try_send(buffer);
+        // Room for both buffers: never refused.
+        let _ = self.empty.push(buffer);
     }
 }
 

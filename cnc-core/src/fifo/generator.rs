@@ -12,6 +12,17 @@
 
 use super::ring::RowRing;
 
+/// Rows closer than this (per axis, in position units) stand: a file's rounding noise is
+/// not motion.
+pub const AT_REST: f64 = 1e-9;
+
+fn moving(a: Option<&[f64]>, b: Option<&[f64]>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => a.iter().zip(b).any(|(x, y)| (x - y).abs() > AT_REST),
+        _ => false,
+    }
+}
+
 /// What one step found.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct GeneratorStatus {
@@ -80,7 +91,7 @@ impl FifoGenerator {
         let mut status = GeneratorStatus::default();
         self.offset += self.tick_s * override_value;
         while ring.len() >= 2 && self.offset >= self.fifo_cycle_s {
-            self.last_segment_moving = ring.row(0) != ring.row(1);
+            self.last_segment_moving = moving(ring.row(0), ring.row(1));
             ring.pop_front();
             self.offset -= self.fifo_cycle_s;
             self.rows_passed += 1;
@@ -184,6 +195,18 @@ mod tests {
         let s2 = g.step(&mut ring, 1.0);
         assert!(!s.underrun && s.at_end && s2.at_end, "{s:?} {s2:?}");
         assert_eq!(g.rows_passed(), 3);
+    }
+
+    #[test]
+    fn rounding_noise_is_not_motion() {
+        let mut ring = ring_of(&[0.0, 1.0, 1.0 + 1e-13]);
+        let mut g = FifoGenerator::new(1, 0.001, 0.001);
+        g.start(&ring);
+        for _ in 0..3 {
+            g.step(&mut ring, 1.0);
+        }
+        let s = g.step(&mut ring, 1.0);
+        assert!(s.at_end && !s.underrun, "{s:?}");
     }
 
     proptest! {

@@ -5,6 +5,11 @@
 use super::override_filter::OverrideType;
 use hli::fifo_calls::{FIFO_MAX_DIMENSION, FIFO_MAX_ROWS};
 
+/// Smallest PT-2 time constant, s.
+pub const PT2_T0_MIN_S: f64 = 1e-4;
+/// Largest PT-2 time constant, s (a stop then takes about 115 s).
+pub const PT2_T0_MAX_S: f64 = 10.0;
+
 /// The parameters of one FIFO group, checked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FifoParams {
@@ -30,8 +35,8 @@ pub enum ParamError {
     /// T_f not a positive finite number.
     #[error("FIFO cycle {0} s: T_f must be a positive finite time")]
     FifoCycle(f64),
-    /// T0 not a positive finite number.
-    #[error("PT-2 time constant {0} s: T0 must be a positive finite time")]
+    /// T0 outside 0.1 ms..=10 s.
+    #[error("PT-2 time constant {0} s: T0 must lie in 0.0001..=10 s")]
     TimeConstant(f64),
 }
 
@@ -50,8 +55,12 @@ impl FifoParams {
             return Err(ParamError::Rows(rows));
         }
         check_time(fifo_cycle_s).map_err(|_| ParamError::FifoCycle(fifo_cycle_s))?;
+        // T0 bounded both ways: tiny values overflow the filter's poles, huge ones make a
+        // stop (the override decaying to 0) last for ever.
         if let OverrideType::Pt2 { t0_s } = override_type {
-            check_time(t0_s).map_err(|_| ParamError::TimeConstant(t0_s))?;
+            if !(PT2_T0_MIN_S..=PT2_T0_MAX_S).contains(&t0_s) {
+                return Err(ParamError::TimeConstant(t0_s));
+            }
         }
         Ok(FifoParams {
             dimension,
@@ -90,11 +99,13 @@ mod tests {
             FifoParams::new(1, 1, 0.002, OverrideType::Instant),
             Err(ParamError::Rows(1))
         );
-        for t in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-            assert!(matches!(
-                FifoParams::new(1, 2, t, OverrideType::Instant),
-                Err(ParamError::FifoCycle(_))
-            ));
+        for t in [0.0, -1.0, f64::NAN, f64::INFINITY, 1e-300, 5e-5, 11.0, 1e20] {
+            if t <= 0.0 || !t.is_finite() {
+                assert!(matches!(
+                    FifoParams::new(1, 2, t, OverrideType::Instant),
+                    Err(ParamError::FifoCycle(_))
+                ));
+            }
             assert!(matches!(
                 FifoParams::new(1, 2, 0.001, OverrideType::Pt2 { t0_s: t }),
                 Err(ParamError::TimeConstant(_))

@@ -127,9 +127,14 @@ impl Group {
         self.reply(Some(error.raw()))
     }
 
-    /// The job is over (stopped, or ended by a fault): no rows, counters for the next.
+    /// The job is over (stopped, ended by a fault or a machine stop): no rows, counters for
+    /// the next job, and the override a stop pulled to 0 back at its value before the stop.
     fn end_job(&mut self, state: FifoGroupState) {
+        if self.state == FifoGroupState::Stopping {
+            self.ovr.reset(self.before_stop);
+        }
         self.ring.clear();
+        self.generator.start(&self.ring);
         self.state = state;
         self.rows_written = 0;
         self.underrun_ticks = 0;
@@ -235,7 +240,6 @@ impl Group {
         }
         if self.state == FifoGroupState::Stopping && self.ovr.settled() && ov == 0.0 {
             self.end_job(FifoGroupState::Idle);
-            self.ovr.reset(self.before_stop);
         }
     }
 
@@ -259,7 +263,8 @@ impl Group {
         if self.members[column - 1].is_some() {
             return self.refuse(FifoError::PositionTaken);
         }
-        if a.setpoint().velocity != 0.0 {
+        // Standing, and no command about to move it (coupling would abort it silently).
+        if a.setpoint().velocity != 0.0 || a.book().active().is_some() {
             return self.refuse(FifoError::AxisMoving);
         }
         if let Err(e) = a.couple(MEMBER) {
@@ -273,6 +278,15 @@ impl Group {
         self.reply(None)
     }
 
+    /// Drops `axis` from the member slots (it belongs to another group now).
+    fn forget(&mut self, axis: usize) {
+        for slot in &mut self.members {
+            if *slot == Some(axis) {
+                *slot = None;
+            }
+        }
+    }
+
     fn disintegrate(&mut self, axes: &mut AxisSet) -> FifoReply {
         if self.running() {
             return self.refuse(FifoError::Running);
@@ -284,10 +298,9 @@ impl Group {
                 }
             }
         }
-        if self.state == FifoGroupState::Error {
-            self.error = None;
-            self.state = FifoGroupState::Idle;
-        }
+        // The group is dissolved: rows queued for its axes go with it.
+        self.error = None;
+        self.end_job(FifoGroupState::Idle);
         self.reply(None)
     }
 
@@ -395,16 +408,18 @@ impl Group {
         if header.columns as usize != self.params.dimension {
             return self.refuse(FifoError::Columns);
         }
-        let result = if header.overwrite != 0 {
+        let before = self.ring.len();
+        let (result, keep) = if header.overwrite != 0 {
             // A running group keeps the pair it interpolates between.
-            let keep = if self.running() { 2 } else { 0 };
-            self.ring.replace_after(keep, values)
+            let keep = if self.running() { before.min(2) } else { 0 };
+            (self.ring.replace_after(keep, values), keep)
         } else {
-            self.ring.push_block(values)
+            (self.ring.push_block(values), before)
         };
         match result {
             Ok(rows) => {
-                self.rows_written += rows as u64;
+                // Written counts the rows of the job: the replaced ones are no longer part.
+                self.rows_written = self.rows_written + rows as u64 - (before - keep) as u64;
                 if self.state == FifoGroupState::Idle {
                     self.state = FifoGroupState::Filling;
                 }
@@ -486,8 +501,22 @@ impl FifoEngine {
             };
         };
         match kind {
-            CallKind::FifoIntegrate => match decode_body(request) {
-                Ok(call) => group.integrate(call, axes),
+            CallKind::FifoIntegrate => match decode_body::<FifoIntegrateCall>(request) {
+                Ok(call) => {
+                    let axis = call.axis as usize;
+                    let reply = group.integrate(call, axes);
+                    if reply.error_id == 0 {
+                        // An axis that left another group between its ticks (fault, power
+                        // off) is that group's no more: it faults there if it ran.
+                        let target = request.target as usize;
+                        for (g, other) in self.groups.iter_mut().enumerate() {
+                            if g != target {
+                                other.forget(axis);
+                            }
+                        }
+                    }
+                    reply
+                }
                 Err(_) => group.refuse(FifoError::Parameter),
             },
             CallKind::FifoDisintegrate => group.disintegrate(axes),

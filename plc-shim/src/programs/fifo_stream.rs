@@ -3,14 +3,15 @@
 //! file that a reader thread loads into two alternating buffers ([`Feeder`]).
 //!
 //! ```text
-//! Power     MC_Power every axis of the group (gpAx 0..N)               -> Status
+//! Power     MC_Power every axis of the machine (gpAx 0..N: for machines of single axes,
+//!           no channels)                                                -> Status
 //! Dimension FiFoGetDimension: N and Z; the file must have N columns     -> Done
 //! Integrate FiFoGroupIntegrate axis k at position k+1, k = 0..N          -> Done each
 //! Fill      FiFoWrite blocks until the FIFO is full or the file is read
 //! Override  FiFoSetChannelOverride (when one is given)                  -> Done
 //! Start     FiFoStart                                                   -> Done
-//! Run       FiFoWrite whenever rows are free; the file read and every row executed with
-//!           the axes at rest (AT_END)                                   ->
+//! Run       FiFoWrite whenever a quarter of the FIFO is free; the file read and every row
+//!           executed (at rest, or held after a file that ends in motion)  ->
 //! Stop      FiFoStop                                                    -> Idle
 //! Dissolve  FiFoGroupDisintegrate                                       -> Done: Finished
 //! ```
@@ -32,7 +33,7 @@ use hli::fifo_calls::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoStartCall,
     FifoStopCall, FIFO_BLOCK_VALUES, FIFO_MAX_DIMENSION,
 };
-use hli::layout::FIFO_FLAG_AT_END;
+use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 
 /// The steps of the sequence.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -193,8 +194,11 @@ impl FifoStream {
             if let Some(b) = &self.buffer {
                 let left = (b.len - self.taken) / n;
                 let rows = left.min(free).min(FIFO_BLOCK_VALUES / n);
-                // Blocks of a quarter FIFO at least (fewer calls), unless the buffer's rest.
-                let worth = rows >= (self.capacity as usize / 4).max(1) || rows == left;
+                // Running: blocks of a quarter FIFO at least (fewer calls), unless the buffer's
+                // rest. Filling: whatever fits, until the FIFO is full.
+                let worth = self.step == Step::Fill
+                    || rows >= (self.capacity as usize / 4).max(1)
+                    || rows == left;
                 if rows > 0 && worth {
                     self.sending = rows * n;
                     self.writing = Writing::Sending;
@@ -336,10 +340,12 @@ impl PlcProgram for FifoStream {
                 if !self.feed(io) {
                     return self.fail(0);
                 }
+                // Every row executed: at rest (the normal end), or held after the last row
+                // of a file that ends in motion (underrun: nothing more will come).
                 let ended = status.is_some_and(|s| {
                     s.group_state_r == FifoGroupState::Running.raw()
                         && s.entries_r <= 1
-                        && s.flags_r & FIFO_FLAG_AT_END != 0
+                        && s.flags_r & (FIFO_FLAG_AT_END | FIFO_FLAG_UNDERRUN) != 0
                 });
                 if matches!(self.step, Step::Run) && self.all_written() && ended {
                     self.step = Step::Stop;
