@@ -25,7 +25,6 @@ use hli::fifo_calls::{
 };
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::CncView;
-use hli::wire::{encode_body, AcyclicRequest};
 use hli::ImageMemory;
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -44,18 +43,9 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 fn call<C: AcyclicCall<Reply = FifoReply>>(machine: &mut Machine, memory: &ImageMemory, body: C) {
-    let (body, body_len) = encode_body(&body);
-    let request = AcyclicRequest {
-        invoke_id: 1,
-        kind: C::KIND.raw(),
-        target: 0,
-        body_len,
-        body,
-    };
-    let (reply, len) = machine
-        .dispatch(&CncView::new(memory), C::KIND, &request)
+    let reply = machine
+        .call(&CncView::new(memory), 0, &body)
         .expect("answered");
-    let reply: FifoReply = bytemuck::pod_read_unaligned(&reply[..len as usize]);
     assert_eq!(reply.error_id, 0, "{:?}", C::KIND);
 }
 

@@ -234,12 +234,8 @@ fn cnc_fifo_run_traces_the_set_points() {
     assert_eq!(t.column("a0_direction")[10], 1.0);
     assert_eq!(t.column("a1_direction")[10], 0.0);
     assert_eq!(t.column("override")[0], 50.0);
-    for (args, code) in [
-        (vec!["--tf", "0"], 1),
-        (vec!["--tf", "0.001", "--override", "0"], 1),
-        (vec!["--tf", "0.001", "--fifo-rows", "1"], 1),
-    ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let fifo_run = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_cnc"))
             .args([
                 "fifo",
                 "run",
@@ -248,25 +244,19 @@ fn cnc_fifo_run_traces_the_set_points() {
                 "--cycle",
                 "0.001",
             ])
-            .args(&args)
+            .args(args)
             .output()
-            .unwrap();
-        assert_eq!(out.status.code(), Some(code), "{args:?}");
+            .unwrap()
+    };
+    for args in [
+        &["--tf", "0"][..],
+        &["--tf", "0.001", "--override", "0"],
+        &["--tf", "0.001", "--fifo-rows", "1"],
+    ] {
+        assert_eq!(fifo_run(args).status.code(), Some(1), "{args:?}");
     }
     std::fs::write(&csv, "1,2\n3,nan\n").unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args([
-            "fifo",
-            "run",
-            "--rows",
-            csv.to_str().unwrap(),
-            "--cycle",
-            "0.001",
-            "--tf",
-            "0.001",
-        ])
-        .output()
-        .unwrap();
+    let out = fifo_run(&["--tf", "0.001"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("rows.csv:2:3"));
     let _ = std::fs::remove_dir_all(&dir);

@@ -64,7 +64,7 @@ fn an_edge_while_busy_sends_nothing_and_a_silent_cnc_times_out() {
 
     // Nobody answers: Error after the timeout.
     let mut start = FifoStart::default();
-    start.timeout_cycles = 5;
+    start.set_timeout_cycles(5);
     let mut seen = Vec::new();
     for cycle in 0..8 {
         let out = start.cycle(

@@ -5,7 +5,7 @@
 //! ending the job.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::{AcyclicCall, AxisCommandCall, CallKind};
+use hli::calls::{AcyclicCall, AxisCommandCall};
 use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
 use hli::fifo_calls::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
@@ -14,7 +14,6 @@ use hli::fifo_calls::{
 };
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 use hli::views::{CncView, PlcView};
-use hli::wire::{encode_body, AcyclicRequest};
 
 const TICK: f64 = 0.001;
 /// Axes 0..3 form the group; 3 is free; 4 is a gear slave of 3.
@@ -48,20 +47,17 @@ fn instant(rows: usize, t_f_ms: f64) -> String {
 }
 
 fn call<C: AcyclicCall<Reply = FifoReply>>(run: &mut InProcess, group: u32, body: C) -> FifoReply {
-    let (body, body_len) = encode_body(&body);
-    let request = AcyclicRequest {
-        invoke_id: 1,
-        kind: C::KIND.raw(),
-        target: group,
-        body_len,
-        body,
-    };
     let view = CncView::new(&run.memory);
-    let (reply, len) = run
-        .machine
-        .dispatch(&view, C::KIND, &request)
-        .expect("answered");
-    bytemuck::pod_read_unaligned(&reply[..len as usize])
+    run.machine.call(&view, group, &body).expect("answered")
+}
+
+/// An axis command as MC_* sends it: the axis layer's error id.
+fn axis_command(run: &mut InProcess, axis: u32, command: AxisCommandCall) -> u32 {
+    let view = CncView::new(&run.memory);
+    run.machine
+        .call(&view, axis, &command)
+        .expect("answered")
+        .error_id
 }
 
 fn write(run: &mut InProcess, rows: &[[f64; 3]], overwrite: bool) -> FifoReply {
@@ -503,27 +499,9 @@ fn refusals_leave_the_rows_alone() {
 #[test]
 fn integration_couples_and_disintegration_frees() {
     let mut run = machine(&instant(16, 1.0));
-    let view_command = |run: &mut InProcess, axis: u32, command: AxisCommandCall| {
-        let (body, body_len) = encode_body(&command);
-        let request = AcyclicRequest {
-            invoke_id: 3,
-            kind: CallKind::AxisCommand.raw(),
-            target: axis,
-            body_len,
-            body,
-        };
-        let view = CncView::new(&run.memory);
-        let (reply, len) = run
-            .machine
-            .dispatch(&view, CallKind::AxisCommand, &request)
-            .unwrap();
-        let reply: hli::calls::AxisCommandReply =
-            bytemuck::pod_read_unaligned(&reply[..len as usize]);
-        reply.error_id
-    };
     let limits = [50.0, 1000.0, 1000.0, 10000.0];
     assert_eq!(
-        view_command(
+        axis_command(
             &mut run,
             FREE as u32,
             AxisCommandCall::move_velocity(1, limits)
@@ -549,7 +527,7 @@ fn integration_couples_and_disintegration_frees() {
         CouplingState::Fifo.raw()
     );
     assert_eq!(status(&run).axis_count_r, 3);
-    let r = view_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits));
+    let r = axis_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits));
     assert_eq!(r, AxisError::Coupled.raw());
     assert_eq!(
         call(&mut run, 0, FifoDisintegrateCall::default()).error_id,
@@ -561,7 +539,7 @@ fn integration_couples_and_disintegration_frees() {
         CouplingState::Uncoupled.raw()
     );
     assert_eq!(
-        view_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits)),
+        axis_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits)),
         0
     );
 }
@@ -736,18 +714,7 @@ fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
 fn an_axis_with_an_active_command_does_not_join() {
     let mut run = machine(&instant(16, 1.0));
     let command = AxisCommandCall::move_absolute(5.0, [50.0, 1000.0, 1000.0, 10000.0]);
-    let (body, body_len) = encode_body(&command);
-    let request = AcyclicRequest {
-        invoke_id: 5,
-        kind: CallKind::AxisCommand.raw(),
-        target: FREE as u32,
-        body_len,
-        body,
-    };
-    let view = CncView::new(&run.memory);
-    run.machine
-        .dispatch(&view, CallKind::AxisCommand, &request)
-        .unwrap();
+    assert_eq!(axis_command(&mut run, FREE as u32, command), 0);
     let r = call(
         &mut run,
         0,
@@ -757,4 +724,49 @@ fn an_axis_with_an_active_command_does_not_join() {
         },
     );
     assert_eq!(r.error_id, FifoError::AxisMoving.raw());
+}
+
+/// A scenario's FIFO group out of range is refused at load with the group and the reason.
+#[test]
+fn a_bad_fifo_group_is_refused_at_load() {
+    for (group, needle) in [
+        (
+            "dimension = 0\nrows = 10\nfifo_cycle_ms = 1.0\n",
+            "FIFO dimension 0",
+        ),
+        (
+            "dimension = 17\nrows = 10\nfifo_cycle_ms = 1.0\n",
+            "FIFO dimension 17",
+        ),
+        (
+            "dimension = 2\nrows = 1\nfifo_cycle_ms = 1.0\n",
+            "FIFO length 1",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 0.0\n",
+            "FIFO cycle 0 s",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = -2.0\n",
+            "FIFO cycle -0.002 s",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"pt2\"\n",
+            "needs pt2_t0_ms",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"soft\"\n",
+            "\"instant\" or \"pt2\"",
+        ),
+    ] {
+        let toml =
+            format!("cycle_ms = 1.0\nticks = 10\n[[axis]]\nname = \"X\"\n[[fifo_group]]\n{group}");
+        let e = Scenario::parse("bad.toml", &toml, |f| panic!("{f}")).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("[[fifo_group]] 0") || text.contains(needle),
+            "{text}"
+        );
+        assert!(text.contains(needle), "{text}");
+    }
 }

@@ -12,7 +12,6 @@ use hli::fifo_calls::{
 };
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
-use hli::wire::{encode_body, AcyclicRequest};
 use plc_shim::fifo::FifoWrite;
 use plc_shim::runtime::PlcIo;
 
@@ -35,18 +34,87 @@ struct Counts {
 }
 
 fn call<C: AcyclicCall<Reply = FifoReply>>(run: &mut InProcess, body: C) -> u32 {
-    let (body, body_len) = encode_body(&body);
-    let request = AcyclicRequest {
-        invoke_id: 1,
-        kind: C::KIND.raw(),
-        target: 0,
-        body_len,
-        body,
-    };
     let view = CncView::new(&run.memory);
-    let (reply, len) = run.machine.dispatch(&view, C::KIND, &request).unwrap();
-    bytemuck::pod_read_unaligned::<FifoReply>(&reply[..len as usize]).error_id
+    run.machine
+        .call(&view, 0, &body)
+        .expect("answered")
+        .error_id
 }
+
+/// The PLC's side: one FiFoWrite instance sending up to 100 rows whenever it may.
+struct Plc {
+    client: AcyclicClient,
+    write: FifoWrite,
+    sent: usize,
+    sending: usize,
+    lowering: bool,
+    cycle: u64,
+}
+
+impl Plc {
+    /// `n` times: CNC tick, the row service answered, PLC cycle; allocations counted apart.
+    fn steps(
+        &mut self,
+        n: usize,
+        run: &mut InProcess,
+        server: &AcyclicServer,
+        rows: &[f64],
+        counts: &mut Counts,
+    ) {
+        for _ in 0..n {
+            let (a0, d0) = (allocations(), deallocations());
+            run.machine.tick(&run.memory);
+            counts.ours += allocations() - a0;
+            counts.ours_freed += deallocations() - d0;
+            let machine = &mut run.machine;
+            let a0 = allocations();
+            let (mut handler, mut freed) = (0, 0);
+            server
+                .poll_rows(|header, values| {
+                    let (h0, f0) = (allocations(), deallocations());
+                    let reply = machine.dispatch_rows(header, values);
+                    handler += allocations() - h0;
+                    freed += deallocations() - f0;
+                    reply
+                })
+                .unwrap();
+            counts.ours += handler;
+            counts.ours_freed += freed;
+            counts.transport += allocations() - a0 - handler;
+            let free = PlcView::new(&run.memory).fifo_group(0).unwrap().free_r as usize;
+            let mut io = PlcIo {
+                view: PlcView::new(&run.memory),
+                memory: &run.memory,
+                acyclic: &mut self.client,
+                cycle: self.cycle,
+            };
+            self.cycle += 1;
+            if self.sending == 0 && !self.lowering && self.sent < ROWS {
+                self.sending = (ROWS - self.sent).min(free).min(100);
+                counts.blocks += usize::from(self.sending > 0);
+            }
+            let execute = self.sending > 0 && !self.lowering;
+            let data = &rows[self.sent * N..];
+            let a0 = allocations();
+            let out = self
+                .write
+                .cycle(&mut io, execute, 0, data, N as u32, self.sending as u32);
+            counts.transport += allocations() - a0;
+            if self.lowering {
+                self.lowering = false;
+            } else if out.done {
+                self.sent += self.sending;
+                self.sending = 0;
+                self.lowering = true;
+            } else if out.error {
+                self.sending = 0;
+                self.lowering = true;
+            }
+        }
+    }
+}
+
+const ROWS: usize = 3000;
 
 #[test]
 fn a_running_group_and_its_row_blocks_allocate_nothing() {
@@ -62,7 +130,7 @@ fn a_running_group_and_its_row_blocks_allocate_nothing() {
     let mut run = InProcess::new(&s, 0).unwrap();
     let instance = format!("fifo-no-alloc-{}", std::process::id());
     let server = AcyclicServer::open(&instance).unwrap();
-    let mut client = AcyclicClient::open(&instance).unwrap();
+    let client = AcyclicClient::open(&instance).unwrap();
     run.step(0.001);
     for axis in 0..N as u32 {
         let integrate = FifoIntegrateCall {
@@ -72,118 +140,30 @@ fn a_running_group_and_its_row_blocks_allocate_nothing() {
         assert_eq!(call(&mut run, integrate), 0);
     }
     // 3000 rows of a slow sweep, written in blocks of up to 100 rows while the group runs.
-    let rows: Vec<f64> = (0..3000)
+    let rows: Vec<f64> = (0..ROWS)
         .flat_map(|k| (0..N).map(move |c| (k as f64 * 0.001 * (c + 1) as f64).sin()))
         .map(|v| v - 0.0)
         .collect();
-    let mut write = FifoWrite::default();
-    let mut counts = Counts::default();
-    let mut sent = 0usize;
-    let mut sending = 0usize;
-    let mut lowering = false;
-    let mut cycle = 0u64;
-    let mut step = |counts: &mut Counts,
-                    run: &mut InProcess,
-                    write: &mut FifoWrite,
-                    client: &mut AcyclicClient,
-                    sent: &mut usize,
-                    sending: &mut usize,
-                    lowering: &mut bool| {
-        let (a0, d0) = (allocations(), deallocations());
-        run.machine.tick(&run.memory);
-        counts.ours += allocations() - a0;
-        counts.ours_freed += deallocations() - d0;
-        let machine = &mut run.machine;
-        let a0 = allocations();
-        let mut handler = 0;
-        let mut freed = 0;
-        server
-            .poll_rows(|header, values| {
-                let (h0, f0) = (allocations(), deallocations());
-                let reply = machine.dispatch_rows(header, values);
-                handler += allocations() - h0;
-                freed += deallocations() - f0;
-                reply
-            })
-            .unwrap();
-        counts.ours += handler;
-        counts.ours_freed += freed;
-        counts.transport += allocations() - a0 - handler;
-        let free = PlcView::new(&run.memory).fifo_group(0).unwrap().free_r as usize;
-        let mut io = PlcIo {
-            view: PlcView::new(&run.memory),
-            memory: &run.memory,
-            acyclic: client,
-            cycle,
-        };
-        cycle += 1;
-        if *sending == 0 && !*lowering && *sent < 3000 {
-            *sending = (3000 - *sent).min(free).min(100);
-            counts.blocks += usize::from(*sending > 0);
-        }
-        let execute = *sending > 0 && !*lowering;
-        let data = &rows[*sent * N..];
-        let a0 = allocations();
-        let out = write.cycle(&mut io, execute, 0, data, N as u32, *sending as u32);
-        counts.transport += allocations() - a0;
-        if *lowering {
-            *lowering = false;
-        } else if out.done {
-            *sent += *sending;
-            *sending = 0;
-            *lowering = true;
-        } else if out.error {
-            *sending = 0;
-            *lowering = true;
-        }
+    let mut plc = Plc {
+        client,
+        write: FifoWrite::default(),
+        sent: 0,
+        sending: 0,
+        lowering: false,
+        cycle: 0,
     };
+    let mut counts = Counts::default();
     // Warm-up: the ports' first use, the first blocks, the start.
-    for _ in 0..20 {
-        step(
-            &mut counts,
-            &mut run,
-            &mut write,
-            &mut client,
-            &mut sent,
-            &mut sending,
-            &mut lowering,
-        );
-    }
+    plc.steps(20, &mut run, &server, &rows, &mut counts);
     assert_eq!(call(&mut run, FifoStartCall::default()), 0);
-    for _ in 0..50 {
-        step(
-            &mut counts,
-            &mut run,
-            &mut write,
-            &mut client,
-            &mut sent,
-            &mut sending,
-            &mut lowering,
-        );
-    }
+    plc.steps(50, &mut run, &server, &rows, &mut counts);
     counts = Counts::default();
-
     // An override change (PT-2) while rows stream in.
-    assert_eq!(
-        call(
-            &mut run,
-            FifoOverrideCall {
-                override_ppm: 600_000
-            }
-        ),
-        0
-    );
-    for _ in 0..2000 {
-        step(
-            &mut counts,
-            &mut run,
-            &mut write,
-            &mut client,
-            &mut sent,
-            &mut sending,
-            &mut lowering,
-        );
-    }
+    let change = FifoOverrideCall {
+        override_ppm: 600_000,
+    };
+    assert_eq!(call(&mut run, change), 0);
+    plc.steps(2000, &mut run, &server, &rows, &mut counts);
     // The rest of the rows, the FIFO running dry (underrun), the stop.
     let (a, d) = (allocations(), deallocations());
     for _ in 0..5000 {
@@ -221,5 +201,9 @@ fn a_running_group_and_its_row_blocks_allocate_nothing() {
     );
     let status = PlcView::new(&run.memory).fifo_group(0).unwrap();
     assert_eq!(status.group_state_r, FifoGroupState::Idle.raw());
-    assert!(sent > 1000, "{sent} rows went through the row service");
+    assert!(
+        plc.sent > 1000,
+        "{} rows went through the row service",
+        plc.sent
+    );
 }

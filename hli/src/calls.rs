@@ -759,6 +759,18 @@ pub fn decode_body<T: Pod>(request: &AcyclicRequest) -> Result<T, ErrorCode> {
     Ok(bytemuck::pod_read_unaligned(&request.body[..len]))
 }
 
+/// Decodes a handler's reply body as `C`'s reply; a size mismatch is
+/// [`ErrorCode::InvalidSize`].
+pub fn decode_reply<C: AcyclicCall>(
+    body: &[u8; ACYCLIC_BODY_SIZE],
+    len: u32,
+) -> Result<C::Reply, ErrorCode> {
+    if len as usize != core::mem::size_of::<C::Reply>() {
+        return Err(ErrorCode::InvalidSize);
+    }
+    Ok(bytemuck::pod_read_unaligned(&body[..len as usize]))
+}
+
 /// A reply a handler produces: the encoded body or a refusal.
 pub type HandlerResult = Result<([u8; ACYCLIC_BODY_SIZE], u32), ErrorCode>;
 

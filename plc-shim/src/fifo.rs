@@ -86,18 +86,35 @@ fn answer(
 /// PLC cycles a block waits for its answer by default (1 s at a 1 ms cycle).
 pub const DEFAULT_TIMEOUT_CYCLES: u64 = 1000;
 
-/// Edge, pending answer and outputs of a one-frame FIFO block.
-pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
-    /// Input: cycles to wait for the answer (tTimeout).
-    pub timeout_cycles: u64,
+/// Something on its way to the CNC that yields a [`FifoReply`].
+trait Answer {
+    fn poll_reply(&self) -> Option<Result<FifoReply, CallError>>;
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> Answer for PendingCall<C> {
+    fn poll_reply(&self) -> Option<Result<FifoReply, CallError>> {
+        self.poll()
+    }
+}
+
+impl Answer for PendingRows {
+    fn poll_reply(&self) -> Option<Result<FifoReply, CallError>> {
+        self.poll()
+    }
+}
+
+/// Execute edge, the call on its way (with the cycle it left in) and the outputs: what every
+/// FIFO block shares.
+struct Core<P> {
+    timeout_cycles: u64,
     execute_before: bool,
-    pending: Option<(PendingCall<C>, u64)>,
+    pending: Option<(P, u64)>,
     out: FifoOutputs,
 }
 
-impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
+impl<P> Default for Core<P> {
     fn default() -> Self {
-        Self {
+        Core {
             timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
             execute_before: false,
             pending: None,
@@ -106,22 +123,72 @@ impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
     }
 }
 
-impl<C: AcyclicCall<Reply = FifoReply>> core::fmt::Debug for FifoBlock<C> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("FifoBlock").field("out", &self.out).finish()
+impl<P: Answer> Core<P> {
+    /// A rising edge with nothing on its way: the block sends now (outputs cleared).
+    fn edge(&mut self, execute: bool) -> bool {
+        let send = rose(&mut self.execute_before, execute) && self.pending.is_none();
+        if send {
+            self.out = FifoOutputs::default();
+        }
+        send
+    }
+
+    /// What the send gave: the call on its way, or an error now.
+    fn sent(&mut self, result: Result<P, u32>, cycle: u64) {
+        match result {
+            Ok(p) => self.pending = Some((p, cycle)),
+            Err(code) => self.out = failed(code, FifoReply::default()),
+        }
+    }
+
+    /// Follows the call on its way; the outputs of this cycle.
+    fn follow(&mut self, execute: bool, cycle: u64) -> FifoOutputs {
+        if let Some((p, sent)) = &self.pending {
+            let waited = cycle.saturating_sub(*sent);
+            match answer(p.poll_reply(), waited, self.timeout_cycles) {
+                None => self.out.busy = true,
+                Some(out) => {
+                    self.out = out;
+                    self.pending = None;
+                }
+            }
+        }
+        // Execute low and nothing on its way: the outputs clear (after one cycle shown).
+        let shown = self.out;
+        if !execute && self.pending.is_none() {
+            self.out = FifoOutputs::default();
+        }
+        shown
     }
 }
 
-/// Clears the outputs one cycle after Execute fell with nothing pending.
-fn settle(out: &mut FifoOutputs, execute: bool, idle: bool) -> FifoOutputs {
-    let shown = *out;
-    if !execute && idle {
-        *out = FifoOutputs::default();
+/// A one-frame FIFO block.
+pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
+    core: Core<PendingCall<C>>,
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
+    fn default() -> Self {
+        Self {
+            core: Core::default(),
+        }
     }
-    shown
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> core::fmt::Debug for FifoBlock<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FifoBlock")
+            .field("out", &self.core.out)
+            .finish()
+    }
 }
 
 impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.core.timeout_cycles = cycles;
+    }
+
     /// One cycle: on a rising `execute`, `call()` goes to FIFO group `group`.
     pub fn cycle(
         &mut self,
@@ -130,27 +197,12 @@ impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
         group: u32,
         call: impl FnOnce() -> C,
     ) -> FifoOutputs {
-        if rose(&mut self.execute_before, execute) && self.pending.is_none() {
-            self.out = FifoOutputs::default();
-            match io.acyclic.start(group, &call()) {
-                Ok(p) => self.pending = Some((p, io.cycle)),
-                Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
-            }
+        if self.core.edge(execute) {
+            let result = io.acyclic.start(group, &call());
+            self.core
+                .sent(result.map_err(|_| ERROR_NO_ANSWER), io.cycle);
         }
-        if let Some((p, sent)) = &self.pending {
-            match answer(
-                p.poll(),
-                io.cycle.saturating_sub(*sent),
-                self.timeout_cycles,
-            ) {
-                None => self.out.busy = true,
-                Some(out) => {
-                    self.out = out;
-                    self.pending = None;
-                }
-            }
-        }
-        settle(&mut self.out, execute, self.pending.is_none())
+        self.core.follow(execute, io.cycle)
     }
 }
 
@@ -170,26 +222,19 @@ pub type FifoSetChannelOverride = FifoBlock<FifoOverrideCall>;
 pub type FifoSetParameters = FifoBlock<FifoParametersCall>;
 
 /// FiFoWrite (`overwrite` false) or FiFoOverwrite (true).
-#[derive(Debug)]
+#[derive(Default)]
 pub struct FifoWrite {
     /// FiFoOverwrite: replace the rows queued behind the pair in use.
     pub overwrite: bool,
-    /// Input: cycles to wait for the answer (tTimeout).
-    pub timeout_cycles: u64,
-    execute_before: bool,
-    pending: Option<(PendingRows, u64)>,
-    out: FifoOutputs,
+    core: Core<PendingRows>,
 }
 
-impl Default for FifoWrite {
-    fn default() -> Self {
-        FifoWrite {
-            overwrite: false,
-            timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
-            execute_before: false,
-            pending: None,
-            out: FifoOutputs::default(),
-        }
+impl core::fmt::Debug for FifoWrite {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FifoWrite")
+            .field("overwrite", &self.overwrite)
+            .field("out", &self.core.out)
+            .finish()
     }
 }
 
@@ -200,6 +245,11 @@ impl FifoWrite {
             overwrite: true,
             ..FifoWrite::default()
         }
+    }
+
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.core.timeout_cycles = cycles;
     }
 
     /// One cycle: on a rising `execute`, the first `rows` rows of `data` (rows of `columns`
@@ -213,10 +263,9 @@ impl FifoWrite {
         columns: u32,
         rows: u32,
     ) -> FifoOutputs {
-        if rose(&mut self.execute_before, execute) && self.pending.is_none() {
-            self.out = FifoOutputs::default();
+        if self.core.edge(execute) {
             let values = (columns as usize).checked_mul(rows as usize);
-            match values {
+            let result = match values {
                 Some(n) if n <= data.len() && n <= FIFO_BLOCK_VALUES => {
                     let header = FifoRowsHeader {
                         group,
@@ -224,32 +273,19 @@ impl FifoWrite {
                         rows,
                         overwrite: u32::from(self.overwrite),
                     };
-                    match io.acyclic.start_rows(header, &data[..n]) {
-                        Ok(p) => self.pending = Some((p, io.cycle)),
-                        Err(_) => self.out = failed(ERROR_NO_ANSWER, FifoReply::default()),
-                    }
+                    io.acyclic
+                        .start_rows(header, &data[..n])
+                        .map_err(|_| ERROR_NO_ANSWER)
                 }
-                _ => self.out = failed(ERROR_BLOCK_SIZE, FifoReply::default()),
-            }
+                _ => Err(ERROR_BLOCK_SIZE),
+            };
+            self.core.sent(result, io.cycle);
         }
-        if let Some((p, sent)) = &self.pending {
-            match answer(
-                p.poll(),
-                io.cycle.saturating_sub(*sent),
-                self.timeout_cycles,
-            ) {
-                None => self.out.busy = true,
-                Some(out) => {
-                    self.out = out;
-                    self.pending = None;
-                }
-            }
-        }
-        settle(&mut self.out, execute, self.pending.is_none())
+        self.core.follow(execute, io.cycle)
     }
 
     /// Whether a block is on its way.
     pub fn busy(&self) -> bool {
-        self.pending.is_some()
+        self.core.pending.is_some()
     }
 }

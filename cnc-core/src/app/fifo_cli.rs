@@ -24,7 +24,6 @@ use hli::fifo_calls::{
 };
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_OVERRIDE_FULL};
 use hli::views::{CncView, PlcView};
-use hli::wire::{encode_body, AcyclicRequest};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -93,20 +92,9 @@ fn call<C: AcyclicCall<Reply = FifoReply>>(
     view: &CncView<'_>,
     body: C,
 ) -> u32 {
-    let (body, body_len) = encode_body(&body);
-    let request = AcyclicRequest {
-        invoke_id: 1,
-        kind: C::KIND.raw(),
-        target: 0,
-        body_len,
-        body,
-    };
-    match machine.dispatch(view, C::KIND, &request) {
-        Ok((reply, len)) => {
-            bytemuck::pod_read_unaligned::<FifoReply>(&reply[..len as usize]).error_id
-        }
-        Err(code) => code.raw(),
-    }
+    machine
+        .call(view, 0, &body)
+        .map_or_else(|code| code.raw(), |reply| reply.error_id)
 }
 
 fn refused(what: &str, code: u32) -> Failure {

@@ -169,19 +169,29 @@ impl Group {
         }
     }
 
-    /// A member faulted while the group ran: the job ends, the others stop on their own.
-    fn fault(&mut self, axes: &mut AxisSet) {
+    /// Every member leaves the group (decoupled where still ours), `halt`ing with its own
+    /// deceleration when asked.
+    fn release(&mut self, axes: &mut AxisSet, halt: bool) {
         for axis in self.members.iter_mut().filter_map(Option::take) {
-            if let Some(a) = axes.axis_mut(axis) {
-                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
-                    a.decouple();
-                    let d = a.config().dynamics;
-                    // MC_Halt, not MC_Stop: the axis must not stay locked for the PLC that
-                    // regroups it. Refused only by an axis that stands already.
-                    let _ = a.command(&AxisCommandCall::halt(d.deceleration, d.jerk));
-                }
+            let Some(a) = axes.axis_mut(axis) else {
+                continue;
+            };
+            if !a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
+                continue;
+            }
+            a.decouple();
+            if halt {
+                let d = a.config().dynamics;
+                // MC_Halt, not MC_Stop: the axis must not stay locked for the PLC that
+                // regroups it. Refused only by an axis that stands already.
+                let _ = a.command(&AxisCommandCall::halt(d.deceleration, d.jerk));
             }
         }
+    }
+
+    /// A member faulted while the group ran: the job ends, the others stop on their own.
+    fn fault(&mut self, axes: &mut AxisSet) {
+        self.release(axes, true);
         self.error = Some(FifoError::AxisFault);
         self.end_job(FifoGroupState::Error);
     }
@@ -291,13 +301,7 @@ impl Group {
         if self.running() {
             return self.refuse(FifoError::Running);
         }
-        for axis in self.members.iter_mut().filter_map(Option::take) {
-            if let Some(a) = axes.axis_mut(axis) {
-                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
-                    a.decouple();
-                }
-            }
-        }
+        self.release(axes, false);
         // The group is dissolved: rows queued for its axes go with it.
         self.error = None;
         self.end_job(FifoGroupState::Idle);
@@ -442,13 +446,7 @@ impl Group {
     /// The machine stops: the job ends, every member leaves the group (the machine then
     /// stops each axis with its own deceleration).
     fn reset(&mut self, axes: &mut AxisSet) {
-        for axis in self.members.iter_mut().filter_map(Option::take) {
-            if let Some(a) = axes.axis_mut(axis) {
-                if a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
-                    a.decouple();
-                }
-            }
-        }
+        self.release(axes, false);
         self.error = None;
         self.end_job(FifoGroupState::Idle);
     }

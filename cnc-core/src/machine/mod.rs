@@ -34,7 +34,9 @@ use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
 use crate::channel::{Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
-use hli::calls::{reply, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode, HandlerResult};
+use hli::calls::{
+    reply, AcyclicCall, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode, HandlerResult,
+};
 use hli::enums::DynCsState;
 use hli::fifo_calls::{FifoReply, FifoRowsHeader};
 use hli::layout::HLI_MAX_AXES;
@@ -256,6 +258,26 @@ impl Machine {
             // A kind of an engine this machine does not have.
             _ => Err(ErrorCode::ServiceNotSupported),
         }
+    }
+
+    /// A typed acyclic call answered in this process (tools, tests, benches): the body
+    /// encoded as the PLC would send it to `target`, dispatched, the reply decoded.
+    pub fn call<C: AcyclicCall>(
+        &mut self,
+        view: &CncView<'_>,
+        target: u32,
+        body: &C,
+    ) -> Result<C::Reply, ErrorCode> {
+        let (body, body_len) = hli::wire::encode_body(body);
+        let request = AcyclicRequest {
+            invoke_id: 0,
+            kind: C::KIND.raw(),
+            target,
+            body_len,
+            body,
+        };
+        let (reply, len) = self.dispatch(view, C::KIND, &request)?;
+        hli::calls::decode_reply::<C>(&reply, len)
     }
 
     /// Answers one FIFO row block: the engine that owns it (the FIFO engine), else it is

@@ -24,18 +24,9 @@ use hli::fifo_calls::{
 use hli::layout::FIFO_OVERRIDE_FULL;
 use std::sync::Arc;
 
-/// The FIFO blocks a timeline can call.
-pub(super) const FIFO_BLOCKS: [&str; 9] = [
-    "FiFoGetDimension",
-    "FiFoGroupIntegrate",
-    "FiFoGroupDisintegrate",
-    "FiFoWrite",
-    "FiFoOverwrite",
-    "FiFoStart",
-    "FiFoStop",
-    "FiFoSetChannelOverride",
-    "FiFoSetParameters",
-];
+/// The FIFO blocks a timeline can call: the tail of [`super::BLOCKS`].
+pub(super) const FIFO_BLOCKS: &[&str] = super::BLOCKS.as_slice().split_at(36).1;
+const _: () = assert!(FIFO_BLOCKS.len() == 9);
 
 /// The inputs of a FIFO call.
 #[derive(Debug, Clone, Default, PartialEq)]
