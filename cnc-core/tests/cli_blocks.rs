@@ -106,14 +106,9 @@ fn blocks_move_single_axes_in_lockstep_tick_exact() {
     // In-process, the same timeline calls the same blocks through an acyclic service of its
     // own: the same trace rows and the same block edges, tick for tick.
     let s = Scenario::load(&scenario_path()).unwrap();
-    let ticks = s.ticks.expect("the scenario has ticks") as usize;
-    let mut run_in = InProcess::new(&s, ticks).unwrap();
-    for _ in 0..ticks {
-        run_in.step(s.cycle_s);
-    }
-    let mut csv = Vec::new();
-    run_in.trace.write_csv(&mut csv).unwrap();
-    let in_rows: Vec<Vec<f64>> = String::from_utf8(csv)
+    assert!(s.ticks.is_some(), "the scenario has ticks");
+    let run_in = InProcess::run_through(&s).unwrap();
+    let in_rows: Vec<Vec<f64>> = String::from_utf8(run_in.trace_csv())
         .unwrap()
         .lines()
         .skip(1)

@@ -44,13 +44,8 @@ fn a_plc_process_couples_scales_changes_and_decouples_a_cam_slave() {
     let _ = std::fs::remove_file(&trace);
 
     let s = Scenario::load(&scenario_path()).unwrap();
-    let ticks = s.ticks.unwrap() as usize;
-    let mut run = InProcess::new(&s, ticks).unwrap();
-    for _ in 0..ticks {
-        run.step(s.cycle_s);
-    }
-    let mut in_process = Vec::new();
-    run.trace.write_csv(&mut in_process).unwrap();
+    let run = InProcess::run_through(&s).unwrap();
+    let in_process = run.trace_csv();
     assert_eq!(
         in_process, two_process,
         "in-process and two-process traces differ"

@@ -285,13 +285,8 @@ fn the_fifo_blocks_from_a_timeline_run_alike_in_one_and_two_processes() {
         "{report}"
     );
     let s = Scenario::load(&path).unwrap();
-    let ticks = s.ticks.unwrap() as usize;
-    let mut run = InProcess::new(&s, ticks).unwrap();
-    for _ in 0..ticks {
-        run.step(s.cycle_s);
-    }
-    let mut in_process = Vec::new();
-    run.trace.write_csv(&mut in_process).unwrap();
+    let run = InProcess::run_through(&s).unwrap();
+    let in_process = run.trace_csv();
     assert_eq!(
         in_process, two_process,
         "in-process and two-process traces differ"

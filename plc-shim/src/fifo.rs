@@ -283,9 +283,14 @@ impl FifoWrite {
         }
         self.core.follow(execute, io.cycle)
     }
+}
 
-    /// Whether a block is on its way.
-    pub fn busy(&self) -> bool {
-        self.core.pending.is_some()
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_library_names_its_version() {
+        let v = super::fifo_library_version();
+        assert_eq!(v, concat!("cncplc-fifo ", env!("CARGO_PKG_VERSION")));
+        assert!(v.len() <= 20, "fits the seed's STRING(20)");
     }
 }

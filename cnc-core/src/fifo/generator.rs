@@ -68,11 +68,6 @@ impl FifoGenerator {
         self.fifo_cycle_s = fifo_cycle_s;
     }
 
-    /// T_f.
-    pub fn fifo_cycle(&self) -> f64 {
-        self.fifo_cycle_s
-    }
-
     /// A job starts at the front row (which the caller has checked against the axes):
     /// positions there, at rest, job time 0.
     pub fn start(&mut self, ring: &RowRing) {

@@ -58,11 +58,6 @@ impl OverrideFilter {
         }
     }
 
-    /// The type.
-    pub fn kind(&self) -> OverrideType {
-        self.kind
-    }
-
     /// A new target in [0, 1] (the caller checks the range).
     pub fn set_target(&mut self, target: f64) {
         self.target = target;
@@ -104,11 +99,6 @@ impl OverrideFilter {
     /// The value in effect.
     pub fn value(&self) -> f64 {
         self.value
-    }
-
-    /// Its rate, 1/s.
-    pub fn rate(&self) -> f64 {
-        self.rate
     }
 
     /// The target.

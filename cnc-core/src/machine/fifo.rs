@@ -475,21 +475,6 @@ impl FifoEngine {
         })
     }
 
-    /// Groups configured.
-    pub fn len(&self) -> usize {
-        self.groups.len()
-    }
-
-    /// Whether no group is configured.
-    pub fn is_empty(&self) -> bool {
-        self.groups.is_empty()
-    }
-
-    /// The status group `index` publishes (as in `gpFifo[index]^`).
-    pub fn status(&self, index: usize) -> Option<HliFifoGroupState> {
-        self.groups.get(index).map(Group::image)
-    }
-
     fn call(&mut self, kind: CallKind, request: &AcyclicRequest, axes: &mut AxisSet) -> FifoReply {
         let tick_s = self.tick_s;
         let Some(group) = self.groups.get_mut(request.target as usize) else {

@@ -139,6 +139,25 @@ impl InProcess {
         })
     }
 
+    /// The whole scenario in-process: its `ticks` steps with a trace row each (the run
+    /// `cnc run --lockstep` makes with a PLC process). A scenario without `ticks` runs none.
+    pub fn run_through(scenario: &Scenario) -> Result<InProcess, ScenarioError> {
+        let ticks = scenario.ticks.unwrap_or(0) as usize;
+        let mut run = InProcess::new(scenario, ticks)?;
+        for _ in 0..ticks {
+            run.step(scenario.cycle_s);
+        }
+        Ok(run)
+    }
+
+    /// The trace as `cnc run --trace` writes it.
+    pub fn trace_csv(&self) -> Vec<u8> {
+        let mut csv = Vec::new();
+        // Writing into a Vec cannot fail.
+        let _ = self.trace.write_csv(&mut csv);
+        csv
+    }
+
     /// One lockstep step: CNC tick, trace sample, acyclic calls answered, PLC cycle (the
     /// order of `cnc run --lockstep`). `cycle_s` gives the trace time.
     pub fn step(&mut self, cycle_s: f64) {
