@@ -14,3 +14,4 @@ pub mod channel;
 pub mod fifo;
 pub mod machine;
 pub mod nc;
+pub mod saw;

@@ -86,6 +86,12 @@ pub enum CallKind {
     FifoOverride,
     /// [`crate::fifo_calls::FifoParametersCall`].
     FifoParameters,
+    /// [`crate::saw_calls::SawGearInCall`].
+    SawGearIn,
+    /// [`crate::saw_calls::SawGearOutCall`].
+    SawGearOut,
+    /// [`crate::saw_calls::SawCharacCall`].
+    SawCharac,
 }
 
 impl CallKind {
@@ -114,6 +120,9 @@ impl CallKind {
             CallKind::FifoStop => 34,
             CallKind::FifoOverride => 35,
             CallKind::FifoParameters => 36,
+            CallKind::SawGearIn => 40,
+            CallKind::SawGearOut => 41,
+            CallKind::SawCharac => 42,
         }
     }
 
@@ -142,6 +151,9 @@ impl CallKind {
             34 => Some(CallKind::FifoStop),
             35 => Some(CallKind::FifoOverride),
             36 => Some(CallKind::FifoParameters),
+            40 => Some(CallKind::SawGearIn),
+            41 => Some(CallKind::SawGearOut),
+            42 => Some(CallKind::SawCharac),
             _ => None,
         }
     }

@@ -26,6 +26,7 @@ pub mod handshake;
 pub mod layout;
 pub mod raw;
 pub mod rpc;
+pub mod saw_calls;
 pub mod segment;
 pub mod signals;
 pub mod symbols;

@@ -1311,6 +1311,10 @@ impl Engine for CamEngine {
         "cam"
     }
 
+    fn holds_table(&self, id: u32) -> bool {
+        self.store.get(id).is_ok()
+    }
+
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
         for i in 0..self.multis.len() {
             let Some(multi) = self.multis[i].as_mut() else {

@@ -51,6 +51,13 @@ pub trait Engine: std::fmt::Debug + Send {
         None
     }
 
+    /// Whether this engine holds motion-function table `id` (the flying saw refuses a slave
+    /// whose internal table, 256 - slave axis ID, a cam uses).
+    fn holds_table(&self, id: u32) -> bool {
+        let _ = id;
+        false
+    }
+
     /// The machine stops on a fault (lost PLC, signal): release every coupled axis so that
     /// each stops with its own deceleration.
     fn reset(&mut self, axes: &mut AxisSet);

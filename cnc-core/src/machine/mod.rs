@@ -25,6 +25,7 @@ mod channel_axes;
 pub mod engine;
 pub mod fifo;
 pub mod gear;
+pub mod saw;
 
 pub use channel_axes::ChannelAxes;
 pub use engine::{Engine, EngineIo};
@@ -231,9 +232,23 @@ impl Machine {
                 | CallKind::CamRead
                 | CallKind::CamPointsRead
                 | CallKind::FifoDimension
+                | CallKind::SawCharac
         );
         if self.stopped && !read {
             return Err(ErrorCode::Busy);
+        }
+        if kind == CallKind::SawGearIn {
+            // The saw's internal table is 256 - the slave's axis ID (chapter 13).
+            let id = self
+                .axes
+                .axis(request.target as usize)
+                .map(|a| 256u32.wrapping_sub(a.config().id));
+            if id.is_some_and(|id| self.engines.iter().any(|e| e.holds_table(id))) {
+                return reply(&hli::saw_calls::SawReply {
+                    error_id: hli::enums::SawError::TableInUse.raw(),
+                    reserved: 0,
+                });
+            }
         }
         for engine in &mut self.engines {
             if let Some(result) = engine.handle(kind, request, &mut self.axes) {

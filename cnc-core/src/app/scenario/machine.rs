@@ -58,6 +58,15 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
             .map_err(|e| invalid(e.to_string()))?;
         engines.push(Box::new(fifo));
     }
+    // The flying saw, last: a master driven by a cam or a FIFO group has its set-point of
+    // this tick by then.
+    if !scenario.axes.is_empty() {
+        let total = channel_axes + scenario.axes.len();
+        engines.push(Box::new(crate::machine::saw::SawEngine::new(
+            total,
+            scenario.cycle_s,
+        )));
+    }
     let mut machine = Machine::new(MachineSetup {
         channels,
         axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),

@@ -1,0 +1,161 @@
+//! The flying saw's calls (seed 001, chapter 12): MC_GearInVelo and MC_GearInPos in one
+//! coupling call, MC_GearOut, and MC_ReadFlyingSawCharacteristics in two parts (the 31
+//! values do not fit one frame). Every call addresses the slave axis as `target` (its `gpAx`
+//! index); the master is an axis index in the body. The slave's progress is read from its
+//! axis image: `coupling_state_r` 2 (velocity) or 3 (position) and `nAxisState` 11/12/13.
+
+use crate::calls::{AcyclicCall, CallKind};
+use crate::wire::ACYCLIC_BODY_SIZE;
+use bytemuck::{Pod, Zeroable};
+
+/// `ST_SyncMode` bits: the checks (chapter 5, values as the seed gives them) and the
+/// operation masks.
+pub mod sync_mask {
+    /// Slave position >= its lower software limit.
+    pub const MINPOS: u32 = 0x0000_0001;
+    /// Slave position <= its upper software limit.
+    pub const MAXPOS: u32 = 0x0000_0002;
+    /// |slave velocity| <= the velocity limit.
+    pub const MAXVELO: u32 = 0x0000_0004;
+    /// Slave acceleration (speeding up) <= the acceleration limit.
+    pub const MAXACC: u32 = 0x0000_0008;
+    /// Slave deceleration (slowing down) <= the deceleration limit.
+    pub const MAXDEC: u32 = 0x0000_0010;
+    /// |slave jerk| <= the jerk limit.
+    pub const MAXJERK: u32 = 0x0000_0020;
+    /// The slave position does not pass beyond its sync position.
+    pub const OVERSHOOTPOS: u32 = 0x0000_0100;
+    /// The slave position does not go back behind its start position.
+    pub const UNDERSHOOTPOS: u32 = 0x0000_0200;
+    /// The slave velocity stays at or below the larger of start and sync velocity.
+    pub const OVERSHOOTVELO: u32 = 0x0000_0400;
+    /// The slave velocity stays at or above the smaller of start and sync velocity.
+    pub const UNDERSHOOTVELO: u32 = 0x0000_0800;
+    /// The slave velocity does not rise above 0.
+    pub const OVERSHOOTVELOZERO: u32 = 0x0000_1000;
+    /// The slave velocity does not fall below 0.
+    pub const UNDERSHOOTVELOZERO: u32 = 0x0000_2000;
+    /// Every check bit.
+    pub const CHECKS: u32 = 0x0000_3F3F;
+    /// Rollback lock: the slave stops when the master runs back over the coupling position.
+    pub const ROLLBACKLOCK: u32 = 0x0001_0000;
+    /// On rollback the slave stops within one tick instead of along a 5th-order polynomial.
+    pub const INSTANTSTOPONROLLBACK: u32 = 0x0002_0000;
+    /// Prefer a phase of constant velocity: P5-P1-P5 at the given acceleration and
+    /// deceleration.
+    pub const PREFERCONSTVELO: u32 = 0x0010_0000;
+    /// The master's acceleration at coupling is taken as 0.
+    pub const IGNOREMASTERACC: u32 = 0x0020_0000;
+    /// The slave's acceleration at coupling is taken as 0 (ours: the seed names the bit
+    /// without a value).
+    pub const IGNORESLAVEACC: u32 = 0x0040_0000;
+    /// A failed check reports its own code instead of the general one (ours, as above).
+    pub const DETAILEDERRORCODES: u32 = 0x0080_0000;
+    /// Every operation bit.
+    pub const OPERATIONS: u32 = 0x00F3_0000;
+}
+
+/// `E_GearInSyncMode`: the slave profile is a function of the master position.
+pub const SYNC_POSITION_BASED: u32 = 0;
+/// `E_GearInSyncMode`: a time-based slave profile that keeps all slave limits (velocity
+/// sync only).
+pub const SYNC_TIME_BASED: u32 = 1;
+
+/// [`SawGearInCall::target`]: synchronise on velocity (MC_GearInVelo).
+pub const SAW_ON_VELOCITY: u32 = 0;
+/// [`SawGearInCall::target`]: synchronise on position (MC_GearInPos).
+pub const SAW_ON_POSITION: u32 = 1;
+
+/// MC_GearInVelo / MC_GearInPos for the slave given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct SawGearInCall {
+    /// The master, its `gpAx` index.
+    pub master: u32,
+    /// [`SAW_ON_VELOCITY`] or [`SAW_ON_POSITION`].
+    pub target: u32,
+    /// [`SYNC_POSITION_BASED`] or [`SYNC_TIME_BASED`].
+    pub sync_mode: u32,
+    /// Check and operation bits ([`sync_mask`]).
+    pub mask: u32,
+    /// RatioDenominator (0 is refused).
+    pub ratio_denominator: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+    /// RatioNumerator (may be negative; 0 is refused).
+    pub ratio_numerator: f64,
+    /// MasterSyncPosition (position sync).
+    pub master_sync_position: f64,
+    /// SlaveSyncPosition (position sync).
+    pub slave_sync_position: f64,
+    /// Velocity limit of the synchronising phase; 0: the axis's own.
+    pub velocity: f64,
+    /// Acceleration limit; 0: the axis's own.
+    pub acceleration: f64,
+    /// Deceleration limit; 0: the axis's own.
+    pub deceleration: f64,
+    /// Jerk limit; 0: the axis's own.
+    pub jerk: f64,
+}
+
+/// MC_GearOut for the slave given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct SawGearOutCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// The reply to the coupling and decoupling calls: 0 when accepted, else a raw
+/// [`crate::enums::SawError`] or [`crate::enums::AxisError`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct SawReply {
+    /// 0 when accepted.
+    pub error_id: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// Values of `MC_FlyingSawCharacValues` one part carries.
+pub const SAW_CHARAC_PART: usize = 16;
+
+/// MC_ReadFlyingSawCharacteristics, one part: fields `16 * part + 1 ..` of the structure
+/// (part 0: fields 1-16, part 1: fields 17-31).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct SawCharacCall {
+    /// 0 or 1.
+    pub part: u32,
+}
+
+/// One part of the characteristic values of the last synchronising phase planned for the
+/// slave.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+pub struct SawCharacReply {
+    /// 0 when answered.
+    pub error_id: u32,
+    /// The part.
+    pub part: u32,
+    /// The values, in the structure's order; unused places 0.
+    pub values: [f64; SAW_CHARAC_PART],
+}
+
+impl AcyclicCall for SawGearInCall {
+    const KIND: CallKind = CallKind::SawGearIn;
+    type Reply = SawReply;
+}
+impl AcyclicCall for SawGearOutCall {
+    const KIND: CallKind = CallKind::SawGearOut;
+    type Reply = SawReply;
+}
+impl AcyclicCall for SawCharacCall {
+    const KIND: CallKind = CallKind::SawCharac;
+    type Reply = SawCharacReply;
+}
+
+const _: () = assert!(core::mem::size_of::<SawGearInCall>() == 80);
+const _: () = assert!(core::mem::size_of::<SawCharacReply>() == 136);
+const _: () = assert!(core::mem::size_of::<SawCharacReply>() <= ACYCLIC_BODY_SIZE);
+const _: () = assert!(sync_mask::CHECKS & sync_mask::OPERATIONS == 0);
