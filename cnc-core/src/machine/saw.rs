@@ -229,9 +229,12 @@ fn step(
                 return step(s, m, slave, 0.0);
             }
             let t = t + dt;
+            // A master that lands on its sync position up to rounding is there: the sync
+            // phase begins in this tick, not the next.
+            let end = s.profile.length - 1e-9 * (1.0 + s.profile.length);
             let done = match s.profile.domain {
-                Domain::Master { .. } => tau >= s.profile.length,
-                Domain::Time => t >= s.profile.length,
+                Domain::Master { .. } => tau >= end,
+                Domain::Time => t >= end,
             };
             if done {
                 let end = s.profile.eval(s.profile.length);

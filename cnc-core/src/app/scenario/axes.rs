@@ -13,6 +13,7 @@
 //! drive = { model = "pt2", frequency_hz = 80.0, damping = 0.7 }   # ideal when absent
 //! start = 0.0                   # where the (simulated) axis stands at start
 //! power = true                  # enabled at start (as if MC_Power had run)
+//! id = 12                       # axis ID; default: next after the channel axes
 //!
 //! [[gear]]
 //! master = "conveyor.X"         # any axis by name
@@ -58,6 +59,8 @@ pub struct AxisFile {
     start: f64,
     #[serde(default)]
     power: bool,
+    /// The axis ID (1..=255); default: the next after the channel axes and the axes before.
+    id: Option<u32>,
 }
 
 fn linear() -> String {
@@ -153,7 +156,16 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
                 "name: not empty, without '.' (CHANNEL.AXIS names channel axes)",
             ));
         }
-        let id = first_id + i as u32;
+        let id = match f.id {
+            None => first_id + i as u32,
+            // Channel axes hold 1..first_id; the saw's table is 256 - ID.
+            Some(id) if (first_id..=255).contains(&id) => id,
+            Some(_) => {
+                return Err(key(&format!(
+                    "id: {first_id}..=255 (the channel axes hold the IDs below)"
+                )))
+            }
+        };
         let mut c = match f.kind.as_str() {
             "linear" => {
                 if f.modulo.is_some() {
@@ -234,6 +246,9 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
         c.validate().map_err(|e| format!("[[axis]] {e}"))?;
         if out.iter().any(|a: &ScenarioAxis| a.config.name == f.name) {
             return Err(key("name: given twice"));
+        }
+        if out.iter().any(|a: &ScenarioAxis| a.config.id == id) {
+            return Err(key(&format!("id: {id} is another axis's already")));
         }
         out.push(ScenarioAxis {
             config: c,
