@@ -9,5 +9,6 @@ pub mod demo;
 pub mod fifo_cli;
 pub mod json;
 pub mod kin_cli;
+pub mod saw_cli;
 pub mod scenario;
 pub mod stats;

@@ -33,6 +33,11 @@ enum Command {
         #[command(subcommand)]
         what: cnc_core::app::fifo_cli::FifoCommand,
     },
+    /// Flying saw: plan a synchronisation, its characteristic values, a trace.
+    Saw {
+        #[command(subcommand)]
+        what: cnc_core::app::saw_cli::SawCommand,
+    },
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
@@ -69,6 +74,7 @@ fn main() -> ExitCode {
         Command::Kin { what } => cnc_core::app::kin_cli::main(what),
         Command::Cam { what } => cnc_core::app::cam_cli::main(what),
         Command::Fifo { what } => cnc_core::app::fifo_cli::main(what),
+        Command::Saw { what } => cnc_core::app::saw_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
     }
 }

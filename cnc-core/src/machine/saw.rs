@@ -8,43 +8,21 @@
 //! again, the slave synchronises anew from where it stands.
 
 use super::engine::{Engine, EngineIo};
-use crate::axis::generator::Kinematic;
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::CharacValues;
-use crate::saw::{self, Domain, Limits, Profile, SawRequest, SyncOn};
+use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, SawError};
 use hli::saw_calls::{
-    sync_mask, SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply,
-    SAW_CHARAC_PART, SAW_ON_POSITION, SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
+    SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SAW_CHARAC_PART,
+    SAW_ON_POSITION, SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
 };
 use hli::wire::AcyclicRequest;
-
-/// Where a coupled slave is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Phase {
-    /// Running the planned phase; `t` is the time since coupling.
-    Synchronizing { t: f64 },
-    /// Synchronous: `slave = s_ref + ratio (master - m_ref)`.
-    Synchron { m_ref: f64, s_ref: f64 },
-    /// After a rollback: braking along `profile` (time since the stop began: `t`).
-    Stopping { profile: Profile, t: f64 },
-    /// After a rollback: standing until the master comes forward over the coupling
-    /// position again.
-    Standing { position: f64 },
-}
 
 #[derive(Debug, Clone, Copy)]
 struct SawSlave {
     master: usize,
-    request: SawRequest,
-    profile: Profile,
-    /// Master position at coupling, and its direction of travel then.
-    m0: f64,
-    dir: f64,
-    phase: Phase,
-    /// The slave's software limits (for a new plan after a rollback).
-    soft: Option<[f64; 2]>,
+    follower: Follower,
 }
 
 /// Flying-saw slaves by axis index.
@@ -162,12 +140,7 @@ impl SawEngine {
         }
         self.slaves[slave] = Some(SawSlave {
             master,
-            request,
-            profile: plan.profile,
-            m0: m.position,
-            dir: if m.velocity < 0.0 { -1.0 } else { 1.0 },
-            phase: Phase::Synchronizing { t: 0.0 },
-            soft: axis.config().soft_limits,
+            follower: Follower::new(request, &plan, &m, axis.config().soft_limits),
         });
         self.characs[slave] = Some(plan.charac.values);
         accepted()
@@ -207,111 +180,6 @@ impl SawEngine {
     }
 }
 
-/// One tick of one slave: its set-point and phase for master set-point `m`; `None` when
-/// the coupling ends (a replan after a rollback that cannot be done).
-fn step(
-    s: &mut SawSlave,
-    m: &Kinematic,
-    slave: Kinematic,
-    dt: f64,
-) -> Option<(Kinematic, AxisState)> {
-    let ratio = s.request.ratio;
-    let tau = (m.position - s.m0) * s.dir;
-    let backwards = m.velocity * s.dir < 0.0;
-    let lock = s.request.mask & sync_mask::ROLLBACKLOCK != 0;
-    let instant = s.request.mask & sync_mask::INSTANTSTOPONROLLBACK != 0;
-    let rolled_back = tau < 0.0 && backwards;
-    match s.phase {
-        Phase::Synchronizing { t } => {
-            // Cases 2, 3, 5, 7: back over the coupling position before the sync phase.
-            if rolled_back {
-                s.phase = stop(&slave, instant, &s.request.limits);
-                return step(s, m, slave, 0.0);
-            }
-            let t = t + dt;
-            // A master that lands on its sync position up to rounding is there: the sync
-            // phase begins in this tick, not the next.
-            let end = s.profile.length - 1e-9 * (1.0 + s.profile.length);
-            let done = match s.profile.domain {
-                Domain::Master { .. } => tau >= end,
-                Domain::Time => t >= end,
-            };
-            if done {
-                let end = s.profile.eval(s.profile.length);
-                let m_ref = match s.profile.domain {
-                    Domain::Master { m0, dir } => m0 + dir * s.profile.length,
-                    // The master where the phase ended, between the ticks.
-                    Domain::Time => m.position - m.velocity * (t - s.profile.length),
-                };
-                s.phase = Phase::Synchron {
-                    m_ref,
-                    s_ref: end[0],
-                };
-                return step(s, m, slave, 0.0);
-            }
-            s.phase = Phase::Synchronizing { t };
-            Some((s.profile.slave_at(m, t), AxisState::SlaveSynchronizing))
-        }
-        Phase::Synchron { m_ref, s_ref } => {
-            // Cases 6 and 8 (cases 1 and 4: the coupling holds for every master motion).
-            if lock && rolled_back {
-                s.phase = stop(&slave, instant, &s.request.limits);
-                return step(s, m, slave, 0.0);
-            }
-            Some((
-                Kinematic {
-                    position: s_ref + ratio * (m.position - m_ref),
-                    velocity: ratio * m.velocity,
-                    acceleration: ratio * m.acceleration,
-                    jerk: ratio * m.jerk,
-                },
-                AxisState::SlaveSynchronous,
-            ))
-        }
-        Phase::Stopping { profile, t } => {
-            let t = t + dt;
-            if t >= profile.length {
-                s.phase = Phase::Standing {
-                    position: profile.eval(profile.length)[0],
-                };
-                return step(s, m, slave, 0.0);
-            }
-            s.phase = Phase::Stopping { profile, t };
-            Some((profile.slave_at(m, t), AxisState::SlavePrephase))
-        }
-        Phase::Standing { position } => {
-            let held = Kinematic {
-                position,
-                ..Kinematic::default()
-            };
-            // Forward over the coupling position again: synchronise anew from standstill.
-            if tau >= 0.0 && m.velocity * s.dir > 0.0 {
-                let plan = saw::plan(&s.request, m, &held, s.soft).ok()?;
-                s.profile = plan.profile;
-                s.m0 = m.position;
-                s.phase = Phase::Synchronizing { t: 0.0 };
-                return Some((held, AxisState::SlaveSynchronizing));
-            }
-            Some((held, AxisState::SlavePrephase))
-        }
-    }
-}
-
-/// The stop of a rollback: within one tick (INSTANTSTOPONROLLBACK) or along a 5th-order
-/// polynomial as fast as deceleration and jerk allow.
-fn stop(slave: &Kinematic, instant: bool, limits: &Limits) -> Phase {
-    if instant || (slave.velocity == 0.0 && slave.acceleration == 0.0) {
-        Phase::Standing {
-            position: slave.position,
-        }
-    } else {
-        Phase::Stopping {
-            profile: saw::rollback_stop(slave, limits),
-            t: 0.0,
-        }
-    }
-}
-
 impl Engine for SawEngine {
     fn name(&self) -> &'static str {
         "flying saw"
@@ -338,7 +206,7 @@ impl Engine for SawEngine {
                 *slot = None;
                 continue;
             }
-            match step(s, &m, axis.setpoint(), dt) {
+            match s.follower.step(&m, axis.setpoint(), dt) {
                 Some((set, phase)) => axis.drive_coupled(set, phase),
                 None => {
                     *slot = None;

@@ -11,14 +11,17 @@
 //!
 //! * `shape`: the pieces and the time a velocity change needs to keep the limits;
 //! * `profile`: a phase, its evaluation in the tick and its characteristic values;
-//! * `plan`: refusals, optimisation steps and checks.
+//! * `plan`: refusals, optimisation steps and checks;
+//! * `follow`: a planned phase run tick by tick, rollback included.
 //!
 //! `crate::machine::saw` runs the phase in the machine tick.
 
+pub mod follow;
 pub mod plan;
 pub mod profile;
 pub mod shape;
 
+pub use follow::Follower;
 pub use plan::{diagonal_ratio, gear_ratio, plan, rollback_stop, Plan, SawRequest, SyncOn};
 pub use profile::{Charac, Domain, Profile, Shape};
 pub use shape::Limits;

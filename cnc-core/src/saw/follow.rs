@@ -1,0 +1,164 @@
+//! Running a planned synchronising phase tick by tick (no axes: the machine's saw engine
+//! and `cnc saw plan` both drive it): the synchronising phase (`nAxisState` 12), the
+//! synchronous phase (13), and the rollback behaviour of chapter 8 with the pre-phase (11).
+
+use super::{plan, rollback_stop, Domain, Limits, Plan, Profile, SawRequest};
+use crate::axis::generator::Kinematic;
+use hli::enums::AxisState;
+use hli::saw_calls::sync_mask;
+
+/// Where a coupled slave is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    /// Running the planned phase; `t` is the time since coupling.
+    Synchronizing { t: f64 },
+    /// Synchronous: `slave = s_ref + ratio (master - m_ref)`.
+    Synchron { m_ref: f64, s_ref: f64 },
+    /// After a rollback: braking along `profile` (time since the stop began: `t`).
+    Stopping { profile: Profile, t: f64 },
+    /// After a rollback: standing until the master comes forward over the coupling
+    /// position again.
+    Standing { position: f64 },
+}
+
+/// A slave following its master through the phases of one coupling command.
+#[derive(Debug, Clone, Copy)]
+pub struct Follower {
+    request: SawRequest,
+    profile: Profile,
+    /// Master position at coupling, and its direction of travel then.
+    m0: f64,
+    dir: f64,
+    phase: Phase,
+    /// The slave's software limits (for a new plan after a rollback).
+    soft: Option<[f64; 2]>,
+}
+
+impl Follower {
+    /// A follower for `plan`, made for `request` with the master at `master` at coupling.
+    pub fn new(
+        request: SawRequest,
+        plan: &Plan,
+        master: &Kinematic,
+        soft: Option<[f64; 2]>,
+    ) -> Follower {
+        Follower {
+            request,
+            profile: plan.profile,
+            m0: master.position,
+            dir: if master.velocity < 0.0 { -1.0 } else { 1.0 },
+            phase: Phase::Synchronizing { t: 0.0 },
+            soft,
+        }
+    }
+
+    /// The coupling command.
+    pub fn request(&self) -> &SawRequest {
+        &self.request
+    }
+
+    /// One tick of one slave: its set-point and phase for master set-point `m`; `None` when
+    /// the coupling ends (a replan after a rollback that cannot be done).
+    pub fn step(
+        &mut self,
+        m: &Kinematic,
+        slave: Kinematic,
+        dt: f64,
+    ) -> Option<(Kinematic, AxisState)> {
+        let ratio = self.request.ratio;
+        let tau = (m.position - self.m0) * self.dir;
+        let backwards = m.velocity * self.dir < 0.0;
+        let lock = self.request.mask & sync_mask::ROLLBACKLOCK != 0;
+        let instant = self.request.mask & sync_mask::INSTANTSTOPONROLLBACK != 0;
+        let rolled_back = tau < 0.0 && backwards;
+        match self.phase {
+            Phase::Synchronizing { t } => {
+                // Cases 2, 3, 5, 7: back over the coupling position before the sync phase.
+                if rolled_back {
+                    self.phase = stop(&slave, instant, &self.request.limits);
+                    return self.step(m, slave, 0.0);
+                }
+                let t = t + dt;
+                // A master that lands on its sync position up to rounding is there: the sync
+                // phase begins in this tick, not the next.
+                let end = self.profile.length - 1e-9 * (1.0 + self.profile.length);
+                let done = match self.profile.domain {
+                    Domain::Master { .. } => tau >= end,
+                    Domain::Time => t >= end,
+                };
+                if done {
+                    let end = self.profile.eval(self.profile.length);
+                    let m_ref = match self.profile.domain {
+                        Domain::Master { m0, dir } => m0 + dir * self.profile.length,
+                        // The master where the phase ended, between the ticks.
+                        Domain::Time => m.position - m.velocity * (t - self.profile.length),
+                    };
+                    self.phase = Phase::Synchron {
+                        m_ref,
+                        s_ref: end[0],
+                    };
+                    return self.step(m, slave, 0.0);
+                }
+                self.phase = Phase::Synchronizing { t };
+                Some((self.profile.slave_at(m, t), AxisState::SlaveSynchronizing))
+            }
+            Phase::Synchron { m_ref, s_ref } => {
+                // Cases 6 and 8 (cases 1 and 4: the coupling holds for every master motion).
+                if lock && rolled_back {
+                    self.phase = stop(&slave, instant, &self.request.limits);
+                    return self.step(m, slave, 0.0);
+                }
+                Some((
+                    Kinematic {
+                        position: s_ref + ratio * (m.position - m_ref),
+                        velocity: ratio * m.velocity,
+                        acceleration: ratio * m.acceleration,
+                        jerk: ratio * m.jerk,
+                    },
+                    AxisState::SlaveSynchronous,
+                ))
+            }
+            Phase::Stopping { profile, t } => {
+                let t = t + dt;
+                if t >= profile.length {
+                    self.phase = Phase::Standing {
+                        position: profile.eval(profile.length)[0],
+                    };
+                    return self.step(m, slave, 0.0);
+                }
+                self.phase = Phase::Stopping { profile, t };
+                Some((profile.slave_at(m, t), AxisState::SlavePrephase))
+            }
+            Phase::Standing { position } => {
+                let held = Kinematic {
+                    position,
+                    ..Kinematic::default()
+                };
+                // Forward over the coupling position again: synchronise anew from standstill.
+                if tau >= 0.0 && m.velocity * self.dir > 0.0 {
+                    let next = plan(&self.request, m, &held, self.soft).ok()?;
+                    self.profile = next.profile;
+                    self.m0 = m.position;
+                    self.phase = Phase::Synchronizing { t: 0.0 };
+                    return Some((held, AxisState::SlaveSynchronizing));
+                }
+                Some((held, AxisState::SlavePrephase))
+            }
+        }
+    }
+}
+
+/// The stop of a rollback: within one tick (INSTANTSTOPONROLLBACK) or along a 5th-order
+/// polynomial as fast as deceleration and jerk allow.
+fn stop(slave: &Kinematic, instant: bool, limits: &Limits) -> Phase {
+    if instant || (slave.velocity == 0.0 && slave.acceleration == 0.0) {
+        Phase::Standing {
+            position: slave.position,
+        }
+    } else {
+        Phase::Stopping {
+            profile: rollback_stop(slave, limits),
+            t: 0.0,
+        }
+    }
+}

@@ -1,0 +1,147 @@
+//! `cnc saw plan`: the characteristic values as JSON under the seed's field names, the
+//! trace with the master at constant velocity, exit 1 with the error code when refused,
+//! exit 2 on bad arguments.
+
+use std::process::{Command, Output};
+
+fn saw(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("saw")
+        .arg("plan")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Position example 1 of the seed.
+const EXAMPLE: [&str; 26] = [
+    "--mode",
+    "position",
+    "--master-position",
+    "-500",
+    "--master-velocity",
+    "500",
+    "--slave-position",
+    "-250",
+    "--slave-velocity",
+    "250",
+    "--ratio",
+    "1",
+    "--master-sync",
+    "1000",
+    "--slave-sync",
+    "1000",
+    "--velocity",
+    "3000",
+    "--acceleration",
+    "2500",
+    "--deceleration",
+    "2500",
+    "--jerk",
+    "5000",
+    "--check",
+    "MAXACC,MAXDEC,MAXJERK,OVERSHOOTVELO",
+];
+
+#[test]
+fn the_plan_prints_every_characteristic_value_and_traces_to_the_sync_point() {
+    let trace = std::env::temp_dir().join(format!("saw-trace-{}.csv", std::process::id()));
+    let mut args = EXAMPLE.to_vec();
+    args.extend(["--trace", trace.to_str().unwrap(), "--duration", "3.5"]);
+    let out = saw(&args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for (name, want) in [
+        ("fMasterVeloNom", 500.0),
+        ("fMasterPosStart", -500.0),
+        ("fSlavePosStart", -250.0),
+        ("fMasterPosEnd", 1000.0),
+        ("fSlavePosEnd", 1000.0),
+        ("fSlaveVeloEnd", 500.0),
+        ("fSlaveVeloMax", 500.0),
+        ("fSlaveVeloMin", 250.0),
+    ] {
+        assert_eq!(json[name].as_f64(), Some(want), "{name}: {json}");
+    }
+    assert_eq!(json.as_object().unwrap().len(), 32, "shape and 31 fields");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let _ = std::fs::remove_file(&trace);
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next(),
+        Some("time,master_position,master_velocity,slave_position,slave_velocity,slave_acceleration,axis_state")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 3501);
+    // At 3 s the master is at 1000: synchronous, the slave at 1000 with 500 mm/s.
+    let at = &rows[3000];
+    assert_eq!(&at[..7], &[3.0, 1000.0, 500.0, 1000.0, 500.0, 0.0, 13.0]);
+    assert_eq!(rows[2999][6], 12.0);
+    assert_eq!(rows[3500][3], 1250.0);
+}
+
+#[test]
+fn a_refused_plan_exits_1_with_its_code() {
+    let mut args = EXAMPLE.to_vec();
+    args[13] = "-1000"; // the master sync position behind the master
+    let out = saw(&args);
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["error_id"].as_u64(), Some(0x4404));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("MasterSyncNotAhead"));
+    // A limit that cannot be kept, with the detailed code asked for.
+    let mut args = EXAMPLE.to_vec();
+    args[19] = "10";
+    args.extend(["--op", "DETAILEDERRORCODES"]);
+    let out = saw(&args);
+    assert_eq!(out.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["error"].as_str(), Some("CheckMaxAcc"));
+}
+
+#[test]
+fn bad_arguments_exit_2() {
+    for bad in [
+        vec!["--check", "ROLLBACKLOCK"],
+        vec!["--op", "MAXACC"],
+        vec!["--check", "NOSUCHBIT"],
+        vec!["--cycle", "0"],
+    ] {
+        let mut args = EXAMPLE[..24].to_vec();
+        args.extend(bad.iter());
+        let out = saw(&args);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+    }
+    let velocity_with_sync = saw(&[
+        "--mode",
+        "velocity",
+        "--master-position",
+        "0",
+        "--master-velocity",
+        "1",
+        "--slave-position",
+        "0",
+        "--slave-velocity",
+        "0",
+        "--ratio",
+        "1",
+        "--master-sync",
+        "5",
+        "--velocity",
+        "1",
+        "--acceleration",
+        "1",
+        "--deceleration",
+        "1",
+        "--jerk",
+        "1",
+    ]);
+    assert_eq!(velocity_with_sync.status.code(), Some(2));
+}
