@@ -145,3 +145,64 @@ fn bad_arguments_exit_2() {
     ]);
     assert_eq!(velocity_with_sync.status.code(), Some(2));
 }
+
+/// The sawing cycle of seed 001's sample in two processes: `cnc run` of
+/// `scenarios/flying-saw` with the PLC program `saw-cut` in its own process. Every cut is
+/// found in the CNC's trace (the tick the blade reaches its depth) and lies on the material
+/// at `saw - conveyor`; 20 cuts, every piece 500 mm to 0.01 mm, and every sync after the
+/// first started from a saw still running home.
+#[test]
+fn the_flying_saw_cuts_twenty_equal_pieces_from_a_plc_process() {
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenarios/flying-saw");
+    let pid = std::process::id();
+    let trace = std::env::temp_dir().join(format!("cli-saw-{pid}.csv"));
+    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args([
+            "run",
+            dir.join("scenario.toml").to_str().unwrap(),
+            "--lockstep",
+        ])
+        .args(["--instance", &format!("cli-saw-{pid}"), "--trace"])
+        .arg(&trace)
+        .output()
+        .unwrap();
+    let report =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{report}");
+    assert!(report.contains("saw-cut: Finished, 20 cuts"), "{report}");
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let _ = std::fs::remove_file(&trace);
+    let mut lines = text.lines();
+    let names: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| names.iter().position(|c| *c == n).expect(n);
+    let (conveyor, saw, blade, coupling) = (
+        col("gpAx[0]^lr_state.command_position_acs_r"),
+        col("gpAx[1]^lr_state.command_position_acs_r"),
+        col("gpAx[2]^lr_state.command_position_acs_r"),
+        col("gpAx[1]^lr_state.coupling_state_r"),
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    const DEPTH: f64 = 50.0 * 1e4; // 0.1 um
+    let mut cuts = Vec::new();
+    let mut syncs_from_moving_back = 0;
+    for w in rows.windows(3) {
+        if w[1][blade] < DEPTH && w[2][blade] >= DEPTH {
+            // Saw and conveyor set-points in mm: where the cut lies on the material.
+            cuts.push((w[2][saw] - w[2][conveyor]) * 1e-4);
+        }
+        if w[1][coupling] == 0.0 && w[2][coupling] == 3.0 && w[1][saw] < w[0][saw] {
+            syncs_from_moving_back += 1;
+        }
+    }
+    assert_eq!(cuts.len(), 20, "{cuts:?}");
+    for pair in cuts.windows(2) {
+        let piece = pair[0] - pair[1];
+        assert!((piece - 500.0).abs() <= 0.01, "piece {piece} mm: {cuts:?}");
+    }
+    assert_eq!(
+        syncs_from_moving_back, 19,
+        "every sync after the first from a returning saw"
+    );
+}

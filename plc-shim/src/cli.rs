@@ -29,6 +29,15 @@ pub struct PlcArgs {
     /// Override `fifo-stream` sets before the start, percent.
     #[arg(long)]
     pub fifo_override: Option<f64>,
+    /// Cuts `saw-cut` makes.
+    #[arg(long, default_value_t = 20)]
+    pub saw_cuts: usize,
+    /// Piece length of `saw-cut`, mm.
+    #[arg(long, default_value_t = 500.0)]
+    pub saw_length: f64,
+    /// Conveyor speed of `saw-cut`, mm/s.
+    #[arg(long, default_value_t = 200.0)]
+    pub saw_speed: f64,
     /// Table speed of `rotary-table`, degree per cycle.
     #[arg(long, default_value_t = 0.01)]
     pub deg_per_cycle: f64,
@@ -44,7 +53,7 @@ pub struct PlcArgs {
 }
 
 /// Names of the built-in programs.
-pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor", "fifo-stream"];
+pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor", "fifo-stream", "saw-cut"];
 
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn main(args: PlcArgs) -> ExitCode {
@@ -65,6 +74,11 @@ pub fn main(args: PlcArgs) -> ExitCode {
                 return ExitCode::from(2);
             }
         },
+        (None, "saw-cut") => Box::new(crate::programs::saw_cut::SawCut::new(
+            args.saw_cuts,
+            args.saw_length,
+            args.saw_speed,
+        )),
         (None, other) => {
             eprintln!("plc: unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})");
             return ExitCode::from(2);

@@ -12,6 +12,7 @@ pub mod motion;
 pub mod programs;
 pub mod realtime;
 pub mod runtime;
+pub mod saw;
 pub mod timeline;
 
 pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

@@ -24,8 +24,8 @@ use hli::fifo_calls::{
 use hli::layout::FIFO_OVERRIDE_FULL;
 use std::sync::Arc;
 
-/// The FIFO blocks a timeline can call: the tail of [`super::BLOCKS`].
-pub(super) const FIFO_BLOCKS: &[&str] = super::BLOCKS.as_slice().split_at(36).1;
+/// The FIFO blocks a timeline can call: 9 entries of [`super::BLOCKS`] from index 36.
+pub(super) const FIFO_BLOCKS: &[&str] = super::BLOCKS.as_slice().split_at(36).1.split_at(9).0;
 const _: () = assert!(FIFO_BLOCKS.len() == 9);
 
 /// The inputs of a FIFO call.

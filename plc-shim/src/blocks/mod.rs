@@ -38,12 +38,14 @@ use crate::motion::{
 use crate::runtime::PlcIo;
 use fifo::{FifoInputs, FifoInstance, FIFO_BLOCKS};
 use hli::calls::McMotionFunctionPoint;
+use saw::{SawInputs, SawInstance, SAW_BLOCKS};
 use std::sync::Arc;
 
 mod fifo;
+mod saw;
 
 /// The blocks a timeline can call.
-pub const BLOCKS: [&str; 45] = [
+pub const BLOCKS: [&str; 49] = [
     "MC_Power",
     "MC_Reset",
     "MC_MoveAbsolute",
@@ -89,6 +91,10 @@ pub const BLOCKS: [&str; 45] = [
     "FiFoStop",
     "FiFoSetChannelOverride",
     "FiFoSetParameters",
+    "MC_GearInVelo",
+    "MC_GearInPos",
+    "MC_GearOut",
+    "MC_ReadFlyingSawCharacteristics",
 ];
 
 /// The outputs a `wait` can name.
@@ -126,6 +132,7 @@ enum Block {
     MultiTable(Box<CamMultiTable>),
     Compat(Box<CompatBlock>),
     Fifo(Box<FifoInstance>),
+    Saw(Box<SawInstance>),
 }
 
 /// A boolean output of a block.
@@ -198,6 +205,8 @@ enum Input {
     Compat(Arc<CompatConfig>),
     /// A FIFO block's inputs.
     Fifo(Arc<FifoInputs>),
+    /// A flying-saw block's inputs.
+    Saw(Arc<SawInputs>),
 }
 
 /// `rows = [[master, slave], ...]`.
@@ -392,8 +401,14 @@ impl Instances {
             .unwrap_or(kind);
         // The FIFO blocks address a group; of them only FiFoGroupIntegrate names an axis.
         let fifo = FIFO_BLOCKS.contains(&kind);
+        let is_saw = SAW_BLOCKS.contains(&kind);
         let uses_axis = !fifo || kind == "FiFoGroupIntegrate";
-        let axis = match table.get("axis").and_then(toml::Value::as_integer) {
+        // The flying-saw blocks take their axis as the seed's `Slave` (or `axis`).
+        let axis_value = match table.get("axis") {
+            None if is_saw => saw::slave(table),
+            given => given,
+        };
+        let axis = match axis_value.and_then(toml::Value::as_integer) {
             Some(a) if (0..i64::from(u32::MAX)).contains(&a) && uses_axis => a as u32,
             Some(a) if uses_axis => return Err(format!("call: axis {a} is not an axis index")),
             Some(_) => return Err(format!("call: {kind} addresses a FIFO group: no `axis`")),
@@ -529,6 +544,9 @@ impl Instances {
         if fifo {
             inputs.push(Input::Fifo(Arc::new(fifo::parse(kind, table)?)));
         }
+        if is_saw {
+            inputs.push(Input::Saw(Arc::new(saw::parse(kind, table)?)));
+        }
         if let Some(kind) = compat {
             let config = crate::cam_compat::parse(kind, table)?;
             if kind == "CamTableReadData" {
@@ -540,7 +558,7 @@ impl Instances {
             if ["block", "instance", "axis"].contains(&key.as_str()) {
                 continue;
             }
-            if (compat.is_some() || fifo) && key != "execute" {
+            if (compat.is_some() || fifo || is_saw) && key != "execute" {
                 continue; // checked by cam_compat::parse or fifo::parse
             }
             if key == "execute" && kind != "MC_Power" {
@@ -914,9 +932,11 @@ impl Instances {
                     };
                     (out, false)
                 }
+                Block::Saw(b) => (b.call(io, axis), false),
             };
             let in_sync = match &inst.block {
                 Block::CamIn(b) => b.out.in_sync,
+                Block::Saw(b) => b.in_sync(),
                 _ => false,
             };
             let now = [
@@ -982,6 +1002,7 @@ impl Instances {
                         .flat_map(|p| [p.point_index as f64, p.master_pos, p.slave_pos])
                         .collect(),
                 ),
+                Block::Saw(b) => b.read_values(),
                 _ => None,
             };
             if let Some(values) = read.filter(|v| !v.is_empty()) {
@@ -1096,6 +1117,7 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
             Block::MultiTable(b)
         }
         fifo if FIFO_BLOCKS.contains(&fifo) => Block::Fifo(Box::new(FifoInstance::new(fifo))),
+        s if SAW_BLOCKS.contains(&s) => Block::Saw(Box::new(SawInstance::new(s))),
         compat if compat.starts_with("CamTable") => {
             let kind = BLOCKS
                 .iter()
@@ -1133,6 +1155,7 @@ fn execute_of(block: &mut Block) -> Option<&mut bool> {
         Block::MultiTable(b) => Some(&mut b.execute),
         Block::Compat(b) => Some(&mut b.execute),
         Block::Fifo(b) => Some(&mut b.execute),
+        Block::Saw(b) => Some(&mut b.execute),
     }
 }
 
@@ -1244,6 +1267,7 @@ fn set_input(block: &mut Block, input: Input) {
         (Block::MultiTable(b), Input::Position(v)) => b.position = v,
         (Block::Compat(b), Input::Compat(config)) => b.config = config,
         (Block::Fifo(b), Input::Fifo(inputs)) => b.inputs = inputs,
+        (Block::Saw(b), Input::Saw(inputs)) => b.inputs = inputs,
 
         // parse_call admits only the inputs of the block.
         _ => {}

@@ -1,8 +1,10 @@
 //! Example PLC programs: the rotary table as dynamic-CS master (here), the cam conveyor
-//! ([`cam_conveyor`]) and a position file streamed through a FIFO group ([`fifo_stream`]).
+//! ([`cam_conveyor`]), a position file streamed through a FIFO group ([`fifo_stream`]) and a
+//! flying saw cutting equal lengths ([`saw_cut`]).
 
 pub mod cam_conveyor;
 pub mod fifo_stream;
+pub mod saw_cut;
 
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
