@@ -2,7 +2,7 @@
 //! and `cnc saw plan` both drive it): the synchronising phase (`nAxisState` 12), the
 //! synchronous phase (13), and the rollback behaviour of chapter 8 with the pre-phase (11).
 
-use super::{plan, rollback_stop, Domain, Limits, Plan, Profile, SawRequest};
+use super::{plan, rollback_stop, Domain, Plan, Profile, SawRequest};
 use crate::axis::generator::Kinematic;
 use hli::enums::AxisState;
 use hli::saw_calls::sync_mask;
@@ -14,8 +14,9 @@ enum Phase {
     Synchronizing { t: f64 },
     /// Synchronous: `slave = s_ref + ratio (master - m_ref)`.
     Synchron { m_ref: f64, s_ref: f64 },
-    /// After a rollback: braking along `profile` (time since the stop began: `t`).
-    Stopping { profile: Profile, t: f64 },
+    /// After a rollback: braking along the follower's `stop` profile (time since the stop
+    /// began: `t`).
+    Stopping { t: f64 },
     /// After a rollback: standing until the master comes forward over the coupling
     /// position again.
     Standing { position: f64 },
@@ -30,6 +31,8 @@ pub struct Follower {
     m0: f64,
     dir: f64,
     phase: Phase,
+    /// The stop of a rollback (while `Stopping`).
+    stop: Profile,
     /// The slave's software limits (for a new plan after a rollback).
     soft: Option<[f64; 2]>,
 }
@@ -48,6 +51,7 @@ impl Follower {
             m0: master.position,
             dir: if master.velocity < 0.0 { -1.0 } else { 1.0 },
             phase: Phase::Synchronizing { t: 0.0 },
+            stop: plan.profile,
             soft,
         }
     }
@@ -75,7 +79,7 @@ impl Follower {
             Phase::Synchronizing { t } => {
                 // Cases 2, 3, 5, 7: back over the coupling position before the sync phase.
                 if rolled_back {
-                    self.phase = stop(&slave, instant, &self.request.limits);
+                    self.phase = self.stop(&slave, instant);
                     return self.step(m, slave, 0.0);
                 }
                 let t = t + dt;
@@ -105,7 +109,7 @@ impl Follower {
             Phase::Synchron { m_ref, s_ref } => {
                 // Cases 6 and 8 (cases 1 and 4: the coupling holds for every master motion).
                 if lock && rolled_back {
-                    self.phase = stop(&slave, instant, &self.request.limits);
+                    self.phase = self.stop(&slave, instant);
                     return self.step(m, slave, 0.0);
                 }
                 Some((
@@ -118,16 +122,17 @@ impl Follower {
                     AxisState::SlaveSynchronous,
                 ))
             }
-            Phase::Stopping { profile, t } => {
+            Phase::Stopping { t } => {
                 let t = t + dt;
-                if t >= profile.length {
+                let stop = &self.stop;
+                if t >= stop.length {
                     self.phase = Phase::Standing {
-                        position: profile.eval(profile.length)[0],
+                        position: stop.eval(stop.length)[0],
                     };
                     return self.step(m, slave, 0.0);
                 }
-                self.phase = Phase::Stopping { profile, t };
-                Some((profile.slave_at(m, t), AxisState::SlavePrephase))
+                self.phase = Phase::Stopping { t };
+                Some((stop.slave_at(m, t), AxisState::SlavePrephase))
             }
             Phase::Standing { position } => {
                 let held = Kinematic {
@@ -148,17 +153,17 @@ impl Follower {
     }
 }
 
-/// The stop of a rollback: within one tick (INSTANTSTOPONROLLBACK) or along a 5th-order
-/// polynomial as fast as deceleration and jerk allow.
-fn stop(slave: &Kinematic, instant: bool, limits: &Limits) -> Phase {
-    if instant || (slave.velocity == 0.0 && slave.acceleration == 0.0) {
-        Phase::Standing {
-            position: slave.position,
-        }
-    } else {
-        Phase::Stopping {
-            profile: rollback_stop(slave, limits),
-            t: 0.0,
+impl Follower {
+    /// The stop of a rollback: within one tick (INSTANTSTOPONROLLBACK) or along a
+    /// polynomial as fast as deceleration and jerk allow.
+    fn stop(&mut self, slave: &Kinematic, instant: bool) -> Phase {
+        if instant || (slave.velocity == 0.0 && slave.acceleration == 0.0) {
+            Phase::Standing {
+                position: slave.position,
+            }
+        } else {
+            self.stop = rollback_stop(slave, &self.request.limits);
+            Phase::Stopping { t: 0.0 }
         }
     }
 }

@@ -204,10 +204,7 @@ fn validate(req: &SawRequest, master: &Kinematic, slave: &Kinematic) -> Result<(
     {
         return Err(SawError::NegativeLimit);
     }
-    if [l.velocity, l.acceleration, l.deceleration, l.jerk]
-        .iter()
-        .any(|v| *v == 0.0)
-    {
+    if [l.velocity, l.acceleration, l.deceleration, l.jerk].contains(&0.0) {
         // The caller puts the axis's own limits in place of 0; an axis without one is bad
         // input as well.
         return Err(SawError::NegativeLimit);
@@ -459,7 +456,7 @@ impl TravelFrame {
         if (mean - half) * (k0 - k1) >= 0.0 {
             // Closer to the start slope: hold it first, then change.
             let len = 2.0 * (d - k0 * x) / (k1 - k0);
-            if !(len > 0.0) {
+            if len.is_nan() || len <= 0.0 {
                 return None;
             }
             let hold = x - len;
@@ -476,7 +473,7 @@ impl TravelFrame {
         } else {
             // Closer to the sync slope: change first, then run synchronously.
             let len = 2.0 * (k1 * x - d) / (k1 - k0);
-            if !(len > 0.0) {
+            if len.is_nan() || len <= 0.0 {
                 return None;
             }
             let a = slope_change(0.0, len, self.s0, k0, 0.0, k1);
