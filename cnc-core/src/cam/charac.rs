@@ -52,11 +52,16 @@ pub struct CharacValues {
 const SAMPLES_PER_PIECE: usize = 64;
 const SAMPLES_PER_ROW: usize = 4;
 
-#[derive(Clone, Copy)]
-struct Extreme {
-    value: f64,
-    at: f64,
-    velocity: f64,
+/// An extreme of one slave quantity: its value, the master position where it occurs and
+/// the slave velocity there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extreme {
+    /// The value.
+    pub value: f64,
+    /// Master position.
+    pub at: f64,
+    /// Slave velocity there.
+    pub velocity: f64,
 }
 
 impl CharacValues {
@@ -181,6 +186,27 @@ impl CharacValues {
         if hi[0].is_none_or(|m| end.value > m.value) {
             hi[0] = Some(end);
         }
+        let four = |d: [f64; 5]| [d[0], d[1], d[2], d[3]];
+        let mut values =
+            CharacValues::from_extremes(1.0, [m0, m1], four(first), four(last), lo, hi);
+        if span > 0.0 {
+            values.fSlaveVeloMean = travel / span;
+            values.fSlaveAccEff = (acc_square / span).sqrt();
+        }
+        values
+    }
+
+    /// The values from the master range, the slave's `[position, velocity, acceleration,
+    /// jerk]` at its start and end, and the lowest and highest of each of the four (none
+    /// seen: 0 at the start); mean and effective values 0, as the dynamic momentum.
+    pub fn from_extremes(
+        master_velocity: f64,
+        [m0, m1]: [f64; 2],
+        first: [f64; 4],
+        last: [f64; 4],
+        lo: [Option<Extreme>; 4],
+        hi: [Option<Extreme>; 4],
+    ) -> CharacValues {
         let get = |e: Option<Extreme>| {
             e.unwrap_or(Extreme {
                 value: 0.0,
@@ -191,7 +217,7 @@ impl CharacValues {
         let (p_lo, v_lo, a_lo, j_lo) = (get(lo[0]), get(lo[1]), get(lo[2]), get(lo[3]));
         let (p_hi, v_hi, a_hi, j_hi) = (get(hi[0]), get(hi[1]), get(hi[2]), get(hi[3]));
         CharacValues {
-            fMasterVeloNom: 1.0,
+            fMasterVeloNom: master_velocity,
             fMasterPosStart: m0,
             fSlavePosStart: first[0],
             fSlaveVeloStart: first[1],
@@ -220,12 +246,8 @@ impl CharacValues {
             fSVeloAtSAccMax: a_hi.velocity,
             fSlaveJerkMax: j_hi.value,
             fSlaveDynMomMax: 0.0,
-            fSlaveVeloMean: if span > 0.0 { travel / span } else { 0.0 },
-            fSlaveAccEff: if span > 0.0 {
-                (acc_square / span).sqrt()
-            } else {
-                0.0
-            },
+            fSlaveVeloMean: 0.0,
+            fSlaveAccEff: 0.0,
         }
     }
 

@@ -3,6 +3,7 @@
 //! (`MC_FlyingSawCharacValues`) for a master at constant velocity.
 
 use crate::axis::generator::Kinematic;
+use crate::cam::charac::Extreme;
 use crate::cam::piece::Piece;
 use crate::cam::CharacValues;
 
@@ -147,13 +148,6 @@ pub struct Charac {
 /// Samples per piece before the sign changes are bisected.
 const SAMPLES: usize = 24;
 
-#[derive(Clone, Copy)]
-struct Extreme {
-    value: f64,
-    at: f64,
-    velocity: f64,
-}
-
 struct Scan {
     lo: [Option<Extreme>; 4],
     hi: [Option<Extreme>; 4],
@@ -258,58 +252,14 @@ impl Profile {
         if self.count == 0 {
             scan.note(m0, &slave);
         }
-        let get = |e: Option<Extreme>| {
-            e.unwrap_or(Extreme {
-                value: 0.0,
-                at: m0,
-                velocity: 0.0,
-            })
-        };
-        let (p_lo, v_lo, a_lo, j_lo) = (
-            get(scan.lo[0]),
-            get(scan.lo[1]),
-            get(scan.lo[2]),
-            get(scan.lo[3]),
+        let values = CharacValues::from_extremes(
+            vm,
+            [m0, master_at(self.length)],
+            first,
+            last,
+            scan.lo,
+            scan.hi,
         );
-        let (p_hi, v_hi, a_hi, j_hi) = (
-            get(scan.hi[0]),
-            get(scan.hi[1]),
-            get(scan.hi[2]),
-            get(scan.hi[3]),
-        );
-        let values = CharacValues {
-            fMasterVeloNom: vm,
-            fMasterPosStart: m0,
-            fSlavePosStart: first[0],
-            fSlaveVeloStart: first[1],
-            fSlaveAccStart: first[2],
-            fSlaveJerkStart: first[3],
-            fMasterPosEnd: master_at(self.length),
-            fSlavePosEnd: last[0],
-            fSlaveVeloEnd: last[1],
-            fSlaveAccEnd: last[2],
-            fSlaveJerkEnd: last[3],
-            fMPosAtSPosMin: p_lo.at,
-            fSlavePosMin: p_lo.value,
-            fMPosAtSVeloMin: v_lo.at,
-            fSlaveVeloMin: v_lo.value,
-            fMPosAtSAccMin: a_lo.at,
-            fSlaveAccMin: a_lo.value,
-            fSVeloAtSAccMin: a_lo.velocity,
-            fSlaveJerkMin: j_lo.value,
-            fSlaveDynMomMin: 0.0,
-            fMPosAtSPosMax: p_hi.at,
-            fSlavePosMax: p_hi.value,
-            fMPosAtSVeloMax: v_hi.at,
-            fSlaveVeloMax: v_hi.value,
-            fMPosAtSAccMax: a_hi.at,
-            fSlaveAccMax: a_hi.value,
-            fSVeloAtSAccMax: a_hi.velocity,
-            fSlaveJerkMax: j_hi.value,
-            fSlaveDynMomMax: 0.0,
-            fSlaveVeloMean: 0.0,
-            fSlaveAccEff: 0.0,
-        };
         Charac {
             values,
             speed_up: scan.speed_up,
