@@ -113,6 +113,8 @@ fn bad_arguments_exit_2() {
         vec!["--op", "MAXACC"],
         vec!["--check", "NOSUCHBIT"],
         vec!["--cycle", "0"],
+        vec!["--duration", "inf", "--trace", "/dev/null"],
+        vec!["--duration", "-1", "--trace", "/dev/null"],
     ] {
         let mut args = EXAMPLE[..24].to_vec();
         args.extend(bad.iter());

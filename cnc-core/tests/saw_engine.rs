@@ -254,16 +254,20 @@ fn the_eight_rollback_cases_of_chapter_8() {
             }
             assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronizing.raw());
         }
-        assert_eq!(
-            command(
-                &mut run,
-                MASTER,
-                AxisCommandCall::move_velocity(-1, [500.0, 10000.0, 10000.0, 1e6])
-            ),
-            0
-        );
+        // Back slowly (300 mm/s^2 towards 2000 mm/s): the master still accelerates when it
+        // runs over the coupling position, so a stop starts from an acceleration.
+        let back = AxisCommandCall::move_velocity(-1, [2000.0, 300.0, 300.0, 1e6]);
+        assert_eq!(command(&mut run, MASTER, back), 0);
         // Up to the tick the master is back over the coupling position.
-        until(&mut run, 20000, |r| set(r, MASTER).position < m0);
+        let mut before = set(&run, SAW);
+        for k in 0.. {
+            assert!(k < 20000, "case {}: the master never came back", n + 1);
+            if set(&run, MASTER).position < m0 {
+                break;
+            }
+            before = set(&run, SAW);
+            run.step(TICK);
+        }
         let s = set(&run, SAW);
         let got = match phase(&run, SAW) {
             p if p == AxisState::SlaveSynchronous.raw() => {
@@ -272,7 +276,14 @@ fn the_eight_rollback_cases_of_chapter_8() {
             }
             p if p == AxisState::SlavePrephase.raw() && s.velocity == 0.0 => InstantStop,
             p if p == AxisState::SlavePrephase.raw() => {
-                // Braking: comes to rest with its jerk bounded and stands in the pre-phase.
+                // Braking from where it was: the first tick of the stop moves on.
+                assert!(s.position != before.position, "case {}: a stall", n + 1);
+                assert!(
+                    before.acceleration.abs() > 100.0,
+                    "case {}: {before:?}",
+                    n + 1
+                );
+                // Comes to rest with its jerk bounded and stands in the pre-phase.
                 let mut jerk: f64 = 0.0;
                 let mut k = 0;
                 while set(&run, SAW).velocity != 0.0 {
@@ -282,7 +293,7 @@ fn the_eight_rollback_cases_of_chapter_8() {
                     assert!(k < 5000, "case {}: no standstill", n + 1);
                 }
                 assert!(k > 10, "case {}: stopped in {k} ticks", n + 1);
-                // The stop keeps the command's jerk (5000 mm/s^3) from its start state.
+                // The stop keeps the command's jerk (5000 mm/s^3) from its start acceleration.
                 assert!(jerk <= 5000.0 * (1.0 + 1e-9), "case {}: jerk {jerk}", n + 1);
                 assert_eq!(phase(&run, SAW), AxisState::SlavePrephase.raw());
                 SmoothStop
@@ -507,4 +518,77 @@ fn the_time_based_phase_runs_on_time_and_ends_synchronous() {
         run.step(TICK);
     }
     assert!((set(&run, SAW).velocity - 500.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_master_at_rest_at_coupling_leads_in_the_direction_it_then_moves() {
+    let mut run = machine("");
+    assert_eq!(
+        gear_in(&mut run, SAW, velocity_call(2.0, m::ROLLBACKLOCK)),
+        0
+    );
+    run.step(TICK);
+    assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronous.raw());
+    let limits = [300.0, 10000.0, 10000.0, 1e6];
+    assert_eq!(
+        command(&mut run, MASTER, AxisCommandCall::move_velocity(-1, limits)),
+        0
+    );
+    for _ in 0..200 {
+        run.step(TICK);
+        assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronous.raw());
+    }
+    assert_eq!(set(&run, SAW).velocity, -600.0);
+    assert!((set(&run, SAW).position - 2.0 * set(&run, MASTER).position).abs() < 1e-9);
+}
+
+#[test]
+fn a_new_command_on_a_coupled_slave_plans_from_where_it_is() {
+    let mut run = moving(250.0);
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(1.0, 0)), 0);
+    for _ in 0..100 {
+        run.step(TICK);
+    }
+    let view = CncView::new(&run.memory);
+    let first = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    let before = set(&run, SAW);
+    // Refused: the coupling stays as it was.
+    let (m0, s0) = (set(&run, MASTER).position, before.position);
+    let behind = position_call(m0 - 1.0, s0 + 100.0, 1.0, 0);
+    assert_eq!(
+        gear_in(&mut run, SAW, behind),
+        SawError::MasterSyncNotAhead.raw()
+    );
+    run.step(TICK);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::GearVelocity.raw()
+    );
+    // Accepted: a position sync from the moving slave, continuous.
+    let prev = set(&run, SAW);
+    assert_eq!(
+        gear_in(
+            &mut run,
+            SAW,
+            position_call(m0 + 1000.0, s0 + 900.0, 1.0, 0)
+        ),
+        0
+    );
+    run.step(TICK);
+    let now = set(&run, SAW);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::GearPosition.raw()
+    );
+    let expected = prev.position + prev.velocity * TICK;
+    assert!((now.position - expected).abs() < 0.01, "{prev:?} {now:?}");
+    let view = CncView::new(&run.memory);
+    let second = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    assert_ne!(first.plan, second.plan, "each plan has its number");
 }

@@ -89,7 +89,7 @@ fn velocity_example_2_reaches_one_and_a_half_times_the_master() {
 #[test]
 fn velocity_example_3_starts_in_the_slaves_acceleration_phase() {
     // Master -500 mm/s, slave +400 mm/s and still accelerating at coupling.
-    let req = request(SyncOn::Velocity, 1.0, limits(2500.0, 5000.0), 0);
+    let req = request(SyncOn::Velocity, 1.0, limits(2500.0, 5000.0), LIMIT_CHECKS);
     let slave = kin(0.0, 400.0, 1200.0);
     let plan = saw::plan(&req, &kin(0.0, -500.0, 0.0), &slave, None).unwrap();
     let c = plan.charac.values;
@@ -104,6 +104,9 @@ fn velocity_example_3_starts_in_the_slaves_acceleration_phase() {
     assert!(c.fSlaveAccEnd.abs() < 1e-9);
     // The master runs negative: the phase ends where the master has travelled its length.
     assert!(c.fMasterPosEnd < 0.0);
+    // The jerk limit binds although the phase starts accelerated.
+    assert!((c.fSlaveJerkMax.abs().max(c.fSlaveJerkMin.abs()) - 5000.0).abs() < 1e-6);
+    assert!(c.fSlaveAccMax <= 2500.0 + 1e-9 && c.fSlaveAccMin >= -2500.0 - 1e-9);
 }
 
 #[test]

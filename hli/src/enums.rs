@@ -241,7 +241,8 @@ hli_enum! {
         NotFinite = 0x4409,
         /// A check of the sync mode failed (the check's own code with DETAILEDERRORCODES).
         Limit = 0x440A,
-        /// MC_GearOut or a characteristics read for an axis the saw does not drive.
+        /// MC_GearOut for an axis the saw does not drive, or a characteristics read for an
+        /// axis the saw never planned for.
         NotCoupled = 0x440B,
         /// Position sync with a master standing still.
         MasterStands = 0x440C,

@@ -138,6 +138,11 @@ pub struct SawCharacReply {
     pub error_id: u32,
     /// The part.
     pub part: u32,
+    /// The number of the plan the values belong to (a read whose parts differ here read
+    /// across a new command and starts again).
+    pub plan: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
     /// The values, in the structure's order; unused places 0.
     pub values: [f64; SAW_CHARAC_PART],
 }
@@ -156,6 +161,6 @@ impl AcyclicCall for SawCharacCall {
 }
 
 const _: () = assert!(core::mem::size_of::<SawGearInCall>() == 80);
-const _: () = assert!(core::mem::size_of::<SawCharacReply>() == 136);
+const _: () = assert!(core::mem::size_of::<SawCharacReply>() == 144);
 const _: () = assert!(core::mem::size_of::<SawCharacReply>() <= ACYCLIC_BODY_SIZE);
 const _: () = assert!(sync_mask::CHECKS & sync_mask::OPERATIONS == 0);

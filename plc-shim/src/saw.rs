@@ -652,6 +652,8 @@ pub struct McReadFlyingSawCharacteristics {
     pub values: [f64; 31],
     request: Request<SawCharacCall>,
     part: u32,
+    /// The plan part 0 belonged to.
+    plan: u32,
     scratch: [f64; 31],
 }
 
@@ -684,7 +686,14 @@ impl McReadFlyingSawCharacteristics {
             Some(Ok(reply)) if reply.part != self.part => {
                 self.request.out = failed(ERROR_NO_ANSWER)
             }
+            // Part 1 of another plan than part 0 (a new command came between): read again.
+            Some(Ok(reply)) if self.part > 0 && reply.plan != self.plan => {
+                self.part = 0;
+                self.request
+                    .send(io, self.slave, &SawCharacCall { part: 0 });
+            }
             Some(Ok(reply)) => {
+                self.plan = reply.plan;
                 let from = self.part as usize * SAW_CHARAC_PART;
                 for (slot, v) in self.scratch[from..].iter_mut().zip(reply.values) {
                     *slot = v;
@@ -964,6 +973,8 @@ mod tests {
                     reply(&SawCharacReply {
                         error_id: 0,
                         part,
+                        plan: 1,
+                        reserved: 0,
                         values,
                     })
                 })

@@ -261,6 +261,12 @@ fn plan(args: &PlanArgs) -> Result<String, Failure> {
             _ => plan.profile.length,
         };
         let duration = args.duration.unwrap_or(1.1 * phase_s + args.cycle);
+        // A trace is written into memory first: at most ten million rows.
+        if !(duration.is_finite() && duration > 0.0 && duration / args.cycle <= 1e7) {
+            return Err(Failure::Usage(format!(
+                "--duration {duration}: a time > 0 of at most 10,000,000 cycles"
+            )));
+        }
         let csv = trace(&request, &plan, &master, &slave, soft, args.cycle, duration);
         std::fs::File::create(path)
             .and_then(|mut f| f.write_all(csv.as_bytes()))

@@ -51,6 +51,9 @@ pub struct Axis {
     stop_lock: bool,
     error: Option<AxisError>,
     coupling: Option<Coupling>,
+    /// Counts couplings: an engine that holds the number it coupled with knows the axis is
+    /// still its own (and not re-coupled by another engine in between).
+    coupling_epoch: u32,
     coupled_setpoint: Kinematic,
     /// The set-point handed out by the last tick (what the actual position must match now).
     last_set: Kinematic,
@@ -95,6 +98,7 @@ impl Axis {
             stop_lock: false,
             error: None,
             coupling: None,
+            coupling_epoch: 0,
             coupled_setpoint: Kinematic::default(),
             last_set: Kinematic::default(),
             encoder_echo: 0,
@@ -327,7 +331,25 @@ impl Axis {
         self.book.finish(CommandResult::Aborted, None);
         self.coupled_setpoint = self.generator.state();
         self.coupling = Some(coupling);
+        self.coupling_epoch = self.coupling_epoch.wrapping_add(1);
         Ok(())
+    }
+
+    /// The number of the current coupling (see [`Axis::couple`]); changes with every one.
+    pub fn coupling_epoch(&self) -> u32 {
+        self.coupling_epoch
+    }
+
+    /// Changes what a coupled axis is coupled to, in place: the set-point goes on where it
+    /// is (a new command of the same engine). `false` when the axis is not coupled.
+    pub fn recouple(&mut self, coupling: Coupling) -> bool {
+        match self.coupling.as_mut() {
+            Some(c) => {
+                *c = coupling;
+                true
+            }
+            None => false,
+        }
     }
 
     /// The coupled engine's set-point for this tick (ignored when not coupled).

@@ -24,6 +24,8 @@ pub struct GearSpec {
 struct Gear {
     spec: GearSpec,
     origin: Option<(f64, f64)>,
+    /// The slave's coupling number when this gear coupled it.
+    epoch: u32,
 }
 
 /// Gear couplings between axes.
@@ -71,7 +73,11 @@ impl GearEngine {
         Ok(GearEngine {
             gears: specs
                 .iter()
-                .map(|&spec| Gear { spec, origin: None })
+                .map(|&spec| Gear {
+                    spec,
+                    origin: None,
+                    epoch: 0,
+                })
                 .collect(),
         })
     }
@@ -102,9 +108,9 @@ impl Engine for GearEngine {
             };
             // A slave that lost its coupling (power off, error, reset) couples again only
             // once it is enabled and free.
-            let owned = axis
-                .coupling()
-                .is_some_and(|c| c.kind == CouplingState::GearVelocity);
+            let owned = gear.origin.is_some()
+                && axis.coupling().is_some()
+                && axis.coupling_epoch() == gear.epoch;
             if !owned {
                 gear.origin = None;
                 let coupling = Coupling {
@@ -120,6 +126,7 @@ impl Engine for GearEngine {
                     continue;
                 }
                 gear.origin = Some((m.position, axis.setpoint().position));
+                gear.epoch = axis.coupling_epoch();
             }
             let Some((m0, s0)) = gear.origin else {
                 continue;
@@ -140,7 +147,10 @@ impl Engine for GearEngine {
         for gear in &mut self.gears {
             if gear.origin.take().is_some() {
                 if let Some(axis) = axes.axis_mut(gear.spec.slave) {
-                    axis.decouple();
+                    // Only its own coupling (another engine may hold the axis since).
+                    if axis.coupling_epoch() == gear.epoch {
+                        axis.decouple();
+                    }
                 }
             }
         }

@@ -23,6 +23,9 @@ use hli::wire::AcyclicRequest;
 struct SawSlave {
     master: usize,
     follower: Follower,
+    /// The axis's coupling number when the saw coupled it: another number means another
+    /// engine took the axis since (after a fault released it), and the slot is stale.
+    epoch: u32,
 }
 
 /// Flying-saw slaves by axis index.
@@ -30,7 +33,10 @@ struct SawSlave {
 pub struct SawEngine {
     cycle_s: f64,
     slaves: Vec<Option<SawSlave>>,
-    characs: Vec<Option<CharacValues>>,
+    /// Per slave: the last plan's values and its number (a read in two parts tells whether
+    /// both belong to the same plan).
+    characs: Vec<Option<(CharacValues, u32)>>,
+    plans: u32,
 }
 
 fn refused(e: SawError) -> HandlerResult {
@@ -51,17 +57,24 @@ impl SawEngine {
             cycle_s,
             slaves: vec![None; axes],
             characs: vec![None; axes],
+            plans: 0,
         }
     }
 
     /// The characteristic values of the last phase planned for `slave`.
     pub fn charac(&self, slave: usize) -> Option<&CharacValues> {
-        self.characs.get(slave)?.as_ref()
+        self.characs.get(slave)?.as_ref().map(|(c, _)| c)
     }
 
-    /// Whether `slave` is coupled to a master by the saw.
-    pub fn coupled(&self, slave: usize) -> bool {
-        self.slaves.get(slave).is_some_and(Option::is_some)
+    /// Whether `slave` is coupled to a master by the saw (the axis still in the coupling
+    /// the saw made).
+    fn owns(&self, slave: usize, axes: &AxisSet) -> bool {
+        let slot = self.slaves.get(slave).and_then(Option::as_ref);
+        let axis = axes.axis(slave);
+        match (slot, axis) {
+            (Some(s), Some(a)) => a.coupling().is_some() && a.coupling_epoch() == s.epoch,
+            _ => false,
+        }
     }
 
     /// Couples `slave` (MC_GearInVelo / MC_GearInPos). Refused with nothing changed.
@@ -73,7 +86,7 @@ impl SawEngine {
         let Some(axis) = axes.axis(slave) else {
             return Err(ErrorCode::InvalidTarget);
         };
-        let ours = self.coupled(slave);
+        let ours = self.owns(slave, axes);
         if axis.coupling().is_some() && !ours {
             return reply(&SawReply {
                 error_id: hli::enums::AxisError::Coupled.raw(),
@@ -123,16 +136,15 @@ impl SawEngine {
             SyncOn::Position { .. } => CouplingState::GearPosition,
         };
         let axis = axes.axis_mut(slave).expect("checked above");
-        if ours {
-            // A new command on a coupled slave: replanned from where it is, no jump.
-            axis.decouple();
-        }
-        if let Err(e) = axis.couple(Coupling {
+        let coupling = Coupling {
             kind,
             master: master as i32,
             phase: AxisState::SlaveSynchronizing,
-        }) {
-            self.slaves[slave] = None;
+        };
+        if ours {
+            // A new command on a coupled slave: planned from where it is, coupled in place.
+            axis.recouple(coupling);
+        } else if let Err(e) = axis.couple(coupling) {
             return reply(&SawReply {
                 error_id: e.raw(),
                 reserved: 0,
@@ -141,13 +153,18 @@ impl SawEngine {
         self.slaves[slave] = Some(SawSlave {
             master,
             follower: Follower::new(request, &plan, &m, axis.config().soft_limits),
+            epoch: axis.coupling_epoch(),
         });
-        self.characs[slave] = Some(plan.charac.values);
+        self.plans = self.plans.wrapping_add(1);
+        self.characs[slave] = Some((plan.charac.values, self.plans));
         accepted()
     }
 
     fn gear_out(&mut self, slave: usize, axes: &mut AxisSet) -> HandlerResult {
-        if self.slaves.get_mut(slave).and_then(Option::take).is_none() {
+        let ours = self.owns(slave, axes);
+        // A stale slot (the axis taken by another engine since) goes without touching it.
+        let had = self.slaves.get_mut(slave).and_then(Option::take).is_some();
+        if !(had && ours) {
             return refused(SawError::NotCoupled);
         }
         if let Some(axis) = axes.axis_mut(slave) {
@@ -157,7 +174,7 @@ impl SawEngine {
     }
 
     fn read_charac(&self, slave: usize, call: &SawCharacCall) -> HandlerResult {
-        let Some(c) = self.charac(slave) else {
+        let Some((c, plan)) = self.characs.get(slave).copied().flatten() else {
             return reply(&SawCharacReply {
                 error_id: SawError::NotCoupled.raw(),
                 ..SawCharacReply::default()
@@ -175,6 +192,8 @@ impl SawEngine {
         reply(&SawCharacReply {
             error_id: 0,
             part: call.part,
+            plan,
+            reserved: 0,
             values,
         })
     }
@@ -195,13 +214,9 @@ impl Engine for SawEngine {
             let Some(axis) = io.axes.axis_mut(i) else {
                 continue;
             };
-            // A slave that lost its coupling (fault, power off) is no longer the saw's.
-            let held = axis.coupling().is_some_and(|c| {
-                matches!(
-                    c.kind,
-                    CouplingState::GearVelocity | CouplingState::GearPosition
-                )
-            });
+            // A slave that lost its coupling (fault, power off), or was coupled by another
+            // engine since, is no longer the saw's.
+            let held = axis.coupling().is_some() && axis.coupling_epoch() == s.epoch;
             if !held {
                 *slot = None;
                 continue;
@@ -244,9 +259,12 @@ impl Engine for SawEngine {
 
     fn reset(&mut self, axes: &mut AxisSet) {
         for (i, slot) in self.slaves.iter_mut().enumerate() {
-            if slot.take().is_some() {
+            if let Some(s) = slot.take() {
                 if let Some(axis) = axes.axis_mut(i) {
-                    axis.decouple();
+                    // Only its own coupling (another engine may hold the axis since).
+                    if axis.coupling_epoch() == s.epoch {
+                        axis.decouple();
+                    }
                 }
             }
         }

@@ -49,7 +49,8 @@ impl Follower {
             request,
             profile: plan.profile,
             m0: master.position,
-            dir: if master.velocity < 0.0 { -1.0 } else { 1.0 },
+            // A master at rest at coupling has no direction yet: it is the one it first moves in.
+            dir: master.velocity.signum() * f64::from(master.velocity != 0.0),
             phase: Phase::Synchronizing { t: 0.0 },
             stop: plan.profile,
             soft,
@@ -70,17 +71,22 @@ impl Follower {
         dt: f64,
     ) -> Option<(Kinematic, AxisState)> {
         let ratio = self.request.ratio;
+        if self.dir == 0.0 && m.velocity != 0.0 {
+            self.dir = m.velocity.signum();
+            self.m0 = m.position;
+        }
         let tau = (m.position - self.m0) * self.dir;
         let backwards = m.velocity * self.dir < 0.0;
         let lock = self.request.mask & sync_mask::ROLLBACKLOCK != 0;
         let instant = self.request.mask & sync_mask::INSTANTSTOPONROLLBACK != 0;
-        let rolled_back = tau < 0.0 && backwards;
+        let rolled_back = self.dir != 0.0 && tau < 0.0 && backwards;
         match self.phase {
             Phase::Synchronizing { t } => {
                 // Cases 2, 3, 5, 7: back over the coupling position before the sync phase.
                 if rolled_back {
+                    // The stop's first set-point is this tick's (t = dt).
                     self.phase = self.stop(&slave, instant);
-                    return self.step(m, slave, 0.0);
+                    return self.step(m, slave, dt);
                 }
                 let t = t + dt;
                 // A master that lands on its sync position up to rounding is there: the sync
@@ -109,8 +115,9 @@ impl Follower {
             Phase::Synchron { m_ref, s_ref } => {
                 // Cases 6 and 8 (cases 1 and 4: the coupling holds for every master motion).
                 if lock && rolled_back {
+                    // The stop's first set-point is this tick's (t = dt).
                     self.phase = self.stop(&slave, instant);
-                    return self.step(m, slave, 0.0);
+                    return self.step(m, slave, dt);
                 }
                 Some((
                     Kinematic {

@@ -9,8 +9,8 @@
 
 use super::profile::{Charac, Domain, Profile, Shape};
 use super::shape::{
-    change_time, jerk_limited_change, phases_to_pieces, quintic, slope_change, slope_change_travel,
-    straight, Limits,
+    change_time, change_time_from, jerk_limited_change, phases_to_pieces, quintic, slope_change,
+    slope_change_travel, straight, Limits,
 };
 use crate::axis::generator::Kinematic;
 use hli::enums::SawError;
@@ -373,12 +373,9 @@ impl TravelFrame {
         if self.k0 == self.k1 && self.c0 == 0.0 {
             return self.immediate();
         }
-        let mut len = self.change_len(self.k0, self.k1, &req.limits);
-        if len == 0.0 {
-            // Only the start curvature to take away: as long as the jerk allows.
-            let a = (self.c0 * self.w * self.w).abs();
-            len = self.w * (1.5 * a / req.limits.jerk).max(1e-6);
-        }
+        let w = self.w;
+        let a0 = self.c0 * w * w;
+        let len = w * change_time_from(self.k0 * w, a0, self.k1 * w, &req.limits);
         let p = slope_change(0.0, len, self.s0, self.k0, self.c0, self.k1);
         Profile::new(self.domain(), Shape::P5, &[p])
     }
@@ -594,10 +591,7 @@ impl TravelFrame {
 /// A stop after a rollback: the velocity taken to 0 along a smooth change in time (as fast
 /// as deceleration and jerk allow), from the slave's set-point.
 pub fn rollback_stop(slave: &Kinematic, limits: &Limits) -> Profile {
-    let mut t = change_time(slave.velocity, 0.0, limits);
-    if t == 0.0 {
-        t = (1.5 * slave.acceleration.abs() / limits.jerk).max(1e-6);
-    }
+    let t = change_time_from(slave.velocity, slave.acceleration, 0.0, limits).max(1e-6);
     let p = slope_change(
         0.0,
         t,

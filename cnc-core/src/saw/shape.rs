@@ -64,6 +64,29 @@ pub fn change_time(va: f64, vb: f64, limits: &Limits) -> f64 {
     by_acc.max(by_dec).max(by_jerk)
 }
 
+/// The shortest duration of a smooth velocity change from `va` with acceleration `a0` to
+/// `vb` (acceleration 0 at the end) that keeps the jerk, and acceleration and deceleration
+/// as [`change_time`] sizes them. The jerk of such a change is linear in time, from
+/// `(6 dv - 4 a0 T) / T^2` at the start to `(2 a0 T - 6 dv) / T^2` at the end, so each end
+/// bounds T from below by the larger root of `J T^2 -+ (c1 T + c0) = 0`.
+pub fn change_time_from(va: f64, a0: f64, vb: f64, limits: &Limits) -> f64 {
+    let dv = vb - va;
+    let j = limits.jerk;
+    // J T^2 >= |c0 + c1 T| for both ends.
+    let mut t = change_time(va, vb, limits);
+    for (c0, c1) in [(6.0 * dv, -4.0 * a0), (-6.0 * dv, 2.0 * a0)] {
+        for sign in [1.0, -1.0] {
+            // J T^2 - sign (c1 T + c0) >= 0: the larger root of J T^2 - b T - c.
+            let (b, c) = (sign * c1, sign * c0);
+            let disc = b * b + 4.0 * j * c;
+            if disc >= 0.0 {
+                t = t.max((b + disc.sqrt()) / (2.0 * j));
+            }
+        }
+    }
+    t
+}
+
 /// A smooth change of slope from `ka` (with curvature `ca`) to `kb` (curvature 0) over
 /// `[start, start + len]`, starting at value `sa`: the slope is the cubic Hermite curve
 /// between the two ends, the value its integral (a polynomial of degree 4, the 5th-order
@@ -233,7 +256,34 @@ mod tests {
         assert!((p.eval(0.0)[3].abs() - 5000.0).abs() < 1e-6);
     }
 
+    #[test]
+    fn a_change_from_an_acceleration_keeps_the_jerk() {
+        // The seed's velocity example 3: 400 -> -500 mm/s from 1200 mm/s^2, jerk 5000.
+        let t = change_time_from(400.0, 1200.0, -500.0, &LIM);
+        assert!((t - 1.6247).abs() < 1e-3, "{t}");
+        let p = slope_change(0.0, t, 0.0, 400.0, 1200.0, -500.0);
+        let peak = (0..=1000)
+            .map(|i| p.eval(t * i as f64 / 1000.0)[3].abs())
+            .fold(0.0, f64::max);
+        assert!((peak - 5000.0).abs() < 1e-6, "{peak}");
+        // Only an acceleration to take out: 4 |a| / J.
+        assert!((change_time_from(10.0, 1000.0, 10.0, &LIM) - 0.8).abs() < 1e-12);
+    }
+
     proptest! {
+        #[test]
+        fn a_change_from_any_acceleration_keeps_the_jerk(
+            va in -1000.0f64..1000.0, a0 in -3000.0f64..3000.0, vb in -1000.0f64..1000.0,
+        ) {
+            let t = change_time_from(va, a0, vb, &LIM);
+            prop_assume!(t > 1e-6);
+            let p = slope_change(0.0, t, 0.0, va, a0, vb);
+            for i in 0..=200 {
+                let d = p.eval(t * i as f64 / 200.0);
+                prop_assert!(d[3].abs() <= LIM.jerk * (1.0 + 1e-9), "jerk {}", d[3]);
+            }
+        }
+
         #[test]
         fn a_smooth_change_keeps_every_limit(
             va in -1000.0f64..1000.0, vb in -1000.0f64..1000.0,
