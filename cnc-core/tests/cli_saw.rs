@@ -208,3 +208,51 @@ fn the_flying_saw_cuts_twenty_equal_pieces_from_a_plc_process() {
         "every sync after the first from a returning saw"
     );
 }
+
+/// The flying-saw blocks called by name from a timeline (`scenarios/saw-blocks`), in
+/// process: the saw is synchronous exactly when the master passes its sync position, the
+/// characteristic values are read, MC_GearOut leaves the saw at the master's speed until
+/// MC_Halt.
+#[test]
+fn the_saw_blocks_run_from_a_timeline() {
+    use cnc_core::app::scenario::{InProcess, Scenario};
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/saw-blocks/scenario.toml");
+    let s = Scenario::load(&path).unwrap();
+    let run = InProcess::run_through(&s).unwrap();
+    let summary = run.timeline.as_ref().unwrap().summary();
+    assert!(!summary.contains("ErrorID"), "{summary}");
+    for block in [
+        "sync (MC_GearInPos",
+        "charac (MC_ReadFlyingSawCharacteristics",
+        "out (MC_GearOut",
+        "halt (MC_Halt",
+    ] {
+        assert!(summary.contains(block), "{block}: {summary}");
+    }
+    let csv = String::from_utf8(run.trace_csv()).unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    // tick, time, master, saw, saw velocity, nAxisState, coupling (0.1 um, 0.1 um/s).
+    let at = rows
+        .iter()
+        .position(|r| r[2] >= 1500.0 * 1e4)
+        .expect("the master passes 1500");
+    let r = &rows[at];
+    assert_eq!(r[5], 13.0, "synchronous at the sync point");
+    assert_eq!(rows[at - 1][5], 12.0, "synchronising the tick before");
+    let expected = 1000.0 * 1e4 + (r[2] - 1500.0 * 1e4);
+    assert!(
+        (r[3] - expected).abs() <= 1.0,
+        "saw {} expected {expected}",
+        r[3]
+    );
+    assert_eq!(r[4], 500.0 * 1e4);
+    // After MC_GearOut (tick 3700) and before MC_Halt (4000): free, at 500 mm/s.
+    let free = &rows[3900];
+    assert_eq!((free[5], free[6], free[4]), (2.0, 0.0, 500.0 * 1e4));
+    assert_eq!(rows.last().unwrap()[4], 0.0, "halted");
+}
