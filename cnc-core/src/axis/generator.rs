@@ -28,6 +28,20 @@ pub struct Kinematic {
     pub jerk: f64,
 }
 
+impl Kinematic {
+    /// The slave of a linear coupling to this master set-point: `s0 + ratio (m - m0)`,
+    /// velocity, acceleration and jerk scaled alike (gears, the flying saw's synchronous
+    /// phase).
+    pub fn geared(&self, ratio: f64, (m0, s0): (f64, f64)) -> Kinematic {
+        Kinematic {
+            position: s0 + ratio * (self.position - m0),
+            velocity: ratio * self.velocity,
+            acceleration: ratio * self.acceleration,
+            jerk: ratio * self.jerk,
+        }
+    }
+}
+
 /// The limits of one move, all strictly positive.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MoveLimits {

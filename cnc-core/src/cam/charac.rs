@@ -295,7 +295,7 @@ impl CharacValues {
 }
 
 /// The root of derivative `order` between `a` and `b` (a sign change is known).
-fn bisect(eval: &dyn Fn(f64) -> [f64; 5], order: usize, mut a: f64, mut b: f64) -> f64 {
+pub(crate) fn bisect(eval: &dyn Fn(f64) -> [f64; 5], order: usize, mut a: f64, mut b: f64) -> f64 {
     let mut fa = eval(a)[order];
     for _ in 0..60 {
         let m = 0.5 * (a + b);

@@ -5,7 +5,6 @@
 //! causes no jump.
 
 use super::engine::{Engine, EngineIo};
-use crate::axis::generator::Kinematic;
 use crate::axis::{AxisSet, Coupling};
 use hli::enums::{AxisState, CouplingState};
 
@@ -128,18 +127,10 @@ impl Engine for GearEngine {
                 gear.origin = Some((m.position, axis.setpoint().position));
                 gear.epoch = axis.coupling_epoch();
             }
-            let Some((m0, s0)) = gear.origin else {
+            let Some(origin) = gear.origin else {
                 continue;
             };
-            axis.drive_coupled(
-                Kinematic {
-                    position: s0 + ratio * (m.position - m0),
-                    velocity: ratio * m.velocity,
-                    acceleration: ratio * m.acceleration,
-                    jerk: ratio * m.jerk,
-                },
-                AxisState::SlaveSynchronous,
-            );
+            axis.drive_coupled(m.geared(ratio, origin), AxisState::SlaveSynchronous);
         }
     }
 

@@ -240,19 +240,15 @@ impl Engine for SawEngine {
         let slave = request.target as usize;
         let known = slave < self.slaves.len();
         Some(match kind {
+            // A slave beyond the engine's slots (an engine built for fewer axes).
             CallKind::SawGearIn if !known => Err(ErrorCode::InvalidTarget),
-            CallKind::SawGearIn => match decode_body::<SawGearInCall>(request) {
-                Ok(call) => self.gear_in(slave, &call, axes),
-                Err(e) => Err(e),
-            },
-            CallKind::SawGearOut => match decode_body::<SawGearOutCall>(request) {
-                Ok(_) => self.gear_out(slave, axes),
-                Err(e) => Err(e),
-            },
-            CallKind::SawCharac => match decode_body::<SawCharacCall>(request) {
-                Ok(call) => self.read_charac(slave, &call),
-                Err(e) => Err(e),
-            },
+            CallKind::SawGearIn => decode_body::<SawGearInCall>(request)
+                .and_then(|call| self.gear_in(slave, &call, axes)),
+            CallKind::SawGearOut => {
+                decode_body::<SawGearOutCall>(request).and_then(|_| self.gear_out(slave, axes))
+            }
+            CallKind::SawCharac => decode_body::<SawCharacCall>(request)
+                .and_then(|call| self.read_charac(slave, &call)),
             _ => return None,
         })
     }

@@ -119,15 +119,7 @@ impl Follower {
                     self.phase = self.stop(&slave, instant);
                     return self.step(m, slave, dt);
                 }
-                Some((
-                    Kinematic {
-                        position: s_ref + ratio * (m.position - m_ref),
-                        velocity: ratio * m.velocity,
-                        acceleration: ratio * m.acceleration,
-                        jerk: ratio * m.jerk,
-                    },
-                    AxisState::SlaveSynchronous,
-                ))
+                Some((m.geared(ratio, (m_ref, s_ref)), AxisState::SlaveSynchronous))
             }
             Phase::Stopping { t } => {
                 let t = t + dt;

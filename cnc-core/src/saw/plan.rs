@@ -260,18 +260,22 @@ pub fn plan(
     let vm = master.velocity;
     let v_sync = req.ratio * vm;
     let start = [slave.position, slave.velocity, slave_acc, 0.0];
-    let profile = if req.time_based {
-        time_based(req, slave.position, slave.velocity, slave_acc, v_sync)
+    let (profile, known) = if req.time_based {
+        (
+            time_based(req, slave.position, slave.velocity, slave_acc, v_sync),
+            None,
+        )
     } else if vm == 0.0 {
         // Master and slave at rest: synchronous at once (the slave stands with the master).
-        Profile::new(
+        let p = Profile::new(
             Domain::Master {
                 m0: master.position,
                 dir: 1.0,
             },
             Shape::Immediate,
             &[straight(0.0, 0.0, slave.position, 0.0)],
-        )
+        );
+        (p, None)
     } else {
         let dir = vm.signum();
         let w = vm.abs();
@@ -288,14 +292,14 @@ pub fn plan(
             k1: req.ratio * dir,
         };
         match req.on {
-            SyncOn::Velocity => travel.on_velocity(req),
+            SyncOn::Velocity => (travel.on_velocity(req), None),
             SyncOn::Position {
                 master: ms,
                 slave: ss,
             } => travel.on_position(req, (ms - master.position) * dir, ss),
         }
     };
-    let charac = profile.charac(master.position, vm, start);
+    let charac = known.unwrap_or_else(|| profile.charac(master.position, vm, start));
     let end = profile.end_state(vm);
     let finite = charac.values.fields().iter().all(|(_, v)| v.is_finite())
         && profile
@@ -381,8 +385,9 @@ impl TravelFrame {
     }
 
     /// Position sync over master travel `x` to slave position `s1`: the optimisation steps
-    /// of chapter 7.
-    fn on_position(&self, req: &SawRequest, x: f64, s1: f64) -> Profile {
+    /// of chapter 7. The characteristic values of the chosen phase come along when a step
+    /// needed them already.
+    fn on_position(&self, req: &SawRequest, x: f64, s1: f64) -> (Profile, Option<Charac>) {
         let d = s1 - self.s0;
         let p5 = || {
             Profile::new(
@@ -398,45 +403,46 @@ impl TravelFrame {
         };
         // Optimisations only for a master and slave without acceleration at coupling.
         if self.c0 != 0.0 {
-            return p5();
+            return (p5(), None);
         }
         if self.k0 == self.k1 && (d - self.k1 * x).abs() <= SLACK * (1.0 + d.abs()) {
-            return self.immediate();
+            return (self.immediate(), None);
         }
         let charac = |p: &Profile| p.charac(self.m0, self.w * self.dir, [self.s0, 0.0, 0.0, 0.0]);
+        // A candidate the acceleration checks let pass, with its values.
+        let passes = |p: Option<Profile>| {
+            let p = p?;
+            let c = charac(&p);
+            acc_ok(&c, req).then_some((p, Some(c)))
+        };
         if req.mask & m::PREFERCONSTVELO != 0 {
-            if let Some(p) = self.const_velo(req, x, d) {
-                if acc_ok(&charac(&p), req) {
-                    return p;
-                }
+            if let Some(chosen) = passes(self.const_velo(req, x, d)) {
+                return chosen;
             }
         }
         // Step 1: velocity overshoot-free, P1+P5 or P5+P1.
-        if let Some(p) = self.monotone(x, d) {
-            if acc_ok(&charac(&p), req) {
-                return p;
-            }
+        if let Some(chosen) = passes(self.monotone(x, d)) {
+            return chosen;
         }
         // Step 2: the plain P5, capped at the velocity limit if it passes it.
         let plain = p5();
-        if req.mask & m::MAXVELO != 0 {
-            let c = charac(&plain);
-            let v = &c.values;
-            let peak = if v.fSlaveVeloMax.abs() >= v.fSlaveVeloMin.abs() {
-                v.fSlaveVeloMax
-            } else {
-                v.fSlaveVeloMin
-            };
-            if over(peak.abs(), req.limits.velocity) {
-                let kv = peak.signum() * req.limits.velocity / self.w;
-                if let Some(p) = self.capped(req, x, d, kv) {
-                    if acc_ok(&charac(&p), req) {
-                        return p;
-                    }
-                }
+        if req.mask & m::MAXVELO == 0 {
+            return (plain, None);
+        }
+        let c = charac(&plain);
+        let v = &c.values;
+        let peak = if v.fSlaveVeloMax.abs() >= v.fSlaveVeloMin.abs() {
+            v.fSlaveVeloMax
+        } else {
+            v.fSlaveVeloMin
+        };
+        if over(peak.abs(), req.limits.velocity) {
+            let kv = peak.signum() * req.limits.velocity / self.w;
+            if let Some(chosen) = passes(self.capped(req, x, d, kv)) {
+                return chosen;
             }
         }
-        plain
+        (plain, Some(c))
     }
 
     /// P1+P5 or P5+P1 when the mean slope `d/x` lies between start and sync slope.

@@ -3,7 +3,7 @@
 //! (`MC_FlyingSawCharacValues`) for a master at constant velocity.
 
 use crate::axis::generator::Kinematic;
-use crate::cam::charac::Extreme;
+use crate::cam::charac::{bisect, Extreme};
 use crate::cam::piece::Piece;
 use crate::cam::CharacValues;
 
@@ -181,25 +181,6 @@ impl Scan {
     }
 }
 
-/// The root of derivative `k` in `[a, b]` where its sign changes.
-fn bisect(piece: &Piece, k: usize, mut a: f64, mut b: f64) -> f64 {
-    let mut fa = piece.eval(a)[k];
-    for _ in 0..56 {
-        let m = 0.5 * (a + b);
-        let fm = piece.eval(m)[k];
-        if fm == 0.0 {
-            return m;
-        }
-        if (fm < 0.0) == (fa < 0.0) {
-            a = m;
-            fa = fm;
-        } else {
-            b = m;
-        }
-    }
-    0.5 * (a + b)
-}
-
 impl Profile {
     /// The characteristic values for a master at constant velocity `vm` from `m0`, the
     /// slave at `s0` when the phase is empty. Extremes inside a piece are found where the
@@ -232,7 +213,7 @@ impl Profile {
                 scan.note(master_at(x), &state(piece, x));
                 for k in 1..5 {
                     if prev[k] * d[k] < 0.0 {
-                        let root = bisect(piece, k, prev_x, x);
+                        let root = bisect(&|x| piece.eval(x), k, prev_x, x);
                         scan.note(master_at(root), &state(piece, root));
                     }
                 }
