@@ -7,8 +7,8 @@
 //! longer campaign.
 
 use cnc_core::nc::ast::*;
-use cnc_core::nc::decode::ZeroVars;
-use cnc_core::nc::{decode_program, parse, parse_general, print};
+use cnc_core::app::check_cli::check_source;
+use cnc_core::nc::{parse, parse_general, print};
 use proptest::prelude::*;
 
 fn span() -> Span {
@@ -267,7 +267,7 @@ proptest! {
         let src = String::from_utf8_lossy(&bytes);
         let (p, _) = parse(&src);
         let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
-        let _ = decode_program(&p, &src, &axes, &ZeroVars);
+        let _ = (&p, check_source(&src, &axes));
     }
 
     /// Structured fuzzing: valid programs with random splices of NC-ish fragments.
@@ -290,7 +290,7 @@ proptest! {
             prop_assert!(d.line >= 1 && d.col >= 1, "{:?}", d);
         }
         let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C", "AB", "AM", "AH", "AA"].map(String::from).to_vec();
-        let _ = decode_program(&tree, &text, &axes, &ZeroVars);
+        let _ = (&tree, check_source(&text, &axes));
     }
 }
 

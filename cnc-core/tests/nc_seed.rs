@@ -3,8 +3,8 @@
 //! Left out, as the issue says: bare `...` elision lines and the syntax synopses, whose `..`
 //! are placeholders.
 
-use cnc_core::nc::decode::ZeroVars;
-use cnc_core::nc::{decode_program, parse};
+use cnc_core::app::check_cli::check_source;
+use cnc_core::nc::parse;
 use std::path::PathBuf;
 
 fn seed() -> String {
@@ -89,7 +89,7 @@ fn every_seed_listing_parses_and_decodes() {
             "seed listing at line {start}:\n{listing}\n{diags:#?}"
         );
         blocks += program.blocks.len();
-        let (_, semantic) = decode_program(&program, listing, &axes, &ZeroVars);
+        let (semantic, _) = check_source(listing, &axes);
         // The first listing is an excerpt that moves with G01 before any F word; everything
         // else must decode cleanly.
         let unexpected: Vec<_> = semantic

@@ -1,10 +1,12 @@
-//! `cnc check`: parse and decode NC programs, report every problem as
+//! `cnc check`: parse, run and decode NC programs, report every problem as
 //! `FILE:LINE:COL: error: MESSAGE`, optionally print the decoded motion blocks as JSON lines.
 
-use crate::app::json::number;
-use crate::nc::decode::{check_channel_axes, ZeroVars};
-use crate::nc::{decode_program, parse, Decoded, Diagnostic};
-use std::path::PathBuf;
+use crate::app::json::push_number;
+use crate::nc::decode::{check_channel_axes, DecoderSetup, ZeroVars};
+use crate::nc::interp::SearchPath;
+use crate::nc::{check_program, Decoded, Diagnostic};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `cnc check`.
@@ -16,35 +18,95 @@ pub struct CheckArgs {
     /// Also print each decoded motion block as a JSON line.
     #[arg(long)]
     pub blocks: bool,
+    /// Folders `L name` searches after the calling program's own (repeatable).
+    #[arg(long = "search", value_name = "DIR")]
+    pub search: Vec<PathBuf>,
     /// NC program files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
 }
 
+/// Checks one program text (subroutine files next to `dir`); returns its diagnostics (sorted)
+/// and the decoded stream of its run.
+pub fn check_source_in(
+    src: &str,
+    axes: &[String],
+    dir: Option<&Path>,
+    search: &SearchPath,
+) -> (Vec<Diagnostic>, Vec<Decoded>) {
+    let mut decoded = Vec::new();
+    let (_, diags) = check_program(
+        "",
+        src.to_string(),
+        axes,
+        &DecoderSetup::default(),
+        (dir, search),
+        &ZeroVars,
+        Some(&mut decoded),
+    );
+    (diags, decoded)
+}
+
 /// Checks one program text; returns its diagnostics (sorted) and the decoded stream.
 pub fn check_source(src: &str, axes: &[String]) -> (Vec<Diagnostic>, Vec<Decoded>) {
-    let (program, mut diags) = parse(src);
-    let (decoded, semantic) = decode_program(&program, src, axes, &ZeroVars);
-    diags.extend(semantic);
-    diags.sort_by_key(|d| (d.line, d.col));
-    diags.dedup();
-    (diags, decoded)
+    check_source_in(src, axes, None, &SearchPath::default())
 }
 
 /// A decoded motion block as the JSON line `--blocks` prints.
 pub fn motion_json(block: &crate::nc::MotionBlock, axes: &[String]) -> String {
-    let target: Vec<String> = axes
-        .iter()
-        .zip(block.target.iter())
-        .map(|(name, v)| format!("\"{name}\":{}", number(*v)))
-        .collect();
-    format!(
-        "{{\"line\":{},\"motion\":\"{}\",\"feed\":{},\"target\":{{{}}}}}",
+    let mut out = String::new();
+    push_motion_json(&mut out, block, axes);
+    out
+}
+
+/// [`motion_json`] appended to `out` (no allocation of its own).
+pub fn push_motion_json(out: &mut String, block: &crate::nc::MotionBlock, axes: &[String]) {
+    use std::fmt::Write as _;
+    let _ = write!(
+        out,
+        "{{\"line\":{},\"motion\":\"{}\",\"feed\":",
         block.line,
-        block.motion.name(),
-        number(block.feed),
-        target.join(",")
-    )
+        block.motion.name()
+    );
+    push_number(out, block.feed);
+    out.push_str(",\"target\":{");
+    for (i, (name, v)) in axes.iter().zip(block.target.iter()).enumerate() {
+        if i > 0 {
+            out.push(',');
+        }
+        out.push('"');
+        out.push_str(name);
+        out.push_str("\":");
+        push_number(out, *v);
+    }
+    out.push('}');
+    if let Some(arc) = &block.arc {
+        let [a, b, _] = arc.plane.axes();
+        let _ = write!(out, ",\"plane\":\"{}\",\"center\":{{", arc.plane.name());
+        for (k, axis) in [a, b].into_iter().enumerate() {
+            if k > 0 {
+                out.push(',');
+            }
+            out.push('"');
+            out.push_str(axes.get(axis).map_or("?", String::as_str));
+            out.push_str("\":");
+            push_number(out, arc.center[k]);
+        }
+        out.push('}');
+        if arc.full_turn {
+            out.push_str(",\"full_turn\":true");
+        }
+    }
+    out.push('}');
+}
+
+/// Writes `text` to stdout; `false` when the reader has gone (a closed pipe ends quietly).
+fn emit(text: &str) -> bool {
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(text.as_bytes())
+        .and_then(|()| stdout.flush())
+        .is_ok()
 }
 
 /// Runs `cnc check`.
@@ -58,6 +120,7 @@ pub fn main(args: CheckArgs) -> ExitCode {
         eprintln!("error: --axes: {message}");
         return ExitCode::from(2);
     }
+    let search = SearchPath(args.search.clone());
     let mut failed = false;
     let mut out = String::new();
     for file in &args.files {
@@ -70,7 +133,18 @@ pub fn main(args: CheckArgs) -> ExitCode {
                 continue;
             }
         };
-        let (diags, decoded) = check_source(&src, &axes);
+        let mut decoded = Vec::new();
+        let keep = args.blocks.then_some(&mut decoded);
+        let dir = file.parent().map(Path::to_path_buf);
+        let (_, diags) = check_program(
+            &name,
+            src,
+            &axes,
+            &DecoderSetup::default(),
+            (dir.as_deref(), &search),
+            &ZeroVars,
+            keep,
+        );
         for d in &diags {
             out.push_str(&d.render(&name));
             out.push('\n');
@@ -79,13 +153,23 @@ pub fn main(args: CheckArgs) -> ExitCode {
         if args.blocks && diags.is_empty() {
             for d in &decoded {
                 if let Decoded::Motion(m) = d {
-                    out.push_str(&motion_json(m, &axes));
+                    push_motion_json(&mut out, m, &axes);
                     out.push('\n');
+                }
+                if out.len() > 1 << 16 {
+                    if !emit(&out) {
+                        return exit_code(failed);
+                    }
+                    out.clear();
                 }
             }
         }
     }
-    print!("{out}");
+    emit(&out);
+    exit_code(failed)
+}
+
+fn exit_code(failed: bool) -> ExitCode {
     if failed {
         ExitCode::from(1)
     } else {

@@ -46,6 +46,77 @@ pub struct ChannelConfig {
     /// The drive of every axis of the channel (simulated ideal when absent).
     #[serde(default)]
     pub drive: Option<crate::axis::sim_drive::DriveModel>,
+    /// What NC programs of the channel use: zero offsets, tool table, tolerances, search path.
+    #[serde(default)]
+    pub nc: NcConfig,
+}
+
+/// `channel.nc.*`: the machine data NC programs refer to.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NcConfig {
+    /// G54..G59: per offset, the value per channel axis (missing ones are 0).
+    #[serde(default)]
+    pub zero_offsets: ZeroOffsets,
+    /// The tool table: length per D number, applied along the plane's normal.
+    #[serde(default)]
+    pub tools: Vec<ToolEntry>,
+    /// How far an arc's end point may lie off its circle (mm; default 0.001).
+    #[serde(default)]
+    pub arc_tolerance: Option<f64>,
+    /// Folders `L name` searches after the calling program's own.
+    #[serde(default)]
+    pub search_path: Vec<String>,
+}
+
+/// G54..G59 of [`NcConfig`].
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct ZeroOffsets {
+    #[serde(default, rename = "G54")]
+    pub g54: Vec<f64>,
+    #[serde(default, rename = "G55")]
+    pub g55: Vec<f64>,
+    #[serde(default, rename = "G56")]
+    pub g56: Vec<f64>,
+    #[serde(default, rename = "G57")]
+    pub g57: Vec<f64>,
+    #[serde(default, rename = "G58")]
+    pub g58: Vec<f64>,
+    #[serde(default, rename = "G59")]
+    pub g59: Vec<f64>,
+}
+
+/// One tool data record.
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ToolEntry {
+    /// The D number that selects it (1 or more).
+    pub d: u32,
+    /// Tool length (mm).
+    pub length: f64,
+}
+
+impl NcConfig {
+    /// The decoder's view of it.
+    pub fn setup(&self) -> crate::nc::decode::DecoderSetup {
+        let z = &self.zero_offsets;
+        crate::nc::decode::DecoderSetup {
+            zero_offsets: [
+                z.g54.clone(),
+                z.g55.clone(),
+                z.g56.clone(),
+                z.g57.clone(),
+                z.g58.clone(),
+                z.g59.clone(),
+            ],
+            tools: self.tools.iter().map(|t| (t.d, t.length)).collect(),
+            arc_tolerance: self
+                .arc_tolerance
+                .unwrap_or(crate::nc::decode::DEFAULT_ARC_TOLERANCE),
+        }
+    }
 }
 
 /// `provide_channel_interface.*`.
@@ -64,14 +135,23 @@ pub struct InterpolatorConfig {
     /// Entries of the dynamic-CS diagnosis history.
     #[serde(default = "default_history")]
     pub dyn_cs_history_max: u32,
+    /// The largest distance between an arc and the chord between two set-points (mm): arcs
+    /// run no faster than keeps it.
+    #[serde(default = "default_chordal_tolerance")]
+    pub chordal_tolerance: f64,
 }
 
 impl Default for InterpolatorConfig {
     fn default() -> Self {
         Self {
             dyn_cs_history_max: default_history(),
+            chordal_tolerance: default_chordal_tolerance(),
         }
     }
+}
+
+fn default_chordal_tolerance() -> f64 {
+    0.001
 }
 
 fn default_history() -> u32 {
@@ -158,6 +238,7 @@ impl ChannelConfig {
             ori_rotation_angle: 0,
             interpolator: InterpolatorConfig::default(),
             program: None,
+            nc: NcConfig::default(),
             drive: None,
         }
     }

@@ -1,5 +1,6 @@
-//! The path interpolator of a channel: one straight block at a time (G0/G1), all channel axes
-//! moving together, with a jerk-limited velocity profile along the path.
+//! The path interpolator of a channel: one block at a time, straight (G0/G1) or an arc
+//! (G2/G3, helical when the plane's normal or other axes move too), all channel axes moving
+//! together, with a jerk-limited velocity profile along the path.
 //!
 //! The profile runs the path parameter `s` from 0 to the block's length `L` with the set-point
 //! generator of the axis layer (rsruckig: time-optimal, jerk-limited, at rest at both ends;
@@ -12,10 +13,23 @@
 //!   or mm), so a pure orientation or auxiliary-axis move runs at the feed in its own units;
 //! * G1 caps the path velocity at `F` (mm/min -> mm/s); G0 runs at the axis limits.
 //!
+//! An arc runs its path parameter over the length of the helix. Every set-point lies on the
+//! circle (the radius blends linearly from start to end when the end point was within the arc
+//! tolerance of it), and the block ends exactly at its end point. Its path limits are the
+//! smallest of the plane axes' (and the helix axis's share), taken at half for acceleration and
+//! jerk because the turning adds as much again, and three arc limits:
+//!
+//! * centripetal acceleration `v²/r` within half the axes' acceleration;
+//! * the jerk of turning, `v³/r²`, within half the axes' jerk;
+//! * the chordal error: the straight line between two set-points strays from the arc by
+//!   `r(1 - cos(vT/2r)) ≈ (vT)²/8r`, kept within the channel's chordal tolerance `e`:
+//!   `v ≤ sqrt(8 r e) / T`.
+//!
 //! The channel owns one generator for its path and hands it to every block: building a
 //! generator allocates (rsruckig's buffers), re-targeting one does not.
 
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
+use crate::nc::arc::ArcMove;
 use crate::nc::decode::AxisValues;
 use crate::nc::MotionMode;
 
@@ -31,11 +45,40 @@ pub struct AxisLimits {
     pub jerk: f64,
 }
 
-/// A straight block being interpolated.
+/// The circle part of an arc block.
+#[derive(Debug, Clone, Copy)]
+struct Circle {
+    /// Plane axes (first, second).
+    axes: [usize; 2],
+    center: [f64; 2],
+    /// Start angle (rad) and signed sweep (positive counter-clockwise).
+    angle0: f64,
+    sweep: f64,
+    /// Start and end radius.
+    r0: f64,
+    r1: f64,
+}
+
+/// How an arc block is to be run: the circle, the channel's cycle and chordal tolerance.
+#[derive(Debug, Clone, Copy)]
+pub struct ArcSpec {
+    /// The decoded arc.
+    pub arc: ArcMove,
+    /// The channel's cycle (s).
+    pub cycle_s: f64,
+    /// The chordal tolerance (mm).
+    pub chordal_tolerance: f64,
+}
+
+/// A block being interpolated.
 #[derive(Debug)]
 pub struct PathMove {
     start: AxisValues,
     delta: AxisValues,
+    /// For an arc: the circle; `delta` then holds the linear part of the other axes.
+    circle: Option<Circle>,
+    /// The exact end point.
+    end: AxisValues,
     length: f64,
     done: bool,
     /// Stopped by `brake`: the block ends where the path stands.
@@ -57,12 +100,13 @@ pub enum PathError {
 
 impl PathMove {
     /// Plans the block from `start` to `target` (same axes) on `generator`, which runs the
-    /// path parameter from 0. `None` when nothing moves.
+    /// path parameter from 0; an arc with `arc`. `None` when nothing moves.
     pub fn plan(
         start: &AxisValues,
         target: &AxisValues,
         motion: MotionMode,
         feed_mm_min: f64,
+        arc: Option<ArcSpec>,
         limits: &[AxisLimits],
         generator: &mut SetpointGenerator,
     ) -> Result<Option<Self>, PathError> {
@@ -72,6 +116,10 @@ impl PathMove {
         }
         if delta.iter().any(|d| !d.is_finite()) {
             return Err(PathError::NotFinite);
+        }
+        if let Some(spec) = arc {
+            return Self::plan_arc(start, target, delta, feed_mm_min, spec, limits, generator)
+                .map(Some);
         }
         let xyz = delta.iter().take(3).map(|d| d * d).sum::<f64>().sqrt();
         let length = if xyz > 1e-12 {
@@ -119,11 +167,101 @@ impl PathMove {
         Ok(Some(Self {
             start: *start,
             delta,
+            circle: None,
+            end: *target,
             length,
             done: false,
             braked: false,
             limits: path,
         }))
+    }
+
+    fn plan_arc(
+        start: &AxisValues,
+        target: &AxisValues,
+        mut delta: AxisValues,
+        feed_mm_min: f64,
+        spec: ArcSpec,
+        limits: &[AxisLimits],
+        generator: &mut SetpointGenerator,
+    ) -> Result<Self, PathError> {
+        let arc = spec.arc;
+        let [a, b, _] = arc.plane.axes();
+        let (p0, p1) = ([start[a], start[b]], [target[a], target[b]]);
+        let c = arc.center;
+        let r0 = (p0[0] - c[0]).hypot(p0[1] - c[1]);
+        let r1 = (p1[0] - c[0]).hypot(p1[1] - c[1]);
+        let sweep = arc.sweep(p0, p1);
+        let signed = if arc.ccw { sweep } else { -sweep };
+        delta[a] = 0.0;
+        delta[b] = 0.0;
+        let circle_length = sweep * (r0 + r1) / 2.0;
+        let linear = delta.iter().take(3).map(|d| d * d).sum::<f64>();
+        let length = (circle_length * circle_length + linear).sqrt();
+        if !(length > 1e-12) || !length.is_finite() {
+            return Err(PathError::NoProfile);
+        }
+        let limit = |i: usize| {
+            limits.get(i).copied().unwrap_or(AxisLimits {
+                velocity: f64::INFINITY,
+                acceleration: f64::INFINITY,
+                jerk: f64::INFINITY,
+            })
+        };
+        let (la, lb) = (limit(a), limit(b));
+        let plane_v = la.velocity.min(lb.velocity);
+        let plane_a = la.acceleration.min(lb.acceleration);
+        let plane_j = la.jerk.min(lb.jerk);
+        let share = circle_length / length;
+        let r = r0.min(r1).max(1e-9);
+        let mut path = MoveLimits {
+            velocity: (plane_v / share.max(1e-12))
+                .min(feed_mm_min / 60.0)
+                .min((plane_a * r / 2.0).sqrt())
+                .min((plane_j * r * r / 2.0).cbrt())
+                .min((8.0 * r * spec.chordal_tolerance).sqrt() / spec.cycle_s),
+            acceleration: plane_a / 2.0 / share.max(1e-12),
+            deceleration: 0.0,
+            jerk: plane_j / 2.0 / share.max(1e-12),
+        };
+        for (i, d) in delta.iter().enumerate() {
+            let axis_share = d.abs() / length;
+            if axis_share <= 1e-12 {
+                continue;
+            }
+            let l = limit(i);
+            path.velocity = path.velocity.min(l.velocity / axis_share);
+            path.acceleration = path.acceleration.min(l.acceleration / axis_share);
+            path.jerk = path.jerk.min(l.jerk / axis_share);
+        }
+        path.deceleration = path.acceleration;
+        let finite = [path.velocity, path.acceleration, path.jerk]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0);
+        if !finite {
+            return Err(PathError::NoProfile);
+        }
+        generator.hold(0.0);
+        generator
+            .move_to(length, path)
+            .map_err(|_| PathError::NoProfile)?;
+        Ok(Self {
+            start: *start,
+            delta,
+            circle: Some(Circle {
+                axes: [a, b],
+                center: c,
+                angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
+                sweep: signed,
+                r0,
+                r1,
+            }),
+            end: *target,
+            length,
+            done: false,
+            braked: false,
+            limits: path,
+        })
     }
 
     /// One tick of `generator` (the one the block was planned on): writes the interpolated
@@ -139,11 +277,19 @@ impl PathMove {
             (generator.state().position / self.length).clamp(0.0, 1.0)
         };
         for (i, p) in position.iter_mut().enumerate() {
-            *p = if self.done && !self.braked {
-                self.start[i] + self.delta[i]
-            } else {
-                self.start[i] + self.delta[i] * s
-            };
+            *p = self.start[i] + self.delta[i] * s;
+        }
+        if let Some(c) = &self.circle {
+            let angle = c.angle0 + c.sweep * s;
+            let r = c.r0 + (c.r1 - c.r0) * s;
+            position[c.axes[0]] = c.center[0] + r * angle.cos();
+            position[c.axes[1]] = c.center[1] + r * angle.sin();
+        }
+        if self.done && !self.braked {
+            // Exactly at the end point (the arithmetic above may miss it by a rounding).
+            for (i, p) in position.iter_mut().enumerate() {
+                *p = self.end[i];
+            }
         }
         self.done
     }

@@ -2,22 +2,20 @@
 //! any diagnostic is refused, never executed), keeping its tree and its jump table. Blocks are
 //! decoded only when the channel reaches them.
 
-use crate::nc::ast::Program;
-pub use crate::nc::control::Jump;
-use crate::nc::decode::{check_channel_axes, ZeroVars};
-use crate::nc::{check_program, parse, Diagnostic};
+use crate::nc::decode::{check_channel_axes, check_program, DecoderSetup, ZeroVars};
+use crate::nc::interp::{ProgramSet, SearchPath};
+use crate::nc::Diagnostic;
+use std::path::{Path, PathBuf};
 
 /// A checked program.
 #[derive(Debug, Clone)]
 pub struct LoadedProgram {
     /// Name for messages (file name or scenario key).
     pub name: String,
-    /// The source text.
-    pub src: String,
-    /// The tree.
-    pub tree: Program,
-    /// Per block: its jump, if it is a `$` statement.
-    pub jumps: Vec<Option<Jump>>,
+    /// The program with every subroutine file it calls.
+    pub set: ProgramSet,
+    /// The machine data its blocks are decoded with.
+    pub setup: DecoderSetup,
 }
 
 /// A program refused at load.
@@ -39,8 +37,23 @@ fn render(name: &str, diagnostics: &[Diagnostic]) -> String {
 }
 
 impl LoadedProgram {
-    /// Parses and checks `src` for a channel with `axes`.
+    /// Parses and checks `src` for a channel with `axes`, without machine data; subroutine
+    /// files are looked for next to `name` when it names a file.
     pub fn load(name: &str, src: &str, axes: &[String]) -> Result<Self, ProgramError> {
+        let dir = Path::new(name).parent().filter(|d| d.is_dir()).map(Path::to_path_buf);
+        Self::load_with(name, src, axes, &DecoderSetup::default(), dir, &SearchPath::default())
+    }
+
+    /// Parses and checks `src` for a channel with `axes` and the machine data of `setup`;
+    /// `L name` looks in `dir`, then in `search`.
+    pub fn load_with(
+        name: &str,
+        src: &str,
+        axes: &[String],
+        setup: &DecoderSetup,
+        dir: Option<PathBuf>,
+        search: &SearchPath,
+    ) -> Result<Self, ProgramError> {
         let refuse = |diagnostics| ProgramError {
             name: name.to_string(),
             diagnostics,
@@ -52,31 +65,35 @@ impl LoadedProgram {
                 message,
                 found: String::new(),
                 offset: 0,
+                file: None,
             }]));
         }
-        let (tree, mut diagnostics) = parse(src);
-        let (jumps, semantic) = check_program(&tree, src, axes, &ZeroVars);
-        diagnostics.extend(semantic);
+        let (set, diagnostics) = check_program(
+            name,
+            src.to_string(),
+            axes,
+            setup,
+            (dir.as_deref(), search),
+            &ZeroVars,
+            None,
+        );
         if !diagnostics.is_empty() {
-            diagnostics.sort_by_key(|d| (d.line, d.col));
-            diagnostics.dedup();
             return Err(refuse(diagnostics));
         }
         Ok(Self {
             name: name.to_string(),
-            src: src.to_string(),
-            tree,
-            jumps,
+            set,
+            setup: setup.clone(),
         })
     }
 
-    /// Number of blocks.
+    /// Number of blocks of the main file.
     pub fn len(&self) -> usize {
-        self.tree.blocks.len()
+        self.set.main().tree.blocks.len()
     }
 
-    /// Whether the program has no blocks.
+    /// Whether the main file has no blocks.
     pub fn is_empty(&self) -> bool {
-        self.tree.blocks.is_empty()
+        self.len() == 0
     }
 }

@@ -16,16 +16,15 @@
 
 use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
-use super::path::{AxisLimits, PathMove};
+use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, Transition, Wanted,
 };
-use super::program::{Jump, LoadedProgram};
+use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
-use crate::nc::ast::Control;
-use crate::nc::control::control_of;
-use crate::nc::decode::{evaluate, AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
+use crate::nc::decode::{AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
+use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
 use hli::enums::{DynCsCommand, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
@@ -69,6 +68,8 @@ enum Wait {
     Tracking,
     /// `#WAIT INDP ALL` or an `INDP_SYN` move.
     Independent,
+    /// `G04` / `#TIME`: until the channel's tick counter reaches this.
+    Dwell { until: u64 },
 }
 
 /// Why a channel stopped: the block and the reason.
@@ -103,7 +104,8 @@ pub struct Channel {
     kinematics: Box<dyn Kinematics + Send>,
     program: Option<LoadedProgram>,
     decoder: DecoderState,
-    next_block: usize,
+    /// Follows the program's control flow and calls.
+    interp: Interpreter,
     line: u32,
     pending: Vec<Decoded>,
     pending_at: usize,
@@ -141,6 +143,15 @@ pub struct Channel {
     m_next_id: u32,
     m_functions_acked: u64,
     tick: u64,
+    /// The channel's cycle (s).
+    cycle_s: f64,
+    /// `S..`: the spindle speed M03/M04 turn at.
+    spindle_speed: f64,
+    /// `T..`: the tool number last programmed.
+    tool_number: u32,
+    /// `#MSG`: the last message and how many there were.
+    message: Option<Arc<str>>,
+    messages: u64,
     /// What the PLC gave this tick (copied in at the start of the tick).
     inputs: ChannelInputs,
     outputs: ChannelOutputs,
@@ -178,7 +189,7 @@ impl Channel {
             kinematics,
             program: None,
             decoder,
-            next_block: 0,
+            interp: Interpreter::new(),
             line: 0,
             pending: Vec::with_capacity(16),
             pending_at: 0,
@@ -210,6 +221,11 @@ impl Channel {
             m_next_id: 0,
             m_functions_acked: 0,
             tick: 0,
+            cycle_s,
+            spindle_speed: 0.0,
+            tool_number: 0,
+            message: None,
+            messages: 0,
             inputs: ChannelInputs::default(),
             outputs: ChannelOutputs::default(),
             config,
@@ -221,10 +237,26 @@ impl Channel {
         Ok(channel)
     }
 
+    /// `S..` last programmed (1/min).
+    pub fn spindle_speed(&self) -> f64 {
+        self.spindle_speed
+    }
+
+    /// `T..` last programmed.
+    pub fn tool_number(&self) -> u32 {
+        self.tool_number
+    }
+
+    /// The last `#MSG` text and how many messages the program gave.
+    pub fn message(&self) -> (Option<&str>, u64) {
+        (self.message.as_deref(), self.messages)
+    }
+
     /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
     pub fn start(&mut self, program: LoadedProgram) {
+        self.decoder.configure(&program.setup);
+        self.interp.start(&program.set);
         self.program = Some(program);
-        self.next_block = 0;
         self.pending.clear();
         self.pending_at = 0;
         self.state = RunState::Running;
@@ -526,62 +558,42 @@ impl Channel {
         }
     }
 
-    /// Decodes the next block into `pending` (control statements jump); `false` when the
-    /// program ended or failed.
+    /// Runs the interpreter one step (a block decoded into `pending`, or a `$` statement
+    /// followed); `false` when the program ended or failed.
     fn next_block_decoded(&mut self) -> bool {
         let Some(program) = self.program.as_ref() else {
             self.state = RunState::Finished;
             return false;
         };
-        let Some(block) = program.tree.blocks.get(self.next_block) else {
-            self.state = RunState::Finished;
-            return false;
-        };
-        self.line = block.line;
-        let index = self.next_block;
         let vars = ChannelVars {
             track_cs: self.tracker.zero_values(),
         };
-        if let Some(jump) = program.jumps.get(index).copied().flatten() {
-            let condition = match control_of(&program.tree, index) {
-                Some(Control::While(c) | Control::If(c)) => Some(c),
-                _ => None,
-            };
-            let holds = |c: Option<&crate::nc::ast::Expr>| -> Option<bool> {
-                c.map_or(Some(true), |c| evaluate(c, &vars).map(|v| v != 0.0))
-            };
-            self.next_block = match jump {
-                Jump::While { end } => match holds(condition) {
-                    Some(true) => index + 1,
-                    Some(false) => end + 1,
-                    None => {
-                        self.fail("condition cannot be evaluated".to_string());
-                        return false;
-                    }
-                },
-                Jump::EndWhile { start } => start,
-                Jump::If { next } => match holds(condition) {
-                    Some(true) => index + 1,
-                    Some(false) => next + 1,
-                    None => {
-                        self.fail("condition cannot be evaluated".to_string());
-                        return false;
-                    }
-                },
-                Jump::Else { end } => end + 1,
-            };
-            return true;
+        match self
+            .interp
+            .step(&program.set, &mut self.decoder, &vars, &mut self.pending)
+        {
+            Ok(Step::End) => {
+                self.state = RunState::Finished;
+                false
+            }
+            Ok(Step::Block { unit, block }) => {
+                if let Some(b) = program
+                    .set
+                    .units
+                    .get(unit as usize)
+                    .and_then(|u| u.tree.blocks.get(block as usize))
+                {
+                    self.line = b.line;
+                }
+                true
+            }
+            // The channel's values are a running machine's: nothing is undecided here.
+            Ok(Step::Control | Step::Undecided) => true,
+            Err(d) => {
+                self.fail(d.message);
+                false
+            }
         }
-        let diagnostics =
-            self.decoder
-                .decode_block(&program.tree, index, &program.src, &vars, &mut self.pending);
-        self.next_block += 1;
-        if let Some(d) = diagnostics.first() {
-            let message = d.message.clone();
-            self.fail(message);
-            return false;
-        }
-        true
     }
 
     fn wait_done(&mut self, wait: Wait, sync: &mut SyncBoard) -> bool {
@@ -612,6 +624,7 @@ impl Channel {
             Wait::Sync => sync.try_wait(self.wait_ids.as_slice()),
             Wait::Tracking => self.tracker.settled(),
             Wait::Independent => self.independent.iter().all(|(_, active)| !*active),
+            Wait::Dwell { until } => self.tick >= until,
         }
     }
 
@@ -642,7 +655,26 @@ impl Channel {
         sync: &mut SyncBoard,
     ) {
         match element {
-            Decoded::Motion(m) => self.start_path(&m.target, m.motion, m.feed),
+            Decoded::Motion(m) => {
+                let arc = m.arc.map(|arc| ArcSpec {
+                    arc,
+                    cycle_s: self.cycle_s,
+                    chordal_tolerance: self.config.interpolator.chordal_tolerance,
+                });
+                self.start_path(&m.target, m.motion, m.feed, arc)
+            }
+            Decoded::Dwell { seconds, .. } => {
+                let ticks = (seconds / self.cycle_s).round();
+                self.wait = Some(Wait::Dwell {
+                    until: self.tick.saturating_add(ticks as u64),
+                });
+            }
+            Decoded::Message { text, .. } => {
+                self.messages += 1;
+                self.message = Some(text);
+            }
+            Decoded::Spindle { speed, .. } => self.spindle_speed = speed,
+            Decoded::Tool { number, .. } => self.tool_number = number,
             Decoded::IndependentMove {
                 axis,
                 target,
@@ -654,7 +686,7 @@ impl Channel {
                 let limits = self.limits;
                 let velocity = match motion {
                     MotionMode::Rapid => limits.velocity,
-                    MotionMode::Linear => (feed / 60.0).min(limits.velocity),
+                    _ => (feed / 60.0).min(limits.velocity),
                 };
                 let (generator, active) = &mut self.independent[axis];
                 generator.hold(self.programmed[axis]);
@@ -858,7 +890,13 @@ impl Channel {
         }
     }
 
-    fn start_path(&mut self, target: &AxisValues, motion: MotionMode, feed: f64) {
+    fn start_path(
+        &mut self,
+        target: &AxisValues,
+        motion: MotionMode,
+        feed: f64,
+        arc: Option<ArcSpec>,
+    ) {
         let mut target = *target;
         // Axes moving independently are left to their own move.
         for (i, (_, active)) in self.independent.iter().enumerate() {
@@ -872,6 +910,7 @@ impl Channel {
             &target,
             motion,
             feed,
+            arc,
             &limits[..self.programmed.len()],
             &mut self.path_generator,
         ) {

@@ -227,6 +227,16 @@ pub enum BinOp {
     Gt,
     /// `>=`
     Ge,
+    /// `MOD` (remainder, with the sign of the dividend)
+    Mod,
+    /// `**` (power)
+    Pow,
+    /// `AND` (both non-zero)
+    And,
+    /// `OR` (either non-zero)
+    Or,
+    /// `XOR` (exactly one non-zero)
+    Xor,
 }
 
 impl BinOp {
@@ -243,16 +253,104 @@ impl BinOp {
             BinOp::Le => "<=",
             BinOp::Gt => ">",
             BinOp::Ge => ">=",
+            BinOp::Mod => "MOD",
+            BinOp::Pow => "**",
+            BinOp::And => "AND",
+            BinOp::Or => "OR",
+            BinOp::Xor => "XOR",
         }
     }
 
-    /// Binding strength (higher binds tighter).
+    /// Binding strength (higher binds tighter): OR and XOR, then AND, then the comparisons,
+    /// then sums, products and MOD, and the power tightest.
     pub fn precedence(self) -> u8 {
         match self {
-            BinOp::Mul | BinOp::Div => 3,
-            BinOp::Add | BinOp::Sub => 2,
-            _ => 1,
+            BinOp::Or | BinOp::Xor => 1,
+            BinOp::And => 2,
+            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Le | BinOp::Gt | BinOp::Ge => 3,
+            BinOp::Add | BinOp::Sub => 4,
+            BinOp::Mul | BinOp::Div | BinOp::Mod => 5,
+            BinOp::Pow => 6,
         }
+    }
+
+    /// Whether the operator is spelled as a word (printed with blanks around it).
+    pub fn is_word(self) -> bool {
+        matches!(self, BinOp::Mod | BinOp::And | BinOp::Or | BinOp::Xor)
+    }
+}
+
+/// The built-in functions of expressions, written `NAME[args]`. Angles are in degrees.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Func {
+    /// `ABS[x]`
+    Abs,
+    /// `SQR[x]`: x squared.
+    Sqr,
+    /// `SQRT[x]`
+    Sqrt,
+    /// `EXP[x]`
+    Exp,
+    /// `LN[x]`
+    Ln,
+    /// `SIN[deg]`
+    Sin,
+    /// `COS[deg]`
+    Cos,
+    /// `TAN[deg]`
+    Tan,
+    /// `ASIN[x]` in degrees.
+    Asin,
+    /// `ACOS[x]` in degrees.
+    Acos,
+    /// `ATAN[x]` in degrees.
+    Atan,
+    /// `ATAN2[y, x]` in degrees.
+    Atan2,
+    /// `INT[x]`: the whole part (toward zero).
+    Int,
+    /// `FRACT[x]`: the fractional part (x - INT[x]).
+    Fract,
+    /// `ROUND[x]`: the nearest whole number (halves away from zero).
+    Round,
+    /// `NOT[x]`: 1 when x is 0, else 0.
+    Not,
+}
+
+impl Func {
+    /// Every function with its spelling and number of arguments.
+    pub const ALL: [(Func, &'static str, usize); 16] = [
+        (Func::Abs, "ABS", 1),
+        (Func::Sqr, "SQR", 1),
+        (Func::Sqrt, "SQRT", 1),
+        (Func::Exp, "EXP", 1),
+        (Func::Ln, "LN", 1),
+        (Func::Sin, "SIN", 1),
+        (Func::Cos, "COS", 1),
+        (Func::Tan, "TAN", 1),
+        (Func::Asin, "ASIN", 1),
+        (Func::Acos, "ACOS", 1),
+        (Func::Atan, "ATAN", 1),
+        (Func::Atan2, "ATAN2", 2),
+        (Func::Int, "INT", 1),
+        (Func::Fract, "FRACT", 1),
+        (Func::Round, "ROUND", 1),
+        (Func::Not, "NOT", 1),
+    ];
+
+    /// The function spelled `name` (upper case).
+    pub fn named(name: &str) -> Option<Func> {
+        Self::ALL.iter().find(|f| f.1 == name).map(|f| f.0)
+    }
+
+    /// Source spelling.
+    pub fn name(self) -> &'static str {
+        Self::ALL.iter().find(|f| f.0 == self).map_or("?", |f| f.1)
+    }
+
+    /// Number of arguments.
+    pub fn arity(self) -> usize {
+        Self::ALL.iter().find(|f| f.0 == self).map_or(1, |f| f.2)
     }
 }
 
@@ -268,6 +366,10 @@ pub enum Expr {
     Neg(Box<Expr>),
     /// A binary operation on two operands (one box for both keeps [`Expr`] at 16 bytes).
     Bin(Box<(BinOp, Expr, Expr)>),
+    /// A P parameter `P12`.
+    Param(u32),
+    /// A function `SIN[...]`, `ATAN2[y, x]` with its arguments.
+    Call(Box<(Func, Vec<Expr>)>),
 }
 
 /// One entry of a bracketed list: `KEY`, `KEY=expr`, `KEY3` (number glued to the key, as in
@@ -354,6 +456,111 @@ pub enum Command {
         /// Axes whose preset is removed; empty = all.
         axes: Vec<AxisName>,
     },
+    /// `#MSG ["text"]`: a message to the operator.
+    Msg {
+        /// The text.
+        text: std::sync::Arc<str>,
+    },
+    /// `#TIME t`: dwell t seconds.
+    Time {
+        /// Seconds.
+        seconds: Expr,
+    },
+    /// `#VAR`: the declarations of `V.P.`/`V.L.` variables follow, up to `#ENDVAR`.
+    Var,
+    /// `#ENDVAR`.
+    EndVar,
+}
+
+/// A variable a program may assign: a P parameter or a self-defined `V.P.`/`V.L.` variable.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Target {
+    /// `P12`.
+    Param(u32),
+    /// `V.P.NAME` (the program's) or `V.L.NAME` (the subroutine level's).
+    Var(Name),
+}
+
+impl core::fmt::Display for Target {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Target::Param(n) => write!(f, "P{n}"),
+            Target::Var(name) => f.write_str(name),
+        }
+    }
+}
+
+/// The one-letter addresses that carry a value but are not axes. The tree keeps them as
+/// [`AxisWord`]s (the decoder tells them apart, and a channel may not name an axis so), which
+/// keeps every item at 32 bytes. The bare dwell time after `G04` is an axis word without a
+/// name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Addr {
+    /// `I`: circle centre along the plane's first axis.
+    I,
+    /// `J`: circle centre along the plane's second axis.
+    J,
+    /// `K`: circle centre along the plane's third axis (G18/G19).
+    K,
+    /// `R`: circle radius (negative: the arc is longer than half a turn).
+    R,
+    /// `S`: spindle speed (1/min).
+    S,
+    /// `T`: tool number.
+    T,
+    /// `D`: tool data record (length offset); `D0` removes the offset.
+    D,
+}
+
+impl Addr {
+    /// The address a word's name spells, if it is one of these.
+    pub fn of_name(name: &AxisName) -> Option<Addr> {
+        let [letter] = name.as_bytes() else {
+            return None;
+        };
+        Some(match letter {
+            b'I' => Addr::I,
+            b'J' => Addr::J,
+            b'K' => Addr::K,
+            b'R' => Addr::R,
+            b'S' => Addr::S,
+            b'T' => Addr::T,
+            b'D' => Addr::D,
+            _ => return None,
+        })
+    }
+
+    /// Source spelling.
+    pub fn letter(self) -> &'static str {
+        match self {
+            Addr::I => "I",
+            Addr::J => "J",
+            Addr::K => "K",
+            Addr::R => "R",
+            Addr::S => "S",
+            Addr::T => "T",
+            Addr::D => "D",
+        }
+    }
+}
+
+/// `P1 = expr`, `V.P.X = expr`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assign {
+    /// What is assigned.
+    pub target: Target,
+    /// The value.
+    pub value: Expr,
+}
+
+/// A subroutine call: `L name` (a file) or `LL name` (a `%L` subroutine of the same file).
+/// Data goes in and out through P parameters and `V.P.` variables, as the dialect has it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SubCall {
+    /// `LL`: a local subroutine.
+    pub local: bool,
+    /// The name as written (file names keep their case).
+    pub name: String,
 }
 
 /// An axis with its value: `X10`, `AB=90`, `X=V.G.TRACK_CS.X`.
@@ -418,7 +625,21 @@ pub enum Item {
         /// Where it stands.
         span: Span,
     },
-    /// `$WHILE expr`, `$ENDWHILE`, `$IF expr`, `$ELSE`, `$ENDIF`.
+    /// `P1 = expr`, `V.L.X = expr` (boxed: rare next to axis words).
+    Assign {
+        /// The assignment.
+        assign: Box<Assign>,
+        /// Where it stands.
+        span: Span,
+    },
+    /// `L name`, `LL name` (boxed).
+    Call {
+        /// The call.
+        call: Box<SubCall>,
+        /// Where it stands.
+        span: Span,
+    },
+    /// A `$` statement (boxed).
     Control {
         /// The control statement (boxed, so the common items stay small).
         control: Box<Control>,
@@ -436,10 +657,80 @@ pub enum Control {
     EndWhile,
     /// `$IF cond`.
     If(Expr),
+    /// `$ELSEIF cond`.
+    ElseIf(Expr),
     /// `$ELSE`.
     Else,
     /// `$ENDIF`.
     EndIf,
+    /// `$FOR P1 = start, end, step`: counts up (or down, with a negative step) while the
+    /// variable has not passed `end`.
+    For {
+        /// The counter.
+        var: Target,
+        /// First value.
+        start: Expr,
+        /// Last value.
+        end: Expr,
+        /// Step (not 0).
+        step: Expr,
+    },
+    /// `$ENDFOR`.
+    EndFor,
+    /// `$DO`: the body runs once, then again while the `$ENDDO` condition holds.
+    Do,
+    /// `$ENDDO cond`.
+    EndDo(Expr),
+    /// `$SWITCH expr`.
+    Switch(Expr),
+    /// `$CASE value`.
+    Case(Expr),
+    /// `$DEFAULT`.
+    Default,
+    /// `$ENDSWITCH`.
+    EndSwitch,
+    /// `$BREAK`: leaves the innermost loop or `$SWITCH`.
+    Break,
+    /// `$CONTINUE`: the innermost loop's next round.
+    Continue,
+    /// `$GOTO N100`: continues at the block numbered 100 of the same program level.
+    Goto(u32),
+}
+
+impl Control {
+    /// The statement's keyword, without `$`.
+    pub fn keyword(&self) -> &'static str {
+        match self {
+            Control::While(_) => "WHILE",
+            Control::EndWhile => "ENDWHILE",
+            Control::If(_) => "IF",
+            Control::ElseIf(_) => "ELSEIF",
+            Control::Else => "ELSE",
+            Control::EndIf => "ENDIF",
+            Control::For { .. } => "FOR",
+            Control::EndFor => "ENDFOR",
+            Control::Do => "DO",
+            Control::EndDo(_) => "ENDDO",
+            Control::Switch(_) => "SWITCH",
+            Control::Case(_) => "CASE",
+            Control::Default => "DEFAULT",
+            Control::EndSwitch => "ENDSWITCH",
+            Control::Break => "BREAK",
+            Control::Continue => "CONTINUE",
+            Control::Goto(_) => "GOTO",
+        }
+    }
+}
+
+/// A local subroutine `%L name` ... `M17` of a program file: a range of its blocks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LocalSub {
+    /// The name, upper case.
+    pub name: String,
+    /// Its blocks: this range of [`Program::blocks`].
+    pub blocks: core::ops::Range<u32>,
+    /// Where `%L name` stands.
+    pub span: Span,
 }
 
 /// One block (a logical line, continuation lines joined). Its items live in the program's
@@ -469,6 +760,10 @@ impl PartialEq for Block {
 pub struct Program {
     /// `%name`.
     pub name: Option<String>,
+    /// The local subroutines (`%L name`), which stand before the main program.
+    pub subs: Vec<LocalSub>,
+    /// The main program's first block (after the local subroutines).
+    pub main_start: u32,
     /// Blocks that hold anything (empty and comment-only lines are not kept).
     pub blocks: Vec<Block>,
     /// The items of all blocks, block after block.

@@ -1,10 +1,10 @@
-//! Control flow of a program: `$WHILE`/`$ENDWHILE` and `$IF`/`$ELSE`/`$ENDIF` matched once, by
-//! block, into the jump table a channel follows (`channel::program` keeps it; the decoder
-//! reports the statements that do not pair up).
+//! Control flow of a program: the `$` statements matched once, level by level (each local
+//! subroutine and the main program on their own: no statement and no `$GOTO` crosses a level),
+//! into the jump table the interpreter ([`super::interp`]) follows.
 
-use super::ast::{Control, Item, Program, Span};
+use super::ast::{Block, Control, Item, Program, Span};
 
-/// Where control goes from a `$` block (block indices).
+/// Where control goes from a `$` block (block indices of the program).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Jump {
     /// `$WHILE`: when the condition is false, continue after `end` (its `$ENDWHILE`).
@@ -17,35 +17,107 @@ pub enum Jump {
         /// The matching `$WHILE`.
         start: usize,
     },
-    /// `$IF`: when false, continue after `next` (its `$ELSE`) or at it (its `$ENDIF`).
+    /// `$IF` and `$ELSEIF` when tested: when false, on to `next` (the next `$ELSEIF`, which is
+    /// tested in turn, or the `$ELSE` or `$ENDIF`, after which the program continues). An
+    /// `$ELSEIF` reached at the end of a true branch continues after `end`.
     If {
-        /// The matching `$ELSE` or `$ENDIF`.
+        /// The next branch.
         next: usize,
+        /// The matching `$ENDIF`.
+        end: usize,
     },
-    /// `$ELSE` reached from the true branch: continue after `end` (its `$ENDIF`).
+    /// `$ELSE` reached from a true branch: continue after `end` (its `$ENDIF`).
     Else {
         /// The matching `$ENDIF`.
         end: usize,
     },
+    /// `$FOR`: the counter is set; when it has passed the end, continue after `end`.
+    For {
+        /// The matching `$ENDFOR`.
+        end: usize,
+    },
+    /// `$ENDFOR`: the counter steps and is tested at `start` (its `$FOR`).
+    EndFor {
+        /// The matching `$FOR`.
+        start: usize,
+    },
+    /// `$ENDDO`: while the condition holds, again after `start` (its `$DO`).
+    EndDo {
+        /// The matching `$DO`.
+        start: usize,
+    },
+    /// `$SWITCH`: the value is compared with the `$CASE`s from `first_case` on.
+    Switch {
+        /// The first `$CASE`, if any.
+        first_case: Option<usize>,
+        /// The `$DEFAULT`, if any.
+        default: Option<usize>,
+        /// The matching `$ENDSWITCH`.
+        end: usize,
+    },
+    /// `$CASE`: the next `$CASE` of the same `$SWITCH`. Reached from the branch before, it
+    /// falls through (write `$BREAK` to leave).
+    Case {
+        /// The next `$CASE`, if any.
+        next: Option<usize>,
+    },
+    /// `$BREAK`, `$CONTINUE`, `$GOTO`: continue at `to`.
+    Go {
+        /// The block to continue at.
+        to: usize,
+    },
 }
 
 /// A `$` statement that does not pair up.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Unmatched {
     /// The block it stands in.
     pub span: Span,
     /// What is missing.
-    pub message: &'static str,
+    pub message: String,
 }
 
 /// The control statement of a block (a `$` statement stands alone in its block; the decoder
 /// refuses a block where it does not).
 pub fn control_of(program: &Program, block: usize) -> Option<&Control> {
     let block = program.blocks.get(block)?;
+    control_in(program, block)
+}
+
+fn control_in<'a>(program: &'a Program, block: &Block) -> Option<&'a Control> {
     program.items_of(block).iter().find_map(|item| match item {
         Item::Control { control, .. } => Some(control.as_ref()),
         _ => None,
     })
+}
+
+/// The levels of a program: each local subroutine's blocks, then the main program's.
+pub fn levels(program: &Program) -> Vec<core::ops::Range<usize>> {
+    let mut levels: Vec<_> = program
+        .subs
+        .iter()
+        .map(|s| s.blocks.start as usize..s.blocks.end as usize)
+        .collect();
+    levels.push(program.main_start as usize..program.blocks.len());
+    levels
+}
+
+/// An open statement while matching.
+enum Open {
+    While(usize),
+    If {
+        start: usize,
+        /// The `$ELSEIF`s and `$ELSE` so far.
+        branches: Vec<usize>,
+        seen_else: bool,
+    },
+    For(usize),
+    Do(usize),
+    Switch {
+        start: usize,
+        cases: Vec<usize>,
+        default: Option<usize>,
+    },
 }
 
 /// Matches the `$` statements of `program`: per block its jump (`None` for other blocks), and
@@ -54,62 +126,239 @@ pub fn control_of(program: &Program, block: usize) -> Option<&Control> {
 pub fn match_control(program: &Program) -> (Vec<Option<Jump>>, Vec<Unmatched>) {
     let mut jumps = vec![None; program.blocks.len()];
     let mut unmatched = Vec::new();
-    // Open statements: (block, is_while, its $ELSE).
-    let mut open: Vec<(usize, bool, Option<usize>)> = Vec::new();
+    for level in levels(program) {
+        match_level(program, level, &mut jumps, &mut unmatched);
+    }
+    (jumps, unmatched)
+}
+
+fn match_level(
+    program: &Program,
+    level: core::ops::Range<usize>,
+    jumps: &mut [Option<Jump>],
+    unmatched: &mut Vec<Unmatched>,
+) {
+    let mut open: Vec<Open> = Vec::new();
     let span_of = |b: usize| program.blocks[b].span;
-    for b in 0..program.blocks.len() {
-        let Some(control) = control_of(program, b) else {
+    let mut report = |b: usize, message: &str| {
+        unmatched.push(Unmatched {
+            span: span_of(b),
+            message: message.to_string(),
+        })
+    };
+    let mut gotos: Vec<(usize, u32)> = Vec::new();
+    for b in level.clone() {
+        let Some(control) = control_in(program, &program.blocks[b]) else {
             continue;
         };
         match control {
-            Control::While(_) => open.push((b, true, None)),
-            Control::If(_) => open.push((b, false, None)),
-            Control::Else => match open.last_mut() {
-                Some((_, false, else_at @ None)) => *else_at = Some(b),
-                _ => unmatched.push(Unmatched {
-                    span: span_of(b),
-                    message: "$ELSE without a matching $IF",
-                }),
+            Control::While(_) => open.push(Open::While(b)),
+            Control::If(_) => open.push(Open::If {
+                start: b,
+                branches: Vec::new(),
+                seen_else: false,
+            }),
+            Control::For { .. } => open.push(Open::For(b)),
+            Control::Do => open.push(Open::Do(b)),
+            Control::Switch(_) => open.push(Open::Switch {
+                start: b,
+                cases: Vec::new(),
+                default: None,
+            }),
+            Control::ElseIf(_) | Control::Else => match open.last_mut() {
+                Some(Open::If {
+                    branches,
+                    seen_else,
+                    ..
+                }) if !*seen_else => {
+                    branches.push(b);
+                    *seen_else = matches!(control, Control::Else);
+                }
+                _ => report(
+                    b,
+                    &format!("${} without a matching $IF", control.keyword()),
+                ),
+            },
+            Control::Case(_) | Control::Default => match open.last_mut() {
+                Some(Open::Switch { cases, default, .. }) if default.is_none() => {
+                    if matches!(control, Control::Default) {
+                        *default = Some(b);
+                    } else {
+                        cases.push(b);
+                    }
+                }
+                _ => report(
+                    b,
+                    &format!("${} without a matching $SWITCH", control.keyword()),
+                ),
             },
             Control::EndWhile => match open.last() {
-                Some(&(start, true, _)) => {
+                Some(&Open::While(start)) => {
                     open.pop();
                     jumps[start] = Some(Jump::While { end: b });
                     jumps[b] = Some(Jump::EndWhile { start });
+                    resolve_exits(program, start, b, b, jumps);
                 }
-                _ => unmatched.push(Unmatched {
-                    span: span_of(b),
-                    message: "$ENDWHILE without a matching $WHILE",
-                }),
+                _ => report(b, "$ENDWHILE without a matching $WHILE"),
+            },
+            Control::EndFor => match open.last() {
+                Some(&Open::For(start)) => {
+                    open.pop();
+                    jumps[start] = Some(Jump::For { end: b });
+                    jumps[b] = Some(Jump::EndFor { start });
+                    resolve_exits(program, start, b, b, jumps);
+                }
+                _ => report(b, "$ENDFOR without a matching $FOR"),
+            },
+            Control::EndDo(_) => match open.last() {
+                Some(&Open::Do(start)) => {
+                    open.pop();
+                    jumps[b] = Some(Jump::EndDo { start });
+                    resolve_exits(program, start, b, b, jumps);
+                }
+                _ => report(b, "$ENDDO without a matching $DO"),
             },
             Control::EndIf => match open.last() {
-                Some(&(start, false, else_at)) => {
-                    open.pop();
-                    jumps[start] = Some(Jump::If {
-                        next: else_at.unwrap_or(b),
-                    });
-                    if let Some(e) = else_at {
-                        jumps[e] = Some(Jump::Else { end: b });
+                Some(Open::If { .. }) => {
+                    let Some(Open::If {
+                        start, branches, ..
+                    }) = open.pop()
+                    else {
+                        unreachable!("matched just above")
+                    };
+                    let mut at = start;
+                    for &branch in &branches {
+                        jumps[at] = Some(Jump::If {
+                            next: branch,
+                            end: b,
+                        });
+                        at = branch;
+                    }
+                    if matches!(control_of(program, at), Some(Control::Else)) {
+                        jumps[at] = Some(Jump::Else { end: b });
+                    } else {
+                        jumps[at] = Some(Jump::If { next: b, end: b });
                     }
                 }
-                _ => unmatched.push(Unmatched {
-                    span: span_of(b),
-                    message: "$ENDIF without a matching $IF",
-                }),
+                _ => report(b, "$ENDIF without a matching $IF"),
             },
+            Control::EndSwitch => match open.last() {
+                Some(Open::Switch { .. }) => {
+                    let Some(Open::Switch {
+                        start,
+                        cases,
+                        default,
+                    }) = open.pop()
+                    else {
+                        unreachable!("matched just above")
+                    };
+                    jumps[start] = Some(Jump::Switch {
+                        first_case: cases.first().copied(),
+                        default,
+                        end: b,
+                    });
+                    for (i, &case) in cases.iter().enumerate() {
+                        jumps[case] = Some(Jump::Case {
+                            next: cases.get(i + 1).copied(),
+                        });
+                    }
+                    // `$BREAK` inside the switch (not inside a loop nested in it) leaves it.
+                    resolve_breaks(program, start, b, jumps);
+                }
+                _ => report(b, "$ENDSWITCH without a matching $SWITCH"),
+            },
+            Control::Break | Control::Continue => {
+                if open.is_empty() {
+                    report(
+                        b,
+                        &format!("${} outside a loop or $SWITCH", control.keyword()),
+                    );
+                }
+            }
+            Control::Goto(n) => gotos.push((b, *n)),
         }
     }
-    for (b, is_while, _) in open {
-        unmatched.push(Unmatched {
-            span: span_of(b),
-            message: if is_while {
-                "$WHILE without $ENDWHILE"
-            } else {
-                "$IF without $ENDIF"
-            },
-        });
+    for o in open {
+        let (b, message) = match o {
+            Open::While(b) => (b, "$WHILE without $ENDWHILE"),
+            Open::If { start, .. } => (start, "$IF without $ENDIF"),
+            Open::For(b) => (b, "$FOR without $ENDFOR"),
+            Open::Do(b) => (b, "$DO without $ENDDO"),
+            Open::Switch { start, .. } => (start, "$SWITCH without $ENDSWITCH"),
+        };
+        report(b, message);
     }
-    (jumps, unmatched)
+    for (b, n) in gotos {
+        let targets: Vec<usize> = level
+            .clone()
+            .filter(|&t| program.blocks[t].number == Some(n))
+            .collect();
+        match targets.as_slice() {
+            [to] => jumps[b] = Some(Jump::Go { to: *to }),
+            [] => report(
+                b,
+                &format!("$GOTO N{n}: no block N{n} in this program level"),
+            ),
+            _ => report(
+                b,
+                &format!("$GOTO N{n}: block number N{n} stands more than once"),
+            ),
+        }
+    }
+    // A `$BREAK`/`$CONTINUE` left without a jump stands in a `$SWITCH` only (`$CONTINUE`
+    // there has no loop).
+    for b in level {
+        if jumps[b].is_none() {
+            if let Some(c @ (Control::Break | Control::Continue)) = control_of(program, b) {
+                report(
+                    b,
+                    &format!("${} outside a loop or $SWITCH", c.keyword()),
+                );
+            }
+        }
+    }
+}
+
+/// Gives the `$BREAK`s and `$CONTINUE`s directly inside the loop `start..=end` (not inside
+/// a loop or `$SWITCH` nested in it) their jumps: after the loop, and to `again`.
+fn resolve_exits(
+    program: &Program,
+    start: usize,
+    end: usize,
+    again: usize,
+    jumps: &mut [Option<Jump>],
+) {
+    let mut depth = 0usize;
+    for b in start + 1..end {
+        match control_of(program, b) {
+            Some(
+                Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_),
+            ) => depth += 1,
+            Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
+                depth = depth.saturating_sub(1)
+            }
+            Some(Control::Break) if depth == 0 => jumps[b] = Some(Jump::Go { to: end + 1 }),
+            Some(Control::Continue) if depth == 0 => jumps[b] = Some(Jump::Go { to: again }),
+            _ => {}
+        }
+    }
+}
+
+/// Gives the `$BREAK`s directly inside the `$SWITCH` `start..=end` their jump after it.
+fn resolve_breaks(program: &Program, start: usize, end: usize, jumps: &mut [Option<Jump>]) {
+    let mut depth = 0usize;
+    for b in start + 1..end {
+        match control_of(program, b) {
+            Some(
+                Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_),
+            ) => depth += 1,
+            Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
+                depth = depth.saturating_sub(1)
+            }
+            Some(Control::Break) if depth == 0 => jumps[b] = Some(Jump::Go { to: end + 1 }),
+            _ => {}
+        }
+    }
 }
 
 #[cfg(test)]
@@ -117,11 +366,15 @@ mod tests {
     use super::*;
     use crate::nc::parse;
 
+    fn leak(s: String) -> &'static str {
+        Box::leak(s.into_boxed_str())
+    }
+
     fn jumps(src: &str) -> (Vec<Option<Jump>>, Vec<&'static str>) {
         let (tree, diags) = parse(src);
         assert!(diags.is_empty(), "{diags:?}");
         let (j, u) = match_control(&tree);
-        (j, u.into_iter().map(|u| u.message).collect())
+        (j, u.into_iter().map(|u| leak(u.message)).collect())
     }
 
     #[test]
@@ -130,7 +383,7 @@ mod tests {
         let (j, u) = jumps(src);
         assert!(u.is_empty());
         assert_eq!(j[0], Some(Jump::While { end: 6 }));
-        assert_eq!(j[1], Some(Jump::If { next: 3 }));
+        assert_eq!(j[1], Some(Jump::If { next: 3, end: 5 }));
         assert_eq!(j[3], Some(Jump::Else { end: 5 }));
         assert_eq!(j[5], None, "$ENDIF falls through");
         assert_eq!(j[6], Some(Jump::EndWhile { start: 0 }));

@@ -14,15 +14,32 @@
 //! the channel decodes a block after the values it depends on are known.
 
 use super::ast::*;
-use super::control::{match_control, Jump};
 use super::Diagnostic;
 use std::sync::Arc;
 
 /// Values of NC variables at decode time.
 pub trait Vars {
-    /// The value of `name` (upper case, e.g. `V.G.TRACK_CS.X`); `None` if there is no such
-    /// variable.
+    /// The value of `name` (upper case, e.g. `V.G.TRACK_CS.X`, `V.P.DEPTH`); `None` if there
+    /// is no such variable.
     fn get(&self, name: &str) -> Option<f64>;
+
+    /// The value of P parameter `n`; `None` while it has not been assigned.
+    fn param(&self, n: u32) -> Option<f64> {
+        let _ = n;
+        None
+    }
+
+    /// Whether the program's own variables (P, `V.P.`, `V.L.`) are unknown here: a block
+    /// checked on its own, outside a run, has no values for them, and that is no error.
+    fn program_values_unknown(&self) -> bool {
+        false
+    }
+
+    /// Whether the `V.G.` values are those of a running machine (a check has placeholders:
+    /// where a condition on them leads is not known then).
+    fn machine_values_known(&self) -> bool {
+        true
+    }
 }
 
 /// The channel variables known to the decoder, all 0: what `cnc check` uses.
@@ -43,26 +60,46 @@ impl Vars for ZeroVars {
     fn get(&self, name: &str) -> Option<f64> {
         KNOWN_VARIABLES.contains(&name).then_some(0.0)
     }
+    fn machine_values_known(&self) -> bool {
+        false
+    }
 }
 
-/// G0 or G1.
+/// G0, G1, G2 or G3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MotionMode {
     /// G0: rapid.
     Rapid,
     /// G1: linear at the programmed feed.
     Linear,
+    /// G2: clockwise arc at the programmed feed.
+    ArcCw,
+    /// G3: counter-clockwise arc at the programmed feed.
+    ArcCcw,
 }
 
 impl MotionMode {
-    /// "G0" / "G1".
+    /// "G0" / "G1" / "G2" / "G3".
     pub fn name(self) -> &'static str {
         match self {
             MotionMode::Rapid => "G0",
             MotionMode::Linear => "G1",
+            MotionMode::ArcCw => "G2",
+            MotionMode::ArcCcw => "G3",
         }
     }
+
+    /// Whether the motion runs at the programmed feed (not G0).
+    pub fn at_feed(self) -> bool {
+        self != MotionMode::Rapid
+    }
 }
+
+/// Millimetres per inch (G70).
+pub const MM_PER_INCH: f64 = 25.4;
+
+/// Default tolerance for an arc's end point against its circle (mm).
+pub const DEFAULT_ARC_TOLERANCE: f64 = 0.001;
 
 /// Most axes one channel can have.
 pub const MAX_CHANNEL_AXES: usize = 16;
@@ -146,12 +183,14 @@ pub struct MotionBlock {
     pub line: u32,
     /// Block number.
     pub number: Option<u32>,
-    /// G0 or G1.
+    /// G0, G1, G2 or G3.
     pub motion: MotionMode,
     /// Feed (mm/min).
     pub feed: f64,
     /// Target per channel axis, in channel order.
     pub target: AxisValues,
+    /// For G2/G3: the circle (the block starts where the one before ended).
+    pub arc: Option<super::arc::ArcMove>,
 }
 
 /// Where a tracking channel takes its dynamic coordinate system from.
@@ -324,6 +363,34 @@ pub enum Decoded {
         /// The statement.
         op: ControlOp,
     },
+    /// `G04` / `#TIME`: wait, nothing moves.
+    Dwell {
+        /// Source line.
+        line: u32,
+        /// Seconds.
+        seconds: f64,
+    },
+    /// `#MSG ["text"]`.
+    Message {
+        /// Source line.
+        line: u32,
+        /// The text.
+        text: Arc<str>,
+    },
+    /// `S..`: the spindle speed (1/min) M03/M04 turn the spindle at.
+    Spindle {
+        /// Source line.
+        line: u32,
+        /// Speed.
+        speed: f64,
+    },
+    /// `T..`: the tool the PLC is to prepare.
+    Tool {
+        /// Source line.
+        line: u32,
+        /// Tool number.
+        number: u32,
+    },
 }
 
 /// A control statement. Where it goes is not here: the program's jump table
@@ -348,6 +415,27 @@ pub enum ControlOp {
     EndIf,
 }
 
+/// The machine data a decoder needs: zero offsets, tool table, arc tolerance.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecoderSetup {
+    /// G54..G59, per channel axis.
+    pub zero_offsets: [Vec<f64>; 6],
+    /// Tool length per D number.
+    pub tools: Vec<(u32, f64)>,
+    /// How far an arc's end point may lie off its circle (mm).
+    pub arc_tolerance: f64,
+}
+
+impl Default for DecoderSetup {
+    fn default() -> Self {
+        Self {
+            zero_offsets: Default::default(),
+            tools: Vec::new(),
+            arc_tolerance: DEFAULT_ARC_TOLERANCE,
+        }
+    }
+}
+
 /// The decoder's modal state.
 #[derive(Debug, Clone)]
 pub struct DecoderState {
@@ -360,6 +448,22 @@ pub struct DecoderState {
     absolute: bool,
     motion: MotionMode,
     feed: f64,
+    /// G17/G18/G19.
+    plane: super::arc::Plane,
+    /// G70 (inch) rather than G71.
+    inch: bool,
+    /// G161: I, J, K are absolute (else, G162, relative to the start point).
+    center_absolute: bool,
+    /// The selected zero offset: 0 for G53 (none), 1..=6 for G54..G59.
+    zero: usize,
+    /// The offsets of G54..G59 per axis (machine configuration).
+    zero_offsets: [AxisValues; 6],
+    /// Tool length per D number (machine configuration).
+    tools: Vec<(u32, f64)>,
+    /// The length of the selected D (0 for D0).
+    tool_length: f64,
+    /// The end point's tolerance against an arc's circle (mm).
+    arc_tolerance: f64,
     /// Per block: the values of its axis words by axis (valid where [`DecoderState::block`]
     /// marks the axis as programmed).
     words: [f64; MAX_CHANNEL_AXES],
@@ -390,46 +494,75 @@ impl Ctx<'_> {
     }
 
     fn eval_expr(&mut self, e: &Expr, span: Span) -> Option<f64> {
-        match e {
+        let value = match e {
             Expr::Num(v) => Some(*v),
-            Expr::Var(name) => match self.vars.get(name) {
+            Expr::Var(name) => self.variable(name, span),
+            Expr::Param(n) => match self.vars.param(*n) {
                 Some(v) => Some(v),
+                None if self.vars.program_values_unknown() => None,
                 None => {
-                    self.error(
-                        span,
-                        format!(
-                            "unknown variable \"{name}\" (known: {})",
-                            KNOWN_VARIABLES.join(", ")
-                        ),
-                    );
+                    self.error(span, format!("P{n} is read before it is assigned"));
                     None
                 }
             },
             Expr::Neg(inner) => self.eval(inner, span).map(|v| -v),
+            Expr::Call(call) => {
+                let (func, args) = &**call;
+                let a = self.eval(args.first()?, span)?;
+                let b = match args.get(1) {
+                    Some(b) => Some(self.eval(b, span)?),
+                    None => None,
+                };
+                match super::eval::function(*func, a, b) {
+                    Ok(v) => Some(v),
+                    Err(message) => {
+                        self.error(span, message);
+                        None
+                    }
+                }
+            }
             Expr::Bin(bin) => {
                 let (op, a, b) = &**bin;
                 let (a, b) = (self.eval(a, span)?, self.eval(b, span)?);
-                let bool_val = |c: bool| if c { 1.0 } else { 0.0 };
-                Some(match op {
-                    BinOp::Add => a + b,
-                    BinOp::Sub => a - b,
-                    BinOp::Mul => a * b,
-                    BinOp::Div => {
-                        if b == 0.0 {
-                            self.error(span, "division by zero");
-                            return None;
-                        }
-                        a / b
+                match super::eval::binary(*op, a, b) {
+                    Ok(v) => Some(v),
+                    Err(message) => {
+                        self.error(span, message);
+                        None
                     }
-                    BinOp::Eq => bool_val(a == b),
-                    BinOp::Ne => bool_val(a != b),
-                    BinOp::Lt => bool_val(a < b),
-                    BinOp::Le => bool_val(a <= b),
-                    BinOp::Gt => bool_val(a > b),
-                    BinOp::Ge => bool_val(a >= b),
-                })
+                }
             }
+        }?;
+        if !value.is_finite() {
+            self.error(
+                span,
+                format!("the value is not a finite number ({value}): it overflowed"),
+            );
+            return None;
         }
+        Some(value)
+    }
+
+    fn variable(&mut self, name: &Name, span: Span) -> Option<f64> {
+        if let Some(v) = self.vars.get(name) {
+            return Some(v);
+        }
+        let own = name.starts_with("V.P.") || name.starts_with("V.L.");
+        if own && self.vars.program_values_unknown() {
+            return None;
+        }
+        if own {
+            self.error(span, format!("variable \"{name}\" is read before it is assigned"));
+        } else {
+            self.error(
+                span,
+                format!(
+                    "unknown variable \"{name}\" (known: V.P.* and V.L.* once assigned, {})",
+                    KNOWN_VARIABLES.join(", ")
+                ),
+            );
+        }
+        None
     }
 
     /// A whole number within `range`, else an error naming `what`.
@@ -475,6 +608,14 @@ impl DecoderState {
             absolute: true,
             motion: MotionMode::Rapid,
             feed: 0.0,
+            plane: super::arc::Plane::Xy,
+            inch: false,
+            center_absolute: false,
+            zero: 0,
+            zero_offsets: [AxisValues::zeros(n); 6],
+            tools: Vec::new(),
+            tool_length: 0.0,
+            arc_tolerance: DEFAULT_ARC_TOLERANCE,
             words: [0.0; MAX_CHANNEL_AXES],
             tail: Vec::with_capacity(4),
         }
@@ -530,6 +671,59 @@ impl DecoderState {
         &self.axes
     }
 
+    /// Takes the machine data of `setup`.
+    pub fn configure(&mut self, setup: &DecoderSetup) {
+        self.set_zero_offsets(&setup.zero_offsets);
+        self.set_tools(&setup.tools);
+        self.set_arc_tolerance(setup.arc_tolerance);
+    }
+
+    /// Sets the offsets G54..G59 select (`table[0]` is G54), per channel axis.
+    pub fn set_zero_offsets(&mut self, table: &[Vec<f64>; 6]) {
+        for (slot, values) in self.zero_offsets.iter_mut().zip(table) {
+            for (i, v) in values.iter().enumerate().take(slot.len()) {
+                slot[i] = *v;
+            }
+        }
+    }
+
+    /// Sets the tool table: the length per D number.
+    pub fn set_tools(&mut self, tools: &[(u32, f64)]) {
+        self.tools = tools.to_vec();
+    }
+
+    /// Sets the tolerance of an arc's end point against its circle (mm).
+    pub fn set_arc_tolerance(&mut self, tolerance: f64) {
+        self.arc_tolerance = tolerance;
+    }
+
+    /// Takes a feed as programmed (for blocks checked out of their program's order).
+    pub fn assume_feed(&mut self) {
+        if self.feed <= 0.0 {
+            self.feed = 1.0;
+        }
+    }
+
+    /// The programmed feed (mm/min), what `V.G.FEEDRATE` reads.
+    pub fn feed(&self) -> f64 {
+        self.feed
+    }
+
+    /// The offset an absolute value of `axis` gets besides G92 and #PSET: the zero offset and,
+    /// on the plane's normal, the tool length.
+    fn offset(&self, axis: usize) -> f64 {
+        let zero = match self.zero {
+            0 => 0.0,
+            z => self.zero_offsets[z - 1].get(axis).copied().unwrap_or(0.0),
+        };
+        let tool = if axis == self.plane.axes()[2] {
+            self.tool_length
+        } else {
+            0.0
+        };
+        zero + tool
+    }
+
     fn unknown_axis(&self, ctx: &mut Ctx<'_>, span: Span, name: &str) {
         ctx.error(
             span,
@@ -550,21 +744,28 @@ impl DecoderState {
         self.axis_names.iter().position(|a| a.packed() == packed)
     }
 
-    /// Decodes one block; `out` receives its elements (a control statement as its kind and
-    /// condition; the jump table says where it goes).
+    /// Decodes one block; `out` receives its elements. Assignments, calls and `$` statements
+    /// are the interpreter's ([`super::interp`]): here they are only checked to stand where
+    /// they may.
     fn block(&mut self, block: &Block, items: &[Item], ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
         let line = block.line;
         let mut g92 = false;
+        let mut dwell_code = false;
         let mut motion_code: Option<(u32, Span)> = None;
         // One bit per axis with a word in this block (axis indices are below 16).
         let mut programmed: u32 = 0;
+        // I, J, K, R in this block (inch already converted), and the bare dwell time.
+        let mut center: [Option<f64>; 3] = [None; 3];
+        let mut radius: Option<f64> = None;
+        let mut dwell: Option<(f64, Span)> = None;
+        let mut feed: Option<f64> = None;
         // Elements that follow the block's motion, in a buffer kept across blocks.
         let mut tail = core::mem::take(&mut self.tail);
         tail.clear();
         for item in items {
             match item {
                 Item::G { code, span } => match code {
-                    0 | 1 => {
+                    0..=3 => {
                         if let Some((other, _)) = motion_code.filter(|(c, _)| c != code) {
                             ctx.error(
                                 *span,
@@ -573,24 +774,76 @@ impl DecoderState {
                         }
                         motion_code = Some((*code, *span));
                     }
+                    4 => dwell_code = true,
+                    // Blocks always end at exact stop here (no blending): G60 and G09 ask for
+                    // nothing more, G359/G360 switch what is always on.
+                    9 | 60 | 359 | 360 => {}
+                    17 => self.plane = super::arc::Plane::Xy,
+                    18 => self.plane = super::arc::Plane::Zx,
+                    19 => self.plane = super::arc::Plane::Yz,
+                    53..=59 => self.zero = (*code - 53) as usize,
+                    70 => self.inch = true,
+                    71 => self.inch = false,
                     90 => self.absolute = true,
                     91 => self.absolute = false,
                     92 => g92 = true,
+                    161 => self.center_absolute = true,
+                    162 => self.center_absolute = false,
                     other => ctx.error(
                         *span,
-                        format!("unknown G code G{other} (known: G0, G1, G90, G91, G92)"),
+                        format!("unknown G code G{other} (known: G0-G4, G9, G17-G19, G53-G60, G70, G71, G90-G92, G161, G162, G359, G360)"),
                     ),
                 },
                 Item::Feed { value, span } => {
                     if let Some(f) = ctx.eval(value, *span) {
                         if f > 0.0 && f.is_finite() {
-                            self.feed = f;
+                            feed = Some(f);
                         } else {
                             ctx.error(*span, format!("feed must be positive, found {f}"));
                         }
                     }
                 }
                 Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
+                Item::Axis(word) if word.name.as_bytes().is_empty() => {
+                    if let Some(v) = ctx.eval(&word.value, word.span) {
+                        dwell = Some((v, word.span));
+                    }
+                }
+                Item::Axis(word) if Addr::of_name(&word.name).is_some() => {
+                    let addr = Addr::of_name(&word.name).unwrap_or(Addr::R);
+                    let Some(v) = ctx.eval(&word.value, word.span) else {
+                        continue;
+                    };
+                    match addr {
+                        Addr::I => center[0] = Some(v),
+                        Addr::J => center[1] = Some(v),
+                        Addr::K => center[2] = Some(v),
+                        Addr::R => radius = Some(v),
+                        Addr::S if v >= 0.0 => tail.push(Decoded::Spindle { line, speed: v }),
+                        Addr::T | Addr::D if v.fract() == 0.0 && (0.0..=1e6).contains(&v) => {
+                            let n = v as u32;
+                            if addr == Addr::T {
+                                tail.push(Decoded::Tool { line, number: n });
+                            } else if n == 0 {
+                                self.tool_length = 0.0;
+                            } else if let Some(&(_, length)) =
+                                self.tools.iter().find(|(d, _)| *d == n)
+                            {
+                                self.tool_length = length;
+                            } else {
+                                ctx.error(
+                                    word.span,
+                                    format!("D{n}: no such tool data record in the tool table (D0 removes the offset)"),
+                                );
+                            }
+                        }
+                        Addr::S => ctx.error(word.span, format!("spindle speed S must not be negative, found {v}")),
+                        _ => ctx.error(
+                            word.span,
+                            format!("{} must be a whole number 0..=1000000, found {v}", addr.letter()),
+                        ),
+                    }
+                }
                 Item::Axis(word) => {
                     let Some(i) = self.axis_of(&word.name) else {
                         self.unknown_axis(ctx, word.span, word.name.as_str());
@@ -619,27 +872,48 @@ impl DecoderState {
                         tail.push(d);
                     }
                 }
-                Item::Control { control, span: _ } => {
-                    let op = match control.as_ref() {
-                        Control::While(c) => ControlOp::While { cond: c.clone() },
-                        Control::EndWhile => ControlOp::EndWhile,
-                        Control::If(c) => ControlOp::If { cond: c.clone() },
-                        Control::Else => ControlOp::Else,
-                        Control::EndIf => ControlOp::EndIf,
-                    };
+                Item::Assign { .. } => {}
+                Item::Call { span, .. } => {
+                    if items.iter().any(|i| !matches!(i, Item::Call { .. } | Item::Assign { .. })) {
+                        ctx.error(*span, "a subroutine call stands in its block with P assignments only");
+                    }
+                }
+                Item::Control { .. } => {
                     if items.len() > 1 {
                         ctx.error(block.span, "a $ statement stands alone in its block");
                     }
-                    tail.push(Decoded::Control { line, op });
                 }
             }
         }
+        // G70 anywhere in the block applies to its values: lengths of the main axes, the
+        // circle and the feed are inches then.
+        if self.inch {
+            for i in BitIndices(programmed & 0b111) {
+                self.words[i] *= MM_PER_INCH;
+            }
+            for c in center.iter_mut().chain(core::iter::once(&mut radius)).flatten() {
+                *c *= MM_PER_INCH;
+            }
+        }
+        if let Some(f) = feed {
+            self.feed = if self.inch { f * MM_PER_INCH } else { f };
+        }
+        if dwell_code || dwell.is_some() {
+            self.dwell(line, block, dwell, programmed, motion_code.is_some(), ctx, &mut tail);
+            programmed = 0;
+        }
         if let Some((code, _)) = motion_code {
-            self.motion = if code == 0 {
-                MotionMode::Rapid
-            } else {
-                MotionMode::Linear
+            self.motion = match code {
+                0 => MotionMode::Rapid,
+                1 => MotionMode::Linear,
+                2 => MotionMode::ArcCw,
+                _ => MotionMode::ArcCcw,
             };
+        }
+        let arc_words = center.iter().any(Option::is_some) || radius.is_some();
+        let is_arc = matches!(self.motion, MotionMode::ArcCw | MotionMode::ArcCcw);
+        if arc_words && !is_arc {
+            ctx.error(block.span, "I, J, K and R belong to G2/G3 blocks");
         }
         let axes = BitIndices(programmed);
         if g92 {
@@ -647,30 +921,128 @@ impl DecoderState {
                 let v = self.words[i];
                 self.g92[i] = if self.absolute { v } else { self.g92[i] + v };
             }
-        } else if programmed != 0 {
-            if self.motion == MotionMode::Linear && self.feed <= 0.0 {
-                ctx.error(block.span, "G1 motion without a feed: program F.. first");
+        } else if programmed != 0 || (is_arc && arc_words) {
+            if self.motion.at_feed() && self.feed <= 0.0 {
+                ctx.error(
+                    block.span,
+                    format!("{} motion without a feed: program F.. first", self.motion.name()),
+                );
             }
+            let start = self.position;
             for i in axes {
                 let v = self.words[i];
                 self.position[i] = if self.absolute {
-                    v + self.g92[i] + self.pset[i]
+                    v + self.g92[i] + self.pset[i] + self.offset(i)
                 } else {
                     self.position[i] + v
                 };
             }
+            let arc = if is_arc {
+                self.arc(&start, center, radius, block.span, ctx)
+            } else {
+                None
+            };
             out.push(Decoded::Motion(MotionBlock {
                 line,
                 number: block.number,
                 motion: self.motion,
                 feed: self.feed,
                 target: self.position,
+                arc,
             }));
         }
         if !tail.is_empty() {
             out.append(&mut tail);
         }
         self.tail = tail;
+    }
+
+    /// `G04 t`, `G04 X t` (the first main axis names the time): alone in its block.
+    #[allow(clippy::too_many_arguments)]
+    fn dwell(
+        &mut self,
+        line: u32,
+        block: &Block,
+        bare: Option<(f64, Span)>,
+        programmed: u32,
+        motion: bool,
+        ctx: &mut Ctx<'_>,
+        tail: &mut Vec<Decoded>,
+    ) {
+        let by_axis = (programmed == 1).then(|| self.words[0] / if self.inch { MM_PER_INCH } else { 1.0 });
+        let seconds = match (bare, by_axis) {
+            _ if motion || (programmed != 0 && programmed != 1) => {
+                ctx.error(block.span, "G04 stands alone in its block: its time is G04 <seconds> or G04 <first axis><seconds>");
+                return;
+            }
+            (Some(_), Some(_)) => {
+                ctx.error(block.span, "G04: give the time once (bare or with the first axis)");
+                return;
+            }
+            (Some((t, _)), None) | (None, Some(t)) => t,
+            (None, None) => {
+                ctx.error(block.span, "G04 needs a time in seconds: G04 2.5");
+                return;
+            }
+        };
+        if !(seconds >= 0.0) {
+            ctx.error(block.span, format!("dwell time must not be negative, found {seconds}"));
+            return;
+        }
+        tail.insert(0, Decoded::Dwell { line, seconds });
+    }
+
+    /// The circle of a G2/G3 block from `start` to the (already set) position.
+    fn arc(
+        &self,
+        start: &AxisValues,
+        center: [Option<f64>; 3],
+        radius: Option<f64>,
+        span: Span,
+        ctx: &mut Ctx<'_>,
+    ) -> Option<super::arc::ArcMove> {
+        use super::arc::{center_from_radius, check_on_circle, ArcError, ArcMove};
+        let [a, b, _] = self.plane.axes();
+        if self.position.len() <= a.max(b) {
+            ctx.error(span, "G2/G3 needs the channel's first three axes (the main axes)");
+            return None;
+        }
+        let p0 = [start[a], start[b]];
+        let p1 = [self.position[a], self.position[b]];
+        let ccw = self.motion == MotionMode::ArcCcw;
+        let given = [center[a], center[b]];
+        let has_center = given.iter().any(Option::is_some);
+        let result = match (has_center, radius) {
+            (true, Some(_)) => Err(ArcError::CenterAndRadius),
+            (false, None) => Err(ArcError::NoCenter),
+            (false, Some(r)) => center_from_radius(p0, p1, r, ccw),
+            (true, None) => {
+                let c = if self.center_absolute {
+                    [
+                        given[0].map_or(p0[0], |v| v + self.g92[a] + self.pset[a] + self.offset(a)),
+                        given[1].map_or(p0[1], |v| v + self.g92[b] + self.pset[b] + self.offset(b)),
+                    ]
+                } else {
+                    [p0[0] + given[0].unwrap_or(0.0), p0[1] + given[1].unwrap_or(0.0)]
+                };
+                check_on_circle(p0, p1, c, self.arc_tolerance).map(|()| c)
+            }
+        };
+        match result {
+            Ok(center) => {
+                let full_turn = (p1[0] - p0[0]).hypot(p1[1] - p0[1]) < 1e-9;
+                Some(ArcMove {
+                    plane: self.plane,
+                    center,
+                    ccw,
+                    full_turn,
+                })
+            }
+            Err(e) => {
+                ctx.error(span, e.to_string());
+                None
+            }
+        }
     }
 
     fn independent(
@@ -845,6 +1217,19 @@ impl DecoderState {
                 }
                 None
             }
+            Command::Msg { text } => Some(Decoded::Message {
+                line,
+                text: text.clone(),
+            }),
+            Command::Time { seconds } => {
+                let seconds = ctx.eval(seconds, span)?;
+                if seconds < 0.0 {
+                    ctx.error(span, format!("#TIME must not be negative, found {seconds}"));
+                    return None;
+                }
+                Some(Decoded::Dwell { line, seconds })
+            }
+            Command::Var | Command::EndVar => None,
             Command::Preset { axes } => {
                 if axes.is_empty() {
                     self.pset.iter_mut().for_each(|p| *p = 0.0);
@@ -1002,6 +1387,30 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
     (ok && (t.source.is_some() || !on)).then_some(t)
 }
 
+/// Evaluates `expr` at `span` of `src` with the variables of `vars`; the diagnostic says what
+/// went wrong (an unknown variable, a division by zero, a value that is not finite...).
+pub fn evaluate_at(expr: &Expr, span: Span, src: &str, vars: &dyn Vars) -> Result<f64, Diagnostic> {
+    let mut ctx = Ctx {
+        src,
+        vars,
+        diags: Vec::new(),
+    };
+    match ctx.eval(expr, span) {
+        Some(v) if ctx.diags.is_empty() => Ok(v),
+        _ => {
+            let mut d = ctx.diags.into_iter().next().unwrap_or_else(|| {
+                Diagnostic::new(span, "the value cannot be computed".to_string(), src)
+            });
+            if d.line == 0 {
+                let mut one = [d];
+                super::locate(&mut one, src);
+                [d] = one;
+            }
+            Err(d)
+        }
+    }
+}
+
 /// Evaluates `expr` with the variables of `vars` (a `$WHILE`/`$IF` condition at run time);
 /// `None` for an unknown variable or a division by zero.
 pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
@@ -1013,67 +1422,52 @@ pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
     ctx.eval(expr, Span::default())
 }
 
-/// Decodes a whole program for a channel with `axes`, reading variables from `vars`: the block
-/// stream `cnc check --blocks` prints. The stream is only meaningful when the diagnostics are
-/// empty: a program with errors must not be executed.
-pub fn decode_program(
-    program: &Program,
-    src: &str,
-    axes: &[String],
-    vars: &dyn Vars,
-) -> (Vec<Decoded>, Vec<Diagnostic>) {
-    let mut out = Vec::with_capacity(program.blocks.len());
-    let (_, diagnostics) = walk(program, src, axes, vars, Some(&mut out));
-    (out, diagnostics)
+/// How many steps a check runs a program before it stops following it (a loop waiting for a
+/// value only a running machine changes): generous for any program that ends by itself.
+pub fn check_budget(blocks: usize) -> u64 {
+    (blocks as u64).saturating_mul(100).saturating_add(1_000_000)
 }
 
-/// Checks a whole program for a channel with `axes` as it is loaded: every block's semantics
-/// (with `vars`), and its control flow, matched once into the jump table the channel follows.
-/// Nothing decoded is kept: the channel decodes each block when it reaches it, with the
-/// variables and positions of that moment. The table is only complete when the diagnostics
-/// are empty.
+/// Checks a whole program for a channel with `axes`, reading the channel's variables from
+/// `vars`: parses it with every subroutine file it calls (from `dir`, then `search`), runs it
+/// once (see [`super::interp::check_set`]) and checks every block the run did not reach. With
+/// `keep`, the decoded stream of the run is kept (what `cnc check --blocks` prints). The set is
+/// only runnable when the diagnostics are empty.
 pub fn check_program(
-    program: &Program,
-    src: &str,
+    name: &str,
+    src: String,
     axes: &[String],
-    vars: &dyn Vars,
-) -> (Vec<Option<Jump>>, Vec<Diagnostic>) {
-    walk(program, src, axes, vars, None)
-}
-
-/// One pass over `program`: each block decoded (into `keep`, or into one scratch buffer reused
-/// block by block), then the control statements matched.
-fn walk(
-    program: &Program,
-    src: &str,
-    axes: &[String],
+    setup: &DecoderSetup,
+    paths: (Option<&std::path::Path>, &super::interp::SearchPath),
     vars: &dyn Vars,
     keep: Option<&mut Vec<Decoded>>,
-) -> (Vec<Option<Jump>>, Vec<Diagnostic>) {
-    let mut ctx = Ctx {
-        src,
-        vars,
-        diags: Vec::new(),
-    };
+) -> (super::interp::ProgramSet, Vec<Diagnostic>) {
+    let (set, mut diags) = super::interp::ProgramSet::load(name, src, paths.0, paths.1);
     if let Err(message) = check_channel_axes(axes) {
-        ctx.error(Span::default(), message);
-        super::locate(&mut ctx.diags, src);
-        return (vec![None; program.blocks.len()], ctx.diags);
+        diags.push(Diagnostic {
+            line: 1,
+            col: 1,
+            message,
+            found: String::new(),
+            offset: 0,
+            file: None,
+        });
+        return (set, diags);
     }
-    let mut state = DecoderState::new(axes);
-    let mut scratch = Vec::new();
-    let keeping = keep.is_some();
-    let out = keep.unwrap_or(&mut scratch);
-    for block in &program.blocks {
-        state.block(block, program.items_of(block), &mut ctx, out);
-        if !keeping {
-            out.clear();
-        }
+    {
+        // Also with syntax errors: the tree holds what was understood, and its semantic
+        // errors are reported with them.
+        let mut decoder = DecoderState::new(axes);
+        decoder.configure(setup);
+        let budget = check_budget(set.block_count());
+        let (run, _) = super::interp::check_set(&set, &mut decoder, vars, budget, keep);
+        diags.extend(run);
+        diags.sort_by(|a, b| {
+            (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col))
+        });
+        // The first diagnostic per position: a call that could not be resolved at load is
+        // not reported again by the run.
+        diags.dedup_by(|b, a| (&a.file, a.line, a.col) == (&b.file, b.line, b.col));
     }
-    let (jumps, unmatched) = match_control(program);
-    for u in unmatched {
-        ctx.error(u.span, u.message);
-    }
-    super::locate(&mut ctx.diags, src);
-    (jumps, ctx.diags)
+    (set, diags)
 }

@@ -13,6 +13,9 @@ const N: u64 = b'N' as u64;
 const G: u64 = b'G' as u64;
 const M: u64 = b'M' as u64;
 const F: u64 = b'F' as u64;
+const P: u64 = b'P' as u64;
+const L: u64 = b'L' as u64;
+const LL: u64 = u16::from_le_bytes(*b"LL") as u64;
 
 impl Lexer<'_> {
     /// Reads the next block through the fast lane into `arena`; `None` (having consumed and
@@ -90,6 +93,8 @@ impl Lexer<'_> {
                     span,
                 },
                 N => return None,
+                // `P1`, `L`, `LL` start assignments and calls: the general path reads them.
+                P | L | LL => return None,
                 _ => Item::Axis(AxisWord {
                     name: AxisName::from_packed(name),
                     value: Expr::Num(value),

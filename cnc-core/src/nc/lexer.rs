@@ -241,6 +241,9 @@ impl<'a> Lexer<'a> {
             if out.is_empty() {
                 // Tokens never span a line break, so the first token's line is this one.
                 self.block_line = self.c.line;
+                if ch == '#' && self.depth == 0 && self.comment_section() {
+                    continue;
+                }
             }
             if self.fast_token(out) {
                 continue;
@@ -271,11 +274,19 @@ impl<'a> Lexer<'a> {
                     self.spaced = true;
                 }
                 '(' => {
+                    // Comments nest: `(a (b) c)` is one comment.
                     let mut closed = false;
+                    let mut open = 0u32;
                     while let Some(x) = self.c.bump() {
+                        if x == '(' {
+                            open += 1;
+                        }
                         if x == ')' {
-                            closed = true;
-                            break;
+                            open -= 1;
+                            if open == 0 {
+                                closed = true;
+                                break;
+                            }
                         }
                         if x == '\n' && self.depth == 0 {
                             break;
@@ -352,7 +363,19 @@ impl<'a> Lexer<'a> {
                     self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
                     let text = &self.c.src[from..self.c.pos];
                     match parse_decimal(text) {
-                        Ok(v) => push(out, Tok::Num(v), self.c.close(start), self.spaced),
+                        Ok(v) if v.is_finite() => {
+                            push(out, Tok::Num(v), self.c.close(start), self.spaced)
+                        }
+                        Ok(_) => {
+                            self.errors.push(LexError {
+                                span: self.c.close(start),
+                                message: format!(
+                                    "number with {} digits is too large (the largest is about 1.8e308)",
+                                    text.len()
+                                ),
+                            });
+                            push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
+                        }
                         Err(_) => {
                             self.errors.push(LexError {
                                 span: self.c.close(start),
@@ -410,6 +433,8 @@ impl<'a> Lexer<'a> {
                         ('!', Some('=')) => Some("!="),
                         ('<', Some('=')) => Some("<="),
                         ('>', Some('=')) => Some(">="),
+                        ('<', Some('>')) => Some("!="),
+                        ('*', Some('*')) => Some("**"),
                         _ => None,
                     };
                     let tok = if let Some(p) = punct {
@@ -429,6 +454,7 @@ impl<'a> Lexer<'a> {
                                 Tok::Punct("]")
                             }
                             ',' => Tok::Punct(","),
+                            ':' => Tok::Punct(":"),
                             '+' => Tok::Punct("+"),
                             '-' => Tok::Punct("-"),
                             '*' => Tok::Punct("*"),
@@ -457,6 +483,62 @@ impl<'a> Lexer<'a> {
         });
         true
     }
+}
+
+impl Lexer<'_> {
+    /// At a line starting `#COMMENT BEGIN`: skips through the line holding `#COMMENT END`
+    /// (reported when missing) and returns true.
+    fn comment_section(&mut self) -> bool {
+        let rest = &self.c.src[self.c.pos..];
+        if !starts_with_words(rest, &["#COMMENT", "BEGIN"]) {
+            return false;
+        }
+        let start = self.c.mark();
+        loop {
+            // Past the current line.
+            while self.c.peek().is_some_and(|x| x != '\n') {
+                self.c.bump();
+            }
+            if self.c.bump().is_none() {
+                self.errors.push(LexError {
+                    span: self.c.close(start),
+                    message: "#COMMENT BEGIN is not closed by #COMMENT END".into(),
+                });
+                return true;
+            }
+            let line = &self.c.src[self.c.pos..];
+            let trimmed = line.trim_start_matches([' ', '\t']);
+            if starts_with_words(trimmed, &["#COMMENT", "END"]) {
+                while self.c.peek().is_some_and(|x| x != '\n') {
+                    self.c.bump();
+                }
+                self.c.bump();
+                self.spaced = true;
+                return true;
+            }
+        }
+    }
+}
+
+/// Whether `text` starts with these words (case-insensitive), separated by blanks, the last
+/// one ending the text or followed by a blank, a comment or the line break.
+fn starts_with_words(mut text: &str, words: &[&str]) -> bool {
+    for (i, word) in words.iter().enumerate() {
+        if i > 0 {
+            let trimmed = text.trim_start_matches([' ', '\t']);
+            if trimmed.len() == text.len() {
+                return false;
+            }
+            text = trimmed;
+        }
+        match text.get(..word.len()) {
+            Some(head) if head.eq_ignore_ascii_case(word) => text = &text[word.len()..],
+            _ => return false,
+        }
+    }
+    text.chars()
+        .next()
+        .is_none_or(|c| matches!(c, ' ' | '\t' | '\r' | '\n' | ';' | '('))
 }
 
 /// A plain decimal `digits[.digits]` at the start of `bytes` with at most 15 digits: its exact

@@ -1,15 +1,18 @@
 //! The NC language front end: [`parse`] (source to tree, never giving up), [`print`] (tree to
 //! canonical source) and [`decode`] (tree to the typed block stream a channel executes).
 
+pub mod arc;
 pub mod ast;
 pub mod control;
 pub mod decode;
+pub mod eval;
+pub mod interp;
 mod fast_lane;
 pub mod lexer;
 pub mod parser;
 pub mod printer;
 
-pub use decode::{check_program, decode_program, Decoded, DecoderState, MotionBlock, MotionMode};
+pub use decode::{check_program, Decoded, DecoderState, MotionBlock, MotionMode};
 pub use parser::{parse, parse_general};
 pub use printer::print;
 
@@ -28,6 +31,9 @@ pub struct Diagnostic {
     pub found: String,
     /// Byte offset in the source, from which [`locate`] counts line and column.
     pub(crate) offset: u32,
+    /// The file it is in, when a program spans several (subroutine files); else the one the
+    /// caller names.
+    pub file: Option<std::sync::Arc<str>>,
 }
 
 impl Diagnostic {
@@ -44,11 +50,21 @@ impl Diagnostic {
             message,
             found,
             offset: span.start,
+            file: None,
         }
     }
 
-    /// `FILE:LINE:COL: error: MESSAGE ["found"]`.
+    /// A diagnostic at `span` of `src` with its line and column counted.
+    pub fn located(span: Span, message: String, src: &str) -> Self {
+        let mut one = [Self::new(span, message, src)];
+        locate(&mut one, src);
+        let [d] = one;
+        d
+    }
+
+    /// `FILE:LINE:COL: error: MESSAGE ["found"]` (its own file, if it has one).
     pub fn render(&self, file: &str) -> String {
+        let file = self.file.as_deref().unwrap_or(file);
         if self.found.is_empty() || self.message.contains(&format!("\"{}\"", self.found)) {
             format!("{file}:{}:{}: error: {}", self.line, self.col, self.message)
         } else {

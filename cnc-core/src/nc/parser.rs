@@ -6,6 +6,9 @@ use super::ast::*;
 use super::lexer::{Lexer, Name, Tok, Token};
 use super::Diagnostic;
 
+/// The highest P parameter number.
+pub const MAX_PARAM: u32 = 999;
+
 /// Parses `src`; the tree holds everything that could be understood.
 pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
     parse_with(src, true)
@@ -182,7 +185,14 @@ impl Parser<'_> {
             if let Tok::Percent(name) = self.peek().clone() {
                 let span = self.span();
                 self.bump();
-                if program.name.is_some() || !program.blocks.is_empty() {
+                if self.local_sub_header(&name, span, &mut program) {
+                    continue;
+                }
+                let after_subs = !program.subs.is_empty() && program.name.is_none();
+                if after_subs {
+                    self.close_sub(&mut program);
+                }
+                if (program.name.is_some() || !program.blocks.is_empty()) && !after_subs {
                     self.error(
                         span,
                         "a program header \"%name\" must come first and only once",
@@ -191,6 +201,7 @@ impl Parser<'_> {
                     self.error(span, "expected a program name after \"%\"");
                 } else {
                     program.name = Some(name);
+                    program.main_start = arena_index(program.blocks.len());
                 }
                 if !self.at_end_of_block() {
                     let s = self.span();
@@ -209,7 +220,74 @@ impl Parser<'_> {
                 program.items.truncate(items_before);
             }
         }
+        if program.name.is_none() && !program.subs.is_empty() {
+            self.close_sub(&mut program);
+        }
         program
+    }
+
+    /// `%L name` (the lexer gives `%L` and the name as separate tokens when blank-separated):
+    /// opens a local subroutine, closing the one before. Returns false for other headers.
+    fn local_sub_header(&mut self, header: &str, span: Span, program: &mut Program) -> bool {
+        if !header.eq_ignore_ascii_case("L") {
+            return false;
+        }
+        let name = match self.peek().clone() {
+            Tok::Word(_) | Tok::Var(_) => {
+                self.bump();
+                self.src[self.tokens[self.pos - 1].span.start as usize
+                    ..self.tokens[self.pos - 1].span.end as usize]
+                    .to_ascii_uppercase()
+            }
+            Tok::Addr(..) | Tok::Num(_) => {
+                self.bump();
+                self.src[self.tokens[self.pos - 1].span.start as usize
+                    ..self.tokens[self.pos - 1].span.end as usize]
+                    .to_ascii_uppercase()
+            }
+            _ => {
+                let found = self.describe();
+                self.error(span, format!("%L: expected a subroutine name, found {found}"));
+                return true;
+            }
+        };
+        if program.name.is_some() {
+            self.error(
+                span,
+                "local subroutines (%L) stand before the main program's \"%name\"",
+            );
+        }
+        if program.subs.iter().any(|s| s.name == name) {
+            self.error(span, format!("local subroutine \"{name}\" is defined twice"));
+        }
+        if !self.at_end_of_block() {
+            let (s, found) = (self.span(), self.describe());
+            self.error(s, format!("expected end of line after \"%L {name}\", found {found}"));
+        }
+        if !program.subs.is_empty() {
+            self.close_sub(program);
+        } else if !program.blocks.is_empty() {
+            self.error(span, "local subroutines (%L) stand at the start of the file");
+        }
+        let start = arena_index(program.blocks.len());
+        program.subs.push(LocalSub {
+            name,
+            blocks: start..start,
+            span,
+        });
+        program.main_start = start;
+        true
+    }
+
+    /// Ends the last local subroutine at the current block; the main program starts here.
+    fn close_sub(&mut self, program: &mut Program) {
+        let end = arena_index(program.blocks.len());
+        if let Some(sub) = program.subs.last_mut() {
+            if sub.blocks.end <= sub.blocks.start {
+                sub.blocks.end = end;
+            }
+        }
+        program.main_start = end;
     }
 
     fn block(&mut self, arena: &mut Vec<Item>) -> Option<Block> {
@@ -249,9 +327,27 @@ impl Parser<'_> {
                 }
             }
         }
+        // `N40:` marks a `$GOTO` target; the colon adds nothing else.
+        if block.number.is_some() && self.is_punct(":") {
+            self.bump();
+        }
         let first = arena.len();
         while !self.at_end_of_block() {
             let before = self.pos;
+            // `G04 2.5`: the dwell time may follow G04 bare.
+            let after_dwell =
+                arena.len() > first && matches!(arena.last(), Some(Item::G { code: 4, .. }));
+            if after_dwell && self.starts_expression() {
+                let span = self.span();
+                if let Some(value) = self.expr() {
+                    arena.push(Item::Axis(AxisWord {
+                        name: AxisName::default(),
+                        value,
+                        span: self.extend(span),
+                    }));
+                }
+                continue;
+            }
             if let Some(item) = self.item() {
                 arena.push(item);
             }
@@ -288,6 +384,10 @@ impl Parser<'_> {
                 })
             }
             Tok::Word(_) | Tok::Addr(..) => self.word_item(span),
+            Tok::Var(name) => {
+                self.bump();
+                self.assignment(Target::Var(name), span)
+            }
             Tok::Percent(_) => {
                 self.bump();
                 self.error(
@@ -369,10 +469,95 @@ impl Parser<'_> {
         axis
     }
 
-    /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`.
+    /// Whether the token at the cursor can start an expression.
+    fn starts_expression(&self) -> bool {
+        match self.peek() {
+            Tok::Num(_) | Tok::Var(_) | Tok::Punct("[" | "-" | "+") => true,
+            Tok::Addr(w, _) => *w == "P",
+            Tok::Word(w) => Func::named(w).is_some(),
+            _ => false,
+        }
+    }
+
+    /// `= expr` after an assignment's target (consumed already).
+    fn assignment(&mut self, target: Target, span: Span) -> Option<Item> {
+        if !self.is_punct("=") {
+            let found = self.describe();
+            self.error(
+                span,
+                format!("expected \"=\" after \"{target}\" (an assignment), found {found}"),
+            );
+            self.recover();
+            return None;
+        }
+        self.bump();
+        let value = self.expr()?;
+        Some(Item::Assign {
+            assign: Box::new(Assign { target, value }),
+            span: self.extend(span),
+        })
+    }
+
+    /// The P parameter number glued to `P` (`P12`), if the word is one.
+    fn param_number(word: Name, glued: Option<f64>) -> Option<u32> {
+        let n = glued?;
+        (word == "P" && n.fract() == 0.0 && (1.0..=f64::from(MAX_PARAM)).contains(&n))
+            .then_some(n as u32)
+    }
+
+    /// `L name [P1=..]`, `LL name [P1=..]`: the name runs to the next blank.
+    fn sub_call(&mut self, local: bool, span: Span) -> Option<Item> {
+        let keyword = if local { "LL" } else { "L" };
+        if self.at_end_of_block() || !self.token().spaced {
+            let found = self.describe();
+            self.error(
+                span,
+                format!("{keyword}: expected a blank and a subroutine name, found {found}"),
+            );
+            self.recover();
+            return None;
+        }
+        let first = self.pos;
+        self.bump();
+        while !self.at_end_of_block() && !self.token().spaced {
+            self.bump();
+        }
+        let (start, end) = (
+            self.tokens[first].span.start as usize,
+            self.tokens[self.pos - 1].span.end as usize,
+        );
+        let name = self.src.get(start..end).unwrap_or("").to_string();
+        if !self.at_end_of_block() {
+            let (at, found) = (self.span(), self.describe());
+            self.error(
+                at,
+                format!("{keyword} {name} takes no arguments (set P parameters before the call), found {found}"),
+            );
+            self.recover();
+        }
+        Some(Item::Call {
+            call: Box::new(SubCall { local, name }),
+            span: self.extend(span),
+        })
+    }
+
+    /// `G01`, `F500`, `M30`, `X10`, `AB=90`, `X1=5`, `X1[...]`, `I5`, `P1=2`, `L sub.nc`.
     fn word_item(&mut self, span: Span) -> Option<Item> {
         let (word, glued) = self.take_word()?;
-        // `NAME=expr` / `NAME3=expr`
+        if glued.is_none() && (word == "L" || word == "LL") {
+            return self.sub_call(word == "LL", span);
+        }
+        if word == "P" {
+            let Some(n) = Self::param_number(word, glued) else {
+                self.error(
+                    span,
+                    format!("a P parameter is P and a whole number 1..={MAX_PARAM}, such as P12"),
+                );
+                self.recover();
+                return None;
+            };
+            return self.assignment(Target::Param(n), span);
+        }
         if self.is_punct("=") {
             // A name that is too long is reported; its value is still read, so that the
             // rest of the block is checked as usual.
@@ -402,6 +587,24 @@ impl Parser<'_> {
                 }),
             });
         }
+        // `X[P1 * 2]`: an expression in brackets right after the address.
+        let independent = matches!(self.peek_at(1), Tok::Word(w) if w.starts_with("INDP"));
+        if self.is_punct("[") && !self.token().spaced && !independent {
+            let name = self.axis_name(word, glued, span)?;
+            let value = self.expr()?;
+            return Some(if name.as_str() == "F" {
+                Item::Feed {
+                    value,
+                    span: self.extend(span),
+                }
+            } else {
+                Item::Axis(AxisWord {
+                    name,
+                    value,
+                    span: self.extend(span),
+                })
+            });
+        }
         // `X1[INDP_ASYN ...]`
         if self.is_punct("[") {
             let name = self.axis_name(word, glued, span);
@@ -416,22 +619,7 @@ impl Parser<'_> {
             });
         }
         // `X-60`: a signed number glued to the address.
-        let glued = glued.or_else(|| {
-            let sign = match self.peek() {
-                Tok::Punct("-") => -1.0,
-                Tok::Punct("+") => 1.0,
-                _ => return None,
-            };
-            match self.peek_at(1) {
-                Tok::Num(n) if !self.token().spaced && !self.tokens[self.pos + 1].spaced => {
-                    let n = *n;
-                    self.bump();
-                    self.bump();
-                    Some(sign * n)
-                }
-                _ => None,
-            }
-        });
+        let glued = glued.or_else(|| self.signed_glued_number());
         let Some(value) = glued else {
             let found = self.describe();
             self.error(
@@ -472,6 +660,24 @@ impl Parser<'_> {
                 value: Expr::Num(value),
                 span: self.extend(span),
             })),
+        }
+    }
+
+    /// A sign and a number glued to the word before (`X-60`), consumed.
+    fn signed_glued_number(&mut self) -> Option<f64> {
+        let sign = match self.peek() {
+            Tok::Punct("-") => -1.0,
+            Tok::Punct("+") => 1.0,
+            _ => return None,
+        };
+        match self.peek_at(1) {
+            Tok::Num(n) if !self.token().spaced && !self.tokens[self.pos + 1].spaced => {
+                let n = *n;
+                self.bump();
+                self.bump();
+                Some(sign * n)
+            }
+            _ => None,
         }
     }
 
@@ -705,10 +911,56 @@ impl Parser<'_> {
                 }
                 Some(Command::Preset { axes })
             }
+            "MSG" => {
+                // `#MSG ["text"]`, also `#MSG SAVE ["text"]` (the message is shown either way).
+                if self.is_word("SAVE") {
+                    self.bump();
+                }
+                let text = if self.is_punct("[") {
+                    self.bump();
+                    let text = match self.peek().clone() {
+                        Tok::Str(t) => {
+                            self.bump();
+                            Some(t)
+                        }
+                        _ => None,
+                    };
+                    if self.is_punct("]") {
+                        self.bump();
+                    } else {
+                        self.error(span, "#MSG: expected \"]\" after the text");
+                    }
+                    text
+                } else {
+                    None
+                };
+                match text {
+                    Some(t) => Some(Command::Msg {
+                        text: std::sync::Arc::from(t),
+                    }),
+                    None => {
+                        self.error(span, "#MSG: expected [\"text\"]");
+                        None
+                    }
+                }
+            }
+            "TIME" => match self.expr() {
+                Some(seconds) => Some(Command::Time { seconds }),
+                None => None,
+            },
+            "VAR" => Some(Command::Var),
+            "ENDVAR" => Some(Command::EndVar),
+            "COMMENT" => {
+                self.error(
+                    span,
+                    "#COMMENT END without #COMMENT BEGIN (a comment section is #COMMENT BEGIN ... #COMMENT END, each on its own line)",
+                );
+                None
+            }
             other => {
                 self.error(
                     span,
-                    format!("unknown command \"#{other}\" (known: #TRACK CS, #CHANNEL INTERFACE, #CS, #TRAFO, #KIN ID, #SIGNAL SYN, #WAIT SYN, #WAIT INDP, #FLUSH, #PSET, #PRESET)"),
+                    format!("unknown command \"#{other}\" (known: #TRACK CS, #CHANNEL INTERFACE, #CS, #TRAFO, #KIN ID, #SIGNAL SYN, #WAIT SYN, #WAIT INDP, #FLUSH, #PSET, #PRESET, #MSG, #TIME, #VAR, #ENDVAR, #COMMENT BEGIN/END)"),
                 );
                 self.recover();
                 return None;
@@ -845,10 +1097,37 @@ impl Parser<'_> {
             "WHILE" => Control::While(self.expr()?),
             "ENDWHILE" => Control::EndWhile,
             "IF" => Control::If(self.expr()?),
+            "ELSEIF" => Control::ElseIf(self.expr()?),
             "ELSE" => Control::Else,
             "ENDIF" => Control::EndIf,
+            "FOR" => self.for_statement(span)?,
+            "ENDFOR" => Control::EndFor,
+            "DO" => Control::Do,
+            "ENDDO" => Control::EndDo(self.expr()?),
+            "SWITCH" => Control::Switch(self.expr()?),
+            "CASE" => Control::Case(self.expr()?),
+            "DEFAULT" => Control::Default,
+            "ENDSWITCH" => Control::EndSwitch,
+            "BREAK" => Control::Break,
+            "CONTINUE" => Control::Continue,
+            "GOTO" => {
+                let target = match *self.peek() {
+                    Tok::Addr(w, n) if w == "N" && n.fract() == 0.0 && n >= 0.0 => {
+                        self.bump();
+                        Some(n as u32)
+                    }
+                    _ => None,
+                };
+                let Some(target) = target else {
+                    let found = self.describe();
+                    self.error(span, format!("$GOTO: expected a block number such as N100, found {found}"));
+                    self.recover();
+                    return None;
+                };
+                Control::Goto(target)
+            }
             other => {
-                self.error(span, format!("unknown statement \"${other}\" (known: $WHILE, $ENDWHILE, $IF, $ELSE, $ENDIF)"));
+                self.error(span, format!("unknown statement \"${other}\" (known: $IF, $ELSEIF, $ELSE, $ENDIF, $WHILE, $ENDWHILE, $DO, $ENDDO, $FOR, $ENDFOR, $SWITCH, $CASE, $DEFAULT, $ENDSWITCH, $BREAK, $CONTINUE, $GOTO)"));
                 self.recover();
                 return None;
             }
@@ -862,6 +1141,48 @@ impl Parser<'_> {
             self.recover();
         }
         Some(control)
+    }
+
+    /// `$FOR P1 = start, end, step` (the step may be left out: 1).
+    fn for_statement(&mut self, span: Span) -> Option<Control> {
+        let var = match *self.peek() {
+            Tok::Addr(w, n) => Self::param_number(w, Some(n)).map(Target::Param),
+            Tok::Var(v) => Some(Target::Var(v)),
+            _ => None,
+        };
+        let Some(var) = var else {
+            let found = self.describe();
+            self.error(span, format!("$FOR: expected a counter such as P1, found {found}"));
+            self.recover();
+            return None;
+        };
+        self.bump();
+        if !self.is_punct("=") {
+            let found = self.describe();
+            self.error(span, format!("$FOR {var}: expected \"=\", found {found}"));
+            self.recover();
+            return None;
+        }
+        self.bump();
+        let start = self.expr()?;
+        let mut bounds = Vec::with_capacity(2);
+        while self.is_punct(",") && bounds.len() < 2 {
+            self.bump();
+            bounds.push(self.expr()?);
+        }
+        let mut bounds = bounds.into_iter();
+        let Some(end) = bounds.next() else {
+            self.error(span, format!("$FOR {var}: expected \"start, end[, step]\""));
+            self.recover();
+            return None;
+        };
+        let step = bounds.next().unwrap_or(Expr::Num(1.0));
+        Some(Control::For {
+            var,
+            start,
+            end,
+            step,
+        })
     }
 
     /// Expression with precedence climbing; unary minus binds tightest.
@@ -878,17 +1199,34 @@ impl Parser<'_> {
             .filter(|op| op.precedence() >= min_prec)
         {
             self.bump();
-            let rhs = self.binary(op.precedence() + 1)?;
+            // The power is right-associative: 2**3**2 is 2**9.
+            let next = if op == BinOp::Pow {
+                op.precedence()
+            } else {
+                op.precedence() + 1
+            };
+            let rhs = self.binary(next)?;
             lhs = Expr::Bin(Box::new((op, lhs, rhs)));
         }
         Some(lhs)
     }
 
     fn binary_operator(&self) -> Option<BinOp> {
-        let Tok::Punct(p) = self.peek() else {
-            return None;
+        let p = match self.peek() {
+            Tok::Punct(p) => *p,
+            Tok::Word(w) => {
+                return match w.as_str() {
+                    "MOD" => Some(BinOp::Mod),
+                    "AND" => Some(BinOp::And),
+                    "OR" => Some(BinOp::Or),
+                    "XOR" => Some(BinOp::Xor),
+                    _ => None,
+                }
+            }
+            _ => return None,
         };
-        Some(match *p {
+        Some(match p {
+            "**" => BinOp::Pow,
             "+" => BinOp::Add,
             "-" => BinOp::Sub,
             "*" => BinOp::Mul,
@@ -901,6 +1239,18 @@ impl Parser<'_> {
             ">=" => BinOp::Ge,
             _ => return None,
         })
+    }
+
+    /// The `]` that closes the bracket opened at `open`, consumed.
+    fn close_bracket(&mut self, open: Span) -> Option<()> {
+        if self.is_punct("]") {
+            self.bump();
+            Some(())
+        } else {
+            let found = self.describe();
+            self.error(open, format!("\"[\" is not closed by \"]\" (found {found})"));
+            None
+        }
     }
 
     fn unary(&mut self) -> Option<Expr> {
@@ -921,11 +1271,68 @@ impl Parser<'_> {
                 self.bump();
                 Some(Expr::Var(Box::new(v)))
             }
+            Tok::Addr(w, n) if w == "P" => {
+                let span = self.span();
+                self.bump();
+                match Self::param_number(w, Some(n)) {
+                    Some(n) => Some(Expr::Param(n)),
+                    None => {
+                        self.error(
+                            span,
+                            format!("a P parameter is P and a whole number 1..={MAX_PARAM}"),
+                        );
+                        None
+                    }
+                }
+            }
+            Tok::Punct("[") => {
+                let open = self.span();
+                self.bump();
+                let inner = self.expr()?;
+                self.close_bracket(open)?;
+                Some(inner)
+            }
+            Tok::Word(w) if Func::named(&w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")) => {
+                let span = self.span();
+                let func = Func::named(&w)?;
+                self.bump();
+                let open = self.span();
+                self.bump();
+                let mut args = vec![self.expr()?];
+                while self.is_punct(",") {
+                    self.bump();
+                    args.push(self.expr()?);
+                }
+                self.close_bracket(open)?;
+                if args.len() != func.arity() {
+                    self.error(
+                        span,
+                        format!(
+                            "{}[...] takes {} argument(s), found {}",
+                            func.name(),
+                            func.arity(),
+                            args.len()
+                        ),
+                    );
+                    return None;
+                }
+                Some(Expr::Call(Box::new((func, args))))
+            }
+            Tok::Word(w) => {
+                let (span, found) = (self.span(), self.describe());
+                let hint = if Func::named(&w).is_some() {
+                    format!("{w} is a function: write {w}[...]")
+                } else {
+                    format!("expected a number, a variable, P.., a function or \"[\", found {found}")
+                };
+                self.error(span, hint);
+                None
+            }
             _ => {
                 let (span, found) = (self.span(), self.describe());
                 self.error(
                     span,
-                    format!("expected a number, a variable or \"-\", found {found}"),
+                    format!("expected a number, a variable, P.., a function or \"[\", found {found}"),
                 );
                 None
             }

@@ -6,16 +6,32 @@ use std::fmt::Write as _;
 /// The program as canonical NC source.
 pub fn print(program: &Program) -> String {
     let mut out = String::new();
-    if let Some(name) = &program.name {
-        let _ = writeln!(out, "%{name}");
-    }
-    for block in &program.blocks {
+    for (b, block) in program.blocks.iter().enumerate() {
+        let b = arena_index(b);
+        if let Some(sub) = program.subs.iter().find(|s| s.blocks.start == b) {
+            let _ = writeln!(out, "%L {}", sub.name);
+        }
+        if b == program.main_start {
+            if let Some(name) = &program.name {
+                let _ = writeln!(out, "%{name}");
+            }
+        }
         let mut parts: Vec<String> = Vec::new();
         if let Some(n) = block.number {
             parts.push(format!("N{n}"));
         }
         parts.extend(program.items_of(block).iter().map(item));
         let _ = writeln!(out, "{}", parts.join(" "));
+    }
+    // Headers after the last block: empty subroutines, or a main program without blocks.
+    let end = arena_index(program.blocks.len());
+    for sub in program.subs.iter().filter(|s| s.blocks.start == end) {
+        let _ = writeln!(out, "%L {}", sub.name);
+    }
+    if program.main_start == end {
+        if let Some(name) = &program.name {
+            let _ = writeln!(out, "%{name}");
+        }
     }
     out
 }
@@ -24,9 +40,10 @@ fn num(v: f64) -> String {
     format!("{v}")
 }
 
-/// An expression; the printed form parses back to the same tree.
+/// An expression; the printed form parses back to the same tree (square brackets group
+/// where the precedence rules alone would read it otherwise).
 pub fn expr(e: &Expr) -> String {
-    fn go(e: &Expr, out: &mut String, parent_prec: u8, right: bool) {
+    fn go(e: &Expr, out: &mut String) {
         match e {
             Expr::Num(v) if *v < 0.0 => {
                 out.push('-');
@@ -34,24 +51,59 @@ pub fn expr(e: &Expr) -> String {
             }
             Expr::Num(v) => out.push_str(&num(*v)),
             Expr::Var(name) => out.push_str(name),
+            Expr::Param(n) => {
+                let _ = write!(out, "P{n}");
+            }
             Expr::Neg(inner) => {
                 out.push('-');
-                go(inner, out, 4, false);
+                operand(inner, out, u8::MAX);
+            }
+            Expr::Call(call) => {
+                let (func, args) = &**call;
+                let _ = write!(out, "{}[", func.name());
+                for (i, a) in args.iter().enumerate() {
+                    if i > 0 {
+                        out.push_str(", ");
+                    }
+                    go(a, out);
+                }
+                out.push(']');
             }
             Expr::Bin(bin) => {
                 let (op, a, b) = &**bin;
                 let prec = op.precedence();
-                // Without grouping brackets in the language, only trees the precedence rules
-                // produce are printable exactly; others print in that shape.
-                let _ = (parent_prec, right);
-                go(a, out, prec, false);
+                // Left-associative operators need brackets around a right operand of the same
+                // strength, the power (right-associative) around a left one.
+                let (left_min, right_min) = if *op == BinOp::Pow {
+                    (prec + 1, prec)
+                } else {
+                    (prec, prec + 1)
+                };
+                operand(a, out, left_min);
                 let _ = write!(out, " {} ", op.symbol());
-                go(b, out, prec + 1, true);
+                operand(b, out, right_min);
             }
         }
     }
+    /// `e` as an operand that binds at least `min` strongly; bracketed when it does not.
+    fn operand(e: &Expr, out: &mut String, min: u8) {
+        let weaker = match e {
+            Expr::Bin(bin) => bin.0.precedence() < min,
+            // `-2` read back is a negation: bracket it where a negation would not be read.
+            Expr::Num(v) if *v < 0.0 => min == u8::MAX,
+            Expr::Neg(_) => min == u8::MAX,
+            _ => false,
+        };
+        if weaker {
+            out.push('[');
+            go(e, out);
+            out.push(']');
+        } else {
+            go(e, out);
+        }
+    }
     let mut out = String::new();
-    go(e, &mut out, 0, false);
+    go(e, &mut out);
     out
 }
 
@@ -106,15 +158,34 @@ fn item(i: &Item) -> String {
             ..
         } if *v >= 0.0 => format!("F{}", num(*v)),
         Item::Feed { value, .. } => format!("F={}", expr(value)),
+        // The bare dwell time after G04.
+        Item::Axis(a) if a.name.as_bytes().is_empty() => expr(&a.value),
         Item::Axis(a) => axis_word(a, false),
         Item::IndependentAxis { axis, .. } => format!("{}{}", axis.name, list(&axis.options)),
         Item::Control { control, .. } => match control.as_ref() {
             Control::While(c) => format!("$WHILE {}", expr(c)),
             Control::EndWhile => "$ENDWHILE".into(),
-            Control::If(c) => format!("$IF {}", expr(c)),
-            Control::Else => "$ELSE".into(),
-            Control::EndIf => "$ENDIF".into(),
+            Control::If(c) | Control::ElseIf(c) | Control::EndDo(c) | Control::Switch(c) | Control::Case(c) => {
+                format!("${} {}", control.keyword(), expr(c))
+            }
+            Control::For {
+                var,
+                start,
+                end,
+                step,
+            } => format!(
+                "$FOR {var} = {}, {}, {}",
+                expr(start),
+                expr(end),
+                expr(step)
+            ),
+            Control::Goto(n) => format!("$GOTO N{n}"),
+            other => format!("${}", other.keyword()),
         },
+        Item::Assign { assign, .. } => format!("{} = {}", assign.target, expr(&assign.value)),
+        Item::Call { call, .. } => {
+            format!("{} {}", if call.local { "LL" } else { "L" }, call.name)
+        }
         Item::Command { command, .. } => match command.as_ref() {
             Command::TrackCs { on, options } if options.is_empty() => {
                 format!("#TRACK CS {}", on_off(*on))
@@ -164,6 +235,10 @@ fn item(i: &Item) -> String {
                 let names: Vec<&str> = axes.iter().map(|a| a.as_str()).collect();
                 format!("#PRESET {}", names.join(" "))
             }
+            Command::Msg { text } => format!("#MSG [\"{text}\"]"),
+            Command::Time { seconds } => format!("#TIME {}", expr(seconds)),
+            Command::Var => "#VAR".into(),
+            Command::EndVar => "#ENDVAR".into(),
         },
     }
 }

@@ -210,10 +210,20 @@ impl Scenario {
             programs.push(match &c.program {
                 Some(p) => {
                     let (path, src) = open(p)?;
-                    Some(LoadedProgram::load(
+                    let search = crate::nc::interp::SearchPath(
+                        c.nc
+                            .search_path
+                            .iter()
+                            .map(|d| path.parent().unwrap_or(Path::new(".")).join(d))
+                            .collect(),
+                    );
+                    Some(LoadedProgram::load_with(
                         &path.display().to_string(),
                         &src,
                         &c.axes,
+                        &c.nc.setup(),
+                        path.parent().map(std::path::Path::to_path_buf),
+                        &search,
                     )?)
                 }
                 None => None,

@@ -1,0 +1,804 @@
+//! The interpreter: runs a program block by block the way a channel consumes it, following
+//! `$` statements, assignments and subroutine calls, and hands each block with its variable
+//! values to the decoder.
+//!
+//! * A [`ProgramSet`] is the main program with every file its `L name` calls reach, loaded
+//!   and checked once: calls, jump tables and `%L` subroutines are resolved there, so running
+//!   allocates nothing (the call stack and the variable stores have fixed capacities).
+//! * P parameters and `V.P.` variables belong to the whole run: a subroutine sees and changes
+//!   its caller's (that is how the dialect hands data to subroutines). `V.L.` variables belong
+//!   to the level that assigns them and the subroutines it calls; they end with that level.
+//! * A condition holds when its value is at least 0.5 in size; `$CASE` values match within
+//!   0.001; a `$CASE` branch runs on into the next one unless it ends with `$BREAK`.
+
+use super::ast::{Block, Command, Control, Item, Name, Program, Span, Target};
+use super::control::{control_of, levels, match_control, Jump};
+use super::decode::{evaluate_at, Decoded, DecoderState, Vars};
+use super::eval::truth;
+use super::parser::MAX_PARAM;
+use super::{parse, Diagnostic};
+use std::path::{Path, PathBuf};
+
+/// Deepest nesting of subroutine calls (the main program is level 0).
+pub const MAX_CALL_DEPTH: usize = 16;
+/// Most `V.P.` variables, and most live `V.L.` variables, of a run.
+pub const MAX_VARIABLES: usize = 256;
+/// Values of `$CASE` and `$SWITCH` closer than this are equal.
+pub const CASE_TOLERANCE: f64 = 0.001;
+
+/// One program file with its tree, jump table and resolved calls.
+#[derive(Debug, Clone)]
+pub struct Unit {
+    /// The file name as given (for messages).
+    pub name: String,
+    /// The source text.
+    pub src: String,
+    /// The tree.
+    pub tree: Program,
+    /// Per block: its jump, if it is a `$` statement.
+    pub jumps: Vec<Option<Jump>>,
+    /// Per block with a call: where it goes (sorted by block).
+    calls: Vec<(u32, Callee)>,
+    /// A subroutine file (its diagnostics name it; the main file's are named by the caller).
+    called: bool,
+}
+
+/// Where a call goes: blocks `blocks` of unit `unit`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Callee {
+    unit: u32,
+    start: u32,
+    end: u32,
+}
+
+/// A main program and every subroutine file it reaches.
+#[derive(Debug, Clone)]
+pub struct ProgramSet {
+    /// `units[0]` is the main program.
+    pub units: Vec<Unit>,
+}
+
+/// Where `L name` looks for files: the calling file's folder, then these folders.
+#[derive(Debug, Clone, Default)]
+pub struct SearchPath(pub Vec<PathBuf>);
+
+impl ProgramSet {
+    /// Parses `src` (named `name`, in folder `dir` when it is a file) and every file its calls
+    /// reach, resolving calls and matching control flow. Every problem is a diagnostic with its
+    /// file; the set is only runnable when there are none.
+    pub fn load(
+        name: &str,
+        src: String,
+        dir: Option<&Path>,
+        search: &SearchPath,
+    ) -> (Self, Vec<Diagnostic>) {
+        let mut set = ProgramSet { units: Vec::new() };
+        let mut diags = Vec::new();
+        let mut dirs: Vec<Option<PathBuf>> = Vec::new();
+        let mut paths: Vec<Option<PathBuf>> = Vec::new();
+        set.add_unit(name.to_string(), src, &mut diags);
+        dirs.push(dir.map(Path::to_path_buf));
+        paths.push(None);
+        let mut u = 0;
+        while u < set.units.len() {
+            let calls: Vec<(u32, Span, bool, String)> = {
+                let unit = &set.units[u];
+                unit.tree
+                    .blocks
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(b, block)| {
+                        unit.tree.items_of(block).iter().filter_map(move |i| match i {
+                            Item::Call { call, span } => {
+                                Some((b as u32, *span, call.local, call.name.clone()))
+                            }
+                            _ => None,
+                        })
+                    })
+                    .collect()
+            };
+            for (b, span, local, callee) in calls {
+                let target = if local {
+                    set.local_callee(u, b, &callee, span, &mut diags)
+                } else {
+                    set.global_callee(u, &callee, span, &dirs, &mut paths, search, &mut diags)
+                        .map(|unit| {
+                            if dirs.len() < set.units.len() {
+                                let dir = paths[unit as usize]
+                                    .as_deref()
+                                    .and_then(Path::parent)
+                                    .map(Path::to_path_buf);
+                                dirs.push(dir);
+                            }
+                            let main = &set.units[unit as usize].tree;
+                            Callee {
+                                unit,
+                                start: main.main_start,
+                                end: main.blocks.len() as u32,
+                            }
+                        })
+                };
+                if let Some(t) = target {
+                    set.units[u].calls.push((b, t));
+                }
+            }
+            u += 1;
+        }
+        (set, diags)
+    }
+
+    fn add_unit(&mut self, name: String, src: String, diags: &mut Vec<Diagnostic>) -> u32 {
+        let (tree, parse_diags) = parse(&src);
+        let (jumps, unmatched) = match_control(&tree);
+        let mut unit_diags = parse_diags;
+        for u in unmatched {
+            unit_diags.push(Diagnostic::new(u.span, u.message, &src));
+        }
+        super::locate(&mut unit_diags, &src);
+        let called = !self.units.is_empty();
+        let file: std::sync::Arc<str> = name.as_str().into();
+        diags.extend(unit_diags.into_iter().map(|mut d| {
+            if called {
+                d.file = Some(file.clone());
+            }
+            d
+        }));
+        self.units.push(Unit {
+            name,
+            src,
+            tree,
+            jumps,
+            calls: Vec::new(),
+            called,
+        });
+        (self.units.len() - 1) as u32
+    }
+
+    fn error(&self, unit: usize, span: Span, message: String, diags: &mut Vec<Diagnostic>) {
+        let u = &self.units[unit];
+        let mut d = Diagnostic::new(span, message, &u.src);
+        let mut one = [d];
+        super::locate(&mut one, &u.src);
+        [d] = one;
+        diags.push(with_file(d, u));
+    }
+
+    fn local_callee(
+        &self,
+        unit: usize,
+        block: u32,
+        name: &str,
+        span: Span,
+        diags: &mut Vec<Diagnostic>,
+    ) -> Option<Callee> {
+        let tree = &self.units[unit].tree;
+        if block < tree.main_start {
+            self.error(
+                unit,
+                span,
+                format!("LL {name}: local subroutines are called from the main program only"),
+                diags,
+            );
+            return None;
+        }
+        let upper = name.to_ascii_uppercase();
+        match tree.subs.iter().find(|s| s.name == upper) {
+            Some(sub) => Some(Callee {
+                unit: unit as u32,
+                start: sub.blocks.start,
+                end: sub.blocks.end,
+            }),
+            None => {
+                let known: Vec<&str> = tree.subs.iter().map(|s| s.name.as_str()).collect();
+                self.error(
+                    unit,
+                    span,
+                    format!(
+                        "LL {name}: no local subroutine \"%L {upper}\" in this file (defined: {})",
+                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                    ),
+                    diags,
+                );
+                None
+            }
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn global_callee(
+        &mut self,
+        unit: usize,
+        name: &str,
+        span: Span,
+        dirs: &[Option<PathBuf>],
+        paths: &mut Vec<Option<PathBuf>>,
+        search: &SearchPath,
+        diags: &mut Vec<Diagnostic>,
+    ) -> Option<u32> {
+        let relative = Path::new(name);
+        let candidates: Vec<PathBuf> = if relative.is_absolute() {
+            vec![relative.to_path_buf()]
+        } else {
+            dirs[unit]
+                .iter()
+                .chain(search.0.iter())
+                .map(|d| d.join(relative))
+                .chain(dirs[unit].is_none().then(|| relative.to_path_buf()))
+                .collect()
+        };
+        let Some(found) = candidates.iter().find(|p| p.is_file()) else {
+            let looked: Vec<String> = candidates.iter().map(|p| p.display().to_string()).collect();
+            self.error(
+                unit,
+                span,
+                format!("L {name}: subroutine file not found (looked at: {})", looked.join(", ")),
+                diags,
+            );
+            return None;
+        };
+        let canonical = found.canonicalize().unwrap_or_else(|_| found.clone());
+        if let Some(u) = paths.iter().position(|p| p.as_ref() == Some(&canonical)) {
+            return Some(u as u32);
+        }
+        let src = match std::fs::read(found) {
+            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Err(e) => {
+                self.error(unit, span, format!("L {name}: cannot read {}: {e}", found.display()), diags);
+                return None;
+            }
+        };
+        let u = self.add_unit(found.display().to_string(), src, diags);
+        paths.push(Some(canonical));
+        Some(u)
+    }
+
+    /// The unit of the main program.
+    pub fn main(&self) -> &Unit {
+        &self.units[0]
+    }
+
+    /// Number of blocks of all units.
+    pub fn block_count(&self) -> usize {
+        self.units.iter().map(|u| u.tree.blocks.len()).sum()
+    }
+}
+
+/// One level of the call stack: the unit, the next block and the end of the level's blocks.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    unit: u32,
+    next: u32,
+    end: u32,
+    /// How many `V.L.` variables lived when the level was entered.
+    locals_mark: u32,
+}
+
+/// What one step did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Step {
+    /// A block was decoded into the output (possibly into nothing, like an assignment).
+    Block {
+        /// The unit and block index.
+        unit: u32,
+        /// Block index in the unit.
+        block: u32,
+    },
+    /// A `$` statement was followed.
+    Control,
+    /// The program has ended (M2/M30, or past its last block).
+    End,
+    /// A condition reads a machine value that only a running machine has (a check runs
+    /// without one): where the program goes from here is not known.
+    Undecided,
+}
+
+/// The run-time state of a program: call stack and variables. Fixed capacities, allocated
+/// once: stepping allocates nothing (except for a diagnostic).
+#[derive(Debug, Clone)]
+pub struct Interpreter {
+    frames: Vec<Frame>,
+    params: Vec<Option<f64>>,
+    globals: Vec<(Name, f64)>,
+    locals: Vec<(Name, f64)>,
+    /// Inside `#VAR` ... `#ENDVAR`: assignments declare (a `V.L.` shadows an outer one).
+    declaring: bool,
+    ended: bool,
+}
+
+impl Default for Interpreter {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// The variables a block sees: the program's own, then the channel's.
+struct Env<'a> {
+    interp: &'a Interpreter,
+    system: &'a dyn Vars,
+}
+
+impl Vars for Env<'_> {
+    fn get(&self, name: &str) -> Option<f64> {
+        if name.starts_with("V.P.") {
+            self.interp.globals.iter().find(|(n, _)| *n == name).map(|v| v.1)
+        } else if name.starts_with("V.L.") {
+            self.interp.locals.iter().rev().find(|(n, _)| *n == name).map(|v| v.1)
+        } else {
+            self.system.get(name)
+        }
+    }
+
+    fn param(&self, n: u32) -> Option<f64> {
+        self.interp.params.get(n as usize).copied().flatten()
+    }
+
+    fn machine_values_known(&self) -> bool {
+        self.system.machine_values_known()
+    }
+}
+
+impl Interpreter {
+    /// A fresh interpreter (no program started).
+    pub fn new() -> Self {
+        Self {
+            frames: Vec::with_capacity(MAX_CALL_DEPTH + 1),
+            params: vec![None; MAX_PARAM as usize + 1],
+            globals: Vec::with_capacity(MAX_VARIABLES),
+            locals: Vec::with_capacity(MAX_VARIABLES),
+            declaring: false,
+            ended: true,
+        }
+    }
+
+    /// Starts the main program of `set`: variables cleared, at its first main block.
+    pub fn start(&mut self, set: &ProgramSet) {
+        self.frames.clear();
+        self.params.iter_mut().for_each(|p| *p = None);
+        self.globals.clear();
+        self.locals.clear();
+        self.declaring = false;
+        let main = &set.main().tree;
+        self.frames.push(Frame {
+            unit: 0,
+            next: main.main_start,
+            end: main.blocks.len() as u32,
+            locals_mark: 0,
+        });
+        self.ended = false;
+    }
+
+    /// The call depth (0 in the main program).
+    pub fn depth(&self) -> usize {
+        self.frames.len().saturating_sub(1)
+    }
+
+    /// P parameter `n`, if assigned.
+    pub fn param(&self, n: u32) -> Option<f64> {
+        self.params.get(n as usize).copied().flatten()
+    }
+
+    /// The source line of the block about to run, and its unit.
+    pub fn position(&self) -> Option<(u32, u32)> {
+        self.frames.last().map(|f| (f.unit, f.next))
+    }
+
+    /// Runs one step: a `$` statement, or one block decoded into `out` with `decoder`.
+    pub fn step(
+        &mut self,
+        set: &ProgramSet,
+        decoder: &mut DecoderState,
+        system: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Result<Step, Diagnostic> {
+        let Some(&frame) = self.frames.last() else {
+            self.ended = true;
+            return Ok(Step::End);
+        };
+        if self.ended {
+            return Ok(Step::End);
+        }
+        if frame.next >= frame.end {
+            // Past the level's last block: a subroutine returns, the main program ends.
+            if self.frames.len() > 1 {
+                self.leave();
+                return Ok(Step::Control);
+            }
+            self.ended = true;
+            return Ok(Step::End);
+        }
+        let unit = &set.units[frame.unit as usize];
+        let b = frame.next as usize;
+        let block = &unit.tree.blocks[b];
+        if let Some(jump) = unit.jumps.get(b).copied().flatten() {
+            if !system.machine_values_known()
+                && control_of(&unit.tree, b).is_some_and(reads_machine_values)
+            {
+                return Ok(Step::Undecided);
+            }
+            let next = self.jump(unit, b, jump, block, system)?;
+            self.top().next = next as u32;
+            return Ok(Step::Control);
+        }
+        if control_of(&unit.tree, b).is_some() {
+            // `$ENDIF`, `$DO`, `$DEFAULT`, `$ENDSWITCH`: nothing to do.
+            self.top().next += 1;
+            return Ok(Step::Control);
+        }
+        self.top().next += 1;
+        let items = unit.tree.items_of(block);
+        let mut call = None;
+        let mut leave = false;
+        let mut end = false;
+        for item in items {
+            match item {
+                Item::Assign { assign, span } => {
+                    let value = evaluate_at(
+                        &assign.value,
+                        *span,
+                        &unit.src,
+                        &Env {
+                            interp: self,
+                            system,
+                        },
+                    )
+                    .map_err(|d| with_file(d, unit))?;
+                    self.assign(assign.target, value)
+                        .map_err(|m| with_file(Diagnostic::located(*span, m, &unit.src), unit))?;
+                }
+                Item::Call { span, .. } => call = Some(*span),
+                Item::M { code: 17 | 29, .. } => leave = true,
+                Item::M { code: 2 | 30, .. } => end = true,
+                Item::Command { command, .. } => match command.as_ref() {
+                    Command::Var => self.declaring = true,
+                    Command::EndVar => self.declaring = false,
+                    _ => {}
+                },
+                _ => {}
+            }
+        }
+        let diags = decoder.decode_block(
+            &unit.tree,
+            b,
+            &unit.src,
+            &Env {
+                interp: self,
+                system,
+            },
+            out,
+        );
+        if let Some(d) = diags.into_iter().next() {
+            return Err(with_file(d, unit));
+        }
+        if let Some(span) = call {
+            let callee = unit
+                .calls
+                .binary_search_by_key(&(b as u32), |c| c.0)
+                .ok()
+                .map(|i| unit.calls[i].1);
+            let Some(callee) = callee else {
+                return Err(with_file(
+                    Diagnostic::located(span, "the subroutine of this call was not loaded".into(), &unit.src),
+                    unit,
+                ));
+            };
+            if self.frames.len() > MAX_CALL_DEPTH {
+                return Err(with_file(
+                    Diagnostic::located(
+                        span,
+                        format!("subroutine calls nest deeper than {MAX_CALL_DEPTH} levels (a recursion without end?)"),
+                        &unit.src,
+                    ),
+                    unit,
+                ));
+            }
+            self.frames.push(Frame {
+                unit: callee.unit,
+                next: callee.start,
+                end: callee.end,
+                locals_mark: self.locals.len() as u32,
+            });
+        } else if end {
+            self.ended = true;
+        } else if leave && self.frames.len() > 1 {
+            self.leave();
+        }
+        Ok(Step::Block {
+            unit: frame.unit,
+            block: b as u32,
+        })
+    }
+
+    /// Goes on after the block that failed (a check reports every error, not the first).
+    pub fn skip_failed(&mut self, at: Option<(u32, u32)>) {
+        if self.position() == at {
+            if let Some(f) = self.frames.last_mut() {
+                f.next += 1;
+            }
+        }
+    }
+
+    fn top(&mut self) -> &mut Frame {
+        let last = self.frames.len() - 1;
+        &mut self.frames[last]
+    }
+
+    /// Returns from a subroutine: its `V.L.` variables end.
+    fn leave(&mut self) {
+        if let Some(f) = self.frames.pop() {
+            self.locals.truncate(f.locals_mark as usize);
+        }
+    }
+
+    fn assign(&mut self, target: Target, value: f64) -> Result<(), String> {
+        match target {
+            Target::Param(n) => {
+                let slot = self.params.get_mut(n as usize).ok_or_else(|| format!("P{n} does not exist"))?;
+                *slot = Some(value);
+            }
+            Target::Var(name) if name.starts_with("V.P.") => {
+                if let Some(v) = self.globals.iter_mut().find(|(n, _)| *n == name) {
+                    v.1 = value;
+                } else if self.globals.len() < MAX_VARIABLES {
+                    self.globals.push((name, value));
+                } else {
+                    return Err(format!("more than {MAX_VARIABLES} V.P. variables"));
+                }
+            }
+            Target::Var(name) if name.starts_with("V.L.") => {
+                let mark = self.frames.last().map_or(0, |f| f.locals_mark as usize);
+                let existing = if self.declaring {
+                    // A declaration makes the level its own variable (shadowing an outer one).
+                    self.locals[mark..].iter_mut().rev().find(|(n, _)| *n == name)
+                } else {
+                    self.locals.iter_mut().rev().find(|(n, _)| *n == name)
+                };
+                if let Some(v) = existing {
+                    v.1 = value;
+                } else if self.locals.len() < MAX_VARIABLES {
+                    self.locals.push((name, value));
+                } else {
+                    return Err(format!("more than {MAX_VARIABLES} live V.L. variables"));
+                }
+            }
+            Target::Var(name) => {
+                return Err(format!(
+                    "\"{name}\" cannot be assigned: a program assigns P parameters, V.P. and V.L. variables"
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// Follows the `$` statement of block `b`; returns the next block.
+    fn jump(
+        &mut self,
+        unit: &Unit,
+        b: usize,
+        jump: Jump,
+        block: &Block,
+        system: &dyn Vars,
+    ) -> Result<usize, Diagnostic> {
+        let control = control_of(&unit.tree, b);
+        let eval = |interp: &Interpreter, e: &super::ast::Expr| {
+            evaluate_at(e, block.span, &unit.src, &Env { interp, system }).map_err(|d| with_file(d, unit))
+        };
+        Ok(match (jump, control) {
+            (Jump::While { end }, Some(Control::While(c))) => {
+                if truth(eval(self, c)?) {
+                    b + 1
+                } else {
+                    end + 1
+                }
+            }
+            (Jump::EndWhile { start }, _) => start,
+            (Jump::If { end, .. }, Some(Control::ElseIf(_))) => end + 1,
+            (Jump::If { .. }, Some(Control::If(_))) => {
+                let mut at = b;
+                loop {
+                    let (Some(Jump::If { next, .. }), Some(Control::If(c) | Control::ElseIf(c))) =
+                        (unit.jumps[at], control_of(&unit.tree, at))
+                    else {
+                        break at + 1;
+                    };
+                    if truth(eval(self, c)?) {
+                        break at + 1;
+                    }
+                    match control_of(&unit.tree, next) {
+                        Some(Control::ElseIf(_)) => at = next,
+                        _ => break next + 1,
+                    }
+                }
+            }
+            (Jump::Else { end }, _) => end + 1,
+            (Jump::For { end }, Some(Control::For { var, start, end: last, step })) => {
+                let first = eval(self, start)?;
+                self.assign(*var, first)
+                    .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
+                let (last, step) = (eval(self, last)?, eval(self, step)?);
+                self.for_continues(unit, block, first, last, step)?
+                    .then_some(b + 1)
+                    .unwrap_or(end + 1)
+            }
+            (Jump::EndFor { start }, _) => {
+                let Some(Control::For { var, end: last, step, .. }) = control_of(&unit.tree, start) else {
+                    return Ok(b + 1);
+                };
+                let (last, step) = (eval(self, last)?, eval(self, step)?);
+                let env = Env { interp: self, system };
+                let current = match var {
+                    Target::Param(n) => env.param(*n),
+                    Target::Var(name) => env.get(name),
+                }
+                .unwrap_or(0.0);
+                let value = current + step;
+                self.assign(*var, value)
+                    .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
+                let for_block = &unit.tree.blocks[start];
+                self.for_continues(unit, for_block, value, last, step)?
+                    .then_some(start + 1)
+                    .unwrap_or(b + 1)
+            }
+            (Jump::EndDo { start }, Some(Control::EndDo(c))) => {
+                if truth(eval(self, c)?) {
+                    start + 1
+                } else {
+                    b + 1
+                }
+            }
+            (Jump::Switch { first_case, default, end }, Some(Control::Switch(v))) => {
+                let value = eval(self, v)?;
+                let mut case = first_case;
+                let mut target = default.map_or(end + 1, |d| d + 1);
+                while let Some(c) = case {
+                    if let Some(Control::Case(e)) = control_of(&unit.tree, c) {
+                        if (eval(self, e)? - value).abs() < CASE_TOLERANCE {
+                            target = c + 1;
+                            break;
+                        }
+                    }
+                    case = match unit.jumps[c] {
+                        Some(Jump::Case { next }) => next,
+                        _ => None,
+                    };
+                }
+                target
+            }
+            (Jump::Case { .. }, _) => b + 1,
+            (Jump::Go { to }, _) => to,
+            _ => b + 1,
+        })
+    }
+
+    fn for_continues(
+        &self,
+        unit: &Unit,
+        block: &Block,
+        value: f64,
+        last: f64,
+        step: f64,
+    ) -> Result<bool, Diagnostic> {
+        if step == 0.0 {
+            return Err(with_file(
+                Diagnostic::located(block.span, "$FOR with step 0 never ends".into(), &unit.src),
+                unit,
+            ));
+        }
+        Ok(if step > 0.0 { value <= last } else { value >= last })
+    }
+}
+
+/// Whether the condition of `control` reads a `V.G.` value.
+fn reads_machine_values(control: &Control) -> bool {
+    fn reads(e: &super::ast::Expr) -> bool {
+        use super::ast::Expr;
+        match e {
+            Expr::Var(name) => name.starts_with("V.G."),
+            Expr::Neg(inner) => reads(inner),
+            Expr::Bin(bin) => reads(&bin.1) || reads(&bin.2),
+            Expr::Call(call) => call.1.iter().any(reads),
+            Expr::Num(_) | Expr::Param(_) => false,
+        }
+    }
+    match control {
+        Control::While(c)
+        | Control::If(c)
+        | Control::ElseIf(c)
+        | Control::EndDo(c)
+        | Control::Switch(c)
+        | Control::Case(c) => reads(c),
+        Control::For {
+            start, end, step, ..
+        } => reads(start) || reads(end) || reads(step),
+        _ => false,
+    }
+}
+
+fn with_file(mut d: Diagnostic, unit: &Unit) -> Diagnostic {
+    if d.file.is_none() && unit.called {
+        d.file = Some(unit.name.as_str().into());
+    }
+    d
+}
+
+/// Checks a loaded set for a channel: runs it once from the start with `vars` (at most
+/// `budget` steps: a loop waiting for a value that only a running machine changes is no
+/// error), then checks every block the run did not reach on its own. With `keep`, the decoded
+/// stream of the run is kept there (`cnc check --blocks`). Returns the diagnostics, the first
+/// per block, sorted by file and position.
+pub fn check_set(
+    set: &ProgramSet,
+    decoder: &mut DecoderState,
+    vars: &dyn Vars,
+    budget: u64,
+    mut keep: Option<&mut Vec<Decoded>>,
+) -> (Vec<Diagnostic>, bool) {
+    let mut visited: Vec<Vec<bool>> = set.units.iter().map(|u| vec![false; u.tree.blocks.len()]).collect();
+    let mut diags = Vec::new();
+    let mut interp = Interpreter::new();
+    interp.start(set);
+    let mut scratch = Vec::with_capacity(8);
+    let mut steps = 0u64;
+    let mut finished = false;
+    let fresh = decoder.clone();
+    while steps < budget {
+        steps += 1;
+        if let Some((u, b)) = interp.position() {
+            if let Some(v) = visited[u as usize].get_mut(b as usize) {
+                *v = true;
+            }
+        }
+        let out = match keep.as_deref_mut() {
+            Some(k) => k,
+            None => {
+                scratch.clear();
+                &mut scratch
+            }
+        };
+        let at = interp.position();
+        match interp.step(set, decoder, vars, out) {
+            Ok(Step::End) => {
+                finished = true;
+                break;
+            }
+            Ok(Step::Undecided) => break,
+            Ok(_) => {}
+            Err(d) => {
+                diags.push(d);
+                interp.skip_failed(at);
+            }
+        }
+    }
+    // The blocks the run did not reach, each on its own: values of the program's own variables
+    // are unknown there, and so is the modal state (a feed is assumed).
+    let unknown = Unknown { system: vars };
+    for (u, unit) in set.units.iter().enumerate() {
+        let mut state = fresh.clone();
+        state.assume_feed();
+        for (b, seen) in visited[u].iter().enumerate() {
+            if *seen {
+                continue;
+            }
+            scratch.clear();
+            let found = state.decode_block(&unit.tree, b, &unit.src, &unknown, &mut scratch);
+            diags.extend(found.into_iter().map(|d| with_file(d, unit)));
+        }
+    }
+    let _ = levels;
+    diags.sort_by(|a, b| (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col)));
+    diags.dedup();
+    (diags, finished)
+}
+
+/// Variables of a block checked on its own: the channel's as given, the program's unknown.
+struct Unknown<'a> {
+    system: &'a dyn Vars,
+}
+
+impl Vars for Unknown<'_> {
+    fn get(&self, name: &str) -> Option<f64> {
+        self.system.get(name)
+    }
+    fn program_values_unknown(&self) -> bool {
+        true
+    }
+}

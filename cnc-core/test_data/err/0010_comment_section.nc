@@ -1,0 +1,4 @@
+N10 G0 X1
+#COMMENT END
+#COMMENT BEGIN
+N20 never closed

@@ -1,0 +1,64 @@
+%L CORNER
+; a local subroutine: one side of a square from P1 (side length), counted in P2
+N1 G91 G1 X=P1 F1000
+N2 G90
+N3 P2 = P2 + 1
+N4 M17
+%L SPIRAL
+N11 $FOR P3 = 1, 3, 1
+N12   G1 X=P3 * 10 Y=-P3 * 10
+N13 $ENDFOR
+N14 M29
+%MAIN
+#COMMENT BEGIN
+  Everything here is skipped: G999 (not a G code) #NOPE
+#COMMENT END
+N10 P1 = 5 P2 = 0
+N20 #MSG ["square of 4 sides"]
+N30 $WHILE P2 < 4
+N40   LL CORNER
+N50 $ENDWHILE
+N60 G04 0.5                            ; dwell 0.5 s
+N70 G04 X1.5
+N80 #TIME P1 / 10
+N90 $IF P2 == 3
+N100   X1
+N110 $ELSEIF P2 == 4 AND P1 > 4
+N120   X2 (the branch taken)
+N130 $ELSE
+N140   X3
+N150 $ENDIF
+N160 $SWITCH P2 MOD 3
+N170 $CASE 0
+N180   Y10
+N190   $BREAK
+N200 $CASE 1
+N210   Y20                             ; 4 MOD 3 = 1: runs on into the next case
+N220 $CASE 2
+N230   Z30
+N240   $BREAK
+N250 $DEFAULT
+N260   Z99
+N270 $ENDSWITCH
+N280 $DO
+N290   P1 = P1 - 2
+N300 $ENDDO P1 > 0
+N310 V.P.DEPTH = -2.5
+N320 V.L.STEP = 2 ** 3
+N330 Z=V.P.DEPTH X=V.L.STEP + ABS[-1] + INT[2.7] + FRACT[1.25] + ROUND[0.5]
+N340 LL SPIRAL
+N350 P4 = 0
+N360 $WHILE 1
+N370   P4 = P4 + 1
+N380   $IF P4 < 3
+N390     $CONTINUE
+N400   $ENDIF
+N410   $BREAK
+N420 $ENDWHILE
+N430 Y=P4
+N440 $GOTO N470
+N450 X999
+N460 Y999
+N470: S6000 M03 T24
+N480 M05
+N490 M30
