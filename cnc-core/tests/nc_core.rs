@@ -1,0 +1,309 @@
+//! The NC language core run for real: arcs interpolated in a channel within the chordal
+//! tolerance, subroutines called in loops returning to the right block, nested calls that do
+//! not grow memory, the depth limit, tools and zero offsets from the machine data, dwell, and
+//! the refusals that keep a bad program from running at all.
+
+use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
+use cnc_core::nc::decode::{DecoderSetup, DecoderState, ZeroVars};
+use cnc_core::nc::interp::{Interpreter, ProgramSet, SearchPath, Step};
+use cnc_core::nc::{Decoded, MotionMode};
+use hli::segment::heap_image;
+use hli::views::CncView;
+
+#[path = "../../tests/support/counting_alloc.rs"]
+mod counting_alloc;
+use counting_alloc::allocations;
+
+const CYCLE: f64 = 0.001;
+
+fn channel_with(config: ChannelConfig, src: &str) -> Controller {
+    let program = LoadedProgram::load_with(
+        &config.name,
+        src,
+        &config.axes,
+        &config.nc.setup(),
+        None,
+        &SearchPath::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let mut channel = Channel::new(0, config, CYCLE).unwrap();
+    channel.start(program);
+    Controller::new(vec![channel]).unwrap()
+}
+
+/// Ticks until the channel finishes (watchdog: `limit` ticks), calling `each` with the
+/// programmed position after every tick.
+fn run(ctl: &mut Controller, limit: u32, mut each: impl FnMut(&[f64])) -> u32 {
+    let memory = heap_image(1, 8);
+    let view = CncView::new(&memory);
+    for tick in 0..limit {
+        ctl.tick(&view);
+        let c = &ctl.channels()[0];
+        assert_ne!(c.state(), RunState::Error, "{:?}", c.error());
+        each(c.programmed());
+        if c.state() == RunState::Finished && !c.is_moving() {
+            return tick;
+        }
+    }
+    panic!("watchdog: not finished after {limit} ticks");
+}
+
+#[test]
+fn an_arc_stays_on_its_circle_within_the_chordal_tolerance_at_every_tick() {
+    // Radius 10 about (0, 0): a half turn, a full circle clockwise, a helix down 4 mm.
+    let src = "G0 X10 Y0 Z0\nG3 X-10 Y0 I-10 J0 F12000\nG2 I10\nG3 X10 Y0 Z-4 R10\nM30\n";
+    let mut config = ChannelConfig::new("mill", &["X", "Y", "Z", "A", "B", "C"]);
+    config.limits.velocity = 500.0;
+    let tolerance = config.interpolator.chordal_tolerance;
+    let mut ctl = channel_with(config, src);
+    let mut points: Vec<[f64; 3]> = Vec::new();
+    run(&mut ctl, 200_000, |p| points.push([p[0], p[1], p[2]]));
+    let on_arc: Vec<&[f64; 3]> = points
+        .iter()
+        .skip_while(|p| (p[0] - 10.0).abs() > 1e-12 || p[1] != 0.0)
+        .collect();
+    assert!(on_arc.len() > 1000, "{} arc ticks", on_arc.len());
+    let mut worst_radius = 0.0f64;
+    let mut worst_sagitta = 0.0f64;
+    for pair in on_arc.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let r = a[0].hypot(a[1]);
+        worst_radius = worst_radius.max((r - 10.0).abs());
+        // The chord between two set-points strays from the circle by r - |midpoint|.
+        let mid = ((a[0] + b[0]) / 2.0).hypot((a[1] + b[1]) / 2.0);
+        worst_sagitta = worst_sagitta.max(10.0 - mid);
+    }
+    assert!(worst_radius < 1e-9, "off the circle by {worst_radius}");
+    assert!(
+        worst_sagitta <= tolerance && worst_sagitta > tolerance / 10.0,
+        "chordal error {worst_sagitta} against {tolerance}"
+    );
+    // Exactly at the end point, the helix down by 4 mm.
+    assert_eq!(*points.last().unwrap(), [10.0, 0.0, -4.0]);
+    // The helix's Z moved in proportion to the angle: at the half-way tick of the last block,
+    // Z is near -2 where the tool is at (0, -10) (G3 from (-10, 0) to (10, 0) passes y = -10).
+    let bottom = on_arc
+        .iter()
+        .filter(|p| p[2] < 0.0)
+        .min_by(|a, b| a[1].total_cmp(&b[1]))
+        .unwrap();
+    assert!((bottom[2] + 2.0).abs() < 0.05, "{bottom:?}");
+}
+
+#[test]
+fn a_subroutine_called_in_a_loop_returns_to_the_block_after_its_call() {
+    let src = "%L STEP\nN1 G91 G1 X1 F6000\nN2 G90\nN3 M17\n%MAIN\nN10 P1 = 0\n\
+               N20 $WHILE P1 < 3\nN30 LL STEP\nN40 Y=P1\nN50 P1 = P1 + 1\nN60 $ENDWHILE\nN70 Z5\nM30\n";
+    let axes: Vec<String> = ["X", "Y", "Z"].map(String::from).to_vec();
+    let (set, diags) = ProgramSet::load("loop.nc", src.to_string(), None, &SearchPath::default());
+    assert!(diags.is_empty(), "{diags:?}");
+    let mut interp = Interpreter::new();
+    let mut decoder = DecoderState::new(&axes);
+    interp.start(&set);
+    let mut out = Vec::new();
+    let mut lines = Vec::new();
+    loop {
+        out.clear();
+        match interp.step(&set, &mut decoder, &ZeroVars, &mut out).unwrap() {
+            Step::End => break,
+            _ => lines.extend(out.iter().filter_map(|d| match d {
+                Decoded::Motion(m) => Some((m.line, m.target[0], m.target[1], m.target[2])),
+                _ => None,
+            })),
+        }
+    }
+    // N1 (line 2) then N40 (line 9), three times, then N70 (line 12).
+    assert_eq!(
+        lines,
+        vec![
+            (2, 1.0, 0.0, 0.0),
+            (9, 1.0, 0.0, 0.0),
+            (2, 2.0, 0.0, 0.0),
+            (9, 2.0, 1.0, 0.0),
+            (2, 3.0, 1.0, 0.0),
+            (9, 3.0, 2.0, 0.0),
+            (12, 3.0, 2.0, 5.0),
+        ]
+    );
+}
+
+fn temp_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("nc_core_{name}_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn ten_thousand_nested_call_cycles_run_without_allocating() {
+    // Main -> a.nc -> sub/b.nc (found through the search path), 10,000 times.
+    let dir = temp_dir("nested");
+    std::fs::create_dir_all(dir.join("lib")).unwrap();
+    std::fs::write(dir.join("a.nc"), "V.L.DEPTH = 1\nL b.nc\nP2 = P2 + V.L.DEPTH\nM17\n").unwrap();
+    // b.nc declares its own V.L.DEPTH (shadowing a.nc's until it returns).
+    std::fs::write(
+        dir.join("lib/b.nc"),
+        "#VAR\nV.L.DEPTH = 2\n#ENDVAR\nP3 = P3 + V.L.DEPTH\nM17\n",
+    )
+    .unwrap();
+    let src = "P1 = 0 P2 = 0 P3 = 0\n$WHILE P1 < 10000\nL a.nc\nP1 = P1 + 1\n$ENDWHILE\nG1 X=P2 Y=P3 F100\nM30\n";
+    let search = SearchPath(vec![dir.join("lib")]);
+    let (set, diags) = ProgramSet::load("main.nc", src.to_string(), Some(&dir), &search);
+    assert!(diags.is_empty(), "{diags:?}");
+    assert_eq!(set.units.len(), 3);
+    let axes: Vec<String> = ["X", "Y"].map(String::from).to_vec();
+    let mut interp = Interpreter::new();
+    let mut decoder = DecoderState::new(&axes);
+    interp.start(&set);
+    let mut out = Vec::with_capacity(16);
+    let mut deepest = 0;
+    let before = allocations();
+    let mut steps = 0u64;
+    loop {
+        out.clear();
+        steps += 1;
+        let step = interp.step(&set, &mut decoder, &ZeroVars, &mut out).unwrap();
+        deepest = deepest.max(interp.depth());
+        if step == Step::End {
+            break;
+        }
+    }
+    let made = allocations() - before;
+    assert_eq!(made, 0, "{made} allocations in {steps} steps");
+    assert_eq!(deepest, 2);
+    // V.L.DEPTH of a.nc is its own again after b.nc returned: P2 adds 1 each time.
+    assert_eq!(interp.param(2), Some(10_000.0));
+    assert_eq!(interp.param(3), Some(20_000.0));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn recursion_past_the_depth_limit_refuses_the_program() {
+    let dir = temp_dir("recursion");
+    std::fs::write(dir.join("again.nc"), "P1 = P1 + 1\nL again.nc\nM17\n").unwrap();
+    let main = dir.join("main.nc");
+    std::fs::write(&main, "P1 = 0\nL again.nc\nM30\n").unwrap();
+    let axes: Vec<String> = ["X"].map(String::from).to_vec();
+    let err = LoadedProgram::load(&main.display().to_string(), "P1 = 0\nL again.nc\nM30\n", &axes)
+        .unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains("again.nc:2:1: error: subroutine calls nest deeper than 16"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn tool_length_and_zero_offsets_come_from_the_machine_data() {
+    let toml = r#"
+        name = "mill"
+        axes = ["X", "Y", "Z", "A", "B", "C"]
+        [nc]
+        zero_offsets = { G54 = [100.0, 50.0, 0.0], G55 = [-10.0] }
+        tools = [{ d = 1, length = 80.0 }, { d = 2, length = 120.5 }]
+    "#;
+    let config: ChannelConfig = toml::from_str(toml).unwrap();
+    let setup: DecoderSetup = config.nc.setup();
+    let src = "G54 G0 X0 Y0 Z10\nD1 Z10\nG18 D2 Z10 Y0\nG17 G55 D0 X0 Y0 Z0\nG53 X0\nM30\n";
+    let mut decoded = Vec::new();
+    let (_, diags) = cnc_core::nc::check_program(
+        "t.nc",
+        src.to_string(),
+        &config.axes,
+        &setup,
+        (None, &SearchPath::default()),
+        &ZeroVars,
+        Some(&mut decoded),
+    );
+    assert!(diags.is_empty(), "{diags:?}");
+    let targets: Vec<[f64; 3]> = decoded
+        .iter()
+        .filter_map(|d| match d {
+            Decoded::Motion(m) => Some([m.target[0], m.target[1], m.target[2]]),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(
+        targets,
+        vec![
+            [100.0, 50.0, 10.0],
+            // D1 under G17: the length along Z.
+            [100.0, 50.0, 90.0],
+            // G18: the normal is Y, so D2 lengthens Y (programmed again), Z keeps the zero offset.
+            [100.0, 170.5, 10.0],
+            // G55, no tool: only X has a G55 offset.
+            [-10.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+        ]
+    );
+}
+
+#[test]
+fn a_dwell_holds_the_channel_for_its_time() {
+    let mut ctl = channel_with(
+        ChannelConfig::new("d", &["X", "Y", "Z", "A", "B", "C"]),
+        "G04 0.25\nG1 X1 F60000\nM30\n",
+    );
+    let mut first_move = None;
+    let mut tick = 0u32;
+    run(&mut ctl, 10_000, |p| {
+        tick += 1;
+        if first_move.is_none() && p[0] != 0.0 {
+            first_move = Some(tick);
+        }
+    });
+    // The dwell is decoded in tick 1 and holds ticks 1..=250 (0.25 s of 1 ms ticks); the
+    // move is decoded and starts in tick 251.
+    assert_eq!(first_move, Some(251));
+}
+
+#[test]
+fn spindle_tool_and_messages_reach_the_channel() {
+    let mut ctl = channel_with(
+        ChannelConfig::new("s", &["X", "Y", "Z", "A", "B", "C"]),
+        "S6000 T24\n#MSG [\"tool in\"]\nM30\n",
+    );
+    run(&mut ctl, 100, |_| {});
+    let c = &ctl.channels()[0];
+    assert_eq!(c.spindle_speed(), 6000.0);
+    assert_eq!(c.tool_number(), 24);
+    assert_eq!(c.message(), (Some("tool in"), 1));
+}
+
+#[test]
+fn an_arc_program_ticks_without_allocating() {
+    // Decoding and executing arcs, calls, loops, assignments and functions in the tick.
+    let src = "%L ROUND\nN1 G3 X-10 Y0 I-10 F30000\nN2 G3 X10 Y0 R10\nN3 M17\n%MAIN\n\
+               G0 X10 Y0\nP1 = 0\n$WHILE 1\nLL ROUND\nP1 = P1 + 1\n$FOR P2 = 1, 2\nG1 Z=SIN[P2 * 30] F30000\n$ENDFOR\n\
+               $SWITCH P1 MOD 2\n$CASE 0\nG04 0.002\n$BREAK\n$DEFAULT\n#TIME 0.001\n$ENDSWITCH\n$ENDWHILE\n";
+    let mut config = ChannelConfig::new("a", &["X", "Y", "Z", "A", "B", "C"]);
+    config.limits.velocity = 2000.0;
+    config.limits.acceleration = 50_000.0;
+    config.limits.jerk = 5_000_000.0;
+    let mut ctl = channel_with(config, src);
+    let memory = heap_image(1, 8);
+    let view = CncView::new(&memory);
+    for _ in 0..3000 {
+        ctl.tick(&view);
+    }
+    let before = allocations();
+    for _ in 0..20_000 {
+        ctl.tick(&view);
+    }
+    let made = allocations() - before;
+    assert_eq!(made, 0, "{made} allocations in 20,000 ticks");
+    let c = &ctl.channels()[0];
+    assert_eq!(c.state(), RunState::Running, "{:?}", c.error());
+}
+
+#[test]
+fn the_arc_modes_are_named_in_the_block_stream() {
+    let (diags, decoded) = cnc_core::app::check_cli::check_source(
+        "G0 X1 Y0\nG2 X0 Y-1 R1 F100\n",
+        &["X".to_string(), "Y".to_string(), "Z".to_string()],
+    );
+    assert!(diags.is_empty());
+    let Some(Decoded::Motion(m)) = decoded.get(1) else {
+        panic!("{decoded:?}")
+    };
+    assert_eq!(m.motion, MotionMode::ArcCw);
+    let arc = m.arc.unwrap();
+    assert!(arc.center[0].abs() < 1e-12 && arc.center[1].abs() < 1e-12);
+}
