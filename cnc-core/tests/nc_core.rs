@@ -108,7 +108,10 @@ fn a_subroutine_called_in_a_loop_returns_to_the_block_after_its_call() {
     let mut lines = Vec::new();
     loop {
         out.clear();
-        match interp.step(&set, &mut decoder, &ZeroVars, &mut out).unwrap() {
+        match interp
+            .step(&set, &mut decoder, &ZeroVars, &mut out)
+            .unwrap()
+        {
             Step::End => break,
             _ => lines.extend(out.iter().filter_map(|d| match d {
                 Decoded::Motion(m) => Some((m.line, m.target[0], m.target[1], m.target[2])),
@@ -142,7 +145,11 @@ fn ten_thousand_nested_call_cycles_run_without_allocating() {
     // Main -> a.nc -> sub/b.nc (found through the search path), 10,000 times.
     let dir = temp_dir("nested");
     std::fs::create_dir_all(dir.join("lib")).unwrap();
-    std::fs::write(dir.join("a.nc"), "V.L.DEPTH = 1\nL b.nc\nP2 = P2 + V.L.DEPTH\nM17\n").unwrap();
+    std::fs::write(
+        dir.join("a.nc"),
+        "V.L.DEPTH = 1\nL b.nc\nP2 = P2 + V.L.DEPTH\nM17\n",
+    )
+    .unwrap();
     // b.nc declares its own V.L.DEPTH (shadowing a.nc's until it returns).
     std::fs::write(
         dir.join("lib/b.nc"),
@@ -165,7 +172,9 @@ fn ten_thousand_nested_call_cycles_run_without_allocating() {
     loop {
         out.clear();
         steps += 1;
-        let step = interp.step(&set, &mut decoder, &ZeroVars, &mut out).unwrap();
+        let step = interp
+            .step(&set, &mut decoder, &ZeroVars, &mut out)
+            .unwrap();
         deepest = deepest.max(interp.depth());
         if step == Step::End {
             break;
@@ -187,10 +196,17 @@ fn recursion_past_the_depth_limit_refuses_the_program() {
     let main = dir.join("main.nc");
     std::fs::write(&main, "P1 = 0\nL again.nc\nM30\n").unwrap();
     let axes: Vec<String> = ["X"].map(String::from).to_vec();
-    let err = LoadedProgram::load(&main.display().to_string(), "P1 = 0\nL again.nc\nM30\n", &axes)
-        .unwrap_err();
+    let err = LoadedProgram::load(
+        &main.display().to_string(),
+        "P1 = 0\nL again.nc\nM30\n",
+        &axes,
+    )
+    .unwrap_err();
     let text = err.to_string();
-    assert!(text.contains("again.nc:2:1: error: subroutine calls nest deeper than 16"), "{text}");
+    assert!(
+        text.contains("again.nc:2:1: error: subroutine calls nest deeper than 16"),
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -40,8 +40,18 @@ impl LoadedProgram {
     /// Parses and checks `src` for a channel with `axes`, without machine data; subroutine
     /// files are looked for next to `name` when it names a file.
     pub fn load(name: &str, src: &str, axes: &[String]) -> Result<Self, ProgramError> {
-        let dir = Path::new(name).parent().filter(|d| d.is_dir()).map(Path::to_path_buf);
-        Self::load_with(name, src, axes, &DecoderSetup::default(), dir, &SearchPath::default())
+        let dir = Path::new(name)
+            .parent()
+            .filter(|d| d.is_dir())
+            .map(Path::to_path_buf);
+        Self::load_with(
+            name,
+            src,
+            axes,
+            &DecoderSetup::default(),
+            dir,
+            &SearchPath::default(),
+        )
     }
 
     /// Parses and checks `src` for a channel with `axes` and the machine data of `setup`;

@@ -145,10 +145,7 @@ pub fn center_from_radius(
     // on the left; clockwise or a long arc flips it.
     let left = ccw == (r > 0.0);
     let s = if left { 1.0 } else { -1.0 } * h / chord;
-    Ok([
-        start[0] + dx / 2.0 - s * dy,
-        start[1] + dy / 2.0 + s * dx,
-    ])
+    Ok([start[0] + dx / 2.0 - s * dy, start[1] + dy / 2.0 + s * dx])
 }
 
 /// Checks that `end` lies on the circle through `start` about `center` within `tolerance`.
@@ -184,7 +181,10 @@ mod tests {
         assert!(c[0].abs() < 1e-12 && c[1].abs() < 1e-12, "{c:?}");
         // The same end points clockwise with R>0: the other centre, (10, 10).
         let c = center_from_radius([10.0, 0.0], [0.0, 10.0], 10.0, false).unwrap();
-        assert!((c[0] - 10.0).abs() < 1e-12 && (c[1] - 10.0).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c[0] - 10.0).abs() < 1e-12 && (c[1] - 10.0).abs() < 1e-12,
+            "{c:?}"
+        );
         // R<0 counter-clockwise: the long way, centre (10, 10).
         let c = center_from_radius([10.0, 0.0], [0.0, 10.0], -10.0, true).unwrap();
         assert!((c[0] - 10.0).abs() < 1e-12, "{c:?}");
@@ -195,7 +195,10 @@ mod tests {
             full_turn: false,
         };
         let sweep = arc.sweep([10.0, 0.0], [0.0, 10.0]);
-        assert!((sweep - 1.5 * core::f64::consts::PI).abs() < 1e-12, "{sweep}");
+        assert!(
+            (sweep - 1.5 * core::f64::consts::PI).abs() < 1e-12,
+            "{sweep}"
+        );
         assert_eq!(
             center_from_radius([0.0, 0.0], [0.0, 0.0], 5.0, true),
             Err(ArcError::FullCircleWithRadius)

@@ -174,10 +174,7 @@ fn match_level(
                     branches.push(b);
                     *seen_else = matches!(control, Control::Else);
                 }
-                _ => report(
-                    b,
-                    &format!("${} without a matching $IF", control.keyword()),
-                ),
+                _ => report(b, &format!("${} without a matching $IF", control.keyword())),
             },
             Control::Case(_) | Control::Default => match open.last_mut() {
                 Some(Open::Switch { cases, default, .. }) if default.is_none() => {
@@ -310,10 +307,7 @@ fn match_level(
     for b in level {
         if jumps[b].is_none() {
             if let Some(c @ (Control::Break | Control::Continue)) = control_of(program, b) {
-                report(
-                    b,
-                    &format!("${} outside a loop or $SWITCH", c.keyword()),
-                );
+                report(b, &format!("${} outside a loop or $SWITCH", c.keyword()));
             }
         }
     }
@@ -331,9 +325,9 @@ fn resolve_exits(
     let mut depth = 0usize;
     for b in start + 1..end {
         match control_of(program, b) {
-            Some(
-                Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_),
-            ) => depth += 1,
+            Some(Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_)) => {
+                depth += 1
+            }
             Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
                 depth = depth.saturating_sub(1)
             }
@@ -349,9 +343,9 @@ fn resolve_breaks(program: &Program, start: usize, end: usize, jumps: &mut [Opti
     let mut depth = 0usize;
     for b in start + 1..end {
         match control_of(program, b) {
-            Some(
-                Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_),
-            ) => depth += 1,
+            Some(Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_)) => {
+                depth += 1
+            }
             Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
                 depth = depth.saturating_sub(1)
             }

@@ -552,7 +552,10 @@ impl Ctx<'_> {
             return None;
         }
         if own {
-            self.error(span, format!("variable \"{name}\" is read before it is assigned"));
+            self.error(
+                span,
+                format!("variable \"{name}\" is read before it is assigned"),
+            );
         } else {
             self.error(
                 span,
@@ -891,7 +894,11 @@ impl DecoderState {
             for i in BitIndices(programmed & 0b111) {
                 self.words[i] *= MM_PER_INCH;
             }
-            for c in center.iter_mut().chain(core::iter::once(&mut radius)).flatten() {
+            for c in center
+                .iter_mut()
+                .chain(core::iter::once(&mut radius))
+                .flatten()
+            {
                 *c *= MM_PER_INCH;
             }
         }
@@ -899,7 +906,15 @@ impl DecoderState {
             self.feed = if self.inch { f * MM_PER_INCH } else { f };
         }
         if dwell_code || dwell.is_some() {
-            self.dwell(line, block, dwell, programmed, motion_code.is_some(), ctx, &mut tail);
+            self.dwell(
+                line,
+                block,
+                dwell,
+                programmed,
+                motion_code.is_some(),
+                ctx,
+                &mut tail,
+            );
             programmed = 0;
         }
         if let Some((code, _)) = motion_code {
@@ -925,7 +940,10 @@ impl DecoderState {
             if self.motion.at_feed() && self.feed <= 0.0 {
                 ctx.error(
                     block.span,
-                    format!("{} motion without a feed: program F.. first", self.motion.name()),
+                    format!(
+                        "{} motion without a feed: program F.. first",
+                        self.motion.name()
+                    ),
                 );
             }
             let start = self.position;
@@ -969,14 +987,18 @@ impl DecoderState {
         ctx: &mut Ctx<'_>,
         tail: &mut Vec<Decoded>,
     ) {
-        let by_axis = (programmed == 1).then(|| self.words[0] / if self.inch { MM_PER_INCH } else { 1.0 });
+        let by_axis =
+            (programmed == 1).then(|| self.words[0] / if self.inch { MM_PER_INCH } else { 1.0 });
         let seconds = match (bare, by_axis) {
             _ if motion || (programmed != 0 && programmed != 1) => {
                 ctx.error(block.span, "G04 stands alone in its block: its time is G04 <seconds> or G04 <first axis><seconds>");
                 return;
             }
             (Some(_), Some(_)) => {
-                ctx.error(block.span, "G04: give the time once (bare or with the first axis)");
+                ctx.error(
+                    block.span,
+                    "G04: give the time once (bare or with the first axis)",
+                );
                 return;
             }
             (Some((t, _)), None) | (None, Some(t)) => t,
@@ -986,7 +1008,10 @@ impl DecoderState {
             }
         };
         if !(seconds >= 0.0) {
-            ctx.error(block.span, format!("dwell time must not be negative, found {seconds}"));
+            ctx.error(
+                block.span,
+                format!("dwell time must not be negative, found {seconds}"),
+            );
             return;
         }
         tail.insert(0, Decoded::Dwell { line, seconds });
@@ -1004,7 +1029,10 @@ impl DecoderState {
         use super::arc::{center_from_radius, check_on_circle, ArcError, ArcMove};
         let [a, b, _] = self.plane.axes();
         if self.position.len() <= a.max(b) {
-            ctx.error(span, "G2/G3 needs the channel's first three axes (the main axes)");
+            ctx.error(
+                span,
+                "G2/G3 needs the channel's first three axes (the main axes)",
+            );
             return None;
         }
         let p0 = [start[a], start[b]];
@@ -1023,7 +1051,10 @@ impl DecoderState {
                         given[1].map_or(p0[1], |v| v + self.g92[b] + self.pset[b] + self.offset(b)),
                     ]
                 } else {
-                    [p0[0] + given[0].unwrap_or(0.0), p0[1] + given[1].unwrap_or(0.0)]
+                    [
+                        p0[0] + given[0].unwrap_or(0.0),
+                        p0[1] + given[1].unwrap_or(0.0),
+                    ]
                 };
                 check_on_circle(p0, p1, c, self.arc_tolerance).map(|()| c)
             }
@@ -1425,7 +1456,9 @@ pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
 /// How many steps a check runs a program before it stops following it (a loop waiting for a
 /// value only a running machine changes): generous for any program that ends by itself.
 pub fn check_budget(blocks: usize) -> u64 {
-    (blocks as u64).saturating_mul(100).saturating_add(1_000_000)
+    (blocks as u64)
+        .saturating_mul(100)
+        .saturating_add(1_000_000)
 }
 
 /// Checks a whole program for a channel with `axes`, reading the channel's variables from

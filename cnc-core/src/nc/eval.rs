@@ -132,7 +132,10 @@ mod tests {
         assert_eq!(function(Func::Cos, 90.0, None), Ok(0.0));
         assert!((function(Func::Cos, 60.0, None).unwrap() - 0.5).abs() < 1e-15);
         assert!((function(Func::Atan2, 1.0, Some(1.0)).unwrap() - 45.0).abs() < 1e-12);
-        assert_eq!(function(Func::Sqrt, -1.0, None), Err("SQRT of a negative value"));
+        assert_eq!(
+            function(Func::Sqrt, -1.0, None),
+            Err("SQRT of a negative value")
+        );
         assert!(function(Func::Ln, 0.0, None).is_err());
         assert!(function(Func::Tan, 90.0, None).is_err());
         assert_eq!(function(Func::Fract, -2.25, None), Ok(-0.25));

@@ -88,12 +88,15 @@ impl ProgramSet {
                     .iter()
                     .enumerate()
                     .flat_map(|(b, block)| {
-                        unit.tree.items_of(block).iter().filter_map(move |i| match i {
-                            Item::Call { call, span } => {
-                                Some((b as u32, *span, call.local, call.name.clone()))
-                            }
-                            _ => None,
-                        })
+                        unit.tree
+                            .items_of(block)
+                            .iter()
+                            .filter_map(move |i| match i {
+                                Item::Call { call, span } => {
+                                    Some((b as u32, *span, call.local, call.name.clone()))
+                                }
+                                _ => None,
+                            })
                     })
                     .collect()
             };
@@ -195,7 +198,11 @@ impl ProgramSet {
                     span,
                     format!(
                         "LL {name}: no local subroutine \"%L {upper}\" in this file (defined: {})",
-                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
                     ),
                     diags,
                 );
@@ -231,7 +238,10 @@ impl ProgramSet {
             self.error(
                 unit,
                 span,
-                format!("L {name}: subroutine file not found (looked at: {})", looked.join(", ")),
+                format!(
+                    "L {name}: subroutine file not found (looked at: {})",
+                    looked.join(", ")
+                ),
                 diags,
             );
             return None;
@@ -243,7 +253,12 @@ impl ProgramSet {
         let src = match std::fs::read(found) {
             Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
             Err(e) => {
-                self.error(unit, span, format!("L {name}: cannot read {}: {e}", found.display()), diags);
+                self.error(
+                    unit,
+                    span,
+                    format!("L {name}: cannot read {}: {e}", found.display()),
+                    diags,
+                );
                 return None;
             }
         };
@@ -320,9 +335,18 @@ struct Env<'a> {
 impl Vars for Env<'_> {
     fn get(&self, name: &str) -> Option<f64> {
         if name.starts_with("V.P.") {
-            self.interp.globals.iter().find(|(n, _)| *n == name).map(|v| v.1)
+            self.interp
+                .globals
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|v| v.1)
         } else if name.starts_with("V.L.") {
-            self.interp.locals.iter().rev().find(|(n, _)| *n == name).map(|v| v.1)
+            self.interp
+                .locals
+                .iter()
+                .rev()
+                .find(|(n, _)| *n == name)
+                .map(|v| v.1)
         } else {
             self.system.get(name)
         }
@@ -477,7 +501,11 @@ impl Interpreter {
                 .map(|i| unit.calls[i].1);
             let Some(callee) = callee else {
                 return Err(with_file(
-                    Diagnostic::located(span, "the subroutine of this call was not loaded".into(), &unit.src),
+                    Diagnostic::located(
+                        span,
+                        "the subroutine of this call was not loaded".into(),
+                        &unit.src,
+                    ),
                     unit,
                 ));
             };
@@ -580,7 +608,8 @@ impl Interpreter {
     ) -> Result<usize, Diagnostic> {
         let control = control_of(&unit.tree, b);
         let eval = |interp: &Interpreter, e: &super::ast::Expr| {
-            evaluate_at(e, block.span, &unit.src, &Env { interp, system }).map_err(|d| with_file(d, unit))
+            evaluate_at(e, block.span, &unit.src, &Env { interp, system })
+                .map_err(|d| with_file(d, unit))
         };
         Ok(match (jump, control) {
             (Jump::While { end }, Some(Control::While(c))) => {
@@ -610,7 +639,15 @@ impl Interpreter {
                 }
             }
             (Jump::Else { end }, _) => end + 1,
-            (Jump::For { end }, Some(Control::For { var, start, end: last, step })) => {
+            (
+                Jump::For { end },
+                Some(Control::For {
+                    var,
+                    start,
+                    end: last,
+                    step,
+                }),
+            ) => {
                 let first = eval(self, start)?;
                 self.assign(*var, first)
                     .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
@@ -620,11 +657,20 @@ impl Interpreter {
                     .unwrap_or(end + 1)
             }
             (Jump::EndFor { start }, _) => {
-                let Some(Control::For { var, end: last, step, .. }) = control_of(&unit.tree, start) else {
+                let Some(Control::For {
+                    var,
+                    end: last,
+                    step,
+                    ..
+                }) = control_of(&unit.tree, start)
+                else {
                     return Ok(b + 1);
                 };
                 let (last, step) = (eval(self, last)?, eval(self, step)?);
-                let env = Env { interp: self, system };
+                let env = Env {
+                    interp: self,
+                    system,
+                };
                 let current = match var {
                     Target::Param(n) => env.param(*n),
                     Target::Var(name) => env.get(name),
@@ -645,7 +691,14 @@ impl Interpreter {
                     b + 1
                 }
             }
-            (Jump::Switch { first_case, default, end }, Some(Control::Switch(v))) => {
+            (
+                Jump::Switch {
+                    first_case,
+                    default,
+                    end,
+                },
+                Some(Control::Switch(v)),
+            ) => {
                 let value = eval(self, v)?;
                 let mut case = first_case;
                 let mut target = default.map_or(end + 1, |d| d + 1);
@@ -683,7 +736,11 @@ impl Interpreter {
                 unit,
             ));
         }
-        Ok(if step > 0.0 { value <= last } else { value >= last })
+        Ok(if step > 0.0 {
+            value <= last
+        } else {
+            value >= last
+        })
     }
 }
 
@@ -732,7 +789,11 @@ pub fn check_set(
     budget: u64,
     mut keep: Option<&mut Vec<Decoded>>,
 ) -> (Vec<Diagnostic>, bool) {
-    let mut visited: Vec<Vec<bool>> = set.units.iter().map(|u| vec![false; u.tree.blocks.len()]).collect();
+    let mut visited: Vec<Vec<bool>> = set
+        .units
+        .iter()
+        .map(|u| vec![false; u.tree.blocks.len()])
+        .collect();
     let mut diags = Vec::new();
     let mut interp = Interpreter::new();
     interp.start(set);
@@ -784,7 +845,9 @@ pub fn check_set(
         }
     }
     let _ = levels;
-    diags.sort_by(|a, b| (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col)));
+    diags.sort_by(|a, b| {
+        (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col))
+    });
     diags.dedup();
     (diags, finished)
 }

@@ -247,7 +247,10 @@ impl Parser<'_> {
             }
             _ => {
                 let found = self.describe();
-                self.error(span, format!("%L: expected a subroutine name, found {found}"));
+                self.error(
+                    span,
+                    format!("%L: expected a subroutine name, found {found}"),
+                );
                 return true;
             }
         };
@@ -258,16 +261,25 @@ impl Parser<'_> {
             );
         }
         if program.subs.iter().any(|s| s.name == name) {
-            self.error(span, format!("local subroutine \"{name}\" is defined twice"));
+            self.error(
+                span,
+                format!("local subroutine \"{name}\" is defined twice"),
+            );
         }
         if !self.at_end_of_block() {
             let (s, found) = (self.span(), self.describe());
-            self.error(s, format!("expected end of line after \"%L {name}\", found {found}"));
+            self.error(
+                s,
+                format!("expected end of line after \"%L {name}\", found {found}"),
+            );
         }
         if !program.subs.is_empty() {
             self.close_sub(program);
         } else if !program.blocks.is_empty() {
-            self.error(span, "local subroutines (%L) stand at the start of the file");
+            self.error(
+                span,
+                "local subroutines (%L) stand at the start of the file",
+            );
         }
         let start = arena_index(program.blocks.len());
         program.subs.push(LocalSub {
@@ -1120,7 +1132,10 @@ impl Parser<'_> {
                 };
                 let Some(target) = target else {
                     let found = self.describe();
-                    self.error(span, format!("$GOTO: expected a block number such as N100, found {found}"));
+                    self.error(
+                        span,
+                        format!("$GOTO: expected a block number such as N100, found {found}"),
+                    );
                     self.recover();
                     return None;
                 };
@@ -1152,7 +1167,10 @@ impl Parser<'_> {
         };
         let Some(var) = var else {
             let found = self.describe();
-            self.error(span, format!("$FOR: expected a counter such as P1, found {found}"));
+            self.error(
+                span,
+                format!("$FOR: expected a counter such as P1, found {found}"),
+            );
             self.recover();
             return None;
         };
@@ -1248,7 +1266,10 @@ impl Parser<'_> {
             Some(())
         } else {
             let found = self.describe();
-            self.error(open, format!("\"[\" is not closed by \"]\" (found {found})"));
+            self.error(
+                open,
+                format!("\"[\" is not closed by \"]\" (found {found})"),
+            );
             None
         }
     }
@@ -1292,7 +1313,9 @@ impl Parser<'_> {
                 self.close_bracket(open)?;
                 Some(inner)
             }
-            Tok::Word(w) if Func::named(&w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")) => {
+            Tok::Word(w)
+                if Func::named(&w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")) =>
+            {
                 let span = self.span();
                 let func = Func::named(&w)?;
                 self.bump();
@@ -1323,7 +1346,9 @@ impl Parser<'_> {
                 let hint = if Func::named(&w).is_some() {
                     format!("{w} is a function: write {w}[...]")
                 } else {
-                    format!("expected a number, a variable, P.., a function or \"[\", found {found}")
+                    format!(
+                        "expected a number, a variable, P.., a function or \"[\", found {found}"
+                    )
                 };
                 self.error(span, hint);
                 None
@@ -1332,7 +1357,9 @@ impl Parser<'_> {
                 let (span, found) = (self.span(), self.describe());
                 self.error(
                     span,
-                    format!("expected a number, a variable, P.., a function or \"[\", found {found}"),
+                    format!(
+                        "expected a number, a variable, P.., a function or \"[\", found {found}"
+                    ),
                 );
                 None
             }

@@ -165,7 +165,11 @@ fn item(i: &Item) -> String {
         Item::Control { control, .. } => match control.as_ref() {
             Control::While(c) => format!("$WHILE {}", expr(c)),
             Control::EndWhile => "$ENDWHILE".into(),
-            Control::If(c) | Control::ElseIf(c) | Control::EndDo(c) | Control::Switch(c) | Control::Case(c) => {
+            Control::If(c)
+            | Control::ElseIf(c)
+            | Control::EndDo(c)
+            | Control::Switch(c)
+            | Control::Case(c) => {
                 format!("${} {}", control.keyword(), expr(c))
             }
             Control::For {

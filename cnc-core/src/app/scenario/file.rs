@@ -211,8 +211,7 @@ impl Scenario {
                 Some(p) => {
                     let (path, src) = open(p)?;
                     let search = crate::nc::interp::SearchPath(
-                        c.nc
-                            .search_path
+                        c.nc.search_path
                             .iter()
                             .map(|d| path.parent().unwrap_or(Path::new(".")).join(d))
                             .collect(),
