@@ -23,14 +23,148 @@ fn number() -> impl Strategy<Value = f64> {
 }
 
 fn variable() -> impl Strategy<Value = Name> {
-    prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C"])
-        .prop_map(|a| Name::from(format!("V.G.TRACK_CS.{a}").as_str()))
+    prop_oneof![
+        prop::sample::select(vec!["X", "Y", "Z", "A", "B", "C"])
+            .prop_map(|a| Name::from(format!("V.G.TRACK_CS.{a}").as_str())),
+        prop::sample::select(vec!["V.P.DEPTH", "V.L.I", "V.P.A_1", "V.L.STEP2"])
+            .prop_map(Name::from),
+    ]
 }
 
 fn atom() -> impl Strategy<Value = Expr> {
     prop_oneof![
         number().prop_map(Expr::Num),
-        variable().prop_map(|v| Expr::Var(Box::new(v)))
+        variable().prop_map(|v| Expr::Var(Box::new(v))),
+        (1u32..1000).prop_map(Expr::Param),
+    ]
+}
+
+fn any_op() -> impl Strategy<Value = BinOp> {
+    prop::sample::select(vec![
+        BinOp::Add,
+        BinOp::Sub,
+        BinOp::Mul,
+        BinOp::Div,
+        BinOp::Eq,
+        BinOp::Ne,
+        BinOp::Lt,
+        BinOp::Le,
+        BinOp::Gt,
+        BinOp::Ge,
+        BinOp::Mod,
+        BinOp::Pow,
+        BinOp::And,
+        BinOp::Or,
+        BinOp::Xor,
+    ])
+}
+
+/// Expressions of any shape (the printer brackets what precedence alone would read otherwise),
+/// with functions.
+fn any_expr() -> impl Strategy<Value = Expr> {
+    atom().prop_recursive(4, 24, 3, |inner| {
+        prop_oneof![
+            inner.clone().prop_map(|e| Expr::Neg(Box::new(e))),
+            (any_op(), inner.clone(), inner.clone())
+                .prop_map(|(op, a, b)| Expr::Bin(Box::new((op, a, b)))),
+            (
+                prop::sample::select(Func::ALL.to_vec()),
+                inner.clone(),
+                inner
+            )
+                .prop_map(|((f, _, n), a, b)| Expr::Call(Box::new((
+                    f,
+                    if n == 2 { vec![a, b] } else { vec![a] }
+                )))),
+        ]
+    })
+}
+
+fn target() -> impl Strategy<Value = Target> {
+    prop_oneof![
+        (1u32..1000).prop_map(Target::Param),
+        prop::sample::select(vec!["V.P.DEPTH", "V.L.I"]).prop_map(|n| Target::Var(Name::from(n))),
+    ]
+}
+
+fn control() -> impl Strategy<Value = Control> {
+    prop_oneof![
+        any_expr().prop_map(Control::While),
+        Just(Control::EndWhile),
+        any_expr().prop_map(Control::If),
+        any_expr().prop_map(Control::ElseIf),
+        Just(Control::Else),
+        Just(Control::EndIf),
+        (target(), any_expr(), any_expr(), any_expr()).prop_map(|(var, start, end, step)| {
+            Control::For {
+                var,
+                start,
+                end,
+                step,
+            }
+        }),
+        Just(Control::EndFor),
+        Just(Control::Do),
+        any_expr().prop_map(Control::EndDo),
+        any_expr().prop_map(Control::Switch),
+        any_expr().prop_map(Control::Case),
+        Just(Control::Default),
+        Just(Control::EndSwitch),
+        Just(Control::Break),
+        Just(Control::Continue),
+        (0u32..100_000).prop_map(Control::Goto),
+    ]
+}
+
+/// Blocks of the language core besides motion: assignments, calls, `$` statements, dwell,
+/// messages and declarations.
+fn core_block() -> impl Strategy<Value = Vec<Item>> {
+    prop_oneof![
+        prop::collection::vec((target(), any_expr()), 1..3).prop_map(|a| a
+            .into_iter()
+            .map(|(target, value)| Item::Assign {
+                assign: Box::new(Assign { target, value }),
+                span: span()
+            })
+            .collect()),
+        (
+            any::<bool>(),
+            prop::sample::select(vec!["sub.nc", "lib/UP_1.NC", "CORNER", "x-2.spf"])
+        )
+            .prop_map(|(local, name)| vec![Item::Call {
+                call: Box::new(SubCall {
+                    local,
+                    name: name.to_string()
+                }),
+                span: span()
+            }]),
+        control().prop_map(|c| vec![Item::Control {
+            control: Box::new(c),
+            span: span()
+        }]),
+        any_expr().prop_map(|value| vec![
+            Item::G {
+                code: 4,
+                span: span()
+            },
+            Item::Axis(AxisWord {
+                name: AxisName::default(),
+                value,
+                span: span()
+            }),
+        ]),
+        prop_oneof![
+            "[a-zA-Z0-9 .,:]{0,20}".prop_map(|t| Command::Msg {
+                text: t.as_str().into()
+            }),
+            any_expr().prop_map(|seconds| Command::Time { seconds }),
+            Just(Command::Var),
+            Just(Command::EndVar),
+        ]
+        .prop_map(|command| vec![Item::Command {
+            command: Box::new(command),
+            span: span()
+        }]),
     ]
 }
 
@@ -224,7 +358,8 @@ fn block() -> impl Strategy<Value = (Option<u32>, Vec<Item>)> {
             command().prop_map(|command| vec![Item::Command {
                 command: Box::new(command),
                 span: span()
-            }])
+            }]),
+            core_block(),
         ],
     )
         .prop_filter("blocks hold something", |(n, items)| {
@@ -235,13 +370,40 @@ fn block() -> impl Strategy<Value = (Option<u32>, Vec<Item>)> {
 fn program() -> impl Strategy<Value = Program> {
     (
         prop::option::of("[A-Za-z][A-Za-z0-9_-]{0,12}"),
+        prop::collection::vec(
+            ("[A-Z][A-Z0-9_]{0,8}", prop::collection::vec(block(), 0..5)),
+            0..3,
+        ),
         prop::collection::vec(block(), 0..40),
     )
-        .prop_map(|(name, blocks)| {
+        .prop_filter(
+            "local subroutines have different names, and a main program a name",
+            |(name, subs, _)| {
+                let mut names: Vec<&String> = subs.iter().map(|s| &s.0).collect();
+                names.sort();
+                names.dedup();
+                // `%L` alone opens a local subroutine: no main program is called L.
+                let main_ok = name.as_deref().is_none_or(|n| !n.eq_ignore_ascii_case("L"));
+                names.len() == subs.len() && (subs.is_empty() || name.is_some()) && main_ok
+            },
+        )
+        .prop_map(|(name, subs, blocks)| {
             let mut program = Program {
                 name,
                 ..Program::default()
             };
+            for (sub, sub_blocks) in subs {
+                let start = program.blocks.len() as u32;
+                for (number, items) in sub_blocks {
+                    program.push_block(number, items, span(), 0);
+                }
+                program.subs.push(LocalSub {
+                    name: sub,
+                    blocks: start..program.blocks.len() as u32,
+                    span: span(),
+                });
+            }
+            program.main_start = program.blocks.len() as u32;
             for (number, items) in blocks {
                 program.push_block(number, items, span(), 0);
             }

@@ -232,28 +232,15 @@ impl Parser<'_> {
         if !header.eq_ignore_ascii_case("L") {
             return false;
         }
-        let name = match self.peek().clone() {
-            Tok::Word(_) | Tok::Var(_) => {
-                self.bump();
-                self.src[self.tokens[self.pos - 1].span.start as usize
-                    ..self.tokens[self.pos - 1].span.end as usize]
-                    .to_ascii_uppercase()
-            }
-            Tok::Addr(..) | Tok::Num(_) => {
-                self.bump();
-                self.src[self.tokens[self.pos - 1].span.start as usize
-                    ..self.tokens[self.pos - 1].span.end as usize]
-                    .to_ascii_uppercase()
-            }
-            _ => {
-                let found = self.describe();
-                self.error(
-                    span,
-                    format!("%L: expected a subroutine name, found {found}"),
-                );
-                return true;
-            }
-        };
+        if self.at_end_of_block() {
+            let found = self.describe();
+            self.error(
+                span,
+                format!("%L: expected a subroutine name, found {found}"),
+            );
+            return true;
+        }
+        let name = self.raw_name().to_ascii_uppercase();
         if program.name.is_some() {
             self.error(
                 span,
@@ -289,6 +276,21 @@ impl Parser<'_> {
         });
         program.main_start = start;
         true
+    }
+
+    /// The source text of the tokens from the cursor to the next blank (a subroutine or file
+    /// name: `UP_1`, `lib/gup_1.nc`), consumed.
+    fn raw_name(&mut self) -> String {
+        let first = self.pos;
+        self.bump();
+        while !self.at_end_of_block() && !self.token().spaced {
+            self.bump();
+        }
+        let (start, end) = (
+            self.tokens[first].span.start as usize,
+            self.tokens[self.pos - 1].span.end as usize,
+        );
+        self.src.get(start..end).unwrap_or("").to_string()
     }
 
     /// Ends the last local subroutine at the current block; the main program starts here.
@@ -485,8 +487,8 @@ impl Parser<'_> {
     fn starts_expression(&self) -> bool {
         match self.peek() {
             Tok::Num(_) | Tok::Var(_) | Tok::Punct("[" | "-" | "+") => true,
-            Tok::Addr(w, _) => *w == "P",
-            Tok::Word(w) => Func::named(w).is_some(),
+            Tok::Addr(w, n) => *w == "P" || (*w == "ATAN" && *n == 2.0),
+            Tok::Word(w) => Func::named(w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")),
             _ => false,
         }
     }
@@ -529,16 +531,7 @@ impl Parser<'_> {
             self.recover();
             return None;
         }
-        let first = self.pos;
-        self.bump();
-        while !self.at_end_of_block() && !self.token().spaced {
-            self.bump();
-        }
-        let (start, end) = (
-            self.tokens[first].span.start as usize,
-            self.tokens[self.pos - 1].span.end as usize,
-        );
-        let name = self.src.get(start..end).unwrap_or("").to_string();
+        let name = self.raw_name();
         if !self.at_end_of_block() {
             let (at, found) = (self.span(), self.describe());
             self.error(
@@ -601,7 +594,10 @@ impl Parser<'_> {
         }
         // `X[P1 * 2]`: an expression in brackets right after the address.
         let independent = matches!(self.peek_at(1), Tok::Word(w) if w.starts_with("INDP"));
-        if self.is_punct("[") && !self.token().spaced && !independent {
+        // `G4 [..]`: a code word ends at its number; the bracket is the next item.
+        let code = glued.is_some() && matches!(word.as_str(), "G" | "M" | "N");
+        let bracket = self.is_punct("[") && !code;
+        if bracket && !self.token().spaced && !independent {
             let name = self.axis_name(word, glued, span)?;
             let value = self.expr()?;
             return Some(if name.as_str() == "F" {
@@ -618,7 +614,7 @@ impl Parser<'_> {
             });
         }
         // `X1[INDP_ASYN ...]`
-        if self.is_punct("[") {
+        if bracket {
             let name = self.axis_name(word, glued, span);
             if name.is_none() && self.at_end_of_block() {
                 return None;
@@ -1051,7 +1047,8 @@ impl Parser<'_> {
                     self.error(open, "\"[\" is not closed by \"]\"");
                     return None;
                 }
-                Tok::Word(_) | Tok::Addr(..) => {
+                // A P parameter or a function is a value, not a key.
+                Tok::Word(_) | Tok::Addr(..) if !self.starts_expression() => {
                     let span = self.span();
                     let (w, glued) = self.take_word()?;
                     let (mut value, mut text) = (None, None);
@@ -1313,33 +1310,16 @@ impl Parser<'_> {
                 self.close_bracket(open)?;
                 Some(inner)
             }
+            // `ATAN2` arrives as the word ATAN with a glued 2.
+            Tok::Addr(w, n)
+                if w == "ATAN" && n == 2.0 && matches!(self.peek_at(1), Tok::Punct("[")) =>
+            {
+                self.call(Func::Atan2)
+            }
             Tok::Word(w)
                 if Func::named(&w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")) =>
             {
-                let span = self.span();
-                let func = Func::named(&w)?;
-                self.bump();
-                let open = self.span();
-                self.bump();
-                let mut args = vec![self.expr()?];
-                while self.is_punct(",") {
-                    self.bump();
-                    args.push(self.expr()?);
-                }
-                self.close_bracket(open)?;
-                if args.len() != func.arity() {
-                    self.error(
-                        span,
-                        format!(
-                            "{}[...] takes {} argument(s), found {}",
-                            func.name(),
-                            func.arity(),
-                            args.len()
-                        ),
-                    );
-                    return None;
-                }
-                Some(Expr::Call(Box::new((func, args))))
+                self.call(Func::named(&w)?)
             }
             Tok::Word(w) => {
                 let (span, found) = (self.span(), self.describe());
@@ -1364,5 +1344,32 @@ impl Parser<'_> {
                 None
             }
         }
+    }
+
+    /// `FUNC[args]`, the cursor on the function's name.
+    fn call(&mut self, func: Func) -> Option<Expr> {
+        let span = self.span();
+        self.bump();
+        let open = self.span();
+        self.bump();
+        let mut args = vec![self.expr()?];
+        while self.is_punct(",") {
+            self.bump();
+            args.push(self.expr()?);
+        }
+        self.close_bracket(open)?;
+        if args.len() != func.arity() {
+            self.error(
+                span,
+                format!(
+                    "{}[...] takes {} argument(s), found {}",
+                    func.name(),
+                    func.arity(),
+                    args.len()
+                ),
+            );
+            return None;
+        }
+        Some(Expr::Call(Box::new((func, args))))
     }
 }

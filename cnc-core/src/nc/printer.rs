@@ -8,7 +8,7 @@ pub fn print(program: &Program) -> String {
     let mut out = String::new();
     for (b, block) in program.blocks.iter().enumerate() {
         let b = arena_index(b);
-        if let Some(sub) = program.subs.iter().find(|s| s.blocks.start == b) {
+        for sub in program.subs.iter().filter(|s| s.blocks.start == b) {
             let _ = writeln!(out, "%L {}", sub.name);
         }
         if b == program.main_start {
