@@ -230,7 +230,7 @@ fn tool_length_and_zero_offsets_come_from_the_machine_data() {
         &setup,
         (None, &SearchPath::default()),
         &ZeroVars,
-        Some(&mut decoded),
+        Some(&mut |step: &[Decoded]| decoded.extend_from_slice(step)),
     );
     assert!(diags.is_empty(), "{diags:?}");
     let targets: Vec<[f64; 3]> = decoded

@@ -3,8 +3,8 @@
 
 use crate::app::json::push_number;
 use crate::nc::decode::{check_channel_axes, DecoderSetup, ZeroVars};
-use crate::nc::interp::SearchPath;
-use crate::nc::{check_program, Decoded, Diagnostic};
+use crate::nc::interp::{check_set, SearchPath};
+use crate::nc::{check_program, Decoded, DecoderState, Diagnostic};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -35,6 +35,7 @@ pub fn check_source_in(
     search: &SearchPath,
 ) -> (Vec<Diagnostic>, Vec<Decoded>) {
     let mut decoded = Vec::new();
+    let mut keep = |step: &[Decoded]| decoded.extend_from_slice(step);
     let (_, diags) = check_program(
         "",
         src.to_string(),
@@ -42,7 +43,7 @@ pub fn check_source_in(
         &DecoderSetup::default(),
         (dir, search),
         &ZeroVars,
-        Some(&mut decoded),
+        Some(&mut keep),
     );
     (diags, decoded)
 }
@@ -125,25 +126,27 @@ pub fn main(args: CheckArgs) -> ExitCode {
     let mut out = String::new();
     for file in &args.files {
         let name = file.display().to_string();
+        // The bytes become the text in place when they are UTF-8 (a copy would double the
+        // file's share of the peak memory).
         let src = match std::fs::read(file) {
-            Ok(bytes) => String::from_utf8_lossy(&bytes).into_owned(),
+            Ok(bytes) => String::from_utf8(bytes)
+                .unwrap_or_else(|e| String::from_utf8_lossy(e.as_bytes()).into_owned()),
             Err(e) => {
                 eprintln!("{name}:1:1: error: cannot read the file: {e}");
                 failed = true;
                 continue;
             }
         };
-        let mut decoded = Vec::new();
-        let keep = args.blocks.then_some(&mut decoded);
         let dir = file.parent().map(Path::to_path_buf);
-        let (_, diags) = check_program(
+        let setup = DecoderSetup::default();
+        let (set, diags) = check_program(
             &name,
             src,
             &axes,
-            &DecoderSetup::default(),
+            &setup,
             (dir.as_deref(), &search),
             &ZeroVars,
-            keep,
+            None,
         );
         for d in &diags {
             out.push_str(&d.render(&name));
@@ -151,17 +154,27 @@ pub fn main(args: CheckArgs) -> ExitCode {
         }
         failed |= !diags.is_empty();
         if args.blocks && diags.is_empty() {
-            for d in &decoded {
-                if let Decoded::Motion(m) = d {
-                    push_motion_json(&mut out, m, &axes);
-                    out.push('\n');
-                }
-                if out.len() > 1 << 16 {
-                    if !emit(&out) {
-                        return exit_code(failed);
+            // Run again, printing as it goes: a clean program's blocks are printed without
+            // keeping them all (they take more memory than the program).
+            let mut decoder = DecoderState::new(&axes);
+            decoder.configure(&setup);
+            let mut reader_gone = false;
+            let mut print = |step: &[Decoded]| {
+                for d in step {
+                    if let Decoded::Motion(m) = d {
+                        push_motion_json(&mut out, m, &axes);
+                        out.push('\n');
                     }
+                }
+                if out.len() > 1 << 16 && !reader_gone {
+                    reader_gone = !emit(&out);
                     out.clear();
                 }
+            };
+            let budget = crate::nc::decode::check_budget(set.block_count());
+            check_set(&set, &mut decoder, &ZeroVars, budget, Some(&mut print));
+            if reader_gone {
+                return exit_code(failed);
             }
         }
     }

@@ -198,7 +198,7 @@ impl PathMove {
         let circle_length = sweep * (r0 + r1) / 2.0;
         let linear = delta.iter().take(3).map(|d| d * d).sum::<f64>();
         let length = (circle_length * circle_length + linear).sqrt();
-        if !(length > 1e-12) || !length.is_finite() {
+        if length.is_nan() || length <= 1e-12 || !length.is_finite() {
             return Err(PathError::NoProfile);
         }
         let limit = |i: usize| {

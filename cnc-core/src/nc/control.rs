@@ -120,11 +120,37 @@ enum Open {
     },
 }
 
-/// Matches the `$` statements of `program`: per block its jump (`None` for other blocks), and
-/// every statement left without a partner. The table is only complete when nothing is
-/// unmatched.
-pub fn match_control(program: &Program) -> (Vec<Option<Jump>>, Vec<Unmatched>) {
-    let mut jumps = vec![None; program.blocks.len()];
+/// The jumps of a program's `$` blocks, by block (sorted; other blocks have none). Kept
+/// sparse: a long program has few `$` blocks, and a slot per block would cost more memory than
+/// the rest of its tree's bookkeeping.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct JumpTable(Vec<(usize, Jump)>);
+
+impl JumpTable {
+    /// The jump of block `b`.
+    pub fn get(&self, b: usize) -> Option<Jump> {
+        self.0
+            .binary_search_by_key(&b, |e| e.0)
+            .ok()
+            .map(|i| self.0[i].1)
+    }
+
+    fn set(&mut self, b: usize, jump: Jump) {
+        match self.0.binary_search_by_key(&b, |e| e.0) {
+            Ok(i) => self.0[i].1 = jump,
+            Err(i) => self.0.insert(i, (b, jump)),
+        }
+    }
+
+    fn has(&self, b: usize) -> bool {
+        self.get(b).is_some()
+    }
+}
+
+/// Matches the `$` statements of `program`: per `$` block its jump, and every statement left
+/// without a partner. The table is only complete when nothing is unmatched.
+pub fn match_control(program: &Program) -> (JumpTable, Vec<Unmatched>) {
+    let mut jumps = JumpTable::default();
     let mut unmatched = Vec::new();
     for level in levels(program) {
         match_level(program, level, &mut jumps, &mut unmatched);
@@ -135,7 +161,7 @@ pub fn match_control(program: &Program) -> (Vec<Option<Jump>>, Vec<Unmatched>) {
 fn match_level(
     program: &Program,
     level: core::ops::Range<usize>,
-    jumps: &mut [Option<Jump>],
+    jumps: &mut JumpTable,
     unmatched: &mut Vec<Unmatched>,
 ) {
     let mut open: Vec<Open> = Vec::new();
@@ -192,8 +218,8 @@ fn match_level(
             Control::EndWhile => match open.last() {
                 Some(&Open::While(start)) => {
                     open.pop();
-                    jumps[start] = Some(Jump::While { end: b });
-                    jumps[b] = Some(Jump::EndWhile { start });
+                    jumps.set(start, Jump::While { end: b });
+                    jumps.set(b, Jump::EndWhile { start });
                     resolve_exits(program, start, b, b, jumps);
                 }
                 _ => report(b, "$ENDWHILE without a matching $WHILE"),
@@ -201,8 +227,8 @@ fn match_level(
             Control::EndFor => match open.last() {
                 Some(&Open::For(start)) => {
                     open.pop();
-                    jumps[start] = Some(Jump::For { end: b });
-                    jumps[b] = Some(Jump::EndFor { start });
+                    jumps.set(start, Jump::For { end: b });
+                    jumps.set(b, Jump::EndFor { start });
                     resolve_exits(program, start, b, b, jumps);
                 }
                 _ => report(b, "$ENDFOR without a matching $FOR"),
@@ -210,7 +236,7 @@ fn match_level(
             Control::EndDo(_) => match open.last() {
                 Some(&Open::Do(start)) => {
                     open.pop();
-                    jumps[b] = Some(Jump::EndDo { start });
+                    jumps.set(b, Jump::EndDo { start });
                     resolve_exits(program, start, b, b, jumps);
                 }
                 _ => report(b, "$ENDDO without a matching $DO"),
@@ -225,16 +251,19 @@ fn match_level(
                     };
                     let mut at = start;
                     for &branch in &branches {
-                        jumps[at] = Some(Jump::If {
-                            next: branch,
-                            end: b,
-                        });
+                        jumps.set(
+                            at,
+                            Jump::If {
+                                next: branch,
+                                end: b,
+                            },
+                        );
                         at = branch;
                     }
                     if matches!(control_of(program, at), Some(Control::Else)) {
-                        jumps[at] = Some(Jump::Else { end: b });
+                        jumps.set(at, Jump::Else { end: b });
                     } else {
-                        jumps[at] = Some(Jump::If { next: b, end: b });
+                        jumps.set(at, Jump::If { next: b, end: b });
                     }
                 }
                 _ => report(b, "$ENDIF without a matching $IF"),
@@ -249,15 +278,21 @@ fn match_level(
                     else {
                         unreachable!("matched just above")
                     };
-                    jumps[start] = Some(Jump::Switch {
-                        first_case: cases.first().copied(),
-                        default,
-                        end: b,
-                    });
+                    jumps.set(
+                        start,
+                        Jump::Switch {
+                            first_case: cases.first().copied(),
+                            default,
+                            end: b,
+                        },
+                    );
                     for (i, &case) in cases.iter().enumerate() {
-                        jumps[case] = Some(Jump::Case {
-                            next: cases.get(i + 1).copied(),
-                        });
+                        jumps.set(
+                            case,
+                            Jump::Case {
+                                next: cases.get(i + 1).copied(),
+                            },
+                        );
                     }
                     // `$BREAK` inside the switch (not inside a loop nested in it) leaves it.
                     resolve_breaks(program, start, b, jumps);
@@ -291,7 +326,7 @@ fn match_level(
             .filter(|&t| program.blocks[t].number == Some(n))
             .collect();
         match targets.as_slice() {
-            [to] => jumps[b] = Some(Jump::Go { to: *to }),
+            [to] => jumps.set(b, Jump::Go { to: *to }),
             [] => report(
                 b,
                 &format!("$GOTO N{n}: no block N{n} in this program level"),
@@ -305,7 +340,7 @@ fn match_level(
     // A `$BREAK`/`$CONTINUE` left without a jump stands in a `$SWITCH` only (`$CONTINUE`
     // there has no loop).
     for b in level {
-        if jumps[b].is_none() {
+        if !jumps.has(b) {
             if let Some(c @ (Control::Break | Control::Continue)) = control_of(program, b) {
                 report(b, &format!("${} outside a loop or $SWITCH", c.keyword()));
             }
@@ -315,13 +350,7 @@ fn match_level(
 
 /// Gives the `$BREAK`s and `$CONTINUE`s directly inside the loop `start..=end` (not inside
 /// a loop or `$SWITCH` nested in it) their jumps: after the loop, and to `again`.
-fn resolve_exits(
-    program: &Program,
-    start: usize,
-    end: usize,
-    again: usize,
-    jumps: &mut [Option<Jump>],
-) {
+fn resolve_exits(program: &Program, start: usize, end: usize, again: usize, jumps: &mut JumpTable) {
     let mut depth = 0usize;
     for b in start + 1..end {
         match control_of(program, b) {
@@ -331,15 +360,15 @@ fn resolve_exits(
             Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
                 depth = depth.saturating_sub(1)
             }
-            Some(Control::Break) if depth == 0 => jumps[b] = Some(Jump::Go { to: end + 1 }),
-            Some(Control::Continue) if depth == 0 => jumps[b] = Some(Jump::Go { to: again }),
+            Some(Control::Break) if depth == 0 => jumps.set(b, Jump::Go { to: end + 1 }),
+            Some(Control::Continue) if depth == 0 => jumps.set(b, Jump::Go { to: again }),
             _ => {}
         }
     }
 }
 
 /// Gives the `$BREAK`s directly inside the `$SWITCH` `start..=end` their jump after it.
-fn resolve_breaks(program: &Program, start: usize, end: usize, jumps: &mut [Option<Jump>]) {
+fn resolve_breaks(program: &Program, start: usize, end: usize, jumps: &mut JumpTable) {
     let mut depth = 0usize;
     for b in start + 1..end {
         match control_of(program, b) {
@@ -349,7 +378,7 @@ fn resolve_breaks(program: &Program, start: usize, end: usize, jumps: &mut [Opti
             Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
                 depth = depth.saturating_sub(1)
             }
-            Some(Control::Break) if depth == 0 => jumps[b] = Some(Jump::Go { to: end + 1 }),
+            Some(Control::Break) if depth == 0 => jumps.set(b, Jump::Go { to: end + 1 }),
             _ => {}
         }
     }
@@ -364,7 +393,7 @@ mod tests {
         Box::leak(s.into_boxed_str())
     }
 
-    fn jumps(src: &str) -> (Vec<Option<Jump>>, Vec<&'static str>) {
+    fn jumps(src: &str) -> (JumpTable, Vec<&'static str>) {
         let (tree, diags) = parse(src);
         assert!(diags.is_empty(), "{diags:?}");
         let (j, u) = match_control(&tree);
@@ -376,12 +405,12 @@ mod tests {
         let src = "$WHILE 1\n$IF 0\nX1\n$ELSE\nX2\n$ENDIF\n$ENDWHILE\nM30\n";
         let (j, u) = jumps(src);
         assert!(u.is_empty());
-        assert_eq!(j[0], Some(Jump::While { end: 6 }));
-        assert_eq!(j[1], Some(Jump::If { next: 3, end: 5 }));
-        assert_eq!(j[3], Some(Jump::Else { end: 5 }));
-        assert_eq!(j[5], None, "$ENDIF falls through");
-        assert_eq!(j[6], Some(Jump::EndWhile { start: 0 }));
-        assert_eq!(j[2], None);
+        assert_eq!(j.get(0), Some(Jump::While { end: 6 }));
+        assert_eq!(j.get(1), Some(Jump::If { next: 3, end: 5 }));
+        assert_eq!(j.get(3), Some(Jump::Else { end: 5 }));
+        assert_eq!(j.get(5), None, "$ENDIF falls through");
+        assert_eq!(j.get(6), Some(Jump::EndWhile { start: 0 }));
+        assert_eq!(j.get(2), None);
     }
 
     #[test]

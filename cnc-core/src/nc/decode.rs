@@ -1007,7 +1007,7 @@ impl DecoderState {
                 return;
             }
         };
-        if !(seconds >= 0.0) {
+        if seconds.is_nan() || seconds < 0.0 {
             ctx.error(
                 block.span,
                 format!("dwell time must not be negative, found {seconds}"),
@@ -1463,8 +1463,9 @@ pub fn check_budget(blocks: usize) -> u64 {
 
 /// Checks a whole program for a channel with `axes`, reading the channel's variables from
 /// `vars`: parses it with every subroutine file it calls (from `dir`, then `search`), runs it
-/// once (see [`super::interp::check_set`]) and checks every block the run did not reach. With
-/// `keep`, the decoded stream of the run is kept (what `cnc check --blocks` prints). The set is
+/// once (see [`super::interp::check_set`]) and checks every block the run did not reach. `keep`
+/// receives the decoded stream of the run (what `cnc check --blocks` prints), also when there
+/// are diagnostics. The set is
 /// only runnable when the diagnostics are empty.
 pub fn check_program(
     name: &str,
@@ -1473,7 +1474,7 @@ pub fn check_program(
     setup: &DecoderSetup,
     paths: (Option<&std::path::Path>, &super::interp::SearchPath),
     vars: &dyn Vars,
-    keep: Option<&mut Vec<Decoded>>,
+    keep: Option<super::interp::BlockSink<'_>>,
 ) -> (super::interp::ProgramSet, Vec<Diagnostic>) {
     let (set, mut diags) = super::interp::ProgramSet::load(name, src, paths.0, paths.1);
     if let Err(message) = check_channel_axes(axes) {

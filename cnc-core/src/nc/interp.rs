@@ -12,7 +12,7 @@
 //!   0.001; a `$CASE` branch runs on into the next one unless it ends with `$BREAK`.
 
 use super::ast::{Block, Command, Control, Item, Name, Program, Span, Target};
-use super::control::{control_of, levels, match_control, Jump};
+use super::control::{control_of, match_control, Jump, JumpTable};
 use super::decode::{evaluate_at, Decoded, DecoderState, Vars};
 use super::eval::truth;
 use super::parser::MAX_PARAM;
@@ -35,8 +35,8 @@ pub struct Unit {
     pub src: String,
     /// The tree.
     pub tree: Program,
-    /// Per block: its jump, if it is a `$` statement.
-    pub jumps: Vec<Option<Jump>>,
+    /// The jumps of its `$` blocks.
+    pub jumps: JumpTable,
     /// Per block with a call: where it goes (sorted by block).
     calls: Vec<(u32, Callee)>,
     /// A subroutine file (its diagnostics name it; the main file's are named by the caller).
@@ -433,7 +433,7 @@ impl Interpreter {
         let unit = &set.units[frame.unit as usize];
         let b = frame.next as usize;
         let block = &unit.tree.blocks[b];
-        if let Some(jump) = unit.jumps.get(b).copied().flatten() {
+        if let Some(jump) = unit.jumps.get(b) {
             if !system.machine_values_known()
                 && control_of(&unit.tree, b).is_some_and(reads_machine_values)
             {
@@ -625,7 +625,7 @@ impl Interpreter {
                 let mut at = b;
                 loop {
                     let (Some(Jump::If { next, .. }), Some(Control::If(c) | Control::ElseIf(c))) =
-                        (unit.jumps[at], control_of(&unit.tree, at))
+                        (unit.jumps.get(at), control_of(&unit.tree, at))
                     else {
                         break at + 1;
                     };
@@ -652,9 +652,11 @@ impl Interpreter {
                 self.assign(*var, first)
                     .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
                 let (last, step) = (eval(self, last)?, eval(self, step)?);
-                self.for_continues(unit, block, first, last, step)?
-                    .then_some(b + 1)
-                    .unwrap_or(end + 1)
+                if self.for_continues(unit, block, first, last, step)? {
+                    b + 1
+                } else {
+                    end + 1
+                }
             }
             (Jump::EndFor { start }, _) => {
                 let Some(Control::For {
@@ -680,9 +682,11 @@ impl Interpreter {
                 self.assign(*var, value)
                     .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
                 let for_block = &unit.tree.blocks[start];
-                self.for_continues(unit, for_block, value, last, step)?
-                    .then_some(start + 1)
-                    .unwrap_or(b + 1)
+                if self.for_continues(unit, for_block, value, last, step)? {
+                    start + 1
+                } else {
+                    b + 1
+                }
             }
             (Jump::EndDo { start }, Some(Control::EndDo(c))) => {
                 if truth(eval(self, c)?) {
@@ -709,7 +713,7 @@ impl Interpreter {
                             break;
                         }
                     }
-                    case = match unit.jumps[c] {
+                    case = match unit.jumps.get(c) {
                         Some(Jump::Case { next }) => next,
                         _ => None,
                     };
@@ -777,17 +781,20 @@ fn with_file(mut d: Diagnostic, unit: &Unit) -> Diagnostic {
     d
 }
 
+/// Receives the decoded elements of each step of a run.
+pub type BlockSink<'a> = &'a mut dyn FnMut(&[Decoded]);
+
 /// Checks a loaded set for a channel: runs it once from the start with `vars` (at most
 /// `budget` steps: a loop waiting for a value that only a running machine changes is no
-/// error), then checks every block the run did not reach on its own. With `keep`, the decoded
-/// stream of the run is kept there (`cnc check --blocks`). Returns the diagnostics, the first
+/// error), then checks every block the run did not reach on its own. `keep` receives the
+/// decoded stream of the run, step by step (`cnc check --blocks`). Returns the diagnostics, the first
 /// per block, sorted by file and position.
 pub fn check_set(
     set: &ProgramSet,
     decoder: &mut DecoderState,
     vars: &dyn Vars,
     budget: u64,
-    mut keep: Option<&mut Vec<Decoded>>,
+    mut keep: Option<BlockSink<'_>>,
 ) -> (Vec<Diagnostic>, bool) {
     let mut visited: Vec<Vec<bool>> = set
         .units
@@ -808,15 +815,15 @@ pub fn check_set(
                 *v = true;
             }
         }
-        let out = match keep.as_deref_mut() {
-            Some(k) => k,
-            None => {
-                scratch.clear();
-                &mut scratch
-            }
-        };
+        scratch.clear();
         let at = interp.position();
-        match interp.step(set, decoder, vars, out) {
+        let step = interp.step(set, decoder, vars, &mut scratch);
+        if let Some(k) = keep.as_deref_mut() {
+            if !scratch.is_empty() {
+                k(&scratch);
+            }
+        }
+        match step {
             Ok(Step::End) => {
                 finished = true;
                 break;
@@ -844,7 +851,6 @@ pub fn check_set(
             diags.extend(found.into_iter().map(|d| with_file(d, unit)));
         }
     }
-    let _ = levels;
     diags.sort_by(|a, b| {
         (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col))
     });

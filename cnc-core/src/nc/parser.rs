@@ -952,10 +952,7 @@ impl Parser<'_> {
                     }
                 }
             }
-            "TIME" => match self.expr() {
-                Some(seconds) => Some(Command::Time { seconds }),
-                None => None,
-            },
+            "TIME" => self.expr().map(|seconds| Command::Time { seconds }),
             "VAR" => Some(Command::Var),
             "ENDVAR" => Some(Command::EndVar),
             "COMMENT" => {
