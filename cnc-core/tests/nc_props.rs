@@ -514,3 +514,69 @@ proptest! {
         prop_assert_eq!(format!("{fast:#?}"), format!("{general:#?}"), "{:?}", text);
     }
 }
+
+/// What a check reports: the rendered diagnostics and the decoded elements.
+fn checked_whole(src: &str, axes: &[String]) -> (Vec<String>, Vec<cnc_core::nc::Decoded>) {
+    let (diags, decoded) = check_source(src, axes);
+    (diags.iter().map(|d| d.render("F")).collect(), decoded)
+}
+
+fn checked_straight(
+    src: &str,
+    axes: &[String],
+) -> Option<(Vec<String>, Vec<cnc_core::nc::Decoded>)> {
+    use cnc_core::nc::decode::{DecoderSetup, ZeroVars};
+    let mut decoded = Vec::new();
+    let mut keep = |step: &[cnc_core::nc::Decoded]| decoded.extend_from_slice(step);
+    let diags = cnc_core::nc::straight::check_straight(
+        src,
+        axes,
+        &DecoderSetup::default(),
+        &ZeroVars,
+        Some(&mut keep),
+    )?;
+    Some((diags.iter().map(|d| d.render("F")).collect(), decoded))
+}
+
+fn straight_program() -> impl Strategy<Value = String> {
+    prop::collection::vec(
+        prop_oneof![
+            4 => motion_block(),
+            1 => command().prop_map(|command| vec![Item::Command {
+                command: Box::new(command),
+                span: span()
+            }]),
+            1 => prop::collection::vec((target(), any_expr()), 1..3).prop_map(|a| a
+                .into_iter()
+                .map(|(target, value)| Item::Assign { assign: Box::new(Assign { target, value }), span: span() })
+                .collect()),
+        ],
+        0..60,
+    )
+    .prop_map(|blocks| {
+        let mut program = Program::default();
+        for items in blocks {
+            program.push_block(None, items, span(), 0);
+        }
+        print(&program)
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// A straight program checked window by window reports what the whole-program check
+    /// reports, and decodes the same blocks.
+    #[test]
+    fn straight_check_matches_the_whole_program_check(
+        text in straight_program(),
+        lines in fragment_lines(),
+    ) {
+        let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C", "AB", "X1"].map(String::from).to_vec();
+        for src in [text, lines] {
+            if let Some(straight) = checked_straight(&src, &axes) {
+                prop_assert_eq!(straight, checked_whole(&src, &axes), "{}", src);
+            }
+        }
+    }
+}

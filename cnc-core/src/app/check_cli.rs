@@ -4,6 +4,7 @@
 use crate::app::json::push_number;
 use crate::nc::decode::{check_channel_axes, DecoderSetup, ZeroVars};
 use crate::nc::interp::{check_set, SearchPath};
+use crate::nc::straight::check_straight;
 use crate::nc::{check_program, Decoded, DecoderState, Diagnostic};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -101,6 +102,21 @@ pub fn push_motion_json(out: &mut String, block: &crate::nc::MotionBlock, axes: 
     out.push('}');
 }
 
+/// Appends the motion blocks of `step` to `out` as JSON lines, writing `out` out when it has
+/// grown (not once the reader has gone).
+fn print_blocks(step: &[Decoded], axes: &[String], out: &mut String, reader_gone: &mut bool) {
+    for d in step {
+        if let Decoded::Motion(m) = d {
+            push_motion_json(out, m, axes);
+            out.push('\n');
+        }
+    }
+    if out.len() > 1 << 16 && !*reader_gone {
+        *reader_gone = !emit(out);
+        out.clear();
+    }
+}
+
 /// Writes `text` to stdout; `false` when the reader has gone (a closed pipe ends quietly).
 fn emit(text: &str) -> bool {
     let mut stdout = std::io::stdout().lock();
@@ -137,8 +153,26 @@ pub fn main(args: CheckArgs) -> ExitCode {
                 continue;
             }
         };
-        let dir = file.parent().map(Path::to_path_buf);
         let setup = DecoderSetup::default();
+        // A straight program is checked as it is read (one window of its tree in memory).
+        if let Some(diags) = check_straight(&src, &axes, &setup, &ZeroVars, None) {
+            for d in &diags {
+                out.push_str(&d.render(&name));
+                out.push('\n');
+            }
+            failed |= !diags.is_empty();
+            if args.blocks && diags.is_empty() {
+                let mut reader_gone = false;
+                let mut print =
+                    |step: &[Decoded]| print_blocks(step, &axes, &mut out, &mut reader_gone);
+                check_straight(&src, &axes, &setup, &ZeroVars, Some(&mut print));
+                if reader_gone {
+                    return exit_code(failed);
+                }
+            }
+            continue;
+        }
+        let dir = file.parent().map(Path::to_path_buf);
         let (set, diags) = check_program(
             &name,
             src,
@@ -159,18 +193,8 @@ pub fn main(args: CheckArgs) -> ExitCode {
             let mut decoder = DecoderState::new(&axes);
             decoder.configure(&setup);
             let mut reader_gone = false;
-            let mut print = |step: &[Decoded]| {
-                for d in step {
-                    if let Decoded::Motion(m) = d {
-                        push_motion_json(&mut out, m, &axes);
-                        out.push('\n');
-                    }
-                }
-                if out.len() > 1 << 16 && !reader_gone {
-                    reader_gone = !emit(&out);
-                    out.clear();
-                }
-            };
+            let mut print =
+                |step: &[Decoded]| print_blocks(step, &axes, &mut out, &mut reader_gone);
             let budget = crate::nc::decode::check_budget(set.block_count());
             check_set(&set, &mut decoder, &ZeroVars, budget, Some(&mut print));
             if reader_gone {

@@ -288,6 +288,17 @@ struct Frame {
     locals_mark: u32,
 }
 
+/// How a block ends besides its motion.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct BlockEnd {
+    /// A subroutine call at this span.
+    pub call: Option<Span>,
+    /// M17/M29: a subroutine returns.
+    pub leave: bool,
+    /// M2/M30: the program ends.
+    pub end: bool,
+}
+
 /// What one step did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Step {
@@ -449,50 +460,9 @@ impl Interpreter {
             return Ok(Step::Control);
         }
         self.top().next += 1;
-        let items = unit.tree.items_of(block);
-        let mut call = None;
-        let mut leave = false;
-        let mut end = false;
-        for item in items {
-            match item {
-                Item::Assign { assign, span } => {
-                    let value = evaluate_at(
-                        &assign.value,
-                        *span,
-                        &unit.src,
-                        &Env {
-                            interp: self,
-                            system,
-                        },
-                    )
-                    .map_err(|d| with_file(d, unit))?;
-                    self.assign(assign.target, value)
-                        .map_err(|m| with_file(Diagnostic::located(*span, m, &unit.src), unit))?;
-                }
-                Item::Call { span, .. } => call = Some(*span),
-                Item::M { code: 17 | 29, .. } => leave = true,
-                Item::M { code: 2 | 30, .. } => end = true,
-                Item::Command { command, .. } => match command.as_ref() {
-                    Command::Var => self.declaring = true,
-                    Command::EndVar => self.declaring = false,
-                    _ => {}
-                },
-                _ => {}
-            }
-        }
-        let diags = decoder.decode_block(
-            &unit.tree,
-            b,
-            &unit.src,
-            &Env {
-                interp: self,
-                system,
-            },
-            out,
-        );
-        if let Some(d) = diags.into_iter().next() {
-            return Err(with_file(d, unit));
-        }
+        let BlockEnd { call, leave, end } = self
+            .run_block(&unit.tree, b, &unit.src, decoder, system, out)
+            .map_err(|d| with_file(d, unit))?;
         if let Some(span) = call {
             let callee = unit
                 .calls
@@ -534,6 +504,65 @@ impl Interpreter {
             unit: frame.unit,
             block: b as u32,
         })
+    }
+
+    /// Runs block `b` of `tree` (parsed from `src`) that is no `$` statement: its assignments
+    /// in order, then the block decoded with the variables as they are then. Says how the
+    /// block ends (a call, M17/M29, M2/M30); following that is the caller's.
+    pub fn run_block(
+        &mut self,
+        tree: &Program,
+        b: usize,
+        src: &str,
+        decoder: &mut DecoderState,
+        system: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Result<BlockEnd, Diagnostic> {
+        let mut ending = BlockEnd::default();
+        let Some(block) = tree.blocks.get(b) else {
+            return Ok(ending);
+        };
+        for item in tree.items_of(block) {
+            match item {
+                Item::Assign { assign, span } => {
+                    let env = Env {
+                        interp: self,
+                        system,
+                    };
+                    let value = evaluate_at(&assign.value, *span, src, &env)?;
+                    self.assign(assign.target, value)
+                        .map_err(|m| Diagnostic::located(*span, m, src))?;
+                }
+                Item::Call { span, .. } => ending.call = Some(*span),
+                Item::M { code: 17 | 29, .. } => ending.leave = true,
+                Item::M { code: 2 | 30, .. } => ending.end = true,
+                Item::Command { command, .. } => match command.as_ref() {
+                    Command::Var => self.declaring = true,
+                    Command::EndVar => self.declaring = false,
+                    _ => {}
+                },
+                _ => {}
+            }
+        }
+        let env = Env {
+            interp: self,
+            system,
+        };
+        let diags = decoder.decode_block(tree, b, src, &env, out);
+        match diags.into_iter().next() {
+            Some(d) => Err(d),
+            None => Ok(ending),
+        }
+    }
+
+    /// Clears the variables for a new run without a program set (a checker running a straight
+    /// program window by window with [`Interpreter::run_block`]).
+    pub fn reset_variables(&mut self) {
+        self.frames.clear();
+        self.params.iter_mut().for_each(|p| *p = None);
+        self.globals.clear();
+        self.locals.clear();
+        self.declaring = false;
     }
 
     /// Goes on after the block that failed (a check reports every error, not the first).
@@ -810,15 +839,17 @@ pub fn check_set(
     let fresh = decoder.clone();
     while steps < budget {
         steps += 1;
-        if let Some((u, b)) = interp.position() {
+        scratch.clear();
+        let at = interp.position();
+        let step = interp.step(set, decoder, vars, &mut scratch);
+        // The block the step ran (or failed in) has been checked by the run.
+        if let (Some((u, b)), Ok(Step::Block { .. } | Step::Control) | Err(_)) = (at, &step) {
             if let Some(v) = visited[u as usize].get_mut(b as usize) {
                 *v = true;
             }
         }
-        scratch.clear();
-        let at = interp.position();
-        let step = interp.step(set, decoder, vars, &mut scratch);
-        if let Some(k) = keep.as_deref_mut() {
+        // A block that failed hands on nothing.
+        if let (Some(k), Ok(_)) = (keep.as_deref_mut(), &step) {
             if !scratch.is_empty() {
                 k(&scratch);
             }

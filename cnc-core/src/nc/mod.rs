@@ -11,6 +11,7 @@ pub mod interp;
 pub mod lexer;
 pub mod parser;
 pub mod printer;
+pub mod straight;
 
 pub use decode::{check_program, Decoded, DecoderState, MotionBlock, MotionMode};
 pub use parser::{parse, parse_general};

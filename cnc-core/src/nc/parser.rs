@@ -28,6 +28,7 @@ fn parse_with(src: &str, fast_lane: bool) -> (Program, Vec<Diagnostic>) {
         tokens: Vec::with_capacity(32),
         pos: 0,
         diags: Vec::new(),
+        blocks_before: 0,
     };
     let program = p.program();
     let mut diags: Vec<Diagnostic> = p
@@ -51,6 +52,61 @@ struct Parser<'a> {
     tokens: Vec<Token>,
     pos: usize,
     diags: Vec<Diagnostic>,
+    /// Blocks of the windows before the current one (see [`Windows`]).
+    blocks_before: usize,
+}
+
+/// A program parsed window by window: a checker that runs a straight program as it reads it
+/// keeps one window of its tree in memory, not the whole tree.
+pub struct Windows<'a> {
+    parser: Parser<'a>,
+    more: bool,
+}
+
+impl<'a> Windows<'a> {
+    /// Windows of `src`.
+    pub fn new(src: &'a str) -> Self {
+        Self {
+            parser: Parser {
+                src,
+                fast_lane: true,
+                lexer: Lexer::new(src),
+                tokens: Vec::with_capacity(32),
+                pos: 0,
+                diags: Vec::new(),
+                blocks_before: 0,
+            },
+            more: true,
+        }
+    }
+
+    /// Replaces the blocks of `window` with the next at most `max_blocks` (the program's name
+    /// and local subroutines stay: a header belongs to the whole program); `false` when no
+    /// block is left.
+    pub fn next(&mut self, window: &mut Program, max_blocks: usize) -> bool {
+        self.parser.blocks_before += window.blocks.len();
+        window.blocks.clear();
+        window.items.clear();
+        if self.more {
+            self.more = self.parser.fill(window, max_blocks);
+        }
+        !window.blocks.is_empty()
+    }
+
+    /// Every syntax diagnostic of the program (after the last window), located.
+    pub fn finish(mut self) -> Vec<Diagnostic> {
+        let src = self.parser.src;
+        let mut diags: Vec<Diagnostic> = self
+            .parser
+            .lexer
+            .errors
+            .drain(..)
+            .map(|e| Diagnostic::new(e.span, e.message, src))
+            .collect();
+        diags.append(&mut self.parser.diags);
+        super::locate(&mut diags, src);
+        diags
+    }
 }
 
 const TRACK_FLAGS: &[&str] = &[
@@ -171,7 +227,21 @@ impl Parser<'_> {
         // system has them, one page fault per 2 MiB instead of one per 4 KiB.
         hli::raw::advise_huge_pages(&mut program.blocks);
         hli::raw::advise_huge_pages(&mut program.items);
+        self.fill(&mut program, usize::MAX);
+        if program.name.is_none() && !program.subs.is_empty() {
+            self.close_sub(&mut program);
+        }
+        program
+    }
+
+    /// Parses on into `program` until it holds `max_blocks` more blocks or the source ends;
+    /// `false` when the source has ended.
+    fn fill(&mut self, program: &mut Program, max_blocks: usize) -> bool {
+        let limit = program.blocks.len().saturating_add(max_blocks);
         loop {
+            if program.blocks.len() >= limit {
+                return true;
+            }
             if self.fast_lane {
                 if let Some(block) = self.lexer.simple_block(&mut program.items) {
                     program.blocks.push(block);
@@ -179,20 +249,21 @@ impl Parser<'_> {
                 }
             }
             if !self.lexer.next_block(&mut self.tokens) {
-                break;
+                return false;
             }
             self.pos = 0;
             if let Tok::Percent(name) = self.peek().clone() {
                 let span = self.span();
                 self.bump();
-                if self.local_sub_header(&name, span, &mut program) {
+                if self.local_sub_header(&name, span, program) {
                     continue;
                 }
                 let after_subs = !program.subs.is_empty() && program.name.is_none();
                 if after_subs {
-                    self.close_sub(&mut program);
+                    self.close_sub(program);
                 }
-                if (program.name.is_some() || !program.blocks.is_empty()) && !after_subs {
+                let blocks_before = !program.blocks.is_empty() || self.blocks_before > 0;
+                if (program.name.is_some() || blocks_before) && !after_subs {
                     self.error(
                         span,
                         "a program header \"%name\" must come first and only once",
@@ -220,10 +291,6 @@ impl Parser<'_> {
                 program.items.truncate(items_before);
             }
         }
-        if program.name.is_none() && !program.subs.is_empty() {
-            self.close_sub(&mut program);
-        }
-        program
     }
 
     /// `%L name` (the lexer gives `%L` and the name as separate tokens when blank-separated):
