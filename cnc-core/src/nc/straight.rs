@@ -94,7 +94,7 @@ pub fn check_straight(
     let mut all = windows.finish();
     all.append(&mut diags);
     let mut diags = all;
-    diags.sort_by(|a, b| (a.line, a.col).cmp(&(b.line, b.col)));
+    diags.sort_by_key(|d| (d.line, d.col));
     diags.dedup_by(|b, a| (a.line, a.col) == (b.line, b.col));
     Some(diags)
 }
