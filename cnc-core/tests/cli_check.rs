@@ -119,3 +119,65 @@ fn bad_axis_lists_are_refused_before_any_file() {
         assert!(out.is_empty());
     }
 }
+
+#[test]
+fn blocks_into_a_closed_pipe_ends_quietly() {
+    // `cnc check --blocks F | head -1`: the reader goes after one line; the checker must end
+    // without a panic message (it used to panic on the broken pipe).
+    use std::io::{BufRead, BufReader};
+    let mut text = String::new();
+    for i in 0..50_000 {
+        text.push_str(&format!("G1 X{} Y{} F1000\n", i % 500, i % 300));
+    }
+    let f = write("pipe.nc", &text);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["check", "--blocks", &f])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.starts_with("{\"line\":1,"), "{first}");
+    // The pipe's reader is dropped here.
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.is_empty(), "{stderr}");
+    assert_eq!(out.status.code(), Some(0));
+}
+
+#[test]
+fn subroutine_files_are_found_next_to_the_program_and_on_the_search_path() {
+    let d = dir().join("subs");
+    std::fs::create_dir_all(d.join("lib")).unwrap();
+    std::fs::write(d.join("side.nc"), "G91 G1 X10 F500\nG90\nL corner.nc\nM17\n").unwrap();
+    std::fs::write(d.join("lib").join("corner.nc"), "G91 Y5\nG90\nM17\n").unwrap();
+    let main = d.join("main.nc");
+    std::fs::write(&main, "$FOR P1 = 1, 2\nL side.nc\n$ENDFOR\nM30\n").unwrap();
+    let main = main.display().to_string();
+    let lib = d.join("lib").display().to_string();
+    // Without the search path the nested file is missing: named with its position.
+    let (code, stdout, _) = cnc(&["check", &main]);
+    assert_eq!(code, 1);
+    assert!(
+        stdout.contains("side.nc:3:1: error: L corner.nc: subroutine file not found"),
+        "{stdout}"
+    );
+    let (code, stdout, stderr) = cnc(&["check", "--blocks", "--search", &lib, &main]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let targets: Vec<&str> = stdout
+        .lines()
+        .map(|l| &l[l.find("\"X\"").unwrap()..l.find(",\"Z\"").unwrap()])
+        .collect();
+    assert_eq!(
+        targets,
+        [
+            "\"X\":10,\"Y\":0",
+            "\"X\":10,\"Y\":5",
+            "\"X\":20,\"Y\":5",
+            "\"X\":20,\"Y\":10"
+        ]
+    );
+}
