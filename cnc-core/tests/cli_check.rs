@@ -152,7 +152,11 @@ fn blocks_into_a_closed_pipe_ends_quietly() {
 fn subroutine_files_are_found_next_to_the_program_and_on_the_search_path() {
     let d = dir().join("subs");
     std::fs::create_dir_all(d.join("lib")).unwrap();
-    std::fs::write(d.join("side.nc"), "G91 G1 X10 F500\nG90\nL corner.nc\nM17\n").unwrap();
+    std::fs::write(
+        d.join("side.nc"),
+        "G91 G1 X10 F500\nG90\nL corner.nc\nM17\n",
+    )
+    .unwrap();
     std::fs::write(d.join("lib").join("corner.nc"), "G91 Y5\nG90\nM17\n").unwrap();
     let main = d.join("main.nc");
     std::fs::write(&main, "$FOR P1 = 1, 2\nL side.nc\n$ENDFOR\nM30\n").unwrap();

@@ -327,3 +327,46 @@ fn the_arc_modes_are_named_in_the_block_stream() {
     let arc = m.arc.unwrap();
     assert!(arc.center[0].abs() < 1e-12 && arc.center[1].abs() < 1e-12);
 }
+
+#[test]
+fn an_arc_under_the_kinematic_transformation_moves_the_tool_on_the_circle() {
+    // A six-axis robot: the arc is programmed in the tool's coordinates, the joints follow
+    // through the inverse kinematics every tick.
+    let mut config = ChannelConfig::new("robot", &["X", "Y", "Z", "A", "B", "C"]);
+    config.kinematics.id = 45;
+    config.kinematics.preset = Some("kr6r900sixx".into());
+    config.start = vec![0.0, -60.0, 90.0, 0.0, 60.0, 0.0];
+    let src = "#TRAFO ON\nG91 G3 X-40 Y0 I-20 J0 F3000\nG2 X40 Y0 R20\nG90\nM30\n";
+    let mut ctl = channel_with(config, src);
+    let memory = heap_image(1, 8);
+    let view = CncView::new(&memory);
+    // Before the first tick the tool stands where the joints put it: where #TRAFO ON starts.
+    let mut tool = vec![ctl.channels()[0].tool_pose().translation.vector];
+    for _ in 0..20_000 {
+        ctl.tick(&view);
+        let c = &ctl.channels()[0];
+        assert_ne!(c.state(), RunState::Error, "{:?}", c.error());
+        tool.push(c.tool_pose().translation.vector);
+        if c.state() == RunState::Finished && !c.is_moving() {
+            break;
+        }
+    }
+    let start = tool[0];
+    let center = start - nalgebra::Vector3::new(20.0, 0.0, 0.0);
+    let mut worst = 0.0f64;
+    let mut highest_y = f64::NEG_INFINITY;
+    for p in &tool {
+        let d = p - center;
+        worst = worst
+            .max((d.x.hypot(d.y) - 20.0).abs())
+            .max((p.z - start.z).abs());
+        highest_y = highest_y.max(p.y - start.y);
+    }
+    // The tool pose of the joints (forward kinematics) is on the circle to the solver's
+    // precision. G3 from angle 0 to 180 degrees and G2 back from 180 to 0 both pass over the
+    // top of the circle (y + 20).
+    assert!(worst < 1e-6, "off the circle by {worst}");
+    assert!((highest_y - 20.0).abs() < 1e-3, "{highest_y}");
+    let end = tool.last().unwrap();
+    assert!((end - start).norm() < 1e-6, "{end:?} vs {start:?}");
+}

@@ -150,6 +150,12 @@ impl core::fmt::Debug for AxisValues {
     }
 }
 
+/// One-letter words that are never axes: G, M, F, N and the circle, spindle, tool, parameter
+/// and call addresses.
+pub const RESERVED_ADDRESSES: &[&str] = &[
+    "D", "F", "G", "I", "J", "K", "L", "M", "N", "P", "R", "S", "T",
+];
+
 /// Checks a channel's axis names: 1 to [`MAX_CHANNEL_AXES`] of them, each a letter followed by
 /// letters or digits (`X`, `AB`, `X1`), none twice.
 pub fn check_channel_axes(axes: &[String]) -> Result<(), String> {
@@ -171,6 +177,12 @@ pub fn check_channel_axes(axes: &[String]) -> Result<(), String> {
         }
         if axes[..i].contains(a) {
             return Err(format!("axis name \"{a}\" is given twice"));
+        }
+        if RESERVED_ADDRESSES.contains(&a.as_str()) {
+            return Err(format!(
+                "axis name \"{a}\" is an address of the language ({})",
+                RESERVED_ADDRESSES.join(" ")
+            ));
         }
     }
     Ok(())
@@ -728,10 +740,23 @@ impl DecoderState {
     }
 
     fn unknown_axis(&self, ctx: &mut Ctx<'_>, span: Span, name: &str) {
+        // `XP1`, `XV.P.A`: an axis with a value glued on, which this dialect writes X=P1.
+        let glued_value = name.len() > 1
+            && matches!(name.as_bytes()[name.len().min(2) - 1], b'P' | b'V')
+            && self.axis_index(&name[..1]).is_some();
+        let hint = if glued_value {
+            format!(
+                " (a value from a variable is written {}=..., e.g. {}=P1)",
+                &name[..1],
+                &name[..1]
+            )
+        } else {
+            String::new()
+        };
         ctx.error(
             span,
             format!(
-                "unknown axis \"{name}\" for this channel (axes: {})",
+                "unknown axis \"{name}\" for this channel (axes: {}){hint}",
                 self.axes.join(" ")
             ),
         );

@@ -619,6 +619,19 @@ impl Parser<'_> {
         if glued.is_none() && (word == "L" || word == "LL") {
             return self.sub_call(word == "LL", span);
         }
+        if word == "PP" || word == "PPP" {
+            self.error(span, "indirect P parameters (PP1) are not supported");
+            self.recover();
+            return None;
+        }
+        if word == "P" && glued.is_none() && self.is_punct("[") {
+            self.error(
+                span,
+                "indexed P parameters (P[..]) and P arrays are not supported",
+            );
+            self.recover();
+            return None;
+        }
         if word == "P" {
             let Some(n) = Self::param_number(word, glued) else {
                 self.error(
@@ -1389,6 +1402,9 @@ impl Parser<'_> {
                 let (span, found) = (self.span(), self.describe());
                 let hint = if Func::named(&w).is_some() {
                     format!("{w} is a function: write {w}[...]")
+                } else if matches!(self.peek_at(1), Tok::Punct("[")) {
+                    let known: Vec<&str> = Func::ALL.iter().map(|f| f.1).collect();
+                    format!("unknown function {w} (known: {})", known.join(", "))
                 } else {
                     format!(
                         "expected a number, a variable, P.., a function or \"[\", found {found}"
