@@ -681,3 +681,69 @@ fn program_state_and_m_function_announcement_reach_the_plc_through_the_stages() 
     assert_eq!(state(&memory), ProgramState::Finished);
     assert_eq!(ctl.channels()[0].m_functions_acked(), 1);
 }
+
+/// Example 3's set-up with an arc: the slave circles the workpiece point (radius 10 mm, in the
+/// workpiece's own coordinates) while the master carries the workpiece; the slave's tool stays
+/// on that circle on the moving workpiece.
+#[test]
+fn an_arc_under_track_cs_stays_on_its_circle_on_the_moving_workpiece() {
+    let master = "%master
+#TRAFO [45]
+#CHANNEL INTERFACE ON [DYN_CS]
+#WAIT SYN [ID1]
+G1 X680 Y40 Z560 F1500
+G1 X600 Y-40 Z520 F1500
+#SIGNAL SYN [ID2 COUNT1]
+M30
+";
+    let slave = "%slave
+#TRAFO [45]
+#CS ON [OFFS] [400, 700, 0, 0, 0, -90]
+#TRACK CS ON [ID=1 SET_ZERO X=400 Y=700 C=-90 FILTER=0 WAIT]
+#CS ON [V.G.TRACK_CS.X, V.G.TRACK_CS.Y, V.G.TRACK_CS.Z, V.G.TRACK_CS.A, -V.G.TRACK_CS.B, V.G.TRACK_CS.C]
+G1 X10 Y0 Z0 A0 B0 C0 F3000
+#SIGNAL SYN [ID1 COUNT1]
+$WHILE 1
+G3 X-10 Y0 I-10 J0 F3000
+G3 X10 Y0 R10
+$ENDWHILE
+";
+    let mut ctl = controller(vec![(robot("master"), master), (robot("slave"), slave)]);
+    let memory = image(2);
+    let offset = offset_frame(
+        &PoseWords {
+            xyz: [400.0, 700.0, 0.0],
+            abc: [0.0, 0.0, -90.0],
+        },
+        false,
+    )
+    .unwrap();
+    let (mut checked, mut worst, mut turned) = (0, 0.0f64, 0.0f64);
+    run_until(
+        &mut ctl,
+        &memory,
+        60_000,
+        |ctl, _| {
+            let (m, s) = (&ctl.channels()[0], &ctl.channels()[1]);
+            if s.tracker().state() == DynCsState::Active && m.is_moving() && s.is_moving() {
+                // The slave's tool in the workpiece's coordinates (the master's tool frame).
+                let workpiece = offset * m.tool_pose();
+                let local = workpiece.inverse() * s.tool_pose();
+                let p = local.translation.vector;
+                worst = worst.max((p.x.hypot(p.y) - 10.0).abs()).max(p.z.abs());
+                turned = turned.max(-p.y);
+                checked += 1;
+            }
+        },
+        |ctl| ctl.channels()[0].state() == RunState::Finished,
+    );
+    assert!(
+        checked > 1000,
+        "{checked} ticks on the arc while the master moved"
+    );
+    assert!(turned > 9.9, "the arc went round: lowest y {}", -turned);
+    assert!(
+        worst < 1e-3,
+        "off the circle on the workpiece by {worst} mm"
+    );
+}
