@@ -1,7 +1,7 @@
 //! `cnc check` against LinuxCNC's `rs274 -g`, whole process against whole process: the same
 //! 100,000-block program (lines and arcs, centre and radius forms), each program started, run
 //! and waited for, in interleaved rounds; medians, the ratio taken per round, and each
-//! process's peak memory (its maximum resident set, from `wait4`). rs274 is skipped, and the
+//! process's peak memory (its maximum resident set, `hli::raw::wait_with_peak_memory`). rs274 is skipped, and the
 //! report says so, when it is not installed (Debian package `linuxcnc-uspace`).
 //!
 //! Three of ours: `cnc check FILE` (parse, run and check every block; prints nothing for a
@@ -65,19 +65,10 @@ fn run(cmd: &mut Command) -> (f64, i64) {
         .stderr(Stdio::null())
         .spawn()
         .expect("start the program");
-    let mut status = 0;
-    // SAFETY: `usage` is a plain C struct the kernel fills; the pid is our own child's.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    let pid = child.id() as libc::pid_t;
-    // SAFETY: waits for our own child; both pointers are to live locals.
-    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    let (success, peak) = hli::raw::wait_with_peak_memory(child).expect("wait4");
     let elapsed = t0.elapsed().as_secs_f64();
-    assert_eq!(waited, pid, "wait4");
-    assert!(
-        libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0,
-        "{cmd:?} failed"
-    );
-    (elapsed, usage.ru_maxrss)
+    assert!(success, "{cmd:?} failed");
+    (elapsed, peak)
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

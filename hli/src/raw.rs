@@ -397,6 +397,25 @@ pub fn advise_huge_pages<T>(buffer: &mut Vec<T>) {
     let _ = buffer;
 }
 
+/// Waits for `child` to end and returns whether it exited with status 0 and its peak resident
+/// memory in KiB (the kernel's `ru_maxrss` of that one process), for benchmarks that compare
+/// whole processes. Lives here so that the workspace keeps a single module with `unsafe`.
+#[cfg(target_os = "linux")]
+pub fn wait_with_peak_memory(child: std::process::Child) -> std::io::Result<(bool, i64)> {
+    let pid = child.id() as libc::pid_t;
+    let mut status: libc::c_int = 0;
+    // SAFETY: `rusage` is a plain C struct of integers, for which all zero bytes are valid.
+    let mut usage: libc::rusage = unsafe { core::mem::zeroed() };
+    // SAFETY: `pid` is our own child, not yet waited for (we own its `Child`); both pointers are
+    // to live locals of the right types for the duration of the call.
+    let waited = unsafe { libc::wait4(pid, &mut status, 0, &mut usage) };
+    if waited != pid {
+        return Err(std::io::Error::last_os_error());
+    }
+    let success = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
+    Ok((success, usage.ru_maxrss))
+}
+
 #[cfg(test)]
 mod huge_page_tests {
     use super::advise_huge_pages;
