@@ -221,7 +221,8 @@ fn tool_length_and_zero_offsets_come_from_the_machine_data() {
     "#;
     let config: ChannelConfig = toml::from_str(toml).unwrap();
     let setup: DecoderSetup = config.nc.setup();
-    let src = "G54 G0 X0 Y0 Z10\nD1 Z10\nG18 D2 Z10 Y0\nG17 G55 D0 X0 Y0 Z0\nG53 X0\nM30\n";
+    let src = "G54 G0 X0 Y0 Z10\nD1 Z10\nG18 D2 Z10 Y0\nG17 G55 D0 X0 Y0 Z0\nG53 X0\n\
+               G54 X10\n#PSET X0\nX5\nM30\n";
     let mut decoded = Vec::new();
     let (_, diags) = cnc_core::nc::check_program(
         "t.nc",
@@ -251,6 +252,10 @@ fn tool_length_and_zero_offsets_come_from_the_machine_data() {
             // G55, no tool: only X has a G55 offset.
             [-10.0, 0.0, 0.0],
             [0.0, 0.0, 0.0],
+            // G54 again: X10 stands at 110; #PSET X0 declares that 0, and X5 is 5 further
+            // (the preset does not take the zero offset a second time).
+            [110.0, 0.0, 0.0],
+            [115.0, 0.0, 0.0],
         ]
     );
 }
@@ -369,4 +374,63 @@ fn an_arc_under_the_kinematic_transformation_moves_the_tool_on_the_circle() {
     assert!((highest_y - 20.0).abs() < 1e-3, "{highest_y}");
     let end = tool.last().unwrap();
     assert!((end - start).norm() < 1e-6, "{end:?} vs {start:?}");
+}
+
+#[test]
+fn an_open_var_section_of_a_subroutine_ends_with_it() {
+    // The subroutine opens #VAR and never closes it; back in the caller an assignment updates
+    // the caller's V.L.N instead of declaring a new one.
+    let src =
+        "%L SUB\n#VAR\nV.L.N = 7\nM17\n%MAIN\nV.L.N = 1\nLL SUB\nV.L.N = 2\nP1 = V.L.N\nM30\n";
+    let (set, diags) = ProgramSet::load("var.nc", src.to_string(), None, &SearchPath::default());
+    assert!(diags.is_empty(), "{diags:?}");
+    let axes: Vec<String> = ["X"].map(String::from).to_vec();
+    let mut interp = Interpreter::new();
+    let mut decoder = DecoderState::new(&axes);
+    interp.start(&set);
+    let mut out = Vec::new();
+    while interp
+        .step(&set, &mut decoder, &ZeroVars, &mut out)
+        .unwrap()
+        != Step::End
+    {}
+    assert_eq!(interp.param(1), Some(2.0));
+}
+
+#[test]
+fn tolerances_and_tool_data_that_are_no_numbers_are_refused() {
+    for (field, toml) in [
+        (
+            "chordal_tolerance",
+            "interpolator = { chordal_tolerance = 0.0 }",
+        ),
+        ("arc_tolerance", "nc = { arc_tolerance = -1.0 }"),
+        ("nc.tools", "nc = { tools = [{ d = 0, length = 5.0 }] }"),
+        (
+            "nc.zero_offsets",
+            "nc = { zero_offsets = { G54 = [1, 2, 3, 4, 5, 6, 7] } }",
+        ),
+    ] {
+        let text =
+            format!("name = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n{toml}\n");
+        let config: ChannelConfig = toml::from_str(&text).unwrap();
+        let err = Channel::new(0, config, CYCLE).unwrap_err().to_string();
+        assert!(err.contains(field), "{field}: {err}");
+    }
+}
+
+#[test]
+fn a_new_program_starts_from_the_modal_defaults() {
+    let config = ChannelConfig::new("m", &["X", "Y", "Z", "A", "B", "C"]);
+    let first = LoadedProgram::load("first", "G70 G91 G1 X1 F100\nM30\n", &config.axes).unwrap();
+    let second = LoadedProgram::load("second", "G1 X1 F100\nM30\n", &config.axes).unwrap();
+    let mut channel = Channel::new(0, config, CYCLE).unwrap();
+    channel.start(first);
+    let mut ctl = Controller::new(vec![channel]).unwrap();
+    run(&mut ctl, 100_000, |_| {});
+    assert!((ctl.channels()[0].programmed()[0] - 25.4).abs() < 1e-9);
+    ctl.channel_mut(0).unwrap().start(second);
+    run(&mut ctl, 100_000, |_| {});
+    // Millimetres and absolute again: X1 is 1 mm, not 25.4 mm further.
+    assert!((ctl.channels()[0].programmed()[0] - 1.0).abs() < 1e-9);
 }

@@ -277,6 +277,45 @@ impl ChannelConfig {
                 return Err(parameter(name, v, "must be positive and finite"));
             }
         }
+        // The NC machine data: a tolerance that is not a positive number would let every arc
+        // through, or none.
+        let tolerances = [
+            (
+                "interpolator.chordal_tolerance",
+                self.interpolator.chordal_tolerance,
+            ),
+            (
+                "nc.arc_tolerance",
+                self.nc
+                    .arc_tolerance
+                    .unwrap_or(crate::nc::decode::DEFAULT_ARC_TOLERANCE),
+            ),
+        ];
+        for (name, v) in tolerances {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(parameter(name, v, "must be positive and finite"));
+            }
+        }
+        let z = &self.nc.zero_offsets;
+        let offsets = [&z.g54, &z.g55, &z.g56, &z.g57, &z.g58, &z.g59];
+        for v in offsets.iter().flat_map(|o| o.iter()) {
+            if !v.is_finite() || offsets.iter().any(|o| o.len() > self.axes.len()) {
+                return Err(parameter(
+                    "nc.zero_offsets",
+                    *v,
+                    "must be finite, at most one value per channel axis",
+                ));
+            }
+        }
+        for t in &self.nc.tools {
+            if !t.length.is_finite() || t.d == 0 {
+                return Err(parameter(
+                    "nc.tools",
+                    t.length,
+                    "a record has a D of 1 or more and a finite length",
+                ));
+            }
+        }
         if self.kin_trafo_display > 2 {
             return Err(parameter(
                 "kin_trafo_display",

@@ -254,6 +254,12 @@ impl Channel {
 
     /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
     pub fn start(&mut self, program: LoadedProgram) {
+        // A new program starts from the modal defaults the check assumed (G90 G17 G71 G53 D0,
+        // no feed), where the axes stand.
+        self.decoder = DecoderState::new(&self.config.axes);
+        for (i, p) in self.programmed.iter().enumerate() {
+            self.decoder.set_position(i, *p);
+        }
         self.decoder.configure(&program.setup);
         self.interp.start(&program.set);
         self.program = Some(program);

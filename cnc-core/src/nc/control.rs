@@ -202,8 +202,15 @@ fn match_level(
                 }
                 _ => report(b, &format!("${} without a matching $IF", control.keyword())),
             },
+            // `$DEFAULT` may stand anywhere among the cases (reached sequentially it runs on
+            // into the case after it, like any branch); once per `$SWITCH`.
             Control::Case(_) | Control::Default => match open.last_mut() {
-                Some(Open::Switch { cases, default, .. }) if default.is_none() => {
+                Some(Open::Switch {
+                    default: Some(_), ..
+                }) if matches!(control, Control::Default) => {
+                    report(b, "a second $DEFAULT in one $SWITCH")
+                }
+                Some(Open::Switch { cases, default, .. }) => {
                     if matches!(control, Control::Default) {
                         *default = Some(b);
                     } else {
@@ -299,14 +306,8 @@ fn match_level(
                 }
                 _ => report(b, "$ENDSWITCH without a matching $SWITCH"),
             },
-            Control::Break | Control::Continue => {
-                if open.is_empty() {
-                    report(
-                        b,
-                        &format!("${} outside a loop or $SWITCH", control.keyword()),
-                    );
-                }
-            }
+            // Given their jumps when their loop or `$SWITCH` closes; reported below if not.
+            Control::Break | Control::Continue => {}
             Control::Goto(n) => gotos.push((b, *n)),
         }
     }
@@ -337,31 +338,35 @@ fn match_level(
             ),
         }
     }
-    // A `$BREAK`/`$CONTINUE` left without a jump stands in a `$SWITCH` only (`$CONTINUE`
-    // there has no loop).
+    // A `$BREAK` or `$CONTINUE` left without a jump has nothing to leave.
     for b in level {
         if !jumps.has(b) {
-            if let Some(c @ (Control::Break | Control::Continue)) = control_of(program, b) {
-                report(b, &format!("${} outside a loop or $SWITCH", c.keyword()));
+            match control_of(program, b) {
+                Some(Control::Break) => report(b, "$BREAK outside a loop or $SWITCH"),
+                Some(Control::Continue) => report(b, "$CONTINUE outside a loop"),
+                _ => {}
             }
         }
     }
 }
 
-/// Gives the `$BREAK`s and `$CONTINUE`s directly inside the loop `start..=end` (not inside
-/// a loop or `$SWITCH` nested in it) their jumps: after the loop, and to `again`.
+/// Gives the `$BREAK`s directly inside the loop `start..=end` (not inside a loop or `$SWITCH`
+/// nested in it) their jump after the loop, and its `$CONTINUE`s (also those inside a nested
+/// `$SWITCH`, which has no next round) their jump to `again`.
 fn resolve_exits(program: &Program, start: usize, end: usize, again: usize, jumps: &mut JumpTable) {
-    let mut depth = 0usize;
+    let (mut loops, mut switches) = (0usize, 0usize);
     for b in start + 1..end {
         match control_of(program, b) {
-            Some(Control::While(_) | Control::For { .. } | Control::Do | Control::Switch(_)) => {
-                depth += 1
+            Some(Control::While(_) | Control::For { .. } | Control::Do) => loops += 1,
+            Some(Control::EndWhile | Control::EndFor | Control::EndDo(_)) => {
+                loops = loops.saturating_sub(1)
             }
-            Some(Control::EndWhile | Control::EndFor | Control::EndDo(_) | Control::EndSwitch) => {
-                depth = depth.saturating_sub(1)
+            Some(Control::Switch(_)) => switches += 1,
+            Some(Control::EndSwitch) => switches = switches.saturating_sub(1),
+            Some(Control::Break) if loops == 0 && switches == 0 => {
+                jumps.set(b, Jump::Go { to: end + 1 })
             }
-            Some(Control::Break) if depth == 0 => jumps.set(b, Jump::Go { to: end + 1 }),
-            Some(Control::Continue) if depth == 0 => jumps.set(b, Jump::Go { to: again }),
+            Some(Control::Continue) if loops == 0 => jumps.set(b, Jump::Go { to: again }),
             _ => {}
         }
     }

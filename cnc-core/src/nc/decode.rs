@@ -476,6 +476,9 @@ pub struct DecoderState {
     tool_length: f64,
     /// The end point's tolerance against an arc's circle (mm).
     arc_tolerance: f64,
+    /// Whether the position is where the program put it (false for a block checked on its own:
+    /// an arc's start is not known then).
+    start_known: bool,
     /// Per block: the values of its axis words by axis (valid where [`DecoderState::block`]
     /// marks the axis as programmed).
     words: [f64; MAX_CHANNEL_AXES],
@@ -631,6 +634,7 @@ impl DecoderState {
             tools: Vec::new(),
             tool_length: 0.0,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
+            start_known: true,
             words: [0.0; MAX_CHANNEL_AXES],
             tail: Vec::with_capacity(4),
         }
@@ -649,6 +653,21 @@ impl DecoderState {
         vars: &dyn Vars,
         out: &mut Vec<Decoded>,
     ) -> Vec<Diagnostic> {
+        let mut diags = self.decode_block_unlocated(program, index, src, vars, out);
+        super::locate(&mut diags, src);
+        diags
+    }
+
+    /// [`DecoderState::decode_block`] with the diagnostics' lines and columns left to count
+    /// ([`super::locate`]): a check counts them once for all.
+    pub fn decode_block_unlocated(
+        &mut self,
+        program: &Program,
+        index: usize,
+        src: &str,
+        vars: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Vec<Diagnostic> {
         let mut ctx = Ctx {
             src,
             vars,
@@ -657,7 +676,6 @@ impl DecoderState {
         if let Some(block) = program.blocks.get(index) {
             self.block(block, program.items_of(block), &mut ctx, out);
         }
-        super::locate(&mut ctx.diags, src);
         ctx.diags
     }
 
@@ -712,10 +730,21 @@ impl DecoderState {
         self.arc_tolerance = tolerance;
     }
 
-    /// Takes a feed as programmed (for blocks checked out of their program's order).
-    pub fn assume_feed(&mut self) {
+    /// For blocks checked out of their program's order: a feed is taken as programmed, and
+    /// where the block starts is not known (the checks that depend on it are left out).
+    pub fn checked_out_of_run(&mut self) {
         if self.feed <= 0.0 {
             self.feed = 1.0;
+        }
+        self.start_known = false;
+    }
+
+    /// Millimetres per programmed length unit (25.4 under G70).
+    fn length_unit(&self) -> f64 {
+        if self.inch {
+            MM_PER_INCH
+        } else {
+            1.0
         }
     }
 
@@ -1068,6 +1097,8 @@ impl DecoderState {
         let result = match (has_center, radius) {
             (true, Some(_)) => Err(ArcError::CenterAndRadius),
             (false, None) => Err(ArcError::NoCenter),
+            // Checked on its own, the block's start is not known: nothing more to check.
+            _ if !self.start_known => return None,
             (false, Some(r)) => center_from_radius(p0, p1, r, ccw),
             (true, None) => {
                 let c = if self.center_absolute {
@@ -1120,8 +1151,8 @@ impl DecoderState {
                 (Some("INDP_ASYN"), None, None) => asynchronous = Some(true),
                 (Some("INDP_SYN"), None, None) => asynchronous = Some(false),
                 (Some("POS"), None, Some(v)) => pos = ctx.eval(v, e.span),
-                (Some("F"), Some(f), None) => feed = f,
-                (Some("F"), None, Some(v)) => feed = ctx.eval(v, e.span)?,
+                (Some("F"), Some(f), None) => feed = f * self.length_unit(),
+                (Some("F"), None, Some(v)) => feed = ctx.eval(v, e.span)? * self.length_unit(),
                 (Some("G"), Some(0.0), None) => motion = MotionMode::Rapid,
                 (Some("G"), Some(1.0), None) => motion = MotionMode::Linear,
                 (Some("G"), Some(90.0), None) => absolute = true,
@@ -1141,8 +1172,13 @@ impl DecoderState {
             ctx.error(span, "independent axis: G1 needs a positive feed F..");
             return None;
         }
+        let pos = if axis < 3 {
+            pos * self.length_unit()
+        } else {
+            pos
+        };
         let target = if absolute {
-            pos + self.g92[axis] + self.pset[axis]
+            pos + self.g92[axis] + self.pset[axis] + self.offset(axis)
         } else {
             self.position[axis] + pos
         };
@@ -1268,7 +1304,14 @@ impl DecoderState {
                         continue;
                     };
                     if let Some(v) = ctx.eval(&word.value, word.span) {
-                        self.pset[i] = self.position[i] - v - self.g92[i];
+                        let v = if self.inch && i < 3 {
+                            v * MM_PER_INCH
+                        } else {
+                            v
+                        };
+                        // The position holds the zero offset and tool length: they are not the
+                        // preset's.
+                        self.pset[i] = self.position[i] - v - self.g92[i] - self.offset(i);
                     }
                 }
                 None
@@ -1454,15 +1497,10 @@ pub fn evaluate_at(expr: &Expr, span: Span, src: &str, vars: &dyn Vars) -> Resul
     match ctx.eval(expr, span) {
         Some(v) if ctx.diags.is_empty() => Ok(v),
         _ => {
-            let mut d = ctx.diags.into_iter().next().unwrap_or_else(|| {
+            // Unlocated: whoever reports it counts lines once for all its diagnostics.
+            Err(ctx.diags.into_iter().next().unwrap_or_else(|| {
                 Diagnostic::new(span, "the value cannot be computed".to_string(), src)
-            });
-            if d.line == 0 {
-                let mut one = [d];
-                super::locate(&mut one, src);
-                [d] = one;
-            }
-            Err(d)
+            }))
         }
     }
 }

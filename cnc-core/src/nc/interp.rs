@@ -286,6 +286,8 @@ struct Frame {
     end: u32,
     /// How many `V.L.` variables lived when the level was entered.
     locals_mark: u32,
+    /// Whether the caller was inside `#VAR` ... `#ENDVAR` (restored on return).
+    caller_declaring: bool,
 }
 
 /// How a block ends besides its motion.
@@ -398,6 +400,7 @@ impl Interpreter {
             next: main.main_start,
             end: main.blocks.len() as u32,
             locals_mark: 0,
+            caller_declaring: false,
         });
         self.ended = false;
     }
@@ -412,9 +415,17 @@ impl Interpreter {
         self.params.get(n as usize).copied().flatten()
     }
 
-    /// The source line of the block about to run, and its unit.
+    /// The unit and block index the next step starts at (possibly one past the level's end).
     pub fn position(&self) -> Option<(u32, u32)> {
         self.frames.last().map(|f| (f.unit, f.next))
+    }
+
+    /// The unit and block index of the block the next step runs, if it runs one of the level.
+    pub fn current_block(&self) -> Option<(u32, u32)> {
+        self.frames
+            .last()
+            .filter(|f| f.next < f.end)
+            .map(|f| (f.unit, f.next))
     }
 
     /// Runs one step: a `$` statement, or one block decoded into `out` with `decoder`.
@@ -445,9 +456,7 @@ impl Interpreter {
         let b = frame.next as usize;
         let block = &unit.tree.blocks[b];
         if let Some(jump) = unit.jumps.get(b) {
-            if !system.machine_values_known()
-                && control_of(&unit.tree, b).is_some_and(reads_machine_values)
-            {
+            if !system.machine_values_known() && decided_by_machine(unit, b, jump) {
                 return Ok(Step::Undecided);
             }
             let next = self.jump(unit, b, jump, block, system)?;
@@ -471,7 +480,7 @@ impl Interpreter {
                 .map(|i| unit.calls[i].1);
             let Some(callee) = callee else {
                 return Err(with_file(
-                    Diagnostic::located(
+                    Diagnostic::new(
                         span,
                         "the subroutine of this call was not loaded".into(),
                         &unit.src,
@@ -481,7 +490,7 @@ impl Interpreter {
             };
             if self.frames.len() > MAX_CALL_DEPTH {
                 return Err(with_file(
-                    Diagnostic::located(
+                    Diagnostic::new(
                         span,
                         format!("subroutine calls nest deeper than {MAX_CALL_DEPTH} levels (a recursion without end?)"),
                         &unit.src,
@@ -494,7 +503,9 @@ impl Interpreter {
                 next: callee.start,
                 end: callee.end,
                 locals_mark: self.locals.len() as u32,
+                caller_declaring: self.declaring,
             });
+            self.declaring = false;
         } else if end {
             self.ended = true;
         } else if leave && self.frames.len() > 1 {
@@ -531,7 +542,7 @@ impl Interpreter {
                     };
                     let value = evaluate_at(&assign.value, *span, src, &env)?;
                     self.assign(assign.target, value)
-                        .map_err(|m| Diagnostic::located(*span, m, src))?;
+                        .map_err(|m| Diagnostic::new(*span, m, src))?;
                 }
                 Item::Call { span, .. } => ending.call = Some(*span),
                 Item::M { code: 17 | 29, .. } => ending.leave = true,
@@ -548,7 +559,7 @@ impl Interpreter {
             interp: self,
             system,
         };
-        let diags = decoder.decode_block(tree, b, src, &env, out);
+        let diags = decoder.decode_block_unlocated(tree, b, src, &env, out);
         match diags.into_iter().next() {
             Some(d) => Err(d),
             None => Ok(ending),
@@ -583,6 +594,7 @@ impl Interpreter {
     fn leave(&mut self) {
         if let Some(f) = self.frames.pop() {
             self.locals.truncate(f.locals_mark as usize);
+            self.declaring = f.caller_declaring;
         }
     }
 
@@ -636,10 +648,12 @@ impl Interpreter {
         system: &dyn Vars,
     ) -> Result<usize, Diagnostic> {
         let control = control_of(&unit.tree, b);
-        let eval = |interp: &Interpreter, e: &super::ast::Expr| {
-            evaluate_at(e, block.span, &unit.src, &Env { interp, system })
-                .map_err(|d| with_file(d, unit))
+        // An expression of block `at` (its span for messages).
+        let eval_in = |interp: &Interpreter, at: usize, e: &super::ast::Expr| {
+            let span = unit.tree.blocks.get(at).map_or(block.span, |bl| bl.span);
+            evaluate_at(e, span, &unit.src, &Env { interp, system }).map_err(|d| with_file(d, unit))
         };
+        let eval = |interp: &Interpreter, e: &super::ast::Expr| eval_in(interp, b, e);
         Ok(match (jump, control) {
             (Jump::While { end }, Some(Control::While(c))) => {
                 if truth(eval(self, c)?) {
@@ -658,7 +672,7 @@ impl Interpreter {
                     else {
                         break at + 1;
                     };
-                    if truth(eval(self, c)?) {
+                    if truth(eval_in(self, at, c)?) {
                         break at + 1;
                     }
                     match control_of(&unit.tree, next) {
@@ -679,7 +693,7 @@ impl Interpreter {
             ) => {
                 let first = eval(self, start)?;
                 self.assign(*var, first)
-                    .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
+                    .map_err(|m| with_file(Diagnostic::new(block.span, m, &unit.src), unit))?;
                 let (last, step) = (eval(self, last)?, eval(self, step)?);
                 if self.for_continues(unit, block, first, last, step)? {
                     b + 1
@@ -697,7 +711,7 @@ impl Interpreter {
                 else {
                     return Ok(b + 1);
                 };
-                let (last, step) = (eval(self, last)?, eval(self, step)?);
+                let (last, step) = (eval_in(self, start, last)?, eval_in(self, start, step)?);
                 let env = Env {
                     interp: self,
                     system,
@@ -709,7 +723,7 @@ impl Interpreter {
                 .unwrap_or(0.0);
                 let value = current + step;
                 self.assign(*var, value)
-                    .map_err(|m| with_file(Diagnostic::located(block.span, m, &unit.src), unit))?;
+                    .map_err(|m| with_file(Diagnostic::new(block.span, m, &unit.src), unit))?;
                 let for_block = &unit.tree.blocks[start];
                 if self.for_continues(unit, for_block, value, last, step)? {
                     start + 1
@@ -737,7 +751,7 @@ impl Interpreter {
                 let mut target = default.map_or(end + 1, |d| d + 1);
                 while let Some(c) = case {
                     if let Some(Control::Case(e)) = control_of(&unit.tree, c) {
-                        if (eval(self, e)? - value).abs() < CASE_TOLERANCE {
+                        if (eval_in(self, c, e)? - value).abs() < CASE_TOLERANCE {
                             target = c + 1;
                             break;
                         }
@@ -765,7 +779,7 @@ impl Interpreter {
     ) -> Result<bool, Diagnostic> {
         if step == 0.0 {
             return Err(with_file(
-                Diagnostic::located(block.span, "$FOR with step 0 never ends".into(), &unit.src),
+                Diagnostic::new(block.span, "$FOR with step 0 never ends".into(), &unit.src),
                 unit,
             ));
         }
@@ -774,6 +788,46 @@ impl Interpreter {
         } else {
             value >= last
         })
+    }
+}
+
+/// Whether where `$` block `b` (with `jump`) leads depends on a `V.G.` value: its own
+/// condition, and for an `$IF` chain every `$ELSEIF`, for a `$SWITCH` every `$CASE`, for an
+/// `$ENDFOR` its `$FOR`'s bounds.
+fn decided_by_machine(unit: &Unit, b: usize, jump: Jump) -> bool {
+    let reads = |at: usize| control_of(&unit.tree, at).is_some_and(reads_machine_values);
+    match jump {
+        Jump::If { .. } if matches!(control_of(&unit.tree, b), Some(Control::If(_))) => {
+            let mut at = b;
+            loop {
+                if reads(at) {
+                    return true;
+                }
+                match unit.jumps.get(at) {
+                    Some(Jump::If { next, .. })
+                        if matches!(control_of(&unit.tree, next), Some(Control::ElseIf(_))) =>
+                    {
+                        at = next
+                    }
+                    _ => return false,
+                }
+            }
+        }
+        Jump::Switch { first_case, .. } => {
+            let mut case = first_case;
+            while let Some(c) = case {
+                if reads(c) {
+                    return true;
+                }
+                case = match unit.jumps.get(c) {
+                    Some(Jump::Case { next }) => next,
+                    _ => None,
+                };
+            }
+            reads(b)
+        }
+        Jump::EndFor { start } => reads(start),
+        _ => reads(b),
     }
 }
 
@@ -830,7 +884,10 @@ pub fn check_set(
         .iter()
         .map(|u| vec![false; u.tree.blocks.len()])
         .collect();
-    let mut diags = Vec::new();
+    // Per unit: its diagnostics, located once at the end (locating one at a time would scan
+    // the source once per diagnostic), and which blocks failed in the run.
+    let mut found: Vec<Vec<Diagnostic>> = set.units.iter().map(|_| Vec::new()).collect();
+    let mut failed: Vec<Vec<bool>> = visited.clone();
     let mut interp = Interpreter::new();
     interp.start(set);
     let mut scratch = Vec::with_capacity(8);
@@ -841,9 +898,10 @@ pub fn check_set(
         steps += 1;
         scratch.clear();
         let at = interp.position();
+        let current = interp.current_block();
         let step = interp.step(set, decoder, vars, &mut scratch);
         // The block the step ran (or failed in) has been checked by the run.
-        if let (Some((u, b)), Ok(Step::Block { .. } | Step::Control) | Err(_)) = (at, &step) {
+        if let (Some((u, b)), Ok(Step::Block { .. } | Step::Control) | Err(_)) = (current, &step) {
             if let Some(v) = visited[u as usize].get_mut(b as usize) {
                 *v = true;
             }
@@ -862,25 +920,39 @@ pub fn check_set(
             Ok(Step::Undecided) => break,
             Ok(_) => {}
             Err(d) => {
-                diags.push(d);
+                let (u, b) = current.or(at).unwrap_or((0, 0));
+                let again = failed[u as usize].get(b as usize).copied().unwrap_or(true);
+                if again {
+                    // A block failing a second time (in a loop): its error is known, and the
+                    // run cannot be trusted past it.
+                    break;
+                }
+                failed[u as usize][b as usize] = true;
+                found[u as usize].push(d);
                 interp.skip_failed(at);
             }
         }
     }
     // The blocks the run did not reach, each on its own: values of the program's own variables
-    // are unknown there, and so is the modal state (a feed is assumed).
+    // are unknown there, and so is the modal state (a feed is assumed, the start is unknown).
     let unknown = Unknown { system: vars };
     for (u, unit) in set.units.iter().enumerate() {
         let mut state = fresh.clone();
-        state.assume_feed();
+        state.checked_out_of_run();
         for (b, seen) in visited[u].iter().enumerate() {
             if *seen {
                 continue;
             }
             scratch.clear();
-            let found = state.decode_block(&unit.tree, b, &unit.src, &unknown, &mut scratch);
-            diags.extend(found.into_iter().map(|d| with_file(d, unit)));
+            let more =
+                state.decode_block_unlocated(&unit.tree, b, &unit.src, &unknown, &mut scratch);
+            found[u].extend(more.into_iter().map(|d| with_file(d, unit)));
         }
+    }
+    let mut diags = Vec::new();
+    for (u, mut list) in found.into_iter().enumerate() {
+        super::locate(&mut list, &set.units[u].src);
+        diags.append(&mut list);
     }
     diags.sort_by(|a, b| {
         (a.file.as_deref(), a.line, a.col).cmp(&(b.file.as_deref(), b.line, b.col))

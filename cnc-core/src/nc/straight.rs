@@ -69,7 +69,7 @@ pub fn check_straight(
             out.clear();
             if let Some(state) = after_end.as_mut() {
                 let unknown = Unknown { system: vars };
-                diags.extend(state.decode_block(&window, b, src, &unknown, &mut out));
+                diags.extend(state.decode_block_unlocated(&window, b, src, &unknown, &mut out));
                 continue;
             }
             match interp.run_block(&window, b, src, &mut decoder, vars, &mut out) {
@@ -82,7 +82,7 @@ pub fn check_straight(
                     if ending.end {
                         let mut state = DecoderState::new(axes);
                         state.configure(setup);
-                        state.assume_feed();
+                        state.checked_out_of_run();
                         after_end = Some(state);
                     }
                 }
@@ -92,6 +92,7 @@ pub fn check_straight(
     }
     // Syntax first, as the whole-program check orders them: the first per position is kept.
     let mut all = windows.finish();
+    super::locate(&mut diags, src);
     all.append(&mut diags);
     let mut diags = all;
     diags.sort_by_key(|d| (d.line, d.col));
