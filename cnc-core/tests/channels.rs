@@ -111,6 +111,18 @@ fn a_linear_block_reaches_its_target_within_feed_and_limits() {
     assert_eq!(&p[..3], &[0.0, 0.0, 0.0]);
 }
 
+/// Where example 3's slave stands relative to the master's tool (X=400 Y=700 C=-90).
+fn slave_offset() -> nalgebra::Isometry3<f64> {
+    offset_frame(
+        &PoseWords {
+            xyz: [400.0, 700.0, 0.0],
+            abc: [0.0, 0.0, -90.0],
+        },
+        false,
+    )
+    .unwrap()
+}
+
 /// The seed's example 3 with our own programs: the master robot (channel 1) carries the
 /// workpiece and publishes its tool frame; the slave (channel 2) stands at X=400 Y=700 C=-90
 /// relative to it, tracks with SET_ZERO, puts its zero on the master's tool with `#CS` and holds
@@ -142,14 +154,7 @@ M30
 ";
     let mut ctl = controller(vec![(robot("master"), master), (robot("slave"), slave)]);
     let memory = image(2);
-    let offset = offset_frame(
-        &PoseWords {
-            xyz: [400.0, 700.0, 0.0],
-            abc: [0.0, 0.0, -90.0],
-        },
-        false,
-    )
-    .unwrap();
+    let offset = slave_offset();
     let mut checked = 0;
     let mut worst: f64 = 0.0;
     let mut master_travel: f64 = 0.0;
@@ -710,14 +715,7 @@ $ENDWHILE
 ";
     let mut ctl = controller(vec![(robot("master"), master), (robot("slave"), slave)]);
     let memory = image(2);
-    let offset = offset_frame(
-        &PoseWords {
-            xyz: [400.0, 700.0, 0.0],
-            abc: [0.0, 0.0, -90.0],
-        },
-        false,
-    )
-    .unwrap();
+    let offset = slave_offset();
     let (mut checked, mut worst, mut turned) = (0, 0.0f64, 0.0f64);
     run_until(
         &mut ctl,

@@ -59,6 +59,31 @@ struct Circle {
     r1: f64,
 }
 
+/// The limits of axis `i`, unlimited for an axis without any.
+fn axis_limits(limits: &[AxisLimits], i: usize) -> AxisLimits {
+    limits.get(i).copied().unwrap_or(AxisLimits {
+        velocity: f64::INFINITY,
+        acceleration: f64::INFINITY,
+        jerk: f64::INFINITY,
+    })
+}
+
+/// Lowers `path` to what every axis moving `delta` along a path of `length` allows: an axis
+/// moving a share `|Δ|/L` of the path moves at that share of the path's velocity (and
+/// acceleration and jerk).
+fn limit_by_axes(path: &mut MoveLimits, delta: &[f64], length: f64, limits: &[AxisLimits]) {
+    for (i, d) in delta.iter().enumerate() {
+        let share = d.abs() / length;
+        if share <= 1e-12 {
+            continue;
+        }
+        let limit = axis_limits(limits, i);
+        path.velocity = path.velocity.min(limit.velocity / share);
+        path.acceleration = path.acceleration.min(limit.acceleration / share);
+        path.jerk = path.jerk.min(limit.jerk / share);
+    }
+}
+
 /// How an arc block is to be run: the circle, the channel's cycle and chordal tolerance.
 #[derive(Debug, Clone, Copy)]
 pub struct ArcSpec {
@@ -136,20 +161,7 @@ impl PathMove {
             deceleration: f64::INFINITY,
             jerk: f64::INFINITY,
         };
-        for (i, d) in delta.iter().enumerate() {
-            let share = d.abs() / length;
-            if share <= 1e-12 {
-                continue;
-            }
-            let limit = limits.get(i).copied().unwrap_or(AxisLimits {
-                velocity: f64::INFINITY,
-                acceleration: f64::INFINITY,
-                jerk: f64::INFINITY,
-            });
-            path.velocity = path.velocity.min(limit.velocity / share);
-            path.acceleration = path.acceleration.min(limit.acceleration / share);
-            path.jerk = path.jerk.min(limit.jerk / share);
-        }
+        limit_by_axes(&mut path, &delta, length, limits);
         if motion == MotionMode::Linear {
             path.velocity = path.velocity.min(feed_mm_min / 60.0);
         }
@@ -201,13 +213,7 @@ impl PathMove {
         if length.is_nan() || length <= 1e-12 || !length.is_finite() {
             return Err(PathError::NoProfile);
         }
-        let limit = |i: usize| {
-            limits.get(i).copied().unwrap_or(AxisLimits {
-                velocity: f64::INFINITY,
-                acceleration: f64::INFINITY,
-                jerk: f64::INFINITY,
-            })
-        };
+        let limit = |i: usize| axis_limits(limits, i);
         let (la, lb) = (limit(a), limit(b));
         let plane_v = la.velocity.min(lb.velocity);
         let plane_a = la.acceleration.min(lb.acceleration);
@@ -224,16 +230,7 @@ impl PathMove {
             deceleration: 0.0,
             jerk: plane_j / 2.0 / share.max(1e-12),
         };
-        for (i, d) in delta.iter().enumerate() {
-            let axis_share = d.abs() / length;
-            if axis_share <= 1e-12 {
-                continue;
-            }
-            let l = limit(i);
-            path.velocity = path.velocity.min(l.velocity / axis_share);
-            path.acceleration = path.acceleration.min(l.acceleration / axis_share);
-            path.jerk = path.jerk.min(l.jerk / axis_share);
-        }
+        limit_by_axes(&mut path, &delta, length, limits);
         path.deceleration = path.acceleration;
         let finite = [path.velocity, path.acceleration, path.jerk]
             .iter()

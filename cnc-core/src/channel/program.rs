@@ -69,14 +69,7 @@ impl LoadedProgram {
             diagnostics,
         };
         if let Err(message) = check_channel_axes(axes) {
-            return Err(refuse(vec![Diagnostic {
-                line: 1,
-                col: 1,
-                message,
-                found: String::new(),
-                offset: 0,
-                file: None,
-            }]));
+            return Err(refuse(vec![Diagnostic::whole_program(message)]));
         }
         let (set, diagnostics) = check_program(
             name,

@@ -1541,14 +1541,7 @@ pub fn check_program(
 ) -> (super::interp::ProgramSet, Vec<Diagnostic>) {
     let (set, mut diags) = super::interp::ProgramSet::load(name, src, paths.0, paths.1);
     if let Err(message) = check_channel_axes(axes) {
-        diags.push(Diagnostic {
-            line: 1,
-            col: 1,
-            message,
-            found: String::new(),
-            offset: 0,
-            file: None,
-        });
+        diags.push(Diagnostic::whole_program(message));
         return (set, diags);
     }
     {

@@ -962,8 +962,8 @@ pub fn check_set(
 }
 
 /// Variables of a block checked on its own: the channel's as given, the program's unknown.
-struct Unknown<'a> {
-    system: &'a dyn Vars,
+pub(crate) struct Unknown<'a> {
+    pub(crate) system: &'a dyn Vars,
 }
 
 impl Vars for Unknown<'_> {

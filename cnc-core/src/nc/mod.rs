@@ -55,6 +55,19 @@ impl Diagnostic {
         }
     }
 
+    /// A diagnostic about the program as a whole (line 1, column 1), such as the channel's axis
+    /// names.
+    pub fn whole_program(message: String) -> Self {
+        Self {
+            line: 1,
+            col: 1,
+            message,
+            found: String::new(),
+            offset: 0,
+            file: None,
+        }
+    }
+
     /// A diagnostic at `span` of `src` with its line and column counted.
     pub fn located(span: Span, message: String, src: &str) -> Self {
         let mut one = [Self::new(span, message, src)];

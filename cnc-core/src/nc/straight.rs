@@ -7,28 +7,13 @@
 
 use super::ast::{Item, Program};
 use super::decode::{DecoderSetup, DecoderState, Vars};
-use super::interp::{BlockSink, Interpreter};
+use super::interp::{BlockSink, Interpreter, Unknown};
 use super::parser::Windows;
 use super::Diagnostic;
 
 /// Blocks per window: small enough to stay in the caches, large enough that refilling costs
 /// nothing.
 const WINDOW: usize = 4096;
-
-/// Variables of blocks after the program's end: checked on their own, the program's values
-/// unknown.
-struct Unknown<'a> {
-    system: &'a dyn Vars,
-}
-
-impl Vars for Unknown<'_> {
-    fn get(&self, name: &str) -> Option<f64> {
-        self.system.get(name)
-    }
-    fn program_values_unknown(&self) -> bool {
-        true
-    }
-}
 
 /// Whether `window` holds anything that makes a program other than straight.
 fn bends(window: &Program) -> bool {
