@@ -185,3 +185,30 @@ fn subroutine_files_are_found_next_to_the_program_and_on_the_search_path() {
         ]
     );
 }
+
+#[test]
+fn tool_records_come_from_the_command_line() {
+    let f = write("tools.nc", "S6000 M03 T24 D1\nG1 Z10 F100\nM30\n");
+    let z = |stdout: &str| {
+        stdout
+            .split("\"Z\":")
+            .nth(1)
+            .map(|r| r.split(',').next().unwrap().to_string())
+    };
+    // No tool table given: D1 takes length 0.
+    let (code, stdout, _) = cnc(&["check", "--blocks", &f]);
+    assert_eq!((code, z(&stdout).as_deref()), (0, Some("10")));
+    // D1 of 80 mm along Z.
+    let (code, stdout, _) = cnc(&["check", "--blocks", "--tool", "1=80", &f]);
+    assert_eq!((code, z(&stdout).as_deref()), (0, Some("90")));
+    // A table without D1: the program is refused at D1.
+    let (code, stdout, _) = cnc(&["check", "--tool", "2=5", &f]);
+    assert_eq!(code, 1);
+    assert!(
+        stdout.contains("tools.nc:1:15: error: D1: no such tool data record"),
+        "{stdout}"
+    );
+    // A malformed record is an argument error.
+    let (code, _, stderr) = cnc(&["check", "--tool", "0=5", &f]);
+    assert_eq!(code, 2, "{stderr}");
+}

@@ -22,9 +22,33 @@ pub struct CheckArgs {
     /// Folders `L name` searches after the calling program's own (repeatable).
     #[arg(long = "search", value_name = "DIR")]
     pub search: Vec<PathBuf>,
+    /// A tool data record, `D=LENGTH` in mm (repeatable). With at least one, a D that is not
+    /// given is an error; without any, every D takes length 0.
+    #[arg(long = "tool", value_name = "D=LENGTH", value_parser = parse_tool)]
+    pub tools: Vec<(u32, f64)>,
     /// NC program files.
     #[arg(required = true)]
     pub files: Vec<PathBuf>,
+}
+
+/// `D=LENGTH`: a D number of 1 or more and a finite length.
+fn parse_tool(text: &str) -> Result<(u32, f64), String> {
+    let (d, length) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected D=LENGTH, found \"{text}\""))?;
+    let d: u32 = d
+        .trim()
+        .parse()
+        .ok()
+        .filter(|d| *d > 0)
+        .ok_or_else(|| format!("D must be a whole number of 1 or more, found \"{d}\""))?;
+    let length: f64 = length
+        .trim()
+        .parse()
+        .ok()
+        .filter(|l: &f64| l.is_finite())
+        .ok_or_else(|| format!("LENGTH must be a finite number, found \"{length}\""))?;
+    Ok((d, length))
 }
 
 /// Checks one program text (subroutine files next to `dir`); returns its diagnostics (sorted)
@@ -153,7 +177,11 @@ pub fn main(args: CheckArgs) -> ExitCode {
                 continue;
             }
         };
-        let setup = DecoderSetup::default();
+        let setup = DecoderSetup {
+            tools: args.tools.clone(),
+            tools_unknown: args.tools.is_empty(),
+            ..DecoderSetup::default()
+        };
         // A straight program is checked as it is read (one window of its tree in memory).
         if let Some(diags) = check_straight(&src, &axes, &setup, &ZeroVars, None) {
             for d in &diags {

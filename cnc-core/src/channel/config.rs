@@ -112,6 +112,8 @@ impl NcConfig {
                 z.g59.clone(),
             ],
             tools: self.tools.iter().map(|t| (t.d, t.length)).collect(),
+            // A channel's tool table is the machine's: a D it does not hold is refused.
+            tools_unknown: false,
             arc_tolerance: self
                 .arc_tolerance
                 .unwrap_or(crate::nc::decode::DEFAULT_ARC_TOLERANCE),

@@ -866,7 +866,7 @@ impl Channel {
                 self.wait_ids = ids;
                 self.wait = Some(Wait::Sync);
             }
-            Decoded::Flush { .. } | Decoded::Control { .. } => {}
+            Decoded::Flush { .. } => {}
         }
     }
 

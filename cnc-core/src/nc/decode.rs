@@ -368,13 +368,6 @@ pub enum Decoded {
         /// WAIT.
         wait: bool,
     },
-    /// A control statement (its jump is in the program's jump table).
-    Control {
-        /// Source line.
-        line: u32,
-        /// The statement.
-        op: ControlOp,
-    },
     /// `G04` / `#TIME`: wait, nothing moves.
     Dwell {
         /// Source line.
@@ -405,28 +398,6 @@ pub enum Decoded {
     },
 }
 
-/// A control statement. Where it goes is not here: the program's jump table
-/// ([`super::control::match_control`]) holds that, matched once per program.
-#[derive(Debug, Clone, PartialEq)]
-pub enum ControlOp {
-    /// `$WHILE`: evaluate the condition.
-    While {
-        /// Condition.
-        cond: Expr,
-    },
-    /// `$ENDWHILE`.
-    EndWhile,
-    /// `$IF`: evaluate the condition.
-    If {
-        /// Condition.
-        cond: Expr,
-    },
-    /// `$ELSE`.
-    Else,
-    /// `$ENDIF`.
-    EndIf,
-}
-
 /// The machine data a decoder needs: zero offsets, tool table, arc tolerance.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DecoderSetup {
@@ -434,6 +405,9 @@ pub struct DecoderSetup {
     pub zero_offsets: [Vec<f64>; 6],
     /// Tool length per D number.
     pub tools: Vec<(u32, f64)>,
+    /// No tool table is at hand (`cnc check` without `--tool`): every D selects length 0
+    /// instead of being refused as unknown.
+    pub tools_unknown: bool,
     /// How far an arc's end point may lie off its circle (mm).
     pub arc_tolerance: f64,
 }
@@ -443,6 +417,7 @@ impl Default for DecoderSetup {
         Self {
             zero_offsets: Default::default(),
             tools: Vec::new(),
+            tools_unknown: false,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
         }
     }
@@ -472,6 +447,8 @@ pub struct DecoderState {
     zero_offsets: [AxisValues; 6],
     /// Tool length per D number (machine configuration).
     tools: Vec<(u32, f64)>,
+    /// See [`DecoderSetup::tools_unknown`].
+    tools_unknown: bool,
     /// The length of the selected D (0 for D0).
     tool_length: f64,
     /// The end point's tolerance against an arc's circle (mm).
@@ -632,6 +609,7 @@ impl DecoderState {
             zero: 0,
             zero_offsets: [AxisValues::zeros(n); 6],
             tools: Vec::new(),
+            tools_unknown: false,
             tool_length: 0.0,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
             start_known: true,
@@ -708,6 +686,7 @@ impl DecoderState {
     pub fn configure(&mut self, setup: &DecoderSetup) {
         self.set_zero_offsets(&setup.zero_offsets);
         self.set_tools(&setup.tools);
+        self.tools_unknown = setup.tools_unknown;
         self.set_arc_tolerance(setup.arc_tolerance);
     }
 
@@ -887,6 +866,8 @@ impl DecoderState {
                                 self.tools.iter().find(|(d, _)| *d == n)
                             {
                                 self.tool_length = length;
+                            } else if self.tools_unknown {
+                                self.tool_length = 0.0;
                             } else {
                                 ctx.error(
                                     word.span,
