@@ -745,3 +745,62 @@ $ENDWHILE
         "off the circle on the workpiece by {worst} mm"
     );
 }
+
+/// `f_wait` of a PLC transition holds the channel's program like `WAIT` of `#TRACK CS`: the
+/// block under way runs on, the next one starts only once the switching has finished.
+#[test]
+fn f_wait_of_a_plc_transition_holds_the_next_block_until_the_switching_is_done() {
+    // (tick the state turned ACTIVE, tick the second block started)
+    let run = |f_wait: Bool| -> (u32, u32) {
+        let mut ctl = controller(vec![(cartesian("slave"), "G1 X1 F600\nG1 X2 F600\nM30\n")]);
+        let memory = image(1);
+        let plc = PlcView::new(&memory);
+        plc.set_dyn_cs_enabled(0, true).unwrap();
+        plc.dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([0, 0, 0]))
+            .unwrap();
+        let params = HliDynCsTransition {
+            command: 0,
+            filter_max_ticks: 400,
+            option: 0,
+            f_wait,
+            f_set_zero: Bool::FALSE,
+            f_kin_base: Bool::FALSE,
+            f_rot_trans: Bool::FALSE,
+            kinematic_base_cs: cs([0; 3]),
+        };
+        plc.dyn_cs_transition(0)
+            .unwrap()
+            .try_send(DynCsCommand::Activate, &params)
+            .unwrap();
+        let view = CncView::new(&memory);
+        let (mut active, mut second) = (None, None);
+        for tick in 0..20_000u32 {
+            ctl.tick(&view);
+            let ch = &ctl.channels()[0];
+            assert_ne!(ch.state(), RunState::Error, "{:?}", ch.error());
+            if active.is_none() && plc.dyn_cs_state(0).unwrap().unwrap() == DynCsState::Active {
+                active = Some(tick);
+            }
+            if second.is_none() && ch.programmed()[0] > 1.0 {
+                second = Some(tick);
+            }
+            if let (Some(a), Some(b)) = (active, second) {
+                return (a, b);
+            }
+        }
+        panic!("watchdog: ACTIVE at {active:?}, second block at {second:?}");
+    };
+    let (active, second) = run(Bool::TRUE);
+    // The first millimetre takes about 110 ticks, the switching 400: the second block waits.
+    assert!(
+        second > active,
+        "second block at {second}, ACTIVE at {active}"
+    );
+    let (active, second) = run(Bool::FALSE);
+    assert!(
+        second < active,
+        "without f_wait: second block at {second}, ACTIVE at {active}"
+    );
+}

@@ -525,10 +525,28 @@ impl Channel {
                     simu: false,
                 };
                 let master = self.plc_frame;
-                let _ = self.tracker.switch_on(setup, master.as_ref());
+                if self.tracker.switch_on(setup, master.as_ref()).is_ok() && wait {
+                    self.hold_program_until_settled();
+                }
             }
-            DynCsCommand::Deactivate => self.tracker.switch_off(Some(params.filter_max_ticks)),
+            DynCsCommand::Deactivate => {
+                self.tracker.switch_off(Some(params.filter_max_ticks));
+                // f_wait on a switch-off, as `#TRACK CS OFF [WAIT]`; a byte that is no BOOL
+                // is no request to wait.
+                if params.f_wait.get() == Ok(true) {
+                    self.hold_program_until_settled();
+                }
+            }
             DynCsCommand::None => {}
+        }
+    }
+
+    /// `f_wait` of a PLC transition, the counterpart of the NC command's WAIT: the program
+    /// goes on to its next block only once the switching has finished (ACTIVE or INACTIVE).
+    /// The block under way runs on; nothing waits when no program runs.
+    fn hold_program_until_settled(&mut self) {
+        if self.state == RunState::Running && self.wait.is_none() {
+            self.wait = Some(Wait::Tracking);
         }
     }
 
