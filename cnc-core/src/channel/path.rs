@@ -84,6 +84,26 @@ fn limit_by_axes(path: &mut MoveLimits, delta: &[f64], length: f64, limits: &[Ax
     }
 }
 
+/// Runs the path parameter from 0 to `length` on `generator` within `path` (decelerating as
+/// it accelerates); no profile for limits that are not positive numbers.
+fn start_profile(
+    path: &mut MoveLimits,
+    length: f64,
+    generator: &mut SetpointGenerator,
+) -> Result<(), PathError> {
+    path.deceleration = path.acceleration;
+    let finite = [path.velocity, path.acceleration, path.jerk]
+        .iter()
+        .all(|v| v.is_finite() && *v > 0.0);
+    if !finite {
+        return Err(PathError::NoProfile);
+    }
+    generator.hold(0.0);
+    generator
+        .move_to(length, *path)
+        .map_err(|_| PathError::NoProfile)
+}
+
 /// How an arc block is to be run: the circle, the channel's cycle and chordal tolerance.
 #[derive(Debug, Clone, Copy)]
 pub struct ArcSpec {
@@ -165,17 +185,7 @@ impl PathMove {
         if motion == MotionMode::Linear {
             path.velocity = path.velocity.min(feed_mm_min / 60.0);
         }
-        path.deceleration = path.acceleration;
-        let finite = [path.velocity, path.acceleration, path.jerk]
-            .iter()
-            .all(|v| v.is_finite() && *v > 0.0);
-        if !finite {
-            return Err(PathError::NoProfile);
-        }
-        generator.hold(0.0);
-        generator
-            .move_to(length, path)
-            .map_err(|_| PathError::NoProfile)?;
+        start_profile(&mut path, length, generator)?;
         Ok(Some(Self {
             start: *start,
             delta,
@@ -231,17 +241,7 @@ impl PathMove {
             jerk: plane_j / 2.0 / share.max(1e-12),
         };
         limit_by_axes(&mut path, &delta, length, limits);
-        path.deceleration = path.acceleration;
-        let finite = [path.velocity, path.acceleration, path.jerk]
-            .iter()
-            .all(|v| v.is_finite() && *v > 0.0);
-        if !finite {
-            return Err(PathError::NoProfile);
-        }
-        generator.hold(0.0);
-        generator
-            .move_to(length, path)
-            .map_err(|_| PathError::NoProfile)?;
+        start_profile(&mut path, length, generator)?;
         Ok(Self {
             start: *start,
             delta,
