@@ -447,6 +447,9 @@ proptest! {
                 text.insert_str(at, piece);
             }
         }
+        if std::env::var_os("NC_PROPS_TRACE").is_some() {
+            std::fs::write("/tmp/nc_props_last.nc", &text).unwrap();
+        }
         let (tree, diags) = parse(&text);
         for d in &diags {
             prop_assert!(d.line >= 1 && d.col >= 1, "{:?}", d);

@@ -427,6 +427,10 @@ impl Parser<'_> {
                         span: self.extend(span),
                     }));
                 }
+                // Never stand still: a token no expression could take is skipped (reported).
+                if self.pos == before {
+                    self.bump();
+                }
                 continue;
             }
             if let Some(item) = self.item() {
@@ -554,7 +558,10 @@ impl Parser<'_> {
     fn starts_expression(&self) -> bool {
         match self.peek() {
             Tok::Num(_) | Tok::Var(_) | Tok::Punct("[" | "-" | "+") => true,
-            Tok::Addr(w, n) => *w == "P" || (*w == "ATAN" && *n == 2.0),
+            Tok::Addr(w, n) => {
+                *w == "P"
+                    || (*w == "ATAN" && *n == 2.0 && matches!(self.peek_at(1), Tok::Punct("[")))
+            }
             Tok::Word(w) => Func::named(w).is_some() && matches!(self.peek_at(1), Tok::Punct("[")),
             _ => false,
         }
