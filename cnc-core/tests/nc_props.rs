@@ -362,8 +362,11 @@ fn block() -> impl Strategy<Value = (Option<u32>, Vec<Item>)> {
             core_block(),
         ],
     )
-        .prop_filter("blocks hold something", |(n, items)| {
-            n.is_some() || !items.is_empty()
+        // A block holds something: an empty one gets a number (a filter would reject too many
+        // cases in long campaigns).
+        .prop_map(|(n, items)| {
+            let n = if items.is_empty() { n.or(Some(1)) } else { n };
+            (n, items)
         })
 }
 
@@ -376,18 +379,20 @@ fn program() -> impl Strategy<Value = Program> {
         ),
         prop::collection::vec(block(), 0..40),
     )
-        .prop_filter(
-            "local subroutines have different names, and a main program a name",
-            |(name, subs, _)| {
-                let mut names: Vec<&String> = subs.iter().map(|s| &s.0).collect();
-                names.sort();
-                names.dedup();
-                // `%L` alone opens a local subroutine: no main program is called L.
-                let main_ok = name.as_deref().is_none_or(|n| !n.eq_ignore_ascii_case("L"));
-                names.len() == subs.len() && (subs.is_empty() || name.is_some()) && main_ok
-            },
-        )
         .prop_map(|(name, subs, blocks)| {
+            // Local subroutines have different names (the index makes them so), and after them
+            // the main program has a name; `%L` alone opens a local subroutine, so no main
+            // program is called L.
+            let subs: Vec<(String, _)> = subs
+                .into_iter()
+                .enumerate()
+                .map(|(i, (n, b))| (format!("{n}{i}"), b))
+                .collect();
+            let name = match name {
+                Some(n) if n.eq_ignore_ascii_case("L") => Some("MAIN".to_string()),
+                None if !subs.is_empty() => Some("MAIN".to_string()),
+                other => other,
+            };
             let mut program = Program {
                 name,
                 ..Program::default()

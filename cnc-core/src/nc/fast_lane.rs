@@ -16,6 +16,8 @@ const F: u64 = b'F' as u64;
 const P: u64 = b'P' as u64;
 const L: u64 = b'L' as u64;
 const LL: u64 = u16::from_le_bytes(*b"LL") as u64;
+const PP: u64 = u16::from_le_bytes(*b"PP") as u64;
+const PPP: u64 = u32::from_le_bytes(*b"PPP\0") as u64;
 
 impl Lexer<'_> {
     /// Reads the next block through the fast lane into `arena`; `None` (having consumed and
@@ -94,7 +96,7 @@ impl Lexer<'_> {
                 },
                 N => return None,
                 // `P1`, `L`, `LL` start assignments and calls: the general path reads them.
-                P | L | LL => return None,
+                P | PP | PPP | L | LL => return None,
                 _ => Item::Axis(AxisWord {
                     name: AxisName::from_packed(name),
                     value: Expr::Num(value),
