@@ -155,6 +155,16 @@ M30
     let mut ctl = controller(vec![(robot("master"), master), (robot("slave"), slave)]);
     let memory = image(2);
     let offset = slave_offset();
+    // The same offset turned 1 degree more about Z: the test must tell it apart.
+    let off_by_a_degree = offset_frame(
+        &PoseWords {
+            xyz: [400.0, 700.0, 0.0],
+            abc: [0.0, 0.0, -89.0],
+        },
+        false,
+    )
+    .unwrap();
+    let mut worst_off_by_a_degree: f64 = 0.0;
     let mut checked = 0;
     let mut worst: f64 = 0.0;
     let mut master_travel: f64 = 0.0;
@@ -174,6 +184,9 @@ M30
                 let miss = (slave_tool.translation.vector - expected.translation.vector).norm();
                 let turn = slave_tool.rotation.angle_to(&expected.rotation);
                 worst = worst.max(miss);
+                let wrong = off_by_a_degree * master_tool;
+                worst_off_by_a_degree = worst_off_by_a_degree
+                    .max((slave_tool.translation.vector - wrong.translation.vector).norm());
                 assert!(turn < 1e-6, "orientation off by {turn} rad");
                 checked += 1;
                 if let Some(last) = last_master {
@@ -193,6 +206,12 @@ M30
     assert!(
         worst < 1e-3,
         "the slave's tool left the workpiece by {worst} mm"
+    );
+    // Against an offset 1 degree off, the same run misses by millimetres: the 1 um bound above
+    // would catch it (about 806 mm from the slave's base, 1 degree is 14 mm).
+    assert!(
+        worst_off_by_a_degree > 1.0,
+        "a 1 degree error in the offset went unseen: {worst_off_by_a_degree} mm"
     );
 }
 
