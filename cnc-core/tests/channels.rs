@@ -366,21 +366,27 @@ fn switching_on_twice_is_an_error_and_keeps_the_setpoint() {
     assert_eq!(ch.tracker().state(), DynCsState::Error);
 }
 
+/// A PLC transition's parameters: a filter, f_wait, no other flag, no offset (the command
+/// word is written by `try_send`).
+fn transition(filter_max_ticks: u32, f_wait: Bool) -> HliDynCsTransition {
+    HliDynCsTransition {
+        command: 0,
+        filter_max_ticks,
+        option: 0,
+        f_wait,
+        f_set_zero: Bool::FALSE,
+        f_kin_base: Bool::FALSE,
+        f_rot_trans: Bool::FALSE,
+        kinematic_base_cs: cs([0; 3]),
+    }
+}
+
 #[test]
 fn a_plc_transition_while_not_enabled_is_refused_with_error() {
     let mut ctl = controller(vec![(cartesian("slave"), "G1 X1 F600\nM30\n")]);
     let memory = image(1);
     let plc = PlcView::new(&memory);
-    let params = HliDynCsTransition {
-        command: 0,
-        filter_max_ticks: 10,
-        option: 0,
-        f_wait: Bool::FALSE,
-        f_set_zero: Bool::FALSE,
-        f_kin_base: Bool::FALSE,
-        f_rot_trans: Bool::FALSE,
-        kinematic_base_cs: cs([0; 3]),
-    };
+    let params = transition(10, Bool::FALSE);
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Activate, &params)
@@ -779,16 +785,7 @@ fn f_wait_of_a_plc_transition_holds_the_next_block_until_the_switching_is_done()
             .unwrap()
             .try_send(&cs([0, 0, 0]))
             .unwrap();
-        let params = HliDynCsTransition {
-            command: 0,
-            filter_max_ticks: 400,
-            option: 0,
-            f_wait,
-            f_set_zero: Bool::FALSE,
-            f_kin_base: Bool::FALSE,
-            f_rot_trans: Bool::FALSE,
-            kinematic_base_cs: cs([0; 3]),
-        };
+        let params = transition(400, f_wait);
         plc.dyn_cs_transition(0)
             .unwrap()
             .try_send(DynCsCommand::Activate, &params)

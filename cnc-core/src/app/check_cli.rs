@@ -182,34 +182,27 @@ pub fn main(args: CheckArgs) -> ExitCode {
             tools_unknown: args.tools.is_empty(),
             ..DecoderSetup::default()
         };
-        // A straight program is checked as it is read (one window of its tree in memory).
-        if let Some(diags) = check_straight(&src, &axes, &setup, &ZeroVars, None) {
-            for d in &diags {
-                out.push_str(&d.render(&name));
-                out.push('\n');
+        // A straight program is checked as it is read (one window of its tree in memory), any
+        // other whole, with the subroutine files it calls.
+        // The whole check takes the text over; the straight one reads it again to print.
+        let mut src = Some(src);
+        let text = src.as_deref().unwrap_or("");
+        let (diags, whole) = match check_straight(text, &axes, &setup, &ZeroVars, None) {
+            Some(diags) => (diags, None),
+            None => {
+                let dir = file.parent().map(Path::to_path_buf);
+                let (set, diags) = check_program(
+                    &name,
+                    src.take().unwrap_or_default(),
+                    &axes,
+                    &setup,
+                    (dir.as_deref(), &search),
+                    &ZeroVars,
+                    None,
+                );
+                (diags, Some(set))
             }
-            failed |= !diags.is_empty();
-            if args.blocks && diags.is_empty() {
-                let mut reader_gone = false;
-                let mut print =
-                    |step: &[Decoded]| print_blocks(step, &axes, &mut out, &mut reader_gone);
-                check_straight(&src, &axes, &setup, &ZeroVars, Some(&mut print));
-                if reader_gone {
-                    return exit_code(failed);
-                }
-            }
-            continue;
-        }
-        let dir = file.parent().map(Path::to_path_buf);
-        let (set, diags) = check_program(
-            &name,
-            src,
-            &axes,
-            &setup,
-            (dir.as_deref(), &search),
-            &ZeroVars,
-            None,
-        );
+        };
         for d in &diags {
             out.push_str(&d.render(&name));
             out.push('\n');
@@ -218,13 +211,21 @@ pub fn main(args: CheckArgs) -> ExitCode {
         if args.blocks && diags.is_empty() {
             // Run again, printing as it goes: a clean program's blocks are printed without
             // keeping them all (they take more memory than the program).
-            let mut decoder = DecoderState::new(&axes);
-            decoder.configure(&setup);
             let mut reader_gone = false;
             let mut print =
                 |step: &[Decoded]| print_blocks(step, &axes, &mut out, &mut reader_gone);
-            let budget = crate::nc::decode::check_budget(set.block_count());
-            check_set(&set, &mut decoder, &ZeroVars, budget, Some(&mut print));
+            match &whole {
+                None => {
+                    let text = src.as_deref().unwrap_or("");
+                    check_straight(text, &axes, &setup, &ZeroVars, Some(&mut print));
+                }
+                Some(set) => {
+                    let mut decoder = DecoderState::new(&axes);
+                    decoder.configure(&setup);
+                    let budget = crate::nc::decode::check_budget(set.block_count());
+                    check_set(set, &mut decoder, &ZeroVars, budget, Some(&mut print));
+                }
+            }
             if reader_gone {
                 return exit_code(failed);
             }

@@ -230,9 +230,7 @@ impl Channel {
             outputs: ChannelOutputs::default(),
             config,
         };
-        for i in 0..n {
-            channel.decoder.set_position(i, set_points[i]);
-        }
+        // The decoder takes the axes' positions when a program starts (`start`).
         channel.update_pose();
         Ok(channel)
     }

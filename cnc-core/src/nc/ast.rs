@@ -273,11 +273,6 @@ impl BinOp {
             BinOp::Pow => 6,
         }
     }
-
-    /// Whether the operator is spelled as a word (printed with blanks around it).
-    pub fn is_word(self) -> bool {
-        matches!(self, BinOp::Mod | BinOp::And | BinOp::Or | BinOp::Xor)
-    }
 }
 
 /// The built-in functions of expressions, written `NAME[args]`. Angles are in degrees.

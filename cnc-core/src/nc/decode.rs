@@ -684,29 +684,15 @@ impl DecoderState {
 
     /// Takes the machine data of `setup`.
     pub fn configure(&mut self, setup: &DecoderSetup) {
-        self.set_zero_offsets(&setup.zero_offsets);
-        self.set_tools(&setup.tools);
-        self.tools_unknown = setup.tools_unknown;
-        self.set_arc_tolerance(setup.arc_tolerance);
-    }
-
-    /// Sets the offsets G54..G59 select (`table[0]` is G54), per channel axis.
-    pub fn set_zero_offsets(&mut self, table: &[Vec<f64>; 6]) {
-        for (slot, values) in self.zero_offsets.iter_mut().zip(table) {
+        // G54..G59 per channel axis (values beyond the channel's axes are refused at load).
+        for (slot, values) in self.zero_offsets.iter_mut().zip(&setup.zero_offsets) {
             for (i, v) in values.iter().enumerate().take(slot.len()) {
                 slot[i] = *v;
             }
         }
-    }
-
-    /// Sets the tool table: the length per D number.
-    pub fn set_tools(&mut self, tools: &[(u32, f64)]) {
-        self.tools = tools.to_vec();
-    }
-
-    /// Sets the tolerance of an arc's end point against its circle (mm).
-    pub fn set_arc_tolerance(&mut self, tolerance: f64) {
-        self.arc_tolerance = tolerance;
+        self.tools = setup.tools.clone();
+        self.tools_unknown = setup.tools_unknown;
+        self.arc_tolerance = setup.arc_tolerance;
     }
 
     /// For blocks checked out of their program's order: a feed is taken as programmed, and
@@ -725,11 +711,6 @@ impl DecoderState {
         } else {
             1.0
         }
-    }
-
-    /// The programmed feed (mm/min), what `V.G.FEEDRATE` reads.
-    pub fn feed(&self) -> f64 {
-        self.feed
     }
 
     /// The offset an absolute value of `axis` gets besides G92 and #PSET: the zero offset and,
@@ -1484,17 +1465,6 @@ pub fn evaluate_at(expr: &Expr, span: Span, src: &str, vars: &dyn Vars) -> Resul
             }))
         }
     }
-}
-
-/// Evaluates `expr` with the variables of `vars` (a `$WHILE`/`$IF` condition at run time);
-/// `None` for an unknown variable or a division by zero.
-pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Option<f64> {
-    let mut ctx = Ctx {
-        src: "",
-        vars,
-        diags: Vec::new(),
-    };
-    ctx.eval(expr, Span::default())
 }
 
 /// How many steps a check runs a program before it stops following it (a loop waiting for a

@@ -389,11 +389,7 @@ impl Interpreter {
 
     /// Starts the main program of `set`: variables cleared, at its first main block.
     pub fn start(&mut self, set: &ProgramSet) {
-        self.frames.clear();
-        self.params.iter_mut().for_each(|p| *p = None);
-        self.globals.clear();
-        self.locals.clear();
-        self.declaring = false;
+        self.reset_variables();
         let main = &set.main().tree;
         self.frames.push(Frame {
             unit: 0,
