@@ -177,9 +177,12 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
         "{text}"
     );
     assert!(
-        text.contains("dynCS: cmd=ON CH=1 FILTER=10 WAIT=1 RELATIVE"),
+        text.contains("dynCS: cmd=ON CH=1 NO FILTER=10 WAIT=1 RELATIVE"),
         "{text}"
     );
-    assert!(text.contains("dynCS: is off = INACTIVE"), "{text}");
+    assert!(
+        text.contains("dynCS: is off = DYN_CS_SYNC_INACTIVE"),
+        "{text}"
+    );
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -26,12 +26,14 @@ fn demo_runs_examples_3_and_4_to_their_end() {
     let (stdout, dir) = demo(&["--lockstep"], "full");
     // Example 3: both slaves switched on, followed, switched off; every program finished.
     assert_eq!(
-        stdout.matches("dynCS: is on = ACTIVE").count(),
+        stdout.matches("dynCS: is on = DYN_CS_SYNC_ACTIVE").count(),
         3,
         "{stdout}"
     );
     assert_eq!(
-        stdout.matches("dynCS: is off = INACTIVE").count(),
+        stdout
+            .matches("dynCS: is off = DYN_CS_SYNC_INACTIVE")
+            .count(),
         3,
         "{stdout}"
     );

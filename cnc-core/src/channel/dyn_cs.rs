@@ -8,7 +8,10 @@
 //! displacement of the dynamic CS (see `kinematics::tracking`). While coupling in, out, or
 //! re-taking the master after a FREEZE, the applied compensation runs from where it was to
 //! where it must be over the filter's ticks: translation linearly, rotation along the shortest
-//! arc, in equal steps. Without a filter (FILTER=0) the change is immediate.
+//! arc, with the weight of a quintic smoothing ramp (`6w^5 - 15w^4 + 10w^3` of the ticks done),
+//! whose slope and curvature are zero at both ends. The compensation therefore starts from rest
+//! and arrives at the master's velocity without a step in velocity or acceleration. Without a
+//! filter (FILTER=0) the change is immediate.
 //!
 //! States (reported in `state_r`): INACTIVE, ACTIVATING (coupling in, or re-taking the master
 //! after a FREEZE), ACTIVE, DEACTIVATING, ERROR (the compensation is held where it was: the
@@ -84,10 +87,22 @@ pub enum TrackEvent {
     },
     /// Coupling complete.
     Active,
+    /// The values that go with a switch-on, logged in the tick after it: the axis positions
+    /// before the dynamic CS (0.1 um / 0.0001 degree) and the master frame at switch-on.
+    OnValues {
+        /// Positions X..C before the dynamic CS, HLI units.
+        axes: [i64; 6],
+        /// Master frame X..C at switch-on.
+        master: [f64; 6],
+    },
     /// Switched off.
     Off {
+        /// Who switched it off.
+        source: MasterSource,
         /// Filter ticks of the out-coupling.
         filter_ticks: u32,
+        /// Positions X..C before the dynamic CS when switched off, HLI units.
+        axes: [i64; 6],
         /// The compensation X..C when switched off.
         applied: [f64; 6],
     },
@@ -100,6 +115,13 @@ pub enum TrackEvent {
     MasterResumed,
     /// An error: state ERROR.
     Error(TrackError),
+    /// A PLC request refused without touching the tracking (state and compensation stay).
+    Refused(TrackError),
+    /// The channel started a program (`restart ... start`, then `... finished`).
+    Restart {
+        /// The second line of the pair.
+        finished: bool,
+    },
 }
 
 /// Why tracking went to ERROR (or a switching request was refused).
@@ -117,8 +139,8 @@ pub enum TrackError {
     /// A channel cannot track itself.
     #[error("a channel cannot track its own interface")]
     OwnChannel,
-    /// The PLC commanded while the unit was not enabled.
-    #[error("PLC command while enable_w is FALSE")]
+    /// The PLC posted a transition while the unit was not enabled.
+    #[error("PLC transition while enable_w is FALSE")]
     PlcNotEnabled,
     /// A transition with invalid parameters.
     #[error("invalid transition parameter: {0}")]
@@ -217,9 +239,17 @@ impl Blend {
         if self.total == 0 {
             1.0
         } else {
-            f64::from(self.done) / f64::from(self.total)
+            smooth_ramp(f64::from(self.done) / f64::from(self.total))
         }
     }
+}
+
+/// The filter's weight over its progress `x` in [0, 1]: `6x^5 - 15x^4 + 10x^3`, rising from 0
+/// to 1 with zero slope and zero curvature at both ends (its steepest slope, at the middle, is
+/// 15/8).
+pub fn smooth_ramp(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * x * (x * (6.0 * x - 15.0) + 10.0)
 }
 
 /// Interpolates between two frames: translation linearly, rotation along the shortest arc.
@@ -250,10 +280,22 @@ pub struct Tracker {
     history: Ring<HistoryEntry>,
     log: Ring<(u64, TrackEvent)>,
     tick: u64,
+    /// The positions before the dynamic CS in the last recorded tick (HLI units).
+    axes: [i64; 6],
+    /// A switch-on whose values are logged with the next recorded tick.
+    on_values_pending: Option<[f64; 6]>,
+    /// PLC requests refused (see [`TrackEvent::Refused`]).
+    refused: u64,
+    /// Frames the PLC commanded while `enable_w` was FALSE (taken, not redirected).
+    not_redirected: u64,
 }
 
-/// Entries of the switching log.
+/// Events kept for the switching log (each renders to one or more lines; the listing shows the
+/// last [`LOG_LINES`] lines).
 pub const LOG_CAPACITY: usize = 64;
+
+/// Lines of the switching log's ring, as the controller's listing counts them.
+pub const LOG_LINES: usize = 40;
 
 impl Tracker {
     /// An inactive tracker; `history` entries of diagnosis (`dyn_cs_history_max`), angles of
@@ -272,7 +314,39 @@ impl Tracker {
             history: Ring::new(history),
             log: Ring::new(LOG_CAPACITY),
             tick: 0,
+            axes: [0; 6],
+            on_values_pending: None,
+            refused: 0,
+            not_redirected: 0,
         }
+    }
+
+    /// The channel started a program: logged as the controller logs a restart.
+    pub fn restart(&mut self) {
+        self.event(TrackEvent::Restart { finished: false });
+        self.event(TrackEvent::Restart { finished: true });
+    }
+
+    /// Refuses a PLC request without touching the tracking: logged and counted.
+    pub fn refuse(&mut self, error: TrackError) {
+        self.refused += 1;
+        self.event(TrackEvent::Refused(error));
+    }
+
+    /// A frame the PLC commanded while `enable_w` was FALSE: the unit does not redirect it
+    /// (the frame is dropped, the semaphore freed), which is no fault.
+    pub fn not_redirected(&mut self) {
+        self.not_redirected += 1;
+    }
+
+    /// PLC requests refused so far.
+    pub fn refused_count(&self) -> u64 {
+        self.refused
+    }
+
+    /// Frames commanded while the unit was not enabled, dropped.
+    pub fn not_redirected_count(&self) -> u64 {
+        self.not_redirected
     }
 
     /// The state as `state_r` reports it.
@@ -369,6 +443,7 @@ impl Tracker {
             simu: setup.simu,
             master: words(&reference),
         });
+        self.on_values_pending = Some(words(&reference));
         self.tracking = Some(tracking);
         self.setup = Some(setup);
         self.last_master = master.copied();
@@ -392,7 +467,9 @@ impl Tracker {
             .or(self.setup.map(|s| s.filter_ticks))
             .unwrap_or(0);
         self.event(TrackEvent::Off {
+            source: self.setup.map_or(MasterSource::Plc, |s| s.source),
             filter_ticks: total,
+            axes: self.axes,
             applied: words(&self.applied),
         });
         self.state = DynCsState::Deactivating;
@@ -416,7 +493,11 @@ impl Tracker {
         match (live, self.master_live) {
             (Some(m), false) => {
                 self.master_live = true;
-                if self.last_master.is_some() && self.state == DynCsState::Active {
+                // A resume while coupling in restarts the soft take-over from where the
+                // compensation stands, so the jump of the master's frame is smoothed too.
+                if self.last_master.is_some()
+                    && matches!(self.state, DynCsState::Active | DynCsState::Activating)
+                {
                     self.event(TrackEvent::MasterResumed);
                     self.state = DynCsState::Activating;
                     self.blend = Some(Blend {
@@ -454,7 +535,14 @@ impl Tracker {
             self.fail(TrackError::BadFrame);
             return self.applied;
         }
+        // While the master is frozen a coupling-in pauses where it stands (the resume starts a
+        // new ramp from there); a coupling-out goes on, it does not need the master. A master
+        // that has offered no frame yet is no freeze: the coupling runs to the compensation
+        // of an unmoved master (the manual's PLC commands its first frame once ACTIVE).
+        let paused =
+            !self.master_live && self.last_master.is_some() && self.state == DynCsState::Activating;
         self.applied = match self.blend.as_mut() {
+            Some(_) if paused => self.applied,
             Some(blend) => {
                 blend.done = (blend.done + 1).min(blend.total);
                 let w = blend.weight();
@@ -502,10 +590,18 @@ impl Tracker {
     /// Records one tick of the diagnosis history: the pose before and after the dynamic CS
     /// (nothing is computed while tracking is inactive).
     pub fn record(&mut self, before: &Isometry3<f64>, after: &Isometry3<f64>) {
+        let input = words(before);
+        self.axes = input.map(hli_units);
+        if let Some(master) = self.on_values_pending.take() {
+            self.event(TrackEvent::OnValues {
+                axes: self.axes,
+                master,
+            });
+        }
         if self.state == DynCsState::Inactive {
             return;
         }
-        let (input, output) = (words(before), words(after));
+        let output = words(after);
         let w = words(&self.applied);
         let mut entry = HistoryEntry {
             tick: self.tick,

@@ -4,6 +4,7 @@
 //! the image itself, so a tick reads the PLC once and a channel can be ticked without one.
 
 use hli::enums::{DynCsCommand, DynCsState, ProgramState};
+use hli::handshake::ProtocolViolation;
 use hli::layout::{
     HliCoordState, HliCoordinateSystemInt, HliDynCsChannelInterface, HliDynCsTransition,
     HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
@@ -104,18 +105,26 @@ pub fn read_inputs(view: &CncView<'_>, index: usize, wanted: Wanted, inputs: &mu
             inputs.dyn_cs_command = reader.try_take().ok().flatten();
         }
         if let Ok(mut reader) = view.dyn_cs_transition(index) {
-            inputs.transition = match reader.try_take() {
-                Ok(Some((command, params))) => Some(Transition::Taken(command, params)),
-                Ok(None) => None,
-                Err(hli::handshake::ProtocolViolation::TornPayload) => None, // next tick
-                Err(_) => Some(Transition::Garbage),
-            };
+            inputs.transition = transition_input(reader.try_take());
         }
     }
     if wanted.m_ack {
         if let Ok(mut reader) = view.m_function_ack(index) {
             inputs.m_ack = reader.try_take().ok().flatten();
         }
+    }
+}
+
+/// What the channel sees of one attempt to take the transition: a torn copy (the PLC rewrote
+/// the unit while it was copied) is nothing yet, left pending for the next tick; only a
+/// command word that is not -1, 0 or +1 is garbage.
+fn transition_input(
+    taken: Result<Option<(DynCsCommand, HliDynCsTransition)>, ProtocolViolation>,
+) -> Option<Transition> {
+    match taken {
+        Ok(Some((command, params))) => Some(Transition::Taken(command, params)),
+        Ok(None) | Err(ProtocolViolation::TornPayload) => None,
+        Err(_) => Some(Transition::Garbage),
     }
 }
 
@@ -181,4 +190,24 @@ pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
         hli::units::mm_to_hli(v)
     };
     raw.unwrap_or(if v < 0.0 { i32::MIN } else { i32::MAX })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_torn_transition_is_left_for_the_next_tick_and_garbage_is_reported() {
+        assert_eq!(transition_input(Err(ProtocolViolation::TornPayload)), None);
+        assert_eq!(transition_input(Ok(None)), None);
+        assert_eq!(
+            transition_input(Err(ProtocolViolation::CommandGarbage { raw: 5 })),
+            Some(Transition::Garbage)
+        );
+        let params: HliDynCsTransition = bytemuck::Zeroable::zeroed();
+        assert_eq!(
+            transition_input(Ok(Some((DynCsCommand::Activate, params)))),
+            Some(Transition::Taken(DynCsCommand::Activate, params))
+        );
+    }
 }

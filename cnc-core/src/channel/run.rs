@@ -23,7 +23,9 @@ use super::plc_io::{
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
-use crate::nc::decode::{AxisValues, SyncIds, TrackSource, Vars, KNOWN_VARIABLES};
+use crate::nc::decode::{
+    AxisValues, SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES,
+};
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
 use hli::enums::{DynCsCommand, DynCsState, ProgramState};
@@ -269,6 +271,7 @@ impl Channel {
         if self.config.provide_channel_interface.track_cs {
             self.interface_on = true;
         }
+        self.tracker.restart();
     }
 
     /// The channel's index (its units in the image).
@@ -468,26 +471,29 @@ impl Channel {
         let enabled = self.inputs.dyn_cs_enabled;
         self.plc_enabled = enabled;
         if let Some(cs) = self.inputs.dyn_cs_command {
+            // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
+            // nowhere (taken, so the PLC's semaphore is free again, and counted).
             if enabled {
                 self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
             } else {
-                self.tracker.fail(TrackError::PlcNotEnabled);
+                self.tracker.not_redirected();
             }
         }
-        let taken = match self.inputs.transition {
+        // A refused transition is logged and counted; it never puts the tracking in ERROR, so
+        // it cannot block a later switch-on.
+        let (command, params) = match self.inputs.transition {
             Some(Transition::Taken(command, params)) => (command, params),
             None => return,
             Some(Transition::Garbage) => {
                 self.tracker
-                    .fail(TrackError::BadTransition("command word is not -1, 0 or +1"));
+                    .refuse(TrackError::BadTransition("command word is not -1, 0 or +1"));
                 return;
             }
         };
         if !enabled {
-            self.tracker.fail(TrackError::PlcNotEnabled);
+            self.tracker.refuse(TrackError::PlcNotEnabled);
             return;
         }
-        let (command, params) = taken;
         match command {
             DynCsCommand::Activate => {
                 let flags = [
@@ -497,14 +503,20 @@ impl Channel {
                     params.f_rot_trans.get(),
                 ];
                 let [Ok(wait), Ok(set_zero), Ok(kin_base), Ok(rot_trans)] = flags else {
-                    self.tracker.fail(TrackError::BadTransition(
+                    self.tracker.refuse(TrackError::BadTransition(
                         "a flag byte is neither FALSE nor TRUE",
                     ));
                     return;
                 };
                 if params.option > 1 {
                     self.tracker
-                        .fail(TrackError::BadTransition("option must be 0 or 1"));
+                        .refuse(TrackError::BadTransition("option must be 0 or 1"));
+                    return;
+                }
+                if self.tracker.state() != DynCsState::Inactive
+                    && self.tracker.state() != DynCsState::Deactivating
+                {
+                    self.tracker.refuse(TrackError::AlreadyOn);
                     return;
                 }
                 let kb = frame_from_hli(&params.kinematic_base_cs, RotationOrder::Zyx);
@@ -750,7 +762,8 @@ impl Channel {
             }
             Decoded::Track { command, .. } => {
                 if !command.on {
-                    self.tracker.switch_off(Some(command.filter_ticks));
+                    // Without FILTER the switch-off takes the switch-on's filter.
+                    self.tracker.switch_off(command.filter_ticks);
                     if command.wait {
                         self.wait = Some(Wait::Tracking);
                     }
@@ -788,7 +801,7 @@ impl Channel {
                     set_zero: command.set_zero,
                     translation_only: command.option == 1,
                     kin_base: command.kin_base,
-                    filter_ticks: command.filter_ticks,
+                    filter_ticks: command.filter_ticks.unwrap_or(DEFAULT_FILTER_TICKS),
                     wait: command.wait,
                     rot_trans: command.rot_trans,
                     offset: command.offset,

@@ -227,8 +227,9 @@ pub struct TrackCommand {
     pub option: u32,
     /// KIN_BASE.
     pub kin_base: bool,
-    /// FILTER in ticks (200 when not given).
-    pub filter_ticks: u32,
+    /// FILTER in ticks; `None` when not given (ON then takes [`DEFAULT_FILTER_TICKS`], OFF
+    /// the filter it switched on with).
+    pub filter_ticks: Option<u32>,
     /// WAIT.
     pub wait: bool,
     /// ROT_TRANS.
@@ -1362,7 +1363,7 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         set_zero: false,
         option: 0,
         kin_base: false,
-        filter_ticks: DEFAULT_FILTER_TICKS,
+        filter_ticks: None,
         wait: false,
         rot_trans: false,
         relative: false,
@@ -1397,7 +1398,9 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
                 t.source = whole_entry(e, ctx, "ID", 0.0, 12.0).map(|v| TrackSource::Id(v as u8))
             }
             "OPTION" => t.option = whole_entry(e, ctx, "OPTION", 0.0, 1.0)?,
-            "FILTER" => t.filter_ticks = whole_entry(e, ctx, "FILTER", 0.0, f64::from(u32::MAX))?,
+            "FILTER" => {
+                t.filter_ticks = Some(whole_entry(e, ctx, "FILTER", 0.0, f64::from(u32::MAX))?)
+            }
             "SET_ZERO" | "ABSOLUTE" => t.set_zero = true,
             "KIN_BASE" => t.kin_base = true,
             "WAIT" => t.wait = true,

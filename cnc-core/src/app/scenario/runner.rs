@@ -460,7 +460,7 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
             tracking: c
                 .tracker()
                 .log()
-                .map(|(tick, event)| (*tick, log_message(*tick, event)))
+                .filter_map(|(tick, event)| Some((*tick, log_message(*tick, event)?)))
                 .collect(),
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),

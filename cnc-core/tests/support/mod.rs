@@ -1,0 +1,93 @@
+//! Helpers shared by the channel tests: channel configurations, a controller running given
+//! programs on a heap image, a watchdog loop, and PLC payloads.
+#![allow(dead_code)] // each test binary uses its own subset
+
+use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
+use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition};
+use hli::segment::heap_image;
+use hli::views::CncView;
+use hli::{Bool, ImageMemory};
+
+pub const CYCLE: f64 = 0.001;
+pub const ROBOT_HOME: [f64; 6] = [0.0, -60.0, 90.0, 0.0, 60.0, 0.0];
+
+pub fn robot(name: &str) -> ChannelConfig {
+    let mut c = ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]);
+    c.kinematics.id = 45;
+    c.kinematics.preset = Some("kr6r900sixx".into());
+    c.start = ROBOT_HOME.to_vec();
+    c
+}
+
+pub fn cartesian(name: &str) -> ChannelConfig {
+    ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"])
+}
+
+pub fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
+    let mut channels = Vec::new();
+    for (i, (config, src)) in configs.into_iter().enumerate() {
+        let program =
+            LoadedProgram::load(&config.name, src, &config.axes).unwrap_or_else(|e| panic!("{e}"));
+        let mut channel = Channel::new(i, config, CYCLE).unwrap();
+        channel.start(program);
+        channels.push(channel);
+    }
+    Controller::new(channels).unwrap()
+}
+
+pub fn image(channels: usize) -> ImageMemory {
+    heap_image(channels as u32, 8)
+}
+
+/// Runs until `done` or the watchdog of `limit` ticks trips (then fails).
+pub fn run_until(
+    ctl: &mut Controller,
+    memory: &ImageMemory,
+    limit: u32,
+    mut each: impl FnMut(&Controller, u32),
+    done: impl Fn(&Controller) -> bool,
+) -> u32 {
+    let view = CncView::new(memory);
+    for tick in 0..limit {
+        ctl.tick(&view);
+        for c in ctl.channels() {
+            assert_ne!(
+                c.state(),
+                RunState::Error,
+                "channel {} stopped: {:?}",
+                c.config().name,
+                c.error()
+            );
+        }
+        each(ctl, tick);
+        if done(ctl) {
+            return tick;
+        }
+    }
+    panic!("watchdog: not done after {limit} ticks");
+}
+
+/// A frame commanded by the PLC: a translation in 0.1 um, no rotation.
+pub fn cs(translation: [i32; 3]) -> HliCoordinateSystemInt {
+    HliCoordinateSystemInt {
+        translation,
+        fill_up_2: 0,
+        rotation: [0; 3],
+        fill_up_1: 0,
+    }
+}
+
+/// A PLC transition's parameters: a filter, f_wait, no other flag, no offset (the command
+/// word is written by `try_send`).
+pub fn transition(filter_max_ticks: u32, f_wait: Bool) -> HliDynCsTransition {
+    HliDynCsTransition {
+        command: 0,
+        filter_max_ticks,
+        option: 0,
+        f_wait,
+        f_set_zero: Bool::FALSE,
+        f_kin_base: Bool::FALSE,
+        f_rot_trans: Bool::FALSE,
+        kinematic_base_cs: cs([0; 3]),
+    }
+}
