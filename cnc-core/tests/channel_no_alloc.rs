@@ -126,15 +126,34 @@ fn the_machine_tick_with_single_axes_an_engine_and_a_plc_allocates_nothing() {
     for _ in 0..500 {
         run.step(s.cycle_s);
     }
+    // The PLC also holds the feed and changes the override now and then: each change
+    // re-targets the path's generator, which must not allocate either.
+    let (mut held_ticks, mut changes) = (0, 0);
     let before = allocations();
-    for _ in 0..5000 {
+    for i in 0..5000u32 {
+        if i % 150 == 0 {
+            let hold = (i / 150) % 3 == 1;
+            let feed = if (i / 150) % 2 == 0 { 700 } else { 1300 };
+            let value = hli::views::PathOverride {
+                feed_permille: feed,
+                rapid_permille: 1000,
+                feed_hold: hold,
+            };
+            hli::views::PlcView::new(&run.memory)
+                .set_path_override(0, value)
+                .unwrap();
+            changes += 1;
+        }
         run.step(s.cycle_s);
+        let plc = hli::views::PlcView::new(&run.memory);
+        held_ticks += u32::from(plc.feed_override_applied(0).unwrap() == 0);
     }
     let made = allocations() - before;
     assert_eq!(
         made, 0,
         "{made} allocations in 5000 machine ticks and PLC cycles"
     );
+    assert!(changes > 30 && held_ticks > 1000, "{changes} {held_ticks}");
     // Everything moved in the measured ticks.
     let axes = run.machine.axes();
     let follower = axes.axis(run.machine.channel_axes()).unwrap();

@@ -292,6 +292,31 @@ hli_enum! {
 }
 
 hli_enum! {
+    /// Why a channel stopped (`HLI_BAHN_STATE.error_id_r`; 0 while it has no error). The seed
+    /// names no channel error numbers; these are ours, one per kind of cause.
+    ChannelErrorId: u32, "HLI_BAHN_STATE.error_id_r" {
+        /// No error.
+        None = 0,
+        /// A block or statement failed when it was decoded or run (an expression, a call).
+        Program = 0x4501,
+        /// No velocity profile for a block (limits, a target that is not finite).
+        Path = 0x4502,
+        /// `#TRACK CS ON` refused (no master interface, own channel, already on).
+        Tracking = 0x4503,
+        /// `#CS` refused (no transformation, too many frames, a bad frame).
+        CoordinateSystem = 0x4504,
+        /// The kinematic transformation: a pose out of reach, an unconfigured kinematic.
+        Kinematics = 0x4505,
+        /// An independent axis move without a profile.
+        IndependentAxis = 0x4506,
+        /// `#SIGNAL SYN` with too many ids pending.
+        Synchronisation = 0x4507,
+        /// A machine stop (the PLC was lost, or a stop was requested).
+        MachineStop = 0x4508,
+    }
+}
+
+hli_enum! {
     /// State of a FIFO axis group.
     FifoGroupState: i32, "HLI_FIFO_GROUP_STATE.group_state_r" {
         /// No job: axes may be integrated, the FIFO is empty.

@@ -324,6 +324,8 @@ impl CncSegment {
             SegmentState::Initialising,
             process_start_stamp(pid).unwrap_or(0),
         ));
+        // Before Ready: a PLC that attaches never sees the zeroed values.
+        write_plc_defaults(&self.memory, channels);
         header
             .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
             .store_release(SegmentState::Ready.raw());
@@ -651,7 +653,17 @@ pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
         SegmentState::Ready,
         0,
     ));
+    write_plc_defaults(&memory, channels);
     memory
+}
+
+/// The PLC-written values whose zero would not be a safe default: each channel's override
+/// starts at 100 % ([`crate::views::DEFAULT_PATH_OVERRIDE`]).
+fn write_plc_defaults(memory: &ImageMemory, channels: u32) {
+    let view = crate::views::PlcView::new(memory);
+    for channel in 0..channels as usize {
+        let _ = view.set_path_override(channel, crate::views::DEFAULT_PATH_OVERRIDE);
+    }
 }
 
 const _: () = assert!(IMAGE_SIZE.is_multiple_of(8));

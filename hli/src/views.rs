@@ -142,6 +142,29 @@ pub enum OverrideError {
     FeedHold(u8),
 }
 
+/// What a channel reports of its block execution every tick (`HLI_BAHN_STATE`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BlockProgress {
+    /// Source line of the block executing.
+    pub block_nr: i32,
+    /// Program state.
+    pub program_state: crate::enums::ProgramState,
+    /// Path velocity, 1 um/s.
+    pub path_feed_um_s: i32,
+    /// Why the channel stopped ([`crate::enums::ChannelErrorId::None`] while it runs).
+    pub error_id: crate::enums::ChannelErrorId,
+    /// Channel ticks so far.
+    pub tick: u64,
+}
+
+/// The override and feed hold a freshly created image holds for every channel: 100 %, no
+/// hold (a zeroed image would mean 0 %, a machine that never moves).
+pub const DEFAULT_PATH_OVERRIDE: PathOverride = PathOverride {
+    feed_permille: 1000,
+    rapid_permille: 1000,
+    feed_hold: false,
+};
+
 /// Largest feed override, 0.1 %.
 pub const MAX_FEED_OVERRIDE: u32 = 2000;
 /// Largest rapid override, 0.1 %.
@@ -267,19 +290,33 @@ impl<'m> CncView<'m> {
         Ok(())
     }
 
-    /// Writes the block progress of a channel: the block's number, the program state and the
-    /// interpolation tick (`bahn_state`, the display values aside).
+    /// Writes the block progress of a channel (`bahn_state`, the display values aside).
     pub fn write_block_progress(
         &self,
         channel: usize,
-        block_nr: i32,
-        program_state: crate::enums::ProgramState,
-        tick: u64,
+        progress: &BlockProgress,
     ) -> Result<(), IndexError> {
         let bahn = self.bahn_state(channel)?;
-        unit_field!(bahn, HliBahnState, active_block_nr_r).store(block_nr);
-        unit_field!(bahn, HliBahnState, program_state_r).store(program_state.raw());
-        unit_field!(bahn, HliBahnState, tick_counter_r).store(tick);
+        unit_field!(bahn, HliBahnState, active_block_nr_r).store(progress.block_nr);
+        unit_field!(bahn, HliBahnState, program_state_r).store(progress.program_state.raw());
+        unit_field!(bahn, HliBahnState, path_feed_r).store(progress.path_feed_um_s);
+        unit_field!(bahn, HliBahnState, error_id_r).store(progress.error_id.raw());
+        unit_field!(bahn, HliBahnState, tick_counter_r).store(progress.tick);
+        Ok(())
+    }
+
+    /// Reports the feed override the channel applies (`feed_override_r`, 0.1 %).
+    pub fn write_feed_override_applied(
+        &self,
+        channel: usize,
+        permille: u32,
+    ) -> Result<(), IndexError> {
+        self.nav
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
+            .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
+            .store(permille);
         Ok(())
     }
 
@@ -440,6 +477,56 @@ impl<'m> PlcView<'m> {
     /// [`crate::enums::FifoGroupState::decode`]).
     pub fn fifo_group(&self, index: usize) -> Result<HliFifoGroupState, IndexError> {
         Ok(self.nav.fifo_group(index)?.read())
+    }
+
+    /// Commands the path override and feed hold of `channel` (`path_override.*_w`).
+    pub fn set_path_override(&self, channel: usize, value: PathOverride) -> Result<(), IndexError> {
+        let unit = self
+            .nav
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override));
+        unit_field!(unit, HliChannelOverrideUnit, feed_override_w).store(value.feed_permille);
+        unit_field!(unit, HliChannelOverrideUnit, rapid_override_w).store(value.rapid_permille);
+        unit.field::<Bool>(offset_of!(HliChannelOverrideUnit, feed_hold_w))
+            .cast::<u8>()
+            .store_release(u8::from(value.feed_hold));
+        Ok(())
+    }
+
+    /// The feed override the channel applies (`feed_override_r`, 0.1 %).
+    pub fn feed_override_applied(&self, channel: usize) -> Result<u32, IndexError> {
+        Ok(self
+            .nav
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
+            .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
+            .load())
+    }
+
+    /// The path feed the CNC published for `channel` (`path_feed_r`, 1 um/s).
+    pub fn path_feed(&self, channel: usize) -> Result<i32, IndexError> {
+        Ok(self
+            .nav
+            .channel(channel)?
+            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
+            .field::<i32>(offset_of!(HliBahnState, path_feed_r))
+            .load())
+    }
+
+    /// The channel's error (`error_id_r`), validated.
+    pub fn channel_error(
+        &self,
+        channel: usize,
+    ) -> Result<Result<crate::enums::ChannelErrorId, InvalidValue>, IndexError> {
+        let raw = self
+            .nav
+            .channel(channel)?
+            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
+            .field::<u32>(offset_of!(HliBahnState, error_id_r))
+            .load();
+        Ok(crate::enums::ChannelErrorId::decode(raw))
     }
 
     /// The program state the CNC published for `channel` (`program_state_r`), validated.

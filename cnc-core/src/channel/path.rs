@@ -27,6 +27,13 @@
 //!
 //! The channel owns one generator for its path and hands it to every block: building a
 //! generator allocates (rsruckig's buffers), re-targeting one does not.
+//!
+//! The PLC's override acts on the block under way ([`PathMove::set_override`]): a new value
+//! re-targets the generator from its current state to the block's end with the velocity
+//! limit scaled (feed override on `F` for G1 and arcs, capped by the axes' and the arc's own
+//! limits; rapid override on the axis limits for G0), so the speed changes jerk-limited, never
+//! by a step. Feed hold, or 0 %, brakes along the path with the block's deceleration and jerk
+//! and keeps the block: a later value lets it go on to its end.
 
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::arc::ArcMove;
@@ -130,6 +137,14 @@ pub struct PathMove {
     braked: bool,
     /// The path limits the block was planned with.
     limits: MoveLimits,
+    /// The velocity limit apart from the feed (axes; for an arc also its geometry).
+    free_velocity: f64,
+    /// `F` in path units per second; infinite for G0.
+    feed: f64,
+    /// The override factor in effect (1 at planning).
+    factor: f64,
+    /// Held by feed hold or 0 %: braking or standing, the block not ended.
+    held: bool,
 }
 
 /// Why a block cannot be interpolated.
@@ -182,9 +197,13 @@ impl PathMove {
             jerk: f64::INFINITY,
         };
         limit_by_axes(&mut path, &delta, length, limits);
-        if motion == MotionMode::Linear {
-            path.velocity = path.velocity.min(feed_mm_min / 60.0);
-        }
+        let free_velocity = path.velocity;
+        let feed = if motion == MotionMode::Linear {
+            feed_mm_min / 60.0
+        } else {
+            f64::INFINITY
+        };
+        path.velocity = path.velocity.min(feed);
         start_profile(&mut path, length, generator)?;
         Ok(Some(Self {
             start: *start,
@@ -195,6 +214,10 @@ impl PathMove {
             done: false,
             braked: false,
             limits: path,
+            free_velocity,
+            feed,
+            factor: 1.0,
+            held: false,
         }))
     }
 
@@ -232,7 +255,6 @@ impl PathMove {
         let r = r0.min(r1).max(1e-9);
         let mut path = MoveLimits {
             velocity: (plane_v / share.max(1e-12))
-                .min(feed_mm_min / 60.0)
                 .min((plane_a * r / 2.0).sqrt())
                 .min((plane_j * r * r / 2.0).cbrt())
                 .min((8.0 * r * spec.chordal_tolerance).sqrt() / spec.cycle_s),
@@ -241,6 +263,9 @@ impl PathMove {
             jerk: plane_j / 2.0 / share.max(1e-12),
         };
         limit_by_axes(&mut path, &delta, length, limits);
+        let free_velocity = path.velocity;
+        let feed = feed_mm_min / 60.0;
+        path.velocity = path.velocity.min(feed);
         start_profile(&mut path, length, generator)?;
         Ok(Self {
             start: *start,
@@ -258,6 +283,10 @@ impl PathMove {
             done: false,
             braked: false,
             limits: path,
+            free_velocity,
+            feed,
+            factor: 1.0,
+            held: false,
         })
     }
 
@@ -266,7 +295,9 @@ impl PathMove {
     /// exactly the target).
     pub fn step(&mut self, generator: &mut SetpointGenerator, position: &mut AxisValues) -> bool {
         if !self.done {
-            self.done = matches!(generator.step(), Progress::Reached | Progress::Idle);
+            let progress = generator.step();
+            // Held, the generator comes to rest short of the end: the block goes on later.
+            self.done = !self.held && matches!(progress, Progress::Reached | Progress::Idle);
         }
         let s = if self.done && !self.braked {
             1.0
@@ -309,6 +340,50 @@ impl PathMove {
         if generator.brake(dec, jerk).is_ok() {
             self.braked = true;
         }
+    }
+
+    /// Applies an override `factor` (1 = 100 %, 0 = hold) to the rest of the block: `feed`
+    /// for G1 and arcs, `rapid` for G0, each in [0, 2]. A change re-targets the generator from
+    /// its current state; nothing changes once the block ends or is braked for a stop.
+    pub fn set_override(&mut self, feed: f64, rapid: f64, generator: &mut SetpointGenerator) {
+        let factor = if self.feed.is_finite() { feed } else { rapid };
+        if self.done || self.braked || factor == self.factor {
+            return;
+        }
+        if factor <= 0.0 {
+            self.factor = factor;
+            if !self.held {
+                self.held = true;
+                if generator
+                    .brake(self.limits.deceleration, self.limits.jerk)
+                    .is_err()
+                {
+                    // No braking profile (never seen): stand where the path is.
+                    let here = generator.state().position;
+                    generator.hold(here);
+                }
+            }
+            return;
+        }
+        let velocity = if self.feed.is_finite() {
+            self.free_velocity.min(self.feed * factor)
+        } else {
+            self.free_velocity * factor
+        };
+        let limits = MoveLimits {
+            velocity,
+            ..self.limits
+        };
+        // Without a profile the old value stays in effect and the next tick tries again.
+        if generator.move_to(self.length, limits).is_ok() {
+            self.factor = factor;
+            self.held = false;
+        }
+    }
+
+    /// Whether feed hold (or 0 %) holds the block.
+    pub fn held(&self) -> bool {
+        self.held
     }
 
     /// Block length.

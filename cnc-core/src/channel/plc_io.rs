@@ -3,13 +3,13 @@
 //! last stage writes what the channel produced ([`write_outputs`]). The channel never touches
 //! the image itself, so a tick reads the PLC once and a channel can be ticked without one.
 
-use hli::enums::{DynCsCommand, DynCsState, ProgramState};
+use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};
 use hli::handshake::ProtocolViolation;
 use hli::layout::{
     HliCoordState, HliCoordinateSystemInt, HliDynCsChannelInterface, HliDynCsTransition,
     HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
 };
-use hli::views::CncView;
+use hli::views::{BlockProgress, CncView, OverrideError, PathOverride};
 use hli::Bool;
 use kinematics::{PoseWords, RotationOrder};
 use nalgebra::Isometry3;
@@ -33,9 +33,23 @@ pub enum Transition {
     Garbage,
 }
 
+/// The override unit as read this tick.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum OverrideInput {
+    /// The channel has no unit in the image (or no image): 100 %, no hold.
+    #[default]
+    Absent,
+    /// A valid value.
+    Valid(PathOverride),
+    /// A value out of range (the channel keeps its last valid one).
+    Invalid(OverrideError),
+}
+
 /// What the PLC gave a channel this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ChannelInputs {
+    /// Path override and feed hold (read every tick).
+    pub path_override: OverrideInput,
     /// `enable_w` (a garbage byte reads as not enabled).
     pub dyn_cs_enabled: bool,
     /// A new frame taken from `command_w`.
@@ -68,6 +82,12 @@ pub struct ChannelOutputs {
     pub program_state: ProgramState,
     /// Channel ticks so far.
     pub tick: u64,
+    /// Path velocity, 1 um/s.
+    pub path_feed_um_s: i32,
+    /// Why the channel stopped.
+    pub error_id: ChannelErrorId,
+    /// The feed override in effect (0.1 %; 0 while feed hold holds the path).
+    pub feed_override_applied: u32,
     /// The channel's published frame.
     pub interface: HliDynCsChannelInterface,
     /// An M function to announce (kept until it is posted).
@@ -84,6 +104,9 @@ impl Default for ChannelOutputs {
             block_nr: 0,
             program_state: ProgramState::Idle,
             tick: 0,
+            path_feed_um_s: 0,
+            error_id: ChannelErrorId::None,
+            feed_override_applied: 0,
             interface: bytemuck::Zeroable::zeroed(),
             m_request: None,
         }
@@ -97,6 +120,11 @@ pub fn read_inputs(view: &CncView<'_>, index: usize, wanted: Wanted, inputs: &mu
     *inputs = ChannelInputs {
         m_request_free: request.as_ref().is_ok_and(|w| w.is_free().unwrap_or(false)),
         has_m_unit: request.is_ok(),
+        path_override: match view.path_override(index) {
+            Ok(Ok(value)) => OverrideInput::Valid(value),
+            Ok(Err(error)) => OverrideInput::Invalid(error),
+            Err(_) => OverrideInput::Absent,
+        },
         ..ChannelInputs::default()
     };
     if wanted.dyn_cs {
@@ -143,7 +171,17 @@ pub fn write_outputs(view: &CncView<'_>, index: usize, outputs: &mut ChannelOutp
     for (i, coord) in outputs.coords[..outputs.coord_count].iter().enumerate() {
         let _ = view.write_coord_state(index, i, coord);
     }
-    let _ = view.write_block_progress(index, outputs.block_nr, outputs.program_state, outputs.tick);
+    let _ = view.write_block_progress(
+        index,
+        &BlockProgress {
+            block_nr: outputs.block_nr,
+            program_state: outputs.program_state,
+            path_feed_um_s: outputs.path_feed_um_s,
+            error_id: outputs.error_id,
+            tick: outputs.tick,
+        },
+    );
+    let _ = view.write_feed_override_applied(index, outputs.feed_override_applied);
     let _ = view.write_channel_interface(index, &outputs.interface);
 }
 

@@ -18,7 +18,8 @@ use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
-    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, Transition, Wanted,
+    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Transition,
+    Wanted,
 };
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
@@ -28,8 +29,9 @@ use crate::nc::decode::{
 };
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
-use hli::enums::{DynCsCommand, DynCsState, ProgramState};
+use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
+use hli::views::{PathOverride, DEFAULT_PATH_OVERRIDE};
 use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
 use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
@@ -79,6 +81,8 @@ enum Wait {
 pub struct ChannelError {
     /// Source line of the block.
     pub line: u32,
+    /// The kind of cause, as `error_id_r` reports it.
+    pub id: ChannelErrorId,
     /// What went wrong.
     pub message: String,
 }
@@ -130,6 +134,10 @@ pub struct Channel {
     cs_stack: [Isometry3<f64>; CS_DEPTH],
     cs_len: usize,
     tracker: Tracker,
+    /// The PLC's override and feed hold in effect (its last valid value).
+    path_override: PathOverride,
+    /// Override values out of range the PLC wrote (each tick one is read, counted once).
+    override_refused: u64,
     interface_on: bool,
     /// Set-points of the channel's axes (joints first under a transformation).
     set_points: AxisValues,
@@ -211,6 +219,8 @@ impl Channel {
             cs_stack: [Isometry3::identity(); CS_DEPTH],
             cs_len: 0,
             tracker: Tracker::new(config.interpolator.dyn_cs_history_max as usize, order),
+            path_override: DEFAULT_PATH_OVERRIDE,
+            override_refused: 0,
             interface_on: false,
             set_points,
             joints,
@@ -343,6 +353,17 @@ impl Channel {
         self.log_file.as_deref()
     }
 
+    /// The PLC's override and feed hold in effect.
+    pub fn path_override(&self) -> PathOverride {
+        self.path_override
+    }
+
+    /// Ticks in which the PLC's override unit held a value out of range (the last valid value
+    /// stayed in effect).
+    pub fn override_refused_count(&self) -> u64 {
+        self.override_refused
+    }
+
     /// The tracker.
     pub fn tracker(&self) -> &Tracker {
         &self.tracker
@@ -395,9 +416,10 @@ impl Channel {
         self.stopping.is_some() && (self.is_moving() || self.state == RunState::Running)
     }
 
-    fn fail(&mut self, message: String) {
+    fn fail(&mut self, id: ChannelErrorId, message: String) {
         self.error = Some(ChannelError {
             line: self.line,
+            id,
             message,
         });
         self.state = RunState::Error;
@@ -434,6 +456,7 @@ impl Channel {
     ) {
         self.tick += 1;
         self.inputs = *inputs;
+        self.take_override();
         self.plc_inputs();
         if self.state == RunState::Running && self.stopping.is_none() {
             self.interpret(masters, sync);
@@ -441,7 +464,7 @@ impl Channel {
         self.advance();
         if let Some(reason) = self.stopping {
             if self.state == RunState::Running && !self.is_moving() {
-                self.fail(reason.to_string());
+                self.fail(ChannelErrorId::MachineStop, reason.to_string());
             }
         }
         let master = self.master_sample(masters);
@@ -624,7 +647,7 @@ impl Channel {
             // The channel's values are a running machine's: nothing is undecided here.
             Ok(Step::Control | Step::Undecided) => true,
             Err(d) => {
-                self.fail(d.message);
+                self.fail(ChannelErrorId::Program, d.message);
                 false
             }
         }
@@ -735,10 +758,10 @@ impl Channel {
                 );
                 *active = planned.is_ok();
                 if planned.is_err() {
-                    self.fail(format!(
-                        "independent axis {}: no profile",
-                        self.config.axes[axis]
-                    ));
+                    self.fail(
+                        ChannelErrorId::IndependentAxis,
+                        format!("independent axis {}: no profile", self.config.axes[axis]),
+                    );
                     return;
                 }
                 if !asynchronous {
@@ -790,7 +813,7 @@ impl Channel {
                         };
                         if let Some(error) = refusal {
                             self.tracker.fail(error);
-                            self.fail(format!("#TRACK CS ON: {error}"));
+                            self.fail(ChannelErrorId::Tracking, format!("#TRACK CS ON: {error}"));
                             return;
                         }
                         masters[c].map(|m| m.frame)
@@ -809,7 +832,7 @@ impl Channel {
                     simu: command.simu,
                 };
                 if let Err(error) = self.tracker.switch_on(setup, master.as_ref()) {
-                    self.fail(format!("#TRACK CS ON: {error}"));
+                    self.fail(ChannelErrorId::Tracking, format!("#TRACK CS ON: {error}"));
                     return;
                 }
                 if command.log_file.is_some() {
@@ -829,13 +852,19 @@ impl Channel {
             Decoded::ChannelInterface { on, .. } => self.interface_on = on,
             Decoded::Cs { on, frame, .. } => {
                 if !self.trafo {
-                    self.fail("#CS needs an active transformation (#TRAFO ON)".to_string());
+                    self.fail(
+                        ChannelErrorId::CoordinateSystem,
+                        "#CS needs an active transformation (#TRAFO ON)".to_string(),
+                    );
                     return;
                 }
                 let before = self.cs_frame();
                 if on {
                     if self.cs_len == CS_DEPTH {
-                        self.fail(format!("more than {CS_DEPTH} coordinate systems active"));
+                        self.fail(
+                            ChannelErrorId::CoordinateSystem,
+                            format!("more than {CS_DEPTH} coordinate systems active"),
+                        );
                         return;
                     }
                     let words = PoseWords {
@@ -848,7 +877,7 @@ impl Channel {
                             self.cs_len += 1;
                         }
                         Err(e) => {
-                            self.fail(format!("#CS: {e}"));
+                            self.fail(ChannelErrorId::CoordinateSystem, format!("#CS: {e}"));
                             return;
                         }
                     }
@@ -862,10 +891,13 @@ impl Channel {
             Decoded::Trafo { on, id, .. } => {
                 if let Some(id) = id {
                     if id != self.config.kinematics.id {
-                        self.fail(format!(
+                        self.fail(
+                            ChannelErrorId::Kinematics,
+                            format!(
                             "kinematic {id} is not configured for this channel (configured: {})",
                             self.config.kinematics.id
-                        ));
+                        ),
+                        );
                         return;
                     }
                 }
@@ -888,7 +920,10 @@ impl Channel {
             }
             Decoded::SignalSyn { id, count, .. } => {
                 if sync.signal(id, count).is_err() {
-                    self.fail("#SIGNAL SYN: too many synchronisation ids pending".to_string());
+                    self.fail(
+                        ChannelErrorId::Synchronisation,
+                        "#SIGNAL SYN: too many synchronisation ids pending".to_string(),
+                    );
                 }
             }
             Decoded::WaitSyn { ids, .. } => {
@@ -950,12 +985,37 @@ impl Channel {
             &mut self.path_generator,
         ) {
             Ok(path) => self.path = path,
-            Err(e) => self.fail(e.to_string()),
+            Err(e) => self.fail(ChannelErrorId::Path, e.to_string()),
+        }
+    }
+
+    /// The override unit of this tick: a valid value takes effect, one out of range is counted
+    /// and the last valid value stays; without a unit the channel runs at 100 %.
+    fn take_override(&mut self) {
+        match self.inputs.path_override {
+            OverrideInput::Valid(value) => self.path_override = value,
+            OverrideInput::Invalid(_) => self.override_refused += 1,
+            OverrideInput::Absent => self.path_override = DEFAULT_PATH_OVERRIDE,
+        }
+    }
+
+    /// The override factors (feed, rapid) in effect: 0 under feed hold.
+    fn override_factors(&self) -> (f64, f64) {
+        let o = self.path_override;
+        if o.feed_hold {
+            (0.0, 0.0)
+        } else {
+            (
+                f64::from(o.feed_permille) / 1000.0,
+                f64::from(o.rapid_permille) / 1000.0,
+            )
         }
     }
 
     fn advance(&mut self) {
+        let (feed, rapid) = self.override_factors();
         if let Some(path) = self.path.as_mut() {
+            path.set_override(feed, rapid, &mut self.path_generator);
             if path.step(&mut self.path_generator, &mut self.programmed) {
                 self.path = None;
             }
@@ -989,7 +1049,7 @@ impl Channel {
                 Ok(j) => self.joints = j,
                 Err(e) => {
                     if self.state == RunState::Running {
-                        self.fail(format!("pose unreachable: {e}"));
+                        self.fail(ChannelErrorId::Kinematics, format!("pose unreachable: {e}"));
                     }
                 }
             }
@@ -1073,6 +1133,19 @@ impl Channel {
             RunState::Error => ProgramState::Error,
         };
         out.tick = self.tick;
+        out.path_feed_um_s = match &self.path {
+            // mm/s to um/s; a velocity is finite and far inside the DINT range.
+            Some(_) => (self.path_generator.state().velocity.abs() * 1000.0)
+                .round()
+                .min(f64::from(i32::MAX)) as i32,
+            None => 0,
+        };
+        out.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
+        out.feed_override_applied = if self.path_override.feed_hold {
+            0
+        } else {
+            self.path_override.feed_permille
+        };
         out.interface = next_interface(
             &out.interface,
             self.published.map(|sample| (sample.frame, sample.live)),
