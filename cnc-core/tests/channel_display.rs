@@ -23,6 +23,14 @@ fn w0(memory: &ImageMemory, channel: usize) -> [i64; 6] {
     })
 }
 
+/// `gpCh[0]^channel_interface.dyn_cs.NAME`.
+fn interface(memory: &ImageMemory, name: &str) -> i64 {
+    Leaf::resolve(&format!("gpCh[0]^channel_interface.dyn_cs.{name}"))
+        .unwrap()
+        .read(memory)
+        .as_f64() as i64
+}
+
 /// The tool pose of the KR 6 R900 at `joints`, in HLI units (0.1 um, 0.0001 degree; A B C in
 /// the channel's default convention, yaw-pitch-roll), from the kinematics crate directly.
 fn tool_words(joints: &[f64; 6]) -> [i64; 6] {
@@ -50,13 +58,7 @@ fn w0_position_r_follows_kin_trafo_display() {
         config.kin_trafo_display = display;
         let mut ctl = controller(vec![(config, program.as_str())]);
         let memory = image(1);
-        run_until(
-            &mut ctl,
-            &memory,
-            20_000,
-            |_, _| {},
-            |c| c.channels()[0].state() == RunState::Finished,
-        );
+        run_to_end(&mut ctl, &memory, 20_000);
         ctl.tick(&CncView::new(&memory));
         let shown = w0(&memory, 0);
         if display == 0 {
@@ -75,13 +77,7 @@ fn w0_position_r_follows_kin_trafo_display() {
     config.kin_trafo_display = 1;
     let mut ctl = controller(vec![(config, "#TRAFO [45]\nG1 X600 Y50 Z450 F6000\nM30\n")]);
     let memory = image(1);
-    run_until(
-        &mut ctl,
-        &memory,
-        20_000,
-        |_, _| {},
-        |c| c.channels()[0].state() == RunState::Finished,
-    );
+    run_to_end(&mut ctl, &memory, 20_000);
     ctl.tick(&CncView::new(&memory));
     let shown = w0(&memory, 0);
     assert_eq!(&shown[..3], &[6_000_000, 500_000, 4_500_000]);
@@ -110,12 +106,7 @@ fn a_master_interface_counts_its_updates_and_stops_when_switched_off() {
     )]);
     let memory = image(1);
     let view = CncView::new(&memory);
-    let leaf = |name: &str| {
-        Leaf::resolve(&format!("gpCh[0]^channel_interface.dyn_cs.{name}"))
-            .unwrap()
-            .read(&memory)
-            .as_f64() as i64
-    };
+    let leaf = |name: &str| interface(&memory, name);
     let mut last_count = 0;
     let mut on_ticks = 0;
     let mut off_seen = false;
@@ -160,12 +151,7 @@ fn a_master_in_error_shows_freeze() {
         ctl.tick(&view);
     }
     assert_eq!(ctl.channels()[0].state(), RunState::Error);
-    let read = |name: &str| {
-        Leaf::resolve(&format!("gpCh[0]^channel_interface.dyn_cs.{name}"))
-            .unwrap()
-            .read(&memory)
-            .as_f64() as i64
-    };
+    let read = |name: &str| interface(&memory, name);
     let count = read("update_counter_r");
     ctl.tick(&view);
     assert_eq!(
@@ -213,11 +199,7 @@ fn request_r_carries_the_applied_compensation() {
     let memory = image(1);
     let plc = PlcView::new(&memory);
     let view = CncView::new(&memory);
-    plc.set_dyn_cs_enabled(0, true).unwrap();
-    plc.dyn_cs_command(0)
-        .unwrap()
-        .try_send(&cs([1000, -1000, 0]))
-        .unwrap();
+    enable_plc_master(&memory, [1000, -1000, 0]);
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Activate, &transition(0, Bool::FALSE))

@@ -124,13 +124,7 @@ fn feed_hold_brakes_along_the_path_and_the_block_goes_on_after_release() {
         assert_eq!(x(&ctl), held_at, "standing under feed hold");
     }
     set_override(&memory, 1000, 1000, false);
-    run_until(
-        &mut ctl,
-        &memory,
-        5000,
-        |_, _| {},
-        |c| c.channels()[0].state() == RunState::Finished,
-    );
+    run_to_end(&mut ctl, &memory, 5000);
     assert_eq!(x(&ctl), 100.0);
 }
 
@@ -144,11 +138,7 @@ fn the_plc_holds_the_feed_until_tracking_is_active() {
     let plc = PlcView::new(&memory);
     let view = CncView::new(&memory);
     set_override(&memory, 1000, 1000, true);
-    plc.set_dyn_cs_enabled(0, true).unwrap();
-    plc.dyn_cs_command(0)
-        .unwrap()
-        .try_send(&cs([0, 0, 0]))
-        .unwrap();
+    enable_plc_master(&memory, [0, 0, 0]);
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Activate, &transition(300, Bool::FALSE))

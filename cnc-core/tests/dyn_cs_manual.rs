@@ -46,11 +46,7 @@ fn manual_diagnosis_run() -> (String, String, u64, u64) {
     let memory = image(1);
     let plc = PlcView::new(&memory);
     let view = CncView::new(&memory);
-    plc.set_dyn_cs_enabled(0, true).unwrap();
-    plc.dyn_cs_command(0)
-        .unwrap()
-        .try_send(&cs([0, 0, 0]))
-        .unwrap();
+    enable_plc_master(&memory, [0, 0, 0]);
     let mut moved_at = None;
     let mut while_active = None;
     for tick in 0..5000u32 {
@@ -380,11 +376,7 @@ fn a_switch_off_from_error_releases_the_held_compensation_softly() {
     let memory = image(1);
     let plc = PlcView::new(&memory);
     let view = CncView::new(&memory);
-    plc.set_dyn_cs_enabled(0, true).unwrap();
-    plc.dyn_cs_command(0)
-        .unwrap()
-        .try_send(&cs([200_000, 0, 0]))
-        .unwrap();
+    enable_plc_master(&memory, [200_000, 0, 0]);
     for _ in 0..20 {
         ctl.tick(&view);
     }

@@ -91,3 +91,24 @@ pub fn transition(filter_max_ticks: u32, f_wait: Bool) -> HliDynCsTransition {
         kinematic_base_cs: cs([0; 3]),
     }
 }
+
+/// The PLC as master of channel 0: `enable_w` TRUE and a first frame at `translation`.
+pub fn enable_plc_master(memory: &ImageMemory, translation: [i32; 3]) {
+    let plc = hli::views::PlcView::new(memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs(translation))
+        .unwrap();
+}
+
+/// Ticks until channel 0 finished (the watchdog of [`run_until`] fails a run that does not).
+pub fn run_to_end(ctl: &mut Controller, memory: &ImageMemory, limit: u32) {
+    run_until(
+        ctl,
+        memory,
+        limit,
+        |_, _| {},
+        |c| c.channels()[0].state() == RunState::Finished,
+    );
+}
