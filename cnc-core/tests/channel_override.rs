@@ -244,3 +244,30 @@ fn program_state_r_and_error_id_r_say_how_a_channel_stands() {
         }
     }
 }
+
+/// A machine stop while feed hold holds the path ends the block where it stands and the
+/// channel in ERROR (machine stop); releasing the hold afterwards moves nothing.
+#[test]
+fn a_stop_under_feed_hold_ends_the_block_where_it_stands() {
+    let mut ctl = controller(vec![(cartesian("c"), "G1 X100 F6000\nM30\n")]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    for _ in 0..300 {
+        ctl.tick(&view);
+    }
+    set_override(&memory, 1000, 1000, true);
+    for _ in 0..300 {
+        ctl.tick(&view);
+    }
+    let held_at = ctl.channels()[0].programmed()[0];
+    ctl.channel_mut(0).unwrap().stop("machine stop: test");
+    set_override(&memory, 1000, 1000, false);
+    for _ in 0..100 {
+        ctl.tick(&view);
+    }
+    let ch = &ctl.channels()[0];
+    assert_eq!(ch.state(), RunState::Error);
+    assert_eq!(ch.error().unwrap().id, ChannelErrorId::MachineStop);
+    assert!(!ch.is_moving());
+    assert_eq!(ch.programmed()[0], held_at);
+}

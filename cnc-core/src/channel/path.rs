@@ -330,6 +330,13 @@ impl PathMove {
         if self.done {
             return;
         }
+        if self.held {
+            // Feed hold brakes (or stands) already: the block ends where the path comes to
+            // rest, and no override resumes it.
+            self.held = false;
+            self.braked = true;
+            return;
+        }
         let s = generator.state();
         let (dec, jerk) = (self.limits.deceleration, self.limits.jerk);
         let v = s.velocity.abs();
