@@ -450,6 +450,15 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
         .try_send(DynCsCommand::Activate, &bad)
         .unwrap();
     ctl.tick(&view);
+    // KIN_BASE with ROT_TRANS, refused by the NC at load, is refused here too.
+    let mut both = transition(0, Bool::FALSE);
+    both.f_kin_base = Bool::TRUE;
+    both.f_rot_trans = Bool::TRUE;
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Activate, &both)
+        .unwrap();
+    ctl.tick(&view);
     let command_word =
         hli::access::Leaf::resolve("gpCh[0]^channel_mc_control.dyn_cs.transition_w.command")
             .unwrap();
@@ -458,11 +467,12 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
     let tracker = ctl.channels()[0].tracker();
     assert_eq!(tracker.state(), DynCsState::Inactive);
     assert_eq!(tracker.not_redirected_count(), 2);
-    assert_eq!(tracker.refused_count(), 3);
+    assert_eq!(tracker.refused_count(), 4);
     let diagnosis = ctl.channels()[0].dyn_cs_diagnosis();
     for refusal in [
         "dynCS: refused: PLC transition while enable_w is FALSE",
         "dynCS: refused: invalid transition parameter: option must be 0 or 1",
+        "dynCS: refused: invalid transition parameter: f_rot_trans cannot be combined with f_kin_base",
         "dynCS: refused: invalid transition parameter: command word is not -1, 0 or +1",
     ] {
         assert!(diagnosis.contains(refusal), "{refusal}\n{diagnosis}");

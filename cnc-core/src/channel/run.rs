@@ -531,6 +531,13 @@ impl Channel {
                     ));
                     return;
                 };
+                if kin_base && rot_trans {
+                    // As the NC command refuses KIN_BASE with ROT_TRANS at load.
+                    self.tracker.refuse(TrackError::BadTransition(
+                        "f_rot_trans cannot be combined with f_kin_base",
+                    ));
+                    return;
+                }
                 if params.option > 1 {
                     self.tracker
                         .refuse(TrackError::BadTransition("option must be 0 or 1"));
