@@ -520,8 +520,9 @@ proptest! {
     }
 }
 
-/// The time-optimal jerk-limited velocity change rsruckig computes, s.
-fn ruckig_duration(v0: f64, a0: f64, v1: f64, acc: f64, jerk: f64) -> f64 {
+/// The time-optimal jerk-limited velocity change rsruckig computes, s; `None` when rsruckig
+/// finds no profile (it misses some on numerical knife edges).
+fn ruckig_duration(v0: f64, a0: f64, v1: f64, acc: f64, jerk: f64) -> Option<f64> {
     use rsruckig::prelude::*;
     let one = |v: f64| DataArrayOrVec::Stack([v]);
     let mut otg = Ruckig::<1, ThrowErrorHandler>::new(None, TICK);
@@ -537,9 +538,8 @@ fn ruckig_duration(v0: f64, a0: f64, v1: f64, acc: f64, jerk: f64) -> f64 {
     input.min_acceleration = Some(one(-acc));
     input.max_jerk = one(jerk);
     let mut trajectory = Trajectory::<1>::new(None);
-    otg.calculate(&input, &mut trajectory)
-        .expect("rsruckig plans it");
-    trajectory.get_duration()
+    otg.calculate(&input, &mut trajectory).ok()?;
+    Some(trajectory.get_duration())
 }
 
 #[test]
@@ -559,7 +559,8 @@ fn the_time_based_examples_match_rsruckig() {
         req.time_based = true;
         let plan = saw::plan(&req, &kin(0.0, vm, 0.0), &kin(0.0, vs, a_s), None).unwrap();
         let ours = plan.profile.length;
-        let theirs = ruckig_duration(vs, a_s, ratio * vm, 2500.0, 5000.0);
+        let theirs =
+            ruckig_duration(vs, a_s, ratio * vm, 2500.0, 5000.0).expect("rsruckig plans it");
         assert!(
             ours <= 1.1 * theirs && ours >= theirs * (1.0 - 1e-6),
             "{vm} {vs}: ours {ours} s, rsruckig {theirs} s"
@@ -581,7 +582,10 @@ proptest! {
         let plan = saw::plan(&req, &master, &kin(0.0, v0, a0), None);
         prop_assert!(plan.is_ok(), "{plan:?}");
         let ours = plan.unwrap().profile.length;
+        // Our plan is asserted above in any case; the comparison needs the peer's profile.
         let theirs = ruckig_duration(v0, a0, v1, acc, jerk);
+        prop_assume!(theirs.is_some());
+        let theirs = theirs.unwrap();
         prop_assert!(ours <= 1.1 * theirs + 1e-9, "ours {ours}, rsruckig {theirs}");
     }
 }
