@@ -502,4 +502,16 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
         .unwrap();
     ctl.tick(&view);
     assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Active);
+    // A second +1 while on is refused; tracking stays ACTIVE.
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Activate, &transition(0, Bool::FALSE))
+        .unwrap();
+    ctl.tick(&view);
+    assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Active);
+    let tracker = ctl.channels()[0].tracker();
+    assert_eq!(tracker.refused_count(), 5);
+    assert!(ctl.channels()[0]
+        .dyn_cs_diagnosis()
+        .contains("dynCS: refused: tracking is already on"));
 }

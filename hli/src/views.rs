@@ -103,6 +103,16 @@ impl<'m> Nav<'m> {
             .field(offset_of!(HliChannelMcControl, dyn_cs)))
     }
 
+    fn path_override(
+        &self,
+        channel: usize,
+    ) -> Result<Place<'m, HliChannelOverrideUnit>, IndexError> {
+        Ok(self
+            .channel(channel)?
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+            .field(offset_of!(HliChannelMcControl, path_override)))
+    }
+
     fn m_function(&self, channel: usize) -> Result<Place<'m, HliMFunctionUnit>, IndexError> {
         Ok(self
             .channel(channel)?
@@ -312,9 +322,7 @@ impl<'m> CncView<'m> {
         permille: u32,
     ) -> Result<(), IndexError> {
         self.nav
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
+            .path_override(channel)?
             .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
             .store(permille);
         Ok(())
@@ -348,12 +356,7 @@ impl<'m> CncView<'m> {
         &self,
         channel: usize,
     ) -> Result<Result<PathOverride, OverrideError>, IndexError> {
-        let unit: HliChannelOverrideUnit = self
-            .nav
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
-            .read();
+        let unit = self.nav.path_override(channel)?.read();
         Ok(validate_override(&unit))
     }
 
@@ -481,11 +484,7 @@ impl<'m> PlcView<'m> {
 
     /// Commands the path override and feed hold of `channel` (`path_override.*_w`).
     pub fn set_path_override(&self, channel: usize, value: PathOverride) -> Result<(), IndexError> {
-        let unit = self
-            .nav
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override));
+        let unit = self.nav.path_override(channel)?;
         unit_field!(unit, HliChannelOverrideUnit, feed_override_w).store(value.feed_permille);
         unit_field!(unit, HliChannelOverrideUnit, rapid_override_w).store(value.rapid_permille);
         unit.field::<Bool>(offset_of!(HliChannelOverrideUnit, feed_hold_w))
@@ -498,9 +497,7 @@ impl<'m> PlcView<'m> {
     pub fn feed_override_applied(&self, channel: usize) -> Result<u32, IndexError> {
         Ok(self
             .nav
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field::<HliChannelOverrideUnit>(offset_of!(HliChannelMcControl, path_override))
+            .path_override(channel)?
             .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
             .load())
     }

@@ -417,7 +417,9 @@ impl Tracker {
     }
 
     /// Switches tracking on with the master's current `master` frame (`None` when the master
-    /// offers none yet: the reference is then taken from its first live frame).
+    /// offers none yet: the reference is then taken from its first live frame). A refusal
+    /// changes nothing; the caller decides whether it is a fault (the NC's) or a refused
+    /// request (the PLC's).
     pub fn switch_on(
         &mut self,
         setup: TrackSetup,
@@ -427,7 +429,6 @@ impl Tracker {
             self.state,
             DynCsState::Activating | DynCsState::Active | DynCsState::Error
         ) {
-            self.fail(TrackError::AlreadyOn);
             return Err(TrackError::AlreadyOn);
         }
         let reference = master.copied().unwrap_or_else(Isometry3::identity);

@@ -197,19 +197,37 @@ impl PathMove {
             jerk: f64::INFINITY,
         };
         limit_by_axes(&mut path, &delta, length, limits);
-        let free_velocity = path.velocity;
         let feed = if motion == MotionMode::Linear {
             feed_mm_min / 60.0
         } else {
             f64::INFINITY
         };
+        let geometry = (*start, delta, None, *target, length);
+        Self::start(geometry, path, feed, generator).map(Some)
+    }
+
+    /// Caps `path` at the `feed` (path units/s) and starts the block's profile; the velocity
+    /// limit without the feed is kept for the override.
+    fn start(
+        (start, delta, circle, end, length): (
+            AxisValues,
+            AxisValues,
+            Option<Circle>,
+            AxisValues,
+            f64,
+        ),
+        mut path: MoveLimits,
+        feed: f64,
+        generator: &mut SetpointGenerator,
+    ) -> Result<Self, PathError> {
+        let free_velocity = path.velocity;
         path.velocity = path.velocity.min(feed);
         start_profile(&mut path, length, generator)?;
-        Ok(Some(Self {
-            start: *start,
+        Ok(Self {
+            start,
             delta,
-            circle: None,
-            end: *target,
+            circle,
+            end,
             length,
             done: false,
             braked: false,
@@ -218,7 +236,7 @@ impl PathMove {
             feed,
             factor: 1.0,
             held: false,
-        }))
+        })
     }
 
     fn plan_arc(
@@ -263,31 +281,16 @@ impl PathMove {
             jerk: plane_j / 2.0 / share.max(1e-12),
         };
         limit_by_axes(&mut path, &delta, length, limits);
-        let free_velocity = path.velocity;
-        let feed = feed_mm_min / 60.0;
-        path.velocity = path.velocity.min(feed);
-        start_profile(&mut path, length, generator)?;
-        Ok(Self {
-            start: *start,
-            delta,
-            circle: Some(Circle {
-                axes: [a, b],
-                center: c,
-                angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
-                sweep: signed,
-                r0,
-                r1,
-            }),
-            end: *target,
-            length,
-            done: false,
-            braked: false,
-            limits: path,
-            free_velocity,
-            feed,
-            factor: 1.0,
-            held: false,
-        })
+        let circle = Circle {
+            axes: [a, b],
+            center: c,
+            angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
+            sweep: signed,
+            r0,
+            r1,
+        };
+        let geometry = (*start, delta, Some(circle), *target, length);
+        Self::start(geometry, path, feed_mm_min / 60.0, generator)
     }
 
     /// One tick of `generator` (the one the block was planned on): writes the interpolated
@@ -386,11 +389,6 @@ impl PathMove {
             self.factor = factor;
             self.held = false;
         }
-    }
-
-    /// Whether feed hold (or 0 %) holds the block.
-    pub fn held(&self) -> bool {
-        self.held
     }
 
     /// Block length.

@@ -76,16 +76,8 @@ pub struct ChannelOutputs {
     pub coords: [HliCoordState; HLI_CHANNEL_AXES],
     /// Path axes of the channel.
     pub coord_count: usize,
-    /// Source line of the block executing.
-    pub block_nr: i32,
-    /// Program state.
-    pub program_state: ProgramState,
-    /// Channel ticks so far.
-    pub tick: u64,
-    /// Path velocity, 1 um/s.
-    pub path_feed_um_s: i32,
-    /// Why the channel stopped.
-    pub error_id: ChannelErrorId,
+    /// Block number, program state, path feed, error and ticks (`bahn_state`).
+    pub progress: BlockProgress,
     /// The feed override in effect (0.1 %; 0 while feed hold holds the path).
     pub feed_override_applied: u32,
     /// The channel's published frame.
@@ -101,11 +93,13 @@ impl Default for ChannelOutputs {
             dyn_cs_request: None,
             coords: [bytemuck::Zeroable::zeroed(); HLI_CHANNEL_AXES],
             coord_count: 0,
-            block_nr: 0,
-            program_state: ProgramState::Idle,
-            tick: 0,
-            path_feed_um_s: 0,
-            error_id: ChannelErrorId::None,
+            progress: BlockProgress {
+                block_nr: 0,
+                program_state: ProgramState::Idle,
+                path_feed_um_s: 0,
+                error_id: ChannelErrorId::None,
+                tick: 0,
+            },
             feed_override_applied: 0,
             interface: bytemuck::Zeroable::zeroed(),
             m_request: None,
@@ -171,16 +165,7 @@ pub fn write_outputs(view: &CncView<'_>, index: usize, outputs: &mut ChannelOutp
     for (i, coord) in outputs.coords[..outputs.coord_count].iter().enumerate() {
         let _ = view.write_coord_state(index, i, coord);
     }
-    let _ = view.write_block_progress(
-        index,
-        &BlockProgress {
-            block_nr: outputs.block_nr,
-            program_state: outputs.program_state,
-            path_feed_um_s: outputs.path_feed_um_s,
-            error_id: outputs.error_id,
-            tick: outputs.tick,
-        },
-    );
+    let _ = view.write_block_progress(index, &outputs.progress);
     let _ = view.write_feed_override_applied(index, outputs.feed_override_applied);
     let _ = view.write_channel_interface(index, &outputs.interface);
 }

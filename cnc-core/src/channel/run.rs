@@ -543,12 +543,6 @@ impl Channel {
                         .refuse(TrackError::BadTransition("option must be 0 or 1"));
                     return;
                 }
-                if self.tracker.state() != DynCsState::Inactive
-                    && self.tracker.state() != DynCsState::Deactivating
-                {
-                    self.tracker.refuse(TrackError::AlreadyOn);
-                    return;
-                }
                 let kb = frame_from_hli(&params.kinematic_base_cs, RotationOrder::Zyx);
                 let w = words(&kb);
                 let setup = TrackSetup {
@@ -565,8 +559,10 @@ impl Channel {
                     simu: false,
                 };
                 let master = self.plc_frame;
-                if self.tracker.switch_on(setup, master.as_ref()).is_ok() && wait {
-                    self.hold_program_until_settled();
+                match self.tracker.switch_on(setup, master.as_ref()) {
+                    Ok(()) if wait => self.hold_program_until_settled(),
+                    Ok(()) => {}
+                    Err(error) => self.tracker.refuse(error),
                 }
             }
             DynCsCommand::Deactivate => {
@@ -839,6 +835,7 @@ impl Channel {
                     simu: command.simu,
                 };
                 if let Err(error) = self.tracker.switch_on(setup, master.as_ref()) {
+                    self.tracker.fail(error);
                     self.fail(ChannelErrorId::Tracking, format!("#TRACK CS ON: {error}"));
                     return;
                 }
@@ -1131,23 +1128,24 @@ impl Channel {
                 fill_up_1: 0,
             };
         }
-        out.block_nr = self.line as i32;
-        out.program_state = match self.state {
+        let progress = &mut out.progress;
+        progress.block_nr = self.line as i32;
+        progress.program_state = match self.state {
             RunState::Idle => ProgramState::Idle,
             RunState::Running if self.wait.is_some() => ProgramState::Waiting,
             RunState::Running => ProgramState::Running,
             RunState::Finished => ProgramState::Finished,
             RunState::Error => ProgramState::Error,
         };
-        out.tick = self.tick;
-        out.path_feed_um_s = match &self.path {
+        progress.tick = self.tick;
+        progress.path_feed_um_s = match &self.path {
             // mm/s to um/s; a velocity is finite and far inside the DINT range.
             Some(_) => (self.path_generator.state().velocity.abs() * 1000.0)
                 .round()
                 .min(f64::from(i32::MAX)) as i32,
             None => 0,
         };
-        out.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
+        progress.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
         out.feed_override_applied = if self.path_override.feed_hold {
             0
         } else {
