@@ -395,6 +395,7 @@ fn lagging(limit: f64) -> AxisConfig {
         dynamic: Dynamic::Pt1 { t1_s: 0.02 },
         dead_time_ticks: 3,
         start_position: 0.0,
+        ..SimDriveConfig::default()
     });
     config
 }
@@ -841,6 +842,7 @@ fn a_sixteen_bit_position_drive_starting_far_from_zero_does_not_jump() {
         dynamic: Dynamic::Pt1 { t1_s: 0.01 },
         dead_time_ticks: 0,
         start_position: 5.0,
+        ..SimDriveConfig::default()
     });
     let mut rig = Rig::new(vec![config]);
     rig.enable(0);

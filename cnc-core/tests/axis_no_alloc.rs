@@ -1,7 +1,7 @@
 //! The axis tick (set-point generation, re-targets, process image, simulated drives) and the
 //! command handler allocate nothing once the axes are built.
 
-use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
+use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode, DriveProtocol, ProbeInterface};
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
@@ -13,12 +13,16 @@ mod counting_alloc;
 use counting_alloc::allocations;
 
 fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {
+    request_of(CallKind::AxisCommand, target, call)
+}
+
+fn request_of<T: bytemuck::Pod>(kind: CallKind, target: u32, call: &T) -> AcyclicRequest {
     let bytes = bytemuck::bytes_of(call);
     let mut body = [0u8; ACYCLIC_BODY_SIZE];
     body[..bytes.len()].copy_from_slice(bytes);
     AcyclicRequest {
         invoke_id: 1,
-        kind: CallKind::AxisCommand.raw(),
+        kind: kind.raw(),
         target,
         body_len: bytes.len() as u32,
         body,
@@ -42,8 +46,18 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
                         },
                         dead_time_ticks: 2,
                         start_position: 1.0,
+                        ..SimDriveConfig::default()
                     })
                 }
+            }
+            // CiA 402 drives with dead-time compensation, and touch probes on a sensor.
+            if i % 2 == 0 {
+                c.io.protocol = DriveProtocol::Cia402;
+                c.io.dc_compensation = true;
+            }
+            if let (0, DriveLink::Simulated(sim)) = (i % 3, &mut c.drive) {
+                c.io.probe = ProbeInterface::Canopen;
+                sim.probe_windows = [Some([20.0, 30.0]), Some([-30.0, -20.0])];
             }
             c
         })
@@ -73,9 +87,20 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
     }
     let before = allocations();
     let mut accepted = 0;
+    let mut armed = 0;
     for round in 0..20 {
         for (n, call) in calls.iter().enumerate() {
             for axis in 0..32u32 {
+                let arm = hli::probe_calls::ProbeArmCall {
+                    probe: 1 + axis % 2,
+                    edge: 1,
+                    ..Default::default()
+                };
+                let (body, _) = set
+                    .handle_probe(&request_of(CallKind::ProbeArm, axis, &arm), true)
+                    .unwrap();
+                let reply: hli::probe_calls::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
+                armed += u32::from(reply.error_id == 0);
                 let (body, _) = set.handle_command(&request(axis, call)).unwrap();
                 let reply: AxisCommandReply = bytemuck::pod_read_unaligned(&body[..8]);
                 accepted += u32::from(reply.error_id == 0);
@@ -86,6 +111,12 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
         }
     }
     let allocations = allocations() - before;
+    // 11 probed axes: an arming is accepted again only after the last one recorded, so
+    // more than 11 accepted armings are recordings.
+    assert!(
+        armed > 11 + 10,
+        "the probes must really record ({armed} armings)"
+    );
     assert!(
         accepted > 4000,
         "the commands must really run ({accepted} accepted)"

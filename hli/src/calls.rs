@@ -92,6 +92,10 @@ pub enum CallKind {
     SawGearOut,
     /// [`crate::saw_calls::SawCharacCall`].
     SawCharac,
+    /// [`crate::probe_calls::ProbeArmCall`].
+    ProbeArm,
+    /// [`crate::probe_calls::ProbeAbortCall`].
+    ProbeAbort,
 }
 
 impl CallKind {
@@ -123,6 +127,8 @@ impl CallKind {
             CallKind::SawGearIn => 40,
             CallKind::SawGearOut => 41,
             CallKind::SawCharac => 42,
+            CallKind::ProbeArm => 50,
+            CallKind::ProbeAbort => 51,
         }
     }
 
@@ -154,6 +160,8 @@ impl CallKind {
             40 => Some(CallKind::SawGearIn),
             41 => Some(CallKind::SawGearOut),
             42 => Some(CallKind::SawCharac),
+            50 => Some(CallKind::ProbeArm),
+            51 => Some(CallKind::ProbeAbort),
             _ => None,
         }
     }

@@ -443,7 +443,90 @@ hli_enum! {
         GeneratorFailed = 0x4250,
         /// MC_Reset while the cause of the error is still present.
         ResetRefused = 0x4251,
+        /// The drive reports a fault (CiA 402 Fault or Fault reaction active).
+        DriveFault = 0x4244,
+        /// The drive left Operation enabled on its own while the axis was enabled, or its
+        /// status word holds no defined state.
+        DriveStateInvalid = 0x4245,
+        /// The drive's own following error (`drive_in.nInData1`, cyclic position mode) or its
+        /// following-error bit exceeded the limit.
+        ExternalFollowingError = 0x4246,
+        /// A touch probe that is armed already was armed again; the first arming stays.
+        ProbeAlreadyArmed = 0x4260,
+        /// The axis has no touch probe of that number (its probe interface, or none).
+        ProbeNotAvailable = 0x4261,
+        /// Probe number, edge or window of a touch-probe call out of range.
+        InvalidProbeParameter = 0x4262,
+        /// MC_AbortTrigger for a probe that is not armed.
+        ProbeNotArmed = 0x4263,
     }
+}
+
+hli_enum! {
+    /// The drive's state machine as the CNC decodes it from `drive_in.nStatus1` (CiA 402
+    /// status word, low byte), `HLI_AXIS_DRIVE_STATE.drive_state_r`.
+    DriveState: u32, "HLI_AXIS_DRIVE_STATE.drive_state_r" {
+        /// The axis does not evaluate a drive state (plain drive protocol).
+        NotEvaluated = 0,
+        /// Not ready to switch on.
+        NotReadyToSwitchOn = 1,
+        /// Switch on disabled.
+        SwitchOnDisabled = 2,
+        /// Ready to switch on.
+        ReadyToSwitchOn = 3,
+        /// Switched on.
+        SwitchedOn = 4,
+        /// Operation enabled: the drive follows the set-points.
+        OperationEnabled = 5,
+        /// Quick stop active.
+        QuickStopActive = 6,
+        /// Fault reaction active.
+        FaultReactionActive = 7,
+        /// Fault.
+        Fault = 8,
+    }
+}
+
+hli_enum! {
+    /// A touch probe of an axis, `HLI_AXIS_PROBE.state_r`.
+    ProbeState: u32, "HLI_AXIS_PROBE.state_r" {
+        /// Not armed (never armed, or its result was read and it was armed no more).
+        Idle = 0,
+        /// Armed: the next matching edge records the position.
+        Armed = 1,
+        /// An edge recorded the position in `recorded_position_r`.
+        Recorded = 2,
+        /// MC_AbortTrigger (or the axis's probe interface lost its data) ended the arming.
+        Aborted = 3,
+    }
+}
+
+hli_enum! {
+    /// Which edge of the probe input records (`HLI_AXIS_PROBE.edge_r`, MC_TouchProbe's
+    /// trigger input).
+    ProbeEdge: u32, "ProbeEdge" {
+        /// The rising edge.
+        Positive = 1,
+        /// The falling edge.
+        Negative = 2,
+    }
+}
+
+/// Bits of `HLI_AXIS_DRIVE_STATE.drive_flags_r`: the CiA 402 status bits the CNC shows
+/// (`drive_in.nStatus1` bit 7 and `nStatus2`, the status word's high byte).
+pub mod drive_flags {
+    /// Warning (status word bit 7).
+    pub const WARNING: u32 = 1 << 0;
+    /// Remote: the drive takes its commands from the field bus (bit 9).
+    pub const REMOTE: u32 = 1 << 1;
+    /// Target reached (bit 10).
+    pub const TARGET_REACHED: u32 = 1 << 2;
+    /// Internal limit active, e.g. torque or current limit (bit 11).
+    pub const INTERNAL_LIMIT: u32 = 1 << 3;
+    /// Cyclic position mode: the drive follows the command value (bit 12).
+    pub const FOLLOWS_COMMAND: u32 = 1 << 4;
+    /// Cyclic position mode: the drive's own following-error monitor tripped (bit 13).
+    pub const FOLLOWING_ERROR: u32 = 1 << 5;
 }
 
 /// Bits of `HLI_AXIS_LR_STATE.status_r`.

@@ -24,6 +24,7 @@ pub mod events;
 pub mod fifo_calls;
 pub mod handshake;
 pub mod layout;
+pub mod probe_calls;
 pub mod raw;
 pub mod rpc;
 pub mod saw_calls;

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod fifo;
 pub mod fifo_file;
 pub mod motion;
+pub mod probe;
 pub mod programs;
 pub mod realtime;
 pub mod runtime;

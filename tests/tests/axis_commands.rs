@@ -175,6 +175,7 @@ fn plc_motion_blocks_drive_simulated_axes_through_the_segment() {
             dynamic: Dynamic::Pt1 { t1_s: 0.005 },
             dead_time_ticks: 1,
             start_position: 0.0,
+            ..SimDriveConfig::default()
         });
         let mut axes = AxisSet::new(vec![AxisConfig::linear("X", 1), lagging], 0.001).unwrap();
         axes.prime(&view);

@@ -1,18 +1,27 @@
 //! One axis: command validation, set-point generation, actual position from the encoder,
 //! following-error monitoring, the position controller and the drive outputs.
 
+use super::cia402;
 use super::commands::CommandBook;
-use super::config::{AxisConfig, DriveMode};
+use super::config::{AxisConfig, DriveMode, DriveProtocol};
 use super::generator::{Goal, Kinematic, MoveLimits, Progress, SetpointGenerator};
 use super::increments::IncrementCounter;
+use super::inputs::DriveInputs;
+use super::probe::Probes;
 use hli::enums::{
-    axis_status, AxisCommandKind, AxisError, AxisState, CommandResult, CouplingState,
-    DirectionBits, IoState,
+    axis_status, drive_flags, AxisCommandKind, AxisError, AxisState, CommandResult, CouplingState,
+    DirectionBits, DriveState, IoState,
 };
 use hli::layout::{
-    HliAxisCommandState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
+    HliAxisCommandState, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn,
+    NcEncoderOut,
 };
+use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
 use hli::rpc::AxisCommandCall;
+
+/// Ticks MC_Reset waits for a drive to leave Fault (pulsing fault reset every other tick)
+/// before it ends with `ResetRefused`.
+pub const DRIVE_RESET_TIMEOUT_TICKS: u32 = 100;
 
 /// A coupling that drives the axis instead of its own generator (cam, gear, FIFO group,
 /// channel): the engine hands in a set-point every tick.
@@ -37,6 +46,8 @@ pub struct AxisOutputs {
     pub enc_out: NcEncoderOut,
     /// Command book.
     pub command_state: HliAxisCommandState,
+    /// The evaluated optional inputs and the touch probes.
+    pub drive_state: HliAxisDriveState,
 }
 
 /// An axis.
@@ -47,7 +58,16 @@ pub struct Axis {
     generator: SetpointGenerator,
     counter: IncrementCounter,
     book: CommandBook,
+    /// MC_Power's level; with a CiA 402 drive the axis is enabled once the drive is in
+    /// operation.
+    power_requested: bool,
     enabled: bool,
+    /// MC_Reset of a drive fault under way: ticks since it began.
+    drive_reset: Option<u32>,
+    inputs: DriveInputs,
+    probes: Probes,
+    /// The encoder's position as read, before dead-time compensation.
+    raw_actual: f64,
     stop_lock: bool,
     error: Option<AxisError>,
     coupling: Option<Coupling>,
@@ -89,12 +109,17 @@ impl Axis {
         let mut generator = SetpointGenerator::new(cycle_s, 0.0);
         generator.set_jerk_ceiling(config.dynamics.jerk);
         Self {
+            inputs: DriveInputs::new(&config, cycle_s),
+            probes: Probes::new(config.io.probe, config.encoder_width),
             counter: IncrementCounter::new(config.encoder_width),
             generator,
             config,
             cycle_s,
             book: CommandBook::default(),
+            power_requested: false,
             enabled: false,
+            drive_reset: None,
+            raw_actual: 0.0,
             stop_lock: false,
             error: None,
             coupling: None,
@@ -223,11 +248,11 @@ impl Axis {
                 if self.error.is_some() {
                     return Err(AxisError::AxisInError);
                 }
-                if !self.enabled {
-                    // Take over where the axis stands, without a jump.
-                    self.generator.hold(self.actual);
+                self.power_requested = true;
+                // A CiA 402 drive is enabled once it reports Operation enabled (`sense`).
+                if self.config.io.protocol == DriveProtocol::Plain {
+                    self.take_over();
                 }
-                self.enabled = true;
             }
             0 => {
                 let moving = match self.coupling {
@@ -240,6 +265,7 @@ impl Axis {
                 // A disabled axis is nobody's slave: the coupling ends with the power.
                 self.coupling = None;
                 self.stop_lock = false;
+                self.power_requested = false;
                 self.enabled = false;
                 self.book.finish(CommandResult::Aborted, None);
             }
@@ -248,9 +274,23 @@ impl Axis {
         Ok(self.book.instant(AxisCommandKind::Power))
     }
 
+    /// Enables the axis where it stands, without a jump.
+    fn take_over(&mut self) {
+        if !self.enabled {
+            self.generator.hold(self.actual);
+        }
+        self.enabled = true;
+    }
+
     fn reset(&mut self) -> Result<u32, AxisError> {
         if self.io_fault.is_some() {
             return Err(AxisError::ResetRefused);
+        }
+        if self.config.io.protocol == DriveProtocol::Cia402 && cia402::is_fault(self.inputs.state) {
+            // The drive needs a fault reset first; the command ends when the drive leaves
+            // Fault (`sense`).
+            self.drive_reset = Some(0);
+            return Ok(self.book.begin(AxisCommandKind::Reset));
         }
         // Without an error there is nothing to reset: a moving axis goes on undisturbed.
         if self.error.take().is_some() {
@@ -317,6 +357,21 @@ impl Axis {
         } else {
             Err(AxisError::TargetOutsideLimits)
         }
+    }
+
+    /// MC_TouchProbe: arms a probe (see [`Probes::arm`]).
+    pub fn arm_probe(&mut self, call: &ProbeArmCall) -> Result<u32, AxisError> {
+        self.probes.arm(call)
+    }
+
+    /// MC_AbortTrigger: disarms a probe.
+    pub fn abort_probe(&mut self, call: &ProbeAbortCall) -> Result<u32, AxisError> {
+        self.probes.abort(call)
+    }
+
+    /// The evaluated drive inputs.
+    pub fn drive_state(&self) -> HliAxisDriveState {
+        self.inputs.image(self.probes.image())
     }
 
     /// Enables the axis as MC_Power would (for axes the CNC itself owns: channel axes).
@@ -423,6 +478,7 @@ impl Axis {
     /// step, so engines coupled to this axis see its set-point of this tick.
     pub fn sense(&mut self, enc_in: &NcEncoderIn, drive_in: &NcDriveIn) {
         let scale = self.config.increments_per_unit;
+        let drive_state = self.inputs.read(enc_in, drive_in);
         // Inputs: a status byte that is not a valid IoState counts as invalid too.
         let encoder_ok = IoState::decode(enc_in.nStatus4) == Ok(IoState::Valid);
         let drive_ok = IoState::decode(drive_in.nStatus4) == Ok(IoState::Valid);
@@ -436,12 +492,24 @@ impl Axis {
         if encoder_ok {
             let first = !self.counter.started();
             let previous = self.actual;
-            self.actual = self.counter.update(enc_in.nInData1) as f64 / scale;
+            let count = self.counter.update(enc_in.nInData1);
+            let raw = count as f64 / scale;
+            // Dead-time compensation: the reading is `input_lag` old; the axis moved on at
+            // the velocity of the last two readings.
+            let raw_velocity = if first {
+                0.0
+            } else {
+                (raw - self.raw_actual) / self.cycle_s
+            };
+            self.raw_actual = raw;
+            self.actual = raw + raw_velocity * self.inputs.input_lag_s;
             self.actual_velocity = if first {
                 0.0
             } else {
                 (self.actual - previous) / self.cycle_s
             };
+            let undefined = self.probes.sense(enc_in, enc_in.nInData1, count, scale);
+            self.inputs.undefined = self.inputs.undefined.wrapping_add(undefined);
             if first {
                 self.generator.hold(self.actual);
                 self.last_set = Kinematic {
@@ -450,10 +518,16 @@ impl Axis {
                 };
             }
         }
+        if !encoder_ok {
+            self.probes.lose_data(AxisError::EncoderIoInvalid);
+        }
         if let Some(cause) = self.io_fault {
             if self.enabled && self.error.is_none() {
                 self.fault(cause);
             }
+        }
+        if drive_ok {
+            self.follow_drive_state(drive_state);
         }
         self.encoder_echo = enc_in.nInData1;
         self.sensed = true;
@@ -463,6 +537,64 @@ impl Axis {
             self.generator.hold(self.actual);
         } else if self.error.is_none() {
             self.generate();
+        }
+    }
+
+    /// A CiA 402 drive's state against what the axis expects: the axis is enabled once the
+    /// drive is in operation; a drive that faults, or leaves operation on its own, or reports
+    /// no defined state, stops the axis; MC_Reset of a drive fault ends here.
+    fn follow_drive_state(&mut self, decoded: Option<DriveState>) {
+        if self.config.io.protocol == DriveProtocol::Plain {
+            return;
+        }
+        let Some(state) = decoded else {
+            if self.enabled && self.error.is_none() {
+                self.fault(AxisError::DriveStateInvalid);
+            }
+            return;
+        };
+        if let Some(ticks) = self.drive_reset {
+            if !cia402::is_fault(state) {
+                self.drive_reset = None;
+                self.error = None;
+                self.generator.hold(self.actual);
+                self.book.finish(CommandResult::Done, None);
+            } else if ticks >= DRIVE_RESET_TIMEOUT_TICKS {
+                self.drive_reset = None;
+                self.book
+                    .finish(CommandResult::Error, Some(AxisError::ResetRefused));
+            } else {
+                self.drive_reset = Some(ticks + 1);
+            }
+        }
+        if cia402::is_fault(state) {
+            if self.error.is_none() {
+                self.fault(AxisError::DriveFault);
+            }
+            self.enabled = false;
+        } else if state == DriveState::OperationEnabled {
+            if self.power_requested && self.error.is_none() {
+                self.take_over();
+            }
+        } else if self.enabled {
+            // The drive left operation on its own (quick stop, switched off locally).
+            self.fault(AxisError::DriveStateInvalid);
+            self.enabled = false;
+        }
+    }
+
+    /// The control word's low byte for a CiA 402 drive (`nCtrl1`).
+    fn control_word(&self) -> u8 {
+        use cia402::control::*;
+        if let Some(ticks) = self.drive_reset {
+            // Fault reset acts on its rising edge: pulse every other tick.
+            return if ticks % 2 == 1 { FAULT_RESET } else { 0 };
+        }
+        let operate = self.power_requested && (self.error.is_none() || self.enabled);
+        match self.inputs.state {
+            _ if !operate => SHUTDOWN,
+            DriveState::SwitchOnDisabled | DriveState::NotReadyToSwitchOn => SHUTDOWN,
+            _ => ENABLE_OPERATION,
         }
     }
 
@@ -478,6 +610,17 @@ impl Axis {
             && self.following_error.abs() > self.config.following_error_limit
         {
             self.fault(AxisError::FollowingError);
+        }
+        // The drive's own following error (cyclic position mode): its value or its bit.
+        let external = self.inputs.external_following_error.abs()
+            > self.config.following_error_limit
+            || self.inputs.flags & drive_flags::FOLLOWING_ERROR != 0;
+        if self.enabled
+            && self.error.is_none()
+            && self.config.drive_mode == DriveMode::Position
+            && external
+        {
+            self.fault(AxisError::ExternalFollowingError);
         }
         // A coupled axis (cam, gear, FIFO, channel) follows set-points no generator braked
         // for: one beyond a software limit is a fault, the axis stops where it is.
@@ -570,21 +713,32 @@ impl Axis {
         let out_velocity = self.output_velocity * vscale;
         let set_direction = direction(set.velocity * vscale);
         let total_direction = direction(out_velocity);
+        let set_count = |p: f64| {
+            cfg.encoder_width
+                .wrap((p * cfg.increments_per_unit).round() as i64)
+        };
         let (data1, data2) = match cfg.drive_mode {
             DriveMode::Position => {
-                let count = (set.position * cfg.increments_per_unit).round() as i64;
-                (cfg.encoder_width.wrap(count), 0)
+                // Dead-time compensation: the set-point of the moment the drive applies it.
+                let s = self.inputs.output_shift_s;
+                let applied = set.position + set.velocity * s + 0.5 * set.acceleration * s * s;
+                (set_count(applied), saturate(set.velocity * vscale))
             }
-            DriveMode::Velocity => (saturate(out_velocity), 0),
+            DriveMode::Velocity => (saturate(out_velocity), set_count(set.position)),
             DriveMode::Universal => {
                 let v = saturate(out_velocity);
                 (v, v.saturating_abs())
             }
         };
+        let control = match cfg.io.protocol {
+            DriveProtocol::Plain => u8::from(self.enabled),
+            DriveProtocol::Cia402 => self.control_word(),
+        };
+        let probe = self.probes.control();
         let drive_out = NcDriveOut {
             nOutData1: data1,
             nOutData2: data2,
-            nCtrl1: u8::from(self.enabled),
+            nCtrl1: control,
             nCtrl2: set_direction.raw(),
             nCtrl3: total_direction.raw(),
             nOutData3: saturate(set.acceleration * cfg.acceleration_increments_per_unit),
@@ -592,6 +746,9 @@ impl Axis {
         };
         let enc_out = NcEncoderOut {
             nOutData1: self.encoder_echo,
+            nCtrl1: probe.ctrl1,
+            nCtrl5: probe.ctrl5,
+            nCtrl6: probe.ctrl6,
             ..bytemuck::Zeroable::zeroed()
         };
         let hli_scale = hli::units::HLI_LENGTH_PER_MM;
@@ -645,6 +802,7 @@ impl Axis {
             drive_out,
             enc_out,
             command_state: self.book.image(),
+            drive_state: self.drive_state(),
         }
     }
 

@@ -32,6 +32,64 @@ pub enum DriveMode {
     Universal,
 }
 
+/// How the CNC drives and reads the drive's state machine (`drive_out.nCtrl1`,
+/// `drive_in.nStatus1`/`nStatus2`), which the specification leaves to the drive type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DriveProtocol {
+    /// `nCtrl1` is 1 while the axis is enabled; the status bytes are not evaluated.
+    #[default]
+    Plain,
+    /// CiA 402 (CANopen, CoE): `nCtrl1` is the control word's low byte, `nStatus1`/`nStatus2`
+    /// the status word; the axis is enabled once the drive reports Operation enabled.
+    Cia402,
+}
+
+/// The touch-probe interface of the encoder or drive, which the specification maps two ways.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum ProbeInterface {
+    /// No touch probe.
+    #[default]
+    None,
+    /// An encoder terminal's external latch: `enc_out.nCtrl1`, `enc_in.nStatus1` and the
+    /// latched count in `enc_in.nInData2`; one probe, either edge.
+    Terminal,
+    /// CANopen 0x60B8/0x60B9: `nCtrl5`/`nCtrl6` and `nStatus5`/`nStatus6` are the control and
+    /// status bytes of probes 1 and 2, the edges' positions in `nInData3..6`.
+    Canopen,
+    /// SERCOS S-0-0405/0406 (probe enable in `nCtrl5`/`nCtrl6`) and S-0-0409..0412 (one
+    /// latched flag per probe and edge in `nStatus5..8`), positions in `nInData3..6`.
+    Sercos,
+}
+
+/// What the axis makes of the optional signals of its process image.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ImageOptions {
+    /// The drive's state machine.
+    pub protocol: DriveProtocol,
+    /// The touch probes.
+    pub probe: ProbeInterface,
+    /// Scaling of the actual torque `drive_in.nInData3`: increments per percent of the rated
+    /// torque (10: CiA 402's per mille).
+    pub torque_increments_per_percent: f64,
+    /// Dead-time compensation from the distributed-clock times `nDcInputTime` and
+    /// `nDcOutputTime`.
+    pub dc_compensation: bool,
+}
+
+impl Default for ImageOptions {
+    fn default() -> Self {
+        Self {
+            protocol: DriveProtocol::Plain,
+            probe: ProbeInterface::None,
+            torque_increments_per_percent: 10.0,
+            dc_compensation: false,
+        }
+    }
+}
+
 /// Where the process image goes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "type")]
@@ -90,6 +148,10 @@ pub struct AxisConfig {
     pub feed_forward: f64,
     /// Simulated or external drive.
     pub drive: DriveLink,
+    /// The optional signals of the process image: drive protocol, touch probes, torque
+    /// scaling, dead-time compensation.
+    #[serde(default)]
+    pub io: ImageOptions,
 }
 
 /// A configuration value out of its range.
@@ -131,6 +193,7 @@ impl AxisConfig {
             position_gain: 50.0,
             feed_forward: 1.0,
             drive: DriveLink::Simulated(SimDriveConfig::default()),
+            io: ImageOptions::default(),
         }
     }
 
@@ -187,6 +250,12 @@ impl AxisConfig {
             "acceleration_increments_per_unit",
             self.acceleration_increments_per_unit,
             self.acceleration_increments_per_unit > 0.0,
+            positive,
+        )?;
+        self.check(
+            "io.torque_increments_per_percent",
+            self.io.torque_increments_per_percent,
+            self.io.torque_increments_per_percent > 0.0,
             positive,
         )?;
         let d = self.dynamics;

@@ -9,13 +9,20 @@
 
 #[allow(clippy::module_inception)]
 mod axis;
+pub mod cia402;
 pub mod commands;
 pub mod config;
 pub mod generator;
 pub mod increments;
+mod inputs;
+pub mod probe;
 pub mod set;
 pub mod sim_drive;
+mod sim_probe;
 
 pub use axis::{motion_phase, Axis, AxisOutputs, Coupling};
-pub use config::{AxisConfig, AxisKind, ConfigError, DriveLink, DriveMode, Dynamics};
+pub use config::{
+    AxisConfig, AxisKind, ConfigError, DriveLink, DriveMode, DriveProtocol, Dynamics, ImageOptions,
+    ProbeInterface,
+};
 pub use set::AxisSet;

@@ -6,9 +6,10 @@ use super::config::{AxisConfig, ConfigError, DriveLink};
 use super::sim_drive::{SimScaling, SimulatedDrive};
 use core::mem::offset_of;
 use hli::layout::{
-    HliAxis, HliAxisCommandState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
-    HLI_MAX_AXES,
+    HliAxis, HliAxisCommandState, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut,
+    NcEncoderIn, NcEncoderOut, HLI_MAX_AXES,
 };
+use hli::probe_calls::{ProbeAbortCall, ProbeArmCall, ProbeReply};
 use hli::rpc::{
     decode_body, reply, AcyclicRequest, AxisCommandCall, AxisCommandReply, ErrorCode, HandlerResult,
 };
@@ -62,6 +63,10 @@ impl AxisSet {
                         acceleration_increments_per_unit: c.acceleration_increments_per_unit,
                         width: c.encoder_width,
                         mode: c.drive_mode,
+                        protocol: c.io.protocol,
+                        probe: c.io.probe,
+                        torque_increments_per_percent: c.io.torque_increments_per_percent,
+                        rated_acceleration: c.dynamics.acceleration,
                     },
                     cycle_s,
                 )),
@@ -150,8 +155,11 @@ impl AxisSet {
             place
                 .field::<HliAxisCommandState>(offset_of!(HliAxis, command_state))
                 .write(&out.command_state);
+            place
+                .field::<HliAxisDriveState>(offset_of!(HliAxis, drive_state))
+                .write(&out.drive_state);
             if let Some(drive) = drive {
-                let drive_in = drive.step(&out.drive_out);
+                let drive_in = drive.step(&out.drive_out, &out.enc_out);
                 place
                     .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
                     .write(&drive_in);
@@ -180,5 +188,29 @@ impl AxisSet {
             },
         };
         reply(&answer)
+    }
+
+    /// Answers a [`ProbeArmCall`] (`arm`) or a [`ProbeAbortCall`] addressed to axis
+    /// `request.target`. Any axis may probe, a channel's too: probing moves nothing.
+    pub fn handle_probe(&mut self, request: &AcyclicRequest, arm: bool) -> HandlerResult {
+        let axis = self
+            .axes
+            .get_mut(request.target as usize)
+            .ok_or(ErrorCode::InvalidTarget)?;
+        let outcome = if arm {
+            axis.arm_probe(&decode_body::<ProbeArmCall>(request)?)
+        } else {
+            axis.abort_probe(&decode_body::<ProbeAbortCall>(request)?)
+        };
+        reply(&match outcome {
+            Ok(arm_id) => ProbeReply {
+                arm_id,
+                error_id: 0,
+            },
+            Err(e) => ProbeReply {
+                arm_id: 0,
+                error_id: e.raw(),
+            },
+        })
     }
 }

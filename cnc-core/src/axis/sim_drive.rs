@@ -3,9 +3,12 @@
 //! writes the encoder (and drive) inputs back, so the whole chain set-point -> increments ->
 //! drive -> encoder -> overflow counting -> position controller runs as with a real axis.
 
-use super::config::DriveMode;
+use super::cia402;
+use super::config::{DriveMode, DriveProtocol, ProbeInterface};
 use super::increments::{CounterWidth, IncrementCounter};
-use hli::layout::{NcDriveIn, NcDriveOut, NcEncoderIn};
+use super::sim_probe::SimProbes;
+use hli::enums::DriveState;
+use hli::layout::{NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut};
 use serde::{Deserialize, Serialize};
 
 /// Longest dead time the simulation holds, in ticks.
@@ -94,6 +97,7 @@ impl DriveModel {
             dynamic,
             dead_time_ticks,
             start_position: start,
+            ..SimDriveConfig::default()
         })
     }
 }
@@ -111,6 +115,13 @@ pub struct SimDriveConfig {
     /// Position of the motor at start, units.
     #[serde(default)]
     pub start_position: f64,
+    /// How long before the tick the encoder is sampled, ns (reported in `nDcInputTime`).
+    #[serde(default)]
+    pub input_delay_ns: u32,
+    /// Sensors on the probe inputs 1 and 2: on while the motor stands in `[from, to]`, axis
+    /// units.
+    #[serde(default)]
+    pub probe_windows: [Option<[f64; 2]>; 2],
 }
 
 impl SimDriveConfig {
@@ -153,6 +164,15 @@ impl SimDriveConfig {
                 "must be at most 64",
             ));
         }
+        for w in self.probe_windows.iter().flatten() {
+            if !(w[0].is_finite() && w[1].is_finite() && w[0] < w[1]) {
+                return Err((
+                    "drive.probe_windows",
+                    w[0],
+                    "must be finite with from below to",
+                ));
+            }
+        }
         if !self.start_position.is_finite() {
             return Err((
                 "drive.start_position",
@@ -177,6 +197,14 @@ pub struct SimScaling {
     pub width: CounterWidth,
     /// How the drive reads its set-point.
     pub mode: DriveMode,
+    /// The drive's state machine.
+    pub protocol: DriveProtocol,
+    /// The probe interface of the encoder.
+    pub probe: ProbeInterface,
+    /// Actual torque scaling, increments per percent of the rated torque.
+    pub torque_increments_per_percent: f64,
+    /// The acceleration the rated torque gives, units/s^2 (the model's inertia).
+    pub rated_acceleration: f64,
 }
 
 /// A simulated drive with its encoder.
@@ -200,6 +228,17 @@ pub struct SimulatedDrive {
     pub encoder_io_invalid: bool,
     /// Fault injection: report I/O data invalid on the drive.
     pub drive_io_invalid: bool,
+    /// Fault injection: the drive goes to Fault (CiA 402) at its next step.
+    pub inject_fault: bool,
+    /// Fault injection: status word low byte reported instead of the state's (CiA 402).
+    pub status_override: Option<u8>,
+    /// CiA 402 state.
+    state: DriveState,
+    last_control: u8,
+    probes: SimProbes,
+    enc_out: NcEncoderOut,
+    /// Steps taken: the reading it writes belongs to tick `steps`.
+    steps: u64,
 }
 
 impl SimulatedDrive {
@@ -210,9 +249,6 @@ impl SimulatedDrive {
             DriveMode::Velocity | DriveMode::Universal => 0.0,
         };
         Self {
-            config,
-            scaling,
-            dt: cycle_s,
             position: config.start_position,
             velocity: 0.0,
             acceleration: 0.0,
@@ -229,7 +265,32 @@ impl SimulatedDrive {
             },
             encoder_io_invalid: false,
             drive_io_invalid: false,
+            inject_fault: false,
+            status_override: None,
+            state: DriveState::SwitchOnDisabled,
+            last_control: 0,
+            probes: SimProbes::new(
+                scaling.probe,
+                scaling.width,
+                scaling.increments_per_unit,
+                config.probe_windows,
+            ),
+            enc_out: bytemuck::Zeroable::zeroed(),
+            steps: 0,
+            config,
+            scaling,
+            dt: cycle_s,
         }
+    }
+
+    /// The distributed-clock time of tick `tick`, ns (low 32 bits, as the image carries it).
+    fn dc_time(&self, tick: u64) -> u32 {
+        (tick as f64 * self.dt * 1e9).round() as u64 as u32
+    }
+
+    /// The CiA 402 state (SwitchOnDisabled until the CNC drives it).
+    pub fn state(&self) -> DriveState {
+        self.state
     }
 
     /// The motor's true position.
@@ -243,18 +304,44 @@ impl SimulatedDrive {
     }
 
     /// The encoder inputs of the motor's current position (what the NC reads next tick).
+    ///
+    /// The encoder is sampled `input_delay_ns` before the tick (the motor was that much
+    /// behind at constant velocity), and says so in `nDcInputTime`.
     pub fn encoder_in(&self) -> NcEncoderIn {
-        let count = (self.position * self.scaling.increments_per_unit).round() as i64;
-        NcEncoderIn {
+        let delay = f64::from(self.config.input_delay_ns) * 1e-9;
+        let sampled = self.position - self.velocity * delay;
+        let count = (sampled * self.scaling.increments_per_unit).round() as i64;
+        let mut enc = NcEncoderIn {
             nInData1: self.scaling.width.wrap(count),
             nStatus4: u8::from(self.encoder_io_invalid),
+            nDcInputTime: self
+                .dc_time(self.steps)
+                .wrapping_sub(self.config.input_delay_ns) as i32,
             ..bytemuck::Zeroable::zeroed()
-        }
+        };
+        self.probes.report(&self.enc_out, &mut enc);
+        enc
     }
 
-    /// Takes the drive outputs of this tick, advances the motor one tick and returns the drive
-    /// inputs.
-    pub fn step(&mut self, out: &NcDriveOut) -> NcDriveIn {
+    /// Takes the drive and encoder outputs of this tick, advances the motor one tick and
+    /// returns the drive inputs.
+    pub fn step(&mut self, out: &NcDriveOut, enc_out: &NcEncoderOut) -> NcDriveIn {
+        let operational = match self.scaling.protocol {
+            DriveProtocol::Plain => true,
+            DriveProtocol::Cia402 => {
+                let reset_edge = out.nCtrl1 & cia402::control::FAULT_RESET != 0
+                    && self.last_control & cia402::control::FAULT_RESET == 0;
+                self.last_control = out.nCtrl1;
+                self.state = if std::mem::take(&mut self.inject_fault) {
+                    DriveState::Fault
+                } else {
+                    cia402::next_state(self.state, out.nCtrl1, reset_edge)
+                };
+                self.state == DriveState::OperationEnabled
+            }
+        };
+        self.enc_out = *enc_out;
+        let from = self.position;
         let command = match self.scaling.mode {
             DriveMode::Position => {
                 self.set_counter.update(out.nOutData1) as f64 / self.scaling.increments_per_unit
@@ -267,7 +354,14 @@ impl SimulatedDrive {
         let len = self.config.dead_time_ticks as usize + 1;
         self.delay[self.delay_head] = command;
         self.delay_head = (self.delay_head + 1) % len;
-        let seen = self.delay[self.delay_head];
+        let mut seen = self.delay[self.delay_head];
+        if !operational {
+            // A drive that is not in operation holds: no velocity, the position where it is.
+            seen = match self.scaling.mode {
+                DriveMode::Position => self.position,
+                DriveMode::Velocity | DriveMode::Universal => 0.0,
+            };
+        }
         let before = self.velocity;
         match self.scaling.mode {
             DriveMode::Position => {
@@ -287,11 +381,33 @@ impl SimulatedDrive {
             }
             _ => 0,
         };
+        self.probes.step(enc_out, from, self.position);
+        self.steps += 1;
+        // Torque in proportion to the acceleration: the rated torque gives the rated one.
+        let torque_percent = 100.0 * self.acceleration / self.scaling.rated_acceleration;
+        let (status1, status2) = match self.scaling.protocol {
+            DriveProtocol::Plain => (0, 0),
+            DriveProtocol::Cia402 => {
+                let position_mode = self.scaling.mode == DriveMode::Position;
+                let in_operation = self.state == DriveState::OperationEnabled;
+                (
+                    self.status_override
+                        .unwrap_or(cia402::status_of(self.state)),
+                    cia402::status_high(true, following == 0, in_operation && position_mode, false),
+                )
+            }
+        };
+        // The set-point taken now is applied after the dead time, at the end of that tick.
+        let applied_at = self.dc_time(self.steps + 1 + u64::from(self.config.dead_time_ticks));
         NcDriveIn {
             nInData1: following,
+            nStatus1: status1,
+            nStatus2: status2,
             nStatus4: u8::from(self.drive_io_invalid),
-            nInData3: (self.acceleration * self.scaling.acceleration_increments_per_unit)
+            nInData3: (torque_percent * self.scaling.torque_increments_per_percent)
+                .round()
                 .clamp(i32::MIN as f64, i32::MAX as f64) as i32,
+            nDcOutputTime: applied_at as i32,
             ..bytemuck::Zeroable::zeroed()
         }
     }
@@ -332,7 +448,7 @@ mod tests {
         let config = SimDriveConfig {
             dynamic,
             dead_time_ticks,
-            start_position: 0.0,
+            ..SimDriveConfig::default()
         };
         let scaling = SimScaling {
             increments_per_unit: 10_000.0,
@@ -340,6 +456,10 @@ mod tests {
             acceleration_increments_per_unit: 1_000.0,
             width: CounterWidth::Bits32,
             mode: DriveMode::Velocity,
+            protocol: DriveProtocol::Plain,
+            probe: ProbeInterface::None,
+            torque_increments_per_percent: 10.0,
+            rated_acceleration: 10_000.0,
         };
         SimulatedDrive::new(config, scaling, 0.001)
     }
@@ -351,7 +471,7 @@ mod tests {
         }; // 100 mm/s
         (0..ticks)
             .map(|_| {
-                d.step(&out);
+                d.step(&out, &bytemuck::Zeroable::zeroed());
                 d.velocity()
             })
             .collect()

@@ -270,6 +270,8 @@ impl Machine {
                 }
                 self.axes.handle_command(request)
             }
+            CallKind::ProbeArm => self.axes.handle_probe(request, true),
+            CallKind::ProbeAbort => self.axes.handle_probe(request, false),
             // A kind of an engine this machine does not have.
             _ => Err(ErrorCode::ServiceNotSupported),
         }

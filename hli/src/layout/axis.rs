@@ -80,10 +80,67 @@ hli_struct! {
 }
 
 hli_struct! {
+    /// One touch probe of an axis: the arming MC_TouchProbe made and what it recorded.
+    ///
+    /// ST path: `gpAx[i]^drive_state.probe_r[k]` (k 0: probe 1, k 1: probe 2).
+    #[st = "HLI_AXIS_PROBE", size = 24]
+    pub struct HliAxisProbe {
+        /// Raw [`crate::enums::ProbeState`].
+        pub state_r: u32 => [0, Cnc],
+        /// Raw [`crate::enums::ProbeEdge`] of the current or last arming, 0 before the first.
+        pub edge_r: u32 => [4, Cnc],
+        /// Id of the current or last arming (counts up from 1 per probe; the reply to the
+        /// arming call carries it), 0 before the first.
+        pub arm_id_r: u32 => [8, Cnc],
+        /// Raw [`crate::enums::AxisError`] that ended the last arming, 0 when none.
+        pub error_id_r: u32 => [12, Cnc],
+        /// Position the edge recorded, in axis units (mm or degree), valid while `state_r`
+        /// is Recorded.
+        pub recorded_position_r: f64 => [16, Cnc],
+    }
+}
+
+/// Touch probes per axis.
+pub const HLI_AXIS_PROBES: usize = 2;
+
+hli_struct! {
+    /// What the CNC made of the drive's and encoder's optional inputs (seed 004): the drive's
+    /// own following error, its torque, its state machine, the distributed-clock times and the
+    /// touch probes.
+    ///
+    /// ST path: `gpAx[i]^drive_state`.
+    #[st = "HLI_AXIS_DRIVE_STATE", size = 80]
+    pub struct HliAxisDriveState {
+        /// The drive's following error (`drive_in.nInData1`, cyclic position mode), 0.1 um
+        /// (0.0001 degree); 0 in the other drive modes.
+        pub drive_following_error_r: i32 => [0, Cnc],
+        /// Actual torque (`drive_in.nInData3`), 0.1 % of the rated torque.
+        pub actual_torque_r: i32 => [4, Cnc],
+        /// Raw [`crate::enums::DriveState`].
+        pub drive_state_r: u32 => [8, Cnc],
+        /// Bits of [`crate::enums::drive_flags`].
+        pub drive_flags_r: u32 => [12, Cnc],
+        /// How long before the tick the encoder reading was taken (`nDcInputTime`), ns; 0
+        /// without dead-time compensation.
+        pub dc_input_lag_r: i32 => [16, Cnc],
+        /// How long after the end of the tick the drive applies its set-point
+        /// (`nDcOutputTime`), ns; 0 without dead-time compensation.
+        pub dc_output_shift_r: i32 => [20, Cnc],
+        /// Input words with undefined bits or patterns (status bytes, DC times) counted
+        /// since start; such a word is not used.
+        pub undefined_inputs_r: u32 => [24, Cnc],
+        /// Padding.
+        pub fill_up_1: u32 => [28, Cnc],
+        /// The touch probes.
+        pub probe_r: [HliAxisProbe; HLI_AXIS_PROBES] => [32, Cnc],
+    }
+}
+
+hli_struct! {
     /// Everything of one axis: `gpAx[axis_idx]^`.
     ///
     /// ST path: `gpAx[i]^`.
-    #[st = "HLI_AXIS", size = 272]
+    #[st = "HLI_AXIS", size = 352]
     pub struct HliAxis {
         /// Cyclic state.
         pub lr_state: HliAxisLrState => [0, Parent],
@@ -97,5 +154,7 @@ hli_struct! {
         pub drive_out: NcDriveOut => [160, Parent],
         /// The command book.
         pub command_state: HliAxisCommandState => [192, Parent],
+        /// The drive's and encoder's optional inputs, evaluated.
+        pub drive_state: HliAxisDriveState => [272, Parent],
     }
 }

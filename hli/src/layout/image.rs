@@ -60,7 +60,7 @@ hli_struct! {
     /// The complete HLI image as it lies in the shared segment.
     ///
     /// ST path: the image root (`header`, `gpCh[..]`, `gpAx[..]`, `gpFifo[..]`).
-    #[st = "HLI_IMAGE", size = 18400]
+    #[st = "HLI_IMAGE", size = 20960]
     pub struct HliImage {
         /// Identity and heartbeats.
         pub header: HliSegmentHeader => [0, Parent],
@@ -69,6 +69,6 @@ hli_struct! {
         /// Axes, `gpAx[i]^`.
         pub gpAx: [HliAxis; HLI_MAX_AXES] => [9120, Parent],
         /// FIFO groups, `gpFifo[i]^`.
-        pub gpFifo: [HliFifoGroupState; HLI_MAX_FIFO_GROUPS] => [17824, Parent],
+        pub gpFifo: [HliFifoGroupState; HLI_MAX_FIFO_GROUPS] => [20384, Parent],
     }
 }

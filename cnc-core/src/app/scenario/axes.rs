@@ -11,6 +11,7 @@
 //! jerk = 100000.0
 //! following_error_limit = 2.0
 //! drive = { model = "pt2", frequency_hz = 80.0, damping = 0.7 }   # ideal when absent
+//! io = { protocol = "cia402", probe = "canopen", dc_compensation = true }  # see docs/axes.md
 //! start = 0.0                   # where the (simulated) axis stands at start
 //! power = true                  # enabled at start (as if MC_Power had run)
 //! id = 12                       # axis ID; default: next after the channel axes
@@ -25,7 +26,7 @@
 //! controller gains) may be given under its own name; absent ones take the defaults of a
 //! linear or rotary axis.
 
-use crate::axis::config::{AxisConfig, AxisKind, DriveLink, DriveMode};
+use crate::axis::config::{AxisConfig, AxisKind, DriveLink, DriveMode, ImageOptions};
 use crate::axis::increments::CounterWidth;
 use crate::axis::sim_drive::DriveModel;
 use crate::channel::ChannelConfig;
@@ -55,6 +56,7 @@ pub struct AxisFile {
     position_gain: Option<f64>,
     feed_forward: Option<f64>,
     drive: Option<DriveModel>,
+    io: Option<ImageOptions>,
     #[serde(default)]
     start: f64,
     #[serde(default)]
@@ -234,6 +236,9 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
         set(&mut c.feed_forward, f.feed_forward);
         if let Some(m) = f.drive_mode {
             c.drive_mode = m;
+        }
+        if let Some(io) = f.io {
+            c.io = io;
         }
         if !f.start.is_finite() {
             return Err(key("start: must be finite"));

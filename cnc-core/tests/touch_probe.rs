@@ -1,0 +1,407 @@
+//! Touch probes through the encoder process image (seed 004: `nInData2..6`, `nStatus1`,
+//! `nStatus5..8`, `nCtrl1`, `nCtrl5/6`), on each of the three interfaces: the recorded
+//! position is the sensor's edge to one increment, where a tick-sampled position would miss it
+//! by up to a tick's travel; windows, a probe armed twice, aborts, stale latches, undefined
+//! status bits and lost encoder data.
+
+use cnc_core::axis::config::{AxisConfig, DriveLink, ProbeInterface};
+use cnc_core::axis::sim_drive::SimDriveConfig;
+use cnc_core::axis::AxisSet;
+use hli::enums::{AxisError, ProbeEdge, ProbeState};
+use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe, NcEncoderIn, NcEncoderOut};
+use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
+use hli::raw::ImageMemory;
+use hli::rpc::AxisCommandCall;
+use hli::views::CncView;
+use hli::PlaceExt;
+
+const CYCLE: f64 = 0.001;
+/// One increment at 10000 per mm.
+const INCREMENT: f64 = 1e-4;
+
+struct Rig {
+    memory: ImageMemory,
+    set: AxisSet,
+}
+
+impl Rig {
+    fn new(config: AxisConfig) -> Self {
+        let memory = hli::segment::heap_image(1, 1);
+        let set = AxisSet::new(vec![config], CYCLE).unwrap();
+        set.prime(&CncView::new(&memory));
+        let mut rig = Self { memory, set };
+        rig.tick();
+        rig.set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::power(true))
+            .unwrap();
+        rig
+    }
+    fn tick(&mut self) {
+        self.set.tick(&CncView::new(&self.memory));
+    }
+    fn place(&self) -> hli::Place<'_, HliAxis> {
+        CncView::new(&self.memory).axis(0).unwrap()
+    }
+    fn probe(&self, k: usize) -> HliAxisProbe {
+        self.place()
+            .field::<HliAxisDriveState>(core::mem::offset_of!(HliAxis, drive_state))
+            .read()
+            .probe_r[k]
+    }
+    fn undefined(&self) -> u32 {
+        self.place()
+            .field::<HliAxisDriveState>(core::mem::offset_of!(HliAxis, drive_state))
+            .read()
+            .undefined_inputs_r
+    }
+    fn enc_out(&self) -> NcEncoderOut {
+        self.place()
+            .field::<NcEncoderOut>(core::mem::offset_of!(HliAxis, enc_out))
+            .read()
+    }
+    fn set_enc_in(&self, value: NcEncoderIn) {
+        self.place()
+            .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in))
+            .write(&value)
+    }
+    fn arm(
+        &mut self,
+        probe: u32,
+        edge: ProbeEdge,
+        window: Option<[f64; 2]>,
+    ) -> Result<u32, AxisError> {
+        let [first_position, last_position] = window.unwrap_or([0.0, 0.0]);
+        self.set.axis_mut(0).unwrap().arm_probe(&ProbeArmCall {
+            probe,
+            edge: edge.raw(),
+            window_only: u32::from(window.is_some()),
+            reserved: 0,
+            first_position,
+            last_position,
+        })
+    }
+    fn abort(&mut self, probe: u32) -> Result<u32, AxisError> {
+        self.set
+            .axis_mut(0)
+            .unwrap()
+            .abort_probe(&ProbeAbortCall { probe, reserved: 0 })
+    }
+    fn move_to(&mut self, target: f64) {
+        self.set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::move_absolute(
+                target,
+                [100.0, 2000.0, 2000.0, 50_000.0],
+            ))
+            .unwrap();
+    }
+    /// Ticks until the axis stands at `target`, returning the tick-sampled positions.
+    fn run_to(&mut self, target: f64) -> Vec<f64> {
+        self.move_to(target);
+        let mut seen = vec![];
+        for _ in 0..5000 {
+            self.tick();
+            let axis = self.set.axis(0).unwrap();
+            seen.push(axis.actual());
+            if (axis.actual() - target).abs() < INCREMENT && axis.setpoint().velocity == 0.0 {
+                return seen;
+            }
+        }
+        panic!("watchdog: the axis did not reach {target}");
+    }
+}
+
+fn probed(interface: ProbeInterface, windows: [Option<[f64; 2]>; 2]) -> AxisConfig {
+    let mut c = AxisConfig::linear("X", 1);
+    c.io.probe = interface;
+    c.drive = DriveLink::Simulated(SimDriveConfig {
+        probe_windows: windows,
+        ..SimDriveConfig::default()
+    });
+    c
+}
+
+/// The tick-sampled position nearest to `edge`: what a probe evaluated per tick could at best
+/// have recorded.
+fn nearest_sample(seen: &[f64], edge: f64) -> f64 {
+    seen.iter()
+        .map(|p| (p - edge).abs())
+        .fold(f64::MAX, f64::min)
+}
+
+#[test]
+fn each_interface_records_the_edges_exact_position() {
+    for interface in [
+        ProbeInterface::Terminal,
+        ProbeInterface::Canopen,
+        ProbeInterface::Sercos,
+    ] {
+        let two = interface != ProbeInterface::Terminal;
+        let second = two.then_some([40.0, 45.0]);
+        let mut rig = Rig::new(probed(interface, [Some([20.0123, 30.00007]), second]));
+        let id = rig.arm(1, ProbeEdge::Positive, None).unwrap();
+        assert_eq!(id, 1);
+        if two {
+            rig.arm(2, ProbeEdge::Negative, None).unwrap();
+        }
+        let seen = rig.run_to(60.0);
+        let p1 = rig.probe(0);
+        assert_eq!(p1.state_r, ProbeState::Recorded.raw(), "{interface:?}");
+        assert_eq!(p1.arm_id_r, id);
+        assert_eq!(p1.edge_r, ProbeEdge::Positive.raw());
+        assert!(
+            (p1.recorded_position_r - 20.0123).abs() <= INCREMENT / 2.0,
+            "{interface:?}: {}",
+            p1.recorded_position_r
+        );
+        // At 100 mm/s a tick travels 0.1 mm: sampling per tick would have missed the edge.
+        assert!(nearest_sample(&seen, 20.0123) > 10.0 * INCREMENT);
+        if two {
+            let p2 = rig.probe(1);
+            assert_eq!(p2.state_r, ProbeState::Recorded.raw(), "{interface:?}");
+            assert!((p2.recorded_position_r - 45.0).abs() <= INCREMENT / 2.0);
+        }
+        // The falling edge of probe 1, on the way back (the sensor goes off at its lower end).
+        rig.arm(1, ProbeEdge::Negative, None).unwrap();
+        rig.run_to(0.0);
+        let p1 = rig.probe(0);
+        assert_eq!(p1.arm_id_r, 2);
+        assert_eq!(p1.state_r, ProbeState::Recorded.raw());
+        assert!(
+            (p1.recorded_position_r - 20.0123).abs() <= INCREMENT / 2.0,
+            "{interface:?} back: {}",
+            p1.recorded_position_r
+        );
+        // Recorded: the probe's enable is off again.
+        let out = rig.enc_out();
+        assert_eq!((out.nCtrl1, out.nCtrl5, out.nCtrl6), (0, 0, 0));
+    }
+}
+
+#[test]
+fn the_control_bytes_follow_the_interfaces_coding() {
+    let cases = [
+        (ProbeInterface::Terminal, ProbeEdge::Positive, (0x02, 0, 0)),
+        (ProbeInterface::Terminal, ProbeEdge::Negative, (0x08, 0, 0)),
+        (ProbeInterface::Canopen, ProbeEdge::Positive, (0, 0x11, 0)),
+        (ProbeInterface::Canopen, ProbeEdge::Negative, (0, 0x21, 0)),
+        (ProbeInterface::Sercos, ProbeEdge::Negative, (0, 0x01, 0)),
+    ];
+    for (interface, edge, expected) in cases {
+        let mut rig = Rig::new(probed(interface, [None, None]));
+        rig.arm(1, edge, None).unwrap();
+        // The first tick checks the status is clear; the enable goes on with it.
+        rig.tick();
+        let out = rig.enc_out();
+        assert_eq!(
+            (out.nCtrl1, out.nCtrl5, out.nCtrl6),
+            expected,
+            "{interface:?}"
+        );
+        rig.abort(1).unwrap();
+        rig.tick();
+        let out = rig.enc_out();
+        assert_eq!((out.nCtrl1, out.nCtrl5, out.nCtrl6), (0, 0, 0));
+    }
+}
+
+#[test]
+fn a_window_skips_edges_outside_it() {
+    let mut rig = Rig::new(probed(ProbeInterface::Canopen, [Some([20.0, 30.0]), None]));
+    // The rising edge at 20 lies outside [25, 35]: not recorded, the probe stays armed.
+    rig.arm(1, ProbeEdge::Positive, Some([25.0, 35.0])).unwrap();
+    rig.run_to(50.0);
+    assert_eq!(rig.probe(0).state_r, ProbeState::Armed.raw());
+    // Moving down the sensor switches on at 30, inside the window.
+    rig.run_to(0.0);
+    let p = rig.probe(0);
+    assert_eq!(p.state_r, ProbeState::Recorded.raw());
+    assert!((p.recorded_position_r - 30.0).abs() <= INCREMENT / 2.0);
+}
+
+#[test]
+fn a_probe_armed_twice_is_refused_and_the_first_arming_records() {
+    let mut rig = Rig::new(probed(ProbeInterface::Sercos, [Some([10.0, 12.0]), None]));
+    let id = rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    assert_eq!(
+        rig.arm(1, ProbeEdge::Negative, None),
+        Err(AxisError::ProbeAlreadyArmed)
+    );
+    rig.run_to(20.0);
+    let p = rig.probe(0);
+    assert_eq!((p.state_r, p.arm_id_r), (ProbeState::Recorded.raw(), id));
+    assert_eq!(p.edge_r, ProbeEdge::Positive.raw());
+    assert!((p.recorded_position_r - 10.0).abs() <= INCREMENT / 2.0);
+}
+
+#[test]
+fn bad_arming_calls_are_refused_with_their_codes() {
+    let mut terminal = Rig::new(probed(ProbeInterface::Terminal, [None, None]));
+    assert_eq!(
+        terminal.arm(2, ProbeEdge::Positive, None),
+        Err(AxisError::ProbeNotAvailable)
+    );
+    assert_eq!(
+        terminal.arm(3, ProbeEdge::Positive, None),
+        Err(AxisError::InvalidProbeParameter)
+    );
+    assert_eq!(
+        terminal.arm(1, ProbeEdge::Positive, Some([5.0, 1.0])),
+        Err(AxisError::InvalidProbeParameter)
+    );
+    assert_eq!(
+        terminal.arm(1, ProbeEdge::Positive, Some([f64::NAN, 1.0])),
+        Err(AxisError::InvalidProbeParameter)
+    );
+    let bad_edge = terminal.set.axis_mut(0).unwrap().arm_probe(&ProbeArmCall {
+        probe: 1,
+        edge: 0,
+        ..ProbeArmCall::default()
+    });
+    assert_eq!(bad_edge, Err(AxisError::InvalidProbeParameter));
+    assert_eq!(terminal.abort(1), Err(AxisError::ProbeNotArmed));
+    let mut none = Rig::new(probed(ProbeInterface::None, [None, None]));
+    assert_eq!(
+        none.arm(1, ProbeEdge::Positive, None),
+        Err(AxisError::ProbeNotAvailable)
+    );
+    // Nothing of it armed anything.
+    assert_eq!(terminal.probe(0).state_r, ProbeState::Idle.raw());
+}
+
+#[test]
+fn an_aborted_probe_records_nothing() {
+    let mut rig = Rig::new(probed(ProbeInterface::Canopen, [Some([10.0, 12.0]), None]));
+    let id = rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.tick();
+    assert_eq!(rig.abort(1), Ok(id));
+    rig.run_to(20.0);
+    let p = rig.probe(0);
+    assert_eq!(p.state_r, ProbeState::Aborted.raw());
+    assert_eq!(p.recorded_position_r, 0.0);
+}
+
+fn external_canopen() -> AxisConfig {
+    let mut c = AxisConfig::linear("X", 1);
+    c.io.probe = ProbeInterface::Canopen;
+    c.drive = DriveLink::External;
+    c
+}
+
+#[test]
+fn a_latch_left_from_before_the_arming_is_never_taken() {
+    let mut rig = Rig::new(external_canopen());
+    let stale = NcEncoderIn {
+        nInData1: 50_000,
+        nInData3: 12_345,
+        nStatus5: 0x03, // enabled, positive edge stored: from an earlier arming
+        ..bytemuck::Zeroable::zeroed()
+    };
+    rig.set_enc_in(stale);
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    for _ in 0..5 {
+        rig.tick();
+        // The enable stays off until the drive has cleared its status.
+        assert_eq!(rig.enc_out().nCtrl5, 0);
+        assert_eq!(rig.probe(0).state_r, ProbeState::Armed.raw());
+    }
+    rig.set_enc_in(NcEncoderIn {
+        nStatus5: 0,
+        ..stale
+    });
+    rig.tick();
+    assert_eq!(rig.enc_out().nCtrl5, 0x11);
+    // A fresh latch: 60000 increments, 1 mm past the reading of 50000.
+    rig.set_enc_in(NcEncoderIn {
+        nStatus5: 0x03,
+        nInData3: 60_000,
+        ..stale
+    });
+    rig.tick();
+    let p = rig.probe(0);
+    assert_eq!(p.state_r, ProbeState::Recorded.raw());
+    assert!((p.recorded_position_r - 6.0).abs() < 1e-12);
+}
+
+#[test]
+fn a_latched_count_is_unwrapped_against_the_encoders_count() {
+    let mut c = external_canopen();
+    c.encoder_width = cnc_core::axis::increments::CounterWidth::Bits16;
+    let mut rig = Rig::new(c);
+    // The 16-bit counter stands at 65000 after a wrap from 0 downwards: -536 increments.
+    rig.set_enc_in(NcEncoderIn {
+        nInData1: 0,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.tick();
+    rig.set_enc_in(NcEncoderIn {
+        nInData1: 65_000,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.tick();
+    // The latch at 100 lies 636 increments above 65000, across the wrap.
+    rig.set_enc_in(NcEncoderIn {
+        nInData1: 65_000,
+        nInData3: 100,
+        nStatus5: 0x03,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.tick();
+    let p = rig.probe(0);
+    assert_eq!(p.state_r, ProbeState::Recorded.raw());
+    assert!(
+        (p.recorded_position_r - 0.01).abs() < 1e-12,
+        "{}",
+        p.recorded_position_r
+    );
+}
+
+#[test]
+fn undefined_status_bits_are_counted_and_never_recorded() {
+    let mut rig = Rig::new(external_canopen());
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.tick();
+    // Bit 3 of the CANopen probe status is reserved.
+    rig.set_enc_in(NcEncoderIn {
+        nStatus5: 0x0B,
+        nInData3: 777,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    let before = rig.undefined();
+    for _ in 0..4 {
+        rig.tick();
+    }
+    assert_eq!(rig.undefined() - before, 4);
+    assert_eq!(rig.probe(0).state_r, ProbeState::Armed.raw());
+    // SERCOS: a latched flag is 0 or 1.
+    let mut c = external_canopen();
+    c.io.probe = ProbeInterface::Sercos;
+    let mut rig = Rig::new(c);
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.set_enc_in(NcEncoderIn {
+        nStatus5: 2,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.tick();
+    assert_eq!(rig.undefined(), 1);
+    assert_eq!(rig.probe(0).state_r, ProbeState::Armed.raw());
+}
+
+#[test]
+fn lost_encoder_data_ends_an_armed_probe_with_the_cause() {
+    let mut rig = Rig::new(external_canopen());
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.tick();
+    rig.set_enc_in(NcEncoderIn {
+        nStatus4: 1,
+        ..bytemuck::Zeroable::zeroed()
+    });
+    rig.tick();
+    let p = rig.probe(0);
+    assert_eq!(p.state_r, ProbeState::Aborted.raw());
+    assert_eq!(p.error_id_r, AxisError::EncoderIoInvalid.raw());
+}
