@@ -209,7 +209,7 @@ fn example_2_the_base_error_is_compensated_and_switched_softly() {
     let (mut active, mut inactive_after, mut worst) = (0, 0, 0.0f64);
     let mut max_step = [0.0f64; 2]; // ACTIVATING, DEACTIVATING
     let mut was_on = false;
-    run(&s, 60_000, None, |run, _| {
+    run(&s, 250_000, None, |run, _| {
         let robot = channel(run, "robot");
         let comp = *robot.tracker().applied();
         let step = (comp.translation.vector - last_comp.translation.vector).norm();
@@ -260,8 +260,14 @@ fn example_1_the_gripper_follows_the_carriage_axis_by_axis() {
     let mut last_x: Option<f64> = None;
     let mut cycles = 0;
     let mut was_active = false;
-    let done = run(&s, 60_000, s.ticks, |run, _| {
+    let (mut far, mut near) = (f64::MIN, f64::MAX);
+    let done = run(&s, 60_000, s.ticks, |run, tick| {
         let (g, c) = (channel(run, "gripper"), channel(run, "carriage"));
+        // The manual's carriage positions: magazine AB=30, working position AB=127.7213.
+        if tick > 5000 {
+            far = far.max(c.set_points()[0]);
+            near = near.min(c.set_points()[0]);
+        }
         let active = g.tracker().state() == DynCsState::Active;
         if active && !was_active {
             cycles += 1;
@@ -282,6 +288,8 @@ fn example_1_the_gripper_follows_the_carriage_axis_by_axis() {
         checked += 1;
     });
     assert!(cycles >= 3, "{cycles} transfer cycles");
+    assert!((far - 127.7213).abs() < 1e-9, "working position {far}");
+    assert!((near - 30.0).abs() < 1e-9, "magazine {near}");
     assert!(checked > 1000, "followed for {checked} ticks");
     assert!(
         travel > 200.0,

@@ -1,16 +1,16 @@
 %carriage
-; X: carriage travel, Z: lift
-G1 X0 Z0 F6000
-#CHANNEL INTERFACE ON [TRACK_CS]
+; AB: the carriage's travel (our first pose coordinate)
+#TRAFO ON
+G1 G90 AB=90 F2000 ; to the magazine
+AB=30
+N20 #CHANNEL INTERFACE ON [TRACK_CS]
 $WHILE 1
-  ; tell the gripper the carriage is at the magazine and wait for it
   #SIGNAL SYN [ID3 COUNT1]
   #WAIT SYN [ID1]
-  ; M0: wait until the PLC confirms the gripper holds the tube
-  M0
-  ; to the working position, the gripper follows
-  G1 X120 Z15 F3000
-  #SIGNAL SYN [ID2 COUNT1]
-  ; back to the magazine
-  G1 X0 Z0 F6000
+  N20 #CHANNEL INTERFACE ON [TRACK_CS]
+  M0 ; wait until the gripper holds the tube
+  AB=127.7213 F2000 ; working position
+  #SIGNAL SYN [ID2 COUNT1] ; the tube is in its working position
+  N20 #CHANNEL INTERFACE OFF [TRACK_CS]
+  AB=30 ; magazine
 $ENDWHILE
