@@ -62,6 +62,86 @@ enum Phase<C: hli::calls::AcyclicCall> {
     Armed(u32),
 }
 
+/// The Execute edge and the call in flight, shared by both blocks.
+struct Core<C: hli::calls::AcyclicCall> {
+    execute_before: bool,
+    phase: Phase<C>,
+}
+
+impl<C: hli::calls::AcyclicCall> Default for Core<C> {
+    fn default() -> Self {
+        Self {
+            execute_before: false,
+            phase: Phase::Idle,
+        }
+    }
+}
+
+/// What one cycle's Execute did.
+struct Edges {
+    fell: bool,
+    was_running: bool,
+}
+
+impl<C: hli::calls::AcyclicCall<Reply = ProbeReply>> Core<C> {
+    /// Takes this cycle's Execute; on its rising edge sends `call` (outputs reset, or the
+    /// transport's error).
+    fn begin(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        axis: u32,
+        execute: bool,
+        call: impl FnOnce() -> C,
+        out: &mut ProbeOutputs,
+    ) -> Edges {
+        let edges = Edges {
+            fell: !execute && self.execute_before,
+            was_running: !matches!(self.phase, Phase::Idle),
+        };
+        let rising = execute && !self.execute_before;
+        self.execute_before = execute;
+        if rising {
+            *out = ProbeOutputs::default();
+            self.phase = match io.acyclic.start(axis, &call()) {
+                Ok(pending) => Phase::Sent(pending),
+                Err(_) => {
+                    *out = failed(ERROR_NO_ANSWER);
+                    Phase::Idle
+                }
+            };
+        }
+        edges
+    }
+
+    /// Polls a call in flight: `Some(Ok(id))` once accepted, `Some(Err(outputs))` when
+    /// refused or lost (the call is over), `None` while waiting (Busy) or with nothing sent.
+    fn poll(&mut self, out: &mut ProbeOutputs) -> Option<Result<u32, ProbeOutputs>> {
+        let Phase::Sent(pending) = &self.phase else {
+            return None;
+        };
+        let Some(result) = pending.poll() else {
+            out.busy = true;
+            return None;
+        };
+        let outcome = reply_outcome(result);
+        self.phase = match outcome {
+            Ok(id) => Phase::Armed(id),
+            Err(_) => Phase::Idle,
+        };
+        Some(outcome)
+    }
+
+    /// Execute low and nothing running: a result shows for the cycle Execute fell in (or the
+    /// cycle it arrived in, if the call was still running), then clears.
+    fn settle(&self, execute: bool, edges: Edges, out: &mut ProbeOutputs) {
+        let idle = matches!(self.phase, Phase::Idle);
+        let finished_now = edges.was_running && idle;
+        if !execute && !edges.fell && !finished_now && idle {
+            *out = ProbeOutputs::default();
+        }
+    }
+}
+
 /// MC_TouchProbe: on a rising Execute edge arms `probe` (1 or 2) of the axis for `edge`;
 /// with `window_only` only an edge between `first_position` and `last_position` records.
 /// Outputs hold while Execute stays TRUE and show for one cycle after it fell.
@@ -80,8 +160,7 @@ pub struct McTouchProbe {
     pub last_position: f64,
     /// Outputs of the last call.
     pub out: ProbeOutputs,
-    execute_before: bool,
-    phase: Phase<ProbeArmCall>,
+    core: Core<ProbeArmCall>,
 }
 
 impl Default for McTouchProbe {
@@ -94,8 +173,7 @@ impl Default for McTouchProbe {
             first_position: 0.0,
             last_position: 0.0,
             out: ProbeOutputs::default(),
-            execute_before: false,
-            phase: Phase::Idle,
+            core: Core::default(),
         }
     }
 }
@@ -103,41 +181,21 @@ impl Default for McTouchProbe {
 impl McTouchProbe {
     /// One cycle for `axis`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
-        let rising = self.execute && !self.execute_before;
-        let fell = !self.execute && self.execute_before;
-        self.execute_before = self.execute;
-        let was_running = !matches!(self.phase, Phase::Idle);
-        if rising {
-            self.out = ProbeOutputs::default();
-            let call = ProbeArmCall {
-                probe: self.probe,
-                edge: self.edge.raw(),
-                window_only: u32::from(self.window_only),
-                reserved: 0,
-                first_position: self.first_position,
-                last_position: self.last_position,
-            };
-            self.phase = match io.acyclic.start(axis, &call) {
-                Ok(pending) => Phase::Sent(pending),
-                Err(_) => {
-                    self.out = failed(ERROR_NO_ANSWER);
-                    Phase::Idle
-                }
-            };
+        let call = ProbeArmCall {
+            probe: self.probe,
+            edge: self.edge.raw(),
+            window_only: u32::from(self.window_only),
+            reserved: 0,
+            first_position: self.first_position,
+            last_position: self.last_position,
+        };
+        let edges = self
+            .core
+            .begin(io, axis, self.execute, || call, &mut self.out);
+        if let Some(Err(out)) = self.core.poll(&mut self.out) {
+            self.out = out;
         }
-        if let Phase::Sent(pending) = &self.phase {
-            match pending.poll() {
-                None => self.out.busy = true,
-                Some(result) => match reply_outcome(result) {
-                    Ok(id) => self.phase = Phase::Armed(id),
-                    Err(out) => {
-                        self.out = out;
-                        self.phase = Phase::Idle;
-                    }
-                },
-            }
-        }
-        if let Phase::Armed(id) = self.phase {
+        if let Phase::Armed(id) = self.core.phase {
             self.out = match probe_image(io, axis, self.probe) {
                 Some(p) if p.arm_id_r != id => ProbeOutputs {
                     command_aborted: true,
@@ -163,15 +221,10 @@ impl McTouchProbe {
                 None => failed(hli::rpc::ErrorCode::InvalidTarget.raw()),
             };
             if !self.out.busy {
-                self.phase = Phase::Idle;
+                self.core.phase = Phase::Idle;
             }
         }
-        // Execute fell: the result shows this cycle (or the cycle it arrives in, if the
-        // arming was still running), then clears.
-        let finished_now = was_running && matches!(self.phase, Phase::Idle);
-        if !self.execute && !fell && !finished_now && matches!(self.phase, Phase::Idle) {
-            self.out = ProbeOutputs::default();
-        }
+        self.core.settle(self.execute, edges, &mut self.out);
     }
 }
 
@@ -183,8 +236,7 @@ pub struct McAbortTrigger {
     pub probe: u32,
     /// Outputs of the last call.
     pub out: ProbeOutputs,
-    execute_before: bool,
-    phase: Phase<ProbeAbortCall>,
+    core: Core<ProbeAbortCall>,
 }
 
 impl Default for McAbortTrigger {
@@ -193,8 +245,7 @@ impl Default for McAbortTrigger {
             execute: false,
             probe: 1,
             out: ProbeOutputs::default(),
-            execute_before: false,
-            phase: Phase::Idle,
+            core: Core::default(),
         }
     }
 }
@@ -202,42 +253,24 @@ impl Default for McAbortTrigger {
 impl McAbortTrigger {
     /// One cycle for `axis`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
-        let rising = self.execute && !self.execute_before;
-        let fell = !self.execute && self.execute_before;
-        self.execute_before = self.execute;
-        let was_running = !matches!(self.phase, Phase::Idle);
-        if rising {
-            self.out = ProbeOutputs::default();
-            let call = ProbeAbortCall {
-                probe: self.probe,
-                reserved: 0,
-            };
-            self.phase = match io.acyclic.start(axis, &call) {
-                Ok(pending) => Phase::Sent(pending),
-                Err(_) => {
-                    self.out = failed(ERROR_NO_ANSWER);
-                    Phase::Idle
-                }
-            };
-        }
-        if let Phase::Sent(pending) = &self.phase {
-            match pending.poll() {
-                None => self.out.busy = true,
-                Some(result) => {
-                    self.out = match reply_outcome(result) {
-                        Ok(_) => ProbeOutputs {
-                            done: true,
-                            ..ProbeOutputs::default()
-                        },
-                        Err(out) => out,
-                    };
-                    self.phase = Phase::Idle;
-                }
+        let call = ProbeAbortCall {
+            probe: self.probe,
+            reserved: 0,
+        };
+        let edges = self
+            .core
+            .begin(io, axis, self.execute, || call, &mut self.out);
+        match self.core.poll(&mut self.out) {
+            Some(Ok(_)) => {
+                self.out = ProbeOutputs {
+                    done: true,
+                    ..ProbeOutputs::default()
+                };
+                self.core.phase = Phase::Idle;
             }
+            Some(Err(out)) => self.out = out,
+            None => {}
         }
-        let finished_now = was_running && matches!(self.phase, Phase::Idle);
-        if !self.execute && !fell && !finished_now && matches!(self.phase, Phase::Idle) {
-            self.out = ProbeOutputs::default();
-        }
+        self.core.settle(self.execute, edges, &mut self.out);
     }
 }
