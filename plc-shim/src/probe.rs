@@ -59,7 +59,8 @@ fn probe_image(io: &PlcIo<'_>, axis: u32, probe: u32) -> Option<HliAxisProbe> {
 enum Phase<C: hli::calls::AcyclicCall> {
     Idle,
     Sent(PendingCall<C>),
-    Armed(u32),
+    /// The CNC took the call: the arming's id.
+    Accepted(u32),
 }
 
 /// The Execute edge and the call in flight, shared by both blocks.
@@ -125,7 +126,7 @@ impl<C: hli::calls::AcyclicCall<Reply = ProbeReply>> Core<C> {
         };
         let outcome = reply_outcome(result);
         self.phase = match outcome {
-            Ok(id) => Phase::Armed(id),
+            Ok(id) => Phase::Accepted(id),
             Err(_) => Phase::Idle,
         };
         Some(outcome)
@@ -195,7 +196,7 @@ impl McTouchProbe {
         if let Some(Err(out)) = self.core.poll(&mut self.out) {
             self.out = out;
         }
-        if let Phase::Armed(id) = self.core.phase {
+        if let Phase::Accepted(id) = self.core.phase {
             self.out = match probe_image(io, axis, self.probe) {
                 Some(p) if p.arm_id_r != id => ProbeOutputs {
                     command_aborted: true,

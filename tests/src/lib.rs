@@ -108,3 +108,51 @@ pub fn remove_stale_segment(instance: &str) {
         Err(e) => panic!("{instance}: the stale segment could not be taken over: {e}"),
     }
 }
+
+/// Runs a CNC in a thread that ticks the axes `build` returns against a fresh segment of
+/// `instance` (1 channel, `axes` axes), in lockstep with one PLC runtime: each tick answers the
+/// pending acyclic calls (axis commands, axis reads, probe calls), ticks, beats and notifies,
+/// then waits for the PLC's cycle. Returns once the segment is ready for the PLC to attach;
+/// the thread ends when `finished` is set (its result: whether it was) or after a watchdog of
+/// two million ticks, and drops the segment, which ends the PLC runtime.
+pub fn serve_axes_in_lockstep(
+    instance: &str,
+    axes: u32,
+    build: impl FnOnce() -> cnc_core::axis::AxisSet + Send + 'static,
+    finished: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> std::thread::JoinHandle<bool> {
+    use hli::rpc::CallKind;
+    let segment = hli::segment::CncSegment::create(instance, 1, axes).unwrap();
+    let instance = instance.to_string();
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let cnc = std::thread::spawn(move || {
+        let view = hli::views::CncView::new(segment.memory());
+        let mut axes = build();
+        axes.prime(&view);
+        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
+        let server = hli::rpc::AcyclicServer::open(&instance).unwrap();
+        ready_tx.send(()).unwrap();
+        for _ in 0..2_000_000 {
+            if finished.load(Ordering::Acquire) {
+                break;
+            }
+            server
+                .poll(|kind, request| match kind {
+                    CallKind::AxisCommand => axes.handle_command(request),
+                    CallKind::ReadAxisState => hli::views::handle_read_axis_state(&view, request),
+                    CallKind::ProbeArm => axes.handle_probe(request, true),
+                    CallKind::ProbeAbort => axes.handle_probe(request, false),
+                    _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
+                })
+                .unwrap();
+            axes.tick(&view);
+            segment.beat();
+            events.notify().unwrap();
+            // Lockstep: the next tick after the PLC's cycle (the timeout only covers start-up).
+            let _ = events.wait(Duration::from_millis(2)).unwrap();
+        }
+        finished.load(Ordering::Acquire)
+    });
+    ready_rx.recv().unwrap();
+    cnc
+}

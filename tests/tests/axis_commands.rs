@@ -6,11 +6,6 @@
 use cnc_core::axis::config::{AxisConfig, DriveLink};
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
-use hli::events::{EventLink, Side};
-use hli::rpc::{AcyclicServer, CallKind};
-use hli::segment::CncSegment;
-use hli::views::handle_read_axis_state;
-use hli::views::CncView;
 use plc_shim::motion::{McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McStop};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime, RunEnd};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -163,47 +158,22 @@ impl PlcProgram for Sequence {
 fn plc_motion_blocks_drive_simulated_axes_through_the_segment() {
     hli::init_logging();
     let instance = unique_instance("axis-fb");
-    let segment = CncSegment::create(&instance, 1, 2).unwrap();
     let finished = Arc::new(AtomicBool::new(false));
-    let cnc_finished = finished.clone();
-    let cnc_instance = instance.clone();
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
-    let cnc = std::thread::spawn(move || {
-        let view = CncView::new(segment.memory());
-        let mut lagging = AxisConfig::linear("Y", 2);
-        lagging.drive = DriveLink::Simulated(SimDriveConfig {
-            dynamic: Dynamic::Pt1 { t1_s: 0.005 },
-            dead_time_ticks: 1,
-            start_position: 0.0,
-            ..SimDriveConfig::default()
-        });
-        let mut axes = AxisSet::new(vec![AxisConfig::linear("X", 1), lagging], 0.001).unwrap();
-        axes.prime(&view);
-        let events = EventLink::open(&cnc_instance, Side::Cnc).unwrap();
-        let server = AcyclicServer::open(&cnc_instance).unwrap();
-        ready_tx.send(()).unwrap();
-        // Watchdog: a hang fails the test instead of blocking it.
-        for _ in 0..2_000_000 {
-            if cnc_finished.load(Ordering::Acquire) {
-                break;
-            }
-            server
-                .poll(|kind, request| match kind {
-                    CallKind::AxisCommand => axes.handle_command(request),
-                    CallKind::ReadAxisState => handle_read_axis_state(&view, request),
-                    _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
-                })
-                .unwrap();
-            axes.tick(&view);
-            segment.beat();
-            events.notify().unwrap();
-            // Lockstep: the next tick after the PLC's cycle (the timeout only covers start-up).
-            let _ = events.wait(Duration::from_millis(2)).unwrap();
-        }
-        cnc_finished.load(Ordering::Acquire)
-        // The segment drops here: marked closed, the PLC runtime ends.
-    });
-    ready_rx.recv().unwrap();
+    let cnc = tests::serve_axes_in_lockstep(
+        &instance,
+        2,
+        || {
+            let mut lagging = AxisConfig::linear("Y", 2);
+            lagging.drive = DriveLink::Simulated(SimDriveConfig {
+                dynamic: Dynamic::Pt1 { t1_s: 0.005 },
+                dead_time_ticks: 1,
+                start_position: 0.0,
+                ..SimDriveConfig::default()
+            });
+            AxisSet::new(vec![AxisConfig::linear("X", 1), lagging], 0.001).unwrap()
+        },
+        finished.clone(),
+    );
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
     let mut program = Sequence {
         finished: finished.clone(),

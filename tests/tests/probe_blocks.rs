@@ -7,10 +7,6 @@ use cnc_core::axis::config::{AxisConfig, DriveLink, ProbeInterface};
 use cnc_core::axis::sim_drive::SimDriveConfig;
 use cnc_core::axis::AxisSet;
 use hli::enums::ProbeEdge;
-use hli::events::{EventLink, Side};
-use hli::rpc::{AcyclicServer, CallKind};
-use hli::segment::CncSegment;
-use hli::views::CncView;
 use plc_shim::motion::{McMoveAbsolute, McPower};
 use plc_shim::probe::{McAbortTrigger, McTouchProbe};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime, RunEnd};
@@ -113,46 +109,21 @@ impl PlcProgram for Sequence {
 fn plc_probe_blocks_arm_record_refuse_and_abort_through_the_segment() {
     hli::init_logging();
     let instance = unique_instance("probe-fb");
-    let segment = CncSegment::create(&instance, 1, 1).unwrap();
     let finished = Arc::new(AtomicBool::new(false));
-    let cnc_finished = finished.clone();
-    let cnc_instance = instance.clone();
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
-    let cnc = std::thread::spawn(move || {
-        let view = CncView::new(segment.memory());
-        let mut x = AxisConfig::linear("X", 1);
-        x.io.probe = ProbeInterface::Canopen;
-        x.drive = DriveLink::Simulated(SimDriveConfig {
-            probe_windows: [Some([20.0017, 30.0]), None],
-            ..SimDriveConfig::default()
-        });
-        let mut axes = AxisSet::new(vec![x], 0.001).unwrap();
-        axes.prime(&view);
-        let events = EventLink::open(&cnc_instance, Side::Cnc).unwrap();
-        let server = AcyclicServer::open(&cnc_instance).unwrap();
-        ready_tx.send(()).unwrap();
-        // Watchdog: a hang fails the test instead of blocking it.
-        for _ in 0..2_000_000 {
-            if cnc_finished.load(Ordering::Acquire) {
-                break;
-            }
-            server
-                .poll(|kind, request| match kind {
-                    CallKind::AxisCommand => axes.handle_command(request),
-                    CallKind::ProbeArm => axes.handle_probe(request, true),
-                    CallKind::ProbeAbort => axes.handle_probe(request, false),
-                    _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
-                })
-                .unwrap();
-            axes.tick(&view);
-            segment.beat();
-            events.notify().unwrap();
-            // Lockstep: the next tick after the PLC's cycle (the timeout only covers start-up).
-            let _ = events.wait(Duration::from_millis(2)).unwrap();
-        }
-        cnc_finished.load(Ordering::Acquire)
-    });
-    ready_rx.recv().unwrap();
+    let cnc = tests::serve_axes_in_lockstep(
+        &instance,
+        1,
+        || {
+            let mut x = AxisConfig::linear("X", 1);
+            x.io.probe = ProbeInterface::Canopen;
+            x.drive = DriveLink::Simulated(SimDriveConfig {
+                probe_windows: [Some([20.0017, 30.0]), None],
+                ..SimDriveConfig::default()
+            });
+            AxisSet::new(vec![x], 0.001).unwrap()
+        },
+        finished.clone(),
+    );
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
     let mut program = Sequence {
         finished: finished.clone(),

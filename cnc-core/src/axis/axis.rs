@@ -292,11 +292,16 @@ impl Axis {
             self.drive_reset = Some(0);
             return Ok(self.book.begin(AxisCommandKind::Reset));
         }
-        // Without an error there is nothing to reset: a moving axis goes on undisturbed.
+        self.clear_error();
+        Ok(self.book.instant(AxisCommandKind::Reset))
+    }
+
+    /// Clears the axis error; the axis takes over where it stands. Without an error there is
+    /// nothing to clear: a moving axis goes on undisturbed.
+    fn clear_error(&mut self) {
         if self.error.take().is_some() {
             self.generator.hold(self.actual);
         }
-        Ok(self.book.instant(AxisCommandKind::Reset))
     }
 
     fn may_move(&self, respect_stop_lock: bool) -> Result<(), AxisError> {
@@ -556,8 +561,7 @@ impl Axis {
         if let Some(ticks) = self.drive_reset {
             if !cia402::is_fault(state) {
                 self.drive_reset = None;
-                self.error = None;
-                self.generator.hold(self.actual);
+                self.clear_error();
                 self.book.finish(CommandResult::Done, None);
             } else if ticks >= DRIVE_RESET_TIMEOUT_TICKS {
                 self.drive_reset = None;
