@@ -288,11 +288,6 @@ impl SimulatedDrive {
         (tick as f64 * self.dt * 1e9).round() as u64 as u32
     }
 
-    /// The CiA 402 state (SwitchOnDisabled until the CNC drives it).
-    pub fn state(&self) -> DriveState {
-        self.state
-    }
-
     /// The motor's true position.
     pub fn position(&self) -> f64 {
         self.position
