@@ -191,9 +191,10 @@ fn run(command: &CamCommand) -> Result<(), CliError> {
     }
 }
 
-/// Position, velocity and acceleration over the master, stacked, as SVG.
+/// Position, velocity and acceleration over the master, stacked, as SVG (through
+/// [`crate::app::plot`], like every plot of the tools).
 pub fn plot(profile: &CamProfile, out: &Path, samples: usize) -> Result<(), String> {
-    use plotters::prelude::*;
+    use crate::app::plot::{Figure, Series, Unit};
     let (m0, m1) = profile.master_range();
     let (lo, hi) = (m0.min(m1), m0.max(m1));
     let mut cursor = ProfileCursor::default();
@@ -203,54 +204,28 @@ pub fn plot(profile: &CamProfile, out: &Path, samples: usize) -> Result<(), Stri
             (x, profile.eval(x, &mut cursor))
         })
         .collect();
-    let root = SVGBackend::new(out, (900, 900)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let panels = root.split_evenly((3, 1));
-    type Series = (&'static str, &'static str, fn(&Sample) -> f64, RGBColor);
-    let series: [Series; 3] = [
-        ("slave position", "position", |s| s.position, BLUE),
-        (
-            "slave velocity",
-            "velocity per master unit",
-            |s| s.velocity,
-            RED,
-        ),
-        (
-            "slave acceleration",
-            "acceleration per master unit^2",
-            |s| s.acceleration,
-            GREEN,
-        ),
+    type Curve = (&'static str, &'static str, fn(&Sample) -> f64);
+    let curves: [Curve; 3] = [
+        ("slave position", "slave position", |s| s.position),
+        ("slave velocity", "per master unit", |s| s.velocity),
+        ("slave acceleration", "per master unit²", |s| {
+            s.acceleration
+        }),
     ];
-    for (panel, (title, unit, get, colour)) in panels.iter().zip(series) {
-        let values: Vec<f64> = points.iter().map(|(_, s)| get(s)).collect();
-        let (mut y0, mut y1) = values
+    let figure = Figure {
+        title: "cam profile".into(),
+        x_label: "master position".into(),
+        series: curves
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(*v), b.max(*v))
-            });
-        let pad = ((y1 - y0) * 0.08).max(1e-9);
-        y0 -= pad;
-        y1 += pad;
-        let mut chart = ChartBuilder::on(panel)
-            .caption(title, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(36)
-            .y_label_area_size(70)
-            .build_cartesian_2d(lo..hi, y0..y1)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("master position")
-            .y_desc(unit)
-            .draw()
-            .map_err(|e| e.to_string())?;
-        chart
-            .draw_series(LineSeries::new(
-                points.iter().zip(&values).map(|((x, _), v)| (*x, *v)),
-                colour.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?;
-    }
-    root.present().map_err(|e| e.to_string())
+            .map(|(name, unit, get)| Series {
+                name: (*name).into(),
+                unit: Unit {
+                    label: unit,
+                    scale: 1.0,
+                },
+                points: points.iter().map(|(x, s)| (*x, get(s))).collect(),
+            })
+            .collect(),
+    };
+    figure.save_svg(out).map_err(|e| e.to_string())
 }

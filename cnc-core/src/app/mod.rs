@@ -9,6 +9,7 @@ pub mod demo;
 pub mod fifo_cli;
 pub mod json;
 pub mod kin_cli;
+pub mod plot;
 pub mod saw_cli;
 pub mod scenario;
 pub mod stats;

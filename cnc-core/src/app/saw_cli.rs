@@ -118,6 +118,9 @@ pub struct PlanArgs {
     /// Trace CSV: time, master and slave set-points, `nAxisState`.
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Draw the traced positions and velocities as SVG (`cnc plot` of the trace).
+    #[arg(long)]
+    plot: Option<PathBuf>,
 }
 
 /// The names of the check and operation bits.
@@ -252,7 +255,7 @@ fn plan(args: &PlanArgs) -> Result<String, Failure> {
         jerk: 0.0,
     };
     let plan = saw::plan(&request, &master, &slave, soft).map_err(Failure::Refused)?;
-    if let Some(path) = &args.trace {
+    if args.trace.is_some() || args.plot.is_some() {
         let seconds = plan.charac.values.fMasterPosEnd - plan.charac.values.fMasterPosStart;
         let phase_s = match plan.profile.domain {
             saw::Domain::Master { .. } if master.velocity != 0.0 => {
@@ -268,9 +271,14 @@ fn plan(args: &PlanArgs) -> Result<String, Failure> {
             )));
         }
         let csv = trace(&request, &plan, &master, &slave, soft, args.cycle, duration);
-        std::fs::File::create(path)
-            .and_then(|mut f| f.write_all(csv.as_bytes()))
-            .map_err(|e| Failure::Usage(format!("--trace {}: {e}", path.display())))?;
+        if let Some(path) = &args.trace {
+            std::fs::File::create(path)
+                .and_then(|mut f| f.write_all(csv.as_bytes()))
+                .map_err(|e| Failure::Usage(format!("--trace {}: {e}", path.display())))?;
+        }
+        if let Some(path) = &args.plot {
+            plot_trace(&csv, path).map_err(|e| Failure::Usage(format!("--plot {e}")))?;
+        }
     }
     let fields = plan.charac.values.fields();
     let mut json = String::from("{\n");
@@ -281,6 +289,35 @@ fn plan(args: &PlanArgs) -> Result<String, Failure> {
     }
     json.push('}');
     Ok(json)
+}
+
+/// Master and slave positions and velocities over time, one panel each.
+fn plot_trace(csv: &str, out: &std::path::Path) -> Result<(), crate::app::plot::PlotError> {
+    use crate::app::plot::{Figure, PlotArgs, Table};
+    let table = Table::parse("trace", csv)?;
+    let args = PlotArgs {
+        trace: PathBuf::new(),
+        signals: [
+            "master_position=raw",
+            "slave_position=raw",
+            "master_velocity=raw",
+            "slave_velocity=raw",
+        ]
+        .map(String::from)
+        .to_vec(),
+        out: out.to_path_buf(),
+        title: None,
+        x: None,
+    };
+    let mut figure = Figure::from_table(&table, &args, "flying saw: synchronisation")?;
+    for s in &mut figure.series {
+        s.unit.label = if s.name.ends_with("position") {
+            "position"
+        } else {
+            "velocity /s"
+        };
+    }
+    figure.save_svg(out)
 }
 
 /// The phase tick by tick with the master at constant velocity from coupling on.

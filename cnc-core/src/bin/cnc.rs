@@ -38,6 +38,8 @@ enum Command {
         #[command(subcommand)]
         what: cnc_core::app::saw_cli::SawCommand,
     },
+    /// Plot signals of a trace CSV as SVG (one panel per unit, with legends).
+    Plot(cnc_core::app::plot::PlotArgs),
     /// Kinematics: forward and inverse transformation.
     Kin {
         #[command(subcommand)]
@@ -71,6 +73,7 @@ fn main() -> ExitCode {
             print_or_fail(&text)
         }
         Command::Check(args) => cnc_core::app::check_cli::main(args),
+        Command::Plot(args) => cnc_core::app::plot::main(args),
         Command::Kin { what } => cnc_core::app::kin_cli::main(what),
         Command::Cam { what } => cnc_core::app::cam_cli::main(what),
         Command::Fifo { what } => cnc_core::app::fifo_cli::main(what),
