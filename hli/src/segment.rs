@@ -385,12 +385,30 @@ impl Drop for CncSegment {
     }
 }
 
+/// Detaching: a PLC that leaves takes its pid out of the header (if no other PLC has claimed
+/// the segment since), so the CNC sees no PLC attached rather than one that hangs. The
+/// mapping itself is unmapped by `memory`; the segment stays with the CNC.
+impl Drop for PlcSegment {
+    fn drop(&mut self) {
+        if self.claimed {
+            let pid = self
+                .header()
+                .field::<u32>(offset_of!(HliSegmentHeader, plc_pid));
+            if pid.load() == std::process::id() {
+                pid.store_release(0);
+            }
+        }
+    }
+}
+
 /// The PLC's side: an attached segment, validated against this build's layout.
 pub struct PlcSegment {
     memory: ImageMemory,
     name: String,
     channels: u32,
     axes: u32,
+    /// This process wrote its pid into the header (a PLC, not a tool).
+    claimed: bool,
 }
 
 impl core::fmt::Debug for PlcSegment {
@@ -409,6 +427,16 @@ impl PlcSegment {
 
     /// Attaches expecting `expected` (a PLC built against another layout passes its own).
     pub fn attach_expecting(instance: &str, expected: LayoutIdentity) -> Result<Self, AttachError> {
+        Self::open(instance, expected, true)
+    }
+
+    /// Attaches as a tool beside the PLC (`plc get/set/watch`): the same checks, but the
+    /// header keeps naming the PLC process, which the CNC supervises.
+    pub fn inspect(instance: &str) -> Result<Self, AttachError> {
+        Self::open(instance, LayoutIdentity::current(), false)
+    }
+
+    fn open(instance: &str, expected: LayoutIdentity, claim: bool) -> Result<Self, AttachError> {
         let name = segment_name(instance).ok_or_else(|| AttachError::InvalidName {
             name: instance.to_string(),
         })?;
@@ -482,14 +510,17 @@ impl PlcSegment {
                 axes: h.axis_count,
             });
         }
-        header
-            .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
-            .store(std::process::id());
+        if claim {
+            header
+                .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
+                .store(std::process::id());
+        }
         Ok(Self {
             memory,
             name,
             channels: h.channel_count,
             axes: h.axis_count,
+            claimed: claim,
         })
     }
 

@@ -7,12 +7,27 @@ use crate::timeline::Timeline;
 use core::time::Duration;
 use std::process::ExitCode;
 
-/// Arguments of the PLC process.
+/// The `plc` command line: run a PLC program, or a tool on a running CNC's image.
 #[derive(Debug, Clone, clap::Parser)]
-#[command(name = "plc", about = "PLC process attached to a CNC's HLI segment")]
+#[command(
+    name = "plc",
+    about = "PLC process attached to a CNC's HLI segment, and tools to read and write its image",
+    args_conflicts_with_subcommands = true
+)]
+pub struct PlcCli {
+    /// A tool instead of a PLC program.
+    #[command(subcommand)]
+    pub tool: Option<crate::tools::ToolCommand>,
+    /// The PLC program to run.
+    #[command(flatten)]
+    pub run: PlcArgs,
+}
+
+/// Arguments of the PLC process.
+#[derive(Debug, Clone, clap::Args)]
 pub struct PlcArgs {
     /// CNC instance to attach to.
-    #[arg(long)]
+    #[arg(long, default_value = crate::tools::DEFAULT_INSTANCE)]
     pub instance: String,
     /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0).
     #[arg(long, default_value = "rotary-table")]
@@ -55,8 +70,16 @@ pub struct PlcArgs {
 /// Names of the built-in programs.
 pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor", "fifo-stream", "saw-cut"];
 
+/// Runs a tool, or the PLC process (exit code 0 when the CNC closed in order).
+pub fn main(cli: PlcCli) -> ExitCode {
+    match cli.tool {
+        Some(tool) => crate::tools::main(tool),
+        None => run(cli.run),
+    }
+}
+
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
-pub fn main(args: PlcArgs) -> ExitCode {
+pub fn run(args: PlcArgs) -> ExitCode {
     let mut program: Box<dyn PlcProgram> = match (&args.timeline, args.program.as_str()) {
         (Some(path), _) => match Timeline::load(path) {
             Ok(t) => Box::new(t),

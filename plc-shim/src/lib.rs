@@ -15,5 +15,6 @@ pub mod realtime;
 pub mod runtime;
 pub mod saw;
 pub mod timeline;
+pub mod tools;
 
 pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

@@ -45,9 +45,10 @@ enum Command {
         #[command(subcommand)]
         what: cnc_core::app::kin_cli::KinCommand,
     },
-    /// Run the PLC process (what `cnc demo` spawns; same as the `plc` binary).
-    #[command(hide = true)]
-    Plc(plc_shim::cli::PlcArgs),
+    /// The PLC process (what `cnc demo` spawns) and the image tools `get`, `set`, `watch`;
+    /// the same as the `plc` binary.
+    #[command(args_conflicts_with_subcommands = true)]
+    Plc(plc_shim::cli::PlcCli),
 }
 
 #[derive(Debug, Subcommand)]

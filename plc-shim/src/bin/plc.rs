@@ -5,5 +5,5 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     hli::init_logging();
-    plc_shim::cli::main(plc_shim::cli::PlcArgs::parse())
+    plc_shim::cli::main(plc_shim::cli::PlcCli::parse())
 }

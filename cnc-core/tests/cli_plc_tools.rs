@@ -1,0 +1,168 @@
+//! `plc get`, `plc set`, `plc watch` (here as `cnc plc ...`, the same code as the `plc`
+//! binary) against a live CNC: values read and written by ST path, writes held to the
+//! handshake protocol, bad input refused with its exit code and nothing written, and a clear
+//! message once no CNC runs. Waits are polls with watchdogs.
+
+use std::path::PathBuf;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const ENABLE: &str = "gpCh[0]^channel_mc_control.dyn_cs.enable_w";
+const ROTATION: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";
+const COMMAND_SEM: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_semaphore_rw";
+const ACK_CODE: &str = "gpCh[0]^channel_mc_control.m_function.ack_w.m_code";
+const ACK_SEM: &str = "gpCh[0]^channel_mc_control.m_function.ack_semaphore_rw";
+const STATE: &str = "gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state";
+const BEAT: &str = "header.cnc_heartbeat";
+
+fn cnc(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn tool(instance: &str, args: &[&str]) -> (i32, String, String) {
+    let mut all = vec!["plc"];
+    all.extend_from_slice(args);
+    all.extend_from_slice(&["--instance", instance]);
+    let o = cnc(&all);
+    (
+        o.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// The value `plc get` prints for `path`.
+fn get(instance: &str, path: &str) -> String {
+    let (code, out, err) = tool(instance, &["get", path]);
+    assert_eq!(code, 0, "{err}");
+    out.trim()
+        .strip_prefix(&format!("{path} = "))
+        .unwrap_or_else(|| panic!("{out}"))
+        .to_string()
+}
+
+/// A CNC running a scenario without a PLC, for ten minutes at most (the test ends it).
+fn start_cnc(instance: &str) -> Child {
+    let dir = std::env::temp_dir().join(format!("plc-tools-{instance}"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let program = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/supervision/long.nc");
+    std::fs::write(
+        dir.join("scenario.toml"),
+        format!(
+            "cycle_ms = 1.0\n[[channel]]\nname = \"portal\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = {:?}\n",
+            program.display().to_string()
+        ),
+    )
+    .unwrap();
+    Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
+        .args(["--instance", instance, "--ticks", "600000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Polls `check` until it holds (watchdog 30 s).
+fn wait_until(what: &str, mut check: impl FnMut() -> bool) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while !check() {
+        assert!(Instant::now() < deadline, "watchdog: {what}");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+#[test]
+fn get_set_and_watch_a_live_cnc_by_st_path() {
+    let instance = format!("plctools-{}", std::process::id());
+    let mut child = start_cnc(&instance);
+    wait_until("the CNC ticks", || {
+        let (code, out, _) = tool(&instance, &["get", BEAT]);
+        code == 0 && !out.trim().ends_with(" 0")
+    });
+
+    // A plain PLC leaf: read, written, read back.
+    assert_eq!(get(&instance, ENABLE), "FALSE");
+    let (code, out, err) = tool(&instance, &["set", ENABLE, "TRUE"]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(out.trim(), format!("{ENABLE} := TRUE"));
+    assert_eq!(get(&instance, ENABLE), "TRUE");
+
+    // A dynamic-CS command published with its semaphore: the CNC takes it (clears the
+    // semaphore) in its next tick.
+    let (code, _, err) = tool(
+        &instance,
+        &["set", ROTATION, "-900000", COMMAND_SEM, "TRUE"],
+    );
+    assert_eq!(code, 0, "{err}");
+    wait_until("the CNC takes the command", || {
+        get(&instance, COMMAND_SEM) == "FALSE"
+    });
+    assert_eq!(get(&instance, ROTATION), "-900000");
+
+    // An M-function acknowledge nobody awaits stays pending: its payload is then refused
+    // (exit 4) and keeps its value, and so is a second publish.
+    let (code, _, err) = tool(&instance, &["set", ACK_CODE, "5", ACK_SEM, "TRUE"]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = tool(&instance, &["set", ACK_CODE, "6"]);
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("has not taken the previous datum"), "{err}");
+    assert_eq!(get(&instance, ACK_CODE), "5");
+    let (code, _, err) = tool(&instance, &["set", ACK_SEM, "TRUE"]);
+    assert_eq!(code, 4, "{err}");
+
+    // The CNC's own leaves are read-only.
+    let (code, _, err) = tool(&instance, &["set", STATE, "2"]);
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("written by the CNC"), "{err}");
+
+    // Bad input: exit 2, nothing written (the first, valid pair is not written either).
+    for (pairs, message) in [
+        (
+            vec![ENABLE, "FALSE", "gpCh[0]^nope", "1"],
+            "no symbol `gpCh[0]^nope`",
+        ),
+        (vec![ENABLE, "FALSE", ROTATION, "0.5"], "does not fit"),
+        (vec![ENABLE, "FALSE", ROTATION, "lots"], "is not a number"),
+        (vec![ENABLE, "2"], "does not fit"),
+    ] {
+        let mut args = vec!["set"];
+        args.extend(pairs);
+        let (code, _, err) = tool(&instance, &args);
+        assert_eq!(code, 2, "{err}");
+        assert!(err.contains(message), "{err}");
+        assert_eq!(get(&instance, ENABLE), "TRUE");
+    }
+    let (code, _, err) = tool(&instance, &["get", "gpAx[99]^lr_state"]);
+    assert_eq!(code, 2, "{err}");
+
+    // Watch: a header, then one line per interval with the CNC's tick rising.
+    let (code, out, err) = tool(
+        &instance,
+        &["watch", BEAT, ENABLE, "--interval", "20", "--count", "3"],
+    );
+    assert_eq!(code, 0, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines[0], format!("cnc_tick {BEAT} {ENABLE}"));
+    assert_eq!(lines.len(), 4, "{out}");
+    let ticks: Vec<u64> = lines[1..]
+        .iter()
+        .map(|l| l.split(' ').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(ticks.windows(2).all(|w| w[0] < w[1]), "{ticks:?}");
+    assert!(lines[1..].iter().all(|l| l.ends_with(" TRUE")), "{out}");
+
+    // The CNC ends: the tools say so with exit 1.
+    let ok = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let _ = child.wait();
+    let (code, _, err) = tool(&instance, &["get", ENABLE]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("is the CNC running?"), "{err}");
+}

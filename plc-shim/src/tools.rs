@@ -1,0 +1,529 @@
+//! `plc get`, `plc set`, `plc watch`: single leaves of a running CNC's image by ST path (the
+//! paths of `cnc hli symbols`), from a shell, beside the PLC process.
+//!
+//! A tool attaches like a PLC (same layout checks) but does not claim the segment: the CNC
+//! keeps supervising its PLC. Writes follow the handshake protocol of the control units, so a
+//! tool cannot tear a datum the other side owns:
+//!
+//! | leaf                                   | written when                | value        |
+//! |----------------------------------------|-----------------------------|--------------|
+//! | CNC-owned (`*_r`, states)              | never                       |              |
+//! | payload of a PLC→CNC unit (`X_w.*`)    | its `X_semaphore_rw` FALSE  | any in range |
+//! | `X_semaphore_rw` of a PLC→CNC unit     | it is FALSE                 | TRUE only    |
+//! | `X_semaphore_rw` of a CNC→PLC unit     | it is TRUE                  | FALSE only   |
+//! | `transition_w.*` parameters            | `transition_w.command` is 0 | any in range |
+//! | `transition_w.command`                 | it is 0                     | not 0        |
+//! | other PLC-owned leaves (`enable_w`)    | always                      | any in range |
+//!
+//! `plc set` takes PATH VALUE pairs, checks all of them (each against the state the earlier
+//! pairs leave) and writes only if every one passes, in the order given: payload first, then
+//! its semaphore publishes it. Exit codes: 0 done, 1 no CNC to attach to, 2 bad input
+//! (unknown path, value of the wrong type or range), 4 refused by the protocol.
+
+use core::time::Duration;
+use hli::access::{AccessError, Leaf, Value};
+use hli::desc::{Scalar, SymbolWriter};
+use hli::enums::SegmentState;
+use hli::segment::{AttachError, PlcSegment};
+use hli::symbols::SymbolTable;
+use hli::ImageMemory;
+use std::process::ExitCode;
+
+/// Instance `cnc demo` runs as, and the tools' default.
+pub const DEFAULT_INSTANCE: &str = "cnc-demo";
+
+/// The tool commands of the `plc` binary.
+#[derive(Debug, Clone, clap::Subcommand)]
+pub enum ToolCommand {
+    /// Print leaves of a running CNC's image: `PATH = VALUE` per line.
+    Get {
+        /// ST paths (see `cnc hli symbols`).
+        #[arg(required = true)]
+        paths: Vec<String>,
+        /// CNC instance.
+        #[arg(long, default_value = DEFAULT_INSTANCE)]
+        instance: String,
+    },
+    /// Write leaves by the handshake protocol: PATH VALUE [PATH VALUE ...], all or nothing.
+    Set {
+        /// PATH VALUE pairs; values are numbers, TRUE or FALSE.
+        #[arg(required = true, num_args = 2.., allow_negative_numbers = true)]
+        pairs: Vec<String>,
+        /// CNC instance.
+        #[arg(long, default_value = DEFAULT_INSTANCE)]
+        instance: String,
+    },
+    /// Print leaves every interval until the CNC ends (or `--count` lines).
+    Watch {
+        /// ST paths.
+        #[arg(required = true)]
+        paths: Vec<String>,
+        /// Interval, ms.
+        #[arg(long, default_value_t = 100)]
+        interval: u64,
+        /// Stop after this many lines.
+        #[arg(long)]
+        count: Option<u64>,
+        /// CNC instance.
+        #[arg(long, default_value = DEFAULT_INSTANCE)]
+        instance: String,
+    },
+}
+
+/// Why a tool did not do what it was asked.
+#[derive(Debug, thiserror::Error)]
+pub enum ToolError {
+    /// No CNC to attach to (or one of another layout).
+    #[error("{0}")]
+    Attach(#[from] AttachError),
+    /// An unknown path, or a value of the wrong type or range.
+    #[error("{0}")]
+    Access(#[from] AccessError),
+    /// A value that is not a number, TRUE or FALSE.
+    #[error("`{value}` for `{path}` is not a number, TRUE or FALSE")]
+    NotAValue {
+        /// The path.
+        path: String,
+        /// The text given.
+        value: String,
+    },
+    /// PATH without a VALUE.
+    #[error("`{0}` has no value: give PATH VALUE pairs")]
+    MissingValue(String),
+    /// The protocol forbids this write now.
+    #[error("`{path}`: {reason}")]
+    Refused {
+        /// The path.
+        path: String,
+        /// Why.
+        reason: Refusal,
+    },
+}
+
+/// Why the protocol refused a write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum Refusal {
+    /// The CNC writes this leaf.
+    #[error("written by the CNC, read-only for the PLC")]
+    CncOwned,
+    /// The payload's semaphore is TRUE: the CNC has not taken the previous datum.
+    #[error("the CNC has not taken the previous datum yet (its semaphore is TRUE)")]
+    Pending,
+    /// A PLC→CNC semaphore may only be set TRUE, and only while FALSE.
+    #[error("a PLC-to-CNC semaphore is set TRUE (publish) while FALSE; the CNC clears it")]
+    PublishOnly,
+    /// A CNC→PLC semaphore may only be cleared, and only while TRUE.
+    #[error("a CNC-to-PLC semaphore is set FALSE (taken) while TRUE; the CNC sets it")]
+    TakeOnly,
+    /// The transition's command word is not 0: the CNC has not taken the previous command.
+    #[error("the CNC has not taken the previous transition command yet (command is not 0)")]
+    CommandPending,
+    /// A transition command must not be 0 (the CNC writes 0 when it takes one).
+    #[error("write a command other than 0; the CNC writes 0 when it takes one")]
+    CommandZero,
+}
+
+impl ToolError {
+    /// The exit code of this failure.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            ToolError::Attach(_) => 1,
+            ToolError::Refused { .. } => 4,
+            _ => 2,
+        }
+    }
+}
+
+/// How a leaf takes part in a handshake.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Role {
+    /// Written by the CNC only.
+    CncOwned,
+    /// A PLC leaf outside any handshake.
+    Free,
+    /// Payload published by this semaphore (PLC→CNC).
+    Payload(Leaf),
+    /// The semaphore of a PLC→CNC unit.
+    PublishSemaphore,
+    /// The semaphore of a CNC→PLC unit.
+    TakeSemaphore,
+    /// A parameter of a unit guarded by this command word.
+    Parameter(Leaf),
+    /// A command word (0 = free).
+    CommandWord,
+}
+
+/// The handshake role of `path`, from the symbol table's naming rule: in a unit, the field
+/// `X_semaphore_rw` guards its sibling `X_w` (PLC→CNC) or `X_r` (CNC→PLC); a struct with a
+/// `command` leaf both sides write is guarded by it.
+fn role(path: &str, leaf: &Leaf) -> Role {
+    let table = SymbolTable::global();
+    let sym = |p: &str| table.lookup(p).map(|s| s.writer);
+    if let Some(unit) = path.strip_suffix("_semaphore_rw") {
+        // `unit` is `...prefix.X`: the sibling payload is `X_w` or `X_r`.
+        return if sym(&format!("{unit}_w")).is_some() {
+            Role::PublishSemaphore
+        } else {
+            Role::TakeSemaphore
+        };
+    }
+    if leaf.writer == SymbolWriter::Both && path.ends_with(".command") {
+        return Role::CommandWord;
+    }
+    if leaf.writer == SymbolWriter::Cnc {
+        return Role::CncOwned;
+    }
+    // Walk the path's components from the leaf up: the first `X_w` with a sibling
+    // `X_semaphore_rw`, or the first struct with a shared `command` word, guards it.
+    let mut end = path.len();
+    while let Some(dot) = path[..end].rfind(['.', '^']) {
+        let component = &path[..end];
+        if let Some(stem) = component.strip_suffix("_w") {
+            if let Ok(sem) = Leaf::resolve(&format!("{stem}_semaphore_rw")) {
+                return Role::Payload(sem);
+            }
+        }
+        if let Ok(command) = Leaf::resolve(&format!("{component}.command")) {
+            if command.writer == SymbolWriter::Both && component.len() < path.len() {
+                return Role::Parameter(command);
+            }
+        }
+        end = dot;
+    }
+    Role::Free
+}
+
+/// Parses a value for `leaf`: TRUE/FALSE, a decimal or `0x` hexadecimal integer, or a
+/// number with a fraction or exponent.
+fn parse_value(path: &str, text: &str, leaf: &Leaf) -> Result<Value, ToolError> {
+    let bad = || ToolError::NotAValue {
+        path: path.to_string(),
+        value: text.to_string(),
+    };
+    let t = text.trim();
+    let value = match t.to_ascii_uppercase().as_str() {
+        "TRUE" => Value::Unsigned(1),
+        "FALSE" => Value::Unsigned(0),
+        upper => {
+            if let Some(hex) = upper.strip_prefix("0X") {
+                Value::Unsigned(u64::from_str_radix(hex, 16).map_err(|_| bad())?)
+            } else if let Ok(i) = t.parse::<i64>() {
+                Value::Int(i)
+            } else if let Ok(u) = t.parse::<u64>() {
+                Value::Unsigned(u)
+            } else {
+                Value::Real(t.parse::<f64>().map_err(|_| bad())?)
+            }
+        }
+    };
+    Ok(leaf.check(path, value)?)
+}
+
+/// Shows a value the way ST writes it (BOOL as TRUE/FALSE).
+pub fn show(leaf: &Leaf, value: Value) -> String {
+    match (leaf.scalar, value) {
+        (Scalar::Bool, Value::Unsigned(0)) => "FALSE".into(),
+        (Scalar::Bool, Value::Unsigned(_)) => "TRUE".into(),
+        _ => value.to_string(),
+    }
+}
+
+fn resolve_all(paths: &[String]) -> Result<Vec<Leaf>, ToolError> {
+    paths
+        .iter()
+        .map(|p| Leaf::resolve(p).map_err(ToolError::from))
+        .collect()
+}
+
+/// One checked write.
+#[derive(Debug, Clone, Copy)]
+pub struct Write {
+    /// The leaf.
+    pub leaf: Leaf,
+    /// The value, in range.
+    pub value: Value,
+}
+
+/// Checks `pairs` (PATH VALUE ...) against the image and the protocol; each pair sees the
+/// state the pairs before it leave. Nothing is written.
+pub fn plan_writes(memory: &ImageMemory, pairs: &[String]) -> Result<Vec<Write>, ToolError> {
+    let mut writes: Vec<Write> = Vec::new();
+    for pair in pairs.chunks(2) {
+        let path = &pair[0];
+        let Some(text) = pair.get(1) else {
+            return Err(ToolError::MissingValue(path.clone()));
+        };
+        let leaf = Leaf::resolve(path)?;
+        let value = parse_value(path, text, &leaf)?;
+        // The value of a leaf after the writes planned so far.
+        let now = |l: &Leaf| {
+            writes
+                .iter()
+                .rev()
+                .find(|w| w.leaf.offset == l.offset)
+                .map_or_else(|| l.read(memory), |w| w.value)
+                .as_f64()
+        };
+        let refuse = |reason| {
+            Err(ToolError::Refused {
+                path: path.clone(),
+                reason,
+            })
+        };
+        match role(path, &leaf) {
+            Role::CncOwned => return refuse(Refusal::CncOwned),
+            Role::Free => {}
+            Role::Payload(sem) if now(&sem) != 0.0 => return refuse(Refusal::Pending),
+            Role::Payload(_) => {}
+            Role::PublishSemaphore if now(&leaf) != 0.0 || value.as_f64() == 0.0 => {
+                return refuse(Refusal::PublishOnly)
+            }
+            Role::PublishSemaphore => {}
+            Role::TakeSemaphore if now(&leaf) == 0.0 || value.as_f64() != 0.0 => {
+                return refuse(Refusal::TakeOnly)
+            }
+            Role::TakeSemaphore => {}
+            Role::Parameter(command) if now(&command) != 0.0 => {
+                return refuse(Refusal::CommandPending)
+            }
+            Role::Parameter(_) => {}
+            Role::CommandWord if value.as_f64() == 0.0 => return refuse(Refusal::CommandZero),
+            Role::CommandWord if now(&leaf) != 0.0 => return refuse(Refusal::CommandPending),
+            Role::CommandWord => {}
+        }
+        writes.push(Write { leaf, value });
+    }
+    Ok(writes)
+}
+
+fn attach(instance: &str) -> Result<PlcSegment, ToolError> {
+    Ok(PlcSegment::inspect(instance)?)
+}
+
+/// `plc get`: the lines it prints.
+pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
+    let leaves = resolve_all(paths)?;
+    let segment = attach(instance)?;
+    Ok(paths
+        .iter()
+        .zip(&leaves)
+        .map(|(p, l)| format!("{p} = {}", show(l, l.read(segment.memory()))))
+        .collect())
+}
+
+/// `plc set`: checks every pair, then writes them in order; returns the lines it prints.
+pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
+    // Paths and values first, so a typo is reported the same with or without a CNC.
+    for pair in pairs.chunks(2) {
+        let leaf = Leaf::resolve(&pair[0])?;
+        match pair.get(1) {
+            Some(text) => drop(parse_value(&pair[0], text, &leaf)?),
+            None => return Err(ToolError::MissingValue(pair[0].clone())),
+        }
+    }
+    let segment = attach(instance)?;
+    let writes = plan_writes(segment.memory(), pairs)?;
+    Ok(pairs
+        .chunks(2)
+        .zip(writes)
+        .map(|(pair, w)| {
+            w.leaf.write(segment.memory(), w.value);
+            format!("{} := {}", pair[0], show(&w.leaf, w.value))
+        })
+        .collect())
+}
+
+/// Runs a tool command; prints its output and returns the exit code.
+pub fn main(command: ToolCommand) -> ExitCode {
+    let result = match &command {
+        ToolCommand::Get { paths, instance } => get(instance, paths).map(print_lines),
+        ToolCommand::Set { pairs, instance } => set(instance, pairs).map(print_lines),
+        ToolCommand::Watch {
+            paths,
+            interval,
+            count,
+            instance,
+        } => watch(
+            instance,
+            paths,
+            Duration::from_millis((*interval).max(1)),
+            *count,
+        ),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("plc: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}
+
+fn print_lines(lines: Vec<String>) {
+    for line in lines {
+        println!("{line}");
+    }
+}
+
+/// `plc watch`: a header line of the paths, then `TICK VALUE...` every interval until the
+/// CNC closes its segment, a signal arrives or `count` lines are printed.
+fn watch(
+    instance: &str,
+    paths: &[String],
+    interval: Duration,
+    count: Option<u64>,
+) -> Result<(), ToolError> {
+    use std::io::Write as _;
+    let leaves = resolve_all(paths)?;
+    let segment = attach(instance)?;
+    hli::signals::capture();
+    let mut out = std::io::stdout().lock();
+    let header = format!("cnc_tick {}", paths.join(" "));
+    if writeln!(out, "{header}").is_err() {
+        return Ok(());
+    }
+    let mut printed = 0u64;
+    while count.is_none_or(|c| printed < c) {
+        if segment.cnc_state() != Ok(SegmentState::Ready) {
+            eprintln!("plc watch: the CNC closed its segment");
+            break;
+        }
+        if hli::signals::take().is_some() {
+            break;
+        }
+        let mut line = segment.cnc_heartbeat().to_string();
+        for leaf in &leaves {
+            line.push(' ');
+            line.push_str(&show(leaf, leaf.read(segment.memory())));
+        }
+        // A closed pipe (`plc watch ... | head`) ends the watch quietly.
+        if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {
+            break;
+        }
+        printed += 1;
+        if count.is_none_or(|c| printed < c) {
+            std::thread::sleep(interval);
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hli::segment::heap_image;
+
+    const SEM: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_semaphore_rw";
+    const ROT: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";
+    const REQ_SEM: &str = "gpCh[0]^channel_mc_control.dyn_cs.request_semaphore_rw";
+    const ENABLE: &str = "gpCh[0]^channel_mc_control.dyn_cs.enable_w";
+    const T_CMD: &str = "gpCh[0]^channel_mc_control.dyn_cs.transition_w.command";
+    const T_FILTER: &str = "gpCh[0]^channel_mc_control.dyn_cs.transition_w.filter_max_ticks";
+    const STATE: &str = "gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state";
+
+    fn pairs(p: &[&str]) -> Vec<String> {
+        p.iter().map(|s| s.to_string()).collect()
+    }
+
+    fn refusal(memory: &ImageMemory, p: &[&str]) -> Option<Refusal> {
+        match plan_writes(memory, &pairs(p)) {
+            Err(ToolError::Refused { reason, .. }) => Some(reason),
+            Ok(_) => None,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    fn apply(memory: &ImageMemory, p: &[&str]) {
+        for w in plan_writes(memory, &pairs(p)).unwrap() {
+            w.leaf.write(memory, w.value);
+        }
+    }
+
+    #[test]
+    fn roles_follow_the_naming_rule() {
+        let r = |p: &str| role(p, &Leaf::resolve(p).unwrap());
+        assert_eq!(r(SEM), Role::PublishSemaphore);
+        assert_eq!(r(REQ_SEM), Role::TakeSemaphore);
+        assert_eq!(r(ROT), Role::Payload(Leaf::resolve(SEM).unwrap()));
+        assert_eq!(r(ENABLE), Role::Free);
+        assert_eq!(r(T_CMD), Role::CommandWord);
+        assert_eq!(r(T_FILTER), Role::Parameter(Leaf::resolve(T_CMD).unwrap()));
+        assert_eq!(r(STATE), Role::CncOwned);
+        let ack = "gpCh[2]^channel_mc_control.m_function.ack_w.m_code";
+        let ack_sem = "gpCh[2]^channel_mc_control.m_function.ack_semaphore_rw";
+        assert_eq!(r(ack), Role::Payload(Leaf::resolve(ack_sem).unwrap()));
+        assert_eq!(r(ack_sem), Role::PublishSemaphore);
+        assert_eq!(
+            r("gpCh[2]^channel_mc_control.m_function.request_semaphore_rw"),
+            Role::TakeSemaphore
+        );
+    }
+
+    #[test]
+    fn a_payload_is_written_only_while_its_semaphore_is_false() {
+        let memory = heap_image(1, 1);
+        apply(&memory, &[ROT, "900000", SEM, "TRUE"]);
+        assert_eq!(
+            Leaf::resolve(ROT).unwrap().read(&memory),
+            Value::Int(900_000)
+        );
+        assert_eq!(refusal(&memory, &[ROT, "1"]), Some(Refusal::Pending));
+        assert_eq!(refusal(&memory, &[SEM, "TRUE"]), Some(Refusal::PublishOnly));
+        assert_eq!(
+            refusal(&memory, &[SEM, "FALSE"]),
+            Some(Refusal::PublishOnly)
+        );
+        // The order counts: the semaphore last publishes, first blocks the payload.
+        let fresh = heap_image(1, 1);
+        assert_eq!(
+            refusal(&fresh, &[SEM, "TRUE", ROT, "1"]),
+            Some(Refusal::Pending)
+        );
+        assert_eq!(refusal(&fresh, &[ROT, "1", SEM, "TRUE"]), None);
+    }
+
+    #[test]
+    fn cnc_leaves_semaphores_and_commands_keep_their_direction() {
+        let memory = heap_image(1, 1);
+        assert_eq!(refusal(&memory, &[STATE, "2"]), Some(Refusal::CncOwned));
+        assert_eq!(
+            refusal(&memory, &[REQ_SEM, "TRUE"]),
+            Some(Refusal::TakeOnly)
+        );
+        assert_eq!(
+            refusal(&memory, &[REQ_SEM, "FALSE"]),
+            Some(Refusal::TakeOnly)
+        );
+        Leaf::resolve(REQ_SEM)
+            .unwrap()
+            .write(&memory, Value::Unsigned(1));
+        assert_eq!(refusal(&memory, &[REQ_SEM, "FALSE"]), None);
+        assert_eq!(refusal(&memory, &[T_CMD, "0"]), Some(Refusal::CommandZero));
+        apply(&memory, &[T_FILTER, "200", T_CMD, "1"]);
+        assert_eq!(
+            refusal(&memory, &[T_FILTER, "5"]),
+            Some(Refusal::CommandPending)
+        );
+        assert_eq!(
+            refusal(&memory, &[T_CMD, "2"]),
+            Some(Refusal::CommandPending)
+        );
+        assert_eq!(refusal(&memory, &[ENABLE, "TRUE"]), None);
+    }
+
+    #[test]
+    fn bad_values_are_refused_before_anything_is_written() {
+        let memory = heap_image(1, 1);
+        for (p, v) in [(ENABLE, "2"), (ROT, "0.5"), (ROT, "abc"), (ROT, "1e12")] {
+            let e = plan_writes(&memory, &pairs(&[ROT, "7", p, v])).unwrap_err();
+            assert_eq!(e.exit_code(), 2, "{e}");
+        }
+        assert_eq!(Leaf::resolve(ROT).unwrap().read(&memory), Value::Int(0));
+        let e = plan_writes(&memory, &pairs(&["gpCh[0]^nope", "1"])).unwrap_err();
+        assert!(e.to_string().contains("no symbol `gpCh[0]^nope`"), "{e}");
+        assert!(matches!(
+            plan_writes(&memory, &pairs(&[ROT])),
+            Err(ToolError::MissingValue(_))
+        ));
+    }
+}
