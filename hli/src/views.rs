@@ -391,6 +391,19 @@ pub struct PlcView<'m> {
     nav: Nav<'m>,
 }
 
+/// The PLC's view of one channel, `gpCh[i]^` (from [`PlcView::gp_ch`]): the channel's
+/// control units without an index to check at every access.
+#[derive(Debug, Clone, Copy)]
+pub struct PlcChannel<'m> {
+    block: Place<'m, HliChannel>,
+}
+
+/// The PLC's view of one axis, `gpAx[i]^` (from [`PlcView::gp_ax`]).
+#[derive(Debug, Clone, Copy)]
+pub struct PlcAxis<'m> {
+    block: Place<'m, HliAxis>,
+}
+
 impl<'m> PlcView<'m> {
     /// View of `memory`.
     pub fn new(memory: &'m ImageMemory) -> Self {
@@ -419,16 +432,26 @@ impl<'m> PlcView<'m> {
         self.nav.axis(index)
     }
 
+    /// Channel `index` (`gpCh[index]^`), `None` beyond the configured channels.
+    pub fn gp_ch(&self, index: usize) -> Option<PlcChannel<'m>> {
+        self.ch(index).ok()
+    }
+
+    /// Axis `index` (`gpAx[index]^`), `None` beyond the configured axes.
+    pub fn gp_ax(&self, index: usize) -> Option<PlcAxis<'m>> {
+        self.nav.axis(index).ok().map(|block| PlcAxis { block })
+    }
+
+    fn ch(&self, index: usize) -> Result<PlcChannel<'m>, IndexError> {
+        self.nav.channel(index).map(|block| PlcChannel { block })
+    }
+
     /// Writes `command_w` (command pattern).
     pub fn dyn_cs_command(
         &self,
         channel: usize,
     ) -> Result<Writer<'m, HliCoordinateSystemInt>, IndexError> {
-        let unit = self.nav.dyn_cs(channel)?;
-        Ok(Writer::new(
-            unit_field!(unit, McControlDynCsUnit, command_semaphore_rw),
-            unit_field!(unit, McControlDynCsUnit, command_w),
-        ))
+        Ok(self.ch(channel)?.dyn_cs_command())
     }
 
     /// Reads `request_r` (request pattern).
@@ -436,29 +459,17 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Reader<'m, HliCoordinateSystemInt>, IndexError> {
-        let unit = self.nav.dyn_cs(channel)?;
-        Ok(Reader::new(
-            unit_field!(unit, McControlDynCsUnit, request_semaphore_rw),
-            unit_field!(unit, McControlDynCsUnit, request_r),
-        ))
+        Ok(self.ch(channel)?.dyn_cs_request())
     }
 
     /// Writes `transition_w`.
     pub fn dyn_cs_transition(&self, channel: usize) -> Result<TransitionWriter<'m>, IndexError> {
-        let unit = self.nav.dyn_cs(channel)?;
-        Ok(TransitionWriter::new(unit_field!(
-            unit,
-            McControlDynCsUnit,
-            transition_w
-        )))
+        Ok(self.ch(channel)?.dyn_cs_transition())
     }
 
     /// Takes over (or releases) the unit: `enable_w`.
     pub fn set_dyn_cs_enabled(&self, channel: usize, enabled: bool) -> Result<(), IndexError> {
-        let unit = self.nav.dyn_cs(channel)?;
-        unit.field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
-            .cast::<u8>()
-            .store_release(u8::from(enabled));
+        self.ch(channel)?.set_dyn_cs_enabled(enabled);
         Ok(())
     }
 
@@ -467,12 +478,7 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Result<DynCsState, InvalidValue>, IndexError> {
-        let unit = self.nav.dyn_cs(channel)?;
-        let raw = unit
-            .field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
-            .field::<u32>(offset_of!(HliDynCsState, actual_state))
-            .load_acquire();
-        Ok(DynCsState::decode(raw))
+        Ok(self.ch(channel)?.dyn_cs_state())
     }
 
     /// FIFO group status `gpFifo[index]^` as the CNC published it (the fill level a
@@ -484,32 +490,18 @@ impl<'m> PlcView<'m> {
 
     /// Commands the path override and feed hold of `channel` (`path_override.*_w`).
     pub fn set_path_override(&self, channel: usize, value: PathOverride) -> Result<(), IndexError> {
-        let unit = self.nav.path_override(channel)?;
-        unit_field!(unit, HliChannelOverrideUnit, feed_override_w).store(value.feed_permille);
-        unit_field!(unit, HliChannelOverrideUnit, rapid_override_w).store(value.rapid_permille);
-        unit.field::<Bool>(offset_of!(HliChannelOverrideUnit, feed_hold_w))
-            .cast::<u8>()
-            .store_release(u8::from(value.feed_hold));
+        self.ch(channel)?.set_path_override(value);
         Ok(())
     }
 
     /// The feed override the channel applies (`feed_override_r`, 0.1 %).
     pub fn feed_override_applied(&self, channel: usize) -> Result<u32, IndexError> {
-        Ok(self
-            .nav
-            .path_override(channel)?
-            .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
-            .load())
+        Ok(self.ch(channel)?.feed_override_applied())
     }
 
     /// The path feed the CNC published for `channel` (`path_feed_r`, 1 um/s).
     pub fn path_feed(&self, channel: usize) -> Result<i32, IndexError> {
-        Ok(self
-            .nav
-            .channel(channel)?
-            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
-            .field::<i32>(offset_of!(HliBahnState, path_feed_r))
-            .load())
+        Ok(self.ch(channel)?.path_feed())
     }
 
     /// The channel's error (`error_id_r`), validated.
@@ -517,13 +509,7 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Result<crate::enums::ChannelErrorId, InvalidValue>, IndexError> {
-        let raw = self
-            .nav
-            .channel(channel)?
-            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
-            .field::<u32>(offset_of!(HliBahnState, error_id_r))
-            .load();
-        Ok(crate::enums::ChannelErrorId::decode(raw))
+        Ok(self.ch(channel)?.channel_error())
     }
 
     /// The program state the CNC published for `channel` (`program_state_r`), validated.
@@ -531,13 +517,7 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Result<crate::enums::ProgramState, InvalidValue>, IndexError> {
-        let raw = self
-            .nav
-            .channel(channel)?
-            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
-            .field::<i32>(offset_of!(HliBahnState, program_state_r))
-            .load();
-        Ok(crate::enums::ProgramState::decode(raw))
+        Ok(self.ch(channel)?.program_state())
     }
 
     /// Reads M-function announcements (request pattern).
@@ -545,11 +525,7 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Reader<'m, HliMFunctionRequest>, IndexError> {
-        let unit = self.nav.m_function(channel)?;
-        Ok(Reader::new(
-            unit_field!(unit, HliMFunctionUnit, request_semaphore_rw),
-            unit_field!(unit, HliMFunctionUnit, request_r),
-        ))
+        Ok(self.ch(channel)?.m_function_request())
     }
 
     /// Acknowledges M functions (command pattern).
@@ -557,20 +533,170 @@ impl<'m> PlcView<'m> {
         &self,
         channel: usize,
     ) -> Result<Writer<'m, HliMFunctionAck>, IndexError> {
-        let unit = self.nav.m_function(channel)?;
-        Ok(Writer::new(
-            unit_field!(unit, HliMFunctionUnit, ack_semaphore_rw),
-            unit_field!(unit, HliMFunctionUnit, ack_w),
-        ))
+        Ok(self.ch(channel)?.m_function_ack())
     }
 
     /// The axis cyclic state, copied out.
     pub fn axis_state(&self, axis: usize) -> Result<HliAxisLrState, IndexError> {
-        Ok(self
-            .nav
-            .axis(axis)?
+        Ok(PlcAxis {
+            block: self.nav.axis(axis)?,
+        }
+        .lr_state())
+    }
+}
+
+impl<'m> PlcChannel<'m> {
+    /// The whole block `gpCh[i]^` (read its `_r` values; write only `_w` values).
+    pub fn block(&self) -> Place<'m, HliChannel> {
+        self.block
+    }
+
+    fn control(&self) -> Place<'m, HliChannelMcControl> {
+        self.block
+            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+    }
+
+    fn dyn_cs(&self) -> Place<'m, McControlDynCsUnit> {
+        self.control()
+            .field(offset_of!(HliChannelMcControl, dyn_cs))
+    }
+
+    fn m_function(&self) -> Place<'m, HliMFunctionUnit> {
+        self.control()
+            .field(offset_of!(HliChannelMcControl, m_function))
+    }
+
+    fn path_override(&self) -> Place<'m, HliChannelOverrideUnit> {
+        self.control()
+            .field(offset_of!(HliChannelMcControl, path_override))
+    }
+
+    fn bahn_state(&self) -> Place<'m, HliBahnState> {
+        self.block
+            .field::<HliBahnState>(offset_of!(HliChannel, bahn_state))
+    }
+
+    /// Writes `channel_mc_control.dyn_cs.command_w` (command pattern).
+    pub fn dyn_cs_command(&self) -> Writer<'m, HliCoordinateSystemInt> {
+        let unit = self.dyn_cs();
+        Writer::new(
+            unit_field!(unit, McControlDynCsUnit, command_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, command_w),
+        )
+    }
+
+    /// Reads `channel_mc_control.dyn_cs.request_r` (request pattern).
+    pub fn dyn_cs_request(&self) -> Reader<'m, HliCoordinateSystemInt> {
+        let unit = self.dyn_cs();
+        Reader::new(
+            unit_field!(unit, McControlDynCsUnit, request_semaphore_rw),
+            unit_field!(unit, McControlDynCsUnit, request_r),
+        )
+    }
+
+    /// Writes `channel_mc_control.dyn_cs.transition_w`.
+    pub fn dyn_cs_transition(&self) -> TransitionWriter<'m> {
+        let unit = self.dyn_cs();
+        TransitionWriter::new(unit_field!(unit, McControlDynCsUnit, transition_w))
+    }
+
+    /// Takes over (or releases) the dynamic-CS unit: `enable_w`.
+    pub fn set_dyn_cs_enabled(&self, enabled: bool) {
+        self.dyn_cs()
+            .field::<Bool>(offset_of!(McControlDynCsUnit, enable_w))
+            .cast::<u8>()
+            .store_release(u8::from(enabled));
+    }
+
+    /// The tracking state `state_r`, validated.
+    pub fn dyn_cs_state(&self) -> Result<DynCsState, InvalidValue> {
+        let raw = self
+            .dyn_cs()
+            .field::<HliDynCsState>(offset_of!(McControlDynCsUnit, state_r))
+            .field::<u32>(offset_of!(HliDynCsState, actual_state))
+            .load_acquire();
+        DynCsState::decode(raw)
+    }
+
+    /// Commands the path override and feed hold (`path_override.*_w`).
+    pub fn set_path_override(&self, value: PathOverride) {
+        let unit = self.path_override();
+        unit_field!(unit, HliChannelOverrideUnit, feed_override_w).store(value.feed_permille);
+        unit_field!(unit, HliChannelOverrideUnit, rapid_override_w).store(value.rapid_permille);
+        unit.field::<Bool>(offset_of!(HliChannelOverrideUnit, feed_hold_w))
+            .cast::<u8>()
+            .store_release(u8::from(value.feed_hold));
+    }
+
+    /// The feed override the channel applies (`feed_override_r`, 0.1 %).
+    pub fn feed_override_applied(&self) -> u32 {
+        self.path_override()
+            .field::<u32>(offset_of!(HliChannelOverrideUnit, feed_override_r))
+            .load()
+    }
+
+    /// The path feed the CNC published (`path_feed_r`, 1 um/s).
+    pub fn path_feed(&self) -> i32 {
+        self.bahn_state()
+            .field::<i32>(offset_of!(HliBahnState, path_feed_r))
+            .load()
+    }
+
+    /// The channel's error (`error_id_r`), validated.
+    pub fn channel_error(&self) -> Result<crate::enums::ChannelErrorId, InvalidValue> {
+        let raw = self
+            .bahn_state()
+            .field::<u32>(offset_of!(HliBahnState, error_id_r))
+            .load();
+        crate::enums::ChannelErrorId::decode(raw)
+    }
+
+    /// The program state the CNC published (`program_state_r`), validated.
+    pub fn program_state(&self) -> Result<crate::enums::ProgramState, InvalidValue> {
+        let raw = self
+            .bahn_state()
+            .field::<i32>(offset_of!(HliBahnState, program_state_r))
+            .load();
+        crate::enums::ProgramState::decode(raw)
+    }
+
+    /// Reads M-function announcements (request pattern).
+    pub fn m_function_request(&self) -> Reader<'m, HliMFunctionRequest> {
+        let unit = self.m_function();
+        Reader::new(
+            unit_field!(unit, HliMFunctionUnit, request_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, request_r),
+        )
+    }
+
+    /// Acknowledges M functions (command pattern).
+    pub fn m_function_ack(&self) -> Writer<'m, HliMFunctionAck> {
+        let unit = self.m_function();
+        Writer::new(
+            unit_field!(unit, HliMFunctionUnit, ack_semaphore_rw),
+            unit_field!(unit, HliMFunctionUnit, ack_w),
+        )
+    }
+}
+
+impl<'m> PlcAxis<'m> {
+    /// The whole block `gpAx[i]^`.
+    pub fn block(&self) -> Place<'m, HliAxis> {
+        self.block
+    }
+
+    /// The cyclic state `lr_state`, copied out.
+    pub fn lr_state(&self) -> HliAxisLrState {
+        self.block
             .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
-            .read())
+            .read()
+    }
+
+    /// The command book `command_state` (what PLCopen blocks follow), copied out.
+    pub fn command_state(&self) -> crate::layout::HliAxisCommandState {
+        self.block
+            .field::<crate::layout::HliAxisCommandState>(offset_of!(HliAxis, command_state))
+            .read()
     }
 }
 

@@ -59,6 +59,10 @@ pub struct PlcArgs {
     /// Watchdog: wait steps of 10 ms without a CNC heartbeat before the CNC counts as lost.
     #[arg(long, default_value_t = 100)]
     pub watchdog_cycles: u32,
+    /// Task cycle as a multiple of the NC tick: run the program every N ticks (the heartbeat
+    /// still follows every tick, so lockstep works with any N).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub period_ticks: u64,
     /// Stop after this many cycles.
     #[arg(long)]
     pub max_cycles: Option<u64>,
@@ -122,12 +126,20 @@ pub fn run(args: PlcArgs) -> ExitCode {
     if !realtime.is_empty() {
         println!("plc: real-time {}", realtime.join(", "));
     }
+    runtime.set_period_ticks(args.period_ticks);
+    hli::signals::capture();
     match runtime.run(program.as_mut(), args.max_cycles) {
         Ok(summary) => {
             println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);
+            println!("plc: task {}", summary.stats);
             println!("{}", program.summary());
+            runtime.detach();
             match summary.end {
                 crate::runtime::RunEnd::CncLost => ExitCode::from(3),
+                crate::runtime::RunEnd::Signal(signal) => {
+                    eprintln!("plc: stopped by {}", signal.name());
+                    ExitCode::from(signal.exit_code())
+                }
                 _ => ExitCode::SUCCESS,
             }
         }

@@ -5,8 +5,16 @@
 //!     wait "tick done" (timeout = one watchdog step)
 //!     CNC closed?  ─► stop (orderly)
 //!     CNC heartbeat unchanged for `watchdog_cycles` steps ─► stop (CNC lost)
-//!     program.cycle(io) ─► heartbeat += 1 ─► notify "cycle done"
+//!     task due (every `period_ticks` NC ticks)? ─► program.cycle(io), timed
+//!     heartbeat += 1 ─► notify "cycle done"
 //! ```
+//!
+//! The task runs on the CNC's "tick done" event: every tick (`period_ticks` = 1), or every
+//! N-th tick like a PLC task whose cycle is a multiple of the NC cycle. The heartbeat is
+//! raised after every tick either way, so a CNC in lockstep (tick N waits for the PLC's
+//! N-th heartbeat) runs with any period. Each cycle is timed on CLOCK_MONOTONIC
+//! ([`CycleStats`]); an overrun is a task slot the program missed because the CNC had
+//! already finished more ticks than the period when the cycle started.
 
 use core::time::Duration;
 use hli::enums::SegmentState;
@@ -30,6 +38,9 @@ pub enum RuntimeError {
 }
 
 /// What a PLC program sees each cycle.
+///
+/// `io.view` is the PLC's side of the image; [`PlcIo::gp_ch`] and [`PlcIo::gp_ax`] narrow it
+/// to one channel or axis as the seeds write `gpCh[i]^` and `gpAx[i]^`.
 pub struct PlcIo<'a> {
     /// The PLC's side of the image.
     pub view: PlcView<'a>,
@@ -39,6 +50,110 @@ pub struct PlcIo<'a> {
     pub acyclic: &'a mut AcyclicClient,
     /// Cycles run so far (0 in the first cycle).
     pub cycle: u64,
+}
+
+impl<'a> PlcIo<'a> {
+    /// Channel `index` (`gpCh[index]^`), or `None` beyond the configured channels.
+    pub fn gp_ch(&self, index: usize) -> Option<hli::views::PlcChannel<'a>> {
+        self.view.gp_ch(index)
+    }
+
+    /// Axis `index` (`gpAx[index]^`), or `None` beyond the configured axes.
+    pub fn gp_ax(&self, index: usize) -> Option<hli::views::PlcAxis<'a>> {
+        self.view.gp_ax(index)
+    }
+}
+
+/// Cycle durations up to this many microseconds are kept to the microsecond (longer ones
+/// count in the last bucket; the maximum is exact).
+const HISTOGRAM_US: usize = 2_000;
+
+/// Timing of the program's cycles, kept without allocating in the cycle.
+#[derive(Clone)]
+pub struct CycleStats {
+    /// Cycles timed.
+    pub cycles: u64,
+    /// Task slots missed (see the module documentation).
+    pub overruns: u64,
+    /// Longest cycle, ns.
+    pub max_ns: u64,
+    /// Sum of the cycle durations, ns.
+    pub total_ns: u64,
+    histogram: Box<[u32; HISTOGRAM_US + 1]>,
+}
+
+impl Default for CycleStats {
+    fn default() -> Self {
+        Self {
+            cycles: 0,
+            overruns: 0,
+            max_ns: 0,
+            total_ns: 0,
+            histogram: Box::new([0; HISTOGRAM_US + 1]),
+        }
+    }
+}
+
+impl core::fmt::Debug for CycleStats {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "{self}")
+    }
+}
+
+impl PartialEq for CycleStats {
+    fn eq(&self, other: &Self) -> bool {
+        self.cycles == other.cycles
+            && self.overruns == other.overruns
+            && self.max_ns == other.max_ns
+            && self.total_ns == other.total_ns
+    }
+}
+impl Eq for CycleStats {}
+
+impl CycleStats {
+    /// Records one cycle of `ns` nanoseconds.
+    pub fn record(&mut self, ns: u64) {
+        self.cycles += 1;
+        self.max_ns = self.max_ns.max(ns);
+        self.total_ns = self.total_ns.saturating_add(ns);
+        let bucket = ((ns / 1_000) as usize).min(HISTOGRAM_US);
+        self.histogram[bucket] = self.histogram[bucket].saturating_add(1);
+    }
+
+    /// The duration `q` (0..=1) of the cycles lie under, µs (the bucket's upper edge; the
+    /// maximum beyond the histogram).
+    pub fn quantile_us(&self, q: f64) -> f64 {
+        if self.cycles == 0 {
+            return 0.0;
+        }
+        let want = ((self.cycles as f64) * q.clamp(0.0, 1.0)).ceil().max(1.0) as u64;
+        let mut seen = 0u64;
+        for (us, n) in self.histogram.iter().enumerate() {
+            seen += u64::from(*n);
+            if seen >= want {
+                return if us == HISTOGRAM_US {
+                    self.max_ns as f64 / 1e3
+                } else {
+                    ((us + 1) as f64).min(self.max_ns as f64 / 1e3)
+                };
+            }
+        }
+        self.max_ns as f64 / 1e3
+    }
+}
+
+impl core::fmt::Display for CycleStats {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "{} cycles, duration p50 {:.0} us p99 {:.0} us max {:.1} us, overruns {}",
+            self.cycles,
+            self.quantile_us(0.5),
+            self.quantile_us(0.99),
+            self.max_ns as f64 / 1e3,
+            self.overruns
+        )
+    }
 }
 
 /// A PLC program: called once per PLC cycle.
@@ -58,6 +173,8 @@ pub struct RunSummary {
     pub cycles: u64,
     /// Why the loop ended.
     pub end: RunEnd,
+    /// Durations and overruns of the cycles.
+    pub stats: CycleStats,
 }
 
 /// Why the cyclic loop ended.
@@ -69,6 +186,8 @@ pub enum RunEnd {
     CncLost,
     /// The cycle limit was reached.
     CycleLimit,
+    /// A termination signal arrived (see [`hli::signals`]).
+    Signal(hli::signals::Termination),
 }
 
 /// The runtime over an attached segment.
@@ -78,6 +197,7 @@ pub struct PlcRuntime {
     acyclic: AcyclicClient,
     watchdog_cycles: u32,
     wait_step: Duration,
+    period_ticks: u64,
 }
 
 impl PlcRuntime {
@@ -97,7 +217,19 @@ impl PlcRuntime {
             acyclic,
             watchdog_cycles,
             wait_step,
+            period_ticks: 1,
         })
+    }
+
+    /// Runs the task every `ticks` NC ticks instead of every tick (at least 1).
+    pub fn set_period_ticks(&mut self, ticks: u64) {
+        self.period_ticks = ticks.max(1);
+    }
+
+    /// Leaves the segment: the PLC's pid leaves the header, the event and call services
+    /// close. The CNC, which supervises the heartbeat, then sees no PLC.
+    pub fn detach(self) {
+        drop(self);
     }
 
     /// The attached segment.
@@ -105,50 +237,68 @@ impl PlcRuntime {
         &self.segment
     }
 
-    /// Runs `program` until the CNC closes or is lost, or `max_cycles` cycles ran.
+    /// Runs `program` until the CNC closes or is lost, a termination signal arrives (when the
+    /// caller captured them with [`hli::signals::capture`]), or `max_cycles` cycles ran.
     pub fn run(
         &mut self,
         program: &mut dyn PlcProgram,
         max_cycles: Option<u64>,
     ) -> Result<RunSummary, RuntimeError> {
         let mut watch = HeartbeatWatch::new(self.watchdog_cycles);
-        let mut cycles = 0u64;
+        let mut stats = CycleStats::default();
+        let end = |end, stats: CycleStats| {
+            Ok(RunSummary {
+                cycles: stats.cycles,
+                end,
+                stats,
+            })
+        };
         // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
         // its cycle (lockstep waits for exactly that cycle).
         let mut last_cnc_beat = 0;
+        // The tick at which the task is due next (None: at the first tick seen).
+        let mut due: Option<u64> = None;
+        let mut wakeups = 0u64;
         loop {
-            if max_cycles.is_some_and(|max| cycles >= max) {
-                return Ok(RunSummary {
-                    cycles,
-                    end: RunEnd::CycleLimit,
-                });
+            if max_cycles.is_some_and(|max| stats.cycles >= max) {
+                return end(RunEnd::CycleLimit, stats);
+            }
+            // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
+            // the program's cycle (as the CNC's tick loop does).
+            wakeups += 1;
+            if wakeups % 64 == 0 {
+                if let Some(signal) = hli::signals::take() {
+                    return end(RunEnd::Signal(signal), stats);
+                }
             }
             self.events.wait(self.wait_step)?;
             if self.segment.cnc_state() != Ok(SegmentState::Ready) {
-                return Ok(RunSummary {
-                    cycles,
-                    end: RunEnd::CncClosed,
-                });
+                return end(RunEnd::CncClosed, stats);
             }
             let beat = self.segment.cnc_heartbeat();
             if watch.observe(beat) == PeerLiveness::Lost {
-                return Ok(RunSummary {
-                    cycles,
-                    end: RunEnd::CncLost,
-                });
+                return end(RunEnd::CncLost, stats);
             }
             if beat == last_cnc_beat {
                 continue; // woken without a new tick (timeout): no cycle
             }
             last_cnc_beat = beat;
-            let mut io = PlcIo {
-                view: PlcView::new(self.segment.memory()),
-                memory: self.segment.memory(),
-                acyclic: &mut self.acyclic,
-                cycle: cycles,
-            };
-            program.cycle(&mut io);
-            cycles += 1;
+            let slot = due.unwrap_or(beat);
+            if beat >= slot {
+                // Slots that passed while the previous cycle (or this process) was late.
+                stats.overruns += (beat - slot) / self.period_ticks;
+                due = Some(beat + self.period_ticks);
+                let mut io = PlcIo {
+                    view: PlcView::new(self.segment.memory()),
+                    memory: self.segment.memory(),
+                    acyclic: &mut self.acyclic,
+                    cycle: stats.cycles,
+                };
+                let start = hli::raw::monotonic::now();
+                program.cycle(&mut io);
+                let took = hli::raw::monotonic::now().saturating_sub(start);
+                stats.record(took.as_nanos() as u64);
+            }
             self.segment.beat();
             self.events.notify()?;
         }

@@ -30,3 +30,94 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     drop(runtime);
     tests::remove_stale_segment(&instance);
 }
+
+/// A CNC in strict lockstep in a thread: `ticks` ticks, each raising the heartbeat by `step`
+/// (2 = a CNC that runs ahead of the PLC by one tick per cycle), then waiting for the PLC's
+/// heartbeat to follow. Dropping the segment at the end closes it.
+fn lockstep_cnc(instance: &str, ticks: u64, step: u64) -> std::thread::JoinHandle<()> {
+    let segment = hli::segment::CncSegment::create(instance, 1, 1).unwrap();
+    let instance = instance.to_string();
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let cnc = std::thread::spawn(move || {
+        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
+        ready_tx.send(()).unwrap();
+        for n in 1..=ticks {
+            for _ in 0..step {
+                segment.beat();
+            }
+            events.notify().unwrap();
+            let deadline = std::time::Instant::now() + Duration::from_secs(10);
+            while segment.plc_heartbeat() < n {
+                assert!(
+                    std::time::Instant::now() < deadline,
+                    "watchdog: PLC cycle {n}"
+                );
+                let _ = events.wait(Duration::from_millis(10)).unwrap();
+            }
+        }
+    });
+    ready_rx.recv().unwrap();
+    cnc
+}
+
+/// Records the CNC tick of each cycle and uses the typed channel and axis views.
+#[derive(Default)]
+struct Recorder {
+    ticks: Vec<u64>,
+    views_ok: bool,
+}
+
+impl PlcProgram for Recorder {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let beat = hli::access::Leaf::resolve("header.cnc_heartbeat").unwrap();
+        self.ticks.push(beat.read(io.memory).as_f64() as u64);
+        // gpCh[0] and gpAx[0] exist, gpCh[1] and gpAx[1] do not (one of each configured).
+        let channel = io.gp_ch(0).expect("gpCh[0]");
+        channel.set_dyn_cs_enabled(true);
+        let enable = hli::access::Leaf::resolve("gpCh[0]^channel_mc_control.dyn_cs.enable_w");
+        self.views_ok = enable.unwrap().read(io.memory).as_f64() == 1.0
+            && channel.dyn_cs_state().is_ok()
+            && io.gp_ch(1).is_none()
+            && io.gp_ax(0).is_some_and(|a| a.lr_state().error_id_r == 0)
+            && io.gp_ax(1).is_none();
+    }
+}
+
+#[test]
+fn a_task_every_third_tick_runs_in_lockstep_and_is_timed() {
+    hli::init_logging();
+    let instance = unique_instance("plc-period");
+    let cnc = lockstep_cnc(&instance, 300, 1);
+    let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
+    runtime.set_period_ticks(3);
+    let mut program = Recorder::default();
+    let summary = runtime.run(&mut program, Some(1_000)).unwrap();
+    cnc.join().unwrap();
+    assert_eq!(summary.end, RunEnd::CncClosed);
+    // Ticks 1, 4, 7, ... 298: a hundred cycles, none missed.
+    assert_eq!(
+        program.ticks,
+        (0..100).map(|k| 1 + 3 * k).collect::<Vec<u64>>()
+    );
+    assert_eq!(summary.cycles, 100);
+    assert_eq!(summary.stats.cycles, 100);
+    assert_eq!(summary.stats.overruns, 0);
+    assert!(summary.stats.max_ns > 0);
+    assert!(summary.stats.quantile_us(0.5) <= summary.stats.quantile_us(0.99));
+    assert!(summary.stats.quantile_us(0.99) <= summary.stats.max_ns as f64 / 1e3 + 1.0);
+    assert!(program.views_ok);
+}
+
+#[test]
+fn ticks_the_task_missed_count_as_overruns() {
+    hli::init_logging();
+    let instance = unique_instance("plc-overrun");
+    // Two CNC ticks per PLC cycle: every cycle after the first comes one slot late.
+    let cnc = lockstep_cnc(&instance, 50, 2);
+    let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
+    let mut program = Recorder::default();
+    let summary = runtime.run(&mut program, Some(1_000)).unwrap();
+    cnc.join().unwrap();
+    assert_eq!(program.ticks, (1..=50).map(|k| 2 * k).collect::<Vec<u64>>());
+    assert_eq!(summary.stats.overruns, 49);
+}
