@@ -266,7 +266,7 @@ impl PlcRuntime {
             // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
-            if wakeups % 64 == 0 {
+            if wakeups.is_multiple_of(64) {
                 if let Some(signal) = hli::signals::take() {
                     return end(RunEnd::Signal(signal), stats);
                 }
