@@ -24,7 +24,7 @@ impl PlcProgram for Probe {
             self.at_400 = (allocations(), deallocations());
         }
         if let Some(channel) = io.gp_ch(0) {
-            channel.set_dyn_cs_enabled(io.cycle % 2 == 0);
+            channel.set_dyn_cs_enabled(io.cycle.is_multiple_of(2));
             let _ = channel.dyn_cs_state();
             let _ = channel.m_function_request().try_take();
         }
