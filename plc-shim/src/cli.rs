@@ -23,12 +23,34 @@ pub struct PlcCli {
     pub run: PlcArgs,
 }
 
-/// Arguments of the PLC process.
+/// How a PLC program is hosted: which CNC, watchdog, task period, real-time options. Shared
+/// by the `plc` binary and PLC programs in users' crates ([`host`]).
 #[derive(Debug, Clone, clap::Args)]
-pub struct PlcArgs {
+pub struct HostArgs {
     /// CNC instance to attach to.
     #[arg(long, default_value = crate::tools::DEFAULT_INSTANCE)]
     pub instance: String,
+    /// Watchdog: wait steps of 10 ms without a CNC heartbeat before the CNC counts as lost.
+    #[arg(long, default_value_t = 100)]
+    pub watchdog_cycles: u32,
+    /// Task cycle as a multiple of the NC tick: run the program every N ticks (the heartbeat
+    /// still follows every tick, so lockstep works with any N).
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
+    pub period_ticks: u64,
+    /// Stop after this many cycles.
+    #[arg(long)]
+    pub max_cycles: Option<u64>,
+    /// Real-time options of the PLC's cycle.
+    #[command(flatten)]
+    pub realtime: crate::realtime::RealtimeOptions,
+}
+
+/// Arguments of the PLC process.
+#[derive(Debug, Clone, clap::Args)]
+pub struct PlcArgs {
+    /// Where and how the program runs.
+    #[command(flatten)]
+    pub host: HostArgs,
     /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0).
     #[arg(long, default_value = "rotary-table")]
     pub program: String,
@@ -56,19 +78,6 @@ pub struct PlcArgs {
     /// Table speed of `rotary-table`, degree per cycle.
     #[arg(long, default_value_t = 0.01)]
     pub deg_per_cycle: f64,
-    /// Watchdog: wait steps of 10 ms without a CNC heartbeat before the CNC counts as lost.
-    #[arg(long, default_value_t = 100)]
-    pub watchdog_cycles: u32,
-    /// Task cycle as a multiple of the NC tick: run the program every N ticks (the heartbeat
-    /// still follows every tick, so lockstep works with any N).
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=1000))]
-    pub period_ticks: u64,
-    /// Stop after this many cycles.
-    #[arg(long)]
-    pub max_cycles: Option<u64>,
-    /// Real-time options of the PLC's cycle.
-    #[command(flatten)]
-    pub realtime: crate::realtime::RealtimeOptions,
 }
 
 /// Names of the built-in programs.
@@ -111,6 +120,18 @@ pub fn run(args: PlcArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    host(program.as_mut(), &args.host)
+}
+
+/// Attaches to the CNC `args` names and runs `program` until the CNC ends, is lost, a signal
+/// arrives or the cycle limit is reached; prints the end, the task statistics and the
+/// program's summary. Exit codes: 0 the CNC closed (or the limit), 1 no CNC or a service
+/// failed, 3 the CNC was lost, 128 + signal number on SIGINT/SIGTERM.
+///
+/// A PLC program in a user's crate is a type implementing [`PlcProgram`] and a `main` that
+/// parses [`HostArgs`] (flattened into its own arguments) and calls this (see
+/// `examples/plc-shuttle`).
+pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
     let mut runtime = match PlcRuntime::attach(
         &args.instance,
         args.watchdog_cycles,
@@ -128,7 +149,7 @@ pub fn run(args: PlcArgs) -> ExitCode {
     }
     runtime.set_period_ticks(args.period_ticks);
     hli::signals::capture();
-    match runtime.run(program.as_mut(), args.max_cycles) {
+    match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
             println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);
             println!("plc: task {}", summary.stats);
