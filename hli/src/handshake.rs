@@ -194,6 +194,15 @@ impl<'m> TransitionWriter<'m> {
         self.unit.field(offset_of!(HliDynCsTransition, command))
     }
 
+    /// Whether the CNC has taken the last command (the command word is 0).
+    pub fn is_free(&self) -> Result<bool, ProtocolViolation> {
+        match self.command().load_acquire() {
+            0 => Ok(true),
+            1 | -1 => Ok(false),
+            raw => Err(ProtocolViolation::CommandGarbage { raw }),
+        }
+    }
+
     /// Writes the parameters of `transition`, then its command (which must not be `None`).
     /// Refused while the CNC has not taken the previous transition.
     pub fn try_send(

@@ -1,6 +1,7 @@
 //! Command line of the PLC process, shared by the `plc` binary and `cnc plc` (which the
 //! demo spawns, so that the single `cargo run -p cnc-core` builds everything it needs).
 
+use crate::programs::turntable::{Turntable, Variant};
 use crate::programs::RotaryTableMaster;
 use crate::runtime::{PlcProgram, PlcRuntime};
 use crate::timeline::Timeline;
@@ -81,7 +82,14 @@ pub struct PlcArgs {
 }
 
 /// Names of the built-in programs.
-pub const BUILT_IN_PROGRAMS: &[&str] = &["rotary-table", "cam-conveyor", "fifo-stream", "saw-cut"];
+pub const BUILT_IN_PROGRAMS: &[&str] = &[
+    "rotary-table",
+    "turntable-hybrid",
+    "turntable-plc-only",
+    "cam-conveyor",
+    "fifo-stream",
+    "saw-cut",
+];
 
 /// Runs a tool, or the PLC process (exit code 0 when the CNC closed in order).
 pub fn main(cli: PlcCli) -> ExitCode {
@@ -102,6 +110,8 @@ pub fn run(args: PlcArgs) -> ExitCode {
             }
         },
         (None, "rotary-table") => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
+        (None, "turntable-hybrid") => Box::new(Turntable::new(Variant::Hybrid)),
+        (None, "turntable-plc-only") => Box::new(Turntable::new(Variant::PlcOnly)),
         (None, "cam-conveyor") => Box::new(crate::programs::cam_conveyor::CamConveyor::new()),
         (None, "fifo-stream") => match fifo_stream(&args) {
             Ok(p) => Box::new(p),

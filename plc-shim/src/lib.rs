@@ -6,6 +6,7 @@ pub mod blocks;
 pub mod cam;
 pub mod cam_compat;
 pub mod cli;
+pub mod dyn_cs;
 pub mod fifo;
 pub mod fifo_file;
 pub mod motion;

@@ -108,6 +108,11 @@ impl CommandCore {
                 }
             };
         }
+        // Execute is low while the command runs: whatever it ends with this cycle or later is
+        // shown for one cycle (also when Execute fell in the very cycle it ends).
+        if !execute && matches!(self.phase, Phase::Sent(_) | Phase::Following(_)) {
+            self.show_once = true;
+        }
         if let Phase::Sent(pending) = &self.phase {
             match pending.poll() {
                 None => self.out.busy = true,

@@ -5,6 +5,7 @@
 pub mod cam_conveyor;
 pub mod fifo_stream;
 pub mod saw_cut;
+pub mod turntable;
 
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};

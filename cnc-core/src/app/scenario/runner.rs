@@ -414,6 +414,17 @@ fn run_machine(
     }
 
     let ticks = machine.ticks();
+    // Lockstep: the PLC's cycle after the last tick belongs to the run as every other one
+    // (it sees the final state) before the segment closes.
+    if options.lockstep && stop.is_none() && !forced {
+        if let Some(child) = child.as_mut() {
+            if let Err(PlcWait::Lost(detail)) =
+                wait_for_plc_cycle(&segment, &events, child, ticks, watchdog, period)
+            {
+                eprintln!("cnc run: the PLC's last cycle did not come: {detail}");
+            }
+        }
+    }
     drop(segment); // marks the segment closed: the PLC stops
     let plc_output = match child {
         Some(mut child) => {
