@@ -12,6 +12,7 @@
 //!
 //! None of them allocates or blocks; each is called once per cycle.
 
+use crate::motion::BlockOutputs;
 use crate::runtime::PlcIo;
 use hli::enums::{DynCsCommand, DynCsOption, DynCsState};
 use hli::handshake::SendError;
@@ -124,23 +125,6 @@ impl DynCsMaster {
     }
 }
 
-/// Outputs of an Execute block, as PLCopen defines them.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct ExecuteOutputs {
-    /// The command reached its goal.
-    pub done: bool,
-    /// The command has not finished.
-    pub busy: bool,
-    /// The command is under way in the CNC (taken, goal not reached).
-    pub active: bool,
-    /// Something else switched the tracking the other way first.
-    pub command_aborted: bool,
-    /// The command failed; see `error_id`.
-    pub error: bool,
-    /// Why ([`DynCsBlockError`]).
-    pub error_id: u32,
-}
-
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum TransitionPhase {
     Idle,
@@ -180,7 +164,7 @@ pub struct McDynCsTransition {
     /// Input: the static frame between the error point and the kinematic base (X.. C..).
     pub kinematic_base_cs: HliCoordinateSystemInt,
     /// Outputs of the last call.
-    pub out: ExecuteOutputs,
+    pub out: BlockOutputs,
     /// Commands the CNC was given.
     pub sent: u64,
     latched: HliDynCsTransition,
@@ -204,7 +188,7 @@ impl Default for McDynCsTransition {
             kin_base: false,
             rot_trans: false,
             kinematic_base_cs: bytemuck::Zeroable::zeroed(),
-            out: ExecuteOutputs::default(),
+            out: BlockOutputs::default(),
             sent: 0,
             latched: bytemuck::Zeroable::zeroed(),
             latched_on: true,
@@ -233,7 +217,7 @@ impl McDynCsTransition {
                 kinematic_base_cs: self.kinematic_base_cs,
             };
             self.latched_on = self.on;
-            self.out = ExecuteOutputs::default();
+            self.out = BlockOutputs::default();
             self.phase = TransitionPhase::Sending;
             self.moved = false;
             self.show_once = false;
@@ -250,7 +234,7 @@ impl McDynCsTransition {
             if self.show_once {
                 self.show_once = false;
             } else {
-                self.out = ExecuteOutputs::default();
+                self.out = BlockOutputs::default();
             }
         }
     }
@@ -287,26 +271,26 @@ impl McDynCsTransition {
         } else {
             (DynCsState::Inactive, DynCsState::Active)
         };
-        self.out = ExecuteOutputs {
+        self.out = BlockOutputs {
             busy: true,
             active: taken,
-            ..ExecuteOutputs::default()
+            ..BlockOutputs::default()
         };
         match ch.dyn_cs_state() {
             Err(_) => self.finish_with_error(DynCsBlockError::InvalidState),
             Ok(DynCsState::Error) => self.finish_with_error(DynCsBlockError::Tracking),
             Ok(state) if taken && state == goal => {
-                self.out = ExecuteOutputs {
+                self.out = BlockOutputs {
                     done: true,
-                    ..ExecuteOutputs::default()
+                    ..BlockOutputs::default()
                 };
                 self.phase = TransitionPhase::Idle;
             }
             // Back in the start state after it had left it: something switched the other way.
             Ok(state) if taken && state == opposite && self.moved => {
-                self.out = ExecuteOutputs {
+                self.out = BlockOutputs {
                     command_aborted: true,
-                    ..ExecuteOutputs::default()
+                    ..BlockOutputs::default()
                 };
                 self.phase = TransitionPhase::Idle;
             }
@@ -315,10 +299,10 @@ impl McDynCsTransition {
     }
 
     fn finish_with_error(&mut self, why: DynCsBlockError) {
-        self.out = ExecuteOutputs {
+        self.out = BlockOutputs {
             error: true,
             error_id: why.code(),
-            ..ExecuteOutputs::default()
+            ..BlockOutputs::default()
         };
         self.phase = TransitionPhase::Idle;
     }

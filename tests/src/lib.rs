@@ -156,3 +156,31 @@ pub fn serve_axes_in_lockstep(
     ready_rx.recv().unwrap();
     cnc
 }
+
+/// A CNC in strict lockstep in a thread, with no machine behind it: a fresh segment of
+/// `instance` (1 channel, 1 axis), `ticks` ticks, each raising the heartbeat by `step` (2 = a
+/// CNC that runs ahead of its PLC by one tick per cycle), notifying and then waiting for the
+/// PLC's heartbeat to reach the tick (watchdog 10 s). Returns once the PLC can attach; the
+/// segment closes when the thread ends.
+pub fn lockstep_beats(instance: &str, ticks: u64, step: u64) -> std::thread::JoinHandle<()> {
+    let segment = hli::segment::CncSegment::create(instance, 1, 1).unwrap();
+    let instance = instance.to_string();
+    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
+    let cnc = std::thread::spawn(move || {
+        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
+        ready_tx.send(()).unwrap();
+        for n in 1..=ticks {
+            for _ in 0..step {
+                segment.beat();
+            }
+            events.notify().unwrap();
+            let deadline = Instant::now() + Duration::from_secs(10);
+            while segment.plc_heartbeat() < n {
+                assert!(Instant::now() < deadline, "watchdog: PLC cycle {n}");
+                let _ = events.wait(Duration::from_millis(10)).unwrap();
+            }
+        }
+    });
+    ready_rx.recv().unwrap();
+    cnc
+}

@@ -38,26 +38,7 @@ impl PlcProgram for Probe {
 fn the_plc_cycle_loop_does_not_allocate() {
     hli::init_logging();
     let instance = unique_instance("plc-no-alloc");
-    let segment = hli::segment::CncSegment::create(&instance, 1, 1).unwrap();
-    let name = instance.clone();
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
-    let cnc = std::thread::spawn(move || {
-        let events = hli::events::EventLink::open(&name, hli::events::Side::Cnc).unwrap();
-        ready_tx.send(()).unwrap();
-        for n in 1..=500u64 {
-            segment.beat();
-            events.notify().unwrap();
-            let deadline = std::time::Instant::now() + Duration::from_secs(10);
-            while segment.plc_heartbeat() < n {
-                assert!(
-                    std::time::Instant::now() < deadline,
-                    "watchdog: PLC cycle {n}"
-                );
-                let _ = events.wait(Duration::from_millis(10)).unwrap();
-            }
-        }
-    });
-    ready_rx.recv().unwrap();
+    let cnc = tests::lockstep_beats(&instance, 500, 1);
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
     let mut probe = Probe {
         at_20: (0, 0),

@@ -31,35 +31,6 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     tests::remove_stale_segment(&instance);
 }
 
-/// A CNC in strict lockstep in a thread: `ticks` ticks, each raising the heartbeat by `step`
-/// (2 = a CNC that runs ahead of the PLC by one tick per cycle), then waiting for the PLC's
-/// heartbeat to follow. Dropping the segment at the end closes it.
-fn lockstep_cnc(instance: &str, ticks: u64, step: u64) -> std::thread::JoinHandle<()> {
-    let segment = hli::segment::CncSegment::create(instance, 1, 1).unwrap();
-    let instance = instance.to_string();
-    let (ready_tx, ready_rx) = std::sync::mpsc::channel();
-    let cnc = std::thread::spawn(move || {
-        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
-        ready_tx.send(()).unwrap();
-        for n in 1..=ticks {
-            for _ in 0..step {
-                segment.beat();
-            }
-            events.notify().unwrap();
-            let deadline = std::time::Instant::now() + Duration::from_secs(10);
-            while segment.plc_heartbeat() < n {
-                assert!(
-                    std::time::Instant::now() < deadline,
-                    "watchdog: PLC cycle {n}"
-                );
-                let _ = events.wait(Duration::from_millis(10)).unwrap();
-            }
-        }
-    });
-    ready_rx.recv().unwrap();
-    cnc
-}
-
 /// Records the CNC tick of each cycle and uses the typed channel and axis views.
 #[derive(Default)]
 struct Recorder {
@@ -87,7 +58,7 @@ impl PlcProgram for Recorder {
 fn a_task_every_third_tick_runs_in_lockstep_and_is_timed() {
     hli::init_logging();
     let instance = unique_instance("plc-period");
-    let cnc = lockstep_cnc(&instance, 300, 1);
+    let cnc = tests::lockstep_beats(&instance, 300, 1);
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
     runtime.set_period_ticks(3);
     let mut program = Recorder::default();
@@ -113,7 +84,7 @@ fn ticks_the_task_missed_count_as_overruns() {
     hli::init_logging();
     let instance = unique_instance("plc-overrun");
     // Two CNC ticks per PLC cycle: every cycle after the first comes one slot late.
-    let cnc = lockstep_cnc(&instance, 50, 2);
+    let cnc = tests::lockstep_beats(&instance, 50, 2);
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
     let mut program = Recorder::default();
     let summary = runtime.run(&mut program, Some(1_000)).unwrap();
