@@ -10,6 +10,7 @@ pub mod fifo_cli;
 pub mod json;
 pub mod kin_cli;
 pub mod plot;
+pub mod progress;
 pub mod saw_cli;
 pub mod scenario;
 pub mod stats;

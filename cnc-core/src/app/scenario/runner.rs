@@ -314,6 +314,12 @@ fn run_machine(
     let mut forced = false;
 
     let mut rest_after = None;
+    let counter = crate::app::progress::TickCounter::default();
+    let progress = crate::app::progress::Progress::start(
+        &counter,
+        options.ticks.or(scenario.ticks),
+        &options.instance,
+    );
     for tick in 0.. {
         match &stop {
             Some((_, since)) if machine.at_rest() => {
@@ -370,6 +376,7 @@ fn run_machine(
             stage.push((b - a).as_nanos() as u64);
         }
         late_ns.push(t0.saturating_sub(deadline).as_nanos() as u64);
+        counter.set(tick + 1);
 
         // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on it
         // above), its process now and then, and termination requests.
@@ -413,6 +420,7 @@ fn run_machine(
         }
     }
 
+    drop(progress);
     let ticks = machine.ticks();
     // Lockstep: the PLC's cycle after the last tick belongs to the run as every other one
     // (it sees the final state) before the segment closes.
