@@ -163,13 +163,26 @@ pub fn serve_axes_in_lockstep(
 /// PLC's heartbeat to reach the tick (watchdog 10 s). Returns once the PLC can attach; the
 /// segment closes when the thread ends.
 pub fn lockstep_beats(instance: &str, ticks: u64, step: u64) -> std::thread::JoinHandle<()> {
+    lockstep_script(instance, ticks, step, |_, _| {})
+}
+
+/// [`lockstep_beats`] with `script(view, tick)` run at the start of every tick: a stand-in
+/// CNC that takes and answers what the PLC writes as the test says.
+pub fn lockstep_script(
+    instance: &str,
+    ticks: u64,
+    step: u64,
+    mut script: impl FnMut(&hli::views::CncView<'_>, u64) + Send + 'static,
+) -> std::thread::JoinHandle<()> {
     let segment = hli::segment::CncSegment::create(instance, 1, 1).unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let cnc = std::thread::spawn(move || {
         let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
+        let view = hli::views::CncView::new(segment.memory());
         ready_tx.send(()).unwrap();
         for n in 1..=ticks {
+            script(&view, n);
             for _ in 0..step {
                 segment.beat();
             }
