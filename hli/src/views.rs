@@ -97,28 +97,36 @@ impl<'m> Nav<'m> {
     }
 
     fn dyn_cs(&self, channel: usize) -> Result<Place<'m, McControlDynCsUnit>, IndexError> {
-        Ok(self
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field(offset_of!(HliChannelMcControl, dyn_cs)))
+        Ok(control_unit(
+            self.channel(channel)?,
+            offset_of!(HliChannelMcControl, dyn_cs),
+        ))
     }
 
     fn path_override(
         &self,
         channel: usize,
     ) -> Result<Place<'m, HliChannelOverrideUnit>, IndexError> {
-        Ok(self
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field(offset_of!(HliChannelMcControl, path_override)))
+        Ok(control_unit(
+            self.channel(channel)?,
+            offset_of!(HliChannelMcControl, path_override),
+        ))
     }
 
     fn m_function(&self, channel: usize) -> Result<Place<'m, HliMFunctionUnit>, IndexError> {
-        Ok(self
-            .channel(channel)?
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-            .field(offset_of!(HliChannelMcControl, m_function)))
+        Ok(control_unit(
+            self.channel(channel)?,
+            offset_of!(HliChannelMcControl, m_function),
+        ))
     }
+}
+
+/// The control unit at `offset` in a channel's `channel_mc_control` (both views reach their
+/// units through here).
+fn control_unit<U>(channel: Place<'_, HliChannel>, offset: usize) -> Place<'_, U> {
+    channel
+        .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
+        .field(offset)
 }
 
 macro_rules! unit_field {
@@ -551,24 +559,16 @@ impl<'m> PlcChannel<'m> {
         self.block
     }
 
-    fn control(&self) -> Place<'m, HliChannelMcControl> {
-        self.block
-            .field::<HliChannelMcControl>(offset_of!(HliChannel, channel_mc_control))
-    }
-
     fn dyn_cs(&self) -> Place<'m, McControlDynCsUnit> {
-        self.control()
-            .field(offset_of!(HliChannelMcControl, dyn_cs))
+        control_unit(self.block, offset_of!(HliChannelMcControl, dyn_cs))
     }
 
     fn m_function(&self) -> Place<'m, HliMFunctionUnit> {
-        self.control()
-            .field(offset_of!(HliChannelMcControl, m_function))
+        control_unit(self.block, offset_of!(HliChannelMcControl, m_function))
     }
 
     fn path_override(&self) -> Place<'m, HliChannelOverrideUnit> {
-        self.control()
-            .field(offset_of!(HliChannelMcControl, path_override))
+        control_unit(self.block, offset_of!(HliChannelMcControl, path_override))
     }
 
     fn bahn_state(&self) -> Place<'m, HliBahnState> {

@@ -161,7 +161,11 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
     hli::signals::capture();
     match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
-            println!("plc: {} cycles, ended by {:?}", summary.cycles, summary.end);
+            println!(
+                "plc: {} cycles, ended by {:?}",
+                summary.cycles(),
+                summary.end
+            );
             println!("plc: task {}", summary.stats);
             println!("{}", program.summary());
             runtime.detach();

@@ -77,8 +77,6 @@ pub struct CycleStats {
     pub overruns: u64,
     /// Longest cycle, ns.
     pub max_ns: u64,
-    /// Sum of the cycle durations, ns.
-    pub total_ns: u64,
     histogram: Box<[u32; HISTOGRAM_US + 1]>,
 }
 
@@ -88,7 +86,6 @@ impl Default for CycleStats {
             cycles: 0,
             overruns: 0,
             max_ns: 0,
-            total_ns: 0,
             histogram: Box::new([0; HISTOGRAM_US + 1]),
         }
     }
@@ -100,22 +97,11 @@ impl core::fmt::Debug for CycleStats {
     }
 }
 
-impl PartialEq for CycleStats {
-    fn eq(&self, other: &Self) -> bool {
-        self.cycles == other.cycles
-            && self.overruns == other.overruns
-            && self.max_ns == other.max_ns
-            && self.total_ns == other.total_ns
-    }
-}
-impl Eq for CycleStats {}
-
 impl CycleStats {
     /// Records one cycle of `ns` nanoseconds.
     pub fn record(&mut self, ns: u64) {
         self.cycles += 1;
         self.max_ns = self.max_ns.max(ns);
-        self.total_ns = self.total_ns.saturating_add(ns);
         let bucket = ((ns / 1_000) as usize).min(HISTOGRAM_US);
         self.histogram[bucket] = self.histogram[bucket].saturating_add(1);
     }
@@ -167,14 +153,19 @@ pub trait PlcProgram {
 }
 
 /// How a run ended.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone)]
 pub struct RunSummary {
-    /// Cycles executed.
-    pub cycles: u64,
     /// Why the loop ended.
     pub end: RunEnd,
-    /// Durations and overruns of the cycles.
+    /// Cycles executed, their durations and overruns.
     pub stats: CycleStats,
+}
+
+impl RunSummary {
+    /// Cycles executed.
+    pub fn cycles(&self) -> u64 {
+        self.stats.cycles
+    }
 }
 
 /// Why the cyclic loop ended.
@@ -246,13 +237,7 @@ impl PlcRuntime {
     ) -> Result<RunSummary, RuntimeError> {
         let mut watch = HeartbeatWatch::new(self.watchdog_cycles);
         let mut stats = CycleStats::default();
-        let end = |end, stats: CycleStats| {
-            Ok(RunSummary {
-                cycles: stats.cycles,
-                end,
-                stats,
-            })
-        };
+        let end = |end, stats: CycleStats| Ok(RunSummary { end, stats });
         // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
         // its cycle (lockstep waits for exactly that cycle).
         let mut last_cnc_beat = 0;

@@ -157,11 +157,9 @@ enum Role {
 /// `X_semaphore_rw` guards its sibling `X_w` (PLC→CNC) or `X_r` (CNC→PLC); a struct with a
 /// `command` leaf both sides write is guarded by it.
 fn role(path: &str, leaf: &Leaf) -> Role {
-    let table = SymbolTable::global();
-    let sym = |p: &str| table.lookup(p).map(|s| s.writer);
     if let Some(unit) = path.strip_suffix("_semaphore_rw") {
         // `unit` is `...prefix.X`: the sibling payload is `X_w` or `X_r`.
-        return if sym(&format!("{unit}_w")).is_some() {
+        return if SymbolTable::global().lookup(&format!("{unit}_w")).is_some() {
             Role::PublishSemaphore
         } else {
             Role::TakeSemaphore
@@ -235,51 +233,63 @@ fn resolve_all(paths: &[String]) -> Result<Vec<Leaf>, ToolError> {
         .collect()
 }
 
-/// One checked write.
+/// One write: a resolved leaf and a value in its range.
 #[derive(Debug, Clone, Copy)]
-pub struct Write {
+pub struct Write<'p> {
+    /// The path as given.
+    pub path: &'p str,
     /// The leaf.
     pub leaf: Leaf,
     /// The value, in range.
     pub value: Value,
 }
 
-/// Checks `pairs` (PATH VALUE ...) against the image and the protocol; each pair sees the
-/// state the pairs before it leave. Nothing is written.
-pub fn plan_writes(memory: &ImageMemory, pairs: &[String]) -> Result<Vec<Write>, ToolError> {
-    let mut writes: Vec<Write> = Vec::new();
-    for pair in pairs.chunks(2) {
-        let path = &pair[0];
-        let Some(text) = pair.get(1) else {
-            return Err(ToolError::MissingValue(path.clone()));
-        };
-        let leaf = Leaf::resolve(path)?;
-        let value = parse_value(path, text, &leaf)?;
-        // The value of a leaf after the writes planned so far.
+/// Resolves the paths and parses the values of `pairs` (PATH VALUE ...); needs no CNC.
+pub fn parse_pairs(pairs: &[String]) -> Result<Vec<Write<'_>>, ToolError> {
+    pairs
+        .chunks(2)
+        .map(|pair| {
+            let path = pair[0].as_str();
+            let text = pair
+                .get(1)
+                .ok_or_else(|| ToolError::MissingValue(path.to_string()))?;
+            let leaf = Leaf::resolve(path)?;
+            let value = parse_value(path, text, &leaf)?;
+            Ok(Write { path, leaf, value })
+        })
+        .collect()
+}
+
+/// Checks `writes` against the image and the protocol, each seeing the state the writes
+/// before it leave. Nothing is written.
+pub fn check_protocol(memory: &ImageMemory, writes: &[Write<'_>]) -> Result<(), ToolError> {
+    for (k, w) in writes.iter().enumerate() {
+        let (leaf, value) = (&w.leaf, w.value);
+        // The value of a leaf after the writes before this one.
         let now = |l: &Leaf| {
-            writes
+            writes[..k]
                 .iter()
                 .rev()
-                .find(|w| w.leaf.offset == l.offset)
-                .map_or_else(|| l.read(memory), |w| w.value)
+                .find(|e| e.leaf.offset == l.offset)
+                .map_or_else(|| l.read(memory), |e| e.value)
                 .as_f64()
         };
         let refuse = |reason| {
             Err(ToolError::Refused {
-                path: path.clone(),
+                path: w.path.to_string(),
                 reason,
             })
         };
-        match role(path, &leaf) {
+        match role(w.path, leaf) {
             Role::CncOwned => return refuse(Refusal::CncOwned),
             Role::Free => {}
             Role::Payload(sem) if now(&sem) != 0.0 => return refuse(Refusal::Pending),
             Role::Payload(_) => {}
-            Role::PublishSemaphore if now(&leaf) != 0.0 || value.as_f64() == 0.0 => {
+            Role::PublishSemaphore if now(leaf) != 0.0 || value.as_f64() == 0.0 => {
                 return refuse(Refusal::PublishOnly)
             }
             Role::PublishSemaphore => {}
-            Role::TakeSemaphore if now(&leaf) == 0.0 || value.as_f64() != 0.0 => {
+            Role::TakeSemaphore if now(leaf) == 0.0 || value.as_f64() != 0.0 => {
                 return refuse(Refusal::TakeOnly)
             }
             Role::TakeSemaphore => {}
@@ -288,12 +298,11 @@ pub fn plan_writes(memory: &ImageMemory, pairs: &[String]) -> Result<Vec<Write>,
             }
             Role::Parameter(_) => {}
             Role::CommandWord if value.as_f64() == 0.0 => return refuse(Refusal::CommandZero),
-            Role::CommandWord if now(&leaf) != 0.0 => return refuse(Refusal::CommandPending),
+            Role::CommandWord if now(leaf) != 0.0 => return refuse(Refusal::CommandPending),
             Role::CommandWord => {}
         }
-        writes.push(Write { leaf, value });
     }
-    Ok(writes)
+    Ok(())
 }
 
 fn attach(instance: &str) -> Result<PlcSegment, ToolError> {
@@ -311,24 +320,17 @@ pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
         .collect())
 }
 
-/// `plc set`: checks every pair, then writes them in order; returns the lines it prints.
+/// `plc set`: parses every pair (a typo is reported the same with or without a CNC), checks
+/// them against the protocol, then writes them in order; returns the lines it prints.
 pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
-    // Paths and values first, so a typo is reported the same with or without a CNC.
-    for pair in pairs.chunks(2) {
-        let leaf = Leaf::resolve(&pair[0])?;
-        match pair.get(1) {
-            Some(text) => drop(parse_value(&pair[0], text, &leaf)?),
-            None => return Err(ToolError::MissingValue(pair[0].clone())),
-        }
-    }
+    let writes = parse_pairs(pairs)?;
     let segment = attach(instance)?;
-    let writes = plan_writes(segment.memory(), pairs)?;
-    Ok(pairs
-        .chunks(2)
-        .zip(writes)
-        .map(|(pair, w)| {
+    check_protocol(segment.memory(), &writes)?;
+    Ok(writes
+        .iter()
+        .map(|w| {
             w.leaf.write(segment.memory(), w.value);
-            format!("{} := {}", pair[0], show(&w.leaf, w.value))
+            format!("{} := {}", w.path, show(&w.leaf, w.value))
         })
         .collect())
 }
@@ -425,8 +427,13 @@ mod tests {
         p.iter().map(|s| s.to_string()).collect()
     }
 
+    /// Parses and checks `pairs` as `plc set` does, writing nothing.
+    fn plan(memory: &ImageMemory, pairs: &[String]) -> Result<(), ToolError> {
+        check_protocol(memory, &parse_pairs(pairs)?)
+    }
+
     fn refusal(memory: &ImageMemory, p: &[&str]) -> Option<Refusal> {
-        match plan_writes(memory, &pairs(p)) {
+        match plan(memory, &pairs(p)) {
             Err(ToolError::Refused { reason, .. }) => Some(reason),
             Ok(_) => None,
             Err(e) => panic!("{e}"),
@@ -434,7 +441,10 @@ mod tests {
     }
 
     fn apply(memory: &ImageMemory, p: &[&str]) {
-        for w in plan_writes(memory, &pairs(p)).unwrap() {
+        let given = pairs(p);
+        let writes = parse_pairs(&given).unwrap();
+        check_protocol(memory, &writes).unwrap();
+        for w in writes {
             w.leaf.write(memory, w.value);
         }
     }
@@ -515,14 +525,14 @@ mod tests {
     fn bad_values_are_refused_before_anything_is_written() {
         let memory = heap_image(1, 1);
         for (p, v) in [(ENABLE, "2"), (ROT, "0.5"), (ROT, "abc"), (ROT, "1e12")] {
-            let e = plan_writes(&memory, &pairs(&[ROT, "7", p, v])).unwrap_err();
+            let e = plan(&memory, &pairs(&[ROT, "7", p, v])).unwrap_err();
             assert_eq!(e.exit_code(), 2, "{e}");
         }
         assert_eq!(Leaf::resolve(ROT).unwrap().read(&memory), Value::Int(0));
-        let e = plan_writes(&memory, &pairs(&["gpCh[0]^nope", "1"])).unwrap_err();
+        let e = plan(&memory, &pairs(&["gpCh[0]^nope", "1"])).unwrap_err();
         assert!(e.to_string().contains("no symbol `gpCh[0]^nope`"), "{e}");
         assert!(matches!(
-            plan_writes(&memory, &pairs(&[ROT])),
+            plan(&memory, &pairs(&[ROT])),
             Err(ToolError::MissingValue(_))
         ));
     }

@@ -23,9 +23,9 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     let summary = runtime.run(&mut Idle, Some(1_000)).unwrap();
     assert_eq!(summary.end, RunEnd::CncLost);
     assert!(
-        summary.cycles <= 1,
+        summary.cycles() <= 1,
         "{} cycles without CNC ticks",
-        summary.cycles
+        summary.cycles()
     );
     drop(runtime);
     tests::remove_stale_segment(&instance);
@@ -70,7 +70,7 @@ fn a_task_every_third_tick_runs_in_lockstep_and_is_timed() {
         program.ticks,
         (0..100).map(|k| 1 + 3 * k).collect::<Vec<u64>>()
     );
-    assert_eq!(summary.cycles, 100);
+    assert_eq!(summary.cycles(), 100);
     assert_eq!(summary.stats.cycles, 100);
     assert_eq!(summary.stats.overruns, 0);
     assert!(summary.stats.max_ns > 0);

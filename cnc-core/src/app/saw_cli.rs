@@ -293,30 +293,27 @@ fn plan(args: &PlanArgs) -> Result<String, Failure> {
 
 /// Master and slave positions and velocities over time, one panel each.
 fn plot_trace(csv: &str, out: &std::path::Path) -> Result<(), crate::app::plot::PlotError> {
-    use crate::app::plot::{Figure, PlotArgs, Table};
+    use crate::app::plot::{Figure, Series, Table, Unit};
     let table = Table::parse("trace", csv)?;
-    let args = PlotArgs {
-        trace: PathBuf::new(),
-        signals: [
-            "master_position=raw",
-            "slave_position=raw",
-            "master_velocity=raw",
-            "slave_velocity=raw",
-        ]
-        .map(String::from)
-        .to_vec(),
-        out: out.to_path_buf(),
-        title: None,
-        x: None,
-    };
-    let mut figure = Figure::from_table(&table, &args, "flying saw: synchronisation")?;
-    for s in &mut figure.series {
-        s.unit.label = if s.name.ends_with("position") {
-            "position"
-        } else {
-            "velocity /s"
-        };
+    let time = table.column("time")?;
+    let mut series = Vec::new();
+    for (name, label) in [
+        ("master_position", "position"),
+        ("slave_position", "position"),
+        ("master_velocity", "velocity /s"),
+        ("slave_velocity", "velocity /s"),
+    ] {
+        series.push(Series {
+            name: name.into(),
+            unit: Unit { label, scale: 1.0 },
+            points: time.iter().copied().zip(table.column(name)?).collect(),
+        });
     }
+    let figure = Figure {
+        title: "flying saw: synchronisation".into(),
+        x_label: "time [s]".into(),
+        series,
+    };
     figure.save_svg(out)
 }
 
