@@ -7,12 +7,10 @@ pub mod fifo_stream;
 pub mod saw_cut;
 pub mod turntable;
 
+use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
-use hli::enums::{DynCsCommand, DynCsState};
-use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition, HliMFunctionAck};
 use hli::rpc::{PendingCall, ReadAxisState};
-use hli::Bool;
 
 /// The table axis (index in `gpAx`).
 const TABLE_AXIS: u32 = 0;
@@ -20,42 +18,27 @@ const TABLE_AXIS: u32 = 0;
 const NOMINAL_CYCLE_S: f64 = 0.001;
 
 /// The PLC as master of a dynamic coordinate system: a rotary table turning at a constant
-/// speed (the seed's example 4, PLC-only variant). It powers the table axis and turns it with
-/// MC_MoveVelocity; every cycle it commands the table frame (rotation = the axis's actual
-/// position)
-/// through `MC_CONTROL_DYN_CS_UNIT.command_w`, switches tracking on through `transition_w`,
-/// reads back `request_r`, acknowledges M functions and reads the table axis acyclically.
-#[derive(Debug, Default)]
+/// speed. It powers the table axis and turns it with MC_MoveVelocity; every cycle it commands
+/// the table frame (rotation = the axis's actual position) through [`DynCsMaster`], switches
+/// tracking on in its second cycle through [`McDynCsTransition`], acknowledges M functions and
+/// reads the table axis acyclically now and then.
+#[derive(Debug)]
 pub struct RotaryTableMaster {
     /// Channel whose unit the PLC drives.
     pub channel: usize,
     /// Table speed, degree per PLC cycle.
     pub deg_per_cycle: f64,
-    /// Filter ticks sent with the activation.
-    pub filter_ticks: u32,
-    /// Commands the CNC consumed (sent while free).
-    pub commands_sent: u64,
-    /// Commands refused because the previous one was pending.
-    pub commands_busy: u64,
-    /// Requests read back.
-    pub requests_read: u64,
-    /// Transitions sent.
-    pub transitions_sent: u64,
-    /// M functions acknowledged.
-    pub m_functions_acked: u64,
     /// Acyclic axis reads answered.
     pub acyclic_replies: u64,
     /// Acyclic calls that failed.
     pub acyclic_errors: u64,
-    /// Protocol or decoding problems seen.
-    pub errors: u64,
-    /// Last tracking state seen.
-    pub last_state: Option<DynCsState>,
+    /// Axis blocks that reported an error (counted once per error shown).
+    pub axis_errors: u64,
     /// The table axis reached its velocity.
     pub table_in_velocity: bool,
-    /// Last table position read from the image, 0.0001 degree.
-    pub table_position: i32,
-    pending_ack: Option<HliMFunctionAck>,
+    master: DynCsMaster,
+    switch: McDynCsTransition,
+    m: MFunctionHandshake,
     power: McPower,
     turn: McMoveVelocity,
     axis_failing: bool,
@@ -63,25 +46,32 @@ pub struct RotaryTableMaster {
 }
 
 impl RotaryTableMaster {
-    /// A table on `channel` turning `deg_per_cycle` per cycle.
+    /// A table on `channel` turning `deg_per_cycle` per cycle, tracking switched on with a
+    /// filter of `filter_ticks`.
     pub fn new(channel: usize, deg_per_cycle: f64, filter_ticks: u32) -> Self {
+        let mut switch = McDynCsTransition::default();
+        switch.filter_max_ticks = filter_ticks;
         Self {
             channel,
             deg_per_cycle,
-            filter_ticks,
-            ..Self::default()
+            acyclic_replies: 0,
+            acyclic_errors: 0,
+            axis_errors: 0,
+            table_in_velocity: false,
+            master: DynCsMaster::default(),
+            switch,
+            m: MFunctionHandshake::default(),
+            power: McPower::default(),
+            turn: McMoveVelocity::default(),
+            axis_failing: false,
+            read: None,
         }
     }
 }
 
 impl PlcProgram for RotaryTableMaster {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
-        let view = io.view;
         let ch = self.channel;
-        if io.cycle == 0 && view.set_dyn_cs_enabled(ch, true).is_err() {
-            self.errors += 1;
-            return;
-        }
         // The table axis: powered, then turning at the configured speed.
         self.power.enable = true;
         self.power.call(io, TABLE_AXIS);
@@ -96,76 +86,23 @@ impl PlcProgram for RotaryTableMaster {
         self.turn.call(io, TABLE_AXIS);
         self.table_in_velocity |= self.turn.out.in_velocity;
         let failing = self.turn.out.error || self.power.error;
-        if failing && !self.axis_failing {
-            self.errors += 1; // once per refusal, not per cycle it stays shown
-        }
+        self.axis_errors += u64::from(failing && !self.axis_failing);
         self.axis_failing = failing;
-        // The table frame: rotation about Z by the table's actual position (wrapped to a turn).
-        if let Ok(axis) = view.axis_state(TABLE_AXIS as usize) {
-            self.table_position = axis.current_position_acs_r;
-        }
-        let frame = HliCoordinateSystemInt {
-            translation: [0; 3],
-            fill_up_2: 0,
-            rotation: [0, 0, self.table_position],
-            fill_up_1: 0,
-        };
-        match view.dyn_cs_command(ch).map(|tx| tx.try_send(&frame)) {
-            Ok(Ok(())) => self.commands_sent += 1,
-            Ok(Err(hli::handshake::SendError::Busy)) => self.commands_busy += 1,
-            _ => self.errors += 1,
-        }
-        if io.cycle == 1 {
-            let params = HliDynCsTransition {
-                command: 0,
-                filter_max_ticks: self.filter_ticks,
-                option: 0,
-                f_wait: Bool::FALSE,
-                f_set_zero: Bool::FALSE,
-                f_kin_base: Bool::FALSE,
-                f_rot_trans: Bool::FALSE,
-                kinematic_base_cs: bytemuck::Zeroable::zeroed(),
-            };
-            match view
-                .dyn_cs_transition(ch)
-                .map(|tx| tx.try_send(DynCsCommand::Activate, &params))
-            {
-                Ok(Ok(())) => self.transitions_sent += 1,
-                _ => self.errors += 1,
-            }
-        }
-        if let Ok(mut rx) = view.dyn_cs_request(ch) {
-            match rx.try_take() {
-                Ok(Some(_)) => self.requests_read += 1,
-                Ok(None) => {}
-                Err(_) => self.errors += 1,
-            }
-        }
-        match view.dyn_cs_state(ch) {
-            Ok(Ok(state)) => self.last_state = Some(state),
-            _ => self.errors += 1,
-        }
-        // M functions: read the announcement, acknowledge it (possibly a later cycle).
-        if let Ok(mut rx) = view.m_function_request(ch) {
-            match rx.try_take() {
-                Ok(Some(request)) => {
-                    self.pending_ack = Some(HliMFunctionAck {
-                        m_code: request.m_code,
-                        request_id: request.request_id,
-                    })
-                }
-                Ok(None) => {}
-                Err(_) => self.errors += 1,
-            }
-        }
-        if let Some(ack) = self.pending_ack {
-            if let Ok(Ok(())) = view.m_function_ack(ch).map(|tx| tx.try_send(&ack)) {
-                self.pending_ack = None;
-                self.m_functions_acked += 1;
-            }
-        }
+        // The table frame: rotation about Z by the table's actual position, every cycle.
+        self.master.enable = true;
+        self.master.send = true;
+        self.master.frame.rotation[2] = io
+            .gp_ax(TABLE_AXIS as usize)
+            .map_or(0, |axis| axis.lr_state().current_position_acs_r);
+        self.master.call(io, ch);
+        // Tracking on in the second cycle (a one-cycle Execute pulse).
+        self.switch.execute = io.cycle == 1;
+        self.switch.call(io, ch);
+        // M functions: acknowledged as they come.
+        self.m.call(io, ch);
+        self.m.acknowledge(io, ch);
         // Acyclic read of the table axis now and then, without blocking the cycle.
-        if io.cycle % 500 == 250 && view.axis_count() > 0 && self.read.is_none() {
+        if io.cycle % 500 == 250 && io.view.axis_count() > 0 && self.read.is_none() {
             match io.acyclic.start(TABLE_AXIS, &ReadAxisState::default()) {
                 Ok(pending) => self.read = Some(pending),
                 Err(_) => self.acyclic_errors += 1,
@@ -182,16 +119,17 @@ impl PlcProgram for RotaryTableMaster {
 
     fn summary(&self) -> String {
         format!(
-            "plc: commands {} (busy {}), requests read {}, transitions {}, M acks {}, acyclic replies {} (errors {}), protocol errors {}, last state {:?}, table in velocity {}",
-            self.commands_sent,
-            self.commands_busy,
-            self.requests_read,
-            self.transitions_sent,
-            self.m_functions_acked,
+            "plc: commands {} (busy {}), requests read {}, transitions {}, M acks {}, acyclic replies {} (errors {}), axis errors {}, block error {:#x}, last state {:?}, table in velocity {}",
+            self.master.frames_sent,
+            self.master.frames_waiting,
+            self.master.requests_read,
+            self.switch.sent,
+            self.m.acknowledged,
             self.acyclic_replies,
             self.acyclic_errors,
-            self.errors,
-            self.last_state,
+            self.axis_errors,
+            self.master.error_id.max(self.switch.out.error_id).max(self.m.error_id),
+            self.master.state,
             self.table_in_velocity
         )
     }
