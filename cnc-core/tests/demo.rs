@@ -1,9 +1,12 @@
-//! `cnc demo`: the embedded examples 3 and 4 run end to end with a spawned PLC process.
+//! `cnc demo`: the embedded machine (four robot channels, a cam station, a flying saw) with a
+//! spawned PLC process, end to end; its report and the files it writes.
 
-use std::process::Command;
+use std::path::PathBuf;
+use std::process::{Command, Output};
 
-fn demo(extra: &[&str], tag: &str) -> (String, std::path::PathBuf) {
+fn demo(extra: &[&str], tag: &str) -> (Output, String, PathBuf) {
     let out_dir = std::env::temp_dir().join(format!("cnc-demo-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out_dir);
     let instance = format!("demo{tag}-{}", std::process::id());
     let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("demo")
@@ -13,49 +16,114 @@ fn demo(extra: &[&str], tag: &str) -> (String, std::path::PathBuf) {
         .output()
         .expect("run cnc demo");
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    (out, stdout, out_dir)
+}
+
+fn assert_success(out: &Output, stdout: &str) {
     assert!(
         out.status.success(),
         "{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    (stdout, out_dir)
 }
 
-#[test]
-fn demo_runs_examples_3_and_4_to_their_end() {
-    let (stdout, dir) = demo(&["--lockstep"], "full");
-    // Example 3: both slaves switched on, followed, switched off; every program finished.
-    assert_eq!(
-        stdout.matches("dynCS: is on = DYN_CS_SYNC_ACTIVE").count(),
-        3,
-        "{stdout}"
+/// The summary line of a channel, whitespace collapsed.
+fn channel_line(stdout: &str, name: &str) -> String {
+    let line = stdout
+        .lines()
+        .skip_while(|l| *l != "== summary")
+        .find(|l| l.split_whitespace().next() == Some(name))
+        .unwrap_or_else(|| panic!("no summary line for {name}:\n{stdout}"));
+    line.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn assert_files(dir: &std::path::Path, min_rows: usize) {
+    let trace = std::fs::read_to_string(dir.join("demo.csv")).unwrap();
+    assert!(trace.starts_with("tick,time,"));
+    assert!(
+        trace.lines().count() > min_rows,
+        "{}",
+        trace.lines().count()
     );
-    assert_eq!(
-        stdout
-            .matches("dynCS: is off = DYN_CS_SYNC_INACTIVE")
-            .count(),
-        3,
-        "{stdout}"
-    );
-    assert!(!stdout.contains("error at line"), "{stdout}");
-    assert_eq!(stdout.matches(": finished;").count(), 4, "{stdout}");
-    // Example 4: the PLC acknowledged M100 and M101 and commanded the table angle.
-    assert!(stdout.contains("M functions acknowledged 2"), "{stdout}");
-    assert!(stdout.contains("cmd=ON PLC=1"), "{stdout}");
-    assert!(stdout.contains("ended by CncClosed"), "{stdout}");
-    assert!(stdout.contains("tick compute p50"), "{stdout}");
-    for name in ["example3-moving-workpiece", "example4-turntable-plc"] {
-        let trace = std::fs::read_to_string(dir.join(format!("{name}.csv"))).unwrap();
-        assert!(trace.starts_with("tick,time,"));
-        assert!(trace.lines().count() > 10_000, "{name}");
+    for plot in ["robots", "tracking", "turntable", "cam", "saw"] {
+        let svg = std::fs::read_to_string(dir.join(format!("{plot}.svg"))).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("<polyline"), "{plot}");
     }
+}
+
+#[test]
+fn the_whole_machine_runs_through_in_lockstep() {
+    let (out, stdout, dir) = demo(&["--lockstep"], "full");
+    assert_success(&out, &stdout);
+    // Example 3: the master publishes, both slaves switch on (ON, ACTIVE) and off (OFF,
+    // INACTIVE); example 4: the PLC switches the turntable robot on M100 / M101.
+    assert_eq!(
+        channel_line(&stdout, "master"),
+        "master finished blocks 11 tracking state changes 0 M handshakes 0 max tracking error 0.000000 mm"
+    );
+    for slave in ["slave-left", "slave-right"] {
+        let line = channel_line(&stdout, slave);
+        assert!(
+            line.starts_with(&format!(
+                "{slave} finished blocks 11 tracking state changes 4 M handshakes 0"
+            )),
+            "{line}"
+        );
+    }
+    let line = channel_line(&stdout, "turntable");
+    assert!(
+        line.starts_with("turntable finished blocks 21 tracking state changes 4 M handshakes 2"),
+        "{line}"
+    );
+    assert!(stdout.contains("cmd=ON PLC=1"), "{stdout}");
+    assert!(stdout.contains("M-function handshakes 2;"), "{stdout}");
+    // The PLC's three stations each ran their sequence through.
+    assert!(
+        stdout.contains("transitions sent 2 done 2 failed 0, M functions 2 acknowledged 2"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("cam-conveyor: Finished;"), "{stdout}");
+    assert!(
+        stdout.contains("saw-cut: Finished, 5 cuts, piece length min 500.0000 max 500.0000 mm"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("CNC tick (14500 ticks): compute p50"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("PLC task: 14500 cycles"), "{stdout}");
+    assert!(stdout.contains("overruns 0"), "{stdout}");
+    assert_files(&dir, 14_500);
     let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
-fn demo_runs_in_real_time() {
-    let (stdout, dir) = demo(&["--ticks", "400"], "rt");
-    assert_eq!(stdout.matches("ticks 400;").count(), 2, "{stdout}");
+fn a_shortened_demo_runs_in_real_time() {
+    let (out, stdout, dir) = demo(&["--ticks", "3000"], "rt");
+    assert_success(&out, &stdout);
     assert!(stdout.contains("real-time mode"), "{stdout}");
+    assert!(
+        stdout.contains("CNC tick (3000 ticks): compute p50"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("start lateness p50"), "{stdout}");
+    // The PLC ran with the CNC and ended in order; its task statistics are reported.
+    assert!(stdout.contains("ended by CncClosed"), "{stdout}");
+    assert!(stdout.contains("PLC task: "), "{stdout}");
+    // Three seconds in: the slaves track, the cam station has started its sequence.
+    for name in ["master", "slave-left", "slave-right", "turntable"] {
+        channel_line(&stdout, name);
+    }
+    assert!(stdout.contains("written to "), "{stdout}");
+    assert_files(&dir, 2_900);
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_arguments_are_refused_and_write_nothing() {
+    let (out, stdout, dir) = demo(&["--ticks", "many"], "bad");
+    assert_eq!(out.status.code(), Some(2), "{stdout}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("--ticks"), "{stderr}");
+    assert!(!dir.exists());
 }

@@ -52,7 +52,9 @@ pub struct PlcArgs {
     /// Where and how the program runs.
     #[command(flatten)]
     pub host: HostArgs,
-    /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0).
+    /// Built-in program: `rotary-table` (PLC as dynamic-CS master of channel 0),
+    /// `turntable-hybrid`, `turntable-plc-only`, `cam-conveyor`, `fifo-stream`, `saw-cut` or
+    /// `demo-machine` (the machine of `cnc demo`).
     #[arg(long, default_value = "rotary-table")]
     pub program: String,
     /// Run this timeline (TOML, see `plc_shim::timeline`) instead of a built-in program.
@@ -67,13 +69,13 @@ pub struct PlcArgs {
     /// Override `fifo-stream` sets before the start, percent.
     #[arg(long)]
     pub fifo_override: Option<f64>,
-    /// Cuts `saw-cut` makes.
+    /// Cuts `saw-cut` (and the saw of `demo-machine`) makes.
     #[arg(long, default_value_t = 20)]
     pub saw_cuts: usize,
-    /// Piece length of `saw-cut`, mm.
+    /// Piece length of `saw-cut` and `demo-machine`, mm.
     #[arg(long, default_value_t = 500.0)]
     pub saw_length: f64,
-    /// Conveyor speed of `saw-cut`, mm/s.
+    /// Conveyor speed of `saw-cut` and `demo-machine`, mm/s.
     #[arg(long, default_value_t = 200.0)]
     pub saw_speed: f64,
     /// Table speed of `rotary-table`, degree per cycle.
@@ -89,6 +91,7 @@ pub const BUILT_IN_PROGRAMS: &[&str] = &[
     "cam-conveyor",
     "fifo-stream",
     "saw-cut",
+    "demo-machine",
 ];
 
 /// Runs a tool, or the PLC process (exit code 0 when the CNC closed in order).
@@ -121,6 +124,11 @@ pub fn run(args: PlcArgs) -> ExitCode {
             }
         },
         (None, "saw-cut") => Box::new(crate::programs::saw_cut::SawCut::new(
+            args.saw_cuts,
+            args.saw_length,
+            args.saw_speed,
+        )),
+        (None, "demo-machine") => Box::new(crate::programs::demo_machine::DemoMachine::new(
             args.saw_cuts,
             args.saw_length,
             args.saw_speed,

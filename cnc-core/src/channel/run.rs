@@ -152,6 +152,8 @@ pub struct Channel {
     plc_enabled: bool,
     m_next_id: u32,
     m_functions_acked: u64,
+    /// NC blocks the interpreter handed on (each block once, loops counted per pass).
+    blocks_executed: u64,
     tick: u64,
     /// The channel's cycle (s).
     cycle_s: f64,
@@ -232,6 +234,7 @@ impl Channel {
             plc_enabled: false,
             m_next_id: 0,
             m_functions_acked: 0,
+            blocks_executed: 0,
             tick: 0,
             cycle_s,
             spindle_speed: 0.0,
@@ -345,6 +348,11 @@ impl Channel {
     /// M functions the PLC acknowledged (completed handshakes).
     pub fn m_functions_acked(&self) -> u64 {
         self.m_functions_acked
+    }
+
+    /// NC blocks run so far (a block in a loop counts once per pass).
+    pub fn blocks_executed(&self) -> u64 {
+        self.blocks_executed
     }
 
     /// The file the program asked the dynamic-CS diagnosis to be written to
@@ -637,6 +645,7 @@ impl Channel {
                 false
             }
             Ok(Step::Block { unit, block }) => {
+                self.blocks_executed += 1;
                 if let Some(b) = program
                     .set
                     .units

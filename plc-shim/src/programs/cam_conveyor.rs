@@ -24,8 +24,8 @@ use crate::motion::{McHalt, McMoveVelocity};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::McMotionFunctionPoint;
 
-const CONVEYOR: u32 = 0;
-const LIFTER: u32 = 1;
+/// The axes of `scenarios/cam-conveyor-program` (`gpAx` indices): conveyor, lifter.
+pub const SCENARIO_AXES: [u32; 2] = [0, 1];
 const TABLE: u32 = 1;
 /// MC_CamActivationMode NextCycle; MC_CamScalingMode AutoOffset and Off.
 const NEXT_CYCLE: u32 = 3;
@@ -78,12 +78,22 @@ pub struct CamConveyor {
     change: McWriteMotionFunctionPoint,
     out: McCamOut,
     halt: McHalt,
+    /// The conveyor (master) and the lifter (`gpAx` indices).
+    axes: [u32; 2],
 }
 
 impl CamConveyor {
-    /// The program before its first cycle.
+    /// The program before its first cycle, on [`SCENARIO_AXES`].
     pub fn new() -> CamConveyor {
-        let mut p = CamConveyor::default();
+        CamConveyor::on_axes(SCENARIO_AXES)
+    }
+
+    /// The program on `[conveyor, lifter]` (`gpAx` indices).
+    pub fn on_axes(axes: [u32; 2]) -> CamConveyor {
+        let mut p = CamConveyor {
+            axes,
+            ..CamConveyor::default()
+        };
         p.entered.reserve(16);
         p.entered.push((Step::Select, 0));
         p
@@ -105,6 +115,7 @@ impl CamConveyor {
 impl PlcProgram for CamConveyor {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
         let cycle = io.cycle;
+        let [conveyor, lifter] = self.axes;
         match self.step {
             Step::Select => {
                 self.select.table = TABLE;
@@ -120,11 +131,11 @@ impl PlcProgram for CamConveyor {
                 }
             }
             Step::Couple => {
-                self.cam_in.master = CONVEYOR;
+                self.cam_in.master = conveyor;
                 self.cam_in.table = TABLE;
                 self.cam_in.start_mode = 1;
                 self.cam_in.execute = true;
-                self.cam_in.call(io, LIFTER);
+                self.cam_in.call(io, lifter);
                 if self.cam_in.out.error {
                     self.fail(self.cam_in.out.error_id);
                 } else if self.cam_in.out.in_sync {
@@ -133,14 +144,14 @@ impl PlcProgram for CamConveyor {
             }
             Step::Run | Step::Scale | Step::Mode | Step::Change | Step::Out | Step::Halt => {
                 // The coupling and the conveyor's move are called every cycle while they run.
-                self.cam_in.call(io, LIFTER);
+                self.cam_in.call(io, lifter);
                 self.run.velocity = 360.0;
                 self.run.direction = 1;
                 self.run.acceleration = 3600.0;
                 self.run.deceleration = 3600.0;
                 self.run.jerk = 36000.0;
                 self.run.execute = self.step != Step::Halt;
-                self.run.call(io, CONVEYOR);
+                self.run.call(io, conveyor);
                 if self.run.out.error {
                     return self.fail(self.run.out.error_id);
                 }
@@ -163,6 +174,7 @@ impl PlcProgram for CamConveyor {
 impl CamConveyor {
     /// The steps after the conveyor runs.
     fn sequence(&mut self, io: &mut PlcIo<'_>, cycle: u64) {
+        let [conveyor, lifter] = self.axes;
         match self.step {
             Step::Run if cycle >= 1700 && self.run.out.in_velocity => {
                 self.go(Step::Scale, cycle);
@@ -173,7 +185,7 @@ impl CamConveyor {
                 self.scale.slave_scaling_mode = AUTO_OFFSET;
                 self.scale.slave_scaling = 0.5;
                 self.scale.execute = true;
-                self.scale.call(io, LIFTER);
+                self.scale.call(io, lifter);
                 if self.scale.out.error {
                     self.fail(self.scale.out.error_id);
                 } else if self.scale.out.done && cycle >= 2600 {
@@ -215,10 +227,10 @@ impl CamConveyor {
                 // In the cam's last rest (350..360 degrees of the conveyor's turn).
                 let at_rest = io
                     .view
-                    .axis_state(CONVEYOR as usize)
+                    .axis_state(conveyor as usize)
                     .is_ok_and(|s| s.command_position_acs_r > 3_500_000);
                 self.out.execute = cycle >= 4000 && at_rest || self.out.execute;
-                self.out.call(io, LIFTER);
+                self.out.call(io, lifter);
                 if self.out.out.error {
                     self.fail(self.out.out.error_id);
                 } else if self.out.out.done {
@@ -229,7 +241,7 @@ impl CamConveyor {
                 self.halt.deceleration = 3600.0;
                 self.halt.jerk = 36000.0;
                 self.halt.execute = true;
-                self.halt.call(io, CONVEYOR);
+                self.halt.call(io, conveyor);
                 if self.halt.out.error {
                     self.fail(self.halt.out.error_id);
                 } else if self.halt.out.done {

@@ -1,8 +1,11 @@
-//! Example PLC programs: the rotary table as dynamic-CS master (here), the cam conveyor
-//! ([`cam_conveyor`]), a position file streamed through a FIFO group ([`fifo_stream`]) and a
-//! flying saw cutting equal lengths ([`saw_cut`]).
+//! Example PLC programs: the rotary table as dynamic-CS master (here), the turntable of
+//! application example 4 ([`turntable`]), the cam conveyor ([`cam_conveyor`]), a position file
+//! streamed through a FIFO group ([`fifo_stream`]), a flying saw cutting equal lengths
+//! ([`saw_cut`]), and the program of `cnc demo`'s machine built from three of them
+//! ([`demo_machine`]).
 
 pub mod cam_conveyor;
+pub mod demo_machine;
 pub mod fifo_stream;
 pub mod saw_cut;
 pub mod turntable;

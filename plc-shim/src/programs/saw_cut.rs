@@ -23,9 +23,8 @@ use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
 use crate::saw::{McGearInPos, McGearOut};
 
-const CONVEYOR: u32 = 0;
-const SAW: u32 = 1;
-const BLADE: u32 = 2;
+/// The axes of the seed's sample (`gpAx` indices): conveyor, saw carriage, blade.
+pub const SAMPLE_AXES: [u32; 3] = [0, 1, 2];
 /// Conveyor position of the first cut, mm.
 const FIRST_CUT: f64 = 600.0;
 /// Saw position where it is synchronous, mm.
@@ -81,6 +80,8 @@ pub struct SawCut {
     pub made: usize,
     /// Where each cut lies on the material (saw - conveyor set-points at the cut), mm.
     pub cut_at: [f64; MAX_CUTS],
+    /// The conveyor, saw carriage and blade (`gpAx` indices).
+    axes: [u32; 3],
     power: [McPower; 3],
     conveyor: McMoveVelocity,
     halt: McHalt,
@@ -106,8 +107,9 @@ impl SawCut {
         let mut blade = McMoveAbsolute::default();
         limits(&mut blade, 500.0);
         let mut gear_in = McGearInPos::default();
-        gear_in.master = CONVEYOR;
-        gear_in.slave = SAW;
+        let [conveyor_axis, saw_axis, _] = SAMPLE_AXES;
+        gear_in.master = conveyor_axis;
+        gear_in.slave = saw_axis;
         gear_in.slave_sync_position = SAW_SYNC;
         gear_in.inputs.acceleration = 4000.0;
         gear_in.inputs.deceleration = 4000.0;
@@ -122,7 +124,7 @@ impl SawCut {
         halt.deceleration = 2000.0;
         halt.jerk = 1e5;
         let mut gear_out = McGearOut::default();
-        gear_out.slave = SAW;
+        gear_out.slave = saw_axis;
         SawCut {
             step: Step::Power,
             cuts: cuts.min(MAX_CUTS),
@@ -130,6 +132,7 @@ impl SawCut {
             speed,
             made: 0,
             cut_at: [0.0; MAX_CUTS],
+            axes: SAMPLE_AXES,
             power: Default::default(),
             conveyor,
             halt,
@@ -139,6 +142,15 @@ impl SawCut {
             blade,
             rearm: false,
         }
+    }
+
+    /// The same program on other axes: `[conveyor, saw carriage, blade]` (`gpAx` indices).
+    pub fn on_axes(mut self, axes: [u32; 3]) -> SawCut {
+        self.axes = axes;
+        self.gear_in.master = axes[0];
+        self.gear_in.slave = axes[1];
+        self.gear_out.slave = axes[1];
+        self
     }
 
     fn fail(&mut self, error_id: u32) {
@@ -164,9 +176,9 @@ impl SawCut {
     }
 
     /// The saw and conveyor set-points in mm.
-    fn set_points(io: &PlcIo<'_>) -> Option<(f64, f64)> {
-        let c = io.view.axis_state(CONVEYOR as usize).ok()?;
-        let s = io.view.axis_state(SAW as usize).ok()?;
+    fn set_points(&self, io: &PlcIo<'_>) -> Option<(f64, f64)> {
+        let c = io.view.axis_state(self.axes[0] as usize).ok()?;
+        let s = io.view.axis_state(self.axes[1] as usize).ok()?;
         Some((
             s.command_position_acs_r as f64 * 1e-4,
             c.command_position_acs_r as f64 * 1e-4,
@@ -177,17 +189,18 @@ impl SawCut {
 impl PlcProgram for SawCut {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
         // Power and the conveyor stay called every cycle (MC_Power is level-driven).
-        for (axis, p) in self.power.iter_mut().enumerate() {
+        let [conveyor, saw, blade] = self.axes;
+        for (&axis, p) in self.axes.iter().zip(self.power.iter_mut()) {
             p.enable = true;
-            p.call(io, axis as u32);
+            p.call(io, axis);
         }
         let rearm = core::mem::take(&mut self.rearm);
         let on = |step: Step, here: Step| !rearm && step == here;
         let step = self.step;
         self.conveyor.execute = !matches!(step, Step::Power);
-        self.conveyor.call(io, CONVEYOR);
+        self.conveyor.call(io, conveyor);
         self.halt.execute = on(step, Step::End);
-        self.halt.call(io, CONVEYOR);
+        self.halt.call(io, conveyor);
         self.gear_in.execute = on(step, Step::Sync);
         let next_cut = FIRST_CUT + self.made as f64 * self.length;
         self.gear_in.master_sync_position = next_cut;
@@ -196,10 +209,10 @@ impl PlcProgram for SawCut {
         self.gear_out.call(io);
         self.saw_home.position = 0.0;
         self.saw_home.execute = on(step, Step::Return) || on(step, Step::End);
-        self.saw_home.call(io, SAW);
+        self.saw_home.call(io, saw);
         self.blade.position = if step == Step::Down { DEPTH } else { 0.0 };
         self.blade.execute = on(step, Step::Down) || on(step, Step::Up);
-        self.blade.call(io, BLADE);
+        self.blade.call(io, blade);
         if rearm {
             return;
         }
@@ -228,7 +241,7 @@ impl PlcProgram for SawCut {
             Step::Down => {
                 if self.blade.out.done {
                     if let (Some((s, c)), Some(slot)) =
-                        (Self::set_points(io), self.cut_at.get_mut(self.made))
+                        (self.set_points(io), self.cut_at.get_mut(self.made))
                     {
                         *slot = s - c;
                     }
@@ -259,7 +272,9 @@ impl PlcProgram for SawCut {
             Step::Return => {
                 // On the way home, once back behind the sync position: the next sync starts
                 // from the moving saw (the universal saw takes any start state).
-                let back = Self::set_points(io).is_some_and(|(s, _)| s < SAW_SYNC - 50.0);
+                let back = self
+                    .set_points(io)
+                    .is_some_and(|(s, _)| s < SAW_SYNC - 50.0);
                 if self.saw_home.out.error {
                     self.fail(self.saw_home.out.error_id);
                 } else if back || self.saw_home.out.done {

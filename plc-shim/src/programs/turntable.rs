@@ -17,10 +17,10 @@ use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::enums::{DynCsOption, DynCsState};
 
-/// The channel whose unit the PLC masters.
-const CHANNEL: usize = 0;
-/// The table axis, `gpAx[6]`.
-const TABLE_AXIS: usize = 6;
+/// The channel whose unit the PLC masters in `scenarios/example4-*`.
+pub const SCENARIO_CHANNEL: usize = 0;
+/// The table axis there, `gpAx[6]`.
+pub const SCENARIO_TABLE_AXIS: usize = 6;
 /// Robot base seen from the table centre, -X, 0.1 um (600 mm).
 const KIN_BASE_X: i32 = -6_000_000;
 
@@ -37,6 +37,10 @@ pub enum Variant {
 #[derive(Debug)]
 pub struct Turntable {
     variant: Variant,
+    /// The robot's channel.
+    channel: usize,
+    /// The table axis (`gpAx` index).
+    table_axis: usize,
     master: DynCsMaster,
     switch: McDynCsTransition,
     m: MFunctionHandshake,
@@ -47,8 +51,13 @@ pub struct Turntable {
 }
 
 impl Turntable {
-    /// The program of `variant`.
+    /// The program of `variant` on the seed example's channel and table axis.
     pub fn new(variant: Variant) -> Turntable {
+        Turntable::on(variant, SCENARIO_CHANNEL, SCENARIO_TABLE_AXIS)
+    }
+
+    /// The program of `variant` for the robot of `channel` with the table on `gpAx[table_axis]`.
+    pub fn on(variant: Variant, channel: usize, table_axis: usize) -> Turntable {
         let mut switch = McDynCsTransition::default();
         switch.option = DynCsOption::TranslationOnly;
         switch.wait = true;
@@ -57,6 +66,8 @@ impl Turntable {
         switch.kinematic_base_cs.translation[0] = KIN_BASE_X;
         Turntable {
             variant,
+            channel,
+            table_axis,
             master: DynCsMaster::default(),
             switch,
             m: MFunctionHandshake::default(),
@@ -68,8 +79,9 @@ impl Turntable {
 
 impl PlcProgram for Turntable {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let channel = self.channel;
         if self.variant == Variant::PlcOnly {
-            self.m.call(io, CHANNEL);
+            self.m.call(io, channel);
             let asked = match self.m.m_code() {
                 Some(100) => Some(true),
                 Some(101) => Some(false),
@@ -80,23 +92,23 @@ impl PlcProgram for Turntable {
             if let Some(on) = asked {
                 self.switch.on = on;
             }
-            self.switch.call(io, CHANNEL);
+            self.switch.call(io, channel);
             if asked.is_some() {
-                self.m.acknowledge(io, CHANNEL);
+                self.m.acknowledge(io, channel);
             }
             let out = self.switch.out;
             self.transitions_done += u64::from(out.done);
             self.transition_failures += u64::from(out.error || out.command_aborted);
         }
         let table = io
-            .gp_ax(TABLE_AXIS)
+            .gp_ax(self.table_axis)
             .map_or(0, |axis| axis.lr_state().current_position_acs_r);
         self.master.enable = true;
         // The state as the CNC reports it in this cycle decides (not the one of the last).
-        let state = io.gp_ch(CHANNEL).and_then(|ch| ch.dyn_cs_state().ok());
+        let state = io.gp_ch(channel).and_then(|ch| ch.dyn_cs_state().ok());
         self.master.send = state == Some(DynCsState::Active);
         self.master.frame.rotation[2] = table.saturating_neg();
-        self.master.call(io, CHANNEL);
+        self.master.call(io, channel);
     }
 
     fn summary(&self) -> String {

@@ -101,6 +101,10 @@ struct PlcFile {
     file: Option<String>,
     /// fifo-stream's override before the start, percent.
     fifo_override: Option<f64>,
+    /// Cuts of saw-cut and demo-machine's saw.
+    saw_cuts: Option<usize>,
+    /// Piece length of the saw, mm.
+    saw_length: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -235,6 +239,8 @@ impl Scenario {
                 program: None,
                 file: None,
                 fifo_override: None,
+                saw_cuts: None,
+                saw_length: None,
             }) => {
                 let (path, text) = open(&t)?;
                 // Checked here, so a bad timeline fails before any process starts.
@@ -252,6 +258,8 @@ impl Scenario {
                 program: Some(p),
                 file,
                 fifo_override,
+                saw_cuts,
+                saw_length,
             }) => {
                 if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p.as_str()) {
                     return Err(invalid(format!(
@@ -276,6 +284,19 @@ impl Scenario {
                     }
                     args.extend(["--fifo-override".to_string(), o.to_string()]);
                 }
+                if let Some(n) = saw_cuts {
+                    let max = plc_shim::programs::saw_cut::MAX_CUTS;
+                    if !(1..=max).contains(&n) {
+                        return Err(invalid(format!("[plc] saw_cuts = {n}: 1 to {max}")));
+                    }
+                    args.extend(["--saw-cuts".to_string(), n.to_string()]);
+                }
+                if let Some(l) = saw_length {
+                    if !(l.is_finite() && l > 0.0) {
+                        return Err(invalid(format!("[plc] saw_length = {l}: mm above 0")));
+                    }
+                    args.extend(["--saw-length".to_string(), l.to_string()]);
+                }
                 PlcSetup::Program(p, args)
             }
             Some(PlcFile {
@@ -284,7 +305,7 @@ impl Scenario {
                 ..
             }) => {
                 return Err(invalid(
-                    "[plc] `file` and `fifo_override` belong to a built-in program".into(),
+                    "[plc] `file`, `fifo_override`, `saw_cuts` and `saw_length` belong to a built-in program".into(),
                 ))
             }
             Some(_) => {

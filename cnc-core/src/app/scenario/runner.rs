@@ -141,6 +141,10 @@ pub struct ChannelReport {
     pub max_tracking_error_mm: f64,
     /// M-function handshakes completed.
     pub m_functions_acked: u64,
+    /// NC blocks run.
+    pub blocks: u64,
+    /// Dynamic-CS state changes (switching on, active, switching off, inactive, error).
+    pub state_changes: usize,
     /// The diagnosis tables.
     pub diagnosis: String,
     /// `#TRACK CS ON [LOG_FILE=..]`: where the program asked the diagnosis to go.
@@ -483,6 +487,18 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
                 .collect(),
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),
+            blocks: c.blocks_executed(),
+            state_changes: c
+                .tracker()
+                .log()
+                .filter(|(_, event)| {
+                    use crate::channel::dyn_cs::TrackEvent as E;
+                    matches!(
+                        event,
+                        E::On { .. } | E::Active | E::Off { .. } | E::Inactive | E::Error(_)
+                    )
+                })
+                .count(),
             diagnosis: c.dyn_cs_diagnosis(),
             log_file: c.log_file().map(str::to_string),
         })
@@ -518,8 +534,8 @@ impl RunReport {
         let mut out = String::new();
         for c in &self.channels {
             out.push_str(&format!(
-                "channel {}: {}; M functions acknowledged {}; max tracking error (tool point of the actual joints vs the commanded one) {:.6} mm\n",
-                c.name, c.outcome, c.m_functions_acked, c.max_tracking_error_mm
+                "channel {}: {}; blocks {}; tracking state changes {}; M functions acknowledged {}; max tracking error (tool point of the actual joints vs the commanded one) {:.6} mm\n",
+                c.name, c.outcome, c.blocks, c.state_changes, c.m_functions_acked, c.max_tracking_error_mm
             ));
             for (tick, event) in &c.tracking {
                 out.push_str(&format!("  {tick} {}\n", event.replace('\n', "\n  ")));
