@@ -96,6 +96,10 @@ pub enum CallKind {
     ProbeArm,
     /// [`crate::probe_calls::ProbeAbortCall`].
     ProbeAbort,
+    /// [`crate::diag_calls::DynCsHistoryReadCall`].
+    DynCsHistoryRead,
+    /// [`crate::diag_calls::DynCsLogReadCall`].
+    DynCsLogRead,
 }
 
 impl CallKind {
@@ -129,6 +133,8 @@ impl CallKind {
             CallKind::SawCharac => 42,
             CallKind::ProbeArm => 50,
             CallKind::ProbeAbort => 51,
+            CallKind::DynCsHistoryRead => 60,
+            CallKind::DynCsLogRead => 61,
         }
     }
 
@@ -162,6 +168,8 @@ impl CallKind {
             42 => Some(CallKind::SawCharac),
             50 => Some(CallKind::ProbeArm),
             51 => Some(CallKind::ProbeAbort),
+            60 => Some(CallKind::DynCsHistoryRead),
+            61 => Some(CallKind::DynCsLogRead),
             _ => None,
         }
     }

@@ -19,6 +19,7 @@ pub mod c_header;
 pub mod calls;
 pub mod command_book;
 pub mod desc;
+pub mod diag_calls;
 pub mod enums;
 pub mod events;
 pub mod fifo_calls;

@@ -106,6 +106,7 @@ pub fn main(args: DemoArgs) -> ExitCode {
     };
     print!("{}", report.render(false));
     print!("{}", summary(&report));
+    crate::app::scenario::runner::keep_diagnosis("cnc demo", &args.instance, &report);
     let written = write_outputs(&report, &args.out);
     let mut failed = report
         .channels

@@ -7,6 +7,7 @@ pub mod cam_cli;
 pub mod check_cli;
 pub mod demo;
 pub mod demo_plots;
+pub mod diag_cli;
 pub mod fifo_cli;
 pub mod json;
 pub mod kin_cli;

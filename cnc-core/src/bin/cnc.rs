@@ -38,6 +38,11 @@ enum Command {
         #[command(subcommand)]
         what: cnc_core::app::saw_cli::SawCommand,
     },
+    /// Diagnosis of a running or finished CNC.
+    Diag {
+        #[command(subcommand)]
+        what: cnc_core::app::diag_cli::DiagCommand,
+    },
     /// Plot signals of a trace CSV as SVG (one panel per unit, with legends).
     Plot(cnc_core::app::plot::PlotArgs),
     /// Kinematics: forward and inverse transformation.
@@ -75,6 +80,7 @@ fn main() -> ExitCode {
         }
         Command::Check(args) => cnc_core::app::check_cli::main(args),
         Command::Plot(args) => cnc_core::app::plot::main(args),
+        Command::Diag { what } => cnc_core::app::diag_cli::main(what),
         Command::Kin { what } => cnc_core::app::kin_cli::main(what),
         Command::Cam { what } => cnc_core::app::cam_cli::main(what),
         Command::Fifo { what } => cnc_core::app::fifo_cli::main(what),

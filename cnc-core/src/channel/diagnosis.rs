@@ -12,7 +12,7 @@
 //! follow the controller's `DYN_CS_SYNC_*`; the freeze, resume, error and refusal lines are
 //! ours.
 
-use super::dyn_cs::{MasterSource, TrackEvent, Tracker, LOG_LINES};
+use super::dyn_cs::{HistoryEntry, MasterSource, TrackEvent, Tracker, LOG_LINES};
 use std::fmt::Write as _;
 
 /// Level of the channel's own messages.
@@ -30,6 +30,20 @@ fn list(values: &[i64]) -> String {
 
 /// Renders the history and the log of channel `index` (0-based; printed 1-based).
 pub fn render(index: usize, tracker: &Tracker) -> String {
+    render_entries(
+        index,
+        tracker.history().copied(),
+        tracker.log().map(|(tick, event)| (*tick, *event)),
+    )
+}
+
+/// Renders a history and a log given entry by entry, oldest first (what a tool read from a
+/// running CNC).
+pub fn render_entries(
+    index: usize,
+    history: impl Iterator<Item = HistoryEntry>,
+    log: impl Iterator<Item = (u64, TrackEvent)>,
+) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "BAHN : DYNAMIC CS, CHANNEL-NR.: {}", index + 1);
     let _ = writeln!(out, "=====");
@@ -38,7 +52,7 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
         out,
         "TIME STATE POSITION_IN CS_TRANSLATION CS_ROTATION POSITION_OUT"
     );
-    for (n, e) in tracker.history().enumerate() {
+    for (n, e) in history.enumerate() {
         let time = if n == 0 {
             e.tick.to_string()
         } else {
@@ -58,9 +72,8 @@ pub fn render(index: usize, tracker: &Tracker) -> String {
     let _ = writeln!(out);
     let _ = writeln!(out, "BAHN LOGGING KANAL-NR.: {}", index + 1);
     let _ = writeln!(out, "=====");
-    let lines: Vec<(u64, u32, String)> = tracker
-        .log()
-        .flat_map(|(tick, event)| event_lines(*tick, event))
+    let lines: Vec<(u64, u32, String)> = log
+        .flat_map(|(tick, event)| event_lines(tick, &event))
         .collect();
     let kept = &lines[lines.len().saturating_sub(LOG_LINES)..];
     let _ = writeln!(

@@ -144,13 +144,77 @@ pub enum TrackError {
     PlcNotEnabled,
     /// A transition with invalid parameters.
     #[error("invalid transition parameter: {0}")]
-    BadTransition(&'static str),
+    BadTransition(BadParameter),
     /// The compensation could not be computed (non-finite frame).
     #[error("invalid master frame")]
     BadFrame,
     /// The machine stopped (its PLC was lost, or a stop was requested).
     #[error("machine stop")]
     MachineStop,
+}
+
+impl TrackError {
+    /// The error as two numbers (for the diagnosis read over the acyclic channel): its kind
+    /// and its value (a channel, a parameter).
+    pub fn code(self) -> (u32, u32) {
+        match self {
+            TrackError::AlreadyOn => (1, 0),
+            TrackError::NoMasterInterface(c) => (2, c as u32),
+            TrackError::NoSuchChannel(c) => (3, c as u32),
+            TrackError::OwnChannel => (4, 0),
+            TrackError::PlcNotEnabled => (5, 0),
+            TrackError::BadTransition(p) => (6, p as u32),
+            TrackError::BadFrame => (7, 0),
+            TrackError::MachineStop => (8, 0),
+        }
+    }
+
+    /// The error [`Self::code`] gave; `None` for numbers it never gives.
+    pub fn from_code(kind: u32, value: u32) -> Option<TrackError> {
+        let channel = value as usize;
+        Some(match kind {
+            1 => TrackError::AlreadyOn,
+            2 => TrackError::NoMasterInterface(channel),
+            3 => TrackError::NoSuchChannel(channel),
+            4 => TrackError::OwnChannel,
+            5 => TrackError::PlcNotEnabled,
+            6 => TrackError::BadTransition(BadParameter::ALL.get(value as usize).copied()?),
+            7 => TrackError::BadFrame,
+            8 => TrackError::MachineStop,
+            _ => return None,
+        })
+    }
+}
+
+/// Which parameter of a PLC transition was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum BadParameter {
+    /// The command word.
+    #[error("command word is not -1, 0 or +1")]
+    CommandWord = 0,
+    /// One of the flag bytes.
+    #[error("a flag byte is neither FALSE nor TRUE")]
+    FlagByte = 1,
+    /// ROT_TRANS with KIN_BASE.
+    #[error("f_rot_trans cannot be combined with f_kin_base")]
+    RotTransWithKinBase = 2,
+    /// The option.
+    #[error("option must be 0 or 1")]
+    OptionValue = 3,
+    /// The offset frame.
+    #[error("offset X..C is not finite")]
+    Offset = 4,
+}
+
+impl BadParameter {
+    /// Every parameter, in the order of their numbers.
+    pub const ALL: [BadParameter; 5] = [
+        BadParameter::CommandWord,
+        BadParameter::FlagByte,
+        BadParameter::RotTransWithKinBase,
+        BadParameter::OptionValue,
+        BadParameter::Offset,
+    ];
 }
 
 /// One line of the diagnosis history: what went in and out of the dynamic CS in one tick.
@@ -170,12 +234,25 @@ pub struct HistoryEntry {
     pub output: [i64; 6],
 }
 
+/// An entry of a [`Ring`] read by sequence number, and the window the ring keeps.
+#[derive(Debug, Clone, Copy)]
+pub struct RingRead<'a, T> {
+    /// The entry and its sequence number (`None`: nothing at or after the one asked for).
+    pub entry: Option<(u64, &'a T)>,
+    /// Entries pushed so far.
+    pub recorded: u64,
+    /// Entries kept.
+    pub kept: usize,
+}
+
 /// A ring of fixed capacity, filled at start-up (no allocation afterwards).
 #[derive(Debug, Clone)]
 pub struct Ring<T: Copy + Default> {
     entries: Vec<T>,
     next: usize,
     len: usize,
+    /// Entries pushed since creation: the sequence number the next one gets.
+    recorded: u64,
 }
 
 impl<T: Copy + Default> Ring<T> {
@@ -185,6 +262,7 @@ impl<T: Copy + Default> Ring<T> {
             entries: vec![T::default(); capacity],
             next: 0,
             len: 0,
+            recorded: 0,
         }
     }
 
@@ -196,6 +274,34 @@ impl<T: Copy + Default> Ring<T> {
         self.entries[self.next] = value;
         self.next = (self.next + 1) % self.entries.len();
         self.len = (self.len + 1).min(self.entries.len());
+        self.recorded += 1;
+    }
+
+    /// Entries pushed since creation (a ring of capacity 0 records none).
+    pub fn recorded(&self) -> u64 {
+        self.recorded
+    }
+
+    /// [`Self::at_or_after`] with the window.
+    pub fn read(&self, sequence: u64) -> RingRead<'_, T> {
+        RingRead {
+            entry: self.at_or_after(sequence),
+            recorded: self.recorded,
+            kept: self.len,
+        }
+    }
+
+    /// The entry with sequence number `sequence`, or the oldest kept one if `sequence` is
+    /// older; `None` when nothing is kept at or after it.
+    pub fn at_or_after(&self, sequence: u64) -> Option<(u64, &T)> {
+        let oldest = self.recorded - self.len as u64;
+        let sequence = sequence.max(oldest);
+        if sequence >= self.recorded {
+            return None;
+        }
+        let back = (self.recorded - sequence) as usize;
+        let cap = self.entries.len();
+        Some((sequence, &self.entries[(self.next + cap - back) % cap]))
     }
 
     /// Oldest first.
@@ -405,8 +511,25 @@ impl Tracker {
         self.log.iter()
     }
 
+    /// History entry `sequence` (or the oldest kept) and the window kept. For reads while
+    /// running.
+    pub fn history_at(&self, sequence: u64) -> RingRead<'_, HistoryEntry> {
+        self.history.read(sequence)
+    }
+
+    /// Log event `sequence` (or the oldest kept), as [`Self::history_at`].
+    pub fn log_at(&self, sequence: u64) -> RingRead<'_, (u64, TrackEvent)> {
+        self.log.read(sequence)
+    }
+
     fn event(&mut self, event: TrackEvent) {
         self.log.push((self.tick, event));
+    }
+
+    /// Logs `event` at the current tick (tests of the log's readers).
+    #[cfg(test)]
+    pub(crate) fn log_for_test(&mut self, event: TrackEvent) {
+        self.event(event);
     }
 
     /// Goes to ERROR for `error`, holding the applied compensation.
@@ -642,7 +765,7 @@ fn build_tracking(
         abc: [o[3], o[4], o[5]],
     };
     Tracking::new(mode, option, &offset, setup.rot_trans, reference)
-        .map_err(|_| TrackError::BadTransition("offset X..C is not finite"))
+        .map_err(|_| TrackError::BadTransition(BadParameter::Offset))
 }
 
 /// X..C words of a frame (Z-Y-X, as on the HLI).

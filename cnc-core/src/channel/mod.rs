@@ -6,6 +6,7 @@
 pub mod axes_out;
 pub mod config;
 pub mod controller;
+pub mod diag_wire;
 pub(crate) mod diagnosis;
 pub mod dyn_cs;
 pub mod path;

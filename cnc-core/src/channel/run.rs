@@ -15,7 +15,9 @@
 //!    channel interface, an M-function announcement.
 
 use super::config::{ChannelConfig, ChannelConfigError};
-use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
+use super::dyn_cs::{
+    words, BadParameter, MasterSample, MasterSource, TrackError, TrackSetup, Tracker,
+};
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Transition,
@@ -517,7 +519,7 @@ impl Channel {
             None => return,
             Some(Transition::Garbage) => {
                 self.tracker
-                    .refuse(TrackError::BadTransition("command word is not -1, 0 or +1"));
+                    .refuse(TrackError::BadTransition(BadParameter::CommandWord));
                 return;
             }
         };
@@ -534,21 +536,19 @@ impl Channel {
                     params.f_rot_trans.get(),
                 ];
                 let [Ok(wait), Ok(set_zero), Ok(kin_base), Ok(rot_trans)] = flags else {
-                    self.tracker.refuse(TrackError::BadTransition(
-                        "a flag byte is neither FALSE nor TRUE",
-                    ));
+                    self.tracker
+                        .refuse(TrackError::BadTransition(BadParameter::FlagByte));
                     return;
                 };
                 if kin_base && rot_trans {
                     // As the NC command refuses KIN_BASE with ROT_TRANS at load.
-                    self.tracker.refuse(TrackError::BadTransition(
-                        "f_rot_trans cannot be combined with f_kin_base",
-                    ));
+                    self.tracker
+                        .refuse(TrackError::BadTransition(BadParameter::RotTransWithKinBase));
                     return;
                 }
                 if params.option > 1 {
                     self.tracker
-                        .refuse(TrackError::BadTransition("option must be 0 or 1"));
+                        .refuse(TrackError::BadTransition(BadParameter::OptionValue));
                     return;
                 }
                 let kb = frame_from_hli(&params.kinematic_base_cs, RotationOrder::Zyx);

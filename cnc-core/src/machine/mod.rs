@@ -33,10 +33,11 @@ pub use engine::{Engine, EngineIo};
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
-use crate::channel::{Channel, Controller, ControllerError, RunState};
+use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::{
-    reply, AcyclicCall, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode, HandlerResult,
+    decode_body, reply, AcyclicCall, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode,
+    HandlerResult,
 };
 use hli::enums::DynCsState;
 use hli::fifo_calls::{FifoReply, FifoRowsHeader};
@@ -233,6 +234,8 @@ impl Machine {
                 | CallKind::CamPointsRead
                 | CallKind::FifoDimension
                 | CallKind::SawCharac
+                | CallKind::DynCsHistoryRead
+                | CallKind::DynCsLogRead
         );
         if self.stopped && !read {
             return Err(ErrorCode::Busy);
@@ -272,6 +275,19 @@ impl Machine {
             }
             CallKind::ProbeArm => self.axes.handle_probe(request, true),
             CallKind::ProbeAbort => self.axes.handle_probe(request, false),
+            CallKind::DynCsHistoryRead | CallKind::DynCsLogRead => {
+                let channel = self
+                    .controller
+                    .channels()
+                    .get(request.target as usize)
+                    .ok_or(ErrorCode::InvalidTarget)?;
+                let tracker = channel.tracker();
+                if kind == CallKind::DynCsHistoryRead {
+                    reply(&diag_wire::answer_history(tracker, &decode_body(request)?))
+                } else {
+                    reply(&diag_wire::answer_log(tracker, &decode_body(request)?))
+                }
+            }
             // A kind of an engine this machine does not have.
             _ => Err(ErrorCode::ServiceNotSupported),
         }

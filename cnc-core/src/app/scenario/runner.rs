@@ -215,6 +215,7 @@ pub fn main(args: RunArgs) -> ExitCode {
     match run(&scenario, &options) {
         Ok(report) => {
             print!("{}", report.render(args.diagnosis));
+            keep_diagnosis("cnc run", &options.instance, &report);
             if let Some(path) = &args.trace {
                 if let Err(e) = report.trace.save(path) {
                     eprintln!("cnc run: trace: {e}");
@@ -254,6 +255,21 @@ pub fn main(args: RunArgs) -> ExitCode {
                 1
             })
         }
+    }
+}
+
+/// Leaves the channels' dynamic-CS listings for `cnc diag dyncs` and says where (a failure
+/// is reported and does not fail the run: the report is already out).
+pub fn keep_diagnosis(tool: &str, instance: &str, report: &RunReport) {
+    if report.channels.is_empty() {
+        return;
+    }
+    match crate::app::diag_cli::keep_finished(instance, &report.channels) {
+        Ok(dir) => println!(
+            "dynamic-CS diagnosis: `cnc diag dyncs --instance {instance} --channel N` ({})",
+            dir.display()
+        ),
+        Err(e) => eprintln!("{tool}: diagnosis not kept: {e}"),
     }
 }
 
