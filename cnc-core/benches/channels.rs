@@ -15,9 +15,10 @@
 //! Axis images hold 32 axes: the first five robots' axes are on the axis layer, the others
 //! have none (as before).
 //!
-//! Last, the demo's two scenarios in-process and hot (no sleep between ticks): the p50 of
-//! the machine tick over the whole run, timed per tick as `cnc demo` times it, so the demo's
-//! reported `machine` p50 (after a 1 ms sleep each tick) compares with it like for like.
+//! Last, the scenarios of examples 3 and 4 (both part of the demo's machine) in-process and
+//! hot (no sleep between ticks): the p50 of the machine tick over the whole run, timed per
+//! tick as `cnc run` times it, so the `machine` p50 that `cnc run` reports for them (after a
+//! 1 ms sleep each tick) compares with it like for like.
 //! Run: `cargo bench -p cnc-core --bench channels`.
 
 use cnc_core::app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};

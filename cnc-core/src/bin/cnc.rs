@@ -12,7 +12,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
-    /// Run the demo: the seed's examples 3 and 4 end to end in real time, with a PLC process.
+    /// Run the demo: one machine with every engine (four robots, a cam station, a flying saw)
+    /// in real time with a PLC process; report, trace and plots.
     Demo(cnc_core::app::demo::DemoArgs),
     /// Run a scenario: machine configuration, NC programs, PLC timeline, trace.
     Run(cnc_core::app::scenario::runner::RunArgs),
