@@ -152,7 +152,7 @@ fn main() {
     }
     println!("(medians of {REPEATS} interleaved runs of {TICKS} ticks each; target <= 5000 ns per channel-tick)");
     println!();
-    println!("demo scenario, hot in-process | ticks | machine tick p50 ns | p99 ns");
+    println!("example scenario (part of the demo machine), hot in-process | ticks | machine tick p50 ns | p99 ns");
     for name in ["example3-moving-workpiece", "example4-turntable-plc"] {
         let (ticks, p50, p99) = demo_hot(name);
         println!("{name:>29} | {ticks:>5} | {p50:>19} | {p99:>6}");
@@ -160,14 +160,14 @@ fn main() {
     println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs)");
 }
 
-/// One scenario of the demo in-process, every tick timed: (ticks, p50 ns, p99 ns) of the
+/// One example scenario in-process, every tick timed: (ticks, p50 ns, p99 ns) of the
 /// last of REPEATS runs (the earlier ones warm the caches and the allocator up).
 fn demo_hot(name: &str) -> (usize, u64, u64) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios")
         .join(name)
         .join("scenario.toml");
-    let scenario = Scenario::load(&path).expect("demo scenario");
+    let scenario = Scenario::load(&path).expect("example scenario");
     let mut times = Vec::with_capacity(20_000);
     for _ in 0..REPEATS {
         times.clear();

@@ -50,6 +50,7 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
         .join("../scenarios/example3-moving-workpiece/scenario.toml");
     let cnc = Command::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["run", scenario.to_str().unwrap(), "--instance", &instance])
+        .arg("--keep-diagnosis")
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -124,7 +125,11 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
         )),
         "{stdout}"
     );
-    let _ = std::fs::remove_dir_all(std::env::temp_dir().join("cncplc-diag").join(&instance));
+    let _ = std::fs::remove_dir_all(
+        std::env::temp_dir()
+            .join("cncplc-diag")
+            .join(format!("instance-{instance}")),
+    );
 }
 
 #[test]

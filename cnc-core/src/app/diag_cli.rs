@@ -5,7 +5,7 @@
 //!   entry over the acyclic channel ([`hli::diag_calls`], a few calls in flight at a time; the
 //!   CNC answers between ticks from its rings) up to the entries recorded when the read
 //!   began, and rendered here.
-//! * **Finished**: `cnc run` and `cnc demo` leave every channel's listing in
+//! * **Finished**: `cnc demo` and `cnc run --keep-diagnosis` leave every channel's listing in
 //!   [`finished_dir`] when they end; the tool prints the one of the channel.
 //!
 //! Exit codes: 0 printed, 1 no such CNC (neither running nor finished) or the read failed,
@@ -45,7 +45,7 @@ pub struct DyncsArgs {
 #[derive(Debug, thiserror::Error)]
 pub enum DiagError {
     /// Neither a running CNC nor a finished run of this instance.
-    #[error("no CNC {instance:?} is running and no finished run left a diagnosis in {dir}")]
+    #[error("no CNC {instance:?} is running and no finished run left a diagnosis in {dir} (`cnc demo` and `cnc run --keep-diagnosis` do)")]
     NoCnc {
         /// The instance.
         instance: String,
@@ -71,6 +71,17 @@ pub enum DiagError {
     /// A reply did not decode.
     #[error("reading the diagnosis: {0}")]
     Wire(#[from] WireError),
+    /// A reply's window is impossible (an entry past the recorded ones, a flag not 0 or 1).
+    #[error("reading the diagnosis: malformed window {0:?}")]
+    BadWindow(DiagWindow),
+    /// The CNC's segment is there but it does not answer.
+    #[error("CNC {instance:?} does not answer diagnosis calls within {limit:?} (stopped or hung)")]
+    NoAnswer {
+        /// The instance.
+        instance: String,
+        /// How long the read waited.
+        limit: Duration,
+    },
     /// A finished run's file could not be read.
     #[error("{file}: {message}")]
     Read {
@@ -90,9 +101,12 @@ impl DiagError {
     }
 }
 
-/// Where a finished run of `instance` leaves its channels' listings.
+/// Where a finished run of `instance` leaves its channels' listings. The prefix keeps an
+/// instance named `.` or `..` (valid segment names) inside the base folder.
 pub fn finished_dir(instance: &str) -> PathBuf {
-    std::env::temp_dir().join("cncplc-diag").join(instance)
+    std::env::temp_dir()
+        .join("cncplc-diag")
+        .join(format!("instance-{instance}"))
 }
 
 fn finished_file(instance: &str, channel: u32) -> PathBuf {
@@ -142,12 +156,21 @@ pub fn dyncs(args: &DyncsArgs) -> Result<(String, String), DiagError> {
             }
             let index = args.channel - 1;
             let mut client = AcyclicClient::open(&args.instance)?;
-            let (history, lost_h) = read_all(&mut client, index, |sequence| {
-                DynCsHistoryReadCall { sequence }
-            })?;
+            let no_answer = |e: DiagError| match e {
+                DiagError::Call(CallError::Timeout(limit)) => DiagError::NoAnswer {
+                    instance: args.instance.clone(),
+                    limit,
+                },
+                e => e,
+            };
+            let (history, lost_h) = read_all(&mut client, index, |sequence| DynCsHistoryReadCall {
+                sequence,
+            })
+            .map_err(no_answer)?;
             let history: Vec<HistoryEntry> = history.iter().filter_map(history_entry).collect();
             let (log, lost_l) =
-                read_all(&mut client, index, |sequence| DynCsLogReadCall { sequence })?;
+                read_all(&mut client, index, |sequence| DynCsLogReadCall { sequence })
+                    .map_err(no_answer)?;
             let log = log
                 .iter()
                 .filter_map(|r| log_event(r).transpose())
@@ -164,7 +187,8 @@ pub fn dyncs(args: &DyncsArgs) -> Result<(String, String), DiagError> {
             }
             Ok((text, origin))
         }
-        Err(AttachError::NotFound { .. }) => {
+        // Gone, or closed and on its way out: what the finished run left.
+        Err(AttachError::NotFound { .. } | AttachError::NotReady { .. }) => {
             let file = finished_file(&args.instance, args.channel);
             match std::fs::read_to_string(&file) {
                 Ok(text) => Ok((
@@ -245,6 +269,12 @@ where
     let first = wait(&client.start(channel, &call(0))?)?;
     let window = first.window();
     let end = window.recorded;
+    let plausible = window.present <= 1
+        && window.sequence <= end
+        && end - window.sequence <= u64::from(window.kept);
+    if !plausible {
+        return Err(DiagError::BadWindow(window));
+    }
     let mut replies = Vec::with_capacity((end - window.sequence) as usize);
     let mut lost = 0;
     if window.present == 1 {

@@ -53,10 +53,11 @@ fn source_number(source: MasterSource) -> u32 {
     }
 }
 
-fn source_of(number: u32) -> MasterSource {
-    match number {
-        0 => MasterSource::Plc,
-        n => MasterSource::Channel(n as usize - 1),
+fn source_of(number: u32) -> Result<MasterSource, WireError> {
+    match number as usize {
+        0 => Ok(MasterSource::Plc),
+        n if n <= hli::layout::HLI_MAX_CHANNELS => Ok(MasterSource::Channel(n - 1)),
+        _ => Err(WireError::UnknownSource(number)),
     }
 }
 
@@ -142,6 +143,9 @@ pub enum WireError {
     /// An error code this build does not know.
     #[error("tracking error {0}/{1} is not known")]
     UnknownError(u32, u32),
+    /// A master that is neither the PLC nor a channel.
+    #[error("master {0} is neither the PLC (0) nor a channel (1..=12)")]
+    UnknownSource(u32),
     /// A frame value that is not a number.
     #[error("log event at tick {0} carries a non-finite frame value")]
     NotFinite(u64),
@@ -162,7 +166,7 @@ pub fn log_event(reply: &DynCsLogReply) -> Result<Option<(u64, TrackEvent)>, Wir
     };
     let event = match reply.kind {
         log_kind::ON => TrackEvent::On {
-            source: source_of(reply.source),
+            source: source_of(reply.source)?,
             filter_ticks: reply.filter_ticks,
             wait: has(log_flags::WAIT),
             relative: has(log_flags::RELATIVE),
@@ -175,7 +179,7 @@ pub fn log_event(reply: &DynCsLogReply) -> Result<Option<(u64, TrackEvent)>, Wir
         },
         log_kind::ACTIVE => TrackEvent::Active,
         log_kind::OFF => TrackEvent::Off {
-            source: source_of(reply.source),
+            source: source_of(reply.source)?,
             filter_ticks: reply.filter_ticks,
             axes: reply.axes,
             applied: reply.frame,
@@ -311,6 +315,9 @@ mod tests {
         reply.error_value = 5;
         assert_eq!(log_event(&reply), Err(WireError::UnknownError(6, 5)));
         reply.kind = log_kind::ON;
+        reply.source = 13;
+        assert_eq!(log_event(&reply), Err(WireError::UnknownSource(13)));
+        reply.source = 0;
         reply.frame[2] = f64::NAN;
         assert_eq!(log_event(&reply), Err(WireError::NotFinite(0)));
     }

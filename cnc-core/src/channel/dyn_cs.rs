@@ -394,6 +394,8 @@ pub struct Tracker {
     refused: u64,
     /// Frames the PLC commanded while `enable_w` was FALSE (taken, not redirected).
     not_redirected: u64,
+    /// State changes since start-up: switched on, active, switched off, inactive, error.
+    state_changes: u64,
 }
 
 /// Events kept for the switching log (each renders to one or more lines; the listing shows the
@@ -424,6 +426,7 @@ impl Tracker {
             on_values_pending: None,
             refused: 0,
             not_redirected: 0,
+            state_changes: 0,
         }
     }
 
@@ -511,6 +514,12 @@ impl Tracker {
         self.log.iter()
     }
 
+    /// State changes since start-up (switched on, active, switched off, inactive, error),
+    /// counted whether or not the log still holds them.
+    pub fn state_changes(&self) -> u64 {
+        self.state_changes
+    }
+
     /// History entry `sequence` (or the oldest kept) and the window kept. For reads while
     /// running.
     pub fn history_at(&self, sequence: u64) -> RingRead<'_, HistoryEntry> {
@@ -523,6 +532,14 @@ impl Tracker {
     }
 
     fn event(&mut self, event: TrackEvent) {
+        self.state_changes += u64::from(matches!(
+            event,
+            TrackEvent::On { .. }
+                | TrackEvent::Active
+                | TrackEvent::Off { .. }
+                | TrackEvent::Inactive
+                | TrackEvent::Error(_)
+        ));
         self.log.push((self.tick, event));
     }
 

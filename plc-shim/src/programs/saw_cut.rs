@@ -1,6 +1,7 @@
 //! A flying saw cutting endless material into equal lengths, as the seed's sample program
-//! does (seed 001, chapter 12.4) in our own code. Three single axes: the conveyor (master,
-//! `gpAx[0]`), the saw carriage (slave, `gpAx[1]`) and the blade (`gpAx[2]`).
+//! does (seed 001, chapter 12.4) in our own code. Three single axes: the conveyor (master),
+//! the saw carriage (slave) and the blade; `gpAx[0..3]` by default ([`SCENARIO_AXES`]),
+//! others with [`SawCut::on_axes`].
 //!
 //! ```text
 //! Power     MC_Power the three axes                                     -> Status
@@ -23,8 +24,8 @@ use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
 use crate::saw::{McGearInPos, McGearOut};
 
-/// The axes of the seed's sample (`gpAx` indices): conveyor, saw carriage, blade.
-pub const SAMPLE_AXES: [u32; 3] = [0, 1, 2];
+/// The axes of `scenarios/flying-saw` (`gpAx` indices): conveyor, saw carriage, blade.
+pub const SCENARIO_AXES: [u32; 3] = [0, 1, 2];
 /// Conveyor position of the first cut, mm.
 const FIRST_CUT: f64 = 600.0;
 /// Saw position where it is synchronous, mm.
@@ -107,7 +108,7 @@ impl SawCut {
         let mut blade = McMoveAbsolute::default();
         limits(&mut blade, 500.0);
         let mut gear_in = McGearInPos::default();
-        let [conveyor_axis, saw_axis, _] = SAMPLE_AXES;
+        let [conveyor_axis, saw_axis, _] = SCENARIO_AXES;
         gear_in.master = conveyor_axis;
         gear_in.slave = saw_axis;
         gear_in.slave_sync_position = SAW_SYNC;
@@ -132,7 +133,7 @@ impl SawCut {
             speed,
             made: 0,
             cut_at: [0.0; MAX_CUTS],
-            axes: SAMPLE_AXES,
+            axes: SCENARIO_AXES,
             power: Default::default(),
             conveyor,
             halt,

@@ -11,7 +11,8 @@
 //!   function in the cycle it sends the transition.
 //!
 //! The frame's rotation is minus the table's actual position: the compensation turns by the
-//! inverse of the table. The table is the channel's seventh axis (`gpAx[6]`).
+//! inverse of the table. In `scenarios/example4-*` the table is channel 0's seventh axis
+//! (`gpAx[6]`, the default); [`Turntable::on`] puts the program on another channel and axis.
 
 use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::runtime::{PlcIo, PlcProgram};

@@ -284,6 +284,12 @@ impl Scenario {
                     }
                     args.extend(["--fifo-override".to_string(), o.to_string()]);
                 }
+                let has_saw = matches!(p.as_str(), "saw-cut" | "demo-machine");
+                if !has_saw && (saw_cuts.is_some() || saw_length.is_some()) {
+                    return Err(invalid(format!(
+                        "[plc] saw_cuts and saw_length belong to saw-cut and demo-machine, not {p:?}"
+                    )));
+                }
                 if let Some(n) = saw_cuts {
                     let max = plc_shim::programs::saw_cut::MAX_CUTS;
                     if !(1..=max).contains(&n) {

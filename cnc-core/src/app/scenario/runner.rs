@@ -53,6 +53,10 @@ pub struct RunArgs {
     /// Print the dynamic-CS diagnosis tables (history and switching log) at the end.
     #[arg(long)]
     pub diagnosis: bool,
+    /// Keep every channel's dynamic-CS listing after the run for `cnc diag dyncs` (in
+    /// $TMPDIR/cncplc-diag/INSTANCE; `cnc demo` always keeps them).
+    #[arg(long)]
+    pub keep_diagnosis: bool,
     /// Where `#TRACK CS ON [LOG_FILE=..]` files with a relative name are written.
     #[arg(long, default_value = ".")]
     pub log_dir: PathBuf,
@@ -144,7 +148,7 @@ pub struct ChannelReport {
     /// NC blocks run.
     pub blocks: u64,
     /// Dynamic-CS state changes (switching on, active, switching off, inactive, error).
-    pub state_changes: usize,
+    pub state_changes: u64,
     /// The diagnosis tables.
     pub diagnosis: String,
     /// `#TRACK CS ON [LOG_FILE=..]`: where the program asked the diagnosis to go.
@@ -215,7 +219,9 @@ pub fn main(args: RunArgs) -> ExitCode {
     match run(&scenario, &options) {
         Ok(report) => {
             print!("{}", report.render(args.diagnosis));
-            keep_diagnosis("cnc run", &options.instance, &report);
+            if args.keep_diagnosis {
+                keep_diagnosis("cnc run", &options.instance, &report);
+            }
             if let Some(path) = &args.trace {
                 if let Err(e) = report.trace.save(path) {
                     eprintln!("cnc run: trace: {e}");
@@ -504,17 +510,7 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),
             blocks: c.blocks_executed(),
-            state_changes: c
-                .tracker()
-                .log()
-                .filter(|(_, event)| {
-                    use crate::channel::dyn_cs::TrackEvent as E;
-                    matches!(
-                        event,
-                        E::On { .. } | E::Active | E::Off { .. } | E::Inactive | E::Error(_)
-                    )
-                })
-                .count(),
+            state_changes: c.tracker().state_changes(),
             diagnosis: c.dyn_cs_diagnosis(),
             log_file: c.log_file().map(str::to_string),
         })
