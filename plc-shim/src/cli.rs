@@ -94,6 +94,10 @@ pub const BUILT_IN_PROGRAMS: &[&str] = &[
     "demo-machine",
 ];
 
+/// The built-in programs with a flying saw (they take `--saw-cuts`, `--saw-length`,
+/// `--saw-speed`).
+pub const SAW_PROGRAMS: &[&str] = &["saw-cut", "demo-machine"];
+
 /// Runs a tool, or the PLC process (exit code 0 when the CNC closed in order).
 pub fn main(cli: PlcCli) -> ExitCode {
     match cli.tool {

@@ -168,13 +168,9 @@ fn summary(report: &RunReport) -> String {
 /// Writes the trace and its plots into `dir`; returns the file names.
 fn write_outputs(report: &RunReport, dir: &Path) -> Result<Vec<String>, String> {
     let csv_name = format!("{NAME}.csv");
-    report.trace.save(&dir.join(&csv_name))?;
-    let mut csv = Vec::new();
-    report
-        .trace
-        .write_csv(&mut csv)
-        .map_err(|e| e.to_string())?;
+    let csv = dir.join(&csv_name);
+    report.trace.save(&csv)?;
     let mut files = vec![csv_name];
-    files.extend(demo_plots::draw(&String::from_utf8_lossy(&csv), dir).map_err(|e| e.to_string())?);
+    files.extend(demo_plots::draw(&csv, dir).map_err(|e| e.to_string())?);
     Ok(files)
 }

@@ -1,5 +1,5 @@
-//! The plots of `cnc demo`: one SVG per station, drawn from the run's trace with
-//! [`crate::app::plot`] (the same figures `cnc plot --signals ...` draws from `demo.csv`).
+//! The plots of `cnc demo`: one SVG per station, drawn from the trace file the run wrote with
+//! [`crate::app::plot`] (what `cnc plot --signals ...` draws from `demo.csv`).
 
 use crate::app::plot::{Figure, PlotError, Series, Table, Unit};
 use std::path::Path;
@@ -61,9 +61,9 @@ const PLOTS: &[PlotSpec] = &[
     ),
 ];
 
-/// Draws every plot of the demo's trace `csv` into `dir`; returns the file names.
-pub fn draw(csv: &str, dir: &Path) -> Result<Vec<String>, PlotError> {
-    let table = Table::parse("demo trace", csv)?;
+/// Draws every plot of the demo's trace file `csv` into `dir`; returns the file names.
+pub fn draw(csv: &Path, dir: &Path) -> Result<Vec<String>, PlotError> {
+    let table = Table::read(csv)?;
     let time = table.column("time")?;
     let mut files = Vec::with_capacity(PLOTS.len());
     for (file, title, curves) in PLOTS {

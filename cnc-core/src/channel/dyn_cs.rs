@@ -277,12 +277,8 @@ impl<T: Copy + Default> Ring<T> {
         self.recorded += 1;
     }
 
-    /// Entries pushed since creation (a ring of capacity 0 records none).
-    pub fn recorded(&self) -> u64 {
-        self.recorded
-    }
-
-    /// [`Self::at_or_after`] with the window.
+    /// The entry with sequence number `sequence` (or the oldest kept one if `sequence` is
+    /// older; none when nothing is kept at or after it) and the window kept.
     pub fn read(&self, sequence: u64) -> RingRead<'_, T> {
         RingRead {
             entry: self.at_or_after(sequence),
@@ -291,9 +287,7 @@ impl<T: Copy + Default> Ring<T> {
         }
     }
 
-    /// The entry with sequence number `sequence`, or the oldest kept one if `sequence` is
-    /// older; `None` when nothing is kept at or after it.
-    pub fn at_or_after(&self, sequence: u64) -> Option<(u64, &T)> {
+    fn at_or_after(&self, sequence: u64) -> Option<(u64, &T)> {
         let oldest = self.recorded - self.len as u64;
         let sequence = sequence.max(oldest);
         if sequence >= self.recorded {

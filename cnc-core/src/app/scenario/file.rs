@@ -284,7 +284,7 @@ impl Scenario {
                     }
                     args.extend(["--fifo-override".to_string(), o.to_string()]);
                 }
-                let has_saw = matches!(p.as_str(), "saw-cut" | "demo-machine");
+                let has_saw = plc_shim::cli::SAW_PROGRAMS.contains(&p.as_str());
                 if !has_saw && (saw_cuts.is_some() || saw_length.is_some()) {
                     return Err(invalid(format!(
                         "[plc] saw_cuts and saw_length belong to saw-cut and demo-machine, not {p:?}"

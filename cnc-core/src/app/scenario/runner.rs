@@ -54,7 +54,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub diagnosis: bool,
     /// Keep every channel's dynamic-CS listing after the run for `cnc diag dyncs` (in
-    /// $TMPDIR/cncplc-diag/INSTANCE; `cnc demo` always keeps them).
+    /// $TMPDIR/cncplc-diag/instance-INSTANCE; `cnc demo` always keeps them).
     #[arg(long)]
     pub keep_diagnosis: bool,
     /// Where `#TRACK CS ON [LOG_FILE=..]` files with a relative name are written.
