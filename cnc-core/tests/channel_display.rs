@@ -163,7 +163,7 @@ fn a_master_in_error_shows_freeze() {
 
 /// P-CHAN-00399: with `provide_channel_interface.track_cs` the master publishes from the
 /// program's start without `#CHANNEL INTERFACE`, and a slave can track it (`CH=1`); without
-/// it the same slave is refused.
+/// it the same slave waits in ACTIVATING for an interface that never comes.
 #[test]
 fn provide_channel_interface_switches_the_interface_on_at_program_start() {
     let run = |provide: bool| -> Controller {
@@ -187,8 +187,11 @@ fn provide_channel_interface_switches_the_interface_on_at_program_start() {
     let (master, slave) = (&ctl.channels()[0], &ctl.channels()[1]);
     assert!(master.published().is_some());
     assert_eq!(slave.state(), RunState::Finished, "{:?}", slave.error());
+    assert_eq!(slave.tracker().state(), DynCsState::Active);
     let ctl = run(false);
-    assert_eq!(ctl.channels()[1].state(), RunState::Error);
+    let slave = &ctl.channels()[1];
+    assert_eq!(slave.state(), RunState::Finished, "{:?}", slave.error());
+    assert_eq!(slave.tracker().state(), DynCsState::Activating);
 }
 
 /// `request_r` of a tracking slave carries the compensation it applies (request pattern: the
@@ -199,24 +202,28 @@ fn request_r_carries_the_applied_compensation() {
     let memory = image(1);
     let plc = PlcView::new(&memory);
     let view = CncView::new(&memory);
-    enable_plc_master(&memory, [1000, -1000, 0]);
+    // 1 um: without a filter the step reaches the axes at once, within their limits.
+    enable_plc_master(&memory, [10, -10, 0]);
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Activate, &transition(0, Bool::FALSE))
         .unwrap();
     ctl.tick(&view);
+    // FILTER=0: ACTIVATING is shown for the switch-on tick, ACTIVE from the next.
+    assert_eq!(plc.dyn_cs_state(0).unwrap(), Ok(DynCsState::Activating));
+    ctl.tick(&view);
     assert_eq!(plc.dyn_cs_state(0).unwrap(), Ok(DynCsState::Active));
     let mut reader = plc.dyn_cs_request(0).unwrap();
     let request = reader.try_take().unwrap().expect("posted");
-    assert_eq!(request.translation, [1000, -1000, 0]);
+    assert_eq!(request.translation, [10, -10, 0]);
     assert_eq!(request.rotation, [0, 0, 0]);
     // Not read again: nothing new is posted until the PLC has taken the last one.
     assert_eq!(reader.try_take().unwrap(), None);
     plc.dyn_cs_command(0)
         .unwrap()
-        .try_send(&cs([2000, 0, 0]))
+        .try_send(&cs([20, 0, 0]))
         .unwrap();
     ctl.tick(&view);
     let request = reader.try_take().unwrap().expect("posted again");
-    assert_eq!(request.translation, [2000, 0, 0]);
+    assert_eq!(request.translation, [20, 0, 0]);
 }

@@ -85,7 +85,8 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
         "{live}"
     );
     assert!(
-        log.contains(&"1 00000010 dynCS: is on = DYN_CS_SYNC_ACTIVE".to_string()),
+        // FILTER=0: ACTIVATING is shown for the switch-on tick, ACTIVE from the next.
+        log.contains(&"2 00000010 dynCS: is on = DYN_CS_SYNC_ACTIVE".to_string()),
         "{live}"
     );
     // A channel the CNC does not have: exit 2, nothing printed.

@@ -142,7 +142,7 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
     std::fs::write(
         dir.join("slave.nc"),
         "#TRACK CS ON [CH=1 RELATIVE FILTER=10 WAIT LOG_FILE=\"logs/slave.log\"]\n\
-         G1 Y5 F1200\n#TRACK CS OFF [WAIT]\nM30\n",
+         G1 Y5 F1200\n#TRACK CS OFF [FILTER=500 WAIT]\nM30\n",
     )
     .unwrap();
     let scenario = dir.join("scenario.toml");

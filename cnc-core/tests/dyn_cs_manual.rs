@@ -365,10 +365,13 @@ fn a_frozen_master_is_held_and_taken_over_softly_on_resume() {
     );
 }
 
-/// ERROR holds the compensation; a switch-off releases it softly along the filter (the manual
-/// describes ERROR only; the soft release is ours and keeps the axes from jumping).
+/// ERROR stops using the master: the slave's axes brake to rest and hold (here they stand
+/// already, 20 mm compensated) while the master moves on. A switch-off clears ERROR without
+/// moving them: the compensation they hold becomes part of the programmed position (the
+/// manual describes ERROR only; the recovery is ours). A new switch-on then couples in softly
+/// along its filter from where the axes stand.
 #[test]
-fn a_switch_off_from_error_releases_the_held_compensation_softly() {
+fn a_switch_off_clears_error_where_the_axes_stand_and_a_new_switch_on_couples_in_softly() {
     let mut ctl = controller(vec![(
         cartesian("slave"),
         "#TRACK CS ON [ID=0 FILTER=0]\n#TIME 0.005\n#TRACK CS ON [ID=0 FILTER=0]\nM30\n",
@@ -380,33 +383,41 @@ fn a_switch_off_from_error_releases_the_held_compensation_softly() {
     for _ in 0..20 {
         ctl.tick(&view);
     }
-    let comp = |ctl: &Controller| {
-        let ch = &ctl.channels()[0];
-        ch.set_points()[0] - ch.programmed()[0]
-    };
+    let x = |ctl: &Controller| ctl.channels()[0].set_points()[0];
     assert_eq!(ctl.channels()[0].state(), RunState::Error);
     assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Error);
-    // The master moves on; ERROR holds 20 mm.
+    // The master moves on; ERROR holds the axes at 20 mm.
     plc.dyn_cs_command(0)
         .unwrap()
         .try_send(&cs([250_000, 0, 0]))
         .unwrap();
     ctl.tick(&view);
-    assert!((comp(&ctl) - 20.0).abs() < 1e-12, "{}", comp(&ctl));
+    assert!((x(&ctl) - 20.0).abs() < 1e-12, "{}", x(&ctl));
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Deactivate, &transition(100, Bool::FALSE))
         .unwrap();
-    for k in 1..=100u32 {
+    for _ in 0..102 {
         ctl.tick(&view);
-        let expected = 20.0 * (1.0 - smooth_ramp(f64::from(k) / 100.0));
-        assert!(
-            (comp(&ctl) - expected).abs() < 1e-9,
-            "tick {k}: {} vs {expected}",
-            comp(&ctl)
-        );
+        assert!((x(&ctl) - 20.0).abs() < 1e-12, "the axes do not move");
     }
     assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Inactive);
+    assert!((ctl.channels()[0].programmed()[0] - 20.0).abs() < 1e-12);
+    // A new switch-on from the PLC: the master's 25 mm come in along the filter.
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Activate, &transition(100, Bool::FALSE))
+        .unwrap();
+    for k in 1..=100u32 {
+        ctl.tick(&view);
+        let expected = 20.0 + 25.0 * smooth_ramp(f64::from(k) / 100.0);
+        assert!(
+            (x(&ctl) - expected).abs() < 1e-9,
+            "tick {k}: {} vs {expected}",
+            x(&ctl)
+        );
+    }
+    assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Active);
 }
 
 /// enable_w redirects the dynamic CS to the PLC. Without it a commanded frame goes nowhere (it
@@ -495,11 +506,16 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
     }
     assert!(active);
     assert_eq!(ctl.channels()[0].state(), RunState::Finished);
-    // A valid transition after the refusals switches on too.
+    // A valid transition after the refusals switches on too (ACTIVATING for its tick).
     plc.dyn_cs_transition(0)
         .unwrap()
         .try_send(DynCsCommand::Activate, &transition(0, Bool::FALSE))
         .unwrap();
+    ctl.tick(&view);
+    assert_eq!(
+        plc.dyn_cs_state(0).unwrap().unwrap(),
+        DynCsState::Activating
+    );
     ctl.tick(&view);
     assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Active);
     // A second +1 while on is refused; tracking stays ACTIVE.

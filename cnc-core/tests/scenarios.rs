@@ -149,6 +149,9 @@ fn turntable(name: &str) {
         }
         previous_table = table;
     });
+    // A switch-off without a filter shows DEACTIVATING for its tick: one more tick settles it.
+    let mut done = done;
+    done.step(s.cycle_s);
     let robot = channel(&done, "robot");
     assert_eq!(robot.state(), RunState::Finished);
     assert!((robot.set_points()[6] + 90.0).abs() < 1e-9, "table at -90");

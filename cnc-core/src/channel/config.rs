@@ -25,6 +25,12 @@ pub struct ChannelConfig {
     /// Dynamic limits of every programmed coordinate (mm or degrees per second).
     #[serde(default = "default_limits")]
     pub limits: AxisLimits,
+    /// Per axis (channel order), the axis's own limits: a robot's joints in degrees per
+    /// second. Axes beyond the list take `limits`. The set-points the channel hands its axes
+    /// are checked against these while tracking, and a failing channel brakes each axis with
+    /// them.
+    #[serde(default)]
+    pub axis_limits: Vec<AxisLimits>,
     /// Axis values at start (joints for a robot), in channel order; missing ones are 0.
     #[serde(default)]
     pub start: Vec<f64>,
@@ -227,6 +233,11 @@ pub enum ChannelConfigError {
 }
 
 impl ChannelConfig {
+    /// The limits of channel axis `i` (its own, else the channel's).
+    pub fn axis_limits(&self, i: usize) -> AxisLimits {
+        self.axis_limits.get(i).copied().unwrap_or(self.limits)
+    }
+
     /// A channel with `axes` and defaults for everything else.
     pub fn new(name: &str, axes: &[&str]) -> Self {
         Self {
@@ -234,6 +245,7 @@ impl ChannelConfig {
             axes: axes.iter().map(|a| a.to_string()).collect(),
             kinematics: KinematicsConfig::default(),
             limits: default_limits(),
+            axis_limits: Vec::new(),
             start: Vec::new(),
             provide_channel_interface: ProvideChannelInterface::default(),
             kin_trafo_display: 0,
@@ -270,14 +282,21 @@ impl ChannelConfig {
             value,
             reason,
         };
-        for (name, v) in [
-            ("limits.velocity", self.limits.velocity),
-            ("limits.acceleration", self.limits.acceleration),
-            ("limits.jerk", self.limits.jerk),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(parameter(name, v, "must be positive and finite"));
+        for (name, l) in core::iter::once(("limits", &self.limits))
+            .chain(self.axis_limits.iter().map(|l| ("axis_limits", l)))
+        {
+            for v in [l.velocity, l.acceleration, l.jerk] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(parameter(name, v, "must be positive and finite"));
+                }
             }
+        }
+        if self.axis_limits.len() > self.axes.len() {
+            return Err(parameter(
+                "axis_limits",
+                self.axis_limits.len() as f64,
+                "at most one entry per axis",
+            ));
         }
         // The NC machine data: a tolerance that is not a positive number would let every arc
         // through, or none.

@@ -28,9 +28,13 @@ pub enum ControllerError {
 
 impl Controller {
     /// The channels, index = position.
-    pub fn new(channels: Vec<Channel>) -> Result<Self, ControllerError> {
+    pub fn new(mut channels: Vec<Channel>) -> Result<Self, ControllerError> {
         if channels.len() > MAX_CHANNELS {
             return Err(ControllerError::TooManyChannels(channels.len()));
+        }
+        let n = channels.len();
+        for channel in &mut channels {
+            channel.set_channel_count(n);
         }
         Ok(Self {
             channels,

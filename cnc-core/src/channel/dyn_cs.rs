@@ -17,7 +17,8 @@
 //! after a FREEZE), ACTIVE, DEACTIVATING, ERROR (the compensation is held where it was: the
 //! channel keeps a safe set-point).
 
-use hli::enums::DynCsState;
+use super::guard::LimitKind;
+use hli::enums::{ChannelErrorId, DynCsState};
 use kinematics::tracking::{track_cs_values, Tracking, TrackingMode, TrackingOption};
 use kinematics::{PoseWords, RotationOrder};
 use nalgebra::{Isometry3, Translation3};
@@ -151,6 +152,24 @@ pub enum TrackError {
     /// The machine stopped (its PLC was lost, or a stop was requested).
     #[error("machine stop")]
     MachineStop,
+    /// A step of the tracked motion broke an axis's limit (refused, not passed on).
+    #[error("axis {} {} limit exceeded by the tracked motion", axis + 1, limit_name(*kind))]
+    JointLimit {
+        /// Axis index in the channel (0-based).
+        axis: u8,
+        /// Which limit.
+        kind: LimitKind,
+    },
+    /// The slave channel failed (its error id names the cause): it can no longer follow.
+    #[error("the channel failed ({0:?})")]
+    ChannelFailed(ChannelErrorId),
+}
+
+fn limit_name(kind: LimitKind) -> &'static str {
+    match kind {
+        LimitKind::Velocity => "velocity",
+        LimitKind::Acceleration => "acceleration",
+    }
 }
 
 impl TrackError {
@@ -166,6 +185,11 @@ impl TrackError {
             TrackError::BadTransition(p) => (6, p as u32),
             TrackError::BadFrame => (7, 0),
             TrackError::MachineStop => (8, 0),
+            TrackError::JointLimit { axis, kind } => (
+                9,
+                u32::from(axis) * 2 + u32::from(kind == LimitKind::Acceleration),
+            ),
+            TrackError::ChannelFailed(id) => (10, id.raw()),
         }
     }
 
@@ -181,6 +205,15 @@ impl TrackError {
             6 => TrackError::BadTransition(BadParameter::ALL.get(value as usize).copied()?),
             7 => TrackError::BadFrame,
             8 => TrackError::MachineStop,
+            9 if value / 2 < u32::from(u8::MAX) => TrackError::JointLimit {
+                axis: (value / 2) as u8,
+                kind: if value % 2 == 1 {
+                    LimitKind::Acceleration
+                } else {
+                    LimitKind::Velocity
+                },
+            },
+            10 => TrackError::ChannelFailed(ChannelErrorId::decode(value).ok()?),
             _ => return None,
         })
     }
@@ -329,6 +362,8 @@ pub struct MasterSample {
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Blend {
     from: Isometry3<f64>,
+    /// Coupling out of ACTIVE: `from` follows the compensation the master asks for.
+    follow: bool,
     /// Ticks done and total.
     done: u32,
     total: u32,
@@ -341,6 +376,13 @@ impl Blend {
         } else {
             smooth_ramp(f64::from(self.done) / f64::from(self.total))
         }
+    }
+
+    /// Whether the transition is over. Without a filter the change is made in the first
+    /// tick but ACTIVATING / DEACTIVATING stays shown for that tick (the manual's PLC-only
+    /// example sees 0 -> 1 -> 2 with the filter off).
+    fn finished(&self) -> bool {
+        self.done >= self.total.max(1) + u32::from(self.total == 0)
     }
 }
 
@@ -390,6 +432,8 @@ pub struct Tracker {
     not_redirected: u64,
     /// State changes since start-up: switched on, active, switched off, inactive, error.
     state_changes: u64,
+    /// Why the tracker last went to ERROR.
+    last_error: Option<TrackError>,
 }
 
 /// Events kept for the switching log (each renders to one or more lines; the listing shows the
@@ -421,6 +465,7 @@ impl Tracker {
             refused: 0,
             not_redirected: 0,
             state_changes: 0,
+            last_error: None,
         }
     }
 
@@ -498,6 +543,16 @@ impl Tracker {
         ) && self.blend.is_none()
     }
 
+    /// Whether a soft coupling in or out is under way (a switch-on waiting for a master
+    /// that offers nothing is not).
+    pub fn in_transition(&self) -> bool {
+        match self.state {
+            DynCsState::Deactivating => true,
+            DynCsState::Activating => self.blend.is_some() && self.master_live,
+            _ => false,
+        }
+    }
+
     /// The diagnosis history, oldest first.
     pub fn history(&self) -> impl Iterator<Item = &HistoryEntry> {
         self.history.iter()
@@ -543,11 +598,34 @@ impl Tracker {
         self.event(event);
     }
 
-    /// Goes to ERROR for `error`, holding the applied compensation.
+    /// Goes to ERROR for `error`, holding the applied compensation: no master frame is
+    /// used any more until OFF or a reset.
     pub fn fail(&mut self, error: TrackError) {
         self.state = DynCsState::Error;
         self.blend = None;
+        self.last_error = Some(error);
         self.event(TrackEvent::Error(error));
+    }
+
+    /// Why the tracker last went to ERROR.
+    pub fn last_error(&self) -> Option<TrackError> {
+        self.last_error
+    }
+
+    /// Tracking off at once (a channel reset at rest): INACTIVE, no compensation. The axes
+    /// keep standing where they are; the channel takes that position over.
+    pub fn reset(&mut self) {
+        if self.state == DynCsState::Inactive {
+            return;
+        }
+        self.state = DynCsState::Inactive;
+        self.applied = Isometry3::identity();
+        self.blend = None;
+        self.setup = None;
+        self.tracking = None;
+        self.last_master = None;
+        self.master_live = false;
+        self.event(TrackEvent::Inactive);
     }
 
     /// Switches tracking on with the master's current `master` frame (`None` when the master
@@ -586,6 +664,7 @@ impl Tracker {
         self.state = DynCsState::Activating;
         self.blend = Some(Blend {
             from: self.applied,
+            follow: false,
             done: 0,
             total: setup.filter_ticks,
         });
@@ -607,9 +686,11 @@ impl Tracker {
             axes: self.axes,
             applied: words(&self.applied),
         });
+        let follow = self.state == DynCsState::Active;
         self.state = DynCsState::Deactivating;
         self.blend = Some(Blend {
             from: self.applied,
+            follow,
             done: 0,
             total,
         });
@@ -637,6 +718,7 @@ impl Tracker {
                     self.state = DynCsState::Activating;
                     self.blend = Some(Blend {
                         from: self.applied,
+                        follow: false,
                         done: 0,
                         total: self.setup.map_or(0, |s| s.filter_ticks),
                     });
@@ -664,6 +746,20 @@ impl Tracker {
             (_, Some(tracking), Some(m)) => tracking.compensation(m),
             _ => self.applied,
         };
+        // Coupling out fades the compensation the master still asks for (not the one of the
+        // switch-off tick): a slave switched off while its master moves leaves the master's
+        // velocity along the ramp instead of stopping at once.
+        if let (DynCsState::Deactivating, Some(blend), Some(tracking), Some(m)) = (
+            self.state,
+            self.blend.as_mut(),
+            &self.tracking,
+            &self.last_master,
+        ) {
+            let live = tracking.compensation(m);
+            if blend.follow && live.translation.vector.iter().all(|v| v.is_finite()) {
+                blend.from = live;
+            }
+        }
         if !target.translation.vector.iter().all(|v| v.is_finite())
             || !target.rotation.coords.iter().all(|v| v.is_finite())
         {
@@ -674,15 +770,20 @@ impl Tracker {
         // new ramp from there); a coupling-out goes on, it does not need the master. A master
         // that has offered no frame yet is no freeze: the coupling runs to the compensation
         // of an unmoved master (the manual's PLC commands its first frame once ACTIVE).
-        let paused =
-            !self.master_live && self.last_master.is_some() && self.state == DynCsState::Activating;
+        // A master channel that has not published yet is waited for: the take-over starts
+        // with its first frame.
+        let waiting = self.last_master.is_some()
+            || self
+                .setup
+                .is_some_and(|s| matches!(s.source, MasterSource::Channel(_)));
+        let paused = !self.master_live && waiting && self.state == DynCsState::Activating;
         self.applied = match self.blend.as_mut() {
             Some(_) if paused => self.applied,
             Some(blend) => {
-                blend.done = (blend.done + 1).min(blend.total);
+                blend.done = blend.done.saturating_add(1);
                 let w = blend.weight();
                 let from = blend.from;
-                if blend.done >= blend.total {
+                if blend.finished() {
                     self.blend = None;
                 }
                 interpolate(&from, &target, w)

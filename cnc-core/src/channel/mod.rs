@@ -9,6 +9,7 @@ pub mod controller;
 pub mod diag_wire;
 pub(crate) mod diagnosis;
 pub mod dyn_cs;
+pub mod guard;
 pub mod path;
 pub mod plc_io;
 pub mod program;

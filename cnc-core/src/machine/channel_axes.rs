@@ -28,7 +28,7 @@ pub struct ChannelAxes {
 pub fn axis_config(channel: &ChannelConfig, i: usize, id: u32) -> AxisConfig {
     let mut c = AxisConfig::linear(&format!("{}.{}", channel.name, channel.axes[i]), id);
     c.soft_limits = None;
-    let l = channel.limits;
+    let l = channel.axis_limits(i);
     let usable = |v: f64| v.is_finite() && v > 0.0;
     if usable(l.velocity) && usable(l.acceleration) && usable(l.jerk) {
         c.dynamics = Dynamics {

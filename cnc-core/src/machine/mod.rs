@@ -420,11 +420,12 @@ impl Machine {
         self.stopped
     }
 
-    /// Whether no channel runs a program any more.
+    /// Whether no channel runs a program any more, and none of them is still coupling its
+    /// dynamic CS in or out or braking after a failure.
     pub fn idle(&self) -> bool {
         self.controller
             .channels()
             .iter()
-            .all(|c| c.state() != RunState::Running)
+            .all(|c| c.state() != RunState::Running && !c.settling())
     }
 }

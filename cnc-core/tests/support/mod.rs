@@ -12,7 +12,7 @@ pub const CYCLE: f64 = 0.001;
 pub const ROBOT_HOME: [f64; 6] = [0.0, -60.0, 90.0, 0.0, 60.0, 0.0];
 
 pub fn robot(name: &str) -> ChannelConfig {
-    let mut c = ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]);
+    let mut c = stiff(ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]));
     c.kinematics.id = 45;
     c.kinematics.preset = Some("kr6r900sixx".into());
     c.start = ROBOT_HOME.to_vec();
@@ -20,7 +20,21 @@ pub fn robot(name: &str) -> ChannelConfig {
 }
 
 pub fn cartesian(name: &str) -> ChannelConfig {
-    ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"])
+    stiff(ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]))
+}
+
+/// Axes that take any step the tests' tracked motion asks of them (frame steps without a
+/// filter, soft couplings of 20 mm in 0.1 s): the tests built on these helpers are about the
+/// dynamic CS, not the axes' limits. The path keeps the channel's `limits`; the tests of the
+/// guard (`tracking_safety.rs`) configure real axis limits.
+pub fn stiff(mut c: ChannelConfig) -> ChannelConfig {
+    let axis = cnc_core::channel::path::AxisLimits {
+        velocity: 1e6,
+        acceleration: 1e9,
+        jerk: 1e12,
+    };
+    c.axis_limits = vec![axis; c.axes.len()];
+    c
 }
 
 pub fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {

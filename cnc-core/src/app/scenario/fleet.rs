@@ -13,7 +13,7 @@ use std::path::PathBuf;
 const LEAD: &str = "%lead
 #TRAFO [45]
 #CHANNEL INTERFACE ON [DYN_CS]
-#TRACK CS ON [ID=0 FILTER=0]
+#TRACK CS ON [ID=0 FILTER=100]
 $WHILE 1
 G1 X660 Y30 Z540 F3000
 G1 X610 Y-30 Z520 F3000
@@ -57,7 +57,8 @@ pub fn tracking_robots_on(n: usize, drive: Option<&str>) -> Result<Scenario, Sce
     })
 }
 
-/// What the PLC does for the fleet: enables robot 1's unit and commands a 1 mm shift once.
+/// What the PLC does for the fleet: enables robot 1's unit and commands a 1 mm shift once
+/// (robot 1 couples it in over 100 ticks, within its joints' limits).
 pub fn plc_setup(view: &PlcView<'_>) {
     let _ = view.set_dyn_cs_enabled(0, true);
     if let Ok(writer) = view.dyn_cs_command(0) {

@@ -14,10 +14,15 @@
 //! 5. HLI outputs, as values the machine writes: display values, state, `request_r`, the
 //!    channel interface, an M-function announcement.
 
+mod safety;
+
+pub use safety::ResetError;
+
 use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{
     words, BadParameter, MasterSample, MasterSource, TrackError, TrackSetup, Tracker,
 };
+use super::guard::JointGuard;
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Transition,
@@ -136,6 +141,12 @@ pub struct Channel {
     cs_stack: [Isometry3<f64>; CS_DEPTH],
     cs_len: usize,
     tracker: Tracker,
+    /// Channels of the controller (a master beyond them does not exist).
+    channels: usize,
+    /// Checks the set-points while tracking and brakes the axes when the channel fails.
+    guard: JointGuard,
+    /// The channel failed this tick: the guard latches at the end of it.
+    latch_pending: bool,
     /// The PLC's override and feed hold in effect (its last valid value).
     path_override: PathOverride,
     /// Override values out of range the PLC wrote (each tick one is read, counted once).
@@ -196,6 +207,8 @@ impl Channel {
         let mut joints = [0.0; 6];
         joints.copy_from_slice(&set_points[..6]);
         let decoder = DecoderState::new(&config.axes);
+        let axis_limits: Vec<_> = (0..n).map(|i| config.axis_limits(i)).collect();
+        let guard = JointGuard::new(&set_points, &axis_limits, cycle_s);
         let mut channel = Self {
             index,
             limits: config.limits,
@@ -223,6 +236,9 @@ impl Channel {
             cs_stack: [Isometry3::identity(); CS_DEPTH],
             cs_len: 0,
             tracker: Tracker::new(config.interpolator.dyn_cs_history_max as usize, order),
+            channels: MAX_CHANNELS,
+            guard,
+            latch_pending: false,
             path_override: DEFAULT_PATH_OVERRIDE,
             override_refused: 0,
             interface_on: false,
@@ -269,6 +285,10 @@ impl Channel {
 
     /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
     pub fn start(&mut self, program: LoadedProgram) {
+        // A channel that failed starts again from where its axes came to rest.
+        if self.state == RunState::Error && self.reset().is_err() {
+            return;
+        }
         // A new program starts from the modal defaults the check assumed (G90 G17 G71 G53 D0,
         // no feed), where the axes stand.
         self.decoder = DecoderState::new(&self.config.axes);
@@ -287,6 +307,12 @@ impl Channel {
             self.interface_on = true;
         }
         self.tracker.restart();
+    }
+
+    /// Tells the channel how many channels its controller has (masters beyond them do not
+    /// exist).
+    pub fn set_channel_count(&mut self, channels: usize) {
+        self.channels = channels.min(MAX_CHANNELS);
     }
 
     /// The channel's index (its units in the image).
@@ -394,7 +420,9 @@ impl Channel {
 
     /// Whether a motion or wait is in progress.
     pub fn is_moving(&self) -> bool {
-        self.path.is_some() || self.independent.iter().any(|(_, active)| *active)
+        self.path.is_some()
+            || self.independent.iter().any(|(_, active)| *active)
+            || self.guard.braking()
     }
 
     /// A controlled stop (supervision, signals): the path brakes along its block with the
@@ -427,6 +455,13 @@ impl Channel {
     }
 
     fn fail(&mut self, id: ChannelErrorId, message: String) {
+        // A tracking slave that fails can no longer follow (the guard brakes its axes).
+        if matches!(
+            self.tracker.state(),
+            DynCsState::Activating | DynCsState::Active | DynCsState::Deactivating
+        ) {
+            self.tracker.fail(TrackError::ChannelFailed(id));
+        }
         self.error = Some(ChannelError {
             line: self.line,
             id,
@@ -435,6 +470,7 @@ impl Channel {
         self.state = RunState::Error;
         self.path = None;
         self.wait = None;
+        self.latch_pending = true;
         for (_, active) in &mut self.independent {
             *active = false;
         }
@@ -479,7 +515,9 @@ impl Channel {
         }
         let master = self.master_sample(masters);
         self.tracker.tick(master);
+        self.fail_on_tracking_error();
         self.update_pose();
+        self.guard_set_points();
         self.fill_outputs();
     }
 
@@ -814,12 +852,13 @@ impl Channel {
                 let master = match source {
                     MasterSource::Plc => self.plc_frame,
                     MasterSource::Channel(c) => {
+                        // A master channel that does not publish yet is waited for
+                        // (ACTIVATING): its interface is taken over softly when it comes on,
+                        // whichever of the two channels ticks first.
                         let refusal = if c == self.index {
                             Some(TrackError::OwnChannel)
-                        } else if c >= MAX_CHANNELS {
+                        } else if c >= self.channels {
                             Some(TrackError::NoSuchChannel(c + 1))
-                        } else if masters[c].is_none() {
-                            Some(TrackError::NoMasterInterface(c + 1))
                         } else {
                             None
                         };
@@ -1106,10 +1145,6 @@ impl Channel {
         }
         self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
         self.tracker.record(&self.pose_in, &self.pose_out);
-        self.published = self.interface_on.then_some(MasterSample {
-            frame: self.tool,
-            live: self.state != RunState::Error,
-        });
     }
 
     fn fill_outputs(&mut self) {

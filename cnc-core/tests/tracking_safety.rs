@@ -1,0 +1,286 @@
+//! Safe tracking: a slave that cannot follow stops within its axes' limits, a step of the
+//! tracked motion beyond them is refused, and switching on does not depend on which channel
+//! ticks first. The axes here have real limits (the other channel tests use stiff ones).
+
+mod support;
+
+use cnc_core::channel::path::AxisLimits;
+use cnc_core::channel::{ChannelConfig, Controller, LoadedProgram, RunState};
+use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState};
+use hli::views::{CncView, PlcView};
+use hli::Bool;
+use support::{cs, image, transition, CYCLE, ROBOT_HOME};
+
+/// Joint limits of a small six-axis robot (degrees per second and its derivatives).
+const JOINT: AxisLimits = AxisLimits {
+    velocity: 300.0,
+    acceleration: 2000.0,
+    jerk: 40_000.0,
+};
+
+fn robot(name: &str) -> ChannelConfig {
+    let mut c = ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]);
+    c.kinematics.id = 45;
+    c.kinematics.preset = Some("kr6r900sixx".into());
+    c.start = ROBOT_HOME.to_vec();
+    c.axis_limits = vec![JOINT; 6];
+    c
+}
+
+fn cartesian(name: &str) -> ChannelConfig {
+    ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"])
+}
+
+/// Channels in the given order, each with its program.
+fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
+    let channels = configs
+        .into_iter()
+        .enumerate()
+        .map(|(i, (config, src))| {
+            let program = LoadedProgram::load(&config.name, src, &config.axes).unwrap();
+            let mut channel = cnc_core::channel::Channel::new(i, config, CYCLE).unwrap();
+            channel.start(program);
+            channel
+        })
+        .collect();
+    Controller::new(channels).unwrap()
+}
+
+/// Watches one channel's set-points tick by tick: every step within the axes' velocity and
+/// acceleration limits (the acceleration with 1 % for the sampling of the braking profile).
+struct StepWatch {
+    last: Vec<f64>,
+    velocity: Vec<f64>,
+    limits: AxisLimits,
+    ticks: u32,
+}
+
+impl StepWatch {
+    fn new(start: &[f64], limits: AxisLimits) -> Self {
+        Self {
+            last: start.to_vec(),
+            velocity: vec![0.0; start.len()],
+            limits,
+            ticks: 0,
+        }
+    }
+
+    fn check(&mut self, now: &[f64], what: &str) {
+        self.ticks += 1;
+        for (i, &p) in now.iter().enumerate() {
+            let v = (p - self.last[i]) / CYCLE;
+            let a = (v - self.velocity[i]) / CYCLE;
+            assert!(
+                v.abs() <= self.limits.velocity * (1.0 + 1e-6),
+                "{what}, tick {}: axis {} velocity {v}",
+                self.ticks,
+                i + 1
+            );
+            assert!(
+                a.abs() <= self.limits.acceleration * 1.01,
+                "{what}, tick {}: axis {} acceleration {a}",
+                self.ticks,
+                i + 1
+            );
+            self.last[i] = p;
+            self.velocity[i] = v;
+        }
+    }
+
+    fn at_rest(&self) -> bool {
+        self.velocity.iter().all(|v| *v == 0.0)
+    }
+}
+
+/// A slave robot tracks a Cartesian master (RELATIVE: from where the master stood) that runs
+/// 700 mm out of the robot's reach and comes back. The slave goes to ERROR (tracker and
+/// channel), brakes its joints within their limits to rest, holds there while the master
+/// comes back (no jump), and after a reset a new program couples in softly again.
+#[test]
+fn a_slave_whose_master_leaves_its_reach_stops_within_its_limits_and_recovers() {
+    let master = "#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 0.1\nG1 X700 F6000\nG1 X0 F6000\nM30\n";
+    let slave = "#TRAFO [45]\n#TRACK CS ON [CH=1 RELATIVE FILTER=0]\n#TIME 30\nM30\n";
+    let mut ctl = controller(vec![(cartesian("master"), master), (robot("slave"), slave)]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    let mut watch = StepWatch::new(&ROBOT_HOME, JOINT);
+    let mut error_tick = None;
+    for tick in 0..20_000u32 {
+        ctl.tick(&view);
+        let (m, s) = (&ctl.channels()[0], &ctl.channels()[1]);
+        watch.check(s.set_points(), "slave");
+        if error_tick.is_none() && s.state() == RunState::Error {
+            error_tick = Some(tick);
+            assert_eq!(s.tracker().state(), DynCsState::Error);
+            assert_eq!(plc.dyn_cs_state(1).unwrap(), Ok(DynCsState::Error));
+            let e = s.error().unwrap();
+            assert!(
+                matches!(e.id, ChannelErrorId::Kinematics | ChannelErrorId::Tracking),
+                "{e:?}"
+            );
+        }
+        if m.state() == RunState::Finished && error_tick.is_some() && !s.settling() {
+            break;
+        }
+    }
+    let error_tick = error_tick.expect("the slave could not follow and failed");
+    assert!(watch.at_rest(), "the slave came to rest");
+    let s = &ctl.channels()[1];
+    assert!(!s.is_moving());
+    // The master is back where it started; the slave stands where it braked.
+    let held = s.set_points().to_vec();
+    for _ in 0..100 {
+        ctl.tick(&view);
+        watch.check(ctl.channels()[1].set_points(), "held");
+    }
+    assert_eq!(ctl.channels()[1].set_points().to_vec(), held);
+    assert!(
+        error_tick > 100,
+        "it tracked before it failed ({error_tick})"
+    );
+    // Recovery: a reset clears both errors where the axes stand; a new program switches on
+    // with a filter and follows again without a step.
+    let channel = ctl.channel_mut(1).unwrap();
+    channel.reset().unwrap();
+    assert_eq!(channel.state(), RunState::Idle);
+    assert_eq!(channel.tracker().state(), DynCsState::Inactive);
+    assert!(channel.error().is_none());
+    let again = "#TRAFO [45]\n#TRACK CS ON [CH=1 FILTER=200]\n#TIME 1\nM30\n";
+    channel.start(LoadedProgram::load("slave", again, &channel.config().axes.clone()).unwrap());
+    for _ in 0..1500 {
+        ctl.tick(&view);
+        watch.check(ctl.channels()[1].set_points(), "recovered");
+    }
+    let s = &ctl.channels()[1];
+    assert_eq!(s.state(), RunState::Finished, "{:?}", s.error());
+    assert_eq!(s.tracker().state(), DynCsState::Active);
+}
+
+/// A PLC frame step of 100 mm without a filter: the step is refused (never handed to the
+/// axes), the tracker goes to ERROR, the channel fails, and the axes stay within their limits.
+#[test]
+fn a_frame_step_without_filter_is_refused_on_a_cartesian_and_a_robot_slave() {
+    for (config, program) in [
+        (
+            cartesian("xyz"),
+            "#TRACK CS ON [ID=0 FILTER=0]\n#TIME 2\nM30\n",
+        ),
+        (
+            robot("kr6"),
+            "#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=0]\n#TIME 2\nM30\n",
+        ),
+    ] {
+        let limits = config.axis_limits(0);
+        let start: Vec<f64> = {
+            let mut s = config.start.clone();
+            s.resize(6, 0.0);
+            s
+        };
+        let name = config.name.clone();
+        let mut ctl = controller(vec![(config, program)]);
+        let memory = image(1);
+        let view = CncView::new(&memory);
+        let plc = PlcView::new(&memory);
+        plc.set_dyn_cs_enabled(0, true).unwrap();
+        plc.dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([0; 3]))
+            .unwrap();
+        let mut watch = StepWatch::new(&start, limits);
+        for _ in 0..50 {
+            ctl.tick(&view);
+            watch.check(ctl.channels()[0].set_points(), &name);
+        }
+        assert_eq!(ctl.channels()[0].tracker().state(), DynCsState::Active);
+        // 100 mm in X in one frame.
+        plc.dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([1_000_000, 0, 0]))
+            .unwrap();
+        let before = ctl.channels()[0].set_points().to_vec();
+        for _ in 0..200 {
+            ctl.tick(&view);
+            watch.check(ctl.channels()[0].set_points(), &name);
+        }
+        let ch = &ctl.channels()[0];
+        assert_eq!(ch.tracker().state(), DynCsState::Error, "{name}");
+        assert_eq!(ch.state(), RunState::Error);
+        assert_eq!(ch.error().unwrap().id, ChannelErrorId::Tracking);
+        assert!(ch.error().unwrap().message.contains("tracked step refused"));
+        assert_eq!(
+            ch.set_points().to_vec(),
+            before,
+            "{name}: nothing of the step passed"
+        );
+    }
+}
+
+/// Master and slave switch the interface and the tracking on in the same block of their
+/// programs: whichever channel ticks first, the slave couples in (ACTIVATING while it waits)
+/// and follows the master, its axes within their limits.
+#[test]
+fn switching_on_works_in_either_channel_order() {
+    let master = "#CHANNEL INTERFACE ON [DYN_CS]\nG1 X50 F1200\n#TIME 0.5\nM30\n";
+    let slave = "#TRACK CS ON [CH={m} FILTER=100 WAIT]\nG1 Y10 F600\n#TIME 2\nM30\n";
+    for master_first in [true, false] {
+        let (mi, si) = if master_first { (0, 1) } else { (1, 0) };
+        let slave = slave.replace("{m}", &(mi + 1).to_string());
+        let mut configs = vec![
+            (cartesian("master"), master),
+            (cartesian("slave"), slave.as_str()),
+        ];
+        if !master_first {
+            configs.swap(0, 1);
+        }
+        let mut ctl = controller(configs);
+        let memory = image(2);
+        let view = CncView::new(&memory);
+        let mut watch = StepWatch::new(&[0.0; 6], cartesian("x").axis_limits(0));
+        let mut seen_activating = false;
+        for _ in 0..4000 {
+            ctl.tick(&view);
+            let s = &ctl.channels()[si];
+            seen_activating |= s.tracker().state() == DynCsState::Activating;
+            watch.check(s.set_points(), "slave");
+            assert_ne!(s.state(), RunState::Error, "{:?}", s.error());
+        }
+        let (m, s) = (&ctl.channels()[mi], &ctl.channels()[si]);
+        assert!(seen_activating);
+        assert_eq!(
+            s.tracker().state(),
+            DynCsState::Active,
+            "order {master_first}"
+        );
+        assert_eq!(s.state(), RunState::Finished);
+        // Absolute tracking of a Cartesian master: the slave's X is the master's X.
+        assert!((s.set_points()[0] - m.set_points()[0]).abs() < 1e-9);
+        assert!((s.set_points()[1] - 10.0).abs() < 1e-9);
+    }
+}
+
+/// FILTER=0 from the PLC: ACTIVATING and DEACTIVATING are each shown for a tick.
+#[test]
+fn without_filter_the_transient_states_are_shown_for_a_tick() {
+    let mut ctl = controller(vec![(cartesian("slave"), "#TIME 1\nM30\n")]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    let mut states = Vec::new();
+    for command in [DynCsCommand::Activate, DynCsCommand::Deactivate] {
+        plc.dyn_cs_transition(0)
+            .unwrap()
+            .try_send(command, &transition(0, Bool::FALSE))
+            .unwrap();
+        for _ in 0..3 {
+            ctl.tick(&view);
+            states.push(plc.dyn_cs_state(0).unwrap().unwrap());
+        }
+    }
+    use DynCsState::*;
+    assert_eq!(
+        states,
+        [Activating, Active, Active, Deactivating, Inactive, Inactive]
+    );
+}
