@@ -284,3 +284,167 @@ fn without_filter_the_transient_states_are_shown_for_a_tick() {
         [Activating, Active, Active, Deactivating, Inactive, Inactive]
     );
 }
+
+/// Every refusal of a PLC transition, from INACTIVE and from ACTIVE, reaches the PLC in
+/// `dyn_cs_result` (a new count, the command word, the reason) and leaves the state as it was;
+/// an accepted one reports 0 and the states it passed.
+#[test]
+fn every_refused_transition_is_reported_with_its_reason_from_both_start_states() {
+    use hli::access::{Leaf, Value};
+    use hli::enums::DynCsTransitionError as E;
+    let read = |plc: &PlcView<'_>| plc.gp_ch(0).unwrap().dyn_cs_result();
+    // (what the PLC does, the refusal expected from INACTIVE, from ACTIVE): a +1's
+    // parameters are checked before the state.
+    type Post = fn(&PlcView<'_>, &hli::ImageMemory);
+    let send = |plc: &PlcView<'_>, command, t| {
+        plc.dyn_cs_transition(0)
+            .unwrap()
+            .try_send(command, &t)
+            .unwrap()
+    };
+    let cases: [(&str, Post, E, E); 6] = [
+        (
+            "garbage word",
+            |_, m| {
+                let word = Leaf::resolve("gpCh[0]^channel_mc_control.dyn_cs.transition_w.command");
+                word.unwrap().write(m, Value::Int(5));
+            },
+            E::CommandWord,
+            E::CommandWord,
+        ),
+        (
+            "flag byte",
+            |p, _| {
+                let mut t = transition(0, Bool::FALSE);
+                t.f_set_zero = bytemuck::cast(7u8);
+                p.dyn_cs_transition(0)
+                    .unwrap()
+                    .try_send(DynCsCommand::Activate, &t)
+                    .unwrap();
+            },
+            E::FlagByte,
+            E::FlagByte,
+        ),
+        (
+            "kin base with rot trans",
+            |p, _| {
+                let mut t = transition(0, Bool::FALSE);
+                t.f_kin_base = Bool::TRUE;
+                t.f_rot_trans = Bool::TRUE;
+                p.dyn_cs_transition(0)
+                    .unwrap()
+                    .try_send(DynCsCommand::Activate, &t)
+                    .unwrap();
+            },
+            E::RotTransWithKinBase,
+            E::RotTransWithKinBase,
+        ),
+        (
+            "option",
+            |p, _| {
+                let mut t = transition(0, Bool::FALSE);
+                t.option = 7;
+                p.dyn_cs_transition(0)
+                    .unwrap()
+                    .try_send(DynCsCommand::Activate, &t)
+                    .unwrap();
+            },
+            E::OptionValue,
+            E::OptionValue,
+        ),
+        (
+            "not enabled",
+            |p, _| {
+                p.set_dyn_cs_enabled(0, false).unwrap();
+                let t = transition(0, Bool::FALSE);
+                p.dyn_cs_transition(0)
+                    .unwrap()
+                    .try_send(DynCsCommand::Activate, &t)
+                    .unwrap();
+            },
+            E::NotEnabled,
+            E::NotEnabled,
+        ),
+        (
+            "on while on",
+            |p, _| {
+                let t = transition(0, Bool::FALSE);
+                p.dyn_cs_transition(0)
+                    .unwrap()
+                    .try_send(DynCsCommand::Activate, &t)
+                    .unwrap();
+            },
+            E::None,
+            E::AlreadyOn,
+        ),
+    ];
+    for from_active in [false, true] {
+        for (name, post, from_inactive_id, from_active_id) in cases {
+            let mut ctl = controller(vec![(cartesian("slave"), "#TIME 1\nM30\n")]);
+            let memory = image(1);
+            let view = CncView::new(&memory);
+            let plc = PlcView::new(&memory);
+            plc.set_dyn_cs_enabled(0, true).unwrap();
+            if from_active {
+                send(&plc, DynCsCommand::Activate, transition(0, Bool::FALSE));
+                ctl.tick(&view);
+                ctl.tick(&view);
+            }
+            let start = plc.dyn_cs_state(0).unwrap().unwrap();
+            let before = read(&plc).taken_count_r;
+            post(&plc, &memory);
+            ctl.tick(&view);
+            let r = read(&plc);
+            let expected = if from_active {
+                from_active_id
+            } else {
+                from_inactive_id
+            };
+            assert_eq!(r.taken_count_r, before + 1, "{name}");
+            assert_eq!(
+                r.error_id_r,
+                expected.raw(),
+                "{name}, from ACTIVE {from_active}"
+            );
+            if expected != E::None {
+                assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), start, "{name}");
+            } else {
+                // Accepted: ACTIVATING passed (and shown for the tick).
+                assert_eq!(r.states_seen_r, 1 << 1, "{name}");
+                assert_eq!(r.command_r, 1);
+            }
+        }
+    }
+    // f_set_zero while the axes move.
+    let mut ctl = controller(vec![(cartesian("slave"), "G1 X100 F600\nM30\n")]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    for _ in 0..10 {
+        ctl.tick(&view);
+    }
+    let mut t = transition(0, Bool::FALSE);
+    t.f_set_zero = Bool::TRUE;
+    send(&plc, DynCsCommand::Activate, t);
+    ctl.tick(&view);
+    assert_eq!(read(&plc).error_id_r, E::SetZeroMoving.raw());
+    assert_eq!(plc.dyn_cs_state(0).unwrap().unwrap(), DynCsState::Inactive);
+}
+
+/// A history size the machine cannot hold (inside the manual's range) is refused with the key,
+/// not aborted on.
+#[test]
+fn a_history_size_beyond_what_is_kept_is_refused_with_its_key() {
+    let mut c = cartesian("big");
+    c.interpolator.dyn_cs_history_max = u32::MAX;
+    let e = cnc_core::channel::Channel::new(0, c, CYCLE).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("interpolator.dyn_cs_history_max = 4294967295"),
+        "{e}"
+    );
+    let mut c = cartesian("ok");
+    c.interpolator.dyn_cs_history_max = cnc_core::channel::config::MAX_HISTORY;
+    assert!(cnc_core::channel::Channel::new(0, c, CYCLE).is_ok());
+}

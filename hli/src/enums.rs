@@ -317,6 +317,34 @@ hli_enum! {
 }
 
 hli_enum! {
+    /// Why the CNC refused a dynamic-CS transition of the PLC
+    /// (`HLI_DYN_CS_TRANSITION_RESULT.error_id_r`; 0 when it carried it out). Ours: the seed
+    /// defines no refusals.
+    DynCsTransitionError: u32, "HLI_DYN_CS_TRANSITION_RESULT.error_id_r" {
+        /// Carried out.
+        None = 0,
+        /// The command word was not -1, 0 or +1.
+        CommandWord = 0x4511,
+        /// A flag byte was neither FALSE nor TRUE.
+        FlagByte = 0x4512,
+        /// `f_rot_trans` with `f_kin_base`.
+        RotTransWithKinBase = 0x4513,
+        /// `option` was not 0 or 1.
+        OptionValue = 0x4514,
+        /// The kinematic-base frame was not finite.
+        Offset = 0x4515,
+        /// `enable_w` was FALSE.
+        NotEnabled = 0x4516,
+        /// +1 while tracking is on (ACTIVATING, ACTIVE or ERROR: switch it off first).
+        AlreadyOn = 0x4517,
+        /// `f_set_zero` while the channel's axes move (SET_ZERO needs standstill).
+        SetZeroMoving = 0x4518,
+        /// Refused for another reason of the tracker.
+        Refused = 0x451F,
+    }
+}
+
+hli_enum! {
     /// State of a FIFO axis group.
     FifoGroupState: i32, "HLI_FIFO_GROUP_STATE.group_state_r" {
         /// No job: axes may be integrated, the FIFO is empty.

@@ -20,6 +20,8 @@ use crate::layout::*;
 use crate::raw::{ImageMemory, Place};
 use core::mem::offset_of;
 
+mod transition;
+
 /// A channel or axis index outside the configured range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("{what} index {index} out of range (configured: {count})")]

@@ -172,6 +172,9 @@ pub struct McDynCsTransition {
     phase: TransitionPhase,
     /// The state left the start state after the CNC took the command.
     moved: bool,
+    /// `dyn_cs_result.taken_count_r` before the command was sent: a new count is the CNC's
+    /// answer to it.
+    taken_before: u32,
     execute_before: bool,
     show_once: bool,
 }
@@ -194,6 +197,7 @@ impl Default for McDynCsTransition {
             latched_on: true,
             phase: TransitionPhase::Idle,
             moved: false,
+            taken_before: 0,
             execute_before: false,
             show_once: false,
         }
@@ -249,6 +253,7 @@ impl McDynCsTransition {
             } else {
                 DynCsCommand::Deactivate
             };
+            self.taken_before = ch.dyn_cs_result().taken_count_r;
             match ch.dyn_cs_transition().try_send(command, &self.latched) {
                 Ok(()) => {
                     self.sent += 1;
@@ -262,15 +267,19 @@ impl McDynCsTransition {
             self.out.busy = true;
             return;
         }
-        let taken = match ch.dyn_cs_transition().is_free() {
-            Ok(free) => free,
-            Err(_) => return self.finish_with_error(DynCsBlockError::Protocol),
-        };
+        // The CNC's answer: refused (with its reason) or carried out, and the states passed
+        // since, so a state that lasted less than a PLC cycle still counts.
+        let result = ch.dyn_cs_result();
+        let taken = result.taken_count_r != self.taken_before;
+        if taken && result.error_id_r != 0 {
+            return self.finish_with_code(result.error_id_r);
+        }
         let (goal, opposite) = if self.latched_on {
             (DynCsState::Active, DynCsState::Inactive)
         } else {
             (DynCsState::Inactive, DynCsState::Active)
         };
+        let seen = |s: DynCsState| taken && result.states_seen_r & state_bit(s) != 0;
         self.out = BlockOutputs {
             busy: true,
             active: taken,
@@ -278,8 +287,9 @@ impl McDynCsTransition {
         };
         match ch.dyn_cs_state() {
             Err(_) => self.finish_with_error(DynCsBlockError::InvalidState),
-            Ok(DynCsState::Error) => self.finish_with_error(DynCsBlockError::Tracking),
-            Ok(state) if taken && state == goal => {
+            _ if seen(DynCsState::Error) => self.finish_with_error(DynCsBlockError::Tracking),
+            Ok(DynCsState::Error) if taken => self.finish_with_error(DynCsBlockError::Tracking),
+            _ if seen(goal) => {
                 self.out = BlockOutputs {
                     done: true,
                     ..BlockOutputs::default()
@@ -299,12 +309,29 @@ impl McDynCsTransition {
     }
 
     fn finish_with_error(&mut self, why: DynCsBlockError) {
+        self.finish_with_code(why.code());
+    }
+
+    /// Error with `error_id`: one of [`DynCsBlockError`] or the CNC's refusal
+    /// (`hli::enums::DynCsTransitionError`).
+    fn finish_with_code(&mut self, error_id: u32) {
         self.out = BlockOutputs {
             error: true,
-            error_id: why.code(),
+            error_id,
             ..BlockOutputs::default()
         };
         self.phase = TransitionPhase::Idle;
+    }
+}
+
+/// The bit of `state` in `dyn_cs_result.states_seen_r`.
+fn state_bit(state: DynCsState) -> u32 {
+    1 << match state {
+        DynCsState::Inactive => 0,
+        DynCsState::Activating => 1,
+        DynCsState::Active => 2,
+        DynCsState::Deactivating => 3,
+        DynCsState::Error => 4,
     }
 }
 

@@ -3,19 +3,42 @@
 //! Error with 0x4803 at ERROR, Busy while the command word is not taken, and a result shown
 //! for one cycle when Execute fell before it came. MFunctionHandshake takes and acknowledges.
 
-use hli::enums::DynCsState;
-use hli::layout::HliMFunctionRequest;
+use hli::enums::{DynCsState, DynCsTransitionError};
+use hli::layout::{HliDynCsTransitionResult, HliMFunctionRequest};
 use plc_shim::dyn_cs::{MFunctionHandshake, McDynCsTransition};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 /// The CNC's side: which commands it took (tick, +1/-1) and the states it plays after each.
-#[derive(Default)]
 struct Cnc {
     taken: Vec<(u64, i32)>,
     acks: Vec<(i32, u32)>,
     plan: Vec<DynCsState>,
+    /// What the CNC reports of the transitions (`dyn_cs_result`).
+    result: HliDynCsTransitionResult,
+}
+
+impl Default for Cnc {
+    fn default() -> Self {
+        Self {
+            taken: Vec::new(),
+            acks: Vec::new(),
+            plan: Vec::new(),
+            result: bytemuck::Zeroable::zeroed(),
+        }
+    }
+}
+
+/// The bit of `state` in `states_seen_r`.
+fn bit(state: DynCsState) -> u32 {
+    1 << match state {
+        DynCsState::Inactive => 0,
+        DynCsState::Activating => 1,
+        DynCsState::Active => 2,
+        DynCsState::Deactivating => 3,
+        DynCsState::Error => 4,
+    }
 }
 
 fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + Send + 'static {
@@ -26,6 +49,10 @@ fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + S
         if !hold {
             if let Ok(Some((command, _))) = view.dyn_cs_transition(0).unwrap().try_take() {
                 cnc.taken.push((tick, command.raw()));
+                cnc.result.taken_count_r += 1;
+                cnc.result.command_r = command.raw();
+                cnc.result.error_id_r = 0;
+                cnc.result.states_seen_r = 0;
                 cnc.plan = match cnc.taken.len() {
                     // 1st: ON, then someone switches off: back to INACTIVE after ACTIVATING.
                     1 => vec![
@@ -36,6 +63,11 @@ fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + S
                     ],
                     // 2nd: ON, ERROR.
                     2 => vec![DynCsState::Activating, DynCsState::Error],
+                    // 4th: refused (+1 while on): the state stays.
+                    4 => {
+                        cnc.result.error_id_r = DynCsTransitionError::AlreadyOn.raw();
+                        Vec::new()
+                    }
                     // 3rd: ON, ACTIVE after three ticks.
                     _ => vec![
                         DynCsState::Activating,
@@ -49,7 +81,9 @@ fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + S
         }
         if let Some(state) = cnc.plan.pop() {
             view.set_dyn_cs_state(0, state).unwrap();
+            cnc.result.states_seen_r |= bit(state);
         }
+        view.write_dyn_cs_result(0, &cnc.result).unwrap();
         if tick == 2 {
             let request = HliMFunctionRequest {
                 m_code: 100,
@@ -80,7 +114,7 @@ impl PlcProgram for Driver {
         let c = io.cycle;
         // Three commands: Execute held until a result (1st), a one-cycle pulse (2nd, its
         // result comes later), held (3rd).
-        self.block.execute = matches!(c, 3..=12 | 18 | 30..=45);
+        self.block.execute = matches!(c, 3..=12 | 18 | 30..=45 | 50..=55);
         self.block.call(io, 0);
         let o = self.block.out;
         let word = [
@@ -127,7 +161,7 @@ fn the_transition_block_reports_done_aborted_and_error_as_plcopen_says() {
     let cnc = cnc.lock().unwrap();
     assert_eq!(
         cnc.taken.iter().map(|t| t.1).collect::<Vec<_>>(),
-        [1, 1, 1],
+        [1, 1, 1, 1],
         "{:?}",
         cnc.taken
     );
@@ -151,6 +185,10 @@ fn the_transition_block_reports_done_aborted_and_error_as_plcopen_says() {
         "31 Busy+Active",
         "34 Done",
         "46 ",
+        // 4th: refused by the CNC (+1 while ACTIVE): Error with the CNC's reason, not Done.
+        "50 Busy",
+        "51 Error 0x4517",
+        "56 ",
     ];
     assert_eq!(driver.log, expected, "{:?}", driver.log);
     assert_eq!(cnc.acks, [(100, 41)]);

@@ -10,6 +10,10 @@ use kinematics::opw::{Robot45, Robot45Params};
 use kinematics::{JointLimit, KinematicId, Kinematics, PoseWords, RotationOrder};
 use serde::Deserialize;
 
+/// The most diagnosis-history entries a channel keeps (each about 160 bytes, allocated at
+/// start-up).
+pub const MAX_HISTORY: u32 = 100_000;
+
 /// One channel.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -336,6 +340,15 @@ impl ChannelConfig {
                     "a record has a D of 1 or more and a finite length",
                 ));
             }
+        }
+        // Every entry is allocated at start-up: a size the machine cannot hold is refused
+        // here instead of aborting the process (the manual allows up to 2^32 - 1).
+        if self.interpolator.dyn_cs_history_max > MAX_HISTORY {
+            return Err(parameter(
+                "interpolator.dyn_cs_history_max",
+                f64::from(self.interpolator.dyn_cs_history_max),
+                "more entries than this controller keeps (at most 100000, 16 MB a channel)",
+            ));
         }
         if self.kin_trafo_display > 2 {
             return Err(parameter(

@@ -247,6 +247,11 @@ mod tests {
             TrackError::PlcNotEnabled,
             TrackError::BadFrame,
             TrackError::MachineStop,
+            TrackError::JointLimit {
+                axis: 5,
+                kind: crate::channel::guard::LimitKind::Acceleration,
+            },
+            TrackError::ChannelFailed(hli::enums::ChannelErrorId::Kinematics),
         ]
         .into_iter()
         .chain(BadParameter::ALL.map(TrackError::BadTransition));
@@ -312,8 +317,8 @@ mod tests {
         assert_eq!(log_event(&reply), Err(WireError::UnknownKind(99)));
         reply.kind = log_kind::ERROR;
         reply.error = 6;
-        reply.error_value = 5;
-        assert_eq!(log_event(&reply), Err(WireError::UnknownError(6, 5)));
+        reply.error_value = 6;
+        assert_eq!(log_event(&reply), Err(WireError::UnknownError(6, 6)));
         reply.kind = log_kind::ON;
         reply.source = 13;
         assert_eq!(log_event(&reply), Err(WireError::UnknownSource(13)));

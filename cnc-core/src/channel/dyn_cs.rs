@@ -237,16 +237,20 @@ pub enum BadParameter {
     /// The offset frame.
     #[error("offset X..C is not finite")]
     Offset = 4,
+    /// SET_ZERO while the channel moves.
+    #[error("f_set_zero needs the channel at standstill")]
+    SetZeroMoving = 5,
 }
 
 impl BadParameter {
     /// Every parameter, in the order of their numbers.
-    pub const ALL: [BadParameter; 5] = [
+    pub const ALL: [BadParameter; 6] = [
         BadParameter::CommandWord,
         BadParameter::FlagByte,
         BadParameter::RotTransWithKinBase,
         BadParameter::OptionValue,
         BadParameter::Offset,
+        BadParameter::SetZeroMoving,
     ];
 }
 

@@ -7,7 +7,7 @@ use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};
 use hli::handshake::ProtocolViolation;
 use hli::layout::{
     HliCoordState, HliCoordinateSystemInt, HliDynCsChannelInterface, HliDynCsTransition,
-    HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
+    HliDynCsTransitionResult, HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
 };
 use hli::views::{BlockProgress, CncView, OverrideError, PathOverride};
 use hli::Bool;
@@ -29,8 +29,9 @@ pub struct Wanted {
 pub enum Transition {
     /// Taken: the command and its parameters.
     Taken(DynCsCommand, HliDynCsTransition),
-    /// The command word was garbage (reset by the reader).
-    Garbage,
+    /// The command word was garbage (reset by the reader): the word found (0 when the
+    /// unit broke the protocol otherwise).
+    Garbage(i32),
 }
 
 /// The override unit as read this tick.
@@ -84,6 +85,8 @@ pub struct ChannelOutputs {
     pub interface: HliDynCsChannelInterface,
     /// An M function to announce (kept until it is posted).
     pub m_request: Option<HliMFunctionRequest>,
+    /// What became of the PLC's transitions.
+    pub dyn_cs_result: HliDynCsTransitionResult,
 }
 
 impl Default for ChannelOutputs {
@@ -103,6 +106,7 @@ impl Default for ChannelOutputs {
             feed_override_applied: 0,
             interface: bytemuck::Zeroable::zeroed(),
             m_request: None,
+            dyn_cs_result: bytemuck::Zeroable::zeroed(),
         }
     }
 }
@@ -146,7 +150,8 @@ fn transition_input(
     match taken {
         Ok(Some((command, params))) => Some(Transition::Taken(command, params)),
         Ok(None) | Err(ProtocolViolation::TornPayload) => None,
-        Err(_) => Some(Transition::Garbage),
+        Err(ProtocolViolation::CommandGarbage { raw }) => Some(Transition::Garbage(raw)),
+        Err(_) => Some(Transition::Garbage(0)),
     }
 }
 
@@ -168,6 +173,7 @@ pub fn write_outputs(view: &CncView<'_>, index: usize, outputs: &mut ChannelOutp
     let _ = view.write_block_progress(index, &outputs.progress);
     let _ = view.write_feed_override_applied(index, outputs.feed_override_applied);
     let _ = view.write_channel_interface(index, &outputs.interface);
+    let _ = view.write_dyn_cs_result(index, &outputs.dyn_cs_result);
 }
 
 /// The interface of a channel after one tick: a valid published frame updates the frame and
@@ -225,7 +231,7 @@ mod tests {
         assert_eq!(transition_input(Ok(None)), None);
         assert_eq!(
             transition_input(Err(ProtocolViolation::CommandGarbage { raw: 5 })),
-            Some(Transition::Garbage)
+            Some(Transition::Garbage(5))
         );
         let params: HliDynCsTransition = bytemuck::Zeroable::zeroed();
         assert_eq!(

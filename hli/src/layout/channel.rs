@@ -121,10 +121,32 @@ hli_struct! {
 }
 
 hli_struct! {
+    /// What became of the PLC's dynamic-CS transitions (our unit; the manual's unit reports
+    /// only the state): the CNC counts every transition it takes from `transition_w`, keeps
+    /// the command word and whether it was carried out or refused (with the reason), and
+    /// collects the tracking states passed since (bit `n` for state `n`, bit 4 for ERROR),
+    /// so a PLC that runs every N ticks sees a state that lasted one tick.
+    ///
+    /// ST path: `gpCh[i]^channel_mc_control.dyn_cs_result`.
+    #[st = "HLI_DYN_CS_TRANSITION_RESULT", size = 16]
+    pub struct HliDynCsTransitionResult {
+        /// Transitions taken from `transition_w` so far (wraps).
+        pub taken_count_r: u32 => [0, Cnc],
+        /// The command word of the last one taken (as the PLC wrote it).
+        pub command_r: i32 => [4, Cnc],
+        /// 0: carried out; else why it was refused (`DynCsTransitionError`).
+        pub error_id_r: u32 => [8, Cnc],
+        /// Tracking states passed since it was taken: bit 0 INACTIVE, 1 ACTIVATING, 2 ACTIVE,
+        /// 3 DEACTIVATING, 4 ERROR.
+        pub states_seen_r: u32 => [12, Cnc],
+    }
+}
+
+hli_struct! {
     /// Control units of a channel.
     ///
     /// ST path: `gpCh[i]^channel_mc_control`.
-    #[st = "HLI_CHANNEL_MC_CONTROL", size = 168]
+    #[st = "HLI_CHANNEL_MC_CONTROL", size = 184]
     pub struct HliChannelMcControl {
         /// Dynamic coordinate system (PLC as master, tracking switch).
         pub dyn_cs: McControlDynCsUnit => [0, Parent],
@@ -132,6 +154,8 @@ hli_struct! {
         pub m_function: HliMFunctionUnit => [128, Parent],
         /// Override and feed hold (ST element `path_override`).
         pub path_override: HliChannelOverrideUnit => [152, Parent],
+        /// The outcome of the PLC's dynamic-CS transitions.
+        pub dyn_cs_result: HliDynCsTransitionResult => [168, Parent],
     }
 }
 
@@ -172,14 +196,14 @@ hli_struct! {
     /// Everything of one channel: `gpCh[channel_idx]^`.
     ///
     /// ST path: `gpCh[i]^`.
-    #[st = "HLI_CHANNEL", size = 744]
+    #[st = "HLI_CHANNEL", size = 760]
     pub struct HliChannel {
         /// Path state and display values.
         pub bahn_state: HliBahnState => [0, Parent],
         /// Control units.
         pub channel_mc_control: HliChannelMcControl => [536, Parent],
         /// Channel interface (dynamic CS master output).
-        pub channel_interface: HliChannelInterface => [704, Parent],
+        pub channel_interface: HliChannelInterface => [720, Parent],
     }
 }
 

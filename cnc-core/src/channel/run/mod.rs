@@ -15,18 +15,16 @@
 //!    channel interface, an M-function announcement.
 
 mod safety;
+mod transition;
 
 pub use safety::ResetError;
 
 use super::config::{ChannelConfig, ChannelConfigError};
-use super::dyn_cs::{
-    words, BadParameter, MasterSample, MasterSource, TrackError, TrackSetup, Tracker,
-};
+use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::guard::JointGuard;
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
-    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Transition,
-    Wanted,
+    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Wanted,
 };
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
@@ -36,7 +34,7 @@ use crate::nc::decode::{
 };
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
-use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};
+use hli::enums::{ChannelErrorId, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
 use hli::views::{PathOverride, DEFAULT_PATH_OVERRIDE};
 use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
@@ -518,6 +516,7 @@ impl Channel {
         self.fail_on_tracking_error();
         self.update_pose();
         self.guard_set_points();
+        self.note_dyn_cs_state();
         self.fill_outputs();
     }
 
@@ -550,77 +549,7 @@ impl Channel {
                 self.tracker.not_redirected();
             }
         }
-        // A refused transition is logged and counted; it never puts the tracking in ERROR, so
-        // it cannot block a later switch-on.
-        let (command, params) = match self.inputs.transition {
-            Some(Transition::Taken(command, params)) => (command, params),
-            None => return,
-            Some(Transition::Garbage) => {
-                self.tracker
-                    .refuse(TrackError::BadTransition(BadParameter::CommandWord));
-                return;
-            }
-        };
-        if !enabled {
-            self.tracker.refuse(TrackError::PlcNotEnabled);
-            return;
-        }
-        match command {
-            DynCsCommand::Activate => {
-                let flags = [
-                    params.f_wait.get(),
-                    params.f_set_zero.get(),
-                    params.f_kin_base.get(),
-                    params.f_rot_trans.get(),
-                ];
-                let [Ok(wait), Ok(set_zero), Ok(kin_base), Ok(rot_trans)] = flags else {
-                    self.tracker
-                        .refuse(TrackError::BadTransition(BadParameter::FlagByte));
-                    return;
-                };
-                if kin_base && rot_trans {
-                    // As the NC command refuses KIN_BASE with ROT_TRANS at load.
-                    self.tracker
-                        .refuse(TrackError::BadTransition(BadParameter::RotTransWithKinBase));
-                    return;
-                }
-                if params.option > 1 {
-                    self.tracker
-                        .refuse(TrackError::BadTransition(BadParameter::OptionValue));
-                    return;
-                }
-                let kb = frame_from_hli(&params.kinematic_base_cs, RotationOrder::Zyx);
-                let w = words(&kb);
-                let setup = TrackSetup {
-                    source: MasterSource::Plc,
-                    set_zero,
-                    translation_only: params.option == 1,
-                    kin_base,
-                    filter_ticks: params.filter_max_ticks,
-                    wait,
-                    rot_trans,
-                    offset: w,
-                    // The transition has no flags for these: NC command only.
-                    relative: false,
-                    simu: false,
-                };
-                let master = self.plc_frame;
-                match self.tracker.switch_on(setup, master.as_ref()) {
-                    Ok(()) if wait => self.hold_program_until_settled(),
-                    Ok(()) => {}
-                    Err(error) => self.tracker.refuse(error),
-                }
-            }
-            DynCsCommand::Deactivate => {
-                self.tracker.switch_off(Some(params.filter_max_ticks));
-                // f_wait on a switch-off, as `#TRACK CS OFF [WAIT]`; a byte that is no BOOL
-                // is no request to wait.
-                if params.f_wait.get() == Ok(true) {
-                    self.hold_program_until_settled();
-                }
-            }
-            DynCsCommand::None => {}
-        }
+        self.take_transition(enabled);
     }
 
     /// `f_wait` of a PLC transition, the counterpart of the NC command's WAIT: the program
