@@ -177,7 +177,9 @@ proptest! {
         let solutions = robot.inverse_all(&pose, &joints).unwrap();
         prop_assert!(!solutions.is_empty());
         for s in solutions.as_slice() {
-            prop_assert!(pose_close(&robot.forward(s).unwrap(), &pose, 1e-9), "{name}: {s:?} for {joints:?}");
+            // 10 pm: with the elbow nearly stretched the elbow angle's acos is ill-conditioned
+            // and a solution lands 1.5 pm off (the kept regression case).
+            prop_assert!(pose_close(&robot.forward(s).unwrap(), &pose, 1e-8), "{name}: {s:?} for {joints:?}");
             for (i, l) in params.limits.iter().enumerate() {
                 prop_assert!(l.contains(s[i]));
             }

@@ -3,11 +3,10 @@
 //! the start-up parameter `configuration.channel[i].interpolator.dyn_cs_history_max`
 //! (P-STUP-00074, default 20).
 
+pub use super::kin_config::KinematicsConfig;
 use super::path::AxisLimits;
 use crate::nc::decode::check_channel_axes;
-use kinematics::cartesian::Cartesian;
-use kinematics::opw::{Robot45, Robot45Params};
-use kinematics::{JointLimit, KinematicId, Kinematics, PoseWords, RotationOrder};
+use kinematics::{Kinematics, RotationOrder};
 use serde::Deserialize;
 
 /// The most diagnosis-history entries a channel keeps (each about 160 bytes, allocated at
@@ -104,8 +103,13 @@ pub struct ZeroOffsets {
 pub struct ToolEntry {
     /// The D number that selects it (1 or more).
     pub d: u32,
-    /// Tool length (mm).
+    /// Tool length (mm): along the plane's normal without a transformation, along the
+    /// flange's tool axis (Z) under one.
     pub length: f64,
+    /// Orientation of the tool point against the flange under a transformation: A B C
+    /// (degrees, Z-Y-X; C turns about the tool axis).
+    #[serde(default)]
+    pub orientation: [f64; 3],
 }
 
 impl NcConfig {
@@ -176,21 +180,6 @@ fn default_limits() -> AxisLimits {
         acceleration: 5000.0,
         jerk: 50_000.0,
     }
-}
-
-/// The kinematic transformation of a channel.
-#[derive(Debug, Clone, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct KinematicsConfig {
-    /// Kinematic id: 0 Cartesian, 45 six-axis robot.
-    #[serde(default)]
-    pub id: u32,
-    /// For id 45: a preset (`kr6r900sixx`, `kr6r700sixx`, `irb2400`).
-    #[serde(default)]
-    pub preset: Option<String>,
-    /// Tool offset X Y Z (mm) A B C (degrees, Z-Y-X) for id 0.
-    #[serde(default)]
-    pub tool: [f64; 6],
 }
 
 /// A configuration that cannot run.
@@ -333,7 +322,7 @@ impl ChannelConfig {
             }
         }
         for t in &self.nc.tools {
-            if !t.length.is_finite() || t.d == 0 {
+            if !t.length.is_finite() || t.d == 0 || !t.orientation.iter().all(|v| v.is_finite()) {
                 return Err(parameter(
                     "nc.tools",
                     t.length,
@@ -369,7 +358,6 @@ impl ChannelConfig {
             channel: channel.clone(),
             reason,
         };
-        let id = KinematicId::from_raw(self.kinematics.id).map_err(|e| kin_error(e.to_string()))?;
         if self.axes.len() < 6 {
             return Err(ChannelConfigError::TooFewAxes {
                 channel: channel.clone(),
@@ -377,33 +365,6 @@ impl ChannelConfig {
                 found: self.axes.len(),
             });
         }
-        match id {
-            KinematicId::Cartesian => {
-                let t = self.kinematics.tool;
-                let tool = PoseWords {
-                    xyz: [t[0], t[1], t[2]],
-                    abc: [t[3], t[4], t[5]],
-                };
-                Ok(Box::new(
-                    Cartesian::new(order, &tool, [JointLimit::NONE; 6])
-                        .map_err(|e| kin_error(e.to_string()))?,
-                ))
-            }
-            KinematicId::Robot45 => {
-                let name = self.kinematics.preset.as_deref().unwrap_or("kr6r900sixx");
-                let params = Robot45Params::preset(name).ok_or_else(|| {
-                    kin_error(format!(
-                        "unknown preset \"{name}\" (known: kr6r900sixx, kr6r700sixx, irb2400)"
-                    ))
-                })?;
-                Ok(Box::new(
-                    Robot45::new(params).map_err(|e| kin_error(e.to_string()))?,
-                ))
-            }
-            other => Err(kin_error(format!(
-                "kinematic {} is not available in channels yet (0 and 45 are)",
-                other.raw()
-            ))),
-        }
+        self.kinematics.build(order).map_err(kin_error)
     }
 }

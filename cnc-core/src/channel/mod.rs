@@ -10,6 +10,7 @@ pub mod diag_wire;
 pub(crate) mod diagnosis;
 pub mod dyn_cs;
 pub mod guard;
+pub mod kin_config;
 pub mod path;
 pub mod plc_io;
 pub mod program;

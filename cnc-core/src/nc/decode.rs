@@ -397,6 +397,15 @@ pub enum Decoded {
         /// Tool number.
         number: u32,
     },
+    /// `D..`: the tool data record selected (0: none). Under a transformation the channel
+    /// puts it on the flange; without one the decoder offsets the plane's normal by its
+    /// length.
+    ToolRecord {
+        /// Source line.
+        line: u32,
+        /// D number.
+        d: u32,
+    },
 }
 
 /// The machine data a decoder needs: zero offsets, tool table, arc tolerance.
@@ -452,6 +461,8 @@ pub struct DecoderState {
     tools_unknown: bool,
     /// The length of the selected D (0 for D0).
     tool_length: f64,
+    /// A transformation is on (`#TRAFO`): the tool length is the channel's, not an offset.
+    trafo: bool,
     /// The end point's tolerance against an arc's circle (mm).
     arc_tolerance: f64,
     /// Whether the position is where the program put it (false for a block checked on its own:
@@ -612,6 +623,7 @@ impl DecoderState {
             tools: Vec::new(),
             tools_unknown: false,
             tool_length: 0.0,
+            trafo: false,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
             start_known: true,
             words: [0.0; MAX_CHANNEL_AXES],
@@ -721,7 +733,7 @@ impl DecoderState {
             0 => 0.0,
             z => self.zero_offsets[z - 1].get(axis).copied().unwrap_or(0.0),
         };
-        let tool = if axis == self.plane.axes()[2] {
+        let tool = if axis == self.plane.axes()[2] && !self.trafo {
             self.tool_length
         } else {
             0.0
@@ -843,11 +855,13 @@ impl DecoderState {
                             if addr == Addr::T {
                                 tail.push(Decoded::Tool { line, number: n });
                             } else if n == 0 {
+                                tail.push(Decoded::ToolRecord { line, d: 0 });
                                 self.tool_length = 0.0;
                             } else if let Some(&(_, length)) =
                                 self.tools.iter().find(|(d, _)| *d == n)
                             {
                                 self.tool_length = length;
+                                tail.push(Decoded::ToolRecord { line, d: n });
                             } else if self.tools_unknown {
                                 self.tool_length = 0.0;
                             } else {
@@ -1204,6 +1218,9 @@ impl DecoderState {
                 };
                 // `#TRAFO [45]` switches on with that id (as the seed's programs use it).
                 let on = on.or(id.map(|_| true));
+                if let Some(on) = on {
+                    self.trafo = on;
+                }
                 Some(Decoded::Trafo { line, on, id })
             }
             Command::KinId { id } => {

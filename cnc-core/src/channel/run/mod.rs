@@ -15,6 +15,7 @@
 //!    channel interface, an M-function announcement.
 
 mod safety;
+mod tool;
 mod transition;
 
 pub use safety::ResetError;
@@ -22,6 +23,7 @@ pub use safety::ResetError;
 use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::guard::JointGuard;
+use super::kin_config::ToolKinematics;
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Wanted,
@@ -112,7 +114,8 @@ pub struct Channel {
     config: ChannelConfig,
     limits: AxisLimits,
     order: RotationOrder,
-    kinematics: Box<dyn Kinematics + Send>,
+    /// The configured kinematics with the selected tool record on its flange.
+    kinematics: ToolKinematics,
     program: Option<LoadedProgram>,
     decoder: DecoderState,
     /// Follows the program's control flow and calls.
@@ -197,7 +200,7 @@ impl Channel {
         config: ChannelConfig,
         cycle_s: f64,
     ) -> Result<Self, ChannelConfigError> {
-        let kinematics = config.build_kinematics()?;
+        let kinematics = ToolKinematics::new(config.build_kinematics()?);
         let order = config.order()?;
         let n = config.axes.len();
         let mut set_points = AxisValues::zeros(n);
@@ -711,6 +714,7 @@ impl Channel {
             }
             Decoded::Spindle { speed, .. } => self.spindle_speed = speed,
             Decoded::Tool { number, .. } => self.tool_number = number,
+            Decoded::ToolRecord { d, .. } => self.select_tool_record(d),
             Decoded::IndependentMove {
                 axis,
                 target,

@@ -6,6 +6,7 @@
 use super::{Channel, RunState};
 use crate::channel::dyn_cs::{MasterSample, TrackError};
 use hli::enums::{ChannelErrorId, DynCsState};
+use kinematics::Kinematics;
 
 /// Why [`Channel::reset`] refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
