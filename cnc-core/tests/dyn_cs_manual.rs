@@ -461,13 +461,12 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
         .try_send(DynCsCommand::Activate, &bad)
         .unwrap();
     ctl.tick(&view);
-    // KIN_BASE with ROT_TRANS, refused by the NC at load, is refused here too.
-    let mut both = transition(0, Bool::FALSE);
-    both.f_kin_base = Bool::TRUE;
-    both.f_rot_trans = Bool::TRUE;
+    // A flag byte that is neither FALSE nor TRUE.
+    let mut flag = transition(0, Bool::FALSE);
+    flag.f_kin_base = bytemuck::cast(7u8);
     plc.dyn_cs_transition(0)
         .unwrap()
-        .try_send(DynCsCommand::Activate, &both)
+        .try_send(DynCsCommand::Activate, &flag)
         .unwrap();
     ctl.tick(&view);
     let command_word =
@@ -483,7 +482,7 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
     for refusal in [
         "dynCS: refused: PLC transition while enable_w is FALSE",
         "dynCS: refused: invalid transition parameter: option must be 0 or 1",
-        "dynCS: refused: invalid transition parameter: f_rot_trans cannot be combined with f_kin_base",
+        "dynCS: refused: invalid transition parameter: a flag byte is neither FALSE nor TRUE",
         "dynCS: refused: invalid transition parameter: command word is not -1, 0 or +1",
     ] {
         assert!(diagnosis.contains(refusal), "{refusal}\n{diagnosis}");

@@ -327,8 +327,6 @@ hli_enum! {
         CommandWord = 0x4511,
         /// A flag byte was neither FALSE nor TRUE.
         FlagByte = 0x4512,
-        /// `f_rot_trans` with `f_kin_base`.
-        RotTransWithKinBase = 0x4513,
         /// `option` was not 0 or 1.
         OptionValue = 0x4514,
         /// The kinematic-base frame was not finite.

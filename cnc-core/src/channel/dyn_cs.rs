@@ -202,7 +202,11 @@ impl TrackError {
             3 => TrackError::NoSuchChannel(channel),
             4 => TrackError::OwnChannel,
             5 => TrackError::PlcNotEnabled,
-            6 => TrackError::BadTransition(BadParameter::ALL.get(value as usize).copied()?),
+            6 => TrackError::BadTransition(
+                BadParameter::ALL
+                    .into_iter()
+                    .find(|p| *p as u32 == value)?,
+            ),
             7 => TrackError::BadFrame,
             8 => TrackError::MachineStop,
             9 if value / 2 < u32::from(u8::MAX) => TrackError::JointLimit {
@@ -228,9 +232,6 @@ pub enum BadParameter {
     /// One of the flag bytes.
     #[error("a flag byte is neither FALSE nor TRUE")]
     FlagByte = 1,
-    /// ROT_TRANS with KIN_BASE.
-    #[error("f_rot_trans cannot be combined with f_kin_base")]
-    RotTransWithKinBase = 2,
     /// The option.
     #[error("option must be 0 or 1")]
     OptionValue = 3,
@@ -244,10 +245,9 @@ pub enum BadParameter {
 
 impl BadParameter {
     /// Every parameter, in the order of their numbers.
-    pub const ALL: [BadParameter; 6] = [
+    pub const ALL: [BadParameter; 5] = [
         BadParameter::CommandWord,
         BadParameter::FlagByte,
-        BadParameter::RotTransWithKinBase,
         BadParameter::OptionValue,
         BadParameter::Offset,
         BadParameter::SetZeroMoving,

@@ -1454,10 +1454,6 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         ctx.error(span, "#TRACK CS ON: expected a source, CH=.. or ID=..");
         ok = false;
     }
-    if t.kin_base && t.rot_trans {
-        ctx.error(span, "#TRACK CS: ROT_TRANS applies to the master-slave offset and cannot be combined with KIN_BASE");
-        ok = false;
-    }
     if given("SET_ZERO") && given("ABSOLUTE") {
         ctx.error(
             span,

@@ -88,10 +88,6 @@ impl Channel {
         let [Ok(wait), Ok(set_zero), Ok(kin_base), Ok(rot_trans)] = flags else {
             return Err(bad(BadParameter::FlagByte));
         };
-        if kin_base && rot_trans {
-            // As the NC command refuses KIN_BASE with ROT_TRANS at load.
-            return Err(bad(BadParameter::RotTransWithKinBase));
-        }
         if params.option > 1 {
             return Err(bad(BadParameter::OptionValue));
         }
@@ -122,7 +118,6 @@ fn refusal_id(error: TrackError) -> DynCsTransitionError {
         TrackError::BadTransition(p) => match p {
             BadParameter::CommandWord => DynCsTransitionError::CommandWord,
             BadParameter::FlagByte => DynCsTransitionError::FlagByte,
-            BadParameter::RotTransWithKinBase => DynCsTransitionError::RotTransWithKinBase,
             BadParameter::OptionValue => DynCsTransitionError::OptionValue,
             BadParameter::Offset => DynCsTransitionError::Offset,
             BadParameter::SetZeroMoving => DynCsTransitionError::SetZeroMoving,
