@@ -466,7 +466,10 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
             let t = Tracking::new(mode, TrackingOption::Full, &offset, rot, None).unwrap();
             t.compensation(&master).translation.vector
         };
-        assert!((expected(true) - expected(false)).norm() > 1.0, "ROT_TRANS matters here");
+        assert!(
+            (expected(true) - expected(false)).norm() > 1.0,
+            "ROT_TRANS matters here"
+        );
         assert!(offset_frame(&offset, true).is_ok());
         let kb = if kin_base { " KIN_BASE" } else { "" };
         let nc = format!("#TRACK CS ON [ID=0 FILTER=0 ROT_TRANS{kb} X=100 C=90]\n#TIME 1\nM30\n");
@@ -484,7 +487,10 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
         t.kinematic_base_cs.rotation = [0, 0, 900_000];
         for ch in 0..2 {
             plc.set_dyn_cs_enabled(ch, true).unwrap();
-            plc.dyn_cs_command(ch).unwrap().try_send(&master_cs).unwrap();
+            plc.dyn_cs_command(ch)
+                .unwrap()
+                .try_send(&master_cs)
+                .unwrap();
         }
         plc.dyn_cs_transition(1)
             .unwrap()
@@ -494,7 +500,12 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
             ctl.tick(&view);
         }
         for ch in ctl.channels() {
-            assert_eq!(ch.tracker().state(), DynCsState::Active, "{}", ch.config().name);
+            assert_eq!(
+                ch.tracker().state(),
+                DynCsState::Active,
+                "{}",
+                ch.config().name
+            );
             let applied = ch.tracker().applied().translation.vector;
             assert!(
                 (applied - expected(true)).norm() < 1e-6,

@@ -203,9 +203,7 @@ impl TrackError {
             4 => TrackError::OwnChannel,
             5 => TrackError::PlcNotEnabled,
             6 => TrackError::BadTransition(
-                BadParameter::ALL
-                    .into_iter()
-                    .find(|p| *p as u32 == value)?,
+                BadParameter::ALL.into_iter().find(|p| *p as u32 == value)?,
             ),
             7 => TrackError::BadFrame,
             8 => TrackError::MachineStop,
