@@ -186,3 +186,65 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// The LOG_FILE is written while the CNC runs, not only at its end: the switch-on's lines
+/// are in the file while the program still waits, and after a SIGTERM the file holds the
+/// complete listing (history and log).
+#[test]
+fn the_log_file_is_written_as_the_events_happen() {
+    let dir = std::env::temp_dir().join(format!("cli-run-live-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("slave.nc"),
+        "#TRACK CS ON [ID=0 FILTER=0 LOG_FILE=\"live.log\"]\n#TIME 120\nM30\n",
+    )
+    .unwrap();
+    let scenario = dir.join("scenario.toml");
+    std::fs::write(
+        &scenario,
+        "cycle_ms = 1.0\n[[channel]]\nname = \"slave\"\n\
+         axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"slave.nc\"\n",
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let cnc = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        .arg("run")
+        .arg(&scenario)
+        .arg("--log-dir")
+        .arg(&out_dir)
+        .args(["--instance", &format!("clirun-live-{}", std::process::id())])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let log = out_dir.join("live.log");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let live = loop {
+        let text = std::fs::read_to_string(&log).unwrap_or_default();
+        if text.contains("dynCS: cmd=ON PLC=1 NO FILTER=0") {
+            break text;
+        }
+        assert!(
+            std::time::Instant::now() < deadline,
+            "watchdog: nothing in {} while running:\n{text}",
+            log.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    assert!(live.starts_with("BAHN LOGGING KANAL-NR.: 1"), "{live}");
+    assert!(live.contains("BAHN restart... start"), "{live}");
+    let status = Command::new("kill")
+        .args(["-TERM", &cnc.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = cnc.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(128 + 15));
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(
+        text.starts_with("BAHN : DYNAMIC CS, CHANNEL-NR.: 1"),
+        "{text}"
+    );
+    assert!(text.contains("dynCS: ERROR: machine stop"), "{text}");
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -95,6 +95,8 @@ pub fn main(args: DemoArgs) -> ExitCode {
         scratch: args.out.clone(),
         plc_watchdog_ticks: None,
         realtime: args.realtime.clone(),
+        // The demo's programs name no LOG_FILE; its listings are kept for `cnc diag`.
+        log_dir: None,
     };
     hli::signals::capture();
     let report = match run(&scenario, &options) {

@@ -4,6 +4,7 @@
 pub mod axes;
 pub mod file;
 pub mod fleet;
+pub mod log_stream;
 pub mod machine;
 pub mod runner;
 pub mod trace;

@@ -14,6 +14,7 @@
 //! ```
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
+use super::log_stream::LogStream;
 use super::machine::{build, Machine};
 use super::trace::Trace;
 use crate::app::stats::Percentiles;
@@ -84,6 +85,9 @@ pub struct RunOptions {
     pub plc_watchdog_ticks: Option<u64>,
     /// Real-time options of the tick loop (over the scenario's).
     pub realtime: plc_shim::realtime::RealtimeOptions,
+    /// Where `LOG_FILE`s are written while the run goes on (`None`: only at the end, by the
+    /// caller).
+    pub log_dir: Option<PathBuf>,
 }
 
 /// Why a run stopped before its end.
@@ -214,6 +218,7 @@ pub fn main(args: RunArgs) -> ExitCode {
         instance,
         plc_watchdog_ticks: args.plc_watchdog_ticks,
         realtime: args.realtime.clone(),
+        log_dir: Some(args.log_dir.clone()),
     };
     hli::signals::capture();
     match run(&scenario, &options) {
@@ -340,6 +345,10 @@ fn run_machine(
     let mut forced = false;
 
     let mut rest_after = None;
+    let mut log_stream = options
+        .log_dir
+        .as_ref()
+        .map(|dir| LogStream::start(dir, machine.controller().channels().len()));
     let counter = crate::app::progress::TickCounter::default();
     let progress = crate::app::progress::Progress::start(
         &counter,
@@ -394,6 +403,9 @@ fn run_machine(
         let t3 = monotonic::now();
         let _ = events.notify();
         let t4 = monotonic::now();
+        if let Some(stream) = log_stream.as_mut() {
+            stream.forward(machine.controller().channels());
+        }
         tick_ns.push((t4 - t0).as_nanos() as u64);
         for (stage, (a, b)) in stage_ns
             .iter_mut()
@@ -447,6 +459,9 @@ fn run_machine(
     }
 
     drop(progress);
+    if let Some(Err(e)) = log_stream.map(LogStream::finish) {
+        eprintln!("cnc run: LOG_FILE while running: {e}");
+    }
     let ticks = machine.ticks();
     // Lockstep: the PLC's cycle after the last tick belongs to the run as every other one
     // (it sees the final state) before the segment closes.

@@ -390,6 +390,11 @@ impl Channel {
         self.log_file.as_deref()
     }
 
+    /// [`Self::log_file`] as the shared name (cloned without allocating).
+    pub fn log_file_name(&self) -> Option<&Arc<str>> {
+        self.log_file.as_ref()
+    }
+
     /// The PLC's override and feed hold in effect.
     pub fn path_override(&self) -> PathOverride {
         self.path_override
