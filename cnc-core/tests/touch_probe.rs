@@ -405,3 +405,29 @@ fn lost_encoder_data_ends_an_armed_probe_with_the_cause() {
     assert_eq!(p.state_r, ProbeState::Aborted.raw());
     assert_eq!(p.error_id_r, AxisError::EncoderIoInvalid.raw());
 }
+
+/// Probe 2 on its rising edge (CANopen and SERCOS have two probes): its enable in `nCtrl6`,
+/// the position where the sensor comes on recorded exactly, probe 1 untouched.
+#[test]
+fn probe_2_records_its_rising_edge() {
+    for (interface, enable) in [
+        (ProbeInterface::Canopen, 0x11),
+        (ProbeInterface::Sercos, 0x01),
+    ] {
+        let mut rig = Rig::new(probed(interface, [None, Some([40.0031, 45.0])]));
+        let id = rig.arm(2, ProbeEdge::Positive, None).unwrap();
+        rig.tick();
+        let out = rig.enc_out();
+        assert_eq!((out.nCtrl5, out.nCtrl6), (0, enable), "{interface:?}");
+        rig.run_to(60.0);
+        let p2 = rig.probe(1);
+        assert_eq!(p2.state_r, ProbeState::Recorded.raw(), "{interface:?}");
+        assert_eq!((p2.arm_id_r, p2.edge_r), (id, ProbeEdge::Positive.raw()));
+        assert!(
+            (p2.recorded_position_r - 40.0031).abs() <= INCREMENT / 2.0,
+            "{interface:?}: {}",
+            p2.recorded_position_r
+        );
+        assert_eq!(rig.probe(0).state_r, ProbeState::Idle.raw());
+    }
+}
