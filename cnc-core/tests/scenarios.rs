@@ -123,7 +123,8 @@ fn example_3_two_slaves_stay_on_the_moving_workpiece() {
 /// lags by at most one tick of table motion.
 fn turntable(name: &str) {
     let s = scenario(name);
-    let centre = Vector3::new(600.0, 0.0, 0.0);
+    // The manual's table centre, 1305.92 mm in front of the robot.
+    let centre = Vector3::new(1305.92, 0.0, 0.0);
     let mut previous_table = 0.0;
     let (mut checked, mut worst, mut worst_same_tick) = (0, 0.0f64, 0.0f64);
     let mut max_table_step = 0.0f64;

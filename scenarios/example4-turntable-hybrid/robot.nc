@@ -1,15 +1,13 @@
 %turntable
-; The manual's table centre lies 1305.92 mm in front of the robot base, beyond the KR 6 R900's
-; reach: ours lies 600 mm in front. A work frame 70 mm up keeps the manual's heights Z90/Z80.
+; The manual's geometry: the table centre lies 1305.92 mm in front of the robot base.
 #TRAFO [45]
-#CS ON [0, 0, 70, 0, 0, 0]
-G1 X600 Y0 Z130 F6000
-N200 X600 Y0
-; Robot base seen from the table centre: 600 mm in -X. The PLC turns the frame with the
+G1 X1305.92 Y0 Z130 F6000
+N200 X1305.92 Y0
+; Robot base seen from the table centre: 1305.92 mm in -X. The PLC turns the frame with the
 ; table; OPTION=1 keeps the tool orientation while the tool point circles with the table.
-N210 #TRACK CS ON [ID=0 OPTION=1 FILTER=0 WAIT KIN_BASE X=-600]
+N210 #TRACK CS ON [ID=0 OPTION=1 FILTER=0 WAIT KIN_BASE X=-1305.92]
 ; from here on X0 Y0 is the table centre
-N230 G92 X600
+N230 G92 X1305.92
 N240 Z90
 ; the robot goes over the table's axis so nothing jumps; the table (X1) turns by itself
 N250 X0 Y0 X1[INDP_ASYN POS=-90 G01 F500 G90]

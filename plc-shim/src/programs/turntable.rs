@@ -2,11 +2,12 @@
 //! machines a workpiece on a turntable, in both of the seed's variants, written with the
 //! blocks of [`crate::dyn_cs`]:
 //!
-//! * **hybrid**: the NC program switches the tracking (`#TRACK CS ON [.. KIN_BASE X=-600]`);
+//! * **hybrid**: the NC program switches the tracking (`#TRACK CS ON [.. KIN_BASE X=-1305.92]`);
 //!   the PLC takes over the unit and, while tracking is ACTIVE, commands the table angle as the
 //!   frame's rotation every cycle the CNC has taken the previous frame;
 //! * **PLC-only**: the PLC also holds the turntable's geometry (KIN_BASE with the robot base
-//!   600 mm in -X of the table centre, OPTION=1, WAIT, no filter) and switches the tracking
+//!   1305.92 mm in -X of the table centre and 800 mm above it, the manual's numbers, OPTION=1,
+//!   WAIT, no filter) and switches the tracking
 //!   itself: on when the NC program announces M100, off on M101, acknowledging each M
 //!   function in the cycle it sends the transition.
 //!
@@ -22,8 +23,11 @@ use hli::enums::{DynCsOption, DynCsState};
 pub const SCENARIO_CHANNEL: usize = 0;
 /// The table axis there, `gpAx[6]`.
 pub const SCENARIO_TABLE_AXIS: usize = 6;
-/// Robot base seen from the table centre, -X, 0.1 um (600 mm).
-const KIN_BASE_X: i32 = -6_000_000;
+/// Robot base seen from the table centre, -X, 0.1 um (1305.92 mm).
+const KIN_BASE_X: i32 = -13_059_200;
+/// Robot base seen from the table centre, +Z, 0.1 um (800 mm; a translation along the table's
+/// axis does not change the compensation of a turn about it).
+const KIN_BASE_Z: i32 = 8_000_000;
 
 /// Which of the seed's variants.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +69,7 @@ impl Turntable {
         switch.kin_base = true;
         switch.filter_max_ticks = 0;
         switch.kinematic_base_cs.translation[0] = KIN_BASE_X;
+        switch.kinematic_base_cs.translation[2] = KIN_BASE_Z;
         Turntable {
             variant,
             channel,
