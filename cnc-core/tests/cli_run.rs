@@ -37,13 +37,13 @@ fn lockstep_traces_are_bit_identical_across_runs_and_match_in_process() {
     let scenario = path.to_str().unwrap();
     let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
     let pid = std::process::id();
-    let args = [scenario, "--lockstep", "--ticks", "4000"];
+    let args = [scenario, "--lockstep", "--ticks", "6000"];
     let first = cnc_run(&args, &format!("clirun-a-{pid}"), &a);
     cnc_run(&args, &format!("clirun-b-{pid}"), &b);
     let (ta, tb) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     assert_eq!(ta, tb, "two lockstep runs differ");
     let text = String::from_utf8(ta.clone()).unwrap();
-    assert_eq!(text.lines().count(), 4001, "header and 4000 ticks");
+    assert_eq!(text.lines().count(), 6001, "header and 6000 ticks");
     assert!(text.starts_with("tick,time,gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state,"));
     // The PLC process switched the tracking on: state 2 appears in the trace.
     assert!(text.lines().any(|l| l.split(',').nth(2) == Some("2")));
@@ -52,8 +52,8 @@ fn lockstep_traces_are_bit_identical_across_runs_and_match_in_process() {
 
     // The in-process lockstep run of the same scenario gives the same bytes.
     let s = Scenario::load(&path).unwrap();
-    let mut run = InProcess::new(&s, 4000).unwrap();
-    for _ in 0..4000 {
+    let mut run = InProcess::new(&s, 6000).unwrap();
+    for _ in 0..6000 {
         run.step(s.cycle_s);
     }
     let mut in_process = Vec::new();

@@ -2,7 +2,9 @@
 //! `nStatus5..8`, `nCtrl1`, `nCtrl5/6`), on each of the three interfaces: the recorded
 //! position is the sensor's edge to one increment, where a tick-sampled position would miss it
 //! by up to a tick's travel; windows, a probe armed twice, aborts, stale latches, undefined
-//! status bits and lost encoder data.
+//! status bits and lost encoder data. Also the encoder's register (`nCtrl2`/`nStatus2`): the
+//! absolute position read at start-up and MC_SetPosition's counter set; and the torque
+//! set-point in `drive_out.nOutData3`.
 
 use cnc_core::axis::config::{AxisConfig, DriveLink, ProbeInterface};
 use cnc_core::axis::sim_drive::SimDriveConfig;
@@ -26,10 +28,7 @@ struct Rig {
 
 impl Rig {
     fn new(config: AxisConfig) -> Self {
-        let memory = hli::segment::heap_image(1, 1);
-        let set = AxisSet::new(vec![config], CYCLE).unwrap();
-        set.prime(&CncView::new(&memory));
-        let mut rig = Self { memory, set };
+        let mut rig = Self::unpowered(config);
         rig.tick();
         rig.set
             .axis_mut(0)
@@ -37,6 +36,12 @@ impl Rig {
             .command(&AxisCommandCall::power(true))
             .unwrap();
         rig
+    }
+    fn unpowered(config: AxisConfig) -> Self {
+        let memory = hli::segment::heap_image(1, 1);
+        let set = AxisSet::new(vec![config], CYCLE).unwrap();
+        set.prime(&CncView::new(&memory));
+        Self { memory, set }
     }
     fn tick(&mut self) {
         self.set.tick(&CncView::new(&self.memory));
@@ -430,4 +435,124 @@ fn probe_2_records_its_rising_edge() {
         );
         assert_eq!(rig.probe(0).state_r, ProbeState::Idle.raw());
     }
+}
+
+/// A 16-bit encoder standing at 500 mm (5 x 10^6 increments, far beyond 16 bits): without the
+/// absolute read the axis takes the wrapped count for its position; with it (`nCtrl2` 0x02,
+/// the answer in `nStatus2` and the value in `nInData2`) it knows where it stands, and MC_Power
+/// is refused until then.
+#[test]
+fn the_absolute_position_is_read_through_the_encoders_register() {
+    let config = |absolute: bool| {
+        let mut c = probed(ProbeInterface::None, [None, None]);
+        c.encoder_width = cnc_core::axis::increments::CounterWidth::Bits16;
+        c.io.encoder_absolute = absolute;
+        if let DriveLink::Simulated(sim) = &mut c.drive {
+            sim.start_position = 500.0;
+        }
+        c
+    };
+    let mut plain = Rig::unpowered(config(false));
+    plain.tick();
+    assert!((plain.set.axis(0).unwrap().actual() - 500.0).abs() > 1.0);
+    let mut rig = Rig::unpowered(config(true));
+    let power = |rig: &mut Rig| {
+        rig.set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::power(true))
+    };
+    assert_eq!(power(&mut rig), Err(AxisError::EncoderNotReady));
+    rig.tick();
+    assert_eq!(rig.enc_out().nCtrl2, 0x02, "read requested");
+    rig.tick();
+    assert!((rig.set.axis(0).unwrap().actual() - 500.0).abs() < INCREMENT);
+    assert_eq!(rig.enc_out().nCtrl2, 0, "request released");
+    power(&mut rig).unwrap();
+    rig.run_to(501.5);
+    assert!((rig.set.axis(0).unwrap().actual() - 501.5).abs() < INCREMENT);
+}
+
+/// MC_SetPosition: at standstill the encoder counts from the new position (`nCtrl2` 0x01 with
+/// the value in `nOutData2`); the axis stands where it stood, its position is the new one, and
+/// moves go on from there. Refused while moving, and on an encoder that cannot set its counter.
+#[test]
+fn set_position_sets_the_encoder_counter_at_standstill() {
+    // The sensor sits at 40..45 mm of the motor's travel: 120 mm once the axis counts from
+    // 100 at the motor's 20.
+    let mut c = probed(ProbeInterface::Canopen, [Some([40.0, 45.0]), None]);
+    c.io.encoder_set_counter = true;
+    let mut rig = Rig::new(c);
+    rig.run_to(10.0);
+    let command = |rig: &mut Rig, p: f64| {
+        rig.set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::set_position(p))
+    };
+    rig.move_to(20.0);
+    rig.tick();
+    assert_eq!(
+        command(&mut rig, 0.0),
+        Err(AxisError::SetPositionWhileMoving)
+    );
+    rig.run_to(20.0);
+    command(&mut rig, 100.0).unwrap();
+    rig.tick();
+    assert_eq!(rig.enc_out().nCtrl2, 0x01);
+    assert_eq!(rig.enc_out().nOutData2, 1_000_000);
+    for _ in 0..3 {
+        rig.tick();
+    }
+    let axis = rig.set.axis(0).unwrap();
+    assert!(
+        (axis.actual() - 100.0).abs() < INCREMENT,
+        "{}",
+        axis.actual()
+    );
+    assert!(axis.following_error().abs() < INCREMENT);
+    assert_eq!(rig.enc_out().nCtrl2, 0);
+    // A probe records on the new scale.
+    rig.arm(1, ProbeEdge::Positive, None).unwrap();
+    rig.run_to(130.0);
+    assert!((rig.probe(0).recorded_position_r - 120.0).abs() <= INCREMENT / 2.0);
+    let mut plain = Rig::new(probed(ProbeInterface::None, [None, None]));
+    assert_eq!(
+        command(&mut plain, 5.0),
+        Err(AxisError::SetPositionNotSupported)
+    );
+}
+
+/// `drive_out.nOutData3` as a torque set-point: percent of the rated torque (which gives the
+/// axis's maximum acceleration) in `torque_increments_per_percent`; the simulated drive's actual
+/// torque (`nInData3`) follows it.
+#[test]
+fn out_data3_carries_the_torque_set_point_when_configured() {
+    use cnc_core::axis::config::OutData3;
+    use hli::layout::{NcDriveIn, NcDriveOut};
+    let mut c = probed(ProbeInterface::None, [None, None]);
+    c.io.out_data3 = OutData3::Torque;
+    let max = c.dynamics.acceleration;
+    let mut rig = Rig::new(c);
+    rig.move_to(50.0);
+    let mut checked = 0;
+    for _ in 0..200 {
+        rig.tick();
+        let a = rig.set.axis(0).unwrap().setpoint().acceleration;
+        let out: NcDriveOut = rig
+            .place()
+            .field::<NcDriveOut>(core::mem::offset_of!(HliAxis, drive_out))
+            .read();
+        let expected = (100.0 * a / max * 10.0).round() as i32;
+        assert_eq!(out.nOutData3, expected);
+        if a.abs() > 0.5 * 2000.0 {
+            checked += 1;
+            let input: NcDriveIn = rig
+                .place()
+                .field::<NcDriveIn>(core::mem::offset_of!(HliAxis, drive_in))
+                .read();
+            assert!(input.nInData3 != 0);
+        }
+    }
+    assert!(checked > 10, "{checked}");
 }

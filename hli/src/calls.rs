@@ -280,6 +280,13 @@ impl AxisCommandCall {
             ..Self::motion(crate::enums::AxisCommandKind::Stop)
         }
     }
+    /// MC_SetPosition: the encoder counts from `position` (at standstill).
+    pub fn set_position(position: f64) -> Self {
+        Self {
+            position,
+            ..Self::motion(crate::enums::AxisCommandKind::SetPosition)
+        }
+    }
     /// Releases MC_Stop's lock.
     pub fn stop_release() -> Self {
         Self::motion(crate::enums::AxisCommandKind::StopRelease)

@@ -411,6 +411,9 @@ hli_enum! {
         Stop = 7,
         /// Releases the lock of MC_Stop (its Execute input fell).
         StopRelease = 8,
+        /// MC_SetPosition: at standstill, the encoder counts from the given position (its
+        /// counter is set through the register interface); nothing moves.
+        SetPosition = 9,
     }
 }
 
@@ -485,6 +488,13 @@ hli_enum! {
         InvalidProbeParameter = 0x4262,
         /// MC_AbortTrigger for a probe that is not armed.
         ProbeNotArmed = 0x4263,
+        /// The encoder's register is busy (the absolute position is still read at start-up,
+        /// or a counter set waits for its answer).
+        EncoderNotReady = 0x4252,
+        /// The encoder cannot set its counter (`io.encoder_set_counter` is off).
+        SetPositionNotSupported = 0x4253,
+        /// MC_SetPosition while the axis moves (it needs standstill).
+        SetPositionWhileMoving = 0x4254,
     }
 }
 

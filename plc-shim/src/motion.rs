@@ -344,6 +344,15 @@ execute_block! {
     } => |s| AxisCommandCall::halt(s.deceleration, s.jerk), reached_is_done = false
 }
 
+execute_block! {
+    /// MC_SetPosition: at standstill the axis's encoder counts from `position` (its counter
+    /// is set through the encoder's register); nothing moves. Done once the encoder answered.
+    McSetPosition {
+        /// Input: the position the axis stands at from now on.
+        position
+    } => |s| AxisCommandCall::set_position(s.position), reached_is_done = true
+}
+
 /// MC_Stop: brakes to standstill and keeps the axis locked while Execute stays TRUE.
 #[derive(Debug, Default)]
 pub struct McStop {

@@ -4,6 +4,7 @@
 use super::cia402;
 use super::commands::CommandBook;
 use super::config::{AxisConfig, DriveMode, DriveProtocol};
+use super::encoder_reg::{EncoderEvent, EncoderRegister};
 use super::generator::{Goal, Kinematic, MoveLimits, Progress, SetpointGenerator};
 use super::increments::IncrementCounter;
 use super::inputs::DriveInputs;
@@ -57,6 +58,10 @@ pub struct Axis {
     cycle_s: f64,
     generator: SetpointGenerator,
     counter: IncrementCounter,
+    /// The encoder's register interface (`nCtrl2`/`nStatus2`).
+    encoder_reg: EncoderRegister,
+    /// The count MC_SetPosition asked for, until the encoder answered.
+    new_count: Option<i64>,
     book: CommandBook,
     /// MC_Power's level; with a CiA 402 drive the axis is enabled once the drive is in
     /// operation.
@@ -112,6 +117,14 @@ impl Axis {
             inputs: DriveInputs::new(&config, cycle_s),
             probes: Probes::new(config.io.probe, config.encoder_width),
             counter: IncrementCounter::new(config.encoder_width),
+            encoder_reg: {
+                let mut r = EncoderRegister::default();
+                if config.io.encoder_absolute {
+                    r.read_absolute();
+                }
+                r
+            },
+            new_count: None,
             generator,
             config,
             cycle_s,
@@ -191,6 +204,7 @@ impl Axis {
         match kind {
             AxisCommandKind::Power => self.power(call.enable),
             AxisCommandKind::Reset => self.reset(),
+            AxisCommandKind::SetPosition => self.set_position(call.position),
             AxisCommandKind::StopRelease => {
                 self.stop_lock = false;
                 Ok(self.book.instant(kind))
@@ -242,11 +256,61 @@ impl Axis {
         }
     }
 
+    /// MC_SetPosition: at standstill the encoder is asked to count from `position`; the
+    /// command ends when it answered (`sense`).
+    fn set_position(&mut self, position: f64) -> Result<u32, AxisError> {
+        let cfg = &self.config;
+        if !cfg.io.encoder_set_counter {
+            return Err(AxisError::SetPositionNotSupported);
+        }
+        if self.error.is_some() {
+            return Err(AxisError::AxisInError);
+        }
+        if self.coupling.is_some() {
+            return Err(AxisError::Coupled);
+        }
+        if self.generator.goal() != Goal::Hold || self.last_set.velocity != 0.0 {
+            return Err(AxisError::SetPositionWhileMoving);
+        }
+        let count = position * cfg.increments_per_unit;
+        if !count.is_finite() || count.abs() > f64::from(i32::MAX) {
+            return Err(AxisError::TargetOutsideLimits);
+        }
+        let value = cfg.encoder_width.wrap(count.round() as i64);
+        if !self.encoder_reg.set_counter(value) {
+            return Err(AxisError::EncoderNotReady);
+        }
+        self.new_count = Some(count.round() as i64);
+        Ok(self.book.begin(AxisCommandKind::SetPosition))
+    }
+
+    /// An answer of the encoder's register: the counter re-based (`true`) to the absolute
+    /// position read, or to the position MC_SetPosition gave.
+    fn encoder_answer(&mut self, enc_in: &NcEncoderIn) -> bool {
+        match self.encoder_reg.sense(enc_in.nStatus2, enc_in.nInData2) {
+            Some(EncoderEvent::Absolute(abs)) => {
+                // The absolute value and nInData1 are of the same sample.
+                self.counter.rebase(i64::from(abs), enc_in.nInData1);
+                true
+            }
+            Some(EncoderEvent::CounterSet(_)) => {
+                let count = self.new_count.take().unwrap_or(0);
+                self.counter.rebase(count, enc_in.nInData1);
+                self.book.finish(CommandResult::Done, None);
+                true
+            }
+            None => false,
+        }
+    }
+
     fn power(&mut self, enable: u32) -> Result<u32, AxisError> {
         match enable {
             1 => {
                 if self.error.is_some() {
                     return Err(AxisError::AxisInError);
+                }
+                if self.encoder_reg.reading_absolute() {
+                    return Err(AxisError::EncoderNotReady);
                 }
                 self.power_requested = true;
                 // A CiA 402 drive is enabled once it reports Operation enabled (`sense`).
@@ -495,7 +559,9 @@ impl Axis {
             None
         };
         if encoder_ok {
-            let first = !self.counter.started();
+            // A re-based count starts afresh (no velocity from the jump).
+            let rebased = self.encoder_answer(enc_in);
+            let first = !self.counter.started() || rebased;
             let previous = self.actual;
             let count = self.counter.update(enc_in.nInData1);
             let raw = count as f64 / scale;
@@ -745,11 +811,14 @@ impl Axis {
             nCtrl1: control,
             nCtrl2: set_direction.raw(),
             nCtrl3: total_direction.raw(),
-            nOutData3: saturate(set.acceleration * cfg.acceleration_increments_per_unit),
+            nOutData3: saturate(cfg.out_data3(set.acceleration)),
             ..bytemuck::Zeroable::zeroed()
         };
+        let (register, register_value) = self.encoder_reg.control();
         let enc_out = NcEncoderOut {
             nOutData1: self.encoder_echo,
+            nOutData2: register_value,
+            nCtrl2: register,
             nCtrl1: probe.ctrl1,
             nCtrl5: probe.ctrl5,
             nCtrl6: probe.ctrl6,

@@ -77,6 +77,40 @@ pub struct ImageOptions {
     /// Dead-time compensation from the distributed-clock times `nDcInputTime` and
     /// `nDcOutputTime`.
     pub dc_compensation: bool,
+    /// What `drive_out.nOutData3` carries: the set-point's acceleration (in
+    /// `acceleration_increments_per_unit`) or a torque set-point from the axis's dynamic
+    /// model (the rated torque gives `dynamics.acceleration`; in
+    /// `torque_increments_per_percent`).
+    pub out_data3: OutData3,
+    /// The encoder's register interface (`enc_out.nCtrl2` / `enc_in.nStatus2`, see
+    /// `axis::encoder_reg`): read the absolute position at start-up.
+    pub encoder_absolute: bool,
+    /// The encoder can set its counter (MC_SetPosition through `nCtrl2`/`nOutData2`).
+    pub encoder_set_counter: bool,
+}
+
+/// What `drive_out.nOutData3` carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum OutData3 {
+    /// The set-point's acceleration.
+    #[default]
+    Acceleration,
+    /// A torque set-point (feed-forward from the dynamic model).
+    Torque,
+}
+
+impl AxisConfig {
+    /// `drive_out.nOutData3` for a set-point acceleration of `acceleration` units/s^2.
+    pub fn out_data3(&self, acceleration: f64) -> f64 {
+        match self.io.out_data3 {
+            OutData3::Acceleration => acceleration * self.acceleration_increments_per_unit,
+            OutData3::Torque => {
+                100.0 * acceleration / self.dynamics.acceleration
+                    * self.io.torque_increments_per_percent
+            }
+        }
+    }
 }
 
 impl Default for ImageOptions {
@@ -86,6 +120,9 @@ impl Default for ImageOptions {
             probe: ProbeInterface::None,
             torque_increments_per_percent: 10.0,
             dc_compensation: false,
+            out_data3: OutData3::Acceleration,
+            encoder_absolute: false,
+            encoder_set_counter: false,
         }
     }
 }

@@ -12,6 +12,7 @@ mod axis;
 pub mod cia402;
 pub mod commands;
 pub mod config;
+pub mod encoder_reg;
 pub mod generator;
 pub mod increments;
 mod inputs;

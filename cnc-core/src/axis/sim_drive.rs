@@ -5,6 +5,7 @@
 
 use super::cia402;
 use super::config::{DriveMode, DriveProtocol, ProbeInterface};
+use super::encoder_reg;
 use super::increments::{CounterWidth, IncrementCounter};
 use super::sim_probe::SimProbes;
 use hli::enums::DriveState;
@@ -237,6 +238,10 @@ pub struct SimulatedDrive {
     last_control: u8,
     probes: SimProbes,
     enc_out: NcEncoderOut,
+    /// The encoder's count minus the motor position's (a counter set moves it).
+    count_offset: i64,
+    /// The register answers in `nStatus2` (see `axis::encoder_reg`).
+    register: u8,
     /// Steps taken: the reading it writes belongs to tick `steps`.
     steps: u64,
 }
@@ -276,6 +281,8 @@ impl SimulatedDrive {
                 config.probe_windows,
             ),
             enc_out: bytemuck::Zeroable::zeroed(),
+            count_offset: 0,
+            register: 0,
             steps: 0,
             config,
             scaling,
@@ -305,9 +312,10 @@ impl SimulatedDrive {
     pub fn encoder_in(&self) -> NcEncoderIn {
         let delay = f64::from(self.config.input_delay_ns) * 1e-9;
         let sampled = self.position - self.velocity * delay;
-        let count = (sampled * self.scaling.increments_per_unit).round() as i64;
+        let count = (sampled * self.scaling.increments_per_unit).round() as i64 + self.count_offset;
         let mut enc = NcEncoderIn {
             nInData1: self.scaling.width.wrap(count),
+            nStatus2: self.register,
             nStatus4: u8::from(self.encoder_io_invalid),
             nDcInputTime: self
                 .dc_time(self.steps)
@@ -315,7 +323,27 @@ impl SimulatedDrive {
             ..bytemuck::Zeroable::zeroed()
         };
         self.probes.report(&self.enc_out, &mut enc);
+        if self.register & encoder_reg::READ_ABSOLUTE != 0 {
+            enc.nInData2 = count.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        }
         enc
+    }
+
+    /// The encoder's side of the register interface: a request bit is answered in the step
+    /// it comes (a counter set takes effect at once) and the answer falls with the request.
+    fn serve_register(&mut self, enc_out: &NcEncoderOut) {
+        for bit in [encoder_reg::SET_COUNTER, encoder_reg::READ_ABSOLUTE] {
+            let asked = enc_out.nCtrl2 & bit != 0;
+            if asked && self.register & bit == 0 {
+                if bit == encoder_reg::SET_COUNTER {
+                    let now = (self.position * self.scaling.increments_per_unit).round() as i64;
+                    self.count_offset = i64::from(enc_out.nOutData2) - now;
+                }
+                self.register |= bit;
+            } else if !asked {
+                self.register &= !bit;
+            }
+        }
     }
 
     /// Takes the drive and encoder outputs of this tick, advances the motor one tick and
@@ -336,10 +364,12 @@ impl SimulatedDrive {
             }
         };
         self.enc_out = *enc_out;
+        self.serve_register(enc_out);
         let from = self.position;
         let command = match self.scaling.mode {
             DriveMode::Position => {
-                self.set_counter.update(out.nOutData1) as f64 / self.scaling.increments_per_unit
+                (self.set_counter.update(out.nOutData1) - self.count_offset) as f64
+                    / self.scaling.increments_per_unit
             }
             DriveMode::Velocity | DriveMode::Universal => {
                 f64::from(out.nOutData1) / self.scaling.velocity_increments_per_unit
@@ -376,7 +406,8 @@ impl SimulatedDrive {
             }
             _ => 0,
         };
-        self.probes.step(enc_out, from, self.position);
+        self.probes
+            .step(enc_out, from, self.position, self.count_offset);
         self.steps += 1;
         // Torque in proportion to the acceleration: the rated torque gives the rated one.
         let torque_percent = 100.0 * self.acceleration / self.scaling.rated_acceleration;

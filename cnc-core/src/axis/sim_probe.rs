@@ -65,7 +65,7 @@ impl SimProbes {
 
     /// The motor moved from `from` to `to` during this tick: enabled probes latch the edges
     /// they see (the first of each kind: first-event mode); a disabled probe forgets.
-    pub fn step(&mut self, out: &NcEncoderOut, from: f64, to: f64) {
+    pub fn step(&mut self, out: &NcEncoderOut, from: f64, to: f64, count_offset: i64) {
         for k in 0..2 {
             let enabled = self.enabled(out, k);
             let Some([lo, hi]) = self.windows[k] else {
@@ -79,7 +79,7 @@ impl SimProbes {
                 if !enabled[edge] {
                     self.latched[k][edge] = None;
                 } else if self.latched[k][edge].is_none() && crossed(at) {
-                    let count = (at * self.scale).round() as i64;
+                    let count = (at * self.scale).round() as i64 + count_offset;
                     self.latched[k][edge] = Some(self.width.wrap(count));
                 }
             }
