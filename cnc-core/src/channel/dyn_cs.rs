@@ -17,8 +17,9 @@
 //! after a FREEZE), ACTIVE, DEACTIVATING, ERROR (the compensation is held where it was: the
 //! channel keeps a safe set-point).
 
-use super::guard::LimitKind;
-use hli::enums::{ChannelErrorId, DynCsState};
+pub use super::ring::{Ring, RingRead};
+pub use super::track_error::{BadParameter, TrackError};
+use hli::enums::DynCsState;
 use kinematics::tracking::{track_cs_values, Tracking, TrackingMode, TrackingOption};
 use kinematics::{PoseWords, RotationOrder};
 use nalgebra::{Isometry3, Translation3};
@@ -125,133 +126,6 @@ pub enum TrackEvent {
     },
 }
 
-/// Why tracking went to ERROR (or a switching request was refused).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum TrackError {
-    /// `#TRACK CS ON` while tracking is on.
-    #[error("tracking is already on: switch it off first")]
-    AlreadyOn,
-    /// The master channel publishes no dynamic CS.
-    #[error("master channel {0} provides no DYN_CS interface (#CHANNEL INTERFACE ON [DYN_CS] or provide_channel_interface.track_cs)")]
-    NoMasterInterface(usize),
-    /// The master channel does not exist.
-    #[error("master channel {0} does not exist")]
-    NoSuchChannel(usize),
-    /// A channel cannot track itself.
-    #[error("a channel cannot track its own interface")]
-    OwnChannel,
-    /// The PLC posted a transition while the unit was not enabled.
-    #[error("PLC transition while enable_w is FALSE")]
-    PlcNotEnabled,
-    /// A transition with invalid parameters.
-    #[error("invalid transition parameter: {0}")]
-    BadTransition(BadParameter),
-    /// The compensation could not be computed (non-finite frame).
-    #[error("invalid master frame")]
-    BadFrame,
-    /// The machine stopped (its PLC was lost, or a stop was requested).
-    #[error("machine stop")]
-    MachineStop,
-    /// A step of the tracked motion broke an axis's limit (refused, not passed on).
-    #[error("axis {} {} limit exceeded by the tracked motion", axis + 1, limit_name(*kind))]
-    JointLimit {
-        /// Axis index in the channel (0-based).
-        axis: u8,
-        /// Which limit.
-        kind: LimitKind,
-    },
-    /// The slave channel failed (its error id names the cause): it can no longer follow.
-    #[error("the channel failed ({0:?})")]
-    ChannelFailed(ChannelErrorId),
-}
-
-fn limit_name(kind: LimitKind) -> &'static str {
-    match kind {
-        LimitKind::Velocity => "velocity",
-        LimitKind::Acceleration => "acceleration",
-    }
-}
-
-impl TrackError {
-    /// The error as two numbers (for the diagnosis read over the acyclic channel): its kind
-    /// and its value (a channel, a parameter).
-    pub fn code(self) -> (u32, u32) {
-        match self {
-            TrackError::AlreadyOn => (1, 0),
-            TrackError::NoMasterInterface(c) => (2, c as u32),
-            TrackError::NoSuchChannel(c) => (3, c as u32),
-            TrackError::OwnChannel => (4, 0),
-            TrackError::PlcNotEnabled => (5, 0),
-            TrackError::BadTransition(p) => (6, p as u32),
-            TrackError::BadFrame => (7, 0),
-            TrackError::MachineStop => (8, 0),
-            TrackError::JointLimit { axis, kind } => (
-                9,
-                u32::from(axis) * 2 + u32::from(kind == LimitKind::Acceleration),
-            ),
-            TrackError::ChannelFailed(id) => (10, id.raw()),
-        }
-    }
-
-    /// The error [`Self::code`] gave; `None` for numbers it never gives.
-    pub fn from_code(kind: u32, value: u32) -> Option<TrackError> {
-        let channel = value as usize;
-        Some(match kind {
-            1 => TrackError::AlreadyOn,
-            2 => TrackError::NoMasterInterface(channel),
-            3 => TrackError::NoSuchChannel(channel),
-            4 => TrackError::OwnChannel,
-            5 => TrackError::PlcNotEnabled,
-            6 => TrackError::BadTransition(
-                BadParameter::ALL.into_iter().find(|p| *p as u32 == value)?,
-            ),
-            7 => TrackError::BadFrame,
-            8 => TrackError::MachineStop,
-            9 if value / 2 < u32::from(u8::MAX) => TrackError::JointLimit {
-                axis: (value / 2) as u8,
-                kind: if value % 2 == 1 {
-                    LimitKind::Acceleration
-                } else {
-                    LimitKind::Velocity
-                },
-            },
-            10 => TrackError::ChannelFailed(ChannelErrorId::decode(value).ok()?),
-            _ => return None,
-        })
-    }
-}
-
-/// Which parameter of a PLC transition was refused.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum BadParameter {
-    /// The command word.
-    #[error("command word is not -1, 0 or +1")]
-    CommandWord = 0,
-    /// One of the flag bytes.
-    #[error("a flag byte is neither FALSE nor TRUE")]
-    FlagByte = 1,
-    /// The option.
-    #[error("option must be 0 or 1")]
-    OptionValue = 3,
-    /// The offset frame.
-    #[error("offset X..C is not finite")]
-    Offset = 4,
-    /// SET_ZERO while the channel moves.
-    #[error("f_set_zero needs the channel at standstill")]
-    SetZeroMoving = 5,
-}
-
-impl BadParameter {
-    /// Every parameter, in the order of their numbers.
-    pub const ALL: [BadParameter; 5] = [
-        BadParameter::CommandWord,
-        BadParameter::FlagByte,
-        BadParameter::OptionValue,
-        BadParameter::Offset,
-        BadParameter::SetZeroMoving,
-    ];
-}
-
 /// One line of the diagnosis history: what went in and out of the dynamic CS in one tick.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct HistoryEntry {
@@ -267,88 +141,6 @@ pub struct HistoryEntry {
     pub rotation: [i64; 3],
     /// Pose after the dynamic CS.
     pub output: [i64; 6],
-}
-
-/// An entry of a [`Ring`] read by sequence number, and the window the ring keeps.
-#[derive(Debug, Clone, Copy)]
-pub struct RingRead<'a, T> {
-    /// The entry and its sequence number (`None`: nothing at or after the one asked for).
-    pub entry: Option<(u64, &'a T)>,
-    /// Entries pushed so far.
-    pub recorded: u64,
-    /// Entries kept.
-    pub kept: usize,
-}
-
-/// A ring of fixed capacity, filled at start-up (no allocation afterwards).
-#[derive(Debug, Clone)]
-pub struct Ring<T: Copy + Default> {
-    entries: Vec<T>,
-    next: usize,
-    len: usize,
-    /// Entries pushed since creation: the sequence number the next one gets.
-    recorded: u64,
-}
-
-impl<T: Copy + Default> Ring<T> {
-    /// A ring of `capacity` entries (0 keeps nothing).
-    pub fn new(capacity: usize) -> Self {
-        Self {
-            entries: vec![T::default(); capacity],
-            next: 0,
-            len: 0,
-            recorded: 0,
-        }
-    }
-
-    /// Appends, dropping the oldest entry when full.
-    pub fn push(&mut self, value: T) {
-        if self.entries.is_empty() {
-            return;
-        }
-        self.entries[self.next] = value;
-        self.next = (self.next + 1) % self.entries.len();
-        self.len = (self.len + 1).min(self.entries.len());
-        self.recorded += 1;
-    }
-
-    /// The entry with sequence number `sequence` (or the oldest kept one if `sequence` is
-    /// older; none when nothing is kept at or after it) and the window kept.
-    pub fn read(&self, sequence: u64) -> RingRead<'_, T> {
-        RingRead {
-            entry: self.at_or_after(sequence),
-            recorded: self.recorded,
-            kept: self.len,
-        }
-    }
-
-    fn at_or_after(&self, sequence: u64) -> Option<(u64, &T)> {
-        let oldest = self.recorded - self.len as u64;
-        let sequence = sequence.max(oldest);
-        if sequence >= self.recorded {
-            return None;
-        }
-        let back = (self.recorded - sequence) as usize;
-        let cap = self.entries.len();
-        Some((sequence, &self.entries[(self.next + cap - back) % cap]))
-    }
-
-    /// Oldest first.
-    pub fn iter(&self) -> impl Iterator<Item = &T> {
-        let cap = self.entries.len();
-        let start = (self.next + cap - self.len) % cap.max(1);
-        (0..self.len).map(move |i| &self.entries[(start + i) % cap])
-    }
-
-    /// Number of entries kept.
-    pub fn len(&self) -> usize {
-        self.len
-    }
-
-    /// Whether nothing is kept.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
 }
 
 /// What the master offers this tick.

@@ -14,8 +14,10 @@ pub mod kin_config;
 pub mod path;
 pub mod plc_io;
 pub mod program;
+pub mod ring;
 pub mod run;
 pub mod sync;
+pub mod track_error;
 
 pub use config::{ChannelConfig, ChannelConfigError};
 pub use controller::{Controller, ControllerError};
