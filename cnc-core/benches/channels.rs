@@ -77,7 +77,8 @@ fn before_machine(n: usize) -> Box<dyn FnMut()> {
     let mut channels: Vec<Channel> = Vec::new();
     for (i, (c, p)) in s.channels.iter().zip(&s.programs).enumerate() {
         let mut ch = Channel::new(i, c.clone(), s.cycle_s).expect("channel");
-        ch.start(p.clone().expect("a program"));
+        ch.start(p.clone().expect("a program"))
+            .expect("a fresh channel starts");
         channels.push(ch);
     }
     let mut publishers: Vec<Option<AxisPublisher>> = Vec::new();

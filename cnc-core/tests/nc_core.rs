@@ -27,7 +27,7 @@ fn channel_with(config: ChannelConfig, src: &str) -> Controller {
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let mut channel = Channel::new(0, config, CYCLE).unwrap();
-    channel.start(program);
+    channel.start(program).unwrap();
     Controller::new(vec![channel]).unwrap()
 }
 
@@ -425,11 +425,11 @@ fn a_new_program_starts_from_the_modal_defaults() {
     let first = LoadedProgram::load("first", "G70 G91 G1 X1 F100\nM30\n", &config.axes).unwrap();
     let second = LoadedProgram::load("second", "G1 X1 F100\nM30\n", &config.axes).unwrap();
     let mut channel = Channel::new(0, config, CYCLE).unwrap();
-    channel.start(first);
+    channel.start(first).unwrap();
     let mut ctl = Controller::new(vec![channel]).unwrap();
     run(&mut ctl, 100_000, |_| {});
     assert!((ctl.channels()[0].programmed()[0] - 25.4).abs() < 1e-9);
-    ctl.channel_mut(0).unwrap().start(second);
+    ctl.channel_mut(0).unwrap().start(second).unwrap();
     run(&mut ctl, 100_000, |_| {});
     // Millimetres and absolute again: X1 is 1 mm, not 25.4 mm further.
     assert!((ctl.channels()[0].programmed()[0] - 1.0).abs() < 1e-9);

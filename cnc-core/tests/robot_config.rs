@@ -194,7 +194,7 @@ fn the_tool_record_is_on_the_flange_under_a_transformation() {
     )
     .unwrap();
     let mut channel = Channel::new(0, c, CYCLE).unwrap();
-    channel.start(loaded);
+    channel.start(loaded).unwrap();
     let mut ctl = Controller::new(vec![channel]).unwrap();
     let memory = image(1);
     let view = CncView::new(&memory);

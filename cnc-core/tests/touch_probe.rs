@@ -556,3 +556,57 @@ fn out_data3_carries_the_torque_set_point_when_configured() {
     }
     assert!(checked > 10, "{checked}");
 }
+
+/// MC_SetPosition on a drive in cyclic position mode with dead time, on 32- and 16-bit
+/// counters: the drive switches its set-point over when the NC does, so the motor never
+/// moves and the axis stands at the new position without a following error.
+#[test]
+fn set_position_in_position_mode_moves_nothing() {
+    use cnc_core::axis::config::DriveMode;
+    use cnc_core::axis::increments::CounterWidth;
+    for width in [CounterWidth::Bits32, CounterWidth::Bits16] {
+        let mut c = probed(ProbeInterface::None, [None, None]);
+        c.io.encoder_set_counter = true;
+        c.drive_mode = DriveMode::Position;
+        c.encoder_width = width;
+        if let DriveLink::Simulated(sim) = &mut c.drive {
+            sim.dead_time_ticks = 2;
+        }
+        let mut rig = Rig::new(c);
+        rig.run_to(7.0);
+        for _ in 0..5 {
+            rig.tick();
+        }
+        rig.set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::set_position(-123.4567))
+            .unwrap();
+        let refused = rig
+            .set
+            .axis_mut(0)
+            .unwrap()
+            .command(&AxisCommandCall::move_absolute(
+                0.0,
+                [100.0, 2000.0, 2000.0, 50_000.0],
+            ));
+        assert_eq!(
+            refused,
+            Err(AxisError::EncoderNotReady),
+            "no move while the count changes"
+        );
+        for _ in 0..20 {
+            rig.tick();
+            let axis = rig.set.axis(0).unwrap();
+            assert!(axis.following_error().abs() < INCREMENT, "{width:?}");
+        }
+        let axis = rig.set.axis(0).unwrap();
+        assert!(
+            (axis.actual() + 123.4567).abs() < INCREMENT,
+            "{width:?}: {}",
+            axis.actual()
+        );
+        rig.run_to(-120.0);
+        assert!((rig.set.axis(0).unwrap().actual() + 120.0).abs() < INCREMENT);
+    }
+}

@@ -39,7 +39,7 @@ fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
         .map(|(i, (config, src))| {
             let program = LoadedProgram::load(&config.name, src, &config.axes).unwrap();
             let mut channel = cnc_core::channel::Channel::new(i, config, CYCLE).unwrap();
-            channel.start(program);
+            channel.start(program).unwrap();
             channel
         })
         .collect();
@@ -147,7 +147,9 @@ fn a_slave_whose_master_leaves_its_reach_stops_within_its_limits_and_recovers() 
     assert_eq!(channel.tracker().state(), DynCsState::Inactive);
     assert!(channel.error().is_none());
     let again = "#TRAFO [45]\n#TRACK CS ON [CH=1 FILTER=200]\n#TIME 1\nM30\n";
-    channel.start(LoadedProgram::load("slave", again, &channel.config().axes.clone()).unwrap());
+    channel
+        .start(LoadedProgram::load("slave", again, &channel.config().axes.clone()).unwrap())
+        .unwrap();
     for _ in 0..1500 {
         ctl.tick(&view);
         watch.check(ctl.channels()[1].set_points(), "recovered");
@@ -515,4 +517,107 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
             );
         }
     }
+}
+
+/// The last step of a coupling out is checked too: 1 mm shed in one tick (FILTER=1) is
+/// refused, never handed to the axes.
+#[test]
+fn the_last_step_of_a_switch_off_is_checked() {
+    let program = "#TRACK CS ON [ID=0 FILTER=300 WAIT]\n#TRACK CS OFF [FILTER=1]\n#TIME 1\nM30\n";
+    let mut ctl = controller(vec![(cartesian("slave"), program)]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs([10_000, 0, 0]))
+        .unwrap();
+    let mut watch = StepWatch::new(&[0.0; 6], cartesian("x").axis_limits(0));
+    for _ in 0..600 {
+        ctl.tick(&view);
+        watch.check(ctl.channels()[0].set_points(), "slave");
+    }
+    let ch = &ctl.channels()[0];
+    assert_eq!(ch.tracker().state(), DynCsState::Error);
+    assert_eq!(ch.error().unwrap().id, ChannelErrorId::Tracking);
+    assert!(
+        (ch.set_points()[0] - 1.0).abs() < 1e-6,
+        "the axis stayed on the compensation: {:?}",
+        ch.set_points()
+    );
+}
+
+/// A reset is refused while the dynamic CS is on (it may be moving the axes); once switched
+/// off it resets.
+#[test]
+fn a_reset_is_refused_while_tracking() {
+    let mut ctl = controller(vec![(cartesian("slave"), "#TIME 0.01\nM30\n")]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Activate, &transition(0, Bool::FALSE))
+        .unwrap();
+    for _ in 0..20 {
+        ctl.tick(&view);
+    }
+    let channel = ctl.channel_mut(0).unwrap();
+    assert_eq!(channel.tracker().state(), DynCsState::Active);
+    assert_eq!(
+        channel.reset(),
+        Err(cnc_core::channel::run::ResetError::Tracking)
+    );
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(DynCsCommand::Deactivate, &transition(0, Bool::FALSE))
+        .unwrap();
+    for _ in 0..3 {
+        ctl.tick(&view);
+    }
+    assert_eq!(ctl.channel_mut(0).unwrap().reset(), Ok(()));
+}
+
+/// A D record selected while a robot tracks: nothing moves at the D block (the compensation
+/// is not applied twice), the tracking goes on.
+#[test]
+fn a_tool_record_selected_while_tracking_moves_nothing() {
+    let mut c = robot("r");
+    c.nc.tools = toml::from_str::<toml::Table>("tools = [{ d = 2, length = 50.0 }]").unwrap()
+        ["tools"]
+        .clone()
+        .try_into()
+        .unwrap();
+    let program = "#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=200 WAIT]\nD2\n#TIME 0.2\nM30\n";
+    let loaded = LoadedProgram::load_with(
+        "r",
+        program,
+        &c.axes,
+        &c.nc.setup(),
+        None,
+        &cnc_core::nc::interp::SearchPath::default(),
+    )
+    .unwrap();
+    let mut channel = cnc_core::channel::Channel::new(0, c, CYCLE).unwrap();
+    channel.start(loaded).unwrap();
+    let mut ctl = Controller::new(vec![channel]).unwrap();
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs([50_000, 0, 0]))
+        .unwrap();
+    let mut watch = StepWatch::new(&ROBOT_HOME, JOINT);
+    for _ in 0..600 {
+        ctl.tick(&view);
+        watch.check(ctl.channels()[0].set_points(), "r");
+    }
+    let ch = &ctl.channels()[0];
+    assert_eq!(ch.state(), RunState::Finished, "{:?}", ch.error());
+    assert_eq!(ch.tracker().state(), DynCsState::Active);
+    assert!(watch.at_rest());
 }

@@ -68,6 +68,15 @@ impl TrackingOption {
         }
     }
 
+    /// The pose `P` that [`Self::apply`] turns into `commanded` (its inverse).
+    pub fn remove(
+        self,
+        compensation: &Isometry3<f64>,
+        commanded: &Isometry3<f64>,
+    ) -> Isometry3<f64> {
+        self.apply(&compensation.inverse(), commanded)
+    }
+
     /// Decodes `OPTION=` / `transition_w.option`.
     pub fn from_raw(raw: u32) -> Result<Self, KinError> {
         match raw {

@@ -16,13 +16,17 @@ pub const SET_COUNTER: u8 = 0x01;
 /// `nCtrl2` / `nStatus2`: read the absolute position / it is in `nInData2`.
 pub const READ_ABSOLUTE: u8 = 0x02;
 
+/// Ticks a request waits for its answer before it is given up ([`EncoderEvent::NoAnswer`]).
+pub const ANSWER_TICKS: u32 = 500;
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Job {
     Idle,
-    /// Waiting for the answer to `bit` (with the value set).
+    /// Waiting for the answer to `bit` (with the value set) since `ticks`.
     Requested {
         bit: u8,
         value: i32,
+        ticks: u32,
     },
     /// Answered; waiting for the encoder to clear its answer.
     Releasing {
@@ -37,6 +41,8 @@ pub enum EncoderEvent {
     CounterSet(i32),
     /// The absolute position (increments).
     Absolute(i32),
+    /// No answer within [`ANSWER_TICKS`]: the request was withdrawn (`bit`).
+    NoAnswer(u8),
 }
 
 /// One request at a time through the register.
@@ -66,7 +72,11 @@ impl EncoderRegister {
         if self.job != Job::Idle {
             return false;
         }
-        self.job = Job::Requested { bit, value };
+        self.job = Job::Requested {
+            bit,
+            value,
+            ticks: 0,
+        };
         true
     }
 
@@ -95,7 +105,7 @@ impl EncoderRegister {
     /// `enc_out.nCtrl2` and `enc_out.nOutData2`.
     pub fn control(&self) -> (u8, i32) {
         match self.job {
-            Job::Requested { bit, value } => (bit, value),
+            Job::Requested { bit, value, .. } => (bit, value),
             _ => (0, 0),
         }
     }
@@ -103,7 +113,7 @@ impl EncoderRegister {
     /// Reads the encoder's answer (`nStatus2`, `nInData2`).
     pub fn sense(&mut self, status2: u8, data2: i32) -> Option<EncoderEvent> {
         match self.job {
-            Job::Requested { bit, value } if status2 & bit != 0 => {
+            Job::Requested { bit, value, .. } if status2 & bit != 0 => {
                 self.job = Job::Releasing { bit };
                 Some(if bit == SET_COUNTER {
                     EncoderEvent::CounterSet(value)
@@ -113,6 +123,18 @@ impl EncoderRegister {
             }
             Job::Releasing { bit } if status2 & bit == 0 => {
                 self.job = Job::Idle;
+                None
+            }
+            Job::Requested { bit, ticks, .. } if ticks + 1 >= ANSWER_TICKS => {
+                self.job = Job::Releasing { bit };
+                Some(EncoderEvent::NoAnswer(bit))
+            }
+            Job::Requested { bit, value, ticks } => {
+                self.job = Job::Requested {
+                    bit,
+                    value,
+                    ticks: ticks + 1,
+                };
                 None
             }
             _ => None,
@@ -145,5 +167,18 @@ mod tests {
             r.sense(READ_ABSOLUTE, -77),
             Some(EncoderEvent::Absolute(-77))
         );
+    }
+
+    #[test]
+    fn a_request_without_answer_is_given_up() {
+        let mut r = EncoderRegister::default();
+        assert!(r.set_counter(5));
+        for _ in 1..ANSWER_TICKS {
+            assert_eq!(r.sense(0, 0), None);
+        }
+        assert_eq!(r.sense(0, 0), Some(EncoderEvent::NoAnswer(SET_COUNTER)));
+        assert_eq!(r.control(), (0, 0));
+        assert_eq!(r.sense(0, 0), None);
+        assert!(r.read_absolute(), "free again");
     }
 }

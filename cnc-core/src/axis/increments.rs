@@ -80,12 +80,6 @@ impl IncrementCounter {
     pub fn started(&self) -> bool {
         self.last_raw.is_some()
     }
-
-    /// From `raw` on, the count is `count` (an absolute position read, a counter set).
-    pub fn rebase(&mut self, count: i64, raw: i32) {
-        self.count = count;
-        self.last_raw = Some(raw);
-    }
 }
 
 #[cfg(test)]

@@ -240,6 +240,9 @@ pub struct SimulatedDrive {
     enc_out: NcEncoderOut,
     /// The encoder's count minus the motor position's (a counter set moves it).
     count_offset: i64,
+    /// The offset the drive reads its position set-point with: the count's, taken over when
+    /// the NC withdraws its set-counter request (from then on its set-points count anew).
+    setpoint_offset: i64,
     /// The register answers in `nStatus2` (see `axis::encoder_reg`).
     register: u8,
     /// Steps taken: the reading it writes belongs to tick `steps`.
@@ -282,6 +285,7 @@ impl SimulatedDrive {
             ),
             enc_out: bytemuck::Zeroable::zeroed(),
             count_offset: 0,
+            setpoint_offset: 0,
             register: 0,
             steps: 0,
             config,
@@ -337,10 +341,16 @@ impl SimulatedDrive {
             if asked && self.register & bit == 0 {
                 if bit == encoder_reg::SET_COUNTER {
                     let now = (self.position * self.scaling.increments_per_unit).round() as i64;
-                    self.count_offset = i64::from(enc_out.nOutData2) - now;
+                    let width = self.scaling.width;
+                    // The shortest way to the value: a 16-bit count keeps its unwrapping.
+                    let old = width.wrap(now + self.count_offset);
+                    self.count_offset += width.delta(old, enc_out.nOutData2);
                 }
                 self.register |= bit;
             } else if !asked {
+                if self.register & bit != 0 && bit == encoder_reg::SET_COUNTER {
+                    self.setpoint_offset = self.count_offset;
+                }
                 self.register &= !bit;
             }
         }
@@ -368,7 +378,7 @@ impl SimulatedDrive {
         let from = self.position;
         let command = match self.scaling.mode {
             DriveMode::Position => {
-                (self.set_counter.update(out.nOutData1) - self.count_offset) as f64
+                (self.set_counter.update(out.nOutData1) - self.setpoint_offset) as f64
                     / self.scaling.increments_per_unit
             }
             DriveMode::Velocity | DriveMode::Universal => {

@@ -287,4 +287,9 @@ impl Kinematics for ToolKinematics {
     fn inverse_all(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Solutions, KinError> {
         self.inner.inverse_all(&(pose * self.tool_inverse), current)
     }
+
+    // The inner kinematics' own nearest-solution inverse (kinematic 45 prunes its branches).
+    fn inverse(&self, pose: &Isometry3<f64>, current: &Joints) -> Result<Joints, KinError> {
+        self.inner.inverse(&(pose * self.tool_inverse), current)
+    }
 }

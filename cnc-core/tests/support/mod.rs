@@ -43,7 +43,7 @@ pub fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
         let program =
             LoadedProgram::load(&config.name, src, &config.axes).unwrap_or_else(|e| panic!("{e}"));
         let mut channel = Channel::new(i, config, CYCLE).unwrap();
-        channel.start(program);
+        channel.start(program).unwrap();
         channels.push(channel);
     }
     Controller::new(channels).unwrap()

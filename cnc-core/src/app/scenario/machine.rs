@@ -30,7 +30,9 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         let mut channel = Channel::new(i, config.clone(), scenario.cycle_s)
             .map_err(|e| invalid(e.to_string()))?;
         if let Some(p) = program {
-            channel.start(p.clone());
+            channel
+                .start(p.clone())
+                .expect("a channel that has not run starts");
         }
         channels.push(channel);
     }

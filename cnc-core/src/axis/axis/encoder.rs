@@ -31,20 +31,45 @@ impl Axis {
         Ok(self.book.begin(AxisCommandKind::SetPosition))
     }
 
+    fn finish_set_position(&mut self, result: CommandResult, error: Option<AxisError>) {
+        if self.book.active().map(|a| a.kind) == Some(AxisCommandKind::SetPosition) {
+            self.book.finish(result, error);
+        }
+    }
+
+    /// Asks the encoder for its absolute position again (MC_Reset after it did not answer).
+    pub(super) fn reread_absolute(&mut self) {
+        if self.config.io.encoder_absolute && self.error == Some(AxisError::EncoderNotReady) {
+            self.encoder_reg.read_absolute();
+        }
+    }
+
     /// An answer of the encoder's register: the counter re-based (`true`) to the absolute
     /// position read, or to the position MC_SetPosition gave.
     pub(super) fn encoder_answer(&mut self, enc_in: &NcEncoderIn) -> bool {
         match self.encoder_reg.sense(enc_in.nStatus2, enc_in.nInData2) {
             Some(EncoderEvent::Absolute(abs)) => {
                 // The absolute value and nInData1 are of the same sample.
-                self.counter.rebase(i64::from(abs), enc_in.nInData1);
+                self.counter.seed(i64::from(abs), enc_in.nInData1);
                 true
             }
             Some(EncoderEvent::CounterSet(_)) => {
                 let count = self.new_count.take().unwrap_or(0);
-                self.counter.rebase(count, enc_in.nInData1);
-                self.book.finish(CommandResult::Done, None);
+                self.counter.seed(count, enc_in.nInData1);
+                self.finish_set_position(CommandResult::Done, None);
                 true
+            }
+            Some(EncoderEvent::NoAnswer(bit)) => {
+                self.new_count = None;
+                if bit == crate::axis::encoder_reg::READ_ABSOLUTE {
+                    // The axis does not know where it stands: it stays off, in error
+                    // (MC_Reset asks again).
+                    self.fault(AxisError::EncoderNotReady);
+                } else {
+                    let error = Some(AxisError::EncoderNotReady);
+                    self.finish_set_position(CommandResult::Error, error);
+                }
+                false
             }
             None => false,
         }

@@ -298,6 +298,7 @@ impl Axis {
             self.drive_reset = Some(0);
             return Ok(self.book.begin(AxisCommandKind::Reset));
         }
+        self.reread_absolute();
         self.clear_error();
         Ok(self.book.instant(AxisCommandKind::Reset))
     }
@@ -313,6 +314,10 @@ impl Axis {
     fn may_move(&self, respect_stop_lock: bool) -> Result<(), AxisError> {
         if self.error.is_some() {
             return Err(AxisError::AxisInError);
+        }
+        if self.encoder_reg.setting_counter() {
+            // The count changes under the move's feet when the encoder answers.
+            return Err(AxisError::EncoderNotReady);
         }
         if !self.enabled {
             return Err(AxisError::NotEnabled);

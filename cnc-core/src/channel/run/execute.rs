@@ -206,8 +206,7 @@ impl Channel {
                 match on {
                     Some(true) if !self.trafo => {
                         self.trafo = true;
-                        let programmed = self.cs_frame().inverse() * self.tool;
-                        self.set_programmed_pose(&programmed);
+                        self.program_tool_pose();
                     }
                     Some(false) if self.trafo => {
                         self.trafo = false;

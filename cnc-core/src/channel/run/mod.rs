@@ -287,10 +287,11 @@ impl Channel {
     }
 
     /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
-    pub fn start(&mut self, program: LoadedProgram) {
-        // A channel that failed starts again from where its axes came to rest.
-        if self.state == RunState::Error && self.reset().is_err() {
-            return;
+    /// A channel that failed is reset first (see [`Channel::reset`]): it starts again from
+    /// where its axes came to rest, and is refused while they still move or track.
+    pub fn start(&mut self, program: LoadedProgram) -> Result<(), ResetError> {
+        if self.state == RunState::Error {
+            self.reset()?;
         }
         // A new program starts from the modal defaults the check assumed (G90 G17 G71 G53 D0,
         // no feed), where the axes stand.
@@ -310,6 +311,7 @@ impl Channel {
             self.interface_on = true;
         }
         self.tracker.restart();
+        Ok(())
     }
 
     /// Tells the channel how many channels its controller has (masters beyond them do not
@@ -434,9 +436,10 @@ impl Channel {
     }
 
     /// A controlled stop (supervision, signals): the path brakes along its block with the
-    /// channel's acceleration and jerk, independent axes brake, tracking goes to ERROR holding
-    /// its compensation, no further block starts; at rest the channel ends in ERROR with
-    /// `reason`. Does not allocate until the channel is at rest.
+    /// channel's acceleration and jerk, independent axes brake, no further block starts; at
+    /// rest the channel ends in ERROR with `reason`. A tracking slave's tracking goes to ERROR
+    /// and the guard brakes each axis on its own limits instead (the compensation may be
+    /// moving). Does not allocate until the channel is at rest.
     pub fn stop(&mut self, reason: &'static str) {
         if self.stopping.is_some() {
             return;
@@ -522,10 +525,14 @@ impl Channel {
             }
         }
         let master = self.master_sample(masters);
+        // The dynamic CS acts on this tick's set-points if it was on before its tick (the
+        // last step of a coupling out) or is on after it.
+        let tracked_before = self.tracks_set_points();
         self.tracker.tick(master);
+        let tracked = tracked_before || self.tracks_set_points();
         self.fail_on_tracking_error();
         self.update_pose();
-        self.guard_set_points();
+        self.guard_set_points(tracked);
         self.note_dyn_cs_state();
         self.fill_outputs();
     }

@@ -21,7 +21,11 @@ impl Channel {
             match self.kinematics.inverse(&commanded, &self.joints) {
                 Ok(j) => self.joints = j,
                 Err(e) => {
-                    if self.state == RunState::Running {
+                    // A running program, or a tracking that moves an idle channel: it fails
+                    // (once) and the guard brakes its axes.
+                    let tracking = self.tracker.state() != DynCsState::Inactive;
+                    let failed = self.state == RunState::Error;
+                    if !failed && (self.state == RunState::Running || tracking) {
                         self.fail(ChannelErrorId::Kinematics, format!("pose unreachable: {e}"));
                     }
                 }

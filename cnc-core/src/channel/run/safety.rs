@@ -14,18 +14,23 @@ pub enum ResetError {
     /// The channel's axes are still moving (a program runs, or they brake).
     #[error("the channel is moving: stop it and wait for rest first")]
     Moving,
+    /// The dynamic CS is on and may be moving the axes: switch it off first.
+    #[error("tracking is on: switch it off first")]
+    Tracking,
 }
 
 impl Channel {
     /// The guard's stage of the tick, after the pose pipeline: checks the new set-points
     /// while tracking, latches on any failure, and while latched replaces the set-points by
     /// the guard's braking or held ones.
-    pub(super) fn guard_set_points(&mut self) {
-        if !self.guard.latched() {
+    pub(super) fn guard_set_points(&mut self, tracked: bool) {
+        if !self.guard.latched() && tracked {
             self.check_tracked_step();
-            if self.latch_pending || self.tracker.state() == DynCsState::Error {
-                self.guard.latch();
-            }
+        }
+        if !self.guard.latched()
+            && (self.latch_pending || self.tracker.state() == DynCsState::Error)
+        {
+            self.guard.latch();
         }
         self.latch_pending = false;
         if self.guard.latched() {
@@ -66,8 +71,8 @@ impl Channel {
     /// While the dynamic CS acts on the set-points, a step beyond an axis's velocity or
     /// acceleration limit is refused: the tracker goes to ERROR and the channel fails.
     fn check_tracked_step(&mut self) {
-        if self.tracker.state() == DynCsState::Inactive || self.tracker.simulating() {
-            return;
+        if self.tracker.state() == DynCsState::Error {
+            return; // latched below; the first cause stays the reported one
         }
         let Some(violation) = self.guard.check(&self.set_points) else {
             return;
@@ -82,6 +87,25 @@ impl Channel {
                 format!("tracked step refused: {violation}"),
             );
         }
+    }
+
+    /// The programmed pose becomes the one of the current tool pose: `#CS` frames and the
+    /// dynamic CS's compensation taken off (so that nothing moves on the next tick).
+    pub(super) fn program_tool_pose(&mut self) {
+        let untracked = if self.tracks_set_points() {
+            self.tracker
+                .option()
+                .remove(self.tracker.applied(), &self.tool)
+        } else {
+            self.tool
+        };
+        let programmed = self.cs_frame().inverse() * untracked;
+        self.set_programmed_pose(&programmed);
+    }
+
+    /// Whether the dynamic CS lays its compensation on the set-points (on, not SIMU).
+    pub(super) fn tracks_set_points(&self) -> bool {
+        self.tracker.state() != DynCsState::Inactive && !self.tracker.simulating()
     }
 
     /// Joints and tool pose of the set-points the guard gave (under a transformation).
@@ -113,8 +137,7 @@ impl Channel {
         if self.trafo {
             if let Ok(tool) = self.kinematics.forward(&self.joints) {
                 self.tool = tool;
-                let programmed = self.cs_frame().inverse() * tool;
-                self.set_programmed_pose(&programmed);
+                self.program_tool_pose();
             }
         } else {
             for i in 0..n.min(6) {
@@ -136,6 +159,12 @@ impl Channel {
     pub fn reset(&mut self) -> Result<(), ResetError> {
         if self.guard.braking() || self.path.is_some() || self.independent.iter().any(|g| g.1) {
             return Err(ResetError::Moving);
+        }
+        if !matches!(
+            self.tracker.state(),
+            DynCsState::Inactive | DynCsState::Error
+        ) {
+            return Err(ResetError::Tracking);
         }
         self.tracker.reset();
         self.error = None;

@@ -29,8 +29,7 @@ impl Channel {
         self.kinematics.set_tool(frame);
         self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
         if self.trafo {
-            let programmed = self.cs_frame().inverse() * self.tool;
-            self.set_programmed_pose(&programmed);
+            self.program_tool_pose();
         }
     }
 }
