@@ -1,13 +1,15 @@
 //! The seed's worked motion function (chapter 3.3: six points, POLYNOM1 and POLYNOM5_MM) and
 //! its two changes. The figures are the project's own test data
-//! (`tests/data/seed000_motion_function.toml`); when `../shared/seeds/` is present, one more
+//! (`tests/data/seed000_motion_function.toml`); when `../shared/seeds/` is present
+//! (`support::seed_text` checks that it exists()), one more
 //! test reads the seed's table and checks that the data says the same.
+
+mod support;
 
 use cnc_core::cam::motion_function::Cursor;
 use cnc_core::cam::online::{MasterNow, OnlineChangeQueue, WriteOutcome};
 use cnc_core::cam::{FunctionType, MotionFunction, MotionFunctionPoint, PointType};
 use serde::Deserialize;
-use std::path::PathBuf;
 
 /// One point as the test data writes it: enumerator names, the rest numbers.
 #[derive(Deserialize)]
@@ -74,18 +76,8 @@ fn figures() -> Figures {
     }
 }
 
-/// The seed's text, if `../shared/seeds/` is there (it is not in a fresh clone).
 fn seed() -> Option<String> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/seeds/000_f46a22ead927b2f0.txt");
-    if !path.exists() {
-        println!("skipped: ../shared/seeds not present");
-        return None;
-    }
-    Some(
-        std::fs::read_to_string(&path)
-            .unwrap_or_else(|e| panic!("reading {}: {e}", path.display())),
-    )
+    support::seed_text("000_f46a22ead927b2f0.txt")
 }
 
 /// A point from the seed's table cells: the extraction splits names ("POLYNO M5_MM",

@@ -5,8 +5,7 @@
 mod support;
 
 use cnc_core::channel::kin_config::{DhRow, KinematicsConfig, OpwGeometry};
-use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
-use cnc_core::nc::interp::SearchPath;
+use cnc_core::channel::{Channel, ChannelConfig, RunState};
 use hli::views::CncView;
 use kinematics::opw::Robot45Params;
 use kinematics::RotationOrder;
@@ -176,26 +175,9 @@ fn a_dh_chain_runs_in_a_channel() {
 #[test]
 fn the_tool_record_is_on_the_flange_under_a_transformation() {
     let mut c = support::robot("r");
-    c.nc.tools = toml::from_str::<toml::Table>(
-        "tools = [{ d = 1, length = 100.0, orientation = [0.0, 0.0, 90.0] }]",
-    )
-    .unwrap()["tools"]
-        .clone()
-        .try_into()
-        .unwrap();
+    c.nc.tools = support::tools("{ d = 1, length = 100.0, orientation = [0.0, 0.0, 90.0] }");
     let program = "#TRAFO [45]\n#TIME 0.01\nD1\n#TIME 0.01\nG91 G1 Z-20 F3000\nM30\n";
-    let loaded = LoadedProgram::load_with(
-        "r",
-        program,
-        &c.axes,
-        &c.nc.setup(),
-        None,
-        &SearchPath::default(),
-    )
-    .unwrap();
-    let mut channel = Channel::new(0, c, CYCLE).unwrap();
-    channel.start(loaded).unwrap();
-    let mut ctl = Controller::new(vec![channel]).unwrap();
+    let mut ctl = controller(vec![(c, program)]);
     let memory = image(1);
     let view = CncView::new(&memory);
     let flange = ctl.channels()[0].tool_pose();

@@ -5,11 +5,11 @@
 mod support;
 
 use cnc_core::channel::path::AxisLimits;
-use cnc_core::channel::{ChannelConfig, Controller, LoadedProgram, RunState};
+use cnc_core::channel::{ChannelConfig, LoadedProgram, RunState};
 use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState};
 use hli::views::{CncView, PlcView};
 use hli::Bool;
-use support::{cs, image, transition, CYCLE, ROBOT_HOME};
+use support::{controller, cs, image, transition, CYCLE, ROBOT_HOME};
 
 /// Joint limits of a small six-axis robot (degrees per second and its derivatives).
 const JOINT: AxisLimits = AxisLimits {
@@ -29,21 +29,6 @@ fn robot(name: &str) -> ChannelConfig {
 
 fn cartesian(name: &str) -> ChannelConfig {
     ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"])
-}
-
-/// Channels in the given order, each with its program.
-fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
-    let channels = configs
-        .into_iter()
-        .enumerate()
-        .map(|(i, (config, src))| {
-            let program = LoadedProgram::load(&config.name, src, &config.axes).unwrap();
-            let mut channel = cnc_core::channel::Channel::new(i, config, CYCLE).unwrap();
-            channel.start(program).unwrap();
-            channel
-        })
-        .collect();
-    Controller::new(channels).unwrap()
 }
 
 /// Watches one channel's set-points tick by tick: every step within the axes' velocity and
@@ -585,24 +570,9 @@ fn a_reset_is_refused_while_tracking() {
 #[test]
 fn a_tool_record_selected_while_tracking_moves_nothing() {
     let mut c = robot("r");
-    c.nc.tools = toml::from_str::<toml::Table>("tools = [{ d = 2, length = 50.0 }]").unwrap()
-        ["tools"]
-        .clone()
-        .try_into()
-        .unwrap();
+    c.nc.tools = support::tools("{ d = 2, length = 50.0 }");
     let program = "#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=200 WAIT]\nD2\n#TIME 0.2\nM30\n";
-    let loaded = LoadedProgram::load_with(
-        "r",
-        program,
-        &c.axes,
-        &c.nc.setup(),
-        None,
-        &cnc_core::nc::interp::SearchPath::default(),
-    )
-    .unwrap();
-    let mut channel = cnc_core::channel::Channel::new(0, c, CYCLE).unwrap();
-    channel.start(loaded).unwrap();
-    let mut ctl = Controller::new(vec![channel]).unwrap();
+    let mut ctl = controller(vec![(c, program)]);
     let memory = image(1);
     let view = CncView::new(&memory);
     let plc = PlcView::new(&memory);

@@ -65,6 +65,20 @@ hli_enum! {
     }
 }
 
+impl DynCsState {
+    /// The state's bit in `HLI_DYN_CS_TRANSITION_RESULT.states_seen_r`: bit n for state n,
+    /// bit 4 for ERROR.
+    pub fn seen_bit(self) -> u32 {
+        1 << match self {
+            DynCsState::Inactive => 0,
+            DynCsState::Activating => 1,
+            DynCsState::Active => 2,
+            DynCsState::Deactivating => 3,
+            DynCsState::Error => 4,
+        }
+    }
+}
+
 hli_enum! {
     /// `HLI_DYN_CS_TRANSITION.command`.
     DynCsCommand: i32, "HLI_DYN_CS_TRANSITION.command" {

@@ -279,7 +279,7 @@ impl McDynCsTransition {
         } else {
             (DynCsState::Inactive, DynCsState::Active)
         };
-        let seen = |s: DynCsState| taken && result.states_seen_r & state_bit(s) != 0;
+        let seen = |s: DynCsState| taken && result.states_seen_r & s.seen_bit() != 0;
         self.out = BlockOutputs {
             busy: true,
             active: taken,
@@ -321,17 +321,6 @@ impl McDynCsTransition {
             ..BlockOutputs::default()
         };
         self.phase = TransitionPhase::Idle;
-    }
-}
-
-/// The bit of `state` in `dyn_cs_result.states_seen_r`.
-fn state_bit(state: DynCsState) -> u32 {
-    1 << match state {
-        DynCsState::Inactive => 0,
-        DynCsState::Activating => 1,
-        DynCsState::Active => 2,
-        DynCsState::Deactivating => 3,
-        DynCsState::Error => 4,
     }
 }
 

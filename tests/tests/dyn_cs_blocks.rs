@@ -30,17 +30,6 @@ impl Default for Cnc {
     }
 }
 
-/// The bit of `state` in `states_seen_r`.
-fn bit(state: DynCsState) -> u32 {
-    1 << match state {
-        DynCsState::Inactive => 0,
-        DynCsState::Activating => 1,
-        DynCsState::Active => 2,
-        DynCsState::Deactivating => 3,
-        DynCsState::Error => 4,
-    }
-}
-
 fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + Send + 'static {
     move |view, tick| {
         let mut cnc = cnc.lock().unwrap();
@@ -81,7 +70,7 @@ fn script(cnc: Arc<Mutex<Cnc>>) -> impl FnMut(&hli::views::CncView<'_>, u64) + S
         }
         if let Some(state) = cnc.plan.pop() {
             view.set_dyn_cs_state(0, state).unwrap();
-            cnc.result.states_seen_r |= bit(state);
+            cnc.result.states_seen_r |= state.seen_bit();
         }
         view.write_dyn_cs_result(0, &cnc.result).unwrap();
         if tick == 2 {

@@ -135,24 +135,20 @@ impl JointGuard {
             let l = self.limits[i];
             let v = (p - self.last.position[i]) / dt;
             let a = (v - self.last.velocity[i]) / dt;
-            // A NaN is beyond every limit.
-            let beyond =
-                |value: f64, limit: f64| value.is_nan() || value.abs() > limit * (1.0 + SLACK);
-            if beyond(v, l.velocity) {
-                return Some(LimitViolation {
-                    axis: i,
-                    kind: LimitKind::Velocity,
-                    value: v,
-                    limit: l.velocity,
-                });
-            }
-            if beyond(a, l.acceleration) {
-                return Some(LimitViolation {
-                    axis: i,
-                    kind: LimitKind::Acceleration,
-                    value: a,
-                    limit: l.acceleration,
-                });
+            let checks = [
+                (LimitKind::Velocity, v, l.velocity),
+                (LimitKind::Acceleration, a, l.acceleration),
+            ];
+            for (kind, value, limit) in checks {
+                // A NaN is beyond every limit.
+                if value.is_nan() || value.abs() > limit * (1.0 + SLACK) {
+                    return Some(LimitViolation {
+                        axis: i,
+                        kind,
+                        value,
+                        limit,
+                    });
+                }
             }
         }
         None

@@ -37,11 +37,42 @@ pub fn stiff(mut c: ChannelConfig) -> ChannelConfig {
     c
 }
 
+/// The text of seed `file` when `../shared/seeds/` is there (it is not in a fresh clone: the
+/// tests that read it are extra cross-checks and say they skipped).
+pub fn seed_text(file: &str) -> Option<String> {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/seeds")
+        .join(file);
+    if !path.exists() {
+        println!("skipped: ../shared/seeds not present");
+        return None;
+    }
+    Some(
+        std::fs::read_to_string(&path)
+            .unwrap_or_else(|e| panic!("reading {}: {e}", path.display())),
+    )
+}
+
+/// The tool table of `nc.tools` from TOML rows (`{ d = 1, length = 100.0 }, ...`).
+pub fn tools(rows: &str) -> Vec<cnc_core::channel::config::ToolEntry> {
+    let table: toml::Table = toml::from_str(&format!("tools = [{rows}]")).unwrap();
+    table["tools"].clone().try_into().unwrap()
+}
+
+/// Channels in the given order, each running its program (checked with the channel's own
+/// machine data: zero offsets, tool table).
 pub fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
     let mut channels = Vec::new();
     for (i, (config, src)) in configs.into_iter().enumerate() {
-        let program =
-            LoadedProgram::load(&config.name, src, &config.axes).unwrap_or_else(|e| panic!("{e}"));
+        let program = LoadedProgram::load_with(
+            &config.name,
+            src,
+            &config.axes,
+            &config.nc.setup(),
+            None,
+            &cnc_core::nc::interp::SearchPath::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let mut channel = Channel::new(i, config, CYCLE).unwrap();
         channel.start(program).unwrap();
         channels.push(channel);

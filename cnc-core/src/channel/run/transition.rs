@@ -4,7 +4,7 @@
 use super::Channel;
 use crate::channel::dyn_cs::{words, BadParameter, MasterSource, TrackError, TrackSetup};
 use crate::channel::plc_io::Transition;
-use hli::enums::{DynCsCommand, DynCsState, DynCsTransitionError};
+use hli::enums::{DynCsCommand, DynCsTransitionError};
 use hli::layout::HliDynCsTransition;
 use kinematics::frame::frame_from_hli;
 use kinematics::RotationOrder;
@@ -39,14 +39,7 @@ impl Channel {
 
     /// Adds the tracker's state of this tick to the states passed since the last transition.
     pub(super) fn note_dyn_cs_state(&mut self) {
-        let bit = match self.tracker.state() {
-            DynCsState::Inactive => 0,
-            DynCsState::Activating => 1,
-            DynCsState::Active => 2,
-            DynCsState::Deactivating => 3,
-            DynCsState::Error => 4,
-        };
-        self.outputs.dyn_cs_result.states_seen_r |= 1 << bit;
+        self.outputs.dyn_cs_result.states_seen_r |= self.tracker.state().seen_bit();
     }
 
     fn carry_out(
