@@ -504,25 +504,37 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
     }
 }
 
-/// The last step of a coupling out is checked too: 1 mm shed in one tick (FILTER=1) is
-/// refused, never handed to the axes.
-#[test]
-fn the_last_step_of_a_switch_off_is_checked() {
-    let program = "#TRACK CS ON [ID=0 FILTER=300 WAIT]\n#TRACK CS OFF [FILTER=1]\n#TIME 1\nM30\n";
-    let mut ctl = controller(vec![(cartesian("slave"), program)]);
+/// 600 ticks of `program` on one channel whose PLC master stands at `x` (0.1 um), every step
+/// watched.
+fn plc_master_run(
+    config: ChannelConfig,
+    program: &str,
+    x: i32,
+    mut watch: StepWatch,
+) -> (cnc_core::channel::Controller, StepWatch) {
+    let mut ctl = controller(vec![(config, program)]);
     let memory = image(1);
     let view = CncView::new(&memory);
     let plc = PlcView::new(&memory);
     plc.set_dyn_cs_enabled(0, true).unwrap();
     plc.dyn_cs_command(0)
         .unwrap()
-        .try_send(&cs([10_000, 0, 0]))
+        .try_send(&cs([x, 0, 0]))
         .unwrap();
-    let mut watch = StepWatch::new(&[0.0; 6], cartesian("x").axis_limits(0));
     for _ in 0..600 {
         ctl.tick(&view);
         watch.check(ctl.channels()[0].set_points(), "slave");
     }
+    (ctl, watch)
+}
+
+/// The last step of a coupling out is checked too: 1 mm shed in one tick (FILTER=1) is
+/// refused, never handed to the axes.
+#[test]
+fn the_last_step_of_a_switch_off_is_checked() {
+    let program = "#TRACK CS ON [ID=0 FILTER=300 WAIT]\n#TRACK CS OFF [FILTER=1]\n#TIME 1\nM30\n";
+    let watch = StepWatch::new(&[0.0; 6], cartesian("x").axis_limits(0));
+    let (ctl, _) = plc_master_run(cartesian("slave"), program, 10_000, watch);
     let ch = &ctl.channels()[0];
     assert_eq!(ch.tracker().state(), DynCsState::Error);
     assert_eq!(ch.error().unwrap().id, ChannelErrorId::Tracking);
@@ -572,20 +584,8 @@ fn a_tool_record_selected_while_tracking_moves_nothing() {
     let mut c = robot("r");
     c.nc.tools = support::tools("{ d = 2, length = 50.0 }");
     let program = "#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=200 WAIT]\nD2\n#TIME 0.2\nM30\n";
-    let mut ctl = controller(vec![(c, program)]);
-    let memory = image(1);
-    let view = CncView::new(&memory);
-    let plc = PlcView::new(&memory);
-    plc.set_dyn_cs_enabled(0, true).unwrap();
-    plc.dyn_cs_command(0)
-        .unwrap()
-        .try_send(&cs([50_000, 0, 0]))
-        .unwrap();
-    let mut watch = StepWatch::new(&ROBOT_HOME, JOINT);
-    for _ in 0..600 {
-        ctl.tick(&view);
-        watch.check(ctl.channels()[0].set_points(), "r");
-    }
+    let watch = StepWatch::new(&ROBOT_HOME, JOINT);
+    let (ctl, watch) = plc_master_run(c, program, 50_000, watch);
     let ch = &ctl.channels()[0];
     assert_eq!(ch.state(), RunState::Finished, "{:?}", ch.error());
     assert_eq!(ch.tracker().state(), DynCsState::Active);
