@@ -41,7 +41,7 @@ use crate::nc::{Decoded, DecoderState, MotionMode};
 use hli::enums::{ChannelErrorId, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
 use hli::views::{PathOverride, DEFAULT_PATH_OVERRIDE};
-use kinematics::frame::{frame_from_hli, frame_to_hli, offset_frame};
+use kinematics::frame::{frame_to_hli, offset_frame};
 use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
 use nalgebra::Isometry3;
@@ -548,25 +548,6 @@ impl Channel {
             }),
             MasterSource::Channel(c) => masters.get(c).copied().flatten(),
         }
-    }
-
-    /// The PLC's side of the dynamic-CS unit (not taken during a stop: see [`Wanted`]).
-    fn plc_inputs(&mut self) {
-        if self.stopping.is_some() {
-            return;
-        }
-        let enabled = self.inputs.dyn_cs_enabled;
-        self.plc_enabled = enabled;
-        if let Some(cs) = self.inputs.dyn_cs_command {
-            // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
-            // nowhere (taken, so the PLC's semaphore is free again, and counted).
-            if enabled {
-                self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
-            } else {
-                self.tracker.not_redirected();
-            }
-        }
-        self.take_transition(enabled);
     }
 
     /// `f_wait` of a PLC transition, the counterpart of the NC command's WAIT: the program

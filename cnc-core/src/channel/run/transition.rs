@@ -10,6 +10,25 @@ use kinematics::frame::frame_from_hli;
 use kinematics::RotationOrder;
 
 impl Channel {
+    /// The PLC's side of the dynamic-CS unit (not taken during a stop: see [`Wanted`]).
+    pub(super) fn plc_inputs(&mut self) {
+        if self.stopping.is_some() {
+            return;
+        }
+        let enabled = self.inputs.dyn_cs_enabled;
+        self.plc_enabled = enabled;
+        if let Some(cs) = self.inputs.dyn_cs_command {
+            // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
+            // nowhere (taken, so the PLC's semaphore is free again, and counted).
+            if enabled {
+                self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
+            } else {
+                self.tracker.not_redirected();
+            }
+        }
+        self.take_transition(enabled);
+    }
+
     /// Takes this tick's transition, if the PLC posted one. A refusal is logged, counted and
     /// reported to the PLC; it never puts the tracking in ERROR, so it cannot block a later
     /// switch-on.
