@@ -87,6 +87,8 @@ fn the_whole_machine_runs_through_in_lockstep() {
         "{line}"
     );
     assert!(stdout.contains("cmd=ON PLC=1"), "{stdout}");
+    // Every switching ends softly: no tracking goes to ERROR in a run that ends normally.
+    assert!(!stdout.contains("dynCS: ERROR"), "{stdout}");
     assert!(stdout.contains("M-function handshakes 2;"), "{stdout}");
     // The PLC's three stations each ran their sequence through.
     assert!(

@@ -104,6 +104,14 @@ fn example_3_two_slaves_stay_on_the_moving_workpiece() {
     );
     assert!(travel > 150.0, "the workpiece moved {travel} mm");
     assert!(worst < 1e-3, "a slave left the workpiece by {worst} mm");
+    for slave in ["slave-left", "slave-right"] {
+        let tracker = channel(&done, slave).tracker();
+        assert_eq!(
+            tracker.state(),
+            DynCsState::Inactive,
+            "{slave} let go softly"
+        );
+    }
     for c in done.machine.controller().channels() {
         assert_eq!(c.state(), RunState::Finished, "{}", c.config().name);
     }

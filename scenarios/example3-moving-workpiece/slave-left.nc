@@ -9,7 +9,9 @@
 G1 X0 Y0 Z0 A0 B0 C0 F3000
 #SIGNAL SYN [ID1 COUNT1]
 #WAIT SYN [ID2]
-#TRACK CS OFF [FILTER=0]
+; let go of the workpiece over half a second: the master moved it, so the compensation
+; to shed is some millimetres (the manual's FILTER=0 would step the joints)
+#TRACK CS OFF [FILTER=500 WAIT]
 #CS OFF
 #CS OFF
 M30

@@ -81,7 +81,8 @@ impl Channel {
             axis: violation.axis as u8,
             kind: violation.kind,
         });
-        if self.state == RunState::Running {
+        // Also a channel whose program ended in this tick: its last step was refused.
+        if self.state != RunState::Error {
             self.fail(
                 ChannelErrorId::Tracking,
                 format!("tracked step refused: {violation}"),
