@@ -10,6 +10,8 @@ use cnc_core::nc::{Decoded, MotionMode};
 use hli::segment::heap_image;
 use hli::views::CncView;
 
+mod support;
+
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 use counting_alloc::allocations;
@@ -17,18 +19,7 @@ use counting_alloc::allocations;
 const CYCLE: f64 = 0.001;
 
 fn channel_with(config: ChannelConfig, src: &str) -> Controller {
-    let program = LoadedProgram::load_with(
-        &config.name,
-        src,
-        &config.axes,
-        &config.nc.setup(),
-        None,
-        &SearchPath::default(),
-    )
-    .unwrap_or_else(|e| panic!("{e}"));
-    let mut channel = Channel::new(0, config, CYCLE).unwrap();
-    channel.start(program).unwrap();
-    Controller::new(vec![channel]).unwrap()
+    support::controller(vec![(config, src)])
 }
 
 /// Ticks until the channel finishes (watchdog: `limit` ticks), calling `each` with the

@@ -20,7 +20,13 @@ use crate::layout::*;
 use crate::raw::{ImageMemory, Place};
 use core::mem::offset_of;
 
+mod path_override;
 mod transition;
+
+use path_override::validate_override;
+pub use path_override::{
+    OverrideError, PathOverride, DEFAULT_PATH_OVERRIDE, MAX_FEED_OVERRIDE, MAX_RAPID_OVERRIDE,
+};
 
 /// A channel or axis index outside the configured range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -137,31 +143,6 @@ macro_rules! unit_field {
     };
 }
 
-/// Path override and feed hold as the PLC commands them, validated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PathOverride {
-    /// Feed override, 0.1 % (0..=2000).
-    pub feed_permille: u32,
-    /// Rapid override, 0.1 % (0..=1000).
-    pub rapid_permille: u32,
-    /// Feed hold.
-    pub feed_hold: bool,
-}
-
-/// A PLC-written override value outside its range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-pub enum OverrideError {
-    /// Feed override above 200.0 %.
-    #[error("feed_override_w {0} above 2000 (0.1 %)")]
-    Feed(u32),
-    /// Rapid override above 100.0 %.
-    #[error("rapid_override_w {0} above 1000 (0.1 %)")]
-    Rapid(u32),
-    /// Feed-hold byte neither FALSE nor TRUE.
-    #[error("feed_hold_w byte {0} is neither FALSE nor TRUE")]
-    FeedHold(u8),
-}
-
 /// What a channel reports of its block execution every tick (`HLI_BAHN_STATE`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BlockProgress {
@@ -176,19 +157,6 @@ pub struct BlockProgress {
     /// Channel ticks so far.
     pub tick: u64,
 }
-
-/// The override and feed hold a freshly created image holds for every channel: 100 %, no
-/// hold (a zeroed image would mean 0 %, a machine that never moves).
-pub const DEFAULT_PATH_OVERRIDE: PathOverride = PathOverride {
-    feed_permille: 1000,
-    rapid_permille: 1000,
-    feed_hold: false,
-};
-
-/// Largest feed override, 0.1 %.
-pub const MAX_FEED_OVERRIDE: u32 = 2000;
-/// Largest rapid override, 0.1 %.
-pub const MAX_RAPID_OVERRIDE: u32 = 1000;
 
 /// The CNC's view of an image.
 #[derive(Debug, Clone, Copy)]
@@ -700,21 +668,6 @@ impl<'m> PlcAxis<'m> {
             .field::<crate::layout::HliAxisCommandState>(offset_of!(HliAxis, command_state))
             .read()
     }
-}
-
-fn validate_override(unit: &HliChannelOverrideUnit) -> Result<PathOverride, OverrideError> {
-    if unit.feed_override_w > MAX_FEED_OVERRIDE {
-        return Err(OverrideError::Feed(unit.feed_override_w));
-    }
-    if unit.rapid_override_w > MAX_RAPID_OVERRIDE {
-        return Err(OverrideError::Rapid(unit.rapid_override_w));
-    }
-    let feed_hold = unit.feed_hold_w.get().map_err(OverrideError::FeedHold)?;
-    Ok(PathOverride {
-        feed_permille: unit.feed_override_w,
-        rapid_permille: unit.rapid_override_w,
-        feed_hold,
-    })
 }
 
 /// The standard handler for [`crate::calls::ReadAxisState`] over a CNC view: validates the index.
