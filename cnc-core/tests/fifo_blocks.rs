@@ -5,7 +5,7 @@
 use hli::fifo_calls::{FifoReply, FifoStartCall};
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::fifo::{FifoStart, FifoWrite};
-use plc_shim::motion::ERROR_NO_ANSWER;
+use plc_shim::kernel::ERROR_NO_ANSWER;
 use plc_shim::runtime::PlcIo;
 
 fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u64) -> PlcIo<'a> {
@@ -18,7 +18,7 @@ fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u6
 }
 
 #[test]
-fn an_edge_while_busy_sends_nothing_and_a_silent_cnc_times_out() {
+fn an_edge_while_busy_sends_the_new_block_and_a_silent_cnc_times_out() {
     hli::init_logging();
     let instance = format!("fifo-blocks-{}", std::process::id());
     let server = AcyclicServer::open(&instance).unwrap();
@@ -49,7 +49,8 @@ fn an_edge_while_busy_sends_nothing_and_a_silent_cnc_times_out() {
             }
         })
         .unwrap();
-    assert_eq!(blocks, 1, "the edge while Busy sent nothing");
+    // The block kernel's rule: the edge while Busy is a new command; only its answer counts.
+    assert_eq!(blocks, 2, "the edge while Busy sent the block again");
     let mut cycle = 3;
     let out = loop {
         let out = write.cycle(&mut io(&memory, &mut client, cycle), true, 0, &rows, 2, 2);
@@ -60,7 +61,7 @@ fn an_edge_while_busy_sends_nothing_and_a_silent_cnc_times_out() {
         assert!(cycle < 100_000, "watchdog: no answer");
         std::thread::yield_now();
     };
-    assert!(out.done && out.reply.row == 2, "{out:?}");
+    assert!(out.done && out.extra.row == 2, "{out:?}");
 
     // Nobody answers: Error after the timeout.
     let mut start = FifoStart::default();

@@ -7,6 +7,9 @@
 //! Done when the CNC has taken the command (a scaling with a positional activation mode is
 //! then queued in the CNC).
 
+use crate::kernel::{
+    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
+};
 use crate::runtime::PlcIo;
 use hli::calls::{
     AcyclicCall, CallError, CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall,
@@ -14,88 +17,52 @@ use hli::calls::{
 use hli::enums::{AxisState, CouplingState};
 use hli::rpc::PendingCall;
 
-/// Outputs of a cam block.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct CamOutputs {
-    /// The CNC took the command (one-shot blocks).
-    pub done: bool,
-    /// Sent and not finished.
-    pub busy: bool,
-    /// MC_CamIn(Ext): the slave follows the cam.
-    pub in_sync: bool,
-    /// MC_CamIn(Ext): the coupling ended without this block (MC_CamOut, a fault, a stop).
-    pub command_aborted: bool,
-    /// Refused or failed; see `error_id`.
-    pub error: bool,
-    /// The CNC's error code.
-    pub error_id: u32,
-}
-
-impl CamOutputs {
-    /// Sent, not finished.
-    pub const BUSY: CamOutputs = CamOutputs {
-        done: false,
-        busy: true,
-        in_sync: false,
-        command_aborted: false,
-        error: false,
-        error_id: 0,
-    };
-    /// Finished.
-    pub const DONE: CamOutputs = CamOutputs {
-        done: true,
-        busy: false,
-        in_sync: false,
-        command_aborted: false,
-        error: false,
-        error_id: 0,
-    };
-}
-
-/// Whether `execute` rose since the last cycle (and remembers it for the next).
-pub(crate) fn rose(before: &mut bool, execute: bool) -> bool {
-    let rising = execute && !*before;
-    *before = execute;
-    rising
-}
-
-enum Phase<C: AcyclicCall> {
-    Idle,
-    Sent(PendingCall<C>),
-    /// A coupling accepted; `seen` once the slave showed it.
-    Following {
-        seen: bool,
-    },
-}
-
-/// The Execute edge, the pending call and the outputs, shared by the cam blocks.
+/// The block kernel as the cam blocks use it: a coupling (MC_CamIn) follows the slave's
+/// image, remembering whether it has seen the coupling there; the others are Done when the
+/// CNC took the call.
 pub struct CamCore<C: AcyclicCall> {
-    execute_before: bool,
-    phase: Phase<C>,
-    out: CamOutputs,
+    kernel: Kernel<PendingCall<C>, bool>,
 }
 
 impl<C: AcyclicCall> Default for CamCore<C> {
     fn default() -> Self {
         Self {
-            execute_before: false,
-            phase: Phase::Idle,
-            out: CamOutputs::default(),
+            kernel: Kernel::default(),
         }
     }
 }
 
 impl<C: AcyclicCall> core::fmt::Debug for CamCore<C> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("CamCore").field("out", &self.out).finish()
+        self.kernel.fmt(f)
     }
 }
 
-pub(crate) fn failed(code: u32) -> CamOutputs {
-    CamOutputs {
-        error: true,
-        error_id: code,
-        ..CamOutputs::default()
+pub(crate) fn failed(code: u32) -> Outputs {
+    Outputs::failed(code)
+}
+
+/// A cam coupling of `slave` as its image shows it; `seen` once the coupling showed there.
+fn follow_coupling(io: &PlcIo<'_>, slave: u32, seen: &mut bool) -> Step<()> {
+    let state = io.view.axis_state(slave as usize).ok();
+    let cam = state.is_some_and(|s| s.coupling_state_r == CouplingState::Cam.raw());
+    let synchronous =
+        state.is_some_and(|s| s.axis_state_r == AxisState::SlaveSynchronous.raw() && cam);
+    let error = state.map_or(0, |s| s.error_id_r);
+    if error != 0 {
+        Step::Ended(failed(error))
+    } else if cam {
+        *seen = true;
+        Step::Running(Outputs {
+            in_sync: synchronous,
+            busy: !synchronous,
+            ..Outputs::default()
+        })
+    } else if *seen {
+        Step::Ended(Outputs::aborted())
+    } else {
+        // Accepted between two ticks: the image shows it from the next tick on.
+        Step::Running(Outputs::busy())
     }
 }
 
@@ -109,95 +76,29 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         target: u32,
         call: impl FnOnce() -> C,
         couples: Option<u32>,
-    ) -> CamOutputs {
-        let rising = rose(&mut self.execute_before, execute);
-        if rising {
-            self.out = CamOutputs::default();
-            self.phase = match io.acyclic.start(target, &call()) {
-                Ok(pending) => Phase::Sent(pending),
-                Err(_) => {
-                    self.out = failed(crate::motion::ERROR_NO_ANSWER);
-                    Phase::Idle
-                }
-            };
-        }
-        if let Phase::Sent(pending) = &self.phase {
-            match pending.poll() {
-                None => self.out.busy = true,
-                Some(Ok(reply)) if reply.error_id != 0 => {
-                    self.out = failed(reply.error_id);
-                    self.phase = Phase::Idle;
-                }
-                Some(Ok(_)) => match couples {
-                    Some(_) => self.phase = Phase::Following { seen: false },
-                    None => {
-                        self.out = CamOutputs::DONE;
-                        self.phase = Phase::Idle;
-                    }
-                },
-                Some(Err(CallError::Refused { code })) => {
-                    self.out = failed(code.raw());
-                    self.phase = Phase::Idle;
-                }
-                Some(Err(_)) => {
-                    self.out = failed(crate::motion::ERROR_NO_ANSWER);
-                    self.phase = Phase::Idle;
-                }
-            }
-        }
-        if let (Phase::Following { seen }, Some(slave)) = (&mut self.phase, couples) {
-            let state = io.view.axis_state(slave as usize).ok();
-            let cam = state.is_some_and(|s| s.coupling_state_r == CouplingState::Cam.raw());
-            let synchronous =
-                state.is_some_and(|s| s.axis_state_r == AxisState::SlaveSynchronous.raw() && cam);
-            let error = state.map_or(0, |s| s.error_id_r);
-            if error != 0 {
-                self.out = failed(error);
-                self.phase = Phase::Idle;
-            } else if cam {
-                *seen = true;
-                self.out = CamOutputs {
-                    in_sync: synchronous,
-                    busy: !synchronous,
-                    ..CamOutputs::default()
-                };
-            } else if *seen {
-                self.out = CamOutputs {
-                    command_aborted: true,
-                    ..CamOutputs::default()
-                };
-                self.phase = Phase::Idle;
-            } else {
-                // Accepted between two ticks: the image shows it from the next tick on.
-                self.out.busy = true;
-            }
-        }
-        if !execute && matches!(self.phase, Phase::Idle) {
-            // Execute low and nothing running: the outputs clear (after one cycle shown).
-            let shown = self.out;
-            self.out = CamOutputs::default();
-            return shown;
-        }
-        self.out
+    ) -> Outputs {
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(target, &call())
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| match (reply.error_id, couples) {
+                (0, Some(_)) => Accept::Follow(false, Outputs::busy()),
+                (code, _) => done_unless(code),
+            },
+            |seen, io, _| match couples {
+                Some(slave) => follow_coupling(io, slave, seen),
+                None => Step::Ended(Outputs::done(())),
+            },
+        )
     }
-}
 
-/// What a pending call gave this cycle, with a transport failure or a refusal as its code.
-enum Polled<R> {
-    /// No answer yet.
-    Waiting,
-    /// The reply body.
-    Reply(R),
-    /// Refused or not answered: the code the block reports.
-    Failed(u32),
-}
-
-fn poll<C: AcyclicCall>(pending: &PendingCall<C>) -> Polled<C::Reply> {
-    match pending.poll() {
-        None => Polled::Waiting,
-        Some(Ok(reply)) => Polled::Reply(reply),
-        Some(Err(CallError::Refused { code })) => Polled::Failed(code.raw()),
-        Some(Err(_)) => Polled::Failed(crate::motion::ERROR_NO_ANSWER),
+    /// Input tTimeout: cycles to wait for the CNC's answer.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
     }
 }
 
@@ -221,52 +122,25 @@ pub struct McCamTableSelect {
     /// Input: raw `MC_InterpolationType` of rows sent.
     pub interpolation: u32,
     /// Outputs of the last call.
-    pub out: CamOutputs,
-    core: CamCore<CamTableSelectCall>,
-    chunker: Chunker,
-    execute_before: bool,
-    loading: bool,
+    pub out: Outputs,
+    kernel: Kernel<SelectTransfer>,
 }
 
 impl McCamTableSelect {
     /// One cycle: the data in chunks (if any), then the selection.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = rose(&mut self.execute_before, self.execute);
-        if rising && !matches!(self.data, CamData::None) {
-            if let CamData::Rows {
-                table_type,
-                interpolation,
-                ..
-            } = &mut self.data
-            {
-                *table_type = if self.table_type == 0 {
-                    10
-                } else {
-                    self.table_type
-                };
-                *interpolation = self.interpolation;
-            }
-            self.chunker.reset();
-            self.loading = true;
-            self.core = CamCore::default();
-        }
-        if self.loading {
-            match self
-                .chunker
-                .cycle(io, self.table, &self.data, true, self.periodic)
-            {
-                Transfer::Running => {
-                    self.out = CamOutputs::BUSY;
-                    return;
-                }
-                Transfer::Failed(code) => {
-                    self.loading = false;
-                    self.out = failed(code);
-                    return;
-                }
-                // Loaded: the selection goes out with a rising edge of its own core.
-                Transfer::Done => self.loading = false,
-            }
+        if let CamData::Rows {
+            table_type,
+            interpolation,
+            ..
+        } = &mut self.data
+        {
+            *table_type = if self.table_type == 0 {
+                10
+            } else {
+                self.table_type
+            };
+            *interpolation = self.interpolation;
         }
         let call = CamTableSelectCall {
             periodic: u32::from(self.periodic),
@@ -274,7 +148,25 @@ impl McCamTableSelect {
             slave_absolute: u32::from(self.slave_absolute),
             reserved: 0,
         };
-        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+        let (table, data, periodic) = (self.table, &self.data, self.periodic);
+        let send = |io: &mut PlcIo<'_>| match data {
+            CamData::None => io
+                .acyclic
+                .start(table, &call)
+                .map(SelectTransfer::Selecting)
+                .map_err(|e| call_error_code(&e)),
+            data => Ok(SelectTransfer::Loading(
+                ChunkTransfer::new(table, data, true, periodic),
+                call,
+            )),
+        };
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            send,
+            |reply| done_unless(reply.error_id),
+            no_follow,
+        );
     }
 }
 
@@ -312,7 +204,7 @@ pub struct McCamIn {
     /// Input: follow the master's actual position (else its set-point).
     pub master_actual: bool,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<CamInCall>,
 }
 
@@ -334,7 +226,7 @@ impl Default for McCamIn {
             interpolation: 0,
             extended: false,
             master_actual: false,
-            out: CamOutputs::default(),
+            out: Outputs::default(),
             core: CamCore::default(),
         }
     }
@@ -372,7 +264,7 @@ pub struct McCamOut {
     /// Input: a rising edge sends it.
     pub execute: bool,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<CamOutCall>,
 }
 
@@ -407,7 +299,7 @@ pub struct McCamScaling {
     /// Input: slave scaling.
     pub slave_scaling: f64,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<CamScalingCall>,
 }
 
@@ -423,7 +315,7 @@ impl Default for McCamScaling {
             slave_offset: 0.0,
             master_scaling: 1.0,
             slave_scaling: 1.0,
-            out: CamOutputs::default(),
+            out: Outputs::default(),
             core: CamCore::default(),
         }
     }
@@ -459,7 +351,7 @@ pub struct McWriteMotionFunctionPoint {
     /// Input: the point.
     pub point: hli::calls::McMotionFunctionPoint,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<hli::calls::CamPointsWriteCall>,
 }
 
@@ -496,7 +388,7 @@ pub struct McSetCamOnlineChangeMode {
     /// Input: raw `MC_CamScalingMode` of the slave.
     pub slave_scaling_mode: u32,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<hli::calls::CamOnlineModeCall>,
 }
 
@@ -539,64 +431,116 @@ enum Pending {
     Points(PendingCall<hli::calls::CamPointsWriteCall>),
 }
 
-/// Sends [`CamData`] chunk by chunk, one per cycle at most (a PLC cycle never waits).
-#[derive(Default)]
-pub struct Chunker {
+/// [`CamData`] on its way to table `table`, chunk by chunk, one chunk in flight and one per
+/// cycle at most (a PLC cycle never waits); answered when the last chunk is taken.
+pub struct ChunkTransfer {
+    table: u32,
+    data: CamData,
+    /// The points make a new function.
+    create: bool,
+    /// Rows of a cyclic table.
+    periodic: bool,
     pending: Option<Pending>,
     next: usize,
-    done: bool,
 }
 
-impl core::fmt::Debug for Chunker {
+impl core::fmt::Debug for ChunkTransfer {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Chunker")
+        f.debug_struct("ChunkTransfer")
+            .field("table", &self.table)
             .field("next", &self.next)
-            .field("done", &self.done)
             .finish()
     }
 }
 
-/// Where a transfer stands after a cycle.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Transfer {
-    /// Chunks still to go.
-    Running,
-    /// Every chunk taken.
-    Done,
-    /// Refused with this code (or no answer).
-    Failed(u32),
+fn chunk_flags(first: bool, last: bool) -> u32 {
+    let mut flags = 0;
+    if first {
+        flags |= hli::calls::CAM_CHUNK_FIRST;
+    }
+    if last {
+        flags |= hli::calls::CAM_CHUNK_LAST;
+    }
+    flags
 }
 
-impl Transfer {
-    /// The block outputs it shows, and whether the transfer still runs.
-    pub fn outputs(self) -> (CamOutputs, bool) {
-        match self {
-            Transfer::Running => (CamOutputs::BUSY, true),
-            Transfer::Done => (CamOutputs::DONE, false),
-            Transfer::Failed(code) => (failed(code), false),
+impl ChunkTransfer {
+    /// A transfer of `data` (shared, not copied) to `table`; nothing is sent before the
+    /// first poll.
+    pub fn new(table: u32, data: &CamData, create: bool, periodic: bool) -> ChunkTransfer {
+        ChunkTransfer {
+            table,
+            data: data.clone(),
+            create,
+            periodic,
+            pending: None,
+            next: 0,
+        }
+    }
+
+    /// The next chunk, sent; `None` when every chunk is out.
+    fn send_next(&mut self, io: &mut PlcIo<'_>) -> Option<Result<Pending, CallError>> {
+        match &self.data {
+            CamData::None => None,
+            CamData::Rows {
+                rows,
+                table_type,
+                interpolation,
+            } => {
+                let chunk = rows
+                    .get(self.next..)?
+                    .get(..hli::calls::CAM_ROWS_PER_CALL.min(rows.len() - self.next))?;
+                if chunk.is_empty() {
+                    return None;
+                }
+                let mut call = hli::calls::CamRowsWriteCall {
+                    first_row: self.next as u32,
+                    count: chunk.len() as u32,
+                    flags: chunk_flags(self.next == 0, self.next + chunk.len() == rows.len()),
+                    total: rows.len() as u32,
+                    table_type: *table_type,
+                    interpolation: *interpolation,
+                    periodic: u32::from(self.periodic),
+                    ..Default::default()
+                };
+                call.rows[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                Some(io.acyclic.start(self.table, &call).map(Pending::Rows))
+            }
+            CamData::Points(points) => {
+                let per = hli::calls::CAM_POINTS_PER_CALL;
+                let chunk = points
+                    .get(self.next..)?
+                    .get(..per.min(points.len() - self.next))?;
+                if chunk.is_empty() {
+                    return None;
+                }
+                let last = self.next + chunk.len() == points.len();
+                let create = if self.create {
+                    hli::calls::CAM_POINTS_CREATE
+                } else {
+                    0
+                };
+                let mut call = hli::calls::CamPointsWriteCall {
+                    first: chunk[0].point_index,
+                    count: chunk.len() as u32,
+                    flags: chunk_flags(self.next == 0, last) | create,
+                    total: points.len() as u32,
+                    ..Default::default()
+                };
+                call.points[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                Some(io.acyclic.start(self.table, &call).map(Pending::Points))
+            }
         }
     }
 }
 
-impl Chunker {
-    /// Starts over.
-    pub fn reset(&mut self) {
-        *self = Chunker::default();
-    }
+impl InFlight for ChunkTransfer {
+    type Reply = ();
+    type Buffer = ();
 
-    /// One cycle of the transfer of `data` to table `table` (`create`: the points make a new
-    /// function; `periodic` for rows).
-    pub fn cycle(
-        &mut self,
-        io: &mut PlcIo<'_>,
-        table: u32,
-        data: &CamData,
-        create: bool,
-        periodic: bool,
-    ) -> Transfer {
-        if self.done {
-            return Transfer::Done;
-        }
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<()> {
         let answered = match &self.pending {
             None => None,
             Some(Pending::Rows(p)) => p.poll().map(|r| r.map(|r| r.error_id)),
@@ -604,87 +548,49 @@ impl Chunker {
         };
         match answered {
             Some(Ok(0)) => self.pending = None,
-            Some(Ok(code)) => return Transfer::Failed(code),
-            Some(Err(CallError::Refused { code })) => return Transfer::Failed(code.raw()),
-            Some(Err(_)) => return Transfer::Failed(crate::motion::ERROR_NO_ANSWER),
-            None if self.pending.is_some() => return Transfer::Running,
+            Some(Ok(code)) => return Polled::Answer(Err(code)),
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            None if self.pending.is_some() => return Polled::Waiting,
             None => {}
         }
-        let sent = match data {
-            CamData::None => {
-                self.done = true;
-                return Transfer::Done;
+        match self.send_next(io) {
+            None => Polled::Answer(Ok(())),
+            Some(Ok(pending)) => {
+                self.pending = Some(pending);
+                Polled::Progress
             }
-            CamData::Rows {
-                rows,
-                table_type,
-                interpolation,
-            } => {
-                let per = hli::calls::CAM_ROWS_PER_CALL;
-                if self.next >= rows.len() {
-                    self.done = true;
-                    return Transfer::Done;
-                }
-                let chunk = &rows[self.next..(self.next + per).min(rows.len())];
-                let mut call = hli::calls::CamRowsWriteCall {
-                    first_row: self.next as u32,
-                    count: chunk.len() as u32,
-                    flags: (if self.next + chunk.len() == rows.len() {
-                        hli::calls::CAM_CHUNK_LAST
-                    } else {
-                        0
-                    }) | if self.next == 0 {
-                        hli::calls::CAM_CHUNK_FIRST
-                    } else {
-                        0
-                    },
-                    total: rows.len() as u32,
-                    table_type: *table_type,
-                    interpolation: *interpolation,
-                    periodic: u32::from(periodic),
-                    ..Default::default()
-                };
-                call.rows[..chunk.len()].copy_from_slice(chunk);
-                self.next += chunk.len();
-                io.acyclic.start(table, &call).map(Pending::Rows)
-            }
-            CamData::Points(points) => {
-                let per = hli::calls::CAM_POINTS_PER_CALL;
-                if self.next >= points.len() {
-                    self.done = true;
-                    return Transfer::Done;
-                }
-                let chunk = &points[self.next..(self.next + per).min(points.len())];
-                let mut call = hli::calls::CamPointsWriteCall {
-                    first: chunk[0].point_index,
-                    count: chunk.len() as u32,
-                    flags: (if self.next + chunk.len() == points.len() {
-                        hli::calls::CAM_CHUNK_LAST
-                    } else {
-                        0
-                    }) | if create {
-                        hli::calls::CAM_POINTS_CREATE
-                    } else {
-                        0
-                    } | if self.next == 0 {
-                        hli::calls::CAM_CHUNK_FIRST
-                    } else {
-                        0
-                    },
-                    total: points.len() as u32,
-                    ..Default::default()
-                };
-                call.points[..chunk.len()].copy_from_slice(chunk);
-                self.next += chunk.len();
-                io.acyclic.start(table, &call).map(Pending::Points)
-            }
-        };
-        match sent {
-            Ok(p) => {
-                self.pending = Some(p);
-                Transfer::Running
-            }
-            Err(_) => Transfer::Failed(crate::motion::ERROR_NO_ANSWER),
+            Some(Err(e)) => Polled::Answer(Err(call_error_code(&e))),
+        }
+    }
+}
+
+/// The data of MC_CamTableSelect (if any) and then the selection itself.
+pub enum SelectTransfer {
+    /// The table's data, chunk by chunk; the selection waits.
+    Loading(ChunkTransfer, CamTableSelectCall),
+    /// The selection, on its way.
+    Selecting(PendingCall<CamTableSelectCall>),
+}
+
+impl InFlight for SelectTransfer {
+    type Reply = CamReply;
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<CamReply> {
+        match self {
+            SelectTransfer::Selecting(pending) => InFlight::poll(pending, io, &mut ()),
+            SelectTransfer::Loading(transfer, call) => match transfer.poll(io, &mut ()) {
+                Polled::Answer(Ok(())) => match io.acyclic.start(transfer.table, call) {
+                    Ok(pending) => {
+                        *self = SelectTransfer::Selecting(pending);
+                        Polled::Progress
+                    }
+                    Err(e) => Polled::Answer(Err(call_error_code(&e))),
+                },
+                Polled::Answer(Err(code)) => Polled::Answer(Err(code)),
+                Polled::Waiting => Polled::Waiting,
+                Polled::Progress => Polled::Progress,
+            },
         }
     }
 }
@@ -700,28 +606,87 @@ pub struct McWriteMotionFunction {
     /// Input: the points.
     pub points: CamData,
     /// Outputs of the last call.
-    pub out: CamOutputs,
-    execute_before: bool,
-    chunker: Chunker,
-    running: bool,
+    pub out: Outputs,
+    kernel: Kernel<ChunkTransfer>,
 }
 
 impl McWriteMotionFunction {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = rose(&mut self.execute_before, self.execute);
-        if rising {
-            self.chunker.reset();
-            self.running = true;
-            self.out = CamOutputs::default();
+        let (table, points) = (self.table, &self.points);
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |_| Ok(ChunkTransfer::new(table, points, false, false)),
+            |()| Accept::Done(()),
+            no_follow,
+        );
+    }
+}
+
+/// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
+pub const ERROR_ARRAY_SIZE: u32 = 0x4B31;
+
+/// A read of numbers in parts of 28, one part per cycle, appended to the block's array (the
+/// buffer); answered with the columns per row once all are in.
+pub struct PartRead {
+    target: u32,
+    request: hli::calls::CamReadCall,
+    pending: PendingCall<hli::calls::CamReadCall>,
+}
+
+impl core::fmt::Debug for PartRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PartRead")
+            .field("part", &self.request.part)
+            .finish()
+    }
+}
+
+impl PartRead {
+    fn start(
+        io: &mut PlcIo<'_>,
+        target: u32,
+        request: hli::calls::CamReadCall,
+    ) -> Result<PartRead, u32> {
+        let pending = io
+            .acyclic
+            .start(target, &request)
+            .map_err(|e| call_error_code(&e))?;
+        Ok(PartRead {
+            target,
+            request,
+            pending,
+        })
+    }
+}
+
+impl InFlight for PartRead {
+    type Reply = u32;
+    type Buffer = Vec<f64>;
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, values: &mut Vec<f64>) -> Polled<u32> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) if reply.error_id != 0 => return Polled::Answer(Err(reply.error_id)),
+            Some(Ok(reply)) => reply,
+        };
+        let count = reply.count as usize;
+        if values.len() + count > values.capacity() || reply.total as usize > values.capacity() {
+            return Polled::Answer(Err(ERROR_ARRAY_SIZE));
         }
-        if self.running {
-            let transfer = self
-                .chunker
-                .cycle(io, self.table, &self.points, false, false);
-            (self.out, self.running) = transfer.outputs();
-        } else if !self.execute {
-            self.out = CamOutputs::default();
+        values.extend_from_slice(&reply.values[..count]);
+        if values.len() >= reply.total as usize || count == 0 {
+            return Polled::Answer(Ok(reply.columns));
+        }
+        self.request.part += 1;
+        match io.acyclic.start(self.target, &self.request) {
+            Ok(pending) => {
+                self.pending = pending;
+                Polled::Progress
+            }
+            Err(e) => Polled::Answer(Err(call_error_code(&e))),
         }
     }
 }
@@ -744,10 +709,8 @@ pub struct McCamRead {
     /// Output: columns per row of a value table.
     pub columns: u32,
     /// Outputs of the last call.
-    pub out: CamOutputs,
-    execute_before: bool,
-    pending: Option<PendingCall<hli::calls::CamReadCall>>,
-    part: u32,
+    pub out: Outputs,
+    kernel: Kernel<PartRead>,
 }
 
 /// Room of a read block's answer when the timeline does not say.
@@ -765,68 +728,96 @@ impl McCamRead {
             target: 0,
             values: Vec::with_capacity(room),
             columns: 1,
-            out: CamOutputs::default(),
-            execute_before: false,
-            pending: None,
-            part: 0,
+            out: Outputs::default(),
+            kernel: Kernel::default(),
         }
+    }
+
+    /// Input tTimeout: cycles to wait for each part.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
     }
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = rose(&mut self.execute_before, self.execute);
-        if rising {
-            self.values.clear();
-            self.part = 0;
-            self.out = CamOutputs::BUSY;
-            self.send(io);
-            return;
-        }
-        let Some(pending) = &self.pending else {
-            if !self.execute {
-                self.out = CamOutputs::default();
-            }
-            return;
+        let (target, request) = (self.target, self.request);
+        let columns = &mut self.columns;
+        let send = |io: &mut PlcIo<'_>, values: &mut Vec<f64>| {
+            values.clear();
+            PartRead::start(io, target, hli::calls::CamReadCall { part: 0, ..request })
         };
-        match poll(pending) {
-            Polled::Waiting => {}
-            Polled::Reply(reply) if reply.error_id != 0 => {
-                self.pending = None;
-                self.out = failed(reply.error_id);
-            }
-            Polled::Reply(reply) => {
-                self.pending = None;
-                let count = reply.count as usize;
-                if self.values.len() + count > self.values.capacity()
-                    || reply.total as usize > self.values.capacity()
-                {
-                    self.out = failed(0x4B31);
-                    return;
-                }
-                self.values.extend_from_slice(&reply.values[..count]);
-                self.columns = reply.columns;
-                if self.values.len() >= reply.total as usize || count == 0 {
-                    self.out = CamOutputs::DONE;
-                } else {
-                    self.part += 1;
-                    self.send(io);
-                }
-            }
-            Polled::Failed(code) => {
-                self.pending = None;
-                self.out = failed(code);
-            }
-        }
+        self.out = self.kernel.cycle_with(
+            io,
+            &mut self.values,
+            self.execute,
+            send,
+            |c| {
+                *columns = c;
+                Accept::Done(())
+            },
+            no_follow,
+        );
     }
+}
 
-    fn send(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamReadCall {
-            part: self.part,
-            ..self.request
+/// A read of motion-function points, four per cycle, appended to the block's array until
+/// `wanted` (0: to the end of the function from `first`).
+pub struct PointsRead {
+    table: u32,
+    first: u32,
+    count: u32,
+    pending: PendingCall<hli::calls::CamPointsReadCall>,
+}
+
+impl core::fmt::Debug for PointsRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PointsRead")
+            .field("table", &self.table)
+            .finish()
+    }
+}
+
+fn read_points(
+    io: &mut PlcIo<'_>,
+    table: u32,
+    first: u32,
+) -> Result<PendingCall<hli::calls::CamPointsReadCall>, u32> {
+    let call = hli::calls::CamPointsReadCall { first, count: 0 };
+    io.acyclic
+        .start(table, &call)
+        .map_err(|e| call_error_code(&e))
+}
+
+impl InFlight for PointsRead {
+    type Reply = ();
+    type Buffer = Vec<hli::calls::McMotionFunctionPoint>;
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, points: &mut Self::Buffer) -> Polled<()> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) if reply.error_id != 0 => return Polled::Answer(Err(reply.error_id)),
+            Some(Ok(reply)) => reply,
         };
-        match io.acyclic.start(self.target, &call) {
-            Ok(p) => self.pending = Some(p),
-            Err(_) => self.out = failed(crate::motion::ERROR_NO_ANSWER),
+        let wanted = if self.count == 0 {
+            (reply.total + 1).saturating_sub(self.first) as usize
+        } else {
+            self.count as usize
+        };
+        if wanted > points.capacity() {
+            return Polled::Answer(Err(ERROR_ARRAY_SIZE));
+        }
+        let take = (reply.count as usize).min(wanted.saturating_sub(points.len()));
+        points.extend_from_slice(&reply.points[..take]);
+        if points.len() >= wanted || reply.count == 0 {
+            return Polled::Answer(Ok(()));
+        }
+        match read_points(io, self.table, self.first + points.len() as u32) {
+            Ok(pending) => {
+                self.pending = pending;
+                Polled::Progress
+            }
+            Err(code) => Polled::Answer(Err(code)),
         }
     }
 }
@@ -847,9 +838,8 @@ pub struct McReadMotionFunction {
     /// Output: the points read.
     pub points: Vec<hli::calls::McMotionFunctionPoint>,
     /// Outputs of the last call.
-    pub out: CamOutputs,
-    execute_before: bool,
-    pending: Option<PendingCall<hli::calls::CamPointsReadCall>>,
+    pub out: Outputs,
+    kernel: Kernel<PointsRead>,
 }
 
 impl McReadMotionFunction {
@@ -861,68 +851,31 @@ impl McReadMotionFunction {
             first: 1,
             count: 0,
             points: Vec::with_capacity(room),
-            out: CamOutputs::default(),
-            execute_before: false,
-            pending: None,
+            out: Outputs::default(),
+            kernel: Kernel::default(),
         }
     }
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let rising = rose(&mut self.execute_before, self.execute);
-        if rising {
-            self.points.clear();
-            self.out = CamOutputs::BUSY;
-            self.send(io);
-            return;
-        }
-        let Some(pending) = &self.pending else {
-            if !self.execute {
-                self.out = CamOutputs::default();
-            }
-            return;
+        let (table, first, count) = (self.table, self.first, self.count);
+        let send = |io: &mut PlcIo<'_>, points: &mut Vec<hli::calls::McMotionFunctionPoint>| {
+            points.clear();
+            Ok(PointsRead {
+                table,
+                first,
+                count,
+                pending: read_points(io, table, first)?,
+            })
         };
-        match poll(pending) {
-            Polled::Waiting => {}
-            Polled::Reply(reply) if reply.error_id != 0 => {
-                self.pending = None;
-                self.out = failed(reply.error_id);
-            }
-            Polled::Reply(reply) => {
-                self.pending = None;
-                let wanted = if self.count == 0 {
-                    (reply.total + 1).saturating_sub(self.first) as usize
-                } else {
-                    self.count as usize
-                };
-                if wanted > self.points.capacity() {
-                    self.out = failed(0x4B31);
-                    return;
-                }
-                let take = (reply.count as usize).min(wanted.saturating_sub(self.points.len()));
-                self.points.extend_from_slice(&reply.points[..take]);
-                if self.points.len() >= wanted || reply.count == 0 {
-                    self.out = CamOutputs::DONE;
-                } else {
-                    self.send(io);
-                }
-            }
-            Polled::Failed(code) => {
-                self.pending = None;
-                self.out = failed(code);
-            }
-        }
-    }
-
-    fn send(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamPointsReadCall {
-            first: self.first + self.points.len() as u32,
-            count: 0,
-        };
-        match io.acyclic.start(self.table, &call) {
-            Ok(p) => self.pending = Some(p),
-            Err(_) => self.out = failed(crate::motion::ERROR_NO_ANSWER),
-        }
+        self.out = self.kernel.cycle_with(
+            io,
+            &mut self.points,
+            self.execute,
+            send,
+            |()| Accept::Done(()),
+            no_follow,
+        );
     }
 }
 
@@ -937,7 +890,7 @@ pub struct CamTableSetWeight {
     /// Input: the scaling.
     pub weight: hli::calls::CamTableWeightCall,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<hli::calls::CamTableWeightCall>,
 }
 
@@ -954,7 +907,7 @@ impl Default for CamTableSetWeight {
                 range_high: 1e300,
                 ..Default::default()
             },
-            out: CamOutputs::default(),
+            out: Outputs::default(),
             core: CamCore::default(),
         }
     }
@@ -986,7 +939,7 @@ pub struct CamTableCoupleAxesMultiTables {
     /// Input: profile tables among them.
     pub profiles: u32,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<hli::calls::CamMultiCoupleCall>,
 }
 
@@ -1021,7 +974,7 @@ pub struct CamMultiTable {
     /// Input: the activation position.
     pub position: f64,
     /// Outputs of the last call.
-    pub out: CamOutputs,
+    pub out: Outputs,
     core: CamCore<hli::calls::CamMultiTableCall>,
 }
 

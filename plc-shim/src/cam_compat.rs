@@ -16,7 +16,8 @@
 //! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
-use crate::cam::{rose, CamCore, CamData, CamOutputs, Chunker, McCamRead};
+use crate::cam::{CamCore, CamData, ChunkTransfer, McCamRead};
+use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
 use hli::calls::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
@@ -192,13 +193,11 @@ pub struct CompatBlock {
     /// What it was told by the last call.
     pub config: Arc<CompatConfig>,
     /// Outputs (bBusy, bErr, iErrId; Done when finished).
-    pub out: CamOutputs,
+    pub out: Outputs,
     /// A read's numbers (CamTableReadData: master, slave per row; ReadSlavePos: the slave
     /// position first).
     pub read: McCamRead,
-    execute_before: bool,
-    chunker: Chunker,
-    transferring: bool,
+    transfer: Kernel<ChunkTransfer>,
     declare: CamCore<CamRowsWriteCall>,
     delete: CamCore<CamTableDeleteCall>,
     couple: CamCore<CamInCall>,
@@ -227,10 +226,8 @@ impl CompatBlock {
             execute: false,
             read: McCamRead::new(what, room),
             config,
-            out: CamOutputs::default(),
-            execute_before: false,
-            chunker: Chunker::default(),
-            transferring: false,
+            out: Outputs::default(),
+            transfer: Kernel::default(),
             declare: CamCore::default(),
             delete: CamCore::default(),
             couple: CamCore::default(),
@@ -242,19 +239,8 @@ impl CompatBlock {
     /// One cycle for slave axis `slave` (the coupling and scaling blocks' axis).
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let c = Arc::clone(&self.config);
-        let rising = rose(&mut self.execute_before, self.execute);
         match c.kind {
             "CamTableGenerate" | "CamTableWriteData" => {
-                if rising {
-                    self.chunker.reset();
-                    self.transferring = true;
-                }
-                if !self.transferring {
-                    if !self.execute {
-                        self.out = CamOutputs::default();
-                    }
-                    return;
-                }
                 let (table_type, periodic) = if c.kind == "CamTableGenerate" {
                     type_of(c.table_type)
                 } else {
@@ -268,8 +254,13 @@ impl CompatBlock {
                     },
                     None => CamData::None,
                 };
-                let transfer = self.chunker.cycle(io, c.table, &data, false, periodic);
-                (self.out, self.transferring) = transfer.outputs();
+                self.out = self.transfer.cycle(
+                    io,
+                    self.execute,
+                    |_| Ok(ChunkTransfer::new(c.table, &data, false, periodic)),
+                    |()| Accept::Done(()),
+                    no_follow,
+                );
             }
             "CamTableCreate" => {
                 let (table_type, periodic) = type_of(c.table_type);

@@ -12,7 +12,7 @@
 //!
 //! None of them allocates or blocks; each is called once per cycle.
 
-use crate::motion::BlockOutputs;
+use crate::kernel::{Accept, InFlight, Kernel, Outputs, Polled, Step, Waited};
 use crate::runtime::PlcIo;
 use hli::enums::{DynCsCommand, DynCsOption, DynCsState};
 use hli::handshake::SendError;
@@ -125,13 +125,83 @@ impl DynCsMaster {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum TransitionPhase {
-    Idle,
-    /// Waiting for the command word to be free.
-    Sending,
-    /// Sent; waiting for the CNC to take it and reach the goal.
-    Following,
+/// A transition command on its way through the channel's `transition_w` unit: written as
+/// soon as the command word is free, answered when `dyn_cs_result.taken_count_r` moves (with
+/// the CNC's refusal code, or 0).
+struct TransitionSend {
+    channel: usize,
+    command: DynCsCommand,
+    latched: HliDynCsTransition,
+    taken_before: u32,
+    written: bool,
+    counted: bool,
+}
+
+impl InFlight for TransitionSend {
+    type Reply = u32;
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<u32> {
+        let Some(ch) = io.gp_ch(self.channel) else {
+            return Polled::Answer(Err(DynCsBlockError::NoChannel.code()));
+        };
+        if !self.written {
+            self.taken_before = ch.dyn_cs_result().taken_count_r;
+            return match ch.dyn_cs_transition().try_send(self.command, &self.latched) {
+                Ok(()) => {
+                    self.written = true;
+                    Polled::Progress
+                }
+                Err(SendError::Busy) => Polled::Waiting,
+                Err(SendError::Violation(_)) => {
+                    Polled::Answer(Err(DynCsBlockError::Protocol.code()))
+                }
+            };
+        }
+        let result = ch.dyn_cs_result();
+        if result.taken_count_r == self.taken_before {
+            return Polled::Waiting;
+        }
+        Polled::Answer(Ok(result.error_id_r))
+    }
+}
+
+/// What the block keeps while it follows a taken command: its goal, and whether the state
+/// left the start state.
+struct TransitionFollow {
+    on: bool,
+    moved: bool,
+}
+
+/// One cycle of following a taken command in the channel's tracking state, with the states
+/// passed since (a state that lasted less than a PLC cycle still counts).
+fn follow_transition(f: &mut TransitionFollow, io: &PlcIo<'_>, channel: usize) -> Step<()> {
+    let Some(ch) = io.gp_ch(channel) else {
+        return Step::Ended(Outputs::failed(DynCsBlockError::NoChannel.code()));
+    };
+    let seen_bits = ch.dyn_cs_result().states_seen_r;
+    let seen = |s: DynCsState| seen_bits & s.seen_bit() != 0;
+    let (goal, opposite) = if f.on {
+        (DynCsState::Active, DynCsState::Inactive)
+    } else {
+        (DynCsState::Inactive, DynCsState::Active)
+    };
+    let tracking = Outputs::failed(DynCsBlockError::Tracking.code());
+    match ch.dyn_cs_state() {
+        Err(_) => Step::Ended(Outputs::failed(DynCsBlockError::InvalidState.code())),
+        _ if seen(DynCsState::Error) => Step::Ended(tracking),
+        Ok(DynCsState::Error) => Step::Ended(tracking),
+        _ if seen(goal) => Step::Ended(Outputs::done(())),
+        // Back in the start state after it had left it: something switched the other way.
+        Ok(state) if state == opposite && f.moved => Step::Ended(Outputs::aborted()),
+        Ok(state) => {
+            f.moved |= state != opposite;
+            Step::Running(Outputs {
+                active: true,
+                ..Outputs::busy()
+            })
+        }
+    }
 }
 
 /// MC_DynCsTransition (our name): switches the tracking ON or OFF through `transition_w`.
@@ -164,19 +234,10 @@ pub struct McDynCsTransition {
     /// Input: the static frame between the error point and the kinematic base (X.. C..).
     pub kinematic_base_cs: HliCoordinateSystemInt,
     /// Outputs of the last call.
-    pub out: BlockOutputs,
+    pub out: Outputs,
     /// Commands the CNC was given.
     pub sent: u64,
-    latched: HliDynCsTransition,
-    latched_on: bool,
-    phase: TransitionPhase,
-    /// The state left the start state after the CNC took the command.
-    moved: bool,
-    /// `dyn_cs_result.taken_count_r` before the command was sent: a new count is the CNC's
-    /// answer to it.
-    taken_before: u32,
-    execute_before: bool,
-    show_once: bool,
+    kernel: Kernel<TransitionSend, TransitionFollow>,
 }
 
 impl Default for McDynCsTransition {
@@ -191,15 +252,9 @@ impl Default for McDynCsTransition {
             kin_base: false,
             rot_trans: false,
             kinematic_base_cs: bytemuck::Zeroable::zeroed(),
-            out: BlockOutputs::default(),
+            out: Outputs::default(),
             sent: 0,
-            latched: bytemuck::Zeroable::zeroed(),
-            latched_on: true,
-            phase: TransitionPhase::Idle,
-            moved: false,
-            taken_before: 0,
-            execute_before: false,
-            show_once: false,
+            kernel: Kernel::default(),
         }
     }
 }
@@ -207,120 +262,46 @@ impl Default for McDynCsTransition {
 impl McDynCsTransition {
     /// One cycle on channel `channel`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, channel: usize) {
-        let rising = self.execute && !self.execute_before;
-        self.execute_before = self.execute;
-        if rising {
-            self.latched = HliDynCsTransition {
-                command: 0,
-                filter_max_ticks: self.filter_max_ticks,
-                option: self.option.raw(),
-                f_wait: Bool::from(self.wait),
-                f_set_zero: Bool::from(self.set_zero),
-                f_kin_base: Bool::from(self.kin_base),
-                f_rot_trans: Bool::from(self.rot_trans),
-                kinematic_base_cs: self.kinematic_base_cs,
-            };
-            self.latched_on = self.on;
-            self.out = BlockOutputs::default();
-            self.phase = TransitionPhase::Sending;
-            self.moved = false;
-            self.show_once = false;
-        }
-        // Execute low while the command runs: its result, when it comes (possibly in this
-        // very cycle), is shown for one cycle.
-        if !self.execute && self.phase != TransitionPhase::Idle {
-            self.show_once = true;
-        }
-        if self.phase != TransitionPhase::Idle {
-            self.step(io, channel);
-        }
-        if !self.execute && self.phase == TransitionPhase::Idle {
-            if self.show_once {
-                self.show_once = false;
-            } else {
-                self.out = BlockOutputs::default();
-            }
-        }
-    }
-
-    fn step(&mut self, io: &mut PlcIo<'_>, channel: usize) {
-        let Some(ch) = io.gp_ch(channel) else {
-            return self.finish_with_error(DynCsBlockError::NoChannel);
+        let on = self.on;
+        let latched = HliDynCsTransition {
+            command: 0,
+            filter_max_ticks: self.filter_max_ticks,
+            option: self.option.raw(),
+            f_wait: Bool::from(self.wait),
+            f_set_zero: Bool::from(self.set_zero),
+            f_kin_base: Bool::from(self.kin_base),
+            f_rot_trans: Bool::from(self.rot_trans),
+            kinematic_base_cs: self.kinematic_base_cs,
         };
-        if self.phase == TransitionPhase::Sending {
-            let command = if self.latched_on {
-                DynCsCommand::Activate
-            } else {
-                DynCsCommand::Deactivate
-            };
-            self.taken_before = ch.dyn_cs_result().taken_count_r;
-            match ch.dyn_cs_transition().try_send(command, &self.latched) {
-                Ok(()) => {
-                    self.sent += 1;
-                    self.phase = TransitionPhase::Following;
-                }
-                Err(SendError::Busy) => {}
-                Err(SendError::Violation(_)) => {
-                    return self.finish_with_error(DynCsBlockError::Protocol)
-                }
-            }
-            self.out.busy = true;
-            return;
-        }
-        // The CNC's answer: refused (with its reason) or carried out, and the states passed
-        // since, so a state that lasted less than a PLC cycle still counts.
-        let result = ch.dyn_cs_result();
-        let taken = result.taken_count_r != self.taken_before;
-        if taken && result.error_id_r != 0 {
-            return self.finish_with_code(result.error_id_r);
-        }
-        let (goal, opposite) = if self.latched_on {
-            (DynCsState::Active, DynCsState::Inactive)
+        let command = if on {
+            DynCsCommand::Activate
         } else {
-            (DynCsState::Inactive, DynCsState::Active)
+            DynCsCommand::Deactivate
         };
-        let seen = |s: DynCsState| taken && result.states_seen_r & s.seen_bit() != 0;
-        self.out = BlockOutputs {
-            busy: true,
-            active: taken,
-            ..BlockOutputs::default()
+        let send = |_: &mut PlcIo<'_>| {
+            Ok(TransitionSend {
+                channel,
+                command,
+                latched,
+                taken_before: 0,
+                written: false,
+                counted: false,
+            })
         };
-        match ch.dyn_cs_state() {
-            Err(_) => self.finish_with_error(DynCsBlockError::InvalidState),
-            _ if seen(DynCsState::Error) => self.finish_with_error(DynCsBlockError::Tracking),
-            Ok(DynCsState::Error) if taken => self.finish_with_error(DynCsBlockError::Tracking),
-            _ if seen(goal) => {
-                self.out = BlockOutputs {
-                    done: true,
-                    ..BlockOutputs::default()
-                };
-                self.phase = TransitionPhase::Idle;
+        let accept = |error_id: u32| match error_id {
+            0 => Accept::Follow(TransitionFollow { on, moved: false }, Outputs::busy()),
+            code => Accept::Failed(code, ()),
+        };
+        let follow = |f: &mut TransitionFollow, io: &mut PlcIo<'_>, _: Waited| {
+            follow_transition(f, io, channel)
+        };
+        self.out = self.kernel.cycle(io, self.execute, send, accept, follow);
+        if let Some(send) = self.kernel.in_flight_mut() {
+            if send.written && !send.counted {
+                send.counted = true;
+                self.sent += 1;
             }
-            // Back in the start state after it had left it: something switched the other way.
-            Ok(state) if taken && state == opposite && self.moved => {
-                self.out = BlockOutputs {
-                    command_aborted: true,
-                    ..BlockOutputs::default()
-                };
-                self.phase = TransitionPhase::Idle;
-            }
-            Ok(state) => self.moved |= taken && state != opposite,
         }
-    }
-
-    fn finish_with_error(&mut self, why: DynCsBlockError) {
-        self.finish_with_code(why.code());
-    }
-
-    /// Error with `error_id`: one of [`DynCsBlockError`] or the CNC's refusal
-    /// (`hli::enums::DynCsTransitionError`).
-    fn finish_with_code(&mut self, error_id: u32) {
-        self.out = BlockOutputs {
-            error: true,
-            error_id,
-            ..BlockOutputs::default()
-        };
-        self.phase = TransitionPhase::Idle;
     }
 }
 

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod dyn_cs;
 pub mod fifo;
 pub mod fifo_file;
+pub mod kernel;
 pub mod motion;
 pub mod probe;
 pub mod programs;

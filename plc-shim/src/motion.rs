@@ -7,78 +7,53 @@
 //! CommandAborted, Error (with ErrorID), held while Execute stays TRUE, or for one cycle if
 //! Execute already fell.
 
+use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
-use hli::rpc::{AxisCommandCall, CallError, PendingCall};
+use hli::rpc::{AxisCommandCall, AxisCommandReply, PendingCall};
 use hli::PlaceExt;
 
-/// Error id of a block whose call failed in transport (no CNC answer).
-pub const ERROR_NO_ANSWER: u32 = 0x745;
-
-/// Outputs of an Execute-driven motion block.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct BlockOutputs {
-    /// The command reached its goal.
-    pub done: bool,
-    /// The command has not finished yet.
-    pub busy: bool,
-    /// The command owns the axis (accepted and not finished).
-    pub active: bool,
-    /// A newer command replaced this one.
-    pub command_aborted: bool,
-    /// The command failed; see `error_id`.
-    pub error: bool,
-    /// Why it failed: an axis error code, an acyclic error code, or [`ERROR_NO_ANSWER`].
-    pub error_id: u32,
-    /// MC_MoveVelocity: the commanded velocity is reached.
-    pub in_velocity: bool,
-}
-
-enum Phase {
-    /// Nothing running: before the first edge, or the command has ended (outputs hold).
-    Idle,
-    /// Sent, no reply yet.
-    Sent(PendingCall<AxisCommandCall>),
-    /// Accepted with this id; followed in the command book.
-    Following(u32),
-}
-
-/// The Execute/Busy/Done machinery shared by the blocks.
+/// The block kernel as the motion blocks use it: the accepted command's id is followed in
+/// the axis's command book.
+#[derive(Debug, Default)]
 pub struct CommandCore {
-    execute_before: bool,
-    fell: bool,
-    phase: Phase,
-    out: BlockOutputs,
-    show_once: bool,
+    kernel: Kernel<PendingCall<AxisCommandCall>, u32>,
 }
 
-impl Default for CommandCore {
-    fn default() -> Self {
-        Self {
-            execute_before: false,
-            fell: false,
-            phase: Phase::Idle,
-            out: BlockOutputs::default(),
-            show_once: false,
-        }
+fn accept(reply: AxisCommandReply) -> Accept<u32, ()> {
+    if reply.error_id != 0 {
+        Accept::Failed(reply.error_id, ())
+    } else {
+        Accept::Follow(reply.command_id, Outputs::busy())
     }
 }
 
-impl core::fmt::Debug for CommandCore {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("CommandCore")
-            .field("out", &self.out)
-            .finish()
-    }
-}
-
-fn fail(code: u32) -> BlockOutputs {
-    BlockOutputs {
-        error: true,
-        error_id: code,
-        ..BlockOutputs::default()
+/// The outputs the command book shows for command `id` of `axis`; `finished_when_reached`:
+/// Done (and the outputs hold) once the goal is reached although the command keeps the axis.
+fn follow(io: &PlcIo<'_>, axis: u32, id: u32, finished_when_reached: bool) -> Step<()> {
+    let book: HliAxisCommandState = match io.view.axis(axis as usize) {
+        Ok(place) => place
+            .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
+            .read(),
+        Err(_) => return Step::Ended(Outputs::failed(hli::rpc::ErrorCode::InvalidTarget.raw())),
+    };
+    match view_command(&book, id) {
+        CommandView::Busy(reached) if reached && finished_when_reached => Step::Ended(Outputs {
+            done: true,
+            active: true,
+            ..Outputs::default()
+        }),
+        CommandView::Busy(reached) => Step::Running(Outputs {
+            busy: true,
+            active: true,
+            in_velocity: reached,
+            ..Outputs::default()
+        }),
+        CommandView::Done => Step::Ended(Outputs::done(())),
+        CommandView::Aborted | CommandView::Unknown => Step::Ended(Outputs::aborted()),
+        CommandView::Error(code) => Step::Ended(Outputs::failed(code)),
     }
 }
 
@@ -93,107 +68,23 @@ impl CommandCore {
         execute: bool,
         call: impl FnOnce() -> AxisCommandCall,
         finished_when_reached: bool,
-    ) -> BlockOutputs {
-        let rising = execute && !self.execute_before;
-        self.fell = !execute && self.execute_before;
-        self.execute_before = execute;
-        if rising {
-            self.out = BlockOutputs::default();
-            self.show_once = false;
-            self.phase = match io.acyclic.start(axis, &call()) {
-                Ok(pending) => Phase::Sent(pending),
-                Err(_) => {
-                    self.out = fail(ERROR_NO_ANSWER);
-                    Phase::Idle
-                }
-            };
-        }
-        // Execute is low while the command runs: whatever it ends with this cycle or later is
-        // shown for one cycle (also when Execute fell in the very cycle it ends).
-        if !execute && matches!(self.phase, Phase::Sent(_) | Phase::Following(_)) {
-            self.show_once = true;
-        }
-        if let Phase::Sent(pending) = &self.phase {
-            match pending.poll() {
-                None => self.out.busy = true,
-                Some(Ok(reply)) if reply.error_id != 0 => {
-                    self.out = fail(reply.error_id);
-                    self.phase = Phase::Idle;
-                }
-                Some(Ok(reply)) => self.phase = Phase::Following(reply.command_id),
-                Some(Err(CallError::Refused { code })) => {
-                    self.out = fail(code.raw());
-                    self.phase = Phase::Idle;
-                }
-                Some(Err(_)) => {
-                    self.out = fail(ERROR_NO_ANSWER);
-                    self.phase = Phase::Idle;
-                }
-            }
-        }
-        if let Phase::Following(id) = self.phase {
-            let book: HliAxisCommandState = match io.view.axis(axis as usize) {
-                Ok(place) => place
-                    .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
-                    .read(),
-                Err(_) => {
-                    self.out = fail(hli::rpc::ErrorCode::InvalidTarget.raw());
-                    self.phase = Phase::Idle;
-                    return self.finish_cycle(execute);
-                }
-            };
-            let view = view_command(&book, id);
-            self.out = match view {
-                CommandView::Busy(reached) if reached && finished_when_reached => BlockOutputs {
-                    done: true,
-                    active: true,
-                    ..BlockOutputs::default()
-                },
-                CommandView::Busy(reached) => BlockOutputs {
-                    busy: true,
-                    active: true,
-                    in_velocity: reached,
-                    ..BlockOutputs::default()
-                },
-                CommandView::Done => BlockOutputs {
-                    done: true,
-                    ..BlockOutputs::default()
-                },
-                CommandView::Aborted | CommandView::Unknown => BlockOutputs {
-                    command_aborted: true,
-                    ..BlockOutputs::default()
-                },
-                CommandView::Error(code) => fail(code),
-            };
-            // Finished, or (MC_Stop) Done once reached: the outputs hold from here on, whatever
-            // later happens to the command on the axis.
-            if !matches!(view, CommandView::Busy(_)) || self.out.done {
-                self.phase = Phase::Idle;
-            }
-        }
-        self.finish_cycle(execute)
+    ) -> Outputs {
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(axis, &call())
+                    .map_err(|_| crate::kernel::ERROR_NO_ANSWER)
+            },
+            accept,
+            |id, io, _: Waited| follow(io, axis, *id, finished_when_reached),
+        )
     }
 
     /// Whether Execute fell in the last cycle.
     pub fn fell(&self) -> bool {
-        self.fell
-    }
-
-    fn finish_cycle(&mut self, execute: bool) -> BlockOutputs {
-        let running = matches!(self.phase, Phase::Sent(_) | Phase::Following(_));
-        if !execute && !running {
-            // Execute fell: show a result that arrived meanwhile once, then clear.
-            if self.show_once {
-                self.show_once = false;
-                return self.out;
-            }
-            self.out = BlockOutputs::default();
-            self.phase = Phase::Idle;
-        }
-        if !execute && running {
-            self.show_once = true;
-        }
-        self.out
+        self.kernel.fell()
     }
 }
 
@@ -244,7 +135,7 @@ macro_rules! execute_block {
             pub execute: bool,
             $($(#[doc = $fdoc])* pub $field: f64,)*
             /// Outputs of the last call.
-            pub out: BlockOutputs,
+            pub out: Outputs,
             core: CommandCore,
         }
 
@@ -314,7 +205,7 @@ pub struct McMoveVelocity {
     /// Input: jerk limit.
     pub jerk: f64,
     /// Outputs of the last call.
-    pub out: BlockOutputs,
+    pub out: Outputs,
     core: CommandCore,
 }
 
@@ -363,7 +254,7 @@ pub struct McStop {
     /// Input: jerk.
     pub jerk: f64,
     /// Outputs of the last call.
-    pub out: BlockOutputs,
+    pub out: Outputs,
     core: CommandCore,
     release: Option<PendingCall<AxisCommandCall>>,
     release_due: bool,

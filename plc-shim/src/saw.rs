@@ -1,8 +1,8 @@
 //! The flying-saw blocks of seed 001 chapter 12 for the PLC program: MC_GearInVelo,
-//! MC_GearInPos, MC_GearOut and MC_ReadFlyingSawCharacteristics. Each sends its call to the
-//! slave's axis index on the rising Execute edge without waiting; an edge while Busy is
-//! ignored (the call on its way keeps its answer), and no answer within `timeout_cycles` PLC
-//! cycles is an Error with [`ERROR_NO_ANSWER`] (the call may still have been executed).
+//! MC_GearInPos, MC_GearOut and MC_ReadFlyingSawCharacteristics, on the block kernel
+//! ([`crate::kernel`]: its Execute, timeout and output rules). Each sends its call to the
+//! slave's axis index on the rising Execute edge without waiting; no answer within the
+//! timeout is an Error with [`ERROR_NO_ANSWER`] (the call may still have been executed).
 //!
 //! MC_GearInVelo / MC_GearInPos: once the CNC accepts the coupling, StartSync is TRUE and the
 //! block follows the slave's axis image. InSync when the slave is coupled the block's way
@@ -16,14 +16,14 @@
 //! that goes away later is CommandAborted. Limits of what the image can tell: a new coupling
 //! of the same kind to the same master made by another instance looks like this block's own.
 //!
-//! The outputs clear one cycle after Execute is low and the block is not Busy; a block that is
-//! InSync then stops following.
+//! With Execute low the block follows on until the coupling ends, and shows that end for one
+//! cycle (the kernel's rule for every block).
 
-use crate::cam::rose;
-use crate::fifo::DEFAULT_TIMEOUT_CYCLES;
-use crate::motion::ERROR_NO_ANSWER;
+use crate::kernel::{
+    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
+    Waited, ERROR_NO_ANSWER,
+};
 use crate::runtime::PlcIo;
-use hli::calls::{AcyclicCall, CallError};
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
 use hli::rpc::PendingCall;
@@ -94,79 +94,8 @@ impl SyncMode {
     }
 }
 
-/// Outputs of a flying-saw block (the one-shot blocks use Done, the couplings StartSync,
-/// InSync, Active and CommandAborted).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct SawOutputs {
-    /// MC_GearOut / the read: the CNC answered.
-    pub done: bool,
-    /// The CNC accepted the coupling (kept until the outputs clear).
-    pub start_sync: bool,
-    /// The slave is coupled and synchronous.
-    pub in_sync: bool,
-    /// Sent and not finished.
-    pub busy: bool,
-    /// The coupling is being made (= Busy, as the seed says).
-    pub active: bool,
-    /// The coupling ended without this block.
-    pub command_aborted: bool,
-    /// Refused or failed; see `error_id`.
-    pub error: bool,
-    /// The CNC's code, the axis's error, or [`ERROR_NO_ANSWER`].
-    pub error_id: u32,
-}
-
-impl SawOutputs {
-    const NONE: SawOutputs = SawOutputs {
-        done: false,
-        start_sync: false,
-        in_sync: false,
-        busy: false,
-        active: false,
-        command_aborted: false,
-        error: false,
-        error_id: 0,
-    };
-    const BUSY: SawOutputs = SawOutputs {
-        busy: true,
-        active: true,
-        ..SawOutputs::NONE
-    };
-    const STARTED: SawOutputs = SawOutputs {
-        start_sync: true,
-        ..SawOutputs::BUSY
-    };
-    const DONE: SawOutputs = SawOutputs {
-        done: true,
-        ..SawOutputs::NONE
-    };
-}
-
-fn failed(error_id: u32) -> SawOutputs {
-    SawOutputs {
-        error: true,
-        error_id,
-        ..SawOutputs::default()
-    }
-}
-
-/// What a call on its way gave this cycle.
-#[derive(Debug, PartialEq)]
-enum Answer<R> {
-    Waiting,
-    Reply(R),
-    /// Refused by the transport layer, lost, or not answered in time: the block's code.
-    Failed(u32),
-}
-
-fn answer<R>(result: Option<Result<R, CallError>>, waited: u64, timeout: u64) -> Answer<R> {
-    match result {
-        None if waited > timeout => Answer::Failed(ERROR_NO_ANSWER),
-        None => Answer::Waiting,
-        Some(Ok(reply)) => Answer::Reply(reply),
-        Some(Err(CallError::Refused { code })) => Answer::Failed(code.raw()),
-        Some(Err(_)) => Answer::Failed(ERROR_NO_ANSWER),
-    }
+fn failed(error_id: u32) -> Outputs {
+    Outputs::failed(error_id)
 }
 
 /// What the slave's image says about the coupling a block made.
@@ -192,60 +121,76 @@ fn read_image(state: Option<HliAxisLrState>, kind: CouplingState, master: u32) -
     }
 }
 
-enum GearPhase {
-    Idle,
-    Sent {
-        call: PendingCall<SawGearInCall>,
-        since: u64,
-        master: u32,
-    },
-    /// Accepted in cycle `since`; `seen` once the image showed the coupling, `synced` once it
-    /// was synchronous.
-    Following {
-        master: u32,
-        since: u64,
-        seen: bool,
-        synced: bool,
-    },
+/// What a coupling block keeps while it follows its accepted coupling: the master it asked
+/// for, whether the image has shown the coupling, and whether it was synchronous once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct GearFollow {
+    master: u32,
+    seen: bool,
+    synced: bool,
 }
 
-/// The Execute edge, the call and the following of the slave, shared by MC_GearInVelo and
-/// MC_GearInPos.
+/// Accepted: StartSync, Busy = Active.
+const STARTED: Outputs = Outputs {
+    start_sync: true,
+    busy: true,
+    active: true,
+    done: false,
+    command_aborted: false,
+    error: false,
+    error_id: 0,
+    in_velocity: false,
+    in_sync: false,
+    extra: (),
+};
+
+/// One cycle of following an accepted coupling through the slave's image.
+fn follow_gear(f: &mut GearFollow, image: Image, waited: Waited) -> Step<()> {
+    // The CNC answers between two ticks: the image read in the reply's own cycle may still be
+    // the tick before the coupling (an earlier coupling of the slave included).
+    if waited.cycles == 0 {
+        return Step::Running(STARTED);
+    }
+    match image {
+        Image::Faulted(code) => Step::Ended(Outputs {
+            start_sync: true,
+            ..failed(code)
+        }),
+        Image::Ours { synchronous } => {
+            f.seen = true;
+            f.synced |= synchronous;
+            let busy = !f.synced;
+            Step::Running(Outputs {
+                start_sync: true,
+                in_sync: synchronous,
+                busy,
+                active: busy,
+                ..Outputs::default()
+            })
+        }
+        // Gone after it was seen; or never shown at all within the timeout (ended between
+        // two PLC cycles).
+        Image::Other if f.seen || waited.cycles > waited.timeout => Step::Ended(Outputs {
+            start_sync: true,
+            command_aborted: true,
+            ..Outputs::default()
+        }),
+        Image::Other => Step::Running(STARTED),
+    }
+}
+
+/// The block kernel as MC_GearInVelo and MC_GearInPos use it.
 struct GearInCore {
     kind: CouplingState,
-    timeout_cycles: u64,
-    execute_before: bool,
-    phase: GearPhase,
-    out: SawOutputs,
+    kernel: Kernel<PendingCall<SawGearInCall>, GearFollow>,
 }
 
 impl GearInCore {
     fn new(kind: CouplingState) -> GearInCore {
         GearInCore {
             kind,
-            timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
-            execute_before: false,
-            phase: GearPhase::Idle,
-            out: SawOutputs::default(),
+            kernel: Kernel::active_while_sent(),
         }
-    }
-
-    fn busy(&self) -> bool {
-        match self.phase {
-            GearPhase::Idle => false,
-            GearPhase::Sent { .. } => true,
-            GearPhase::Following { synced, .. } => !synced,
-        }
-    }
-
-    /// A rising edge while not Busy: the block sends now (outputs cleared).
-    fn edge(&mut self, execute: bool) -> bool {
-        let send = rose(&mut self.execute_before, execute) && !self.busy();
-        if send {
-            self.out = SawOutputs::default();
-            self.phase = GearPhase::Idle;
-        }
-        send
     }
 
     fn cycle(
@@ -254,131 +199,38 @@ impl GearInCore {
         execute: bool,
         slave: u32,
         call: SawGearInCall,
-    ) -> SawOutputs {
-        if self.edge(execute) {
-            self.phase = match io.acyclic.start(slave, &call) {
-                Ok(pending) => GearPhase::Sent {
-                    call: pending,
-                    since: io.cycle,
-                    master: call.master,
-                },
-                Err(_) => {
-                    self.out = failed(ERROR_NO_ANSWER);
-                    GearPhase::Idle
-                }
-            };
-        }
-        self.poll_reply(io.cycle);
-        if let GearPhase::Following { master, .. } = self.phase {
-            let image = read_image(io.view.axis_state(slave as usize).ok(), self.kind, master);
-            self.follow(image, io.cycle);
-        }
-        self.finish(execute)
-    }
-
-    fn poll_reply(&mut self, cycle: u64) {
-        let GearPhase::Sent {
-            call,
-            since,
-            master,
-        } = &self.phase
-        else {
-            return;
-        };
-        let (since, master) = (*since, *master);
-        match answer(
-            call.poll(),
-            cycle.saturating_sub(since),
-            self.timeout_cycles,
-        ) {
-            Answer::Waiting => self.out = SawOutputs::BUSY,
-            Answer::Reply(reply) if reply.error_id != 0 => {
-                self.out = failed(reply.error_id);
-                self.phase = GearPhase::Idle;
-            }
-            Answer::Reply(_) => {
-                self.out = SawOutputs::STARTED;
-                self.phase = GearPhase::Following {
-                    master,
-                    since: cycle,
-                    seen: false,
-                    synced: false,
-                };
-            }
-            Answer::Failed(code) => {
-                self.out = failed(code);
-                self.phase = GearPhase::Idle;
-            }
-        }
-    }
-
-    fn follow(&mut self, image: Image, cycle: u64) {
-        let GearPhase::Following {
-            since,
-            seen,
-            synced,
-            ..
-        } = &mut self.phase
-        else {
-            return;
-        };
-        // The CNC answers between two ticks: the image read in the reply's own cycle may
-        // still be the tick before the coupling (an earlier coupling of the slave included).
-        if cycle <= *since {
-            return;
-        }
-        let waited = cycle - *since;
-        let ended = SawOutputs {
-            start_sync: true,
-            command_aborted: true,
-            ..SawOutputs::default()
-        };
-        match image {
-            Image::Faulted(code) => {
-                self.out = SawOutputs {
-                    start_sync: true,
-                    ..failed(code)
-                };
-                self.phase = GearPhase::Idle;
-            }
-            Image::Ours { synchronous } => {
-                *seen = true;
-                *synced |= synchronous;
-                let busy = !*synced;
-                self.out = SawOutputs {
-                    start_sync: true,
-                    in_sync: synchronous,
-                    busy,
-                    active: busy,
-                    ..SawOutputs::default()
-                };
-            }
-            // Gone after it was seen; or never shown at all within the timeout (ended
-            // between two PLC cycles).
-            Image::Other if *seen || waited > self.timeout_cycles => {
-                self.out = ended;
-                self.phase = GearPhase::Idle;
-            }
-            Image::Other => {}
-        }
-    }
-
-    /// The outputs of this cycle; Execute low and not Busy: they clear after being shown.
-    fn finish(&mut self, execute: bool) -> SawOutputs {
-        let shown = self.out;
-        if !execute && !self.busy() {
-            self.out = SawOutputs::default();
-            self.phase = GearPhase::Idle;
-        }
-        shown
+    ) -> Outputs {
+        let kind = self.kind;
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(slave, &call)
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| match reply.error_id {
+                0 => Accept::Follow(
+                    GearFollow {
+                        master: call.master,
+                        seen: false,
+                        synced: false,
+                    },
+                    STARTED,
+                ),
+                code => Accept::Failed(code, ()),
+            },
+            |f, io, waited| {
+                let image = read_image(io.view.axis_state(slave as usize).ok(), kind, f.master);
+                follow_gear(f, image, waited)
+            },
+        )
     }
 }
 
 impl core::fmt::Debug for GearInCore {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("GearInCore")
-            .field("out", &self.out)
-            .finish()
+        self.kernel.fmt(f)
     }
 }
 
@@ -451,7 +303,7 @@ pub struct McGearInVelo {
     /// In/out: the slave axis index (the call's target).
     pub slave: u32,
     /// Outputs of the last cycle.
-    pub out: SawOutputs,
+    pub out: Outputs,
     core: GearInCore,
 }
 
@@ -462,7 +314,7 @@ impl Default for McGearInVelo {
             inputs: GearInInputs::default(),
             master: 0,
             slave: 0,
-            out: SawOutputs::default(),
+            out: Outputs::default(),
             core: GearInCore::new(CouplingState::GearVelocity),
         }
     }
@@ -471,7 +323,7 @@ impl Default for McGearInVelo {
 impl McGearInVelo {
     /// Input: cycles to wait for the CNC's answer.
     pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.core.timeout_cycles = cycles;
+        self.core.kernel.set_timeout_cycles(cycles);
     }
 
     /// One cycle.
@@ -498,7 +350,7 @@ pub struct McGearInPos {
     /// In/out: the slave axis index (the call's target).
     pub slave: u32,
     /// Outputs of the last cycle.
-    pub out: SawOutputs,
+    pub out: Outputs,
     core: GearInCore,
 }
 
@@ -511,7 +363,7 @@ impl Default for McGearInPos {
             slave_sync_position: 0.0,
             master: 0,
             slave: 0,
-            out: SawOutputs::default(),
+            out: Outputs::default(),
             core: GearInCore::new(CouplingState::GearPosition),
         }
     }
@@ -520,7 +372,7 @@ impl Default for McGearInPos {
 impl McGearInPos {
     /// Input: cycles to wait for the CNC's answer.
     pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.core.timeout_cycles = cycles;
+        self.core.kernel.set_timeout_cycles(cycles);
     }
 
     /// One cycle.
@@ -528,77 +380,6 @@ impl McGearInPos {
         let positions = [self.master_sync_position, self.slave_sync_position];
         let call = self.inputs.call(self.master, SAW_ON_POSITION, positions);
         self.out = self.core.cycle(io, self.execute, self.slave, call);
-    }
-}
-
-/// Execute edge, one call on its way (with the cycle it left in) and the outputs: the
-/// one-shot blocks' share.
-struct Request<C: AcyclicCall> {
-    timeout_cycles: u64,
-    execute_before: bool,
-    pending: Option<(PendingCall<C>, u64)>,
-    out: SawOutputs,
-}
-
-impl<C: AcyclicCall> Default for Request<C> {
-    fn default() -> Self {
-        Request {
-            timeout_cycles: DEFAULT_TIMEOUT_CYCLES,
-            execute_before: false,
-            pending: None,
-            out: SawOutputs::default(),
-        }
-    }
-}
-
-impl<C: AcyclicCall> Request<C> {
-    fn edge(&mut self, execute: bool) -> bool {
-        let send = rose(&mut self.execute_before, execute) && self.pending.is_none();
-        if send {
-            self.out = SawOutputs::default();
-        }
-        send
-    }
-
-    fn send(&mut self, io: &mut PlcIo<'_>, target: u32, call: &C) {
-        match io.acyclic.start(target, call) {
-            Ok(p) => {
-                self.pending = Some((p, io.cycle));
-                self.out = SawOutputs {
-                    active: false,
-                    ..SawOutputs::BUSY
-                };
-            }
-            Err(_) => self.out = failed(ERROR_NO_ANSWER),
-        }
-    }
-
-    /// The answer once it is in (the reply, or the code of a failure); `None` while waiting
-    /// or when nothing is on its way.
-    fn take_answer(&mut self, cycle: u64) -> Option<Result<C::Reply, u32>> {
-        let (pending, since) = self.pending.as_ref()?;
-        let waited = cycle.saturating_sub(*since);
-        let got = match answer(pending.poll(), waited, self.timeout_cycles) {
-            Answer::Waiting => return None,
-            Answer::Reply(reply) => Ok(reply),
-            Answer::Failed(code) => Err(code),
-        };
-        self.pending = None;
-        Some(got)
-    }
-
-    fn finish(&mut self, execute: bool) -> SawOutputs {
-        let shown = self.out;
-        if !execute && self.pending.is_none() {
-            self.out = SawOutputs::default();
-        }
-        shown
-    }
-}
-
-impl<C: AcyclicCall> core::fmt::Debug for Request<C> {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("Request").field("out", &self.out).finish()
     }
 }
 
@@ -611,29 +392,102 @@ pub struct McGearOut {
     /// In/out: the slave axis index.
     pub slave: u32,
     /// Outputs of the last cycle.
-    pub out: SawOutputs,
-    request: Request<SawGearOutCall>,
+    pub out: Outputs,
+    kernel: Kernel<PendingCall<SawGearOutCall>>,
 }
 
 impl McGearOut {
     /// Input: cycles to wait for the CNC's answer.
     pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.request.timeout_cycles = cycles;
+        self.kernel.set_timeout_cycles(cycles);
     }
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        if self.request.edge(self.execute) {
-            self.request
-                .send(io, self.slave, &SawGearOutCall::default());
+        let slave = self.slave;
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |io| {
+                io.acyclic
+                    .start(slave, &SawGearOutCall::default())
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| done_unless(reply.error_id),
+            no_follow,
+        );
+    }
+}
+
+/// The read of the characteristic values in its parts: part 0 first; a part of another plan
+/// than part 0 (a new command came between) starts the read over.
+struct CharacRead {
+    slave: u32,
+    pending: PendingCall<SawCharacCall>,
+    part: u32,
+    plan: u32,
+    scratch: [f64; 31],
+}
+
+impl CharacRead {
+    fn start(io: &mut PlcIo<'_>, slave: u32) -> Result<CharacRead, u32> {
+        Ok(CharacRead {
+            slave,
+            pending: Self::send(io, slave, 0)?,
+            part: 0,
+            plan: 0,
+            scratch: [0.0; 31],
+        })
+    }
+
+    fn send(io: &mut PlcIo<'_>, slave: u32, part: u32) -> Result<PendingCall<SawCharacCall>, u32> {
+        io.acyclic
+            .start(slave, &SawCharacCall { part })
+            .map_err(|e| call_error_code(&e))
+    }
+
+    fn next(&mut self, io: &mut PlcIo<'_>, part: u32) -> Polled<[f64; 31]> {
+        match Self::send(io, self.slave, part) {
+            Ok(pending) => {
+                self.pending = pending;
+                self.part = part;
+                Polled::Progress
+            }
+            Err(code) => Polled::Answer(Err(code)),
         }
-        match self.request.take_answer(io.cycle) {
-            None => {}
-            Some(Ok(reply)) if reply.error_id != 0 => self.request.out = failed(reply.error_id),
-            Some(Ok(_)) => self.request.out = SawOutputs::DONE,
-            Some(Err(code)) => self.request.out = failed(code),
+    }
+}
+
+impl InFlight for CharacRead {
+    type Reply = [f64; 31];
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<[f64; 31]> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) => reply,
+        };
+        if reply.error_id != 0 {
+            return Polled::Answer(Err(reply.error_id));
         }
-        self.out = self.request.finish(self.execute);
+        if reply.part != self.part {
+            // An answer to another question: as if none came.
+            return Polled::Answer(Err(ERROR_NO_ANSWER));
+        }
+        if self.part > 0 && reply.plan != self.plan {
+            return self.next(io, 0);
+        }
+        self.plan = reply.plan;
+        let from = self.part as usize * SAW_CHARAC_PART;
+        for (slot, v) in self.scratch[from..].iter_mut().zip(reply.values) {
+            *slot = v;
+        }
+        if from + SAW_CHARAC_PART >= CHARAC_FIELDS.len() {
+            Polled::Answer(Ok(self.scratch))
+        } else {
+            self.next(io, self.part + 1)
+        }
     }
 }
 
@@ -647,20 +501,24 @@ pub struct McReadFlyingSawCharacteristics {
     /// In/out: the slave axis index.
     pub slave: u32,
     /// Outputs of the last cycle.
-    pub out: SawOutputs,
+    pub out: Outputs,
     /// In/out: fields 1-31 of `MC_FlyingSawCharacValues` ([`CHARAC_FIELDS`]).
     pub values: [f64; 31],
-    request: Request<SawCharacCall>,
-    part: u32,
-    /// The plan part 0 belonged to.
-    plan: u32,
-    scratch: [f64; 31],
+    kernel: Kernel<CharacRead>,
+}
+
+impl core::fmt::Debug for CharacRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("CharacRead")
+            .field("part", &self.part)
+            .finish()
+    }
 }
 
 impl McReadFlyingSawCharacteristics {
     /// Input: cycles to wait for each part.
     pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.request.timeout_cycles = cycles;
+        self.kernel.set_timeout_cycles(cycles);
     }
 
     /// The values with their field names, in the structure's order.
@@ -673,50 +531,25 @@ impl McReadFlyingSawCharacteristics {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        if self.request.edge(self.execute) {
-            self.part = 0;
-            self.scratch = [0.0; 31];
-            self.request
-                .send(io, self.slave, &SawCharacCall { part: 0 });
-        }
-        match self.request.take_answer(io.cycle) {
-            None => {}
-            Some(Ok(reply)) if reply.error_id != 0 => self.request.out = failed(reply.error_id),
-            // An answer to another question: as if none came.
-            Some(Ok(reply)) if reply.part != self.part => {
-                self.request.out = failed(ERROR_NO_ANSWER)
-            }
-            // Part 1 of another plan than part 0 (a new command came between): read again.
-            Some(Ok(reply)) if self.part > 0 && reply.plan != self.plan => {
-                self.part = 0;
-                self.request
-                    .send(io, self.slave, &SawCharacCall { part: 0 });
-            }
-            Some(Ok(reply)) => {
-                self.plan = reply.plan;
-                let from = self.part as usize * SAW_CHARAC_PART;
-                for (slot, v) in self.scratch[from..].iter_mut().zip(reply.values) {
-                    *slot = v;
-                }
-                if from + SAW_CHARAC_PART >= CHARAC_FIELDS.len() {
-                    self.values = self.scratch;
-                    self.request.out = SawOutputs::DONE;
-                } else {
-                    self.part += 1;
-                    let call = SawCharacCall { part: self.part };
-                    self.request.send(io, self.slave, &call);
-                }
-            }
-            Some(Err(code)) => self.request.out = failed(code),
-        }
-        self.out = self.request.finish(self.execute);
+        let slave = self.slave;
+        let values = &mut self.values;
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |io| CharacRead::start(io, slave),
+            |read| {
+                *values = read;
+                Accept::Done(())
+            },
+            no_follow,
+        );
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hli::calls::{decode_body, reply, CallKind, ErrorCode};
+    use hli::calls::{decode_body, reply, CallKind};
     use hli::layout::HliAxis;
     use hli::rpc::{AcyclicClient, AcyclicServer};
     use hli::saw_calls::{SawCharacReply, SawReply};
@@ -728,20 +561,6 @@ mod tests {
         let v = saw_library_version();
         assert_eq!(v, concat!("cncplc-saw ", env!("CARGO_PKG_VERSION")));
         assert!(v.len() <= 20, "fits a STRING(20)");
-    }
-
-    #[test]
-    fn answers_time_out_after_the_timeout_and_refusals_keep_their_code() {
-        assert_eq!(answer::<u32>(None, 5, 5), Answer::Waiting);
-        assert_eq!(answer::<u32>(None, 6, 5), Answer::Failed(ERROR_NO_ANSWER));
-        let refused = Some(Err::<u32, _>(CallError::Refused {
-            code: ErrorCode::InvalidTarget,
-        }));
-        let code = ErrorCode::InvalidTarget.raw();
-        assert_eq!(answer(refused, 0, 5), Answer::Failed(code));
-        let lost = Some(Err::<u32, _>(CallError::Transport("gone".into())));
-        assert_eq!(answer(lost, 0, 5), Answer::Failed(ERROR_NO_ANSWER));
-        assert_eq!(answer(Some(Ok(7u32)), 99, 5), Answer::Reply(7));
     }
 
     fn state(coupling: CouplingState, master: i32, axis: AxisState, error: u32) -> HliAxisLrState {
@@ -775,75 +594,66 @@ mod tests {
         assert_eq!(read_image(None, pos, 2), Image::Other);
     }
 
-    /// A core that had its coupling accepted in cycle 10.
-    fn accepted() -> GearInCore {
-        let mut fsm = GearInCore::new(CouplingState::GearPosition);
-        fsm.execute_before = true;
-        fsm.out = SawOutputs::STARTED;
-        fsm.phase = GearPhase::Following {
-            master: 0,
-            since: 10,
-            seen: false,
-            synced: false,
-        };
-        fsm
+    fn waited(cycles: u64) -> Waited {
+        Waited { cycles, timeout: 3 }
     }
+
+    fn outputs(step: Step<()>) -> (bool, Outputs) {
+        match step {
+            Step::Running(out) => (false, out),
+            Step::Ended(out) => (true, out),
+        }
+    }
+
+    const FRESH: GearFollow = GearFollow {
+        master: 0,
+        seen: false,
+        synced: false,
+    };
 
     #[test]
     fn a_coupling_is_busy_until_in_sync_then_aborted_when_it_goes_away() {
-        let mut fsm = accepted();
+        let mut f = FRESH;
         let ours = |synchronous| Image::Ours { synchronous };
-        fsm.follow(ours(true), 10); // the reply's own cycle: its image may be older
-        assert_eq!(fsm.finish(true), SawOutputs::STARTED);
-        fsm.follow(Image::Other, 11); // not shown yet
-        assert_eq!(fsm.finish(true), SawOutputs::STARTED);
-        fsm.follow(ours(false), 12);
-        assert_eq!(fsm.finish(true), SawOutputs::STARTED);
-        assert!(
-            !fsm.edge(false) && !fsm.edge(true),
-            "an edge while Busy is ignored"
+        // The reply's own cycle: its image may be older.
+        assert_eq!(
+            outputs(follow_gear(&mut f, ours(true), waited(0))),
+            (false, STARTED)
         );
-        fsm.follow(ours(true), 13);
-        let out = fsm.finish(true);
+        // Not shown yet.
+        let step = follow_gear(&mut f, Image::Other, waited(1));
+        assert_eq!(outputs(step), (false, STARTED));
+        let step = follow_gear(&mut f, ours(false), waited(2));
+        assert_eq!(outputs(step), (false, STARTED));
+        let (ended, out) = outputs(follow_gear(&mut f, ours(true), waited(3)));
+        assert!(!ended && out.in_sync && out.start_sync && !out.busy && !out.active);
+        // A rollback stop: still coupled.
+        let (ended, out) = outputs(follow_gear(&mut f, ours(false), waited(4)));
         assert!(
-            out.in_sync && out.start_sync && !out.busy && !out.active,
+            !ended && !out.in_sync && !out.busy && !out.command_aborted,
             "{out:?}"
         );
-        fsm.follow(ours(false), 14); // a rollback stop: still coupled
-        let out = fsm.finish(true);
-        assert!(!out.in_sync && !out.busy && !out.command_aborted, "{out:?}");
-        fsm.follow(Image::Other, 15); // MC_GearOut, or another coupling
-        let out = fsm.finish(false);
-        assert!(out.command_aborted && !out.busy, "shown once: {out:?}");
-        assert_eq!(fsm.finish(false), SawOutputs::default(), "then cleared");
+        // MC_GearOut, or another coupling.
+        let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(5)));
+        assert!(ended && out.command_aborted && !out.busy, "{out:?}");
     }
 
     #[test]
-    fn faults_unseen_couplings_and_a_low_execute_end_the_following() {
-        let mut fsm = accepted();
-        fsm.follow(Image::Faulted(0x4711), 11);
-        let out = fsm.finish(true);
-        assert!(out.error && out.error_id == 0x4711 && !out.busy, "{out:?}");
-
-        let mut fsm = accepted();
-        fsm.timeout_cycles = 3;
-        fsm.follow(Image::Other, 13);
-        assert!(fsm.finish(true).busy, "still waiting for the image");
-        fsm.follow(Image::Other, 14);
+    fn faults_and_unseen_couplings_end_the_following() {
+        let (ended, out) = outputs(follow_gear(
+            &mut { FRESH },
+            Image::Faulted(0x4711),
+            waited(1),
+        ));
         assert!(
-            fsm.finish(true).command_aborted,
-            "never shown: ended unseen"
+            ended && out.error && out.error_id == 0x4711 && out.start_sync,
+            "{out:?}"
         );
-
-        let mut fsm = accepted();
-        fsm.follow(Image::Ours { synchronous: true }, 11);
-        assert!(
-            fsm.finish(false).in_sync,
-            "InSync shown once with Execute low"
-        );
-        assert!(matches!(fsm.phase, GearPhase::Idle));
-        assert_eq!(fsm.finish(false), SawOutputs::default());
-        assert!(!fsm.edge(false) && fsm.edge(true), "a new edge sends again");
+        let mut f = FRESH;
+        let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(3)));
+        assert!(!ended && out.busy, "still waiting for the image");
+        let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(4)));
+        assert!(ended && out.command_aborted, "never shown: ended unseen");
     }
 
     fn io<'a>(

@@ -69,7 +69,7 @@ impl PlcProgram for Sequence {
             }
             3 if self.probe.out.done => {
                 self.log
-                    .push(format!("recorded {:.4}", self.probe.out.recorded_position));
+                    .push(format!("recorded {:.4}", self.probe.out.extra));
                 self.probe.execute = false;
                 self.step = 4;
             }

@@ -12,10 +12,12 @@
 //! ```
 
 use crate::fifo::{
-    FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoOutputs,
-    FifoSetChannelOverride, FifoSetParameters, FifoStart, FifoStop, FifoWrite,
+    FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoSetChannelOverride,
+    FifoSetParameters, FifoStart, FifoStop, FifoWrite,
 };
+use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
+use hli::fifo_calls::FifoReply;
 use hli::fifo_calls::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoParametersCall, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES, FIFO_OVERRIDE_INSTANT,
@@ -209,7 +211,7 @@ impl FifoInstance {
     }
 
     /// One cycle; `axis` is FiFoGroupIntegrate's.
-    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> FifoOutputs {
+    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs<FifoReply> {
         let e = self.execute;
         let i = &*self.inputs;
         let g = i.group;

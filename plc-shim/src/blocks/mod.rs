@@ -27,13 +27,14 @@
 //! FALSE for one cycle first, so every call is a new edge.
 
 use crate::cam::{
-    CamData, CamMultiTable, CamOutputs, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn,
-    McCamOut, McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction,
-    McSetCamOnlineChangeMode, McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
+    CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
+    McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
+    McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
 };
 use crate::cam_compat::{CompatBlock, CompatConfig};
+use crate::kernel::Outputs;
 use crate::motion::{
-    BlockOutputs, McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
+    McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
 use crate::runtime::PlcIo;
 use fifo::{FifoInputs, FifoInstance, FIFO_BLOCKS};
@@ -835,10 +836,10 @@ impl Instances {
             let (out, status) = match &mut inst.block {
                 Block::Power(b) => {
                     b.call(io, axis);
-                    let out = BlockOutputs {
+                    let out = Outputs {
                         error: b.error,
                         error_id: b.error_id,
-                        ..BlockOutputs::default()
+                        ..Outputs::default()
                     };
                     (out, b.status)
                 }
@@ -923,12 +924,12 @@ impl Instances {
                 }
                 Block::Fifo(b) => {
                     let out = b.call(io, axis);
-                    let out = BlockOutputs {
+                    let out = Outputs {
                         done: out.done,
                         busy: out.busy,
                         error: out.error,
                         error_id: out.error_id,
-                        ..BlockOutputs::default()
+                        ..Outputs::default()
                     };
                     (out, false)
                 }
@@ -1045,15 +1046,13 @@ impl Clone for Instances {
 }
 
 /// A cam block's outputs in the motion blocks' shape (InSync is recorded beside them).
-fn cam_outputs(out: CamOutputs) -> BlockOutputs {
-    BlockOutputs {
-        done: out.done,
-        busy: out.busy,
+fn cam_outputs(out: Outputs) -> Outputs {
+    Outputs {
         active: false,
-        command_aborted: out.command_aborted,
-        error: out.error,
-        error_id: out.error_id,
         in_velocity: false,
+        in_sync: false,
+        start_sync: false,
+        ..out
     }
 }
 

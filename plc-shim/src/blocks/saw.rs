@@ -22,10 +22,10 @@
 //! as given: the CNC refuses bits it does not know) or lists of flag names, with or without
 //! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
 
-use crate::motion::BlockOutputs;
+use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
 use crate::saw::{
-    GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics, SawOutputs,
+    GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics,
 };
 use hli::saw_calls::sync_mask;
 use std::sync::Arc;
@@ -295,7 +295,7 @@ impl SawInstance {
 
     /// One cycle for slave `axis`; the outputs in the motion blocks' shape (InSync and
     /// StartSync through [`SawInstance::in_sync`] and [`SawInstance::start_sync`]).
-    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> BlockOutputs {
+    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs {
         let e = self.execute;
         let i = &*self.inputs;
         let out = match &mut self.kind {
@@ -322,18 +322,14 @@ impl SawInstance {
                 b.out
             }
         };
-        BlockOutputs {
-            done: out.done,
-            busy: out.busy,
-            active: out.active,
-            command_aborted: out.command_aborted,
-            error: out.error,
-            error_id: out.error_id,
-            in_velocity: false,
+        Outputs {
+            in_sync: false,
+            start_sync: false,
+            ..out
         }
     }
 
-    fn outputs(&self) -> SawOutputs {
+    fn outputs(&self) -> Outputs {
         match &self.kind {
             Kind::Velo(b) => b.out,
             Kind::Pos(b) => b.out,

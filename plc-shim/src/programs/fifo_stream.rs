@@ -218,7 +218,7 @@ impl FifoStream {
             // Execute was low for this cycle: the next block may go.
             Writing::Lowering => self.writing = Writing::Idle,
             Writing::Sending if out.done => {
-                self.rows_written += u64::from(out.reply.row);
+                self.rows_written += u64::from(out.extra.row);
                 self.blocks += 1;
                 self.taken += self.sending;
                 self.sending = 0;
@@ -275,8 +275,8 @@ impl PlcProgram for FifoStream {
                 if out.error {
                     self.fail(out.error_id);
                 } else if out.done {
-                    self.dimension = out.reply.dimension;
-                    self.capacity = out.reply.capacity;
+                    self.dimension = out.extra.dimension;
+                    self.capacity = out.extra.capacity;
                     if self.feeder.columns() != self.dimension as usize {
                         self.fail(FifoError::Columns.raw());
                     } else {

@@ -1,0 +1,464 @@
+//! One table of blocks, every family, run through the same Execute, refusal, timeout and
+//! restart cases against a stand-in CNC in this thread (an acyclic server polled by hand).
+
+use super::{Outputs, DEFAULT_TIMEOUT_CYCLES, ERROR_NO_ANSWER};
+use crate::cam::{
+    CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
+    McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
+    McWriteMotionFunction, McWriteMotionFunctionPoint,
+};
+use crate::cam_compat::{CompatBlock, CompatConfig};
+use crate::dyn_cs::McDynCsTransition;
+use crate::fifo::{FifoGetDimension, FifoStart, FifoWrite};
+use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop};
+use crate::probe::{McAbortTrigger, McTouchProbe};
+use crate::runtime::PlcIo;
+use crate::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
+use hli::calls::ErrorCode;
+use hli::fifo_calls::{FifoDimensionCall, FifoReply, FifoStartCall};
+use hli::rpc::{AcyclicClient, AcyclicServer};
+use hli::views::PlcView;
+use std::sync::Arc;
+
+/// What every block shows, whatever its extras.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Seen {
+    done: bool,
+    busy: bool,
+    aborted: bool,
+    error: bool,
+    error_id: u32,
+}
+
+fn seen<X>(o: Outputs<X>) -> Seen {
+    Seen {
+        done: o.done,
+        busy: o.busy,
+        aborted: o.command_aborted,
+        error: o.error,
+        error_id: o.error_id,
+    }
+}
+
+/// A block under test: one cycle with this Execute, its outputs.
+type Cycle = Box<dyn FnMut(&mut PlcIo<'_>, bool) -> Seen>;
+
+macro_rules! block {
+    ($block:expr, |$b:ident, $io:ident| $call:expr) => {
+        block!($block, |_b| (), |$b, $io| $call)
+    };
+    ($block:expr, |$s:ident| $setup:expr, |$b:ident, $io:ident| $call:expr) => {{
+        let mut $b = $block;
+        let $s = &mut $b;
+        $setup;
+        Box::new(move |$io: &mut PlcIo<'_>, execute: bool| {
+            $b.execute = execute;
+            $call;
+            seen($b.out)
+        }) as Cycle
+    }};
+}
+
+/// Every Execute-driven block, addressed at axis 1, table 1 or FIFO group 0.
+fn blocks() -> Vec<(&'static str, Cycle)> {
+    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
+    let points = Arc::from(vec![hli::calls::McMotionFunctionPoint::default(); 6]);
+    let compat = |kind: &'static str| {
+        let mut c = CompatConfig::new(kind);
+        c.table = 1;
+        c.rows = Some(Arc::clone(&rows));
+        CompatBlock::new(Arc::new(c))
+    };
+    vec![
+        (
+            "MC_Reset",
+            block!(McReset::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_MoveAbsolute",
+            block!(McMoveAbsolute::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_MoveVelocity",
+            block!(McMoveVelocity::default(), |b, io| b.call(io, 1)),
+        ),
+        ("MC_Halt", block!(McHalt::default(), |b, io| b.call(io, 1))),
+        (
+            "MC_SetPosition",
+            block!(McSetPosition::default(), |b, io| b.call(io, 1)),
+        ),
+        ("MC_Stop", block!(McStop::default(), |b, io| b.call(io, 1))),
+        (
+            "MC_TouchProbe",
+            block!(McTouchProbe::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_AbortTrigger",
+            block!(McAbortTrigger::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_CamIn",
+            block!(
+                McCamIn::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io, 1)
+            ),
+        ),
+        (
+            "MC_CamOut",
+            block!(McCamOut::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_CamScaling",
+            block!(McCamScaling::default(), |b, io| b.call(io, 1)),
+        ),
+        (
+            "MC_CamTableSelect",
+            block!(
+                McCamTableSelect::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_CamTableSelect+rows",
+            block!(
+                McCamTableSelect::default(),
+                |s| {
+                    s.table = 1;
+                    s.data = CamData::Rows {
+                        rows: Arc::clone(&rows),
+                        table_type: 0,
+                        interpolation: 0,
+                    };
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_WriteMotionFunction",
+            block!(
+                McWriteMotionFunction::default(),
+                |s| {
+                    s.table = 1;
+                    s.points = CamData::Points(points);
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_WriteMotionFunctionPoint",
+            block!(
+                McWriteMotionFunctionPoint::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_SetCamOnlineChangeMode",
+            block!(
+                McSetCamOnlineChangeMode::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_CamInfo",
+            block!(
+                McCamRead::new(hli::calls::CAM_READ_INFO, 64),
+                |s| {
+                    s.target = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_ReadMotionFunction",
+            block!(
+                McReadMotionFunction::new(8),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "CamTableSetWeight",
+            block!(
+                CamTableSetWeight::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "CamTableCoupleAxesMultiTables",
+            block!(CamTableCoupleAxesMultiTables::default(), |b, io| b
+                .call(io, 1)),
+        ),
+        (
+            "CamTableEnableCorrectionTable",
+            block!(
+                CamMultiTable::default(),
+                |s| {
+                    s.table = 1;
+                },
+                |b, io| b.call(io, 1)
+            ),
+        ),
+        (
+            "CamTableGenerate",
+            block!(compat("CamTableGenerate"), |b, io| b.call(io, 1)),
+        ),
+        (
+            "CamTableCreate",
+            block!(compat("CamTableCreate"), |b, io| b.call(io, 1)),
+        ),
+        (
+            "CamTableReadData",
+            block!(compat("CamTableReadData"), |b, io| b.call(io, 1)),
+        ),
+        (
+            "CamTableCoupleAxes",
+            block!(compat("CamTableCoupleAxes"), |b, io| b.call(io, 1)),
+        ),
+        (
+            "CamTableOffsetChange",
+            block!(compat("CamTableOffsetChange"), |b, io| b.call(io, 1)),
+        ),
+        ("FiFoGetDimension", fifo_get_dimension()),
+        ("FiFoStart", fifo_start()),
+        ("FiFoWrite", fifo_write()),
+        (
+            "MC_GearInVelo",
+            block!(
+                McGearInVelo::default(),
+                |s| {
+                    s.slave = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_GearInPos",
+            block!(
+                McGearInPos::default(),
+                |s| {
+                    s.slave = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_GearOut",
+            block!(
+                McGearOut::default(),
+                |s| {
+                    s.slave = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+        (
+            "MC_ReadFlyingSawCharacteristics",
+            block!(
+                McReadFlyingSawCharacteristics::default(),
+                |s| {
+                    s.slave = 1;
+                },
+                |b, io| b.call(io)
+            ),
+        ),
+    ]
+}
+
+fn fifo_get_dimension() -> Cycle {
+    let mut b = FifoGetDimension::default();
+    Box::new(move |io: &mut PlcIo<'_>, execute| {
+        seen(b.cycle(io, execute, 0, FifoDimensionCall::default))
+    })
+}
+
+fn fifo_start() -> Cycle {
+    let mut b = FifoStart::default();
+    Box::new(move |io: &mut PlcIo<'_>, execute| {
+        seen(b.cycle(io, execute, 0, FifoStartCall::default))
+    })
+}
+
+fn fifo_write() -> Cycle {
+    let mut b = FifoWrite::default();
+    let data = [1.0; 6];
+    Box::new(move |io: &mut PlcIo<'_>, execute| seen(b.cycle(io, execute, 0, &data, 2, 3)))
+}
+
+/// The stand-in CNC of one case: an image with one channel and two axes, a server that
+/// answers when told to, and a client for the blocks.
+struct Cnc {
+    memory: hli::ImageMemory,
+    server: AcyclicServer,
+    client: AcyclicClient,
+    cycle: u64,
+}
+
+impl Cnc {
+    fn new(case: &str, block: &str) -> Cnc {
+        let name: String = block.chars().filter(char::is_ascii_alphanumeric).collect();
+        let instance = format!("kernel-{case}-{name}-{}", std::process::id());
+        Cnc {
+            memory: hli::segment::heap_image(1, 2),
+            server: AcyclicServer::open(&instance).unwrap(),
+            client: AcyclicClient::open(&instance).unwrap(),
+            cycle: 0,
+        }
+    }
+
+    /// One PLC cycle of `block`.
+    fn run(&mut self, block: &mut Cycle, execute: bool) -> Seen {
+        self.cycle += 1;
+        let mut io = PlcIo {
+            view: PlcView::new(&self.memory),
+            memory: &self.memory,
+            acyclic: &mut self.client,
+            cycle: self.cycle,
+        };
+        block(&mut io, execute)
+    }
+
+    /// Refuses every call and row block on its way; how many.
+    fn refuse(&self) -> usize {
+        let calls = self
+            .server
+            .poll(|_, _| Err(ErrorCode::InvalidData))
+            .unwrap();
+        let rows = self.server.poll_rows(|_, _| FifoReply {
+            error_id: ErrorCode::InvalidData.raw(),
+            ..FifoReply::default()
+        });
+        calls + rows.unwrap()
+    }
+
+    /// Cycles with `execute` until the block stops being Busy (refusing what comes); the
+    /// outputs then.
+    fn until_answered(&mut self, block: &mut Cycle, execute: bool) -> Seen {
+        for _ in 0..10_000 {
+            self.refuse();
+            let out = self.run(block, execute);
+            if !out.busy {
+                return out;
+            }
+            std::thread::yield_now();
+        }
+        panic!("watchdog: the block never left Busy");
+    }
+}
+
+const REFUSED: Seen = Seen {
+    done: false,
+    busy: false,
+    aborted: false,
+    error: true,
+    error_id: 0x706,
+};
+
+#[test]
+fn a_refusal_holds_while_execute_stays_true_and_clears_when_it_falls() {
+    for (name, mut block) in blocks() {
+        let mut cnc = Cnc::new("held", name);
+        let first = cnc.run(&mut block, true);
+        assert!(
+            first.busy && !first.error,
+            "{name}: Busy from the edge: {first:?}"
+        );
+        assert_eq!(cnc.until_answered(&mut block, true), REFUSED, "{name}");
+        assert_eq!(cnc.run(&mut block, true), REFUSED, "{name}: held");
+        let fell = cnc.run(&mut block, false);
+        assert_eq!(
+            fell,
+            Seen::default(),
+            "{name}: cleared with the falling edge"
+        );
+    }
+}
+
+#[test]
+fn a_short_pulse_shows_its_result_for_one_cycle() {
+    for (name, mut block) in blocks() {
+        let mut cnc = Cnc::new("pulse", name);
+        cnc.run(&mut block, true);
+        assert!(
+            cnc.run(&mut block, false).busy,
+            "{name}: still Busy after the pulse"
+        );
+        assert_eq!(cnc.until_answered(&mut block, false), REFUSED, "{name}");
+        assert_eq!(
+            cnc.run(&mut block, false),
+            Seen::default(),
+            "{name}: shown once"
+        );
+    }
+}
+
+#[test]
+fn no_answer_is_an_error_after_the_timeout() {
+    for (name, mut block) in blocks() {
+        let mut cnc = Cnc::new("timeout", name);
+        for _ in 0..=DEFAULT_TIMEOUT_CYCLES {
+            let out = cnc.run(&mut block, true);
+            assert!(out.busy, "{name}: Busy while waiting: {out:?}");
+        }
+        let out = cnc.run(&mut block, true);
+        assert!(
+            out.error && out.error_id == ERROR_NO_ANSWER,
+            "{name}: {out:?}"
+        );
+    }
+}
+
+#[test]
+fn a_rising_edge_while_busy_sends_the_new_command() {
+    for (name, mut block) in blocks() {
+        let mut cnc = Cnc::new("restart", name);
+        cnc.run(&mut block, true);
+        cnc.run(&mut block, false);
+        cnc.run(&mut block, true);
+        let mut sent = 0;
+        for _ in 0..10_000 {
+            sent += cnc.refuse();
+            if sent >= 3 || (sent == 2 && name != "MC_Stop") {
+                break;
+            }
+            std::thread::yield_now();
+        }
+        // MC_Stop also releases its lock when Execute falls.
+        let expected = if name == "MC_Stop" { 3 } else { 2 };
+        assert_eq!(sent, expected, "{name}: both commands went out");
+        assert_eq!(cnc.until_answered(&mut block, true), REFUSED, "{name}");
+    }
+}
+
+#[test]
+fn a_dyn_cs_transition_nobody_takes_times_out() {
+    let mut cnc = Cnc::new("timeout", "dyncs");
+    let mut b = McDynCsTransition::default();
+    let mut block: Cycle = Box::new(move |io: &mut PlcIo<'_>, execute| {
+        b.execute = execute;
+        b.call(io, 0);
+        seen(b.out)
+    });
+    for _ in 0..=DEFAULT_TIMEOUT_CYCLES {
+        let out = cnc.run(&mut block, true);
+        assert!(out.busy, "written, then waiting: {out:?}");
+    }
+    let out = cnc.run(&mut block, true);
+    assert!(out.error && out.error_id == ERROR_NO_ANSWER, "{out:?}");
+}
