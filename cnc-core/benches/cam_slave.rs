@@ -15,7 +15,9 @@ use cnc_core::cam::{
 };
 use cnc_core::machine::cams::CamEngine;
 use cnc_core::machine::{Engine, Machine, MachineSetup};
-use hli::calls::{AcyclicCall, AxisCommandCall, CamInCall, CamTableSelectCall};
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::cam::{CamInCall, CamTableSelectCall};
+use hli::calls::AcyclicCall;
 use hli::views::CncView;
 use hli::wire::{encode_body, AcyclicRequest};
 use hli::ImageMemory;

@@ -5,8 +5,10 @@ use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode, DriveProtocol, Pr
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
-use hli::rpc::{AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind, ACYCLIC_BODY_SIZE};
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::calls::CallKind;
 use hli::views::CncView;
+use hli::wire::{AcyclicRequest, ACYCLIC_BODY_SIZE};
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -91,7 +93,7 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
     for round in 0..20 {
         for (n, call) in calls.iter().enumerate() {
             for axis in 0..32u32 {
-                let arm = hli::probe_calls::ProbeArmCall {
+                let arm = hli::calls::probe::ProbeArmCall {
                     probe: 1 + axis % 2,
                     edge: 1,
                     ..Default::default()
@@ -99,7 +101,7 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
                 let (body, _) = set
                     .handle_probe(&request_of(CallKind::ProbeArm, axis, &arm), true)
                     .unwrap();
-                let reply: hli::probe_calls::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
+                let reply: hli::calls::probe::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
                 armed += u32::from(reply.error_id == 0);
                 let (body, _) = set.handle_command(&request(axis, call)).unwrap();
                 let reply: AxisCommandReply = bytemuck::pod_read_unaligned(&body[..8]);

@@ -77,7 +77,8 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
 #[test]
 fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     use cnc_core::app::scenario::{InProcess, Scenario};
-    use hli::calls::{AcyclicCall, CamScalingCall};
+    use hli::calls::cam::CamScalingCall;
+    use hli::calls::AcyclicCall;
     use hli::enums::AxisState;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/cam-conveyor/scenario.toml");
@@ -125,10 +126,11 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
             };
             let view = hli::views::CncView::new(&run.memory);
             let (reply, len) = run.machine.dispatch(&view, kind, &request).unwrap();
-            let reply: hli::calls::CamReply = bytemuck::pod_read_unaligned(&reply[..len as usize]);
+            let reply: hli::calls::cam::CamReply =
+                bytemuck::pod_read_unaligned(&reply[..len as usize]);
             assert_eq!(reply.error_id, 0);
         };
-    let mode = hli::calls::CamOnlineModeCall {
+    let mode = hli::calls::cam::CamOnlineModeCall {
         activation_mode: 3,
         ..Default::default()
     };
@@ -138,8 +140,8 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         1,
         hli::wire::encode_body(&mode),
     );
-    let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
-    points[0] = hli::calls::McMotionFunctionPoint {
+    let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
+    points[0] = hli::calls::cam::McMotionFunctionPoint {
         point_index: 4,
         function_type: 15,
         point_type: 2,
@@ -148,10 +150,10 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         slave_pos: 30.0,
         ..Default::default()
     };
-    let write = hli::calls::CamPointsWriteCall {
+    let write = hli::calls::cam::CamPointsWriteCall {
         first: 4,
         count: 1,
-        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
         total: 1,
         points,
     };

@@ -5,13 +5,14 @@
 //! ending the job.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::{AcyclicCall, AxisCommandCall};
-use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
-use hli::fifo_calls::{
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall,
     FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
 };
+use hli::calls::AcyclicCall;
+use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 use hli::views::{CncView, PlcView};
 

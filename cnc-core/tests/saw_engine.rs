@@ -7,13 +7,13 @@
 use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw;
-use hli::calls::AxisCommandCall;
-use hli::enums::{AxisError, AxisState, CouplingState, SawError};
-use hli::layout::HliAxisLrState;
-use hli::saw_calls::{
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SAW_ON_POSITION, SAW_ON_VELOCITY,
     SYNC_TIME_BASED,
 };
+use hli::enums::{AxisError, AxisState, CouplingState, SawError};
+use hli::layout::HliAxisLrState;
 use hli::views::{CncView, PlcView};
 
 const TICK: f64 = 0.001;

@@ -3,9 +3,9 @@
 //! plan made inside the tick when the master comes forward again.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::AxisCommandCall;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{sync_mask, SawGearInCall, SAW_ON_VELOCITY};
 use hli::enums::AxisState;
-use hli::saw_calls::{sync_mask, SawGearInCall, SAW_ON_VELOCITY};
 use hli::views::{CncView, PlcView};
 
 #[path = "../../tests/support/counting_alloc.rs"]

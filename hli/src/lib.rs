@@ -7,9 +7,10 @@
 //! * [`segment`]: the shared-memory object (create, attach, validate, heartbeats);
 //! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
 //!   PLC's side of an image;
-//! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (kinds,
-//!   bodies, codes), [`fifo_calls`] (the FIFO group's calls and row blocks), [`rpc`] (the
-//!   iceoryx2 request-response transports; re-exports all three);
+//! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (what
+//!   every call has in common, the kinds, the refusal codes; one module per family of
+//!   calls: [`calls::cam`], [`calls::fifo`] ...), [`rpc`] (the iceoryx2 request-response
+//!   transports);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
@@ -32,8 +33,6 @@ pub mod units;
 pub mod views;
 pub mod wire;
 
-// The families' old addresses, until their users move.
-pub use calls::{diag as diag_calls, fifo as fifo_calls, probe as probe_calls, saw as saw_calls};
 pub use desc::{Bool, HliType, PlaceExt, SymbolWriter};
 pub use raw::{ImageMemory, Place};
 

@@ -8,9 +8,8 @@
 //! then queued in the CNC).
 
 use crate::runtime::PlcIo;
-use hli::calls::{
-    AcyclicCall, CallError, CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall,
-};
+use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall};
+use hli::calls::{AcyclicCall, CallError};
 use hli::enums::{AxisState, CouplingState};
 use hli::rpc::PendingCall;
 
@@ -457,21 +456,21 @@ pub struct McWriteMotionFunctionPoint {
     /// Input: the table ID.
     pub table: u32,
     /// Input: the point.
-    pub point: hli::calls::McMotionFunctionPoint,
+    pub point: hli::calls::cam::McMotionFunctionPoint,
     /// Outputs of the last call.
     pub out: CamOutputs,
-    core: CamCore<hli::calls::CamPointsWriteCall>,
+    core: CamCore<hli::calls::cam::CamPointsWriteCall>,
 }
 
 impl McWriteMotionFunctionPoint {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
+        let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
         points[0] = self.point;
-        let call = hli::calls::CamPointsWriteCall {
+        let call = hli::calls::cam::CamPointsWriteCall {
             first: self.point.point_index,
             count: 1,
-            flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
             total: 1,
             points,
         };
@@ -497,13 +496,13 @@ pub struct McSetCamOnlineChangeMode {
     pub slave_scaling_mode: u32,
     /// Outputs of the last call.
     pub out: CamOutputs,
-    core: CamCore<hli::calls::CamOnlineModeCall>,
+    core: CamCore<hli::calls::cam::CamOnlineModeCall>,
 }
 
 impl McSetCamOnlineChangeMode {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamOnlineModeCall {
+        let call = hli::calls::cam::CamOnlineModeCall {
             activation_mode: self.activation_mode,
             master_scaling_mode: self.master_scaling_mode,
             slave_scaling_mode: self.slave_scaling_mode,
@@ -531,12 +530,12 @@ pub enum CamData {
         interpolation: u32,
     },
     /// Motion-function points.
-    Points(std::sync::Arc<[hli::calls::McMotionFunctionPoint]>),
+    Points(std::sync::Arc<[hli::calls::cam::McMotionFunctionPoint]>),
 }
 
 enum Pending {
-    Rows(PendingCall<hli::calls::CamRowsWriteCall>),
-    Points(PendingCall<hli::calls::CamPointsWriteCall>),
+    Rows(PendingCall<hli::calls::cam::CamRowsWriteCall>),
+    Points(PendingCall<hli::calls::cam::CamPointsWriteCall>),
 }
 
 /// Sends [`CamData`] chunk by chunk, one per cycle at most (a PLC cycle never waits).
@@ -620,21 +619,21 @@ impl Chunker {
                 table_type,
                 interpolation,
             } => {
-                let per = hli::calls::CAM_ROWS_PER_CALL;
+                let per = hli::calls::cam::CAM_ROWS_PER_CALL;
                 if self.next >= rows.len() {
                     self.done = true;
                     return Transfer::Done;
                 }
                 let chunk = &rows[self.next..(self.next + per).min(rows.len())];
-                let mut call = hli::calls::CamRowsWriteCall {
+                let mut call = hli::calls::cam::CamRowsWriteCall {
                     first_row: self.next as u32,
                     count: chunk.len() as u32,
                     flags: (if self.next + chunk.len() == rows.len() {
-                        hli::calls::CAM_CHUNK_LAST
+                        hli::calls::cam::CAM_CHUNK_LAST
                     } else {
                         0
                     }) | if self.next == 0 {
-                        hli::calls::CAM_CHUNK_FIRST
+                        hli::calls::cam::CAM_CHUNK_FIRST
                     } else {
                         0
                     },
@@ -649,25 +648,25 @@ impl Chunker {
                 io.acyclic.start(table, &call).map(Pending::Rows)
             }
             CamData::Points(points) => {
-                let per = hli::calls::CAM_POINTS_PER_CALL;
+                let per = hli::calls::cam::CAM_POINTS_PER_CALL;
                 if self.next >= points.len() {
                     self.done = true;
                     return Transfer::Done;
                 }
                 let chunk = &points[self.next..(self.next + per).min(points.len())];
-                let mut call = hli::calls::CamPointsWriteCall {
+                let mut call = hli::calls::cam::CamPointsWriteCall {
                     first: chunk[0].point_index,
                     count: chunk.len() as u32,
                     flags: (if self.next + chunk.len() == points.len() {
-                        hli::calls::CAM_CHUNK_LAST
+                        hli::calls::cam::CAM_CHUNK_LAST
                     } else {
                         0
                     }) | if create {
-                        hli::calls::CAM_POINTS_CREATE
+                        hli::calls::cam::CAM_POINTS_CREATE
                     } else {
                         0
                     } | if self.next == 0 {
-                        hli::calls::CAM_CHUNK_FIRST
+                        hli::calls::cam::CAM_CHUNK_FIRST
                     } else {
                         0
                     },
@@ -736,7 +735,7 @@ pub struct McCamRead {
     /// Input: a rising edge starts the read.
     pub execute: bool,
     /// What is read and its parameters (the target is set by [`McCamRead::target`]).
-    pub request: hli::calls::CamReadCall,
+    pub request: hli::calls::cam::CamReadCall,
     /// Table ID, or the slave axis of MC_CamInfo.
     pub target: u32,
     /// Output: the numbers read.
@@ -746,7 +745,7 @@ pub struct McCamRead {
     /// Outputs of the last call.
     pub out: CamOutputs,
     execute_before: bool,
-    pending: Option<PendingCall<hli::calls::CamReadCall>>,
+    pending: Option<PendingCall<hli::calls::cam::CamReadCall>>,
     part: u32,
 }
 
@@ -758,7 +757,7 @@ impl McCamRead {
     pub fn new(what: u32, room: usize) -> McCamRead {
         McCamRead {
             execute: false,
-            request: hli::calls::CamReadCall {
+            request: hli::calls::cam::CamReadCall {
                 what,
                 ..Default::default()
             },
@@ -820,7 +819,7 @@ impl McCamRead {
     }
 
     fn send(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamReadCall {
+        let call = hli::calls::cam::CamReadCall {
             part: self.part,
             ..self.request
         };
@@ -845,11 +844,11 @@ pub struct McReadMotionFunction {
     /// Input: points wanted (0: all from `first`).
     pub count: u32,
     /// Output: the points read.
-    pub points: Vec<hli::calls::McMotionFunctionPoint>,
+    pub points: Vec<hli::calls::cam::McMotionFunctionPoint>,
     /// Outputs of the last call.
     pub out: CamOutputs,
     execute_before: bool,
-    pending: Option<PendingCall<hli::calls::CamPointsReadCall>>,
+    pending: Option<PendingCall<hli::calls::cam::CamPointsReadCall>>,
 }
 
 impl McReadMotionFunction {
@@ -915,7 +914,7 @@ impl McReadMotionFunction {
     }
 
     fn send(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamPointsReadCall {
+        let call = hli::calls::cam::CamPointsReadCall {
             first: self.first + self.points.len() as u32,
             count: 0,
         };
@@ -935,10 +934,10 @@ pub struct CamTableSetWeight {
     /// Input: the table ID.
     pub table: u32,
     /// Input: the scaling.
-    pub weight: hli::calls::CamTableWeightCall,
+    pub weight: hli::calls::cam::CamTableWeightCall,
     /// Outputs of the last call.
     pub out: CamOutputs,
-    core: CamCore<hli::calls::CamTableWeightCall>,
+    core: CamCore<hli::calls::cam::CamTableWeightCall>,
 }
 
 impl Default for CamTableSetWeight {
@@ -946,7 +945,7 @@ impl Default for CamTableSetWeight {
         Self {
             execute: false,
             table: 0,
-            weight: hli::calls::CamTableWeightCall {
+            weight: hli::calls::cam::CamTableWeightCall {
                 weight: 1.0,
                 master_slope: 1.0,
                 slave_slope: 1.0,
@@ -987,13 +986,13 @@ pub struct CamTableCoupleAxesMultiTables {
     pub profiles: u32,
     /// Outputs of the last call.
     pub out: CamOutputs,
-    core: CamCore<hli::calls::CamMultiCoupleCall>,
+    core: CamCore<hli::calls::cam::CamMultiCoupleCall>,
 }
 
 impl CamTableCoupleAxesMultiTables {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
-        let call = hli::calls::CamMultiCoupleCall {
+        let call = hli::calls::cam::CamMultiCoupleCall {
             master: self.master,
             on: u32::from(self.on),
             tables: self.count,
@@ -1011,8 +1010,8 @@ impl CamTableCoupleAxesMultiTables {
 pub struct CamMultiTable {
     /// Input: a rising edge sends it.
     pub execute: bool,
-    /// What it does: [`hli::calls::CAM_MULTI_ENABLE_CORRECTION`] or
-    /// [`hli::calls::CAM_MULTI_STOP_CYCLIC`].
+    /// What it does: [`hli::calls::cam::CAM_MULTI_ENABLE_CORRECTION`] or
+    /// [`hli::calls::cam::CAM_MULTI_STOP_CYCLIC`].
     pub op: u32,
     /// Input: the table ID.
     pub table: u32,
@@ -1022,13 +1021,13 @@ pub struct CamMultiTable {
     pub position: f64,
     /// Outputs of the last call.
     pub out: CamOutputs,
-    core: CamCore<hli::calls::CamMultiTableCall>,
+    core: CamCore<hli::calls::cam::CamMultiTableCall>,
 }
 
 impl CamMultiTable {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
-        let call = hli::calls::CamMultiTableCall {
+        let call = hli::calls::cam::CamMultiTableCall {
             op: self.op,
             table: self.table,
             flags: u32::from(self.at_position),

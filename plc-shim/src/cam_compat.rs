@@ -18,7 +18,7 @@
 
 use crate::cam::{rose, CamCore, CamData, CamOutputs, Chunker, McCamRead};
 use crate::runtime::PlcIo;
-use hli::calls::{
+use hli::calls::cam::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,

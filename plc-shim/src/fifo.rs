@@ -16,11 +16,11 @@
 use crate::cam::rose;
 use crate::motion::ERROR_NO_ANSWER;
 use crate::runtime::PlcIo;
-use hli::calls::{AcyclicCall, CallError};
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
 };
+use hli::calls::{AcyclicCall, CallError};
 use hli::rpc::{PendingCall, PendingRows};
 
 /// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).

@@ -8,10 +8,12 @@
 //! Execute already fell.
 
 use crate::runtime::PlcIo;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::CallError;
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
-use hli::rpc::{AxisCommandCall, CallError, PendingCall};
+use hli::rpc::PendingCall;
 use hli::PlaceExt;
 
 /// Error id of a block whose call failed in transport (no CNC answer).
@@ -137,7 +139,7 @@ impl CommandCore {
                     .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
                     .read(),
                 Err(_) => {
-                    self.out = fail(hli::rpc::ErrorCode::InvalidTarget.raw());
+                    self.out = fail(hli::calls::ErrorCode::InvalidTarget.raw());
                     self.phase = Phase::Idle;
                     return self.finish_cycle(execute);
                 }

@@ -5,10 +5,11 @@
 
 use crate::motion::ERROR_NO_ANSWER;
 use crate::runtime::PlcIo;
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall, ProbeReply};
+use hli::calls::CallError;
 use hli::enums::{ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe};
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall, ProbeReply};
-use hli::rpc::{CallError, PendingCall};
+use hli::rpc::PendingCall;
 use hli::PlaceExt;
 
 /// Outputs of the probe blocks.
@@ -217,9 +218,9 @@ impl McTouchProbe {
                         command_aborted: true,
                         ..ProbeOutputs::default()
                     },
-                    Err(_) => failed(hli::rpc::ErrorCode::InvalidData.raw()),
+                    Err(_) => failed(hli::calls::ErrorCode::InvalidData.raw()),
                 },
-                None => failed(hli::rpc::ErrorCode::InvalidTarget.raw()),
+                None => failed(hli::calls::ErrorCode::InvalidTarget.raw()),
             };
             if !self.out.busy {
                 self.core.phase = Phase::Idle;

@@ -23,14 +23,14 @@ use crate::cam::rose;
 use crate::fifo::DEFAULT_TIMEOUT_CYCLES;
 use crate::motion::ERROR_NO_ANSWER;
 use crate::runtime::PlcIo;
+use hli::calls::saw::{
+    SawCharacCall, SawGearInCall, SawGearOutCall, SAW_CHARAC_PART, SAW_ON_POSITION,
+    SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
+};
 use hli::calls::{AcyclicCall, CallError};
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
 use hli::rpc::PendingCall;
-use hli::saw_calls::{
-    SawCharacCall, SawGearInCall, SawGearOutCall, SAW_CHARAC_PART, SAW_ON_POSITION,
-    SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
-};
 
 /// Version of this block library (like the FIFO library's version function).
 pub fn saw_library_version() -> &'static str {
@@ -74,7 +74,7 @@ pub const CHARAC_FIELDS: [&str; 31] = [
 ];
 
 /// `ST_SyncMode`: the profile kind and the check and operation flags as one bit mask
-/// ([`hli::saw_calls::sync_mask`]); the CNC refuses bits it does not know.
+/// ([`hli::calls::saw::sync_mask`]); the CNC refuses bits it does not know.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SyncMode {
     /// GEARINSYNCMODE_TIMEBASED (MC_GearInVelo only) rather than position-based.
@@ -716,10 +716,10 @@ impl McReadFlyingSawCharacteristics {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hli::calls::saw::{SawCharacReply, SawReply};
     use hli::calls::{decode_body, reply, CallKind, ErrorCode};
     use hli::layout::HliAxis;
     use hli::rpc::{AcyclicClient, AcyclicServer};
-    use hli::saw_calls::{SawCharacReply, SawReply};
     use hli::views::{CncView, PlcView};
     use hli::PlaceExt;
 

@@ -121,7 +121,7 @@ pub fn serve_axes_in_lockstep(
     build: impl FnOnce() -> cnc_core::axis::AxisSet + Send + 'static,
     finished: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<bool> {
-    use hli::rpc::CallKind;
+    use hli::calls::CallKind;
     let segment = hli::segment::CncSegment::create(instance, 1, axes).unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();

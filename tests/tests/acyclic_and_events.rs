@@ -1,12 +1,12 @@
 //! The acyclic request-response plumbing and the wake-up events, between two threads of one
 //! process (the transport is the same iceoryx2 IPC service the processes use).
 
+use hli::calls::axis::ReadAxisState;
+use hli::calls::{AcyclicCall, CallError, CallKind, ErrorCode};
 use hli::enums::AxisState;
 use hli::events::{EventLink, Side};
 use hli::layout::{HliAxis, HliAxisLrState};
-use hli::rpc::{
-    AcyclicCall, AcyclicClient, AcyclicServer, CallError, CallKind, ErrorCode, ReadAxisState,
-};
+use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::segment::CncSegment;
 use hli::views::handle_read_axis_state;
 use hli::views::CncView;

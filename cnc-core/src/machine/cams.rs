@@ -30,17 +30,17 @@ use crate::cam::{
     CamProfile, Interpolation, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor,
     TableErrorCode, TableType,
 };
-use hli::calls::{
-    decode_body, reply, CallKind, CamInCall, CamMultiCoupleCall, CamMultiTableCall,
-    CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
-    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
-    CamTableSelectCall, CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult,
+use hli::calls::cam::{
+    CamInCall, CamMultiCoupleCall, CamMultiTableCall, CamOnlineModeCall, CamOutCall,
+    CamPointsReadCall, CamPointsReply, CamPointsWriteCall, CamReadCall, CamReply, CamRowsWriteCall,
+    CamScalingCall, CamTableDeleteCall, CamTableSelectCall, CamTableWeightCall, CamValuesReply,
     McMotionFunctionPoint, CAM_CHUNK_FIRST, CAM_CHUNK_LAST, CAM_KEEP_MASTER_OFFSET,
     CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL,
     CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS,
     CAM_READ_VALUES, CAM_ROWS_DECLARE, CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
 };
+use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
 

@@ -23,12 +23,13 @@ use crate::axis::{AxisSet, Coupling};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
 };
-use hli::calls::{decode_body, reply, AxisCommandCall, CallKind, HandlerResult};
-use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
-use hli::fifo_calls::{
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoParametersCall, FifoReply, FifoRowsHeader,
     FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
 };
+use hli::calls::{decode_body, reply, CallKind, HandlerResult};
+use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{
     HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
     FIFO_OVERRIDE_FULL, HLI_MAX_FIFO_GROUPS,

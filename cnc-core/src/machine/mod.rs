@@ -35,12 +35,10 @@ use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
 use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
-use hli::calls::{
-    decode_body, reply, AcyclicCall, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode,
-    HandlerResult,
-};
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::calls::fifo::{FifoReply, FifoRowsHeader};
+use hli::calls::{decode_body, reply, AcyclicCall, CallKind, ErrorCode, HandlerResult};
 use hli::enums::DynCsState;
-use hli::fifo_calls::{FifoReply, FifoRowsHeader};
 use hli::layout::HLI_MAX_AXES;
 use hli::views::{handle_read_axis_state, CncView};
 use hli::wire::AcyclicRequest;
@@ -247,7 +245,7 @@ impl Machine {
                 .axis(request.target as usize)
                 .map(|a| 256u32.wrapping_sub(a.config().id));
             if id.is_some_and(|id| self.engines.iter().any(|e| e.holds_table(id))) {
-                return reply(&hli::saw_calls::SawReply {
+                return reply(&hli::calls::saw::SawReply {
                     error_id: hli::enums::SawError::TableInUse.raw(),
                     reserved: 0,
                 });

@@ -11,12 +11,12 @@ use super::engine::{Engine, EngineIo};
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
-use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
-use hli::enums::{AxisState, CouplingState, SawError};
-use hli::saw_calls::{
+use hli::calls::saw::{
     SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SAW_CHARAC_PART,
     SAW_ON_POSITION, SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
 };
+use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
+use hli::enums::{AxisState, CouplingState, SawError};
 use hli::wire::AcyclicRequest;
 
 #[derive(Debug, Clone, Copy)]

@@ -8,8 +8,6 @@ pub mod diag;
 pub mod fifo;
 pub mod probe;
 pub mod saw;
-pub use axis::*;
-pub use cam::*;
 
 use crate::enums::InvalidValue;
 use crate::wire::{encode_body, AcyclicRequest, ACYCLIC_BODY_SIZE};
@@ -80,33 +78,33 @@ pub enum CallKind {
     CamMultiTable,
     /// [`CamTableDeleteCall`].
     CamTableDelete,
-    /// [`crate::fifo_calls::FifoDimensionCall`].
+    /// [`crate::calls::fifo::FifoDimensionCall`].
     FifoDimension,
-    /// [`crate::fifo_calls::FifoIntegrateCall`].
+    /// [`crate::calls::fifo::FifoIntegrateCall`].
     FifoIntegrate,
-    /// [`crate::fifo_calls::FifoDisintegrateCall`].
+    /// [`crate::calls::fifo::FifoDisintegrateCall`].
     FifoDisintegrate,
-    /// [`crate::fifo_calls::FifoStartCall`].
+    /// [`crate::calls::fifo::FifoStartCall`].
     FifoStart,
-    /// [`crate::fifo_calls::FifoStopCall`].
+    /// [`crate::calls::fifo::FifoStopCall`].
     FifoStop,
-    /// [`crate::fifo_calls::FifoOverrideCall`].
+    /// [`crate::calls::fifo::FifoOverrideCall`].
     FifoOverride,
-    /// [`crate::fifo_calls::FifoParametersCall`].
+    /// [`crate::calls::fifo::FifoParametersCall`].
     FifoParameters,
-    /// [`crate::saw_calls::SawGearInCall`].
+    /// [`crate::calls::saw::SawGearInCall`].
     SawGearIn,
-    /// [`crate::saw_calls::SawGearOutCall`].
+    /// [`crate::calls::saw::SawGearOutCall`].
     SawGearOut,
-    /// [`crate::saw_calls::SawCharacCall`].
+    /// [`crate::calls::saw::SawCharacCall`].
     SawCharac,
-    /// [`crate::probe_calls::ProbeArmCall`].
+    /// [`crate::calls::probe::ProbeArmCall`].
     ProbeArm,
-    /// [`crate::probe_calls::ProbeAbortCall`].
+    /// [`crate::calls::probe::ProbeAbortCall`].
     ProbeAbort,
-    /// [`crate::diag_calls::DynCsHistoryReadCall`].
+    /// [`crate::calls::diag::DynCsHistoryReadCall`].
     DynCsHistoryRead,
-    /// [`crate::diag_calls::DynCsLogReadCall`].
+    /// [`crate::calls::diag::DynCsLogReadCall`].
     DynCsLogRead,
 }
 

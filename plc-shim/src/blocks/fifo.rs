@@ -16,7 +16,7 @@ use crate::fifo::{
     FifoSetChannelOverride, FifoSetParameters, FifoStart, FifoStop, FifoWrite,
 };
 use crate::runtime::PlcIo;
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoParametersCall, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES, FIFO_OVERRIDE_INSTANT,
     FIFO_OVERRIDE_PT2,
