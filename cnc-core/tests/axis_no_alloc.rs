@@ -15,7 +15,7 @@ mod counting_alloc;
 use counting_alloc::allocations;
 
 fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {
-    request_of(CallKind::AxisCommand, target, call)
+    request_of(CallKind::AXIS_COMMAND, target, call)
 }
 
 fn request_of<T: bytemuck::Pod>(kind: CallKind, target: u32, call: &T) -> AcyclicRequest {
@@ -99,7 +99,7 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
                     ..Default::default()
                 };
                 let (body, _) = set
-                    .handle_probe(&request_of(CallKind::ProbeArm, axis, &arm), true)
+                    .handle_probe(&request_of(CallKind::PROBE_ARM, axis, &arm), true)
                     .unwrap();
                 let reply: hli::calls::probe::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
                 armed += u32::from(reply.error_id == 0);

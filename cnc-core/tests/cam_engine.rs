@@ -95,14 +95,14 @@ fn run_master(run: &mut InProcess, velocity: f64) {
     let (body, body_len) = encode_body(&command);
     let request = AcyclicRequest {
         invoke_id: 2,
-        kind: CallKind::AxisCommand.raw(),
+        kind: CallKind::AXIS_COMMAND.raw(),
         target: MASTER as u32,
         body_len,
         body,
     };
     let view = CncView::new(&run.memory);
     run.machine
-        .dispatch(&view, CallKind::AxisCommand, &request)
+        .dispatch(&view, CallKind::AXIS_COMMAND, &request)
         .unwrap();
 }
 

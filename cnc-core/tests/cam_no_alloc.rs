@@ -136,7 +136,7 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     };
     send(
         &mut run,
-        hli::calls::CallKind::CamOnlineMode,
+        hli::calls::CallKind::CAM_ONLINE_MODE,
         1,
         hli::wire::encode_body(&mode),
     );
@@ -159,7 +159,7 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     };
     send(
         &mut run,
-        hli::calls::CallKind::CamPointsWrite,
+        hli::calls::CallKind::CAM_POINTS_WRITE,
         1,
         hli::wire::encode_body(&write),
     );

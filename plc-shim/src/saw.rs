@@ -899,7 +899,7 @@ mod tests {
             true
         });
         let answered = server.poll(|kind, request| {
-            assert_eq!((kind, request.target), (CallKind::SawGearIn, 1));
+            assert_eq!((kind, request.target), (CallKind::SAW_GEAR_IN, 1));
             let call: SawGearInCall = decode_body(request)?;
             assert_eq!(
                 (call.target, call.master_sync_position),
@@ -935,7 +935,7 @@ mod tests {
             true
         });
         let answered = server.poll(|kind, _| {
-            assert_eq!(kind, CallKind::SawGearOut);
+            assert_eq!(kind, CallKind::SAW_GEAR_OUT);
             reply(&SawReply::default())
         });
         assert_eq!(answered.unwrap(), 1);

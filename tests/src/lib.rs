@@ -138,10 +138,10 @@ pub fn serve_axes_in_lockstep(
             }
             server
                 .poll(|kind, request| match kind {
-                    CallKind::AxisCommand => axes.handle_command(request),
-                    CallKind::ReadAxisState => hli::views::handle_read_axis_state(&view, request),
-                    CallKind::ProbeArm => axes.handle_probe(request, true),
-                    CallKind::ProbeAbort => axes.handle_probe(request, false),
+                    CallKind::AXIS_COMMAND => axes.handle_command(request),
+                    CallKind::READ_AXIS_STATE => hli::views::handle_read_axis_state(&view, request),
+                    CallKind::PROBE_ARM => axes.handle_probe(request, true),
+                    CallKind::PROBE_ABORT => axes.handle_probe(request, false),
                     _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
                 })
                 .unwrap();

@@ -23,7 +23,7 @@ struct OversizedRead {
     a: u64,
 }
 impl AcyclicCall for OversizedRead {
-    const KIND: CallKind = CallKind::ReadAxisState;
+    const KIND: CallKind = CallKind::READ_AXIS_STATE;
     type Reply = HliAxisLrState;
 }
 
@@ -59,7 +59,7 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
     while !stop.load(Ordering::Acquire) {
         answered += server
             .poll(|kind, request| match kind {
-                CallKind::ReadAxisState => handle_read_axis_state(&view, request),
+                CallKind::READ_AXIS_STATE => handle_read_axis_state(&view, request),
                 _ => Err(ErrorCode::ServiceNotSupported),
             })
             .unwrap();

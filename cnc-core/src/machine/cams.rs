@@ -1474,19 +1474,19 @@ impl Engine for CamEngine {
         self.retired.clear();
         self.retired_changes.clear();
         Some(match kind {
-            CallKind::CamTableSelect => self.table_select(request),
-            CallKind::CamIn => self.cam_in(request, axes),
-            CallKind::CamOut => self.cam_out(request, axes),
-            CallKind::CamScaling => self.cam_scaling(request, axes),
-            CallKind::CamPointsWrite => self.points_write(request, axes),
-            CallKind::CamPointsRead => self.points_read(request),
-            CallKind::CamOnlineMode => self.online_mode(request),
-            CallKind::CamRowsWrite => self.rows_write(request),
-            CallKind::CamRead => self.read(request, axes),
-            CallKind::CamTableWeight => self.table_weight(request),
-            CallKind::CamMultiCouple => self.multi_couple(request, axes),
-            CallKind::CamMultiTable => self.multi_table(request),
-            CallKind::CamTableDelete => self.table_delete(request),
+            CallKind::CAM_TABLE_SELECT => self.table_select(request),
+            CallKind::CAM_IN => self.cam_in(request, axes),
+            CallKind::CAM_OUT => self.cam_out(request, axes),
+            CallKind::CAM_SCALING => self.cam_scaling(request, axes),
+            CallKind::CAM_POINTS_WRITE => self.points_write(request, axes),
+            CallKind::CAM_POINTS_READ => self.points_read(request),
+            CallKind::CAM_ONLINE_MODE => self.online_mode(request),
+            CallKind::CAM_ROWS_WRITE => self.rows_write(request),
+            CallKind::CAM_READ => self.read(request, axes),
+            CallKind::CAM_TABLE_WEIGHT => self.table_weight(request),
+            CallKind::CAM_MULTI_COUPLE => self.multi_couple(request, axes),
+            CallKind::CAM_MULTI_TABLE => self.multi_table(request),
+            CallKind::CAM_TABLE_DELETE => self.table_delete(request),
             _ => return None,
         })
     }

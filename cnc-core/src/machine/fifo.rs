@@ -485,7 +485,7 @@ impl FifoEngine {
             };
         };
         match kind {
-            CallKind::FifoIntegrate => match decode_body::<FifoIntegrateCall>(request) {
+            CallKind::FIFO_INTEGRATE => match decode_body::<FifoIntegrateCall>(request) {
                 Ok(call) => {
                     let axis = call.axis as usize;
                     let reply = group.integrate(call, axes);
@@ -503,14 +503,14 @@ impl FifoEngine {
                 }
                 Err(_) => group.refuse(FifoError::Parameter),
             },
-            CallKind::FifoDisintegrate => group.disintegrate(axes),
-            CallKind::FifoStart => group.start(axes),
-            CallKind::FifoStop => group.stop(),
-            CallKind::FifoOverride => match decode_body(request) {
+            CallKind::FIFO_DISINTEGRATE => group.disintegrate(axes),
+            CallKind::FIFO_START => group.start(axes),
+            CallKind::FIFO_STOP => group.stop(),
+            CallKind::FIFO_OVERRIDE => match decode_body(request) {
                 Ok(call) => group.set_override(call),
                 Err(_) => group.refuse(FifoError::Parameter),
             },
-            CallKind::FifoParameters => match decode_body(request) {
+            CallKind::FIFO_PARAMETERS => match decode_body(request) {
                 Ok(call) => group.set_parameters(call, tick_s),
                 Err(_) => group.refuse(FifoError::Parameter),
             },
@@ -542,13 +542,13 @@ impl Engine for FifoEngine {
     ) -> Option<HandlerResult> {
         let fifo = matches!(
             kind,
-            CallKind::FifoDimension
-                | CallKind::FifoIntegrate
-                | CallKind::FifoDisintegrate
-                | CallKind::FifoStart
-                | CallKind::FifoStop
-                | CallKind::FifoOverride
-                | CallKind::FifoParameters
+            CallKind::FIFO_DIMENSION
+                | CallKind::FIFO_INTEGRATE
+                | CallKind::FIFO_DISINTEGRATE
+                | CallKind::FIFO_START
+                | CallKind::FIFO_STOP
+                | CallKind::FIFO_OVERRIDE
+                | CallKind::FIFO_PARAMETERS
         );
         fifo.then(|| reply(&self.call(kind, request, axes)))
     }

@@ -225,20 +225,10 @@ impl Machine {
         request: &AcyclicRequest,
     ) -> HandlerResult {
         // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
-        let read = matches!(
-            kind,
-            CallKind::ReadAxisState
-                | CallKind::CamRead
-                | CallKind::CamPointsRead
-                | CallKind::FifoDimension
-                | CallKind::SawCharac
-                | CallKind::DynCsHistoryRead
-                | CallKind::DynCsLogRead
-        );
-        if self.stopped && !read {
+        if self.stopped && !kind.is_read_only() {
             return Err(ErrorCode::Busy);
         }
-        if kind == CallKind::SawGearIn {
+        if kind == CallKind::SAW_GEAR_IN {
             // The saw's internal table is 256 - the slave's axis ID (chapter 13).
             let id = self
                 .axes
@@ -257,8 +247,8 @@ impl Machine {
             }
         }
         match kind {
-            CallKind::ReadAxisState => handle_read_axis_state(view, request),
-            CallKind::AxisCommand => {
+            CallKind::READ_AXIS_STATE => handle_read_axis_state(view, request),
+            CallKind::AXIS_COMMAND => {
                 let target = request.target as usize;
                 if target < self.channel_axes() {
                     return reply(&AxisCommandReply {
@@ -271,16 +261,16 @@ impl Machine {
                 }
                 self.axes.handle_command(request)
             }
-            CallKind::ProbeArm => self.axes.handle_probe(request, true),
-            CallKind::ProbeAbort => self.axes.handle_probe(request, false),
-            CallKind::DynCsHistoryRead | CallKind::DynCsLogRead => {
+            CallKind::PROBE_ARM => self.axes.handle_probe(request, true),
+            CallKind::PROBE_ABORT => self.axes.handle_probe(request, false),
+            CallKind::DYN_CS_HISTORY_READ | CallKind::DYN_CS_LOG_READ => {
                 let channel = self
                     .controller
                     .channels()
                     .get(request.target as usize)
                     .ok_or(ErrorCode::InvalidTarget)?;
                 let tracker = channel.tracker();
-                if kind == CallKind::DynCsHistoryRead {
+                if kind == CallKind::DYN_CS_HISTORY_READ {
                     reply(&diag_wire::answer_history(tracker, &decode_body(request)?))
                 } else {
                     reply(&diag_wire::answer_log(tracker, &decode_body(request)?))

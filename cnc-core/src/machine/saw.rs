@@ -241,13 +241,13 @@ impl Engine for SawEngine {
         let known = slave < self.slaves.len();
         Some(match kind {
             // A slave beyond the engine's slots (an engine built for fewer axes).
-            CallKind::SawGearIn if !known => Err(ErrorCode::InvalidTarget),
-            CallKind::SawGearIn => decode_body::<SawGearInCall>(request)
+            CallKind::SAW_GEAR_IN if !known => Err(ErrorCode::InvalidTarget),
+            CallKind::SAW_GEAR_IN => decode_body::<SawGearInCall>(request)
                 .and_then(|call| self.gear_in(slave, &call, axes)),
-            CallKind::SawGearOut => {
+            CallKind::SAW_GEAR_OUT => {
                 decode_body::<SawGearOutCall>(request).and_then(|_| self.gear_out(slave, axes))
             }
-            CallKind::SawCharac => decode_body::<SawCharacCall>(request)
+            CallKind::SAW_CHARAC => decode_body::<SawCharacCall>(request)
                 .and_then(|call| self.read_charac(slave, &call)),
             _ => return None,
         })

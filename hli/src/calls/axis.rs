@@ -1,7 +1,6 @@
 //! The axis calls: the cyclic state of an axis read on demand, and the axis commands of the
 //! PLCopen motion blocks (MC_Power .. MC_SetPosition) as one acyclic call.
 
-use super::{AcyclicCall, CallKind};
 use crate::layout::HliAxisLrState;
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
@@ -12,11 +11,6 @@ use bytemuck::{Pod, Zeroable};
 pub struct ReadAxisState {
     /// Reserved, must be 0.
     pub reserved: u32,
-}
-
-impl AcyclicCall for ReadAxisState {
-    const KIND: CallKind = CallKind::ReadAxisState;
-    type Reply = HliAxisLrState;
 }
 
 const _: () = assert!(core::mem::size_of::<HliAxisLrState>() <= ACYCLIC_BODY_SIZE);
@@ -135,7 +129,9 @@ pub struct AxisCommandReply {
     pub error_id: u32,
 }
 
-impl AcyclicCall for AxisCommandCall {
-    const KIND: CallKind = CallKind::AxisCommand;
-    type Reply = AxisCommandReply;
+calls! { family "axis";
+    /// [`ReadAxisState`]: the cyclic state of an axis, read on demand.
+    READ_AXIS_STATE = 1: ReadAxisState -> HliAxisLrState, read_only;
+    /// [`AxisCommandCall`]: a PLCopen motion command.
+    AXIS_COMMAND = 2: AxisCommandCall -> AxisCommandReply, command;
 }

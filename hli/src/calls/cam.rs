@@ -2,7 +2,6 @@
 //! chunks, couplings (MC_CamIn, MC_CamOut, MC_CamScaling), the online change of points and
 //! the multi-table slaves. Every reply is a [`CamReply`] unless a read says otherwise.
 
-use super::{AcyclicCall, CallKind};
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
 
@@ -101,26 +100,6 @@ pub struct CamReply {
     pub error_id: u32,
     /// Reserved, 0.
     pub reserved: u32,
-}
-
-impl AcyclicCall for CamTableSelectCall {
-    const KIND: CallKind = CallKind::CamTableSelect;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamInCall {
-    const KIND: CallKind = CallKind::CamIn;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamOutCall {
-    const KIND: CallKind = CallKind::CamOut;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamScalingCall {
-    const KIND: CallKind = CallKind::CamScaling;
-    type Reply = CamReply;
 }
 
 /// One point of a motion function as the PLC holds it (`MC_MotionFunctionPoint`).
@@ -250,11 +229,6 @@ pub struct CamTableDeleteCall {
     pub reserved: u32,
 }
 
-impl AcyclicCall for CamTableDeleteCall {
-    const KIND: CallKind = CallKind::CamTableDelete;
-    type Reply = CamReply;
-}
-
 /// Rows of a position table that fit one call.
 pub const CAM_ROWS_PER_CALL: usize = 13;
 
@@ -339,11 +313,6 @@ pub struct CamValuesReply {
     pub values: [f64; CAM_VALUES_PER_REPLY],
 }
 
-impl AcyclicCall for CamReadCall {
-    const KIND: CallKind = CallKind::CamRead;
-    type Reply = CamValuesReply;
-}
-
 /// CamTableSetWeight for the table given as `target`: how it counts in a multi-table slave.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
@@ -408,39 +377,33 @@ pub struct CamMultiTableCall {
     pub position: f64,
 }
 
-impl AcyclicCall for CamTableWeightCall {
-    const KIND: CallKind = CallKind::CamTableWeight;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamMultiCoupleCall {
-    const KIND: CallKind = CallKind::CamMultiCouple;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamMultiTableCall {
-    const KIND: CallKind = CallKind::CamMultiTable;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamPointsWriteCall {
-    const KIND: CallKind = CallKind::CamPointsWrite;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamPointsReadCall {
-    const KIND: CallKind = CallKind::CamPointsRead;
-    type Reply = CamPointsReply;
-}
-
-impl AcyclicCall for CamOnlineModeCall {
-    const KIND: CallKind = CallKind::CamOnlineMode;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamRowsWriteCall {
-    const KIND: CallKind = CallKind::CamRowsWrite;
-    type Reply = CamReply;
+calls! { family "cam";
+    /// [`CamTableSelectCall`]: MC_CamTableSelect.
+    CAM_TABLE_SELECT = 10: CamTableSelectCall -> CamReply, command;
+    /// [`CamInCall`]: MC_CamIn / MC_CamInExt.
+    CAM_IN = 11: CamInCall -> CamReply, command;
+    /// [`CamOutCall`]: MC_CamOut.
+    CAM_OUT = 12: CamOutCall -> CamReply, command;
+    /// [`CamScalingCall`]: MC_CamScaling.
+    CAM_SCALING = 13: CamScalingCall -> CamReply, command;
+    /// [`CamPointsWriteCall`]: a chunk of MC_WriteMotionFunction(Point).
+    CAM_POINTS_WRITE = 14: CamPointsWriteCall -> CamReply, command;
+    /// [`CamPointsReadCall`]: MC_ReadMotionFunction(Point).
+    CAM_POINTS_READ = 15: CamPointsReadCall -> CamPointsReply, read_only;
+    /// [`CamOnlineModeCall`]: MC_SetCamOnlineChangeMode.
+    CAM_ONLINE_MODE = 16: CamOnlineModeCall -> CamReply, command;
+    /// [`CamRowsWriteCall`]: a chunk of a position table.
+    CAM_ROWS_WRITE = 17: CamRowsWriteCall -> CamReply, command;
+    /// [`CamReadCall`]: cam data read in parts.
+    CAM_READ = 18: CamReadCall -> CamValuesReply, read_only;
+    /// [`CamTableWeightCall`]: CamTableSetWeight.
+    CAM_TABLE_WEIGHT = 19: CamTableWeightCall -> CamReply, command;
+    /// [`CamMultiCoupleCall`]: CamTableCoupleAxesMultiTables.
+    CAM_MULTI_COUPLE = 20: CamMultiCoupleCall -> CamReply, command;
+    /// [`CamMultiTableCall`]: a table of a multi-table slave.
+    CAM_MULTI_TABLE = 21: CamMultiTableCall -> CamReply, command;
+    /// [`CamTableDeleteCall`]: CamTableDelete.
+    CAM_TABLE_DELETE = 22: CamTableDeleteCall -> CamReply, command;
 }
 
 // Every body fits one frame.

@@ -9,8 +9,6 @@
 //! addressed by their `gpAx` index as in the other calls; group positions count from 1 as in
 //! the seed.
 
-use crate::calls::{AcyclicCall, CallKind};
-use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
 
 /// Values (rows x columns) one row block may carry: 64 KiB of `f64`, the buffer size of the
@@ -134,24 +132,21 @@ pub struct FifoRowsHeader {
 
 crate::raw::zero_copy_send!(FifoRowsHeader, FifoReply);
 
-macro_rules! fifo_calls {
-    ($($call:ty => $kind:ident),* $(,)?) => {$(
-        impl AcyclicCall for $call {
-            const KIND: CallKind = CallKind::$kind;
-            type Reply = FifoReply;
-        }
-        const _: () = assert!(core::mem::size_of::<$call>() <= ACYCLIC_BODY_SIZE);
-    )*};
-}
-
-fifo_calls! {
-    FifoDimensionCall => FifoDimension,
-    FifoIntegrateCall => FifoIntegrate,
-    FifoDisintegrateCall => FifoDisintegrate,
-    FifoStartCall => FifoStart,
-    FifoStopCall => FifoStop,
-    FifoOverrideCall => FifoOverride,
-    FifoParametersCall => FifoParameters,
+calls! { family "fifo";
+    /// [`FifoDimensionCall`]: FiFoGetDimension.
+    FIFO_DIMENSION = 30: FifoDimensionCall -> FifoReply, read_only;
+    /// [`FifoIntegrateCall`]: FiFoGroupIntegrate.
+    FIFO_INTEGRATE = 31: FifoIntegrateCall -> FifoReply, command;
+    /// [`FifoDisintegrateCall`]: FiFoGroupDisintegrate.
+    FIFO_DISINTEGRATE = 32: FifoDisintegrateCall -> FifoReply, command;
+    /// [`FifoStartCall`]: FiFoStart.
+    FIFO_START = 33: FifoStartCall -> FifoReply, command;
+    /// [`FifoStopCall`]: FiFoStop.
+    FIFO_STOP = 34: FifoStopCall -> FifoReply, command;
+    /// [`FifoOverrideCall`]: FiFoSetChannelOverride.
+    FIFO_OVERRIDE = 35: FifoOverrideCall -> FifoReply, command;
+    /// [`FifoParametersCall`]: the group's parameters a PLC may set.
+    FIFO_PARAMETERS = 36: FifoParametersCall -> FifoReply, command;
 }
 
 const _: () = assert!(core::mem::size_of::<FifoReply>() == 32);

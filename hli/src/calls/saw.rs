@@ -4,7 +4,6 @@
 //! index); the master is an axis index in the body. The slave's progress is read from its
 //! axis image: `coupling_state_r` 2 (velocity) or 3 (position) and `nAxisState` 11/12/13.
 
-use crate::calls::{AcyclicCall, CallKind};
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
 
@@ -147,17 +146,13 @@ pub struct SawCharacReply {
     pub values: [f64; SAW_CHARAC_PART],
 }
 
-impl AcyclicCall for SawGearInCall {
-    const KIND: CallKind = CallKind::SawGearIn;
-    type Reply = SawReply;
-}
-impl AcyclicCall for SawGearOutCall {
-    const KIND: CallKind = CallKind::SawGearOut;
-    type Reply = SawReply;
-}
-impl AcyclicCall for SawCharacCall {
-    const KIND: CallKind = CallKind::SawCharac;
-    type Reply = SawCharacReply;
+calls! { family "saw";
+    /// [`SawGearInCall`]: MC_GearInVelo / MC_GearInPos.
+    SAW_GEAR_IN = 40: SawGearInCall -> SawReply, command;
+    /// [`SawGearOutCall`]: MC_GearOut.
+    SAW_GEAR_OUT = 41: SawGearOutCall -> SawReply, command;
+    /// [`SawCharacCall`]: MC_ReadFlyingSawCharacteristics, one part.
+    SAW_CHARAC = 42: SawCharacCall -> SawCharacReply, read_only;
 }
 
 const _: () = assert!(core::mem::size_of::<SawGearInCall>() == 80);
