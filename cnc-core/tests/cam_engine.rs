@@ -5,8 +5,9 @@
 
 use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::axis::generator::Kinematic;
-use cnc_core::cam::coupling::{CamLaw, Scaling, StartMode};
+use cnc_core::cam::coupling::{CamLaw, Scaling};
 use cnc_core::cam::{CamProfile, ProfileCursor};
+use hli::calls::cam::CamStartMode;
 use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall};
 use hli::calls::{AcyclicCall, CallKind};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
@@ -141,7 +142,7 @@ fn the_conveyor_scenario_follows_the_law_scales_changes_a_point_and_decouples() 
     let law = CamLaw::new(
         &original,
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         0.0,
         0.0,
@@ -331,7 +332,7 @@ fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
     let law = CamLaw::new(
         &profile,
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         0.0,
         0.0,
@@ -934,7 +935,7 @@ fn a_slave_may_follow_the_masters_actual_position() {
     let law = CamLaw::new(
         &seed_cam(),
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         false,
         0.0,
         0.0,
@@ -1001,7 +1002,7 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
         let law = CamLaw::new(
             &seed_cam(),
             Scaling::default(),
-            StartMode::Absolute,
+            CamStartMode::Absolute,
             true,
             0.0,
             0.0,

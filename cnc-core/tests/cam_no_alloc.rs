@@ -2,9 +2,10 @@
 //! with every interpolation, linear and cyclic.
 
 use cnc_core::cam::{
-    CamProfile, FunctionType, Interpolation, MotionFunction, MotionFunctionPoint, PointType,
-    PositionTable, ProfileCursor, TableType,
+    CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
+    ProfileCursor, TableType,
 };
+use hli::calls::cam::CamInterpolation;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -44,9 +45,9 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
         .map(|i| [i as f64 * 0.4, (i as f64 * 0.01).sin()])
         .collect();
     for interpolation in [
-        Interpolation::Linear,
-        Interpolation::FourPoint,
-        Interpolation::Spline,
+        CamInterpolation::Linear,
+        CamInterpolation::FourPoint,
+        CamInterpolation::Spline,
     ] {
         for periodic in [false, true] {
             for ty in [TableType::Equidistant, TableType::NonEquidistant] {

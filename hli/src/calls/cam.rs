@@ -2,8 +2,91 @@
 //! chunks, couplings (MC_CamIn, MC_CamOut, MC_CamScaling), the online change of points and
 //! the multi-table slaves. Every reply is a [`CamReply`] unless a read says otherwise.
 
+use crate::enums::wire_enum;
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
+
+wire_enum! {
+    /// `MC_StartMode` ([`CamInCall::start_mode`]): whether the cam's master and slave
+    /// coordinates are absolute or measured from the axes' positions at coupling (or
+    /// switching).
+    CamStartMode {
+        /// 1: both absolute.
+        Absolute = 1 => "absolute",
+        /// 2: both relative.
+        Relative = 2 => "relative",
+        /// 3: master absolute, slave relative.
+        MasterAbsSlaveRel = 3 => "master_abs_slave_rel",
+        /// 4: master relative, slave absolute.
+        MasterRelSlaveAbs = 4 => "master_rel_slave_abs",
+    }
+}
+
+impl CamStartMode {
+    /// Whether the master coordinate is measured from the coupling position.
+    pub fn master_relative(self) -> bool {
+        matches!(
+            self,
+            CamStartMode::Relative | CamStartMode::MasterRelSlaveAbs
+        )
+    }
+
+    /// Whether the slave coordinate is measured from the coupling position.
+    pub fn slave_relative(self) -> bool {
+        matches!(
+            self,
+            CamStartMode::Relative | CamStartMode::MasterAbsSlaveRel
+        )
+    }
+}
+
+wire_enum! {
+    /// `MC_CamActivationMode`: when a coupling, switch, rescaling or change of points takes
+    /// effect (the positional modes take their position from the call body).
+    CamActivationMode {
+        /// 0: at once (in the next tick).
+        Instantaneous = 0 => "instantaneous",
+        /// 1: when the master's position within the cam passes the activation position.
+        AtMasterCamPos = 1 => "at_master_cam_pos",
+        /// 2: when the master axis passes the activation position (absolute).
+        AtMasterAxisPos = 2 => "at_master_axis_pos",
+        /// 3: at the next cycle boundary (a cyclic cam) or range edge (a linear one).
+        NextCycle = 3 => "next_cycle",
+        /// 4: at the next cycle boundary, once.
+        NextCycleOnce = 4 => "next_cycle_once",
+        /// 5: as soon as possible (point data).
+        AsSoonAsPossible = 5 => "as_soon_as_possible",
+        /// 6: nothing is changed.
+        Off = 6 => "off",
+        /// 7: a queued, not yet active change is dropped.
+        DeleteQueuedData = 7 => "delete_queued_data",
+    }
+}
+
+wire_enum! {
+    /// `MC_InterpolationType` of a position table.
+    CamInterpolation {
+        /// 0: straight lines between rows.
+        Linear = 0 => "linear",
+        /// 1: the cubic through the four nearest rows (equidistant tables only).
+        FourPoint = 1 => "4point",
+        /// 2: a cubic spline, tangential at the ends of a linear table, cyclic for a periodic
+        /// one.
+        Spline = 2 => "spline",
+    }
+}
+
+wire_enum! {
+    /// `MC_CamScalingMode` of one side (master or slave).
+    CamScalingMode {
+        /// 0: scaling and offset taken as given.
+        UserDefined = 0 => "user_defined",
+        /// 1: scaling taken, offset computed so that nothing jumps.
+        AutoOffset = 1 => "auto_offset",
+        /// 2: this side's scaling and offset stay as they are.
+        Off = 2 => "off",
+    }
+}
 
 /// MC_CamTableSelect for the table given as `target` (its ID, 1..=255): how couplings
 /// through it run when MC_CamIn does not say otherwise.
@@ -28,15 +111,15 @@ pub struct CamInCall {
     pub master: u32,
     /// Cam table ID.
     pub table_id: u32,
-    /// Raw `MC_StartMode` (1..=4).
+    /// Raw [`CamStartMode`].
     pub start_mode: u32,
-    /// Raw `MC_CamActivationMode` (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamActivationMode`] (MC_CamInExt; 0 for MC_CamIn).
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamScalingMode`] of the master (MC_CamInExt; 0 for MC_CamIn).
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamScalingMode`] of the slave (MC_CamInExt; 0 for MC_CamIn).
     pub slave_scaling_mode: u32,
-    /// Raw `MC_InterpolationType` of a table (0 linear, the seed's default; one other than
+    /// Raw [`CamInterpolation`] of a table (0 linear, the seed's default; one other than
     /// the stored table's gives the coupling its own copy). Motion functions ignore it.
     pub interpolation: u32,
     /// 1 for MC_CamInExt: the coupling may later switch to another cam.
@@ -70,11 +153,11 @@ pub struct CamOutCall {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamScalingCall {
-    /// Raw `MC_CamActivationMode`.
+    /// Raw [`CamActivationMode`].
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master.
+    /// Raw [`CamScalingMode`] of the master.
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave.
+    /// Raw [`CamScalingMode`] of the slave.
     pub slave_scaling_mode: u32,
     /// Values left as they are ([`CAM_KEEP_MASTER_SCALING`] ...); 0 for MC_CamScaling.
     pub reserved: u32,
@@ -189,11 +272,11 @@ pub struct CamPointsReply {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamOnlineModeCall {
-    /// Raw `MC_CamActivationMode`.
+    /// Raw [`CamActivationMode`].
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master when a change applies.
+    /// Raw [`CamScalingMode`] of the master when a change applies.
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave when a change applies.
+    /// Raw [`CamScalingMode`] of the slave when a change applies.
     pub slave_scaling_mode: u32,
     /// Reserved, 0.
     pub reserved: u32,
@@ -248,7 +331,7 @@ pub struct CamRowsWriteCall {
     pub total: u32,
     /// Raw `MC_TableType` (10 equidistant, 11 non-equidistant).
     pub table_type: u32,
-    /// Raw `MC_InterpolationType` the table keeps by default.
+    /// Raw [`CamInterpolation`] the table keeps by default.
     pub interpolation: u32,
     /// 1: continued period by period.
     pub periodic: u32,
@@ -416,3 +499,87 @@ const _: () = {
     assert!(core::mem::size_of::<CamInCall>() <= ACYCLIC_BODY_SIZE);
     assert!(core::mem::size_of::<CamScalingCall>() <= ACYCLIC_BODY_SIZE);
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn table<T: Copy>(
+        all: &[T],
+        raw: fn(T) -> u32,
+        name: fn(T) -> &'static str,
+    ) -> Vec<(&'static str, u32)> {
+        all.iter().map(|&v| (name(v), raw(v))).collect()
+    }
+
+    #[test]
+    fn the_mode_selectors_keep_their_names_and_numbers() {
+        assert_eq!(
+            table(CamStartMode::ALL, CamStartMode::raw, CamStartMode::name),
+            [
+                ("absolute", 1),
+                ("relative", 2),
+                ("master_abs_slave_rel", 3),
+                ("master_rel_slave_abs", 4)
+            ]
+        );
+        assert_eq!(
+            table(
+                CamActivationMode::ALL,
+                CamActivationMode::raw,
+                CamActivationMode::name
+            ),
+            [
+                ("instantaneous", 0),
+                ("at_master_cam_pos", 1),
+                ("at_master_axis_pos", 2),
+                ("next_cycle", 3),
+                ("next_cycle_once", 4),
+                ("as_soon_as_possible", 5),
+                ("off", 6),
+                ("delete_queued_data", 7)
+            ]
+        );
+        assert_eq!(
+            table(
+                CamInterpolation::ALL,
+                CamInterpolation::raw,
+                CamInterpolation::name
+            ),
+            [("linear", 0), ("4point", 1), ("spline", 2)]
+        );
+        assert_eq!(
+            table(
+                CamScalingMode::ALL,
+                CamScalingMode::raw,
+                CamScalingMode::name
+            ),
+            [("user_defined", 0), ("auto_offset", 1), ("off", 2)]
+        );
+    }
+
+    #[test]
+    fn a_selector_decodes_from_its_number_or_its_name() {
+        for &mode in CamActivationMode::ALL {
+            assert_eq!(CamActivationMode::from_raw(mode.raw()), Some(mode));
+            assert_eq!(CamActivationMode::from_name(mode.name()), Some(mode));
+        }
+        assert_eq!(CamStartMode::from_raw(0), None);
+        assert_eq!(CamScalingMode::from_raw(3), None);
+        assert_eq!(
+            CamInterpolation::from_name("4POINT"),
+            Some(CamInterpolation::FourPoint)
+        );
+        assert_eq!(
+            CamStartMode::from_name("Master_Abs_Slave_Rel"),
+            Some(CamStartMode::MasterAbsSlaveRel)
+        );
+        assert_eq!(CamScalingMode::from_name("auto offset"), None);
+        assert!(
+            CamStartMode::Relative.master_relative() && CamStartMode::Relative.slave_relative()
+        );
+        assert!(!CamStartMode::MasterAbsSlaveRel.master_relative());
+        assert!(CamStartMode::MasterRelSlaveAbs.master_relative());
+        assert!(!CamStartMode::Absolute.slave_relative());
+    }
+}
