@@ -4,7 +4,7 @@
 
 use cnc_core::app::scenario::{InProcess, Scenario};
 use hli::calls::axis::AxisCommandCall;
-use hli::calls::saw::{sync_mask, SawGearInCall, SAW_ON_VELOCITY};
+use hli::calls::saw::{sync_mask, SawGearInCall, SawSyncTarget};
 use hli::enums::AxisState;
 use hli::views::{CncView, PlcView};
 
@@ -45,7 +45,7 @@ fn the_saw_tick_allocates_nothing() {
     ticks(&mut run, 200);
     let gear_in = SawGearInCall {
         master: 0,
-        target: SAW_ON_VELOCITY,
+        target: SawSyncTarget::Velocity.raw(),
         ratio_numerator: 1.0,
         ratio_denominator: 1,
         mask: sync_mask::ROLLBACKLOCK,

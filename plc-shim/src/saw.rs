@@ -24,8 +24,7 @@ use crate::fifo::DEFAULT_TIMEOUT_CYCLES;
 use crate::motion::ERROR_NO_ANSWER;
 use crate::runtime::PlcIo;
 use hli::calls::saw::{
-    SawCharacCall, SawGearInCall, SawGearOutCall, SAW_CHARAC_PART, SAW_ON_POSITION,
-    SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
+    SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
 };
 use hli::calls::{AcyclicCall, CallError};
 use hli::enums::{AxisState, CouplingState};
@@ -87,9 +86,9 @@ impl SyncMode {
     /// The raw `E_GearInSyncMode`.
     pub fn raw_mode(self) -> u32 {
         if self.time_based {
-            SYNC_TIME_BASED
+            SawSyncMode::TimeBased.raw()
         } else {
-            SYNC_POSITION_BASED
+            SawSyncMode::PositionBased.raw()
         }
     }
 }
@@ -476,7 +475,9 @@ impl McGearInVelo {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let call = self.inputs.call(self.master, SAW_ON_VELOCITY, [0.0; 2]);
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Velocity.raw(), [0.0; 2]);
         self.out = self.core.cycle(io, self.execute, self.slave, call);
     }
 }
@@ -526,7 +527,9 @@ impl McGearInPos {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let positions = [self.master_sync_position, self.slave_sync_position];
-        let call = self.inputs.call(self.master, SAW_ON_POSITION, positions);
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Position.raw(), positions);
         self.out = self.core.cycle(io, self.execute, self.slave, call);
     }
 }
@@ -903,7 +906,7 @@ mod tests {
             let call: SawGearInCall = decode_body(request)?;
             assert_eq!(
                 (call.target, call.master_sync_position),
-                (SAW_ON_POSITION, 100.0)
+                (SawSyncTarget::Position.raw(), 100.0)
             );
             reply(&SawReply::default())
         });

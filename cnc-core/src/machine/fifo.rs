@@ -25,8 +25,8 @@ use crate::fifo::{
 };
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::fifo::{
-    FifoIntegrateCall, FifoOverrideCall, FifoParametersCall, FifoReply, FifoRowsHeader,
-    FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
+    FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,
+    FifoRowsHeader,
 };
 use hli::calls::{decode_body, reply, CallKind, HandlerResult};
 use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
@@ -381,12 +381,12 @@ impl Group {
         if self.running() {
             return self.refuse(FifoError::Running);
         }
-        let kind = match call.override_type {
-            FIFO_OVERRIDE_INSTANT => OverrideType::Instant,
-            FIFO_OVERRIDE_PT2 => OverrideType::Pt2 {
+        let kind = match FifoOverrideType::from_raw(call.override_type) {
+            Some(FifoOverrideType::Instant) => OverrideType::Instant,
+            Some(FifoOverrideType::Pt2) => OverrideType::Pt2 {
                 t0_s: call.pt2_t0_s,
             },
-            _ => return self.refuse(FifoError::Parameter),
+            None => return self.refuse(FifoError::Parameter),
         };
         let Ok(params) = FifoParams::new(
             self.params.dimension,

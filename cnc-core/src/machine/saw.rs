@@ -12,8 +12,8 @@ use crate::axis::{AxisSet, Coupling};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use hli::calls::saw::{
-    SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SAW_CHARAC_PART,
-    SAW_ON_POSITION, SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
+    SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
+    SawSyncTarget, SAW_CHARAC_PART,
 };
 use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, SawError};
@@ -93,18 +93,18 @@ impl SawEngine {
                 reserved: 0,
             });
         }
-        let on = match call.target {
-            SAW_ON_VELOCITY => SyncOn::Velocity,
-            SAW_ON_POSITION => SyncOn::Position {
+        let on = match SawSyncTarget::from_raw(call.target) {
+            Some(SawSyncTarget::Velocity) => SyncOn::Velocity,
+            Some(SawSyncTarget::Position) => SyncOn::Position {
                 master: call.master_sync_position,
                 slave: call.slave_sync_position,
             },
-            _ => return refused(SawError::Mode),
+            None => return refused(SawError::Mode),
         };
-        let time_based = match call.sync_mode {
-            SYNC_POSITION_BASED => false,
-            SYNC_TIME_BASED => true,
-            _ => return refused(SawError::Mode),
+        let time_based = match SawSyncMode::from_raw(call.sync_mode) {
+            Some(SawSyncMode::PositionBased) => false,
+            Some(SawSyncMode::TimeBased) => true,
+            None => return refused(SawError::Mode),
         };
         let ratio = match saw::gear_ratio(call.ratio_numerator, call.ratio_denominator) {
             Ok(r) => r,
