@@ -9,10 +9,10 @@
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::axis::AxisSet;
 use core::mem::offset_of;
+use hli::calls::axis::AxisCommandCall;
 use hli::layout::{
     HliAxis, HliAxisCommandState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
 };
-use hli::rpc::AxisCommandCall;
 use hli::views::CncView;
 use hli::PlaceExt;
 use std::hint::black_box;

@@ -6,9 +6,10 @@
 //! Run: `cargo bench -p cnc-core --bench cam`.
 
 use cnc_core::cam::{
-    CamProfile, FunctionType, Interpolation, MotionFunction, MotionFunctionPoint, PointType,
-    PositionTable, ProfileCursor, TableType,
+    CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
+    ProfileCursor, TableType,
 };
+use hli::calls::cam::CamInterpolation;
 use std::hint::black_box;
 use std::time::Instant;
 
@@ -106,25 +107,25 @@ fn main() {
                 "non-equidistant, linear",
                 TableType::NonEquidistant,
                 false,
-                Interpolation::Linear,
+                CamInterpolation::Linear,
             ),
             (
                 "equidistant, linear",
                 TableType::Equidistant,
                 true,
-                Interpolation::Linear,
+                CamInterpolation::Linear,
             ),
             (
                 "equidistant, 4-point",
                 TableType::Equidistant,
                 true,
-                Interpolation::FourPoint,
+                CamInterpolation::FourPoint,
             ),
             (
                 "non-equidistant, spline",
                 TableType::NonEquidistant,
                 false,
-                Interpolation::Spline,
+                CamInterpolation::Spline,
             ),
         ] {
             let r = rows(n, even);
@@ -152,7 +153,13 @@ fn main() {
     // Fast masters skip rows between ticks: 20 rows per evaluation on the large table.
     let r = rows(100_000, false);
     let t = CamProfile::Table(
-        PositionTable::new(&r, TableType::NonEquidistant, Interpolation::Linear, false).unwrap(),
+        PositionTable::new(
+            &r,
+            TableType::NonEquidistant,
+            CamInterpolation::Linear,
+            false,
+        )
+        .unwrap(),
     );
     let (o, b) = (
         median((0..REPEATS).map(|_| sweep(&t, 5_000)).collect()),

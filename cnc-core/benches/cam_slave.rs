@@ -10,12 +10,15 @@
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::cam::online::CamStore;
 use cnc_core::cam::{
-    CamProfile, FunctionType, Interpolation, MotionFunction, MotionFunctionPoint, PointType,
-    PositionTable, TableType,
+    CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
+    TableType,
 };
 use cnc_core::machine::cams::CamEngine;
 use cnc_core::machine::{Engine, Machine, MachineSetup};
-use hli::calls::{AcyclicCall, AxisCommandCall, CamInCall, CamTableSelectCall};
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::cam::CamInterpolation;
+use hli::calls::cam::{CamInCall, CamTableSelectCall};
+use hli::calls::AcyclicCall;
 use hli::views::CncView;
 use hli::wire::{encode_body, AcyclicRequest};
 use hli::ImageMemory;
@@ -54,7 +57,7 @@ fn table(rows: usize) -> CamProfile {
         })
         .collect();
     CamProfile::Table(
-        PositionTable::new(&r, TableType::Equidistant, Interpolation::Linear, true)
+        PositionTable::new(&r, TableType::Equidistant, CamInterpolation::Linear, true)
             .expect("bench table"),
     )
 }

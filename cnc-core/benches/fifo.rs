@@ -19,10 +19,10 @@ use cnc_core::axis::config::AxisConfig;
 use cnc_core::fifo::{FifoGenerator, FifoParams, OverrideFilter, OverrideType, RowRing};
 use cnc_core::machine::fifo::FifoEngine;
 use cnc_core::machine::{Machine, MachineSetup};
-use hli::calls::AcyclicCall;
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoRowsHeader, FifoStartCall,
 };
+use hli::calls::AcyclicCall;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::CncView;
 use hli::ImageMemory;

@@ -18,7 +18,7 @@
 
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw::{self, Limits, SawRequest, SyncOn};
-use hli::saw_calls::sync_mask as m;
+use hli::calls::saw::sync_mask as m;
 use rsruckig::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;

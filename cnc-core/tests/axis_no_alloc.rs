@@ -5,15 +5,17 @@ use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode, DriveProtocol, Pr
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
-use hli::rpc::{AcyclicRequest, AxisCommandCall, AxisCommandReply, CallKind, ACYCLIC_BODY_SIZE};
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::calls::CallKind;
 use hli::views::CncView;
+use hli::wire::{AcyclicRequest, ACYCLIC_BODY_SIZE};
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 use counting_alloc::allocations;
 
 fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {
-    request_of(CallKind::AxisCommand, target, call)
+    request_of(CallKind::AXIS_COMMAND, target, call)
 }
 
 fn request_of<T: bytemuck::Pod>(kind: CallKind, target: u32, call: &T) -> AcyclicRequest {
@@ -91,15 +93,15 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
     for round in 0..20 {
         for (n, call) in calls.iter().enumerate() {
             for axis in 0..32u32 {
-                let arm = hli::probe_calls::ProbeArmCall {
+                let arm = hli::calls::probe::ProbeArmCall {
                     probe: 1 + axis % 2,
                     edge: 1,
                     ..Default::default()
                 };
                 let (body, _) = set
-                    .handle_probe(&request_of(CallKind::ProbeArm, axis, &arm), true)
+                    .handle_probe(&request_of(CallKind::PROBE_ARM, axis, &arm), true)
                     .unwrap();
-                let reply: hli::probe_calls::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
+                let reply: hli::calls::probe::ProbeReply = bytemuck::pod_read_unaligned(&body[..8]);
                 armed += u32::from(reply.error_id == 0);
                 let (body, _) = set.handle_command(&request(axis, call)).unwrap();
                 let reply: AxisCommandReply = bytemuck::pod_read_unaligned(&body[..8]);

@@ -6,10 +6,12 @@
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
-    Scaling, ScalingMode, StartMode,
+    Scaling,
 };
 use cnc_core::cam::online::MasterNow;
-use cnc_core::cam::{CamProfile, Interpolation, PositionTable, ProfileCursor, TableType};
+use cnc_core::cam::{CamProfile, PositionTable, ProfileCursor, TableType};
+use hli::calls::cam::CamInterpolation;
+use hli::calls::cam::{CamScalingMode, CamStartMode};
 use proptest::prelude::*;
 
 /// T(x) = x / 2 on 0..100: period 100, stroke 50.
@@ -18,7 +20,7 @@ fn ramp() -> CamProfile {
         PositionTable::new(
             &[[0.0, 0.0], [100.0, 50.0]],
             TableType::Equidistant,
-            Interpolation::Linear,
+            CamInterpolation::Linear,
             false,
         )
         .unwrap(),
@@ -34,7 +36,13 @@ fn wave() -> CamProfile {
         })
         .collect();
     CamProfile::Table(
-        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Spline, false).unwrap(),
+        PositionTable::new(
+            &rows,
+            TableType::Equidistant,
+            CamInterpolation::Spline,
+            false,
+        )
+        .unwrap(),
     )
 }
 
@@ -63,10 +71,10 @@ fn linear_law_in_every_start_mode_by_hand() {
     let law = |start| CamLaw::new(&p, SCALED, start, false, 20.0, 7.0);
     // Master absolute: x = (10 + 50) / 2 = 30, T = 15. Relative: x = (10 + 50 - 20) / 2 = 20.
     let cases = [
-        (StartMode::Absolute, 5.0 + 3.0 * 15.0),
-        (StartMode::MasterRelSlaveAbs, 5.0 + 3.0 * 10.0),
-        (StartMode::MasterAbsSlaveRel, 7.0 + 5.0 + 3.0 * 15.0),
-        (StartMode::Relative, 7.0 + 5.0 + 3.0 * 10.0),
+        (CamStartMode::Absolute, 5.0 + 3.0 * 15.0),
+        (CamStartMode::MasterRelSlaveAbs, 5.0 + 3.0 * 10.0),
+        (CamStartMode::MasterAbsSlaveRel, 7.0 + 5.0 + 3.0 * 15.0),
+        (CamStartMode::Relative, 7.0 + 5.0 + 3.0 * 10.0),
     ];
     for (start, expected) in cases {
         assert_eq!(
@@ -76,16 +84,16 @@ fn linear_law_in_every_start_mode_by_hand() {
         );
     }
     // Outside the range a linear cam holds its edge value, at rest: x = 130 -> T(100) = 50.
-    let edge = slave(&law(StartMode::Absolute), &p, at(250.0));
+    let edge = slave(&law(CamStartMode::Absolute), &p, at(250.0));
     assert_eq!((edge.position, edge.velocity), (5.0 + 150.0, 0.0));
-    let below = slave(&law(StartMode::Absolute), &p, at(-100.0));
+    let below = slave(&law(CamStartMode::Absolute), &p, at(-100.0));
     assert_eq!(below.position, 5.0);
 }
 
 #[test]
 fn cyclic_law_adds_the_scaled_stroke_per_cycle_by_hand() {
     let p = ramp();
-    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(&p, SCALED, CamStartMode::Absolute, true, 0.0, 0.0);
     // x = (10 + 250) / 2 = 130: cycle 1, local 30, T = 15 + 50.
     let (s, c) = law.slave(&p, &mut ProfileCursor::default(), &at(250.0));
     assert_eq!((c.cycle, c.local), (1, 30.0));
@@ -95,7 +103,7 @@ fn cyclic_law_adds_the_scaled_stroke_per_cycle_by_hand() {
     assert_eq!((c.cycle, c.local), (-1, 55.0));
     assert_eq!(s.position, 5.0 + 3.0 * -22.5);
     // Relative master and slave: measured from the coupling positions 20 and 7.
-    let rel = CamLaw::new(&p, SCALED, StartMode::Relative, true, 20.0, 7.0);
+    let rel = CamLaw::new(&p, SCALED, CamStartMode::Relative, true, 20.0, 7.0);
     // x = (10 + 250 - 20) / 2 = 120: cycle 1, local 20, T = 10 + 50.
     assert_eq!(slave(&rel, &p, at(250.0)).position, 7.0 + 5.0 + 3.0 * 60.0);
 }
@@ -103,7 +111,7 @@ fn cyclic_law_adds_the_scaled_stroke_per_cycle_by_hand() {
 #[test]
 fn the_slave_derivatives_follow_the_chain_rule() {
     let p = wave();
-    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(&p, SCALED, CamStartMode::Absolute, true, 0.0, 0.0);
     let master = Kinematic {
         position: 123.0,
         velocity: 40.0,
@@ -137,7 +145,7 @@ fn the_slave_derivatives_follow_the_chain_rule() {
 #[test]
 fn a_cyclic_cam_over_ten_thousand_periods_keeps_its_count_and_does_not_drift() {
     let p = ramp();
-    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(&p, SCALED, CamStartMode::Absolute, true, 0.0, 0.0);
     let mut cursor = ProfileCursor::default();
     // 1 ms ticks at 2000 units/s: x advances 1 per tick; 10_000 periods of 100.
     let mut last_cycle = i64::MIN;
@@ -165,7 +173,7 @@ proptest! {
     ) {
         let p = ramp();
         let scaling = Scaling { master_offset: mo, slave_offset: 1.0, master_scaling: ms, slave_scaling: ss };
-        let law = CamLaw::new(&p, scaling, StartMode::Absolute, true, 0.0, 0.0);
+        let law = CamLaw::new(&p, scaling, CamStartMode::Absolute, true, 0.0, 0.0);
         let a = slave(&law, &p, at(m)).position;
         let b = slave(&law, &p, at(m + dm)).position;
         // Slope 0.5 of the cam, scaled: no jump at any cycle boundary.
@@ -177,8 +185,8 @@ proptest! {
 #[test]
 fn coupling_modes_follow_the_seeds_table() {
     use Activation::*;
-    let abs = StartMode::Absolute;
-    let rel = StartMode::Relative;
+    let abs = CamStartMode::Absolute;
+    let rel = CamStartMode::Relative;
     let modes = [
         Instantaneous,
         AtMasterAxisPos(1.0),
@@ -226,8 +234,8 @@ fn coupling_modes_follow_the_seeds_table() {
         assert!(check_switch(*mode, rel, true).is_err());
     }
     // The master-relative start modes count as relative, the master-absolute ones not.
-    assert!(check_couple(NextCycle, StartMode::MasterRelSlaveAbs, false).is_err());
-    assert!(check_couple(NextCycle, StartMode::MasterAbsSlaveRel, false).is_ok());
+    assert!(check_couple(NextCycle, CamStartMode::MasterRelSlaveAbs, false).is_err());
+    assert!(check_couple(NextCycle, CamStartMode::MasterAbsSlaveRel, false).is_ok());
     // Scaling: the five modes of its table; the others refused with the combination.
     for mode in [
         Instantaneous,
@@ -242,7 +250,7 @@ fn coupling_modes_follow_the_seeds_table() {
         assert_eq!(
             check_scaling(mode, abs, false),
             Err(CouplingError::Combination {
-                activation: cnc_core::cam::coupling::activation_raw(mode),
+                activation: mode.mode().raw(),
                 start: 1,
                 master_auto: false,
                 when: "scaling",
@@ -277,17 +285,24 @@ fn an_axis_position_behind_the_master_is_refused() {
 fn master_auto_offset_keeps_the_share_of_the_cycle() {
     // The seed's example: a 360 cam scaled by 2 at 90 (25 %) stays at 25 % of its now 720.
     let p = wave();
-    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(
+        &p,
+        Scaling::default(),
+        CamStartMode::Absolute,
+        true,
+        0.0,
+        0.0,
+    );
     let twice = Scaling {
         master_scaling: 2.0,
         ..Scaling::default()
     };
-    let modes = (ScalingMode::AutoOffset, ScalingMode::Off);
+    let modes = (CamScalingMode::AutoOffset, CamScalingMode::Off);
     let scaled = law.rescaled(
         &p,
         twice,
         modes,
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         90.0,
         0.0,
@@ -302,19 +317,26 @@ fn master_auto_offset_keeps_the_share_of_the_cycle() {
 #[test]
 fn slave_auto_offset_keeps_the_slave_where_it_is() {
     let p = wave();
-    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(
+        &p,
+        Scaling::default(),
+        CamStartMode::Absolute,
+        true,
+        0.0,
+        0.0,
+    );
     let before = slave(&law, &p, at(200.0)).position;
     // The seed's second example: MasterOffset 10 (a phase shift) with slave auto-offset.
     let shifted = Scaling {
         master_offset: 10.0,
         ..Scaling::default()
     };
-    let modes = (ScalingMode::UserDefined, ScalingMode::AutoOffset);
+    let modes = (CamScalingMode::UserDefined, CamScalingMode::AutoOffset);
     let after = law.rescaled(
         &p,
         shifted,
         modes,
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         200.0,
         before,
@@ -326,8 +348,8 @@ fn slave_auto_offset_keeps_the_slave_where_it_is() {
     let user = law.rescaled(
         &p,
         shifted,
-        (ScalingMode::UserDefined, ScalingMode::UserDefined),
-        StartMode::Absolute,
+        (CamScalingMode::UserDefined, CamScalingMode::UserDefined),
+        CamStartMode::Absolute,
         true,
         200.0,
         before,
@@ -343,8 +365,8 @@ fn slave_auto_offset_keeps_the_slave_where_it_is() {
     let held = law.rescaled(
         &p,
         frozen,
-        (ScalingMode::Off, ScalingMode::AutoOffset),
-        StartMode::Absolute,
+        (CamScalingMode::Off, CamScalingMode::AutoOffset),
+        CamStartMode::Absolute,
         true,
         200.0,
         before,
@@ -392,7 +414,7 @@ fn bad_scalings_are_refused_with_the_value() {
 fn a_slave_couples_in_the_base_cycle_wherever_the_master_stands() {
     // Seed 5.1.4: coupled with the master three periods on, the stroke counts from there.
     let p = ramp();
-    let law = CamLaw::new(&p, SCALED, StartMode::Absolute, true, 650.0, 0.0);
+    let law = CamLaw::new(&p, SCALED, CamStartMode::Absolute, true, 650.0, 0.0);
     // x = (10 + 650) / 2 = 330: cycle 3, local 30; at coupling no stroke is added.
     assert_eq!(slave(&law, &p, at(650.0)).position, 5.0 + 3.0 * 15.0);
     assert_eq!(law.cycles_since_coupling(650.0), 0);
@@ -414,20 +436,27 @@ fn master_auto_offset_keeps_the_share_when_switching_to_another_period() {
     // From a 360 cam at 90 (25 % into its second cycle) to a 100 cam scaled by 2 (200 of the
     // master per cycle): the master stands 25 % into the new cam's cycle, cycles counted on.
     let p = wave();
-    let law = CamLaw::new(&p, Scaling::default(), StartMode::Absolute, true, 0.0, 0.0);
+    let law = CamLaw::new(
+        &p,
+        Scaling::default(),
+        CamStartMode::Absolute,
+        true,
+        0.0,
+        0.0,
+    );
     let master = 360.0 + 90.0;
     let next = ramp();
     let scaling = Scaling {
         master_scaling: 2.0,
         ..Scaling::default()
     };
-    let modes = (ScalingMode::AutoOffset, ScalingMode::AutoOffset);
+    let modes = (CamScalingMode::AutoOffset, CamScalingMode::AutoOffset);
     let before = slave(&law, &p, at(master)).position;
     let switched = law.rescaled(
         &next,
         scaling,
         modes,
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         master,
         before,

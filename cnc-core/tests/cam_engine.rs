@@ -5,11 +5,11 @@
 
 use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::axis::generator::Kinematic;
-use cnc_core::cam::coupling::{CamLaw, Scaling, StartMode};
+use cnc_core::cam::coupling::{CamLaw, Scaling};
 use cnc_core::cam::{CamProfile, ProfileCursor};
-use hli::calls::{
-    AcyclicCall, CallKind, CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall,
-};
+use hli::calls::cam::CamStartMode;
+use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall};
+use hli::calls::{AcyclicCall, CallKind};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::views::CncView;
 use hli::wire::{encode_body, AcyclicRequest};
@@ -92,18 +92,18 @@ fn cam_in(table: u32) -> CamInCall {
 
 fn run_master(run: &mut InProcess, velocity: f64) {
     let command =
-        hli::calls::AxisCommandCall::move_velocity(1, [velocity, 3600.0, 3600.0, 36000.0]);
+        hli::calls::axis::AxisCommandCall::move_velocity(1, [velocity, 3600.0, 3600.0, 36000.0]);
     let (body, body_len) = encode_body(&command);
     let request = AcyclicRequest {
         invoke_id: 2,
-        kind: CallKind::AxisCommand.raw(),
+        kind: CallKind::AXIS_COMMAND.raw(),
         target: MASTER as u32,
         body_len,
         body,
     };
     let view = CncView::new(&run.memory);
     run.machine
-        .dispatch(&view, CallKind::AxisCommand, &request)
+        .dispatch(&view, CallKind::AXIS_COMMAND, &request)
         .unwrap();
 }
 
@@ -142,7 +142,7 @@ fn the_conveyor_scenario_follows_the_law_scales_changes_a_point_and_decouples() 
     let law = CamLaw::new(
         &original,
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         0.0,
         0.0,
@@ -332,7 +332,7 @@ fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
     let law = CamLaw::new(
         &profile,
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         true,
         0.0,
         0.0,
@@ -430,8 +430,8 @@ fn the_machine_tick_with_a_coupled_cam_slave_keeps_its_cycle_count_over_many_tur
     let rows: Vec<[f64; 2]> = (0..=36)
         .map(|i| [i as f64 * 10.0, i as f64 * 10.0 / 36.0])
         .collect();
-    for (k, chunk) in rows.chunks(hli::calls::CAM_ROWS_PER_CALL).enumerate() {
-        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+    for (k, chunk) in rows.chunks(hli::calls::cam::CAM_ROWS_PER_CALL).enumerate() {
+        let first = k * hli::calls::cam::CAM_ROWS_PER_CALL;
         let last = first + chunk.len() == rows.len();
         let call = rows_chunk(chunk, first, rows.len(), last);
         let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 9, &call));
@@ -484,16 +484,19 @@ fn rows_chunk(
     first: usize,
     total: usize,
     last: bool,
-) -> hli::calls::CamRowsWriteCall {
-    let mut call = hli::calls::CamRowsWriteCall {
+) -> hli::calls::cam::CamRowsWriteCall {
+    let mut call = hli::calls::cam::CamRowsWriteCall {
         first_row: first as u32,
         count: rows.len() as u32,
-        flags: if last { hli::calls::CAM_CHUNK_LAST } else { 0 }
-            | if first == 0 {
-                hli::calls::CAM_CHUNK_FIRST
-            } else {
-                0
-            },
+        flags: if last {
+            hli::calls::cam::CAM_CHUNK_LAST
+        } else {
+            0
+        } | if first == 0 {
+            hli::calls::cam::CAM_CHUNK_FIRST
+        } else {
+            0
+        },
         total: total as u32,
         table_type: 10,
         interpolation: 0,
@@ -517,9 +520,9 @@ fn a_table_of_100000_rows_arrives_in_chunks_and_a_coupling_runs_on_it() {
             ]
         })
         .collect();
-    let chunks: Vec<&[[f64; 2]]> = rows.chunks(hli::calls::CAM_ROWS_PER_CALL).collect();
+    let chunks: Vec<&[[f64; 2]]> = rows.chunks(hli::calls::cam::CAM_ROWS_PER_CALL).collect();
     for (k, chunk) in chunks.iter().enumerate() {
-        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+        let first = k * hli::calls::cam::CAM_ROWS_PER_CALL;
         let last = k + 1 == chunks.len();
         let reply = dispatch_raw(&mut run, 5, &rows_chunk(chunk, first, total, last));
         let reply: CamReply = bytemuck::pod_read_unaligned(&reply);
@@ -556,7 +559,7 @@ fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
     let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.0]).collect();
     let first = rows_chunk(&rows[..13], 0, 26, false);
     let skipped = rows_chunk(&rows[..13], 20, 26, true);
-    let answer = |run: &mut InProcess, c: &hli::calls::CamRowsWriteCall| {
+    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
         bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
     };
     assert_eq!(answer(&mut run, &first), 0);
@@ -577,7 +580,7 @@ fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
 
 #[test]
 fn points_read_back_and_a_refused_write_leaves_the_function() {
-    use hli::calls::{
+    use hli::calls::cam::{
         CamPointsReadCall, CamPointsReply, CamPointsWriteCall, McMotionFunctionPoint,
     };
     let mut run = machine("");
@@ -604,7 +607,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     let write = CamPointsWriteCall {
         first: 4,
         count: 1,
-        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
         total: 1,
         points,
     };
@@ -626,14 +629,18 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
 }
 
 /// Every part of a read, joined.
-fn read_all(run: &mut InProcess, target: u32, call: hli::calls::CamReadCall) -> (Vec<f64>, u32) {
+fn read_all(
+    run: &mut InProcess,
+    target: u32,
+    call: hli::calls::cam::CamReadCall,
+) -> (Vec<f64>, u32) {
     let mut values = Vec::new();
     let mut columns = 1;
     for part in 0.. {
-        let reply: hli::calls::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+        let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
             run,
             target,
-            &hli::calls::CamReadCall { part, ..call },
+            &hli::calls::cam::CamReadCall { part, ..call },
         ));
         assert_eq!(reply.error_id, 0, "part {part}");
         values.extend_from_slice(&reply.values[..reply.count as usize]);
@@ -647,7 +654,7 @@ fn read_all(run: &mut InProcess, target: u32, call: hli::calls::CamReadCall) -> 
 
 #[test]
 fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
-    use hli::calls::{
+    use hli::calls::cam::{
         CamReadCall, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
         CAM_READ_VALUES,
     };
@@ -743,7 +750,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
     );
     assert_eq!(v[22], 90.0, "cam master coordinate");
     // Not coupled: refused.
-    let reply: hli::calls::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+    let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
         &mut run,
         2,
         &CamReadCall {
@@ -928,7 +935,7 @@ fn a_slave_may_follow_the_masters_actual_position() {
     let law = CamLaw::new(
         &seed_cam(),
         Scaling::default(),
-        StartMode::Absolute,
+        CamStartMode::Absolute,
         false,
         0.0,
         0.0,
@@ -963,7 +970,7 @@ fn a_slave_may_follow_the_masters_actual_position() {
 
 #[test]
 fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
-    use hli::calls::CamScalingCall;
+    use hli::calls::cam::CamScalingCall;
     // (mode, position, the master position from which the new scaling must show)
     let cases = [
         (0u32, 0.0, 0.0),
@@ -995,7 +1002,7 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
         let law = CamLaw::new(
             &seed_cam(),
             Scaling::default(),
-            StartMode::Absolute,
+            CamStartMode::Absolute,
             true,
             0.0,
             0.0,
@@ -1095,7 +1102,7 @@ fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
 fn a_first_chunk_drops_an_unfinished_transfer() {
     let mut run = machine("");
     run.step(0.001);
-    let answer = |run: &mut InProcess, c: &hli::calls::CamRowsWriteCall| {
+    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
         bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
     };
     let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.5 * i as f64]).collect();
@@ -1107,8 +1114,8 @@ fn a_first_chunk_drops_an_unfinished_transfer() {
     let (v, _) = read_all(
         &mut run,
         7,
-        hli::calls::CamReadCall {
-            what: hli::calls::CAM_READ_ROWS,
+        hli::calls::cam::CamReadCall {
+            what: hli::calls::cam::CAM_READ_ROWS,
             ..Default::default()
         },
     );
@@ -1123,8 +1130,8 @@ fn a_slave_coupled_later_starts_in_the_base_cycle() {
     let rows: Vec<[f64; 2]> = (0..=36)
         .map(|i| [i as f64 * 10.0, i as f64 * 10.0 / 36.0])
         .collect();
-    for (k, chunk) in rows.chunks(hli::calls::CAM_ROWS_PER_CALL).enumerate() {
-        let first = k * hli::calls::CAM_ROWS_PER_CALL;
+    for (k, chunk) in rows.chunks(hli::calls::cam::CAM_ROWS_PER_CALL).enumerate() {
+        let first = k * hli::calls::cam::CAM_ROWS_PER_CALL;
         let call = rows_chunk(chunk, first, rows.len(), first + chunk.len() == rows.len());
         let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 9, &call));
         assert_eq!(reply.error_id, 0);
@@ -1149,7 +1156,7 @@ fn a_slave_coupled_later_starts_in_the_base_cycle() {
 
 #[test]
 fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
-    use hli::calls::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    use hli::calls::cam::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
     let mut run = machine("");
     run.step(0.001);
     select_cyclic(&mut run, 1);
@@ -1186,7 +1193,7 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
     let write = CamPointsWriteCall {
         first: 4,
         count: 1,
-        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
         total: 1,
         points,
     };

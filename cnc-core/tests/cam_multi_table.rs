@@ -7,14 +7,15 @@
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::multi_table::{MultiTableError, MultiTableLaw, TableSpec, TableWeight};
 use cnc_core::cam::online::CamStore;
-use cnc_core::cam::{CamProfile, Interpolation, PositionTable, TableType};
+use cnc_core::cam::{CamProfile, PositionTable, TableType};
+use hli::calls::cam::CamInterpolation;
 
 fn table(rows: &[[f64; 2]]) -> CamProfile {
     CamProfile::Table(
         PositionTable::new(
             rows,
             TableType::NonEquidistant,
-            Interpolation::Linear,
+            CamInterpolation::Linear,
             false,
         )
         .unwrap(),

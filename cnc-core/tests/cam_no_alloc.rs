@@ -2,9 +2,10 @@
 //! with every interpolation, linear and cyclic.
 
 use cnc_core::cam::{
-    CamProfile, FunctionType, Interpolation, MotionFunction, MotionFunctionPoint, PointType,
-    PositionTable, ProfileCursor, TableType,
+    CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
+    ProfileCursor, TableType,
 };
+use hli::calls::cam::CamInterpolation;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
@@ -44,9 +45,9 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
         .map(|i| [i as f64 * 0.4, (i as f64 * 0.01).sin()])
         .collect();
     for interpolation in [
-        Interpolation::Linear,
-        Interpolation::FourPoint,
-        Interpolation::Spline,
+        CamInterpolation::Linear,
+        CamInterpolation::FourPoint,
+        CamInterpolation::Spline,
     ] {
         for periodic in [false, true] {
             for ty in [TableType::Equidistant, TableType::NonEquidistant] {
@@ -77,7 +78,8 @@ fn sweeping_the_master_through_every_kind_of_profile_allocates_nothing() {
 #[test]
 fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     use cnc_core::app::scenario::{InProcess, Scenario};
-    use hli::calls::{AcyclicCall, CamScalingCall};
+    use hli::calls::cam::CamScalingCall;
+    use hli::calls::AcyclicCall;
     use hli::enums::AxisState;
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../scenarios/cam-conveyor/scenario.toml");
@@ -125,21 +127,22 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
             };
             let view = hli::views::CncView::new(&run.memory);
             let (reply, len) = run.machine.dispatch(&view, kind, &request).unwrap();
-            let reply: hli::calls::CamReply = bytemuck::pod_read_unaligned(&reply[..len as usize]);
+            let reply: hli::calls::cam::CamReply =
+                bytemuck::pod_read_unaligned(&reply[..len as usize]);
             assert_eq!(reply.error_id, 0);
         };
-    let mode = hli::calls::CamOnlineModeCall {
+    let mode = hli::calls::cam::CamOnlineModeCall {
         activation_mode: 3,
         ..Default::default()
     };
     send(
         &mut run,
-        hli::calls::CallKind::CamOnlineMode,
+        hli::calls::CallKind::CAM_ONLINE_MODE,
         1,
         hli::wire::encode_body(&mode),
     );
-    let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
-    points[0] = hli::calls::McMotionFunctionPoint {
+    let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
+    points[0] = hli::calls::cam::McMotionFunctionPoint {
         point_index: 4,
         function_type: 15,
         point_type: 2,
@@ -148,16 +151,16 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         slave_pos: 30.0,
         ..Default::default()
     };
-    let write = hli::calls::CamPointsWriteCall {
+    let write = hli::calls::cam::CamPointsWriteCall {
         first: 4,
         count: 1,
-        flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
         total: 1,
         points,
     };
     send(
         &mut run,
-        hli::calls::CallKind::CamPointsWrite,
+        hli::calls::CallKind::CAM_POINTS_WRITE,
         1,
         hli::wire::encode_body(&write),
     );

@@ -3,14 +3,13 @@
 
 use cnc_core::cam::file::{self, BinaryOptions};
 use cnc_core::cam::table::TableCursor;
-use cnc_core::cam::{
-    CamError, CamProfile, Interpolation, PositionTable, TableErrorCode, TableType,
-};
+use cnc_core::cam::{CamError, CamProfile, PositionTable, TableErrorCode, TableType};
+use hli::calls::cam::CamInterpolation;
 
-const ALL: [Interpolation; 3] = [
-    Interpolation::Linear,
-    Interpolation::FourPoint,
-    Interpolation::Spline,
+const ALL: [CamInterpolation; 3] = [
+    CamInterpolation::Linear,
+    CamInterpolation::FourPoint,
+    CamInterpolation::Spline,
 ];
 
 fn cubic(x: f64) -> (f64, f64) {
@@ -39,7 +38,7 @@ fn every_interpolation_reproduces_its_support_points() {
     let wavy = |x: f64| (0.7 * x).sin() * 3.0 + 0.1 * x;
     for periodic in [false, true] {
         for interpolation in ALL {
-            let types: &[TableType] = if interpolation == Interpolation::FourPoint {
+            let types: &[TableType] = if interpolation == CamInterpolation::FourPoint {
                 &[TableType::Equidistant]
             } else {
                 &[TableType::Equidistant, TableType::NonEquidistant]
@@ -70,16 +69,20 @@ fn every_interpolation_reproduces_its_support_points() {
 fn four_point_and_spline_reproduce_a_cubic() {
     for (interpolation, masters, ty) in [
         (
-            Interpolation::FourPoint,
+            CamInterpolation::FourPoint,
             equidistant(30, 0.4),
             TableType::Equidistant,
         ),
         (
-            Interpolation::Spline,
+            CamInterpolation::Spline,
             equidistant(30, 0.4),
             TableType::Equidistant,
         ),
-        (Interpolation::Spline, uneven(30), TableType::NonEquidistant),
+        (
+            CamInterpolation::Spline,
+            uneven(30),
+            TableType::NonEquidistant,
+        ),
     ] {
         let t = PositionTable::new(&rows_of(&masters, |x| cubic(x).0), ty, interpolation, false)
             .unwrap();
@@ -109,7 +112,7 @@ fn four_point_and_spline_reproduce_a_cubic() {
     let t = PositionTable::new(
         &rows_of(&equidistant(30, 0.4), |x| cubic(x).0),
         TableType::Equidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         false,
     )
     .unwrap();
@@ -143,7 +146,13 @@ fn cyclic_tables_continue_with_stroke_and_cycle_counter_without_drift() {
         assert!((far.sample.velocity - base.sample.velocity).abs() < 1e-9);
     }
     // The periodic spline is smooth across the period boundary.
-    let t = PositionTable::new(&rows, TableType::Equidistant, Interpolation::Spline, true).unwrap();
+    let t = PositionTable::new(
+        &rows,
+        TableType::Equidistant,
+        CamInterpolation::Spline,
+        true,
+    )
+    .unwrap();
     let mut c = TableCursor::default();
     let (l, r) = (
         t.eval(360.0 - 1e-9, &mut c).sample,
@@ -157,8 +166,13 @@ fn cyclic_tables_continue_with_stroke_and_cycle_counter_without_drift() {
 #[test]
 fn linear_tables_hold_their_edge_values_outside() {
     let rows = [[0.0, 1.0], [10.0, 3.0], [20.0, 2.0]];
-    let t =
-        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    let t = PositionTable::new(
+        &rows,
+        TableType::Equidistant,
+        CamInterpolation::Linear,
+        false,
+    )
+    .unwrap();
     let mut c = TableCursor::default();
     for (x, y) in [(-5.0, 1.0), (25.0, 2.0), (5.0, 2.0), (15.0, 2.5)] {
         let s = t.eval(x, &mut c);
@@ -172,8 +186,13 @@ fn a_support_point_belongs_to_the_interval_the_seed_names() {
     // Equidistant: T[k] <= x < T[k+1]; non-equidistant: T[k] < x <= T[k+1].
     let rows = [[0.0, 0.0], [1.0, 1.0], [2.0, 3.0]];
     let mut c = TableCursor::default();
-    let eq =
-        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    let eq = PositionTable::new(
+        &rows,
+        TableType::Equidistant,
+        CamInterpolation::Linear,
+        false,
+    )
+    .unwrap();
     assert_eq!(
         eq.eval(1.0, &mut c).sample.velocity,
         2.0,
@@ -182,7 +201,7 @@ fn a_support_point_belongs_to_the_interval_the_seed_names() {
     let ne = PositionTable::new(
         &rows,
         TableType::NonEquidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         false,
     )
     .unwrap();
@@ -246,7 +265,7 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
     let e = PositionTable::new(
         &back,
         TableType::NonEquidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         false,
     )
     .unwrap_err();
@@ -263,7 +282,7 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
     let e = PositionTable::new(
         &rows_of(&uneven(6), |x| x),
         TableType::Equidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         false,
     )
     .unwrap_err();
@@ -271,15 +290,20 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
 
     let mut nan = good.clone();
     nan[2][1] = f64::NAN;
-    let e =
-        PositionTable::new(&nan, TableType::Equidistant, Interpolation::Linear, false).unwrap_err();
+    let e = PositionTable::new(
+        &nan,
+        TableType::Equidistant,
+        CamInterpolation::Linear,
+        false,
+    )
+    .unwrap_err();
     assert_eq!(e.code(), TableErrorCode::NumRowsInvalid);
     assert!(e.to_string().contains("row 2"));
 
     let e = PositionTable::new(
         &good[..3],
         TableType::Equidistant,
-        Interpolation::FourPoint,
+        CamInterpolation::FourPoint,
         false,
     )
     .unwrap_err();
@@ -287,7 +311,7 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
     let e = PositionTable::new(
         &rows_of(&uneven(6), |x| x),
         TableType::NonEquidistant,
-        Interpolation::FourPoint,
+        CamInterpolation::FourPoint,
         false,
     )
     .unwrap_err();
@@ -306,7 +330,8 @@ fn bad_tables_are_refused_with_the_seed_codes_and_the_row() {
 
 mod lookup {
     use cnc_core::cam::table::TableCursor;
-    use cnc_core::cam::{Interpolation, PositionTable, TableType};
+    use cnc_core::cam::{PositionTable, TableType};
+    use hli::calls::cam::CamInterpolation;
     use proptest::prelude::*;
 
     proptest! {
@@ -319,7 +344,7 @@ mod lookup {
         ) {
             let mut x = 0.0;
             let rows: Vec<[f64; 2]> = steps.iter().enumerate().map(|(i, s)| { x += s; [x, (i as f64 * 0.37).sin()] }).collect();
-            let t = PositionTable::new(&rows, TableType::NonEquidistant, Interpolation::Linear, false).unwrap();
+            let t = PositionTable::new(&rows, TableType::NonEquidistant, CamInterpolation::Linear, false).unwrap();
             let (lo, hi) = t.master_range();
             let mut cursor = TableCursor::default();
             for q in queries {
@@ -339,8 +364,13 @@ fn near_equidistant_and_degenerate_rows_are_refused() {
     // Off by 0.0009 at a step of 0.001: not equidistant (the tolerance is 1e-9 of the step
     // plus rounding, not 1e-9 of the position).
     let rows = [[1e6, 0.0], [1e6 + 0.0019, 1.0], [1e6 + 0.002, 2.0]];
-    let e = PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false)
-        .unwrap_err();
+    let e = PositionTable::new(
+        &rows,
+        TableType::Equidistant,
+        CamInterpolation::Linear,
+        false,
+    )
+    .unwrap_err();
     assert!(matches!(e, CamError::NotEquidistant { row: 1, .. }), "{e}");
     let even = file::write_binary(&rows).unwrap();
     let CamProfile::Table(t) = file::parse(&even, BinaryOptions::default())
@@ -358,7 +388,7 @@ fn near_equidistant_and_degenerate_rows_are_refused() {
     let e = PositionTable::new(
         &[[0.0, 0.0], [5e-324, 1.0]],
         TableType::NonEquidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         false,
     )
     .unwrap_err();
@@ -367,7 +397,7 @@ fn near_equidistant_and_degenerate_rows_are_refused() {
     let e = PositionTable::new(
         &[[-1e308, 0.0], [1e308, 1.0]],
         TableType::Equidistant,
-        Interpolation::Linear,
+        CamInterpolation::Linear,
         true,
     )
     .unwrap_err();
@@ -378,8 +408,13 @@ fn near_equidistant_and_degenerate_rows_are_refused() {
 fn an_equidistant_row_belongs_to_the_interval_above_it_despite_rounding() {
     // Steps of 1/3 do not add up exactly: every row must still open its own interval.
     let rows: Vec<[f64; 2]> = (0..50).map(|i| [i as f64 / 3.0, (i * i) as f64]).collect();
-    let t =
-        PositionTable::new(&rows, TableType::Equidistant, Interpolation::Linear, false).unwrap();
+    let t = PositionTable::new(
+        &rows,
+        TableType::Equidistant,
+        CamInterpolation::Linear,
+        false,
+    )
+    .unwrap();
     let mut c = TableCursor::default();
     for k in 0..48 {
         let s = t.eval(rows[k][0], &mut c).sample;
@@ -413,7 +448,7 @@ fn splines_are_smooth_at_every_row_and_periodic_ones_reproduce_a_periodic_functi
         let t = PositionTable::new(
             &rows,
             TableType::NonEquidistant,
-            Interpolation::Spline,
+            CamInterpolation::Spline,
             periodic,
         )
         .unwrap();

@@ -94,7 +94,7 @@ fn switching_tracking_on_and_off_decodes_without_allocating() {
 fn the_machine_tick_with_single_axes_an_engine_and_a_plc_allocates_nothing() {
     use cnc_core::app::scenario::file::Scenario;
     use cnc_core::app::scenario::machine::InProcess;
-    use hli::rpc::AxisCommandCall;
+    use hli::calls::axis::AxisCommandCall;
     let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"portal\"\n\
         axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"loop.nc\"\n\
         drive = { model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }\n\

@@ -6,12 +6,12 @@
 use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode, DriveProtocol};
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
+use hli::calls::axis::AxisCommandCall;
 use hli::enums::{axis_status, drive_flags, AxisError, DriveState};
 use hli::layout::{
     HliAxis, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
 };
 use hli::raw::ImageMemory;
-use hli::rpc::AxisCommandCall;
 use hli::views::CncView;
 use hli::PlaceExt;
 
@@ -520,7 +520,7 @@ fn a_scenario_configures_the_image_options_and_the_machine_answers_probe_calls()
         .read();
     // Powered at start through the CiA 402 sequence.
     assert_eq!(state.drive_state_r, DriveState::OperationEnabled.raw());
-    let arm = hli::probe_calls::ProbeArmCall {
+    let arm = hli::calls::probe::ProbeArmCall {
         probe: 2,
         edge: hli::enums::ProbeEdge::Negative.raw(),
         ..Default::default()

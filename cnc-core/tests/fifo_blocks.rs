@@ -2,7 +2,7 @@
 //! Busy is ignored (one block travels, its answer is kept), and no answer within the
 //! timeout is an Error.
 
-use hli::fifo_calls::{FifoReply, FifoStartCall};
+use hli::calls::fifo::{FifoReply, FifoStartCall};
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::fifo::{FifoStart, FifoWrite};
 use plc_shim::kernel::ERROR_NO_ANSWER;

@@ -5,13 +5,13 @@
 //! ending the job.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::{AcyclicCall, AxisCommandCall};
-use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
-use hli::fifo_calls::{
-    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::{
+    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
     FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall,
-    FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
 };
+use hli::calls::AcyclicCall;
+use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 use hli::views::{CncView, PlcView};
 
@@ -204,7 +204,7 @@ fn pt2(run: &mut InProcess, t0_s: f64) {
         FifoParametersCall {
             fifo_cycle_s: 0.001,
             pt2_t0_s: t0_s,
-            override_type: FIFO_OVERRIDE_PT2,
+            override_type: FifoOverrideType::Pt2.raw(),
             reserved: 0,
         },
     );
@@ -217,9 +217,9 @@ fn pt2(run: &mut InProcess, t0_s: f64) {
 fn pt2_override_is_continuous_and_settles() {
     let rows: Vec<[f64; 3]> = (0..2000).map(|k| [k as f64 * 0.1, 0.0, 0.0]).collect();
     let mut jumps = Vec::new();
-    for kind in [FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2] {
+    for kind in [FifoOverrideType::Instant.raw(), FifoOverrideType::Pt2.raw()] {
         let mut run = machine(&instant(4000, 1.0));
-        if kind == FIFO_OVERRIDE_PT2 {
+        if kind == FifoOverrideType::Pt2.raw() {
             pt2(&mut run, 0.02);
         }
         integrate(&mut run);

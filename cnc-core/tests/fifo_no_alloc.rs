@@ -5,11 +5,11 @@
 //! cycle: counted apart and pinned at 3 per block.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::AcyclicCall;
-use hli::enums::FifoGroupState;
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall, FifoStopCall,
 };
+use hli::calls::AcyclicCall;
+use hli::enums::FifoGroupState;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
 use plc_shim::fifo::FifoWrite;

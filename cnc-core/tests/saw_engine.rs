@@ -7,13 +7,12 @@
 use cnc_core::app::scenario::{InProcess, Scenario};
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw;
-use hli::calls::AxisCommandCall;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{
+    sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget,
+};
 use hli::enums::{AxisError, AxisState, CouplingState, SawError};
 use hli::layout::HliAxisLrState;
-use hli::saw_calls::{
-    sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SAW_ON_POSITION, SAW_ON_VELOCITY,
-    SYNC_TIME_BASED,
-};
 use hli::views::{CncView, PlcView};
 
 const TICK: f64 = 0.001;
@@ -120,7 +119,7 @@ fn moving(slave_velocity: f64) -> InProcess {
 fn velocity_call(ratio: f64, mask: u32) -> SawGearInCall {
     SawGearInCall {
         master: MASTER as u32,
-        target: SAW_ON_VELOCITY,
+        target: SawSyncTarget::Velocity.raw(),
         ratio_numerator: ratio,
         ratio_denominator: 1,
         mask,
@@ -133,7 +132,7 @@ fn velocity_call(ratio: f64, mask: u32) -> SawGearInCall {
 
 fn position_call(ms: f64, ss: f64, ratio: f64, mask: u32) -> SawGearInCall {
     SawGearInCall {
-        target: SAW_ON_POSITION,
+        target: SawSyncTarget::Position.raw(),
         master_sync_position: ms,
         slave_sync_position: ss,
         ..velocity_call(ratio, mask)
@@ -367,7 +366,7 @@ fn a_refused_command_leaves_the_slave_moving_as_before() {
         ),
         (
             SawGearInCall {
-                sync_mode: SYNC_TIME_BASED,
+                sync_mode: SawSyncMode::TimeBased.raw(),
                 ..position_call(m0 + 1e3, s0 + 1e3, 1.0, 0)
             },
             SawError::TimeBasedPosition.raw(),
@@ -503,7 +502,7 @@ fn the_diagonal_saw_moves_with_the_master_along_the_master() {
 fn the_time_based_phase_runs_on_time_and_ends_synchronous() {
     let mut run = moving(-250.0);
     let call = SawGearInCall {
-        sync_mode: SYNC_TIME_BASED,
+        sync_mode: SawSyncMode::TimeBased.raw(),
         ..velocity_call(1.0, m::MAXACC | m::MAXJERK)
     };
     assert_eq!(gear_in(&mut run, SAW, call), 0);

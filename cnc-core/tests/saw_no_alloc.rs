@@ -3,9 +3,9 @@
 //! plan made inside the tick when the master comes forward again.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use hli::calls::AxisCommandCall;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{sync_mask, SawGearInCall, SawSyncTarget};
 use hli::enums::AxisState;
-use hli::saw_calls::{sync_mask, SawGearInCall, SAW_ON_VELOCITY};
 use hli::views::{CncView, PlcView};
 
 #[path = "../../tests/support/counting_alloc.rs"]
@@ -45,7 +45,7 @@ fn the_saw_tick_allocates_nothing() {
     ticks(&mut run, 200);
     let gear_in = SawGearInCall {
         master: 0,
-        target: SAW_ON_VELOCITY,
+        target: SawSyncTarget::Velocity.raw(),
         ratio_numerator: 1.0,
         ratio_denominator: 1,
         mask: sync_mask::ROLLBACKLOCK,

@@ -5,8 +5,8 @@
 
 use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw::{self, Limits, Plan, SawRequest, Shape, SyncOn};
+use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
-use hli::saw_calls::sync_mask as m;
 use proptest::prelude::*;
 
 const TICK: f64 = 0.001;

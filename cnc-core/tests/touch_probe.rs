@@ -9,11 +9,11 @@
 use cnc_core::axis::config::{AxisConfig, DriveLink, ProbeInterface};
 use cnc_core::axis::sim_drive::SimDriveConfig;
 use cnc_core::axis::AxisSet;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{AxisError, ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe, NcEncoderIn, NcEncoderOut};
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
 use hli::raw::ImageMemory;
-use hli::rpc::AxisCommandCall;
 use hli::views::CncView;
 use hli::PlaceExt;
 

@@ -48,6 +48,53 @@ macro_rules! hli_enum {
     };
 }
 
+/// Declares a mode selector a call body carries as a raw `u32`: the enum, and `raw`,
+/// `from_raw` (`None` for a number it does not have), `name`, `from_name` (ASCII case
+/// ignored) and `ALL`, the names being what timelines and command lines give.
+macro_rules! wire_enum {
+    (
+        $(#[doc = $doc:literal])*
+        $name:ident {
+            $( $(#[doc = $vdoc:literal])* $variant:ident = $value:literal => $text:literal ),* $(,)?
+        }
+    ) => {
+        $(#[doc = $doc])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum $name {
+            $( $(#[doc = $vdoc])* $variant, )*
+        }
+
+        impl $name {
+            /// Every value, in declaration order.
+            pub const ALL: &'static [$name] = &[$($name::$variant),*];
+
+            /// The raw value on the wire.
+            pub const fn raw(self) -> u32 {
+                match self { $( $name::$variant => $value, )* }
+            }
+
+            /// The value of a raw number, `None` for a number it does not have.
+            pub const fn from_raw(raw: u32) -> Option<Self> {
+                match raw {
+                    $( $value => Some($name::$variant), )*
+                    _ => None,
+                }
+            }
+
+            /// The value's name.
+            pub const fn name(self) -> &'static str {
+                match self { $( $name::$variant => $text, )* }
+            }
+
+            /// The value of a name (ASCII case ignored), `None` for a name it does not have.
+            pub fn from_name(name: &str) -> Option<Self> {
+                Self::ALL.iter().copied().find(|v| v.name().eq_ignore_ascii_case(name))
+            }
+        }
+    };
+}
+pub(crate) use wire_enum;
+
 hli_enum! {
     /// `HLI_DYN_CS_*`: state of a tracking channel. Carried in a UDINT, so ERROR (-1) is
     /// stored as 0xFFFF_FFFF.

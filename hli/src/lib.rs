@@ -7,9 +7,10 @@
 //! * [`segment`]: the shared-memory object (create, attach, validate, heartbeats);
 //! * [`handshake`]: the semaphore protocols as typed handles; [`views`]: the CNC's and the
 //!   PLC's side of an image;
-//! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (kinds,
-//!   bodies, codes), [`fifo_calls`] (the FIFO group's calls and row blocks), [`rpc`] (the
-//!   iceoryx2 request-response transports; re-exports all three);
+//! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (what
+//!   every call has in common, the kinds, the refusal codes; one module per family of
+//!   calls: [`calls::cam`], [`calls::fifo`] ...), [`rpc`] (the iceoryx2 request-response
+//!   transports);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
 //! All `unsafe` code is in [`raw`]. The crate has no motion logic.
@@ -19,16 +20,12 @@ pub mod c_header;
 pub mod calls;
 pub mod command_book;
 pub mod desc;
-pub mod diag_calls;
 pub mod enums;
 pub mod events;
-pub mod fifo_calls;
 pub mod handshake;
 pub mod layout;
-pub mod probe_calls;
 pub mod raw;
 pub mod rpc;
-pub mod saw_calls;
 pub mod segment;
 pub mod signals;
 pub mod symbols;

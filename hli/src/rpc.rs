@@ -1,13 +1,13 @@
 //! The transport of the acyclic ADS-like calls from the PLC to the CNC: an iceoryx2
 //! request-response service carrying the frames of [`crate::wire`], one call per PLC block
 //! Execute edge (table writes, coupling commands, FIFO row blocks, reads of characteristic
-//! values...). The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`];
-//! both are re-exported here. The CNC-side handlers live with the CNC's view
+//! values...). The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
+//! and its families; this module is the transport alone. The CNC-side handlers live with the CNC's view
 //! ([`crate::views::handle_read_axis_state`]) and in the engines.
 
-pub use crate::calls::*;
-pub use crate::fifo_calls::*;
-pub use crate::wire::*;
+use crate::calls::fifo::{FifoReply, FifoRowsHeader, FIFO_BLOCK_VALUES};
+use crate::calls::{AcyclicCall, CallError, CallKind, ErrorCode, HandlerResult};
+use crate::wire::{encode_body, AcyclicRequest, AcyclicResponse, ACYCLIC_BODY_SIZE};
 use core::time::Duration;
 use iceoryx2::node::Node;
 use iceoryx2::port::client::Client;

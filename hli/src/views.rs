@@ -670,12 +670,12 @@ impl<'m> PlcAxis<'m> {
     }
 }
 
-/// The standard handler for [`crate::calls::ReadAxisState`] over a CNC view: validates the index.
+/// The standard handler for [`crate::calls::axis::ReadAxisState`] over a CNC view: validates the index.
 pub fn handle_read_axis_state(
     view: &CncView<'_>,
     request: &crate::wire::AcyclicRequest,
 ) -> crate::calls::HandlerResult {
-    let body: crate::calls::ReadAxisState = crate::calls::decode_body(request)?;
+    let body: crate::calls::axis::ReadAxisState = crate::calls::decode_body(request)?;
     if body.reserved != 0 {
         return Err(crate::calls::ErrorCode::InvalidData);
     }

@@ -11,9 +11,8 @@ use crate::kernel::{
     call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
 };
 use crate::runtime::PlcIo;
-use hli::calls::{
-    AcyclicCall, CallError, CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall,
-};
+use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall};
+use hli::calls::{AcyclicCall, CallError};
 use hli::enums::{AxisState, CouplingState};
 use hli::rpc::PendingCall;
 
@@ -349,21 +348,21 @@ pub struct McWriteMotionFunctionPoint {
     /// Input: the table ID.
     pub table: u32,
     /// Input: the point.
-    pub point: hli::calls::McMotionFunctionPoint,
+    pub point: hli::calls::cam::McMotionFunctionPoint,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<hli::calls::CamPointsWriteCall>,
+    core: CamCore<hli::calls::cam::CamPointsWriteCall>,
 }
 
 impl McWriteMotionFunctionPoint {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let mut points = [hli::calls::McMotionFunctionPoint::default(); 4];
+        let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
         points[0] = self.point;
-        let call = hli::calls::CamPointsWriteCall {
+        let call = hli::calls::cam::CamPointsWriteCall {
             first: self.point.point_index,
             count: 1,
-            flags: hli::calls::CAM_CHUNK_FIRST | hli::calls::CAM_CHUNK_LAST,
+            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
             total: 1,
             points,
         };
@@ -389,13 +388,13 @@ pub struct McSetCamOnlineChangeMode {
     pub slave_scaling_mode: u32,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<hli::calls::CamOnlineModeCall>,
+    core: CamCore<hli::calls::cam::CamOnlineModeCall>,
 }
 
 impl McSetCamOnlineChangeMode {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let call = hli::calls::CamOnlineModeCall {
+        let call = hli::calls::cam::CamOnlineModeCall {
             activation_mode: self.activation_mode,
             master_scaling_mode: self.master_scaling_mode,
             slave_scaling_mode: self.slave_scaling_mode,
@@ -423,12 +422,12 @@ pub enum CamData {
         interpolation: u32,
     },
     /// Motion-function points.
-    Points(std::sync::Arc<[hli::calls::McMotionFunctionPoint]>),
+    Points(std::sync::Arc<[hli::calls::cam::McMotionFunctionPoint]>),
 }
 
 enum Pending {
-    Rows(PendingCall<hli::calls::CamRowsWriteCall>),
-    Points(PendingCall<hli::calls::CamPointsWriteCall>),
+    Rows(PendingCall<hli::calls::cam::CamRowsWriteCall>),
+    Points(PendingCall<hli::calls::cam::CamPointsWriteCall>),
 }
 
 /// [`CamData`] on its way to table `table`, chunk by chunk, one chunk in flight and one per
@@ -456,10 +455,10 @@ impl core::fmt::Debug for ChunkTransfer {
 fn chunk_flags(first: bool, last: bool) -> u32 {
     let mut flags = 0;
     if first {
-        flags |= hli::calls::CAM_CHUNK_FIRST;
+        flags |= hli::calls::cam::CAM_CHUNK_FIRST;
     }
     if last {
-        flags |= hli::calls::CAM_CHUNK_LAST;
+        flags |= hli::calls::cam::CAM_CHUNK_LAST;
     }
     flags
 }
@@ -489,11 +488,11 @@ impl ChunkTransfer {
             } => {
                 let chunk = rows
                     .get(self.next..)?
-                    .get(..hli::calls::CAM_ROWS_PER_CALL.min(rows.len() - self.next))?;
+                    .get(..hli::calls::cam::CAM_ROWS_PER_CALL.min(rows.len() - self.next))?;
                 if chunk.is_empty() {
                     return None;
                 }
-                let mut call = hli::calls::CamRowsWriteCall {
+                let mut call = hli::calls::cam::CamRowsWriteCall {
                     first_row: self.next as u32,
                     count: chunk.len() as u32,
                     flags: chunk_flags(self.next == 0, self.next + chunk.len() == rows.len()),
@@ -508,7 +507,7 @@ impl ChunkTransfer {
                 Some(io.acyclic.start(self.table, &call).map(Pending::Rows))
             }
             CamData::Points(points) => {
-                let per = hli::calls::CAM_POINTS_PER_CALL;
+                let per = hli::calls::cam::CAM_POINTS_PER_CALL;
                 let chunk = points
                     .get(self.next..)?
                     .get(..per.min(points.len() - self.next))?;
@@ -517,11 +516,11 @@ impl ChunkTransfer {
                 }
                 let last = self.next + chunk.len() == points.len();
                 let create = if self.create {
-                    hli::calls::CAM_POINTS_CREATE
+                    hli::calls::cam::CAM_POINTS_CREATE
                 } else {
                     0
                 };
-                let mut call = hli::calls::CamPointsWriteCall {
+                let mut call = hli::calls::cam::CamPointsWriteCall {
                     first: chunk[0].point_index,
                     count: chunk.len() as u32,
                     flags: chunk_flags(self.next == 0, last) | create,
@@ -631,8 +630,8 @@ pub const ERROR_ARRAY_SIZE: u32 = 0x4B31;
 /// buffer); answered with the columns per row once all are in.
 pub struct PartRead {
     target: u32,
-    request: hli::calls::CamReadCall,
-    pending: PendingCall<hli::calls::CamReadCall>,
+    request: hli::calls::cam::CamReadCall,
+    pending: PendingCall<hli::calls::cam::CamReadCall>,
 }
 
 impl core::fmt::Debug for PartRead {
@@ -647,7 +646,7 @@ impl PartRead {
     fn start(
         io: &mut PlcIo<'_>,
         target: u32,
-        request: hli::calls::CamReadCall,
+        request: hli::calls::cam::CamReadCall,
     ) -> Result<PartRead, u32> {
         let pending = io
             .acyclic
@@ -701,7 +700,7 @@ pub struct McCamRead {
     /// Input: a rising edge starts the read.
     pub execute: bool,
     /// What is read and its parameters (the target is set by [`McCamRead::target`]).
-    pub request: hli::calls::CamReadCall,
+    pub request: hli::calls::cam::CamReadCall,
     /// Table ID, or the slave axis of MC_CamInfo.
     pub target: u32,
     /// Output: the numbers read.
@@ -721,7 +720,7 @@ impl McCamRead {
     pub fn new(what: u32, room: usize) -> McCamRead {
         McCamRead {
             execute: false,
-            request: hli::calls::CamReadCall {
+            request: hli::calls::cam::CamReadCall {
                 what,
                 ..Default::default()
             },
@@ -744,7 +743,11 @@ impl McCamRead {
         let columns = &mut self.columns;
         let send = |io: &mut PlcIo<'_>, values: &mut Vec<f64>| {
             values.clear();
-            PartRead::start(io, target, hli::calls::CamReadCall { part: 0, ..request })
+            PartRead::start(
+                io,
+                target,
+                hli::calls::cam::CamReadCall { part: 0, ..request },
+            )
         };
         self.out = self.kernel.cycle_with(
             io,
@@ -766,7 +769,7 @@ pub struct PointsRead {
     table: u32,
     first: u32,
     count: u32,
-    pending: PendingCall<hli::calls::CamPointsReadCall>,
+    pending: PendingCall<hli::calls::cam::CamPointsReadCall>,
 }
 
 impl core::fmt::Debug for PointsRead {
@@ -781,8 +784,8 @@ fn read_points(
     io: &mut PlcIo<'_>,
     table: u32,
     first: u32,
-) -> Result<PendingCall<hli::calls::CamPointsReadCall>, u32> {
-    let call = hli::calls::CamPointsReadCall { first, count: 0 };
+) -> Result<PendingCall<hli::calls::cam::CamPointsReadCall>, u32> {
+    let call = hli::calls::cam::CamPointsReadCall { first, count: 0 };
     io.acyclic
         .start(table, &call)
         .map_err(|e| call_error_code(&e))
@@ -790,7 +793,7 @@ fn read_points(
 
 impl InFlight for PointsRead {
     type Reply = ();
-    type Buffer = Vec<hli::calls::McMotionFunctionPoint>;
+    type Buffer = Vec<hli::calls::cam::McMotionFunctionPoint>;
 
     fn poll(&mut self, io: &mut PlcIo<'_>, points: &mut Self::Buffer) -> Polled<()> {
         let reply = match self.pending.poll() {
@@ -836,7 +839,7 @@ pub struct McReadMotionFunction {
     /// Input: points wanted (0: all from `first`).
     pub count: u32,
     /// Output: the points read.
-    pub points: Vec<hli::calls::McMotionFunctionPoint>,
+    pub points: Vec<hli::calls::cam::McMotionFunctionPoint>,
     /// Outputs of the last call.
     pub out: Outputs,
     kernel: Kernel<PointsRead>,
@@ -859,7 +862,8 @@ impl McReadMotionFunction {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (table, first, count) = (self.table, self.first, self.count);
-        let send = |io: &mut PlcIo<'_>, points: &mut Vec<hli::calls::McMotionFunctionPoint>| {
+        let send = |io: &mut PlcIo<'_>,
+                    points: &mut Vec<hli::calls::cam::McMotionFunctionPoint>| {
             points.clear();
             Ok(PointsRead {
                 table,
@@ -888,10 +892,10 @@ pub struct CamTableSetWeight {
     /// Input: the table ID.
     pub table: u32,
     /// Input: the scaling.
-    pub weight: hli::calls::CamTableWeightCall,
+    pub weight: hli::calls::cam::CamTableWeightCall,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<hli::calls::CamTableWeightCall>,
+    core: CamCore<hli::calls::cam::CamTableWeightCall>,
 }
 
 impl Default for CamTableSetWeight {
@@ -899,7 +903,7 @@ impl Default for CamTableSetWeight {
         Self {
             execute: false,
             table: 0,
-            weight: hli::calls::CamTableWeightCall {
+            weight: hli::calls::cam::CamTableWeightCall {
                 weight: 1.0,
                 master_slope: 1.0,
                 slave_slope: 1.0,
@@ -940,13 +944,13 @@ pub struct CamTableCoupleAxesMultiTables {
     pub profiles: u32,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<hli::calls::CamMultiCoupleCall>,
+    core: CamCore<hli::calls::cam::CamMultiCoupleCall>,
 }
 
 impl CamTableCoupleAxesMultiTables {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
-        let call = hli::calls::CamMultiCoupleCall {
+        let call = hli::calls::cam::CamMultiCoupleCall {
             master: self.master,
             on: u32::from(self.on),
             tables: self.count,
@@ -964,8 +968,8 @@ impl CamTableCoupleAxesMultiTables {
 pub struct CamMultiTable {
     /// Input: a rising edge sends it.
     pub execute: bool,
-    /// What it does: [`hli::calls::CAM_MULTI_ENABLE_CORRECTION`] or
-    /// [`hli::calls::CAM_MULTI_STOP_CYCLIC`].
+    /// What it does: [`hli::calls::cam::CAM_MULTI_ENABLE_CORRECTION`] or
+    /// [`hli::calls::cam::CAM_MULTI_STOP_CYCLIC`].
     pub op: u32,
     /// Input: the table ID.
     pub table: u32,
@@ -975,13 +979,13 @@ pub struct CamMultiTable {
     pub position: f64,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<hli::calls::CamMultiTableCall>,
+    core: CamCore<hli::calls::cam::CamMultiTableCall>,
 }
 
 impl CamMultiTable {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
-        let call = hli::calls::CamMultiTableCall {
+        let call = hli::calls::cam::CamMultiTableCall {
             op: self.op,
             table: self.table,
             flags: u32::from(self.at_position),

@@ -19,7 +19,7 @@
 use crate::cam::{CamCore, CamData, ChunkTransfer, McCamRead};
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
-use hli::calls::{
+use hli::calls::cam::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,

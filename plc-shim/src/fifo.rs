@@ -14,11 +14,12 @@
 
 use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
-use hli::calls::AcyclicCall;
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
 };
+use hli::calls::AcyclicCall;
+
 use hli::rpc::{PendingCall, PendingRows};
 
 /// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).

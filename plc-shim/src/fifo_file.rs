@@ -134,7 +134,7 @@ impl RowReader {
             }
             let columns = u32::from_le_bytes(header[8..12].try_into().unwrap_or_default());
             let rows = u64::from_le_bytes(header[16..24].try_into().unwrap_or_default());
-            if columns == 0 || columns > hli::fifo_calls::FIFO_MAX_DIMENSION {
+            if columns == 0 || columns > hli::calls::fifo::FIFO_MAX_DIMENSION {
                 return Err(FileError::Binary {
                     file,
                     message: format!("{columns} columns: 1 to 16"),
@@ -170,7 +170,7 @@ impl RowReader {
             }
         }
         let columns = first.as_ref().map_or(0, Vec::len);
-        if columns > hli::fifo_calls::FIFO_MAX_DIMENSION as usize {
+        if columns > hli::calls::fifo::FIFO_MAX_DIMENSION as usize {
             return Err(FileError::Csv {
                 file,
                 line,

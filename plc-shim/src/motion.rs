@@ -9,10 +9,11 @@
 
 use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
-use hli::rpc::{AxisCommandCall, AxisCommandReply, PendingCall};
+use hli::rpc::PendingCall;
 use hli::PlaceExt;
 
 /// The block kernel as the motion blocks use it: the accepted command's id is followed in
@@ -37,7 +38,7 @@ fn follow(io: &PlcIo<'_>, axis: u32, id: u32, finished_when_reached: bool) -> St
         Ok(place) => place
             .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
             .read(),
-        Err(_) => return Step::Ended(Outputs::failed(hli::rpc::ErrorCode::InvalidTarget.raw())),
+        Err(_) => return Step::Ended(Outputs::failed(hli::calls::ErrorCode::InvalidTarget.raw())),
     };
     match view_command(&book, id) {
         CommandView::Busy(reached) if reached && finished_when_reached => Step::Ended(Outputs {

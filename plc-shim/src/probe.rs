@@ -5,9 +5,9 @@
 
 use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe};
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
 use hli::rpc::PendingCall;
 use hli::PlaceExt;
 
@@ -36,9 +36,9 @@ fn follow_arming(image: Option<HliAxisProbe>, id: u32) -> Step<f64> {
             Ok(ProbeState::Recorded) => Outputs::done(p.recorded_position_r),
             Ok(ProbeState::Aborted) if p.error_id_r != 0 => failed(p.error_id_r),
             Ok(ProbeState::Aborted) | Ok(ProbeState::Idle) => Outputs::aborted(),
-            Err(_) => failed(hli::rpc::ErrorCode::InvalidData.raw()),
+            Err(_) => failed(hli::calls::ErrorCode::InvalidData.raw()),
         },
-        None => failed(hli::rpc::ErrorCode::InvalidTarget.raw()),
+        None => failed(hli::calls::ErrorCode::InvalidTarget.raw()),
     };
     Step::Ended(out)
 }

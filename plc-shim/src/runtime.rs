@@ -17,9 +17,10 @@
 //! already finished more ticks than the period when the cycle started.
 
 use core::time::Duration;
+use hli::calls::CallError;
 use hli::enums::SegmentState;
 use hli::events::{EventError, EventLink, Side};
-use hli::rpc::{AcyclicClient, CallError};
+use hli::rpc::AcyclicClient;
 use hli::segment::{AttachError, HeartbeatWatch, PeerLiveness, PlcSegment};
 use hli::views::PlcView;
 

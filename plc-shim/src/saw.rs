@@ -24,13 +24,12 @@ use crate::kernel::{
     Waited, ERROR_NO_ANSWER,
 };
 use crate::runtime::PlcIo;
+use hli::calls::saw::{
+    SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
+};
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
 use hli::rpc::PendingCall;
-use hli::saw_calls::{
-    SawCharacCall, SawGearInCall, SawGearOutCall, SAW_CHARAC_PART, SAW_ON_POSITION,
-    SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
-};
 
 /// Version of this block library (like the FIFO library's version function).
 pub fn saw_library_version() -> &'static str {
@@ -74,7 +73,7 @@ pub const CHARAC_FIELDS: [&str; 31] = [
 ];
 
 /// `ST_SyncMode`: the profile kind and the check and operation flags as one bit mask
-/// ([`hli::saw_calls::sync_mask`]); the CNC refuses bits it does not know.
+/// ([`hli::calls::saw::sync_mask`]); the CNC refuses bits it does not know.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct SyncMode {
     /// GEARINSYNCMODE_TIMEBASED (MC_GearInVelo only) rather than position-based.
@@ -87,9 +86,9 @@ impl SyncMode {
     /// The raw `E_GearInSyncMode`.
     pub fn raw_mode(self) -> u32 {
         if self.time_based {
-            SYNC_TIME_BASED
+            SawSyncMode::TimeBased.raw()
         } else {
-            SYNC_POSITION_BASED
+            SawSyncMode::PositionBased.raw()
         }
     }
 }
@@ -328,7 +327,9 @@ impl McGearInVelo {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let call = self.inputs.call(self.master, SAW_ON_VELOCITY, [0.0; 2]);
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Velocity.raw(), [0.0; 2]);
         self.out = self.core.cycle(io, self.execute, self.slave, call);
     }
 }
@@ -378,7 +379,9 @@ impl McGearInPos {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let positions = [self.master_sync_position, self.slave_sync_position];
-        let call = self.inputs.call(self.master, SAW_ON_POSITION, positions);
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Position.raw(), positions);
         self.out = self.core.cycle(io, self.execute, self.slave, call);
     }
 }
@@ -549,10 +552,10 @@ impl McReadFlyingSawCharacteristics {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use hli::calls::saw::{SawCharacReply, SawReply};
     use hli::calls::{decode_body, reply, CallKind};
     use hli::layout::HliAxis;
     use hli::rpc::{AcyclicClient, AcyclicServer};
-    use hli::saw_calls::{SawCharacReply, SawReply};
     use hli::views::{CncView, PlcView};
     use hli::PlaceExt;
 
@@ -709,11 +712,11 @@ mod tests {
             true
         });
         let answered = server.poll(|kind, request| {
-            assert_eq!((kind, request.target), (CallKind::SawGearIn, 1));
+            assert_eq!((kind, request.target), (CallKind::SAW_GEAR_IN, 1));
             let call: SawGearInCall = decode_body(request)?;
             assert_eq!(
                 (call.target, call.master_sync_position),
-                (SAW_ON_POSITION, 100.0)
+                (SawSyncTarget::Position.raw(), 100.0)
             );
             reply(&SawReply::default())
         });
@@ -745,7 +748,7 @@ mod tests {
             true
         });
         let answered = server.poll(|kind, _| {
-            assert_eq!(kind, CallKind::SawGearOut);
+            assert_eq!(kind, CallKind::SAW_GEAR_OUT);
             reply(&SawReply::default())
         });
         assert_eq!(answered.unwrap(), 1);

@@ -121,7 +121,7 @@ pub fn serve_axes_in_lockstep(
     build: impl FnOnce() -> cnc_core::axis::AxisSet + Send + 'static,
     finished: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<bool> {
-    use hli::rpc::CallKind;
+    use hli::calls::CallKind;
     let segment = hli::segment::CncSegment::create(instance, 1, axes).unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
@@ -138,10 +138,10 @@ pub fn serve_axes_in_lockstep(
             }
             server
                 .poll(|kind, request| match kind {
-                    CallKind::AxisCommand => axes.handle_command(request),
-                    CallKind::ReadAxisState => hli::views::handle_read_axis_state(&view, request),
-                    CallKind::ProbeArm => axes.handle_probe(request, true),
-                    CallKind::ProbeAbort => axes.handle_probe(request, false),
+                    CallKind::AXIS_COMMAND => axes.handle_command(request),
+                    CallKind::READ_AXIS_STATE => hli::views::handle_read_axis_state(&view, request),
+                    CallKind::PROBE_ARM => axes.handle_probe(request, true),
+                    CallKind::PROBE_ABORT => axes.handle_probe(request, false),
                     _ => Err(hli::calls::ErrorCode::ServiceNotSupported),
                 })
                 .unwrap();

@@ -1,12 +1,12 @@
 //! The acyclic request-response plumbing and the wake-up events, between two threads of one
 //! process (the transport is the same iceoryx2 IPC service the processes use).
 
+use hli::calls::axis::ReadAxisState;
+use hli::calls::{AcyclicCall, CallError, CallKind, ErrorCode};
 use hli::enums::AxisState;
 use hli::events::{EventLink, Side};
 use hli::layout::{HliAxis, HliAxisLrState};
-use hli::rpc::{
-    AcyclicCall, AcyclicClient, AcyclicServer, CallError, CallKind, ErrorCode, ReadAxisState,
-};
+use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::segment::CncSegment;
 use hli::views::handle_read_axis_state;
 use hli::views::CncView;
@@ -23,7 +23,7 @@ struct OversizedRead {
     a: u64,
 }
 impl AcyclicCall for OversizedRead {
-    const KIND: CallKind = CallKind::ReadAxisState;
+    const KIND: CallKind = CallKind::READ_AXIS_STATE;
     type Reply = HliAxisLrState;
 }
 
@@ -59,7 +59,7 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
     while !stop.load(Ordering::Acquire) {
         answered += server
             .poll(|kind, request| match kind {
-                CallKind::ReadAxisState => handle_read_axis_state(&view, request),
+                CallKind::READ_AXIS_STATE => handle_read_axis_state(&view, request),
                 _ => Err(ErrorCode::ServiceNotSupported),
             })
             .unwrap();

@@ -1,7 +1,7 @@
 //! FIFO row blocks between processes: a PLC that dies while writing a block leaves no half
 //! block; the block it had sent before arrives whole.
 
-use hli::fifo_calls::FifoReply;
+use hli::calls::fifo::FifoReply;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -60,7 +60,7 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
     assert_eq!(*values, (0..30).map(f64::from).collect::<Vec<_>>());
     // The service goes on for the next PLC.
     let mut client = AcyclicClient::open(&instance).unwrap();
-    let header = hli::fifo_calls::FifoRowsHeader {
+    let header = hli::calls::fifo::FifoRowsHeader {
         group: 0,
         columns: 1,
         rows: 2,

@@ -3,7 +3,8 @@
 
 use crate::app::json::number as num;
 use crate::cam::file::{self, BinaryOptions, LoadError};
-use crate::cam::{CamProfile, CharacValues, Interpolation, ProfileCursor, Sample};
+use crate::cam::{CamProfile, CharacValues, ProfileCursor, Sample};
+use hli::calls::cam::CamInterpolation;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -13,17 +14,17 @@ use std::process::ExitCode;
 pub struct BinaryArgs {
     /// Interpolation of a binary table: linear, 4point or spline.
     #[arg(long, default_value = "linear", value_parser = parse_interpolation)]
-    interpolation: Interpolation,
+    interpolation: CamInterpolation,
     /// A binary table continues cyclically (master period, slave stroke).
     #[arg(long)]
     periodic: bool,
 }
 
-fn parse_interpolation(s: &str) -> Result<Interpolation, String> {
+fn parse_interpolation(s: &str) -> Result<CamInterpolation, String> {
     match s {
-        "linear" => Ok(Interpolation::Linear),
-        "4point" => Ok(Interpolation::FourPoint),
-        "spline" => Ok(Interpolation::Spline),
+        "linear" => Ok(CamInterpolation::Linear),
+        "4point" => Ok(CamInterpolation::FourPoint),
+        "spline" => Ok(CamInterpolation::Spline),
         _ => Err(format!("{s:?}: linear, 4point or spline")),
     }
 }

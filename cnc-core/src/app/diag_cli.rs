@@ -2,7 +2,7 @@
 //! log, in the controller's listing layout) of a channel of a running or a finished CNC.
 //!
 //! * **Running** (the instance's segment exists): the history and the log are read entry by
-//!   entry over the acyclic channel ([`hli::diag_calls`], a few calls in flight at a time; the
+//!   entry over the acyclic channel ([`hli::calls::diag`], a few calls in flight at a time; the
 //!   CNC answers between ticks from its rings) up to the entries recorded when the read
 //!   began, and rendered here.
 //! * **Finished**: `cnc demo` and `cnc run --keep-diagnosis` leave every channel's listing in
@@ -15,8 +15,8 @@ use crate::app::scenario::runner::ChannelReport;
 use crate::channel::diag_wire::{history_entry, log_event, WireError};
 use crate::channel::diagnosis::render_entries;
 use crate::channel::dyn_cs::{HistoryEntry, TrackEvent};
+use hli::calls::diag::{DiagWindow, DynCsHistoryReadCall, DynCsLogReadCall};
 use hli::calls::{AcyclicCall, CallError};
-use hli::diag_calls::{DiagWindow, DynCsHistoryReadCall, DynCsLogReadCall};
 use hli::rpc::{AcyclicClient, PendingCall};
 use hli::segment::{AttachError, PlcSegment};
 use std::path::PathBuf;
@@ -230,13 +230,13 @@ trait Windowed {
     fn window(&self) -> DiagWindow;
 }
 
-impl Windowed for hli::diag_calls::DynCsHistoryReply {
+impl Windowed for hli::calls::diag::DynCsHistoryReply {
     fn window(&self) -> DiagWindow {
         self.window
     }
 }
 
-impl Windowed for hli::diag_calls::DynCsLogReply {
+impl Windowed for hli::calls::diag::DynCsLogReply {
     fn window(&self) -> DiagWindow {
         self.window
     }

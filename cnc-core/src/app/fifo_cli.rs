@@ -16,12 +16,12 @@ use crate::axis::DriveLink;
 use crate::fifo::{FifoParams, OverrideType};
 use crate::machine::fifo::FifoEngine;
 use crate::machine::{Machine, MachineSetup};
-use hli::calls::AcyclicCall;
-use hli::enums::FifoGroupState;
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoRowsHeader, FifoStartCall,
     FIFO_BLOCK_VALUES,
 };
+use hli::calls::AcyclicCall;
+use hli::enums::FifoGroupState;
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_OVERRIDE_FULL};
 use hli::views::{CncView, PlcView};
 use std::io::Write;

@@ -17,8 +17,8 @@
 use super::json::number;
 use crate::axis::generator::Kinematic;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
+use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
-use hli::saw_calls::sync_mask as m;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -10,9 +10,9 @@
 
 use super::config::ProbeInterface;
 use super::increments::CounterWidth;
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{AxisError, ProbeEdge, ProbeState};
 use hli::layout::{HliAxisProbe, NcEncoderIn, HLI_AXIS_PROBES};
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
 
 /// Encoder terminal (`nCtrl1`/`nStatus1`): enable the external latch on the rising edge.
 pub const TERMINAL_LATCH_POSITIVE: u8 = 0x02;

@@ -5,15 +5,15 @@ use super::axis::Axis;
 use super::config::{AxisConfig, ConfigError, DriveLink};
 use super::sim_drive::{SimScaling, SimulatedDrive};
 use core::mem::offset_of;
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall, ProbeReply};
+use hli::calls::{decode_body, reply, ErrorCode, HandlerResult};
 use hli::layout::{
     HliAxis, HliAxisCommandState, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut,
     NcEncoderIn, NcEncoderOut, HLI_MAX_AXES,
 };
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall, ProbeReply};
-use hli::rpc::{
-    decode_body, reply, AcyclicRequest, AxisCommandCall, AxisCommandReply, ErrorCode, HandlerResult,
-};
 use hli::views::CncView;
+use hli::wire::AcyclicRequest;
 use hli::PlaceExt;
 
 /// Why a set of axes cannot be built.

@@ -25,85 +25,7 @@
 use super::online::{ActivationMode, MasterNow};
 use super::{CamProfile, ProfileCursor};
 use crate::axis::generator::Kinematic;
-
-/// `MC_StartMode`: whether the cam's master and slave coordinates are absolute or measured
-/// from the axes' positions at coupling (or switching).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum StartMode {
-    /// 1: both absolute.
-    Absolute,
-    /// 2: both relative.
-    Relative,
-    /// 3: master absolute, slave relative.
-    MasterAbsSlaveRel,
-    /// 4: master relative, slave absolute.
-    MasterRelSlaveAbs,
-}
-
-impl StartMode {
-    /// From the raw value (1..=4).
-    pub fn from_raw(raw: u32) -> Option<StartMode> {
-        Some(match raw {
-            1 => StartMode::Absolute,
-            2 => StartMode::Relative,
-            3 => StartMode::MasterAbsSlaveRel,
-            4 => StartMode::MasterRelSlaveAbs,
-            _ => return None,
-        })
-    }
-
-    /// The raw value.
-    pub fn raw(self) -> u32 {
-        match self {
-            StartMode::Absolute => 1,
-            StartMode::Relative => 2,
-            StartMode::MasterAbsSlaveRel => 3,
-            StartMode::MasterRelSlaveAbs => 4,
-        }
-    }
-
-    /// Whether the master coordinate is measured from the coupling position.
-    pub fn master_relative(self) -> bool {
-        matches!(self, StartMode::Relative | StartMode::MasterRelSlaveAbs)
-    }
-
-    /// Whether the slave coordinate is measured from the coupling position.
-    pub fn slave_relative(self) -> bool {
-        matches!(self, StartMode::Relative | StartMode::MasterAbsSlaveRel)
-    }
-}
-
-/// `MC_CamScalingMode` of one side.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScalingMode {
-    /// 0: scaling and offset taken as given.
-    UserDefined,
-    /// 1: scaling taken, offset computed so that nothing jumps.
-    AutoOffset,
-    /// 2: this side's scaling and offset stay as they are.
-    Off,
-}
-
-impl ScalingMode {
-    /// From the raw value (0..=2).
-    pub fn from_raw(raw: u32) -> Option<ScalingMode> {
-        Some(match raw {
-            0 => ScalingMode::UserDefined,
-            1 => ScalingMode::AutoOffset,
-            2 => ScalingMode::Off,
-            _ => return None,
-        })
-    }
-
-    /// The raw value.
-    pub fn raw(self) -> u32 {
-        match self {
-            ScalingMode::UserDefined => 0,
-            ScalingMode::AutoOffset => 1,
-            ScalingMode::Off => 2,
-        }
-    }
-}
+use hli::calls::cam::{CamActivationMode, CamScalingMode, CamStartMode};
 
 /// `MC_CamActivationMode` as couplings and scalings use it (the online change of points uses
 /// [`ActivationMode`], without the deletion).
@@ -130,17 +52,35 @@ pub enum Activation {
 impl Activation {
     /// From the raw mode and its position.
     pub fn from_raw(raw: u32, position: f64) -> Option<Activation> {
-        Some(match raw {
-            0 => Activation::Instantaneous,
-            1 => Activation::AtMasterCamPos(position),
-            2 => Activation::AtMasterAxisPos(position),
-            3 => Activation::NextCycle,
-            4 => Activation::NextCycleOnce,
-            5 => Activation::AsSoonAsPossible,
-            6 => Activation::Off,
-            7 => Activation::DeleteQueuedData,
-            _ => return None,
-        })
+        CamActivationMode::from_raw(raw).map(|mode| Activation::new(mode, position))
+    }
+
+    /// The mode with its position (the modes without one ignore it).
+    pub fn new(mode: CamActivationMode, position: f64) -> Activation {
+        match mode {
+            CamActivationMode::Instantaneous => Activation::Instantaneous,
+            CamActivationMode::AtMasterCamPos => Activation::AtMasterCamPos(position),
+            CamActivationMode::AtMasterAxisPos => Activation::AtMasterAxisPos(position),
+            CamActivationMode::NextCycle => Activation::NextCycle,
+            CamActivationMode::NextCycleOnce => Activation::NextCycleOnce,
+            CamActivationMode::AsSoonAsPossible => Activation::AsSoonAsPossible,
+            CamActivationMode::Off => Activation::Off,
+            CamActivationMode::DeleteQueuedData => Activation::DeleteQueuedData,
+        }
+    }
+
+    /// The mode on the wire, without its position.
+    pub fn mode(self) -> CamActivationMode {
+        match self {
+            Activation::Instantaneous => CamActivationMode::Instantaneous,
+            Activation::AtMasterCamPos(_) => CamActivationMode::AtMasterCamPos,
+            Activation::AtMasterAxisPos(_) => CamActivationMode::AtMasterAxisPos,
+            Activation::NextCycle => CamActivationMode::NextCycle,
+            Activation::NextCycleOnce => CamActivationMode::NextCycleOnce,
+            Activation::AsSoonAsPossible => CamActivationMode::AsSoonAsPossible,
+            Activation::Off => CamActivationMode::Off,
+            Activation::DeleteQueuedData => CamActivationMode::DeleteQueuedData,
+        }
     }
 
     /// The timing rule, for the modes that wait (`None` for the others).
@@ -250,7 +190,7 @@ pub struct CamLaw {
     /// Offsets and scalings.
     pub scaling: Scaling,
     /// Absolute or relative, per side.
-    pub start: StartMode,
+    pub start: CamStartMode,
     /// Cyclic (continued period by period) or linear (held at its edges).
     pub periodic: bool,
     /// Pmc: the master position at coupling (0 when the master is absolute).
@@ -270,7 +210,7 @@ impl CamLaw {
     pub fn new(
         profile: &CamProfile,
         scaling: Scaling,
-        start: StartMode,
+        start: CamStartMode,
         periodic: bool,
         master: f64,
         slave: f64,
@@ -409,8 +349,8 @@ impl CamLaw {
         &self,
         profile: &CamProfile,
         requested: Scaling,
-        modes: (ScalingMode, ScalingMode),
-        start: StartMode,
+        modes: (CamScalingMode, CamScalingMode),
+        start: CamStartMode,
         periodic: bool,
         master: f64,
         slave: f64,
@@ -418,11 +358,11 @@ impl CamLaw {
     ) -> CamLaw {
         let (master_mode, slave_mode) = modes;
         let mut scaling = self.scaling;
-        if master_mode != ScalingMode::Off {
+        if master_mode != CamScalingMode::Off {
             scaling.master_offset = requested.master_offset;
             scaling.master_scaling = requested.master_scaling;
         }
-        if slave_mode != ScalingMode::Off {
+        if slave_mode != CamScalingMode::Off {
             scaling.slave_offset = requested.slave_offset;
             scaling.slave_scaling = requested.slave_scaling;
         }
@@ -434,7 +374,7 @@ impl CamLaw {
             (self.start, self.master_origin, self.slave_origin)
         };
         let mut law = CamLaw::new(profile, scaling, start, periodic, master_at, slave_at);
-        if master_mode == ScalingMode::AutoOffset {
+        if master_mode == CamScalingMode::AutoOffset {
             let old = self.locate(master);
             let share = self.share_of_cycle(old);
             let x = law.first + share * law.period;
@@ -445,7 +385,7 @@ impl CamLaw {
         // coupling stay what they were (only coupling anew starts in the base cycle).
         let cycles = self.locate(master).cycle - self.cycle0;
         law.cycle0 = law.locate(master).cycle - cycles;
-        if slave_mode == ScalingMode::AutoOffset {
+        if slave_mode == CamScalingMode::AutoOffset {
             let mut cursor = ProfileCursor::default();
             let standing = Kinematic {
                 position: master,
@@ -479,7 +419,7 @@ impl CamLaw {
 /// before it is coupled).
 pub fn check_couple(
     activation: Activation,
-    start: StartMode,
+    start: CamStartMode,
     master_auto: bool,
 ) -> Result<(), CouplingError> {
     let allowed = !master_auto
@@ -496,7 +436,7 @@ pub fn check_couple(
 /// with an absolute master.
 pub fn check_switch(
     activation: Activation,
-    start: StartMode,
+    start: CamStartMode,
     master_auto: bool,
 ) -> Result<(), CouplingError> {
     let allowed = !(master_auto && start.master_relative())
@@ -515,7 +455,7 @@ pub fn check_switch(
 /// auto-offset contradicts a relative master here too (5.1.16.3).
 pub fn check_scaling(
     activation: Activation,
-    start: StartMode,
+    start: CamStartMode,
     master_auto: bool,
 ) -> Result<(), CouplingError> {
     let allowed = !(master_auto && start.master_relative())
@@ -533,7 +473,7 @@ pub fn check_scaling(
 fn refuse_unless(
     allowed: bool,
     activation: Activation,
-    start: StartMode,
+    start: CamStartMode,
     master_auto: bool,
     when: &'static str,
 ) -> Result<(), CouplingError> {
@@ -541,25 +481,11 @@ fn refuse_unless(
         return Ok(());
     }
     Err(CouplingError::Combination {
-        activation: activation_raw(activation),
+        activation: activation.mode().raw(),
         start: start.raw(),
         master_auto,
         when,
     })
-}
-
-/// The raw number of an activation mode.
-pub fn activation_raw(activation: Activation) -> u32 {
-    match activation {
-        Activation::Instantaneous => 0,
-        Activation::AtMasterCamPos(_) => 1,
-        Activation::AtMasterAxisPos(_) => 2,
-        Activation::NextCycle => 3,
-        Activation::NextCycleOnce => 4,
-        Activation::AsSoonAsPossible => 5,
-        Activation::Off => 6,
-        Activation::DeleteQueuedData => 7,
-    }
 }
 
 /// Refuses an axis-position activation the master has passed in its direction of travel

@@ -4,8 +4,9 @@
 
 use super::error::CamError;
 use super::motion_function::{MotionFunction, MotionFunctionPoint, PointType};
-use super::table::{Interpolation, PositionTable, TableType};
+use super::table::{PositionTable, TableType};
 use super::{CamProfile, FunctionType};
+use hli::calls::cam::CamInterpolation;
 use serde::Deserialize;
 use std::path::Path;
 
@@ -36,7 +37,7 @@ pub struct CamFile {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BinaryOptions {
     /// Interpolation of the table.
-    pub interpolation: Interpolation,
+    pub interpolation: CamInterpolation,
     /// Whether the table continues cyclically.
     pub periodic: bool,
 }
@@ -44,7 +45,7 @@ pub struct BinaryOptions {
 impl Default for BinaryOptions {
     fn default() -> Self {
         BinaryOptions {
-            interpolation: Interpolation::Linear,
+            interpolation: CamInterpolation::Linear,
             periodic: false,
         }
     }
@@ -155,11 +156,11 @@ fn from_json(file: FileJson) -> Result<CamFile, CamError> {
                 _ => return Err(CamError::UnknownTableType),
             };
             let interpolation = match interpolation.as_deref().map(str::to_ascii_lowercase) {
-                None => Interpolation::Linear,
+                None => CamInterpolation::Linear,
                 Some(name) => match name.as_str() {
-                    "linear" | "0" => Interpolation::Linear,
-                    "4point" | "fourpoint" | "4_point" | "1" => Interpolation::FourPoint,
-                    "spline" | "2" => Interpolation::Spline,
+                    "linear" | "0" => CamInterpolation::Linear,
+                    "4point" | "fourpoint" | "4_point" | "1" => CamInterpolation::FourPoint,
+                    "spline" | "2" => CamInterpolation::Spline,
                     _ => return Err(CamError::UnknownInterpolation),
                 },
             };

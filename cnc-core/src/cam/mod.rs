@@ -33,7 +33,7 @@ pub use charac::CharacValues;
 pub use error::{CamError, Field, TableErrorCode};
 pub use law::FunctionType;
 pub use motion_function::{MotionFunction, MotionFunctionPoint, PointType};
-pub use table::{Interpolation, PositionTable, TableType};
+pub use table::{PositionTable, TableType};
 
 /// Slave position and its derivatives with respect to the master position.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -7,6 +7,7 @@
 use super::error::CamError;
 use super::motion_function::{MotionFunction, MotionFunctionPoint};
 use super::CamProfile;
+use hli::calls::cam::CamActivationMode;
 
 /// `MC_CamActivationMode`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,27 +30,30 @@ impl ActivationMode {
     /// From the raw mode and its position. 4 (`NEXTCYCLEONCE`, "not yet implemented" in the
     /// seed) and 7 (`DELETEQUEUEDDATA`, an action, not a mode) are refused here.
     pub fn from_raw(raw: u32, position: f64) -> Result<ActivationMode, CamError> {
-        Ok(match raw {
-            0 => ActivationMode::Instantaneous,
-            1 => ActivationMode::AtMasterCamPos(position),
-            2 => ActivationMode::AtMasterAxisPos(position),
-            3 => ActivationMode::NextCycle,
-            5 => ActivationMode::AsSoonAsPossible,
-            6 => ActivationMode::Off,
-            _ => return Err(CamError::ActivationMode { mode: raw }),
+        Ok(match CamActivationMode::from_raw(raw) {
+            Some(CamActivationMode::Instantaneous) => ActivationMode::Instantaneous,
+            Some(CamActivationMode::AtMasterCamPos) => ActivationMode::AtMasterCamPos(position),
+            Some(CamActivationMode::AtMasterAxisPos) => ActivationMode::AtMasterAxisPos(position),
+            Some(CamActivationMode::NextCycle) => ActivationMode::NextCycle,
+            Some(CamActivationMode::AsSoonAsPossible) => ActivationMode::AsSoonAsPossible,
+            Some(CamActivationMode::Off) => ActivationMode::Off,
+            Some(CamActivationMode::NextCycleOnce | CamActivationMode::DeleteQueuedData) | None => {
+                return Err(CamError::ActivationMode { mode: raw })
+            }
         })
     }
 
     /// The raw mode number and its position (0 for the modes without one).
     pub fn raw(self) -> (u32, f64) {
-        match self {
-            ActivationMode::Instantaneous => (0, 0.0),
-            ActivationMode::AtMasterCamPos(p) => (1, p),
-            ActivationMode::AtMasterAxisPos(p) => (2, p),
-            ActivationMode::NextCycle => (3, 0.0),
-            ActivationMode::AsSoonAsPossible => (5, 0.0),
-            ActivationMode::Off => (6, 0.0),
-        }
+        let (mode, position) = match self {
+            ActivationMode::Instantaneous => (CamActivationMode::Instantaneous, 0.0),
+            ActivationMode::AtMasterCamPos(p) => (CamActivationMode::AtMasterCamPos, p),
+            ActivationMode::AtMasterAxisPos(p) => (CamActivationMode::AtMasterAxisPos, p),
+            ActivationMode::NextCycle => (CamActivationMode::NextCycle, 0.0),
+            ActivationMode::AsSoonAsPossible => (CamActivationMode::AsSoonAsPossible, 0.0),
+            ActivationMode::Off => (CamActivationMode::Off, 0.0),
+        };
+        (mode.raw(), position)
     }
 
     /// Whether an axis-position activation lies behind the master in its direction of

@@ -3,6 +3,7 @@
 
 use super::error::{CamError, Field};
 use super::Sample;
+use hli::calls::cam::CamInterpolation;
 
 /// Most rows a table may hold (the binary file counts rows in an unsigned short; tables sent
 /// by a PLC may be larger).
@@ -17,24 +18,13 @@ pub enum TableType {
     NonEquidistant,
 }
 
-/// `MC_InterpolationType`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Interpolation {
-    /// 0: straight lines between rows.
-    Linear,
-    /// 1: the cubic through the four nearest rows (equidistant tables only).
-    FourPoint,
-    /// 2: a cubic spline, tangential at the ends of a linear table, cyclic for a periodic one.
-    Spline,
-}
-
 /// A checked position table.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PositionTable {
     master: Vec<f64>,
     slave: Vec<f64>,
     table_type: TableType,
-    interpolation: Interpolation,
+    interpolation: CamInterpolation,
     periodic: bool,
     /// 1 / equidistant step (0 for non-equidistant tables).
     inverse_step: f64,
@@ -62,15 +52,15 @@ impl PositionTable {
     pub fn new(
         rows: &[[f64; 2]],
         table_type: TableType,
-        interpolation: Interpolation,
+        interpolation: CamInterpolation,
         periodic: bool,
     ) -> Result<PositionTable, CamError> {
         if rows.is_empty() {
             return Err(CamError::NoData);
         }
         let min = match interpolation {
-            Interpolation::Linear => 2,
-            Interpolation::FourPoint | Interpolation::Spline => 4,
+            CamInterpolation::Linear => 2,
+            CamInterpolation::FourPoint | CamInterpolation::Spline => 4,
         };
         if rows.len() < min || rows.len() > MAX_ROWS {
             return Err(CamError::Rows {
@@ -79,7 +69,7 @@ impl PositionTable {
                 max: MAX_ROWS,
             });
         }
-        if interpolation == Interpolation::FourPoint && table_type != TableType::Equidistant {
+        if interpolation == CamInterpolation::FourPoint && table_type != TableType::Equidistant {
             return Err(CamError::InterpolationNeedsEquidistant);
         }
         for (row, r) in rows.iter().enumerate() {
@@ -141,7 +131,7 @@ impl PositionTable {
         if table_type == TableType::Equidistant && !table.inverse_step.is_finite() {
             return Err(degenerate(1));
         }
-        if interpolation == Interpolation::Spline {
+        if interpolation == CamInterpolation::Spline {
             table.curvature = if periodic {
                 table.periodic_curvature()
             } else {
@@ -180,7 +170,7 @@ impl PositionTable {
     }
 
     /// Interpolation.
-    pub fn interpolation(&self) -> Interpolation {
+    pub fn interpolation(&self) -> CamInterpolation {
         self.interpolation
     }
 
@@ -252,7 +242,7 @@ impl PositionTable {
 
     fn eval_on(&self, k: usize, x: f64) -> Sample {
         match self.interpolation {
-            Interpolation::Linear => {
+            CamInterpolation::Linear => {
                 let h = self.master[k + 1] - self.master[k];
                 let slope = (self.slave[k + 1] - self.slave[k]) / h;
                 Sample {
@@ -262,8 +252,8 @@ impl PositionTable {
                     jerk: 0.0,
                 }
             }
-            Interpolation::FourPoint => self.four_point(k, x),
-            Interpolation::Spline => self.spline(k, x),
+            CamInterpolation::FourPoint => self.four_point(k, x),
+            CamInterpolation::Spline => self.spline(k, x),
         }
     }
 

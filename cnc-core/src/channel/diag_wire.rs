@@ -4,7 +4,7 @@
 //! entries the listing renders ([`history_entry`], [`log_event`]).
 
 use super::dyn_cs::{HistoryEntry, MasterSource, RingRead, TrackError, TrackEvent, Tracker};
-use hli::diag_calls::{
+use hli::calls::diag::{
     log_flags, log_kind, DiagWindow, DynCsHistoryReadCall, DynCsHistoryReply, DynCsLogReadCall,
     DynCsLogReply,
 };

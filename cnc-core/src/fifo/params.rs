@@ -3,7 +3,7 @@
 //! override type. Bounds above the seed's are ours: they size the ring and the block calls.
 
 use super::override_filter::OverrideType;
-use hli::fifo_calls::{FIFO_MAX_DIMENSION, FIFO_MAX_ROWS};
+use hli::calls::fifo::{FIFO_MAX_DIMENSION, FIFO_MAX_ROWS};
 
 /// Smallest PT-2 time constant, s.
 pub const PT2_T0_MIN_S: f64 = 1e-4;

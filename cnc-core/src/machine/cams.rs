@@ -22,25 +22,26 @@ use crate::axis::generator::Kinematic;
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
-    Scaling, ScalingMode, StartMode,
+    Scaling,
 };
 use crate::cam::multi_table::{MultiTableError, MultiTableLaw, TableSpec, TableWeight};
 use crate::cam::online::{ActivationMode, CamStore, MasterNow};
 use crate::cam::{
-    CamProfile, Interpolation, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor,
-    TableErrorCode, TableType,
+    CamProfile, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor, TableErrorCode,
+    TableType,
 };
-use hli::calls::{
-    decode_body, reply, CallKind, CamInCall, CamMultiCoupleCall, CamMultiTableCall,
+use hli::calls::cam::{
+    CamActivationMode, CamInCall, CamInterpolation, CamMultiCoupleCall, CamMultiTableCall,
     CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
-    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
-    CamTableSelectCall, CamTableWeightCall, CamValuesReply, ErrorCode, HandlerResult,
+    CamReadCall, CamReply, CamRowsWriteCall, CamScalingCall, CamScalingMode, CamStartMode,
+    CamTableDeleteCall, CamTableSelectCall, CamTableWeightCall, CamValuesReply,
     McMotionFunctionPoint, CAM_CHUNK_FIRST, CAM_CHUNK_LAST, CAM_KEEP_MASTER_OFFSET,
     CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC, CAM_POINTS_CREATE, CAM_POINTS_PER_CALL,
     CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS,
     CAM_READ_VALUES, CAM_ROWS_DECLARE, CAM_ROWS_PER_CALL, CAM_VALUES_PER_REPLY,
 };
+use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
 
@@ -61,8 +62,8 @@ enum Queued {
     Switch {
         table: u32,
         scaling: Scaling,
-        modes: (ScalingMode, ScalingMode),
-        start: StartMode,
+        modes: (CamScalingMode, CamScalingMode),
+        start: CamStartMode,
         activation: ActivationMode,
     },
     /// A rescaling (MC_CamScaling): the values asked for, and the keep bits of the ones
@@ -70,7 +71,7 @@ enum Queued {
     Scale {
         requested: Scaling,
         keep: u32,
-        modes: (ScalingMode, ScalingMode),
+        modes: (CamScalingMode, CamScalingMode),
         activation: ActivationMode,
     },
 }
@@ -112,11 +113,11 @@ fn merged_scaling(
     current: Scaling,
     requested: Scaling,
     keep: u32,
-    (master_mode, slave_mode): (ScalingMode, ScalingMode),
+    (master_mode, slave_mode): (CamScalingMode, CamScalingMode),
 ) -> Scaling {
     let take = |bit: u32, on: bool| on && keep & bit == 0;
-    let master_on = master_mode != ScalingMode::Off;
-    let slave_on = slave_mode != ScalingMode::Off;
+    let master_on = master_mode != CamScalingMode::Off;
+    let slave_on = slave_mode != CamScalingMode::Off;
     Scaling {
         master_offset: if take(CAM_KEEP_MASTER_OFFSET, master_on) {
             requested.master_offset
@@ -222,7 +223,7 @@ pub struct CamEngine {
     store: CamStore,
     selects: Vec<Option<Select>>,
     /// Per table: how a point change that applies treats the master and slave offsets.
-    online_scaling: Vec<(ScalingMode, ScalingMode)>,
+    online_scaling: Vec<(CamScalingMode, CamScalingMode)>,
     points_in: Vec<Option<PointsTransfer>>,
     rows_in: Vec<Option<RowsTransfer>>,
     /// Tables declared (CamTableCreate) for rows that follow: type, interpolation, cyclic,
@@ -265,7 +266,10 @@ impl CamEngine {
             multis: (0..axes).map(|_| None).collect(),
             store,
             selects: vec![None; TABLE_SLOTS],
-            online_scaling: vec![(ScalingMode::UserDefined, ScalingMode::UserDefined); TABLE_SLOTS],
+            online_scaling: vec![
+                (CamScalingMode::UserDefined, CamScalingMode::UserDefined);
+                TABLE_SLOTS
+            ],
             points_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             declared: vec![None; TABLE_SLOTS],
@@ -303,11 +307,8 @@ impl CamEngine {
             // Motion functions carry their own laws: the interpolation does not apply.
             return Ok(None);
         };
-        let wanted = match interpolation {
-            0 => Interpolation::Linear,
-            1 => Interpolation::FourPoint,
-            2 => Interpolation::Spline,
-            _ => return Err(CamCouplingError::UnknownMode.raw()),
+        let Some(wanted) = CamInterpolation::from_raw(interpolation) else {
+            return Err(CamCouplingError::UnknownMode.raw());
         };
         if wanted == t.interpolation() {
             return Ok(None);
@@ -332,10 +333,10 @@ impl CamEngine {
             return code(CamCouplingError::MasterIsSlave.raw());
         }
         let (Some(start), Some(activation), Some(master_mode), Some(slave_mode)) = (
-            StartMode::from_raw(call.start_mode),
+            CamStartMode::from_raw(call.start_mode),
             Activation::from_raw(call.activation_mode, call.activation_position),
-            ScalingMode::from_raw(call.master_scaling_mode),
-            ScalingMode::from_raw(call.slave_scaling_mode),
+            CamScalingMode::from_raw(call.master_scaling_mode),
+            CamScalingMode::from_raw(call.slave_scaling_mode),
         ) else {
             return code(CamCouplingError::UnknownMode.raw());
         };
@@ -359,7 +360,7 @@ impl CamEngine {
         let Some(master_set) = master_of(axes, master, follow_actual) else {
             return code(CamCouplingError::NoSuchMaster.raw());
         };
-        let master_auto = master_mode == ScalingMode::AutoOffset;
+        let master_auto = master_mode == CamScalingMode::AutoOffset;
         // The master's direction of travel decides whether an axis position lies behind it.
         let now = MasterNow {
             axis: (
@@ -731,8 +732,8 @@ impl CamEngine {
         let call: CamOnlineModeCall = decode_body(request)?;
         let id = request.target;
         let (Some(master_mode), Some(slave_mode)) = (
-            ScalingMode::from_raw(call.master_scaling_mode),
-            ScalingMode::from_raw(call.slave_scaling_mode),
+            CamScalingMode::from_raw(call.master_scaling_mode),
+            CamScalingMode::from_raw(call.slave_scaling_mode),
         ) else {
             return code(CamCouplingError::UnknownMode.raw());
         };
@@ -742,7 +743,9 @@ impl CamEngine {
         let Ok(queue) = self.store.queue_mut(id) else {
             return code(TABLE_INVALID);
         };
-        if call.activation_mode == 7 {
+        if CamActivationMode::from_raw(call.activation_mode)
+            == Some(CamActivationMode::DeleteQueuedData)
+        {
             queue.delete_queued();
             return accepted();
         }
@@ -835,11 +838,8 @@ impl CamEngine {
             11 => TableType::NonEquidistant,
             _ => return code(TableErrorCode::McTableTypeInvalid as u32),
         };
-        let interpolation = match transfer.interpolation {
-            0 => Interpolation::Linear,
-            1 => Interpolation::FourPoint,
-            2 => Interpolation::Spline,
-            _ => return code(CamCouplingError::UnknownMode.raw()),
+        let Some(interpolation) = CamInterpolation::from_raw(transfer.interpolation) else {
+            return code(CamCouplingError::UnknownMode.raw());
         };
         if transfer.periodic > 1 {
             return code(CamCouplingError::UnknownMode.raw());
@@ -1019,15 +1019,7 @@ impl CamEngine {
         let first_slave = profile.eval(first, &mut ProfileCursor::default()).position;
         let (rows, columns, interpolation) = match profile {
             CamProfile::MotionFunction(f) => (f.points().len(), 1, 0),
-            CamProfile::Table(t) => (
-                t.len(),
-                2,
-                match t.interpolation() {
-                    Interpolation::Linear => 0,
-                    Interpolation::FourPoint => 1,
-                    Interpolation::Spline => 2,
-                },
-            ),
+            CamProfile::Table(t) => (t.len(), 2, t.interpolation().raw()),
         };
         let sc = s.law.scaling;
         let flag = |b: bool| f64::from(u8::from(b));
@@ -1044,7 +1036,7 @@ impl CamEngine {
             _ => (
                 false,
                 (0, 0.0),
-                (ScalingMode::UserDefined, ScalingMode::UserDefined),
+                (CamScalingMode::UserDefined, CamScalingMode::UserDefined),
             ),
         };
         let queue_mode = self
@@ -1064,7 +1056,7 @@ impl CamEngine {
                 false,
                 0,
                 (0, 0.0),
-                (ScalingMode::UserDefined, ScalingMode::UserDefined),
+                (CamScalingMode::UserDefined, CamScalingMode::UserDefined),
             ),
         };
         Ok(vec![
@@ -1164,8 +1156,8 @@ impl CamEngine {
         }
         let (Some(activation), Some(master_mode), Some(slave_mode)) = (
             Activation::from_raw(call.activation_mode, call.activation_position),
-            ScalingMode::from_raw(call.master_scaling_mode),
-            ScalingMode::from_raw(call.slave_scaling_mode),
+            CamScalingMode::from_raw(call.master_scaling_mode),
+            CamScalingMode::from_raw(call.slave_scaling_mode),
         ) else {
             return code(CamCouplingError::UnknownMode.raw());
         };
@@ -1178,7 +1170,7 @@ impl CamEngine {
         if let Err(e) = check_scaling(
             activation,
             state.law.start,
-            master_mode == ScalingMode::AutoOffset,
+            master_mode == CamScalingMode::AutoOffset,
         ) {
             return code(coupling_code(e));
         }
@@ -1474,19 +1466,19 @@ impl Engine for CamEngine {
         self.retired.clear();
         self.retired_changes.clear();
         Some(match kind {
-            CallKind::CamTableSelect => self.table_select(request),
-            CallKind::CamIn => self.cam_in(request, axes),
-            CallKind::CamOut => self.cam_out(request, axes),
-            CallKind::CamScaling => self.cam_scaling(request, axes),
-            CallKind::CamPointsWrite => self.points_write(request, axes),
-            CallKind::CamPointsRead => self.points_read(request),
-            CallKind::CamOnlineMode => self.online_mode(request),
-            CallKind::CamRowsWrite => self.rows_write(request),
-            CallKind::CamRead => self.read(request, axes),
-            CallKind::CamTableWeight => self.table_weight(request),
-            CallKind::CamMultiCouple => self.multi_couple(request, axes),
-            CallKind::CamMultiTable => self.multi_table(request),
-            CallKind::CamTableDelete => self.table_delete(request),
+            CallKind::CAM_TABLE_SELECT => self.table_select(request),
+            CallKind::CAM_IN => self.cam_in(request, axes),
+            CallKind::CAM_OUT => self.cam_out(request, axes),
+            CallKind::CAM_SCALING => self.cam_scaling(request, axes),
+            CallKind::CAM_POINTS_WRITE => self.points_write(request, axes),
+            CallKind::CAM_POINTS_READ => self.points_read(request),
+            CallKind::CAM_ONLINE_MODE => self.online_mode(request),
+            CallKind::CAM_ROWS_WRITE => self.rows_write(request),
+            CallKind::CAM_READ => self.read(request, axes),
+            CallKind::CAM_TABLE_WEIGHT => self.table_weight(request),
+            CallKind::CAM_MULTI_COUPLE => self.multi_couple(request, axes),
+            CallKind::CAM_MULTI_TABLE => self.multi_table(request),
+            CallKind::CAM_TABLE_DELETE => self.table_delete(request),
             _ => return None,
         })
     }

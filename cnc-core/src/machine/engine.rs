@@ -7,9 +7,10 @@
 //! the drive, and is the only writer of `gpAx[k]^`.
 
 use crate::axis::AxisSet;
-use hli::fifo_calls::{FifoReply, FifoRowsHeader};
-use hli::rpc::{AcyclicRequest, CallKind, HandlerResult};
+use hli::calls::fifo::{FifoReply, FifoRowsHeader};
+use hli::calls::{CallKind, HandlerResult};
 use hli::views::CncView;
+use hli::wire::AcyclicRequest;
 
 /// What an engine sees in its tick.
 pub struct EngineIo<'a, 'm> {

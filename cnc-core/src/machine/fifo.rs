@@ -23,12 +23,13 @@ use crate::axis::{AxisSet, Coupling};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
 };
-use hli::calls::{decode_body, reply, AxisCommandCall, CallKind, HandlerResult};
-use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
-use hli::fifo_calls::{
-    FifoIntegrateCall, FifoOverrideCall, FifoParametersCall, FifoReply, FifoRowsHeader,
-    FIFO_OVERRIDE_INSTANT, FIFO_OVERRIDE_PT2,
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::{
+    FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,
+    FifoRowsHeader,
 };
+use hli::calls::{decode_body, reply, CallKind, HandlerResult};
+use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{
     HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
     FIFO_OVERRIDE_FULL, HLI_MAX_FIFO_GROUPS,
@@ -380,12 +381,12 @@ impl Group {
         if self.running() {
             return self.refuse(FifoError::Running);
         }
-        let kind = match call.override_type {
-            FIFO_OVERRIDE_INSTANT => OverrideType::Instant,
-            FIFO_OVERRIDE_PT2 => OverrideType::Pt2 {
+        let kind = match FifoOverrideType::from_raw(call.override_type) {
+            Some(FifoOverrideType::Instant) => OverrideType::Instant,
+            Some(FifoOverrideType::Pt2) => OverrideType::Pt2 {
                 t0_s: call.pt2_t0_s,
             },
-            _ => return self.refuse(FifoError::Parameter),
+            None => return self.refuse(FifoError::Parameter),
         };
         let Ok(params) = FifoParams::new(
             self.params.dimension,
@@ -484,7 +485,7 @@ impl FifoEngine {
             };
         };
         match kind {
-            CallKind::FifoIntegrate => match decode_body::<FifoIntegrateCall>(request) {
+            CallKind::FIFO_INTEGRATE => match decode_body::<FifoIntegrateCall>(request) {
                 Ok(call) => {
                     let axis = call.axis as usize;
                     let reply = group.integrate(call, axes);
@@ -502,14 +503,14 @@ impl FifoEngine {
                 }
                 Err(_) => group.refuse(FifoError::Parameter),
             },
-            CallKind::FifoDisintegrate => group.disintegrate(axes),
-            CallKind::FifoStart => group.start(axes),
-            CallKind::FifoStop => group.stop(),
-            CallKind::FifoOverride => match decode_body(request) {
+            CallKind::FIFO_DISINTEGRATE => group.disintegrate(axes),
+            CallKind::FIFO_START => group.start(axes),
+            CallKind::FIFO_STOP => group.stop(),
+            CallKind::FIFO_OVERRIDE => match decode_body(request) {
                 Ok(call) => group.set_override(call),
                 Err(_) => group.refuse(FifoError::Parameter),
             },
-            CallKind::FifoParameters => match decode_body(request) {
+            CallKind::FIFO_PARAMETERS => match decode_body(request) {
                 Ok(call) => group.set_parameters(call, tick_s),
                 Err(_) => group.refuse(FifoError::Parameter),
             },
@@ -541,13 +542,13 @@ impl Engine for FifoEngine {
     ) -> Option<HandlerResult> {
         let fifo = matches!(
             kind,
-            CallKind::FifoDimension
-                | CallKind::FifoIntegrate
-                | CallKind::FifoDisintegrate
-                | CallKind::FifoStart
-                | CallKind::FifoStop
-                | CallKind::FifoOverride
-                | CallKind::FifoParameters
+            CallKind::FIFO_DIMENSION
+                | CallKind::FIFO_INTEGRATE
+                | CallKind::FIFO_DISINTEGRATE
+                | CallKind::FIFO_START
+                | CallKind::FIFO_STOP
+                | CallKind::FIFO_OVERRIDE
+                | CallKind::FIFO_PARAMETERS
         );
         fifo.then(|| reply(&self.call(kind, request, axes)))
     }

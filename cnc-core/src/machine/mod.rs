@@ -35,12 +35,10 @@ use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
 use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
-use hli::calls::{
-    decode_body, reply, AcyclicCall, AxisCommandCall, AxisCommandReply, CallKind, ErrorCode,
-    HandlerResult,
-};
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::calls::fifo::{FifoReply, FifoRowsHeader};
+use hli::calls::{decode_body, reply, AcyclicCall, CallKind, ErrorCode, HandlerResult};
 use hli::enums::DynCsState;
-use hli::fifo_calls::{FifoReply, FifoRowsHeader};
 use hli::layout::HLI_MAX_AXES;
 use hli::views::{handle_read_axis_state, CncView};
 use hli::wire::AcyclicRequest;
@@ -227,27 +225,17 @@ impl Machine {
         request: &AcyclicRequest,
     ) -> HandlerResult {
         // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
-        let read = matches!(
-            kind,
-            CallKind::ReadAxisState
-                | CallKind::CamRead
-                | CallKind::CamPointsRead
-                | CallKind::FifoDimension
-                | CallKind::SawCharac
-                | CallKind::DynCsHistoryRead
-                | CallKind::DynCsLogRead
-        );
-        if self.stopped && !read {
+        if self.stopped && !kind.is_read_only() {
             return Err(ErrorCode::Busy);
         }
-        if kind == CallKind::SawGearIn {
+        if kind == CallKind::SAW_GEAR_IN {
             // The saw's internal table is 256 - the slave's axis ID (chapter 13).
             let id = self
                 .axes
                 .axis(request.target as usize)
                 .map(|a| 256u32.wrapping_sub(a.config().id));
             if id.is_some_and(|id| self.engines.iter().any(|e| e.holds_table(id))) {
-                return reply(&hli::saw_calls::SawReply {
+                return reply(&hli::calls::saw::SawReply {
                     error_id: hli::enums::SawError::TableInUse.raw(),
                     reserved: 0,
                 });
@@ -259,8 +247,8 @@ impl Machine {
             }
         }
         match kind {
-            CallKind::ReadAxisState => handle_read_axis_state(view, request),
-            CallKind::AxisCommand => {
+            CallKind::READ_AXIS_STATE => handle_read_axis_state(view, request),
+            CallKind::AXIS_COMMAND => {
                 let target = request.target as usize;
                 if target < self.channel_axes() {
                     return reply(&AxisCommandReply {
@@ -273,16 +261,16 @@ impl Machine {
                 }
                 self.axes.handle_command(request)
             }
-            CallKind::ProbeArm => self.axes.handle_probe(request, true),
-            CallKind::ProbeAbort => self.axes.handle_probe(request, false),
-            CallKind::DynCsHistoryRead | CallKind::DynCsLogRead => {
+            CallKind::PROBE_ARM => self.axes.handle_probe(request, true),
+            CallKind::PROBE_ABORT => self.axes.handle_probe(request, false),
+            CallKind::DYN_CS_HISTORY_READ | CallKind::DYN_CS_LOG_READ => {
                 let channel = self
                     .controller
                     .channels()
                     .get(request.target as usize)
                     .ok_or(ErrorCode::InvalidTarget)?;
                 let tracker = channel.tracker();
-                if kind == CallKind::DynCsHistoryRead {
+                if kind == CallKind::DYN_CS_HISTORY_READ {
                     reply(&diag_wire::answer_history(tracker, &decode_body(request)?))
                 } else {
                     reply(&diag_wire::answer_log(tracker, &decode_body(request)?))

@@ -11,12 +11,12 @@ use super::engine::{Engine, EngineIo};
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
+use hli::calls::saw::{
+    SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
+    SawSyncTarget, SAW_CHARAC_PART,
+};
 use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, SawError};
-use hli::saw_calls::{
-    SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SAW_CHARAC_PART,
-    SAW_ON_POSITION, SAW_ON_VELOCITY, SYNC_POSITION_BASED, SYNC_TIME_BASED,
-};
 use hli::wire::AcyclicRequest;
 
 #[derive(Debug, Clone, Copy)]
@@ -93,18 +93,18 @@ impl SawEngine {
                 reserved: 0,
             });
         }
-        let on = match call.target {
-            SAW_ON_VELOCITY => SyncOn::Velocity,
-            SAW_ON_POSITION => SyncOn::Position {
+        let on = match SawSyncTarget::from_raw(call.target) {
+            Some(SawSyncTarget::Velocity) => SyncOn::Velocity,
+            Some(SawSyncTarget::Position) => SyncOn::Position {
                 master: call.master_sync_position,
                 slave: call.slave_sync_position,
             },
-            _ => return refused(SawError::Mode),
+            None => return refused(SawError::Mode),
         };
-        let time_based = match call.sync_mode {
-            SYNC_POSITION_BASED => false,
-            SYNC_TIME_BASED => true,
-            _ => return refused(SawError::Mode),
+        let time_based = match SawSyncMode::from_raw(call.sync_mode) {
+            Some(SawSyncMode::PositionBased) => false,
+            Some(SawSyncMode::TimeBased) => true,
+            None => return refused(SawError::Mode),
         };
         let ratio = match saw::gear_ratio(call.ratio_numerator, call.ratio_denominator) {
             Ok(r) => r,
@@ -241,13 +241,13 @@ impl Engine for SawEngine {
         let known = slave < self.slaves.len();
         Some(match kind {
             // A slave beyond the engine's slots (an engine built for fewer axes).
-            CallKind::SawGearIn if !known => Err(ErrorCode::InvalidTarget),
-            CallKind::SawGearIn => decode_body::<SawGearInCall>(request)
+            CallKind::SAW_GEAR_IN if !known => Err(ErrorCode::InvalidTarget),
+            CallKind::SAW_GEAR_IN => decode_body::<SawGearInCall>(request)
                 .and_then(|call| self.gear_in(slave, &call, axes)),
-            CallKind::SawGearOut => {
+            CallKind::SAW_GEAR_OUT => {
                 decode_body::<SawGearOutCall>(request).and_then(|_| self.gear_out(slave, axes))
             }
-            CallKind::SawCharac => decode_body::<SawCharacCall>(request)
+            CallKind::SAW_CHARAC => decode_body::<SawCharacCall>(request)
                 .and_then(|call| self.read_charac(slave, &call)),
             _ => return None,
         })

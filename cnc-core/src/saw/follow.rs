@@ -4,8 +4,8 @@
 
 use super::{plan, rollback_stop, Domain, Plan, Profile, SawRequest};
 use crate::axis::generator::Kinematic;
+use hli::calls::saw::sync_mask;
 use hli::enums::AxisState;
-use hli::saw_calls::sync_mask;
 
 /// Where a coupled slave is.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -13,8 +13,8 @@ use super::shape::{
     slope_change_travel, straight, Limits,
 };
 use crate::axis::generator::Kinematic;
+use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
-use hli::saw_calls::sync_mask as m;
 
 /// What to synchronise on.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,8 +1,19 @@
-//! The axis commands of the PLCopen motion blocks (MC_Power .. MC_SetPosition) as one
-//! acyclic call.
+//! The axis calls: the cyclic state of an axis read on demand, and the axis commands of the
+//! PLCopen motion blocks (MC_Power .. MC_SetPosition) as one acyclic call.
 
-use super::{AcyclicCall, CallKind};
+use crate::layout::HliAxisLrState;
+use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
+
+/// Reads the cyclic state of the axis given as `target`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
+pub struct ReadAxisState {
+    /// Reserved, must be 0.
+    pub reserved: u32,
+}
+
+const _: () = assert!(core::mem::size_of::<HliAxisLrState>() <= ACYCLIC_BODY_SIZE);
 
 /// A motion command for the axis given as `target` (what MC_Power, MC_MoveAbsolute ... send
 /// on their Execute edge). Units are the axis's (mm or degree, per second...).
@@ -118,7 +129,9 @@ pub struct AxisCommandReply {
     pub error_id: u32,
 }
 
-impl AcyclicCall for AxisCommandCall {
-    const KIND: CallKind = CallKind::AxisCommand;
-    type Reply = AxisCommandReply;
+calls! { family "axis";
+    /// [`ReadAxisState`]: the cyclic state of an axis, read on demand.
+    READ_AXIS_STATE = 1: ReadAxisState -> HliAxisLrState, read_only;
+    /// [`AxisCommandCall`]: a PLCopen motion command.
+    AXIS_COMMAND = 2: AxisCommandCall -> AxisCommandReply, command;
 }

@@ -17,11 +17,9 @@ use crate::fifo::{
 };
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
-use hli::fifo_calls::FifoReply;
-use hli::fifo_calls::{
-    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
-    FifoParametersCall, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES, FIFO_OVERRIDE_INSTANT,
-    FIFO_OVERRIDE_PT2,
+use hli::calls::fifo::{
+    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
+    FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
 };
 use hli::layout::FIFO_OVERRIDE_FULL;
 use std::sync::Arc;
@@ -58,7 +56,7 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, Strin
         params: FifoParametersCall {
             fifo_cycle_s: 0.001,
             pt2_t0_s: 0.0,
-            override_type: FIFO_OVERRIDE_INSTANT,
+            override_type: FifoOverrideType::Instant.raw(),
             reserved: 0,
         },
         ..FifoInputs::default()
@@ -116,8 +114,8 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, Strin
             }
             "override_type" => {
                 inputs.params.override_type = match value.as_str() {
-                    Some("instant") => FIFO_OVERRIDE_INSTANT,
-                    Some("pt2") => FIFO_OVERRIDE_PT2,
+                    Some("instant") => FifoOverrideType::Instant.raw(),
+                    Some("pt2") => FifoOverrideType::Pt2.raw(),
                     _ => return Err(bad("\"instant\" or \"pt2\"")),
                 }
             }

@@ -38,7 +38,7 @@ use crate::motion::{
 };
 use crate::runtime::PlcIo;
 use fifo::{FifoInputs, FifoInstance, FIFO_BLOCKS};
-use hli::calls::McMotionFunctionPoint;
+use hli::calls::cam::McMotionFunctionPoint;
 use saw::{SawInputs, SawInstance, SAW_BLOCKS};
 use std::sync::Arc;
 
@@ -900,7 +900,7 @@ impl Instances {
                     (cam_outputs(b.out), false)
                 }
                 Block::Read(b) => {
-                    if b.request.what == hli::calls::CAM_READ_INFO {
+                    if b.request.what == hli::calls::cam::CAM_READ_INFO {
                         b.target = axis;
                     }
                     b.call(io);
@@ -1088,17 +1088,18 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
             Block::ReadFunction(Box::new(b))
         }
         "MC_ReadCamTableSlaveDynamics" => Block::Read(Box::new(McCamRead::new(
-            hli::calls::CAM_READ_SLAVE_DYNAMICS,
+            hli::calls::cam::CAM_READ_SLAVE_DYNAMICS,
             3,
         ))),
         "MC_ReadCamTableCharacteristics" => Block::Read(Box::new(McCamRead::new(
-            hli::calls::CAM_READ_CHARACTERISTICS,
+            hli::calls::cam::CAM_READ_CHARACTERISTICS,
             31,
         ))),
-        "MC_ReadMotionFunctionValues" => {
-            Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_VALUES, room)))
-        }
-        "MC_CamInfo" => Block::Read(Box::new(McCamRead::new(hli::calls::CAM_READ_INFO, 40))),
+        "MC_ReadMotionFunctionValues" => Block::Read(Box::new(McCamRead::new(
+            hli::calls::cam::CAM_READ_VALUES,
+            room,
+        ))),
+        "MC_CamInfo" => Block::Read(Box::new(McCamRead::new(hli::calls::cam::CAM_READ_INFO, 40))),
         "CamTableSetWeight" => Block::SetWeight(Box::default()),
         "CamTableCoupleAxesMultiTables" => {
             let mut b = Box::<CamTableCoupleAxesMultiTables>::default();
@@ -1107,12 +1108,12 @@ fn new_block(kind: &str, room: Option<usize>) -> Block {
         }
         "CamTableEnableCorrectionTable" => {
             let mut b = Box::<CamMultiTable>::default();
-            b.op = hli::calls::CAM_MULTI_ENABLE_CORRECTION;
+            b.op = hli::calls::cam::CAM_MULTI_ENABLE_CORRECTION;
             Block::MultiTable(b)
         }
         "CamTableDeactivateCyclicTable" => {
             let mut b = Box::<CamMultiTable>::default();
-            b.op = hli::calls::CAM_MULTI_STOP_CYCLIC;
+            b.op = hli::calls::cam::CAM_MULTI_STOP_CYCLIC;
             Block::MultiTable(b)
         }
         fifo if FIFO_BLOCKS.contains(&fifo) => Block::Fifo(Box::new(FifoInstance::new(fifo))),

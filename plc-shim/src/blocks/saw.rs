@@ -27,7 +27,7 @@ use crate::runtime::PlcIo;
 use crate::saw::{
     GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics,
 };
-use hli::saw_calls::sync_mask;
+use hli::calls::saw::sync_mask;
 use std::sync::Arc;
 
 /// The flying-saw blocks a timeline can call: the tail of [`super::BLOCKS`].

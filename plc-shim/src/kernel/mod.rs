@@ -145,7 +145,7 @@ impl<C: AcyclicCall> InFlight for PendingCall<C> {
 }
 
 impl InFlight for PendingRows {
-    type Reply = hli::fifo_calls::FifoReply;
+    type Reply = hli::calls::fifo::FifoReply;
     type Buffer = ();
     fn poll(&mut self, _: &mut PlcIo<'_>, _: &mut ()) -> Polled<Self::Reply> {
         polled(PendingRows::poll(self))

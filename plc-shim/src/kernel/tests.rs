@@ -14,8 +14,8 @@ use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPositi
 use crate::probe::{McAbortTrigger, McTouchProbe};
 use crate::runtime::PlcIo;
 use crate::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
+use hli::calls::fifo::{FifoDimensionCall, FifoReply, FifoStartCall};
 use hli::calls::ErrorCode;
-use hli::fifo_calls::{FifoDimensionCall, FifoReply, FifoStartCall};
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::PlcView;
 use std::sync::Arc;
@@ -62,7 +62,7 @@ macro_rules! block {
 /// Every Execute-driven block, addressed at axis 1, table 1 or FIFO group 0.
 fn blocks() -> Vec<(&'static str, Cycle)> {
     let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
-    let points = Arc::from(vec![hli::calls::McMotionFunctionPoint::default(); 6]);
+    let points = Arc::from(vec![hli::calls::cam::McMotionFunctionPoint::default(); 6]);
     let compat = |kind: &'static str| {
         let mut c = CompatConfig::new(kind);
         c.table = 1;
@@ -173,7 +173,7 @@ fn blocks() -> Vec<(&'static str, Cycle)> {
         (
             "MC_CamInfo",
             block!(
-                McCamRead::new(hli::calls::CAM_READ_INFO, 64),
+                McCamRead::new(hli::calls::cam::CAM_READ_INFO, 64),
                 |s| {
                     s.target = 1;
                 },

@@ -22,7 +22,7 @@ use crate::cam::{
 };
 use crate::motion::{McHalt, McMoveVelocity};
 use crate::runtime::{PlcIo, PlcProgram};
-use hli::calls::McMotionFunctionPoint;
+use hli::calls::cam::McMotionFunctionPoint;
 
 /// The axes of `scenarios/cam-conveyor-program` (`gpAx` indices): conveyor, lifter.
 pub const SCENARIO_AXES: [u32; 2] = [0, 1];

@@ -28,11 +28,11 @@ use crate::fifo::{
 use crate::fifo_file::{Buffer, Fed, Feeder, FileError};
 use crate::motion::McPower;
 use crate::runtime::{PlcIo, PlcProgram};
-use hli::enums::{FifoError, FifoGroupState};
-use hli::fifo_calls::{
+use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoStartCall,
     FifoStopCall, FIFO_BLOCK_VALUES, FIFO_MAX_DIMENSION,
 };
+use hli::enums::{FifoError, FifoGroupState};
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 
 /// The steps of the sequence.

@@ -13,7 +13,8 @@ pub mod turntable;
 use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
-use hli::rpc::{PendingCall, ReadAxisState};
+use hli::calls::axis::ReadAxisState;
+use hli::rpc::PendingCall;
 
 /// The table axis (index in `gpAx`).
 const TABLE_AXIS: u32 = 0;

@@ -47,7 +47,7 @@ fn main() -> ExitCode {
         }
         ["plc-half-block", instance] => {
             let mut client = hli::rpc::AcyclicClient::open(instance).expect("client");
-            let header = hli::fifo_calls::FifoRowsHeader {
+            let header = hli::calls::fifo::FifoRowsHeader {
                 group: 0,
                 columns: 3,
                 rows: 10,

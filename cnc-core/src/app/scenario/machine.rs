@@ -130,7 +130,7 @@ impl InProcess {
                     std::process::id(),
                     IN_PROCESS_SERVICES.fetch_add(1, Ordering::Relaxed)
                 );
-                let refused = |e: hli::rpc::CallError| invalid(format!("acyclic service: {e}"));
+                let refused = |e: hli::calls::CallError| invalid(format!("acyclic service: {e}"));
                 let server = AcyclicServer::open(&instance).map_err(refused)?;
                 let client = AcyclicClient::open(&instance).map_err(refused)?;
                 Some((server, client))

@@ -12,6 +12,8 @@ use super::generator::{Goal, Kinematic, MoveLimits, Progress, SetpointGenerator}
 use super::increments::IncrementCounter;
 use super::inputs::DriveInputs;
 use super::probe::Probes;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{
     axis_status, drive_flags, AxisCommandKind, AxisError, AxisState, CommandResult, CouplingState,
     DirectionBits, DriveState, IoState,
@@ -20,8 +22,6 @@ use hli::layout::{
     HliAxisCommandState, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn,
     NcEncoderOut,
 };
-use hli::probe_calls::{ProbeAbortCall, ProbeArmCall};
-use hli::rpc::AxisCommandCall;
 
 /// Ticks MC_Reset waits for a drive to leave Fault (pulsing fault reset every other tick)
 /// before it ends with `ResetRefused`.

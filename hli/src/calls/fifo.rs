@@ -9,8 +9,7 @@
 //! addressed by their `gpAx` index as in the other calls; group positions count from 1 as in
 //! the seed.
 
-use crate::calls::{AcyclicCall, CallKind};
-use crate::wire::ACYCLIC_BODY_SIZE;
+use crate::enums::wire_enum;
 use bytemuck::{Pod, Zeroable};
 
 /// Values (rows x columns) one row block may carry: 64 KiB of `f64`, the buffer size of the
@@ -23,10 +22,15 @@ pub const FIFO_MAX_DIMENSION: u32 = 16;
 /// Rows a FIFO may hold.
 pub const FIFO_MAX_ROWS: u32 = 1 << 20;
 
-/// [`FifoParametersCall::override_type`]: the override changes at once.
-pub const FIFO_OVERRIDE_INSTANT: u32 = 0;
-/// [`FifoParametersCall::override_type`]: the override follows a PT-2 lag (damping 1.001).
-pub const FIFO_OVERRIDE_PT2: u32 = 1;
+wire_enum! {
+    /// [`FifoParametersCall::override_type`]: how the override follows a new value.
+    FifoOverrideType {
+        /// 0: the override changes at once.
+        Instant = 0 => "instant",
+        /// 1: the override follows a PT-2 lag (damping 1.001).
+        Pt2 = 1 => "pt2",
+    }
+}
 
 /// The reply to every FIFO call and row block: 0 when accepted, else a raw
 /// [`crate::enums::FifoError`] or [`crate::enums::AxisError`]; and the FIFO's state after it.
@@ -109,9 +113,9 @@ pub struct FifoOverrideCall {
 pub struct FifoParametersCall {
     /// FIFO cycle T_f, s (> 0).
     pub fifo_cycle_s: f64,
-    /// PT-2 time constant T0, s (> 0; used by [`FIFO_OVERRIDE_PT2`]).
+    /// PT-2 time constant T0, s (> 0; used by [`FifoOverrideType::Pt2`]).
     pub pt2_t0_s: f64,
-    /// [`FIFO_OVERRIDE_INSTANT`] or [`FIFO_OVERRIDE_PT2`].
+    /// Raw [`FifoOverrideType`].
     pub override_type: u32,
     /// Reserved, 0.
     pub reserved: u32,
@@ -134,25 +138,40 @@ pub struct FifoRowsHeader {
 
 crate::raw::zero_copy_send!(FifoRowsHeader, FifoReply);
 
-macro_rules! fifo_calls {
-    ($($call:ty => $kind:ident),* $(,)?) => {$(
-        impl AcyclicCall for $call {
-            const KIND: CallKind = CallKind::$kind;
-            type Reply = FifoReply;
-        }
-        const _: () = assert!(core::mem::size_of::<$call>() <= ACYCLIC_BODY_SIZE);
-    )*};
-}
-
-fifo_calls! {
-    FifoDimensionCall => FifoDimension,
-    FifoIntegrateCall => FifoIntegrate,
-    FifoDisintegrateCall => FifoDisintegrate,
-    FifoStartCall => FifoStart,
-    FifoStopCall => FifoStop,
-    FifoOverrideCall => FifoOverride,
-    FifoParametersCall => FifoParameters,
+calls! { family "fifo";
+    /// [`FifoDimensionCall`]: FiFoGetDimension.
+    FIFO_DIMENSION = 30: FifoDimensionCall -> FifoReply, read_only;
+    /// [`FifoIntegrateCall`]: FiFoGroupIntegrate.
+    FIFO_INTEGRATE = 31: FifoIntegrateCall -> FifoReply, command;
+    /// [`FifoDisintegrateCall`]: FiFoGroupDisintegrate.
+    FIFO_DISINTEGRATE = 32: FifoDisintegrateCall -> FifoReply, command;
+    /// [`FifoStartCall`]: FiFoStart.
+    FIFO_START = 33: FifoStartCall -> FifoReply, command;
+    /// [`FifoStopCall`]: FiFoStop.
+    FIFO_STOP = 34: FifoStopCall -> FifoReply, command;
+    /// [`FifoOverrideCall`]: FiFoSetChannelOverride.
+    FIFO_OVERRIDE = 35: FifoOverrideCall -> FifoReply, command;
+    /// [`FifoParametersCall`]: the group's parameters a PLC may set.
+    FIFO_PARAMETERS = 36: FifoParametersCall -> FifoReply, command;
 }
 
 const _: () = assert!(core::mem::size_of::<FifoReply>() == 32);
 const _: () = assert!(core::mem::size_of::<FifoRowsHeader>() == 16);
+
+#[cfg(test)]
+mod tests {
+    use super::FifoOverrideType;
+
+    #[test]
+    fn the_override_types_keep_their_numbers() {
+        assert_eq!(
+            FifoOverrideType::from_name("instant").map(FifoOverrideType::raw),
+            Some(0)
+        );
+        assert_eq!(
+            FifoOverrideType::from_name("PT2").map(FifoOverrideType::raw),
+            Some(1)
+        );
+        assert_eq!(FifoOverrideType::from_raw(2), None);
+    }
+}

@@ -4,7 +4,7 @@
 //! index); the master is an axis index in the body. The slave's progress is read from its
 //! axis image: `coupling_state_r` 2 (velocity) or 3 (position) and `nAxisState` 11/12/13.
 
-use crate::calls::{AcyclicCall, CallKind};
+use crate::enums::wire_enum;
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
 
@@ -55,16 +55,25 @@ pub mod sync_mask {
     pub const OPERATIONS: u32 = 0x00F3_0000;
 }
 
-/// `E_GearInSyncMode`: the slave profile is a function of the master position.
-pub const SYNC_POSITION_BASED: u32 = 0;
-/// `E_GearInSyncMode`: a time-based slave profile that keeps all slave limits (velocity
-/// sync only).
-pub const SYNC_TIME_BASED: u32 = 1;
+wire_enum! {
+    /// `E_GearInSyncMode` ([`SawGearInCall::sync_mode`]).
+    SawSyncMode {
+        /// 0: the slave profile is a function of the master position.
+        PositionBased = 0 => "position_based",
+        /// 1: a time-based slave profile that keeps all slave limits (velocity sync only).
+        TimeBased = 1 => "time_based",
+    }
+}
 
-/// [`SawGearInCall::target`]: synchronise on velocity (MC_GearInVelo).
-pub const SAW_ON_VELOCITY: u32 = 0;
-/// [`SawGearInCall::target`]: synchronise on position (MC_GearInPos).
-pub const SAW_ON_POSITION: u32 = 1;
+wire_enum! {
+    /// [`SawGearInCall::target`]: what the slave synchronises on.
+    SawSyncTarget {
+        /// 0: velocity (MC_GearInVelo).
+        Velocity = 0 => "velocity",
+        /// 1: position (MC_GearInPos).
+        Position = 1 => "position",
+    }
+}
 
 /// MC_GearInVelo / MC_GearInPos for the slave given as `target`.
 #[repr(C)]
@@ -72,9 +81,9 @@ pub const SAW_ON_POSITION: u32 = 1;
 pub struct SawGearInCall {
     /// The master, its `gpAx` index.
     pub master: u32,
-    /// [`SAW_ON_VELOCITY`] or [`SAW_ON_POSITION`].
+    /// Raw [`SawSyncTarget`].
     pub target: u32,
-    /// [`SYNC_POSITION_BASED`] or [`SYNC_TIME_BASED`].
+    /// Raw [`SawSyncMode`].
     pub sync_mode: u32,
     /// Check and operation bits ([`sync_mask`]).
     pub mask: u32,
@@ -147,20 +156,34 @@ pub struct SawCharacReply {
     pub values: [f64; SAW_CHARAC_PART],
 }
 
-impl AcyclicCall for SawGearInCall {
-    const KIND: CallKind = CallKind::SawGearIn;
-    type Reply = SawReply;
-}
-impl AcyclicCall for SawGearOutCall {
-    const KIND: CallKind = CallKind::SawGearOut;
-    type Reply = SawReply;
-}
-impl AcyclicCall for SawCharacCall {
-    const KIND: CallKind = CallKind::SawCharac;
-    type Reply = SawCharacReply;
+calls! { family "saw";
+    /// [`SawGearInCall`]: MC_GearInVelo / MC_GearInPos.
+    SAW_GEAR_IN = 40: SawGearInCall -> SawReply, command;
+    /// [`SawGearOutCall`]: MC_GearOut.
+    SAW_GEAR_OUT = 41: SawGearOutCall -> SawReply, command;
+    /// [`SawCharacCall`]: MC_ReadFlyingSawCharacteristics, one part.
+    SAW_CHARAC = 42: SawCharacCall -> SawCharacReply, read_only;
 }
 
 const _: () = assert!(core::mem::size_of::<SawGearInCall>() == 80);
 const _: () = assert!(core::mem::size_of::<SawCharacReply>() == 144);
 const _: () = assert!(core::mem::size_of::<SawCharacReply>() <= ACYCLIC_BODY_SIZE);
 const _: () = assert!(sync_mask::CHECKS & sync_mask::OPERATIONS == 0);
+
+#[cfg(test)]
+mod tests {
+    use super::{SawSyncMode, SawSyncTarget};
+
+    #[test]
+    fn the_sync_selectors_keep_their_numbers() {
+        assert_eq!(SawSyncMode::PositionBased.raw(), 0);
+        assert_eq!(
+            SawSyncMode::from_name("time_based"),
+            Some(SawSyncMode::TimeBased)
+        );
+        assert_eq!(SawSyncMode::TimeBased.raw(), 1);
+        assert_eq!(SawSyncTarget::Velocity.raw(), 0);
+        assert_eq!(SawSyncTarget::from_raw(1), Some(SawSyncTarget::Position));
+        assert_eq!(SawSyncTarget::from_raw(2), None);
+    }
+}

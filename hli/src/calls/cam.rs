@@ -1,205 +1,92 @@
-//! The vocabulary of the acyclic calls: the call kinds, each kind's typed request and reply
-//! body ([`AcyclicCall`]), the ADS-style refusal codes, and the body decoding a handler uses.
-//! The engines add their kinds to [`CallKind`].
+//! The cam family's calls (seed 000): tables and motion functions written and read in
+//! chunks, couplings (MC_CamIn, MC_CamOut, MC_CamScaling), the online change of points and
+//! the multi-table slaves. Every reply is a [`CamReply`] unless a read says otherwise.
 
-mod axis;
-pub use axis::{AxisCommandCall, AxisCommandReply};
-
-use crate::enums::InvalidValue;
-use crate::layout::HliAxisLrState;
-use crate::wire::{encode_body, AcyclicRequest, ACYCLIC_BODY_SIZE};
+use crate::enums::wire_enum;
+use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
-use core::time::Duration;
 
-macro_rules! codes {
-    ($( $(#[doc = $d:literal])* $name:ident = $v:literal ),* $(,)?) => {
-        /// Why a call was refused: ADS-style device error codes.
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        pub enum ErrorCode { $( $(#[doc = $d])* $name, )* }
-        impl ErrorCode {
-            /// The numeric code.
-            pub fn raw(self) -> u32 { match self { $( ErrorCode::$name => $v, )* } }
-            /// Decodes a numeric code.
-            pub fn decode(raw: u32) -> Result<Self, InvalidValue> {
-                $( if raw == $v { return Ok(ErrorCode::$name); } )*
-                Err(InvalidValue { type_name: "ErrorCode", raw: raw as i64,
-                                   allowed: concat!($(stringify!($v), " "),*) })
-            }
-        }
-    };
-}
-
-codes! {
-    /// The call kind is not known to the server (0x701, service not supported).
-    ServiceNotSupported = 0x701,
-    /// The target (axis, channel, table) does not exist (0x703, invalid index offset).
-    InvalidTarget = 0x703,
-    /// The body has the wrong size for the kind (0x705, invalid size).
-    InvalidSize = 0x705,
-    /// The body's values are not acceptable (0x706, invalid data).
-    InvalidData = 0x706,
-    /// The addressed object is busy or in a state that refuses the call (0x712, busy).
-    Busy = 0x712,
-}
-
-/// Numbers of the call kinds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CallKind {
-    /// [`ReadAxisState`].
-    ReadAxisState,
-    /// [`AxisCommandCall`].
-    AxisCommand,
-    /// [`CamTableSelectCall`].
-    CamTableSelect,
-    /// [`CamInCall`].
-    CamIn,
-    /// [`CamOutCall`].
-    CamOut,
-    /// [`CamScalingCall`].
-    CamScaling,
-    /// [`CamPointsWriteCall`].
-    CamPointsWrite,
-    /// [`CamPointsReadCall`].
-    CamPointsRead,
-    /// [`CamOnlineModeCall`].
-    CamOnlineMode,
-    /// [`CamRowsWriteCall`].
-    CamRowsWrite,
-    /// [`CamReadCall`].
-    CamRead,
-    /// [`CamTableWeightCall`].
-    CamTableWeight,
-    /// [`CamMultiCoupleCall`].
-    CamMultiCouple,
-    /// [`CamMultiTableCall`].
-    CamMultiTable,
-    /// [`CamTableDeleteCall`].
-    CamTableDelete,
-    /// [`crate::fifo_calls::FifoDimensionCall`].
-    FifoDimension,
-    /// [`crate::fifo_calls::FifoIntegrateCall`].
-    FifoIntegrate,
-    /// [`crate::fifo_calls::FifoDisintegrateCall`].
-    FifoDisintegrate,
-    /// [`crate::fifo_calls::FifoStartCall`].
-    FifoStart,
-    /// [`crate::fifo_calls::FifoStopCall`].
-    FifoStop,
-    /// [`crate::fifo_calls::FifoOverrideCall`].
-    FifoOverride,
-    /// [`crate::fifo_calls::FifoParametersCall`].
-    FifoParameters,
-    /// [`crate::saw_calls::SawGearInCall`].
-    SawGearIn,
-    /// [`crate::saw_calls::SawGearOutCall`].
-    SawGearOut,
-    /// [`crate::saw_calls::SawCharacCall`].
-    SawCharac,
-    /// [`crate::probe_calls::ProbeArmCall`].
-    ProbeArm,
-    /// [`crate::probe_calls::ProbeAbortCall`].
-    ProbeAbort,
-    /// [`crate::diag_calls::DynCsHistoryReadCall`].
-    DynCsHistoryRead,
-    /// [`crate::diag_calls::DynCsLogReadCall`].
-    DynCsLogRead,
-}
-
-impl CallKind {
-    /// The raw kind number.
-    pub fn raw(self) -> u32 {
-        match self {
-            CallKind::ReadAxisState => 1,
-            CallKind::AxisCommand => 2,
-            CallKind::CamTableSelect => 10,
-            CallKind::CamIn => 11,
-            CallKind::CamOut => 12,
-            CallKind::CamScaling => 13,
-            CallKind::CamPointsWrite => 14,
-            CallKind::CamPointsRead => 15,
-            CallKind::CamOnlineMode => 16,
-            CallKind::CamRowsWrite => 17,
-            CallKind::CamRead => 18,
-            CallKind::CamTableWeight => 19,
-            CallKind::CamMultiCouple => 20,
-            CallKind::CamMultiTable => 21,
-            CallKind::CamTableDelete => 22,
-            CallKind::FifoDimension => 30,
-            CallKind::FifoIntegrate => 31,
-            CallKind::FifoDisintegrate => 32,
-            CallKind::FifoStart => 33,
-            CallKind::FifoStop => 34,
-            CallKind::FifoOverride => 35,
-            CallKind::FifoParameters => 36,
-            CallKind::SawGearIn => 40,
-            CallKind::SawGearOut => 41,
-            CallKind::SawCharac => 42,
-            CallKind::ProbeArm => 50,
-            CallKind::ProbeAbort => 51,
-            CallKind::DynCsHistoryRead => 60,
-            CallKind::DynCsLogRead => 61,
-        }
-    }
-
-    /// Decodes a raw kind number.
-    pub fn decode(raw: u32) -> Option<Self> {
-        match raw {
-            1 => Some(CallKind::ReadAxisState),
-            2 => Some(CallKind::AxisCommand),
-            10 => Some(CallKind::CamTableSelect),
-            11 => Some(CallKind::CamIn),
-            12 => Some(CallKind::CamOut),
-            13 => Some(CallKind::CamScaling),
-            14 => Some(CallKind::CamPointsWrite),
-            15 => Some(CallKind::CamPointsRead),
-            16 => Some(CallKind::CamOnlineMode),
-            17 => Some(CallKind::CamRowsWrite),
-            18 => Some(CallKind::CamRead),
-            19 => Some(CallKind::CamTableWeight),
-            20 => Some(CallKind::CamMultiCouple),
-            21 => Some(CallKind::CamMultiTable),
-            22 => Some(CallKind::CamTableDelete),
-            30 => Some(CallKind::FifoDimension),
-            31 => Some(CallKind::FifoIntegrate),
-            32 => Some(CallKind::FifoDisintegrate),
-            33 => Some(CallKind::FifoStart),
-            34 => Some(CallKind::FifoStop),
-            35 => Some(CallKind::FifoOverride),
-            36 => Some(CallKind::FifoParameters),
-            40 => Some(CallKind::SawGearIn),
-            41 => Some(CallKind::SawGearOut),
-            42 => Some(CallKind::SawCharac),
-            50 => Some(CallKind::ProbeArm),
-            51 => Some(CallKind::ProbeAbort),
-            60 => Some(CallKind::DynCsHistoryRead),
-            61 => Some(CallKind::DynCsLogRead),
-            _ => None,
-        }
+wire_enum! {
+    /// `MC_StartMode` ([`CamInCall::start_mode`]): whether the cam's master and slave
+    /// coordinates are absolute or measured from the axes' positions at coupling (or
+    /// switching).
+    CamStartMode {
+        /// 1: both absolute.
+        Absolute = 1 => "absolute",
+        /// 2: both relative.
+        Relative = 2 => "relative",
+        /// 3: master absolute, slave relative.
+        MasterAbsSlaveRel = 3 => "master_abs_slave_rel",
+        /// 4: master relative, slave absolute.
+        MasterRelSlaveAbs = 4 => "master_rel_slave_abs",
     }
 }
 
-/// A typed call: request body `Self`, reply body `Reply`.
-pub trait AcyclicCall: Pod {
-    /// The kind number.
-    const KIND: CallKind;
-    /// The reply body.
-    type Reply: Pod;
+impl CamStartMode {
+    /// Whether the master coordinate is measured from the coupling position.
+    pub fn master_relative(self) -> bool {
+        matches!(
+            self,
+            CamStartMode::Relative | CamStartMode::MasterRelSlaveAbs
+        )
+    }
+
+    /// Whether the slave coordinate is measured from the coupling position.
+    pub fn slave_relative(self) -> bool {
+        matches!(
+            self,
+            CamStartMode::Relative | CamStartMode::MasterAbsSlaveRel
+        )
+    }
 }
 
-/// Reads the cyclic state of the axis given as `target`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable, Default)]
-pub struct ReadAxisState {
-    /// Reserved, must be 0.
-    pub reserved: u32,
+wire_enum! {
+    /// `MC_CamActivationMode`: when a coupling, switch, rescaling or change of points takes
+    /// effect (the positional modes take their position from the call body).
+    CamActivationMode {
+        /// 0: at once (in the next tick).
+        Instantaneous = 0 => "instantaneous",
+        /// 1: when the master's position within the cam passes the activation position.
+        AtMasterCamPos = 1 => "at_master_cam_pos",
+        /// 2: when the master axis passes the activation position (absolute).
+        AtMasterAxisPos = 2 => "at_master_axis_pos",
+        /// 3: at the next cycle boundary (a cyclic cam) or range edge (a linear one).
+        NextCycle = 3 => "next_cycle",
+        /// 4: at the next cycle boundary, once.
+        NextCycleOnce = 4 => "next_cycle_once",
+        /// 5: as soon as possible (point data).
+        AsSoonAsPossible = 5 => "as_soon_as_possible",
+        /// 6: nothing is changed.
+        Off = 6 => "off",
+        /// 7: a queued, not yet active change is dropped.
+        DeleteQueuedData = 7 => "delete_queued_data",
+    }
 }
 
-impl AcyclicCall for ReadAxisState {
-    const KIND: CallKind = CallKind::ReadAxisState;
-    type Reply = HliAxisLrState;
+wire_enum! {
+    /// `MC_InterpolationType` of a position table.
+    CamInterpolation {
+        /// 0: straight lines between rows.
+        Linear = 0 => "linear",
+        /// 1: the cubic through the four nearest rows (equidistant tables only).
+        FourPoint = 1 => "4point",
+        /// 2: a cubic spline, tangential at the ends of a linear table, cyclic for a periodic
+        /// one.
+        Spline = 2 => "spline",
+    }
 }
 
-const _: () = assert!(core::mem::size_of::<HliAxisLrState>() <= ACYCLIC_BODY_SIZE);
+wire_enum! {
+    /// `MC_CamScalingMode` of one side (master or slave).
+    CamScalingMode {
+        /// 0: scaling and offset taken as given.
+        UserDefined = 0 => "user_defined",
+        /// 1: scaling taken, offset computed so that nothing jumps.
+        AutoOffset = 1 => "auto_offset",
+        /// 2: this side's scaling and offset stay as they are.
+        Off = 2 => "off",
+    }
+}
 
 /// MC_CamTableSelect for the table given as `target` (its ID, 1..=255): how couplings
 /// through it run when MC_CamIn does not say otherwise.
@@ -224,15 +111,15 @@ pub struct CamInCall {
     pub master: u32,
     /// Cam table ID.
     pub table_id: u32,
-    /// Raw `MC_StartMode` (1..=4).
+    /// Raw [`CamStartMode`].
     pub start_mode: u32,
-    /// Raw `MC_CamActivationMode` (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamActivationMode`] (MC_CamInExt; 0 for MC_CamIn).
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamScalingMode`] of the master (MC_CamInExt; 0 for MC_CamIn).
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave (MC_CamInExt; 0 for MC_CamIn).
+    /// Raw [`CamScalingMode`] of the slave (MC_CamInExt; 0 for MC_CamIn).
     pub slave_scaling_mode: u32,
-    /// Raw `MC_InterpolationType` of a table (0 linear, the seed's default; one other than
+    /// Raw [`CamInterpolation`] of a table (0 linear, the seed's default; one other than
     /// the stored table's gives the coupling its own copy). Motion functions ignore it.
     pub interpolation: u32,
     /// 1 for MC_CamInExt: the coupling may later switch to another cam.
@@ -266,11 +153,11 @@ pub struct CamOutCall {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamScalingCall {
-    /// Raw `MC_CamActivationMode`.
+    /// Raw [`CamActivationMode`].
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master.
+    /// Raw [`CamScalingMode`] of the master.
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave.
+    /// Raw [`CamScalingMode`] of the slave.
     pub slave_scaling_mode: u32,
     /// Values left as they are ([`CAM_KEEP_MASTER_SCALING`] ...); 0 for MC_CamScaling.
     pub reserved: u32,
@@ -296,26 +183,6 @@ pub struct CamReply {
     pub error_id: u32,
     /// Reserved, 0.
     pub reserved: u32,
-}
-
-impl AcyclicCall for CamTableSelectCall {
-    const KIND: CallKind = CallKind::CamTableSelect;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamInCall {
-    const KIND: CallKind = CallKind::CamIn;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamOutCall {
-    const KIND: CallKind = CallKind::CamOut;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamScalingCall {
-    const KIND: CallKind = CallKind::CamScaling;
-    type Reply = CamReply;
 }
 
 /// One point of a motion function as the PLC holds it (`MC_MotionFunctionPoint`).
@@ -405,11 +272,11 @@ pub struct CamPointsReply {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamOnlineModeCall {
-    /// Raw `MC_CamActivationMode`.
+    /// Raw [`CamActivationMode`].
     pub activation_mode: u32,
-    /// Raw `MC_CamScalingMode` of the master when a change applies.
+    /// Raw [`CamScalingMode`] of the master when a change applies.
     pub master_scaling_mode: u32,
-    /// Raw `MC_CamScalingMode` of the slave when a change applies.
+    /// Raw [`CamScalingMode`] of the slave when a change applies.
     pub slave_scaling_mode: u32,
     /// Reserved, 0.
     pub reserved: u32,
@@ -445,11 +312,6 @@ pub struct CamTableDeleteCall {
     pub reserved: u32,
 }
 
-impl AcyclicCall for CamTableDeleteCall {
-    const KIND: CallKind = CallKind::CamTableDelete;
-    type Reply = CamReply;
-}
-
 /// Rows of a position table that fit one call.
 pub const CAM_ROWS_PER_CALL: usize = 13;
 
@@ -469,7 +331,7 @@ pub struct CamRowsWriteCall {
     pub total: u32,
     /// Raw `MC_TableType` (10 equidistant, 11 non-equidistant).
     pub table_type: u32,
-    /// Raw `MC_InterpolationType` the table keeps by default.
+    /// Raw [`CamInterpolation`] the table keeps by default.
     pub interpolation: u32,
     /// 1: continued period by period.
     pub periodic: u32,
@@ -532,11 +394,6 @@ pub struct CamValuesReply {
     pub columns: u32,
     /// The values.
     pub values: [f64; CAM_VALUES_PER_REPLY],
-}
-
-impl AcyclicCall for CamReadCall {
-    const KIND: CallKind = CallKind::CamRead;
-    type Reply = CamValuesReply;
 }
 
 /// CamTableSetWeight for the table given as `target`: how it counts in a multi-table slave.
@@ -603,39 +460,33 @@ pub struct CamMultiTableCall {
     pub position: f64,
 }
 
-impl AcyclicCall for CamTableWeightCall {
-    const KIND: CallKind = CallKind::CamTableWeight;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamMultiCoupleCall {
-    const KIND: CallKind = CallKind::CamMultiCouple;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamMultiTableCall {
-    const KIND: CallKind = CallKind::CamMultiTable;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamPointsWriteCall {
-    const KIND: CallKind = CallKind::CamPointsWrite;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamPointsReadCall {
-    const KIND: CallKind = CallKind::CamPointsRead;
-    type Reply = CamPointsReply;
-}
-
-impl AcyclicCall for CamOnlineModeCall {
-    const KIND: CallKind = CallKind::CamOnlineMode;
-    type Reply = CamReply;
-}
-
-impl AcyclicCall for CamRowsWriteCall {
-    const KIND: CallKind = CallKind::CamRowsWrite;
-    type Reply = CamReply;
+calls! { family "cam";
+    /// [`CamTableSelectCall`]: MC_CamTableSelect.
+    CAM_TABLE_SELECT = 10: CamTableSelectCall -> CamReply, command;
+    /// [`CamInCall`]: MC_CamIn / MC_CamInExt.
+    CAM_IN = 11: CamInCall -> CamReply, command;
+    /// [`CamOutCall`]: MC_CamOut.
+    CAM_OUT = 12: CamOutCall -> CamReply, command;
+    /// [`CamScalingCall`]: MC_CamScaling.
+    CAM_SCALING = 13: CamScalingCall -> CamReply, command;
+    /// [`CamPointsWriteCall`]: a chunk of MC_WriteMotionFunction(Point).
+    CAM_POINTS_WRITE = 14: CamPointsWriteCall -> CamReply, command;
+    /// [`CamPointsReadCall`]: MC_ReadMotionFunction(Point).
+    CAM_POINTS_READ = 15: CamPointsReadCall -> CamPointsReply, read_only;
+    /// [`CamOnlineModeCall`]: MC_SetCamOnlineChangeMode.
+    CAM_ONLINE_MODE = 16: CamOnlineModeCall -> CamReply, command;
+    /// [`CamRowsWriteCall`]: a chunk of a position table.
+    CAM_ROWS_WRITE = 17: CamRowsWriteCall -> CamReply, command;
+    /// [`CamReadCall`]: cam data read in parts.
+    CAM_READ = 18: CamReadCall -> CamValuesReply, read_only;
+    /// [`CamTableWeightCall`]: CamTableSetWeight.
+    CAM_TABLE_WEIGHT = 19: CamTableWeightCall -> CamReply, command;
+    /// [`CamMultiCoupleCall`]: CamTableCoupleAxesMultiTables.
+    CAM_MULTI_COUPLE = 20: CamMultiCoupleCall -> CamReply, command;
+    /// [`CamMultiTableCall`]: a table of a multi-table slave.
+    CAM_MULTI_TABLE = 21: CamMultiTableCall -> CamReply, command;
+    /// [`CamTableDeleteCall`]: CamTableDelete.
+    CAM_TABLE_DELETE = 22: CamTableDeleteCall -> CamReply, command;
 }
 
 // Every body fits one frame.
@@ -649,51 +500,86 @@ const _: () = {
     assert!(core::mem::size_of::<CamScalingCall>() <= ACYCLIC_BODY_SIZE);
 };
 
-/// Why a call did not produce a reply.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-pub enum CallError {
-    /// The server refused it.
-    #[error("refused with error 0x{:X} ({code:?})", code.raw())]
-    Refused {
-        /// The server's code.
-        code: ErrorCode,
-    },
-    /// The server answered with something that does not decode.
-    #[error("malformed response: {0}")]
-    Malformed(String),
-    /// No answer within the timeout.
-    #[error("no response within {0:?}")]
-    Timeout(Duration),
-    /// iceoryx2 failed.
-    #[error("request-response service: {0}")]
-    Transport(String),
-}
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// Decodes a request body as `T`; a size mismatch is [`ErrorCode::InvalidSize`].
-pub fn decode_body<T: Pod>(request: &AcyclicRequest) -> Result<T, ErrorCode> {
-    let len = request.body_len as usize;
-    if len != core::mem::size_of::<T>() {
-        return Err(ErrorCode::InvalidSize);
+    fn table<T: Copy>(
+        all: &[T],
+        raw: fn(T) -> u32,
+        name: fn(T) -> &'static str,
+    ) -> Vec<(&'static str, u32)> {
+        all.iter().map(|&v| (name(v), raw(v))).collect()
     }
-    Ok(bytemuck::pod_read_unaligned(&request.body[..len]))
-}
 
-/// Decodes a handler's reply body as `C`'s reply; a size mismatch is
-/// [`ErrorCode::InvalidSize`].
-pub fn decode_reply<C: AcyclicCall>(
-    body: &[u8; ACYCLIC_BODY_SIZE],
-    len: u32,
-) -> Result<C::Reply, ErrorCode> {
-    if len as usize != core::mem::size_of::<C::Reply>() {
-        return Err(ErrorCode::InvalidSize);
+    #[test]
+    fn the_mode_selectors_keep_their_names_and_numbers() {
+        assert_eq!(
+            table(CamStartMode::ALL, CamStartMode::raw, CamStartMode::name),
+            [
+                ("absolute", 1),
+                ("relative", 2),
+                ("master_abs_slave_rel", 3),
+                ("master_rel_slave_abs", 4)
+            ]
+        );
+        assert_eq!(
+            table(
+                CamActivationMode::ALL,
+                CamActivationMode::raw,
+                CamActivationMode::name
+            ),
+            [
+                ("instantaneous", 0),
+                ("at_master_cam_pos", 1),
+                ("at_master_axis_pos", 2),
+                ("next_cycle", 3),
+                ("next_cycle_once", 4),
+                ("as_soon_as_possible", 5),
+                ("off", 6),
+                ("delete_queued_data", 7)
+            ]
+        );
+        assert_eq!(
+            table(
+                CamInterpolation::ALL,
+                CamInterpolation::raw,
+                CamInterpolation::name
+            ),
+            [("linear", 0), ("4point", 1), ("spline", 2)]
+        );
+        assert_eq!(
+            table(
+                CamScalingMode::ALL,
+                CamScalingMode::raw,
+                CamScalingMode::name
+            ),
+            [("user_defined", 0), ("auto_offset", 1), ("off", 2)]
+        );
     }
-    Ok(bytemuck::pod_read_unaligned(&body[..len as usize]))
-}
 
-/// A reply a handler produces: the encoded body or a refusal.
-pub type HandlerResult = Result<([u8; ACYCLIC_BODY_SIZE], u32), ErrorCode>;
-
-/// Encodes a typed reply for a handler.
-pub fn reply<T: Pod>(value: &T) -> HandlerResult {
-    Ok(encode_body(value))
+    #[test]
+    fn a_selector_decodes_from_its_number_or_its_name() {
+        for &mode in CamActivationMode::ALL {
+            assert_eq!(CamActivationMode::from_raw(mode.raw()), Some(mode));
+            assert_eq!(CamActivationMode::from_name(mode.name()), Some(mode));
+        }
+        assert_eq!(CamStartMode::from_raw(0), None);
+        assert_eq!(CamScalingMode::from_raw(3), None);
+        assert_eq!(
+            CamInterpolation::from_name("4POINT"),
+            Some(CamInterpolation::FourPoint)
+        );
+        assert_eq!(
+            CamStartMode::from_name("Master_Abs_Slave_Rel"),
+            Some(CamStartMode::MasterAbsSlaveRel)
+        );
+        assert_eq!(CamScalingMode::from_name("auto offset"), None);
+        assert!(
+            CamStartMode::Relative.master_relative() && CamStartMode::Relative.slave_relative()
+        );
+        assert!(!CamStartMode::MasterAbsSlaveRel.master_relative());
+        assert!(CamStartMode::MasterRelSlaveAbs.master_relative());
+        assert!(!CamStartMode::Absolute.slave_relative());
+    }
 }

@@ -10,7 +10,6 @@
 //! from there. A sequence not recorded yet gets a reply with `present` 0; a channel that
 //! does not exist is refused with `InvalidTarget`.
 
-use crate::calls::{AcyclicCall, CallKind};
 use bytemuck::{Pod, Zeroable};
 
 /// Read history entry `sequence` (or the oldest kept one, if it is older).
@@ -128,14 +127,11 @@ pub struct DynCsLogReply {
     pub frame: [f64; 6],
 }
 
-impl AcyclicCall for DynCsHistoryReadCall {
-    const KIND: CallKind = CallKind::DynCsHistoryRead;
-    type Reply = DynCsHistoryReply;
-}
-
-impl AcyclicCall for DynCsLogReadCall {
-    const KIND: CallKind = CallKind::DynCsLogRead;
-    type Reply = DynCsLogReply;
+calls! { family "diag";
+    /// [`DynCsHistoryReadCall`]: one entry of a channel's dynamic-CS history.
+    DYN_CS_HISTORY_READ = 60: DynCsHistoryReadCall -> DynCsHistoryReply, read_only;
+    /// [`DynCsLogReadCall`]: one event of a channel's dynamic-CS log.
+    DYN_CS_LOG_READ = 61: DynCsLogReadCall -> DynCsLogReply, read_only;
 }
 
 const _: () = assert!(core::mem::size_of::<DynCsHistoryReply>() == 184);

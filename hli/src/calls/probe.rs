@@ -2,7 +2,6 @@
 //! index), MC_AbortTrigger disarms it. What the probe recorded is read from the axis image,
 //! `gpAx[i]^drive_state.probe_r[k]`, under the arm id the reply carries.
 
-use crate::calls::{AcyclicCall, CallKind};
 use bytemuck::{Pod, Zeroable};
 
 /// MC_TouchProbe: arm probe `probe` (1 or 2) for one edge; with `window_only` 1 only an edge
@@ -45,12 +44,9 @@ pub struct ProbeReply {
     pub error_id: u32,
 }
 
-impl AcyclicCall for ProbeArmCall {
-    const KIND: CallKind = CallKind::ProbeArm;
-    type Reply = ProbeReply;
-}
-
-impl AcyclicCall for ProbeAbortCall {
-    const KIND: CallKind = CallKind::ProbeAbort;
-    type Reply = ProbeReply;
+calls! { family "probe";
+    /// [`ProbeArmCall`]: MC_TouchProbe.
+    PROBE_ARM = 50: ProbeArmCall -> ProbeReply, command;
+    /// [`ProbeAbortCall`]: MC_AbortTrigger.
+    PROBE_ABORT = 51: ProbeAbortCall -> ProbeReply, command;
 }
