@@ -626,58 +626,11 @@ impl Parser<'_> {
         if glued.is_none() && (word == "L" || word == "LL") {
             return self.sub_call(word == "LL", span);
         }
-        if word == "PP" || word == "PPP" {
-            self.error(span, "indirect P parameters (PP1) are not supported");
-            self.recover();
-            return None;
-        }
-        if word == "P" && glued.is_none() && self.is_punct("[") {
-            self.error(
-                span,
-                "indexed P parameters (P[..]) and P arrays are not supported",
-            );
-            self.recover();
-            return None;
-        }
-        if word == "P" {
-            let Some(n) = Self::param_number(word, glued) else {
-                self.error(
-                    span,
-                    format!("a P parameter is P and a whole number 1..={MAX_PARAM}, such as P12"),
-                );
-                self.recover();
-                return None;
-            };
-            return self.assignment(Target::Param(n), span);
+        if word == "P" || word == "PP" || word == "PPP" {
+            return self.param_assignment(word, glued, span);
         }
         if self.is_punct("=") {
-            // A name that is too long is reported; its value is still read, so that the
-            // rest of the block is checked as usual.
-            let name = self.axis_name(word, glued, span);
-            if name.is_none() && self.at_end_of_block() {
-                return None;
-            }
-            self.bump();
-            let value = self.expr();
-            let (name, value) = (name?, value?);
-            return Some(match name.as_str() {
-                "F" => Item::Feed {
-                    value,
-                    span: self.extend(span),
-                },
-                "G" | "M" | "N" => {
-                    self.error(
-                        span,
-                        format!("{name}=... is not allowed: write {name}<number>"),
-                    );
-                    return None;
-                }
-                _ => Item::Axis(AxisWord {
-                    name,
-                    value,
-                    span: self.extend(span),
-                }),
-            });
+            return self.assigned_word(word, glued, span);
         }
         // `X[P1 * 2]`: an expression in brackets right after the address.
         let independent = matches!(self.peek_at(1), Tok::Word(w) if w.starts_with("INDP"));
@@ -685,34 +638,106 @@ impl Parser<'_> {
         let code = glued.is_some() && matches!(word.as_str(), "G" | "M" | "N");
         let bracket = self.is_punct("[") && !code;
         if bracket && !self.token().spaced && !independent {
-            let name = self.axis_name(word, glued, span)?;
-            let value = self.expr()?;
-            return Some(if name.as_str() == "F" {
-                Item::Feed {
-                    value,
-                    span: self.extend(span),
-                }
-            } else {
-                Item::Axis(AxisWord {
-                    name,
-                    value,
-                    span: self.extend(span),
-                })
-            });
+            return self.bracketed_word(word, glued, span);
         }
-        // `X1[INDP_ASYN ...]`
         if bracket {
-            let name = self.axis_name(word, glued, span);
-            if name.is_none() && self.at_end_of_block() {
+            return self.independent_axis(word, glued, span);
+        }
+        self.numbered_word(word, glued, span)
+    }
+
+    /// `P12 = expr` after `P12` (`word` and `glued`); indirect (`PP1`) and indexed (`P[..]`)
+    /// parameters are reported and the block skipped.
+    fn param_assignment(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Item> {
+        if word == "PP" || word == "PPP" {
+            self.error(span, "indirect P parameters (PP1) are not supported");
+            self.recover();
+            return None;
+        }
+        if glued.is_none() && self.is_punct("[") {
+            self.error(
+                span,
+                "indexed P parameters (P[..]) and P arrays are not supported",
+            );
+            self.recover();
+            return None;
+        }
+        let Some(n) = Self::param_number(word, glued) else {
+            self.error(
+                span,
+                format!("a P parameter is P and a whole number 1..={MAX_PARAM}, such as P12"),
+            );
+            self.recover();
+            return None;
+        };
+        self.assignment(Target::Param(n), span)
+    }
+
+    /// `X=expr`, `F=expr`, the cursor on the `=`; `G=`, `M=` and `N=` are reported.
+    fn assigned_word(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Item> {
+        // A name that is too long is reported; its value is still read, so that the
+        // rest of the block is checked as usual.
+        let name = self.axis_name(word, glued, span);
+        if name.is_none() && self.at_end_of_block() {
+            return None;
+        }
+        self.bump();
+        let value = self.expr();
+        let (name, value) = (name?, value?);
+        Some(match name.as_str() {
+            "F" => Item::Feed {
+                value,
+                span: self.extend(span),
+            },
+            "G" | "M" | "N" => {
+                self.error(
+                    span,
+                    format!("{name}=... is not allowed: write {name}<number>"),
+                );
                 return None;
             }
-            let options = self.bracket_list();
-            let (name, options) = (name?, options?);
-            return Some(Item::IndependentAxis {
-                axis: Box::new(IndependentAxis { name, options }),
+            _ => Item::Axis(AxisWord {
+                name,
+                value,
                 span: self.extend(span),
-            });
+            }),
+        })
+    }
+
+    /// `X[P1 * 2]`, `F[..]`: the value in brackets right after the address.
+    fn bracketed_word(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Item> {
+        let name = self.axis_name(word, glued, span)?;
+        let value = self.expr()?;
+        Some(if name.as_str() == "F" {
+            Item::Feed {
+                value,
+                span: self.extend(span),
+            }
+        } else {
+            Item::Axis(AxisWord {
+                name,
+                value,
+                span: self.extend(span),
+            })
+        })
+    }
+
+    /// `X1[INDP_ASYN ...]`: an independent axis command, the cursor on the `[`.
+    fn independent_axis(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Item> {
+        let name = self.axis_name(word, glued, span);
+        if name.is_none() && self.at_end_of_block() {
+            return None;
         }
+        let options = self.bracket_list();
+        let (name, options) = (name?, options?);
+        Some(Item::IndependentAxis {
+            axis: Box::new(IndependentAxis { name, options }),
+            span: self.extend(span),
+        })
+    }
+
+    /// A word with its number: `G01`, `M30`, `F500`, `X10`, also signed (`X-60`).
+    fn numbered_word(&mut self, word: Name, glued: Option<f64>, span: Span) -> Option<Item> {
         // `X-60`: a signed number glued to the address.
         let glued = glued.or_else(|| self.signed_glued_number());
         let Some(value) = glued else {
@@ -797,6 +822,10 @@ impl Parser<'_> {
         }
     }
 
+    /// A `#` command, the cursor after the `#` (`span` runs to the end of the block). A command
+    /// that cannot be read is reported and gives `None`. Then the rest of the block is skipped,
+    /// except where a part of the command failed (its ON/OFF, its bracket list, an axis name,
+    /// or `#TRAFO` given neither ON, OFF nor an id): parsing goes on where that part stopped.
     fn command(&mut self, span: Span) -> Option<Command> {
         let name = match self.peek().clone() {
             Tok::Word(w) if !self.token().spaced => {
@@ -813,233 +842,19 @@ impl Parser<'_> {
                 return None;
             }
         };
-        let result = match name.as_str() {
-            "TRACK" | "TRACK_CS" => {
-                if name == "TRACK" && !self.expect_word("CS", "#TRACK CS") {
-                    self.recover();
-                    return None;
-                }
-                if self.is_word("ABS") {
-                    self.bump();
-                    Some(Command::TrackCsAbs)
-                } else {
-                    let on = self.on_off("#TRACK CS")?;
-                    let options = if self.is_punct("[") {
-                        self.bracket_list()?
-                    } else {
-                        Vec::new()
-                    };
-                    self.check_track_options(&options);
-                    Some(Command::TrackCs { on, options })
-                }
-            }
-            "CHANNEL" => {
-                if !self.expect_word("INTERFACE", "#CHANNEL INTERFACE") {
-                    self.recover();
-                    return None;
-                }
-                let on = self.on_off("#CHANNEL INTERFACE")?;
-                let mut kind = None;
-                if self.is_punct("[") {
-                    let entries = self.bracket_list()?;
-                    for e in entries {
-                        match (&e.key, &e.value, e.glued) {
-                            (Some(k), None, None) if k == "DYN_CS" || k == "TRACK_CS" => {
-                                if kind.replace(*k).is_some() {
-                                    self.error(
-                                        e.span,
-                                        "#CHANNEL INTERFACE names its interface once",
-                                    );
-                                }
-                            }
-                            _ => self
-                                .error(e.span, "#CHANNEL INTERFACE: expected DYN_CS or TRACK_CS"),
-                        }
-                    }
-                }
-                Some(Command::ChannelInterface { on, kind })
-            }
-            "CS" => {
-                let on = self.on_off("#CS")?;
-                let mut name = None;
-                let mut values = Vec::new();
-                let mut lists = 0;
-                while self.is_punct("[") {
-                    lists += 1;
-                    let entries = self.bracket_list()?;
-                    let is_name = entries.len() == 1
-                        && entries[0].key.is_some()
-                        && entries[0].value.is_none()
-                        && entries[0].glued.is_none();
-                    if is_name && name.is_none() && values.is_empty() {
-                        name = entries[0].key;
-                    } else {
-                        for e in entries {
-                            match (e.key, e.value) {
-                                (None, Some(v)) => values.push(v),
-                                _ => self.error(
-                                    e.span,
-                                    "#CS: expected a value (number, variable or expression)",
-                                ),
-                            }
-                        }
-                    }
-                    if lists > 2 {
-                        self.error(span, "#CS takes at most a name list and a value list");
-                    }
-                }
-                Some(Command::Cs { on, name, values })
-            }
-            "TRAFO" => {
-                let on = match self.peek() {
-                    Tok::Word(w) if w == "ON" || w == "OFF" => self.on_off("#TRAFO"),
-                    _ => None,
-                };
-                let id = if self.is_punct("[") {
-                    let entries = self.bracket_list()?;
-                    match entries.as_slice() {
-                        [Entry {
-                            key: None,
-                            value: Some(v),
-                            ..
-                        }] => Some(v.clone()),
-                        _ => {
-                            self.error(span, "#TRAFO [..]: expected one kinematic id");
-                            None
-                        }
-                    }
-                } else {
-                    None
-                };
-                if on.is_none() && id.is_none() {
-                    let found = self.describe();
-                    self.error(
-                        span,
-                        format!("#TRAFO: expected ON, OFF or [id], found {found}"),
-                    );
-                    return None;
-                }
-                Some(Command::Trafo { on, id })
-            }
-            "KIN" => {
-                if !self.expect_word("ID", "#KIN ID") {
-                    self.recover();
-                    return None;
-                }
-                let entries = if self.is_punct("[") {
-                    self.bracket_list()?
-                } else {
-                    Vec::new()
-                };
-                match entries.as_slice() {
-                    [Entry {
-                        key: None,
-                        value: Some(v),
-                        ..
-                    }] => Some(Command::KinId { id: v.clone() }),
-                    _ => {
-                        self.error(span, "#KIN ID: expected [id]");
-                        None
-                    }
-                }
-            }
-            "SIGNAL" => {
-                if !self.expect_word("SYN", "#SIGNAL SYN") {
-                    self.recover();
-                    return None;
-                }
-                let options = self.required_list("#SIGNAL SYN")?;
-                self.check_keys(&options, &["ID", "COUNT"], "#SIGNAL SYN");
-                Some(Command::SignalSyn { options })
-            }
-            "WAIT" => match self.peek().clone() {
-                Tok::Word(w) if w == "SYN" => {
-                    self.bump();
-                    let options = self.required_list("#WAIT SYN")?;
-                    self.check_keys(&options, &["ID"], "#WAIT SYN");
-                    Some(Command::WaitSyn { options })
-                }
-                Tok::Word(w) if w == "INDP" => {
-                    self.bump();
-                    self.expect_word("ALL", "#WAIT INDP ALL")
-                        .then_some(Command::WaitIndpAll)
-                }
-                _ => {
-                    let found = self.describe();
-                    self.error(span, format!("#WAIT: expected SYN or INDP, found {found}"));
-                    None
-                }
-            },
-            "FLUSH" => match self.peek().clone() {
-                Tok::Word(w) if w == "WAIT" || w == "CONTINUE" => {
-                    self.bump();
-                    Some(Command::Flush { wait: w == "WAIT" })
-                }
-                _ => {
-                    let found = self.describe();
-                    self.error(
-                        span,
-                        format!("#FLUSH: expected WAIT or CONTINUE, found {found}"),
-                    );
-                    None
-                }
-            },
-            "PSET" => {
-                let mut axes = Vec::new();
-                while matches!(self.peek(), Tok::Word(_) | Tok::Addr(..)) {
-                    let s = self.span();
-                    match self.word_item(s) {
-                        Some(Item::Axis(a)) => axes.push(a),
-                        _ => self.error(s, "#PSET: expected axis assignments such as X=10"),
-                    }
-                }
-                if axes.is_empty() {
-                    self.error(span, "#PSET: expected at least one axis assignment");
-                }
-                Some(Command::Pset { axes })
-            }
-            "PRESET" => {
-                let mut axes = Vec::new();
-                while let Some((w, glued)) = self.take_word() {
-                    let s = self.span();
-                    axes.push(self.axis_name(w, glued, s)?);
-                }
-                Some(Command::Preset { axes })
-            }
-            "MSG" => {
-                // `#MSG ["text"]`, also `#MSG SAVE ["text"]` (the message is shown either way).
-                if self.is_word("SAVE") {
-                    self.bump();
-                }
-                let text = if self.is_punct("[") {
-                    self.bump();
-                    let text = match self.peek().clone() {
-                        Tok::Str(t) => {
-                            self.bump();
-                            Some(t)
-                        }
-                        _ => None,
-                    };
-                    if self.is_punct("]") {
-                        self.bump();
-                    } else {
-                        self.error(span, "#MSG: expected \"]\" after the text");
-                    }
-                    text
-                } else {
-                    None
-                };
-                match text {
-                    Some(t) => Some(Command::Msg {
-                        text: std::sync::Arc::from(t),
-                    }),
-                    None => {
-                        self.error(span, "#MSG: expected [\"text\"]");
-                        None
-                    }
-                }
-            }
-            "TIME" => self.expr().map(|seconds| Command::Time { seconds }),
+        match name.as_str() {
+            "TRACK" | "TRACK_CS" => self.track_cs(name),
+            "CHANNEL" => self.channel_interface(),
+            "CS" => self.cs(span),
+            "TRAFO" => self.trafo(span),
+            "KIN" => self.kin_id(span),
+            "SIGNAL" => self.signal_syn(),
+            "WAIT" => self.wait(span),
+            "FLUSH" => self.flush(span),
+            "PSET" => self.pset(span),
+            "PRESET" => self.preset(),
+            "MSG" => self.msg(span),
+            "TIME" => self.time(),
             "VAR" => Some(Command::Var),
             "ENDVAR" => Some(Command::EndVar),
             "COMMENT" => {
@@ -1047,6 +862,7 @@ impl Parser<'_> {
                     span,
                     "#COMMENT END without #COMMENT BEGIN (a comment section is #COMMENT BEGIN ... #COMMENT END, each on its own line)",
                 );
+                self.recover();
                 None
             }
             other => {
@@ -1055,13 +871,272 @@ impl Parser<'_> {
                     format!("unknown command \"#{other}\" (known: #TRACK CS, #CHANNEL INTERFACE, #CS, #TRAFO, #KIN ID, #SIGNAL SYN, #WAIT SYN, #WAIT INDP, #FLUSH, #PSET, #PRESET, #MSG, #TIME, #VAR, #ENDVAR, #COMMENT BEGIN/END)"),
                 );
                 self.recover();
-                return None;
+                None
             }
-        };
-        if result.is_none() {
-            self.recover();
         }
-        result
+    }
+
+    /// `#TRACK CS ABS`, `#TRACK CS ON|OFF [options]` (`name` is `TRACK` or `TRACK_CS`).
+    fn track_cs(&mut self, name: Name) -> Option<Command> {
+        if name == "TRACK" && !self.expect_word("CS", "#TRACK CS") {
+            self.recover();
+            return None;
+        }
+        if self.is_word("ABS") {
+            self.bump();
+            return Some(Command::TrackCsAbs);
+        }
+        let on = self.on_off("#TRACK CS")?;
+        let options = if self.is_punct("[") {
+            self.bracket_list()?
+        } else {
+            Vec::new()
+        };
+        self.check_track_options(&options);
+        Some(Command::TrackCs { on, options })
+    }
+
+    /// `#CHANNEL INTERFACE ON|OFF [DYN_CS|TRACK_CS]`, after `CHANNEL`.
+    fn channel_interface(&mut self) -> Option<Command> {
+        if !self.expect_word("INTERFACE", "#CHANNEL INTERFACE") {
+            self.recover();
+            return None;
+        }
+        let on = self.on_off("#CHANNEL INTERFACE")?;
+        let mut kind = None;
+        if self.is_punct("[") {
+            let entries = self.bracket_list()?;
+            for e in entries {
+                match (&e.key, &e.value, e.glued) {
+                    (Some(k), None, None) if k == "DYN_CS" || k == "TRACK_CS" => {
+                        if kind.replace(*k).is_some() {
+                            self.error(e.span, "#CHANNEL INTERFACE names its interface once");
+                        }
+                    }
+                    _ => self.error(e.span, "#CHANNEL INTERFACE: expected DYN_CS or TRACK_CS"),
+                }
+            }
+        }
+        Some(Command::ChannelInterface { on, kind })
+    }
+
+    /// `#CS ON|OFF [name] [values]`, after `CS`.
+    fn cs(&mut self, span: Span) -> Option<Command> {
+        let on = self.on_off("#CS")?;
+        let mut name = None;
+        let mut values = Vec::new();
+        let mut lists = 0;
+        while self.is_punct("[") {
+            lists += 1;
+            let entries = self.bracket_list()?;
+            let is_name = entries.len() == 1
+                && entries[0].key.is_some()
+                && entries[0].value.is_none()
+                && entries[0].glued.is_none();
+            if is_name && name.is_none() && values.is_empty() {
+                name = entries[0].key;
+            } else {
+                for e in entries {
+                    match (e.key, e.value) {
+                        (None, Some(v)) => values.push(v),
+                        _ => self.error(
+                            e.span,
+                            "#CS: expected a value (number, variable or expression)",
+                        ),
+                    }
+                }
+            }
+            if lists > 2 {
+                self.error(span, "#CS takes at most a name list and a value list");
+            }
+        }
+        Some(Command::Cs { on, name, values })
+    }
+
+    /// `#TRAFO ON|OFF`, `#TRAFO [id]`, `#TRAFO ON [id]`, after `TRAFO`.
+    fn trafo(&mut self, span: Span) -> Option<Command> {
+        let on = match self.peek() {
+            Tok::Word(w) if w == "ON" || w == "OFF" => self.on_off("#TRAFO"),
+            _ => None,
+        };
+        let id = if self.is_punct("[") {
+            let entries = self.bracket_list()?;
+            match entries.as_slice() {
+                [Entry {
+                    key: None,
+                    value: Some(v),
+                    ..
+                }] => Some(v.clone()),
+                _ => {
+                    self.error(span, "#TRAFO [..]: expected one kinematic id");
+                    None
+                }
+            }
+        } else {
+            None
+        };
+        if on.is_none() && id.is_none() {
+            let found = self.describe();
+            self.error(
+                span,
+                format!("#TRAFO: expected ON, OFF or [id], found {found}"),
+            );
+            return None;
+        }
+        Some(Command::Trafo { on, id })
+    }
+
+    /// `#KIN ID [id]`, after `KIN`.
+    fn kin_id(&mut self, span: Span) -> Option<Command> {
+        if !self.expect_word("ID", "#KIN ID") {
+            self.recover();
+            return None;
+        }
+        let entries = if self.is_punct("[") {
+            self.bracket_list()?
+        } else {
+            Vec::new()
+        };
+        match entries.as_slice() {
+            [Entry {
+                key: None,
+                value: Some(v),
+                ..
+            }] => Some(Command::KinId { id: v.clone() }),
+            _ => {
+                self.error(span, "#KIN ID: expected [id]");
+                self.recover();
+                None
+            }
+        }
+    }
+
+    /// `#SIGNAL SYN [ID.. COUNT..]`, after `SIGNAL`.
+    fn signal_syn(&mut self) -> Option<Command> {
+        if !self.expect_word("SYN", "#SIGNAL SYN") {
+            self.recover();
+            return None;
+        }
+        let options = self.required_list("#SIGNAL SYN")?;
+        self.check_keys(&options, &["ID", "COUNT"], "#SIGNAL SYN");
+        Some(Command::SignalSyn { options })
+    }
+
+    /// `#WAIT SYN [ID..]`, `#WAIT INDP ALL`, after `WAIT`.
+    fn wait(&mut self, span: Span) -> Option<Command> {
+        match self.peek().clone() {
+            Tok::Word(w) if w == "SYN" => {
+                self.bump();
+                let options = self.required_list("#WAIT SYN")?;
+                self.check_keys(&options, &["ID"], "#WAIT SYN");
+                Some(Command::WaitSyn { options })
+            }
+            Tok::Word(w) if w == "INDP" => {
+                self.bump();
+                if self.expect_word("ALL", "#WAIT INDP ALL") {
+                    Some(Command::WaitIndpAll)
+                } else {
+                    self.recover();
+                    None
+                }
+            }
+            _ => {
+                let found = self.describe();
+                self.error(span, format!("#WAIT: expected SYN or INDP, found {found}"));
+                self.recover();
+                None
+            }
+        }
+    }
+
+    /// `#FLUSH WAIT|CONTINUE`, after `FLUSH`.
+    fn flush(&mut self, span: Span) -> Option<Command> {
+        match self.peek().clone() {
+            Tok::Word(w) if w == "WAIT" || w == "CONTINUE" => {
+                self.bump();
+                Some(Command::Flush { wait: w == "WAIT" })
+            }
+            _ => {
+                let found = self.describe();
+                self.error(
+                    span,
+                    format!("#FLUSH: expected WAIT or CONTINUE, found {found}"),
+                );
+                self.recover();
+                None
+            }
+        }
+    }
+
+    /// `#PSET X=10 ...`, after `PSET`.
+    fn pset(&mut self, span: Span) -> Option<Command> {
+        let mut axes = Vec::new();
+        while matches!(self.peek(), Tok::Word(_) | Tok::Addr(..)) {
+            let s = self.span();
+            match self.word_item(s) {
+                Some(Item::Axis(a)) => axes.push(a),
+                _ => self.error(s, "#PSET: expected axis assignments such as X=10"),
+            }
+        }
+        if axes.is_empty() {
+            self.error(span, "#PSET: expected at least one axis assignment");
+        }
+        Some(Command::Pset { axes })
+    }
+
+    /// `#PRESET`, `#PRESET X ...`, after `PRESET`.
+    fn preset(&mut self) -> Option<Command> {
+        let mut axes = Vec::new();
+        while let Some((w, glued)) = self.take_word() {
+            let s = self.span();
+            axes.push(self.axis_name(w, glued, s)?);
+        }
+        Some(Command::Preset { axes })
+    }
+
+    /// `#MSG ["text"]`, also `#MSG SAVE ["text"]` (the message is shown either way), after
+    /// `MSG`.
+    fn msg(&mut self, span: Span) -> Option<Command> {
+        if self.is_word("SAVE") {
+            self.bump();
+        }
+        let text = if self.is_punct("[") {
+            self.bump();
+            let text = match self.peek().clone() {
+                Tok::Str(t) => {
+                    self.bump();
+                    Some(t)
+                }
+                _ => None,
+            };
+            if self.is_punct("]") {
+                self.bump();
+            } else {
+                self.error(span, "#MSG: expected \"]\" after the text");
+            }
+            text
+        } else {
+            None
+        };
+        match text {
+            Some(t) => Some(Command::Msg {
+                text: std::sync::Arc::from(t),
+            }),
+            None => {
+                self.error(span, "#MSG: expected [\"text\"]");
+                self.recover();
+                None
+            }
+        }
+    }
+
+    /// `#TIME t`, after `TIME`.
+    fn time(&mut self) -> Option<Command> {
+        let Some(seconds) = self.expr() else {
+            self.recover();
+            return None;
+        };
+        Some(Command::Time { seconds })
     }
 
     fn required_list(&mut self, context: &str) -> Option<Vec<Entry>> {
