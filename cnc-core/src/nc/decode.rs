@@ -602,6 +602,28 @@ impl Iterator for BitIndices {
     }
 }
 
+/// What the items of the block being decoded ask for besides modal settings, gathered before
+/// anything moves (the axis values themselves are in `DecoderState::words`).
+#[derive(Default)]
+struct BlockInput {
+    /// G92: the axis words set offsets.
+    g92: bool,
+    /// G04.
+    dwell_code: bool,
+    /// G0..G3 and where it stands.
+    motion_code: Option<(u32, Span)>,
+    /// One bit per axis with a word in this block (axis indices are below 16).
+    programmed: u32,
+    /// I, J, K in this block (inch converted by [`DecoderState::inches_and_feed`]).
+    center: [Option<f64>; 3],
+    /// R in this block (converted like the centre).
+    radius: Option<f64>,
+    /// The bare dwell time (`G04 2.5`).
+    dwell: Option<(f64, Span)>,
+    /// F in this block.
+    feed: Option<f64>,
+}
+
 impl DecoderState {
     /// A channel with these axis names (upper case), at position 0, G0 G90, feed 0.
     pub fn new(axes: &[String]) -> Self {
@@ -778,56 +800,49 @@ impl DecoderState {
     /// are the interpreter's ([`super::interp`]): here they are only checked to stand where
     /// they may.
     fn block(&mut self, block: &Block, items: &[Item], ctx: &mut Ctx<'_>, out: &mut Vec<Decoded>) {
-        let line = block.line;
-        let mut g92 = false;
-        let mut dwell_code = false;
-        let mut motion_code: Option<(u32, Span)> = None;
-        // One bit per axis with a word in this block (axis indices are below 16).
-        let mut programmed: u32 = 0;
-        // I, J, K, R in this block (inch already converted), and the bare dwell time.
-        let mut center: [Option<f64>; 3] = [None; 3];
-        let mut radius: Option<f64> = None;
-        let mut dwell: Option<(f64, Span)> = None;
-        let mut feed: Option<f64> = None;
         // Elements that follow the block's motion, in a buffer kept across blocks.
         let mut tail = core::mem::take(&mut self.tail);
         tail.clear();
+        let mut input = self.read_items(block, items, ctx, &mut tail);
+        self.inches_and_feed(&mut input);
+        if input.dwell_code || input.dwell.is_some() {
+            self.dwell(block, &input, ctx, &mut tail);
+            input.programmed = 0;
+        }
+        if let Some((code, _)) = input.motion_code {
+            self.motion = match code {
+                0 => MotionMode::Rapid,
+                1 => MotionMode::Linear,
+                2 => MotionMode::ArcCw,
+                _ => MotionMode::ArcCcw,
+            };
+        }
+        self.path_motion(block, &input, ctx, out);
+        if !tail.is_empty() {
+            out.append(&mut tail);
+        }
+        self.tail = tail;
+    }
+
+    /// Reads the items of `block` in order: modal G codes take effect at once, what moves is
+    /// gathered into the returned [`BlockInput`] (axis values into `self.words`), and the
+    /// elements that follow the motion go to `tail`.
+    fn read_items(
+        &mut self,
+        block: &Block,
+        items: &[Item],
+        ctx: &mut Ctx<'_>,
+        tail: &mut Vec<Decoded>,
+    ) -> BlockInput {
+        let line = block.line;
+        let mut input = BlockInput::default();
         for item in items {
             match item {
-                Item::G { code, span } => match code {
-                    0..=3 => {
-                        if let Some((other, _)) = motion_code.filter(|(c, _)| c != code) {
-                            ctx.error(
-                                *span,
-                                format!("G{code} and G{other} in one block: choose one motion"),
-                            );
-                        }
-                        motion_code = Some((*code, *span));
-                    }
-                    4 => dwell_code = true,
-                    // Blocks always end at exact stop here (no blending): G60 and G09 ask for
-                    // nothing more, G359/G360 switch what is always on.
-                    9 | 60 | 359 | 360 => {}
-                    17 => self.plane = super::arc::Plane::Xy,
-                    18 => self.plane = super::arc::Plane::Zx,
-                    19 => self.plane = super::arc::Plane::Yz,
-                    53..=59 => self.zero = (*code - 53) as usize,
-                    70 => self.inch = true,
-                    71 => self.inch = false,
-                    90 => self.absolute = true,
-                    91 => self.absolute = false,
-                    92 => g92 = true,
-                    161 => self.center_absolute = true,
-                    162 => self.center_absolute = false,
-                    other => ctx.error(
-                        *span,
-                        format!("unknown G code G{other} (known: G0-G4, G9, G17-G19, G53-G60, G70, G71, G90-G92, G161, G162, G359, G360)"),
-                    ),
-                },
+                Item::G { code, span } => self.g_code(*code, *span, &mut input, ctx),
                 Item::Feed { value, span } => {
                     if let Some(f) = ctx.eval(value, *span) {
                         if f > 0.0 && f.is_finite() {
-                            feed = Some(f);
+                            input.feed = Some(f);
                         } else {
                             ctx.error(*span, format!("feed must be positive, found {f}"));
                         }
@@ -836,65 +851,13 @@ impl DecoderState {
                 Item::M { code, .. } => tail.push(Decoded::MFunction { line, code: *code }),
                 Item::Axis(word) if word.name.as_bytes().is_empty() => {
                     if let Some(v) = ctx.eval(&word.value, word.span) {
-                        dwell = Some((v, word.span));
+                        input.dwell = Some((v, word.span));
                     }
                 }
                 Item::Axis(word) if Addr::of_name(&word.name).is_some() => {
-                    let addr = Addr::of_name(&word.name).unwrap_or(Addr::R);
-                    let Some(v) = ctx.eval(&word.value, word.span) else {
-                        continue;
-                    };
-                    match addr {
-                        Addr::I => center[0] = Some(v),
-                        Addr::J => center[1] = Some(v),
-                        Addr::K => center[2] = Some(v),
-                        Addr::R => radius = Some(v),
-                        Addr::S if v >= 0.0 => tail.push(Decoded::Spindle { line, speed: v }),
-                        Addr::T | Addr::D if v.fract() == 0.0 && (0.0..=1e6).contains(&v) => {
-                            let n = v as u32;
-                            if addr == Addr::T {
-                                tail.push(Decoded::Tool { line, number: n });
-                            } else if n == 0 {
-                                tail.push(Decoded::ToolRecord { line, d: 0 });
-                                self.tool_length = 0.0;
-                            } else if let Some(&(_, length)) =
-                                self.tools.iter().find(|(d, _)| *d == n)
-                            {
-                                self.tool_length = length;
-                                tail.push(Decoded::ToolRecord { line, d: n });
-                            } else if self.tools_unknown {
-                                self.tool_length = 0.0;
-                            } else {
-                                ctx.error(
-                                    word.span,
-                                    format!("D{n}: no such tool data record in the tool table (D0 removes the offset)"),
-                                );
-                            }
-                        }
-                        Addr::S => ctx.error(word.span, format!("spindle speed S must not be negative, found {v}")),
-                        _ => ctx.error(
-                            word.span,
-                            format!("{} must be a whole number 0..=1000000, found {v}", addr.letter()),
-                        ),
-                    }
+                    self.address_word(line, word, &mut input, ctx, tail)
                 }
-                Item::Axis(word) => {
-                    let Some(i) = self.axis_of(&word.name) else {
-                        self.unknown_axis(ctx, word.span, word.name.as_str());
-                        continue;
-                    };
-                    if programmed & (1 << i) != 0 {
-                        ctx.error(
-                            word.span,
-                            format!("axis {} programmed twice in one block", word.name),
-                        );
-                        continue;
-                    }
-                    if let Some(v) = ctx.eval(&word.value, word.span) {
-                        self.words[i] = v;
-                        programmed |= 1 << i;
-                    }
-                }
+                Item::Axis(word) => self.axis_word(word, &mut input, ctx),
                 Item::IndependentAxis { axis, span } => {
                     let (name, options) = (axis.name.as_str(), &axis.options);
                     if let Some(d) = self.independent(line, name, options, *span, ctx) {
@@ -908,8 +871,14 @@ impl DecoderState {
                 }
                 Item::Assign { .. } => {}
                 Item::Call { span, .. } => {
-                    if items.iter().any(|i| !matches!(i, Item::Call { .. } | Item::Assign { .. })) {
-                        ctx.error(*span, "a subroutine call stands in its block with P assignments only");
+                    if items
+                        .iter()
+                        .any(|i| !matches!(i, Item::Call { .. } | Item::Assign { .. }))
+                    {
+                        ctx.error(
+                            *span,
+                            "a subroutine call stands in its block with P assignments only",
+                        );
                     }
                 }
                 Item::Control { .. } => {
@@ -919,55 +888,174 @@ impl DecoderState {
                 }
             }
         }
-        // G70 anywhere in the block applies to its values: lengths of the main axes, the
-        // circle and the feed are inches then.
+        input
+    }
+
+    /// `G<code>` at `span`: a motion or a dwell of the block, G92, or a modal setting taken at
+    /// once.
+    fn g_code(&mut self, code: u32, span: Span, input: &mut BlockInput, ctx: &mut Ctx<'_>) {
+        match code {
+            0..=3 => {
+                if let Some((other, _)) = input.motion_code.filter(|(c, _)| *c != code) {
+                    ctx.error(
+                        span,
+                        format!("G{code} and G{other} in one block: choose one motion"),
+                    );
+                }
+                input.motion_code = Some((code, span));
+            }
+            4 => input.dwell_code = true,
+            // Blocks always end at exact stop here (no blending): G60 and G09 ask for
+            // nothing more, G359/G360 switch what is always on.
+            9 | 60 | 359 | 360 => {}
+            17 => self.plane = super::arc::Plane::Xy,
+            18 => self.plane = super::arc::Plane::Zx,
+            19 => self.plane = super::arc::Plane::Yz,
+            53..=59 => self.zero = (code - 53) as usize,
+            70 => self.inch = true,
+            71 => self.inch = false,
+            90 => self.absolute = true,
+            91 => self.absolute = false,
+            92 => input.g92 = true,
+            161 => self.center_absolute = true,
+            162 => self.center_absolute = false,
+            other => ctx.error(
+                span,
+                format!("unknown G code G{other} (known: G0-G4, G9, G17-G19, G53-G60, G70, G71, G90-G92, G161, G162, G359, G360)"),
+            ),
+        }
+    }
+
+    /// A word of an address that is no axis (see [`Addr`]): the circle's I, J, K, R for the
+    /// block, S, T and D as elements in `tail`.
+    fn address_word(
+        &mut self,
+        line: u32,
+        word: &AxisWord,
+        input: &mut BlockInput,
+        ctx: &mut Ctx<'_>,
+        tail: &mut Vec<Decoded>,
+    ) {
+        let addr = Addr::of_name(&word.name).unwrap_or(Addr::R);
+        let Some(v) = ctx.eval(&word.value, word.span) else {
+            return;
+        };
+        match addr {
+            Addr::I => input.center[0] = Some(v),
+            Addr::J => input.center[1] = Some(v),
+            Addr::K => input.center[2] = Some(v),
+            Addr::R => input.radius = Some(v),
+            Addr::S if v >= 0.0 => tail.push(Decoded::Spindle { line, speed: v }),
+            Addr::T | Addr::D if v.fract() == 0.0 && (0.0..=1e6).contains(&v) => {
+                let n = v as u32;
+                if addr == Addr::T {
+                    tail.push(Decoded::Tool { line, number: n });
+                } else {
+                    self.tool_record(line, n, word.span, ctx, tail);
+                }
+            }
+            Addr::S => ctx.error(
+                word.span,
+                format!("spindle speed S must not be negative, found {v}"),
+            ),
+            _ => ctx.error(
+                word.span,
+                format!(
+                    "{} must be a whole number 0..=1000000, found {v}",
+                    addr.letter()
+                ),
+            ),
+        }
+    }
+
+    /// `D<n>` at `span`: selects tool data record `n` and its length (D0: none).
+    fn tool_record(
+        &mut self,
+        line: u32,
+        n: u32,
+        span: Span,
+        ctx: &mut Ctx<'_>,
+        tail: &mut Vec<Decoded>,
+    ) {
+        if n == 0 {
+            tail.push(Decoded::ToolRecord { line, d: 0 });
+            self.tool_length = 0.0;
+        } else if let Some(&(_, length)) = self.tools.iter().find(|(d, _)| *d == n) {
+            self.tool_length = length;
+            tail.push(Decoded::ToolRecord { line, d: n });
+        } else if self.tools_unknown {
+            self.tool_length = 0.0;
+        } else {
+            ctx.error(
+                span,
+                format!("D{n}: no such tool data record in the tool table (D0 removes the offset)"),
+            );
+        }
+    }
+
+    /// An axis word: its value into `self.words`, its axis marked programmed (once per
+    /// block).
+    fn axis_word(&mut self, word: &AxisWord, input: &mut BlockInput, ctx: &mut Ctx<'_>) {
+        let Some(i) = self.axis_of(&word.name) else {
+            self.unknown_axis(ctx, word.span, word.name.as_str());
+            return;
+        };
+        if input.programmed & (1 << i) != 0 {
+            ctx.error(
+                word.span,
+                format!("axis {} programmed twice in one block", word.name),
+            );
+            return;
+        }
+        if let Some(v) = ctx.eval(&word.value, word.span) {
+            self.words[i] = v;
+            input.programmed |= 1 << i;
+        }
+    }
+
+    /// Takes the block's feed. G70 anywhere in the block applies to its values: lengths of
+    /// the main axes, the circle and the feed are inches then.
+    fn inches_and_feed(&mut self, input: &mut BlockInput) {
         if self.inch {
-            for i in BitIndices(programmed & 0b111) {
+            for i in BitIndices(input.programmed & 0b111) {
                 self.words[i] *= MM_PER_INCH;
             }
-            for c in center
+            for c in input
+                .center
                 .iter_mut()
-                .chain(core::iter::once(&mut radius))
+                .chain(core::iter::once(&mut input.radius))
                 .flatten()
             {
                 *c *= MM_PER_INCH;
             }
         }
-        if let Some(f) = feed {
+        if let Some(f) = input.feed {
             self.feed = if self.inch { f * MM_PER_INCH } else { f };
         }
-        if dwell_code || dwell.is_some() {
-            self.dwell(
-                line,
-                block,
-                dwell,
-                programmed,
-                motion_code.is_some(),
-                ctx,
-                &mut tail,
-            );
-            programmed = 0;
-        }
-        if let Some((code, _)) = motion_code {
-            self.motion = match code {
-                0 => MotionMode::Rapid,
-                1 => MotionMode::Linear,
-                2 => MotionMode::ArcCw,
-                _ => MotionMode::ArcCcw,
-            };
-        }
+    }
+
+    /// What the block's axis words and circle do: set G92 offsets (with G92), or move, one
+    /// motion element into `out`.
+    fn path_motion(
+        &mut self,
+        block: &Block,
+        input: &BlockInput,
+        ctx: &mut Ctx<'_>,
+        out: &mut Vec<Decoded>,
+    ) {
+        let (center, radius) = (input.center, input.radius);
         let arc_words = center.iter().any(Option::is_some) || radius.is_some();
         let is_arc = matches!(self.motion, MotionMode::ArcCw | MotionMode::ArcCcw);
         if arc_words && !is_arc {
             ctx.error(block.span, "I, J, K and R belong to G2/G3 blocks");
         }
-        let axes = BitIndices(programmed);
-        if g92 {
+        let axes = BitIndices(input.programmed);
+        if input.g92 {
             for i in axes {
                 let v = self.words[i];
                 self.g92[i] = if self.absolute { v } else { self.g92[i] + v };
             }
-        } else if programmed != 0 || (is_arc && arc_words) {
+        } else if input.programmed != 0 || (is_arc && arc_words) {
             if self.motion.at_feed() && self.feed <= 0.0 {
                 ctx.error(
                     block.span,
@@ -992,7 +1080,7 @@ impl DecoderState {
                 None
             };
             out.push(Decoded::Motion(MotionBlock {
-                line,
+                line: block.line,
                 number: block.number,
                 motion: self.motion,
                 feed: self.feed,
@@ -1000,24 +1088,18 @@ impl DecoderState {
                 arc,
             }));
         }
-        if !tail.is_empty() {
-            out.append(&mut tail);
-        }
-        self.tail = tail;
     }
 
     /// `G04 t`, `G04 X t` (the first main axis names the time): alone in its block.
-    #[allow(clippy::too_many_arguments)]
     fn dwell(
         &mut self,
-        line: u32,
         block: &Block,
-        bare: Option<(f64, Span)>,
-        programmed: u32,
-        motion: bool,
+        input: &BlockInput,
         ctx: &mut Ctx<'_>,
         tail: &mut Vec<Decoded>,
     ) {
+        let (line, bare, programmed) = (block.line, input.dwell, input.programmed);
+        let motion = input.motion_code.is_some();
         let by_axis =
             (programmed == 1).then(|| self.words[0] / if self.inch { MM_PER_INCH } else { 1.0 });
         let seconds = match (bare, by_axis) {
@@ -1170,6 +1252,8 @@ impl DecoderState {
         })
     }
 
+    /// The `#` command `command` at `span` of the block on `line`: its element, if it has one
+    /// (`#PSET` and `#PRESET` change the decoder's offsets only).
     fn command(
         &mut self,
         line: u32,
@@ -1185,44 +1269,8 @@ impl DecoderState {
             Command::ChannelInterface { on, .. } => {
                 Some(Decoded::ChannelInterface { line, on: *on })
             }
-            Command::Cs { on, name, values } => {
-                if values.len() > 6 {
-                    ctx.error(
-                        span,
-                        format!(
-                            "#CS takes at most 6 values (X Y Z A B C), found {}",
-                            values.len()
-                        ),
-                    );
-                    return None;
-                }
-                if !on && !values.is_empty() {
-                    ctx.error(span, "#CS OFF takes no values");
-                    return None;
-                }
-                let mut frame = [0.0; 6];
-                for (i, v) in values.iter().enumerate() {
-                    frame[i] = ctx.eval(v, span)?;
-                }
-                Some(Decoded::Cs {
-                    line,
-                    on: *on,
-                    name: *name,
-                    frame,
-                })
-            }
-            Command::Trafo { on, id } => {
-                let id = match id {
-                    Some(e) => Some(ctx.whole(e, span, "kinematic id", 0.0, 65535.0)?),
-                    None => None,
-                };
-                // `#TRAFO [45]` switches on with that id (as the seed's programs use it).
-                let on = on.or(id.map(|_| true));
-                if let Some(on) = on {
-                    self.trafo = on;
-                }
-                Some(Decoded::Trafo { line, on, id })
-            }
+            Command::Cs { on, name, values } => cs(line, *on, *name, values, span, ctx),
+            Command::Trafo { on, id } => self.trafo(line, *on, id.as_ref(), span, ctx),
             Command::KinId { id } => {
                 let id = ctx.whole(id, span, "kinematic id", 0.0, 65535.0)?;
                 Some(Decoded::Trafo {
@@ -1231,98 +1279,174 @@ impl DecoderState {
                     id: Some(id),
                 })
             }
-            Command::SignalSyn { options } => {
-                let mut id = None;
-                let mut count = None;
-                for e in options {
-                    let v = entry_number(e, ctx)?;
-                    let whole = ctx.whole(
-                        &Expr::Num(v),
-                        e.span,
-                        e.key.as_deref().unwrap_or("value"),
-                        1.0,
-                        65535.0,
-                    )?;
-                    match e.key.as_deref() {
-                        Some("ID") => id = Some(whole),
-                        _ => count = Some(whole),
-                    }
-                }
-                match (id, count) {
-                    (Some(id), Some(count)) => Some(Decoded::SignalSyn { line, id, count }),
-                    _ => {
-                        ctx.error(span, "#SIGNAL SYN needs ID.. and COUNT..");
-                        None
-                    }
-                }
-            }
-            Command::WaitSyn { options } => {
-                let mut ids = SyncIds::default();
-                for e in options {
-                    let v = entry_number(e, ctx)?;
-                    let id = ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?;
-                    if !ids.push(id) {
-                        ctx.error(
-                            e.span,
-                            format!("#WAIT SYN waits for at most {} ids", SyncIds::CAPACITY),
-                        );
-                        return None;
-                    }
-                }
-                if ids.as_slice().is_empty() {
-                    ctx.error(span, "#WAIT SYN needs at least one ID..");
-                    return None;
-                }
-                Some(Decoded::WaitSyn { line, ids })
-            }
+            Command::SignalSyn { options } => signal_syn(line, options, span, ctx),
+            Command::WaitSyn { options } => wait_syn(line, options, span, ctx),
             Command::WaitIndpAll => Some(Decoded::WaitIndependent { line }),
             Command::Flush { wait } => Some(Decoded::Flush { line, wait: *wait }),
             Command::Pset { axes } => {
-                for word in axes {
-                    let Some(i) = self.axis_of(&word.name) else {
-                        self.unknown_axis(ctx, word.span, word.name.as_str());
-                        continue;
-                    };
-                    if let Some(v) = ctx.eval(&word.value, word.span) {
-                        let v = if self.inch && i < 3 {
-                            v * MM_PER_INCH
-                        } else {
-                            v
-                        };
-                        // The position holds the zero offset and tool length: they are not the
-                        // preset's.
-                        self.pset[i] = self.position[i] - v - self.g92[i] - self.offset(i);
-                    }
-                }
+                self.pset(axes, ctx);
                 None
             }
             Command::Msg { text } => Some(Decoded::Message {
                 line,
                 text: text.clone(),
             }),
-            Command::Time { seconds } => {
-                let seconds = ctx.eval(seconds, span)?;
-                if seconds < 0.0 {
-                    ctx.error(span, format!("#TIME must not be negative, found {seconds}"));
-                    return None;
-                }
-                Some(Decoded::Dwell { line, seconds })
-            }
+            Command::Time { seconds } => time(line, seconds, span, ctx),
             Command::Var | Command::EndVar => None,
             Command::Preset { axes } => {
-                if axes.is_empty() {
-                    self.pset.iter_mut().for_each(|p| *p = 0.0);
-                }
-                for name in axes {
-                    match self.axis_index(name.as_str()) {
-                        Some(i) => self.pset[i] = 0.0,
-                        None => self.unknown_axis(ctx, span, name.as_str()),
-                    }
-                }
+                self.preset(axes, span, ctx);
                 None
             }
         }
     }
+
+    /// `#TRAFO ON|OFF [id]`: switches the transformation (which takes the tool length off the
+    /// decoder's offsets).
+    fn trafo(
+        &mut self,
+        line: u32,
+        on: Option<bool>,
+        id: Option<&Expr>,
+        span: Span,
+        ctx: &mut Ctx<'_>,
+    ) -> Option<Decoded> {
+        let id = match id {
+            Some(e) => Some(ctx.whole(e, span, "kinematic id", 0.0, 65535.0)?),
+            None => None,
+        };
+        // `#TRAFO [45]` switches on with that id (as the seed's programs use it).
+        let on = on.or(id.map(|_| true));
+        if let Some(on) = on {
+            self.trafo = on;
+        }
+        Some(Decoded::Trafo { line, on, id })
+    }
+
+    /// `#PSET X..`: each axis's preset offset, so that its position reads as given.
+    fn pset(&mut self, axes: &[AxisWord], ctx: &mut Ctx<'_>) {
+        for word in axes {
+            let Some(i) = self.axis_of(&word.name) else {
+                self.unknown_axis(ctx, word.span, word.name.as_str());
+                continue;
+            };
+            if let Some(v) = ctx.eval(&word.value, word.span) {
+                let v = if self.inch && i < 3 {
+                    v * MM_PER_INCH
+                } else {
+                    v
+                };
+                // The position holds the zero offset and tool length: they are not the
+                // preset's.
+                self.pset[i] = self.position[i] - v - self.g92[i] - self.offset(i);
+            }
+        }
+    }
+
+    /// `#PRESET` (every axis) or `#PRESET X ..`: removes the preset offsets.
+    fn preset(&mut self, axes: &[AxisName], span: Span, ctx: &mut Ctx<'_>) {
+        if axes.is_empty() {
+            self.pset.iter_mut().for_each(|p| *p = 0.0);
+        }
+        for name in axes {
+            match self.axis_index(name.as_str()) {
+                Some(i) => self.pset[i] = 0.0,
+                None => self.unknown_axis(ctx, span, name.as_str()),
+            }
+        }
+    }
+}
+
+/// `#CS ON|OFF [name] [values]` at `span`: the frame, missing values 0.
+fn cs(
+    line: u32,
+    on: bool,
+    name: Option<Name>,
+    values: &[Expr],
+    span: Span,
+    ctx: &mut Ctx<'_>,
+) -> Option<Decoded> {
+    if values.len() > 6 {
+        ctx.error(
+            span,
+            format!(
+                "#CS takes at most 6 values (X Y Z A B C), found {}",
+                values.len()
+            ),
+        );
+        return None;
+    }
+    if !on && !values.is_empty() {
+        ctx.error(span, "#CS OFF takes no values");
+        return None;
+    }
+    let mut frame = [0.0; 6];
+    for (i, v) in values.iter().enumerate() {
+        frame[i] = ctx.eval(v, span)?;
+    }
+    Some(Decoded::Cs {
+        line,
+        on,
+        name,
+        frame,
+    })
+}
+
+/// `#SIGNAL SYN [ID.. COUNT..]` at `span`.
+fn signal_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<Decoded> {
+    let mut id = None;
+    let mut count = None;
+    for e in options {
+        let v = entry_number(e, ctx)?;
+        let whole = ctx.whole(
+            &Expr::Num(v),
+            e.span,
+            e.key.as_deref().unwrap_or("value"),
+            1.0,
+            65535.0,
+        )?;
+        match e.key.as_deref() {
+            Some("ID") => id = Some(whole),
+            _ => count = Some(whole),
+        }
+    }
+    match (id, count) {
+        (Some(id), Some(count)) => Some(Decoded::SignalSyn { line, id, count }),
+        _ => {
+            ctx.error(span, "#SIGNAL SYN needs ID.. and COUNT..");
+            None
+        }
+    }
+}
+
+/// `#WAIT SYN [ID..]` at `span`: at most [`SyncIds::CAPACITY`] ids.
+fn wait_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<Decoded> {
+    let mut ids = SyncIds::default();
+    for e in options {
+        let v = entry_number(e, ctx)?;
+        let id = ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?;
+        if !ids.push(id) {
+            ctx.error(
+                e.span,
+                format!("#WAIT SYN waits for at most {} ids", SyncIds::CAPACITY),
+            );
+            return None;
+        }
+    }
+    if ids.as_slice().is_empty() {
+        ctx.error(span, "#WAIT SYN needs at least one ID..");
+        return None;
+    }
+    Some(Decoded::WaitSyn { line, ids })
+}
+
+/// `#TIME t` at `span`: a dwell of `t` seconds.
+fn time(line: u32, seconds: &Expr, span: Span, ctx: &mut Ctx<'_>) -> Option<Decoded> {
+    let seconds = ctx.eval(seconds, span)?;
+    if seconds < 0.0 {
+        ctx.error(span, format!("#TIME must not be negative, found {seconds}"));
+        return None;
+    }
+    Some(Decoded::Dwell { line, seconds })
 }
 
 fn entry_number(e: &Entry, ctx: &mut Ctx<'_>) -> Option<f64> {
