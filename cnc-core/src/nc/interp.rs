@@ -11,7 +11,7 @@
 //! * A condition holds when its value is at least 0.5 in size; `$CASE` values match within
 //!   0.001; a `$CASE` branch runs on into the next one unless it ends with `$BREAK`.
 
-use super::ast::{Block, Command, Control, Item, Name, Program, Span, Target};
+use super::ast::{Block, Command, Control, Expr, Item, Name, Program, Span, Target};
 use super::control::{control_of, match_control, Jump, JumpTable};
 use super::decode::{evaluate_at, Decoded, DecoderState, Vars};
 use super::eval::truth;
@@ -643,16 +643,15 @@ impl Interpreter {
         block: &Block,
         system: &dyn Vars,
     ) -> Result<usize, Diagnostic> {
-        let control = control_of(&unit.tree, b);
-        // An expression of block `at` (its span for messages).
-        let eval_in = |interp: &Interpreter, at: usize, e: &super::ast::Expr| {
-            let span = unit.tree.blocks.get(at).map_or(block.span, |bl| bl.span);
-            evaluate_at(e, span, &unit.src, &Env { interp, system }).map_err(|d| with_file(d, unit))
+        let here = Here {
+            unit,
+            b,
+            block,
+            system,
         };
-        let eval = |interp: &Interpreter, e: &super::ast::Expr| eval_in(interp, b, e);
-        Ok(match (jump, control) {
+        Ok(match (jump, control_of(&unit.tree, b)) {
             (Jump::While { end }, Some(Control::While(c))) => {
-                if truth(eval(self, c)?) {
+                if truth(here.eval(self, c)?) {
                     b + 1
                 } else {
                     end + 1
@@ -660,23 +659,7 @@ impl Interpreter {
             }
             (Jump::EndWhile { start }, _) => start,
             (Jump::If { end, .. }, Some(Control::ElseIf(_))) => end + 1,
-            (Jump::If { .. }, Some(Control::If(_))) => {
-                let mut at = b;
-                loop {
-                    let (Some(Jump::If { next, .. }), Some(Control::If(c) | Control::ElseIf(c))) =
-                        (unit.jumps.get(at), control_of(&unit.tree, at))
-                    else {
-                        break at + 1;
-                    };
-                    if truth(eval_in(self, at, c)?) {
-                        break at + 1;
-                    }
-                    match control_of(&unit.tree, next) {
-                        Some(Control::ElseIf(_)) => at = next,
-                        _ => break next + 1,
-                    }
-                }
-            }
+            (Jump::If { .. }, Some(Control::If(_))) => self.if_chain(&here)?,
             (Jump::Else { end }, _) => end + 1,
             (
                 Jump::For { end },
@@ -686,49 +669,10 @@ impl Interpreter {
                     end: last,
                     step,
                 }),
-            ) => {
-                let first = eval(self, start)?;
-                self.assign(*var, first)
-                    .map_err(|m| with_file(Diagnostic::new(block.span, m, &unit.src), unit))?;
-                let (last, step) = (eval(self, last)?, eval(self, step)?);
-                if self.for_continues(unit, block, first, last, step)? {
-                    b + 1
-                } else {
-                    end + 1
-                }
-            }
-            (Jump::EndFor { start }, _) => {
-                let Some(Control::For {
-                    var,
-                    end: last,
-                    step,
-                    ..
-                }) = control_of(&unit.tree, start)
-                else {
-                    return Ok(b + 1);
-                };
-                let (last, step) = (eval_in(self, start, last)?, eval_in(self, start, step)?);
-                let env = Env {
-                    interp: self,
-                    system,
-                };
-                let current = match var {
-                    Target::Param(n) => env.param(*n),
-                    Target::Var(name) => env.get(name),
-                }
-                .unwrap_or(0.0);
-                let value = current + step;
-                self.assign(*var, value)
-                    .map_err(|m| with_file(Diagnostic::new(block.span, m, &unit.src), unit))?;
-                let for_block = &unit.tree.blocks[start];
-                if self.for_continues(unit, for_block, value, last, step)? {
-                    start + 1
-                } else {
-                    b + 1
-                }
-            }
+            ) => self.for_start(&here, *var, [start, last, step], end)?,
+            (Jump::EndFor { start }, _) => self.end_for(&here, start)?,
             (Jump::EndDo { start }, Some(Control::EndDo(c))) => {
-                if truth(eval(self, c)?) {
+                if truth(here.eval(self, c)?) {
                     start + 1
                 } else {
                     b + 1
@@ -742,27 +686,120 @@ impl Interpreter {
                 },
                 Some(Control::Switch(v)),
             ) => {
-                let value = eval(self, v)?;
-                let mut case = first_case;
-                let mut target = default.map_or(end + 1, |d| d + 1);
-                while let Some(c) = case {
-                    if let Some(Control::Case(e)) = control_of(&unit.tree, c) {
-                        if (eval_in(self, c, e)? - value).abs() < CASE_TOLERANCE {
-                            target = c + 1;
-                            break;
-                        }
-                    }
-                    case = match unit.jumps.get(c) {
-                        Some(Jump::Case { next }) => next,
-                        _ => None,
-                    };
-                }
-                target
+                let target = default.map_or(end + 1, |d| d + 1);
+                self.switch(&here, v, first_case, target)?
             }
             (Jump::Case { .. }, _) => b + 1,
             (Jump::Go { to }, _) => to,
             _ => b + 1,
         })
+    }
+
+    /// `$IF` and its `$ELSEIF`s, tested in turn: the first block of the branch that runs, or
+    /// after the chain's `$ELSE` or `$ENDIF`.
+    fn if_chain(&mut self, here: &Here<'_>) -> Result<usize, Diagnostic> {
+        let unit = here.unit;
+        let mut at = here.b;
+        Ok(loop {
+            let (Some(Jump::If { next, .. }), Some(Control::If(c) | Control::ElseIf(c))) =
+                (unit.jumps.get(at), control_of(&unit.tree, at))
+            else {
+                break at + 1;
+            };
+            if truth(here.eval_in(self, at, c)?) {
+                break at + 1;
+            }
+            match control_of(&unit.tree, next) {
+                Some(Control::ElseIf(_)) => at = next,
+                _ => break next + 1,
+            }
+        })
+    }
+
+    /// `$FOR var = start, last, step` (`bounds`): sets the counter; the loop's first block,
+    /// or after its `$ENDFOR` at `end` when the counter is past `last` already.
+    fn for_start(
+        &mut self,
+        here: &Here<'_>,
+        var: Target,
+        bounds: [&Expr; 3],
+        end: usize,
+    ) -> Result<usize, Diagnostic> {
+        let [start, last, step] = bounds;
+        let first = here.eval(self, start)?;
+        self.assign(var, first).map_err(|m| here.error(m))?;
+        let (last, step) = (here.eval(self, last)?, here.eval(self, step)?);
+        Ok(
+            if self.for_continues(here.unit, here.block, first, last, step)? {
+                here.b + 1
+            } else {
+                end + 1
+            },
+        )
+    }
+
+    /// `$ENDFOR` of the `$FOR` at `start`: steps the counter; back into the loop while it has
+    /// not passed the end, else on after the `$ENDFOR`.
+    fn end_for(&mut self, here: &Here<'_>, start: usize) -> Result<usize, Diagnostic> {
+        let (unit, b) = (here.unit, here.b);
+        let Some(Control::For {
+            var,
+            end: last,
+            step,
+            ..
+        }) = control_of(&unit.tree, start)
+        else {
+            return Ok(b + 1);
+        };
+        let (last, step) = (
+            here.eval_in(self, start, last)?,
+            here.eval_in(self, start, step)?,
+        );
+        let env = Env {
+            interp: self,
+            system: here.system,
+        };
+        let current = match var {
+            Target::Param(n) => env.param(*n),
+            Target::Var(name) => env.get(name),
+        }
+        .unwrap_or(0.0);
+        let value = current + step;
+        self.assign(*var, value).map_err(|m| here.error(m))?;
+        let for_block = &unit.tree.blocks[start];
+        Ok(if self.for_continues(unit, for_block, value, last, step)? {
+            start + 1
+        } else {
+            b + 1
+        })
+    }
+
+    /// `$SWITCH v`: the first block of the `$CASE` from `first_case` on whose value matches,
+    /// else `otherwise` (after the `$DEFAULT`, or after the `$ENDSWITCH`).
+    fn switch(
+        &mut self,
+        here: &Here<'_>,
+        v: &Expr,
+        first_case: Option<usize>,
+        otherwise: usize,
+    ) -> Result<usize, Diagnostic> {
+        let unit = here.unit;
+        let value = here.eval(self, v)?;
+        let mut case = first_case;
+        let mut target = otherwise;
+        while let Some(c) = case {
+            if let Some(Control::Case(e)) = control_of(&unit.tree, c) {
+                if (here.eval_in(self, c, e)? - value).abs() < CASE_TOLERANCE {
+                    target = c + 1;
+                    break;
+                }
+            }
+            case = match unit.jumps.get(c) {
+                Some(Jump::Case { next }) => next,
+                _ => None,
+            };
+        }
+        Ok(target)
     }
 
     fn for_continues(
@@ -784,6 +821,44 @@ impl Interpreter {
         } else {
             value >= last
         })
+    }
+}
+
+/// The `$` block being followed: block `b` of `unit`, and the channel's variables.
+struct Here<'a> {
+    unit: &'a Unit,
+    b: usize,
+    block: &'a Block,
+    system: &'a dyn Vars,
+}
+
+impl Here<'_> {
+    /// The value of `e`, an expression of block `at` (whose span its messages name).
+    fn eval_in(&self, interp: &Interpreter, at: usize, e: &Expr) -> Result<f64, Diagnostic> {
+        let span = self
+            .unit
+            .tree
+            .blocks
+            .get(at)
+            .map_or(self.block.span, |bl| bl.span);
+        let env = Env {
+            interp,
+            system: self.system,
+        };
+        evaluate_at(e, span, &self.unit.src, &env).map_err(|d| with_file(d, self.unit))
+    }
+
+    /// The value of `e`, an expression of the block itself.
+    fn eval(&self, interp: &Interpreter, e: &Expr) -> Result<f64, Diagnostic> {
+        self.eval_in(interp, self.b, e)
+    }
+
+    /// A diagnostic with `message` at the block.
+    fn error(&self, message: String) -> Diagnostic {
+        with_file(
+            Diagnostic::new(self.block.span, message, &self.unit.src),
+            self.unit,
+        )
     }
 }
 
