@@ -164,187 +164,246 @@ fn match_level(
     jumps: &mut JumpTable,
     unmatched: &mut Vec<Unmatched>,
 ) {
-    let mut open: Vec<Open> = Vec::new();
-    let span_of = |b: usize| program.blocks[b].span;
-    let mut report = |b: usize, message: &str| {
-        unmatched.push(Unmatched {
-            span: span_of(b),
-            message: message.to_string(),
-        })
+    let mut matching = LevelMatch {
+        program,
+        jumps,
+        unmatched,
+        open: Vec::new(),
+        gotos: Vec::new(),
     };
-    let mut gotos: Vec<(usize, u32)> = Vec::new();
     for b in level.clone() {
         let Some(control) = control_in(program, &program.blocks[b]) else {
             continue;
         };
+        matching.statement(b, control);
+    }
+    matching.report_open();
+    matching.resolve_gotos(level.clone());
+    matching.report_stray_exits(level);
+}
+
+/// The matching of one level, statement by statement: what is still open, the `$GOTO`s (whose
+/// targets are looked up once the level is read), and where jumps and problems go.
+struct LevelMatch<'a> {
+    program: &'a Program,
+    jumps: &'a mut JumpTable,
+    unmatched: &'a mut Vec<Unmatched>,
+    open: Vec<Open>,
+    gotos: Vec<(usize, u32)>,
+}
+
+impl LevelMatch<'_> {
+    fn report(&mut self, b: usize, message: &str) {
+        self.unmatched.push(Unmatched {
+            span: self.program.blocks[b].span,
+            message: message.to_string(),
+        })
+    }
+
+    /// The `$` statement `control` of block `b`: opens, continues or closes a statement.
+    fn statement(&mut self, b: usize, control: &Control) {
         match control {
-            Control::While(_) => open.push(Open::While(b)),
-            Control::If(_) => open.push(Open::If {
+            Control::While(_) => self.open.push(Open::While(b)),
+            Control::If(_) => self.open.push(Open::If {
                 start: b,
                 branches: Vec::new(),
                 seen_else: false,
             }),
-            Control::For { .. } => open.push(Open::For(b)),
-            Control::Do => open.push(Open::Do(b)),
-            Control::Switch(_) => open.push(Open::Switch {
+            Control::For { .. } => self.open.push(Open::For(b)),
+            Control::Do => self.open.push(Open::Do(b)),
+            Control::Switch(_) => self.open.push(Open::Switch {
                 start: b,
                 cases: Vec::new(),
                 default: None,
             }),
-            Control::ElseIf(_) | Control::Else => match open.last_mut() {
-                Some(Open::If {
-                    branches,
-                    seen_else,
-                    ..
-                }) if !*seen_else => {
-                    branches.push(b);
-                    *seen_else = matches!(control, Control::Else);
-                }
-                _ => report(b, &format!("${} without a matching $IF", control.keyword())),
-            },
-            // `$DEFAULT` may stand anywhere among the cases (reached sequentially it runs on
-            // into the case after it, like any branch); once per `$SWITCH`.
-            Control::Case(_) | Control::Default => match open.last_mut() {
-                Some(Open::Switch {
-                    default: Some(_), ..
-                }) if matches!(control, Control::Default) => {
-                    report(b, "a second $DEFAULT in one $SWITCH")
-                }
-                Some(Open::Switch { cases, default, .. }) => {
-                    if matches!(control, Control::Default) {
-                        *default = Some(b);
-                    } else {
-                        cases.push(b);
-                    }
-                }
-                _ => report(
+            Control::ElseIf(_) | Control::Else => self.branch(b, control),
+            Control::Case(_) | Control::Default => self.case(b, control),
+            Control::EndWhile => match self.open.last() {
+                Some(&Open::While(start)) => self.close_loop(
+                    start,
                     b,
-                    &format!("${} without a matching $SWITCH", control.keyword()),
+                    Some(Jump::While { end: b }),
+                    Jump::EndWhile { start },
                 ),
+                _ => self.report(b, "$ENDWHILE without a matching $WHILE"),
             },
-            Control::EndWhile => match open.last() {
-                Some(&Open::While(start)) => {
-                    open.pop();
-                    jumps.set(start, Jump::While { end: b });
-                    jumps.set(b, Jump::EndWhile { start });
-                    resolve_exits(program, start, b, b, jumps);
-                }
-                _ => report(b, "$ENDWHILE without a matching $WHILE"),
-            },
-            Control::EndFor => match open.last() {
+            Control::EndFor => match self.open.last() {
                 Some(&Open::For(start)) => {
-                    open.pop();
-                    jumps.set(start, Jump::For { end: b });
-                    jumps.set(b, Jump::EndFor { start });
-                    resolve_exits(program, start, b, b, jumps);
+                    self.close_loop(start, b, Some(Jump::For { end: b }), Jump::EndFor { start })
                 }
-                _ => report(b, "$ENDFOR without a matching $FOR"),
+                _ => self.report(b, "$ENDFOR without a matching $FOR"),
             },
-            Control::EndDo(_) => match open.last() {
-                Some(&Open::Do(start)) => {
-                    open.pop();
-                    jumps.set(b, Jump::EndDo { start });
-                    resolve_exits(program, start, b, b, jumps);
-                }
-                _ => report(b, "$ENDDO without a matching $DO"),
+            Control::EndDo(_) => match self.open.last() {
+                Some(&Open::Do(start)) => self.close_loop(start, b, None, Jump::EndDo { start }),
+                _ => self.report(b, "$ENDDO without a matching $DO"),
             },
-            Control::EndIf => match open.last() {
-                Some(Open::If { .. }) => {
-                    let Some(Open::If {
-                        start, branches, ..
-                    }) = open.pop()
-                    else {
-                        unreachable!("matched just above")
-                    };
-                    let mut at = start;
-                    for &branch in &branches {
-                        jumps.set(
-                            at,
-                            Jump::If {
-                                next: branch,
-                                end: b,
-                            },
-                        );
-                        at = branch;
-                    }
-                    if matches!(control_of(program, at), Some(Control::Else)) {
-                        jumps.set(at, Jump::Else { end: b });
-                    } else {
-                        jumps.set(at, Jump::If { next: b, end: b });
-                    }
-                }
-                _ => report(b, "$ENDIF without a matching $IF"),
-            },
-            Control::EndSwitch => match open.last() {
-                Some(Open::Switch { .. }) => {
-                    let Some(Open::Switch {
-                        start,
-                        cases,
-                        default,
-                    }) = open.pop()
-                    else {
-                        unreachable!("matched just above")
-                    };
-                    jumps.set(
-                        start,
-                        Jump::Switch {
-                            first_case: cases.first().copied(),
-                            default,
-                            end: b,
-                        },
-                    );
-                    for (i, &case) in cases.iter().enumerate() {
-                        jumps.set(
-                            case,
-                            Jump::Case {
-                                next: cases.get(i + 1).copied(),
-                            },
-                        );
-                    }
-                    // `$BREAK` inside the switch (not inside a loop nested in it) leaves it.
-                    resolve_breaks(program, start, b, jumps);
-                }
-                _ => report(b, "$ENDSWITCH without a matching $SWITCH"),
-            },
+            Control::EndIf => self.close_if(b),
+            Control::EndSwitch => self.close_switch(b),
             // Given their jumps when their loop or `$SWITCH` closes; reported below if not.
             Control::Break | Control::Continue => {}
-            Control::Goto(n) => gotos.push((b, *n)),
+            Control::Goto(n) => self.gotos.push((b, *n)),
         }
     }
-    for o in open {
-        let (b, message) = match o {
-            Open::While(b) => (b, "$WHILE without $ENDWHILE"),
-            Open::If { start, .. } => (start, "$IF without $ENDIF"),
-            Open::For(b) => (b, "$FOR without $ENDFOR"),
-            Open::Do(b) => (b, "$DO without $ENDDO"),
-            Open::Switch { start, .. } => (start, "$SWITCH without $ENDSWITCH"),
+
+    /// `$ELSEIF` or `$ELSE` at block `b`: a branch of the open `$IF`.
+    fn branch(&mut self, b: usize, control: &Control) {
+        match self.open.last_mut() {
+            Some(Open::If {
+                branches,
+                seen_else,
+                ..
+            }) if !*seen_else => {
+                branches.push(b);
+                *seen_else = matches!(control, Control::Else);
+            }
+            _ => self.report(b, &format!("${} without a matching $IF", control.keyword())),
+        }
+    }
+
+    /// `$CASE` or `$DEFAULT` at block `b`: a case of the open `$SWITCH`.
+    fn case(&mut self, b: usize, control: &Control) {
+        // `$DEFAULT` may stand anywhere among the cases (reached sequentially it runs on
+        // into the case after it, like any branch); once per `$SWITCH`.
+        match self.open.last_mut() {
+            Some(Open::Switch {
+                default: Some(_), ..
+            }) if matches!(control, Control::Default) => {
+                self.report(b, "a second $DEFAULT in one $SWITCH")
+            }
+            Some(Open::Switch { cases, default, .. }) => {
+                if matches!(control, Control::Default) {
+                    *default = Some(b);
+                } else {
+                    cases.push(b);
+                }
+            }
+            _ => self.report(
+                b,
+                &format!("${} without a matching $SWITCH", control.keyword()),
+            ),
+        }
+    }
+
+    /// Closes the innermost open statement, the loop from `start` to `end`: the jump of its
+    /// first block (`$DO` has none), of its last, and of its `$BREAK`s and `$CONTINUE`s.
+    fn close_loop(&mut self, start: usize, end: usize, first: Option<Jump>, last: Jump) {
+        self.open.pop();
+        if let Some(jump) = first {
+            self.jumps.set(start, jump);
+        }
+        self.jumps.set(end, last);
+        resolve_exits(self.program, start, end, end, self.jumps);
+    }
+
+    /// `$ENDIF` at block `b`: closes the open `$IF`, chaining its branches.
+    fn close_if(&mut self, b: usize) {
+        let Some(Open::If { .. }) = self.open.last() else {
+            self.report(b, "$ENDIF without a matching $IF");
+            return;
         };
-        report(b, message);
-    }
-    for (b, n) in gotos {
-        let targets: Vec<usize> = level
-            .clone()
-            .filter(|&t| program.blocks[t].number == Some(n))
-            .collect();
-        match targets.as_slice() {
-            [to] => jumps.set(b, Jump::Go { to: *to }),
-            [] => report(
-                b,
-                &format!("$GOTO N{n}: no block N{n} in this program level"),
-            ),
-            _ => report(
-                b,
-                &format!("$GOTO N{n}: block number N{n} stands more than once"),
-            ),
+        let Some(Open::If {
+            start, branches, ..
+        }) = self.open.pop()
+        else {
+            unreachable!("matched just above")
+        };
+        let mut at = start;
+        for &branch in &branches {
+            self.jumps.set(
+                at,
+                Jump::If {
+                    next: branch,
+                    end: b,
+                },
+            );
+            at = branch;
+        }
+        if matches!(control_of(self.program, at), Some(Control::Else)) {
+            self.jumps.set(at, Jump::Else { end: b });
+        } else {
+            self.jumps.set(at, Jump::If { next: b, end: b });
         }
     }
-    // A `$BREAK` or `$CONTINUE` left without a jump has nothing to leave.
-    for b in level {
-        if !jumps.has(b) {
-            match control_of(program, b) {
-                Some(Control::Break) => report(b, "$BREAK outside a loop or $SWITCH"),
-                Some(Control::Continue) => report(b, "$CONTINUE outside a loop"),
-                _ => {}
+
+    /// `$ENDSWITCH` at block `b`: closes the open `$SWITCH`, chaining its cases.
+    fn close_switch(&mut self, b: usize) {
+        let Some(Open::Switch { .. }) = self.open.last() else {
+            self.report(b, "$ENDSWITCH without a matching $SWITCH");
+            return;
+        };
+        let Some(Open::Switch {
+            start,
+            cases,
+            default,
+        }) = self.open.pop()
+        else {
+            unreachable!("matched just above")
+        };
+        self.jumps.set(
+            start,
+            Jump::Switch {
+                first_case: cases.first().copied(),
+                default,
+                end: b,
+            },
+        );
+        for (i, &case) in cases.iter().enumerate() {
+            self.jumps.set(
+                case,
+                Jump::Case {
+                    next: cases.get(i + 1).copied(),
+                },
+            );
+        }
+        // `$BREAK` inside the switch (not inside a loop nested in it) leaves it.
+        resolve_breaks(self.program, start, b, self.jumps);
+    }
+
+    /// Reports the statements left open at the end of the level.
+    fn report_open(&mut self) {
+        for o in core::mem::take(&mut self.open) {
+            let (b, message) = match o {
+                Open::While(b) => (b, "$WHILE without $ENDWHILE"),
+                Open::If { start, .. } => (start, "$IF without $ENDIF"),
+                Open::For(b) => (b, "$FOR without $ENDFOR"),
+                Open::Do(b) => (b, "$DO without $ENDDO"),
+                Open::Switch { start, .. } => (start, "$SWITCH without $ENDSWITCH"),
+            };
+            self.report(b, message);
+        }
+    }
+
+    /// Gives each `$GOTO` its jump to the one block of `level` with its number.
+    fn resolve_gotos(&mut self, level: core::ops::Range<usize>) {
+        for (b, n) in core::mem::take(&mut self.gotos) {
+            let targets: Vec<usize> = level
+                .clone()
+                .filter(|&t| self.program.blocks[t].number == Some(n))
+                .collect();
+            match targets.as_slice() {
+                [to] => self.jumps.set(b, Jump::Go { to: *to }),
+                [] => self.report(
+                    b,
+                    &format!("$GOTO N{n}: no block N{n} in this program level"),
+                ),
+                _ => self.report(
+                    b,
+                    &format!("$GOTO N{n}: block number N{n} stands more than once"),
+                ),
+            }
+        }
+    }
+
+    /// Reports the `$BREAK`s and `$CONTINUE`s of `level` left without a jump: they have
+    /// nothing to leave.
+    fn report_stray_exits(&mut self, level: core::ops::Range<usize>) {
+        for b in level {
+            if !self.jumps.has(b) {
+                match control_of(self.program, b) {
+                    Some(Control::Break) => self.report(b, "$BREAK outside a loop or $SWITCH"),
+                    Some(Control::Continue) => self.report(b, "$CONTINUE outside a loop"),
+                    _ => {}
+                }
             }
         }
     }

@@ -248,226 +248,7 @@ impl<'a> Lexer<'a> {
             if self.fast_token(out) {
                 continue;
             }
-            let start = self.c.mark();
-            match ch {
-                ' ' | '\t' | '\r' => {
-                    self.c
-                        .skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
-                    self.spaced = true;
-                }
-                '\n' => {
-                    self.c.bump();
-                    // Inside `[ ]` a list may run on over the next line, unless that line plainly
-                    // starts a new block: then the bracket was left open and the block ends here.
-                    if self.depth > 0 && starts_new_block(&self.c.src[self.c.pos..]) {
-                        self.depth = 0;
-                    }
-                    if self.depth == 0 {
-                        push(out, Tok::Newline, self.c.close(start), true);
-                    }
-                    self.spaced = true;
-                }
-                ';' => {
-                    while self.c.peek().is_some_and(|x| x != '\n') {
-                        self.c.bump();
-                    }
-                    self.spaced = true;
-                }
-                '(' => {
-                    // Comments nest: `(a (b) c)` is one comment.
-                    let mut closed = false;
-                    let mut open = 0u32;
-                    while let Some(x) = self.c.bump() {
-                        if x == '(' {
-                            open += 1;
-                        }
-                        if x == ')' {
-                            open -= 1;
-                            if open == 0 {
-                                closed = true;
-                                break;
-                            }
-                        }
-                        if x == '\n' && self.depth == 0 {
-                            break;
-                        }
-                    }
-                    if !closed {
-                        self.errors.push(LexError {
-                            span: self.c.close(start),
-                            message: "comment \"(\" is not closed by \")\" on its line".into(),
-                        });
-                    }
-                    self.spaced = true;
-                }
-                '\\' => {
-                    // Continuation: the rest of the line must be blank (or a comment).
-                    self.c.bump();
-                    let rest_blank = {
-                        let tail = &self.c.src[self.c.pos..];
-                        let line = tail.split('\n').next().unwrap_or("");
-                        let code = line.split(';').next().unwrap_or("");
-                        code.trim().is_empty()
-                    };
-                    if rest_blank {
-                        while self.c.peek().is_some_and(|x| x != '\n') {
-                            self.c.bump();
-                        }
-                        self.c.bump();
-                    } else {
-                        push(out, Tok::Bad('\\'), self.c.close(start), self.spaced);
-                    }
-                    self.spaced = true;
-                }
-                '%' => {
-                    self.c.bump();
-                    let mut name = String::new();
-                    while let Some(x) = self.c.peek() {
-                        if x.is_whitespace() || x == ';' || x == '(' {
-                            break;
-                        }
-                        name.push(x);
-                        self.c.bump();
-                    }
-                    push(out, Tok::Percent(name), self.c.close(start), self.spaced);
-                    self.spaced = false;
-                }
-                '"' => {
-                    self.c.bump();
-                    let mut text = String::new();
-                    let mut closed = false;
-                    while let Some(x) = self.c.peek() {
-                        if x == '\n' {
-                            break;
-                        }
-                        self.c.bump();
-                        if x == '"' {
-                            closed = true;
-                            break;
-                        }
-                        text.push(x);
-                    }
-                    if !closed {
-                        self.errors.push(LexError {
-                            span: self.c.close(start),
-                            message: "string is not closed by '\"' on its line".into(),
-                        });
-                    }
-                    push(out, Tok::Str(text), self.c.close(start), self.spaced);
-                    self.spaced = false;
-                }
-                '0'..='9' | '.'
-                    if ch != '.' || self.c.peek2().is_some_and(|d| d.is_ascii_digit()) =>
-                {
-                    let from = self.c.pos;
-                    self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
-                    let text = &self.c.src[from..self.c.pos];
-                    match parse_decimal(text) {
-                        Ok(v) if v.is_finite() => {
-                            push(out, Tok::Num(v), self.c.close(start), self.spaced)
-                        }
-                        Ok(_) => {
-                            self.errors.push(LexError {
-                                span: self.c.close(start),
-                                message: format!(
-                                    "number with {} digits is too large (the largest is about 1.8e308)",
-                                    text.len()
-                                ),
-                            });
-                            push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
-                        }
-                        Err(_) => {
-                            self.errors.push(LexError {
-                                span: self.c.close(start),
-                                message: format!("malformed number \"{text}\""),
-                            });
-                            push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
-                        }
-                    }
-                    self.spaced = false;
-                }
-                x if x.is_ascii_alphabetic() || x == '_' => {
-                    let mut name = Name::new();
-                    let from = self.c.pos;
-                    self.c
-                        .skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
-                    let mut fits = true;
-                    for &b in &self.c.src.as_bytes()[from..self.c.pos] {
-                        fits &= name.push(b.to_ascii_uppercase());
-                    }
-                    // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
-                    let is_var = self.c.peek() == Some('.')
-                        && self
-                            .c
-                            .peek2()
-                            .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
-                    if is_var {
-                        while let Some(y) = self.c.peek() {
-                            if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
-                                fits &= name.push(y.to_ascii_uppercase() as u8);
-                                self.c.bump();
-                            } else {
-                                break;
-                            }
-                        }
-                    }
-                    if !fits {
-                        self.errors.push(LexError {
-                            span: self.c.close(start),
-                            message: format!("name longer than {} characters", Name::CAPACITY),
-                        });
-                    }
-                    let tok = if is_var {
-                        Tok::Var(name)
-                    } else {
-                        Tok::Word(name)
-                    };
-                    push(out, tok, self.c.close(start), self.spaced);
-                    self.spaced = false;
-                }
-                _ => {
-                    self.c.bump();
-                    let next = self.c.peek();
-                    let punct: Option<&'static str> = match (ch, next) {
-                        ('=', Some('=')) => Some("=="),
-                        ('!', Some('=')) => Some("!="),
-                        ('<', Some('=')) => Some("<="),
-                        ('>', Some('=')) => Some(">="),
-                        ('<', Some('>')) => Some("!="),
-                        ('*', Some('*')) => Some("**"),
-                        _ => None,
-                    };
-                    let tok = if let Some(p) = punct {
-                        self.c.bump();
-                        Tok::Punct(p)
-                    } else {
-                        match ch {
-                            '#' => Tok::Punct("#"),
-                            '$' => Tok::Punct("$"),
-                            '=' => Tok::Punct("="),
-                            '[' => {
-                                self.depth += 1;
-                                Tok::Punct("[")
-                            }
-                            ']' => {
-                                self.depth = self.depth.saturating_sub(1);
-                                Tok::Punct("]")
-                            }
-                            ',' => Tok::Punct(","),
-                            ':' => Tok::Punct(":"),
-                            '+' => Tok::Punct("+"),
-                            '-' => Tok::Punct("-"),
-                            '*' => Tok::Punct("*"),
-                            '/' => Tok::Punct("/"),
-                            '<' => Tok::Punct("<"),
-                            '>' => Tok::Punct(">"),
-                            other => Tok::Bad(other),
-                        }
-                    };
-                    push(out, tok, self.c.close(start), self.spaced);
-                    self.spaced = false;
-                }
-            }
+            self.general_token(ch, out);
             if out.last().is_some_and(|t| t.tok == Tok::Newline) {
                 return true;
             }
@@ -482,6 +263,260 @@ impl<'a> Lexer<'a> {
             spaced: true,
         });
         true
+    }
+
+    /// What [`Lexer::fast_token`] left at `ch` (the cursor's character): one token, blank,
+    /// comment, continuation or line break, by the general path.
+    fn general_token(&mut self, ch: char, out: &mut Vec<Token>) {
+        let start = self.c.mark();
+        match ch {
+            ' ' | '\t' | '\r' => {
+                self.c
+                    .skip_ascii_while(|b| b == b' ' || b == b'\t' || b == b'\r');
+                self.spaced = true;
+            }
+            '\n' => self.line_break(start, out),
+            ';' => self.line_comment(),
+            '(' => self.paren_comment(start),
+            '\\' => self.continuation(start, out),
+            '%' => self.percent(start, out),
+            '"' => self.string(start, out),
+            '0'..='9' | '.' if ch != '.' || self.c.peek2().is_some_and(|d| d.is_ascii_digit()) => {
+                self.number(start, out)
+            }
+            x if x.is_ascii_alphabetic() || x == '_' => self.word_or_variable(start, out),
+            _ => self.punct(ch, start, out),
+        }
+    }
+}
+
+/// The general path's tokens, one kind each; `start` marks where the token begins (the cursor,
+/// which stands on its first character).
+impl Lexer<'_> {
+    /// `\n`: ends the block, unless an open `[` continues it.
+    fn line_break(&mut self, start: Span, out: &mut Vec<Token>) {
+        self.c.bump();
+        // Inside `[ ]` a list may run on over the next line, unless that line plainly
+        // starts a new block: then the bracket was left open and the block ends here.
+        if self.depth > 0 && starts_new_block(&self.c.src[self.c.pos..]) {
+            self.depth = 0;
+        }
+        if self.depth == 0 {
+            push(out, Tok::Newline, self.c.close(start), true);
+        }
+        self.spaced = true;
+    }
+
+    /// `; ...` to the end of the line.
+    fn line_comment(&mut self) {
+        while self.c.peek().is_some_and(|x| x != '\n') {
+            self.c.bump();
+        }
+        self.spaced = true;
+    }
+
+    /// `( ... )`, nested; reported when its line ends first (outside `[ ]`).
+    fn paren_comment(&mut self, start: Span) {
+        // Comments nest: `(a (b) c)` is one comment.
+        let mut closed = false;
+        let mut open = 0u32;
+        while let Some(x) = self.c.bump() {
+            if x == '(' {
+                open += 1;
+            }
+            if x == ')' {
+                open -= 1;
+                if open == 0 {
+                    closed = true;
+                    break;
+                }
+            }
+            if x == '\n' && self.depth == 0 {
+                break;
+            }
+        }
+        if !closed {
+            self.errors.push(LexError {
+                span: self.c.close(start),
+                message: "comment \"(\" is not closed by \")\" on its line".into(),
+            });
+        }
+        self.spaced = true;
+    }
+
+    /// `\`: continues the block on the next line. The rest of its line must be blank (or a
+    /// comment); else the `\` is a bad character.
+    fn continuation(&mut self, start: Span, out: &mut Vec<Token>) {
+        self.c.bump();
+        let rest_blank = {
+            let tail = &self.c.src[self.c.pos..];
+            let line = tail.split('\n').next().unwrap_or("");
+            let code = line.split(';').next().unwrap_or("");
+            code.trim().is_empty()
+        };
+        if rest_blank {
+            while self.c.peek().is_some_and(|x| x != '\n') {
+                self.c.bump();
+            }
+            self.c.bump();
+        } else {
+            push(out, Tok::Bad('\\'), self.c.close(start), self.spaced);
+        }
+        self.spaced = true;
+    }
+
+    /// `%name`: a program or subroutine header.
+    fn percent(&mut self, start: Span, out: &mut Vec<Token>) {
+        self.c.bump();
+        let mut name = String::new();
+        while let Some(x) = self.c.peek() {
+            if x.is_whitespace() || x == ';' || x == '(' {
+                break;
+            }
+            name.push(x);
+            self.c.bump();
+        }
+        push(out, Tok::Percent(name), self.c.close(start), self.spaced);
+        self.spaced = false;
+    }
+
+    /// `"text"`, reported when its line ends first.
+    fn string(&mut self, start: Span, out: &mut Vec<Token>) {
+        self.c.bump();
+        let mut text = String::new();
+        let mut closed = false;
+        while let Some(x) = self.c.peek() {
+            if x == '\n' {
+                break;
+            }
+            self.c.bump();
+            if x == '"' {
+                closed = true;
+                break;
+            }
+            text.push(x);
+        }
+        if !closed {
+            self.errors.push(LexError {
+                span: self.c.close(start),
+                message: "string is not closed by '\"' on its line".into(),
+            });
+        }
+        push(out, Tok::Str(text), self.c.close(start), self.spaced);
+        self.spaced = false;
+    }
+
+    /// A number the fast path did not take (long or malformed); reported as such, read as 0.
+    fn number(&mut self, start: Span, out: &mut Vec<Token>) {
+        let from = self.c.pos;
+        self.c.skip_ascii_while(|b| b.is_ascii_digit() || b == b'.');
+        let text = &self.c.src[from..self.c.pos];
+        match parse_decimal(text) {
+            Ok(v) if v.is_finite() => push(out, Tok::Num(v), self.c.close(start), self.spaced),
+            Ok(_) => {
+                self.errors.push(LexError {
+                    span: self.c.close(start),
+                    message: format!(
+                        "number with {} digits is too large (the largest is about 1.8e308)",
+                        text.len()
+                    ),
+                });
+                push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
+            }
+            Err(_) => {
+                self.errors.push(LexError {
+                    span: self.c.close(start),
+                    message: format!("malformed number \"{text}\""),
+                });
+                push(out, Tok::Num(0.0), self.c.close(start), self.spaced);
+            }
+        }
+        self.spaced = false;
+    }
+
+    /// A word, or a variable with dots (`V.G.TRACK_CS.X`); a name too long is reported.
+    fn word_or_variable(&mut self, start: Span, out: &mut Vec<Token>) {
+        let mut name = Name::new();
+        let from = self.c.pos;
+        self.c
+            .skip_ascii_while(|b| b.is_ascii_alphabetic() || b == b'_');
+        let mut fits = true;
+        for &b in &self.c.src.as_bytes()[from..self.c.pos] {
+            fits &= name.push(b.to_ascii_uppercase());
+        }
+        // `V.G.TRACK_CS.X`: a variable runs on through dots, letters and digits.
+        let is_var = self.c.peek() == Some('.')
+            && self
+                .c
+                .peek2()
+                .is_some_and(|d| d.is_ascii_alphanumeric() || d == '_');
+        if is_var {
+            while let Some(y) = self.c.peek() {
+                if y.is_ascii_alphanumeric() || y == '_' || y == '.' {
+                    fits &= name.push(y.to_ascii_uppercase() as u8);
+                    self.c.bump();
+                } else {
+                    break;
+                }
+            }
+        }
+        if !fits {
+            self.errors.push(LexError {
+                span: self.c.close(start),
+                message: format!("name longer than {} characters", Name::CAPACITY),
+            });
+        }
+        let tok = if is_var {
+            Tok::Var(name)
+        } else {
+            Tok::Word(name)
+        };
+        push(out, tok, self.c.close(start), self.spaced);
+        self.spaced = false;
+    }
+
+    /// Punctuation (one or two characters, `[` and `]` counted), or a bad character.
+    fn punct(&mut self, ch: char, start: Span, out: &mut Vec<Token>) {
+        self.c.bump();
+        let next = self.c.peek();
+        let punct: Option<&'static str> = match (ch, next) {
+            ('=', Some('=')) => Some("=="),
+            ('!', Some('=')) => Some("!="),
+            ('<', Some('=')) => Some("<="),
+            ('>', Some('=')) => Some(">="),
+            ('<', Some('>')) => Some("!="),
+            ('*', Some('*')) => Some("**"),
+            _ => None,
+        };
+        let tok = if let Some(p) = punct {
+            self.c.bump();
+            Tok::Punct(p)
+        } else {
+            match ch {
+                '#' => Tok::Punct("#"),
+                '$' => Tok::Punct("$"),
+                '=' => Tok::Punct("="),
+                '[' => {
+                    self.depth += 1;
+                    Tok::Punct("[")
+                }
+                ']' => {
+                    self.depth = self.depth.saturating_sub(1);
+                    Tok::Punct("]")
+                }
+                ',' => Tok::Punct(","),
+                ':' => Tok::Punct(":"),
+                '+' => Tok::Punct("+"),
+                '-' => Tok::Punct("-"),
+                '*' => Tok::Punct("*"),
+                '/' => Tok::Punct("/"),
+                '<' => Tok::Punct("<"),
+                '>' => Tok::Punct(">"),
+                other => Tok::Bad(other),
+            }
+        };
+        push(out, tok, self.c.close(start), self.spaced);
+        self.spaced = false;
     }
 }
 

@@ -1,0 +1,192 @@
+//! Values at decode time: the [`Vars`] a block reads, and the context that evaluates its
+//! expressions and collects its diagnostics.
+
+use crate::nc::ast::*;
+use crate::nc::Diagnostic;
+
+/// Values of NC variables at decode time.
+pub trait Vars {
+    /// The value of `name` (upper case, e.g. `V.G.TRACK_CS.X`, `V.P.DEPTH`); `None` if there
+    /// is no such variable.
+    fn get(&self, name: &str) -> Option<f64>;
+
+    /// The value of P parameter `n`; `None` while it has not been assigned.
+    fn param(&self, n: u32) -> Option<f64> {
+        let _ = n;
+        None
+    }
+
+    /// Whether the program's own variables (P, `V.P.`, `V.L.`) are unknown here: a block
+    /// checked on its own, outside a run, has no values for them, and that is no error.
+    fn program_values_unknown(&self) -> bool {
+        false
+    }
+
+    /// Whether the `V.G.` values are those of a running machine (a check has placeholders:
+    /// where a condition on them leads is not known then).
+    fn machine_values_known(&self) -> bool {
+        true
+    }
+}
+
+/// The channel variables known to the decoder, all 0: what `cnc check` uses.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ZeroVars;
+
+/// The variables the language defines.
+pub const KNOWN_VARIABLES: &[&str] = &[
+    "V.G.TRACK_CS.X",
+    "V.G.TRACK_CS.Y",
+    "V.G.TRACK_CS.Z",
+    "V.G.TRACK_CS.A",
+    "V.G.TRACK_CS.B",
+    "V.G.TRACK_CS.C",
+];
+
+impl Vars for ZeroVars {
+    fn get(&self, name: &str) -> Option<f64> {
+        KNOWN_VARIABLES.contains(&name).then_some(0.0)
+    }
+    fn machine_values_known(&self) -> bool {
+        false
+    }
+}
+
+/// One decoding (a block, or an expression): the source its messages quote, the variables it
+/// reads and the diagnostics it finds.
+pub(super) struct Ctx<'a> {
+    pub(super) src: &'a str,
+    pub(super) vars: &'a dyn Vars,
+    pub(super) diags: Vec<Diagnostic>,
+}
+
+impl Ctx<'_> {
+    pub(super) fn error(&mut self, span: Span, message: impl Into<String>) {
+        self.diags
+            .push(Diagnostic::new(span, message.into(), self.src));
+    }
+
+    /// The value of `e`: a literal at once (nearly every word of a program), anything else
+    /// through [`Ctx::eval_expr`].
+    #[inline(always)]
+    pub(super) fn eval(&mut self, e: &Expr, span: Span) -> Option<f64> {
+        match e {
+            Expr::Num(v) => Some(*v),
+            _ => self.eval_expr(e, span),
+        }
+    }
+
+    fn eval_expr(&mut self, e: &Expr, span: Span) -> Option<f64> {
+        let value = match e {
+            Expr::Num(v) => Some(*v),
+            Expr::Var(name) => self.variable(name, span),
+            Expr::Param(n) => match self.vars.param(*n) {
+                Some(v) => Some(v),
+                None if self.vars.program_values_unknown() => None,
+                None => {
+                    self.error(span, format!("P{n} is read before it is assigned"));
+                    None
+                }
+            },
+            Expr::Neg(inner) => self.eval(inner, span).map(|v| -v),
+            Expr::Call(call) => {
+                let (func, args) = &**call;
+                let a = self.eval(args.first()?, span)?;
+                let b = match args.get(1) {
+                    Some(b) => Some(self.eval(b, span)?),
+                    None => None,
+                };
+                match crate::nc::eval::function(*func, a, b) {
+                    Ok(v) => Some(v),
+                    Err(message) => {
+                        self.error(span, message);
+                        None
+                    }
+                }
+            }
+            Expr::Bin(bin) => {
+                let (op, a, b) = &**bin;
+                let (a, b) = (self.eval(a, span)?, self.eval(b, span)?);
+                match crate::nc::eval::binary(*op, a, b) {
+                    Ok(v) => Some(v),
+                    Err(message) => {
+                        self.error(span, message);
+                        None
+                    }
+                }
+            }
+        }?;
+        if !value.is_finite() {
+            self.error(
+                span,
+                format!("the value is not a finite number ({value}): it overflowed"),
+            );
+            return None;
+        }
+        Some(value)
+    }
+
+    fn variable(&mut self, name: &Name, span: Span) -> Option<f64> {
+        if let Some(v) = self.vars.get(name) {
+            return Some(v);
+        }
+        let own = name.starts_with("V.P.") || name.starts_with("V.L.");
+        if own && self.vars.program_values_unknown() {
+            return None;
+        }
+        if own {
+            self.error(
+                span,
+                format!("variable \"{name}\" is read before it is assigned"),
+            );
+        } else {
+            self.error(
+                span,
+                format!(
+                    "unknown variable \"{name}\" (known: V.P.* and V.L.* once assigned, {})",
+                    KNOWN_VARIABLES.join(", ")
+                ),
+            );
+        }
+        None
+    }
+
+    /// A whole number within `range`, else an error naming `what`.
+    pub(super) fn whole(
+        &mut self,
+        e: &Expr,
+        span: Span,
+        what: &str,
+        min: f64,
+        max: f64,
+    ) -> Option<u32> {
+        let v = self.eval(e, span)?;
+        if v.fract() != 0.0 || v < min || v > max {
+            self.error(
+                span,
+                format!("{what} must be a whole number in {min}..={max}, found {v}"),
+            );
+            return None;
+        }
+        Some(v as u32)
+    }
+}
+
+/// Evaluates `expr` at `span` of `src` with the variables of `vars`; the diagnostic says what
+/// went wrong (an unknown variable, a division by zero, a value that is not finite...).
+pub fn evaluate_at(expr: &Expr, span: Span, src: &str, vars: &dyn Vars) -> Result<f64, Diagnostic> {
+    let mut ctx = Ctx {
+        src,
+        vars,
+        diags: Vec::new(),
+    };
+    match ctx.eval(expr, span) {
+        Some(v) if ctx.diags.is_empty() => Ok(v),
+        _ => {
+            // Unlocated: whoever reports it counts lines once for all its diagnostics.
+            Err(ctx.diags.into_iter().next().unwrap_or_else(|| {
+                Diagnostic::new(span, "the value cannot be computed".to_string(), src)
+            }))
+        }
+    }
+}
