@@ -4,9 +4,9 @@
 //! every refusal with its code while the axis keeps doing what it did.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::coupling::{CamLaw, Scaling, StartMode};
 use cnc_core::cam::{CamProfile, ProfileCursor};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::{
     AcyclicCall, CallKind, CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall,
 };

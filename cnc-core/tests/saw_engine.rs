@@ -5,8 +5,8 @@
 //! diagonal saw; the time-based phase.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw;
+use cnc_core::setpoint::Kinematic;
 use hli::calls::AxisCommandCall;
 use hli::enums::{AxisError, AxisState, CouplingState, SawError};
 use hli::layout::HliAxisLrState;

@@ -24,7 +24,7 @@
 
 use super::online::{ActivationMode, MasterNow};
 use super::{CamProfile, ProfileCursor};
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 
 /// `MC_StartMode`: whether the cam's master and slave coordinates are absolute or measured
 /// from the axes' positions at coupling (or switching).

@@ -22,7 +22,7 @@
 
 use super::online::CamStore;
 use super::{CamProfile, ProfileCursor};
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 
 /// Tables of one multi-table slave.
 pub const MAX_MULTI_TABLES: usize = 8;

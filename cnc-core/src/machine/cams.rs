@@ -18,7 +18,6 @@
 //! there, as the seed says (5.1.4).
 
 use super::engine::{Engine, EngineIo};
-use crate::axis::generator::Kinematic;
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
@@ -30,6 +29,7 @@ use crate::cam::{
     CamProfile, Interpolation, MotionFunction, MotionFunctionPoint, PositionTable, ProfileCursor,
     TableErrorCode, TableType,
 };
+use crate::setpoint::Kinematic;
 use hli::calls::{
     decode_body, reply, CallKind, CamInCall, CamMultiCoupleCall, CamMultiTableCall,
     CamOnlineModeCall, CamOutCall, CamPointsReadCall, CamPointsReply, CamPointsWriteCall,
