@@ -1,0 +1,533 @@
+//! The cam engine: slave axes coupled to a master axis through a cam profile (seed 000,
+//! chapters 4.3 to 4.5 and 5.1.1 to 5.1.6). Each tick, for every coupled slave, it takes the
+//! master's set-point of this tick, applies queued online changes of the cam's points, a due
+//! switch or rescaling, and hands the slave its set-point through the coupling law
+//! ([`crate::cam::coupling::CamLaw`]); the axis stage does the rest (limits, following
+//! error, drive).
+//!
+//! Commands arrive as acyclic calls between ticks: MC_CamTableSelect (per table: cyclic; its
+//! absolute flags are checked, MC_CamIn's start mode decides), MC_CamIn / MC_CamInExt (couple, or with Ext switch cams),
+//! MC_CamOut (the slave goes on at its velocity as a free axis) and MC_CamScaling; and the
+//! data: motion-function points written (a change under the table's online-change mode, or
+//! a new function) and read, position tables written, each in chunks that change nothing
+//! until the last one is checked whole. A refused call leaves every axis and table as it was.
+//!
+//! A first coupling with a waiting activation mode couples the slave at once but holds it
+//! (`nAxisState` 11, pre-phase) until the master reaches the activation; then the slave
+//! follows the cam (13, synchronous) and jumps to the cam's position if it does not stand
+//! there, as the seed says (5.1.4).
+//!
+//! Here: the engine's state, its tick (multi-table slaves, online point changes, then every
+//! cam slave: activation, rescaling, switch, hand-over) and the calls' dispatch. The calls
+//! live beside it: `couplings` (couple, switch, decouple, scale, the multi-table slave),
+//! `data` (points and rows in chunks, online-change mode, table delete) and `reads`
+//! (MC_CamRead's answers).
+
+mod couplings;
+mod data;
+mod reads;
+
+use super::engine::{Engine, EngineIo};
+use crate::axis::AxisSet;
+use crate::cam::coupling::{CamLaw, CouplingError, Scaling, ScalingMode, StartMode};
+use crate::cam::multi_table::{MultiTableLaw, TableWeight};
+use crate::cam::online::{ActivationMode, CamStore};
+use crate::cam::{CamProfile, ProfileCursor, TableErrorCode};
+use crate::setpoint::Kinematic;
+use data::{PointsTransfer, RowsTransfer};
+use hli::calls::{
+    reply, CallKind, CamReply, HandlerResult, CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING,
+    CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
+};
+use hli::enums::{AxisState, CamCouplingError, CouplingState};
+use hli::wire::AcyclicRequest;
+
+/// Table IDs run 1..=255.
+const TABLE_SLOTS: usize = 256;
+
+/// MC_CamTableSelect's settings of a table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Select {
+    periodic: bool,
+}
+
+/// A change a coupling waits for (each kind in its own slot: a scaling does not drop a
+/// queued switch, nor the reverse).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Queued {
+    /// A switch to another cam (MC_CamInExt while coupled).
+    Switch {
+        table: u32,
+        scaling: Scaling,
+        modes: (ScalingMode, ScalingMode),
+        start: StartMode,
+        activation: ActivationMode,
+    },
+    /// A rescaling (MC_CamScaling): the values asked for, and the keep bits of the ones
+    /// that stay as the coupling has them when it applies (after a switch, too).
+    Scale {
+        requested: Scaling,
+        keep: u32,
+        modes: (ScalingMode, ScalingMode),
+        activation: ActivationMode,
+    },
+}
+
+/// One coupled slave.
+#[derive(Debug)]
+struct Slave {
+    master: usize,
+    table: u32,
+    /// The table interpolated as the coupling asked, when that differs from the stored one.
+    own: Option<CamProfile>,
+    /// The same for the cam a queued switch goes to.
+    switch_own: Option<CamProfile>,
+    law: CamLaw,
+    cursor: ProfileCursor,
+    /// False while a first coupling waits for its activation.
+    active: bool,
+    /// Coupled with MC_CamInExt: may switch cams.
+    extended: bool,
+    /// The first coupling's activation, while it waits (the slave holds).
+    waiting: Option<ActivationMode>,
+    /// A queued switch (`Queued::Switch`).
+    switch: Option<Queued>,
+    /// A queued rescaling (`Queued::Scale`).
+    scale: Option<Queued>,
+    /// The master's set-point of the last tick.
+    master_before: f64,
+    /// Where the slave holds while it waits.
+    hold: f64,
+    /// Master and slave set-points when the coupling became active (or was made).
+    coupled_at: (f64, f64),
+    /// Follows the master's actual position rather than its set-point.
+    follow_actual: bool,
+}
+
+/// The scaling a rescaling gives: the values asked for, except those of a side whose mode is
+/// Off and those the keep bits name, which stay as `current` has them.
+fn merged_scaling(
+    current: Scaling,
+    requested: Scaling,
+    keep: u32,
+    (master_mode, slave_mode): (ScalingMode, ScalingMode),
+) -> Scaling {
+    let take = |bit: u32, on: bool| on && keep & bit == 0;
+    let master_on = master_mode != ScalingMode::Off;
+    let slave_on = slave_mode != ScalingMode::Off;
+    Scaling {
+        master_offset: if take(CAM_KEEP_MASTER_OFFSET, master_on) {
+            requested.master_offset
+        } else {
+            current.master_offset
+        },
+        master_scaling: if take(CAM_KEEP_MASTER_SCALING, master_on) {
+            requested.master_scaling
+        } else {
+            current.master_scaling
+        },
+        slave_offset: if take(CAM_KEEP_SLAVE_OFFSET, slave_on) {
+            requested.slave_offset
+        } else {
+            current.slave_offset
+        },
+        slave_scaling: if take(CAM_KEEP_SLAVE_SCALING, slave_on) {
+            requested.slave_scaling
+        } else {
+            current.slave_scaling
+        },
+    }
+}
+
+/// Whether couplings through `table` run cyclic: MC_CamTableSelect's choice, else the
+/// table's own flag (a motion function: linear).
+fn periodic_of(selects: &[Option<Select>], table: u32, profile: &CamProfile) -> bool {
+    match selects.get(table as usize).copied().flatten() {
+        Some(select) => select.periodic,
+        None => match profile {
+            CamProfile::Table(t) => t.periodic(),
+            CamProfile::MotionFunction(_) => false,
+        },
+    }
+}
+
+/// What of the master a slave follows: its set-point (the seed's rule) or its actual
+/// position and velocity.
+fn master_of(axes: &AxisSet, master: usize, actual: bool) -> Option<Kinematic> {
+    let a = axes.axis(master)?;
+    Some(if actual {
+        Kinematic {
+            position: a.actual(),
+            velocity: a.actual_velocity(),
+            ..Kinematic::default()
+        }
+    } else {
+        a.setpoint()
+    })
+}
+
+/// A multi-table slave (chapter 4.6).
+#[derive(Debug)]
+struct MultiSlave {
+    master: usize,
+    law: MultiTableLaw,
+}
+
+/// Cam couplings of a machine.
+#[derive(Debug)]
+pub struct CamEngine {
+    /// Per table: its weight and scaling in a multi-table slave (CamTableSetWeight).
+    weights: Vec<TableWeight>,
+    /// Multi-table slaves by axis.
+    multis: Vec<Option<MultiSlave>>,
+    store: CamStore,
+    selects: Vec<Option<Select>>,
+    /// Per table: how a point change that applies treats the master and slave offsets.
+    online_scaling: Vec<(ScalingMode, ScalingMode)>,
+    points_in: Vec<Option<PointsTransfer>>,
+    rows_in: Vec<Option<RowsTransfer>>,
+    /// Tables declared (CamTableCreate) for rows that follow: type, interpolation, cyclic,
+    /// rows.
+    declared: Vec<Option<(u32, u32, u32, u32)>>,
+    slaves: Vec<Option<Slave>>,
+    /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
+    retired: Vec<CamProfile>,
+    /// Motion functions a point change replaced, with their change records, freed alike.
+    retired_changes: Vec<crate::cam::online::Replaced>,
+}
+
+/// A refusal as the code the block reports.
+fn code(e: u32) -> HandlerResult {
+    reply(&CamReply {
+        error_id: e,
+        reserved: 0,
+    })
+}
+
+fn accepted() -> HandlerResult {
+    code(0)
+}
+
+fn coupling_code(e: CouplingError) -> u32 {
+    match e {
+        CouplingError::Parameter { .. } => CamCouplingError::BadParameter.raw(),
+        CouplingError::Combination { .. } => CamCouplingError::ModeCombination.raw(),
+        CouplingError::Passed { .. } => CamCouplingError::ActivationPassed.raw(),
+    }
+}
+
+const TABLE_INVALID: u32 = TableErrorCode::CamTableIdInvalid as u32;
+
+impl CamEngine {
+    /// An engine for a machine of `axes` axes with the tables of `store`.
+    pub fn new(store: CamStore, axes: usize) -> CamEngine {
+        CamEngine {
+            weights: vec![TableWeight::default(); TABLE_SLOTS],
+            multis: (0..axes).map(|_| None).collect(),
+            store,
+            selects: vec![None; TABLE_SLOTS],
+            online_scaling: vec![(ScalingMode::UserDefined, ScalingMode::UserDefined); TABLE_SLOTS],
+            points_in: (0..TABLE_SLOTS).map(|_| None).collect(),
+            rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
+            declared: vec![None; TABLE_SLOTS],
+            slaves: (0..axes).map(|_| None).collect(),
+            // Room for every retirement between two calls: each slave lost (two profiles), a
+            // switch per slave, a point change per table in use.
+            retired: Vec::with_capacity(4 * axes + 8),
+            retired_changes: Vec::with_capacity(2 * axes + 8),
+        }
+    }
+
+    fn select_periodic(&self, table: u32, profile: &CamProfile) -> bool {
+        periodic_of(&self.selects, table, profile)
+    }
+
+    /// Whether a coupling uses table `id` or switches to it.
+    fn in_use(&self, id: u32) -> bool {
+        self.slaves.iter().flatten().any(|s| {
+            s.table == id || matches!(s.switch, Some(Queued::Switch { table, .. }) if table == id)
+        }) || self
+            .multis
+            .iter()
+            .flatten()
+            .any(|m| m.law.tables().any(|t| t == id))
+    }
+
+    /// Online changes of the motion functions coupled slaves run on, under each table's
+    /// mode. A change is timed by the first slave on its table (the lowest axis); with
+    /// AsSoonAsPossible it waits until no slave on the table stands in a segment it touches.
+    /// Every slave on the table then takes it at once, each law rebuilt with the table's
+    /// scaling modes (offsets keep the master's place and the slave's position when they say
+    /// so); a slave still waiting for its activation only takes the new geometry.
+    fn apply_point_changes(&mut self, axes: &AxisSet) {
+        for i in 0..self.slaves.len() {
+            let Some(s) = self.slaves[i].as_ref() else {
+                continue;
+            };
+            let table = s.table;
+            let queued = self.store.queue(table).is_ok_and(|q| q.is_queued());
+            if s.own.is_some() || !queued {
+                continue;
+            }
+            let Some(master) = master_of(axes, s.master, s.follow_actual) else {
+                continue;
+            };
+            let now = s.law.master_now(s.master_before, master.position);
+            if let Ok(queue) = self.store.queue(table) {
+                if queue.pending_mode() == Some(ActivationMode::AsSoonAsPossible) {
+                    let touched = self.slaves.iter().flatten().any(|o| {
+                        o.table == table
+                            && o.own.is_none()
+                            && master_of(axes, o.master, o.follow_actual).is_some_and(|m| {
+                                queue.touches(o.law.master_now(o.master_before, m.position))
+                            })
+                    });
+                    if touched {
+                        continue;
+                    }
+                }
+            }
+            let Ok(Some(old)) = self.store.apply_due(table, now) else {
+                continue;
+            };
+            let Ok(new) = self.store.get(table) else {
+                continue;
+            };
+            let modes = self.online_scaling[table as usize];
+            for other in self.slaves.iter_mut().flatten() {
+                if other.table != table || other.own.is_some() {
+                    continue;
+                }
+                other.cursor = ProfileCursor::default();
+                if !other.active {
+                    other.law.take_geometry(new);
+                    continue;
+                }
+                let Some(m) = master_of(axes, other.master, other.follow_actual) else {
+                    continue;
+                };
+                let (before, _) = other
+                    .law
+                    .slave(&old.profile, &mut ProfileCursor::default(), &m);
+                let law = other.law;
+                other.law = law.rescaled(
+                    new,
+                    law.scaling,
+                    modes,
+                    law.start,
+                    law.periodic,
+                    m.position,
+                    before.position,
+                    false,
+                );
+                other.cursor = ProfileCursor::default();
+            }
+            self.retired_changes.push(old);
+        }
+    }
+}
+
+impl Engine for CamEngine {
+    fn name(&self) -> &'static str {
+        "cam"
+    }
+
+    fn holds_table(&self, id: u32) -> bool {
+        self.store.get(id).is_ok()
+    }
+
+    fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
+        for i in 0..self.multis.len() {
+            let Some(multi) = self.multis[i].as_mut() else {
+                continue;
+            };
+            let still = io
+                .axes
+                .axis(i)
+                .and_then(|a| a.coupling())
+                .is_some_and(|c| c.kind == CouplingState::Cam);
+            let master = io.axes.axis(multi.master).map(|a| a.setpoint());
+            let (true, Some(master)) = (still, master) else {
+                self.multis[i] = None;
+                continue;
+            };
+            let set = multi.law.slave(&self.store, &master);
+            if let Some(axis) = io.axes.axis_mut(i) {
+                axis.drive_coupled(set, AxisState::SlaveSynchronous);
+            }
+        }
+        self.apply_point_changes(io.axes);
+        for i in 0..self.slaves.len() {
+            let Some(state) = self.slaves[i].as_mut() else {
+                continue;
+            };
+            // A slave that lost its coupling (fault, power off) is free again.
+            let still = io
+                .axes
+                .axis(i)
+                .and_then(|a| a.coupling())
+                .is_some_and(|c| c.kind == CouplingState::Cam);
+            let master = master_of(io.axes, state.master, state.follow_actual);
+            let (true, Some(master)) = (still, master) else {
+                if let Some(gone) = self.slaves[i].take() {
+                    self.retired.extend(gone.own);
+                    self.retired.extend(gone.switch_own);
+                }
+                continue;
+            };
+            let now = state.law.master_now(state.master_before, master.position);
+            let Ok(stored) = self.store.get(state.table) else {
+                continue;
+            };
+            let profile = state.own.as_ref().unwrap_or(stored);
+            let (mut set, _) = state.law.slave(profile, &mut state.cursor, &master);
+            if state.waiting.is_some_and(|t| t.due(now)) {
+                // Relative sides start from here; the cycle counter too.
+                state.law = CamLaw::new(
+                    profile,
+                    state.law.scaling,
+                    state.law.start,
+                    state.law.periodic,
+                    master.position,
+                    state.hold,
+                );
+                state.active = true;
+                state.waiting = None;
+                state.coupled_at = (master.position, state.hold);
+                set = state.law.slave(profile, &mut state.cursor, &master).0;
+            }
+            if let Some(Queued::Scale {
+                requested,
+                keep,
+                modes,
+                activation,
+            }) = state.scale.filter(|_| state.active)
+            {
+                if activation.due(now) {
+                    let law = state.law;
+                    let scaling = merged_scaling(law.scaling, requested, keep, modes);
+                    state.law = law.rescaled(
+                        profile,
+                        scaling,
+                        modes,
+                        law.start,
+                        law.periodic,
+                        master.position,
+                        set.position,
+                        false,
+                    );
+                    state.scale = None;
+                    set = state.law.slave(profile, &mut state.cursor, &master).0;
+                }
+            }
+            if let Some(Queued::Switch {
+                table,
+                scaling,
+                modes,
+                start,
+                activation,
+            }) = state.switch.filter(|_| state.active)
+            {
+                if activation.due(now) {
+                    let stored_next = self.store.get(table).ok();
+                    if let Some(next) = state.switch_own.as_ref().or(stored_next) {
+                        let periodic = periodic_of(&self.selects, table, next);
+                        let law = state.law;
+                        state.law = law.rescaled(
+                            next,
+                            scaling,
+                            modes,
+                            start,
+                            periodic,
+                            master.position,
+                            set.position,
+                            true,
+                        );
+                        state.table = table;
+                        state.cursor = ProfileCursor::default();
+                        set = state.law.slave(next, &mut state.cursor, &master).0;
+                        // The switched-to cam's own copy becomes the coupling's.
+                        let next_own = state.switch_own.take();
+                        if let Some(old) = core::mem::replace(&mut state.own, next_own) {
+                            self.retired.push(old);
+                        }
+                    }
+                    state.switch = None;
+                }
+            }
+            // A law that cannot give a finite set-point (extreme scalings) releases the
+            // slave rather than pass the number on.
+            let finite = set.position.is_finite()
+                && set.velocity.is_finite()
+                && set.acceleration.is_finite()
+                && set.jerk.is_finite();
+            if !finite {
+                if let Some(axis) = io.axes.axis_mut(i) {
+                    axis.decouple();
+                }
+                continue;
+            }
+            let (set, phase) = if state.active {
+                (set, AxisState::SlaveSynchronous)
+            } else {
+                (
+                    Kinematic {
+                        position: state.hold,
+                        ..Kinematic::default()
+                    },
+                    AxisState::SlavePrephase,
+                )
+            };
+            if let Some(axis) = io.axes.axis_mut(i) {
+                axis.drive_coupled(set, phase);
+            }
+            state.master_before = master.position;
+        }
+    }
+
+    fn handle(
+        &mut self,
+        kind: CallKind,
+        request: &AcyclicRequest,
+        axes: &mut AxisSet,
+    ) -> Option<HandlerResult> {
+        // Between ticks: free what the ticks retired.
+        self.retired.clear();
+        self.retired_changes.clear();
+        Some(match kind {
+            CallKind::CamTableSelect => self.table_select(request),
+            CallKind::CamIn => self.cam_in(request, axes),
+            CallKind::CamOut => self.cam_out(request, axes),
+            CallKind::CamScaling => self.cam_scaling(request, axes),
+            CallKind::CamPointsWrite => self.points_write(request, axes),
+            CallKind::CamPointsRead => self.points_read(request),
+            CallKind::CamOnlineMode => self.online_mode(request),
+            CallKind::CamRowsWrite => self.rows_write(request),
+            CallKind::CamRead => self.read(request, axes),
+            CallKind::CamTableWeight => self.table_weight(request),
+            CallKind::CamMultiCouple => self.multi_couple(request, axes),
+            CallKind::CamMultiTable => self.multi_table(request),
+            CallKind::CamTableDelete => self.table_delete(request),
+            _ => return None,
+        })
+    }
+
+    fn reset(&mut self, axes: &mut AxisSet) {
+        for (i, slot) in self.multis.iter_mut().enumerate() {
+            if slot.take().is_some() {
+                if let Some(axis) = axes.axis_mut(i) {
+                    axis.decouple();
+                }
+            }
+        }
+        for (i, slot) in self.slaves.iter_mut().enumerate() {
+            if let Some(state) = slot.take() {
+                if let Some(axis) = axes.axis_mut(i) {
+                    axis.decouple();
+                }
+                self.retired.extend(state.own);
+                self.retired.extend(state.switch_own);
+            }
+        }
+    }
+}
