@@ -42,6 +42,30 @@ fn couple_cam(
     .map_err(AxisError::raw)
 }
 
+/// MC_CamIn's request, checked: what a switch or a first coupling is made of.
+struct CamInAsk {
+    master: usize,
+    start: StartMode,
+    activation: Activation,
+    /// Master and slave scaling modes.
+    modes: (ScalingMode, ScalingMode),
+    scaling: Scaling,
+    /// The table interpolated as asked, when that differs from the stored one.
+    own: Option<CamProfile>,
+    follow_actual: bool,
+    /// The master's set-point (or actual position) now.
+    master_set: Kinematic,
+    /// The master's motion, for an activation already passed.
+    now: MasterNow,
+}
+
+impl CamInAsk {
+    /// The master side takes its offset from the coupling (AutoOffset).
+    fn master_auto(&self) -> bool {
+        self.modes.0 == ScalingMode::AutoOffset
+    }
+}
+
 impl CamEngine {
     pub(super) fn table_select(&mut self, request: &AcyclicRequest) -> HandlerResult {
         let call: CamTableSelectCall = decode_body(request)?;
@@ -59,11 +83,7 @@ impl CamEngine {
     }
 
     /// The profile a coupling uses: the stored one, or a copy interpolated as requested.
-    pub(super) fn profile_for(
-        &self,
-        table: u32,
-        interpolation: u32,
-    ) -> Result<Option<CamProfile>, u32> {
+    fn profile_for(&self, table: u32, interpolation: u32) -> Result<Option<CamProfile>, u32> {
         let profile = self.store.get(table).map_err(|_| TABLE_INVALID)?;
         let CamProfile::Table(t) = profile else {
             // Motion functions carry their own laws: the interpolation does not apply.
@@ -87,15 +107,35 @@ impl CamEngine {
     pub(super) fn cam_in(&mut self, request: &AcyclicRequest, axes: &mut AxisSet) -> HandlerResult {
         let call: CamInCall = decode_body(request)?;
         let slave = request.target as usize;
-        let master = call.master as usize;
         if slave >= axes.len() {
             return Err(ErrorCode::InvalidTarget);
         }
+        let ask = match self.cam_in_ask(&call, slave, axes) {
+            Ok(ask) => ask,
+            Err(e) => return code(e),
+        };
+        let Some(axis) = axes.axis(slave) else {
+            return Err(ErrorCode::InvalidTarget);
+        };
+        match (axis.coupling(), self.slaves[slave].as_ref()) {
+            // Coupled through a cam already: a switch (MC_CamInExt both times) or a refusal.
+            (Some(c), Some(_)) if c.kind == CouplingState::Cam => {
+                self.queue_switch(slave, &call, ask)
+            }
+            (Some(_), _) => code(AxisError::Coupled.raw()),
+            (None, _) => self.couple_first(slave, &call, ask, axes),
+        }
+    }
+
+    /// MC_CamIn's values checked (of an existing slave axis), its table's profile made and
+    /// the master's set-point read: `Err` is the code of a refusal.
+    fn cam_in_ask(&self, call: &CamInCall, slave: usize, axes: &AxisSet) -> Result<CamInAsk, u32> {
+        let master = call.master as usize;
         if master >= axes.len() {
-            return code(CamCouplingError::NoSuchMaster.raw());
+            return Err(CamCouplingError::NoSuchMaster.raw());
         }
         if master == slave {
-            return code(CamCouplingError::MasterIsSlave.raw());
+            return Err(CamCouplingError::MasterIsSlave.raw());
         }
         let (Some(start), Some(activation), Some(master_mode), Some(slave_mode)) = (
             StartMode::from_raw(call.start_mode),
@@ -103,10 +143,10 @@ impl CamEngine {
             ScalingMode::from_raw(call.master_scaling_mode),
             ScalingMode::from_raw(call.slave_scaling_mode),
         ) else {
-            return code(CamCouplingError::UnknownMode.raw());
+            return Err(CamCouplingError::UnknownMode.raw());
         };
         if call.extended > 1 || call.master_source > 1 || !call.activation_position.is_finite() {
-            return code(CamCouplingError::BadParameter.raw());
+            return Err(CamCouplingError::BadParameter.raw());
         }
         let scaling = Scaling {
             master_offset: call.master_offset,
@@ -115,17 +155,13 @@ impl CamEngine {
             slave_scaling: call.slave_scaling,
         };
         if let Err(e) = scaling.check() {
-            return code(coupling_code(e));
+            return Err(coupling_code(e));
         }
-        let own = match self.profile_for(call.table_id, call.interpolation) {
-            Ok(own) => own,
-            Err(e) => return code(e),
-        };
+        let own = self.profile_for(call.table_id, call.interpolation)?;
         let follow_actual = call.master_source == 1;
         let Some(master_set) = master_of(axes, master, follow_actual) else {
-            return code(CamCouplingError::NoSuchMaster.raw());
+            return Err(CamCouplingError::NoSuchMaster.raw());
         };
-        let master_auto = master_mode == ScalingMode::AutoOffset;
         // The master's direction of travel decides whether an axis position lies behind it.
         let now = MasterNow {
             axis: (
@@ -134,104 +170,122 @@ impl CamEngine {
             ),
             ..MasterNow::default()
         };
-        let Some(axis) = axes.axis(slave) else {
-            return Err(ErrorCode::InvalidTarget);
-        };
-        let coupled = axis.coupling();
-        let ours = self.slaves[slave].as_ref();
-        match (coupled, ours) {
-            // Coupled through a cam already: a switch (MC_CamInExt both times) or a refusal.
-            (Some(c), Some(current)) if c.kind == CouplingState::Cam => {
-                if !(current.extended && call.extended == 1) {
-                    return code(CamCouplingError::NotSwitchable.raw());
-                }
-                if !current.active {
-                    return code(CamCouplingError::CouplingPending.raw());
-                }
-                if current.master != master {
-                    return code(CamCouplingError::NoSuchMaster.raw());
-                }
-                if let Err(e) = check_switch(activation, start, master_auto)
-                    .and_then(|()| check_not_passed(activation, now))
-                {
-                    return code(coupling_code(e));
-                }
-                let current = self.slaves[slave].as_mut().expect("checked above");
-                if activation == Activation::DeleteQueuedData {
-                    if current.switch.take().is_some() {
-                        if let Some(old) = current.switch_own.take() {
-                            self.retired.push(old);
-                        }
-                    }
-                    return accepted();
-                }
-                if let Some(old) = core::mem::replace(&mut current.switch_own, own) {
+        Ok(CamInAsk {
+            master,
+            start,
+            activation,
+            modes: (master_mode, slave_mode),
+            scaling,
+            own,
+            follow_actual,
+            master_set,
+            now,
+        })
+    }
+
+    /// MC_CamInExt on a slave coupled with MC_CamInExt: queues the switch to `call`'s table
+    /// (or deletes the queued one).
+    fn queue_switch(&mut self, slave: usize, call: &CamInCall, ask: CamInAsk) -> HandlerResult {
+        let current = self.slaves[slave]
+            .as_mut()
+            .expect("cam_in matched a cam slave");
+        if !(current.extended && call.extended == 1) {
+            return code(CamCouplingError::NotSwitchable.raw());
+        }
+        if !current.active {
+            return code(CamCouplingError::CouplingPending.raw());
+        }
+        if current.master != ask.master {
+            return code(CamCouplingError::NoSuchMaster.raw());
+        }
+        if let Err(e) = check_switch(ask.activation, ask.start, ask.master_auto())
+            .and_then(|()| check_not_passed(ask.activation, ask.now))
+        {
+            return code(coupling_code(e));
+        }
+        if ask.activation == Activation::DeleteQueuedData {
+            if current.switch.take().is_some() {
+                if let Some(old) = current.switch_own.take() {
                     self.retired.push(old);
                 }
-                let current = self.slaves[slave].as_mut().expect("checked above");
-                current.switch = Some(Queued::Switch {
-                    table: call.table_id,
-                    scaling,
-                    modes: (master_mode, slave_mode),
-                    start,
-                    activation: activation.timing().expect("checked: a timed mode"),
-                });
-                accepted()
             }
-            (Some(_), _) => code(AxisError::Coupled.raw()),
-            (None, _) => {
-                // Whatever the engine still held for this axis is stale: the axis layer
-                // dropped the coupling (a fault, power off).
-                self.multis[slave] = None;
-                if let Err(e) = check_couple(activation, start, master_auto)
-                    .and_then(|()| check_not_passed(activation, now))
-                {
-                    return code(coupling_code(e));
-                }
-                let profile = match &own {
-                    Some(p) => p,
-                    None => self
-                        .store
-                        .get(call.table_id)
-                        .map_err(|_| ErrorCode::InvalidData)?,
-                };
-                let periodic = self.select_periodic(call.table_id, profile);
-                let hold = axis.setpoint().position;
-                let law = CamLaw::new(profile, scaling, start, periodic, master_set.position, hold);
-                if let Err(e) = couple_cam(axes, slave, master, AxisState::SlavePrephase) {
-                    return code(e);
-                }
-                let Some(axis) = axes.axis_mut(slave) else {
-                    return Err(ErrorCode::InvalidTarget);
-                };
-                axis.drive_coupled(
-                    Kinematic {
-                        position: hold,
-                        ..Kinematic::default()
-                    },
-                    AxisState::SlavePrephase,
-                );
-                let timing = activation.timing().expect("checked: a timed mode");
-                self.slaves[slave] = Some(Slave {
-                    master,
-                    table: call.table_id,
-                    own,
-                    switch_own: None,
-                    law,
-                    cursor: ProfileCursor::default(),
-                    active: false,
-                    extended: call.extended == 1,
-                    waiting: Some(timing),
-                    switch: None,
-                    scale: None,
-                    master_before: master_set.position,
-                    hold,
-                    coupled_at: (master_set.position, hold),
-                    follow_actual,
-                });
-                accepted()
-            }
+            return accepted();
         }
+        if let Some(old) = core::mem::replace(&mut current.switch_own, ask.own) {
+            self.retired.push(old);
+        }
+        current.switch = Some(Queued::Switch {
+            table: call.table_id,
+            scaling: ask.scaling,
+            modes: ask.modes,
+            start: ask.start,
+            activation: ask.activation.timing().expect("checked: a timed mode"),
+        });
+        accepted()
+    }
+
+    /// A first coupling of a free axis: coupled at once, held where it stands (pre-phase)
+    /// until its activation.
+    fn couple_first(
+        &mut self,
+        slave: usize,
+        call: &CamInCall,
+        ask: CamInAsk,
+        axes: &mut AxisSet,
+    ) -> HandlerResult {
+        // Whatever the engine still held for this axis is stale: the axis layer
+        // dropped the coupling (a fault, power off).
+        self.multis[slave] = None;
+        if let Err(e) = check_couple(ask.activation, ask.start, ask.master_auto())
+            .and_then(|()| check_not_passed(ask.activation, ask.now))
+        {
+            return code(coupling_code(e));
+        }
+        let profile = match &ask.own {
+            Some(p) => p,
+            None => self
+                .store
+                .get(call.table_id)
+                .map_err(|_| ErrorCode::InvalidData)?,
+        };
+        let periodic = self.select_periodic(call.table_id, profile);
+        let Some(hold) = axes.axis(slave).map(|a| a.setpoint().position) else {
+            return Err(ErrorCode::InvalidTarget);
+        };
+        let master_at = ask.master_set.position;
+        let law = CamLaw::new(profile, ask.scaling, ask.start, periodic, master_at, hold);
+        if let Err(e) = couple_cam(axes, slave, ask.master, AxisState::SlavePrephase) {
+            return code(e);
+        }
+        let Some(axis) = axes.axis_mut(slave) else {
+            return Err(ErrorCode::InvalidTarget);
+        };
+        axis.drive_coupled(
+            Kinematic {
+                position: hold,
+                ..Kinematic::default()
+            },
+            AxisState::SlavePrephase,
+        );
+        let timing = ask.activation.timing().expect("checked: a timed mode");
+        self.slaves[slave] = Some(Slave {
+            master: ask.master,
+            table: call.table_id,
+            own: ask.own,
+            switch_own: None,
+            law,
+            cursor: ProfileCursor::default(),
+            active: false,
+            extended: call.extended == 1,
+            waiting: Some(timing),
+            switch: None,
+            scale: None,
+            master_before: master_at,
+            hold,
+            coupled_at: (master_at, hold),
+            follow_actual: ask.follow_actual,
+        });
+        accepted()
     }
 
     pub(super) fn table_weight(&mut self, request: &AcyclicRequest) -> HandlerResult {

@@ -205,21 +205,7 @@ impl CamEngine {
         }
         let slot = id as usize;
         if call.flags & CAM_ROWS_DECLARE != 0 {
-            // CamTableCreate: the table's type and size, for the rows that follow.
-            if call.count != 0 || call.total < 2 {
-                return code(TableErrorCode::NumRowsInvalid as u32);
-            }
-            if !matches!(call.table_type, 10 | 11) {
-                return code(TableErrorCode::McTableTypeInvalid as u32);
-            }
-            self.declared[slot] = Some((
-                call.table_type,
-                call.interpolation,
-                call.periodic,
-                call.total,
-            ));
-            self.rows_in[slot] = None;
-            return accepted();
+            return self.declare_rows(slot, &call);
         }
         if call.table_type == 0 {
             // Rows for a declared table (CamTableWriteData).
@@ -233,16 +219,48 @@ impl CamEngine {
             call.interpolation = interpolation;
             call.periodic = periodic;
         }
+        if let Err(e) = self.receive_rows(id, &call) {
+            return code(e);
+        }
+        if call.flags & CAM_CHUNK_LAST == 0 {
+            return accepted();
+        }
+        let transfer = self.rows_in[slot].take().expect("filled above");
+        self.store_rows(id, transfer)
+    }
+
+    /// CamTableCreate: the table's type and size, for the rows that follow.
+    fn declare_rows(&mut self, slot: usize, call: &CamRowsWriteCall) -> HandlerResult {
+        if call.count != 0 || call.total < 2 {
+            return code(TableErrorCode::NumRowsInvalid as u32);
+        }
+        if !matches!(call.table_type, 10 | 11) {
+            return code(TableErrorCode::McTableTypeInvalid as u32);
+        }
+        self.declared[slot] = Some((
+            call.table_type,
+            call.interpolation,
+            call.periodic,
+            call.total,
+        ));
+        self.rows_in[slot] = None;
+        accepted()
+    }
+
+    /// One chunk of rows for table `id` added to its transfer (the first chunk starts one);
+    /// `Err` is the refusal, which drops the transfer but for a missing one.
+    fn receive_rows(&mut self, id: u32, call: &CamRowsWriteCall) -> Result<(), u32> {
+        let slot = id as usize;
         let count = call.count as usize;
         if count == 0 || count > CAM_ROWS_PER_CALL || call.total == 0 {
             self.rows_in[slot] = None;
-            return code(TableErrorCode::NumRowsInvalid as u32);
+            return Err(TableErrorCode::NumRowsInvalid as u32);
         }
         if call.flags & CAM_CHUNK_FIRST != 0 {
             // A new transfer, refused at once for a table in use.
             if self.in_use(id) {
                 self.rows_in[slot] = None;
-                return code(CamCouplingError::TableInUse.raw());
+                return Err(CamCouplingError::TableInUse.raw());
             }
             self.rows_in[slot] = Some(RowsTransfer {
                 total: call.total,
@@ -253,7 +271,7 @@ impl CamEngine {
             });
         }
         let Some(transfer) = self.rows_in[slot].as_mut() else {
-            return code(CamCouplingError::ChunkOutOfOrder.raw());
+            return Err(CamCouplingError::ChunkOutOfOrder.raw());
         };
         let continues = transfer.total == call.total
             && transfer.table_type == call.table_type
@@ -263,13 +281,14 @@ impl CamEngine {
             && transfer.rows.len() + count <= call.total as usize;
         if !continues {
             self.rows_in[slot] = None;
-            return code(CamCouplingError::ChunkOutOfOrder.raw());
+            return Err(CamCouplingError::ChunkOutOfOrder.raw());
         }
         transfer.rows.extend_from_slice(&call.rows[..count]);
-        if call.flags & CAM_CHUNK_LAST == 0 {
-            return accepted();
-        }
-        let transfer = self.rows_in[slot].take().expect("filled above");
+        Ok(())
+    }
+
+    /// The last chunk came: the rows, checked whole, become table `id`.
+    fn store_rows(&mut self, id: u32, transfer: RowsTransfer) -> HandlerResult {
         if transfer.rows.len() != transfer.total as usize {
             return code(CamCouplingError::ChunkOutOfOrder.raw());
         }
@@ -298,7 +317,7 @@ impl CamEngine {
         ) {
             Ok(t) => {
                 let _ = self.store.insert(id, CamProfile::Table(t));
-                self.selects[slot] = None;
+                self.selects[id as usize] = None;
                 accepted()
             }
             Err(e) => code(e.code() as u32),

@@ -31,7 +31,7 @@ use super::engine::{Engine, EngineIo};
 use crate::axis::AxisSet;
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling, ScalingMode, StartMode};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
-use crate::cam::online::{ActivationMode, CamStore};
+use crate::cam::online::{ActivationMode, CamStore, MasterNow};
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode};
 use crate::setpoint::Kinematic;
 use data::{PointsTransfer, RowsTransfer};
@@ -327,6 +327,211 @@ impl CamEngine {
     }
 }
 
+impl CamEngine {
+    /// The multi-table slaves' set-points; a slave that lost its coupling or its master is
+    /// dropped.
+    fn tick_multis(&mut self, axes: &mut AxisSet) {
+        for i in 0..self.multis.len() {
+            let Some(multi) = self.multis[i].as_mut() else {
+                continue;
+            };
+            let still = cam_coupled(axes, i);
+            let master = axes.axis(multi.master).map(|a| a.setpoint());
+            let (true, Some(master)) = (still, master) else {
+                self.multis[i] = None;
+                continue;
+            };
+            let set = multi.law.slave(&self.store, &master);
+            if let Some(axis) = axes.axis_mut(i) {
+                axis.drive_coupled(set, AxisState::SlaveSynchronous);
+            }
+        }
+    }
+
+    /// Cam slave `i` for this tick: its set-point from the master's, after a due activation,
+    /// rescaling and switch; held while it waits, released when the law gives no finite
+    /// set-point.
+    fn tick_slave(&mut self, i: usize, axes: &mut AxisSet) {
+        let Some(state) = self.slaves[i].as_mut() else {
+            return;
+        };
+        // A slave that lost its coupling (fault, power off) is free again.
+        let still = cam_coupled(axes, i);
+        let master = master_of(axes, state.master, state.follow_actual);
+        let (true, Some(master)) = (still, master) else {
+            if let Some(gone) = self.slaves[i].take() {
+                self.retired.extend(gone.own);
+                self.retired.extend(gone.switch_own);
+            }
+            return;
+        };
+        let now = state.law.master_now(state.master_before, master.position);
+        let Ok(stored) = self.store.get(state.table) else {
+            return;
+        };
+        let mut set = state.setpoint(stored, &master);
+        if state.waiting.is_some_and(|t| t.due(now)) {
+            set = state.activate(stored, &master);
+        }
+        set = state.rescale_if_due(stored, &master, now, set);
+        let store = &self.store;
+        set = state.switch_if_due(store, &self.selects, &mut self.retired, &master, now, set);
+        // A law that cannot give a finite set-point (extreme scalings) releases the
+        // slave rather than pass the number on.
+        let finite = set.position.is_finite()
+            && set.velocity.is_finite()
+            && set.acceleration.is_finite()
+            && set.jerk.is_finite();
+        if !finite {
+            if let Some(axis) = axes.axis_mut(i) {
+                axis.decouple();
+            }
+            return;
+        }
+        let (set, phase) = if state.active {
+            (set, AxisState::SlaveSynchronous)
+        } else {
+            (
+                Kinematic {
+                    position: state.hold,
+                    ..Kinematic::default()
+                },
+                AxisState::SlavePrephase,
+            )
+        };
+        if let Some(axis) = axes.axis_mut(i) {
+            axis.drive_coupled(set, phase);
+        }
+        state.master_before = master.position;
+    }
+}
+
+impl Slave {
+    /// The set-point of the coupling as it stands, on its own copy of the table or the
+    /// stored one.
+    fn setpoint(&mut self, stored: &CamProfile, master: &Kinematic) -> Kinematic {
+        let profile = self.own.as_ref().unwrap_or(stored);
+        self.law.slave(profile, &mut self.cursor, master).0
+    }
+
+    /// A first coupling whose activation came becomes synchronous: relative sides start
+    /// from here, the cycle counter too. The set-point of the new law.
+    fn activate(&mut self, stored: &CamProfile, master: &Kinematic) -> Kinematic {
+        let profile = self.own.as_ref().unwrap_or(stored);
+        self.law = CamLaw::new(
+            profile,
+            self.law.scaling,
+            self.law.start,
+            self.law.periodic,
+            master.position,
+            self.hold,
+        );
+        self.active = true;
+        self.waiting = None;
+        self.coupled_at = (master.position, self.hold);
+        self.law.slave(profile, &mut self.cursor, master).0
+    }
+
+    /// A queued rescaling whose activation came applies (an active coupling only); the
+    /// set-point after it, else `set`.
+    fn rescale_if_due(
+        &mut self,
+        stored: &CamProfile,
+        master: &Kinematic,
+        now: MasterNow,
+        set: Kinematic,
+    ) -> Kinematic {
+        let Some(Queued::Scale {
+            requested,
+            keep,
+            modes,
+            activation,
+        }) = self.scale.filter(|_| self.active)
+        else {
+            return set;
+        };
+        if !activation.due(now) {
+            return set;
+        }
+        let profile = self.own.as_ref().unwrap_or(stored);
+        let law = self.law;
+        let scaling = merged_scaling(law.scaling, requested, keep, modes);
+        self.law = law.rescaled(
+            profile,
+            scaling,
+            modes,
+            law.start,
+            law.periodic,
+            master.position,
+            set.position,
+            false,
+        );
+        self.scale = None;
+        self.law.slave(profile, &mut self.cursor, master).0
+    }
+
+    /// A queued switch whose activation came moves the coupling to the other cam (an
+    /// active coupling only; the profile it leaves goes to `retired`); the set-point after
+    /// it, else `set`.
+    fn switch_if_due(
+        &mut self,
+        store: &CamStore,
+        selects: &[Option<Select>],
+        retired: &mut Vec<CamProfile>,
+        master: &Kinematic,
+        now: MasterNow,
+        set: Kinematic,
+    ) -> Kinematic {
+        let Some(Queued::Switch {
+            table,
+            scaling,
+            modes,
+            start,
+            activation,
+        }) = self.switch.filter(|_| self.active)
+        else {
+            return set;
+        };
+        if !activation.due(now) {
+            return set;
+        }
+        let mut set = set;
+        let stored_next = store.get(table).ok();
+        if let Some(next) = self.switch_own.as_ref().or(stored_next) {
+            let periodic = periodic_of(selects, table, next);
+            let law = self.law;
+            self.law = law.rescaled(
+                next,
+                scaling,
+                modes,
+                start,
+                periodic,
+                master.position,
+                set.position,
+                true,
+            );
+            self.table = table;
+            self.cursor = ProfileCursor::default();
+            set = self.law.slave(next, &mut self.cursor, master).0;
+            // The switched-to cam's own copy becomes the coupling's.
+            let next_own = self.switch_own.take();
+            if let Some(old) = core::mem::replace(&mut self.own, next_own) {
+                retired.push(old);
+            }
+        }
+        self.switch = None;
+        set
+    }
+}
+
+/// Whether axis `i` is coupled through a cam (the axis layer drops a coupling on a fault or
+/// power off).
+fn cam_coupled(axes: &AxisSet, i: usize) -> bool {
+    axes.axis(i)
+        .and_then(|a| a.coupling())
+        .is_some_and(|c| c.kind == CouplingState::Cam)
+}
+
 impl Engine for CamEngine {
     fn name(&self) -> &'static str {
         "cam"
@@ -337,151 +542,10 @@ impl Engine for CamEngine {
     }
 
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
-        for i in 0..self.multis.len() {
-            let Some(multi) = self.multis[i].as_mut() else {
-                continue;
-            };
-            let still = io
-                .axes
-                .axis(i)
-                .and_then(|a| a.coupling())
-                .is_some_and(|c| c.kind == CouplingState::Cam);
-            let master = io.axes.axis(multi.master).map(|a| a.setpoint());
-            let (true, Some(master)) = (still, master) else {
-                self.multis[i] = None;
-                continue;
-            };
-            let set = multi.law.slave(&self.store, &master);
-            if let Some(axis) = io.axes.axis_mut(i) {
-                axis.drive_coupled(set, AxisState::SlaveSynchronous);
-            }
-        }
+        self.tick_multis(io.axes);
         self.apply_point_changes(io.axes);
         for i in 0..self.slaves.len() {
-            let Some(state) = self.slaves[i].as_mut() else {
-                continue;
-            };
-            // A slave that lost its coupling (fault, power off) is free again.
-            let still = io
-                .axes
-                .axis(i)
-                .and_then(|a| a.coupling())
-                .is_some_and(|c| c.kind == CouplingState::Cam);
-            let master = master_of(io.axes, state.master, state.follow_actual);
-            let (true, Some(master)) = (still, master) else {
-                if let Some(gone) = self.slaves[i].take() {
-                    self.retired.extend(gone.own);
-                    self.retired.extend(gone.switch_own);
-                }
-                continue;
-            };
-            let now = state.law.master_now(state.master_before, master.position);
-            let Ok(stored) = self.store.get(state.table) else {
-                continue;
-            };
-            let profile = state.own.as_ref().unwrap_or(stored);
-            let (mut set, _) = state.law.slave(profile, &mut state.cursor, &master);
-            if state.waiting.is_some_and(|t| t.due(now)) {
-                // Relative sides start from here; the cycle counter too.
-                state.law = CamLaw::new(
-                    profile,
-                    state.law.scaling,
-                    state.law.start,
-                    state.law.periodic,
-                    master.position,
-                    state.hold,
-                );
-                state.active = true;
-                state.waiting = None;
-                state.coupled_at = (master.position, state.hold);
-                set = state.law.slave(profile, &mut state.cursor, &master).0;
-            }
-            if let Some(Queued::Scale {
-                requested,
-                keep,
-                modes,
-                activation,
-            }) = state.scale.filter(|_| state.active)
-            {
-                if activation.due(now) {
-                    let law = state.law;
-                    let scaling = merged_scaling(law.scaling, requested, keep, modes);
-                    state.law = law.rescaled(
-                        profile,
-                        scaling,
-                        modes,
-                        law.start,
-                        law.periodic,
-                        master.position,
-                        set.position,
-                        false,
-                    );
-                    state.scale = None;
-                    set = state.law.slave(profile, &mut state.cursor, &master).0;
-                }
-            }
-            if let Some(Queued::Switch {
-                table,
-                scaling,
-                modes,
-                start,
-                activation,
-            }) = state.switch.filter(|_| state.active)
-            {
-                if activation.due(now) {
-                    let stored_next = self.store.get(table).ok();
-                    if let Some(next) = state.switch_own.as_ref().or(stored_next) {
-                        let periodic = periodic_of(&self.selects, table, next);
-                        let law = state.law;
-                        state.law = law.rescaled(
-                            next,
-                            scaling,
-                            modes,
-                            start,
-                            periodic,
-                            master.position,
-                            set.position,
-                            true,
-                        );
-                        state.table = table;
-                        state.cursor = ProfileCursor::default();
-                        set = state.law.slave(next, &mut state.cursor, &master).0;
-                        // The switched-to cam's own copy becomes the coupling's.
-                        let next_own = state.switch_own.take();
-                        if let Some(old) = core::mem::replace(&mut state.own, next_own) {
-                            self.retired.push(old);
-                        }
-                    }
-                    state.switch = None;
-                }
-            }
-            // A law that cannot give a finite set-point (extreme scalings) releases the
-            // slave rather than pass the number on.
-            let finite = set.position.is_finite()
-                && set.velocity.is_finite()
-                && set.acceleration.is_finite()
-                && set.jerk.is_finite();
-            if !finite {
-                if let Some(axis) = io.axes.axis_mut(i) {
-                    axis.decouple();
-                }
-                continue;
-            }
-            let (set, phase) = if state.active {
-                (set, AxisState::SlaveSynchronous)
-            } else {
-                (
-                    Kinematic {
-                        position: state.hold,
-                        ..Kinematic::default()
-                    },
-                    AxisState::SlavePrephase,
-                )
-            };
-            if let Some(axis) = io.axes.axis_mut(i) {
-                axis.drive_coupled(set, phase);
-            }
-            state.master_before = master.position;
+            self.tick_slave(i, io.axes);
         }
     }
 
