@@ -16,8 +16,8 @@
 //! (the three measured in turn within every repeat); the ratio is ours / rsruckig's.
 //! Run: `cargo bench -p cnc-core --bench saw`.
 
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw::{self, Limits, SawRequest, SyncOn};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
 use rsruckig::prelude::*;
 use std::hint::black_box;

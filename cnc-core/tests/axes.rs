@@ -4,10 +4,10 @@
 
 use cnc_core::axis::commands::{view_command, CommandView};
 use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::{AxisSet, Coupling};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::enums::{AxisError, AxisState, CouplingState, DirectionBits};
 use hli::layout::{HliAxis, NcDriveOut, NcEncoderIn};

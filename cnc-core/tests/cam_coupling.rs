@@ -3,13 +3,13 @@
 //! cyclic cam over many periods without drift, the validity tables of 5.1.16.13, and the
 //! automatic offsets of 5.1.16.14.
 
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, CouplingError,
     Scaling,
 };
 use cnc_core::cam::online::MasterNow;
 use cnc_core::cam::{CamProfile, PositionTable, ProfileCursor, TableType};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::cam::CamInterpolation;
 use hli::calls::cam::{CamScalingMode, CamStartMode};
 use proptest::prelude::*;

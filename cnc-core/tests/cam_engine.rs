@@ -4,9 +4,9 @@
 //! every refusal with its code while the axis keeps doing what it did.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::coupling::{CamLaw, Scaling};
 use cnc_core::cam::{CamProfile, ProfileCursor};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::cam::CamStartMode;
 use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall, CamTableSelectCall};
 use hli::calls::{AcyclicCall, CallKind};

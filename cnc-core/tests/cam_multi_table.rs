@@ -4,10 +4,10 @@
 //! ended at its cycle boundary with the stop table taking over without a jump, and the
 //! refusals.
 
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::cam::multi_table::{MultiTableError, MultiTableLaw, TableSpec, TableWeight};
 use cnc_core::cam::online::CamStore;
 use cnc_core::cam::{CamProfile, PositionTable, TableType};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::cam::CamInterpolation;
 
 fn table(rows: &[[f64; 2]]) -> CamProfile {

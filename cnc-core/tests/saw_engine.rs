@@ -5,8 +5,8 @@
 //! diagonal saw; the time-based phase.
 
 use cnc_core::app::scenario::{InProcess, Scenario};
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw;
+use cnc_core::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget,

@@ -3,8 +3,8 @@
 //! choose the polynomials the seed names; every refusal of chapter 13 and of the checks;
 //! property tests for the invariants (ends met exactly, no non-finite value, checks honest).
 
-use cnc_core::axis::generator::Kinematic;
 use cnc_core::saw::{self, Limits, Plan, SawRequest, Shape, SyncOn};
+use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
 use proptest::prelude::*;

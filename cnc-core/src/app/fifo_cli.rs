@@ -22,6 +22,7 @@ use hli::calls::fifo::{
 };
 use hli::calls::AcyclicCall;
 use hli::enums::FifoGroupState;
+use hli::layout::HliFifoGroupState;
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_OVERRIDE_FULL};
 use hli::views::{CncView, PlcView};
 use std::io::Write;
@@ -109,6 +110,53 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
     let (n, rows) = plc_shim::fifo_file::RowReader::open(&args.rows)
         .and_then(|r| r.read_all())
         .map_err(|e| Failure::File(e.to_string()))?;
+    check_args(args)?;
+    let mut machine = build_machine(args, n, &rows)?;
+    let memory = hli::segment::heap_image(0, n as u32);
+    machine.tick(&memory);
+    let view = CncView::new(&memory);
+    integrate(&mut machine, &view, args, n)?;
+    let mut feed = RowFeed {
+        rows: &rows,
+        n,
+        total: rows.len() / n,
+        written: 0,
+    };
+    feed.write(&mut machine, args.fifo_rows)?;
+    let code = call(&mut machine, &view, FifoStartCall::default());
+    if code != 0 {
+        return Err(refused("FiFoStart", code));
+    }
+    let mut trace = trace_header(n);
+    let (ticks, underrun_ticks) = run_job(args, &mut machine, &memory, &mut feed, &mut trace)?;
+    if let Some(path) = &args.trace {
+        std::fs::File::create(path)
+            .and_then(|mut f| f.write_all(trace.as_bytes()))
+            .map_err(|e| Failure::File(format!("{}: {e}", path.display())))?;
+    }
+    let last: Vec<String> = (0..n)
+        .map(|i| {
+            let p = machine
+                .axes()
+                .axis(i)
+                .map_or(0.0, |a| a.setpoint().position);
+            // + 0.0 turns -0 into 0.
+            format!("{:.4}", p + 0.0)
+        })
+        .collect();
+    Ok(format!(
+        "fifo: {} rows x {n} axes, T_f {} s, tick {} s, override {} %: {ticks} ticks ({:.3} s), {underrun_ticks} underrun ticks, end at [{}]",
+        feed.total,
+        args.tf,
+        args.cycle,
+        args.override_percent,
+        ticks as f64 * args.cycle,
+        last.join(", ")
+    ))
+}
+
+/// The override and the tick, checked.
+fn check_args(args: &FifoRunArgs) -> Result<(), Failure> {
     if !(args.override_percent > 0.0 && args.override_percent <= 100.0) {
         return Err(Failure::Refused(format!(
             "--override {}: above 0 (0 % never ends), at most 100",
@@ -121,6 +169,12 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
             args.cycle
         )));
     }
+    Ok(())
+}
+
+/// A machine of `n` ideal axes standing on the first row, without software limits (the file
+/// is the job), switched on, with one FIFO group of `n` columns.
+fn build_machine(args: &FifoRunArgs, n: usize, rows: &[f64]) -> Result<Machine, Failure> {
     let kind = match args.pt2 {
         Some(t0_s) => OverrideType::Pt2 { t0_s },
         None => OverrideType::Instant,
@@ -155,13 +209,20 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
                 .map_err(|e| Failure::Refused(format!("{e:?}")))?;
         }
     }
-    let memory = hli::segment::heap_image(0, n as u32);
-    machine.tick(&memory);
-    let view = CncView::new(&memory);
+    Ok(machine)
+}
+
+/// Every axis joins the group in its column, and the override is set.
+fn integrate(
+    machine: &mut Machine,
+    view: &CncView<'_>,
+    args: &FifoRunArgs,
+    n: usize,
+) -> Result<(), Failure> {
     for i in 0..n as u32 {
         let code = call(
-            &mut machine,
-            &view,
+            machine,
+            view,
             FifoIntegrateCall {
                 axis: i,
                 group_position: i + 1,
@@ -172,14 +233,31 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
         }
     }
     let ppm = (args.override_percent / 100.0 * f64::from(FIFO_OVERRIDE_FULL)).round() as u32;
-    let code = call(&mut machine, &view, FifoOverrideCall { override_ppm: ppm });
+    let code = call(machine, view, FifoOverrideCall { override_ppm: ppm });
     if code != 0 {
         return Err(refused("FiFoSetChannelOverride", code));
     }
-    let total = rows.len() / n;
-    let mut written = 0;
-    let write = |machine: &mut Machine, free: usize, written: &mut usize| -> Result<(), Failure> {
-        let count = (total - *written).min(free).min(FIFO_BLOCK_VALUES / n);
+    Ok(())
+}
+
+/// The file's rows, written into the group in blocks as a PLC would.
+struct RowFeed<'a> {
+    /// Every row, `n` values each.
+    rows: &'a [f64],
+    n: usize,
+    /// Rows in the file.
+    total: usize,
+    /// Rows written so far.
+    written: usize,
+}
+
+impl RowFeed<'_> {
+    /// Writes the next rows, at most `free` and one block.
+    fn write(&mut self, machine: &mut Machine, free: usize) -> Result<(), Failure> {
+        let n = self.n;
+        let count = (self.total - self.written)
+            .min(free)
+            .min(FIFO_BLOCK_VALUES / n);
         if count == 0 {
             return Ok(());
         }
@@ -189,18 +267,20 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
             rows: count as u32,
             overwrite: 0,
         };
-        let reply = machine.dispatch_rows(&header, &rows[*written * n..(*written + count) * n]);
+        let reply = machine.dispatch_rows(
+            &header,
+            &self.rows[self.written * n..(self.written + count) * n],
+        );
         if reply.error_id != 0 {
             return Err(refused("FiFoWrite", reply.error_id));
         }
-        *written += count;
+        self.written += count;
         Ok(())
-    };
-    write(&mut machine, args.fifo_rows, &mut written)?;
-    let code = call(&mut machine, &view, FifoStartCall::default());
-    if code != 0 {
-        return Err(refused("FiFoStart", code));
     }
+}
+
+/// The trace's header line.
+fn trace_header(n: usize) -> String {
     let mut trace = String::from("time,fill,override");
     for i in 0..n {
         trace.push_str(&format!(
@@ -208,57 +288,46 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
         ));
     }
     trace.push('\n');
+    trace
+}
+
+/// Ticks the machine until the job ends at rest, refilling the FIFO and tracing each tick;
+/// the ticks run and the group's underrun ticks.
+fn run_job(
+    args: &FifoRunArgs,
+    machine: &mut Machine,
+    memory: &hli::ImageMemory,
+    feed: &mut RowFeed<'_>,
+    trace: &mut String,
+) -> Result<(u64, u32), Failure> {
     // Watchdog: twice the job's duration at the override, plus the PT-2's settling.
-    let job = total as f64 * args.tf / (args.override_percent / 100.0);
+    let job = feed.total as f64 * args.tf / (args.override_percent / 100.0);
     let limit = (2.0 * job / args.cycle) as u64 + 100_000;
-    let plc = PlcView::new(&memory);
+    let plc = PlcView::new(memory);
     let mut ticks = 0u64;
     let mut underrun_ticks;
     loop {
-        machine.tick(&memory);
+        machine.tick(memory);
         ticks += 1;
         let s = plc
             .fifo_group(0)
             .map_err(|e| Failure::Refused(e.to_string()))?;
         underrun_ticks = s.underrun_ticks_r;
         if args.trace.is_some() {
-            trace.push_str(&format!(
-                "{:.6},{},{}",
-                ticks as f64 * args.cycle,
-                s.entries_r,
-                f64::from(s.override_r) / 1e4
-            ));
-            for i in 0..n {
-                let set = machine
-                    .axes()
-                    .axis(i)
-                    .map(|a| a.setpoint())
-                    .unwrap_or_default();
-                let direction = if set.velocity > 0.0 {
-                    1
-                } else if set.velocity < 0.0 {
-                    -1
-                } else {
-                    0
-                };
-                trace.push_str(&format!(
-                    ",{},{},{},{direction}",
-                    set.position, set.velocity, set.acceleration
-                ));
-            }
-            trace.push('\n');
+            trace_row(trace, machine, &s, ticks as f64 * args.cycle, feed.n);
         }
         if s.group_state_r == FifoGroupState::Error.raw() {
             return Err(refused("the group", s.error_id_r));
         }
         let at_end = s.flags_r & FIFO_FLAG_AT_END != 0 && s.entries_r <= 1;
-        if written == total && at_end {
+        if feed.written == feed.total && at_end {
             break;
         }
         // Whenever a quarter of the FIFO is free, as a PLC would refill it.
-        if s.free_r as usize >= (args.fifo_rows / 4).max(1) || total - written <= s.free_r as usize
+        if s.free_r as usize >= (args.fifo_rows / 4).max(1)
+            || feed.total - feed.written <= s.free_r as usize
         {
-            write(&mut machine, s.free_r as usize, &mut written)?;
+            feed.write(machine, s.free_r as usize)?;
         }
         if ticks > limit {
             return Err(Failure::Refused(format!(
@@ -266,27 +335,35 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
             )));
         }
     }
-    if let Some(path) = &args.trace {
-        std::fs::File::create(path)
-            .and_then(|mut f| f.write_all(trace.as_bytes()))
-            .map_err(|e| Failure::File(format!("{}: {e}", path.display())))?;
+    Ok((ticks, underrun_ticks))
+}
+
+/// One trace line at `time`: the group's fill and override, each axis's set-point and
+/// direction.
+fn trace_row(trace: &mut String, machine: &Machine, s: &HliFifoGroupState, time: f64, n: usize) {
+    trace.push_str(&format!(
+        "{:.6},{},{}",
+        time,
+        s.entries_r,
+        f64::from(s.override_r) / 1e4
+    ));
+    for i in 0..n {
+        let set = machine
+            .axes()
+            .axis(i)
+            .map(|a| a.setpoint())
+            .unwrap_or_default();
+        let direction = if set.velocity > 0.0 {
+            1
+        } else if set.velocity < 0.0 {
+            -1
+        } else {
+            0
+        };
+        trace.push_str(&format!(
+            ",{},{},{},{direction}",
+            set.position, set.velocity, set.acceleration
+        ));
     }
-    let last: Vec<String> = (0..n)
-        .map(|i| {
-            let p = machine
-                .axes()
-                .axis(i)
-                .map_or(0.0, |a| a.setpoint().position);
-            // + 0.0 turns -0 into 0.
-            format!("{:.4}", p + 0.0)
-        })
-        .collect();
-    Ok(format!(
-        "fifo: {total} rows x {n} axes, T_f {} s, tick {} s, override {} %: {ticks} ticks ({:.3} s), {underrun_ticks} underrun ticks, end at [{}]",
-        args.tf,
-        args.cycle,
-        args.override_percent,
-        ticks as f64 * args.cycle,
-        last.join(", ")
-    ))
+    trace.push('\n');
 }

@@ -15,8 +15,8 @@
 //! arguments or a trace that cannot be written.
 
 use super::json::number;
-use crate::axis::generator::Kinematic;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
+use crate::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
 use std::io::Write;

@@ -100,6 +100,9 @@ pub enum OutData3 {
     Torque,
 }
 
+/// The reason a value that must be positive gives.
+const POSITIVE: &str = "must be a finite number above 0";
+
 impl AxisConfig {
     /// `drive_out.nOutData3` for a set-point acceleration of `acceleration` units/s^2.
     pub fn out_data3(&self, acceleration: f64) -> f64 {
@@ -270,57 +273,82 @@ impl AxisConfig {
 
     /// Checks every value; the first one out of range is the error.
     pub fn validate(&self) -> Result<(), ConfigError> {
-        let positive = "must be a finite number above 0";
+        self.check_scalings()?;
+        self.check_dynamics()?;
+        self.check_controller()?;
+        self.check_kind_and_limits()?;
+        if let DriveLink::Simulated(sim) = self.drive {
+            sim.validate()
+                .map_err(|(field, value, reason)| ConfigError {
+                    axis: self.name.clone(),
+                    field,
+                    value,
+                    reason,
+                })?;
+        }
+        Ok(())
+    }
+
+    /// The increments per unit of position, velocity, acceleration and torque.
+    fn check_scalings(&self) -> Result<(), ConfigError> {
         self.check(
             "increments_per_unit",
             self.increments_per_unit,
             self.increments_per_unit > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "velocity_increments_per_unit",
             self.velocity_increments_per_unit,
             self.velocity_increments_per_unit > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "acceleration_increments_per_unit",
             self.acceleration_increments_per_unit,
             self.acceleration_increments_per_unit > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "io.torque_increments_per_percent",
             self.io.torque_increments_per_percent,
             self.io.torque_increments_per_percent > 0.0,
-            positive,
-        )?;
+            POSITIVE,
+        )
+    }
+
+    /// Velocity, acceleration, deceleration and jerk limits.
+    fn check_dynamics(&self) -> Result<(), ConfigError> {
         let d = self.dynamics;
-        self.check("dynamics.velocity", d.velocity, d.velocity > 0.0, positive)?;
+        self.check("dynamics.velocity", d.velocity, d.velocity > 0.0, POSITIVE)?;
         self.check(
             "dynamics.acceleration",
             d.acceleration,
             d.acceleration > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "dynamics.deceleration",
             d.deceleration,
             d.deceleration > 0.0,
-            positive,
+            POSITIVE,
         )?;
-        self.check("dynamics.jerk", d.jerk, d.jerk > 0.0, positive)?;
+        self.check("dynamics.jerk", d.jerk, d.jerk > 0.0, POSITIVE)
+    }
+
+    /// Following-error limit, in-target window, position gain, feed-forward.
+    fn check_controller(&self) -> Result<(), ConfigError> {
         self.check(
             "following_error_limit",
             self.following_error_limit,
             self.following_error_limit > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "in_target_window",
             self.in_target_window,
             self.in_target_window > 0.0,
-            positive,
+            POSITIVE,
         )?;
         self.check(
             "position_gain",
@@ -333,7 +361,11 @@ impl AxisConfig {
             self.feed_forward,
             (0.0..=1.0).contains(&self.feed_forward),
             "must lie in 0..=1",
-        )?;
+        )
+    }
+
+    /// A rotary axis's modulo, and the software limits (none on an endless axis).
+    fn check_kind_and_limits(&self) -> Result<(), ConfigError> {
         if let AxisKind::Rotary { modulo } = self.kind {
             self.check(
                 "kind.modulo",
@@ -358,15 +390,6 @@ impl AxisConfig {
                 "must be below the upper limit",
             )?;
             self.check("soft_limits[1]", max, true, "must be finite")?;
-        }
-        if let DriveLink::Simulated(sim) = self.drive {
-            sim.validate()
-                .map_err(|(field, value, reason)| ConfigError {
-                    axis: self.name.clone(),
-                    field,
-                    value,
-                    reason,
-                })?;
         }
         Ok(())
     }

@@ -13,34 +13,8 @@
 //! [`SetpointGenerator::set_jerk_ceiling`]); a state reached under the axis limits then never
 //! leads above the axis's maximum velocity.
 
+use crate::setpoint::Kinematic;
 use rsruckig::prelude::*;
-
-/// Position, velocity, acceleration and jerk of a set-point.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Kinematic {
-    /// Position (mm or degree).
-    pub position: f64,
-    /// Velocity per second.
-    pub velocity: f64,
-    /// Acceleration per second squared.
-    pub acceleration: f64,
-    /// Jerk per second cubed.
-    pub jerk: f64,
-}
-
-impl Kinematic {
-    /// The slave of a linear coupling to this master set-point: `s0 + ratio (m - m0)`,
-    /// velocity, acceleration and jerk scaled alike (gears, the flying saw's synchronous
-    /// phase).
-    pub fn geared(&self, ratio: f64, (m0, s0): (f64, f64)) -> Kinematic {
-        Kinematic {
-            position: s0 + ratio * (self.position - m0),
-            velocity: ratio * self.velocity,
-            acceleration: ratio * self.acceleration,
-            jerk: ratio * self.jerk,
-        }
-    }
-}
 
 /// The limits of one move, all strictly positive.
 #[derive(Debug, Clone, Copy, PartialEq)]

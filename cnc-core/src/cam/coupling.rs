@@ -24,7 +24,7 @@
 
 use super::online::{ActivationMode, MasterNow};
 use super::{CamProfile, ProfileCursor};
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 use hli::calls::cam::{CamActivationMode, CamScalingMode, CamStartMode};
 
 /// `MC_CamActivationMode` as couplings and scalings use it (the online change of points uses

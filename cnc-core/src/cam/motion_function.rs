@@ -215,110 +215,19 @@ impl MotionFunction {
         if points.is_empty() {
             return Err(CamError::TooFewPoints { active: 0 });
         }
-        // Points in order; an IGNORE point takes no part beyond its index and type.
-        let mut kept: Vec<(MotionFunctionPoint, PointType)> = Vec::new();
-        for (i, p) in points.iter().enumerate() {
-            let expected = 1 + i as u32;
-            if p.index != expected {
-                return Err(CamError::PointIndex {
-                    found: p.index,
-                    expected,
-                });
-            }
-            let point_type =
-                PointType::from_raw(p.point_type).ok_or(CamError::UnknownPointType {
-                    point: p.index,
-                    raw: p.point_type,
-                })?;
-            if point_type == PointType::Ignore {
-                continue;
-            }
-            for (value, field) in [
-                (p.master, Field::Master),
-                (p.slave, Field::Slave),
-                (p.velocity, Field::Velocity),
-                (p.acceleration, Field::Acceleration),
-                (p.jerk, Field::Jerk),
-            ] {
-                if !value.is_finite() {
-                    return Err(CamError::PointNotFinite {
-                        point: p.index,
-                        field,
-                    });
-                }
-            }
-            check_rel_index(points, i)?;
-            kept.push((*p, point_type));
-        }
+        let kept = kept_points(points)?;
         if kept.len() < 2 {
             return Err(CamError::TooFewPoints { active: kept.len() });
         }
-        // Every active point but the last starts a segment: its law must be known. The last
-        // one's function type is not used.
-        let mut active: Vec<(MotionFunctionPoint, FunctionType, PointType)> =
-            Vec::with_capacity(kept.len());
-        for (k, (p, point_type)) in kept.iter().enumerate() {
-            let function = match FunctionType::from_raw(p.function) {
-                Some(f) => f,
-                None if k + 1 == kept.len() => FunctionType::Polynom1,
-                None => {
-                    return Err(CamError::UnknownFunctionType {
-                        point: p.index,
-                        raw: p.function,
-                    })
-                }
-            };
-            active.push((*p, function, *point_type));
-        }
+        let active = with_laws(&kept)?;
         let sign = if active[1].0.master > active[0].0.master {
             1.0
         } else {
             -1.0
         };
-        for w in active.windows(2) {
-            // Finite by now: a plain comparison is exact.
-            if (w[1].0.master - w[0].0.master) * sign <= 0.0 {
-                return Err(CamError::MasterNotMonotonic {
-                    point: w[1].0.index,
-                    master: w[1].0.master,
-                    previous: w[0].0.master,
-                });
-            }
-        }
+        check_monotonic(&active, sign)?;
         let ends = settle(&active, sign)?;
-        let mut pieces = Vec::new();
-        let mut segments = Vec::new();
-        for (k, w) in active.windows(2).enumerate() {
-            let (p, law, _) = w[0];
-            let q = w[1].0;
-            let symmetry = if law.has_symmetry() { p.jerk } else { 0.0 };
-            if law.has_symmetry() && symmetry.abs() >= 0.5 {
-                return Err(CamError::Symmetry {
-                    point: p.index,
-                    value: p.jerk,
-                });
-            }
-            let spec = SegmentSpec {
-                law,
-                x0: sign * p.master,
-                x1: sign * q.master,
-                start: ends[k],
-                end: ends[k + 1],
-                symmetry,
-            };
-            let built = law::build(&spec).ok_or(CamError::Unbuildable { point: p.index })?;
-            let first = pieces.len();
-            pieces.extend(built);
-            segments.push(Segment {
-                from_point: p.index,
-                to_point: q.index,
-                law,
-                start: unflip(ends[k], sign),
-                end: unflip(ends[k + 1], sign),
-                master: (p.master, q.master),
-                pieces: first..pieces.len(),
-            });
-        }
+        let (pieces, segments) = build_segments(&active, sign, &ends)?;
         Ok(MotionFunction {
             points: points.to_vec(),
             segments,
@@ -402,6 +311,131 @@ impl MotionFunction {
     }
 }
 
+/// The points in order with their types, checked (index, type, finite values, relative
+/// index); an IGNORE point takes no part beyond its index and type.
+fn kept_points(
+    points: &[MotionFunctionPoint],
+) -> Result<Vec<(MotionFunctionPoint, PointType)>, CamError> {
+    let mut kept: Vec<(MotionFunctionPoint, PointType)> = Vec::new();
+    for (i, p) in points.iter().enumerate() {
+        let expected = 1 + i as u32;
+        if p.index != expected {
+            return Err(CamError::PointIndex {
+                found: p.index,
+                expected,
+            });
+        }
+        let point_type = PointType::from_raw(p.point_type).ok_or(CamError::UnknownPointType {
+            point: p.index,
+            raw: p.point_type,
+        })?;
+        if point_type == PointType::Ignore {
+            continue;
+        }
+        for (value, field) in [
+            (p.master, Field::Master),
+            (p.slave, Field::Slave),
+            (p.velocity, Field::Velocity),
+            (p.acceleration, Field::Acceleration),
+            (p.jerk, Field::Jerk),
+        ] {
+            if !value.is_finite() {
+                return Err(CamError::PointNotFinite {
+                    point: p.index,
+                    field,
+                });
+            }
+        }
+        check_rel_index(points, i)?;
+        kept.push((*p, point_type));
+    }
+    Ok(kept)
+}
+
+/// The active points with the law each starts: every active point but the last starts a
+/// segment, its law must be known; the last one's function type is not used.
+fn with_laws(
+    kept: &[(MotionFunctionPoint, PointType)],
+) -> Result<Vec<(MotionFunctionPoint, FunctionType, PointType)>, CamError> {
+    let mut active: Vec<(MotionFunctionPoint, FunctionType, PointType)> =
+        Vec::with_capacity(kept.len());
+    for (k, (p, point_type)) in kept.iter().enumerate() {
+        let function = match FunctionType::from_raw(p.function) {
+            Some(f) => f,
+            None if k + 1 == kept.len() => FunctionType::Polynom1,
+            None => {
+                return Err(CamError::UnknownFunctionType {
+                    point: p.index,
+                    raw: p.function,
+                })
+            }
+        };
+        active.push((*p, function, *point_type));
+    }
+    Ok(active)
+}
+
+/// The master positions run strictly in the direction `sign`.
+fn check_monotonic(
+    active: &[(MotionFunctionPoint, FunctionType, PointType)],
+    sign: f64,
+) -> Result<(), CamError> {
+    for w in active.windows(2) {
+        // Finite by now: a plain comparison is exact.
+        if (w[1].0.master - w[0].0.master) * sign <= 0.0 {
+            return Err(CamError::MasterNotMonotonic {
+                point: w[1].0.index,
+                master: w[1].0.master,
+                previous: w[0].0.master,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The pieces of every segment between active points, built from the settled `ends`, and
+/// the segments over them.
+fn build_segments(
+    active: &[(MotionFunctionPoint, FunctionType, PointType)],
+    sign: f64,
+    ends: &[EndState],
+) -> Result<(Vec<Piece>, Vec<Segment>), CamError> {
+    let mut pieces = Vec::new();
+    let mut segments = Vec::new();
+    for (k, w) in active.windows(2).enumerate() {
+        let (p, law, _) = w[0];
+        let q = w[1].0;
+        let symmetry = if law.has_symmetry() { p.jerk } else { 0.0 };
+        if law.has_symmetry() && symmetry.abs() >= 0.5 {
+            return Err(CamError::Symmetry {
+                point: p.index,
+                value: p.jerk,
+            });
+        }
+        let spec = SegmentSpec {
+            law,
+            x0: sign * p.master,
+            x1: sign * q.master,
+            start: ends[k],
+            end: ends[k + 1],
+            symmetry,
+        };
+        let built = law::build(&spec).ok_or(CamError::Unbuildable { point: p.index })?;
+        let first = pieces.len();
+        pieces.extend(built);
+        segments.push(Segment {
+            from_point: p.index,
+            to_point: q.index,
+            law,
+            start: unflip(ends[k], sign),
+            end: unflip(ends[k + 1], sign),
+            master: (p.master, q.master),
+            pieces: first..pieces.len(),
+        });
+    }
+    Ok((pieces, segments))
+}
+
 fn unflip(e: EndState, sign: f64) -> EndState {
     EndState {
         y: e.y,
@@ -462,103 +496,144 @@ fn settle(
     active: &[(MotionFunctionPoint, FunctionType, PointType)],
     sign: f64,
 ) -> Result<Vec<EndState>, CamError> {
-    let n = active.len();
-    let mut v = Vec::with_capacity(n);
-    let mut a = Vec::with_capacity(n);
-    let mut j = Vec::with_capacity(n);
-    for (k, (p, _, ty)) in active.iter().enumerate() {
-        // The jerk field of a point that starts a law with symmetry is that symmetry.
-        let starts_symmetric = k + 1 < n && active[k].1.has_symmetry();
-        let user_jerk = if starts_symmetric { 0.0 } else { sign * p.jerk };
-        let (kv, ka, kj) = match ty {
-            PointType::Rest => (Known::Fixed(0.0), Known::Fixed(0.0), Known::Fixed(0.0)),
-            PointType::Velocity => (
-                Known::User(sign * p.velocity),
-                Known::Fixed(0.0),
-                Known::Fixed(0.0),
-            ),
-            PointType::Turn => (
-                Known::Fixed(0.0),
-                Known::User(p.acceleration),
-                Known::User(user_jerk),
-            ),
-            _ => (
-                Known::User(sign * p.velocity),
-                Known::User(p.acceleration),
-                Known::User(user_jerk),
-            ),
-        };
-        v.push(kv);
-        a.push(ka);
-        j.push(kj);
-    }
+    let mut known = Settling::at_points(active, sign);
     // Velocities (and the line's zero jerk) do not depend on anything else.
-    for k in 0..n - 1 {
-        let (p, law, _) = active[k];
-        let q = active[k + 1].0;
-        let (start, end) = law.ends();
-        let slope = (q.slave - p.slave) / (sign * (q.master - p.master));
-        for (kind, at, by) in [
-            (start, k, Demand::SegmentAfter),
-            (end, k + 1, Demand::SegmentBefore),
-        ] {
-            let point = active[at].0.index;
-            match kind {
-                EndKind::Line => {
-                    v[at].demand(slope, by, point, Field::Velocity)?;
-                    a[at].demand(0.0, by, point, Field::Acceleration)?;
-                    j[at].demand(0.0, by, point, Field::Jerk)?;
-                }
-                EndKind::Rest | EndKind::Turn => v[at].demand(0.0, by, point, Field::Velocity)?,
-                EndKind::Velocity => a[at].demand(0.0, by, point, Field::Acceleration)?,
-                EndKind::Motion => {}
-            }
-            // A 3rd-order polynomial cannot also end with zero acceleration (seed: it is a
-            // rest-to-rest law all the same); every other rest end demands it.
-            if kind == EndKind::Rest && law != FunctionType::Polynom3 {
-                a[at].demand(0.0, by, point, Field::Acceleration)?;
-            }
-        }
-    }
+    known.law_ends(active, sign)?;
     // Turn ends produce their acceleration from the settled velocities.
-    for k in 0..n - 1 {
-        let (p, law, _) = active[k];
-        let q = active[k + 1].0;
-        let (start, end) = law.ends();
-        if start != EndKind::Turn && end != EndKind::Turn {
-            continue;
-        }
-        let state = |at: usize, y: f64| EndState {
-            y,
-            v: v[at].value(),
-            a: 0.0,
-            j: 0.0,
-        };
-        let spec = SegmentSpec {
-            law,
-            x0: sign * p.master,
-            x1: sign * q.master,
-            start: state(k, p.slave),
-            end: state(k + 1, q.slave),
-            symmetry: 0.0,
-        };
-        let pieces = law::build(&spec).ok_or(CamError::Unbuildable { point: p.index })?;
-        if start == EndKind::Turn {
-            let acc = pieces[0].eval(spec.x0)[2];
-            a[k].demand(acc, Demand::SegmentAfter, p.index, Field::Acceleration)?;
-        }
-        if end == EndKind::Turn {
-            let last = &pieces[pieces.len() - 1];
-            let acc = last.eval(spec.x1)[2];
-            a[k + 1].demand(acc, Demand::SegmentBefore, q.index, Field::Acceleration)?;
-        }
-    }
-    Ok((0..n)
+    known.turn_ends(active, sign)?;
+    Ok((0..active.len())
         .map(|k| EndState {
             y: active[k].0.slave,
-            v: v[k].value(),
-            a: a[k].value(),
-            j: j[k].value(),
+            v: known.v[k].value(),
+            a: known.a[k].value(),
+            j: known.j[k].value(),
         })
         .collect())
+}
+
+/// Velocity, acceleration and jerk at each active point while they are settled.
+struct Settling {
+    v: Vec<Known>,
+    a: Vec<Known>,
+    j: Vec<Known>,
+}
+
+impl Settling {
+    /// What each point's type fixes and its user values give.
+    fn at_points(active: &[(MotionFunctionPoint, FunctionType, PointType)], sign: f64) -> Self {
+        let n = active.len();
+        let mut v = Vec::with_capacity(n);
+        let mut a = Vec::with_capacity(n);
+        let mut j = Vec::with_capacity(n);
+        for (k, (p, _, ty)) in active.iter().enumerate() {
+            // The jerk field of a point that starts a law with symmetry is that symmetry.
+            let starts_symmetric = k + 1 < n && active[k].1.has_symmetry();
+            let user_jerk = if starts_symmetric { 0.0 } else { sign * p.jerk };
+            let (kv, ka, kj) = match ty {
+                PointType::Rest => (Known::Fixed(0.0), Known::Fixed(0.0), Known::Fixed(0.0)),
+                PointType::Velocity => (
+                    Known::User(sign * p.velocity),
+                    Known::Fixed(0.0),
+                    Known::Fixed(0.0),
+                ),
+                PointType::Turn => (
+                    Known::Fixed(0.0),
+                    Known::User(p.acceleration),
+                    Known::User(user_jerk),
+                ),
+                _ => (
+                    Known::User(sign * p.velocity),
+                    Known::User(p.acceleration),
+                    Known::User(user_jerk),
+                ),
+            };
+            v.push(kv);
+            a.push(ka);
+            j.push(kj);
+        }
+        Settling { v, a, j }
+    }
+
+    /// What each segment's law demands at its ends: a line its slope and no acceleration or
+    /// jerk, rest and turn ends no velocity, velocity ends no acceleration, rest ends no
+    /// acceleration (but the 3rd-order polynomial's).
+    fn law_ends(
+        &mut self,
+        active: &[(MotionFunctionPoint, FunctionType, PointType)],
+        sign: f64,
+    ) -> Result<(), CamError> {
+        let (v, a, j) = (&mut self.v, &mut self.a, &mut self.j);
+        for k in 0..active.len() - 1 {
+            let (p, law, _) = active[k];
+            let q = active[k + 1].0;
+            let (start, end) = law.ends();
+            let slope = (q.slave - p.slave) / (sign * (q.master - p.master));
+            for (kind, at, by) in [
+                (start, k, Demand::SegmentAfter),
+                (end, k + 1, Demand::SegmentBefore),
+            ] {
+                let point = active[at].0.index;
+                match kind {
+                    EndKind::Line => {
+                        v[at].demand(slope, by, point, Field::Velocity)?;
+                        a[at].demand(0.0, by, point, Field::Acceleration)?;
+                        j[at].demand(0.0, by, point, Field::Jerk)?;
+                    }
+                    EndKind::Rest | EndKind::Turn => {
+                        v[at].demand(0.0, by, point, Field::Velocity)?
+                    }
+                    EndKind::Velocity => a[at].demand(0.0, by, point, Field::Acceleration)?,
+                    EndKind::Motion => {}
+                }
+                // A 3rd-order polynomial cannot also end with zero acceleration (seed: it is a
+                // rest-to-rest law all the same); every other rest end demands it.
+                if kind == EndKind::Rest && law != FunctionType::Polynom3 {
+                    a[at].demand(0.0, by, point, Field::Acceleration)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The acceleration a turn end produces, from the law built on the settled velocities.
+    fn turn_ends(
+        &mut self,
+        active: &[(MotionFunctionPoint, FunctionType, PointType)],
+        sign: f64,
+    ) -> Result<(), CamError> {
+        let (v, a) = (&self.v, &mut self.a);
+        for k in 0..active.len() - 1 {
+            let (p, law, _) = active[k];
+            let q = active[k + 1].0;
+            let (start, end) = law.ends();
+            if start != EndKind::Turn && end != EndKind::Turn {
+                continue;
+            }
+            let state = |at: usize, y: f64| EndState {
+                y,
+                v: v[at].value(),
+                a: 0.0,
+                j: 0.0,
+            };
+            let spec = SegmentSpec {
+                law,
+                x0: sign * p.master,
+                x1: sign * q.master,
+                start: state(k, p.slave),
+                end: state(k + 1, q.slave),
+                symmetry: 0.0,
+            };
+            let pieces = law::build(&spec).ok_or(CamError::Unbuildable { point: p.index })?;
+            if start == EndKind::Turn {
+                let acc = pieces[0].eval(spec.x0)[2];
+                a[k].demand(acc, Demand::SegmentAfter, p.index, Field::Acceleration)?;
+            }
+            if end == EndKind::Turn {
+                let last = &pieces[pieces.len() - 1];
+                let acc = last.eval(spec.x1)[2];
+                a[k + 1].demand(acc, Demand::SegmentBefore, q.index, Field::Acceleration)?;
+            }
+        }
+        Ok(())
+    }
 }

@@ -22,7 +22,7 @@
 
 use super::online::CamStore;
 use super::{CamProfile, ProfileCursor};
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 
 /// Tables of one multi-table slave.
 pub const MAX_MULTI_TABLES: usize = 8;
@@ -263,7 +263,6 @@ impl MultiTableLaw {
     /// The slave's set-point for the master's set-point `m`, the tables taken from `store`
     /// (a table gone from it counts as standing still).
     pub fn slave(&mut self, store: &CamStore, m: &Kinematic) -> Kinematic {
-        let cam = |id: u32| store.get(id).ok();
         let before = self.master_before;
         self.master_before = m.position;
         // Profile tables whose range holds the master. A cyclic one asked to stop ends at its
@@ -272,42 +271,8 @@ impl MultiTableLaw {
         let mut profile_sum = Kinematic::default();
         let mut any_profile = false;
         for _pass in 0..2 {
-            let mut handed_over = false;
-            profile_sum = Kinematic::default();
-            any_profile = false;
-            for i in 0..MAX_MULTI_TABLES {
-                let Some(mut e) = self.entries[i] else {
-                    continue;
-                };
-                let Some(p) = cam(e.table) else { continue };
-                if !e.profile {
-                    continue;
-                }
-                if !(e.w.range_low <= m.position && m.position < e.w.range_high) {
-                    // Out of its range: its cycle count starts afresh when it comes back.
-                    if let Some(out) = self.entries[i].as_mut() {
-                        out.last_cycle = None;
-                    }
-                    continue;
-                }
-                let (c, cycle) = contribution(&mut e, p, m);
-                let previous = e.last_cycle.replace(cycle);
-                if let (true, true, Some(prev)) = (e.periodic, e.stop_at_cycle_end, previous) {
-                    if prev != cycle {
-                        // The boundary crossed is the start of the later cycle.
-                        let reached = value_at_cycle_start(&e, p, prev.max(cycle));
-                        e.w.range_high = m.position;
-                        e.stop_at_cycle_end = false;
-                        self.entries[i] = Some(e);
-                        self.hand_over(i, m.position, reached, store);
-                        handed_over = true;
-                        continue;
-                    }
-                }
-                self.entries[i] = Some(e);
-                add(&mut profile_sum, &c);
-                any_profile = true;
-            }
+            let handed_over;
+            (profile_sum, any_profile, handed_over) = self.profile_pass(store, m);
             if !handed_over {
                 break;
             }
@@ -322,6 +287,65 @@ impl MultiTableLaw {
             }
         };
         // Corrections beside the profile.
+        self.add_corrections(store, m, before, &mut out);
+        out.position += self.kept;
+        out
+    }
+
+    /// One pass over the profile tables: the sum of those whose range holds the master,
+    /// whether any does, and whether a cyclic one ended and handed over.
+    fn profile_pass(&mut self, store: &CamStore, m: &Kinematic) -> (Kinematic, bool, bool) {
+        let cam = |id: u32| store.get(id).ok();
+        let mut handed_over = false;
+        let mut profile_sum = Kinematic::default();
+        let mut any_profile = false;
+        for i in 0..MAX_MULTI_TABLES {
+            let Some(mut e) = self.entries[i] else {
+                continue;
+            };
+            let Some(p) = cam(e.table) else { continue };
+            if !e.profile {
+                continue;
+            }
+            if !(e.w.range_low <= m.position && m.position < e.w.range_high) {
+                // Out of its range: its cycle count starts afresh when it comes back.
+                if let Some(out) = self.entries[i].as_mut() {
+                    out.last_cycle = None;
+                }
+                continue;
+            }
+            let (c, cycle) = contribution(&mut e, p, m);
+            let previous = e.last_cycle.replace(cycle);
+            if let (true, true, Some(prev)) = (e.periodic, e.stop_at_cycle_end, previous) {
+                if prev != cycle {
+                    // The boundary crossed is the start of the later cycle.
+                    let reached = value_at_cycle_start(&e, p, prev.max(cycle));
+                    e.w.range_high = m.position;
+                    e.stop_at_cycle_end = false;
+                    self.entries[i] = Some(e);
+                    self.hand_over(i, m.position, reached, store);
+                    handed_over = true;
+                    continue;
+                }
+            }
+            self.entries[i] = Some(e);
+            add(&mut profile_sum, &c);
+            any_profile = true;
+        }
+        (profile_sum, any_profile, handed_over)
+    }
+
+    /// The corrections running at master position `m` (the master stood at `before` last
+    /// tick) added to `out`: armed ones start when the master passes their position, a
+    /// correction that ran through leaves what it added in `kept`.
+    fn add_corrections(
+        &mut self,
+        store: &CamStore,
+        m: &Kinematic,
+        before: f64,
+        out: &mut Kinematic,
+    ) {
+        let cam = |id: u32| store.get(id).ok();
         for i in 0..MAX_MULTI_TABLES {
             let Some(mut e) = self.entries[i] else {
                 continue;
@@ -365,13 +389,11 @@ impl MultiTableLaw {
                     self.kept += c.position;
                     e.run = Run::Idle;
                 } else {
-                    add(&mut out, &c);
+                    add(out, &c);
                 }
             }
             self.entries[i] = Some(e);
         }
-        out.position += self.kept;
-        out
     }
 
     /// Cyclic profile table `ended` ended at master position `at` with its contribution

@@ -264,35 +264,68 @@ impl ChannelConfig {
 
     /// Checks everything and builds the kinematics.
     pub fn build_kinematics(&self) -> Result<Box<dyn Kinematics + Send>, ChannelConfigError> {
-        let channel = self.name.clone();
         check_channel_axes(&self.axes).map_err(|reason| ChannelConfigError::Axes {
-            channel: channel.clone(),
+            channel: self.name.clone(),
             reason,
         })?;
-        let parameter = |name, value: f64, reason| ChannelConfigError::Parameter {
-            channel: channel.clone(),
+        self.check_limits()?;
+        self.check_nc_data()?;
+        self.check_channel_data()?;
+        let order = self.order()?;
+        if self.axes.len() < 6 {
+            return Err(ChannelConfigError::TooFewAxes {
+                channel: self.name.clone(),
+                id: self.kinematics.id,
+                found: self.axes.len(),
+            });
+        }
+        self.kinematics
+            .build(order)
+            .map_err(|reason| ChannelConfigError::Kinematics {
+                channel: self.name.clone(),
+                reason,
+            })
+    }
+
+    /// Parameter `name` of this channel refused: its value and why.
+    fn parameter(
+        &self,
+        name: &'static str,
+        value: f64,
+        reason: &'static str,
+    ) -> ChannelConfigError {
+        ChannelConfigError::Parameter {
+            channel: self.name.clone(),
             name,
             value,
             reason,
-        };
+        }
+    }
+
+    /// The dynamic limits, positive and finite, at most one entry per axis.
+    fn check_limits(&self) -> Result<(), ChannelConfigError> {
         for (name, l) in core::iter::once(("limits", &self.limits))
             .chain(self.axis_limits.iter().map(|l| ("axis_limits", l)))
         {
             for v in [l.velocity, l.acceleration, l.jerk] {
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(parameter(name, v, "must be positive and finite"));
+                    return Err(self.parameter(name, v, "must be positive and finite"));
                 }
             }
         }
         if self.axis_limits.len() > self.axes.len() {
-            return Err(parameter(
+            return Err(self.parameter(
                 "axis_limits",
                 self.axis_limits.len() as f64,
                 "at most one entry per axis",
             ));
         }
-        // The NC machine data: a tolerance that is not a positive number would let every arc
-        // through, or none.
+        Ok(())
+    }
+
+    /// The NC machine data: tolerances, zero offsets, tool records.
+    fn check_nc_data(&self) -> Result<(), ChannelConfigError> {
+        // A tolerance that is not a positive number would let every arc through, or none.
         let tolerances = [
             (
                 "interpolator.chordal_tolerance",
@@ -307,14 +340,14 @@ impl ChannelConfig {
         ];
         for (name, v) in tolerances {
             if !(v.is_finite() && v > 0.0) {
-                return Err(parameter(name, v, "must be positive and finite"));
+                return Err(self.parameter(name, v, "must be positive and finite"));
             }
         }
         let z = &self.nc.zero_offsets;
         let offsets = [&z.g54, &z.g55, &z.g56, &z.g57, &z.g58, &z.g59];
         for v in offsets.iter().flat_map(|o| o.iter()) {
             if !v.is_finite() || offsets.iter().any(|o| o.len() > self.axes.len()) {
-                return Err(parameter(
+                return Err(self.parameter(
                     "nc.zero_offsets",
                     *v,
                     "must be finite, at most one value per channel axis",
@@ -323,48 +356,41 @@ impl ChannelConfig {
         }
         for t in &self.nc.tools {
             if !t.length.is_finite() || t.d == 0 || !t.orientation.iter().all(|v| v.is_finite()) {
-                return Err(parameter(
+                return Err(self.parameter(
                     "nc.tools",
                     t.length,
                     "a record has a D of 1 or more and a finite length",
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The diagnosis history's size, the display mode, the start values.
+    fn check_channel_data(&self) -> Result<(), ChannelConfigError> {
         // Every entry is allocated at start-up: a size the machine cannot hold is refused
         // here instead of aborting the process (the manual allows up to 2^32 - 1).
         if self.interpolator.dyn_cs_history_max > MAX_HISTORY {
-            return Err(parameter(
+            return Err(self.parameter(
                 "interpolator.dyn_cs_history_max",
                 f64::from(self.interpolator.dyn_cs_history_max),
                 "more entries than this controller keeps (at most 100000, 16 MB a channel)",
             ));
         }
         if self.kin_trafo_display > 2 {
-            return Err(parameter(
+            return Err(self.parameter(
                 "kin_trafo_display",
                 f64::from(self.kin_trafo_display),
                 "must be 0, 1 or 2",
             ));
         }
         if self.start.len() > self.axes.len() || self.start.iter().any(|v| !v.is_finite()) {
-            return Err(parameter(
+            return Err(self.parameter(
                 "start",
                 self.start.len() as f64,
                 "at most one finite value per axis",
             ));
         }
-        let order = self.order()?;
-        let kin_error = |reason: String| ChannelConfigError::Kinematics {
-            channel: channel.clone(),
-            reason,
-        };
-        if self.axes.len() < 6 {
-            return Err(ChannelConfigError::TooFewAxes {
-                channel: channel.clone(),
-                id: self.kinematics.id,
-                found: self.axes.len(),
-            });
-        }
-        self.kinematics.build(order).map_err(kin_error)
+        Ok(())
     }
 }

@@ -499,6 +499,30 @@ impl Tracker {
             _ => {}
         }
         // The master's frame, held while it is frozen; a resume is taken over softly.
+        self.follow_master(master);
+        let target = match (self.state, &self.tracking, &self.last_master) {
+            (DynCsState::Deactivating, _, _) => Isometry3::identity(),
+            (_, Some(tracking), Some(m)) => tracking.compensation(m),
+            _ => self.applied,
+        };
+        self.fade_from_live();
+        if !target.translation.vector.iter().all(|v| v.is_finite())
+            || !target.rotation.coords.iter().all(|v| v.is_finite())
+        {
+            self.fail(TrackError::BadFrame);
+            return self.applied;
+        }
+        self.blend_towards(&target);
+        if self.blend.is_none() {
+            self.end_transition();
+        }
+        self.applied
+    }
+
+    /// The master's sample of this tick: a live frame is taken (after a freeze, a coupling
+    /// in takes it over softly, and a switch-on without a frame takes it as the reference);
+    /// none freezes the master's last frame.
+    fn follow_master(&mut self, master: Option<MasterSample>) {
         let live = master.filter(|m| m.live);
         match (live, self.master_live) {
             (Some(m), false) => {
@@ -535,14 +559,12 @@ impl Tracker {
             }
             (None, false) => {}
         }
-        let target = match (self.state, &self.tracking, &self.last_master) {
-            (DynCsState::Deactivating, _, _) => Isometry3::identity(),
-            (_, Some(tracking), Some(m)) => tracking.compensation(m),
-            _ => self.applied,
-        };
-        // Coupling out fades the compensation the master still asks for (not the one of the
-        // switch-off tick): a slave switched off while its master moves leaves the master's
-        // velocity along the ramp instead of stopping at once.
+    }
+
+    /// Coupling out fades the compensation the master still asks for (not the one of the
+    /// switch-off tick): a slave switched off while its master moves leaves the master's
+    /// velocity along the ramp instead of stopping at once.
+    fn fade_from_live(&mut self) {
         if let (DynCsState::Deactivating, Some(blend), Some(tracking), Some(m)) = (
             self.state,
             self.blend.as_mut(),
@@ -554,12 +576,10 @@ impl Tracker {
                 blend.from = live;
             }
         }
-        if !target.translation.vector.iter().all(|v| v.is_finite())
-            || !target.rotation.coords.iter().all(|v| v.is_finite())
-        {
-            self.fail(TrackError::BadFrame);
-            return self.applied;
-        }
+    }
+
+    /// The compensation applied this tick: `target`, or one step of the blend towards it.
+    fn blend_towards(&mut self, target: &Isometry3<f64>) {
         // While the master is frozen a coupling-in pauses where it stands (the resume starts a
         // new ramp from there); a coupling-out goes on, it does not need the master. A master
         // that has offered no frame yet is no freeze: the coupling runs to the compensation
@@ -580,29 +600,31 @@ impl Tracker {
                 if blend.finished() {
                     self.blend = None;
                 }
-                interpolate(&from, &target, w)
+                interpolate(&from, target, w)
             }
-            None => target,
+            None => *target,
         };
-        if self.blend.is_none() {
-            match self.state {
-                DynCsState::Activating => {
-                    self.state = DynCsState::Active;
-                    self.event(TrackEvent::Active);
-                }
-                DynCsState::Deactivating => {
-                    self.state = DynCsState::Inactive;
-                    self.applied = Isometry3::identity();
-                    self.setup = None;
-                    self.tracking = None;
-                    self.last_master = None;
-                    self.master_live = false;
-                    self.event(TrackEvent::Inactive);
-                }
-                _ => {}
+    }
+
+    /// The blend is done: coupling in becomes ACTIVE, coupling out INACTIVE (everything
+    /// released).
+    fn end_transition(&mut self) {
+        match self.state {
+            DynCsState::Activating => {
+                self.state = DynCsState::Active;
+                self.event(TrackEvent::Active);
             }
+            DynCsState::Deactivating => {
+                self.state = DynCsState::Inactive;
+                self.applied = Isometry3::identity();
+                self.setup = None;
+                self.tracking = None;
+                self.last_master = None;
+                self.master_live = false;
+                self.event(TrackEvent::Inactive);
+            }
+            _ => {}
         }
-        self.applied
     }
 
     fn rebuild_reference(

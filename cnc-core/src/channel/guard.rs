@@ -15,8 +15,9 @@
 //! `Channel::resync_to_set_points`).
 
 use super::path::AxisLimits;
-use crate::axis::generator::{Kinematic, Progress, SetpointGenerator};
+use crate::axis::generator::{Progress, SetpointGenerator};
 use crate::nc::decode::{AxisValues, MAX_CHANNEL_AXES};
+use crate::setpoint::Kinematic;
 
 /// Which limit a refused step broke.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,11 +4,11 @@
 //! and an actual position like every other axis.
 
 use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
-use crate::axis::generator::Kinematic;
 use crate::axis::sim_drive::DriveModel;
 use crate::axis::{motion_phase, AxisSet, Coupling};
 use crate::channel::config::ChannelConfig;
 use crate::nc::decode::AxisValues;
+use crate::setpoint::Kinematic;
 use hli::enums::{AxisState, CouplingState};
 
 /// The link from one channel to its axes `first..first + count` of the axis set.

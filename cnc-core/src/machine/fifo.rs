@@ -18,11 +18,11 @@
 //! are sized when the engine is built.
 
 use super::engine::{Engine, EngineIo};
-use crate::axis::generator::Kinematic;
 use crate::axis::{AxisSet, Coupling};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
 };
+use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,

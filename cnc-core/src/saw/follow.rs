@@ -3,7 +3,7 @@
 //! synchronous phase (13), and the rollback behaviour of chapter 8 with the pre-phase (11).
 
 use super::{plan, rollback_stop, Domain, Plan, Profile, SawRequest};
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 use hli::calls::saw::sync_mask;
 use hli::enums::AxisState;
 

@@ -12,7 +12,7 @@ use super::shape::{
     change_time, change_time_from, jerk_limited_change, phases_to_pieces, quintic, slope_change,
     slope_change_travel, straight, Limits,
 };
-use crate::axis::generator::Kinematic;
+use crate::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
 use hli::enums::SawError;
 

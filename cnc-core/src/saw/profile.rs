@@ -2,10 +2,10 @@
 //! (time-based), how it is evaluated in the tick, and its characteristic values
 //! (`MC_FlyingSawCharacValues`) for a master at constant velocity.
 
-use crate::axis::generator::Kinematic;
 use crate::cam::charac::{bisect, Extreme};
 use crate::cam::piece::Piece;
 use crate::cam::CharacValues;
+use crate::setpoint::Kinematic;
 
 /// What the pieces are a function of.
 #[derive(Debug, Clone, Copy, PartialEq)]

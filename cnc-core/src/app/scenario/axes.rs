@@ -152,108 +152,16 @@ pub struct ScenarioAxis {
 pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, String> {
     let mut out = Vec::with_capacity(files.len());
     for (i, f) in files.iter().enumerate() {
-        let key = |k: &str| format!("[[axis]] {:?}: {k}", f.name);
         if f.name.is_empty() || f.name.contains('.') {
-            return Err(key(
-                "name: not empty, without '.' (CHANNEL.AXIS names channel axes)",
-            ));
+            return Err(f.key("name: not empty, without '.' (CHANNEL.AXIS names channel axes)"));
         }
-        let id = match f.id {
-            None => first_id + i as u32,
-            // Channel axes hold 1..first_id; the saw's table is 256 - ID.
-            Some(id) if (first_id..=255).contains(&id) => id,
-            Some(_) => {
-                return Err(key(&format!(
-                    "id: {first_id}..=255 (the channel axes hold the IDs below)"
-                )))
-            }
-        };
-        let mut c = match f.kind.as_str() {
-            "linear" => {
-                if f.modulo.is_some() {
-                    return Err(key(
-                        "modulo: a linear axis has no modulo (kind = \"rotary\")",
-                    ));
-                }
-                AxisConfig::linear(&f.name, id)
-            }
-            "rotary" => {
-                if f.soft_limits.is_some() {
-                    return Err(key(
-                        "soft_limits: an endless rotary axis has no software limits",
-                    ));
-                }
-                let mut c = AxisConfig::rotary(&f.name, id);
-                if let Some(m) = f.modulo {
-                    c.kind = AxisKind::Rotary { modulo: m };
-                }
-                c
-            }
-            other => return Err(key(&format!("kind {other:?}: \"linear\" or \"rotary\""))),
-        };
-        if let Some(l) = f.soft_limits {
-            if l[0].partial_cmp(&l[1]) != Some(std::cmp::Ordering::Less) {
-                return Err(key(&format!(
-                    "soft_limits {l:?}: the minimum must lie below the maximum"
-                )));
-            }
-            if !(l[0]..=l[1]).contains(&f.start) {
-                return Err(key(&format!(
-                    "start {}: outside soft_limits {l:?}",
-                    f.start
-                )));
-            }
-            c.soft_limits = Some(l);
-        }
-        if let Some(bits) = f.encoder_bits {
-            c.encoder_width = match bits {
-                16 => CounterWidth::Bits16,
-                32 => CounterWidth::Bits32,
-                _ => return Err(key(&format!("encoder_bits {bits}: 16 or 32"))),
-            };
-        }
-        let set = |slot: &mut f64, v: Option<f64>| {
-            if let Some(v) = v {
-                *slot = v;
-            }
-        };
-        set(&mut c.increments_per_unit, f.increments_per_unit);
-        set(
-            &mut c.velocity_increments_per_unit,
-            f.velocity_increments_per_unit,
-        );
-        set(
-            &mut c.acceleration_increments_per_unit,
-            f.acceleration_increments_per_unit,
-        );
-        set(&mut c.dynamics.velocity, f.velocity);
-        set(&mut c.dynamics.acceleration, f.acceleration);
-        set(&mut c.dynamics.deceleration, f.deceleration);
-        set(&mut c.dynamics.jerk, f.jerk);
-        set(&mut c.following_error_limit, f.following_error_limit);
-        set(&mut c.in_target_window, f.in_target_window);
-        set(&mut c.position_gain, f.position_gain);
-        set(&mut c.feed_forward, f.feed_forward);
-        if let Some(m) = f.drive_mode {
-            c.drive_mode = m;
-        }
-        if let Some(io) = f.io {
-            c.io = io;
-        }
-        if !f.start.is_finite() {
-            return Err(key("start: must be finite"));
-        }
-        let model = f.drive.unwrap_or(DriveModel::Ideal { dead_time_ticks: 0 });
-        c.drive = match model.simulated(f.start) {
-            Some(sim) => DriveLink::Simulated(sim),
-            None => DriveLink::External,
-        };
-        c.validate().map_err(|e| format!("[[axis]] {e}"))?;
+        let id = f.id(first_id, i)?;
+        let c = f.config(id)?;
         if out.iter().any(|a: &ScenarioAxis| a.config.name == f.name) {
-            return Err(key("name: given twice"));
+            return Err(f.key("name: given twice"));
         }
         if out.iter().any(|a: &ScenarioAxis| a.config.id == id) {
-            return Err(key(&format!("id: {id} is another axis's already")));
+            return Err(f.key(&format!("id: {id} is another axis's already")));
         }
         out.push(ScenarioAxis {
             config: c,
@@ -261,6 +169,125 @@ pub fn axes(files: &[AxisFile], first_id: u32) -> Result<Vec<ScenarioAxis>, Stri
         });
     }
     Ok(out)
+}
+
+impl AxisFile {
+    /// An error at key `k` of this axis.
+    fn key(&self, k: &str) -> String {
+        format!("[[axis]] {:?}: {k}", self.name)
+    }
+
+    /// The axis ID: the one given, or the next after the channel axes and the `index` axes
+    /// before.
+    fn id(&self, first_id: u32, index: usize) -> Result<u32, String> {
+        match self.id {
+            None => Ok(first_id + index as u32),
+            // Channel axes hold 1..first_id; the saw's table is 256 - ID.
+            Some(id) if (first_id..=255).contains(&id) => Ok(id),
+            Some(_) => Err(self.key(&format!(
+                "id: {first_id}..=255 (the channel axes hold the IDs below)"
+            ))),
+        }
+    }
+
+    /// The axis layer's configuration of this axis with ID `id`, validated.
+    fn config(&self, id: u32) -> Result<AxisConfig, String> {
+        let mut c = self.kind_config(id)?;
+        self.apply_limits(&mut c)?;
+        self.apply_values(&mut c);
+        if !self.start.is_finite() {
+            return Err(self.key("start: must be finite"));
+        }
+        let model = self
+            .drive
+            .unwrap_or(DriveModel::Ideal { dead_time_ticks: 0 });
+        c.drive = match model.simulated(self.start) {
+            Some(sim) => DriveLink::Simulated(sim),
+            None => DriveLink::External,
+        };
+        c.validate().map_err(|e| format!("[[axis]] {e}"))?;
+        Ok(c)
+    }
+
+    /// The defaults of a linear or a rotary axis (with its modulo).
+    fn kind_config(&self, id: u32) -> Result<AxisConfig, String> {
+        match self.kind.as_str() {
+            "linear" => {
+                if self.modulo.is_some() {
+                    return Err(self.key("modulo: a linear axis has no modulo (kind = \"rotary\")"));
+                }
+                Ok(AxisConfig::linear(&self.name, id))
+            }
+            "rotary" => {
+                if self.soft_limits.is_some() {
+                    return Err(
+                        self.key("soft_limits: an endless rotary axis has no software limits")
+                    );
+                }
+                let mut c = AxisConfig::rotary(&self.name, id);
+                if let Some(m) = self.modulo {
+                    c.kind = AxisKind::Rotary { modulo: m };
+                }
+                Ok(c)
+            }
+            other => Err(self.key(&format!("kind {other:?}: \"linear\" or \"rotary\""))),
+        }
+    }
+
+    /// The software limits (the start inside them) and the encoder width, checked.
+    fn apply_limits(&self, c: &mut AxisConfig) -> Result<(), String> {
+        if let Some(l) = self.soft_limits {
+            if l[0].partial_cmp(&l[1]) != Some(std::cmp::Ordering::Less) {
+                return Err(self.key(&format!(
+                    "soft_limits {l:?}: the minimum must lie below the maximum"
+                )));
+            }
+            if !(l[0]..=l[1]).contains(&self.start) {
+                return Err(self.key(&format!("start {}: outside soft_limits {l:?}", self.start)));
+            }
+            c.soft_limits = Some(l);
+        }
+        if let Some(bits) = self.encoder_bits {
+            c.encoder_width = match bits {
+                16 => CounterWidth::Bits16,
+                32 => CounterWidth::Bits32,
+                _ => return Err(self.key(&format!("encoder_bits {bits}: 16 or 32"))),
+            };
+        }
+        Ok(())
+    }
+
+    /// Every other value given, over the defaults (checked with the whole configuration).
+    fn apply_values(&self, c: &mut AxisConfig) {
+        let set = |slot: &mut f64, v: Option<f64>| {
+            if let Some(v) = v {
+                *slot = v;
+            }
+        };
+        set(&mut c.increments_per_unit, self.increments_per_unit);
+        set(
+            &mut c.velocity_increments_per_unit,
+            self.velocity_increments_per_unit,
+        );
+        set(
+            &mut c.acceleration_increments_per_unit,
+            self.acceleration_increments_per_unit,
+        );
+        set(&mut c.dynamics.velocity, self.velocity);
+        set(&mut c.dynamics.acceleration, self.acceleration);
+        set(&mut c.dynamics.deceleration, self.deceleration);
+        set(&mut c.dynamics.jerk, self.jerk);
+        set(&mut c.following_error_limit, self.following_error_limit);
+        set(&mut c.in_target_window, self.in_target_window);
+        set(&mut c.position_gain, self.position_gain);
+        set(&mut c.feed_forward, self.feed_forward);
+        if let Some(m) = self.drive_mode {
+            c.drive_mode = m;
+        }
+        if let Some(io) = self.io {
+            c.io = io;
+        }
+    }
 }
 
 /// Every axis name of the machine in axis-set order: channel axes `CHANNEL.AXIS` (while they

@@ -190,136 +190,11 @@ impl Scenario {
         text: &str,
         open: impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
     ) -> Result<Scenario, ScenarioError> {
-        let invalid = |message: String| ScenarioError::Invalid {
-            file: name.to_string(),
-            message,
-        };
+        let invalid = invalid_in(name);
         let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
-        if !(file.cycle_ms.is_finite() && (0.05..=100.0).contains(&file.cycle_ms)) {
-            return Err(invalid(format!(
-                "cycle_ms = {}: must lie in 0.05..=100",
-                file.cycle_ms
-            )));
-        }
-        let no_machine = file.channel.is_empty() && file.axis.is_empty();
-        if no_machine || file.channel.len() > crate::channel::MAX_CHANNELS {
-            return Err(invalid(format!(
-                "{} channels: a scenario has 0 to {} (and at least one [[channel]] or [[axis]])",
-                file.channel.len(),
-                crate::channel::MAX_CHANNELS
-            )));
-        }
-        let mut programs = Vec::with_capacity(file.channel.len());
-        for c in &file.channel {
-            programs.push(match &c.program {
-                Some(p) => {
-                    let (path, src) = open(p)?;
-                    let search = crate::nc::interp::SearchPath(
-                        c.nc.search_path
-                            .iter()
-                            .map(|d| path.parent().unwrap_or(Path::new(".")).join(d))
-                            .collect(),
-                    );
-                    Some(LoadedProgram::load_with(
-                        &path.display().to_string(),
-                        &src,
-                        &c.axes,
-                        &c.nc.setup(),
-                        path.parent().map(std::path::Path::to_path_buf),
-                        &search,
-                    )?)
-                }
-                None => None,
-            });
-        }
-        let plc = match file.plc {
-            None => PlcSetup::None,
-            Some(PlcFile {
-                timeline: Some(t),
-                program: None,
-                file: None,
-                fifo_override: None,
-                saw_cuts: None,
-                saw_length: None,
-            }) => {
-                let (path, text) = open(&t)?;
-                // Checked here, so a bad timeline fails before any process starts.
-                let timeline =
-                    plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
-                        .map_err(|e| invalid(e.to_string()))?;
-                PlcSetup::Timeline {
-                    path,
-                    text,
-                    timeline: Box::new(timeline),
-                }
-            }
-            Some(PlcFile {
-                timeline: None,
-                program: Some(p),
-                file,
-                fifo_override,
-                saw_cuts,
-                saw_length,
-            }) => {
-                if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p.as_str()) {
-                    return Err(invalid(format!(
-                        "[plc] program {p:?}: known are {:?}",
-                        plc_shim::cli::BUILT_IN_PROGRAMS
-                    )));
-                }
-                let mut args = Vec::new();
-                if let Some(f) = file {
-                    // Resolved beside the scenario and checked (header or first row) now.
-                    let path = Path::new(name).parent().unwrap_or(Path::new(".")).join(&f);
-                    plc_shim::fifo_file::RowReader::open(&path)
-                        .map_err(|e| invalid(format!("[plc] file: {e}")))?;
-                    let path = std::fs::canonicalize(&path).unwrap_or(path);
-                    args.extend(["--file".to_string(), path.display().to_string()]);
-                }
-                if let Some(o) = fifo_override {
-                    if !(0.0..=100.0).contains(&o) {
-                        return Err(invalid(format!(
-                            "[plc] fifo_override = {o}: 0 to 100 percent"
-                        )));
-                    }
-                    args.extend(["--fifo-override".to_string(), o.to_string()]);
-                }
-                let has_saw = plc_shim::cli::SAW_PROGRAMS.contains(&p.as_str());
-                if !has_saw && (saw_cuts.is_some() || saw_length.is_some()) {
-                    return Err(invalid(format!(
-                        "[plc] saw_cuts and saw_length belong to saw-cut and demo-machine, not {p:?}"
-                    )));
-                }
-                if let Some(n) = saw_cuts {
-                    let max = plc_shim::programs::saw_cut::MAX_CUTS;
-                    if !(1..=max).contains(&n) {
-                        return Err(invalid(format!("[plc] saw_cuts = {n}: 1 to {max}")));
-                    }
-                    args.extend(["--saw-cuts".to_string(), n.to_string()]);
-                }
-                if let Some(l) = saw_length {
-                    if !(l.is_finite() && l > 0.0) {
-                        return Err(invalid(format!("[plc] saw_length = {l}: mm above 0")));
-                    }
-                    args.extend(["--saw-length".to_string(), l.to_string()]);
-                }
-                PlcSetup::Program(p, args)
-            }
-            Some(PlcFile {
-                timeline: Some(_),
-                program: None,
-                ..
-            }) => {
-                return Err(invalid(
-                    "[plc] `file`, `fifo_override`, `saw_cuts` and `saw_length` belong to a built-in program".into(),
-                ))
-            }
-            Some(_) => {
-                return Err(invalid(
-                    "[plc] takes exactly one of `timeline` and `program`".into(),
-                ))
-            }
-        };
+        file.check_shape().map_err(&invalid)?;
+        let programs = load_programs(&file.channel, &open)?;
+        let plc = plc_setup(name, file.plc, &open)?;
         if file.channel.is_empty() && file.ticks.is_none() {
             return Err(invalid(
                 "a scenario without channels needs `ticks` (no program says when it ends)".into(),
@@ -338,67 +213,10 @@ impl Scenario {
         let gears = super::axes::gears(&file.gear, &names, channel_axes).map_err(&invalid)?;
         crate::machine::gear::GearEngine::new(&gears, names.len())
             .map_err(|e| invalid(e.to_string()))?;
-        if let PlcSetup::Timeline { timeline, path, .. } = &plc {
-            for (instance, axis) in timeline.block_axes() {
-                if (axis as usize) < channel_axes {
-                    return Err(invalid(format!(
-                        "{}: block {instance:?}: axis {axis} ({}) is a channel axis, commanded by its channel",
-                        path.display(),
-                        names[axis as usize]
-                    )));
-                }
-                if axis as usize >= names.len() {
-                    return Err(invalid(format!(
-                        "{}: block {instance:?}: axis {axis} does not exist (the machine has {} axes: {})",
-                        path.display(),
-                        names.len(),
-                        names.join(", ")
-                    )));
-                }
-            }
-        }
-        let mut cam_tables: Vec<(u32, crate::cam::CamProfile)> = Vec::new();
-        for t in &file.cam_table {
-            let (path, text) = open(&t.file)?;
-            let at = path.display();
-            if !text.trim_start().starts_with('{') {
-                return Err(invalid(format!(
-                    "[[cam_table]] {at}: a scenario takes JSON cam files (docs/cams.md)"
-                )));
-            }
-            let cam = crate::cam::file::parse(text.as_bytes(), Default::default())
-                .map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
-            let id = match (cam.id, t.id) {
-                (Some(a), Some(b)) if a != b => {
-                    return Err(invalid(format!(
-                        "[[cam_table]] {at}: the file has id {a}, the scenario says {b}"
-                    )))
-                }
-                (Some(id), _) | (None, Some(id)) => id,
-                (None, None) => {
-                    return Err(invalid(format!(
-                        "[[cam_table]] {at}: no id (give `id = 1..255`)"
-                    )))
-                }
-            };
-            if !(1..=255).contains(&id) {
-                return Err(invalid(format!(
-                    "[[cam_table]] {at}: id {id} is outside 1..255"
-                )));
-            }
-            if cam_tables.iter().any(|(other, _)| *other == id) {
-                return Err(invalid(format!(
-                    "[[cam_table]] {at}: id {id} is taken by another table"
-                )));
-            }
-            cam_tables.push((id, cam.profile));
-        }
+        check_block_axes(&plc, channel_axes, &names).map_err(&invalid)?;
+        let cam_tables = cam_tables(name, &file.cam_table, &open)?;
         let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
-        let mut signals = Vec::with_capacity(file.trace.signals.len());
-        for s in file.trace.signals {
-            let leaf = Leaf::resolve(&s).map_err(|e| invalid(format!("[trace] {e}")))?;
-            signals.push((s, leaf));
-        }
+        let signals = trace_signals(file.trace.signals).map_err(&invalid)?;
         Ok(Scenario {
             name: name.to_string(),
             cycle_s: file.cycle_ms * 1e-3,
@@ -416,4 +234,252 @@ impl Scenario {
             realtime_plc: file.realtime_plc,
         })
     }
+}
+
+/// The refusal of scenario `name` with a message.
+fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
+    move |message: String| ScenarioError::Invalid {
+        file: name.to_string(),
+        message,
+    }
+}
+
+impl ScenarioFile {
+    /// The cycle time and the number of channels (and that there is a machine at all).
+    fn check_shape(&self) -> Result<(), String> {
+        if !(self.cycle_ms.is_finite() && (0.05..=100.0).contains(&self.cycle_ms)) {
+            return Err(format!(
+                "cycle_ms = {}: must lie in 0.05..=100",
+                self.cycle_ms
+            ));
+        }
+        let no_machine = self.channel.is_empty() && self.axis.is_empty();
+        if no_machine || self.channel.len() > crate::channel::MAX_CHANNELS {
+            return Err(format!(
+                "{} channels: a scenario has 0 to {} (and at least one [[channel]] or [[axis]])",
+                self.channel.len(),
+                crate::channel::MAX_CHANNELS
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Each channel's program, read through `open` and checked (None: the channel has none).
+fn load_programs(
+    channels: &[ChannelConfig],
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<Vec<Option<LoadedProgram>>, ScenarioError> {
+    let mut programs = Vec::with_capacity(channels.len());
+    for c in channels {
+        programs.push(match &c.program {
+            Some(p) => {
+                let (path, src) = open(p)?;
+                let search = crate::nc::interp::SearchPath(
+                    c.nc.search_path
+                        .iter()
+                        .map(|d| path.parent().unwrap_or(Path::new(".")).join(d))
+                        .collect(),
+                );
+                Some(LoadedProgram::load_with(
+                    &path.display().to_string(),
+                    &src,
+                    &c.axes,
+                    &c.nc.setup(),
+                    path.parent().map(std::path::Path::to_path_buf),
+                    &search,
+                )?)
+            }
+            None => None,
+        });
+    }
+    Ok(programs)
+}
+
+/// The PLC of scenario `name`: none, a timeline (read through `open` and checked), or a
+/// built-in program with its arguments.
+fn plc_setup(
+    name: &str,
+    plc: Option<PlcFile>,
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<PlcSetup, ScenarioError> {
+    let invalid = invalid_in(name);
+    Ok(match plc {
+        None => PlcSetup::None,
+        Some(PlcFile {
+            timeline: Some(t),
+            program: None,
+            file: None,
+            fifo_override: None,
+            saw_cuts: None,
+            saw_length: None,
+        }) => {
+            let (path, text) = open(&t)?;
+            // Checked here, so a bad timeline fails before any process starts.
+            let timeline = plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
+                .map_err(|e| invalid(e.to_string()))?;
+            PlcSetup::Timeline {
+                path,
+                text,
+                timeline: Box::new(timeline),
+            }
+        }
+        Some(PlcFile {
+            timeline: None,
+            program: Some(p),
+            file,
+            fifo_override,
+            saw_cuts,
+            saw_length,
+        }) => {
+            let args = program_args(name, &p, file, fifo_override, (saw_cuts, saw_length))
+                .map_err(invalid)?;
+            PlcSetup::Program(p, args)
+        }
+        Some(PlcFile {
+            timeline: Some(_),
+            program: None,
+            ..
+        }) => {
+            return Err(invalid(
+                "[plc] `file`, `fifo_override`, `saw_cuts` and `saw_length` belong to a built-in program".into(),
+            ))
+        }
+        Some(_) => {
+            return Err(invalid(
+                "[plc] takes exactly one of `timeline` and `program`".into(),
+            ))
+        }
+    })
+}
+
+/// The command-line arguments of built-in program `p` of scenario `name`: its data file
+/// (resolved beside the scenario), the FIFO override, the saw's cuts and piece length.
+fn program_args(
+    name: &str,
+    p: &str,
+    file: Option<String>,
+    fifo_override: Option<f64>,
+    (saw_cuts, saw_length): (Option<usize>, Option<f64>),
+) -> Result<Vec<String>, String> {
+    if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p) {
+        return Err(format!(
+            "[plc] program {p:?}: known are {:?}",
+            plc_shim::cli::BUILT_IN_PROGRAMS
+        ));
+    }
+    let mut args = Vec::new();
+    if let Some(f) = file {
+        // Resolved beside the scenario and checked (header or first row) now.
+        let path = Path::new(name).parent().unwrap_or(Path::new(".")).join(&f);
+        plc_shim::fifo_file::RowReader::open(&path).map_err(|e| format!("[plc] file: {e}"))?;
+        let path = std::fs::canonicalize(&path).unwrap_or(path);
+        args.extend(["--file".to_string(), path.display().to_string()]);
+    }
+    if let Some(o) = fifo_override {
+        if !(0.0..=100.0).contains(&o) {
+            return Err(format!("[plc] fifo_override = {o}: 0 to 100 percent"));
+        }
+        args.extend(["--fifo-override".to_string(), o.to_string()]);
+    }
+    let has_saw = plc_shim::cli::SAW_PROGRAMS.contains(&p);
+    if !has_saw && (saw_cuts.is_some() || saw_length.is_some()) {
+        return Err(format!(
+            "[plc] saw_cuts and saw_length belong to saw-cut and demo-machine, not {p:?}"
+        ));
+    }
+    if let Some(n) = saw_cuts {
+        let max = plc_shim::programs::saw_cut::MAX_CUTS;
+        if !(1..=max).contains(&n) {
+            return Err(format!("[plc] saw_cuts = {n}: 1 to {max}"));
+        }
+        args.extend(["--saw-cuts".to_string(), n.to_string()]);
+    }
+    if let Some(l) = saw_length {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(format!("[plc] saw_length = {l}: mm above 0"));
+        }
+        args.extend(["--saw-length".to_string(), l.to_string()]);
+    }
+    Ok(args)
+}
+
+/// A timeline's blocks command single axes only, and only axes the machine has.
+fn check_block_axes(plc: &PlcSetup, channel_axes: usize, names: &[String]) -> Result<(), String> {
+    let PlcSetup::Timeline { timeline, path, .. } = plc else {
+        return Ok(());
+    };
+    for (instance, axis) in timeline.block_axes() {
+        if (axis as usize) < channel_axes {
+            return Err(format!(
+                "{}: block {instance:?}: axis {axis} ({}) is a channel axis, commanded by its channel",
+                path.display(),
+                names[axis as usize]
+            ));
+        }
+        if axis as usize >= names.len() {
+            return Err(format!(
+                "{}: block {instance:?}: axis {axis} does not exist (the machine has {} axes: {})",
+                path.display(),
+                names.len(),
+                names.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The cam tables of scenario `name`, each JSON file read through `open`, by ID.
+fn cam_tables(
+    name: &str,
+    files: &[CamTableFile],
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<Vec<(u32, crate::cam::CamProfile)>, ScenarioError> {
+    let invalid = invalid_in(name);
+    let mut cam_tables: Vec<(u32, crate::cam::CamProfile)> = Vec::new();
+    for t in files {
+        let (path, text) = open(&t.file)?;
+        let at = path.display();
+        if !text.trim_start().starts_with('{') {
+            return Err(invalid(format!(
+                "[[cam_table]] {at}: a scenario takes JSON cam files (docs/cams.md)"
+            )));
+        }
+        let cam = crate::cam::file::parse(text.as_bytes(), Default::default())
+            .map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
+        let id =
+            cam_table_id(cam.id, t.id).map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
+        if cam_tables.iter().any(|(other, _)| *other == id) {
+            return Err(invalid(format!(
+                "[[cam_table]] {at}: id {id} is taken by another table"
+            )));
+        }
+        cam_tables.push((id, cam.profile));
+    }
+    Ok(cam_tables)
+}
+
+/// A cam table's ID: the file's or the scenario's (they must agree), in 1..=255.
+fn cam_table_id(in_file: Option<u32>, in_scenario: Option<u32>) -> Result<u32, String> {
+    let id = match (in_file, in_scenario) {
+        (Some(a), Some(b)) if a != b => {
+            return Err(format!("the file has id {a}, the scenario says {b}"))
+        }
+        (Some(id), _) | (None, Some(id)) => id,
+        (None, None) => return Err("no id (give `id = 1..255`)".to_string()),
+    };
+    if !(1..=255).contains(&id) {
+        return Err(format!("id {id} is outside 1..255"));
+    }
+    Ok(id)
+}
+
+/// The trace signals resolved to leaves of the image.
+fn trace_signals(signals: Vec<String>) -> Result<Vec<(String, Leaf)>, String> {
+    let mut out = Vec::with_capacity(signals.len());
+    for s in signals {
+        let leaf = Leaf::resolve(&s).map_err(|e| format!("[trace] {e}"))?;
+        out.push((s, leaf));
+    }
+    Ok(out)
 }

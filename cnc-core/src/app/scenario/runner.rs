@@ -14,7 +14,6 @@
 //! ```
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
-use super::log_stream::LogStream;
 use super::machine::{build, Machine};
 use super::trace::Trace;
 use crate::app::stats::Percentiles;
@@ -24,9 +23,11 @@ use hli::events::{EventLink, Side};
 use hli::raw::monotonic;
 use hli::rpc::AcyclicServer;
 use hli::segment::CncSegment;
-use hli::views::CncView;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
+use tick_loop::{Bounds, Ending, Measured, TickLoop};
+
+mod tick_loop;
 
 /// Ticks run when neither `--ticks` nor the scenario says: until every channel is idle, at
 /// most this many.
@@ -295,213 +296,112 @@ fn run_machine(
     machine: &mut Machine,
     options: &RunOptions,
 ) -> Result<RunReport, String> {
-    let segment = CncSegment::create(
-        &options.instance,
-        scenario.channels.len() as u32,
-        machine.axis_images() as u32,
-    )
-    .map_err(|e| e.to_string())?;
-    let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
-    let server = AcyclicServer::open(&options.instance).map_err(|e| e.to_string())?;
-    let mut child = spawn_plc(scenario, options)?;
-    if let Some(child) = child.as_mut() {
-        wait_for_attach(&segment, child)?;
-        if !options.lockstep {
-            // The heartbeat watchdog starts with the loop: the PLC must be cycling by then.
-            wait_for_first_cycle(&segment, &events, child)?;
-        }
-    }
-
+    let mut link = PlcLink::open(scenario, machine, options)?;
     // After spawning: the PLC must not inherit the CNC's scheduling and CPU.
     let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
-    let limit = options
-        .ticks
-        .or(scenario.ticks)
-        .unwrap_or(DEFAULT_TICK_LIMIT);
-    let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
-    // Room for a stop that starts at the last tick.
-    let rows = usize::try_from(limit.saturating_add(stop_limit))
-        .map_err(|_| "--ticks too large".to_string())?;
-    let watchdog = options
-        .plc_watchdog_ticks
-        .or(scenario.plc_watchdog_ticks)
-        .unwrap_or(DEFAULT_PLC_WATCHDOG_TICKS)
-        .max(1);
-    let mut trace = Trace::new(&scenario.signals, rows);
-    let mut tick_ns = Vec::with_capacity(rows);
-    let mut late_ns = Vec::with_capacity(rows);
-    // Where a tick's time goes: machine tick, trace sample, acyclic calls, "tick done" event.
-    let mut stage_ns: [Vec<u64>; 4] = core::array::from_fn(|_| Vec::with_capacity(rows));
-    let mut acyclic_answered = 0u64;
-    let memory = segment.memory();
-    let view = CncView::new(memory);
-    let period = Duration::from_secs_f64(scenario.cycle_s);
-    let start = monotonic::now();
-    let mut stop: Option<(StopCause, u64)> = None;
-    // The PLC heartbeat last seen to change, and when (wall clock: a CNC that stalled and
-    // catches up in a burst must not take the PLC for dead).
-    let mut plc_seen = (segment.plc_heartbeat(), monotonic::now());
-    let watchdog_time = period * watchdog.min(u64::from(u32::MAX)) as u32;
-    let mut forced = false;
-
-    let mut rest_after = None;
-    let mut log_stream = options
-        .log_dir
-        .as_ref()
-        .map(|dir| LogStream::start(dir, machine.controller().channels().len()));
-    let counter = crate::app::progress::TickCounter::default();
-    let progress = crate::app::progress::Progress::start(
-        &counter,
-        options.ticks.or(scenario.ticks),
-        &options.instance,
-    );
-    for tick in 0.. {
-        match &stop {
-            Some((_, since)) if machine.at_rest() => {
-                rest_after = Some(tick - since);
-                break;
-            }
-            Some((_, since)) if tick - since > stop_limit => break,
-            Some(_) => {}
-            None if tick >= limit => break,
-            None if options.ticks.is_none() && scenario.ticks.is_none() && machine.idle() => break,
-            None => {}
-        }
-        let deadline = start + period * (tick as u32);
-        let plc_alive = stop.is_none() && child.is_some();
-        if options.lockstep && plc_alive {
-            if let Some(child) = child.as_mut() {
-                match wait_for_plc_cycle(&segment, &events, child, tick, watchdog, period) {
-                    Ok(()) => {}
-                    Err(PlcWait::Lost(detail)) => {
-                        let cause = StopCause::PlcLost { tick, detail };
-                        eprintln!("cnc run: {}", cause.message());
-                        machine.stop(STOP_REASON_PLC);
-                        stop = Some((cause, tick));
-                    }
-                }
-            }
-        } else if !options.lockstep {
-            monotonic::sleep_until(deadline);
-        }
-        let t0 = monotonic::now();
-        machine.tick(memory);
-        let t1 = monotonic::now();
-        let time = if options.lockstep {
-            tick as f64 * scenario.cycle_s
-        } else {
-            (t0 - start).as_secs_f64()
-        };
-        trace.record(memory, tick, time);
-        let t2 = monotonic::now();
-        acyclic_answered += server
-            .poll(|kind, request| machine.dispatch(&view, kind, request))
-            .unwrap_or(0) as u64;
-        acyclic_answered += server
-            .poll_rows(|header, values| machine.dispatch_rows(header, values))
-            .unwrap_or(0) as u64;
-        let t3 = monotonic::now();
-        let _ = events.notify();
-        let t4 = monotonic::now();
-        if let Some(stream) = log_stream.as_mut() {
-            stream.forward(machine.controller().channels());
-        }
-        tick_ns.push((t4 - t0).as_nanos() as u64);
-        for (stage, (a, b)) in stage_ns
-            .iter_mut()
-            .zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)])
-        {
-            stage.push((b - a).as_nanos() as u64);
-        }
-        late_ns.push(t0.saturating_sub(deadline).as_nanos() as u64);
-        counter.set(tick + 1);
-
-        // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on it
-        // above), its process now and then, and termination requests.
-        if stop.is_none() && !options.lockstep {
-            if let Some(child) = child.as_mut() {
-                let beat = segment.plc_heartbeat();
-                let now = monotonic::now();
-                if beat != plc_seen.0 {
-                    plc_seen = (beat, now);
-                }
-                let exited = if tick % 64 == 0 {
-                    child.try_wait().ok().flatten()
-                } else {
-                    None
-                };
-                let silent = now.saturating_sub(plc_seen.1);
-                if exited.is_some() || silent > watchdog_time {
-                    let silent_ticks = (silent.as_secs_f64() / scenario.cycle_s) as u64;
-                    let detail = describe_plc(child, exited, silent_ticks);
-                    let cause = StopCause::PlcLost { tick, detail };
-                    eprintln!("cnc run: {}", cause.message());
-                    machine.stop(STOP_REASON_PLC);
-                    stop = Some((cause, tick));
-                }
-            }
-        }
-        if tick % 16 == 0 {
-            if let Some(signal) = hli::signals::take() {
-                if stop.is_some() {
-                    // A request during a stop: end now (the segment is still removed and the
-                    // PLC still reaped below); the first cause stays the reported one.
-                    eprintln!("cnc run: {} during the stop: ending at once", signal.name());
-                    forced = true;
-                    break;
-                }
-                let cause = StopCause::Signal { tick, signal };
-                eprintln!("cnc run: {}", cause.message());
-                machine.stop(STOP_REASON_SIGNAL);
-                stop = Some((cause, tick));
-            }
-        }
-    }
-
-    drop(progress);
-    if let Some(Err(e)) = log_stream.map(LogStream::finish) {
-        eprintln!("cnc run: LOG_FILE while running: {e}");
-    }
+    let bounds = Bounds::of(scenario, options)?;
+    let measured = Measured::new(scenario, bounds.rows);
+    let (mut measured, ending) =
+        TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
     let ticks = machine.ticks();
-    // Lockstep: the PLC's cycle after the last tick belongs to the run as every other one
-    // (it sees the final state) before the segment closes.
-    if options.lockstep && stop.is_none() && !forced {
-        if let Some(child) = child.as_mut() {
-            if let Err(PlcWait::Lost(detail)) =
-                wait_for_plc_cycle(&segment, &events, child, ticks, watchdog, period)
-            {
-                eprintln!("cnc run: the PLC's last cycle did not come: {detail}");
-            }
-        }
-    }
-    drop(segment); // marks the segment closed: the PLC stops
-    let plc_output = match child {
-        Some(mut child) => {
-            if forced || matches!(stop, Some((StopCause::PlcLost { .. }, _))) {
-                // A lost PLC may be hung: it would never see the segment close.
-                let _ = child.kill();
-            }
-            wait_for_exit(child)?
-        }
-        None => String::new(),
-    };
+    let plc_output = link.close(options, &ending, ticks, &bounds)?;
     Ok(RunReport {
         ticks,
-        tick_ns: Percentiles::of(&mut tick_ns),
-        stage_p50_ns: stage_ns.map(|mut v| Percentiles::of(&mut v).p50),
+        tick_ns: Percentiles::of(&mut measured.tick_ns),
+        stage_p50_ns: measured.stage_ns.map(|mut v| Percentiles::of(&mut v).p50),
         late_ns: if options.lockstep {
             Percentiles::default()
         } else {
-            Percentiles::of(&mut late_ns)
+            Percentiles::of(&mut measured.late_ns)
         },
         channels: channel_reports(machine),
-        acyclic_answered,
+        acyclic_answered: measured.acyclic_answered,
         plc_output,
-        trace,
-        stop: stop.map(|(cause, _)| cause),
-        rest_after,
+        trace: measured.trace,
+        stop: ending.stop.map(|(cause, _)| cause),
+        rest_after: ending.rest_after,
         realtime,
     })
+}
+
+/// The PLC side of a run: the segment, the events, the acyclic service and the PLC process
+/// (none when the scenario has no PLC).
+struct PlcLink {
+    segment: CncSegment,
+    events: EventLink,
+    server: AcyclicServer,
+    child: Option<Child>,
+}
+
+impl PlcLink {
+    /// Creates the segment and the services and spawns the PLC; returns once it attached
+    /// (real time: once it runs its cycles).
+    fn open(
+        scenario: &Scenario,
+        machine: &Machine,
+        options: &RunOptions,
+    ) -> Result<PlcLink, String> {
+        let segment = CncSegment::create(
+            &options.instance,
+            scenario.channels.len() as u32,
+            machine.axis_images() as u32,
+        )
+        .map_err(|e| e.to_string())?;
+        let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
+        let server = AcyclicServer::open(&options.instance).map_err(|e| e.to_string())?;
+        let mut child = spawn_plc(scenario, options)?;
+        if let Some(child) = child.as_mut() {
+            wait_for_attach(&segment, child)?;
+            if !options.lockstep {
+                // The heartbeat watchdog starts with the loop: the PLC must be cycling by then.
+                wait_for_first_cycle(&segment, &events, child)?;
+            }
+        }
+        Ok(PlcLink {
+            segment,
+            events,
+            server,
+            child,
+        })
+    }
+
+    /// After the last tick (`ticks` run): closes the segment, so the PLC stops, and returns
+    /// what the PLC printed.
+    fn close(
+        mut self,
+        options: &RunOptions,
+        ending: &Ending,
+        ticks: u64,
+        bounds: &Bounds,
+    ) -> Result<String, String> {
+        // Lockstep: the PLC's cycle after the last tick belongs to the run as every other one
+        // (it sees the final state) before the segment closes.
+        if options.lockstep && ending.stop.is_none() && !ending.forced {
+            if let Some(child) = self.child.as_mut() {
+                if let Err(PlcWait::Lost(detail)) = wait_for_plc_cycle(
+                    &self.segment,
+                    &self.events,
+                    child,
+                    ticks,
+                    bounds.watchdog,
+                    bounds.period,
+                ) {
+                    eprintln!("cnc run: the PLC's last cycle did not come: {detail}");
+                }
+            }
+        }
+        drop(self.segment); // marks the segment closed: the PLC stops
+        match self.child {
+            Some(mut child) => {
+                if ending.forced || matches!(ending.stop, Some((StopCause::PlcLost { .. }, _))) {
+                    // A lost PLC may be hung: it would never see the segment close.
+                    let _ = child.kill();
+                }
+                wait_for_exit(child)
+            }
+            None => Ok(String::new()),
+        }
+    }
 }
 
 /// The per-channel part of the report.

@@ -18,6 +18,21 @@ fn direction(value_in_increments: f64) -> DirectionBits {
 
 impl Axis {
     pub(super) fn outputs(&self, set: Kinematic) -> AxisOutputs {
+        let drive_out = self.drive_out(set);
+        let enc_out = self.encoder_out();
+        let lr_state = self.lr_state(set);
+        AxisOutputs {
+            lr_state,
+            drive_out,
+            enc_out,
+            command_state: self.book.image(),
+            drive_state: self.drive_state(),
+        }
+    }
+
+    /// The drive's outputs for set-point `set`: the two data words of the drive mode, the
+    /// control word, the direction bits, the acceleration or torque set-point.
+    fn drive_out(&self, set: Kinematic) -> NcDriveOut {
         let cfg = &self.config;
         let vscale = cfg.velocity_increments_per_unit;
         let out_velocity = self.output_velocity * vscale;
@@ -44,8 +59,7 @@ impl Axis {
             DriveProtocol::Plain => u8::from(self.enabled),
             DriveProtocol::Cia402 => self.control_word(),
         };
-        let probe = self.probes.control();
-        let drive_out = NcDriveOut {
+        NcDriveOut {
             nOutData1: data1,
             nOutData2: data2,
             nCtrl1: control,
@@ -53,9 +67,14 @@ impl Axis {
             nCtrl3: total_direction.raw(),
             nOutData3: saturate(cfg.out_data3(set.acceleration)),
             ..bytemuck::Zeroable::zeroed()
-        };
+        }
+    }
+
+    /// The encoder's outputs: the counter echo, the register request, the probe control.
+    fn encoder_out(&self) -> NcEncoderOut {
+        let probe = self.probes.control();
         let (register, register_value) = self.encoder_reg.control();
-        let enc_out = NcEncoderOut {
+        NcEncoderOut {
             nOutData1: self.encoder_echo,
             nOutData2: register_value,
             nCtrl2: register,
@@ -63,7 +82,12 @@ impl Axis {
             nCtrl5: probe.ctrl5,
             nCtrl6: probe.ctrl6,
             ..bytemuck::Zeroable::zeroed()
-        };
+        }
+    }
+
+    /// The axis's cyclic state for set-point `set`, in HLI units.
+    fn lr_state(&self, set: Kinematic) -> HliAxisLrState {
+        let cfg = &self.config;
         let hli_scale = hli::units::HLI_LENGTH_PER_MM;
         // Wrapped in whole HLI units, so rounding never shows the period itself.
         let display = |p: f64| match cfg.modulo() {
@@ -73,27 +97,7 @@ impl Axis {
             }
             None => saturate(p * hli_scale),
         };
-        let mut status = 0;
-        if self.enabled {
-            status |= axis_status::ENABLED;
-        }
-        let moving = match self.coupling {
-            Some(_) => set.velocity != 0.0,
-            None => set.velocity != 0.0 || self.generator.goal() != Goal::Hold,
-        };
-        if moving {
-            status |= axis_status::MOVING;
-        }
-        if !moving && self.following_error.abs() <= cfg.in_target_window {
-            status |= axis_status::IN_TARGET;
-        }
-        if self.error.is_some() {
-            status |= axis_status::ERROR;
-        }
-        if self.io_fault.is_some() {
-            status |= axis_status::IO_INVALID;
-        }
-        let lr_state = HliAxisLrState {
+        HliAxisLrState {
             current_position_acs_r: display(self.actual),
             command_position_acs_r: display(set.position),
             current_velocity_r: saturate(self.actual_velocity * hli_scale),
@@ -107,15 +111,33 @@ impl Axis {
                 .raw(),
             master_axis_r: self.coupling.map_or(-1, |c| c.master),
             error_id_r: self.error.map_or(0, AxisError::raw),
-            status_r: status,
+            status_r: self.status_bits(set),
             fill_up_1: 0,
-        };
-        AxisOutputs {
-            lr_state,
-            drive_out,
-            enc_out,
-            command_state: self.book.image(),
-            drive_state: self.drive_state(),
         }
+    }
+
+    /// The status bits: enabled, moving, in target, error, I/O invalid.
+    fn status_bits(&self, set: Kinematic) -> u32 {
+        let mut status = 0;
+        if self.enabled {
+            status |= axis_status::ENABLED;
+        }
+        let moving = match self.coupling {
+            Some(_) => set.velocity != 0.0,
+            None => set.velocity != 0.0 || self.generator.goal() != Goal::Hold,
+        };
+        if moving {
+            status |= axis_status::MOVING;
+        }
+        if !moving && self.following_error.abs() <= self.config.in_target_window {
+            status |= axis_status::IN_TARGET;
+        }
+        if self.error.is_some() {
+            status |= axis_status::ERROR;
+        }
+        if self.io_fault.is_some() {
+            status |= axis_status::IO_INVALID;
+        }
+        status
     }
 }

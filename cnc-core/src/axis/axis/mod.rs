@@ -8,10 +8,11 @@ use super::cia402;
 use super::commands::CommandBook;
 use super::config::{AxisConfig, DriveMode, DriveProtocol};
 use super::encoder_reg::{EncoderEvent, EncoderRegister};
-use super::generator::{Goal, Kinematic, MoveLimits, Progress, SetpointGenerator};
+use super::generator::{Goal, MoveLimits, Progress, SetpointGenerator};
 use super::increments::IncrementCounter;
 use super::inputs::DriveInputs;
 use super::probe::Probes;
+use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{
