@@ -1,14 +1,20 @@
 //! The seam every motion engine plugs into (cams, FIFO groups, flying saw, gears): a tick
-//! with the HLI view and the axis set, the acyclic calls it owns, and its reaction to a fault.
+//! with the HLI view and the axis set, the acyclic calls it declares and answers, the bulk
+//! service, the shared resources it holds, and its reaction to a fault.
 //!
 //! An engine never writes an axis block itself. It couples the axes it drives
-//! (`Axis::couple`) and hands each of them its set-point for the tick (`Axis::drive_coupled`);
-//! the axis stage then runs limits, following-error monitoring, the position controller and
-//! the drive, and is the only writer of `gpAx[k]^`.
+//! ([`AxisSet::couple`], which gives a [`crate::axis::Lease`]) and hands each of them its
+//! set-point for the tick ([`AxisSet::drive`] with that lease); the axis stage then runs
+//! limits, following-error monitoring, the position controller and the drive, and is the
+//! only writer of `gpAx[k]^`.
+//!
+//! The machine routes a call by the table the engines declare ([`Engine::calls`]): it names
+//! no engine and no family. A new engine is its pure module, one file here with its `Engine`
+//! impl, one calls file in `hli::calls`, and one line where the engine set is built.
 
 use crate::axis::AxisSet;
 use hli::calls::fifo::{FifoReply, FifoRowsHeader};
-use hli::calls::{CallKind, HandlerResult};
+use hli::calls::{CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::views::CncView;
 use hli::wire::AcyclicRequest;
 
@@ -22,44 +28,170 @@ pub struct EngineIo<'a, 'm> {
     pub tick: u64,
 }
 
+/// Something engines share and one may hold, asked for by another before it takes it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Resource {
+    /// Motion-function (cam) table `id`: the flying saw plans its slave's motion in table
+    /// 256 - the slave's axis ID (seed 001, chapter 13), which a cam must not be using.
+    MotionTable(u32),
+}
+
+/// The engines other than the one answering a call.
+#[derive(Clone, Copy)]
+pub struct Others<'a> {
+    before: &'a [Box<dyn Engine>],
+    after: &'a [Box<dyn Engine>],
+}
+
+impl<'a> Others<'a> {
+    /// The engines around `engines[i]`.
+    pub fn split(engines: &'a mut [Box<dyn Engine>], i: usize) -> (&'a mut dyn Engine, Self) {
+        let (before, rest) = engines.split_at_mut(i);
+        let (me, after) = rest.split_first_mut().expect("an engine at i");
+        (me.as_mut(), Others { before, after })
+    }
+
+    /// Whether one of them holds `resource`.
+    pub fn hold(&self, resource: Resource) -> bool {
+        self.before
+            .iter()
+            .chain(self.after)
+            .any(|e| e.holds(resource))
+    }
+}
+
+/// What an engine answers a call with: the axes, and the other engines to ask about shared
+/// resources.
+pub struct CallCx<'a> {
+    /// Every axis of the machine.
+    pub axes: &'a mut AxisSet,
+    /// The other engines.
+    pub others: Others<'a>,
+}
+
 /// A motion engine in the machine tick.
 pub trait Engine: std::fmt::Debug + Send {
     /// A short name for reports.
     fn name(&self) -> &'static str;
 
+    /// The call kinds this engine answers: its family's table (`hli::calls::<family>::CALLS`)
+    /// or part of it. The machine routes every call of these kinds to [`Engine::handle`]; two
+    /// engines declaring one kind is an error when the machine is built.
+    fn calls(&self) -> &'static [CallSpec] {
+        &[]
+    }
+
     /// One tick, between the axes' sense (inputs read, free axes' generators stepped: a
     /// master's set-point is this tick's) and act (following error, controller, outputs).
-    /// An engine may couple an axis here (`Axis::couple`, then `drive_coupled`); a decoupled
-    /// axis steps its own generator this tick (`Axis::decouple`). Must not allocate, lock or
-    /// do IO.
+    /// An engine may couple an axis here ([`AxisSet::couple`], then [`AxisSet::drive`]); a
+    /// released axis steps its own generator this tick. Must not allocate, lock or do IO.
     fn tick(&mut self, io: &mut EngineIo<'_, '_>);
 
-    /// An acyclic call this engine owns, answered; `None` when the call is not its own.
+    /// A call of one of the kinds of [`Engine::calls`], answered.
     fn handle(
         &mut self,
         kind: CallKind,
         request: &AcyclicRequest,
-        axes: &mut AxisSet,
-    ) -> Option<HandlerResult> {
-        let _ = (kind, request, axes);
-        None
+        cx: CallCx<'_>,
+    ) -> HandlerResult {
+        let _ = (kind, request, cx);
+        Err(ErrorCode::ServiceNotSupported)
     }
 
-    /// A FIFO row block (the bulk data of the row service) this engine owns, answered;
-    /// `None` when it is not its own.
-    fn handle_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
+    /// A block of the bulk service (rows of numbers written straight into shared memory, not
+    /// copied into a call frame), answered; `None` when the block is not this engine's.
+    fn handle_bulk(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
         let _ = (header, values);
         None
     }
 
-    /// Whether this engine holds motion-function table `id` (the flying saw refuses a slave
-    /// whose internal table, 256 - slave axis ID, a cam uses).
-    fn holds_table(&self, id: u32) -> bool {
-        let _ = id;
+    /// Whether this engine holds `resource` now.
+    fn holds(&self, resource: Resource) -> bool {
+        let _ = resource;
         false
     }
 
     /// The machine stops on a fault (lost PLC, signal): release every coupled axis so that
     /// each stops with its own deceleration.
     fn reset(&mut self, axes: &mut AxisSet);
+}
+
+/// Which engine answers which call kind: built once from the engines' [`Engine::calls`].
+#[derive(Debug, Default)]
+pub struct Routes {
+    table: Vec<(CallKind, usize)>,
+}
+
+/// Two engines declare the same call kind.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("call kind {kind:?} is declared by the engines {first} and {second}")]
+pub struct RouteConflict {
+    /// The kind.
+    pub kind: CallKind,
+    /// The engine that declared it first.
+    pub first: &'static str,
+    /// The other one.
+    pub second: &'static str,
+}
+
+impl Routes {
+    /// The routes of `engines`.
+    pub fn new(engines: &[Box<dyn Engine>]) -> Result<Routes, RouteConflict> {
+        let mut table: Vec<(CallKind, usize)> = Vec::new();
+        for (i, engine) in engines.iter().enumerate() {
+            for spec in engine.calls() {
+                if let Some(&(_, first)) = table.iter().find(|(k, _)| *k == spec.kind) {
+                    return Err(RouteConflict {
+                        kind: spec.kind,
+                        first: engines[first].name(),
+                        second: engine.name(),
+                    });
+                }
+                table.push((spec.kind, i));
+            }
+        }
+        Ok(Routes { table })
+    }
+
+    /// The engine that answers `kind`.
+    pub fn engine(&self, kind: CallKind) -> Option<usize> {
+        self.table.iter().find(|(k, _)| *k == kind).map(|&(_, i)| i)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[derive(Debug)]
+    struct Declares(&'static str, &'static [CallSpec]);
+
+    impl Engine for Declares {
+        fn name(&self) -> &'static str {
+            self.0
+        }
+        fn calls(&self) -> &'static [CallSpec] {
+            self.1
+        }
+        fn tick(&mut self, _: &mut EngineIo<'_, '_>) {}
+        fn reset(&mut self, _: &mut AxisSet) {}
+    }
+
+    #[test]
+    fn calls_route_to_the_engine_that_declares_them_and_only_one_may() {
+        let engines: Vec<Box<dyn Engine>> = vec![
+            Box::new(Declares("a", hli::calls::cam::CALLS)),
+            Box::new(Declares("b", hli::calls::fifo::CALLS)),
+        ];
+        let routes = Routes::new(&engines).unwrap();
+        assert_eq!(routes.engine(CallKind::CAM_IN), Some(0));
+        assert_eq!(routes.engine(CallKind::FIFO_START), Some(1));
+        assert_eq!(routes.engine(CallKind::AXIS_COMMAND), None);
+        let twice: Vec<Box<dyn Engine>> = vec![
+            Box::new(Declares("a", hli::calls::saw::CALLS)),
+            Box::new(Declares("b", hli::calls::saw::CALLS)),
+        ];
+        let conflict = Routes::new(&twice).unwrap_err();
+        assert_eq!((conflict.first, conflict.second), ("a", "b"));
+    }
 }

@@ -17,7 +17,7 @@
 //! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
 //! are sized when the engine is built.
 
-use super::engine::{Engine, EngineIo};
+use super::engine::{CallCx, Engine, EngineIo};
 use crate::axis::{AxisSet, Coupling};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
@@ -28,7 +28,7 @@ use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,
     FifoRowsHeader,
 };
-use hli::calls::{decode_body, reply, CallKind, HandlerResult};
+use hli::calls::{decode_body, reply, CallKind, CallSpec, HandlerResult};
 use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{
     HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
@@ -534,26 +534,20 @@ impl Engine for FifoEngine {
         }
     }
 
+    fn calls(&self) -> &'static [CallSpec] {
+        hli::calls::fifo::CALLS
+    }
+
     fn handle(
         &mut self,
         kind: CallKind,
         request: &AcyclicRequest,
-        axes: &mut AxisSet,
-    ) -> Option<HandlerResult> {
-        let fifo = matches!(
-            kind,
-            CallKind::FIFO_DIMENSION
-                | CallKind::FIFO_INTEGRATE
-                | CallKind::FIFO_DISINTEGRATE
-                | CallKind::FIFO_START
-                | CallKind::FIFO_STOP
-                | CallKind::FIFO_OVERRIDE
-                | CallKind::FIFO_PARAMETERS
-        );
-        fifo.then(|| reply(&self.call(kind, request, axes)))
+        cx: CallCx<'_>,
+    ) -> HandlerResult {
+        reply(&self.call(kind, request, cx.axes))
     }
 
-    fn handle_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
+    fn handle_bulk(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
         Some(match self.groups.get_mut(header.group as usize) {
             Some(group) => group.write(header, values),
             None => FifoReply {

@@ -14,7 +14,7 @@
 //!                  axis blocks gpAx[k]^
 //!   7 CNC units    each channel's display values, state, requests and interface; heartbeat;
 //!                  tracking error measured on the actual axis positions
-//! between ticks:  acyclic calls (`dispatch`): engines first, then the axis commands
+//! between ticks:  acyclic calls (`dispatch`): routed by kind to the engine that declares it, else the axis layer
 //! ```
 //!
 //! The machine is library code: it knows no PLC program and no process. `cnc run`, the demo,
@@ -28,7 +28,7 @@ pub mod gear;
 pub mod saw;
 
 pub use channel_axes::ChannelAxes;
-pub use engine::{Engine, EngineIo};
+pub use engine::{CallCx, Engine, EngineIo, Others, Resource, RouteConflict, Routes};
 
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
@@ -57,6 +57,9 @@ pub enum MachineError {
     /// The axes.
     #[error(transparent)]
     Axes(#[from] AxisSetError),
+    /// Two engines declare the same call kind.
+    #[error(transparent)]
+    Routes(#[from] RouteConflict),
     /// Single axes that do not fit behind the channel axes.
     #[error(
         "{channel_axes} channel axes and {single} single axes: the image holds {HLI_MAX_AXES}"
@@ -90,6 +93,7 @@ pub struct Machine {
     links: Vec<Option<ChannelAxes>>,
     single_axes: usize,
     engines: Vec<Box<dyn Engine>>,
+    routes: Routes,
     heartbeat: Leaf,
     ticks: u64,
     commanded: Vec<Isometry3<f64>>,
@@ -140,12 +144,14 @@ impl Machine {
             link.couple(&mut axis_set);
         }
         let n = channels.len();
+        let routes = Routes::new(&engines)?;
         Ok(Machine {
             controller: Controller::new(channels)?,
             axes: axis_set,
             links,
             single_axes,
             engines,
+            routes,
             heartbeat: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
             ticks: 0,
             commanded: vec![Isometry3::identity(); n],
@@ -216,7 +222,8 @@ impl Machine {
         }
     }
 
-    /// Answers one acyclic call: an engine that owns it, else the axis layer. Commands to a
+    /// Answers one acyclic call: the engine that declares its kind, else the machine's own
+    /// (the axis layer, the probes, the channels' diagnosis). Commands to a
     /// channel's axes are refused (`Coupled`): the channel owns them.
     pub fn dispatch(
         &mut self,
@@ -228,23 +235,13 @@ impl Machine {
         if self.stopped && !kind.is_read_only() {
             return Err(ErrorCode::Busy);
         }
-        if kind == CallKind::SAW_GEAR_IN {
-            // The saw's internal table is 256 - the slave's axis ID (chapter 13).
-            let id = self
-                .axes
-                .axis(request.target as usize)
-                .map(|a| 256u32.wrapping_sub(a.config().id));
-            if id.is_some_and(|id| self.engines.iter().any(|e| e.holds_table(id))) {
-                return reply(&hli::calls::saw::SawReply {
-                    error_id: hli::enums::SawError::TableInUse.raw(),
-                    reserved: 0,
-                });
-            }
-        }
-        for engine in &mut self.engines {
-            if let Some(result) = engine.handle(kind, request, &mut self.axes) {
-                return result;
-            }
+        if let Some(i) = self.routes.engine(kind) {
+            let (engine, others) = Others::split(&mut self.engines, i);
+            let cx = CallCx {
+                axes: &mut self.axes,
+                others,
+            };
+            return engine.handle(kind, request, cx);
         }
         match kind {
             CallKind::READ_AXIS_STATE => handle_read_axis_state(view, request),
@@ -301,8 +298,8 @@ impl Machine {
         hli::calls::decode_reply::<C>(&reply, len)
     }
 
-    /// Answers one FIFO row block: the engine that owns it (the FIFO engine), else it is
-    /// refused as addressing no group. A stopped machine takes no rows.
+    /// Answers one block of the bulk service: the engine that owns it, else it is refused as
+    /// addressing no group. A stopped machine takes no blocks.
     pub fn dispatch_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> FifoReply {
         if self.stopped {
             return FifoReply {
@@ -311,7 +308,7 @@ impl Machine {
             };
         }
         for engine in &mut self.engines {
-            if let Some(reply) = engine.handle_rows(header, values) {
+            if let Some(reply) = engine.handle_bulk(header, values) {
                 return reply;
             }
         }

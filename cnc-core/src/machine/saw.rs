@@ -7,7 +7,7 @@
 //! synchronous phase was reached; when the master comes forward over the coupling position
 //! again, the slave synchronises anew from where it stands.
 
-use super::engine::{Engine, EngineIo};
+use super::engine::{CallCx, Engine, EngineIo, Resource};
 use crate::axis::{AxisSet, Coupling};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
@@ -15,7 +15,7 @@ use hli::calls::saw::{
     SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
     SawSyncTarget, SAW_CHARAC_PART,
 };
-use hli::calls::{decode_body, reply, CallKind, ErrorCode, HandlerResult};
+use hli::calls::{decode_body, reply, CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, SawError};
 use hli::wire::AcyclicRequest;
 
@@ -199,6 +199,15 @@ impl SawEngine {
     }
 }
 
+/// The motion table the saw plans `slave`'s motion in: 256 - its axis ID (seed 001, chapter
+/// 13); the axis ID 0 of a missing axis names no table a cam can hold.
+fn own_table(axes: &AxisSet, slave: usize) -> Resource {
+    let id = axes
+        .axis(slave)
+        .map_or(0, |a| 256u32.wrapping_sub(a.config().id));
+    Resource::MotionTable(id)
+}
+
 impl Engine for SawEngine {
     fn name(&self) -> &'static str {
         "flying saw"
@@ -231,17 +240,28 @@ impl Engine for SawEngine {
         }
     }
 
+    fn calls(&self) -> &'static [CallSpec] {
+        hli::calls::saw::CALLS
+    }
+
     fn handle(
         &mut self,
         kind: CallKind,
         request: &AcyclicRequest,
-        axes: &mut AxisSet,
-    ) -> Option<HandlerResult> {
+        cx: CallCx<'_>,
+    ) -> HandlerResult {
         let slave = request.target as usize;
         let known = slave < self.slaves.len();
-        Some(match kind {
+        let axes = cx.axes;
+        match kind {
             // A slave beyond the engine's slots (an engine built for fewer axes).
             CallKind::SAW_GEAR_IN if !known => Err(ErrorCode::InvalidTarget),
+            // The saw plans in table 256 - the slave's axis ID (chapter 13): not while another
+            // engine (a cam) uses that table.
+            CallKind::SAW_GEAR_IN if cx.others.hold(own_table(axes, slave)) => reply(&SawReply {
+                error_id: SawError::TableInUse.raw(),
+                reserved: 0,
+            }),
             CallKind::SAW_GEAR_IN => decode_body::<SawGearInCall>(request)
                 .and_then(|call| self.gear_in(slave, &call, axes)),
             CallKind::SAW_GEAR_OUT => {
@@ -249,8 +269,8 @@ impl Engine for SawEngine {
             }
             CallKind::SAW_CHARAC => decode_body::<SawCharacCall>(request)
                 .and_then(|call| self.read_charac(slave, &call)),
-            _ => return None,
-        })
+            _ => Err(ErrorCode::ServiceNotSupported),
+        }
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {

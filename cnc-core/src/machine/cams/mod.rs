@@ -27,7 +27,7 @@ mod couplings;
 mod data;
 mod reads;
 
-use super::engine::{Engine, EngineIo};
+use super::engine::{CallCx, Engine, EngineIo, Resource};
 use crate::axis::AxisSet;
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
@@ -39,7 +39,7 @@ use hli::calls::cam::{
     CamReply, CamScalingMode, CamStartMode, CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING,
     CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
 };
-use hli::calls::{reply, CallKind, HandlerResult};
+use hli::calls::{reply, CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CamCouplingError, CouplingState};
 use hli::wire::AcyclicRequest;
 
@@ -541,8 +541,14 @@ impl Engine for CamEngine {
         "cam"
     }
 
-    fn holds_table(&self, id: u32) -> bool {
-        self.store.get(id).is_ok()
+    fn calls(&self) -> &'static [CallSpec] {
+        hli::calls::cam::CALLS
+    }
+
+    fn holds(&self, resource: Resource) -> bool {
+        match resource {
+            Resource::MotionTable(id) => self.store.get(id).is_ok(),
+        }
     }
 
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
@@ -557,12 +563,13 @@ impl Engine for CamEngine {
         &mut self,
         kind: CallKind,
         request: &AcyclicRequest,
-        axes: &mut AxisSet,
-    ) -> Option<HandlerResult> {
+        cx: CallCx<'_>,
+    ) -> HandlerResult {
+        let axes = cx.axes;
         // Between ticks: free what the ticks retired.
         self.retired.clear();
         self.retired_changes.clear();
-        Some(match kind {
+        match kind {
             CallKind::CAM_TABLE_SELECT => self.table_select(request),
             CallKind::CAM_IN => self.cam_in(request, axes),
             CallKind::CAM_OUT => self.cam_out(request, axes),
@@ -576,8 +583,8 @@ impl Engine for CamEngine {
             CallKind::CAM_MULTI_COUPLE => self.multi_couple(request, axes),
             CallKind::CAM_MULTI_TABLE => self.multi_table(request),
             CallKind::CAM_TABLE_DELETE => self.table_delete(request),
-            _ => return None,
-        })
+            _ => Err(ErrorCode::ServiceNotSupported),
+        }
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
