@@ -619,13 +619,17 @@ fn bad_commands_are_refused_and_do_not_disturb_a_running_move() {
         Err(AxisError::NotEnabled)
     );
     rig.call(0, AxisCommandCall::power(true)).unwrap();
-    let axis = rig.set.axis_mut(0).unwrap();
-    axis.couple(Coupling {
-        kind: CouplingState::Cam,
-        master: 1,
-        phase: AxisState::SlaveSynchronizing,
-    })
-    .unwrap();
+    let _lease = rig
+        .set
+        .couple(
+            0,
+            Coupling {
+                kind: CouplingState::Cam,
+                master: 1,
+                phase: AxisState::SlaveSynchronizing,
+            },
+        )
+        .unwrap();
     assert_eq!(
         rig.call(0, AxisCommandCall::move_absolute(1.0, LIMITS)),
         Err(AxisError::Coupled)
@@ -640,19 +644,22 @@ fn bad_commands_are_refused_and_do_not_disturb_a_running_move() {
 fn a_decoupled_slave_goes_on_at_constant_velocity() {
     let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
     rig.enable(0);
-    rig.set
-        .axis_mut(0)
-        .unwrap()
-        .couple(Coupling {
-            kind: CouplingState::GearVelocity,
-            master: 1,
-            phase: AxisState::SlaveSynchronous,
-        })
+    let lease = rig
+        .set
+        .couple(
+            0,
+            Coupling {
+                kind: CouplingState::GearVelocity,
+                master: 1,
+                phase: AxisState::SlaveSynchronous,
+            },
+        )
         .unwrap();
     // The coupled engine moves the slave at 100 mm/s.
     for n in 0..200 {
         let p = n as f64 * 0.1;
-        rig.set.axis_mut(0).unwrap().drive_coupled(
+        rig.set.drive(
+            lease,
             Kinematic {
                 position: p,
                 velocity: 100.0,
@@ -670,7 +677,7 @@ fn a_decoupled_slave_goes_on_at_constant_velocity() {
         .read();
     assert_eq!(lr.axis_state_r, 13);
     assert_eq!(lr.coupling_state_r, CouplingState::GearVelocity.raw());
-    rig.set.axis_mut(0).unwrap().decouple();
+    rig.set.release(lease);
     rig.ticks(500);
     let k = rig.set_point(0);
     assert!((k.velocity - 100.0).abs() < 1e-9, "velocity {}", k.velocity);
@@ -797,17 +804,14 @@ fn power_off_ends_a_coupling_at_rest_and_is_refused_at_speed() {
         master: 1,
         phase: AxisState::SlaveSynchronous,
     };
-    rig.set.axis_mut(0).unwrap().couple(slave).unwrap();
+    let lease = rig.set.couple(0, slave).unwrap();
     let moving = Kinematic {
         position: 0.0,
         velocity: 10.0,
         acceleration: 0.0,
         jerk: 0.0,
     };
-    rig.set
-        .axis_mut(0)
-        .unwrap()
-        .drive_coupled(moving, AxisState::SlaveSynchronous);
+    rig.set.drive(lease, moving, AxisState::SlaveSynchronous);
     rig.tick();
     assert_eq!(
         rig.call(0, AxisCommandCall::power(false)),
@@ -817,10 +821,7 @@ fn power_off_ends_a_coupling_at_rest_and_is_refused_at_speed() {
         velocity: 0.0,
         ..moving
     };
-    rig.set
-        .axis_mut(0)
-        .unwrap()
-        .drive_coupled(resting, AxisState::SlaveSynchronous);
+    rig.set.drive(lease, resting, AxisState::SlaveSynchronous);
     rig.tick();
     rig.call(0, AxisCommandCall::power(false)).unwrap();
     rig.tick();
@@ -866,19 +867,22 @@ fn decoupling_inside_an_engines_tick_keeps_the_motion_going() {
     // set-point of that very tick moves on by one tick's travel, no stall.
     let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
     rig.enable(0);
-    rig.set
-        .axis_mut(0)
-        .unwrap()
-        .couple(Coupling {
-            kind: CouplingState::Cam,
-            master: -1,
-            phase: AxisState::SlaveSynchronous,
-        })
+    let lease = rig
+        .set
+        .couple(
+            0,
+            Coupling {
+                kind: CouplingState::Cam,
+                master: -1,
+                phase: AxisState::SlaveSynchronous,
+            },
+        )
         .unwrap();
     let view = CncView::new(&rig.memory);
     for k in 1..=50 {
         rig.set.sense(&view);
-        rig.set.axis_mut(0).unwrap().drive_coupled(
+        rig.set.drive(
+            lease,
             Kinematic {
                 position: 0.1 * k as f64,
                 velocity: 100.0,
@@ -890,7 +894,7 @@ fn decoupling_inside_an_engines_tick_keeps_the_motion_going() {
     }
     let before = rig.set_point(0).position;
     rig.set.sense(&view);
-    rig.set.axis_mut(0).unwrap().decouple();
+    rig.set.release(lease);
     rig.set.act(&view);
     let after = rig.set_point(0);
     assert!(
@@ -902,4 +906,34 @@ fn decoupling_inside_an_engines_tick_keeps_the_motion_going() {
     // Between ticks the generator takes over with the next tick (no double step).
     rig.tick();
     assert!((rig.set_point(0).position - after.position - 0.1).abs() < 1e-9);
+}
+
+/// Issue 32: one ownership rule. A coupling is driven and released through its lease; once
+/// another coupling took the axis (here after a release), the old lease does nothing.
+#[test]
+fn a_stale_lease_neither_drives_nor_releases_the_axis() {
+    let mut rig = Rig::new(vec![AxisConfig::linear("X", 1)]);
+    rig.enable(0);
+    let coupling = |kind| Coupling {
+        kind,
+        master: -1,
+        phase: AxisState::SlaveSynchronous,
+    };
+    let first = rig.set.couple(0, coupling(CouplingState::Cam)).unwrap();
+    assert!(rig.set.holds(first));
+    assert!(rig.set.release(first));
+    let second = rig
+        .set
+        .couple(0, coupling(CouplingState::GearVelocity))
+        .unwrap();
+    assert!(!rig.set.holds(first) && rig.set.holds(second));
+    let away = Kinematic {
+        position: 5.0,
+        ..Kinematic::default()
+    };
+    assert!(!rig.set.drive(first, away, AxisState::SlaveSynchronous));
+    assert!(!rig.set.release(first), "a stale lease releases nothing");
+    let kind = rig.set.axis(0).unwrap().coupling().map(|c| c.kind);
+    assert_eq!(kind, Some(CouplingState::GearVelocity));
+    assert!(rig.set.drive(second, away, AxisState::SlaveSynchronous));
 }

@@ -26,4 +26,4 @@ pub use config::{
     AxisConfig, AxisKind, ConfigError, DriveLink, DriveMode, DriveProtocol, Dynamics, ImageOptions,
     ProbeInterface,
 };
-pub use set::AxisSet;
+pub use set::{AxisSet, Lease};

@@ -1,13 +1,15 @@
 //! All axes of the CNC bound to the HLI image: the cyclic tick and the handler of the PLC's
 //! axis commands.
 
-use super::axis::Axis;
+use super::axis::{Axis, Coupling};
 use super::config::{AxisConfig, ConfigError, DriveLink};
 use super::sim_drive::{SimScaling, SimulatedDrive};
+use crate::setpoint::Kinematic;
 use core::mem::offset_of;
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall, ProbeReply};
 use hli::calls::{decode_body, reply, ErrorCode, HandlerResult};
+use hli::enums::{AxisError, AxisState};
 use hli::layout::{
     HliAxis, HliAxisCommandState, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut,
     NcEncoderIn, NcEncoderOut, HLI_MAX_AXES,
@@ -28,6 +30,24 @@ pub enum AxisSetError {
     /// Two axes share a name or id.
     #[error("axis {0:?} is configured twice (name or id)")]
     Duplicate(String),
+}
+
+/// The right to drive a coupled axis: which axis, and which of its couplings. Coupling an axis
+/// ([`AxisSet::couple`]) gives a new lease; driving, changing and releasing the coupling take
+/// it and do nothing once it is stale (the axis faulted, or another engine coupled it since).
+/// Every engine and the channels hold their axes this way: one ownership rule.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[must_use = "a coupling is driven and released through its lease"]
+pub struct Lease {
+    axis: usize,
+    epoch: u32,
+}
+
+impl Lease {
+    /// The axis index.
+    pub fn axis(self) -> usize {
+        self.axis
+    }
 }
 
 /// The axes with their simulated drives.
@@ -93,6 +113,49 @@ impl AxisSet {
     pub fn axis_mut(&mut self, i: usize) -> Option<&mut Axis> {
         self.axes.get_mut(i)
     }
+    /// Couples axis `i` to an engine (or a channel) that hands in its set-points with
+    /// [`AxisSet::drive`]; refused when the axis may not move (see [`Axis::couple`]).
+    pub fn couple(&mut self, i: usize, coupling: Coupling) -> Result<Lease, AxisError> {
+        let axis = self.axes.get_mut(i).ok_or(AxisError::InvalidParameter)?;
+        axis.couple(coupling)?;
+        Ok(Lease {
+            axis: i,
+            epoch: axis.coupling_epoch(),
+        })
+    }
+
+    /// The axis of `lease` while the lease holds.
+    fn leased(&mut self, lease: Lease) -> Option<&mut Axis> {
+        self.axes
+            .get_mut(lease.axis)
+            .filter(|a| a.coupling().is_some() && a.coupling_epoch() == lease.epoch)
+    }
+
+    /// Whether `lease` still holds its axis.
+    pub fn holds(&self, lease: Lease) -> bool {
+        self.axes
+            .get(lease.axis)
+            .is_some_and(|a| a.coupling().is_some() && a.coupling_epoch() == lease.epoch)
+    }
+
+    /// This tick's set-point of a leased axis; `false` (nothing done) once the lease is stale.
+    pub fn drive(&mut self, lease: Lease, setpoint: Kinematic, phase: AxisState) -> bool {
+        self.leased(lease)
+            .map(|a| a.drive_coupled(setpoint, phase))
+            .is_some()
+    }
+
+    /// Changes what a leased axis is coupled to, in place (see [`Axis::recouple`]).
+    pub fn recouple(&mut self, lease: Lease, coupling: Coupling) -> bool {
+        self.leased(lease).is_some_and(|a| a.recouple(coupling))
+    }
+
+    /// Ends the coupling of `lease` (see [`Axis::decouple`]); `false` when the lease was
+    /// already stale (the axis is someone else's, or free).
+    pub fn release(&mut self, lease: Lease) -> bool {
+        self.leased(lease).map(Axis::decouple).is_some()
+    }
+
     /// The simulated drive of axis `i`, if it has one.
     pub fn drive_mut(&mut self, i: usize) -> Option<&mut SimulatedDrive> {
         self.drives.get_mut(i).and_then(Option::as_mut)

@@ -5,7 +5,7 @@
 
 use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
 use crate::axis::sim_drive::DriveModel;
-use crate::axis::{motion_phase, AxisSet, Coupling};
+use crate::axis::{motion_phase, AxisSet, Coupling, Lease};
 use crate::channel::config::ChannelConfig;
 use crate::nc::decode::AxisValues;
 use crate::setpoint::Kinematic;
@@ -19,6 +19,8 @@ pub struct ChannelAxes {
     last: AxisValues,
     last_velocity: AxisValues,
     cycle_s: f64,
+    /// The channel's couplings of its axes (sized when built).
+    leases: Vec<Option<Lease>>,
 }
 
 /// The axis configuration of channel axis `i` of `channel`: named `CHANNEL.AXIS`, standing at
@@ -58,6 +60,7 @@ impl ChannelAxes {
             last: *start,
             last_velocity: AxisValues::zeros(start.len()),
             cycle_s,
+            leases: vec![None; start.len()],
         }
     }
 
@@ -67,16 +70,18 @@ impl ChannelAxes {
     }
 
     /// Powers the channel's axes and couples them to the channel (before the first tick).
-    pub fn couple(&self, axes: &mut AxisSet) {
-        for i in self.first..self.first + self.count {
-            if let Some(axis) = axes.axis_mut(i) {
-                let _ = axis.switch_on();
-                let _ = axis.couple(Coupling {
-                    kind: CouplingState::Channel,
-                    master: -1,
-                    phase: AxisState::Standstill,
-                });
+    pub fn couple(&mut self, axes: &mut AxisSet) {
+        for (i, lease) in self.leases.iter_mut().enumerate() {
+            let axis = self.first + i;
+            if let Some(a) = axes.axis_mut(axis) {
+                let _ = a.switch_on();
             }
+            let coupling = Coupling {
+                kind: CouplingState::Channel,
+                master: -1,
+                phase: AxisState::Standstill,
+            };
+            *lease = axes.couple(axis, coupling).ok();
         }
     }
 
@@ -86,16 +91,14 @@ impl ChannelAxes {
             let v = (p - self.last[i]) / self.cycle_s;
             let a = (v - self.last_velocity[i]) / self.cycle_s;
             let phase = motion_phase(v, a);
-            if let Some(axis) = axes.axis_mut(self.first + i) {
-                axis.drive_coupled(
-                    Kinematic {
-                        position: p,
-                        velocity: v,
-                        acceleration: a,
-                        jerk: 0.0,
-                    },
-                    phase,
-                );
+            if let Some(lease) = self.leases.get(i).copied().flatten() {
+                let set = Kinematic {
+                    position: p,
+                    velocity: v,
+                    acceleration: a,
+                    jerk: 0.0,
+                };
+                axes.drive(lease, set, phase);
             }
             self.last[i] = p;
             self.last_velocity[i] = v;

@@ -18,7 +18,7 @@
 //! are sized when the engine is built.
 
 use super::engine::{CallCx, Engine, EngineIo};
-use crate::axis::{AxisSet, Coupling};
+use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
 };
@@ -58,7 +58,7 @@ pub enum FifoConfigError {
 struct Group {
     params: FifoParams,
     /// Axis index per column (group position - 1).
-    members: Vec<Option<usize>>,
+    members: Vec<Option<Lease>>,
     ring: RowRing,
     generator: FifoGenerator,
     ovr: OverrideFilter,
@@ -77,10 +77,9 @@ const MEMBER: Coupling = Coupling {
     phase: AxisState::SlaveSynchronous,
 };
 
-fn is_member(axes: &AxisSet, axis: usize) -> bool {
-    axes.axis(axis)
-        .and_then(|a| a.coupling())
-        .is_some_and(|c| c.kind == CouplingState::Fifo)
+/// Whether every slot holds a member whose coupling is still the group's.
+fn complete(members: &[Option<Lease>], axes: &AxisSet) -> bool {
+    members.iter().all(|m| m.is_some_and(|l| axes.holds(l)))
 }
 
 fn ppm(value: f64) -> u32 {
@@ -173,14 +172,13 @@ impl Group {
     /// Every member leaves the group (decoupled where still ours), `halt`ing with its own
     /// deceleration when asked.
     fn release(&mut self, axes: &mut AxisSet, halt: bool) {
-        for axis in self.members.iter_mut().filter_map(Option::take) {
-            let Some(a) = axes.axis_mut(axis) else {
-                continue;
-            };
-            if !a.coupling().is_some_and(|c| c.kind == CouplingState::Fifo) {
+        for lease in self.members.iter_mut().filter_map(Option::take) {
+            if !axes.release(lease) {
                 continue;
             }
-            a.decouple();
+            let Some(a) = axes.axis_mut(lease.axis()) else {
+                continue;
+            };
             if halt {
                 let d = a.config().dynamics;
                 // MC_Halt, not MC_Stop: the axis must not stay locked for the PLC that
@@ -202,44 +200,36 @@ impl Group {
             // Members stand where they are; one that lost its coupling (power off, fault,
             // reset) has left the group.
             for slot in &mut self.members {
-                let Some(axis) = *slot else { continue };
-                if !is_member(axes, axis) {
+                let Some(lease) = *slot else { continue };
+                let Some(a) = axes.axis(lease.axis()).filter(|_| axes.holds(lease)) else {
                     *slot = None;
                     continue;
-                }
-                if let Some(a) = axes.axis_mut(axis) {
-                    let hold = Kinematic {
-                        position: a.setpoint().position,
-                        ..Kinematic::default()
-                    };
-                    a.drive_coupled(hold, AxisState::SlaveSynchronous);
-                }
+                };
+                let hold = Kinematic {
+                    position: a.setpoint().position,
+                    ..Kinematic::default()
+                };
+                axes.drive(lease, hold, AxisState::SlaveSynchronous);
             }
             return;
         }
-        if self
-            .members
-            .iter()
-            .any(|m| !m.is_some_and(|axis| is_member(axes, axis)))
-        {
+        if !complete(&self.members, axes) {
             self.fault(axes);
             return;
         }
         let ov = self.ovr.step();
         let status = self.generator.step(&mut self.ring, ov);
-        for (c, axis) in self.members.iter().enumerate() {
-            let Some(a) = axis.and_then(|axis| axes.axis_mut(axis)) else {
+        for (c, lease) in self.members.iter().enumerate() {
+            let Some(lease) = *lease else {
                 continue;
             };
-            a.drive_coupled(
-                Kinematic {
-                    position: self.generator.position()[c],
-                    velocity: self.generator.velocity()[c],
-                    acceleration: self.generator.acceleration()[c],
-                    jerk: 0.0,
-                },
-                AxisState::SlaveSynchronous,
-            );
+            let set = Kinematic {
+                position: self.generator.position()[c],
+                velocity: self.generator.velocity()[c],
+                acceleration: self.generator.acceleration()[c],
+                jerk: 0.0,
+            };
+            axes.drive(lease, set, AxisState::SlaveSynchronous);
         }
         self.flags = 0;
         if status.underrun {
@@ -263,7 +253,7 @@ impl Group {
             return self.refuse(FifoError::GroupPosition);
         }
         let axis = call.axis as usize;
-        let Some(a) = axes.axis_mut(axis) else {
+        let Some(a) = axes.axis(axis) else {
             return self.refuse(FifoError::NoSuchAxis);
         };
         match a.coupling().map(|c| c.kind) {
@@ -278,10 +268,11 @@ impl Group {
         if a.setpoint().velocity != 0.0 || a.book().active().is_some() {
             return self.refuse(FifoError::AxisMoving);
         }
-        if let Err(e) = a.couple(MEMBER) {
-            return self.reply(Some(e.raw()));
-        }
-        self.members[column - 1] = Some(axis);
+        let lease = match axes.couple(axis, MEMBER) {
+            Ok(lease) => lease,
+            Err(e) => return self.reply(Some(e.raw())),
+        };
+        self.members[column - 1] = Some(lease);
         if self.state == FifoGroupState::Error {
             self.error = None;
             self.state = FifoGroupState::Idle;
@@ -292,7 +283,7 @@ impl Group {
     /// Drops `axis` from the member slots (it belongs to another group now).
     fn forget(&mut self, axis: usize) {
         for slot in &mut self.members {
-            if *slot == Some(axis) {
+            if slot.is_some_and(|l| l.axis() == axis) {
                 *slot = None;
             }
         }
@@ -316,18 +307,14 @@ impl Group {
         if self.state == FifoGroupState::Error {
             return self.refuse(FifoError::AxisFault);
         }
-        if self
-            .members
-            .iter()
-            .any(|m| !m.is_some_and(|axis| is_member(axes, axis)))
-        {
+        if !complete(&self.members, axes) {
             return self.refuse(FifoError::GroupIncomplete);
         }
         let Some(first) = self.ring.row(0) else {
             return self.refuse(FifoError::Empty);
         };
         for (c, axis) in self.members.iter().enumerate() {
-            let Some(a) = axis.and_then(|axis| axes.axis(axis)) else {
+            let Some(a) = axis.and_then(|l| axes.axis(l.axis())) else {
                 continue;
             };
             let set = a.setpoint();

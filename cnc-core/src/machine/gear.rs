@@ -5,7 +5,7 @@
 //! causes no jump.
 
 use super::engine::{Engine, EngineIo};
-use crate::axis::{AxisSet, Coupling};
+use crate::axis::{AxisSet, Coupling, Lease};
 use hli::enums::{AxisState, CouplingState};
 
 /// One gear: axis indices in the machine's axis set and the ratio.
@@ -23,8 +23,8 @@ pub struct GearSpec {
 struct Gear {
     spec: GearSpec,
     origin: Option<(f64, f64)>,
-    /// The slave's coupling number when this gear coupled it.
-    epoch: u32,
+    /// The slave's coupling, while this gear holds it.
+    lease: Option<Lease>,
 }
 
 /// Gear couplings between axes.
@@ -75,7 +75,7 @@ impl GearEngine {
                 .map(|&spec| Gear {
                     spec,
                     origin: None,
-                    epoch: 0,
+                    lease: None,
                 })
                 .collect(),
         })
@@ -102,47 +102,43 @@ impl Engine for GearEngine {
             let Some(m) = io.axes.axis(master).map(|a| a.setpoint()) else {
                 continue;
             };
-            let Some(axis) = io.axes.axis_mut(slave) else {
-                continue;
-            };
             // A slave that lost its coupling (power off, error, reset) couples again only
             // once it is enabled and free.
-            let owned = gear.origin.is_some()
-                && axis.coupling().is_some()
-                && axis.coupling_epoch() == gear.epoch;
+            let owned = gear.origin.is_some() && gear.lease.is_some_and(|l| io.axes.holds(l));
             if !owned {
                 gear.origin = None;
+                gear.lease = None;
+                let Some(axis) = io.axes.axis(slave) else {
+                    continue;
+                };
+                if !axis.enabled() || !axis.has_position() || axis.error().is_some() {
+                    continue;
+                }
+                let start = axis.setpoint().position;
                 let coupling = Coupling {
                     kind: CouplingState::GearVelocity,
                     master: master as i32,
                     phase: AxisState::SlaveSynchronous,
                 };
-                if !axis.enabled()
-                    || !axis.has_position()
-                    || axis.error().is_some()
-                    || axis.couple(coupling).is_err()
-                {
+                let Ok(lease) = io.axes.couple(slave, coupling) else {
                     continue;
-                }
-                gear.origin = Some((m.position, axis.setpoint().position));
-                gear.epoch = axis.coupling_epoch();
+                };
+                gear.origin = Some((m.position, start));
+                gear.lease = Some(lease);
             }
-            let Some(origin) = gear.origin else {
-                continue;
-            };
-            axis.drive_coupled(m.geared(ratio, origin), AxisState::SlaveSynchronous);
+            if let (Some(origin), Some(lease)) = (gear.origin, gear.lease) {
+                let set = m.geared(ratio, origin);
+                io.axes.drive(lease, set, AxisState::SlaveSynchronous);
+            }
         }
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
         for gear in &mut self.gears {
-            if gear.origin.take().is_some() {
-                if let Some(axis) = axes.axis_mut(gear.spec.slave) {
-                    // Only its own coupling (another engine may hold the axis since).
-                    if axis.coupling_epoch() == gear.epoch {
-                        axis.decouple();
-                    }
-                }
+            gear.origin = None;
+            // Only its own coupling (another engine may hold the axis since).
+            if let Some(lease) = gear.lease.take() {
+                axes.release(lease);
             }
         }
     }

@@ -140,7 +140,7 @@ impl Machine {
         let single_axes = axes.len();
         configs.extend(axes);
         let mut axis_set = AxisSet::new(configs, cycle_s)?;
-        for link in links.iter().flatten() {
+        for link in links.iter_mut().flatten() {
             link.couple(&mut axis_set);
         }
         let n = channels.len();

@@ -8,7 +8,7 @@
 //! again, the slave synchronises anew from where it stands.
 
 use super::engine::{CallCx, Engine, EngineIo, Resource};
-use crate::axis::{AxisSet, Coupling};
+use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use hli::calls::saw::{
@@ -23,9 +23,9 @@ use hli::wire::AcyclicRequest;
 struct SawSlave {
     master: usize,
     follower: Follower,
-    /// The axis's coupling number when the saw coupled it: another number means another
-    /// engine took the axis since (after a fault released it), and the slot is stale.
-    epoch: u32,
+    /// The slave's coupling: stale once another engine took the axis since (after a fault
+    /// released it), and the slot with it.
+    lease: Lease,
 }
 
 /// Flying-saw slaves by axis index.
@@ -70,11 +70,7 @@ impl SawEngine {
     /// the saw made).
     fn owns(&self, slave: usize, axes: &AxisSet) -> bool {
         let slot = self.slaves.get(slave).and_then(Option::as_ref);
-        let axis = axes.axis(slave);
-        match (slot, axis) {
-            (Some(s), Some(a)) => a.coupling().is_some() && a.coupling_epoch() == s.epoch,
-            _ => false,
-        }
+        slot.is_some_and(|s| axes.holds(s.lease))
     }
 
     /// Couples `slave` (MC_GearInVelo / MC_GearInPos). Refused with nothing changed.
@@ -135,25 +131,32 @@ impl SawEngine {
             SyncOn::Velocity => CouplingState::GearVelocity,
             SyncOn::Position { .. } => CouplingState::GearPosition,
         };
-        let axis = axes.axis_mut(slave).expect("checked above");
+        let soft_limits = axis.config().soft_limits;
         let coupling = Coupling {
             kind,
             master: master as i32,
             phase: AxisState::SlaveSynchronizing,
         };
-        if ours {
+        let lease = match self.slaves[slave].as_ref().map(|s| s.lease) {
             // A new command on a coupled slave: planned from where it is, coupled in place.
-            axis.recouple(coupling);
-        } else if let Err(e) = axis.couple(coupling) {
-            return reply(&SawReply {
-                error_id: e.raw(),
-                reserved: 0,
-            });
-        }
+            Some(lease) if ours => {
+                axes.recouple(lease, coupling);
+                lease
+            }
+            _ => match axes.couple(slave, coupling) {
+                Ok(lease) => lease,
+                Err(e) => {
+                    return reply(&SawReply {
+                        error_id: e.raw(),
+                        reserved: 0,
+                    })
+                }
+            },
+        };
         self.slaves[slave] = Some(SawSlave {
             master,
-            follower: Follower::new(request, &plan, &m, axis.config().soft_limits),
-            epoch: axis.coupling_epoch(),
+            follower: Follower::new(request, &plan, &m, soft_limits),
+            lease,
         });
         self.plans = self.plans.wrapping_add(1);
         self.characs[slave] = Some((plan.charac.values, self.plans));
@@ -161,16 +164,12 @@ impl SawEngine {
     }
 
     fn gear_out(&mut self, slave: usize, axes: &mut AxisSet) -> HandlerResult {
-        let ours = self.owns(slave, axes);
         // A stale slot (the axis taken by another engine since) goes without touching it.
-        let had = self.slaves.get_mut(slave).and_then(Option::take).is_some();
-        if !(had && ours) {
-            return refused(SawError::NotCoupled);
+        let had = self.slaves.get_mut(slave).and_then(Option::take);
+        match had {
+            Some(s) if axes.release(s.lease) => accepted(),
+            _ => refused(SawError::NotCoupled),
         }
-        if let Some(axis) = axes.axis_mut(slave) {
-            axis.decouple();
-        }
-        accepted()
     }
 
     fn read_charac(&self, slave: usize, call: &SawCharacCall) -> HandlerResult {
@@ -220,21 +219,19 @@ impl Engine for SawEngine {
             let Some(m) = io.axes.axis(s.master).map(|a| a.setpoint()) else {
                 continue;
             };
-            let Some(axis) = io.axes.axis_mut(i) else {
-                continue;
-            };
             // A slave that lost its coupling (fault, power off), or was coupled by another
             // engine since, is no longer the saw's.
-            let held = axis.coupling().is_some() && axis.coupling_epoch() == s.epoch;
-            if !held {
+            let Some(now) = io.axes.axis(i).filter(|_| io.axes.holds(s.lease)) else {
                 *slot = None;
                 continue;
-            }
-            match s.follower.step(&m, axis.setpoint(), dt) {
-                Some((set, phase)) => axis.drive_coupled(set, phase),
+            };
+            match s.follower.step(&m, now.setpoint(), dt) {
+                Some((set, phase)) => {
+                    io.axes.drive(s.lease, set, phase);
+                }
                 None => {
+                    io.axes.release(s.lease);
                     *slot = None;
-                    axis.decouple();
                 }
             }
         }
@@ -274,14 +271,10 @@ impl Engine for SawEngine {
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
-        for (i, slot) in self.slaves.iter_mut().enumerate() {
+        for slot in &mut self.slaves {
+            // Only its own coupling (another engine may hold the axis since).
             if let Some(s) = slot.take() {
-                if let Some(axis) = axes.axis_mut(i) {
-                    // Only its own coupling (another engine may hold the axis since).
-                    if axis.coupling_epoch() == s.epoch {
-                        axis.decouple();
-                    }
-                }
+                axes.release(s.lease);
             }
         }
     }

@@ -398,7 +398,7 @@ impl Axis {
 
     /// Couples the axis to an engine that hands in set-points with [`Axis::drive_coupled`].
     /// Refused while another command owns the axis is not needed: the coupling aborts it.
-    pub fn couple(&mut self, coupling: Coupling) -> Result<(), AxisError> {
+    pub(in crate::axis) fn couple(&mut self, coupling: Coupling) -> Result<(), AxisError> {
         self.may_move(true)?;
         self.book.finish(CommandResult::Aborted, None);
         self.coupled_setpoint = self.generator.state();
@@ -408,13 +408,13 @@ impl Axis {
     }
 
     /// The number of the current coupling (see [`Axis::couple`]); changes with every one.
-    pub fn coupling_epoch(&self) -> u32 {
+    pub(in crate::axis) fn coupling_epoch(&self) -> u32 {
         self.coupling_epoch
     }
 
     /// Changes what a coupled axis is coupled to, in place: the set-point goes on where it
     /// is (a new command of the same engine). `false` when the axis is not coupled.
-    pub fn recouple(&mut self, coupling: Coupling) -> bool {
+    pub(in crate::axis) fn recouple(&mut self, coupling: Coupling) -> bool {
         match self.coupling.as_mut() {
             Some(c) => {
                 *c = coupling;
@@ -425,7 +425,7 @@ impl Axis {
     }
 
     /// The coupled engine's set-point for this tick (ignored when not coupled).
-    pub fn drive_coupled(&mut self, setpoint: Kinematic, phase: AxisState) {
+    pub(in crate::axis) fn drive_coupled(&mut self, setpoint: Kinematic, phase: AxisState) {
         if let Some(c) = self.coupling.as_mut() {
             c.phase = phase;
             self.coupled_setpoint = setpoint;
@@ -440,7 +440,7 @@ impl Axis {
     /// an engine's tick (between `sense` and `act`, in place of this tick's `drive_coupled`)
     /// it steps at once from the last coupled set-point, so the motion goes on without a
     /// one-tick stall.
-    pub fn decouple(&mut self) {
+    pub(in crate::axis) fn decouple(&mut self) {
         if self.coupling.take().is_none() {
             return;
         }

@@ -7,7 +7,7 @@ use super::{
     accepted, code, coupling_code, master_of, merged_scaling, CamEngine, MultiSlave, Queued,
     Select, Slave, TABLE_INVALID,
 };
-use crate::axis::{AxisSet, Coupling};
+use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, Scaling,
 };
@@ -30,16 +30,16 @@ fn couple_cam(
     slave: usize,
     master: usize,
     phase: AxisState,
-) -> Result<(), u32> {
-    let axis = axes
-        .axis_mut(slave)
-        .ok_or(CamCouplingError::NotCamCoupled.raw())?;
-    axis.couple(Coupling {
+) -> Result<Lease, u32> {
+    if axes.axis(slave).is_none() {
+        return Err(CamCouplingError::NotCamCoupled.raw());
+    }
+    let coupling = Coupling {
         kind: CouplingState::Cam,
         master: master as i32,
         phase,
-    })
-    .map_err(AxisError::raw)
+    };
+    axes.couple(slave, coupling).map_err(AxisError::raw)
 }
 
 /// MC_CamIn's request, checked: what a switch or a first coupling is made of.
@@ -116,9 +116,7 @@ impl CamEngine {
         };
         match (axis.coupling(), self.slaves[slave].as_ref()) {
             // Coupled through a cam already: a switch (MC_CamInExt both times) or a refusal.
-            (Some(c), Some(_)) if c.kind == CouplingState::Cam => {
-                self.queue_switch(slave, &call, ask)
-            }
+            (Some(_), Some(s)) if axes.holds(s.lease) => self.queue_switch(slave, &call, ask),
             (Some(_), _) => code(AxisError::Coupled.raw()),
             (None, _) => self.couple_first(slave, &call, ask, axes),
         }
@@ -251,21 +249,18 @@ impl CamEngine {
         };
         let master_at = ask.master_set.position;
         let law = CamLaw::new(profile, ask.scaling, ask.start, periodic, master_at, hold);
-        if let Err(e) = couple_cam(axes, slave, ask.master, AxisState::SlavePrephase) {
-            return code(e);
-        }
-        let Some(axis) = axes.axis_mut(slave) else {
-            return Err(ErrorCode::InvalidTarget);
+        let lease = match couple_cam(axes, slave, ask.master, AxisState::SlavePrephase) {
+            Ok(lease) => lease,
+            Err(e) => return code(e),
         };
-        axis.drive_coupled(
-            Kinematic {
-                position: hold,
-                ..Kinematic::default()
-            },
-            AxisState::SlavePrephase,
-        );
+        let held = Kinematic {
+            position: hold,
+            ..Kinematic::default()
+        };
+        axes.drive(lease, held, AxisState::SlavePrephase);
         let timing = ask.activation.timing().expect("checked: a timed mode");
         self.slaves[slave] = Some(Slave {
+            lease,
             master: ask.master,
             table: call.table_id,
             own: ask.own,
@@ -327,12 +322,11 @@ impl CamEngine {
             return Err(ErrorCode::InvalidTarget);
         }
         if call.on == 0 {
-            if self.multis[slave].take().is_none() {
+            let Some(multi) = self.multis[slave].take() else {
                 return code(CamCouplingError::NotCamCoupled.raw());
-            }
-            if let Some(axis) = axes.axis_mut(slave) {
-                axis.decouple();
-            }
+            };
+            // Only its own coupling (another engine may hold the axis since).
+            axes.release(multi.lease);
             return accepted();
         }
         let master = call.master as usize;
@@ -374,14 +368,15 @@ impl CamEngine {
             }
             Err(_) => return code(CamCouplingError::UnknownMode.raw()),
         };
-        if let Err(e) = couple_cam(axes, slave, master, AxisState::SlaveSynchronous) {
-            return code(e);
-        }
+        let lease = match couple_cam(axes, slave, master, AxisState::SlaveSynchronous) {
+            Ok(lease) => lease,
+            Err(e) => return code(e),
+        };
         if let Some(stale) = self.slaves[slave].take() {
             self.retired.extend(stale.own);
             self.retired.extend(stale.switch_own);
         }
-        self.multis[slave] = Some(MultiSlave { master, law });
+        self.multis[slave] = Some(MultiSlave { lease, master, law });
         accepted()
     }
 
@@ -421,22 +416,16 @@ impl CamEngine {
         if slave >= axes.len() {
             return Err(ErrorCode::InvalidTarget);
         }
-        let cam_coupled = axes
-            .axis(slave)
-            .and_then(|a| a.coupling())
-            .is_some_and(|c| c.kind == CouplingState::Cam);
-        if cam_coupled && self.multis[slave].take().is_some() {
-            if let Some(axis) = axes.axis_mut(slave) {
-                axis.decouple();
-            }
+        let multi = self.multis[slave].as_ref().map(|m| m.lease);
+        if let Some(lease) = multi.filter(|l| axes.holds(*l)) {
+            self.multis[slave] = None;
+            axes.release(lease);
             return accepted();
         }
-        let Some(state) = self.slaves[slave].take().filter(|_| cam_coupled) else {
+        let Some(state) = self.slaves[slave].take().filter(|s| axes.holds(s.lease)) else {
             return code(CamCouplingError::NotCamCoupled.raw());
         };
-        if let Some(axis) = axes.axis_mut(slave) {
-            axis.decouple();
-        }
+        axes.release(state.lease);
         drop(state);
         accepted()
     }

@@ -28,7 +28,7 @@ mod data;
 mod reads;
 
 use super::engine::{CallCx, Engine, EngineIo, Resource};
-use crate::axis::AxisSet;
+use crate::axis::{AxisSet, Lease};
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
 use crate::cam::online::{ActivationMode, CamStore, MasterNow};
@@ -40,7 +40,7 @@ use hli::calls::cam::{
     CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
 };
 use hli::calls::{reply, CallKind, CallSpec, ErrorCode, HandlerResult};
-use hli::enums::{AxisState, CamCouplingError, CouplingState};
+use hli::enums::{AxisState, CamCouplingError};
 use hli::wire::AcyclicRequest;
 
 /// Table IDs run 1..=255.
@@ -77,6 +77,8 @@ enum Queued {
 /// One coupled slave.
 #[derive(Debug)]
 struct Slave {
+    /// The slave's coupling.
+    lease: Lease,
     master: usize,
     table: u32,
     /// The table interpolated as the coupling asked, when that differs from the stored one.
@@ -170,6 +172,8 @@ fn master_of(axes: &AxisSet, master: usize, actual: bool) -> Option<Kinematic> {
 /// A multi-table slave (chapter 4.6).
 #[derive(Debug)]
 struct MultiSlave {
+    /// The slave's coupling.
+    lease: Lease,
     master: usize,
     law: MultiTableLaw,
 }
@@ -339,16 +343,14 @@ impl CamEngine {
             let Some(multi) = self.multis[i].as_mut() else {
                 continue;
             };
-            let still = cam_coupled(axes, i);
+            let still = axes.holds(multi.lease);
             let master = axes.axis(multi.master).map(|a| a.setpoint());
             let (true, Some(master)) = (still, master) else {
                 self.multis[i] = None;
                 continue;
             };
             let set = multi.law.slave(&self.store, &master);
-            if let Some(axis) = axes.axis_mut(i) {
-                axis.drive_coupled(set, AxisState::SlaveSynchronous);
-            }
+            axes.drive(multi.lease, set, AxisState::SlaveSynchronous);
         }
     }
 
@@ -359,8 +361,8 @@ impl CamEngine {
         let Some(state) = self.slaves[i].as_mut() else {
             return;
         };
-        // A slave that lost its coupling (fault, power off) is free again.
-        let still = cam_coupled(axes, i);
+        // A slave that lost its coupling (fault, power off, another engine) is free again.
+        let still = axes.holds(state.lease);
         let master = master_of(axes, state.master, state.follow_actual);
         let (true, Some(master)) = (still, master) else {
             if let Some(gone) = self.slaves[i].take() {
@@ -387,9 +389,7 @@ impl CamEngine {
             && set.acceleration.is_finite()
             && set.jerk.is_finite();
         if !finite {
-            if let Some(axis) = axes.axis_mut(i) {
-                axis.decouple();
-            }
+            axes.release(state.lease);
             return;
         }
         let (set, phase) = if state.active {
@@ -403,9 +403,7 @@ impl CamEngine {
                 AxisState::SlavePrephase,
             )
         };
-        if let Some(axis) = axes.axis_mut(i) {
-            axis.drive_coupled(set, phase);
-        }
+        axes.drive(state.lease, set, phase);
         state.master_before = master.position;
     }
 }
@@ -528,14 +526,6 @@ impl Slave {
     }
 }
 
-/// Whether axis `i` is coupled through a cam (the axis layer drops a coupling on a fault or
-/// power off).
-fn cam_coupled(axes: &AxisSet, i: usize) -> bool {
-    axes.axis(i)
-        .and_then(|a| a.coupling())
-        .is_some_and(|c| c.kind == CouplingState::Cam)
-}
-
 impl Engine for CamEngine {
     fn name(&self) -> &'static str {
         "cam"
@@ -588,21 +578,14 @@ impl Engine for CamEngine {
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
-        for (i, slot) in self.multis.iter_mut().enumerate() {
-            if slot.take().is_some() {
-                if let Some(axis) = axes.axis_mut(i) {
-                    axis.decouple();
-                }
-            }
+        // Only its own couplings (another engine may hold an axis since).
+        for multi in self.multis.iter_mut().filter_map(Option::take) {
+            axes.release(multi.lease);
         }
-        for (i, slot) in self.slaves.iter_mut().enumerate() {
-            if let Some(state) = slot.take() {
-                if let Some(axis) = axes.axis_mut(i) {
-                    axis.decouple();
-                }
-                self.retired.extend(state.own);
-                self.retired.extend(state.switch_own);
-            }
+        for state in self.slaves.iter_mut().filter_map(Option::take) {
+            axes.release(state.lease);
+            self.retired.extend(state.own);
+            self.retired.extend(state.switch_own);
         }
     }
 }
