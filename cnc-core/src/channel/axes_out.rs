@@ -4,7 +4,7 @@
 //! layer, no drive. The machine (`crate::machine`) now runs channel axes as `Axis` objects.
 
 use super::plc_io::hli_value;
-use crate::nc::decode::AxisValues;
+use crate::setpoint::AxisValues;
 use hli::enums::CouplingState;
 use hli::layout::{HliAxis, HliAxisLrState};
 use hli::views::CncView;

@@ -16,8 +16,8 @@
 
 use super::path::AxisLimits;
 use crate::axis::generator::{Progress, SetpointGenerator};
-use crate::nc::decode::{AxisValues, MAX_CHANNEL_AXES};
 use crate::setpoint::Kinematic;
+use crate::setpoint::{AxisValues, MAX_CHANNEL_AXES};
 
 /// Which limit a refused step broke.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

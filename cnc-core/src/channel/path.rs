@@ -37,8 +37,8 @@
 
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::arc::ArcMove;
-use crate::nc::decode::AxisValues;
 use crate::nc::MotionMode;
+use crate::setpoint::AxisValues;
 
 /// Per-axis dynamic limits of a channel's programmed coordinates (mm or degrees, per second).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]

@@ -7,7 +7,7 @@ use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
 use crate::axis::sim_drive::DriveModel;
 use crate::axis::{motion_phase, AxisSet, Coupling, Lease};
 use crate::channel::config::ChannelConfig;
-use crate::nc::decode::AxisValues;
+use crate::setpoint::AxisValues;
 use crate::setpoint::Kinematic;
 use hli::enums::{AxisState, CouplingState};
 

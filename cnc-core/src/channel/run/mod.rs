@@ -33,11 +33,10 @@ use super::plc_io::{
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
-use crate::nc::decode::{
-    AxisValues, SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES,
-};
+use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
+use crate::setpoint::AxisValues;
 use hli::enums::{ChannelErrorId, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
 use hli::views::{PathOverride, DEFAULT_PATH_OVERRIDE};
@@ -722,7 +721,7 @@ impl Channel {
                 target[i] = self.programmed[i];
             }
         }
-        let limits = [self.limits; crate::nc::decode::MAX_CHANNEL_AXES];
+        let limits = [self.limits; crate::setpoint::MAX_CHANNEL_AXES];
         match PathMove::plan(
             &self.programmed,
             &target,

@@ -1,55 +1,8 @@
-//! A channel's axes: their names, checked, and one value per axis stored inline.
+//! A channel's axes: their names, checked (the values per axis are
+//! [`crate::setpoint::AxisValues`]).
 
 use crate::nc::ast::AxisName;
-
-/// Most axes one channel can have.
-pub const MAX_CHANNEL_AXES: usize = 16;
-
-/// One value per channel axis, in channel order, stored inline: a decoded block needs no heap
-/// allocation, and the channel's tick can copy targets freely.
-#[derive(Clone, Copy, PartialEq)]
-pub struct AxisValues {
-    len: u8,
-    /// Slots beyond `len` stay 0, so the derived equality compares only the used ones.
-    values: [f64; MAX_CHANNEL_AXES],
-}
-
-impl AxisValues {
-    /// `n` zeros; `n` is cut to [`MAX_CHANNEL_AXES`] ([`check_channel_axes`] refuses more).
-    pub fn zeros(n: usize) -> Self {
-        Self {
-            len: n.min(MAX_CHANNEL_AXES) as u8,
-            values: [0.0; MAX_CHANNEL_AXES],
-        }
-    }
-
-    /// The values of `slice` (cut to [`MAX_CHANNEL_AXES`]).
-    pub fn from_slice(slice: &[f64]) -> Self {
-        let mut v = Self::zeros(slice.len());
-        let n = v.len();
-        v.values[..n].copy_from_slice(&slice[..n]);
-        v
-    }
-}
-
-impl core::ops::Deref for AxisValues {
-    type Target = [f64];
-    fn deref(&self) -> &[f64] {
-        &self.values[..self.len as usize]
-    }
-}
-
-impl core::ops::DerefMut for AxisValues {
-    fn deref_mut(&mut self) -> &mut [f64] {
-        &mut self.values[..self.len as usize]
-    }
-}
-
-impl core::fmt::Debug for AxisValues {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_list().entries(self.iter()).finish()
-    }
-}
+use crate::setpoint::MAX_CHANNEL_AXES;
 
 /// One-letter words that are never axes: G, M, F, N and the circle, spindle, tool, parameter
 /// and call addresses.

@@ -1,8 +1,9 @@
 //! One block decoded: its items read, then its dwell, motion or offsets.
 
 use super::values::Ctx;
-use super::{AxisValues, Decoded, DecoderState, MotionBlock, MotionMode, MM_PER_INCH};
+use super::{Decoded, DecoderState, MotionBlock, MotionMode, MM_PER_INCH};
 use crate::nc::ast::*;
+use crate::setpoint::AxisValues;
 
 /// The indices of the set bits of a mask, lowest first.
 #[derive(Clone, Copy)]

@@ -24,7 +24,8 @@ mod commands;
 mod output;
 mod values;
 
-pub use axes::{check_channel_axes, AxisValues, MAX_CHANNEL_AXES, RESERVED_ADDRESSES};
+use crate::setpoint::{AxisValues, MAX_CHANNEL_AXES};
+pub use axes::{check_channel_axes, RESERVED_ADDRESSES};
 pub use output::{Decoded, MotionBlock, SyncIds, TrackCommand, TrackSource, DEFAULT_FILTER_TICKS};
 pub use values::{evaluate_at, Vars, ZeroVars, KNOWN_VARIABLES};
 

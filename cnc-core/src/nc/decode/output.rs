@@ -1,7 +1,8 @@
 //! What the decoder hands the channel: the [`Decoded`] elements of a block.
 
-use super::{AxisValues, MotionMode};
+use super::MotionMode;
 use crate::nc::ast::Name;
+use crate::setpoint::AxisValues;
 use std::sync::Arc;
 
 /// A path motion with absolute targets for every axis of the channel.
