@@ -60,9 +60,13 @@ impl<'a> Others<'a> {
     }
 }
 
-/// What an engine answers a call with: the axes, and the other engines to ask about shared
-/// resources.
-pub struct CallCx<'a> {
+/// A call for an engine: its kind and frame, the axes, and the other engines to ask about
+/// shared resources.
+pub struct Call<'a> {
+    /// The call kind (one of the engine's [`Engine::calls`]).
+    pub kind: CallKind,
+    /// The frame.
+    pub request: &'a AcyclicRequest,
     /// Every axis of the machine.
     pub axes: &'a mut AxisSet,
     /// The other engines.
@@ -88,13 +92,8 @@ pub trait Engine: std::fmt::Debug + Send {
     fn tick(&mut self, io: &mut EngineIo<'_, '_>);
 
     /// A call of one of the kinds of [`Engine::calls`], answered.
-    fn handle(
-        &mut self,
-        kind: CallKind,
-        request: &AcyclicRequest,
-        cx: CallCx<'_>,
-    ) -> HandlerResult {
-        let _ = (kind, request, cx);
+    fn handle(&mut self, call: Call<'_>) -> HandlerResult {
+        let _ = call;
         Err(ErrorCode::ServiceNotSupported)
     }
 

@@ -17,7 +17,7 @@
 //! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
 //! are sized when the engine is built.
 
-use super::engine::{CallCx, Engine, EngineIo};
+use super::engine::{Call, Engine, EngineIo};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
@@ -525,13 +525,8 @@ impl Engine for FifoEngine {
         hli::calls::fifo::CALLS
     }
 
-    fn handle(
-        &mut self,
-        kind: CallKind,
-        request: &AcyclicRequest,
-        cx: CallCx<'_>,
-    ) -> HandlerResult {
-        reply(&self.call(kind, request, cx.axes))
+    fn handle(&mut self, call: Call<'_>) -> HandlerResult {
+        reply(&self.call(call.kind, call.request, call.axes))
     }
 
     fn handle_bulk(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {

@@ -28,7 +28,7 @@ pub mod gear;
 pub mod saw;
 
 pub use channel_axes::ChannelAxes;
-pub use engine::{CallCx, Engine, EngineIo, Others, Resource, RouteConflict, Routes};
+pub use engine::{Call, Engine, EngineIo, Others, Resource, RouteConflict, Routes};
 
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
@@ -237,11 +237,12 @@ impl Machine {
         }
         if let Some(i) = self.routes.engine(kind) {
             let (engine, others) = Others::split(&mut self.engines, i);
-            let cx = CallCx {
+            return engine.handle(Call {
+                kind,
+                request,
                 axes: &mut self.axes,
                 others,
-            };
-            return engine.handle(kind, request, cx);
+            });
         }
         match kind {
             CallKind::READ_AXIS_STATE => handle_read_axis_state(view, request),

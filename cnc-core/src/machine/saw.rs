@@ -7,7 +7,7 @@
 //! synchronous phase was reached; when the master comes forward over the coupling position
 //! again, the slave synchronises anew from where it stands.
 
-use super::engine::{CallCx, Engine, EngineIo, Resource};
+use super::engine::{Call, Engine, EngineIo, Resource};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
@@ -17,7 +17,6 @@ use hli::calls::saw::{
 };
 use hli::calls::{decode_body, reply, CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, SawError};
-use hli::wire::AcyclicRequest;
 
 #[derive(Debug, Clone, Copy)]
 struct SawSlave {
@@ -241,21 +240,21 @@ impl Engine for SawEngine {
         hli::calls::saw::CALLS
     }
 
-    fn handle(
-        &mut self,
-        kind: CallKind,
-        request: &AcyclicRequest,
-        cx: CallCx<'_>,
-    ) -> HandlerResult {
+    fn handle(&mut self, call: Call<'_>) -> HandlerResult {
+        let Call {
+            kind,
+            request,
+            axes,
+            others,
+        } = call;
         let slave = request.target as usize;
         let known = slave < self.slaves.len();
-        let axes = cx.axes;
         match kind {
             // A slave beyond the engine's slots (an engine built for fewer axes).
             CallKind::SAW_GEAR_IN if !known => Err(ErrorCode::InvalidTarget),
             // The saw plans in table 256 - the slave's axis ID (chapter 13): not while another
             // engine (a cam) uses that table.
-            CallKind::SAW_GEAR_IN if cx.others.hold(own_table(axes, slave)) => reply(&SawReply {
+            CallKind::SAW_GEAR_IN if others.hold(own_table(axes, slave)) => reply(&SawReply {
                 error_id: SawError::TableInUse.raw(),
                 reserved: 0,
             }),

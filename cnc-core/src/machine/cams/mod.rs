@@ -27,7 +27,7 @@ mod couplings;
 mod data;
 mod reads;
 
-use super::engine::{CallCx, Engine, EngineIo, Resource};
+use super::engine::{Call, Engine, EngineIo, Resource};
 use crate::axis::{AxisSet, Lease};
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
@@ -41,7 +41,6 @@ use hli::calls::cam::{
 };
 use hli::calls::{reply, CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CamCouplingError};
-use hli::wire::AcyclicRequest;
 
 /// Table IDs run 1..=255.
 const TABLE_SLOTS: usize = 256;
@@ -549,13 +548,13 @@ impl Engine for CamEngine {
         }
     }
 
-    fn handle(
-        &mut self,
-        kind: CallKind,
-        request: &AcyclicRequest,
-        cx: CallCx<'_>,
-    ) -> HandlerResult {
-        let axes = cx.axes;
+    fn handle(&mut self, call: Call<'_>) -> HandlerResult {
+        let Call {
+            kind,
+            request,
+            axes,
+            ..
+        } = call;
         // Between ticks: free what the ticks retired.
         self.retired.clear();
         self.retired_changes.clear();
