@@ -158,6 +158,44 @@ pub struct BlockProgress {
     pub tick: u64,
 }
 
+/// What both views have: the image's size and its channel and axis blocks. A side writes only
+/// the values its role owns (`_w` for the PLC, `_r` for the CNC).
+macro_rules! navigation {
+    ($view:ident) => {
+        impl<'m> $view<'m> {
+            /// View of `memory` (a segment's or a heap image).
+            pub fn new(memory: &'m ImageMemory) -> Self {
+                Self {
+                    nav: Nav::new(memory),
+                }
+            }
+
+            /// Configured channels.
+            pub fn channel_count(&self) -> usize {
+                self.nav.channels
+            }
+
+            /// Configured axes.
+            pub fn axis_count(&self) -> usize {
+                self.nav.axes
+            }
+
+            /// Channel block `gpCh[index]^`.
+            pub fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
+                self.nav.channel(index)
+            }
+
+            /// Axis block `gpAx[index]^`.
+            pub fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
+                self.nav.axis(index)
+            }
+        }
+    };
+}
+
+navigation!(CncView);
+navigation!(PlcView);
+
 /// The CNC's view of an image.
 #[derive(Debug, Clone, Copy)]
 pub struct CncView<'m> {
@@ -165,33 +203,6 @@ pub struct CncView<'m> {
 }
 
 impl<'m> CncView<'m> {
-    /// View of `memory` (a segment's or a heap image).
-    pub fn new(memory: &'m ImageMemory) -> Self {
-        Self {
-            nav: Nav::new(memory),
-        }
-    }
-
-    /// Configured channels.
-    pub fn channel_count(&self) -> usize {
-        self.nav.channels
-    }
-
-    /// Configured axes.
-    pub fn axis_count(&self) -> usize {
-        self.nav.axes
-    }
-
-    /// Channel block `gpCh[index]^`.
-    pub fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
-        self.nav.channel(index)
-    }
-
-    /// Axis block `gpAx[index]^`.
-    pub fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
-        self.nav.axis(index)
-    }
-
     /// FIFO group status `gpFifo[index]^`.
     pub fn fifo_group(&self, index: usize) -> Result<Place<'m, HliFifoGroupState>, IndexError> {
         self.nav.fifo_group(index)
@@ -383,33 +394,6 @@ pub struct PlcAxis<'m> {
 }
 
 impl<'m> PlcView<'m> {
-    /// View of `memory`.
-    pub fn new(memory: &'m ImageMemory) -> Self {
-        Self {
-            nav: Nav::new(memory),
-        }
-    }
-
-    /// Configured channels.
-    pub fn channel_count(&self) -> usize {
-        self.nav.channels
-    }
-
-    /// Configured axes.
-    pub fn axis_count(&self) -> usize {
-        self.nav.axes
-    }
-
-    /// Channel block `gpCh[index]^` (read its `_r` values; write only `_w` values).
-    pub fn channel(&self, index: usize) -> Result<Place<'m, HliChannel>, IndexError> {
-        self.nav.channel(index)
-    }
-
-    /// Axis block `gpAx[index]^`.
-    pub fn axis(&self, index: usize) -> Result<Place<'m, HliAxis>, IndexError> {
-        self.nav.axis(index)
-    }
-
     /// Channel `index` (`gpCh[index]^`), `None` beyond the configured channels.
     pub fn gp_ch(&self, index: usize) -> Option<PlcChannel<'m>> {
         self.ch(index).ok()
