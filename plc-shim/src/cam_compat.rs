@@ -168,7 +168,7 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
             "table" => c.table = int(1, 255)?,
             "table_type" => c.table_type = int(1, 4)?,
             "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
-            "rows" => c.rows = Some(crate::blocks::rows_of(value)?),
+            "rows" => c.rows = Some(crate::timeline::registry::rows_of(value)?),
             "room" => c.room = int(1, 1 << 20)? as usize,
             "master" => c.master = int(0, i64::from(u32::MAX))?,
             "master_offset" => c.master_offset = num()?,

@@ -2,7 +2,6 @@
 //! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
 //! the acyclic request-response service.
 
-pub mod blocks;
 pub mod cam;
 pub mod cam_compat;
 pub mod cli;
