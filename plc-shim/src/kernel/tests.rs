@@ -2,18 +2,20 @@
 //! restart cases against a stand-in CNC in this thread (an acyclic server polled by hand).
 
 use super::{Outputs, DEFAULT_TIMEOUT_CYCLES, ERROR_NO_ANSWER};
-use crate::cam::{
+use crate::blocks::cam::{
     CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
     McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
     McWriteMotionFunction, McWriteMotionFunctionPoint,
 };
-use crate::cam_compat::{CompatBlock, CompatConfig};
-use crate::dyn_cs::McDynCsTransition;
-use crate::fifo::{FifoGetDimension, FifoStart, FifoWrite};
-use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop};
-use crate::probe::{McAbortTrigger, McTouchProbe};
+use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
+use crate::blocks::dyn_cs::McDynCsTransition;
+use crate::blocks::fifo::{FifoGetDimension, FifoStart, FifoWrite};
+use crate::blocks::motion::{
+    McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop,
+};
+use crate::blocks::probe::{McAbortTrigger, McTouchProbe};
+use crate::blocks::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use crate::runtime::PlcIo;
-use crate::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use hli::calls::fifo::{FifoDimensionCall, FifoReply, FifoStartCall};
 use hli::calls::ErrorCode;
 use hli::rpc::{AcyclicClient, AcyclicServer};

@@ -21,12 +21,12 @@
 //! on its way at a time, so the rows arrive in the file's order. Any other error ends the
 //! sequence in `Failed`.
 
-use crate::fifo::{
+use crate::blocks::fifo::{
     FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoSetChannelOverride, FifoStart,
     FifoStop, FifoWrite,
 };
+use crate::blocks::motion::McPower;
 use crate::fifo_file::{Buffer, Fed, Feeder, FileError};
-use crate::motion::McPower;
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoStartCall,

@@ -20,9 +20,9 @@
 //! phase that difference is `SAW_SYNC - (FIRST_CUT + k * length)`, so the pieces are the cut
 //! length long to the precision of the position sync.
 
-use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
+use crate::blocks::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
+use crate::blocks::saw::{McGearInPos, McGearOut};
 use crate::runtime::{PlcIo, PlcProgram};
-use crate::saw::{McGearInPos, McGearOut};
 
 /// The axes of `scenarios/flying-saw` (`gpAx` indices): conveyor, saw carriage, blade.
 pub const SCENARIO_AXES: [u32; 3] = [0, 1, 2];

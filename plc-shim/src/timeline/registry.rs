@@ -1,5 +1,5 @@
 //! Function-block instances a timeline calls by name: the PLCopen motion blocks of
-//! [`crate::motion`], each instance bound to one axis, called once per PLC cycle like a PLC
+//! [`crate::blocks::motion`], each instance bound to one axis, called once per PLC cycle like a PLC
 //! program calls its instances, with the edges of its outputs recorded for the report.
 //!
 //! ```toml
@@ -11,7 +11,7 @@
 //!          velocity = 200.0, acceleration = 2000.0, deceleration = 2000.0, jerk = 50000.0 }
 //! ```
 //!
-//! The cam blocks of [`crate::cam`] take the slave as `axis` and name the master and the
+//! The cam blocks of [`crate::blocks::cam`] take the slave as `axis` and name the master and the
 //! table; modes are given by number or by name:
 //!
 //! ```toml
@@ -26,16 +26,16 @@
 //! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
 //! FALSE for one cycle first, so every call is a new edge.
 
-use crate::cam::{
+use crate::blocks::cam::{
     CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
     McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
     McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
 };
-use crate::cam_compat::{CompatBlock, CompatConfig};
-use crate::kernel::Outputs;
-use crate::motion::{
+use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
+use crate::blocks::motion::{
     McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
+use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
 use fifo::{FifoInputs, FifoInstance, FIFO_BLOCKS};
 use hli::calls::cam::McMotionFunctionPoint;
@@ -537,9 +537,9 @@ impl Instances {
         };
         let mut inputs = Vec::new();
         let mut execute = true;
-        let compat = crate::cam_compat::COMPAT_BLOCKS
+        let compat = crate::blocks::cam_compat::COMPAT_BLOCKS
             .iter()
-            .chain([crate::cam_compat::COMPAT_MASTER_SLAVE_SCALE].iter())
+            .chain([crate::blocks::cam_compat::COMPAT_MASTER_SLAVE_SCALE].iter())
             .find(|b| **b == kind)
             .copied();
         if fifo {
@@ -549,7 +549,7 @@ impl Instances {
             inputs.push(Input::Saw(Arc::new(saw::parse(kind, table)?)));
         }
         if let Some(kind) = compat {
-            let config = crate::cam_compat::parse(kind, table)?;
+            let config = crate::blocks::cam_compat::parse(kind, table)?;
             if kind == "CamTableReadData" {
                 inputs.push(Input::Room(config.room));
             }

@@ -11,7 +11,7 @@
 //! call = { block = "FiFoSetChannelOverride", instance = "ov", override = 50.0 }   # percent
 //! ```
 
-use crate::fifo::{
+use crate::blocks::fifo::{
     FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoSetChannelOverride,
     FifoSetParameters, FifoStart, FifoStop, FifoWrite,
 };

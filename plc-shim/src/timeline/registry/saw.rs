@@ -22,11 +22,11 @@
 //! as given: the CNC refuses bits it does not know) or lists of flag names, with or without
 //! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
 
-use crate::kernel::Outputs;
-use crate::runtime::PlcIo;
-use crate::saw::{
+use crate::blocks::saw::{
     GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics,
 };
+use crate::kernel::Outputs;
+use crate::runtime::PlcIo;
 use hli::calls::saw::sync_mask;
 use std::sync::Arc;
 
@@ -350,7 +350,7 @@ impl SawInstance {
     }
 
     /// The read's 31 values once it has finished, in `MC_FlyingSawCharacValues` order
-    /// ([`crate::saw::CHARAC_FIELDS`]).
+    /// ([`crate::blocks::saw::CHARAC_FIELDS`]).
     pub(super) fn read_values(&self) -> Option<Vec<f64>> {
         match &self.kind {
             Kind::Read(b) if self.read => Some(b.values.to_vec()),
