@@ -1,7 +1,7 @@
 //! The compatibility blocks of seed 000, chapter 5.2.1 and 5.2.2 (the older CamTable...
 //! blocks), as thin wrappers over the calls of the chapter 5.1 blocks: each sends on its
 //! rising edge (bExecute, or bCoupleOn / bCoupleOff) and reports Busy, Err and ErrId. The
-//! multi-table blocks of 5.2.3 live with the others in [`crate::blocks::cam`].
+//! multi-table blocks of 5.2.3 are in [`crate::blocks::cam_multi`].
 //!
 //! | block | what it sends |
 //! | --- | --- |
@@ -16,7 +16,9 @@
 //! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
-use crate::blocks::cam::{CamCore, CamData, ChunkTransfer, McCamRead};
+use crate::blocks::cam::CamCore;
+use crate::blocks::cam_data::{CamData, ChunkTransfer};
+use crate::blocks::cam_read::McCamRead;
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
 use hli::calls::cam::{
@@ -100,7 +102,7 @@ impl CompatConfig {
             slave_absolute: true,
             interpolation: 0,
             on: true,
-            room: crate::blocks::cam::DEFAULT_READ_ROOM,
+            room: crate::blocks::cam_read::DEFAULT_READ_ROOM,
         }
     }
 }

@@ -3,6 +3,9 @@
 
 pub mod cam;
 pub mod cam_compat;
+pub mod cam_data;
+pub mod cam_multi;
+pub mod cam_read;
 pub mod dyn_cs;
 pub mod fifo;
 pub mod motion;

@@ -3,11 +3,12 @@
 
 use super::{Outputs, DEFAULT_TIMEOUT_CYCLES, ERROR_NO_ANSWER};
 use crate::blocks::cam::{
-    CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
-    McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
-    McWriteMotionFunction, McWriteMotionFunctionPoint,
+    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
 };
 use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
+use crate::blocks::cam_data::{CamData, McCamTableSelect, McWriteMotionFunction};
+use crate::blocks::cam_multi::{CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight};
+use crate::blocks::cam_read::{McCamRead, McReadMotionFunction};
 use crate::blocks::dyn_cs::McDynCsTransition;
 use crate::blocks::fifo::{FifoGetDimension, FifoStart, FifoWrite};
 use crate::blocks::motion::{

@@ -17,9 +17,9 @@
 //! Any Error stops the sequence in `Failed` with the block and its ErrorID.
 
 use crate::blocks::cam::{
-    McCamIn, McCamOut, McCamScaling, McCamTableSelect, McSetCamOnlineChangeMode,
-    McWriteMotionFunctionPoint,
+    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
 };
+use crate::blocks::cam_data::McCamTableSelect;
 use crate::blocks::motion::{McHalt, McMoveVelocity};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::cam::McMotionFunctionPoint;

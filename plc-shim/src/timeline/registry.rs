@@ -27,11 +27,12 @@
 //! FALSE for one cycle first, so every call is a new edge.
 
 use crate::blocks::cam::{
-    CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
-    McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
-    McWriteMotionFunction, McWriteMotionFunctionPoint, DEFAULT_READ_ROOM,
+    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
 };
 use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
+use crate::blocks::cam_data::{CamData, McCamTableSelect, McWriteMotionFunction};
+use crate::blocks::cam_multi::{CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight};
+use crate::blocks::cam_read::{McCamRead, McReadMotionFunction, DEFAULT_READ_ROOM};
 use crate::blocks::motion::{
     McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McReset, McStop,
 };
