@@ -11,7 +11,11 @@
 
 use crate::kernel::{call_error_code, done_unless, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
-use hli::calls::cam::{CamInCall, CamOutCall, CamReply, CamScalingCall};
+use crate::timeline::registry::{input, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use hli::calls::cam::{
+    CamActivationMode, CamInCall, CamInterpolation, CamOutCall, CamReply, CamScalingCall,
+    CamScalingMode, CamStartMode,
+};
 use hli::calls::AcyclicCall;
 use hli::enums::{AxisState, CouplingState};
 use hli::rpc::PendingCall;
@@ -336,3 +340,230 @@ impl McSetCamOnlineChangeMode {
         self.out = self.core.cycle(io, self.execute, self.table, || call, None);
     }
 }
+
+/// What a timeline records of a cam block's outputs: Done, Busy, CommandAborted, Error (no
+/// Active, InVelocity, InSync or StartSync).
+pub(crate) fn recorded(out: Outputs) -> (Outputs, bool) {
+    let out = Outputs {
+        active: false,
+        in_velocity: false,
+        in_sync: false,
+        start_sync: false,
+        ..out
+    };
+    (out, false)
+}
+
+impl TimelineBlock for McCamIn {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            ("master_source", Some(v), _) => self.master_actual = v != 0,
+            ("master", Some(v), _) => self.master = v,
+            ("table", Some(v), _) => self.table = v,
+            ("start_mode", Some(v), _) => self.start_mode = v,
+            ("interpolation", Some(v), _) => self.interpolation = v,
+            ("master_offset", _, Some(v)) => self.master_offset = v,
+            ("slave_offset", _, Some(v)) => self.slave_offset = v,
+            ("master_scaling", _, Some(v)) => self.master_scaling = v,
+            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        let (out, status) = recorded(self.out);
+        // InSync, the one output a coupling adds.
+        let in_sync = self.out.in_sync;
+        (Outputs { in_sync, ..out }, status)
+    }
+}
+
+impl TimelineBlock for McCamOut {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McCamScaling {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            ("master_offset", _, Some(v)) => self.master_offset = v,
+            ("slave_offset", _, Some(v)) => self.slave_offset = v,
+            ("master_scaling", _, Some(v)) => self.master_scaling = v,
+            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McWriteMotionFunctionPoint {
+    fn set(&mut self, key: &str, value: &Value) {
+        let p = &mut self.point;
+        match (key, value.uint(), value.real()) {
+            ("table", Some(v), _) => self.table = v,
+            ("point_index", Some(v), _) => p.point_index = v,
+            ("function_type", Some(v), _) => p.function_type = v,
+            ("point_type", Some(v), _) => p.point_type = v,
+            ("rel_index_next", Some(v), _) => p.rel_index_next_point = v,
+            ("master_pos", _, Some(v)) => p.master_pos = v,
+            ("slave_pos", _, Some(v)) => p.slave_pos = v,
+            ("slave_velo", _, Some(v)) => p.slave_velo = v,
+            ("slave_acc", _, Some(v)) => p.slave_acc = v,
+            ("slave_jerk", _, Some(v)) => p.slave_jerk = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McSetCamOnlineChangeMode {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("table", Some(v), _) => self.table = v,
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+const ACTIVATION_MODE: InputSpec = input("activation_mode", mode::<CamActivationMode>());
+const ACTIVATION_POSITION: InputSpec = input("activation_position", Kind::Real);
+const MASTER_SCALING_MODE: InputSpec = input("master_scaling_mode", mode::<CamScalingMode>());
+const SLAVE_SCALING_MODE: InputSpec = input("slave_scaling_mode", mode::<CamScalingMode>());
+const MASTER_OFFSET: InputSpec = input("master_offset", Kind::Real);
+const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real);
+const MASTER_SCALING: InputSpec = input("master_scaling", Kind::Real);
+const SLAVE_SCALING: InputSpec = input("slave_scaling", Kind::Real);
+/// The master's set-point (the default) or its actual position.
+const MASTER_SOURCE: InputSpec = input(
+    "master_source",
+    Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]),
+);
+const MASTER: InputSpec = input("master", Kind::Count);
+const TABLE: InputSpec = input("table", Kind::Count);
+const START_MODE: InputSpec = input("start_mode", mode::<CamStartMode>());
+const INTERPOLATION: InputSpec = input("interpolation", mode::<CamInterpolation>());
+
+/// The one-call cam blocks a timeline calls; the slave is the instance's axis.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_CamIn",
+        &[
+            MASTER_SOURCE,
+            MASTER,
+            TABLE,
+            START_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+            INTERPOLATION,
+        ],
+        |_| Box::<McCamIn>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_CamInExt",
+        &[
+            MASTER_SOURCE,
+            MASTER,
+            TABLE,
+            START_MODE,
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+            INTERPOLATION,
+        ],
+        |_| {
+            Box::new(McCamIn {
+                extended: true,
+                ..McCamIn::default()
+            })
+        },
+    ),
+    BlockSpec::on_axis("MC_CamOut", &[], |_| Box::<McCamOut>::default()),
+    BlockSpec::on_axis(
+        "MC_CamScaling",
+        &[
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+        ],
+        |_| Box::<McCamScaling>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_WriteMotionFunctionPoint",
+        &[
+            TABLE,
+            input("point_index", Kind::Count),
+            input("function_type", Kind::Count),
+            input("point_type", Kind::Count),
+            input("rel_index_next", Kind::Count),
+            input("master_pos", Kind::Real),
+            input("slave_pos", Kind::Real),
+            input("slave_velo", Kind::Real),
+            input("slave_acc", Kind::Real),
+            input("slave_jerk", Kind::Real),
+        ],
+        |_| Box::<McWriteMotionFunctionPoint>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_SetCamOnlineChangeMode",
+        &[
+            TABLE,
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+        ],
+        |_| Box::<McSetCamOnlineChangeMode>::default(),
+    ),
+];

@@ -16,34 +16,18 @@
 //! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
-use crate::blocks::cam::CamCore;
-use crate::blocks::cam_data::{CamData, ChunkTransfer};
-use crate::blocks::cam_read::McCamRead;
+use super::cam::{recorded, CamCore};
+use super::cam_data::{rows_of, CamData, ChunkTransfer};
+use super::cam_read::{McCamRead, DEFAULT_READ_ROOM};
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{number, BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::cam::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,
 };
 use std::sync::Arc;
-
-/// The names, for the timeline.
-pub const COMPAT_BLOCKS: [&str; 10] = [
-    "CamTableGenerate",
-    "CamTableCreate",
-    "CamTableWriteData",
-    "CamTableReadData",
-    "CamTableReadSlavePos",
-    "CamTableDelete",
-    "CamTableCoupleAxes",
-    "CamTableCoupleAxesIpol",
-    "CamTableOffsetChange",
-    "CamTableSetSlaveScale",
-];
-
-/// One more: listed apart so the array above stays readable.
-pub const COMPAT_MASTER_SLAVE_SCALE: &str = "CamTableSetMasterSlaveScale";
 
 /// What a compatibility block is told, checked when the timeline is read.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,16 +86,8 @@ impl CompatConfig {
             slave_absolute: true,
             interpolation: 0,
             on: true,
-            room: crate::blocks::cam_read::DEFAULT_READ_ROOM,
+            room: DEFAULT_READ_ROOM,
         }
-    }
-}
-
-fn number(value: &toml::Value) -> Option<f64> {
-    match value {
-        toml::Value::Float(f) => Some(*f),
-        toml::Value::Integer(i) => Some(*i as f64),
-        _ => None,
     }
 }
 
@@ -170,7 +146,7 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
             "table" => c.table = int(1, 255)?,
             "table_type" => c.table_type = int(1, 4)?,
             "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
-            "rows" => c.rows = Some(crate::timeline::registry::rows_of(value)?),
+            "rows" => c.rows = Some(rows_of(value)?),
             "room" => c.room = int(1, 1 << 20)? as usize,
             "master" => c.master = int(0, i64::from(u32::MAX))?,
             "master_offset" => c.master_offset = num()?,
@@ -341,3 +317,66 @@ impl CompatBlock {
         }
     }
 }
+
+impl TimelineBlock for CompatBlock {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(config) = value.custom::<CompatConfig>() {
+            self.config = config;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+    fn read(&self) -> Option<Vec<f64>> {
+        Some(self.read.values.clone())
+    }
+}
+
+/// A call of `kind` checked whole: its configuration, and the room of CamTableReadData's
+/// answer.
+fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
+    let config = parse(kind, table)?;
+    let room = (kind == "CamTableReadData").then_some(config.room);
+    Ok((Value::Custom(Arc::new(config)), room))
+}
+
+/// A block of `kind` with room `room` for a read's numbers.
+fn make(kind: &'static str, room: Option<usize>) -> Box<dyn TimelineBlock> {
+    let config = CompatConfig {
+        room: room.unwrap_or(DEFAULT_READ_ROOM),
+        ..CompatConfig::new(kind)
+    };
+    Box::new(CompatBlock::new(Arc::new(config)))
+}
+
+/// The compatibility blocks a timeline calls, each on the slave's axis.
+macro_rules! compat_blocks {
+    ($($name:literal),* $(,)?) => {
+        &[$(BlockSpec {
+            name: $name,
+            target: Target::Axis,
+            execute: true,
+            inputs: Inputs::Table(checked),
+            make: |room| make($name, room),
+        }),*]
+    };
+}
+
+/// The compatibility blocks a timeline calls (their inputs: [`parse`]).
+pub const TIMELINE: &[BlockSpec] = compat_blocks![
+    "CamTableGenerate",
+    "CamTableCreate",
+    "CamTableWriteData",
+    "CamTableReadData",
+    "CamTableReadSlavePos",
+    "CamTableDelete",
+    "CamTableCoupleAxes",
+    "CamTableCoupleAxesIpol",
+    "CamTableOffsetChange",
+    "CamTableSetSlaveScale",
+    "CamTableSetMasterSlaveScale",
+];

@@ -2,13 +2,18 @@
 //! rows or points, if given, before the selection) and MC_WriteMotionFunction, both sending
 //! their data in chunks, one chunk in flight and one per cycle at most.
 
+use super::cam::recorded;
 use crate::kernel::{
     call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled,
 };
 use crate::runtime::PlcIo;
-use hli::calls::cam::{CamReply, CamTableSelectCall};
+use crate::timeline::registry::{
+    input, mode, number, BlockSpec, InputSpec, Kind, TimelineBlock, Value,
+};
+use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
 use hli::calls::CallError;
 use hli::rpc::PendingCall;
+use std::sync::Arc;
 
 /// MC_CamTableSelect: how couplings through table `table` run (cyclic or linear).
 #[derive(Debug, Default)]
@@ -295,3 +300,170 @@ impl McWriteMotionFunction {
         );
     }
 }
+
+/// `rows = [[master, slave], ...]`.
+pub fn rows_of(value: &toml::Value) -> Result<Arc<[[f64; 2]]>, String> {
+    let bad = || "call: `rows` must be [[master, slave], ...] of finite numbers".to_string();
+    let list = value.as_array().ok_or_else(bad)?;
+    list.iter()
+        .map(|row| match row.as_array().map(|r| r.as_slice()) {
+            Some([m, s]) => match (number(m), number(s)) {
+                (Some(m), Some(s)) if m.is_finite() && s.is_finite() => Ok([m, s]),
+                _ => Err(bad()),
+            },
+            _ => Err(bad()),
+        })
+        .collect()
+}
+
+/// The fields of a point in `points`.
+const POINT_FIELDS: [&str; 9] = [
+    "index",
+    "function",
+    "type",
+    "rel_index_next",
+    "master",
+    "slave",
+    "velocity",
+    "acceleration",
+    "jerk",
+];
+
+/// Point `i` of `points`.
+fn point_of(i: usize, p: &toml::Value) -> Result<McMotionFunctionPoint, String> {
+    let t = p
+        .as_table()
+        .ok_or_else(|| format!("call: points[{i}] is not a table"))?;
+    let int = |k: &str, default: Option<u32>| -> Result<u32, String> {
+        match t.get(k) {
+            Some(v) => v
+                .as_integer()
+                .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                .map(|v| v as u32)
+                .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+            None => default.ok_or_else(|| format!("call: points[{i}].{k} is missing")),
+        }
+    };
+    let num = |k: &str, required: bool| -> Result<f64, String> {
+        match t.get(k) {
+            Some(v) => number(v)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+            None if required => Err(format!("call: points[{i}].{k} is missing")),
+            None => Ok(0.0),
+        }
+    };
+    if let Some(key) = t.keys().find(|k| !POINT_FIELDS.contains(&k.as_str())) {
+        return Err(format!(
+            "call: points[{i}] has no field `{key}` (fields: {})",
+            POINT_FIELDS.join(", ")
+        ));
+    }
+    Ok(McMotionFunctionPoint {
+        point_index: int("index", None)?,
+        function_type: int("function", None)?,
+        point_type: int("type", None)?,
+        rel_index_next_point: int("rel_index_next", Some(1))?,
+        master_pos: num("master", true)?,
+        slave_pos: num("slave", true)?,
+        slave_velo: num("velocity", false)?,
+        slave_acc: num("acceleration", false)?,
+        slave_jerk: num("jerk", false)?,
+    })
+}
+
+/// `points = [{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0, ... }, ...]`.
+fn points_of(value: &toml::Value) -> Result<Arc<[McMotionFunctionPoint]>, String> {
+    let list = value
+        .as_array()
+        .ok_or("call: `points` must be an array of point tables")?;
+    list.iter()
+        .enumerate()
+        .map(|(i, p)| point_of(i, p))
+        .collect()
+}
+
+const TABLE: InputSpec = input("table", Kind::Count);
+const POINTS: InputSpec = input(
+    "points",
+    Kind::Parsed {
+        parse: |v| points_of(v).map(Value::Points),
+        example: "[{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0 }]",
+    },
+);
+
+impl TimelineBlock for McCamTableSelect {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("table", Value::Int(v)) => self.table = *v as u32,
+            ("periodic", Value::Bool(v)) => self.periodic = *v,
+            ("master_absolute", Value::Bool(v)) => self.master_absolute = *v,
+            ("slave_absolute", Value::Bool(v)) => self.slave_absolute = *v,
+            ("table_type", Value::Int(v)) => self.table_type = *v as u32,
+            ("interpolation", Value::Int(v)) => self.interpolation = *v as u32,
+            ("rows", Value::Rows(rows)) => {
+                self.data = CamData::Rows {
+                    rows: Arc::clone(rows),
+                    table_type: 10,
+                    interpolation: 0,
+                }
+            }
+            ("points", Value::Points(points)) => self.data = CamData::Points(Arc::clone(points)),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McWriteMotionFunction {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("table", Value::Int(v)) => self.table = *v as u32,
+            ("points", Value::Points(points)) => self.points = CamData::Points(Arc::clone(points)),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+/// The cam blocks with table data a timeline calls.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_CamTableSelect",
+        &[
+            TABLE,
+            input("periodic", Kind::Bool),
+            input("master_absolute", Kind::Bool),
+            input("slave_absolute", Kind::Bool),
+            input(
+                "rows",
+                Kind::Parsed {
+                    parse: |v| rows_of(v).map(Value::Rows),
+                    example: "[[0.0, 0.0], [1.0, 2.0]]",
+                },
+            ),
+            POINTS,
+            input(
+                "table_type",
+                Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)]),
+            ),
+            input("interpolation", mode::<CamInterpolation>()),
+        ],
+        |_| Box::<McCamTableSelect>::default(),
+    ),
+    BlockSpec::on_axis("MC_WriteMotionFunction", &[TABLE, POINTS], |_| {
+        Box::<McWriteMotionFunction>::default()
+    }),
+];

@@ -3,8 +3,13 @@
 //! numbers) and MC_ReadMotionFunction / MC_ReadMotionFunctionPoint ([`McReadMotionFunction`],
 //! four points per cycle), each into an array whose room is set when the block is made.
 
+use super::cam::recorded;
 use crate::kernel::{call_error_code, no_follow, Accept, InFlight, Kernel, Outputs, Polled};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use hli::calls::cam::{
+    CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES,
+};
 use hli::rpc::PendingCall;
 
 /// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
@@ -266,3 +271,110 @@ impl McReadMotionFunction {
         );
     }
 }
+
+impl TimelineBlock for McCamRead {
+    fn set(&mut self, key: &str, value: &Value) {
+        let r = &mut self.request;
+        match (key, value.uint(), value.real(), value) {
+            ("table", Some(v), _, _) => self.target = v,
+            ("value_select_mask", Some(v), _, _) => r.mask = v,
+            ("master_position" | "start_pos_master", _, Some(v), _) => r.a = v,
+            ("end_pos_master", _, Some(v), _) => r.b = v,
+            ("increment", _, Some(v), _) => r.c = v,
+            ("at_master_position", _, _, Value::Bool(v)) => r.flags = u32::from(*v),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        if self.request.what == CAM_READ_INFO {
+            self.target = axis; // MC_CamInfo reads the slave's coupling
+        }
+        self.call(io);
+        recorded(self.out)
+    }
+    fn read(&self) -> Option<Vec<f64>> {
+        Some(self.values.clone())
+    }
+}
+
+impl TimelineBlock for McReadMotionFunction {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint()) {
+            ("table", Some(v)) => self.table = v,
+            ("point_index", Some(v)) => self.first = v,
+            ("num_points", Some(v)) => self.count = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+    /// Index, master and slave position of every point read.
+    fn read(&self) -> Option<Vec<f64>> {
+        let points = self.points.iter();
+        Some(
+            points
+                .flat_map(|p| [p.point_index as f64, p.master_pos, p.slave_pos])
+                .collect(),
+        )
+    }
+}
+
+const TABLE: InputSpec = input("table", Kind::Count);
+const POINT_INDEX: InputSpec = input("point_index", Kind::Count);
+const MASTER_POSITION: InputSpec = input("master_position", Kind::Real);
+const ROOM: InputSpec = input("room", Kind::Room);
+
+/// The cam reads a timeline calls; `room` (where a read has it) is the room of the answer,
+/// [`DEFAULT_READ_ROOM`] if not given.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_ReadMotionFunction",
+        &[TABLE, POINT_INDEX, input("num_points", Kind::Count), ROOM],
+        |room| {
+            let room = room.unwrap_or(DEFAULT_READ_ROOM);
+            Box::new(McReadMotionFunction::new(room))
+        },
+    ),
+    BlockSpec::on_axis("MC_ReadMotionFunctionPoint", &[TABLE, POINT_INDEX], |_| {
+        Box::new(McReadMotionFunction {
+            count: 1,
+            ..McReadMotionFunction::new(1)
+        })
+    }),
+    BlockSpec::on_axis(
+        "MC_ReadCamTableSlaveDynamics",
+        &[TABLE, MASTER_POSITION],
+        |_| Box::new(McCamRead::new(CAM_READ_SLAVE_DYNAMICS, 3)),
+    ),
+    BlockSpec::on_axis("MC_ReadCamTableCharacteristics", &[TABLE], |_| {
+        Box::new(McCamRead::new(CAM_READ_CHARACTERISTICS, 31))
+    }),
+    BlockSpec::on_axis(
+        "MC_ReadMotionFunctionValues",
+        &[
+            TABLE,
+            input("value_select_mask", Kind::Count),
+            input("start_pos_master", Kind::Real),
+            input("end_pos_master", Kind::Real),
+            input("increment", Kind::Real),
+            ROOM,
+        ],
+        |room| {
+            let room = room.unwrap_or(DEFAULT_READ_ROOM);
+            Box::new(McCamRead::new(CAM_READ_VALUES, room))
+        },
+    ),
+    BlockSpec::on_axis(
+        "MC_CamInfo",
+        &[input("at_master_position", Kind::Bool), MASTER_POSITION],
+        |_| Box::new(McCamRead::new(CAM_READ_INFO, 40)),
+    ),
+];

@@ -18,18 +18,26 @@
 //!
 //! With Execute low the block follows on until the coupling ends, and shows that end for one
 //! cycle (the kernel's rule for every block).
+//!
+//! A timeline calls them by their names ([`TIMELINE`]) with the seed's input names
+//! ([`inputs`]).
 
 use crate::kernel::{
     call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
     Waited, ERROR_NO_ANSWER,
 };
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::saw::{
     SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
 };
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
 use hli::rpc::PendingCall;
+use inputs::SawInputs;
+use std::sync::Arc;
+
+pub mod inputs;
 
 /// Version of this block library (like the FIFO library's version function).
 pub fn saw_library_version() -> &'static str {
@@ -548,6 +556,114 @@ impl McReadFlyingSawCharacteristics {
         );
     }
 }
+
+impl TimelineBlock for McGearInVelo {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(i) = value.custom::<SawInputs>() {
+            (self.inputs, self.master) = (i.gear, i.master);
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McGearInPos {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(i) = value.custom::<SawInputs>() {
+            (self.inputs, self.master) = (i.gear, i.master);
+            [self.master_sync_position, self.slave_sync_position] = i.sync_positions;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McGearOut {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+/// MC_ReadFlyingSawCharacteristics in a timeline: its values are reported once a read
+/// finished.
+#[derive(Debug, Default)]
+struct CharacInstance {
+    block: McReadFlyingSawCharacteristics,
+    read: bool,
+}
+
+impl TimelineBlock for CharacInstance {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.block.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.block.slave = axis;
+        self.block.call(io);
+        self.read |= self.block.out.done;
+        recorded(self.block.out)
+    }
+    /// The 31 values in `MC_FlyingSawCharacValues` order ([`CHARAC_FIELDS`]).
+    fn read(&self) -> Option<Vec<f64>> {
+        self.read.then(|| self.block.values.to_vec())
+    }
+}
+
+/// What a timeline records of a saw block's outputs: all but StartSync.
+fn recorded(out: Outputs) -> (Outputs, bool) {
+    let out = Outputs {
+        start_sync: false,
+        ..out
+    };
+    (out, false)
+}
+
+/// A call of `kind` checked whole ([`inputs`]).
+fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
+    Ok((Value::Custom(Arc::new(inputs::parse(kind, table)?)), None))
+}
+
+/// A flying-saw block a timeline calls, on its slave's axis (`Slave` or `axis`).
+const fn saw_block(
+    name: &'static str,
+    make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
+) -> BlockSpec {
+    BlockSpec {
+        name,
+        target: Target::AxisOr(inputs::slave),
+        execute: true,
+        inputs: Inputs::Table(checked),
+        make,
+    }
+}
+
+/// The flying-saw blocks a timeline calls (their inputs: [`inputs`]).
+pub const TIMELINE: &[BlockSpec] = &[
+    saw_block("MC_GearInVelo", |_| Box::<McGearInVelo>::default()),
+    saw_block("MC_GearInPos", |_| Box::<McGearInPos>::default()),
+    saw_block("MC_GearOut", |_| Box::<McGearOut>::default()),
+    saw_block("MC_ReadFlyingSawCharacteristics", |_| {
+        Box::<CharacInstance>::default()
+    }),
+];
 
 #[cfg(test)]
 mod tests;

@@ -27,6 +27,7 @@ use hli::desc::Scalar;
 use hli::ImageMemory;
 use serde::Deserialize;
 
+pub mod instances;
 pub mod registry;
 
 /// Why a timeline was refused.
@@ -205,8 +206,8 @@ struct Step {
     commit: Option<Leaf>,
     take: Option<Leaf>,
     repeat: bool,
-    call: Option<registry::Call>,
-    wait: Option<(usize, registry::Output)>,
+    call: Option<instances::Call>,
+    wait: Option<(usize, instances::Output)>,
 }
 
 /// What happened to one step.
@@ -229,7 +230,7 @@ pub struct Timeline {
     records: Vec<StepRecord>,
     values: Vec<Value>,
     cnc_tick: Leaf,
-    instances: registry::Instances,
+    instances: instances::Instances,
 }
 
 impl Timeline {
@@ -240,7 +241,7 @@ impl Timeline {
             message: e.to_string(),
         })?;
         let mut steps = Vec::with_capacity(parsed.step.len());
-        let mut instances = registry::Instances::default();
+        let mut instances = instances::Instances::default();
         for (i, s) in parsed.step.into_iter().enumerate() {
             let fail = |reason: String| TimelineError::Step {
                 file: file.to_string(),

@@ -1,6 +1,5 @@
-//! The flying-saw blocks in a timeline: their inputs from a `call` table under the seed's
-//! names (case and underscores do not matter: `RatioNumerator` = `ratio_numerator`), one
-//! instance of each kind, called once per cycle like the other blocks. The slave is the
+//! The flying-saw blocks' inputs in a timeline `call`, under the seed's names (case and
+//! underscores do not matter: `RatioNumerator` = `ratio_numerator`). The slave is the
 //! instance's axis, given as `Slave` (or `axis`).
 //!
 //! ```toml
@@ -22,19 +21,9 @@
 //! as given: the CNC refuses bits it does not know) or lists of flag names, with or without
 //! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
 
-use crate::blocks::saw::{
-    GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics,
-};
-use crate::kernel::Outputs;
-use crate::runtime::PlcIo;
+use super::GearInInputs;
+use crate::timeline::registry::number;
 use hli::calls::saw::sync_mask;
-use std::sync::Arc;
-
-/// The flying-saw blocks a timeline can call: the tail of [`super::BLOCKS`].
-pub(super) const SAW_BLOCKS: &[&str] = super::BLOCKS
-    .as_slice()
-    .split_at(super::BLOCKS.as_slice().len() - 4)
-    .1;
 
 /// The check flags of `ST_SyncMode` by short name (`GearInSync_CheckMask_<name>`).
 const CHECK_FLAGS: [(&str, u32); 12] = [
@@ -64,11 +53,11 @@ const OPERATION_FLAGS: [(&str, u32); 6] = [
 
 /// The inputs of a flying-saw call.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub(crate) struct SawInputs {
-    master: u32,
-    gear: GearInInputs,
+pub(super) struct SawInputs {
+    pub(super) master: u32,
+    pub(super) gear: GearInInputs,
     /// MasterSyncPosition, SlaveSyncPosition.
-    sync_positions: [f64; 2],
+    pub(super) sync_positions: [f64; 2],
 }
 
 /// The inputs of `kind` under the seed's names (`Slave` is every kind's: the axis).
@@ -173,7 +162,7 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String
             "CheckMask" => checks = mask(value, &CHECK_FLAGS).map_err(|e| bad(&e))?,
             "OpMask" => operations = mask(value, &OPERATION_FLAGS).map_err(|e| bad(&e))?,
             other => {
-                let v = super::number(value)
+                let v = number(value)
                     .filter(|v| v.is_finite())
                     .ok_or_else(|| bad("a finite number"))?;
                 match other {
@@ -255,127 +244,12 @@ fn mask(value: &toml::Value, flags: &[(&str, u32)]) -> Result<u32, String> {
     }
 }
 
-#[derive(Debug)]
-enum Kind {
-    Velo(McGearInVelo),
-    Pos(McGearInPos),
-    Out(McGearOut),
-    /// Boxed: two 31-value arrays.
-    Read(Box<McReadFlyingSawCharacteristics>),
-}
-
-/// A flying-saw block instance of a timeline.
-#[derive(Debug)]
-pub(crate) struct SawInstance {
-    /// Execute.
-    pub(crate) execute: bool,
-    /// The inputs of the last call.
-    pub(crate) inputs: Arc<SawInputs>,
-    kind: Kind,
-    /// The read has finished once (its values are worth reporting).
-    read: bool,
-}
-
-impl SawInstance {
-    /// An instance of `kind` (one of [`SAW_BLOCKS`]).
-    pub(super) fn new(kind: &str) -> SawInstance {
-        let kind = match kind {
-            "MC_GearInVelo" => Kind::Velo(McGearInVelo::default()),
-            "MC_GearInPos" => Kind::Pos(McGearInPos::default()),
-            "MC_GearOut" => Kind::Out(McGearOut::default()),
-            _ => Kind::Read(Box::default()),
-        };
-        SawInstance {
-            execute: false,
-            inputs: Arc::default(),
-            kind,
-            read: false,
-        }
-    }
-
-    /// One cycle for slave `axis`; the outputs in the motion blocks' shape (InSync and
-    /// StartSync through [`SawInstance::in_sync`] and [`SawInstance::start_sync`]).
-    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs {
-        let e = self.execute;
-        let i = &*self.inputs;
-        let out = match &mut self.kind {
-            Kind::Velo(b) => {
-                (b.execute, b.inputs, b.master, b.slave) = (e, i.gear, i.master, axis);
-                b.call(io);
-                b.out
-            }
-            Kind::Pos(b) => {
-                (b.execute, b.inputs, b.master, b.slave) = (e, i.gear, i.master, axis);
-                [b.master_sync_position, b.slave_sync_position] = i.sync_positions;
-                b.call(io);
-                b.out
-            }
-            Kind::Out(b) => {
-                (b.execute, b.slave) = (e, axis);
-                b.call(io);
-                b.out
-            }
-            Kind::Read(b) => {
-                (b.execute, b.slave) = (e, axis);
-                b.call(io);
-                self.read |= b.out.done;
-                b.out
-            }
-        };
-        Outputs {
-            in_sync: false,
-            start_sync: false,
-            ..out
-        }
-    }
-
-    fn outputs(&self) -> Outputs {
-        match &self.kind {
-            Kind::Velo(b) => b.out,
-            Kind::Pos(b) => b.out,
-            Kind::Out(b) => b.out,
-            Kind::Read(b) => b.out,
-        }
-    }
-
-    /// InSync of the last cycle (FALSE for MC_GearOut and the read).
-    pub(super) fn in_sync(&self) -> bool {
-        self.outputs().in_sync
-    }
-
-    /// StartSync of the last cycle (FALSE for MC_GearOut and the read).
-    #[allow(dead_code)] // for a StartSync column beside InSync
-    pub(super) fn start_sync(&self) -> bool {
-        self.outputs().start_sync
-    }
-
-    /// The read's 31 values once it has finished, in `MC_FlyingSawCharacValues` order
-    /// ([`crate::blocks::saw::CHARAC_FIELDS`]).
-    pub(super) fn read_values(&self) -> Option<Vec<f64>> {
-        match &self.kind {
-            Kind::Read(b) if self.read => Some(b.values.to_vec()),
-            _ => None,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn parsed(kind: &str, text: &str) -> Result<SawInputs, String> {
         parse(kind, &toml::from_str(text).unwrap())
-    }
-
-    #[test]
-    fn the_saw_blocks_are_the_tail_of_the_block_list() {
-        let names = [
-            "MC_GearInVelo",
-            "MC_GearInPos",
-            "MC_GearOut",
-            "MC_ReadFlyingSawCharacteristics",
-        ];
-        assert_eq!(SAW_BLOCKS, names);
     }
 
     #[test]
@@ -425,13 +299,5 @@ mod tests {
         assert!(err("MC_GearOut", "Slave = 1\naxis = 2").contains("differ"));
         assert!(parsed("MC_GearOut", "Slave = 1\naxis = 1").is_ok());
         assert!(parsed("MC_ReadFlyingSawCharacteristics", "slave = 1").is_ok());
-    }
-
-    #[test]
-    fn a_fresh_instance_has_no_outputs_and_no_values() {
-        for kind in SAW_BLOCKS {
-            let i = SawInstance::new(kind);
-            assert!(!i.in_sync() && !i.start_sync() && i.read_values().is_none());
-        }
     }
 }
