@@ -419,4 +419,7 @@ pub const TIMELINE: &[BlockSpec] = &[
     BlockSpec::on_axis("MC_Stop", &[DECELERATION, JERK], |_| {
         Box::<McStop>::default()
     }),
+    BlockSpec::on_axis("MC_SetPosition", &[input("position", Kind::Real)], |_| {
+        Box::<McSetPosition>::default()
+    }),
 ];

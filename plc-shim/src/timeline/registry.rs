@@ -3,7 +3,7 @@
 //! inputs with their kinds, and the constructor; [`FAMILIES`] lists the tables, one line per
 //! family. The instances and their calls are [`super::instances`].
 
-use crate::blocks::{cam, cam_compat, cam_data, cam_multi, cam_read, fifo, motion, saw};
+use crate::blocks::{cam, cam_compat, cam_data, cam_multi, cam_read, fifo, motion, probe, saw};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
 use hli::calls::cam::McMotionFunctionPoint;
@@ -14,6 +14,7 @@ use std::sync::Arc;
 /// The blocks of every family a timeline can call: one line per family.
 pub const FAMILIES: &[&[BlockSpec]] = &[
     motion::TIMELINE,
+    probe::TIMELINE,
     cam_data::TIMELINE,
     cam::TIMELINE,
     cam_read::TIMELINE,
