@@ -264,57 +264,66 @@ impl CompatBlock {
                 self.out = self.read.out;
             }
             "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => {
-                let start_mode = match (c.master_absolute, c.slave_absolute) {
-                    (true, true) => 1,
-                    (false, false) => 2,
-                    (true, false) => 3,
-                    (false, true) => 4,
-                };
-                let call = CamInCall {
-                    master: c.master,
-                    table_id: c.table,
-                    start_mode,
-                    interpolation: c.interpolation,
-                    master_offset: c.master_offset,
-                    slave_offset: c.slave_offset,
-                    master_scaling: 1.0,
-                    slave_scaling: 1.0,
-                    ..CamInCall::default()
-                };
-                self.out = if c.on {
-                    let mut o = self
-                        .couple
-                        .cycle(io, self.execute, slave, || call, Some(slave));
-                    // The old block is done once the coupling stands (no InSync output).
-                    o.done = o.in_sync;
-                    o
-                } else {
-                    self.decouple
-                        .cycle(io, self.execute, slave, CamOutCall::default, None)
-                };
+                self.out = self.couple_axes(io, &c, slave)
             }
-            kind => {
-                let keep = match kind {
-                    "CamTableOffsetChange" => CAM_KEEP_MASTER_SCALING | CAM_KEEP_SLAVE_SCALING,
-                    "CamTableSetSlaveScale" => {
-                        CAM_KEEP_MASTER_SCALING | CAM_KEEP_MASTER_OFFSET | CAM_KEEP_SLAVE_OFFSET
-                    }
-                    _ => 0,
-                };
-                let call = CamScalingCall {
-                    activation_mode: 0,
-                    master_scaling_mode: 0,
-                    slave_scaling_mode: 0,
-                    reserved: keep,
-                    activation_position: 0.0,
-                    master_offset: c.master_offset,
-                    slave_offset: c.slave_offset,
-                    master_scaling: c.master_slope,
-                    slave_scaling: c.slave_slope,
-                };
-                self.out = self.scale.cycle(io, self.execute, slave, || call, None);
-            }
+            _ => self.out = self.rescale(io, &c, slave),
         }
+    }
+
+    /// CamTableCoupleAxes(Ipol): MC_CamIn (CoupleOn), or MC_CamOut (CoupleOff).
+    fn couple_axes(&mut self, io: &mut PlcIo<'_>, c: &CompatConfig, slave: u32) -> Outputs {
+        let start_mode = match (c.master_absolute, c.slave_absolute) {
+            (true, true) => 1,
+            (false, false) => 2,
+            (true, false) => 3,
+            (false, true) => 4,
+        };
+        let call = CamInCall {
+            master: c.master,
+            table_id: c.table,
+            start_mode,
+            interpolation: c.interpolation,
+            master_offset: c.master_offset,
+            slave_offset: c.slave_offset,
+            master_scaling: 1.0,
+            slave_scaling: 1.0,
+            ..CamInCall::default()
+        };
+        if c.on {
+            let mut o = self
+                .couple
+                .cycle(io, self.execute, slave, || call, Some(slave));
+            // The old block is done once the coupling stands (no InSync output).
+            o.done = o.in_sync;
+            o
+        } else {
+            self.decouple
+                .cycle(io, self.execute, slave, CamOutCall::default, None)
+        }
+    }
+
+    /// CamTableOffsetChange, CamTableSetSlaveScale, CamTableSetMasterSlaveScale: MC_CamScaling
+    /// at once, keeping what the block does not set.
+    fn rescale(&mut self, io: &mut PlcIo<'_>, c: &CompatConfig, slave: u32) -> Outputs {
+        let keep = match c.kind {
+            "CamTableOffsetChange" => CAM_KEEP_MASTER_SCALING | CAM_KEEP_SLAVE_SCALING,
+            "CamTableSetSlaveScale" => {
+                CAM_KEEP_MASTER_SCALING | CAM_KEEP_MASTER_OFFSET | CAM_KEEP_SLAVE_OFFSET
+            }
+            _ => 0,
+        };
+        let call = CamScalingCall {
+            activation_mode: 0,
+            master_scaling_mode: 0,
+            slave_scaling_mode: 0,
+            reserved: keep,
+            activation_position: 0.0,
+            master_offset: c.master_offset,
+            slave_offset: c.slave_offset,
+            master_scaling: c.master_slope,
+            slave_scaling: c.slave_slope,
+        };
+        self.scale.cycle(io, self.execute, slave, || call, None)
     }
 }
 

@@ -125,26 +125,49 @@ fn show(memory: &hli::ImageMemory, coupling: CouplingState, master: i32, axis: A
         .write(&state(coupling, master, axis, 0));
 }
 
-/// The blocks against a stand-in CNC in this thread: the coupling call, the slave's image
-/// written by hand, MC_GearOut, and the read in two parts.
-#[test]
-fn blocks_against_a_stand_in_cnc() {
-    hli::init_logging();
-    let instance = format!("saw-blocks-{}", std::process::id());
-    let server = AcyclicServer::open(&instance).unwrap();
-    let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::segment::heap_image(0, 2);
-    let mut cycle = 0;
-    let mut run = |call: &mut dyn FnMut(&mut PlcIo<'_>) -> bool| loop {
-        cycle += 1;
-        assert!(cycle < 100_000, "watchdog: no answer");
-        if call(&mut io(&memory, &mut client, cycle)) {
-            break;
-        }
-        std::thread::yield_now();
-    };
-    let pos = CouplingState::GearPosition;
+/// A stand-in CNC in this thread: an acyclic server polled by hand and an image with two
+/// axes whose slave image the test writes.
+struct StandIn {
+    server: AcyclicServer,
+    client: AcyclicClient,
+    memory: hli::ImageMemory,
+    cycle: u64,
+}
 
+impl StandIn {
+    fn new(name: &str) -> StandIn {
+        hli::init_logging();
+        let instance = format!("saw-{name}-{}", std::process::id());
+        StandIn {
+            server: AcyclicServer::open(&instance).unwrap(),
+            client: AcyclicClient::open(&instance).unwrap(),
+            memory: hli::segment::heap_image(0, 2),
+            cycle: 0,
+        }
+    }
+
+    /// PLC cycles of `call` until it says it is through.
+    fn run(&mut self, call: &mut dyn FnMut(&mut PlcIo<'_>, &AcyclicServer) -> bool) {
+        loop {
+            self.cycle += 1;
+            assert!(self.cycle < 100_000, "watchdog: no answer");
+            if call(
+                &mut io(&self.memory, &mut self.client, self.cycle),
+                &self.server,
+            ) {
+                break;
+            }
+            std::thread::yield_now();
+        }
+    }
+}
+
+/// The couplings against a stand-in CNC: the coupling call, the slave's image written by
+/// hand, MC_GearOut.
+#[test]
+fn couplings_against_a_stand_in_cnc() {
+    let mut cnc = StandIn::new("couplings");
+    let pos = CouplingState::GearPosition;
     let mut gear = McGearInPos {
         execute: true,
         master: 0,
@@ -152,11 +175,11 @@ fn blocks_against_a_stand_in_cnc() {
         master_sync_position: 100.0,
         ..McGearInPos::default()
     };
-    run(&mut |io| {
+    cnc.run(&mut |io, _| {
         gear.call(io);
         true
     });
-    let answered = server.poll(|kind, request| {
+    let answered = cnc.server.poll(|kind, request| {
         assert_eq!((kind, request.target), (CallKind::SAW_GEAR_IN, 1));
         let call: SawGearInCall = decode_body(request)?;
         assert_eq!(
@@ -166,7 +189,7 @@ fn blocks_against_a_stand_in_cnc() {
         reply(&SawReply::default())
     });
     assert_eq!(answered.unwrap(), 1);
-    run(&mut |io| {
+    cnc.run(&mut |io, _| {
         gear.call(io);
         gear.out.start_sync
     });
@@ -175,8 +198,8 @@ fn blocks_against_a_stand_in_cnc() {
         (AxisState::SlaveSynchronizing, false),
         (AxisState::SlaveSynchronous, true),
     ] {
-        show(&memory, pos, 0, axis);
-        run(&mut |io| {
+        show(&cnc.memory, pos, 0, axis);
+        cnc.run(&mut |io, _| {
             gear.call(io);
             true
         });
@@ -188,22 +211,27 @@ fn blocks_against_a_stand_in_cnc() {
         slave: 1,
         ..McGearOut::default()
     };
-    run(&mut |io| {
+    cnc.run(&mut |io, _| {
         gear_out.call(io);
         true
     });
-    let answered = server.poll(|kind, _| {
+    let answered = cnc.server.poll(|kind, _| {
         assert_eq!(kind, CallKind::SAW_GEAR_OUT);
         reply(&SawReply::default())
     });
     assert_eq!(answered.unwrap(), 1);
-    run(&mut |io| {
+    cnc.run(&mut |io, _| {
         gear_out.call(io);
         !gear_out.out.busy
     });
     assert!(gear_out.out.done, "{:?}", gear_out.out);
-    show(&memory, CouplingState::Uncoupled, -1, AxisState::Inactive);
-    run(&mut |io| {
+    show(
+        &cnc.memory,
+        CouplingState::Uncoupled,
+        -1,
+        AxisState::Inactive,
+    );
+    cnc.run(&mut |io, _| {
         gear.call(io);
         true
     });
@@ -212,13 +240,18 @@ fn blocks_against_a_stand_in_cnc() {
         "{:?}",
         gear.out
     );
+}
 
+/// The characteristic values against a stand-in CNC, in two parts.
+#[test]
+fn the_read_takes_two_parts() {
+    let mut cnc = StandIn::new("read");
     let mut read = McReadFlyingSawCharacteristics {
         execute: true,
         slave: 1,
         ..McReadFlyingSawCharacteristics::default()
     };
-    run(&mut |io| {
+    cnc.run(&mut |io, server| {
         read.call(io);
         server
             .poll(|_, request| {
