@@ -1,5 +1,7 @@
 //! The function blocks a PLC program calls, one file per family, all on the block kernel
-//! ([`crate::kernel`]).
+//! ([`crate::kernel`]). Each family's file ends with its `TIMELINE` table, the blocks a
+//! timeline calls by name ([`crate::timeline::registry`]); `dyn_cs` has none (its blocks
+//! address a channel).
 
 pub mod cam;
 pub mod cam_compat;
