@@ -268,11 +268,12 @@ fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, String> {
                     * 1e-3
             }
             "override_type" => {
-                inputs.params.override_type = match value.as_str() {
-                    Some("instant") => FifoOverrideType::Instant.raw(),
-                    Some("pt2") => FifoOverrideType::Pt2.raw(),
-                    _ => return Err(bad("\"instant\" or \"pt2\"")),
-                }
+                // By the wire enum's names, as written.
+                let types = FifoOverrideType::ALL.iter();
+                let given = types.clone().find(|t| value.as_str() == Some(t.name()));
+                let names: Vec<String> = types.map(|t| format!("{:?}", t.name())).collect();
+                let given = given.ok_or_else(|| bad(&names.join(" or ")))?;
+                inputs.params.override_type = given.raw()
             }
             _ => {
                 let (rows, columns) = rows_of(value).map_err(|e| bad(&e))?;
@@ -457,5 +458,16 @@ mod tests {
         let v = super::fifo_library_version();
         assert_eq!(v, concat!("cncplc-fifo ", env!("CARGO_PKG_VERSION")));
         assert!(v.len() <= 20, "fits the seed's STRING(20)");
+    }
+
+    #[test]
+    fn the_override_type_goes_by_the_wire_enums_names() {
+        let parsed = |text: &str| super::parse("FiFoSetParameters", &toml::from_str(text).unwrap());
+        let i = parsed("override_type = \"pt2\"\npt2_t0_ms = 20").unwrap();
+        assert_eq!(i.params.override_type, super::FifoOverrideType::Pt2.raw());
+        assert_eq!(
+            parsed("override_type = \"fast\"").unwrap_err(),
+            "call: FiFoSetParameters input `override_type` = \"fast\": \"instant\" or \"pt2\""
+        );
     }
 }

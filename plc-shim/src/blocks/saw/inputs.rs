@@ -23,7 +23,7 @@
 
 use super::GearInInputs;
 use crate::timeline::registry::number;
-use hli::calls::saw::sync_mask;
+use hli::calls::saw::{sync_mask, SawSyncMode};
 
 /// The check flags of `ST_SyncMode` by short name (`GearInSync_CheckMask_<name>`).
 const CHECK_FLAGS: [(&str, u32); 12] = [
@@ -196,23 +196,26 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String
 
 /// `SyncMode`: a name (`"time-based"`, `"GEARINSYNCMODE_TIMEBASED"`, ...) or the raw 0 / 1.
 fn time_based(value: &toml::Value) -> Option<bool> {
-    match value {
+    let mode = match value {
         toml::Value::String(name) => {
-            let name: String = name
-                .chars()
-                .filter(char::is_ascii_alphanumeric)
-                .collect::<String>()
-                .to_ascii_lowercase();
-            match name.strip_prefix("gearinsyncmode").unwrap_or(&name) {
-                "positionbased" => Some(false),
-                "timebased" => Some(true),
-                _ => None,
-            }
+            // The wire enum's names with letters and digits only, in lower case.
+            let letters = |name: &str| -> String {
+                name.chars()
+                    .filter(char::is_ascii_alphanumeric)
+                    .collect::<String>()
+                    .to_ascii_lowercase()
+            };
+            let name = letters(name);
+            let name = name.strip_prefix("gearinsyncmode").unwrap_or(&name);
+            SawSyncMode::ALL
+                .iter()
+                .copied()
+                .find(|m| letters(m.name()) == name)
         }
-        toml::Value::Integer(0) => Some(false),
-        toml::Value::Integer(1) => Some(true),
+        toml::Value::Integer(raw) => u32::try_from(*raw).ok().and_then(SawSyncMode::from_raw),
         _ => None,
-    }
+    }?;
+    Some(mode == SawSyncMode::TimeBased)
 }
 
 /// A mask: the raw bits, or a list of names from `flags`.
@@ -278,6 +281,15 @@ mod tests {
         assert!(i.gear.sync_mode.time_based);
         assert_eq!(i.gear.sync_mode.mask, 3, "raw bits go as given");
         assert_eq!(i.gear.ratio_denominator, 1, "ratio 1:1 by default");
+        for (mode, time_based) in [
+            ("\"GEARINSYNCMODE_TIMEBASED\"", true),
+            ("\"position_based\"", false),
+            ("1", true),
+            ("0", false),
+        ] {
+            let i = parsed("MC_GearInVelo", &format!("Master = 0\nSyncMode = {mode}")).unwrap();
+            assert_eq!(i.gear.sync_mode.time_based, time_based, "{mode}");
+        }
     }
 
     #[test]
