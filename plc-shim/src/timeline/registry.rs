@@ -144,11 +144,8 @@ pub const fn mode<E: WireEnum>() -> Kind {
         E::from_raw(raw).is_some()
     }
     fn names<E: WireEnum>() -> String {
-        let names: Vec<String> = E::ALL
-            .iter()
-            .map(|v| format!("{} ({})", v.name(), v.raw()))
-            .collect();
-        names.join(", ")
+        let name = |v: &E| format!("{} ({})", v.name(), v.raw());
+        E::ALL.iter().map(name).collect::<Vec<_>>().join(", ")
     }
     Kind::Mode(Mode {
         from_name: from_name::<E>,
