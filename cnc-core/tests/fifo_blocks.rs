@@ -4,7 +4,7 @@
 
 use hli::calls::fifo::{FifoReply, FifoStartCall};
 use hli::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::fifo::{FifoStart, FifoWrite};
+use plc_shim::blocks::fifo::{FifoStart, FifoWrite};
 use plc_shim::kernel::ERROR_NO_ANSWER;
 use plc_shim::runtime::PlcIo;
 

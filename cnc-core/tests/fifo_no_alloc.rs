@@ -12,7 +12,7 @@ use hli::calls::AcyclicCall;
 use hli::enums::FifoGroupState;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
-use plc_shim::fifo::FifoWrite;
+use plc_shim::blocks::fifo::FifoWrite;
 use plc_shim::runtime::PlcIo;
 
 #[path = "../../tests/support/counting_alloc.rs"]

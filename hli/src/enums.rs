@@ -50,7 +50,8 @@ macro_rules! hli_enum {
 
 /// Declares a mode selector a call body carries as a raw `u32`: the enum, and `raw`,
 /// `from_raw` (`None` for a number it does not have), `name`, `from_name` (ASCII case
-/// ignored) and `ALL`, the names being what timelines and command lines give.
+/// ignored) and `ALL`, the names being what timelines and command lines give; the same as
+/// [`WireEnum`] for code generic over them.
 macro_rules! wire_enum {
     (
         $(#[doc = $doc:literal])*
@@ -88,12 +89,45 @@ macro_rules! wire_enum {
 
             /// The value of a name (ASCII case ignored), `None` for a name it does not have.
             pub fn from_name(name: &str) -> Option<Self> {
-                Self::ALL.iter().copied().find(|v| v.name().eq_ignore_ascii_case(name))
+                <Self as $crate::enums::WireEnum>::from_name(name)
+            }
+        }
+
+        impl $crate::enums::WireEnum for $name {
+            const ALL: &'static [Self] = $name::ALL;
+            fn raw(self) -> u32 {
+                $name::raw(self)
+            }
+            fn from_raw(raw: u32) -> Option<Self> {
+                $name::from_raw(raw)
+            }
+            fn name(self) -> &'static str {
+                $name::name(self)
             }
         }
     };
 }
 pub(crate) use wire_enum;
+
+/// Every `wire_enum!` type, for code generic over them (the PLC timeline takes a mode by
+/// its name or its number).
+pub trait WireEnum: Copy + 'static {
+    /// Every value, in declaration order.
+    const ALL: &'static [Self];
+    /// The raw value on the wire.
+    fn raw(self) -> u32;
+    /// The value of a raw number, `None` for a number it does not have.
+    fn from_raw(raw: u32) -> Option<Self>;
+    /// The value's name.
+    fn name(self) -> &'static str;
+    /// The value of a name (ASCII case ignored), `None` for a name it does not have.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .iter()
+            .copied()
+            .find(|v| v.name().eq_ignore_ascii_case(name))
+    }
+}
 
 hli_enum! {
     /// `HLI_DYN_CS_*`: state of a tracking channel. Carried in a UDINT, so ERROR (-1) is

@@ -3,19 +3,12 @@
 //! the acyclic request-response service.
 
 pub mod blocks;
-pub mod cam;
-pub mod cam_compat;
 pub mod cli;
-pub mod dyn_cs;
-pub mod fifo;
 pub mod fifo_file;
 pub mod kernel;
-pub mod motion;
-pub mod probe;
 pub mod programs;
 pub mod realtime;
 pub mod runtime;
-pub mod saw;
 pub mod timeline;
 pub mod tools;
 

@@ -6,7 +6,9 @@
 use cnc_core::axis::config::{AxisConfig, DriveLink};
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
 use cnc_core::axis::AxisSet;
-use plc_shim::motion::{McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McStop};
+use plc_shim::blocks::motion::{
+    McHalt, McMoveAbsolute, McMoveRelative, McMoveVelocity, McPower, McStop,
+};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime, RunEnd};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;

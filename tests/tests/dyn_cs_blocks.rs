@@ -5,7 +5,7 @@
 
 use hli::enums::{DynCsState, DynCsTransitionError};
 use hli::layout::{HliDynCsTransitionResult, HliMFunctionRequest};
-use plc_shim::dyn_cs::{MFunctionHandshake, McDynCsTransition};
+use plc_shim::blocks::dyn_cs::{MFunctionHandshake, McDynCsTransition};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

@@ -5,7 +5,7 @@
 //! blocks and the HLI come from `plc-shim`; `main.rs` only parses the arguments and hands the
 //! program to [`plc_shim::cli::host`].
 
-use plc_shim::motion::{McMoveAbsolute, McPower};
+use plc_shim::blocks::motion::{McMoveAbsolute, McPower};
 use plc_shim::runtime::{PlcIo, PlcProgram};
 
 /// Where the sequence is.

@@ -1,5 +1,19 @@
-//! The FIFO blocks in a timeline: their inputs from a `call` table and one instance of each
-//! kind, called once per cycle like the other blocks.
+//! The FIFO blocks of seed 002 chapter 7 for the PLC program: FiFoGetDimension,
+//! FiFoGroupIntegrate, FiFoGroupDisintegrate, FiFoWrite, FiFoOverwrite, FiFoStart, FiFoStop,
+//! FiFoSetChannelOverride, our FiFoSetParameters, and the library version function, on the
+//! block kernel ([`crate::kernel`]: its Execute, timeout and output rules). Each sends on the
+//! rising Execute edge without waiting, is Busy until the CNC answers, then Done or Error
+//! (with the CNC's code, [`hli::enums::FifoError`] or [`hli::enums::AxisError`]). No answer
+//! within the timeout (the seed's tTimeout; default 1000 cycles) is an Error with
+//! [`crate::kernel::ERROR_NO_ANSWER`]: the call may still have been executed.
+//!
+//! FiFoWrite and FiFoOverwrite send a row block on the row service: the rows are written
+//! once, straight into the shared memory the CNC reads (seed: `AdrdataArray`, `iColDim`,
+//! `iRowsToWrite`). A block the FIFO cannot take whole is refused whole (`Full`): offer it
+//! again later; [`PlcView::fifo_group`](hli::views::PlcView::fifo_group) tells the free rows.
+//!
+//! In a timeline ([`TIMELINE`]) a FIFO block addresses its group (`group`); of them only
+//! FiFoGroupIntegrate names an axis:
 //!
 //! ```toml
 //! [[step]]
@@ -11,26 +25,167 @@
 //! call = { block = "FiFoSetChannelOverride", instance = "ov", override = 50.0 }   # percent
 //! ```
 
-use crate::fifo::{
-    FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoSetChannelOverride,
-    FifoSetParameters, FifoStart, FifoStop, FifoWrite,
-};
-use crate::kernel::Outputs;
+use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
-    FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
+    FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
 };
+use hli::calls::AcyclicCall;
 use hli::layout::FIFO_OVERRIDE_FULL;
+use hli::rpc::{PendingCall, PendingRows};
 use std::sync::Arc;
 
-/// The FIFO blocks a timeline can call: 9 entries of [`super::BLOCKS`] from index 36.
-pub(super) const FIFO_BLOCKS: &[&str] = super::BLOCKS.as_slice().split_at(36).1.split_at(9).0;
-const _: () = assert!(FIFO_BLOCKS.len() == 9);
+/// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).
+pub fn fifo_library_version() -> &'static str {
+    concat!("cncplc-fifo ", env!("CARGO_PKG_VERSION"))
+}
+
+/// Error id of a row block that does not fit one call (more than
+/// [`FIFO_BLOCK_VALUES`] values, or rows x columns not the slice given): refused in the PLC.
+pub const ERROR_BLOCK_SIZE: u32 = hli::enums::FifoError::BlockSize as u32;
+
+/// The CNC's answer to a FIFO call: Done with its reply, or Error with its code (the reply
+/// beside it: the FIFO's state and fill level).
+fn accept(reply: FifoReply) -> Accept<(), FifoReply> {
+    if reply.error_id != 0 {
+        Accept::Failed(reply.error_id, reply)
+    } else {
+        Accept::Done(reply)
+    }
+}
+
+/// A one-frame FIFO block. Its outputs carry the CNC's reply as their extra: the FIFO's
+/// state, fill level, and FiFoGetDimension's values.
+pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
+    kernel: Kernel<PendingCall<C>, (), FifoReply>,
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
+    fn default() -> Self {
+        Self {
+            kernel: Kernel::default(),
+        }
+    }
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> core::fmt::Debug for FifoBlock<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        self.kernel.fmt(f)
+    }
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle: on a rising `execute`, `call()` goes to FIFO group `group`.
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        group: u32,
+        call: impl FnOnce() -> C,
+    ) -> Outputs<FifoReply> {
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(group, &call())
+                    .map_err(|e| call_error_code(&e))
+            },
+            accept,
+            no_follow,
+        )
+    }
+}
+
+/// FiFoGetDimension: `reply.dimension` (iNoOfAxes) and `reply.capacity` (iNoOfFifoEntries).
+pub type FifoGetDimension = FifoBlock<FifoDimensionCall>;
+/// FiFoGroupIntegrate.
+pub type FifoGroupIntegrate = FifoBlock<FifoIntegrateCall>;
+/// FiFoGroupDisintegrate.
+pub type FifoGroupDisintegrate = FifoBlock<FifoDisintegrateCall>;
+/// FiFoStart.
+pub type FifoStart = FifoBlock<FifoStartCall>;
+/// FiFoStop.
+pub type FifoStop = FifoBlock<FifoStopCall>;
+/// FiFoSetChannelOverride (ppm, 1,000,000 = 100 %).
+pub type FifoSetChannelOverride = FifoBlock<FifoOverrideCall>;
+/// FiFoSetParameters (ours): T_f and the override type while the group is not running.
+pub type FifoSetParameters = FifoBlock<FifoParametersCall>;
+
+/// FiFoWrite (`overwrite` false) or FiFoOverwrite (true).
+#[derive(Default)]
+pub struct FifoWrite {
+    /// FiFoOverwrite: replace the rows queued behind the pair in use.
+    pub overwrite: bool,
+    kernel: Kernel<PendingRows, (), FifoReply>,
+}
+
+impl core::fmt::Debug for FifoWrite {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FifoWrite")
+            .field("overwrite", &self.overwrite)
+            .field("kernel", &self.kernel)
+            .finish()
+    }
+}
+
+impl FifoWrite {
+    /// FiFoOverwrite.
+    pub fn overwrite() -> FifoWrite {
+        FifoWrite {
+            overwrite: true,
+            ..FifoWrite::default()
+        }
+    }
+
+    /// Input: cycles to wait for the answer (tTimeout).
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle: on a rising `execute`, the first `rows` rows of `data` (rows of `columns`
+    /// values, row after row: iColDim, iRowsToWrite) go to group `group`.
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        group: u32,
+        data: &[f64],
+        columns: u32,
+        rows: u32,
+    ) -> Outputs<FifoReply> {
+        let overwrite = self.overwrite;
+        let send = |io: &mut PlcIo<'_>| {
+            let values = (columns as usize).checked_mul(rows as usize);
+            match values {
+                Some(n) if n <= data.len() && n <= FIFO_BLOCK_VALUES => {
+                    let header = FifoRowsHeader {
+                        group,
+                        columns,
+                        rows,
+                        overwrite: u32::from(overwrite),
+                    };
+                    io.acyclic
+                        .start_rows(header, &data[..n])
+                        .map_err(|e| call_error_code(&e))
+                }
+                _ => Err(ERROR_BLOCK_SIZE),
+            }
+        };
+        self.kernel.cycle(io, execute, send, accept, no_follow)
+    }
+}
 
 /// The inputs of a FIFO call.
 #[derive(Debug, Clone, Default, PartialEq)]
-pub(crate) struct FifoInputs {
+struct FifoInputs {
     group: u32,
     group_position: u32,
     override_ppm: u32,
@@ -51,7 +206,7 @@ fn allowed(kind: &str) -> &'static [&'static str] {
 
 /// Checks the inputs of a FIFO `call` table (`block`, `instance`, `axis`, `execute` are the
 /// caller's).
-pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, String> {
+fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, String> {
     let mut inputs = FifoInputs {
         params: FifoParametersCall {
             fifo_cycle_s: 0.001,
@@ -113,11 +268,12 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, Strin
                     * 1e-3
             }
             "override_type" => {
-                inputs.params.override_type = match value.as_str() {
-                    Some("instant") => FifoOverrideType::Instant.raw(),
-                    Some("pt2") => FifoOverrideType::Pt2.raw(),
-                    _ => return Err(bad("\"instant\" or \"pt2\"")),
-                }
+                // By the wire enum's names, as written.
+                let types = FifoOverrideType::ALL.iter();
+                let given = types.clone().find(|t| value.as_str() == Some(t.name()));
+                let names: Vec<String> = types.map(|t| format!("{:?}", t.name())).collect();
+                let given = given.ok_or_else(|| bad(&names.join(" or ")))?;
+                inputs.params.override_type = given.raw()
             }
             _ => {
                 let (rows, columns) = rows_of(value).map_err(|e| bad(&e))?;
@@ -165,6 +321,7 @@ fn rows_of(value: &toml::Value) -> Result<(Arc<[f64]>, u32), String> {
     Ok((values.into(), columns.unwrap_or(0) as u32))
 }
 
+/// The block of a FIFO instance.
 #[derive(Debug)]
 enum Kind {
     Dimension(FifoGetDimension),
@@ -179,37 +336,17 @@ enum Kind {
 
 /// A FIFO block instance of a timeline.
 #[derive(Debug)]
-pub(crate) struct FifoInstance {
+struct FifoInstance {
     /// Execute.
-    pub(crate) execute: bool,
+    execute: bool,
     /// The inputs of the last call.
-    pub(crate) inputs: Arc<FifoInputs>,
+    inputs: Arc<FifoInputs>,
     kind: Kind,
 }
 
 impl FifoInstance {
-    /// An instance of `kind` (one of [`FIFO_BLOCKS`]).
-    pub(super) fn new(kind: &str) -> FifoInstance {
-        let kind = match kind {
-            "FiFoGetDimension" => Kind::Dimension(FifoGetDimension::default()),
-            "FiFoGroupIntegrate" => Kind::Integrate(FifoGroupIntegrate::default()),
-            "FiFoGroupDisintegrate" => Kind::Disintegrate(FifoGroupDisintegrate::default()),
-            "FiFoStart" => Kind::Start(FifoStart::default()),
-            "FiFoStop" => Kind::Stop(FifoStop::default()),
-            "FiFoSetChannelOverride" => Kind::Override(FifoSetChannelOverride::default()),
-            "FiFoSetParameters" => Kind::Parameters(FifoSetParameters::default()),
-            "FiFoOverwrite" => Kind::Write(FifoWrite::overwrite()),
-            _ => Kind::Write(FifoWrite::default()),
-        };
-        FifoInstance {
-            execute: false,
-            inputs: Arc::default(),
-            kind,
-        }
-    }
-
     /// One cycle; `axis` is FiFoGroupIntegrate's.
-    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs<FifoReply> {
+    fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs<FifoReply> {
         let e = self.execute;
         let i = &*self.inputs;
         let g = i.group;
@@ -231,5 +368,106 @@ impl FifoInstance {
                 b.cycle(io, e, g, &i.rows, i.columns, rows)
             }
         }
+    }
+}
+
+impl TimelineBlock for FifoInstance {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(inputs) = value.custom::<FifoInputs>() {
+            self.inputs = inputs;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    /// Done, Busy, Error and ErrorID (the reply is not recorded).
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        let out = self.call(io, axis);
+        let out = Outputs {
+            done: out.done,
+            busy: out.busy,
+            error: out.error,
+            error_id: out.error_id,
+            ..Outputs::default()
+        };
+        (out, false)
+    }
+}
+
+/// A call of `kind` checked whole.
+fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
+    Ok((Value::Custom(Arc::new(parse(kind, table)?)), None))
+}
+
+/// A FIFO block a timeline calls: on its group (`group`, an input), or also on an axis.
+macro_rules! fifo_block {
+    ($name:literal, $target:ident, $block:expr) => {
+        BlockSpec {
+            name: $name,
+            target: Target::$target,
+            execute: true,
+            inputs: Inputs::Table(checked),
+            make: |_| {
+                Box::new(FifoInstance {
+                    execute: false,
+                    inputs: Arc::default(),
+                    kind: $block,
+                })
+            },
+        }
+    };
+}
+
+/// The FIFO blocks a timeline calls; of them only FiFoGroupIntegrate names an axis.
+pub const TIMELINE: &[BlockSpec] = &[
+    fifo_block!(
+        "FiFoGetDimension",
+        Group,
+        Kind::Dimension(FifoGetDimension::default())
+    ),
+    fifo_block!(
+        "FiFoGroupIntegrate",
+        Axis,
+        Kind::Integrate(FifoGroupIntegrate::default())
+    ),
+    fifo_block!(
+        "FiFoGroupDisintegrate",
+        Group,
+        Kind::Disintegrate(FifoGroupDisintegrate::default())
+    ),
+    fifo_block!("FiFoWrite", Group, Kind::Write(FifoWrite::default())),
+    fifo_block!("FiFoOverwrite", Group, Kind::Write(FifoWrite::overwrite())),
+    fifo_block!("FiFoStart", Group, Kind::Start(FifoStart::default())),
+    fifo_block!("FiFoStop", Group, Kind::Stop(FifoStop::default())),
+    fifo_block!(
+        "FiFoSetChannelOverride",
+        Group,
+        Kind::Override(FifoSetChannelOverride::default())
+    ),
+    fifo_block!(
+        "FiFoSetParameters",
+        Group,
+        Kind::Parameters(FifoSetParameters::default())
+    ),
+];
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_library_names_its_version() {
+        let v = super::fifo_library_version();
+        assert_eq!(v, concat!("cncplc-fifo ", env!("CARGO_PKG_VERSION")));
+        assert!(v.len() <= 20, "fits the seed's STRING(20)");
+    }
+
+    #[test]
+    fn the_override_type_goes_by_the_wire_enums_names() {
+        let parsed = |text: &str| super::parse("FiFoSetParameters", &toml::from_str(text).unwrap());
+        let i = parsed("override_type = \"pt2\"\npt2_t0_ms = 20").unwrap();
+        assert_eq!(i.params.override_type, super::FifoOverrideType::Pt2.raw());
+        assert_eq!(
+            parsed("override_type = \"fast\"").unwrap_err(),
+            "call: FiFoSetParameters input `override_type` = \"fast\": \"instant\" or \"pt2\""
+        );
     }
 }

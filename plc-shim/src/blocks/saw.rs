@@ -1,437 +1,669 @@
-//! The flying-saw blocks in a timeline: their inputs from a `call` table under the seed's
-//! names (case and underscores do not matter: `RatioNumerator` = `ratio_numerator`), one
-//! instance of each kind, called once per cycle like the other blocks. The slave is the
-//! instance's axis, given as `Slave` (or `axis`).
+//! The flying-saw blocks of seed 001 chapter 12 for the PLC program: MC_GearInVelo,
+//! MC_GearInPos, MC_GearOut and MC_ReadFlyingSawCharacteristics, on the block kernel
+//! ([`crate::kernel`]: its Execute, timeout and output rules). Each sends its call to the
+//! slave's axis index on the rising Execute edge without waiting; no answer within the
+//! timeout is an Error with [`ERROR_NO_ANSWER`] (the call may still have been executed).
 //!
-//! ```toml
-//! [[step]]
-//! call = { block = "MC_GearInPos", instance = "saw", Slave = 1, Master = 0,
-//!          RatioNumerator = 1.0, RatioDenominator = 1, MasterSyncPosition = 500.0,
-//!          SlaveSyncPosition = 100.0, CheckMask = ["MAXVELO", "MAXACC"],
-//!          OpMask = ["ROLLBACKLOCK"] }
-//! [[step]]
-//! wait = "saw.InSync"
-//! [[step]]
-//! call = { block = "MC_ReadFlyingSawCharacteristics", instance = "charac", Slave = 1 }
-//! [[step]]
-//! call = { block = "MC_GearOut", instance = "out", Slave = 1 }
-//! ```
+//! MC_GearInVelo / MC_GearInPos: once the CNC accepts the coupling, StartSync is TRUE and the
+//! block follows the slave's axis image. InSync when the slave is coupled the block's way
+//! (`coupling_state_r` 2 for velocity, 3 for position, to the block's master) and synchronous
+//! (`nAxisState` 13); Busy = Active until InSync, CommandAborted or Error (the seed: Active is
+//! Busy for now). CommandAborted when that coupling goes away (MC_GearOut, MC_Stop, or a new
+//! coupling of the other kind or to another master); Error with the axis's `error_id_r` when
+//! the slave faults. After InSync the block keeps following while Execute stays TRUE: InSync
+//! shows whether the slave is synchronous now (a rollback stop lowers it until the slave is
+//! synchronous again; Busy stays FALSE, the command ended at the first InSync), and a coupling
+//! that goes away later is CommandAborted. Limits of what the image can tell: a new coupling
+//! of the same kind to the same master made by another instance looks like this block's own.
 //!
-//! `SyncMode` is `"position-based"` (the default) or `"time-based"` (MC_GearInVelo only; the
-//! CNC refuses it for MC_GearInPos). `CheckMask` and `OpMask` are integers (the raw bits, sent
-//! as given: the CNC refuses bits it does not know) or lists of flag names, with or without
-//! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
+//! With Execute low the block follows on until the coupling ends, and shows that end for one
+//! cycle (the kernel's rule for every block).
+//!
+//! A timeline calls them by their names ([`TIMELINE`]) with the seed's input names
+//! ([`inputs`]).
 
-use crate::kernel::Outputs;
-use crate::runtime::PlcIo;
-use crate::saw::{
-    GearInInputs, McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics,
+use crate::kernel::{
+    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
+    Waited, ERROR_NO_ANSWER,
 };
-use hli::calls::saw::sync_mask;
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
+use hli::calls::saw::{
+    SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
+};
+use hli::enums::{AxisState, CouplingState};
+use hli::layout::HliAxisLrState;
+use hli::rpc::PendingCall;
+use inputs::SawInputs;
 use std::sync::Arc;
 
-/// The flying-saw blocks a timeline can call: the tail of [`super::BLOCKS`].
-pub(super) const SAW_BLOCKS: &[&str] = super::BLOCKS
-    .as_slice()
-    .split_at(super::BLOCKS.as_slice().len() - 4)
-    .1;
+pub mod inputs;
 
-/// The check flags of `ST_SyncMode` by short name (`GearInSync_CheckMask_<name>`).
-const CHECK_FLAGS: [(&str, u32); 12] = [
-    ("MINPOS", sync_mask::MINPOS),
-    ("MAXPOS", sync_mask::MAXPOS),
-    ("MAXVELO", sync_mask::MAXVELO),
-    ("MAXACC", sync_mask::MAXACC),
-    ("MAXDEC", sync_mask::MAXDEC),
-    ("MAXJERK", sync_mask::MAXJERK),
-    ("OVERSHOOTPOS", sync_mask::OVERSHOOTPOS),
-    ("UNDERSHOOTPOS", sync_mask::UNDERSHOOTPOS),
-    ("OVERSHOOTVELO", sync_mask::OVERSHOOTVELO),
-    ("UNDERSHOOTVELO", sync_mask::UNDERSHOOTVELO),
-    ("OVERSHOOTVELOZERO", sync_mask::OVERSHOOTVELOZERO),
-    ("UNDERSHOOTVELOZERO", sync_mask::UNDERSHOOTVELOZERO),
+/// Version of this block library (like the FIFO library's version function).
+pub fn saw_library_version() -> &'static str {
+    concat!("cncplc-saw ", env!("CARGO_PKG_VERSION"))
+}
+
+/// Fields 1-31 of `MC_FlyingSawCharacValues`, in the structure's order (the CNC sends them
+/// in this order, 16 per part).
+pub const CHARAC_FIELDS: [&str; 31] = [
+    "fMasterVeloNom",
+    "fMasterPosStart",
+    "fSlavePosStart",
+    "fSlaveVeloStart",
+    "fSlaveAccStart",
+    "fSlaveJerkStart",
+    "fMasterPosEnd",
+    "fSlavePosEnd",
+    "fSlaveVeloEnd",
+    "fSlaveAccEnd",
+    "fSlaveJerkEnd",
+    "fMPosAtSPosMin",
+    "fSlavePosMin",
+    "fMPosAtSVeloMin",
+    "fSlaveVeloMin",
+    "fMPosAtSAccMin",
+    "fSlaveAccMin",
+    "fSVeloAtSAccMin",
+    "fSlaveJerkMin",
+    "fSlaveDynMomMin",
+    "fMPosAtSPosMax",
+    "fSlavePosMax",
+    "fMPosAtSVeloMax",
+    "fSlaveVeloMax",
+    "fMPosAtSAccMax",
+    "fSlaveAccMax",
+    "fSVeloAtSAccMax",
+    "fSlaveJerkMax",
+    "fSlaveDynMomMax",
+    "fSlaveVeloMean",
+    "fSlaveAccEff",
 ];
 
-/// The operation flags of `ST_SyncMode` by short name (`GearInSync_OpMask_<name>`).
-const OPERATION_FLAGS: [(&str, u32); 6] = [
-    ("ROLLBACKLOCK", sync_mask::ROLLBACKLOCK),
-    ("INSTANTSTOPONROLLBACK", sync_mask::INSTANTSTOPONROLLBACK),
-    ("PREFERCONSTVELO", sync_mask::PREFERCONSTVELO),
-    ("IGNOREMASTERACC", sync_mask::IGNOREMASTERACC),
-    ("IGNORESLAVEACC", sync_mask::IGNORESLAVEACC),
-    ("DETAILEDERRORCODES", sync_mask::DETAILEDERRORCODES),
-];
+/// `ST_SyncMode`: the profile kind and the check and operation flags as one bit mask
+/// ([`hli::calls::saw::sync_mask`]); the CNC refuses bits it does not know.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SyncMode {
+    /// GEARINSYNCMODE_TIMEBASED (MC_GearInVelo only) rather than position-based.
+    pub time_based: bool,
+    /// Check and operation bits.
+    pub mask: u32,
+}
 
-/// The inputs of a flying-saw call.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub(crate) struct SawInputs {
+impl SyncMode {
+    /// The raw `E_GearInSyncMode`.
+    pub fn raw_mode(self) -> u32 {
+        if self.time_based {
+            SawSyncMode::TimeBased.raw()
+        } else {
+            SawSyncMode::PositionBased.raw()
+        }
+    }
+}
+
+fn failed(error_id: u32) -> Outputs {
+    Outputs::failed(error_id)
+}
+
+/// What the slave's image says about the coupling a block made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Image {
+    Faulted(u32),
+    Ours { synchronous: bool },
+    Other,
+}
+
+fn read_image(state: Option<HliAxisLrState>, kind: CouplingState, master: u32) -> Image {
+    match state {
+        Some(s) if s.error_id_r != 0 => Image::Faulted(s.error_id_r),
+        Some(s)
+            if s.coupling_state_r == kind.raw()
+                && i64::from(s.master_axis_r) == i64::from(master) =>
+        {
+            Image::Ours {
+                synchronous: s.axis_state_r == AxisState::SlaveSynchronous.raw(),
+            }
+        }
+        _ => Image::Other,
+    }
+}
+
+/// What a coupling block keeps while it follows its accepted coupling: the master it asked
+/// for, whether the image has shown the coupling, and whether it was synchronous once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct GearFollow {
     master: u32,
-    gear: GearInInputs,
-    /// MasterSyncPosition, SlaveSyncPosition.
-    sync_positions: [f64; 2],
+    seen: bool,
+    synced: bool,
 }
 
-/// The inputs of `kind` under the seed's names (`Slave` is every kind's: the axis).
-fn inputs_of(kind: &str) -> &'static [&'static str] {
-    match kind {
-        "MC_GearInVelo" => &[
-            "Slave",
-            "Master",
-            "RatioNumerator",
-            "RatioDenominator",
-            "SyncMode",
-            "CheckMask",
-            "OpMask",
-            "Velocity",
-            "Acceleration",
-            "Deceleration",
-            "Jerk",
-        ],
-        "MC_GearInPos" => &[
-            "Slave",
-            "Master",
-            "RatioNumerator",
-            "RatioDenominator",
-            "MasterSyncPosition",
-            "SlaveSyncPosition",
-            "SyncMode",
-            "CheckMask",
-            "OpMask",
-            "Velocity",
-            "Acceleration",
-            "Deceleration",
-            "Jerk",
-        ],
-        _ => &["Slave"],
+/// Accepted: StartSync, Busy = Active.
+const STARTED: Outputs = Outputs {
+    start_sync: true,
+    busy: true,
+    active: true,
+    done: false,
+    command_aborted: false,
+    error: false,
+    error_id: 0,
+    in_velocity: false,
+    in_sync: false,
+    extra: (),
+};
+
+/// One cycle of following an accepted coupling through the slave's image.
+fn follow_gear(f: &mut GearFollow, image: Image, waited: Waited) -> Step<()> {
+    // The CNC answers between two ticks: the image read in the reply's own cycle may still be
+    // the tick before the coupling (an earlier coupling of the slave included).
+    if waited.cycles == 0 {
+        return Step::Running(STARTED);
+    }
+    match image {
+        Image::Faulted(code) => Step::Ended(Outputs {
+            start_sync: true,
+            ..failed(code)
+        }),
+        Image::Ours { synchronous } => {
+            f.seen = true;
+            f.synced |= synchronous;
+            let busy = !f.synced;
+            Step::Running(Outputs {
+                start_sync: true,
+                in_sync: synchronous,
+                busy,
+                active: busy,
+                ..Outputs::default()
+            })
+        }
+        // Gone after it was seen; or never shown at all within the timeout (ended between
+        // two PLC cycles).
+        Image::Other if f.seen || waited.cycles > waited.timeout => Step::Ended(Outputs {
+            start_sync: true,
+            command_aborted: true,
+            ..Outputs::default()
+        }),
+        Image::Other => Step::Running(STARTED),
     }
 }
 
-/// A key without underscores, in lower case: `ratio_numerator` and `RatioNumerator` meet.
-fn folded(key: &str) -> String {
-    key.chars()
-        .filter(|c| *c != '_')
-        .collect::<String>()
-        .to_ascii_lowercase()
+/// The block kernel as MC_GearInVelo and MC_GearInPos use it.
+struct GearInCore {
+    kind: CouplingState,
+    kernel: Kernel<PendingCall<SawGearInCall>, GearFollow>,
 }
 
-/// `Slave = N` under any spelling, for the caller's axis.
-pub(super) fn slave(table: &toml::Table) -> Option<&toml::Value> {
-    table
-        .iter()
-        .find(|(key, _)| folded(key) == "slave")
-        .map(|(_, value)| value)
-}
-
-/// Checks the inputs of a flying-saw `call` table (`block`, `instance`, `axis`, `execute`
-/// are the caller's; `Slave` is read by the caller as the axis).
-pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String> {
-    let mut inputs = SawInputs::default();
-    let mut master = None;
-    let mut sync_positions = [None, None];
-    let (mut checks, mut operations) = (0, 0);
-    let known = inputs_of(kind);
-    if let (Some(s), Some(a)) = (slave(table), table.get("axis")) {
-        if s != a {
-            return Err(format!(
-                "call: {kind}: `Slave` = {s} and `axis` = {a} differ"
-            ));
+impl GearInCore {
+    fn new(kind: CouplingState) -> GearInCore {
+        GearInCore {
+            kind,
+            kernel: Kernel::active_while_sent(),
         }
     }
-    for (key, value) in table {
-        if ["block", "instance", "axis", "execute"].contains(&key.as_str()) {
-            continue;
+
+    fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        slave: u32,
+        call: SawGearInCall,
+    ) -> Outputs {
+        let kind = self.kind;
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(slave, &call)
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| match reply.error_id {
+                0 => Accept::Follow(
+                    GearFollow {
+                        master: call.master,
+                        seen: false,
+                        synced: false,
+                    },
+                    STARTED,
+                ),
+                code => Accept::Failed(code, ()),
+            },
+            |f, io, waited| {
+                let image = read_image(io.view.axis_state(slave as usize).ok(), kind, f.master);
+                follow_gear(f, image, waited)
+            },
+        )
+    }
+}
+
+impl core::fmt::Debug for GearInCore {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        self.kernel.fmt(f)
+    }
+}
+
+/// The inputs MC_GearInVelo and MC_GearInPos share.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GearInInputs {
+    /// Gear ratio numerator (may be negative; a ratio of 0 is refused). With a denominator
+    /// of 1 it may carry the whole ratio (0.25 for 1:4).
+    pub ratio_numerator: f64,
+    /// Gear ratio denominator (0 is refused).
+    pub ratio_denominator: u32,
+    /// Profile kind and flags.
+    pub sync_mode: SyncMode,
+    /// Slave velocity limit of the synchronising phase (0: the axis's own).
+    pub velocity: f64,
+    /// Acceleration limit (0: the axis's own).
+    pub acceleration: f64,
+    /// Deceleration limit (0: the axis's own).
+    pub deceleration: f64,
+    /// Jerk limit (0: the axis's own).
+    pub jerk: f64,
+}
+
+impl Default for GearInInputs {
+    /// Ratio 1:1, position-based, no flags, the axis's own limits.
+    fn default() -> Self {
+        GearInInputs {
+            ratio_numerator: 1.0,
+            ratio_denominator: 1,
+            sync_mode: SyncMode::default(),
+            velocity: 0.0,
+            acceleration: 0.0,
+            deceleration: 0.0,
+            jerk: 0.0,
         }
-        let Some(name) = known.iter().find(|n| folded(n) == folded(key)) else {
-            return Err(format!(
-                "call: {kind} has no input `{key}` (inputs: {})",
-                known.join(", ")
-            ));
+    }
+}
+
+impl GearInInputs {
+    /// The call that couples to `master`, synchronising `on` velocity or position (the sync
+    /// positions matter for the latter only).
+    fn call(&self, master: u32, on: u32, sync_positions: [f64; 2]) -> SawGearInCall {
+        SawGearInCall {
+            master,
+            target: on,
+            sync_mode: self.sync_mode.raw_mode(),
+            mask: self.sync_mode.mask,
+            ratio_denominator: self.ratio_denominator,
+            reserved: 0,
+            ratio_numerator: self.ratio_numerator,
+            master_sync_position: sync_positions[0],
+            slave_sync_position: sync_positions[1],
+            velocity: self.velocity,
+            acceleration: self.acceleration,
+            deceleration: self.deceleration,
+            jerk: self.jerk,
+        }
+    }
+}
+
+/// MC_GearInVelo: the slave synchronises on the master's velocity times the ratio.
+#[derive(Debug)]
+pub struct McGearInVelo {
+    /// Input: a rising edge sends the coupling.
+    pub execute: bool,
+    /// Inputs: ratio, SyncMode and the limits.
+    pub inputs: GearInInputs,
+    /// In/out: the master axis index.
+    pub master: u32,
+    /// In/out: the slave axis index (the call's target).
+    pub slave: u32,
+    /// Outputs of the last cycle.
+    pub out: Outputs,
+    core: GearInCore,
+}
+
+impl Default for McGearInVelo {
+    fn default() -> Self {
+        McGearInVelo {
+            execute: false,
+            inputs: GearInInputs::default(),
+            master: 0,
+            slave: 0,
+            out: Outputs::default(),
+            core: GearInCore::new(CouplingState::GearVelocity),
+        }
+    }
+}
+
+impl McGearInVelo {
+    /// Input: cycles to wait for the CNC's answer.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.core.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Velocity.raw(), [0.0; 2]);
+        self.out = self.core.cycle(io, self.execute, self.slave, call);
+    }
+}
+
+/// MC_GearInPos: the slave reaches the synchronous velocity exactly when master and slave
+/// pass their sync positions (the master must be moving).
+#[derive(Debug)]
+pub struct McGearInPos {
+    /// Input: a rising edge sends the coupling.
+    pub execute: bool,
+    /// Inputs: ratio, SyncMode and the limits.
+    pub inputs: GearInInputs,
+    /// Input: the master's sync position.
+    pub master_sync_position: f64,
+    /// Input: the slave's sync position.
+    pub slave_sync_position: f64,
+    /// In/out: the master axis index.
+    pub master: u32,
+    /// In/out: the slave axis index (the call's target).
+    pub slave: u32,
+    /// Outputs of the last cycle.
+    pub out: Outputs,
+    core: GearInCore,
+}
+
+impl Default for McGearInPos {
+    fn default() -> Self {
+        McGearInPos {
+            execute: false,
+            inputs: GearInInputs::default(),
+            master_sync_position: 0.0,
+            slave_sync_position: 0.0,
+            master: 0,
+            slave: 0,
+            out: Outputs::default(),
+            core: GearInCore::new(CouplingState::GearPosition),
+        }
+    }
+}
+
+impl McGearInPos {
+    /// Input: cycles to wait for the CNC's answer.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.core.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let positions = [self.master_sync_position, self.slave_sync_position];
+        let call = self
+            .inputs
+            .call(self.master, SawSyncTarget::Position.raw(), positions);
+        self.out = self.core.cycle(io, self.execute, self.slave, call);
+    }
+}
+
+/// MC_GearOut: the slave leaves the coupling and keeps its velocity as a free axis (stop it
+/// with MC_Stop or MC_Halt). Done when the CNC has decoupled it.
+#[derive(Debug, Default)]
+pub struct McGearOut {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// In/out: the slave axis index.
+    pub slave: u32,
+    /// Outputs of the last cycle.
+    pub out: Outputs,
+    kernel: Kernel<PendingCall<SawGearOutCall>>,
+}
+
+impl McGearOut {
+    /// Input: cycles to wait for the CNC's answer.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let slave = self.slave;
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |io| {
+                io.acyclic
+                    .start(slave, &SawGearOutCall::default())
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| done_unless(reply.error_id),
+            no_follow,
+        );
+    }
+}
+
+/// The read of the characteristic values in its parts: part 0 first; a part of another plan
+/// than part 0 (a new command came between) starts the read over.
+struct CharacRead {
+    slave: u32,
+    pending: PendingCall<SawCharacCall>,
+    part: u32,
+    plan: u32,
+    scratch: [f64; 31],
+}
+
+impl CharacRead {
+    fn start(io: &mut PlcIo<'_>, slave: u32) -> Result<CharacRead, u32> {
+        Ok(CharacRead {
+            slave,
+            pending: Self::send(io, slave, 0)?,
+            part: 0,
+            plan: 0,
+            scratch: [0.0; 31],
+        })
+    }
+
+    fn send(io: &mut PlcIo<'_>, slave: u32, part: u32) -> Result<PendingCall<SawCharacCall>, u32> {
+        io.acyclic
+            .start(slave, &SawCharacCall { part })
+            .map_err(|e| call_error_code(&e))
+    }
+
+    fn next(&mut self, io: &mut PlcIo<'_>, part: u32) -> Polled<[f64; 31]> {
+        match Self::send(io, self.slave, part) {
+            Ok(pending) => {
+                self.pending = pending;
+                self.part = part;
+                Polled::Progress
+            }
+            Err(code) => Polled::Answer(Err(code)),
+        }
+    }
+}
+
+impl InFlight for CharacRead {
+    type Reply = [f64; 31];
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<[f64; 31]> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) => reply,
         };
-        let bad = |what: &str| format!("call: {kind} input `{key}` = {value}: {what}");
-        let gear = &mut inputs.gear;
-        match *name {
-            "Slave" => {} // the axis, read by the caller
-            "Master" => {
-                master = Some(
-                    value
-                        .as_integer()
-                        .filter(|m| (0..i64::from(u32::MAX)).contains(m))
-                        .ok_or_else(|| bad("an axis index"))? as u32,
-                )
-            }
-            "RatioDenominator" => {
-                gear.ratio_denominator = value
-                    .as_integer()
-                    .filter(|d| (0..=i64::from(u16::MAX)).contains(d))
-                    .ok_or_else(|| bad("a UINT, 0..=65535"))?
-                    as u32
-            }
-            "SyncMode" => {
-                gear.sync_mode.time_based =
-                    time_based(value).ok_or_else(|| bad("\"position-based\" or \"time-based\""))?
-            }
-            "CheckMask" => checks = mask(value, &CHECK_FLAGS).map_err(|e| bad(&e))?,
-            "OpMask" => operations = mask(value, &OPERATION_FLAGS).map_err(|e| bad(&e))?,
-            other => {
-                let v = super::number(value)
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| bad("a finite number"))?;
-                match other {
-                    "RatioNumerator" => gear.ratio_numerator = v,
-                    "MasterSyncPosition" => sync_positions[0] = Some(v),
-                    "SlaveSyncPosition" => sync_positions[1] = Some(v),
-                    "Velocity" => gear.velocity = v,
-                    "Acceleration" => gear.acceleration = v,
-                    "Deceleration" => gear.deceleration = v,
-                    _ => gear.jerk = v,
-                }
-            }
+        if reply.error_id != 0 {
+            return Polled::Answer(Err(reply.error_id));
         }
-    }
-    inputs.gear.sync_mode.mask = checks | operations;
-    if known.contains(&"Master") {
-        inputs.master = master.ok_or_else(|| format!("call: {kind} needs `Master`"))?;
-    }
-    if known.contains(&"MasterSyncPosition") {
-        match sync_positions {
-            [Some(m), Some(s)] => inputs.sync_positions = [m, s],
-            _ => {
-                return Err(format!(
-                    "call: {kind} needs `MasterSyncPosition` and `SlaveSyncPosition`"
-                ))
-            }
+        if reply.part != self.part {
+            // An answer to another question: as if none came.
+            return Polled::Answer(Err(ERROR_NO_ANSWER));
         }
-    }
-    Ok(inputs)
-}
-
-/// `SyncMode`: a name (`"time-based"`, `"GEARINSYNCMODE_TIMEBASED"`, ...) or the raw 0 / 1.
-fn time_based(value: &toml::Value) -> Option<bool> {
-    match value {
-        toml::Value::String(name) => {
-            let name: String = name
-                .chars()
-                .filter(char::is_ascii_alphanumeric)
-                .collect::<String>()
-                .to_ascii_lowercase();
-            match name.strip_prefix("gearinsyncmode").unwrap_or(&name) {
-                "positionbased" => Some(false),
-                "timebased" => Some(true),
-                _ => None,
-            }
+        if self.part > 0 && reply.plan != self.plan {
+            return self.next(io, 0);
         }
-        toml::Value::Integer(0) => Some(false),
-        toml::Value::Integer(1) => Some(true),
-        _ => None,
+        self.plan = reply.plan;
+        let from = self.part as usize * SAW_CHARAC_PART;
+        for (slot, v) in self.scratch[from..].iter_mut().zip(reply.values) {
+            *slot = v;
+        }
+        if from + SAW_CHARAC_PART >= CHARAC_FIELDS.len() {
+            Polled::Answer(Ok(self.scratch))
+        } else {
+            self.next(io, self.part + 1)
+        }
     }
 }
 
-/// A mask: the raw bits, or a list of names from `flags`.
-fn mask(value: &toml::Value, flags: &[(&str, u32)]) -> Result<u32, String> {
-    let names = || {
-        let names: Vec<&str> = flags.iter().map(|(n, _)| *n).collect();
-        names.join(", ")
-    };
-    match value {
-        toml::Value::Integer(bits) => u32::try_from(*bits).map_err(|_| "a 32-bit mask".to_string()),
-        toml::Value::Array(list) => {
-            list.iter()
-                .try_fold(0u32, |bits, item| -> Result<u32, String> {
-                    let name = item
-                        .as_str()
-                        .ok_or_else(|| format!("flag names ({})", names()))?;
-                    let upper = name.replace('_', "").to_ascii_uppercase();
-                    let short = ["GEARINSYNCCHECKMASK", "GEARINSYNCOPMASK"]
-                        .iter()
-                        .find_map(|prefix| upper.strip_prefix(prefix))
-                        .unwrap_or(&upper);
-                    match flags.iter().find(|(n, _)| *n == short) {
-                        Some((_, bit)) => Ok(bits | bit),
-                        None => Err(format!("unknown flag {name:?} (known: {})", names())),
-                    }
-                })
-        }
-        _ => Err(format!("an integer or a list of flag names ({})", names())),
+/// MC_ReadFlyingSawCharacteristics: the characteristic values of the synchronising phase last
+/// planned for the slave, in two calls (fields 1-16, then 17-31). `values` (the seed's
+/// CamTableCharac) is written whole when both parts are in, so it never mixes two reads.
+#[derive(Debug, Default)]
+pub struct McReadFlyingSawCharacteristics {
+    /// Input: a rising edge starts the read.
+    pub execute: bool,
+    /// In/out: the slave axis index.
+    pub slave: u32,
+    /// Outputs of the last cycle.
+    pub out: Outputs,
+    /// In/out: fields 1-31 of `MC_FlyingSawCharacValues` ([`CHARAC_FIELDS`]).
+    pub values: [f64; 31],
+    kernel: Kernel<CharacRead>,
+}
+
+impl core::fmt::Debug for CharacRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("CharacRead")
+            .field("part", &self.part)
+            .finish()
     }
 }
 
-#[derive(Debug)]
-enum Kind {
-    Velo(McGearInVelo),
-    Pos(McGearInPos),
-    Out(McGearOut),
-    /// Boxed: two 31-value arrays.
-    Read(Box<McReadFlyingSawCharacteristics>),
+impl McReadFlyingSawCharacteristics {
+    /// Input: cycles to wait for each part.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// The values with their field names, in the structure's order.
+    pub fn characteristics(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {
+        CHARAC_FIELDS
+            .iter()
+            .copied()
+            .zip(self.values.iter().copied())
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let slave = self.slave;
+        let values = &mut self.values;
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |io| CharacRead::start(io, slave),
+            |read| {
+                *values = read;
+                Accept::Done(())
+            },
+            no_follow,
+        );
+    }
 }
 
-/// A flying-saw block instance of a timeline.
-#[derive(Debug)]
-pub(crate) struct SawInstance {
-    /// Execute.
-    pub(crate) execute: bool,
-    /// The inputs of the last call.
-    pub(crate) inputs: Arc<SawInputs>,
-    kind: Kind,
-    /// The read has finished once (its values are worth reporting).
+impl TimelineBlock for McGearInVelo {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(i) = value.custom::<SawInputs>() {
+            (self.inputs, self.master) = (i.gear, i.master);
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McGearInPos {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(i) = value.custom::<SawInputs>() {
+            (self.inputs, self.master) = (i.gear, i.master);
+            [self.master_sync_position, self.slave_sync_position] = i.sync_positions;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McGearOut {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.slave = axis;
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+/// MC_ReadFlyingSawCharacteristics in a timeline: its values are reported once a read
+/// finished.
+#[derive(Debug, Default)]
+struct CharacInstance {
+    block: McReadFlyingSawCharacteristics,
     read: bool,
 }
 
-impl SawInstance {
-    /// An instance of `kind` (one of [`SAW_BLOCKS`]).
-    pub(super) fn new(kind: &str) -> SawInstance {
-        let kind = match kind {
-            "MC_GearInVelo" => Kind::Velo(McGearInVelo::default()),
-            "MC_GearInPos" => Kind::Pos(McGearInPos::default()),
-            "MC_GearOut" => Kind::Out(McGearOut::default()),
-            _ => Kind::Read(Box::default()),
-        };
-        SawInstance {
-            execute: false,
-            inputs: Arc::default(),
-            kind,
-            read: false,
-        }
+impl TimelineBlock for CharacInstance {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.block.execute)
     }
-
-    /// One cycle for slave `axis`; the outputs in the motion blocks' shape (InSync and
-    /// StartSync through [`SawInstance::in_sync`] and [`SawInstance::start_sync`]).
-    pub(super) fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs {
-        let e = self.execute;
-        let i = &*self.inputs;
-        let out = match &mut self.kind {
-            Kind::Velo(b) => {
-                (b.execute, b.inputs, b.master, b.slave) = (e, i.gear, i.master, axis);
-                b.call(io);
-                b.out
-            }
-            Kind::Pos(b) => {
-                (b.execute, b.inputs, b.master, b.slave) = (e, i.gear, i.master, axis);
-                [b.master_sync_position, b.slave_sync_position] = i.sync_positions;
-                b.call(io);
-                b.out
-            }
-            Kind::Out(b) => {
-                (b.execute, b.slave) = (e, axis);
-                b.call(io);
-                b.out
-            }
-            Kind::Read(b) => {
-                (b.execute, b.slave) = (e, axis);
-                b.call(io);
-                self.read |= b.out.done;
-                b.out
-            }
-        };
-        Outputs {
-            in_sync: false,
-            start_sync: false,
-            ..out
-        }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.block.slave = axis;
+        self.block.call(io);
+        self.read |= self.block.out.done;
+        recorded(self.block.out)
     }
-
-    fn outputs(&self) -> Outputs {
-        match &self.kind {
-            Kind::Velo(b) => b.out,
-            Kind::Pos(b) => b.out,
-            Kind::Out(b) => b.out,
-            Kind::Read(b) => b.out,
-        }
-    }
-
-    /// InSync of the last cycle (FALSE for MC_GearOut and the read).
-    pub(super) fn in_sync(&self) -> bool {
-        self.outputs().in_sync
-    }
-
-    /// StartSync of the last cycle (FALSE for MC_GearOut and the read).
-    #[allow(dead_code)] // for a StartSync column beside InSync
-    pub(super) fn start_sync(&self) -> bool {
-        self.outputs().start_sync
-    }
-
-    /// The read's 31 values once it has finished, in `MC_FlyingSawCharacValues` order
-    /// ([`crate::saw::CHARAC_FIELDS`]).
-    pub(super) fn read_values(&self) -> Option<Vec<f64>> {
-        match &self.kind {
-            Kind::Read(b) if self.read => Some(b.values.to_vec()),
-            _ => None,
-        }
+    /// The 31 values in `MC_FlyingSawCharacValues` order ([`CHARAC_FIELDS`]).
+    fn read(&self) -> Option<Vec<f64>> {
+        self.read.then(|| self.block.values.to_vec())
     }
 }
+
+/// What a timeline records of a saw block's outputs: all but StartSync.
+fn recorded(out: Outputs) -> (Outputs, bool) {
+    let out = Outputs {
+        start_sync: false,
+        ..out
+    };
+    (out, false)
+}
+
+/// A call of `kind` checked whole ([`inputs`]).
+fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
+    Ok((Value::Custom(Arc::new(inputs::parse(kind, table)?)), None))
+}
+
+/// A flying-saw block a timeline calls, on its slave's axis (`Slave` or `axis`).
+const fn saw_block(
+    name: &'static str,
+    make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
+) -> BlockSpec {
+    BlockSpec {
+        name,
+        target: Target::AxisOr(inputs::slave),
+        execute: true,
+        inputs: Inputs::Table(checked),
+        make,
+    }
+}
+
+/// The flying-saw blocks a timeline calls (their inputs: [`inputs`]).
+pub const TIMELINE: &[BlockSpec] = &[
+    saw_block("MC_GearInVelo", |_| Box::<McGearInVelo>::default()),
+    saw_block("MC_GearInPos", |_| Box::<McGearInPos>::default()),
+    saw_block("MC_GearOut", |_| Box::<McGearOut>::default()),
+    saw_block("MC_ReadFlyingSawCharacteristics", |_| {
+        Box::<CharacInstance>::default()
+    }),
+];
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parsed(kind: &str, text: &str) -> Result<SawInputs, String> {
-        parse(kind, &toml::from_str(text).unwrap())
-    }
-
-    #[test]
-    fn the_saw_blocks_are_the_tail_of_the_block_list() {
-        let names = [
-            "MC_GearInVelo",
-            "MC_GearInPos",
-            "MC_GearOut",
-            "MC_ReadFlyingSawCharacteristics",
-        ];
-        assert_eq!(SAW_BLOCKS, names);
-    }
-
-    #[test]
-    fn inputs_take_the_seed_names_and_flag_lists() {
-        let text = "Slave = 1\nMaster = 0\nratio_numerator = -0.5\nRatioDenominator = 4\n\
-                    MasterSyncPosition = 500\nSlaveSyncPosition = 100.0\nJerk = 1e5\n\
-                    CheckMask = [\"MAXACC\", \"GearInSync_CheckMask_MaxJerk\"]\n\
-                    OpMask = [\"rollback_lock\"]";
-        let i = parsed("MC_GearInPos", text).unwrap();
-        assert_eq!(i.master, 0);
-        assert_eq!(i.sync_positions, [500.0, 100.0]);
-        assert_eq!(
-            (i.gear.ratio_numerator, i.gear.ratio_denominator),
-            (-0.5, 4)
-        );
-        assert_eq!(i.gear.jerk, 1e5);
-        let bits = sync_mask::MAXACC | sync_mask::MAXJERK | sync_mask::ROLLBACKLOCK;
-        assert_eq!(i.gear.sync_mode.mask, bits);
-        assert!(!i.gear.sync_mode.time_based);
-
-        let i = parsed(
-            "MC_GearInVelo",
-            "Master = 2\nSyncMode = \"time-based\"\nOpMask = 3",
-        )
-        .unwrap();
-        assert!(i.gear.sync_mode.time_based);
-        assert_eq!(i.gear.sync_mode.mask, 3, "raw bits go as given");
-        assert_eq!(i.gear.ratio_denominator, 1, "ratio 1:1 by default");
-    }
-
-    #[test]
-    fn wrong_inputs_are_named() {
-        let err = |kind, text| parsed(kind, text).unwrap_err();
-        assert!(err("MC_GearInVelo", "Slave = 1").contains("needs `Master`"));
-        assert!(err("MC_GearInPos", "Master = 0\nMasterSyncPosition = 1.0")
-            .contains("SlaveSyncPosition"));
-        assert!(err("MC_GearInVelo", "Master = 0\nMasterSyncPosition = 1.0")
-            .contains("has no input `MasterSyncPosition`"));
-        assert!(err("MC_GearOut", "Master = 0").contains("has no input `Master`"));
-        assert!(err(
-            "MC_GearInVelo",
-            "Master = 0\nCheckMask = [\"ROLLBACKLOCK\"]"
-        )
-        .contains("unknown flag"));
-        assert!(err("MC_GearInVelo", "Master = 0\nSyncMode = \"fast\"").contains("time-based"));
-        assert!(err("MC_GearInVelo", "Master = 0\nRatioDenominator = 70000").contains("UINT"));
-        assert!(err("MC_GearOut", "Slave = 1\naxis = 2").contains("differ"));
-        assert!(parsed("MC_GearOut", "Slave = 1\naxis = 1").is_ok());
-        assert!(parsed("MC_ReadFlyingSawCharacteristics", "slave = 1").is_ok());
-    }
-
-    #[test]
-    fn a_fresh_instance_has_no_outputs_and_no_values() {
-        for kind in SAW_BLOCKS {
-            let i = SawInstance::new(kind);
-            assert!(!i.in_sync() && !i.start_sync() && i.read_values().is_none());
-        }
-    }
-}
+mod tests;

@@ -2,18 +2,21 @@
 //! restart cases against a stand-in CNC in this thread (an acyclic server polled by hand).
 
 use super::{Outputs, DEFAULT_TIMEOUT_CYCLES, ERROR_NO_ANSWER};
-use crate::cam::{
-    CamData, CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight, McCamIn, McCamOut,
-    McCamRead, McCamScaling, McCamTableSelect, McReadMotionFunction, McSetCamOnlineChangeMode,
-    McWriteMotionFunction, McWriteMotionFunctionPoint,
+use crate::blocks::cam::{
+    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
 };
-use crate::cam_compat::{CompatBlock, CompatConfig};
-use crate::dyn_cs::McDynCsTransition;
-use crate::fifo::{FifoGetDimension, FifoStart, FifoWrite};
-use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop};
-use crate::probe::{McAbortTrigger, McTouchProbe};
+use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
+use crate::blocks::cam_data::{CamData, McCamTableSelect, McWriteMotionFunction};
+use crate::blocks::cam_multi::{CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight};
+use crate::blocks::cam_read::{McCamRead, McReadMotionFunction};
+use crate::blocks::dyn_cs::McDynCsTransition;
+use crate::blocks::fifo::{FifoGetDimension, FifoStart, FifoWrite};
+use crate::blocks::motion::{
+    McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop,
+};
+use crate::blocks::probe::{McAbortTrigger, McTouchProbe};
+use crate::blocks::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use crate::runtime::PlcIo;
-use crate::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use hli::calls::fifo::{FifoDimensionCall, FifoReply, FifoStartCall};
 use hli::calls::ErrorCode;
 use hli::rpc::{AcyclicClient, AcyclicServer};
@@ -61,14 +64,15 @@ macro_rules! block {
 
 /// Every Execute-driven block, addressed at axis 1, table 1 or FIFO group 0.
 fn blocks() -> Vec<(&'static str, Cycle)> {
-    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
-    let points = Arc::from(vec![hli::calls::cam::McMotionFunctionPoint::default(); 6]);
-    let compat = |kind: &'static str| {
-        let mut c = CompatConfig::new(kind);
-        c.table = 1;
-        c.rows = Some(Arc::clone(&rows));
-        CompatBlock::new(Arc::new(c))
-    };
+    let mut all = axis_blocks();
+    all.extend(cam_blocks());
+    all.extend(table_blocks());
+    all.extend(group_and_saw_blocks());
+    all
+}
+
+/// The motion and probe blocks.
+fn axis_blocks() -> Vec<(&'static str, Cycle)> {
     vec![
         (
             "MC_Reset",
@@ -96,6 +100,14 @@ fn blocks() -> Vec<(&'static str, Cycle)> {
             "MC_AbortTrigger",
             block!(McAbortTrigger::default(), |b, io| b.call(io, 1)),
         ),
+    ]
+}
+
+/// The cam blocks of chapter 5.1.
+fn cam_blocks() -> Vec<(&'static str, Cycle)> {
+    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
+    let points = Arc::from(vec![hli::calls::cam::McMotionFunctionPoint::default(); 6]);
+    vec![
         (
             "MC_CamIn",
             block!(
@@ -190,6 +202,19 @@ fn blocks() -> Vec<(&'static str, Cycle)> {
                 |b, io| b.call(io)
             ),
         ),
+    ]
+}
+
+/// The multi-table and compatibility blocks.
+fn table_blocks() -> Vec<(&'static str, Cycle)> {
+    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
+    let compat = |kind: &'static str| {
+        let mut c = CompatConfig::new(kind);
+        c.table = 1;
+        c.rows = Some(Arc::clone(&rows));
+        CompatBlock::new(Arc::new(c))
+    };
+    vec![
         (
             "CamTableSetWeight",
             block!(
@@ -235,6 +260,12 @@ fn blocks() -> Vec<(&'static str, Cycle)> {
             "CamTableOffsetChange",
             block!(compat("CamTableOffsetChange"), |b, io| b.call(io, 1)),
         ),
+    ]
+}
+
+/// The FIFO and flying-saw blocks.
+fn group_and_saw_blocks() -> Vec<(&'static str, Cycle)> {
+    vec![
         ("FiFoGetDimension", fifo_get_dimension()),
         ("FiFoStart", fifo_start()),
         ("FiFoWrite", fifo_write()),

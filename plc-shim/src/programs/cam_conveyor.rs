@@ -16,11 +16,11 @@
 //!
 //! Any Error stops the sequence in `Failed` with the block and its ErrorID.
 
-use crate::cam::{
-    McCamIn, McCamOut, McCamScaling, McCamTableSelect, McSetCamOnlineChangeMode,
-    McWriteMotionFunctionPoint,
+use crate::blocks::cam::{
+    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
 };
-use crate::motion::{McHalt, McMoveVelocity};
+use crate::blocks::cam_data::McCamTableSelect;
+use crate::blocks::motion::{McHalt, McMoveVelocity};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::cam::McMotionFunctionPoint;
 

@@ -21,12 +21,12 @@
 //! on its way at a time, so the rows arrive in the file's order. Any other error ends the
 //! sequence in `Failed`.
 
-use crate::fifo::{
+use crate::blocks::fifo::{
     FifoGetDimension, FifoGroupDisintegrate, FifoGroupIntegrate, FifoSetChannelOverride, FifoStart,
     FifoStop, FifoWrite,
 };
+use crate::blocks::motion::McPower;
 use crate::fifo_file::{Buffer, Fed, Feeder, FileError};
-use crate::motion::McPower;
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoStartCall,
@@ -245,14 +245,10 @@ impl FifoStream {
     fn all_written(&self) -> bool {
         self.file_read && self.buffer.is_none() && self.writing == Writing::Idle
     }
-}
 
-impl PlcProgram for FifoStream {
-    fn cycle(&mut self, io: &mut PlcIo<'_>) {
-        let status = io.view.fifo_group(self.group as usize).ok();
-        if let Some(s) = status {
-            self.underrun_ticks = self.underrun_ticks.max(s.underrun_ticks_r);
-        }
+    /// The steps before the FIFO is filled: the axes powered, the group's dimension read,
+    /// the axes integrated one by one.
+    fn set_up(&mut self, io: &mut PlcIo<'_>) {
         let group = self.group;
         match self.step {
             Step::Power => {
@@ -304,6 +300,20 @@ impl PlcProgram for FifoStream {
                     }
                 }
             }
+            _ => {}
+        }
+    }
+}
+
+impl PlcProgram for FifoStream {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let status = io.view.fifo_group(self.group as usize).ok();
+        if let Some(s) = status {
+            self.underrun_ticks = self.underrun_ticks.max(s.underrun_ticks_r);
+        }
+        let group = self.group;
+        match self.step {
+            Step::Power | Step::Dimension | Step::Integrate => self.set_up(io),
             Step::Fill => {
                 if !self.feed(io) {
                     return self.fail(0);

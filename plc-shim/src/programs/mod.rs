@@ -10,8 +10,8 @@ pub mod fifo_stream;
 pub mod saw_cut;
 pub mod turntable;
 
-use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
-use crate::motion::{McMoveVelocity, McPower};
+use crate::blocks::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
+use crate::blocks::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::axis::ReadAxisState;
 use hli::rpc::PendingCall;

@@ -20,9 +20,9 @@
 //! phase that difference is `SAW_SYNC - (FIRST_CUT + k * length)`, so the pieces are the cut
 //! length long to the precision of the position sync.
 
-use crate::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
+use crate::blocks::motion::{McHalt, McMoveAbsolute, McMoveVelocity, McPower};
+use crate::blocks::saw::{McGearInPos, McGearOut};
 use crate::runtime::{PlcIo, PlcProgram};
-use crate::saw::{McGearInPos, McGearOut};
 
 /// The axes of `scenarios/flying-saw` (`gpAx` indices): conveyor, saw carriage, blade.
 pub const SCENARIO_AXES: [u32; 3] = [0, 1, 2];
@@ -176,19 +176,9 @@ impl SawCut {
         self.rearm = true;
     }
 
-    /// The saw and conveyor set-points in mm.
-    fn set_points(&self, io: &PlcIo<'_>) -> Option<(f64, f64)> {
-        let c = io.view.axis_state(self.axes[0] as usize).ok()?;
-        let s = io.view.axis_state(self.axes[1] as usize).ok()?;
-        Some((
-            s.command_position_acs_r as f64 * 1e-4,
-            c.command_position_acs_r as f64 * 1e-4,
-        ))
-    }
-}
-
-impl PlcProgram for SawCut {
-    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+    /// Calls every block once, each with Execute TRUE in its steps, unless the blocks are
+    /// re-armed this cycle (every Execute low); returns whether they were.
+    fn call_blocks(&mut self, io: &mut PlcIo<'_>) -> bool {
         // Power and the conveyor stay called every cycle (MC_Power is level-driven).
         let [conveyor, saw, blade] = self.axes;
         for (&axis, p) in self.axes.iter().zip(self.power.iter_mut()) {
@@ -214,7 +204,24 @@ impl PlcProgram for SawCut {
         self.blade.position = if step == Step::Down { DEPTH } else { 0.0 };
         self.blade.execute = on(step, Step::Down) || on(step, Step::Up);
         self.blade.call(io, blade);
-        if rearm {
+        rearm
+    }
+
+    /// The saw and conveyor set-points in mm.
+    fn set_points(&self, io: &PlcIo<'_>) -> Option<(f64, f64)> {
+        let c = io.view.axis_state(self.axes[0] as usize).ok()?;
+        let s = io.view.axis_state(self.axes[1] as usize).ok()?;
+        Some((
+            s.command_position_acs_r as f64 * 1e-4,
+            c.command_position_acs_r as f64 * 1e-4,
+        ))
+    }
+}
+
+impl PlcProgram for SawCut {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        let step = self.step;
+        if self.call_blocks(io) {
             return;
         }
         match step {

@@ -1,6 +1,6 @@
 //! Seed 003, application example 4: the PLC as master of the dynamic CS of a robot that
 //! machines a workpiece on a turntable, in both of the seed's variants, written with the
-//! blocks of [`crate::dyn_cs`]:
+//! blocks of [`crate::blocks::dyn_cs`]:
 //!
 //! * **hybrid**: the NC program switches the tracking (`#TRACK CS ON [.. KIN_BASE X=-1305.92]`);
 //!   the PLC takes over the unit and, while tracking is ACTIVE, commands the table angle as the
@@ -15,7 +15,7 @@
 //! inverse of the table. In `scenarios/example4-*` the table is channel 0's seventh axis
 //! (`gpAx[6]`, the default); [`Turntable::on`] puts the program on another channel and axis.
 
-use crate::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
+use crate::blocks::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::enums::{DynCsOption, DynCsState};
 

@@ -1,10 +1,12 @@
 //! The touch-probe blocks: MC_TouchProbe arms a probe of an axis on its Execute edge and
 //! reports the recorded position; MC_AbortTrigger disarms it. The arming is followed in the
 //! axis image (`gpAx[i]^drive_state.probe_r[k]`) under the arm id the CNC's reply carries, so
-//! a later arming (by another block) shows as CommandAborted here.
+//! a later arming (by another block) shows as CommandAborted here. A timeline calls both
+//! ([`TIMELINE`]); its report shows the position MC_TouchProbe recorded last.
 
 use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe};
@@ -56,6 +58,7 @@ fn send<C: hli::calls::AcyclicCall>(
 /// MC_TouchProbe: on a rising Execute edge arms `probe` (1 or 2) of the axis for `edge`;
 /// with `window_only` only an edge between `first_position` and `last_position` records.
 /// Outputs hold while Execute stays TRUE and show for one cycle after it fell.
+#[derive(Debug)]
 pub struct McTouchProbe {
     /// Input: a rising edge arms the probe.
     pub execute: bool,
@@ -115,6 +118,7 @@ impl McTouchProbe {
 }
 
 /// MC_AbortTrigger: on a rising Execute edge disarms `probe` of the axis.
+#[derive(Debug)]
 pub struct McAbortTrigger {
     /// Input: a rising edge disarms.
     pub execute: bool,
@@ -155,3 +159,93 @@ impl McAbortTrigger {
         );
     }
 }
+
+/// The outputs without the extra (the recorded position).
+fn plain(out: Outputs<f64>) -> (Outputs, bool) {
+    let out = Outputs {
+        done: out.done,
+        busy: out.busy,
+        active: out.active,
+        command_aborted: out.command_aborted,
+        error: out.error,
+        error_id: out.error_id,
+        in_velocity: out.in_velocity,
+        in_sync: out.in_sync,
+        start_sync: out.start_sync,
+        extra: (),
+    };
+    (out, false)
+}
+
+/// MC_TouchProbe in a timeline: the position it recorded last, for the report.
+#[derive(Debug, Default)]
+struct TouchProbeInstance {
+    block: McTouchProbe,
+    recorded: Option<f64>,
+}
+
+impl TimelineBlock for TouchProbeInstance {
+    fn set(&mut self, key: &str, value: &Value) {
+        let b = &mut self.block;
+        match (key, value) {
+            ("probe", Value::Int(v)) => b.probe = *v as u32,
+            ("edge", Value::Int(v)) => b.edge = ProbeEdge::decode(*v as u32).unwrap_or(b.edge),
+            ("window_only", Value::Bool(v)) => b.window_only = *v,
+            ("first_position", Value::Real(v)) => b.first_position = *v,
+            ("last_position", Value::Real(v)) => b.last_position = *v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.block.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.block.call(io, axis);
+        if self.block.out.done {
+            self.recorded = Some(self.block.out.extra);
+        }
+        plain(self.block.out)
+    }
+    fn read(&self) -> Option<Vec<f64>> {
+        self.recorded.map(|p| vec![p])
+    }
+}
+
+impl TimelineBlock for McAbortTrigger {
+    fn set(&mut self, key: &str, value: &Value) {
+        if let ("probe", Value::Int(v)) = (key, value) {
+            self.probe = *v as u32;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        plain(self.out)
+    }
+}
+
+/// Probe 1 or 2 of the axis.
+const PROBE: InputSpec = input("probe", Kind::Range(1, 2));
+
+/// The touch-probe blocks a timeline calls.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_TouchProbe",
+        &[
+            PROBE,
+            input(
+                "edge",
+                Kind::OneOf(&[("\"positive\"", 1), ("\"negative\"", 2)]),
+            ),
+            input("window_only", Kind::Bool),
+            input("first_position", Kind::Real),
+            input("last_position", Kind::Real),
+        ],
+        |_| Box::<TouchProbeInstance>::default(),
+    ),
+    BlockSpec::on_axis("MC_AbortTrigger", &[PROBE], |_| {
+        Box::<McAbortTrigger>::default()
+    }),
+];

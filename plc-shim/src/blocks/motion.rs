@@ -9,6 +9,9 @@
 
 use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{
+    input, BlockSpec, InputSpec, Inputs, Kind, Target, TimelineBlock, Value,
+};
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
@@ -148,6 +151,22 @@ macro_rules! execute_block {
                 self.out = self.core.cycle(io, axis, self.execute, || call, $reached);
             }
         }
+
+        impl TimelineBlock for $name {
+            fn set(&mut self, key: &str, value: &Value) {
+                let _ = (key, value);
+                $(if let (stringify!($field), Value::Real(v)) = (key, value) {
+                    self.$field = *v;
+                })*
+            }
+            fn execute(&mut self) -> Option<&mut bool> {
+                Some(&mut self.execute)
+            }
+            fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+                self.call(io, axis);
+                (self.out, false)
+            }
+        }
     };
 }
 
@@ -282,3 +301,125 @@ impl McStop {
         }
     }
 }
+
+impl TimelineBlock for McPower {
+    fn set(&mut self, key: &str, value: &Value) {
+        if let ("enable", Value::Bool(v)) = (key, value) {
+            self.enable = *v;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        None // the level of `enable` is the command
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        let out = Outputs {
+            error: self.error,
+            error_id: self.error_id,
+            ..Outputs::default()
+        };
+        (out, self.status)
+    }
+}
+
+impl TimelineBlock for McMoveVelocity {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("direction", Value::Int(d)) => self.direction = *d as i32,
+            ("velocity", Value::Real(v)) => self.velocity = *v,
+            ("acceleration", Value::Real(v)) => self.acceleration = *v,
+            ("deceleration", Value::Real(v)) => self.deceleration = *v,
+            ("jerk", Value::Real(v)) => self.jerk = *v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        (self.out, false)
+    }
+}
+
+impl TimelineBlock for McStop {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("deceleration", Value::Real(v)) => self.deceleration = *v,
+            ("jerk", Value::Real(v)) => self.jerk = *v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        (self.out, false)
+    }
+}
+
+/// The limits of a move: velocity, acceleration, deceleration, jerk.
+const VELOCITY: InputSpec = input("velocity", Kind::Real);
+const ACCELERATION: InputSpec = input("acceleration", Kind::Real);
+const DECELERATION: InputSpec = input("deceleration", Kind::Real);
+const JERK: InputSpec = input("jerk", Kind::Real);
+
+/// The motion blocks a timeline calls.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec {
+        name: "MC_Power",
+        target: Target::Axis,
+        execute: false,
+        inputs: Inputs::Keys(&[input("enable", Kind::Bool)]),
+        make: |_| Box::<McPower>::default(),
+    },
+    BlockSpec::on_axis("MC_Reset", &[], |_| Box::<McReset>::default()),
+    BlockSpec::on_axis(
+        "MC_MoveAbsolute",
+        &[
+            input("position", Kind::Real),
+            VELOCITY,
+            ACCELERATION,
+            DECELERATION,
+            JERK,
+        ],
+        |_| Box::<McMoveAbsolute>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_MoveRelative",
+        &[
+            input("distance", Kind::Real),
+            VELOCITY,
+            ACCELERATION,
+            DECELERATION,
+            JERK,
+        ],
+        |_| Box::<McMoveRelative>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_MoveVelocity",
+        &[
+            VELOCITY,
+            input("direction", Kind::OneOf(&[("1", 1), ("-1", -1)])),
+            ACCELERATION,
+            DECELERATION,
+            JERK,
+        ],
+        |_| {
+            Box::new(McMoveVelocity {
+                direction: 1,
+                ..McMoveVelocity::default()
+            })
+        },
+    ),
+    BlockSpec::on_axis("MC_Halt", &[DECELERATION, JERK], |_| {
+        Box::<McHalt>::default()
+    }),
+    BlockSpec::on_axis("MC_Stop", &[DECELERATION, JERK], |_| {
+        Box::<McStop>::default()
+    }),
+    BlockSpec::on_axis("MC_SetPosition", &[input("position", Kind::Real)], |_| {
+        Box::<McSetPosition>::default()
+    }),
+];

@@ -27,6 +27,9 @@ use hli::desc::Scalar;
 use hli::ImageMemory;
 use serde::Deserialize;
 
+pub mod instances;
+pub mod registry;
+
 /// Why a timeline was refused.
 #[derive(Debug, thiserror::Error)]
 pub enum TimelineError {
@@ -203,8 +206,8 @@ struct Step {
     commit: Option<Leaf>,
     take: Option<Leaf>,
     repeat: bool,
-    call: Option<crate::blocks::Call>,
-    wait: Option<(usize, crate::blocks::Output)>,
+    call: Option<instances::Call>,
+    wait: Option<(usize, instances::Output)>,
 }
 
 /// What happened to one step.
@@ -227,7 +230,7 @@ pub struct Timeline {
     records: Vec<StepRecord>,
     values: Vec<Value>,
     cnc_tick: Leaf,
-    instances: crate::blocks::Instances,
+    instances: instances::Instances,
 }
 
 impl Timeline {
@@ -238,7 +241,7 @@ impl Timeline {
             message: e.to_string(),
         })?;
         let mut steps = Vec::with_capacity(parsed.step.len());
-        let mut instances = crate::blocks::Instances::default();
+        let mut instances = instances::Instances::default();
         for (i, s) in parsed.step.into_iter().enumerate() {
             let fail = |reason: String| TimelineError::Step {
                 file: file.to_string(),

@@ -1,7 +1,7 @@
 //! The compatibility blocks of seed 000, chapter 5.2.1 and 5.2.2 (the older CamTable...
 //! blocks), as thin wrappers over the calls of the chapter 5.1 blocks: each sends on its
 //! rising edge (bExecute, or bCoupleOn / bCoupleOff) and reports Busy, Err and ErrId. The
-//! multi-table blocks of 5.2.3 live with the others in [`crate::cam`].
+//! multi-table blocks of 5.2.3 are in [`crate::blocks::cam_multi`].
 //!
 //! | block | what it sends |
 //! | --- | --- |
@@ -16,32 +16,18 @@
 //! | CamTableSetSlaveScale | MC_CamScaling of the slave scaling, at once |
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
-use crate::cam::{CamCore, CamData, ChunkTransfer, McCamRead};
+use super::cam::{recorded, CamCore};
+use super::cam_data::{rows_of, CamData, ChunkTransfer};
+use super::cam_read::{McCamRead, DEFAULT_READ_ROOM};
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
+use crate::timeline::registry::{number, BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::cam::{
     CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
     CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,
 };
 use std::sync::Arc;
-
-/// The names, for the timeline.
-pub const COMPAT_BLOCKS: [&str; 10] = [
-    "CamTableGenerate",
-    "CamTableCreate",
-    "CamTableWriteData",
-    "CamTableReadData",
-    "CamTableReadSlavePos",
-    "CamTableDelete",
-    "CamTableCoupleAxes",
-    "CamTableCoupleAxesIpol",
-    "CamTableOffsetChange",
-    "CamTableSetSlaveScale",
-];
-
-/// One more: listed apart so the array above stays readable.
-pub const COMPAT_MASTER_SLAVE_SCALE: &str = "CamTableSetMasterSlaveScale";
 
 /// What a compatibility block is told, checked when the timeline is read.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,16 +86,8 @@ impl CompatConfig {
             slave_absolute: true,
             interpolation: 0,
             on: true,
-            room: crate::cam::DEFAULT_READ_ROOM,
+            room: DEFAULT_READ_ROOM,
         }
-    }
-}
-
-fn number(value: &toml::Value) -> Option<f64> {
-    match value {
-        toml::Value::Float(f) => Some(*f),
-        toml::Value::Integer(i) => Some(*i as f64),
-        _ => None,
     }
 }
 
@@ -168,7 +146,7 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
             "table" => c.table = int(1, 255)?,
             "table_type" => c.table_type = int(1, 4)?,
             "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
-            "rows" => c.rows = Some(crate::blocks::rows_of(value)?),
+            "rows" => c.rows = Some(rows_of(value)?),
             "room" => c.room = int(1, 1 << 20)? as usize,
             "master" => c.master = int(0, i64::from(u32::MAX))?,
             "master_offset" => c.master_offset = num()?,
@@ -286,56 +264,128 @@ impl CompatBlock {
                 self.out = self.read.out;
             }
             "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => {
-                let start_mode = match (c.master_absolute, c.slave_absolute) {
-                    (true, true) => 1,
-                    (false, false) => 2,
-                    (true, false) => 3,
-                    (false, true) => 4,
-                };
-                let call = CamInCall {
-                    master: c.master,
-                    table_id: c.table,
-                    start_mode,
-                    interpolation: c.interpolation,
-                    master_offset: c.master_offset,
-                    slave_offset: c.slave_offset,
-                    master_scaling: 1.0,
-                    slave_scaling: 1.0,
-                    ..CamInCall::default()
-                };
-                self.out = if c.on {
-                    let mut o = self
-                        .couple
-                        .cycle(io, self.execute, slave, || call, Some(slave));
-                    // The old block is done once the coupling stands (no InSync output).
-                    o.done = o.in_sync;
-                    o
-                } else {
-                    self.decouple
-                        .cycle(io, self.execute, slave, CamOutCall::default, None)
-                };
+                self.out = self.couple_axes(io, &c, slave)
             }
-            kind => {
-                let keep = match kind {
-                    "CamTableOffsetChange" => CAM_KEEP_MASTER_SCALING | CAM_KEEP_SLAVE_SCALING,
-                    "CamTableSetSlaveScale" => {
-                        CAM_KEEP_MASTER_SCALING | CAM_KEEP_MASTER_OFFSET | CAM_KEEP_SLAVE_OFFSET
-                    }
-                    _ => 0,
-                };
-                let call = CamScalingCall {
-                    activation_mode: 0,
-                    master_scaling_mode: 0,
-                    slave_scaling_mode: 0,
-                    reserved: keep,
-                    activation_position: 0.0,
-                    master_offset: c.master_offset,
-                    slave_offset: c.slave_offset,
-                    master_scaling: c.master_slope,
-                    slave_scaling: c.slave_slope,
-                };
-                self.out = self.scale.cycle(io, self.execute, slave, || call, None);
-            }
+            _ => self.out = self.rescale(io, &c, slave),
         }
     }
+
+    /// CamTableCoupleAxes(Ipol): MC_CamIn (CoupleOn), or MC_CamOut (CoupleOff).
+    fn couple_axes(&mut self, io: &mut PlcIo<'_>, c: &CompatConfig, slave: u32) -> Outputs {
+        let start_mode = match (c.master_absolute, c.slave_absolute) {
+            (true, true) => 1,
+            (false, false) => 2,
+            (true, false) => 3,
+            (false, true) => 4,
+        };
+        let call = CamInCall {
+            master: c.master,
+            table_id: c.table,
+            start_mode,
+            interpolation: c.interpolation,
+            master_offset: c.master_offset,
+            slave_offset: c.slave_offset,
+            master_scaling: 1.0,
+            slave_scaling: 1.0,
+            ..CamInCall::default()
+        };
+        if c.on {
+            let mut o = self
+                .couple
+                .cycle(io, self.execute, slave, || call, Some(slave));
+            // The old block is done once the coupling stands (no InSync output).
+            o.done = o.in_sync;
+            o
+        } else {
+            self.decouple
+                .cycle(io, self.execute, slave, CamOutCall::default, None)
+        }
+    }
+
+    /// CamTableOffsetChange, CamTableSetSlaveScale, CamTableSetMasterSlaveScale: MC_CamScaling
+    /// at once, keeping what the block does not set.
+    fn rescale(&mut self, io: &mut PlcIo<'_>, c: &CompatConfig, slave: u32) -> Outputs {
+        let keep = match c.kind {
+            "CamTableOffsetChange" => CAM_KEEP_MASTER_SCALING | CAM_KEEP_SLAVE_SCALING,
+            "CamTableSetSlaveScale" => {
+                CAM_KEEP_MASTER_SCALING | CAM_KEEP_MASTER_OFFSET | CAM_KEEP_SLAVE_OFFSET
+            }
+            _ => 0,
+        };
+        let call = CamScalingCall {
+            activation_mode: 0,
+            master_scaling_mode: 0,
+            slave_scaling_mode: 0,
+            reserved: keep,
+            activation_position: 0.0,
+            master_offset: c.master_offset,
+            slave_offset: c.slave_offset,
+            master_scaling: c.master_slope,
+            slave_scaling: c.slave_slope,
+        };
+        self.scale.cycle(io, self.execute, slave, || call, None)
+    }
 }
+
+impl TimelineBlock for CompatBlock {
+    fn set(&mut self, _: &str, value: &Value) {
+        if let Some(config) = value.custom::<CompatConfig>() {
+            self.config = config;
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+    fn read(&self) -> Option<Vec<f64>> {
+        Some(self.read.values.clone())
+    }
+}
+
+/// A call of `kind` checked whole: its configuration, and the room of CamTableReadData's
+/// answer.
+fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
+    let config = parse(kind, table)?;
+    let room = (kind == "CamTableReadData").then_some(config.room);
+    Ok((Value::Custom(Arc::new(config)), room))
+}
+
+/// A block of `kind` with room `room` for a read's numbers.
+fn make(kind: &'static str, room: Option<usize>) -> Box<dyn TimelineBlock> {
+    let config = CompatConfig {
+        room: room.unwrap_or(DEFAULT_READ_ROOM),
+        ..CompatConfig::new(kind)
+    };
+    Box::new(CompatBlock::new(Arc::new(config)))
+}
+
+/// The compatibility blocks a timeline calls, each on the slave's axis.
+macro_rules! compat_blocks {
+    ($($name:literal),* $(,)?) => {
+        &[$(BlockSpec {
+            name: $name,
+            target: Target::Axis,
+            execute: true,
+            inputs: Inputs::Table(checked),
+            make: |room| make($name, room),
+        }),*]
+    };
+}
+
+/// The compatibility blocks a timeline calls (their inputs: [`parse`]).
+pub const TIMELINE: &[BlockSpec] = compat_blocks![
+    "CamTableGenerate",
+    "CamTableCreate",
+    "CamTableWriteData",
+    "CamTableReadData",
+    "CamTableReadSlavePos",
+    "CamTableDelete",
+    "CamTableCoupleAxes",
+    "CamTableCoupleAxesIpol",
+    "CamTableOffsetChange",
+    "CamTableSetSlaveScale",
+    "CamTableSetMasterSlaveScale",
+];

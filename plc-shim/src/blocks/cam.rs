@@ -1,0 +1,569 @@
+//! The cam blocks of chapter 5.1 for the PLC program that send one call: MC_CamIn,
+//! MC_CamInExt, MC_CamOut, MC_CamScaling, MC_WriteMotionFunctionPoint and
+//! MC_SetCamOnlineChangeMode. Like the motion blocks, each sends its call on the rising
+//! Execute edge without waiting and stays Busy until the CNC answers. MC_CamIn and
+//! MC_CamInExt then follow the slave's axis image: InSync once the slave is coupled through a
+//! cam and synchronous (`coupling_state_r` 1, `nAxisState` 13), CommandAborted when the
+//! coupling goes away, Error with the axis's error when the slave faults. The others are Done
+//! when the CNC has taken the command (a scaling with a positional activation mode is then
+//! queued in the CNC). The table data and the selection are in [`super::cam_data`], the reads
+//! in [`super::cam_read`], the multi-table blocks in [`super::cam_multi`].
+
+use crate::kernel::{call_error_code, done_unless, Accept, Kernel, Outputs, Step};
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{input, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use hli::calls::cam::{
+    CamActivationMode, CamInCall, CamInterpolation, CamOutCall, CamReply, CamScalingCall,
+    CamScalingMode, CamStartMode,
+};
+use hli::calls::AcyclicCall;
+use hli::enums::{AxisState, CouplingState};
+use hli::rpc::PendingCall;
+
+/// The block kernel as the cam blocks use it: a coupling (MC_CamIn) follows the slave's
+/// image, remembering whether it has seen the coupling there; the others are Done when the
+/// CNC took the call.
+pub struct CamCore<C: AcyclicCall> {
+    kernel: Kernel<PendingCall<C>, bool>,
+}
+
+impl<C: AcyclicCall> Default for CamCore<C> {
+    fn default() -> Self {
+        Self {
+            kernel: Kernel::default(),
+        }
+    }
+}
+
+impl<C: AcyclicCall> core::fmt::Debug for CamCore<C> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        self.kernel.fmt(f)
+    }
+}
+
+pub(crate) fn failed(code: u32) -> Outputs {
+    Outputs::failed(code)
+}
+
+/// A cam coupling of `slave` as its image shows it; `seen` once the coupling showed there.
+fn follow_coupling(io: &PlcIo<'_>, slave: u32, seen: &mut bool) -> Step<()> {
+    let state = io.view.axis_state(slave as usize).ok();
+    let cam = state.is_some_and(|s| s.coupling_state_r == CouplingState::Cam.raw());
+    let synchronous =
+        state.is_some_and(|s| s.axis_state_r == AxisState::SlaveSynchronous.raw() && cam);
+    let error = state.map_or(0, |s| s.error_id_r);
+    if error != 0 {
+        Step::Ended(failed(error))
+    } else if cam {
+        *seen = true;
+        Step::Running(Outputs {
+            in_sync: synchronous,
+            busy: !synchronous,
+            ..Outputs::default()
+        })
+    } else if *seen {
+        Step::Ended(Outputs::aborted())
+    } else {
+        // Accepted between two ticks: the image shows it from the next tick on.
+        Step::Running(Outputs::busy())
+    }
+}
+
+impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
+    /// One cycle: `call` goes to `target` on a rising edge of `execute`; a coupling block
+    /// (`couples`) then follows `slave`'s image.
+    pub fn cycle(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        target: u32,
+        call: impl FnOnce() -> C,
+        couples: Option<u32>,
+    ) -> Outputs {
+        self.kernel.cycle(
+            io,
+            execute,
+            |io| {
+                io.acyclic
+                    .start(target, &call())
+                    .map_err(|e| call_error_code(&e))
+            },
+            |reply| match (reply.error_id, couples) {
+                (0, Some(_)) => Accept::Follow(false, Outputs::busy()),
+                (code, _) => done_unless(code),
+            },
+            |seen, io, _| match couples {
+                Some(slave) => follow_coupling(io, slave, seen),
+                None => Step::Ended(Outputs::done(())),
+            },
+        )
+    }
+
+    /// Input tTimeout: cycles to wait for the CNC's answer.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+}
+
+/// MC_CamIn and MC_CamInExt (`extended`): couples `slave` to `master` through a cam.
+#[derive(Debug)]
+pub struct McCamIn {
+    /// Input: a rising edge sends the coupling.
+    pub execute: bool,
+    /// Input: the master axis.
+    pub master: u32,
+    /// Input: the cam table ID.
+    pub table: u32,
+    /// Input: raw `MC_StartMode` (1 absolute .. 4).
+    pub start_mode: u32,
+    /// Input (Ext): raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Input (Ext): the activation position.
+    pub activation_position: f64,
+    /// Input (Ext): raw `MC_CamScalingMode` of the master.
+    pub master_scaling_mode: u32,
+    /// Input (Ext): raw `MC_CamScalingMode` of the slave.
+    pub slave_scaling_mode: u32,
+    /// Input: master offset.
+    pub master_offset: f64,
+    /// Input: slave offset.
+    pub slave_offset: f64,
+    /// Input: master scaling.
+    pub master_scaling: f64,
+    /// Input: slave scaling.
+    pub slave_scaling: f64,
+    /// Input: raw `MC_InterpolationType` (tables).
+    pub interpolation: u32,
+    /// MC_CamInExt rather than MC_CamIn.
+    pub extended: bool,
+    /// Input: follow the master's actual position (else its set-point).
+    pub master_actual: bool,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<CamInCall>,
+}
+
+impl Default for McCamIn {
+    fn default() -> Self {
+        Self {
+            execute: false,
+            master: 0,
+            table: 0,
+            start_mode: 1,
+            activation_mode: 0,
+            activation_position: 0.0,
+            master_scaling_mode: 0,
+            slave_scaling_mode: 0,
+            master_offset: 0.0,
+            slave_offset: 0.0,
+            master_scaling: 1.0,
+            slave_scaling: 1.0,
+            interpolation: 0,
+            extended: false,
+            master_actual: false,
+            out: Outputs::default(),
+            core: CamCore::default(),
+        }
+    }
+}
+
+impl McCamIn {
+    /// One cycle for slave axis `slave`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let call = CamInCall {
+            master: self.master,
+            table_id: self.table,
+            start_mode: self.start_mode,
+            activation_mode: self.activation_mode,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+            interpolation: self.interpolation,
+            extended: u32::from(self.extended),
+            activation_position: self.activation_position,
+            master_offset: self.master_offset,
+            slave_offset: self.slave_offset,
+            master_scaling: self.master_scaling,
+            slave_scaling: self.slave_scaling,
+            master_source: u32::from(self.master_actual),
+            reserved: 0,
+        };
+        self.out = self
+            .core
+            .cycle(io, self.execute, slave, || call, Some(slave));
+    }
+}
+
+/// MC_CamOut: the slave leaves its cam and goes on at its velocity as a free axis.
+#[derive(Debug, Default)]
+pub struct McCamOut {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<CamOutCall>,
+}
+
+impl McCamOut {
+    /// One cycle for slave axis `slave`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        self.out = self
+            .core
+            .cycle(io, self.execute, slave, CamOutCall::default, None);
+    }
+}
+
+/// MC_CamScaling: new offsets and scalings of a coupling, now or at an activation.
+#[derive(Debug)]
+pub struct McCamScaling {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Input: the activation position.
+    pub activation_position: f64,
+    /// Input: raw `MC_CamScalingMode` of the master.
+    pub master_scaling_mode: u32,
+    /// Input: raw `MC_CamScalingMode` of the slave.
+    pub slave_scaling_mode: u32,
+    /// Input: master offset.
+    pub master_offset: f64,
+    /// Input: slave offset.
+    pub slave_offset: f64,
+    /// Input: master scaling.
+    pub master_scaling: f64,
+    /// Input: slave scaling.
+    pub slave_scaling: f64,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<CamScalingCall>,
+}
+
+impl Default for McCamScaling {
+    fn default() -> Self {
+        Self {
+            execute: false,
+            activation_mode: 0,
+            activation_position: 0.0,
+            master_scaling_mode: 0,
+            slave_scaling_mode: 0,
+            master_offset: 0.0,
+            slave_offset: 0.0,
+            master_scaling: 1.0,
+            slave_scaling: 1.0,
+            out: Outputs::default(),
+            core: CamCore::default(),
+        }
+    }
+}
+
+impl McCamScaling {
+    /// One cycle for slave axis `slave`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let call = CamScalingCall {
+            activation_mode: self.activation_mode,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+            reserved: 0,
+            activation_position: self.activation_position,
+            master_offset: self.master_offset,
+            slave_offset: self.slave_offset,
+            master_scaling: self.master_scaling,
+            slave_scaling: self.slave_scaling,
+        };
+        self.out = self.core.cycle(io, self.execute, slave, || call, None);
+    }
+}
+
+/// MC_WriteMotionFunctionPoint: one point of the motion function `table` changed, under the
+/// table's online-change mode (MC_SetCamOnlineChangeMode). Done when the CNC took it (checked
+/// whole with the function it changes; queued when its activation is still to come).
+#[derive(Debug, Default)]
+pub struct McWriteMotionFunctionPoint {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the point.
+    pub point: hli::calls::cam::McMotionFunctionPoint,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<hli::calls::cam::CamPointsWriteCall>,
+}
+
+impl McWriteMotionFunctionPoint {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
+        points[0] = self.point;
+        let call = hli::calls::cam::CamPointsWriteCall {
+            first: self.point.point_index,
+            count: 1,
+            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+            total: 1,
+            points,
+        };
+        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}
+
+/// MC_SetCamOnlineChangeMode: when point changes of `table` apply, and whether the master
+/// and slave offsets follow so that nothing jumps.
+#[derive(Debug, Default)]
+pub struct McSetCamOnlineChangeMode {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: raw `MC_CamActivationMode`.
+    pub activation_mode: u32,
+    /// Input: the activation position.
+    pub activation_position: f64,
+    /// Input: raw `MC_CamScalingMode` of the master.
+    pub master_scaling_mode: u32,
+    /// Input: raw `MC_CamScalingMode` of the slave.
+    pub slave_scaling_mode: u32,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<hli::calls::cam::CamOnlineModeCall>,
+}
+
+impl McSetCamOnlineChangeMode {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let call = hli::calls::cam::CamOnlineModeCall {
+            activation_mode: self.activation_mode,
+            master_scaling_mode: self.master_scaling_mode,
+            slave_scaling_mode: self.slave_scaling_mode,
+            reserved: 0,
+            activation_position: self.activation_position,
+        };
+        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}
+
+/// What a timeline records of a cam block's outputs: Done, Busy, CommandAborted, Error (no
+/// Active, InVelocity, InSync or StartSync).
+pub(crate) fn recorded(out: Outputs) -> (Outputs, bool) {
+    let out = Outputs {
+        active: false,
+        in_velocity: false,
+        in_sync: false,
+        start_sync: false,
+        ..out
+    };
+    (out, false)
+}
+
+impl TimelineBlock for McCamIn {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            ("master_source", Some(v), _) => self.master_actual = v != 0,
+            ("master", Some(v), _) => self.master = v,
+            ("table", Some(v), _) => self.table = v,
+            ("start_mode", Some(v), _) => self.start_mode = v,
+            ("interpolation", Some(v), _) => self.interpolation = v,
+            ("master_offset", _, Some(v)) => self.master_offset = v,
+            ("slave_offset", _, Some(v)) => self.slave_offset = v,
+            ("master_scaling", _, Some(v)) => self.master_scaling = v,
+            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        let (out, status) = recorded(self.out);
+        // InSync, the one output a coupling adds.
+        let in_sync = self.out.in_sync;
+        (Outputs { in_sync, ..out }, status)
+    }
+}
+
+impl TimelineBlock for McCamOut {
+    fn set(&mut self, _: &str, _: &Value) {}
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McCamScaling {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            ("master_offset", _, Some(v)) => self.master_offset = v,
+            ("slave_offset", _, Some(v)) => self.slave_offset = v,
+            ("master_scaling", _, Some(v)) => self.master_scaling = v,
+            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McWriteMotionFunctionPoint {
+    fn set(&mut self, key: &str, value: &Value) {
+        let p = &mut self.point;
+        match (key, value.uint(), value.real()) {
+            ("table", Some(v), _) => self.table = v,
+            ("point_index", Some(v), _) => p.point_index = v,
+            ("function_type", Some(v), _) => p.function_type = v,
+            ("point_type", Some(v), _) => p.point_type = v,
+            ("rel_index_next", Some(v), _) => p.rel_index_next_point = v,
+            ("master_pos", _, Some(v)) => p.master_pos = v,
+            ("slave_pos", _, Some(v)) => p.slave_pos = v,
+            ("slave_velo", _, Some(v)) => p.slave_velo = v,
+            ("slave_acc", _, Some(v)) => p.slave_acc = v,
+            ("slave_jerk", _, Some(v)) => p.slave_jerk = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McSetCamOnlineChangeMode {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint(), value.real()) {
+            ("table", Some(v), _) => self.table = v,
+            ("activation_mode", Some(v), _) => self.activation_mode = v,
+            ("activation_position", _, Some(v)) => self.activation_position = v,
+            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
+            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+const ACTIVATION_MODE: InputSpec = input("activation_mode", mode::<CamActivationMode>());
+const ACTIVATION_POSITION: InputSpec = input("activation_position", Kind::Real);
+const MASTER_SCALING_MODE: InputSpec = input("master_scaling_mode", mode::<CamScalingMode>());
+const SLAVE_SCALING_MODE: InputSpec = input("slave_scaling_mode", mode::<CamScalingMode>());
+const MASTER_OFFSET: InputSpec = input("master_offset", Kind::Real);
+const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real);
+const MASTER_SCALING: InputSpec = input("master_scaling", Kind::Real);
+const SLAVE_SCALING: InputSpec = input("slave_scaling", Kind::Real);
+/// The master's set-point (the default) or its actual position.
+const MASTER_SOURCE: InputSpec = input(
+    "master_source",
+    Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]),
+);
+const MASTER: InputSpec = input("master", Kind::Count);
+const TABLE: InputSpec = input("table", Kind::Count);
+const START_MODE: InputSpec = input("start_mode", mode::<CamStartMode>());
+const INTERPOLATION: InputSpec = input("interpolation", mode::<CamInterpolation>());
+
+/// The one-call cam blocks a timeline calls; the slave is the instance's axis.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_CamIn",
+        &[
+            MASTER_SOURCE,
+            MASTER,
+            TABLE,
+            START_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+            INTERPOLATION,
+        ],
+        |_| Box::<McCamIn>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_CamInExt",
+        &[
+            MASTER_SOURCE,
+            MASTER,
+            TABLE,
+            START_MODE,
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+            INTERPOLATION,
+        ],
+        |_| {
+            Box::new(McCamIn {
+                extended: true,
+                ..McCamIn::default()
+            })
+        },
+    ),
+    BlockSpec::on_axis("MC_CamOut", &[], |_| Box::<McCamOut>::default()),
+    BlockSpec::on_axis(
+        "MC_CamScaling",
+        &[
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+            MASTER_OFFSET,
+            SLAVE_OFFSET,
+            MASTER_SCALING,
+            SLAVE_SCALING,
+        ],
+        |_| Box::<McCamScaling>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_WriteMotionFunctionPoint",
+        &[
+            TABLE,
+            input("point_index", Kind::Count),
+            input("function_type", Kind::Count),
+            input("point_type", Kind::Count),
+            input("rel_index_next", Kind::Count),
+            input("master_pos", Kind::Real),
+            input("slave_pos", Kind::Real),
+            input("slave_velo", Kind::Real),
+            input("slave_acc", Kind::Real),
+            input("slave_jerk", Kind::Real),
+        ],
+        |_| Box::<McWriteMotionFunctionPoint>::default(),
+    ),
+    BlockSpec::on_axis(
+        "MC_SetCamOnlineChangeMode",
+        &[
+            TABLE,
+            ACTIVATION_MODE,
+            ACTIVATION_POSITION,
+            MASTER_SCALING_MODE,
+            SLAVE_SCALING_MODE,
+        ],
+        |_| Box::<McSetCamOnlineChangeMode>::default(),
+    ),
+];

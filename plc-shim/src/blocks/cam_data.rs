@@ -1,0 +1,469 @@
+//! The cam blocks of chapter 5.1 that send table data: MC_CamTableSelect (with the table's
+//! rows or points, if given, before the selection) and MC_WriteMotionFunction, both sending
+//! their data in chunks, one chunk in flight and one per cycle at most.
+
+use super::cam::recorded;
+use crate::kernel::{
+    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled,
+};
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{
+    input, mode, number, BlockSpec, InputSpec, Kind, TimelineBlock, Value,
+};
+use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
+use hli::calls::CallError;
+use hli::rpc::PendingCall;
+use std::sync::Arc;
+
+/// MC_CamTableSelect: how couplings through table `table` run (cyclic or linear).
+#[derive(Debug, Default)]
+pub struct McCamTableSelect {
+    /// Input: a rising edge sends the selection.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: continued period by period.
+    pub periodic: bool,
+    /// Input: master coordinates absolute.
+    pub master_absolute: bool,
+    /// Input: slave coordinates absolute.
+    pub slave_absolute: bool,
+    /// Input: the table's data, loaded into the CNC first (none: a table the CNC has).
+    pub data: CamData,
+    /// Input: raw `MC_TableType` of rows sent (10 equidistant, 11 non-equidistant; 0: 10).
+    pub table_type: u32,
+    /// Input: raw `MC_InterpolationType` of rows sent.
+    pub interpolation: u32,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    kernel: Kernel<SelectTransfer>,
+}
+
+impl McCamTableSelect {
+    /// One cycle: the data in chunks (if any), then the selection.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        if let CamData::Rows {
+            table_type,
+            interpolation,
+            ..
+        } = &mut self.data
+        {
+            *table_type = if self.table_type == 0 {
+                10
+            } else {
+                self.table_type
+            };
+            *interpolation = self.interpolation;
+        }
+        let call = CamTableSelectCall {
+            periodic: u32::from(self.periodic),
+            master_absolute: u32::from(self.master_absolute),
+            slave_absolute: u32::from(self.slave_absolute),
+            reserved: 0,
+        };
+        let (table, data, periodic) = (self.table, &self.data, self.periodic);
+        let send = |io: &mut PlcIo<'_>| match data {
+            CamData::None => io
+                .acyclic
+                .start(table, &call)
+                .map(SelectTransfer::Selecting)
+                .map_err(|e| call_error_code(&e)),
+            data => Ok(SelectTransfer::Loading(
+                ChunkTransfer::new(table, data, true, periodic),
+                call,
+            )),
+        };
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            send,
+            |reply| done_unless(reply.error_id),
+            no_follow,
+        );
+    }
+}
+
+/// A transfer of table data in chunks, one chunk in flight: what MC_CamTableSelect with data
+/// and MC_WriteMotionFunction send before they are done.
+#[derive(Debug, Clone, Default)]
+pub enum CamData {
+    /// Nothing to send.
+    #[default]
+    None,
+    /// A position table: `[master, slave]` rows.
+    Rows {
+        /// The rows.
+        rows: std::sync::Arc<[[f64; 2]]>,
+        /// Raw `MC_TableType` (10, 11).
+        table_type: u32,
+        /// Raw `MC_InterpolationType`.
+        interpolation: u32,
+    },
+    /// Motion-function points.
+    Points(std::sync::Arc<[hli::calls::cam::McMotionFunctionPoint]>),
+}
+
+enum Pending {
+    Rows(PendingCall<hli::calls::cam::CamRowsWriteCall>),
+    Points(PendingCall<hli::calls::cam::CamPointsWriteCall>),
+}
+
+/// [`CamData`] on its way to table `table`, chunk by chunk, one chunk in flight and one per
+/// cycle at most (a PLC cycle never waits); answered when the last chunk is taken.
+pub struct ChunkTransfer {
+    table: u32,
+    data: CamData,
+    /// The points make a new function.
+    create: bool,
+    /// Rows of a cyclic table.
+    periodic: bool,
+    pending: Option<Pending>,
+    next: usize,
+}
+
+impl core::fmt::Debug for ChunkTransfer {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("ChunkTransfer")
+            .field("table", &self.table)
+            .field("next", &self.next)
+            .finish()
+    }
+}
+
+fn chunk_flags(first: bool, last: bool) -> u32 {
+    let mut flags = 0;
+    if first {
+        flags |= hli::calls::cam::CAM_CHUNK_FIRST;
+    }
+    if last {
+        flags |= hli::calls::cam::CAM_CHUNK_LAST;
+    }
+    flags
+}
+
+impl ChunkTransfer {
+    /// A transfer of `data` (shared, not copied) to `table`; nothing is sent before the
+    /// first poll.
+    pub fn new(table: u32, data: &CamData, create: bool, periodic: bool) -> ChunkTransfer {
+        ChunkTransfer {
+            table,
+            data: data.clone(),
+            create,
+            periodic,
+            pending: None,
+            next: 0,
+        }
+    }
+
+    /// The next chunk, sent; `None` when every chunk is out.
+    fn send_next(&mut self, io: &mut PlcIo<'_>) -> Option<Result<Pending, CallError>> {
+        match &self.data {
+            CamData::None => None,
+            CamData::Rows {
+                rows,
+                table_type,
+                interpolation,
+            } => {
+                let chunk = rows
+                    .get(self.next..)?
+                    .get(..hli::calls::cam::CAM_ROWS_PER_CALL.min(rows.len() - self.next))?;
+                if chunk.is_empty() {
+                    return None;
+                }
+                let mut call = hli::calls::cam::CamRowsWriteCall {
+                    first_row: self.next as u32,
+                    count: chunk.len() as u32,
+                    flags: chunk_flags(self.next == 0, self.next + chunk.len() == rows.len()),
+                    total: rows.len() as u32,
+                    table_type: *table_type,
+                    interpolation: *interpolation,
+                    periodic: u32::from(self.periodic),
+                    ..Default::default()
+                };
+                call.rows[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                Some(io.acyclic.start(self.table, &call).map(Pending::Rows))
+            }
+            CamData::Points(points) => {
+                let per = hli::calls::cam::CAM_POINTS_PER_CALL;
+                let chunk = points
+                    .get(self.next..)?
+                    .get(..per.min(points.len() - self.next))?;
+                if chunk.is_empty() {
+                    return None;
+                }
+                let last = self.next + chunk.len() == points.len();
+                let create = if self.create {
+                    hli::calls::cam::CAM_POINTS_CREATE
+                } else {
+                    0
+                };
+                let mut call = hli::calls::cam::CamPointsWriteCall {
+                    first: chunk[0].point_index,
+                    count: chunk.len() as u32,
+                    flags: chunk_flags(self.next == 0, last) | create,
+                    total: points.len() as u32,
+                    ..Default::default()
+                };
+                call.points[..chunk.len()].copy_from_slice(chunk);
+                self.next += chunk.len();
+                Some(io.acyclic.start(self.table, &call).map(Pending::Points))
+            }
+        }
+    }
+}
+
+impl InFlight for ChunkTransfer {
+    type Reply = ();
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<()> {
+        let answered = match &self.pending {
+            None => None,
+            Some(Pending::Rows(p)) => p.poll().map(|r| r.map(|r| r.error_id)),
+            Some(Pending::Points(p)) => p.poll().map(|r| r.map(|r| r.error_id)),
+        };
+        match answered {
+            Some(Ok(0)) => self.pending = None,
+            Some(Ok(code)) => return Polled::Answer(Err(code)),
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            None if self.pending.is_some() => return Polled::Waiting,
+            None => {}
+        }
+        match self.send_next(io) {
+            None => Polled::Answer(Ok(())),
+            Some(Ok(pending)) => {
+                self.pending = Some(pending);
+                Polled::Progress
+            }
+            Some(Err(e)) => Polled::Answer(Err(call_error_code(&e))),
+        }
+    }
+}
+
+/// The data of MC_CamTableSelect (if any) and then the selection itself.
+pub enum SelectTransfer {
+    /// The table's data, chunk by chunk; the selection waits.
+    Loading(ChunkTransfer, CamTableSelectCall),
+    /// The selection, on its way.
+    Selecting(PendingCall<CamTableSelectCall>),
+}
+
+impl InFlight for SelectTransfer {
+    type Reply = CamReply;
+    type Buffer = ();
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<CamReply> {
+        match self {
+            SelectTransfer::Selecting(pending) => InFlight::poll(pending, io, &mut ()),
+            SelectTransfer::Loading(transfer, call) => match transfer.poll(io, &mut ()) {
+                Polled::Answer(Ok(())) => match io.acyclic.start(transfer.table, call) {
+                    Ok(pending) => {
+                        *self = SelectTransfer::Selecting(pending);
+                        Polled::Progress
+                    }
+                    Err(e) => Polled::Answer(Err(call_error_code(&e))),
+                },
+                Polled::Answer(Err(code)) => Polled::Answer(Err(code)),
+                Polled::Waiting => Polled::Waiting,
+                Polled::Progress => Polled::Progress,
+            },
+        }
+    }
+}
+
+/// MC_WriteMotionFunction: several points of the motion function `table` (the first one's
+/// index says where they go), sent in chunks and taken whole with the last.
+#[derive(Debug, Default)]
+pub struct McWriteMotionFunction {
+    /// Input: a rising edge starts the transfer.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the points.
+    pub points: CamData,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    kernel: Kernel<ChunkTransfer>,
+}
+
+impl McWriteMotionFunction {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let (table, points) = (self.table, &self.points);
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |_| Ok(ChunkTransfer::new(table, points, false, false)),
+            |()| Accept::Done(()),
+            no_follow,
+        );
+    }
+}
+
+/// `rows = [[master, slave], ...]`.
+pub fn rows_of(value: &toml::Value) -> Result<Arc<[[f64; 2]]>, String> {
+    let bad = || "call: `rows` must be [[master, slave], ...] of finite numbers".to_string();
+    let list = value.as_array().ok_or_else(bad)?;
+    list.iter()
+        .map(|row| match row.as_array().map(|r| r.as_slice()) {
+            Some([m, s]) => match (number(m), number(s)) {
+                (Some(m), Some(s)) if m.is_finite() && s.is_finite() => Ok([m, s]),
+                _ => Err(bad()),
+            },
+            _ => Err(bad()),
+        })
+        .collect()
+}
+
+/// The fields of a point in `points`.
+const POINT_FIELDS: [&str; 9] = [
+    "index",
+    "function",
+    "type",
+    "rel_index_next",
+    "master",
+    "slave",
+    "velocity",
+    "acceleration",
+    "jerk",
+];
+
+/// Point `i` of `points`.
+fn point_of(i: usize, p: &toml::Value) -> Result<McMotionFunctionPoint, String> {
+    let t = p
+        .as_table()
+        .ok_or_else(|| format!("call: points[{i}] is not a table"))?;
+    let int = |k: &str, default: Option<u32>| -> Result<u32, String> {
+        match t.get(k) {
+            Some(v) => v
+                .as_integer()
+                .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                .map(|v| v as u32)
+                .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+            None => default.ok_or_else(|| format!("call: points[{i}].{k} is missing")),
+        }
+    };
+    let num = |k: &str, required: bool| -> Result<f64, String> {
+        match t.get(k) {
+            Some(v) => number(v)
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("call: points[{i}].{k} = {v} is not valid")),
+            None if required => Err(format!("call: points[{i}].{k} is missing")),
+            None => Ok(0.0),
+        }
+    };
+    if let Some(key) = t.keys().find(|k| !POINT_FIELDS.contains(&k.as_str())) {
+        return Err(format!(
+            "call: points[{i}] has no field `{key}` (fields: {})",
+            POINT_FIELDS.join(", ")
+        ));
+    }
+    Ok(McMotionFunctionPoint {
+        point_index: int("index", None)?,
+        function_type: int("function", None)?,
+        point_type: int("type", None)?,
+        rel_index_next_point: int("rel_index_next", Some(1))?,
+        master_pos: num("master", true)?,
+        slave_pos: num("slave", true)?,
+        slave_velo: num("velocity", false)?,
+        slave_acc: num("acceleration", false)?,
+        slave_jerk: num("jerk", false)?,
+    })
+}
+
+/// `points = [{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0, ... }, ...]`.
+fn points_of(value: &toml::Value) -> Result<Arc<[McMotionFunctionPoint]>, String> {
+    let list = value
+        .as_array()
+        .ok_or("call: `points` must be an array of point tables")?;
+    list.iter()
+        .enumerate()
+        .map(|(i, p)| point_of(i, p))
+        .collect()
+}
+
+const TABLE: InputSpec = input("table", Kind::Count);
+const POINTS: InputSpec = input(
+    "points",
+    Kind::Parsed {
+        parse: |v| points_of(v).map(Value::Points),
+        example: "[{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0 }]",
+    },
+);
+
+impl TimelineBlock for McCamTableSelect {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("table", Value::Int(v)) => self.table = *v as u32,
+            ("periodic", Value::Bool(v)) => self.periodic = *v,
+            ("master_absolute", Value::Bool(v)) => self.master_absolute = *v,
+            ("slave_absolute", Value::Bool(v)) => self.slave_absolute = *v,
+            ("table_type", Value::Int(v)) => self.table_type = *v as u32,
+            ("interpolation", Value::Int(v)) => self.interpolation = *v as u32,
+            ("rows", Value::Rows(rows)) => {
+                self.data = CamData::Rows {
+                    rows: Arc::clone(rows),
+                    table_type: 10,
+                    interpolation: 0,
+                }
+            }
+            ("points", Value::Points(points)) => self.data = CamData::Points(Arc::clone(points)),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for McWriteMotionFunction {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("table", Value::Int(v)) => self.table = *v as u32,
+            ("points", Value::Points(points)) => self.points = CamData::Points(Arc::clone(points)),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+/// The cam blocks with table data a timeline calls.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_CamTableSelect",
+        &[
+            TABLE,
+            input("periodic", Kind::Bool),
+            input("master_absolute", Kind::Bool),
+            input("slave_absolute", Kind::Bool),
+            input(
+                "rows",
+                Kind::Parsed {
+                    parse: |v| rows_of(v).map(Value::Rows),
+                    example: "[[0.0, 0.0], [1.0, 2.0]]",
+                },
+            ),
+            POINTS,
+            input(
+                "table_type",
+                Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)]),
+            ),
+            input("interpolation", mode::<CamInterpolation>()),
+        ],
+        |_| Box::<McCamTableSelect>::default(),
+    ),
+    BlockSpec::on_axis("MC_WriteMotionFunction", &[TABLE, POINTS], |_| {
+        Box::<McWriteMotionFunction>::default()
+    }),
+];

@@ -1,0 +1,268 @@
+//! The multi-table blocks of seed 000 chapter 5.2.3: CamTableSetWeight,
+//! CamTableCoupleAxesMultiTables, CamTableEnableCorrectionTable and
+//! CamTableDeactivateCyclicTable, each one call on [`CamCore`].
+
+use super::cam::{recorded, CamCore};
+use crate::kernel::Outputs;
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{input, BlockSpec, Kind, TimelineBlock, Value};
+use hli::calls::cam::{CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC};
+
+/// CamTableSetWeight (5.2.3.1): weight, offsets, slopes and range of `table` in a
+/// multi-table slave.
+#[derive(Debug)]
+pub struct CamTableSetWeight {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the scaling.
+    pub weight: hli::calls::cam::CamTableWeightCall,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<hli::calls::cam::CamTableWeightCall>,
+}
+
+impl Default for CamTableSetWeight {
+    fn default() -> Self {
+        Self {
+            execute: false,
+            table: 0,
+            weight: hli::calls::cam::CamTableWeightCall {
+                weight: 1.0,
+                master_slope: 1.0,
+                slave_slope: 1.0,
+                range_low: -1e300,
+                range_high: 1e300,
+                ..Default::default()
+            },
+            out: Outputs::default(),
+            core: CamCore::default(),
+        }
+    }
+}
+
+impl CamTableSetWeight {
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let call = self.weight;
+        self.out = self.core.cycle(io, self.execute, self.table, || call, None);
+    }
+}
+
+/// CamTableCoupleAxesMultiTables (5.2.3.2): couples `slave` to `master` through up to
+/// eight tables (the first `profiles` are profile tables, the others corrections), or
+/// decouples it (`on` FALSE; the block's CoupleOff edge).
+#[derive(Debug, Default)]
+pub struct CamTableCoupleAxesMultiTables {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// Input: couple (TRUE) or decouple (FALSE).
+    pub on: bool,
+    /// Input: the master axis.
+    pub master: u32,
+    /// Input: the table IDs (up to 8).
+    pub tables: [u32; 8],
+    /// Input: tables used.
+    pub count: u32,
+    /// Input: profile tables among them.
+    pub profiles: u32,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<hli::calls::cam::CamMultiCoupleCall>,
+}
+
+impl CamTableCoupleAxesMultiTables {
+    /// One cycle for slave axis `slave`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let call = hli::calls::cam::CamMultiCoupleCall {
+            master: self.master,
+            on: u32::from(self.on),
+            tables: self.count,
+            profiles: self.profiles,
+            table_ids: self.tables,
+        };
+        self.out = self.core.cycle(io, self.execute, slave, || call, None);
+    }
+}
+
+/// CamTableEnableCorrectionTable (5.2.3.3) and CamTableDeactivateCyclicTable (5.2.3.4):
+/// a table of a multi-table slave started (a correction: at once, or at `position` when
+/// `at_position`) or ended at its cycle boundary (a cyclic profile table).
+#[derive(Debug, Default)]
+pub struct CamMultiTable {
+    /// Input: a rising edge sends it.
+    pub execute: bool,
+    /// What it does: [`hli::calls::cam::CAM_MULTI_ENABLE_CORRECTION`] or
+    /// [`hli::calls::cam::CAM_MULTI_STOP_CYCLIC`].
+    pub op: u32,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: a correction starts at `position` rather than at once.
+    pub at_position: bool,
+    /// Input: the activation position.
+    pub position: f64,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CamCore<hli::calls::cam::CamMultiTableCall>,
+}
+
+impl CamMultiTable {
+    /// One cycle for slave axis `slave`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let call = hli::calls::cam::CamMultiTableCall {
+            op: self.op,
+            table: self.table,
+            flags: u32::from(self.at_position),
+            reserved: 0,
+            position: self.position,
+        };
+        self.out = self.core.cycle(io, self.execute, slave, || call, None);
+    }
+}
+
+impl TimelineBlock for CamTableSetWeight {
+    fn set(&mut self, key: &str, value: &Value) {
+        let w = &mut self.weight;
+        match (key, value.uint(), value.real()) {
+            ("table", Some(v), _) => self.table = v,
+            ("weight", _, Some(v)) => w.weight = v,
+            ("master_offset", _, Some(v)) => w.master_offset = v,
+            ("master_slope", _, Some(v)) => w.master_slope = v,
+            ("slave_offset", _, Some(v)) => w.slave_offset = v,
+            ("slave_slope", _, Some(v)) => w.slave_slope = v,
+            ("range_low", _, Some(v)) => w.range_low = v,
+            ("range_high", _, Some(v)) => w.range_high = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for CamTableCoupleAxesMultiTables {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("master", Value::Int(v)) => self.master = *v as u32,
+            ("profiles", Value::Int(v)) => self.profiles = *v as u32,
+            ("on", Value::Bool(v)) => self.on = *v,
+            ("tables", Value::Ids(ids, n)) => {
+                (self.tables, self.count) = (*ids, *n);
+                if self.profiles == 0 || self.profiles > *n {
+                    self.profiles = *n;
+                }
+            }
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+impl TimelineBlock for CamMultiTable {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("table", Value::Int(v)) => self.table = *v as u32,
+            ("at_position", Value::Bool(v)) => self.at_position = *v,
+            ("position", Value::Real(v)) => self.position = *v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        self.call(io, axis);
+        recorded(self.out)
+    }
+}
+
+/// `tables = [1, 2, ...]`: 1 to 8 table IDs.
+fn table_ids(value: &toml::Value) -> Result<Value, String> {
+    let list = value
+        .as_array()
+        .filter(|l| (1..=8).contains(&l.len()))
+        .ok_or_else(|| format!("call: `tables` = {value}: 1 to 8 table IDs"))?;
+    let mut ids = [0u32; 8];
+    for (slot, v) in ids.iter_mut().zip(list) {
+        *slot = v
+            .as_integer()
+            .filter(|v| (1..=255).contains(v))
+            .ok_or_else(|| format!("call: `tables`: {v} is not a table ID"))?
+            as u32;
+    }
+    Ok(Value::Ids(ids, list.len() as u32))
+}
+
+/// The multi-table blocks a timeline calls; the slave is the instance's axis.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "CamTableSetWeight",
+        &[
+            input("table", Kind::Count),
+            input("weight", Kind::Real),
+            input("master_offset", Kind::Real),
+            input("master_slope", Kind::Real),
+            input("slave_offset", Kind::Real),
+            input("slave_slope", Kind::Real),
+            input("range_low", Kind::Real),
+            input("range_high", Kind::Real),
+        ],
+        |_| Box::<CamTableSetWeight>::default(),
+    ),
+    BlockSpec::on_axis(
+        "CamTableCoupleAxesMultiTables",
+        &[
+            input("master", Kind::Count),
+            input(
+                "tables",
+                Kind::Parsed {
+                    parse: table_ids,
+                    example: "[1, 2]",
+                },
+            ),
+            input("profiles", Kind::Range(1, 8)),
+            input("on", Kind::Bool),
+        ],
+        |_| {
+            Box::new(CamTableCoupleAxesMultiTables {
+                on: true,
+                ..CamTableCoupleAxesMultiTables::default()
+            })
+        },
+    ),
+    BlockSpec::on_axis(
+        "CamTableEnableCorrectionTable",
+        &[
+            input("table", Kind::Count),
+            input("at_position", Kind::Bool),
+            input("position", Kind::Real),
+        ],
+        |_| {
+            Box::new(CamMultiTable {
+                op: CAM_MULTI_ENABLE_CORRECTION,
+                ..CamMultiTable::default()
+            })
+        },
+    ),
+    BlockSpec::on_axis(
+        "CamTableDeactivateCyclicTable",
+        &[input("table", Kind::Count)],
+        |_| {
+            Box::new(CamMultiTable {
+                op: CAM_MULTI_STOP_CYCLIC,
+                ..CamMultiTable::default()
+            })
+        },
+    ),
+];

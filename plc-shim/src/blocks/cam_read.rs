@@ -1,0 +1,380 @@
+//! The reads of chapter 5.1: MC_ReadCamTableSlaveDynamics, MC_ReadCamTableCharacteristics,
+//! MC_ReadMotionFunctionValues and MC_CamInfo ([`McCamRead`], answers in parts of 28
+//! numbers) and MC_ReadMotionFunction / MC_ReadMotionFunctionPoint ([`McReadMotionFunction`],
+//! four points per cycle), each into an array whose room is set when the block is made.
+
+use super::cam::recorded;
+use crate::kernel::{call_error_code, no_follow, Accept, InFlight, Kernel, Outputs, Polled};
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use hli::calls::cam::{
+    CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES,
+};
+use hli::rpc::PendingCall;
+
+/// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
+pub const ERROR_ARRAY_SIZE: u32 = 0x4B31;
+
+/// A read of numbers in parts of 28, one part per cycle, appended to the block's array (the
+/// buffer); answered with the columns per row once all are in.
+pub struct PartRead {
+    target: u32,
+    request: hli::calls::cam::CamReadCall,
+    pending: PendingCall<hli::calls::cam::CamReadCall>,
+}
+
+impl core::fmt::Debug for PartRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PartRead")
+            .field("part", &self.request.part)
+            .finish()
+    }
+}
+
+impl PartRead {
+    fn start(
+        io: &mut PlcIo<'_>,
+        target: u32,
+        request: hli::calls::cam::CamReadCall,
+    ) -> Result<PartRead, u32> {
+        let pending = io
+            .acyclic
+            .start(target, &request)
+            .map_err(|e| call_error_code(&e))?;
+        Ok(PartRead {
+            target,
+            request,
+            pending,
+        })
+    }
+}
+
+impl InFlight for PartRead {
+    type Reply = u32;
+    type Buffer = Vec<f64>;
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, values: &mut Vec<f64>) -> Polled<u32> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) if reply.error_id != 0 => return Polled::Answer(Err(reply.error_id)),
+            Some(Ok(reply)) => reply,
+        };
+        let count = reply.count as usize;
+        if values.len() + count > values.capacity() || reply.total as usize > values.capacity() {
+            return Polled::Answer(Err(ERROR_ARRAY_SIZE));
+        }
+        values.extend_from_slice(&reply.values[..count]);
+        if values.len() >= reply.total as usize || count == 0 {
+            return Polled::Answer(Ok(reply.columns));
+        }
+        self.request.part += 1;
+        match io.acyclic.start(self.target, &self.request) {
+            Ok(pending) => {
+                self.pending = pending;
+                Polled::Progress
+            }
+            Err(e) => Polled::Answer(Err(call_error_code(&e))),
+        }
+    }
+}
+
+/// The reads of chapter 5.1 (MC_ReadCamTableSlaveDynamics, MC_ReadCamTableCharacteristics,
+/// MC_ReadMotionFunctionValues, MC_CamInfo): the answer comes in parts of 28 numbers, one
+/// part per cycle, into `values`, whose room is set when the instance is made (like the
+/// array an MC_CAM_REF points to); an answer that does not fit is refused with
+/// MC_ERROR_ARRAYSIZE_INVALID.
+#[derive(Debug)]
+pub struct McCamRead {
+    /// Input: a rising edge starts the read.
+    pub execute: bool,
+    /// What is read and its parameters (the target is set by [`McCamRead::target`]).
+    pub request: hli::calls::cam::CamReadCall,
+    /// Table ID, or the slave axis of MC_CamInfo.
+    pub target: u32,
+    /// Output: the numbers read.
+    pub values: Vec<f64>,
+    /// Output: columns per row of a value table.
+    pub columns: u32,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    kernel: Kernel<PartRead>,
+}
+
+/// Room of a read block's answer when the timeline does not say.
+pub const DEFAULT_READ_ROOM: usize = 1024;
+
+impl McCamRead {
+    /// A read of kind `what` with room for `room` numbers.
+    pub fn new(what: u32, room: usize) -> McCamRead {
+        McCamRead {
+            execute: false,
+            request: hli::calls::cam::CamReadCall {
+                what,
+                ..Default::default()
+            },
+            target: 0,
+            values: Vec::with_capacity(room),
+            columns: 1,
+            out: Outputs::default(),
+            kernel: Kernel::default(),
+        }
+    }
+
+    /// Input tTimeout: cycles to wait for each part.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.kernel.set_timeout_cycles(cycles);
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let (target, request) = (self.target, self.request);
+        let columns = &mut self.columns;
+        let send = |io: &mut PlcIo<'_>, values: &mut Vec<f64>| {
+            values.clear();
+            PartRead::start(
+                io,
+                target,
+                hli::calls::cam::CamReadCall { part: 0, ..request },
+            )
+        };
+        self.out = self.kernel.cycle_with(
+            io,
+            &mut self.values,
+            self.execute,
+            send,
+            |c| {
+                *columns = c;
+                Accept::Done(())
+            },
+            no_follow,
+        );
+    }
+}
+
+/// A read of motion-function points, four per cycle, appended to the block's array until
+/// `wanted` (0: to the end of the function from `first`).
+pub struct PointsRead {
+    table: u32,
+    first: u32,
+    count: u32,
+    pending: PendingCall<hli::calls::cam::CamPointsReadCall>,
+}
+
+impl core::fmt::Debug for PointsRead {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("PointsRead")
+            .field("table", &self.table)
+            .finish()
+    }
+}
+
+fn read_points(
+    io: &mut PlcIo<'_>,
+    table: u32,
+    first: u32,
+) -> Result<PendingCall<hli::calls::cam::CamPointsReadCall>, u32> {
+    let call = hli::calls::cam::CamPointsReadCall { first, count: 0 };
+    io.acyclic
+        .start(table, &call)
+        .map_err(|e| call_error_code(&e))
+}
+
+impl InFlight for PointsRead {
+    type Reply = ();
+    type Buffer = Vec<hli::calls::cam::McMotionFunctionPoint>;
+
+    fn poll(&mut self, io: &mut PlcIo<'_>, points: &mut Self::Buffer) -> Polled<()> {
+        let reply = match self.pending.poll() {
+            None => return Polled::Waiting,
+            Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
+            Some(Ok(reply)) if reply.error_id != 0 => return Polled::Answer(Err(reply.error_id)),
+            Some(Ok(reply)) => reply,
+        };
+        let wanted = if self.count == 0 {
+            (reply.total + 1).saturating_sub(self.first) as usize
+        } else {
+            self.count as usize
+        };
+        if wanted > points.capacity() {
+            return Polled::Answer(Err(ERROR_ARRAY_SIZE));
+        }
+        let take = (reply.count as usize).min(wanted.saturating_sub(points.len()));
+        points.extend_from_slice(&reply.points[..take]);
+        if points.len() >= wanted || reply.count == 0 {
+            return Polled::Answer(Ok(()));
+        }
+        match read_points(io, self.table, self.first + points.len() as u32) {
+            Ok(pending) => {
+                self.pending = pending;
+                Polled::Progress
+            }
+            Err(code) => Polled::Answer(Err(code)),
+        }
+    }
+}
+
+/// MC_ReadMotionFunction / MC_ReadMotionFunctionPoint: points of the motion function
+/// `table` from `first` on (`count` 0: to the end), four per cycle, into `points`, whose room
+/// is set when the instance is made.
+#[derive(Debug)]
+pub struct McReadMotionFunction {
+    /// Input: a rising edge starts the read.
+    pub execute: bool,
+    /// Input: the table ID.
+    pub table: u32,
+    /// Input: the first point.
+    pub first: u32,
+    /// Input: points wanted (0: all from `first`).
+    pub count: u32,
+    /// Output: the points read.
+    pub points: Vec<hli::calls::cam::McMotionFunctionPoint>,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    kernel: Kernel<PointsRead>,
+}
+
+impl McReadMotionFunction {
+    /// A reader with room for `room` points.
+    pub fn new(room: usize) -> McReadMotionFunction {
+        McReadMotionFunction {
+            execute: false,
+            table: 0,
+            first: 1,
+            count: 0,
+            points: Vec::with_capacity(room),
+            out: Outputs::default(),
+            kernel: Kernel::default(),
+        }
+    }
+
+    /// One cycle.
+    pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let (table, first, count) = (self.table, self.first, self.count);
+        let send = |io: &mut PlcIo<'_>,
+                    points: &mut Vec<hli::calls::cam::McMotionFunctionPoint>| {
+            points.clear();
+            Ok(PointsRead {
+                table,
+                first,
+                count,
+                pending: read_points(io, table, first)?,
+            })
+        };
+        self.out = self.kernel.cycle_with(
+            io,
+            &mut self.points,
+            self.execute,
+            send,
+            |()| Accept::Done(()),
+            no_follow,
+        );
+    }
+}
+
+impl TimelineBlock for McCamRead {
+    fn set(&mut self, key: &str, value: &Value) {
+        let r = &mut self.request;
+        match (key, value.uint(), value.real(), value) {
+            ("table", Some(v), _, _) => self.target = v,
+            ("value_select_mask", Some(v), _, _) => r.mask = v,
+            ("master_position" | "start_pos_master", _, Some(v), _) => r.a = v,
+            ("end_pos_master", _, Some(v), _) => r.b = v,
+            ("increment", _, Some(v), _) => r.c = v,
+            ("at_master_position", _, _, Value::Bool(v)) => r.flags = u32::from(*v),
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+        if self.request.what == CAM_READ_INFO {
+            self.target = axis; // MC_CamInfo reads the slave's coupling
+        }
+        self.call(io);
+        recorded(self.out)
+    }
+    fn read(&self) -> Option<Vec<f64>> {
+        Some(self.values.clone())
+    }
+}
+
+impl TimelineBlock for McReadMotionFunction {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value.uint()) {
+            ("table", Some(v)) => self.table = v,
+            ("point_index", Some(v)) => self.first = v,
+            ("num_points", Some(v)) => self.count = v,
+            _ => {}
+        }
+    }
+    fn execute(&mut self) -> Option<&mut bool> {
+        Some(&mut self.execute)
+    }
+    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+        self.call(io);
+        recorded(self.out)
+    }
+    /// Index, master and slave position of every point read.
+    fn read(&self) -> Option<Vec<f64>> {
+        let points = self.points.iter();
+        Some(
+            points
+                .flat_map(|p| [p.point_index as f64, p.master_pos, p.slave_pos])
+                .collect(),
+        )
+    }
+}
+
+const TABLE: InputSpec = input("table", Kind::Count);
+const POINT_INDEX: InputSpec = input("point_index", Kind::Count);
+const MASTER_POSITION: InputSpec = input("master_position", Kind::Real);
+const ROOM: InputSpec = input("room", Kind::Room);
+
+/// The cam reads a timeline calls; `room` (where a read has it) is the room of the answer,
+/// [`DEFAULT_READ_ROOM`] if not given.
+pub const TIMELINE: &[BlockSpec] = &[
+    BlockSpec::on_axis(
+        "MC_ReadMotionFunction",
+        &[TABLE, POINT_INDEX, input("num_points", Kind::Count), ROOM],
+        |room| {
+            let room = room.unwrap_or(DEFAULT_READ_ROOM);
+            Box::new(McReadMotionFunction::new(room))
+        },
+    ),
+    BlockSpec::on_axis("MC_ReadMotionFunctionPoint", &[TABLE, POINT_INDEX], |_| {
+        Box::new(McReadMotionFunction {
+            count: 1,
+            ..McReadMotionFunction::new(1)
+        })
+    }),
+    BlockSpec::on_axis(
+        "MC_ReadCamTableSlaveDynamics",
+        &[TABLE, MASTER_POSITION],
+        |_| Box::new(McCamRead::new(CAM_READ_SLAVE_DYNAMICS, 3)),
+    ),
+    BlockSpec::on_axis("MC_ReadCamTableCharacteristics", &[TABLE], |_| {
+        Box::new(McCamRead::new(CAM_READ_CHARACTERISTICS, 31))
+    }),
+    BlockSpec::on_axis(
+        "MC_ReadMotionFunctionValues",
+        &[
+            TABLE,
+            input("value_select_mask", Kind::Count),
+            input("start_pos_master", Kind::Real),
+            input("end_pos_master", Kind::Real),
+            input("increment", Kind::Real),
+            ROOM,
+        ],
+        |room| {
+            let room = room.unwrap_or(DEFAULT_READ_ROOM);
+            Box::new(McCamRead::new(CAM_READ_VALUES, room))
+        },
+    ),
+    BlockSpec::on_axis(
+        "MC_CamInfo",
+        &[input("at_master_position", Kind::Bool), MASTER_POSITION],
+        |_| Box::new(McCamRead::new(CAM_READ_INFO, 40)),
+    ),
+];

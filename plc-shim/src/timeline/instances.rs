@@ -1,0 +1,350 @@
+//! The block instances of a timeline: each `call` checked against its block's
+//! [`BlockSpec`] (the registry, [`super::registry`]), an instance made on a name's first call,
+//! every instance called once per PLC cycle like a PLC program calls its instances, and the
+//! edges of its outputs recorded for the report.
+//!
+//! ```toml
+//! [[step]]
+//! call = { block = "MC_Power", instance = "power_x", axis = 0, enable = true }
+//! [[step]]
+//! wait = "power_x.Status"                  # ready once this output is TRUE
+//! call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1,
+//!          start_mode = "absolute", slave_scaling = 2.0 }
+//! ```
+//!
+//! A call sets the given inputs and a rising edge on Execute (`execute = false` lowers it
+//! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
+//! FALSE for one cycle first, so every call is a new edge.
+
+use super::registry::{find, BlockSpec, Inputs, Kind, Target, TimelineBlock, Value, WHOLE};
+use crate::runtime::PlcIo;
+
+/// A call of an instance, checked.
+#[derive(Debug, Clone)]
+pub struct Call {
+    instance: usize,
+    inputs: Vec<(&'static str, Value)>,
+    execute: bool,
+}
+
+/// The outputs a `wait` can name.
+pub const OUTPUTS: [&str; 8] = [
+    "Done",
+    "Busy",
+    "Active",
+    "CommandAborted",
+    "Error",
+    "InVelocity",
+    "Status",
+    "InSync",
+];
+
+/// A boolean output of a block.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Output(usize);
+
+/// Where an output rose first, and how often.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Edge {
+    /// CNC tick of the first rising edge.
+    pub first: Option<u64>,
+    /// Rising edges seen.
+    pub count: u64,
+}
+
+#[derive(Debug)]
+struct Instance {
+    name: String,
+    spec: &'static BlockSpec,
+    axis: u32,
+    block: Box<dyn TimelineBlock>,
+    raise_next_cycle: bool,
+    last: [bool; 8],
+    edges: [Edge; 8],
+    error_id: u32,
+    /// Room of a read block's answer (made with the instance, never in a cycle).
+    room: Option<usize>,
+}
+
+impl Instance {
+    fn new(name: String, spec: &'static BlockSpec, axis: u32, room: Option<usize>) -> Self {
+        Instance {
+            name,
+            spec,
+            axis,
+            block: (spec.make)(room),
+            raise_next_cycle: false,
+            last: [false; 8],
+            edges: [Edge::default(); 8],
+            error_id: 0,
+            room,
+        }
+    }
+
+    fn uses_axis(&self) -> bool {
+        !matches!(self.spec.target, Target::Group)
+    }
+}
+
+/// The instances of a timeline.
+#[derive(Debug, Default)]
+pub struct Instances {
+    list: Vec<Instance>,
+}
+
+/// The gpAx index a call of `spec` gives (0 for a group's block).
+fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
+    let given = match (table.get("axis"), spec.target) {
+        (None, Target::AxisOr(find)) => find(table),
+        (given, _) => given,
+    };
+    let uses_axis = !matches!(spec.target, Target::Group);
+    match given.and_then(toml::Value::as_integer) {
+        Some(a) if (0..i64::from(u32::MAX)).contains(&a) && uses_axis => Ok(a as u32),
+        Some(a) if uses_axis => Err(format!("call: axis {a} is not an axis index")),
+        Some(_) => Err(format!(
+            "call: {} addresses a FIFO group: no `axis`",
+            spec.name
+        )),
+        None if uses_axis => Err("call: `axis` (the gpAx index) is missing".into()),
+        None => Ok(0),
+    }
+}
+
+/// The inputs of a call of `spec`, the room it gives, and whether it raises Execute.
+type Checked = (Vec<(&'static str, Value)>, Option<usize>, bool);
+
+fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
+    let (mut inputs, mut room, mut execute) = (Vec::new(), None, true);
+    if let Inputs::Table(parse) = spec.inputs {
+        let (value, r) = parse(spec.name, table)?;
+        inputs.push((WHOLE, value));
+        room = r;
+    }
+    for (key, value) in table {
+        if ["block", "instance", "axis"].contains(&key.as_str()) {
+            continue;
+        }
+        if key == "execute" && spec.execute {
+            execute = value
+                .as_bool()
+                .ok_or("call: `execute` must be true or false")?;
+            continue;
+        }
+        let Inputs::Keys(keys) = spec.inputs else {
+            continue; // checked whole above
+        };
+        let Some(input) = keys.iter().find(|i| i.key == key) else {
+            let known: Vec<&str> = keys.iter().map(|i| i.key).collect();
+            let known = if known.is_empty() {
+                "none".into()
+            } else {
+                known.join(", ")
+            };
+            return Err(format!(
+                "call: {} has no input `{key}` (inputs: {known})",
+                spec.name
+            ));
+        };
+        match (&input.kind, input.kind.check(spec.name, key, value)?) {
+            (Kind::Room, Value::Int(r)) => room = Some(r as usize),
+            (_, value) => inputs.push((input.key, value)),
+        }
+    }
+    Ok((inputs, room, execute))
+}
+
+impl Instances {
+    /// Checks a `call` table and registers its instance (created on its first call); `Err`
+    /// says which key is wrong.
+    pub fn parse_call(&mut self, table: &toml::Table) -> Result<Call, String> {
+        let block = table
+            .get("block")
+            .and_then(toml::Value::as_str)
+            .ok_or("call: `block` (a string) is missing")?;
+        let spec = find(block)?;
+        let name = table
+            .get("instance")
+            .and_then(toml::Value::as_str)
+            .unwrap_or(spec.name);
+        let axis = axis_of(spec, table)?;
+        let (inputs, room, execute) = inputs_of(spec, table)?;
+        let instance = match self.list.iter().position(|i| i.name == name) {
+            Some(i) => {
+                let inst = &mut self.list[i];
+                if inst.spec.name != spec.name || inst.axis != axis {
+                    return Err(format!(
+                        "call: instance {name:?} is a {} on axis {}, not a {} on axis {axis}",
+                        inst.spec.name, inst.axis, spec.name
+                    ));
+                }
+                // The room of a read's answer is the instance's, made now (never in a cycle).
+                if let Some(r) = room.filter(|r| Some(*r) > inst.room) {
+                    inst.room = Some(r);
+                    inst.block = (spec.make)(Some(r));
+                }
+                i
+            }
+            None => {
+                self.list
+                    .push(Instance::new(name.to_string(), spec, axis, room));
+                self.list.len() - 1
+            }
+        };
+        Ok(Call {
+            instance,
+            inputs,
+            execute,
+        })
+    }
+
+    /// Checks a `wait` (`INSTANCE.OUTPUT`) against the instances called so far.
+    pub fn parse_wait(&self, text: &str) -> Result<(usize, Output), String> {
+        let (name, output) = text
+            .trim()
+            .split_once('.')
+            .ok_or_else(|| format!("wait {text:?}: INSTANCE.OUTPUT"))?;
+        let instance = self
+            .list
+            .iter()
+            .position(|i| i.name == name)
+            .ok_or_else(|| format!("wait: no instance {name:?} is called before this step"))?;
+        let output = OUTPUTS
+            .iter()
+            .position(|o| o.eq_ignore_ascii_case(output))
+            .ok_or_else(|| {
+                let known = OUTPUTS.join(", ");
+                format!("wait: unknown output {output:?} (known: {known})")
+            })?;
+        Ok((instance, Output(output)))
+    }
+
+    /// Whether there are any.
+    pub fn is_empty(&self) -> bool {
+        self.list.is_empty()
+    }
+
+    /// The axes the instances use, with their instance names.
+    pub fn axes(&self) -> impl Iterator<Item = (&str, u32)> {
+        self.list
+            .iter()
+            .filter(|i| i.uses_axis())
+            .map(|i| (i.name.as_str(), i.axis))
+    }
+
+    /// Whether `output` of `instance` was TRUE after the last cycle.
+    pub fn holds(&self, (instance, Output(output)): (usize, Output)) -> bool {
+        self.list[instance].last[output]
+    }
+
+    /// Applies a fired call: inputs now, the Execute edge in this or the next cycle. The
+    /// outputs seen so far are forgotten, so a later `wait` sees only this call's.
+    pub fn apply(&mut self, call: &Call) {
+        let inst = &mut self.list[call.instance];
+        for (key, value) in &call.inputs {
+            inst.block.set(key, value);
+        }
+        inst.last = [false; 8];
+        match inst.block.execute() {
+            // Execute is (or is about to be) TRUE: hold it FALSE for a cycle, then raise it.
+            Some(execute) if call.execute && (*execute || inst.raise_next_cycle) => {
+                *execute = false;
+                inst.raise_next_cycle = true;
+            }
+            Some(execute) => {
+                *execute = call.execute;
+                inst.raise_next_cycle = false;
+            }
+            None => {}
+        }
+    }
+
+    /// Raises the Execute edges due from the last cycle (call before the steps fire).
+    pub fn begin_cycle(&mut self) {
+        for inst in &mut self.list {
+            if inst.raise_next_cycle {
+                inst.raise_next_cycle = false;
+                if let Some(e) = inst.block.execute() {
+                    *e = true;
+                }
+            }
+        }
+    }
+
+    /// Calls every instance once and records its output edges at CNC tick `tick`.
+    pub fn call_all(&mut self, io: &mut PlcIo<'_>, tick: u64) {
+        for inst in &mut self.list {
+            let (out, status) = inst.block.cycle(io, inst.axis);
+            let now = [
+                out.done,
+                out.busy,
+                out.active,
+                out.command_aborted,
+                out.error,
+                out.in_velocity,
+                status,
+                out.in_sync,
+            ];
+            for ((is, was), edge) in now.iter().zip(inst.last).zip(inst.edges.iter_mut()) {
+                if *is && !was {
+                    edge.count += 1;
+                    edge.first.get_or_insert(tick);
+                }
+            }
+            if out.error {
+                inst.error_id = out.error_id;
+            }
+            inst.last = now;
+        }
+    }
+
+    /// One line per instance: its block and axis, and the first rising edge of every output
+    /// that rose (`Busy 12 (x1), Done 341 (x1)`), with the last error id; then what a read
+    /// block read.
+    pub fn summary(&self) -> String {
+        let mut out = String::new();
+        for inst in &self.list {
+            let edges: Vec<String> = OUTPUTS
+                .iter()
+                .zip(&inst.edges)
+                .filter_map(|(name, e)| e.first.map(|t| format!("{name} {t} (x{})", e.count)))
+                .collect();
+            let target = match inst.uses_axis() {
+                true => format!(" on gpAx[{}]", inst.axis),
+                false => String::new(),
+            };
+            let edges = match edges.is_empty() {
+                true => "no output rose".to_string(),
+                false => edges.join(", "),
+            };
+            let error = match inst.error_id {
+                0 => String::new(),
+                id => format!(", ErrorID {id:#06x}"),
+            };
+            let (name, kind) = (&inst.name, inst.spec.name);
+            out.push_str(&format!("block {name} ({kind}{target}): {edges}{error}\n"));
+            if let Some(values) = inst.block.read().filter(|v| !v.is_empty()) {
+                let shown: Vec<String> = values.iter().take(12).map(|v| format!("{v}")).collect();
+                let more = if values.len() > 12 { ", ..." } else { "" };
+                let (n, shown) = (values.len(), shown.join(", "));
+                out.push_str(&format!("  read {n} value(s): {shown}{more}\n"));
+            }
+        }
+        out
+    }
+}
+
+/// A clone has the same instances with fresh block states (a timeline is cloned before it
+/// runs).
+impl Clone for Instances {
+    fn clone(&self) -> Self {
+        let list = self.list.iter();
+        let fresh = |i: &Instance| Instance::new(i.name.clone(), i.spec, i.axis, i.room);
+        Instances {
+            list: list.map(fresh).collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,297 @@
+//! The blocks a timeline calls by name. Each family registers its blocks in the `TIMELINE`
+//! table at the end of its file in [`crate::blocks`]: name, what an instance addresses, the
+//! inputs with their kinds, and the constructor; [`FAMILIES`] lists the tables, one line per
+//! family. The instances and their calls are [`super::instances`].
+
+use crate::blocks::{cam, cam_compat, cam_data, cam_multi, cam_read, fifo, motion, probe, saw};
+use crate::kernel::Outputs;
+use crate::runtime::PlcIo;
+use hli::calls::cam::McMotionFunctionPoint;
+use hli::enums::WireEnum;
+use std::any::Any;
+use std::sync::Arc;
+
+/// The blocks of every family a timeline can call: one line per family.
+pub const FAMILIES: &[&[BlockSpec]] = &[
+    motion::TIMELINE,
+    probe::TIMELINE,
+    cam_data::TIMELINE,
+    cam::TIMELINE,
+    cam_read::TIMELINE,
+    cam_multi::TIMELINE,
+    cam_compat::TIMELINE,
+    fifo::TIMELINE,
+    saw::TIMELINE,
+];
+
+/// A block as a timeline knows it.
+#[derive(Debug)]
+pub struct BlockSpec {
+    /// The name a `call` gives (ASCII case ignored).
+    pub name: &'static str,
+    /// What an instance addresses: how `axis` is read.
+    pub target: Target,
+    /// A call raises Execute (`execute = false` lowers it); false for MC_Power.
+    pub execute: bool,
+    /// The inputs a call may set.
+    pub inputs: Inputs,
+    /// A fresh instance; `room` is the room of a read's answer, if the call gave one.
+    pub make: fn(room: Option<usize>) -> Box<dyn TimelineBlock>,
+}
+
+impl BlockSpec {
+    /// A block on an axis with an Execute input, its inputs given key by key (most blocks).
+    pub const fn on_axis(
+        name: &'static str,
+        inputs: &'static [InputSpec],
+        make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
+    ) -> BlockSpec {
+        BlockSpec {
+            name,
+            target: Target::Axis,
+            execute: true,
+            inputs: Inputs::Keys(inputs),
+            make,
+        }
+    }
+}
+
+/// What an instance addresses.
+#[derive(Debug, Clone, Copy)]
+pub enum Target {
+    /// An axis: `axis`, its gpAx index.
+    Axis,
+    /// A FIFO group, given as an input: no `axis`.
+    Group,
+    /// An axis given as `axis` or, without it, where the function finds it (the seed's
+    /// `Slave` of the flying-saw blocks).
+    AxisOr(fn(&toml::Table) -> Option<&toml::Value>),
+}
+
+/// How a call's inputs are checked.
+#[derive(Debug)]
+pub enum Inputs {
+    /// Key by key, each of its kind; the block is set key by key.
+    Keys(&'static [InputSpec]),
+    /// The whole table by the family (every key but `block`, `instance`, `axis`, `execute`):
+    /// one value, set under [`WHOLE`], and the room of a read's answer if it has one.
+    Table(fn(&'static str, &toml::Table) -> Result<Whole, String>),
+}
+
+/// A call checked whole: its one value, and the room of a read's answer if it gives one.
+pub type Whole = (Value, Option<usize>);
+
+/// The key a whole-table value is set under ([`Inputs::Table`]).
+pub const WHOLE: &str = "inputs";
+
+/// An input of a block.
+#[derive(Debug)]
+pub struct InputSpec {
+    /// Its key in a `call`.
+    pub key: &'static str,
+    /// What it takes.
+    pub kind: Kind,
+}
+
+/// An input `key` of kind `kind`.
+pub const fn input(key: &'static str, kind: Kind) -> InputSpec {
+    InputSpec { key, kind }
+}
+
+/// What an input takes, and the [`Value`] a block is set with.
+#[derive(Debug)]
+pub enum Kind {
+    /// `true` or `false`: [`Value::Bool`].
+    Bool,
+    /// A finite number: [`Value::Real`].
+    Real,
+    /// An integer 0..u32::MAX (a table ID, an index, a mask): [`Value::Int`].
+    Count,
+    /// An integer `lo..=hi`: [`Value::Int`].
+    Range(i64, i64),
+    /// One of these values as written in TOML (a note may follow a space): [`Value::Int`].
+    OneOf(&'static [(&'static str, i64)]),
+    /// A wire enum by name or number ([`mode`]): [`Value::Int`], its raw value.
+    Mode(Mode),
+    /// The room of a read's answer, 1..=1048576: sizes the instance, is not set.
+    Room,
+    /// A shape of the family's, parsed by `parse`; `example` is a valid value in TOML.
+    Parsed {
+        /// The parser (its errors name the key).
+        parse: fn(&toml::Value) -> Result<Value, String>,
+        /// A valid value.
+        example: &'static str,
+    },
+}
+
+/// A wire enum seen through its names and numbers.
+#[derive(Debug)]
+pub struct Mode {
+    /// The raw value of a name.
+    pub from_name: fn(&str) -> Option<u32>,
+    /// Whether a number is one of its values.
+    pub valid: fn(u32) -> bool,
+    /// Every value as `name (number)`.
+    pub names: fn() -> String,
+}
+
+/// The input kind of wire enum `E` (its names come with it from hli).
+pub const fn mode<E: WireEnum>() -> Kind {
+    fn from_name<E: WireEnum>(name: &str) -> Option<u32> {
+        E::from_name(name).map(E::raw)
+    }
+    fn valid<E: WireEnum>(raw: u32) -> bool {
+        E::from_raw(raw).is_some()
+    }
+    fn names<E: WireEnum>() -> String {
+        let name = |v: &E| format!("{} ({})", v.name(), v.raw());
+        E::ALL.iter().map(name).collect::<Vec<_>>().join(", ")
+    }
+    Kind::Mode(Mode {
+        from_name: from_name::<E>,
+        valid: valid::<E>,
+        names: names::<E>,
+    })
+}
+
+/// A checked input value.
+#[derive(Debug, Clone)]
+pub enum Value {
+    /// [`Kind::Bool`].
+    Bool(bool),
+    /// [`Kind::Real`].
+    Real(f64),
+    /// The integer kinds.
+    Int(i64),
+    /// Table rows `[master, slave]`.
+    Rows(Arc<[[f64; 2]]>),
+    /// Motion-function points.
+    Points(Arc<[McMotionFunctionPoint]>),
+    /// Up to 8 table IDs, and how many.
+    Ids([u32; 8], u32),
+    /// A family's own inputs ([`Inputs::Table`]).
+    Custom(Arc<dyn Any + Send + Sync>),
+}
+
+impl Value {
+    /// An integer input's value as a `u32` (a count, a table ID, a mode's raw value).
+    pub fn uint(&self) -> Option<u32> {
+        match self {
+            Value::Int(v) => Some(*v as u32),
+            _ => None,
+        }
+    }
+
+    /// A number input's value.
+    pub fn real(&self) -> Option<f64> {
+        match self {
+            Value::Real(v) => Some(*v),
+            _ => None,
+        }
+    }
+
+    /// The family's own inputs, if they are a `T`.
+    pub fn custom<T: Any + Send + Sync>(&self) -> Option<Arc<T>> {
+        match self {
+            Value::Custom(c) => Arc::clone(c).downcast().ok(),
+            _ => None,
+        }
+    }
+}
+
+/// A block instance a timeline calls.
+pub trait TimelineBlock: core::fmt::Debug {
+    /// Sets input `key` of the block's spec (or [`WHOLE`]) to `value`, of the key's kind.
+    fn set(&mut self, key: &str, value: &Value);
+    /// Execute, if the block has it.
+    fn execute(&mut self) -> Option<&mut bool>;
+    /// One PLC cycle for `axis` (0 for a group's block): the outputs to record (InSync
+    /// where the report shows it) and Status.
+    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool);
+    /// What a read block read, as it stands, for the report.
+    fn read(&self) -> Option<Vec<f64>> {
+        None
+    }
+}
+
+/// A number, integer or float.
+pub fn number(value: &toml::Value) -> Option<f64> {
+    match value {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+fn blocks() -> impl Iterator<Item = &'static BlockSpec> {
+    FAMILIES.iter().flat_map(|family| family.iter())
+}
+
+/// The block called `name` (ASCII case ignored).
+pub fn find(name: &str) -> Result<&'static BlockSpec, String> {
+    blocks()
+        .find(|b| b.name.eq_ignore_ascii_case(name))
+        .ok_or_else(|| {
+            let known: Vec<&str> = blocks().map(|b| b.name).collect();
+            format!("call: unknown block {name:?} (known: {})", known.join(", "))
+        })
+}
+
+impl Kind {
+    /// `value` checked for input `key` of `block`.
+    pub(super) fn check(
+        &self,
+        block: &str,
+        key: &str,
+        value: &toml::Value,
+    ) -> Result<Value, String> {
+        let bad = || format!("call: {block} input `{key}` = {value} is not valid");
+        let range = |lo: i64, hi: i64| {
+            value
+                .as_integer()
+                .filter(|v| (lo..=hi).contains(v))
+                .map(Value::Int)
+                .ok_or_else(|| format!("call: `{key}` = {value}: {lo}..={hi}"))
+        };
+        match self {
+            Kind::Bool => value.as_bool().map(Value::Bool).ok_or_else(bad),
+            Kind::Real => number(value)
+                .filter(|v| v.is_finite())
+                .map(Value::Real)
+                .ok_or_else(bad),
+            Kind::Count => value
+                .as_integer()
+                .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                .map(Value::Int)
+                .ok_or_else(bad),
+            Kind::Range(lo, hi) => range(*lo, *hi),
+            Kind::Room => range(1, 1 << 20),
+            Kind::OneOf(choices) => {
+                let text = value.to_string();
+                let found = choices
+                    .iter()
+                    .find(|(c, _)| c.split(' ').next() == Some(&text));
+                found.map(|(_, v)| Value::Int(*v)).ok_or_else(|| {
+                    let texts: Vec<&str> = choices.iter().map(|(c, _)| *c).collect();
+                    format!("call: `{key}` = {value}: {}", texts.join(" or "))
+                })
+            }
+            Kind::Mode(m) => match value {
+                toml::Value::String(name) => (m.from_name)(name)
+                    .map(|v| Value::Int(v.into()))
+                    .ok_or_else(|| format!("call: `{key}` = {name:?}: known are {}", (m.names)())),
+                toml::Value::Integer(i) if u32::try_from(*i).is_ok_and(m.valid) => {
+                    Ok(Value::Int(*i))
+                }
+                _ => Err(format!(
+                    "call: `{key}` = {value}: known are {}",
+                    (m.names)()
+                )),
+            },
+            Kind::Parsed { parse, .. } => parse(value),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
