@@ -387,13 +387,7 @@ impl TimelineBlock for McCamIn {
 
 impl TimelineBlock for McCamOut {
     fn set(&mut self, _: &str, _: &Value) {}
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        recorded(self.out)
-    }
+    execute_cycle!(with_axis, recorded);
 }
 
 impl TimelineBlock for McCamScaling {
@@ -410,13 +404,7 @@ impl TimelineBlock for McCamScaling {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        recorded(self.out)
-    }
+    execute_cycle!(with_axis, recorded);
 }
 
 impl TimelineBlock for McWriteMotionFunctionPoint {
@@ -436,13 +424,7 @@ impl TimelineBlock for McWriteMotionFunctionPoint {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
 }
 
 impl TimelineBlock for McSetCamOnlineChangeMode {
@@ -456,13 +438,7 @@ impl TimelineBlock for McSetCamOnlineChangeMode {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
 }
 
 const ACTIVATION_MODE: InputSpec = input("activation_mode", mode::<CamActivationMode>());

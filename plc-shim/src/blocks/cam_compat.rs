@@ -333,13 +333,7 @@ impl TimelineBlock for CompatBlock {
             self.config = config;
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        recorded(self.out)
-    }
+    execute_cycle!(with_axis, recorded);
     fn read(&self) -> Option<Vec<f64>> {
         Some(self.read.values.clone())
     }

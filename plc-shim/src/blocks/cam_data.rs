@@ -412,13 +412,7 @@ impl TimelineBlock for McCamTableSelect {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
 }
 
 impl TimelineBlock for McWriteMotionFunction {
@@ -429,13 +423,7 @@ impl TimelineBlock for McWriteMotionFunction {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
 }
 
 /// The cam blocks with table data a timeline calls.

@@ -136,13 +136,7 @@ impl TimelineBlock for CamTableSetWeight {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
 }
 
 impl TimelineBlock for CamTableCoupleAxesMultiTables {
@@ -160,13 +154,7 @@ impl TimelineBlock for CamTableCoupleAxesMultiTables {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        recorded(self.out)
-    }
+    execute_cycle!(with_axis, recorded);
 }
 
 impl TimelineBlock for CamMultiTable {
@@ -178,13 +166,7 @@ impl TimelineBlock for CamMultiTable {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        recorded(self.out)
-    }
+    execute_cycle!(with_axis, recorded);
 }
 
 /// `tables = [1, 2, ...]`: 1 to 8 table IDs.

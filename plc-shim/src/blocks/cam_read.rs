@@ -309,13 +309,7 @@ impl TimelineBlock for McReadMotionFunction {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(no_axis, recorded);
     /// Index, master and slave position of every point read.
     fn read(&self) -> Option<Vec<f64>> {
         let points = self.points.iter();

@@ -3,6 +3,38 @@
 //! timeline calls by name ([`crate::timeline::registry`]); `dyn_cs` has none (its blocks
 //! address a channel).
 
+use crate::kernel::Outputs;
+
+/// The outputs a timeline records for a block: the kernel's without the family's extra, and no
+/// Status.
+pub(crate) fn plain<X: Copy + Default>(out: Outputs<X>) -> (Outputs, bool) {
+    (out.without_extra(), false)
+}
+
+/// `TimelineBlock::execute` and `cycle` of a block with an `execute` input and an `out`
+/// output, called with its axis (`with_axis`) or without (`no_axis`); `$record` turns its
+/// outputs into what the timeline records (`plain`, or a family's own).
+macro_rules! execute_cycle {
+    (with_axis, $record:path) => {
+        fn execute(&mut self) -> Option<&mut bool> {
+            Some(&mut self.execute)
+        }
+        fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+            self.call(io, axis);
+            $record(self.out)
+        }
+    };
+    (no_axis, $record:path) => {
+        fn execute(&mut self) -> Option<&mut bool> {
+            Some(&mut self.execute)
+        }
+        fn cycle(&mut self, io: &mut PlcIo<'_>, _: u32) -> (Outputs, bool) {
+            self.call(io);
+            $record(self.out)
+        }
+    };
+}
+
 pub mod cam;
 pub mod cam_compat;
 pub mod cam_data;

@@ -7,6 +7,7 @@
 //! CommandAborted, Error (with ErrorID), held while Execute stays TRUE, or for one cycle if
 //! Execute already fell.
 
+use super::plain;
 use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
@@ -159,13 +160,7 @@ macro_rules! execute_block {
                     self.$field = *v;
                 })*
             }
-            fn execute(&mut self) -> Option<&mut bool> {
-                Some(&mut self.execute)
-            }
-            fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-                self.call(io, axis);
-                (self.out, false)
-            }
+            execute_cycle!(with_axis, plain);
         }
     };
 }
@@ -333,13 +328,7 @@ impl TimelineBlock for McMoveVelocity {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        (self.out, false)
-    }
+    execute_cycle!(with_axis, plain);
 }
 
 impl TimelineBlock for McStop {
@@ -350,13 +339,7 @@ impl TimelineBlock for McStop {
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        (self.out, false)
-    }
+    execute_cycle!(with_axis, plain);
 }
 
 /// The limits of a move: velocity, acceleration, deceleration, jerk.

@@ -4,6 +4,7 @@
 //! a later arming (by another block) shows as CommandAborted here. A timeline calls both
 //! ([`TIMELINE`]); its report shows the position MC_TouchProbe recorded last.
 
+use super::plain;
 use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
@@ -160,23 +161,6 @@ impl McAbortTrigger {
     }
 }
 
-/// The outputs without the extra (the recorded position).
-fn plain(out: Outputs<f64>) -> (Outputs, bool) {
-    let out = Outputs {
-        done: out.done,
-        busy: out.busy,
-        active: out.active,
-        command_aborted: out.command_aborted,
-        error: out.error,
-        error_id: out.error_id,
-        in_velocity: out.in_velocity,
-        in_sync: out.in_sync,
-        start_sync: out.start_sync,
-        extra: (),
-    };
-    (out, false)
-}
-
 /// MC_TouchProbe in a timeline: the position it recorded last, for the report.
 #[derive(Debug, Default)]
 struct TouchProbeInstance {
@@ -217,13 +201,7 @@ impl TimelineBlock for McAbortTrigger {
             self.probe = *v as u32;
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        plain(self.out)
-    }
+    execute_cycle!(with_axis, plain);
 }
 
 /// Probe 1 or 2 of the axis.

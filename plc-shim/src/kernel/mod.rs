@@ -91,6 +91,22 @@ impl<X: Default> Outputs<X> {
         }
     }
 
+    /// The same outputs without the family's extra.
+    pub fn without_extra(self) -> Outputs {
+        Outputs {
+            done: self.done,
+            busy: self.busy,
+            active: self.active,
+            command_aborted: self.command_aborted,
+            error: self.error,
+            error_id: self.error_id,
+            in_velocity: self.in_velocity,
+            in_sync: self.in_sync,
+            start_sync: self.start_sync,
+            extra: (),
+        }
+    }
+
     /// CommandAborted.
     pub fn aborted() -> Self {
         Outputs {
