@@ -439,35 +439,39 @@ pub fn check_switch(
     start: CamStartMode,
     master_auto: bool,
 ) -> Result<(), CouplingError> {
-    let allowed = !(master_auto && start.master_relative())
-        && matches!(
-            activation,
-            Activation::Instantaneous
-                | Activation::AtMasterCamPos(_)
-                | Activation::AtMasterAxisPos(_)
-                | Activation::NextCycle
-                | Activation::DeleteQueuedData
-        );
-    refuse_unless(allowed, activation, start, master_auto, "switching")
+    let deletion = matches!(activation, Activation::DeleteQueuedData);
+    check_change(activation, start, master_auto, deletion, "switching")
 }
 
-/// Whether `activation` may rescale a coupling (5.1.16.13, "scaling of cam tables"); master
-/// auto-offset contradicts a relative master here too (5.1.16.3).
+/// Whether `activation` may rescale a coupling (5.1.16.13, "scaling of cam tables"): every
+/// timed mode and Off; master auto-offset contradicts a relative master here too (5.1.16.3).
 pub fn check_scaling(
     activation: Activation,
     start: CamStartMode,
     master_auto: bool,
 ) -> Result<(), CouplingError> {
-    let allowed = !(master_auto && start.master_relative())
-        && matches!(
-            activation,
-            Activation::Instantaneous
-                | Activation::AtMasterCamPos(_)
-                | Activation::AtMasterAxisPos(_)
-                | Activation::NextCycle
-                | Activation::Off
-        );
-    refuse_unless(allowed, activation, start, master_auto, "scaling")
+    let off = matches!(activation, Activation::Off);
+    check_change(activation, start, master_auto, off, "scaling")
+}
+
+/// A change of a running coupling (`what`): the timed modes, or the one other mode the change
+/// allows (`other`); master auto-offset only with an absolute master.
+fn check_change(
+    activation: Activation,
+    start: CamStartMode,
+    master_auto: bool,
+    other: bool,
+    what: &'static str,
+) -> Result<(), CouplingError> {
+    let timed = matches!(
+        activation,
+        Activation::Instantaneous
+            | Activation::AtMasterCamPos(_)
+            | Activation::AtMasterAxisPos(_)
+            | Activation::NextCycle
+    );
+    let allowed = !(master_auto && start.master_relative()) && (timed || other);
+    refuse_unless(allowed, activation, start, master_auto, what)
 }
 
 fn refuse_unless(
