@@ -12,8 +12,9 @@ pub(crate) fn plain<X: Copy + Default>(out: Outputs<X>) -> (Outputs, bool) {
 }
 
 /// `TimelineBlock::execute` and `cycle` of a block with an `execute` input and an `out`
-/// output, called with its axis (`with_axis`) or without (`no_axis`); `$record` turns its
-/// outputs into what the timeline records (`plain`, or a family's own).
+/// output, called with its axis (`with_axis`), with it as its `slave` field (`as_slave`) or
+/// without (`no_axis`); `$record` turns its outputs into what the timeline records (`plain`,
+/// or a family's own).
 macro_rules! execute_cycle {
     (with_axis, $record:path) => {
         fn execute(&mut self) -> Option<&mut bool> {
@@ -21,6 +22,16 @@ macro_rules! execute_cycle {
         }
         fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
             self.call(io, axis);
+            $record(self.out)
+        }
+    };
+    (as_slave, $record:path) => {
+        fn execute(&mut self) -> Option<&mut bool> {
+            Some(&mut self.execute)
+        }
+        fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
+            self.slave = axis;
+            self.call(io);
             $record(self.out)
         }
     };

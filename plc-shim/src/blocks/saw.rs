@@ -563,14 +563,7 @@ impl TimelineBlock for McGearInVelo {
             (self.inputs, self.master) = (i.gear, i.master);
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.slave = axis;
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(as_slave, recorded);
 }
 
 impl TimelineBlock for McGearInPos {
@@ -580,26 +573,12 @@ impl TimelineBlock for McGearInPos {
             [self.master_sync_position, self.slave_sync_position] = i.sync_positions;
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.slave = axis;
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(as_slave, recorded);
 }
 
 impl TimelineBlock for McGearOut {
     fn set(&mut self, _: &str, _: &Value) {}
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.slave = axis;
-        self.call(io);
-        recorded(self.out)
-    }
+    execute_cycle!(as_slave, recorded);
 }
 
 /// MC_ReadFlyingSawCharacteristics in a timeline: its values are reported once a read
