@@ -159,10 +159,14 @@ impl InFlight for TransitionSend {
             };
         }
         let result = ch.dyn_cs_result();
-        if result.taken_count_r == self.taken_before {
-            return Polled::Waiting;
+        if result.taken_count_r != self.taken_before {
+            return Polled::Answer(Ok(result.error_id_r));
         }
-        Polled::Answer(Ok(result.error_id_r))
+        // Not taken yet; a state that is no tracking state ends the command at once.
+        match ch.dyn_cs_state() {
+            Ok(_) => Polled::Waiting,
+            Err(_) => Polled::Answer(Err(DynCsBlockError::InvalidState.code())),
+        }
     }
 }
 

@@ -493,3 +493,26 @@ fn a_dyn_cs_transition_nobody_takes_times_out() {
     let out = cnc.run(&mut block, true);
     assert!(out.error && out.error_id == ERROR_NO_ANSWER, "{out:?}");
 }
+
+#[test]
+fn a_dyn_cs_transition_fails_at_once_on_a_state_that_is_no_tracking_state() {
+    let mut cnc = Cnc::new("invalid", "dyncs");
+    let mut b = McDynCsTransition::default();
+    let mut block: Cycle = Box::new(move |io: &mut PlcIo<'_>, execute| {
+        b.execute = execute;
+        b.call(io, 0);
+        seen(b.out)
+    });
+    assert!(
+        cnc.run(&mut block, true).busy,
+        "written, waiting for the CNC"
+    );
+    let state =
+        hli::access::Leaf::resolve("gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state");
+    state
+        .unwrap()
+        .write(&cnc.memory, hli::access::Value::Unsigned(99));
+    let out = cnc.run(&mut block, true);
+    let invalid = crate::blocks::dyn_cs::DynCsBlockError::InvalidState.code();
+    assert!(out.error && out.error_id == invalid, "{out:?}");
+}
