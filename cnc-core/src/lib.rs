@@ -3,12 +3,10 @@
 //! The library: `machine` (one tick for channels, axes and engines), `channel` (NC channels
 //! and the dynamic CS), `axis` (the axis layer and the process image), `cam` (cam profiles), `fifo` (FIFO groups: rows, override, set-points),
 //! `nc` (the NC language), `setpoint` (the set-point every one of them speaks). It knows no
-//! PLC program and no process.
-//!
-//! The application: `app` (scenarios and `cnc run`, the demo, the command-line tools), which
-//! may use the PLC crate; the `cnc` binary sits on top of it.
+//! PLC program and no process: the application (scenarios, `cnc run`, the demo, the
+//! command-line tools and the `cnc` binary) is the package `cnc-app` in `cnc-core/app/`, and
+//! Cargo keeps the PLC crate out of this one.
 
-pub mod app;
 pub mod axis;
 pub mod cam;
 pub mod channel;

@@ -311,7 +311,7 @@ fn an_arc_program_ticks_without_allocating() {
 
 #[test]
 fn the_arc_modes_are_named_in_the_block_stream() {
-    let (diags, decoded) = cnc_core::app::check_cli::check_source(
+    let (diags, decoded) = cnc_core::nc::check::check_source(
         "G0 X1 Y0\nG2 X0 Y-1 R1 F100\n",
         &["X".to_string(), "Y".to_string(), "Z".to_string()],
     );

@@ -3,7 +3,7 @@
 //! exactly the diagnostics in `NNNN_name.expected`. `UPDATE_GOLDEN=1` rewrites the expectations
 //! (review the diff before committing).
 
-use cnc_core::app::check_cli::{check_source, motion_json};
+use cnc_core::nc::check::{check_source, motion_json};
 use cnc_core::nc::{parse, print, Decoded};
 use std::path::{Path, PathBuf};
 

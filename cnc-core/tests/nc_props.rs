@@ -6,8 +6,8 @@
 //! proptest strategies. `PROPTEST_CASES=100000 cargo test -p cnc-core --test nc_props` runs a
 //! longer campaign.
 
-use cnc_core::app::check_cli::check_source;
 use cnc_core::nc::ast::*;
+use cnc_core::nc::check::check_source;
 use cnc_core::nc::{parse, parse_general, print};
 use proptest::prelude::*;
 

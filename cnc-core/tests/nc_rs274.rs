@@ -8,7 +8,7 @@
 //! radius form are computed (irrational in general) and compared to rs274's printing precision,
 //! 5e-5 mm.
 
-use cnc_core::app::check_cli::check_source;
+use cnc_core::nc::check::check_source;
 use cnc_core::nc::Decoded;
 use proptest::prelude::*;
 use std::process::Command;

@@ -8,7 +8,7 @@
 
 mod support;
 
-use cnc_core::app::check_cli::check_source;
+use cnc_core::nc::check::check_source;
 use cnc_core::nc::decode::TrackSource;
 use cnc_core::nc::{parse, Decoded};
 

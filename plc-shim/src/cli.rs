@@ -1,5 +1,5 @@
 //! Command line of the PLC process, shared by the `plc` binary and `cnc plc` (which the
-//! demo spawns, so that the single `cargo run -p cnc-core` builds everything it needs).
+//! demo spawns, so that the single `cargo run -p cnc-app` builds everything it needs).
 
 use crate::programs::turntable::{Turntable, Variant};
 use crate::programs::RotaryTableMaster;

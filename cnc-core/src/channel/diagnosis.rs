@@ -188,7 +188,7 @@ pub fn event_lines(tick: u64, event: &TrackEvent) -> Vec<(u64, u32, String)> {
 
 /// The first line of an event's message, for reports; `None` for the lines that only carry
 /// values or the channel's restart.
-pub(crate) fn log_message(tick: u64, event: &TrackEvent) -> Option<String> {
+pub fn log_message(tick: u64, event: &TrackEvent) -> Option<String> {
     match event {
         TrackEvent::Restart { .. } | TrackEvent::OnValues { .. } => None,
         _ => event_lines(tick, event)

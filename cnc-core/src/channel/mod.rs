@@ -7,7 +7,7 @@ pub mod axes_out;
 pub mod config;
 pub mod controller;
 pub mod diag_wire;
-pub(crate) mod diagnosis;
+pub mod diagnosis;
 pub mod dyn_cs;
 pub mod guard;
 pub mod kin_config;

@@ -18,6 +18,7 @@
 //! are sized when the engine is built.
 
 use super::engine::{Call, Engine, EngineIo};
+use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
@@ -445,6 +446,17 @@ impl Group {
 pub struct FifoEngine {
     groups: Vec<Group>,
     tick_s: f64,
+}
+
+/// The FIFO groups of a machine, if it has any ([`super::engines::STANDARD`]).
+pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
+    if setup.fifo_groups.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(Box::new(FifoEngine::new(
+        setup.fifo_groups,
+        setup.cycle_s,
+    )?)))
 }
 
 impl FifoEngine {

@@ -5,6 +5,7 @@
 //! causes no jump.
 
 use super::engine::{Engine, EngineIo};
+use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use hli::enums::{AxisState, CouplingState};
 
@@ -48,6 +49,14 @@ pub enum GearError {
     /// Ratio zero or not finite.
     #[error("gear: ratio {0} must be finite and not 0")]
     Ratio(f64),
+}
+
+/// The gears of a machine, if it has any ([`super::engines::STANDARD`]).
+pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
+    if setup.gears.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(Box::new(GearEngine::new(setup.gears, setup.axes())?)))
 }
 
 impl GearEngine {

@@ -23,6 +23,7 @@
 pub mod cams;
 mod channel_axes;
 pub mod engine;
+pub mod engines;
 pub mod fifo;
 pub mod gear;
 pub mod saw;

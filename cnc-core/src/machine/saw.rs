@@ -8,6 +8,7 @@
 //! again, the slave synchronises anew from where it stands.
 
 use super::engine::{Call, Engine, EngineIo, Resource};
+use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
@@ -47,6 +48,14 @@ fn refused(e: SawError) -> HandlerResult {
 
 fn accepted() -> HandlerResult {
     reply(&SawReply::default())
+}
+
+/// The flying saw of a machine with single axes ([`super::engines::STANDARD`]).
+pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
+    if setup.single_axes == 0 {
+        return Ok(None);
+    }
+    Ok(Some(Box::new(SawEngine::new(setup.axes(), setup.cycle_s))))
 }
 
 impl SawEngine {

@@ -3,11 +3,13 @@
 
 pub mod arc;
 pub mod ast;
+pub mod check;
 pub mod control;
 pub mod decode;
 pub mod eval;
 mod fast_lane;
 pub mod interp;
+pub mod json;
 pub mod lexer;
 pub mod parser;
 pub mod printer;

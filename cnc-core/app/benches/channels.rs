@@ -1,0 +1,188 @@
+//! Tick cost of the CNC with 1, 4 and 12 six-axis robots (kinematic 45), tracking active on
+//! every channel (robot 1 follows the PLC's dynamic CS, the others follow robot 1), each
+//! running an endless loop of moves: interpreter, interpolation, inverse and forward
+//! transformation, dynamic CS, HLI outputs and axis images.
+//!
+//! Reported: median over interleaved repeats of the time per tick and per channel-tick, and the ratio of
+//! the per-channel-tick cost to the 1-channel run of the same process (linearity). Baseline in
+//! the same run: the same channels ticking without any program and without tracking (the
+//! fixed cost of outputs and bookkeeping), so the ratio says what the motion work adds.
+//! Target: <= 5 us per channel-tick, linear in channels.
+//!
+//! Also in the same run: the whole machine tick with the robots' axes on simulated PT2 drives,
+//! and the path before the machine tick (channels plus set-points written straight into the
+//! axis images, no axis layer) as the baseline the machine tick is compared with.
+//! Axis images hold 32 axes: the first five robots' axes are on the axis layer, the others
+//! have none (as before).
+//!
+//! Last, the scenarios of examples 3 and 4 (both part of the demo's machine) in-process and
+//! hot (no sleep between ticks): the p50 of the machine tick over the whole run, timed per
+//! tick as `cnc run` times it, so the `machine` p50 that `cnc run` reports for them (after a
+//! 1 ms sleep each tick) compares with it like for like.
+//! Run: `cargo bench -p cnc-app --bench channels`.
+
+use cnc_app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
+use cnc_app::scenario::{InProcess, Scenario};
+use cnc_core::channel::axes_out::AxisPublisher;
+use cnc_core::channel::{Channel, Controller};
+use hli::views::CncView;
+use hli::views::PlcView;
+use std::time::Instant;
+
+const TICKS: usize = 5_000;
+const REPEATS: usize = 9;
+const WARM_UP: usize = 3_000;
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// One sample: ns per tick over TICKS ticks.
+fn sample(tick: &mut dyn FnMut()) -> f64 {
+    let t0 = Instant::now();
+    for _ in 0..TICKS {
+        tick();
+    }
+    t0.elapsed().as_nanos() as f64 / TICKS as f64
+}
+
+/// Median ns per tick of each contender, the repeats interleaved (contender 1, 2, .., 1, 2,
+/// ..) so a slow phase of the machine hits all of them alike.
+fn interleaved(contenders: &mut [Box<dyn FnMut() + '_>]) -> Vec<f64> {
+    let mut samples = vec![Vec::with_capacity(REPEATS); contenders.len()];
+    for _ in 0..REPEATS {
+        for (c, tick) in contenders.iter_mut().enumerate() {
+            samples[c].push(sample(tick.as_mut()));
+        }
+    }
+    samples.into_iter().map(median).collect()
+}
+
+fn tracking(n: usize) -> Box<dyn FnMut()> {
+    let mut run = running(n, WARM_UP).expect("fleet running");
+    Box::new(move || run.machine.tick(&run.memory))
+}
+
+fn tracking_pt2(n: usize) -> Box<dyn FnMut()> {
+    let drive = "{ model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }";
+    let mut run = running_on(n, Some(drive), WARM_UP).expect("fleet running on PT2 drives");
+    Box::new(move || run.machine.tick(&run.memory))
+}
+
+/// The path before the machine tick: channels, then each channel's set-points written into
+/// its axis images (while they last), the CNC heartbeat not counted.
+fn before_machine(n: usize) -> Box<dyn FnMut()> {
+    let s = tracking_robots(n).expect("fleet scenario");
+    let mut channels: Vec<Channel> = Vec::new();
+    for (i, (c, p)) in s.channels.iter().zip(&s.programs).enumerate() {
+        let mut ch = Channel::new(i, c.clone(), s.cycle_s).expect("channel");
+        ch.start(p.clone().expect("a program"))
+            .expect("a fresh channel starts");
+        channels.push(ch);
+    }
+    let mut publishers: Vec<Option<AxisPublisher>> = Vec::new();
+    let mut first = 0;
+    for c in &channels {
+        let fits = first + 6 <= 32;
+        publishers.push(fits.then(|| AxisPublisher::new(first, c.set_points(), s.cycle_s)));
+        if fits {
+            first += 6;
+        }
+    }
+    let mut controller = Controller::new(channels).expect("controller");
+    let memory = hli::segment::heap_image(n as u32, 32);
+    plc_setup(&PlcView::new(&memory));
+    let mut tick = move || {
+        let view = CncView::new(&memory);
+        controller.tick(&view);
+        for (c, p) in controller.channels().iter().zip(publishers.iter_mut()) {
+            if let Some(p) = p {
+                p.publish(&view, c.set_points());
+            }
+        }
+    };
+    for _ in 0..WARM_UP {
+        tick();
+    }
+    Box::new(tick)
+}
+
+fn idle(n: usize) -> Box<dyn FnMut()> {
+    let s = tracking_robots(n).expect("fleet scenario");
+    let channels = s
+        .channels
+        .iter()
+        .enumerate()
+        .map(|(i, c)| Channel::new(i, c.clone(), s.cycle_s).expect("channel"))
+        .collect();
+    let mut controller = Controller::new(channels).expect("controller");
+    let memory = hli::segment::heap_image(n as u32, 32);
+    Box::new(move || controller.tick(&CncView::new(&memory)))
+}
+
+fn main() {
+    // `-- profile N`: only the machine tick of N robots, for a profiler.
+    let args: Vec<String> = std::env::args().collect();
+    if let Some(at) = args.iter().position(|a| a == "profile") {
+        let n = args.get(at + 1).and_then(|a| a.parse().ok()).unwrap_or(1);
+        let mut tick = tracking(n);
+        for _ in 0..200_000 / n {
+            tick();
+        }
+        return;
+    }
+    println!("channels | tracking: ns/tick | ns/channel-tick | vs 1 channel | idle baseline ns/channel-tick | tracking / idle | PT2 drives ns/channel-tick | before machine ns/channel-tick | machine / before");
+    let mut one = None;
+    for n in [1usize, 4, 12] {
+        let mut contenders = [tracking(n), idle(n), tracking_pt2(n), before_machine(n)];
+        let [t, b, d, old] = interleaved(&mut contenders)[..] else {
+            unreachable!("four contenders")
+        };
+        let per = t / n as f64;
+        let base = *one.get_or_insert(per);
+        println!(
+            "{n:>8} | {t:>17.0} | {per:>15.0} | {:>12.2} | {:>29.0} | {:>15.1} | {:>26.0} | {:>31.0} | {:>16.2}",
+            per / base,
+            b / n as f64,
+            t / b,
+            d / n as f64,
+            old / n as f64,
+            t / old
+        );
+    }
+    println!("(medians of {REPEATS} interleaved runs of {TICKS} ticks each; target <= 5000 ns per channel-tick)");
+    println!();
+    println!("example scenario (part of the demo machine), hot in-process | ticks | machine tick p50 ns | p99 ns");
+    for name in ["example3-moving-workpiece", "example4-turntable-plc"] {
+        let (ticks, p50, p99) = demo_hot(name);
+        println!("{name:>29} | {ticks:>5} | {p50:>19} | {p99:>6}");
+    }
+    println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs)");
+}
+
+/// One example scenario in-process, every tick timed: (ticks, p50 ns, p99 ns) of the
+/// last of REPEATS runs (the earlier ones warm the caches and the allocator up).
+fn demo_hot(name: &str) -> (usize, u64, u64) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenarios")
+        .join(name)
+        .join("scenario.toml");
+    let scenario = Scenario::load(&path).expect("example scenario");
+    let mut times = Vec::with_capacity(20_000);
+    for _ in 0..REPEATS {
+        times.clear();
+        let mut run = InProcess::new(&scenario, 0).expect("in-process run");
+        while times.len() < 100_000 && (times.len() < 10 || !run.machine.idle()) {
+            let t0 = Instant::now();
+            run.machine.tick(&run.memory);
+            times.push(t0.elapsed().as_nanos() as u64);
+            if let Some(t) = run.timeline.as_mut() {
+                t.cycle(&run.memory);
+            }
+        }
+    }
+    times.sort_unstable();
+    let at = |q: f64| times[((times.len() - 1) as f64 * q) as usize];
+    (times.len(), at(0.5), at(0.99))
+}

@@ -1,0 +1,105 @@
+//! The `cnc` binary.
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Debug, Parser)]
+#[command(name = "cnc", about = "CNC process of the CNC/PLC runtime", version)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the demo: one machine with every engine (four robots, a cam station, a flying saw)
+    /// in real time with a PLC process; report, trace and plots.
+    Demo(cnc_app::demo::DemoArgs),
+    /// Run a scenario: machine configuration, NC programs, PLC timeline, trace.
+    Run(cnc_app::scenario::runner::RunArgs),
+    /// HLI tooling.
+    Hli {
+        #[command(subcommand)]
+        what: HliCommand,
+    },
+    /// Check NC programs: parse, decode, report FILE:LINE:COL diagnostics.
+    Check(cnc_app::check_cli::CheckArgs),
+    /// Cam profiles: evaluate, characteristic values, plot.
+    Cam {
+        #[command(subcommand)]
+        what: cnc_app::cam_cli::CamCommand,
+    },
+    /// FIFO groups: run a position file through a group and trace the set-points.
+    Fifo {
+        #[command(subcommand)]
+        what: cnc_app::fifo_cli::FifoCommand,
+    },
+    /// Flying saw: plan a synchronisation, its characteristic values, a trace.
+    Saw {
+        #[command(subcommand)]
+        what: cnc_app::saw_cli::SawCommand,
+    },
+    /// Diagnosis of a running or finished CNC.
+    Diag {
+        #[command(subcommand)]
+        what: cnc_app::diag_cli::DiagCommand,
+    },
+    /// Plot signals of a trace CSV as SVG (one panel per unit, with legends).
+    Plot(cnc_app::plot::PlotArgs),
+    /// Kinematics: forward and inverse transformation.
+    Kin {
+        #[command(subcommand)]
+        what: cnc_app::kin_cli::KinCommand,
+    },
+    /// The PLC process (what `cnc demo` spawns) and the image tools `get`, `set`, `watch`;
+    /// the same as the `plc` binary.
+    #[command(args_conflicts_with_subcommands = true)]
+    Plc(plc_shim::cli::PlcCli),
+}
+
+#[derive(Debug, Subcommand)]
+enum HliCommand {
+    /// Print the symbol table: PATH OFFSET SIZE TYPE WRITER, one line per node and leaf.
+    Symbols,
+    /// Print a C header of the whole image (sizes and offsets asserted).
+    Header,
+}
+
+fn main() -> ExitCode {
+    hli::init_logging();
+    match Cli::parse().command {
+        Command::Demo(args) => cnc_app::demo::main(args),
+        Command::Run(args) => cnc_app::scenario::runner::main(args),
+        Command::Hli { what } => {
+            let text = match what {
+                HliCommand::Symbols => {
+                    hli::symbols::format_table(hli::symbols::SymbolTable::global())
+                }
+                HliCommand::Header => hli::c_header::generate(),
+            };
+            print_or_fail(&text)
+        }
+        Command::Check(args) => cnc_app::check_cli::main(args),
+        Command::Plot(args) => cnc_app::plot::main(args),
+        Command::Diag { what } => cnc_app::diag_cli::main(what),
+        Command::Kin { what } => cnc_app::kin_cli::main(what),
+        Command::Cam { what } => cnc_app::cam_cli::main(what),
+        Command::Fifo { what } => cnc_app::fifo_cli::main(what),
+        Command::Saw { what } => cnc_app::saw_cli::main(what),
+        Command::Plc(args) => plc_shim::cli::main(args),
+    }
+}
+
+/// Prints `text`; a closed pipe (`cnc hli symbols | head`) is not an error worth a panic.
+fn print_or_fail(text: &str) -> ExitCode {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("cnc: {e}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,485 @@
+//! The scenario file: a machine configuration (cycle time, channels under the controller's
+//! parameter names) plus what to run on it (NC programs, a PLC timeline or built-in program)
+//! and what to trace.
+//!
+//! ```toml
+//! cycle_ms = 1.0
+//! ticks = 12000                   # default run length (`--ticks` overrides)
+//! [[channel]]
+//! name = "master"
+//! axes = ["X", "Y", "Z", "A", "B", "C"]
+//! kinematics = { id = 45, preset = "kr6r900sixx" }
+//! program = "master.nc"           # relative to this file
+//! [[cam_table]]
+//! file = "../cams/seed_example.json"  # a JSON cam file (docs/cams.md); its `id`, or:
+//! id = 1
+//! [[fifo_group]]                  # gpFifo[0]^: N axes, Z rows, T_f (docs/fifo.md)
+//! dimension = 3
+//! rows = 500
+//! fifo_cycle_ms = 2.0
+//! override = "pt2"                # or "instant" (default)
+//! pt2_t0_ms = 40.0
+//! [plc]
+//! timeline = "plc.toml"           # or: program = "rotary-table"; program = "fifo-stream"
+//!                                 # with file = "contour.csv" (and fifo_override = 80.0)
+//! [trace]
+//! signals = ["gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state"]
+//! ```
+
+use cnc_core::channel::{ChannelConfig, LoadedProgram};
+use hli::access::Leaf;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// Why a scenario cannot run.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// A file could not be read.
+    #[error("{file}: {message}")]
+    Read {
+        /// The file.
+        file: String,
+        /// The OS error.
+        message: String,
+    },
+    /// The TOML did not parse, has unknown fields or values out of range.
+    #[error("{file}: {message}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong (with line and column where the parser knows them).
+        message: String,
+    },
+    /// An NC program was refused (its diagnostics, FILE:LINE:COL each).
+    #[error("{0}")]
+    Program(#[from] cnc_core::channel::ProgramError),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioFile {
+    #[serde(default = "default_cycle_ms")]
+    cycle_ms: f64,
+    ticks: Option<u64>,
+    plc_watchdog_ticks: Option<u64>,
+    #[serde(default)]
+    channel: Vec<ChannelConfig>,
+    #[serde(default)]
+    axis: Vec<super::axes::AxisFile>,
+    #[serde(default)]
+    gear: Vec<super::axes::GearFile>,
+    #[serde(default)]
+    cam_table: Vec<CamTableFile>,
+    #[serde(default)]
+    fifo_group: Vec<super::axes::FifoGroupFile>,
+    plc: Option<PlcFile>,
+    #[serde(default)]
+    trace: TraceFile,
+    #[serde(default)]
+    realtime: plc_shim::realtime::RealtimeOptions,
+    #[serde(default)]
+    realtime_plc: plc_shim::realtime::RealtimeOptions,
+}
+
+fn default_cycle_ms() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CamTableFile {
+    file: String,
+    id: Option<u32>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlcFile {
+    timeline: Option<String>,
+    program: Option<String>,
+    /// A built-in program's data file (fifo-stream's positions), relative to the scenario.
+    file: Option<String>,
+    /// fifo-stream's override before the start, percent.
+    fifo_override: Option<f64>,
+    /// Cuts of saw-cut and demo-machine's saw.
+    saw_cuts: Option<usize>,
+    /// Piece length of the saw, mm.
+    saw_length: Option<f64>,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TraceFile {
+    #[serde(default)]
+    signals: Vec<String>,
+}
+
+/// What runs in the PLC process.
+#[derive(Debug, Clone)]
+pub enum PlcSetup {
+    /// No PLC.
+    None,
+    /// A timeline: its path (as given, resolved), its text (for the PLC process) and the
+    /// parsed, checked timeline (for in-process runs).
+    Timeline {
+        /// Where it came from.
+        path: PathBuf,
+        /// The TOML text.
+        text: String,
+        /// The parsed timeline.
+        timeline: Box<plc_shim::timeline::Timeline>,
+    },
+    /// A built-in program of `plc-shim` by name, with its arguments (`--file PATH`...).
+    Program(String, Vec<String>),
+}
+
+/// A checked scenario, every file read.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// Where the scenario came from (for messages).
+    pub name: String,
+    /// Tick period, seconds.
+    pub cycle_s: f64,
+    /// Default run length.
+    pub ticks: Option<u64>,
+    /// Ticks without a PLC cycle before the PLC counts as lost.
+    pub plc_watchdog_ticks: Option<u64>,
+    /// The channels.
+    pub channels: Vec<ChannelConfig>,
+    /// Their programs, checked (None: the channel stays idle).
+    pub programs: Vec<Option<LoadedProgram>>,
+    /// Single axes, behind the channel axes.
+    pub axes: Vec<super::axes::ScenarioAxis>,
+    /// Gear couplings between axes (indices in the machine's axis set).
+    pub gears: Vec<cnc_core::machine::gear::GearSpec>,
+    /// Cam tables by ID, loaded into the cam engine at start.
+    pub cam_tables: Vec<(u32, cnc_core::cam::CamProfile)>,
+    /// FIFO groups, `gpFifo[0..]` (the FIFO engine exists when there is one).
+    pub fifo_groups: Vec<cnc_core::fifo::FifoParams>,
+    /// The PLC.
+    pub plc: PlcSetup,
+    /// Trace signals: ST path and resolved leaf.
+    pub signals: Vec<(String, Leaf)>,
+    /// Real-time options of the CNC's tick loop (`[realtime]`).
+    pub realtime: plc_shim::realtime::RealtimeOptions,
+    /// Real-time options of the spawned PLC (`[realtime_plc]`).
+    pub realtime_plc: plc_shim::realtime::RealtimeOptions,
+}
+
+impl Scenario {
+    /// Loads `path` and the files it names.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let read = |p: &Path| {
+            std::fs::read_to_string(p).map_err(|e| ScenarioError::Read {
+                file: p.display().to_string(),
+                message: e.to_string(),
+            })
+        };
+        let text = read(path)?;
+        Scenario::parse(&path.display().to_string(), &text, |relative| {
+            let p = dir.join(relative);
+            read(&p).map(|text| (p, text))
+        })
+    }
+
+    /// Parses scenario `text`; `open` reads a file named in it (relative path) and returns
+    /// its resolved path and text. The demo passes files embedded in the binary this way.
+    pub fn parse(
+        name: &str,
+        text: &str,
+        open: impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+    ) -> Result<Scenario, ScenarioError> {
+        let invalid = invalid_in(name);
+        let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        file.check_shape().map_err(&invalid)?;
+        let programs = load_programs(&file.channel, &open)?;
+        let plc = plc_setup(name, file.plc, &open)?;
+        if file.channel.is_empty() && file.ticks.is_none() {
+            return Err(invalid(
+                "a scenario without channels needs `ticks` (no program says when it ends)".into(),
+            ));
+        }
+        let channel_axes = super::axes::axis_names(&file.channel, &[]).len();
+        let axes = super::axes::axes(&file.axis, channel_axes as u32 + 1).map_err(&invalid)?;
+        if channel_axes + axes.len() > hli::layout::HLI_MAX_AXES {
+            return Err(invalid(format!(
+                "{channel_axes} channel axes and {} [[axis]]: the image holds {}",
+                axes.len(),
+                hli::layout::HLI_MAX_AXES
+            )));
+        }
+        let names = super::axes::axis_names(&file.channel, &axes);
+        let gears = super::axes::gears(&file.gear, &names, channel_axes).map_err(&invalid)?;
+        cnc_core::machine::gear::GearEngine::new(&gears, names.len())
+            .map_err(|e| invalid(e.to_string()))?;
+        check_block_axes(&plc, channel_axes, &names).map_err(&invalid)?;
+        let cam_tables = cam_tables(name, &file.cam_table, &open)?;
+        let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
+        let signals = trace_signals(file.trace.signals).map_err(&invalid)?;
+        Ok(Scenario {
+            name: name.to_string(),
+            cycle_s: file.cycle_ms * 1e-3,
+            ticks: file.ticks,
+            plc_watchdog_ticks: file.plc_watchdog_ticks,
+            channels: file.channel,
+            programs,
+            axes,
+            gears,
+            cam_tables,
+            fifo_groups,
+            plc,
+            signals,
+            realtime: file.realtime,
+            realtime_plc: file.realtime_plc,
+        })
+    }
+}
+
+/// The refusal of scenario `name` with a message.
+fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
+    move |message: String| ScenarioError::Invalid {
+        file: name.to_string(),
+        message,
+    }
+}
+
+impl ScenarioFile {
+    /// The cycle time and the number of channels (and that there is a machine at all).
+    fn check_shape(&self) -> Result<(), String> {
+        if !(self.cycle_ms.is_finite() && (0.05..=100.0).contains(&self.cycle_ms)) {
+            return Err(format!(
+                "cycle_ms = {}: must lie in 0.05..=100",
+                self.cycle_ms
+            ));
+        }
+        let no_machine = self.channel.is_empty() && self.axis.is_empty();
+        if no_machine || self.channel.len() > cnc_core::channel::MAX_CHANNELS {
+            return Err(format!(
+                "{} channels: a scenario has 0 to {} (and at least one [[channel]] or [[axis]])",
+                self.channel.len(),
+                cnc_core::channel::MAX_CHANNELS
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Each channel's program, read through `open` and checked (None: the channel has none).
+fn load_programs(
+    channels: &[ChannelConfig],
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<Vec<Option<LoadedProgram>>, ScenarioError> {
+    let mut programs = Vec::with_capacity(channels.len());
+    for c in channels {
+        programs.push(match &c.program {
+            Some(p) => {
+                let (path, src) = open(p)?;
+                let search = cnc_core::nc::interp::SearchPath(
+                    c.nc.search_path
+                        .iter()
+                        .map(|d| path.parent().unwrap_or(Path::new(".")).join(d))
+                        .collect(),
+                );
+                Some(LoadedProgram::load_with(
+                    &path.display().to_string(),
+                    &src,
+                    &c.axes,
+                    &c.nc.setup(),
+                    path.parent().map(std::path::Path::to_path_buf),
+                    &search,
+                )?)
+            }
+            None => None,
+        });
+    }
+    Ok(programs)
+}
+
+/// The PLC of scenario `name`: none, a timeline (read through `open` and checked), or a
+/// built-in program with its arguments.
+fn plc_setup(
+    name: &str,
+    plc: Option<PlcFile>,
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<PlcSetup, ScenarioError> {
+    let invalid = invalid_in(name);
+    Ok(match plc {
+        None => PlcSetup::None,
+        Some(PlcFile {
+            timeline: Some(t),
+            program: None,
+            file: None,
+            fifo_override: None,
+            saw_cuts: None,
+            saw_length: None,
+        }) => {
+            let (path, text) = open(&t)?;
+            // Checked here, so a bad timeline fails before any process starts.
+            let timeline = plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
+                .map_err(|e| invalid(e.to_string()))?;
+            PlcSetup::Timeline {
+                path,
+                text,
+                timeline: Box::new(timeline),
+            }
+        }
+        Some(PlcFile {
+            timeline: None,
+            program: Some(p),
+            file,
+            fifo_override,
+            saw_cuts,
+            saw_length,
+        }) => {
+            let args = program_args(name, &p, file, fifo_override, (saw_cuts, saw_length))
+                .map_err(invalid)?;
+            PlcSetup::Program(p, args)
+        }
+        Some(PlcFile {
+            timeline: Some(_),
+            program: None,
+            ..
+        }) => {
+            return Err(invalid(
+                "[plc] `file`, `fifo_override`, `saw_cuts` and `saw_length` belong to a built-in program".into(),
+            ))
+        }
+        Some(_) => {
+            return Err(invalid(
+                "[plc] takes exactly one of `timeline` and `program`".into(),
+            ))
+        }
+    })
+}
+
+/// The command-line arguments of built-in program `p` of scenario `name`: its data file
+/// (resolved beside the scenario), the FIFO override, the saw's cuts and piece length.
+fn program_args(
+    name: &str,
+    p: &str,
+    file: Option<String>,
+    fifo_override: Option<f64>,
+    (saw_cuts, saw_length): (Option<usize>, Option<f64>),
+) -> Result<Vec<String>, String> {
+    if !plc_shim::cli::BUILT_IN_PROGRAMS.contains(&p) {
+        return Err(format!(
+            "[plc] program {p:?}: known are {:?}",
+            plc_shim::cli::BUILT_IN_PROGRAMS
+        ));
+    }
+    let mut args = Vec::new();
+    if let Some(f) = file {
+        // Resolved beside the scenario and checked (header or first row) now.
+        let path = Path::new(name).parent().unwrap_or(Path::new(".")).join(&f);
+        plc_shim::fifo_file::RowReader::open(&path).map_err(|e| format!("[plc] file: {e}"))?;
+        let path = std::fs::canonicalize(&path).unwrap_or(path);
+        args.extend(["--file".to_string(), path.display().to_string()]);
+    }
+    if let Some(o) = fifo_override {
+        if !(0.0..=100.0).contains(&o) {
+            return Err(format!("[plc] fifo_override = {o}: 0 to 100 percent"));
+        }
+        args.extend(["--fifo-override".to_string(), o.to_string()]);
+    }
+    let has_saw = plc_shim::cli::SAW_PROGRAMS.contains(&p);
+    if !has_saw && (saw_cuts.is_some() || saw_length.is_some()) {
+        return Err(format!(
+            "[plc] saw_cuts and saw_length belong to saw-cut and demo-machine, not {p:?}"
+        ));
+    }
+    if let Some(n) = saw_cuts {
+        let max = plc_shim::programs::saw_cut::MAX_CUTS;
+        if !(1..=max).contains(&n) {
+            return Err(format!("[plc] saw_cuts = {n}: 1 to {max}"));
+        }
+        args.extend(["--saw-cuts".to_string(), n.to_string()]);
+    }
+    if let Some(l) = saw_length {
+        if !(l.is_finite() && l > 0.0) {
+            return Err(format!("[plc] saw_length = {l}: mm above 0"));
+        }
+        args.extend(["--saw-length".to_string(), l.to_string()]);
+    }
+    Ok(args)
+}
+
+/// A timeline's blocks command single axes only, and only axes the machine has.
+fn check_block_axes(plc: &PlcSetup, channel_axes: usize, names: &[String]) -> Result<(), String> {
+    let PlcSetup::Timeline { timeline, path, .. } = plc else {
+        return Ok(());
+    };
+    for (instance, axis) in timeline.block_axes() {
+        if (axis as usize) < channel_axes {
+            return Err(format!(
+                "{}: block {instance:?}: axis {axis} ({}) is a channel axis, commanded by its channel",
+                path.display(),
+                names[axis as usize]
+            ));
+        }
+        if axis as usize >= names.len() {
+            return Err(format!(
+                "{}: block {instance:?}: axis {axis} does not exist (the machine has {} axes: {})",
+                path.display(),
+                names.len(),
+                names.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The cam tables of scenario `name`, each JSON file read through `open`, by ID.
+fn cam_tables(
+    name: &str,
+    files: &[CamTableFile],
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<Vec<(u32, cnc_core::cam::CamProfile)>, ScenarioError> {
+    let invalid = invalid_in(name);
+    let mut cam_tables: Vec<(u32, cnc_core::cam::CamProfile)> = Vec::new();
+    for t in files {
+        let (path, text) = open(&t.file)?;
+        let at = path.display();
+        if !text.trim_start().starts_with('{') {
+            return Err(invalid(format!(
+                "[[cam_table]] {at}: a scenario takes JSON cam files (docs/cams.md)"
+            )));
+        }
+        let cam = cnc_core::cam::file::parse(text.as_bytes(), Default::default())
+            .map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
+        let id =
+            cam_table_id(cam.id, t.id).map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
+        if cam_tables.iter().any(|(other, _)| *other == id) {
+            return Err(invalid(format!(
+                "[[cam_table]] {at}: id {id} is taken by another table"
+            )));
+        }
+        cam_tables.push((id, cam.profile));
+    }
+    Ok(cam_tables)
+}
+
+/// A cam table's ID: the file's or the scenario's (they must agree), in 1..=255.
+fn cam_table_id(in_file: Option<u32>, in_scenario: Option<u32>) -> Result<u32, String> {
+    let id = match (in_file, in_scenario) {
+        (Some(a), Some(b)) if a != b => {
+            return Err(format!("the file has id {a}, the scenario says {b}"))
+        }
+        (Some(id), _) | (None, Some(id)) => id,
+        (None, None) => return Err("no id (give `id = 1..255`)".to_string()),
+    };
+    if !(1..=255).contains(&id) {
+        return Err(format!("id {id} is outside 1..255"));
+    }
+    Ok(id)
+}
+
+/// The trace signals resolved to leaves of the image.
+fn trace_signals(signals: Vec<String>) -> Result<Vec<(String, Leaf)>, String> {
+    let mut out = Vec::with_capacity(signals.len());
+    for s in signals {
+        let leaf = Leaf::resolve(&s).map_err(|e| format!("[trace] {e}"))?;
+        out.push((s, leaf));
+    }
+    Ok(out)
+}

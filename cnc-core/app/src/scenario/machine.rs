@@ -1,0 +1,177 @@
+//! The CNC side of a scenario: its channels on one image, ticking; and the in-process run
+//! that alternates CNC ticks and PLC timeline cycles on a heap image exactly as lockstep mode
+//! alternates the two processes (tests use it; `cnc run --lockstep` gives the same trace).
+//! A timeline that calls function blocks gets the same acyclic service as the PLC process,
+//! opened in this process under a name of its own, and the machine answers it between the
+//! tick and the PLC cycle, as `cnc run` does.
+
+use super::file::{PlcSetup, Scenario, ScenarioError};
+use super::trace::Trace;
+use cnc_core::channel::Channel;
+use cnc_core::machine::engines::{self, EngineSetup};
+pub use cnc_core::machine::Machine;
+use cnc_core::machine::MachineSetup;
+use hli::rpc::{AcyclicClient, AcyclicServer};
+use hli::views::{CncView, PlcView};
+use hli::ImageMemory;
+use plc_shim::runtime::PlcIo;
+use plc_shim::timeline::Timeline;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Builds the machine of a scenario: its channels with their programs started, channel axes
+/// on ideal drives.
+pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
+    let invalid = |message: String| ScenarioError::Invalid {
+        file: scenario.name.clone(),
+        message,
+    };
+    let mut channels = Vec::with_capacity(scenario.channels.len());
+    for (i, (config, program)) in scenario.channels.iter().zip(&scenario.programs).enumerate() {
+        let mut channel = Channel::new(i, config.clone(), scenario.cycle_s)
+            .map_err(|e| invalid(e.to_string()))?;
+        if let Some(p) = program {
+            channel
+                .start(p.clone())
+                .expect("a channel that has not run starts");
+        }
+        channels.push(channel);
+    }
+    let channel_axes = super::axes::axis_names(&scenario.channels, &[]).len();
+    let engines = engines::standard(&EngineSetup {
+        channel_axes,
+        single_axes: scenario.axes.len(),
+        cycle_s: scenario.cycle_s,
+        gears: &scenario.gears,
+        cam_tables: &scenario.cam_tables,
+        fifo_groups: &scenario.fifo_groups,
+    })
+    .map_err(|e| invalid(e.to_string()))?;
+    let mut machine = Machine::new(MachineSetup {
+        channels,
+        axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),
+        engines,
+        cycle_s: scenario.cycle_s,
+    })
+    .map_err(|e| invalid(e.to_string()))?;
+    for (i, a) in scenario.axes.iter().enumerate() {
+        if a.power {
+            if let Some(axis) = machine.axes_mut().axis_mut(channel_axes + i) {
+                axis.switch_on()
+                    .map_err(|e| invalid(format!("[[axis]] {:?}: power: {e:?}", a.config.name)))?;
+            }
+        }
+    }
+    Ok(machine)
+}
+
+/// An in-process run: the machine, its image, the PLC timeline and the trace.
+#[derive(Debug)]
+pub struct InProcess {
+    /// The CNC side.
+    pub machine: Machine,
+    /// The image both sides share.
+    pub memory: ImageMemory,
+    /// The PLC timeline, if the scenario has one.
+    pub timeline: Option<Timeline>,
+    /// The trace.
+    pub trace: Trace,
+    /// The acyclic service of a timeline that calls blocks: the CNC's and the PLC's end.
+    acyclic: Option<(AcyclicServer, AcyclicClient)>,
+    plc_cycles: u64,
+}
+
+/// Numbers the acyclic services of in-process runs (several may run in one process).
+static IN_PROCESS_SERVICES: AtomicU32 = AtomicU32::new(0);
+
+impl InProcess {
+    /// Sets up `scenario` on a heap image with room for `rows` trace rows. A built-in PLC
+    /// program is refused: those run only in the PLC process.
+    pub fn new(scenario: &Scenario, rows: usize) -> Result<InProcess, ScenarioError> {
+        let invalid = |message: String| ScenarioError::Invalid {
+            file: scenario.name.clone(),
+            message,
+        };
+        let timeline = match &scenario.plc {
+            PlcSetup::None => None,
+            PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
+            PlcSetup::Program(p, _) => {
+                return Err(invalid(format!(
+                    "built-in PLC program {p:?} runs only in the PLC process"
+                )))
+            }
+        };
+        let acyclic = match &timeline {
+            Some(t) if t.calls_blocks() => {
+                let instance = format!(
+                    "inproc-{}-{}",
+                    std::process::id(),
+                    IN_PROCESS_SERVICES.fetch_add(1, Ordering::Relaxed)
+                );
+                let refused = |e: hli::calls::CallError| invalid(format!("acyclic service: {e}"));
+                let server = AcyclicServer::open(&instance).map_err(refused)?;
+                let client = AcyclicClient::open(&instance).map_err(refused)?;
+                Some((server, client))
+            }
+            _ => None,
+        };
+        let machine = build(scenario)?;
+        let memory =
+            hli::segment::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
+        Ok(InProcess {
+            machine,
+            memory,
+            timeline,
+            trace: Trace::new(&scenario.signals, rows),
+            acyclic,
+            plc_cycles: 0,
+        })
+    }
+
+    /// The whole scenario in-process: its `ticks` steps with a trace row each (the run
+    /// `cnc run --lockstep` makes with a PLC process). A scenario without `ticks` runs none.
+    pub fn run_through(scenario: &Scenario) -> Result<InProcess, ScenarioError> {
+        let ticks = scenario.ticks.unwrap_or(0) as usize;
+        let mut run = InProcess::new(scenario, ticks)?;
+        for _ in 0..ticks {
+            run.step(scenario.cycle_s);
+        }
+        Ok(run)
+    }
+
+    /// The trace as `cnc run --trace` writes it.
+    pub fn trace_csv(&self) -> Vec<u8> {
+        let mut csv = Vec::new();
+        // Writing into a Vec cannot fail.
+        let _ = self.trace.write_csv(&mut csv);
+        csv
+    }
+
+    /// One lockstep step: CNC tick, trace sample, acyclic calls answered, PLC cycle (the
+    /// order of `cnc run --lockstep`). `cycle_s` gives the trace time.
+    pub fn step(&mut self, cycle_s: f64) {
+        let tick = self.machine.ticks();
+        self.machine.tick(&self.memory);
+        self.trace.record(&self.memory, tick, tick as f64 * cycle_s);
+        let Some(timeline) = self.timeline.as_mut() else {
+            return;
+        };
+        match self.acyclic.as_mut() {
+            Some((server, client)) => {
+                let view = CncView::new(&self.memory);
+                let machine = &mut self.machine;
+                let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
+                let _ = server.poll_rows(|header, values| machine.dispatch_rows(header, values));
+                timeline.cycle_io(&mut PlcIo {
+                    view: PlcView::new(&self.memory),
+                    memory: &self.memory,
+                    acyclic: client,
+                    cycle: self.plc_cycles,
+                });
+            }
+            None => {
+                timeline.cycle(&self.memory);
+            }
+        }
+        self.plc_cycles += 1;
+    }
+}

@@ -1,0 +1,343 @@
+//! The tick loop of `cnc run`: tick N starts at its deadline (real time) or once the PLC ran
+//! its cycle after tick N-1 (lockstep); the machine ticks, the trace takes its sample, the
+//! acyclic calls are answered and "tick done" goes out; between ticks the PLC and the
+//! termination signals are watched, and a stop runs on until the machine is at rest.
+
+use super::{
+    describe_plc, wait_for_plc_cycle, PlcLink, PlcWait, RunOptions, StopCause,
+    DEFAULT_PLC_WATCHDOG_TICKS, DEFAULT_TICK_LIMIT, STOP_LIMIT_S, STOP_REASON_PLC,
+    STOP_REASON_SIGNAL,
+};
+use crate::progress::{Progress, TickCounter};
+use crate::scenario::file::Scenario;
+use crate::scenario::log_stream::LogStream;
+use crate::scenario::machine::Machine;
+use crate::scenario::trace::Trace;
+use core::time::Duration;
+use hli::events::EventLink;
+use hli::raw::monotonic;
+use hli::rpc::AcyclicServer;
+use hli::segment::CncSegment;
+use hli::views::CncView;
+use hli::ImageMemory;
+use std::process::Child;
+
+/// How long a run may go: its ticks, the stop's, the PLC watchdog.
+pub(super) struct Bounds {
+    /// Ticks before the run ends (when no stop came).
+    limit: u64,
+    /// Ticks a stop may take to bring the machine to rest.
+    stop_limit: u64,
+    /// Rows of the trace and the timings: room for a stop that starts at the last tick.
+    pub(super) rows: usize,
+    /// Ticks without a PLC cycle before the PLC counts as lost (at least 1).
+    pub(super) watchdog: u64,
+    /// The CNC cycle.
+    pub(super) period: Duration,
+    /// `watchdog` ticks of time.
+    watchdog_time: Duration,
+}
+
+impl Bounds {
+    /// The bounds of `scenario` run with `options`; `Err` when the ticks do not fit.
+    pub(super) fn of(scenario: &Scenario, options: &RunOptions) -> Result<Bounds, String> {
+        let limit = options
+            .ticks
+            .or(scenario.ticks)
+            .unwrap_or(DEFAULT_TICK_LIMIT);
+        let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
+        // Room for a stop that starts at the last tick.
+        let rows = usize::try_from(limit.saturating_add(stop_limit))
+            .map_err(|_| "--ticks too large".to_string())?;
+        let watchdog = options
+            .plc_watchdog_ticks
+            .or(scenario.plc_watchdog_ticks)
+            .unwrap_or(DEFAULT_PLC_WATCHDOG_TICKS)
+            .max(1);
+        let period = Duration::from_secs_f64(scenario.cycle_s);
+        Ok(Bounds {
+            limit,
+            stop_limit,
+            rows,
+            watchdog,
+            period,
+            watchdog_time: period * watchdog.min(u64::from(u32::MAX)) as u32,
+        })
+    }
+}
+
+/// What the loop measures, every buffer sized before the first tick.
+pub(super) struct Measured {
+    /// The trace.
+    pub(super) trace: Trace,
+    /// Compute time of each tick, ns.
+    pub(super) tick_ns: Vec<u64>,
+    /// How late each tick started after its deadline, ns.
+    pub(super) late_ns: Vec<u64>,
+    /// Where a tick's time goes: machine tick, trace sample, acyclic calls, "tick done"
+    /// event.
+    pub(super) stage_ns: [Vec<u64>; 4],
+    /// Acyclic calls answered.
+    pub(super) acyclic_answered: u64,
+}
+
+impl Measured {
+    /// Room for `rows` ticks of `scenario`'s trace signals and timings.
+    pub(super) fn new(scenario: &Scenario, rows: usize) -> Measured {
+        Measured {
+            trace: Trace::new(&scenario.signals, rows),
+            tick_ns: Vec::with_capacity(rows),
+            late_ns: Vec::with_capacity(rows),
+            stage_ns: core::array::from_fn(|_| Vec::with_capacity(rows)),
+            acyclic_answered: 0,
+        }
+    }
+
+    /// One tick's timings: `t` are the instants before the machine tick, the trace sample,
+    /// the acyclic calls and the event, and after the event.
+    fn push(&mut self, t: [Duration; 5], deadline: Duration) {
+        let [t0, t1, t2, t3, t4] = t;
+        self.tick_ns.push((t4 - t0).as_nanos() as u64);
+        for (stage, (a, b)) in
+            self.stage_ns
+                .iter_mut()
+                .zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)])
+        {
+            stage.push((b - a).as_nanos() as u64);
+        }
+        self.late_ns
+            .push(t0.saturating_sub(deadline).as_nanos() as u64);
+    }
+}
+
+/// How the loop ended.
+pub(super) struct Ending {
+    /// Why the run stopped early, and the tick the stop began.
+    pub(super) stop: Option<(StopCause, u64)>,
+    /// A second termination request ended the stop at once.
+    pub(super) forced: bool,
+    /// Ticks from the stop until the machine was at rest.
+    pub(super) rest_after: Option<u64>,
+}
+
+/// The loop's state over a run.
+pub(super) struct TickLoop<'a> {
+    scenario: &'a Scenario,
+    options: &'a RunOptions,
+    machine: &'a mut Machine,
+    segment: &'a CncSegment,
+    events: &'a EventLink,
+    server: &'a AcyclicServer,
+    child: &'a mut Option<Child>,
+    bounds: &'a Bounds,
+    measured: Measured,
+    /// When tick 0 was due.
+    start: Duration,
+    /// The PLC heartbeat last seen to change, and when (wall clock: a CNC that stalled and
+    /// catches up in a burst must not take the PLC for dead).
+    plc_seen: (u64, Duration),
+    ending: Ending,
+    log_stream: Option<LogStream>,
+    counter: TickCounter,
+    progress: Option<Progress>,
+}
+
+impl<'a> TickLoop<'a> {
+    /// The loop of `machine` with the PLC of `link`; tick 0 is due now.
+    pub(super) fn new(
+        scenario: &'a Scenario,
+        options: &'a RunOptions,
+        machine: &'a mut Machine,
+        link: &'a mut PlcLink,
+        bounds: &'a Bounds,
+        measured: Measured,
+    ) -> TickLoop<'a> {
+        let PlcLink {
+            segment,
+            events,
+            server,
+            child,
+        } = link;
+        let start = monotonic::now();
+        let plc_seen = (segment.plc_heartbeat(), monotonic::now());
+        let log_stream = options
+            .log_dir
+            .as_ref()
+            .map(|dir| LogStream::start(dir, machine.controller().channels().len()));
+        let counter = TickCounter::default();
+        let progress = Progress::start(
+            &counter,
+            options.ticks.or(scenario.ticks),
+            &options.instance,
+        );
+        TickLoop {
+            scenario,
+            options,
+            machine,
+            segment,
+            events,
+            server,
+            child,
+            bounds,
+            measured,
+            start,
+            plc_seen,
+            ending: Ending {
+                stop: None,
+                forced: false,
+                rest_after: None,
+            },
+            log_stream,
+            counter,
+            progress,
+        }
+    }
+
+    /// Ticks until the run ends; what it measured and how it ended.
+    pub(super) fn run(mut self) -> (Measured, Ending) {
+        let memory = self.segment.memory();
+        let view = CncView::new(memory);
+        for tick in 0.. {
+            if self.ends_before(tick) {
+                break;
+            }
+            let deadline = self.start + self.bounds.period * (tick as u32);
+            self.pace(tick, deadline);
+            self.step(tick, deadline, memory, &view);
+            // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on
+            // it before the tick), its process now and then, and termination requests.
+            if self.ending.stop.is_none() && !self.options.lockstep {
+                self.watch_plc(tick);
+            }
+            if tick % 16 == 0 && self.take_signal(tick) {
+                break;
+            }
+        }
+        drop(self.progress);
+        if let Some(Err(e)) = self.log_stream.map(LogStream::finish) {
+            eprintln!("cnc run: LOG_FILE while running: {e}");
+        }
+        (self.measured, self.ending)
+    }
+
+    /// Whether the run ends before `tick`: its ticks are done (or, without a tick count,
+    /// every channel is idle), or a stop brought the machine to rest or ran out of time.
+    fn ends_before(&mut self, tick: u64) -> bool {
+        match &self.ending.stop {
+            Some((_, since)) if self.machine.at_rest() => {
+                self.ending.rest_after = Some(tick - since);
+                true
+            }
+            Some((_, since)) if tick - since > self.bounds.stop_limit => true,
+            Some(_) => false,
+            None if tick >= self.bounds.limit => true,
+            None if self.options.ticks.is_none()
+                && self.scenario.ticks.is_none()
+                && self.machine.idle() =>
+            {
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// Waits for tick `tick`: lockstep for the PLC's cycle after the last tick (while the
+    /// PLC is not lost), real time until `deadline`.
+    fn pace(&mut self, tick: u64, deadline: Duration) {
+        let plc_alive = self.ending.stop.is_none() && self.child.is_some();
+        if self.options.lockstep && plc_alive {
+            if let Some(child) = self.child.as_mut() {
+                let (watchdog, period) = (self.bounds.watchdog, self.bounds.period);
+                match wait_for_plc_cycle(self.segment, self.events, child, tick, watchdog, period) {
+                    Ok(()) => {}
+                    Err(PlcWait::Lost(detail)) => self.lose_plc(tick, detail),
+                }
+            }
+        } else if !self.options.lockstep {
+            monotonic::sleep_until(deadline);
+        }
+    }
+
+    /// Tick `tick`: the machine, the trace sample, the acyclic calls, "tick done", the
+    /// switching log handed on, the timings.
+    fn step(&mut self, tick: u64, deadline: Duration, memory: &ImageMemory, view: &CncView<'_>) {
+        let t0 = monotonic::now();
+        self.machine.tick(memory);
+        let t1 = monotonic::now();
+        let time = if self.options.lockstep {
+            tick as f64 * self.scenario.cycle_s
+        } else {
+            (t0 - self.start).as_secs_f64()
+        };
+        self.measured.trace.record(memory, tick, time);
+        let t2 = monotonic::now();
+        self.measured.acyclic_answered += self
+            .server
+            .poll(|kind, request| self.machine.dispatch(view, kind, request))
+            .unwrap_or(0) as u64;
+        self.measured.acyclic_answered += self
+            .server
+            .poll_rows(|header, values| self.machine.dispatch_rows(header, values))
+            .unwrap_or(0) as u64;
+        let t3 = monotonic::now();
+        let _ = self.events.notify();
+        let t4 = monotonic::now();
+        if let Some(stream) = self.log_stream.as_mut() {
+            stream.forward(self.machine.controller().channels());
+        }
+        self.measured.push([t0, t1, t2, t3, t4], deadline);
+        self.counter.set(tick + 1);
+    }
+
+    /// Real time, after tick `tick`: a PLC whose heartbeat stood still for the watchdog's
+    /// time, or whose process exited (looked at every 64 ticks), is lost.
+    fn watch_plc(&mut self, tick: u64) {
+        let Some(child) = self.child.as_mut() else {
+            return;
+        };
+        let beat = self.segment.plc_heartbeat();
+        let now = monotonic::now();
+        if beat != self.plc_seen.0 {
+            self.plc_seen = (beat, now);
+        }
+        let exited = if tick.is_multiple_of(64) {
+            child.try_wait().ok().flatten()
+        } else {
+            None
+        };
+        let silent = now.saturating_sub(self.plc_seen.1);
+        if exited.is_some() || silent > self.bounds.watchdog_time {
+            let silent_ticks = (silent.as_secs_f64() / self.scenario.cycle_s) as u64;
+            let detail = describe_plc(child, exited, silent_ticks);
+            self.lose_plc(tick, detail);
+        }
+    }
+
+    /// The PLC is lost at `tick`: the machine stops.
+    fn lose_plc(&mut self, tick: u64, detail: String) {
+        let cause = StopCause::PlcLost { tick, detail };
+        eprintln!("cnc run: {}", cause.message());
+        self.machine.stop(STOP_REASON_PLC);
+        self.ending.stop = Some((cause, tick));
+    }
+
+    /// A termination request at `tick` stops the machine; a second one during the stop ends
+    /// the run at once (true: end now).
+    fn take_signal(&mut self, tick: u64) -> bool {
+        let Some(signal) = hli::signals::take() else {
+            return false;
+        };
+        if self.ending.stop.is_some() {
+            // A request during a stop: end now (the segment is still removed and the PLC
+            // still reaped after the loop); the first cause stays the reported one.
+            eprintln!("cnc run: {} during the stop: ending at once", signal.name());
+            self.ending.forced = true;
+            return true;
+        }
+        let cause = StopCause::Signal { tick, signal };
+        eprintln!("cnc run: {}", cause.message());
+        self.machine.stop(STOP_REASON_SIGNAL);
+        self.ending.stop = Some((cause, tick));
+        false
+    }
+}

@@ -1,0 +1,772 @@
+//! The FIFO engine in the machine tick (seed 002): a group of three single axes driven by
+//! rows, checked tick by tick against the interpolation of the rows; the override (instant
+//! and PT-2) on the velocity; whole-block refusal, underrun and the end at rest; FiFoStop;
+//! every refusal with its code while the queued rows stay as they were; a faulted member
+//! ending the job.
+
+use cnc_app::scenario::{InProcess, Scenario};
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::{
+    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
+    FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall,
+};
+use hli::calls::AcyclicCall;
+use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
+use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
+use hli::views::{CncView, PlcView};
+
+const TICK: f64 = 0.001;
+/// Axes 0..3 form the group; 3 is free; 4 is a gear slave of 3.
+const FREE: usize = 3;
+const GEAR_SLAVE: usize = 4;
+
+fn machine(group: &str) -> InProcess {
+    machine_y(group, "")
+}
+
+/// With `y` appended to axis Y's table.
+fn machine_y(group: &str, y: &str) -> InProcess {
+    let toml = format!(
+        "cycle_ms = 1.0\nticks = 10\n\
+         [[axis]]\nname = \"X\"\npower = true\nvelocity = 2000.0\nfollowing_error_limit = 100.0\n\
+         [[axis]]\nname = \"Y\"\npower = true\nvelocity = 2000.0\nfollowing_error_limit = 100.0\n{y}\n\
+         [[axis]]\nname = \"Z\"\npower = true\nvelocity = 2000.0\nfollowing_error_limit = 100.0\n\
+         [[axis]]\nname = \"W\"\npower = true\n\
+         [[axis]]\nname = \"S\"\npower = true\n\
+         [[gear]]\nmaster = \"W\"\nslave = \"S\"\nratio = 2.0\n\
+         [[fifo_group]]\n{group}"
+    );
+    let s = Scenario::parse("fifo.toml", &toml, |f| panic!("no file {f}")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    run.step(TICK);
+    run
+}
+
+fn instant(rows: usize, t_f_ms: f64) -> String {
+    format!("dimension = 3\nrows = {rows}\nfifo_cycle_ms = {t_f_ms}\n")
+}
+
+fn call<C: AcyclicCall<Reply = FifoReply>>(run: &mut InProcess, group: u32, body: C) -> FifoReply {
+    let view = CncView::new(&run.memory);
+    run.machine.call(&view, group, &body).expect("answered")
+}
+
+/// An axis command as MC_* sends it: the axis layer's error id.
+fn axis_command(run: &mut InProcess, axis: u32, command: AxisCommandCall) -> u32 {
+    let view = CncView::new(&run.memory);
+    run.machine
+        .call(&view, axis, &command)
+        .expect("answered")
+        .error_id
+}
+
+fn write(run: &mut InProcess, rows: &[[f64; 3]], overwrite: bool) -> FifoReply {
+    let values: Vec<f64> = rows.iter().flatten().copied().collect();
+    let header = FifoRowsHeader {
+        group: 0,
+        columns: 3,
+        rows: rows.len() as u32,
+        overwrite: u32::from(overwrite),
+    };
+    run.machine.dispatch_rows(&header, &values)
+}
+
+fn integrate(run: &mut InProcess) {
+    for axis in 0..3 {
+        let r = call(
+            run,
+            0,
+            FifoIntegrateCall {
+                axis,
+                group_position: axis + 1,
+            },
+        );
+        assert_eq!(r.error_id, 0, "integrate {axis}");
+    }
+}
+
+fn start(run: &mut InProcess) -> FifoReply {
+    call(run, 0, FifoStartCall::default())
+}
+
+fn position(run: &InProcess, axis: usize) -> f64 {
+    run.machine.axes().axis(axis).unwrap().setpoint().position
+}
+
+fn velocity(run: &InProcess, axis: usize) -> f64 {
+    run.machine.axes().axis(axis).unwrap().setpoint().velocity
+}
+
+fn status(run: &InProcess) -> hli::layout::HliFifoGroupState {
+    PlcView::new(&run.memory).fifo_group(0).unwrap()
+}
+
+/// Rows k = 0..n of a smooth 3-axis contour starting at the origin.
+fn contour(n: usize) -> Vec<[f64; 3]> {
+    (0..n)
+        .map(|k| {
+            let t = k as f64 * 0.05;
+            [10.0 * t * t, 5.0 * (1.0 - t.cos()), -3.0 * t]
+        })
+        .collect()
+}
+
+fn lerp(rows: &[[f64; 3]], t_over_tf: f64, axis: usize) -> f64 {
+    let k = (t_over_tf.floor() as usize).min(rows.len() - 1);
+    if k + 1 >= rows.len() {
+        return rows[k][axis];
+    }
+    rows[k][axis] + (t_over_tf - k as f64) * (rows[k + 1][axis] - rows[k][axis])
+}
+
+/// The axes' set-points tick by tick are the rows interpolated at `n x tick`, for T_f of
+/// 1, 3 and 2.5 ticks (fine interpolation, also at a ratio that is not a whole number).
+#[test]
+fn set_points_interpolate_the_rows() {
+    for t_f_ms in [1.0, 3.0, 2.5, 0.4] {
+        let mut run = machine(&instant(64, t_f_ms));
+        integrate(&mut run);
+        let rows = contour(40);
+        assert_eq!(write(&mut run, &rows, false).error_id, 0);
+        assert_eq!(start(&mut run).error_id, 0);
+        let ratio = TICK / (t_f_ms * 1e-3);
+        let ticks = ((rows.len() - 1) as f64 / ratio).ceil() as usize;
+        for n in 1..=ticks {
+            run.step(TICK);
+            for axis in 0..3 {
+                let want = lerp(&rows, n as f64 * ratio, axis);
+                let got = position(&run, axis);
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "T_f {t_f_ms} ms, tick {n}, axis {axis}: {got} vs {want}"
+                );
+            }
+        }
+        let s = status(&run);
+        assert_eq!(s.rows_consumed_r, rows.len() as u64 - 1, "T_f {t_f_ms}");
+        assert_eq!(s.entries_r, 1, "the last row stays as the held position");
+    }
+}
+
+/// Override 40 %: the job time runs at 0.4 x real time, so velocities are 0.4 x the rows'.
+#[test]
+fn override_scales_velocity() {
+    let mut run = machine(&instant(64, 1.0));
+    integrate(&mut run);
+    let rows: Vec<[f64; 3]> = (0..50)
+        .map(|k| [k as f64 * 0.2, 0.0, -(k as f64) * 0.1])
+        .collect();
+    write(&mut run, &rows, false);
+    let r = call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 400_000,
+        },
+    );
+    assert_eq!(r.error_id, 0, "an override may be set before the start");
+    start(&mut run);
+    for _ in 0..20 {
+        run.step(TICK);
+    }
+    // Rows move X by 0.2 per ms = 200 /s, Z by -100 /s.
+    assert!(
+        (velocity(&run, 0) - 0.4 * 200.0).abs() < 1e-6,
+        "{}",
+        velocity(&run, 0)
+    );
+    assert!((velocity(&run, 2) + 0.4 * 100.0).abs() < 1e-6);
+    assert_eq!(status(&run).override_r, 400_000);
+    // 0 % stops the axes and keeps the job.
+    call(&mut run, 0, FifoOverrideCall { override_ppm: 0 });
+    run.step(TICK);
+    let held = position(&run, 0);
+    for _ in 0..5 {
+        run.step(TICK);
+    }
+    assert_eq!((position(&run, 0), velocity(&run, 0)), (held, 0.0));
+    assert_eq!(status(&run).group_state_r, FifoGroupState::Running.raw());
+    // Above 100 % is refused.
+    let r = call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 1_000_001,
+        },
+    );
+    assert_eq!(r.error_id, FifoError::Override.raw());
+}
+
+fn pt2(run: &mut InProcess, t0_s: f64) {
+    let r = call(
+        run,
+        0,
+        FifoParametersCall {
+            fifo_cycle_s: 0.001,
+            pt2_t0_s: t0_s,
+            override_type: FifoOverrideType::Pt2.raw(),
+            reserved: 0,
+        },
+    );
+    assert_eq!(r.error_id, 0);
+}
+
+/// PT-2: an override step from 100 % to 20 % changes the velocity without a step (the
+/// largest change per tick is a fraction of the instant override's one jump) and settles.
+#[test]
+fn pt2_override_is_continuous_and_settles() {
+    let rows: Vec<[f64; 3]> = (0..2000).map(|k| [k as f64 * 0.1, 0.0, 0.0]).collect();
+    let mut jumps = Vec::new();
+    for kind in [FifoOverrideType::Instant.raw(), FifoOverrideType::Pt2.raw()] {
+        let mut run = machine(&instant(4000, 1.0));
+        if kind == FifoOverrideType::Pt2.raw() {
+            pt2(&mut run, 0.02);
+        }
+        integrate(&mut run);
+        write(&mut run, &rows, false);
+        start(&mut run);
+        for _ in 0..10 {
+            run.step(TICK);
+        }
+        call(
+            &mut run,
+            0,
+            FifoOverrideCall {
+                override_ppm: 200_000,
+            },
+        );
+        let mut before = velocity(&run, 0);
+        let mut largest: f64 = 0.0;
+        for _ in 0..400 {
+            run.step(TICK);
+            largest = largest.max((velocity(&run, 0) - before).abs());
+            before = velocity(&run, 0);
+        }
+        assert!(
+            (velocity(&run, 0) - 20.0).abs() < 1e-6,
+            "settled at 20 % of 100 /s"
+        );
+        assert_eq!(status(&run).override_r, 200_000);
+        jumps.push(largest);
+    }
+    // Instant: one jump of 80 /s. PT-2 (T0 = 20 ticks): at most 80 / (e x 20) ~ 1.5 /s.
+    assert!((jumps[0] - 80.0).abs() < 1e-6, "{jumps:?}");
+    assert!(jumps[1] < 1.6, "{jumps:?}");
+}
+
+/// A block is queued whole or refused whole; the fill level is in the image every tick.
+#[test]
+fn a_block_that_does_not_fit_is_refused_whole() {
+    let mut run = machine(&instant(10, 1.0));
+    let rows = vec![[0.0; 3]; 8];
+    let r = write(&mut run, &rows, false);
+    assert_eq!((r.error_id, r.entries, r.free), (0, 8, 2));
+    let r = write(&mut run, &rows[..3], false);
+    assert_eq!((r.error_id, r.entries), (FifoError::Full.raw(), 8));
+    assert_eq!(write(&mut run, &rows[..2], false).entries, 10);
+    run.step(TICK);
+    let s = status(&run);
+    assert_eq!((s.entries_r, s.free_r, s.capacity_r), (10, 0, 10));
+    assert_eq!(s.group_state_r, FifoGroupState::Filling.raw());
+    assert_eq!(s.rows_written_r, 10);
+}
+
+/// FiFoOverwrite keeps the pair the group interpolates between and replaces the rest.
+#[test]
+fn overwrite_replaces_the_queued_rows() {
+    let mut run = machine(&instant(16, 2.0));
+    integrate(&mut run);
+    write(
+        &mut run,
+        &[[0.0; 3], [1.0; 3], [2.0; 3], [3.0; 3], [4.0; 3]],
+        false,
+    );
+    start(&mut run);
+    run.step(TICK); // half way between rows 0 and 1
+    let r = write(&mut run, &[[1.5; 3], [2.0; 3]], true);
+    assert_eq!((r.error_id, r.entries), (0, 4));
+    let mut seen = Vec::new();
+    for _ in 0..6 {
+        run.step(TICK);
+        seen.push(position(&run, 0));
+    }
+    assert_eq!(seen, [1.0, 1.25, 1.5, 1.75, 2.0, 2.0]);
+}
+
+/// The FIFO runs dry while moving: the axes hold the last row, the group keeps running
+/// and goes on when rows come; rows that end at rest are the normal end.
+#[test]
+fn underrun_holds_then_resumes() {
+    let mut run = machine(&instant(16, 1.0));
+    integrate(&mut run);
+    write(&mut run, &[[0.0; 3], [0.5; 3], [1.0; 3]], false);
+    start(&mut run);
+    for _ in 0..4 {
+        run.step(TICK);
+    }
+    let s = status(&run);
+    assert_eq!(s.flags_r & FIFO_FLAG_UNDERRUN, FIFO_FLAG_UNDERRUN);
+    assert_eq!(s.group_state_r, FifoGroupState::Running.raw());
+    assert_eq!(s.underrun_ticks_r, 2);
+    assert_eq!((position(&run, 1), velocity(&run, 1)), (1.0, 0.0));
+    write(&mut run, &[[1.5; 3], [2.0; 3], [2.0; 3]], false);
+    run.step(TICK);
+    assert_eq!(position(&run, 1), 1.5, "goes on from the held row, no jump");
+    for _ in 0..3 {
+        run.step(TICK);
+    }
+    let s = status(&run);
+    assert_eq!(
+        s.flags_r & (FIFO_FLAG_UNDERRUN | FIFO_FLAG_AT_END),
+        FIFO_FLAG_AT_END
+    );
+    assert_eq!(s.rows_consumed_r, 5);
+}
+
+/// FiFoStop: instant ends the job in the next tick (rows dropped, Idle, axes standing);
+/// PT-2 brings the axes down smoothly first. No override change is taken while stopping;
+/// the override set before the stop is in effect again for the next job.
+#[test]
+fn stop_ends_the_job() {
+    for pt2_t0 in [None, Some(0.01)] {
+        let mut run = machine(&instant(600, 1.0));
+        if let Some(t0) = pt2_t0 {
+            pt2(&mut run, t0);
+        }
+        integrate(&mut run);
+        let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
+        write(&mut run, &rows, false);
+        call(
+            &mut run,
+            0,
+            FifoOverrideCall {
+                override_ppm: 800_000,
+            },
+        );
+        start(&mut run);
+        for _ in 0..20 {
+            run.step(TICK);
+        }
+        assert_eq!(call(&mut run, 0, FifoStopCall::default()).error_id, 0);
+        let r = call(
+            &mut run,
+            0,
+            FifoOverrideCall {
+                override_ppm: 500_000,
+            },
+        );
+        assert_eq!(r.error_id, FifoError::Stopping.raw());
+        let r = write(&mut run, &rows[..1], false);
+        assert_eq!(r.error_id, FifoError::Stopping.raw());
+        let mut ticks = 0;
+        let mut before = velocity(&run, 0);
+        let mut largest: f64 = 0.0;
+        while status(&run).group_state_r != FifoGroupState::Idle.raw() {
+            run.step(TICK);
+            largest = largest.max((velocity(&run, 0) - before).abs());
+            before = velocity(&run, 0);
+            ticks += 1;
+            assert!(ticks < 2000, "the stop never ended");
+        }
+        let s = status(&run);
+        assert_eq!((s.entries_r, s.rows_written_r), (0, 0));
+        assert_eq!(s.override_r, 800_000, "the override before the stop");
+        assert_eq!(velocity(&run, 0), 0.0);
+        match pt2_t0 {
+            None => assert_eq!(ticks, 1),
+            Some(_) => {
+                assert!(ticks > 50, "{ticks}");
+                assert!(
+                    largest < 1.5,
+                    "no velocity step (40 /s before the stop): {largest}"
+                );
+            }
+        }
+    }
+}
+
+/// Refusals, each with its code; the queued rows stay as they were.
+#[test]
+fn refusals_leave_the_rows_alone() {
+    let mut run = machine(&instant(16, 1.0));
+    assert_eq!(start(&mut run).error_id, FifoError::GroupIncomplete.raw());
+    integrate(&mut run);
+    assert_eq!(start(&mut run).error_id, FifoError::Empty.raw());
+    write(&mut run, &[[0.0; 3], [1.0; 3]], false);
+    let entries = |run: &mut InProcess| call(run, 0, FifoDimensionCall::default()).entries;
+    assert_eq!(entries(&mut run), 2);
+
+    let mut bad = [[2.0; 3], [3.0; 3]];
+    bad[1][2] = f64::NAN;
+    let r = write(&mut run, &bad, false);
+    assert_eq!(
+        (r.error_id, r.row, r.column),
+        (FifoError::NonFinite.raw(), 1, 2)
+    );
+    assert_eq!(entries(&mut run), 2);
+    bad[1][2] = f64::INFINITY;
+    assert_eq!(
+        write(&mut run, &bad, true).error_id,
+        FifoError::NonFinite.raw()
+    );
+    assert_eq!(entries(&mut run), 2, "a refused overwrite drops nothing");
+    let header = FifoRowsHeader {
+        group: 0,
+        columns: 2,
+        rows: 3,
+        overwrite: 0,
+    };
+    let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
+    assert_eq!(r.error_id, FifoError::Columns.raw());
+    assert_eq!(entries(&mut run), 2);
+    let header = FifoRowsHeader { group: 5, ..header };
+    let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
+    assert_eq!(r.error_id, FifoError::NoSuchGroup.raw());
+    assert_eq!(
+        write(&mut run, &[], false).error_id,
+        FifoError::BlockSize.raw()
+    );
+    assert_eq!(entries(&mut run), 2);
+    let r = call(&mut run, 3, FifoStartCall::default());
+    assert_eq!(r.error_id, FifoError::NoSuchGroup.raw());
+    for (t_f, t0, kind) in [
+        (0.0, 0.01, 0),
+        (-1.0, 0.01, 0),
+        (f64::NAN, 0.01, 0),
+        (0.001, 0.0, 1),
+        (0.001, 0.01, 7),
+        (0.001, 1e-300, 1),
+        (0.001, 1e20, 1),
+    ] {
+        let r = call(
+            &mut run,
+            0,
+            FifoParametersCall {
+                fifo_cycle_s: t_f,
+                pt2_t0_s: t0,
+                override_type: kind,
+                reserved: 0,
+            },
+        );
+        assert_eq!(r.error_id, FifoError::Parameter.raw(), "{t_f} {t0} {kind}");
+    }
+    assert_eq!(entries(&mut run), 2);
+
+    // Integration: taken positions, a group member, a coupled axis, a moving axis, no axis.
+    let integrate_call = |axis, group_position| FifoIntegrateCall {
+        axis,
+        group_position,
+    };
+    let r = call(&mut run, 0, integrate_call(FREE as u32, 2));
+    assert_eq!(r.error_id, FifoError::PositionTaken.raw());
+    let r = call(&mut run, 0, integrate_call(FREE as u32, 4));
+    assert_eq!(r.error_id, FifoError::GroupPosition.raw());
+    let r = call(&mut run, 0, integrate_call(1, 2));
+    assert_eq!(r.error_id, FifoError::AxisInGroup.raw());
+    let r = call(&mut run, 0, integrate_call(GEAR_SLAVE as u32, 1));
+    assert_eq!(r.error_id, FifoError::AxisCoupled.raw());
+    let r = call(&mut run, 0, integrate_call(17, 1));
+    assert_eq!(r.error_id, FifoError::NoSuchAxis.raw());
+
+    // The first row must be where the axes stand.
+    call(&mut run, 0, FifoStopCall::default()); // drops the rows of a group not started
+    write(&mut run, &[[0.0, 0.5, 0.0], [1.0; 3]], false);
+    let r = start(&mut run);
+    assert_eq!((r.error_id, r.column), (FifoError::StartMismatch.raw(), 1));
+    assert_eq!(entries(&mut run), 2);
+
+    // Running: no integration, no parameters, no second start.
+    write(&mut run, &[[0.0; 3], [0.0; 3]], true);
+    assert_eq!(start(&mut run).error_id, 0);
+    assert_eq!(start(&mut run).error_id, FifoError::Running.raw());
+    let r = call(&mut run, 0, FifoDisintegrateCall::default());
+    assert_eq!(r.error_id, FifoError::Running.raw());
+    let r = call(
+        &mut run,
+        0,
+        FifoParametersCall {
+            fifo_cycle_s: 0.002,
+            pt2_t0_s: 0.0,
+            override_type: 0,
+            reserved: 0,
+        },
+    );
+    assert_eq!(r.error_id, FifoError::Running.raw());
+}
+
+/// A moving axis does not join; a PTP command to a member is refused as coupled; after
+/// FiFoGroupDisintegrate the axes are free PTP axes again.
+#[test]
+fn integration_couples_and_disintegration_frees() {
+    let mut run = machine(&instant(16, 1.0));
+    let limits = [50.0, 1000.0, 1000.0, 10000.0];
+    assert_eq!(
+        axis_command(
+            &mut run,
+            FREE as u32,
+            AxisCommandCall::move_velocity(1, limits)
+        ),
+        0
+    );
+    run.step(TICK);
+    run.step(TICK);
+    let r = call(
+        &mut run,
+        0,
+        FifoIntegrateCall {
+            axis: FREE as u32,
+            group_position: 1,
+        },
+    );
+    assert_eq!(r.error_id, FifoError::AxisMoving.raw());
+    integrate(&mut run);
+    run.step(TICK);
+    let axis_state = |run: &InProcess, axis| PlcView::new(&run.memory).axis_state(axis).unwrap();
+    assert_eq!(
+        axis_state(&run, 0).coupling_state_r,
+        CouplingState::Fifo.raw()
+    );
+    assert_eq!(status(&run).axis_count_r, 3);
+    let r = axis_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits));
+    assert_eq!(r, AxisError::Coupled.raw());
+    assert_eq!(
+        call(&mut run, 0, FifoDisintegrateCall::default()).error_id,
+        0
+    );
+    run.step(TICK);
+    assert_eq!(
+        axis_state(&run, 0).coupling_state_r,
+        CouplingState::Uncoupled.raw()
+    );
+    assert_eq!(
+        axis_command(&mut run, 0, AxisCommandCall::move_absolute(5.0, limits)),
+        0
+    );
+}
+
+/// A member that faults (here: Y runs into its soft limit) ends the job: Error with
+/// AxisFault, the other members leave the group and stop on their own; a new integration
+/// clears the error.
+#[test]
+fn a_faulted_member_ends_the_job() {
+    let mut run = machine_y(&instant(600, 1.0), "soft_limits = [-10.0, 1.0]");
+    integrate(&mut run);
+    let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
+    write(&mut run, &rows, false);
+    start(&mut run);
+    let mut ticks = 0;
+    loop {
+        run.step(TICK);
+        ticks += 1;
+        if status(&run).group_state_r != FifoGroupState::Running.raw() {
+            break;
+        }
+        assert!(ticks < 100, "Y never reached its limit");
+    }
+    assert!(
+        (20..=22).contains(&ticks),
+        "Y passes 1.0 at tick 20: {ticks}"
+    );
+    assert!(
+        velocity(&run, 0) > 0.0,
+        "X goes on as a free axis and stops by itself"
+    );
+    let s = status(&run);
+    assert_eq!(s.group_state_r, FifoGroupState::Error.raw());
+    assert_eq!(s.error_id_r, FifoError::AxisFault.raw());
+    assert_eq!((s.axis_count_r, s.entries_r), (0, 0));
+    assert_eq!(
+        write(&mut run, &rows[..2], false).error_id,
+        FifoError::AxisFault.raw()
+    );
+    let mut ticks = 0;
+    while velocity(&run, 0) != 0.0 {
+        run.step(TICK);
+        ticks += 1;
+        assert!(ticks < 5000, "the other members never stopped");
+    }
+    let r = call(
+        &mut run,
+        0,
+        FifoIntegrateCall {
+            axis: 0,
+            group_position: 1,
+        },
+    );
+    assert_eq!(r.error_id, 0);
+    assert_eq!(
+        status_after_tick(&mut run).group_state_r,
+        FifoGroupState::Idle.raw()
+    );
+}
+
+fn status_after_tick(run: &mut InProcess) -> hli::layout::HliFifoGroupState {
+    run.step(TICK);
+    status(run)
+}
+
+/// FiFoGetDimension gives N and Z; a stopped machine still answers it.
+#[test]
+fn get_dimension() {
+    let mut run = machine(&instant(250, 2.0));
+    let r = call(&mut run, 0, FifoDimensionCall::default());
+    assert_eq!((r.error_id, r.dimension, r.capacity), (0, 3, 250));
+    run.machine.stop("test");
+    let r = call(&mut run, 0, FifoDimensionCall::default());
+    assert_eq!(r.dimension, 3);
+    assert_eq!(
+        write(&mut run, &[[0.0; 3]], false).error_id,
+        hli::calls::ErrorCode::Busy.raw()
+    );
+}
+
+/// FiFoOverwrite on a group not started replaces every queued row; on a running group that
+/// holds its last row (dry), it keeps that row.
+#[test]
+fn overwrite_before_the_start_and_when_dry() {
+    let mut run = machine(&instant(16, 1.0));
+    integrate(&mut run);
+    write(&mut run, &[[0.0; 3], [5.0; 3], [9.0; 3]], false);
+    let r = write(&mut run, &[[0.0; 3], [1.0; 3]], true);
+    assert_eq!((r.error_id, r.entries), (0, 2));
+    start(&mut run);
+    run.step(TICK);
+    run.step(TICK);
+    assert_eq!(position(&run, 0), 1.0, "the replaced rows, not 5 and 9");
+    // Dry: one row (1.0) held; an overwrite keeps it and goes on from it.
+    let r = write(&mut run, &[[1.5; 3], [2.0; 3]], true);
+    assert_eq!((r.error_id, r.entries), (0, 3));
+    run.step(TICK);
+    assert_eq!(position(&run, 0), 1.5);
+    let s = status_after_tick(&mut run);
+    assert!(s.rows_written_r >= s.rows_consumed_r);
+    assert_eq!(s.rows_written_r, 4, "0, 1 and the two overwritten rows");
+}
+
+/// A stop that ends by a fault or a machine stop gives the override back as well; a new job
+/// starts with its counters at 0; dissolving drops the queued rows.
+#[test]
+fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
+    let mut run = machine_y(&instant(600, 1.0), "soft_limits = [-10.0, 1.0]");
+    pt2(&mut run, 0.5);
+    integrate(&mut run);
+    let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
+    write(&mut run, &rows, false);
+    call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 900_000,
+        },
+    );
+    start(&mut run);
+    for _ in 0..15 {
+        run.step(TICK);
+    }
+    assert_eq!(call(&mut run, 0, FifoStopCall::default()).error_id, 0);
+    // The slow PT-2 stop still moves Y past its limit of 1.0: the fault ends the job.
+    let mut ticks = 0;
+    while status(&run).group_state_r != FifoGroupState::Error.raw() {
+        run.step(TICK);
+        ticks += 1;
+        assert!(ticks < 2000, "no fault");
+    }
+    let s = status(&run);
+    assert_eq!(
+        (s.override_target_r, s.rows_consumed_r, s.rows_written_r),
+        (900_000, 0, 0)
+    );
+    // Machine stop while stopping.
+    let mut run = machine(&instant(600, 1.0));
+    pt2(&mut run, 0.5);
+    integrate(&mut run);
+    write(&mut run, &rows, false);
+    call(
+        &mut run,
+        0,
+        FifoOverrideCall {
+            override_ppm: 700_000,
+        },
+    );
+    start(&mut run);
+    for _ in 0..15 {
+        run.step(TICK);
+    }
+    call(&mut run, 0, FifoStopCall::default());
+    run.step(TICK);
+    run.machine.stop("test");
+    let s = status_after_tick(&mut run);
+    assert_eq!(s.group_state_r, FifoGroupState::Idle.raw());
+    assert_eq!((s.override_target_r, s.rows_consumed_r), (700_000, 0));
+    // Dissolving drops rows.
+    let mut run = machine(&instant(16, 1.0));
+    integrate(&mut run);
+    write(&mut run, &[[0.0; 3], [1.0; 3]], false);
+    let r = call(&mut run, 0, FifoDisintegrateCall::default());
+    assert_eq!((r.error_id, r.entries), (0, 0));
+    let s = status_after_tick(&mut run);
+    assert_eq!(s.group_state_r, FifoGroupState::Idle.raw());
+}
+
+/// An axis with a command that has not moved it yet does not join (coupling would abort the
+/// command without a word).
+#[test]
+fn an_axis_with_an_active_command_does_not_join() {
+    let mut run = machine(&instant(16, 1.0));
+    let command = AxisCommandCall::move_absolute(5.0, [50.0, 1000.0, 1000.0, 10000.0]);
+    assert_eq!(axis_command(&mut run, FREE as u32, command), 0);
+    let r = call(
+        &mut run,
+        0,
+        FifoIntegrateCall {
+            axis: FREE as u32,
+            group_position: 1,
+        },
+    );
+    assert_eq!(r.error_id, FifoError::AxisMoving.raw());
+}
+
+/// A scenario's FIFO group out of range is refused at load with the group and the reason.
+#[test]
+fn a_bad_fifo_group_is_refused_at_load() {
+    for (group, needle) in [
+        (
+            "dimension = 0\nrows = 10\nfifo_cycle_ms = 1.0\n",
+            "FIFO dimension 0",
+        ),
+        (
+            "dimension = 17\nrows = 10\nfifo_cycle_ms = 1.0\n",
+            "FIFO dimension 17",
+        ),
+        (
+            "dimension = 2\nrows = 1\nfifo_cycle_ms = 1.0\n",
+            "FIFO length 1",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 0.0\n",
+            "FIFO cycle 0 s",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = -2.0\n",
+            "FIFO cycle -0.002 s",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"pt2\"\n",
+            "needs pt2_t0_ms",
+        ),
+        (
+            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"soft\"\n",
+            "\"instant\" or \"pt2\"",
+        ),
+    ] {
+        let toml =
+            format!("cycle_ms = 1.0\nticks = 10\n[[axis]]\nname = \"X\"\n[[fifo_group]]\n{group}");
+        let e = Scenario::parse("bad.toml", &toml, |f| panic!("{f}")).unwrap_err();
+        let text = e.to_string();
+        assert!(
+            text.contains("[[fifo_group]] 0") || text.contains(needle),
+            "{text}"
+        );
+        assert!(text.contains(needle), "{text}");
+    }
+}

@@ -1,0 +1,335 @@
+//! The machine tick: channel axes on the axis layer, single axes and an engine (gears) in one
+//! tick; scenario `[[axis]]` and `[[gear]]` tables, refused with file, key and reason.
+
+use cnc_app::scenario::{InProcess, Scenario, ScenarioError};
+use hli::enums::CouplingState;
+use hli::layout::{HliAxis, HliAxisLrState};
+use hli::views::CncView;
+use hli::PlaceExt;
+use std::path::PathBuf;
+
+/// Channel axes take images 0..6; the single axis follows.
+const FEED: usize = 6;
+
+const PROGRAM: &str = "%conveyor\nG1 X100 F6000\nG1 X40 F3000\nM30\n";
+
+fn scenario(extra: &str) -> Result<Scenario, ScenarioError> {
+    let toml = format!(
+        "cycle_ms = 1.0\n[[channel]]\nname = \"conveyor\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"c.nc\"\n\
+         drive = {{ model = \"pt1\", t1_ms = 2.0 }}\n{extra}"
+    );
+    Scenario::parse("machine.toml", &toml, |f| {
+        Ok((PathBuf::from(f), PROGRAM.to_string()))
+    })
+}
+
+fn lr(memory: &hli::ImageMemory, axis: usize) -> HliAxisLrState {
+    CncView::new(memory)
+        .axis(axis)
+        .unwrap()
+        .field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
+        .read()
+}
+
+const GEARED: &str =
+    "[[axis]]\nname = \"Feed\"\npower = true\nstart = 5.0\nsoft_limits = [-500.0, 500.0]\n\
+    drive = { model = \"pt2\", frequency_hz = 60.0, damping = 0.9 }\n\
+    [[gear]]\nmaster = \"conveyor.X\"\nslave = \"Feed\"\nratio = -2.0\n";
+
+#[test]
+fn a_gear_slave_follows_a_channel_axis_through_simulated_drives() {
+    let s = scenario(GEARED).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut max_fe: f64 = 0.0;
+    let mut ticks = 0;
+    let mut last: Option<(f64, f64, bool)> = None;
+    while !run.machine.idle() || ticks < 3000 {
+        run.step(s.cycle_s);
+        ticks += 1;
+        assert!(ticks < 20_000, "watchdog: the program did not end");
+        let feed = run.machine.axes().axis(FEED).unwrap();
+        assert!(feed.error().is_none(), "{:?}", feed.error());
+        max_fe = max_fe.max(feed.following_error().abs());
+        // Once coupled, the slave's set-point moves by -2 times the master's, tick by tick.
+        let m = run.machine.axes().axis(0).unwrap().setpoint().position;
+        let f = feed.setpoint().position;
+        if let Some((m0, f0, coupled)) = last {
+            if coupled {
+                assert!(((f - f0) + 2.0 * (m - m0)).abs() < 1e-9, "tick {ticks}");
+            }
+        }
+        last = Some((m, f, feed.coupling().is_some()));
+    }
+    // The conveyor stands at X40, so the slave at 5 - 80; both drives settled on it.
+    let conveyor = run.machine.axes().axis(0).unwrap();
+    let feed = run.machine.axes().axis(FEED).unwrap();
+    assert!(
+        (conveyor.actual() - 40.0).abs() < 1e-3,
+        "{}",
+        conveyor.actual()
+    );
+    assert!((feed.actual() + 75.0).abs() < 1e-3, "{}", feed.actual());
+    // The drives lag: a following error shows while moving (ideal drives show none).
+    assert!(max_fe > 0.01, "max following error {max_fe}");
+    let image = lr(&run.memory, FEED);
+    assert_eq!(image.coupling_state_r, CouplingState::GearVelocity.raw());
+    assert_eq!(image.master_axis_r, 0);
+    assert_eq!(
+        lr(&run.memory, 0).coupling_state_r,
+        CouplingState::Channel.raw()
+    );
+}
+
+#[test]
+fn an_unpowered_gear_slave_stays_uncoupled() {
+    let s = scenario(&GEARED.replace("power = true\n", "")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..500 {
+        run.step(s.cycle_s);
+    }
+    let feed = run.machine.axes().axis(FEED).unwrap();
+    assert!(feed.coupling().is_none());
+    assert_eq!(feed.actual(), 5.0);
+}
+
+#[test]
+fn bad_axes_and_gears_are_refused_with_key_and_reason() {
+    for (extra, expect) in [
+        ("[[axis]]\nkind = \"linear\"\n", "missing field `name`"),
+        ("[[axis]]\nname = \"A\"\nmodulo = 360.0\n", "\"A\": modulo"),
+        ("[[axis]]\nname = \"A\"\nkind = \"rotary\"\nsoft_limits = [0.0, 1.0]\n", "\"A\": soft_limits"),
+        ("[[axis]]\nname = \"A\"\nsoft_limits = [5.0, 1.0]\n", "minimum must lie below"),
+        ("[[axis]]\nname = \"A\"\nvelocity = -1.0\n", "dynamics.velocity"),
+        ("[[axis]]\nname = \"A\"\nspeed = 1.0\n", "unknown field `speed`"),
+        ("[[axis]]\nname = \"A\"\n[[axis]]\nname = \"A\"\n", "given twice"),
+        ("[[axis]]\nname = \"A\"\ndrive = { model = \"pt3\" }\n", "pt3"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.Q\"\nslave = \"A\"\nratio = 1.0\n", "master \"conveyor.Q\": no such axis"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"A\"\nratio = 1.0\n", "its own master"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.X\"\nslave = \"A\"\nratio = 0.0\n", "ratio 0"),
+    ] {
+        let e = scenario(extra).expect_err(extra).to_string();
+        assert!(e.starts_with("machine.toml:"), "{e}");
+        assert!(e.contains(expect), "{extra}: {e}");
+    }
+}
+
+#[test]
+fn a_channel_whose_axis_faults_stops_in_error() {
+    // A slow drive (10 Hz) cannot follow fast moves: the following error passes the limit.
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+        program = \"c.nc\"\nlimits = { velocity = 1000.0, acceleration = 20000.0, jerk = 2000000.0 }\n\
+        drive = { model = \"pt2\", frequency_hz = 2.0, damping = 0.3 }\n";
+    let s = Scenario::parse("fault.toml", toml, |f| {
+        Ok((
+            PathBuf::from(f),
+            "%c\nG0 X400\nG0 X0\nG0 X400\nM30\n".to_string(),
+        ))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..5000 {
+        run.step(s.cycle_s);
+    }
+    let c = &run.machine.controller().channels()[0];
+    let error = c
+        .error()
+        .expect("the channel ended in error")
+        .message
+        .clone();
+    assert!(error.contains("a channel axis faulted"), "{error}");
+    assert!(run.machine.axes().axis(0).unwrap().error().is_some());
+}
+
+#[test]
+fn gears_drive_single_axes_only_and_names_stay_apart() {
+    for (extra, expect) in [
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"conveyor.Y\"\nratio = 1.0\n", "a channel axis is driven by its channel"),
+        ("[[axis]]\nname = \"conveyor.Q\"\n", "without '.'"),
+    ] {
+        let e = scenario(extra).expect_err(extra).to_string();
+        assert!(e.contains(expect), "{extra}: {e}");
+    }
+    let e = Scenario::parse("axes.toml", "[[axis]]\nname = \"A\"\n", |_| unreachable!())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("needs `ticks`"), "{e}");
+}
+
+#[test]
+fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest() {
+    // The channel waits for an M-function acknowledge nobody gives.
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"c.nc\"\n";
+    let s = Scenario::parse("wait.toml", toml, |f| {
+        Ok((
+            PathBuf::from(f),
+            "%c\nG1 X1 F600\nM100\nG1 X2 F600\nM30\n".to_string(),
+        ))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..1000 {
+        run.step(s.cycle_s);
+    }
+    assert!(run.machine.controller().channels()[0].error().is_none());
+    run.machine.stop("machine stop: test");
+    // An acknowledge the PLC gives during the stop stays pending: a stopping channel takes
+    // nothing from it.
+    let plc = hli::views::PlcView::new(&run.memory);
+    let request = plc
+        .m_function_request(0)
+        .unwrap()
+        .try_take()
+        .unwrap()
+        .unwrap();
+    let ack_free = |m: &hli::ImageMemory| {
+        hli::views::PlcView::new(m)
+            .m_function_ack(0)
+            .unwrap()
+            .is_free()
+            .unwrap()
+    };
+    plc.m_function_ack(0)
+        .unwrap()
+        .try_send(&hli::layout::HliMFunctionAck {
+            m_code: 100,
+            request_id: request.request_id,
+        })
+        .unwrap();
+    assert!(
+        !run.machine.at_rest(),
+        "the waiting channel has not ended yet"
+    );
+    run.step(s.cycle_s);
+    let c = &run.machine.controller().channels()[0];
+    assert_eq!(
+        c.error().map(|e| e.message.as_str()),
+        Some("machine stop: test")
+    );
+    assert!(run.machine.at_rest());
+    assert!(run.machine.stopped());
+    assert!(
+        !ack_free(&run.memory),
+        "the acknowledge was taken during the stop"
+    );
+    assert_eq!(
+        run.machine.controller().channels()[0].m_functions_acked(),
+        0
+    );
+}
+
+#[test]
+fn a_gear_on_a_single_axis_master_follows_it_in_the_same_tick() {
+    // Master and slave are both single axes; the PLC moves the master with MC_MoveAbsolute.
+    // Free axes run their generators before the engines, so the gear sees the master's
+    // set-point of the same tick: no lag, in acceleration as at constant velocity.
+    let toml = "cycle_ms = 1.0\nticks = 2000\n\
+        [[axis]]\nname = \"Master\"\npower = true\n\
+        [[axis]]\nname = \"Slave\"\npower = true\nstart = 3.0\n\
+        [[gear]]\nmaster = \"Master\"\nslave = \"Slave\"\nratio = 0.5\n\
+        [plc]\ntimeline = \"plc.toml\"\n";
+    let timeline = "[[step]]\nat_tick = 10\ncall = { block = \"MC_MoveAbsolute\", instance = \"m\", axis = 0, \
+        position = 200.0, velocity = 300.0, acceleration = 3000.0, deceleration = 3000.0, jerk = 30000.0 }\n";
+    let s = Scenario::parse("single.toml", toml, |_| {
+        Ok((PathBuf::from("plc.toml"), timeline.to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut moved = 0;
+    for _ in 0..2000 {
+        run.step(s.cycle_s);
+        let m = run.machine.axes().axis(0).unwrap().setpoint();
+        let f = run.machine.axes().axis(1).unwrap().setpoint();
+        assert!(
+            (f.position - (3.0 + 0.5 * m.position)).abs() < 1e-9,
+            "tick {}: slave {} for master {}",
+            run.machine.ticks(),
+            f.position,
+            m.position
+        );
+        assert!((f.velocity - 0.5 * m.velocity).abs() < 1e-9);
+        moved += usize::from(m.velocity != 0.0);
+    }
+    assert!(moved > 500, "the master moved for {moved} ticks");
+    let master = run.machine.axes().axis(0).unwrap();
+    assert!(
+        (master.actual() - 200.0).abs() < 1e-3,
+        "{}",
+        master.actual()
+    );
+    let slave = run.machine.axes().axis(1).unwrap();
+    assert!((slave.actual() - 103.0).abs() < 1e-3, "{}", slave.actual());
+}
+
+/// A tracking slave's axes are axes like any other: on simulated PT2 drives, the slave channel
+/// (images 6..11) follows the master channel's X move through `#TRACK CS`, and its X axis
+/// image shows it: the drive's velocity command (`nOutData1`, 10000 increments per mm/s) runs
+/// up to the master's 50 mm/s, the encoder count (`nInData1`, 10000 per mm) is the axis's
+/// actual position in the next tick, which lags its set-point (a following error) and settles on the master's
+/// 50 mm.
+#[test]
+fn a_tracking_slave_drives_its_axis_images_through_simulated_drives() {
+    let toml = "cycle_ms = 1.0\n\
+        [[channel]]\nname = \"master\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"m.nc\"\n\
+        drive = { model = \"pt2\", frequency_hz = 60.0, damping = 0.9 }\n\
+        [[channel]]\nname = \"slave\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"s.nc\"\n\
+        drive = { model = \"pt2\", frequency_hz = 60.0, damping = 0.9 }\n";
+    let s = Scenario::parse("tracking.toml", toml, |f| {
+        let text = if f == "m.nc" {
+            "#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 0.05\nG1 X50 F3000\n#TIME 0.5\nM30\n"
+        } else {
+            "#TRACK CS ON [CH=1 FILTER=0]\n#TIME 3\nM30\n"
+        };
+        Ok((PathBuf::from(f), text.to_string()))
+    })
+    .unwrap();
+    const SLAVE_X: usize = 6;
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let (mut max_command, mut min_command, mut max_fe, mut count) = (0i32, 0i32, 0.0f64, 0i32);
+    for tick in 0..4000 {
+        run.step(s.cycle_s);
+        let channels = run.machine.controller().channels();
+        for c in channels {
+            assert!(c.error().is_none(), "{}: {:?}", c.config().name, c.error());
+        }
+        // Masters tick first: the slave's set-point is the master's X of the same tick.
+        let master_x = channels[0].set_points()[0];
+        assert!(
+            (channels[1].set_points()[0] - master_x).abs() < 1e-9,
+            "tick {tick}"
+        );
+        let axis = run.machine.axes().axis(SLAVE_X).unwrap();
+        let image: HliAxis = CncView::new(&run.memory).axis(SLAVE_X).unwrap().read();
+        // The axis read, at the start of this tick, the count the drive wrote in the last.
+        assert_eq!(
+            f64::from(count) / 10_000.0,
+            axis.actual(),
+            "tick {tick}: the encoder count is the actual position"
+        );
+        assert_eq!(image.lr_state.current_position_acs_r, count, "tick {tick}");
+        count = image.enc_in.nInData1;
+        max_command = max_command.max(image.drive_out.nOutData1);
+        min_command = min_command.min(image.drive_out.nOutData1);
+        max_fe = max_fe.max(axis.following_error().abs());
+    }
+    // F3000 is 50 mm/s: 500000 increments per second at the top.
+    assert!(
+        max_command > 450_000 && max_command < 700_000,
+        "top velocity command {max_command}"
+    );
+    // Backwards only to take out the PT2 drive's small overshoot at the end.
+    assert!(
+        min_command > -max_command / 10,
+        "{min_command} {max_command}"
+    );
+    assert!(max_fe > 0.01, "the drive lags: {max_fe}");
+    let slave_x = run.machine.axes().axis(SLAVE_X).unwrap();
+    assert!(
+        (slave_x.actual() - 50.0).abs() < 1e-3,
+        "{}",
+        slave_x.actual()
+    );
+    assert_eq!(
+        lr(&run.memory, SLAVE_X).coupling_state_r,
+        CouplingState::Channel.raw()
+    );
+}

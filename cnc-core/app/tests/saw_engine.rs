@@ -1,0 +1,622 @@
+//! The flying-saw engine in the machine tick (seed 001): position sync exactly at the sync
+//! positions, to the tick; MC_GearOut leaves the slave at its velocity; the eight rollback
+//! cases of chapter 8 and the new synchronisation after one; refusals that leave the slave
+//! moving as before; the internal table rule; the characteristic values over the call; the
+//! diagonal saw; the time-based phase.
+
+use cnc_app::scenario::{InProcess, Scenario};
+use cnc_core::saw;
+use cnc_core::setpoint::Kinematic;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{
+    sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget,
+};
+use hli::enums::{AxisError, AxisState, CouplingState, SawError};
+use hli::layout::HliAxisLrState;
+use hli::views::{CncView, PlcView};
+
+const TICK: f64 = 0.001;
+const MASTER: usize = 0;
+const SAW: usize = 1;
+const LIMITS: [f64; 4] = [2000.0, 10000.0, 10000.0, 1e6];
+
+fn axis(name: &str, extra: &str) -> String {
+    format!(
+        "[[axis]]\nname = \"{name}\"\npower = true\nsoft_limits = [-1e7, 1e7]\nvelocity = 3000.0\n\
+         acceleration = 20000.0\ndeceleration = 20000.0\njerk = 1e7\nfollowing_error_limit = 1e4\n{extra}"
+    )
+}
+
+fn machine(extra: &str) -> InProcess {
+    let toml = format!(
+        "cycle_ms = 1.0\nticks = 10\n{}{}{extra}",
+        axis("Master", ""),
+        axis("Saw", "")
+    );
+    let s = Scenario::parse("saw.toml", &toml, |f| {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenarios/cams")
+            .join(f);
+        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    run.step(TICK);
+    run
+}
+
+fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) -> u32 {
+    let view = CncView::new(&run.memory);
+    run.machine.call(&view, axis as u32, &c).unwrap().error_id
+}
+
+fn gear_in(run: &mut InProcess, slave: usize, call: SawGearInCall) -> u32 {
+    let view = CncView::new(&run.memory);
+    run.machine
+        .call(&view, slave as u32, &call)
+        .unwrap()
+        .error_id
+}
+
+fn gear_out(run: &mut InProcess, slave: usize) -> u32 {
+    let view = CncView::new(&run.memory);
+    run.machine
+        .call(&view, slave as u32, &SawGearOutCall::default())
+        .unwrap()
+        .error_id
+}
+
+fn image(run: &InProcess, axis: usize) -> HliAxisLrState {
+    PlcView::new(&run.memory).axis_state(axis).unwrap()
+}
+
+fn set(run: &InProcess, axis: usize) -> Kinematic {
+    run.machine.axes().axis(axis).unwrap().setpoint()
+}
+
+fn phase(run: &InProcess, axis: usize) -> i32 {
+    image(run, axis).axis_state_r
+}
+
+/// Ticks until `done` holds; a watchdog of `max` ticks instead of a time limit.
+fn until(run: &mut InProcess, max: usize, done: impl Fn(&InProcess) -> bool) -> usize {
+    for k in 0..max {
+        if done(run) {
+            return k;
+        }
+        run.step(TICK);
+    }
+    panic!("not reached within {max} ticks");
+}
+
+/// Master at +500 mm/s, the saw at `slave_velocity`, both at constant velocity.
+fn moving(slave_velocity: f64) -> InProcess {
+    let mut run = machine("");
+    assert_eq!(
+        command(
+            &mut run,
+            MASTER,
+            AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6])
+        ),
+        0
+    );
+    let dir = if slave_velocity < 0.0 { -1 } else { 1 };
+    if slave_velocity != 0.0 {
+        let limits = [slave_velocity.abs(), 10000.0, 10000.0, 1e6];
+        assert_eq!(
+            command(&mut run, SAW, AxisCommandCall::move_velocity(dir, limits)),
+            0
+        );
+    }
+    until(&mut run, 2000, |r| {
+        set(r, MASTER).acceleration == 0.0
+            && set(r, SAW).acceleration == 0.0
+            && set(r, MASTER).velocity == 500.0
+    });
+    run
+}
+
+fn velocity_call(ratio: f64, mask: u32) -> SawGearInCall {
+    SawGearInCall {
+        master: MASTER as u32,
+        target: SawSyncTarget::Velocity.raw(),
+        ratio_numerator: ratio,
+        ratio_denominator: 1,
+        mask,
+        acceleration: 2500.0,
+        deceleration: 2500.0,
+        jerk: 5000.0,
+        ..SawGearInCall::default()
+    }
+}
+
+fn position_call(ms: f64, ss: f64, ratio: f64, mask: u32) -> SawGearInCall {
+    SawGearInCall {
+        target: SawSyncTarget::Position.raw(),
+        master_sync_position: ms,
+        slave_sync_position: ss,
+        ..velocity_call(ratio, mask)
+    }
+}
+
+#[test]
+fn position_sync_is_exact_at_the_tick_the_master_reaches_its_sync_position() {
+    // Seed 001, position sync example 1, relative to where the axes are.
+    let mut run = moving(250.0);
+    let (m0, s0) = (set(&run, MASTER).position, set(&run, SAW).position);
+    let (ms, ss) = (m0 + 1500.0, s0 + 1250.0);
+    assert_eq!(
+        gear_in(
+            &mut run,
+            SAW,
+            position_call(ms, ss, 1.0, m::MAXACC | m::MAXDEC | m::MAXJERK)
+        ),
+        0
+    );
+    run.step(TICK);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::GearPosition.raw()
+    );
+    // Up to the last tick before the master reaches its sync position: synchronising.
+    let k = until(&mut run, 4000, |r| {
+        set(r, MASTER).position + 500.0 * TICK >= ms - 1e-9
+    });
+    assert!(k > 2900, "three seconds of master travel: {k} ticks");
+    assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronizing.raw());
+    assert!(set(&run, SAW).position < ss);
+    run.step(TICK);
+    let (mp, sp) = (set(&run, MASTER), set(&run, SAW));
+    assert!(mp.position >= ms - 1e-9);
+    assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronous.raw());
+    assert!(
+        (sp.position - (ss + (mp.position - ms))).abs() < 1e-9,
+        "{sp:?} {mp:?}"
+    );
+    assert!((sp.velocity - 500.0).abs() < 1e-9);
+}
+
+#[test]
+fn gear_out_leaves_the_slave_at_its_velocity_until_halted() {
+    let mut run = moving(-250.0);
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(1.5, 0)), 0);
+    until(&mut run, 5000, |r| {
+        phase(r, SAW) == AxisState::SlaveSynchronous.raw()
+    });
+    assert!((set(&run, SAW).velocity - 750.0).abs() < 1e-9);
+    assert_eq!(gear_out(&mut run, SAW), 0);
+    assert_eq!(gear_out(&mut run, SAW), SawError::NotCoupled.raw());
+    assert_eq!(
+        command(&mut run, MASTER, AxisCommandCall::halt(10000.0, 1e6)),
+        0
+    );
+    for _ in 0..300 {
+        run.step(TICK);
+    }
+    assert_eq!(set(&run, MASTER).velocity, 0.0);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::Uncoupled.raw()
+    );
+    assert_eq!(phase(&run, SAW), AxisState::ConstantVelocity.raw());
+    assert!((set(&run, SAW).velocity - 750.0).abs() < 1e-9);
+    assert_eq!(
+        command(&mut run, SAW, AxisCommandCall::halt(10000.0, 1e6)),
+        0
+    );
+    until(&mut run, 2000, |r| set(r, SAW).velocity == 0.0);
+}
+
+/// Rollback, chapter 8: `(lock, instant, synchron reached)` and what must happen when the
+/// master runs back over the coupling position.
+#[derive(Debug, PartialEq)]
+enum Outcome {
+    /// The coupling holds: the slave runs back with the master.
+    Follows,
+    /// The slave's velocity is taken down along a polynomial.
+    SmoothStop,
+    /// The slave stops within the tick.
+    InstantStop,
+}
+
+#[test]
+fn the_eight_rollback_cases_of_chapter_8() {
+    use Outcome::*;
+    let cases = [
+        (false, false, true, Follows),     // 1
+        (false, false, false, SmoothStop), // 2
+        (false, true, false, InstantStop), // 3
+        (false, true, true, Follows),      // 4
+        (true, false, false, SmoothStop),  // 5
+        (true, false, true, SmoothStop),   // 6
+        (true, true, false, InstantStop),  // 7
+        (true, true, true, InstantStop),   // 8
+    ];
+    for (n, (lock, instant, synced, want)) in cases.into_iter().enumerate() {
+        let mask = if lock { m::ROLLBACKLOCK } else { 0 }
+            | if instant { m::INSTANTSTOPONROLLBACK } else { 0 };
+        let mut run = moving(250.0);
+        let m0 = set(&run, MASTER).position;
+        let call = if synced {
+            velocity_call(1.0, mask)
+        } else {
+            position_call(m0 + 1e5, set(&run, SAW).position + 1e5, 1.0, mask)
+        };
+        assert_eq!(gear_in(&mut run, SAW, call), 0, "case {}", n + 1);
+        if synced {
+            until(&mut run, 5000, |r| {
+                phase(r, SAW) == AxisState::SlaveSynchronous.raw()
+            });
+        } else {
+            for _ in 0..200 {
+                run.step(TICK);
+            }
+            assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronizing.raw());
+        }
+        // Back slowly (300 mm/s^2 towards 2000 mm/s): the master still accelerates when it
+        // runs over the coupling position, so a stop starts from an acceleration.
+        let back = AxisCommandCall::move_velocity(-1, [2000.0, 300.0, 300.0, 1e6]);
+        assert_eq!(command(&mut run, MASTER, back), 0);
+        // Up to the tick the master is back over the coupling position.
+        let mut before = set(&run, SAW);
+        for k in 0.. {
+            assert!(k < 20000, "case {}: the master never came back", n + 1);
+            if set(&run, MASTER).position < m0 {
+                break;
+            }
+            before = set(&run, SAW);
+            run.step(TICK);
+        }
+        let s = set(&run, SAW);
+        let got = match phase(&run, SAW) {
+            p if p == AxisState::SlaveSynchronous.raw() => {
+                assert!((s.velocity - set(&run, MASTER).velocity).abs() < 1e-9);
+                Follows
+            }
+            p if p == AxisState::SlavePrephase.raw() && s.velocity == 0.0 => InstantStop,
+            p if p == AxisState::SlavePrephase.raw() => {
+                // Braking from where it was: the first tick of the stop moves on.
+                assert!(s.position != before.position, "case {}: a stall", n + 1);
+                assert!(
+                    before.acceleration.abs() > 100.0,
+                    "case {}: {before:?}",
+                    n + 1
+                );
+                // Comes to rest with its jerk bounded and stands in the pre-phase.
+                let mut jerk: f64 = 0.0;
+                let mut k = 0;
+                while set(&run, SAW).velocity != 0.0 {
+                    jerk = jerk.max(set(&run, SAW).jerk.abs());
+                    run.step(TICK);
+                    k += 1;
+                    assert!(k < 5000, "case {}: no standstill", n + 1);
+                }
+                assert!(k > 10, "case {}: stopped in {k} ticks", n + 1);
+                // The stop keeps the command's jerk (5000 mm/s^3) from its start acceleration.
+                assert!(jerk <= 5000.0 * (1.0 + 1e-9), "case {}: jerk {jerk}", n + 1);
+                assert_eq!(phase(&run, SAW), AxisState::SlavePrephase.raw());
+                SmoothStop
+            }
+            p => panic!("case {}: phase {p}", n + 1),
+        };
+        assert_eq!(got, want, "case {}", n + 1);
+        if got != Follows {
+            // The master comes forward again over the coupling position: a new sync.
+            let standing = set(&run, SAW).position;
+            for _ in 0..50 {
+                run.step(TICK);
+                assert_eq!(
+                    set(&run, SAW).position,
+                    standing,
+                    "case {}: stands while the master is behind",
+                    n + 1
+                );
+            }
+            assert_eq!(
+                command(
+                    &mut run,
+                    MASTER,
+                    AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6])
+                ),
+                0
+            );
+            until(&mut run, 20000, |r| {
+                phase(r, SAW) == AxisState::SlaveSynchronizing.raw()
+            });
+            assert!(set(&run, MASTER).position >= m0);
+        }
+    }
+}
+
+#[test]
+fn a_refused_command_leaves_the_slave_moving_as_before() {
+    let mut run = moving(250.0);
+    let m0 = set(&run, MASTER).position;
+    let s0 = set(&run, SAW).position;
+    let refusals = [
+        (
+            position_call(m0 - 10.0, s0 + 100.0, 1.0, 0),
+            SawError::MasterSyncNotAhead.raw(),
+        ),
+        (
+            position_call(m0 + 100.0, s0 - 100.0, 1.0, 0),
+            SawError::SlaveSyncNotAhead.raw(),
+        ),
+        (velocity_call(0.0, 0), SawError::RatioZero.raw()),
+        (
+            SawGearInCall {
+                ratio_denominator: 0,
+                ..velocity_call(1.0, 0)
+            },
+            SawError::RatioZero.raw(),
+        ),
+        (
+            SawGearInCall {
+                jerk: -1.0,
+                ..velocity_call(1.0, 0)
+            },
+            SawError::NegativeLimit.raw(),
+        ),
+        (
+            SawGearInCall {
+                sync_mode: 7,
+                ..velocity_call(1.0, 0)
+            },
+            SawError::Mode.raw(),
+        ),
+        (
+            SawGearInCall {
+                sync_mode: SawSyncMode::TimeBased.raw(),
+                ..position_call(m0 + 1e3, s0 + 1e3, 1.0, 0)
+            },
+            SawError::TimeBasedPosition.raw(),
+        ),
+        (
+            SawGearInCall {
+                master: SAW as u32,
+                ..velocity_call(1.0, 0)
+            },
+            SawError::NoSuchMaster.raw(),
+        ),
+        (
+            SawGearInCall {
+                master: 9,
+                ..velocity_call(1.0, 0)
+            },
+            SawError::NoSuchMaster.raw(),
+        ),
+        // A limit that cannot be kept: sync 10 mm away in 10 mm of master travel from 250
+        // to 500 mm/s with 1 mm/s^2.
+        (
+            SawGearInCall {
+                acceleration: 1.0,
+                ..position_call(m0 + 10.0, s0 + 10.0, 1.0, m::MAXACC)
+            },
+            SawError::Limit.raw(),
+        ),
+    ];
+    for (call, code) in refusals {
+        assert_eq!(gear_in(&mut run, SAW, call), code, "{call:?}");
+        run.step(TICK);
+        assert_eq!(
+            image(&run, SAW).coupling_state_r,
+            CouplingState::Uncoupled.raw()
+        );
+        assert_eq!(set(&run, SAW).velocity, 250.0);
+        assert_eq!(phase(&run, SAW), AxisState::ConstantVelocity.raw());
+    }
+}
+
+#[test]
+fn a_slave_whose_internal_table_a_cam_uses_is_refused() {
+    // The stroke table has ID 2: the saw's table of axis ID 254.
+    let mut run = machine(&format!(
+        "{}[[cam_table]]\nfile = \"stroke_table.json\"\n",
+        axis("Other", "id = 254\n")
+    ));
+    assert_eq!(
+        command(&mut run, MASTER, AxisCommandCall::move_velocity(1, LIMITS)),
+        0
+    );
+    for _ in 0..100 {
+        run.step(TICK);
+    }
+    assert_eq!(
+        gear_in(&mut run, 2, velocity_call(1.0, 0)),
+        SawError::TableInUse.raw()
+    );
+    // Axis ID 2 (table 254) is free.
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(1.0, 0)), 0);
+}
+
+#[test]
+fn a_gear_slave_cannot_be_a_saw_slave() {
+    let mut run = machine(&format!(
+        "{}[[gear]]\nmaster = \"Master\"\nslave = \"Geared\"\nratio = 2.0\n",
+        axis("Geared", "")
+    ));
+    run.step(TICK);
+    assert_eq!(
+        gear_in(&mut run, 2, velocity_call(1.0, 0)),
+        AxisError::Coupled.raw()
+    );
+}
+
+#[test]
+fn the_characteristic_values_arrive_in_two_parts() {
+    let mut run = moving(250.0);
+    let view = CncView::new(&run.memory);
+    let none = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    assert_eq!(none.error_id, SawError::NotCoupled.raw());
+    let (m0, s0) = (set(&run, MASTER).position, set(&run, SAW).position);
+    assert_eq!(
+        gear_in(
+            &mut run,
+            SAW,
+            position_call(m0 + 1500.0, s0 + 1250.0, 1.0, 0)
+        ),
+        0
+    );
+    let view = CncView::new(&run.memory);
+    let a = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    let b = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 1 })
+        .unwrap();
+    assert_eq!((a.error_id, a.part, b.part), (0, 0, 1));
+    // fMasterVeloNom, fMasterPosStart, fSlavePosStart, fSlaveVeloStart ... fMasterPosEnd,
+    // fSlavePosEnd, fSlaveVeloEnd.
+    assert_eq!(a.values[0], 500.0);
+    assert_eq!((a.values[1], a.values[2], a.values[3]), (m0, s0, 250.0));
+    assert!((a.values[6] - (m0 + 1500.0)).abs() < 1e-9);
+    assert!((a.values[7] - (s0 + 1250.0)).abs() < 1e-9);
+    assert!((a.values[8] - 500.0).abs() < 1e-9);
+    // Part 1 starts at field 17 (fSlaveAccMin); fSlaveVeloMax is field 24.
+    assert!((b.values[7] - 500.0).abs() < 1e-9, "{:?}", b.values);
+    assert!(run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 2 })
+        .is_err());
+}
+
+#[test]
+fn the_diagonal_saw_moves_with_the_master_along_the_master() {
+    let alpha = 30f64.to_radians();
+    let ratio = saw::diagonal_ratio(alpha, 1.0).unwrap();
+    assert!(saw::diagonal_ratio(90f64.to_radians(), 1.0).is_err());
+    let mut run = moving(0.0);
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(ratio, 0)), 0);
+    until(&mut run, 5000, |r| {
+        phase(r, SAW) == AxisState::SlaveSynchronous.raw()
+    });
+    assert!((set(&run, SAW).velocity * alpha.cos() - set(&run, MASTER).velocity).abs() < 1e-9);
+}
+
+#[test]
+fn the_time_based_phase_runs_on_time_and_ends_synchronous() {
+    let mut run = moving(-250.0);
+    let call = SawGearInCall {
+        sync_mode: SawSyncMode::TimeBased.raw(),
+        ..velocity_call(1.0, m::MAXACC | m::MAXJERK)
+    };
+    assert_eq!(gear_in(&mut run, SAW, call), 0);
+    let mut peak_acc: f64 = 0.0;
+    let k = until(&mut run, 5000, |r| {
+        phase(r, SAW) == AxisState::SlaveSynchronous.raw()
+    });
+    // sqrt(750/5000) twice: 775 ms (a tick more for the tick the phase ends in).
+    assert!((775..=777).contains(&k), "{k} ticks");
+    for _ in 0..10 {
+        peak_acc = peak_acc.max(set(&run, SAW).acceleration.abs());
+        run.step(TICK);
+    }
+    assert!((set(&run, SAW).velocity - 500.0).abs() < 1e-9);
+}
+
+#[test]
+fn a_master_at_rest_at_coupling_leads_in_the_direction_it_then_moves() {
+    let mut run = machine("");
+    assert_eq!(
+        gear_in(&mut run, SAW, velocity_call(2.0, m::ROLLBACKLOCK)),
+        0
+    );
+    run.step(TICK);
+    assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronous.raw());
+    let limits = [300.0, 10000.0, 10000.0, 1e6];
+    assert_eq!(
+        command(&mut run, MASTER, AxisCommandCall::move_velocity(-1, limits)),
+        0
+    );
+    for _ in 0..200 {
+        run.step(TICK);
+        assert_eq!(phase(&run, SAW), AxisState::SlaveSynchronous.raw());
+    }
+    assert_eq!(set(&run, SAW).velocity, -600.0);
+    assert!((set(&run, SAW).position - 2.0 * set(&run, MASTER).position).abs() < 1e-9);
+}
+
+#[test]
+fn a_new_command_on_a_coupled_slave_plans_from_where_it_is() {
+    let mut run = moving(250.0);
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(1.0, 0)), 0);
+    for _ in 0..100 {
+        run.step(TICK);
+    }
+    let view = CncView::new(&run.memory);
+    let first = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    let before = set(&run, SAW);
+    // Refused: the coupling stays as it was.
+    let (m0, s0) = (set(&run, MASTER).position, before.position);
+    let behind = position_call(m0 - 1.0, s0 + 100.0, 1.0, 0);
+    assert_eq!(
+        gear_in(&mut run, SAW, behind),
+        SawError::MasterSyncNotAhead.raw()
+    );
+    run.step(TICK);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::GearVelocity.raw()
+    );
+    // Accepted: a position sync from the moving slave, continuous.
+    let prev = set(&run, SAW);
+    assert_eq!(
+        gear_in(
+            &mut run,
+            SAW,
+            position_call(m0 + 1000.0, s0 + 900.0, 1.0, 0)
+        ),
+        0
+    );
+    run.step(TICK);
+    let now = set(&run, SAW);
+    assert_eq!(
+        image(&run, SAW).coupling_state_r,
+        CouplingState::GearPosition.raw()
+    );
+    let expected = prev.position + prev.velocity * TICK;
+    assert!((now.position - expected).abs() < 0.01, "{prev:?} {now:?}");
+    let view = CncView::new(&run.memory);
+    let second = run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+        .unwrap();
+    assert_ne!(first.plan, second.plan, "each plan has its number");
+}
+
+/// The saw settings of `[plc]` go with the programs that have a saw, and only in range.
+#[test]
+fn saw_settings_of_a_plc_program_are_checked() {
+    let parse = |plc: &str| {
+        let toml = format!("cycle_ms = 1.0\nticks = 10\n[[axis]]\nname = \"A\"\n[plc]\n{plc}\n");
+        Scenario::parse("plc.toml", &toml, |f| {
+            Err(cnc_app::scenario::ScenarioError::Read {
+                file: f.into(),
+                message: "none".into(),
+            })
+        })
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+    };
+    assert_eq!(
+        parse("program = \"saw-cut\"\nsaw_cuts = 3\nsaw_length = 250.0"),
+        Ok(())
+    );
+    assert_eq!(parse("program = \"demo-machine\"\nsaw_cuts = 5"), Ok(()));
+    let e = parse("program = \"cam-conveyor\"\nsaw_cuts = 3").unwrap_err();
+    assert!(e.contains("belong to saw-cut and demo-machine"), "{e}");
+    let e = parse("program = \"saw-cut\"\nsaw_cuts = 0").unwrap_err();
+    assert!(e.contains("saw_cuts = 0: 1 to 64"), "{e}");
+    let e = parse("program = \"saw-cut\"\nsaw_length = -1.0").unwrap_err();
+    assert!(e.contains("saw_length = -1: mm above 0"), "{e}");
+    let e = parse("timeline = \"t.toml\"\nsaw_cuts = 3").unwrap_err();
+    assert!(e.contains("belong to a built-in program"), "{e}");
+}
