@@ -6,7 +6,9 @@
 //! * `cnc-beat INSTANCE`: create the segment, print `ready`, beat every millisecond until
 //!   stdin closes.
 //! * `plc-half-block INSTANCE`: send a whole FIFO row block of 10 rows x 3, then loan a
-//!   second, write half of it, print `half`, and abort (a PLC dying mid-write).
+//!   second, write half of it, print `half`, and abort when stdin closes (a PLC dying
+//!   mid-write; the test takes the whole block first, so no cleanup of the dead process by
+//!   another test's iceoryx2 node can take it away).
 
 use hli::segment::{CncSegment, PlcSegment};
 use hli::views::PlcView;
@@ -61,6 +63,7 @@ fn main() -> ExitCode {
             }
             println!("half");
             std::io::stdout().flush().ok();
+            let _ = std::io::stdin().lock().read_line(&mut String::new());
             std::process::abort();
         }
         other => {

@@ -10,10 +10,9 @@ use cnc_core::nc::{Decoded, MotionMode};
 use hli::segment::heap_image;
 use hli::views::CncView;
 
-mod support;
+use crate::support;
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
 const CYCLE: f64 = 0.001;

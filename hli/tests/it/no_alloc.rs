@@ -3,8 +3,7 @@
 use hli::segment::heap_image;
 use hli::views::{CncView, PlcView};
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
 #[test]

@@ -10,8 +10,7 @@ use hli::calls::CallKind;
 use hli::views::CncView;
 use hli::wire::{AcyclicRequest, ACYCLIC_BODY_SIZE};
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
 fn request(target: u32, call: &AxisCommandCall) -> AcyclicRequest {

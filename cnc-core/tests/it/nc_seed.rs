@@ -6,7 +6,7 @@
 //! Left out, as the issue says: bare `...` elision lines and the syntax synopses, whose `..`
 //! are placeholders.
 
-mod support;
+use crate::support;
 
 use cnc_core::nc::check::check_source;
 use cnc_core::nc::decode::TrackSource;
@@ -150,7 +150,7 @@ fn the_extraction_finds_the_known_constructs() {
 
 #[test]
 fn our_program_uses_each_known_construct_and_checks_cleanly() {
-    let src = include_str!("data/dyn_cs_constructs.nc");
+    let src = include_str!("../data/dyn_cs_constructs.nc");
     for construct in CONSTRUCTS {
         assert!(
             src.contains(construct),

@@ -16,6 +16,7 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
     let mut child = ChildGuard(
         Command::new(env!("CARGO_BIN_EXE_hli-peer"))
             .args(["plc-half-block", &instance])
+            .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
@@ -26,25 +27,28 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
         .read_line(&mut line)
         .unwrap();
     assert_eq!(line.trim(), "half");
-    let status = child
-        .wait_with_watchdog(Duration::from_secs(30))
-        .expect("child ended");
-    assert!(!status.success(), "the child aborted");
-    // Everything that reached the service: one whole block, never the half-written loan.
+    // The whole block arrives while the PLC is alive (a watchdog, not a timing assert).
     let mut blocks = Vec::new();
-    let deadline = Instant::now() + Duration::from_secs(5);
-    while Instant::now() < deadline {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while blocks.is_empty() {
+        assert!(
+            Instant::now() < deadline,
+            "watchdog: the whole block never arrived"
+        );
         server
             .poll_rows(|header, values| {
                 blocks.push((*header, values.to_vec()));
                 FifoReply::default()
             })
             .unwrap();
-        if !blocks.is_empty() {
-            break;
-        }
         std::thread::yield_now();
     }
+    // Now the PLC dies with half of the second block written.
+    drop(child.0.stdin.take());
+    let status = child
+        .wait_with_watchdog(Duration::from_secs(30))
+        .expect("child ended");
+    assert!(!status.success(), "the child aborted");
     // A few more polls: nothing else may arrive.
     for _ in 0..100 {
         server

@@ -15,8 +15,7 @@ use hli::views::{CncView, PlcView};
 use plc_shim::blocks::fifo::FifoWrite;
 use plc_shim::runtime::PlcIo;
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::{allocations, deallocations};
 
 const N: usize = 6;

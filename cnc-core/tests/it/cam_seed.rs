@@ -4,7 +4,7 @@
 //! (`support::seed_text` checks that it exists()), one more
 //! test reads the seed's table and checks that the data says the same.
 
-mod support;
+use crate::support;
 
 use cnc_core::cam::motion_function::Cursor;
 use cnc_core::cam::online::{MasterNow, OnlineChangeQueue, WriteOutcome};
@@ -66,7 +66,7 @@ struct Figures {
 }
 
 fn figures() -> Figures {
-    let text = include_str!("data/seed000_motion_function.toml");
+    let text = include_str!("../data/seed000_motion_function.toml");
     let data: SeedData = toml::from_str(text).expect("tests/data/seed000_motion_function.toml");
     let points = |rows: &[PointRow]| rows.iter().map(PointRow::point).collect::<Vec<_>>();
     Figures {

@@ -2,8 +2,7 @@
 //! task, time it, beat, notify) and a program using the typed views, counted per thread by a
 //! counting allocator between the 20th and the 400th cycle.
 
-#[path = "../support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 
 use counting_alloc::{allocations, deallocations};
 use plc_shim::runtime::{PlcIo, PlcProgram, PlcRuntime, RunEnd};

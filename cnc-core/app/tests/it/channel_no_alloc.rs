@@ -4,8 +4,7 @@
 
 use cnc_app::scenario::fleet::running;
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
 #[test]

@@ -7,8 +7,7 @@ use kinematics::opw::{Robot45, Robot45Params};
 use kinematics::tracking::{Tracking, TrackingMode, TrackingOption};
 use kinematics::{Kinematics, PoseWords};
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::allocations;
 
 #[test]

@@ -8,8 +8,7 @@ use hli::calls::saw::{sync_mask, SawGearInCall, SawSyncTarget};
 use hli::enums::AxisState;
 use hli::views::{CncView, PlcView};
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::{allocations, deallocations};
 
 const TICK: f64 = 0.001;

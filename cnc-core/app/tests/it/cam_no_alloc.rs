@@ -7,8 +7,7 @@ use cnc_core::cam::{
 };
 use hli::calls::cam::CamInterpolation;
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 use counting_alloc::{allocations, deallocations};
 
 #[test]
