@@ -13,7 +13,9 @@
 //!   transports);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
-//! All `unsafe` code is in [`raw`]. The crate has no motion logic.
+//! All `unsafe` code of the crate is in [`raw`] (the image memory and the `ZeroCopySend`
+//! impls). The crate has no motion logic; system calls that are not about the interface (the
+//! tick's sleep, memory advice, real-time settings) are in the `cnc-os` crate.
 
 pub mod access;
 pub mod c_header;
