@@ -8,6 +8,8 @@
 //! The application: `app` (scenarios and `cnc run`, the demo, the command-line tools), which
 //! may use the PLC crate; the `cnc` binary sits on top of it.
 
+#![forbid(unsafe_code)]
+
 pub mod app;
 pub mod axis;
 pub mod cam;

@@ -13,7 +13,10 @@
 //!   at start-up (a programming error), never an out-of-bounds access.
 //!
 //! Besides the image, the module holds `zero_copy_send!`, the `unsafe impl` that lets iceoryx2
-//! copy a plain-data payload between the processes. System calls that are not about the interface (sleeping, memory advice, real-time settings)
+//! copy a plain-data payload between the processes. The crate root denies `unsafe_code` and
+//! allows it for this module alone; the macro's expansion carries its own allow, so the
+//! `unsafe impl` it writes into `wire`, `calls` and `layout` is still text of this module.
+//! System calls that are not about the interface (sleeping, memory advice, real-time settings)
 //! are in the `cnc-os` crate.
 
 use core::marker::PhantomData;
@@ -303,6 +306,7 @@ macro_rules! zero_copy_send {
         // pointers, no references, no process-local handles, every bit pattern valid. Both
         // processes are built from this crate, so the default type name identifies the same
         // layout.
+        #[allow(unsafe_code)]
         unsafe impl iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend for $t {}
     )*};
 }

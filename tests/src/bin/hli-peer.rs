@@ -8,6 +8,8 @@
 //! * `plc-half-block INSTANCE`: send a whole FIFO row block of 10 rows x 3, then loan a
 //!   second, write half of it, print `half`, and abort (a PLC dying mid-write).
 
+#![forbid(unsafe_code)]
+
 use hli::segment::{CncSegment, PlcSegment};
 use hli::views::PlcView;
 use std::io::{BufRead, Write};
