@@ -7,6 +7,8 @@
 //! command-line tools and the `cnc` binary) is the package `cnc-app` in `cnc-core/app/`, and
 //! Cargo keeps the PLC crate out of this one.
 
+#![forbid(unsafe_code)]
+
 pub mod axis;
 pub mod cam;
 pub mod channel;

@@ -13,7 +13,12 @@
 //!   transports);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
-//! All `unsafe` code is in [`raw`]. The crate has no motion logic.
+//! All `unsafe` code of the crate is in [`raw`] (the image memory and the `ZeroCopySend`
+//! impls): the root denies `unsafe_code` and only `raw` allows it. The crate has no motion
+//! logic; system calls that are not about the interface (the tick's sleep, memory advice,
+//! real-time settings) are in the `cnc-os` crate.
+
+#![deny(unsafe_code)]
 
 pub mod access;
 pub mod c_header;
@@ -24,6 +29,7 @@ pub mod enums;
 pub mod events;
 pub mod handshake;
 pub mod layout;
+#[allow(unsafe_code)]
 pub mod raw;
 pub mod rpc;
 pub mod segment;

@@ -7,6 +7,8 @@
 //! for poses. Every computation refuses NaN/inf input and returns a typed [`KinError`] instead
 //! of NaN. Forward and inverse calls do not allocate.
 
+#![forbid(unsafe_code)]
+
 pub mod cartesian;
 pub mod chain;
 pub mod error;

@@ -2,6 +2,8 @@
 //! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
 //! the acyclic request-response service.
 
+#![forbid(unsafe_code)]
+
 pub mod blocks;
 pub mod cli;
 pub mod fifo_file;

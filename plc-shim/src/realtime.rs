@@ -67,7 +67,7 @@ impl RealtimeOptions {
         let mut applied = Vec::new();
         #[cfg(target_os = "linux")]
         {
-            use hli::raw::realtime as rt;
+            use cnc_os::realtime as rt;
             let mut attempt = |name: String, result: std::io::Result<()>| match result {
                 Ok(()) => applied.push(name),
                 Err(e) => {

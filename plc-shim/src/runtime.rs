@@ -280,9 +280,9 @@ impl PlcRuntime {
                     acyclic: &mut self.acyclic,
                     cycle: stats.cycles,
                 };
-                let start = hli::raw::monotonic::now();
+                let start = cnc_os::monotonic::now();
                 program.cycle(&mut io);
-                let took = hli::raw::monotonic::now().saturating_sub(start);
+                let took = cnc_os::monotonic::now().saturating_sub(start);
                 stats.record(took.as_nanos() as u64);
             }
             self.segment.beat();

@@ -1,6 +1,8 @@
 //! Shared helpers of the integration tests: unique instance names, payloads with checksums,
 //! and a watchdog for child processes. Nothing here is used by production code.
 
+#![forbid(unsafe_code)]
+
 use hli::layout::HliCoordinateSystemInt;
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};

@@ -1,7 +1,7 @@
 //! `cnc check` against LinuxCNC's `rs274 -g`, whole process against whole process: the same
 //! 100,000-block program (lines and arcs, centre and radius forms), each program started, run
 //! and waited for, in interleaved rounds; medians, the ratio taken per round, and each
-//! process's peak memory (its maximum resident set, `hli::raw::wait_with_peak_memory`). rs274 is skipped, and the
+//! process's peak memory (its maximum resident set, `cnc_os::wait_with_peak_memory`). rs274 is skipped, and the
 //! report says so, when it is not installed (Debian package `linuxcnc-uspace`).
 //!
 //! Three of ours: `cnc check FILE` (parse, run and check every block; prints nothing for a
@@ -65,7 +65,7 @@ fn run(cmd: &mut Command) -> (f64, i64) {
         .stderr(Stdio::null())
         .spawn()
         .expect("start the program");
-    let (success, peak) = hli::raw::wait_with_peak_memory(child).expect("wait4");
+    let (success, peak) = cnc_os::wait_with_peak_memory(child).expect("wait4");
     let elapsed = t0.elapsed().as_secs_f64();
     assert!(success, "{cmd:?} failed");
     (elapsed, peak)

@@ -2,6 +2,8 @@
 //! process with its spawned PLC), the demo, and the command-line tools. This package may use
 //! the PLC crate (`plc-shim`: timelines, the PLC process); the library does not depend on it.
 
+#![forbid(unsafe_code)]
+
 pub mod cam_cli;
 pub mod check_cli;
 pub mod demo;

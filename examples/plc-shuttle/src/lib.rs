@@ -5,6 +5,8 @@
 //! blocks and the HLI come from `plc-shim`; `main.rs` only parses the arguments and hands the
 //! program to [`plc_shim::cli::host`].
 
+#![forbid(unsafe_code)]
+
 use plc_shim::blocks::motion::{McMoveAbsolute, McPower};
 use plc_shim::runtime::{PlcIo, PlcProgram};
 

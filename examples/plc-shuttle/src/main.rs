@@ -4,6 +4,8 @@
 //! cargo run -p plc-shuttle -- --instance cnc-demo --axis 0 --far 400 --strokes 5
 //! ```
 
+#![forbid(unsafe_code)]
+
 use clap::Parser;
 use plc_shuttle::Shuttle;
 use std::process::ExitCode;

@@ -1,5 +1,7 @@
 //! The `plc` binary: attaches to a running CNC instance and runs a built-in PLC program.
 
+#![forbid(unsafe_code)]
+
 use clap::Parser;
 use std::process::ExitCode;
 

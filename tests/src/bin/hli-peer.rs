@@ -10,6 +10,8 @@
 //!   mid-write; the test takes the whole block first, so no cleanup of the dead process by
 //!   another test's iceoryx2 node can take it away).
 
+#![forbid(unsafe_code)]
+
 use hli::segment::{CncSegment, PlcSegment};
 use hli::views::PlcView;
 use std::io::{BufRead, Write};

@@ -1,5 +1,7 @@
 //! The `cnc` binary.
 
+#![forbid(unsafe_code)]
+
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 

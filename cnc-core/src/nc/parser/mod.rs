@@ -221,8 +221,8 @@ impl Parser<'_> {
         program.items.reserve((self.src.len() / 4).min(RESERVE_CAP));
         // Long programs fill tens of megabytes of fresh memory: in huge pages where the
         // system has them, one page fault per 2 MiB instead of one per 4 KiB.
-        hli::raw::advise_huge_pages(&mut program.blocks);
-        hli::raw::advise_huge_pages(&mut program.items);
+        cnc_os::advise_huge_pages(&mut program.blocks);
+        cnc_os::advise_huge_pages(&mut program.items);
         self.fill(&mut program, usize::MAX);
         if program.name.is_none() && !program.subs.is_empty() {
             self.close_sub(&mut program);
