@@ -2,7 +2,7 @@
 //! process image (increments, wraps, direction bits, drive modes), following error, I/O faults
 //! and refused commands.
 
-use cnc_core::axis::commands::{view_command, CommandView};
+use cnc_core::axis::commands::CommandView;
 use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode};
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
@@ -10,73 +10,14 @@ use cnc_core::axis::{AxisSet, Coupling};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::enums::{AxisError, AxisState, CouplingState, DirectionBits};
-use hli::layout::{HliAxis, NcDriveOut, NcEncoderIn};
-use hli::raw::ImageMemory;
+use hli::layout::{HliAxis, NcEncoderIn};
 use hli::views::CncView;
 use hli::PlaceExt;
 use proptest::prelude::*;
 
 const CYCLE: f64 = 0.001;
 
-struct Rig {
-    memory: ImageMemory,
-    set: AxisSet,
-}
-
-impl Rig {
-    fn new(configs: Vec<AxisConfig>) -> Self {
-        let memory = hli::segment::heap_image(1, configs.len() as u32);
-        let set = AxisSet::new(configs, CYCLE).unwrap();
-        set.prime(&CncView::new(&memory));
-        Self { memory, set }
-    }
-    fn tick(&mut self) {
-        self.set.tick(&CncView::new(&self.memory));
-    }
-    fn ticks(&mut self, n: usize) {
-        for _ in 0..n {
-            self.tick();
-        }
-    }
-    fn call(&mut self, axis: usize, call: AxisCommandCall) -> Result<u32, AxisError> {
-        self.set.axis_mut(axis).unwrap().command(&call)
-    }
-    fn enable(&mut self, axis: usize) {
-        self.tick();
-        self.call(axis, AxisCommandCall::power(true)).unwrap();
-    }
-    fn set_point(&self, axis: usize) -> Kinematic {
-        self.set.axis(axis).unwrap().setpoint()
-    }
-    fn view(&self, axis: usize, id: u32) -> CommandView {
-        view_command(&self.set.axis(axis).unwrap().book().image(), id)
-    }
-    fn drive_out(&self, axis: usize) -> NcDriveOut {
-        CncView::new(&self.memory)
-            .axis(axis)
-            .unwrap()
-            .field::<NcDriveOut>(core::mem::offset_of!(HliAxis, drive_out))
-            .read()
-    }
-    fn enc_in(&self, axis: usize) -> NcEncoderIn {
-        CncView::new(&self.memory)
-            .axis(axis)
-            .unwrap()
-            .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in))
-            .read()
-    }
-    /// Ticks until `done` or a watchdog of `max` ticks (a hang fails the test, it does not
-    /// time it).
-    fn until(&mut self, max: usize, mut done: impl FnMut(&Self) -> bool) -> usize {
-        for n in 0..max {
-            if done(self) {
-                return n;
-            }
-            self.tick();
-        }
-        panic!("watchdog: condition not met within {max} ticks");
-    }
-}
+type Rig = tests::AxisRig;
 
 const LIMITS: [f64; 4] = [500.0, 5000.0, 4000.0, 100_000.0];
 

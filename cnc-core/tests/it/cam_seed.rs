@@ -4,7 +4,7 @@
 //! (`support::seed_text` checks that it exists()), one more
 //! test reads the seed's table and checks that the data says the same.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::cam::motion_function::Cursor;
 use cnc_core::cam::online::{MasterNow, OnlineChangeQueue, WriteOutcome};

@@ -4,7 +4,7 @@
 //! automatic switch-on by P-CHAN-00399 `provide_channel_interface.track_cs`, and the slave's
 //! `request_r`.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::{Channel, ChannelConfigError, Controller, RunState};
 use hli::access::Leaf;

@@ -3,7 +3,7 @@
 //! lets the block go on, a PLC holding the feed until tracking is ACTIVE, refused values, and
 //! `path_feed_r`, `program_state_r`, `error_id_r`, `feed_override_r` as the PLC reads them.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::{Controller, RunState};
 use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};

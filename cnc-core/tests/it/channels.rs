@@ -2,7 +2,7 @@
 //! (the seed's example 3 geometry), the PLC as master through `MC_CONTROL_DYN_CS_UNIT`, and
 //! the refusals that put tracking into ERROR.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::{Controller, LoadedProgram, RunState, MAX_CHANNELS};
 use hli::enums::{DynCsCommand, DynCsState};

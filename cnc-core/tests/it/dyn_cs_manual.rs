@@ -4,7 +4,7 @@
 //! take-over, the soft release out of ERROR, and the PLC requests that are refused or not
 //! redirected without ever blocking a later switch-on.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::dyn_cs::{smooth_ramp, TrackEvent};
 use cnc_core::channel::{Controller, RunState};

@@ -24,7 +24,7 @@ mod nc_rs274;
 mod nc_seed;
 mod robot_config;
 mod saw_plan;
-mod support;
+
 mod touch_probe;
 mod track_cs_language;
 mod tracking_safety;

@@ -10,7 +10,7 @@ use cnc_core::nc::{Decoded, MotionMode};
 use hli::segment::heap_image;
 use hli::views::CncView;
 
-use crate::support;
+use tests::channel_rig as support;
 
 use crate::counting_alloc;
 use counting_alloc::allocations;

@@ -6,7 +6,7 @@
 //! Left out, as the issue says: bare `...` elision lines and the syntax synopses, whose `..`
 //! are placeholders.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::nc::check::check_source;
 use cnc_core::nc::decode::TrackSource;

@@ -2,7 +2,7 @@
 //! shortcuts), kinematic 201 by its DH rows, both running in a channel, and the tool data
 //! record (`D`) on the flange under a transformation.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::kin_config::{DhRow, KinematicsConfig, OpwGeometry};
 use cnc_core::channel::{Channel, ChannelConfig, RunState};

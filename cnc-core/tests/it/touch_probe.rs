@@ -8,43 +8,38 @@
 
 use cnc_core::axis::config::{AxisConfig, DriveLink, ProbeInterface};
 use cnc_core::axis::sim_drive::SimDriveConfig;
-use cnc_core::axis::AxisSet;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{AxisError, ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe, NcEncoderIn, NcEncoderOut};
-use hli::raw::ImageMemory;
 use hli::views::CncView;
 use hli::PlaceExt;
 
-const CYCLE: f64 = 0.001;
 /// One increment at 10000 per mm.
 const INCREMENT: f64 = 1e-4;
 
-struct Rig {
-    memory: ImageMemory,
-    set: AxisSet,
+/// The kit's axis rig with one axis, and the probe's own accessors.
+struct Rig(tests::AxisRig);
+
+impl core::ops::Deref for Rig {
+    type Target = tests::AxisRig;
+    fn deref(&self) -> &tests::AxisRig {
+        &self.0
+    }
+}
+
+impl core::ops::DerefMut for Rig {
+    fn deref_mut(&mut self) -> &mut tests::AxisRig {
+        &mut self.0
+    }
 }
 
 impl Rig {
     fn new(config: AxisConfig) -> Self {
-        let mut rig = Self::unpowered(config);
-        rig.tick();
-        rig.set
-            .axis_mut(0)
-            .unwrap()
-            .command(&AxisCommandCall::power(true))
-            .unwrap();
-        rig
+        Rig(tests::AxisRig::powered(config))
     }
     fn unpowered(config: AxisConfig) -> Self {
-        let memory = hli::segment::heap_image(1, 1);
-        let set = AxisSet::new(vec![config], CYCLE).unwrap();
-        set.prime(&CncView::new(&memory));
-        Self { memory, set }
-    }
-    fn tick(&mut self) {
-        self.set.tick(&CncView::new(&self.memory));
+        Rig(tests::AxisRig::new(vec![config]))
     }
     fn place(&self) -> hli::Place<'_, HliAxis> {
         CncView::new(&self.memory).axis(0).unwrap()

@@ -1,7 +1,7 @@
 //! `#TRACK CS` as the program loads it: every refusal with its place (NAME:LINE:COL), ABSOLUTE
 //! as SET_ZERO's other name, and `V.G.TRACK_CS.A..C` in the channel's orientation convention.
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::{LoadedProgram, RunState};
 use hli::views::{CncView, PlcView};

@@ -2,7 +2,7 @@
 //! tracked motion beyond them is refused, and switching on does not depend on which channel
 //! ticks first. The axes here have real limits (the other channel tests use stiff ones).
 
-use crate::support;
+use tests::channel_rig as support;
 
 use cnc_core::channel::path::AxisLimits;
 use cnc_core::channel::{ChannelConfig, LoadedProgram, RunState};

@@ -5,78 +5,13 @@
 
 use cnc_core::axis::config::{AxisConfig, DriveLink, DriveMode, DriveProtocol};
 use cnc_core::axis::sim_drive::{Dynamic, SimDriveConfig};
-use cnc_core::axis::AxisSet;
 use hli::calls::axis::AxisCommandCall;
 use hli::enums::{axis_status, drive_flags, AxisError, DriveState};
-use hli::layout::{
-    HliAxis, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn, NcEncoderOut,
-};
-use hli::raw::ImageMemory;
+use hli::layout::{HliAxis, HliAxisDriveState, HliAxisLrState, NcDriveIn, NcDriveOut, NcEncoderIn};
 use hli::views::CncView;
 use hli::PlaceExt;
 
-const CYCLE: f64 = 0.001;
-
-struct Rig {
-    memory: ImageMemory,
-    set: AxisSet,
-}
-
-macro_rules! block {
-    ($name:ident, $set:ident, $ty:ty, $field:ident) => {
-        #[allow(dead_code)]
-        fn $name(&self, axis: usize) -> $ty {
-            CncView::new(&self.memory)
-                .axis(axis)
-                .unwrap()
-                .field::<$ty>(core::mem::offset_of!(HliAxis, $field))
-                .read()
-        }
-        #[allow(dead_code)]
-        fn $set(&self, axis: usize, value: $ty) {
-            CncView::new(&self.memory)
-                .axis(axis)
-                .unwrap()
-                .field::<$ty>(core::mem::offset_of!(HliAxis, $field))
-                .write(&value)
-        }
-    };
-}
-
-impl Rig {
-    fn new(configs: Vec<AxisConfig>) -> Self {
-        let memory = hli::segment::heap_image(1, configs.len() as u32);
-        let set = AxisSet::new(configs, CYCLE).unwrap();
-        set.prime(&CncView::new(&memory));
-        Self { memory, set }
-    }
-    fn tick(&mut self) {
-        self.set.tick(&CncView::new(&self.memory));
-    }
-    fn ticks(&mut self, n: usize) {
-        for _ in 0..n {
-            self.tick();
-        }
-    }
-    fn call(&mut self, axis: usize, call: AxisCommandCall) -> Result<u32, AxisError> {
-        self.set.axis_mut(axis).unwrap().command(&call)
-    }
-    fn until(&mut self, max: usize, mut done: impl FnMut(&Self) -> bool) -> usize {
-        for n in 0..max {
-            if done(self) {
-                return n;
-            }
-            self.tick();
-        }
-        panic!("watchdog: condition not met within {max} ticks");
-    }
-    block!(lr, set_lr, HliAxisLrState, lr_state);
-    block!(drive_state, set_drive_state, HliAxisDriveState, drive_state);
-    block!(drive_out, set_drive_out, NcDriveOut, drive_out);
-    block!(enc_out, set_enc_out, NcEncoderOut, enc_out);
-    block!(drive_in, set_drive_in, NcDriveIn, drive_in);
-    block!(enc_in, set_enc_in, NcEncoderIn, enc_in);
-}
+type Rig = tests::AxisRig;
 
 fn external(name: &str, id: u32, mode: DriveMode) -> AxisConfig {
     let mut c = AxisConfig::linear(name, id);

@@ -1,6 +1,5 @@
-//! Helpers shared by the channel tests: channel configurations, a controller running given
-//! programs on a heap image, a watchdog loop, and PLC payloads.
-#![allow(dead_code)] // each test binary uses its own subset
+//! Channels on a heap image for the channel tests: channel configurations, a controller
+//! running given programs, a watchdog loop, and the PLC's dynamic-CS payloads.
 
 use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
 use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition};
@@ -8,9 +7,12 @@ use hli::segment::heap_image;
 use hli::views::CncView;
 use hli::{Bool, ImageMemory};
 
+/// The CNC cycle of the channel tests, 1 ms.
 pub const CYCLE: f64 = 0.001;
+/// The joint angles a [`robot`] starts at (degrees).
 pub const ROBOT_HOME: [f64; 6] = [0.0, -60.0, 90.0, 0.0, 60.0, 0.0];
 
+/// A KR6 R900 sixx robot channel (kinematic 45) with stiff axes, at [`ROBOT_HOME`].
 pub fn robot(name: &str) -> ChannelConfig {
     let mut c = stiff(ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]));
     c.kinematics.id = 45;
@@ -19,6 +21,7 @@ pub fn robot(name: &str) -> ChannelConfig {
     c
 }
 
+/// A Cartesian channel with the six axes X..C, stiff.
 pub fn cartesian(name: &str) -> ChannelConfig {
     stiff(ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]))
 }
@@ -80,6 +83,7 @@ pub fn controller(configs: Vec<(ChannelConfig, &str)>) -> Controller {
     Controller::new(channels).unwrap()
 }
 
+/// A heap image of `channels` channels and 8 axes.
 pub fn image(channels: usize) -> ImageMemory {
     heap_image(channels as u32, 8)
 }

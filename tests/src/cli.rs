@@ -1,0 +1,206 @@
+//! Running the project's programs (`cnc`, `plc`, `hli-peer`) from a test: [`Cli`] is a
+//! `Command` whose `output`, `status` and `spawn` come with a watchdog (a hung program is
+//! killed and the test fails with what it printed, it never hangs the test run), and
+//! [`Scratch`] a folder of the test's own that is removed afterwards.
+//!
+//! ```no_run
+//! let out = tests::Cli::new(env!("CARGO_BIN_EXE_cnc"))
+//!     .args(["hli", "symbols"])
+//!     .output()
+//!     .unwrap();
+//! assert!(out.status.success());
+//! ```
+
+use crate::child::ChildGuard;
+use std::ffi::OsStr;
+use std::io::{self, Read};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitStatus, Output, Stdio};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// How long a program may run before its watchdog kills it: long enough for a debug build on
+/// a loaded 2-core machine; `TEST_WATCHDOG_S` overrides it.
+pub fn default_watchdog() -> Duration {
+    let secs = std::env::var("TEST_WATCHDOG_S")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(600);
+    Duration::from_secs(secs)
+}
+
+/// A program to run, with a watchdog.
+#[derive(Debug)]
+pub struct Cli {
+    command: Command,
+    watchdog: Duration,
+}
+
+impl Cli {
+    /// `program` (a test's `env!("CARGO_BIN_EXE_cnc")`, say) with no arguments yet.
+    pub fn new(program: impl AsRef<OsStr>) -> Self {
+        Cli {
+            command: Command::new(program),
+            watchdog: default_watchdog(),
+        }
+    }
+
+    /// One more argument.
+    pub fn arg(mut self, arg: impl AsRef<OsStr>) -> Self {
+        self.command.arg(arg);
+        self
+    }
+
+    /// More arguments.
+    pub fn args<I: IntoIterator<Item = S>, S: AsRef<OsStr>>(mut self, args: I) -> Self {
+        self.command.args(args);
+        self
+    }
+
+    /// An environment variable of the program.
+    pub fn env(mut self, key: impl AsRef<OsStr>, value: impl AsRef<OsStr>) -> Self {
+        self.command.env(key, value);
+        self
+    }
+
+    /// The program's working folder.
+    pub fn current_dir(mut self, dir: impl AsRef<Path>) -> Self {
+        self.command.current_dir(dir);
+        self
+    }
+
+    /// The program's stdin ([`Cli::spawn`]; `output` and `status` give it none).
+    pub fn stdin(mut self, cfg: Stdio) -> Self {
+        self.command.stdin(cfg);
+        self
+    }
+
+    /// The program's stdout ([`Cli::spawn`]).
+    pub fn stdout(mut self, cfg: Stdio) -> Self {
+        self.command.stdout(cfg);
+        self
+    }
+
+    /// The program's stderr ([`Cli::spawn`]).
+    pub fn stderr(mut self, cfg: Stdio) -> Self {
+        self.command.stderr(cfg);
+        self
+    }
+
+    /// Another watchdog than [`default_watchdog`].
+    pub fn watchdog(mut self, limit: Duration) -> Self {
+        self.watchdog = limit;
+        self
+    }
+
+    /// Runs the program to its end with stdout and stderr captured. `Err` if it could not
+    /// start, or if the watchdog killed it (the error carries what it printed).
+    pub fn output(mut self) -> io::Result<Output> {
+        let child = self
+            .command
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()?;
+        let mut guard = ChildGuard(child);
+        let out = drain(guard.0.stdout.take());
+        let err = drain(guard.0.stderr.take());
+        let status = guard.wait_with_watchdog(self.watchdog);
+        let (stdout, stderr) = (join(out), join(err));
+        match status {
+            Some(status) => Ok(Output {
+                status,
+                stdout,
+                stderr,
+            }),
+            None => Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!(
+                    "watchdog: {:?} killed after {:?}\nstdout:\n{}\nstderr:\n{}",
+                    self.command,
+                    self.watchdog,
+                    String::from_utf8_lossy(&stdout),
+                    String::from_utf8_lossy(&stderr)
+                ),
+            )),
+        }
+    }
+
+    /// Runs the program to its end with its output inherited; `Err` as [`Cli::output`].
+    pub fn status(mut self) -> io::Result<ExitStatus> {
+        let mut guard = ChildGuard(self.command.stdin(Stdio::null()).spawn()?);
+        guard.wait_with_watchdog(self.watchdog).ok_or_else(|| {
+            let text = format!(
+                "watchdog: {:?} killed after {:?}",
+                self.command, self.watchdog
+            );
+            io::Error::new(io::ErrorKind::TimedOut, text)
+        })
+    }
+
+    /// Starts the program; the guard kills it when dropped unless it has ended (wait for it
+    /// with [`ChildGuard::wait_with_watchdog`]).
+    pub fn spawn(mut self) -> io::Result<ChildGuard> {
+        Ok(ChildGuard(self.command.spawn()?))
+    }
+}
+
+fn drain(pipe: Option<impl Read + Send + 'static>) -> Option<JoinHandle<Vec<u8>>> {
+    pipe.map(|mut pipe| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            bytes
+        })
+    })
+}
+
+fn join(reader: Option<JoinHandle<Vec<u8>>>) -> Vec<u8> {
+    reader.and_then(|r| r.join().ok()).unwrap_or_default()
+}
+
+/// A folder of the test's own under the temporary folder, removed when dropped.
+#[derive(Debug)]
+pub struct Scratch(PathBuf);
+
+impl Scratch {
+    /// A fresh, empty folder named after `test` and unique in this test run.
+    pub fn new(test: &str) -> Self {
+        let dir = std::env::temp_dir().join(crate::unique_instance(test));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("create the scratch folder");
+        Scratch(dir)
+    }
+
+    /// The folder.
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+
+    /// A path in the folder.
+    pub fn join(&self, name: impl AsRef<Path>) -> PathBuf {
+        self.0.join(name)
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// The repository's root folder (where `scenarios/` and `docs/` are).
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the tests package sits in the repository root")
+        .to_path_buf()
+}
+
+/// `scenarios/NAME/scenario.toml` of the repository.
+pub fn scenario(name: &str) -> PathBuf {
+    repo_root()
+        .join("scenarios")
+        .join(name)
+        .join("scenario.toml")
+}
