@@ -22,4 +22,4 @@ pub use config::{ChannelConfig, ChannelConfigError};
 pub use controller::{Controller, ControllerError};
 pub use dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 pub use program::{LoadedProgram, ProgramError};
-pub use run::{Channel, ChannelError, RunState, MAX_CHANNELS};
+pub use run::{Channel, ChannelError, ChannelFault, RunState, MAX_CHANNELS};

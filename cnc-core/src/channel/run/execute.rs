@@ -96,10 +96,7 @@ impl Channel {
             Decoded::Trafo { on, id, .. } => self.switch_trafo(on, id),
             Decoded::SignalSyn { id, count, .. } => {
                 if sync.signal(id, count).is_err() {
-                    self.fail(
-                        ChannelErrorId::Synchronisation,
-                        "#SIGNAL SYN: too many synchronisation ids pending".to_string(),
-                    );
+                    self.fail(ChannelFault::SyncBoardFull);
                 }
             }
             Decoded::WaitSyn { ids, .. } => {
@@ -189,7 +186,7 @@ impl Channel {
     /// `#TRACK CS ON` refused: the tracker goes to ERROR and the channel fails.
     pub(super) fn refuse_track(&mut self, error: TrackError) {
         self.pose.tracker.fail(error);
-        self.fail(ChannelErrorId::Tracking, format!("#TRACK CS ON: {error}"));
+        self.fail(ChannelFault::TrackRefused(error));
     }
 }
 

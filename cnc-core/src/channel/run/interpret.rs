@@ -188,8 +188,8 @@ impl Channel {
             }
             // The channel's values are a running machine's: nothing is undecided here.
             Ok(Step::Control | Step::Undecided) => true,
-            Err(d) => {
-                self.fail(ChannelErrorId::Program, d.message);
+            Err(e) => {
+                self.fail(ChannelFault::Program(e.fault));
                 false
             }
         }

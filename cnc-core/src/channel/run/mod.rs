@@ -22,6 +22,7 @@
 //! (`PlcLink`), `transition` the PLC's dynamic-CS transition, `safety` the guard, the
 //! failure latch and the reset (`Safety`).
 
+mod error;
 mod execute;
 mod interpret;
 mod motion;
@@ -31,6 +32,7 @@ mod safety;
 mod tool;
 mod transition;
 
+pub use error::{ChannelError, ChannelFault};
 pub use safety::ResetError;
 
 use execute::ProgramValues;
@@ -51,6 +53,7 @@ use super::plc_io::{
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
+use crate::nc::ast::AxisName;
 use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
@@ -83,17 +86,6 @@ pub enum RunState {
     Finished,
     /// Stopped by an error (see [`Channel::error`]).
     Error,
-}
-
-/// Why a channel stopped: the block and the reason.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ChannelError {
-    /// Source line of the block.
-    pub line: u32,
-    /// The kind of cause, as `error_id_r` reports it.
-    pub id: ChannelErrorId,
-    /// What went wrong.
-    pub message: String,
 }
 
 /// One channel: its identity and run state, and one part per job (see the module's text).
@@ -231,7 +223,7 @@ impl Channel {
         self.advance();
         if let Some(reason) = self.stopping {
             if self.state == RunState::Running && !self.is_moving() {
-                self.fail(ChannelErrorId::MachineStop, reason.to_string());
+                self.fail(ChannelFault::MachineStop(reason));
             }
         }
         let master = self.master_sample(masters);

@@ -116,7 +116,7 @@ impl Channel {
             &mut self.motion.path_generator,
         ) {
             Ok(path) => self.motion.path = path,
-            Err(e) => self.fail(ChannelErrorId::Path, e.to_string()),
+            Err(e) => self.fail(ChannelFault::Path(e)),
         }
     }
 
@@ -148,10 +148,8 @@ impl Channel {
         );
         *active = planned.is_ok();
         if planned.is_err() {
-            self.fail(
-                ChannelErrorId::IndependentAxis,
-                format!("independent axis {}: no profile", self.config.axes[axis]),
-            );
+            let axis = AxisName::from(self.config.axes[axis].as_str());
+            self.fail(ChannelFault::IndependentNoProfile { axis });
             return;
         }
         if !asynchronous {

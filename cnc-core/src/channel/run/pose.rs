@@ -108,7 +108,7 @@ impl Channel {
                     let tracking = self.pose.tracker.state() != DynCsState::Inactive;
                     let failed = self.state == RunState::Error;
                     if !failed && (self.state == RunState::Running || tracking) {
-                        self.fail(ChannelErrorId::Kinematics, format!("pose unreachable: {e}"));
+                        self.fail(ChannelFault::PoseUnreachable(e));
                     }
                 }
             }
@@ -201,19 +201,13 @@ impl Channel {
     /// last one taken off; the tool stays where it is.
     pub(super) fn coordinate_system(&mut self, on: bool, frame: [f64; 6]) {
         if !self.pose.trafo {
-            self.fail(
-                ChannelErrorId::CoordinateSystem,
-                "#CS needs an active transformation (#TRAFO ON)".to_string(),
-            );
+            self.fail(ChannelFault::CsWithoutTrafo);
             return;
         }
         let before = self.cs_frame();
         if on {
             if self.pose.cs_len == CS_DEPTH {
-                self.fail(
-                    ChannelErrorId::CoordinateSystem,
-                    format!("more than {CS_DEPTH} coordinate systems active"),
-                );
+                self.fail(ChannelFault::CsDepth);
                 return;
             }
             let words = PoseWords {
@@ -226,7 +220,7 @@ impl Channel {
                     self.pose.cs_len += 1;
                 }
                 Err(e) => {
-                    self.fail(ChannelErrorId::CoordinateSystem, format!("#CS: {e}"));
+                    self.fail(ChannelFault::CsFrame(e));
                     return;
                 }
             }
@@ -243,13 +237,8 @@ impl Channel {
     pub(super) fn switch_trafo(&mut self, on: Option<bool>, id: Option<u32>) {
         if let Some(id) = id {
             if id != self.config.kinematics.id {
-                self.fail(
-                    ChannelErrorId::Kinematics,
-                    format!(
-                        "kinematic {id} is not configured for this channel (configured: {})",
-                        self.config.kinematics.id
-                    ),
-                );
+                let configured = self.config.kinematics.id;
+                self.fail(ChannelFault::KinematicNotConfigured { id, configured });
                 return;
             }
         }

@@ -3,10 +3,10 @@
 //! channel takes the held position over before it hands the set-points back. A reset clears
 //! the channel's and the tracker's errors at rest.
 
-use super::{Channel, ChannelError, RunState};
+use super::{Channel, ChannelError, ChannelFault, RunState};
 use crate::channel::dyn_cs::TrackError;
 use crate::channel::guard::JointGuard;
-use hli::enums::{ChannelErrorId, DynCsState};
+use hli::enums::DynCsState;
 use kinematics::Kinematics;
 
 /// Why [`Channel::reset`] refused.
@@ -29,7 +29,8 @@ pub(super) struct Safety {
 }
 
 impl Channel {
-    pub(super) fn fail(&mut self, id: ChannelErrorId, message: String) {
+    pub(super) fn fail(&mut self, fault: ChannelFault) {
+        let id = fault.id();
         // A tracking slave that fails can no longer follow (the guard brakes its axes).
         if matches!(
             self.pose.tracker.state(),
@@ -40,7 +41,7 @@ impl Channel {
         self.error = Some(ChannelError {
             line: self.run.line,
             id,
-            message,
+            fault,
         });
         self.state = RunState::Error;
         self.motion.path = None;
@@ -100,7 +101,7 @@ impl Channel {
             .tracker
             .last_error()
             .unwrap_or(TrackError::BadFrame);
-        self.fail(ChannelErrorId::Tracking, format!("tracking: {cause}"));
+        self.fail(ChannelFault::Tracking(cause));
     }
 
     /// While the dynamic CS acts on the set-points, a step beyond an axis's velocity or
@@ -118,10 +119,7 @@ impl Channel {
         });
         // Also a channel whose program ended in this tick: its last step was refused.
         if self.state != RunState::Error {
-            self.fail(
-                ChannelErrorId::Tracking,
-                format!("tracked step refused: {violation}"),
-            );
+            self.fail(ChannelFault::TrackedStep(violation));
         }
     }
 
