@@ -259,6 +259,39 @@ impl PathMove {
         self.done
     }
 
+    /// The velocity and acceleration of every axis at the position the last [`Self::step`]
+    /// wrote, from the path's own (`generator`'s) velocity and acceleration: the exact
+    /// derivatives of the interpolated position, 0 once the block has ended at its target.
+    pub fn rates(
+        &self,
+        generator: &SetpointGenerator,
+        velocity: &mut AxisValues,
+        acceleration: &mut AxisValues,
+    ) {
+        if self.done && !self.braked {
+            velocity.fill(0.0);
+            acceleration.fill(0.0);
+            return;
+        }
+        let state = generator.state();
+        let s = (state.position / self.length).clamp(0.0, 1.0);
+        let (ds, dds) = (
+            state.velocity / self.length,
+            state.acceleration / self.length,
+        );
+        for (i, d) in self.delta.iter().enumerate() {
+            velocity[i] = d * ds;
+            acceleration[i] = d * dds;
+        }
+        if let Some(c) = &self.circle {
+            let (v, a) = c.rates(s, ds, dds);
+            for (k, &axis) in c.axes.iter().enumerate() {
+                velocity[axis] = v[k];
+                acceleration[axis] = a[k];
+            }
+        }
+    }
+
     /// Brakes along the block to a standstill with the block's own deceleration and jerk;
     /// the block then ends where the path came to rest, short of its target. When the rest of
     /// the block is shorter than the braking distance, the block runs to its end (where it

@@ -235,6 +235,7 @@ impl Channel {
         self.fail_on_tracking_error();
         self.update_pose();
         self.guard_set_points(tracked);
+        self.motion.rates_apply = !self.pose.trafo && !tracked && !self.safety.guard.latched();
         self.note_dyn_cs_state();
         self.fill_outputs();
     }

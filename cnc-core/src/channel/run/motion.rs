@@ -9,6 +9,13 @@ pub(super) struct Motion {
     pub(super) limits: AxisLimits,
     /// Programmed position (channel coordinates, after offsets).
     pub(super) programmed: AxisValues,
+    /// Its velocity and acceleration this tick, from the path's and the independent axes'
+    /// generators (0 for an axis at rest).
+    pub(super) velocity: AxisValues,
+    pub(super) acceleration: AxisValues,
+    /// The set-points are the programmed position this tick (no transformation, no dynamic CS
+    /// on them, the guard not holding them): `velocity` and `acceleration` are theirs.
+    pub(super) rates_apply: bool,
     pub(super) path: Option<PathMove>,
     /// Runs the path parameter of every block (one generator, re-targeted: no allocation).
     pub(super) path_generator: SetpointGenerator,
@@ -26,6 +33,9 @@ impl Motion {
         Self {
             limits,
             programmed: *start,
+            velocity: AxisValues::zeros(start.len()),
+            acceleration: AxisValues::zeros(start.len()),
+            rates_apply: false,
             path: None,
             path_generator: SetpointGenerator::new(cycle_s, 0.0),
             independent: (0..start.len())
@@ -41,6 +51,15 @@ impl Channel {
     /// Programmed position (channel coordinates).
     pub fn programmed(&self) -> &AxisValues {
         &self.motion.programmed
+    }
+
+    /// The velocity and acceleration of the set-points this tick (channel order), when the
+    /// channel knows them exactly: without a transformation, without the dynamic CS acting on
+    /// the set-points and without the guard holding them, they are the path's and the
+    /// independent axes' own. `None` otherwise (the axes take differences then).
+    pub fn set_point_rates(&self) -> Option<(&AxisValues, &AxisValues)> {
+        let m = &self.motion;
+        m.rates_apply.then_some((&m.velocity, &m.acceleration))
     }
 
     /// The PLC's override and feed hold in effect.
@@ -182,16 +201,24 @@ impl Channel {
 
     pub(super) fn advance(&mut self) {
         let (feed, rapid) = self.override_factors();
-        if let Some(path) = self.motion.path.as_mut() {
-            path.set_override(feed, rapid, &mut self.motion.path_generator);
-            if path.step(&mut self.motion.path_generator, &mut self.motion.programmed) {
-                self.motion.path = None;
+        let m = &mut self.motion;
+        m.velocity.fill(0.0);
+        m.acceleration.fill(0.0);
+        if let Some(path) = m.path.as_mut() {
+            path.set_override(feed, rapid, &mut m.path_generator);
+            let ended = path.step(&mut m.path_generator, &mut m.programmed);
+            path.rates(&m.path_generator, &mut m.velocity, &mut m.acceleration);
+            if ended {
+                m.path = None;
             }
         }
-        for (i, (g, active)) in self.motion.independent.iter_mut().enumerate() {
+        for (i, (g, active)) in m.independent.iter_mut().enumerate() {
             if *active {
                 let progress = g.step();
-                self.motion.programmed[i] = g.state().position;
+                let state = g.state();
+                m.programmed[i] = state.position;
+                m.velocity[i] = state.velocity;
+                m.acceleration[i] = state.acceleration;
                 if matches!(progress, Progress::Reached | Progress::Idle) {
                     *active = false;
                 }
