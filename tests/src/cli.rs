@@ -4,7 +4,7 @@
 //! [`Scratch`] a folder of the test's own that is removed afterwards.
 //!
 //! ```no_run
-//! let out = tests::Cli::new(env!("CARGO_BIN_EXE_cnc"))
+//! let out = tests::Cli::new("target/debug/cnc")
 //!     .args(["hli", "symbols"])
 //!     .output()
 //!     .unwrap();

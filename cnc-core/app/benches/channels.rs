@@ -23,10 +23,13 @@
 
 use cnc_app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
 use cnc_app::scenario::{InProcess, Scenario};
-use cnc_core::channel::axes_out::AxisPublisher;
 use cnc_core::channel::{Channel, Controller};
+use cnc_core::setpoint::AxisValues;
+use hli::enums::CouplingState;
+use hli::layout::{HliAxis, HliAxisLrState};
 use hli::views::CncView;
 use hli::views::PlcView;
+use hli::PlaceExt;
 use std::time::Instant;
 
 const TICKS: usize = 5_000;
@@ -68,6 +71,64 @@ fn tracking_pt2(n: usize) -> Box<dyn FnMut()> {
     let drive = "{ model = \"pt2\", frequency_hz = 80.0, damping = 0.9 }";
     let mut run = running_on(n, Some(drive), WARM_UP).expect("fleet running on PT2 drives");
     Box::new(move || run.machine.tick(&run.memory))
+}
+
+/// The way channel axes reached the axis images before the machine tick, kept here as this
+/// benchmark's baseline: each channel axis's `gpAx[k]^lr_state` written straight from the
+/// channel's set-point, no axis layer, no drive (the library's only writer of gpAx is the
+/// axis layer).
+struct AxisPublisher {
+    first: usize,
+    last: AxisValues,
+    last_velocity: AxisValues,
+    cycle_s: f64,
+}
+
+impl AxisPublisher {
+    /// Axes `first..first + start.len()` of the image, standing at `start`, ticking every
+    /// `cycle_s`.
+    fn new(first: usize, start: &AxisValues, cycle_s: f64) -> Self {
+        Self {
+            first,
+            last: *start,
+            last_velocity: AxisValues::zeros(start.len()),
+            cycle_s,
+        }
+    }
+
+    /// Writes `set_points` (channel order) into the axis images. Does not allocate.
+    fn publish(&mut self, view: &CncView<'_>, set_points: &AxisValues) {
+        for (i, &p) in set_points.iter().enumerate() {
+            let Ok(axis) = view.axis(self.first + i) else {
+                break;
+            };
+            let v = (p - self.last[i]) / self.cycle_s;
+            let a = (v - self.last_velocity[i]) / self.cycle_s;
+            let state = cnc_core::axis::motion_phase(v, a);
+            // Linear units (0.1 um) and angle units (0.0001 degree) scale alike.
+            let raw = |x: f64| {
+                hli::units::mm_to_hli(x).unwrap_or(if x < 0.0 { i32::MIN } else { i32::MAX })
+            };
+            let position = raw(p);
+            axis.field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
+                .write(&HliAxisLrState {
+                    current_position_acs_r: position,
+                    command_position_acs_r: position,
+                    current_velocity_r: raw(v),
+                    command_velocity_r: raw(v),
+                    command_acceleration_r: raw(a),
+                    following_error_r: 0,
+                    axis_state_r: state.raw(),
+                    coupling_state_r: CouplingState::Channel.raw(),
+                    master_axis_r: -1,
+                    error_id_r: 0,
+                    status_r: 0,
+                    fill_up_1: 0,
+                });
+            self.last[i] = p;
+            self.last_velocity[i] = v;
+        }
+    }
 }
 
 /// The path before the machine tick: channels, then each channel's set-points written into

@@ -3,7 +3,6 @@
 //! publishing its frame with `#CHANNEL INTERFACE`, the PLC as master through
 //! `MC_CONTROL_DYN_CS_UNIT`, and tracking slaves with `#TRACK CS`).
 
-pub mod axes_out;
 pub mod config;
 pub mod controller;
 pub mod diag_wire;
@@ -23,4 +22,4 @@ pub use config::{ChannelConfig, ChannelConfigError};
 pub use controller::{Controller, ControllerError};
 pub use dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 pub use program::{LoadedProgram, ProgramError};
-pub use run::{Channel, ChannelError, RunState, MAX_CHANNELS};
+pub use run::{Channel, ChannelError, ChannelFault, RunState, MAX_CHANNELS};

@@ -1,7 +1,8 @@
 //! A channel's axes on the axis layer: each channel axis is an `Axis` coupled to its channel
-//! (coupling kind `Channel`), fed the channel's set-point every tick with velocity and
-//! acceleration from differences, so it has a drive (ideal or simulated), a following error
-//! and an actual position like every other axis.
+//! (coupling kind `Channel`), fed the channel's set-point every tick with the path's velocity
+//! and acceleration where the channel knows them (no transformation, no dynamic CS on the
+//! set-points), else with differences, so it has a drive (ideal or simulated), a following
+//! error and an actual position like every other axis.
 
 use crate::axis::config::{AxisConfig, DriveLink, Dynamics};
 use crate::axis::sim_drive::DriveModel;
@@ -85,11 +86,24 @@ impl ChannelAxes {
         }
     }
 
-    /// Hands the channel's set-points of this tick to its axes. Does not allocate.
-    pub fn drive(&mut self, axes: &mut AxisSet, set_points: &AxisValues) {
+    /// Hands the channel's set-points of this tick to its axes, with their velocity and
+    /// acceleration from `rates` when the channel gives them
+    /// ([`crate::channel::Channel::set_point_rates`]), else from differences. Does not
+    /// allocate.
+    pub fn drive(
+        &mut self,
+        axes: &mut AxisSet,
+        set_points: &AxisValues,
+        rates: Option<(&AxisValues, &AxisValues)>,
+    ) {
         for (i, &p) in set_points.iter().enumerate().take(self.count) {
-            let v = (p - self.last[i]) / self.cycle_s;
-            let a = (v - self.last_velocity[i]) / self.cycle_s;
+            let (v, a) = match rates {
+                Some((velocity, acceleration)) => (velocity[i], acceleration[i]),
+                None => {
+                    let v = (p - self.last[i]) / self.cycle_s;
+                    (v, (v - self.last_velocity[i]) / self.cycle_s)
+                }
+            };
             let phase = motion_phase(v, a);
             if let Some(lease) = self.leases.get(i).copied().flatten() {
                 let set = Kinematic {

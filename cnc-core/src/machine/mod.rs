@@ -174,7 +174,11 @@ impl Machine {
         // 3 hand-over
         for (channel, link) in self.controller.channels().iter().zip(self.links.iter_mut()) {
             if let Some(link) = link {
-                link.drive(&mut self.axes, channel.set_points());
+                link.drive(
+                    &mut self.axes,
+                    channel.set_points(),
+                    channel.set_point_rates(),
+                );
             }
         }
         // 4 axes sense

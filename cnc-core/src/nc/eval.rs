@@ -17,30 +17,68 @@ fn flag(c: bool) -> f64 {
     }
 }
 
+/// Why an operator or function has no value a program can use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EvalError {
+    /// `a / 0`.
+    DivisionByZero,
+    /// `a MOD 0`.
+    ModByZero,
+    /// A negative number to a fractional power.
+    NegativeToFraction,
+    /// 0 to a negative power.
+    ZeroToNegative,
+    /// `SQRT` of a negative value.
+    SqrtNegative,
+    /// `LN` of 0 or less.
+    LnNotPositive,
+    /// `TAN` at an odd multiple of 90 degrees.
+    TanPole,
+    /// `ASIN`/`ACOS` outside -1..1.
+    AsinAcosRange,
+}
+
+impl core::fmt::Display for EvalError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(match self {
+            EvalError::DivisionByZero => "division by zero",
+            EvalError::ModByZero => "MOD by zero",
+            EvalError::NegativeToFraction => {
+                "a negative number to a fractional power (**) has no real value"
+            }
+            EvalError::ZeroToNegative => "0 to a negative power (**) is a division by zero",
+            EvalError::SqrtNegative => "SQRT of a negative value",
+            EvalError::LnNotPositive => "LN of a value that is not positive",
+            EvalError::TanPole => "TAN of an odd multiple of 90 degrees",
+            EvalError::AsinAcosRange => "ASIN/ACOS of a value outside -1..1",
+        })
+    }
+}
+
 /// `a op b`.
-pub fn binary(op: BinOp, a: f64, b: f64) -> Result<f64, &'static str> {
+pub fn binary(op: BinOp, a: f64, b: f64) -> Result<f64, EvalError> {
     Ok(match op {
         BinOp::Add => a + b,
         BinOp::Sub => a - b,
         BinOp::Mul => a * b,
         BinOp::Div => {
             if b == 0.0 {
-                return Err("division by zero");
+                return Err(EvalError::DivisionByZero);
             }
             a / b
         }
         BinOp::Mod => {
             if b == 0.0 {
-                return Err("MOD by zero");
+                return Err(EvalError::ModByZero);
             }
             a % b
         }
         BinOp::Pow => {
             if a < 0.0 && b.fract() != 0.0 {
-                return Err("a negative number to a fractional power (**) has no real value");
+                return Err(EvalError::NegativeToFraction);
             }
             if a == 0.0 && b < 0.0 {
-                return Err("0 to a negative power (**) is a division by zero");
+                return Err(EvalError::ZeroToNegative);
             }
             a.powf(b)
         }
@@ -57,20 +95,20 @@ pub fn binary(op: BinOp, a: f64, b: f64) -> Result<f64, &'static str> {
 }
 
 /// `func[a]` or `func[a, b]` (ATAN2 takes y, then x).
-pub fn function(func: Func, a: f64, b: Option<f64>) -> Result<f64, &'static str> {
+pub fn function(func: Func, a: f64, b: Option<f64>) -> Result<f64, EvalError> {
     Ok(match func {
         Func::Abs => a.abs(),
         Func::Sqr => a * a,
         Func::Sqrt => {
             if a < 0.0 {
-                return Err("SQRT of a negative value");
+                return Err(EvalError::SqrtNegative);
             }
             a.sqrt()
         }
         Func::Exp => a.exp(),
         Func::Ln => {
             if a <= 0.0 {
-                return Err("LN of a value that is not positive");
+                return Err(EvalError::LnNotPositive);
             }
             a.ln()
         }
@@ -79,13 +117,13 @@ pub fn function(func: Func, a: f64, b: Option<f64>) -> Result<f64, &'static str>
         Func::Tan => {
             let c = sin_deg(a + 90.0);
             if c == 0.0 {
-                return Err("TAN of an odd multiple of 90 degrees");
+                return Err(EvalError::TanPole);
             }
             sin_deg(a) / c
         }
         Func::Asin | Func::Acos => {
             if !(-1.0..=1.0).contains(&a) {
-                return Err("ASIN/ACOS of a value outside -1..1");
+                return Err(EvalError::AsinAcosRange);
             }
             if func == Func::Asin {
                 a.asin().to_degrees()
@@ -134,7 +172,11 @@ mod tests {
         assert!((function(Func::Atan2, 1.0, Some(1.0)).unwrap() - 45.0).abs() < 1e-12);
         assert_eq!(
             function(Func::Sqrt, -1.0, None),
-            Err("SQRT of a negative value")
+            Err(EvalError::SqrtNegative)
+        );
+        assert_eq!(
+            EvalError::SqrtNegative.to_string(),
+            "SQRT of a negative value"
         );
         assert!(function(Func::Ln, 0.0, None).is_err());
         assert!(function(Func::Tan, 90.0, None).is_err());

@@ -286,7 +286,7 @@ fn switching_on_twice_is_an_error_and_keeps_the_setpoint() {
     }
     let ch = &ctl.channels()[0];
     assert_eq!(ch.state(), RunState::Error);
-    assert!(ch.error().unwrap().message.contains("already on"));
+    assert!(ch.error().unwrap().to_string().contains("already on"));
     assert_eq!(ch.error().unwrap().line, 2);
     assert_eq!(ch.tracker().state(), DynCsState::Error);
 }

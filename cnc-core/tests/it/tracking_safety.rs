@@ -194,7 +194,11 @@ fn a_frame_step_without_filter_is_refused_on_a_cartesian_and_a_robot_slave() {
         assert_eq!(ch.tracker().state(), DynCsState::Error, "{name}");
         assert_eq!(ch.state(), RunState::Error);
         assert_eq!(ch.error().unwrap().id, ChannelErrorId::Tracking);
-        assert!(ch.error().unwrap().message.contains("tracked step refused"));
+        assert!(ch
+            .error()
+            .unwrap()
+            .to_string()
+            .contains("tracked step refused"));
         assert_eq!(
             ch.set_points().to_vec(),
             before,

@@ -414,7 +414,7 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
         .map(|(c, &err)| ChannelReport {
             name: c.config().name.clone(),
             outcome: match c.error() {
-                Some(e) => format!("error at line {}: {}", e.line, e.message),
+                Some(e) => format!("error at line {}: {}", e.line, e.message()),
                 None => format!("{:?}", c.state()).to_lowercase(),
             },
             tracking: c

@@ -160,3 +160,82 @@ fn the_machine_tick_with_single_axes_an_engine_and_a_plc_allocates_nothing() {
     assert!(axes.axis(spindle).unwrap().setpoint().velocity > 89.0);
     assert!(run.timeline.as_ref().unwrap().records()[0].fired > 1000);
 }
+
+/// Runs `program` on a six-axis Cartesian channel: 200 ticks to start, then counts the
+/// allocations of the 3000 ticks in which the program fails (the error kept as values, the
+/// guard latching and holding the axes). Returns the error and the allocations.
+fn fail_in_the_tick(program: &str) -> (cnc_core::channel::ChannelError, usize) {
+    use cnc_app::scenario::file::Scenario;
+    use cnc_app::scenario::machine::InProcess;
+    use cnc_core::channel::RunState;
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"failing\"\n\
+        axes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"fail.nc\"\n";
+    let program = program.to_string();
+    let scenario = Scenario::parse("failing", toml, |file| {
+        Ok((std::path::PathBuf::from(file), program.clone()))
+    })
+    .expect("the program passes the check at load");
+    let mut run = InProcess::new(&scenario, 0).unwrap();
+    for _ in 0..200 {
+        run.machine.tick(&run.memory);
+    }
+    let running = run.machine.controller().channels()[0].state();
+    assert_eq!(
+        running,
+        RunState::Running,
+        "the program runs before it fails"
+    );
+    let before = allocations();
+    for _ in 0..3000 {
+        run.machine.tick(&run.memory);
+    }
+    let made = allocations() - before;
+    let channel = &run.machine.controller().channels()[0];
+    assert_eq!(channel.state(), RunState::Error);
+    (*channel.error().expect("the channel failed"), made)
+}
+
+/// A division by zero in a block the check at load cannot reach: the `$IF` reads a machine
+/// value, and on its own the block's P1 has no value yet. At run time the channel reaches it
+/// after a move and fails in the tick.
+#[test]
+fn a_division_by_zero_at_run_time_fails_the_channel_without_allocating() {
+    use cnc_core::channel::ChannelFault;
+    use cnc_core::nc::decode::DecodeError;
+    use cnc_core::nc::eval::EvalError;
+    use cnc_core::nc::interp::ProgramFault;
+    let program =
+        "%fail\nP1 = 0\nG1 X100 F6000\n$IF V.G.TRACK_CS.X < 1\nP2 = 10 / P1\n$ENDIF\nM30\n";
+    let (error, made) = fail_in_the_tick(program);
+    assert_eq!(
+        error.fault,
+        ChannelFault::Program(ProgramFault::Decode(DecodeError::Eval(
+            EvalError::DivisionByZero
+        )))
+    );
+    assert_eq!(error.to_string(), "division by zero");
+    assert_eq!(made, 0, "{made} allocations while the channel failed");
+}
+
+/// A variable read before it is assigned, in a motion block reached only at run time.
+#[test]
+fn an_unassigned_variable_at_run_time_fails_the_channel_without_allocating() {
+    let program = "%fail\nG1 X100 F6000\n$IF V.G.TRACK_CS.X < 1\nG1 X=V.P.DEPTH\n$ENDIF\nM30\n";
+    let (error, made) = fail_in_the_tick(program);
+    assert_eq!(
+        error.to_string(),
+        "variable \"V.P.DEPTH\" is read before it is assigned"
+    );
+    assert_eq!(made, 0, "{made} allocations while the channel failed");
+}
+
+/// `#TRACK CS ON` to a channel the controller does not have: refused when the block runs
+/// (the check at load does not know the controller), the tracking goes to ERROR.
+#[test]
+fn a_tracking_refused_at_run_time_fails_the_channel_without_allocating() {
+    let program = "%fail\nG1 X100 F6000\n#TRACK CS ON [CH=5]\nM30\n";
+    let (error, made) = fail_in_the_tick(program);
+    assert_eq!(error.id, hli::enums::ChannelErrorId::Tracking);
+    assert!(error.to_string().starts_with("#TRACK CS ON: "), "{error}");
+    assert_eq!(made, 0, "{made} allocations while the channel failed");
+}

@@ -131,11 +131,7 @@ fn a_channel_whose_axis_faults_stops_in_error() {
         run.step(s.cycle_s);
     }
     let c = &run.machine.controller().channels()[0];
-    let error = c
-        .error()
-        .expect("the channel ended in error")
-        .message
-        .clone();
+    let error = c.error().expect("the channel ended in error").to_string();
     assert!(error.contains("a channel axis faulted"), "{error}");
     assert!(run.machine.axes().axis(0).unwrap().error().is_some());
 }
@@ -202,7 +198,7 @@ fn a_stop_ends_a_waiting_channel_in_error_before_the_machine_counts_as_at_rest()
     run.step(s.cycle_s);
     let c = &run.machine.controller().channels()[0];
     assert_eq!(
-        c.error().map(|e| e.message.as_str()),
+        c.error().map(|e| e.to_string()).as_deref(),
         Some("machine stop: test")
     );
     assert!(run.machine.at_rest());

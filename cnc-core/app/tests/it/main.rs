@@ -5,6 +5,7 @@
 mod cam_engine;
 mod cam_no_alloc;
 mod channel_no_alloc;
+mod channel_rates;
 mod cli_blocks;
 mod cli_cam;
 mod cli_cams;

@@ -1,128 +1,291 @@
-//! The pose pipeline (programmed words -> `#CS` -> dynamic CS -> kinematics) and the values
-//! the channel shows the PLC after its tick.
+//! The pose pipeline: programmed words -> `#CS` frames -> dynamic CS -> kinematics (with
+//! `#TRAFO` on) or per-axis compensation (off), the switching of `#CS` and `#TRAFO`, and the
+//! frame the channel publishes on its interface.
 
 use super::*;
 
+/// The pose pipeline's state: kinematics, `#CS` stack, the dynamic CS and the set-points.
+pub(super) struct Pose {
+    pub(super) order: RotationOrder,
+    /// The configured kinematics with the selected tool record on its flange.
+    pub(super) kinematics: ToolKinematics,
+    /// `#TRAFO` is on.
+    pub(super) trafo: bool,
+    pub(super) cs_stack: [Isometry3<f64>; CS_DEPTH],
+    pub(super) cs_len: usize,
+    /// The dynamic CS (tracking slave side).
+    pub(super) tracker: Tracker,
+    /// Set-points of the channel's axes (joints first under a transformation).
+    pub(super) set_points: AxisValues,
+    pub(super) joints: Joints,
+    /// Tool pose before and after the dynamic CS (base coordinates).
+    pub(super) pose_in: Isometry3<f64>,
+    pub(super) pose_out: Isometry3<f64>,
+    /// Tool pose of the set-points (forward kinematics, once per tick).
+    pub(super) tool: Isometry3<f64>,
+    /// `#CHANNEL INTERFACE ON`: the channel publishes its tool frame.
+    pub(super) interface_on: bool,
+    pub(super) published: Option<MasterSample>,
+}
+
 impl Channel {
+    /// Set-points of the channel's axes.
+    pub fn set_points(&self) -> &AxisValues {
+        &self.pose.set_points
+    }
+
+    /// Tool pose commanded (after the dynamic CS), base coordinates.
+    pub fn pose_out(&self) -> &Isometry3<f64> {
+        &self.pose.pose_out
+    }
+
+    /// Tool pose before the dynamic CS.
+    pub fn pose_in(&self) -> &Isometry3<f64> {
+        &self.pose.pose_in
+    }
+
+    /// The tool pose of the current set-points by forward kinematics.
+    pub fn tool_pose(&self) -> Isometry3<f64> {
+        self.pose.tool
+    }
+
+    /// The tool pose that the given actual axis positions (channel order) realise.
+    pub fn realised_tool(&self, actual: &[f64]) -> Option<Isometry3<f64>> {
+        let mut j = [0.0; 6];
+        let n = actual.len().min(6);
+        j[..n].copy_from_slice(&actual[..n]);
+        self.pose.kinematics.forward(&j).ok()
+    }
+
+    /// The tracker.
+    pub fn tracker(&self) -> &Tracker {
+        &self.pose.tracker
+    }
+
+    /// What this channel publishes on its interface this tick.
+    pub fn published(&self) -> Option<MasterSample> {
+        self.pose.published
+    }
+
+    /// Whether the channel follows another channel's interface (it must tick after it).
+    pub fn follows_channel(&self) -> Option<usize> {
+        match self.pose.tracker.source() {
+            Some(MasterSource::Channel(c)) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The dynamic-CS diagnosis as the text tables of the controller: the history (tick,
+    /// state, input position, CS translation and rotation, output position) and the switching
+    /// log.
+    pub fn dyn_cs_diagnosis(&self) -> String {
+        crate::channel::diagnosis::render(self.index, &self.pose.tracker)
+    }
+
     /// The pose pipeline. Under SIMU the tracked pose is computed and shown (history,
     /// `position_dyncs_r`) while the set-points stay on the untracked pose.
     pub(super) fn update_pose(&mut self) {
-        let n = self.programmed.len();
-        let compensation = *self.tracker.applied();
-        let simulating = self.tracker.simulating();
-        if self.trafo {
-            self.pose_in = self.cs_frame() * self.programmed_frame();
-            self.pose_out = self.tracker.option().apply(&compensation, &self.pose_in);
+        let n = self.motion.programmed.len();
+        let compensation = *self.pose.tracker.applied();
+        let simulating = self.pose.tracker.simulating();
+        if self.pose.trafo {
+            self.pose.pose_in = self.cs_frame() * self.programmed_frame();
+            self.pose.pose_out = self
+                .pose
+                .tracker
+                .option()
+                .apply(&compensation, &self.pose.pose_in);
             let commanded = if simulating {
-                self.pose_in
+                self.pose.pose_in
             } else {
-                self.pose_out
+                self.pose.pose_out
             };
-            match self.kinematics.inverse(&commanded, &self.joints) {
-                Ok(j) => self.joints = j,
+            match self.pose.kinematics.inverse(&commanded, &self.pose.joints) {
+                Ok(j) => self.pose.joints = j,
                 Err(e) => {
                     // A running program, or a tracking that moves an idle channel: it fails
                     // (once) and the guard brakes its axes.
-                    let tracking = self.tracker.state() != DynCsState::Inactive;
+                    let tracking = self.pose.tracker.state() != DynCsState::Inactive;
                     let failed = self.state == RunState::Error;
                     if !failed && (self.state == RunState::Running || tracking) {
-                        self.fail(ChannelErrorId::Kinematics, format!("pose unreachable: {e}"));
+                        self.fail(ChannelFault::PoseUnreachable(e));
                     }
                 }
             }
-            self.set_points[..6].copy_from_slice(&self.joints);
-            self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
+            self.pose.set_points[..6].copy_from_slice(&self.pose.joints);
+            self.pose.tool = self
+                .pose
+                .kinematics
+                .forward(&self.pose.joints)
+                .unwrap_or(self.pose.tool);
         } else {
-            let tracking = self.tracker.state() != DynCsState::Inactive;
+            let tracking = self.pose.tracker.state() != DynCsState::Inactive;
             let mut c = if tracking {
                 words(&compensation)
             } else {
                 [0.0; 6]
             };
-            if self.tracker.option() == TrackingOption::TranslationOnly {
+            if self.pose.tracker.option() == TrackingOption::TranslationOnly {
                 c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
             }
             let mut tracked = [0.0; 6];
             for (i, c) in c.iter().enumerate() {
-                tracked[i] = self.programmed[i] + c;
-                self.set_points[i] = if simulating {
-                    self.programmed[i]
+                tracked[i] = self.motion.programmed[i] + c;
+                self.pose.set_points[i] = if simulating {
+                    self.motion.programmed[i]
                 } else {
                     tracked[i]
                 };
-                self.joints[i] = self.set_points[i];
+                self.pose.joints[i] = self.pose.set_points[i];
             }
             if tracking {
                 let mut plain = [0.0; 6];
-                plain.copy_from_slice(&self.programmed[..6]);
-                self.pose_in = self.kinematics.forward(&plain).unwrap_or(self.pose_in);
+                plain.copy_from_slice(&self.motion.programmed[..6]);
+                self.pose.pose_in = self
+                    .pose
+                    .kinematics
+                    .forward(&plain)
+                    .unwrap_or(self.pose.pose_in);
             }
-            self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
-            self.pose_out = if simulating {
-                self.kinematics.forward(&tracked).unwrap_or(self.tool)
+            self.pose.tool = self
+                .pose
+                .kinematics
+                .forward(&self.pose.joints)
+                .unwrap_or(self.pose.tool);
+            self.pose.pose_out = if simulating {
+                self.pose
+                    .kinematics
+                    .forward(&tracked)
+                    .unwrap_or(self.pose.tool)
             } else {
-                self.tool
+                self.pose.tool
             };
             if !tracking {
                 // No compensation: the pose before the dynamic CS is the tool pose.
-                self.pose_in = self.tool;
+                self.pose.pose_in = self.pose.tool;
             }
         }
-        self.set_points[6..n].copy_from_slice(&self.programmed[6..n]);
-        self.tracker.record(&self.pose_in, &self.pose_out);
+        self.pose.set_points[6..n].copy_from_slice(&self.motion.programmed[6..n]);
+        self.pose
+            .tracker
+            .record(&self.pose.pose_in, &self.pose.pose_out);
     }
 
-    pub(super) fn fill_outputs(&mut self) {
-        let out = &mut self.outputs;
-        out.dyn_cs_state = self.tracker.state();
-        out.dyn_cs_request = frame_to_hli(self.tracker.applied(), RotationOrder::Zyx).ok();
-        let w0 = words_in(&self.tool, self.order);
-        let dyncs = words_in(&self.pose_out, self.order);
-        out.coord_count = self.programmed.len().min(out.coords.len());
-        for i in 0..out.coord_count {
-            let angle = (3..6).contains(&i);
-            let to_hli = |v: f64| hli_value(v, angle);
-            out.coords[i] = HliCoordState {
-                w0_position_r: if self.config.kin_trafo_display > 0 && i < 6 {
-                    to_hli(w0[i])
-                } else {
-                    0
-                },
-                position_dyncs_r: if i < 6 {
-                    to_hli(dyncs[i])
-                } else {
-                    to_hli(self.set_points[i])
-                },
-                command_position_r: to_hli(self.programmed[i]),
-                fill_up_1: 0,
-            };
+    pub(super) fn cs_frame(&self) -> Isometry3<f64> {
+        self.pose.cs_stack[..self.pose.cs_len]
+            .iter()
+            .fold(Isometry3::identity(), |acc, f| acc * f)
+    }
+
+    /// The programmed X..C words as a frame (channel orientation convention).
+    pub(super) fn programmed_frame(&self) -> Isometry3<f64> {
+        let p = &self.motion.programmed;
+        PoseWords {
+            xyz: [p[0], p[1], p[2]],
+            abc: [p[3], p[4], p[5]],
         }
-        let progress = &mut out.progress;
-        progress.block_nr = self.line as i32;
-        progress.program_state = match self.state {
-            RunState::Idle => ProgramState::Idle,
-            RunState::Running if self.wait.is_some() => ProgramState::Waiting,
-            RunState::Running => ProgramState::Running,
-            RunState::Finished => ProgramState::Finished,
-            RunState::Error => ProgramState::Error,
-        };
-        progress.tick = self.tick;
-        progress.path_feed_um_s = match &self.path {
-            // mm/s to um/s; a velocity is finite and far inside the DINT range.
-            Some(_) => (self.path_generator.state().velocity.abs() * 1000.0)
-                .round()
-                .min(f64::from(i32::MAX)) as i32,
-            None => 0,
-        };
-        progress.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
-        out.feed_override_applied = if self.path_override.feed_hold {
-            0
+        .to_frame(self.pose.order)
+        .unwrap_or_else(|_| Isometry3::identity())
+    }
+
+    pub(super) fn set_programmed_pose(&mut self, pose: &Isometry3<f64>) {
+        let w = PoseWords::from_frame(pose, self.pose.order);
+        let values = [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]];
+        for (i, v) in values.iter().enumerate() {
+            self.motion.programmed[i] = *v;
+            self.run.decoder.set_position(i, *v);
+        }
+    }
+
+    /// `#CS ON|OFF`: a coordinate system pushed on the stack (`frame`: X Y Z A B C) or the
+    /// last one taken off; the tool stays where it is.
+    pub(super) fn coordinate_system(&mut self, on: bool, frame: [f64; 6]) {
+        if !self.pose.trafo {
+            self.fail(ChannelFault::CsWithoutTrafo);
+            return;
+        }
+        let before = self.cs_frame();
+        if on {
+            if self.pose.cs_len == CS_DEPTH {
+                self.fail(ChannelFault::CsDepth);
+                return;
+            }
+            let words = PoseWords {
+                xyz: [frame[0], frame[1], frame[2]],
+                abc: [frame[3], frame[4], frame[5]],
+            };
+            match offset_frame(&words, false) {
+                Ok(f) => {
+                    self.pose.cs_stack[self.pose.cs_len] = f;
+                    self.pose.cs_len += 1;
+                }
+                Err(e) => {
+                    self.fail(ChannelFault::CsFrame(e));
+                    return;
+                }
+            }
         } else {
-            self.path_override.feed_permille
+            self.pose.cs_len = self.pose.cs_len.saturating_sub(1);
+        }
+        // The tool stays where it is; its programmed words change.
+        let base = before * self.programmed_frame();
+        self.set_programmed_pose(&(self.cs_frame().inverse() * base));
+    }
+
+    /// `#TRAFO ON|OFF [id]`: the kinematic transformation switched on (the programmed words
+    /// become the tool pose) or off (they become the joints again).
+    pub(super) fn switch_trafo(&mut self, on: Option<bool>, id: Option<u32>) {
+        if let Some(id) = id {
+            if id != self.config.kinematics.id {
+                let configured = self.config.kinematics.id;
+                self.fail(ChannelFault::KinematicNotConfigured { id, configured });
+                return;
+            }
+        }
+        match on {
+            Some(true) if !self.pose.trafo => {
+                self.pose.trafo = true;
+                self.program_tool_pose();
+            }
+            Some(false) if self.pose.trafo => {
+                self.pose.trafo = false;
+                self.pose.cs_len = 0;
+                for i in 0..6 {
+                    self.motion.programmed[i] = self.pose.joints[i];
+                    self.run.decoder.set_position(i, self.pose.joints[i]);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The programmed pose becomes the one of the current tool pose: `#CS` frames and the
+    /// dynamic CS's compensation taken off (so that nothing moves on the next tick).
+    pub(super) fn program_tool_pose(&mut self) {
+        let untracked = if self.tracks_set_points() {
+            self.pose
+                .tracker
+                .option()
+                .remove(self.pose.tracker.applied(), &self.pose.tool)
+        } else {
+            self.pose.tool
         };
-        out.interface = next_interface(
-            &out.interface,
-            self.published.map(|sample| (sample.frame, sample.live)),
-        );
+        let programmed = self.cs_frame().inverse() * untracked;
+        self.set_programmed_pose(&programmed);
+    }
+
+    /// Whether the dynamic CS lays its compensation on the set-points (on, not SIMU).
+    pub(super) fn tracks_set_points(&self) -> bool {
+        self.pose.tracker.state() != DynCsState::Inactive && !self.pose.tracker.simulating()
+    }
+
+    /// What the channel publishes on its interface: its tool frame, live while it runs or
+    /// brakes, frozen once a failed channel stands.
+    pub(super) fn publish(&mut self) {
+        let live = self.state != RunState::Error || self.safety.guard.braking();
+        self.pose.published = self.pose.interface_on.then_some(MasterSample {
+            frame: self.pose.tool,
+            live,
+        });
     }
 }

@@ -26,9 +26,13 @@ impl Channel {
                 offset_frame(&words, false).ok()
             })
             .unwrap_or_else(Isometry3::identity);
-        self.kinematics.set_tool(frame);
-        self.tool = self.kinematics.forward(&self.joints).unwrap_or(self.tool);
-        if self.trafo {
+        self.pose.kinematics.set_tool(frame);
+        self.pose.tool = self
+            .pose
+            .kinematics
+            .forward(&self.pose.joints)
+            .unwrap_or(self.pose.tool);
+        if self.pose.trafo {
             self.program_tool_pose();
         }
     }

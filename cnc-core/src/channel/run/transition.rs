@@ -15,15 +15,15 @@ impl Channel {
         if self.stopping.is_some() {
             return;
         }
-        let enabled = self.inputs.dyn_cs_enabled;
-        self.plc_enabled = enabled;
-        if let Some(cs) = self.inputs.dyn_cs_command {
+        let enabled = self.plc.inputs.dyn_cs_enabled;
+        self.plc.plc_enabled = enabled;
+        if let Some(cs) = self.plc.inputs.dyn_cs_command {
             // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
             // nowhere (taken, so the PLC's semaphore is free again, and counted).
             if enabled {
-                self.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
+                self.plc.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
             } else {
-                self.tracker.not_redirected();
+                self.pose.tracker.not_redirected();
             }
         }
         self.take_transition(enabled);
@@ -33,7 +33,7 @@ impl Channel {
     /// reported to the PLC; it never puts the tracking in ERROR, so it cannot block a later
     /// switch-on.
     pub(super) fn take_transition(&mut self, enabled: bool) {
-        let (raw, result) = match self.inputs.transition {
+        let (raw, result) = match self.plc.inputs.transition {
             None => return,
             Some(Transition::Garbage(raw)) => (
                 raw,
@@ -47,9 +47,9 @@ impl Channel {
             }
         };
         if let Err(error) = result {
-            self.tracker.refuse(error);
+            self.pose.tracker.refuse(error);
         }
-        let out = &mut self.outputs.dyn_cs_result;
+        let out = &mut self.plc.outputs.dyn_cs_result;
         out.taken_count_r = out.taken_count_r.wrapping_add(1);
         out.command_r = raw;
         out.error_id_r = result.err().map_or(0, |e| refusal_id(e).raw());
@@ -58,7 +58,7 @@ impl Channel {
 
     /// Adds the tracker's state of this tick to the states passed since the last transition.
     pub(super) fn note_dyn_cs_state(&mut self) {
-        self.outputs.dyn_cs_result.states_seen_r |= self.tracker.state().seen_bit();
+        self.plc.outputs.dyn_cs_result.states_seen_r |= self.pose.tracker.state().seen_bit();
     }
 
     fn carry_out(
@@ -69,14 +69,14 @@ impl Channel {
         match command {
             DynCsCommand::Activate => {
                 let setup = self.plc_setup(params)?;
-                let master = self.plc_frame;
-                self.tracker.switch_on(setup, master.as_ref())?;
+                let master = self.plc.plc_frame;
+                self.pose.tracker.switch_on(setup, master.as_ref())?;
                 if setup.wait {
                     self.hold_program_until_settled();
                 }
             }
             DynCsCommand::Deactivate => {
-                self.tracker.switch_off(Some(params.filter_max_ticks));
+                self.pose.tracker.switch_off(Some(params.filter_max_ticks));
                 // f_wait on a switch-off, as `#TRACK CS OFF [WAIT]`; a byte that is no BOOL
                 // is no request to wait.
                 if params.f_wait.get() == Ok(true) {

@@ -1,6 +1,7 @@
 //! One block decoded: its items read, then its dwell, motion or offsets.
 
 use super::values::Ctx;
+use super::{DecodeError, Form};
 use super::{Decoded, DecoderState, MotionBlock, MotionMode, MM_PER_INCH};
 use crate::nc::ast::*;
 use crate::setpoint::AxisValues;
@@ -98,7 +99,7 @@ impl DecoderState {
                         if f > 0.0 && f.is_finite() {
                             input.feed = Some(f);
                         } else {
-                            ctx.error(*span, format!("feed must be positive, found {f}"));
+                            ctx.error(*span, DecodeError::FeedNotPositive { value: f });
                         }
                     }
                 }
@@ -129,15 +130,12 @@ impl DecoderState {
                         .iter()
                         .any(|i| !matches!(i, Item::Call { .. } | Item::Assign { .. }))
                     {
-                        ctx.error(
-                            *span,
-                            "a subroutine call stands in its block with P assignments only",
-                        );
+                        ctx.error(*span, Form::CallNotAlone);
                     }
                 }
                 Item::Control { .. } => {
                     if items.len() > 1 {
-                        ctx.error(block.span, "a $ statement stands alone in its block");
+                        ctx.error(block.span, Form::ControlNotAlone);
                     }
                 }
             }
@@ -151,10 +149,7 @@ impl DecoderState {
         match code {
             0..=3 => {
                 if let Some((other, _)) = input.motion_code.filter(|(c, _)| *c != code) {
-                    ctx.error(
-                        span,
-                        format!("G{code} and G{other} in one block: choose one motion"),
-                    );
+                    ctx.error(span, DecodeError::MotionTwice { code, other });
                 }
                 input.motion_code = Some((code, span));
             }
@@ -173,10 +168,7 @@ impl DecoderState {
             92 => input.g92 = true,
             161 => self.center_absolute = true,
             162 => self.center_absolute = false,
-            other => ctx.error(
-                span,
-                format!("unknown G code G{other} (known: G0-G4, G9, G17-G19, G53-G60, G70, G71, G90-G92, G161, G162, G359, G360)"),
-            ),
+            other => ctx.error(span, DecodeError::UnknownGCode { code: other }),
         }
     }
 
@@ -208,16 +200,13 @@ impl DecoderState {
                     self.tool_record(line, n, word.span, ctx, tail);
                 }
             }
-            Addr::S => ctx.error(
-                word.span,
-                format!("spindle speed S must not be negative, found {v}"),
-            ),
+            Addr::S => ctx.error(word.span, DecodeError::SpindleNegative { value: v }),
             _ => ctx.error(
                 word.span,
-                format!(
-                    "{} must be a whole number 0..=1000000, found {v}",
-                    addr.letter()
-                ),
+                DecodeError::NotWholeAddress {
+                    letter: addr.letter(),
+                    value: v,
+                },
             ),
         }
     }
@@ -240,10 +229,7 @@ impl DecoderState {
         } else if self.tools_unknown {
             self.tool_length = 0.0;
         } else {
-            ctx.error(
-                span,
-                format!("D{n}: no such tool data record in the tool table (D0 removes the offset)"),
-            );
+            ctx.error(span, DecodeError::NoToolRecord { d: n });
         }
     }
 
@@ -255,10 +241,8 @@ impl DecoderState {
             return;
         };
         if input.programmed & (1 << i) != 0 {
-            ctx.error(
-                word.span,
-                format!("axis {} programmed twice in one block", word.name),
-            );
+            let name = Name::from(word.name.as_str());
+            ctx.error(word.span, DecodeError::AxisTwice { name });
             return;
         }
         if let Some(v) = ctx.eval(&word.value, word.span) {
@@ -301,7 +285,7 @@ impl DecoderState {
         let arc_words = center.iter().any(Option::is_some) || radius.is_some();
         let is_arc = matches!(self.motion, MotionMode::ArcCw | MotionMode::ArcCcw);
         if arc_words && !is_arc {
-            ctx.error(block.span, "I, J, K and R belong to G2/G3 blocks");
+            ctx.error(block.span, Form::ArcWordsWithoutArc);
         }
         let axes = BitIndices(input.programmed);
         if input.g92 {
@@ -311,13 +295,8 @@ impl DecoderState {
             }
         } else if input.programmed != 0 || (is_arc && arc_words) {
             if self.motion.at_feed() && self.feed <= 0.0 {
-                ctx.error(
-                    block.span,
-                    format!(
-                        "{} motion without a feed: program F.. first",
-                        self.motion.name()
-                    ),
-                );
+                let motion = self.motion.name();
+                ctx.error(block.span, DecodeError::NoFeed { motion });
             }
             let start = self.position;
             for i in axes {
@@ -358,27 +337,21 @@ impl DecoderState {
             (programmed == 1).then(|| self.words[0] / if self.inch { MM_PER_INCH } else { 1.0 });
         let seconds = match (bare, by_axis) {
             _ if motion || (programmed != 0 && programmed != 1) => {
-                ctx.error(block.span, "G04 stands alone in its block: its time is G04 <seconds> or G04 <first axis><seconds>");
+                ctx.error(block.span, Form::DwellNotAlone);
                 return;
             }
             (Some(_), Some(_)) => {
-                ctx.error(
-                    block.span,
-                    "G04: give the time once (bare or with the first axis)",
-                );
+                ctx.error(block.span, Form::DwellTimeTwice);
                 return;
             }
             (Some((t, _)), None) | (None, Some(t)) => t,
             (None, None) => {
-                ctx.error(block.span, "G04 needs a time in seconds: G04 2.5");
+                ctx.error(block.span, Form::DwellNoTime);
                 return;
             }
         };
         if seconds.is_nan() || seconds < 0.0 {
-            ctx.error(
-                block.span,
-                format!("dwell time must not be negative, found {seconds}"),
-            );
+            ctx.error(block.span, DecodeError::DwellNegative { seconds });
             return;
         }
         tail.insert(0, Decoded::Dwell { line, seconds });
@@ -396,10 +369,7 @@ impl DecoderState {
         use crate::nc::arc::{center_from_radius, check_on_circle, ArcError, ArcMove};
         let [a, b, _] = self.plane.axes();
         if self.position.len() <= a.max(b) {
-            ctx.error(
-                span,
-                "G2/G3 needs the channel's first three axes (the main axes)",
-            );
+            ctx.error(span, Form::ArcNeedsMainAxes);
             return None;
         }
         let p0 = [start[a], start[b]];
@@ -439,7 +409,7 @@ impl DecoderState {
                 })
             }
             Err(e) => {
-                ctx.error(span, e.to_string());
+                ctx.error(span, DecodeError::Arc(e));
                 None
             }
         }
@@ -470,19 +440,19 @@ impl DecoderState {
                 (Some("G"), Some(1.0), None) => motion = MotionMode::Linear,
                 (Some("G"), Some(90.0), None) => absolute = true,
                 (Some("G"), Some(91.0), None) => absolute = false,
-                _ => ctx.error(e.span, "independent axis: expected INDP_ASYN, INDP_SYN, POS=.., G0, G1, G90, G91 or F.."),
+                _ => ctx.error(e.span, Form::IndependentOption),
             }
         }
         let Some(asynchronous) = asynchronous else {
-            ctx.error(span, "independent axis: expected INDP_ASYN or INDP_SYN");
+            ctx.error(span, Form::IndependentMode);
             return None;
         };
         let Some(pos) = pos else {
-            ctx.error(span, "independent axis: expected POS=..");
+            ctx.error(span, Form::IndependentPos);
             return None;
         };
         if motion == MotionMode::Linear && feed <= 0.0 {
-            ctx.error(span, "independent axis: G1 needs a positive feed F..");
+            ctx.error(span, DecodeError::IndependentNoFeed);
             return None;
         }
         let pos = if axis < 3 {

@@ -1,7 +1,9 @@
 //! The `#` commands of a block, checked and decoded.
 
 use super::values::Ctx;
-use super::{Decoded, DecoderState, SyncIds, TrackCommand, TrackSource, MM_PER_INCH};
+use super::{
+    DecodeError, Decoded, DecoderState, Form, SyncIds, TrackCommand, TrackSource, MM_PER_INCH,
+};
 use crate::nc::ast::*;
 use std::sync::Arc;
 
@@ -120,17 +122,12 @@ fn cs(
     ctx: &mut Ctx<'_>,
 ) -> Option<Decoded> {
     if values.len() > 6 {
-        ctx.error(
-            span,
-            format!(
-                "#CS takes at most 6 values (X Y Z A B C), found {}",
-                values.len()
-            ),
-        );
+        let found = values.len();
+        ctx.error(span, DecodeError::CsValues { found });
         return None;
     }
     if !on && !values.is_empty() {
-        ctx.error(span, "#CS OFF takes no values");
+        ctx.error(span, Form::CsOffValues);
         return None;
     }
     let mut frame = [0.0; 6];
@@ -166,7 +163,7 @@ fn signal_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Op
     match (id, count) {
         (Some(id), Some(count)) => Some(Decoded::SignalSyn { line, id, count }),
         _ => {
-            ctx.error(span, "#SIGNAL SYN needs ID.. and COUNT..");
+            ctx.error(span, Form::SignalSynOptions);
             None
         }
     }
@@ -179,15 +176,12 @@ fn wait_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Opti
         let v = entry_number(e, ctx)?;
         let id = ctx.whole(&Expr::Num(v), e.span, "ID", 1.0, 65535.0)?;
         if !ids.push(id) {
-            ctx.error(
-                e.span,
-                format!("#WAIT SYN waits for at most {} ids", SyncIds::CAPACITY),
-            );
+            ctx.error(e.span, DecodeError::WaitSynIds);
             return None;
         }
     }
     if ids.as_slice().is_empty() {
-        ctx.error(span, "#WAIT SYN needs at least one ID..");
+        ctx.error(span, Form::WaitSynNoId);
         return None;
     }
     Some(Decoded::WaitSyn { line, ids })
@@ -197,7 +191,7 @@ fn wait_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Opti
 fn time(line: u32, seconds: &Expr, span: Span, ctx: &mut Ctx<'_>) -> Option<Decoded> {
     let seconds = ctx.eval(seconds, span)?;
     if seconds < 0.0 {
-        ctx.error(span, format!("#TIME must not be negative, found {seconds}"));
+        ctx.error(span, DecodeError::TimeNegative { seconds });
         return None;
     }
     Some(Decoded::Dwell { line, seconds })
@@ -208,7 +202,7 @@ fn entry_number(e: &Entry, ctx: &mut Ctx<'_>) -> Option<f64> {
         (Some(v), None) => Some(v),
         (None, Some(v)) => ctx.eval(v, e.span),
         _ => {
-            ctx.error(e.span, "expected a value");
+            ctx.error(e.span, Form::ExpectedValue);
             None
         }
     }
@@ -273,13 +267,23 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
         let key = e.key.as_deref().unwrap_or("");
         let bit = option_bit(key);
         if seen & bit != 0 {
-            ctx.error(e.span, format!("#TRACK CS: option {key} given twice"));
+            ctx.error(
+                e.span,
+                DecodeError::TrackOptionTwice {
+                    key: Name::from(key),
+                },
+            );
             ok = false;
             continue;
         }
         seen |= bit;
         if !on && !OFF_OPTIONS.contains(&key) {
-            ctx.error(e.span, format!("#TRACK CS OFF: option {key} is only allowed with ON (OFF takes WAIT, FILTER, ID, CH)"));
+            ctx.error(
+                e.span,
+                DecodeError::TrackOffOption {
+                    key: Name::from(key),
+                },
+            );
             ok = false;
             continue;
         }
@@ -305,7 +309,7 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
             "LOG_FILE" => match &e.text {
                 Some(name) if !name.trim().is_empty() => t.log_file = Some(Arc::clone(name)),
                 _ => {
-                    ctx.error(e.span, "#TRACK CS: LOG_FILE needs a file name in quotes, e.g. LOG_FILE=\"dyncs.log\"");
+                    ctx.error(e.span, Form::LogFileName);
                     ok = false;
                 }
             },
@@ -322,21 +326,15 @@ fn track(on: bool, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Option<T
     }
     let given = |key: &str| seen & option_bit(key) != 0;
     if given("CH") && given("ID") {
-        ctx.error(
-            span,
-            "#TRACK CS: give the source as CH=.. or ID=.., not both",
-        );
+        ctx.error(span, Form::TrackSourceTwice);
         ok = false;
     }
     if on && !given("CH") && !given("ID") {
-        ctx.error(span, "#TRACK CS ON: expected a source, CH=.. or ID=..");
+        ctx.error(span, Form::TrackNoSource);
         ok = false;
     }
     if given("SET_ZERO") && given("ABSOLUTE") {
-        ctx.error(
-            span,
-            "#TRACK CS: SET_ZERO and ABSOLUTE are the same option; give one",
-        );
+        ctx.error(span, Form::TrackSetZeroTwice);
         ok = false;
     }
     (ok && (t.source.is_some() || !on)).then_some(t)

@@ -15,19 +15,22 @@
 //!
 //! This module holds the decoder's state and its entry points; `block` decodes a block's
 //! items, dwell and motion, `commands` its `#` commands, `values` evaluates expressions with
-//! the [`Vars`], `axes` checks axis names and keeps values per axis, and `output` defines the
-//! [`Decoded`] elements.
+//! the [`Vars`], `axes` checks axis names and keeps values per axis, `output` defines the
+//! [`Decoded`] elements and `error` the [`DecodeError`] a block fails with (a value; its text
+//! is made where a diagnostic or a channel's error is written).
 
 mod axes;
 mod block;
 mod commands;
+mod error;
 mod output;
 mod values;
 
 use crate::setpoint::{AxisValues, MAX_CHANNEL_AXES};
 pub use axes::{check_channel_axes, RESERVED_ADDRESSES};
+pub use error::{DecodeError, Form};
 pub use output::{Decoded, MotionBlock, SyncIds, TrackCommand, TrackSource, DEFAULT_FILTER_TICKS};
-pub use values::{evaluate_at, Vars, ZeroVars, KNOWN_VARIABLES};
+pub use values::{evaluate, Vars, ZeroVars, KNOWN_VARIABLES};
 
 use super::ast::*;
 use super::Diagnostic;
@@ -193,15 +196,36 @@ impl DecoderState {
         vars: &dyn Vars,
         out: &mut Vec<Decoded>,
     ) -> Vec<Diagnostic> {
-        let mut ctx = Ctx {
-            src,
-            vars,
-            diags: Vec::new(),
-        };
+        let mut ctx = Ctx::all(vars);
         if let Some(block) = program.blocks.get(index) {
             self.block(block, program.items_of(block), &mut ctx, out);
         }
-        ctx.diags
+        ctx.into_errors()
+            .map(|(span, e)| self.diagnostic(span, &e, src))
+            .collect()
+    }
+
+    /// Decodes block `index` of `program` as a running channel does: the first error, as a
+    /// value, and nothing allocated (neither for the elements, within the capacity of `out`,
+    /// nor for an error).
+    pub fn decode_block_in_run(
+        &mut self,
+        program: &Program,
+        index: usize,
+        vars: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Result<(), (Span, DecodeError)> {
+        let mut ctx = Ctx::first_only(vars);
+        if let Some(block) = program.blocks.get(index) {
+            self.block(block, program.items_of(block), &mut ctx, out);
+        }
+        ctx.first.map_or(Ok(()), Err)
+    }
+
+    /// The diagnostic of `error` at `span` of `src`, with this channel's axis names where
+    /// the text lists them (lines and columns not counted yet).
+    pub fn diagnostic(&self, span: Span, error: &DecodeError, src: &str) -> Diagnostic {
+        Diagnostic::new(span, error.with_axes(&self.axes).to_string(), src)
     }
 
     /// The programmed position per axis (after offsets), as the next incremental block sees it.
@@ -277,25 +301,11 @@ impl DecoderState {
 
     fn unknown_axis(&self, ctx: &mut Ctx<'_>, span: Span, name: &str) {
         // `XP1`, `XV.P.A`: an axis with a value glued on, which this dialect writes X=P1.
-        let glued_value = name.len() > 1
+        let glued = name.len() > 1
             && matches!(name.as_bytes()[name.len().min(2) - 1], b'P' | b'V')
             && self.axis_index(&name[..1]).is_some();
-        let hint = if glued_value {
-            format!(
-                " (a value from a variable is written {}=..., e.g. {}=P1)",
-                &name[..1],
-                &name[..1]
-            )
-        } else {
-            String::new()
-        };
-        ctx.error(
-            span,
-            format!(
-                "unknown axis \"{name}\" for this channel (axes: {}){hint}",
-                self.axes.join(" ")
-            ),
-        );
+        let name = Name::from(name);
+        ctx.error(span, DecodeError::UnknownAxis { name, glued });
     }
 
     fn axis_index(&self, name: &str) -> Option<usize> {

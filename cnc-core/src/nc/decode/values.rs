@@ -1,8 +1,8 @@
 //! Values at decode time: the [`Vars`] a block reads, and the context that evaluates its
 //! expressions and collects its diagnostics.
 
+use super::DecodeError;
 use crate::nc::ast::*;
-use crate::nc::Diagnostic;
 
 /// Values of NC variables at decode time.
 pub trait Vars {
@@ -52,18 +52,49 @@ impl Vars for ZeroVars {
     }
 }
 
-/// One decoding (a block, or an expression): the source its messages quote, the variables it
-/// reads and the diagnostics it finds.
+/// One decoding (a block, or an expression): the variables it reads and the errors it finds.
 pub(super) struct Ctx<'a> {
-    pub(super) src: &'a str,
     pub(super) vars: &'a dyn Vars,
-    pub(super) diags: Vec<Diagnostic>,
+    /// The first error and where it stands: what a run stops at.
+    pub(super) first: Option<(Span, DecodeError)>,
+    /// The errors after the first, for a check that reports them all (`None` in a run: the
+    /// tick allocates nothing for a failing block).
+    pub(super) more: Option<Vec<(Span, DecodeError)>>,
 }
 
-impl Ctx<'_> {
-    pub(super) fn error(&mut self, span: Span, message: impl Into<String>) {
-        self.diags
-            .push(Diagnostic::new(span, message.into(), self.src));
+impl<'a> Ctx<'a> {
+    /// A decoding that keeps its first error only (a run).
+    pub(super) fn first_only(vars: &'a dyn Vars) -> Self {
+        Self {
+            vars,
+            first: None,
+            more: None,
+        }
+    }
+
+    /// A decoding that keeps every error (a check).
+    pub(super) fn all(vars: &'a dyn Vars) -> Self {
+        Self {
+            vars,
+            first: None,
+            more: Some(Vec::new()),
+        }
+    }
+
+    pub(super) fn error(&mut self, span: Span, error: impl Into<DecodeError>) {
+        let error = (span, error.into());
+        if self.first.is_none() {
+            self.first = Some(error);
+        } else if let Some(more) = self.more.as_mut() {
+            more.push(error);
+        }
+    }
+
+    /// Every error found, in order.
+    pub(super) fn into_errors(self) -> impl Iterator<Item = (Span, DecodeError)> {
+        self.first
+            .into_iter()
+            .chain(self.more.into_iter().flatten())
     }
 
     /// The value of `e`: a literal at once (nearly every word of a program), anything else
@@ -84,7 +115,7 @@ impl Ctx<'_> {
                 Some(v) => Some(v),
                 None if self.vars.program_values_unknown() => None,
                 None => {
-                    self.error(span, format!("P{n} is read before it is assigned"));
+                    self.error(span, DecodeError::UnassignedParam { number: *n });
                     None
                 }
             },
@@ -98,8 +129,8 @@ impl Ctx<'_> {
                 };
                 match crate::nc::eval::function(*func, a, b) {
                     Ok(v) => Some(v),
-                    Err(message) => {
-                        self.error(span, message);
+                    Err(e) => {
+                        self.error(span, e);
                         None
                     }
                 }
@@ -109,18 +140,15 @@ impl Ctx<'_> {
                 let (a, b) = (self.eval(a, span)?, self.eval(b, span)?);
                 match crate::nc::eval::binary(*op, a, b) {
                     Ok(v) => Some(v),
-                    Err(message) => {
-                        self.error(span, message);
+                    Err(e) => {
+                        self.error(span, e);
                         None
                     }
                 }
             }
         }?;
         if !value.is_finite() {
-            self.error(
-                span,
-                format!("the value is not a finite number ({value}): it overflowed"),
-            );
+            self.error(span, DecodeError::NotFinite { value });
             return None;
         }
         Some(value)
@@ -134,19 +162,11 @@ impl Ctx<'_> {
         if own && self.vars.program_values_unknown() {
             return None;
         }
+        let name = *name;
         if own {
-            self.error(
-                span,
-                format!("variable \"{name}\" is read before it is assigned"),
-            );
+            self.error(span, DecodeError::UnassignedVariable { name });
         } else {
-            self.error(
-                span,
-                format!(
-                    "unknown variable \"{name}\" (known: V.P.* and V.L.* once assigned, {})",
-                    KNOWN_VARIABLES.join(", ")
-                ),
-            );
+            self.error(span, DecodeError::UnknownVariable { name });
         }
         None
     }
@@ -162,9 +182,15 @@ impl Ctx<'_> {
     ) -> Option<u32> {
         let v = self.eval(e, span)?;
         if v.fract() != 0.0 || v < min || v > max {
+            let what = Name::from(what);
             self.error(
                 span,
-                format!("{what} must be a whole number in {min}..={max}, found {v}"),
+                DecodeError::NotWhole {
+                    what,
+                    min,
+                    max,
+                    value: v,
+                },
             );
             return None;
         }
@@ -172,21 +198,13 @@ impl Ctx<'_> {
     }
 }
 
-/// Evaluates `expr` at `span` of `src` with the variables of `vars`; the diagnostic says what
-/// went wrong (an unknown variable, a division by zero, a value that is not finite...).
-pub fn evaluate_at(expr: &Expr, span: Span, src: &str, vars: &dyn Vars) -> Result<f64, Diagnostic> {
-    let mut ctx = Ctx {
-        src,
-        vars,
-        diags: Vec::new(),
-    };
-    match ctx.eval(expr, span) {
-        Some(v) if ctx.diags.is_empty() => Ok(v),
-        _ => {
-            // Unlocated: whoever reports it counts lines once for all its diagnostics.
-            Err(ctx.diags.into_iter().next().unwrap_or_else(|| {
-                Diagnostic::new(span, "the value cannot be computed".to_string(), src)
-            }))
-        }
+/// Evaluates `expr` with the variables of `vars`; the error says what went wrong (an unknown
+/// variable, a division by zero, a value that is not finite...). Allocates nothing.
+pub fn evaluate(expr: &Expr, vars: &dyn Vars) -> Result<f64, DecodeError> {
+    let mut ctx = Ctx::first_only(vars);
+    match (ctx.eval(expr, Span::default()), ctx.first) {
+        (Some(v), None) => Ok(v),
+        (_, Some((_, e))) => Err(e),
+        (None, None) => Err(DecodeError::NoValue),
     }
 }

@@ -68,7 +68,7 @@ pub fn check_set(
                     break;
                 }
                 failed[u as usize][b as usize] = true;
-                found[u as usize].push(d);
+                found[u as usize].push(d.diagnostic(set, decoder.axes()));
                 interp.skip_failed(at);
             }
         }

@@ -1,12 +1,14 @@
 //! Following the `$` statements through a unit's jump table, and telling which of them a
 //! check cannot follow without a running machine.
 
-use super::{with_file, Env, Interpreter, Unit, CASE_TOLERANCE};
-use crate::nc::ast::{Block, Control, Expr, Target};
+use super::{Env, Interpreter, ProgramFault, Unit, CASE_TOLERANCE};
+use crate::nc::ast::{Block, Control, Expr, Span, Target};
 use crate::nc::control::{control_of, Jump};
-use crate::nc::decode::{evaluate_at, Vars};
+use crate::nc::decode::{evaluate, Vars};
 use crate::nc::eval::truth;
-use crate::nc::Diagnostic;
+
+/// A fault and the span of the block it stands at.
+type Failed = (Span, ProgramFault);
 
 impl Interpreter {
     /// Follows the `$` statement of block `b`; returns the next block.
@@ -17,7 +19,7 @@ impl Interpreter {
         jump: Jump,
         block: &Block,
         system: &dyn Vars,
-    ) -> Result<usize, Diagnostic> {
+    ) -> Result<usize, Failed> {
         let here = Here {
             unit,
             b,
@@ -72,7 +74,7 @@ impl Interpreter {
 
     /// `$IF` and its `$ELSEIF`s, tested in turn: the first block of the branch that runs, or
     /// after the chain's `$ELSE` or `$ENDIF`.
-    fn if_chain(&mut self, here: &Here<'_>) -> Result<usize, Diagnostic> {
+    fn if_chain(&mut self, here: &Here<'_>) -> Result<usize, Failed> {
         let unit = here.unit;
         let mut at = here.b;
         Ok(loop {
@@ -99,23 +101,21 @@ impl Interpreter {
         var: Target,
         bounds: [&Expr; 3],
         end: usize,
-    ) -> Result<usize, Diagnostic> {
+    ) -> Result<usize, Failed> {
         let [start, last, step] = bounds;
         let first = here.eval(self, start)?;
         self.assign(var, first).map_err(|m| here.error(m))?;
         let (last, step) = (here.eval(self, last)?, here.eval(self, step)?);
-        Ok(
-            if self.for_continues(here.unit, here.block, first, last, step)? {
-                here.b + 1
-            } else {
-                end + 1
-            },
-        )
+        Ok(if self.for_continues(here.block, first, last, step)? {
+            here.b + 1
+        } else {
+            end + 1
+        })
     }
 
     /// `$ENDFOR` of the `$FOR` at `start`: steps the counter; back into the loop while it has
     /// not passed the end, else on after the `$ENDFOR`.
-    fn end_for(&mut self, here: &Here<'_>, start: usize) -> Result<usize, Diagnostic> {
+    fn end_for(&mut self, here: &Here<'_>, start: usize) -> Result<usize, Failed> {
         let (unit, b) = (here.unit, here.b);
         let Some(Control::For {
             var,
@@ -142,7 +142,7 @@ impl Interpreter {
         let value = current + step;
         self.assign(*var, value).map_err(|m| here.error(m))?;
         let for_block = &unit.tree.blocks[start];
-        Ok(if self.for_continues(unit, for_block, value, last, step)? {
+        Ok(if self.for_continues(for_block, value, last, step)? {
             start + 1
         } else {
             b + 1
@@ -157,7 +157,7 @@ impl Interpreter {
         v: &Expr,
         first_case: Option<usize>,
         otherwise: usize,
-    ) -> Result<usize, Diagnostic> {
+    ) -> Result<usize, Failed> {
         let unit = here.unit;
         let value = here.eval(self, v)?;
         let mut case = first_case;
@@ -179,17 +179,13 @@ impl Interpreter {
 
     fn for_continues(
         &self,
-        unit: &Unit,
         block: &Block,
         value: f64,
         last: f64,
         step: f64,
-    ) -> Result<bool, Diagnostic> {
+    ) -> Result<bool, Failed> {
         if step == 0.0 {
-            return Err(with_file(
-                Diagnostic::new(block.span, "$FOR with step 0 never ends".into(), &unit.src),
-                unit,
-            ));
+            return Err((block.span, ProgramFault::ForStepZero));
         }
         Ok(if step > 0.0 {
             value <= last
@@ -209,7 +205,7 @@ struct Here<'a> {
 
 impl Here<'_> {
     /// The value of `e`, an expression of block `at` (whose span its messages name).
-    fn eval_in(&self, interp: &Interpreter, at: usize, e: &Expr) -> Result<f64, Diagnostic> {
+    fn eval_in(&self, interp: &Interpreter, at: usize, e: &Expr) -> Result<f64, Failed> {
         let span = self
             .unit
             .tree
@@ -220,20 +216,17 @@ impl Here<'_> {
             interp,
             system: self.system,
         };
-        evaluate_at(e, span, &self.unit.src, &env).map_err(|d| with_file(d, self.unit))
+        evaluate(e, &env).map_err(|error| (span, error.into()))
     }
 
     /// The value of `e`, an expression of the block itself.
-    fn eval(&self, interp: &Interpreter, e: &Expr) -> Result<f64, Diagnostic> {
+    fn eval(&self, interp: &Interpreter, e: &Expr) -> Result<f64, Failed> {
         self.eval_in(interp, self.b, e)
     }
 
-    /// A diagnostic with `message` at the block.
-    fn error(&self, message: String) -> Diagnostic {
-        with_file(
-            Diagnostic::new(self.block.span, message, &self.unit.src),
-            self.unit,
-        )
+    /// `fault` at the block.
+    fn error(&self, fault: ProgramFault) -> Failed {
+        (self.block.span, fault)
     }
 }
 

@@ -12,19 +12,23 @@
 //!   0.001; a `$CASE` branch runs on into the next one unless it ends with `$BREAK`.
 //!
 //! This module runs the blocks ([`Interpreter`]); `load` builds the [`ProgramSet`], `jump`
-//! follows the `$` statements, and `check` runs a set once to check it ([`check_set`]).
+//! follows the `$` statements, `check` runs a set once to check it ([`check_set`]), and
+//! `error` holds [`StepError`], why a step failed as a value (a check makes a diagnostic of
+//! it, a channel keeps it).
 
 mod check;
+mod error;
 mod jump;
 mod load;
 
 pub(crate) use check::Unknown;
 pub use check::{check_set, BlockSink};
+pub use error::{ProgramFault, StepError};
 pub use load::{ProgramSet, SearchPath, Unit};
 
 use super::ast::{Command, Item, Name, Program, Span, Target};
 use super::control::control_of;
-use super::decode::{evaluate_at, Decoded, DecoderState, Vars};
+use super::decode::{evaluate, Decoded, DecoderState, Vars};
 use super::parser::MAX_PARAM;
 use super::Diagnostic;
 use jump::decided_by_machine;
@@ -79,7 +83,7 @@ pub enum Step {
 }
 
 /// The run-time state of a program: call stack and variables. Fixed capacities, allocated
-/// once: stepping allocates nothing (except for a diagnostic).
+/// once: stepping allocates nothing, also when it fails (its error is a value).
 #[derive(Debug, Clone)]
 pub struct Interpreter {
     frames: Vec<Frame>,
@@ -189,7 +193,7 @@ impl Interpreter {
         decoder: &mut DecoderState,
         system: &dyn Vars,
         out: &mut Vec<Decoded>,
-    ) -> Result<Step, Diagnostic> {
+    ) -> Result<Step, StepError> {
         let Some(&frame) = self.frames.last() else {
             self.ended = true;
             return Ok(Step::End);
@@ -213,7 +217,13 @@ impl Interpreter {
             if !system.machine_values_known() && decided_by_machine(unit, b, jump) {
                 return Ok(Step::Undecided);
             }
-            let next = self.jump(unit, b, jump, block, system)?;
+            let next = self
+                .jump(unit, b, jump, block, system)
+                .map_err(|(span, fault)| StepError {
+                    unit: frame.unit,
+                    span,
+                    fault,
+                })?;
             self.top().next = next as u32;
             return Ok(Step::Control);
         }
@@ -223,9 +233,14 @@ impl Interpreter {
             return Ok(Step::Control);
         }
         self.top().next += 1;
+        let failed = |(span, fault)| StepError {
+            unit: frame.unit,
+            span,
+            fault,
+        };
         let BlockEnd { call, leave, end } = self
-            .run_block(&unit.tree, b, &unit.src, decoder, system, out)
-            .map_err(|d| with_file(d, unit))?;
+            .run_block_in_run(&unit.tree, b, decoder, system, out)
+            .map_err(failed)?;
         if let Some(span) = call {
             let callee = unit
                 .calls
@@ -233,24 +248,10 @@ impl Interpreter {
                 .ok()
                 .map(|i| unit.calls[i].1);
             let Some(callee) = callee else {
-                return Err(with_file(
-                    Diagnostic::new(
-                        span,
-                        "the subroutine of this call was not loaded".into(),
-                        &unit.src,
-                    ),
-                    unit,
-                ));
+                return Err(failed((span, ProgramFault::CallNotLoaded)));
             };
             if self.frames.len() > MAX_CALL_DEPTH {
-                return Err(with_file(
-                    Diagnostic::new(
-                        span,
-                        format!("subroutine calls nest deeper than {MAX_CALL_DEPTH} levels (a recursion without end?)"),
-                        &unit.src,
-                    ),
-                    unit,
-                ));
+                return Err(failed((span, ProgramFault::CallDepth)));
             }
             self.frames.push(Frame {
                 unit: callee.unit,
@@ -273,7 +274,8 @@ impl Interpreter {
 
     /// Runs block `b` of `tree` (parsed from `src`) that is no `$` statement: its assignments
     /// in order, then the block decoded with the variables as they are then. Says how the
-    /// block ends (a call, M17/M29, M2/M30); following that is the caller's.
+    /// block ends (a call, M17/M29, M2/M30); following that is the caller's. For a checker:
+    /// the error is a diagnostic (see [`Interpreter::run_block_in_run`]).
     pub fn run_block(
         &mut self,
         tree: &Program,
@@ -283,6 +285,22 @@ impl Interpreter {
         system: &dyn Vars,
         out: &mut Vec<Decoded>,
     ) -> Result<BlockEnd, Diagnostic> {
+        self.run_block_in_run(tree, b, decoder, system, out)
+            .map_err(|(span, fault)| {
+                Diagnostic::new(span, fault.with_axes(decoder.axes()).to_string(), src)
+            })
+    }
+
+    /// [`Interpreter::run_block`] as a running channel needs it: the error is a value, the
+    /// fault and where it stands, and nothing is allocated.
+    pub fn run_block_in_run(
+        &mut self,
+        tree: &Program,
+        b: usize,
+        decoder: &mut DecoderState,
+        system: &dyn Vars,
+        out: &mut Vec<Decoded>,
+    ) -> Result<BlockEnd, (Span, ProgramFault)> {
         let mut ending = BlockEnd::default();
         let Some(block) = tree.blocks.get(b) else {
             return Ok(ending);
@@ -294,9 +312,9 @@ impl Interpreter {
                         interp: self,
                         system,
                     };
-                    let value = evaluate_at(&assign.value, *span, src, &env)?;
+                    let value = evaluate(&assign.value, &env).map_err(|e| (*span, e.into()))?;
                     self.assign(assign.target, value)
-                        .map_err(|m| Diagnostic::new(*span, m, src))?;
+                        .map_err(|fault| (*span, fault))?;
                 }
                 Item::Call { span, .. } => ending.call = Some(*span),
                 Item::M { code: 17 | 29, .. } => ending.leave = true,
@@ -313,11 +331,10 @@ impl Interpreter {
             interp: self,
             system,
         };
-        let diags = decoder.decode_block_unlocated(tree, b, src, &env, out);
-        match diags.into_iter().next() {
-            Some(d) => Err(d),
-            None => Ok(ending),
-        }
+        decoder
+            .decode_block_in_run(tree, b, &env, out)
+            .map_err(|(span, e)| (span, e.into()))?;
+        Ok(ending)
     }
 
     /// Clears the variables for a new run without a program set (a checker running a straight
@@ -352,10 +369,13 @@ impl Interpreter {
         }
     }
 
-    fn assign(&mut self, target: Target, value: f64) -> Result<(), String> {
+    fn assign(&mut self, target: Target, value: f64) -> Result<(), ProgramFault> {
         match target {
             Target::Param(n) => {
-                let slot = self.params.get_mut(n as usize).ok_or_else(|| format!("P{n} does not exist"))?;
+                let slot = self
+                    .params
+                    .get_mut(n as usize)
+                    .ok_or(ProgramFault::NoSuchParam { number: n })?;
                 *slot = Some(value);
             }
             Target::Var(name) if name.starts_with("V.P.") => {
@@ -364,14 +384,17 @@ impl Interpreter {
                 } else if self.globals.len() < MAX_VARIABLES {
                     self.globals.push((name, value));
                 } else {
-                    return Err(format!("more than {MAX_VARIABLES} V.P. variables"));
+                    return Err(ProgramFault::TooManyGlobals);
                 }
             }
             Target::Var(name) if name.starts_with("V.L.") => {
                 let mark = self.frames.last().map_or(0, |f| f.locals_mark as usize);
                 let existing = if self.declaring {
                     // A declaration makes the level its own variable (shadowing an outer one).
-                    self.locals[mark..].iter_mut().rev().find(|(n, _)| *n == name)
+                    self.locals[mark..]
+                        .iter_mut()
+                        .rev()
+                        .find(|(n, _)| *n == name)
                 } else {
                     self.locals.iter_mut().rev().find(|(n, _)| *n == name)
                 };
@@ -380,14 +403,10 @@ impl Interpreter {
                 } else if self.locals.len() < MAX_VARIABLES {
                     self.locals.push((name, value));
                 } else {
-                    return Err(format!("more than {MAX_VARIABLES} live V.L. variables"));
+                    return Err(ProgramFault::TooManyLocals);
                 }
             }
-            Target::Var(name) => {
-                return Err(format!(
-                    "\"{name}\" cannot be assigned: a program assigns P parameters, V.P. and V.L. variables"
-                ))
-            }
+            Target::Var(name) => return Err(ProgramFault::NotAssignable { name }),
         }
         Ok(())
     }

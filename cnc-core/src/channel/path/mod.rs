@@ -39,6 +39,9 @@ use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::arc::ArcMove;
 use crate::nc::MotionMode;
 use crate::setpoint::AxisValues;
+use circle::Circle;
+
+mod circle;
 
 /// Per-axis dynamic limits of a channel's programmed coordinates (mm or degrees, per second).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
@@ -50,20 +53,6 @@ pub struct AxisLimits {
     pub acceleration: f64,
     /// Jerk.
     pub jerk: f64,
-}
-
-/// The circle part of an arc block.
-#[derive(Debug, Clone, Copy)]
-struct Circle {
-    /// Plane axes (first, second).
-    axes: [usize; 2],
-    center: [f64; 2],
-    /// Start angle (rad) and signed sweep (positive counter-clockwise).
-    angle0: f64,
-    sweep: f64,
-    /// Start and end radius.
-    r0: f64,
-    r1: f64,
 }
 
 /// The limits of axis `i`, unlimited for an axis without any.
@@ -239,60 +228,6 @@ impl PathMove {
         })
     }
 
-    fn plan_arc(
-        start: &AxisValues,
-        target: &AxisValues,
-        mut delta: AxisValues,
-        feed_mm_min: f64,
-        spec: ArcSpec,
-        limits: &[AxisLimits],
-        generator: &mut SetpointGenerator,
-    ) -> Result<Self, PathError> {
-        let arc = spec.arc;
-        let [a, b, _] = arc.plane.axes();
-        let (p0, p1) = ([start[a], start[b]], [target[a], target[b]]);
-        let c = arc.center;
-        let r0 = (p0[0] - c[0]).hypot(p0[1] - c[1]);
-        let r1 = (p1[0] - c[0]).hypot(p1[1] - c[1]);
-        let sweep = arc.sweep(p0, p1);
-        let signed = if arc.ccw { sweep } else { -sweep };
-        delta[a] = 0.0;
-        delta[b] = 0.0;
-        let circle_length = sweep * (r0 + r1) / 2.0;
-        let linear = delta.iter().take(3).map(|d| d * d).sum::<f64>();
-        let length = (circle_length * circle_length + linear).sqrt();
-        if length.is_nan() || length <= 1e-12 || !length.is_finite() {
-            return Err(PathError::NoProfile);
-        }
-        let limit = |i: usize| axis_limits(limits, i);
-        let (la, lb) = (limit(a), limit(b));
-        let plane_v = la.velocity.min(lb.velocity);
-        let plane_a = la.acceleration.min(lb.acceleration);
-        let plane_j = la.jerk.min(lb.jerk);
-        let share = circle_length / length;
-        let r = r0.min(r1).max(1e-9);
-        let mut path = MoveLimits {
-            velocity: (plane_v / share.max(1e-12))
-                .min((plane_a * r / 2.0).sqrt())
-                .min((plane_j * r * r / 2.0).cbrt())
-                .min((8.0 * r * spec.chordal_tolerance).sqrt() / spec.cycle_s),
-            acceleration: plane_a / 2.0 / share.max(1e-12),
-            deceleration: 0.0,
-            jerk: plane_j / 2.0 / share.max(1e-12),
-        };
-        limit_by_axes(&mut path, &delta, length, limits);
-        let circle = Circle {
-            axes: [a, b],
-            center: c,
-            angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
-            sweep: signed,
-            r0,
-            r1,
-        };
-        let geometry = (*start, delta, Some(circle), *target, length);
-        Self::start(geometry, path, feed_mm_min / 60.0, generator)
-    }
-
     /// One tick of `generator` (the one the block was planned on): writes the interpolated
     /// position into `position`; `true` when the block has ended (the position is then
     /// exactly the target).
@@ -311,10 +246,9 @@ impl PathMove {
             *p = self.start[i] + self.delta[i] * s;
         }
         if let Some(c) = &self.circle {
-            let angle = c.angle0 + c.sweep * s;
-            let r = c.r0 + (c.r1 - c.r0) * s;
-            position[c.axes[0]] = c.center[0] + r * angle.cos();
-            position[c.axes[1]] = c.center[1] + r * angle.sin();
+            let [x, y] = c.point(s);
+            position[c.axes[0]] = x;
+            position[c.axes[1]] = y;
         }
         if self.done && !self.braked {
             // Exactly at the end point (the arithmetic above may miss it by a rounding).
@@ -323,6 +257,39 @@ impl PathMove {
             }
         }
         self.done
+    }
+
+    /// The velocity and acceleration of every axis at the position the last [`Self::step`]
+    /// wrote, from the path's own (`generator`'s) velocity and acceleration: the exact
+    /// derivatives of the interpolated position, 0 once the block has ended at its target.
+    pub fn rates(
+        &self,
+        generator: &SetpointGenerator,
+        velocity: &mut AxisValues,
+        acceleration: &mut AxisValues,
+    ) {
+        if self.done && !self.braked {
+            velocity.fill(0.0);
+            acceleration.fill(0.0);
+            return;
+        }
+        let state = generator.state();
+        let s = (state.position / self.length).clamp(0.0, 1.0);
+        let (ds, dds) = (
+            state.velocity / self.length,
+            state.acceleration / self.length,
+        );
+        for (i, d) in self.delta.iter().enumerate() {
+            velocity[i] = d * ds;
+            acceleration[i] = d * dds;
+        }
+        if let Some(c) = &self.circle {
+            let (v, a) = c.rates(s, ds, dds);
+            for (k, &axis) in c.axes.iter().enumerate() {
+                velocity[axis] = v[k];
+                acceleration[axis] = a[k];
+            }
+        }
     }
 
     /// Brakes along the block to a standstill with the block's own deceleration and jerk;

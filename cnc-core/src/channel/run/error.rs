@@ -1,0 +1,127 @@
+//! Why a channel stopped, as values: the channel fails in its tick, where no text is made.
+//! `Display` renders the reason where it is shown (the run's report, a log line, a test).
+
+use super::CS_DEPTH;
+use crate::channel::dyn_cs::TrackError;
+use crate::channel::guard::LimitViolation;
+use crate::channel::path::PathError;
+use crate::nc::ast::AxisName;
+use crate::nc::interp::ProgramFault;
+use core::fmt;
+use hli::enums::ChannelErrorId;
+use kinematics::KinError;
+
+/// Why a channel stopped: the block and the reason.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChannelError {
+    /// Source line of the block.
+    pub line: u32,
+    /// The kind of cause, as `error_id_r` reports it.
+    pub id: ChannelErrorId,
+    /// What went wrong.
+    pub fault: ChannelFault,
+}
+
+impl ChannelError {
+    /// What went wrong, as text (rendered when it is written, never in the tick).
+    pub fn message(&self) -> impl fmt::Display + '_ {
+        &self.fault
+    }
+}
+
+impl fmt::Display for ChannelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.fault)
+    }
+}
+
+/// What went wrong in a channel, with the values that say why.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ChannelFault {
+    /// The program cannot go on: a block that does not decode, an expression without a value,
+    /// a jump or call that fails.
+    Program(ProgramFault),
+    /// The path of a motion block has no profile.
+    Path(PathError),
+    /// `#SIGNAL SYN` found the synchronisation board full.
+    SyncBoardFull,
+    /// An independent axis's move has no profile.
+    IndependentNoProfile {
+        /// The axis.
+        axis: AxisName,
+    },
+    /// `#TRACK CS ON` refused.
+    TrackRefused(TrackError),
+    /// The tracking went to ERROR while the program ran.
+    Tracking(TrackError),
+    /// A tracked step beyond an axis's limit.
+    TrackedStep(LimitViolation),
+    /// `#CS` without a transformation.
+    CsWithoutTrafo,
+    /// More `#CS` frames than the stack holds.
+    CsDepth,
+    /// A `#CS` frame that is no frame.
+    CsFrame(KinError),
+    /// `#TRAFO [id]` of a kinematic the channel does not have.
+    KinematicNotConfigured {
+        /// The id programmed.
+        id: u32,
+        /// The channel's kinematic.
+        configured: u32,
+    },
+    /// The inverse kinematics has no solution for the pose.
+    PoseUnreachable(KinError),
+    /// A controlled stop ended the program (the reason the machine gave).
+    MachineStop(&'static str),
+}
+
+impl ChannelFault {
+    /// The kind of cause, as `error_id_r` reports it.
+    pub fn id(&self) -> ChannelErrorId {
+        match self {
+            ChannelFault::Program(_) => ChannelErrorId::Program,
+            ChannelFault::Path(_) => ChannelErrorId::Path,
+            ChannelFault::SyncBoardFull => ChannelErrorId::Synchronisation,
+            ChannelFault::IndependentNoProfile { .. } => ChannelErrorId::IndependentAxis,
+            ChannelFault::TrackRefused(_)
+            | ChannelFault::Tracking(_)
+            | ChannelFault::TrackedStep(_) => ChannelErrorId::Tracking,
+            ChannelFault::CsWithoutTrafo | ChannelFault::CsDepth | ChannelFault::CsFrame(_) => {
+                ChannelErrorId::CoordinateSystem
+            }
+            ChannelFault::KinematicNotConfigured { .. } | ChannelFault::PoseUnreachable(_) => {
+                ChannelErrorId::Kinematics
+            }
+            ChannelFault::MachineStop(_) => ChannelErrorId::MachineStop,
+        }
+    }
+}
+
+impl fmt::Display for ChannelFault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ChannelFault::Program(p) => write!(f, "{p}"),
+            ChannelFault::Path(e) => write!(f, "{e}"),
+            ChannelFault::SyncBoardFull => {
+                f.write_str("#SIGNAL SYN: too many synchronisation ids pending")
+            }
+            ChannelFault::IndependentNoProfile { axis } => {
+                write!(f, "independent axis {axis}: no profile")
+            }
+            ChannelFault::TrackRefused(e) => write!(f, "#TRACK CS ON: {e}"),
+            ChannelFault::Tracking(e) => write!(f, "tracking: {e}"),
+            ChannelFault::TrackedStep(v) => write!(f, "tracked step refused: {v}"),
+            ChannelFault::CsWithoutTrafo => {
+                f.write_str("#CS needs an active transformation (#TRAFO ON)")
+            }
+            ChannelFault::CsDepth => write!(f, "more than {CS_DEPTH} coordinate systems active"),
+            ChannelFault::CsFrame(e) => write!(f, "#CS: {e}"),
+            ChannelFault::KinematicNotConfigured { id, configured } => write!(
+                f,
+                "kinematic {id} is not configured for this channel (configured: {configured})"
+            ),
+            ChannelFault::PoseUnreachable(e) => write!(f, "pose unreachable: {e}"),
+            ChannelFault::MachineStop(reason) => f.write_str(reason),
+        }
+    }
+}

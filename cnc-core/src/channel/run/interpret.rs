@@ -1,0 +1,229 @@
+//! The run loop and its waits: the interpreter runs blocks until one moves or waits (at most
+//! [`BLOCKS_PER_TICK`] a tick), each block decoded when the channel reaches it with the
+//! variables of that moment; a wait (M function, `#WAIT SYN`, tracking, independent axes,
+//! dwell) holds the next block back until it is over.
+
+use super::*;
+
+/// The program and where the channel is in it.
+pub(super) struct ProgramRun {
+    pub(super) program: Option<LoadedProgram>,
+    pub(super) decoder: DecoderState,
+    /// Follows the program's control flow and calls.
+    pub(super) interp: Interpreter,
+    /// Source line of the block executing.
+    pub(super) line: u32,
+    /// The elements of the block decoded last, and the next one to carry out.
+    pub(super) pending: Vec<Decoded>,
+    pub(super) pending_at: usize,
+    pub(super) wait: Option<Wait>,
+    pub(super) wait_ids: SyncIds,
+    /// NC blocks the interpreter handed on (each block once, loops counted per pass).
+    pub(super) blocks_executed: u64,
+}
+
+impl ProgramRun {
+    /// No program yet, for a channel with these axes.
+    pub(super) fn new(axes: &[String]) -> Self {
+        Self {
+            program: None,
+            decoder: DecoderState::new(axes),
+            interp: Interpreter::new(),
+            line: 0,
+            pending: Vec::with_capacity(16),
+            pending_at: 0,
+            wait: None,
+            wait_ids: SyncIds::default(),
+            blocks_executed: 0,
+        }
+    }
+}
+
+/// What the interpreter waits for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Wait {
+    /// The PLC's acknowledge of M function `code` announced with `id`.
+    MFunction { code: u32, id: u32 },
+    /// The announcement of `code` could not be posted yet (the previous one is unread).
+    MAnnounce { code: u32 },
+    /// `#WAIT SYN` for the ids in `wait_ids`.
+    Sync,
+    /// `#TRACK CS ... WAIT`.
+    Tracking,
+    /// `#WAIT INDP ALL` or an `INDP_SYN` move.
+    Independent,
+    /// `G04` / `#TIME`: until the channel's tick counter reaches this.
+    Dwell { until: u64 },
+}
+
+/// The variables a block sees when it is decoded.
+struct ChannelVars {
+    track_cs: [f64; 6],
+}
+
+impl Vars for ChannelVars {
+    fn get(&self, name: &str) -> Option<f64> {
+        KNOWN_VARIABLES
+            .iter()
+            .position(|v| *v == name)
+            .map(|i| self.track_cs[i])
+    }
+}
+
+impl Channel {
+    /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
+    /// A channel that failed is reset first (see [`Channel::reset`]): it starts again from
+    /// where its axes came to rest, and is refused while they still move or track.
+    pub fn start(&mut self, program: LoadedProgram) -> Result<(), ResetError> {
+        if self.state == RunState::Error {
+            self.reset()?;
+        }
+        // A new program starts from the modal defaults the check assumed (G90 G17 G71 G53 D0,
+        // no feed), where the axes stand.
+        self.run.decoder = DecoderState::new(&self.config.axes);
+        for (i, p) in self.motion.programmed.iter().enumerate() {
+            self.run.decoder.set_position(i, *p);
+        }
+        self.run.decoder.configure(&program.setup);
+        self.run.interp.start(&program.set);
+        self.run.program = Some(program);
+        self.run.pending.clear();
+        self.run.pending_at = 0;
+        self.state = RunState::Running;
+        self.run.wait = None;
+        self.error = None;
+        if self.config.provide_channel_interface.track_cs {
+            self.pose.interface_on = true;
+        }
+        self.pose.tracker.restart();
+        Ok(())
+    }
+
+    /// Line of the block executing.
+    pub fn line(&self) -> u32 {
+        self.run.line
+    }
+
+    /// NC blocks run so far (a block in a loop counts once per pass).
+    pub fn blocks_executed(&self) -> u64 {
+        self.run.blocks_executed
+    }
+
+    /// `f_wait` of a PLC transition, the counterpart of the NC command's WAIT: the program
+    /// goes on to its next block only once the switching has finished (ACTIVE or INACTIVE).
+    /// The block under way runs on; nothing waits when no program runs.
+    pub(super) fn hold_program_until_settled(&mut self) {
+        if self.state == RunState::Running && self.run.wait.is_none() {
+            self.run.wait = Some(Wait::Tracking);
+        }
+    }
+
+    /// Runs blocks until one moves or waits.
+    pub(super) fn interpret(
+        &mut self,
+        masters: &[Option<MasterSample>; MAX_CHANNELS],
+        sync: &mut SyncBoard,
+    ) {
+        for _ in 0..BLOCKS_PER_TICK {
+            if let Some(wait) = self.run.wait {
+                if !self.wait_done(wait, sync) {
+                    return;
+                }
+                self.run.wait = None;
+            }
+            if self.motion.path.is_some() || self.state != RunState::Running {
+                return;
+            }
+            if self.run.pending_at < self.run.pending.len() {
+                let element = core::mem::replace(
+                    &mut self.run.pending[self.run.pending_at],
+                    Decoded::Flush {
+                        line: 0,
+                        wait: false,
+                    },
+                );
+                self.run.pending_at += 1;
+                self.execute(element, masters, sync);
+                continue;
+            }
+            self.run.pending.clear();
+            self.run.pending_at = 0;
+            if !self.next_block_decoded() {
+                return;
+            }
+        }
+    }
+
+    /// Runs the interpreter one step (a block decoded into `pending`, or a `$` statement
+    /// followed); `false` when the program ended or failed.
+    pub(super) fn next_block_decoded(&mut self) -> bool {
+        let Some(program) = self.run.program.as_ref() else {
+            self.state = RunState::Finished;
+            return false;
+        };
+        let vars = ChannelVars {
+            track_cs: self.pose.tracker.zero_values(),
+        };
+        match self.run.interp.step(
+            &program.set,
+            &mut self.run.decoder,
+            &vars,
+            &mut self.run.pending,
+        ) {
+            Ok(Step::End) => {
+                self.state = RunState::Finished;
+                false
+            }
+            Ok(Step::Block { unit, block }) => {
+                self.run.blocks_executed += 1;
+                if let Some(b) = program
+                    .set
+                    .units
+                    .get(unit as usize)
+                    .and_then(|u| u.tree.blocks.get(block as usize))
+                {
+                    self.run.line = b.line;
+                }
+                true
+            }
+            // The channel's values are a running machine's: nothing is undecided here.
+            Ok(Step::Control | Step::Undecided) => true,
+            Err(e) => {
+                self.fail(ChannelFault::Program(e.fault));
+                false
+            }
+        }
+    }
+
+    pub(super) fn wait_done(&mut self, wait: Wait, sync: &mut SyncBoard) -> bool {
+        match wait {
+            Wait::MFunction { code, id } => {
+                if !self.plc.inputs.has_m_unit {
+                    return true;
+                }
+                match self.plc.inputs.m_ack.take() {
+                    Some(HliMFunctionAck { m_code, request_id }) => {
+                        // A stale acknowledge (other id) is consumed and ignored.
+                        let done = request_id == id && m_code == code as i32;
+                        self.plc.m_functions_acked += u64::from(done);
+                        done
+                    }
+                    None => false,
+                }
+            }
+            Wait::MAnnounce { code } => {
+                if self.announce(code) {
+                    self.run.wait = Some(Wait::MFunction {
+                        code,
+                        id: self.plc.m_next_id,
+                    });
+                }
+                false
+            }
+            Wait::Sync => sync.try_wait(self.run.wait_ids.as_slice()),
+            Wait::Tracking => self.pose.tracker.settled(),
+            Wait::Independent => self.motion.independent.iter().all(|(_, active)| !*active),
+            Wait::Dwell { until } => self.tick >= until,
+        }
+    }
+}
