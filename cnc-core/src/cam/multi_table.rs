@@ -483,14 +483,5 @@ fn fold(e: &Entry, u: f64) -> (f64, i64) {
     if !e.periodic || e.period <= 0.0 {
         return (u, 0);
     }
-    let mut cycle = ((u - e.first) / e.period).floor();
-    let mut local = u - cycle * e.period;
-    if local >= e.first + e.period {
-        cycle += 1.0;
-        local -= e.period;
-    } else if local < e.first {
-        cycle -= 1.0;
-        local += e.period;
-    }
-    (local, cycle as i64)
+    super::fold_period(u, e.first, e.period)
 }
