@@ -9,7 +9,7 @@
 //! queued in the CNC). The table data and the selection are in [`super::cam_data`], the reads
 //! in [`super::cam_read`], the multi-table blocks in [`super::cam_multi`].
 
-use crate::kernel::{call_error_code, done_unless, Accept, Kernel, Outputs, Step};
+use crate::kernel::{done_unless, send, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::cam::{
@@ -83,11 +83,7 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         self.kernel.cycle(
             io,
             execute,
-            |io| {
-                io.acyclic
-                    .start(target, &call())
-                    .map_err(|e| call_error_code(&e))
-            },
+            |io| send(io, target, &call()),
             |reply| match (reply.error_id, couples) {
                 (0, Some(_)) => Accept::Follow(false, Outputs::busy()),
                 (code, _) => done_unless(code),
@@ -99,10 +95,7 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         )
     }
 
-    /// Input tTimeout: cycles to wait for the CNC's answer.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(kernel);
 }
 
 /// MC_CamIn and MC_CamInExt (`extended`): couples `slave` to `master` through a cam.

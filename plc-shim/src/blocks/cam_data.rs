@@ -4,7 +4,7 @@
 
 use super::cam::recorded;
 use crate::kernel::{
-    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled,
+    call_error_code, done_unless, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled,
 };
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
@@ -63,11 +63,7 @@ impl McCamTableSelect {
         };
         let (table, data, periodic) = (self.table, &self.data, self.periodic);
         let send = |io: &mut PlcIo<'_>| match data {
-            CamData::None => io
-                .acyclic
-                .start(table, &call)
-                .map(SelectTransfer::Selecting)
-                .map_err(|e| call_error_code(&e)),
+            CamData::None => send(io, table, &call).map(SelectTransfer::Selecting),
             data => Ok(SelectTransfer::Loading(
                 ChunkTransfer::new(table, data, true, periodic),
                 call,

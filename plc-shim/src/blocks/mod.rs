@@ -46,6 +46,17 @@ macro_rules! execute_cycle {
     };
 }
 
+/// Input tTimeout of a block on the kernel at `self.<path>`: its `set_timeout_cycles`.
+macro_rules! timeout_input {
+    ($($path:ident).+) => {
+        /// Input tTimeout: cycles to wait for the CNC's answer (a read in parts: for each
+        /// part).
+        pub fn set_timeout_cycles(&mut self, cycles: u64) {
+            self.$($path).+.set_timeout_cycles(cycles);
+        }
+    };
+}
+
 pub mod cam;
 pub mod cam_compat;
 pub mod cam_data;

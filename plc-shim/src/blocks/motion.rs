@@ -8,7 +8,7 @@
 //! Execute already fell.
 
 use super::plain;
-use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
+use crate::kernel::{send, Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
     input, BlockSpec, InputSpec, Inputs, Kind, Target, TimelineBlock, Value,
@@ -77,11 +77,7 @@ impl CommandCore {
         self.kernel.cycle(
             io,
             execute,
-            |io| {
-                io.acyclic
-                    .start(axis, &call())
-                    .map_err(|_| crate::kernel::ERROR_NO_ANSWER)
-            },
+            |io| send(io, axis, &call()),
             accept,
             |id, io, _: Waited| follow(io, axis, *id, finished_when_reached),
         )
