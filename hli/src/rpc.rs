@@ -36,24 +36,42 @@ fn transport(e: impl core::fmt::Debug) -> CallError {
     CallError::Transport(format!("{e:?}"))
 }
 
-fn open_service(
-    node: &Node<ipc::Service>,
-    instance: &str,
-) -> Result<
-    iceoryx2::service::port_factory::request_response::PortFactory<
-        ipc::Service,
-        AcyclicRequest,
-        (),
-        AcyclicResponse,
-        (),
-    >,
-    CallError,
-> {
-    let name: ServiceName = service_name(instance)
-        .as_str()
-        .try_into()
-        .map_err(transport)?;
-    node.service_builder(&name)
+/// The calls' service and the row service, from which each end makes its ports.
+type CallsService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    AcyclicRequest,
+    (),
+    AcyclicResponse,
+    (),
+>;
+type RowsService = iceoryx2::service::port_factory::request_response::PortFactory<
+    ipc::Service,
+    [f64],
+    FifoRowsHeader,
+    FifoReply,
+    (),
+>;
+
+/// Prints the type's name alone: the iceoryx2 ports have nothing worth showing.
+macro_rules! debug_by_name {
+    ($($ty:ident),*) => {
+        $(impl core::fmt::Debug for $ty {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(stringify!($ty))
+            }
+        })*
+    };
+}
+
+debug_by_name!(AcyclicClient, AcyclicServer, RowsLoan, PendingRows);
+
+/// A service name as iceoryx2 takes it.
+fn name_of(name: String) -> Result<ServiceName, CallError> {
+    name.as_str().try_into().map_err(transport)
+}
+
+fn open_service(node: &Node<ipc::Service>, instance: &str) -> Result<CallsService, CallError> {
+    node.service_builder(&name_of(service_name(instance))?)
         .request_response::<AcyclicRequest, AcyclicResponse>()
         // One pending call per PLC block and axis: 32 axes with a move and a power block each.
         .max_active_requests_per_client(64)
@@ -61,24 +79,8 @@ fn open_service(
         .map_err(transport)
 }
 
-fn open_rows_service(
-    node: &Node<ipc::Service>,
-    instance: &str,
-) -> Result<
-    iceoryx2::service::port_factory::request_response::PortFactory<
-        ipc::Service,
-        [f64],
-        FifoRowsHeader,
-        FifoReply,
-        (),
-    >,
-    CallError,
-> {
-    let name: ServiceName = rows_service_name(instance)
-        .as_str()
-        .try_into()
-        .map_err(transport)?;
-    node.service_builder(&name)
+fn open_rows_service(node: &Node<ipc::Service>, instance: &str) -> Result<RowsService, CallError> {
+    node.service_builder(&name_of(rows_service_name(instance))?)
         .request_response::<[f64], FifoReply>()
         .request_user_header::<FifoRowsHeader>()
         // A few FiFoWrite/FiFoOverwrite instances per group, each with one block on its way.
@@ -86,6 +88,21 @@ fn open_rows_service(
         .max_loaned_requests(4)
         .open_or_create()
         .map_err(transport)
+}
+
+/// A node of its own for one end of `instance`'s services, and the end's two ports: `port`
+/// makes its port of the calls' service, `rows` its port of the row service.
+fn open_end<P, R, E: core::fmt::Debug, F: core::fmt::Debug>(
+    instance: &str,
+    port: impl FnOnce(&CallsService) -> Result<P, E>,
+    rows: impl FnOnce(&RowsService) -> Result<R, F>,
+) -> Result<(Node<ipc::Service>, P, R), CallError> {
+    let node = NodeBuilder::new()
+        .create::<ipc::Service>()
+        .map_err(transport)?;
+    let port = port(&open_service(&node, instance)?).map_err(transport)?;
+    let rows = rows(&open_rows_service(&node, instance)?).map_err(transport)?;
+    Ok((node, port, rows))
 }
 
 /// The PLC's end: sends calls and waits for their replies; sends FIFO row blocks.
@@ -96,27 +113,18 @@ pub struct AcyclicClient {
     next_invoke_id: u32,
 }
 
-impl core::fmt::Debug for AcyclicClient {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("AcyclicClient")
-    }
-}
-
 impl AcyclicClient {
     /// Connects to `instance`'s service (creating it if the server is not up yet).
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let node = NodeBuilder::new()
-            .create::<ipc::Service>()
-            .map_err(transport)?;
-        let port = open_service(&node, instance)?
-            .client_builder()
-            .create()
-            .map_err(transport)?;
-        let rows = open_rows_service(&node, instance)?
-            .client_builder()
-            .initial_max_slice_len(FIFO_BLOCK_VALUES)
-            .create()
-            .map_err(transport)?;
+        let (node, port, rows) = open_end(
+            instance,
+            |calls| calls.client_builder().create(),
+            |rows| {
+                rows.client_builder()
+                    .initial_max_slice_len(FIFO_BLOCK_VALUES)
+                    .create()
+            },
+        )?;
         Ok(Self {
             _node: node,
             port,
@@ -274,12 +282,6 @@ pub struct RowsLoan {
     loan: RowsLoanPort,
 }
 
-impl core::fmt::Debug for RowsLoan {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("RowsLoan")
-    }
-}
-
 impl RowsLoan {
     /// The block's values, row after row (zero until written).
     pub fn values_mut(&mut self) -> &mut [f64] {
@@ -296,12 +298,6 @@ impl RowsLoan {
 /// A row block on its way: poll it until it yields the CNC's reply.
 pub struct PendingRows {
     pending: RowsPendingPort,
-}
-
-impl core::fmt::Debug for PendingRows {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("PendingRows")
-    }
 }
 
 impl PendingRows {
@@ -323,26 +319,14 @@ pub struct AcyclicServer {
     rows: RowsServerPort,
 }
 
-impl core::fmt::Debug for AcyclicServer {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("AcyclicServer")
-    }
-}
-
 impl AcyclicServer {
     /// Opens (or creates) `instance`'s service and its server port.
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let node = NodeBuilder::new()
-            .create::<ipc::Service>()
-            .map_err(transport)?;
-        let port = open_service(&node, instance)?
-            .server_builder()
-            .create()
-            .map_err(transport)?;
-        let rows = open_rows_service(&node, instance)?
-            .server_builder()
-            .create()
-            .map_err(transport)?;
+        let (node, port, rows) = open_end(
+            instance,
+            |calls| calls.server_builder().create(),
+            |rows| rows.server_builder().create(),
+        )?;
         Ok(Self {
             _node: node,
             port,

@@ -204,6 +204,74 @@ fn process_start_stamp(pid: u32) -> Option<u64> {
     fields.nth(22 - 4)?.parse().ok()
 }
 
+/// A zeroed shared-memory object of `size` bytes, owner-only, created as `mode` says.
+fn create_object(
+    fname: &FileName,
+    mode: CreationMode,
+    size: usize,
+) -> Result<SharedMemory, SharedMemoryCreationError> {
+    SharedMemoryBuilder::new(fname)
+        .is_memory_locked(false)
+        .creation_mode(mode)
+        .size(size)
+        .permission(Permission::OWNER_READ_WRITE)
+        .zero_memory(true)
+        .create()
+}
+
+/// What both sides of a segment ([`CncSegment`], [`PlcSegment`]) have over their mapping
+/// (`memory`) and its `name`: `Debug` by the name, the whole image, the header, the raw memory;
+/// `beat` counts the side's own heartbeat counter of the header (a CNC tick, a PLC cycle),
+/// and a reader named after the other side's counter loads that one.
+macro_rules! segment_side {
+    ($side:ident, beats $own:ident, watches $peer:ident) => {
+        impl core::fmt::Debug for $side {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.debug_struct(stringify!($side))
+                    .field("name", &self.name)
+                    .finish()
+            }
+        }
+
+        impl $side {
+            /// The segment's shared-memory name.
+            pub fn name(&self) -> &str {
+                &self.name
+            }
+
+            /// The whole image.
+            pub fn image(&self) -> Place<'_, HliImage> {
+                self.memory.place(0)
+            }
+
+            /// The header.
+            pub fn header(&self) -> Place<'_, HliSegmentHeader> {
+                self.memory.place(0)
+            }
+
+            /// The raw memory (symbol-table access, snapshots).
+            pub fn memory(&self) -> &ImageMemory {
+                &self.memory
+            }
+
+            /// Marks one more tick (CNC) or cycle (PLC) of this side; returns the new
+            /// heartbeat.
+            pub fn beat(&self) -> u64 {
+                self.header()
+                    .field::<u64>(offset_of!(HliSegmentHeader, $own))
+                    .increment()
+            }
+
+            /// The other side's heartbeat.
+            pub fn $peer(&self) -> u64 {
+                self.header()
+                    .field::<u64>(offset_of!(HliSegmentHeader, $peer))
+                    .load_acquire()
+            }
+        }
+    };
+}
+
 /// A previous owner's segment that was found dead and replaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StaleSegment {
@@ -218,13 +286,7 @@ pub struct CncSegment {
     replaced: Option<StaleSegment>,
 }
 
-impl core::fmt::Debug for CncSegment {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("CncSegment")
-            .field("name", &self.name)
-            .finish()
-    }
-}
+segment_side!(CncSegment, beats cnc_heartbeat, watches plc_heartbeat);
 
 impl CncSegment {
     /// Creates the segment of `instance` for `channels` channels and `axes` axes. A segment
@@ -278,13 +340,7 @@ impl CncSegment {
     }
 
     fn create_exclusive(fname: &FileName) -> Result<SharedMemory, SharedMemoryCreationError> {
-        SharedMemoryBuilder::new(fname)
-            .is_memory_locked(false)
-            .creation_mode(CreationMode::CreateExclusive)
-            .size(IMAGE_SIZE)
-            .permission(Permission::OWNER_READ_WRITE)
-            .zero_memory(true)
-            .create()
+        create_object(fname, CreationMode::CreateExclusive, IMAGE_SIZE)
     }
 
     /// Decides whether an existing object may be replaced: only when no live CNC owns it.
@@ -331,43 +387,9 @@ impl CncSegment {
             .store_release(SegmentState::Ready.raw());
     }
 
-    /// The segment's shared-memory name.
-    pub fn name(&self) -> &str {
-        &self.name
-    }
-
     /// The stale segment this one replaced, if any.
     pub fn replaced_stale(&self) -> Option<StaleSegment> {
         self.replaced
-    }
-
-    /// The whole image.
-    pub fn image(&self) -> Place<'_, HliImage> {
-        self.memory.place(0)
-    }
-
-    /// The header.
-    pub fn header(&self) -> Place<'_, HliSegmentHeader> {
-        self.memory.place(0)
-    }
-
-    /// The raw memory (symbol-table access, snapshots).
-    pub fn memory(&self) -> &ImageMemory {
-        &self.memory
-    }
-
-    /// Marks one more CNC tick; returns the new heartbeat.
-    pub fn beat(&self) -> u64 {
-        self.header()
-            .field::<u64>(offset_of!(HliSegmentHeader, cnc_heartbeat))
-            .increment()
-    }
-
-    /// The PLC's heartbeat.
-    pub fn plc_heartbeat(&self) -> u64 {
-        self.header()
-            .field::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat))
-            .load_acquire()
     }
 
     /// Size of the mapping in bytes.
@@ -411,13 +433,7 @@ pub struct PlcSegment {
     claimed: bool,
 }
 
-impl core::fmt::Debug for PlcSegment {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("PlcSegment")
-            .field("name", &self.name)
-            .finish()
-    }
-}
+segment_side!(PlcSegment, beats plc_heartbeat, watches cnc_heartbeat);
 
 impl PlcSegment {
     /// Attaches to the segment of `instance`, which must match this build's layout.
@@ -524,21 +540,6 @@ impl PlcSegment {
         })
     }
 
-    /// The whole image.
-    pub fn image(&self) -> Place<'_, HliImage> {
-        self.memory.place(0)
-    }
-
-    /// The header.
-    pub fn header(&self) -> Place<'_, HliSegmentHeader> {
-        self.memory.place(0)
-    }
-
-    /// The raw memory.
-    pub fn memory(&self) -> &ImageMemory {
-        &self.memory
-    }
-
     /// Channels the CNC configured.
     pub fn channel_count(&self) -> u32 {
         self.channels
@@ -547,20 +548,6 @@ impl PlcSegment {
     /// Axes the CNC configured.
     pub fn axis_count(&self) -> u32 {
         self.axes
-    }
-
-    /// Marks one more PLC cycle; returns the new heartbeat.
-    pub fn beat(&self) -> u64 {
-        self.header()
-            .field::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat))
-            .increment()
-    }
-
-    /// The CNC's heartbeat.
-    pub fn cnc_heartbeat(&self) -> u64 {
-        self.header()
-            .field::<u64>(offset_of!(HliSegmentHeader, cnc_heartbeat))
-            .load_acquire()
     }
 
     /// The CNC's segment state (`Closed` after an orderly shutdown).
@@ -638,13 +625,7 @@ pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateE
     let fname = FileName::new(name.as_bytes()).map_err(|_| CreateError::InvalidName {
         name: name.to_string(),
     })?;
-    SharedMemoryBuilder::new(&fname)
-        .is_memory_locked(false)
-        .creation_mode(CreationMode::PurgeAndCreate)
-        .size(size)
-        .permission(Permission::OWNER_READ_WRITE)
-        .zero_memory(true)
-        .create()
+    create_object(&fname, CreationMode::PurgeAndCreate, size)
         .map(ImageMemory::shared)
         .map_err(|e| CreateError::Os {
             name: name.to_string(),

@@ -179,15 +179,7 @@ fn layout_hash(symbols: &[Symbol]) -> u64 {
     const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
     let mut hash = FNV_OFFSET;
     for s in symbols {
-        let line = format!(
-            "{} {} {} {} {}\n",
-            s.path,
-            s.offset,
-            s.size,
-            s.type_name,
-            s.writer.label()
-        );
-        for byte in line.bytes() {
+        for byte in table_line(s).bytes() {
             hash ^= u64::from(byte);
             hash = hash.wrapping_mul(FNV_PRIME);
         }
@@ -199,16 +191,22 @@ fn layout_hash(symbols: &[Symbol]) -> u64 {
 pub fn format_table(table: &SymbolTable) -> String {
     let mut out = String::with_capacity(table.symbols().len() * 80);
     for s in table.symbols() {
-        out.push_str(&format!(
-            "{} {} {} {} {}\n",
-            s.path,
-            s.offset,
-            s.size,
-            s.type_name,
-            s.writer.label()
-        ));
+        out.push_str(&table_line(s));
     }
     out
+}
+
+/// A symbol's line of the table, `PATH OFFSET SIZE TYPE WRITER`: what [`format_table`] prints
+/// and what the layout hash is taken over.
+fn table_line(s: &Symbol) -> String {
+    format!(
+        "{} {} {} {} {}\n",
+        s.path,
+        s.offset,
+        s.size,
+        s.type_name,
+        s.writer.label()
+    )
 }
 
 #[cfg(test)]

@@ -323,54 +323,61 @@ impl SetpointGenerator {
 mod tests {
     use super::*;
 
-    fn run(from: f64, to: f64, l: MoveLimits) -> Result<usize, GeneratorError> {
-        let mut g = SetpointGenerator::new(0.001, from);
-        g.move_to(to, l)?;
+    /// Velocity, acceleration, deceleration and jerk limits in this order.
+    fn limits([velocity, acceleration, deceleration, jerk]: [f64; 4]) -> MoveLimits {
+        MoveLimits {
+            velocity,
+            acceleration,
+            deceleration,
+            jerk,
+        }
+    }
+
+    /// Steps `g` until it reports its goal reached (fails after `max` steps); the steps
+    /// before that one.
+    fn steps_to_reach(g: &mut SetpointGenerator, max: usize) -> usize {
         let mut n = 0;
         while g.step() != Progress::Reached {
             n += 1;
-            assert!(n < 100_000);
+            assert!(n < max);
         }
-        Ok(n)
+        n
+    }
+
+    fn run(from: f64, to: f64, l: MoveLimits) -> Result<usize, GeneratorError> {
+        let mut g = SetpointGenerator::new(0.001, from);
+        g.move_to(to, l)?;
+        Ok(steps_to_reach(&mut g, 100_000))
     }
 
     #[test]
     fn a_knife_edge_retarget_still_finds_a_profile() {
         let mut g = SetpointGenerator::new(0.001, 0.0);
         g.set_jerk_ceiling(200_000.0);
-        let first = MoveLimits {
-            velocity: 460.74781648558354,
-            acceleration: 5204.042272881033,
-            deceleration: 8614.688363408739,
-            jerk: 184719.09022780522,
-        };
+        let first = limits([
+            460.74781648558354,
+            5204.042272881033,
+            8614.688363408739,
+            184719.09022780522,
+        ]);
         g.move_to(-77.90457864321381, first).unwrap();
         for _ in 0..218 {
             g.step();
         }
-        let second = MoveLimits {
-            velocity: 722.222359667801,
-            acceleration: 8430.952228104466,
-            deceleration: 8127.029675668488,
-            jerk: 196414.45591088082,
-        };
+        let second = limits([
+            722.222359667801,
+            8430.952228104466,
+            8127.029675668488,
+            196414.45591088082,
+        ]);
         g.move_to(-895.1502189081375, second).unwrap();
-        let mut n = 0;
-        while g.step() != Progress::Reached {
-            n += 1;
-            assert!(n < 10_000);
-        }
+        steps_to_reach(&mut g, 10_000);
         assert_eq!(g.state().position, -895.1502189081375);
     }
 
     #[test]
     fn asymmetric_limits_that_trip_the_library_still_move() {
-        let l = MoveLimits {
-            velocity: 500.0,
-            acceleration: 5000.0,
-            deceleration: 4000.0,
-            jerk: 100_000.0,
-        };
+        let l = limits([500.0, 5000.0, 4000.0, 100_000.0]);
         for (a, b) in [
             (0.0, -15.0),
             (10.0, -15.0),

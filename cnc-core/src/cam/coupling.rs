@@ -269,21 +269,8 @@ impl CamLaw {
                 cycle: 0,
             };
         }
-        let mut cycle = ((x - self.first) / self.period).floor();
-        let mut local = x - cycle * self.period;
-        // Rounding may leave `local` a hair outside the period.
-        if local >= self.first + self.period {
-            cycle += 1.0;
-            local -= self.period;
-        } else if local < self.first {
-            cycle -= 1.0;
-            local += self.period;
-        }
-        CamPosition {
-            x,
-            local,
-            cycle: cycle as i64,
-        }
+        let (local, cycle) = super::fold_period(x, self.first, self.period);
+        CamPosition { x, local, cycle }
     }
 
     /// The slave set-point for the master set-point `master`, and where the master lies in

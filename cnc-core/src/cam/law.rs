@@ -9,6 +9,22 @@
 use super::piece::{shape, Piece, Wave};
 use std::f64::consts::PI;
 
+/// The pattern of the laws that are one normalised rest-to-rest shape ([`rest_to_rest`])
+/// stretched over a segment with a symmetry: every rest-to-rest law but the step. One list
+/// for [`FunctionType::ends`], [`FunctionType::has_symmetry`] and [`build`].
+macro_rules! shaped_rest_to_rest {
+    () => {
+        FunctionType::Polynom3
+            | FunctionType::Polynom5
+            | FunctionType::Polynom8
+            | FunctionType::SineLine
+            | FunctionType::ModifiedSineLine
+            | FunctionType::Bestehorn
+            | FunctionType::AccelerationTrapezoid
+            | FunctionType::SineStraightCombination
+    };
+}
+
 /// `MC_MotionFunctionType`: the law between a point and the next one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FunctionType {
@@ -194,15 +210,7 @@ impl FunctionType {
         use FunctionType::*;
         match self {
             Polynom1 => (Line, Line),
-            Polynom3
-            | Polynom5
-            | Polynom8
-            | SineLine
-            | ModifiedSineLine
-            | Bestehorn
-            | AccelerationTrapezoid
-            | SineStraightCombination
-            | Step => (Rest, Rest),
+            shaped_rest_to_rest!() | Step => (Rest, Rest),
             Polynom5Motion | Polynom7Motion | Polynom6StartJerk | Polynom6Inflection => {
                 (Motion, Motion)
             }
@@ -217,7 +225,7 @@ impl FunctionType {
     /// Whether the start point's jerk field sets the law's symmetry (seed: the rest-to-rest
     /// laws whose jerk at the ends is not a boundary value; every one but the step).
     pub fn has_symmetry(self) -> bool {
-        self.ends() == (EndKind::Rest, EndKind::Rest) && self != FunctionType::Step
+        matches!(self, shaped_rest_to_rest!())
     }
 }
 
@@ -263,14 +271,7 @@ pub fn build(spec: &SegmentSpec) -> Option<Vec<Piece>> {
     let in_z: Vec<Piece> = match spec.law {
         Polynom1 => vec![Piece::poly(0.0, 1.0, &[y0, h])],
         Step => vec![Piece::poly(0.0, 1.0, &[y0])],
-        Polynom3
-        | Polynom5
-        | Polynom8
-        | SineLine
-        | ModifiedSineLine
-        | Bestehorn
-        | AccelerationTrapezoid
-        | SineStraightCombination => {
+        shaped_rest_to_rest!() => {
             let base = rest_to_rest(spec.law);
             shape::scaled(&asymmetric(&base, 0.5 + spec.symmetry)?, h, y0)
         }

@@ -58,6 +58,23 @@ impl Sample {
     }
 }
 
+/// `x` folded into the period `[first, first + period)` of a cyclic profile (`period` > 0),
+/// and how many periods were folded (negative below `first`): the cam coupling and the
+/// multi-table slave count a cyclic table's cycles this way.
+pub(crate) fn fold_period(x: f64, first: f64, period: f64) -> (f64, i64) {
+    let mut cycle = ((x - first) / period).floor();
+    let mut local = x - cycle * period;
+    // Rounding may leave `local` a hair outside the period.
+    if local >= first + period {
+        cycle += 1.0;
+        local -= period;
+    } else if local < first {
+        cycle -= 1.0;
+        local += period;
+    }
+    (local, cycle as i64)
+}
+
 /// Value and four derivatives of one closed-form piece at a master position.
 pub(crate) type PieceEval<'a> = &'a dyn Fn(f64) -> [f64; 5];
 

@@ -27,38 +27,9 @@ use crate::setpoint::Kinematic;
 /// Tables of one multi-table slave.
 pub const MAX_MULTI_TABLES: usize = 8;
 
-/// The scaling of one table (CamTableSetWeight).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TableWeight {
-    /// W: the table's weight in the sum (> 0).
-    pub weight: f64,
-    /// MO: added to the scaled master position.
-    pub master_offset: f64,
-    /// MS: multiplies the master position (not 0).
-    pub master_slope: f64,
-    /// SO: added to the scaled slave value.
-    pub slave_offset: f64,
-    /// SS: multiplies the slave value.
-    pub slave_slope: f64,
-    /// RL: the master position from which a profile table counts.
-    pub range_low: f64,
-    /// RH: the master position up to which it counts (RL < RH).
-    pub range_high: f64,
-}
-
-impl Default for TableWeight {
-    fn default() -> Self {
-        TableWeight {
-            weight: 1.0,
-            master_offset: 0.0,
-            master_slope: 1.0,
-            slave_offset: 0.0,
-            slave_slope: 1.0,
-            range_low: f64::NEG_INFINITY,
-            range_high: f64::INFINITY,
-        }
-    }
-}
+/// The scaling of one table (CamTableSetWeight): the call's body as the CNC received it (W,
+/// MO, MS, SO, SS, RL, RH); its default is the neutral scaling.
+pub type TableWeight = hli::calls::cam::CamTableWeightCall;
 
 /// Why a weight or a multi-table coupling is refused.
 #[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
@@ -84,37 +55,34 @@ pub enum MultiTableError {
     NotInCoupling(u32, &'static str),
 }
 
-impl TableWeight {
-    /// Refuses NaN, a weight not above 0, a master slope of 0 and RL not below RH (ranges
-    /// may be open: infinite), and magnitudes the law could overflow with (as
-    /// `coupling::Scaling::check`).
-    pub fn check(&self) -> Result<(), MultiTableError> {
-        let bounded = [
-            ("weight", self.weight, 0.0, 1e6),
-            ("master offset", self.master_offset, 0.0, 1e12),
-            ("master slope", self.master_slope, 0.0, 1e6),
-            ("slave offset", self.slave_offset, 0.0, 1e12),
-            ("slave slope", self.slave_slope, 0.0, 1e6),
-        ];
-        for (what, value, min, max) in bounded {
-            let magnitude = value.abs();
-            if !(value.is_finite() && magnitude >= min && magnitude <= max) {
-                return Err(MultiTableError::Parameter { what, value });
-            }
+/// Refuses in a table's weight NaN, a weight not above 0, a master slope of 0 and RL not below
+/// RH (ranges may be open: infinite), and magnitudes the law could overflow with (as
+/// `coupling::Scaling::check`).
+pub fn check_weight(w: &TableWeight) -> Result<(), MultiTableError> {
+    let bounded = [
+        ("weight", w.weight, 0.0, 1e6),
+        ("master offset", w.master_offset, 0.0, 1e12),
+        ("master slope", w.master_slope, 0.0, 1e6),
+        ("slave offset", w.slave_offset, 0.0, 1e12),
+        ("slave slope", w.slave_slope, 0.0, 1e6),
+    ];
+    for (what, value, min, max) in bounded {
+        let magnitude = value.abs();
+        if !(value.is_finite() && magnitude >= min && magnitude <= max) {
+            return Err(MultiTableError::Parameter { what, value });
         }
-        let refuse = |what, value| Err(MultiTableError::Parameter { what, value });
-        if self.weight <= 0.0 {
-            return refuse("weight", self.weight);
-        }
-        if self.master_slope.abs() < 1e-6 {
-            return refuse("master slope", self.master_slope);
-        }
-        if self.range_low.is_nan() || self.range_high.is_nan() || self.range_low >= self.range_high
-        {
-            return refuse("range low", self.range_low);
-        }
-        Ok(())
     }
+    let refuse = |what, value| Err(MultiTableError::Parameter { what, value });
+    if w.weight <= 0.0 {
+        return refuse("weight", w.weight);
+    }
+    if w.master_slope.abs() < 1e-6 {
+        return refuse("master slope", w.master_slope);
+    }
+    if w.range_low.is_nan() || w.range_high.is_nan() || w.range_low >= w.range_high {
+        return refuse("range low", w.range_low);
+    }
+    Ok(())
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -188,7 +156,7 @@ impl MultiTableLaw {
         }
         let mut entries = [None; MAX_MULTI_TABLES];
         for (slot, t) in entries.iter_mut().zip(tables) {
-            t.weight.check()?;
+            check_weight(&t.weight)?;
             let (a, b) = t.cam.master_range();
             let (first, last) = (a.min(b), a.max(b));
             let mut c = ProfileCursor::default();
@@ -483,14 +451,5 @@ fn fold(e: &Entry, u: f64) -> (f64, i64) {
     if !e.periodic || e.period <= 0.0 {
         return (u, 0);
     }
-    let mut cycle = ((u - e.first) / e.period).floor();
-    let mut local = u - cycle * e.period;
-    if local >= e.first + e.period {
-        cycle += 1.0;
-        local -= e.period;
-    } else if local < e.first {
-        cycle -= 1.0;
-        local += e.period;
-    }
-    (local, cycle as i64)
+    super::fold_period(u, e.first, e.period)
 }

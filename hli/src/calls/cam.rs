@@ -397,23 +397,39 @@ pub struct CamValuesReply {
 }
 
 /// CamTableSetWeight for the table given as `target`: how it counts in a multi-table slave.
+/// The CNC keeps it as it came as the table's scaling (`cnc_core::cam::multi_table::TableWeight`).
 #[repr(C)]
-#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, PartialEq)]
 pub struct CamTableWeightCall {
-    /// Weight W (> 0).
+    /// Weight W of the table in the sum (> 0).
     pub weight: f64,
-    /// Master offset MO.
+    /// Master offset MO, added to the scaled master position.
     pub master_offset: f64,
     /// Master slope MS (multiplies the master position; not 0).
     pub master_slope: f64,
-    /// Slave offset SO.
+    /// Slave offset SO, added to the scaled slave value.
     pub slave_offset: f64,
-    /// Slave slope SS.
+    /// Slave slope SS, multiplies the slave value.
     pub slave_slope: f64,
     /// Lower end RL of the master range in which a profile table counts.
     pub range_low: f64,
     /// Upper end RH (RL < RH).
     pub range_high: f64,
+}
+
+impl Default for CamTableWeightCall {
+    /// The neutral scaling: weight and slopes 1, no offsets, a range without ends.
+    fn default() -> Self {
+        CamTableWeightCall {
+            weight: 1.0,
+            master_offset: 0.0,
+            master_slope: 1.0,
+            slave_offset: 0.0,
+            slave_slope: 1.0,
+            range_low: f64::NEG_INFINITY,
+            range_high: f64::INFINITY,
+        }
+    }
 }
 
 /// Tables of a multi-table slave.

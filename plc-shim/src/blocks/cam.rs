@@ -9,9 +9,11 @@
 //! queued in the CNC). The table data and the selection are in [`super::cam_data`], the reads
 //! in [`super::cam_read`], the multi-table blocks in [`super::cam_multi`].
 
-use crate::kernel::{call_error_code, done_unless, Accept, Kernel, Outputs, Step};
+use crate::kernel::{done_unless, send, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{
+    input, joined, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value,
+};
 use hli::calls::cam::{
     CamActivationMode, CamInCall, CamInterpolation, CamOutCall, CamReply, CamScalingCall,
     CamScalingMode, CamStartMode,
@@ -83,11 +85,7 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         self.kernel.cycle(
             io,
             execute,
-            |io| {
-                io.acyclic
-                    .start(target, &call())
-                    .map_err(|e| call_error_code(&e))
-            },
+            |io| send(io, target, &call()),
             |reply| match (reply.error_id, couples) {
                 (0, Some(_)) => Accept::Follow(false, Outputs::busy()),
                 (code, _) => done_unless(code),
@@ -99,9 +97,17 @@ impl<C: AcyclicCall<Reply = CamReply>> CamCore<C> {
         )
     }
 
-    /// Input tTimeout: cycles to wait for the CNC's answer.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
+    timeout_input!(kernel);
+}
+
+/// MC_CamScaling's inputs as the coupling blocks keep them before a program sets them: at
+/// once (activation mode 0), each side's scaling as given (mode 0), no offsets, scalings 1.
+/// MC_CamIn(Ext) and MC_SetCamOnlineChangeMode keep theirs among these.
+fn unscaled() -> CamScalingCall {
+    CamScalingCall {
+        master_scaling: 1.0,
+        slave_scaling: 1.0,
+        ..CamScalingCall::default()
     }
 }
 
@@ -116,22 +122,9 @@ pub struct McCamIn {
     pub table: u32,
     /// Input: raw `MC_StartMode` (1 absolute .. 4).
     pub start_mode: u32,
-    /// Input (Ext): raw `MC_CamActivationMode`.
-    pub activation_mode: u32,
-    /// Input (Ext): the activation position.
-    pub activation_position: f64,
-    /// Input (Ext): raw `MC_CamScalingMode` of the master.
-    pub master_scaling_mode: u32,
-    /// Input (Ext): raw `MC_CamScalingMode` of the slave.
-    pub slave_scaling_mode: u32,
-    /// Input: master offset.
-    pub master_offset: f64,
-    /// Input: slave offset.
-    pub slave_offset: f64,
-    /// Input: master scaling.
-    pub master_scaling: f64,
-    /// Input: slave scaling.
-    pub slave_scaling: f64,
+    /// Inputs: the activation and each side's scaling mode (Ext), the offsets and the
+    /// scalings, as MC_CamScaling takes them (`reserved` is not sent).
+    pub scaling: CamScalingCall,
     /// Input: raw `MC_InterpolationType` (tables).
     pub interpolation: u32,
     /// MC_CamInExt rather than MC_CamIn.
@@ -150,14 +143,7 @@ impl Default for McCamIn {
             master: 0,
             table: 0,
             start_mode: 1,
-            activation_mode: 0,
-            activation_position: 0.0,
-            master_scaling_mode: 0,
-            slave_scaling_mode: 0,
-            master_offset: 0.0,
-            slave_offset: 0.0,
-            master_scaling: 1.0,
-            slave_scaling: 1.0,
+            scaling: unscaled(),
             interpolation: 0,
             extended: false,
             master_actual: false,
@@ -170,20 +156,21 @@ impl Default for McCamIn {
 impl McCamIn {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
+        let s = self.scaling;
         let call = CamInCall {
             master: self.master,
             table_id: self.table,
             start_mode: self.start_mode,
-            activation_mode: self.activation_mode,
-            master_scaling_mode: self.master_scaling_mode,
-            slave_scaling_mode: self.slave_scaling_mode,
+            activation_mode: s.activation_mode,
+            master_scaling_mode: s.master_scaling_mode,
+            slave_scaling_mode: s.slave_scaling_mode,
             interpolation: self.interpolation,
             extended: u32::from(self.extended),
-            activation_position: self.activation_position,
-            master_offset: self.master_offset,
-            slave_offset: self.slave_offset,
-            master_scaling: self.master_scaling,
-            slave_scaling: self.slave_scaling,
+            activation_position: s.activation_position,
+            master_offset: s.master_offset,
+            slave_offset: s.slave_offset,
+            master_scaling: s.master_scaling,
+            slave_scaling: s.slave_scaling,
             master_source: u32::from(self.master_actual),
             reserved: 0,
         };
@@ -217,22 +204,9 @@ impl McCamOut {
 pub struct McCamScaling {
     /// Input: a rising edge sends it.
     pub execute: bool,
-    /// Input: raw `MC_CamActivationMode`.
-    pub activation_mode: u32,
-    /// Input: the activation position.
-    pub activation_position: f64,
-    /// Input: raw `MC_CamScalingMode` of the master.
-    pub master_scaling_mode: u32,
-    /// Input: raw `MC_CamScalingMode` of the slave.
-    pub slave_scaling_mode: u32,
-    /// Input: master offset.
-    pub master_offset: f64,
-    /// Input: slave offset.
-    pub slave_offset: f64,
-    /// Input: master scaling.
-    pub master_scaling: f64,
-    /// Input: slave scaling.
-    pub slave_scaling: f64,
+    /// Inputs: the activation, each side's scaling mode, the offsets and the scalings
+    /// (`reserved` is sent 0).
+    pub scaling: CamScalingCall,
     /// Outputs of the last call.
     pub out: Outputs,
     core: CamCore<CamScalingCall>,
@@ -242,14 +216,7 @@ impl Default for McCamScaling {
     fn default() -> Self {
         Self {
             execute: false,
-            activation_mode: 0,
-            activation_position: 0.0,
-            master_scaling_mode: 0,
-            slave_scaling_mode: 0,
-            master_offset: 0.0,
-            slave_offset: 0.0,
-            master_scaling: 1.0,
-            slave_scaling: 1.0,
+            scaling: unscaled(),
             out: Outputs::default(),
             core: CamCore::default(),
         }
@@ -260,15 +227,8 @@ impl McCamScaling {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let call = CamScalingCall {
-            activation_mode: self.activation_mode,
-            master_scaling_mode: self.master_scaling_mode,
-            slave_scaling_mode: self.slave_scaling_mode,
             reserved: 0,
-            activation_position: self.activation_position,
-            master_offset: self.master_offset,
-            slave_offset: self.slave_offset,
-            master_scaling: self.master_scaling,
-            slave_scaling: self.slave_scaling,
+            ..self.scaling
         };
         self.out = self.core.cycle(io, self.execute, slave, || call, None);
     }
@@ -314,14 +274,9 @@ pub struct McSetCamOnlineChangeMode {
     pub execute: bool,
     /// Input: the table ID.
     pub table: u32,
-    /// Input: raw `MC_CamActivationMode`.
-    pub activation_mode: u32,
-    /// Input: the activation position.
-    pub activation_position: f64,
-    /// Input: raw `MC_CamScalingMode` of the master.
-    pub master_scaling_mode: u32,
-    /// Input: raw `MC_CamScalingMode` of the slave.
-    pub slave_scaling_mode: u32,
+    /// Inputs: the activation and each side's scaling mode, as MC_CamScaling takes them (its
+    /// offsets and scalings are not used).
+    pub scaling: CamScalingCall,
     /// Outputs of the last call.
     pub out: Outputs,
     core: CamCore<hli::calls::cam::CamOnlineModeCall>,
@@ -330,12 +285,13 @@ pub struct McSetCamOnlineChangeMode {
 impl McSetCamOnlineChangeMode {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let s = self.scaling;
         let call = hli::calls::cam::CamOnlineModeCall {
-            activation_mode: self.activation_mode,
-            master_scaling_mode: self.master_scaling_mode,
-            slave_scaling_mode: self.slave_scaling_mode,
+            activation_mode: s.activation_mode,
+            master_scaling_mode: s.master_scaling_mode,
+            slave_scaling_mode: s.slave_scaling_mode,
             reserved: 0,
-            activation_position: self.activation_position,
+            activation_position: s.activation_position,
         };
         self.out = self.core.cycle(io, self.execute, self.table, || call, None);
     }
@@ -356,21 +312,13 @@ pub(crate) fn recorded(out: Outputs) -> (Outputs, bool) {
 
 impl TimelineBlock for McCamIn {
     fn set(&mut self, key: &str, value: &Value) {
-        match (key, value.uint(), value.real()) {
-            ("activation_mode", Some(v), _) => self.activation_mode = v,
-            ("activation_position", _, Some(v)) => self.activation_position = v,
-            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
-            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
-            ("master_source", Some(v), _) => self.master_actual = v != 0,
-            ("master", Some(v), _) => self.master = v,
-            ("table", Some(v), _) => self.table = v,
-            ("start_mode", Some(v), _) => self.start_mode = v,
-            ("interpolation", Some(v), _) => self.interpolation = v,
-            ("master_offset", _, Some(v)) => self.master_offset = v,
-            ("slave_offset", _, Some(v)) => self.slave_offset = v,
-            ("master_scaling", _, Some(v)) => self.master_scaling = v,
-            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
-            _ => {}
+        match (key, value.uint()) {
+            ("master_source", Some(v)) => self.master_actual = v != 0,
+            ("master", Some(v)) => self.master = v,
+            ("table", Some(v)) => self.table = v,
+            ("start_mode", Some(v)) => self.start_mode = v,
+            ("interpolation", Some(v)) => self.interpolation = v,
+            _ => set_scaling(&mut self.scaling, key, value),
         }
     }
     fn execute(&mut self) -> Option<&mut bool> {
@@ -392,154 +340,102 @@ impl TimelineBlock for McCamOut {
 
 impl TimelineBlock for McCamScaling {
     fn set(&mut self, key: &str, value: &Value) {
-        match (key, value.uint(), value.real()) {
-            ("activation_mode", Some(v), _) => self.activation_mode = v,
-            ("activation_position", _, Some(v)) => self.activation_position = v,
-            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
-            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
-            ("master_offset", _, Some(v)) => self.master_offset = v,
-            ("slave_offset", _, Some(v)) => self.slave_offset = v,
-            ("master_scaling", _, Some(v)) => self.master_scaling = v,
-            ("slave_scaling", _, Some(v)) => self.slave_scaling = v,
-            _ => {}
-        }
+        set_scaling(&mut self.scaling, key, value);
     }
     execute_cycle!(with_axis, recorded);
 }
 
 impl TimelineBlock for McWriteMotionFunctionPoint {
     fn set(&mut self, key: &str, value: &Value) {
-        let p = &mut self.point;
-        match (key, value.uint(), value.real()) {
-            ("table", Some(v), _) => self.table = v,
-            ("point_index", Some(v), _) => p.point_index = v,
-            ("function_type", Some(v), _) => p.function_type = v,
-            ("point_type", Some(v), _) => p.point_type = v,
-            ("rel_index_next", Some(v), _) => p.rel_index_next_point = v,
-            ("master_pos", _, Some(v)) => p.master_pos = v,
-            ("slave_pos", _, Some(v)) => p.slave_pos = v,
-            ("slave_velo", _, Some(v)) => p.slave_velo = v,
-            ("slave_acc", _, Some(v)) => p.slave_acc = v,
-            ("slave_jerk", _, Some(v)) => p.slave_jerk = v,
-            _ => {}
-        }
+        set_point(self, key, value);
     }
     execute_cycle!(no_axis, recorded);
 }
 
 impl TimelineBlock for McSetCamOnlineChangeMode {
     fn set(&mut self, key: &str, value: &Value) {
-        match (key, value.uint(), value.real()) {
-            ("table", Some(v), _) => self.table = v,
-            ("activation_mode", Some(v), _) => self.activation_mode = v,
-            ("activation_position", _, Some(v)) => self.activation_position = v,
-            ("master_scaling_mode", Some(v), _) => self.master_scaling_mode = v,
-            ("slave_scaling_mode", Some(v), _) => self.slave_scaling_mode = v,
-            _ => {}
+        match (key, value.uint()) {
+            ("table", Some(v)) => self.table = v,
+            _ => set_scaling(&mut self.scaling, key, value),
         }
     }
     execute_cycle!(no_axis, recorded);
 }
 
-const ACTIVATION_MODE: InputSpec = input("activation_mode", mode::<CamActivationMode>());
-const ACTIVATION_POSITION: InputSpec = input("activation_position", Kind::Real);
-const MASTER_SCALING_MODE: InputSpec = input("master_scaling_mode", mode::<CamScalingMode>());
-const SLAVE_SCALING_MODE: InputSpec = input("slave_scaling_mode", mode::<CamScalingMode>());
-const MASTER_OFFSET: InputSpec = input("master_offset", Kind::Real);
-const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real);
-const MASTER_SCALING: InputSpec = input("master_scaling", Kind::Real);
-const SLAVE_SCALING: InputSpec = input("slave_scaling", Kind::Real);
+inputs! {
+    /// MC_CamScaling's inputs, in its order. MC_CamInExt takes them all, MC_CamIn the offsets
+    /// and scalings ([`SCALES`]), MC_SetCamOnlineChangeMode the activation and the scaling
+    /// modes ([`ACTIVATION`]).
+    SCALING, set_scaling: CamScalingCall {
+        "activation_mode": mode::<CamActivationMode>() => activation_mode,
+        "activation_position": Kind::Real => activation_position,
+        "master_scaling_mode": mode::<CamScalingMode>() => master_scaling_mode,
+        "slave_scaling_mode": mode::<CamScalingMode>() => slave_scaling_mode,
+        "master_offset": Kind::Real => master_offset,
+        "slave_offset": Kind::Real => slave_offset,
+        "master_scaling": Kind::Real => master_scaling,
+        "slave_scaling": Kind::Real => slave_scaling,
+    }
+}
+
+/// The activation and each side's scaling mode, of [`SCALING`].
+const ACTIVATION: &[InputSpec] = SCALING.split_at(4).0;
+/// The offsets and the scalings, of [`SCALING`].
+const SCALES: &[InputSpec] = SCALING.split_at(4).1;
+
+inputs! {
+    /// MC_WriteMotionFunctionPoint's inputs: the table and the point.
+    POINT, set_point: McWriteMotionFunctionPoint {
+        "table": Kind::Count => table,
+        "point_index": Kind::Count => point.point_index,
+        "function_type": Kind::Count => point.function_type,
+        "point_type": Kind::Count => point.point_type,
+        "rel_index_next": Kind::Count => point.rel_index_next_point,
+        "master_pos": Kind::Real => point.master_pos,
+        "slave_pos": Kind::Real => point.slave_pos,
+        "slave_velo": Kind::Real => point.slave_velo,
+        "slave_acc": Kind::Real => point.slave_acc,
+        "slave_jerk": Kind::Real => point.slave_jerk,
+    }
+}
+
 /// The master's set-point (the default) or its actual position.
 const MASTER_SOURCE: InputSpec = input(
     "master_source",
     Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]),
 );
-const MASTER: InputSpec = input("master", Kind::Count);
 const TABLE: InputSpec = input("table", Kind::Count);
-const START_MODE: InputSpec = input("start_mode", mode::<CamStartMode>());
+/// What MC_CamIn and MC_CamInExt take before the scaling's inputs; the interpolation comes
+/// after them.
+const CAM_IN_FIRST: [InputSpec; 4] = [
+    MASTER_SOURCE,
+    input("master", Kind::Count),
+    TABLE,
+    input("start_mode", mode::<CamStartMode>()),
+];
 const INTERPOLATION: InputSpec = input("interpolation", mode::<CamInterpolation>());
+
+const CAM_IN: [InputSpec; 9] = joined(&[&CAM_IN_FIRST, SCALES, &[INTERPOLATION]]);
+const CAM_IN_EXT: [InputSpec; 13] = joined(&[&CAM_IN_FIRST, &SCALING, &[INTERPOLATION]]);
+const ONLINE_CHANGE_MODE: [InputSpec; 5] = joined(&[&[TABLE], ACTIVATION]);
 
 /// The one-call cam blocks a timeline calls; the slave is the instance's axis.
 pub const TIMELINE: &[BlockSpec] = &[
-    BlockSpec::on_axis(
-        "MC_CamIn",
-        &[
-            MASTER_SOURCE,
-            MASTER,
-            TABLE,
-            START_MODE,
-            MASTER_OFFSET,
-            SLAVE_OFFSET,
-            MASTER_SCALING,
-            SLAVE_SCALING,
-            INTERPOLATION,
-        ],
-        |_| Box::<McCamIn>::default(),
-    ),
-    BlockSpec::on_axis(
-        "MC_CamInExt",
-        &[
-            MASTER_SOURCE,
-            MASTER,
-            TABLE,
-            START_MODE,
-            ACTIVATION_MODE,
-            ACTIVATION_POSITION,
-            MASTER_SCALING_MODE,
-            SLAVE_SCALING_MODE,
-            MASTER_OFFSET,
-            SLAVE_OFFSET,
-            MASTER_SCALING,
-            SLAVE_SCALING,
-            INTERPOLATION,
-        ],
-        |_| {
-            Box::new(McCamIn {
-                extended: true,
-                ..McCamIn::default()
-            })
-        },
-    ),
+    BlockSpec::on_axis("MC_CamIn", &CAM_IN, |_| Box::<McCamIn>::default()),
+    BlockSpec::on_axis("MC_CamInExt", &CAM_IN_EXT, |_| {
+        Box::new(McCamIn {
+            extended: true,
+            ..McCamIn::default()
+        })
+    }),
     BlockSpec::on_axis("MC_CamOut", &[], |_| Box::<McCamOut>::default()),
-    BlockSpec::on_axis(
-        "MC_CamScaling",
-        &[
-            ACTIVATION_MODE,
-            ACTIVATION_POSITION,
-            MASTER_SCALING_MODE,
-            SLAVE_SCALING_MODE,
-            MASTER_OFFSET,
-            SLAVE_OFFSET,
-            MASTER_SCALING,
-            SLAVE_SCALING,
-        ],
-        |_| Box::<McCamScaling>::default(),
-    ),
-    BlockSpec::on_axis(
-        "MC_WriteMotionFunctionPoint",
-        &[
-            TABLE,
-            input("point_index", Kind::Count),
-            input("function_type", Kind::Count),
-            input("point_type", Kind::Count),
-            input("rel_index_next", Kind::Count),
-            input("master_pos", Kind::Real),
-            input("slave_pos", Kind::Real),
-            input("slave_velo", Kind::Real),
-            input("slave_acc", Kind::Real),
-            input("slave_jerk", Kind::Real),
-        ],
-        |_| Box::<McWriteMotionFunctionPoint>::default(),
-    ),
-    BlockSpec::on_axis(
-        "MC_SetCamOnlineChangeMode",
-        &[
-            TABLE,
-            ACTIVATION_MODE,
-            ACTIVATION_POSITION,
-            MASTER_SCALING_MODE,
-            SLAVE_SCALING_MODE,
-        ],
-        |_| Box::<McSetCamOnlineChangeMode>::default(),
-    ),
+    BlockSpec::on_axis("MC_CamScaling", &SCALING, |_| {
+        Box::<McCamScaling>::default()
+    }),
+    BlockSpec::on_axis("MC_WriteMotionFunctionPoint", &POINT, |_| {
+        Box::<McWriteMotionFunctionPoint>::default()
+    }),
+    BlockSpec::on_axis("MC_SetCamOnlineChangeMode", &ONLINE_CHANGE_MODE, |_| {
+        Box::<McSetCamOnlineChangeMode>::default()
+    }),
 ];

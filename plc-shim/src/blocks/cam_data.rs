@@ -4,11 +4,11 @@
 
 use super::cam::recorded;
 use crate::kernel::{
-    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled,
+    call_error_code, done_unless, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled,
 };
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
-    input, mode, number, BlockSpec, InputSpec, Kind, TimelineBlock, Value,
+    input, mode, number, BlockSpec, InputField, InputSpec, Kind, TimelineBlock, Value,
 };
 use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
 use hli::calls::CallError;
@@ -63,11 +63,7 @@ impl McCamTableSelect {
         };
         let (table, data, periodic) = (self.table, &self.data, self.periodic);
         let send = |io: &mut PlcIo<'_>| match data {
-            CamData::None => io
-                .acyclic
-                .start(table, &call)
-                .map(SelectTransfer::Selecting)
-                .map_err(|e| call_error_code(&e)),
+            CamData::None => send(io, table, &call).map(SelectTransfer::Selecting),
             data => Ok(SelectTransfer::Loading(
                 ChunkTransfer::new(table, data, true, periodic),
                 call,
@@ -383,75 +379,75 @@ fn points_of(value: &toml::Value) -> Result<Arc<[McMotionFunctionPoint]>, String
         .collect()
 }
 
-const TABLE: InputSpec = input("table", Kind::Count);
-const POINTS: InputSpec = input(
-    "points",
-    Kind::Parsed {
-        parse: |v| points_of(v).map(Value::Points),
-        example: "[{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0 }]",
-    },
-);
-
-impl TimelineBlock for McCamTableSelect {
-    fn set(&mut self, key: &str, value: &Value) {
-        match (key, value) {
-            ("table", Value::Int(v)) => self.table = *v as u32,
-            ("periodic", Value::Bool(v)) => self.periodic = *v,
-            ("master_absolute", Value::Bool(v)) => self.master_absolute = *v,
-            ("slave_absolute", Value::Bool(v)) => self.slave_absolute = *v,
-            ("table_type", Value::Int(v)) => self.table_type = *v as u32,
-            ("interpolation", Value::Int(v)) => self.interpolation = *v as u32,
-            ("rows", Value::Rows(rows)) => {
-                self.data = CamData::Rows {
+/// `rows` sets a position table, `points` a motion function: what the block then sends.
+impl InputField for CamData {
+    fn take(&mut self, value: &Value) {
+        match value {
+            Value::Rows(rows) => {
+                *self = CamData::Rows {
                     rows: Arc::clone(rows),
                     table_type: 10,
                     interpolation: 0,
                 }
             }
-            ("points", Value::Points(points)) => self.data = CamData::Points(Arc::clone(points)),
+            Value::Points(points) => *self = CamData::Points(Arc::clone(points)),
             _ => {}
         }
+    }
+}
+
+/// Motion-function points in a timeline.
+const POINTS: Kind = Kind::Parsed {
+    parse: |v| points_of(v).map(Value::Points),
+    example: "[{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0 }]",
+};
+
+inputs! {
+    /// MC_CamTableSelect's inputs: the table, the selection and the data sent before it.
+    SELECT, set_select: McCamTableSelect {
+        "table": Kind::Count => table,
+        "periodic": Kind::Bool => periodic,
+        "master_absolute": Kind::Bool => master_absolute,
+        "slave_absolute": Kind::Bool => slave_absolute,
+        "rows": Kind::Parsed {
+            parse: |v| rows_of(v).map(Value::Rows),
+            example: "[[0.0, 0.0], [1.0, 2.0]]",
+        } => data,
+        "points": POINTS => data,
+        "table_type": Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)])
+            => table_type,
+        "interpolation": mode::<CamInterpolation>() => interpolation,
+    }
+}
+
+inputs! {
+    /// MC_WriteMotionFunction's inputs.
+    WRITE, set_write: McWriteMotionFunction {
+        "table": Kind::Count => table,
+        "points": POINTS => points,
+    }
+}
+
+impl TimelineBlock for McCamTableSelect {
+    fn set(&mut self, key: &str, value: &Value) {
+        set_select(self, key, value);
     }
     execute_cycle!(no_axis, recorded);
 }
 
 impl TimelineBlock for McWriteMotionFunction {
     fn set(&mut self, key: &str, value: &Value) {
-        match (key, value) {
-            ("table", Value::Int(v)) => self.table = *v as u32,
-            ("points", Value::Points(points)) => self.points = CamData::Points(Arc::clone(points)),
-            _ => {}
-        }
+        set_write(self, key, value);
     }
     execute_cycle!(no_axis, recorded);
 }
 
 /// The cam blocks with table data a timeline calls.
 pub const TIMELINE: &[BlockSpec] = &[
-    BlockSpec::on_axis(
-        "MC_CamTableSelect",
-        &[
-            TABLE,
-            input("periodic", Kind::Bool),
-            input("master_absolute", Kind::Bool),
-            input("slave_absolute", Kind::Bool),
-            input(
-                "rows",
-                Kind::Parsed {
-                    parse: |v| rows_of(v).map(Value::Rows),
-                    example: "[[0.0, 0.0], [1.0, 2.0]]",
-                },
-            ),
-            POINTS,
-            input(
-                "table_type",
-                Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)]),
-            ),
-            input("interpolation", mode::<CamInterpolation>()),
-        ],
-        |_| Box::<McCamTableSelect>::default(),
-    ),
-    BlockSpec::on_axis("MC_WriteMotionFunction", &[TABLE, POINTS], |_| {
+    BlockSpec::on_axis("MC_CamTableSelect", &SELECT, |_| {
+        Box::<McCamTableSelect>::default()
+    }),
+    BlockSpec::on_axis("MC_WriteMotionFunction", &WRITE, |_| {
         Box::<McWriteMotionFunction>::default()
     }),
 ];

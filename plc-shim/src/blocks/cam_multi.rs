@@ -5,7 +5,7 @@
 use super::cam::{recorded, CamCore};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, BlockSpec, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::cam::{CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC};
 
 /// CamTableSetWeight (5.2.3.1): weight, offsets, slopes and range of `table` in a
@@ -121,20 +121,23 @@ impl CamMultiTable {
     }
 }
 
+inputs! {
+    /// CamTableSetWeight's inputs: the table and its scaling.
+    WEIGHT, set_weight: CamTableSetWeight {
+        "table": Kind::Count => table,
+        "weight": Kind::Real => weight.weight,
+        "master_offset": Kind::Real => weight.master_offset,
+        "master_slope": Kind::Real => weight.master_slope,
+        "slave_offset": Kind::Real => weight.slave_offset,
+        "slave_slope": Kind::Real => weight.slave_slope,
+        "range_low": Kind::Real => weight.range_low,
+        "range_high": Kind::Real => weight.range_high,
+    }
+}
+
 impl TimelineBlock for CamTableSetWeight {
     fn set(&mut self, key: &str, value: &Value) {
-        let w = &mut self.weight;
-        match (key, value.uint(), value.real()) {
-            ("table", Some(v), _) => self.table = v,
-            ("weight", _, Some(v)) => w.weight = v,
-            ("master_offset", _, Some(v)) => w.master_offset = v,
-            ("master_slope", _, Some(v)) => w.master_slope = v,
-            ("slave_offset", _, Some(v)) => w.slave_offset = v,
-            ("slave_slope", _, Some(v)) => w.slave_slope = v,
-            ("range_low", _, Some(v)) => w.range_low = v,
-            ("range_high", _, Some(v)) => w.range_high = v,
-            _ => {}
-        }
+        set_weight(self, key, value);
     }
     execute_cycle!(no_axis, recorded);
 }
@@ -188,20 +191,9 @@ fn table_ids(value: &toml::Value) -> Result<Value, String> {
 
 /// The multi-table blocks a timeline calls; the slave is the instance's axis.
 pub const TIMELINE: &[BlockSpec] = &[
-    BlockSpec::on_axis(
-        "CamTableSetWeight",
-        &[
-            input("table", Kind::Count),
-            input("weight", Kind::Real),
-            input("master_offset", Kind::Real),
-            input("master_slope", Kind::Real),
-            input("slave_offset", Kind::Real),
-            input("slave_slope", Kind::Real),
-            input("range_low", Kind::Real),
-            input("range_high", Kind::Real),
-        ],
-        |_| Box::<CamTableSetWeight>::default(),
-    ),
+    BlockSpec::on_axis("CamTableSetWeight", &WEIGHT, |_| {
+        Box::<CamTableSetWeight>::default()
+    }),
     BlockSpec::on_axis(
         "CamTableCoupleAxesMultiTables",
         &[

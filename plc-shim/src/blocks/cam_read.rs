@@ -4,7 +4,7 @@
 //! four points per cycle), each into an array whose room is set when the block is made.
 
 use super::cam::recorded;
-use crate::kernel::{call_error_code, no_follow, Accept, InFlight, Kernel, Outputs, Polled};
+use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::cam::{
@@ -37,10 +37,7 @@ impl PartRead {
         target: u32,
         request: hli::calls::cam::CamReadCall,
     ) -> Result<PartRead, u32> {
-        let pending = io
-            .acyclic
-            .start(target, &request)
-            .map_err(|e| call_error_code(&e))?;
+        let pending = send(io, target, &request)?;
         Ok(PartRead {
             target,
             request,
@@ -121,10 +118,7 @@ impl McCamRead {
         }
     }
 
-    /// Input tTimeout: cycles to wait for each part.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(kernel);
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
@@ -175,9 +169,7 @@ fn read_points(
     first: u32,
 ) -> Result<PendingCall<hli::calls::cam::CamPointsReadCall>, u32> {
     let call = hli::calls::cam::CamPointsReadCall { first, count: 0 };
-    io.acyclic
-        .start(table, &call)
-        .map_err(|e| call_error_code(&e))
+    send(io, table, &call)
 }
 
 impl InFlight for PointsRead {

@@ -25,7 +25,7 @@
 //! call = { block = "FiFoSetChannelOverride", instance = "ov", override = 50.0 }   # percent
 //! ```
 
-use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs};
+use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::fifo::{
@@ -56,13 +56,14 @@ fn accept(reply: FifoReply) -> Accept<(), FifoReply> {
     }
 }
 
-/// A one-frame FIFO block. Its outputs carry the CNC's reply as their extra: the FIFO's
-/// state, fill level, and FiFoGetDimension's values.
-pub struct FifoBlock<C: AcyclicCall<Reply = FifoReply>> {
-    kernel: Kernel<PendingCall<C>, (), FifoReply>,
+/// A FIFO block: what it sends on its Execute edge (`P`: a call on its way, or a row block)
+/// is answered with a FifoReply, which its outputs carry as their extra: the FIFO's state,
+/// fill level, and FiFoGetDimension's values.
+pub struct FifoBlock<P> {
+    kernel: Kernel<P, (), FifoReply>,
 }
 
-impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
+impl<P> Default for FifoBlock<P> {
     fn default() -> Self {
         Self {
             kernel: Kernel::default(),
@@ -70,18 +71,27 @@ impl<C: AcyclicCall<Reply = FifoReply>> Default for FifoBlock<C> {
     }
 }
 
-impl<C: AcyclicCall<Reply = FifoReply>> core::fmt::Debug for FifoBlock<C> {
+impl<P> core::fmt::Debug for FifoBlock<P> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         self.kernel.fmt(f)
     }
 }
 
-impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
-    /// Input: cycles to wait for the answer (tTimeout).
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+impl<P: InFlight<Reply = FifoReply, Buffer = ()>> FifoBlock<P> {
+    timeout_input!(kernel);
 
+    /// One cycle: on a rising `execute`, `send` puts the call or the rows on their way.
+    fn run(
+        &mut self,
+        io: &mut PlcIo<'_>,
+        execute: bool,
+        send: impl FnOnce(&mut PlcIo<'_>) -> Result<P, u32>,
+    ) -> Outputs<FifoReply> {
+        self.kernel.cycle(io, execute, send, accept, no_follow)
+    }
+}
+
+impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<PendingCall<C>> {
     /// One cycle: on a rising `execute`, `call()` goes to FIFO group `group`.
     pub fn cycle(
         &mut self,
@@ -90,50 +100,31 @@ impl<C: AcyclicCall<Reply = FifoReply>> FifoBlock<C> {
         group: u32,
         call: impl FnOnce() -> C,
     ) -> Outputs<FifoReply> {
-        self.kernel.cycle(
-            io,
-            execute,
-            |io| {
-                io.acyclic
-                    .start(group, &call())
-                    .map_err(|e| call_error_code(&e))
-            },
-            accept,
-            no_follow,
-        )
+        self.run(io, execute, |io| send(io, group, &call()))
     }
 }
 
 /// FiFoGetDimension: `reply.dimension` (iNoOfAxes) and `reply.capacity` (iNoOfFifoEntries).
-pub type FifoGetDimension = FifoBlock<FifoDimensionCall>;
+pub type FifoGetDimension = FifoBlock<PendingCall<FifoDimensionCall>>;
 /// FiFoGroupIntegrate.
-pub type FifoGroupIntegrate = FifoBlock<FifoIntegrateCall>;
+pub type FifoGroupIntegrate = FifoBlock<PendingCall<FifoIntegrateCall>>;
 /// FiFoGroupDisintegrate.
-pub type FifoGroupDisintegrate = FifoBlock<FifoDisintegrateCall>;
+pub type FifoGroupDisintegrate = FifoBlock<PendingCall<FifoDisintegrateCall>>;
 /// FiFoStart.
-pub type FifoStart = FifoBlock<FifoStartCall>;
+pub type FifoStart = FifoBlock<PendingCall<FifoStartCall>>;
 /// FiFoStop.
-pub type FifoStop = FifoBlock<FifoStopCall>;
+pub type FifoStop = FifoBlock<PendingCall<FifoStopCall>>;
 /// FiFoSetChannelOverride (ppm, 1,000,000 = 100 %).
-pub type FifoSetChannelOverride = FifoBlock<FifoOverrideCall>;
+pub type FifoSetChannelOverride = FifoBlock<PendingCall<FifoOverrideCall>>;
 /// FiFoSetParameters (ours): T_f and the override type while the group is not running.
-pub type FifoSetParameters = FifoBlock<FifoParametersCall>;
+pub type FifoSetParameters = FifoBlock<PendingCall<FifoParametersCall>>;
 
 /// FiFoWrite (`overwrite` false) or FiFoOverwrite (true).
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub struct FifoWrite {
     /// FiFoOverwrite: replace the rows queued behind the pair in use.
     pub overwrite: bool,
-    kernel: Kernel<PendingRows, (), FifoReply>,
-}
-
-impl core::fmt::Debug for FifoWrite {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.debug_struct("FifoWrite")
-            .field("overwrite", &self.overwrite)
-            .field("kernel", &self.kernel)
-            .finish()
-    }
+    block: FifoBlock<PendingRows>,
 }
 
 impl FifoWrite {
@@ -145,10 +136,7 @@ impl FifoWrite {
         }
     }
 
-    /// Input: cycles to wait for the answer (tTimeout).
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(block.kernel);
 
     /// One cycle: on a rising `execute`, the first `rows` rows of `data` (rows of `columns`
     /// values, row after row: iColDim, iRowsToWrite) go to group `group`.
@@ -179,7 +167,7 @@ impl FifoWrite {
                 _ => Err(ERROR_BLOCK_SIZE),
             }
         };
-        self.kernel.cycle(io, execute, send, accept, no_follow)
+        self.block.run(io, execute, send)
     }
 }
 

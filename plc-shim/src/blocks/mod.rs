@@ -46,6 +46,42 @@ macro_rules! execute_cycle {
     };
 }
 
+/// Input tTimeout of a block on the kernel at `self.<path>`: its `set_timeout_cycles`.
+macro_rules! timeout_input {
+    ($($path:ident).+) => {
+        /// Input tTimeout: cycles to wait for the CNC's answer (a read in parts: for each
+        /// part).
+        pub fn set_timeout_cycles(&mut self, cycles: u64) {
+            self.$($path).+.set_timeout_cycles(cycles);
+        }
+    };
+}
+
+/// Inputs declared once, in the order a call lists them: each one's key, kind and the field
+/// of `$target` it sets (a path below it). Gives the list `$list` (an `[InputSpec; N]` for a
+/// `TIMELINE` entry, or part of one through `joined`) and `$set(target, key, value)`, which
+/// sets the field of `key` and leaves the others.
+macro_rules! inputs {
+    (
+        $(#[doc = $doc:literal])*
+        $list:ident, $set:ident: $target:ty {
+            $($key:literal: $kind:expr => $($field:ident).+),* $(,)?
+        }
+    ) => {
+        $(#[doc = $doc])*
+        const $list: [InputSpec; { [$($key),*].len() }] = [$(input($key, $kind)),*];
+
+        /// Sets input `key` of `target` (see the list beside it); other keys leave it.
+        fn $set(target: &mut $target, key: &str, value: &Value) {
+            use crate::timeline::registry::InputField;
+            match key {
+                $($key => target.$($field).+.take(value),)*
+                _ => {}
+            }
+        }
+    };
+}
+
 pub mod cam;
 pub mod cam_compat;
 pub mod cam_data;

@@ -8,7 +8,7 @@
 //! Execute already fell.
 
 use super::plain;
-use crate::kernel::{Accept, Kernel, Outputs, Step, Waited};
+use crate::kernel::{send, Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
     input, BlockSpec, InputSpec, Inputs, Kind, Target, TimelineBlock, Value,
@@ -77,11 +77,7 @@ impl CommandCore {
         self.kernel.cycle(
             io,
             execute,
-            |io| {
-                io.acyclic
-                    .start(axis, &call())
-                    .map_err(|_| crate::kernel::ERROR_NO_ANSWER)
-            },
+            |io| send(io, axis, &call()),
             accept,
             |id, io, _: Waited| follow(io, axis, *id, finished_when_reached),
         )
@@ -131,7 +127,34 @@ impl McPower {
     }
 }
 
+/// A motion block whose inputs are numbers: the block, its call (`$build` from the inputs;
+/// `reached_is_done` as [`CommandCore::cycle`] takes it), its `TimelineBlock` and its
+/// `INPUTS`, each input by its field's name.
 macro_rules! execute_block {
+    // A move: its own inputs, then the limits `limits()` gives in the call's order.
+    ($(#[doc = $doc:literal])* $name:ident { $($(#[doc = $fdoc:literal])* $field:ident),* } + limits => |$s:ident| $build:expr, reached_is_done = $reached:expr) => {
+        execute_block! {
+            $(#[doc = $doc])*
+            $name {
+                $($(#[doc = $fdoc])* $field,)*
+                /// Input: velocity limit.
+                velocity,
+                /// Input: acceleration limit.
+                acceleration,
+                /// Input: deceleration limit.
+                deceleration,
+                /// Input: jerk limit.
+                jerk
+            } => |$s| $build, reached_is_done = $reached
+        }
+
+        impl $name {
+            /// Velocity, acceleration, deceleration and jerk limit.
+            fn limits(&self) -> [f64; 4] {
+                [self.velocity, self.acceleration, self.deceleration, self.jerk]
+            }
+        }
+    };
     ($(#[doc = $doc:literal])* $name:ident { $($(#[doc = $fdoc:literal])* $field:ident),* } => |$s:ident| $build:expr, reached_is_done = $reached:expr) => {
         $(#[doc = $doc])*
         #[derive(Debug, Default)]
@@ -145,6 +168,9 @@ macro_rules! execute_block {
         }
 
         impl $name {
+            /// The inputs a timeline call sets: its fields but Execute, numbers all.
+            const INPUTS: &'static [InputSpec] = &[$(input(stringify!($field), Kind::Real)),*];
+
             /// One cycle for `axis`.
             pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
                 let $s = &*self;
@@ -174,16 +200,8 @@ execute_block! {
     /// MC_MoveAbsolute: moves to `position`.
     McMoveAbsolute {
         /// Input: target position.
-        position,
-        /// Input: velocity limit.
-        velocity,
-        /// Input: acceleration limit.
-        acceleration,
-        /// Input: deceleration limit.
-        deceleration,
-        /// Input: jerk limit.
-        jerk
-    } => |s| AxisCommandCall::move_absolute(s.position, [s.velocity, s.acceleration, s.deceleration, s.jerk]),
+        position
+    } + limits => |s| AxisCommandCall::move_absolute(s.position, s.limits()),
     reached_is_done = false
 }
 
@@ -191,16 +209,8 @@ execute_block! {
     /// MC_MoveRelative: moves by `distance` from the set position.
     McMoveRelative {
         /// Input: distance.
-        distance,
-        /// Input: velocity limit.
-        velocity,
-        /// Input: acceleration limit.
-        acceleration,
-        /// Input: deceleration limit.
-        deceleration,
-        /// Input: jerk limit.
-        jerk
-    } => |s| AxisCommandCall::move_relative(s.distance, [s.velocity, s.acceleration, s.deceleration, s.jerk]),
+        distance
+    } + limits => |s| AxisCommandCall::move_relative(s.distance, s.limits()),
     reached_is_done = false
 }
 
@@ -357,29 +367,13 @@ pub const TIMELINE: &[BlockSpec] = &[
         inputs: Inputs::Keys(&[input("enable", Kind::Bool)]),
         make: |_| Box::<McPower>::default(),
     },
-    BlockSpec::on_axis("MC_Reset", &[], |_| Box::<McReset>::default()),
-    BlockSpec::on_axis(
-        "MC_MoveAbsolute",
-        &[
-            input("position", Kind::Real),
-            VELOCITY,
-            ACCELERATION,
-            DECELERATION,
-            JERK,
-        ],
-        |_| Box::<McMoveAbsolute>::default(),
-    ),
-    BlockSpec::on_axis(
-        "MC_MoveRelative",
-        &[
-            input("distance", Kind::Real),
-            VELOCITY,
-            ACCELERATION,
-            DECELERATION,
-            JERK,
-        ],
-        |_| Box::<McMoveRelative>::default(),
-    ),
+    BlockSpec::on_axis("MC_Reset", McReset::INPUTS, |_| Box::<McReset>::default()),
+    BlockSpec::on_axis("MC_MoveAbsolute", McMoveAbsolute::INPUTS, |_| {
+        Box::<McMoveAbsolute>::default()
+    }),
+    BlockSpec::on_axis("MC_MoveRelative", McMoveRelative::INPUTS, |_| {
+        Box::<McMoveRelative>::default()
+    }),
     BlockSpec::on_axis(
         "MC_MoveVelocity",
         &[
@@ -396,13 +390,11 @@ pub const TIMELINE: &[BlockSpec] = &[
             })
         },
     ),
-    BlockSpec::on_axis("MC_Halt", &[DECELERATION, JERK], |_| {
-        Box::<McHalt>::default()
-    }),
+    BlockSpec::on_axis("MC_Halt", McHalt::INPUTS, |_| Box::<McHalt>::default()),
     BlockSpec::on_axis("MC_Stop", &[DECELERATION, JERK], |_| {
         Box::<McStop>::default()
     }),
-    BlockSpec::on_axis("MC_SetPosition", &[input("position", Kind::Real)], |_| {
+    BlockSpec::on_axis("MC_SetPosition", McSetPosition::INPUTS, |_| {
         Box::<McSetPosition>::default()
     }),
 ];

@@ -5,7 +5,7 @@
 //! ([`TIMELINE`]); its report shows the position MC_TouchProbe recorded last.
 
 use super::plain;
-use crate::kernel::{call_error_code, no_follow, Accept, Kernel, Outputs, Step};
+use crate::kernel::{no_follow, send, Accept, Kernel, Outputs, Step};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
@@ -44,16 +44,6 @@ fn follow_arming(image: Option<HliAxisProbe>, id: u32) -> Step<f64> {
         None => failed(hli::calls::ErrorCode::InvalidTarget.raw()),
     };
     Step::Ended(out)
-}
-
-fn send<C: hli::calls::AcyclicCall>(
-    io: &mut PlcIo<'_>,
-    axis: u32,
-    call: &C,
-) -> Result<PendingCall<C>, u32> {
-    io.acyclic
-        .start(axis, call)
-        .map_err(|e| call_error_code(&e))
 }
 
 /// MC_TouchProbe: on a rising Execute edge arms `probe` (1 or 2) of the axis for `edge`;

@@ -23,7 +23,7 @@
 //! ([`inputs`]).
 
 use crate::kernel::{
-    call_error_code, done_unless, no_follow, Accept, InFlight, Kernel, Outputs, Polled, Step,
+    call_error_code, done_unless, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled, Step,
     Waited, ERROR_NO_ANSWER,
 };
 use crate::runtime::PlcIo;
@@ -211,11 +211,7 @@ impl GearInCore {
         self.kernel.cycle(
             io,
             execute,
-            |io| {
-                io.acyclic
-                    .start(slave, &call)
-                    .map_err(|e| call_error_code(&e))
-            },
+            |io| send(io, slave, &call),
             |reply| match reply.error_id {
                 0 => Accept::Follow(
                     GearFollow {
@@ -328,10 +324,7 @@ impl Default for McGearInVelo {
 }
 
 impl McGearInVelo {
-    /// Input: cycles to wait for the CNC's answer.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.core.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(core.kernel);
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
@@ -379,10 +372,7 @@ impl Default for McGearInPos {
 }
 
 impl McGearInPos {
-    /// Input: cycles to wait for the CNC's answer.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.core.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(core.kernel);
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
@@ -408,10 +398,7 @@ pub struct McGearOut {
 }
 
 impl McGearOut {
-    /// Input: cycles to wait for the CNC's answer.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(kernel);
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
@@ -419,11 +406,7 @@ impl McGearOut {
         self.out = self.kernel.cycle(
             io,
             self.execute,
-            |io| {
-                io.acyclic
-                    .start(slave, &SawGearOutCall::default())
-                    .map_err(|e| call_error_code(&e))
-            },
+            |io| send(io, slave, &SawGearOutCall::default()),
             |reply| done_unless(reply.error_id),
             no_follow,
         );
@@ -452,9 +435,7 @@ impl CharacRead {
     }
 
     fn send(io: &mut PlcIo<'_>, slave: u32, part: u32) -> Result<PendingCall<SawCharacCall>, u32> {
-        io.acyclic
-            .start(slave, &SawCharacCall { part })
-            .map_err(|e| call_error_code(&e))
+        send(io, slave, &SawCharacCall { part })
     }
 
     fn next(&mut self, io: &mut PlcIo<'_>, part: u32) -> Polled<[f64; 31]> {
@@ -527,10 +508,7 @@ impl core::fmt::Debug for CharacRead {
 }
 
 impl McReadFlyingSawCharacteristics {
-    /// Input: cycles to wait for each part.
-    pub fn set_timeout_cycles(&mut self, cycles: u64) {
-        self.kernel.set_timeout_cycles(cycles);
-    }
+    timeout_input!(kernel);
 
     /// The values with their field names, in the structure's order.
     pub fn characteristics(&self) -> impl Iterator<Item = (&'static str, f64)> + '_ {

@@ -124,6 +124,18 @@ pub fn call_error_code(error: &CallError) -> u32 {
     }
 }
 
+/// Sends `call` to `target` on the acyclic service: the call on its way, or the code of a call
+/// that could not be sent ([`call_error_code`]). What most blocks' `send` does.
+pub fn send<C: AcyclicCall>(
+    io: &mut PlcIo<'_>,
+    target: u32,
+    call: &C,
+) -> Result<PendingCall<C>, u32> {
+    io.acyclic
+        .start(target, call)
+        .map_err(|e| call_error_code(&e))
+}
+
 /// What a call on its way gave this cycle.
 pub enum Polled<R> {
     /// Still on its way.

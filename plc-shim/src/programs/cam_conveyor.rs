@@ -180,10 +180,10 @@ impl CamConveyor {
                 self.go(Step::Scale, cycle);
             }
             Step::Scale => {
-                self.scale.activation_mode = NEXT_CYCLE;
-                self.scale.master_scaling_mode = OFF;
-                self.scale.slave_scaling_mode = AUTO_OFFSET;
-                self.scale.slave_scaling = 0.5;
+                self.scale.scaling.activation_mode = NEXT_CYCLE;
+                self.scale.scaling.master_scaling_mode = OFF;
+                self.scale.scaling.slave_scaling_mode = AUTO_OFFSET;
+                self.scale.scaling.slave_scaling = 0.5;
                 self.scale.execute = true;
                 self.scale.call(io, lifter);
                 if self.scale.out.error {
@@ -194,7 +194,7 @@ impl CamConveyor {
             }
             Step::Mode => {
                 self.mode.table = TABLE;
-                self.mode.activation_mode = NEXT_CYCLE;
+                self.mode.scaling.activation_mode = NEXT_CYCLE;
                 self.mode.execute = true;
                 self.mode.call(io);
                 if self.mode.out.error {

@@ -85,7 +85,7 @@ pub type Whole = (Value, Option<usize>);
 pub const WHOLE: &str = "inputs";
 
 /// An input of a block.
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy)]
 pub struct InputSpec {
     /// Its key in a `call`.
     pub key: &'static str,
@@ -98,8 +98,25 @@ pub const fn input(key: &'static str, kind: Kind) -> InputSpec {
     InputSpec { key, kind }
 }
 
+/// The input lists `parts` one after the other, as one list of `N` inputs (a block's list
+/// made of groups it shares with others).
+pub const fn joined<const N: usize>(parts: &[&[InputSpec]]) -> [InputSpec; N] {
+    let mut out = [input("", Kind::Bool); N];
+    let (mut n, mut i) = (0, 0);
+    while i < parts.len() {
+        let mut j = 0;
+        while j < parts[i].len() {
+            out[n] = parts[i][j];
+            (n, j) = (n + 1, j + 1);
+        }
+        i += 1;
+    }
+    assert!(n == N, "joined: the parts do not make N inputs");
+    out
+}
+
 /// What an input takes, and the [`Value`] a block is set with.
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy)]
 pub enum Kind {
     /// `true` or `false`: [`Value::Bool`].
     Bool,
@@ -125,7 +142,7 @@ pub enum Kind {
 }
 
 /// A wire enum seen through its names and numbers.
-#[derive(Debug)]
+#[derive(Debug, Clone, Copy)]
 pub struct Mode {
     /// The raw value of a name.
     pub from_name: fn(&str) -> Option<u32>,
@@ -195,6 +212,38 @@ impl Value {
         match self {
             Value::Custom(c) => Arc::clone(c).downcast().ok(),
             _ => None,
+        }
+    }
+}
+
+/// A field of a block that an input sets, from a value of the input's kind: the integer kinds
+/// set a `u32`, [`Kind::Real`] an `f64`, [`Kind::Bool`] a `bool`. A value of another kind
+/// (which the checks against the kinds do not let through) leaves it.
+pub trait InputField {
+    /// Takes `value` if it is of the field's kind.
+    fn take(&mut self, value: &Value);
+}
+
+impl InputField for u32 {
+    fn take(&mut self, value: &Value) {
+        if let Some(v) = value.uint() {
+            *self = v;
+        }
+    }
+}
+
+impl InputField for f64 {
+    fn take(&mut self, value: &Value) {
+        if let Some(v) = value.real() {
+            *self = v;
+        }
+    }
+}
+
+impl InputField for bool {
+    fn take(&mut self, value: &Value) {
+        if let Value::Bool(v) = value {
+            *self = *v;
         }
     }
 }

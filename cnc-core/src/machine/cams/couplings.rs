@@ -11,14 +11,16 @@ use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::coupling::{
     check_couple, check_not_passed, check_scaling, check_switch, Activation, CamLaw, Scaling,
 };
-use crate::cam::multi_table::{MultiTableError, MultiTableLaw, TableSpec, TableWeight};
+use crate::cam::multi_table::{
+    check_weight, MultiTableError, MultiTableLaw, TableSpec, TableWeight,
+};
 use crate::cam::online::MasterNow;
 use crate::cam::{CamProfile, PositionTable, ProfileCursor, TableErrorCode};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{
     CamInCall, CamInterpolation, CamMultiCoupleCall, CamMultiTableCall, CamOutCall, CamScalingCall,
-    CamScalingMode, CamStartMode, CamTableSelectCall, CamTableWeightCall,
-    CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC,
+    CamScalingMode, CamStartMode, CamTableSelectCall, CAM_MULTI_ENABLE_CORRECTION,
+    CAM_MULTI_STOP_CYCLIC,
 };
 use hli::calls::{decode_body, ErrorCode, HandlerResult};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
@@ -281,21 +283,12 @@ impl CamEngine {
     }
 
     pub(super) fn table_weight(&mut self, request: &AcyclicRequest) -> HandlerResult {
-        let call: CamTableWeightCall = decode_body(request)?;
+        let w: TableWeight = decode_body(request)?;
         let id = request.target;
         if !(1..=255).contains(&id) {
             return code(TABLE_INVALID);
         }
-        let w = TableWeight {
-            weight: call.weight,
-            master_offset: call.master_offset,
-            master_slope: call.master_slope,
-            slave_offset: call.slave_offset,
-            slave_slope: call.slave_slope,
-            range_low: call.range_low,
-            range_high: call.range_high,
-        };
-        if w.check().is_err() {
+        if check_weight(&w).is_err() {
             return code(CamCouplingError::BadParameter.raw());
         }
         // The seed: weights are set before a table becomes active, not while it is.

@@ -25,30 +25,37 @@ use super::GearInInputs;
 use crate::timeline::registry::number;
 use hli::calls::saw::{sync_mask, SawSyncMode};
 
+/// `(name, bit)` of `sync_mask` flags: a flag's short name is its constant's name.
+macro_rules! flags {
+    ($($flag:ident),* $(,)?) => {
+        [$((stringify!($flag), sync_mask::$flag)),*]
+    };
+}
+
 /// The check flags of `ST_SyncMode` by short name (`GearInSync_CheckMask_<name>`).
-const CHECK_FLAGS: [(&str, u32); 12] = [
-    ("MINPOS", sync_mask::MINPOS),
-    ("MAXPOS", sync_mask::MAXPOS),
-    ("MAXVELO", sync_mask::MAXVELO),
-    ("MAXACC", sync_mask::MAXACC),
-    ("MAXDEC", sync_mask::MAXDEC),
-    ("MAXJERK", sync_mask::MAXJERK),
-    ("OVERSHOOTPOS", sync_mask::OVERSHOOTPOS),
-    ("UNDERSHOOTPOS", sync_mask::UNDERSHOOTPOS),
-    ("OVERSHOOTVELO", sync_mask::OVERSHOOTVELO),
-    ("UNDERSHOOTVELO", sync_mask::UNDERSHOOTVELO),
-    ("OVERSHOOTVELOZERO", sync_mask::OVERSHOOTVELOZERO),
-    ("UNDERSHOOTVELOZERO", sync_mask::UNDERSHOOTVELOZERO),
+const CHECK_FLAGS: [(&str, u32); 12] = flags![
+    MINPOS,
+    MAXPOS,
+    MAXVELO,
+    MAXACC,
+    MAXDEC,
+    MAXJERK,
+    OVERSHOOTPOS,
+    UNDERSHOOTPOS,
+    OVERSHOOTVELO,
+    UNDERSHOOTVELO,
+    OVERSHOOTVELOZERO,
+    UNDERSHOOTVELOZERO,
 ];
 
 /// The operation flags of `ST_SyncMode` by short name (`GearInSync_OpMask_<name>`).
-const OPERATION_FLAGS: [(&str, u32); 6] = [
-    ("ROLLBACKLOCK", sync_mask::ROLLBACKLOCK),
-    ("INSTANTSTOPONROLLBACK", sync_mask::INSTANTSTOPONROLLBACK),
-    ("PREFERCONSTVELO", sync_mask::PREFERCONSTVELO),
-    ("IGNOREMASTERACC", sync_mask::IGNOREMASTERACC),
-    ("IGNORESLAVEACC", sync_mask::IGNORESLAVEACC),
-    ("DETAILEDERRORCODES", sync_mask::DETAILEDERRORCODES),
+const OPERATION_FLAGS: [(&str, u32); 6] = flags![
+    ROLLBACKLOCK,
+    INSTANTSTOPONROLLBACK,
+    PREFERCONSTVELO,
+    IGNOREMASTERACC,
+    IGNORESLAVEACC,
+    DETAILEDERRORCODES,
 ];
 
 /// The inputs of a flying-saw call.
@@ -60,38 +67,33 @@ pub(super) struct SawInputs {
     pub(super) sync_positions: [f64; 2],
 }
 
+/// The inputs of MC_GearInPos under the seed's names, in the order an error lists them.
+const GEAR_IN_POS: [&str; 13] = [
+    "Slave",
+    "Master",
+    "RatioNumerator",
+    "RatioDenominator",
+    "MasterSyncPosition",
+    "SlaveSyncPosition",
+    "SyncMode",
+    "CheckMask",
+    "OpMask",
+    "Velocity",
+    "Acceleration",
+    "Deceleration",
+    "Jerk",
+];
+
 /// The inputs of `kind` under the seed's names (`Slave` is every kind's: the axis).
-fn inputs_of(kind: &str) -> &'static [&'static str] {
+/// MC_GearInVelo has MC_GearInPos's but the two sync positions.
+fn inputs_of(kind: &str) -> Vec<&'static str> {
     match kind {
-        "MC_GearInVelo" => &[
-            "Slave",
-            "Master",
-            "RatioNumerator",
-            "RatioDenominator",
-            "SyncMode",
-            "CheckMask",
-            "OpMask",
-            "Velocity",
-            "Acceleration",
-            "Deceleration",
-            "Jerk",
-        ],
-        "MC_GearInPos" => &[
-            "Slave",
-            "Master",
-            "RatioNumerator",
-            "RatioDenominator",
-            "MasterSyncPosition",
-            "SlaveSyncPosition",
-            "SyncMode",
-            "CheckMask",
-            "OpMask",
-            "Velocity",
-            "Acceleration",
-            "Deceleration",
-            "Jerk",
-        ],
-        _ => &["Slave"],
+        "MC_GearInPos" => GEAR_IN_POS.to_vec(),
+        "MC_GearInVelo" => GEAR_IN_POS
+            .into_iter()
+            .filter(|name| !name.ends_with("SyncPosition"))
+            .collect(),
+        _ => vec!["Slave"],
     }
 }
 
