@@ -16,7 +16,7 @@
 //! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
 //! FALSE for one cycle first, so every call is a new edge.
 
-use super::registry::{find, BlockSpec, Inputs, Kind, Target, TimelineBlock, Value, WHOLE};
+use super::registry::{find, number, BlockSpec, Inputs, Kind, Target, TimelineBlock, Value, WHOLE};
 use crate::runtime::PlcIo;
 
 /// A call of an instance, checked.
@@ -152,6 +152,57 @@ fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
         }
     }
     Ok((inputs, room, execute))
+}
+
+impl Kind {
+    /// `value` checked for input `key` of `block`.
+    fn check(&self, block: &str, key: &str, value: &toml::Value) -> Result<Value, String> {
+        let bad = || format!("call: {block} input `{key}` = {value} is not valid");
+        let range = |lo: i64, hi: i64| {
+            value
+                .as_integer()
+                .filter(|v| (lo..=hi).contains(v))
+                .map(Value::Int)
+                .ok_or_else(|| format!("call: `{key}` = {value}: {lo}..={hi}"))
+        };
+        match self {
+            Kind::Bool => value.as_bool().map(Value::Bool).ok_or_else(bad),
+            Kind::Real => number(value)
+                .filter(|v| v.is_finite())
+                .map(Value::Real)
+                .ok_or_else(bad),
+            Kind::Count => value
+                .as_integer()
+                .filter(|v| (0..i64::from(u32::MAX)).contains(v))
+                .map(Value::Int)
+                .ok_or_else(bad),
+            Kind::Range(lo, hi) => range(*lo, *hi),
+            Kind::Room => range(1, 1 << 20),
+            Kind::OneOf(choices) => {
+                let text = value.to_string();
+                let found = choices
+                    .iter()
+                    .find(|(c, _)| c.split(' ').next() == Some(&text));
+                found.map(|(_, v)| Value::Int(*v)).ok_or_else(|| {
+                    let texts: Vec<&str> = choices.iter().map(|(c, _)| *c).collect();
+                    format!("call: `{key}` = {value}: {}", texts.join(" or "))
+                })
+            }
+            Kind::Mode(m) => match value {
+                toml::Value::String(name) => (m.from_name)(name)
+                    .map(|v| Value::Int(v.into()))
+                    .ok_or_else(|| format!("call: `{key}` = {name:?}: known are {}", (m.names)())),
+                toml::Value::Integer(i) if u32::try_from(*i).is_ok_and(m.valid) => {
+                    Ok(Value::Int(*i))
+                }
+                _ => Err(format!(
+                    "call: `{key}` = {value}: known are {}",
+                    (m.names)()
+                )),
+            },
+            Kind::Parsed { parse, .. } => parse(value),
+        }
+    }
 }
 
 impl Instances {

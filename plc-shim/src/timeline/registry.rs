@@ -1,7 +1,8 @@
 //! The blocks a timeline calls by name. Each family registers its blocks in the `TIMELINE`
 //! table at the end of its file in [`crate::blocks`]: name, what an instance addresses, the
 //! inputs with their kinds, and the constructor; [`FAMILIES`] lists the tables, one line per
-//! family. The instances and their calls are [`super::instances`].
+//! family. The instances, and the checks of a call against these declarations, are
+//! [`super::instances`].
 
 use crate::blocks::{cam, cam_compat, cam_data, cam_multi, cam_read, fifo, motion, probe, saw};
 use crate::kernel::Outputs;
@@ -284,62 +285,6 @@ pub fn find(name: &str) -> Result<&'static BlockSpec, String> {
             let known: Vec<&str> = blocks().map(|b| b.name).collect();
             format!("call: unknown block {name:?} (known: {})", known.join(", "))
         })
-}
-
-impl Kind {
-    /// `value` checked for input `key` of `block`.
-    pub(super) fn check(
-        &self,
-        block: &str,
-        key: &str,
-        value: &toml::Value,
-    ) -> Result<Value, String> {
-        let bad = || format!("call: {block} input `{key}` = {value} is not valid");
-        let range = |lo: i64, hi: i64| {
-            value
-                .as_integer()
-                .filter(|v| (lo..=hi).contains(v))
-                .map(Value::Int)
-                .ok_or_else(|| format!("call: `{key}` = {value}: {lo}..={hi}"))
-        };
-        match self {
-            Kind::Bool => value.as_bool().map(Value::Bool).ok_or_else(bad),
-            Kind::Real => number(value)
-                .filter(|v| v.is_finite())
-                .map(Value::Real)
-                .ok_or_else(bad),
-            Kind::Count => value
-                .as_integer()
-                .filter(|v| (0..i64::from(u32::MAX)).contains(v))
-                .map(Value::Int)
-                .ok_or_else(bad),
-            Kind::Range(lo, hi) => range(*lo, *hi),
-            Kind::Room => range(1, 1 << 20),
-            Kind::OneOf(choices) => {
-                let text = value.to_string();
-                let found = choices
-                    .iter()
-                    .find(|(c, _)| c.split(' ').next() == Some(&text));
-                found.map(|(_, v)| Value::Int(*v)).ok_or_else(|| {
-                    let texts: Vec<&str> = choices.iter().map(|(c, _)| *c).collect();
-                    format!("call: `{key}` = {value}: {}", texts.join(" or "))
-                })
-            }
-            Kind::Mode(m) => match value {
-                toml::Value::String(name) => (m.from_name)(name)
-                    .map(|v| Value::Int(v.into()))
-                    .ok_or_else(|| format!("call: `{key}` = {name:?}: known are {}", (m.names)())),
-                toml::Value::Integer(i) if u32::try_from(*i).is_ok_and(m.valid) => {
-                    Ok(Value::Int(*i))
-                }
-                _ => Err(format!(
-                    "call: `{key}` = {value}: known are {}",
-                    (m.names)()
-                )),
-            },
-            Kind::Parsed { parse, .. } => parse(value),
-        }
-    }
 }
 
 #[cfg(test)]
