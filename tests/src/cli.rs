@@ -203,3 +203,17 @@ pub fn cnc_run(cnc: &str, args: &[&str], instance: &str, trace: &Path) -> Output
     assert!(out.status.success(), "cnc run {args:?}: {}", report(&out));
     out
 }
+
+/// `cnc run SCENARIO --lockstep` ([`cnc_run`]) under an instance of its own, its trace written
+/// to a scratch folder (removed again): the [`report`] and the trace's bytes.
+pub fn cnc_run_lockstep(cnc: &str, scenario: &Path, tag: &str) -> (String, Vec<u8>) {
+    let scratch = Scratch::new(tag);
+    let trace = scratch.join("trace.csv");
+    let out = cnc_run(
+        cnc,
+        &[scenario.to_str().expect("a UTF-8 path"), "--lockstep"],
+        &crate::unique_instance(tag),
+        &trace,
+    );
+    (report(&out), std::fs::read(&trace).expect("read the trace"))
+}
