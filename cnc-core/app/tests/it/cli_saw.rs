@@ -205,8 +205,7 @@ fn the_flying_saw_cuts_twenty_equal_pieces_from_a_plc_process() {
 #[test]
 fn the_saw_blocks_run_from_a_timeline() {
     use cnc_app::scenario::{InProcess, Scenario};
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/saw-blocks/scenario.toml");
+    let path = tests::cli::scenario("saw-blocks");
     let s = Scenario::load(&path).unwrap();
     let run = InProcess::run_through(&s).unwrap();
     let summary = run.timeline.as_ref().unwrap().summary();
