@@ -13,7 +13,7 @@
 
 use crate::child::ChildGuard;
 use std::ffi::OsStr;
-use std::io;
+use std::io::{self, BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output, Stdio};
 use std::time::Duration;
@@ -116,6 +116,17 @@ impl Cli {
             );
             io::Error::new(io::ErrorKind::TimedOut, text)
         })
+    }
+
+    /// Runs the program as `| head -1` would: its stdout is closed after the first line.
+    /// Returns that line and the end of the run (status, stderr) as [`Cli::output`] does.
+    pub fn first_line(self) -> io::Result<(String, Output)> {
+        let watchdog = self.watchdog;
+        let mut child = self.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
+        let mut line = String::new();
+        let stdout = child.0.stdout.take().expect("piped stdout");
+        BufReader::new(stdout).read_line(&mut line)?;
+        Ok((line, child.wait_with_output(watchdog)?))
     }
 
     /// Starts the program; the guard kills it when dropped unless it has ended (wait for it
