@@ -4,7 +4,9 @@
 //! [`Scratch`] a folder of the test's own that is removed afterwards.
 //!
 //! ```no_run
-//! let out = tests::Cli::new(env!("CARGO_BIN_EXE_cnc"))
+//! // A test of the `cnc-app` package names the binary with `env!("CARGO_BIN_EXE_cnc")`.
+//! let cnc = "target/debug/cnc";
+//! let out = tests::Cli::new(cnc)
 //!     .args(["hli", "symbols"])
 //!     .output()
 //!     .unwrap();
