@@ -20,7 +20,7 @@ fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u6
 #[test]
 fn an_edge_while_busy_sends_the_new_block_and_a_silent_cnc_times_out() {
     hli::init_logging();
-    let instance = format!("fifo-blocks-{}", std::process::id());
+    let instance = tests::unique_instance("fifo-blocks");
     let server = AcyclicServer::open(&instance).unwrap();
     let mut client = AcyclicClient::open(&instance).unwrap();
     let memory = hli::segment::heap_image(0, 1);

@@ -1,14 +1,27 @@
-//! A child process that never outlives its test.
+//! A child process that never outlives its test, and signals sent to a process.
 
-use std::process::Child;
+use crate::cli::Cli;
+use std::io::{self, Read};
+use std::process::{Child, ExitStatus, Output};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// Kills `child` when dropped unless it has exited: a hung child never outlives its test.
 pub struct ChildGuard(pub Child);
 
 impl ChildGuard {
+    /// The child's process id.
+    pub fn id(&self) -> u32 {
+        self.0.id()
+    }
+
+    /// Sends the signal `name` to the child: [`signal`].
+    pub fn signal(&self, name: &str) -> bool {
+        signal(self.id(), name)
+    }
+
     /// Waits for the child to exit, up to `limit`; kills it and returns `None` on expiry.
-    pub fn wait_with_watchdog(&mut self, limit: Duration) -> Option<std::process::ExitStatus> {
+    pub fn wait_with_watchdog(&mut self, limit: Duration) -> Option<ExitStatus> {
         let deadline = Instant::now() + limit;
         loop {
             if let Ok(Some(status)) = self.0.try_wait() {
@@ -21,6 +34,31 @@ impl ChildGuard {
             std::thread::sleep(Duration::from_millis(5));
         }
     }
+
+    /// [`ChildGuard::wait_with_watchdog`], collecting what the child writes to its piped
+    /// stdout and stderr (those the test has not taken). `Err` (`TimedOut`) when the watchdog
+    /// killed it; the error carries what it printed.
+    pub fn wait_with_output(&mut self, limit: Duration) -> io::Result<Output> {
+        let out = drain(self.0.stdout.take());
+        let err = drain(self.0.stderr.take());
+        let status = self.wait_with_watchdog(limit);
+        let (stdout, stderr) = (join(out), join(err));
+        match status {
+            Some(status) => Ok(Output {
+                status,
+                stdout,
+                stderr,
+            }),
+            None => Err(io::Error::new(
+                io::ErrorKind::TimedOut,
+                format!(
+                    "watchdog: killed after {limit:?}\nstdout:\n{}\nstderr:\n{}",
+                    String::from_utf8_lossy(&stdout),
+                    String::from_utf8_lossy(&stderr)
+                ),
+            )),
+        }
+    }
 }
 
 impl Drop for ChildGuard {
@@ -30,4 +68,28 @@ impl Drop for ChildGuard {
             let _ = self.0.wait();
         }
     }
+}
+
+/// Sends the signal `name` (`"TERM"`, `"KILL"`, `"STOP"`, ...) to process `pid` with
+/// `kill -NAME PID`; true when `kill` delivered it.
+pub fn signal(pid: u32, name: &str) -> bool {
+    Cli::new("kill")
+        .arg(format!("-{name}"))
+        .arg(pid.to_string())
+        .output()
+        .is_ok_and(|out| out.status.success())
+}
+
+fn drain(pipe: Option<impl Read + Send + 'static>) -> Option<JoinHandle<Vec<u8>>> {
+    pipe.map(|mut pipe| {
+        std::thread::spawn(move || {
+            let mut bytes = Vec::new();
+            let _ = pipe.read_to_end(&mut bytes);
+            bytes
+        })
+    })
+}
+
+fn join(reader: Option<JoinHandle<Vec<u8>>>) -> Vec<u8> {
+    reader.and_then(|r| r.join().ok()).unwrap_or_default()
 }

@@ -1,10 +1,12 @@
-//! Running the project's programs (`cnc`, `plc`, `hli-peer`) from a test: [`Cli`] is a
+//! Running programs (`cnc`, `plc`, `hli-peer`, tools) from a test: [`Cli`] is a
 //! `Command` whose `output`, `status` and `spawn` come with a watchdog (a hung program is
 //! killed and the test fails with what it printed, it never hangs the test run), and
 //! [`Scratch`] a folder of the test's own that is removed afterwards.
 //!
 //! ```no_run
-//! let out = tests::Cli::new("target/debug/cnc")
+//! // A test of the `cnc-app` package names the binary with `env!("CARGO_BIN_EXE_cnc")`.
+//! let cnc = "target/debug/cnc";
+//! let out = tests::Cli::new(cnc)
 //!     .args(["hli", "symbols"])
 //!     .output()
 //!     .unwrap();
@@ -13,10 +15,9 @@
 
 use crate::child::ChildGuard;
 use std::ffi::OsStr;
-use std::io::{self, Read};
+use std::io::{self, BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output, Stdio};
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// How long a program may run before its watchdog kills it: long enough for a debug build on
@@ -102,28 +103,9 @@ impl Cli {
             .stdout(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()?;
-        let mut guard = ChildGuard(child);
-        let out = drain(guard.0.stdout.take());
-        let err = drain(guard.0.stderr.take());
-        let status = guard.wait_with_watchdog(self.watchdog);
-        let (stdout, stderr) = (join(out), join(err));
-        match status {
-            Some(status) => Ok(Output {
-                status,
-                stdout,
-                stderr,
-            }),
-            None => Err(io::Error::new(
-                io::ErrorKind::TimedOut,
-                format!(
-                    "watchdog: {:?} killed after {:?}\nstdout:\n{}\nstderr:\n{}",
-                    self.command,
-                    self.watchdog,
-                    String::from_utf8_lossy(&stdout),
-                    String::from_utf8_lossy(&stderr)
-                ),
-            )),
-        }
+        ChildGuard(child)
+            .wait_with_output(self.watchdog)
+            .map_err(|e| io::Error::new(e.kind(), format!("{:?}: {e}", self.command)))
     }
 
     /// Runs the program to its end with its output inherited; `Err` as [`Cli::output`].
@@ -138,25 +120,22 @@ impl Cli {
         })
     }
 
+    /// Runs the program as `| head -1` would: its stdout is closed after the first line.
+    /// Returns that line and the end of the run (status, stderr) as [`Cli::output`] does.
+    pub fn first_line(self) -> io::Result<(String, Output)> {
+        let watchdog = self.watchdog;
+        let mut child = self.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
+        let mut line = String::new();
+        let stdout = child.0.stdout.take().expect("piped stdout");
+        BufReader::new(stdout).read_line(&mut line)?;
+        Ok((line, child.wait_with_output(watchdog)?))
+    }
+
     /// Starts the program; the guard kills it when dropped unless it has ended (wait for it
-    /// with [`ChildGuard::wait_with_watchdog`]).
+    /// with [`ChildGuard::wait_with_watchdog`] or [`ChildGuard::wait_with_output`]).
     pub fn spawn(mut self) -> io::Result<ChildGuard> {
         Ok(ChildGuard(self.command.spawn()?))
     }
-}
-
-fn drain(pipe: Option<impl Read + Send + 'static>) -> Option<JoinHandle<Vec<u8>>> {
-    pipe.map(|mut pipe| {
-        std::thread::spawn(move || {
-            let mut bytes = Vec::new();
-            let _ = pipe.read_to_end(&mut bytes);
-            bytes
-        })
-    })
-}
-
-fn join(reader: Option<JoinHandle<Vec<u8>>>) -> Vec<u8> {
-    reader.and_then(|r| r.join().ok()).unwrap_or_default()
 }
 
 /// A folder of the test's own under the temporary folder, removed when dropped.
@@ -203,4 +182,51 @@ pub fn scenario(name: &str) -> PathBuf {
         .join("scenarios")
         .join(name)
         .join("scenario.toml")
+}
+
+/// Runs `program` with `args` to its end (watchdog, captured output): its exit code (-1 when
+/// a signal ended it), stdout and stderr as text. Panics if it could not start or hung.
+pub fn code_and_text(program: impl AsRef<OsStr>, args: &[&str]) -> (i32, String, String) {
+    let out = Cli::new(program)
+        .args(args)
+        .output()
+        .expect("run the program");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// What a run printed: its stdout, then its stderr.
+pub fn report(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr)
+}
+
+/// `cnc run ARGS --instance INSTANCE --trace TRACE` to its end, `cnc` being the calling test's
+/// `env!("CARGO_BIN_EXE_cnc")`; asserts that it succeeded, with its [`report`] if not.
+pub fn cnc_run(cnc: &str, args: &[&str], instance: &str, trace: &Path) -> Output {
+    let out = Cli::new(cnc)
+        .arg("run")
+        .args(args)
+        .args(["--instance", instance, "--trace"])
+        .arg(trace)
+        .output()
+        .expect("run cnc");
+    assert!(out.status.success(), "cnc run {args:?}: {}", report(&out));
+    out
+}
+
+/// `cnc run SCENARIO --lockstep` ([`cnc_run`]) under an instance of its own, its trace written
+/// to a scratch folder (removed again): the [`report`] and the trace's bytes.
+pub fn cnc_run_lockstep(cnc: &str, scenario: &Path, tag: &str) -> (String, Vec<u8>) {
+    let scratch = Scratch::new(tag);
+    let trace = scratch.join("trace.csv");
+    let out = cnc_run(
+        cnc,
+        &[scenario.to_str().expect("a UTF-8 path"), "--lockstep"],
+        &crate::unique_instance(tag),
+        &trace,
+    );
+    (report(&out), std::fs::read(&trace).expect("read the trace"))
 }

@@ -2,9 +2,10 @@
 //! used by production code.
 //!
 //! * [`unique_instance`]: a shared-memory instance name no other test uses;
-//! * [`cli`]: `cnc`, `plc` and `hli-peer` run with a watchdog and captured output
-//!   ([`Cli`]), a scratch folder ([`Scratch`]), the repository's scenarios;
-//! * [`child`]: a child process that never outlives its test ([`ChildGuard`]);
+//! * [`cli`]: every program a test runs (`cnc`, `plc`, `hli-peer`, `kill`, `gcc`, ...) runs
+//!   with a watchdog and captured output ([`Cli`]); `cnc run` with an instance and a trace
+//!   ([`cli::cnc_run`]); a scratch folder ([`Scratch`]); the repository's scenarios;
+//! * [`child`]: a child process that never outlives its test ([`ChildGuard`]), signals;
 //! * [`rig`]: axes on a heap image ([`AxisRig`]); [`channel_rig`]: channels and a controller
 //!   on a heap image, configurations, a watchdog loop, PLC payloads;
 //! * [`lockstep`]: stand-in CNCs in a thread for the PLC-side tests; [`peer`]: payloads with
@@ -25,7 +26,9 @@ pub mod rig;
 pub use child::ChildGuard;
 pub use cli::{Cli, Scratch};
 pub use lockstep::{lockstep_beats, lockstep_script, serve_axes_in_lockstep};
-pub use peer::{checksum, payload, remove_stale_segment, spawn_ready_peer, verify};
+pub use peer::{
+    checksum, payload, remove_stale_segment, spawn_peer_saying, spawn_ready_peer, verify,
+};
 pub use rig::AxisRig;
 
 use std::sync::atomic::{AtomicU32, Ordering};

@@ -1,9 +1,10 @@
 //! Payloads with checksums for the torn-write tests, and the `hli-peer` helper process.
 
 use crate::child::ChildGuard;
+use crate::cli::Cli;
 use hli::layout::HliCoordinateSystemInt;
 use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 /// A payload carrying `seq` and a checksum over it (in `fill_up_1`).
 pub fn payload(seq: u32) -> HliCoordinateSystemInt {
@@ -37,20 +38,24 @@ pub fn verify(p: &HliCoordinateSystemInt) -> Option<u32> {
 /// Starts the `hli-peer` helper binary (path from the calling test's `CARGO_BIN_EXE_hli-peer`)
 /// in `mode` for `instance` and waits for its `ready` line.
 pub fn spawn_ready_peer(peer_exe: &str, mode: &str, instance: &str) -> ChildGuard {
-    let mut child = ChildGuard(
-        Command::new(peer_exe)
-            .args([mode, instance])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("spawn hli-peer"),
-    );
+    spawn_peer_saying(peer_exe, &[mode, instance], "ready")
+}
+
+/// Starts the `hli-peer` helper binary with `args` (stdin and stdout piped: closing its stdin
+/// is how some modes are told to end) and waits for it to print `first_line`.
+pub fn spawn_peer_saying(peer_exe: &str, args: &[&str], first_line: &str) -> ChildGuard {
+    let mut child = Cli::new(peer_exe)
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("spawn hli-peer");
     let mut line = String::new();
     BufReader::new(child.0.stdout.as_mut().expect("piped stdout"))
         .read_line(&mut line)
-        .expect("read the peer's ready line");
-    assert_eq!(line.trim(), "ready", "hli-peer {mode} did not start");
+        .expect("read the peer's first line");
+    assert_eq!(line.trim(), first_line, "hli-peer {args:?} did not start");
     child
 }
 

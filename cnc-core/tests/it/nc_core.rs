@@ -124,16 +124,10 @@ fn a_subroutine_called_in_a_loop_returns_to_the_block_after_its_call() {
     );
 }
 
-fn temp_dir(name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("nc_core_{name}_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn ten_thousand_nested_call_cycles_run_without_allocating() {
     // Main -> a.nc -> sub/b.nc (found through the search path), 10,000 times.
-    let dir = temp_dir("nested");
+    let dir = tests::Scratch::new("nc-nested");
     std::fs::create_dir_all(dir.join("lib")).unwrap();
     std::fs::write(
         dir.join("a.nc"),
@@ -148,7 +142,7 @@ fn ten_thousand_nested_call_cycles_run_without_allocating() {
     .unwrap();
     let src = "P1 = 0 P2 = 0 P3 = 0\n$WHILE P1 < 10000\nL a.nc\nP1 = P1 + 1\n$ENDWHILE\nG1 X=P2 Y=P3 F100\nM30\n";
     let search = SearchPath(vec![dir.join("lib")]);
-    let (set, diags) = ProgramSet::load("main.nc", src.to_string(), Some(&dir), &search);
+    let (set, diags) = ProgramSet::load("main.nc", src.to_string(), Some(dir.path()), &search);
     assert!(diags.is_empty(), "{diags:?}");
     assert_eq!(set.units.len(), 3);
     let axes: Vec<String> = ["X", "Y"].map(String::from).to_vec();
@@ -176,12 +170,11 @@ fn ten_thousand_nested_call_cycles_run_without_allocating() {
     // V.L.DEPTH of a.nc is its own again after b.nc returned: P2 adds 1 each time.
     assert_eq!(interp.param(2), Some(10_000.0));
     assert_eq!(interp.param(3), Some(20_000.0));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn recursion_past_the_depth_limit_refuses_the_program() {
-    let dir = temp_dir("recursion");
+    let dir = tests::Scratch::new("nc-recursion");
     std::fs::write(dir.join("again.nc"), "P1 = P1 + 1\nL again.nc\nM17\n").unwrap();
     let main = dir.join("main.nc");
     std::fs::write(&main, "P1 = 0\nL again.nc\nM30\n").unwrap();
@@ -197,7 +190,6 @@ fn recursion_past_the_depth_limit_refuses_the_program() {
         text.contains("again.nc:2:1: error: subroutine calls nest deeper than 16"),
         "{text}"
     );
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

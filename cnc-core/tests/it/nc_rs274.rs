@@ -11,10 +11,10 @@
 use cnc_core::nc::check::check_source;
 use cnc_core::nc::Decoded;
 use proptest::prelude::*;
-use std::process::Command;
+use tests::{Cli, Scratch};
 
 fn have_rs274() -> bool {
-    let found = Command::new("rs274")
+    let found = Cli::new("rs274")
         .arg("-g")
         .arg("/dev/null")
         .output()
@@ -192,14 +192,10 @@ fn numbers(args: &str) -> Vec<f64> {
 }
 
 fn theirs(body: &str) -> Vec<Motion> {
-    let path = std::env::temp_dir().join(format!(
-        "nc_rs274_{}_{}.ngc",
-        std::process::id(),
-        rand_suffix()
-    ));
+    let dir = Scratch::new("rs274");
+    let path = dir.join("program.ngc");
     std::fs::write(&path, format!("G21 G90 G94 G91.1\n{body}M2\n")).unwrap();
-    let output = Command::new("rs274").arg("-g").arg(&path).output().unwrap();
-    let _ = std::fs::remove_file(&path);
+    let output = Cli::new("rs274").arg("-g").arg(&path).output().unwrap();
     let text = String::from_utf8_lossy(&output.stdout);
     let mut plane = 0usize;
     let mut motions = Vec::new();
@@ -246,12 +242,6 @@ fn theirs(body: &str) -> Vec<Motion> {
         String::from_utf8_lossy(&output.stderr)
     );
     motions
-}
-
-fn rand_suffix() -> u64 {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static N: AtomicU64 = AtomicU64::new(0);
-    N.fetch_add(1, Ordering::Relaxed)
 }
 
 proptest! {

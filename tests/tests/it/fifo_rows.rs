@@ -3,30 +3,19 @@
 
 use hli::calls::fifo::FifoReply;
 use hli::rpc::{AcyclicClient, AcyclicServer};
-use std::io::{BufRead, BufReader};
-use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-use tests::{unique_instance, ChildGuard};
+use tests::unique_instance;
 
 #[test]
 fn a_plc_dying_mid_write_leaves_no_half_block() {
     hli::init_logging();
     let instance = unique_instance("half-block");
     let server = AcyclicServer::open(&instance).unwrap();
-    let mut child = ChildGuard(
-        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
-            .args(["plc-half-block", &instance])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap(),
+    let mut child = tests::spawn_peer_saying(
+        env!("CARGO_BIN_EXE_hli-peer"),
+        &["plc-half-block", &instance],
+        "half",
     );
-    let mut line = String::new();
-    BufReader::new(child.0.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
-    assert_eq!(line.trim(), "half");
     // The whole block arrives while the PLC is alive (a watchdog, not a timing assert).
     let mut blocks = Vec::new();
     let deadline = Instant::now() + Duration::from_secs(30);

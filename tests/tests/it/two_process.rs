@@ -3,9 +3,9 @@
 
 use hli::segment::CncSegment;
 use hli::views::CncView;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
-use tests::{payload, unique_instance, verify, ChildGuard};
+use tests::{payload, unique_instance, verify};
 
 const HANDSHAKES: u32 = 1_000_000;
 
@@ -14,13 +14,11 @@ fn a_million_handshakes_each_way_are_exact() {
     hli::init_logging();
     let instance = unique_instance("million");
     let segment = CncSegment::create(&instance, 1, 1).unwrap();
-    let mut child = ChildGuard(
-        Command::new(env!("CARGO_BIN_EXE_hli-peer"))
-            .args(["plc-handshakes", &instance, &HANDSHAKES.to_string()])
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap(),
-    );
+    let mut child = tests::Cli::new(env!("CARGO_BIN_EXE_hli-peer"))
+        .args(["plc-handshakes", &instance, &HANDSHAKES.to_string()])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
     let view = CncView::new(segment.memory());
     let mut rx = view.dyn_cs_command(0).unwrap();
     let tx = view.dyn_cs_request(0).unwrap();

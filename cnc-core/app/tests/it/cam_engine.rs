@@ -13,13 +13,13 @@ use hli::calls::{AcyclicCall, CallKind};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
 use hli::views::CncView;
 use hli::wire::{encode_body, AcyclicRequest};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 const MASTER: usize = 0;
 const SLAVE: usize = 1;
 
 fn scenarios() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios")
+    tests::cli::repo_root().join("scenarios")
 }
 
 fn seed_cam() -> CamProfile {

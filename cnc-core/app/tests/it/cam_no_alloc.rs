@@ -80,8 +80,7 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
     use hli::calls::cam::CamScalingCall;
     use hli::calls::AcyclicCall;
     use hli::enums::AxisState;
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/cam-conveyor/scenario.toml");
+    let path = tests::cli::scenario("cam-conveyor");
     let s = Scenario::load(&path).unwrap();
     let mut run = InProcess::new(&s, 0).unwrap();
     // The PLC couples the lifter and starts the conveyor within the first ticks.

@@ -4,16 +4,17 @@
 
 use cnc_app::scenario::{InProcess, Scenario};
 use std::path::PathBuf;
-use std::process::Command;
+use tests::{Cli, Scratch};
 
 fn scenario_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/axes-plcopen/scenario.toml")
+    tests::cli::scenario("axes-plcopen")
 }
 
 fn run(extra: &[&str], tag: &str) -> (i32, String, Vec<Vec<f64>>) {
-    let trace = std::env::temp_dir().join(format!("blocks-{tag}-{}.csv", std::process::id()));
-    let instance = format!("blocks-{tag}-{}", std::process::id());
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let scratch = Scratch::new(&format!("blocks-{tag}"));
+    let trace = scratch.join("trace.csv");
+    let instance = tests::unique_instance(&format!("blocks-{tag}"));
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args([
             "run",
             scenario_path().to_str().unwrap(),
@@ -25,8 +26,7 @@ fn run(extra: &[&str], tag: &str) -> (i32, String, Vec<Vec<f64>>) {
         .args(extra)
         .output()
         .unwrap();
-    let text =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    let text = tests::cli::report(&out);
     let rows = std::fs::read_to_string(&trace)
         .unwrap_or_default()
         .lines()
@@ -132,8 +132,7 @@ fn blocks_move_single_axes_in_real_time() {
 
 #[test]
 fn bad_calls_are_refused_before_start() {
-    let dir = std::env::temp_dir().join(format!("blocks-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("blocks-bad");
     let base = std::fs::read_to_string(scenario_path()).unwrap();
     for (timeline, expect) in [
         ("[[step]]\ncall = { block = \"MC_Jump\", axis = 0 }\n", "unknown block \"MC_Jump\""),
@@ -147,7 +146,7 @@ fn bad_calls_are_refused_before_start() {
         std::fs::write(dir.join("plc.toml"), timeline).unwrap();
         let path = dir.join("scenario.toml");
         std::fs::write(&path, &base).unwrap();
-        let out = Command::new(env!("CARGO_BIN_EXE_cnc")).args(["run", path.to_str().unwrap()]).output().unwrap();
+        let out = Cli::new(env!("CARGO_BIN_EXE_cnc")).args(["run", path.to_str().unwrap()]).output().unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{timeline}: {err}");
         assert!(err.contains("plc.toml") && err.contains(expect), "{timeline}: {err}");

@@ -1,32 +1,17 @@
 //! The `cnc cam eval|charac|plot` command-line contract.
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("cnc-cam-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+use tests::{Cli, Scratch};
 
 fn example(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/cams")
+    tests::cli::repo_root()
+        .join("scenarios/cams")
         .join(name)
         .display()
         .to_string()
 }
 
 fn cnc(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    tests::cli::code_and_text(env!("CARGO_BIN_EXE_cnc"), args)
 }
 
 #[test]
@@ -99,7 +84,8 @@ fn charac_prints_every_field_of_mc_table_charac_values() {
 
 #[test]
 fn plot_writes_an_svg_with_three_labelled_panels() {
-    let out = dir().join("seed.svg");
+    let dir = Scratch::new("cam-plot");
+    let out = dir.join("seed.svg");
     let (code, _, err) = cnc(&[
         "cam",
         "plot",
@@ -122,7 +108,8 @@ fn plot_writes_an_svg_with_three_labelled_panels() {
 
 #[test]
 fn refused_files_name_the_code_and_the_point_and_exit_1() {
-    let bad = dir().join("bad.json");
+    let dir = Scratch::new("cam-bad");
+    let bad = dir.join("bad.json");
     std::fs::write(
         &bad,
         r#"{"kind":"motion_function","points":[
@@ -144,7 +131,8 @@ fn refused_files_name_the_code_and_the_point_and_exit_1() {
 
 #[test]
 fn binary_tables_are_read_with_their_interpolation() {
-    let path = dir().join("table.bin");
+    let dir = Scratch::new("cam-bin");
+    let path = dir.join("table.bin");
     let rows: Vec<[f64; 2]> = (0..=8).map(|i| [i as f64, (i * i) as f64]).collect();
     std::fs::write(&path, cnc_core::cam::file::write_binary(&rows).unwrap()).unwrap();
     let (code, out, err) = cnc(&[
@@ -178,9 +166,7 @@ fn binary_tables_are_read_with_their_interpolation() {
 
 #[test]
 fn a_closed_pipe_ends_eval_quietly() {
-    use std::io::{BufRead, BufReader};
-    use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let (first, out) = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args([
             "cam",
             "eval",
@@ -192,17 +178,10 @@ fn a_closed_pipe_ends_eval_quietly() {
             "--step",
             "0.0001",
         ])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut first)
+        .first_line()
         .unwrap();
     assert_eq!(first.trim(), "master,position,velocity,acceleration,jerk");
-    // The reader is gone: the 3.6 million rows behind it meet a closed pipe.
-    let out = child.wait_with_output().unwrap();
+    // The reader went after the first line: the 3.6 million rows behind it met a closed pipe.
     assert!(out.status.success(), "{:?}", out.status);
     assert!(
         out.stderr.is_empty(),

@@ -4,10 +4,13 @@
 
 use cnc_app::scenario::{InProcess, Scenario};
 use std::path::PathBuf;
-use std::process::Command;
 
 fn scenario_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/cam-conveyor/scenario.toml")
+    tests::cli::scenario("cam-conveyor")
+}
+
+fn run_lockstep(scenario: &std::path::Path, tag: &str) -> (String, Vec<u8>) {
+    tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), scenario, tag)
 }
 
 fn blocks(report: &str) -> Vec<String> {
@@ -20,17 +23,7 @@ fn blocks(report: &str) -> Vec<String> {
 
 #[test]
 fn a_plc_process_couples_scales_changes_and_decouples_a_cam_slave() {
-    let pid = std::process::id();
-    let trace = std::env::temp_dir().join(format!("cli-cams-{pid}.csv"));
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", scenario_path().to_str().unwrap(), "--lockstep"])
-        .args(["--instance", &format!("cli-cams-{pid}"), "--trace"])
-        .arg(&trace)
-        .output()
-        .unwrap();
-    let report =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{report}");
+    let (report, two_process) = run_lockstep(&scenario_path(), "cams-couple");
     for needle in [
         "block cam (MC_CamIn on gpAx[1]): Busy 7 (x1), CommandAborted 4086 (x1), InSync 9 (x1)",
         "block scale (MC_CamScaling on gpAx[1]): Done",
@@ -40,8 +33,6 @@ fn a_plc_process_couples_scales_changes_and_decouples_a_cam_slave() {
         assert!(report.contains(needle), "{needle}\n{report}");
     }
     assert!(!report.contains("ErrorID"), "{report}");
-    let two_process = std::fs::read(&trace).unwrap();
-    let _ = std::fs::remove_file(&trace);
 
     let s = Scenario::load(&scenario_path()).unwrap();
     let run = InProcess::run_through(&s).unwrap();
@@ -58,29 +49,12 @@ fn a_plc_process_couples_scales_changes_and_decouples_a_cam_slave() {
 
 #[test]
 fn the_plc_program_does_what_the_timeline_does_tick_for_tick() {
-    let pid = std::process::id();
-    let run = |scenario: &str, tag: &str| {
-        let trace = std::env::temp_dir().join(format!("cli-cams-{tag}-{pid}.csv"));
-        let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join(format!("../../scenarios/{scenario}/scenario.toml"));
-        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-            .args(["run", path.to_str().unwrap(), "--lockstep"])
-            .args(["--instance", &format!("cli-cams-{tag}-{pid}"), "--trace"])
-            .arg(&trace)
-            .output()
-            .unwrap();
-        let report = String::from_utf8_lossy(&out.stdout).into_owned()
-            + &String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(0), "{report}");
-        let rows = std::fs::read(&trace).unwrap();
-        let _ = std::fs::remove_file(&trace);
-        (report, rows)
-    };
-    let (report, program) = run("cam-conveyor-program", "program");
+    let run = |scenario: &str, tag: &str| run_lockstep(&tests::cli::scenario(scenario), tag);
+    let (report, program) = run("cam-conveyor-program", "cams-program");
     assert!(
         report.contains("cam-conveyor: Finished; Select at cycle 0, Couple at cycle 5"),
         "{report}"
     );
-    let (_, timeline) = run("cam-conveyor", "timeline");
+    let (_, timeline) = run("cam-conveyor", "cams-timeline");
     assert_eq!(program, timeline, "the program and the timeline differ");
 }

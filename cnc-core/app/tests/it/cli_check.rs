@@ -1,35 +1,22 @@
 //! The `cnc check` command-line contract.
 
-use std::path::PathBuf;
-use std::process::Command;
+use tests::{Cli, Scratch};
 
-fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("cnc-check-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-fn write(name: &str, text: &str) -> String {
-    let path = dir().join(name);
+/// `text` in the file `name` of a scratch folder of its own (kept while the test holds it).
+fn write(name: &str, text: &str) -> (Scratch, String) {
+    let dir = Scratch::new("check");
+    let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
-    path.display().to_string()
+    (dir, path.display().to_string())
 }
 
 fn cnc(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    tests::cli::code_and_text(env!("CARGO_BIN_EXE_cnc"), args)
 }
 
 #[test]
 fn clean_program_exits_0_silently() {
-    let f = write(
+    let (_dir, f) = write(
         "clean.nc",
         "%p\nN10 G1 X10 Y20 F100\n#TRACK CS ON [ID=0 FILTER=10]\nM30\n",
     );
@@ -40,7 +27,7 @@ fn clean_program_exits_0_silently() {
 
 #[test]
 fn errors_exit_1_with_file_line_col_and_the_offending_text() {
-    let f = write(
+    let (_dir, f) = write(
         "bad.nc",
         "N10 G1 X10 F100\nN20 #TRACK CS ON [CH=1 ID=2]\nN30 Q5\n",
     );
@@ -62,7 +49,7 @@ fn errors_exit_1_with_file_line_col_and_the_offending_text() {
 
 #[test]
 fn blocks_prints_absolute_targets_for_every_axis() {
-    let f = write(
+    let (_dir, f) = write(
         "blocks.nc",
         "N10 G1 G90 X10 Y20 F1000\nN20 G91 X5\nN30 G90 G92 Z100\nN40 Z1\n",
     );
@@ -78,7 +65,7 @@ fn blocks_prints_absolute_targets_for_every_axis() {
 
 #[test]
 fn axes_option_names_the_channel_axes_and_errors_print_no_blocks() {
-    let f = write("axes.nc", "AB=90\nAM=1 AA=25.44\n");
+    let (_dir, f) = write("axes.nc", "AB=90\nAM=1 AA=25.44\n");
     let (code, out, _) = cnc(&["check", "--axes", "AB,AM,AA", "--blocks", &f]);
     assert_eq!(code, 0, "{out}");
     assert!(
@@ -96,7 +83,7 @@ fn axes_option_names_the_channel_axes_and_errors_print_no_blocks() {
 
 #[test]
 fn several_files_and_unreadable_ones() {
-    let good = write("good.nc", "X1\n");
+    let (_dir, good) = write("good.nc", "X1\n");
     let (code, _, err) = cnc(&["check", &good, "/nonexistent/prog.nc"]);
     assert_eq!(code, 1);
     assert!(
@@ -107,7 +94,7 @@ fn several_files_and_unreadable_ones() {
 
 #[test]
 fn bad_axis_lists_are_refused_before_any_file() {
-    let file = write("axes_list.nc", "N10 G1 X1 F100\n");
+    let (_dir, file) = write("axes_list.nc", "N10 G1 X1 F100\n");
     for (axes, why) in [
         ("X,Y,X", "given twice"),
         ("X,1Y", "upper-case letters then digits"),
@@ -124,25 +111,17 @@ fn bad_axis_lists_are_refused_before_any_file() {
 fn blocks_into_a_closed_pipe_ends_quietly() {
     // `cnc check --blocks F | head -1`: the reader goes after one line; the checker must end
     // without a panic message (it used to panic on the broken pipe).
-    use std::io::{BufRead, BufReader};
     let mut text = String::new();
     for i in 0..50_000 {
         text.push_str(&format!("G1 X{} Y{} F1000\n", i % 500, i % 300));
     }
-    let f = write("pipe.nc", &text);
-    let mut child = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let (_dir, f) = write("pipe.nc", &text);
+    let (first, out) = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["check", "--blocks", &f])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut first = String::new();
-    BufReader::new(child.stdout.take().unwrap())
-        .read_line(&mut first)
+        .first_line()
         .unwrap();
     assert!(first.starts_with("{\"line\":1,"), "{first}");
-    // The pipe's reader is dropped here.
-    let out = child.wait_with_output().unwrap();
+    // The pipe's reader went after the first line.
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.is_empty(), "{stderr}");
     assert_eq!(out.status.code(), Some(0));
@@ -150,7 +129,8 @@ fn blocks_into_a_closed_pipe_ends_quietly() {
 
 #[test]
 fn subroutine_files_are_found_next_to_the_program_and_on_the_search_path() {
-    let d = dir().join("subs");
+    let scratch = Scratch::new("check-subs");
+    let d = scratch.join("subs");
     std::fs::create_dir_all(d.join("lib")).unwrap();
     std::fs::write(
         d.join("side.nc"),
@@ -188,7 +168,7 @@ fn subroutine_files_are_found_next_to_the_program_and_on_the_search_path() {
 
 #[test]
 fn tool_records_come_from_the_command_line() {
-    let f = write("tools.nc", "S6000 M03 T24 D1\nG1 Z10 F100\nM30\n");
+    let (_dir, f) = write("tools.nc", "S6000 M03 T24 D1\nG1 Z10 F100\nM30\n");
     let z = |stdout: &str| {
         stdout
             .split("\"Z\":")

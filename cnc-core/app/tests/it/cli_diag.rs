@@ -2,12 +2,12 @@
 //! ticks) and of the same CNC once it has ended; bad input and a missing CNC. Waits are polls
 //! with watchdogs.
 
-use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
+use std::process::{Output, Stdio};
 use std::time::{Duration, Instant};
+use tests::Cli;
 
 fn diag(instance: &str, channel: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args([
             "diag",
             "dyncs",
@@ -45,10 +45,9 @@ fn history_rows(listing: &str) -> Vec<&str> {
 
 #[test]
 fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
-    let instance = format!("diag-{}", std::process::id());
-    let scenario = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/example3-moving-workpiece/scenario.toml");
-    let cnc = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let instance = tests::unique_instance("diag");
+    let scenario = tests::cli::scenario("example3-moving-workpiece");
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["run", scenario.to_str().unwrap(), "--instance", &instance])
         .arg("--keep-diagnosis")
         .stdout(Stdio::piped())
@@ -105,12 +104,10 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
 
     // Stopped with SIGTERM: the controlled stop ends the tracking in ERROR and the run leaves
     // its listings behind.
-    let status = Command::new("kill")
-        .args(["-TERM", &cnc.id().to_string()])
-        .status()
+    assert!(cnc.signal("TERM"));
+    let out = cnc
+        .wait_with_output(tests::cli::default_watchdog())
         .unwrap();
-    assert!(status.success());
-    let out = cnc.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(128 + 15));
     let o = diag(&instance, "2");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -134,20 +131,17 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
         )),
         "{stdout}"
     );
-    let _ = std::fs::remove_dir_all(
-        std::env::temp_dir()
-            .join("cncplc-diag")
-            .join(format!("instance-{instance}")),
-    );
+    let _ = std::fs::remove_dir_all(cnc_app::diag_cli::finished_dir(&instance));
 }
 
 #[test]
 fn no_cnc_and_bad_channels_are_refused() {
-    let o = diag("diag-nobody-here", "1");
+    let nobody = tests::unique_instance("diag-nobody");
+    let o = diag(&nobody, "1");
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("no CNC \"diag-nobody-here\" is running"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains(&format!("no CNC \"{nobody}\" is running")));
     for bad in ["0", "13", "x"] {
-        let o = diag("diag-nobody-here", bad);
+        let o = diag(&nobody, bad);
         assert_eq!(o.status.code(), Some(2), "{bad}");
         assert!(text(&o).is_empty());
     }

@@ -2,20 +2,13 @@
 //! `fifo-stream` streams the contour scenario and a 100,000-row file through the row service
 //! and the segment; the set-points are checked row by row against the files.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
+use tests::{Cli, Scratch};
 
-fn run(scenario: &Path, instance: &str, trace: &Path) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", scenario.to_str().unwrap(), "--lockstep"])
-        .args(["--instance", instance, "--trace"])
-        .arg(trace)
-        .output()
-        .unwrap();
-    let report =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{report}");
-    report
+/// `cnc run SCENARIO --lockstep` with a trace: the report and the trace.
+fn run(scenario: &Path, tag: &str) -> (String, Trace) {
+    let (report, trace) = tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), scenario, tag);
+    (report, Trace::parse(&trace))
 }
 
 /// The trace: a header line, then ticks; columns by name.
@@ -26,8 +19,11 @@ struct Trace {
 
 impl Trace {
     fn read(path: &Path) -> Trace {
-        let text = std::fs::read_to_string(path).unwrap();
-        let _ = std::fs::remove_file(path);
+        Trace::parse(&std::fs::read(path).unwrap())
+    }
+
+    fn parse(bytes: &[u8]) -> Trace {
+        let text = std::str::from_utf8(bytes).unwrap();
         let mut lines = text.lines();
         let names = lines
             .next()
@@ -51,14 +47,8 @@ const RUNNING: f64 = 2.0;
 
 #[test]
 fn the_contour_scenario_streams_every_row_from_a_plc_process() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/fifo-contour");
-    let pid = std::process::id();
-    let trace_path = std::env::temp_dir().join(format!("cli-fifo-{pid}.csv"));
-    let report = run(
-        &dir.join("scenario.toml"),
-        &format!("cli-fifo-{pid}"),
-        &trace_path,
-    );
+    let dir = tests::cli::repo_root().join("scenarios/fifo-contour");
+    let (report, trace) = run(&dir.join("scenario.toml"), "cli-fifo");
     assert!(
         report.contains("fifo-stream: Finished; 3001 rows in"),
         "{report}"
@@ -69,7 +59,6 @@ fn the_contour_scenario_streams_every_row_from_a_plc_process() {
         .read_all()
         .unwrap();
     assert_eq!(columns, 3);
-    let trace = Trace::read(&trace_path);
     let state = trace.column("gpFifo[0]^group_state_r");
     let start = state
         .iter()
@@ -112,9 +101,7 @@ fn the_contour_scenario_streams_every_row_from_a_plc_process() {
 #[test]
 fn a_hundred_thousand_rows_arrive_whole_and_in_order() {
     const ROWS: usize = 100_000;
-    let pid = std::process::id();
-    let dir = std::env::temp_dir().join(format!("cli-fifo-100k-{pid}"));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-fifo-100k");
     // Row k: X at k um, Y at -k/2 um, Z at 0; the last row repeated (the end at rest).
     let mut values = Vec::with_capacity(3 * (ROWS + 1));
     for k in 0..ROWS {
@@ -136,14 +123,7 @@ fn a_hundred_thousand_rows_arrive_whole_and_in_order() {
         axis.replace("{n}", "Z"),
     );
     std::fs::write(dir.join("scenario.toml"), scenario).unwrap();
-    let trace_path = dir.join("trace.csv");
-    let report = run(
-        &dir.join("scenario.toml"),
-        &format!("cli-fifo-100k-{pid}"),
-        &trace_path,
-    );
-    let trace = Trace::read(&trace_path);
-    let _ = std::fs::remove_dir_all(&dir);
+    let (report, trace) = run(&dir.join("scenario.toml"), "fifo-100k");
     // The PLC's count.
     assert!(
         report.contains(&format!("fifo-stream: Finished; {ROWS} rows in")),
@@ -173,9 +153,7 @@ fn a_hundred_thousand_rows_arrive_whole_and_in_order() {
 /// override on the velocity, and refusals with their exit codes.
 #[test]
 fn cnc_fifo_run_traces_the_set_points() {
-    let pid = std::process::id();
-    let dir = std::env::temp_dir().join(format!("cli-fifo-run-{pid}"));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-fifo-run");
     let csv = dir.join("rows.csv");
     // X climbs 3 per row for 10 rows, then stands; Y stands at 5.
     let mut text = String::from("x,y\n");
@@ -184,7 +162,7 @@ fn cnc_fifo_run_traces_the_set_points() {
     }
     std::fs::write(&csv, text).unwrap();
     let trace = dir.join("trace.csv");
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["fifo", "run", "--rows", csv.to_str().unwrap()])
         .args([
             "--tf",
@@ -235,7 +213,7 @@ fn cnc_fifo_run_traces_the_set_points() {
     assert_eq!(t.column("a1_direction")[10], 0.0);
     assert_eq!(t.column("override")[0], 50.0);
     let fifo_run = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_cnc"))
+        Cli::new(env!("CARGO_BIN_EXE_cnc"))
             .args([
                 "fifo",
                 "run",
@@ -259,7 +237,6 @@ fn cnc_fifo_run_traces_the_set_points() {
     let out = fifo_run(&["--tf", "0.001"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("rows.csv:2:3"));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The FIFO blocks from a timeline: the same trace and block edges in-process and with a
@@ -267,12 +244,9 @@ fn cnc_fifo_run_traces_the_set_points() {
 #[test]
 fn the_fifo_blocks_from_a_timeline_run_alike_in_one_and_two_processes() {
     use cnc_app::scenario::{InProcess, Scenario};
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/fifo-blocks/scenario.toml");
-    let pid = std::process::id();
-    let trace_path = std::env::temp_dir().join(format!("cli-fifo-blocks-{pid}.csv"));
-    let report = run(&path, &format!("cli-fifo-blocks-{pid}"), &trace_path);
-    let two_process = std::fs::read(&trace_path).unwrap();
+    let path = tests::cli::scenario("fifo-blocks");
+    let (report, two_process) =
+        tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), &path, "fifo-blocks");
     let blocks = |text: &str| -> Vec<String> {
         text.lines()
             .filter(|l| l.starts_with("block "))
@@ -295,7 +269,7 @@ fn the_fifo_blocks_from_a_timeline_run_alike_in_one_and_two_processes() {
         blocks(&run.timeline.as_ref().unwrap().summary()),
         blocks(&report)
     );
-    let t = Trace::read(&trace_path);
+    let t = Trace::parse(&two_process);
     let x = t.column("gpAx[0]^lr_state.command_position_acs_r");
     let top = x.iter().cloned().fold(f64::MIN, f64::max);
     assert_eq!(top, 80_000.0, "the overwritten rows end at X = 8");

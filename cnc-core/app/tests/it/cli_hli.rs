@@ -1,9 +1,9 @@
 //! The `cnc hli` command-line contract.
 
-use std::process::Command;
+use tests::{Cli, Scratch};
 
 fn cnc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(args)
         .output()
         .expect("run cnc")
@@ -33,11 +33,10 @@ fn symbols_lists_every_node_and_leaf_with_offsets() {
 }
 
 fn gcc_syntax_check(source: &str, name: &str) -> std::process::Output {
-    let dir = std::env::temp_dir().join(format!("cnc-hli-header-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("hli-header");
     let path = dir.join(name);
     std::fs::write(&path, source).unwrap();
-    Command::new("gcc")
+    Cli::new("gcc")
         .args(["-fsyntax-only", "-std=c11", "-Wall", "-Werror", "-x", "c"])
         .arg(&path)
         .output()

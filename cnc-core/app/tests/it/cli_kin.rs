@@ -1,17 +1,8 @@
 //! The `cnc kin` command-line contract.
 
-use std::process::Command;
-
 fn cnc(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(args)
-        .output()
-        .expect("run cnc");
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).trim().to_string(),
-        String::from_utf8_lossy(&out.stderr).to_string(),
-    )
+    let (code, out, err) = tests::cli::code_and_text(env!("CARGO_BIN_EXE_cnc"), args);
+    (code == 0, out.trim().to_string(), err)
 }
 
 fn numbers(json: &str) -> Vec<f64> {

@@ -4,8 +4,9 @@
 //! message once no CNC runs. Waits are polls with watchdogs.
 
 use std::path::PathBuf;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
+use tests::{ChildGuard, Cli, Scratch};
 
 const ENABLE: &str = "gpCh[0]^channel_mc_control.dyn_cs.enable_w";
 const ROTATION: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";
@@ -15,23 +16,11 @@ const ACK_SEM: &str = "gpCh[0]^channel_mc_control.m_function.ack_semaphore_rw";
 const STATE: &str = "gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state";
 const BEAT: &str = "header.cnc_heartbeat";
 
-fn cnc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 fn tool(instance: &str, args: &[&str]) -> (i32, String, String) {
     let mut all = vec!["plc"];
     all.extend_from_slice(args);
     all.extend_from_slice(&["--instance", instance]);
-    let o = cnc(&all);
-    (
-        o.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
+    tests::cli::code_and_text(env!("CARGO_BIN_EXE_cnc"), &all)
 }
 
 /// The value `plc get` prints for `path`.
@@ -44,10 +33,10 @@ fn get(instance: &str, path: &str) -> String {
         .to_string()
 }
 
-/// A CNC running a scenario without a PLC, for ten minutes at most (the test ends it).
-fn start_cnc(instance: &str) -> Child {
-    let dir = std::env::temp_dir().join(format!("plc-tools-{instance}"));
-    std::fs::create_dir_all(&dir).unwrap();
+/// A CNC running a scenario without a PLC, for ten minutes at most (the test ends it), and
+/// the scratch folder of its scenario.
+fn start_cnc(instance: &str) -> (ChildGuard, Scratch) {
+    let dir = Scratch::new("plc-tools");
     let program = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/supervision/long.nc");
     std::fs::write(
         dir.join("scenario.toml"),
@@ -57,13 +46,14 @@ fn start_cnc(instance: &str) -> Child {
         ),
     )
     .unwrap();
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["run", dir.join("scenario.toml").to_str().unwrap()])
         .args(["--instance", instance, "--ticks", "600000"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .unwrap()
+        .unwrap();
+    (cnc, dir)
 }
 
 /// Polls `check` until it holds (watchdog 30 s).
@@ -77,8 +67,8 @@ fn wait_until(what: &str, mut check: impl FnMut() -> bool) {
 
 #[test]
 fn get_set_and_watch_a_live_cnc_by_st_path() {
-    let instance = format!("plctools-{}", std::process::id());
-    let mut child = start_cnc(&instance);
+    let instance = tests::unique_instance("plctools");
+    let (mut child, _dir) = start_cnc(&instance);
     wait_until("the CNC ticks", || {
         let (code, out, _) = tool(&instance, &["get", BEAT]);
         code == 0 && !out.trim().ends_with(" 0")
@@ -156,12 +146,8 @@ fn get_set_and_watch_a_live_cnc_by_st_path() {
     assert!(lines[1..].iter().all(|l| l.ends_with(" TRUE")), "{out}");
 
     // The CNC ends: the tools say so with exit 1.
-    let ok = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
-    let _ = child.wait();
+    assert!(child.signal("TERM"));
+    let _ = child.wait_with_output(tests::cli::default_watchdog());
     let (code, _, err) = tool(&instance, &["get", ENABLE]);
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("is the CNC running?"), "{err}");

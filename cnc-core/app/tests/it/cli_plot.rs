@@ -3,10 +3,11 @@
 //! the cam tool's plot go through the same module.
 
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
+use tests::{Cli, Scratch};
 
 fn cnc(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(args)
         .output()
         .unwrap()
@@ -27,17 +28,10 @@ fn has(svg: &str, text: &str) -> bool {
     texts(svg).iter().any(|t| t == text)
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cli-plot-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 const POS: &str = "gpAx[0]^lr_state.command_position_acs_r";
 const STATE: &str = "gpAx[0]^lr_state.axis_state_r";
 
-fn trace(dir: &std::path::Path) -> PathBuf {
+fn trace(dir: &Scratch) -> PathBuf {
     let mut csv = format!("tick,time,{POS},{STATE}\n");
     for k in 0..5000 {
         // 0 .. 123.4567 mm in HLI units (0.1 um), one spike the plot must keep.
@@ -51,7 +45,7 @@ fn trace(dir: &std::path::Path) -> PathBuf {
 
 #[test]
 fn a_trace_becomes_an_svg_with_units_legends_and_every_peak() {
-    let dir = scratch("ok");
+    let dir = Scratch::new("plot-ok");
     let csv = trace(&dir);
     let out = dir.join("plot.svg");
     let o = cnc(&[
@@ -80,7 +74,7 @@ fn a_trace_becomes_an_svg_with_units_legends_and_every_peak() {
 
 #[test]
 fn a_unit_can_be_given_and_bad_input_writes_nothing() {
-    let dir = scratch("bad");
+    let dir = Scratch::new("plot-bad");
     let csv = trace(&dir);
     let out = dir.join("plot.svg");
     let o = cnc(&[
@@ -128,7 +122,7 @@ fn a_unit_can_be_given_and_bad_input_writes_nothing() {
 
 #[test]
 fn the_saw_tool_plots_its_synchronisation() {
-    let dir = scratch("saw");
+    let dir = Scratch::new("plot-saw");
     let out = dir.join("saw.svg");
     let o = cnc(&[
         "saw",

@@ -1,15 +1,13 @@
 //! Real-time options: applied where the system allows, each refused one left out with one
 //! warning and the run going on; unknown keys refused.
 
-use std::path::PathBuf;
-use std::process::Command;
+use tests::Cli;
 
 #[test]
 fn a_refused_option_warns_once_and_the_run_goes_on() {
-    let scenario = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/axes-plcopen/scenario.toml");
-    let instance = format!("rt-{}", std::process::id());
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let scenario = tests::cli::scenario("axes-plcopen");
+    let instance = tests::unique_instance("rt");
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args([
             "run",
             scenario.to_str().unwrap(),

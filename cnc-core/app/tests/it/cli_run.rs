@@ -3,43 +3,24 @@
 //! completes; bad scenarios are refused before anything starts.
 
 use cnc_app::scenario::{InProcess, Scenario};
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn scenario_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios")
-        .join(name)
-        .join("scenario.toml")
-}
+use std::path::Path;
+use std::process::Stdio;
+use std::time::{Duration, Instant};
+use tests::{Cli, Scratch};
 
 fn cnc_run(args: &[&str], instance: &str, trace: &Path) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .arg("run")
-        .args(args)
-        .args(["--instance", instance, "--trace"])
-        .arg(trace)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "cnc run {args:?}: {}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
+    tests::cli::cnc_run(env!("CARGO_BIN_EXE_cnc"), args, instance, trace)
 }
 
 #[test]
 fn lockstep_traces_are_bit_identical_across_runs_and_match_in_process() {
-    let dir = std::env::temp_dir().join(format!("cli-run-{}", std::process::id()));
-    let path = scenario_path("example4-turntable-plc");
+    let dir = Scratch::new("cli-run");
+    let path = tests::cli::scenario("example4-turntable-plc");
     let scenario = path.to_str().unwrap();
     let (a, b) = (dir.join("a.csv"), dir.join("b.csv"));
-    let pid = std::process::id();
     let args = [scenario, "--lockstep", "--ticks", "6000"];
-    let first = cnc_run(&args, &format!("clirun-a-{pid}"), &a);
-    cnc_run(&args, &format!("clirun-b-{pid}"), &b);
+    let first = cnc_run(&args, &tests::unique_instance("clirun-a"), &a);
+    cnc_run(&args, &tests::unique_instance("clirun-b"), &b);
     let (ta, tb) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     assert_eq!(ta, tb, "two lockstep runs differ");
     let text = String::from_utf8(ta.clone()).unwrap();
@@ -59,17 +40,16 @@ fn lockstep_traces_are_bit_identical_across_runs_and_match_in_process() {
     let mut in_process = Vec::new();
     run.trace.write_csv(&mut in_process).unwrap();
     assert_eq!(in_process, ta, "in-process and two-process lockstep differ");
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn a_real_time_run_completes_with_its_plc() {
-    let dir = std::env::temp_dir().join(format!("cli-run-rt-{}", std::process::id()));
-    let path = scenario_path("example4-turntable-hybrid");
+    let dir = Scratch::new("cli-run-rt");
+    let path = tests::cli::scenario("example4-turntable-hybrid");
     let trace = dir.join("rt.csv");
     let out = cnc_run(
         &[path.to_str().unwrap(), "--ticks", "300"],
-        &format!("clirun-rt-{}", std::process::id()),
+        &tests::unique_instance("clirun-rt"),
         &trace,
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -77,13 +57,11 @@ fn a_real_time_run_completes_with_its_plc() {
     assert!(stdout.contains("ended by CncClosed"), "{stdout}");
     let text = std::fs::read_to_string(&trace).unwrap();
     assert_eq!(text.lines().count(), 301);
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
 fn bad_scenarios_are_refused_with_their_file() {
-    let dir = std::env::temp_dir().join(format!("cli-run-bad-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-run-bad");
     let cases = [
         (
             "cycle_ms = 1.0\n[[channel]]\nname = \"a\"\naxes = [\"X\"]\nbogus = 1\n",
@@ -101,7 +79,7 @@ fn bad_scenarios_are_refused_with_their_file() {
     for (i, (text, needle)) in cases.iter().enumerate() {
         let file = dir.join(format!("bad{i}.toml"));
         std::fs::write(&file, text).unwrap();
-        let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+        let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
             .arg("run")
             .arg(&file)
             .output()
@@ -118,22 +96,20 @@ fn bad_scenarios_are_refused_with_their_file() {
         "[[channel]]\nname = \"a\"\naxes = [\"X\"]\nprogram = \"p.nc\"\n",
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("run")
         .arg(&file)
         .output()
         .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("p.nc:2:"), "{err}");
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// `#TRACK CS ON [LOG_FILE=..]`: after the run, `cnc run` writes the channel's diagnosis
 /// (history and switching log) to the named file under `--log-dir`.
 #[test]
 fn a_log_file_named_in_the_program_receives_the_diagnosis() {
-    let dir = std::env::temp_dir().join(format!("cli-run-log-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-run-log");
     std::fs::write(
         dir.join("master.nc"),
         "#CHANNEL INTERFACE ON [DYN_CS]\nG1 X20 F1200\nM30\n",
@@ -155,12 +131,12 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
     )
     .unwrap();
     let out_dir = dir.join("out");
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("run")
         .arg(&scenario)
         .arg("--log-dir")
         .arg(&out_dir)
-        .args(["--instance", &format!("clirun-log-{}", std::process::id())])
+        .args(["--instance", &tests::unique_instance("clirun-log")])
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&out.stdout);
@@ -184,7 +160,6 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
         text.contains("dynCS: is off = DYN_CS_SYNC_INACTIVE"),
         "{text}"
     );
-    let _ = std::fs::remove_dir_all(dir);
 }
 
 /// The LOG_FILE is written while the CNC runs, not only at its end: the switch-on's lines
@@ -192,8 +167,7 @@ fn a_log_file_named_in_the_program_receives_the_diagnosis() {
 /// complete listing (history and log).
 #[test]
 fn the_log_file_is_written_as_the_events_happen() {
-    let dir = std::env::temp_dir().join(format!("cli-run-live-log-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-run-live-log");
     std::fs::write(
         dir.join("slave.nc"),
         "#TRACK CS ON [ID=0 FILTER=0 LOG_FILE=\"live.log\"]\n#TIME 120\nM30\n",
@@ -207,38 +181,36 @@ fn the_log_file_is_written_as_the_events_happen() {
     )
     .unwrap();
     let out_dir = dir.join("out");
-    let cnc = Command::new(env!("CARGO_BIN_EXE_cnc"))
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("run")
         .arg(&scenario)
         .arg("--log-dir")
         .arg(&out_dir)
-        .args(["--instance", &format!("clirun-live-{}", std::process::id())])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
+        .args(["--instance", &tests::unique_instance("clirun-live")])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
         .spawn()
         .unwrap();
     let log = out_dir.join("live.log");
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let deadline = Instant::now() + Duration::from_secs(60);
     let live = loop {
         let text = std::fs::read_to_string(&log).unwrap_or_default();
         if text.contains("dynCS: cmd=ON PLC=1 NO FILTER=0") {
             break text;
         }
         assert!(
-            std::time::Instant::now() < deadline,
+            Instant::now() < deadline,
             "watchdog: nothing in {} while running:\n{text}",
             log.display()
         );
-        std::thread::sleep(std::time::Duration::from_millis(20));
+        std::thread::sleep(Duration::from_millis(20));
     };
     assert!(live.starts_with("BAHN LOGGING KANAL-NR.: 1"), "{live}");
     assert!(live.contains("BAHN restart... start"), "{live}");
-    let status = Command::new("kill")
-        .args(["-TERM", &cnc.id().to_string()])
-        .status()
+    assert!(cnc.signal("TERM"));
+    let out = cnc
+        .wait_with_output(tests::cli::default_watchdog())
         .unwrap();
-    assert!(status.success());
-    let out = cnc.wait_with_output().unwrap();
     assert_eq!(out.status.code(), Some(128 + 15));
     let text = std::fs::read_to_string(&log).unwrap();
     assert!(
@@ -246,5 +218,4 @@ fn the_log_file_is_written_as_the_events_happen() {
         "{text}"
     );
     assert!(text.contains("dynCS: ERROR: machine stop"), "{text}");
-    let _ = std::fs::remove_dir_all(dir);
 }

@@ -2,10 +2,11 @@
 //! trace with the master at constant velocity, exit 1 with the error code when refused,
 //! exit 2 on bad arguments.
 
-use std::process::{Command, Output};
+use std::process::Output;
+use tests::{Cli, Scratch};
 
 fn saw(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("saw")
         .arg("plan")
         .args(args)
@@ -45,7 +46,8 @@ const EXAMPLE: [&str; 26] = [
 
 #[test]
 fn the_plan_prints_every_characteristic_value_and_traces_to_the_sync_point() {
-    let trace = std::env::temp_dir().join(format!("saw-trace-{}.csv", std::process::id()));
+    let scratch = Scratch::new("saw-plan");
+    let trace = scratch.join("trace.csv");
     let mut args = EXAMPLE.to_vec();
     args.extend(["--trace", trace.to_str().unwrap(), "--duration", "3.5"]);
     let out = saw(&args);
@@ -70,7 +72,6 @@ fn the_plan_prints_every_characteristic_value_and_traces_to_the_sync_point() {
     }
     assert_eq!(json.as_object().unwrap().len(), 32, "shape and 31 fields");
     let text = std::fs::read_to_string(&trace).unwrap();
-    let _ = std::fs::remove_file(&trace);
     let mut lines = text.lines();
     assert_eq!(
         lines.next(),
@@ -155,26 +156,13 @@ fn bad_arguments_exit_2() {
 /// first started from a saw still running home.
 #[test]
 fn the_flying_saw_cuts_twenty_equal_pieces_from_a_plc_process() {
-    let dir =
-        std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/flying-saw");
-    let pid = std::process::id();
-    let trace = std::env::temp_dir().join(format!("cli-saw-{pid}.csv"));
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args([
-            "run",
-            dir.join("scenario.toml").to_str().unwrap(),
-            "--lockstep",
-        ])
-        .args(["--instance", &format!("cli-saw-{pid}"), "--trace"])
-        .arg(&trace)
-        .output()
-        .unwrap();
-    let report =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{report}");
+    let (report, trace) = tests::cli::cnc_run_lockstep(
+        env!("CARGO_BIN_EXE_cnc"),
+        &tests::cli::scenario("flying-saw"),
+        "cli-saw",
+    );
     assert!(report.contains("saw-cut: Finished, 20 cuts"), "{report}");
-    let text = std::fs::read_to_string(&trace).unwrap();
-    let _ = std::fs::remove_file(&trace);
+    let text = String::from_utf8(trace).unwrap();
     let mut lines = text.lines();
     let names: Vec<&str> = lines.next().unwrap().split(',').collect();
     let col = |n: &str| names.iter().position(|c| *c == n).expect(n);
@@ -217,8 +205,7 @@ fn the_flying_saw_cuts_twenty_equal_pieces_from_a_plc_process() {
 #[test]
 fn the_saw_blocks_run_from_a_timeline() {
     use cnc_app::scenario::{InProcess, Scenario};
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios/saw-blocks/scenario.toml");
+    let path = tests::cli::scenario("saw-blocks");
     let s = Scenario::load(&path).unwrap();
     let run = InProcess::run_through(&s).unwrap();
     let summary = run.timeline.as_ref().unwrap().summary();

@@ -5,15 +5,17 @@
 
 use hli::access::Leaf;
 use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
+use std::process::Stdio;
 use std::time::{Duration, Instant};
+use tests::child::signal;
+use tests::{ChildGuard, Cli, Scratch};
 
 fn scenario() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/supervision/scenario.toml")
 }
 
-fn start(instance: &str, trace: &std::path::Path) -> Child {
-    Command::new(env!("CARGO_BIN_EXE_cnc"))
+fn start(instance: &str, trace: &std::path::Path) -> ChildGuard {
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args([
             "run",
             scenario().to_str().unwrap(),
@@ -72,17 +74,9 @@ fn plc_pid(instance: &str) -> i32 {
     panic!("no PLC process for {instance}");
 }
 
-fn signal(pid: u32, name: &str) {
-    let ok = Command::new("kill")
-        .args([&format!("-{name}"), &pid.to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
-}
-
 /// Waits for `child` (watchdog 60 s), returns exit code and stdout + stderr.
-fn finish(child: Child) -> (i32, String) {
-    let out = child.wait_with_output().unwrap();
+fn finish(mut child: ChildGuard) -> (i32, String) {
+    let out = child.wait_with_output(Duration::from_secs(60)).unwrap();
     (
         out.status.code().unwrap_or(-1),
         format!(
@@ -145,11 +139,12 @@ fn check_controlled_stop(
 
 #[test]
 fn a_killed_plc_stops_the_machine_with_exit_4() {
-    let instance = format!("sup-kill-{}", std::process::id());
-    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let instance = tests::unique_instance("sup-kill");
+    let scratch = Scratch::new("sup-kill");
+    let trace = scratch.join("trace.csv");
     let child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
-    signal(plc_pid(&instance) as u32, "KILL");
+    assert!(signal(plc_pid(&instance) as u32, "KILL"));
     let (code, report) = finish(child);
     check_controlled_stop(
         &instance,
@@ -163,18 +158,16 @@ fn a_killed_plc_stops_the_machine_with_exit_4() {
 
 #[test]
 fn a_hung_plc_is_reported_after_the_watchdog() {
-    let instance = format!("sup-hang-{}", std::process::id());
-    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let instance = tests::unique_instance("sup-hang");
+    let scratch = Scratch::new("sup-hang");
+    let trace = scratch.join("trace.csv");
     let child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
     let pid = plc_pid(&instance) as u32;
-    signal(pid, "STOP");
+    assert!(signal(pid, "STOP"));
     let (code, report) = finish(child);
     // The CNC killed the hung PLC itself; make sure in any case.
-    let _ = Command::new("kill")
-        .args(["-KILL", &pid.to_string()])
-        .stderr(Stdio::null())
-        .status();
+    let _ = signal(pid, "KILL");
     check_controlled_stop(
         &instance,
         &trace,
@@ -188,11 +181,12 @@ fn a_hung_plc_is_reported_after_the_watchdog() {
 #[test]
 fn sigint_and_sigterm_stop_the_machine_and_write_the_trace() {
     for (name, code) in [("INT", 130), ("TERM", 143)] {
-        let instance = format!("sup-{}-{}", name.to_lowercase(), std::process::id());
-        let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+        let instance = tests::unique_instance(&format!("sup-{}", name.to_lowercase()));
+        let scratch = Scratch::new("sup-signal");
+        let trace = scratch.join("trace.csv");
         let child = start(&instance, &trace);
         wait_for_plc_cycles(&instance, 300);
-        signal(child.id(), name);
+        assert!(child.signal(name));
         let (exit, report) = finish(child);
         check_controlled_stop(
             &instance,
@@ -212,14 +206,15 @@ fn sigint_and_sigterm_stop_the_machine_and_write_the_trace() {
 #[test]
 fn a_second_signal_during_the_stop_ends_at_once_and_still_cleans_up() {
     use std::io::{BufRead, BufReader};
-    let instance = format!("sup-twice-{}", std::process::id());
-    let trace = std::env::temp_dir().join(format!("{instance}.csv"));
+    let instance = tests::unique_instance("sup-twice");
+    let scratch = Scratch::new("sup-twice");
+    let trace = scratch.join("trace.csv");
     let mut child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
     let plc = plc_pid(&instance);
-    signal(child.id(), "INT");
+    assert!(child.signal("INT"));
     // Once the CNC says it stops (the stop takes hundreds of ticks), the second signal.
-    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let mut err = BufReader::new(child.0.stderr.take().unwrap());
     let mut line = String::new();
     while !line.contains("stopping the machine") {
         line.clear();
@@ -228,10 +223,10 @@ fn a_second_signal_during_the_stop_ends_at_once_and_still_cleans_up() {
             "the CNC ended before saying it stops"
         );
     }
-    signal(child.id(), "INT");
+    assert!(child.signal("INT"));
     let mut rest = String::new();
     std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = child.wait_with_output(Duration::from_secs(60)).unwrap();
     assert_eq!(out.status.code(), Some(130), "{rest}");
     assert!(
         rest.contains("SIGINT during the stop: ending at once"),

@@ -4,30 +4,9 @@
 //! `scenarios.rs` checks (the robot on the programmed square of the turning workpiece), and
 //! the program's report shows the handshakes it made.
 
-use std::path::PathBuf;
-use std::process::Command;
-
 fn run(dir: &str, file: &str) -> (String, Vec<u8>) {
-    let tag = format!(
-        "{dir}-{}-{}",
-        file.trim_end_matches(".toml"),
-        std::process::id()
-    );
-    let trace = std::env::temp_dir().join(format!("cli-turntable-{tag}.csv"));
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("../../scenarios/{dir}/{file}"));
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", path.to_str().unwrap(), "--lockstep"])
-        .args(["--instance", &format!("tt-{tag}"), "--trace"])
-        .arg(&trace)
-        .output()
-        .unwrap();
-    let report =
-        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(0), "{report}");
-    let rows = std::fs::read(&trace).unwrap();
-    let _ = std::fs::remove_file(&trace);
-    (report, rows)
+    let path = tests::cli::repo_root().join(format!("scenarios/{dir}/{file}"));
+    tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), &path, "tt")
 }
 
 #[test]

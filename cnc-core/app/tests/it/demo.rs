@@ -1,32 +1,25 @@
 //! `cnc demo`: the embedded machine (four robot channels, a cam station, a flying saw) with a
 //! spawned PLC process, end to end; its report and the files it writes.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
+use tests::{Cli, Scratch};
 
-/// Removes the listings a demo leaves for `cnc diag`.
-fn forget(instance: &str) {
-    let _ = std::fs::remove_dir_all(
-        std::env::temp_dir()
-            .join("cncplc-diag")
-            .join(format!("instance-{instance}")),
-    );
-}
-
-fn demo(extra: &[&str], tag: &str) -> (Output, String, PathBuf) {
-    let out_dir = std::env::temp_dir().join(format!("cnc-demo-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&out_dir);
-    let instance = format!("demo{tag}-{}", std::process::id());
-    let out = Command::new(env!("CARGO_BIN_EXE_cnc"))
+/// A demo run: what it printed, its stdout, and the scratch folder it was told to write to
+/// (`out` inside it, which the demo creates).
+fn demo(extra: &[&str], tag: &str) -> (Output, String, Scratch) {
+    let scratch = Scratch::new(&format!("demo-{tag}"));
+    let instance = tests::unique_instance(&format!("demo{tag}"));
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .arg("demo")
         .args(extra)
         .args(["--instance", &instance, "--out"])
-        .arg(&out_dir)
+        .arg(scratch.join("out"))
         .output()
         .expect("run cnc demo");
-    forget(&instance);
+    // The listings a demo leaves for `cnc diag`.
+    let _ = std::fs::remove_dir_all(cnc_app::diag_cli::finished_dir(&instance));
     let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    (out, stdout, out_dir)
+    (out, stdout, scratch)
 }
 
 fn assert_success(out: &Output, stdout: &str) {
@@ -106,8 +99,7 @@ fn the_whole_machine_runs_through_in_lockstep() {
     );
     assert!(stdout.contains("PLC task: 14500 cycles"), "{stdout}");
     assert!(stdout.contains("overruns 0"), "{stdout}");
-    assert_files(&dir, 14_500);
-    let _ = std::fs::remove_dir_all(dir);
+    assert_files(&dir.join("out"), 14_500);
 }
 
 #[test]
@@ -131,8 +123,7 @@ fn a_shortened_demo_runs_in_real_time() {
     channel_line(&stdout, "master");
     channel_line(&stdout, "turntable");
     assert!(stdout.contains("written to "), "{stdout}");
-    assert_files(&dir, 2_900);
-    let _ = std::fs::remove_dir_all(dir);
+    assert_files(&dir.join("out"), 2_900);
 }
 
 #[test]
@@ -141,5 +132,5 @@ fn bad_arguments_are_refused_and_write_nothing() {
     assert_eq!(out.status.code(), Some(2), "{stdout}");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("--ticks"), "{stderr}");
-    assert!(!dir.exists());
+    assert!(!dir.join("out").exists());
 }

@@ -127,7 +127,7 @@ fn a_running_group_and_its_row_blocks_allocate_nothing() {
     );
     let s = Scenario::parse("no-alloc.toml", &toml, |f| panic!("{f}")).unwrap();
     let mut run = InProcess::new(&s, 0).unwrap();
-    let instance = format!("fifo-no-alloc-{}", std::process::id());
+    let instance = tests::unique_instance("fifo-no-alloc");
     let server = AcyclicServer::open(&instance).unwrap();
     let client = AcyclicClient::open(&instance).unwrap();
     run.step(0.001);

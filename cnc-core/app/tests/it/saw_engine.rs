@@ -34,9 +34,7 @@ fn machine(extra: &str) -> InProcess {
         axis("Saw", "")
     );
     let s = Scenario::parse("saw.toml", &toml, |f| {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../scenarios/cams")
-            .join(f);
+        let path = tests::cli::repo_root().join("scenarios/cams").join(f);
         Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
     })
     .unwrap();

@@ -7,14 +7,9 @@ use hli::enums::DynCsState;
 use kinematics::frame::offset_frame;
 use kinematics::PoseWords;
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
-use std::path::PathBuf;
 
 fn scenario(name: &str) -> Scenario {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenarios")
-        .join(name)
-        .join("scenario.toml");
-    Scenario::load(&path).unwrap_or_else(|e| panic!("{e}"))
+    Scenario::load(&tests::cli::scenario(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Runs until every channel stopped (or `ticks` when given); fails on a channel error or when
