@@ -1,0 +1,394 @@
+//! Table data in chunks, points, reads and the data, multi-table and compatibility scenarios.
+
+use super::*;
+
+#[test]
+fn a_table_of_100000_rows_arrives_in_chunks_and_a_coupling_runs_on_it() {
+    let mut run = machine("");
+    run.step(0.001);
+    let total = 100_000;
+    let rows: Vec<[f64; 2]> = (0..total)
+        .map(|i| {
+            [
+                i as f64 * 0.0036,
+                5.0 * (i as f64 / (total - 1) as f64 * std::f64::consts::TAU).sin(),
+            ]
+        })
+        .collect();
+    let chunks: Vec<&[[f64; 2]]> = rows.chunks(hli::calls::cam::CAM_ROWS_PER_CALL).collect();
+    for (k, chunk) in chunks.iter().enumerate() {
+        let first = k * hli::calls::cam::CAM_ROWS_PER_CALL;
+        let last = k + 1 == chunks.len();
+        let reply = dispatch_raw(&mut run, 5, &rows_chunk(chunk, first, total, last));
+        let reply: CamReply = bytemuck::pod_read_unaligned(&reply);
+        assert_eq!(reply.error_id, 0, "chunk {k}");
+        if k % 1000 == 0 {
+            // The machine ticks on between chunks: the upload never holds a tick up.
+            run.step(0.001);
+        }
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(5)), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..3000 {
+        run.step(0.001);
+        assert!(run.machine.axes().axis(SLAVE).unwrap().error().is_none());
+    }
+    // The slave follows the uploaded wave (period 360, amplitude 5).
+    let m = set(&run, MASTER).position;
+    let expected = 5.0 * ((m.rem_euclid(360.0)) / 360.0 * std::f64::consts::TAU).sin();
+    assert!(
+        (set(&run, SLAVE).position - expected).abs() < 1e-3,
+        "{} vs {expected}",
+        set(&run, SLAVE).position
+    );
+    // A coupled table is not replaced.
+    let one = rows_chunk(&rows[..13], 0, 13, true);
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 5, &one));
+    assert_eq!(reply.error_id, CamCouplingError::TableInUse.raw());
+}
+
+#[test]
+fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
+    let mut run = machine("");
+    run.step(0.001);
+    let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.0]).collect();
+    let first = rows_chunk(&rows[..13], 0, 26, false);
+    let skipped = rows_chunk(&rows[..13], 20, 26, true);
+    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
+    };
+    assert_eq!(answer(&mut run, &first), 0);
+    assert_eq!(
+        answer(&mut run, &skipped),
+        CamCouplingError::ChunkOutOfOrder.raw()
+    );
+    // Nothing was stored: table 7 does not exist.
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(7)), 0x4B32);
+    // A table whose masters do not rise: refused with the table code, nothing stored.
+    let mut bad = rows.clone();
+    bad[5][0] = 1.0;
+    assert_eq!(answer(&mut run, &rows_chunk(&bad[..13], 0, 26, false)), 0);
+    let reply = answer(&mut run, &rows_chunk(&bad[13..], 13, 26, true));
+    assert!((0x4B30..=0x4B38).contains(&reply), "{reply:#x}");
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(7)), 0x4B32);
+}
+
+#[test]
+fn points_read_back_and_a_refused_write_leaves_the_function() {
+    use hli::calls::cam::{
+        CamPointsReadCall, CamPointsReply, CamPointsWriteCall, McMotionFunctionPoint,
+    };
+    let mut run = machine("");
+    run.step(0.001);
+    let read = |run: &mut InProcess, first: u32| -> CamPointsReply {
+        bytemuck::pod_read_unaligned(&dispatch_raw(
+            run,
+            1,
+            &CamPointsReadCall { first, count: 0 },
+        ))
+    };
+    let r = read(&mut run, 1);
+    assert_eq!((r.error_id, r.count, r.total), (0, 4, 6));
+    assert_eq!(r.points[3].master_pos, 240.0);
+    assert_eq!(r.points[3].slave_pos, 40.0);
+    let r = read(&mut run, 5);
+    assert_eq!((r.count, r.points[1].master_pos), (2, 360.0));
+    assert_eq!(read(&mut run, 7).error_id, 0x4B33);
+    // A point whose master position breaks the monotonic order: refused whole.
+    let mut p4: McMotionFunctionPoint = read(&mut run, 4).points[0];
+    p4.master_pos = 400.0;
+    let mut points = [McMotionFunctionPoint::default(); 4];
+    points[0] = p4;
+    let write = CamPointsWriteCall {
+        first: 4,
+        count: 1,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert!(
+        (0x4B30..=0x4B38).contains(&reply.error_id),
+        "{:#x}",
+        reply.error_id
+    );
+    run.step(0.001);
+    assert_eq!(read(&mut run, 4).points[0].master_pos, 240.0);
+    // A good one applies (instantaneous mode, nothing coupled).
+    points[0].master_pos = 250.0;
+    let write = CamPointsWriteCall { points, ..write };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert_eq!(reply.error_id, 0);
+    run.step(0.001);
+    assert_eq!(read(&mut run, 4).points[0].master_pos, 250.0);
+}
+
+#[test]
+fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
+    use hli::calls::cam::{
+        CamReadCall, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
+        CAM_READ_VALUES,
+    };
+    let mut run = machine("");
+    run.step(0.001);
+    let seed = seed_cam();
+    // Slave dynamics of the motion function: position, velocity, acceleration of the raw cam.
+    let (v, _) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_SLAVE_DYNAMICS,
+            a: 90.0,
+            ..Default::default()
+        },
+    );
+    let s = seed.eval(90.0, &mut ProfileCursor::default());
+    assert_eq!(v, vec![s.position, s.velocity, s.acceleration]);
+    // An equidistant table gives no acceleration (seed 5.1.7).
+    let (v, _) = read_all(
+        &mut run,
+        2,
+        CamReadCall {
+            what: CAM_READ_SLAVE_DYNAMICS,
+            a: 100.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v[2], 0.0);
+    assert!(v[1] != 0.0);
+    // Characteristics: the 31 values of MC_TableCharacValues, in two parts.
+    let (v, _) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_CHARACTERISTICS,
+            ..Default::default()
+        },
+    );
+    let expected: Vec<f64> = cnc_core::cam::CharacValues::normed(&seed)
+        .fields()
+        .iter()
+        .map(|(_, v)| *v)
+        .collect();
+    assert_eq!(v, expected);
+    // A value table of position and velocity from 0 to 360 in steps of 10: 37 rows of 3.
+    let (v, columns) = read_all(
+        &mut run,
+        1,
+        CamReadCall {
+            what: CAM_READ_VALUES,
+            mask: 3,
+            a: 0.0,
+            b: 360.0,
+            c: 10.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!((v.len(), columns), (111, 3));
+    for row in v.chunks(3) {
+        let s = seed.eval(row[0], &mut ProfileCursor::default());
+        assert_eq!([row[1], row[2]], [s.position, s.velocity], "at {}", row[0]);
+    }
+    // The coupling info of a scaled coupling, at a master position given.
+    let scaled = CamInCall {
+        slave_scaling: 2.0,
+        slave_offset: 1.0,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, scaled), 0);
+    run.step(0.001);
+    let (v, _) = read_all(
+        &mut run,
+        SLAVE as u32,
+        CamReadCall {
+            what: CAM_READ_INFO,
+            flags: 1,
+            a: 90.0,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v.len(), 40);
+    assert_eq!(v[0], 1.0, "table");
+    assert_eq!(v[1], 22.0, "a motion function");
+    assert_eq!((v[4], v[5]), (6.0, 1.0), "points, columns");
+    assert_eq!((v[6], v[8]), (0.0, 360.0), "master start, period");
+    assert_eq!((v[15], v[17]), (1.0, 2.0), "slave offset, scaling");
+    assert_eq!(v[20], 90.0, "at the master position given");
+    assert_eq!(
+        v[21],
+        1.0 + 2.0 * s_at(&seed, 90.0),
+        "slave set-point there"
+    );
+    assert_eq!(v[22], 90.0, "cam master coordinate");
+    // Not coupled: refused.
+    let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+        &mut run,
+        2,
+        &CamReadCall {
+            what: CAM_READ_INFO,
+            ..Default::default()
+        },
+    ));
+    assert_eq!(reply.error_id, CamCouplingError::NotCamCoupled.raw());
+}
+
+fn s_at(p: &CamProfile, x: f64) -> f64 {
+    p.eval(x, &mut ProfileCursor::default()).position
+}
+
+/// The numbers of a read block in the PLC's report.
+fn read_values(report: &str, instance: &str) -> Vec<f64> {
+    let mut lines = report.lines();
+    lines
+        .find(|l| l.starts_with(&format!("block {instance} ")))
+        .unwrap_or_else(|| panic!("no block {instance}\n{report}"));
+    let line = lines.next().unwrap_or("");
+    let (_, values) = line
+        .split_once(": ")
+        .unwrap_or_else(|| panic!("{instance}: {line}"));
+    values
+        .split(", ")
+        .filter(|v| *v != "...")
+        .map(|v| v.parse().unwrap())
+        .collect()
+}
+
+#[test]
+fn the_data_scenario_loads_reads_and_writes_through_the_blocks() {
+    let s = Scenario::load(&scenarios().join("cam-data/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut followed = 0;
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        if phase(&run, SLAVE) == AxisState::SlaveSynchronous {
+            // The uploaded zigzag (0, 10, 0, -10, 0 every 90 degrees), linear, cyclic.
+            let m = set(&run, MASTER).position.rem_euclid(360.0);
+            let expected = match m {
+                x if x < 90.0 => x / 9.0,
+                x if x < 270.0 => 10.0 - (x - 90.0) / 9.0,
+                x => -10.0 + (x - 270.0) / 9.0,
+            };
+            assert!(
+                (set(&run, SLAVE).position - expected).abs() < 1e-9,
+                "at {m}"
+            );
+            followed += 1;
+        }
+    }
+    assert!(followed > 1000);
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    let seed = seed_cam();
+    let s90 = seed.eval(90.0, &mut ProfileCursor::default());
+    assert_eq!(
+        read_values(&report, "dynamics"),
+        vec![s90.position, s90.velocity, s90.acceleration]
+    );
+    // Positions every 45 degrees: 9 rows of master and slave (the first 12 numbers shown).
+    let values = read_values(&report, "values");
+    for row in values.chunks(2) {
+        assert_eq!(
+            row[1],
+            seed.eval(row[0], &mut ProfileCursor::default()).position
+        );
+    }
+    // Point 4 after MC_WriteMotionFunction: index, master, slave.
+    assert_eq!(read_values(&report, "point4"), vec![4.0, 240.0, 30.0]);
+    // MC_CamInfo: table 3, equidistant (10), cyclic, linear, 5 rows of 2 columns.
+    assert_eq!(
+        read_values(&report, "info")[..6],
+        [3.0, 10.0, 1.0, 0.0, 5.0, 2.0]
+    );
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+}
+
+#[test]
+fn the_multi_table_scenario_runs_start_work_correction_and_stop_tables() {
+    let s = Scenario::load(&scenarios().join("cam-multi-table/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    // By hand: the start table 0.2 per unit to 100; the work table 0.4 per unit from 20;
+    // the correction bump (+0.2 per unit for 10, back for 10) from 350; the work table ends
+    // at its boundary at 500 (the stop came at about 489) and the stop table adds 0.2 per
+    // unit for 50 units from 180; then the feeder stands at 190.
+    let bump = |d: f64| match d {
+        d if (0.0..10.0).contains(&d) => 0.2 * d,
+        d if (10.0..20.0).contains(&d) => 2.0 - 0.2 * (d - 10.0),
+        _ => 0.0,
+    };
+    let expected = |pm: f64| match pm {
+        pm if pm < 100.0 => 0.2 * pm,
+        pm if pm < 500.0 => 20.0 + 0.4 * (pm - 100.0) + bump(pm - 350.0),
+        pm if pm < 550.0 => 180.0 + 0.2 * (pm - 500.0),
+        _ => 190.0,
+    };
+    let mut coupled_ticks = 0;
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let feeder = run.machine.axes().axis(SLAVE).unwrap();
+        if feeder.coupling().map(|c| c.kind) != Some(CouplingState::Cam) {
+            continue;
+        }
+        coupled_ticks += 1;
+        let pm = set(&run, MASTER).position;
+        let f = set(&run, SLAVE).position;
+        assert!(
+            (f - expected(pm)).abs() < 1e-9,
+            "line {pm}: feeder {f}, expected {}",
+            expected(pm)
+        );
+    }
+    assert!(coupled_ticks > 7000, "{coupled_ticks}");
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    assert_eq!(set(&run, SLAVE).position, 190.0);
+}
+
+#[test]
+fn the_compatibility_blocks_make_read_couple_rescale_and_delete() {
+    let s = Scenario::load(&scenarios().join("cam-compat/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    // The generated zigzag, linear: +-9 per turn, doubled, shifted by 0.5 from tick 1500.
+    let zigzag = |m: f64| {
+        let m = m.rem_euclid(360.0);
+        match m {
+            m if m < 90.0 => m / 10.0,
+            m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
+            m => -9.0 + (m - 270.0) / 10.0,
+        }
+    };
+    let mut checked = 0;
+    for tick in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let coupled = run.machine.axes().axis(SLAVE).unwrap().coupling().is_some();
+        if coupled && (1600..3000).contains(&tick) {
+            let m = set(&run, MASTER).position;
+            let expected = 0.5 + 2.0 * zigzag(m);
+            assert!(
+                (set(&run, SLAVE).position - expected).abs() < 1e-9,
+                "tick {tick}, drum {m}"
+            );
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 1400);
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert_eq!(
+        read_values(&report, "read"),
+        vec![0.0, 0.0, 40.0, 4.0, 100.0, 5.0]
+    );
+    // Non-equidistant: the slave position only (seed 5.1.7).
+    assert_eq!(read_values(&report, "slavepos"), vec![2.0, 0.0, 0.0]);
+    for (done, kind) in [
+        ("release", "CamTableCoupleAxes"),
+        ("delete21", "CamTableDelete"),
+        ("delete22", "CamTableDelete"),
+    ] {
+        assert!(
+            report.contains(&format!("block {done} ({kind} on gpAx[1]): Done")),
+            "{report}"
+        );
+    }
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+}

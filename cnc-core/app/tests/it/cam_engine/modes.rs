@@ -1,0 +1,303 @@
+//! Actual-value masters, scaling activation modes, coupling starts and online point changes.
+
+use super::*;
+
+#[test]
+fn a_slave_may_follow_the_masters_actual_position() {
+    let mut run = machine("");
+    run.step(0.001);
+    let actual = CamInCall {
+        master_source: 1,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, actual), 0);
+    run_master(&mut run, 360.0);
+    let law = CamLaw::new(
+        &seed_cam(),
+        Scaling::default(),
+        CamStartMode::Absolute,
+        false,
+        0.0,
+        0.0,
+    );
+    let profile = seed_cam();
+    let mut differs = 0;
+    for _ in 0..300 {
+        run.step(0.001);
+        let master = run.machine.axes().axis(MASTER).unwrap();
+        let on_actual = law_at(
+            &law,
+            &profile,
+            Kinematic {
+                position: master.actual(),
+                ..Kinematic::default()
+            },
+        );
+        assert!((set(&run, SLAVE).position - on_actual.position).abs() < 1e-9);
+        let on_set = law_at(&law, &profile, master.setpoint());
+        differs += usize::from((on_set.position - on_actual.position).abs() > 1e-6);
+    }
+    assert!(
+        differs > 100,
+        "the actual position lags the set-point: {differs}"
+    );
+    let bad = CamInCall {
+        master_source: 2,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, 2, bad), CamCouplingError::BadParameter.raw());
+}
+
+#[test]
+fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
+    use hli::calls::cam::CamScalingCall;
+    // (mode, position, the master position from which the new scaling must show)
+    let cases = [
+        (0u32, 0.0, 0.0),
+        (1, 200.0, 200.0),
+        (2, 560.0, 560.0),
+        (3, 0.0, 360.0),
+    ];
+    for (mode, position, from) in cases {
+        let mut run = machine("");
+        run.step(0.001);
+        select_cyclic(&mut run, 1);
+        assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+        run_master(&mut run, 360.0);
+        for _ in 0..400 {
+            run.step(0.001);
+        }
+        let m0 = set(&run, MASTER).position;
+        // Slave scaling 0.5 with slave auto-offset: no jump at the activation.
+        let scaling = CamScalingCall {
+            activation_mode: mode,
+            activation_position: position,
+            master_scaling_mode: 2,
+            slave_scaling_mode: 1,
+            master_scaling: 1.0,
+            slave_scaling: 0.5,
+            ..CamScalingCall::default()
+        };
+        assert_eq!(call(&mut run, SLAVE as u32, scaling), 0, "mode {mode}");
+        let law = CamLaw::new(
+            &seed_cam(),
+            Scaling::default(),
+            CamStartMode::Absolute,
+            true,
+            0.0,
+            0.0,
+        );
+        let profile = seed_cam();
+        let mut last = set(&run, SLAVE).position;
+        let mut switched_at = None;
+        for _ in 0..1500 {
+            run.step(0.001);
+            let m = set(&run, MASTER);
+            let p = set(&run, SLAVE).position;
+            assert!(
+                (p - last).abs() < 0.35,
+                "mode {mode}: jump {} at {}",
+                p - last,
+                m.position
+            );
+            last = p;
+            let full = law_at(&law, &profile, m).position;
+            if switched_at.is_none() && (p - full).abs() > 1e-9 {
+                switched_at = Some(m.position);
+            }
+        }
+        let at = switched_at.unwrap_or_else(|| panic!("mode {mode} never took effect"));
+        // The master was at m0 when the command came; the change shows from `from` on (within
+        // the cam's flat stretches it cannot show earlier than it is seen).
+        // AtMasterCamPos: the first time after the command that the master's place in the
+        // cam is `position` (in absolute master terms).
+        let due = match mode {
+            0 => m0,
+            1 => m0 + (position - m0.rem_euclid(360.0)).rem_euclid(360.0),
+            _ => from,
+        };
+        assert!(
+            at >= due - 1e-9,
+            "mode {mode}: took effect at {at}, due at {due}"
+        );
+        assert!(
+            at < due + 60.0,
+            "mode {mode}: took effect at {at}, due at {due}"
+        );
+    }
+}
+
+#[test]
+fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
+    // (activation mode, position, start mode, expected: Ok(master position of the start) or
+    // Err(code))
+    let relative = CamCouplingError::ModeCombination.raw();
+    let cases: [(u32, f64, u32, Result<f64, u32>); 4] = [
+        (1, 100.0, 1, Ok(100.0)),
+        (3, 0.0, 1, Ok(360.0)),
+        (1, 100.0, 2, Err(relative)),
+        (3, 0.0, 4, Err(relative)),
+    ];
+    for (mode, position, start, expected) in cases {
+        let mut run = machine("");
+        run.step(0.001);
+        select_cyclic(&mut run, 1);
+        let coupling = CamInCall {
+            extended: 1,
+            activation_mode: mode,
+            activation_position: position,
+            start_mode: start,
+            ..cam_in(1)
+        };
+        let reply = call(&mut run, SLAVE as u32, coupling);
+        match expected {
+            Err(code) => {
+                assert_eq!(reply, code, "mode {mode} start {start}");
+                assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+                continue;
+            }
+            Ok(from) => {
+                assert_eq!(reply, 0, "mode {mode}");
+                run_master(&mut run, 360.0);
+                let mut started = None;
+                for _ in 0..1500 {
+                    run.step(0.001);
+                    if phase(&run, SLAVE) == AxisState::SlaveSynchronous {
+                        started.get_or_insert(set(&run, MASTER).position);
+                    } else {
+                        assert_eq!(set(&run, SLAVE).position, 0.0, "holds while waiting");
+                    }
+                }
+                let at = started.unwrap_or_else(|| panic!("mode {mode} never started"));
+                assert!(
+                    (from..from + 0.5).contains(&at),
+                    "mode {mode}: started at {at}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_first_chunk_drops_an_unfinished_transfer() {
+    let mut run = machine("");
+    run.step(0.001);
+    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
+    };
+    let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.5 * i as f64]).collect();
+    // A transfer left half-done (the PLC re-triggered its block) ...
+    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    // ... does not block the next one, which starts over.
+    let whole: Vec<[f64; 2]> = (0..13).map(|i| [i as f64 * 10.0, 1.0]).collect();
+    assert_eq!(answer(&mut run, &rows_chunk(&whole, 0, 13, true)), 0);
+    let (v, _) = read_all(
+        &mut run,
+        7,
+        hli::calls::cam::CamReadCall {
+            what: hli::calls::cam::CAM_READ_ROWS,
+            ..Default::default()
+        },
+    );
+    assert_eq!(v.len(), 26);
+    assert_eq!((v[2], v[3]), (10.0, 1.0));
+}
+
+#[test]
+fn a_slave_coupled_later_starts_in_the_base_cycle() {
+    let mut run = machine("");
+    run.step(0.001);
+    let rows: Vec<[f64; 2]> = (0..=36)
+        .map(|i| [i as f64 * 10.0, i as f64 * 10.0 / 36.0])
+        .collect();
+    for (k, chunk) in rows.chunks(hli::calls::cam::CAM_ROWS_PER_CALL).enumerate() {
+        let first = k * hli::calls::cam::CAM_ROWS_PER_CALL;
+        let call = rows_chunk(chunk, first, rows.len(), first + chunk.len() == rows.len());
+        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 9, &call));
+        assert_eq!(reply.error_id, 0);
+    }
+    run_master(&mut run, 360.0);
+    for _ in 0..1500 {
+        run.step(0.001);
+    }
+    // The master is more than a turn on; coupled now, the slave takes the cam's value at
+    // the master's place in its turn, without the strokes of the turns before (seed 5.1.4).
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(9)), 0);
+    run.step(0.001);
+    let m = set(&run, MASTER).position;
+    assert!(m > 400.0, "{m}");
+    let expected = m.rem_euclid(360.0) / 36.0;
+    assert!(
+        (set(&run, SLAVE).position - expected).abs() < 1e-9,
+        "slave {} at master {m}, expected {expected}",
+        set(&run, SLAVE).position
+    );
+}
+
+#[test]
+fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
+    use hli::calls::cam::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    // Two slaves on table 1: the lifter, and the third axis 20 degrees ahead.
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+    let ahead = CamInCall {
+        master_offset: 20.0,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, 2, ahead), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..500 {
+        run.step(0.001);
+    }
+    let mode = CamOnlineModeCall {
+        activation_mode: 5,
+        ..Default::default()
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &mode));
+    assert_eq!(reply.error_id, 0);
+    // Point 4 (the fall's start, 240) from 40 to 30: the segments from 30 to 340 change (the
+    // rise's end slope too), so both slaves are clear of them only while the lifter is
+    // between 340 and 10 degrees.
+    let mut points = [McMotionFunctionPoint::default(); 4];
+    points[0] = McMotionFunctionPoint {
+        point_index: 4,
+        function_type: 15,
+        point_type: 2,
+        rel_index_next_point: 1,
+        master_pos: 240.0,
+        slave_pos: 30.0,
+        ..Default::default()
+    };
+    let write = CamPointsWriteCall {
+        first: 4,
+        count: 1,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    };
+    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+    assert_eq!(reply.error_id, 0);
+    let mut last = [set(&run, SLAVE).position, set(&run, 2).position];
+    let mut top = [0.0f64; 2];
+    for tick in 0..2000 {
+        run.step(0.001);
+        for (k, axis) in [SLAVE, 2].into_iter().enumerate() {
+            let p = set(&run, axis).position;
+            assert!(
+                (p - last[k]).abs() < 0.35,
+                "axis {axis} jumped {} at tick {tick}",
+                p - last[k]
+            );
+            last[k] = p;
+            if tick >= 1000 {
+                top[k] = top[k].max(p);
+            }
+        }
+    }
+    // The change came (the tops are now about 31, no longer about 42) without a jump.
+    for t in top {
+        assert!(t > 25.0 && t < 35.0, "top {t}");
+    }
+}
