@@ -214,6 +214,7 @@ fn a_division_by_zero_at_run_time_fails_the_channel_without_allocating() {
         )))
     );
     assert_eq!(error.to_string(), "division by zero");
+    assert_eq!(error.line, 5, "the line of the failing block");
     assert_eq!(made, 0, "{made} allocations while the channel failed");
 }
 
@@ -226,6 +227,7 @@ fn an_unassigned_variable_at_run_time_fails_the_channel_without_allocating() {
         error.to_string(),
         "variable \"V.P.DEPTH\" is read before it is assigned"
     );
+    assert_eq!(error.line, 4, "the line of the failing block");
     assert_eq!(made, 0, "{made} allocations while the channel failed");
 }
 
@@ -237,5 +239,6 @@ fn a_tracking_refused_at_run_time_fails_the_channel_without_allocating() {
     let (error, made) = fail_in_the_tick(program);
     assert_eq!(error.id, hli::enums::ChannelErrorId::Tracking);
     assert!(error.to_string().starts_with("#TRACK CS ON: "), "{error}");
+    assert_eq!(error.line, 3, "the line of the failing block");
     assert_eq!(made, 0, "{made} allocations while the channel failed");
 }

@@ -189,6 +189,15 @@ impl Channel {
             // The channel's values are a running machine's: nothing is undecided here.
             Ok(Step::Control | Step::Undecided) => true,
             Err(e) => {
+                // The failing block's line (not the last one that ran): the block whose span
+                // holds the error's, found by bisection (nothing allocated).
+                if let Some(unit) = program.set.units.get(e.unit as usize) {
+                    let blocks = &unit.tree.blocks;
+                    let after = blocks.partition_point(|b| b.span.start <= e.span.start);
+                    if let Some(b) = after.checked_sub(1).and_then(|i| blocks.get(i)) {
+                        self.run.line = b.line;
+                    }
+                }
                 self.fail(ChannelFault::Program(e.fault));
                 false
             }
