@@ -20,7 +20,7 @@ use cnc_core::fifo::{FifoGenerator, FifoParams, OverrideFilter, OverrideType, Ro
 use cnc_core::machine::fifo::FifoEngine;
 use cnc_core::machine::{Machine, MachineSetup};
 use hli::calls::fifo::{
-    FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoRowsHeader, FifoStartCall,
+    rows_header, FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall,
 };
 use hli::calls::AcyclicCall;
 use hli::rpc::{AcyclicClient, AcyclicServer};
@@ -82,13 +82,11 @@ fn row(k: usize) -> [f64; N] {
 
 fn refill(machine: &mut Machine, next: &mut usize, rows: usize) {
     let values: Vec<f64> = (*next..*next + rows).flat_map(row).collect();
-    let header = FifoRowsHeader {
-        group: 0,
-        columns: N as u32,
-        rows: rows as u32,
-        overwrite: 0,
-    };
-    assert_eq!(machine.dispatch_rows(&header, &values).error_id, 0);
+    let header = rows_header(0, N as u32, rows as u32, false);
+    let kind = hli::calls::CallKind::FIFO_WRITE_ROWS;
+    let (body, len) = machine.dispatch_bulk(kind, &header, &values).unwrap();
+    let reply: FifoReply = bytemuck::pod_read_unaligned(&body[..len as usize]);
+    assert_eq!(reply.error_id, 0);
     *next += rows;
 }
 
@@ -185,12 +183,7 @@ fn tick_cost() {
 /// The child: sends `BLOCKS` blocks, prints the elapsed ns.
 fn client(instance: &str) {
     let mut client = AcyclicClient::open(instance).expect("client");
-    let header = FifoRowsHeader {
-        group: 0,
-        columns: N as u32,
-        rows: BLOCK_ROWS as u32,
-        overwrite: 0,
-    };
+    let header = rows_header(0, N as u32, BLOCK_ROWS as u32, false);
     let start = Instant::now();
     for b in 0..BLOCKS {
         let mut loan = client.loan_rows(header, BLOCK_ROWS * N).expect("loan");
@@ -199,7 +192,7 @@ fn client(instance: &str) {
         }
         let pending = loan.send().expect("send");
         loop {
-            match pending.poll() {
+            match pending.poll::<FifoReply>() {
                 Some(Ok(reply)) => {
                     assert_eq!(reply.error_id, 0, "block {b}: {reply:?}");
                     break;
@@ -227,16 +220,16 @@ fn transfer(engine: bool, run: usize) -> f64 {
     while answered < BLOCKS {
         answered += if engine {
             server
-                .poll_rows(|h, v| machine.dispatch_rows(h, v))
+                .poll_rows(|k, h, v| machine.dispatch_bulk(k, h, v))
                 .expect("poll")
         } else {
             server
-                .poll_rows(|_, v| {
+                .poll_rows(|_, _, v| {
                     seen += v[0];
-                    FifoReply {
+                    hli::calls::reply(&FifoReply {
                         row: BLOCK_ROWS as u32,
                         ..FifoReply::default()
-                    }
+                    })
                 })
                 .expect("poll")
         };

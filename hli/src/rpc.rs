@@ -1,13 +1,14 @@
 //! The transport of the acyclic ADS-like calls from the PLC to the CNC: an iceoryx2
 //! request-response service carrying the frames of [`crate::wire`], one call per PLC block
-//! Execute edge (table writes, coupling commands, FIFO row blocks, reads of characteristic
-//! values...). The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
+//! Execute edge (table writes, coupling commands, reads of characteristic values...), and bulk
+//! calls whose numbers are written straight into shared memory (FIFO row blocks). The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
 //! and its families; this module is the transport alone. The CNC-side handlers live with the CNC's view
 //! ([`crate::views::handle_read_axis_state`]) and in the engines.
 
-use crate::calls::fifo::{FifoReply, FifoRowsHeader, FIFO_BLOCK_VALUES};
 use crate::calls::{AcyclicCall, CallError, CallKind, ErrorCode, HandlerResult};
-use crate::wire::{encode_body, AcyclicRequest, AcyclicResponse, ACYCLIC_BODY_SIZE};
+use crate::wire::{
+    encode_body, AcyclicRequest, AcyclicResponse, BulkHeader, ACYCLIC_BODY_SIZE, BULK_MAX_VALUES,
+};
 use core::time::Duration;
 use iceoryx2::node::Node;
 use iceoryx2::port::client::Client;
@@ -20,17 +21,22 @@ pub fn service_name(instance: &str) -> String {
     format!("cncplc/{instance}/acyclic")
 }
 
-/// Service name of an instance's FIFO row blocks.
+/// Service name of an instance's bulk calls (FIFO row blocks).
 pub fn rows_service_name(instance: &str) -> String {
     format!("cncplc/{instance}/fifo-rows")
 }
 
 type AcyclicClientPort = Client<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
 type AcyclicServerPort = Server<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
-type RowsClientPort = Client<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
-type RowsServerPort = Server<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
-type RowsPendingPort =
-    iceoryx2::pending_response::PendingResponse<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
+type RowsClientPort = Client<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
+type RowsServerPort = Server<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
+type RowsPendingPort = iceoryx2::pending_response::PendingResponse<
+    ipc::Service,
+    [f64],
+    BulkHeader,
+    AcyclicResponse,
+    (),
+>;
 
 fn transport(e: impl core::fmt::Debug) -> CallError {
     CallError::Transport(format!("{e:?}"))
@@ -47,8 +53,8 @@ type CallsService = iceoryx2::service::port_factory::request_response::PortFacto
 type RowsService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
     [f64],
-    FifoRowsHeader,
-    FifoReply,
+    BulkHeader,
+    AcyclicResponse,
     (),
 >;
 
@@ -81,8 +87,8 @@ fn open_service(node: &Node<ipc::Service>, instance: &str) -> Result<CallsServic
 
 fn open_rows_service(node: &Node<ipc::Service>, instance: &str) -> Result<RowsService, CallError> {
     node.service_builder(&name_of(rows_service_name(instance))?)
-        .request_response::<[f64], FifoReply>()
-        .request_user_header::<FifoRowsHeader>()
+        .request_response::<[f64], AcyclicResponse>()
+        .request_user_header::<BulkHeader>()
         // A few FiFoWrite/FiFoOverwrite instances per group, each with one block on its way.
         .max_active_requests_per_client(16)
         .max_loaned_requests(4)
@@ -121,7 +127,7 @@ impl AcyclicClient {
             |calls| calls.client_builder().create(),
             |rows| {
                 rows.client_builder()
-                    .initial_max_slice_len(FIFO_BLOCK_VALUES)
+                    .initial_max_slice_len(BULK_MAX_VALUES)
                     .create()
             },
         )?;
@@ -133,26 +139,22 @@ impl AcyclicClient {
         })
     }
 
-    /// Loans a row block of `values` values in the shared memory the CNC will read: the PLC
+    /// Loans a bulk call of `values` values in the shared memory the CNC will read: the PLC
     /// computes its rows straight into it ([`RowsLoan::values_mut`]) and sends it whole
     /// ([`RowsLoan::send`]). A loan that is dropped, or whose process dies before the send,
     /// never reaches the CNC: there is no half block.
-    pub fn loan_rows(
-        &mut self,
-        header: FifoRowsHeader,
-        values: usize,
-    ) -> Result<RowsLoan, CallError> {
+    pub fn loan_rows(&mut self, header: BulkHeader, values: usize) -> Result<RowsLoan, CallError> {
         let mut loan = self.rows.loan_slice(values).map_err(transport)?;
         *loan.user_header_mut() = header;
         Ok(RowsLoan { loan })
     }
 
-    /// Sends a FIFO row block (`FiFoWrite`, `FiFoOverwrite`): `values` holds
+    /// Sends a bulk call (a FIFO row block: `FiFoWrite`, `FiFoOverwrite`): `values` holds
     /// `header.rows x header.columns` values, row after row, and is written once, straight
     /// into the shared memory the CNC reads it from. Poll the returned [`PendingRows`].
     pub fn start_rows(
         &mut self,
-        header: FifoRowsHeader,
+        header: BulkHeader,
         values: &[f64],
     ) -> Result<PendingRows, CallError> {
         let mut loan = self
@@ -259,23 +261,28 @@ fn decode_response<C: AcyclicCall>(
             C::KIND.raw()
         )));
     }
+    decode_reply_body(response)
+}
+
+/// The body of an answered response as `R`, or its refusal.
+fn decode_reply_body<R: bytemuck::Pod>(response: &AcyclicResponse) -> Result<R, CallError> {
     if response.error_code != 0 {
         let code = ErrorCode::decode(response.error_code)
             .map_err(|e| CallError::Malformed(e.to_string()))?;
         return Err(CallError::Refused { code });
     }
     let len = response.body_len as usize;
-    if len != core::mem::size_of::<C::Reply>() {
+    if len != core::mem::size_of::<R>() {
         return Err(CallError::Malformed(format!(
             "reply body of {len} bytes, expected {}",
-            core::mem::size_of::<C::Reply>()
+            core::mem::size_of::<R>()
         )));
     }
     Ok(bytemuck::pod_read_unaligned(&response.body[..len]))
 }
 
 type RowsLoanPort =
-    iceoryx2::request_mut::RequestMut<ipc::Service, [f64], FifoRowsHeader, FifoReply, ()>;
+    iceoryx2::request_mut::RequestMut<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
 
 /// A row block being written in place (see [`AcyclicClient::loan_rows`]).
 pub struct RowsLoan {
@@ -301,13 +308,16 @@ pub struct PendingRows {
 }
 
 impl PendingRows {
-    /// The CNC's reply once it has answered, `None` while it has not.
-    pub fn poll(&self) -> Option<Result<FifoReply, CallError>> {
-        match self.pending.receive() {
-            Ok(Some(response)) => Some(Ok(*response.payload())),
-            Ok(None) => None,
-            Err(e) => Some(Err(transport(e))),
-        }
+    /// The CNC's reply, decoded as `R` (the reply body of the bulk call's kind), once it has
+    /// answered; `None` while it has not.
+    pub fn poll<R: bytemuck::Pod>(&self) -> Option<Result<R, CallError>> {
+        let response = match self.pending.receive() {
+            Ok(Some(response)) => response,
+            Ok(None) => return None,
+            Err(e) => return Some(Err(transport(e))),
+        };
+        let response: &AcyclicResponse = response.payload();
+        Some(decode_reply_body(response))
     }
 }
 
@@ -334,27 +344,27 @@ impl AcyclicServer {
         })
     }
 
-    /// Answers every pending row block with `handler(header, values)`; a block whose
-    /// payload is not `rows x columns` values is refused as a wrong column count before the
-    /// handler sees it. Returns how many blocks were answered.
+    /// Answers every pending bulk call with `handler(kind, header, values)`. An unknown kind
+    /// is refused with [`ErrorCode::ServiceNotSupported`] and a payload that is not
+    /// `rows x columns` values with [`ErrorCode::InvalidSize`], before the handler sees them.
+    /// Returns how many calls were answered.
     pub fn poll_rows(
         &self,
-        mut handler: impl FnMut(&FifoRowsHeader, &[f64]) -> FifoReply,
+        mut handler: impl FnMut(CallKind, &BulkHeader, &[f64]) -> HandlerResult,
     ) -> Result<usize, CallError> {
         let mut answered = 0;
         while let Some(active) = self.rows.receive().map_err(transport)? {
             let header = *active.user_header();
             let values: &[f64] = active.payload();
             let expected = (header.rows as usize).checked_mul(header.columns as usize);
-            let reply = if expected == Some(values.len()) {
-                handler(&header, values)
-            } else {
-                FifoReply {
-                    error_id: crate::enums::FifoError::Columns.raw(),
-                    ..FifoReply::default()
-                }
+            let result = match CallKind::decode(header.kind) {
+                None => Err(ErrorCode::ServiceNotSupported),
+                Some(_) if expected != Some(values.len()) => Err(ErrorCode::InvalidSize),
+                Some(kind) => handler(kind, &header, values),
             };
-            active.send_copy(reply).map_err(transport)?;
+            active
+                .send_copy(response(0, header.kind, result))
+                .map_err(transport)?;
             answered += 1;
         }
         Ok(answered)
@@ -374,21 +384,26 @@ impl AcyclicServer {
                 Some(kind) => handler(kind, request),
                 None => Err(ErrorCode::ServiceNotSupported),
             };
-            let (error_code, body, body_len) = match result {
-                Ok((body, len)) => (0, body, len),
-                Err(code) => (code.raw(), [0u8; ACYCLIC_BODY_SIZE], 0),
-            };
             active
-                .send_copy(AcyclicResponse {
-                    invoke_id: request.invoke_id,
-                    kind: request.kind,
-                    error_code,
-                    body_len,
-                    body,
-                })
+                .send_copy(response(request.invoke_id, request.kind, result))
                 .map_err(transport)?;
             answered += 1;
         }
         Ok(answered)
+    }
+}
+
+/// The response frame of a handler's result.
+fn response(invoke_id: u32, kind: u32, result: HandlerResult) -> AcyclicResponse {
+    let (error_code, body, body_len) = match result {
+        Ok((body, len)) => (0, body, len),
+        Err(code) => (code.raw(), [0u8; ACYCLIC_BODY_SIZE], 0),
+    };
+    AcyclicResponse {
+        invoke_id,
+        kind,
+        error_code,
+        body_len,
+        body,
     }
 }

@@ -53,7 +53,29 @@ impl Default for AcyclicResponse {
     }
 }
 
-crate::raw::zero_copy_send!(AcyclicRequest, AcyclicResponse);
+/// Values one bulk call may carry: 64 KiB of `f64` (the buffer size of the FIFO seed's sample
+/// program).
+pub const BULK_MAX_VALUES: usize = 8192;
+
+/// The header of a bulk call: a call whose payload is `rows x columns` numbers written
+/// straight into the shared memory the CNC reads (not copied into a frame), such as a FIFO row
+/// block. The kind routes it like any call; the reply is an [`AcyclicResponse`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct BulkHeader {
+    /// The call kind ([`crate::calls::CallKind`] raw).
+    pub kind: u32,
+    /// What it addresses (a FIFO group's index, ...).
+    pub target: u32,
+    /// Values per row.
+    pub columns: u32,
+    /// Rows.
+    pub rows: u32,
+}
+
+const _: () = assert!(core::mem::size_of::<BulkHeader>() == 16);
+
+crate::raw::zero_copy_send!(AcyclicRequest, AcyclicResponse, BulkHeader);
 
 /// A body encoded for a frame: the bytes and their count.
 pub fn encode_body<T: Pod>(value: &T) -> ([u8; ACYCLIC_BODY_SIZE], u32) {

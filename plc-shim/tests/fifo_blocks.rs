@@ -40,13 +40,13 @@ fn an_edge_while_busy_sends_the_new_block_and_a_silent_cnc_times_out() {
     }
     let mut blocks = 0;
     server
-        .poll_rows(|_, values| {
+        .poll_rows(|_, _, values| {
             assert_eq!(values, rows);
             blocks += 1;
-            FifoReply {
+            hli::calls::reply(&FifoReply {
                 row: 2,
                 ..FifoReply::default()
-            }
+            })
         })
         .unwrap();
     // The block kernel's rule: the edge while Busy is a new command; only its answer counts.

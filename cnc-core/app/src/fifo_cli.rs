@@ -17,10 +17,10 @@ use cnc_core::fifo::{FifoParams, OverrideType};
 use cnc_core::machine::fifo::FifoEngine;
 use cnc_core::machine::{Machine, MachineSetup};
 use hli::calls::fifo::{
-    FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoRowsHeader, FifoStartCall,
+    rows_header, FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall, FifoWriteRowsCall,
     FIFO_BLOCK_VALUES,
 };
-use hli::calls::AcyclicCall;
+use hli::calls::{decode_reply, AcyclicCall};
 use hli::enums::FifoGroupState;
 use hli::layout::HliFifoGroupState;
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_OVERRIDE_FULL};
@@ -261,16 +261,12 @@ impl RowFeed<'_> {
         if count == 0 {
             return Ok(());
         }
-        let header = FifoRowsHeader {
-            group: 0,
-            columns: n as u32,
-            rows: count as u32,
-            overwrite: 0,
-        };
-        let reply = machine.dispatch_rows(
-            &header,
-            &self.rows[self.written * n..(self.written + count) * n],
-        );
+        let header = rows_header(0, n as u32, count as u32, false);
+        let values = &self.rows[self.written * n..(self.written + count) * n];
+        let reply = machine
+            .dispatch_bulk(FifoWriteRowsCall::KIND, &header, values)
+            .and_then(|(body, len)| decode_reply::<FifoWriteRowsCall>(&body, len))
+            .map_err(|code| refused("FiFoWrite", code.raw()))?;
         if reply.error_id != 0 {
             return Err(refused("FiFoWrite", reply.error_id));
         }

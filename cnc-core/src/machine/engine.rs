@@ -13,10 +13,9 @@
 //! impl, one calls file in `hli::calls`, and one line where the engine set is built.
 
 use crate::axis::AxisSet;
-use hli::calls::fifo::{FifoReply, FifoRowsHeader};
 use hli::calls::{CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::views::CncView;
-use hli::wire::AcyclicRequest;
+use hli::wire::{AcyclicRequest, BulkHeader};
 
 /// What an engine sees in its tick.
 pub struct EngineIo<'a, 'm> {
@@ -97,11 +96,17 @@ pub trait Engine: std::fmt::Debug + Send {
         Err(ErrorCode::ServiceNotSupported)
     }
 
-    /// A block of the bulk service (rows of numbers written straight into shared memory, not
-    /// copied into a call frame), answered; `None` when the block is not this engine's.
-    fn handle_bulk(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
-        let _ = (header, values);
-        None
+    /// A bulk call of one of its kinds (rows of numbers written straight into shared memory,
+    /// not copied into a frame; `header` says the kind, target and shape, the transport has
+    /// checked that `values` holds `rows x columns`), answered like [`Engine::handle`].
+    fn handle_bulk(
+        &mut self,
+        kind: CallKind,
+        header: &BulkHeader,
+        values: &[f64],
+    ) -> HandlerResult {
+        let _ = (kind, header, values);
+        Err(ErrorCode::ServiceNotSupported)
     }
 
     /// Whether this engine holds `resource` now.

@@ -27,15 +27,14 @@ use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,
-    FifoRowsHeader,
 };
-use hli::calls::{decode_body, reply, CallKind, CallSpec, HandlerResult};
+use hli::calls::{decode_body, reply, CallKind, CallSpec, ErrorCode, HandlerResult};
 use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{
     HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
     FIFO_OVERRIDE_FULL, HLI_MAX_FIFO_GROUPS,
 };
-use hli::wire::AcyclicRequest;
+use hli::wire::{AcyclicRequest, BulkHeader};
 use hli::PlaceExt;
 
 /// Why the engine cannot be built.
@@ -392,7 +391,8 @@ impl Group {
         self.reply(None)
     }
 
-    fn write(&mut self, header: &FifoRowsHeader, values: &[f64]) -> FifoReply {
+    /// A row block: FiFoOverwrite when `overwrite`, else FiFoWrite.
+    fn write(&mut self, header: &BulkHeader, values: &[f64], overwrite: bool) -> FifoReply {
         match self.state {
             FifoGroupState::Stopping => return self.refuse(FifoError::Stopping),
             FifoGroupState::Error => return self.refuse(FifoError::AxisFault),
@@ -402,7 +402,7 @@ impl Group {
             return self.refuse(FifoError::Columns);
         }
         let before = self.ring.len();
-        let (result, keep) = if header.overwrite != 0 {
+        let (result, keep) = if overwrite {
             // A running group keeps the pair it interpolates between.
             let keep = if self.running() { before.min(2) } else { 0 };
             (self.ring.replace_after(keep, values), keep)
@@ -538,12 +538,30 @@ impl Engine for FifoEngine {
     }
 
     fn handle(&mut self, call: Call<'_>) -> HandlerResult {
+        if matches!(
+            call.kind,
+            CallKind::FIFO_WRITE_ROWS | CallKind::FIFO_OVERWRITE_ROWS
+        ) {
+            // Row blocks come by the bulk service only (their rows are not in a frame).
+            return Err(ErrorCode::ServiceNotSupported);
+        }
         reply(&self.call(call.kind, call.request, call.axes))
     }
 
-    fn handle_bulk(&mut self, header: &FifoRowsHeader, values: &[f64]) -> Option<FifoReply> {
-        Some(match self.groups.get_mut(header.group as usize) {
-            Some(group) => group.write(header, values),
+    fn handle_bulk(
+        &mut self,
+        kind: CallKind,
+        header: &BulkHeader,
+        values: &[f64],
+    ) -> HandlerResult {
+        let overwrite = match kind {
+            CallKind::FIFO_WRITE_ROWS => false,
+            CallKind::FIFO_OVERWRITE_ROWS => true,
+            // The other kinds come in a frame.
+            _ => return Err(ErrorCode::ServiceNotSupported),
+        };
+        reply(&match self.groups.get_mut(header.target as usize) {
+            Some(group) => group.write(header, values, overwrite),
             None => FifoReply {
                 error_id: FifoError::NoSuchGroup.raw(),
                 ..FifoReply::default()

@@ -37,12 +37,11 @@ use crate::axis::AxisSet;
 use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
-use hli::calls::fifo::{FifoReply, FifoRowsHeader};
 use hli::calls::{decode_body, reply, AcyclicCall, CallKind, ErrorCode, HandlerResult};
 use hli::enums::DynCsState;
 use hli::layout::HLI_MAX_AXES;
 use hli::views::{handle_read_axis_state, CncView};
-use hli::wire::AcyclicRequest;
+use hli::wire::{AcyclicRequest, BulkHeader};
 use hli::ImageMemory;
 use nalgebra::Isometry3;
 
@@ -304,24 +303,22 @@ impl Machine {
         hli::calls::decode_reply::<C>(&reply, len)
     }
 
-    /// Answers one block of the bulk service: the engine that owns it, else it is refused as
-    /// addressing no group. A stopped machine takes no blocks.
-    pub fn dispatch_rows(&mut self, header: &FifoRowsHeader, values: &[f64]) -> FifoReply {
+    /// Answers one bulk call: routed by its kind like [`Machine::dispatch`] to the engine
+    /// that declares it (refused when none does). A stopped machine takes none.
+    pub fn dispatch_bulk(
+        &mut self,
+        kind: CallKind,
+        header: &BulkHeader,
+        values: &[f64],
+    ) -> HandlerResult {
         if self.stopped {
-            return FifoReply {
-                error_id: ErrorCode::Busy.raw(),
-                ..FifoReply::default()
-            };
+            return Err(ErrorCode::Busy);
         }
-        for engine in &mut self.engines {
-            if let Some(reply) = engine.handle_bulk(header, values) {
-                return reply;
-            }
-        }
-        FifoReply {
-            error_id: hli::enums::FifoError::NoSuchGroup.raw(),
-            ..FifoReply::default()
-        }
+        let engine = self
+            .routes
+            .engine(kind)
+            .ok_or(ErrorCode::ServiceNotSupported)?;
+        self.engines[engine].handle_bulk(kind, header, values)
     }
 
     /// Brings the machine to a safe state (supervision, signals): every channel stops on

@@ -9,12 +9,14 @@
 //! addressed by their `gpAx` index as in the other calls; group positions count from 1 as in
 //! the seed.
 
+use crate::calls::CallKind;
 use crate::enums::wire_enum;
+use crate::wire::BulkHeader;
 use bytemuck::{Pod, Zeroable};
 
 /// Values (rows x columns) one row block may carry: 64 KiB of `f64`, the buffer size of the
 /// seed's sample program.
-pub const FIFO_BLOCK_VALUES: usize = 8192;
+pub const FIFO_BLOCK_VALUES: usize = crate::wire::BULK_MAX_VALUES;
 
 /// Axes a FIFO group may have.
 pub const FIFO_MAX_DIMENSION: u32 = 16;
@@ -121,22 +123,39 @@ pub struct FifoParametersCall {
     pub reserved: u32,
 }
 
-/// The header of a row block (`FiFoWrite`, `FiFoOverwrite`); the payload is `rows x columns`
-/// values, row after row.
+/// FiFoWrite as a bulk call: its rows travel as the payload of the bulk service under a
+/// [`BulkHeader`] (target: the group, columns: the group's N, rows), not in a frame; this
+/// body is only the call's declaration ([`rows_header`] makes the header).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
-pub struct FifoRowsHeader {
-    /// The group, `gpFifo` index.
-    pub group: u32,
-    /// Values per row (must be the group's N).
-    pub columns: u32,
-    /// Rows in the block.
-    pub rows: u32,
-    /// 1: FiFoOverwrite (replace the rows queued behind the pair in use), 0: FiFoWrite.
-    pub overwrite: u32,
+pub struct FifoWriteRowsCall {
+    /// Reserved, 0.
+    pub reserved: u32,
 }
 
-crate::raw::zero_copy_send!(FifoRowsHeader, FifoReply);
+/// FiFoOverwrite as a bulk call (replaces the rows queued behind the pair in use), as
+/// [`FifoWriteRowsCall`].
+#[repr(C)]
+#[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
+pub struct FifoOverwriteRowsCall {
+    /// Reserved, 0.
+    pub reserved: u32,
+}
+
+/// The bulk header of a row block of `rows x columns` values for `group`: FiFoOverwrite
+/// when `overwrite`, else FiFoWrite.
+pub fn rows_header(group: u32, columns: u32, rows: u32, overwrite: bool) -> BulkHeader {
+    let kind = match overwrite {
+        true => CallKind::FIFO_OVERWRITE_ROWS,
+        false => CallKind::FIFO_WRITE_ROWS,
+    };
+    BulkHeader {
+        kind: kind.raw(),
+        target: group,
+        columns,
+        rows,
+    }
+}
 
 calls! { family "fifo";
     /// [`FifoDimensionCall`]: FiFoGetDimension.
@@ -153,10 +172,13 @@ calls! { family "fifo";
     FIFO_OVERRIDE = 35: FifoOverrideCall -> FifoReply, command;
     /// [`FifoParametersCall`]: the group's parameters a PLC may set.
     FIFO_PARAMETERS = 36: FifoParametersCall -> FifoReply, command;
+    /// [`FifoWriteRowsCall`]: FiFoWrite, a bulk call (its rows in shared memory).
+    FIFO_WRITE_ROWS = 37: FifoWriteRowsCall -> FifoReply, command;
+    /// [`FifoOverwriteRowsCall`]: FiFoOverwrite, a bulk call.
+    FIFO_OVERWRITE_ROWS = 38: FifoOverwriteRowsCall -> FifoReply, command;
 }
 
 const _: () = assert!(core::mem::size_of::<FifoReply>() == 32);
-const _: () = assert!(core::mem::size_of::<FifoRowsHeader>() == 16);
 
 #[cfg(test)]
 mod tests {

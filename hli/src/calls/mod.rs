@@ -315,6 +315,8 @@ mod tests {
         (CallKind::FIFO_STOP, 34),
         (CallKind::FIFO_OVERRIDE, 35),
         (CallKind::FIFO_PARAMETERS, 36),
+        (CallKind::FIFO_WRITE_ROWS, 37),
+        (CallKind::FIFO_OVERWRITE_ROWS, 38),
         (CallKind::SAW_GEAR_IN, 40),
         (CallKind::SAW_GEAR_OUT, 41),
         (CallKind::SAW_CHARAC, 42),
@@ -336,7 +338,7 @@ mod tests {
             assert_eq!(CallKind::decode(raw), Some(kind));
             assert_eq!(kind.spec().map(|s| s.kind), Some(kind));
         }
-        for raw in [0, 3, 9, 23, 37, 43, 52, 62, u32::MAX] {
+        for raw in [0, 3, 9, 23, 39, 43, 52, 62, u32::MAX] {
             assert_eq!(CallKind::decode(raw), None, "{raw}");
         }
     }

@@ -25,16 +25,19 @@
 //! call = { block = "FiFoSetChannelOverride", instance = "ov", override = 50.0 }   # percent
 //! ```
 
-use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs};
+use crate::kernel::{
+    call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, PendingBulk,
+};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::fifo::{
-    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
-    FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall, FIFO_BLOCK_VALUES,
+    rows_header, FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
+    FifoOverrideType, FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall,
+    FIFO_BLOCK_VALUES,
 };
 use hli::calls::AcyclicCall;
 use hli::layout::FIFO_OVERRIDE_FULL;
-use hli::rpc::{PendingCall, PendingRows};
+use hli::rpc::PendingCall;
 use std::sync::Arc;
 
 /// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).
@@ -124,7 +127,7 @@ pub type FifoSetParameters = FifoBlock<PendingCall<FifoParametersCall>>;
 pub struct FifoWrite {
     /// FiFoOverwrite: replace the rows queued behind the pair in use.
     pub overwrite: bool,
-    block: FifoBlock<PendingRows>,
+    block: FifoBlock<PendingBulk<FifoReply>>,
 }
 
 impl FifoWrite {
@@ -154,14 +157,10 @@ impl FifoWrite {
             let values = (columns as usize).checked_mul(rows as usize);
             match values {
                 Some(n) if n <= data.len() && n <= FIFO_BLOCK_VALUES => {
-                    let header = FifoRowsHeader {
-                        group,
-                        columns,
-                        rows,
-                        overwrite: u32::from(overwrite),
-                    };
+                    let header = rows_header(group, columns, rows, overwrite);
                     io.acyclic
                         .start_rows(header, &data[..n])
+                        .map(PendingBulk::new)
                         .map_err(|e| call_error_code(&e))
                 }
                 _ => Err(ERROR_BLOCK_SIZE),

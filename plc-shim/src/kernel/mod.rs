@@ -172,11 +172,34 @@ impl<C: AcyclicCall> InFlight for PendingCall<C> {
     }
 }
 
-impl InFlight for PendingRows {
-    type Reply = hli::calls::fifo::FifoReply;
+/// A bulk call on its way (its values written straight into shared memory), answered with
+/// the reply body `R` of its kind.
+pub struct PendingBulk<R> {
+    pending: PendingRows,
+    reply: core::marker::PhantomData<fn() -> R>,
+}
+
+impl<R> PendingBulk<R> {
+    /// `pending`, whose answer is an `R`.
+    pub fn new(pending: PendingRows) -> Self {
+        PendingBulk {
+            pending,
+            reply: core::marker::PhantomData,
+        }
+    }
+}
+
+impl<R> core::fmt::Debug for PendingBulk<R> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("PendingBulk")
+    }
+}
+
+impl<R: bytemuck::Pod> InFlight for PendingBulk<R> {
+    type Reply = R;
     type Buffer = ();
-    fn poll(&mut self, _: &mut PlcIo<'_>, _: &mut ()) -> Polled<Self::Reply> {
-        polled(PendingRows::poll(self))
+    fn poll(&mut self, _: &mut PlcIo<'_>, _: &mut ()) -> Polled<R> {
+        polled(self.pending.poll::<R>())
     }
 }
 

@@ -17,7 +17,7 @@ use crate::blocks::motion::{
 use crate::blocks::probe::{McAbortTrigger, McTouchProbe};
 use crate::blocks::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use crate::runtime::PlcIo;
-use hli::calls::fifo::{FifoDimensionCall, FifoReply, FifoStartCall};
+use hli::calls::fifo::{FifoDimensionCall, FifoStartCall};
 use hli::calls::ErrorCode;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::PlcView;
@@ -371,10 +371,7 @@ impl Cnc {
             .server
             .poll(|_, _| Err(ErrorCode::InvalidData))
             .unwrap();
-        let rows = self.server.poll_rows(|_, _| FifoReply {
-            error_id: ErrorCode::InvalidData.raw(),
-            ..FifoReply::default()
-        });
+        let rows = self.server.poll_rows(|_, _, _| Err(ErrorCode::InvalidData));
         calls + rows.unwrap()
     }
 

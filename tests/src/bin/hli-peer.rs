@@ -51,12 +51,7 @@ fn main() -> ExitCode {
         }
         ["plc-half-block", instance] => {
             let mut client = hli::rpc::AcyclicClient::open(instance).expect("client");
-            let header = hli::calls::fifo::FifoRowsHeader {
-                group: 0,
-                columns: 3,
-                rows: 10,
-                overwrite: 0,
-            };
+            let header = hli::calls::fifo::rows_header(0, 3, 10, false);
             let whole: Vec<f64> = (0..30).map(f64::from).collect();
             let _sent = client.start_rows(header, &whole).expect("send");
             let mut loan = client.loan_rows(header, 30).expect("loan");

@@ -2,6 +2,7 @@
 //! block; the block it had sent before arrives whole.
 
 use hli::calls::fifo::FifoReply;
+use hli::calls::reply;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use std::time::{Duration, Instant};
 use tests::unique_instance;
@@ -25,9 +26,9 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
             "watchdog: the whole block never arrived"
         );
         server
-            .poll_rows(|header, values| {
+            .poll_rows(|_, header, values| {
                 blocks.push((*header, values.to_vec()));
-                FifoReply::default()
+                reply(&FifoReply::default())
             })
             .unwrap();
         std::thread::yield_now();
@@ -41,9 +42,9 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
     // A few more polls: nothing else may arrive.
     for _ in 0..100 {
         server
-            .poll_rows(|header, values| {
+            .poll_rows(|_, header, values| {
                 blocks.push((*header, values.to_vec()));
-                FifoReply::default()
+                reply(&FifoReply::default())
             })
             .unwrap();
     }
@@ -53,25 +54,20 @@ fn a_plc_dying_mid_write_leaves_no_half_block() {
     assert_eq!(*values, (0..30).map(f64::from).collect::<Vec<_>>());
     // The service goes on for the next PLC.
     let mut client = AcyclicClient::open(&instance).unwrap();
-    let header = hli::calls::fifo::FifoRowsHeader {
-        group: 0,
-        columns: 1,
-        rows: 2,
-        overwrite: 0,
-    };
+    let header = hli::calls::fifo::rows_header(0, 1, 2, false);
     let pending = client.start_rows(header, &[7.0, 8.0]).unwrap();
     let mut got = Vec::new();
     let reply = loop {
         server
-            .poll_rows(|_, values| {
+            .poll_rows(|_, _, values| {
                 got.extend_from_slice(values);
-                FifoReply {
+                reply(&FifoReply {
                     row: 2,
                     ..FifoReply::default()
-                }
+                })
             })
             .unwrap();
-        if let Some(reply) = pending.poll() {
+        if let Some(reply) = pending.poll::<FifoReply>() {
             break reply.unwrap();
         }
         assert!(

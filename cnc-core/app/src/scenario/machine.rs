@@ -160,7 +160,8 @@ impl InProcess {
                 let view = CncView::new(&self.memory);
                 let machine = &mut self.machine;
                 let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
-                let _ = server.poll_rows(|header, values| machine.dispatch_rows(header, values));
+                let _ = server
+                    .poll_rows(|kind, header, values| machine.dispatch_bulk(kind, header, values));
                 timeline.cycle_io(&mut PlcIo {
                     view: PlcView::new(&self.memory),
                     memory: &self.memory,

@@ -7,13 +7,15 @@
 use cnc_app::scenario::{InProcess, Scenario};
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::fifo::{
-    FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoOverrideType,
-    FifoParametersCall, FifoReply, FifoRowsHeader, FifoStartCall, FifoStopCall,
+    rows_header, FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
+    FifoOverrideType, FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall,
+    FifoWriteRowsCall,
 };
-use hli::calls::AcyclicCall;
+use hli::calls::{decode_reply, AcyclicCall, CallKind};
 use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 use hli::views::{CncView, PlcView};
+use hli::wire::BulkHeader;
 
 const TICK: f64 = 0.001;
 /// Axes 0..3 form the group; 3 is free; 4 is a gear slave of 3.
@@ -62,13 +64,21 @@ fn axis_command(run: &mut InProcess, axis: u32, command: AxisCommandCall) -> u32
 
 fn write(run: &mut InProcess, rows: &[[f64; 3]], overwrite: bool) -> FifoReply {
     let values: Vec<f64> = rows.iter().flatten().copied().collect();
-    let header = FifoRowsHeader {
-        group: 0,
-        columns: 3,
-        rows: rows.len() as u32,
-        overwrite: u32::from(overwrite),
-    };
-    run.machine.dispatch_rows(&header, &values)
+    let header = rows_header(0, 3, rows.len() as u32, overwrite);
+    bulk(run, &header, &values)
+}
+
+/// A bulk call (a row block) answered by the machine, as the PLC's block reads it: a
+/// refused call as its error id.
+fn bulk(run: &mut InProcess, header: &BulkHeader, values: &[f64]) -> FifoReply {
+    let kind = CallKind::decode(header.kind).unwrap();
+    match run.machine.dispatch_bulk(kind, header, values) {
+        Ok((body, len)) => decode_reply::<FifoWriteRowsCall>(&body, len).unwrap(),
+        Err(code) => FifoReply {
+            error_id: code.raw(),
+            ..FifoReply::default()
+        },
+    }
 }
 
 fn integrate(run: &mut InProcess) {
@@ -410,17 +420,15 @@ fn refusals_leave_the_rows_alone() {
         FifoError::NonFinite.raw()
     );
     assert_eq!(entries(&mut run), 2, "a refused overwrite drops nothing");
-    let header = FifoRowsHeader {
-        group: 0,
-        columns: 2,
-        rows: 3,
-        overwrite: 0,
-    };
-    let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
+    let header = rows_header(0, 2, 3, false);
+    let r = bulk(&mut run, &header, &[0.0; 6]);
     assert_eq!(r.error_id, FifoError::Columns.raw());
     assert_eq!(entries(&mut run), 2);
-    let header = FifoRowsHeader { group: 5, ..header };
-    let r = run.machine.dispatch_rows(&header, &[0.0; 6]);
+    let header = BulkHeader {
+        target: 5,
+        ..header
+    };
+    let r = bulk(&mut run, &header, &[0.0; 6]);
     assert_eq!(r.error_id, FifoError::NoSuchGroup.raw());
     assert_eq!(
         write(&mut run, &[], false).error_id,
@@ -769,4 +777,34 @@ fn a_bad_fifo_group_is_refused_at_load() {
         );
         assert!(text.contains(needle), "{text}");
     }
+}
+
+/// Row blocks come by the bulk service only: the same kind in a frame is refused, and so is
+/// a bulk call of a kind that has no bulk handler.
+#[test]
+fn row_blocks_come_by_the_bulk_service_only() {
+    use hli::calls::ErrorCode;
+    let mut run = machine(&instant(250, 2.0));
+    let request = hli::wire::AcyclicRequest {
+        invoke_id: 0,
+        kind: CallKind::FIFO_WRITE_ROWS.raw(),
+        target: 0,
+        body_len: 4,
+        body: [0; hli::wire::ACYCLIC_BODY_SIZE],
+    };
+    let view = CncView::new(&run.memory);
+    let framed = run
+        .machine
+        .dispatch(&view, CallKind::FIFO_WRITE_ROWS, &request);
+    assert_eq!(framed.unwrap_err(), ErrorCode::ServiceNotSupported);
+    let header = BulkHeader {
+        kind: CallKind::FIFO_START.raw(),
+        target: 0,
+        columns: 3,
+        rows: 1,
+    };
+    let bulk = run
+        .machine
+        .dispatch_bulk(CallKind::FIFO_START, &header, &[0.0; 3]);
+    assert_eq!(bulk.unwrap_err(), ErrorCode::ServiceNotSupported);
 }
