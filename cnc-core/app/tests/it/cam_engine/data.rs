@@ -125,10 +125,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
 
 #[test]
 fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
-    use hli::calls::cam::{
-        CamReadCall, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
-        CAM_READ_VALUES,
-    };
+    use hli::calls::cam::{CamReadCall, CamReadKind};
     let mut run = machine("");
     run.step(0.001);
     let seed = seed_cam();
@@ -137,7 +134,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_SLAVE_DYNAMICS,
+            what: CamReadKind::SlaveDynamics.raw(),
             a: 90.0,
             ..Default::default()
         },
@@ -149,7 +146,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         2,
         CamReadCall {
-            what: CAM_READ_SLAVE_DYNAMICS,
+            what: CamReadKind::SlaveDynamics.raw(),
             a: 100.0,
             ..Default::default()
         },
@@ -161,7 +158,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_CHARACTERISTICS,
+            what: CamReadKind::Characteristics.raw(),
             ..Default::default()
         },
     );
@@ -176,7 +173,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_VALUES,
+            what: CamReadKind::Values.raw(),
             mask: 3,
             a: 0.0,
             b: 360.0,
@@ -201,7 +198,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         SLAVE as u32,
         CamReadCall {
-            what: CAM_READ_INFO,
+            what: CamReadKind::Info.raw(),
             flags: 1,
             a: 90.0,
             ..Default::default()
@@ -225,7 +222,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         2,
         &CamReadCall {
-            what: CAM_READ_INFO,
+            what: CamReadKind::Info.raw(),
             ..Default::default()
         },
     ));
