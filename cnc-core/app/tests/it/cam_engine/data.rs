@@ -227,6 +227,55 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         },
     ));
     assert_eq!(reply.error_id, CamCouplingError::NotCamCoupled.raw());
+    // A kind of read that does not exist: refused as an unknown mode.
+    for what in [0, 6] {
+        let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+            &mut run,
+            1,
+            &CamReadCall {
+                what,
+                ..Default::default()
+            },
+        ));
+        assert_eq!(
+            reply.error_id,
+            CamCouplingError::UnknownMode.raw(),
+            "what {what}"
+        );
+    }
+}
+
+#[test]
+fn a_multi_table_call_refuses_an_operation_it_does_not_have() {
+    use hli::calls::cam::{CamMultiCoupleCall, CamMultiTableCall, CamMultiTableOp};
+    let mut run = machine("");
+    run.step(0.001);
+    let mut table_ids = [0; hli::calls::cam::CAM_MULTI_TABLES];
+    table_ids[0] = 2;
+    let couple = CamMultiCoupleCall {
+        master: MASTER as u32,
+        on: 1,
+        tables: 1,
+        profiles: 1,
+        table_ids,
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, couple), 0);
+    let on_table = |op, table| CamMultiTableCall {
+        op,
+        table,
+        ..CamMultiTableCall::default()
+    };
+    for op in [0, 3] {
+        let refused = call(&mut run, SLAVE as u32, on_table(op, 2));
+        assert_eq!(refused, CamCouplingError::UnknownMode.raw(), "op {op}");
+    }
+    // A known operation gets as far as the table: one the slave does not use is refused.
+    let enable = on_table(CamMultiTableOp::EnableCorrection.raw(), 9);
+    let refused = call(&mut run, SLAVE as u32, enable);
+    assert_eq!(
+        refused,
+        cnc_core::cam::TableErrorCode::CamTableIdInvalid as u32
+    );
 }
 
 fn s_at(p: &CamProfile, x: f64) -> f64 {
