@@ -300,10 +300,6 @@ pub const CAM_KEEP_MASTER_OFFSET: u32 = 4;
 /// See [`CAM_KEEP_MASTER_SCALING`].
 pub const CAM_KEEP_SLAVE_OFFSET: u32 = 8;
 
-/// [`CamReadCall::what`]: CamTableReadData of the table given as `target`: its rows
-/// `[master, slave]`, row after row (position tables only).
-pub const CAM_READ_ROWS: u32 = 5;
-
 /// CamTableDelete for the table given as `target` (refused while a coupling uses it).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
@@ -341,19 +337,28 @@ pub struct CamRowsWriteCall {
     pub rows: [[f64; 2]; CAM_ROWS_PER_CALL],
 }
 
-/// [`CamReadCall::what`]: MC_ReadCamTableSlaveDynamics of the table given as `target` at
-/// master position `a`: slave position, velocity, acceleration (what the table type gives).
-pub const CAM_READ_SLAVE_DYNAMICS: u32 = 1;
-/// [`CamReadCall::what`]: MC_ReadCamTableCharacteristics of the table given as `target`: the
-/// 31 values of `MC_TableCharacValues` in their order.
-pub const CAM_READ_CHARACTERISTICS: u32 = 2;
-/// [`CamReadCall::what`]: MC_ReadMotionFunctionValues of the table given as `target`: rows
-/// `[master, the columns of mask]` from `a` to `b` in steps of `c`, row after row.
-pub const CAM_READ_VALUES: u32 = 3;
-/// [`CamReadCall::what`]: MC_CamInfo of the slave axis given as `target` (at master
-/// position `a` when `flags` bit 0 is set): the 40 values of `MC_CamInfoData` in their order
-/// (booleans 0 or 1, IDs and modes as numbers).
-pub const CAM_READ_INFO: u32 = 4;
+wire_enum! {
+    /// What a [`CamReadCall`] reads ([`CamReadCall::what`]).
+    CamReadKind {
+        /// 1: MC_ReadCamTableSlaveDynamics of the table given as `target` at master position
+        /// `a`: slave position, velocity, acceleration (what the table type gives).
+        SlaveDynamics = 1 => "slave_dynamics",
+        /// 2: MC_ReadCamTableCharacteristics of the table given as `target`: the 31 values of
+        /// `MC_TableCharacValues` in their order.
+        Characteristics = 2 => "characteristics",
+        /// 3: MC_ReadMotionFunctionValues of the table given as `target`: rows
+        /// `[master, the columns of mask]` from `a` to `b` in steps of `c`, row after row.
+        Values = 3 => "values",
+        /// 4: MC_CamInfo of the slave axis given as `target` (at master position `a` when
+        /// `flags` bit 0 is set): the 40 values of `MC_CamInfoData` in their order (booleans
+        /// 0 or 1, IDs and modes as numbers).
+        Info = 4 => "info",
+        /// 5: CamTableReadData of the table given as `target`: its rows `[master, slave]`,
+        /// row after row (position tables only).
+        Rows = 5 => "rows",
+    }
+}
+
 /// Values in one [`CamValuesReply`].
 pub const CAM_VALUES_PER_REPLY: usize = 28;
 
@@ -362,8 +367,7 @@ pub const CAM_VALUES_PER_REPLY: usize = 28;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamReadCall {
-    /// [`CAM_READ_SLAVE_DYNAMICS`], [`CAM_READ_CHARACTERISTICS`], [`CAM_READ_VALUES`],
-    /// [`CAM_READ_INFO`].
+    /// Raw [`CamReadKind`]: what is read.
     pub what: u32,
     /// Which part of the answer.
     pub part: u32,
@@ -453,10 +457,16 @@ pub struct CamMultiCoupleCall {
     pub table_ids: [u32; CAM_MULTI_TABLES],
 }
 
-/// [`CamMultiTableCall::op`]: CamTableEnableCorrectionTable.
-pub const CAM_MULTI_ENABLE_CORRECTION: u32 = 1;
-/// [`CamMultiTableCall::op`]: CamTableDeactivateCyclicTable.
-pub const CAM_MULTI_STOP_CYCLIC: u32 = 2;
+wire_enum! {
+    /// What a [`CamMultiTableCall`] does to its table ([`CamMultiTableCall::op`]).
+    CamMultiTableOp {
+        /// 1: CamTableEnableCorrectionTable, a correction table starts.
+        EnableCorrection = 1 => "enable_correction",
+        /// 2: CamTableDeactivateCyclicTable, a cyclic profile table ends at its next cycle
+        /// boundary.
+        StopCyclic = 2 => "stop_cyclic",
+    }
+}
 
 /// A table of the multi-table slave given as `target`: start a correction (at once, or when
 /// the master passes `position` if `flags` bit 0) or end a cyclic profile table at its next
@@ -464,7 +474,7 @@ pub const CAM_MULTI_STOP_CYCLIC: u32 = 2;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamMultiTableCall {
-    /// [`CAM_MULTI_ENABLE_CORRECTION`] or [`CAM_MULTI_STOP_CYCLIC`].
+    /// Raw [`CamMultiTableOp`]: what is done to the table.
     pub op: u32,
     /// The table ID.
     pub table: u32,
@@ -572,6 +582,24 @@ mod tests {
             ),
             [("user_defined", 0), ("auto_offset", 1), ("off", 2)]
         );
+        assert_eq!(
+            table(CamReadKind::ALL, CamReadKind::raw, CamReadKind::name),
+            [
+                ("slave_dynamics", 1),
+                ("characteristics", 2),
+                ("values", 3),
+                ("info", 4),
+                ("rows", 5)
+            ]
+        );
+        assert_eq!(
+            table(
+                CamMultiTableOp::ALL,
+                CamMultiTableOp::raw,
+                CamMultiTableOp::name
+            ),
+            [("enable_correction", 1), ("stop_cyclic", 2)]
+        );
     }
 
     #[test]
@@ -591,6 +619,9 @@ mod tests {
             Some(CamStartMode::MasterAbsSlaveRel)
         );
         assert_eq!(CamScalingMode::from_name("auto offset"), None);
+        assert_eq!(CamReadKind::from_raw(0), None);
+        assert_eq!(CamReadKind::from_raw(6), None);
+        assert_eq!(CamMultiTableOp::from_raw(3), None);
         assert!(
             CamStartMode::Relative.master_relative() && CamStartMode::Relative.slave_relative()
         );

@@ -23,9 +23,9 @@ use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{number, BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
 use hli::calls::cam::{
-    CamInCall, CamOutCall, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
+    CamInCall, CamOutCall, CamReadKind, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
-    CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_ROWS_DECLARE,
+    CAM_ROWS_DECLARE,
 };
 use std::sync::Arc;
 
@@ -197,8 +197,8 @@ impl CompatBlock {
     /// A block of `config`'s kind.
     pub fn new(config: Arc<CompatConfig>) -> CompatBlock {
         let (what, room) = match config.kind {
-            "CamTableReadSlavePos" => (CAM_READ_SLAVE_DYNAMICS, 3),
-            _ => (CAM_READ_ROWS, config.room.max(2)),
+            "CamTableReadSlavePos" => (CamReadKind::SlaveDynamics, 3),
+            _ => (CamReadKind::Rows, config.room.max(2)),
         };
         CompatBlock {
             execute: false,

@@ -6,7 +6,7 @@ use super::cam::{recorded, CamCore};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
-use hli::calls::cam::{CAM_MULTI_ENABLE_CORRECTION, CAM_MULTI_STOP_CYCLIC};
+use hli::calls::cam::CamMultiTableOp;
 
 /// CamTableSetWeight (5.2.3.1): weight, offsets, slopes and range of `table` in a
 /// multi-table slave.
@@ -89,13 +89,12 @@ impl CamTableCoupleAxesMultiTables {
 /// CamTableEnableCorrectionTable (5.2.3.3) and CamTableDeactivateCyclicTable (5.2.3.4):
 /// a table of a multi-table slave started (a correction: at once, or at `position` when
 /// `at_position`) or ended at its cycle boundary (a cyclic profile table).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct CamMultiTable {
     /// Input: a rising edge sends it.
     pub execute: bool,
-    /// What it does: [`hli::calls::cam::CAM_MULTI_ENABLE_CORRECTION`] or
-    /// [`hli::calls::cam::CAM_MULTI_STOP_CYCLIC`].
-    pub op: u32,
+    /// What it does.
+    pub op: CamMultiTableOp,
     /// Input: the table ID.
     pub table: u32,
     /// Input: a correction starts at `position` rather than at once.
@@ -108,10 +107,23 @@ pub struct CamMultiTable {
 }
 
 impl CamMultiTable {
+    /// The block that does `op`, its inputs cleared.
+    pub fn new(op: CamMultiTableOp) -> CamMultiTable {
+        CamMultiTable {
+            execute: false,
+            op,
+            table: 0,
+            at_position: false,
+            position: 0.0,
+            out: Outputs::default(),
+            core: CamCore::default(),
+        }
+    }
+
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let call = hli::calls::cam::CamMultiTableCall {
-            op: self.op,
+            op: self.op.raw(),
             table: self.table,
             flags: u32::from(self.at_position),
             reserved: 0,
@@ -222,21 +234,11 @@ pub const TIMELINE: &[BlockSpec] = &[
             input("at_position", Kind::Bool),
             input("position", Kind::Real),
         ],
-        |_| {
-            Box::new(CamMultiTable {
-                op: CAM_MULTI_ENABLE_CORRECTION,
-                ..CamMultiTable::default()
-            })
-        },
+        |_| Box::new(CamMultiTable::new(CamMultiTableOp::EnableCorrection)),
     ),
     BlockSpec::on_axis(
         "CamTableDeactivateCyclicTable",
         &[input("table", Kind::Count)],
-        |_| {
-            Box::new(CamMultiTable {
-                op: CAM_MULTI_STOP_CYCLIC,
-                ..CamMultiTable::default()
-            })
-        },
+        |_| Box::new(CamMultiTable::new(CamMultiTableOp::StopCyclic)),
     ),
 ];

@@ -7,9 +7,7 @@ use super::cam::recorded;
 use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
-use hli::calls::cam::{
-    CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES,
-};
+use hli::calls::cam::CamReadKind;
 use hli::rpc::PendingCall;
 
 /// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
@@ -103,11 +101,11 @@ pub const DEFAULT_READ_ROOM: usize = 1024;
 
 impl McCamRead {
     /// A read of kind `what` with room for `room` numbers.
-    pub fn new(what: u32, room: usize) -> McCamRead {
+    pub fn new(what: CamReadKind, room: usize) -> McCamRead {
         McCamRead {
             execute: false,
             request: hli::calls::cam::CamReadCall {
-                what,
+                what: what.raw(),
                 ..Default::default()
             },
             target: 0,
@@ -281,7 +279,7 @@ impl TimelineBlock for McCamRead {
         Some(&mut self.execute)
     }
     fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        if self.request.what == CAM_READ_INFO {
+        if self.request.what == CamReadKind::Info.raw() {
             self.target = axis; // MC_CamInfo reads the slave's coupling
         }
         self.call(io);
@@ -338,10 +336,10 @@ pub const TIMELINE: &[BlockSpec] = &[
     BlockSpec::on_axis(
         "MC_ReadCamTableSlaveDynamics",
         &[TABLE, MASTER_POSITION],
-        |_| Box::new(McCamRead::new(CAM_READ_SLAVE_DYNAMICS, 3)),
+        |_| Box::new(McCamRead::new(CamReadKind::SlaveDynamics, 3)),
     ),
     BlockSpec::on_axis("MC_ReadCamTableCharacteristics", &[TABLE], |_| {
-        Box::new(McCamRead::new(CAM_READ_CHARACTERISTICS, 31))
+        Box::new(McCamRead::new(CamReadKind::Characteristics, 31))
     }),
     BlockSpec::on_axis(
         "MC_ReadMotionFunctionValues",
@@ -355,12 +353,12 @@ pub const TIMELINE: &[BlockSpec] = &[
         ],
         |room| {
             let room = room.unwrap_or(DEFAULT_READ_ROOM);
-            Box::new(McCamRead::new(CAM_READ_VALUES, room))
+            Box::new(McCamRead::new(CamReadKind::Values, room))
         },
     ),
     BlockSpec::on_axis(
         "MC_CamInfo",
         &[input("at_master_position", Kind::Bool), MASTER_POSITION],
-        |_| Box::new(McCamRead::new(CAM_READ_INFO, 40)),
+        |_| Box::new(McCamRead::new(CamReadKind::Info, 40)),
     ),
 ];

@@ -17,6 +17,7 @@ use crate::blocks::motion::{
 use crate::blocks::probe::{McAbortTrigger, McTouchProbe};
 use crate::blocks::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use crate::runtime::PlcIo;
+use hli::calls::cam::CamMultiTableOp;
 use hli::calls::fifo::{FifoDimensionCall, FifoStartCall};
 use hli::calls::ErrorCode;
 use hli::rpc::{AcyclicClient, AcyclicServer};
@@ -185,7 +186,7 @@ fn cam_blocks() -> Vec<(&'static str, Cycle)> {
         (
             "MC_CamInfo",
             block!(
-                McCamRead::new(hli::calls::cam::CAM_READ_INFO, 64),
+                McCamRead::new(hli::calls::cam::CamReadKind::Info, 64),
                 |s| {
                     s.target = 1;
                 },
@@ -233,7 +234,7 @@ fn table_blocks() -> Vec<(&'static str, Cycle)> {
         (
             "CamTableEnableCorrectionTable",
             block!(
-                CamMultiTable::default(),
+                CamMultiTable::new(CamMultiTableOp::EnableCorrection),
                 |s| {
                     s.table = 1;
                 },

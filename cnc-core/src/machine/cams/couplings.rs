@@ -18,9 +18,8 @@ use crate::cam::online::MasterNow;
 use crate::cam::{CamProfile, PositionTable, ProfileCursor, TableErrorCode};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{
-    CamInCall, CamInterpolation, CamMultiCoupleCall, CamMultiTableCall, CamOutCall, CamScalingCall,
-    CamScalingMode, CamStartMode, CamTableSelectCall, CAM_MULTI_ENABLE_CORRECTION,
-    CAM_MULTI_STOP_CYCLIC,
+    CamInCall, CamInterpolation, CamMultiCoupleCall, CamMultiTableCall, CamMultiTableOp,
+    CamOutCall, CamScalingCall, CamScalingMode, CamStartMode, CamTableSelectCall,
 };
 use hli::calls::{decode_body, ErrorCode, HandlerResult};
 use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
@@ -382,16 +381,16 @@ impl CamEngine {
         else {
             return code(CamCouplingError::NotCamCoupled.raw());
         };
-        let done = match call.op {
-            CAM_MULTI_ENABLE_CORRECTION => {
+        let done = match CamMultiTableOp::from_raw(call.op) {
+            Some(CamMultiTableOp::EnableCorrection) => {
                 if call.flags & 1 != 0 && !call.position.is_finite() {
                     return code(CamCouplingError::BadParameter.raw());
                 }
                 let at = (call.flags & 1 != 0).then_some(call.position);
                 m.law.enable_correction(call.table, at)
             }
-            CAM_MULTI_STOP_CYCLIC => m.law.stop_cyclic(call.table),
-            _ => return code(CamCouplingError::UnknownMode.raw()),
+            Some(CamMultiTableOp::StopCyclic) => m.law.stop_cyclic(call.table),
+            None => return code(CamCouplingError::UnknownMode.raw()),
         };
         match done {
             Ok(()) => accepted(),

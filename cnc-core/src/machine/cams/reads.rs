@@ -7,8 +7,7 @@ use crate::axis::AxisSet;
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode, TableType};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{
-    CamReadCall, CamScalingMode, CamValuesReply, CAM_READ_CHARACTERISTICS, CAM_READ_INFO,
-    CAM_READ_ROWS, CAM_READ_SLAVE_DYNAMICS, CAM_READ_VALUES, CAM_VALUES_PER_REPLY,
+    CamReadCall, CamReadKind, CamScalingMode, CamValuesReply, CAM_VALUES_PER_REPLY,
 };
 use hli::calls::{decode_body, reply, HandlerResult};
 use hli::enums::CamCouplingError;
@@ -49,9 +48,9 @@ impl CamEngine {
         let id = request.target;
         let skip = call.part as usize * CAM_VALUES_PER_REPLY;
         // A values read makes only the part asked for; the others make all and are cut here.
-        let answer = match call.what {
-            CAM_READ_SLAVE_DYNAMICS => self.slave_dynamics(id, &call),
-            CAM_READ_CHARACTERISTICS => self.table(id).map(|p| {
+        let answer = match CamReadKind::from_raw(call.what) {
+            Some(CamReadKind::SlaveDynamics) => self.slave_dynamics(id, &call),
+            Some(CamReadKind::Characteristics) => self.table(id).map(|p| {
                 let values: Vec<f64> = crate::cam::CharacValues::normed(p)
                     .fields()
                     .iter()
@@ -60,13 +59,13 @@ impl CamEngine {
                 let n = values.len();
                 Made::all(values, n)
             }),
-            CAM_READ_VALUES => self.sampled_values(id, &call, skip),
-            CAM_READ_ROWS => self.rows_part(id, skip),
-            CAM_READ_INFO => self.info(id as usize, &call, axes).map(|v| {
+            Some(CamReadKind::Values) => self.sampled_values(id, &call, skip),
+            Some(CamReadKind::Rows) => self.rows_part(id, skip),
+            Some(CamReadKind::Info) => self.info(id as usize, &call, axes).map(|v| {
                 let n = v.len();
                 Made::all(v, n)
             }),
-            _ => Err(CamCouplingError::UnknownMode.raw()),
+            None => Err(CamCouplingError::UnknownMode.raw()),
         };
         let made = match answer {
             Ok(made) => made,

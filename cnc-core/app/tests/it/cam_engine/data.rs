@@ -125,10 +125,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
 
 #[test]
 fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
-    use hli::calls::cam::{
-        CamReadCall, CAM_READ_CHARACTERISTICS, CAM_READ_INFO, CAM_READ_SLAVE_DYNAMICS,
-        CAM_READ_VALUES,
-    };
+    use hli::calls::cam::{CamReadCall, CamReadKind};
     let mut run = machine("");
     run.step(0.001);
     let seed = seed_cam();
@@ -137,7 +134,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_SLAVE_DYNAMICS,
+            what: CamReadKind::SlaveDynamics.raw(),
             a: 90.0,
             ..Default::default()
         },
@@ -149,7 +146,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         2,
         CamReadCall {
-            what: CAM_READ_SLAVE_DYNAMICS,
+            what: CamReadKind::SlaveDynamics.raw(),
             a: 100.0,
             ..Default::default()
         },
@@ -161,7 +158,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_CHARACTERISTICS,
+            what: CamReadKind::Characteristics.raw(),
             ..Default::default()
         },
     );
@@ -176,7 +173,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         1,
         CamReadCall {
-            what: CAM_READ_VALUES,
+            what: CamReadKind::Values.raw(),
             mask: 3,
             a: 0.0,
             b: 360.0,
@@ -201,7 +198,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         SLAVE as u32,
         CamReadCall {
-            what: CAM_READ_INFO,
+            what: CamReadKind::Info.raw(),
             flags: 1,
             a: 90.0,
             ..Default::default()
@@ -225,11 +222,60 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         &mut run,
         2,
         &CamReadCall {
-            what: CAM_READ_INFO,
+            what: CamReadKind::Info.raw(),
             ..Default::default()
         },
     ));
     assert_eq!(reply.error_id, CamCouplingError::NotCamCoupled.raw());
+    // A kind of read that does not exist: refused as an unknown mode.
+    for what in [0, 6] {
+        let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+            &mut run,
+            1,
+            &CamReadCall {
+                what,
+                ..Default::default()
+            },
+        ));
+        assert_eq!(
+            reply.error_id,
+            CamCouplingError::UnknownMode.raw(),
+            "what {what}"
+        );
+    }
+}
+
+#[test]
+fn a_multi_table_call_refuses_an_operation_it_does_not_have() {
+    use hli::calls::cam::{CamMultiCoupleCall, CamMultiTableCall, CamMultiTableOp};
+    let mut run = machine("");
+    run.step(0.001);
+    let mut table_ids = [0; hli::calls::cam::CAM_MULTI_TABLES];
+    table_ids[0] = 2;
+    let couple = CamMultiCoupleCall {
+        master: MASTER as u32,
+        on: 1,
+        tables: 1,
+        profiles: 1,
+        table_ids,
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, couple), 0);
+    let on_table = |op, table| CamMultiTableCall {
+        op,
+        table,
+        ..CamMultiTableCall::default()
+    };
+    for op in [0, 3] {
+        let refused = call(&mut run, SLAVE as u32, on_table(op, 2));
+        assert_eq!(refused, CamCouplingError::UnknownMode.raw(), "op {op}");
+    }
+    // A known operation gets as far as the table: one the slave does not use is refused.
+    let enable = on_table(CamMultiTableOp::EnableCorrection.raw(), 9);
+    let refused = call(&mut run, SLAVE as u32, enable);
+    assert_eq!(
+        refused,
+        cnc_core::cam::TableErrorCode::CamTableIdInvalid as u32
+    );
 }
 
 fn s_at(p: &CamProfile, x: f64) -> f64 {

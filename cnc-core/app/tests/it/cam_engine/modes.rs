@@ -195,7 +195,7 @@ fn a_first_chunk_drops_an_unfinished_transfer() {
         &mut run,
         7,
         hli::calls::cam::CamReadCall {
-            what: hli::calls::cam::CAM_READ_ROWS,
+            what: hli::calls::cam::CamReadKind::Rows.raw(),
             ..Default::default()
         },
     );
