@@ -610,4 +610,56 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn asymmetric_trapezoid_jumps_in_jerk_where_its_ramps_end() {
+        // The property-test seed: symmetry -0.34 puts the turning point at 0.16 and stretches
+        // the second half by 2 * 0.84, so the base shape's ramp end at 5/8 lands at
+        // 0.16 + 0.84 / 4 = 0.37. The jerk there drops from the stretched ramp's to zero.
+        let spec = SegmentSpec {
+            law: FunctionType::AccelerationTrapezoid,
+            x0: 0.0,
+            x1: 1.0,
+            start: EndState::default(),
+            end: EndState {
+                y: 1.0,
+                ..EndState::default()
+            },
+            symmetry: -0.34,
+        };
+        let pieces = build(&spec).expect("a regular trapezoid");
+        let cut = pieces
+            .iter()
+            .map(|p| p.start)
+            .find(|c| (c - 0.37).abs() < 1e-12)
+            .expect("a cut at 0.37");
+        // The symmetric shape's ramp jerk is 128/3; the second half divides it by 1.68^2.
+        let ramp = -128.0 / 3.0 / (1.68 * 1.68);
+        let (left, right) = (
+            shape::eval(&pieces, cut - 1e-3),
+            shape::eval(&pieces, cut + 1e-3),
+        );
+        assert!((left[3] - ramp).abs() < 1e-9, "{} vs {ramp}", left[3]);
+        assert!(right[3].abs() < 1e-9, "{}", right[3]);
+        // The jerk reported on each side is the slope of the acceleration on that side.
+        let h = 1e-6;
+        for x in [cut - 1e-3, cut + 1e-3] {
+            let (m, p, q) = (
+                shape::eval(&pieces, x - h),
+                shape::eval(&pieces, x),
+                shape::eval(&pieces, x + h),
+            );
+            assert!(((q[2] - m[2]) / (2.0 * h) - p[3]).abs() < 1e-6, "at {x}");
+        }
+        // The acceleration has a kink there, not a step.
+        let (a_left, a_right) = (
+            pieces.iter().find(|p| p.end == cut),
+            pieces.iter().find(|p| p.start == cut),
+        );
+        let (a_left, a_right) = (
+            a_left.expect("piece before").eval(cut),
+            a_right.expect("piece after").eval(cut),
+        );
+        assert!((a_left[2] - a_right[2]).abs() < 1e-9);
+    }
 }
