@@ -9,10 +9,9 @@
 //! * [`rig`]: axes on a heap image ([`AxisRig`]); [`channel_rig`]: channels and a controller
 //!   on a heap image, configurations, a watchdog loop, PLC payloads;
 //! * [`lockstep`]: stand-in CNCs in a thread for the PLC-side tests; [`peer`]: payloads with
-//!   checksums and the `hli-peer` helper process.
-//!
-//! The in-process machine of a scenario (CNC ticks and PLC timeline cycles alternating on a
-//! heap image) is `cnc_app::scenario::InProcess`.
+//!   checksums and the `hli-peer` helper process;
+//! * [`InProcess`]: the in-process machine of a scenario (the application's
+//!   `cnc_app::scenario::InProcess`, re-exported).
 
 #![forbid(unsafe_code)]
 
@@ -30,6 +29,11 @@ pub use peer::{
     checksum, payload, remove_stale_segment, spawn_peer_saying, spawn_ready_peer, verify,
 };
 pub use rig::AxisRig;
+
+/// The in-process machine of a scenario: CNC ticks and PLC timeline cycles alternating on a
+/// heap image, the same trace as `cnc run --lockstep` (the application's, kept there because
+/// the application runs it too).
+pub use cnc_app::scenario::InProcess;
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
