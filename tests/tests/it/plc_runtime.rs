@@ -16,7 +16,9 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
     let mut runtime = PlcRuntime::attach(&instance, 5, Duration::from_millis(5)).unwrap();
     child.0.kill().unwrap();
-    child.0.wait().unwrap();
+    child
+        .wait_with_watchdog(Duration::from_secs(30))
+        .expect("watchdog: the killed peer was not reaped");
     // The max_cycles bound is a watchdog. The PLC gets one cycle for the last tick the CNC
     // finished before the loop started (lockstep needs that cycle); without new ticks no
     // further cycle runs.

@@ -52,7 +52,9 @@ fn live_segment_is_not_taken_over_and_its_heartbeat_stops_when_the_cnc_dies() {
     assert_eq!(liveness, PeerLiveness::Alive);
 
     child.0.kill().unwrap();
-    child.0.wait().unwrap();
+    child
+        .wait_with_watchdog(Duration::from_secs(30))
+        .expect("watchdog: the killed peer was not reaped");
     let verdicts: Vec<_> = (0..6).map(|_| watch.observe(plc.cnc_heartbeat())).collect();
     assert_eq!(verdicts.last(), Some(&PeerLiveness::Lost), "{verdicts:?}");
     assert!(!plc.cnc_process_alive());
