@@ -83,8 +83,7 @@ fn row(k: usize) -> [f64; N] {
 fn refill(machine: &mut Machine, next: &mut usize, rows: usize) {
     let values: Vec<f64> = (*next..*next + rows).flat_map(row).collect();
     let header = rows_header(0, N as u32, rows as u32, false);
-    let kind = hli::calls::CallKind::FIFO_WRITE_ROWS;
-    let (body, len) = machine.dispatch_bulk(kind, &header, &values).unwrap();
+    let (body, len) = machine.dispatch_bulk(&header, &values).unwrap();
     let reply: FifoReply = bytemuck::pod_read_unaligned(&body[..len as usize]);
     assert_eq!(reply.error_id, 0);
     *next += rows;
@@ -220,7 +219,7 @@ fn transfer(engine: bool, run: usize) -> f64 {
     while answered < BLOCKS {
         answered += if engine {
             server
-                .poll_rows(|k, h, v| machine.dispatch_bulk(k, h, v))
+                .poll_rows(|_, h, v| machine.dispatch_bulk(h, v))
                 .expect("poll")
         } else {
             server

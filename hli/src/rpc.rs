@@ -344,8 +344,8 @@ impl AcyclicServer {
         })
     }
 
-    /// Answers every pending bulk call with `handler(kind, header, values)`. An unknown kind
-    /// is refused with [`ErrorCode::ServiceNotSupported`] and a payload that is not
+    /// Answers every pending bulk call with `handler(kind, header, values)`. An unknown or
+    /// non-bulk kind is refused with [`ErrorCode::ServiceNotSupported`] and a payload that is not
     /// `rows x columns` values with [`ErrorCode::InvalidSize`], before the handler sees them.
     /// Returns how many calls were answered.
     pub fn poll_rows(
@@ -358,6 +358,7 @@ impl AcyclicServer {
             let values: &[f64] = active.payload();
             let expected = (header.rows as usize).checked_mul(header.columns as usize);
             let result = match CallKind::decode(header.kind) {
+                Some(kind) if !kind.is_bulk() => Err(ErrorCode::ServiceNotSupported),
                 None => Err(ErrorCode::ServiceNotSupported),
                 Some(_) if expected != Some(values.len()) => Err(ErrorCode::InvalidSize),
                 Some(kind) => handler(kind, &header, values),
@@ -370,9 +371,9 @@ impl AcyclicServer {
         Ok(answered)
     }
 
-    /// Answers every pending request with `handler(kind, request)`. Unknown kinds are refused
-    /// with [`ErrorCode::ServiceNotSupported`] without calling the handler. Returns how many
-    /// requests were answered.
+    /// Answers every pending request with `handler(kind, request)`. Unknown and bulk kinds are
+    /// refused with [`ErrorCode::ServiceNotSupported`] without calling the handler. Returns how
+    /// many requests were answered.
     pub fn poll(
         &self,
         mut handler: impl FnMut(CallKind, &AcyclicRequest) -> HandlerResult,
@@ -381,6 +382,8 @@ impl AcyclicServer {
         while let Some(active) = self.port.receive().map_err(transport)? {
             let request: &AcyclicRequest = active.payload();
             let result = match CallKind::decode(request.kind) {
+                // A bulk kind's numbers never come in a frame.
+                Some(kind) if kind.is_bulk() => Err(ErrorCode::ServiceNotSupported),
                 Some(kind) => handler(kind, request),
                 None => Err(ErrorCode::ServiceNotSupported),
             };

@@ -2,7 +2,7 @@
 
 use crate::cli::Cli;
 use std::io::{self, Read};
-use std::process::{Child, ExitStatus, Output};
+use std::process::{Child, Command, ExitStatus, Output};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -28,7 +28,7 @@ impl ChildGuard {
                 return Some(status);
             }
             if Instant::now() > deadline {
-                let _ = self.0.kill();
+                self.kill_group();
                 return None;
             }
             std::thread::sleep(Duration::from_millis(5));
@@ -39,6 +39,8 @@ impl ChildGuard {
     /// stdout and stderr (those the test has not taken). `Err` (`TimedOut`) when the watchdog
     /// killed it; the error carries what it printed.
     pub fn wait_with_output(&mut self, limit: Duration) -> io::Result<Output> {
+        // As std's `wait_with_output`: a child reading its stdin to the end gets its end.
+        drop(self.0.stdin.take());
         let out = drain(self.0.stdout.take());
         let err = drain(self.0.stderr.take());
         let status = self.wait_with_watchdog(limit);
@@ -61,10 +63,22 @@ impl ChildGuard {
     }
 }
 
+impl ChildGuard {
+    /// Kills the child and every process of its group (a child started by [`Cli`] leads a
+    /// group of its own, so a PLC that `cnc run` spawned goes with it and no pipe stays open).
+    pub fn kill_group(&mut self) {
+        let _ = Command::new("kill")
+            .args(["-KILL", "--", &format!("-{}", self.id())])
+            .stderr(std::process::Stdio::null())
+            .status();
+        let _ = self.0.kill();
+    }
+}
+
 impl Drop for ChildGuard {
     fn drop(&mut self) {
         if let Ok(None) = self.0.try_wait() {
-            let _ = self.0.kill();
+            self.kill_group();
             let _ = self.0.wait();
         }
     }

@@ -16,6 +16,7 @@
 use crate::child::ChildGuard;
 use std::ffi::OsStr;
 use std::io::{self, BufRead, BufReader};
+use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Output, Stdio};
 use std::time::Duration;
@@ -40,8 +41,11 @@ pub struct Cli {
 impl Cli {
     /// `program` (a test's `env!("CARGO_BIN_EXE_cnc")`, say) with no arguments yet.
     pub fn new(program: impl AsRef<OsStr>) -> Self {
+        let mut command = Command::new(program);
+        // A group of its own: the watchdog kills the program with everything it started.
+        command.process_group(0);
         Cli {
-            command: Command::new(program),
+            command,
             watchdog: default_watchdog(),
         }
     }
@@ -125,9 +129,22 @@ impl Cli {
     pub fn first_line(self) -> io::Result<(String, Output)> {
         let watchdog = self.watchdog;
         let mut child = self.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn()?;
-        let mut line = String::new();
         let stdout = child.0.stdout.take().expect("piped stdout");
-        BufReader::new(stdout).read_line(&mut line)?;
+        let (tx, rx) = std::sync::mpsc::channel();
+        // The line is read on a thread, so that the watchdog also covers a silent program.
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let read = BufReader::new(stdout).read_line(&mut line).map(|_| line);
+            let _ = tx.send(read);
+        });
+        let line = match rx.recv_timeout(watchdog) {
+            Ok(read) => read?,
+            Err(_) => {
+                child.kill_group();
+                let text = format!("watchdog: no first line within {watchdog:?}");
+                return Err(io::Error::new(io::ErrorKind::TimedOut, text));
+            }
+        };
         Ok((line, child.wait_with_output(watchdog)?))
     }
 

@@ -264,7 +264,7 @@ impl RowFeed<'_> {
         let header = rows_header(0, n as u32, count as u32, false);
         let values = &self.rows[self.written * n..(self.written + count) * n];
         let reply = machine
-            .dispatch_bulk(FifoWriteRowsCall::KIND, &header, values)
+            .dispatch_bulk(&header, values)
             .and_then(|(body, len)| decode_reply::<FifoWriteRowsCall>(&body, len))
             .map_err(|code| refused("FiFoWrite", code.raw()))?;
         if reply.error_id != 0 {

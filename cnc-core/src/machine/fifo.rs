@@ -538,13 +538,6 @@ impl Engine for FifoEngine {
     }
 
     fn handle(&mut self, call: Call<'_>) -> HandlerResult {
-        if matches!(
-            call.kind,
-            CallKind::FIFO_WRITE_ROWS | CallKind::FIFO_OVERWRITE_ROWS
-        ) {
-            // Row blocks come by the bulk service only (their rows are not in a frame).
-            return Err(ErrorCode::ServiceNotSupported);
-        }
         reply(&self.call(call.kind, call.request, call.axes))
     }
 

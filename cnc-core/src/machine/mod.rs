@@ -235,6 +235,10 @@ impl Machine {
         kind: CallKind,
         request: &AcyclicRequest,
     ) -> HandlerResult {
+        // A bulk kind's numbers come by the bulk service only ([`Machine::dispatch_bulk`]).
+        if kind.is_bulk() {
+            return Err(ErrorCode::ServiceNotSupported);
+        }
         // A stopped machine takes no commands, only reads (a PLC must not undo the stop).
         if self.stopped && !kind.is_read_only() {
             return Err(ErrorCode::Busy);
@@ -303,14 +307,13 @@ impl Machine {
         hli::calls::decode_reply::<C>(&reply, len)
     }
 
-    /// Answers one bulk call: routed by its kind like [`Machine::dispatch`] to the engine
-    /// that declares it (refused when none does). A stopped machine takes none.
-    pub fn dispatch_bulk(
-        &mut self,
-        kind: CallKind,
-        header: &BulkHeader,
-        values: &[f64],
-    ) -> HandlerResult {
+    /// Answers one bulk call: routed by the kind its header names, like [`Machine::dispatch`],
+    /// to the engine that declares it (refused when none does or the kind is no bulk kind).
+    /// A stopped machine takes none.
+    pub fn dispatch_bulk(&mut self, header: &BulkHeader, values: &[f64]) -> HandlerResult {
+        let kind = CallKind::decode(header.kind)
+            .filter(|k| k.is_bulk())
+            .ok_or(ErrorCode::ServiceNotSupported)?;
         if self.stopped {
             return Err(ErrorCode::Busy);
         }

@@ -173,9 +173,9 @@ calls! { family "fifo";
     /// [`FifoParametersCall`]: the group's parameters a PLC may set.
     FIFO_PARAMETERS = 36: FifoParametersCall -> FifoReply, command;
     /// [`FifoWriteRowsCall`]: FiFoWrite, a bulk call (its rows in shared memory).
-    FIFO_WRITE_ROWS = 37: FifoWriteRowsCall -> FifoReply, command;
+    FIFO_WRITE_ROWS = 37: FifoWriteRowsCall -> FifoReply, bulk;
     /// [`FifoOverwriteRowsCall`]: FiFoOverwrite, a bulk call.
-    FIFO_OVERWRITE_ROWS = 38: FifoOverwriteRowsCall -> FifoReply, command;
+    FIFO_OVERWRITE_ROWS = 38: FifoOverwriteRowsCall -> FifoReply, bulk;
 }
 
 const _: () = assert!(core::mem::size_of::<FifoReply>() == 32);

@@ -24,7 +24,8 @@
 //! A line names the kind (`CallKind::CAM_IN`, its number on the wire), binds the request body
 //! to it and to its reply (`impl AcyclicCall for CamInCall`), asserts at compile time that
 //! both bodies fit a frame, and lists the kind in the family's `CALLS`. `read_only` kinds
-//! only read: a stopped machine still answers them; `command` kinds change something. The
+//! only read: a stopped machine still answers them; `command` kinds change something; `bulk`
+//! kinds change something with numbers that come in shared memory (the bulk service). The
 //! family then joins with its `pub mod` here and one entry in [`FAMILIES`]. A kind number
 //! used twice, in one family or across two, does not compile.
 
@@ -70,6 +71,7 @@ macro_rules! calls {
                     kind: $crate::calls::CallKind::$kind,
                     name: stringify!($kind),
                     read_only: calls!(@read_only $access),
+                    bulk: calls!(@bulk $access),
                     family: $family,
                 },
             )*
@@ -77,6 +79,9 @@ macro_rules! calls {
     };
     (@read_only read_only) => { true };
     (@read_only command) => { false };
+    (@read_only bulk) => { false };
+    (@bulk bulk) => { true };
+    (@bulk $other:ident) => { false };
 }
 
 pub mod axis;
@@ -112,6 +117,9 @@ pub struct CallSpec {
     pub name: &'static str,
     /// Whether the call only reads (a stopped machine answers it).
     pub read_only: bool,
+    /// Whether it is a bulk call: its numbers come in shared memory by the bulk service, never
+    /// in a frame (and nothing else comes by the bulk service).
+    pub bulk: bool,
     /// The family that declares it (`"cam"`).
     pub family: &'static str,
 }
@@ -151,6 +159,14 @@ impl CallKind {
     pub const fn is_read_only(self) -> bool {
         match self.spec() {
             Some(spec) => spec.read_only,
+            None => false,
+        }
+    }
+
+    /// Whether the kind is a bulk call ([`CallSpec::bulk`]).
+    pub const fn is_bulk(self) -> bool {
+        match self.spec() {
+            Some(spec) => spec.bulk,
             None => false,
         }
     }

@@ -160,8 +160,7 @@ impl InProcess {
                 let view = CncView::new(&self.memory);
                 let machine = &mut self.machine;
                 let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
-                let _ = server
-                    .poll_rows(|kind, header, values| machine.dispatch_bulk(kind, header, values));
+                let _ = server.poll_rows(|_, header, values| machine.dispatch_bulk(header, values));
                 timeline.cycle_io(&mut PlcIo {
                     view: PlcView::new(&self.memory),
                     memory: &self.memory,

@@ -71,8 +71,7 @@ fn write(run: &mut InProcess, rows: &[[f64; 3]], overwrite: bool) -> FifoReply {
 /// A bulk call (a row block) answered by the machine, as the PLC's block reads it: a
 /// refused call as its error id.
 fn bulk(run: &mut InProcess, header: &BulkHeader, values: &[f64]) -> FifoReply {
-    let kind = CallKind::decode(header.kind).unwrap();
-    match run.machine.dispatch_bulk(kind, header, values) {
+    match run.machine.dispatch_bulk(header, values) {
         Ok((body, len)) => decode_reply::<FifoWriteRowsCall>(&body, len).unwrap(),
         Err(code) => FifoReply {
             error_id: code.raw(),
@@ -803,8 +802,16 @@ fn row_blocks_come_by_the_bulk_service_only() {
         columns: 3,
         rows: 1,
     };
-    let bulk = run
-        .machine
-        .dispatch_bulk(CallKind::FIFO_START, &header, &[0.0; 3]);
+    let bulk = run.machine.dispatch_bulk(&header, &[0.0; 3]);
     assert_eq!(bulk.unwrap_err(), ErrorCode::ServiceNotSupported);
+    // A machine without FIFO groups has no engine for row blocks: refused as any FIFO call.
+    let mut bare = cnc_core::machine::Machine::new(cnc_core::machine::MachineSetup {
+        channels: Vec::new(),
+        axes: Vec::new(),
+        engines: Vec::new(),
+        cycle_s: TICK,
+    })
+    .unwrap();
+    let rows = bare.dispatch_bulk(&rows_header(0, 3, 1, false), &[0.0; 3]);
+    assert_eq!(rows.unwrap_err(), ErrorCode::ServiceNotSupported);
 }

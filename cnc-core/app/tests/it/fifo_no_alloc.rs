@@ -69,9 +69,9 @@ impl Plc {
             let a0 = allocations();
             let (mut handler, mut freed) = (0, 0);
             server
-                .poll_rows(|kind, header, values| {
+                .poll_rows(|_, header, values| {
                     let (h0, f0) = (allocations(), deallocations());
-                    let reply = machine.dispatch_bulk(kind, header, values);
+                    let reply = machine.dispatch_bulk(header, values);
                     handler += allocations() - h0;
                     freed += deallocations() - f0;
                     reply

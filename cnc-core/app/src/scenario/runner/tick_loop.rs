@@ -277,7 +277,7 @@ impl<'a> TickLoop<'a> {
             .unwrap_or(0) as u64;
         self.measured.acyclic_answered += self
             .server
-            .poll_rows(|kind, header, values| self.machine.dispatch_bulk(kind, header, values))
+            .poll_rows(|_, header, values| self.machine.dispatch_bulk(header, values))
             .unwrap_or(0) as u64;
         let t3 = monotonic::now();
         let _ = self.events.notify();
