@@ -58,7 +58,7 @@ fn parse_and_decode(src: &str, axes: &[String]) -> (f64, f64) {
     let mut motions = 0usize;
     for index in 0..tree.blocks.len() {
         out.clear();
-        let semantic = decoder.decode_block(&tree, index, src, &ZeroVars, &mut out);
+        let semantic = decoder.decode_block_unlocated(&tree, index, src, &ZeroVars, &mut out);
         assert!(semantic.is_empty());
         motions += out
             .iter()

@@ -72,6 +72,17 @@ pub struct Call<'a> {
     pub others: Others<'a>,
 }
 
+/// A bulk call for an engine: its kind, its header and its numbers (read in place from shared
+/// memory; the transport has checked that `values` holds `rows x columns`).
+pub struct Bulk<'a> {
+    /// The call kind (one of the engine's bulk [`Engine::calls`]).
+    pub kind: CallKind,
+    /// Target and shape.
+    pub header: &'a BulkHeader,
+    /// The numbers, row after row.
+    pub values: &'a [f64],
+}
+
 /// A motion engine in the machine tick.
 pub trait Engine: std::fmt::Debug + Send {
     /// A short name for reports.
@@ -96,16 +107,10 @@ pub trait Engine: std::fmt::Debug + Send {
         Err(ErrorCode::ServiceNotSupported)
     }
 
-    /// A bulk call of one of its kinds (rows of numbers written straight into shared memory,
-    /// not copied into a frame; `header` says the kind, target and shape, the transport has
-    /// checked that `values` holds `rows x columns`), answered like [`Engine::handle`].
-    fn handle_bulk(
-        &mut self,
-        kind: CallKind,
-        header: &BulkHeader,
-        values: &[f64],
-    ) -> HandlerResult {
-        let _ = (kind, header, values);
+    /// A bulk call of one of its kinds (numbers written straight into shared memory, not
+    /// copied into a frame), answered like [`Engine::handle`].
+    fn handle_bulk(&mut self, call: Bulk<'_>) -> HandlerResult {
+        let _ = call;
         Err(ErrorCode::ServiceNotSupported)
     }
 

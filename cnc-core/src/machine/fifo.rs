@@ -17,7 +17,7 @@
 //! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
 //! are sized when the engine is built.
 
-use super::engine::{Call, Engine, EngineIo};
+use super::engine::{Bulk, Call, Engine, EngineIo};
 use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
@@ -541,20 +541,15 @@ impl Engine for FifoEngine {
         reply(&self.call(call.kind, call.request, call.axes))
     }
 
-    fn handle_bulk(
-        &mut self,
-        kind: CallKind,
-        header: &BulkHeader,
-        values: &[f64],
-    ) -> HandlerResult {
-        let overwrite = match kind {
+    fn handle_bulk(&mut self, call: Bulk<'_>) -> HandlerResult {
+        let overwrite = match call.kind {
             CallKind::FIFO_WRITE_ROWS => false,
             CallKind::FIFO_OVERWRITE_ROWS => true,
             // The other kinds come in a frame.
             _ => return Err(ErrorCode::ServiceNotSupported),
         };
-        reply(&match self.groups.get_mut(header.target as usize) {
-            Some(group) => group.write(header, values, overwrite),
+        reply(&match self.groups.get_mut(call.header.target as usize) {
+            Some(group) => group.write(call.header, call.values, overwrite),
             None => FifoReply {
                 error_id: FifoError::NoSuchGroup.raw(),
                 ..FifoReply::default()

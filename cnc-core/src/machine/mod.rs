@@ -29,7 +29,7 @@ pub mod gear;
 pub mod saw;
 
 pub use channel_axes::ChannelAxes;
-pub use engine::{Call, Engine, EngineIo, Others, Resource, RouteConflict, Routes};
+pub use engine::{Bulk, Call, Engine, EngineIo, Others, Resource, RouteConflict, Routes};
 
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
@@ -321,7 +321,11 @@ impl Machine {
             .routes
             .engine(kind)
             .ok_or(ErrorCode::ServiceNotSupported)?;
-        self.engines[engine].handle_bulk(kind, header, values)
+        self.engines[engine].handle_bulk(Bulk {
+            kind,
+            header,
+            values,
+        })
     }
 
     /// Brings the machine to a safe state (supervision, signals): every channel stops on

@@ -171,23 +171,9 @@ impl DecoderState {
     /// Decodes block `index` of `program` (parsed from `src`) with the variable values of
     /// `vars` now, appending its elements to `out`: how a channel consumes its program, one
     /// block when it reaches it. Returns the block's diagnostics (empty when it decoded
-    /// cleanly; nothing is allocated then). Where a control statement goes is in the
-    /// program's jump table ([`super::control::match_control`]).
-    pub fn decode_block(
-        &mut self,
-        program: &Program,
-        index: usize,
-        src: &str,
-        vars: &dyn Vars,
-        out: &mut Vec<Decoded>,
-    ) -> Vec<Diagnostic> {
-        let mut diags = self.decode_block_unlocated(program, index, src, vars, out);
-        super::locate(&mut diags, src);
-        diags
-    }
-
-    /// [`DecoderState::decode_block`] with the diagnostics' lines and columns left to count
-    /// ([`super::locate`]): a check counts them once for all.
+    /// cleanly; nothing is allocated then), their lines and columns left to count
+    /// ([`super::locate`]): a check counts them once for all. Where a control statement goes
+    /// is in the program's jump table ([`super::control::match_control`]).
     pub fn decode_block_unlocated(
         &mut self,
         program: &Program,
