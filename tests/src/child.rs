@@ -1,6 +1,5 @@
 //! A child process that never outlives its test, and signals sent to a process.
 
-use crate::cli::Cli;
 use std::io::{self, Read};
 use std::process::{Child, Command, ExitStatus, Output};
 use std::thread::JoinHandle;
@@ -13,6 +12,13 @@ impl ChildGuard {
     /// The child's process id.
     pub fn id(&self) -> u32 {
         self.0.id()
+    }
+
+    /// Kills the child and every process of its group (a child started by [`crate::Cli`] leads a
+    /// group of its own, so a PLC that `cnc run` spawned goes with it and no pipe stays open).
+    pub fn kill_group(&mut self) {
+        kill(&["-KILL", "--", &format!("-{}", self.id())]);
+        let _ = self.0.kill();
     }
 
     /// Sends the signal `name` to the child: [`signal`].
@@ -63,18 +69,6 @@ impl ChildGuard {
     }
 }
 
-impl ChildGuard {
-    /// Kills the child and every process of its group (a child started by [`Cli`] leads a
-    /// group of its own, so a PLC that `cnc run` spawned goes with it and no pipe stays open).
-    pub fn kill_group(&mut self) {
-        let _ = Command::new("kill")
-            .args(["-KILL", "--", &format!("-{}", self.id())])
-            .stderr(std::process::Stdio::null())
-            .status();
-        let _ = self.0.kill();
-    }
-}
-
 impl Drop for ChildGuard {
     fn drop(&mut self) {
         if let Ok(None) = self.0.try_wait() {
@@ -87,11 +81,17 @@ impl Drop for ChildGuard {
 /// Sends the signal `name` (`"TERM"`, `"KILL"`, `"STOP"`, ...) to process `pid` with
 /// `kill -NAME PID`; true when `kill` delivered it.
 pub fn signal(pid: u32, name: &str) -> bool {
-    Cli::new("kill")
-        .arg(format!("-{name}"))
-        .arg(pid.to_string())
-        .output()
-        .is_ok_and(|out| out.status.success())
+    kill(&[&format!("-{name}"), &pid.to_string()])
+}
+
+/// Runs `kill ARGS`; true when it delivered. `kill` returns at once, so it runs without the
+/// watchdog (whose expiry calls it: through [`crate::Cli`] it would call itself).
+fn kill(args: &[&str]) -> bool {
+    Command::new("kill")
+        .args(args)
+        .stderr(std::process::Stdio::null())
+        .status()
+        .is_ok_and(|status| status.success())
 }
 
 fn drain(pipe: Option<impl Read + Send + 'static>) -> Option<JoinHandle<Vec<u8>>> {
