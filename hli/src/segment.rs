@@ -22,11 +22,17 @@ use iceoryx2_bb_posix::shared_memory::{
     SharedMemoryCreationError,
 };
 use iceoryx2_bb_system_types::file_name::{FileName, SemanticString};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+mod guard;
+mod liveness;
+pub use guard::{CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS};
+pub use liveness::{HeartbeatWatch, PeerLiveness};
 
 /// "HLI-SEG1" as a little-endian u64.
 pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");
 /// Bumped whenever the meaning of the image changes without its layout changing.
-pub const LAYOUT_VERSION: u32 = 2;
+pub const LAYOUT_VERSION: u32 = 3;
 /// Size of the image in bytes.
 pub const IMAGE_SIZE: usize = size_of::<HliImage>();
 const HEADER_SIZE: usize = size_of::<HliSegmentHeader>();
@@ -157,6 +163,14 @@ pub enum AttachError {
         /// Claimed axes.
         axes: u32,
     },
+    /// The header announces a cycle or flags this build does not know.
+    #[error("segment header announces a CNC cycle of {cycle_ns} ns with flags 0x{flags:X} (cycle 1 us..1 s, flags 0x1)")]
+    InvalidTiming {
+        /// Announced cycle, ns.
+        cycle_ns: u32,
+        /// Announced flags.
+        flags: u32,
+    },
     /// The CNC has not finished creating the segment, or has shut down.
     #[error("segment {name} is not ready (state {state})")]
     NotReady {
@@ -192,9 +206,30 @@ fn file_name(name: &str) -> FileName {
 /// Start time of a process (clock ticks since boot) and whether it is still running, from
 /// `/proc`; `None` where there is no such process. Tells a live owner from a reused pid.
 fn process_start_stamp(pid: u32) -> Option<u64> {
-    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    start_stamp_at(&stat_path(pid))
+}
+
+fn stat_path(pid: u32) -> String {
+    format!("/proc/{pid}/stat")
+}
+
+/// [`process_start_stamp`] from the process's `stat` file, read into a buffer on the stack
+/// (no allocation: the PLC asks from its wait).
+fn start_stamp_at(path: &str) -> Option<u64> {
+    use std::io::Read;
+    let mut buf = [0u8; 4096];
+    let mut file = std::fs::File::open(path).ok()?;
+    let mut len = 0;
+    loop {
+        let n = file.read(buf.get_mut(len..)?).ok()?;
+        if n == 0 {
+            break;
+        }
+        len += n;
+    }
+    let stat = core::str::from_utf8(&buf[..len]).ok()?;
     // The command name (field 2) is in parentheses and may contain spaces.
-    let after_name = &stat[stat.rfind(')')? + 2..];
+    let after_name = stat.get(stat.rfind(')')? + 2..)?;
     let mut fields = after_name.split_whitespace();
     let state = fields.next()?;
     if state == "Z" || state == "X" {
@@ -255,11 +290,19 @@ macro_rules! segment_side {
             }
 
             /// Marks one more tick (CNC) or cycle (PLC) of this side; returns the new
-            /// heartbeat.
+            /// heartbeat. The count is this side's own: what the segment holds is written,
+            /// never read back.
             pub fn beat(&self) -> u64 {
+                let beats = self.beats.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
                 self.header()
                     .field::<u64>(offset_of!(HliSegmentHeader, $own))
-                    .increment()
+                    .store_release(beats);
+                beats
+            }
+
+            /// This side's heartbeats so far.
+            pub fn beats(&self) -> u64 {
+                self.beats.load(Ordering::Relaxed)
             }
 
             /// The other side's heartbeat.
@@ -284,14 +327,28 @@ pub struct CncSegment {
     memory: ImageMemory,
     name: String,
     replaced: Option<StaleSegment>,
+    /// The header as written at creation (Ready): what every check compares against.
+    expected: HliSegmentHeader,
+    beats: AtomicU64,
 }
 
 segment_side!(CncSegment, beats cnc_heartbeat, watches plc_heartbeat);
 
 impl CncSegment {
-    /// Creates the segment of `instance` for `channels` channels and `axes` axes. A segment
-    /// left behind by a crashed CNC is replaced; one whose owner is alive is refused.
+    /// Creates the segment of `instance` for `channels` channels and `axes` axes, announcing
+    /// the default timing (real time, 1 ms). A segment left behind by a crashed CNC is
+    /// replaced; one whose owner is alive is refused.
     pub fn create(instance: &str, channels: u32, axes: u32) -> Result<Self, CreateError> {
+        Self::create_with(instance, channels, axes, CncTiming::default())
+    }
+
+    /// [`CncSegment::create`] announcing `timing` to the PLC.
+    pub fn create_with(
+        instance: &str,
+        channels: u32,
+        axes: u32,
+        timing: CncTiming,
+    ) -> Result<Self, CreateError> {
         let name = segment_name(instance).ok_or_else(|| CreateError::InvalidName {
             name: instance.to_string(),
         })?;
@@ -330,12 +387,14 @@ impl CncSegment {
                 })
             }
         };
-        let segment = Self {
+        let mut segment = Self {
             memory: ImageMemory::shared(shm),
             name,
             replaced,
+            expected: bytemuck::Zeroable::zeroed(),
+            beats: AtomicU64::new(0),
         };
-        segment.write_header(channels, axes);
+        segment.expected = segment.write_header(channels, axes, timing);
         Ok(segment)
     }
 
@@ -371,20 +430,47 @@ impl CncSegment {
         })
     }
 
-    fn write_header(&self, channels: u32, axes: u32) {
+    /// Writes the header (Initialising), the PLC defaults, then Ready; returns the header as
+    /// it stands at Ready.
+    fn write_header(&self, channels: u32, axes: u32, timing: CncTiming) -> HliSegmentHeader {
         let pid = std::process::id();
         let header = self.header();
-        header.write(&initial_header(
+        let mut written = initial_header(
             channels,
             axes,
             SegmentState::Initialising,
             process_start_stamp(pid).unwrap_or(0),
-        ));
+            timing,
+        );
+        header.write(&written);
         // Before Ready: a PLC that attaches never sees the zeroed values.
         write_plc_defaults(&self.memory, channels);
         header
             .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
             .store_release(SegmentState::Ready.raw());
+        written.segment_state = SegmentState::Ready.raw();
+        written
+    }
+
+    /// Compares the CNC-owned header with what this CNC wrote: identity, state (Ready) and
+    /// `heartbeat`, the last heartbeat the CNC wrote. Reads a few words; no system call.
+    pub fn check_header(&self, heartbeat: u64) -> Result<(), HeaderFault> {
+        let found: HliSegmentHeader = self.header().read();
+        guard::compare_identity(&self.expected, &found)?;
+        guard::check_state(found.segment_state, &[SegmentState::Ready])?;
+        if found.cnc_heartbeat != heartbeat {
+            return Err(HeaderFault {
+                field: HeaderField::CncHeartbeat,
+                expected: heartbeat,
+                found: found.cnc_heartbeat,
+            });
+        }
+        Ok(())
+    }
+
+    /// The timing this CNC announced.
+    pub fn timing(&self) -> CncTiming {
+        CncTiming::of(&self.expected).unwrap_or_default()
     }
 
     /// The stale segment this one replaced, if any.
@@ -431,6 +517,12 @@ pub struct PlcSegment {
     axes: u32,
     /// This process wrote its pid into the header (a PLC, not a tool).
     claimed: bool,
+    /// The header as found at attach: what every check compares against.
+    seen: HliSegmentHeader,
+    /// `/proc/<cnc_pid>/stat` of the CNC named at attach.
+    cnc_stat: String,
+    timing: CncTiming,
+    beats: AtomicU64,
 }
 
 segment_side!(PlcSegment, beats plc_heartbeat, watches cnc_heartbeat);
@@ -526,6 +618,10 @@ impl PlcSegment {
                 axes: h.axis_count,
             });
         }
+        let timing = CncTiming::of(&h).ok_or(AttachError::InvalidTiming {
+            cycle_ns: h.cnc_cycle_ns,
+            flags: h.cnc_flags,
+        })?;
         if claim {
             header
                 .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
@@ -537,6 +633,10 @@ impl PlcSegment {
             channels: h.channel_count,
             axes: h.axis_count,
             claimed: claim,
+            seen: h,
+            cnc_stat: stat_path(h.cnc_pid),
+            timing,
+            beats: AtomicU64::new(h.plc_heartbeat),
         })
     }
 
@@ -559,62 +659,26 @@ impl PlcSegment {
         )
     }
 
-    /// Whether the CNC process that created the segment still runs.
+    /// Whether the CNC process that created the segment (as the header said at attach) still
+    /// runs. Reads `/proc`: a system call, for the PLC's wait, not for its cycle.
     pub fn cnc_process_alive(&self) -> bool {
-        let h: HliSegmentHeader = self.header().read();
-        process_start_stamp(h.cnc_pid) == Some(h.cnc_start_stamp)
-    }
-}
-
-/// Watches a peer's heartbeat from one's own cycle: the peer is lost when its counter has not
-/// moved for `limit` consecutive observations. No clocks, no sleeps: the observer's own cycle
-/// is the time base.
-#[derive(Debug, Clone)]
-pub struct HeartbeatWatch {
-    last: Option<u64>,
-    unchanged: u32,
-    limit: u32,
-}
-
-/// Verdict of a [`HeartbeatWatch`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PeerLiveness {
-    /// The counter moved recently.
-    Alive,
-    /// The counter has not moved yet since the watch started.
-    NotStarted,
-    /// The counter stood still for `limit` observations.
-    Lost,
-}
-
-impl HeartbeatWatch {
-    /// A watch that declares the peer lost after `limit` unchanged observations.
-    pub fn new(limit: u32) -> Self {
-        Self {
-            last: None,
-            unchanged: 0,
-            limit: limit.max(1),
-        }
+        start_stamp_at(&self.cnc_stat) == Some(self.seen.cnc_start_stamp)
     }
 
-    /// Feeds the current heartbeat value.
-    pub fn observe(&mut self, value: u64) -> PeerLiveness {
-        match self.last {
-            Some(last) if last == value => {
-                self.unchanged = self.unchanged.saturating_add(1);
-            }
-            Some(_) => self.unchanged = 0,
-            None => {
-                self.last = Some(value);
-                return PeerLiveness::NotStarted;
-            }
-        }
-        self.last = Some(value);
-        if self.unchanged >= self.limit {
-            PeerLiveness::Lost
-        } else {
-            PeerLiveness::Alive
-        }
+    /// The CNC's timing, as announced at attach.
+    pub fn cnc_timing(&self) -> CncTiming {
+        self.timing
+    }
+
+    /// Compares the CNC-owned header with what it was at attach: the identity must be
+    /// unchanged and the state Ready or Closed. Returns the state. Reads a few words.
+    pub fn check_header(&self) -> Result<SegmentState, HeaderFault> {
+        let found: HliSegmentHeader = self.header().read();
+        guard::compare_identity(&self.seen, &found)?;
+        guard::check_state(
+            found.segment_state,
+            &[SegmentState::Ready, SegmentState::Closed],
+        )
     }
 }
 
@@ -639,6 +703,7 @@ fn initial_header(
     axes: u32,
     state: SegmentState,
     start_stamp: u64,
+    timing: CncTiming,
 ) -> HliSegmentHeader {
     let identity = LayoutIdentity::current();
     HliSegmentHeader {
@@ -652,6 +717,8 @@ fn initial_header(
         cnc_pid: std::process::id(),
         segment_state: state.raw(),
         cnc_start_stamp: start_stamp,
+        cnc_cycle_ns: timing.cycle_ns,
+        cnc_flags: timing.flags(),
         ..bytemuck::Zeroable::zeroed()
     }
 }
@@ -664,6 +731,7 @@ pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
         axes,
         SegmentState::Ready,
         0,
+        CncTiming::default(),
     ));
     write_plc_defaults(&memory, channels);
     memory
@@ -683,17 +751,6 @@ const _: () = assert!(IMAGE_SIZE.is_multiple_of(8));
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn heartbeat_watch_declares_loss_after_limit() {
-        let mut w = HeartbeatWatch::new(3);
-        assert_eq!(w.observe(5), PeerLiveness::NotStarted);
-        assert_eq!(w.observe(6), PeerLiveness::Alive);
-        assert_eq!(w.observe(6), PeerLiveness::Alive);
-        assert_eq!(w.observe(6), PeerLiveness::Alive);
-        assert_eq!(w.observe(6), PeerLiveness::Lost);
-        assert_eq!(w.observe(7), PeerLiveness::Alive);
-    }
 
     #[test]
     fn names_are_checked() {

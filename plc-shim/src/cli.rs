@@ -31,8 +31,11 @@ pub struct HostArgs {
     /// CNC instance to attach to.
     #[arg(long, default_value = crate::tools::DEFAULT_INSTANCE)]
     pub instance: String,
-    /// Watchdog: wait steps of 10 ms without a CNC heartbeat before the CNC counts as lost.
-    #[arg(long, default_value_t = 100)]
+    /// Watchdog: CNC cycles (the cycle the CNC announces in the header) without a CNC
+    /// heartbeat before the CNC counts as lost; a CNC process that is gone is noticed two
+    /// cycles after its last tick. In lockstep and before the first tick the CNC has 10 s.
+    #[arg(long, default_value_t = crate::watchdog::DEFAULT_WATCHDOG_CYCLES,
+          value_parser = clap::value_parser!(u32).range(1..))]
     pub watchdog_cycles: u32,
     /// Task cycle as a multiple of the NC tick: run the program every N ticks (the heartbeat
     /// still follows every tick, so lockstep works with any N).
@@ -148,7 +151,8 @@ pub fn run(args: PlcArgs) -> ExitCode {
 /// Attaches to the CNC `args` names and runs `program` until the CNC ends, is lost, a signal
 /// arrives or the cycle limit is reached; prints the end, the task statistics and the
 /// program's summary. Exit codes: 0 the CNC closed (or the limit), 1 no CNC or a service
-/// failed, 3 the CNC was lost, 128 + signal number on SIGINT/SIGTERM.
+/// failed, 3 the CNC was lost, 5 the segment header was corrupted, 128 + signal number on
+/// SIGINT/SIGTERM.
 ///
 /// A PLC program in a user's crate is a type implementing [`PlcProgram`] and a `main` that
 /// parses [`HostArgs`] (flattened into its own arguments) and calls this (see
@@ -182,7 +186,14 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
             println!("{}", program.summary());
             runtime.detach();
             match summary.end {
-                crate::runtime::RunEnd::CncLost => ExitCode::from(3),
+                crate::runtime::RunEnd::CncLost(loss) => {
+                    eprintln!("plc: CNC lost: {loss}; the last cycle ran not operational");
+                    ExitCode::from(3)
+                }
+                crate::runtime::RunEnd::SegmentCorrupt(fault) => {
+                    eprintln!("plc: {fault}; the last cycle ran not operational");
+                    ExitCode::from(5)
+                }
                 crate::runtime::RunEnd::Signal(signal) => {
                     eprintln!("plc: stopped by {}", signal.name());
                     ExitCode::from(signal.exit_code())

@@ -13,5 +13,6 @@ pub mod realtime;
 pub mod runtime;
 pub mod timeline;
 pub mod tools;
+pub mod watchdog;
 
 pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

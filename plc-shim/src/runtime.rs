@@ -2,12 +2,18 @@
 //!
 //! ```text
 //!  attach segment ─► open events + acyclic client ─► loop:
-//!     wait "tick done" (timeout = one watchdog step)
+//!     wait "tick done" (timeout = one CNC cycle, at most the wait step)
+//!     CNC-owned header changed?  ─► last cycle (not operational), stop (segment corrupt)
 //!     CNC closed?  ─► stop (orderly)
-//!     CNC heartbeat unchanged for `watchdog_cycles` steps ─► stop (CNC lost)
+//!     CNC gone, or silent for `watchdog_cycles` of its cycles ([`crate::watchdog`])
+//!                  ─► last cycle (not operational), stop (CNC lost)
 //!     task due (every `period_ticks` NC ticks)? ─► program.cycle(io), timed
 //!     heartbeat += 1 ─► notify "cycle done"
 //! ```
+//!
+//! The last cycle after a loss runs with [`PlcIo::link`] = [`Link::NotOperational`], as a
+//! fieldbus master reports a lost slave: the program can see it, and every block of the
+//! kernel ([`crate::kernel`]) ends what it was doing with an error.
 //!
 //! The task runs on the CNC's "tick done" event: every tick (`period_ticks` = 1), or every
 //! N-th tick like a PLC task whose cycle is a multiple of the NC cycle. The heartbeat is
@@ -21,8 +27,11 @@ use hli::calls::CallError;
 use hli::enums::SegmentState;
 use hli::events::{EventError, EventLink, Side};
 use hli::rpc::AcyclicClient;
-use hli::segment::{AttachError, HeartbeatWatch, PeerLiveness, PlcSegment};
+use hli::segment::{AttachError, HeaderFault, PlcSegment};
 use hli::views::PlcView;
+
+pub use crate::watchdog::CncLoss;
+use crate::watchdog::CncWatch;
 
 /// Why the runtime could not start or had to stop.
 #[derive(Debug, thiserror::Error)]
@@ -51,6 +60,19 @@ pub struct PlcIo<'a> {
     pub acyclic: &'a mut AcyclicClient,
     /// Cycles run so far (0 in the first cycle).
     pub cycle: u64,
+    /// Whether the CNC is there ([`Link::NotOperational`] in the last cycle after a loss).
+    pub link: Link,
+}
+
+/// The state of the link to the CNC a program sees, like a fieldbus's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Link {
+    /// The CNC ticks; the image is live.
+    #[default]
+    Operational,
+    /// The CNC is lost or its segment is corrupted: nothing written reaches a machine, nothing
+    /// read is current. The runtime stops after this cycle.
+    NotOperational,
 }
 
 impl<'a> PlcIo<'a> {
@@ -174,8 +196,10 @@ impl RunSummary {
 pub enum RunEnd {
     /// The CNC marked the segment closed.
     CncClosed,
-    /// The CNC's heartbeat stopped (crash or hang).
-    CncLost,
+    /// The CNC process is gone or stopped ticking.
+    CncLost(CncLoss),
+    /// A CNC-owned header field changed (someone wrote where only the CNC writes).
+    SegmentCorrupt(HeaderFault),
     /// The cycle limit was reached.
     CycleLimit,
     /// A termination signal arrived (see [`hli::signals`]).
@@ -193,8 +217,9 @@ pub struct PlcRuntime {
 }
 
 impl PlcRuntime {
-    /// Attaches to `instance`. `watchdog_cycles` wait steps of `wait_step` without a CNC
-    /// heartbeat declare the CNC lost.
+    /// Attaches to `instance`. `watchdog_cycles` of the CNC's cycles (from the header) without
+    /// a heartbeat declare the CNC lost ([`crate::watchdog`]); a wait for a tick lasts one CNC
+    /// cycle, at most `wait_step`.
     pub fn attach(
         instance: &str,
         watchdog_cycles: u32,
@@ -203,6 +228,12 @@ impl PlcRuntime {
         let segment = PlcSegment::attach(instance)?;
         let events = EventLink::open(instance, Side::Plc)?;
         let acyclic = AcyclicClient::open(instance)?;
+        let timing = segment.cnc_timing();
+        let wait_step = if timing.lockstep {
+            wait_step
+        } else {
+            wait_step.min(timing.cycle())
+        };
         Ok(Self {
             segment,
             events,
@@ -236,7 +267,12 @@ impl PlcRuntime {
         program: &mut dyn PlcProgram,
         max_cycles: Option<u64>,
     ) -> Result<RunSummary, RuntimeError> {
-        let mut watch = HeartbeatWatch::new(self.watchdog_cycles);
+        let mut watch = CncWatch::new(
+            self.segment.cnc_timing(),
+            self.watchdog_cycles,
+            self.segment.cnc_heartbeat(),
+            cnc_os::monotonic::now(),
+        );
         let mut stats = CycleStats::default();
         let end = |end, stats: CycleStats| Ok(RunSummary { end, stats });
         // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
@@ -258,12 +294,12 @@ impl PlcRuntime {
                 }
             }
             self.events.wait(self.wait_step)?;
-            if self.segment.cnc_state() != Ok(SegmentState::Ready) {
-                return end(RunEnd::CncClosed, stats);
-            }
             let beat = self.segment.cnc_heartbeat();
-            if watch.observe(beat) == PeerLiveness::Lost {
-                return end(RunEnd::CncLost, stats);
+            if let Some(ended) = self.supervise(&mut watch, beat) {
+                if ended != RunEnd::CncClosed {
+                    self.last_cycle(program, &mut stats);
+                }
+                return end(ended, stats);
             }
             if beat == last_cnc_beat {
                 continue; // woken without a new tick (timeout): no cycle
@@ -279,6 +315,7 @@ impl PlcRuntime {
                     memory: self.segment.memory(),
                     acyclic: &mut self.acyclic,
                     cycle: stats.cycles,
+                    link: Link::Operational,
                 };
                 let start = cnc_os::monotonic::now();
                 program.cycle(&mut io);
@@ -288,5 +325,35 @@ impl PlcRuntime {
             self.segment.beat();
             self.events.notify()?;
         }
+    }
+}
+
+impl PlcRuntime {
+    /// After a wake-up that found heartbeat `beat`: how the run ends, if it does (a corrupted
+    /// header before an orderly close, a close before a silence).
+    fn supervise(&self, watch: &mut CncWatch, beat: u64) -> Option<RunEnd> {
+        match self.segment.check_header() {
+            Err(fault) => return Some(RunEnd::SegmentCorrupt(fault)),
+            Ok(SegmentState::Ready) => {}
+            Ok(_) => return Some(RunEnd::CncClosed),
+        }
+        let now = cnc_os::monotonic::now();
+        watch
+            .observe(beat, now, || self.segment.cnc_process_alive())
+            .err()
+            .map(RunEnd::CncLost)
+    }
+
+    /// The program's cycle after a loss: [`Link::NotOperational`], not timed as a task cycle
+    /// and no heartbeat after it.
+    fn last_cycle(&mut self, program: &mut dyn PlcProgram, stats: &mut CycleStats) {
+        let mut io = PlcIo {
+            view: PlcView::new(self.segment.memory()),
+            memory: self.segment.memory(),
+            acyclic: &mut self.acyclic,
+            cycle: stats.cycles,
+            link: Link::NotOperational,
+        };
+        program.cycle(&mut io);
     }
 }

@@ -14,6 +14,7 @@ fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u6
         memory,
         acyclic: client,
         cycle,
+        link: plc_shim::runtime::Link::Operational,
     }
 }
 

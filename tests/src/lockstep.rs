@@ -17,7 +17,13 @@ pub fn serve_axes_in_lockstep(
     finished: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<bool> {
     use hli::calls::CallKind;
-    let segment = hli::segment::CncSegment::create(instance, 1, axes).unwrap();
+    let segment = hli::segment::CncSegment::create_with(
+        instance,
+        1,
+        axes,
+        hli::segment::CncTiming::lockstep(),
+    )
+    .unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let cnc = std::thread::spawn(move || {
@@ -69,7 +75,9 @@ pub fn lockstep_script(
     step: u64,
     mut script: impl FnMut(&hli::views::CncView<'_>, u64) + Send + 'static,
 ) -> std::thread::JoinHandle<()> {
-    let segment = hli::segment::CncSegment::create(instance, 1, 1).unwrap();
+    let segment =
+        hli::segment::CncSegment::create_with(instance, 1, 1, hli::segment::CncTiming::lockstep())
+            .unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let cnc = std::thread::spawn(move || {

@@ -38,7 +38,7 @@ use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::calls::{decode_body, reply, AcyclicCall, CallKind, ErrorCode, HandlerResult};
-use hli::enums::DynCsState;
+use hli::enums::{AxisError, DynCsState};
 use hli::layout::HLI_MAX_AXES;
 use hli::views::{handle_read_axis_state, CncView};
 use hli::wire::{AcyclicRequest, BulkHeader};
@@ -95,6 +95,9 @@ pub struct Machine {
     engines: Vec<Box<dyn Engine>>,
     routes: Routes,
     heartbeat: Leaf,
+    /// Heartbeats written before the first tick (a real-time start announces ticks before the
+    /// loop): tick N writes `heartbeat_base + N + 1`.
+    heartbeat_base: u64,
     ticks: u64,
     commanded: Vec<Isometry3<f64>>,
     max_tracking_error: Vec<f64>,
@@ -153,6 +156,7 @@ impl Machine {
             engines,
             routes,
             heartbeat: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
+            heartbeat_base: 0,
             ticks: 0,
             commanded: vec![Isometry3::identity(); n],
             max_tracking_error: vec![0.0; n],
@@ -203,7 +207,10 @@ impl Machine {
         }
         // 7 CNC units
         self.controller.write_plc(&view);
-        memory.place::<u64>(self.heartbeat.offset).increment();
+        // The machine's own count, never read back from the segment.
+        memory
+            .place::<u64>(self.heartbeat.offset)
+            .store_release(self.heartbeat_base + self.ticks + 1);
         self.measure_tracking();
         self.ticks += 1;
     }
@@ -351,17 +358,29 @@ impl Machine {
         }
     }
 
-    /// Whether every channel and every axis has come to rest (set-point velocity 0).
+    /// Whether every channel and every axis has come to rest (set-point velocity 0). An
+    /// axis in error counts as at rest: its set-point stood still at the fault and its drive
+    /// is not trusted to arrive ([`Machine::held_by_fault`] names them).
     pub fn at_rest(&self) -> bool {
         let channels = self.controller.channels().iter().all(|c| !c.stopping());
         // Set-points at rest and the drives arrived (following error inside the window).
         let axes = (0..self.axes.len()).all(|i| {
             self.axes.axis(i).is_none_or(|a| {
-                a.setpoint().velocity == 0.0
-                    && a.following_error().abs() <= a.config().in_target_window
+                a.error().is_some()
+                    || (a.setpoint().velocity == 0.0
+                        && a.following_error().abs() <= a.config().in_target_window)
             })
         });
         channels && axes
+    }
+
+    /// The axes in error: each stands where its fault stopped its set-point (not braked) and
+    /// its controller output is zero.
+    pub fn held_by_fault(&self) -> impl Iterator<Item = (&str, AxisError)> + '_ {
+        (0..self.axes.len()).filter_map(|i| {
+            let a = self.axes.axis(i)?;
+            Some((a.config().name.as_str(), a.error()?))
+        })
     }
 
     /// Per channel, the largest distance (mm) in ACTIVE between the tool point the actual
@@ -373,6 +392,17 @@ impl Machine {
     /// Ticks done.
     pub fn ticks(&self) -> u64 {
         self.ticks
+    }
+
+    /// Before the first tick: `beats` heartbeats were already written (ticks announced before
+    /// the loop), so tick N writes `beats + N + 1`.
+    pub fn start_heartbeat_at(&mut self, beats: u64) {
+        self.heartbeat_base = beats;
+    }
+
+    /// The heartbeat the last tick wrote (the base before the first tick).
+    pub fn heartbeat(&self) -> u64 {
+        self.heartbeat_base + self.ticks
     }
 
     /// Axis images in use (at least 1).

@@ -39,8 +39,11 @@ hli_struct! {
         pub segment_state: u32 => [44, Cnc],
         /// Boot time of the CNC's process (ns since an arbitrary epoch) to tell pid reuse apart.
         pub cnc_start_stamp: u64 => [48, Cnc],
-        /// Padding.
-        pub fill_up_1: u64 => [56, Cnc],
+        /// The CNC's cycle in nanoseconds: the PLC's time base for noticing a silent CNC.
+        pub cnc_cycle_ns: u32 => [56, Cnc],
+        /// Bit 0: lockstep (the CNC ticks only after the PLC's cycle, so its ticks keep no
+        /// clock and a silent CNC is given the lockstep patience).
+        pub cnc_flags: u32 => [60, Cnc],
         /// Incremented by the CNC once per tick.
         pub cnc_heartbeat: u64 => [64, Cnc],
         /// Padding up to the next cache line.

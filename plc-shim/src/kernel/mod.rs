@@ -17,12 +17,14 @@
 //!   exclusive and end it;
 //! * an answer that takes more than `timeout_cycles` PLC cycles (tTimeout; default
 //!   [`DEFAULT_TIMEOUT_CYCLES`], about the seeds' one second) ends the command with
-//!   [`ERROR_NO_ANSWER`]; so does a call that cannot be sent;
+//!   [`ERROR_NO_ANSWER`]; so does a call that cannot be sent, and, at once, every command
+//!   running or starting while the link to the CNC is not operational
+//!   ([`crate::runtime::Link`]);
 //! * the outputs of an ended command hold while Execute stays TRUE and clear in the cycle
 //!   Execute is seen FALSE; a command that ends while Execute is already FALSE (a short
 //!   pulse) shows its result for exactly one cycle.
 
-use crate::runtime::PlcIo;
+use crate::runtime::{Link, PlcIo};
 use hli::calls::{AcyclicCall, CallError};
 use hli::rpc::{PendingCall, PendingRows};
 
@@ -315,6 +317,9 @@ impl<P: InFlight, F, X: Copy + Default> Kernel<P, F, X> {
         accept: impl FnOnce(P::Reply) -> Accept<F, X>,
         follow: impl FnOnce(&mut F, &mut PlcIo<'_>, Waited) -> Step<X>,
     ) -> Outputs<X> {
+        if io.link == Link::NotOperational {
+            return self.not_operational(execute);
+        }
         let rising = execute && !self.execute_before;
         self.fell = !execute && self.execute_before;
         self.execute_before = execute;
@@ -328,6 +333,20 @@ impl<P: InFlight, F, X: Copy + Default> Kernel<P, F, X> {
         }
         self.poll(io, buffer, accept);
         self.follow(io, follow);
+        self.finish(execute)
+    }
+
+    /// The CNC is gone: a command on its way or followed ends with [`ERROR_NO_ANSWER`], and
+    /// so does a rising Execute, at once (no call is sent, no timeout waited for).
+    fn not_operational(&mut self, execute: bool) -> Outputs<X> {
+        let rising = execute && !self.execute_before;
+        self.fell = !execute && self.execute_before;
+        self.execute_before = execute;
+        if self.running() || rising {
+            self.phase = Phase::Idle;
+            self.show_once = !execute;
+            self.out = Outputs::failed(ERROR_NO_ANSWER);
+        }
         self.finish(execute)
     }
 

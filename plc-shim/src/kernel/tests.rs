@@ -356,12 +356,18 @@ impl Cnc {
 
     /// One PLC cycle of `block`.
     fn run(&mut self, block: &mut Cycle, execute: bool) -> Seen {
+        self.run_on(block, execute, crate::runtime::Link::Operational)
+    }
+
+    /// One PLC cycle of `block` with the link to the CNC in state `link`.
+    fn run_on(&mut self, block: &mut Cycle, execute: bool, link: crate::runtime::Link) -> Seen {
         self.cycle += 1;
         let mut io = PlcIo {
             view: PlcView::new(&self.memory),
             memory: &self.memory,
             acyclic: &mut self.client,
             cycle: self.cycle,
+            link,
         };
         block(&mut io, execute)
     }
@@ -398,6 +404,43 @@ const REFUSED: Seen = Seen {
     error: true,
     error_id: 0x706,
 };
+
+/// The outputs of every block whose command ends because the CNC is gone.
+const NOT_OPERATIONAL: Seen = Seen {
+    done: false,
+    busy: false,
+    aborted: false,
+    error: true,
+    error_id: ERROR_NO_ANSWER,
+};
+
+#[test]
+fn a_lost_cnc_ends_every_command_with_an_error_at_once() {
+    use crate::runtime::Link::NotOperational;
+    for (name, mut block) in blocks() {
+        let mut cnc = Cnc::new("lost", name);
+        assert!(cnc.run(&mut block, true).busy, "{name}: Busy from the edge");
+        // The call is on its way, never answered: the loss ends it in the same cycle.
+        assert_eq!(
+            cnc.run_on(&mut block, true, NotOperational),
+            NOT_OPERATIONAL,
+            "{name}: a running command"
+        );
+        assert_eq!(
+            cnc.run_on(&mut block, false, NotOperational),
+            Seen::default(),
+            "{name}: cleared with the falling edge"
+        );
+        cnc.refuse(); // what went out so far (MC_Stop releases on the falling edge)
+                      // A new Execute while the CNC is gone sends nothing and fails at once.
+        assert_eq!(
+            cnc.run_on(&mut block, true, NotOperational),
+            NOT_OPERATIONAL,
+            "{name}: a rising Execute"
+        );
+        assert_eq!(cnc.refuse(), 0, "{name}: no call on a lost link");
+    }
+}
 
 #[test]
 fn a_refusal_holds_while_execute_stays_true_and_clears_when_it_falls() {

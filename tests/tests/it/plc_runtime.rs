@@ -23,7 +23,14 @@ fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
     // finished before the loop started (lockstep needs that cycle); without new ticks no
     // further cycle runs.
     let summary = runtime.run(&mut Idle, Some(1_000)).unwrap();
-    assert_eq!(summary.end, RunEnd::CncLost);
+    assert!(
+        matches!(
+            summary.end,
+            RunEnd::CncLost(plc_shim::runtime::CncLoss::Dead { .. })
+        ),
+        "{:?}",
+        summary.end
+    );
     assert!(
         summary.cycles() <= 1,
         "{} cycles without CNC ticks",

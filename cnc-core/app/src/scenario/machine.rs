@@ -166,6 +166,7 @@ impl InProcess {
                     memory: &self.memory,
                     acyclic: client,
                     cycle: self.plc_cycles,
+                    link: plc_shim::runtime::Link::Operational,
                 });
             }
             None => {

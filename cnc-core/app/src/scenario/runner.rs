@@ -101,6 +101,14 @@ pub enum StopCause {
         /// What happened to the PLC process.
         detail: String,
     },
+    /// A CNC-owned header field of the segment changed: someone wrote where only the CNC
+    /// writes.
+    SegmentCorrupt {
+        /// The tick the CNC noticed it.
+        tick: u64,
+        /// Which field, what the CNC wrote, what it found.
+        fault: hli::segment::HeaderFault,
+    },
     /// SIGINT or SIGTERM.
     Signal {
         /// The tick it was noticed at.
@@ -111,10 +119,12 @@ pub enum StopCause {
 }
 
 impl StopCause {
-    /// The exit code `cnc run` ends with: 4 for a lost PLC, 128 + signal for a signal.
+    /// The exit code `cnc run` ends with: 4 for a lost PLC, 5 for a corrupted segment
+    /// header, 128 + signal for a signal.
     pub fn exit_code(&self) -> u8 {
         match self {
             StopCause::PlcLost { .. } => 4,
+            StopCause::SegmentCorrupt { .. } => 5,
             StopCause::Signal { signal, .. } => signal.exit_code(),
         }
     }
@@ -124,6 +134,9 @@ impl StopCause {
         match self {
             StopCause::PlcLost { tick, detail } => {
                 format!("PLC lost at tick {tick}: {detail}; stopping the machine")
+            }
+            StopCause::SegmentCorrupt { tick, fault } => {
+                format!("{fault} (noticed at tick {tick}); stopping the machine")
             }
             StopCause::Signal { tick, signal } => {
                 format!("{} at tick {tick}: stopping the machine", signal.name())
@@ -197,6 +210,8 @@ pub struct RunReport {
     pub rest_after: Option<u64>,
     /// Real-time options in force in the tick loop.
     pub realtime: Vec<String>,
+    /// Axes in error at the end: held where their fault stopped them, not braked.
+    pub held_by_fault: Vec<String>,
 }
 
 /// `cnc run`.
@@ -321,6 +336,10 @@ fn run_machine(
         stop: ending.stop.map(|(cause, _)| cause),
         rest_after: ending.rest_after,
         realtime,
+        held_by_fault: machine
+            .held_by_fault()
+            .map(|(name, error)| format!("{name} ({error:?})"))
+            .collect(),
     })
 }
 
@@ -341,10 +360,18 @@ impl PlcLink {
         machine: &Machine,
         options: &RunOptions,
     ) -> Result<PlcLink, String> {
-        let segment = CncSegment::create(
+        let timing = hli::segment::CncTiming {
+            cycle_ns: (scenario.cycle_s * 1e9).round().clamp(
+                f64::from(hli::segment::MIN_CYCLE_NS),
+                f64::from(hli::segment::MAX_CYCLE_NS),
+            ) as u32,
+            lockstep: options.lockstep,
+        };
+        let segment = CncSegment::create_with(
             &options.instance,
             scenario.channels.len() as u32,
             machine.axis_images() as u32,
+            timing,
         )
         .map_err(|e| e.to_string())?;
         let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
@@ -393,8 +420,16 @@ impl PlcLink {
         drop(self.segment); // marks the segment closed: the PLC stops
         match self.child {
             Some(mut child) => {
-                if ending.forced || matches!(ending.stop, Some((StopCause::PlcLost { .. }, _))) {
-                    // A lost PLC may be hung: it would never see the segment close.
+                let untrusted = matches!(
+                    ending.stop,
+                    Some((
+                        StopCause::PlcLost { .. } | StopCause::SegmentCorrupt { .. },
+                        _
+                    ))
+                );
+                if ending.forced || untrusted {
+                    // A lost PLC may be hung, one that wrote over the header may be anything:
+                    // neither can be relied on to see the segment close.
                     let _ = child.kill();
                 }
                 wait_for_exit(child)
@@ -496,6 +531,12 @@ impl RunReport {
             };
             out.push_str(&format!("stopped: {}; {rest}\n", cause.message()));
         }
+        if !self.held_by_fault.is_empty() {
+            out.push_str(&format!(
+                "axes in error, held where their fault stopped them (not braked, output 0): {}\n",
+                self.held_by_fault.join(", ")
+            ));
+        }
         out.push_str(&self.plc_output);
         out
     }
@@ -547,6 +588,8 @@ enum PlcWait {
 
 /// The channel reason for a stop on a lost PLC.
 const STOP_REASON_PLC: &str = "machine stop: PLC lost";
+/// The channel reason for a stop on a corrupted segment header.
+const STOP_REASON_SEGMENT: &str = "machine stop: segment header corrupted";
 /// The channel reason for a stop on SIGINT/SIGTERM.
 const STOP_REASON_SIGNAL: &str = "machine stop: termination requested";
 

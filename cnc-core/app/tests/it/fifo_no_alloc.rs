@@ -86,6 +86,7 @@ impl Plc {
                 memory: &run.memory,
                 acyclic: &mut self.client,
                 cycle: self.cycle,
+                link: plc_shim::runtime::Link::Operational,
             };
             self.cycle += 1;
             if self.sending == 0 && !self.lowering && self.sent < ROWS {

@@ -114,6 +114,7 @@ fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u6
         memory,
         acyclic: client,
         cycle,
+        link: crate::runtime::Link::Operational,
     }
 }
 

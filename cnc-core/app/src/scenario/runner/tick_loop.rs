@@ -6,7 +6,7 @@
 use super::{
     describe_plc, wait_for_plc_cycle, PlcLink, PlcWait, RunOptions, StopCause,
     DEFAULT_PLC_WATCHDOG_TICKS, DEFAULT_TICK_LIMIT, STOP_LIMIT_S, STOP_REASON_PLC,
-    STOP_REASON_SIGNAL,
+    STOP_REASON_SEGMENT, STOP_REASON_SIGNAL,
 };
 use crate::progress::{Progress, TickCounter};
 use crate::scenario::file::Scenario;
@@ -158,6 +158,8 @@ impl<'a> TickLoop<'a> {
             server,
             child,
         } = link;
+        // Ticks announced while the PLC started count as heartbeats already written.
+        machine.start_heartbeat_at(segment.beats());
         let start = monotonic::now();
         let plc_seen = (segment.plc_heartbeat(), monotonic::now());
         let log_stream = options
@@ -206,6 +208,9 @@ impl<'a> TickLoop<'a> {
             self.step(tick, deadline, memory, &view);
             // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on
             // it before the tick), its process now and then, and termination requests.
+            if self.ending.stop.is_none() {
+                self.check_header(tick);
+            }
             if self.ending.stop.is_none() && !self.options.lockstep {
                 self.watch_plc(tick);
             }
@@ -310,6 +315,17 @@ impl<'a> TickLoop<'a> {
             let silent_ticks = (silent.as_secs_f64() / self.scenario.cycle_s) as u64;
             let detail = describe_plc(child, exited, silent_ticks);
             self.lose_plc(tick, detail);
+        }
+    }
+
+    /// After tick `tick`: the CNC-owned header must be as the CNC wrote it; a changed field
+    /// stops the machine (the PLC sees the same change and stops on its side).
+    fn check_header(&mut self, tick: u64) {
+        if let Err(fault) = self.segment.check_header(self.machine.heartbeat()) {
+            let cause = StopCause::SegmentCorrupt { tick, fault };
+            eprintln!("cnc run: {}", cause.message());
+            self.machine.stop(STOP_REASON_SEGMENT);
+            self.ending.stop = Some((cause, tick));
         }
     }
 
