@@ -55,6 +55,10 @@ impl Lease {
 pub struct AxisSet {
     axes: Vec<Axis>,
     drives: Vec<Option<SimulatedDrive>>,
+    /// What each simulated drive answered last, as written into the image: the axis reads
+    /// these, never its own drive's answer back from the segment (where the PLC could have
+    /// written over it). Unused for external drives, whose inputs come by the image.
+    sim_inputs: Vec<(NcEncoderIn, NcDriveIn)>,
 }
 
 impl AxisSet {
@@ -72,7 +76,7 @@ impl AxisSet {
                 return Err(AxisSetError::Duplicate(c.name.clone()));
             }
         }
-        let drives = configs
+        let drives: Vec<Option<SimulatedDrive>> = configs
             .iter()
             .map(|c| match c.drive {
                 DriveLink::Simulated(sim) => Some(SimulatedDrive::new(
@@ -94,7 +98,21 @@ impl AxisSet {
             })
             .collect();
         let axes = configs.into_iter().map(|c| Axis::new(c, cycle_s)).collect();
-        Ok(Self { axes, drives })
+        let sim_inputs = drives
+            .iter()
+            .map(|d| {
+                let enc_in = d.as_ref().map(SimulatedDrive::encoder_in);
+                (
+                    enc_in.unwrap_or_else(bytemuck::Zeroable::zeroed),
+                    bytemuck::Zeroable::zeroed(),
+                )
+            })
+            .collect();
+        Ok(Self {
+            axes,
+            drives,
+            sim_inputs,
+        })
     }
 
     /// Number of axes.
@@ -185,18 +203,52 @@ impl AxisSet {
         self.act(view);
     }
 
-    /// First half of the axis stage: every axis reads its inputs and free axes run their
-    /// generators, so engines see this tick's set-points of their masters.
+    /// First half of the axis stage: every axis reads its inputs (an external drive's from
+    /// the image, a simulated drive's as it answered) and free axes run their generators, so
+    /// engines see this tick's set-points of their masters. A slave whose master axis is in
+    /// error is let go and brakes ([`AxisSet::release_orphans`]).
     pub fn sense(&mut self, view: &CncView<'_>) {
         for (i, axis) in self.axes.iter_mut().enumerate() {
             let Ok(place) = view.axis(i) else { continue };
-            let enc_in: NcEncoderIn = place
-                .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
-                .read();
-            let drive_in: NcDriveIn = place
-                .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
-                .read();
+            let (enc_in, drive_in) = match self.drives[i] {
+                Some(_) => self.sim_inputs[i],
+                None => (
+                    place
+                        .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
+                        .read(),
+                    place
+                        .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
+                        .read(),
+                ),
+            };
             axis.sense(&enc_in, &drive_in);
+        }
+        self.release_orphans();
+    }
+
+    /// A slave coupled to a master axis that is in error (its set-point stands at once)
+    /// would stop with it, without braking: it is let go with the motion it had and brakes
+    /// with its own deceleration and jerk (MC_Stop). The engine that held it sees its lease
+    /// gone.
+    fn release_orphans(&mut self) {
+        for i in 0..self.axes.len() {
+            let Some(master) = self.axes[i]
+                .coupling()
+                .and_then(|c| usize::try_from(c.master).ok())
+            else {
+                continue;
+            };
+            if master == i || self.axes.get(master).is_none_or(|m| m.error().is_none()) {
+                continue;
+            }
+            let axis = &mut self.axes[i];
+            axis.decouple();
+            let d = axis.config().dynamics;
+            // Refused only by an axis that may not move: it stands already.
+            let _ = axis.command(&hli::calls::axis::AxisCommandCall::stop(
+                d.deceleration,
+                d.jerk,
+            ));
         }
     }
 
@@ -223,12 +275,14 @@ impl AxisSet {
                 .write(&out.drive_state);
             if let Some(drive) = drive {
                 let drive_in = drive.step(&out.drive_out, &out.enc_out);
+                let enc_in = drive.encoder_in();
+                self.sim_inputs[i] = (enc_in, drive_in);
                 place
                     .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
                     .write(&drive_in);
                 place
                     .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
-                    .write(&drive.encoder_in());
+                    .write(&enc_in);
             }
         }
     }

@@ -329,3 +329,109 @@ fn a_tracking_slave_drives_its_axis_images_through_simulated_drives() {
         CouplingState::Channel.raw()
     );
 }
+
+#[test]
+fn a_gear_slave_whose_master_faults_brakes_with_its_own_deceleration() {
+    // The channel's X faults (a 2 Hz drive cannot follow); its gear slave, moving at speed,
+    // must not stop with it in one tick: it is let go with the motion it had and brakes
+    // (MC_Stop) with its own deceleration and jerk.
+    let toml = "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+        program = \"c.nc\"\nlimits = { velocity = 1000.0, acceleration = 20000.0, jerk = 2000000.0 }\n\
+        drive = { model = \"pt2\", frequency_hz = 2.0, damping = 0.3 }\n\
+        [[axis]]\nname = \"Feed\"\npower = true\nvelocity = 5000.0\nacceleration = 20000.0\n\
+        deceleration = 2000.0\njerk = 2000000.0\n\
+        [[gear]]\nmaster = \"c.X\"\nslave = \"Feed\"\nratio = 1.0\n";
+    let s = Scenario::parse("orphan.toml", toml, |f| {
+        Ok((PathBuf::from(f), "%c\nG0 X400\nG0 X0\nM30\n".to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let feed = |run: &InProcess| run.machine.axes().axis(FEED).unwrap().setpoint();
+    let mut fault_at = None;
+    let mut at_fault = feed(&run);
+    let mut last = feed(&run);
+    for tick in 0..5000 {
+        run.step(s.cycle_s);
+        let now = feed(&run);
+        if fault_at.is_none() && run.machine.axes().axis(0).unwrap().error().is_some() {
+            fault_at = Some(tick);
+            at_fault = last;
+        }
+        // The fault comes at the end of tick `at`; from the next tick on the slave moves
+        // within its limits: acceleration at most 20000 mm/s², its change at most the jerk.
+        if fault_at.is_some_and(|at| tick > at) {
+            assert!(
+                (now.velocity - last.velocity).abs() <= 20.0 + 1e-6,
+                "tick {tick}: the slave's velocity jumped from {} to {}",
+                last.velocity,
+                now.velocity
+            );
+            assert!(
+                now.acceleration.abs() <= 20_000.0 + 1e-6,
+                "tick {tick}: {now:?}"
+            );
+            assert!(
+                (now.acceleration - last.acceleration).abs() <= 2_000.0 + 1e-6,
+                "tick {tick}: {last:?} -> {now:?}"
+            );
+        }
+        last = now;
+    }
+    assert!(fault_at.is_some(), "the master never faulted");
+    assert!(
+        at_fault.velocity.abs() > 10.0,
+        "the slave moved at the fault: {at_fault:?}"
+    );
+    let slave = run.machine.axes().axis(FEED).unwrap();
+    assert_eq!(slave.error(), None, "the slave itself is sound");
+    assert_eq!(slave.setpoint().velocity, 0.0, "and came to rest");
+    assert!(
+        run.machine.at_rest(),
+        "the faulted master counts as held, not moving"
+    );
+    let held: Vec<_> = run
+        .machine
+        .held_by_fault()
+        .map(|(n, _)| n.to_string())
+        .collect();
+    assert_eq!(held, ["c.X"]);
+}
+
+#[test]
+fn garbage_over_simulated_drive_inputs_in_the_image_is_not_taken_back() {
+    // A PLC that writes over the axis image's inputs of simulated drives (which the CNC
+    // itself wrote there) changes nothing: the axes keep reading their drives' answers.
+    use hli::layout::{NcDriveIn, NcEncoderIn};
+    let s = scenario(GEARED).unwrap();
+    let mut clean = InProcess::new(&s, 0).unwrap();
+    let mut hammered = InProcess::new(&s, 0).unwrap();
+    let mut noise = 0x9E37_79B9_7F4A_7C15u64;
+    for _ in 0..3000 {
+        clean.step(s.cycle_s);
+        for axis in 0..=FEED {
+            let place = CncView::new(&hammered.memory).axis(axis).unwrap();
+            noise = noise.rotate_left(13) ^ 0xD1B5_4A32_D192_ED03;
+            let mut enc: NcEncoderIn = bytemuck::Zeroable::zeroed();
+            let mut drive: NcDriveIn = bytemuck::Zeroable::zeroed();
+            bytemuck::bytes_of_mut(&mut enc).fill(noise as u8);
+            bytemuck::bytes_of_mut(&mut drive).fill((noise >> 8) as u8);
+            place
+                .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in))
+                .write(&enc);
+            place
+                .field::<NcDriveIn>(core::mem::offset_of!(HliAxis, drive_in))
+                .write(&drive);
+        }
+        hammered.step(s.cycle_s);
+        for axis in 0..=FEED {
+            let (a, b) = (lr(&clean.memory, axis), lr(&hammered.memory, axis));
+            assert_eq!(
+                bytemuck::bytes_of(&a),
+                bytemuck::bytes_of(&b),
+                "axis {axis} at tick {}",
+                clean.machine.ticks()
+            );
+        }
+    }
+    assert!(hammered.machine.held_by_fault().next().is_none());
+}
