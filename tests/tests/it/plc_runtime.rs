@@ -101,3 +101,83 @@ fn ticks_the_task_missed_count_as_overruns() {
     assert_eq!(program.ticks, (1..=50).map(|k| 2 * k).collect::<Vec<u64>>());
     assert_eq!(summary.stats.overruns, 49);
 }
+
+/// Signals the CNC peer `pid` with `signal` in its 50th cycle; records every cycle's link.
+struct Betrayed {
+    pid: u32,
+    signal: &'static str,
+    links: Vec<plc_shim::runtime::Link>,
+}
+
+impl PlcProgram for Betrayed {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        self.links.push(io.link);
+        if io.cycle == 50 {
+            assert!(tests::child::signal(self.pid, self.signal));
+        }
+    }
+}
+
+/// Runs a PLC runtime on a `cnc-beat` peer (1 ms cycle) that gets `signal` in the PLC's 50th
+/// cycle; returns how the run ended and the links the program saw.
+fn betrayed_by(signal: &'static str) -> (RunEnd, Vec<plc_shim::runtime::Link>) {
+    hli::init_logging();
+    let instance = unique_instance(&format!("plc-{}", signal.to_lowercase()));
+    let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
+    let mut runtime = PlcRuntime::attach(
+        &instance,
+        plc_shim::watchdog::DEFAULT_WATCHDOG_CYCLES,
+        Duration::from_millis(10),
+    )
+    .unwrap();
+    let mut program = Betrayed {
+        pid: child.id(),
+        signal,
+        links: Vec::new(),
+    };
+    // The cycle limit is a watchdog: the loss ends the run long before.
+    let summary = runtime.run(&mut program, Some(1_000_000)).unwrap();
+    let _ = child.signal("KILL");
+    child
+        .wait_with_watchdog(Duration::from_secs(30))
+        .expect("watchdog: the peer was not reaped");
+    drop(runtime);
+    tests::remove_stale_segment(&instance);
+    (summary.end, program.links)
+}
+
+#[test]
+fn a_killed_cnc_is_lost_within_cycles_and_the_program_is_told() {
+    use plc_shim::runtime::{CncLoss, Link};
+    let (end, links) = betrayed_by("KILL");
+    let RunEnd::CncLost(CncLoss::Dead { silent_cycles }) = end else {
+        panic!("{end:?}");
+    };
+    // Noticed from the process being gone, at least two cycles after the last tick; how
+    // many more depends on the machine's load (a figure for docs/reliability.md, not a
+    // timed assertion).
+    assert!(silent_cycles >= 2, "{silent_cycles}");
+    eprintln!("killed CNC noticed after {silent_cycles} CNC cycles");
+    // Every cycle operational but the last one, which comes after the loss.
+    let (last, before) = links.split_last().unwrap();
+    assert_eq!(*last, Link::NotOperational);
+    assert!(before.iter().all(|l| *l == Link::Operational));
+    assert!(
+        before.len() >= 51,
+        "{} cycles before the loss",
+        before.len()
+    );
+}
+
+#[test]
+fn a_stopped_cnc_is_lost_after_the_watchdog_cycles() {
+    use plc_shim::runtime::{CncLoss, Link};
+    let (end, links) = betrayed_by("STOP");
+    let RunEnd::CncLost(CncLoss::Silent { silent_cycles }) = end else {
+        panic!("{end:?}");
+    };
+    let limit = u64::from(plc_shim::watchdog::DEFAULT_WATCHDOG_CYCLES);
+    assert!(silent_cycles >= limit, "{silent_cycles}");
+    eprintln!("stopped CNC noticed after {silent_cycles} CNC cycles");
+    assert_eq!(links.last(), Some(&Link::NotOperational));
+}

@@ -241,3 +241,41 @@ fn a_second_signal_during_the_stop_ends_at_once_and_still_cleans_up() {
         "the PLC process is gone"
     );
 }
+
+/// Writes `bytes` over the leaf `path` of the segment file, as a PLC that writes where only
+/// the CNC writes.
+fn write_over(instance: &str, path: &str, bytes: &[u8]) {
+    use std::os::unix::fs::FileExt;
+    let offset = Leaf::resolve(path).unwrap().offset as u64;
+    let file = std::fs::OpenOptions::new()
+        .write(true)
+        .open(segment(instance))
+        .unwrap();
+    file.write_all_at(bytes, offset).unwrap();
+}
+
+#[test]
+fn a_header_written_over_stops_both_sides_naming_the_field() {
+    // Before: the PLC read a changed state as the CNC's orderly close and exited 0, the CNC
+    // neither noticed nor stopped. Now both name the field; the machine stops at rest.
+    for (path, bytes) in [
+        ("header.magic", &[0xA5u8; 8][..]),
+        ("header.segment_state", &[7, 0, 0, 0][..]),
+        ("header.layout_hash", &[1, 2, 3, 4, 5, 6, 7, 8][..]),
+    ] {
+        let instance = tests::unique_instance("sup-header");
+        let scratch = Scratch::new("sup-header");
+        let trace = scratch.join("trace.csv");
+        let child = start(&instance, &trace);
+        wait_for_plc_cycles(&instance, 300);
+        write_over(&instance, path, bytes);
+        let (code, report) = finish(child);
+        let cause = format!("segment header corrupted: {path} is 0x");
+        check_controlled_stop(&instance, &trace, code, 5, &report, &cause);
+        assert!(
+            report.contains(&format!("plc: {cause}")),
+            "the PLC names it too\n{report}"
+        );
+        assert!(report.contains("ended by SegmentCorrupt"), "{report}");
+    }
+}
