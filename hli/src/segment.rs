@@ -26,6 +26,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 mod guard;
 mod liveness;
+mod reset;
 pub use guard::{CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS};
 pub use liveness::{HeartbeatWatch, PeerLiveness};
 

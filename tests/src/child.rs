@@ -107,3 +107,21 @@ fn drain(pipe: Option<impl Read + Send + 'static>) -> Option<JoinHandle<Vec<u8>>
 fn join(reader: Option<JoinHandle<Vec<u8>>>) -> Vec<u8> {
     reader.and_then(|r| r.join().ok()).unwrap_or_default()
 }
+
+/// The PLC process of `instance` (a `plc` or `cnc plc` with `--instance INSTANCE`), found in
+/// /proc by its command line.
+pub fn plc_pid(instance: &str) -> Option<u32> {
+    for entry in std::fs::read_dir("/proc").ok()?.flatten() {
+        let Ok(pid) = entry.file_name().to_string_lossy().parse::<u32>() else {
+            continue;
+        };
+        let Ok(cmd) = std::fs::read(entry.path().join("cmdline")) else {
+            continue;
+        };
+        let cmd = String::from_utf8_lossy(&cmd).replace('\0', " ");
+        if cmd.contains(" plc ") && cmd.contains(&format!("--instance {instance} ")) {
+            return Some(pid);
+        }
+    }
+    None
+}

@@ -94,6 +94,7 @@ pub fn main(args: DemoArgs) -> ExitCode {
         instance: args.instance.clone(),
         scratch: args.out.clone(),
         plc_watchdog_ticks: None,
+        plc_restart: false,
         realtime: args.realtime.clone(),
         // The demo's programs name no LOG_FILE; its listings are kept for `cnc diag`.
         log_dir: None,

@@ -358,6 +358,23 @@ impl Machine {
         }
     }
 
+    /// Takes commands again after a [`Machine::stop`] that reached rest (a new PLC took
+    /// over): the single axes the stop locked are released and stand powered, as they were
+    /// left; channels that ended stay ended. `false` (nothing done) while not at rest.
+    pub fn rearm(&mut self) -> bool {
+        if !self.at_rest() {
+            return false;
+        }
+        self.stopped = false;
+        for i in self.channel_axes()..self.axes.len() {
+            if let Some(axis) = self.axes.axis_mut(i) {
+                // Refused only by an axis that cannot take commands: nothing to release.
+                let _ = axis.command(&AxisCommandCall::stop_release());
+            }
+        }
+        true
+    }
+
     /// Whether every channel and every axis has come to rest (set-point velocity 0). An
     /// axis in error counts as at rest: its set-point stood still at the fault and its drive
     /// is not trusted to arrive ([`Machine::held_by_fault`] names them).

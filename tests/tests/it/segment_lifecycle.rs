@@ -187,3 +187,40 @@ fn too_many_channels_or_axes_are_refused() {
         Err(CreateError::TooMany { what: "axis", .. })
     ));
 }
+
+#[test]
+fn a_new_plc_finds_every_plc_leaf_set_back_and_the_defaults_written() {
+    use hli::desc::SymbolWriter;
+    use hli::symbols::{SymbolKind, SymbolTable};
+    let instance = unique_instance("reset-units");
+    let segment = CncSegment::create(&instance, 2, 3).unwrap();
+    let fresh = segment.memory().snapshot();
+    // A PLC that wrote everywhere it may (and the CNC's own leaves, which stay).
+    let plc_side = |w: SymbolWriter| matches!(w, SymbolWriter::Plc | SymbolWriter::Both);
+    let leaves: Vec<_> = SymbolTable::global()
+        .symbols()
+        .iter()
+        .filter(|s| matches!(s.kind, SymbolKind::Leaf(_)) && !s.path.starts_with("header."))
+        .collect();
+    for s in &leaves {
+        for k in 0..s.size {
+            segment.memory().place::<u8>(s.offset + k).store(0x5A);
+        }
+    }
+    let cleared = segment.reset_plc_units();
+    assert_eq!(
+        cleared,
+        leaves.iter().filter(|s| plc_side(s.writer)).count(),
+        "every PLC-side leaf, whatever its size"
+    );
+    let after = segment.memory().snapshot();
+    for s in &leaves {
+        let range = s.offset..s.offset + s.size;
+        if plc_side(s.writer) {
+            // Cleared, or the default a fresh segment has (the path override's 100 %).
+            assert_eq!(after[range.clone()], fresh[range], "{}", s.path);
+        } else {
+            assert!(after[range].iter().all(|b| *b == 0x5A), "{} kept", s.path);
+        }
+    }
+}

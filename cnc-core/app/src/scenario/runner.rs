@@ -27,6 +27,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use tick_loop::{Bounds, Ending, Measured, TickLoop};
 
+mod restart;
 mod tick_loop;
 
 /// Ticks run when neither `--ticks` nor the scenario says: until every channel is idle, at
@@ -66,6 +67,12 @@ pub struct RunArgs {
     /// (default: the scenario's `plc_watchdog_ticks`, else 100).
     #[arg(long)]
     pub plc_watchdog_ticks: Option<u64>,
+    /// A lost PLC stops the machine, but the run goes on and takes a new PLC process on the
+    /// same instance (`plc --instance I ...`): the CNC stays up while the PLC restarts. The
+    /// run then ends at its tick count or on a signal, not when the channels are idle
+    /// (real-time mode only).
+    #[arg(long, conflicts_with = "lockstep")]
+    pub plc_restart: bool,
     /// Real-time options of the tick loop (over the scenario's `[realtime]`).
     #[command(flatten)]
     pub realtime: plc_shim::realtime::RealtimeOptions,
@@ -84,6 +91,8 @@ pub struct RunOptions {
     pub scratch: PathBuf,
     /// See [`RunArgs::plc_watchdog_ticks`].
     pub plc_watchdog_ticks: Option<u64>,
+    /// See [`RunArgs::plc_restart`].
+    pub plc_restart: bool,
     /// Real-time options of the tick loop (over the scenario's).
     pub realtime: plc_shim::realtime::RealtimeOptions,
     /// Where `LOG_FILE`s are written while the run goes on (`None`: only at the end, by the
@@ -212,6 +221,10 @@ pub struct RunReport {
     pub realtime: Vec<String>,
     /// Axes in error at the end: held where their fault stopped them, not braked.
     pub held_by_fault: Vec<String>,
+    /// `--plc-restart`: new PLCs that took over after a loss.
+    pub plc_restarts: u64,
+    /// `--plc-restart`: the run ended while no PLC ran.
+    pub ended_without_plc: bool,
 }
 
 /// `cnc run`.
@@ -233,6 +246,7 @@ pub fn main(args: RunArgs) -> ExitCode {
         scratch: std::env::temp_dir(),
         instance,
         plc_watchdog_ticks: args.plc_watchdog_ticks,
+        plc_restart: args.plc_restart,
         realtime: args.realtime.clone(),
         log_dir: Some(args.log_dir.clone()),
     };
@@ -263,6 +277,8 @@ pub fn main(args: RunArgs) -> ExitCode {
             }
             if let Some(cause) = &report.stop {
                 ExitCode::from(cause.exit_code())
+            } else if report.ended_without_plc {
+                ExitCode::from(4)
             } else if report
                 .channels
                 .iter()
@@ -316,10 +332,14 @@ fn run_machine(
     let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
     let bounds = Bounds::of(scenario, options)?;
     let measured = Measured::new(scenario, bounds.rows);
-    let (mut measured, ending) =
+    let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
     let ticks = machine.ticks();
-    let plc_output = link.close(options, &ending, ticks, &bounds)?;
+    let mut plc_output = String::new();
+    for child in ending.lost_plcs.drain(..) {
+        plc_output.push_str(&wait_for_exit(child)?);
+    }
+    plc_output.push_str(&link.close(options, &ending, ticks, &bounds)?);
     Ok(RunReport {
         ticks,
         tick_ns: Percentiles::of(&mut measured.tick_ns),
@@ -336,6 +356,8 @@ fn run_machine(
         stop: ending.stop.map(|(cause, _)| cause),
         rest_after: ending.rest_after,
         realtime,
+        plc_restarts: ending.restarts,
+        ended_without_plc: ending.without_plc,
         held_by_fault: machine
             .held_by_fault()
             .map(|(name, error)| format!("{name} ({error:?})"))
@@ -530,6 +552,17 @@ impl RunReport {
                 None => "machine NOT at rest when the stop limit ran out".into(),
             };
             out.push_str(&format!("stopped: {}; {rest}\n", cause.message()));
+        }
+        if self.plc_restarts > 0 || self.ended_without_plc {
+            out.push_str(&format!(
+                "PLC restarts: {}{}\n",
+                self.plc_restarts,
+                if self.ended_without_plc {
+                    "; the run ended while no PLC ran"
+                } else {
+                    ""
+                }
+            ));
         }
         if !self.held_by_fault.is_empty() {
             out.push_str(&format!(

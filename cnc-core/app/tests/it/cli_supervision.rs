@@ -57,23 +57,6 @@ fn wait_for_plc_cycles(instance: &str, n: u64) {
     }
 }
 
-/// The PLC process of `instance` (found in /proc by its command line).
-fn plc_pid(instance: &str) -> i32 {
-    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
-        let Ok(pid) = entry.file_name().to_string_lossy().parse::<i32>() else {
-            continue;
-        };
-        let Ok(cmd) = std::fs::read(entry.path().join("cmdline")) else {
-            continue;
-        };
-        let cmd = String::from_utf8_lossy(&cmd).replace('\0', " ");
-        if cmd.contains(" plc ") && cmd.contains(&format!("--instance {instance} ")) {
-            return pid;
-        }
-    }
-    panic!("no PLC process for {instance}");
-}
-
 /// Waits for `child` (watchdog 60 s), returns exit code and stdout + stderr.
 fn finish(mut child: ChildGuard) -> (i32, String) {
     let out = child.wait_with_output(Duration::from_secs(60)).unwrap();
@@ -144,7 +127,10 @@ fn a_killed_plc_stops_the_machine_with_exit_4() {
     let trace = scratch.join("trace.csv");
     let child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
-    assert!(signal(plc_pid(&instance) as u32, "KILL"));
+    assert!(signal(
+        tests::child::plc_pid(&instance).expect("the PLC process"),
+        "KILL"
+    ));
     let (code, report) = finish(child);
     check_controlled_stop(
         &instance,
@@ -163,7 +149,7 @@ fn a_hung_plc_is_reported_after_the_watchdog() {
     let trace = scratch.join("trace.csv");
     let child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
-    let pid = plc_pid(&instance) as u32;
+    let pid = tests::child::plc_pid(&instance).expect("the PLC process");
     assert!(signal(pid, "STOP"));
     let (code, report) = finish(child);
     // The CNC killed the hung PLC itself; make sure in any case.
@@ -211,7 +197,7 @@ fn a_second_signal_during_the_stop_ends_at_once_and_still_cleans_up() {
     let trace = scratch.join("trace.csv");
     let mut child = start(&instance, &trace);
     wait_for_plc_cycles(&instance, 300);
-    let plc = plc_pid(&instance);
+    let plc = tests::child::plc_pid(&instance).expect("the PLC process");
     assert!(child.signal("INT"));
     // Once the CNC says it stops (the stop takes hundreds of ticks), the second signal.
     let mut err = BufReader::new(child.0.stderr.take().unwrap());

@@ -18,6 +18,7 @@ mod cli_plc_tools;
 mod cli_plot;
 mod cli_progress;
 mod cli_realtime;
+mod cli_restart;
 mod cli_run;
 mod cli_saw;
 mod cli_supervision;

@@ -3,6 +3,7 @@
 //! acyclic calls are answered and "tick done" goes out; between ticks the PLC and the
 //! termination signals are watched, and a stop runs on until the machine is at rest.
 
+use super::restart::{Gap, GapEvent};
 use super::{
     describe_plc, wait_for_plc_cycle, PlcLink, PlcWait, RunOptions, StopCause,
     DEFAULT_PLC_WATCHDOG_TICKS, DEFAULT_TICK_LIMIT, STOP_LIMIT_S, STOP_REASON_PLC,
@@ -118,6 +119,12 @@ pub(super) struct Ending {
     pub(super) forced: bool,
     /// Ticks from the stop until the machine was at rest.
     pub(super) rest_after: Option<u64>,
+    /// `--plc-restart`: PLC processes lost (killed if they still ran), to be reaped.
+    pub(super) lost_plcs: Vec<Child>,
+    /// `--plc-restart`: new PLCs that took over.
+    pub(super) restarts: u64,
+    /// `--plc-restart`: the run ended while no PLC ran.
+    pub(super) without_plc: bool,
 }
 
 /// The loop's state over a run.
@@ -136,6 +143,10 @@ pub(super) struct TickLoop<'a> {
     /// The PLC heartbeat last seen to change, and when (wall clock: a CNC that stalled and
     /// catches up in a burst must not take the PLC for dead).
     plc_seen: (u64, Duration),
+    /// Whether a PLC is expected to cycle (one was spawned, or took over after a loss).
+    supervised: bool,
+    /// `--plc-restart`: where the run is between two PLCs.
+    gap: Gap,
     ending: Ending,
     log_stream: Option<LogStream>,
     counter: TickCounter,
@@ -162,6 +173,7 @@ impl<'a> TickLoop<'a> {
         machine.start_heartbeat_at(segment.beats());
         let start = monotonic::now();
         let plc_seen = (segment.plc_heartbeat(), monotonic::now());
+        let supervised = child.is_some();
         let log_stream = options
             .log_dir
             .as_ref()
@@ -184,10 +196,15 @@ impl<'a> TickLoop<'a> {
             measured,
             start,
             plc_seen,
+            supervised,
+            gap: Gap::Closed,
             ending: Ending {
                 stop: None,
                 forced: false,
                 rest_after: None,
+                lost_plcs: Vec::new(),
+                restarts: 0,
+                without_plc: false,
             },
             log_stream,
             counter,
@@ -212,12 +229,17 @@ impl<'a> TickLoop<'a> {
                 self.check_header(tick);
             }
             if self.ending.stop.is_none() && !self.options.lockstep {
-                self.watch_plc(tick);
+                if self.gap.open() {
+                    self.mind_gap(tick);
+                } else {
+                    self.watch_plc(tick);
+                }
             }
             if tick % 16 == 0 && self.take_signal(tick) {
                 break;
             }
         }
+        self.ending.without_plc = self.gap.open();
         drop(self.progress);
         if let Some(Err(e)) = self.log_stream.map(LogStream::finish) {
             eprintln!("cnc run: LOG_FILE while running: {e}");
@@ -238,6 +260,7 @@ impl<'a> TickLoop<'a> {
             None if tick >= self.bounds.limit => true,
             None if self.options.ticks.is_none()
                 && self.scenario.ticks.is_none()
+                && !self.options.plc_restart
                 && self.machine.idle() =>
             {
                 true
@@ -297,23 +320,26 @@ impl<'a> TickLoop<'a> {
     /// Real time, after tick `tick`: a PLC whose heartbeat stood still for the watchdog's
     /// time, or whose process exited (looked at every 64 ticks), is lost.
     fn watch_plc(&mut self, tick: u64) {
-        let Some(child) = self.child.as_mut() else {
+        if !self.supervised {
             return;
-        };
+        }
         let beat = self.segment.plc_heartbeat();
         let now = monotonic::now();
         if beat != self.plc_seen.0 {
             self.plc_seen = (beat, now);
         }
-        let exited = if tick.is_multiple_of(64) {
-            child.try_wait().ok().flatten()
-        } else {
-            None
+        let exited = match self.child.as_mut() {
+            Some(child) if tick.is_multiple_of(64) => child.try_wait().ok().flatten(),
+            _ => None,
         };
         let silent = now.saturating_sub(self.plc_seen.1);
         if exited.is_some() || silent > self.bounds.watchdog_time {
             let silent_ticks = (silent.as_secs_f64() / self.scenario.cycle_s) as u64;
-            let detail = describe_plc(child, exited, silent_ticks);
+            let detail = match self.child.as_mut() {
+                Some(child) => describe_plc(child, exited, silent_ticks),
+                // A PLC that took over after a loss is not this process's child.
+                None => format!("no PLC cycle for {silent_ticks} ticks"),
+            };
             self.lose_plc(tick, detail);
         }
     }
@@ -329,12 +355,62 @@ impl<'a> TickLoop<'a> {
         }
     }
 
-    /// The PLC is lost at `tick`: the machine stops.
+    /// The PLC is lost at `tick`: the machine stops. With `--plc-restart` the run goes on
+    /// and waits for a new PLC ([`Gap`]); a PLC process of its own is killed (it may be hung)
+    /// and reaped after the run.
     fn lose_plc(&mut self, tick: u64, detail: String) {
+        if self.options.plc_restart && !self.options.lockstep {
+            eprintln!(
+                "cnc run: PLC lost at tick {tick}: {detail}; stopping the machine and waiting for a new PLC on instance {}",
+                self.options.instance
+            );
+            self.machine.stop(STOP_REASON_PLC);
+            if let Some(mut child) = self.child.take() {
+                let _ = child.kill();
+                self.ending.lost_plcs.push(child);
+            }
+            let pid = self
+                .segment
+                .header()
+                .field::<u32>(core::mem::offset_of!(
+                    hli::layout::HliSegmentHeader,
+                    plc_pid
+                ))
+                .load_acquire();
+            self.gap = Gap::Lost { pid, since: tick };
+            self.supervised = false;
+            return;
+        }
         let cause = StopCause::PlcLost { tick, detail };
         eprintln!("cnc run: {}", cause.message());
         self.machine.stop(STOP_REASON_PLC);
         self.ending.stop = Some((cause, tick));
+    }
+
+    /// `--plc-restart`, after tick `tick` while no PLC runs: the gap's next step, said.
+    fn mind_gap(&mut self, tick: u64) {
+        let instance = &self.options.instance;
+        match self.gap.step(tick, self.machine, self.segment) {
+            GapEvent::None => {}
+            GapEvent::Waiting { cleared } => eprintln!(
+                "cnc run: machine at rest at tick {tick}; {cleared} PLC leaves cleared; waiting for a new PLC on instance {instance}"
+            ),
+            GapEvent::Attached { pid } => {
+                eprintln!("cnc run: PLC process {pid} attached at tick {tick}; machine re-armed")
+            }
+            GapEvent::Running { pid } => {
+                self.ending.restarts += 1;
+                self.supervised = true;
+                self.plc_seen = (self.segment.plc_heartbeat(), monotonic::now());
+                eprintln!("cnc run: PLC process {pid} runs its cycles since tick {tick}");
+            }
+            GapEvent::Lost { pid } => {
+                self.machine.stop(STOP_REASON_PLC);
+                eprintln!(
+                    "cnc run: PLC process {pid} left or did not cycle at tick {tick}; stopping the machine, waiting for a new PLC"
+                );
+            }
+        }
     }
 
     /// A termination request at `tick` stops the machine; a second one during the stop ends
