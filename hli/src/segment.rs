@@ -26,9 +26,11 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 mod guard;
 mod liveness;
+mod process;
 mod reset;
 pub use guard::{CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS};
 pub use liveness::{HeartbeatWatch, PeerLiveness};
+use process::{check_owner, process_start_stamp, start_stamp_at, stat_path};
 
 /// "HLI-SEG1" as a little-endian u64.
 pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");
@@ -111,6 +113,16 @@ pub enum AttachError {
     NotFound {
         /// Segment name.
         name: String,
+    },
+    /// The object belongs to another user: its CNC is not ours to attach to.
+    #[error("segment {name} belongs to user {owner}, not to this process's user {me}")]
+    ForeignOwner {
+        /// Segment name.
+        name: String,
+        /// The file's owner.
+        owner: u32,
+        /// This process's effective user.
+        me: u32,
     },
     /// The object is smaller than the layout needs.
     #[error("segment {name} is truncated: {found} bytes, the layout needs {expected}")]
@@ -202,42 +214,6 @@ pub fn segment_name(instance: &str) -> Option<String> {
 
 fn file_name(name: &str) -> FileName {
     FileName::new(name.as_bytes()).expect("segment_name yields a valid file name")
-}
-
-/// Start time of a process (clock ticks since boot) and whether it is still running, from
-/// `/proc`; `None` where there is no such process. Tells a live owner from a reused pid.
-fn process_start_stamp(pid: u32) -> Option<u64> {
-    start_stamp_at(&stat_path(pid))
-}
-
-fn stat_path(pid: u32) -> String {
-    format!("/proc/{pid}/stat")
-}
-
-/// [`process_start_stamp`] from the process's `stat` file, read into a buffer on the stack
-/// (no allocation: the PLC asks from its wait).
-fn start_stamp_at(path: &str) -> Option<u64> {
-    use std::io::Read;
-    let mut buf = [0u8; 4096];
-    let mut file = std::fs::File::open(path).ok()?;
-    let mut len = 0;
-    loop {
-        let n = file.read(buf.get_mut(len..)?).ok()?;
-        if n == 0 {
-            break;
-        }
-        len += n;
-    }
-    let stat = core::str::from_utf8(&buf[..len]).ok()?;
-    // The command name (field 2) is in parentheses and may contain spaces.
-    let after_name = stat.get(stat.rfind(')')? + 2..)?;
-    let mut fields = after_name.split_whitespace();
-    let state = fields.next()?;
-    if state == "Z" || state == "X" {
-        return None; // exited, not yet reaped
-    }
-    // After the state come fields 4.., the start time is field 22.
-    fields.nth(22 - 4)?.parse().ok()
 }
 
 /// A zeroed shared-memory object of `size` bytes, owner-only, created as `mode` says.
@@ -564,6 +540,7 @@ impl PlcSegment {
                 })
             }
         };
+        check_owner(&name)?;
         let found = shm.size() as u64;
         if found < HEADER_SIZE as u64 {
             return Err(AttachError::Truncated {
