@@ -30,7 +30,7 @@ fn start(instance: &str, trace: &std::path::Path) -> ChildGuard {
         .unwrap()
 }
 
-fn segment(instance: &str) -> PathBuf {
+pub(crate) fn segment(instance: &str) -> PathBuf {
     PathBuf::from(format!("/dev/shm/cncplc_{instance}.hli"))
 }
 
@@ -45,7 +45,7 @@ fn plc_heartbeat(instance: &str) -> Option<u64> {
 
 /// Waits (watchdog 30 s) until the PLC has cycled `n` times: the run is in the middle of its
 /// first move then.
-fn wait_for_plc_cycles(instance: &str, n: u64) {
+pub(crate) fn wait_for_plc_cycles(instance: &str, n: u64) {
     let deadline = Instant::now() + Duration::from_secs(30);
     while plc_heartbeat(instance).unwrap_or(0) < n {
         assert!(
@@ -58,7 +58,7 @@ fn wait_for_plc_cycles(instance: &str, n: u64) {
 }
 
 /// Waits for `child` (watchdog 60 s), returns exit code and stdout + stderr.
-fn finish(mut child: ChildGuard) -> (i32, String) {
+pub(crate) fn finish(mut child: ChildGuard) -> (i32, String) {
     let out = child.wait_with_output(Duration::from_secs(60)).unwrap();
     (
         out.status.code().unwrap_or(-1),
@@ -71,7 +71,7 @@ fn finish(mut child: ChildGuard) -> (i32, String) {
 }
 
 /// Ticks the report says the machine needed to come to rest.
-fn rest_ticks(report: &str) -> u64 {
+pub(crate) fn rest_ticks(report: &str) -> u64 {
     let line = report
         .lines()
         .find(|l| l.starts_with("stopped:"))

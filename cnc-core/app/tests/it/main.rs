@@ -11,6 +11,7 @@ mod cli_cam;
 mod cli_cams;
 mod cli_check;
 mod cli_diag;
+mod cli_fault_matrix;
 mod cli_fifo;
 mod cli_hli;
 mod cli_kin;
