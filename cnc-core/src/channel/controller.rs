@@ -3,7 +3,7 @@
 //! the machine's axis set (`crate::machine`), which hands each channel's set-points on.
 
 use super::dyn_cs::MasterSample;
-use super::plc_io::{read_inputs, write_outputs, ChannelInputs};
+use super::plc_io::{read_inputs, write_outputs, ChannelInputs, Violations};
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
 use hli::views::CncView;
@@ -14,6 +14,8 @@ pub struct Controller {
     channels: Vec<Channel>,
     masters: [Option<MasterSample>; MAX_CHANNELS],
     inputs: [ChannelInputs; MAX_CHANNELS],
+    /// What the channels refused of the PLC's writes, summed over the run.
+    violations: Violations,
     sync: SyncBoard,
     order: [usize; MAX_CHANNELS],
 }
@@ -40,6 +42,7 @@ impl Controller {
             channels,
             masters: [None; MAX_CHANNELS],
             inputs: [ChannelInputs::default(); MAX_CHANNELS],
+            violations: Violations::default(),
             sync: SyncBoard::default(),
             order: core::array::from_fn(|i| i),
         })
@@ -68,7 +71,13 @@ impl Controller {
     pub fn read_plc(&mut self, view: &CncView<'_>) {
         for (i, channel) in self.channels.iter().enumerate() {
             read_inputs(view, channel.index(), channel.wanted(), &mut self.inputs[i]);
+            self.violations.add(&self.inputs[i].violations);
         }
+    }
+
+    /// What the channels refused of the PLC's writes so far, by class.
+    pub fn violations(&self) -> &Violations {
+        &self.violations
     }
 
     /// One tick of every channel on the inputs read last: channels that follow no other

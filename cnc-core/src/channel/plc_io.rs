@@ -46,6 +46,67 @@ pub enum OverrideInput {
     Invalid(OverrideError),
 }
 
+/// What the CNC refused of what a PLC wrote, by class: counted, never taken. Counters
+/// saturate; they cannot wrap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Violations {
+    /// Semaphore bytes neither FALSE nor TRUE.
+    pub semaphore_garbage: u64,
+    /// Payloads that changed while they were copied (written while the semaphore was TRUE).
+    pub torn_payload: u64,
+    /// Transition command words other than -1, 0 and +1.
+    pub command_garbage: u64,
+    /// BOOL bytes (`enable_w`, `feed_hold_w`) neither FALSE nor TRUE.
+    pub bool_garbage: u64,
+    /// Override values above their maximum.
+    pub out_of_range: u64,
+    /// Acyclic calls refused (any error code: a bad body, a value out of range, a wrong
+    /// state, a stopped machine).
+    pub refused_calls: u64,
+}
+
+impl Violations {
+    /// Counts one protocol violation.
+    pub fn protocol(&mut self, violation: ProtocolViolation) {
+        let class = match violation {
+            ProtocolViolation::SemaphoreGarbage { .. } => &mut self.semaphore_garbage,
+            ProtocolViolation::TornPayload => &mut self.torn_payload,
+            ProtocolViolation::CommandGarbage { .. } => &mut self.command_garbage,
+        };
+        *class = class.saturating_add(1);
+    }
+
+    /// Adds `other`'s counts.
+    pub fn add(&mut self, other: &Violations) {
+        for (mine, theirs) in [
+            (&mut self.semaphore_garbage, other.semaphore_garbage),
+            (&mut self.torn_payload, other.torn_payload),
+            (&mut self.command_garbage, other.command_garbage),
+            (&mut self.bool_garbage, other.bool_garbage),
+            (&mut self.out_of_range, other.out_of_range),
+            (&mut self.refused_calls, other.refused_calls),
+        ] {
+            *mine = mine.saturating_add(theirs);
+        }
+    }
+
+    /// Every count.
+    pub fn total(&self) -> u64 {
+        let mut sum = Violations::default();
+        sum.add(self);
+        [
+            sum.semaphore_garbage,
+            sum.torn_payload,
+            sum.command_garbage,
+            sum.bool_garbage,
+            sum.out_of_range,
+            sum.refused_calls,
+        ]
+        .into_iter()
+        .fold(0, u64::saturating_add)
+    }
+}
+
 /// What the PLC gave a channel this tick.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ChannelInputs {
@@ -64,6 +125,8 @@ pub struct ChannelInputs {
     /// Whether the image has this channel's M-function unit (without one, M functions are
     /// not announced and not waited for).
     pub has_m_unit: bool,
+    /// What was refused this tick.
+    pub violations: Violations,
 }
 
 /// What a channel shows the PLC after its tick.
@@ -114,31 +177,70 @@ impl Default for ChannelOutputs {
 /// Reads channel `index`'s PLC units into `inputs` (everything not wanted is left pending in
 /// the image). An index outside the image reads as a PLC that gives nothing.
 pub fn read_inputs(view: &CncView<'_>, index: usize, wanted: Wanted, inputs: &mut ChannelInputs) {
+    let mut violations = Violations::default();
     let request = view.m_function_request(index);
+    let m_request_free = match request.as_ref().map(|w| w.is_free()) {
+        Ok(Ok(free)) => free,
+        Ok(Err(v)) => {
+            violations.protocol(v);
+            false
+        }
+        Err(_) => false,
+    };
+    let path_override = match view.path_override(index) {
+        Ok(Ok(value)) => OverrideInput::Valid(value),
+        Ok(Err(error)) => {
+            match error {
+                OverrideError::FeedHold(_) => violations.bool_garbage += 1,
+                OverrideError::Feed(_) | OverrideError::Rapid(_) => violations.out_of_range += 1,
+            }
+            OverrideInput::Invalid(error)
+        }
+        Err(_) => OverrideInput::Absent,
+    };
     *inputs = ChannelInputs {
-        m_request_free: request.as_ref().is_ok_and(|w| w.is_free().unwrap_or(false)),
+        m_request_free,
         has_m_unit: request.is_ok(),
-        path_override: match view.path_override(index) {
-            Ok(Ok(value)) => OverrideInput::Valid(value),
-            Ok(Err(error)) => OverrideInput::Invalid(error),
-            Err(_) => OverrideInput::Absent,
-        },
+        path_override,
         ..ChannelInputs::default()
     };
     if wanted.dyn_cs {
-        inputs.dyn_cs_enabled = matches!(view.dyn_cs_enabled(index), Ok(Ok(true)));
+        inputs.dyn_cs_enabled = match view.dyn_cs_enabled(index) {
+            Ok(Ok(enabled)) => enabled,
+            Ok(Err(_)) => {
+                violations.bool_garbage += 1;
+                false
+            }
+            Err(_) => false,
+        };
         if let Ok(mut reader) = view.dyn_cs_command(index) {
-            inputs.dyn_cs_command = reader.try_take().ok().flatten();
+            inputs.dyn_cs_command = taken(reader.try_take(), &mut violations);
         }
         if let Ok(mut reader) = view.dyn_cs_transition(index) {
-            inputs.transition = transition_input(reader.try_take());
+            let attempt = reader.try_take();
+            if let Err(v) = attempt {
+                violations.protocol(v);
+            }
+            inputs.transition = transition_input(attempt);
         }
     }
     if wanted.m_ack {
         if let Ok(mut reader) = view.m_function_ack(index) {
-            inputs.m_ack = reader.try_take().ok().flatten();
+            inputs.m_ack = taken(reader.try_take(), &mut violations);
         }
     }
+    inputs.violations = violations;
+}
+
+/// What a take gave: the payload, or nothing with the violation counted.
+fn taken<P>(
+    attempt: Result<Option<P>, ProtocolViolation>,
+    violations: &mut Violations,
+) -> Option<P> {
+    attempt.unwrap_or_else(|v| {
+        violations.protocol(v);
+        None
+    })
 }
 
 /// What the channel sees of one attempt to take the transition: a torn copy (the PLC rewrote

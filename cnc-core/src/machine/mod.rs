@@ -34,6 +34,7 @@ pub use engine::{Bulk, Call, Engine, EngineIo, Others, Resource, RouteConflict, 
 use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
+use crate::channel::plc_io::Violations;
 use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
@@ -102,6 +103,8 @@ pub struct Machine {
     commanded: Vec<Isometry3<f64>>,
     max_tracking_error: Vec<f64>,
     stopped: bool,
+    /// Acyclic calls refused.
+    refused_calls: u64,
 }
 
 impl Machine {
@@ -157,6 +160,7 @@ impl Machine {
             routes,
             heartbeat: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
             heartbeat_base: 0,
+            refused_calls: 0,
             ticks: 0,
             commanded: vec![Isometry3::identity(); n],
             max_tracking_error: vec![0.0; n],
@@ -235,8 +239,33 @@ impl Machine {
 
     /// Answers one acyclic call: the engine that declares its kind, else the machine's own
     /// (the axis layer, the probes, the channels' diagnosis). Commands to a
-    /// channel's axes are refused (`Coupled`): the channel owns them.
+    /// channel's axes are refused (`Coupled`): the channel owns them. A refusal is counted
+    /// ([`Machine::plc_violations`]).
     pub fn dispatch(
+        &mut self,
+        view: &CncView<'_>,
+        kind: CallKind,
+        request: &AcyclicRequest,
+    ) -> HandlerResult {
+        let answer = self.answer(view, kind, request);
+        self.count_refusal(&answer);
+        answer
+    }
+
+    fn count_refusal(&mut self, answer: &HandlerResult) {
+        if answer.is_err() {
+            self.refused_calls = self.refused_calls.saturating_add(1);
+        }
+    }
+
+    /// What the PLC's writes and calls the CNC refused so far, by class.
+    pub fn plc_violations(&self) -> Violations {
+        let mut all = *self.controller.violations();
+        all.refused_calls = all.refused_calls.saturating_add(self.refused_calls);
+        all
+    }
+
+    fn answer(
         &mut self,
         view: &CncView<'_>,
         kind: CallKind,
@@ -318,6 +347,12 @@ impl Machine {
     /// to the engine that declares it (refused when none does or the kind is no bulk kind).
     /// A stopped machine takes none.
     pub fn dispatch_bulk(&mut self, header: &BulkHeader, values: &[f64]) -> HandlerResult {
+        let answer = self.answer_bulk(header, values);
+        self.count_refusal(&answer);
+        answer
+    }
+
+    fn answer_bulk(&mut self, header: &BulkHeader, values: &[f64]) -> HandlerResult {
         let kind = CallKind::decode(header.kind)
             .filter(|k| k.is_bulk())
             .ok_or(ErrorCode::ServiceNotSupported)?;

@@ -223,6 +223,8 @@ pub struct RunReport {
     pub held_by_fault: Vec<String>,
     /// `--plc-restart`: new PLCs that took over after a loss.
     pub plc_restarts: u64,
+    /// What the CNC refused of the PLC's writes and calls, by class.
+    pub violations: cnc_core::channel::plc_io::Violations,
     /// `--plc-restart`: the run ended while no PLC ran.
     pub ended_without_plc: bool,
 }
@@ -357,6 +359,7 @@ fn run_machine(
         rest_after: ending.rest_after,
         realtime,
         plc_restarts: ending.restarts,
+        violations: machine.plc_violations(),
         ended_without_plc: ending.without_plc,
         held_by_fault: machine
             .held_by_fault()
@@ -552,6 +555,13 @@ impl RunReport {
                 None => "machine NOT at rest when the stop limit ran out".into(),
             };
             out.push_str(&format!("stopped: {}; {rest}\n", cause.message()));
+        }
+        if self.violations.total() > 0 {
+            let v = &self.violations;
+            out.push_str(&format!(
+                "refused from the PLC: semaphore garbage {}, torn payloads {}, transition command garbage {}, BOOL garbage {}, out of range {}, acyclic calls {}\n",
+                v.semaphore_garbage, v.torn_payload, v.command_garbage, v.bool_garbage, v.out_of_range, v.refused_calls
+            ));
         }
         if self.plc_restarts > 0 || self.ended_without_plc {
             out.push_str(&format!(

@@ -30,6 +30,7 @@ mod demo;
 mod drive_inputs;
 mod fifo_engine;
 mod fifo_no_alloc;
+mod hostile;
 mod machine;
 mod saw_engine;
 mod saw_no_alloc;
