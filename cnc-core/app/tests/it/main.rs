@@ -30,6 +30,7 @@ mod demo;
 mod drive_inputs;
 mod fifo_engine;
 mod fifo_no_alloc;
+mod fuzz;
 mod hostile;
 mod machine;
 mod saw_engine;

@@ -1,0 +1,318 @@
+//! Mutation fuzzing of the decoders of outside input, on the stable toolchain: the NC
+//! checker, scenario files, PLC timelines, cam files (JSON and binary tables) and FIFO
+//! position files (CSV and binary). Each target takes its seeds (the files the project ships,
+//! and `tests/data/fuzz/TARGET/`), mutates them with a seeded generator (bit flips, hostile
+//! tokens, deletions, duplications, splices) and feeds every case to the decoder, which must
+//! answer with a value or a typed error and never panic; a value must hold no non-finite
+//! number. Every file in `tests/data/fuzz/TARGET/` is replayed on every run: a case that ever
+//! crashed a decoder is kept there as a named regression.
+//!
+//! The number of cases per target is fixed (`FUZZ_CASES`, default 1500), so the run is
+//! bounded; `FUZZ_CASES=200000 cargo test --release -p cnc-app --test it fuzz` runs longer.
+//! Not coverage-guided: the stable toolchain CI has has no libFuzzer (docs/reliability.md).
+
+use cnc_app::scenario::Scenario;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+/// Words that break careless decoders.
+const TOKENS: &[&str] = &[
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e309",
+    "-1e309",
+    "99999999999999999999",
+    "-0",
+    "0x",
+    "\"",
+    "'",
+    "=",
+    "[[",
+    "]]",
+    "{",
+    "}",
+    "[",
+    "]",
+    ",",
+    "\n",
+    "#",
+    ";",
+    "(",
+    ")",
+    "N",
+    "G1 ",
+    "X",
+    "M30",
+    "%",
+    "\u{0}",
+    "\u{FFFD}",
+    "..",
+    "/",
+    "true",
+    "2147483648",
+    "-2147483649",
+];
+
+/// xorshift64*.
+struct Noise(u64);
+
+impl Noise {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// One to four mutations of `seed`, spliced with `other` now and then.
+fn mutate(seed: &[u8], other: &[u8], noise: &mut Noise) -> Vec<u8> {
+    let mut case = seed.to_vec();
+    for _ in 0..1 + noise.below(4) {
+        let at = noise.below(case.len() + 1);
+        match noise.below(7) {
+            0 if !case.is_empty() => {
+                let i = at.min(case.len() - 1);
+                case[i] ^= 1 << noise.below(8);
+            }
+            1 => {
+                let token = TOKENS[noise.below(TOKENS.len())].as_bytes();
+                case.splice(at..at, token.iter().copied());
+            }
+            2 => {
+                let end = (at + noise.below(64)).min(case.len());
+                case.drain(at..end);
+            }
+            3 => {
+                let end = (at + noise.below(64)).min(case.len());
+                let copy = case[at..end].to_vec();
+                case.splice(at..at, copy);
+            }
+            4 if !other.is_empty() => {
+                let from = noise.below(other.len());
+                let end = (from + noise.below(256)).min(other.len());
+                case.splice(at..at, other[from..end].iter().copied());
+            }
+            5 if !case.is_empty() => {
+                let i = at.min(case.len() - 1);
+                case[i] = noise.next() as u8;
+            }
+            _ => case.truncate(at),
+        }
+    }
+    case
+}
+
+/// Files under `dir` (recursively) whose names end in one of `ends`.
+fn files(dir: &Path, ends: &[&str], out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut entries: Vec<_> = entries.flatten().map(|e| e.path()).collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            files(&path, ends, out);
+        } else if ends.iter().any(|e| path.to_string_lossy().ends_with(e)) {
+            out.push(path);
+        }
+    }
+}
+
+/// A fuzz target: its name, the file endings of its seeds, and the decoder under test.
+struct Target {
+    name: &'static str,
+    ends: &'static [&'static str],
+    decode: fn(&[u8]),
+}
+
+fn nc(bytes: &[u8]) {
+    let text = String::from_utf8_lossy(bytes);
+    let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();
+    let _ = cnc_core::nc::check::check_source(&text, &axes);
+}
+
+fn scenario(bytes: &[u8]) {
+    let text = String::from_utf8_lossy(bytes);
+    let _ = Scenario::parse("fuzz.toml", &text, |name| {
+        Ok((PathBuf::from(name), "%p\nG1 X10 F600\nM30\n".to_string()))
+    });
+}
+
+fn timeline(bytes: &[u8]) {
+    let text = String::from_utf8_lossy(bytes);
+    let _ = plc_shim::timeline::Timeline::parse("fuzz.toml", &text);
+}
+
+fn cam(bytes: &[u8]) {
+    use cnc_core::cam::file::{parse, BinaryOptions};
+    let Ok(file) = parse(bytes, BinaryOptions::default()) else {
+        return;
+    };
+    let (start, end) = file.profile.master_range();
+    assert!(
+        start.is_finite() && end.is_finite(),
+        "master range {start}..{end}"
+    );
+    let mut cursor = Default::default();
+    for k in 0..=8 {
+        let x = start + (end - start) * f64::from(k) / 8.0;
+        let s = file.profile.eval(x, &mut cursor);
+        assert!(
+            s.position.is_finite() && s.velocity.is_finite() && s.acceleration.is_finite(),
+            "at {x}: {s:?}"
+        );
+    }
+}
+
+/// A FIFO file of `ending` written to a scratch file and read to its end.
+fn fifo(bytes: &[u8], ending: &str) {
+    let dir = std::env::temp_dir().join(format!("cncplc-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("case.{ending}"));
+    std::fs::write(&path, bytes).unwrap();
+    let Ok(mut reader) = plc_shim::fifo_file::RowReader::open(&path) else {
+        return;
+    };
+    let mut rows = vec![0.0; reader.columns() * 64];
+    // Files are small: a bound on the reads, not on the file.
+    for _ in 0..10_000 {
+        match reader.read_rows(&mut rows) {
+            Ok(0) | Err(_) => return,
+            Ok(n) => assert!(rows[..n].iter().all(|v| v.is_finite()), "{:?}", &rows[..n]),
+        }
+    }
+}
+
+fn fifo_csv(bytes: &[u8]) {
+    fifo(bytes, "csv");
+}
+
+fn fifo_binary(bytes: &[u8]) {
+    fifo(bytes, "fifo");
+}
+
+const TARGETS: &[Target] = &[
+    Target {
+        name: "nc",
+        ends: &[".nc"],
+        decode: nc,
+    },
+    Target {
+        name: "scenario",
+        ends: &["scenario.toml", "program.toml"],
+        decode: scenario,
+    },
+    Target {
+        name: "timeline",
+        ends: &["plc.toml", "forth.toml"],
+        decode: timeline,
+    },
+    Target {
+        name: "cam",
+        ends: &[".json", ".cam"],
+        decode: cam,
+    },
+    Target {
+        name: "fifo-csv",
+        ends: &[".csv"],
+        decode: fifo_csv,
+    },
+    Target {
+        name: "fifo-binary",
+        ends: &[".fifo"],
+        decode: fifo_binary,
+    },
+];
+
+/// Runs `case` through `target`; a panic is saved as a regression candidate and reported.
+fn run_case(target: &Target, case: &[u8], what: &str) {
+    if catch_unwind(AssertUnwindSafe(|| (target.decode)(case))).is_ok() {
+        return;
+    }
+    let dir = std::env::temp_dir()
+        .join("cncplc-fuzz-crashes")
+        .join(target.name);
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("crash-{:016x}", fxhash(case)));
+    std::fs::write(&path, case).unwrap();
+    panic!(
+        "fuzz target {}: {what} panicked; the case is {} (keep it as tests/data/fuzz/{}/NAME)",
+        target.name,
+        path.display(),
+        target.name
+    );
+}
+
+fn fxhash(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+fn seeds(target: &Target) -> Vec<(PathBuf, Vec<u8>)> {
+    let root = tests::cli::repo_root();
+    let mut paths = Vec::new();
+    for dir in ["scenarios", "examples", "cnc-core/app/tests/data"] {
+        files(&root.join(dir), target.ends, &mut paths);
+    }
+    paths.retain(|p| !p.starts_with(root.join("cnc-core/app/tests/data/fuzz")));
+    files(
+        &root.join("cnc-core/app/tests/data/fuzz").join(target.name),
+        &[""],
+        &mut paths,
+    );
+    paths
+        .into_iter()
+        .map(|p| {
+            let bytes = std::fs::read(&p).unwrap();
+            (p, bytes)
+        })
+        .collect()
+}
+
+fn cases() -> usize {
+    std::env::var("FUZZ_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1500)
+}
+
+#[test]
+fn every_decoder_of_outside_input_survives_mutated_input() {
+    let mut report = Vec::new();
+    for (t, target) in TARGETS.iter().enumerate() {
+        let seeds = seeds(target);
+        assert!(
+            !seeds.is_empty() || target.name == "fifo-binary",
+            "{}: no seeds",
+            target.name
+        );
+        // Every seed and every kept regression as it is.
+        for (path, bytes) in &seeds {
+            run_case(target, bytes, &path.display().to_string());
+        }
+        let mut noise = Noise(0xF022_0000 + t as u64);
+        let n = cases();
+        for k in 0..n {
+            let (_, seed) = match seeds.len() {
+                0 => (PathBuf::new(), Vec::new()),
+                len => seeds[noise.below(len)].clone(),
+            };
+            let other = seeds
+                .get(noise.below(seeds.len()))
+                .map(|s| s.1.clone())
+                .unwrap_or_default();
+            let case = mutate(&seed, &other, &mut noise);
+            run_case(target, &case, &format!("case {k}"));
+        }
+        report.push(format!("{} {} seeds, {n} cases", target.name, seeds.len()));
+    }
+    eprintln!("fuzz: {}", report.join("; "));
+}
