@@ -308,8 +308,10 @@ impl PlcRuntime {
             let slot = due.unwrap_or(beat);
             if beat >= slot {
                 // Slots that passed while the previous cycle (or this process) was late.
-                stats.overruns += (beat - slot) / self.period_ticks;
-                due = Some(beat + self.period_ticks);
+                stats.overruns = stats
+                    .overruns
+                    .saturating_add((beat - slot) / self.period_ticks);
+                due = Some(beat.saturating_add(self.period_ticks));
                 let mut io = PlcIo {
                     view: PlcView::new(self.segment.memory()),
                     memory: self.segment.memory(),

@@ -52,11 +52,11 @@ macro_rules! embed {
 
 const FILES: &[(&str, &str)] = embed!(
     "scenario.toml",
-    "../example3-moving-workpiece/master.nc",
-    "../example3-moving-workpiece/slave-left.nc",
-    "../example3-moving-workpiece/slave-right.nc",
-    "../example4-turntable-plc/robot.nc",
-    "../cams/seed_example.json"
+    "master.nc",
+    "slave-left.nc",
+    "slave-right.nc",
+    "robot.nc",
+    "seed_example.json"
 );
 
 /// The embedded machine.

@@ -11,7 +11,7 @@
 //! kinematics = { id = 45, preset = "kr6r900sixx" }
 //! program = "master.nc"           # relative to this file
 //! [[cam_table]]
-//! file = "../cams/seed_example.json"  # a JSON cam file (docs/cams.md); its `id`, or:
+//! file = "seed_example.json"         # a JSON cam file (docs/cams.md); its `id`, or:
 //! id = 1
 //! [[fifo_group]]                  # gpFifo[0]^: N axes, Z rows, T_f (docs/fifo.md)
 //! dimension = 3
@@ -193,7 +193,7 @@ impl Scenario {
         let invalid = invalid_in(name);
         let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
         file.check_shape().map_err(&invalid)?;
-        let programs = load_programs(&file.channel, &open)?;
+        let programs = load_programs(name, &file.channel, &open)?;
         let plc = plc_setup(name, file.plc, &open)?;
         if file.channel.is_empty() && file.ticks.is_none() {
             return Err(invalid(
@@ -237,6 +237,29 @@ impl Scenario {
 }
 
 /// The refusal of scenario `name` with a message.
+/// A relative path a scenario gives under `key` must stay inside the scenario's folder; an
+/// absolute one names a file elsewhere on purpose.
+fn confined(key: &str, path: &Path) -> Result<(), String> {
+    use std::path::Component;
+    let mut depth = 0usize;
+    for part in path.components() {
+        match part {
+            Component::RootDir | Component::Prefix(_) => return Ok(()),
+            Component::CurDir => {}
+            Component::Normal(_) => depth += 1,
+            Component::ParentDir => {
+                depth = depth.checked_sub(1).ok_or_else(|| {
+                    format!(
+                        "{key} {:?} leaves the scenario's folder: give an absolute path for a file outside it",
+                        path.display().to_string()
+                    )
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
+
 fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
     move |message: String| ScenarioError::Invalid {
         file: name.to_string(),
@@ -267,6 +290,7 @@ impl ScenarioFile {
 
 /// Each channel's program, read through `open` and checked (None: the channel has none).
 fn load_programs(
+    name: &str,
     channels: &[ChannelConfig],
     open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
 ) -> Result<Vec<Option<LoadedProgram>>, ScenarioError> {
@@ -274,6 +298,11 @@ fn load_programs(
     for c in channels {
         programs.push(match &c.program {
             Some(p) => {
+                confined("[[channel]] program", Path::new(p)).map_err(invalid_in(name))?;
+                for d in &c.nc.search_path {
+                    let beside = Path::new(p).parent().unwrap_or(Path::new("")).join(d);
+                    confined("[[channel]] nc.search_path", &beside).map_err(invalid_in(name))?;
+                }
                 let (path, src) = open(p)?;
                 let search = cnc_core::nc::interp::SearchPath(
                     c.nc.search_path
@@ -314,6 +343,7 @@ fn plc_setup(
             saw_cuts: None,
             saw_length: None,
         }) => {
+            confined("[plc] timeline", Path::new(&t)).map_err(&invalid)?;
             let (path, text) = open(&t)?;
             // Checked here, so a bad timeline fails before any process starts.
             let timeline = plc_shim::timeline::Timeline::parse(&path.display().to_string(), &text)
@@ -370,6 +400,7 @@ fn program_args(
     }
     let mut args = Vec::new();
     if let Some(f) = file {
+        confined("[plc] file", Path::new(&f))?;
         // Resolved beside the scenario and checked (header or first row) now.
         let path = Path::new(name).parent().unwrap_or(Path::new(".")).join(&f);
         plc_shim::fifo_file::RowReader::open(&path).map_err(|e| format!("[plc] file: {e}"))?;
@@ -438,6 +469,7 @@ fn cam_tables(
     let invalid = invalid_in(name);
     let mut cam_tables: Vec<(u32, cnc_core::cam::CamProfile)> = Vec::new();
     for t in files {
+        confined("[[cam_table]] file", Path::new(&t.file)).map_err(&invalid)?;
         let (path, text) = open(&t.file)?;
         let at = path.display();
         if !text.trim_start().starts_with('{') {

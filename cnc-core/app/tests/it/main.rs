@@ -35,4 +35,5 @@ mod hostile;
 mod machine;
 mod saw_engine;
 mod saw_no_alloc;
+mod scenario_paths;
 mod scenarios;

@@ -1,0 +1,16 @@
+%slaveright
+; works on the workpiece from the right, 30 mm beside the left one
+#TRAFO [45]
+; the master's base seen from this robot: 400 mm ahead, 700 mm right, turned +90 degree
+#CS ON [OFFS] [400, -700, 0, 0, 0, 90]
+#TRACK CS ON [ID=1 SET_ZERO X=400 Y=-700 C=90 FILTER=0 WAIT]
+#CS ON [V.G.TRACK_CS.X, V.G.TRACK_CS.Y, V.G.TRACK_CS.Z, V.G.TRACK_CS.A, -V.G.TRACK_CS.B, V.G.TRACK_CS.C]
+G1 X0 Y30 Z0 A0 B0 C0 F3000
+#SIGNAL SYN [ID3 COUNT1]
+#WAIT SYN [ID2]
+; let go of the workpiece over half a second: the master moved it, so the compensation
+; to shed is some millimetres (the manual's FILTER=0 would step the joints)
+#TRACK CS OFF [FILTER=500 WAIT]
+#CS OFF
+#CS OFF
+M30
