@@ -219,3 +219,48 @@ fn a_hostile_plc_for_a_million_cycles() {
         seen.total()
     );
 }
+
+/// Every leaf only the CNC writes (the axis image's inputs included: the simulated drives'
+/// answers), header aside.
+fn cnc_leaves() -> Vec<&'static Symbol> {
+    SymbolTable::global()
+        .symbols()
+        .iter()
+        .filter(|s| matches!(s.kind, SymbolKind::Leaf(_)) && !s.path.starts_with("header."))
+        .filter(|s| matches!(s.writer, SymbolWriter::Cnc | SymbolWriter::Io))
+        .collect()
+}
+
+#[test]
+fn garbage_over_the_cnc_s_own_leaves_changes_nothing_it_does() {
+    // Example 3 (three channels, two tracking the master through the channel interface) has
+    // no PLC: whatever a PLC wrote over the CNC's own leaves, the CNC must not take it back.
+    // A clean run and one whose CNC-written leaves are overwritten before every tick must
+    // move every axis the same, tick for tick.
+    let leaves = cnc_leaves();
+    let path = tests::cli::scenario("example3-moving-workpiece");
+    let scenario = Scenario::load(&path).unwrap();
+    let mut clean = InProcess::new(&scenario, 0).unwrap();
+    let mut hit = InProcess::new(&scenario, 0).unwrap();
+    let mut noise = Noise(0xBAD_CAFE);
+    for tick in 0..4_000 {
+        for _ in 0..64 {
+            let s = leaves[noise.below(leaves.len())];
+            let v = noise.value(s.size);
+            write(&hit.memory, s, v);
+        }
+        clean.step(scenario.cycle_s);
+        hit.step(scenario.cycle_s);
+        for i in 0..clean.machine.axes().len() {
+            let (a, b) = (
+                clean.machine.axes().axis(i).unwrap().setpoint(),
+                hit.machine.axes().axis(i).unwrap().setpoint(),
+            );
+            assert_eq!(a, b, "tick {tick}: axis {i}");
+        }
+    }
+    let moved = (0..clean.machine.axes().len())
+        .filter(|&i| clean.machine.axes().axis(i).unwrap().setpoint().position != 0.0)
+        .count();
+    assert!(moved > 3, "the example moved {moved} axes");
+}
