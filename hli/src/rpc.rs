@@ -117,6 +117,7 @@ pub struct AcyclicClient {
     port: AcyclicClientPort,
     rows: RowsClientPort,
     next_invoke_id: u32,
+    sent: u64,
 }
 
 impl AcyclicClient {
@@ -136,6 +137,7 @@ impl AcyclicClient {
             port,
             rows,
             next_invoke_id: 1,
+            sent: 0,
         })
     }
 
@@ -163,7 +165,14 @@ impl AcyclicClient {
             .map_err(transport)?;
         *loan.user_header_mut() = header;
         let pending = loan.write_from_slice(values).send().map_err(transport)?;
+        self.sent += 1;
         Ok(PendingRows { pending })
+    }
+
+    /// Calls sent by [`AcyclicClient::start`] and [`AcyclicClient::start_rows`] (and so by
+    /// [`AcyclicClient::call`]); loaned row blocks are not counted.
+    pub fn sent(&self) -> u64 {
+        self.sent
     }
 
     /// Sends `call` to `target` and waits up to `timeout` for the reply.
@@ -206,6 +215,7 @@ impl AcyclicClient {
                 body,
             })
             .map_err(transport)?;
+        self.sent += 1;
         Ok(PendingCall {
             pending,
             invoke_id,

@@ -16,6 +16,15 @@ thread_local! {
     static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
     /// Frees made by this thread (a free in a cyclic path may take a lock as well).
     static DEALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+    /// Bytes this thread allocated minus the bytes it freed.
+    static LIVE_BYTES: Cell<isize> = const { Cell::new(0) };
+}
+
+/// Bytes the current thread has allocated and not freed (frees of memory another thread
+/// allocated count against it).
+#[allow(dead_code)] // only the soak test asks
+pub fn live_bytes() -> isize {
+    LIVE_BYTES.with(Cell::get)
 }
 
 /// Frees the current thread has made so far.
@@ -33,11 +42,13 @@ pub fn allocations() -> usize {
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         let _ = ALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+        let _ = LIVE_BYTES.try_with(|n| n.set(n.get() + layout.size() as isize));
         // SAFETY: same contract as the caller's.
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         let _ = DEALLOCATIONS.try_with(|n| n.set(n.get() + 1));
+        let _ = LIVE_BYTES.try_with(|n| n.set(n.get() - layout.size() as isize));
         // SAFETY: same contract as the caller's.
         unsafe { System.dealloc(ptr, layout) }
     }

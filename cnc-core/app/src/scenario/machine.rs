@@ -78,6 +78,7 @@ pub struct InProcess {
     /// The acyclic service of a timeline that calls blocks: the CNC's and the PLC's end.
     acyclic: Option<(AcyclicServer, AcyclicClient)>,
     plc_cycles: u64,
+    answered: u64,
 }
 
 /// Numbers the acyclic services of in-process runs (several may run in one process).
@@ -124,6 +125,7 @@ impl InProcess {
             trace: Trace::new(&scenario.signals, rows),
             acyclic,
             plc_cycles: 0,
+            answered: 0,
         })
     }
 
@@ -146,6 +148,13 @@ impl InProcess {
         csv
     }
 
+    /// Calls the timeline sent and calls the CNC answered so far (a call sent in the last
+    /// cycle is answered in the next step).
+    pub fn calls(&self) -> (u64, u64) {
+        let sent = self.acyclic.as_ref().map_or(0, |(_, client)| client.sent());
+        (sent, self.answered)
+    }
+
     /// One lockstep step: CNC tick, trace sample, acyclic calls answered, PLC cycle (the
     /// order of `cnc run --lockstep`). `cycle_s` gives the trace time.
     pub fn step(&mut self, cycle_s: f64) {
@@ -159,8 +168,10 @@ impl InProcess {
             Some((server, client)) => {
                 let view = CncView::new(&self.memory);
                 let machine = &mut self.machine;
-                let _ = server.poll(|kind, request| machine.dispatch(&view, kind, request));
-                let _ = server.poll_rows(|_, header, values| machine.dispatch_bulk(header, values));
+                let calls = server.poll(|kind, request| machine.dispatch(&view, kind, request));
+                let rows =
+                    server.poll_rows(|_, header, values| machine.dispatch_bulk(header, values));
+                self.answered += (calls.unwrap_or(0) + rows.unwrap_or(0)) as u64;
                 timeline.cycle_io(&mut PlcIo {
                     view: PlcView::new(&self.memory),
                     memory: &self.memory,

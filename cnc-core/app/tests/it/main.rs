@@ -37,3 +37,4 @@ mod saw_engine;
 mod saw_no_alloc;
 mod scenario_paths;
 mod scenarios;
+mod soak;
