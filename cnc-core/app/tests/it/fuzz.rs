@@ -1,6 +1,6 @@
 //! Mutation fuzzing of the decoders of outside input, on the stable toolchain: the NC
-//! checker, scenario files, PLC timelines, cam files (JSON and binary tables) and FIFO
-//! position files (CSV and binary). Each target takes its seeds (the files the project ships,
+//! checker, scenario files, PLC timelines, cam files (JSON and binary tables), FIFO
+//! position files (CSV and binary) and acyclic calls (frames and bulk calls of any kind). Each target takes its seeds (the files the project ships,
 //! and `tests/data/fuzz/TARGET/`), mutates them with a seeded generator (bit flips, hostile
 //! tokens, deletions, duplications, splices) and feeds every case to the decoder, which must
 //! answer with a value or a typed error and never panic; a value must hold no non-finite
@@ -9,9 +9,9 @@
 //!
 //! The number of cases per target is fixed (`FUZZ_CASES`, default 1500), so the run is
 //! bounded; `FUZZ_CASES=200000 cargo test --release -p cnc-app --test it fuzz` runs longer.
-//! Not coverage-guided: the stable toolchain CI has has no libFuzzer (docs/reliability.md).
+//! Coverage-guided fuzzing is `tests/fuzz` (cargo-fuzz, nightly); its corpus is the same
+//! folders, so what libFuzzer found is replayed here on stable in every CI run.
 
-use cnc_app::scenario::Scenario;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
@@ -132,71 +132,13 @@ struct Target {
     decode: fn(&[u8]),
 }
 
-fn nc(bytes: &[u8]) {
-    let text = String::from_utf8_lossy(bytes);
-    let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();
-    let _ = cnc_core::nc::check::check_source(&text, &axes);
-}
+/// The shipped scenarios, for the call target's machines.
+static SCENARIOS: std::sync::LazyLock<PathBuf> =
+    std::sync::LazyLock::new(|| tests::cli::repo_root().join("scenarios"));
 
-fn scenario(bytes: &[u8]) {
-    let text = String::from_utf8_lossy(bytes);
-    let _ = Scenario::parse("fuzz.toml", &text, |name| {
-        Ok((PathBuf::from(name), "%p\nG1 X10 F600\nM30\n".to_string()))
-    });
-}
-
-fn timeline(bytes: &[u8]) {
-    let text = String::from_utf8_lossy(bytes);
-    let _ = plc_shim::timeline::Timeline::parse("fuzz.toml", &text);
-}
-
-fn cam(bytes: &[u8]) {
-    use cnc_core::cam::file::{parse, BinaryOptions};
-    let Ok(file) = parse(bytes, BinaryOptions::default()) else {
-        return;
-    };
-    let (start, end) = file.profile.master_range();
-    assert!(
-        start.is_finite() && end.is_finite(),
-        "master range {start}..{end}"
-    );
-    let mut cursor = Default::default();
-    for k in 0..=8 {
-        let x = start + (end - start) * f64::from(k) / 8.0;
-        let s = file.profile.eval(x, &mut cursor);
-        assert!(
-            s.position.is_finite() && s.velocity.is_finite() && s.acceleration.is_finite(),
-            "at {x}: {s:?}"
-        );
-    }
-}
-
-/// A FIFO file of `ending` written to a scratch file and read to its end.
-fn fifo(bytes: &[u8], ending: &str) {
-    let dir = std::env::temp_dir().join(format!("cncplc-fuzz-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("case.{ending}"));
-    std::fs::write(&path, bytes).unwrap();
-    let Ok(mut reader) = plc_shim::fifo_file::RowReader::open(&path) else {
-        return;
-    };
-    let mut rows = vec![0.0; reader.columns() * 64];
-    // Files are small: a bound on the reads, not on the file.
-    for _ in 0..10_000 {
-        match reader.read_rows(&mut rows) {
-            Ok(0) | Err(_) => return,
-            Ok(n) => assert!(rows[..n].iter().all(|v| v.is_finite()), "{:?}", &rows[..n]),
-        }
-    }
-}
-
-fn fifo_csv(bytes: &[u8]) {
-    fifo(bytes, "csv");
-}
-
-fn fifo_binary(bytes: &[u8]) {
-    fifo(bytes, "fifo");
-}
+#[path = "../../../../tests/support/decoders.rs"]
+mod decoders;
+use decoders::{calls, cam, fifo_binary, fifo_csv, nc, scenario, timeline};
 
 const TARGETS: &[Target] = &[
     Target {
@@ -228,6 +170,11 @@ const TARGETS: &[Target] = &[
         name: "fifo-binary",
         ends: &[".fifo"],
         decode: fifo_binary,
+    },
+    Target {
+        name: "calls",
+        ends: &[".call"],
+        decode: calls,
     },
 ];
 
@@ -289,11 +236,7 @@ fn every_decoder_of_outside_input_survives_mutated_input() {
     let mut report = Vec::new();
     for (t, target) in TARGETS.iter().enumerate() {
         let seeds = seeds(target);
-        assert!(
-            !seeds.is_empty() || target.name == "fifo-binary",
-            "{}: no seeds",
-            target.name
-        );
+        assert!(!seeds.is_empty(), "{}: no seeds", target.name);
         // Every seed and every kept regression as it is.
         for (path, bytes) in &seeds {
             run_case(target, bytes, &path.display().to_string());
