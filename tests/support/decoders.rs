@@ -110,11 +110,7 @@ pub fn calls(bytes: &[u8]) {
                 .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
                 .collect();
             let columns = u32::from(bytes[0] >> 4) % 8;
-            let rows = if columns == 0 {
-                0
-            } else {
-                values.len() as u32 / columns
-            };
+            let rows = (values.len() as u32).checked_div(columns).unwrap_or(0);
             let header = hli::wire::BulkHeader {
                 kind: kind.raw(),
                 target,
