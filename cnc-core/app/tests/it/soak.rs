@@ -157,7 +157,7 @@ fn random_input(kind: &Kind, next: &mut impl FnMut() -> u64) -> Option<String> {
         0.0, 1.0, -1.0, 10.0, 100.0, 360.0, 1000.0, -250.0, 0.5, 1e6, -1e9, 5000.0,
     ];
     Some(match kind {
-        Kind::Bool => (next() % 2 == 0).to_string(),
+        Kind::Bool => next().is_multiple_of(2).to_string(),
         Kind::Real => format!("{:?}", REALS[(next() % REALS.len() as u64) as usize]),
         Kind::Count => (next() % 6).to_string(),
         Kind::Range(lo, hi) => {
@@ -214,7 +214,7 @@ fn random_timeline(steps: usize, seed: u64) -> String {
             }
         };
         let mut call = format!("block = \"{}\", instance = \"{instance}\"{axis}", b.name);
-        if b.execute && next() % 5 == 0 {
+        if b.execute && next().is_multiple_of(5) {
             call.push_str(", execute = false");
         } else {
             for input in inputs {
