@@ -604,6 +604,11 @@ impl Engine for CamEngine {
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {
+        // A transfer cut by the stop (its PLC lost between two chunks) is dropped: a new PLC
+        // that sent the missing chunks must not complete a table half of which is the old
+        // PLC's. Nothing was stored from it.
+        self.points_in.iter_mut().for_each(|t| *t = None);
+        self.rows_in.iter_mut().for_each(|t| *t = None);
         // Only its own couplings (another engine may hold an axis since).
         for multi in self.multis.iter_mut().filter_map(Option::take) {
             axes.release(multi.lease);

@@ -438,3 +438,43 @@ fn the_compatibility_blocks_make_read_couple_rescale_and_delete() {
     }
     assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
 }
+
+#[test]
+fn a_transfer_cut_between_chunks_by_a_lost_plc_is_dropped_with_the_stop() {
+    // A PLC lost between two chunks (docs/reliability.md): the first chunk was taken, the last
+    // never comes, and the machine stops. A new PLC that sends the missing chunk must not
+    // complete a table half of which is the old PLC's: the stop dropped the transfer.
+    let mut run = machine("");
+    run.step(0.001);
+    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
+    };
+    let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64 * 10.0, 0.0]).collect();
+    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    run.machine.stop("machine stop: PLC lost");
+    for _ in 0..2000 {
+        run.step(0.001);
+        if run.machine.at_rest() {
+            break;
+        }
+    }
+    assert!(run.machine.rearm(), "re-armed at rest for the new PLC");
+    assert_eq!(
+        answer(&mut run, &rows_chunk(&rows[13..], 13, 26, true)),
+        CamCouplingError::ChunkOutOfOrder.raw(),
+        "the old transfer is gone"
+    );
+    assert_eq!(
+        call(&mut run, SLAVE as u32, cam_in(7)),
+        0x4B32,
+        "nothing stored"
+    );
+    // The new PLC's own transfer, from its first chunk, is taken whole.
+    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    assert_eq!(answer(&mut run, &rows_chunk(&rows[13..], 13, 26, true)), 0);
+    assert_eq!(
+        call(&mut run, SLAVE as u32, cam_in(7)),
+        0,
+        "the new table couples"
+    );
+}
