@@ -2,7 +2,8 @@
 //! integers, TRUE semaphores that push the garbage through) over random leaves of everything
 //! a PLC may write, and sends a call of a random kind with a random body. The CNC must never
 //! panic, keep its own values valid (every float it writes finite, every axis state a state,
-//! every set-point finite) and count what it refused, by class.
+//! every set-point finite and inside its axis's software limits) and count what it refused,
+//! by class.
 //!
 //! CI runs a few thousand ticks per scenario; `cargo test --release -p cnc-app --test it
 //! hostile -- --ignored --nocapture` runs 10^6 and prints the counts (docs/reliability.md).
@@ -156,6 +157,15 @@ fn check(run: &InProcess, leaves: &Leaves, scenario: &str) {
             sp.position.is_finite() && sp.velocity.is_finite() && sp.acceleration.is_finite(),
             "{scenario} tick {tick}: axis {i} {sp:?}"
         );
+        // Within its software limits (a set-point that would leave them stops the axis).
+        if let Some([min, max]) = axis.config().soft_limits {
+            let room = 1e-6 * (max - min);
+            assert!(
+                (min - room..=max + room).contains(&sp.position),
+                "{scenario} tick {tick}: axis {i} at {} outside [{min}, {max}]",
+                sp.position
+            );
+        }
         let lr: hli::layout::HliAxisLrState = view
             .axis(i)
             .unwrap()
