@@ -393,6 +393,17 @@ impl Machine {
         }
     }
 
+    /// Disables every axis (MC_Power off), as a machine that lost its PLC may be configured
+    /// to once at rest: the axes stand without torque until a PLC powers them again.
+    pub fn disable_drives(&mut self) {
+        for i in 0..self.axes.len() {
+            if let Some(axis) = self.axes.axis_mut(i) {
+                // Refused only by an axis that is off already.
+                let _ = axis.command(&AxisCommandCall::power(false));
+            }
+        }
+    }
+
     /// Takes commands again after a [`Machine::stop`] that reached rest (a new PLC took
     /// over): the single axes the stop locked are released and stand powered, as they were
     /// left; channels that ended stay ended. `false` (nothing done) while not at rest.

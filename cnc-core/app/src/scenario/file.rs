@@ -55,6 +55,18 @@ pub enum ScenarioError {
     Program(#[from] cnc_core::channel::ProgramError),
 }
 
+/// What the drives do once the stop after a lost PLC reached rest, while the CNC waits for a
+/// new PLC (`plc_loss_drives`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DrivesOnLoss {
+    /// Powered, holding their positions (the new PLC can move them at once).
+    #[default]
+    Hold,
+    /// Disabled (MC_Power off): the new PLC powers them with MC_Power first.
+    Disable,
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
@@ -62,6 +74,8 @@ struct ScenarioFile {
     cycle_ms: f64,
     ticks: Option<u64>,
     plc_watchdog_ticks: Option<u64>,
+    #[serde(default)]
+    plc_loss_drives: DrivesOnLoss,
     #[serde(default)]
     channel: Vec<ChannelConfig>,
     #[serde(default)]
@@ -144,6 +158,8 @@ pub struct Scenario {
     pub ticks: Option<u64>,
     /// Ticks without a PLC cycle before the PLC counts as lost.
     pub plc_watchdog_ticks: Option<u64>,
+    /// What the drives do once a stop after a lost PLC reached rest (`cnc run --plc-restart`).
+    pub plc_loss_drives: DrivesOnLoss,
     /// The channels.
     pub channels: Vec<ChannelConfig>,
     /// Their programs, checked (None: the channel stays idle).
@@ -222,6 +238,7 @@ impl Scenario {
             cycle_s: file.cycle_ms * 1e-3,
             ticks: file.ticks,
             plc_watchdog_ticks: file.plc_watchdog_ticks,
+            plc_loss_drives: file.plc_loss_drives,
             channels: file.channel,
             programs,
             axes,

@@ -140,3 +140,40 @@ fn a_plc_killed_three_times_mid_run_is_replaced_and_moves_the_axis_again() {
         "segment left behind"
     );
 }
+
+#[test]
+fn drives_configured_to_disable_stand_off_until_the_new_plc_powers_them() {
+    let instance = tests::unique_instance("restart-off");
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", data("disable.toml").to_str().unwrap()])
+        .args(["--plc-restart", "--instance", &instance])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .watchdog(Duration::from_secs(120))
+        .spawn()
+        .unwrap();
+    let mut log = BufReader::new(cnc.0.stderr.take().unwrap());
+    wait_for(&instance, "the first move", |p, v| p > 20.0 && v != 0);
+    assert!(signal(plc_pid(&instance).expect("a PLC process"), "KILL"));
+    let line = expect_line(&mut log, "PLC leaves cleared");
+    assert!(line.contains("drives disabled"), "{line}");
+    // Off from the next tick on (a poll with a watchdog).
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let enabled = hli::enums::axis_status::ENABLED;
+    while slide(&instance, "status_r").is_some_and(|s| s as u32 & enabled != 0) {
+        assert!(
+            Instant::now() < deadline,
+            "watchdog: the slide stays enabled"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    // The new PLC powers it (MC_Power) and moves it on to 100 mm.
+    let plc = start_plc(&instance, "forth.toml");
+    expect_line(&mut log, "runs its cycles");
+    wait_for(&instance, "arrival at 100 mm", |p, v| p == 100.0 && v == 0);
+    assert!(cnc.signal("INT"));
+    let out = cnc.wait_with_output(Duration::from_secs(60)).unwrap();
+    assert_eq!(out.status.code(), Some(130));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("PLC restarts: 1\n"));
+    drop(plc);
+}

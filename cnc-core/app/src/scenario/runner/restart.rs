@@ -13,6 +13,7 @@
 //! were). A new PLC sees every PLC-written leaf cleared, every command unit empty and every
 //! request withdrawn ([`CncSegment::reset_plc_units`]).
 
+use super::super::file::DrivesOnLoss;
 use super::super::machine::Machine;
 use cnc_os::monotonic;
 use core::mem::offset_of;
@@ -42,8 +43,9 @@ pub(super) enum Gap {
 pub(super) enum GapEvent {
     /// Nothing changed.
     None,
-    /// The machine came to rest; `cleared` PLC leaves were set back.
-    Waiting { cleared: usize },
+    /// The machine came to rest; `cleared` PLC leaves were set back, the drives disabled
+    /// when so configured.
+    Waiting { cleared: usize, disabled: bool },
     /// PLC `pid` attached; the machine takes commands again.
     Attached { pid: u32 },
     /// The new PLC runs its cycles.
@@ -64,6 +66,7 @@ impl Gap {
         tick: u64,
         machine: &mut Machine,
         segment: &CncSegment,
+        drives: DrivesOnLoss,
     ) -> GapEvent {
         let pid_now = segment
             .header()
@@ -76,8 +79,12 @@ impl Gap {
                     return GapEvent::None;
                 }
                 let cleared = segment.reset_plc_units();
+                let disabled = drives == DrivesOnLoss::Disable;
+                if disabled {
+                    machine.disable_drives();
+                }
                 *self = Gap::Waiting { pid };
-                GapEvent::Waiting { cleared }
+                GapEvent::Waiting { cleared, disabled }
             }
             Gap::Waiting { pid } => {
                 if pid_now == 0 || pid_now == pid || !machine.rearm() {

@@ -390,10 +390,12 @@ impl<'a> TickLoop<'a> {
     /// `--plc-restart`, after tick `tick` while no PLC runs: the gap's next step, said.
     fn mind_gap(&mut self, tick: u64) {
         let instance = &self.options.instance;
-        match self.gap.step(tick, self.machine, self.segment) {
+        let drives = self.scenario.plc_loss_drives;
+        match self.gap.step(tick, self.machine, self.segment, drives) {
             GapEvent::None => {}
-            GapEvent::Waiting { cleared } => eprintln!(
-                "cnc run: machine at rest at tick {tick}; {cleared} PLC leaves cleared; waiting for a new PLC on instance {instance}"
+            GapEvent::Waiting { cleared, disabled } => eprintln!(
+                "cnc run: machine at rest at tick {tick}; {cleared} PLC leaves cleared{}; waiting for a new PLC on instance {instance}",
+                if disabled { "; drives disabled" } else { "" }
             ),
             GapEvent::Attached { pid } => {
                 eprintln!("cnc run: PLC process {pid} attached at tick {tick}; machine re-armed")
