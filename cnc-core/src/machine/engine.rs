@@ -83,6 +83,33 @@ pub struct Bulk<'a> {
     pub values: &'a [f64],
 }
 
+/// Where the data an engine took from the PLC went, counted in its units (a FIFO row, a cam
+/// table's row or point): each unit taken is done (executed, stored), dropped (an overwrite,
+/// a stop, a refused or cut transfer) or still pending, so `taken = done + dropped + pending`
+/// at every moment. Counters saturate.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Balance {
+    /// Units taken in.
+    pub taken: u64,
+    /// Units that did what they came for.
+    pub done: u64,
+    /// Units thrown away.
+    pub dropped: u64,
+    /// Units still held.
+    pub pending: u64,
+}
+
+impl Balance {
+    /// Whether every unit taken is accounted for.
+    pub fn holds(&self) -> bool {
+        let out = self
+            .done
+            .saturating_add(self.dropped)
+            .saturating_add(self.pending);
+        self.taken == out
+    }
+}
+
 /// A motion engine in the machine tick.
 pub trait Engine: std::fmt::Debug + Send {
     /// A short name for reports.
@@ -123,6 +150,11 @@ pub trait Engine: std::fmt::Debug + Send {
     /// The machine stops on a fault (lost PLC, signal): release every coupled axis so that
     /// each stops with its own deceleration.
     fn reset(&mut self, axes: &mut AxisSet);
+
+    /// Where the data it took went ([`Balance`]); an engine that takes no data has none.
+    fn balance(&self) -> Balance {
+        Balance::default()
+    }
 }
 
 /// Which engine answers which call kind: built once from the engines' [`Engine::calls`].

@@ -17,7 +17,7 @@
 //! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
 //! are sized when the engine is built.
 
-use super::engine::{Bulk, Call, Engine, EngineIo};
+use super::engine::{Balance, Bulk, Call, Engine, EngineIo};
 use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
@@ -67,6 +67,9 @@ struct Group {
     flags: u32,
     rows_written: u64,
     underrun_ticks: u32,
+    /// Rows taken, passed by the generator, and dropped (overwritten, or left when a job
+    /// ended, the row a finished job stands on included): [`Balance`].
+    balance: Balance,
     /// The override target before FiFoStop, in effect again once the stop has ended the job.
     before_stop: f64,
 }
@@ -98,6 +101,7 @@ impl Group {
             flags: 0,
             rows_written: 0,
             underrun_ticks: 0,
+            balance: Balance::default(),
             before_stop: 1.0,
             params,
         }
@@ -133,6 +137,7 @@ impl Group {
         if self.state == FifoGroupState::Stopping {
             self.ovr.reset(self.before_stop);
         }
+        self.balance.dropped = self.balance.dropped.saturating_add(self.ring.len() as u64);
         self.ring.clear();
         self.generator.start(&self.ring);
         self.state = state;
@@ -218,7 +223,10 @@ impl Group {
             return;
         }
         let ov = self.ovr.step();
+        let queued = self.ring.len();
         let status = self.generator.step(&mut self.ring, ov);
+        let passed = queued.saturating_sub(self.ring.len()) as u64;
+        self.balance.done = self.balance.done.saturating_add(passed);
         for (c, lease) in self.members.iter().enumerate() {
             let Some(lease) = *lease else {
                 continue;
@@ -411,6 +419,9 @@ impl Group {
         };
         match result {
             Ok(rows) => {
+                let b = &mut self.balance;
+                b.taken = b.taken.saturating_add(rows as u64);
+                b.dropped = b.dropped.saturating_add((before - keep) as u64);
                 // Written counts the rows of the job: the replaced ones are no longer part.
                 self.rows_written = self.rows_written + rows as u64 - (before - keep) as u64;
                 if self.state == FifoGroupState::Idle {
@@ -522,6 +533,17 @@ impl FifoEngine {
 impl Engine for FifoEngine {
     fn name(&self) -> &'static str {
         "fifo"
+    }
+
+    fn balance(&self) -> Balance {
+        let mut sum = Balance::default();
+        for g in &self.groups {
+            sum.taken = sum.taken.saturating_add(g.balance.taken);
+            sum.done = sum.done.saturating_add(g.balance.done);
+            sum.dropped = sum.dropped.saturating_add(g.balance.dropped);
+            sum.pending = sum.pending.saturating_add(g.ring.len() as u64);
+        }
+        sum
     }
 
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {

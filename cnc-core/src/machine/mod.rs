@@ -258,6 +258,11 @@ impl Machine {
         }
     }
 
+    /// Each engine's name and where the data it took went ([`engine::Balance`]).
+    pub fn balances(&self) -> impl Iterator<Item = (&'static str, engine::Balance)> + '_ {
+        self.engines.iter().map(|e| (e.name(), e.balance()))
+    }
+
     /// What the PLC's writes and calls the CNC refused so far, by class.
     pub fn plc_violations(&self) -> Violations {
         let mut all = *self.controller.violations();

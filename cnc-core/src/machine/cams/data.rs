@@ -65,14 +65,14 @@ impl CamEngine {
         let slot = id as usize;
         let count = call.count as usize;
         if count == 0 || count > CAM_POINTS_PER_CALL || call.total == 0 {
-            self.points_in[slot] = None;
+            self.drop_points(slot);
             return code(TableErrorCode::NumPointsInvalid as u32);
         }
         let create = call.flags & CAM_POINTS_CREATE != 0;
         if call.flags & CAM_CHUNK_FIRST != 0 {
             // A new transfer: whatever an earlier one left unfinished goes.
+            self.drop_points(slot);
             if create && self.in_use(id) {
-                self.points_in[slot] = None;
                 return code(CamCouplingError::TableInUse.raw());
             }
             self.points_in[slot] = Some(PointsTransfer {
@@ -90,16 +90,27 @@ impl CamEngine {
             && call.first == transfer.first + transfer.points.len() as u32
             && transfer.points.len() + count <= call.total as usize;
         if !continues {
-            self.points_in[slot] = None;
+            self.drop_points(slot);
             return code(CamCouplingError::ChunkOutOfOrder.raw());
         }
         transfer
             .points
             .extend(call.points[..count].iter().map(point_from_plc));
+        self.data_balance.taken = self.data_balance.taken.saturating_add(count as u64);
         if call.flags & CAM_CHUNK_LAST == 0 {
             return accepted();
         }
         let transfer = self.points_in[slot].take().expect("filled above");
+        let units = transfer.points.len();
+        let answer = self.store_points(id, transfer, axes);
+        self.settle(units, &answer);
+        answer
+    }
+
+    /// The last chunk came: the points, checked whole, become a motion function or change
+    /// table `id`'s.
+    fn store_points(&mut self, id: u32, transfer: PointsTransfer, axes: &AxisSet) -> HandlerResult {
+        let slot = id as usize;
         if transfer.points.len() != transfer.total as usize {
             return code(CamCouplingError::ChunkOutOfOrder.raw());
         }
@@ -228,7 +239,47 @@ impl CamEngine {
             return accepted();
         }
         let transfer = self.rows_in[slot].take().expect("filled above");
-        self.store_rows(id, transfer)
+        let units = transfer.rows.len();
+        let answer = self.store_rows(id, transfer);
+        self.settle(units, &answer);
+        answer
+    }
+
+    /// Drops table `slot`'s open points transfer; its points count as dropped.
+    pub(super) fn drop_points(&mut self, slot: usize) {
+        if let Some(t) = self.points_in[slot].take() {
+            let b = &mut self.data_balance;
+            b.dropped = b.dropped.saturating_add(t.points.len() as u64);
+        }
+    }
+
+    /// Drops table `slot`'s open rows transfer; its rows count as dropped.
+    pub(super) fn drop_rows(&mut self, slot: usize) {
+        if let Some(t) = self.rows_in[slot].take() {
+            let b = &mut self.data_balance;
+            b.dropped = b.dropped.saturating_add(t.rows.len() as u64);
+        }
+    }
+
+    /// A finished transfer of `units` answered with `answer`: stored, or dropped.
+    fn settle(&mut self, units: usize, answer: &HandlerResult) {
+        let b = &mut self.data_balance;
+        let to = if answer.is_ok() {
+            &mut b.done
+        } else {
+            &mut b.dropped
+        };
+        *to = to.saturating_add(units as u64);
+    }
+
+    /// Points and rows in open transfers.
+    pub(super) fn pending_units(&self) -> u64 {
+        let points = self.points_in.iter().flatten().map(|t| t.points.len());
+        let rows = self.rows_in.iter().flatten().map(|t| t.rows.len());
+        points
+            .chain(rows)
+            .map(|n| n as u64)
+            .fold(0, u64::saturating_add)
     }
 
     /// CamTableCreate: the table's type and size, for the rows that follow.
@@ -245,7 +296,7 @@ impl CamEngine {
             call.periodic,
             call.total,
         ));
-        self.rows_in[slot] = None;
+        self.drop_rows(slot);
         accepted()
     }
 
@@ -255,13 +306,13 @@ impl CamEngine {
         let slot = id as usize;
         let count = call.count as usize;
         if count == 0 || count > CAM_ROWS_PER_CALL || call.total == 0 {
-            self.rows_in[slot] = None;
+            self.drop_rows(slot);
             return Err(TableErrorCode::NumRowsInvalid as u32);
         }
         if call.flags & CAM_CHUNK_FIRST != 0 {
             // A new transfer, refused at once for a table in use.
+            self.drop_rows(slot);
             if self.in_use(id) {
-                self.rows_in[slot] = None;
                 return Err(CamCouplingError::TableInUse.raw());
             }
             self.rows_in[slot] = Some(RowsTransfer {
@@ -282,10 +333,12 @@ impl CamEngine {
             && call.first_row as usize == transfer.rows.len()
             && transfer.rows.len() + count <= call.total as usize;
         if !continues {
-            self.rows_in[slot] = None;
+            self.drop_rows(slot);
             return Err(CamCouplingError::ChunkOutOfOrder.raw());
         }
         transfer.rows.extend_from_slice(&call.rows[..count]);
+        let b = &mut self.data_balance;
+        b.taken = b.taken.saturating_add(count as u64);
         Ok(())
     }
 

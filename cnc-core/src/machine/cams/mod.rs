@@ -27,7 +27,7 @@ mod couplings;
 mod data;
 mod reads;
 
-use super::engine::{Call, Engine, EngineIo, Resource};
+use super::engine::{Balance, Call, Engine, EngineIo, Resource};
 use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Lease};
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
@@ -191,6 +191,8 @@ pub struct CamEngine {
     online_scaling: Vec<(CamScalingMode, CamScalingMode)>,
     points_in: Vec<Option<PointsTransfer>>,
     rows_in: Vec<Option<RowsTransfer>>,
+    /// Points and rows of transfers: taken, stored, dropped ([`Engine::balance`]).
+    data_balance: Balance,
     /// Tables declared (CamTableCreate) for rows that follow: type, interpolation, cyclic,
     /// rows.
     declared: Vec<Option<(u32, u32, u32, u32)>>,
@@ -263,6 +265,7 @@ impl CamEngine {
             ],
             points_in: (0..TABLE_SLOTS).map(|_| None).collect(),
             rows_in: (0..TABLE_SLOTS).map(|_| None).collect(),
+            data_balance: Balance::default(),
             declared: vec![None; TABLE_SLOTS],
             slaves: (0..axes).map(|_| None).collect(),
             // Room for every retirement between two calls: each slave lost (two profiles), a
@@ -557,6 +560,13 @@ impl Engine for CamEngine {
         "cam"
     }
 
+    fn balance(&self) -> Balance {
+        Balance {
+            pending: self.pending_units(),
+            ..self.data_balance
+        }
+    }
+
     fn calls(&self) -> &'static [CallSpec] {
         hli::calls::cam::CALLS
     }
@@ -607,8 +617,10 @@ impl Engine for CamEngine {
         // A transfer cut by the stop (its PLC lost between two chunks) is dropped: a new PLC
         // that sent the missing chunks must not complete a table half of which is the old
         // PLC's. Nothing was stored from it.
-        self.points_in.iter_mut().for_each(|t| *t = None);
-        self.rows_in.iter_mut().for_each(|t| *t = None);
+        for slot in 0..TABLE_SLOTS {
+            self.drop_points(slot);
+            self.drop_rows(slot);
+        }
         // Only its own couplings (another engine may hold an axis since).
         for multi in self.multis.iter_mut().filter_map(Option::take) {
             axes.release(multi.lease);
