@@ -268,7 +268,7 @@ macro_rules! segment_side {
 
             /// Marks one more tick (CNC) or cycle (PLC) of this side; returns the new
             /// heartbeat. The count is this side's own: what the segment holds is written,
-            /// never read back.
+            /// not taken back.
             pub fn beat(&self) -> u64 {
                 let beats = self.beats.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
                 self.header()
@@ -461,11 +461,19 @@ impl CncSegment {
     }
 }
 
-impl Drop for CncSegment {
-    fn drop(&mut self) {
+impl CncSegment {
+    /// Marks the segment closed (the PLC stops); the object stays until the segment is
+    /// dropped.
+    pub fn mark_closed(&self) {
         self.header()
             .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
             .store_release(SegmentState::Closed.raw());
+    }
+}
+
+impl Drop for CncSegment {
+    fn drop(&mut self) {
+        self.mark_closed();
         // `memory` owns the object and unlinks it when dropped.
     }
 }
@@ -498,6 +506,9 @@ pub struct PlcSegment {
     seen: HliSegmentHeader,
     /// `/proc/<cnc_pid>/stat` of the CNC named at attach.
     cnc_stat: String,
+    /// Whether the CNC's process could be seen at attach (its start time read and matching):
+    /// else (another pid namespace, an unknown start time) its liveness is not judged.
+    cnc_visible: bool,
     timing: CncTiming,
     beats: AtomicU64,
 }
@@ -613,6 +624,8 @@ impl PlcSegment {
             claimed: claim,
             seen: h,
             cnc_stat: stat_path(h.cnc_pid),
+            cnc_visible: h.cnc_start_stamp != 0
+                && start_stamp_at(&stat_path(h.cnc_pid)) == Some(h.cnc_start_stamp),
             timing,
             beats: AtomicU64::new(h.plc_heartbeat),
         })
@@ -639,13 +652,27 @@ impl PlcSegment {
 
     /// Whether the CNC process that created the segment (as the header said at attach) still
     /// runs. Reads `/proc`: a system call, for the PLC's wait, not for its cycle.
+    /// A CNC that could not be seen at attach counts as alive (its silence still counts).
     pub fn cnc_process_alive(&self) -> bool {
-        start_stamp_at(&self.cnc_stat) == Some(self.seen.cnc_start_stamp)
+        !self.cnc_visible || start_stamp_at(&self.cnc_stat) == Some(self.seen.cnc_start_stamp)
     }
 
     /// The CNC's timing, as announced at attach.
     pub fn cnc_timing(&self) -> CncTiming {
         self.timing
+    }
+
+    /// The pid of another PLC that claimed the segment since this one did (a new PLC the
+    /// CNC took after it lost this one): this one must stop writing. `None` for a tool.
+    pub fn replaced_by(&self) -> Option<u32> {
+        if !self.claimed {
+            return None;
+        }
+        let pid = self
+            .header()
+            .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
+            .load_acquire();
+        (pid != std::process::id()).then_some(pid)
     }
 
     /// Compares the CNC-owned header with what it was at attach: the identity must be

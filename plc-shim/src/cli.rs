@@ -151,8 +151,8 @@ pub fn run(args: PlcArgs) -> ExitCode {
 /// Attaches to the CNC `args` names and runs `program` until the CNC ends, is lost, a signal
 /// arrives or the cycle limit is reached; prints the end, the task statistics and the
 /// program's summary. Exit codes: 0 the CNC closed (or the limit), 1 no CNC or a service
-/// failed, 3 the CNC was lost, 5 the segment header was corrupted, 128 + signal number on
-/// SIGINT/SIGTERM.
+/// failed, 3 the CNC was lost, 5 the segment header was corrupted, 6 another PLC took over,
+/// 128 + signal number on SIGINT/SIGTERM.
 ///
 /// A PLC program in a user's crate is a type implementing [`PlcProgram`] and a `main` that
 /// parses [`HostArgs`] (flattened into its own arguments) and calls this (see
@@ -193,6 +193,10 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
                 crate::runtime::RunEnd::SegmentCorrupt(fault) => {
                     eprintln!("plc: {fault}; the last cycle ran not operational");
                     ExitCode::from(5)
+                }
+                crate::runtime::RunEnd::Replaced(pid) => {
+                    eprintln!("plc: PLC process {pid} took over the segment; stopping");
+                    ExitCode::from(6)
                 }
                 crate::runtime::RunEnd::Signal(signal) => {
                     eprintln!("plc: stopped by {}", signal.name());

@@ -87,6 +87,10 @@ impl<'a> PlcIo<'a> {
     }
 }
 
+/// More CNC ticks than this between two wake-ups of the PLC are not a late PLC but a
+/// heartbeat written over (hours of ticks at the shortest cycle).
+const MAX_TICKS_BETWEEN_WAKE_UPS: u64 = 1 << 32;
+
 /// Cycle durations up to this many microseconds are kept to the microsecond (longer ones
 /// count in the last bucket; the maximum is exact).
 const HISTOGRAM_US: usize = 2_000;
@@ -200,6 +204,9 @@ pub enum RunEnd {
     CncLost(CncLoss),
     /// A CNC-owned header field changed (someone wrote where only the CNC writes).
     SegmentCorrupt(HeaderFault),
+    /// Another PLC (this pid) claimed the segment: the CNC took a new PLC after it lost this
+    /// one (a PLC that was hung and came back). This one stops without another cycle.
+    Replaced(u32),
     /// The cycle limit was reached.
     CycleLimit,
     /// A termination signal arrived (see [`hli::signals`]).
@@ -296,13 +303,18 @@ impl PlcRuntime {
             self.events.wait(self.wait_step)?;
             let beat = self.segment.cnc_heartbeat();
             if let Some(ended) = self.supervise(&mut watch, beat) {
-                if ended != RunEnd::CncClosed {
+                if matches!(ended, RunEnd::CncLost(_) | RunEnd::SegmentCorrupt(_)) {
                     self.last_cycle(program, &mut stats);
                 }
                 return end(ended, stats);
             }
             if beat == last_cnc_beat {
                 continue; // woken without a new tick (timeout): no cycle
+            }
+            // A heartbeat that went back or leapt (written over between two ticks): the task
+            // starts its schedule over instead of waiting for a slot that never comes.
+            if beat < last_cnc_beat || beat - last_cnc_beat > MAX_TICKS_BETWEEN_WAKE_UPS {
+                due = None;
             }
             last_cnc_beat = beat;
             let slot = due.unwrap_or(beat);
@@ -334,6 +346,9 @@ impl PlcRuntime {
     /// After a wake-up that found heartbeat `beat`: how the run ends, if it does (a corrupted
     /// header before an orderly close, a close before a silence).
     fn supervise(&self, watch: &mut CncWatch, beat: u64) -> Option<RunEnd> {
+        if let Some(pid) = self.segment.replaced_by() {
+            return Some(RunEnd::Replaced(pid));
+        }
         match self.segment.check_header() {
             Err(fault) => return Some(RunEnd::SegmentCorrupt(fault)),
             Ok(SegmentState::Ready) => {}

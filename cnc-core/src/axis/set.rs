@@ -228,7 +228,8 @@ impl AxisSet {
 
     /// A slave coupled to a master axis that is in error (its set-point stands at once)
     /// would stop with it, without braking: it is let go with the motion it had and brakes
-    /// with its own deceleration and jerk (MC_Stop). The engine that held it sees its lease
+    /// with its own deceleration and jerk (MC_Halt: not locked, so once the master is
+    /// repaired the PLC can couple or move it again). The engine that held it sees its lease
     /// gone.
     fn release_orphans(&mut self) {
         for i in 0..self.axes.len() {
@@ -245,7 +246,7 @@ impl AxisSet {
             axis.decouple();
             let d = axis.config().dynamics;
             // Refused only by an axis that may not move: it stands already.
-            let _ = axis.command(&hli::calls::axis::AxisCommandCall::stop(
+            let _ = axis.command(&hli::calls::axis::AxisCommandCall::halt(
                 d.deceleration,
                 d.jerk,
             ));

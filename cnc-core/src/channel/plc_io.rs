@@ -60,8 +60,10 @@ pub struct Violations {
     pub bool_garbage: u64,
     /// Override values above their maximum.
     pub out_of_range: u64,
-    /// Acyclic calls refused (any error code: a bad body, a value out of range, a wrong
-    /// state, a stopped machine).
+    /// Acyclic calls refused with an error code in the frame (a body of the wrong size, an
+    /// unknown kind or target, a stopped machine, a refusal a family gives as a code). A
+    /// refusal a family reports inside an accepted reply (an axis's or a cam's error id) is
+    /// the block's to see and is not counted here.
     pub refused_calls: u64,
 }
 

@@ -123,6 +123,11 @@ impl Engine for GearEngine {
                 if !axis.enabled() || !axis.has_position() || axis.error().is_some() {
                     continue;
                 }
+                // Not to a master in error: its set-point stood at the fault (the axis set
+                // let the slave go for that); once the master is reset it couples again.
+                if io.axes.axis(master).is_some_and(|m| m.error().is_some()) {
+                    continue;
+                }
                 let start = axis.setpoint().position;
                 let coupling = Coupling {
                     kind: CouplingState::GearVelocity,

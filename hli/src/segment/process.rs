@@ -39,15 +39,21 @@ pub(super) fn start_stamp_at(path: &str) -> Option<u64> {
     fields.nth(22 - 4)?.parse().ok()
 }
 
+/// The process's effective user, from `/proc/self/status` (`Uid:` real, effective, ...); the
+/// owner of `/proc/self` would be root for a process given file capabilities.
+fn effective_uid() -> Option<u32> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let uids = status.lines().find_map(|l| l.strip_prefix("Uid:"))?;
+    uids.split_whitespace().nth(1)?.parse().ok()
+}
+
 /// Refuses a segment file another user owns (owner-only permissions keep others out of ours;
 /// this keeps us out of theirs, where the mode would let us in).
 pub(super) fn check_owner(name: &str) -> Result<(), AttachError> {
     use std::os::unix::fs::MetadataExt;
     let owner = std::fs::metadata(format!("/dev/shm/{name}")).map(|m| m.uid());
-    // /proc/self belongs to the process's effective user.
-    let me = std::fs::metadata("/proc/self").map(|m| m.uid());
-    match (owner, me) {
-        (Ok(owner), Ok(me)) if owner != me => Err(AttachError::ForeignOwner {
+    match (owner, effective_uid()) {
+        (Ok(owner), Some(me)) if owner != me => Err(AttachError::ForeignOwner {
             name: name.to_string(),
             owner,
             me,

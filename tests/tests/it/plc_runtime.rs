@@ -118,18 +118,14 @@ impl PlcProgram for Betrayed {
     }
 }
 
-/// Runs a PLC runtime on a `cnc-beat` peer (1 ms cycle) that gets `signal` in the PLC's 50th
-/// cycle; returns how the run ended and the links the program saw.
-fn betrayed_by(signal: &'static str) -> (RunEnd, Vec<plc_shim::runtime::Link>) {
+/// Runs a PLC runtime (watchdog `watchdog` CNC cycles) on a `cnc-beat` peer (1 ms cycle) that
+/// gets `signal` in the PLC's 50th cycle; returns how the run ended and the links the program
+/// saw.
+fn betrayed_by(signal: &'static str, watchdog: u32) -> (RunEnd, Vec<plc_shim::runtime::Link>) {
     hli::init_logging();
     let instance = unique_instance(&format!("plc-{}", signal.to_lowercase()));
     let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
-    let mut runtime = PlcRuntime::attach(
-        &instance,
-        plc_shim::watchdog::DEFAULT_WATCHDOG_CYCLES,
-        Duration::from_millis(10),
-    )
-    .unwrap();
+    let mut runtime = PlcRuntime::attach(&instance, watchdog, Duration::from_millis(10)).unwrap();
     let mut program = Betrayed {
         pid: child.id(),
         signal,
@@ -149,7 +145,9 @@ fn betrayed_by(signal: &'static str) -> (RunEnd, Vec<plc_shim::runtime::Link>) {
 #[test]
 fn a_killed_cnc_is_lost_within_cycles_and_the_program_is_told() {
     use plc_shim::runtime::{CncLoss, Link};
-    let (end, links) = betrayed_by("KILL");
+    // A long watchdog: a loaded machine's stall must not pass for a hung CNC before the kill
+    // (a dead one is seen from its process, whatever the watchdog).
+    let (end, links) = betrayed_by("KILL", 2_000);
     let RunEnd::CncLost(CncLoss::Dead { silent_cycles }) = end else {
         panic!("{end:?}");
     };
@@ -172,7 +170,7 @@ fn a_killed_cnc_is_lost_within_cycles_and_the_program_is_told() {
 #[test]
 fn a_stopped_cnc_is_lost_after_the_watchdog_cycles() {
     use plc_shim::runtime::{CncLoss, Link};
-    let (end, links) = betrayed_by("STOP");
+    let (end, links) = betrayed_by("STOP", plc_shim::watchdog::DEFAULT_WATCHDOG_CYCLES);
     let RunEnd::CncLost(CncLoss::Silent { silent_cycles }) = end else {
         panic!("{end:?}");
     };
@@ -180,4 +178,35 @@ fn a_stopped_cnc_is_lost_after_the_watchdog_cycles() {
     assert!(silent_cycles >= limit, "{silent_cycles}");
     eprintln!("stopped CNC noticed after {silent_cycles} CNC cycles");
     assert_eq!(links.last(), Some(&Link::NotOperational));
+}
+
+/// Writes another pid into the header's PLC slot in its 10th cycle, as a new PLC that the CNC
+/// took after it lost this one would.
+struct Overtaken;
+
+impl PlcProgram for Overtaken {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        if io.cycle == 10 {
+            let pid = hli::access::Leaf::resolve("header.plc_pid").unwrap();
+            io.memory.place::<u32>(pid.offset).store(4_000_000);
+        }
+    }
+}
+
+#[test]
+fn a_plc_whose_slot_another_plc_claimed_stops_without_another_cycle() {
+    hli::init_logging();
+    let instance = unique_instance("plc-replaced");
+    // Eleven ticks: the eleventh cycle takes the slot over, and the CNC ends after it.
+    let cnc = tests::lockstep_beats(&instance, 11, 1);
+    let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
+    let summary = runtime.run(&mut Overtaken, Some(1_000)).unwrap();
+    assert_eq!(summary.end, RunEnd::Replaced(4_000_000));
+    assert_eq!(
+        summary.cycles(),
+        11,
+        "no cycle after the take-over was seen"
+    );
+    drop(runtime);
+    cnc.join().unwrap();
 }

@@ -253,7 +253,6 @@ impl Scenario {
     }
 }
 
-/// The refusal of scenario `name` with a message.
 /// A relative path a scenario gives under `key` must stay inside the scenario's folder; an
 /// absolute one names a file elsewhere on purpose.
 fn confined(key: &str, path: &Path) -> Result<(), String> {
@@ -277,6 +276,7 @@ fn confined(key: &str, path: &Path) -> Result<(), String> {
     Ok(())
 }
 
+/// The refusal of scenario `name` with a message.
 fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
     move |message: String| ScenarioError::Invalid {
         file: name.to_string(),

@@ -334,6 +334,12 @@ fn run_machine(
     let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
     let bounds = Bounds::of(scenario, options)?;
     let measured = Measured::new(scenario, bounds.rows);
+    // Real time: the heartbeat watchdogs start with the loop, so the PLC must be cycling by
+    // then, and nothing slow may come between its first cycle and tick 0 (the PLC counts the
+    // CNC's silence in cycles once it has seen it tick).
+    if let (false, Some(child)) = (options.lockstep, link.child.as_mut()) {
+        wait_for_first_cycle(&link.segment, &link.events, child)?;
+    }
     let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
     let ticks = machine.ticks();
@@ -404,10 +410,6 @@ impl PlcLink {
         let mut child = spawn_plc(scenario, options)?;
         if let Some(child) = child.as_mut() {
             wait_for_attach(&segment, child)?;
-            if !options.lockstep {
-                // The heartbeat watchdog starts with the loop: the PLC must be cycling by then.
-                wait_for_first_cycle(&segment, &events, child)?;
-            }
         }
         Ok(PlcLink {
             segment,

@@ -1,8 +1,9 @@
 //! The fault matrix: for every engine, a scenario whose PLC is killed (SIGKILL) or stopped
 //! (SIGSTOP, hung) at a random cycle while the engine works: an axis command, a dynamic-CS
 //! transition with its M-function handshakes, a cam data transfer, a FIFO row stream, the
-//! flying saw's commands, gears on a channel. Each run must end in a controlled stop that
-//! reaches rest, with one line naming the cause, exit code 4, no panic and no segment left.
+//! flying saw's commands (`cli_supervision.rs` has the gear on a channel). Each run must end
+//! in a controlled stop that reaches rest, with one line naming the cause, exit code 4, no
+//! panic and no segment left.
 //! The kill point is drawn from the process id and printed, so a failure names its case.
 
 use super::cli_supervision::{finish, rest_ticks, segment, wait_for_plc_cycles};

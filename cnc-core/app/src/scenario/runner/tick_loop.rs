@@ -240,6 +240,11 @@ impl<'a> TickLoop<'a> {
             }
         }
         self.ending.without_plc = self.gap.open();
+        if !self.options.lockstep {
+            // Closed before the threads are joined: the PLC must not take the wait for a
+            // silent CNC. (Lockstep: the PLC runs its last cycle first, see `PlcLink::close`.)
+            self.segment.mark_closed();
+        }
         drop(self.progress);
         if let Some(Err(e)) = self.log_stream.map(LogStream::finish) {
             eprintln!("cnc run: LOG_FILE while running: {e}");
@@ -257,6 +262,8 @@ impl<'a> TickLoop<'a> {
             }
             Some((_, since)) if tick - since > self.bounds.stop_limit => true,
             Some(_) => false,
+            // --plc-restart: a stop after a lost PLC runs to rest (or its limit) as any stop.
+            None if self.gap_braking(tick) => false,
             None if tick >= self.bounds.limit => true,
             None if self.options.ticks.is_none()
                 && self.scenario.ticks.is_none()
@@ -267,6 +274,24 @@ impl<'a> TickLoop<'a> {
             }
             None => false,
         }
+    }
+
+    /// Whether the stop after a lost PLC (`--plc-restart`) still brakes at `tick`; once its
+    /// limit runs out without rest, says so once and lets the run end.
+    fn gap_braking(&self, tick: u64) -> bool {
+        let Gap::Lost { since, .. } = self.gap else {
+            return false;
+        };
+        if self.machine.at_rest() {
+            return false;
+        }
+        if tick - since <= self.bounds.stop_limit {
+            return true;
+        }
+        if tick - since == self.bounds.stop_limit + 1 {
+            eprintln!("cnc run: machine NOT at rest when the stop limit ran out (PLC lost at tick {since})");
+        }
+        false
     }
 
     /// Waits for tick `tick`: lockstep for the PLC's cycle after the last tick (while the
