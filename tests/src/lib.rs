@@ -19,12 +19,14 @@ pub mod channel_rig;
 pub mod child;
 pub mod cli;
 pub mod lockstep;
+pub mod noise;
 pub mod peer;
 pub mod rig;
 
 pub use child::ChildGuard;
 pub use cli::{Cli, Scratch};
 pub use lockstep::{lockstep_beats, lockstep_script, serve_axes_in_lockstep};
+pub use noise::Noise;
 pub use peer::{
     checksum, payload, remove_stale_segment, spawn_peer_saying, spawn_ready_peer, verify,
 };

@@ -14,6 +14,7 @@
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
+use tests::Noise;
 
 /// Words that break careless decoders.
 const TOKENS: &[&str] = &[
@@ -54,22 +55,6 @@ const TOKENS: &[&str] = &[
     "2147483648",
     "-2147483649",
 ];
-
-/// xorshift64*.
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
-}
 
 /// One to four mutations of `seed`, spliced with `other` now and then.
 fn mutate(seed: &[u8], other: &[u8], noise: &mut Noise) -> Vec<u8> {
@@ -241,7 +226,7 @@ fn every_decoder_of_outside_input_survives_mutated_input() {
         for (path, bytes) in &seeds {
             run_case(target, bytes, &path.display().to_string());
         }
-        let mut noise = Noise(0xF022_0000 + t as u64);
+        let mut noise = Noise::new(0xF022_0000 + t as u64);
         let n = cases();
         for k in 0..n {
             let (_, seed) = match seeds.len() {

@@ -16,6 +16,7 @@ use hli::symbols::{Symbol, SymbolKind, SymbolTable};
 use hli::views::CncView;
 use hli::wire::AcyclicRequest;
 use hli::PlaceExt;
+use tests::Noise;
 
 /// Scenarios that together run every engine with a PLC timeline in-process.
 const SCENARIOS: &[&str] = &[
@@ -26,40 +27,24 @@ const SCENARIOS: &[&str] = &[
     "saw-blocks",
 ];
 
-/// xorshift64*: reproducible noise from a seed.
-struct Noise(u64);
-
-impl Noise {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
-
-    /// A hostile value of `size` bytes: random bits, or one of the values that break
-    /// careless code (NaN, ±inf, extremes, 0, ±1, TRUE).
-    fn value(&mut self, size: usize) -> u64 {
-        let special: [u64; 10] = [
-            f64::NAN.to_bits(),
-            f64::INFINITY.to_bits(),
-            f64::NEG_INFINITY.to_bits(),
-            u64::from(f32::NAN.to_bits()),
-            u64::MAX,
-            1 << (size * 8 - 1),
-            (1 << (size * 8 - 1)) - 1,
-            0,
-            1,
-            2,
-        ];
-        match self.below(3) {
-            0 => special[self.below(special.len())],
-            _ => self.next(),
-        }
+/// A hostile value of `size` bytes: random bits, or one of the values that break
+/// careless code (NaN, ±inf, extremes, 0, ±1, TRUE).
+fn hostile_value(noise: &mut Noise, size: usize) -> u64 {
+    let special: [u64; 10] = [
+        f64::NAN.to_bits(),
+        f64::INFINITY.to_bits(),
+        f64::NEG_INFINITY.to_bits(),
+        u64::from(f32::NAN.to_bits()),
+        u64::MAX,
+        1 << (size * 8 - 1),
+        (1 << (size * 8 - 1)) - 1,
+        0,
+        1,
+        2,
+    ];
+    match noise.below(3) {
+        0 => special[noise.below(special.len())],
+        _ => noise.next(),
     }
 }
 
@@ -107,7 +92,7 @@ fn write(memory: &hli::ImageMemory, s: &Symbol, value: u64) {
 fn attack(run: &mut InProcess, leaves: &Leaves, noise: &mut Noise, writes: usize) {
     for _ in 0..writes {
         let s = leaves.plc[noise.below(leaves.plc.len())];
-        let v = noise.value(s.size);
+        let v = hostile_value(noise, s.size);
         write(&run.memory, s, v);
     }
     for _ in 0..2 {
@@ -119,16 +104,16 @@ fn attack(run: &mut InProcess, leaves: &Leaves, noise: &mut Noise, writes: usize
     };
     let mut request: AcyclicRequest = bytemuck::Zeroable::zeroed();
     request.kind = kind.raw();
-    request.target = noise.value(4) as u32 % 40;
+    request.target = hostile_value(noise, 4) as u32 % 40;
     request.body_len = noise.below(hli::wire::ACYCLIC_BODY_SIZE + 8) as u32;
     for chunk in request.body.chunks_mut(8) {
-        let bytes = noise.value(8).to_le_bytes();
+        let bytes = hostile_value(noise, 8).to_le_bytes();
         chunk.copy_from_slice(&bytes[..chunk.len()]);
     }
     let view = CncView::new(&run.memory);
     let _ = run.machine.dispatch(&view, kind, &request);
     let values: Vec<f64> = (0..noise.below(16))
-        .map(|_| f64::from_bits(noise.value(8)))
+        .map(|_| f64::from_bits(hostile_value(noise, 8)))
         .collect();
     let header = hli::wire::BulkHeader {
         kind: kind.raw(),
@@ -193,7 +178,7 @@ fn siege(ticks: u64, writes: usize, seed: u64) -> Violations {
             .join("scenario.toml");
         let scenario = Scenario::load(&path).unwrap();
         let mut run = InProcess::new(&scenario, 0).unwrap();
-        let mut noise = Noise(seed ^ (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+        let mut noise = Noise::new(seed ^ (k as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15));
         for _ in 0..ticks {
             attack(&mut run, &leaves, &mut noise, writes);
             run.step(scenario.cycle_s);
@@ -252,11 +237,11 @@ fn garbage_over_the_cnc_s_own_leaves_changes_nothing_it_does() {
     let scenario = Scenario::load(&path).unwrap();
     let mut clean = InProcess::new(&scenario, 0).unwrap();
     let mut hit = InProcess::new(&scenario, 0).unwrap();
-    let mut noise = Noise(0xBAD_CAFE);
+    let mut noise = Noise::new(0xBAD_CAFE);
     for tick in 0..4_000 {
         for _ in 0..64 {
             let s = leaves[noise.below(leaves.len())];
-            let v = noise.value(s.size);
+            let v = hostile_value(&mut noise, s.size);
             write(&hit.memory, s, v);
         }
         clean.step(scenario.cycle_s);

@@ -21,6 +21,7 @@ use hli::views::CncView;
 use hli::wire::AcyclicRequest;
 use plc_shim::timeline::registry::{BlockSpec, Inputs, Kind, Target, FAMILIES};
 use std::path::PathBuf;
+use tests::Noise;
 
 const SCENARIOS: &[&str] = &[
     "example4-turntable-plc",
@@ -53,13 +54,8 @@ fn fnv(hash: u64, value: u64) -> u64 {
 }
 
 /// A call of a random kind with a random body (most are refused; each is answered).
-fn random_call(run: &mut InProcess, state: &mut u64) {
-    let mut next = || {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    };
+fn random_call(run: &mut InProcess, noise: &mut Noise) {
+    let mut next = || noise.next();
     let Some(kind) = CallKind::decode((next() % 48) as u32) else {
         return;
     };
@@ -82,12 +78,12 @@ fn soak(name: &str, ticks: u64, seed: u64) -> Soaked {
 
 fn soak_scenario(scenario: &Scenario, ticks: u64, seed: u64) -> Soaked {
     let mut run = InProcess::new(scenario, 0).unwrap();
-    let mut state = seed | 1;
+    let mut noise = Noise::new(seed);
     let mut hash = 0xcbf2_9ce4_8422_2325;
     let mut heap_after_warm_up = 0;
     for tick in 0..ticks {
         if tick % 7 == 0 {
-            random_call(&mut run, &mut state);
+            random_call(&mut run, &mut noise);
         }
         run.step(scenario.cycle_s);
         for (_, leaf) in &scenario.signals {
@@ -207,13 +203,8 @@ fn random_input(kind: &Kind, next: &mut impl FnMut() -> u64) -> Option<String> {
 /// axes (a scenario refuses an axis it does not have), one instance per block and axis,
 /// Execute lowered now and then.
 fn random_timeline(steps: usize, seed: u64) -> String {
-    let mut state = seed | 1;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state
-    };
+    let mut noise = Noise::new(seed);
+    let mut next = move || noise.next();
     let blocks: Vec<&BlockSpec> = FAMILIES
         .iter()
         .flat_map(|family| family.iter())
