@@ -81,18 +81,24 @@ fn kill_plc(instance: &str, log: &mut BufReader<ChildStderr>) -> (f64, i64) {
     position_and_velocity(instance)
 }
 
-#[test]
-fn a_plc_killed_three_times_mid_run_is_replaced_and_moves_the_axis_again() {
-    let instance = tests::unique_instance("restart");
+/// `cnc run --plc-restart` of `scenario` (a file of tests/data/restart) and its log.
+fn start_cnc(instance: &str, scenario: &str) -> (ChildGuard, BufReader<ChildStderr>) {
     let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", data("scenario.toml").to_str().unwrap()])
-        .args(["--plc-restart", "--instance", &instance])
+        .args(["run", data(scenario).to_str().unwrap()])
+        .args(["--plc-restart", "--instance", instance])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .watchdog(Duration::from_secs(120))
         .spawn()
         .unwrap();
-    let mut log = BufReader::new(cnc.0.stderr.take().unwrap());
+    let log = BufReader::new(cnc.0.stderr.take().unwrap());
+    (cnc, log)
+}
+
+#[test]
+fn a_plc_killed_three_times_mid_run_is_replaced_and_moves_the_axis_again() {
+    let instance = tests::unique_instance("restart");
+    let (mut cnc, mut log) = start_cnc(&instance, "scenario.toml");
     // PLC 0 (spawned by the CNC) moves the slide towards 100 mm; killed on the way.
     wait_for(&instance, "the first move", |p, v| p > 20.0 && v != 0);
     let (stop_1, v) = kill_plc(&instance, &mut log);
@@ -144,15 +150,7 @@ fn a_plc_killed_three_times_mid_run_is_replaced_and_moves_the_axis_again() {
 #[test]
 fn drives_configured_to_disable_stand_off_until_the_new_plc_powers_them() {
     let instance = tests::unique_instance("restart-off");
-    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", data("disable.toml").to_str().unwrap()])
-        .args(["--plc-restart", "--instance", &instance])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .watchdog(Duration::from_secs(120))
-        .spawn()
-        .unwrap();
-    let mut log = BufReader::new(cnc.0.stderr.take().unwrap());
+    let (mut cnc, mut log) = start_cnc(&instance, "disable.toml");
     wait_for(&instance, "the first move", |p, v| p > 20.0 && v != 0);
     assert!(signal(plc_pid(&instance).expect("a PLC process"), "KILL"));
     let line = expect_line(&mut log, "PLC leaves cleared");
