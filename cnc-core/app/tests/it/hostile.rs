@@ -99,6 +99,13 @@ fn attack(run: &mut InProcess, leaves: &Leaves, noise: &mut Noise, writes: usize
         let s = leaves.semaphores[noise.below(leaves.semaphores.len())];
         write(&run.memory, s, 1);
     }
+    random_calls(run, noise);
+}
+
+/// A call frame of a random kind with a random target and body, and a bulk call of that kind
+/// with random numbers and shape, straight to the machine (most are refused; the soak uses it
+/// too).
+pub(crate) fn random_calls(run: &mut InProcess, noise: &mut Noise) {
     let Some(kind) = CallKind::decode(noise.below(48) as u32) else {
         return;
     };

@@ -1,6 +1,6 @@
 //! Soak: every engine's scenario with its PLC timeline, in-process in lockstep, for many
 //! ticks, with a randomised second PLC on top that sends a call of a random kind with a
-//! random body every few ticks. Checked:
+//! random body, and a bulk call, every few ticks (`hostile::random_calls`). Checked:
 //! * no drift: a second run with the same seed gives the same trace, tick for tick (a running
 //!   hash of the scenario's trace signals and of every axis's set-point);
 //! * conservation: every call the timeline sent was answered once, and every unit of data an
@@ -16,9 +16,6 @@
 use crate::counting_alloc::live_bytes;
 use cnc_app::scenario::{InProcess, Scenario};
 use cnc_core::machine::engine::Balance;
-use hli::calls::CallKind;
-use hli::views::CncView;
-use hli::wire::AcyclicRequest;
 use plc_shim::timeline::registry::{BlockSpec, Inputs, Kind, Target, FAMILIES};
 use std::path::PathBuf;
 use tests::Noise;
@@ -53,24 +50,6 @@ fn fnv(hash: u64, value: u64) -> u64 {
     })
 }
 
-/// A call of a random kind with a random body (most are refused; each is answered).
-fn random_call(run: &mut InProcess, noise: &mut Noise) {
-    let mut next = || noise.next();
-    let Some(kind) = CallKind::decode((next() % 48) as u32) else {
-        return;
-    };
-    let mut request: AcyclicRequest = bytemuck::Zeroable::zeroed();
-    request.kind = kind.raw();
-    request.target = (next() % 40) as u32;
-    request.body_len = (next() % 248) as u32;
-    for chunk in request.body.chunks_mut(8) {
-        let bytes = next().to_le_bytes();
-        chunk.copy_from_slice(&bytes[..chunk.len()]);
-    }
-    let view = CncView::new(&run.memory);
-    let _ = run.machine.dispatch(&view, kind, &request);
-}
-
 fn soak(name: &str, ticks: u64, seed: u64) -> Soaked {
     let scenario = Scenario::load(&tests::cli::scenario(name)).unwrap();
     soak_scenario(&scenario, ticks, seed)
@@ -83,7 +62,7 @@ fn soak_scenario(scenario: &Scenario, ticks: u64, seed: u64) -> Soaked {
     let mut heap_after_warm_up = 0;
     for tick in 0..ticks {
         if tick % 7 == 0 {
-            random_call(&mut run, &mut noise);
+            super::hostile::random_calls(&mut run, &mut noise);
         }
         run.step(scenario.cycle_s);
         for (_, leaf) in &scenario.signals {

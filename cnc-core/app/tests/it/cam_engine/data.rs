@@ -54,12 +54,9 @@ fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
     let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.0]).collect();
     let first = rows_chunk(&rows[..13], 0, 26, false);
     let skipped = rows_chunk(&rows[..13], 20, 26, true);
-    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
-        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
-    };
-    assert_eq!(answer(&mut run, &first), 0);
+    assert_eq!(rows_answer(&mut run, 7, &first), 0);
     assert_eq!(
-        answer(&mut run, &skipped),
+        rows_answer(&mut run, 7, &skipped),
         CamCouplingError::ChunkOutOfOrder.raw()
     );
     // Nothing was stored: table 7 does not exist.
@@ -67,8 +64,11 @@ fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
     // A table whose masters do not rise: refused with the table code, nothing stored.
     let mut bad = rows.clone();
     bad[5][0] = 1.0;
-    assert_eq!(answer(&mut run, &rows_chunk(&bad[..13], 0, 26, false)), 0);
-    let reply = answer(&mut run, &rows_chunk(&bad[13..], 13, 26, true));
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&bad[..13], 0, 26, false)),
+        0
+    );
+    let reply = rows_answer(&mut run, 7, &rows_chunk(&bad[13..], 13, 26, true));
     assert!((0x4B30..=0x4B38).contains(&reply), "{reply:#x}");
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(7)), 0x4B32);
 }
@@ -446,11 +446,11 @@ fn a_transfer_cut_between_chunks_by_a_lost_plc_is_dropped_with_the_stop() {
     // complete a table half of which is the old PLC's: the stop dropped the transfer.
     let mut run = machine("");
     run.step(0.001);
-    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
-        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
-    };
     let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64 * 10.0, 0.0]).collect();
-    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&rows[..13], 0, 26, false)),
+        0
+    );
     run.machine.stop("machine stop: PLC lost");
     for _ in 0..2000 {
         run.step(0.001);
@@ -460,7 +460,7 @@ fn a_transfer_cut_between_chunks_by_a_lost_plc_is_dropped_with_the_stop() {
     }
     assert!(run.machine.rearm(), "re-armed at rest for the new PLC");
     assert_eq!(
-        answer(&mut run, &rows_chunk(&rows[13..], 13, 26, true)),
+        rows_answer(&mut run, 7, &rows_chunk(&rows[13..], 13, 26, true)),
         CamCouplingError::ChunkOutOfOrder.raw(),
         "the old transfer is gone"
     );
@@ -470,8 +470,14 @@ fn a_transfer_cut_between_chunks_by_a_lost_plc_is_dropped_with_the_stop() {
         "nothing stored"
     );
     // The new PLC's own transfer, from its first chunk, is taken whole.
-    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
-    assert_eq!(answer(&mut run, &rows_chunk(&rows[13..], 13, 26, true)), 0);
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&rows[..13], 0, 26, false)),
+        0
+    );
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&rows[13..], 13, 26, true)),
+        0
+    );
     assert_eq!(
         call(&mut run, SLAVE as u32, cam_in(7)),
         0,

@@ -482,6 +482,11 @@ fn dispatch_raw<C: AcyclicCall>(run: &mut InProcess, target: u32, body: &C) -> V
     reply[..len as usize].to_vec()
 }
 
+/// The error id a rows chunk for table `id` is answered with (0: taken).
+fn rows_answer(run: &mut InProcess, id: u32, chunk: &hli::calls::cam::CamRowsWriteCall) -> u32 {
+    bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, id, chunk)).error_id
+}
+
 fn rows_chunk(
     rows: &[[f64; 2]],
     first: usize,

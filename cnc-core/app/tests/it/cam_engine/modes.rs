@@ -182,15 +182,18 @@ fn couplings_by_cam_position_and_next_cycle_start_where_they_say() {
 fn a_first_chunk_drops_an_unfinished_transfer() {
     let mut run = machine("");
     run.step(0.001);
-    let answer = |run: &mut InProcess, c: &hli::calls::cam::CamRowsWriteCall| {
-        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 7, c)).error_id
-    };
     let rows: Vec<[f64; 2]> = (0..26).map(|i| [i as f64, 0.5 * i as f64]).collect();
     // A transfer left half-done (the PLC re-triggered its block) ...
-    assert_eq!(answer(&mut run, &rows_chunk(&rows[..13], 0, 26, false)), 0);
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&rows[..13], 0, 26, false)),
+        0
+    );
     // ... does not block the next one, which starts over.
     let whole: Vec<[f64; 2]> = (0..13).map(|i| [i as f64 * 10.0, 1.0]).collect();
-    assert_eq!(answer(&mut run, &rows_chunk(&whole, 0, 13, true)), 0);
+    assert_eq!(
+        rows_answer(&mut run, 7, &rows_chunk(&whole, 0, 13, true)),
+        0
+    );
     let (v, _) = read_all(
         &mut run,
         7,
