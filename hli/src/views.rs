@@ -20,6 +20,7 @@ use crate::layout::*;
 use crate::raw::{ImageMemory, Place};
 use core::mem::offset_of;
 
+mod channel_control;
 mod path_override;
 mod transition;
 

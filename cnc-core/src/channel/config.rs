@@ -58,6 +58,29 @@ pub struct ChannelConfig {
     /// What NC programs of the channel use: zero offsets, tool table, tolerances, search path.
     #[serde(default)]
     pub nc: NcConfig,
+    /// The folder the PLC selects programs from (`SELECT` of the channel control unit), a
+    /// path relative to the configuration file; without one, SELECT is refused.
+    #[serde(default)]
+    pub programs: Option<String>,
+    /// Who starts `program`: `"cnc"` (with the CNC, the default) or `"plc"` (selected, it
+    /// waits for the PLC's START).
+    #[serde(default)]
+    pub program_start: ProgramStart,
+    /// How long `#WAIT SYN` may wait (s) before the channel fails; none: as long as another
+    /// channel runs.
+    #[serde(default)]
+    pub sync_timeout_s: Option<f64>,
+}
+
+/// Who starts a channel's configured program.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ProgramStart {
+    /// The CNC, when it starts.
+    #[default]
+    Cnc,
+    /// The PLC, with START on the channel control unit.
+    Plc,
 }
 
 /// `channel.nc.*`: the machine data NC programs refer to.
@@ -247,6 +270,9 @@ impl ChannelConfig {
             program: None,
             nc: NcConfig::default(),
             drive: None,
+            programs: None,
+            program_start: ProgramStart::Cnc,
+            sync_timeout_s: None,
         }
     }
 
@@ -390,6 +416,11 @@ impl ChannelConfig {
                 self.start.len() as f64,
                 "at most one finite value per axis",
             ));
+        }
+        if let Some(t) = self.sync_timeout_s {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(self.parameter("sync_timeout_s", t, "must be a finite time > 0"));
+            }
         }
         Ok(())
     }

@@ -6,6 +6,7 @@ use super::dyn_cs::MasterSample;
 use super::plc_io::{read_inputs, write_outputs, ChannelInputs, Violations};
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
+use hli::enums::ChannelState;
 use hli::views::CncView;
 
 /// All channels.
@@ -75,6 +76,19 @@ impl Controller {
         }
     }
 
+    /// Between ticks: the channels' program loading and starting their control units asked
+    /// for (allocates; never in a tick). Returns how many were served.
+    pub fn serve_channels(&mut self) -> usize {
+        let mut served = 0;
+        for channel in &mut self.channels {
+            if channel.pending().is_some() {
+                channel.serve();
+                served += 1;
+            }
+        }
+        served
+    }
+
     /// What the channels refused of the PLC's writes so far, by class.
     pub fn violations(&self) -> &Violations {
         &self.violations
@@ -94,10 +108,25 @@ impl Controller {
                 }
             }
         }
+        let running = self
+            .channels
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| {
+                matches!(
+                    c.channel_state(),
+                    ChannelState::Running | ChannelState::Holding
+                )
+            })
+            .fold(0u32, |mask, (i, _)| mask | 1 << i);
+        self.sync.set_running(running);
         for k in 0..n {
             let i = self.order[k];
             self.channels[i].tick(&self.inputs[i], &self.masters, &mut self.sync);
             self.masters[i] = self.channels[i].published();
+            if self.channels[i].take_aborted() {
+                self.sync.note_abort();
+            }
         }
     }
 

@@ -8,6 +8,7 @@ pub mod controller;
 pub mod diag_wire;
 pub mod diagnosis;
 pub mod dyn_cs;
+pub mod folder;
 pub mod guard;
 pub mod kin_config;
 pub mod path;

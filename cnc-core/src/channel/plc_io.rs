@@ -6,8 +6,9 @@
 use hli::enums::{ChannelErrorId, DynCsCommand, DynCsState, ProgramState};
 use hli::handshake::ProtocolViolation;
 use hli::layout::{
-    HliCoordState, HliCoordinateSystemInt, HliDynCsChannelInterface, HliDynCsTransition,
-    HliDynCsTransitionResult, HliMFunctionAck, HliMFunctionRequest, HLI_CHANNEL_AXES,
+    HliChannelCommand, HliChannelControlState, HliCoordState, HliCoordinateSystemInt,
+    HliDynCsChannelInterface, HliDynCsTransition, HliDynCsTransitionResult, HliMFunctionAck,
+    HliMFunctionRequest, HLI_CHANNEL_AXES,
 };
 use hli::views::{BlockProgress, CncView, OverrideError, PathOverride};
 use hli::Bool;
@@ -125,6 +126,8 @@ pub struct ChannelInputs {
     /// Whether the image has this channel's M-function unit (without one, M functions are
     /// not announced and not waited for).
     pub has_m_unit: bool,
+    /// A command taken from the channel control unit.
+    pub command: Option<HliChannelCommand>,
     /// What was refused this tick.
     pub violations: Violations,
 }
@@ -150,6 +153,8 @@ pub struct ChannelOutputs {
     pub m_request: Option<HliMFunctionRequest>,
     /// What became of the PLC's transitions.
     pub dyn_cs_result: HliDynCsTransitionResult,
+    /// The channel control unit's state block.
+    pub control: HliChannelControlState,
 }
 
 impl Default for ChannelOutputs {
@@ -170,6 +175,7 @@ impl Default for ChannelOutputs {
             interface: bytemuck::Zeroable::zeroed(),
             m_request: None,
             dyn_cs_result: bytemuck::Zeroable::zeroed(),
+            control: bytemuck::Zeroable::zeroed(),
         }
     }
 }
@@ -229,6 +235,10 @@ pub fn read_inputs(view: &CncView<'_>, index: usize, wanted: Wanted, inputs: &mu
             inputs.m_ack = taken(reader.try_take(), &mut violations);
         }
     }
+    // Taken every tick: a command the channel cannot carry out now is refused, not left.
+    if let Ok(mut reader) = view.channel_command(index) {
+        inputs.command = taken(reader.try_take(), &mut violations);
+    }
     inputs.violations = violations;
 }
 
@@ -276,6 +286,7 @@ pub fn write_outputs(view: &CncView<'_>, index: usize, outputs: &mut ChannelOutp
     let _ = view.write_feed_override_applied(index, outputs.feed_override_applied);
     let _ = view.write_channel_interface(index, &outputs.interface);
     let _ = view.write_dyn_cs_result(index, &outputs.dyn_cs_result);
+    let _ = view.write_channel_control_state(index, &outputs.control);
 }
 
 /// The interface of a channel after one tick: a valid published frame updates the frame and

@@ -5,10 +5,15 @@
 /// Distinct ids the board holds at once.
 pub const SYNC_IDS: usize = 64;
 
-/// The board.
+/// The board, and what a waiting channel needs to know of the others: which run, and
+/// whether one was stopped, reset or failed since it began to wait.
 #[derive(Debug, Clone)]
 pub struct SyncBoard {
     slots: [(u32, u32); SYNC_IDS],
+    /// Bit `c`: channel `c` runs its program this tick.
+    running: u32,
+    /// Counts channels that stopped, were reset or failed while they ran.
+    aborts: u32,
 }
 
 /// More distinct ids pending than the board holds.
@@ -20,6 +25,8 @@ impl Default for SyncBoard {
     fn default() -> Self {
         Self {
             slots: [(0, 0); SYNC_IDS],
+            running: 0,
+            aborts: 0,
         }
     }
 }
@@ -34,6 +41,26 @@ impl SyncBoard {
         let slot = self.slots.iter_mut().find(|s| s.1 == 0).ok_or(SyncFull)?;
         *slot = (id, count);
         Ok(())
+    }
+
+    /// The channels that run their program this tick (bit `c` for channel `c`).
+    pub fn set_running(&mut self, mask: u32) {
+        self.running = mask;
+    }
+
+    /// Whether a channel other than `me` runs its program.
+    pub fn others_running(&self, me: usize) -> bool {
+        self.running & !(1u32 << me) != 0
+    }
+
+    /// A channel that ran was stopped, reset or failed.
+    pub fn note_abort(&mut self) {
+        self.aborts = self.aborts.wrapping_add(1);
+    }
+
+    /// The count of such aborts (a waiting channel compares it with the count when it began).
+    pub fn aborts(&self) -> u32 {
+        self.aborts
     }
 
     /// Signals pending for `id`.

@@ -10,6 +10,7 @@ use crate::axis::{motion_phase, AxisSet, Coupling, Lease};
 use crate::channel::config::ChannelConfig;
 use crate::setpoint::AxisValues;
 use crate::setpoint::Kinematic;
+use hli::calls::axis::AxisCommandCall;
 use hli::enums::{AxisState, CouplingState};
 
 /// The link from one channel to its axes `first..first + count` of the axis set.
@@ -117,6 +118,38 @@ impl ChannelAxes {
             self.last[i] = p;
             self.last_velocity[i] = v;
         }
+    }
+
+    /// A channel's RESET on its axes: each axis in error is reset, powered and coupled to the
+    /// channel again where it stands. `false` when an axis keeps its error (the drive still
+    /// faults) or cannot be coupled.
+    pub fn reset(&mut self, axes: &mut AxisSet) -> bool {
+        let mut ok = true;
+        for (i, lease) in self.leases.iter_mut().enumerate() {
+            let axis = self.first + i;
+            let Some(a) = axes.axis_mut(axis) else {
+                continue;
+            };
+            let coupled = a
+                .coupling()
+                .is_some_and(|c| c.kind == CouplingState::Channel);
+            if a.error().is_none() && lease.is_some() && coupled {
+                continue;
+            }
+            let _ = a.command(&AxisCommandCall::reset());
+            if a.error().is_some() || a.switch_on().is_err() {
+                ok = false;
+                continue;
+            }
+            let coupling = Coupling {
+                kind: CouplingState::Channel,
+                master: -1,
+                phase: AxisState::Standstill,
+            };
+            *lease = axes.couple(axis, coupling).ok();
+            ok &= lease.is_some();
+        }
+        ok
     }
 
     /// Whether one of the channel's axes is in error (it has dropped its coupling).

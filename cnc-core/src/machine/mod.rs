@@ -178,6 +178,7 @@ impl Machine {
         self.controller.read_plc(&view);
         // 2 channels
         self.controller.tick_channels();
+        self.reset_channel_axes();
         // 3 hand-over
         for (channel, link) in self.controller.channels().iter().zip(self.links.iter_mut()) {
             if let Some(link) = link {
@@ -217,6 +218,31 @@ impl Machine {
             .store_release(self.heartbeat_base + self.ticks + 1);
         self.measure_tracking();
         self.ticks += 1;
+    }
+
+    /// A channel that carried out a RESET in its tick gets its axes reset and coupled again;
+    /// it takes their positions over, so nothing jumps. Allocates nothing.
+    fn reset_channel_axes(&mut self) {
+        for (c, link) in self.links.iter_mut().enumerate() {
+            let Some(channel) = self.controller.channel_mut(c) else {
+                continue;
+            };
+            if !channel.take_axis_reset() {
+                continue;
+            }
+            let Some(link) = link else { continue };
+            if !link.reset(&mut self.axes) {
+                channel.axis_reset_failed();
+            }
+            channel.adopt_positions(&link.actual(&self.axes));
+        }
+    }
+
+    /// Between ticks: what the channels' control units asked for that allocates (loading and
+    /// checking a selected program, starting one). Never called in a tick; `cnc run`, the
+    /// in-process runs and the demo call it after each tick. Returns how many were served.
+    pub fn serve_channels(&mut self) -> usize {
+        self.controller.serve_channels()
     }
 
     /// The tool point the actual joints realise against the commanded point of the tick the

@@ -11,6 +11,7 @@ mod cam_props;
 mod cam_refusals;
 mod cam_seed;
 mod cam_tables;
+mod channel_control;
 mod channel_display;
 mod channel_override;
 mod channels;

@@ -1,6 +1,7 @@
 //! Per-channel part of the image: `gpCh[channel_idx]^...`. Designed in the style of the
 //! specification's units (explicit padding, natural alignment, asserted offsets).
 
+use super::channel_control::HliChannelControlUnit;
 use super::dyn_cs::{HliCoordinateSystemInt, McControlDynCsUnit};
 use crate::desc::Bool;
 use crate::hli_struct;
@@ -196,7 +197,7 @@ hli_struct! {
     /// Everything of one channel: `gpCh[channel_idx]^`.
     ///
     /// ST path: `gpCh[i]^`.
-    #[st = "HLI_CHANNEL", size = 760]
+    #[st = "HLI_CHANNEL", size = 1056]
     pub struct HliChannel {
         /// Path state and display values.
         pub bahn_state: HliBahnState => [0, Parent],
@@ -204,6 +205,8 @@ hli_struct! {
         pub channel_mc_control: HliChannelMcControl => [536, Parent],
         /// Channel interface (dynamic CS master output).
         pub channel_interface: HliChannelInterface => [720, Parent],
+        /// The PLC operates the channel (program select, start, stop, ...).
+        pub channel_control: HliChannelControlUnit => [760, Parent],
     }
 }
 

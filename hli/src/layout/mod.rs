@@ -4,6 +4,7 @@
 pub mod axis;
 pub mod axis_image;
 pub mod channel;
+pub mod channel_control;
 pub mod dyn_cs;
 pub mod fifo;
 pub mod image;
@@ -11,6 +12,7 @@ pub mod image;
 pub use axis::*;
 pub use axis_image::*;
 pub use channel::*;
+pub use channel_control::*;
 pub use dyn_cs::*;
 pub use fifo::*;
 pub use image::*;

@@ -87,6 +87,7 @@ pub mod cam_compat;
 pub mod cam_data;
 pub mod cam_multi;
 pub mod cam_read;
+pub mod channel;
 pub mod dyn_cs;
 pub mod fifo;
 pub mod motion;

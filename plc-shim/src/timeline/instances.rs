@@ -82,7 +82,7 @@ impl Instance {
     }
 
     fn uses_axis(&self) -> bool {
-        !matches!(self.spec.target, Target::Group)
+        !matches!(self.spec.target, Target::Group | Target::Channel)
     }
 }
 
@@ -92,8 +92,29 @@ pub struct Instances {
     list: Vec<Instance>,
 }
 
-/// The gpAx index a call of `spec` gives (0 for a group's block).
+/// The gpAx index a call of `spec` gives (0 for a group's block; the gpCh index for a
+/// channel's block).
 fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
+    if let Target::Channel = spec.target {
+        return match table.get("channel").map(toml::Value::as_integer) {
+            Some(Some(c)) if (0..hli::layout::HLI_MAX_CHANNELS as i64).contains(&c) => Ok(c as u32),
+            Some(_) => Err(format!(
+                "call: {}: `channel` must be a gpCh index 0..{}",
+                spec.name,
+                hli::layout::HLI_MAX_CHANNELS
+            )),
+            None => Err(format!(
+                "call: {}: `channel` (the gpCh index) is missing",
+                spec.name
+            )),
+        };
+    }
+    if table.contains_key("channel") {
+        return Err(format!(
+            "call: {} addresses no channel: no `channel`",
+            spec.name
+        ));
+    }
     let given = match (table.get("axis"), spec.target) {
         (None, Target::AxisOr(find)) => find(table),
         (given, _) => given,
@@ -122,7 +143,7 @@ fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
         room = r;
     }
     for (key, value) in table {
-        if ["block", "instance", "axis"].contains(&key.as_str()) {
+        if ["block", "instance", "axis", "channel"].contains(&key.as_str()) {
             continue;
         }
         if key == "execute" && spec.execute {
@@ -280,6 +301,14 @@ impl Instances {
         self.list
             .iter()
             .filter(|i| i.uses_axis())
+            .map(|i| (i.name.as_str(), i.axis))
+    }
+
+    /// The channel (gpCh index) of every instance of a channel's block, with its name.
+    pub fn channels(&self) -> impl Iterator<Item = (&str, u32)> {
+        self.list
+            .iter()
+            .filter(|i| matches!(i.spec.target, Target::Channel))
             .map(|i| (i.name.as_str(), i.axis))
     }
 

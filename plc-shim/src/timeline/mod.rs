@@ -315,6 +315,11 @@ impl Timeline {
         self.instances.axes()
     }
 
+    /// The channel (gpCh index) of every channel block instance, with the instance name.
+    pub fn block_channels(&self) -> impl Iterator<Item = (&str, u32)> {
+        self.instances.channels()
+    }
+
     /// One PLC cycle with block calls: Execute edges due, the steps, then every instance.
     /// Does not allocate.
     pub fn cycle_io(&mut self, io: &mut crate::runtime::PlcIo<'_>) {

@@ -4,7 +4,9 @@
 //! family. The instances, and the checks of a call against these declarations, are
 //! [`super::instances`].
 
-use crate::blocks::{cam, cam_compat, cam_data, cam_multi, cam_read, fifo, motion, probe, saw};
+use crate::blocks::{
+    cam, cam_compat, cam_data, cam_multi, cam_read, channel, fifo, motion, probe, saw,
+};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
 use hli::calls::cam::McMotionFunctionPoint;
@@ -23,6 +25,7 @@ pub const FAMILIES: &[&[BlockSpec]] = &[
     cam_compat::TIMELINE,
     fifo::TIMELINE,
     saw::TIMELINE,
+    channel::TIMELINE,
 ];
 
 /// A block as a timeline knows it.
@@ -67,6 +70,8 @@ pub enum Target {
     /// An axis given as `axis` or, without it, where the function finds it (the seed's
     /// `Slave` of the flying-saw blocks).
     AxisOr(fn(&toml::Table) -> Option<&toml::Value>),
+    /// A channel, given as `channel` (its gpCh index), handed to the block as its `axis`.
+    Channel,
 }
 
 /// How a call's inputs are checked.

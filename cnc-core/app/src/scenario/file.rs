@@ -164,6 +164,8 @@ pub struct Scenario {
     pub channels: Vec<ChannelConfig>,
     /// Their programs, checked (None: the channel stays idle).
     pub programs: Vec<Option<LoadedProgram>>,
+    /// Their program folders (`programs`), where the PLC's SELECT loads from.
+    pub folders: Vec<Option<cnc_core::channel::folder::ProgramFolder>>,
     /// Single axes, behind the channel axes.
     pub axes: Vec<super::axes::ScenarioAxis>,
     /// Gear couplings between axes (indices in the machine's axis set).
@@ -193,10 +195,18 @@ impl Scenario {
             })
         };
         let text = read(path)?;
-        Scenario::parse(&path.display().to_string(), &text, |relative| {
+        let mut scenario = Scenario::parse(&path.display().to_string(), &text, |relative| {
             let p = dir.join(relative);
             read(&p).map(|text| (p, text))
-        })
+        })?;
+        // Folders are named relative to the scenario's file.
+        for folder in scenario.folders.iter_mut().flatten() {
+            folder.dir = dir.join(&folder.dir);
+            for d in &mut folder.search.0 {
+                *d = dir.join(&*d);
+            }
+        }
+        Ok(scenario)
     }
 
     /// Parses scenario `text`; `open` reads a file named in it (relative path) and returns
@@ -210,6 +220,7 @@ impl Scenario {
         let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
         file.check_shape().map_err(&invalid)?;
         let programs = load_programs(name, &file.channel, &open)?;
+        let folders = program_folders(name, &file.channel)?;
         let plc = plc_setup(name, file.plc, &open)?;
         if file.channel.is_empty() && file.ticks.is_none() {
             return Err(invalid(
@@ -230,6 +241,7 @@ impl Scenario {
         cnc_core::machine::gear::GearEngine::new(&gears, names.len())
             .map_err(|e| invalid(e.to_string()))?;
         check_block_axes(&plc, channel_axes, &names).map_err(&invalid)?;
+        check_block_channels(&plc, file.channel.len()).map_err(&invalid)?;
         let cam_tables = cam_tables(name, &file.cam_table, &open)?;
         let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
         let signals = trace_signals(file.trace.signals).map_err(&invalid)?;
@@ -241,6 +253,7 @@ impl Scenario {
             plc_loss_drives: file.plc_loss_drives,
             channels: file.channel,
             programs,
+            folders,
             axes,
             gears,
             cam_tables,
@@ -340,6 +353,34 @@ fn load_programs(
         });
     }
     Ok(programs)
+}
+
+/// Each channel's program folder (`programs`), relative to the scenario's folder, with the
+/// channel's machine data and search path (None: SELECT is refused).
+fn program_folders(
+    name: &str,
+    channels: &[ChannelConfig],
+) -> Result<Vec<Option<cnc_core::channel::folder::ProgramFolder>>, ScenarioError> {
+    let mut folders = Vec::with_capacity(channels.len());
+    for c in channels {
+        let Some(dir) = &c.programs else {
+            folders.push(None);
+            continue;
+        };
+        confined("[[channel]] programs", Path::new(dir)).map_err(invalid_in(name))?;
+        let mut search = Vec::with_capacity(c.nc.search_path.len());
+        for d in &c.nc.search_path {
+            let beside = Path::new(dir).join(d);
+            confined("[[channel]] nc.search_path", &beside).map_err(invalid_in(name))?;
+            search.push(beside);
+        }
+        folders.push(Some(cnc_core::channel::folder::ProgramFolder {
+            dir: PathBuf::from(dir),
+            setup: c.nc.setup(),
+            search: cnc_core::nc::interp::SearchPath(search),
+        }));
+    }
+    Ok(folders)
 }
 
 /// The PLC of scenario `name`: none, a timeline (read through `open` and checked), or a
@@ -471,6 +512,22 @@ fn check_block_axes(plc: &PlcSetup, channel_axes: usize, names: &[String]) -> Re
                 path.display(),
                 names.len(),
                 names.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every channel block of a timeline addresses a channel of the machine.
+fn check_block_channels(plc: &PlcSetup, channels: usize) -> Result<(), String> {
+    let PlcSetup::Timeline { timeline, path, .. } = plc else {
+        return Ok(());
+    };
+    for (instance, channel) in timeline.block_channels() {
+        if channel as usize >= channels {
+            return Err(format!(
+                "{}: block {instance:?}: channel {channel} does not exist (the machine has {channels})",
+                path.display()
             ));
         }
     }

@@ -7,6 +7,7 @@
 
 use super::file::{PlcSetup, Scenario, ScenarioError};
 use super::trace::Trace;
+use cnc_core::channel::config::ProgramStart;
 use cnc_core::channel::Channel;
 use cnc_core::machine::engines::{self, EngineSetup};
 pub use cnc_core::machine::Machine;
@@ -29,10 +30,15 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
     for (i, (config, program)) in scenario.channels.iter().zip(&scenario.programs).enumerate() {
         let mut channel = Channel::new(i, config.clone(), scenario.cycle_s)
             .map_err(|e| invalid(e.to_string()))?;
-        if let Some(p) = program {
-            channel
+        match program {
+            Some(p) if config.program_start == ProgramStart::Plc => channel.select(p.clone()),
+            Some(p) => channel
                 .start(p.clone())
-                .expect("a channel that has not run starts");
+                .expect("a channel that has not run starts"),
+            None => {}
+        }
+        if let Some(Some(folder)) = scenario.folders.get(i) {
+            channel.set_program_folder(folder.clone());
         }
         channels.push(channel);
     }
@@ -161,6 +167,13 @@ impl InProcess {
         let tick = self.machine.ticks();
         self.machine.tick(&self.memory);
         self.trace.record(&self.memory, tick, tick as f64 * cycle_s);
+        self.plc_cycle();
+        // Between this tick and the next, as `cnc run` does after "tick done".
+        self.machine.serve_channels();
+    }
+
+    /// The PLC's cycle after a tick, with the acyclic calls answered first.
+    fn plc_cycle(&mut self) {
         let Some(timeline) = self.timeline.as_mut() else {
             return;
         };

@@ -4,6 +4,7 @@
 
 mod cam_engine;
 mod cam_no_alloc;
+mod channel_control;
 mod channel_no_alloc;
 mod channel_rates;
 mod cli_blocks;

@@ -73,6 +73,10 @@ pub enum ChannelFault {
     PoseUnreachable(KinError),
     /// A controlled stop ended the program (the reason the machine gave).
     MachineStop(&'static str),
+    /// `#WAIT SYN` waited longer than the channel's `sync_timeout_s` (seconds waited).
+    SyncTimeout(f64),
+    /// `#WAIT SYN`: the channels that could still signal were stopped, reset or failed.
+    SyncPartnerStopped,
 }
 
 impl ChannelFault {
@@ -93,6 +97,9 @@ impl ChannelFault {
                 ChannelErrorId::Kinematics
             }
             ChannelFault::MachineStop(_) => ChannelErrorId::MachineStop,
+            ChannelFault::SyncTimeout(_) | ChannelFault::SyncPartnerStopped => {
+                ChannelErrorId::SyncAbandoned
+            }
         }
     }
 }
@@ -122,6 +129,12 @@ impl fmt::Display for ChannelFault {
             ),
             ChannelFault::PoseUnreachable(e) => write!(f, "pose unreachable: {e}"),
             ChannelFault::MachineStop(reason) => f.write_str(reason),
+            ChannelFault::SyncTimeout(s) => {
+                write!(f, "#WAIT SYN: no signal after {s} s (sync_timeout_s)")
+            }
+            ChannelFault::SyncPartnerStopped => f.write_str(
+                "#WAIT SYN: every other channel that could signal was stopped, reset or failed",
+            ),
         }
     }
 }

@@ -101,7 +101,10 @@ impl Channel {
             }
             Decoded::WaitSyn { ids, .. } => {
                 self.run.wait_ids = ids;
-                self.run.wait = Some(Wait::Sync);
+                self.run.wait = Some(Wait::Sync {
+                    since: self.tick,
+                    aborts: sync.aborts(),
+                });
             }
             Decoded::Flush { .. } => {}
         }
@@ -111,7 +114,7 @@ impl Channel {
     /// for the request slot) and awaited.
     pub(super) fn m_function(&mut self, code: u32) {
         if code == 30 || code == 2 {
-            self.state = RunState::Finished;
+            self.program_end();
             return;
         }
         if self.announce(code) {

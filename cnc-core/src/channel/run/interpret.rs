@@ -46,8 +46,9 @@ pub(super) enum Wait {
     MFunction { code: u32, id: u32 },
     /// The announcement of `code` could not be posted yet (the previous one is unread).
     MAnnounce { code: u32 },
-    /// `#WAIT SYN` for the ids in `wait_ids`.
-    Sync,
+    /// `#WAIT SYN` for the ids in `wait_ids`, since tick `since`, when the board had counted
+    /// `aborts` aborted channels.
+    Sync { since: u64, aborts: u32 },
     /// `#TRACK CS ... WAIT`.
     Tracking,
     /// `#WAIT INDP ALL` or an `INDP_SYN` move.
@@ -70,6 +71,14 @@ impl Vars for ChannelVars {
     }
 }
 
+/// The file name of a program's name (a path when it was loaded from a file).
+fn program_file_name(name: &str) -> &str {
+    std::path::Path::new(name)
+        .file_name()
+        .and_then(|n| n.to_str())
+        .unwrap_or(name)
+}
+
 impl Channel {
     /// Loads `program` and starts it (a checked program; see [`LoadedProgram::load`]).
     /// A channel that failed is reset first (see [`Channel::reset`]): it starts again from
@@ -78,6 +87,25 @@ impl Channel {
         if self.state == RunState::Error {
             self.reset()?;
         }
+        self.control.program_name = hli::layout::nul_padded(program_file_name(&program.name));
+        self.control.start_block = None;
+        self.run.program = Some(program);
+        self.begin_selected();
+        Ok(())
+    }
+
+    /// Selects `program` without starting it (the PLC starts it with START).
+    pub fn select(&mut self, program: LoadedProgram) {
+        self.control.program_name = hli::layout::nul_padded(program_file_name(&program.name));
+        self.control.start_block = None;
+        self.run.program = Some(program);
+    }
+
+    /// Starts the selected program (allocates: between ticks only).
+    pub(super) fn begin_selected(&mut self) {
+        let Some(program) = self.run.program.as_ref() else {
+            return;
+        };
         // A new program starts from the modal defaults the check assumed (G90 G17 G71 G53 D0,
         // no feed), where the axes stand.
         self.run.decoder = DecoderState::new(&self.config.axes);
@@ -86,17 +114,20 @@ impl Channel {
         }
         self.run.decoder.configure(&program.setup);
         self.run.interp.start(&program.set);
-        self.run.program = Some(program);
+        if let Some(block) = self.control.start_block {
+            self.run.interp.start_at(block);
+        }
         self.run.pending.clear();
         self.run.pending_at = 0;
         self.state = RunState::Running;
         self.run.wait = None;
         self.error = None;
+        let c = &mut self.control;
+        (c.program_ended, c.block_ran, c.block_stop, c.held) = (false, false, false, false);
         if self.config.provide_channel_interface.track_cs {
             self.pose.interface_on = true;
         }
         self.pose.tracker.restart();
-        Ok(())
     }
 
     /// Line of the block executing.
@@ -148,6 +179,11 @@ impl Channel {
             }
             self.run.pending.clear();
             self.run.pending_at = 0;
+            if self.control.single_block && self.control.block_ran {
+                // Single block: the block is done; START runs the next one.
+                self.control.block_stop = true;
+                return;
+            }
             if !self.next_block_decoded() {
                 return;
             }
@@ -171,11 +207,12 @@ impl Channel {
             &mut self.run.pending,
         ) {
             Ok(Step::End) => {
-                self.state = RunState::Finished;
+                self.program_end();
                 false
             }
             Ok(Step::Block { unit, block }) => {
                 self.run.blocks_executed += 1;
+                self.control.block_ran = true;
                 if let Some(b) = program
                     .set
                     .units
@@ -204,6 +241,23 @@ impl Channel {
         }
     }
 
+    /// `#WAIT SYN`: done when every id holds a signal; fails when no other channel runs any
+    /// more after one was stopped, reset or failed, or after the channel's `sync_timeout_s`.
+    fn sync_done(&mut self, sync: &mut SyncBoard, since: u64, aborts: u32) -> bool {
+        if sync.try_wait(self.run.wait_ids.as_slice()) {
+            return true;
+        }
+        if sync.aborts() != aborts && !sync.others_running(self.index) {
+            self.fail(ChannelFault::SyncPartnerStopped);
+        } else if let Some(limit) = self.config.sync_timeout_s {
+            let waited = (self.tick - since) as f64 * self.cycle_s;
+            if waited >= limit {
+                self.fail(ChannelFault::SyncTimeout(limit));
+            }
+        }
+        false
+    }
+
     pub(super) fn wait_done(&mut self, wait: Wait, sync: &mut SyncBoard) -> bool {
         match wait {
             Wait::MFunction { code, id } => {
@@ -229,7 +283,7 @@ impl Channel {
                 }
                 false
             }
-            Wait::Sync => sync.try_wait(self.run.wait_ids.as_slice()),
+            Wait::Sync { since, aborts } => self.sync_done(sync, since, aborts),
             Wait::Tracking => self.pose.tracker.settled(),
             Wait::Independent => self.motion.independent.iter().all(|(_, active)| !*active),
             Wait::Dwell { until } => self.tick >= until,

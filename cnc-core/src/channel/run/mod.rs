@@ -22,6 +22,7 @@
 //! (`PlcLink`), `transition` the PLC's dynamic-CS transition, `safety` the guard, the
 //! failure latch and the reset (`Safety`).
 
+mod control;
 mod error;
 mod execute;
 mod interpret;
@@ -32,9 +33,11 @@ mod safety;
 mod tool;
 mod transition;
 
+pub use control::Pending;
 pub use error::{ChannelError, ChannelFault};
 pub use safety::ResetError;
 
+use control::Control;
 use execute::ProgramValues;
 use interpret::{ProgramRun, Wait};
 use motion::Motion;
@@ -107,6 +110,7 @@ pub struct Channel {
     pose: Pose,
     safety: Safety,
     plc: PlcLink,
+    control: Control,
 }
 
 impl core::fmt::Debug for Channel {
@@ -172,6 +176,7 @@ impl Channel {
                 m_next_id: 0,
                 m_functions_acked: 0,
             },
+            control: Control::new(),
             config,
         };
         // The decoder takes the axes' positions when a program starts (`start`).
@@ -216,11 +221,14 @@ impl Channel {
         self.tick += 1;
         self.plc.inputs = *inputs;
         self.take_override();
+        self.take_command();
         self.plc_inputs();
-        if self.state == RunState::Running && self.stopping.is_none() {
+        let c = &self.control;
+        if self.state == RunState::Running && self.stopping.is_none() && !c.plc_stop && !c.held {
             self.interpret(masters, sync);
         }
         self.advance();
+        self.follow_command();
         if let Some(reason) = self.stopping {
             if self.state == RunState::Running && !self.is_moving() {
                 self.fail(ChannelFault::MachineStop(reason));
@@ -238,6 +246,7 @@ impl Channel {
         self.motion.rates_apply = !self.pose.trafo && !tracked && !self.safety.guard.latched();
         self.note_dyn_cs_state();
         self.fill_outputs();
+        self.fill_control_state();
     }
 
     fn master_sample(

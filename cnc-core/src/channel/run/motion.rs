@@ -189,7 +189,7 @@ impl Channel {
     /// The override factors (feed, rapid) in effect: 0 under feed hold.
     pub(super) fn override_factors(&self) -> (f64, f64) {
         let o = self.motion.path_override;
-        if o.feed_hold {
+        if o.feed_hold || self.control.held {
             (0.0, 0.0)
         } else {
             (

@@ -26,10 +26,12 @@ impl Channel {
     /// What this channel takes from the PLC this tick (see [`super::plc_io::read_inputs`]).
     pub fn wanted(&self) -> Wanted {
         Wanted {
-            dyn_cs: self.stopping.is_none(),
+            dyn_cs: self.stopping.is_none() && !self.control.plc_stop,
             // Not during a stop: the channel interprets nothing then, and an acknowledge taken
             // now would be lost to the PLC's handshake.
-            m_ack: self.stopping.is_none() && matches!(self.run.wait, Some(Wait::MFunction { .. })),
+            m_ack: self.stopping.is_none()
+                && !self.control.plc_stop
+                && matches!(self.run.wait, Some(Wait::MFunction { .. })),
         }
     }
 
@@ -102,7 +104,7 @@ impl Channel {
             None => 0,
         };
         progress.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
-        out.feed_override_applied = if self.motion.path_override.feed_hold {
+        out.feed_override_applied = if self.motion.path_override.feed_hold || self.control.held {
             0
         } else {
             self.motion.path_override.feed_permille

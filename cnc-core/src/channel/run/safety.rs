@@ -43,6 +43,7 @@ impl Channel {
             id,
             fault,
         });
+        self.control.aborted |= self.state == RunState::Running;
         self.state = RunState::Error;
         self.motion.path = None;
         self.run.wait = None;
@@ -160,6 +161,19 @@ impl Channel {
         }
         self.pose.pose_in = self.pose.tool;
         self.pose.pose_out = self.pose.tool;
+    }
+
+    /// After a RESET of its axes: the channel's set-points and programmed position become
+    /// where the axes stand (an axis that faulted stood away from its set-point).
+    pub fn adopt_positions(&mut self, actual: &crate::setpoint::AxisValues) {
+        let n = self.pose.set_points.len().min(actual.len());
+        if self.pose.set_points[..n] == actual[..n] {
+            return;
+        }
+        self.pose.set_points[..n].copy_from_slice(&actual[..n]);
+        self.take_joints_from_set_points();
+        self.resync_to_set_points();
+        self.safety.guard.accept(&self.pose.set_points);
     }
 
     /// Clears the channel's error and the tracker's ERROR (tracking off at once: the

@@ -42,8 +42,14 @@ fn every_block_takes_its_own_inputs() {
         let mut call = toml::Table::new();
         call.insert("block".into(), spec.name.into());
         call.insert("instance".into(), "i".into());
-        if !matches!(spec.target, Target::Group) {
-            call.insert("axis".into(), 1.into());
+        match spec.target {
+            Target::Group => {}
+            Target::Channel => {
+                call.insert("channel".into(), 0.into());
+            }
+            _ => {
+                call.insert("axis".into(), 1.into());
+            }
         }
         let mut instances = Instances::default();
         match spec.inputs {

@@ -338,6 +338,9 @@ impl<'a> TickLoop<'a> {
         if let Some(stream) = self.log_stream.as_mut() {
             stream.forward(self.machine.controller().channels());
         }
+        // Program loading and starting for the channels' control units: after "tick done",
+        // outside the measured tick.
+        self.machine.serve_channels();
         self.measured.push([t0, t1, t2, t3, t4], deadline);
         self.counter.set(tick + 1);
     }
