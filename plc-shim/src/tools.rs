@@ -68,6 +68,9 @@ pub enum ToolCommand {
         #[arg(long, default_value = DEFAULT_INSTANCE)]
         instance: String,
     },
+    /// Operate a channel through its control unit: select, start, stop, hold, resume, reset,
+    /// single block, mode; or print its state.
+    Channel(crate::channel_tool::ChannelArgs),
 }
 
 /// Why a tool did not do what it was asked.
@@ -338,6 +341,7 @@ pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
 /// Runs a tool command; prints its output and returns the exit code.
 pub fn main(command: ToolCommand) -> ExitCode {
     let result = match &command {
+        ToolCommand::Channel(args) => return crate::channel_tool::main(args),
         ToolCommand::Get { paths, instance } => get(instance, paths).map(print_lines),
         ToolCommand::Set { pairs, instance } => set(instance, pairs).map(print_lines),
         ToolCommand::Watch {

@@ -242,3 +242,65 @@ fn a_tracking_refused_at_run_time_fails_the_channel_without_allocating() {
     assert_eq!(error.line, 3, "the line of the failing block");
     assert_eq!(made, 0, "{made} allocations while the channel failed");
 }
+
+/// The PLC's channel commands, taken in the tick, on a tracking robot among others: feed hold
+/// and resume, single block, stop (tracking switched off softly), reset, start, mode and the
+/// refusals allocate nothing in the tick; loading and starting a program happen between ticks
+/// (`serve_channels`, not counted).
+#[test]
+fn channel_commands_are_taken_in_the_tick_without_allocating() {
+    use hli::enums::{ChannelCommand as C, ChannelCommandState};
+    use hli::layout::HliChannelCommand;
+    use hli::views::PlcView;
+    let mut run = running(2, 3000).unwrap();
+    let commands = [
+        (C::FeedHold, 0),
+        (C::Resume, 0),
+        (C::SingleBlock, 1),
+        (C::SingleBlock, 0),
+        (C::Stop, 0),
+        (C::Mode, 1),
+        (C::Start, 0),
+        (C::Mode, 0),
+        (C::Reset, 0),
+        (C::Start, 0),
+        (C::Select, 0),
+    ];
+    let mut made = 0;
+    for (k, (command, value)) in commands.into_iter().enumerate() {
+        let id = k as u32 + 1;
+        let c = HliChannelCommand {
+            command_id: id,
+            command: command.raw(),
+            start_line: 0,
+            value,
+            program: [0; 64],
+        };
+        let plc = PlcView::new(&run.memory);
+        plc.gp_ch(1)
+            .unwrap()
+            .channel_command()
+            .try_send(&c)
+            .unwrap();
+        for _ in 0..1500 {
+            let before = allocations();
+            run.machine.tick(&run.memory);
+            made += allocations() - before;
+            run.machine.serve_channels();
+        }
+        let s = PlcView::new(&run.memory)
+            .gp_ch(1)
+            .unwrap()
+            .channel_control_state();
+        assert_eq!(s.command_id, id, "{command:?} taken");
+        assert_ne!(
+            s.command_state,
+            ChannelCommandState::Busy.raw(),
+            "{command:?} answered"
+        );
+    }
+    assert_eq!(
+        made, 0,
+        "{made} allocations in the ticks that took the commands"
+    );
+}
