@@ -77,11 +77,12 @@ impl Controller {
     }
 
     /// Between ticks: the channels' program loading and starting their control units asked
-    /// for (allocates; never in a tick). Returns how many were served.
+    /// for, and the text of a new error for the state block (allocates; never in a tick).
+    /// Returns how many were served.
     pub fn serve_channels(&mut self) -> usize {
         let mut served = 0;
         for channel in &mut self.channels {
-            if channel.pending().is_some() {
+            if channel.wants_service() {
                 channel.serve();
                 served += 1;
             }

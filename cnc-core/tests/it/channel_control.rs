@@ -381,6 +381,12 @@ fn reset_clears_the_error_and_a_moving_channel_decelerates_first() {
     rig.run_ticks(2_000, |_| {});
     assert_eq!(rig.state(0), ChannelState::Error);
     assert_eq!(rig.state_block(0).error_id, ChannelErrorId::Tracking.raw());
+    let message = rig.state_block(0).message;
+    let text = nul_padded_str(&message).unwrap();
+    assert!(
+        text.starts_with("line 2: #TRACK CS ON"),
+        "the error's text: {text}"
+    );
     assert_eq!(
         rig.command(0, ChannelCommand::Start, plain, 5),
         Some(E::InError)
@@ -553,5 +559,78 @@ fn feed_hold_on_a_tracking_slave_keeps_tracking() {
         rig.ctl.channels()[0].tracker().state(),
         DynCsState::Inactive
     );
+    assert_eq!(rig.state(0), ChannelState::Selected);
+}
+
+/// A machine stop (a lost PLC, supervision): commands are refused while the channel brakes;
+/// at rest the channel is in ERROR, and a (new) PLC resets it and runs the part again.
+#[test]
+fn after_a_machine_stop_the_plc_resets_and_restarts_the_channel() {
+    let mut rig = Rig::new(vec![(cartesian("c"), Some(PART))], None);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(400, |_| {});
+    rig.ctl.channel_mut(0).unwrap().stop("machine stop: test");
+    assert_eq!(
+        rig.command(0, ChannelCommand::Reset, plain, 5),
+        Some(E::MachineStop)
+    );
+    while rig.ctl.channels()[0].stopping() {
+        rig.tick();
+        assert!(rig.ticks < 5_000, "watchdog");
+    }
+    rig.tick();
+    assert_eq!(rig.state(0), ChannelState::Error);
+    assert_eq!(
+        rig.state_block(0).error_id,
+        ChannelErrorId::MachineStop.raw()
+    );
+    assert_eq!(rig.command(0, ChannelCommand::Reset, plain, 5), None);
+    assert_eq!(rig.state(0), ChannelState::Selected);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    while rig.state(0) != ChannelState::Selected {
+        rig.tick();
+        assert!(rig.ticks < 50_000, "watchdog");
+    }
+    assert_eq!(rig.state_block(0).programs_ended, 1);
+}
+
+/// A command payload written without its semaphore is never read; a garbage semaphore byte is
+/// counted as a protocol violation and nothing is taken.
+#[test]
+fn a_command_without_its_semaphore_is_not_taken() {
+    use hli::desc::PlaceExt;
+    use hli::layout::{HliChannel, HliChannelControlUnit};
+    use std::mem::offset_of;
+    fn unit(memory: &ImageMemory) -> hli::Place<'_, HliChannelControlUnit> {
+        CncView::new(memory)
+            .channel(0)
+            .unwrap()
+            .field::<HliChannelControlUnit>(offset_of!(HliChannel, channel_control))
+    }
+    let mut rig = Rig::new(vec![(cartesian("c"), Some(PART))], None);
+    let start = HliChannelCommand {
+        command_id: 42,
+        command: ChannelCommand::Start.raw(),
+        start_line: 0,
+        value: 0,
+        program: [0; 64],
+    };
+    unit(&rig.memory)
+        .field::<HliChannelCommand>(offset_of!(HliChannelControlUnit, command_w))
+        .write(&start);
+    rig.run_ticks(100, |r| {
+        assert_eq!(r.state(0), ChannelState::Selected);
+        assert_eq!(r.state_block(0).command_id, 0);
+    });
+    unit(&rig.memory)
+        .field::<hli::Bool>(offset_of!(HliChannelControlUnit, command_semaphore_rw))
+        .write(&hli::Bool(7));
+    rig.tick();
+    assert_eq!(
+        rig.state_block(0).command_id,
+        0,
+        "garbage semaphore: nothing taken"
+    );
+    assert_eq!(rig.ctl.violations().semaphore_garbage, 1);
     assert_eq!(rig.state(0), ChannelState::Selected);
 }

@@ -391,3 +391,92 @@ pub const TIMELINE: &[BlockSpec] = &[
         |_| Box::<ReadChannelState>::default(),
     ),
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::runtime::Link;
+    use hli::rpc::{AcyclicClient, AcyclicServer};
+    use hli::views::{CncView, PlcView};
+
+    /// One cycle of `block` on `channel` of a one-channel image, the link in state `link`.
+    fn cycle(
+        memory: &hli::ImageMemory,
+        client: &mut AcyclicClient,
+        block: &mut ChannelCommandBlock,
+        channel: usize,
+        link: Link,
+    ) -> Outputs {
+        let mut io = PlcIo {
+            view: PlcView::new(memory),
+            memory,
+            acyclic: client,
+            cycle: 0,
+            link,
+        };
+        block.call(&mut io, channel);
+        block.out
+    }
+
+    /// The CNC's side: takes the command and answers it in the state block.
+    fn answer(memory: &hli::ImageMemory, state: ChannelCommandState) -> u32 {
+        let cnc = CncView::new(memory);
+        let taken = cnc.channel_command(0).unwrap().try_take().unwrap();
+        let plc = PlcView::new(memory);
+        let mut s = plc.gp_ch(0).unwrap().channel_control_state();
+        if let Some(c) = taken {
+            s.command_id = c.command_id;
+        }
+        s.command_state = state.raw();
+        cnc.write_channel_control_state(0, &s).unwrap();
+        s.command_id
+    }
+
+    #[test]
+    fn a_command_follows_the_channel_and_ends_done_aborted_or_with_an_error() {
+        let instance = format!("channel-blocks-{}", std::process::id());
+        let _server = AcyclicServer::open(&instance).unwrap();
+        let mut client = AcyclicClient::open(&instance).unwrap();
+        let memory = hli::segment::heap_image(1, 0);
+        let mut stop = ChannelCommandBlock::new(ChannelCommand::Stop);
+        stop.execute = true;
+        // Written, then Busy while the channel stops, then Done.
+        assert!(cycle(&memory, &mut client, &mut stop, 0, Link::Operational).busy);
+        answer(&memory, ChannelCommandState::Busy);
+        let out = cycle(&memory, &mut client, &mut stop, 0, Link::Operational);
+        assert!(out.busy && out.active);
+        answer(&memory, ChannelCommandState::Done);
+        assert!(cycle(&memory, &mut client, &mut stop, 0, Link::Operational).done);
+
+        // Another command taken on the channel: CommandAborted.
+        let mut hold = ChannelCommandBlock::new(ChannelCommand::FeedHold);
+        hold.execute = true;
+        cycle(&memory, &mut client, &mut hold, 0, Link::Operational);
+        answer(&memory, ChannelCommandState::Busy);
+        cycle(&memory, &mut client, &mut hold, 0, Link::Operational);
+        let cnc = CncView::new(&memory);
+        let mut s = PlcView::new(&memory)
+            .gp_ch(0)
+            .unwrap()
+            .channel_control_state();
+        s.command_id = s.command_id.wrapping_add(1);
+        cnc.write_channel_control_state(0, &s).unwrap();
+        assert!(cycle(&memory, &mut client, &mut hold, 0, Link::Operational).command_aborted);
+
+        // No such channel; no CNC.
+        let mut start = ChannelCommandBlock::new(ChannelCommand::Start);
+        start.execute = true;
+        let out = cycle(&memory, &mut client, &mut start, 3, Link::Operational);
+        assert_eq!(
+            (out.error, out.error_id),
+            (true, ChannelBlockError::NoChannel.code())
+        );
+        let mut start = ChannelCommandBlock::new(ChannelCommand::Start);
+        start.execute = true;
+        let out = cycle(&memory, &mut client, &mut start, 0, Link::NotOperational);
+        assert_eq!(
+            (out.error, out.error_id),
+            (true, crate::kernel::ERROR_NO_ANSWER)
+        );
+    }
+}

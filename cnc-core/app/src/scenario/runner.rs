@@ -174,6 +174,8 @@ pub struct ChannelReport {
     pub m_functions_acked: u64,
     /// NC blocks run.
     pub blocks: u64,
+    /// Programs that ran to their end (several when the PLC started the channel again).
+    pub programs_ended: u32,
     /// Dynamic-CS state changes (switching on, active, switching off, inactive, error).
     pub state_changes: u64,
     /// The diagnosis tables.
@@ -487,6 +489,7 @@ pub fn channel_reports(machine: &Machine) -> Vec<ChannelReport> {
             max_tracking_error_mm: err,
             m_functions_acked: c.m_functions_acked(),
             blocks: c.blocks_executed(),
+            programs_ended: c.programs_ended(),
             state_changes: c.tracker().state_changes(),
             diagnosis: c.dyn_cs_diagnosis(),
             log_file: c.log_file().map(str::to_string),
@@ -523,8 +526,8 @@ impl RunReport {
         let mut out = String::new();
         for c in &self.channels {
             out.push_str(&format!(
-                "channel {}: {}; blocks {}; tracking state changes {}; M functions acknowledged {}; max tracking error (tool point of the actual joints vs the commanded one) {:.6} mm\n",
-                c.name, c.outcome, c.blocks, c.state_changes, c.m_functions_acked, c.max_tracking_error_mm
+                "channel {}: {}; programs ended {}; blocks {}; tracking state changes {}; M functions acknowledged {}; max tracking error (tool point of the actual joints vs the commanded one) {:.6} mm\n",
+                c.name, c.outcome, c.programs_ended, c.blocks, c.state_changes, c.m_functions_acked, c.max_tracking_error_mm
             ));
             for (tick, event) in &c.tracking {
                 out.push_str(&format!("  {tick} {}\n", event.replace('\n', "\n  ")));

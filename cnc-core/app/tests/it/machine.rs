@@ -134,6 +134,53 @@ fn a_channel_whose_axis_faults_stops_in_error() {
     let error = c.error().expect("the channel ended in error").to_string();
     assert!(error.contains("a channel axis faulted"), "{error}");
     assert!(run.machine.axes().axis(0).unwrap().error().is_some());
+
+    // The PLC's RESET: the axis is reset and coupled again where it stands, the channel takes
+    // that position over (no step), and is ready for a new start.
+    use hli::enums::{ChannelCommand, ChannelCommandState, ChannelState};
+    let command = hli::layout::HliChannelCommand {
+        command_id: 7,
+        command: ChannelCommand::Reset.raw(),
+        start_line: 0,
+        value: 0,
+        program: [0; 64],
+    };
+    let plc = hli::views::PlcView::new(&run.memory);
+    plc.gp_ch(0)
+        .unwrap()
+        .channel_command()
+        .try_send(&command)
+        .unwrap();
+    for _ in 0..3 {
+        run.step(s.cycle_s);
+    }
+    let state = hli::views::PlcView::new(&run.memory)
+        .gp_ch(0)
+        .unwrap()
+        .channel_control_state();
+    assert_eq!(
+        (state.command_id, state.command_state),
+        (7, ChannelCommandState::Done.raw())
+    );
+    assert_eq!(state.state, ChannelState::Selected.raw());
+    let axis = run.machine.axes().axis(0).unwrap();
+    assert_eq!(axis.error(), None, "the axis was reset");
+    let c = &run.machine.controller().channels()[0];
+    assert!(
+        (c.set_points()[0] - axis.actual()).abs() < 1e-9,
+        "the channel stands where the axis stands"
+    );
+    let before = axis.actual();
+    for _ in 0..200 {
+        run.step(s.cycle_s);
+    }
+    let axis = run.machine.axes().axis(0).unwrap();
+    assert!(
+        (axis.actual() - before).abs() < 1e-6,
+        "at rest and held: {before} -> {}",
+        axis.actual()
+    );
+    assert_eq!(axis.error(), None);
 }
 
 #[test]

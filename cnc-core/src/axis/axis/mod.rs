@@ -309,6 +309,13 @@ impl Axis {
     fn clear_error(&mut self) {
         if self.error.take().is_some() {
             self.generator.hold(self.actual);
+            // The following error of the next tick is measured against where the axis was
+            // taken over, not against the set-point the fault froze (the drive may have
+            // drifted from it since): a reset does not fault again at once.
+            self.last_set = Kinematic {
+                position: self.actual,
+                ..Kinematic::default()
+            };
         }
     }
 

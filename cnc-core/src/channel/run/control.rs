@@ -59,6 +59,8 @@ pub(super) struct Control {
     pub(super) start_block: Option<u32>,
     /// The channel was stopped, reset or failed while it ran (for `#WAIT SYN` partners).
     pub(super) aborted: bool,
+    /// The channel failed and its text is not in the state block yet.
+    pub(super) error_unshown: bool,
 }
 
 impl Control {
@@ -79,6 +81,7 @@ impl Control {
             axis_reset: false,
             start_block: None,
             aborted: false,
+            error_unshown: false,
         }
     }
 }
@@ -108,9 +111,20 @@ impl Channel {
         }
     }
 
+    /// Programs that ran to their end since the CNC started.
+    pub fn programs_ended(&self) -> u32 {
+        self.plc.outputs.control.programs_ended
+    }
+
     /// Work for the machine between ticks, if any ([`Channel::serve`]).
     pub fn pending(&self) -> Option<Pending> {
         self.control.pending
+    }
+
+    /// Whether [`Channel::serve`] has something to do: pending work, or the text of a new
+    /// error to show in the state block.
+    pub fn wants_service(&self) -> bool {
+        self.control.pending.is_some() || self.control.error_unshown
     }
 
     /// Takes the command the PLC posted this tick: carried out, refused, or Busy.
@@ -121,7 +135,6 @@ impl Channel {
         let out = &mut self.plc.outputs.control;
         out.command_id = command.command_id;
         out.states_seen = 0;
-        out.message = [0; CONTROL_MESSAGE_LEN];
         let outcome = match ChannelCommand::decode(command.command) {
             Ok(kind) => {
                 self.control.command = Some(kind);
@@ -333,6 +346,7 @@ impl Channel {
         let c = &mut self.control;
         (c.held, c.block_stop, c.block_ran, c.program_ended) = (false, false, false, false);
         c.axis_reset = true;
+        self.plc.outputs.control.message = [0; CONTROL_MESSAGE_LEN];
         true
     }
 
@@ -351,6 +365,14 @@ impl Channel {
     /// Carries out what the tick left for between ticks: loads and checks a selected program
     /// from the folder, or starts the selected one. Allocates; never called in a tick.
     pub fn serve(&mut self) {
+        if self.control.error_unshown {
+            // The error's text, rendered here (never in the tick) for the state block.
+            self.control.error_unshown = false;
+            if let Some(e) = &self.error {
+                let text = format!("line {}: {e}", e.line);
+                self.plc.outputs.control.message = hli::layout::nul_padded(&text);
+            }
+        }
         match self.control.pending.take() {
             Some(Pending::Select { name, start_line }) => {
                 let loaded = match &self.control.folder {
@@ -403,7 +425,10 @@ impl Channel {
 
     fn selected(&mut self, outcome: Result<(), SelectRefusal>) {
         match outcome {
-            Ok(()) => self.command_ended(ChannelCommandError::None),
+            Ok(()) => {
+                self.plc.outputs.control.message = [0; CONTROL_MESSAGE_LEN];
+                self.command_ended(ChannelCommandError::None);
+            }
             Err(refusal) => {
                 self.plc.outputs.control.message = hli::layout::nul_padded(&refusal.message);
                 self.command_ended(refusal.code);

@@ -44,6 +44,7 @@ impl Channel {
             fault,
         });
         self.control.aborted |= self.state == RunState::Running;
+        self.control.error_unshown = true;
         self.state = RunState::Error;
         self.motion.path = None;
         self.run.wait = None;
