@@ -662,6 +662,16 @@ impl PlcSegment {
         self.timing
     }
 
+    /// The pid of the PLC that claimed the segment, while that process lives (a tool sees
+    /// whether a PLC operates the CNC). `None` when no PLC is attached.
+    pub fn attached_plc(&self) -> Option<u32> {
+        let pid = self
+            .header()
+            .field::<u32>(offset_of!(HliSegmentHeader, plc_pid))
+            .load_acquire();
+        (pid != 0 && std::path::Path::new(&format!("/proc/{pid}")).exists()).then_some(pid)
+    }
+
     /// The pid of another PLC that claimed the segment since this one did (a new PLC the
     /// CNC took after it lost this one): this one must stop writing. `None` for a tool.
     pub fn replaced_by(&self) -> Option<u32> {

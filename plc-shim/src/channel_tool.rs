@@ -3,8 +3,12 @@
 //! The tool attaches without claiming the PLC slot, writes the command when its semaphore is
 //! free, waits for the channel's answer and prints it; `state` prints the state block.
 //!
+//! The unit has one writer, the PLC: while a PLC is attached the tool refuses to send (its
+//! command and the PLC's could mix) unless `--force`; `state` always works.
+//!
 //! Exit codes: 0 done, 1 no CNC to attach to, 2 bad input (no such channel, a name that does
-//! not fit), 3 no answer in time, 4 refused by the channel (the code and its text printed).
+//! not fit), 3 no answer in time, 4 refused by the channel (the code and its text printed) or
+//! because a PLC is attached.
 
 use crate::tools::ToolError;
 use core::time::Duration;
@@ -60,6 +64,10 @@ pub struct ChannelArgs {
     /// How long to wait for the channel's answer, ms (a stop waits for rest).
     #[arg(long, default_value_t = 10_000)]
     pub timeout_ms: u64,
+    /// Send even while a PLC is attached (its commands and the tool's could mix: the unit
+    /// has one writer, the PLC).
+    #[arg(long)]
+    pub force: bool,
     /// CNC instance.
     #[arg(long, default_value = crate::tools::DEFAULT_INSTANCE)]
     pub instance: String,
@@ -118,8 +126,16 @@ fn run(args: &ChannelArgs) -> Result<Vec<String>, Failure> {
         ))
     })?;
     let mut lines = Vec::new();
+    if let (Some(pid), false) = (
+        segment.attached_plc(),
+        args.action == Action::State || args.force,
+    ) {
+        return Err(Failure::Refused(format!(
+            "a PLC (pid {pid}) operates this CNC and owns the channel control unit; send the command from it, or pass --force"
+        )));
+    }
     let command = match args.action {
-        Action::State => return Ok(describe(&ch.channel_control_state())),
+        Action::State => return Ok(describe(&crate::blocks::channel::stable_state(&ch))),
         Action::Start if args.program.is_some() => {
             lines.push(send(&ch, ChannelCommand::Select, args)?);
             ChannelCommand::Start
@@ -159,7 +175,7 @@ fn send(ch: &PlcChannel<'_>, kind: ChannelCommand, args: &ChannelArgs) -> Result
         std::thread::sleep(Duration::from_millis(1));
     }
     loop {
-        let s = ch.channel_control_state();
+        let s = crate::blocks::channel::stable_state(ch);
         if s.command_id == id {
             match ChannelCommandState::decode(s.command_state) {
                 Ok(ChannelCommandState::Done) => return Ok(format!("{kind:?}: done")),

@@ -3,10 +3,10 @@
 //! the machine's axis set (`crate::machine`), which hands each channel's set-points on.
 
 use super::dyn_cs::MasterSample;
+use super::folder::Loader;
 use super::plc_io::{read_inputs, write_outputs, ChannelInputs, Violations};
 use super::run::{Channel, MAX_CHANNELS};
 use super::sync::SyncBoard;
-use hli::enums::ChannelState;
 use hli::views::CncView;
 
 /// All channels.
@@ -78,12 +78,20 @@ impl Controller {
 
     /// Between ticks: the channels' program loading and starting their control units asked
     /// for, and the text of a new error for the state block (allocates; never in a tick).
-    /// Returns how many were served.
-    pub fn serve_channels(&mut self) -> usize {
+    /// With a `loader`, programs are loaded on its thread and taken over here when ready
+    /// (the real-time loop); without one, here and now (lockstep and in-process runs stay
+    /// deterministic). Returns how many channels were served.
+    pub fn serve_channels(&mut self, loader: Option<&Loader>) -> usize {
         let mut served = 0;
+        while let Some(loaded) = loader.and_then(Loader::try_take) {
+            if let Some(channel) = self.channels.get_mut(loaded.channel) {
+                channel.finish_select(loaded);
+                served += 1;
+            }
+        }
         for channel in &mut self.channels {
             if channel.wants_service() {
-                channel.serve();
+                channel.serve(loader);
                 served += 1;
             }
         }
@@ -113,12 +121,7 @@ impl Controller {
             .channels
             .iter()
             .enumerate()
-            .filter(|(_, c)| {
-                matches!(
-                    c.channel_state(),
-                    ChannelState::Running | ChannelState::Holding
-                )
-            })
+            .filter(|(_, c)| c.may_signal())
             .fold(0u32, |mask, (i, _)| mask | 1 << i);
         self.sync.set_running(running);
         for k in 0..n {

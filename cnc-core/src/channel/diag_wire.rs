@@ -252,6 +252,7 @@ mod tests {
                 kind: crate::channel::guard::LimitKind::Acceleration,
             },
             TrackError::ChannelFailed(hli::enums::ChannelErrorId::Kinematics),
+            TrackError::PlcStop,
         ]
         .into_iter()
         .chain(BadParameter::ALL.map(TrackError::BadTransition));

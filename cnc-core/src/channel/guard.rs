@@ -166,6 +166,16 @@ impl JointGuard {
         }
     }
 
+    /// The axes stand at `position` (taken over after an axis reset): the next step is
+    /// measured from rest there.
+    pub fn rest_at(&mut self, position: &AxisValues) {
+        for (i, p) in position.iter().enumerate() {
+            self.last.position[i] = *p;
+            self.last.velocity[i] = 0.0;
+            self.last.acceleration[i] = 0.0;
+        }
+    }
+
     /// Latches: every axis brakes from its last accepted state with its deceleration and
     /// jerk. Does nothing when latched already.
     pub fn latch(&mut self) {

@@ -43,12 +43,13 @@ impl SyncBoard {
         Ok(())
     }
 
-    /// The channels that run their program this tick (bit `c` for channel `c`).
+    /// The channels that may still signal this tick (bit `c` for channel `c`): running, or
+    /// with a program selected and not started yet.
     pub fn set_running(&mut self, mask: u32) {
         self.running = mask;
     }
 
-    /// Whether a channel other than `me` runs its program.
+    /// Whether a channel other than `me` may still signal.
     pub fn others_running(&self, me: usize) -> bool {
         self.running & !(1u32 << me) != 0
     }

@@ -43,6 +43,10 @@ pub enum TrackError {
     /// The slave channel failed (its error id names the cause): it can no longer follow.
     #[error("the channel failed ({0:?})")]
     ChannelFailed(ChannelErrorId),
+    /// The PLC stopped or reset the channel: its axes brake on their own limits and hold;
+    /// the compensation they hold becomes part of the programmed position at rest.
+    #[error("stopped by the PLC")]
+    PlcStop,
 }
 
 fn limit_name(kind: LimitKind) -> &'static str {
@@ -70,6 +74,7 @@ impl TrackError {
                 u32::from(axis) * 2 + u32::from(kind == LimitKind::Acceleration),
             ),
             TrackError::ChannelFailed(id) => (10, id.raw()),
+            TrackError::PlcStop => (11, 0),
         }
     }
 
@@ -96,6 +101,7 @@ impl TrackError {
                 },
             },
             10 => TrackError::ChannelFailed(ChannelErrorId::decode(value).ok()?),
+            11 => TrackError::PlcStop,
             _ => return None,
         })
     }

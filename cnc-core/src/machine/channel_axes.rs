@@ -120,11 +120,12 @@ impl ChannelAxes {
         }
     }
 
-    /// A channel's RESET on its axes: each axis in error is reset, powered and coupled to the
-    /// channel again where it stands. `false` when an axis keeps its error (the drive still
-    /// faults) or cannot be coupled.
-    pub fn reset(&mut self, axes: &mut AxisSet) -> bool {
-        let mut ok = true;
+    /// A channel's RESET on its axes: each axis in error (or not coupled to the channel) is
+    /// reset, powered and coupled to the channel again where it stands, and the hand-over
+    /// takes its next set-point from rest there. `Ok(mask)`: bit `i` for each axis reset;
+    /// `Err(mask)` when an axis keeps its error or cannot be coupled.
+    pub fn reset(&mut self, axes: &mut AxisSet) -> Result<u32, u32> {
+        let (mut reset, mut ok) = (0u32, true);
         for (i, lease) in self.leases.iter_mut().enumerate() {
             let axis = self.first + i;
             let Some(a) = axes.axis_mut(axis) else {
@@ -136,11 +137,15 @@ impl ChannelAxes {
             if a.error().is_none() && lease.is_some() && coupled {
                 continue;
             }
+            reset |= 1 << i.min(31);
             let _ = a.command(&AxisCommandCall::reset());
             if a.error().is_some() || a.switch_on().is_err() {
                 ok = false;
                 continue;
             }
+            let actual = a.actual();
+            self.last[i] = actual;
+            self.last_velocity[i] = 0.0;
             let coupling = Coupling {
                 kind: CouplingState::Channel,
                 master: -1,
@@ -149,7 +154,11 @@ impl ChannelAxes {
             *lease = axes.couple(axis, coupling).ok();
             ok &= lease.is_some();
         }
-        ok
+        if ok {
+            Ok(reset)
+        } else {
+            Err(reset)
+        }
     }
 
     /// Whether one of the channel's axes is in error (it has dropped its coupling).

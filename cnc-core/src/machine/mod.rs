@@ -231,10 +231,11 @@ impl Machine {
                 continue;
             }
             let Some(link) = link else { continue };
-            if !link.reset(&mut self.axes) {
+            let reset = link.reset(&mut self.axes);
+            channel.adopt_positions(&link.actual(&self.axes), reset.unwrap_or_else(|m| m));
+            if reset.is_err() {
                 channel.axis_reset_failed();
             }
-            channel.adopt_positions(&link.actual(&self.axes));
         }
     }
 
@@ -242,7 +243,13 @@ impl Machine {
     /// checking a selected program, starting one). Never called in a tick; `cnc run`, the
     /// in-process runs and the demo call it after each tick. Returns how many were served.
     pub fn serve_channels(&mut self) -> usize {
-        self.controller.serve_channels()
+        self.controller.serve_channels(None)
+    }
+
+    /// [`Machine::serve_channels`] with programs loaded on `loader`'s thread (the real-time
+    /// loop: a file is never read between two ticks).
+    pub fn serve_channels_with(&mut self, loader: &crate::channel::folder::Loader) -> usize {
+        self.controller.serve_channels(Some(loader))
     }
 
     /// The tool point the actual joints realise against the commanded point of the tick the
@@ -410,6 +417,8 @@ impl Machine {
         for i in 0..self.controller.channels().len() {
             if let Some(c) = self.controller.channel_mut(i) {
                 c.stop(reason);
+                // The channel control unit takes no command until the machine is re-armed.
+                c.set_machine_stopped(true);
             }
         }
         for engine in &mut self.engines {
@@ -443,6 +452,11 @@ impl Machine {
             return false;
         }
         self.stopped = false;
+        for i in 0..self.controller.channels().len() {
+            if let Some(c) = self.controller.channel_mut(i) {
+                c.set_machine_stopped(false);
+            }
+        }
         for i in self.channel_axes()..self.axes.len() {
             if let Some(axis) = self.axes.axis_mut(i) {
                 // Refused only by an axis that cannot take commands: nothing to release.

@@ -72,7 +72,7 @@ impl Rig {
 
     fn tick(&mut self) {
         self.ctl.tick(&CncView::new(&self.memory));
-        self.ctl.serve_channels();
+        self.ctl.serve_channels(None);
         self.ticks += 1;
     }
 
@@ -633,4 +633,227 @@ fn a_command_without_its_semaphore_is_not_taken() {
     );
     assert_eq!(rig.ctl.violations().semaphore_garbage, 1);
     assert_eq!(rig.state(0), ChannelState::Selected);
+}
+
+/// A tracking slave on a conveyor moving at 100 mm/s is stopped by the PLC: with real axis
+/// limits it brakes on them from the conveyor's speed (never back along the compensation),
+/// comes to rest relative to the world, and ends SELECTED with tracking INACTIVE.
+#[test]
+fn stop_of_a_tracking_slave_brakes_it_to_rest_in_the_world_within_its_limits() {
+    let mut config = ChannelConfig::new("s", &["X", "Y", "Z", "A", "B", "C"]);
+    let limit = cnc_core::channel::path::AxisLimits {
+        velocity: 500.0,
+        acceleration: 2000.0,
+        jerk: 100_000.0,
+    };
+    config.axis_limits = vec![limit; 6];
+    let slave = "#TRACK CS ON [ID=0 FILTER=500]\nG1 X50 F600\nG1 X0\nM30\n";
+    let mut rig = Rig::new(vec![(config, Some(slave))], None);
+    enable_plc_master(&rig.memory, [0, 0, 0]);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    // The conveyor: 100 mm/s = 1000 units of 0.1 um per 1 ms tick.
+    let mut conveyor = 0i32;
+    let mut step = |rig: &mut Rig| {
+        conveyor += 1000;
+        let plc = PlcView::new(&rig.memory);
+        let _ = plc
+            .dyn_cs_command(0)
+            .unwrap()
+            .try_send(&cs([conveyor, 0, 0]));
+        rig.tick();
+    };
+    for _ in 0..1_000 {
+        step(&mut rig);
+    }
+    let c = &rig.ctl.channels()[0];
+    assert_eq!(c.tracker().state(), DynCsState::Active, "{:?}", c.error());
+    let id = rig.post(0, ChannelCommand::Stop, plain);
+    let (mut last, mut v_last) = (rig.x(0), f64::NAN);
+    let mut ticks = 0;
+    loop {
+        step(&mut rig);
+        let v = (rig.x(0) - last) / CYCLE;
+        assert!(v.abs() <= limit.velocity * 1.01, "velocity {v}");
+        if v_last.is_finite() {
+            let a = (v - v_last) / CYCLE;
+            assert!(a.abs() <= limit.acceleration * 1.01, "acceleration {a}");
+        }
+        assert!(v >= -1e-9, "never back along the compensation: {v}");
+        (last, v_last) = (rig.x(0), v);
+        let s = rig.state_block(0);
+        if s.command_id == id && s.command_state == ChannelCommandState::Done.raw() {
+            break;
+        }
+        ticks += 1;
+        assert!(ticks < 5_000, "watchdog");
+    }
+    assert_eq!(rig.state(0), ChannelState::Selected);
+    assert_eq!(
+        rig.ctl.channels()[0].tracker().state(),
+        DynCsState::Inactive
+    );
+    let rest = rig.x(0);
+    for _ in 0..200 {
+        step(&mut rig);
+        assert_eq!(
+            rig.x(0),
+            rest,
+            "at rest in the world while the conveyor runs on"
+        );
+    }
+}
+
+/// Feed hold while the channel waits for an M acknowledge: the acknowledge is taken and the
+/// program goes on after RESUME.
+#[test]
+fn an_m_acknowledge_during_feed_hold_is_not_lost() {
+    let program = "M100\nG1 X10 F6000\nM30\n";
+    let mut rig = Rig::new(vec![(cartesian("c"), Some(program))], None);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(3, |_| {});
+    assert_eq!(rig.command(0, ChannelCommand::FeedHold, plain, 5), None);
+    let plc = PlcView::new(&rig.memory);
+    let ch = plc.gp_ch(0).unwrap();
+    let request = ch.m_function_request().try_take().unwrap().unwrap();
+    let ack = hli::layout::HliMFunctionAck {
+        m_code: 100,
+        request_id: request.request_id,
+    };
+    ch.m_function_ack().try_send(&ack).unwrap();
+    rig.run_ticks(50, |r| assert_eq!(r.x(0), 0.0, "held"));
+    assert_eq!(rig.command(0, ChannelCommand::Resume, plain, 5), None);
+    rig.run_ticks(2_000, |_| {});
+    assert_eq!(rig.x(0), 10.0);
+    assert_eq!(rig.state_block(0).programs_ended, 1);
+}
+
+/// STOP while a RESET decelerates ends with it; single block switched off in a single-block
+/// stop still waits for START; the machine-stopped flag refuses every command.
+#[test]
+fn stop_during_reset_single_block_off_and_a_machine_stop_flag() {
+    let mut rig = Rig::new(vec![(cartesian("c"), Some(PART))], None);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(300, |_| {});
+    rig.post(0, ChannelCommand::Reset, plain);
+    rig.tick();
+    assert_eq!(rig.command(0, ChannelCommand::Stop, plain, 2_000), None);
+    assert_eq!(rig.state(0), ChannelState::Selected);
+
+    assert_eq!(
+        rig.command(0, ChannelCommand::SingleBlock, |c| c.value = 1, 5),
+        None
+    );
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    while rig.state(0) != ChannelState::Holding {
+        rig.tick();
+        assert!(rig.ticks < 20_000, "watchdog");
+    }
+    assert_eq!(
+        rig.command(0, ChannelCommand::SingleBlock, |c| c.value = 0, 5),
+        None
+    );
+    let at = rig.x(0);
+    rig.run_ticks(100, |r| {
+        assert_eq!(r.state(0), ChannelState::Holding);
+        assert_eq!(r.x(0), at);
+    });
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(10, |_| {});
+    assert_eq!(rig.state(0), ChannelState::Running);
+
+    rig.ctl.channel_mut(0).unwrap().set_machine_stopped(true);
+    assert_eq!(
+        rig.command(0, ChannelCommand::Stop, plain, 5),
+        Some(E::MachineStop)
+    );
+    rig.ctl.channel_mut(0).unwrap().set_machine_stopped(false);
+    assert_eq!(rig.command(0, ChannelCommand::Stop, plain, 2_000), None);
+}
+
+/// Three channels: A waits for a signal B will give, B is selected and not started yet, C is
+/// unrelated and stopped by the PLC. A keeps waiting (B may still signal) and goes on once B
+/// runs.
+#[test]
+fn a_wait_syn_is_not_failed_while_a_selected_partner_may_still_signal() {
+    let waits = "#WAIT SYN [ID1]\nG1 X20 F6000\nM30\n";
+    let signals = "#SIGNAL SYN [ID1 COUNT1]\nM30\n";
+    let other = "G1 X300 F600\nM30\n";
+    let mut rig = Rig::new(
+        vec![
+            (cartesian("a"), Some(waits)),
+            (cartesian("b"), Some(signals)),
+            (cartesian("c"), Some(other)),
+        ],
+        None,
+    );
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    assert_eq!(rig.command(2, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(100, |_| {});
+    assert_eq!(rig.command(2, ChannelCommand::Stop, plain, 2_000), None);
+    rig.run_ticks(100, |r| assert_eq!(r.state(0), ChannelState::Running));
+    assert_eq!(rig.command(1, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(2_000, |_| {});
+    assert_eq!(rig.x(0), 20.0);
+    assert_eq!(rig.state_block(0).programs_ended, 1);
+}
+
+/// SELECT with a start line is a block search: the modal state of the blocks before it is
+/// carried (here G1 and F), and blocks a search cannot carry are refused with their line.
+#[test]
+fn a_start_line_carries_the_modal_state_and_refuses_what_a_search_cannot_carry() {
+    let plain_part = "G1 X100 F6000\nY50\nX0\nY0\nM30\n";
+    let with_m = "G1 X10 F6000\nM100\nX20\nM30\n";
+    let dir = folder(&[("part.nc", plain_part), ("m.nc", with_m)]);
+    let mut rig = Rig::new(vec![(cartesian("c"), None)], Some(&dir));
+    // Line 2 (Y50) is a bare `Y50`: G1 at F6000 come from line 1. X stays 0 (line 1 is
+    // not run), Y goes to 50 and back.
+    assert_eq!(
+        rig.command(0, ChannelCommand::Select, select("part.nc", 2), 5),
+        None
+    );
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    let mut top_y = 0.0f64;
+    while rig.state(0) != ChannelState::Selected {
+        rig.tick();
+        assert_eq!(rig.x(0), 0.0);
+        top_y = top_y.max(rig.ctl.channels()[0].set_points()[1]);
+        assert!(rig.ticks < 20_000, "watchdog");
+    }
+    assert_eq!(top_y, 50.0, "line 2 ran as G1 Y50 at the feed of line 1");
+    assert_eq!(
+        rig.command(0, ChannelCommand::Select, select("m.nc", 3), 5),
+        Some(E::StartLineNotFound)
+    );
+    let message = rig.state_block(0).message;
+    let text = nul_padded_str(&message).unwrap();
+    assert!(
+        text.contains("m.nc:2: an M function before line 3"),
+        "{text}"
+    );
+}
+
+/// The real-time loop's loader: the file is read on a thread of its own; the channel stays
+/// BUSY meanwhile and selects the program once the result is taken between ticks.
+#[test]
+fn the_loader_thread_selects_between_later_ticks() {
+    let dir = folder(&[("part.nc", PART)]);
+    let mut rig = Rig::new(vec![(cartesian("c"), None)], Some(&dir));
+    let loader = cnc_core::channel::folder::Loader::spawn().unwrap();
+    let id = rig.post(0, ChannelCommand::Select, select("part.nc", 0));
+    let mut ticks = 0;
+    loop {
+        rig.ctl.tick(&CncView::new(&rig.memory));
+        rig.ctl.serve_channels(Some(&loader));
+        let s = rig.state_block(0);
+        assert_eq!(s.command_id, id);
+        if s.command_state == ChannelCommandState::Done.raw() {
+            break;
+        }
+        assert_eq!(s.command_state, ChannelCommandState::Busy.raw());
+        ticks += 1;
+        assert!(ticks < 1_000_000, "watchdog");
+        std::thread::yield_now();
+    }
+    assert_eq!(rig.state(0), ChannelState::Selected);
+    assert_eq!(nul_padded_str(&rig.state_block(0).program), Some("part.nc"));
 }

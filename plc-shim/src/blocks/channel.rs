@@ -16,7 +16,7 @@ use crate::timeline::registry::{
 };
 use hli::enums::{ChannelCommand, ChannelCommandState, ChannelMode, ChannelState};
 use hli::handshake::SendError;
-use hli::layout::{HliChannelCommand, PROGRAM_NAME_LEN};
+use hli::layout::{HliChannelCommand, HliChannelControlState, PROGRAM_NAME_LEN};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::Arc;
 
@@ -53,6 +53,8 @@ struct CommandSend {
     channel: usize,
     command: HliChannelCommand,
     written: bool,
+    /// Polls that found the command taken (semaphore FALSE) but another id answered.
+    taken_elsewhere: u8,
 }
 
 /// What the channel said of the command: its state and code.
@@ -61,11 +63,25 @@ type Answer = (ChannelCommandState, u32);
 /// The answer with the command's id (the block follows that id).
 type Reply = (Answer, u32);
 
+/// The state block read whole: two reads that agree (the CNC writes it leaf by leaf), so a new
+/// id is never seen with the previous command's answer.
+pub fn stable_state(ch: &hli::views::PlcChannel<'_>) -> HliChannelControlState {
+    let mut last = ch.channel_control_state();
+    for _ in 0..8 {
+        let again = ch.channel_control_state();
+        if bytemuck::bytes_of(&again) == bytemuck::bytes_of(&last) {
+            return again;
+        }
+        last = again;
+    }
+    last
+}
+
 fn answer_of(io: &PlcIo<'_>, channel: usize, id: u32) -> Option<Result<Answer, u32>> {
     let Some(ch) = io.gp_ch(channel) else {
         return Some(Err(ChannelBlockError::NoChannel.code()));
     };
-    let state = ch.channel_control_state();
+    let state = stable_state(&ch);
     if state.command_id != id {
         return None;
     }
@@ -98,6 +114,17 @@ impl InFlight for CommandSend {
         let id = self.command.command_id;
         match answer_of(io, self.channel, id) {
             Some(answer) => Polled::Answer(answer.map(|a| (a, id))),
+            // Taken, and another command's answer shows, in two polls one after the other
+            // (the CNC writes the answer in the tick it takes a command): another command
+            // replaced this one before its answer was seen. Followed, it ends CommandAborted.
+            None if ch.channel_command().is_free() == Ok(true) => {
+                self.taken_elsewhere += 1;
+                if self.taken_elsewhere >= 2 {
+                    Polled::Answer(Ok(((ChannelCommandState::Busy, 0), id)))
+                } else {
+                    Polled::Waiting
+                }
+            }
             None => Polled::Waiting,
         }
     }
@@ -191,6 +218,7 @@ impl ChannelCommandBlock {
                     program,
                 },
                 written: false,
+                taken_elsewhere: 0,
             })
         };
         self.out = self.kernel.cycle(
@@ -241,7 +269,7 @@ impl ReadChannelState {
             (self.error, self.error_id_block) = (true, ChannelBlockError::NoChannel.code());
             return;
         };
-        let s = ch.channel_control_state();
+        let s = stable_state(&ch);
         match (ChannelState::decode(s.state), ChannelMode::decode(s.mode)) {
             (Ok(state), Ok(mode)) => {
                 (self.state, self.mode) = (Some(state), Some(mode));
@@ -462,6 +490,29 @@ mod tests {
         s.command_id = s.command_id.wrapping_add(1);
         cnc.write_channel_control_state(0, &s).unwrap();
         assert!(cycle(&memory, &mut client, &mut hold, 0, Link::Operational).command_aborted);
+
+        // Taken, but another command's answer shows before this one's was seen: aborted.
+        let mut resume = ChannelCommandBlock::new(ChannelCommand::Resume);
+        resume.execute = true;
+        cycle(&memory, &mut client, &mut resume, 0, Link::Operational);
+        let cnc = CncView::new(&memory);
+        cnc.channel_command(0).unwrap().try_take().unwrap().unwrap();
+        let mut s = PlcView::new(&memory)
+            .gp_ch(0)
+            .unwrap()
+            .channel_control_state();
+        s.command_id = s.command_id.wrapping_add(17);
+        s.command_state = ChannelCommandState::Done.raw();
+        cnc.write_channel_control_state(0, &s).unwrap();
+        let mut aborted = false;
+        for _ in 0..4 {
+            aborted |=
+                cycle(&memory, &mut client, &mut resume, 0, Link::Operational).command_aborted;
+        }
+        assert!(
+            aborted,
+            "a command replaced before its answer ends CommandAborted"
+        );
 
         // No such channel; no CNC.
         let mut start = ChannelCommandBlock::new(ChannelCommand::Start);

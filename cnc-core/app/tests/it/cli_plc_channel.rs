@@ -80,4 +80,14 @@ fn plc_channel_selects_starts_holds_stops_and_refuses_with_codes() {
     let (code, _, err) = tool(&instance, &["state", "--channel", "3"]);
     assert_eq!(code, 2, "{err}");
     assert!(err.contains("channel 3 does not exist"), "{err}");
+
+    // A PLC attached owns the unit: the tool refuses to send beside it, unless --force.
+    let plc = hli::segment::PlcSegment::attach(&instance).unwrap();
+    let (code, _, err) = tool(&instance, &["start"]);
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("a PLC (pid"), "{err}");
+    assert!(state(&instance).contains("state = Selected"));
+    let (code, _, err) = tool(&instance, &["start", "--force"]);
+    assert_eq!(code, 0, "{err}");
+    drop(plc);
 }

@@ -7,7 +7,9 @@
 //! single-block stop), STOPPING (a stop or reset decelerating, or a machine stop), ERROR.
 
 use super::*;
-use crate::channel::folder::{ProgramFolder, ProgramName, SelectRefusal};
+use crate::channel::folder::{
+    Job, Loaded, Loader, ProgramFolder, ProgramName, SelectRefusal, StartPoint,
+};
 use hli::enums::{
     ChannelCommand, ChannelCommandError, ChannelCommandState, ChannelMode, ChannelSignal,
     ChannelState,
@@ -19,6 +21,13 @@ use hli::layout::{HliChannelCommand, CONTROL_MESSAGE_LEN, PROGRAM_NAME_LEN};
 pub enum Pending {
     /// Load and check a program from the folder; start at a source line (0: the first block).
     Select {
+        /// The file name.
+        name: ProgramName,
+        /// The line.
+        start_line: u32,
+    },
+    /// The program is being loaded on the loader's thread.
+    Loading {
         /// The file name.
         name: ProgramName,
         /// The line.
@@ -54,13 +63,17 @@ pub(super) struct Control {
     pub(super) program_name: [u8; PROGRAM_NAME_LEN],
     /// The machine resets the channel's axes after this tick (a RESET was carried out).
     pub(super) axis_reset: bool,
-    /// Where the started program begins (a block index of the main program; None: its
-    /// start).
-    pub(super) start_block: Option<u32>,
+    /// Where the started program begins (a block search's result; None: its beginning).
+    pub(super) start: Option<Box<StartPoint>>,
     /// The channel was stopped, reset or failed while it ran (for `#WAIT SYN` partners).
     pub(super) aborted: bool,
     /// The channel failed and its text is not in the state block yet.
     pub(super) error_unshown: bool,
+    /// The machine stopped (supervision, a lost PLC) and has not been re-armed: no command.
+    pub(super) machine_stopped: bool,
+    /// The selected program has not been started since it was selected (a partner that
+    /// may still signal a `#WAIT SYN`).
+    pub(super) fresh: bool,
 }
 
 impl Control {
@@ -79,14 +92,19 @@ impl Control {
             folder: None,
             program_name: [0; PROGRAM_NAME_LEN],
             axis_reset: false,
-            start_block: None,
+            start: None,
             aborted: false,
             error_unshown: false,
+            machine_stopped: false,
+            fresh: false,
         }
     }
 }
 
 type Outcome = Result<bool, ChannelCommandError>;
+
+/// Why a channel is in ERROR after a RESET its axes did not follow.
+pub const AXIS_NOT_RESET: &str = "RESET: a channel axis keeps its fault (see its error_id_r)";
 
 impl Channel {
     /// Where SELECT finds programs (set when the machine is built).
@@ -111,6 +129,15 @@ impl Channel {
         }
     }
 
+    /// Whether the channel may still signal a `#WAIT SYN` of another channel: it runs its
+    /// program, or holds one selected and not started yet.
+    pub fn may_signal(&self) -> bool {
+        matches!(
+            self.channel_state(),
+            ChannelState::Running | ChannelState::Holding
+        ) || (self.control.fresh && self.channel_state() == ChannelState::Selected)
+    }
+
     /// Programs that ran to their end since the CNC started.
     pub fn programs_ended(&self) -> u32 {
         self.plc.outputs.control.programs_ended
@@ -124,7 +151,10 @@ impl Channel {
     /// Whether [`Channel::serve`] has something to do: pending work, or the text of a new
     /// error to show in the state block.
     pub fn wants_service(&self) -> bool {
-        self.control.pending.is_some() || self.control.error_unshown
+        matches!(
+            self.control.pending,
+            Some(Pending::Select { .. } | Pending::Start)
+        ) || self.control.error_unshown
     }
 
     /// Takes the command the PLC posted this tick: carried out, refused, or Busy.
@@ -166,7 +196,9 @@ impl Channel {
 
     fn carry_out_command(&mut self, kind: ChannelCommand, command: &HliChannelCommand) -> Outcome {
         use ChannelCommandError as E;
-        if self.stopping() {
+        // A machine stop owns the channel until the machine is re-armed (a PLC must not undo
+        // it), and until its braking has latched and ended.
+        if self.control.machine_stopped || self.stopping() || self.guard_pending() {
             return Err(E::MachineStop);
         }
         let running = self.state == RunState::Running && !self.control.plc_stop;
@@ -189,6 +221,7 @@ impl Channel {
                 Ok(true)
             }
             ChannelCommand::Reset => Ok(self.reset_command()),
+            // Off during a single-block stop: the channel still waits for START there.
             ChannelCommand::SingleBlock => match command.value {
                 0 | 1 => {
                     self.control.single_block = command.value == 1;
@@ -231,8 +264,12 @@ impl Channel {
             if !(c.held || c.block_stop) {
                 return Err(E::Running);
             }
-            // Cycle start from a hold: the path goes on.
-            (c.held, c.block_stop, c.block_ran) = (false, false, false);
+            // Cycle start from a hold: the path goes on; from a single-block stop, the next
+            // block runs.
+            if c.block_stop {
+                (c.block_stop, c.block_ran) = (false, false);
+            }
+            c.held = false;
             return Ok(true);
         }
         if c.plc_stop || c.pending.is_some() {
@@ -268,9 +305,13 @@ impl Channel {
     }
 
     /// A stop of the PLC: the path and independent axes brake, no block starts, waits end (an
-    /// M function announced stays announced: its late acknowledge is taken as stale), and
-    /// tracking switches off softly over its filter. The program ends at rest.
+    /// M function announced stays announced: its late acknowledge is taken as stale). A
+    /// tracking slave takes the safe path: its tracking stops (ERROR, reason PlcStop) and the
+    /// guard brakes every axis on its own limits from its motion, so it comes to rest relative
+    /// to the world; at rest the compensation becomes part of the programmed position and the
+    /// tracking is INACTIVE. The program ends at rest.
     fn begin_plc_stop(&mut self) {
+        self.control.aborted |= self.state == RunState::Running;
         let c = &mut self.control;
         (c.plc_stop, c.held, c.block_stop) = (true, false, false);
         let (dec, jerk) = (self.motion.limits.acceleration, self.motion.limits.jerk);
@@ -284,37 +325,74 @@ impl Channel {
         }
         if matches!(
             self.pose.tracker.state(),
-            DynCsState::Activating | DynCsState::Active
+            DynCsState::Activating | DynCsState::Active | DynCsState::Deactivating
         ) {
-            self.pose.tracker.switch_off(None);
+            self.pose.tracker.fail(TrackError::PlcStop);
+            self.safety.latch_pending = true;
         }
         self.run.wait = None;
-        self.control.aborted = true;
+    }
+
+    /// A tracker in ERROR whose guard has not latched yet (it latches at the end of the tick
+    /// it failed in): its axes may still move with the compensation.
+    fn guard_pending(&self) -> bool {
+        self.pose.tracker.state() == DynCsState::Error && !self.safety.guard.latched()
+    }
+
+    /// A machine stop ends a command of the PLC under way: the stop owns the channel.
+    pub(super) fn abort_plc_command(&mut self) {
+        let c = &mut self.control;
+        (c.plc_stop, c.reset_after_stop, c.pending, c.held) = (false, false, None, false);
+        if self.plc.outputs.control.command_state == ChannelCommandState::Busy.raw() {
+            self.command_ended(ChannelCommandError::Aborted);
+        }
+    }
+
+    /// Whether the machine has stopped the channel and not been re-armed (set by the
+    /// machine; see [`crate::machine::Machine::stop`]).
+    pub fn set_machine_stopped(&mut self, stopped: bool) {
+        self.control.machine_stopped = stopped;
     }
 
     /// After the tick's motion: a stop of the PLC that reached rest ends the program (and
     /// resets when asked to); a feed hold that reached rest is done.
     pub(super) fn follow_command(&mut self) {
         let settled = !self.is_moving() && !self.pose.tracker.in_transition();
-        if self.control.plc_stop && settled {
-            self.control.plc_stop = false;
-            if self.state == RunState::Running {
-                self.state = RunState::Finished;
-            }
-            self.run.wait = None;
-            if self.pose.tracker.state() == DynCsState::Inactive {
-                self.resync_to_set_points();
-            }
-            if std::mem::take(&mut self.control.reset_after_stop) {
-                let done = self.finish_reset();
-                if done && self.command_busy(ChannelCommand::Reset) {
-                    self.command_ended(ChannelCommandError::None);
-                }
-            } else if self.command_busy(ChannelCommand::Stop) {
-                self.command_ended(ChannelCommandError::None);
-            }
+        if self.control.plc_stop && settled && !self.guard_pending() {
+            self.plc_stop_at_rest();
         }
         if self.command_busy(ChannelCommand::FeedHold) && self.path_at_rest() {
+            self.command_ended(ChannelCommandError::None);
+        }
+    }
+
+    fn plc_stop_at_rest(&mut self) {
+        self.control.plc_stop = false;
+        if self.state == RunState::Running {
+            self.state = RunState::Finished;
+        }
+        self.run.wait = None;
+        if self.pose.tracker.last_error() == Some(TrackError::PlcStop)
+            && self.pose.tracker.state() == DynCsState::Error
+        {
+            // The safe path of a tracking slave ended: the axes hold where they braked to;
+            // that becomes the programmed position, tracking INACTIVE.
+            self.pose.tracker.reset();
+            self.safety.guard.release();
+        }
+        if self.pose.tracker.state() == DynCsState::Inactive && !self.safety.guard.latched() {
+            self.resync_to_set_points();
+            self.safety.guard.accept(&self.pose.set_points);
+        }
+        let done = if std::mem::take(&mut self.control.reset_after_stop) {
+            self.finish_reset()
+        } else {
+            true
+        };
+        // A STOP taken while a RESET decelerated ends with it.
+        let busy =
+            self.command_busy(ChannelCommand::Stop) || self.command_busy(ChannelCommand::Reset);
+        if done && busy {
             self.command_ended(ChannelCommandError::None);
         }
     }
@@ -355,16 +433,19 @@ impl Channel {
         std::mem::take(&mut self.control.axis_reset)
     }
 
-    /// The machine could not reset one of the channel's axes: the RESET failed.
+    /// The machine could not reset one of the channel's axes: the RESET failed and the
+    /// channel is in ERROR (it cannot start with an axis it does not drive).
     pub fn axis_reset_failed(&mut self) {
         if self.control.command == Some(ChannelCommand::Reset) {
             self.command_ended(ChannelCommandError::AxisFault);
         }
+        self.fail(ChannelFault::MachineStop(AXIS_NOT_RESET));
     }
 
     /// Carries out what the tick left for between ticks: loads and checks a selected program
-    /// from the folder, or starts the selected one. Allocates; never called in a tick.
-    pub fn serve(&mut self) {
+    /// from the folder (on `loader`'s thread when one is given, else here), or starts the
+    /// selected one; and renders a new error's text. Allocates; never called in a tick.
+    pub fn serve(&mut self, loader: Option<&Loader>) {
         if self.control.error_unshown {
             // The error's text, rendered here (never in the tick) for the state block.
             self.control.error_unshown = false;
@@ -373,54 +454,70 @@ impl Channel {
                 self.plc.outputs.control.message = hli::layout::nul_padded(&text);
             }
         }
-        match self.control.pending.take() {
+        match self.control.pending {
             Some(Pending::Select { name, start_line }) => {
-                let loaded = match &self.control.folder {
-                    Some(folder) => folder.load(&name, &self.config.axes),
-                    None => Err(SelectRefusal {
-                        code: ChannelCommandError::NoProgramFolder,
-                        message: String::new(),
-                    }),
+                let Some(folder) = self.control.folder.clone() else {
+                    self.control.pending = None;
+                    return self.command_ended(ChannelCommandError::NoProgramFolder);
                 };
-                let outcome = loaded.and_then(|p| self.take_selected(p, &name, start_line));
-                self.selected(outcome);
+                let job = Job {
+                    channel: self.index,
+                    folder,
+                    axes: self.config.axes.clone(),
+                    name,
+                    start_line,
+                };
+                match loader {
+                    None => self.finish_select(job.run()),
+                    // A full queue: tried again after the next tick.
+                    Some(loader) => {
+                        if loader.send(job).is_ok() {
+                            self.control.pending = Some(Pending::Loading { name, start_line });
+                        }
+                    }
+                }
             }
             Some(Pending::Start) => {
+                self.control.pending = None;
                 self.begin_selected();
                 self.command_ended(ChannelCommandError::None);
             }
-            None => {}
+            Some(Pending::Loading { .. }) | None => {}
         }
+    }
+
+    /// A program the loader loaded: selected if the channel still waits for it (a STOP or
+    /// RESET since dropped the wait: the result is dropped too).
+    pub fn finish_select(&mut self, loaded: Loaded) {
+        let waiting = matches!(
+            self.control.pending,
+            Some(Pending::Select { name, start_line } | Pending::Loading { name, start_line })
+                if name == loaded.name && start_line == loaded.start_line
+        );
+        if !waiting {
+            return;
+        }
+        self.control.pending = None;
+        let outcome = loaded
+            .result
+            .map(|(program, start)| self.take_selected(program, &loaded.name, start));
+        self.selected(outcome);
     }
 
     fn take_selected(
         &mut self,
         program: LoadedProgram,
         name: &ProgramName,
-        start_line: u32,
-    ) -> Result<(), SelectRefusal> {
-        let start_block = match start_line {
-            0 => None,
-            line => {
-                let main = &program.set.main().tree;
-                let found = main.blocks[main.main_start as usize..]
-                    .iter()
-                    .position(|b| b.line == line)
-                    .map(|i| i as u32 + main.main_start);
-                Some(found.ok_or_else(|| SelectRefusal {
-                    code: ChannelCommandError::StartLineNotFound,
-                    message: format!("{}: no block starts at line {line}", program.name),
-                })?)
-            }
-        };
+        start: Option<StartPoint>,
+    ) {
         self.run.program = Some(program);
         self.control.program_name = *name.bytes();
-        self.control.start_block = start_block;
+        self.control.start = start.map(Box::new);
         self.control.program_ended = false;
+        self.control.fresh = true;
         if self.state == RunState::Finished {
             self.state = RunState::Idle;
         }
-        Ok(())
     }
 
     fn selected(&mut self, outcome: Result<(), SelectRefusal>) {

@@ -88,7 +88,7 @@ impl Channel {
             self.reset()?;
         }
         self.control.program_name = hli::layout::nul_padded(program_file_name(&program.name));
-        self.control.start_block = None;
+        self.control.start = None;
         self.run.program = Some(program);
         self.begin_selected();
         Ok(())
@@ -97,7 +97,8 @@ impl Channel {
     /// Selects `program` without starting it (the PLC starts it with START).
     pub fn select(&mut self, program: LoadedProgram) {
         self.control.program_name = hli::layout::nul_padded(program_file_name(&program.name));
-        self.control.start_block = None;
+        self.control.start = None;
+        self.control.fresh = true;
         self.run.program = Some(program);
     }
 
@@ -114,8 +115,13 @@ impl Channel {
         }
         self.run.decoder.configure(&program.setup);
         self.run.interp.start(&program.set);
-        if let Some(block) = self.control.start_block {
-            self.run.interp.start_at(block);
+        if let Some(start) = self.control.start.as_deref() {
+            // A block search's start: its modal state and flow, where the axes stand.
+            self.run.decoder = start.decoder.clone();
+            self.run.interp = start.interp.clone();
+            for (i, p) in self.motion.programmed.iter().enumerate() {
+                self.run.decoder.set_position(i, *p);
+            }
         }
         self.run.pending.clear();
         self.run.pending_at = 0;
@@ -124,6 +130,7 @@ impl Channel {
         self.error = None;
         let c = &mut self.control;
         (c.program_ended, c.block_ran, c.block_stop, c.held) = (false, false, false, false);
+        c.fresh = false;
         if self.config.provide_channel_interface.track_cs {
             self.pose.interface_on = true;
         }
@@ -163,6 +170,10 @@ impl Channel {
                 self.run.wait = None;
             }
             if self.motion.path.is_some() || self.state != RunState::Running {
+                return;
+            }
+            // Feed hold and a single-block stop: waits end as they would, nothing new starts.
+            if self.control.held || self.control.block_stop {
                 return;
             }
             if self.run.pending_at < self.run.pending.len() {
@@ -238,6 +249,14 @@ impl Channel {
                 self.fail(ChannelFault::Program(e.fault));
                 false
             }
+        }
+    }
+
+    /// A feed hold does not count against `sync_timeout_s`: the wait's clock stands.
+    pub(super) fn hold_sync_clock(&mut self) {
+        if let (true, Some(Wait::Sync { since, .. })) = (self.control.held, self.run.wait.as_mut())
+        {
+            *since += 1;
         }
     }
 

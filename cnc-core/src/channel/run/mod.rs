@@ -223,8 +223,8 @@ impl Channel {
         self.take_override();
         self.take_command();
         self.plc_inputs();
-        let c = &self.control;
-        if self.state == RunState::Running && self.stopping.is_none() && !c.plc_stop && !c.held {
+        if self.state == RunState::Running && self.stopping.is_none() && !self.control.plc_stop {
+            self.hold_sync_clock();
             self.interpret(masters, sync);
         }
         self.advance();

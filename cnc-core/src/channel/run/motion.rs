@@ -100,7 +100,9 @@ impl Channel {
         }
         if self.pose.tracker.state() != DynCsState::Inactive {
             self.pose.tracker.fail(TrackError::MachineStop);
+            self.safety.latch_pending = true;
         }
+        self.abort_plc_command();
         self.stopping = Some(reason);
     }
 

@@ -95,6 +95,7 @@ impl Channel {
         if self.pose.tracker.state() != DynCsState::Error
             || self.state != RunState::Running
             || self.stopping.is_some()
+            || self.control.plc_stop
         {
             return;
         }
@@ -166,22 +167,30 @@ impl Channel {
 
     /// After a RESET of its axes: the channel's set-points and programmed position become
     /// where the axes stand (an axis that faulted stood away from its set-point).
-    pub fn adopt_positions(&mut self, actual: &crate::setpoint::AxisValues) {
-        let n = self.pose.set_points.len().min(actual.len());
-        if self.pose.set_points[..n] == actual[..n] {
+    /// `reset` has bit `i` set for each axis `i` that was reset (the others keep theirs).
+    pub fn adopt_positions(&mut self, actual: &crate::setpoint::AxisValues, reset: u32) {
+        let n = self.pose.set_points.len().min(actual.len()).min(32);
+        if reset == 0 {
             return;
         }
-        self.pose.set_points[..n].copy_from_slice(&actual[..n]);
+        for i in (0..n).filter(|i| reset & (1 << i) != 0) {
+            self.pose.set_points[i] = actual[i];
+        }
         self.take_joints_from_set_points();
         self.resync_to_set_points();
-        self.safety.guard.accept(&self.pose.set_points);
+        self.safety.guard.rest_at(&self.pose.set_points);
     }
 
     /// Clears the channel's error and the tracker's ERROR (tracking off at once: the
     /// compensation the axes hold becomes part of the programmed position), ends a program
     /// and leaves the channel idle where its axes stand. Refused while the axes move.
     pub fn reset(&mut self) -> Result<(), ResetError> {
-        if self.safety.guard.braking()
+        // A tracker that failed this tick: the guard latches at its end and brakes from the
+        // compensation's motion; dropping the compensation now would be a step.
+        let latch_due =
+            self.pose.tracker.state() == DynCsState::Error && !self.safety.guard.latched();
+        if latch_due
+            || self.safety.guard.braking()
             || self.motion.path.is_some()
             || self.motion.independent.iter().any(|g| g.1)
         {

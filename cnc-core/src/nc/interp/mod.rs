@@ -163,16 +163,6 @@ impl Interpreter {
         self.ended = false;
     }
 
-    /// After [`Interpreter::start`]: the main program goes on at block `index` instead of its
-    /// first main block (a start line the PLC selected; ignored outside the main program).
-    pub fn start_at(&mut self, index: u32) {
-        if let Some(frame) = self.frames.first_mut() {
-            if index >= frame.next && index < frame.end {
-                frame.next = index;
-            }
-        }
-    }
-
     /// The call depth (0 in the main program).
     pub fn depth(&self) -> usize {
         self.frames.len().saturating_sub(1)

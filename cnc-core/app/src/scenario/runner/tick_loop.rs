@@ -14,6 +14,7 @@ use crate::scenario::file::Scenario;
 use crate::scenario::log_stream::LogStream;
 use crate::scenario::machine::Machine;
 use crate::scenario::trace::Trace;
+use cnc_core::channel::folder::Loader;
 use cnc_os::monotonic;
 use core::time::Duration;
 use hli::events::EventLink;
@@ -151,6 +152,9 @@ pub(super) struct TickLoop<'a> {
     log_stream: Option<LogStream>,
     counter: TickCounter,
     progress: Option<Progress>,
+    /// Real time: programs the PLC selects are loaded on this thread, never between two
+    /// ticks (lockstep loads them in place: its ticks wait for nothing else anyway).
+    loader: Option<Loader>,
 }
 
 impl<'a> TickLoop<'a> {
@@ -184,6 +188,8 @@ impl<'a> TickLoop<'a> {
             options.ticks.or(scenario.ticks),
             &options.instance,
         );
+        // Without a thread (the system refused one) programs load in place, between ticks.
+        let loader = (!options.lockstep).then(|| Loader::spawn().ok()).flatten();
         TickLoop {
             scenario,
             options,
@@ -209,6 +215,7 @@ impl<'a> TickLoop<'a> {
             log_stream,
             counter,
             progress,
+            loader,
         }
     }
 
@@ -339,8 +346,11 @@ impl<'a> TickLoop<'a> {
             stream.forward(self.machine.controller().channels());
         }
         // Program loading and starting for the channels' control units: after "tick done",
-        // outside the measured tick.
-        self.machine.serve_channels();
+        // outside the measured tick; in real time the loading itself on the loader's thread.
+        match &self.loader {
+            Some(loader) => self.machine.serve_channels_with(loader),
+            None => self.machine.serve_channels(),
+        };
         self.measured.push([t0, t1, t2, t3, t4], deadline);
         self.counter.set(tick + 1);
     }
