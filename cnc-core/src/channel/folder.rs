@@ -290,12 +290,10 @@ impl Loader {
         Ok(Loader { jobs, done })
     }
 
-    /// Hands a job to the thread; `Err(job)` when its queue is full or it ended.
-    pub fn send(&self, job: Job) -> Result<(), Job> {
-        self.jobs.try_send(job).map_err(|e| match e {
-            std::sync::mpsc::TrySendError::Full(j)
-            | std::sync::mpsc::TrySendError::Disconnected(j) => j,
-        })
+    /// Hands a job to the thread; `false` when its queue is full or it ended (the caller
+    /// tries again later).
+    pub fn send(&self, job: Job) -> bool {
+        self.jobs.try_send(job).is_ok()
     }
 
     /// A result, if one is ready.

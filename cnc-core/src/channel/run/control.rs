@@ -471,7 +471,7 @@ impl Channel {
                     None => self.finish_select(job.run()),
                     // A full queue: tried again after the next tick.
                     Some(loader) => {
-                        if loader.send(job).is_ok() {
+                        if loader.send(job) {
                             self.control.pending = Some(Pending::Loading { name, start_line });
                         }
                     }

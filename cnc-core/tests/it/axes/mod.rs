@@ -148,7 +148,13 @@ proptest! {
         }
         let (id, target) = last.unwrap();
         let slowest = moves.last().unwrap().1;
-        rig.until(budget(3600.0, slowest), |r| r.view(0, id) == CommandView::Done);
+        // The last move may take over at the speed of an earlier, faster one and brake from it
+        // with its own (low) deceleration: that distance and time come on top.
+        let fastest = moves.iter().map(|m| m.1[0]).fold(0.0, f64::max);
+        let decel = slowest[1].min(slowest[2]);
+        let braking = fastest * fastest / (2.0 * decel);
+        let extra = (2.0 * fastest / decel / CYCLE) as usize;
+        rig.until(budget(3600.0 + braking, slowest) + extra, |r| r.view(0, id) == CommandView::Done);
         prop_assert_eq!(rig.set_point(0).position, target);
     }
 }
