@@ -247,3 +247,13 @@ pub fn cnc_run_lockstep(cnc: &str, scenario: &Path, tag: &str) -> (String, Vec<u
     );
     (report(&out), std::fs::read(&trace).expect("read the trace"))
 }
+
+/// Polls `check` until it holds: a watchdog of 30 s fails the test that waits for `what` (a
+/// live process's state seen from outside; the wait is a poll, never a timing).
+pub fn wait_until(what: &str, mut check: impl FnMut() -> bool) {
+    let deadline = std::time::Instant::now() + Duration::from_secs(30);
+    while !check() {
+        assert!(std::time::Instant::now() < deadline, "watchdog: {what}");
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}

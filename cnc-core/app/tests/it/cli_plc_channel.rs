@@ -3,7 +3,7 @@
 //! a program that fails its check refused with FILE:LINE:COL, a channel that does not exist.
 
 use std::process::Stdio;
-use std::time::{Duration, Instant};
+use tests::cli::wait_until;
 use tests::{Cli, Scratch};
 
 fn tool(instance: &str, args: &[&str]) -> (i32, String, String) {
@@ -17,15 +17,6 @@ fn state(instance: &str) -> String {
     let (code, out, err) = tool(instance, &["state"]);
     assert_eq!(code, 0, "{err}");
     out
-}
-
-/// Polls `check` until it holds (watchdog 30 s).
-fn wait_until(what: &str, mut check: impl FnMut() -> bool) {
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while !check() {
-        assert!(Instant::now() < deadline, "watchdog: {what}");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 #[test]

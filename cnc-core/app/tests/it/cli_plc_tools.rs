@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 use std::process::Stdio;
-use std::time::{Duration, Instant};
+use tests::cli::wait_until;
 use tests::{ChildGuard, Cli, Scratch};
 
 const ENABLE: &str = "gpCh[0]^channel_mc_control.dyn_cs.enable_w";
@@ -54,15 +54,6 @@ fn start_cnc(instance: &str) -> (ChildGuard, Scratch) {
         .spawn()
         .unwrap();
     (cnc, dir)
-}
-
-/// Polls `check` until it holds (watchdog 30 s).
-fn wait_until(what: &str, mut check: impl FnMut() -> bool) {
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while !check() {
-        assert!(Instant::now() < deadline, "watchdog: {what}");
-        std::thread::sleep(Duration::from_millis(5));
-    }
 }
 
 #[test]
