@@ -354,6 +354,15 @@ impl AcyclicServer {
         })
     }
 
+    /// Connects to the clients there are now (maps their segments), so that the first call a
+    /// client sends is not answered in a tick that also maps its segment (with locked memory
+    /// that populates the whole mapping: milliseconds). Called before the first tick.
+    pub fn connect(&self) -> Result<(), CallError> {
+        self.port.has_requests().map_err(transport)?;
+        self.rows.has_requests().map_err(transport)?;
+        Ok(())
+    }
+
     /// Answers every pending bulk call with `handler(kind, header, values)`. An unknown or
     /// non-bulk kind is refused with [`ErrorCode::ServiceNotSupported`] and a payload that is not
     /// `rows x columns` values with [`ErrorCode::InvalidSize`], before the handler sees them.

@@ -183,6 +183,7 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
                 summary.end
             );
             println!("plc: task {}", summary.stats);
+            println!("plc: wake-up to done {}", summary.wake_to_done);
             println!("{}", program.summary());
             runtime.detach();
             match summary.end {

@@ -186,6 +186,9 @@ pub struct RunSummary {
     pub end: RunEnd,
     /// Cycles executed, their durations and overruns.
     pub stats: CycleStats,
+    /// From the wake-up ("tick done" received) to "cycle done" sent, for the cycles that ran
+    /// the program: the PLC's whole answer to a tick (its overruns are not counted here).
+    pub wake_to_done: CycleStats,
 }
 
 impl RunSummary {
@@ -281,7 +284,14 @@ impl PlcRuntime {
             cnc_os::monotonic::now(),
         );
         let mut stats = CycleStats::default();
-        let end = |end, stats: CycleStats| Ok(RunSummary { end, stats });
+        let mut wake_to_done = CycleStats::default();
+        let end = |end, stats: CycleStats, wake_to_done: CycleStats| {
+            Ok(RunSummary {
+                end,
+                stats,
+                wake_to_done,
+            })
+        };
         // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
         // its cycle (lockstep waits for exactly that cycle).
         let mut last_cnc_beat = 0;
@@ -290,23 +300,24 @@ impl PlcRuntime {
         let mut wakeups = 0u64;
         loop {
             if max_cycles.is_some_and(|max| stats.cycles >= max) {
-                return end(RunEnd::CycleLimit, stats);
+                return end(RunEnd::CycleLimit, stats, wake_to_done);
             }
             // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
             if wakeups.is_multiple_of(64) {
                 if let Some(signal) = hli::signals::take() {
-                    return end(RunEnd::Signal(signal), stats);
+                    return end(RunEnd::Signal(signal), stats, wake_to_done);
                 }
             }
             self.events.wait(self.wait_step)?;
+            let woke = cnc_os::monotonic::now();
             let beat = self.segment.cnc_heartbeat();
             if let Some(ended) = self.supervise(&mut watch, beat) {
                 if matches!(ended, RunEnd::CncLost(_) | RunEnd::SegmentCorrupt(_)) {
                     self.last_cycle(program, &mut stats);
                 }
-                return end(ended, stats);
+                return end(ended, stats, wake_to_done);
             }
             if beat == last_cnc_beat {
                 continue; // woken without a new tick (timeout): no cycle
@@ -318,7 +329,8 @@ impl PlcRuntime {
             }
             last_cnc_beat = beat;
             let slot = due.unwrap_or(beat);
-            if beat >= slot {
+            let ran = beat >= slot;
+            if ran {
                 // Slots that passed while the previous cycle (or this process) was late.
                 stats.overruns = stats
                     .overruns
@@ -338,6 +350,10 @@ impl PlcRuntime {
             }
             self.segment.beat();
             self.events.notify()?;
+            if ran {
+                let took = cnc_os::monotonic::now().saturating_sub(woke);
+                wake_to_done.record(took.as_nanos() as u64);
+            }
         }
     }
 }

@@ -165,6 +165,13 @@ fn summary(report: &RunReport) -> String {
         Some(task) => out.push_str(&format!("PLC task: {task}\n")),
         None => out.push_str("PLC task: no statistics (the PLC did not end in order)\n"),
     }
+    if let Some(wake) = report
+        .plc_output
+        .lines()
+        .find_map(|l| l.strip_prefix("plc: wake-up to done "))
+    {
+        out.push_str(&format!("PLC wake-up to done: {wake}\n"));
+    }
     out
 }
 
@@ -173,7 +180,10 @@ fn write_outputs(report: &RunReport, dir: &Path) -> Result<Vec<String>, String> 
     let csv_name = format!("{NAME}.csv");
     let csv = dir.join(&csv_name);
     report.trace.save(&csv)?;
-    let mut files = vec![csv_name];
+    let latency = dir.join("latency.md");
+    std::fs::write(&latency, report.latency.full())
+        .map_err(|e| format!("{}: {e}", latency.display()))?;
+    let mut files = vec![csv_name, "latency.md".to_string()];
     files.extend(demo_plots::draw(&csv, dir).map_err(|e| e.to_string())?);
     Ok(files)
 }

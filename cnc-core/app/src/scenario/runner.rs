@@ -27,6 +27,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use tick_loop::{Bounds, Ending, Measured, TickLoop};
 
+pub mod latency;
 mod restart;
 mod tick_loop;
 
@@ -44,6 +45,10 @@ pub struct RunArgs {
     /// Write the trace CSV here.
     #[arg(long)]
     pub trace: Option<PathBuf>,
+    /// Write where the tick time went (every part's p50/p99/max, the overruns, the ten
+    /// worst ticks with their parts) to this file (markdown).
+    #[arg(long)]
+    pub latency_report: Option<PathBuf>,
     /// Run exactly N ticks (channels that finish earlier stay idle).
     #[arg(long)]
     pub ticks: Option<u64>,
@@ -202,8 +207,8 @@ pub struct RunReport {
     pub ticks: u64,
     /// Compute time of a tick, ns.
     pub tick_ns: Percentiles,
-    /// Median ns of the tick's parts: machine tick, trace sample, acyclic calls, event.
-    pub stage_p50_ns: [u64; 4],
+    /// The tick's parts, the overruns and the worst ticks.
+    pub latency: latency::Latency,
     /// How late a tick started after its deadline (real-time mode), ns.
     pub late_ns: Percentiles,
     /// Per channel.
@@ -260,6 +265,13 @@ pub fn main(args: RunArgs) -> ExitCode {
             print!("{}", report.render(args.diagnosis));
             if args.keep_diagnosis {
                 keep_diagnosis("cnc run", &options.instance, &report);
+            }
+            if let Some(path) = &args.latency_report {
+                if let Err(e) = std::fs::write(path, report.latency.full()) {
+                    eprintln!("cnc run: latency report {}: {e}", path.display());
+                    return ExitCode::from(1);
+                }
+                println!("latency report: {}", path.display());
             }
             if let Some(path) = &args.trace {
                 if let Err(e) = report.trace.save(path) {
@@ -342,6 +354,10 @@ fn run_machine(
     if let (false, Some(child)) = (options.lockstep, link.child.as_mut()) {
         wait_for_first_cycle(&link.segment, &link.events, child)?;
     }
+    // The PLC's client exists now: its segment is mapped here, not in tick 0's calls.
+    link.server
+        .connect()
+        .map_err(|e| format!("acyclic service: {e}"))?;
     let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
     let ticks = machine.ticks();
@@ -350,10 +366,12 @@ fn run_machine(
         plc_output.push_str(&wait_for_exit(child)?);
     }
     plc_output.push_str(&link.close(options, &ending, ticks, &bounds)?);
+    let cycle_ns = (scenario.cycle_s * 1e9).round() as u64;
+    let latency = latency::Latency::of(&measured, cycle_ns, !options.lockstep);
     Ok(RunReport {
         ticks,
         tick_ns: Percentiles::of(&mut measured.tick_ns),
-        stage_p50_ns: measured.stage_ns.map(|mut v| Percentiles::of(&mut v).p50),
+        latency,
         late_ns: if options.lockstep {
             Percentiles::default()
         } else {
@@ -536,10 +554,7 @@ impl RunReport {
                 out.push_str(&c.diagnosis);
             }
         }
-        let [machine, trace, acyclic, event] = self.stage_p50_ns;
-        out.push_str(&format!(
-            "tick parts p50: machine {machine} ns, trace {trace} ns, acyclic calls {acyclic} ns, tick-done event {event} ns\n"
-        ));
+        out.push_str(&self.latency.summary());
         out.push_str(&format!(
             "ticks {}; tick compute p50 {} ns, p99 {} ns, max {} ns; start lateness p50 {} ns, p99 {} ns, max {} ns; acyclic calls answered {}\n",
             self.ticks,

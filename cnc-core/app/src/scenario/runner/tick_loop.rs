@@ -84,6 +84,18 @@ pub(super) struct Measured {
 }
 
 impl Measured {
+    /// No trace and no samples (tests of what is computed from them).
+    #[cfg(test)]
+    pub(super) fn empty() -> Measured {
+        Measured {
+            trace: Trace::new(&[], 0),
+            tick_ns: Vec::new(),
+            late_ns: Vec::new(),
+            stage_ns: Default::default(),
+            acyclic_answered: 0,
+        }
+    }
+
     /// Room for `rows` ticks of `scenario`'s trace signals and timings.
     pub(super) fn new(scenario: &Scenario, rows: usize) -> Measured {
         Measured {
