@@ -111,41 +111,62 @@ pub fn main(cli: PlcCli) -> ExitCode {
 
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn run(args: PlcArgs) -> ExitCode {
-    let mut program: Box<dyn PlcProgram> = match (&args.timeline, args.program.as_str()) {
-        (Some(path), _) => match Timeline::load(path) {
+    let mut program: Box<dyn PlcProgram> = match &args.timeline {
+        Some(path) => match Timeline::load(path) {
             Ok(t) => Box::new(t),
             Err(e) => {
                 eprintln!("plc: {e}");
                 return ExitCode::from(2);
             }
         },
-        (None, "rotary-table") => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
-        (None, "turntable-hybrid") => Box::new(Turntable::new(Variant::Hybrid)),
-        (None, "turntable-plc-only") => Box::new(Turntable::new(Variant::PlcOnly)),
-        (None, "cam-conveyor") => Box::new(crate::programs::cam_conveyor::CamConveyor::new()),
-        (None, "fifo-stream") => match fifo_stream(&args) {
-            Ok(p) => Box::new(p),
+        None => match built_in(&args) {
+            Ok(p) => p,
             Err(e) => {
-                eprintln!("plc: fifo-stream: {e}");
+                eprintln!("plc: {e}");
                 return ExitCode::from(2);
             }
         },
-        (None, "saw-cut") => Box::new(crate::programs::saw_cut::SawCut::new(
-            args.saw_cuts,
-            args.saw_length,
-            args.saw_speed,
-        )),
-        (None, "demo-machine") => Box::new(crate::programs::demo_machine::DemoMachine::new(
-            args.saw_cuts,
-            args.saw_length,
-            args.saw_speed,
-        )),
-        (None, other) => {
-            eprintln!("plc: unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})");
-            return ExitCode::from(2);
-        }
     };
     host(program.as_mut(), &args.host)
+}
+
+/// The built-in program `args.program` with its arguments (the PLC process runs it; an
+/// in-process run of a scenario runs it in the CNC's process).
+pub fn built_in(args: &PlcArgs) -> Result<Box<dyn PlcProgram>, String> {
+    Ok(match args.program.as_str() {
+        "rotary-table" => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
+        "turntable-hybrid" => Box::new(Turntable::new(Variant::Hybrid)),
+        "turntable-plc-only" => Box::new(Turntable::new(Variant::PlcOnly)),
+        "cam-conveyor" => Box::new(crate::programs::cam_conveyor::CamConveyor::new()),
+        "fifo-stream" => Box::new(fifo_stream(args).map_err(|e| format!("fifo-stream: {e}"))?),
+        "saw-cut" => Box::new(crate::programs::saw_cut::SawCut::new(
+            args.saw_cuts,
+            args.saw_length,
+            args.saw_speed,
+        )),
+        "demo-machine" => Box::new(crate::programs::demo_machine::DemoMachine::new(
+            args.saw_cuts,
+            args.saw_length,
+            args.saw_speed,
+        )),
+        other => {
+            return Err(format!(
+                "unknown program {other:?} (known: {BUILT_IN_PROGRAMS:?})"
+            ))
+        }
+    })
+}
+
+/// The built-in program of a scenario's `[plc] program` and its arguments, as the PLC
+/// process would parse them.
+pub fn built_in_from(name: &str, extra: &[String]) -> Result<Box<dyn PlcProgram>, String> {
+    use clap::Parser;
+    let argv = ["plc", "--program", name]
+        .into_iter()
+        .map(str::to_string)
+        .chain(extra.iter().cloned());
+    let cli = PlcCli::try_parse_from(argv).map_err(|e| e.to_string())?;
+    built_in(&cli.run)
 }
 
 /// Attaches to the CNC `args` names and runs `program` until the CNC ends, is lost, a signal

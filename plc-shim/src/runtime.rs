@@ -91,6 +91,51 @@ impl<'a> PlcIo<'a> {
 /// heartbeat written over (hours of ticks at the shortest cycle).
 const MAX_TICKS_BETWEEN_WAKE_UPS: u64 = 1 << 32;
 
+/// When the task is due, on the CNC's heartbeat: a cycle every `period` ticks, and the slots
+/// a late PLC missed counted. Pure arithmetic on the heartbeat, so a heartbeat written over
+/// (one that went back, or leapt) can neither wrap the count nor stall the task.
+#[derive(Debug, Clone, Copy)]
+pub struct TaskSchedule {
+    period: u64,
+    /// 0 = "no tick seen yet": a tick the CNC finished before the loop started still gets its
+    /// cycle (lockstep waits for exactly that cycle).
+    last_beat: u64,
+    /// The tick at which the task is due next (None: at the next tick seen).
+    due: Option<u64>,
+}
+
+impl TaskSchedule {
+    /// A task every `period` ticks (at least 1).
+    pub fn new(period: u64) -> Self {
+        Self {
+            period: period.max(1),
+            last_beat: 0,
+            due: None,
+        }
+    }
+
+    /// A wake-up that found heartbeat `beat`: `None` when no new tick came; `Some(None)` when
+    /// the task is not due; `Some(Some(missed))` when it runs now, `missed` slots after the
+    /// one it was due at.
+    pub fn wake(&mut self, beat: u64) -> Option<Option<u64>> {
+        if beat == self.last_beat {
+            return None;
+        }
+        // A heartbeat that went back or leapt: the schedule starts over instead of waiting
+        // for a slot that never comes, or counting slots that never were.
+        if beat < self.last_beat || beat - self.last_beat > MAX_TICKS_BETWEEN_WAKE_UPS {
+            self.due = None;
+        }
+        self.last_beat = beat;
+        let slot = self.due.unwrap_or(beat);
+        if beat < slot {
+            return Some(None);
+        }
+        self.due = Some(beat.saturating_add(self.period));
+        Some(Some((beat - slot) / self.period))
+    }
+}
+
 /// Cycle durations up to this many microseconds are kept to the microsecond (longer ones
 /// count in the last bucket; the maximum is exact).
 const HISTOGRAM_US: usize = 2_000;
@@ -292,11 +337,7 @@ impl PlcRuntime {
                 wake_to_done,
             })
         };
-        // 0 = "no tick seen yet": a tick the CNC finished before this loop started still gets
-        // its cycle (lockstep waits for exactly that cycle).
-        let mut last_cnc_beat = 0;
-        // The tick at which the task is due next (None: at the first tick seen).
-        let mut due: Option<u64> = None;
+        let mut schedule = TaskSchedule::new(self.period_ticks);
         let mut wakeups = 0u64;
         loop {
             if max_cycles.is_some_and(|max| stats.cycles >= max) {
@@ -319,23 +360,12 @@ impl PlcRuntime {
                 }
                 return end(ended, stats, wake_to_done);
             }
-            if beat == last_cnc_beat {
+            let Some(step) = schedule.wake(beat) else {
                 continue; // woken without a new tick (timeout): no cycle
-            }
-            // A heartbeat that went back or leapt (written over between two ticks): the task
-            // starts its schedule over instead of waiting for a slot that never comes.
-            if beat < last_cnc_beat || beat - last_cnc_beat > MAX_TICKS_BETWEEN_WAKE_UPS {
-                due = None;
-            }
-            last_cnc_beat = beat;
-            let slot = due.unwrap_or(beat);
-            let ran = beat >= slot;
-            if ran {
-                // Slots that passed while the previous cycle (or this process) was late.
-                stats.overruns = stats
-                    .overruns
-                    .saturating_add((beat - slot) / self.period_ticks);
-                due = Some(beat.saturating_add(self.period_ticks));
+            };
+            let ran = step.is_some();
+            if let Some(missed) = step {
+                stats.overruns = stats.overruns.saturating_add(missed);
                 let mut io = PlcIo {
                     view: PlcView::new(self.segment.memory()),
                     memory: self.segment.memory(),
@@ -388,5 +418,36 @@ impl PlcRuntime {
             link: Link::NotOperational,
         };
         program.cycle(&mut io);
+    }
+}
+
+#[cfg(test)]
+mod schedule_tests {
+    use super::TaskSchedule;
+
+    #[test]
+    fn missed_slots_are_counted_and_a_heartbeat_written_over_never_wraps_the_count() {
+        let mut s = TaskSchedule::new(1);
+        assert_eq!(s.wake(1), Some(Some(0)));
+        assert_eq!(s.wake(1), None, "no new tick");
+        assert_eq!(s.wake(4), Some(Some(2)), "ticks 2 and 3 missed");
+        // Written over: a leap to near the end of the range, then back.
+        assert_eq!(s.wake(u64::MAX - 3), Some(Some(0)));
+        assert_eq!(s.wake(5), Some(Some(0)));
+        assert_eq!(s.wake(u64::MAX), Some(Some(0)));
+        assert_eq!(s.wake(u64::MAX - 1), Some(Some(0)));
+        let mut every_third = TaskSchedule::new(3);
+        let ran: Vec<u64> = (1..=10)
+            .filter(|&b| matches!(every_third.wake(b), Some(Some(_))))
+            .collect();
+        assert_eq!(ran, [1, 4, 7, 10]);
+        let mut total = 0u64;
+        let mut s = TaskSchedule::new(1);
+        for beat in [1, 2, u64::MAX, 3, u64::MAX / 2, 4, 1 << 40, 5] {
+            if let Some(Some(missed)) = s.wake(beat) {
+                total = total.saturating_add(missed);
+            }
+        }
+        assert_eq!(total, 0, "a corrupted heartbeat adds no overruns");
     }
 }

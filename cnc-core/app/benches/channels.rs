@@ -19,6 +19,8 @@
 //! hot (no sleep between ticks): the p50 of the machine tick over the whole run, timed per
 //! tick as `cnc run` times it, so the `machine` p50 that `cnc run` reports for them (after a
 //! 1 ms sleep each tick) compares with it like for like.
+//! And the demo's whole machine with its PLC program run in this process between the ticks
+//! (the in-process twin of `cnc demo`), its machine tick timed the same way.
 //! Run: `cargo bench -p cnc-app --bench channels`.
 
 use cnc_app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
@@ -219,7 +221,37 @@ fn main() {
         let (ticks, p50, p99) = demo_hot(name);
         println!("{name:>29} | {ticks:>5} | {p50:>19} | {p99:>6}");
     }
-    println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs)");
+    let (ticks, p50, p99) = demo_twin();
+    println!(
+        "{:>29} | {ticks:>5} | {p50:>19} | {p99:>6}",
+        "demo machine + its PLC program"
+    );
+    println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs; the demo's");
+    println!(" twin runs its PLC program in this process between the ticks, untimed: compare");
+    println!(" its p50 with the `machine` p50 of `cnc demo`'s report)");
+}
+
+/// The demo's whole machine with its PLC program (`demo-machine`) in this process, every
+/// machine tick timed: (ticks, p50 ns, p99 ns) of the last of 3 runs.
+fn demo_twin() -> (usize, u64, u64) {
+    let scenario = cnc_app::demo::scenario().expect("the demo scenario");
+    let ticks = scenario.ticks.unwrap_or(14_500) as usize;
+    let mut times = Vec::with_capacity(ticks);
+    for _ in 0..3 {
+        times.clear();
+        let mut run = InProcess::new(&scenario, 0).expect("in-process demo");
+        for _ in 0..ticks {
+            let t0 = Instant::now();
+            run.machine.tick(&run.memory);
+            times.push(t0.elapsed().as_nanos() as u64);
+            run.answer_calls();
+            run.run_program();
+            run.machine.serve_channels();
+        }
+    }
+    times.sort_unstable();
+    let at = |q: f64| times[((times.len() - 1) as f64 * q) as usize];
+    (times.len(), at(0.5), at(0.99))
 }
 
 /// One example scenario in-process, every tick timed: (ticks, p50 ns, p99 ns) of the

@@ -15,7 +15,7 @@ use cnc_core::machine::MachineSetup;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
 use hli::ImageMemory;
-use plc_shim::runtime::PlcIo;
+use plc_shim::runtime::{PlcIo, PlcProgram};
 use plc_shim::timeline::Timeline;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -79,6 +79,9 @@ pub struct InProcess {
     pub memory: ImageMemory,
     /// The PLC timeline, if the scenario has one.
     pub timeline: Option<Timeline>,
+    /// The scenario's built-in PLC program (`[plc] program`), run in this process: the
+    /// in-process twin of the PLC process.
+    pub program: Option<BuiltIn>,
     /// The trace.
     pub trace: Trace,
     /// The acyclic service of a timeline that calls blocks: the CNC's and the PLC's end.
@@ -87,28 +90,72 @@ pub struct InProcess {
     answered: u64,
 }
 
+/// A built-in PLC program run in the CNC's process.
+pub struct BuiltIn(pub Box<dyn PlcProgram>);
+
+impl core::fmt::Debug for BuiltIn {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("BuiltIn(PLC program)")
+    }
+}
+
 /// Numbers the acyclic services of in-process runs (several may run in one process).
 static IN_PROCESS_SERVICES: AtomicU32 = AtomicU32::new(0);
 
 impl InProcess {
+    /// A built-in program's cycle: the calls answered, then the program.
+    fn program_cycle(&mut self) {
+        self.answer_calls();
+        self.run_program();
+    }
+
+    /// Answers the acyclic calls the PLC side sent (between a tick and the PLC's cycle).
+    pub fn answer_calls(&mut self) {
+        let Some((server, _)) = self.acyclic.as_mut() else {
+            return;
+        };
+        let view = CncView::new(&self.memory);
+        let machine = &mut self.machine;
+        let calls = server.poll(|kind, request| machine.dispatch(&view, kind, request));
+        let rows = server.poll_rows(|_, header, values| machine.dispatch_bulk(header, values));
+        self.answered += (calls.unwrap_or(0) + rows.unwrap_or(0)) as u64;
+    }
+
+    /// One cycle of the built-in PLC program alone (the calls are answered before, by
+    /// [`InProcess::answer_calls`]); nothing without one.
+    pub fn run_program(&mut self) {
+        let (Some(program), Some((_, client))) = (self.program.as_mut(), self.acyclic.as_mut())
+        else {
+            return;
+        };
+        program.0.cycle(&mut PlcIo {
+            view: PlcView::new(&self.memory),
+            memory: &self.memory,
+            acyclic: client,
+            cycle: self.plc_cycles,
+            link: plc_shim::runtime::Link::Operational,
+        });
+        self.plc_cycles += 1;
+    }
+
     /// Sets up `scenario` on a heap image with room for `rows` trace rows. A built-in PLC
-    /// program is refused: those run only in the PLC process.
+    /// program runs in this process, with the acyclic service it would have in its own.
     pub fn new(scenario: &Scenario, rows: usize) -> Result<InProcess, ScenarioError> {
         let invalid = |message: String| ScenarioError::Invalid {
             file: scenario.name.clone(),
             message,
         };
-        let timeline = match &scenario.plc {
-            PlcSetup::None => None,
-            PlcSetup::Timeline { timeline, .. } => Some(Timeline::clone(timeline)),
-            PlcSetup::Program(p, _) => {
-                return Err(invalid(format!(
-                    "built-in PLC program {p:?} runs only in the PLC process"
-                )))
+        let (timeline, program) = match &scenario.plc {
+            PlcSetup::None => (None, None),
+            PlcSetup::Timeline { timeline, .. } => (Some(Timeline::clone(timeline)), None),
+            PlcSetup::Program(p, args) => {
+                let program = plc_shim::cli::built_in_from(p, args)
+                    .map_err(|e| invalid(format!("[plc] program {p:?}: {e}")))?;
+                (None, Some(BuiltIn(program)))
             }
         };
         let acyclic = match &timeline {
-            Some(t) if t.calls_blocks() => {
+            _ if program.is_some() => {
                 let instance = format!(
                     "inproc-{}-{}",
                     std::process::id(),
@@ -128,6 +175,7 @@ impl InProcess {
             machine,
             memory,
             timeline,
+            program,
             trace: Trace::new(&scenario.signals, rows),
             acyclic,
             plc_cycles: 0,
@@ -174,6 +222,9 @@ impl InProcess {
 
     /// The PLC's cycle after a tick, with the acyclic calls answered first.
     fn plc_cycle(&mut self) {
+        if self.program.is_some() {
+            return self.program_cycle();
+        }
         let Some(timeline) = self.timeline.as_mut() else {
             return;
         };

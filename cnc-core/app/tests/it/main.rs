@@ -29,6 +29,7 @@ mod cli_turntable;
 #[path = "../../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 mod demo;
+mod demo_twin;
 mod drive_inputs;
 mod fifo_engine;
 mod fifo_no_alloc;

@@ -187,8 +187,6 @@ impl<'a> TickLoop<'a> {
         } = link;
         // Ticks announced while the PLC started count as heartbeats already written.
         machine.start_heartbeat_at(segment.beats());
-        let start = monotonic::now();
-        let plc_seen = (segment.plc_heartbeat(), monotonic::now());
         let supervised = child.is_some();
         let log_stream = options
             .log_dir
@@ -202,6 +200,10 @@ impl<'a> TickLoop<'a> {
         );
         // Without a thread (the system refused one) programs load in place, between ticks.
         let loader = (!options.lockstep).then(|| Loader::spawn().ok()).flatten();
+        // Tick 0 is due once everything above is set up (threads started, files opened), so
+        // its lateness is the loop's, not the set-up's.
+        let start = monotonic::now();
+        let plc_seen = (segment.plc_heartbeat(), monotonic::now());
         TickLoop {
             scenario,
             options,
