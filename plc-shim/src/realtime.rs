@@ -1,5 +1,6 @@
 //! Real-time options of a cyclic process (the CNC's tick loop, the PLC's cycle): SCHED_FIFO
-//! priority, CPU pinning, locked memory with a pre-faulted stack, timer slack. They come from
+//! priority, CPU pinning, locked memory with a pre-faulted stack, timer slack, a bound on the
+//! CPUs' wake-up latency. They come from
 //! the machine configuration and from flags (flags win); each one the system refuses is left
 //! out with one warning, and the process runs on without it.
 
@@ -25,6 +26,10 @@ pub struct RealtimeOptions {
     /// Timer slack of the cyclic thread, ns (1 is the least).
     #[arg(long = "rt-timer-slack-ns")]
     pub timer_slack_ns: Option<u64>,
+    /// Hold every CPU's wake-up latency at most this many us (`/dev/cpu_dma_latency`, as
+    /// cyclictest does): no deep idle state delays the tick's wake-up.
+    #[arg(long = "rt-cpu-wake-latency-us")]
+    pub cpu_wake_latency_us: Option<u32>,
 }
 
 impl RealtimeOptions {
@@ -35,6 +40,21 @@ impl RealtimeOptions {
             cpu: self.cpu.or(file.cpu),
             lock_memory: self.lock_memory || file.lock_memory,
             timer_slack_ns: self.timer_slack_ns.or(file.timer_slack_ns),
+            cpu_wake_latency_us: self.cpu_wake_latency_us.or(file.cpu_wake_latency_us),
+        }
+    }
+
+    /// The options for the PLC process a CNC with these options spawns: one priority below
+    /// the CNC's thread (the tick comes first), the same memory lock and timer slack, no CPU
+    /// of its own (the scenario's `[realtime_plc]` can pin it).
+    pub fn for_plc(&self) -> RealtimeOptions {
+        RealtimeOptions {
+            priority: self.priority.map(|p| (p - 1).max(1)),
+            cpu: None,
+            lock_memory: self.lock_memory,
+            timer_slack_ns: self.timer_slack_ns,
+            // The CNC's request holds for the whole machine.
+            cpu_wake_latency_us: None,
         }
     }
 
@@ -57,6 +77,9 @@ impl RealtimeOptions {
         }
         if let Some(t) = self.timer_slack_ns {
             args.extend(["--rt-timer-slack-ns".to_string(), t.to_string()]);
+        }
+        if let Some(us) = self.cpu_wake_latency_us {
+            args.extend(["--rt-cpu-wake-latency-us".to_string(), us.to_string()]);
         }
         args
     }
@@ -84,6 +107,12 @@ impl RealtimeOptions {
             if let Some(ns) = self.timer_slack_ns {
                 attempt(format!("timer slack {ns} ns"), rt::set_timer_slack(ns));
             }
+            if let Some(us) = self.cpu_wake_latency_us {
+                attempt(
+                    format!("CPU wake-up latency <= {us} us"),
+                    rt::hold_cpu_wake_latency(us),
+                );
+            }
             if let Some(cpu) = self.cpu {
                 attempt(format!("CPU {cpu}"), rt::pin_to_cpu(cpu));
             }
@@ -110,6 +139,7 @@ mod tests {
             cpu: Some(1),
             lock_memory: false,
             timer_slack_ns: Some(1000),
+            cpu_wake_latency_us: Some(0),
         };
         let flags = RealtimeOptions {
             priority: Some(80),
@@ -128,7 +158,9 @@ mod tests {
                 "--rt-cpu",
                 "1",
                 "--rt-timer-slack-ns",
-                "1000"
+                "1000",
+                "--rt-cpu-wake-latency-us",
+                "0"
             ]
         );
     }

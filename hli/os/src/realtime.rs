@@ -56,6 +56,22 @@ pub fn set_timer_slack(nanoseconds: u64) -> io::Result<()> {
     })
 }
 
+/// Asks the kernel to keep every CPU's wake-up latency at most `microseconds` (PM QoS: the
+/// value written to `/dev/cpu_dma_latency`, held while the file stays open): no deep idle
+/// state whose exit delays a timer's wake-up. `cyclictest` does the same by default. The file
+/// stays open until the process ends.
+pub fn hold_cpu_wake_latency(microseconds: u32) -> io::Result<()> {
+    use std::io::Write;
+    static HELD: std::sync::OnceLock<std::fs::File> = std::sync::OnceLock::new();
+    let mut file = std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/cpu_dma_latency")?;
+    file.write_all(&(microseconds as i32).to_ne_bytes())?;
+    // A second request keeps the first file (and its value) open.
+    let _ = HELD.set(file);
+    Ok(())
+}
+
 /// Touches `bytes` of stack below the caller, so that (with locked memory) the stack the
 /// tick will use is mapped before it runs.
 pub fn prefault_stack(bytes: usize) {

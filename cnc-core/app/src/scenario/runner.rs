@@ -627,7 +627,13 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
             command.args(["--program", p]).args(args);
         }
     }
-    command.args(scenario.realtime_plc.to_args());
+    // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC.
+    command.args(
+        scenario
+            .realtime_plc
+            .over(&options.realtime.for_plc())
+            .to_args(),
+    );
     command
         .stdout(Stdio::piped())
         .stdin(Stdio::null())
