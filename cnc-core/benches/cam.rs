@@ -16,6 +16,16 @@ use std::time::Instant;
 const EVALS: usize = 1_000_000;
 const REPEATS: usize = 9;
 
+/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
+/// runs to its end; its figures mean nothing then.
+fn scaled(full: usize) -> usize {
+    if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
+        (full / 1000).max(1)
+    } else {
+        full
+    }
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -140,10 +150,10 @@ fn main() {
     );
     let mut ours: Vec<Vec<f64>> = vec![Vec::new(); cases.len()];
     let mut base: Vec<Vec<f64>> = vec![Vec::new(); cases.len()];
-    for _ in 0..REPEATS {
+    for _ in 0..scaled(REPEATS) {
         for (i, (_, profile, r)) in cases.iter().enumerate() {
-            ours[i].push(sweep(profile, EVALS));
-            base[i].push(sweep_binary_search(r, EVALS));
+            ours[i].push(sweep(profile, scaled(EVALS)));
+            base[i].push(sweep_binary_search(r, scaled(EVALS)));
         }
     }
     for (i, (name, _, _)) in cases.iter().enumerate() {
@@ -162,9 +172,9 @@ fn main() {
         .unwrap(),
     );
     let (o, b) = (
-        median((0..REPEATS).map(|_| sweep(&t, 5_000)).collect()),
+        median((0..scaled(REPEATS)).map(|_| sweep(&t, 5_000)).collect()),
         median(
-            (0..REPEATS)
+            (0..scaled(REPEATS))
                 .map(|_| sweep_binary_search(&r, 5_000))
                 .collect(),
         ),

@@ -133,7 +133,12 @@ fn main() {
     let rounds: usize = std::env::var("NC_BENCH_ROUNDS")
         .ok()
         .and_then(|r| r.parse().ok())
-        .unwrap_or(7);
+        // CNC_BENCH_SMOKE=1 (CI): one round, to show the bench runs; no figure is meant.
+        .unwrap_or(if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
+            1
+        } else {
+            7
+        });
     let tries = if rounds == 1 { 1 } else { 3 };
     let src = program();
     let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();

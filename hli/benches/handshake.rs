@@ -376,8 +376,18 @@ fn main() {
     }
     hli::init_logging();
     let quick = std::env::args().any(|a| a == "--quick");
-    let repeats = if quick { 3 } else { 5 };
-    let (poll_count, event_count) = if quick {
+    // CNC_BENCH_SMOKE=1 (CI): one short repeat, to show the bench runs; no figure is meant.
+    let smoke = std::env::var_os("CNC_BENCH_SMOKE").is_some();
+    let repeats = if smoke {
+        1
+    } else if quick {
+        3
+    } else {
+        5
+    };
+    let (poll_count, event_count) = if smoke {
+        (500, 100)
+    } else if quick {
         (20_000, 3_000)
     } else {
         (200_000, 20_000)

@@ -38,6 +38,16 @@ const TICKS: usize = 5_000;
 const REPEATS: usize = 9;
 const WARM_UP: usize = 3_000;
 
+/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
+/// runs to its end; its figures mean nothing then.
+fn scaled(full: usize) -> usize {
+    if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
+        (full / 1000).max(1)
+    } else {
+        full
+    }
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     v[v.len() / 2]
@@ -46,17 +56,17 @@ fn median(mut v: Vec<f64>) -> f64 {
 /// One sample: ns per tick over TICKS ticks.
 fn sample(tick: &mut dyn FnMut()) -> f64 {
     let t0 = Instant::now();
-    for _ in 0..TICKS {
+    for _ in 0..scaled(TICKS) {
         tick();
     }
-    t0.elapsed().as_nanos() as f64 / TICKS as f64
+    t0.elapsed().as_nanos() as f64 / scaled(TICKS) as f64
 }
 
 /// Median ns per tick of each contender, the repeats interleaved (contender 1, 2, .., 1, 2,
 /// ..) so a slow phase of the machine hits all of them alike.
 fn interleaved(contenders: &mut [Box<dyn FnMut() + '_>]) -> Vec<f64> {
-    let mut samples = vec![Vec::with_capacity(REPEATS); contenders.len()];
-    for _ in 0..REPEATS {
+    let mut samples = vec![Vec::with_capacity(scaled(REPEATS)); contenders.len()];
+    for _ in 0..scaled(REPEATS) {
         for (c, tick) in contenders.iter_mut().enumerate() {
             samples[c].push(sample(tick.as_mut()));
         }
@@ -237,7 +247,7 @@ fn demo_twin() -> (usize, u64, u64) {
     let scenario = cnc_app::demo::scenario().expect("the demo scenario");
     let ticks = scenario.ticks.unwrap_or(14_500) as usize;
     let mut times = Vec::with_capacity(ticks);
-    for _ in 0..3 {
+    for _ in 0..scaled(3) {
         times.clear();
         let mut run = InProcess::new(&scenario, 0).expect("in-process demo");
         for _ in 0..ticks {
@@ -263,7 +273,7 @@ fn demo_hot(name: &str) -> (usize, u64, u64) {
         .join("scenario.toml");
     let scenario = Scenario::load(&path).expect("example scenario");
     let mut times = Vec::with_capacity(20_000);
-    for _ in 0..REPEATS {
+    for _ in 0..scaled(REPEATS) {
         times.clear();
         let mut run = InProcess::new(&scenario, 0).expect("in-process run");
         while times.len() < 100_000 && (times.len() < 10 || !run.machine.idle()) {

@@ -80,7 +80,12 @@ fn main() {
     let rounds: usize = std::env::var("NC_CHECK_ROUNDS")
         .ok()
         .and_then(|r| r.parse().ok())
-        .unwrap_or(9);
+        // CNC_BENCH_SMOKE=1 (CI): one round, to show the bench runs; no figure is meant.
+        .unwrap_or(if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
+            1
+        } else {
+            9
+        });
     let body = body();
     let dir = std::env::temp_dir();
     let ours = dir.join(format!("nc-check-{}.nc", std::process::id()));
