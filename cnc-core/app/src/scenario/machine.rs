@@ -155,7 +155,7 @@ impl InProcess {
             }
         };
         let acyclic = match &timeline {
-            _ if program.is_some() => {
+            _ if program.is_some() || timeline.as_ref().is_some_and(Timeline::calls_blocks) => {
                 let instance = format!(
                     "inproc-{}-{}",
                     std::process::id(),
