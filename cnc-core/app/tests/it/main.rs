@@ -25,6 +25,7 @@ mod cli_restart;
 mod cli_run;
 mod cli_saw;
 mod cli_supervision;
+mod cli_syscalls;
 mod cli_turntable;
 #[path = "../../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
