@@ -134,11 +134,13 @@ fn main() {
         .ok()
         .and_then(|r| r.parse().ok())
         // CNC_BENCH_SMOKE=1 (CI): one round, to show the bench runs; no figure is meant.
-        .unwrap_or(if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
-            1
-        } else {
-            7
-        });
+        .unwrap_or(
+            if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
+                1
+            } else {
+                7
+            },
+        );
     let tries = if rounds == 1 { 1 } else { 3 };
     let src = program();
     let axes: Vec<String> = ["X", "Y", "Z", "A", "B", "C"].map(String::from).to_vec();

@@ -377,7 +377,7 @@ fn main() {
     hli::init_logging();
     let quick = std::env::args().any(|a| a == "--quick");
     // CNC_BENCH_SMOKE=1 (CI): one short repeat, to show the bench runs; no figure is meant.
-    let smoke = std::env::var_os("CNC_BENCH_SMOKE").is_some();
+    let smoke = std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1");
     let repeats = if smoke {
         1
     } else if quick {

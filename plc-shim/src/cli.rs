@@ -204,7 +204,14 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
                 summary.end
             );
             println!("plc: task {}", summary.stats);
-            println!("plc: wake-up to done {}", summary.wake_to_done);
+            let w = &summary.wake_to_done;
+            println!(
+                "plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us",
+                w.cycles,
+                w.quantile_us(0.5),
+                w.quantile_us(0.99),
+                w.max_ns as f64 / 1e3
+            );
             println!("{}", program.summary());
             runtime.detach();
             match summary.end {

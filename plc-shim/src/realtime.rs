@@ -49,7 +49,7 @@ impl RealtimeOptions {
     /// of its own (the scenario's `[realtime_plc]` can pin it).
     pub fn for_plc(&self) -> RealtimeOptions {
         RealtimeOptions {
-            priority: self.priority.map(|p| (p - 1).max(1)),
+            priority: self.priority.map(|p| p.saturating_sub(1).max(1)),
             cpu: None,
             lock_memory: self.lock_memory,
             timer_slack_ns: self.timer_slack_ns,

@@ -81,11 +81,13 @@ fn main() {
         .ok()
         .and_then(|r| r.parse().ok())
         // CNC_BENCH_SMOKE=1 (CI): one round, to show the bench runs; no figure is meant.
-        .unwrap_or(if std::env::var_os("CNC_BENCH_SMOKE").is_some() {
-            1
-        } else {
-            9
-        });
+        .unwrap_or(
+            if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
+                1
+            } else {
+                9
+            },
+        );
     let body = body();
     let dir = std::env::temp_dir();
     let ours = dir.join(format!("nc-check-{}.nc", std::process::id()));

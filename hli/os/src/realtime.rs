@@ -66,7 +66,8 @@ pub fn hold_cpu_wake_latency(microseconds: u32) -> io::Result<()> {
     let mut file = std::fs::OpenOptions::new()
         .write(true)
         .open("/dev/cpu_dma_latency")?;
-    file.write_all(&(microseconds as i32).to_ne_bytes())?;
+    let value = i32::try_from(microseconds).unwrap_or(i32::MAX);
+    file.write_all(&value.to_ne_bytes())?;
     // A second request keeps the first file (and its value) open.
     let _ = HELD.set(file);
     Ok(())

@@ -84,7 +84,8 @@ pub struct InProcess {
     pub program: Option<BuiltIn>,
     /// The trace.
     pub trace: Trace,
-    /// The acyclic service of a timeline that calls blocks: the CNC's and the PLC's end.
+    /// The acyclic service of a timeline that calls blocks or of a built-in program: the CNC's
+    /// and the PLC's end.
     acyclic: Option<(AcyclicServer, AcyclicClient)>,
     plc_cycles: u64,
     answered: u64,

@@ -355,9 +355,10 @@ fn run_machine(
         wait_for_first_cycle(&link.segment, &link.events, child)?;
     }
     // The PLC's client exists now: its segment is mapped here, not in tick 0's calls.
-    link.server
-        .connect()
-        .map_err(|e| format!("acyclic service: {e}"))?;
+    // A warm-up only: a connection that fails now is tried again by every poll.
+    if let Err(e) = link.server.connect() {
+        eprintln!("cnc run: acyclic service: connecting before tick 0: {e}");
+    }
     let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
     let ticks = machine.ticks();
@@ -631,7 +632,7 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
     command.args(
         scenario
             .realtime_plc
-            .over(&options.realtime.for_plc())
+            .over(&options.realtime.over(&scenario.realtime).for_plc())
             .to_args(),
     );
     command
