@@ -18,7 +18,7 @@ use hli::layout::{HliChannelCommand, CONTROL_MESSAGE_LEN, PROGRAM_NAME_LEN};
 
 /// Work a channel asks the machine to do between ticks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Pending {
+pub(super) enum Pending {
     /// Load and check a program from the folder; start at a source line (0: the first block).
     Select {
         /// The file name.
@@ -141,11 +141,6 @@ impl Channel {
     /// Programs that ran to their end since the CNC started.
     pub fn programs_ended(&self) -> u32 {
         self.plc.outputs.control.programs_ended
-    }
-
-    /// Work for the machine between ticks, if any ([`Channel::serve`]).
-    pub fn pending(&self) -> Option<Pending> {
-        self.control.pending
     }
 
     /// Whether [`Channel::serve`] has something to do: pending work, or the text of a new

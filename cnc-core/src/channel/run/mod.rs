@@ -33,7 +33,6 @@ mod safety;
 mod tool;
 mod transition;
 
-pub use control::Pending;
 pub use error::{ChannelError, ChannelFault};
 pub use safety::ResetError;
 
