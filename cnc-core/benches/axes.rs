@@ -147,7 +147,7 @@ fn main() {
     }
     let worst = holding.max(moving).max(retarget);
     println!(
-        "target <= 500 ns per axis-tick: worst case {worst:.1} ns -> {}",
+        "TARGET | <= 500 ns per axis-tick, worst case | {worst:.1} ns | {}",
         if worst <= 500.0 { "met" } else { "MISSED" }
     );
 }

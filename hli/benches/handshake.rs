@@ -436,17 +436,17 @@ fn main() {
     let hli_event = get(Method::HliEvent);
     let iox_event = get(Method::Iox2Event);
     println!(
-        "target polling p50 <= 2x floor: {:.2}x -> {}",
+        "TARGET | HLI polling handshake p50 <= 2x the flag ping-pong floor | {:.2}x | {}",
         hli_poll / floor,
         verdict(hli_poll <= 2.0 * floor)
     );
     println!(
-        "target polling >= 2x faster than iceoryx2 pub-sub: {:.2}x -> {}",
+        "TARGET | HLI polling handshake >= 2x faster than iceoryx2 pub-sub | {:.2}x | {}",
         pubsub / hli_poll,
         verdict(pubsub >= 2.0 * hli_poll)
     );
     println!(
-        "target event-woken within 1.5x of iceoryx2 event ping-pong: {:.2}x -> {}",
+        "TARGET | HLI event-woken handshake within 1.5x of iceoryx2 event ping-pong | {:.2}x | {}",
         hli_event / iox_event,
         verdict(hli_event <= 1.5 * iox_event)
     );

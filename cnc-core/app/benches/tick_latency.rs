@@ -51,10 +51,11 @@ fn number(text: &str, anchor: &str, key: &str) -> Option<f64> {
         .ok()
 }
 
-/// `cnc run` of `path` for `ticks`, with the real-time options when `rt`.
-fn cnc(path: &Path, ticks: u64, rt: bool) -> Option<Figures> {
+/// `cnc run` of `path` for `ticks` of `cycle_us`, with the real-time options when `rt`.
+fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32) -> Option<Figures> {
     let mut c = Command::new(env!("CARGO_BIN_EXE_cnc"));
     c.args(["run", path.to_str()?, "--ticks", &ticks.to_string()]);
+    c.args(["--cycle-ms", &(f64::from(cycle_us) / 1000.0).to_string()]);
     c.args([
         "--instance",
         &format!("bench-latency-{}", std::process::id()),
@@ -81,13 +82,14 @@ fn cnc(path: &Path, ticks: u64, rt: bool) -> Option<Figures> {
     })
 }
 
-/// (p50, p99) latency in us from cyclictest's histogram, `None` when it is not installed.
-fn cyclictest(loops: u64, rt: bool) -> Option<Figures> {
+/// (p50, p99) latency in us from cyclictest's histogram (every `interval_us`), `None`
+/// when it is not installed.
+fn cyclictest(loops: u64, rt: bool, interval_us: u32) -> Option<Figures> {
     let mut c = Command::new("cyclictest");
     c.args([
         "-m",
         "-i",
-        "1000",
+        &interval_us.to_string(),
         "-l",
         &loops.to_string(),
         "-q",
@@ -127,8 +129,8 @@ fn cyclictest(loops: u64, rt: bool) -> Option<Figures> {
         }
         10_000.0
     };
-    // Wake-ups later than a whole cycle: what makes a 1 ms task miss its slot on this
-    // machine, whatever runs in it (shown in the overruns column).
+    // Wake-ups later than a whole cycle: what makes a task of this cycle miss its slot on
+    // this machine, whatever runs in it (shown in the overruns column).
     let overflows = text
         .lines()
         .find_map(|l| l.strip_prefix("# Histogram Overflows:"))
@@ -136,7 +138,7 @@ fn cyclictest(loops: u64, rt: bool) -> Option<Figures> {
         .unwrap_or(0);
     let late_cycles = histogram
         .iter()
-        .filter(|(us, _)| *us >= 1000.0)
+        .filter(|(us, _)| *us >= f64::from(interval_us))
         .map(|h| h.1)
         .sum::<u64>()
         + overflows;
@@ -148,10 +150,10 @@ fn cyclictest(loops: u64, rt: bool) -> Option<Figures> {
 }
 
 fn main() {
-    let (rounds, demo_ticks, ex4_ticks) = if smoke() {
-        (1, 300, 300)
+    let (rounds, demo_ticks, ex4_ticks, fast_ticks) = if smoke() {
+        (1, 300, 300, 300)
     } else {
-        (5, 14_500, 5_000)
+        (5, 14_500, 5_000, 20_000)
     };
     let present = Command::new("cyclictest").arg("--help").output().is_ok();
     if !present {
@@ -166,17 +168,21 @@ fn main() {
         "demo, default scheduler",
         "example 4, real-time options",
         "example 4, default scheduler",
+        "cyclictest -m -p 80 -i 250",
+        "example 4 at 250 us, real-time options",
     ];
     let mut rows: Vec<Vec<Figures>> = vec![Vec::new(); names.len()];
     for _ in 0..rounds {
         if present {
-            rows[0].extend(cyclictest(demo_ticks, true));
-            rows[1].extend(cyclictest(demo_ticks, false));
+            rows[0].extend(cyclictest(demo_ticks, true, 1000));
+            rows[1].extend(cyclictest(demo_ticks, false, 1000));
+            rows[6].extend(cyclictest(fast_ticks, true, 250));
         }
-        rows[2].extend(cnc(&demo, demo_ticks, true));
-        rows[3].extend(cnc(&demo, demo_ticks, false));
-        rows[4].extend(cnc(&ex4, ex4_ticks, true));
-        rows[5].extend(cnc(&ex4, ex4_ticks, false));
+        rows[2].extend(cnc(&demo, demo_ticks, true, 1000));
+        rows[3].extend(cnc(&demo, demo_ticks, false, 1000));
+        rows[4].extend(cnc(&ex4, ex4_ticks, true, 1000));
+        rows[5].extend(cnc(&ex4, ex4_ticks, false, 1000));
+        rows[7].extend(cnc(&ex4, fast_ticks, true, 250));
     }
     println!("tick start lateness (us), cycle 1 ms, medians of {rounds} interleaved rounds; demo {demo_ticks} ticks, example 4 {ex4_ticks}");
     println!(
@@ -196,7 +202,7 @@ fn main() {
             plc_overruns: m(|r| r.plc_overruns),
         };
         med[i] = Some(f);
-        if i < 2 {
+        if rows_of_cyclictest(i) {
             println!(
                 "{name:<40} {:>8.1} {:>8.1} {:>12} {:>12} {:>13.0}",
                 f.late.0, f.late.1, "", "", f.plc_overruns
@@ -208,27 +214,71 @@ fn main() {
             );
         }
     }
-    let ratio = |a: Option<Figures>, b: Option<Figures>| match (a, b) {
-        (Some(a), Some(b)) => format!("{:.2}", a.late.1 / b.late.1),
-        _ => "-".into(),
+    targets(&med);
+}
+
+/// Rows 0, 1 and 6 are cyclictest's.
+fn rows_of_cyclictest(i: usize) -> bool {
+    matches!(i, 0 | 1 | 6)
+}
+
+/// One `TARGET` line per target, from the medians of the rows.
+fn targets(med: &[Option<Figures>]) {
+    let verdict = |ok: bool| match (smoke(), ok) {
+        (true, _) => "smoke run, no figure meant",
+        (false, true) => "met",
+        (false, false) => "MISSED",
     };
-    println!("targets (ratios in this run):");
-    println!(
-        "  demo RT start lateness p99 / cyclictest -p 80 p99: {} (target <= 1.5)",
-        ratio(med[2], med[0])
-    );
-    println!(
-        "  demo default p99 / cyclictest (no priority) p99: {} (target <= 1.5)",
-        ratio(med[3], med[1])
-    );
-    if let Some(f) = med[2] {
+    let lateness = |what: &str, ours: usize, peer: usize| match (med[ours], med[peer]) {
+        (Some(a), Some(b)) => {
+            let r = a.late.1 / b.late.1;
+            println!(
+                "TARGET | {what} | {r:.2} ({:.1} / {:.1} us) | {}",
+                a.late.1,
+                b.late.1,
+                verdict(r <= 1.5)
+            );
+        }
+        (Some(_), None) => {
+            println!("TARGET | {what} | - | skipped: cyclictest (rt-tests) not installed")
+        }
+        _ => println!("TARGET | {what} | - | MISSED: the run gave no figures"),
+    };
+    let rest = |what: &str, row: usize| {
+        let Some(f) = med[row] else {
+            println!(
+                "TARGET | {what}: tick compute p99 <= 3x p50 | - | MISSED: the run gave no figures"
+            );
+            return;
+        };
+        let r = f.compute.1 / f.compute.0;
         println!(
-            "  demo RT tick compute p99 / p50: {:.2} (target <= 3)",
-            f.compute.1 / f.compute.0
+            "TARGET | {what}: tick compute p99 <= 3x p50 | {r:.2} ({:.1} / {:.1} us) | {}",
+            f.compute.1,
+            f.compute.0,
+            verdict(r <= 3.0)
         );
         println!(
-            "  demo RT PLC overruns (median per run): {:.0} (target 0)",
-            f.plc_overruns
+            "TARGET | {what}: 0 PLC overruns | {:.0} per run (median) | {}",
+            f.plc_overruns,
+            verdict(f.plc_overruns == 0.0)
         );
-    }
+    };
+    lateness(
+        "demo RT start lateness p99 <= 1.5x cyclictest -p 80 p99",
+        2,
+        0,
+    );
+    lateness(
+        "demo default start lateness p99 <= 1.5x cyclictest --laptop p99",
+        3,
+        1,
+    );
+    rest("demo RT", 2);
+    lateness(
+        "example 4 at 250 us RT start lateness p99 <= 1.5x cyclictest -p 80 -i 250 p99",
+        7,
+        6,
+    );
+    rest("example 4 at 250 us RT", 7);
 }

@@ -297,15 +297,19 @@ fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
     }
 }
 
+/// A tick cycle in ms that a machine may have: 0.05..=100.
+pub fn check_cycle_ms(cycle_ms: f64) -> Result<(), String> {
+    if cycle_ms.is_finite() && (0.05..=100.0).contains(&cycle_ms) {
+        Ok(())
+    } else {
+        Err(format!("cycle_ms = {cycle_ms}: must lie in 0.05..=100"))
+    }
+}
+
 impl ScenarioFile {
     /// The cycle time and the number of channels (and that there is a machine at all).
     fn check_shape(&self) -> Result<(), String> {
-        if !(self.cycle_ms.is_finite() && (0.05..=100.0).contains(&self.cycle_ms)) {
-            return Err(format!(
-                "cycle_ms = {}: must lie in 0.05..=100",
-                self.cycle_ms
-            ));
-        }
+        check_cycle_ms(self.cycle_ms)?;
         let no_machine = self.channel.is_empty() && self.axis.is_empty();
         if no_machine || self.channel.len() > cnc_core::channel::MAX_CHANNELS {
             return Err(format!(

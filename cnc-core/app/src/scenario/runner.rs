@@ -52,6 +52,10 @@ pub struct RunArgs {
     /// Run exactly N ticks (channels that finish earlier stay idle).
     #[arg(long)]
     pub ticks: Option<u64>,
+    /// The tick cycle in ms, over the scenario's `cycle_ms` (0.05..=100); the PLC follows
+    /// the cycle the CNC announces.
+    #[arg(long)]
+    pub cycle_ms: Option<f64>,
     /// Lockstep mode: tick N waits for the PLC's cycle; runs are reproducible bit for bit.
     #[arg(long)]
     pub lockstep: bool,
@@ -238,13 +242,20 @@ pub struct RunReport {
 
 /// `cnc run`.
 pub fn main(args: RunArgs) -> ExitCode {
-    let scenario = match Scenario::load(&args.scenario) {
+    let mut scenario = match Scenario::load(&args.scenario) {
         Ok(s) => s,
         Err(e) => {
             eprintln!("cnc run: {e}");
             return ExitCode::from(2);
         }
     };
+    if let Some(ms) = args.cycle_ms {
+        if let Err(e) = super::file::check_cycle_ms(ms) {
+            eprintln!("cnc run: --cycle-ms: {e}");
+            return ExitCode::from(2);
+        }
+        scenario.cycle_s = ms * 1e-3;
+    }
     let instance = args
         .instance
         .clone()

@@ -46,3 +46,48 @@ fn unknown_realtime_keys_are_refused() {
         "{e}"
     );
 }
+
+#[test]
+fn the_cycle_is_set_on_the_command_line_and_checked() {
+    let scenario = tests::cli::scenario("axes-plcopen");
+    let scratch = tests::Scratch::new("cycle-ms");
+    let trace = scratch.join("trace.csv");
+    let run = |cycle: &str| {
+        let instance = tests::unique_instance("cycle");
+        Cli::new(env!("CARGO_BIN_EXE_cnc"))
+            .args(["run", scenario.to_str().unwrap(), "--lockstep"])
+            .args([
+                "--ticks",
+                "100",
+                "--instance",
+                &instance,
+                "--cycle-ms",
+                cycle,
+            ])
+            .arg("--trace")
+            .arg(&trace)
+            .output()
+            .unwrap()
+    };
+    let out = run("0.25");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    // The trace's time column steps by 250 us.
+    let text = std::fs::read_to_string(&trace).unwrap();
+    let times: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
+        .collect();
+    assert!(
+        (times[2] - times[1] - 0.00025).abs() < 1e-9,
+        "{:?}",
+        &times[..3]
+    );
+    for bad in ["0", "nan", "1000"] {
+        let out = run(bad);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--cycle-ms {bad}: {stderr}");
+        assert!(stderr.contains("--cycle-ms: cycle_ms = "), "{stderr}");
+    }
+}
