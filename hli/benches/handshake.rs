@@ -1,6 +1,7 @@
 //! Cross-process round-trip benchmark of the HLI handshakes against peers measured in the same
 //! run: a plain cache-line flag ping-pong (the floor), iceoryx2 publish-subscribe, an iceoryx2
-//! event ping-pong and a Unix-domain socket. Every method moves a 32-byte
+//! event ping-pong, a Unix-domain socket and a futex word in the segment (the wake-up
+//! alternatives: a sleeping side woken by iceoryx2's event, by a socket, or by `futex(2)`). Every method moves a 32-byte
 //! `HLI_COORDINATE_SYSTEM_INT` there and back (the flag floor moves a counter).
 //!
 //! Run: `cargo bench -p hli --bench handshake` (add `-- --quick` for a short run).
@@ -15,6 +16,7 @@ use iceoryx2::prelude::*;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
 const PEER_ENV: &str = "HLI_BENCH_PEER";
@@ -28,16 +30,18 @@ enum Method {
     Uds,
     HliEvent,
     Iox2Event,
+    Futex,
 }
 
 impl Method {
-    const ALL: [Method; 6] = [
+    const ALL: [Method; 7] = [
         Method::Flag,
         Method::HliPoll,
         Method::Iox2PubSub,
         Method::Uds,
         Method::HliEvent,
         Method::Iox2Event,
+        Method::Futex,
     ];
     fn name(self) -> &'static str {
         match self {
@@ -47,6 +51,7 @@ impl Method {
             Method::Uds => "Unix socket ping-pong",
             Method::HliEvent => "HLI command+request, event-woken",
             Method::Iox2Event => "iceoryx2 event ping-pong",
+            Method::Futex => "futex word in the segment, ping-pong",
         }
     }
     fn key(self) -> &'static str {
@@ -57,6 +62,7 @@ impl Method {
             Method::Uds => "uds",
             Method::HliEvent => "hli-event",
             Method::Iox2Event => "iox2-event",
+            Method::Futex => "futex",
         }
     }
     fn from_key(key: &str) -> Option<Self> {
@@ -166,6 +172,17 @@ fn peer_main(method: Method, name: &str, count: usize) {
                 stream.write_all(&buf).unwrap();
             }
         }
+        Method::Futex => {
+            let mem = PlcSegment::attach(name).expect("attach");
+            let ping = mem.memory().place::<u32>(FLAG_PING).atomic();
+            let pong = mem.memory().place::<u32>(FLAG_PONG).atomic();
+            ready();
+            for i in 1..=total as u32 {
+                futex_await(ping, i);
+                pong.store(i, Ordering::Release);
+                cnc_os::futex::wake(pong, 1).unwrap();
+            }
+        }
         Method::Iox2Event => {
             let link = EventLink::open(name, Side::Plc).unwrap();
             ready();
@@ -177,6 +194,17 @@ fn peer_main(method: Method, name: &str, count: usize) {
                 }
             }
         }
+    }
+}
+
+/// Sleeps on the futex `word` until it holds `value`.
+fn futex_await(word: &AtomicU32, value: u32) {
+    loop {
+        let seen = word.load(Ordering::Acquire);
+        if seen == value {
+            return;
+        }
+        cnc_os::futex::wait(word, seen, Duration::from_millis(10)).unwrap();
     }
 }
 
@@ -325,6 +353,21 @@ fn measure(method: Method, count: usize, tag: &str) -> Vec<u64> {
             child.wait().unwrap();
             let _ = std::fs::remove_file(&path);
         }
+        Method::Futex => {
+            let segment = CncSegment::create(&name, 1, 1).unwrap();
+            let mut child = spawn_peer(method, &name, count);
+            let ping = segment.memory().place::<u32>(FLAG_PING).atomic();
+            let pong = segment.memory().place::<u32>(FLAG_PONG).atomic();
+            for i in 0..total {
+                let v = i as u32 + 1;
+                let t0 = Instant::now();
+                ping.store(v, Ordering::Release);
+                cnc_os::futex::wake(ping, 1).unwrap();
+                futex_await(pong, v);
+                record(&mut samples, i, t0);
+            }
+            child.wait().unwrap();
+        }
         Method::Iox2Event => {
             let link = EventLink::open(&name, Side::Cnc).unwrap();
             let mut child = spawn_peer(method, &name, count);
@@ -449,5 +492,14 @@ fn main() {
         "TARGET | HLI event-woken handshake within 1.5x of iceoryx2 event ping-pong | {:.2}x | {}",
         hli_event / iox_event,
         verdict(hli_event <= 1.5 * iox_event)
+    );
+    let futex = get(Method::Futex);
+    println!(
+        "wake-up alternatives, p50 round trip: futex word {:.1} us, iceoryx2 event {:.1} us, Unix socket {:.1} us, polling {:.1} us (futex / iceoryx2 event {:.2}x)",
+        futex / 1e3,
+        iox_event / 1e3,
+        get(Method::Uds) / 1e3,
+        hli_poll / 1e3,
+        futex / iox_event
     );
 }

@@ -284,6 +284,15 @@ impl<T: AtomicLeaf> Place<'_, T> {
     }
 }
 
+impl<'m> Place<'m, u32> {
+    /// The word as an atomic for as long as the image lives: a futex word that both
+    /// processes wait on and wake.
+    pub fn atomic(self) -> &'m AtomicU32 {
+        // SAFETY: as in `AtomicLeaf::load_at` for u32; the mapping outlives `'m`.
+        unsafe { AtomicU32::from_ptr(self.address().cast()) }
+    }
+}
+
 impl Place<'_, u64> {
     /// Atomic increment (heartbeats); returns the new value.
     pub fn increment(self) -> u64 {

@@ -1,8 +1,9 @@
 //! The operating-system calls the CNC and PLC processes make that have nothing to do with the
 //! interface between them: a sleep to an absolute CLOCK_MONOTONIC deadline ([`monotonic`]),
 //! transparent-huge-page advice for large buffers ([`advise_huge_pages`]), a child process's
-//! peak memory ([`wait_with_peak_memory`]) and the real-time settings of a thread
-//! ([`realtime`]: SCHED_FIFO, CPU pinning, locked memory, timer slack, stack pre-faulting).
+//! peak memory ([`wait_with_peak_memory`]), the real-time settings of a thread
+//! ([`realtime`]: SCHED_FIFO, CPU pinning, locked memory, timer slack, stack pre-faulting) and
+//! a futex word shared between processes ([`futex`]).
 //!
 //! Each is a thin, safe wrapper around one or two system calls. The crate is, beside
 //! `hli::raw` (the shared image memory), the only place of the workspace where `unsafe` code
@@ -11,6 +12,9 @@
 
 #![deny(unsafe_code)]
 
+#[cfg(target_os = "linux")]
+#[allow(unsafe_code)]
+pub mod futex;
 #[allow(unsafe_code)]
 mod memory;
 #[allow(unsafe_code)]

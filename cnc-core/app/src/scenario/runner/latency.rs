@@ -5,8 +5,17 @@
 use super::tick_loop::Measured;
 use crate::stats::Percentiles;
 
-/// The tick's parts as the loop times them.
-pub const PARTS: [&str; 4] = ["machine", "trace", "acyclic calls", "tick-done event"];
+/// The tick's parts as the loop times them: the four up to "tick done" (the tick's compute
+/// time), then the loop's work after it until it sleeps for the next tick (the channels'
+/// log stream and program service, the header check, the PLC watch, the signal check),
+/// which delays the next tick when it runs long.
+pub const PARTS: [&str; 5] = [
+    "machine",
+    "trace",
+    "acyclic calls",
+    "tick-done event",
+    "after tick done",
+];
 /// How many of the worst ticks the report keeps.
 pub const WORST: usize = 10;
 
@@ -20,7 +29,10 @@ pub struct WorstTick {
     /// Its compute time, ns.
     pub compute_ns: u64,
     /// Its parts ([`PARTS`]), ns.
-    pub parts_ns: [u64; 4],
+    pub parts_ns: [u64; 5],
+    /// The previous tick's work after "tick done", ns: when it ran long, it is why this tick
+    /// started late.
+    pub before_ns: u64,
 }
 
 impl WorstTick {
@@ -38,7 +50,7 @@ pub struct Latency {
     /// Ticks measured.
     pub ticks: u64,
     /// Each part of the tick.
-    pub parts: [Percentiles; 4],
+    pub parts: [Percentiles; 5],
     /// Ticks that finished after the next tick's deadline (start lateness + compute > cycle).
     pub overruns: u64,
     /// The worst ticks by finish time after their deadline, worst first.
@@ -63,6 +75,10 @@ impl Latency {
             late_ns: late(i),
             compute_ns: measured.tick_ns[i],
             parts_ns: core::array::from_fn(|k| measured.stage_ns[k].get(i).copied().unwrap_or(0)),
+            before_ns: i
+                .checked_sub(1)
+                .and_then(|p| measured.stage_ns[4].get(p).copied())
+                .unwrap_or(0),
         };
         let mut order: Vec<usize> = (0..n).collect();
         order.sort_by_key(|&i| std::cmp::Reverse(tick(i).finish_ns()));
@@ -129,16 +145,16 @@ impl Latency {
             out.push_str(&format!("| {name} | {} | {} | {} |\n", p.p50, p.p99, p.max));
         }
         out.push_str(&format!(
-            "\nticks that overran their cycle: {} ({:.3} %)\n\n## The {} worst ticks (by finish after their deadline)\n\n| tick | late ns | compute ns | machine | trace | acyclic | event |\n|---:|---:|---:|---:|---:|---:|---:|\n",
+            "\nticks that overran their cycle: {} ({:.3} %)\n\n## The {} worst ticks (by finish after their deadline)\n\n| tick | late ns | after the previous tick | compute ns | machine | trace | acyclic | event | after this tick |\n|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
             self.overruns,
             self.overrun_percent(),
             self.worst.len()
         ));
         for w in &self.worst {
-            let [m, t, a, e] = w.parts_ns;
+            let [m, t, a, e, after] = w.parts_ns;
             out.push_str(&format!(
-                "| {} | {} | {} | {m} | {t} | {a} | {e} |\n",
-                w.tick, w.late_ns, w.compute_ns
+                "| {} | {} | {} | {} | {m} | {t} | {a} | {e} | {after} |\n",
+                w.tick, w.late_ns, w.before_ns, w.compute_ns
             ));
         }
         out
@@ -146,10 +162,10 @@ impl Latency {
 }
 
 fn render_tick(w: &WorstTick) -> String {
-    let [m, t, a, e] = w.parts_ns;
+    let [m, t, a, e, after] = w.parts_ns;
     format!(
-        "{}: late {} ns, compute {} ns (machine {m}, trace {t}, acyclic {a}, event {e})",
-        w.tick, w.late_ns, w.compute_ns
+        "{}: late {} ns (the previous tick's work after tick done {} ns), compute {} ns (machine {m}, trace {t}, acyclic {a}, event {e}); after tick done {after} ns",
+        w.tick, w.late_ns, w.before_ns, w.compute_ns
     )
 }
 
@@ -173,7 +189,12 @@ mod tests {
         assert_eq!(l.overruns, 2, "900 + 200 and 2000 + 10 pass 1000");
         assert_eq!(l.parts[0].max, 50);
         assert!(l.summary().contains("warning: more than 0.1 %"));
-        assert!(l.full().contains("| 3 | 2000 | 10 |"));
+        assert!(l.full().contains("| 3 | 2000 | 16 | 10 |"), "{}", l.full());
+        assert_eq!(
+            l.worst[0].before_ns,
+            50 / 4 + 4,
+            "tick 2's work after tick done"
+        );
         let lockstep = Latency::of(&m, 1_000, false);
         assert_eq!(lockstep.overruns, 0);
         assert!(!lockstep.summary().contains("warning"));

@@ -77,8 +77,8 @@ pub(super) struct Measured {
     /// How late each tick started after its deadline, ns.
     pub(super) late_ns: Vec<u64>,
     /// Where a tick's time goes: machine tick, trace sample, acyclic calls, "tick done"
-    /// event.
-    pub(super) stage_ns: [Vec<u64>; 4],
+    /// event, and the loop's work after it ([`super::latency::PARTS`]).
+    pub(super) stage_ns: [Vec<u64>; 5],
     /// Acyclic calls answered.
     pub(super) acyclic_answered: u64,
 }
@@ -108,14 +108,15 @@ impl Measured {
     }
 
     /// One tick's timings: `t` are the instants before the machine tick, the trace sample,
-    /// the acyclic calls and the event, and after the event.
-    fn push(&mut self, t: [Duration; 5], deadline: Duration) {
-        let [t0, t1, t2, t3, t4] = t;
+    /// the acyclic calls and the event, after the event, and after the loop's work that
+    /// follows it.
+    fn push(&mut self, t: [Duration; 6], deadline: Duration) {
+        let [t0, t1, t2, t3, t4, t5] = t;
         self.tick_ns.push((t4 - t0).as_nanos() as u64);
         for (stage, (a, b)) in
             self.stage_ns
                 .iter_mut()
-                .zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)])
+                .zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4), (t4, t5)])
         {
             stage.push((b - a).as_nanos() as u64);
         }
@@ -243,7 +244,7 @@ impl<'a> TickLoop<'a> {
             }
             let deadline = self.start + self.bounds.period * (tick as u32);
             self.pace(tick, deadline);
-            self.step(tick, deadline, memory, &view);
+            let [t0, t1, t2, t3, t4] = self.step(tick, memory, &view);
             // Supervision, between ticks: the PLC's heartbeat (real time; lockstep waits on
             // it before the tick), its process now and then, and termination requests.
             if self.ending.stop.is_none() {
@@ -256,7 +257,10 @@ impl<'a> TickLoop<'a> {
                     self.watch_plc(tick);
                 }
             }
-            if tick % 16 == 0 && self.take_signal(tick) {
+            let end_now = tick % 16 == 0 && self.take_signal(tick);
+            let t5 = monotonic::now();
+            self.measured.push([t0, t1, t2, t3, t4, t5], deadline);
+            if end_now {
                 break;
             }
         }
@@ -333,8 +337,8 @@ impl<'a> TickLoop<'a> {
     }
 
     /// Tick `tick`: the machine, the trace sample, the acyclic calls, "tick done", the
-    /// switching log handed on, the timings.
-    fn step(&mut self, tick: u64, deadline: Duration, memory: &ImageMemory, view: &CncView<'_>) {
+    /// switching log handed on; the instants before each part and after the event.
+    fn step(&mut self, tick: u64, memory: &ImageMemory, view: &CncView<'_>) -> [Duration; 5] {
         let t0 = monotonic::now();
         self.machine.tick(memory);
         let t1 = monotonic::now();
@@ -365,8 +369,8 @@ impl<'a> TickLoop<'a> {
             Some(loader) => self.machine.serve_channels_with(loader),
             None => self.machine.serve_channels(),
         };
-        self.measured.push([t0, t1, t2, t3, t4], deadline);
         self.counter.set(tick + 1);
+        [t0, t1, t2, t3, t4]
     }
 
     /// Real time, after tick `tick`: a PLC whose heartbeat stood still for the watchdog's
