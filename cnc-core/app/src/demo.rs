@@ -61,8 +61,15 @@ const FILES: &[(&str, &str)] = embed!(
 
 /// The embedded machine.
 pub fn scenario() -> Result<Scenario, ScenarioError> {
+    scenario_with("")
+}
+
+/// The embedded machine with `extra` appended to its scenario file (more axes, a FIFO group:
+/// the tests that load the whole machine further).
+pub fn scenario_with(extra: &str) -> Result<Scenario, ScenarioError> {
     let (main, text) = FILES[0];
-    Scenario::parse(&format!("{NAME}/{main}"), text, |relative| {
+    let text = format!("{text}\n{extra}");
+    Scenario::parse(&format!("{NAME}/{main}"), &text, |relative| {
         FILES
             .iter()
             .find(|(file, _)| *file == relative)
