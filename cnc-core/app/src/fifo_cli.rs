@@ -23,7 +23,7 @@ use hli::calls::fifo::{
 use hli::calls::{decode_reply, AcyclicCall};
 use hli::enums::FifoGroupState;
 use hli::layout::HliFifoGroupState;
-use hli::layout::{FIFO_FLAG_AT_END, FIFO_OVERRIDE_FULL};
+use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN, FIFO_OVERRIDE_FULL};
 use hli::views::{CncView, PlcView};
 use std::io::Write;
 use std::path::PathBuf;
@@ -63,14 +63,26 @@ pub struct FifoRunArgs {
     trace: Option<PathBuf>,
 }
 
+/// Exit code of a run whose rows end in motion: the group held the last row with an
+/// underrun (the axes stopped with a velocity step), the trace written.
+pub const EXIT_ENDS_IN_MOTION: u8 = 3;
+
 /// Runs `cnc fifo`: exit 0, 1 when the group refused the file or a parameter, 2 when the file
-/// cannot be read.
+/// cannot be read, 3 ([`EXIT_ENDS_IN_MOTION`]) when the rows end in motion.
 pub fn main(command: FifoCommand) -> ExitCode {
     let FifoCommand::Run(args) = command;
     match run(&args) {
-        Ok(summary) => {
+        Ok((summary, None)) => {
             println!("{summary}");
             ExitCode::SUCCESS
+        }
+        Ok((summary, Some(end))) => {
+            println!("{summary}");
+            eprintln!(
+                "cnc fifo: the rows end in motion: the FIFO ran dry at tick {} and the group holds the last row (underrun); velocity step {:.6} units/s on axis {}",
+                end.tick, end.step, end.axis
+            );
+            ExitCode::from(EXIT_ENDS_IN_MOTION)
         }
         Err(Failure::File(e)) => {
             eprintln!("cnc fifo: {e}");
@@ -106,7 +118,22 @@ fn refused(what: &str, code: u32) -> Failure {
     Failure::Refused(format!("{what}: refused with 0x{code:X} {name}"))
 }
 
-fn run(args: &FifoRunArgs) -> Result<String, Failure> {
+/// A job whose rows ended in motion: the tick the FIFO ran dry, the largest velocity step of
+/// the hold and its axis.
+struct MotionEnd {
+    tick: u64,
+    axis: usize,
+    step: f64,
+}
+
+/// How the job ended: its ticks, the group's underrun ticks, and whether in motion.
+struct JobEnd {
+    ticks: u64,
+    underrun_ticks: u32,
+    in_motion: Option<MotionEnd>,
+}
+
+fn run(args: &FifoRunArgs) -> Result<(String, Option<MotionEnd>), Failure> {
     let (n, rows) = plc_shim::fifo_file::RowReader::open(&args.rows)
         .and_then(|r| r.read_all())
         .map_err(|e| Failure::File(e.to_string()))?;
@@ -128,12 +155,18 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
         return Err(refused("FiFoStart", code));
     }
     let mut trace = trace_header(n);
-    let (ticks, underrun_ticks) = run_job(args, &mut machine, &memory, &mut feed, &mut trace)?;
+    let ended = run_job(args, &mut machine, &memory, &mut feed, &mut trace);
+    // The trace is written however the job ended: it shows why.
     if let Some(path) = &args.trace {
         std::fs::File::create(path)
             .and_then(|mut f| f.write_all(trace.as_bytes()))
             .map_err(|e| Failure::File(format!("{}: {e}", path.display())))?;
     }
+    let JobEnd {
+        ticks,
+        underrun_ticks,
+        in_motion,
+    } = ended?;
     let last: Vec<String> = (0..n)
         .map(|i| {
             let p = machine
@@ -144,7 +177,7 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
             format!("{:.4}", p + 0.0)
         })
         .collect();
-    Ok(format!(
+    let summary = format!(
         "fifo: {} rows x {n} axes, T_f {} s, tick {} s, override {} %: {ticks} ticks ({:.3} s), {underrun_ticks} underrun ticks, end at [{}]",
         feed.total,
         args.tf,
@@ -152,7 +185,8 @@ fn run(args: &FifoRunArgs) -> Result<String, Failure> {
         args.override_percent,
         ticks as f64 * args.cycle,
         last.join(", ")
-    ))
+    );
+    Ok((summary, in_motion))
 }
 
 /// The override and the tick, checked.
@@ -287,21 +321,44 @@ fn trace_header(n: usize) -> String {
     trace
 }
 
-/// Ticks the machine until the job ends at rest, refilling the FIFO and tracing each tick;
-/// the ticks run and the group's underrun ticks.
+/// The set-point velocities of the first `n` axes.
+fn velocities(machine: &Machine, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| {
+            machine
+                .axes()
+                .axis(i)
+                .map_or(0.0, |a| a.setpoint().velocity)
+        })
+        .collect()
+}
+
+/// The largest velocity change from `before` to `after`, and its axis.
+fn largest_step(before: &[f64], after: &[f64]) -> (usize, f64) {
+    before
+        .iter()
+        .zip(after)
+        .map(|(b, a)| (a - b).abs())
+        .enumerate()
+        .fold((0, 0.0), |w, (i, d)| if d > w.1 { (i, d) } else { w })
+}
+
+/// Ticks the machine until the job ends at rest, or in motion when every row is written and
+/// the FIFO ran dry (the group holds the last row), refilling the FIFO and tracing each tick.
 fn run_job(
     args: &FifoRunArgs,
     machine: &mut Machine,
     memory: &hli::ImageMemory,
     feed: &mut RowFeed<'_>,
     trace: &mut String,
-) -> Result<(u64, u32), Failure> {
+) -> Result<JobEnd, Failure> {
     // Watchdog: twice the job's duration at the override, plus the PT-2's settling.
     let job = feed.total as f64 * args.tf / (args.override_percent / 100.0);
     let limit = (2.0 * job / args.cycle) as u64 + 100_000;
     let plc = PlcView::new(memory);
     let mut ticks = 0u64;
     let mut underrun_ticks;
+    let mut before = velocities(machine, feed.n);
     loop {
         machine.tick(memory);
         ticks += 1;
@@ -319,6 +376,21 @@ fn run_job(
         if feed.written == feed.total && at_end {
             break;
         }
+        let dry = s.flags_r & FIFO_FLAG_UNDERRUN != 0 && s.entries_r <= 1;
+        if feed.written == feed.total && dry {
+            let (axis, step) = largest_step(&before, &velocities(machine, feed.n));
+            let in_motion = Some(MotionEnd {
+                tick: ticks,
+                axis,
+                step,
+            });
+            return Ok(JobEnd {
+                ticks,
+                underrun_ticks,
+                in_motion,
+            });
+        }
+        before = velocities(machine, feed.n);
         // Whenever a quarter of the FIFO is free, as a PLC would refill it.
         if s.free_r as usize >= (args.fifo_rows / 4).max(1)
             || feed.total - feed.written <= s.free_r as usize
@@ -331,7 +403,11 @@ fn run_job(
             )));
         }
     }
-    Ok((ticks, underrun_ticks))
+    Ok(JobEnd {
+        ticks,
+        underrun_ticks,
+        in_motion: None,
+    })
 }
 
 /// One trace line at `time`: the group's fill and override, each axis's set-point and

@@ -279,3 +279,39 @@ fn the_fifo_blocks_from_a_timeline_run_alike_in_one_and_two_processes() {
         x.last().unwrap()
     );
 }
+
+/// `cnc fifo run` with rows that end at speed: the group holds the last row with an underrun,
+/// the run ends there with exit 3, says so with the velocity step, and writes the trace.
+#[test]
+fn cnc_fifo_run_with_rows_that_end_in_motion_ends_and_says_so() {
+    let dir = Scratch::new("cli-fifo-in-motion");
+    let csv = dir.join("ramp.csv");
+    // X climbs 0.1 per row of T_f = 2 ms (50 units/s) to its last row; Y half as fast.
+    let mut text = String::from("x,y\n");
+    for k in 0..200 {
+        text.push_str(&format!("{},{}\n", 0.1 * k as f64, 0.05 * k as f64));
+    }
+    std::fs::write(&csv, text).unwrap();
+    let trace = dir.join("trace.csv");
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["fifo", "run", "--rows", csv.to_str().unwrap()])
+        .args(["--tf", "0.002", "--cycle", "0.001", "--trace"])
+        .arg(&trace)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("the rows end in motion")
+            && stderr.contains("velocity step 50.0000")
+            && stderr.contains("on axis 0"),
+        "{stderr}"
+    );
+    let t = Trace::read(&trace);
+    let x = t.column("a0_position");
+    let v = t.column("a0_velocity");
+    // Ended at the first tick of the hold, not after a long wait: the job's 199 row spans.
+    assert!(t.rows.len() < 450, "{} ticks", t.rows.len());
+    assert!((x[x.len() - 1] - 19.9).abs() < 1e-9, "held at the last row");
+    assert!((v[v.len() - 2] - 50.0).abs() < 1e-6 && v[v.len() - 1] == 0.0);
+}

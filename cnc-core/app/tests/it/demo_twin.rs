@@ -151,7 +151,10 @@ fn every_engine_at_once_the_machine_tick_allocates_nothing() {
     assert!(summary.contains("saw-cut: Finished, 5 cuts"), "{summary}");
     assert!(summary.contains("cam-conveyor: Finished"), "{summary}");
     let group = PlcView::new(&run.memory).fifo_group(0).unwrap();
-    assert!(next >= 7_000, "the FIFO streamed a row every 2 ticks: {next}");
+    assert!(
+        next >= 7_000,
+        "the FIFO streamed a row every 2 ticks: {next}"
+    );
     assert_eq!(
         group.underrun_ticks_r, 0,
         "the FIFO never ran dry while fed"
