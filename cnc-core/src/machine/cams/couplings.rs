@@ -260,6 +260,8 @@ impl CamEngine {
         };
         axes.drive(lease, held, AxisState::SlavePrephase);
         let timing = ask.activation.timing().expect("checked: a timed mode");
+        // A new coupling: the last one's state, kept after a fault, is no longer the slave's.
+        self.lost[slave] = None;
         self.slaves[slave] = Some(Slave {
             lease,
             master: ask.master,
@@ -408,6 +410,9 @@ impl CamEngine {
         if slave >= axes.len() {
             return Err(ErrorCode::InvalidTarget);
         }
+        // A coupling lost to a fault counts as coupled until this decoupling (seed 000
+        // 5.1.15: MC_CamInfo before decoupling); MC_CamInfo reads nothing after it.
+        let was_lost = self.lost[slave].take().is_some();
         let multi = self.multis[slave].as_ref().map(|m| m.lease);
         if let Some(lease) = multi.filter(|l| axes.holds(*l)) {
             self.multis[slave] = None;
@@ -415,6 +420,9 @@ impl CamEngine {
             return accepted();
         }
         let Some(state) = self.slaves[slave].take().filter(|s| axes.holds(s.lease)) else {
+            if was_lost {
+                return accepted();
+            }
             return code(CamCouplingError::NotCamCoupled.raw());
         };
         axes.release(state.lease);

@@ -197,6 +197,10 @@ pub struct CamEngine {
     /// rows.
     declared: Vec<Option<(u32, u32, u32, u32)>>,
     slaves: Vec<Option<Slave>>,
+    /// Per axis: the last valid coupling of a slave that lost it without MC_CamOut (a fault,
+    /// an emergency stop, power off), which MC_CamInfo still reads (seed 000 5.1.15: the
+    /// recovery after an emergency stop); dropped by the next MC_CamIn or MC_CamOut.
+    lost: Vec<Option<Slave>>,
     /// Profiles replaced or released in a tick, freed between ticks (no free in the tick).
     retired: Vec<CamProfile>,
     /// Motion functions a point change replaced, with their change records, freed alike.
@@ -268,10 +272,20 @@ impl CamEngine {
             data_balance: Balance::default(),
             declared: vec![None; TABLE_SLOTS],
             slaves: (0..axes).map(|_| None).collect(),
+            lost: (0..axes).map(|_| None).collect(),
             // Room for every retirement between two calls: each slave lost (two profiles), a
             // switch per slave, a point change per table in use.
             retired: Vec::with_capacity(4 * axes + 8),
             retired_changes: Vec::with_capacity(2 * axes + 8),
+        }
+    }
+
+    /// Keeps slave `i`'s coupling, lost without MC_CamOut, for MC_CamInfo: a move, no
+    /// allocation (an older lost coupling of the axis, if any, is retired).
+    fn keep_lost(&mut self, i: usize, gone: Slave) {
+        if let Some(old) = self.lost[i].replace(gone) {
+            self.retired.extend(old.own);
+            self.retired.extend(old.switch_own);
         }
     }
 
@@ -395,8 +409,7 @@ impl CamEngine {
         let master = master_of(axes, state.master, state.follow_actual);
         let (true, Some(master)) = (still, master) else {
             if let Some(gone) = self.slaves[i].take() {
-                self.retired.extend(gone.own);
-                self.retired.extend(gone.switch_own);
+                self.keep_lost(i, gone);
             }
             return;
         };
@@ -625,10 +638,11 @@ impl Engine for CamEngine {
         for multi in self.multis.iter_mut().filter_map(Option::take) {
             axes.release(multi.lease);
         }
-        for state in self.slaves.iter_mut().filter_map(Option::take) {
-            axes.release(state.lease);
-            self.retired.extend(state.own);
-            self.retired.extend(state.switch_own);
+        for i in 0..self.slaves.len() {
+            if let Some(state) = self.slaves[i].take() {
+                axes.release(state.lease);
+                self.keep_lost(i, state);
+            }
         }
     }
 }

@@ -186,14 +186,22 @@ impl CamEngine {
         call: &CamReadCall,
         axes: &AxisSet,
     ) -> Result<Vec<f64>, u32> {
-        let Some(s) = self.slaves.get(slave).and_then(Option::as_ref) else {
-            return Err(CamCouplingError::NotCamCoupled.raw());
+        let coupled = self.slaves.get(slave).and_then(Option::as_ref);
+        // After a fault, the last valid state: at the master position of the last tick the
+        // coupling ran (seed 000 5.1.15).
+        let lost = self.lost.get(slave).and_then(Option::as_ref);
+        let (s, master_now) = match (coupled, lost) {
+            (Some(s), _) => {
+                let now = axes
+                    .axis(s.master)
+                    .map_or(s.master_before, |a| a.setpoint().position);
+                (s, now)
+            }
+            (None, Some(s)) => (s, s.master_before),
+            (None, None) => return Err(CamCouplingError::NotCamCoupled.raw()),
         };
         let stored = self.store.get(s.table).map_err(|_| TABLE_INVALID)?;
         let profile = s.own.as_ref().unwrap_or(stored);
-        let master_now = axes
-            .axis(s.master)
-            .map_or(s.master_before, |a| a.setpoint().position);
         let at = if call.flags & 1 != 0 {
             if !call.a.is_finite() {
                 return Err(CamCouplingError::BadParameter.raw());

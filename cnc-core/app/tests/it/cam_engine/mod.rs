@@ -17,6 +17,7 @@ use std::path::PathBuf;
 
 mod data;
 mod modes;
+mod recovery;
 
 const MASTER: usize = 0;
 const SLAVE: usize = 1;
