@@ -53,6 +53,10 @@ pub enum MultiTableError {
     /// The table is not one of the coupling's, or not of the kind the command needs.
     #[error("table {0} is not a {1} of this coupling")]
     NotInCoupling(u32, &'static str),
+    /// The table is active (a profile table whose range holds the master, a running
+    /// correction): its scaling is set before it becomes active, never while it is.
+    #[error("table {0} is active: its scaling is set before it becomes active")]
+    Active(u32),
 }
 
 /// Refuses in a table's weight NaN, a weight not above 0, a master slope of 0 and RL not below
@@ -192,6 +196,50 @@ impl MultiTableLaw {
     /// The tables of the coupling.
     pub fn tables(&self) -> impl Iterator<Item = u32> + '_ {
         self.entries.iter().flatten().map(|e| e.table)
+    }
+
+    /// Whether `table` is active now: a profile table whose range holds the master's last
+    /// position, or a correction that runs or starts with the next tick.
+    pub fn is_active(&self, table: u32) -> bool {
+        let m = self.master_before;
+        self.entries.iter().flatten().any(|e| {
+            e.table == table
+                && if e.profile {
+                    e.w.range_low <= m && m < e.w.range_high
+                } else {
+                    matches!(e.run, Run::Starting | Run::Running)
+                }
+        })
+    }
+
+    /// CamTableSetWeight on `table` of the running coupling: its new scaling, taken when it
+    /// becomes active (seed 000 4.6.3: the scaling is set before a table becomes active; a
+    /// correction keeps the open range the NC gives it). Refused with nothing changed while
+    /// the table is active, or when it is not one of the coupling's.
+    pub fn set_weight(&mut self, table: u32, w: TableWeight) -> Result<(), MultiTableError> {
+        check_weight(&w)?;
+        if self.is_active(table) {
+            return Err(MultiTableError::Active(table));
+        }
+        let mut found = false;
+        for e in self
+            .entries
+            .iter_mut()
+            .flatten()
+            .filter(|e| e.table == table)
+        {
+            let (low, high) = (e.w.range_low, e.w.range_high);
+            e.w = w;
+            if !e.profile {
+                (e.w.range_low, e.w.range_high) = (low, high);
+            }
+            found = true;
+        }
+        if found {
+            Ok(())
+        } else {
+            Err(MultiTableError::NotInCoupling(table, "table"))
+        }
     }
 
     /// Starts correction `table`: at once (`at` None) or when the master passes `at`.

@@ -294,3 +294,64 @@ fn coupled_outside_every_range_the_slave_stands_where_it_stood() {
     let p = law.slave(&s, &at(50.0));
     assert_eq!((p.position, p.velocity), (7.5, 0.0));
 }
+
+/// Seed 000 4.6.3/4.6.4: scale, then activate. While the cyclic work table runs, the stop
+/// table (not active yet) takes a new slave slope, and the hand-over runs it with that slope;
+/// the active work table's scaling is refused with nothing changed.
+#[test]
+fn a_table_not_yet_active_takes_its_scaling_and_the_active_one_refuses_it() {
+    let s = store();
+    let stop = TableWeight {
+        range_low: 1e12,
+        ..TableWeight::default()
+    };
+    let mut law = MultiTableLaw::new(
+        &[
+            spec(&s, 2, true, true, TableWeight::default()),
+            spec(&s, 4, true, false, stop),
+            spec(&s, 3, false, false, TableWeight::default()),
+        ],
+        0.0,
+        0.0,
+    )
+    .unwrap();
+    for pm in 0..250 {
+        law.slave(&s, &at(f64::from(pm)));
+    }
+    assert!(law.is_active(2) && !law.is_active(4) && !law.is_active(3));
+    let steeper = TableWeight {
+        slave_slope: 2.0,
+        ..stop
+    };
+    assert_eq!(law.set_weight(2, steeper), Err(MultiTableError::Active(2)));
+    law.set_weight(4, steeper).unwrap();
+    // A correction that has not started takes its scaling too; a running one refuses it.
+    law.set_weight(3, TableWeight::default()).unwrap();
+    law.enable_correction(3, None).unwrap();
+    assert_eq!(
+        law.set_weight(3, TableWeight::default()),
+        Err(MultiTableError::Active(3))
+    );
+    assert_eq!(
+        law.set_weight(9, TableWeight::default()),
+        Err(MultiTableError::NotInCoupling(9, "table"))
+    );
+    // Without the correction's effect: compare the slave's rise over the stop table.
+    law.stop_cyclic(2).unwrap();
+    let mut pm = 250.0;
+    let mut at_boundary = None;
+    while pm < 400.0 {
+        pm += 1.0;
+        let p = law.slave(&s, &at(pm)).position;
+        if pm == 300.0 {
+            at_boundary = Some(p);
+        }
+    }
+    let end = law.slave(&s, &at(400.0)).position;
+    // The stop table, 0..50 -> 0..5, now at slave slope 2: it adds 10, not 5.
+    let rise = end - at_boundary.unwrap();
+    assert!(
+        (rise - 10.0).abs() < 1e-9,
+        "rise over the stop table {rise}"
+    );
+}

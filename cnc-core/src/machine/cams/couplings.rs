@@ -292,14 +292,16 @@ impl CamEngine {
         if check_weight(&w).is_err() {
             return code(CamCouplingError::BadParameter.raw());
         }
-        // The seed: weights are set before a table becomes active, not while it is.
-        if self
-            .multis
-            .iter()
-            .flatten()
-            .any(|m| m.law.tables().any(|t| t == id))
-        {
+        // The seed (000 4.6.3): a table's scaling is set before it becomes active, never
+        // while it is; a table of a running coupling that is not active yet takes it.
+        if self.multis.iter().flatten().any(|m| m.law.is_active(id)) {
             return code(CamCouplingError::TableInUse.raw());
+        }
+        for m in self.multis.iter_mut().flatten() {
+            // Only the couplings that have the table (checked and not active: no refusal).
+            if m.law.tables().any(|t| t == id) {
+                let _ = m.law.set_weight(id, w);
+            }
         }
         self.weights[id as usize] = w;
         accepted()

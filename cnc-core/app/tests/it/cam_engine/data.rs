@@ -484,3 +484,64 @@ fn a_transfer_cut_between_chunks_by_a_lost_plc_is_dropped_with_the_stop() {
         "the new table couples"
     );
 }
+
+/// Seed 000 4.6.3/4.6.4, "scale, then activate", through the engine: while the multi-table
+/// scenario's work table runs, CamTableSetWeight doubles the stop table's slave slope (the
+/// stop table is not active yet: accepted) and is refused for the work table (active: 0x4268,
+/// nothing changed). The stop table then adds 20 instead of 10, and the feeder stands at 200.
+#[test]
+fn a_multi_table_coupling_takes_the_scaling_of_a_table_not_yet_active() {
+    use hli::calls::cam::CamTableWeightCall;
+    let s = Scenario::load(&scenarios().join("cam-multi-table/scenario.toml")).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..3000 {
+        run.step(s.cycle_s);
+    }
+    let pm = set(&run, MASTER).position;
+    assert!(
+        pm > 150.0 && pm < 400.0,
+        "the work table runs: line at {pm}"
+    );
+    let steeper = CamTableWeightCall {
+        slave_slope: 2.0,
+        range_low: 100_000.0,
+        range_high: 200_000.0,
+        ..CamTableWeightCall::default()
+    };
+    let weight = |run: &mut InProcess, table: u32, w: &CamTableWeightCall| {
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, table, w)).error_id
+    };
+    assert_eq!(
+        weight(&mut run, 13, &steeper),
+        0,
+        "the stop table, not active yet"
+    );
+    let work = CamTableWeightCall {
+        slave_slope: 3.0,
+        ..CamTableWeightCall::default()
+    };
+    assert_eq!(
+        weight(&mut run, 12, &work),
+        CamCouplingError::TableInUse.raw()
+    );
+    for _ in 3000..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let pm = set(&run, MASTER).position;
+        let f = set(&run, SLAVE).position;
+        // The work table as before (its scaling kept), the stop table at slope 0.4 per unit.
+        if (400.0..500.0).contains(&pm) {
+            assert!(
+                (f - (20.0 + 0.4 * (pm - 100.0))).abs() < 1e-9,
+                "line {pm}: {f}"
+            );
+        }
+        if (500.0..550.0).contains(&pm) {
+            assert!(
+                (f - (180.0 + 0.4 * (pm - 500.0))).abs() < 1e-9,
+                "line {pm}: {f}"
+            );
+        }
+    }
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    assert_eq!(set(&run, SLAVE).position, 200.0);
+}
