@@ -240,7 +240,9 @@ hli_enum! {
         NoSuchMaster = 0x4260,
         /// The master is the slave itself.
         MasterIsSlave = 0x4261,
-        /// Activation, start and scaling mode do not go together (seed 5.1.16.13/14).
+        /// Activation, start and scaling mode do not go together (seed 5.1.16.13/14), or
+        /// MC_CamIn's start mode contradicts the MasterAbsolute/SlaveAbsolute its table was
+        /// selected with (MC_CamTableSelect).
         ModeCombination = 0x4262,
         /// The activation position lies behind the master in its direction of travel.
         ActivationPassed = 0x4263,

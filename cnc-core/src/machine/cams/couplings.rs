@@ -79,6 +79,7 @@ impl CamEngine {
         }
         self.selects[id as usize] = Some(Select {
             periodic: call.periodic == 1,
+            absolute: (call.master_absolute == 1, call.slave_absolute == 1),
         });
         accepted()
     }
@@ -143,6 +144,15 @@ impl CamEngine {
         };
         if call.extended > 1 || call.master_source > 1 || !call.activation_position.is_finite() {
             return Err(CamCouplingError::BadParameter.raw());
+        }
+        // MC_CamTableSelect's MasterAbsolute/SlaveAbsolute and MC_CamIn's StartMode say the
+        // same thing twice: a coupling whose start mode contradicts the table's selection is
+        // refused rather than one of the two silently ignored.
+        let selected = self.selects.get(call.table_id as usize).copied().flatten();
+        if let Some(Select { absolute, .. }) = selected {
+            if absolute != (!start.master_relative(), !start.slave_relative()) {
+                return Err(CamCouplingError::ModeCombination.raw());
+            }
         }
         let scaling = Scaling {
             master_offset: call.master_offset,

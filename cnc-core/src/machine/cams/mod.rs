@@ -50,6 +50,9 @@ const TABLE_SLOTS: usize = 256;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Select {
     periodic: bool,
+    /// MasterAbsolute and SlaveAbsolute: the start mode a coupling through the table must
+    /// have (MC_CamIn's StartMode governs; a contradiction is refused).
+    absolute: (bool, bool),
 }
 
 /// A change a coupling waits for (each kind in its own slot: a scaling does not drop a

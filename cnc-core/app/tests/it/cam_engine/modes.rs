@@ -304,3 +304,50 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
         assert!(t > 25.0 && t < 35.0, "top {t}");
     }
 }
+
+/// No input silently ignored: a table selected absolute for master and slave couples with
+/// StartMode absolute only; every other start mode contradicts the selection and is refused
+/// (0x4262) with the axis untouched. A table selected master-relative takes exactly that mode;
+/// a table never selected takes whatever MC_CamIn says.
+#[test]
+fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    let contradiction = CamCouplingError::ModeCombination.raw();
+    for mode in [2, 3, 4] {
+        let c = CamInCall {
+            start_mode: mode,
+            ..cam_in(1)
+        };
+        assert_eq!(
+            call(&mut run, SLAVE as u32, c),
+            contradiction,
+            "start mode {mode}"
+        );
+        assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+    assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    // Master relative, slave absolute: StartMode MasterRelSlaveAbs and nothing else.
+    let select = CamTableSelectCall {
+        periodic: 1,
+        master_absolute: 0,
+        slave_absolute: 1,
+        reserved: 0,
+    };
+    assert_eq!(call(&mut run, 2, select), 0);
+    let mode = |m: u32| CamInCall {
+        start_mode: m,
+        ..cam_in(2)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, mode(1)), contradiction);
+    let master_rel_slave_abs = CamStartMode::MasterRelSlaveAbs.raw();
+    assert_eq!(call(&mut run, SLAVE as u32, mode(master_rel_slave_abs)), 0);
+    assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    // A table never selected: MC_CamIn's start mode alone governs.
+    let mut fresh = machine("");
+    fresh.step(0.001);
+    let relative = CamStartMode::Relative.raw();
+    assert_eq!(call(&mut fresh, SLAVE as u32, mode(relative)), 0);
+}
