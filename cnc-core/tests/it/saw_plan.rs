@@ -589,3 +589,99 @@ proptest! {
         prop_assert!(ours <= 1.1 * theirs + 1e-9, "ours {ours}, rsruckig {theirs}");
     }
 }
+
+/// Step 1 of chapter 7 on the start slope's side: a mean slope d/x between the start slope
+/// (0.5) and the sync slope (1), nearer the start: the slave keeps its velocity first, then
+/// changes to sync (P1 + P5), and is synchronous exactly at the sync point.
+#[test]
+fn step_1_near_the_start_slope_holds_first_then_changes_p1_p5() {
+    let req = request(
+        SyncOn::Position {
+            master: 1000.0,
+            slave: 1000.0,
+        },
+        1.0,
+        limits(2500.0, 1e9),
+        LIMIT_CHECKS,
+    );
+    // x = 1500, d = 900: mean slope 0.6.
+    let master = kin(-500.0, 500.0, 0.0);
+    let plan = saw::plan(&req, &master, &kin(100.0, 250.0, 0.0), None).unwrap();
+    assert_eq!(plan.profile.shape, Shape::P1P5);
+    let c = plan.charac.values;
+    assert!(c.fSlaveVeloMax <= 500.0 + 1e-9 && c.fSlaveVeloMin >= 250.0 - 1e-9);
+    let samples = run(&plan, master, 0);
+    // The first stretch at the start velocity: the slave's velocity is still 250 after 1 s.
+    let (_, _, s1) = samples[1000];
+    assert!((s1.velocity - 250.0).abs() < 1e-9, "{}", s1.velocity);
+    let (_, m, s) = samples.last().unwrap();
+    assert!((m.position - 1000.0).abs() < 1e-9);
+    assert!((s.position - 1000.0).abs() < 1e-9 && (s.velocity - 500.0).abs() < 1e-9);
+}
+
+/// Step 1's profile is dropped when it breaks a checked limit (its change is short: the mean
+/// slope lies just past the start slope); the planner falls back to the plain P5 over the
+/// whole distance, which keeps the limit, and still meets the sync point.
+#[test]
+fn step_1_falls_back_to_the_plain_p5_when_its_change_breaks_the_acceleration_limit() {
+    let on = SyncOn::Position {
+        master: 1000.0,
+        slave: 1000.0,
+    };
+    // x = 1500, d = 780: mean slope 0.52; the P1 + P5 change over 120 master units.
+    let (master, slave) = (kin(-500.0, 500.0, 0.0), kin(220.0, 250.0, 0.0));
+    let free = saw::plan(
+        &request(on, 1.0, limits(1e6, 1e9), LIMIT_CHECKS),
+        &master,
+        &slave,
+        None,
+    );
+    let free = free.unwrap();
+    assert_eq!(free.profile.shape, Shape::P1P5);
+    let its_peak = free
+        .charac
+        .values
+        .fSlaveAccMax
+        .abs()
+        .max(free.charac.values.fSlaveAccMin.abs());
+    // A limit below that change's peak: step 1 does not pass, the plain P5 does.
+    let limit = 0.5 * its_peak;
+    let req = request(on, 1.0, limits(limit, 1e9), LIMIT_CHECKS);
+    let plan = saw::plan(&req, &master, &slave, None).unwrap();
+    assert_eq!(plan.profile.shape, Shape::P5, "fell back to the plain P5");
+    let c = plan.charac.values;
+    assert!(
+        c.fSlaveAccMax <= limit + 1e-9 && c.fSlaveAccMin >= -limit - 1e-9,
+        "{c:?}"
+    );
+    let samples = run(&plan, master, 0);
+    let (_, _, s) = samples.last().unwrap();
+    assert!((s.position - 1000.0).abs() < 1e-9 && (s.velocity - 500.0).abs() < 1e-9);
+}
+
+/// IGNOREMASTERACC: the master's acceleration at coupling counts as 0. Without the bit the
+/// phase starts with the slave's own acceleration (0) whatever the master does; with it the
+/// phase's start is planned as if the master stood at its velocity, so the slave starts with
+/// its start slope times the master's acceleration. With a master at constant velocity both
+/// plans are the same.
+#[test]
+fn ignoremasteracc_plans_as_if_the_master_did_not_accelerate() {
+    let req = |mask| request(SyncOn::Velocity, 1.0, limits(5000.0, 1e9), mask);
+    let slave = kin(0.0, 250.0, 0.0);
+    let accelerating = kin(0.0, 500.0, 1000.0);
+    let with = saw::plan(&req(m::IGNOREMASTERACC), &accelerating, &slave, None).unwrap();
+    let without = saw::plan(&req(0), &accelerating, &slave, None).unwrap();
+    let start_acc = |p: &Plan| p.profile.slave_at(&accelerating, 0.0).acceleration;
+    assert!(start_acc(&without).abs() < 1e-9, "{}", start_acc(&without));
+    // Start slope 250/500 = 0.5 times the master's 1000.
+    assert!(
+        (start_acc(&with) - 500.0).abs() < 1e-9,
+        "{}",
+        start_acc(&with)
+    );
+    let steady = kin(0.0, 500.0, 0.0);
+    let a = saw::plan(&req(m::IGNOREMASTERACC), &steady, &slave, None).unwrap();
+    let b = saw::plan(&req(0), &steady, &slave, None).unwrap();
+    assert_eq!(a.profile.length, b.profile.length);
+    assert_eq!(a.charac.values.fSlaveAccMax, b.charac.values.fSlaveAccMax);
+}
