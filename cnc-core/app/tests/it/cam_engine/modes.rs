@@ -351,3 +351,101 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
     let relative = CamStartMode::Relative.raw();
     assert_eq!(call(&mut fresh, SLAVE as u32, mode(relative)), 0);
 }
+
+/// DeleteQueuedData on a pending MC_CamInExt switch: the queued switch to the stroke table is
+/// dropped (MC_CamInfo shows nothing queued), and when the master passes the activation
+/// position the slave stays on the seed cam, on its law tick by tick.
+#[test]
+fn delete_queued_data_drops_a_pending_switch_and_the_slave_stays_on_its_cam() {
+    use hli::calls::cam::{CamReadCall, CamReadKind};
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    let ext = CamInCall {
+        extended: 1,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, ext), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..700 {
+        run.step(0.001);
+    }
+    let switch = CamInCall {
+        extended: 1,
+        activation_mode: 1,
+        activation_position: 200.0,
+        ..cam_in(2)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, switch), 0);
+    let queued = |run: &mut InProcess| {
+        let info = CamReadCall {
+            what: CamReadKind::Info.raw(),
+            ..Default::default()
+        };
+        let v = read_all(run, SLAVE as u32, info).0;
+        (v[34], v[35])
+    };
+    assert_eq!(queued(&mut run), (1.0, 2.0), "the switch to table 2 queued");
+    let delete = CamInCall {
+        extended: 1,
+        activation_mode: 7,
+        ..cam_in(2)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, delete), 0);
+    assert_eq!(queued(&mut run).0, 0.0, "nothing queued any more");
+    let profile = seed_cam();
+    let law = CamLaw::new(
+        &profile,
+        Scaling::default(),
+        CamStartMode::Absolute,
+        true,
+        0.0,
+        0.0,
+    );
+    // More than a whole turn: past cam position 200 at least once.
+    for tick in 0..1500 {
+        run.step(0.001);
+        let expected = law_at(&law, &profile, set(&run, MASTER)).position;
+        assert!(
+            (set(&run, SLAVE).position - expected).abs() < 1e-9,
+            "tick {tick}: still the seed cam"
+        );
+    }
+}
+
+/// MC_CamOut at speed: the slave leaves the cam with the velocity it had and goes on at it
+/// as a free axis (no stop, no jump), as the seed's decoupling does.
+#[test]
+fn cam_out_at_speed_leaves_the_slave_moving_at_its_velocity() {
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 2);
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(2)), 0);
+    run_master(&mut run, 360.0);
+    // The stroke table climbs from 0 to 16 over the first half turn: at 90 the slave moves.
+    while set(&run, MASTER).position < 90.0 {
+        run.step(0.001);
+    }
+    let before = set(&run, SLAVE);
+    assert!(before.velocity > 10.0, "moving: {}", before.velocity);
+    assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    run.step(0.001);
+    let after = set(&run, SLAVE);
+    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    assert!(
+        (after.velocity - before.velocity).abs() < 0.01 * before.velocity.abs(),
+        "{} then {}",
+        before.velocity,
+        after.velocity
+    );
+    let step = after.position - before.position;
+    assert!(
+        (step - before.velocity * 0.001).abs() < 1e-3,
+        "no jump: {step}"
+    );
+    for _ in 0..100 {
+        run.step(0.001);
+    }
+    let later = set(&run, SLAVE);
+    assert!((later.velocity - before.velocity).abs() < 0.01 * before.velocity.abs());
+}
