@@ -449,3 +449,84 @@ fn cam_out_at_speed_leaves_the_slave_moving_at_its_velocity() {
     let later = set(&run, SLAVE);
     assert!((later.velocity - before.velocity).abs() < 0.01 * before.velocity.abs());
 }
+
+/// Seed 000 4.5, example 1 as written: on a cam that rests at the start of its cycle (the
+/// seed cam rests at 0 from 0 to 30), MC_CamScaling with MasterOffset 0, SlaveOffset 0,
+/// MasterScaling 1, SlaveScaling 0, MasterScalingMode Off, SlaveScalingMode UserDefined and
+/// ActivationMode NextCycle stills the slave from the next cycle on, the coupling kept; the
+/// same call with SlaveScaling 1.0 brings the motion back at the cycle after.
+#[test]
+fn the_seeds_example_1_stills_the_slave_at_the_next_cycle_and_brings_it_back() {
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+    run_master(&mut run, 360.0);
+    let profile = seed_cam();
+    let law = CamLaw::new(
+        &profile,
+        Scaling::default(),
+        CamStartMode::Absolute,
+        true,
+        0.0,
+        0.0,
+    );
+    let example = |slave_scaling: f64| CamScalingCall {
+        activation_mode: 3,
+        master_scaling_mode: 2,
+        slave_scaling_mode: 0,
+        master_offset: 0.0,
+        slave_offset: 0.0,
+        master_scaling: 1.0,
+        slave_scaling,
+        ..CamScalingCall::default()
+    };
+    // Mid cycle: sent; the slave follows its law up to the cycle's end.
+    while set(&run, MASTER).position < 200.0 {
+        run.step(0.001);
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, example(0.0)), 0);
+    let follows = |run: &InProcess| {
+        (set(run, SLAVE).position - law_at(&law, &profile, set(run, MASTER)).position).abs() < 1e-9
+    };
+    while set(&run, MASTER).position < 359.0 {
+        run.step(0.001);
+        assert!(follows(&run));
+    }
+    // The next cycle: the slave stands at the rest value 0, coupled.
+    while set(&run, MASTER).position < 380.0 {
+        run.step(0.001);
+    }
+    let mut moved: f64 = 0.0;
+    while set(&run, MASTER).position < 700.0 {
+        run.step(0.001);
+        let s = set(&run, SLAVE);
+        moved = moved.max(s.position.abs()).max(s.velocity.abs());
+        assert_eq!(
+            run.machine
+                .axes()
+                .axis(SLAVE)
+                .unwrap()
+                .coupling()
+                .map(|c| c.kind),
+            Some(CouplingState::Cam)
+        );
+    }
+    assert_eq!(moved, 0.0, "stilled for the whole cycle");
+    // SlaveScaling 1.0: the motion comes back at the next cycle, on the law again.
+    assert_eq!(call(&mut run, SLAVE as u32, example(1.0)), 0);
+    while set(&run, MASTER).position < 740.0 {
+        run.step(0.001);
+    }
+    let mut back = false;
+    while set(&run, MASTER).position < 1000.0 {
+        run.step(0.001);
+        assert!(
+            follows(&run),
+            "on its law at {}",
+            set(&run, MASTER).position
+        );
+        back |= set(&run, SLAVE).position > 1.0;
+    }
+    assert!(back, "the slave moves again");
+}
