@@ -545,3 +545,62 @@ fn a_multi_table_coupling_takes_the_scaling_of_a_table_not_yet_active() {
     assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
     assert_eq!(set(&run, SLAVE).position, 200.0);
 }
+
+/// CamTableSetSlaveScale (a compatibility block): only the slave's scaling changes, at once;
+/// the master and slave offsets a CamTableOffsetChange set before, and the master scaling,
+/// stay. The pusher then follows 0.5 + 3 x zigzag(drum + 30).
+#[test]
+fn cam_table_set_slave_scale_changes_the_slave_scaling_alone() {
+    let scenario = "cycle_ms = 1.0\nticks = 3000\n\
+        [[axis]]\nname = \"Drum\"\nkind = \"rotary\"\npower = true\n\
+        [[axis]]\nname = \"Pusher\"\npower = true\nsoft_limits = [-50.0, 50.0]\n\
+        following_error_limit = 5.0\n[plc]\ntimeline = \"plc.toml\"\n";
+    let timeline = r#"
+[[step]]
+at_tick = 2
+call = { block = "CamTableGenerate", instance = "generate", axis = 1, table = 22, table_type = 2, rows = [[0.0, 0.0], [90.0, 9.0], [180.0, 0.0], [270.0, -9.0], [360.0, 0.0]] }
+[[step]]
+wait = "generate.Done"
+call = { block = "CamTableCoupleAxesIpol", instance = "couple", axis = 1, master = 0, table = 22, interpolation = 0, master_absolute = true, slave_absolute = true }
+[[step]]
+wait = "couple.Done"
+call = { block = "CamTableOffsetChange", instance = "shift", axis = 1, master_offset = 30.0, slave_offset = 0.5 }
+[[step]]
+wait = "shift.Done"
+call = { block = "CamTableSetSlaveScale", instance = "slave", axis = 1, slave_slope = 3.0 }
+[[step]]
+wait = "slave.Done"
+call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.0, direction = 1, acceleration = 1800.0, deceleration = 1800.0, jerk = 18000.0 }
+"#;
+    let s = Scenario::parse("slave-scale.toml", scenario, |f| {
+        assert_eq!(f, "plc.toml");
+        Ok((PathBuf::from(f), timeline.to_string()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let zigzag = |m: f64| {
+        let m = m.rem_euclid(360.0);
+        match m {
+            m if m < 90.0 => m / 10.0,
+            m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
+            m => -9.0 + (m - 270.0) / 10.0,
+        }
+    };
+    let mut checked = 0;
+    for tick in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        if tick > 1000 && set(&run, MASTER).velocity > 0.0 {
+            let m = set(&run, MASTER).position;
+            let expected = 0.5 + 3.0 * zigzag(m + 30.0);
+            assert!(
+                (set(&run, SLAVE).position - expected).abs() < 1e-9,
+                "tick {tick}, drum {m}: {}",
+                set(&run, SLAVE).position
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 1500, "{checked}");
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+}

@@ -530,3 +530,84 @@ fn the_seeds_example_1_stills_the_slave_at_the_next_cycle_and_brings_it_back() {
     }
     assert!(back, "the slave moves again");
 }
+
+/// A point change applied at once (Instantaneous) while the slave is in a segment it moves:
+/// with the slave scaling mode AutoOffset the slave offset takes up the difference and the
+/// slave does not jump, then follows the changed cam shifted by that offset; with
+/// UserDefined the same change jumps (the contrast that shows the offset at work).
+#[test]
+fn an_online_point_change_with_slave_auto_offset_does_not_jump() {
+    use hli::calls::cam::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    let run_with = |slave_mode: u32| -> (f64, Vec<(f64, f64)>) {
+        let mut run = machine("");
+        run.step(0.001);
+        select_cyclic(&mut run, 1);
+        assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+        run_master(&mut run, 360.0);
+        // In the rise from 150 towards point 4 at 240.
+        while set(&run, MASTER).position < 200.0 {
+            run.step(0.001);
+        }
+        let mode = CamOnlineModeCall {
+            activation_mode: 0,
+            slave_scaling_mode: slave_mode,
+            ..Default::default()
+        };
+        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &mode));
+        assert_eq!(reply.error_id, 0);
+        let mut points = [McMotionFunctionPoint::default(); 4];
+        points[0] = McMotionFunctionPoint {
+            point_index: 4,
+            function_type: 15,
+            point_type: 2,
+            rel_index_next_point: 1,
+            master_pos: 240.0,
+            slave_pos: 30.0,
+            ..Default::default()
+        };
+        let write = CamPointsWriteCall {
+            first: 4,
+            count: 1,
+            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+            total: 1,
+            points,
+        };
+        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
+        assert_eq!(reply.error_id, 0);
+        let mut last = set(&run, SLAVE).position;
+        let mut largest: f64 = 0.0;
+        let mut samples = Vec::new();
+        for _ in 0..300 {
+            run.step(0.001);
+            let p = set(&run, SLAVE).position;
+            largest = largest.max((p - last).abs());
+            last = p;
+            samples.push((set(&run, MASTER).position, p));
+        }
+        (largest, samples)
+    };
+    let (auto_step, samples) = run_with(1);
+    let (user_step, _) = run_with(0);
+    // One tick's travel on the rise is under 0.35; the plain change jumps by about 2.
+    assert!(auto_step < 0.35, "AutoOffset: largest step {auto_step}");
+    assert!(user_step > 1.0, "UserDefined: largest step {user_step}");
+    // After the change: the changed cam plus one constant offset.
+    let changed = changed_cam(&seed_cam());
+    let offsets: Vec<f64> = samples
+        .iter()
+        .map(|&(m, p)| {
+            p - changed
+                .eval(m.rem_euclid(360.0), &mut ProfileCursor::default())
+                .position
+        })
+        .collect();
+    let spread = offsets
+        .iter()
+        .fold(0.0f64, |w, o| w.max((o - offsets[0]).abs()));
+    assert!(spread < 1e-9, "one offset: {offsets:?}");
+    assert!(
+        offsets[0].abs() > 0.1,
+        "the offset took up the change: {}",
+        offsets[0]
+    );
+}
