@@ -356,6 +356,10 @@ wire_enum! {
         /// 5: CamTableReadData of the table given as `target`: its rows `[master, slave]`,
         /// row after row (position tables only).
         Rows = 5 => "rows",
+        /// 6: what the coupling of the slave axis given as `target` still waits to activate:
+        /// a scaling (MC_CamScaling), a switch (MC_CamInExt), a point change of its table
+        /// (1 or 0 each). MC_CamScaling is Done once its scaling no longer waits.
+        Queued = 6 => "queued",
     }
 }
 

@@ -15,8 +15,8 @@ use crate::timeline::registry::{
     input, joined, mode, BlockSpec, InputSpec, Kind, TimelineBlock, Value,
 };
 use hli::calls::cam::{
-    CamActivationMode, CamInCall, CamInterpolation, CamOutCall, CamReply, CamScalingCall,
-    CamScalingMode, CamStartMode,
+    CamActivationMode, CamInCall, CamInterpolation, CamOutCall, CamReadCall, CamReadKind, CamReply,
+    CamScalingCall, CamScalingMode, CamStartMode,
 };
 use hli::calls::AcyclicCall;
 use hli::enums::{AxisState, CouplingState};
@@ -199,7 +199,10 @@ impl McCamOut {
     }
 }
 
-/// MC_CamScaling: new offsets and scalings of a coupling, now or at an activation.
+/// MC_CamScaling: new offsets and scalings of a coupling, now or at an activation. Done when
+/// the scaling has been carried out (seed 000 5.1.6), Busy while it waits for its
+/// activation: once the CNC took it, the block asks each cycle whether the coupling still
+/// has a scaling queued (a `CamRead` of kind `Queued`).
 #[derive(Debug)]
 pub struct McCamScaling {
     /// Input: a rising edge sends it.
@@ -209,7 +212,7 @@ pub struct McCamScaling {
     pub scaling: CamScalingCall,
     /// Outputs of the last call.
     pub out: Outputs,
-    core: CamCore<CamScalingCall>,
+    kernel: Kernel<PendingCall<CamScalingCall>, Option<PendingCall<CamReadCall>>>,
 }
 
 impl Default for McCamScaling {
@@ -218,8 +221,40 @@ impl Default for McCamScaling {
             execute: false,
             scaling: unscaled(),
             out: Outputs::default(),
-            core: CamCore::default(),
+            kernel: Kernel::default(),
         }
+    }
+}
+
+/// Whether slave `slave`'s scaling has been carried out: asked with a read when none is on
+/// its way (`asked`), answered when it arrives (asked again while still queued).
+fn scaling_carried_out(
+    io: &mut PlcIo<'_>,
+    slave: u32,
+    asked: &mut Option<PendingCall<CamReadCall>>,
+) -> Step<()> {
+    let Some(pending) = asked.as_ref() else {
+        let read = CamReadCall {
+            what: CamReadKind::Queued.raw(),
+            ..CamReadCall::default()
+        };
+        return match send(io, slave, &read) {
+            Ok(p) => {
+                *asked = Some(p);
+                Step::Running(Outputs::busy())
+            }
+            Err(code) => Step::Ended(failed(code)),
+        };
+    };
+    match pending.poll() {
+        None => Step::Running(Outputs::busy()),
+        Some(Ok(reply)) if reply.error_id != 0 => Step::Ended(failed(reply.error_id)),
+        Some(Ok(reply)) if reply.values[0] != 0.0 => {
+            *asked = None;
+            Step::Running(Outputs::busy())
+        }
+        Some(Ok(_)) => Step::Ended(Outputs::done(())),
+        Some(Err(e)) => Step::Ended(failed(crate::kernel::call_error_code(&e))),
     }
 }
 
@@ -230,8 +265,19 @@ impl McCamScaling {
             reserved: 0,
             ..self.scaling
         };
-        self.out = self.core.cycle(io, self.execute, slave, || call, None);
+        self.out = self.kernel.cycle(
+            io,
+            self.execute,
+            |io| send(io, slave, &call),
+            |reply| match reply.error_id {
+                0 => Accept::Follow(None, Outputs::busy()),
+                code => Accept::Failed(code, ()),
+            },
+            |asked, io, _| scaling_carried_out(io, slave, asked),
+        );
     }
+
+    timeout_input!(kernel);
 }
 
 /// MC_WriteMotionFunctionPoint: one point of the motion function `table` changed, under the

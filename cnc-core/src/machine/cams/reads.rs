@@ -65,6 +65,7 @@ impl CamEngine {
                 let n = v.len();
                 Made::all(v, n)
             }),
+            Some(CamReadKind::Queued) => self.queued(id as usize).map(|v| Made::all(v.to_vec(), 3)),
             None => Err(CamCouplingError::UnknownMode.raw()),
         };
         let made = match answer {
@@ -176,6 +177,20 @@ impl CamEngine {
             Ok(_) => Err(TableErrorCode::McTableTypeInvalid as u32),
             Err(e) => Err(e),
         }
+    }
+
+    /// What slave `slave`'s coupling waits to activate: a scaling, a switch, a point change
+    /// of its table (1.0 or 0.0 each).
+    fn queued(&self, slave: usize) -> Result<[f64; 3], u32> {
+        let Some(s) = self.slaves.get(slave).and_then(Option::as_ref) else {
+            return Err(CamCouplingError::NotCamCoupled.raw());
+        };
+        let points = self.store.queue(s.table).is_ok_and(|q| q.is_queued());
+        Ok([
+            flag(s.scale.is_some()),
+            flag(s.switch.is_some()),
+            flag(points),
+        ])
     }
 
     /// The 40 values of MC_CamInfoData for slave `slave`, at the master's set-point or at

@@ -228,7 +228,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
     ));
     assert_eq!(reply.error_id, CamCouplingError::NotCamCoupled.raw());
     // A kind of read that does not exist: refused as an unknown mode.
-    for what in [0, 6] {
+    for what in [0, 7] {
         let reply: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
             &mut run,
             1,

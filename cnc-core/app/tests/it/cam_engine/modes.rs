@@ -611,3 +611,65 @@ fn an_online_point_change_with_slave_auto_offset_does_not_jump() {
         offsets[0]
     );
 }
+
+/// MC_CamScaling is Done when the scaling has been carried out (seed 000 5.1.6), not when the
+/// CNC took it: sent mid-cycle with ActivationMode NextCycle, it stays Busy until the master
+/// crosses the cycle boundary; the step waiting for its Done fires only then.
+#[test]
+fn cam_scaling_is_done_when_its_scaling_activates() {
+    let scenario = "cycle_ms = 1.0\nticks = 2500\n\
+        [[axis]]\nname = \"Conveyor\"\nkind = \"rotary\"\npower = true\nvelocity = 720.0\n\
+        acceleration = 3600.0\ndeceleration = 3600.0\njerk = 36000.0\n\
+        [[axis]]\nname = \"Lifter\"\npower = true\nsoft_limits = [-100.0, 200.0]\n\
+        [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
+    let timeline = r#"
+[[step]]
+at_tick = 2
+call = { block = "MC_CamTableSelect", instance = "select", axis = 1, table = 1, periodic = true, master_absolute = true, slave_absolute = true }
+[[step]]
+wait = "select.Done"
+call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1, start_mode = "absolute" }
+[[step]]
+wait = "cam.InSync"
+call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
+[[step]]
+at_tick = 500
+call = { block = "MC_CamScaling", instance = "scale", axis = 1, activation_mode = "next_cycle", slave_scaling_mode = "auto_offset", slave_scaling = 0.5 }
+[[step]]
+wait = "scale.Done"
+call = { block = "MC_Halt", instance = "halt", axis = 0, deceleration = 3600.0, jerk = 36000.0 }
+"#;
+    let s = Scenario::parse("scaling-done.toml", scenario, |f| {
+        if f == "plc.toml" {
+            return Ok((PathBuf::from(f), timeline.to_string()));
+        }
+        let path = scenarios().join("cams").join(f);
+        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let mut crossed = None;
+    let mut before: f64 = 0.0;
+    for tick in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let m = set(&run, MASTER).position;
+        if crossed.is_none() && tick > 500 && m.rem_euclid(360.0) < before.rem_euclid(360.0) {
+            crossed = Some(tick);
+        }
+        before = m;
+    }
+    let crossed = crossed.expect("the master crossed a cycle boundary after tick 500");
+    let records = run.timeline.as_ref().unwrap().records().to_vec();
+    let sent = records[3].first_fired_at.expect("the scaling was sent");
+    let done = records[4].first_fired_at.expect("the scaling became Done");
+    assert!(
+        sent >= 500 && sent + 100 < crossed,
+        "sent at {sent}, boundary at {crossed}"
+    );
+    assert!(
+        (crossed..crossed + 5).contains(&done),
+        "Done at tick {done}, the boundary at {crossed}"
+    );
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+}
