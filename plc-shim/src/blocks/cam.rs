@@ -22,6 +22,12 @@ use hli::calls::AcyclicCall;
 use hli::enums::{AxisState, CouplingState};
 use hli::rpc::PendingCall;
 
+/// Version of this block library (seed 000 5.3, Get_TcNcCamming_Version): at most the
+/// STRING(20) the seed's function returns.
+pub fn camming_library_version() -> &'static str {
+    concat!("cncplc-cam ", env!("CARGO_PKG_VERSION"))
+}
+
 /// The block kernel as the cam blocks use it: a coupling (MC_CamIn) follows the slave's
 /// image, remembering whether it has seen the coupling there; the others are Done when the
 /// CNC took the call.
@@ -485,3 +491,14 @@ pub const TIMELINE: &[BlockSpec] = &[
         Box::<McSetCamOnlineChangeMode>::default()
     }),
 ];
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_library_names_its_version_within_the_seeds_string_20() {
+        let v = super::camming_library_version();
+        assert_eq!(v, concat!("cncplc-cam ", env!("CARGO_PKG_VERSION")));
+        assert!(v.len() <= 20, "{v}");
+        assert!(crate::blocks::fifo::fifo_library_version().len() <= 20);
+    }
+}
