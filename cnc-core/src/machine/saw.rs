@@ -26,6 +26,9 @@ struct SawSlave {
     /// The slave's coupling: stale once another engine took the axis since (after a fault
     /// released it), and the slot with it.
     lease: Lease,
+    /// The motion table the saw plans this slave in ([`own_table`]), which no cam may load
+    /// while the saw drives the slave.
+    table: Resource,
 }
 
 /// Flying-saw slaves by axis index.
@@ -165,6 +168,7 @@ impl SawEngine {
             master,
             follower: Follower::new(request, &plan, &m, soft_limits),
             lease,
+            table: own_table(axes, slave),
         });
         self.plans = self.plans.wrapping_add(1);
         self.characs[slave] = Some((plan.charac.values, self.plans));
@@ -247,6 +251,10 @@ impl Engine for SawEngine {
 
     fn calls(&self) -> &'static [CallSpec] {
         hli::calls::saw::CALLS
+    }
+
+    fn holds(&self, resource: Resource) -> bool {
+        self.slaves.iter().flatten().any(|s| s.table == resource)
     }
 
     fn handle(&mut self, call: Call<'_>) -> HandlerResult {

@@ -406,7 +406,7 @@ fn a_refused_command_leaves_the_slave_moving_as_before() {
 }
 
 #[test]
-fn a_slave_whose_internal_table_a_cam_uses_is_refused() {
+fn the_saws_internal_table_and_a_cam_table_exclude_each_other() {
     // The stroke table has ID 2: the saw's table of axis ID 254.
     let mut run = machine(&format!(
         "{}[[cam_table]]\nfile = \"stroke_table.json\"\n",
@@ -425,6 +425,25 @@ fn a_slave_whose_internal_table_a_cam_uses_is_refused() {
     );
     // Axis ID 2 (table 254) is free.
     assert_eq!(gear_in(&mut run, SAW, velocity_call(1.0, 0)), 0);
+    // The other way round: while the saw drives axis ID 2, no cam table 254 can be loaded;
+    // once the saw has let it go, it can.
+    let rows = |run: &mut InProcess| {
+        let mut call = hli::calls::cam::CamRowsWriteCall {
+            count: 2,
+            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+            total: 2,
+            table_type: 10,
+            ..Default::default()
+        };
+        call.rows[..2].copy_from_slice(&[[0.0, 0.0], [360.0, 10.0]]);
+        let view = CncView::new(&run.memory);
+        run.machine.call(&view, 254, &call).unwrap().error_id
+    };
+    let in_use = hli::enums::CamCouplingError::TableInUse.raw();
+    assert_eq!(rows(&mut run), in_use, "the saw plans in table 254");
+    assert_eq!(gear_out(&mut run, SAW), 0);
+    run.step(TICK);
+    assert_eq!(rows(&mut run), 0, "free again");
 }
 
 #[test]

@@ -606,11 +606,17 @@ impl Engine for CamEngine {
             kind,
             request,
             axes,
-            ..
+            others,
         } = call;
         // Between ticks: free what the ticks retired.
         self.retired.clear();
         self.retired_changes.clear();
+        // Table data written into a table another engine plans in (the flying saw's table
+        // 256 - the slave's axis ID while it drives that slave, seed 001 chapter 13): refused.
+        let writes_table = matches!(kind, CallKind::CAM_POINTS_WRITE | CallKind::CAM_ROWS_WRITE);
+        if writes_table && others.hold(Resource::MotionTable(request.target)) {
+            return code(CamCouplingError::TableInUse.raw());
+        }
         match kind {
             CallKind::CAM_TABLE_SELECT => self.table_select(request),
             CallKind::CAM_IN => self.cam_in(request, axes),
