@@ -1,12 +1,15 @@
 //! Position files for FIFO groups, and the double-buffered reader a PLC program fills its
 //! FIFO from.
 //!
-//! Two formats, one row of N positions per FIFO entry:
+//! Three formats, one row of N positions per FIFO entry:
 //! * CSV (`.csv`, any other name): one row per line, values separated by commas, an optional
 //!   header line (a first line that is not all numbers), blank lines and `#` comments
 //!   skipped;
 //! * binary (`.fifo`): the 8 bytes `CNCFIFO1`, columns (u32), reserved (u32), rows (u64),
-//!   then the rows' `f64`s, all little-endian. [`write_binary`] writes it.
+//!   then the rows' `f64`s, all little-endian. [`write_binary`] writes it;
+//! * the seed's table layout (`.tab`), as the seed's FIFO sample program reads its position
+//!   file: a header of rows and columns, each an unsigned short, then the rows' doubles
+//!   without separators (little-endian). [`write_seed_table`] writes it.
 //!
 //! A bad value is refused with its place (`FILE:LINE:COL` for CSV, row and column for
 //! binary), never passed on. [`Feeder`] reads the file on a thread of its own into two
@@ -113,8 +116,67 @@ fn csv_row(file: &str, line: usize, text: &str) -> Result<Option<Vec<f64>>, File
     Ok(Some(row))
 }
 
+/// The `.fifo` header: magic, columns (u32), reserved (u32), rows (u64).
+fn fifo_header(reader: &mut impl Read, file: &str) -> Result<(usize, u64), FileError> {
+    let mut header = [0u8; 24];
+    reader.read_exact(&mut header).map_err(|e| FileError::Io {
+        file: file.to_string(),
+        message: e.to_string(),
+    })?;
+    if &header[..8] != BINARY_MAGIC {
+        return Err(FileError::Binary {
+            file: file.to_string(),
+            message: "not a FIFO position file (no CNCFIFO1 header)".into(),
+        });
+    }
+    let columns = u32::from_le_bytes(header[8..12].try_into().unwrap_or_default());
+    let rows = u64::from_le_bytes(header[16..24].try_into().unwrap_or_default());
+    Ok((columns as usize, rows))
+}
+
+/// The seed's table header (`.tab`, seed 000 4.6.2, as the FIFO sample program reads its
+/// position file): rows and columns, each an unsigned short, then the rows' doubles with no
+/// separators (little-endian here).
+fn table_header(reader: &mut impl Read, file: &str) -> Result<(usize, u64), FileError> {
+    let mut header = [0u8; 4];
+    reader.read_exact(&mut header).map_err(|e| FileError::Io {
+        file: file.to_string(),
+        message: e.to_string(),
+    })?;
+    let rows = u16::from_le_bytes([header[0], header[1]]);
+    let columns = u16::from_le_bytes([header[2], header[3]]);
+    Ok((usize::from(columns), u64::from(rows)))
+}
+
 impl RowReader {
-    /// Opens `path`: binary when it ends in `.fifo`, else CSV (its first row sets the columns).
+    /// A binary file of `columns` x `rows` after its header, checked.
+    fn binary(
+        file: String,
+        reader: BufReader<std::fs::File>,
+        (columns, rows): (usize, u64),
+    ) -> Result<RowReader, FileError> {
+        if columns == 0 || columns > hli::calls::fifo::FIFO_MAX_DIMENSION as usize {
+            return Err(FileError::Binary {
+                file,
+                message: format!("{columns} columns: 1 to 16"),
+            });
+        }
+        if rows == 0 {
+            return Err(FileError::Empty(file));
+        }
+        Ok(RowReader {
+            file,
+            columns,
+            source: Source::Binary {
+                reader,
+                rows_left: rows,
+                row: 0,
+            },
+        })
+    }
+
+    /// Opens `path`: binary when it ends in `.fifo` or `.tab`, else CSV (its first row sets
+    /// the columns).
     pub fn open(path: &Path) -> Result<RowReader, FileError> {
         let file = path.display().to_string();
         let io = |e: std::io::Error| FileError::Io {
@@ -123,35 +185,17 @@ impl RowReader {
         };
         let handle = std::fs::File::open(path).map_err(io)?;
         let mut reader = BufReader::with_capacity(1 << 16, handle);
-        if path.extension().is_some_and(|e| e == "fifo") {
-            let mut header = [0u8; 24];
-            reader.read_exact(&mut header).map_err(io)?;
-            if &header[..8] != BINARY_MAGIC {
-                return Err(FileError::Binary {
-                    file,
-                    message: "not a FIFO position file (no CNCFIFO1 header)".into(),
-                });
+        let extension = path.extension().and_then(|e| e.to_str());
+        match extension {
+            Some("fifo") => {
+                let shape = fifo_header(&mut reader, &file)?;
+                return RowReader::binary(file, reader, shape);
             }
-            let columns = u32::from_le_bytes(header[8..12].try_into().unwrap_or_default());
-            let rows = u64::from_le_bytes(header[16..24].try_into().unwrap_or_default());
-            if columns == 0 || columns > hli::calls::fifo::FIFO_MAX_DIMENSION {
-                return Err(FileError::Binary {
-                    file,
-                    message: format!("{columns} columns: 1 to 16"),
-                });
+            Some("tab") => {
+                let shape = table_header(&mut reader, &file)?;
+                return RowReader::binary(file, reader, shape);
             }
-            if rows == 0 {
-                return Err(FileError::Empty(file));
-            }
-            return Ok(RowReader {
-                file,
-                columns: columns as usize,
-                source: Source::Binary {
-                    reader,
-                    rows_left: rows,
-                    row: 0,
-                },
-            });
+            _ => {}
         }
         let mut lines = reader.lines();
         let mut line = 0;
@@ -286,6 +330,25 @@ pub fn write_binary(path: &Path, columns: usize, values: &[f64]) -> std::io::Res
     out.write_all(&(columns as u32).to_le_bytes())?;
     out.write_all(&0u32.to_le_bytes())?;
     out.write_all(&((values.len() / columns) as u64).to_le_bytes())?;
+    for v in values {
+        out.write_all(&v.to_le_bytes())?;
+    }
+    out.flush()
+}
+
+/// Writes `values` (rows of `columns`) in the seed's table layout (`.tab`): rows and columns
+/// as unsigned shorts, then the doubles. `InvalidInput` beyond 65,535 rows or columns.
+pub fn write_seed_table(path: &Path, columns: usize, values: &[f64]) -> std::io::Result<()> {
+    let rows = values.len() / columns.max(1);
+    let (Ok(r), Ok(c)) = (u16::try_from(rows), u16::try_from(columns)) else {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{rows} rows x {columns} columns: the header holds up to 65,535 each"),
+        ));
+    };
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    out.write_all(&r.to_le_bytes())?;
+    out.write_all(&c.to_le_bytes())?;
     for v in values {
         out.write_all(&v.to_le_bytes())?;
     }
@@ -494,5 +557,28 @@ mod tests {
             }
         }
         assert_eq!(got, values);
+    }
+
+    #[test]
+    fn the_seeds_table_layout_reads_back_and_bad_headers_are_refused() {
+        let dir = std::env::temp_dir().join(format!("fifo-tab-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("contour.tab");
+        let values: Vec<f64> = (0..3000).map(|i| f64::from(i) * 0.5).collect();
+        write_seed_table(&path, 3, &values).unwrap();
+        // 4 header bytes, then 1000 rows of 3 doubles.
+        assert_eq!(std::fs::metadata(&path).unwrap().len(), 4 + 3000 * 8);
+        let (columns, got) = RowReader::open(&path).unwrap().read_all().unwrap();
+        assert_eq!((columns, got), (3, values));
+        let bad = dir.join("bad.tab");
+        std::fs::write(&bad, [2u8, 0, 17, 0]).unwrap();
+        let e = RowReader::open(&bad).unwrap_err().to_string();
+        assert!(e.contains("17 columns: 1 to 16"), "{e}");
+        std::fs::write(&bad, [0u8, 0, 2, 0]).unwrap();
+        assert!(matches!(RowReader::open(&bad), Err(FileError::Empty(_))));
+        // Fewer values than the header says: refused with the OS's word, not padded.
+        std::fs::write(&bad, [2u8, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0]).unwrap();
+        assert!(RowReader::open(&bad).unwrap().read_all().is_err());
+        assert!(write_seed_table(&bad, 1, &vec![0.0; 70_000]).is_err());
     }
 }
