@@ -159,16 +159,13 @@ fn run(command: &CamCommand) -> Result<(), CliError> {
             master_velocity,
             binary,
         } => {
-            if !(master_velocity.is_finite() && *master_velocity > 0.0) {
+            let profile = load(file, binary)?;
+            let Some(values) = CharacValues::normed(&profile).rescaled(*master_velocity) else {
                 return Err(CliError::Message(
                     1,
-                    format!("--master-velocity {master_velocity}: a positive finite velocity"),
+                    format!("--master-velocity {master_velocity}: a finite velocity other than 0"),
                 ));
-            }
-            let profile = load(file, binary)?;
-            let values = CharacValues::normed(&profile)
-                .rescaled(*master_velocity)
-                .expect("--master-velocity checked above");
+            };
             let body: Vec<String> = values
                 .fields()
                 .iter()

@@ -251,13 +251,45 @@ impl CharacValues {
         }
     }
 
-    /// The same values for a master at constant velocity `v` (the normed values scale with
-    /// powers of `v`; positions do not change). `None` for a velocity that is not a finite
-    /// number above 0 (minimum and maximum would trade places).
+    /// The same values for a master at constant velocity `v`, also a negative one (the
+    /// normed values scale with powers of `v`; positions do not change). A negative velocity
+    /// turns velocities and jerks over: their minimum and maximum trade places with the master
+    /// positions they lie at; accelerations keep theirs. `None` for a velocity that is 0 or
+    /// not finite.
     pub fn rescaled(&self, v: f64) -> Option<CharacValues> {
-        if !(v.is_finite() && v > 0.0 && self.fMasterVeloNom > 0.0) {
+        if !(v.is_finite() && v != 0.0 && self.fMasterVeloNom > 0.0) {
             return None;
         }
+        let mut c = self.rescaled_by_magnitude(v.abs());
+        if v < 0.0 {
+            c.turn_over();
+        }
+        c.fMasterVeloNom = v;
+        Some(c)
+    }
+
+    /// The velocities and jerks of a master running backwards: signs turned, minimum and
+    /// maximum traded (with the master positions they lie at).
+    fn turn_over(&mut self) {
+        for f in [
+            &mut self.fSlaveVeloStart,
+            &mut self.fSlaveVeloEnd,
+            &mut self.fSVeloAtSAccMin,
+            &mut self.fSVeloAtSAccMax,
+            &mut self.fSlaveJerkStart,
+            &mut self.fSlaveJerkEnd,
+        ] {
+            *f = -*f;
+        }
+        let (lo, hi) = (-self.fSlaveVeloMax, -self.fSlaveVeloMin);
+        (self.fSlaveVeloMin, self.fSlaveVeloMax) = (lo, hi);
+        (self.fMPosAtSVeloMin, self.fMPosAtSVeloMax) = (self.fMPosAtSVeloMax, self.fMPosAtSVeloMin);
+        let (lo, hi) = (-self.fSlaveJerkMax, -self.fSlaveJerkMin);
+        (self.fSlaveJerkMin, self.fSlaveJerkMax) = (lo, hi);
+    }
+
+    /// [`CharacValues::rescaled`] for a velocity above 0.
+    fn rescaled_by_magnitude(&self, v: f64) -> CharacValues {
         let k = v / self.fMasterVeloNom;
         let (k2, k3) = (k * k, k * k * k);
         let mut c = *self;
@@ -290,7 +322,7 @@ impl CharacValues {
         ] {
             *f *= k3;
         }
-        Some(c)
+        c
     }
 }
 

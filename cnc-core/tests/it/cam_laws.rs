@@ -275,9 +275,7 @@ fn characteristic_values_agree_with_a_fine_sweep_for_every_law() {
 fn rescaling_to_a_master_velocity_scales_each_order() {
     let c = CharacValues::normed(&unit(FunctionType::Polynom5, 0.0));
     let r = c.rescaled(3.0).unwrap();
-    assert!(
-        c.rescaled(0.0).is_none() && c.rescaled(-1.0).is_none() && c.rescaled(f64::NAN).is_none()
-    );
+    assert!(c.rescaled(0.0).is_none() && c.rescaled(f64::NAN).is_none());
     assert_eq!(r.fMasterVeloNom, 3.0);
     assert!((r.fSlaveVeloMax - 3.0 * c.fSlaveVeloMax).abs() < 1e-12);
     assert!((r.fSlaveAccMax - 9.0 * c.fSlaveAccMax).abs() < 1e-12);
@@ -442,4 +440,35 @@ fn ignored_points_are_ignored_completely() {
     let f = MotionFunction::new(&points).expect("the ignored point does not count");
     assert_eq!(f.segments().len(), 1);
     assert!((at(&f, 50.0).position - 0.5).abs() < 1e-12);
+}
+
+/// A negative master velocity (seed 000 3.4: any constant master velocity): the cam runs
+/// backwards, so velocities and jerks turn over (minimum and maximum trade places with their
+/// master positions) and accelerations scale with the square, their places kept. Checked
+/// against the cam sampled backwards at 2 units/s.
+#[test]
+fn rescaling_to_a_negative_master_velocity_turns_velocities_and_jerks_over() {
+    let p = unit(FunctionType::Polynom5, 0.0);
+    let c = CharacValues::normed(&p);
+    let r = c.rescaled(-2.0).unwrap();
+    assert_eq!(r.fMasterVeloNom, -2.0);
+    assert!((r.fSlaveVeloMax - -2.0 * c.fSlaveVeloMin).abs() < 1e-12);
+    assert!((r.fSlaveVeloMin - -2.0 * c.fSlaveVeloMax).abs() < 1e-12);
+    assert_eq!(r.fMPosAtSVeloMax, c.fMPosAtSVeloMin);
+    assert_eq!(r.fMPosAtSVeloMin, c.fMPosAtSVeloMax);
+    assert!((r.fSlaveAccMax - 4.0 * c.fSlaveAccMax).abs() < 1e-12);
+    assert_eq!(r.fMPosAtSAccMax, c.fMPosAtSAccMax);
+    assert!((r.fSlaveJerkMax - -8.0 * c.fSlaveJerkMin).abs() < 1e-9);
+    assert_eq!(r.fSlavePosMax, c.fSlavePosMax);
+    // Sampled: slave velocity = T'(x) * v, acceleration = T''(x) * v^2 with v = -2.
+    let mut cursor = cnc_core::cam::ProfileCursor::default();
+    let (mut v_lo, mut v_hi, mut a_hi) = (f64::MAX, f64::MIN, f64::MIN);
+    for k in 0..=10_000 {
+        let s = p.eval(f64::from(k) * 1e-4, &mut cursor);
+        v_lo = v_lo.min(-2.0 * s.velocity);
+        v_hi = v_hi.max(-2.0 * s.velocity);
+        a_hi = a_hi.max(4.0 * s.acceleration);
+    }
+    assert!((r.fSlaveVeloMin - v_lo).abs() < 1e-6 && (r.fSlaveVeloMax - v_hi).abs() < 1e-6);
+    assert!((r.fSlaveAccMax - a_hi).abs() < 1e-3 * (1.0 + a_hi.abs()));
 }

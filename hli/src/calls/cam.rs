@@ -344,7 +344,8 @@ wire_enum! {
         /// `a`: slave position, velocity, acceleration (what the table type gives).
         SlaveDynamics = 1 => "slave_dynamics",
         /// 2: MC_ReadCamTableCharacteristics of the table given as `target`: the 31 values of
-        /// `MC_TableCharacValues` in their order.
+        /// `MC_TableCharacValues` in their order, for a master at constant velocity `a` (0:
+        /// the normed values, for 1.0; a negative velocity runs the cam backwards).
         Characteristics = 2 => "characteristics",
         /// 3: MC_ReadMotionFunctionValues of the table given as `target`: rows
         /// `[master, the columns of mask]` from `a` to `b` in steps of `c`, row after row.

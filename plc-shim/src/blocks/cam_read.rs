@@ -268,7 +268,7 @@ impl TimelineBlock for McCamRead {
         match (key, value.uint(), value.real(), value) {
             ("table", Some(v), _, _) => self.target = v,
             ("value_select_mask", Some(v), _, _) => r.mask = v,
-            ("master_position" | "start_pos_master", _, Some(v), _) => r.a = v,
+            ("master_position" | "start_pos_master" | "master_velocity", _, Some(v), _) => r.a = v,
             ("end_pos_master", _, Some(v), _) => r.b = v,
             ("increment", _, Some(v), _) => r.c = v,
             ("at_master_position", _, _, Value::Bool(v)) => r.flags = u32::from(*v),
@@ -338,9 +338,13 @@ pub const TIMELINE: &[BlockSpec] = &[
         &[TABLE, MASTER_POSITION],
         |_| Box::new(McCamRead::new(CamReadKind::SlaveDynamics, 3)),
     ),
-    BlockSpec::on_axis("MC_ReadCamTableCharacteristics", &[TABLE], |_| {
-        Box::new(McCamRead::new(CamReadKind::Characteristics, 31))
-    }),
+    // `master_velocity`: the values rescaled to a master at that constant velocity (seed 000
+    // 3.4; not given or 0: the normed values).
+    BlockSpec::on_axis(
+        "MC_ReadCamTableCharacteristics",
+        &[TABLE, input("master_velocity", Kind::Real)],
+        |_| Box::new(McCamRead::new(CamReadKind::Characteristics, 31)),
+    ),
     BlockSpec::on_axis(
         "MC_ReadMotionFunctionValues",
         &[

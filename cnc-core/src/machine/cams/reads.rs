@@ -50,14 +50,22 @@ impl CamEngine {
         // A values read makes only the part asked for; the others make all and are cut here.
         let answer = match CamReadKind::from_raw(call.what) {
             Some(CamReadKind::SlaveDynamics) => self.slave_dynamics(id, &call),
-            Some(CamReadKind::Characteristics) => self.table(id).map(|p| {
-                let values: Vec<f64> = crate::cam::CharacValues::normed(p)
+            Some(CamReadKind::Characteristics) => self.table(id).and_then(|p| {
+                // `a`: the master velocity the values are for (0: the normed values, 1.0).
+                let normed = crate::cam::CharacValues::normed(p);
+                let at = if call.a == 0.0 {
+                    Some(normed)
+                } else {
+                    normed.rescaled(call.a)
+                };
+                let values: Vec<f64> = at
+                    .ok_or(CamCouplingError::BadParameter.raw())?
                     .fields()
                     .iter()
                     .map(|(_, v)| *v)
                     .collect();
                 let n = values.len();
-                Made::all(values, n)
+                Ok(Made::all(values, n))
             }),
             Some(CamReadKind::Values) => self.sampled_values(id, &call, skip),
             Some(CamReadKind::Rows) => self.rows_part(id, skip),

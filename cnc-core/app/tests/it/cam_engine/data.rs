@@ -168,6 +168,38 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         .map(|(_, v)| *v)
         .collect();
     assert_eq!(v, expected);
+    // Rescaled on the PLC path (seed 000 3.4): to a working master velocity, also a negative
+    // one; a velocity that is not a number is refused.
+    for velocity in [2.0, -2.0] {
+        let (v, _) = read_all(
+            &mut run,
+            1,
+            CamReadCall {
+                what: CamReadKind::Characteristics.raw(),
+                a: velocity,
+                ..Default::default()
+            },
+        );
+        let expected: Vec<f64> = cnc_core::cam::CharacValues::normed(&seed)
+            .rescaled(velocity)
+            .unwrap()
+            .fields()
+            .iter()
+            .map(|(_, v)| *v)
+            .collect();
+        assert_eq!(v, expected, "at {velocity}");
+        assert_eq!(v[0], velocity, "fMasterVeloNom");
+    }
+    let nan: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
+        &mut run,
+        1,
+        &CamReadCall {
+            what: CamReadKind::Characteristics.raw(),
+            a: f64::NAN,
+            ..Default::default()
+        },
+    ));
+    assert_eq!(nan.error_id, CamCouplingError::BadParameter.raw());
     // A value table of position and velocity from 0 to 360 in steps of 10: 37 rows of 3.
     let (v, columns) = read_all(
         &mut run,
@@ -603,4 +635,36 @@ call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.
     assert!(checked > 1500, "{checked}");
     let report = run.timeline.as_ref().unwrap().summary();
     assert!(!report.contains("ErrorID"), "{report}");
+}
+
+/// MC_ReadCamTableCharacteristics with its `master_velocity` input in a timeline: the values
+/// for a master running backwards at 2 units/s (seed 000 3.4's rescaling on the PLC path).
+#[test]
+fn the_characteristics_block_reads_values_rescaled_to_a_master_velocity() {
+    let scenario = "cycle_ms = 1.0\nticks = 20\n[[axis]]\nname = \"Lifter\"\npower = true\n\
+        [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
+    let timeline = "[[step]]\nat_tick = 2\ncall = { block = \"MC_ReadCamTableCharacteristics\", \
+        instance = \"charac\", axis = 0, table = 1, master_velocity = -2.0 }\n";
+    let s = Scenario::parse("charac.toml", scenario, |f| {
+        if f == "plc.toml" {
+            return Ok((PathBuf::from(f), timeline.to_string()));
+        }
+        let path = scenarios().join("cams").join(f);
+        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+    }
+    let report = run.timeline.as_ref().unwrap().summary();
+    let got = read_values(&report, "charac");
+    let expected = cnc_core::cam::CharacValues::normed(&seed_cam())
+        .rescaled(-2.0)
+        .unwrap();
+    let fields = expected.fields();
+    assert_eq!(got[0], -2.0, "fMasterVeloNom: {report}");
+    for (k, value) in got.iter().enumerate() {
+        assert_eq!(*value, fields[k].1, "{}", fields[k].0);
+    }
 }
