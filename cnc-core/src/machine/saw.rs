@@ -240,6 +240,11 @@ impl Engine for SawEngine {
             match s.follower.step(&m, now.setpoint(), dt) {
                 Some((set, phase)) => {
                     io.axes.drive(s.lease, set, phase);
+                    // A new plan in the tick (after a rollback): the values describe it now.
+                    if let Some(values) = s.follower.take_replanned() {
+                        self.plans = self.plans.wrapping_add(1);
+                        self.characs[i] = Some((values, self.plans));
+                    }
                 }
                 None => {
                     io.axes.release(s.lease);

@@ -35,6 +35,8 @@ pub struct Follower {
     stop: Profile,
     /// The slave's software limits (for a new plan after a rollback).
     soft: Option<[f64; 2]>,
+    /// The characteristic values of a plan made in a tick (after a rollback), until taken.
+    replanned: Option<crate::cam::CharacValues>,
 }
 
 impl Follower {
@@ -54,7 +56,14 @@ impl Follower {
             phase: Phase::Synchronizing { t: 0.0 },
             stop: plan.profile,
             soft,
+            replanned: None,
         }
+    }
+
+    /// The characteristic values of the plan made in the last tick, once: the phase that runs
+    /// now after a rollback, which a read of the values then describes.
+    pub fn take_replanned(&mut self) -> Option<crate::cam::CharacValues> {
+        self.replanned.take()
     }
 
     /// The coupling command.
@@ -142,6 +151,7 @@ impl Follower {
                 if tau >= 0.0 && m.velocity * self.dir > 0.0 {
                     let next = plan(&self.request, m, &held, self.soft).ok()?;
                     self.profile = next.profile;
+                    self.replanned = Some(next.charac.values);
                     self.m0 = m.position;
                     self.phase = Phase::Synchronizing { t: 0.0 };
                     return Some((held, AxisState::SlaveSynchronizing));

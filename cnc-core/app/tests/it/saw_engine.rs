@@ -637,3 +637,52 @@ fn saw_settings_of_a_plc_program_are_checked() {
     let e = parse("timeline = \"t.toml\"\nsaw_cuts = 3").unwrap_err();
     assert!(e.contains("belong to a built-in program"), "{e}");
 }
+
+/// After a rollback the slave stands in the pre-phase; when the master comes forward over the
+/// coupling position again the saw plans anew inside the tick, and the characteristic values
+/// read then describe that new phase (its start: the master where it re-planned, the slave
+/// where it stood), not the first one.
+#[test]
+fn the_characteristic_values_describe_the_phase_planned_after_a_rollback() {
+    let mut run = moving(250.0);
+    let m0 = set(&run, MASTER).position;
+    assert_eq!(
+        gear_in(&mut run, SAW, velocity_call(1.0, m::ROLLBACKLOCK)),
+        0
+    );
+    until(&mut run, 5000, |r| {
+        phase(r, SAW) == AxisState::SlaveSynchronous.raw()
+    });
+    let charac = |run: &mut InProcess| {
+        let view = CncView::new(&run.memory);
+        let reply = run
+            .machine
+            .call(&view, SAW as u32, &SawCharacCall { part: 0 })
+            .unwrap();
+        assert_eq!(reply.error_id, 0);
+        (reply.values[1], reply.values[2])
+    };
+    let first = charac(&mut run);
+    assert!(
+        (first.0 - m0).abs() < 1.0,
+        "the first phase starts at {m0}: {first:?}"
+    );
+    let back = AxisCommandCall::move_velocity(-1, [2000.0, 3000.0, 3000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, back), 0);
+    until(&mut run, 20_000, |r| {
+        set(r, MASTER).position < m0 - 100.0 && set(r, SAW).velocity == 0.0
+    });
+    let stood = set(&run, SAW).position;
+    let forward = AxisCommandCall::move_velocity(1, [500.0, 3000.0, 3000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, forward), 0);
+    until(&mut run, 20_000, |r| {
+        phase(r, SAW) == AxisState::SlaveSynchronizing.raw()
+    });
+    let again = charac(&mut run);
+    assert!(
+        (again.0 - m0).abs() < 1.0,
+        "the new phase starts where the master passed the coupling position: {again:?}"
+    );
+    assert_eq!(again.1, stood, "from where the slave stood");
+    assert_ne!(again, first);
+}
