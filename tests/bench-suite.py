@@ -131,7 +131,7 @@ def targets(text):
     return rows
 
 
-def report(results, peers, smoke, wall):
+def report(results, peers, smoke, wall, out_dir):
     out = ["# Benchmark report", ""]
     if smoke:
         out.append("Written by `python3 tests/bench-suite.py --smoke`: a smoke run, every count"
@@ -149,14 +149,14 @@ def report(results, peers, smoke, wall):
     for (package, bench, _, _), (code, _, text) in zip(BENCHES, results):
         rows = targets(text) if code == 0 else [("runs to its end", "-", "FAILED")]
         for what, figure, verdict in rows:
-            if smoke:
+            if smoke and verdict != "FAILED":
                 verdict = "smoke"
             key = "met" if verdict == "met" else "missed" if verdict.startswith("MISSED") or verdict == "FAILED" else "other"
             counts[key] += 1
             out.append(f"| {bench} | {what} | {figure} | {verdict} |")
     out += ["", f"{counts['met']} met, {counts['missed']} missed, {counts['other']} skipped or not judged;"
             f" the suite took {wall / 60:.1f} min.", ""]
-    if (ROOT / "docs/benchmarks/scaling.svg").exists() and not smoke:
+    if (out_dir / "scaling.svg").exists() and not smoke:
         out += ["![tick cost against machine size](scaling.svg)", ""]
     out += ["## Each bench", ""]
     for (package, bench, what, baseline), (code, seconds, text) in zip(BENCHES, results):
@@ -194,7 +194,7 @@ def main():
         results.append(run_bench(package, bench, env))
         code, seconds, _ = results[-1]
         print(f"bench-suite: {bench} {'ok' if code == 0 else f'FAILED ({code})'} in {seconds:.0f} s", flush=True)
-    text = report(results, peers, args.smoke, time.monotonic() - t0)
+    text = report(results, peers, args.smoke, time.monotonic() - t0, out_dir)
     (out_dir / "README.md").write_text(text + "\n")
     print(f"bench-suite: report {out_dir / 'README.md'}")
     failed = [b for (_, b, _, _), (c, _, _) in zip(BENCHES, results) if c != 0]

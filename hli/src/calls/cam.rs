@@ -594,7 +594,8 @@ mod tests {
                 ("characteristics", 2),
                 ("values", 3),
                 ("info", 4),
-                ("rows", 5)
+                ("rows", 5),
+                ("queued", 6)
             ]
         );
         assert_eq!(
@@ -625,7 +626,7 @@ mod tests {
         );
         assert_eq!(CamScalingMode::from_name("auto offset"), None);
         assert_eq!(CamReadKind::from_raw(0), None);
-        assert_eq!(CamReadKind::from_raw(6), None);
+        assert_eq!(CamReadKind::from_raw(7), None);
         assert_eq!(CamMultiTableOp::from_raw(3), None);
         assert!(
             CamStartMode::Relative.master_relative() && CamStartMode::Relative.slave_relative()

@@ -218,7 +218,7 @@ pub struct McCamScaling {
     pub scaling: CamScalingCall,
     /// Outputs of the last call.
     pub out: Outputs,
-    kernel: Kernel<PendingCall<CamScalingCall>, Option<PendingCall<CamReadCall>>>,
+    kernel: Kernel<PendingCall<CamScalingCall>, Asked>,
 }
 
 impl Default for McCamScaling {
@@ -232,33 +232,43 @@ impl Default for McCamScaling {
     }
 }
 
-/// Whether slave `slave`'s scaling has been carried out: asked with a read when none is on
-/// its way (`asked`), answered when it arrives (asked again while still queued).
+/// A `Queued` read of slave `slave`'s coupling on its way, and the cycle it was sent in.
+type Asked = Option<(PendingCall<CamReadCall>, u64)>;
+
+/// Sends the `Queued` read of slave `slave`'s coupling.
+fn ask_queued(io: &mut PlcIo<'_>, slave: u32, asked: &mut Asked) -> Step<()> {
+    let read = CamReadCall {
+        what: CamReadKind::Queued.raw(),
+        ..CamReadCall::default()
+    };
+    match send(io, slave, &read) {
+        Ok(p) => {
+            *asked = Some((p, io.cycle));
+            Step::Running(Outputs::busy())
+        }
+        Err(code) => Step::Ended(failed(code)),
+    }
+}
+
+/// Whether slave `slave`'s scaling has been carried out: a `Queued` read each cycle (the next
+/// one sent as soon as the last says a scaling still waits), Done once none waits. A read not
+/// answered within the block's timeout ends it with [`crate::kernel::ERROR_NO_ANSWER`].
 fn scaling_carried_out(
     io: &mut PlcIo<'_>,
     slave: u32,
-    asked: &mut Option<PendingCall<CamReadCall>>,
+    asked: &mut Asked,
+    timeout: u64,
 ) -> Step<()> {
-    let Some(pending) = asked.as_ref() else {
-        let read = CamReadCall {
-            what: CamReadKind::Queued.raw(),
-            ..CamReadCall::default()
-        };
-        return match send(io, slave, &read) {
-            Ok(p) => {
-                *asked = Some(p);
-                Step::Running(Outputs::busy())
-            }
-            Err(code) => Step::Ended(failed(code)),
-        };
+    let Some((pending, sent)) = asked.as_ref() else {
+        return ask_queued(io, slave, asked);
     };
     match pending.poll() {
+        None if io.cycle.saturating_sub(*sent) > timeout => {
+            Step::Ended(failed(crate::kernel::ERROR_NO_ANSWER))
+        }
         None => Step::Running(Outputs::busy()),
         Some(Ok(reply)) if reply.error_id != 0 => Step::Ended(failed(reply.error_id)),
-        Some(Ok(reply)) if reply.values[0] != 0.0 => {
-            *asked = None;
-            Step::Running(Outputs::busy())
-        }
+        Some(Ok(reply)) if reply.values[0] != 0.0 => ask_queued(io, slave, asked),
         Some(Ok(_)) => Step::Ended(Outputs::done(())),
         Some(Err(e)) => Step::Ended(failed(crate::kernel::call_error_code(&e))),
     }
@@ -279,7 +289,7 @@ impl McCamScaling {
                 0 => Accept::Follow(None, Outputs::busy()),
                 code => Accept::Failed(code, ()),
             },
-            |asked, io, _| scaling_carried_out(io, slave, asked),
+            |asked, io, waited| scaling_carried_out(io, slave, asked, waited.timeout),
         );
     }
 

@@ -146,11 +146,17 @@ impl CamEngine {
             return Err(CamCouplingError::BadParameter.raw());
         }
         // MC_CamTableSelect's MasterAbsolute/SlaveAbsolute and MC_CamIn's StartMode say the
-        // same thing twice: a coupling whose start mode contradicts the table's selection is
-        // refused rather than one of the two silently ignored.
+        // same thing twice: a side the selection made absolute that the start mode takes
+        // relative is refused rather than one of the two silently ignored. FALSE, the seed's
+        // default of both flags, cannot be told from a flag not given: it imposes nothing
+        // (MC_CamIn's own default is absolute).
         let selected = self.selects.get(call.table_id as usize).copied().flatten();
-        if let Some(Select { absolute, .. }) = selected {
-            if absolute != (!start.master_relative(), !start.slave_relative()) {
+        if let Some(Select {
+            absolute: (master_abs, slave_abs),
+            ..
+        }) = selected
+        {
+            if (master_abs && start.master_relative()) || (slave_abs && start.slave_relative()) {
                 return Err(CamCouplingError::ModeCombination.raw());
             }
         }
@@ -378,6 +384,8 @@ impl CamEngine {
             Ok(lease) => lease,
             Err(e) => return code(e),
         };
+        // A new coupling: a cam coupling lost before is no longer the slave's.
+        self.lost[slave] = None;
         if let Some(stale) = self.slaves[slave].take() {
             self.retired.extend(stale.own);
             self.retired.extend(stale.switch_own);
@@ -424,7 +432,9 @@ impl CamEngine {
         }
         // A coupling lost to a fault counts as coupled until this decoupling (seed 000
         // 5.1.15: MC_CamInfo before decoupling); MC_CamInfo reads nothing after it.
-        let was_lost = self.lost[slave].take().is_some();
+        // (Not when another engine has coupled the axis since: that coupling is not ours.)
+        let was_lost = self.lost[slave].take().is_some()
+            && axes.axis(slave).is_some_and(|a| a.coupling().is_none());
         let multi = self.multis[slave].as_ref().map(|m| m.lease);
         if let Some(lease) = multi.filter(|l| axes.holds(*l)) {
             self.multis[slave] = None;

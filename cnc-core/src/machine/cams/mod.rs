@@ -50,8 +50,8 @@ const TABLE_SLOTS: usize = 256;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct Select {
     periodic: bool,
-    /// MasterAbsolute and SlaveAbsolute: the start mode a coupling through the table must
-    /// have (MC_CamIn's StartMode governs; a contradiction is refused).
+    /// MasterAbsolute and SlaveAbsolute: a side selected absolute may not be coupled relative
+    /// (MC_CamIn's StartMode governs; a contradiction is refused).
     absolute: (bool, bool),
 }
 
@@ -296,15 +296,18 @@ impl CamEngine {
         periodic_of(&self.selects, table, profile)
     }
 
-    /// Whether a coupling uses table `id` or switches to it.
+    /// Whether a coupling uses table `id` or switches to it. A coupling lost to a fault
+    /// counts until it is decoupled: MC_CamInfo still reads it from its table.
     fn in_use(&self, id: u32) -> bool {
-        self.slaves.iter().flatten().any(|s| {
+        let uses = |s: &Slave| {
             s.table == id || matches!(s.switch, Some(Queued::Switch { table, .. }) if table == id)
-        }) || self
-            .multis
-            .iter()
-            .flatten()
-            .any(|m| m.law.tables().any(|t| t == id))
+        };
+        self.slaves.iter().chain(&self.lost).flatten().any(uses)
+            || self
+                .multis
+                .iter()
+                .flatten()
+                .any(|m| m.law.tables().any(|t| t == id))
     }
 
     /// Online changes of the motion functions coupled slaves run on, under each table's

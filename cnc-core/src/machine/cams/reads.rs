@@ -220,8 +220,11 @@ impl CamEngine {
                     .map_or(s.master_before, |a| a.setpoint().position);
                 (s, now)
             }
-            (None, Some(s)) => (s, s.master_before),
-            (None, None) => return Err(CamCouplingError::NotCamCoupled.raw()),
+            // Unless another engine has coupled the axis since.
+            (None, Some(s)) if axes.axis(slave).is_some_and(|a| a.coupling().is_none()) => {
+                (s, s.master_before)
+            }
+            (None, _) => return Err(CamCouplingError::NotCamCoupled.raw()),
         };
         let stored = self.store.get(s.table).map_err(|_| TABLE_INVALID)?;
         let profile = s.own.as_ref().unwrap_or(stored);

@@ -306,9 +306,10 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
 }
 
 /// No input silently ignored: a table selected absolute for master and slave couples with
-/// StartMode absolute only; every other start mode contradicts the selection and is refused
-/// (0x4262) with the axis untouched. A table selected master-relative takes exactly that mode;
-/// a table never selected takes whatever MC_CamIn says.
+/// StartMode absolute only; every start mode that takes a side relative contradicts the
+/// selection and is refused (0x4262) with the axis untouched. A flag selected FALSE (the seed's
+/// default, not told from one not given) imposes nothing; a table never selected takes
+/// whatever MC_CamIn says.
 #[test]
 fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
     let mut run = machine("");
@@ -329,7 +330,8 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
     }
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
     assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
-    // Master relative, slave absolute: StartMode MasterRelSlaveAbs and nothing else.
+    // Slave selected absolute, master left FALSE: the slave may not be coupled relative,
+    // the master may be either.
     let select = CamTableSelectCall {
         periodic: 1,
         master_absolute: 0,
@@ -337,19 +339,24 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
         reserved: 0,
     };
     assert_eq!(call(&mut run, 2, select), 0);
-    let mode = |m: u32| CamInCall {
-        start_mode: m,
+    let mode = |m: CamStartMode| CamInCall {
+        start_mode: m.raw(),
         ..cam_in(2)
     };
-    assert_eq!(call(&mut run, SLAVE as u32, mode(1)), contradiction);
-    let master_rel_slave_abs = CamStartMode::MasterRelSlaveAbs.raw();
-    assert_eq!(call(&mut run, SLAVE as u32, mode(master_rel_slave_abs)), 0);
-    assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    for refused in [CamStartMode::Relative, CamStartMode::MasterAbsSlaveRel] {
+        assert_eq!(call(&mut run, SLAVE as u32, mode(refused)), contradiction);
+    }
+    for taken in [CamStartMode::Absolute, CamStartMode::MasterRelSlaveAbs] {
+        assert_eq!(call(&mut run, SLAVE as u32, mode(taken)), 0, "{taken:?}");
+        assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    }
     // A table never selected: MC_CamIn's start mode alone governs.
     let mut fresh = machine("");
     fresh.step(0.001);
-    let relative = CamStartMode::Relative.raw();
-    assert_eq!(call(&mut fresh, SLAVE as u32, mode(relative)), 0);
+    assert_eq!(
+        call(&mut fresh, SLAVE as u32, mode(CamStartMode::Relative)),
+        0
+    );
 }
 
 /// DeleteQueuedData on a pending MC_CamInExt switch: the queued switch to the stroke table is

@@ -191,9 +191,16 @@ fn a_slave_that_faults_while_coupled_keeps_its_last_valid_coupling_until_cam_out
         "the last slave position {}",
         v[21]
     );
+    // Its table stays in use until then (the read rebuilds positions from it).
+    let delete = |run: &mut InProcess| {
+        let d = hli::calls::cam::CamTableDeleteCall::default();
+        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 3, &d)).error_id
+    };
+    assert_eq!(delete(&mut run), CamCouplingError::TableInUse.raw());
     // MC_CamOut decouples the lost coupling; then there is nothing to read or decouple.
     assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
     let refused = CamCouplingError::NotCamCoupled.raw();
     assert_eq!(cam_info(&mut run, None), Err(refused));
     assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), refused);
+    assert_eq!(delete(&mut run), 0, "the table is free again");
 }
