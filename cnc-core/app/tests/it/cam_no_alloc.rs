@@ -139,23 +139,7 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         1,
         hli::wire::encode_body(&mode),
     );
-    let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
-    points[0] = hli::calls::cam::McMotionFunctionPoint {
-        point_index: 4,
-        function_type: 15,
-        point_type: 2,
-        rel_index_next_point: 1,
-        master_pos: 240.0,
-        slave_pos: 30.0,
-        ..Default::default()
-    };
-    let write = hli::calls::cam::CamPointsWriteCall {
-        first: 4,
-        count: 1,
-        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
-        total: 1,
-        points,
-    };
+    let write = crate::cam_engine::one_point_write(crate::cam_engine::seed_point_4(30.0));
     send(
         &mut run,
         hli::calls::CallKind::CAM_POINTS_WRITE,

@@ -75,9 +75,7 @@ fn chunks_out_of_order_and_bad_tables_are_refused_whole() {
 
 #[test]
 fn points_read_back_and_a_refused_write_leaves_the_function() {
-    use hli::calls::cam::{
-        CamPointsReadCall, CamPointsReply, CamPointsWriteCall, McMotionFunctionPoint,
-    };
+    use hli::calls::cam::{CamPointsReadCall, CamPointsReply, McMotionFunctionPoint};
     let mut run = machine("");
     run.step(0.001);
     let read = |run: &mut InProcess, first: u32| -> CamPointsReply {
@@ -97,15 +95,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     // A point whose master position breaks the monotonic order: refused whole.
     let mut p4: McMotionFunctionPoint = read(&mut run, 4).points[0];
     p4.master_pos = 400.0;
-    let mut points = [McMotionFunctionPoint::default(); 4];
-    points[0] = p4;
-    let write = CamPointsWriteCall {
-        first: 4,
-        count: 1,
-        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
-        total: 1,
-        points,
-    };
+    let write = one_point_write(p4);
     let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
     assert!(
         (0x4B30..=0x4B38).contains(&reply.error_id),
@@ -115,8 +105,8 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     run.step(0.001);
     assert_eq!(read(&mut run, 4).points[0].master_pos, 240.0);
     // A good one applies (instantaneous mode, nothing coupled).
-    points[0].master_pos = 250.0;
-    let write = CamPointsWriteCall { points, ..write };
+    p4.master_pos = 250.0;
+    let write = one_point_write(p4);
     let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
     assert_eq!(reply.error_id, 0);
     run.step(0.001);
@@ -604,11 +594,7 @@ call = { block = "CamTableSetSlaveScale", instance = "slave", axis = 1, slave_sl
 wait = "slave.Done"
 call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.0, direction = 1, acceleration = 1800.0, deceleration = 1800.0, jerk = 18000.0 }
 "#;
-    let s = Scenario::parse("slave-scale.toml", scenario, |f| {
-        assert_eq!(f, "plc.toml");
-        Ok((PathBuf::from(f), timeline.to_string()))
-    })
-    .unwrap();
+    let s = with_timeline("slave-scale.toml", scenario, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
     let zigzag = |m: f64| {
         let m = m.rem_euclid(360.0);
@@ -645,14 +631,7 @@ fn the_characteristics_block_reads_values_rescaled_to_a_master_velocity() {
         [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
     let timeline = "[[step]]\nat_tick = 2\ncall = { block = \"MC_ReadCamTableCharacteristics\", \
         instance = \"charac\", axis = 0, table = 1, master_velocity = -2.0 }\n";
-    let s = Scenario::parse("charac.toml", scenario, |f| {
-        if f == "plc.toml" {
-            return Ok((PathBuf::from(f), timeline.to_string()));
-        }
-        let path = scenarios().join("cams").join(f);
-        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
-    })
-    .unwrap();
+    let s = with_timeline("charac.toml", scenario, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
     for _ in 0..s.ticks.unwrap() {
         run.step(s.cycle_s);

@@ -123,6 +123,59 @@ fn phase(run: &InProcess, axis: usize) -> AxisState {
         .motion_state(set(run, axis))
 }
 
+/// The seed cam's point 4 (the fall's start at master 240) at slave position `slave`.
+pub(crate) fn seed_point_4(slave: f64) -> hli::calls::cam::McMotionFunctionPoint {
+    hli::calls::cam::McMotionFunctionPoint {
+        point_index: 4,
+        function_type: 15,
+        point_type: 2,
+        rel_index_next_point: 1,
+        master_pos: 240.0,
+        slave_pos: slave,
+        ..Default::default()
+    }
+}
+
+/// MC_WriteMotionFunctionPoint's call of one point, in one chunk.
+pub(crate) fn one_point_write(
+    point: hli::calls::cam::McMotionFunctionPoint,
+) -> hli::calls::cam::CamPointsWriteCall {
+    let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
+    points[0] = point;
+    hli::calls::cam::CamPointsWriteCall {
+        first: point.point_index,
+        count: 1,
+        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
+        total: 1,
+        points,
+    }
+}
+
+/// The law of a slave coupled absolute, unscaled, to the seed cam at master 0, slave 0.
+fn seed_law(periodic: bool) -> CamLaw {
+    CamLaw::new(
+        &seed_cam(),
+        Scaling::default(),
+        CamStartMode::Absolute,
+        periodic,
+        0.0,
+        0.0,
+    )
+}
+
+/// A scenario `toml` whose `plc.toml` is `timeline` and whose other files are the cam
+/// examples (`scenarios/cams`).
+fn with_timeline(name: &str, toml: &str, timeline: &str) -> Scenario {
+    Scenario::parse(name, toml, |f| {
+        if f == "plc.toml" {
+            return Ok((PathBuf::from(f), timeline.to_string()));
+        }
+        let path = scenarios().join("cams").join(f);
+        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
+    })
+    .unwrap()
+}
+
 fn law_at(law: &CamLaw, profile: &CamProfile, master: Kinematic) -> Kinematic {
     law.slave(profile, &mut ProfileCursor::default(), &master).0
 }
@@ -143,14 +196,7 @@ fn the_conveyor_scenario_follows_the_law_scales_changes_a_point_and_decouples() 
     let mut run = InProcess::new(&s, 0).unwrap();
     let original = seed_cam();
     let changed = changed_cam(&original);
-    let law = CamLaw::new(
-        &original,
-        Scaling::default(),
-        CamStartMode::Absolute,
-        true,
-        0.0,
-        0.0,
-    );
+    let law = seed_law(true);
     // The three phases: scaling 1 with the original cam, 0.5 with it, 0.5 with the changed
     // one. Each switch happens where the laws before and after agree (the rest at the cycle
     // start), so the phase a tick belongs to is the first that explains it from the last.
@@ -333,14 +379,7 @@ fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
     assert_eq!(call(&mut run, SLAVE as u32, at_axis), 0);
     run_master(&mut run, 360.0);
     let profile = seed_cam();
-    let law = CamLaw::new(
-        &profile,
-        Scaling::default(),
-        CamStartMode::Absolute,
-        true,
-        0.0,
-        0.0,
-    );
+    let law = seed_law(true);
     let mut started = None;
     for tick in 0..2000 {
         run.step(0.001);

@@ -12,14 +12,7 @@ fn a_slave_may_follow_the_masters_actual_position() {
     };
     assert_eq!(call(&mut run, SLAVE as u32, actual), 0);
     run_master(&mut run, 360.0);
-    let law = CamLaw::new(
-        &seed_cam(),
-        Scaling::default(),
-        CamStartMode::Absolute,
-        false,
-        0.0,
-        0.0,
-    );
+    let law = seed_law(false);
     let profile = seed_cam();
     let mut differs = 0;
     for _ in 0..300 {
@@ -79,14 +72,7 @@ fn every_scaling_activation_mode_takes_effect_where_it_says_without_a_jump() {
             ..CamScalingCall::default()
         };
         assert_eq!(call(&mut run, SLAVE as u32, scaling), 0, "mode {mode}");
-        let law = CamLaw::new(
-            &seed_cam(),
-            Scaling::default(),
-            CamStartMode::Absolute,
-            true,
-            0.0,
-            0.0,
-        );
+        let law = seed_law(true);
         let profile = seed_cam();
         let mut last = set(&run, SLAVE).position;
         let mut switched_at = None;
@@ -239,7 +225,7 @@ fn a_slave_coupled_later_starts_in_the_base_cycle() {
 
 #[test]
 fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
-    use hli::calls::cam::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    use hli::calls::cam::CamOnlineModeCall;
     let mut run = machine("");
     run.step(0.001);
     select_cyclic(&mut run, 1);
@@ -263,25 +249,7 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
     // Point 4 (the fall's start, 240) from 40 to 30: the segments from 30 to 340 change (the
     // rise's end slope too), so both slaves are clear of them only while the lifter is
     // between 340 and 10 degrees.
-    let mut points = [McMotionFunctionPoint::default(); 4];
-    points[0] = McMotionFunctionPoint {
-        point_index: 4,
-        function_type: 15,
-        point_type: 2,
-        rel_index_next_point: 1,
-        master_pos: 240.0,
-        slave_pos: 30.0,
-        ..Default::default()
-    };
-    let write = CamPointsWriteCall {
-        first: 4,
-        count: 1,
-        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
-        total: 1,
-        points,
-    };
-    let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
-    assert_eq!(reply.error_id, 0);
+    assert_eq!(write_point_4(&mut run), 0);
     let mut last = [set(&run, SLAVE).position, set(&run, 2).position];
     let mut top = [0.0f64; 2];
     for tick in 0..2000 {
@@ -401,14 +369,7 @@ fn delete_queued_data_drops_a_pending_switch_and_the_slave_stays_on_its_cam() {
     assert_eq!(call(&mut run, SLAVE as u32, delete), 0);
     assert_eq!(queued(&mut run).0, 0.0, "nothing queued any more");
     let profile = seed_cam();
-    let law = CamLaw::new(
-        &profile,
-        Scaling::default(),
-        CamStartMode::Absolute,
-        true,
-        0.0,
-        0.0,
-    );
+    let law = seed_law(true);
     // More than a whole turn: past cam position 200 at least once.
     for tick in 0..1500 {
         run.step(0.001);
@@ -470,14 +431,7 @@ fn the_seeds_example_1_stills_the_slave_at_the_next_cycle_and_brings_it_back() {
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
     run_master(&mut run, 360.0);
     let profile = seed_cam();
-    let law = CamLaw::new(
-        &profile,
-        Scaling::default(),
-        CamStartMode::Absolute,
-        true,
-        0.0,
-        0.0,
-    );
+    let law = seed_law(true);
     let example = |slave_scaling: f64| CamScalingCall {
         activation_mode: 3,
         master_scaling_mode: 2,
@@ -544,7 +498,7 @@ fn the_seeds_example_1_stills_the_slave_at_the_next_cycle_and_brings_it_back() {
 /// UserDefined the same change jumps (the contrast that shows the offset at work).
 #[test]
 fn an_online_point_change_with_slave_auto_offset_does_not_jump() {
-    use hli::calls::cam::{CamOnlineModeCall, CamPointsWriteCall, McMotionFunctionPoint};
+    use hli::calls::cam::CamOnlineModeCall;
     let run_with = |slave_mode: u32| -> (f64, Vec<(f64, f64)>) {
         let mut run = machine("");
         run.step(0.001);
@@ -562,25 +516,7 @@ fn an_online_point_change_with_slave_auto_offset_does_not_jump() {
         };
         let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &mode));
         assert_eq!(reply.error_id, 0);
-        let mut points = [McMotionFunctionPoint::default(); 4];
-        points[0] = McMotionFunctionPoint {
-            point_index: 4,
-            function_type: 15,
-            point_type: 2,
-            rel_index_next_point: 1,
-            master_pos: 240.0,
-            slave_pos: 30.0,
-            ..Default::default()
-        };
-        let write = CamPointsWriteCall {
-            first: 4,
-            count: 1,
-            flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
-            total: 1,
-            points,
-        };
-        let reply: CamReply = bytemuck::pod_read_unaligned(&dispatch_raw(&mut run, 1, &write));
-        assert_eq!(reply.error_id, 0);
+        assert_eq!(write_point_4(&mut run), 0);
         let mut last = set(&run, SLAVE).position;
         let mut largest: f64 = 0.0;
         let mut samples = Vec::new();
@@ -646,14 +582,7 @@ call = { block = "MC_CamScaling", instance = "scale", axis = 1, activation_mode 
 wait = "scale.Done"
 call = { block = "MC_Halt", instance = "halt", axis = 0, deceleration = 3600.0, jerk = 36000.0 }
 "#;
-    let s = Scenario::parse("scaling-done.toml", scenario, |f| {
-        if f == "plc.toml" {
-            return Ok((PathBuf::from(f), timeline.to_string()));
-        }
-        let path = scenarios().join("cams").join(f);
-        Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
-    })
-    .unwrap();
+    let s = with_timeline("scaling-done.toml", scenario, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
     let mut crossed = None;
     let mut before: f64 = 0.0;
@@ -679,4 +608,11 @@ call = { block = "MC_Halt", instance = "halt", axis = 0, deceleration = 3600.0, 
     );
     let report = run.timeline.as_ref().unwrap().summary();
     assert!(!report.contains("ErrorID"), "{report}");
+}
+
+/// MC_WriteMotionFunctionPoint of the seed cam's point 4 (the fall's start at 240) from 40 to
+/// 30, as the conveyor's PLC writes it: the error id of the answer.
+fn write_point_4(run: &mut InProcess) -> u32 {
+    let write = one_point_write(seed_point_4(30.0));
+    bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 1, &write)).error_id
 }
