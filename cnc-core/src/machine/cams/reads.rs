@@ -47,6 +47,10 @@ impl CamEngine {
         let call: CamReadCall = decode_body(request)?;
         let id = request.target;
         let skip = call.part as usize * CAM_VALUES_PER_REPLY;
+        if call.what == CamReadKind::Queued.raw() {
+            // Asked every PLC cycle while MC_CamScaling waits: answered without allocating.
+            return self.queued_reply(id as usize);
+        }
         // A values read makes only the part asked for; the others make all and are cut here.
         let answer = match CamReadKind::from_raw(call.what) {
             Some(CamReadKind::SlaveDynamics) => self.slave_dynamics(id, &call),
@@ -73,7 +77,8 @@ impl CamEngine {
                 let n = v.len();
                 Made::all(v, n)
             }),
-            Some(CamReadKind::Queued) => self.queued(id as usize).map(|v| Made::all(v.to_vec(), 3)),
+            // Answered above, without allocating.
+            Some(CamReadKind::Queued) => Err(CamCouplingError::UnknownMode.raw()),
             None => Err(CamCouplingError::UnknownMode.raw()),
         };
         let made = match answer {
@@ -188,17 +193,27 @@ impl CamEngine {
     }
 
     /// What slave `slave`'s coupling waits to activate: a scaling, a switch, a point change
-    /// of its table (1.0 or 0.0 each).
-    fn queued(&self, slave: usize) -> Result<[f64; 3], u32> {
+    /// of its table (1.0 or 0.0 each), as the reply; no allocation.
+    fn queued_reply(&self, slave: usize) -> HandlerResult {
         let Some(s) = self.slaves.get(slave).and_then(Option::as_ref) else {
-            return Err(CamCouplingError::NotCamCoupled.raw());
+            return reply(&CamValuesReply {
+                error_id: CamCouplingError::NotCamCoupled.raw(),
+                ..CamValuesReply::default()
+            });
         };
         let points = self.store.queue(s.table).is_ok_and(|q| q.is_queued());
-        Ok([
+        let mut out = CamValuesReply {
+            total: 3,
+            columns: 1,
+            count: 3,
+            ..CamValuesReply::default()
+        };
+        out.values[..3].copy_from_slice(&[
             flag(s.scale.is_some()),
             flag(s.switch.is_some()),
             flag(points),
-        ])
+        ]);
+        reply(&out)
     }
 
     /// The 40 values of MC_CamInfoData for slave `slave`, at the master's set-point or at
