@@ -274,47 +274,41 @@ fn table(dims: &[Dimension]) -> String {
     s
 }
 
-/// One panel per dimension, ns per tick over its size (log x for the flat ones).
+/// One panel per dimension, ns per tick over its size (over log10 of it for the flat ones).
 fn plot(dims: &[Dimension], out: &std::path::Path) -> Result<(), String> {
     use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
     let root = SVGBackend::new(out, (1200, 760)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    root.fill(&WHITE).map_err(|e| err(&e))?;
     let panels = root.split_evenly((2, 3));
     for (d, area) in dims.iter().zip(panels.iter()) {
+        let flat = d.shape == Shape::Flat;
+        let x_of = |x: f64| if flat { x.log10() } else { x };
+        let points: Vec<(f64, f64)> = d.points().iter().map(|&(x, y)| (x_of(x), y)).collect();
         let top = d.ns.iter().copied().fold(0.0, f64::max) * 1.15;
-        let x0 = d.xs[0] as f64;
-        let x1 = *d.xs.last().unwrap_or(&1) as f64;
-        let mut builder = ChartBuilder::on(area);
-        builder
+        let (x0, x1) = (points[0].0, points[points.len() - 1].0);
+        let x_range = if flat { x0..x1 } else { 0.0..x1 * 1.05 };
+        let x_desc = if flat {
+            format!("log10 of {}", d.x_label)
+        } else {
+            d.x_label.to_string()
+        };
+        let mut chart = ChartBuilder::on(area)
             .caption(d.name, ("sans-serif", 16))
             .margin(12)
             .x_label_area_size(36)
-            .y_label_area_size(56);
-        let line = LineSeries::new(d.points(), &BLUE).point_size(3);
-        let drawn = if d.shape == Shape::Flat {
-            let mut c = builder
-                .build_cartesian_2d((x0..x1).log_scale(), 0.0..top)
-                .map_err(|e| e.to_string())?;
-            c.configure_mesh()
-                .max_light_lines(0)
-                .x_desc(d.x_label)
-                .y_desc("ns per tick")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            c.draw_series(line).map(|_| ())
-        } else {
-            let mut c = builder
-                .build_cartesian_2d(0.0..x1 * 1.05, 0.0..top)
-                .map_err(|e| e.to_string())?;
-            c.configure_mesh()
-                .max_light_lines(0)
-                .x_desc(d.x_label)
-                .y_desc("ns per tick")
-                .draw()
-                .map_err(|e| e.to_string())?;
-            c.draw_series(line).map(|_| ())
-        };
-        drawn.map_err(|e| e.to_string())?;
+            .y_label_area_size(56)
+            .build_cartesian_2d(x_range, 0.0..top)
+            .map_err(|e| err(&e))?;
+        chart
+            .configure_mesh()
+            .max_light_lines(0)
+            .x_desc(x_desc)
+            .y_desc("ns per tick")
+            .draw()
+            .map_err(|e| err(&e))?;
+        let line = LineSeries::new(points, &BLUE).point_size(3);
+        chart.draw_series(line).map_err(|e| err(&e))?;
     }
-    root.present().map_err(|e| e.to_string())
+    root.present().map_err(|e| err(&e))
 }

@@ -417,14 +417,6 @@ fn the_compatibility_blocks_make_read_couple_rescale_and_delete() {
     let s = Scenario::load(&scenarios().join("cam-compat/scenario.toml")).unwrap();
     let mut run = InProcess::new(&s, 0).unwrap();
     // The generated zigzag, linear: +-9 per turn, doubled, shifted by 0.5 from tick 1500.
-    let zigzag = |m: f64| {
-        let m = m.rem_euclid(360.0);
-        match m {
-            m if m < 90.0 => m / 10.0,
-            m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
-            m => -9.0 + (m - 270.0) / 10.0,
-        }
-    };
     let mut checked = 0;
     for tick in 0..s.ticks.unwrap() {
         run.step(s.cycle_s);
@@ -596,14 +588,6 @@ call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.
 "#;
     let s = with_timeline("slave-scale.toml", scenario, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
-    let zigzag = |m: f64| {
-        let m = m.rem_euclid(360.0);
-        match m {
-            m if m < 90.0 => m / 10.0,
-            m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
-            m => -9.0 + (m - 270.0) / 10.0,
-        }
-    };
     let mut checked = 0;
     for tick in 0..s.ticks.unwrap() {
         run.step(s.cycle_s);

@@ -123,6 +123,34 @@ fn phase(run: &InProcess, axis: usize) -> AxisState {
         .motion_state(set(run, axis))
 }
 
+/// The lifter coupled with MC_CamInExt to the seed cam (table 1, cyclic), the conveyor at
+/// 360 degrees/s for 0.7 s: a coupling ready for a switch.
+fn switchable_at_speed() -> InProcess {
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    let ext = CamInCall {
+        extended: 1,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, ext), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..700 {
+        run.step(0.001);
+    }
+    run
+}
+
+/// The zigzag of the compatibility scenario's table 22 (+-9 per turn, linear) at master `m`.
+fn zigzag(m: f64) -> f64 {
+    let m = m.rem_euclid(360.0);
+    match m {
+        m if m < 90.0 => m / 10.0,
+        m if m < 270.0 => 9.0 - (m - 90.0) / 10.0,
+        m => -9.0 + (m - 270.0) / 10.0,
+    }
+}
+
 /// The seed cam's point 4 (the fall's start at master 240) at slave position `slave`.
 pub(crate) fn seed_point_4(slave: f64) -> hli::calls::cam::McMotionFunctionPoint {
     hli::calls::cam::McMotionFunctionPoint {
@@ -415,18 +443,7 @@ fn an_axis_position_activation_holds_the_slave_until_the_master_passes_it() {
 
 #[test]
 fn switching_cams_mid_cycle_with_auto_offsets_keeps_the_slave_continuous() {
-    let mut run = machine("");
-    run.step(0.001);
-    select_cyclic(&mut run, 1);
-    let ext = CamInCall {
-        extended: 1,
-        ..cam_in(1)
-    };
-    assert_eq!(call(&mut run, SLAVE as u32, ext), 0);
-    run_master(&mut run, 360.0);
-    for _ in 0..700 {
-        run.step(0.001);
-    }
+    let mut run = switchable_at_speed();
     // To the stroke table at cam position 200 (the next time round: the master is past it),
     // where the two cams differ by about 13: both offsets automatic, so neither the master's
     // place in the cycle nor the slave jumps.

@@ -333,18 +333,7 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
 #[test]
 fn delete_queued_data_drops_a_pending_switch_and_the_slave_stays_on_its_cam() {
     use hli::calls::cam::{CamReadCall, CamReadKind};
-    let mut run = machine("");
-    run.step(0.001);
-    select_cyclic(&mut run, 1);
-    let ext = CamInCall {
-        extended: 1,
-        ..cam_in(1)
-    };
-    assert_eq!(call(&mut run, SLAVE as u32, ext), 0);
-    run_master(&mut run, 360.0);
-    for _ in 0..700 {
-        run.step(0.001);
-    }
+    let mut run = switchable_at_speed();
     let switch = CamInCall {
         extended: 1,
         activation_mode: 1,
