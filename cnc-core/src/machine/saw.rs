@@ -12,6 +12,7 @@ use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
+use hli::calls::cam::{TableOrganisation, TABLE_TYPE_MOTION_FUNCTION};
 use hli::calls::saw::{
     SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
     SawSyncTarget, SAW_CHARAC_PART,
@@ -31,14 +32,37 @@ struct SawSlave {
     table: Resource,
 }
 
+/// The characteristic values of a slave's last plan, as MC_ReadFlyingSawCharacteristics
+/// reads them.
+#[derive(Debug, Clone, Copy)]
+struct Characs {
+    values: CharacValues,
+    /// The plan's number (a read in parts tells whether all belong to the same plan).
+    plan: u32,
+    /// The organisation fields: the saw's motion table (256 - axis ID) and the points of the
+    /// synchronising phase's motion function.
+    organisation: TableOrganisation,
+}
+
+/// The organisation fields of a plan of `pieces` pieces in motion table `table`.
+fn organisation(table: Resource, pieces: usize) -> TableOrganisation {
+    let Resource::MotionTable(table_id) = table;
+    TableOrganisation {
+        table_id,
+        rows: pieces as u32 + 1,
+        columns: 1,
+        table_type: TABLE_TYPE_MOTION_FUNCTION,
+        periodic: false,
+    }
+}
+
 /// Flying-saw slaves by axis index.
 #[derive(Debug)]
 pub struct SawEngine {
     cycle_s: f64,
     slaves: Vec<Option<SawSlave>>,
-    /// Per slave: the last plan's values and its number (a read in two parts tells whether
-    /// both belong to the same plan).
-    characs: Vec<Option<(CharacValues, u32)>>,
+    /// Per slave: the last plan's values.
+    characs: Vec<Option<Characs>>,
     plans: u32,
 }
 
@@ -74,7 +98,7 @@ impl SawEngine {
 
     /// The characteristic values of the last phase planned for `slave`.
     pub fn charac(&self, slave: usize) -> Option<&CharacValues> {
-        self.characs.get(slave)?.as_ref().map(|(c, _)| c)
+        self.characs.get(slave)?.as_ref().map(|c| &c.values)
     }
 
     /// Whether `slave` is coupled to a master by the saw (the axis still in the coupling
@@ -164,14 +188,19 @@ impl SawEngine {
                 }
             },
         };
+        let table = own_table(axes, slave);
         self.slaves[slave] = Some(SawSlave {
             master,
             follower: Follower::new(request, &plan, &m, soft_limits),
             lease,
-            table: own_table(axes, slave),
+            table,
         });
         self.plans = self.plans.wrapping_add(1);
-        self.characs[slave] = Some((plan.charac.values, self.plans));
+        self.characs[slave] = Some(Characs {
+            values: plan.charac.values,
+            plan: self.plans,
+            organisation: organisation(table, plan.profile.pieces().len()),
+        });
         accepted()
     }
 
@@ -185,25 +214,28 @@ impl SawEngine {
     }
 
     fn read_charac(&self, slave: usize, call: &SawCharacCall) -> HandlerResult {
-        let Some((c, plan)) = self.characs.get(slave).copied().flatten() else {
+        let Some(c) = self.characs.get(slave).copied().flatten() else {
             return reply(&SawCharacReply {
                 error_id: SawError::NotCoupled.raw(),
                 ..SawCharacReply::default()
             });
         };
-        let fields = c.fields();
+        let fields = c.values.fields().map(|(_, v)| v);
+        let organisation = c.organisation.values();
         let from = call.part as usize * SAW_CHARAC_PART;
-        if from >= fields.len() {
-            return Err(ErrorCode::InvalidData);
-        }
+        let part: &[f64] = match call.part {
+            0 | 1 => &fields[from..],
+            2 => &organisation,
+            _ => return Err(ErrorCode::InvalidData),
+        };
         let mut values = [0.0; SAW_CHARAC_PART];
-        for (v, (_, f)) in values.iter_mut().zip(fields[from..].iter()) {
+        for (v, f) in values.iter_mut().zip(part) {
             *v = *f;
         }
         reply(&SawCharacReply {
             error_id: 0,
             part: call.part,
-            plan,
+            plan: c.plan,
             reserved: 0,
             values,
         })
@@ -241,9 +273,13 @@ impl Engine for SawEngine {
                 Some((set, phase)) => {
                     io.axes.drive(s.lease, set, phase);
                     // A new plan in the tick (after a rollback): the values describe it now.
-                    if let Some(values) = s.follower.take_replanned() {
+                    if let Some((values, pieces)) = s.follower.take_replanned() {
                         self.plans = self.plans.wrapping_add(1);
-                        self.characs[i] = Some((values, self.plans));
+                        self.characs[i] = Some(Characs {
+                            values,
+                            plan: self.plans,
+                            organisation: organisation(s.table, pieces),
+                        });
                     }
                 }
                 None => {

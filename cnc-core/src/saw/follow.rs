@@ -36,7 +36,7 @@ pub struct Follower {
     /// The slave's software limits (for a new plan after a rollback).
     soft: Option<[f64; 2]>,
     /// The characteristic values of a plan made in a tick (after a rollback), until taken.
-    replanned: Option<crate::cam::CharacValues>,
+    replanned: Option<(crate::cam::CharacValues, usize)>,
 }
 
 impl Follower {
@@ -60,9 +60,10 @@ impl Follower {
         }
     }
 
-    /// The characteristic values of the plan made in the last tick, once: the phase that runs
-    /// now after a rollback, which a read of the values then describes.
-    pub fn take_replanned(&mut self) -> Option<crate::cam::CharacValues> {
+    /// The characteristic values of the plan made in the last tick, once, with its number of
+    /// pieces: the phase that runs now after a rollback, which a read of the values then
+    /// describes.
+    pub fn take_replanned(&mut self) -> Option<(crate::cam::CharacValues, usize)> {
         self.replanned.take()
     }
 
@@ -151,7 +152,7 @@ impl Follower {
                 if tau >= 0.0 && m.velocity * self.dir > 0.0 {
                     let next = plan(&self.request, m, &held, self.soft).ok()?;
                     self.profile = next.profile;
-                    self.replanned = Some(next.charac.values);
+                    self.replanned = Some((next.charac.values, next.profile.pieces().len()));
                     self.m0 = m.position;
                     self.phase = Phase::Synchronizing { t: 0.0 };
                     return Some((held, AxisState::SlaveSynchronizing));

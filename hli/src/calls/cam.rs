@@ -345,7 +345,9 @@ wire_enum! {
         SlaveDynamics = 1 => "slave_dynamics",
         /// 2: MC_ReadCamTableCharacteristics of the table given as `target`: the 31 values of
         /// `MC_TableCharacValues` in their order, for a master at constant velocity `a` (0:
-        /// the normed values, for 1.0; a negative velocity runs the cam backwards).
+        /// the normed values, for 1.0; a negative velocity runs the cam backwards), then the
+        /// five organisation fields ([`TableOrganisation`]; the reserved block between is
+        /// left out): 36 values.
         Characteristics = 2 => "characteristics",
         /// 3: MC_ReadMotionFunctionValues of the table given as `target`: rows
         /// `[master, the columns of mask]` from `a` to `b` in steps of `c`, row after row.
@@ -366,6 +368,66 @@ wire_enum! {
 
 /// Values in one [`CamValuesReply`].
 pub const CAM_VALUES_PER_REPLY: usize = 28;
+
+/// The organisation fields that close `MC_TableCharacValues` and `MC_FlyingSawCharacValues`
+/// (after the 31 values and a reserved block): which table the values describe and its shape.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TableOrganisation {
+    /// CamTableID.
+    pub table_id: u32,
+    /// NumberOfRows: the rows of a position table, the points of a motion function.
+    pub rows: u32,
+    /// NumberOfColumns: 2 for a position table (master, slave), 1 for a motion function.
+    pub columns: u32,
+    /// TableType: raw `MC_TableType` (10 equidistant, 11 non-equidistant, 22 motion function).
+    pub table_type: u32,
+    /// Periodic.
+    pub periodic: bool,
+}
+
+/// `MC_TableType` of a motion function (`MC_TableType_TABULARTYPE_MOTIONFUNC`).
+pub const TABLE_TYPE_MOTION_FUNCTION: u32 = 22;
+
+impl TableOrganisation {
+    /// The field names, in the structure's order.
+    pub const FIELDS: [&'static str; 5] = [
+        "CamTableID",
+        "NumberOfRows",
+        "NumberOfColumns",
+        "TableType",
+        "Periodic",
+    ];
+
+    /// The five fields as numbers, in [`Self::FIELDS`] order (Periodic 1 or 0).
+    pub fn values(&self) -> [f64; 5] {
+        [
+            f64::from(self.table_id),
+            f64::from(self.rows),
+            f64::from(self.columns),
+            f64::from(self.table_type),
+            f64::from(u8::from(self.periodic)),
+        ]
+    }
+
+    /// The fields from their numbers; `None` unless each is a whole number in its range.
+    pub fn from_values(v: &[f64]) -> Option<TableOrganisation> {
+        let whole = |x: f64| {
+            (x.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&x)).then_some(x as u32)
+        };
+        let [id, rows, columns, kind, periodic] = <[f64; 5]>::try_from(v).ok()?;
+        Some(TableOrganisation {
+            table_id: whole(id)?,
+            rows: whole(rows)?,
+            columns: whole(columns)?,
+            table_type: whole(kind)?,
+            periodic: match periodic {
+                0.0 => false,
+                1.0 => true,
+                _ => return None,
+            },
+        })
+    }
+}
 
 /// A read of cam data, answered as numbers in parts of [`CAM_VALUES_PER_REPLY`]: part `k`
 /// holds values `28 k ..` of the whole answer.
@@ -634,5 +696,27 @@ mod tests {
         assert!(!CamStartMode::MasterAbsSlaveRel.master_relative());
         assert!(CamStartMode::MasterRelSlaveAbs.master_relative());
         assert!(!CamStartMode::Absolute.slave_relative());
+    }
+
+    #[test]
+    fn the_organisation_fields_go_to_numbers_and_back_and_refuse_what_they_cannot_be() {
+        let org = TableOrganisation {
+            table_id: 254,
+            rows: 3,
+            columns: 1,
+            table_type: TABLE_TYPE_MOTION_FUNCTION,
+            periodic: true,
+        };
+        assert_eq!(org.values(), [254.0, 3.0, 1.0, 22.0, 1.0]);
+        assert_eq!(TableOrganisation::from_values(&org.values()), Some(org));
+        for bad in [
+            [254.5, 3.0, 1.0, 22.0, 0.0],
+            [-1.0, 3.0, 1.0, 22.0, 0.0],
+            [1.0, f64::NAN, 1.0, 22.0, 0.0],
+            [1.0, 3.0, 1.0, 22.0, 2.0],
+        ] {
+            assert_eq!(TableOrganisation::from_values(&bad), None, "{bad:?}");
+        }
+        assert_eq!(TableOrganisation::from_values(&[1.0; 4]), None);
     }
 }

@@ -1,6 +1,6 @@
 //! The flying saw's calls (seed 001, chapter 12): MC_GearInVelo and MC_GearInPos in one
-//! coupling call, MC_GearOut, and MC_ReadFlyingSawCharacteristics in two parts (the 31
-//! values do not fit one frame). Every call addresses the slave axis as `target` (its `gpAx`
+//! coupling call, MC_GearOut, and MC_ReadFlyingSawCharacteristics in three parts (the 31
+//! values do not fit one frame; the organisation fields come last). Every call addresses the slave axis as `target` (its `gpAx`
 //! index); the master is an axis index in the body. The slave's progress is read from its
 //! axis image: `coupling_state_r` 2 (velocity) or 3 (position) and `nAxisState` 11/12/13.
 
@@ -129,12 +129,16 @@ pub struct SawReply {
 /// Values of `MC_FlyingSawCharacValues` one part carries.
 pub const SAW_CHARAC_PART: usize = 16;
 
+/// Parts of MC_ReadFlyingSawCharacteristics: two for the 31 values, one for the organisation.
+pub const SAW_CHARAC_PARTS: u32 = 3;
+
 /// MC_ReadFlyingSawCharacteristics, one part: fields `16 * part + 1 ..` of the structure
-/// (part 0: fields 1-16, part 1: fields 17-31).
+/// (part 0: fields 1-16, part 1: fields 17-31), and part 2: the five organisation fields
+/// ([`crate::calls::cam::TableOrganisation`], the reserved block left out).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
 pub struct SawCharacCall {
-    /// 0 or 1.
+    /// 0, 1 or 2 ([`SAW_CHARAC_PARTS`]).
     pub part: u32,
 }
 

@@ -118,6 +118,13 @@ impl McCamRead {
 
     timeout_input!(kernel);
 
+    /// The organisation fields of a characteristics read (after its 31 values), once read.
+    pub fn organisation(&self) -> Option<hli::calls::cam::TableOrganisation> {
+        let read = self.request.what == CamReadKind::Characteristics.raw();
+        let fields = self.values.get(31..36).filter(|_| read)?;
+        hli::calls::cam::TableOrganisation::from_values(fields)
+    }
+
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (target, request) = (self.target, self.request);
@@ -343,7 +350,7 @@ pub const TIMELINE: &[BlockSpec] = &[
     BlockSpec::on_axis(
         "MC_ReadCamTableCharacteristics",
         &[TABLE, input("master_velocity", Kind::Real)],
-        |_| Box::new(McCamRead::new(CamReadKind::Characteristics, 31)),
+        |_| Box::new(McCamRead::new(CamReadKind::Characteristics, 36)),
     ),
     BlockSpec::on_axis(
         "MC_ReadMotionFunctionValues",

@@ -28,8 +28,10 @@ use crate::kernel::{
 };
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
+use hli::calls::cam::TableOrganisation;
 use hli::calls::saw::{
     SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
+    SAW_CHARAC_PARTS,
 };
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
@@ -420,7 +422,8 @@ struct CharacRead {
     pending: PendingCall<SawCharacCall>,
     part: u32,
     plan: u32,
-    scratch: [f64; 31],
+    /// Three parts of 16: the 31 values, then the organisation fields from place 32 on.
+    scratch: [f64; 48],
 }
 
 impl CharacRead {
@@ -430,7 +433,7 @@ impl CharacRead {
             pending: Self::send(io, slave, 0)?,
             part: 0,
             plan: 0,
-            scratch: [0.0; 31],
+            scratch: [0.0; 48],
         })
     }
 
@@ -438,7 +441,7 @@ impl CharacRead {
         send(io, slave, &SawCharacCall { part })
     }
 
-    fn next(&mut self, io: &mut PlcIo<'_>, part: u32) -> Polled<[f64; 31]> {
+    fn next(&mut self, io: &mut PlcIo<'_>, part: u32) -> Polled<[f64; 48]> {
         match Self::send(io, self.slave, part) {
             Ok(pending) => {
                 self.pending = pending;
@@ -451,10 +454,10 @@ impl CharacRead {
 }
 
 impl InFlight for CharacRead {
-    type Reply = [f64; 31];
+    type Reply = [f64; 48];
     type Buffer = ();
 
-    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<[f64; 31]> {
+    fn poll(&mut self, io: &mut PlcIo<'_>, _: &mut ()) -> Polled<[f64; 48]> {
         let reply = match self.pending.poll() {
             None => return Polled::Waiting,
             Some(Err(e)) => return Polled::Answer(Err(call_error_code(&e))),
@@ -475,7 +478,7 @@ impl InFlight for CharacRead {
         for (slot, v) in self.scratch[from..].iter_mut().zip(reply.values) {
             *slot = v;
         }
-        if from + SAW_CHARAC_PART >= CHARAC_FIELDS.len() {
+        if self.part + 1 >= SAW_CHARAC_PARTS {
             Polled::Answer(Ok(self.scratch))
         } else {
             self.next(io, self.part + 1)
@@ -484,8 +487,9 @@ impl InFlight for CharacRead {
 }
 
 /// MC_ReadFlyingSawCharacteristics: the characteristic values of the synchronising phase last
-/// planned for the slave, in two calls (fields 1-16, then 17-31). `values` (the seed's
-/// CamTableCharac) is written whole when both parts are in, so it never mixes two reads.
+/// planned for the slave, in three calls (fields 1-16, 17-31, then the organisation fields).
+/// `values` and `organisation` (the seed's CamTableCharac) are written whole when every part
+/// is in, so they never mix two reads.
 #[derive(Debug, Default)]
 pub struct McReadFlyingSawCharacteristics {
     /// Input: a rising edge starts the read.
@@ -496,6 +500,9 @@ pub struct McReadFlyingSawCharacteristics {
     pub out: Outputs,
     /// In/out: fields 1-31 of `MC_FlyingSawCharacValues` ([`CHARAC_FIELDS`]).
     pub values: [f64; 31],
+    /// In/out: the organisation fields (CamTableID 256 - the slave's axis ID, the points of
+    /// the phase's motion function, 1 column, TableType 22, not periodic).
+    pub organisation: TableOrganisation,
     kernel: Kernel<CharacRead>,
 }
 
@@ -521,13 +528,19 @@ impl McReadFlyingSawCharacteristics {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let slave = self.slave;
-        let values = &mut self.values;
+        let (values, organisation) = (&mut self.values, &mut self.organisation);
         self.out = self.kernel.cycle(
             io,
             self.execute,
             |io| CharacRead::start(io, slave),
             |read| {
-                *values = read;
+                let org = TableOrganisation::from_values(&read[32..37]);
+                let Some(org) = org else {
+                    // Fields that are no organisation: as if no answer came.
+                    return Accept::Failed(ERROR_NO_ANSWER, ());
+                };
+                values.copy_from_slice(&read[..31]);
+                *organisation = org;
                 Accept::Done(())
             },
             no_follow,
@@ -578,9 +591,12 @@ impl TimelineBlock for CharacInstance {
         self.read |= self.block.out.done;
         recorded(self.block.out)
     }
-    /// The 31 values in `MC_FlyingSawCharacValues` order ([`CHARAC_FIELDS`]).
+    /// The 31 values in `MC_FlyingSawCharacValues` order ([`CHARAC_FIELDS`]), then the
+    /// five organisation fields.
     fn read(&self) -> Option<Vec<f64>> {
-        self.read.then(|| self.block.values.to_vec())
+        let org = self.block.organisation.values();
+        self.read
+            .then(|| self.block.values.iter().chain(&org).copied().collect())
     }
 }
 

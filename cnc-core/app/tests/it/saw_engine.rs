@@ -460,7 +460,7 @@ fn a_gear_slave_cannot_be_a_saw_slave() {
 }
 
 #[test]
-fn the_characteristic_values_arrive_in_two_parts() {
+fn the_characteristic_values_arrive_in_three_parts() {
     let mut run = moving(250.0);
     let view = CncView::new(&run.memory);
     let none = run
@@ -496,9 +496,18 @@ fn the_characteristic_values_arrive_in_two_parts() {
     assert!((a.values[8] - 500.0).abs() < 1e-9);
     // Part 1 starts at field 17 (fSlaveAccMin); fSlaveVeloMax is field 24.
     assert!((b.values[7] - 500.0).abs() < 1e-9, "{:?}", b.values);
-    assert!(run
+    // Part 2: the organisation fields. The saw plans in table 256 - axis ID 2; a phase on
+    // position is a motion function of at least two points, one column, not periodic.
+    let c = run
         .machine
         .call(&view, SAW as u32, &SawCharacCall { part: 2 })
+        .unwrap();
+    let org = hli::calls::cam::TableOrganisation::from_values(&c.values[..5]).unwrap();
+    assert_eq!((org.table_id, org.columns, org.table_type), (254, 1, 22));
+    assert!((2..=4).contains(&org.rows) && !org.periodic, "{org:?}");
+    assert!(run
+        .machine
+        .call(&view, SAW as u32, &SawCharacCall { part: 3 })
         .is_err());
 }
 

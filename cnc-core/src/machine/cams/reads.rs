@@ -7,7 +7,8 @@ use crate::axis::AxisSet;
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode, TableType};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{
-    CamReadCall, CamReadKind, CamScalingMode, CamValuesReply, CAM_VALUES_PER_REPLY,
+    CamReadCall, CamReadKind, CamScalingMode, CamValuesReply, TableOrganisation,
+    CAM_VALUES_PER_REPLY,
 };
 use hli::calls::{decode_body, reply, HandlerResult};
 use hli::enums::CamCouplingError;
@@ -62,12 +63,13 @@ impl CamEngine {
                 } else {
                     normed.rescaled(call.a)
                 };
-                let values: Vec<f64> = at
+                let mut values: Vec<f64> = at
                     .ok_or(CamCouplingError::BadParameter.raw())?
                     .fields()
                     .iter()
                     .map(|(_, v)| *v)
                     .collect();
+                values.extend_from_slice(&self.organisation(id, p).values());
                 let n = values.len();
                 Ok(Made::all(values, n))
             }),
@@ -104,6 +106,21 @@ impl CamEngine {
             out.count += 1;
         }
         reply(&out)
+    }
+
+    /// The organisation fields of stored table `id` (periodic as MC_CamTableSelect chose).
+    fn organisation(&self, id: u32, p: &CamProfile) -> TableOrganisation {
+        let (rows, columns) = match p {
+            CamProfile::Table(t) => (t.len(), 2),
+            CamProfile::MotionFunction(f) => (f.points().len(), 1),
+        };
+        TableOrganisation {
+            table_id: id,
+            rows: u32::try_from(rows).unwrap_or(u32::MAX),
+            columns,
+            table_type: u32::from(p.table_type_raw()),
+            periodic: self.select_periodic(id, p),
+        }
     }
 
     /// Stored table `id`, or the refusal.

@@ -243,9 +243,10 @@ fn couplings_against_a_stand_in_cnc() {
     );
 }
 
-/// The characteristic values against a stand-in CNC, in two parts.
+/// The characteristic values against a stand-in CNC, in three parts: the values, then the
+/// organisation fields.
 #[test]
-fn the_read_takes_two_parts() {
+fn the_read_takes_three_parts() {
     let mut cnc = StandIn::new("read");
     let mut read = McReadFlyingSawCharacteristics {
         execute: true,
@@ -260,6 +261,9 @@ fn the_read_takes_two_parts() {
                 let mut values = [0.0; SAW_CHARAC_PART];
                 for (i, v) in values.iter_mut().enumerate() {
                     *v = (call.part as usize * SAW_CHARAC_PART + i + 1) as f64;
+                }
+                if call.part == 2 {
+                    values[..5].copy_from_slice(&[254.0, 3.0, 1.0, 22.0, 0.0]);
                 }
                 let part = call.part;
                 reply(&SawCharacReply {
@@ -279,4 +283,7 @@ fn the_read_takes_two_parts() {
     assert_eq!(got[0], ("fMasterVeloNom", 1.0));
     assert_eq!(got[16], ("fSlaveAccMin", 17.0));
     assert_eq!(got[30], ("fSlaveAccEff", 31.0));
+    let org = read.organisation;
+    assert_eq!((org.table_id, org.rows, org.columns), (254, 3, 1));
+    assert_eq!((org.table_type, org.periodic), (22, false));
 }

@@ -143,7 +143,8 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
     );
     assert_eq!(v[2], 0.0);
     assert!(v[1] != 0.0);
-    // Characteristics: the 31 values of MC_TableCharacValues, in two parts.
+    // Characteristics: the 31 values of MC_TableCharacValues, then the organisation fields,
+    // in two parts.
     let (v, _) = read_all(
         &mut run,
         1,
@@ -157,7 +158,27 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
         .iter()
         .map(|(_, v)| *v)
         .collect();
-    assert_eq!(v, expected);
+    assert_eq!(v[..31], expected);
+    // Table 1 is the seed's motion function: its points, one column, type 22.
+    let org = hli::calls::cam::TableOrganisation::from_values(&v[31..]).unwrap();
+    let points = match &seed {
+        cnc_core::cam::CamProfile::MotionFunction(f) => f.points().len() as u32,
+        _ => unreachable!("table 1 is a motion function"),
+    };
+    assert_eq!((org.table_id, org.rows, org.columns), (1, points, 1));
+    assert_eq!((org.table_type, org.periodic), (22, false));
+    // Table 2, an equidistant position table: its rows, two columns, type 10.
+    let (v, _) = read_all(
+        &mut run,
+        2,
+        CamReadCall {
+            what: CamReadKind::Characteristics.raw(),
+            ..Default::default()
+        },
+    );
+    let org = hli::calls::cam::TableOrganisation::from_values(&v[31..]).unwrap();
+    assert_eq!((org.table_id, org.columns, org.table_type), (2, 2, 10));
+    assert!(org.rows >= 2, "{org:?}");
     // Rescaled on the PLC path (seed 000 3.4): to a working master velocity, also a negative
     // one; a velocity that is not a number is refused.
     for velocity in [2.0, -2.0] {
@@ -177,7 +198,7 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
             .iter()
             .map(|(_, v)| *v)
             .collect();
-        assert_eq!(v, expected, "at {velocity}");
+        assert_eq!(v[..31], expected, "at {velocity}");
         assert_eq!(v[0], velocity, "fMasterVeloNom");
     }
     let nan: hli::calls::cam::CamValuesReply = bytemuck::pod_read_unaligned(&dispatch_raw(
