@@ -429,8 +429,8 @@ impl TableOrganisation {
     }
 }
 
-/// A read of cam data, answered as numbers in parts of [`CAM_VALUES_PER_REPLY`]: part `k`
-/// holds values `28 k ..` of the whole answer.
+/// A read of cam data, answered as numbers in parts of [`CAM_VALUES_PER_REPLY`] (or fewer:
+/// [`CamReadCall::part_len`]): part `k` holds values `28 k ..` of the whole answer.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq)]
 pub struct CamReadCall {
@@ -449,6 +449,12 @@ pub struct CamReadCall {
     pub b: f64,
     /// Increment of a values read.
     pub c: f64,
+    /// Values per part (CamTableReadData's iBlockSize / 8): 0 or above
+    /// [`CAM_VALUES_PER_REPLY`] is [`CAM_VALUES_PER_REPLY`]; part `k` then holds values
+    /// `part_len k ..`.
+    pub part_len: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
 }
 
 /// The answer to a [`CamReadCall`].

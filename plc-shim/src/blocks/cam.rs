@@ -160,6 +160,8 @@ impl Default for McCamIn {
 }
 
 impl McCamIn {
+    timeout_input!(core);
+
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let s = self.scaling;
@@ -197,6 +199,8 @@ pub struct McCamOut {
 }
 
 impl McCamOut {
+    timeout_input!(core);
+
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         self.out = self
@@ -313,6 +317,8 @@ pub struct McWriteMotionFunctionPoint {
 }
 
 impl McWriteMotionFunctionPoint {
+    timeout_input!(core);
+
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
@@ -345,6 +351,8 @@ pub struct McSetCamOnlineChangeMode {
 }
 
 impl McSetCamOnlineChangeMode {
+    timeout_input!(core);
+
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let s = self.scaling;
@@ -373,6 +381,7 @@ pub(crate) fn recorded(out: Outputs) -> (Outputs, bool) {
 }
 
 impl TimelineBlock for McCamIn {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value.uint()) {
             ("master_source", Some(v)) => self.master_actual = v != 0,
@@ -396,11 +405,13 @@ impl TimelineBlock for McCamIn {
 }
 
 impl TimelineBlock for McCamOut {
+    timeline_timeout!();
     fn set(&mut self, _: &str, _: &Value) {}
     execute_cycle!(with_axis, recorded);
 }
 
 impl TimelineBlock for McCamScaling {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         set_scaling(&mut self.scaling, key, value);
     }
@@ -408,6 +419,7 @@ impl TimelineBlock for McCamScaling {
 }
 
 impl TimelineBlock for McWriteMotionFunctionPoint {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         set_point(self, key, value);
     }
@@ -415,6 +427,7 @@ impl TimelineBlock for McWriteMotionFunctionPoint {
 }
 
 impl TimelineBlock for McSetCamOnlineChangeMode {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value.uint()) {
             ("table", Some(v)) => self.table = v,

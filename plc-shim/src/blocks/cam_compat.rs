@@ -17,7 +17,7 @@
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
 use super::cam::{recorded, CamCore};
-use super::cam_data::{rows_of, CamData, ChunkTransfer};
+use super::cam_data::{rows_of, CamData, ChunkTransfer, ROW_BYTES};
 use super::cam_read::{McCamRead, DEFAULT_READ_ROOM};
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
@@ -65,6 +65,8 @@ pub struct CompatConfig {
     pub on: bool,
     /// Room for a read's numbers.
     pub room: usize,
+    /// iBlockSize: bytes moved per call (0: the call's room, 13 rows or 28 numbers).
+    pub block_size: u32,
 }
 
 impl CompatConfig {
@@ -87,6 +89,7 @@ impl CompatConfig {
             interpolation: 0,
             on: true,
             room: DEFAULT_READ_ROOM,
+            block_size: 0,
         }
     }
 }
@@ -94,10 +97,10 @@ impl CompatConfig {
 /// Checks the inputs of compatibility block `kind` in a timeline `call` table.
 pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, String> {
     let allowed: &[&str] = match kind {
-        "CamTableGenerate" => &["table", "table_type", "rows"],
+        "CamTableGenerate" => &["table", "table_type", "rows", "block_size"],
         "CamTableCreate" => &["table", "table_type", "num_rows"],
-        "CamTableWriteData" => &["table", "rows"],
-        "CamTableReadData" => &["table", "room"],
+        "CamTableWriteData" => &["table", "rows", "block_size"],
+        "CamTableReadData" => &["table", "room", "block_size"],
         "CamTableReadSlavePos" => &["table", "master_pos"],
         "CamTableDelete" => &["table"],
         "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => &[
@@ -121,7 +124,7 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
     };
     let mut c = CompatConfig::new(kind);
     for (key, value) in table {
-        if ["block", "instance", "axis", "execute"].contains(&key.as_str()) {
+        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
             continue;
         }
         if !allowed.contains(&key.as_str())
@@ -148,6 +151,15 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
             "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
             "rows" => c.rows = Some(rows_of(value)?),
             "room" => c.room = int(1, 1 << 20)? as usize,
+            "block_size" => {
+                c.block_size = int(0, i64::from(u32::MAX))?;
+                if (1..ROW_BYTES).contains(&c.block_size) {
+                    return Err(format!(
+                        "call: {kind} `block_size` = {value}: 0 (the default) or at least \
+                         {ROW_BYTES} bytes (one row)"
+                    ));
+                }
+            }
             "master" => c.master = int(0, i64::from(u32::MAX))?,
             "master_offset" => c.master_offset = num()?,
             "slave_offset" => c.slave_offset = num()?,
@@ -214,6 +226,18 @@ impl CompatBlock {
         }
     }
 
+    /// Input tTimeout: cycles to wait for the CNC's answer (for each part of a transfer or
+    /// read), for whichever call the block makes.
+    pub fn set_timeout_cycles(&mut self, cycles: u64) {
+        self.transfer.set_timeout_cycles(cycles);
+        self.read.set_timeout_cycles(cycles);
+        self.declare.set_timeout_cycles(cycles);
+        self.delete.set_timeout_cycles(cycles);
+        self.couple.set_timeout_cycles(cycles);
+        self.decouple.set_timeout_cycles(cycles);
+        self.scale.set_timeout_cycles(cycles);
+    }
+
     /// One cycle for slave axis `slave` (the coupling and scaling blocks' axis).
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let c = Arc::clone(&self.config);
@@ -232,10 +256,14 @@ impl CompatBlock {
                     },
                     None => CamData::None,
                 };
+                let block = c.block_size;
                 self.out = self.transfer.cycle(
                     io,
                     self.execute,
-                    |_| Ok(ChunkTransfer::new(c.table, &data, false, periodic)),
+                    |_| {
+                        Ok(ChunkTransfer::new(c.table, &data, false, periodic)
+                            .with_block_size(block))
+                    },
                     |()| Accept::Done(()),
                     no_follow,
                 );
@@ -260,6 +288,8 @@ impl CompatBlock {
                 self.read.execute = self.execute;
                 self.read.target = c.table;
                 self.read.request.a = c.master_pos;
+                // iBlockSize in numbers of 8 bytes (0: the reply's room).
+                self.read.request.part_len = c.block_size / 8;
                 self.read.call(io);
                 self.out = self.read.out;
             }
@@ -328,6 +358,7 @@ impl CompatBlock {
 }
 
 impl TimelineBlock for CompatBlock {
+    timeline_timeout!();
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(config) = value.custom::<CompatConfig>() {
             self.config = config;

@@ -40,6 +40,8 @@ pub struct McCamTableSelect {
 }
 
 impl McCamTableSelect {
+    timeout_input!(kernel);
+
     /// One cycle: the data in chunks (if any), then the selection.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         if let CamData::Rows {
@@ -115,7 +117,12 @@ pub struct ChunkTransfer {
     periodic: bool,
     pending: Option<Pending>,
     next: usize,
+    /// Rows per call (iBlockSize of the compatibility blocks), 1..=CAM_ROWS_PER_CALL.
+    rows_per_call: usize,
 }
+
+/// Bytes of one table row (master and slave, two LREALs): the least iBlockSize moves.
+pub const ROW_BYTES: u32 = 16;
 
 impl core::fmt::Debug for ChunkTransfer {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
@@ -148,7 +155,18 @@ impl ChunkTransfer {
             periodic,
             pending: None,
             next: 0,
+            rows_per_call: hli::calls::cam::CAM_ROWS_PER_CALL,
         }
+    }
+
+    /// The transfer in steps of at most `bytes` (iBlockSize): `bytes / 16` rows per call, at
+    /// most the call's room; 0 (the seed's default) and anything below a row keep the room.
+    pub fn with_block_size(mut self, bytes: u32) -> ChunkTransfer {
+        if bytes >= ROW_BYTES {
+            let rows = (bytes / ROW_BYTES) as usize;
+            self.rows_per_call = rows.min(hli::calls::cam::CAM_ROWS_PER_CALL);
+        }
+        self
     }
 
     /// The next chunk, sent; `None` when every chunk is out.
@@ -162,7 +180,7 @@ impl ChunkTransfer {
             } => {
                 let chunk = rows
                     .get(self.next..)?
-                    .get(..hli::calls::cam::CAM_ROWS_PER_CALL.min(rows.len() - self.next))?;
+                    .get(..self.rows_per_call.min(rows.len() - self.next))?;
                 if chunk.is_empty() {
                     return None;
                 }
@@ -284,6 +302,8 @@ pub struct McWriteMotionFunction {
 }
 
 impl McWriteMotionFunction {
+    timeout_input!(kernel);
+
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (table, points) = (self.table, &self.points);
@@ -429,6 +449,7 @@ inputs! {
 }
 
 impl TimelineBlock for McCamTableSelect {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         set_select(self, key, value);
     }
@@ -436,6 +457,7 @@ impl TimelineBlock for McCamTableSelect {
 }
 
 impl TimelineBlock for McWriteMotionFunction {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         set_write(self, key, value);
     }

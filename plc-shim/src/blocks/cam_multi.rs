@@ -43,6 +43,8 @@ impl Default for CamTableSetWeight {
 }
 
 impl CamTableSetWeight {
+    timeout_input!(core);
+
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let call = self.weight;
@@ -73,6 +75,8 @@ pub struct CamTableCoupleAxesMultiTables {
 }
 
 impl CamTableCoupleAxesMultiTables {
+    timeout_input!(core);
+
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {
         let call = hli::calls::cam::CamMultiCoupleCall {
@@ -107,6 +111,8 @@ pub struct CamMultiTable {
 }
 
 impl CamMultiTable {
+    timeout_input!(core);
+
     /// The block that does `op`, its inputs cleared.
     pub fn new(op: CamMultiTableOp) -> CamMultiTable {
         CamMultiTable {
@@ -148,6 +154,7 @@ inputs! {
 }
 
 impl TimelineBlock for CamTableSetWeight {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         set_weight(self, key, value);
     }
@@ -155,6 +162,7 @@ impl TimelineBlock for CamTableSetWeight {
 }
 
 impl TimelineBlock for CamTableCoupleAxesMultiTables {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("master", Value::Int(v)) => self.master = *v as u32,
@@ -173,6 +181,7 @@ impl TimelineBlock for CamTableCoupleAxesMultiTables {
 }
 
 impl TimelineBlock for CamMultiTable {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("table", Value::Int(v)) => self.table = *v as u32,

@@ -232,6 +232,8 @@ pub struct McReadMotionFunction {
 }
 
 impl McReadMotionFunction {
+    timeout_input!(kernel);
+
     /// A reader with room for `room` points.
     pub fn new(room: usize) -> McReadMotionFunction {
         McReadMotionFunction {
@@ -270,6 +272,7 @@ impl McReadMotionFunction {
 }
 
 impl TimelineBlock for McCamRead {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         let r = &mut self.request;
         match (key, value.uint(), value.real(), value) {
@@ -298,6 +301,7 @@ impl TimelineBlock for McCamRead {
 }
 
 impl TimelineBlock for McReadMotionFunction {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value.uint()) {
             ("table", Some(v)) => self.table = v,

@@ -285,6 +285,7 @@ impl ReadChannelState {
 }
 
 impl TimelineBlock for ChannelCommandBlock {
+    timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("program", v) => {

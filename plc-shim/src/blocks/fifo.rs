@@ -205,7 +205,7 @@ fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, String> {
     };
     let known = allowed(kind);
     for (key, value) in table {
-        if ["block", "instance", "axis", "execute"].contains(&key.as_str()) {
+        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
             continue;
         }
         if !known.contains(&key.as_str()) {
@@ -332,6 +332,20 @@ struct FifoInstance {
 }
 
 impl FifoInstance {
+    /// Input tTimeout of whichever block this is.
+    fn set_timeout_cycles(&mut self, cycles: u64) {
+        match &mut self.kind {
+            Kind::Dimension(b) => b.set_timeout_cycles(cycles),
+            Kind::Integrate(b) => b.set_timeout_cycles(cycles),
+            Kind::Disintegrate(b) => b.set_timeout_cycles(cycles),
+            Kind::Start(b) => b.set_timeout_cycles(cycles),
+            Kind::Stop(b) => b.set_timeout_cycles(cycles),
+            Kind::Override(b) => b.set_timeout_cycles(cycles),
+            Kind::Parameters(b) => b.set_timeout_cycles(cycles),
+            Kind::Write(b) => b.set_timeout_cycles(cycles),
+        }
+    }
+
     /// One cycle; `axis` is FiFoGroupIntegrate's.
     fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs<FifoReply> {
         let e = self.execute;
@@ -359,6 +373,7 @@ impl FifoInstance {
 }
 
 impl TimelineBlock for FifoInstance {
+    timeline_timeout!();
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(inputs) = value.custom::<FifoInputs>() {
             self.inputs = inputs;

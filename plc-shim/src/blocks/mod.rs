@@ -57,6 +57,23 @@ macro_rules! timeout_input {
     };
 }
 
+/// `TimelineBlock::timeout_cycles` of a block with input tTimeout (its `set_timeout_cycles`,
+/// at `self.<path>` if given).
+macro_rules! timeline_timeout {
+    () => {
+        fn timeout_cycles(&mut self, cycles: u64) -> bool {
+            self.set_timeout_cycles(cycles);
+            true
+        }
+    };
+    ($($path:ident).+) => {
+        fn timeout_cycles(&mut self, cycles: u64) -> bool {
+            self.$($path).+.set_timeout_cycles(cycles);
+            true
+        }
+    };
+}
+
 /// Inputs declared once, in the order a call lists them: each one's key, kind and the field
 /// of `$target` it sets (a path below it). Gives the list `$list` (an `[InputSpec; N]` for a
 /// `TIMELINE` entry, or part of one through `joined`) and `$set(target, key, value)`, which

@@ -549,6 +549,7 @@ impl McReadFlyingSawCharacteristics {
 }
 
 impl TimelineBlock for McGearInVelo {
+    timeline_timeout!();
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(i) = value.custom::<SawInputs>() {
             (self.inputs, self.master) = (i.gear, i.master);
@@ -558,6 +559,7 @@ impl TimelineBlock for McGearInVelo {
 }
 
 impl TimelineBlock for McGearInPos {
+    timeline_timeout!();
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(i) = value.custom::<SawInputs>() {
             (self.inputs, self.master) = (i.gear, i.master);
@@ -568,6 +570,7 @@ impl TimelineBlock for McGearInPos {
 }
 
 impl TimelineBlock for McGearOut {
+    timeline_timeout!();
     fn set(&mut self, _: &str, _: &Value) {}
     execute_cycle!(as_slave, recorded);
 }
@@ -581,6 +584,7 @@ struct CharacInstance {
 }
 
 impl TimelineBlock for CharacInstance {
+    timeline_timeout!(block);
     fn set(&mut self, _: &str, _: &Value) {}
     fn execute(&mut self) -> Option<&mut bool> {
         Some(&mut self.block.execute)

@@ -557,3 +557,68 @@ fn a_dyn_cs_transition_fails_at_once_on_a_state_that_is_no_tracking_state() {
     let invalid = crate::blocks::dyn_cs::DynCsBlockError::InvalidState.code();
     assert!(out.error && out.error_id == invalid, "{out:?}");
 }
+
+/// tTimeout from a timeline: every block that has it (`TimelineBlock::timeout_cycles`; every
+/// cam, compatibility, FIFO, saw and channel block) ends with ERROR_NO_ANSWER after the cycles
+/// it was given, where the default would still wait.
+#[test]
+fn a_timeline_timeout_ends_every_block_that_has_one_after_its_cycles() {
+    use crate::timeline::registry::{Target, Value, FAMILIES, WHOLE};
+    const CYCLES: u64 = 7;
+    let mut with = 0;
+    for spec in FAMILIES.iter().flat_map(|f| f.iter()) {
+        let mut block = (spec.make)(None);
+        if !block.timeout_cycles(CYCLES) {
+            continue;
+        }
+        with += 1;
+        let axis = match spec.target {
+            Target::Group | Target::Channel => 0,
+            _ => 1,
+        };
+        let mut fresh = (spec.make)(None);
+        // Table 1 and two points, for the blocks that send nothing without them.
+        let points = [hli::calls::cam::McMotionFunctionPoint::default(); 2];
+        for b in [&mut block, &mut fresh] {
+            b.timeout_cycles(CYCLES);
+            b.set("table", &Value::Int(1));
+            if spec.name == "MC_WriteMotionFunction" {
+                b.set("points", &Value::Points(Arc::new(points)));
+            }
+            let compat = CompatConfig {
+                table: 1,
+                rows: Some(Arc::new([[0.0, 0.0], [1.0, 1.0]])),
+                ..CompatConfig::new(spec.name)
+            };
+            b.set(WHOLE, &Value::Custom(Arc::new(compat)));
+        }
+        fresh.timeout_cycles(DEFAULT_TIMEOUT_CYCLES);
+        let mut cnc = Cnc::new("tl-timeout", spec.name);
+        // Both blocks in each PLC cycle.
+        let mut run = |b: &mut Box<dyn crate::timeline::registry::TimelineBlock>, cycle| {
+            *b.execute().unwrap() = true;
+            let mut io = PlcIo {
+                view: PlcView::new(&cnc.memory),
+                memory: &cnc.memory,
+                acyclic: &mut cnc.client,
+                cycle,
+                link: crate::runtime::Link::Operational,
+            };
+            b.cycle(&mut io, axis).0
+        };
+        for cycle in 1..=CYCLES + 1 {
+            let out = run(&mut block, cycle);
+            assert!(out.busy, "{}: Busy while waiting: {out:?}", spec.name);
+            run(&mut fresh, cycle);
+        }
+        let out = run(&mut block, CYCLES + 2);
+        assert!(
+            out.error && out.error_id == ERROR_NO_ANSWER,
+            "{}: {out:?}",
+            spec.name
+        );
+        let out = run(&mut fresh, CYCLES + 2);
+        assert!(out.busy && !out.error, "{}: default: {out:?}", spec.name);
+    }
+    assert!(with >= 30, "blocks with tTimeout: {with}");
+}

@@ -25,6 +25,33 @@ pub struct Call {
     instance: usize,
     inputs: Vec<(&'static str, Value)>,
     execute: bool,
+    /// tTimeout in PLC cycles, if the call gives it.
+    timeout: Option<u64>,
+}
+
+/// The longest tTimeout a call may give, in PLC cycles (about three hours at 1 ms).
+pub const MAX_TIMEOUT_CYCLES: i64 = 10_000_000;
+
+/// The `timeout_cycles` of a call of `spec`, checked: 1..=[`MAX_TIMEOUT_CYCLES`], and only for
+/// a block with tTimeout.
+fn timeout_of(spec: &BlockSpec, table: &toml::Table) -> Result<Option<u64>, String> {
+    let Some(value) = table.get("timeout_cycles") else {
+        return Ok(None);
+    };
+    let cycles = value
+        .as_integer()
+        .filter(|c| (1..=MAX_TIMEOUT_CYCLES).contains(c))
+        .ok_or_else(|| {
+            format!("call: `timeout_cycles` = {value}: PLC cycles 1..={MAX_TIMEOUT_CYCLES}")
+        })?;
+    // Asked of a fresh instance, made here (never in a cycle).
+    if !(spec.make)(None).timeout_cycles(cycles as u64) {
+        return Err(format!(
+            "call: {} has no tTimeout: no `timeout_cycles`",
+            spec.name
+        ));
+    }
+    Ok(Some(cycles as u64))
 }
 
 /// The outputs a `wait` can name.
@@ -143,7 +170,7 @@ fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
         room = r;
     }
     for (key, value) in table {
-        if ["block", "instance", "axis", "channel"].contains(&key.as_str()) {
+        if ["block", "instance", "axis", "channel", "timeout_cycles"].contains(&key.as_str()) {
             continue;
         }
         if key == "execute" && spec.execute {
@@ -241,6 +268,7 @@ impl Instances {
             .unwrap_or(spec.name);
         let axis = axis_of(spec, table)?;
         let (inputs, room, execute) = inputs_of(spec, table)?;
+        let timeout = timeout_of(spec, table)?;
         let instance = match self.list.iter().position(|i| i.name == name) {
             Some(i) => {
                 let inst = &mut self.list[i];
@@ -267,6 +295,7 @@ impl Instances {
             instance,
             inputs,
             execute,
+            timeout,
         })
     }
 
@@ -323,6 +352,9 @@ impl Instances {
         let inst = &mut self.list[call.instance];
         for (key, value) in &call.inputs {
             inst.block.set(key, value);
+        }
+        if let Some(cycles) = call.timeout {
+            inst.block.timeout_cycles(cycles);
         }
         inst.last = [false; 8];
         match inst.block.execute() {

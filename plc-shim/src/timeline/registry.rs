@@ -84,6 +84,11 @@ pub enum Inputs {
     Table(fn(&'static str, &toml::Table) -> Result<Whole, String>),
 }
 
+/// The keys of a call every block takes (checked by [`super::instances`], not by a family's
+/// whole-table parser): `timeout_cycles` is the seed's tTimeout, in PLC cycles, of a block
+/// that has it ([`TimelineBlock::timeout_cycles`]).
+pub const CALL_KEYS: [&str; 5] = ["block", "instance", "axis", "execute", "timeout_cycles"];
+
 /// A call checked whole: its one value, and the room of a read's answer if it gives one.
 pub type Whole = (Value, Option<usize>);
 
@@ -266,6 +271,10 @@ pub trait TimelineBlock: core::fmt::Debug {
     /// What a read block read, as it stands, for the report.
     fn read(&self) -> Option<Vec<f64>> {
         None
+    }
+    /// Input tTimeout, in PLC cycles: `true` if the block has it (and took it).
+    fn timeout_cycles(&mut self, _cycles: u64) -> bool {
+        false
     }
 }
 

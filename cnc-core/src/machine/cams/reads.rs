@@ -47,7 +47,11 @@ impl CamEngine {
     pub(super) fn read(&self, request: &AcyclicRequest, axes: &AxisSet) -> HandlerResult {
         let call: CamReadCall = decode_body(request)?;
         let id = request.target;
-        let skip = call.part as usize * CAM_VALUES_PER_REPLY;
+        let per = match call.part_len as usize {
+            0 => CAM_VALUES_PER_REPLY,
+            n => n.min(CAM_VALUES_PER_REPLY),
+        };
+        let skip = call.part as usize * per;
         if call.what == CamReadKind::Queued.raw() {
             // Asked every PLC cycle while MC_CamScaling waits: answered without allocating.
             return self.queued_reply(id as usize);
@@ -73,8 +77,8 @@ impl CamEngine {
                 let n = values.len();
                 Ok(Made::all(values, n))
             }),
-            Some(CamReadKind::Values) => self.sampled_values(id, &call, skip),
-            Some(CamReadKind::Rows) => self.rows_part(id, skip),
+            Some(CamReadKind::Values) => self.sampled_values(id, &call, skip, per),
+            Some(CamReadKind::Rows) => self.rows_part(id, skip, per),
             Some(CamReadKind::Info) => self.info(id as usize, &call, axes).map(|v| {
                 let n = v.len();
                 Made::all(v, n)
@@ -101,6 +105,7 @@ impl CamEngine {
             .values
             .iter_mut()
             .zip(made.values.iter().skip(skip - made.from.min(skip)))
+            .take(per)
         {
             *o = *v;
             out.count += 1;
@@ -150,9 +155,16 @@ impl CamEngine {
         Ok(Made::all(v.to_vec(), 3))
     }
 
-    /// The part from value `skip` on of the table sampled from `call.a` to `call.b` in steps
-    /// of `call.c`: per row the master position and the quantities `call.mask` names.
-    fn sampled_values(&self, id: u32, call: &CamReadCall, skip: usize) -> Result<Made, u32> {
+    /// The part of `per` values from value `skip` on of the table sampled from `call.a` to
+    /// `call.b` in steps of `call.c`: per row the master position and the quantities
+    /// `call.mask` names.
+    fn sampled_values(
+        &self,
+        id: u32,
+        call: &CamReadCall,
+        skip: usize,
+        per: usize,
+    ) -> Result<Made, u32> {
         let p = self.table(id)?;
         let (from, to, step) = (finite(call.a)?, finite(call.b)?, finite(call.c)?);
         if call.mask == 0 || call.mask > 15 {
@@ -164,10 +176,10 @@ impl CamEngine {
         let cols = columns as usize;
         let total = rows * cols;
         // Only the rows of the part asked for are evaluated.
-        let mut values = Vec::with_capacity(CAM_VALUES_PER_REPLY);
+        let mut values = Vec::with_capacity(per);
         let mut cursor = ProfileCursor::default();
         let mut row_cache: Option<(usize, [f64; 5])> = None;
-        for i in skip..(skip + CAM_VALUES_PER_REPLY).min(total) {
+        for i in skip..(skip + per).min(total) {
             let (row, col) = (i / cols, i % cols);
             let cells = match row_cache {
                 Some((r, c)) if r == row => c,
@@ -188,13 +200,14 @@ impl CamEngine {
         })
     }
 
-    /// The part from value `skip` on of a position table's rows (master, slave).
-    fn rows_part(&self, id: u32, skip: usize) -> Result<Made, u32> {
+    /// The part of `per` values from value `skip` on of a position table's rows (master,
+    /// slave).
+    fn rows_part(&self, id: u32, skip: usize, per: usize) -> Result<Made, u32> {
         match self.table(id) {
             Ok(CamProfile::Table(t)) => {
                 let total = t.len() * 2;
                 // Only the rows of this part.
-                let values: Vec<f64> = (skip..(skip + CAM_VALUES_PER_REPLY).min(total))
+                let values: Vec<f64> = (skip..(skip + per).min(total))
                     .filter_map(|i| t.row_at(i / 2).map(|r| r[i % 2]))
                     .collect();
                 Ok(Made {

@@ -129,7 +129,7 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String
         }
     }
     for (key, value) in table {
-        if ["block", "instance", "axis", "execute"].contains(&key.as_str()) {
+        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
             continue;
         }
         let Some(name) = known.iter().find(|n| folded(n) == folded(key)) else {

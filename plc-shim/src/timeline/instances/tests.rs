@@ -100,6 +100,20 @@ fn bad_calls_name_the_key() {
         err("block = \"MC_Halt\"\naxis = 0\ndeceleration = \"fast\""),
         "call: MC_Halt input `deceleration` = \"fast\" is not valid"
     );
+    assert_eq!(
+        err("block = \"MC_Halt\"\naxis = 0\ntimeout_cycles = 10"),
+        "call: MC_Halt has no tTimeout: no `timeout_cycles`"
+    );
+    assert_eq!(
+        err("block = \"MC_CamIn\"\naxis = 1\ntimeout_cycles = 0"),
+        "call: `timeout_cycles` = 0: PLC cycles 1..=10000000"
+    );
+    assert_eq!(
+        err("block = \"CamTableReadData\"\naxis = 1\ntable = 1\nblock_size = 8"),
+        "call: CamTableReadData `block_size` = 8: 0 (the default) or at least 16 bytes (one row)"
+    );
+    assert!(err("block = \"CamTableDelete\"\naxis = 1\nblock_size = 32")
+        .starts_with("call: CamTableDelete has no input `block_size`"));
     let mut i = Instances::default();
     i.parse_call(&table("block = \"MC_Halt\"\ninstance = \"h\"\naxis = 0"))
         .unwrap();
@@ -137,4 +151,21 @@ fn modes_by_name_or_number() {
         i.summary(),
         "block c (MC_CamIn on gpAx[1]): no output rose\n"
     );
+}
+
+/// tTimeout (`timeout_cycles`) on any block that has it, beside a whole-table family's own
+/// inputs; applied with the call.
+#[test]
+fn a_timeout_is_taken_by_blocks_that_have_one() {
+    let mut i = Instances::default();
+    for text in [
+        "block = \"CamTableReadData\"\naxis = 1\ntable = 1\nblock_size = 32\ntimeout_cycles = 50",
+        "block = \"MC_CamIn\"\naxis = 1\nmaster = 0\ntable = 1\ntimeout_cycles = 50",
+        "block = \"MC_GearOut\"\naxis = 1\ntimeout_cycles = 50",
+        "block = \"FiFoStart\"\ngroup = 0\ntimeout_cycles = 50",
+    ] {
+        let call = i.parse_call(&table(text)).unwrap();
+        assert_eq!(call.timeout, Some(50), "{text}");
+        i.apply(&call);
+    }
 }

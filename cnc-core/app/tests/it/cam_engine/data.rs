@@ -652,3 +652,60 @@ fn the_characteristics_block_reads_values_rescaled_to_a_master_velocity() {
         assert_eq!(*value, fields[k].1, "{}", fields[k].0);
     }
 }
+
+/// The tick of the first rising edge of `output` of `instance` in the PLC's report.
+fn first_edge(report: &str, instance: &str, output: &str) -> u64 {
+    let line = report
+        .lines()
+        .find(|l| l.starts_with(&format!("block {instance} ")))
+        .unwrap_or_else(|| panic!("no block {instance}\n{report}"));
+    let (_, after) = line
+        .split_once(&format!("{output} "))
+        .unwrap_or_else(|| panic!("{instance}: no {output}: {line}"));
+    after.split(' ').next().unwrap().parse().unwrap()
+}
+
+/// iBlockSize of the compatibility blocks (seed 000 5.2.1): CamTableGenerate with 32 bytes
+/// sends two rows per call (four calls for eight rows, where the default sends one), and
+/// CamTableReadData with 16 bytes reads one row per part; the table arrives and reads back
+/// the same either way. Both also take a tTimeout.
+#[test]
+fn a_block_size_sets_how_much_each_step_of_a_compatibility_block_moves() {
+    let scenario = "cycle_ms = 1.0\nticks = 60\n[[axis]]\nname = \"Lifter\"\npower = true\n\
+        [plc]\ntimeline = \"plc.toml\"\n";
+    let rows = "[[0.0, 0.0], [10.0, 1.0], [20.0, 4.0], [30.0, 9.0], [40.0, 16.0], \
+        [50.0, 25.0], [60.0, 36.0], [70.0, 49.0]]";
+    let timeline = format!(
+        "[[step]]\nat_tick = 2\ncall = {{ block = \"CamTableGenerate\", instance = \"whole\", \
+         axis = 0, table = 21, rows = {rows} }}\n\
+         [[step]]\nat_tick = 2\ncall = {{ block = \"CamTableGenerate\", instance = \"pairs\", \
+         axis = 0, table = 22, rows = {rows}, block_size = 32, timeout_cycles = 100 }}\n\
+         [[step]]\nwait = \"pairs.Done\"\ncall = {{ block = \"CamTableReadData\", \
+         instance = \"read\", axis = 0, table = 22 }}\n\
+         [[step]]\nwait = \"pairs.Done\"\ncall = {{ block = \"CamTableReadData\", \
+         instance = \"row_by_row\", axis = 0, table = 22, block_size = 16, \
+         timeout_cycles = 100 }}\n"
+    );
+    let s = with_timeline("block_size.toml", scenario, &timeline);
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+    }
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    let (whole, pairs) = (
+        first_edge(&report, "whole", "Done"),
+        first_edge(&report, "pairs", "Done"),
+    );
+    assert!(pairs >= whole + 3, "four calls, not one: {report}");
+    let (read, row_by_row) = (
+        first_edge(&report, "read", "Done"),
+        first_edge(&report, "row_by_row", "Done"),
+    );
+    assert!(row_by_row >= read + 6, "eight parts, not one: {report}");
+    let expected = [
+        0.0, 0.0, 10.0, 1.0, 20.0, 4.0, 30.0, 9.0, 40.0, 16.0, 50.0, 25.0,
+    ];
+    assert_eq!(read_values(&report, "read"), expected, "{report}");
+    assert_eq!(read_values(&report, "row_by_row"), expected, "{report}");
+}
