@@ -36,10 +36,9 @@ pub enum Resource {
 }
 
 /// The engines other than the one answering a call.
-#[derive(Clone, Copy)]
 pub struct Others<'a> {
-    before: &'a [Box<dyn Engine>],
-    after: &'a [Box<dyn Engine>],
+    before: &'a mut [Box<dyn Engine>],
+    after: &'a mut [Box<dyn Engine>],
 }
 
 impl<'a> Others<'a> {
@@ -54,8 +53,17 @@ impl<'a> Others<'a> {
     pub fn hold(&self, resource: Resource) -> bool {
         self.before
             .iter()
-            .chain(self.after)
+            .chain(self.after.iter())
             .any(|e| e.holds(resource))
+    }
+
+    /// Asks them to let slave `axis` go from a gear coupling ([`Engine::gear_out`]): whether
+    /// one did.
+    pub fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+        self.before
+            .iter_mut()
+            .chain(self.after.iter_mut())
+            .any(|e| e.gear_out(axis, axes))
     }
 }
 
@@ -144,6 +152,14 @@ pub trait Engine: std::fmt::Debug + Send {
     /// Whether this engine holds `resource` now.
     fn holds(&self, resource: Resource) -> bool {
         let _ = resource;
+        false
+    }
+
+    /// MC_GearOut for slave `axis`, asked by the engine that answers MC_GearOut when the
+    /// slave is not its own: an engine whose gear coupling holds the axis lets it go (the
+    /// slave goes on free at its velocity) and says so; the others answer `false`.
+    fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+        let _ = (axis, axes);
         false
     }
 

@@ -3,6 +3,10 @@
 //! flying saw's synchronous phase reuses). A gear couples as soon as its slave is enabled
 //! and free, and holds the positions both axes had at that tick as its origin, so coupling
 //! causes no jump.
+//!
+//! MC_GearOut lets a gear's slave go: it runs on free at its velocity (its own generator, as
+//! after the saw's MC_GearOut) and the gear stays out until the slave has been disabled; the
+//! next time it is enabled and free, the gear couples again.
 
 use super::engine::{Engine, EngineIo};
 use super::engines::{EngineSetup, SetupError};
@@ -26,6 +30,8 @@ struct Gear {
     origin: Option<(f64, f64)>,
     /// The slave's coupling, while this gear holds it.
     lease: Option<Lease>,
+    /// Let go by MC_GearOut: not coupled again until the slave has been disabled.
+    out: bool,
 }
 
 /// Gear couplings between axes.
@@ -85,6 +91,7 @@ impl GearEngine {
                     spec,
                     origin: None,
                     lease: None,
+                    out: false,
                 })
                 .collect(),
         })
@@ -120,7 +127,8 @@ impl Engine for GearEngine {
                 let Some(axis) = io.axes.axis(slave) else {
                     continue;
                 };
-                if !axis.enabled() || !axis.has_position() || axis.error().is_some() {
+                gear.out &= axis.enabled();
+                if gear.out || !axis.enabled() || !axis.has_position() || axis.error().is_some() {
                     continue;
                 }
                 // Not to a master in error: its set-point stood at the fault (the axis set
@@ -145,6 +153,18 @@ impl Engine for GearEngine {
                 io.axes.drive(lease, set, AxisState::SlaveSynchronous);
             }
         }
+    }
+
+    fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+        let held = |g: &&mut Gear| g.spec.slave == axis && g.lease.is_some_and(|l| axes.holds(l));
+        let Some(gear) = self.gears.iter_mut().find(held) else {
+            return false;
+        };
+        if let Some(lease) = gear.lease.take() {
+            axes.release(lease);
+        }
+        (gear.origin, gear.out) = (None, true);
+        true
     }
 
     fn reset(&mut self, axes: &mut AxisSet) {

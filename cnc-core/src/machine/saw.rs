@@ -303,7 +303,7 @@ impl Engine for SawEngine {
             kind,
             request,
             axes,
-            others,
+            mut others,
         } = call;
         let slave = request.target as usize;
         let known = slave < self.slaves.len();
@@ -318,6 +318,14 @@ impl Engine for SawEngine {
             }),
             CallKind::SAW_GEAR_IN => decode_body::<SawGearInCall>(request)
                 .and_then(|call| self.gear_in(slave, &call, axes)),
+            // MC_GearOut of a slave the saw does not hold: a gear coupling of another engine.
+            CallKind::SAW_GEAR_OUT if !self.owns(slave, axes) => {
+                decode_body::<SawGearOutCall>(request)?;
+                match others.gear_out(slave, axes) {
+                    true => accepted(),
+                    false => refused(SawError::NotCoupled),
+                }
+            }
             CallKind::SAW_GEAR_OUT => {
                 decode_body::<SawGearOutCall>(request).and_then(|_| self.gear_out(slave, axes))
             }

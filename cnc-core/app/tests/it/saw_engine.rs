@@ -459,6 +459,55 @@ fn a_gear_slave_cannot_be_a_saw_slave() {
     );
 }
 
+/// MC_GearOut releases a gear coupling too (issue 37 item 7): the geared slave goes on free at
+/// its velocity, without a jump, and the gear stays out until the slave has been disabled;
+/// enabled again, it couples anew.
+#[test]
+fn mc_gear_out_releases_a_gear_slave_until_it_is_disabled() {
+    const GEARED: usize = 2;
+    let mut run = machine(&format!(
+        "{}[[gear]]\nmaster = \"Master\"\nslave = \"Geared\"\nratio = 2.0\n",
+        axis("Geared", "")
+    ));
+    assert_eq!(gear_out(&mut run, SAW), SawError::NotCoupled.raw());
+    let fast = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, fast), 0);
+    until(&mut run, 2000, |r| set(r, GEARED).velocity == 1000.0);
+    let coupled = |r: &InProcess| r.machine.axes().axis(GEARED).unwrap().coupling().is_some();
+    assert!(coupled(&run));
+    let before = set(&run, GEARED);
+    assert_eq!(gear_out(&mut run, GEARED), 0);
+    run.step(TICK);
+    let after = set(&run, GEARED);
+    assert!(!coupled(&run), "free after MC_GearOut");
+    assert_eq!(after.velocity, 1000.0, "it keeps its velocity");
+    assert!(
+        (after.position - (before.position + 1.0)).abs() < 1e-9,
+        "no jump"
+    );
+    for _ in 0..100 {
+        run.step(TICK);
+        assert!(
+            !coupled(&run),
+            "the gear stays out while the slave is enabled"
+        );
+    }
+    assert_eq!(gear_out(&mut run, GEARED), SawError::NotCoupled.raw());
+    // Stopped and disabled, then enabled: the gear takes the slave again.
+    assert_eq!(
+        command(&mut run, GEARED, AxisCommandCall::halt(1e4, 1e6)),
+        0
+    );
+    until(&mut run, 2000, |r| set(r, GEARED).velocity == 0.0);
+    assert_eq!(command(&mut run, GEARED, AxisCommandCall::power(false)), 0);
+    run.step(TICK);
+    run.step(TICK);
+    assert!(!coupled(&run));
+    assert_eq!(command(&mut run, GEARED, AxisCommandCall::power(true)), 0);
+    until(&mut run, 100, coupled);
+    until(&mut run, 2000, |r| set(r, GEARED).velocity == 1000.0);
+}
+
 #[test]
 fn the_characteristic_values_arrive_in_three_parts() {
     let mut run = moving(250.0);
