@@ -506,6 +506,16 @@ impl<'m> PlcView<'m> {
         }
         .lr_state())
     }
+
+    /// The image index (`gpAx[i]`) of the axis with NC axis ID `id`, as the CNC writes it in
+    /// `lr_state.nc_axis_id_r` (from its first tick on); `None` for ID 0 or an ID no axis has.
+    /// A scan of the axes; no allocation.
+    pub fn axis_index_by_id(&self, id: u32) -> Option<usize> {
+        if id == 0 {
+            return None;
+        }
+        (0..self.axis_count()).find(|&i| self.axis_state(i).is_ok_and(|s| s.nc_axis_id_r == id))
+    }
 }
 
 impl<'m> PlcChannel<'m> {

@@ -135,7 +135,7 @@ impl AxisPublisher {
                     master_axis_r: -1,
                     error_id_r: 0,
                     status_r: 0,
-                    fill_up_1: 0,
+                    nc_axis_id_r: i as u32 + 1,
                 });
             self.last[i] = p;
             self.last_velocity[i] = v;

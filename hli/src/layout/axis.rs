@@ -32,8 +32,9 @@ hli_struct! {
         pub error_id_r: u32 => [36, Cnc],
         /// Status bits; see [`crate::enums::axis_status`].
         pub status_r: u32 => [40, Cnc],
-        /// Padding.
-        pub fill_up_1: i32 => [44, Cnc],
+        /// The axis's NC axis ID (the ID the NC and the manuals name it by; 0 when it has
+        /// none): a PLC finds the image index of an axis ID here.
+        pub nc_axis_id_r: u32 => [44, Cnc],
     }
 }
 

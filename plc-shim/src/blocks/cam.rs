@@ -382,6 +382,10 @@ pub(crate) fn recorded(out: Outputs) -> (Outputs, bool) {
 
 impl TimelineBlock for McCamIn {
     timeline_timeout!();
+    fn set_master(&mut self, index: u32) -> bool {
+        self.master = index;
+        true
+    }
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value.uint()) {
             ("master_source", Some(v)) => self.master_actual = v != 0,

@@ -193,6 +193,9 @@ pub struct CompatBlock {
     couple: CamCore<CamInCall>,
     decouple: CamCore<CamOutCall>,
     scale: CamCore<CamScalingCall>,
+    /// The master of CamTableCoupleAxes(Ipol) when given by NC axis ID (the timeline's
+    /// `master_id`, resolved): it overrides `config.master` until the next configuration.
+    master: Option<u32>,
 }
 
 /// `iTableType` to the table type and whether it is cyclic.
@@ -223,6 +226,7 @@ impl CompatBlock {
             couple: CamCore::default(),
             decouple: CamCore::default(),
             scale: CamCore::default(),
+            master: None,
         }
     }
 
@@ -309,7 +313,7 @@ impl CompatBlock {
             (false, true) => 4,
         };
         let call = CamInCall {
-            master: c.master,
+            master: self.master.unwrap_or(c.master),
             table_id: c.table,
             start_mode,
             interpolation: c.interpolation,
@@ -362,7 +366,15 @@ impl TimelineBlock for CompatBlock {
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(config) = value.custom::<CompatConfig>() {
             self.config = config;
+            self.master = None;
         }
+    }
+    fn set_master(&mut self, index: u32) -> bool {
+        let coupling = ["CamTableCoupleAxes", "CamTableCoupleAxesIpol"].contains(&self.config.kind);
+        if coupling {
+            self.master = Some(index);
+        }
+        coupling
     }
     execute_cycle!(with_axis, recorded);
     fn read(&self) -> Option<Vec<f64>> {

@@ -163,6 +163,10 @@ impl TimelineBlock for CamTableSetWeight {
 
 impl TimelineBlock for CamTableCoupleAxesMultiTables {
     timeline_timeout!();
+    fn set_master(&mut self, index: u32) -> bool {
+        self.master = index;
+        true
+    }
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("master", Value::Int(v)) => self.master = *v as u32,

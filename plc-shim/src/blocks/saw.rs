@@ -550,6 +550,10 @@ impl McReadFlyingSawCharacteristics {
 
 impl TimelineBlock for McGearInVelo {
     timeline_timeout!();
+    fn set_master(&mut self, index: u32) -> bool {
+        self.master = index;
+        true
+    }
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(i) = value.custom::<SawInputs>() {
             (self.inputs, self.master) = (i.gear, i.master);
@@ -560,6 +564,10 @@ impl TimelineBlock for McGearInVelo {
 
 impl TimelineBlock for McGearInPos {
     timeline_timeout!();
+    fn set_master(&mut self, index: u32) -> bool {
+        self.master = index;
+        true
+    }
     fn set(&mut self, _: &str, value: &Value) {
         if let Some(i) = value.custom::<SawInputs>() {
             (self.inputs, self.master) = (i.gear, i.master);

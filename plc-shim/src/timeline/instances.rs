@@ -27,6 +27,29 @@ pub struct Call {
     execute: bool,
     /// tTimeout in PLC cycles, if the call gives it.
     timeout: Option<u64>,
+    /// The master's NC axis ID, if the call gives it (`master_id`).
+    master_id: Option<u32>,
+}
+
+/// An NC axis ID of key `key` in a call, if given: 1..=u32::MAX.
+fn id_of(table: &toml::Table, key: &str) -> Result<Option<u32>, String> {
+    let Some(value) = table.get(key) else {
+        return Ok(None);
+    };
+    let id = value
+        .as_integer()
+        .filter(|i| (1..=i64::from(u32::MAX)).contains(i))
+        .ok_or_else(|| format!("call: `{key}` = {value}: an NC axis ID 1..={}", u32::MAX))?;
+    Ok(Some(id as u32))
+}
+
+/// The `master_id` of a call of `spec`, checked: only for a block with a master.
+fn master_id_of(spec: &BlockSpec, table: &toml::Table) -> Result<Option<u32>, String> {
+    let id = id_of(table, "master_id")?;
+    if id.is_some() && !(spec.make)(None).set_master(0) {
+        return Err(format!("call: {} has no master: no `master_id`", spec.name));
+    }
+    Ok(id)
 }
 
 /// The longest tTimeout a call may give, in PLC cycles (about three hours at 1 ms).
@@ -83,7 +106,12 @@ pub struct Edge {
 struct Instance {
     name: String,
     spec: &'static BlockSpec,
+    /// The gpAx index the block addresses (resolved from `axis_id` if given).
     axis: u32,
+    /// The axis's NC axis ID, when the calls address it so.
+    axis_id: Option<u32>,
+    /// The master's NC axis ID, when the last call gave one.
+    master_id: Option<u32>,
     block: Box<dyn TimelineBlock>,
     raise_next_cycle: bool,
     last: [bool; 8],
@@ -94,11 +122,13 @@ struct Instance {
 }
 
 impl Instance {
-    fn new(name: String, spec: &'static BlockSpec, axis: u32, room: Option<usize>) -> Self {
+    fn new(name: String, spec: &'static BlockSpec, axis: AxisRef, room: Option<usize>) -> Self {
         Instance {
             name,
             spec,
-            axis,
+            axis: axis.0,
+            axis_id: axis.1,
+            master_id: None,
             block: (spec.make)(room),
             raise_next_cycle: false,
             last: [false; 8],
@@ -119,9 +149,42 @@ pub struct Instances {
     list: Vec<Instance>,
 }
 
+/// What an instance addresses: the gpAx index (0 for a group's block, the gpCh index for a
+/// channel's block; [`UNRESOLVED`] until an NC axis ID is found), and the NC axis ID if the
+/// call gave `axis_id`.
+type AxisRef = (u32, Option<u32>);
+
+/// The index of an axis given by an NC axis ID the image does not (yet) show: calls to it are
+/// refused by the CNC, so the block ends in Error.
+pub const UNRESOLVED: u32 = u32::MAX;
+
+/// The axis a call of `spec` addresses: `axis_id` (an NC axis ID) or as [`index_of`] reads it.
+fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<AxisRef, String> {
+    let Some(id) = id_of(table, "axis_id")? else {
+        return index_of(spec, table).map(|i| (i, None));
+    };
+    let given = match spec.target {
+        Target::Group | Target::Channel => {
+            return Err(format!(
+                "call: {} addresses no axis: no `axis_id`",
+                spec.name
+            ))
+        }
+        Target::AxisOr(find) => table.get("axis").or_else(|| find(table)),
+        Target::Axis => table.get("axis"),
+    };
+    match given {
+        Some(_) => Err(format!(
+            "call: {}: `axis_id` or the axis index, not both",
+            spec.name
+        )),
+        None => Ok((UNRESOLVED, Some(id))),
+    }
+}
+
 /// The gpAx index a call of `spec` gives (0 for a group's block; the gpCh index for a
 /// channel's block).
-fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
+fn index_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
     if let Target::Channel = spec.target {
         return match table.get("channel").map(toml::Value::as_integer) {
             Some(Some(c)) if (0..hli::layout::HLI_MAX_CHANNELS as i64).contains(&c) => Ok(c as u32),
@@ -170,7 +233,15 @@ fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
         room = r;
     }
     for (key, value) in table {
-        if ["block", "instance", "axis", "channel", "timeout_cycles"].contains(&key.as_str()) {
+        let addressing = [
+            "block",
+            "instance",
+            "axis",
+            "channel",
+            "axis_id",
+            "master_id",
+        ];
+        if addressing.contains(&key.as_str()) || key == "timeout_cycles" {
             continue;
         }
         if key == "execute" && spec.execute {
@@ -269,13 +340,17 @@ impl Instances {
         let axis = axis_of(spec, table)?;
         let (inputs, room, execute) = inputs_of(spec, table)?;
         let timeout = timeout_of(spec, table)?;
+        let master_id = master_id_of(spec, table)?;
         let instance = match self.list.iter().position(|i| i.name == name) {
             Some(i) => {
                 let inst = &mut self.list[i];
-                if inst.spec.name != spec.name || inst.axis != axis {
+                if inst.spec.name != spec.name || (inst.axis, inst.axis_id) != axis {
                     return Err(format!(
-                        "call: instance {name:?} is a {} on axis {}, not a {} on axis {axis}",
-                        inst.spec.name, inst.axis, spec.name
+                        "call: instance {name:?} is a {} on {}, not a {} on {}",
+                        inst.spec.name,
+                        axis_text((inst.axis, inst.axis_id)),
+                        spec.name,
+                        axis_text(axis)
                     ));
                 }
                 // The room of a read's answer is the instance's, made now (never in a cycle).
@@ -296,6 +371,7 @@ impl Instances {
             inputs,
             execute,
             timeout,
+            master_id,
         })
     }
 
@@ -329,8 +405,22 @@ impl Instances {
     pub fn axes(&self) -> impl Iterator<Item = (&str, u32)> {
         self.list
             .iter()
-            .filter(|i| i.uses_axis())
+            .filter(|i| i.uses_axis() && i.axis_id.is_none())
             .map(|i| (i.name.as_str(), i.axis))
+    }
+
+    /// The NC axis IDs the calls name, with the instance's name and whether the ID is the
+    /// block's own axis (`axis_id`; else a master, `master_id`).
+    pub fn axis_ids<'c>(&self, calls: impl Iterator<Item = &'c Call>) -> Vec<(String, u32, bool)> {
+        let own = self.list.iter().filter_map(|i| {
+            let id = i.axis_id?;
+            Some((i.name.clone(), id, true))
+        });
+        let masters = calls.filter_map(|c| {
+            let id = c.master_id?;
+            Some((self.list[c.instance].name.clone(), id, false))
+        });
+        own.chain(masters).collect()
     }
 
     /// The channel (gpCh index) of every instance of a channel's block, with its name.
@@ -356,6 +446,7 @@ impl Instances {
         if let Some(cycles) = call.timeout {
             inst.block.timeout_cycles(cycles);
         }
+        inst.master_id = call.master_id;
         inst.last = [false; 8];
         match inst.block.execute() {
             // Execute is (or is about to be) TRUE: hold it FALSE for a cycle, then raise it.
@@ -386,6 +477,12 @@ impl Instances {
     /// Calls every instance once and records its output edges at CNC tick `tick`.
     pub fn call_all(&mut self, io: &mut PlcIo<'_>, tick: u64) {
         for inst in &mut self.list {
+            if let Some(id) = inst.axis_id {
+                inst.axis = resolve(&io.view, inst.axis, id);
+            }
+            if let Some(id) = inst.master_id {
+                inst.block.set_master(resolve(&io.view, UNRESOLVED, id));
+            }
             let (out, status) = inst.block.cycle(io, inst.axis);
             let now = [
                 out.done,
@@ -446,12 +543,33 @@ impl Instances {
     }
 }
 
+/// The gpAx index of NC axis ID `id`: `known` if the image still shows that ID there, else
+/// found anew ([`UNRESOLVED`] if no axis has it). No allocation.
+fn resolve(view: &hli::views::PlcView<'_>, known: u32, id: u32) -> u32 {
+    let there = view.axis_state(known as usize);
+    if there.is_ok_and(|s| s.nc_axis_id_r == id) {
+        return known;
+    }
+    view.axis_index_by_id(id).map_or(UNRESOLVED, |i| i as u32)
+}
+
+/// How an instance's axis reads in a message.
+fn axis_text((axis, id): AxisRef) -> String {
+    match id {
+        Some(id) => format!("axis ID {id}"),
+        None => format!("axis {axis}"),
+    }
+}
+
 /// A clone has the same instances with fresh block states (a timeline is cloned before it
 /// runs).
 impl Clone for Instances {
     fn clone(&self) -> Self {
         let list = self.list.iter();
-        let fresh = |i: &Instance| Instance::new(i.name.clone(), i.spec, i.axis, i.room);
+        let fresh = |i: &Instance| {
+            let axis = (i.axis, i.axis_id);
+            Instance::new(i.name.clone(), i.spec, axis, i.room)
+        };
         Instances {
             list: list.map(fresh).collect(),
         }

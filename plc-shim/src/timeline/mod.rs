@@ -315,6 +315,13 @@ impl Timeline {
         self.instances.axes()
     }
 
+    /// The NC axis IDs the block calls name (`axis_id`, `master_id`), with the instance name
+    /// and whether it is the block's own axis.
+    pub fn block_axis_ids(&self) -> Vec<(String, u32, bool)> {
+        let calls = self.steps.iter().filter_map(|s| s.call.as_ref());
+        self.instances.axis_ids(calls)
+    }
+
     /// The channel (gpCh index) of every channel block instance, with the instance name.
     pub fn block_channels(&self) -> impl Iterator<Item = (&str, u32)> {
         self.instances.channels()

@@ -86,8 +86,17 @@ pub enum Inputs {
 
 /// The keys of a call every block takes (checked by [`super::instances`], not by a family's
 /// whole-table parser): `timeout_cycles` is the seed's tTimeout, in PLC cycles, of a block
-/// that has it ([`TimelineBlock::timeout_cycles`]).
-pub const CALL_KEYS: [&str; 5] = ["block", "instance", "axis", "execute", "timeout_cycles"];
+/// that has it ([`TimelineBlock::timeout_cycles`]); `axis_id` addresses the block's axis by
+/// its NC axis ID instead of `axis`, and `master_id` its master ([`TimelineBlock::set_master`]).
+pub const CALL_KEYS: [&str; 7] = [
+    "block",
+    "instance",
+    "axis",
+    "execute",
+    "timeout_cycles",
+    "axis_id",
+    "master_id",
+];
 
 /// A call checked whole: its one value, and the room of a read's answer if it gives one.
 pub type Whole = (Value, Option<usize>);
@@ -274,6 +283,11 @@ pub trait TimelineBlock: core::fmt::Debug {
     }
     /// Input tTimeout, in PLC cycles: `true` if the block has it (and took it).
     fn timeout_cycles(&mut self, _cycles: u64) -> bool {
+        false
+    }
+    /// The master axis (gpAx index) of a coupling block: `true` if the block has one (and
+    /// took it). A timeline's `master_id` is resolved to the index and set here every cycle.
+    fn set_master(&mut self, _index: u32) -> bool {
         false
     }
 }

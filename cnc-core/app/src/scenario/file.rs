@@ -241,6 +241,10 @@ impl Scenario {
         cnc_core::machine::gear::GearEngine::new(&gears, names.len())
             .map_err(|e| invalid(e.to_string()))?;
         check_block_axes(&plc, channel_axes, &names).map_err(&invalid)?;
+        let ids: Vec<u32> = (1..=channel_axes as u32)
+            .chain(axes.iter().map(|a| a.config.id))
+            .collect();
+        check_block_axis_ids(&plc, channel_axes, &ids, &names).map_err(&invalid)?;
         check_block_channels(&plc, file.channel.len()).map_err(&invalid)?;
         let cam_tables = cam_tables(name, &file.cam_table, &open)?;
         let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
@@ -516,6 +520,36 @@ fn check_block_axes(plc: &PlcSetup, channel_axes: usize, names: &[String]) -> Re
                 path.display(),
                 names.len(),
                 names.join(", ")
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The NC axis IDs a timeline's blocks name (`axis_id`, `master_id`) are the machine's
+/// (`ids[i]` is axis `i`'s), and a block's own axis is a single axis.
+fn check_block_axis_ids(
+    plc: &PlcSetup,
+    channel_axes: usize,
+    ids: &[u32],
+    names: &[String],
+) -> Result<(), String> {
+    let PlcSetup::Timeline { timeline, path, .. } = plc else {
+        return Ok(());
+    };
+    for (instance, id, own) in timeline.block_axis_ids() {
+        let key = if own { "axis_id" } else { "master_id" };
+        let Some(axis) = ids.iter().position(|&i| i == id) else {
+            return Err(format!(
+                "{}: block {instance:?}: `{key}` = {id}: no axis has that ID (the machine's: {ids:?})",
+                path.display()
+            ));
+        };
+        if own && axis < channel_axes {
+            return Err(format!(
+                "{}: block {instance:?}: axis ID {id} ({}) is a channel axis, commanded by its channel",
+                path.display(),
+                names[axis]
             ));
         }
     }

@@ -112,7 +112,7 @@ impl Axis {
             master_axis_r: self.coupling.map_or(-1, |c| c.master),
             error_id_r: self.error.map_or(0, AxisError::raw),
             status_r: self.status_bits(set),
-            fill_up_1: 0,
+            nc_axis_id_r: cfg.id,
         }
     }
 

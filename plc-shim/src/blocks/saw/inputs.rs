@@ -180,7 +180,8 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String
         }
     }
     inputs.gear.sync_mode.mask = checks | operations;
-    if known.contains(&"Master") {
+    // The master by its NC axis ID (`master_id`) is set by the timeline's instances.
+    if known.contains(&"Master") && !table.contains_key("master_id") {
         inputs.master = master.ok_or_else(|| format!("call: {kind} needs `Master`"))?;
     }
     if known.contains(&"MasterSyncPosition") {

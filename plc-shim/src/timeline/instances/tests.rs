@@ -169,3 +169,48 @@ fn a_timeout_is_taken_by_blocks_that_have_one() {
         i.apply(&call);
     }
 }
+
+/// An NC axis ID is found in the image's `nc_axis_id_r` (as the CNC writes it), kept while the
+/// image still shows it there; an ID no axis has stays unresolved (the CNC then refuses the
+/// block's calls: an Error, never a wrong axis).
+#[test]
+fn axis_ids_resolve_from_the_image() {
+    use hli::layout::{HliAxis, HliAxisLrState};
+    use hli::PlaceExt;
+    let memory = hli::segment::heap_image(1, 3);
+    let cnc = hli::views::CncView::new(&memory);
+    let write_id = |axis: usize, id: u32| {
+        cnc.axis(axis)
+            .unwrap()
+            .field::<HliAxisLrState>(core::mem::offset_of!(HliAxis, lr_state))
+            .write(&HliAxisLrState {
+                nc_axis_id_r: id,
+                ..bytemuck::Zeroable::zeroed()
+            });
+    };
+    write_id(1, 9);
+    write_id(2, 7);
+    let view = hli::views::PlcView::new(&memory);
+    assert_eq!(resolve(&view, UNRESOLVED, 9), 1);
+    assert_eq!(resolve(&view, UNRESOLVED, 7), 2);
+    assert_eq!(resolve(&view, UNRESOLVED, 12), UNRESOLVED);
+    assert_eq!(view.axis_index_by_id(0), None);
+    write_id(1, 4);
+    write_id(0, 9);
+    assert_eq!(
+        resolve(&view, 1, 9),
+        0,
+        "found anew when the image moved it"
+    );
+    let mut i = Instances::default();
+    i.parse_call(&table("block = \"MC_Halt\"\ninstance = \"h\"\naxis_id = 9"))
+        .unwrap();
+    assert_eq!(i.axes().count(), 0, "not an index");
+    let e = i
+        .parse_call(&table("block = \"MC_Halt\"\ninstance = \"h\"\naxis = 1"))
+        .unwrap_err();
+    assert_eq!(
+        e,
+        "call: instance \"h\" is a MC_Halt on axis ID 9, not a MC_Halt on axis 1"
+    );
+}

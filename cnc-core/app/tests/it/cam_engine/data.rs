@@ -581,33 +581,42 @@ fn a_multi_table_coupling_takes_the_scaling_of_a_table_not_yet_active() {
     assert_eq!(set(&run, SLAVE).position, 200.0);
 }
 
-/// CamTableSetSlaveScale (a compatibility block): only the slave's scaling changes, at once;
-/// the master and slave offsets a CamTableOffsetChange set before, and the master scaling,
-/// stay. The pusher then follows 0.5 + 3 x zigzag(drum + 30).
-#[test]
-fn cam_table_set_slave_scale_changes_the_slave_scaling_alone() {
-    let scenario = "cycle_ms = 1.0\nticks = 3000\n\
-        [[axis]]\nname = \"Drum\"\nkind = \"rotary\"\npower = true\n\
-        [[axis]]\nname = \"Pusher\"\npower = true\nsoft_limits = [-50.0, 50.0]\n\
-        following_error_limit = 5.0\n[plc]\ntimeline = \"plc.toml\"\n";
-    let timeline = r#"
+/// The machine of the compatibility tests: a drum and a pusher, single axes 0 and 1 with
+/// NC axis IDs 7 and 9.
+const DRUM_AND_PUSHER: &str = "cycle_ms = 1.0\nticks = 3000\n\
+    [[axis]]\nname = \"Drum\"\nid = 7\nkind = \"rotary\"\npower = true\n\
+    [[axis]]\nname = \"Pusher\"\nid = 9\npower = true\nsoft_limits = [-50.0, 50.0]\n\
+    following_error_limit = 5.0\n[plc]\ntimeline = \"plc.toml\"\n";
+
+/// CamTableGenerate, CamTableCoupleAxesIpol, CamTableOffsetChange, CamTableSetSlaveScale and
+/// MC_MoveVelocity in a row; `pusher` and `drum` address the axes (`axis = 1` or
+/// `axis_id = 9`; `master = 0` or `master_id = 7`).
+fn slave_scale_timeline(pusher: &str, drum: &str, master: &str) -> String {
+    format!(
+        r#"
 [[step]]
 at_tick = 2
-call = { block = "CamTableGenerate", instance = "generate", axis = 1, table = 22, table_type = 2, rows = [[0.0, 0.0], [90.0, 9.0], [180.0, 0.0], [270.0, -9.0], [360.0, 0.0]] }
+call = {{ block = "CamTableGenerate", instance = "generate", {pusher}, table = 22, table_type = 2, rows = [[0.0, 0.0], [90.0, 9.0], [180.0, 0.0], [270.0, -9.0], [360.0, 0.0]] }}
 [[step]]
 wait = "generate.Done"
-call = { block = "CamTableCoupleAxesIpol", instance = "couple", axis = 1, master = 0, table = 22, interpolation = 0, master_absolute = true, slave_absolute = true }
+call = {{ block = "CamTableCoupleAxesIpol", instance = "couple", {pusher}, {master}, table = 22, interpolation = 0, master_absolute = true, slave_absolute = true }}
 [[step]]
 wait = "couple.Done"
-call = { block = "CamTableOffsetChange", instance = "shift", axis = 1, master_offset = 30.0, slave_offset = 0.5 }
+call = {{ block = "CamTableOffsetChange", instance = "shift", {pusher}, master_offset = 30.0, slave_offset = 0.5 }}
 [[step]]
 wait = "shift.Done"
-call = { block = "CamTableSetSlaveScale", instance = "slave", axis = 1, slave_slope = 3.0 }
+call = {{ block = "CamTableSetSlaveScale", instance = "slave", {pusher}, slave_slope = 3.0 }}
 [[step]]
 wait = "slave.Done"
-call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.0, direction = 1, acceleration = 1800.0, deceleration = 1800.0, jerk = 18000.0 }
-"#;
-    let s = with_timeline("slave-scale.toml", scenario, timeline);
+call = {{ block = "MC_MoveVelocity", instance = "turn", {drum}, velocity = 180.0, direction = 1, acceleration = 1800.0, deceleration = 1800.0, jerk = 18000.0 }}
+"#
+    )
+}
+
+/// Runs the slave-scale timeline; every tick after the drum turns, the pusher follows
+/// 0.5 + 3 x zigzag(drum + 30).
+fn run_slave_scale(timeline: &str) {
+    let s = with_timeline("slave-scale.toml", DRUM_AND_PUSHER, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
     let mut checked = 0;
     for tick in 0..s.ticks.unwrap() {
@@ -626,6 +635,43 @@ call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.
     assert!(checked > 1500, "{checked}");
     let report = run.timeline.as_ref().unwrap().summary();
     assert!(!report.contains("ErrorID"), "{report}");
+}
+
+/// CamTableSetSlaveScale (a compatibility block): only the slave's scaling changes, at once;
+/// the master and slave offsets a CamTableOffsetChange set before, and the master scaling,
+/// stay. The pusher then follows 0.5 + 3 x zigzag(drum + 30).
+#[test]
+fn cam_table_set_slave_scale_changes_the_slave_scaling_alone() {
+    run_slave_scale(&slave_scale_timeline("axis = 1", "axis = 0", "master = 0"));
+}
+
+/// Every block addresses its axis, and a coupling its master, by NC axis ID as well as by
+/// image index (issue 37 item 7): the same run with `axis_id` and `master_id` only.
+#[test]
+fn blocks_address_axes_by_their_nc_axis_id() {
+    run_slave_scale(&slave_scale_timeline(
+        "axis_id = 9",
+        "axis_id = 7",
+        "master_id = 7",
+    ));
+    // IDs the machine does not have, or a channel's, are refused when the scenario is read.
+    let refused = |timeline: &str| {
+        let s = with_timeline_result("ids.toml", DRUM_AND_PUSHER, timeline);
+        s.expect_err("refused")
+    };
+    let call = |keys: &str| {
+        format!("[[step]]\nat_tick = 2\ncall = {{ block = \"CamTableCoupleAxes\", {keys} }}\n")
+    };
+    let e = refused(&call("axis_id = 9, master_id = 8"));
+    assert!(e.contains("`master_id` = 8: no axis has that ID"), "{e}");
+    let e = refused(&call("axis_id = 12, master = 0"));
+    assert!(e.contains("`axis_id` = 12: no axis has that ID"), "{e}");
+    let e = refused(&call("axis_id = 9, axis = 1"));
+    assert!(e.contains("`axis_id` or the axis index, not both"), "{e}");
+    let e = refused(
+        "[[step]]\nat_tick = 2\ncall = { block = \"MC_Halt\", axis_id = 9, master_id = 7 }\n",
+    );
+    assert!(e.contains("MC_Halt has no master"), "{e}");
 }
 
 /// MC_ReadCamTableCharacteristics with its `master_velocity` input in a timeline: the values

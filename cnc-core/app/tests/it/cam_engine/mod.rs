@@ -194,6 +194,11 @@ fn seed_law(periodic: bool) -> CamLaw {
 /// A scenario `toml` whose `plc.toml` is `timeline` and whose other files are the cam
 /// examples (`scenarios/cams`).
 fn with_timeline(name: &str, toml: &str, timeline: &str) -> Scenario {
+    with_timeline_result(name, toml, timeline).unwrap()
+}
+
+/// [`with_timeline`], or why the scenario is refused.
+fn with_timeline_result(name: &str, toml: &str, timeline: &str) -> Result<Scenario, String> {
     Scenario::parse(name, toml, |f| {
         if f == "plc.toml" {
             return Ok((PathBuf::from(f), timeline.to_string()));
@@ -201,7 +206,7 @@ fn with_timeline(name: &str, toml: &str, timeline: &str) -> Scenario {
         let path = scenarios().join("cams").join(f);
         Ok((path.clone(), std::fs::read_to_string(path).unwrap()))
     })
-    .unwrap()
+    .map_err(|e| e.to_string())
 }
 
 fn law_at(law: &CamLaw, profile: &CamProfile, master: Kinematic) -> Kinematic {
