@@ -127,6 +127,15 @@ impl AxisSet {
     pub fn axis(&self, i: usize) -> Option<&Axis> {
         self.axes.get(i)
     }
+    /// What a slave follows of master axis `i`: its set-point, or with `actual` its encoder
+    /// ([`Axis::actual_kinematic`]: an actual-value master, such as an encoder wheel).
+    pub fn master(&self, i: usize, actual: bool) -> Option<Kinematic> {
+        let a = self.axes.get(i)?;
+        Some(match actual {
+            true => a.actual_kinematic(),
+            false => a.setpoint(),
+        })
+    }
     /// Axis `i`, mutable (for couplings and tests).
     pub fn axis_mut(&mut self, i: usize) -> Option<&mut Axis> {
         self.axes.get_mut(i)

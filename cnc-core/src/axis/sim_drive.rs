@@ -123,6 +123,11 @@ pub struct SimDriveConfig {
     /// units.
     #[serde(default)]
     pub probe_windows: [Option<[f64; 2]>; 2],
+    /// Noise on the encoder reading, axis units: each reading is off by up to this much,
+    /// uniformly and the same in every run (a function of the tick), before it is quantised
+    /// to increments. 0: none.
+    #[serde(default)]
+    pub encoder_noise: f64,
 }
 
 impl SimDriveConfig {
@@ -157,6 +162,13 @@ impl SimDriveConfig {
                 }
             }
             Dynamic::Pt1 { .. } => {}
+        }
+        if !(self.encoder_noise >= 0.0 && self.encoder_noise.is_finite()) {
+            return Err((
+                "encoder_noise",
+                self.encoder_noise,
+                "must be a finite number, 0 or above",
+            ));
         }
         if self.dead_time_ticks > MAX_DEAD_TIME_TICKS {
             return Err((
@@ -299,6 +311,20 @@ impl SimulatedDrive {
         (tick as f64 * self.dt * 1e9).round() as u64 as u32
     }
 
+    /// This tick's encoder noise: uniform in `±encoder_noise`, from the tick number alone
+    /// (splitmix64), so every run reads the same.
+    fn noise(&self) -> f64 {
+        if self.config.encoder_noise == 0.0 {
+            return 0.0;
+        }
+        let mut z = self.steps.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        let unit = (z >> 11) as f64 / (1u64 << 53) as f64; // [0, 1)
+        (2.0 * unit - 1.0) * self.config.encoder_noise
+    }
+
     /// The motor's true position.
     pub fn position(&self) -> f64 {
         self.position
@@ -315,7 +341,7 @@ impl SimulatedDrive {
     /// behind at constant velocity), and says so in `nDcInputTime`.
     pub fn encoder_in(&self) -> NcEncoderIn {
         let delay = f64::from(self.config.input_delay_ns) * 1e-9;
-        let sampled = self.position - self.velocity * delay;
+        let sampled = self.position - self.velocity * delay + self.noise();
         let count = (sampled * self.scaling.increments_per_unit).round() as i64 + self.count_offset;
         let mut enc = NcEncoderIn {
             nInData1: self.scaling.width.wrap(count),

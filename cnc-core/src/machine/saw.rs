@@ -12,6 +12,7 @@ use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
+use crate::setpoint::Kinematic;
 use hli::calls::cam::{TableOrganisation, TABLE_TYPE_MOTION_FUNCTION};
 use hli::calls::saw::{
     SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
@@ -23,6 +24,8 @@ use hli::enums::{AxisState, CouplingState, SawError};
 #[derive(Debug, Clone, Copy)]
 struct SawSlave {
     master: usize,
+    /// Follows the master's actual values (an encoder master).
+    actual: bool,
     follower: Follower,
     /// The slave's coupling: stale once another engine took the axis since (after a fault
     /// released it), and the slot with it.
@@ -156,7 +159,12 @@ impl SawEngine {
                 jerk: or(call.jerk, own.jerk),
             },
         };
-        let m = axes.axis(master).map(|a| a.setpoint()).unwrap_or_default();
+        let actual = match call.master_source {
+            0 => false,
+            1 => true,
+            _ => return refused(SawError::Mode),
+        };
+        let m = encoder_at_coupling(axes, master, actual, self.cycle_s);
         let s = axis.setpoint();
         let plan = match saw::plan(&request, &m, &s, axis.config().soft_limits) {
             Ok(p) => p,
@@ -191,6 +199,7 @@ impl SawEngine {
         let table = own_table(axes, slave);
         self.slaves[slave] = Some(SawSlave {
             master,
+            actual,
             follower: Follower::new(request, &plan, &m, soft_limits),
             lease,
             table,
@@ -242,6 +251,16 @@ impl SawEngine {
     }
 }
 
+/// The master's values a coupling plans from: its set-point, or its encoder's with the
+/// acceleration threshold of an encoder master ([`saw::encoder_master`]).
+fn encoder_at_coupling(axes: &AxisSet, master: usize, actual: bool, cycle_s: f64) -> Kinematic {
+    let m = axes.master(master, actual).unwrap_or_default();
+    match (actual, axes.axis(master)) {
+        (true, Some(a)) => saw::encoder_master(m, 1.0 / a.config().increments_per_unit, cycle_s),
+        _ => m,
+    }
+}
+
 /// The motion table the saw plans `slave`'s motion in: 256 - its axis ID (seed 001, chapter
 /// 13); the axis ID 0 of a missing axis names no table a cam can hold.
 fn own_table(axes: &AxisSet, slave: usize) -> Resource {
@@ -260,7 +279,7 @@ impl Engine for SawEngine {
         let dt = self.cycle_s;
         for (i, slot) in self.slaves.iter_mut().enumerate() {
             let Some(s) = slot else { continue };
-            let Some(m) = io.axes.axis(s.master).map(|a| a.setpoint()) else {
+            let Some(m) = io.axes.master(s.master, s.actual) else {
                 continue;
             };
             // A slave that lost its coupling (fault, power off), or was coupled by another

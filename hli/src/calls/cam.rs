@@ -528,6 +528,11 @@ pub struct CamMultiCoupleCall {
     pub profiles: u32,
     /// Table IDs.
     pub table_ids: [u32; CAM_MULTI_TABLES],
+    /// 0: the master's set-point; 1: its actual values (an encoder master), as MC_CamIn's
+    /// `master_source`.
+    pub master_source: u32,
+    /// Reserved, 0.
+    pub reserved: u32,
 }
 
 wire_enum! {

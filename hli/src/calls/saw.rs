@@ -89,8 +89,9 @@ pub struct SawGearInCall {
     pub mask: u32,
     /// RatioDenominator (0 is refused).
     pub ratio_denominator: u32,
-    /// Reserved, 0.
-    pub reserved: u32,
+    /// 0: the master's set-point; 1: its actual values (an encoder master: at coupling, an
+    /// acceleration below 2 x its scaling / cycle^2 counts as none, seed 001 chapter 3).
+    pub master_source: u32,
     /// RatioNumerator (may be negative; 0 is refused).
     pub ratio_numerator: f64,
     /// MasterSyncPosition (position sync).

@@ -479,7 +479,7 @@ inputs! {
 }
 
 /// The master's set-point (the default) or its actual position.
-const MASTER_SOURCE: InputSpec = input(
+pub(crate) const MASTER_SOURCE: InputSpec = input(
     "master_source",
     Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]),
 );

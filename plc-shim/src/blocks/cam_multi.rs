@@ -69,6 +69,9 @@ pub struct CamTableCoupleAxesMultiTables {
     pub count: u32,
     /// Input: profile tables among them.
     pub profiles: u32,
+    /// Input: follow the master's actual values (an encoder master), as MC_CamIn's
+    /// `master_source`; ours, not the seed's.
+    pub master_actual: bool,
     /// Outputs of the last call.
     pub out: Outputs,
     core: CamCore<hli::calls::cam::CamMultiCoupleCall>,
@@ -85,6 +88,8 @@ impl CamTableCoupleAxesMultiTables {
             tables: self.count,
             profiles: self.profiles,
             table_ids: self.tables,
+            master_source: u32::from(self.master_actual),
+            reserved: 0,
         };
         self.out = self.core.cycle(io, self.execute, slave, || call, None);
     }
@@ -170,6 +175,7 @@ impl TimelineBlock for CamTableCoupleAxesMultiTables {
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("master", Value::Int(v)) => self.master = *v as u32,
+            ("master_source", Value::Int(v)) => self.master_actual = *v != 0,
             ("profiles", Value::Int(v)) => self.profiles = *v as u32,
             ("on", Value::Bool(v)) => self.on = *v,
             ("tables", Value::Ids(ids, n)) => {
@@ -232,6 +238,7 @@ pub const TIMELINE: &[BlockSpec] = &[
             ),
             input("profiles", Kind::Range(1, 8)),
             input("on", Kind::Bool),
+            crate::blocks::cam::MASTER_SOURCE,
         ],
         |_| {
             Box::new(CamTableCoupleAxesMultiTables {

@@ -257,6 +257,10 @@ pub struct GearInInputs {
     pub deceleration: f64,
     /// Jerk limit (0: the axis's own).
     pub jerk: f64,
+    /// Follow the master's actual values (an encoder master) rather than its set-point; our
+    /// input, as MC_CamIn's `master_source` (the seed knows the encoder master as an axis
+    /// type).
+    pub master_actual: bool,
 }
 
 impl Default for GearInInputs {
@@ -270,6 +274,7 @@ impl Default for GearInInputs {
             acceleration: 0.0,
             deceleration: 0.0,
             jerk: 0.0,
+            master_actual: false,
         }
     }
 }
@@ -284,7 +289,7 @@ impl GearInInputs {
             sync_mode: self.sync_mode.raw_mode(),
             mask: self.sync_mode.mask,
             ratio_denominator: self.ratio_denominator,
-            reserved: 0,
+            master_source: u32::from(self.master_actual),
             ratio_numerator: self.ratio_numerator,
             master_sync_position: sync_positions[0],
             slave_sync_position: sync_positions[1],

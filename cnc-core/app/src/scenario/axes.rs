@@ -15,6 +15,7 @@
 //! start = 0.0                   # where the (simulated) axis stands at start
 //! power = true                  # enabled at start (as if MC_Power had run)
 //! id = 12                       # axis ID; default: next after the channel axes
+//! encoder_noise = 0.00005       # simulated encoder: each reading off by up to this, units
 //!
 //! [[gear]]
 //! master = "conveyor.X"         # any axis by name
@@ -63,6 +64,9 @@ pub struct AxisFile {
     power: bool,
     /// The axis ID (1..=255); default: the next after the channel axes and the axes before.
     id: Option<u32>,
+    /// Noise on the simulated encoder's readings, units (an actual-value master's encoder).
+    #[serde(default)]
+    encoder_noise: f64,
 }
 
 fn linear() -> String {
@@ -202,7 +206,13 @@ impl AxisFile {
             .drive
             .unwrap_or(DriveModel::Ideal { dead_time_ticks: 0 });
         c.drive = match model.simulated(self.start) {
-            Some(sim) => DriveLink::Simulated(sim),
+            Some(sim) => DriveLink::Simulated(cnc_core::axis::sim_drive::SimDriveConfig {
+                encoder_noise: self.encoder_noise,
+                ..sim
+            }),
+            None if self.encoder_noise != 0.0 => {
+                return Err(self.key("encoder_noise: only for a simulated drive"))
+            }
             None => DriveLink::External,
         };
         c.validate().map_err(|e| format!("[[axis]] {e}"))?;

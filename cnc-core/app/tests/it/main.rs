@@ -37,6 +37,7 @@ mod fifo_no_alloc;
 mod fuzz;
 mod hostile;
 mod machine;
+mod saw_encoder;
 mod saw_engine;
 mod saw_no_alloc;
 mod scenario_paths;

@@ -93,6 +93,10 @@ pub struct Axis {
     io_fault: Option<AxisError>,
     actual: f64,
     actual_velocity: f64,
+    /// From the last two actual velocities (0 until two were measured).
+    actual_acceleration: f64,
+    /// Encoder readings since the count (re)started, up to 3.
+    readings: u8,
     following_error: f64,
     output_velocity: f64,
 }
@@ -134,6 +138,8 @@ impl Axis {
             io_fault: None,
             actual: 0.0,
             actual_velocity: 0.0,
+            actual_acceleration: 0.0,
+            readings: 0,
             following_error: 0.0,
             output_velocity: 0.0,
         }
@@ -157,6 +163,16 @@ impl Axis {
     /// The actual velocity (from the last two encoder readings).
     pub fn actual_velocity(&self) -> f64 {
         self.actual_velocity
+    }
+    /// Position, velocity and acceleration from the encoder alone (the last three readings;
+    /// unfiltered, so quantisation and noise show in velocity and more in acceleration).
+    pub fn actual_kinematic(&self) -> Kinematic {
+        Kinematic {
+            position: self.actual,
+            velocity: self.actual_velocity,
+            acceleration: self.actual_acceleration,
+            jerk: 0.0,
+        }
     }
     /// Set minus actual position of the last tick.
     pub fn following_error(&self) -> f64 {
@@ -517,7 +533,7 @@ impl Axis {
             // A re-based count starts afresh (no velocity from the jump).
             let rebased = self.encoder_answer(enc_in);
             let first = !self.counter.started() || rebased;
-            let previous = self.actual;
+            let (previous, previous_velocity) = (self.actual, self.actual_velocity);
             let count = self.counter.update(enc_in.nInData1);
             let raw = count as f64 / scale;
             // Dead-time compensation: the reading is `input_lag` old; the axis moved on at
@@ -533,6 +549,12 @@ impl Axis {
                 0.0
             } else {
                 (self.actual - previous) / self.cycle_s
+            };
+            // Two velocities measured since the count started make an acceleration.
+            self.readings = if first { 1 } else { (self.readings + 1).min(3) };
+            self.actual_acceleration = match self.readings {
+                3 => (self.actual_velocity - previous_velocity) / self.cycle_s,
+                _ => 0.0,
             };
             let undefined = self.probes.sense(enc_in, enc_in.nInData1, count, scale);
             self.inputs.undefined = self.inputs.undefined.wrapping_add(undefined);

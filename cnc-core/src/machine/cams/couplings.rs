@@ -369,7 +369,11 @@ impl CamEngine {
                 cam,
             });
         }
-        let Some(m) = axes.axis(master).map(|a| a.setpoint()) else {
+        if call.master_source > 1 {
+            return code(CamCouplingError::UnknownMode.raw());
+        }
+        let follow_actual = call.master_source == 1;
+        let Some(m) = master_of(axes, master, follow_actual) else {
             return code(CamCouplingError::NoSuchMaster.raw());
         };
         let slave_at = axes.axis(slave).map_or(0.0, |a| a.setpoint().position);
@@ -390,7 +394,12 @@ impl CamEngine {
             self.retired.extend(stale.own);
             self.retired.extend(stale.switch_own);
         }
-        self.multis[slave] = Some(MultiSlave { lease, master, law });
+        self.multis[slave] = Some(MultiSlave {
+            lease,
+            master,
+            follow_actual,
+            law,
+        });
         accepted()
     }
 

@@ -158,18 +158,9 @@ fn periodic_of(selects: &[Option<Select>], table: u32, profile: &CamProfile) -> 
 }
 
 /// What of the master a slave follows: its set-point (the seed's rule) or its actual
-/// position and velocity.
+/// position, velocity and acceleration ([`AxisSet::master`]).
 fn master_of(axes: &AxisSet, master: usize, actual: bool) -> Option<Kinematic> {
-    let a = axes.axis(master)?;
-    Some(if actual {
-        Kinematic {
-            position: a.actual(),
-            velocity: a.actual_velocity(),
-            ..Kinematic::default()
-        }
-    } else {
-        a.setpoint()
-    })
+    axes.master(master, actual)
 }
 
 /// A multi-table slave (chapter 4.6).
@@ -178,6 +169,8 @@ struct MultiSlave {
     /// The slave's coupling.
     lease: Lease,
     master: usize,
+    /// Follows the master's actual values (an encoder master).
+    follow_actual: bool,
     law: MultiTableLaw,
 }
 
@@ -393,7 +386,7 @@ impl CamEngine {
                 continue;
             };
             let still = axes.holds(multi.lease);
-            let master = axes.axis(multi.master).map(|a| a.setpoint());
+            let master = master_of(axes, multi.master, multi.follow_actual);
             let (true, Some(master)) = (still, master) else {
                 self.multis[i] = None;
                 continue;

@@ -67,8 +67,9 @@ pub(super) struct SawInputs {
     pub(super) sync_positions: [f64; 2],
 }
 
-/// The inputs of MC_GearInPos under the seed's names, in the order an error lists them.
-const GEAR_IN_POS: [&str; 13] = [
+/// The inputs of MC_GearInPos under the seed's names, in the order an error lists them, and
+/// our `MasterSource` ("set_point" or "actual", as MC_CamIn's).
+const GEAR_IN_POS: [&str; 14] = [
     "Slave",
     "Master",
     "RatioNumerator",
@@ -82,6 +83,7 @@ const GEAR_IN_POS: [&str; 13] = [
     "Acceleration",
     "Deceleration",
     "Jerk",
+    "MasterSource",
 ];
 
 /// The inputs of `kind` under the seed's names (`Slave` is every kind's: the axis).
@@ -162,6 +164,13 @@ pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String
                     time_based(value).ok_or_else(|| bad("\"position-based\" or \"time-based\""))?
             }
             "CheckMask" => checks = mask(value, &CHECK_FLAGS).map_err(|e| bad(&e))?,
+            "MasterSource" => {
+                gear.master_actual = match value.as_str() {
+                    Some("set_point") => false,
+                    Some("actual") => true,
+                    _ => return Err(bad("\"set_point\" or \"actual\"")),
+                }
+            }
             "OpMask" => operations = mask(value, &OPERATION_FLAGS).map_err(|e| bad(&e))?,
             other => {
                 let v = number(value)
@@ -275,6 +284,9 @@ mod tests {
         let bits = sync_mask::MAXACC | sync_mask::MAXJERK | sync_mask::ROLLBACKLOCK;
         assert_eq!(i.gear.sync_mode.mask, bits);
         assert!(!i.gear.sync_mode.time_based);
+        assert!(!i.gear.master_actual, "the set-point by default");
+        let i = parsed("MC_GearInVelo", "Master = 0\nmaster_source = \"actual\"").unwrap();
+        assert!(i.gear.master_actual);
 
         let i = parsed(
             "MC_GearInVelo",
@@ -312,6 +324,10 @@ mod tests {
         assert!(err("MC_GearInVelo", "Master = 0\nSyncMode = \"fast\"").contains("time-based"));
         assert!(err("MC_GearInVelo", "Master = 0\nRatioDenominator = 70000").contains("UINT"));
         assert!(err("MC_GearOut", "Slave = 1\naxis = 2").contains("differ"));
+        assert!(
+            err("MC_GearInVelo", "Master = 0\nMasterSource = \"encoder\"")
+                .contains("\"set_point\" or \"actual\"")
+        );
         assert!(parsed("MC_GearOut", "Slave = 1\naxis = 1").is_ok());
         assert!(parsed("MC_ReadFlyingSawCharacteristics", "slave = 1").is_ok());
     }

@@ -301,6 +301,7 @@ fn a_multi_table_call_refuses_an_operation_it_does_not_have() {
         tables: 1,
         profiles: 1,
         table_ids,
+        ..Default::default()
     };
     assert_eq!(call(&mut run, SLAVE as u32, couple), 0);
     let on_table = |op, table| CamMultiTableCall {

@@ -16,6 +16,7 @@ use hli::wire::{encode_body, AcyclicRequest};
 use std::path::PathBuf;
 
 mod data;
+mod encoder;
 mod modes;
 mod recovery;
 

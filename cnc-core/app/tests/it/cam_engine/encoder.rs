@@ -1,0 +1,120 @@
+//! A multi-table slave on an encoder master (issue 37 item 2): CamTableCoupleAxesMultiTables
+//! with `master_source` actual follows the master's encoder, noise and all, not its set-point.
+
+use super::*;
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::cam::{CamMultiCoupleCall, CAM_MULTI_TABLES};
+
+/// A wheel on a slow drive (PT1, 40 ms) whose encoder reads with noise, a feeder, and table 5:
+/// a straight line of slope 1/2 from 0 to 1000.
+fn wheel_and_feeder() -> InProcess {
+    let toml = "cycle_ms = 1.0\nticks = 10\n\
+        [[axis]]\nname = \"Wheel\"\npower = true\nsoft_limits = [-1e4, 1e4]\n\
+        drive = { model = \"pt1\", t1_ms = 40.0 }\nencoder_noise = 0.00003\n\
+        [[axis]]\nname = \"Feeder\"\npower = true\nsoft_limits = [-1e4, 1e4]\n\
+        [[cam_table]]\nfile = \"line.json\"\n";
+    let line = r#"{ "kind": "table", "id": 5, "table_type": "non_equidistant",
+        "rows": [[0, 0], [1000, 500]] }"#;
+    let s = Scenario::parse("wheel.toml", toml, |f| {
+        assert_eq!(f, "line.json");
+        Ok((PathBuf::from(f), line.to_string()))
+    })
+    .unwrap();
+    InProcess::new(&s, 0).unwrap()
+}
+
+fn couple(run: &mut InProcess, master_source: u32) {
+    let mut table_ids = [0; CAM_MULTI_TABLES];
+    table_ids[0] = 5;
+    let couple = CamMultiCoupleCall {
+        master: MASTER as u32,
+        on: 1,
+        tables: 1,
+        profiles: 1,
+        table_ids,
+        master_source,
+        ..Default::default()
+    };
+    assert_eq!(call(run, SLAVE as u32, couple), 0);
+}
+
+/// Runs the wheel at 100 mm/s and halts it; every tick, `follows` gets the feeder's set-point,
+/// the wheel's encoder position and its set-point position.
+fn run_wheel(run: &mut InProcess, mut follows: impl FnMut(f64, f64, f64)) {
+    let view = CncView::new(&run.memory);
+    let go = AxisCommandCall::move_velocity(1, [100.0, 1000.0, 1000.0, 1e5]);
+    assert_eq!(
+        run.machine
+            .call(&view, MASTER as u32, &go)
+            .unwrap()
+            .error_id,
+        0
+    );
+    for tick in 0..2500 {
+        if tick == 1500 {
+            let view = CncView::new(&run.memory);
+            let halt = AxisCommandCall::halt(1000.0, 1e5);
+            assert_eq!(
+                run.machine
+                    .call(&view, MASTER as u32, &halt)
+                    .unwrap()
+                    .error_id,
+                0
+            );
+        }
+        run.step(0.001);
+        let encoder = run.machine.axes().master(MASTER, true).unwrap();
+        follows(
+            set(run, SLAVE).position,
+            encoder.position,
+            set(run, MASTER).position,
+        );
+    }
+}
+
+#[test]
+fn a_multi_table_slave_follows_an_encoder_master() {
+    let mut run = wheel_and_feeder();
+    run.step(0.001);
+    couple(&mut run, 1);
+    let start = set(&run, SLAVE).position;
+    let mut lag = 0.0f64;
+    run_wheel(&mut run, |feeder, encoder, setpoint| {
+        // feeder = start + (encoder - where it was) / 2, to rounding, whatever the noise.
+        assert!(
+            (feeder - start - 0.5 * encoder).abs() < 1e-9,
+            "{feeder} {encoder}"
+        );
+        lag = lag.max((setpoint - encoder).abs());
+    });
+    // The encoder was not the set-point: the drive lags it by millimetres.
+    assert!(lag > 1.0, "{lag}");
+    // A coupling to the set-point (the default) follows that instead.
+    let mut run = wheel_and_feeder();
+    run.step(0.001);
+    couple(&mut run, 0);
+    run_wheel(&mut run, |feeder, _, setpoint| {
+        assert!(
+            (feeder - start - 0.5 * setpoint).abs() < 1e-9,
+            "{feeder} {setpoint}"
+        );
+    });
+    // An unknown source is refused.
+    let mut run = wheel_and_feeder();
+    run.step(0.001);
+    let mut table_ids = [0; CAM_MULTI_TABLES];
+    table_ids[0] = 5;
+    let bad = CamMultiCoupleCall {
+        master: MASTER as u32,
+        on: 1,
+        tables: 1,
+        profiles: 1,
+        table_ids,
+        master_source: 2,
+        ..Default::default()
+    };
+    assert_eq!(
+        call(&mut run, SLAVE as u32, bad),
+        CamCouplingError::UnknownMode.raw()
+    );
+}
