@@ -192,8 +192,19 @@ impl AxisSet {
         self.axes.iter().position(|a| a.config().name == name)
     }
 
-    /// Writes the simulated encoders' first readings into the image (before the first tick).
+    /// Writes the simulated encoders' first readings into the image (before the first tick),
+    /// and every axis's NC axis ID, so a PLC finds an axis by ID from its first cycle.
     pub fn prime(&self, view: &CncView<'_>) {
+        for (i, axis) in self.axes.iter().enumerate() {
+            if let Ok(place) = view.axis(i) {
+                place
+                    .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
+                    .write(&HliAxisLrState {
+                        nc_axis_id_r: axis.config().id,
+                        ..bytemuck::Zeroable::zeroed()
+                    });
+            }
+        }
         for (i, drive) in self.drives.iter().enumerate() {
             if let (Some(drive), Ok(place)) = (drive, view.axis(i)) {
                 place

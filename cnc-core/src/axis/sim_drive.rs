@@ -124,8 +124,8 @@ pub struct SimDriveConfig {
     #[serde(default)]
     pub probe_windows: [Option<[f64; 2]>; 2],
     /// Noise on the encoder reading, axis units: each reading is off by up to this much,
-    /// uniformly and the same in every run (a function of the tick), before it is quantised
-    /// to increments. 0: none.
+    /// uniformly and the same in every run (a function of the tick alone, so every noisy
+    /// axis draws the same sequence, scaled), before it is quantised to increments. 0: none.
     #[serde(default)]
     pub encoder_noise: f64,
 }

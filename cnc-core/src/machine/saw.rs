@@ -164,7 +164,7 @@ impl SawEngine {
             1 => true,
             _ => return refused(SawError::Mode),
         };
-        let m = encoder_at_coupling(axes, master, actual, self.cycle_s);
+        let m = master_values(axes, master, actual, self.cycle_s).unwrap_or_default();
         let s = axis.setpoint();
         let plan = match saw::plan(&request, &m, &s, axis.config().soft_limits) {
             Ok(p) => p,
@@ -251,14 +251,14 @@ impl SawEngine {
     }
 }
 
-/// The master's values a coupling plans from: its set-point, or its encoder's with the
-/// acceleration threshold of an encoder master ([`saw::encoder_master`]).
-fn encoder_at_coupling(axes: &AxisSet, master: usize, actual: bool, cycle_s: f64) -> Kinematic {
-    let m = axes.master(master, actual).unwrap_or_default();
-    match (actual, axes.axis(master)) {
+/// The master's values the saw plans from and follows: its set-point, or its encoder's with
+/// the acceleration threshold of an encoder master ([`saw::encoder_master`]).
+fn master_values(axes: &AxisSet, master: usize, actual: bool, cycle_s: f64) -> Option<Kinematic> {
+    let m = axes.master(master, actual)?;
+    Some(match (actual, axes.axis(master)) {
         (true, Some(a)) => saw::encoder_master(m, 1.0 / a.config().increments_per_unit, cycle_s),
         _ => m,
-    }
+    })
 }
 
 /// The motion table the saw plans `slave`'s motion in: 256 - its axis ID (seed 001, chapter
@@ -279,7 +279,9 @@ impl Engine for SawEngine {
         let dt = self.cycle_s;
         for (i, slot) in self.slaves.iter_mut().enumerate() {
             let Some(s) = slot else { continue };
-            let Some(m) = io.axes.master(s.master, s.actual) else {
+            // An encoder master with the threshold in every tick too: a phase planned anew
+            // after a rollback plans from the same kind of values as the coupling did.
+            let Some(m) = master_values(io.axes, s.master, s.actual, dt) else {
                 continue;
             };
             // A slave that lost its coupling (fault, power off), or was coupled by another

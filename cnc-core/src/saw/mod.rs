@@ -62,7 +62,7 @@ mod tests {
         };
         assert_eq!(at(199.0).acceleration, 0.0);
         assert_eq!(at(-199.0).acceleration, 0.0);
-        assert_eq!(at(200.0).acceleration, 200.0);
+        assert_eq!(at(201.0).acceleration, 201.0);
         assert_eq!(at(-350.0).acceleration, -350.0);
         assert_eq!((at(150.0).position, at(150.0).velocity), (5.0, 300.0));
     }

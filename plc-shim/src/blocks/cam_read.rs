@@ -56,6 +56,10 @@ impl InFlight for PartRead {
             Some(Ok(reply)) => reply,
         };
         let count = reply.count as usize;
+        if count > reply.values.len() {
+            // A part the reply cannot hold: as if no answer came.
+            return Polled::Answer(Err(crate::kernel::ERROR_NO_ANSWER));
+        }
         if values.len() + count > values.capacity() || reply.total as usize > values.capacity() {
             return Polled::Answer(Err(ERROR_ARRAY_SIZE));
         }

@@ -49,6 +49,14 @@ fn master_id_of(spec: &BlockSpec, table: &toml::Table) -> Result<Option<u32>, St
     if id.is_some() && !(spec.make)(None).set_master(0) {
         return Err(format!("call: {} has no master: no `master_id`", spec.name));
     }
+    // `master` or `Master` (any spelling) beside it would be overridden: one or the other.
+    let index = |k: &String| k.eq_ignore_ascii_case("master");
+    if id.is_some() && table.keys().any(index) {
+        return Err(format!(
+            "call: {}: `master_id` or the master's index, not both",
+            spec.name
+        ));
+    }
     Ok(id)
 }
 
@@ -164,6 +172,9 @@ fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<AxisRef, String> {
         return index_of(spec, table).map(|i| (i, None));
     };
     let given = match spec.target {
+        _ if table.contains_key("channel") => {
+            return Err(format!("call: {} addresses an axis, no channel", spec.name))
+        }
         Target::Group | Target::Channel => {
             return Err(format!(
                 "call: {} addresses no axis: no `axis_id`",
@@ -518,9 +529,11 @@ impl Instances {
                 .zip(&inst.edges)
                 .filter_map(|(name, e)| e.first.map(|t| format!("{name} {t} (x{})", e.count)))
                 .collect();
-            let target = match inst.uses_axis() {
-                true => format!(" on gpAx[{}]", inst.axis),
-                false => String::new(),
+            let target = match (inst.uses_axis(), inst.axis_id, inst.axis) {
+                (true, Some(id), UNRESOLVED) => format!(" on axis ID {id} (not found)"),
+                (true, Some(id), axis) => format!(" on gpAx[{axis}] (axis ID {id})"),
+                (true, None, axis) => format!(" on gpAx[{axis}]"),
+                (false, ..) => String::new(),
             };
             let edges = match edges.is_empty() {
                 true => "no output rose".to_string(),

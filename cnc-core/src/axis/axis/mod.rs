@@ -95,8 +95,10 @@ pub struct Axis {
     actual_velocity: f64,
     /// From the last two actual velocities (0 until two were measured).
     actual_acceleration: f64,
-    /// Encoder readings since the count (re)started, up to 3.
+    /// Encoder readings since the count (re)started, up to 3, and the last velocity from raw
+    /// readings (without the dead-time compensation, which would show as acceleration).
     readings: u8,
+    raw_velocity: f64,
     following_error: f64,
     output_velocity: f64,
 }
@@ -140,6 +142,7 @@ impl Axis {
             actual_velocity: 0.0,
             actual_acceleration: 0.0,
             readings: 0,
+            raw_velocity: 0.0,
             following_error: 0.0,
             output_velocity: 0.0,
         }
@@ -474,9 +477,14 @@ impl Axis {
     }
 
     fn resume_free(&mut self) {
-        let s = self.coupled_setpoint;
         let d = self.config.dynamics;
-        // Resume from the coupled state: position, velocity and acceleration carry over.
+        // Resume from the coupled state: position, velocity and acceleration carry over; an
+        // acceleration beyond the axis's own (an encoder master's noise) is taken as its limit.
+        let most = d.acceleration.max(d.deceleration);
+        let s = Kinematic {
+            acceleration: self.coupled_setpoint.acceleration.clamp(-most, most),
+            ..self.coupled_setpoint
+        };
         if s.velocity == 0.0 {
             self.generator.hold(s.position);
         } else {
@@ -533,7 +541,7 @@ impl Axis {
             // A re-based count starts afresh (no velocity from the jump).
             let rebased = self.encoder_answer(enc_in);
             let first = !self.counter.started() || rebased;
-            let (previous, previous_velocity) = (self.actual, self.actual_velocity);
+            let previous = self.actual;
             let count = self.counter.update(enc_in.nInData1);
             let raw = count as f64 / scale;
             // Dead-time compensation: the reading is `input_lag` old; the axis moved on at
@@ -550,12 +558,13 @@ impl Axis {
             } else {
                 (self.actual - previous) / self.cycle_s
             };
-            // Two velocities measured since the count started make an acceleration.
+            // Two raw velocities since the count started make an acceleration.
             self.readings = if first { 1 } else { (self.readings + 1).min(3) };
             self.actual_acceleration = match self.readings {
-                3 => (self.actual_velocity - previous_velocity) / self.cycle_s,
+                3 => (raw_velocity - self.raw_velocity) / self.cycle_s,
                 _ => 0.0,
             };
+            self.raw_velocity = raw_velocity;
             let undefined = self.probes.sense(enc_in, enc_in.nInData1, count, scale);
             self.inputs.undefined = self.inputs.undefined.wrapping_add(undefined);
             if first {

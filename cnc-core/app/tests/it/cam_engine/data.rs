@@ -669,6 +669,11 @@ fn blocks_address_axes_by_their_nc_axis_id() {
     assert!(e.contains("`axis_id` = 12: no axis has that ID"), "{e}");
     let e = refused(&call("axis_id = 9, axis = 1"));
     assert!(e.contains("`axis_id` or the axis index, not both"), "{e}");
+    let e = refused(&call("axis_id = 9, master_id = 7, master = 0"));
+    assert!(
+        e.contains("`master_id` or the master's index, not both"),
+        "{e}"
+    );
     let e = refused(
         "[[step]]\nat_tick = 2\ncall = { block = \"MC_Halt\", axis_id = 9, master_id = 7 }\n",
     );
@@ -755,4 +760,10 @@ fn a_block_size_sets_how_much_each_step_of_a_compatibility_block_moves() {
     ];
     assert_eq!(read_values(&report, "read"), expected, "{report}");
     assert_eq!(read_values(&report, "row_by_row"), expected, "{report}");
+    // All 16 numbers came, the last part too (the report shows the first 12).
+    for instance in ["read", "row_by_row"] {
+        let line = format!("block {instance} ");
+        let at = report.find(&line).unwrap();
+        assert!(report[at..].contains("read 16 value(s)"), "{report}");
+    }
 }
