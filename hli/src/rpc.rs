@@ -1,7 +1,8 @@
-//! The transport of the acyclic ADS-like calls from the PLC to the CNC: an iceoryx2
-//! request-response service carrying the frames of [`crate::wire`], one call per PLC block
-//! Execute edge (table writes, coupling commands, reads of characteristic values...), and bulk
-//! calls whose numbers are written straight into shared memory (FIFO row blocks). The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
+//! The transport of the acyclic ADS-like calls from the PLC to the CNC: a mailbox of call slots
+//! in shared memory ([`mailbox`]) carrying the frames of [`crate::wire`], one call per PLC
+//! block Execute edge (table writes, coupling commands, reads of characteristic values...),
+//! without allocating on either side; and bulk calls whose numbers are written straight into
+//! shared memory (FIFO row blocks), an iceoryx2 request-response service. The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
 //! and its families; this module is the transport alone. The CNC-side handlers live with the CNC's view
 //! ([`crate::views::handle_read_axis_state`]) and in the engines.
 
@@ -14,20 +15,17 @@ use iceoryx2::node::Node;
 use iceoryx2::port::client::Client;
 use iceoryx2::port::server::Server;
 use iceoryx2::prelude::*;
+use mailbox::{Mailbox, Ticket, MAILBOX_SLOTS};
+use std::sync::Arc;
 use std::time::Instant;
 
-/// Service name of an instance's acyclic calls.
-pub fn service_name(instance: &str) -> String {
-    format!("cncplc/{instance}/acyclic")
-}
+pub mod mailbox;
 
 /// Service name of an instance's bulk calls (FIFO row blocks).
 pub fn rows_service_name(instance: &str) -> String {
     format!("cncplc/{instance}/fifo-rows")
 }
 
-type AcyclicClientPort = Client<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
-type AcyclicServerPort = Server<ipc::Service, AcyclicRequest, (), AcyclicResponse, ()>;
 type RowsClientPort = Client<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
 type RowsServerPort = Server<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
 type RowsPendingPort = iceoryx2::pending_response::PendingResponse<
@@ -42,14 +40,7 @@ fn transport(e: impl core::fmt::Debug) -> CallError {
     CallError::Transport(format!("{e:?}"))
 }
 
-/// The calls' service and the row service, from which each end makes its ports.
-type CallsService = iceoryx2::service::port_factory::request_response::PortFactory<
-    ipc::Service,
-    AcyclicRequest,
-    (),
-    AcyclicResponse,
-    (),
->;
+/// The row service, from which each end makes its port.
 type RowsService = iceoryx2::service::port_factory::request_response::PortFactory<
     ipc::Service,
     [f64],
@@ -76,15 +67,6 @@ fn name_of(name: String) -> Result<ServiceName, CallError> {
     name.as_str().try_into().map_err(transport)
 }
 
-fn open_service(node: &Node<ipc::Service>, instance: &str) -> Result<CallsService, CallError> {
-    node.service_builder(&name_of(service_name(instance))?)
-        .request_response::<AcyclicRequest, AcyclicResponse>()
-        // One pending call per PLC block and axis: 32 axes with a move and a power block each.
-        .max_active_requests_per_client(64)
-        .open_or_create()
-        .map_err(transport)
-}
-
 fn open_rows_service(node: &Node<ipc::Service>, instance: &str) -> Result<RowsService, CallError> {
     node.service_builder(&name_of(rows_service_name(instance))?)
         .request_response::<[f64], AcyclicResponse>()
@@ -96,45 +78,39 @@ fn open_rows_service(node: &Node<ipc::Service>, instance: &str) -> Result<RowsSe
         .map_err(transport)
 }
 
-/// A node of its own for one end of `instance`'s services, and the end's two ports: `port`
-/// makes its port of the calls' service, `rows` its port of the row service.
-fn open_end<P, R, E: core::fmt::Debug, F: core::fmt::Debug>(
+/// A node of its own for one end of `instance`'s row service, and the end's port.
+fn open_end<R, F: core::fmt::Debug>(
     instance: &str,
-    port: impl FnOnce(&CallsService) -> Result<P, E>,
     rows: impl FnOnce(&RowsService) -> Result<R, F>,
-) -> Result<(Node<ipc::Service>, P, R), CallError> {
+) -> Result<(Node<ipc::Service>, R), CallError> {
     let node = NodeBuilder::new()
         .create::<ipc::Service>()
         .map_err(transport)?;
-    let port = port(&open_service(&node, instance)?).map_err(transport)?;
     let rows = rows(&open_rows_service(&node, instance)?).map_err(transport)?;
-    Ok((node, port, rows))
+    Ok((node, rows))
 }
 
 /// The PLC's end: sends calls and waits for their replies; sends FIFO row blocks.
 pub struct AcyclicClient {
     _node: Node<ipc::Service>,
-    port: AcyclicClientPort,
+    calls: Arc<Mailbox>,
     rows: RowsClientPort,
     next_invoke_id: u32,
     sent: u64,
 }
 
 impl AcyclicClient {
-    /// Connects to `instance`'s service (creating it if the server is not up yet).
+    /// Connects to `instance`'s calls (the CNC's server must have made its mailbox).
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let (node, port, rows) = open_end(
-            instance,
-            |calls| calls.client_builder().create(),
-            |rows| {
-                rows.client_builder()
-                    .initial_max_slice_len(BULK_MAX_VALUES)
-                    .create()
-            },
-        )?;
+        let calls = Arc::new(Mailbox::open(instance)?);
+        let (node, rows) = open_end(instance, |rows| {
+            rows.client_builder()
+                .initial_max_slice_len(BULK_MAX_VALUES)
+                .create()
+        })?;
         Ok(Self {
             _node: node,
-            port,
+            calls,
             rows,
             next_invoke_id: 1,
             sent: 0,
@@ -205,36 +181,32 @@ impl AcyclicClient {
         let (body, body_len) = encode_body(call);
         let invoke_id = self.next_invoke_id;
         self.next_invoke_id = self.next_invoke_id.wrapping_add(1);
-        let pending = self
-            .port
-            .send_copy(AcyclicRequest {
-                invoke_id,
-                kind: C::KIND.raw(),
-                target,
-                body_len,
-                body,
-            })
-            .map_err(transport)?;
+        let request = AcyclicRequest {
+            invoke_id,
+            kind: C::KIND.raw(),
+            target,
+            body_len,
+            body,
+        };
+        let (slot, ticket) = self.calls.send(&request)?;
         self.sent += 1;
         Ok(PendingCall {
-            pending,
+            ticket: Ticket {
+                mailbox: Arc::clone(&self.calls),
+                slot,
+                ticket,
+                taken: core::cell::Cell::new(false),
+            },
             invoke_id,
             _call: core::marker::PhantomData,
         })
     }
 }
 
-type PendingPort = iceoryx2::pending_response::PendingResponse<
-    ipc::Service,
-    AcyclicRequest,
-    (),
-    AcyclicResponse,
-    (),
->;
-
-/// A call on its way: poll it until it yields the reply or the refusal.
+/// A call on its way: poll it until it yields the reply or the refusal. Dropped before, it
+/// gives the call up (the CNC still carries it out, as a frame already sent).
 pub struct PendingCall<C: AcyclicCall> {
-    pending: PendingPort,
+    ticket: Ticket,
     invoke_id: u32,
     _call: core::marker::PhantomData<C>,
 }
@@ -248,13 +220,8 @@ impl<C: AcyclicCall> core::fmt::Debug for PendingCall<C> {
 impl<C: AcyclicCall> PendingCall<C> {
     /// The reply (or refusal) once the server has answered, `None` while it has not.
     pub fn poll(&self) -> Option<Result<C::Reply, CallError>> {
-        let response = match self.pending.receive() {
-            Ok(Some(response)) => response,
-            Ok(None) => return None,
-            Err(e) => return Some(Err(transport(e))),
-        };
-        let response: &AcyclicResponse = response.payload();
-        Some(decode_response::<C>(response, self.invoke_id))
+        let response = self.ticket.take()?;
+        Some(decode_response::<C>(&response, self.invoke_id))
     }
 }
 
@@ -335,21 +302,22 @@ impl PendingRows {
 /// the motion path).
 pub struct AcyclicServer {
     _node: Node<ipc::Service>,
-    port: AcyclicServerPort,
+    calls: Mailbox,
+    /// Per slot, the polls it stood half-way ([`Mailbox::serve`]).
+    ages: core::cell::Cell<[u32; MAILBOX_SLOTS]>,
     rows: RowsServerPort,
 }
 
 impl AcyclicServer {
-    /// Opens (or creates) `instance`'s service and its server port.
+    /// Creates `instance`'s mailbox (replacing one a dead server left) and opens (or creates)
+    /// its row service's server port. The mailbox is removed when the server is dropped.
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let (node, port, rows) = open_end(
-            instance,
-            |calls| calls.server_builder().create(),
-            |rows| rows.server_builder().create(),
-        )?;
+        let calls = Mailbox::create(instance)?;
+        let (node, rows) = open_end(instance, |rows| rows.server_builder().create())?;
         Ok(Self {
             _node: node,
-            port,
+            calls,
+            ages: core::cell::Cell::new([0; MAILBOX_SLOTS]),
             rows,
         })
     }
@@ -358,7 +326,6 @@ impl AcyclicServer {
     /// client sends is not answered in a tick that also maps its segment (with locked memory
     /// that populates the whole mapping: milliseconds). Called before the first tick.
     pub fn connect(&self) -> Result<(), CallError> {
-        self.port.has_requests().map_err(transport)?;
         self.rows.has_requests().map_err(transport)?;
         Ok(())
     }
@@ -397,20 +364,21 @@ impl AcyclicServer {
         &self,
         mut handler: impl FnMut(CallKind, &AcyclicRequest) -> HandlerResult,
     ) -> Result<usize, CallError> {
-        let mut answered = 0;
-        while let Some(active) = self.port.receive().map_err(transport)? {
-            let request: &AcyclicRequest = active.payload();
+        let mut ages = self.ages.get();
+        let answered = self.calls.serve(&mut ages, |request| {
             let result = match CallKind::decode(request.kind) {
                 // A bulk kind's numbers never come in a frame.
                 Some(kind) if kind.is_bulk() => Err(ErrorCode::ServiceNotSupported),
+                // A body longer than a frame holds is no body.
+                Some(_) if request.body_len as usize > ACYCLIC_BODY_SIZE => {
+                    Err(ErrorCode::InvalidSize)
+                }
                 Some(kind) => handler(kind, request),
                 None => Err(ErrorCode::ServiceNotSupported),
             };
-            active
-                .send_copy(response(request.invoke_id, request.kind, result))
-                .map_err(transport)?;
-            answered += 1;
-        }
+            response(request.invoke_id, request.kind, result)
+        });
+        self.ages.set(ages);
         Ok(answered)
     }
 }

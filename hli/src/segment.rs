@@ -30,7 +30,8 @@ mod process;
 mod reset;
 pub use guard::{CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS};
 pub use liveness::{HeartbeatWatch, PeerLiveness};
-use process::{check_owner, process_start_stamp, start_stamp_at, stat_path};
+pub(crate) use process::process_start_stamp;
+use process::{check_owner, start_stamp_at, stat_path};
 
 /// "HLI-SEG1" as a little-endian u64.
 pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");

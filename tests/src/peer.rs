@@ -63,6 +63,10 @@ pub fn spawn_peer_saying(peer_exe: &str, args: &[&str], first_line: &str) -> Chi
 /// gone) and drops it, which unlinks it. Tests that SIGKILL a CNC call this last, so a test
 /// run leaves nothing in /dev/shm.
 pub fn remove_stale_segment(instance: &str) {
+    // The calls' mailbox a killed CNC left: taken over (its process is gone) and dropped.
+    if let Err(e) = hli::rpc::mailbox::Mailbox::create(instance) {
+        panic!("{instance}: the stale mailbox could not be taken over: {e}");
+    }
     match hli::segment::CncSegment::create(instance, 1, 1) {
         Ok(segment) => assert!(
             segment.replaced_stale().is_some(),

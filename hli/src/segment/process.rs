@@ -5,7 +5,7 @@ use super::AttachError;
 
 /// Start time of a process (clock ticks since boot) and whether it is still running, from
 /// `/proc`; `None` where there is no such process. Tells a live owner from a reused pid.
-pub(super) fn process_start_stamp(pid: u32) -> Option<u64> {
+pub(crate) fn process_start_stamp(pid: u32) -> Option<u64> {
     start_stamp_at(&stat_path(pid))
 }
 

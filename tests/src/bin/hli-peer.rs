@@ -34,6 +34,8 @@ fn main() -> ExitCode {
             std::process::abort();
         }
         ["cnc-beat", instance] => {
+            // Its mailbox first, as a CNC makes it; it answers no call.
+            let _calls = hli::rpc::AcyclicServer::open(instance).expect("mailbox");
             let segment = CncSegment::create(instance, 1, 1).expect("create");
             println!("ready");
             std::io::stdout().flush().ok();

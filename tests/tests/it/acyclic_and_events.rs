@@ -94,6 +94,7 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
 fn a_call_nobody_answers_times_out() {
     hli::init_logging();
     let instance = unique_instance("rpc-timeout");
+    let _server = AcyclicServer::open(&instance).unwrap(); // never polled
     let mut client = AcyclicClient::open(&instance).unwrap();
     let result = client.call(0, &ReadAxisState::default(), Duration::from_millis(20));
     assert_eq!(result, Err(CallError::Timeout(Duration::from_millis(20))));

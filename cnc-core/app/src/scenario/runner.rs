@@ -430,6 +430,8 @@ impl PlcLink {
             ) as u32,
             lockstep: options.lockstep,
         };
+        // The calls' mailbox first: a PLC that finds the segment Ready finds the mailbox.
+        let server = AcyclicServer::open(&options.instance).map_err(|e| e.to_string())?;
         let segment = CncSegment::create_with(
             &options.instance,
             scenario.channels.len() as u32,
@@ -438,7 +440,6 @@ impl PlcLink {
         )
         .map_err(|e| e.to_string())?;
         let events = EventLink::open(&options.instance, Side::Cnc).map_err(|e| e.to_string())?;
-        let server = AcyclicServer::open(&options.instance).map_err(|e| e.to_string())?;
         let mut child = spawn_plc(scenario, options)?;
         if let Some(child) = child.as_mut() {
             wait_for_attach(&segment, child)?;

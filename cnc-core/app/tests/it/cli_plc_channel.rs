@@ -31,7 +31,7 @@ fn plc_channel_selects_starts_holds_stops_and_refuses_with_codes() {
         "cycle_ms = 1.0\n[[channel]]\nname = \"cell\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprograms = \"programs\"\n",
     )
     .unwrap();
-    let _cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
         .args(["run", dir.join("scenario.toml").to_str().unwrap()])
         .args(["--instance", &instance, "--ticks", "600000"])
         .stdout(Stdio::piped())
@@ -81,4 +81,20 @@ fn plc_channel_selects_starts_holds_stops_and_refuses_with_codes() {
     let (code, _, err) = tool(&instance, &["start", "--force"]);
     assert_eq!(code, 0, "{err}");
     drop(plc);
+    // Stopped by a signal, the CNC leaves no shared memory behind: segment and mailbox gone.
+    assert!(cnc.signal("TERM"));
+    let out = cnc.wait_with_output(std::time::Duration::from_secs(60));
+    let out = out.unwrap();
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        said.contains("SIGTERM") || said.contains("signal"),
+        "{said}"
+    );
+    for object in [
+        format!("cncplc_{instance}.hli"),
+        format!("cncplc_{instance}.calls"),
+    ] {
+        let path = std::path::Path::new("/dev/shm").join(&object);
+        assert!(!path.exists(), "{object} left behind");
+    }
 }

@@ -1,0 +1,145 @@
+//! The mailbox's slots through their states, by hand.
+
+use super::*;
+
+fn name(case: &str) -> String {
+    format!("mbx-{case}-{}", std::process::id())
+}
+
+fn request(id: u32) -> AcyclicRequest {
+    AcyclicRequest {
+        invoke_id: id,
+        kind: 7,
+        target: 3,
+        body_len: 4,
+        body: [id as u8; crate::wire::ACYCLIC_BODY_SIZE],
+    }
+}
+
+fn echo(r: &AcyclicRequest) -> AcyclicResponse {
+    AcyclicResponse {
+        invoke_id: r.invoke_id,
+        kind: r.kind,
+        error_code: 0,
+        body_len: r.body_len,
+        body: r.body,
+    }
+}
+
+fn state(m: &Mailbox, i: usize) -> u32 {
+    m.slot(i).state().load(SeqCst)
+}
+
+#[test]
+fn a_call_goes_out_is_answered_and_taken_once() {
+    let server = Mailbox::create(&name("round")).unwrap();
+    let client = Mailbox::open(&name("round")).unwrap();
+    let mut ages = [0; MAILBOX_SLOTS];
+    let (slot, ticket) = client.send(&request(9)).unwrap();
+    assert_eq!(
+        client.take(slot, ticket).map(|r| r.invoke_id),
+        None,
+        "not yet"
+    );
+    assert_eq!(server.serve(&mut ages, echo), 1);
+    assert_eq!(
+        client.take(slot, ticket + 1).map(|r| r.invoke_id),
+        None,
+        "not ours"
+    );
+    let reply = client.take(slot, ticket).unwrap();
+    assert_eq!((reply.invoke_id, reply.body[0]), (9, 9));
+    assert_eq!(
+        client.take(slot, ticket).map(|r| r.invoke_id),
+        None,
+        "taken once"
+    );
+    assert_eq!(state(&server, slot), FREE);
+    assert_eq!(server.serve(&mut ages, echo), 0);
+}
+
+#[test]
+fn a_call_given_up_still_runs_and_its_slot_comes_free() {
+    let server = Mailbox::create(&name("abandon")).unwrap();
+    let client = Mailbox::open(&name("abandon")).unwrap();
+    let mut ages = [0; MAILBOX_SLOTS];
+    // Given up before the CNC saw it: answered, then freed by the server.
+    let (slot, ticket) = client.send(&request(1)).unwrap();
+    client.abandon(slot, ticket);
+    let mut ran = 0;
+    server.serve(&mut ages, |r| {
+        ran += 1;
+        echo(r)
+    });
+    assert_eq!((ran, state(&server, slot)), (1, FREE));
+    // Given up after the reply came: freed at once.
+    let (slot, ticket) = client.send(&request(2)).unwrap();
+    server.serve(&mut ages, echo);
+    assert_eq!(state(&server, slot), REPLY);
+    client.abandon(slot, ticket);
+    assert_eq!(state(&server, slot), FREE);
+    // A stale ticket touches nothing: the slot is someone else's now.
+    let (again, new) = client.send(&request(3)).unwrap();
+    assert_eq!(again, slot);
+    client.abandon(slot, ticket);
+    assert_eq!((state(&server, slot), new != ticket), (REQUEST, true));
+}
+
+#[test]
+fn the_slots_run_out_and_a_dead_clients_slots_come_back() {
+    let server = Mailbox::create(&name("full")).unwrap();
+    let client = Mailbox::open(&name("full")).unwrap();
+    let mut ages = [0; MAILBOX_SLOTS];
+    for id in 0..MAILBOX_SLOTS as u32 {
+        client.send(&request(id)).unwrap();
+    }
+    let full = client.send(&request(99)).unwrap_err();
+    assert!(full.to_string().contains("all slots are taken"), "{full}");
+    // Answered and never taken (the client died): free after STALE_POLLS polls in that state
+    // (the answering poll counts), not before.
+    assert_eq!(server.serve(&mut ages, echo), MAILBOX_SLOTS);
+    for _ in 1..STALE_POLLS {
+        server.serve(&mut ages, echo);
+    }
+    assert!(client.send(&request(99)).is_err());
+    server.serve(&mut ages, echo);
+    assert!(client.send(&request(99)).is_ok());
+}
+
+#[test]
+fn a_mailbox_is_made_once_and_needs_its_server() {
+    assert!(
+        Mailbox::open(&name("none")).is_err(),
+        "no server, no mailbox"
+    );
+    let server = Mailbox::create(&name("once")).unwrap();
+    let second = Mailbox::create(&name("once")).unwrap_err();
+    assert!(second.to_string().contains("live process"), "{second}");
+    drop(server);
+    assert!(
+        Mailbox::open(&name("once")).is_err(),
+        "removed with its server"
+    );
+    assert!(Mailbox::create(&name("once")).is_ok());
+}
+
+#[test]
+fn calls_are_answered_in_the_order_they_were_sent() {
+    let server = Mailbox::create(&name("order")).unwrap();
+    let client = Mailbox::open(&name("order")).unwrap();
+    let mut ages = [0; MAILBOX_SLOTS];
+    // Slots 0 and 1 taken, 0 freed again: the third call takes slot 0, after the second.
+    let (first, t1) = client.send(&request(1)).unwrap();
+    client.send(&request(2)).unwrap();
+    server.serve(&mut ages, echo);
+    client.take(first, t1).unwrap();
+    let (second_slot, _) = client.send(&request(3)).unwrap();
+    client.send(&request(4)).unwrap();
+    assert_eq!(second_slot, first, "the free slot 0 again");
+    let mut order = Vec::new();
+    server.serve(&mut ages, |r| {
+        order.push(r.invoke_id);
+        echo(r)
+    });
+    assert_eq!(order, [3, 4]);
+}
