@@ -10,6 +10,14 @@
 //! time from the absolute deadline to the first instruction of the tick. A peer that is
 //! absent is skipped and said so. `CNC_BENCH_SMOKE=1`: one short round (CI: no timing
 //! asserted). Run: `cargo bench -p cnc-app --bench tick_latency`.
+//!
+//! The compute target's baseline is a constant job in the same shape as the demo: this bench
+//! started again as two processes ([`peer`]), one at SCHED_FIFO 80 that wakes every 1 ms at an
+//! absolute deadline and runs the same pass over 512 KiB each time (timed as the CNC times its
+//! tick), and one at SCHED_FIFO 79 that wakes every 1 ms for the same pass over its own
+//! memory (the PLC's place).
+//! Whatever spreads the constant job's time (cold caches after the sleep, the VM, the other
+//! process) spreads the tick's too: its p99/p50 is what this machine allows.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -149,7 +157,79 @@ fn cyclictest(loops: u64, rt: bool, interval_us: u32) -> Option<Figures> {
     })
 }
 
+/// The constant job: one pass over `memory` (a word of every cache line, read and written,
+/// each step depending on the last): the same work every time, with a working set like the
+/// demo machine's, so the caches' state after the sleep counts as it does for the tick.
+fn constant_job(memory: &mut [u64]) -> u64 {
+    let mut x = 0x9E37_79B9_7F4A_7C15_u64;
+    for word in memory.iter_mut().step_by(8) {
+        x = x.rotate_left(5) ^ *word;
+        *word = x;
+    }
+    x
+}
+
+/// Words the constant job walks (512 KiB; the companion walks as much of its own).
+const JOB_WORDS: usize = 64 * 1024;
+
+/// The bench started again as a peer process (`TICK_LATENCY_PEER`): `constant LOOPS` (the
+/// constant job every 1 ms at SCHED_FIFO 80; prints `constant p50 P p99 Q` in ns) or
+/// `companion LOOPS` (a short job every 1 ms at SCHED_FIFO 79). `None`: not a peer.
+fn peer() -> Option<()> {
+    let mode = std::env::var("TICK_LATENCY_PEER").ok()?;
+    let mut words = mode.split_whitespace();
+    let (kind, loops) = (words.next()?, words.next()?.parse::<usize>().ok()?);
+    let constant = kind == "constant";
+    // As `cnc run` with the real-time options (the companion as its PLC, one below).
+    let _ = cnc_os::realtime::set_fifo_priority(if constant { 80 } else { 79 });
+    let _ = cnc_os::realtime::lock_memory();
+    let _ = cnc_os::realtime::set_timer_slack(1);
+    let _ = cnc_os::realtime::hold_cpu_wake_latency(0);
+    let mut took = Vec::with_capacity(loops);
+    let mut memory = vec![1u64; JOB_WORDS];
+    let period = std::time::Duration::from_millis(1);
+    let mut deadline = cnc_os::monotonic::now() + period;
+    for _ in 0..loops {
+        cnc_os::monotonic::sleep_until(deadline);
+        let start = cnc_os::monotonic::now();
+        std::hint::black_box(constant_job(&mut memory));
+        took.push((cnc_os::monotonic::now() - start).as_nanos() as f64);
+        deadline += period;
+    }
+    if constant {
+        took.sort_by(f64::total_cmp);
+        let at = |q: f64| took[((took.len() - 1) as f64 * q) as usize];
+        println!("constant p50 {:.0} p99 {:.0}", at(0.5), at(0.99));
+    }
+    Some(())
+}
+
+/// The constant job beside its companion, both as processes of their own: its time p50/p99
+/// (us), `None` if a peer could not run.
+fn constant_work(loops: u64) -> Option<Figures> {
+    let exe = std::env::current_exe().ok()?;
+    let start = |kind: &str| {
+        Command::new(&exe)
+            .env("TICK_LATENCY_PEER", format!("{kind} {loops}"))
+            .stdout(std::process::Stdio::piped())
+            .spawn()
+            .ok()
+    };
+    let companion = start("companion")?;
+    let constant = start("constant")?.wait_with_output().ok()?;
+    let _ = companion.wait_with_output();
+    let text = String::from_utf8_lossy(&constant.stdout);
+    let us = |key: &str| number(&text, "constant", key).map(|v| v / 1000.0);
+    Some(Figures {
+        compute: (us("p50 ")?, us("p99 ")?),
+        ..Figures::default()
+    })
+}
+
 fn main() {
+    if peer().is_some() {
+        return;
+    }
     let (rounds, demo_ticks, ex4_ticks, fast_ticks) = if smoke() {
         (1, 300, 300, 300)
     } else {
@@ -170,6 +250,7 @@ fn main() {
         "example 4, default scheduler",
         "cyclictest -m -p 80 -i 250",
         "example 4 at 250 us, real-time options",
+        "constant job every 1 ms beside a companion",
     ];
     let mut rows: Vec<Vec<Figures>> = vec![Vec::new(); names.len()];
     for _ in 0..rounds {
@@ -183,6 +264,7 @@ fn main() {
         rows[4].extend(cnc(&ex4, ex4_ticks, true, 1000));
         rows[5].extend(cnc(&ex4, ex4_ticks, false, 1000));
         rows[7].extend(cnc(&ex4, fast_ticks, true, 250));
+        rows[8].extend(constant_work(demo_ticks));
     }
     println!("tick start lateness (us), cycle 1 ms, medians of {rounds} interleaved rounds; demo {demo_ticks} ticks, example 4 {ex4_ticks}");
     println!(
@@ -202,7 +284,12 @@ fn main() {
             plc_overruns: m(|r| r.plc_overruns),
         };
         med[i] = Some(f);
-        if rows_of_cyclictest(i) {
+        if i == 8 {
+            println!(
+                "{name:<40} {:>8} {:>8} {:>12.1} {:>12.1} {:>13}",
+                "-", "-", f.compute.0, f.compute.1, "-"
+            );
+        } else if rows_of_cyclictest(i) {
             println!(
                 "{name:<40} {:>8.1} {:>8.1} {:>12} {:>12} {:>13.0}",
                 f.late.0, f.late.1, "", "", f.plc_overruns
@@ -215,9 +302,19 @@ fn main() {
         }
     }
     targets(&med);
+    if let (Some(job), Some(demo)) = (med[8], med[2]) {
+        let (r, d) = (
+            job.compute.1 / job.compute.0,
+            demo.compute.1 / demo.compute.0,
+        );
+        println!(
+            "the constant job's time p99/p50 on this machine: {r:.2} ({:.1} / {:.1} us); the demo tick's: {d:.2}",
+            job.compute.1, job.compute.0
+        );
+    }
 }
 
-/// Rows 0, 1 and 6 are cyclictest's.
+/// Rows 0, 1 and 6 are cyclictest's (row 8, the constant job, has no lateness).
 fn rows_of_cyclictest(i: usize) -> bool {
     matches!(i, 0 | 1 | 6)
 }
