@@ -194,12 +194,14 @@ fn tick_cost() {
 fn client(instance: &str) {
     let mut client = AcyclicClient::open(instance).expect("client");
     let header = rows_header(0, N as u32, BLOCK_ROWS as u32, false);
+    let mut rows = vec![0.0; BLOCK_ROWS * N];
     let start = Instant::now();
     for b in 0..scaled(BLOCKS) {
         let mut loan = client.loan_rows(header, BLOCK_ROWS * N).expect("loan");
-        for (i, v) in loan.values_mut().iter_mut().enumerate() {
+        for (i, v) in rows.iter_mut().enumerate() {
             *v = (b * BLOCK_ROWS * N + i) as f64 * 1e-6;
         }
+        loan.write(0, &rows);
         let pending = loan.send().expect("send");
         loop {
             match pending.poll::<FifoReply>() {

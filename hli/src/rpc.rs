@@ -1,55 +1,24 @@
-//! The transport of the acyclic ADS-like calls from the PLC to the CNC: a mailbox of call slots
-//! in shared memory ([`mailbox`]) carrying the frames of [`crate::wire`], one call per PLC
-//! block Execute edge (table writes, coupling commands, reads of characteristic values...),
-//! without allocating on either side; and bulk calls whose numbers are written straight into
-//! shared memory (FIFO row blocks), an iceoryx2 request-response service. The vocabulary (call kinds, typed bodies, refusal codes) is [`crate::calls`]
-//! and its families; this module is the transport alone. The CNC-side handlers live with the CNC's view
-//! ([`crate::views::handle_read_axis_state`]) and in the engines.
+//! The transport of the acyclic ADS-like calls from the PLC to the CNC: a mailbox of slots in
+//! shared memory ([`mailbox`]) carrying the frames of [`crate::wire`], one call per PLC block
+//! Execute edge (table writes, coupling commands, reads of characteristic values...), and bulk
+//! calls whose numbers are written straight into the mailbox (FIFO row blocks). Nothing is
+//! allocated on either side after opening. The vocabulary (call kinds, typed bodies, refusal
+//! codes) is [`crate::calls`] and its families; this module is the transport alone. The
+//! CNC-side handlers live with the CNC's view ([`crate::views::handle_read_axis_state`]) and in
+//! the engines.
 
 use crate::calls::{AcyclicCall, CallError, CallKind, ErrorCode, HandlerResult};
 use crate::wire::{
     encode_body, AcyclicRequest, AcyclicResponse, BulkHeader, ACYCLIC_BODY_SIZE, BULK_MAX_VALUES,
 };
 use core::time::Duration;
-use iceoryx2::node::Node;
-use iceoryx2::port::client::Client;
-use iceoryx2::port::server::Server;
-use iceoryx2::prelude::*;
-use mailbox::{Mailbox, Ticket, MAILBOX_SLOTS};
+use mailbox::{BulkLoan, Mailbox, Ticket, BULK_SLOTS, MAILBOX_SLOTS};
 use std::sync::Arc;
 use std::time::Instant;
 
 pub mod mailbox;
 
-/// Service name of an instance's bulk calls (FIFO row blocks).
-pub fn rows_service_name(instance: &str) -> String {
-    format!("cncplc/{instance}/fifo-rows")
-}
-
-type RowsClientPort = Client<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
-type RowsServerPort = Server<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
-type RowsPendingPort = iceoryx2::pending_response::PendingResponse<
-    ipc::Service,
-    [f64],
-    BulkHeader,
-    AcyclicResponse,
-    (),
->;
-
-fn transport(e: impl core::fmt::Debug) -> CallError {
-    CallError::Transport(format!("{e:?}"))
-}
-
-/// The row service, from which each end makes its port.
-type RowsService = iceoryx2::service::port_factory::request_response::PortFactory<
-    ipc::Service,
-    [f64],
-    BulkHeader,
-    AcyclicResponse,
-    (),
->;
-
-/// Prints the type's name alone: the iceoryx2 ports have nothing worth showing.
+/// Prints the type's name alone.
 macro_rules! debug_by_name {
     ($($ty:ident),*) => {
         $(impl core::fmt::Debug for $ty {
@@ -62,39 +31,9 @@ macro_rules! debug_by_name {
 
 debug_by_name!(AcyclicClient, AcyclicServer, RowsLoan, PendingRows);
 
-/// A service name as iceoryx2 takes it.
-fn name_of(name: String) -> Result<ServiceName, CallError> {
-    name.as_str().try_into().map_err(transport)
-}
-
-fn open_rows_service(node: &Node<ipc::Service>, instance: &str) -> Result<RowsService, CallError> {
-    node.service_builder(&name_of(rows_service_name(instance))?)
-        .request_response::<[f64], AcyclicResponse>()
-        .request_user_header::<BulkHeader>()
-        // A few FiFoWrite/FiFoOverwrite instances per group, each with one block on its way.
-        .max_active_requests_per_client(16)
-        .max_loaned_requests(4)
-        .open_or_create()
-        .map_err(transport)
-}
-
-/// A node of its own for one end of `instance`'s row service, and the end's port.
-fn open_end<R, F: core::fmt::Debug>(
-    instance: &str,
-    rows: impl FnOnce(&RowsService) -> Result<R, F>,
-) -> Result<(Node<ipc::Service>, R), CallError> {
-    let node = NodeBuilder::new()
-        .create::<ipc::Service>()
-        .map_err(transport)?;
-    let rows = rows(&open_rows_service(&node, instance)?).map_err(transport)?;
-    Ok((node, rows))
-}
-
 /// The PLC's end: sends calls and waits for their replies; sends FIFO row blocks.
 pub struct AcyclicClient {
-    _node: Node<ipc::Service>,
     calls: Arc<Mailbox>,
-    rows: RowsClientPort,
     next_invoke_id: u32,
     sent: u64,
 }
@@ -102,29 +41,21 @@ pub struct AcyclicClient {
 impl AcyclicClient {
     /// Connects to `instance`'s calls (the CNC's server must have made its mailbox).
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let calls = Arc::new(Mailbox::open(instance)?);
-        let (node, rows) = open_end(instance, |rows| {
-            rows.client_builder()
-                .initial_max_slice_len(BULK_MAX_VALUES)
-                .create()
-        })?;
         Ok(Self {
-            _node: node,
-            calls,
-            rows,
+            calls: Arc::new(Mailbox::open(instance)?),
             next_invoke_id: 1,
             sent: 0,
         })
     }
 
     /// Loans a bulk call of `values` values in the shared memory the CNC will read: the PLC
-    /// computes its rows straight into it ([`RowsLoan::values_mut`]) and sends it whole
+    /// writes its rows straight into it ([`RowsLoan::write`]) and sends it whole
     /// ([`RowsLoan::send`]). A loan that is dropped, or whose process dies before the send,
     /// never reaches the CNC: there is no half block.
     pub fn loan_rows(&mut self, header: BulkHeader, values: usize) -> Result<RowsLoan, CallError> {
-        let mut loan = self.rows.loan_slice(values).map_err(transport)?;
-        *loan.user_header_mut() = header;
-        Ok(RowsLoan { loan })
+        Ok(RowsLoan {
+            loan: self.calls.loan(header, values)?,
+        })
     }
 
     /// Sends a bulk call (a FIFO row block: `FiFoWrite`, `FiFoOverwrite`): `values` holds
@@ -135,14 +66,12 @@ impl AcyclicClient {
         header: BulkHeader,
         values: &[f64],
     ) -> Result<PendingRows, CallError> {
-        let mut loan = self
-            .rows
-            .loan_slice_uninit(values.len())
-            .map_err(transport)?;
-        *loan.user_header_mut() = header;
-        let pending = loan.write_from_slice(values).send().map_err(transport)?;
+        let mut loan = self.calls.loan(header, values.len())?;
+        loan.write(0, values);
         self.sent += 1;
-        Ok(PendingRows { pending })
+        Ok(PendingRows {
+            ticket: loan.send(),
+        })
     }
 
     /// Calls sent by [`AcyclicClient::start`] and [`AcyclicClient::start_rows`] (and so by
@@ -258,75 +187,77 @@ fn decode_reply_body<R: bytemuck::Pod>(response: &AcyclicResponse) -> Result<R, 
     Ok(bytemuck::pod_read_unaligned(&response.body[..len]))
 }
 
-type RowsLoanPort =
-    iceoryx2::request_mut::RequestMut<ipc::Service, [f64], BulkHeader, AcyclicResponse, ()>;
-
 /// A row block being written in place (see [`AcyclicClient::loan_rows`]).
 pub struct RowsLoan {
-    loan: RowsLoanPort,
+    loan: BulkLoan,
 }
 
 impl RowsLoan {
-    /// The block's values, row after row (zero until written).
-    pub fn values_mut(&mut self) -> &mut [f64] {
-        self.loan.payload_mut()
+    /// How many values the block holds (zero until written).
+    pub fn len(&self) -> usize {
+        self.loan.len()
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.loan.is_empty()
+    }
+
+    /// Writes `values` from value `at` on, row after row (those beyond the block are left
+    /// out).
+    pub fn write(&mut self, at: usize, values: &[f64]) {
+        self.loan.write(at, values);
     }
 
     /// Sends the block whole.
     pub fn send(self) -> Result<PendingRows, CallError> {
-        let pending = self.loan.send().map_err(transport)?;
-        Ok(PendingRows { pending })
+        Ok(PendingRows {
+            ticket: self.loan.send(),
+        })
     }
 }
 
 /// A row block on its way: poll it until it yields the CNC's reply.
 pub struct PendingRows {
-    pending: RowsPendingPort,
+    ticket: Ticket,
 }
 
 impl PendingRows {
     /// The CNC's reply, decoded as `R` (the reply body of the bulk call's kind), once it has
     /// answered; `None` while it has not.
     pub fn poll<R: bytemuck::Pod>(&self) -> Option<Result<R, CallError>> {
-        let response = match self.pending.receive() {
-            Ok(Some(response)) => response,
-            Ok(None) => return None,
-            Err(e) => return Some(Err(transport(e))),
-        };
-        let response: &AcyclicResponse = response.payload();
-        Some(decode_reply_body(response))
+        let response = self.ticket.take()?;
+        Some(decode_reply_body(&response))
     }
 }
 
 /// The CNC's end: answers pending calls and row blocks when polled (once per tick, outside
 /// the motion path).
 pub struct AcyclicServer {
-    _node: Node<ipc::Service>,
     calls: Mailbox,
     /// Per slot, the polls it stood half-way ([`Mailbox::serve`]).
     ages: core::cell::Cell<[u32; MAILBOX_SLOTS]>,
-    rows: RowsServerPort,
+    /// The same for the bulk slots.
+    bulk_ages: core::cell::Cell<[u32; BULK_SLOTS]>,
+    /// Where a row block's numbers are copied for the handler (room made at opening).
+    rows: core::cell::RefCell<Vec<f64>>,
 }
 
 impl AcyclicServer {
-    /// Creates `instance`'s mailbox (replacing one a dead server left) and opens (or creates)
-    /// its row service's server port. The mailbox is removed when the server is dropped.
+    /// Creates `instance`'s mailbox (replacing one a dead server left). It is removed when
+    /// the server is dropped.
     pub fn open(instance: &str) -> Result<Self, CallError> {
-        let calls = Mailbox::create(instance)?;
-        let (node, rows) = open_end(instance, |rows| rows.server_builder().create())?;
         Ok(Self {
-            _node: node,
-            calls,
+            calls: Mailbox::create(instance)?,
             ages: core::cell::Cell::new([0; MAILBOX_SLOTS]),
-            rows,
+            bulk_ages: core::cell::Cell::new([0; BULK_SLOTS]),
+            rows: core::cell::RefCell::new(Vec::with_capacity(BULK_MAX_VALUES)),
         })
     }
 
-    /// Connects to the clients there are now (maps their segments), so that the first call a
-    /// client sends is not answered in a tick that also maps its segment (with locked memory
-    /// that populates the whole mapping: milliseconds). Called before the first tick.
+    /// Kept for the callers of the former transport, which mapped its clients' segments
+    /// before the first tick: the mailbox is mapped at opening, so there is nothing to do.
     pub fn connect(&self) -> Result<(), CallError> {
-        self.rows.has_requests().map_err(transport)?;
         Ok(())
     }
 
@@ -338,22 +269,19 @@ impl AcyclicServer {
         &self,
         mut handler: impl FnMut(CallKind, &BulkHeader, &[f64]) -> HandlerResult,
     ) -> Result<usize, CallError> {
-        let mut answered = 0;
-        while let Some(active) = self.rows.receive().map_err(transport)? {
-            let header = *active.user_header();
-            let values: &[f64] = active.payload();
-            let expected = (header.rows as usize).checked_mul(header.columns as usize);
-            let result = match CallKind::decode(header.kind) {
-                Some(kind) if !kind.is_bulk() => Err(ErrorCode::ServiceNotSupported),
-                None => Err(ErrorCode::ServiceNotSupported),
-                Some(_) if expected != Some(values.len()) => Err(ErrorCode::InvalidSize),
-                Some(kind) => handler(kind, &header, values),
-            };
-            active
-                .send_copy(response(0, header.kind, result))
-                .map_err(transport)?;
-            answered += 1;
-        }
+        let mut ages = self.bulk_ages.get();
+        let mut rows = self.rows.borrow_mut();
+        let refuse = response(0, 0, Err(ErrorCode::InvalidSize));
+        let answered = self
+            .calls
+            .serve_bulk(&mut ages, &mut rows, refuse, |header, values| {
+                let result = match CallKind::decode(header.kind) {
+                    Some(kind) if kind.is_bulk() => handler(kind, header, values),
+                    _ => Err(ErrorCode::ServiceNotSupported),
+                };
+                response(0, header.kind, result)
+            });
+        self.bulk_ages.set(ages);
         Ok(answered)
     }
 

@@ -21,7 +21,7 @@
 use super::super::calls::CallError;
 use super::super::desc::PlaceExt;
 use super::super::raw::{ImageMemory, Place};
-use super::super::wire::{AcyclicRequest, AcyclicResponse};
+use super::super::wire::{AcyclicRequest, AcyclicResponse, BulkHeader, BULK_MAX_VALUES};
 use iceoryx2_bb_posix::shared_memory::{
     AccessMode, CreationMode, Permission, SharedMemoryBuilder, SharedMemoryCreationError,
 };
@@ -57,7 +57,16 @@ const OFF_STAMP: usize = 16;
 const OFF_TICKETS: usize = 24;
 /// A slot: state, abandoned flag, ticket, reserved, then the request and the response.
 const SLOT_BYTES: usize = 16 + 2 * FRAME_WORDS * 4;
-const SIZE: usize = HEADER_BYTES + MAILBOX_SLOTS * SLOT_BYTES;
+/// Bulk slots (FIFO row blocks, numbers written in place): calls of this kind on their way
+/// at once.
+pub const BULK_SLOTS: usize = 8;
+/// A bulk slot: state, abandoned flag, ticket, the count of numbers, the [`BulkHeader`], the
+/// numbers, then the response.
+const BULK_SLOT_BYTES: usize = 32 + BULK_MAX_VALUES * 8 + FRAME_WORDS * 4;
+const OFF_BULK: usize = HEADER_BYTES + MAILBOX_SLOTS * SLOT_BYTES;
+const SIZE: usize = OFF_BULK + BULK_SLOTS * BULK_SLOT_BYTES;
+/// Every slot, calls first (`0..MAILBOX_SLOTS`), then bulk.
+const ALL_SLOTS: usize = MAILBOX_SLOTS + BULK_SLOTS;
 
 /// The object name of `instance`'s mailbox: 1..=200 characters of `[A-Za-z0-9_.-]`.
 pub fn mailbox_name(instance: &str) -> Option<String> {
@@ -77,10 +86,11 @@ fn file_name(name: &str) -> Result<FileName, CallError> {
     FileName::new(name.as_bytes()).map_err(|e| os(name, e))
 }
 
-/// One slot of the mailbox.
+/// One slot of the mailbox: where it starts, and where its response frame is.
 #[derive(Clone, Copy)]
 struct Slot<'m> {
     at: usize,
+    response_at: usize,
     memory: &'m ImageMemory,
 }
 
@@ -97,15 +107,29 @@ impl<'m> Slot<'m> {
     fn ticket(&self) -> &'m std::sync::atomic::AtomicU32 {
         self.word(8).atomic()
     }
-    fn frame(&self, second: bool) -> Place<'m, [u32; FRAME_WORDS]> {
-        let offset = 16 + usize::from(second) * FRAME_WORDS * 4;
-        self.memory.place::<[u32; FRAME_WORDS]>(self.at + offset)
+    /// The count of numbers of a bulk slot.
+    fn count(&self) -> Place<'m, u32> {
+        self.word(12)
+    }
+    fn request_frame(&self) -> Place<'m, [u32; FRAME_WORDS]> {
+        self.memory.place::<[u32; FRAME_WORDS]>(self.at + 16)
+    }
+    fn response_frame(&self) -> Place<'m, [u32; FRAME_WORDS]> {
+        self.memory
+            .place::<[u32; FRAME_WORDS]>(self.at + self.response_at)
     }
     fn request(&self) -> AcyclicRequest {
-        bytemuck::cast(self.frame(false).read())
+        bytemuck::cast(self.request_frame().read())
     }
     fn response(&self) -> AcyclicResponse {
-        bytemuck::cast(self.frame(true).read())
+        bytemuck::cast(self.response_frame().read())
+    }
+    fn header(&self) -> Place<'m, [u32; 4]> {
+        self.memory.place::<[u32; 4]>(self.at + 16)
+    }
+    /// Number `k` of a bulk slot.
+    fn value(&self, k: usize) -> Place<'m, f64> {
+        self.memory.place::<f64>(self.at + 32 + 8 * k)
     }
     /// Whether the slot is `state` under `ticket`.
     fn is(&self, state: u32, ticket: u32) -> bool {
@@ -121,11 +145,41 @@ pub struct Mailbox {
 }
 
 impl Mailbox {
+    /// Slot `i`: a call slot below [`MAILBOX_SLOTS`], a bulk slot from there on.
     fn slot(&self, i: usize) -> Slot<'_> {
-        Slot {
-            at: HEADER_BYTES + i * SLOT_BYTES,
-            memory: &self.memory,
+        let i = i.min(ALL_SLOTS - 1);
+        match i.checked_sub(MAILBOX_SLOTS) {
+            None => Slot {
+                at: HEADER_BYTES + i * SLOT_BYTES,
+                response_at: 16 + FRAME_WORDS * 4,
+                memory: &self.memory,
+            },
+            Some(b) => Slot {
+                at: OFF_BULK + b * BULK_SLOT_BYTES,
+                response_at: 32 + BULK_MAX_VALUES * 8,
+                memory: &self.memory,
+            },
         }
+    }
+
+    /// Claims a free slot among `slots` for writing: the slot and its ticket.
+    fn claim(&self, slots: core::ops::Range<usize>) -> Result<(usize, u32), CallError> {
+        for i in slots {
+            let slot = self.slot(i);
+            if slot
+                .state()
+                .compare_exchange(FREE, WRITING, SeqCst, SeqCst)
+                .is_err()
+            {
+                continue;
+            }
+            let tickets = self.memory.place::<u32>(OFF_TICKETS).atomic();
+            let ticket = tickets.fetch_add(1, SeqCst);
+            slot.ticket().store(ticket, SeqCst);
+            slot.abandoned().store(0, SeqCst);
+            return Ok((i, ticket));
+        }
+        Err(os(&self.name, "all slots are taken"))
     }
 
     /// Creates `instance`'s mailbox for the server; one a dead server left is replaced, one a
@@ -192,32 +246,41 @@ impl Mailbox {
 
     /// Claims a free slot and sends `request` in it: the slot and its ticket.
     pub fn send(&self, request: &AcyclicRequest) -> Result<(usize, u32), CallError> {
-        for i in 0..MAILBOX_SLOTS {
-            let slot = self.slot(i);
-            if slot
-                .state()
-                .compare_exchange(FREE, WRITING, SeqCst, SeqCst)
-                .is_err()
-            {
-                continue;
-            }
-            let ticket = self
-                .memory
-                .place::<u32>(OFF_TICKETS)
-                .atomic()
-                .fetch_add(1, SeqCst);
-            slot.ticket().store(ticket, SeqCst);
-            slot.abandoned().store(0, SeqCst);
-            slot.frame(false).write(&bytemuck::cast(*request));
-            slot.state().store(REQUEST, SeqCst);
-            return Ok((i, ticket));
+        let (i, ticket) = self.claim(0..MAILBOX_SLOTS)?;
+        let slot = self.slot(i);
+        slot.request_frame().write(&bytemuck::cast(*request));
+        slot.state().store(REQUEST, SeqCst);
+        Ok((i, ticket))
+    }
+
+    /// Claims a bulk slot for `count` numbers under `header`, to be written in place and sent
+    /// whole ([`BulkLoan`]); more than [`BULK_MAX_VALUES`] numbers are refused.
+    pub fn loan(self: &Arc<Self>, header: BulkHeader, count: usize) -> Result<BulkLoan, CallError> {
+        if count > BULK_MAX_VALUES {
+            return Err(os(
+                &self.name,
+                format!("{count} numbers, at most {BULK_MAX_VALUES}"),
+            ));
         }
-        Err(os(&self.name, "all slots are taken"))
+        let (slot, ticket) = self.claim(MAILBOX_SLOTS..ALL_SLOTS)?;
+        let s = self.slot(slot);
+        s.header().write(&bytemuck::cast(header));
+        s.count().store(count as u32);
+        for k in 0..count {
+            s.value(k).store(0.0);
+        }
+        Ok(BulkLoan {
+            mailbox: Arc::clone(self),
+            slot,
+            ticket,
+            count,
+            sent: false,
+        })
     }
 
     /// The reply in slot `i` under `ticket`, taken (the slot freed); `None` before it came.
     pub fn take(&self, i: usize, ticket: u32) -> Option<AcyclicResponse> {
-        let slot = self.slot(i.min(MAILBOX_SLOTS - 1));
+        let slot = self.slot(i);
         if !slot.is(REPLY, ticket) {
             return None;
         }
@@ -231,7 +294,7 @@ impl Mailbox {
     /// Gives up the call in slot `i` under `ticket`: it still runs; the slot is freed by
     /// whichever side sees the reply first.
     pub fn abandon(&self, i: usize, ticket: u32) {
-        let slot = self.slot(i.min(MAILBOX_SLOTS - 1));
+        let slot = self.slot(i);
         if slot.ticket().load(SeqCst) != ticket || slot.state().load(SeqCst) == FREE {
             return;
         }
@@ -250,8 +313,46 @@ impl Mailbox {
         ages: &mut [u32; MAILBOX_SLOTS],
         mut answer: impl FnMut(&AcyclicRequest) -> AcyclicResponse,
     ) -> usize {
+        let answered = self.answer_each(0..MAILBOX_SLOTS, |slot| answer(&slot.request()));
+        self.age(0, ages);
+        answered
+    }
+
+    /// Answers every sent bulk call with `answer(header, numbers)`, oldest first, the numbers
+    /// copied into `buffer` (room for [`BULK_MAX_VALUES`]: nothing allocated); a count above
+    /// that room, or other than rows x columns, is answered with `refuse` without `answer`.
+    pub fn serve_bulk(
+        &self,
+        ages: &mut [u32; BULK_SLOTS],
+        buffer: &mut Vec<f64>,
+        refuse: AcyclicResponse,
+        mut answer: impl FnMut(&BulkHeader, &[f64]) -> AcyclicResponse,
+    ) -> usize {
+        let answered = self.answer_each(MAILBOX_SLOTS..ALL_SLOTS, |slot| {
+            let header: BulkHeader = bytemuck::cast(slot.header().read());
+            let count = slot.count().load() as usize;
+            let shape = (header.rows as usize).checked_mul(header.columns as usize);
+            if count > BULK_MAX_VALUES || count > buffer.capacity() || shape != Some(count) {
+                let mut refused = refuse;
+                refused.kind = header.kind;
+                return refused;
+            }
+            buffer.clear();
+            buffer.extend((0..count).map(|k| slot.value(k).load()));
+            answer(&header, buffer)
+        });
+        self.age(MAILBOX_SLOTS, ages);
+        answered
+    }
+
+    /// Answers the sent slots among `slots`, oldest ticket first.
+    fn answer_each(
+        &self,
+        slots: core::ops::Range<usize>,
+        mut answer: impl FnMut(&Slot<'_>) -> AcyclicResponse,
+    ) -> usize {
         let mut answered = 0;
-        while let Some(i) = self.oldest_request() {
+        while let Some(i) = self.oldest_request(slots.clone()) {
             let slot = self.slot(i);
             if slot
                 .state()
@@ -260,16 +361,22 @@ impl Mailbox {
             {
                 continue;
             }
-            let response = answer(&slot.request());
-            slot.frame(true).write(&bytemuck::cast(response));
+            let response = answer(&slot);
+            slot.response_frame().write(&bytemuck::cast(response));
             slot.state().store(REPLY, SeqCst);
             if slot.abandoned().load(SeqCst) != 0 {
                 let _ = slot.state().compare_exchange(REPLY, FREE, SeqCst, SeqCst);
             }
             answered += 1;
         }
+        answered
+    }
+
+    /// Counts the polls each slot from `first` on stood neither free nor sent, and frees it
+    /// after [`STALE_POLLS`].
+    fn age(&self, first: usize, ages: &mut [u32]) {
         for (i, age) in ages.iter_mut().enumerate() {
-            let state = self.slot(i).state();
+            let state = self.slot(first + i).state();
             match state.load(SeqCst) {
                 FREE | REQUEST => *age = 0,
                 _ if *age >= STALE_POLLS => {
@@ -279,16 +386,70 @@ impl Mailbox {
                 _ => *age += 1,
             }
         }
-        answered
     }
 
-    /// The sent slot with the oldest ticket (tickets count up and wrap: the oldest is the one
-    /// furthest behind the counter).
-    fn oldest_request(&self) -> Option<usize> {
+    /// The sent slot among `slots` with the oldest ticket (tickets count up and wrap: the
+    /// oldest is the one furthest behind the counter).
+    fn oldest_request(&self, slots: core::ops::Range<usize>) -> Option<usize> {
         let now = self.memory.place::<u32>(OFF_TICKETS).load();
-        (0..MAILBOX_SLOTS)
+        slots
             .filter(|&i| self.slot(i).state().load(SeqCst) == REQUEST)
             .max_by_key(|&i| now.wrapping_sub(self.slot(i).ticket().load(SeqCst)))
+    }
+}
+
+/// A bulk slot claimed for writing: its numbers are written in place and sent whole; dropped
+/// unsent, the slot is freed and nothing reaches the CNC (a process that dies while writing
+/// leaves it claimed, and the server frees it after [`STALE_POLLS`]: never a half block).
+#[derive(Debug)]
+pub struct BulkLoan {
+    mailbox: Arc<Mailbox>,
+    slot: usize,
+    ticket: u32,
+    count: usize,
+    sent: bool,
+}
+
+impl BulkLoan {
+    /// How many numbers the loan holds.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether it holds none.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Writes `values` from number `at` on (those beyond the loan are left out).
+    pub fn write(&mut self, at: usize, values: &[f64]) {
+        let slot = self.mailbox.slot(self.slot);
+        let end = self.count.min(at.saturating_add(values.len()));
+        for (k, v) in (at..end).zip(values) {
+            slot.value(k).store(*v);
+        }
+    }
+
+    /// Sends the block whole: the ticket of the call.
+    pub fn send(mut self) -> Ticket {
+        let slot = self.mailbox.slot(self.slot);
+        slot.state().store(REQUEST, SeqCst);
+        self.sent = true;
+        Ticket {
+            mailbox: Arc::clone(&self.mailbox),
+            slot: self.slot,
+            ticket: self.ticket,
+            taken: core::cell::Cell::new(false),
+        }
+    }
+}
+
+impl Drop for BulkLoan {
+    fn drop(&mut self) {
+        let slot = self.mailbox.slot(self.slot);
+        if !self.sent && slot.ticket().load(SeqCst) == self.ticket {
+            let _ = slot.state().compare_exchange(WRITING, FREE, SeqCst, SeqCst);
+        }
     }
 }
 

@@ -57,9 +57,8 @@ fn main() -> ExitCode {
             let whole: Vec<f64> = (0..30).map(f64::from).collect();
             let _sent = client.start_rows(header, &whole).expect("send");
             let mut loan = client.loan_rows(header, 30).expect("loan");
-            for (i, v) in loan.values_mut().iter_mut().take(15).enumerate() {
-                *v = 100.0 + i as f64;
-            }
+            let half: Vec<f64> = (0..15).map(|i| 100.0 + f64::from(i)).collect();
+            loan.write(0, &half);
             println!("half");
             std::io::stdout().flush().ok();
             let _ = std::io::stdin().lock().read_line(&mut String::new());

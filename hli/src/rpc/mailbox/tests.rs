@@ -143,3 +143,65 @@ fn calls_are_answered_in_the_order_they_were_sent() {
     });
     assert_eq!(order, [3, 4]);
 }
+
+fn bulk_refused() -> AcyclicResponse {
+    AcyclicResponse {
+        invoke_id: 0,
+        kind: 0,
+        error_code: 99,
+        body_len: 0,
+        body: [0; crate::wire::ACYCLIC_BODY_SIZE],
+    }
+}
+
+fn header(rows: u32, columns: u32) -> BulkHeader {
+    BulkHeader {
+        kind: 50,
+        target: 0,
+        columns,
+        rows,
+    }
+}
+
+#[test]
+fn a_bulk_block_is_written_in_place_and_arrives_whole_or_not_at_all() {
+    let server = Mailbox::create(&name("bulk")).unwrap();
+    let client = Arc::new(Mailbox::open(&name("bulk")).unwrap());
+    let (mut ages, mut buffer) = ([0; BULK_SLOTS], Vec::with_capacity(BULK_MAX_VALUES));
+    let mut got = Vec::new();
+    let mut serve = |got: &mut Vec<(u32, Vec<f64>)>| {
+        server.serve_bulk(&mut ages, &mut buffer, bulk_refused(), |h, v| {
+            got.push((h.rows, v.to_vec()));
+            AcyclicResponse {
+                error_code: 0,
+                ..bulk_refused()
+            }
+        })
+    };
+    // Written in two parts, sent whole, answered.
+    let mut loan = client.loan(header(2, 3), 6).unwrap();
+    loan.write(0, &[1.0, 2.0, 3.0]);
+    loan.write(3, &[4.0, 5.0, 6.0, 7.0]); // the 7th is beyond the loan
+    let ticket = loan.send();
+    assert_eq!(serve(&mut got), 1);
+    assert_eq!(got, [(2, vec![1.0, 2.0, 3.0, 4.0, 5.0, 6.0])]);
+    assert_eq!(ticket.take().unwrap().error_code, 0);
+    // A loan dropped unsent never arrives, and its slot comes free at once.
+    let unsent = client.loan(header(1, 1), 1).unwrap();
+    let slot = unsent.slot;
+    drop(unsent);
+    assert_eq!((serve(&mut got), state(&server, slot)), (0, FREE));
+    // A count that is not rows x columns is refused before the handler sees it.
+    let wrong = client.loan(header(2, 2), 3).unwrap().send();
+    assert_eq!(serve(&mut got), 1);
+    assert_eq!((got.len(), wrong.take().unwrap().error_code), (1, 99));
+    // More numbers than a slot holds are refused at the loan.
+    assert!(client.loan(header(1, 1), BULK_MAX_VALUES + 1).is_err());
+    // The bulk slots run out apart from the call slots.
+    let loans: Vec<BulkLoan> = (0..BULK_SLOTS)
+        .map(|_| client.loan(header(1, 1), 1).unwrap())
+        .collect();
+    assert!(client.loan(header(1, 1), 1).is_err());
+    assert!(client.send(&request(1)).is_ok());
+    drop(loans);
+}
