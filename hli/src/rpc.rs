@@ -54,7 +54,7 @@ impl AcyclicClient {
     /// never reaches the CNC: there is no half block.
     pub fn loan_rows(&mut self, header: BulkHeader, values: usize) -> Result<RowsLoan, CallError> {
         Ok(RowsLoan {
-            loan: self.calls.loan(header, values)?,
+            loan: self.calls.loan(header, values, true)?,
         })
     }
 
@@ -66,12 +66,11 @@ impl AcyclicClient {
         header: BulkHeader,
         values: &[f64],
     ) -> Result<PendingRows, CallError> {
-        let mut loan = self.calls.loan(header, values.len())?;
+        let mut loan = self.calls.loan(header, values.len(), false)?;
         loan.write(0, values);
+        let ticket = loan.send()?;
         self.sent += 1;
-        Ok(PendingRows {
-            ticket: loan.send(),
-        })
+        Ok(PendingRows { ticket })
     }
 
     /// Calls sent by [`AcyclicClient::start`] and [`AcyclicClient::start_rows`] (and so by
@@ -193,7 +192,7 @@ pub struct RowsLoan {
 }
 
 impl RowsLoan {
-    /// How many values the block holds (zero until written).
+    /// How many values the block holds (each 0 until written).
     pub fn len(&self) -> usize {
         self.loan.len()
     }
@@ -212,7 +211,7 @@ impl RowsLoan {
     /// Sends the block whole.
     pub fn send(self) -> Result<PendingRows, CallError> {
         Ok(PendingRows {
-            ticket: self.loan.send(),
+            ticket: self.loan.send()?,
         })
     }
 }
@@ -270,7 +269,12 @@ impl AcyclicServer {
         mut handler: impl FnMut(CallKind, &BulkHeader, &[f64]) -> HandlerResult,
     ) -> Result<usize, CallError> {
         let mut ages = self.bulk_ages.get();
-        let mut rows = self.rows.borrow_mut();
+        // A handler that polls again finds the room taken: refused, never a panic.
+        let Ok(mut rows) = self.rows.try_borrow_mut() else {
+            return Err(CallError::Transport(
+                "poll_rows called from its own handler".into(),
+            ));
+        };
         let refuse = response(0, 0, Err(ErrorCode::InvalidSize));
         let answered = self
             .calls

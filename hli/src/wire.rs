@@ -75,8 +75,6 @@ pub struct BulkHeader {
 
 const _: () = assert!(core::mem::size_of::<BulkHeader>() == 16);
 
-crate::raw::zero_copy_send!(AcyclicRequest, AcyclicResponse, BulkHeader);
-
 /// A body encoded for a frame: the bytes and their count.
 pub fn encode_body<T: Pod>(value: &T) -> ([u8; ACYCLIC_BODY_SIZE], u32) {
     let bytes = bytemuck::bytes_of(value);

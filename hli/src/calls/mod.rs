@@ -269,9 +269,16 @@ pub enum CallError {
     /// No answer within the timeout.
     #[error("no response within {0:?}")]
     Timeout(Duration),
-    /// iceoryx2 failed.
-    #[error("request-response service: {0}")]
+    /// The transport (the call mailbox, `crate::rpc::mailbox`) failed: opening it, or a loan
+    /// taken away.
+    #[error("call mailbox: {0}")]
     Transport(String),
+    /// Every slot of the call mailbox is taken (calls on their way at once); nothing was sent.
+    #[error("call mailbox: every slot is taken")]
+    SlotsTaken,
+    /// A bulk call of more numbers than a slot holds; nothing was sent.
+    #[error("call mailbox: {0} numbers, more than a bulk slot holds")]
+    TooLarge(usize),
 }
 
 /// Decodes a request body as `T`; a size mismatch is [`ErrorCode::InvalidSize`].

@@ -16,7 +16,9 @@
 //! (a block restarted while Busy) marks the slot abandoned; the call still runs, as a frame
 //! already sent would, and whichever side sees the reply first frees the slot. A slot a dead
 //! client left (claimed and never sent, or answered and never taken) is freed by the server
-//! after [`STALE_POLLS`] polls.
+//! after [`STALE_POLLS`] polls, once its process is gone (every slot names its claimant's
+//! pid). The state and the ticket are two words: a holder's ticket check and the next
+//! claimant's ticket store could meet only after 2^32 calls.
 
 use super::super::calls::CallError;
 use super::super::desc::PlaceExt;
@@ -55,14 +57,16 @@ const OFF_SLOTS: usize = 8;
 const OFF_PID: usize = 12;
 const OFF_STAMP: usize = 16;
 const OFF_TICKETS: usize = 24;
-/// A slot: state, abandoned flag, ticket, reserved, then the request and the response.
+/// A slot: state, abandoned flag, ticket, the claimant's pid, then the request and the
+/// response.
 const SLOT_BYTES: usize = 16 + 2 * FRAME_WORDS * 4;
 /// Bulk slots (FIFO row blocks, numbers written in place): calls of this kind on their way
 /// at once.
 pub const BULK_SLOTS: usize = 8;
-/// A bulk slot: state, abandoned flag, ticket, the count of numbers, the [`BulkHeader`], the
-/// numbers, then the response.
-const BULK_SLOT_BYTES: usize = 32 + BULK_MAX_VALUES * 8 + FRAME_WORDS * 4;
+/// A bulk slot: state, abandoned flag, ticket, the claimant's pid, the [`BulkHeader`], the
+/// count of numbers (and a pad word), the numbers, then the response.
+const BULK_SLOT_BYTES: usize = BULK_VALUES_AT + BULK_MAX_VALUES * 8 + FRAME_WORDS * 4;
+const BULK_VALUES_AT: usize = 40;
 const OFF_BULK: usize = HEADER_BYTES + MAILBOX_SLOTS * SLOT_BYTES;
 const SIZE: usize = OFF_BULK + BULK_SLOTS * BULK_SLOT_BYTES;
 /// Every slot, calls first (`0..MAILBOX_SLOTS`), then bulk.
@@ -107,9 +111,13 @@ impl<'m> Slot<'m> {
     fn ticket(&self) -> &'m std::sync::atomic::AtomicU32 {
         self.word(8).atomic()
     }
+    /// The pid of the process that claimed the slot.
+    fn pid(&self) -> Place<'m, u32> {
+        self.word(12)
+    }
     /// The count of numbers of a bulk slot.
     fn count(&self) -> Place<'m, u32> {
-        self.word(12)
+        self.word(32)
     }
     fn request_frame(&self) -> Place<'m, [u32; FRAME_WORDS]> {
         self.memory.place::<[u32; FRAME_WORDS]>(self.at + 16)
@@ -129,7 +137,7 @@ impl<'m> Slot<'m> {
     }
     /// Number `k` of a bulk slot.
     fn value(&self, k: usize) -> Place<'m, f64> {
-        self.memory.place::<f64>(self.at + 32 + 8 * k)
+        self.memory.place::<f64>(self.at + BULK_VALUES_AT + 8 * k)
     }
     /// Whether the slot is `state` under `ticket`.
     fn is(&self, state: u32, ticket: u32) -> bool {
@@ -142,6 +150,9 @@ impl<'m> Slot<'m> {
 pub struct Mailbox {
     memory: ImageMemory,
     name: String,
+    /// This process's pid, written into the slots it claims (read once: no system call per
+    /// call).
+    pid: u32,
 }
 
 impl Mailbox {
@@ -156,7 +167,7 @@ impl Mailbox {
             },
             Some(b) => Slot {
                 at: OFF_BULK + b * BULK_SLOT_BYTES,
-                response_at: 32 + BULK_MAX_VALUES * 8,
+                response_at: BULK_VALUES_AT + BULK_MAX_VALUES * 8,
                 memory: &self.memory,
             },
         }
@@ -177,9 +188,10 @@ impl Mailbox {
             let ticket = tickets.fetch_add(1, SeqCst);
             slot.ticket().store(ticket, SeqCst);
             slot.abandoned().store(0, SeqCst);
+            slot.pid().store(self.pid);
             return Ok((i, ticket));
         }
-        Err(os(&self.name, "all slots are taken"))
+        Err(CallError::SlotsTaken)
     }
 
     /// Creates `instance`'s mailbox for the server; one a dead server left is replaced, one a
@@ -199,11 +211,18 @@ impl Mailbox {
         let shm = match create() {
             Ok(shm) => shm,
             Err(SharedMemoryCreationError::AlreadyExist) => {
-                if let Ok(old) = Mailbox::open(instance) {
-                    let pid = old.memory.place::<u32>(OFF_PID).load();
-                    let stamp = old.memory.place::<u64>(OFF_STAMP).load();
-                    if crate::segment::process_start_stamp(pid) == Some(stamp) {
-                        return Err(os(&name, format!("in use by the live process {pid}")));
+                // Whatever its shape (another build's, one half made): its server's pid and
+                // start stamp decide, read before anything else of it.
+                let old = SharedMemoryBuilder::new(&fname)
+                    .is_memory_locked(false)
+                    .open_existing(AccessMode::ReadWrite);
+                if let Ok(old) = old.map(ImageMemory::shared) {
+                    if old.len() >= HEADER_BYTES {
+                        let pid = old.place::<u32>(OFF_PID).load();
+                        let stamp = old.place::<u64>(OFF_STAMP).load();
+                        if crate::segment::process_start_stamp(pid) == Some(stamp) {
+                            return Err(os(&name, format!("in use by the live process {pid}")));
+                        }
                     }
                 }
                 iceoryx2_bb_posix::shared_memory::SharedMemory::remove(&fname)
@@ -219,7 +238,7 @@ impl Mailbox {
         let stamp = crate::segment::process_start_stamp(pid).unwrap_or(0);
         memory.place::<u64>(OFF_STAMP).store(stamp);
         memory.place::<u64>(0).store_release(MAGIC);
-        Ok(Mailbox { memory, name })
+        Ok(Mailbox { memory, name, pid })
     }
 
     /// Opens `instance`'s mailbox for a client: it must be there, with this build's shape.
@@ -241,7 +260,8 @@ impl Mailbox {
                 format!("not a mailbox of this build ({slots} slots)"),
             ));
         }
-        Ok(Mailbox { memory, name })
+        let pid = std::process::id();
+        Ok(Mailbox { memory, name, pid })
     }
 
     /// Claims a free slot and sends `request` in it: the slot and its ticket.
@@ -254,19 +274,22 @@ impl Mailbox {
     }
 
     /// Claims a bulk slot for `count` numbers under `header`, to be written in place and sent
-    /// whole ([`BulkLoan`]); more than [`BULK_MAX_VALUES`] numbers are refused.
-    pub fn loan(self: &Arc<Self>, header: BulkHeader, count: usize) -> Result<BulkLoan, CallError> {
+    /// whole ([`BulkLoan`]), its numbers 0 if `zeroed` (else what the slot held before: for a
+    /// caller that writes them all); more than [`BULK_MAX_VALUES`] numbers are refused.
+    pub fn loan(
+        self: &Arc<Self>,
+        header: BulkHeader,
+        count: usize,
+        zeroed: bool,
+    ) -> Result<BulkLoan, CallError> {
         if count > BULK_MAX_VALUES {
-            return Err(os(
-                &self.name,
-                format!("{count} numbers, at most {BULK_MAX_VALUES}"),
-            ));
+            return Err(CallError::TooLarge(count));
         }
         let (slot, ticket) = self.claim(MAILBOX_SLOTS..ALL_SLOTS)?;
         let s = self.slot(slot);
         s.header().write(&bytemuck::cast(header));
         s.count().store(count as u32);
-        for k in 0..count {
+        for k in (0..count).filter(|_| zeroed) {
             s.value(k).store(0.0);
         }
         Ok(BulkLoan {
@@ -352,7 +375,12 @@ impl Mailbox {
         mut answer: impl FnMut(&Slot<'_>) -> AcyclicResponse,
     ) -> usize {
         let mut answered = 0;
-        while let Some(i) = self.oldest_request(slots.clone()) {
+        // At most one answer per slot and poll: a peer that keeps sending cannot hold the
+        // server here.
+        for _ in slots.clone() {
+            let Some(i) = self.oldest_request(slots.clone()) else {
+                break;
+            };
             let slot = self.slot(i);
             if slot
                 .state()
@@ -372,16 +400,20 @@ impl Mailbox {
         answered
     }
 
-    /// Counts the polls each slot from `first` on stood neither free nor sent, and frees it
-    /// after [`STALE_POLLS`].
+    /// Counts the polls each slot from `first` on stood neither free nor sent; after
+    /// [`STALE_POLLS`] it frees the slot if the process that claimed it is gone (a live one,
+    /// however slow, keeps it; asked again after as many polls).
     fn age(&self, first: usize, ages: &mut [u32]) {
         for (i, age) in ages.iter_mut().enumerate() {
-            let state = self.slot(first + i).state();
-            match state.load(SeqCst) {
+            let slot = self.slot(first + i);
+            match slot.state().load(SeqCst) {
                 FREE | REQUEST => *age = 0,
-                _ if *age >= STALE_POLLS => {
-                    state.store(FREE, SeqCst);
+                stuck if *age >= STALE_POLLS => {
                     *age = 0;
+                    let pid = slot.pid().load();
+                    if crate::segment::process_start_stamp(pid).is_none() {
+                        let _ = slot.state().compare_exchange(stuck, FREE, SeqCst, SeqCst);
+                    }
                 }
                 _ => *age += 1,
             }
@@ -430,17 +462,25 @@ impl BulkLoan {
         }
     }
 
-    /// Sends the block whole: the ticket of the call.
-    pub fn send(mut self) -> Ticket {
+    /// Sends the block whole: the ticket of the call; `Err` if the slot is no longer this
+    /// loan's (freed as a dead process's: nothing is sent).
+    pub fn send(mut self) -> Result<Ticket, CallError> {
         let slot = self.mailbox.slot(self.slot);
-        slot.state().store(REQUEST, SeqCst);
+        let ours = slot.ticket().load(SeqCst) == self.ticket
+            && slot
+                .state()
+                .compare_exchange(WRITING, REQUEST, SeqCst, SeqCst)
+                .is_ok();
+        if !ours {
+            return Err(os(&self.mailbox.name, "the loan's slot was taken away"));
+        }
         self.sent = true;
-        Ticket {
+        Ok(Ticket {
             mailbox: Arc::clone(&self.mailbox),
             slot: self.slot,
             ticket: self.ticket,
             taken: core::cell::Cell::new(false),
-        }
+        })
     }
 }
 
