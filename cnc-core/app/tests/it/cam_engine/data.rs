@@ -290,20 +290,10 @@ fn reads_give_dynamics_characteristics_value_tables_and_the_coupling_info() {
 
 #[test]
 fn a_multi_table_call_refuses_an_operation_it_does_not_have() {
-    use hli::calls::cam::{CamMultiCoupleCall, CamMultiTableCall, CamMultiTableOp};
+    use hli::calls::cam::{CamMultiTableCall, CamMultiTableOp};
     let mut run = machine("");
     run.step(0.001);
-    let mut table_ids = [0; hli::calls::cam::CAM_MULTI_TABLES];
-    table_ids[0] = 2;
-    let couple = CamMultiCoupleCall {
-        master: MASTER as u32,
-        on: 1,
-        tables: 1,
-        profiles: 1,
-        table_ids,
-        ..Default::default()
-    };
-    assert_eq!(call(&mut run, SLAVE as u32, couple), 0);
+    assert_eq!(call(&mut run, SLAVE as u32, multi_couple(2, 0)), 0);
     let on_table = |op, table| CamMultiTableCall {
         op,
         table,

@@ -3,7 +3,6 @@
 
 use super::*;
 use hli::calls::axis::AxisCommandCall;
-use hli::calls::cam::{CamMultiCoupleCall, CAM_MULTI_TABLES};
 
 /// A wheel on a slow drive (PT1, 40 ms) whose encoder reads with noise, a feeder, and table 5:
 /// a straight line of slope 1/2 from 0 to 1000.
@@ -24,18 +23,7 @@ fn wheel_and_feeder() -> InProcess {
 }
 
 fn couple(run: &mut InProcess, master_source: u32) {
-    let mut table_ids = [0; CAM_MULTI_TABLES];
-    table_ids[0] = 5;
-    let couple = CamMultiCoupleCall {
-        master: MASTER as u32,
-        on: 1,
-        tables: 1,
-        profiles: 1,
-        table_ids,
-        master_source,
-        ..Default::default()
-    };
-    assert_eq!(call(run, SLAVE as u32, couple), 0);
+    assert_eq!(call(run, SLAVE as u32, multi_couple(5, master_source)), 0);
 }
 
 /// Runs the wheel at 100 mm/s and halts it; every tick, `follows` gets the feeder's set-point,
@@ -102,19 +90,8 @@ fn a_multi_table_slave_follows_an_encoder_master() {
     // An unknown source is refused.
     let mut run = wheel_and_feeder();
     run.step(0.001);
-    let mut table_ids = [0; CAM_MULTI_TABLES];
-    table_ids[0] = 5;
-    let bad = CamMultiCoupleCall {
-        master: MASTER as u32,
-        on: 1,
-        tables: 1,
-        profiles: 1,
-        table_ids,
-        master_source: 2,
-        ..Default::default()
-    };
     assert_eq!(
-        call(&mut run, SLAVE as u32, bad),
+        call(&mut run, SLAVE as u32, multi_couple(5, 2)),
         CamCouplingError::UnknownMode.raw()
     );
 }

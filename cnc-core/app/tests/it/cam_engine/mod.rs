@@ -73,6 +73,22 @@ fn call<C: AcyclicCall<Reply = CamReply>>(run: &mut InProcess, target: u32, body
     reply.error_id
 }
 
+/// CamTableCoupleAxesMultiTables of the slave to the master through profile table `table`
+/// alone, following the master's set-point (`master_source` 0) or its encoder (1).
+fn multi_couple(table: u32, master_source: u32) -> hli::calls::cam::CamMultiCoupleCall {
+    let mut table_ids = [0; hli::calls::cam::CAM_MULTI_TABLES];
+    table_ids[0] = table;
+    hli::calls::cam::CamMultiCoupleCall {
+        master: MASTER as u32,
+        on: 1,
+        tables: 1,
+        profiles: 1,
+        table_ids,
+        master_source,
+        reserved: 0,
+    }
+}
+
 /// MC_CamTableSelect: couplings through `table` run cyclic, absolute.
 fn select_cyclic(run: &mut InProcess, table: u32) {
     let select = CamTableSelectCall {
