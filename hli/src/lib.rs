@@ -9,8 +9,8 @@
 //!   PLC's side of an image;
 //! * [`events`]: iceoryx2 wake-ups; acyclic calls: [`wire`] (frames), [`calls`] (what
 //!   every call has in common, the kinds, the refusal codes; one module per family of
-//!   calls: [`calls::cam`], [`calls::fifo`] ...), [`rpc`] (the iceoryx2 request-response
-//!   transports);
+//!   calls: [`calls::cam`], [`calls::fifo`] ...), [`rpc`] (the transport: a mailbox of call
+//!   and bulk slots in shared memory);
 //! * [`units`], [`enums`]: HLI units and validated enumerations.
 //!
 //! All `unsafe` code of the crate is in [`raw`] (the image memory and the `ZeroCopySend`

@@ -1,6 +1,6 @@
 //! The PLC process: attaches to a CNC's HLI segment and runs a PLC program once per cycle,
 //! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
-//! the acyclic request-response service.
+//! the acyclic calls' mailbox (`hli::rpc`).
 
 #![forbid(unsafe_code)]
 

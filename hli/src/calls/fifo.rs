@@ -1,9 +1,9 @@
 //! The FIFO group's calls (seed 002, chapter 7): the one-frame commands over the acyclic
 //! service (`FiFoGetDimension`, `FiFoGroupIntegrate`, `FiFoGroupDisintegrate`, `FiFoStart`,
 //! `FiFoStop`, `FiFoSetChannelOverride`, and the parameters a PLC may set), and the row
-//! blocks of `FiFoWrite`/`FiFoOverwrite`, which travel on a request-response service of
-//! their own: a header plus a slice of `f64` the PLC writes in place into shared memory
-//! (no copy on the way), answered with the same [`FifoReply`].
+//! blocks of `FiFoWrite`/`FiFoOverwrite`, which travel in the bulk slots of the call mailbox
+//! (`crate::rpc::mailbox`): a header plus up to 8192 `f64` the PLC writes in place into shared
+//! memory, answered with the same [`FifoReply`].
 //!
 //! Every call addresses its group by index (`target`, 0-based, `gpFifo[target]^`); axes are
 //! addressed by their `gpAx` index as in the other calls; group positions count from 1 as in

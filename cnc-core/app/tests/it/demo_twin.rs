@@ -1,10 +1,9 @@
 //! The demo machine with its PLC program in one process (the in-process twin of `cnc demo`):
 //! it runs its whole cycle like the two processes do, and with every engine at work (four
 //! robot channels, three tracking; a cam slave through a rescale and an online point change;
-//! a flying saw cutting) the machine tick allocates nothing. The PLC program's cycle allocates
-//! exactly once per acyclic call it sends, inside iceoryx2's request-response (each loaned
-//! request gets a reference-counted shared state, `ChunkMutSharedState::new`), and nothing
-//! else.
+//! a flying saw cutting) the machine tick allocates nothing, nor does the PLC program's cycle,
+//! the acyclic calls it sends included (they go through the call mailbox; over iceoryx2's
+//! request-response each call allocated once).
 
 use crate::counting_alloc::allocations;
 use cnc_app::scenario::InProcess;
