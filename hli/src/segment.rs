@@ -205,12 +205,15 @@ pub enum AttachError {
 
 /// The shared-memory object name of an instance.
 pub fn segment_name(instance: &str) -> Option<String> {
-    let ok = !instance.is_empty()
-        && instance.len() <= 48
+    instance_ok(instance, 48).then(|| format!("cncplc_{instance}.hli"))
+}
+
+/// Whether `instance` is 1..=`longest` characters of `[A-Za-z0-9_.-]` (a shared-memory name).
+pub(crate) fn instance_ok(instance: &str, longest: usize) -> bool {
+    (1..=longest).contains(&instance.len())
         && instance
             .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b));
-    ok.then(|| format!("cncplc_{instance}.hli"))
+            .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b))
 }
 
 fn file_name(name: &str) -> FileName {

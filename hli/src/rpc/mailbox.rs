@@ -74,12 +74,7 @@ const ALL_SLOTS: usize = MAILBOX_SLOTS + BULK_SLOTS;
 
 /// The object name of `instance`'s mailbox: 1..=200 characters of `[A-Za-z0-9_.-]`.
 pub fn mailbox_name(instance: &str) -> Option<String> {
-    let ok = !instance.is_empty()
-        && instance.len() <= 200
-        && instance
-            .bytes()
-            .all(|b| b.is_ascii_alphanumeric() || b"_.-".contains(&b));
-    ok.then(|| format!("cncplc_{instance}.calls"))
+    crate::segment::instance_ok(instance, 200).then(|| format!("cncplc_{instance}.calls"))
 }
 
 fn os(name: &str, what: impl core::fmt::Debug) -> CallError {
