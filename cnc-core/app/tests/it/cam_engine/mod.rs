@@ -140,6 +140,17 @@ fn phase(run: &InProcess, axis: usize) -> AxisState {
         .motion_state(set(run, axis))
 }
 
+/// MC_CamInExt switching the slave to the stroke table (2) when the master reaches cam
+/// position 200, the rest as `cam_in`.
+fn switch_to_stroke_at_200() -> CamInCall {
+    CamInCall {
+        extended: 1,
+        activation_mode: 1,
+        activation_position: 200.0,
+        ..cam_in(2)
+    }
+}
+
 /// The lifter coupled with MC_CamInExt to the seed cam (table 1, cyclic), the conveyor at
 /// 360 degrees/s for 0.7 s: a coupling ready for a switch.
 fn switchable_at_speed() -> InProcess {
@@ -470,13 +481,10 @@ fn switching_cams_mid_cycle_with_auto_offsets_keeps_the_slave_continuous() {
     // where the two cams differ by about 13: both offsets automatic, so neither the master's
     // place in the cycle nor the slave jumps.
     let switch = CamInCall {
-        extended: 1,
-        activation_mode: 1,
-        activation_position: 200.0,
         master_scaling_mode: 1,
         slave_scaling_mode: 1,
         interpolation: 2,
-        ..cam_in(2)
+        ..switch_to_stroke_at_200()
     };
     assert_eq!(call(&mut run, SLAVE as u32, switch), 0);
     let mut last = set(&run, SLAVE).position;

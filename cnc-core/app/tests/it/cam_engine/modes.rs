@@ -334,13 +334,7 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
 fn delete_queued_data_drops_a_pending_switch_and_the_slave_stays_on_its_cam() {
     use hli::calls::cam::{CamReadCall, CamReadKind};
     let mut run = switchable_at_speed();
-    let switch = CamInCall {
-        extended: 1,
-        activation_mode: 1,
-        activation_position: 200.0,
-        ..cam_in(2)
-    };
-    assert_eq!(call(&mut run, SLAVE as u32, switch), 0);
+    assert_eq!(call(&mut run, SLAVE as u32, switch_to_stroke_at_200()), 0);
     let queued = |run: &mut InProcess| {
         let info = CamReadCall {
             what: CamReadKind::Info.raw(),
