@@ -125,6 +125,23 @@ impl SetpointGenerator {
         self.state
     }
 
+    /// Where the running profile ends (the position held when it holds).
+    pub fn end_position(&self) -> f64 {
+        if self.goal == Goal::Hold {
+            return self.state.position;
+        }
+        let (mut p, mut section) = (one(0.0), Some(0));
+        self.trajectory.at_time(
+            self.trajectory.get_duration(),
+            &mut Some(&mut p),
+            &mut None,
+            &mut None,
+            &mut None,
+            &mut section,
+        );
+        p[0]
+    }
+
     /// The current goal.
     pub fn goal(&self) -> Goal {
         self.goal

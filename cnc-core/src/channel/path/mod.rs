@@ -42,6 +42,7 @@ use crate::setpoint::AxisValues;
 use circle::Circle;
 
 mod circle;
+pub mod contour;
 
 /// Per-axis dynamic limits of a channel's programmed coordinates (mm or degrees, per second).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]

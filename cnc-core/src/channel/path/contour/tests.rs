@@ -1,0 +1,284 @@
+//! The contour against its promises: every tick within the tolerance of the programmed path
+//! and within every axis's velocity, acceleration and jerk; at rest at the end; braking on
+//! the path for feed hold and a stop.
+
+use super::*;
+use proptest::prelude::*;
+
+const CYCLE: f64 = 0.001;
+
+fn limits(n: usize) -> Vec<AxisLimits> {
+    vec![
+        AxisLimits {
+            velocity: 200.0,
+            acceleration: 2000.0,
+            jerk: 40_000.0,
+        };
+        n
+    ]
+}
+
+/// The polyline's corners.
+fn zigzag(n: usize, length: f64, turn_deg: f64) -> Vec<[f64; 3]> {
+    let mut points = vec![[0.0; 3]];
+    for k in 0..n {
+        let phi = if k % 2 == 0 {
+            0.0
+        } else {
+            turn_deg.to_radians()
+        };
+        let [x, y, z] = points[k];
+        points.push([x + length * phi.cos(), y + length * phi.sin(), z]);
+    }
+    points
+}
+
+fn values(p: [f64; 3]) -> AxisValues {
+    AxisValues::from_slice(&p)
+}
+
+/// What a run gave, tick by tick.
+struct Trace {
+    positions: Vec<AxisValues>,
+}
+
+/// Runs `points` at `feed` (mm/s) with `tolerance` (None: exact stop), feeding blocks as the
+/// window takes them; `hold` = (tick it starts, ticks it lasts).
+fn run(
+    points: &[[f64; 3]],
+    feed: f64,
+    tolerance: Option<f64>,
+    hold: Option<(usize, usize)>,
+) -> Trace {
+    let lim = limits(3);
+    let mut c = Contour::new(&lim, CYCLE, 16);
+    let mut next = 1;
+    let mut pos = values(points[0]);
+    let (mut vel, mut acc) = (AxisValues::zeros(3), AxisValues::zeros(3));
+    let mut positions = vec![pos];
+    for tick in 0..2_000_000 {
+        while next < points.len() && c.has_room() {
+            let seg = Segment {
+                start: values(points[next - 1]),
+                end: values(points[next]),
+                feed,
+                rapid: false,
+                line: next as u32,
+                blend: tolerance,
+            };
+            c.push(&seg).expect("a straight block");
+            next += 1;
+        }
+        if next == points.len() {
+            c.close();
+        }
+        if let Some((at, len)) = hold {
+            if tick == at {
+                c.set_factors(0.0, 0.0);
+            }
+            if tick == at + len {
+                c.set_factors(1.0, 1.0);
+            }
+        }
+        let moving = c.step(&mut pos, &mut vel, &mut acc).expect("no fault");
+        positions.push(pos);
+        if !moving && next == points.len() {
+            return Trace { positions };
+        }
+    }
+    panic!("did not finish");
+}
+
+fn dist_to_segment(p: &[f64], a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let ab: Vec<f64> = (0..3).map(|i| b[i] - a[i]).collect();
+    let ap: Vec<f64> = (0..3).map(|i| p[i] - a[i]).collect();
+    let len2: f64 = ab.iter().map(|v| v * v).sum();
+    let t = if len2 > 0.0 {
+        (ap.iter().zip(&ab).map(|(x, y)| x * y).sum::<f64>() / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (0..3)
+        .map(|i| (ap[i] - t * ab[i]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// The largest distance of any tick from the programmed path.
+fn worst_deviation(trace: &Trace, points: &[[f64; 3]]) -> f64 {
+    let mut seg = 0usize;
+    let mut worst = 0.0f64;
+    for p in &trace.positions {
+        let near = |k: usize| dist_to_segment(p, &points[k], &points[k + 1]);
+        let lo = seg.saturating_sub(2);
+        let hi = (seg + 4).min(points.len() - 1);
+        let (best_k, best) = (lo..hi)
+            .map(|k| (k, near(k)))
+            .fold((seg, f64::INFINITY), |m, x| if x.1 < m.1 { x } else { m });
+        seg = best_k;
+        worst = worst.max(best);
+    }
+    worst
+}
+
+/// The largest |velocity|, |acceleration| and |jerk| of any axis by differences over ticks.
+fn worst_rates(trace: &Trace) -> (f64, f64, f64) {
+    let p = &trace.positions;
+    let (mut v, mut a, mut j) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 3..p.len() {
+        for i in 0..3 {
+            let (p0, p1, p2, p3) = (p[k - 3][i], p[k - 2][i], p[k - 1][i], p[k][i]);
+            v = v.max(((p3 - p2) / CYCLE).abs());
+            a = a.max(((p3 - 2.0 * p2 + p1) / CYCLE.powi(2)).abs());
+            j = j.max(((p3 - 3.0 * p2 + 3.0 * p1 - p0) / CYCLE.powi(3)).abs());
+        }
+    }
+    (v, a, j)
+}
+
+fn assert_within_limits(trace: &Trace) {
+    let l = limits(1)[0];
+    let p = &trace.positions;
+    for k in 3..p.len() {
+        let a = (0..3)
+            .map(|i| ((p[k][i] - 2.0 * p[k - 1][i] + p[k - 2][i]) / CYCLE.powi(2)).abs())
+            .fold(0.0, f64::max);
+        if a > l.acceleration * 1.01 {
+            eprintln!(
+                "tick {k}: a {a}: {:?} {:?} {:?} {:?}",
+                p[k - 3],
+                p[k - 2],
+                p[k - 1],
+                p[k]
+            );
+            break;
+        }
+    }
+    let (v, a, j) = worst_rates(trace);
+    assert!(v <= l.velocity * (1.0 + 1e-6), "velocity {v}");
+    assert!(a <= l.acceleration * (1.0 + 1e-6), "acceleration {a}");
+    assert!(j <= l.jerk * (1.0 + 1e-6), "jerk {j}");
+}
+
+#[test]
+fn a_zigzag_runs_through_its_corners_within_tolerance_and_limits() {
+    let points = zigzag(200, 1.0, 10.0);
+    let tol = 0.05;
+    let cont = run(&points, 100.0, Some(tol), None);
+    let exact = run(&points, 100.0, None, None);
+    let dev = worst_deviation(&cont, &points);
+    assert!(dev <= tol + 1e-9, "deviation {dev}");
+    assert!(dev > 0.2 * tol, "corners are rounded: {dev}");
+    assert_within_limits(&cont);
+    assert_within_limits(&exact);
+    assert!(worst_deviation(&exact, &points) <= 1e-9);
+    let (tc, te) = (cont.positions.len(), exact.positions.len());
+    assert!(3 * tc < te, "continuous {tc} ticks, exact stop {te}");
+    let end = cont.positions.last().unwrap();
+    assert_eq!(&end[..], &points[200][..]);
+}
+
+#[test]
+fn feed_hold_brakes_on_the_path_and_goes_on() {
+    let points = zigzag(60, 2.0, 30.0);
+    let tol = 0.05;
+    for at in [50, 137, 300] {
+        let held = run(&points, 150.0, Some(tol), Some((at, 400)));
+        assert!(worst_deviation(&held, &points) <= tol + 1e-9);
+        assert_within_limits(&held);
+        // It stood still for a while.
+        let p = &held.positions;
+        let still = (1..p.len()).filter(|&k| p[k] == p[k - 1]).count();
+        assert!(still > 100, "held at {at}: {still} ticks still");
+        assert_eq!(&p.last().unwrap()[..], &points[60][..]);
+    }
+}
+
+#[test]
+fn a_stop_comes_to_rest_on_the_path_and_empties_the_window() {
+    let points = zigzag(100, 1.0, 20.0);
+    let lim = limits(3);
+    let mut c = Contour::new(&lim, CYCLE, 16);
+    let mut pos = values(points[0]);
+    let (mut vel, mut acc) = (AxisValues::zeros(3), AxisValues::zeros(3));
+    let mut next = 1;
+    let mut trace = Trace {
+        positions: vec![pos],
+    };
+    for tick in 0..100_000 {
+        while next < points.len() && c.has_room() {
+            let seg = Segment {
+                start: values(points[next - 1]),
+                end: values(points[next]),
+                feed: 150.0,
+                rapid: false,
+                line: next as u32,
+                blend: Some(0.02),
+            };
+            c.push(&seg).unwrap();
+            next += 1;
+        }
+        if tick == 200 {
+            c.stop();
+        }
+        let moving = c.step(&mut pos, &mut vel, &mut acc).unwrap();
+        trace.positions.push(pos);
+        if tick > 200 && !moving {
+            break;
+        }
+    }
+    assert!(!c.active());
+    assert!(worst_deviation(&trace, &points) <= 0.02 + 1e-9);
+    assert_within_limits(&trace);
+    let n = trace.positions.len();
+    let last_step = (0..3)
+        .map(|i| (trace.positions[n - 1][i] - trace.positions[n - 2][i]).abs())
+        .fold(0.0, f64::max);
+    assert!(last_step < 1e-6, "at rest: {last_step}");
+    assert!(n < 1000, "stopped early: {n}");
+}
+
+#[test]
+fn a_reversal_and_a_sharp_corner_stop_exactly() {
+    let points = vec![
+        [0.0, 0.0, 0.0],
+        [10.0, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+        [5.0, 1.5, 0.0],
+    ];
+    let t = run(&points, 100.0, Some(0.5), None);
+    assert!(worst_deviation(&t, &points) <= 1e-9, "no rounding");
+    assert!(
+        t.positions.iter().any(|p| p[..] == points[1][..]),
+        "rests at the turn"
+    );
+    assert_within_limits(&t);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    #[test]
+    fn random_polylines_keep_tolerance_and_limits(
+        steps in proptest::collection::vec((0.05f64..8.0, -3.0f64..3.0, -1.0f64..1.0), 2..25),
+        tol in 0.001f64..0.5,
+        feed in 5.0f64..300.0,
+    ) {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        let mut heading = 0.0f64;
+        for (len, turn, climb) in steps {
+            heading += turn;
+            let [x, y, z] = *points.last().unwrap();
+            points.push([x + len * heading.cos(), y + len * heading.sin(), z + climb]);
+        }
+        let t = run(&points, feed, Some(tol), None);
+        let dev = worst_deviation(&t, &points);
+        prop_assert!(dev <= tol + 1e-9, "deviation {} > {}", dev, tol);
+        let l = limits(1)[0];
+        let (v, a, j) = worst_rates(&t);
+        prop_assert!(v <= l.velocity * (1.0 + 1e-6), "velocity {}", v);
+        prop_assert!(a <= l.acceleration * (1.0 + 1e-6), "acceleration {}", a);
+        prop_assert!(j <= l.jerk * (1.0 + 1e-6), "jerk {}", j);
+        prop_assert_eq!(&t.positions.last().unwrap()[..], &points.last().unwrap()[..]);
+    }
+}
