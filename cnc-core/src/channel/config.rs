@@ -178,6 +178,13 @@ pub struct InterpolatorConfig {
     /// run no faster than keeps it.
     #[serde(default = "default_chordal_tolerance")]
     pub chordal_tolerance: f64,
+    /// Continuous path: straight blocks decoded ahead of the one under way (1..=128).
+    #[serde(default = "default_lookahead")]
+    pub lookahead: u32,
+    /// Continuous path: the corner deviation (mm) until a program sets one with
+    /// `#CONTOUR MODE [DEV PATH_DEV=..]`.
+    #[serde(default = "default_path_dev")]
+    pub path_dev: f64,
 }
 
 impl Default for InterpolatorConfig {
@@ -185,12 +192,22 @@ impl Default for InterpolatorConfig {
         Self {
             dyn_cs_history_max: default_history(),
             chordal_tolerance: default_chordal_tolerance(),
+            lookahead: default_lookahead(),
+            path_dev: default_path_dev(),
         }
     }
 }
 
 fn default_chordal_tolerance() -> f64 {
     0.001
+}
+
+fn default_lookahead() -> u32 {
+    crate::channel::path::contour::DEFAULT_LOOKAHEAD as u32
+}
+
+fn default_path_dev() -> f64 {
+    crate::nc::decode::DEFAULT_PATH_DEV
 }
 
 fn default_history() -> u32 {
@@ -401,6 +418,22 @@ impl ChannelConfig {
                 "interpolator.dyn_cs_history_max",
                 f64::from(self.interpolator.dyn_cs_history_max),
                 "more entries than this controller keeps (at most 100000, 16 MB a channel)",
+            ));
+        }
+        let lookahead = self.interpolator.lookahead;
+        if lookahead == 0 || lookahead as usize > crate::channel::path::contour::MAX_LOOKAHEAD {
+            return Err(self.parameter(
+                "interpolator.lookahead",
+                f64::from(lookahead),
+                "must be 1 to 128 blocks",
+            ));
+        }
+        let dev = self.interpolator.path_dev;
+        if !(dev.is_finite() && dev >= 0.0) {
+            return Err(self.parameter(
+                "interpolator.path_dev",
+                dev,
+                "must be a finite distance of 0 or more (mm)",
             ));
         }
         if self.kin_trafo_display > 2 {

@@ -241,6 +241,7 @@ fn item(i: &Item) -> String {
             }
             Command::Msg { text } => format!("#MSG [\"{text}\"]"),
             Command::Time { seconds } => format!("#TIME {}", expr(seconds)),
+            Command::Contour { options } => format!("#CONTOUR MODE {}", list(options)),
             Command::Var => "#VAR".into(),
             Command::EndVar => "#ENDVAR".into(),
         },

@@ -15,6 +15,7 @@ mod channel_control;
 mod channel_display;
 mod channel_override;
 mod channels;
+mod continuous_path;
 #[path = "../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 mod dyn_cs_manual;

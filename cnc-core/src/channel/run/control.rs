@@ -209,7 +209,7 @@ impl Channel {
             ChannelCommand::FeedHold | ChannelCommand::Resume if !running => Err(E::NotRunning),
             ChannelCommand::FeedHold => {
                 self.control.held = true;
-                Ok(self.motion.path.is_none())
+                Ok(!self.path_active())
             }
             ChannelCommand::Resume => {
                 self.control.held = false;
@@ -310,9 +310,7 @@ impl Channel {
         let c = &mut self.control;
         (c.plc_stop, c.held, c.block_stop) = (true, false, false);
         let (dec, jerk) = (self.motion.limits.acceleration, self.motion.limits.jerk);
-        if let Some(path) = self.motion.path.as_mut() {
-            path.brake(&mut self.motion.path_generator);
-        }
+        self.brake_path();
         for (g, active) in &mut self.motion.independent {
             if *active && g.brake(dec, jerk).is_err() {
                 *active = false;
@@ -401,7 +399,10 @@ impl Channel {
     }
 
     fn path_at_rest(&self) -> bool {
-        self.motion.path.is_none() || self.motion.path_generator.state().velocity == 0.0
+        let contour_still = !self.motion.contour.active()
+            || self.motion.contour.path_state().velocity.abs() <= 1e-12;
+        contour_still
+            && (self.motion.path.is_none() || self.motion.path_generator.state().velocity == 0.0)
     }
 
     /// Whether the channel was stopped, reset or failed while it ran since the last call.

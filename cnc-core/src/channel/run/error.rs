@@ -4,6 +4,7 @@
 use super::CS_DEPTH;
 use crate::channel::dyn_cs::TrackError;
 use crate::channel::guard::LimitViolation;
+use crate::channel::path::contour::ContourError;
 use crate::channel::path::PathError;
 use crate::nc::ast::AxisName;
 use crate::nc::interp::ProgramFault;
@@ -43,6 +44,8 @@ pub enum ChannelFault {
     Program(ProgramFault),
     /// The path of a motion block has no profile.
     Path(PathError),
+    /// The continuous path cannot go on.
+    Contour(ContourError),
     /// `#SIGNAL SYN` found the synchronisation board full.
     SyncBoardFull,
     /// An independent axis's move has no profile.
@@ -84,7 +87,7 @@ impl ChannelFault {
     pub fn id(&self) -> ChannelErrorId {
         match self {
             ChannelFault::Program(_) => ChannelErrorId::Program,
-            ChannelFault::Path(_) => ChannelErrorId::Path,
+            ChannelFault::Path(_) | ChannelFault::Contour(_) => ChannelErrorId::Path,
             ChannelFault::SyncBoardFull => ChannelErrorId::Synchronisation,
             ChannelFault::IndependentNoProfile { .. } => ChannelErrorId::IndependentAxis,
             ChannelFault::TrackRefused(_)
@@ -109,6 +112,7 @@ impl fmt::Display for ChannelFault {
         match self {
             ChannelFault::Program(p) => write!(f, "{p}"),
             ChannelFault::Path(e) => write!(f, "{e}"),
+            ChannelFault::Contour(e) => write!(f, "{e}"),
             ChannelFault::SyncBoardFull => {
                 f.write_str("#SIGNAL SYN: too many synchronisation ids pending")
             }

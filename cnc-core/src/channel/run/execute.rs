@@ -53,6 +53,7 @@ impl Channel {
         sync: &mut SyncBoard,
     ) {
         match element {
+            Decoded::Motion(m) if self.start_contour(&m) => {}
             Decoded::Motion(m) => {
                 let arc = m.arc.map(|arc| ArcSpec {
                     arc,

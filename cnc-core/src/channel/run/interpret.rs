@@ -20,6 +20,12 @@ pub(super) struct ProgramRun {
     pub(super) wait_ids: SyncIds,
     /// NC blocks the interpreter handed on (each block once, loops counted per pass).
     pub(super) blocks_executed: u64,
+    /// Found while decoding ahead of a contour: the program's end, or an error with its
+    /// line; acted on once the contour has come to rest.
+    pub(super) end_deferred: bool,
+    pub(super) fault_deferred: Option<(u32, ChannelFault)>,
+    /// Line of the block decoded last (the line shown is the contour's while one runs).
+    pub(super) decoded_line: u32,
 }
 
 impl ProgramRun {
@@ -35,6 +41,9 @@ impl ProgramRun {
             wait: None,
             wait_ids: SyncIds::default(),
             blocks_executed: 0,
+            end_deferred: false,
+            fault_deferred: None,
+            decoded_line: 0,
         }
     }
 }
@@ -125,6 +134,11 @@ impl Channel {
         }
         self.run.pending.clear();
         self.run.pending_at = 0;
+        self.run.end_deferred = false;
+        self.run.fault_deferred = None;
+        self.run
+            .decoder
+            .set_path_dev(self.config.interpolator.path_dev);
         self.state = RunState::Running;
         self.run.wait = None;
         self.error = None;
@@ -172,9 +186,21 @@ impl Channel {
             if self.motion.path.is_some() || self.state != RunState::Running {
                 return;
             }
+            if !self.contour_may_look_ahead() {
+                return;
+            }
             // Feed hold and a single-block stop: waits end as they would, nothing new starts.
             if self.control.held || self.control.block_stop {
                 return;
+            }
+            if self.run.pending_at < self.run.pending.len() && self.motion.contour.active() {
+                // Look-ahead: a straight block joins the contour; anything else waits until
+                // the contour has come to rest.
+                if !self.join_pending() {
+                    self.motion.contour.close();
+                    return;
+                }
+                continue;
             }
             if self.run.pending_at < self.run.pending.len() {
                 let element = core::mem::replace(
@@ -201,6 +227,42 @@ impl Channel {
         }
     }
 
+    /// With a contour under way: whether the interpreter may decode and join more blocks
+    /// (its window is open and has room). When the contour has come to rest, what decoding
+    /// ahead found takes effect: the program's end, or its error.
+    fn contour_may_look_ahead(&mut self) -> bool {
+        if self.motion.contour.active() {
+            if let Some(line) = self.motion.contour.line() {
+                self.run.line = line;
+            }
+            return !self.motion.contour.closed() && self.motion.contour.has_room();
+        }
+        self.run.line = self.run.decoded_line;
+        if let Some((line, fault)) = self.run.fault_deferred.take() {
+            self.run.line = line;
+            self.fail(fault);
+            return false;
+        }
+        if core::mem::take(&mut self.run.end_deferred) {
+            self.program_end();
+            return false;
+        }
+        true
+    }
+
+    /// The next pending element joins the contour, when it is a straight block.
+    fn join_pending(&mut self) -> bool {
+        let Some(Decoded::Motion(m)) = self.run.pending.get(self.run.pending_at) else {
+            return false;
+        };
+        let m = m.clone();
+        if !self.join_contour(&m) {
+            return false;
+        }
+        self.run.pending_at += 1;
+        true
+    }
+
     /// Runs the interpreter one step (a block decoded into `pending`, or a `$` statement
     /// followed); `false` when the program ended or failed.
     pub(super) fn next_block_decoded(&mut self) -> bool {
@@ -217,6 +279,11 @@ impl Channel {
             &vars,
             &mut self.run.pending,
         ) {
+            Ok(Step::End) if self.motion.contour.active() => {
+                self.motion.contour.close();
+                self.run.end_deferred = true;
+                false
+            }
             Ok(Step::End) => {
                 self.program_end();
                 false
@@ -231,6 +298,7 @@ impl Channel {
                     .and_then(|u| u.tree.blocks.get(block as usize))
                 {
                     self.run.line = b.line;
+                    self.run.decoded_line = b.line;
                 }
                 true
             }
@@ -246,7 +314,15 @@ impl Channel {
                         self.run.line = b.line;
                     }
                 }
-                self.fail(ChannelFault::Program(e.fault));
+                let fault = ChannelFault::Program(e.fault);
+                if self.motion.contour.active() {
+                    // Decoded ahead: the contour runs to the end of what it holds first.
+                    self.run.fault_deferred = Some((self.run.line, fault));
+                    self.run.line = self.run.decoded_line;
+                    self.motion.contour.close();
+                } else {
+                    self.fail(fault);
+                }
                 false
             }
         }

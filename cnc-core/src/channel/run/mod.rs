@@ -48,6 +48,7 @@ use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::guard::JointGuard;
 use super::kin_config::ToolKinematics;
+use super::path::contour::{Contour, Segment};
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Wanted,
@@ -56,6 +57,7 @@ use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::nc::ast::AxisName;
+use crate::nc::decode::MotionBlock;
 use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
@@ -147,7 +149,12 @@ impl Channel {
             stopping: None,
             run: ProgramRun::new(&config.axes),
             values: ProgramValues::default(),
-            motion: Motion::new(config.limits, &set_points, cycle_s),
+            motion: Motion::new(
+                config.limits,
+                &set_points,
+                cycle_s,
+                config.interpolator.lookahead as usize,
+            ),
             pose: Pose {
                 order,
                 kinematics,
@@ -227,6 +234,9 @@ impl Channel {
             self.interpret(masters, sync);
         }
         self.advance();
+        if let Some(line) = self.motion.contour.line() {
+            self.run.line = line;
+        }
         self.follow_command();
         if let Some(reason) = self.stopping {
             if self.state == RunState::Running && !self.is_moving() {

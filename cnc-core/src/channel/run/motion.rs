@@ -25,12 +25,27 @@ pub(super) struct Motion {
     pub(super) path_override: PathOverride,
     /// Override values out of range the PLC wrote (each tick one is read, counted once).
     pub(super) override_refused: u64,
+    /// Continuous path: the look-ahead window of straight blocks and the motion along it.
+    pub(super) contour: Contour,
+    /// The last block handed to the contour: where it ends and how its end may be blended
+    /// (`None`: the contour ends there).
+    pub(super) contour_end: AxisValues,
+    pub(super) contour_blend: Option<f64>,
 }
 
 impl Motion {
     /// At rest at `start`, with `limits`, ticking every `cycle_s`.
-    pub(super) fn new(limits: AxisLimits, start: &AxisValues, cycle_s: f64) -> Self {
+    pub(super) fn new(
+        limits: AxisLimits,
+        start: &AxisValues,
+        cycle_s: f64,
+        lookahead: usize,
+    ) -> Self {
+        let per_axis = vec![limits; start.len()];
         Self {
+            contour: Contour::new(&per_axis, cycle_s, lookahead),
+            contour_end: *start,
+            contour_blend: None,
             limits,
             programmed: *start,
             velocity: AxisValues::zeros(start.len()),
@@ -73,9 +88,71 @@ impl Channel {
         self.motion.override_refused
     }
 
+    /// Whether a path block (or a contour of them) is under way.
+    pub(super) fn path_active(&self) -> bool {
+        self.motion.path.is_some() || self.motion.contour.active()
+    }
+
+    /// The path brakes along itself to a stop (controlled stop, PLC stop).
+    pub(super) fn brake_path(&mut self) {
+        if let Some(path) = self.motion.path.as_mut() {
+            path.brake(&mut self.motion.path_generator);
+        }
+        self.motion.contour.stop();
+    }
+
+    /// The path is dropped where it stands (the guard takes over, or the axes are at rest).
+    pub(super) fn drop_path(&mut self) {
+        self.motion.path = None;
+        self.motion.contour.clear();
+        self.motion.contour_blend = None;
+    }
+
+    /// Continuous path: a straight block `m` starts a contour (when it may be blended at its
+    /// end and nothing moves independently); `false` when it runs on its own.
+    pub(super) fn start_contour(&mut self, m: &MotionBlock) -> bool {
+        let free = !self.control.single_block
+            && m.blend.is_some()
+            && m.arc.is_none()
+            && !self.motion.independent.iter().any(|(_, a)| *a);
+        if !free {
+            return false;
+        }
+        self.motion.contour.clear();
+        self.motion.contour_end = self.motion.programmed;
+        self.motion.contour_blend = None;
+        self.join_contour(m)
+    }
+
+    /// A straight block joins the open contour (`false`: it cannot, and the contour ends
+    /// before it).
+    pub(super) fn join_contour(&mut self, m: &MotionBlock) -> bool {
+        let segment = Segment {
+            start: self.motion.contour_end,
+            end: m.target,
+            feed: if m.motion == MotionMode::Rapid {
+                f64::INFINITY
+            } else {
+                m.feed / 60.0
+            },
+            rapid: m.motion == MotionMode::Rapid,
+            line: m.line,
+            blend: self.motion.contour_blend,
+        };
+        if m.arc.is_some() || self.motion.contour.push(&segment).is_err() {
+            return false;
+        }
+        self.motion.contour_end = m.target;
+        self.motion.contour_blend = m.blend;
+        if m.blend.is_none() {
+            self.motion.contour.close();
+        }
+        true
+    }
+
     /// Whether a motion or wait is in progress.
     pub fn is_moving(&self) -> bool {
-        self.motion.path.is_some()
+        self.path_active()
             || self.motion.independent.iter().any(|(_, active)| *active)
             || self.safety.guard.braking()
     }
@@ -90,9 +167,7 @@ impl Channel {
             return;
         }
         let (dec, jerk) = (self.motion.limits.acceleration, self.motion.limits.jerk);
-        if let Some(path) = self.motion.path.as_mut() {
-            path.brake(&mut self.motion.path_generator);
-        }
+        self.brake_path();
         for (g, active) in &mut self.motion.independent {
             if *active && g.brake(dec, jerk).is_err() {
                 *active = false;
@@ -206,6 +281,17 @@ impl Channel {
         let m = &mut self.motion;
         m.velocity.fill(0.0);
         m.acceleration.fill(0.0);
+        if m.contour.active() {
+            m.contour.set_factors(feed, rapid);
+            let stepped = m
+                .contour
+                .step(&mut m.programmed, &mut m.velocity, &mut m.acceleration);
+            if let Err(e) = stepped {
+                self.fail(ChannelFault::Contour(e));
+                return;
+            }
+        }
+        let m = &mut self.motion;
         if let Some(path) = m.path.as_mut() {
             path.set_override(feed, rapid, &mut m.path_generator);
             let ended = path.step(&mut m.path_generator, &mut m.programmed);

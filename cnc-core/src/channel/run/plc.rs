@@ -96,13 +96,18 @@ impl Channel {
             RunState::Error => ProgramState::Error,
         };
         progress.tick = self.tick;
-        progress.path_feed_um_s = match &self.motion.path {
-            // mm/s to um/s; a velocity is finite and far inside the DINT range.
-            Some(_) => (self.motion.path_generator.state().velocity.abs() * 1000.0)
-                .round()
-                .min(f64::from(i32::MAX)) as i32,
-            None => 0,
+        let speed = if self.motion.contour.active() {
+            Some(self.motion.contour.path_state().velocity)
+        } else {
+            self.motion
+                .path
+                .as_ref()
+                .map(|_| self.motion.path_generator.state().velocity)
         };
+        // mm/s to um/s; a velocity is finite and far inside the DINT range.
+        progress.path_feed_um_s = speed.map_or(0, |v| {
+            (v.abs() * 1000.0).round().min(f64::from(i32::MAX)) as i32
+        });
         progress.error_id = self.error.as_ref().map_or(ChannelErrorId::None, |e| e.id);
         out.feed_override_applied = if self.motion.path_override.feed_hold || self.control.held {
             0

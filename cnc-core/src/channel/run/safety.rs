@@ -46,7 +46,7 @@ impl Channel {
         self.control.aborted |= self.state == RunState::Running;
         self.control.error_unshown = true;
         self.state = RunState::Error;
-        self.motion.path = None;
+        self.drop_path();
         self.run.wait = None;
         self.safety.latch_pending = true;
         for (_, active) in &mut self.motion.independent {
@@ -141,7 +141,7 @@ impl Channel {
     /// tracker is INACTIVE, so no compensation lies between them): the next program, or the
     /// next switch-on, starts from there without a step.
     pub(super) fn resync_to_set_points(&mut self) {
-        self.motion.path = None;
+        self.drop_path();
         for (_, active) in &mut self.motion.independent {
             *active = false;
         }
@@ -191,7 +191,7 @@ impl Channel {
             self.pose.tracker.state() == DynCsState::Error && !self.safety.guard.latched();
         if latch_due
             || self.safety.guard.braking()
-            || self.motion.path.is_some()
+            || self.path_active()
             || self.motion.independent.iter().any(|g| g.1)
         {
             return Err(ResetError::Moving);

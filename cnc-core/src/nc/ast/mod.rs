@@ -119,6 +119,12 @@ pub enum Command {
         /// Seconds.
         seconds: Expr,
     },
+    /// `#CONTOUR MODE [DEV PATH_DEV=..]`: how corners of continuous path (G61, G261) are
+    /// rounded.
+    Contour {
+        /// The entries in the brackets.
+        options: Vec<Entry>,
+    },
     /// `#VAR`: the declarations of `V.P.`/`V.L.` variables follow, up to `#ENDVAR`.
     Var,
     /// `#ENDVAR`.

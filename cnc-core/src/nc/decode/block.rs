@@ -42,6 +42,9 @@ struct BlockInput {
     dwell: Option<(f64, Span)>,
     /// F in this block.
     feed: Option<f64>,
+    /// G61: this block's end is blended; G60/G09: it stops exactly.
+    contour_here: bool,
+    exact_here: bool,
 }
 
 impl DecoderState {
@@ -154,9 +157,14 @@ impl DecoderState {
                 input.motion_code = Some((code, span));
             }
             4 => input.dwell_code = true,
-            // Blocks always end at exact stop here (no blending): G60 and G09 ask for
-            // nothing more, G359/G360 switch what is always on.
-            9 | 60 | 359 | 360 => {}
+            // Exact stop at this block's end (G60, G09) or at every one (G360 .. G359);
+            // continuous path at this block's end (G61) or at every one (G261 .. G260).
+            9 | 60 => input.exact_here = true,
+            359 => self.exact_stop = false,
+            360 => self.exact_stop = true,
+            61 => input.contour_here = true,
+            260 => self.contour = false,
+            261 => self.contour = true,
             17 => self.plane = crate::nc::arc::Plane::Xy,
             18 => self.plane = crate::nc::arc::Plane::Zx,
             19 => self.plane = crate::nc::arc::Plane::Yz,
@@ -318,9 +326,18 @@ impl DecoderState {
                 motion: self.motion,
                 feed: self.feed,
                 target: self.position,
+                blend: self.blend(input, is_arc),
                 arc,
             }));
         }
+    }
+
+    /// Whether this block's end may be blended, and within what: continuous path (G61 here or
+    /// G261 on), no exact stop (G60/G09 here or G360 on), a straight block.
+    fn blend(&self, input: &BlockInput, is_arc: bool) -> Option<f64> {
+        let continuous = input.contour_here || self.contour;
+        let exact = input.exact_here || self.exact_stop;
+        (continuous && !exact && !is_arc).then_some(self.path_dev)
     }
 
     /// `G04 t`, `G04 X t` (the first main axis names the time): alone in its block.

@@ -49,6 +49,10 @@ impl DecoderState {
             }),
             Command::Time { seconds } => time(line, seconds, span, ctx),
             Command::Var | Command::EndVar => None,
+            Command::Contour { options } => {
+                self.contour(options, ctx);
+                None
+            }
             Command::Preset { axes } => {
                 self.preset(axes, span, ctx);
                 None
@@ -188,6 +192,30 @@ fn wait_syn(line: u32, options: &[Entry], span: Span, ctx: &mut Ctx<'_>) -> Opti
 }
 
 /// `#TIME t` at `span`: a dwell of `t` seconds.
+impl DecoderState {
+    /// `#CONTOUR MODE [DEV PATH_DEV=..]`: the corner deviation of continuous path from here on.
+    fn contour(&mut self, options: &[Entry], ctx: &mut Ctx<'_>) {
+        for e in options
+            .iter()
+            .filter(|e| e.key.as_deref() == Some("PATH_DEV"))
+        {
+            let Some(value) = entry_number(e, ctx) else {
+                continue;
+            };
+            if !(value.is_finite() && value >= 0.0) {
+                ctx.error(e.span, DecodeError::PathDeviation { value });
+                continue;
+            }
+            let mm = if self.inch {
+                value * MM_PER_INCH
+            } else {
+                value
+            };
+            self.path_dev = mm;
+        }
+    }
+}
+
 fn time(line: u32, seconds: &Expr, span: Span, ctx: &mut Ctx<'_>) -> Option<Decoded> {
     let seconds = ctx.eval(seconds, span)?;
     if seconds < 0.0 {

@@ -84,6 +84,11 @@ pub enum DecodeError {
         /// The time found (s).
         seconds: f64,
     },
+    /// A `PATH_DEV` that is negative or not finite.
+    PathDeviation {
+        /// The value found.
+        value: f64,
+    },
     /// A negative `#TIME`.
     TimeNegative {
         /// The time found (s).
@@ -307,6 +312,10 @@ impl fmt::Display for DecodeError {
             DecodeError::DwellNegative { seconds } => {
                 write!(f, "dwell time must not be negative, found {seconds}")
             }
+            DecodeError::PathDeviation { value } => write!(
+                f,
+                "#CONTOUR MODE: PATH_DEV must be a finite distance of 0 or more (mm), found {value}"
+            ),
             DecodeError::TimeNegative { seconds } => {
                 write!(f, "#TIME must not be negative, found {seconds}")
             }
@@ -323,7 +332,7 @@ impl fmt::Display for DecodeError {
             }
             DecodeError::UnknownGCode { code } => write!(
                 f,
-                "unknown G code G{code} (known: G0-G4, G9, G17-G19, G53-G60, G70, G71, G90-G92, G161, G162, G359, G360)"
+                "unknown G code G{code} (known: G0-G4, G9, G17-G19, G53-G61, G70, G71, G90-G92, G161, G162, G260, G261, G359, G360)"
             ),
             DecodeError::CsValues { found } => {
                 write!(f, "#CS takes at most 6 values (X Y Z A B C), found {found}")

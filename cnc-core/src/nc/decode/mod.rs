@@ -69,6 +69,9 @@ impl MotionMode {
 /// Millimetres per inch (G70).
 pub const MM_PER_INCH: f64 = 25.4;
 
+/// Default corner deviation of continuous path (mm), until `#CONTOUR MODE` sets one.
+pub const DEFAULT_PATH_DEV: f64 = 0.05;
+
 /// Default tolerance for an arc's end point against its circle (mm).
 pub const DEFAULT_ARC_TOLERANCE: f64 = 0.001;
 
@@ -129,6 +132,12 @@ pub struct DecoderState {
     trafo: bool,
     /// The end point's tolerance against an arc's circle (mm).
     arc_tolerance: f64,
+    /// G261: continuous path at every block's end (G260 ends it).
+    contour: bool,
+    /// G360: exact stop at every block's end (G359 ends it); wins over G261.
+    exact_stop: bool,
+    /// `#CONTOUR MODE [PATH_DEV=..]`: the corner deviation (mm).
+    path_dev: f64,
     /// Whether the position is where the program put it (false for a block checked on its own:
     /// an arc's start is not known then).
     start_known: bool,
@@ -162,6 +171,9 @@ impl DecoderState {
             tool_length: 0.0,
             trafo: false,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
+            contour: false,
+            exact_stop: false,
+            path_dev: DEFAULT_PATH_DEV,
             start_known: true,
             words: [0.0; MAX_CHANNEL_AXES],
             tail: Vec::with_capacity(4),
@@ -250,6 +262,11 @@ impl DecoderState {
         self.tools = setup.tools.clone();
         self.tools_unknown = setup.tools_unknown;
         self.arc_tolerance = setup.arc_tolerance;
+    }
+
+    /// The corner deviation of continuous path until the program sets one (mm).
+    pub fn set_path_dev(&mut self, mm: f64) {
+        self.path_dev = mm;
     }
 
     /// For blocks checked out of their program's order: a feed is taken as programmed, and

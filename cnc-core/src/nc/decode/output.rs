@@ -20,6 +20,9 @@ pub struct MotionBlock {
     pub target: AxisValues,
     /// For G2/G3: the circle (the block starts where the one before ended).
     pub arc: Option<crate::nc::arc::ArcMove>,
+    /// Continuous path: the corner with the next block may be rounded by at most this
+    /// distance (mm). `None`: the block ends at exact stop.
+    pub blend: Option<f64>,
 }
 
 /// Where a tracking channel takes its dynamic coordinate system from.

@@ -73,6 +73,7 @@ impl Parser<'_> {
             "PRESET" => self.preset(),
             "MSG" => self.msg(span),
             "TIME" => self.time(),
+            "CONTOUR" => self.contour(),
             "VAR" => Some(Command::Var),
             "ENDVAR" => Some(Command::EndVar),
             "COMMENT" => {
@@ -86,7 +87,7 @@ impl Parser<'_> {
             other => {
                 self.error(
                     span,
-                    format!("unknown command \"#{other}\" (known: #TRACK CS, #CHANNEL INTERFACE, #CS, #TRAFO, #KIN ID, #SIGNAL SYN, #WAIT SYN, #WAIT INDP, #FLUSH, #PSET, #PRESET, #MSG, #TIME, #VAR, #ENDVAR, #COMMENT BEGIN/END)"),
+                    format!("unknown command \"#{other}\" (known: #TRACK CS, #CHANNEL INTERFACE, #CS, #TRAFO, #KIN ID, #SIGNAL SYN, #WAIT SYN, #WAIT INDP, #FLUSH, #PSET, #PRESET, #MSG, #TIME, #CONTOUR MODE, #VAR, #ENDVAR, #COMMENT BEGIN/END)"),
                 );
                 self.recover();
                 None
@@ -355,6 +356,28 @@ impl Parser<'_> {
             return None;
         };
         Some(Command::Time { seconds })
+    }
+
+    /// `#CONTOUR MODE [DEV PATH_DEV=..]`, after `CONTOUR`.
+    fn contour(&mut self) -> Option<Command> {
+        if !self.expect_word("MODE", "#CONTOUR MODE") {
+            self.recover();
+            return None;
+        }
+        let options = self.required_list("#CONTOUR MODE")?;
+        for e in &options {
+            let ok = matches!(
+                (e.key.as_deref(), e.glued.is_some() || e.value.is_some()),
+                (Some("DEV"), false) | (Some("PATH_DEV"), true)
+            );
+            if !ok {
+                self.error(
+                    e.span,
+                    "#CONTOUR MODE: expected DEV and PATH_DEV=<mm> (corner deviation; the other contouring modes are not supported)",
+                );
+            }
+        }
+        Some(Command::Contour { options })
     }
 
     fn required_list(&mut self, context: &str) -> Option<Vec<Entry>> {

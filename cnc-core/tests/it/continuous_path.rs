@@ -1,0 +1,243 @@
+//! Continuous path on a channel (G261/G61 with `#CONTOUR MODE [DEV PATH_DEV=..]`): every tick
+//! within the corner deviation of the programmed path and within the channel's velocity,
+//! acceleration and jerk; exact stop where the program asks for one or an M function waits;
+//! feed hold on the path; bad tolerances and look-ahead depths refused.
+
+use tests::channel_rig as support;
+
+use cnc_core::channel::{ChannelConfig, Controller, LoadedProgram, RunState};
+use cnc_core::setpoint::AxisValues;
+use hli::views::{PathOverride, PlcView};
+use hli::ImageMemory;
+use support::*;
+
+/// A zigzag of `n` blocks of `len` mm turning by ±`turn` degrees, as points and as G1 blocks.
+fn zigzag(n: usize, len: f64, turn: f64) -> (Vec<[f64; 2]>, String) {
+    let mut points = vec![[0.0, 0.0]];
+    let mut text = String::new();
+    for k in 0..n {
+        let phi = if k % 2 == 0 {
+            0.0f64
+        } else {
+            turn.to_radians()
+        };
+        let [x, y] = points[k];
+        let (px, py) = (
+            format!("{:.6}", x + len * phi.cos()),
+            format!("{:.6}", y + len * phi.sin()),
+        );
+        text.push_str(&format!("X{px} Y{py}\n"));
+        points.push([px.parse().unwrap(), py.parse().unwrap()]);
+    }
+    (points, text)
+}
+
+/// Positions of X and Y each tick until the channel finished (or `each` decides).
+fn run(
+    program: &str,
+    config: ChannelConfig,
+    mut each: impl FnMut(&ImageMemory, u32),
+) -> (Vec<AxisValues>, Controller) {
+    let mut ctl = controller(vec![(config, program)]);
+    let memory = image(1);
+    let mut trace = vec![*ctl.channels()[0].programmed()];
+    run_until(
+        &mut ctl,
+        &memory,
+        400_000,
+        |c, tick| {
+            trace.push(*c.channels()[0].programmed());
+            each(&memory, tick);
+        },
+        |c| c.channels()[0].state() == RunState::Finished,
+    );
+    (trace, ctl)
+}
+
+fn distance_to_path(p: &[f64], points: &[[f64; 2]], near: &mut usize) -> f64 {
+    let seg = |k: usize| {
+        let (a, b) = (points[k], points[k + 1]);
+        let ab = [b[0] - a[0], b[1] - a[1]];
+        let ap = [p[0] - a[0], p[1] - a[1]];
+        let t = ((ap[0] * ab[0] + ap[1] * ab[1]) / (ab[0] * ab[0] + ab[1] * ab[1])).clamp(0.0, 1.0);
+        ((ap[0] - t * ab[0]).powi(2) + (ap[1] - t * ab[1]).powi(2)).sqrt()
+    };
+    let lo = near.saturating_sub(2);
+    let hi = (*near + 4).min(points.len() - 1);
+    let (k, d) = (lo..hi)
+        .map(|k| (k, seg(k)))
+        .fold((*near, f64::INFINITY), |m, x| if x.1 < m.1 { x } else { m });
+    *near = k;
+    d + p[2].abs()
+}
+
+/// The largest distance from the path, and the largest |v|, |a|, |j| of any axis.
+fn measure(trace: &[AxisValues], points: &[[f64; 2]]) -> (f64, [f64; 3]) {
+    let mut near = 0;
+    let worst = trace
+        .iter()
+        .map(|p| distance_to_path(p, points, &mut near))
+        .fold(0.0, f64::max);
+    let mut rates = [0.0f64; 3];
+    for w in trace.windows(4) {
+        let axes = w[0].iter().zip(&*w[1]).zip(&*w[2]).zip(&*w[3]).take(3);
+        for (((&p0, &p1), &p2), &p3) in axes {
+            rates[0] = rates[0].max(((p3 - p2) / CYCLE).abs());
+            rates[1] = rates[1].max(((p3 - 2.0 * p2 + p1) / CYCLE.powi(2)).abs());
+            rates[2] = rates[2].max(((p3 - 3.0 * p2 + 3.0 * p1 - p0) / CYCLE.powi(3)).abs());
+        }
+    }
+    (worst, rates)
+}
+
+fn assert_within(config: &ChannelConfig, rates: [f64; 3]) {
+    let l = config.limits;
+    let slack = 1.0 + 1e-6;
+    assert!(rates[0] <= l.velocity * slack, "velocity {}", rates[0]);
+    assert!(
+        rates[1] <= l.acceleration * slack,
+        "acceleration {}",
+        rates[1]
+    );
+    assert!(rates[2] <= l.jerk * slack, "jerk {}", rates[2]);
+}
+
+/// How many of the path's inner corners a tick stood on exactly.
+fn corners_visited(trace: &[AxisValues], points: &[[f64; 2]]) -> usize {
+    points[1..points.len() - 1]
+        .iter()
+        .filter(|c| trace.iter().any(|p| p[0] == c[0] && p[1] == c[1]))
+        .count()
+}
+
+#[test]
+fn a_zigzag_runs_through_its_corners_within_the_deviation_and_the_limits() {
+    let (points, blocks) = zigzag(150, 1.0, 10.0);
+    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261 G1 F6000\n{blocks}G260\nM30\n");
+    let exact = format!("G1 F6000\n{blocks}M30\n");
+    let config = cartesian("c");
+    let (cont, _) = run(&program, config.clone(), |_, _| {});
+    let (stop, _) = run(&exact, config.clone(), |_, _| {});
+    let (dev, rates) = measure(&cont, &points);
+    assert!(dev <= 0.02 + 1e-9, "deviation {dev}");
+    assert!(dev > 0.005, "the corners are rounded: {dev}");
+    assert_within(&config, rates);
+    assert_within(&config, measure(&stop, &points).1);
+    assert_eq!(corners_visited(&cont, &points), 0, "every corner rounded");
+    assert_eq!(
+        corners_visited(&stop, &points),
+        149,
+        "exact stop at every corner"
+    );
+    assert!(
+        3 * cont.len() < stop.len(),
+        "continuous {} ticks, exact stop {}",
+        cont.len(),
+        stop.len()
+    );
+    let end = cont.last().unwrap();
+    assert_eq!([end[0], end[1]], points[150]);
+}
+
+/// G60 (this block) and a dwell (as an M function, `#WAIT SYN` or any element that is no
+/// straight block) stop the path exactly at their block's end; G61 blends
+/// one corner without G261.
+#[test]
+fn exact_stop_where_the_program_asks_and_where_the_program_waits() {
+    let program = "#CONTOUR MODE [DEV PATH_DEV=0.1]\nG1 F3000\nG261 X10\nX20 Y5\nG60 X30 Y0\nX40 Y5\nX50 Y0\nG04 0.05\nX60 Y5\nG260 G61 X70 Y0\nX80 Y5\nM30\n";
+    let points = [
+        [0.0, 0.0],
+        [10.0, 0.0],
+        [20.0, 5.0],
+        [30.0, 0.0],
+        [40.0, 5.0],
+        [50.0, 0.0],
+        [60.0, 5.0],
+        [70.0, 0.0],
+        [80.0, 5.0],
+    ];
+    let config = cartesian("c");
+    let (trace, _) = run(program, config.clone(), |_, _| {});
+    let (dev, rates) = measure(&trace, &points);
+    assert!(dev <= 0.1 + 1e-9);
+    assert_within(&config, rates);
+    let stood_on = |c: [f64; 2]| trace.iter().any(|p| p[0] == c[0] && p[1] == c[1]);
+    // Exactly at the G60 block's end and the dwell's block end; the corners of G261 and of
+    // G61 are rounded.
+    for (k, exact) in [
+        (1, false),
+        (2, false),
+        (3, true),
+        (4, false),
+        (5, true),
+        (6, false),
+        (7, false),
+    ] {
+        assert_eq!(stood_on(points[k]), exact, "corner {k}");
+    }
+}
+
+/// Feed hold from the PLC's override unit brakes on the path within the limits; releasing it
+/// lets the contour go on to its end.
+#[test]
+fn feed_hold_brakes_on_the_contour_and_goes_on() {
+    let (points, blocks) = zigzag(60, 2.0, 30.0);
+    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.05]\nG261 G1 F9000\n{blocks}M30\n");
+    let config = cartesian("c");
+    let hold = |memory: &ImageMemory, on: bool| {
+        PlcView::new(memory)
+            .set_path_override(
+                0,
+                PathOverride {
+                    feed_permille: 1000,
+                    rapid_permille: 1000,
+                    feed_hold: on,
+                },
+            )
+            .unwrap()
+    };
+    let (trace, _) = run(&program, config.clone(), |memory, tick| match tick {
+        300 => hold(memory, true),
+        900 => hold(memory, false),
+        _ => {}
+    });
+    let (dev, rates) = measure(&trace, &points);
+    assert!(dev <= 0.05 + 1e-9);
+    assert_within(&config, rates);
+    let still = trace.windows(2).filter(|w| w[0] == w[1]).count();
+    assert!(still > 400, "stood still under feed hold: {still}");
+    assert_eq!(
+        [trace.last().unwrap()[0], trace.last().unwrap()[1]],
+        points[60]
+    );
+}
+
+#[test]
+fn bad_tolerances_and_depths_are_refused() {
+    let config = cartesian("c");
+    for (src, col) in [
+        ("G1 F100\n#CONTOUR MODE [DEV PATH_DEV=-0.1]\nX1\n", "2:"),
+        ("G1 F100\n#CONTOUR MODE [DEV PATH_DEV=1/0]\nX1\n", "2:"),
+        ("G1 F100\n#CONTOUR MODE [DIST PATH_DEV=1]\nX1\n", "2:"),
+    ] {
+        let e = LoadedProgram::load_with(
+            "bad.nc",
+            src,
+            &config.axes,
+            &config.nc.setup(),
+            None,
+            &cnc_core::nc::interp::SearchPath::default(),
+        )
+        .err()
+        .unwrap_or_else(|| panic!("{src} accepted"))
+        .to_string();
+        assert!(e.contains(&format!("bad.nc:{col}")), "{e}");
+    }
+    for (depth, dev) in [(0, 0.1), (129, 0.1), (32, f64::NAN), (32, -1.0)] {
+        let mut c = cartesian("c");
+        c.interpolator.lookahead = depth;
+        c.interpolator.path_dev = dev;
+        let e = cnc_core::channel::Channel::new(0, c, CYCLE).err().unwrap();
+        assert!(e.to_string().contains("interpolator."), "{e}");
+    }
+}
