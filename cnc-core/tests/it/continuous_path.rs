@@ -241,3 +241,45 @@ fn bad_tolerances_and_depths_are_refused() {
         assert!(e.to_string().contains("interpolator."), "{e}");
     }
 }
+
+/// Under `#TRAFO` the contour slows down where the robot's joints would exceed their own
+/// limits: every tick's joint steps stay within the joints' velocity and acceleration.
+#[test]
+fn under_trafo_the_joints_stay_within_their_limits() {
+    let program = "#TRAFO [45]\nG1 X680 Y40 Z560 F3000\n#CONTOUR MODE [DEV PATH_DEV=1]\nG261 F30000\nX640 Y0 Z540\nX600 Y-40 Z520\nX640 Y-80 Z540\nX680 Y40 Z560\nG260 X680 Y40 Z550\n#TRAFO OFF\nM30\n";
+    let joint = cnc_core::channel::path::AxisLimits {
+        velocity: 20.0,
+        acceleration: 200.0,
+        jerk: 4000.0,
+    };
+    let mut config = robot("r");
+    config.axis_limits = vec![joint; 6];
+    let mut ctl = controller(vec![(config, program)]);
+    let memory = image(1);
+    let mut joints = Vec::new();
+    let mut contour_ticks = 0;
+    run_until(
+        &mut ctl,
+        &memory,
+        200_000,
+        |c, _| {
+            let ch = &c.channels()[0];
+            let on_contour = ch.line() >= 5 && ch.line() <= 9;
+            joints.push((*ch.set_points(), on_contour));
+            contour_ticks += usize::from(on_contour);
+        },
+        |c| c.channels()[0].state() == RunState::Finished,
+    );
+    assert!(contour_ticks > 100, "the contour ran: {contour_ticks}");
+    let (mut v, mut a) = (0.0f64, 0.0f64);
+    // The first block runs at exact stop in Cartesian limits only: the contour is measured.
+    for w in joints.windows(3).filter(|w| w.iter().all(|(_, on)| *on)) {
+        let w: Vec<_> = w.iter().map(|(q, _)| q).collect();
+        for j in 0..6 {
+            v = v.max(((w[2][j] - w[1][j]) / CYCLE).abs());
+            a = a.max(((w[2][j] - 2.0 * w[1][j] + w[0][j]) / CYCLE.powi(2)).abs());
+        }
+    }
+    assert!(v <= joint.velocity * 1.001, "joint velocity {v}");
+    assert!(a <= joint.acceleration * 1.05, "joint acceleration {a}");
+}

@@ -176,6 +176,7 @@ impl Channel {
         masters: &[Option<MasterSample>; MAX_CHANNELS],
         sync: &mut SyncBoard,
     ) {
+        let mut joined = 0;
         for _ in 0..BLOCKS_PER_TICK {
             if let Some(wait) = self.run.wait {
                 if !self.wait_done(wait, sync) {
@@ -196,6 +197,10 @@ impl Channel {
             if self.run.pending_at < self.run.pending.len() && self.motion.contour.active() {
                 // Look-ahead: a straight block joins the contour; anything else waits until
                 // the contour has come to rest.
+                if self.pose.trafo && joined >= joint_caps::TRAFO_BLOCKS_PER_TICK {
+                    return;
+                }
+                joined += 1;
                 if !self.join_pending() {
                     self.motion.contour.close();
                     return;

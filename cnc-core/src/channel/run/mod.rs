@@ -26,6 +26,7 @@ mod control;
 mod error;
 mod execute;
 mod interpret;
+mod joint_caps;
 mod motion;
 mod plc;
 mod pose;

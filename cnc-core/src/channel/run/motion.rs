@@ -139,7 +139,17 @@ impl Channel {
             line: m.line,
             blend: self.motion.contour_blend,
         };
-        if m.arc.is_some() || self.motion.contour.push(&segment).is_err() {
+        if m.arc.is_some() {
+            return false;
+        }
+        let pushed = match joint_caps::joint_caps(&self.pose, &self.config) {
+            Some(mut caps) => {
+                let contour = &mut self.motion.contour;
+                contour.push(&segment, &mut |p| caps.apply(p))
+            }
+            None => self.motion.contour.push(&segment, &mut |_| {}),
+        };
+        if pushed.is_err() {
             return false;
         }
         self.motion.contour_end = m.target;

@@ -183,8 +183,14 @@ impl Contour {
 
     /// Adds a straight block. Its corner with the block before is rounded when both move X,
     /// Y or Z, the turn is at most [`MAX_TURN_DEG`], the block before is not under way yet and
-    /// `segment.blend` allows it; else the path rests between them.
-    pub fn push(&mut self, segment: &Segment) -> Result<(), PushError> {
+    /// `segment.blend` allows it; else the path rests between them. `limit` may lower each new
+    /// piece's caps and dynamics before the look-ahead plans with them (the joints' limits
+    /// under a transformation).
+    pub fn push(
+        &mut self,
+        segment: &Segment,
+        limit: &mut dyn FnMut(&mut Piece),
+    ) -> Result<(), PushError> {
         if !self.has_room() {
             return Err(PushError::Full);
         }
@@ -201,13 +207,14 @@ impl Contour {
             self.closed = false;
             self.last_end = None;
         }
-        let rounded = self.round_corner(segment, &dir, length);
+        let rounded = self.round_corner(segment, &dir, length, limit);
         if !rounded {
             if let Some(last) = self.pieces.back_mut() {
                 last.rest_after = true;
             }
             let mut p = Piece::straight(segment.start, dir, length, length, &self.limits);
             tag(&mut p, segment);
+            limit(&mut p);
             self.pieces.push_back(p);
         }
         self.blocks += 1;
@@ -218,7 +225,13 @@ impl Contour {
 
     /// Rounds the corner into `segment` when it may be: shortens the last straight piece,
     /// adds the curve and the block's straight piece. `false` (nothing changed) when not.
-    fn round_corner(&mut self, segment: &Segment, u2: &AxisValues, length: f64) -> bool {
+    fn round_corner(
+        &mut self,
+        segment: &Segment,
+        u2: &AxisValues,
+        length: f64,
+        limit: &mut dyn FnMut(&mut Piece),
+    ) -> bool {
         let (Some(tolerance), Some((end, u1))) = (segment.blend, self.last_end) else {
             return false;
         };
@@ -269,6 +282,8 @@ impl Contour {
         }
         let mut straight = Piece::straight(origin, *u2, length - d, length, &self.limits);
         tag(&mut straight, segment);
+        limit(&mut curve);
+        limit(&mut straight);
         self.pieces.push_back(curve);
         self.pieces.push_back(straight);
         self.sweep_back(self.pieces.len() - 1);

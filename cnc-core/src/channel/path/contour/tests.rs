@@ -66,7 +66,7 @@ fn run(
                 line: next as u32,
                 blend: tolerance,
             };
-            c.push(&seg).expect("a straight block");
+            c.push(&seg, &mut |_| {}).expect("a straight block");
             next += 1;
         }
         if next == points.len() {
@@ -198,7 +198,7 @@ fn a_stop_comes_to_rest_on_the_path_and_empties_the_window() {
                 line: next as u32,
                 blend: Some(0.02),
             };
-            c.push(&seg).unwrap();
+            c.push(&seg, &mut |_| {}).unwrap();
             next += 1;
         }
         if tick == 200 {
