@@ -275,9 +275,9 @@ fn under_trafo_the_joints_stay_within_their_limits() {
     // The first block runs at exact stop in Cartesian limits only: the contour is measured.
     for w in joints.windows(3).filter(|w| w.iter().all(|(_, on)| *on)) {
         let w: Vec<_> = w.iter().map(|(q, _)| q).collect();
-        for j in 0..6 {
-            v = v.max(((w[2][j] - w[1][j]) / CYCLE).abs());
-            a = a.max(((w[2][j] - 2.0 * w[1][j] + w[0][j]) / CYCLE.powi(2)).abs());
+        for ((q0, q1), q2) in w[0].iter().zip(w[1].iter()).zip(w[2].iter()).take(6) {
+            v = v.max(((q2 - q1) / CYCLE).abs());
+            a = a.max(((q2 - 2.0 * q1 + q0) / CYCLE.powi(2)).abs());
         }
     }
     assert!(v <= joint.velocity * 1.001, "joint velocity {v}");
