@@ -23,7 +23,9 @@
 //! (the in-process twin of `cnc demo`), its machine tick timed the same way.
 //! Run: `cargo bench -p cnc-app --bench channels`.
 
-use cnc_app::scenario::fleet::{plc_setup, running, running_on, tracking_robots};
+use cnc_app::scenario::fleet::{
+    plc_setup, running, running_on, running_with, tracking_robots, Moves,
+};
 use cnc_app::scenario::{InProcess, Scenario};
 use cnc_core::channel::{Channel, Controller};
 use cnc_core::setpoint::AxisValues;
@@ -72,6 +74,12 @@ fn interleaved(contenders: &mut [Box<dyn FnMut() + '_>]) -> Vec<f64> {
         }
     }
     samples.into_iter().map(median).collect()
+}
+
+/// The fleet going round a triangle, at exact stop or in continuous path.
+fn tracking_moves(n: usize, moves: Moves) -> Box<dyn FnMut()> {
+    let mut run = running_with(n, None, moves, WARM_UP).expect("fleet running");
+    Box::new(move || run.machine.tick(&run.memory))
 }
 
 fn tracking(n: usize) -> Box<dyn FnMut()> {
@@ -231,6 +239,7 @@ fn main() {
         "TARGET | <= 5000 ns per tracking channel-tick, 1 to 12 channels | worst {worst:.0} ns | {}",
         if worst <= 5000.0 { "met" } else { "MISSED" }
     );
+    contour_cost();
     println!();
     println!("example scenario (part of the demo machine), hot in-process | ticks | machine tick p50 ns | p99 ns");
     for name in ["example3-moving-workpiece", "example4-turntable-plc"] {
@@ -245,6 +254,35 @@ fn main() {
     println!("(per-tick times of one whole run each, after {REPEATS} warm-up runs; the demo's");
     println!(" twin runs its PLC program in this process between the ticks, untimed: compare");
     println!(" its p50 with the `machine` p50 of `cnc demo`'s report)");
+}
+
+/// The fleet going round a triangle in continuous path (look-ahead, corner curves, joint
+/// caps under #TRAFO) against the same triangle at exact stop, interleaved: what continuous
+/// path adds per channel-tick.
+fn contour_cost() {
+    println!();
+    println!("channels | exact stop ns/channel-tick | continuous path ns/channel-tick | ratio");
+    let mut worst: f64 = 0.0;
+    for n in [1usize, 4, 12] {
+        let mut contenders = [
+            tracking_moves(n, Moves::Triangle),
+            tracking_moves(n, Moves::TriangleContour),
+        ];
+        let [e, c] = interleaved(&mut contenders)[..] else {
+            unreachable!("two contenders")
+        };
+        worst = worst.max(c / e);
+        println!(
+            "{n:>8} | {:>26.0} | {:>31.0} | {:>5.2}",
+            e / n as f64,
+            c / n as f64,
+            c / e
+        );
+    }
+    println!(
+        "TARGET | continuous path per channel-tick <= 1.2x exact stop's (channels bench fleet) | worst {worst:.2}x | {}",
+        if worst <= 1.2 { "met" } else { "MISSED" }
+    );
 }
 
 /// The demo's whole machine with its PLC program (`demo-machine`) in this process, every

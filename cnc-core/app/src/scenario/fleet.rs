@@ -37,6 +37,40 @@ pub fn tracking_robots(n: usize) -> Result<Scenario, ScenarioError> {
 /// The scenario of `n` robots whose axes have `drive` (a TOML drive model, e.g.
 /// `{ model = "pt2", frequency_hz = 80.0, damping = 0.9 }`).
 pub fn tracking_robots_on(n: usize, drive: Option<&str>) -> Result<Scenario, ScenarioError> {
+    tracking_robots_with(n, drive, Moves::BackAndForth)
+}
+
+/// The robots' loops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Moves {
+    /// Back and forth between two points (every block ends at rest: the turn is a reversal).
+    BackAndForth,
+    /// Round a triangle, each block ending at exact stop.
+    Triangle,
+    /// Round the same triangle in continuous path (`G261`, corner deviation 1 mm).
+    TriangleContour,
+}
+
+/// The loop of `text` replaced by a triangle through its two points and a third.
+fn triangle(text: &str, contour: bool) -> String {
+    let (head, rest) = text.split_once("$WHILE 1\n").expect("a loop");
+    let (first, rest) = rest.split_once('\n').expect("a first move");
+    let (second, _) = rest.split_once('\n').expect("a second move");
+    let third = "G1 X650 Y-20 Z560";
+    let mode = if contour {
+        "#CONTOUR MODE [DEV PATH_DEV=1]\nG261\n"
+    } else {
+        ""
+    };
+    format!("{head}{mode}$WHILE 1\n{first}\n{second}\n{third}\n$ENDWHILE\n")
+}
+
+/// [`tracking_robots_on`] with the robots' loops of `moves`.
+pub fn tracking_robots_with(
+    n: usize,
+    drive: Option<&str>,
+    moves: Moves,
+) -> Result<Scenario, ScenarioError> {
     let mut toml = String::from("cycle_ms = 1.0\n");
     for i in 0..n {
         toml.push_str(&format!(
@@ -53,7 +87,12 @@ pub fn tracking_robots_on(n: usize, drive: Option<&str>) -> Result<Scenario, Sce
     }
     Scenario::parse("fleet", &toml, |file| {
         let text = if file == "lead.nc" { LEAD } else { FOLLOWER };
-        Ok((PathBuf::from(file), text.to_string()))
+        let text = match moves {
+            Moves::BackAndForth => text.to_string(),
+            Moves::Triangle => triangle(text, false),
+            Moves::TriangleContour => triangle(text, true),
+        };
+        Ok((PathBuf::from(file), text))
     })
 }
 
@@ -79,7 +118,17 @@ pub fn running(n: usize, warm_up: usize) -> Result<InProcess, String> {
 
 /// [`running`] with the robots' axes on `drive` (see [`tracking_robots_on`]).
 pub fn running_on(n: usize, drive: Option<&str>, warm_up: usize) -> Result<InProcess, String> {
-    let s = tracking_robots_on(n, drive).map_err(|e| e.to_string())?;
+    running_with(n, drive, Moves::BackAndForth, warm_up)
+}
+
+/// [`running_on`] with the robots' loops of `moves`.
+pub fn running_with(
+    n: usize,
+    drive: Option<&str>,
+    moves: Moves,
+    warm_up: usize,
+) -> Result<InProcess, String> {
+    let s = tracking_robots_with(n, drive, moves).map_err(|e| e.to_string())?;
     let mut run = InProcess::new(&s, 0).map_err(|e| e.to_string())?;
     plc_setup(&PlcView::new(&run.memory));
     for _ in 0..warm_up {

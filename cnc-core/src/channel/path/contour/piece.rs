@@ -293,21 +293,23 @@ impl Bounds {
         }
         let acc_room = (l.acceleration - self.g1 * acc).max(0.0);
         cap = cap.min((acc_room / self.g2).sqrt());
-        // 3 g2 a v + g3 v³ ≤ J - g1 j: increasing in v, solved by bisection.
+        // 3 g2 a v + g3 v³ ≤ J - g1 j: increasing and convex in v, so Newton from an upper
+        // bound comes down onto the root; then one step below it if rounding left it above.
         let jerk_room = (l.jerk - self.g1 * jerk).max(0.0);
-        let needs = |v: f64| 3.0 * self.g2 * acc * v + self.g3 * v * v * v;
-        let mut hi = (jerk_room / self.g3).cbrt().min(cap);
-        if needs(hi) > jerk_room {
-            let mut lo = 0.0;
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if needs(mid) <= jerk_room {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
+        let (lin, cub) = (3.0 * self.g2 * acc, self.g3);
+        let needs = |v: f64| lin * v + cub * v * v * v;
+        let mut hi = (jerk_room / cub).cbrt().min(cap);
+        if lin > 0.0 {
+            hi = hi.min(jerk_room / lin);
+        }
+        for _ in 0..40 {
+            let f = needs(hi) - jerk_room;
+            if f <= 0.0 {
+                break;
             }
-            hi = lo;
+            let next = hi - f / (lin + 3.0 * cub * hi * hi);
+            // At the root within rounding: one step below it.
+            hi = if next < hi { next } else { hi * (1.0 - 1e-12) };
         }
         cap.min(hi)
     }

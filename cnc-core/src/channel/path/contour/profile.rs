@@ -35,15 +35,56 @@ pub fn change_distance(va: f64, vb: f64, d: Dynamics) -> f64 {
 }
 
 /// The highest velocity reachable from `v0` within `length` (and the highest velocity from
-/// which `v0` is reachable by braking), capped at `cap`.
+/// which `v0` is reachable by braking), capped at `cap`. In closed form: the look-ahead's
+/// backward sweep calls this for every piece it passes.
 pub fn max_reach(v0: f64, length: f64, cap: f64, d: Dynamics) -> f64 {
     if cap <= v0 {
         return cap.max(0.0);
     }
+    if length <= 0.0 {
+        return v0;
+    }
     if change_distance(v0, cap, d) <= length {
         return cap;
     }
-    bisect(v0, cap, |v| change_distance(v0, v, d) <= length)
+    let (a, j) = (d.acceleration, d.jerk);
+    // Reaching the acceleration limit: (2 v0 + dv)(dv/a + a/j) = 2 length, a quadratic
+    // A dv² + B dv + C = 0 (C < 0), its root in the form without cancellation.
+    let (qa, qb, qc) = (
+        1.0 / a,
+        2.0 * v0 / a + a / j,
+        2.0 * v0 * a / j - 2.0 * length,
+    );
+    let dv = -2.0 * qc / (qb + (qb * qb - 4.0 * qa * qc).max(0.0).sqrt());
+    let dv = if dv * j >= a * a {
+        dv
+    } else {
+        // Below it: (2 v0 + s²) s = length sqrt(j) with s = sqrt(dv), the cubic
+        // f(s) = s³ + 2 v0 s - length sqrt(j), increasing and convex for s ≥ 0: Newton from
+        // an upper bound comes down onto the root.
+        let (p, q) = (2.0 * v0, length * j.sqrt());
+        let mut s = q.cbrt().min(if p > 0.0 { q / p } else { f64::INFINITY });
+        for _ in 0..8 {
+            s -= (s * s * s + p * s - q) / (3.0 * s * s + p);
+        }
+        s * s
+    };
+    // Never above what fits (the root may round up).
+    let mut v = (v0 + dv).min(cap);
+    for _ in 0..16 {
+        let covered = change_distance(v0, v, d);
+        if covered <= length {
+            return v;
+        }
+        let shrunk = v0 + (v - v0) * (length / covered) * (1.0 - 1e-12);
+        // Rounding may give the same value back: one step below it then.
+        v = if shrunk < v {
+            shrunk
+        } else {
+            f64::from_bits(v.to_bits() - 1)
+        };
+    }
+    v0
 }
 
 /// The lowest velocity reachable from `v0` by braking within `length`.
@@ -173,7 +214,8 @@ impl PieceProfile {
     /// override was lowered) brakes to it when that fits, else keeps its entry velocity.
     pub fn plan(length: f64, v0: f64, v1: f64, cap: f64, d: Dynamics) -> Option<Self> {
         let fits = |vp: f64| {
-            change_distance(v0, vp, d) + change_distance(vp, v1, d) <= length * (1.0 + 1e-12)
+            change_distance(v0, vp, d) + change_distance(vp, v1, d)
+                <= length * (1.0 + 1e-12) + 1e-15
         };
         let low = v0.max(v1);
         if !fits(low) {
@@ -302,6 +344,24 @@ mod tests {
                 assert!(s.velocity >= -1e-9);
                 last = s.position;
             }
+        }
+    }
+
+    #[test]
+    fn the_closed_form_reach_covers_its_length() {
+        for (v0, len) in [
+            (0.0, 1.0),
+            (10.0, 0.3),
+            (0.0, 100.0),
+            (300.0, 2.0),
+            (5.0, 1e-6),
+        ] {
+            let v = max_reach(v0, len, 1e9, D);
+            let covered = change_distance(v0, v, D);
+            assert!(
+                (covered - len).abs() <= 1e-9 * len.max(1.0),
+                "{v0} {len}: {covered}"
+            );
         }
     }
 

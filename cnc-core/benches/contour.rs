@@ -1,0 +1,255 @@
+//! Continuous path against exact stop, and against a lower bound, on the same programs and
+//! limits in the same run.
+//!
+//! 1. **Polyline**: 1,000 blocks of 1 mm turning by ±10 degrees (a zigzag), F6000, the
+//!    channel's default limits (1000 mm/s, 5000 mm/s², 50000 mm/s³), `PATH_DEV=0.05`. Cycle
+//!    time with exact stop (every block ends at rest) and with continuous path (G261); the
+//!    largest distance of any tick's set-point from the programmed polyline; and the lower
+//!    bound: the time-optimal jerk-limited move over the straight distance from start to end
+//!    at the feed, with the limits of the best direction (√3 × an axis's acceleration and
+//!    jerk). The bound ignores the corners, so it is loose: no path within 0.05 mm of the
+//!    zigzag is straight. Target: continuous ≥ 3× faster than exact stop.
+//! 2. **Robot contour** of application example 4 (the square over the turntable, without the
+//!    table's motion) on the IRB 2400 under `#TRAFO`, the same way.
+//! 3. **Tick cost**: the channel's tick on the polyline, continuous against exact stop, ns
+//!    per tick over the whole run (median over interleaved repeats): what the look-ahead, the
+//!    corner curves and the backward bounds add to a channel's tick. Target: ≤ 1.2×.
+//!
+//! Cycle times are counted in ticks of the 1 ms cycle (the trace is deterministic); only
+//! the tick cost is timed. Run: `cargo bench -p cnc-core --bench contour`.
+
+use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
+use cnc_core::nc::interp::SearchPath;
+use cnc_core::setpoint::AxisValues;
+use hli::segment::heap_image;
+use hli::views::CncView;
+use std::time::Instant;
+
+const CYCLE: f64 = 0.001;
+const REPEATS: usize = 7;
+
+/// `CNC_BENCH_SMOKE=1` (CI): a short polyline and one repeat, to show the bench runs to its
+/// end; its figures mean nothing then.
+fn smoke() -> bool {
+    std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// The zigzag's points and its blocks.
+fn zigzag(n: usize) -> (Vec<[f64; 3]>, String) {
+    let mut points = vec![[0.0; 3]];
+    let mut text = String::new();
+    for k in 0..n {
+        let phi = if k % 2 == 0 {
+            0.0f64
+        } else {
+            10f64.to_radians()
+        };
+        let [x, y, _] = points[k];
+        let (px, py) = (
+            format!("{:.6}", x + phi.cos()),
+            format!("{:.6}", y + phi.sin()),
+        );
+        text.push_str(&format!("X{px} Y{py}\n"));
+        points.push([px.parse().unwrap(), py.parse().unwrap(), 0.0]);
+    }
+    (points, text)
+}
+
+fn controller(config: &ChannelConfig, src: &str) -> Controller {
+    let program = LoadedProgram::load_with(
+        "bench.nc",
+        src,
+        &config.axes,
+        &config.nc.setup(),
+        None,
+        &SearchPath::default(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let mut channel = Channel::new(0, config.clone(), CYCLE).unwrap();
+    channel.start(program).unwrap();
+    Controller::new(vec![channel]).unwrap()
+}
+
+/// Runs `src` to its end: the programmed positions of every tick.
+fn run(config: &ChannelConfig, src: &str) -> Vec<AxisValues> {
+    let mut ctl = controller(config, src);
+    let memory = heap_image(1, 8);
+    let view = CncView::new(&memory);
+    let mut trace = Vec::new();
+    for _ in 0..2_000_000 {
+        ctl.tick(&view);
+        let c = &ctl.channels()[0];
+        assert_ne!(c.state(), RunState::Error, "{:?}", c.error());
+        trace.push(*c.programmed());
+        if c.state() == RunState::Finished {
+            return trace;
+        }
+    }
+    panic!("did not finish");
+}
+
+/// ns per tick of a whole run of `src`.
+fn tick_cost(config: &ChannelConfig, src: &str) -> f64 {
+    let mut ctl = controller(config, src);
+    let memory = heap_image(1, 8);
+    let view = CncView::new(&memory);
+    let t0 = Instant::now();
+    let mut ticks = 0;
+    while ctl.channels()[0].state() != RunState::Finished {
+        ctl.tick(&view);
+        ticks += 1;
+    }
+    t0.elapsed().as_nanos() as f64 / ticks as f64
+}
+
+fn distance_to_polyline(p: &[f64], points: &[[f64; 3]], near: &mut usize) -> f64 {
+    let seg = |k: usize| {
+        let (a, b) = (points[k], points[k + 1]);
+        let ab: Vec<f64> = (0..3).map(|i| b[i] - a[i]).collect();
+        let ap: Vec<f64> = (0..3).map(|i| p[i] - a[i]).collect();
+        let len2: f64 = ab.iter().map(|v| v * v).sum();
+        let t = (ap.iter().zip(&ab).map(|(x, y)| x * y).sum::<f64>() / len2).clamp(0.0, 1.0);
+        (0..3)
+            .map(|i| (ap[i] - t * ab[i]).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
+    let lo = near.saturating_sub(2);
+    let hi = (*near + 4).min(points.len() - 1);
+    let (k, d) = (lo..hi)
+        .map(|k| (k, seg(k)))
+        .fold((*near, f64::INFINITY), |m, x| if x.1 < m.1 { x } else { m });
+    *near = k;
+    d
+}
+
+/// The time-optimal rest-to-rest jerk-limited move over `length` within `v`, `a`, `j`.
+fn lower_bound(length: f64, v: f64, a: f64, j: f64) -> f64 {
+    // Velocity change 0 -> w takes w/a + a/j (or 2 sqrt(w/j)) and covers w T / 2.
+    let change = |w: f64| {
+        if w * j >= a * a {
+            w / a + a / j
+        } else {
+            2.0 * (w / j).sqrt()
+        }
+    };
+    let fits = |w: f64| w * change(w) <= length;
+    let peak = if fits(v) {
+        v
+    } else {
+        let (mut lo, mut hi) = (0.0, v);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    2.0 * change(peak) + (length - peak * change(peak)) / peak
+}
+
+fn report(what: &str, exact: usize, cont: usize, bound: f64) {
+    let (te, tc) = (exact as f64 * CYCLE, cont as f64 * CYCLE);
+    println!("{what}");
+    println!("  exact stop:      {te:9.3} s");
+    println!("  continuous path: {tc:9.3} s   ({:.2}x faster)", te / tc);
+    println!(
+        "  lower bound:     {bound:9.3} s   (continuous / bound {:.2})",
+        tc / bound
+    );
+}
+
+fn polyline() {
+    let n = if smoke() { 40 } else { 1000 };
+    let (points, blocks) = zigzag(n);
+    let config = ChannelConfig::new("c", &["X", "Y", "Z", "A", "B", "C"]);
+    let exact = run(&config, &format!("G1 F6000\n{blocks}M30\n"));
+    let cont = run(
+        &config,
+        &format!("#CONTOUR MODE [DEV PATH_DEV=0.05]\nG261 G1 F6000\n{blocks}M30\n"),
+    );
+    let mut near = 0;
+    let deviation = cont
+        .iter()
+        .map(|p| distance_to_polyline(p, &points, &mut near))
+        .fold(0.0, f64::max);
+    let l = config.limits;
+    let straight = points[n][0].hypot(points[n][1]);
+    let root3 = 3f64.sqrt();
+    let bound = lower_bound(straight, 100.0, root3 * l.acceleration, root3 * l.jerk);
+    report(
+        &format!("polyline, {n} blocks of 1 mm, +-10 degrees, F6000, PATH_DEV 0.05 mm"),
+        exact.len(),
+        cont.len(),
+        bound,
+    );
+    println!("  largest deviation on any tick: {deviation:.5} mm (tolerance 0.05 mm)");
+    let ratio = exact.len() as f64 / cont.len() as f64;
+    println!(
+        "TARGET | continuous path >= 3x faster than exact stop (polyline) | {ratio:.2}x (lower bound ratio {:.2}) | {}",
+        cont.len() as f64 * CYCLE / bound,
+        if ratio >= 3.0 { "met" } else { "MISSED" }
+    );
+    println!(
+        "TARGET | corner deviation <= tolerance on every tick | {deviation:.5} mm of 0.05 mm | {}",
+        if deviation <= 0.05 + 1e-9 {
+            "met"
+        } else {
+            "MISSED"
+        }
+    );
+    let mut costs = (Vec::new(), Vec::new());
+    let exact_src = format!("G1 F6000\n{blocks}M30\n");
+    let cont_src = format!("#CONTOUR MODE [DEV PATH_DEV=0.05]\nG261 G1 F6000\n{blocks}M30\n");
+    for _ in 0..if smoke() { 1 } else { REPEATS } {
+        costs.0.push(tick_cost(&config, &exact_src));
+        costs.1.push(tick_cost(&config, &cont_src));
+    }
+    let (e, c) = (median(costs.0), median(costs.1));
+    println!("channel tick on the polyline (median of {REPEATS} interleaved runs)");
+    println!("  exact stop:      {e:8.0} ns/tick");
+    println!("  continuous path: {c:8.0} ns/tick   ({:.2}x)", c / e);
+    println!(
+        "TARGET | look-ahead tick cost <= 1.2x exact stop's | {:.2}x ({c:.0} ns vs {e:.0} ns) | {}",
+        c / e,
+        if c <= 1.2 * e { "met" } else { "MISSED" }
+    );
+}
+
+fn robot() {
+    let square = "X-60\nX60\nX0\nY-60\nY60\nY0\n";
+    let head = "#TRAFO [45]\nG1 X1305.92 Y0 Z130 F6000\nG92 X1305.92\nZ90\nX0 Y0\nZ80\n";
+    let mut config = ChannelConfig::new("robot", &["X", "Y", "Z", "A", "B", "C"]);
+    config.kinematics.id = 45;
+    config.kinematics.preset = Some("irb2400".into());
+    config.start = vec![0.0, 40.0, 0.0, 0.0, 50.0, 0.0];
+    let exact = run(&config, &format!("{head}{square}Z90\nM30\n"));
+    let cont = run(
+        &config,
+        &format!("{head}#CONTOUR MODE [DEV PATH_DEV=1]\nG261\n{square}G260 Z90\nM30\n"),
+    );
+    // The square alone: 6 blocks, 420 mm of path.
+    let l = config.limits;
+    let root3 = 3f64.sqrt();
+    let bound = lower_bound(420.0, 100.0, root3 * l.acceleration, root3 * l.jerk);
+    report(
+        "robot contour of example 4 (IRB 2400, #TRAFO), whole program, F6000, PATH_DEV 1 mm",
+        exact.len(),
+        cont.len(),
+        bound,
+    );
+    println!("  (the bound covers the square's 420 mm only: a floor for the whole program)");
+}
+
+fn main() {
+    polyline();
+    robot();
+}
