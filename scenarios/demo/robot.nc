@@ -11,6 +11,9 @@ N230 G92 X1305.92
 N240 Z90
 ; the robot goes over the table's axis so nothing jumps; the table (X1) turns by itself
 N250 X0 Y0 X1[INDP_ASYN POS=-90 G01 F500 G90]
+; continuous path (the demo's addition to the manual's program): corners rounded within 1 mm
+#CONTOUR MODE [DEV PATH_DEV=1]
+G261
 N260 Z80
 N270 X-60
 N280 X60
@@ -19,6 +22,7 @@ N300 Y-60
 N310 Y60
 Y0
 N320 Z90
+G260
 N480 #WAIT INDP ALL
 ; back over the table centre before switching off, so nothing jumps
 N490 G01 X0 Y0

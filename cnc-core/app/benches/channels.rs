@@ -246,6 +246,7 @@ fn main() {
         let (ticks, p50, p99) = demo_hot(name);
         println!("{name:>29} | {ticks:>5} | {p50:>19} | {p99:>6}");
     }
+    demo_gain();
     let (ticks, p50, p99) = demo_twin();
     println!(
         "{:>29} | {ticks:>5} | {p50:>19} | {p99:>6}",
@@ -283,6 +284,44 @@ fn contour_cost() {
         "TARGET | continuous path per channel-tick <= 1.2x exact stop's (channels bench fleet) | worst {worst:.2}x | {}",
         if worst <= 1.2 { "met" } else { "MISSED" }
     );
+}
+
+/// The tick at which each robot's program ended in the demo's twin (with its PLC program).
+fn robots_end(scenario: &cnc_app::scenario::Scenario) -> Vec<(String, Option<usize>)> {
+    let ticks = scenario.ticks.unwrap_or(14_500) as usize;
+    let mut run = InProcess::new(scenario, 0).expect("in-process demo");
+    let n = run.machine.controller().channels().len();
+    let mut ended = vec![None; n];
+    for tick in 0..ticks {
+        run.machine.tick(&run.memory);
+        run.answer_calls();
+        run.run_program();
+        run.machine.serve_channels();
+        for (i, c) in run.machine.controller().channels().iter().enumerate() {
+            if ended[i].is_none() && c.state() == cnc_core::channel::RunState::Finished {
+                ended[i] = Some(tick + 1);
+            }
+        }
+    }
+    let names = run.machine.controller().channels().iter();
+    names.map(|c| c.config().name.clone()).zip(ended).collect()
+}
+
+/// The demo's robot programs in continuous path against the manual's own (exact stop), the
+/// same machine and PLC program: when each program ends.
+fn demo_gain() {
+    let cont = robots_end(&cnc_app::demo::scenario().expect("the demo"));
+    let exact = robots_end(&cnc_app::demo::scenario_exact_stop().expect("the demo"));
+    println!("demo robot program | exact stop ends at tick | continuous path ends at tick | saved");
+    for ((name, c), (_, e)) in cont.iter().zip(&exact) {
+        let show = |t: &Option<usize>| t.map_or("-".to_string(), |t| t.to_string());
+        let saved = match (c, e) {
+            (Some(c), Some(e)) => format!("{} ms", *e as i64 - *c as i64),
+            _ => "-".into(),
+        };
+        println!("{name:>18} | {:>23} | {:>28} | {saved}", show(e), show(c));
+    }
+    println!();
 }
 
 /// The demo's whole machine with its PLC program (`demo-machine`) in this process, every

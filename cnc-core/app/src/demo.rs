@@ -64,6 +64,38 @@ pub fn scenario() -> Result<Scenario, ScenarioError> {
     scenario_with("")
 }
 
+/// The embedded machine with its robots' programs as the manual has them: without the lines
+/// that switch continuous path on (`#CONTOUR MODE`, `G261`, `G260` and their comment). The
+/// benchmarks compare the two.
+pub fn scenario_exact_stop() -> Result<Scenario, ScenarioError> {
+    let (main, text) = FILES[0];
+    Scenario::parse(&format!("{NAME}/{main}"), text, |relative| {
+        FILES
+            .iter()
+            .find(|(file, _)| *file == relative)
+            .map(|(file, text)| {
+                let kept: String = text
+                    .lines()
+                    .filter(|l| !continuous_path_line(l))
+                    .map(|l| format!("{l}\n"))
+                    .collect();
+                (PathBuf::from(format!("{NAME}/{file}")), kept)
+            })
+            .ok_or_else(|| ScenarioError::Read {
+                file: relative.to_string(),
+                message: "not embedded in the demo".into(),
+            })
+    })
+}
+
+/// A line the demo adds to the manual's programs for continuous path.
+pub fn continuous_path_line(line: &str) -> bool {
+    line.starts_with("; continuous path (the demo's addition")
+        || line.starts_with("#CONTOUR MODE")
+        || line == "G261"
+        || line == "G260"
+}
+
 /// The embedded machine with `extra` appended to its scenario file (more axes, a FIFO group:
 /// the tests that load the whole machine further).
 pub fn scenario_with(extra: &str) -> Result<Scenario, ScenarioError> {

@@ -75,8 +75,9 @@ fn the_whole_machine_runs_through_in_lockstep() {
     }
     let line = channel_line(&stdout, "turntable");
     assert!(
-        // 20 blocks: the manual's program on a robot that reaches its table (no work frame).
-        line.starts_with("turntable finished blocks 20 tracking state changes 4 M handshakes 2"),
+        // 23 blocks: the manual's program on a robot that reaches its table (no work frame),
+        // with continuous path switched on and off around its square (3 blocks more).
+        line.starts_with("turntable finished blocks 23 tracking state changes 4 M handshakes 2"),
         "{line}"
     );
     assert!(stdout.contains("cmd=ON PLC=1"), "{stdout}");

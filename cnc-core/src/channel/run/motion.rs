@@ -31,6 +31,9 @@ pub(super) struct Motion {
     /// (`None`: the contour ends there).
     pub(super) contour_end: AxisValues,
     pub(super) contour_blend: Option<f64>,
+    /// Axes moving independently when the contour started: the contour leaves them alone
+    /// (bit per axis).
+    pub(super) contour_excluded: u32,
 }
 
 impl Motion {
@@ -46,6 +49,7 @@ impl Motion {
             contour: Contour::new(&per_axis, cycle_s, lookahead),
             contour_end: *start,
             contour_blend: None,
+            contour_excluded: 0,
             limits,
             programmed: *start,
             velocity: AxisValues::zeros(start.len()),
@@ -109,27 +113,36 @@ impl Channel {
     }
 
     /// Continuous path: a straight block `m` starts a contour (when it may be blended at its
-    /// end and nothing moves independently); `false` when it runs on its own.
+    /// end); `false` when it runs on its own. Axes moving independently keep their own moves.
     pub(super) fn start_contour(&mut self, m: &MotionBlock) -> bool {
-        let free = !self.control.single_block
-            && m.blend.is_some()
-            && m.arc.is_none()
-            && !self.motion.independent.iter().any(|(_, a)| *a);
-        if !free {
+        if self.control.single_block || m.blend.is_none() || m.arc.is_some() {
             return false;
         }
         self.motion.contour.clear();
         self.motion.contour_end = self.motion.programmed;
         self.motion.contour_blend = None;
+        self.motion.contour_excluded = self
+            .motion
+            .independent
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, active))| *active)
+            .fold(0, |bits, (i, _)| bits | 1 << i);
         self.join_contour(m)
     }
 
     /// A straight block joins the open contour (`false`: it cannot, and the contour ends
     /// before it).
     pub(super) fn join_contour(&mut self, m: &MotionBlock) -> bool {
+        let mut end = m.target;
+        for (i, e) in end.iter_mut().enumerate() {
+            if self.motion.contour_excluded & (1 << i) != 0 {
+                *e = self.motion.contour_end[i];
+            }
+        }
         let segment = Segment {
             start: self.motion.contour_end,
-            end: m.target,
+            end,
             feed: if m.motion == MotionMode::Rapid {
                 f64::INFINITY
             } else {
@@ -152,7 +165,7 @@ impl Channel {
         if pushed.is_err() {
             return false;
         }
-        self.motion.contour_end = m.target;
+        self.motion.contour_end = end;
         self.motion.contour_blend = m.blend;
         if m.blend.is_none() {
             self.motion.contour.close();
@@ -293,9 +306,14 @@ impl Channel {
         m.acceleration.fill(0.0);
         if m.contour.active() {
             m.contour.set_factors(feed, rapid);
+            let kept = m.programmed;
             let stepped = m
                 .contour
                 .step(&mut m.programmed, &mut m.velocity, &mut m.acceleration);
+            // Axes moving independently are their own generators' (set below).
+            for i in (0..kept.len()).filter(|i| m.contour_excluded & (1 << i) != 0) {
+                m.programmed[i] = kept[i];
+            }
             if let Err(e) = stepped {
                 self.fail(ChannelFault::Contour(e));
                 return;
