@@ -40,6 +40,8 @@ BENCHES = [
     ("cnc-core", "fifo", "FIFO group tick, rows across processes",
      "standing axes, a transport-only handler"),
     ("cnc-core", "saw", "flying-saw planning per command", "rsruckig"),
+    ("cnc-core", "contour", "continuous path against exact stop",
+     "exact stop, a lower bound, the exact-stop channel tick"),
     ("cnc-app", "scaling", "machine tick against machine size", "its own smallest size"),
     ("cnc-app", "tick_latency", "tick start lateness, whole processes", "cyclictest"),
 ]
