@@ -11,9 +11,11 @@
 //!    zigzag is straight. Target: continuous ≥ 3× faster than exact stop.
 //! 2. **Robot contour** of application example 4 (the square over the turntable, without the
 //!    table's motion) on the IRB 2400 under `#TRAFO`, the same way.
-//! 3. **Tick cost**: the channel's tick on the polyline, continuous against exact stop, ns
-//!    per tick over the whole run (median over interleaved repeats): what the look-ahead, the
-//!    corner curves and the backward bounds add to a channel's tick. Target: ≤ 1.2×.
+//! 3. **Tick cost** on the polyline, continuous against exact stop: ns per tick over the whole
+//!    run (median over interleaved repeats), and CPU for the whole program. A continuous tick
+//!    runs through 3× the blocks, so per tick it costs more and per program less; the target
+//!    on the look-ahead's tick cost (≤ 1.2× per channel-tick on the same moves) is measured
+//!    by the channels bench, whose robots go round a triangle in both modes.
 //!
 //! Cycle times are counted in ticks of the 1 ms cycle (the trace is deterministic); only
 //! the tick cost is timed. Run: `cargo bench -p cnc-core --bench contour`.
@@ -214,14 +216,24 @@ fn polyline() {
         costs.1.push(tick_cost(&config, &cont_src));
     }
     let (e, c) = (median(costs.0), median(costs.1));
+    let (te, tc) = (exact.len() as f64, cont.len() as f64);
     println!("channel tick on the polyline (median of {REPEATS} interleaved runs)");
-    println!("  exact stop:      {e:8.0} ns/tick");
-    println!("  continuous path: {c:8.0} ns/tick   ({:.2}x)", c / e);
     println!(
-        "TARGET | look-ahead tick cost <= 1.2x exact stop's | {:.2}x ({c:.0} ns vs {e:.0} ns) | {}",
-        c / e,
-        if c <= 1.2 * e { "met" } else { "MISSED" }
+        "  exact stop:      {e:8.0} ns/tick, {:8.0} us for the program",
+        e * te / 1000.0
     );
+    println!(
+        "  continuous path: {c:8.0} ns/tick, {:8.0} us for the program",
+        c * tc / 1000.0
+    );
+    println!(
+        "  per tick {:.2}x: a continuous tick goes through {:.1}x the blocks an exact-stop tick \
+         does (decoding, corner curves, the backward sweep); for the whole program {:.2}x",
+        c / e,
+        te / tc,
+        c * tc / (e * te)
+    );
+    println!("  (the target on the look-ahead's tick cost is the channels bench's: same moves, both modes)");
 }
 
 fn robot() {

@@ -283,3 +283,42 @@ fn under_trafo_the_joints_stay_within_their_limits() {
     assert!(v <= joint.velocity * 1.001, "joint velocity {v}");
     assert!(a <= joint.acceleration * 1.05, "joint acceleration {a}");
 }
+
+/// A block that fails while decoded ahead (here on a value only the run knows: the tracked
+/// frame's X, 1 mm, which the check takes as 0): the contour runs to the end of the blocks
+/// before it and comes to rest there, then the channel fails with the block's line.
+#[test]
+fn an_error_found_ahead_takes_effect_at_rest() {
+    let program = "#TRACK CS ON [ID=0 SET_ZERO WAIT]\nG261 G1 F6000\nX10\nX20 Y2\nX30 Y0\nX[10/[V.G.TRACK_CS.X - 1]] Y9\nM30\n";
+    let config = cartesian("c");
+    let mut ctl = controller(vec![(config.clone(), program)]);
+    let memory = image(1);
+    enable_plc_master(&memory, [10_000, 0, 0]);
+    let view = hli::views::CncView::new(&memory);
+    let mut trace = vec![*ctl.channels()[0].programmed()];
+    for _ in 0..20_000 {
+        ctl.tick(&view);
+        let c = &ctl.channels()[0];
+        trace.push(*c.programmed());
+        if c.state() == RunState::Error {
+            break;
+        }
+    }
+    let c = &ctl.channels()[0];
+    assert_eq!(c.state(), RunState::Error, "{:?}", c.error());
+    assert_eq!(c.error().unwrap().line, 6, "{:?}", c.error());
+    let end = trace.last().unwrap();
+    assert_eq!(
+        [end[0], end[1]],
+        [30.0, 0.0],
+        "at rest at the last good block"
+    );
+    let points = [[0.0, 0.0], [10.0, 0.0], [20.0, 2.0], [30.0, 0.0]];
+    let (dev, rates) = measure(&trace, &points);
+    assert!(dev <= 0.05 + 1e-9, "deviation {dev}");
+    assert_within(&config, rates);
+    assert!(
+        corners_visited(&trace, &points) == 0,
+        "its corners were rounded"
+    );
+}
