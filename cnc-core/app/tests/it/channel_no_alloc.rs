@@ -2,7 +2,7 @@
 //! kinematic transformation both ways, dynamic CS, HLI outputs, axis images) allocates nothing
 //! once the programs run.
 
-use cnc_app::scenario::fleet::running;
+use cnc_app::scenario::fleet::{running, running_with, Moves};
 
 use crate::counting_alloc;
 use counting_alloc::allocations;
@@ -24,6 +24,23 @@ fn twelve_tracking_robots_tick_without_allocating() {
         .channels()
         .iter()
         .all(|c| c.is_moving()));
+}
+
+/// The same fleet going round a triangle in continuous path: decoding ahead, corner curves,
+/// the backward sweep, the joint caps under #TRAFO and every piece's profile allocate nothing.
+#[test]
+fn twelve_robots_in_continuous_path_tick_without_allocating() {
+    let mut run = running_with(12, None, Moves::TriangleContour, 3000).unwrap();
+    let before = allocations();
+    for _ in 0..5000 {
+        run.machine.tick(&run.memory);
+    }
+    let made = allocations() - before;
+    assert_eq!(made, 0, "{made} allocations in 5000 ticks of 12 channels");
+    let channels = run.machine.controller().channels();
+    assert!(channels.iter().all(|c| c.is_moving()));
+    // The loops ran through several corners in the measured ticks.
+    assert!(channels.iter().all(|c| c.blocks_executed() > 6));
 }
 
 /// A robot that switches tracking on and off, with every option, in an endless loop: the
