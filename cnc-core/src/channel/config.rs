@@ -96,6 +96,10 @@ pub struct NcConfig {
     /// How far an arc's end point may lie off its circle (mm; default 0.001).
     #[serde(default)]
     pub arc_tolerance: Option<f64>,
+    /// Continuous path: the corner deviation (mm; default 0.05) until a program sets one with
+    /// `#CONTOUR MODE [DEV PATH_DEV=..]`.
+    #[serde(default)]
+    pub path_dev: Option<f64>,
     /// Folders `L name` searches after the calling program's own.
     #[serde(default)]
     pub search_path: Vec<String>,
@@ -154,6 +158,7 @@ impl NcConfig {
             arc_tolerance: self
                 .arc_tolerance
                 .unwrap_or(crate::nc::decode::DEFAULT_ARC_TOLERANCE),
+            path_dev: self.path_dev.unwrap_or(crate::nc::decode::DEFAULT_PATH_DEV),
         }
     }
 }
@@ -181,10 +186,6 @@ pub struct InterpolatorConfig {
     /// Continuous path: straight blocks decoded ahead of the one under way (1..=128).
     #[serde(default = "default_lookahead")]
     pub lookahead: u32,
-    /// Continuous path: the corner deviation (mm) until a program sets one with
-    /// `#CONTOUR MODE [DEV PATH_DEV=..]`.
-    #[serde(default = "default_path_dev")]
-    pub path_dev: f64,
 }
 
 impl Default for InterpolatorConfig {
@@ -193,7 +194,6 @@ impl Default for InterpolatorConfig {
             dyn_cs_history_max: default_history(),
             chordal_tolerance: default_chordal_tolerance(),
             lookahead: default_lookahead(),
-            path_dev: default_path_dev(),
         }
     }
 }
@@ -204,10 +204,6 @@ fn default_chordal_tolerance() -> f64 {
 
 fn default_lookahead() -> u32 {
     crate::channel::path::contour::DEFAULT_LOOKAHEAD as u32
-}
-
-fn default_path_dev() -> f64 {
-    crate::nc::decode::DEFAULT_PATH_DEV
 }
 
 fn default_history() -> u32 {
@@ -428,10 +424,13 @@ impl ChannelConfig {
                 "must be 1 to 128 blocks",
             ));
         }
-        let dev = self.interpolator.path_dev;
+        let dev = self
+            .nc
+            .path_dev
+            .unwrap_or(crate::nc::decode::DEFAULT_PATH_DEV);
         if !(dev.is_finite() && dev >= 0.0) {
             return Err(self.parameter(
-                "interpolator.path_dev",
+                "nc.path_dev",
                 dev,
                 "must be a finite distance of 0 or more (mm)",
             ));

@@ -236,9 +236,13 @@ fn bad_tolerances_and_depths_are_refused() {
     for (depth, dev) in [(0, 0.1), (129, 0.1), (32, f64::NAN), (32, -1.0)] {
         let mut c = cartesian("c");
         c.interpolator.lookahead = depth;
-        c.interpolator.path_dev = dev;
+        c.nc.path_dev = Some(dev);
         let e = cnc_core::channel::Channel::new(0, c, CYCLE).err().unwrap();
-        assert!(e.to_string().contains("interpolator."), "{e}");
+        let e = e.to_string();
+        assert!(
+            e.contains("interpolator.lookahead") || e.contains("nc.path_dev"),
+            "{e}"
+        );
     }
 }
 

@@ -136,9 +136,6 @@ impl Channel {
         self.run.pending_at = 0;
         self.run.end_deferred = false;
         self.run.fault_deferred = None;
-        self.run
-            .decoder
-            .set_path_dev(self.config.interpolator.path_dev);
         self.state = RunState::Running;
         self.run.wait = None;
         self.error = None;
@@ -239,6 +236,10 @@ impl Channel {
         if self.motion.contour.active() {
             if let Some(line) = self.motion.contour.line() {
                 self.run.line = line;
+            }
+            if self.control.single_block {
+                // Switched on during a contour: no block joins it any more.
+                self.motion.contour.close();
             }
             return !self.motion.contour.closed() && self.motion.contour.has_room();
         }

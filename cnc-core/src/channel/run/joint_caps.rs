@@ -9,7 +9,8 @@
 //!
 //! * the path's velocity is capped at `V / |q'|` and at `sqrt(A / 2 |q''|)`;
 //! * the path parameter's acceleration at `A / 2 |q'|`, its jerk at `J / 2 |q'|` (half of
-//!   each for the path parameter, half for the joint path's own curvature).
+//!   each for the path parameter). The joints' jerk from the joint path's own curvature
+//!   (`3 q'' v a + q''' v³`) is not bounded beyond that.
 //!
 //! Where the joints turn fast for little path (near a singularity) the path slows down there
 //! instead of asking them more than they have. The sampling sees the piece at five points: a
@@ -62,10 +63,11 @@ impl JointCaps<'_> {
         if length <= 1e-9 {
             return;
         }
-        let h = (length * 1e-3).max(1e-4);
+        // The difference step: small against the piece, never more than a quarter of it.
+        let h = (length * 1e-3).max(1e-4).min(length / 4.0);
         let (mut cap, mut acc, mut jerk) = (piece.hard_cap, f64::INFINITY, f64::INFINITY);
         for share in SAMPLES {
-            let at = (share * length).clamp(h, length - h.min(length / 2.0));
+            let at = (share * length).clamp(h, length - h);
             let (Some(a), Some(b), Some(c)) = (
                 self.joints(piece, at - h),
                 self.joints(piece, at),
@@ -95,8 +97,13 @@ impl JointCaps<'_> {
 }
 
 /// The joint caps for the contour's next pieces of a channel with `pose` and `config` (only
-/// under a transformation).
-pub(super) fn joint_caps<'a>(pose: &'a Pose, config: &ChannelConfig) -> Option<JointCaps<'a>> {
+/// under a transformation), the inverse kinematics starting from `seed` (the joints of the
+/// last piece sampled, so a piece far ahead resolves to the configuration the path follows).
+pub(super) fn joint_caps<'a>(
+    pose: &'a Pose,
+    config: &ChannelConfig,
+    seed: Joints,
+) -> Option<JointCaps<'a>> {
     if !pose.trafo {
         return None;
     }
@@ -111,7 +118,7 @@ pub(super) fn joint_caps<'a>(pose: &'a Pose, config: &ChannelConfig) -> Option<J
         kinematics: &pose.kinematics,
         order: pose.order,
         cs,
-        seed: pose.joints,
+        seed,
         limits,
     })
 }

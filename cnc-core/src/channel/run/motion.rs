@@ -34,6 +34,8 @@ pub(super) struct Motion {
     /// Axes moving independently when the contour started: the contour leaves them alone
     /// (bit per axis).
     pub(super) contour_excluded: u32,
+    /// Under `#TRAFO`: the joints at the end of the last piece the joint caps sampled.
+    pub(super) contour_joints: kinematics::Joints,
 }
 
 impl Motion {
@@ -50,6 +52,7 @@ impl Motion {
             contour_end: *start,
             contour_blend: None,
             contour_excluded: 0,
+            contour_joints: [0.0; 6],
             limits,
             programmed: *start,
             velocity: AxisValues::zeros(start.len()),
@@ -121,6 +124,7 @@ impl Channel {
         self.motion.contour.clear();
         self.motion.contour_end = self.motion.programmed;
         self.motion.contour_blend = None;
+        self.motion.contour_joints = self.pose.joints;
         self.motion.contour_excluded = self
             .motion
             .independent
@@ -155,10 +159,13 @@ impl Channel {
         if m.arc.is_some() {
             return false;
         }
-        let pushed = match joint_caps::joint_caps(&self.pose, &self.config) {
+        let seed = self.motion.contour_joints;
+        let pushed = match joint_caps::joint_caps(&self.pose, &self.config, seed) {
             Some(mut caps) => {
                 let contour = &mut self.motion.contour;
-                contour.push(&segment, &mut |p| caps.apply(p))
+                let pushed = contour.push(&segment, &mut |p| caps.apply(p));
+                self.motion.contour_joints = caps.seed;
+                pushed
             }
             None => self.motion.contour.push(&segment, &mut |_| {}),
         };

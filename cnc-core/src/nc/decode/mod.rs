@@ -87,6 +87,8 @@ pub struct DecoderSetup {
     pub tools_unknown: bool,
     /// How far an arc's end point may lie off its circle (mm).
     pub arc_tolerance: f64,
+    /// The corner deviation of continuous path until the program sets one (mm).
+    pub path_dev: f64,
 }
 
 impl Default for DecoderSetup {
@@ -96,6 +98,7 @@ impl Default for DecoderSetup {
             tools: Vec::new(),
             tools_unknown: false,
             arc_tolerance: DEFAULT_ARC_TOLERANCE,
+            path_dev: DEFAULT_PATH_DEV,
         }
     }
 }
@@ -262,11 +265,7 @@ impl DecoderState {
         self.tools = setup.tools.clone();
         self.tools_unknown = setup.tools_unknown;
         self.arc_tolerance = setup.arc_tolerance;
-    }
-
-    /// The corner deviation of continuous path until the program sets one (mm).
-    pub fn set_path_dev(&mut self, mm: f64) {
-        self.path_dev = mm;
+        self.path_dev = setup.path_dev;
     }
 
     /// For blocks checked out of their program's order: a feed is taken as programmed, and

@@ -352,7 +352,13 @@ impl Contour {
         if factors == self.factors {
             return;
         }
-        let holding = factors.0 <= 0.0 && factors.1 <= 0.0;
+        // The piece under way is held when its own factor is 0 (feed for G1, rapid for G0).
+        let front_rapid = self.pieces.front().is_some_and(|p| p.rapid);
+        let holding = if front_rapid {
+            factors.1 <= 0.0
+        } else {
+            factors.0 <= 0.0
+        };
         self.factors = factors;
         if !self.pieces.is_empty() {
             // Every bound may change: sweep the whole window.
@@ -480,9 +486,7 @@ impl Contour {
         let v1 = if rest <= 1e-12 {
             v0
         } else {
-            let reach_low = min_reach(v0, rest, p.dynamics);
-            let soft = max_reach(v0, rest, p.bound_soft.max(0.0), p.dynamics);
-            soft.max(reach_low).min(p.bound_hard.max(reach_low))
+            feasible_end(v0, rest, p)
         };
         let cap = p.soft_cap(ff, rf);
         self.profile =
@@ -554,9 +558,11 @@ impl Contour {
                 self.blocks = self.blocks.saturating_sub(1);
             }
             if self.pieces.is_empty() {
+                // The piece ran to its end: the block's exact end point, unless a stop cut
+                // the window short.
                 match self.last_end {
                     Some((end, _)) if !self.stopping => self.rest_point = end,
-                    _ => p.point(self.state.position.min(p.length), &mut self.rest_point),
+                    _ => p.end(&mut self.rest_point),
                 }
             }
         }
@@ -595,6 +601,38 @@ impl Contour {
         self.start_piece(here, 0.0)?;
         self.advance_profile()
     }
+}
+
+/// The end velocity of a piece entered at `v0` with `rest` of it to go: the highest its length
+/// allows within its soft bound, at least the lowest braking reaches, at most its hard bound,
+/// and always one the piece's length can reach. Braking part of the way can take longer than
+/// braking to rest (the distance `(v0 + v) T(v0 - v) / 2` first grows as `v` falls from
+/// `v0`, then shrinks), so a velocity between the bounds may not fit: then the highest below
+/// it that does, or the hard bound (which the look-ahead made reachable from every entry
+/// velocity up to the one before's hard bound).
+fn feasible_end(v0: f64, rest: f64, p: &Piece) -> f64 {
+    let d = p.dynamics;
+    let fits = |v: f64| profile::change_distance(v0, v, d) <= rest * (1.0 + 1e-12) + 1e-15;
+    let reach_low = min_reach(v0, rest, d);
+    let soft = max_reach(v0, rest, p.bound_soft.max(0.0), d);
+    let v1 = soft.max(reach_low).min(p.bound_hard.max(reach_low));
+    if fits(v1) {
+        return v1;
+    }
+    if fits(0.0) {
+        // Between 0 (fits) and v1 (does not): the highest that fits.
+        let (mut lo, mut hi) = (0.0, v1);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        return lo;
+    }
+    v0.min(p.bound_hard)
 }
 
 /// What the backward sweep carries from a piece to the one before: its bounds, length,
