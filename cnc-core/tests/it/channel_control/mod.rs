@@ -428,3 +428,60 @@ fn reset_clears_the_error_and_a_moving_channel_decelerates_first() {
 }
 
 mod interplay;
+
+/// STOP during a continuous path: the path brakes on the contour within the channel's limits
+/// and rests on it (within the corner deviation of the programmed zigzag); the program stays
+/// selected.
+#[test]
+fn stop_brakes_a_continuous_path_on_the_contour() {
+    let mut program = String::from("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261 G1 F9000\n");
+    for k in 1..=200 {
+        program.push_str(&format!("X{k} Y{}\n", if k % 2 == 1 { 0.2 } else { 0.0 }));
+    }
+    program.push_str("M30\n");
+    let config = cartesian("c");
+    let limits = config.limits;
+    let mut rig = Rig::new(vec![(config, Some(&program))], None);
+    assert_eq!(rig.command(0, ChannelCommand::Start, plain, 5), None);
+    rig.run_ticks(300, |_| {});
+    let id = rig.post(0, ChannelCommand::Stop, plain);
+    let mut trace = Vec::new();
+    for _ in 0..5_000 {
+        rig.tick();
+        let c = &rig.ctl.channels()[0];
+        trace.push([c.set_points()[0], c.set_points()[1]]);
+        let s = rig.state_block(0);
+        if s.command_id == id
+            && ChannelCommandState::decode(s.command_state).unwrap() == ChannelCommandState::Done
+        {
+            break;
+        }
+    }
+    assert_eq!(rig.state(0), ChannelState::Selected);
+    for w in trace.windows(3) {
+        for i in 0..2 {
+            let v = (w[2][i] - w[1][i]) / CYCLE;
+            let a = (w[2][i] - 2.0 * w[1][i] + w[0][i]) / (CYCLE * CYCLE);
+            assert!(v.abs() <= limits.velocity * 1.000001, "velocity {v}");
+            assert!(
+                a.abs() <= limits.acceleration * 1.000001,
+                "acceleration {a}"
+            );
+        }
+    }
+    let [x, y] = *trace.last().unwrap();
+    assert!(x > 1.0 && x < 199.0, "stopped on the way: {x}");
+    // The zigzag's corners at the whole millimetres: y = 0.2 at odd ones, 0 at even ones.
+    let corner = |k: f64| [k, if k as i64 % 2 == 1 { 0.2 } else { 0.0 }];
+    let to_segment = |a: [f64; 2], b: [f64; 2]| {
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let t = (((x - a[0]) * dx + (y - a[1]) * dy) / (dx * dx + dy * dy)).clamp(0.0, 1.0);
+        (x - a[0] - t * dx).hypot(y - a[1] - t * dy)
+    };
+    let k = x.floor();
+    let off = to_segment(corner(k - 1.0), corner(k))
+        .min(to_segment(corner(k), corner(k + 1.0)))
+        .min(to_segment(corner(k + 1.0), corner(k + 2.0)));
+    assert!(off <= 0.02 + 1e-9, "off the path by {off} at {x} {y}");
+    rig.run_ticks(100, |r| assert_eq!(r.x(0), x, "at rest"));
+}
