@@ -459,9 +459,9 @@ fn stop_brakes_a_continuous_path_on_the_contour() {
     }
     assert_eq!(rig.state(0), ChannelState::Selected);
     for w in trace.windows(3) {
-        for i in 0..2 {
-            let v = (w[2][i] - w[1][i]) / CYCLE;
-            let a = (w[2][i] - 2.0 * w[1][i] + w[0][i]) / (CYCLE * CYCLE);
+        for ((p0, p1), p2) in w[0].iter().zip(&w[1]).zip(&w[2]) {
+            let v = (p2 - p1) / CYCLE;
+            let a = (p2 - 2.0 * p1 + p0) / (CYCLE * CYCLE);
             assert!(v.abs() <= limits.velocity * 1.000001, "velocity {v}");
             assert!(
                 a.abs() <= limits.acceleration * 1.000001,
