@@ -621,16 +621,7 @@ fn feasible_end(v0: f64, rest: f64, p: &Piece) -> f64 {
     }
     if fits(0.0) {
         // Between 0 (fits) and v1 (does not): the highest that fits.
-        let (mut lo, mut hi) = (0.0, v1);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if fits(mid) {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        return lo;
+        return profile::bisect(0.0, v1, fits);
     }
     v0.min(p.bound_hard)
 }

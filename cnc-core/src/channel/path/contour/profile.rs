@@ -106,7 +106,7 @@ pub fn min_reach(v0: f64, length: f64, d: Dynamics) -> f64 {
 }
 
 /// The largest `v` in `[lo, hi]` with `ok(v)`, `ok(lo)` assumed.
-fn bisect(mut lo: f64, mut hi: f64, ok: impl Fn(f64) -> bool) -> f64 {
+pub(super) fn bisect(mut lo: f64, mut hi: f64, ok: impl Fn(f64) -> bool) -> f64 {
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
         if ok(mid) {
