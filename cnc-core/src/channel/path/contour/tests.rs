@@ -52,6 +52,20 @@ fn run(
     tolerance: Option<f64>,
     hold: Option<(usize, usize)>,
 ) -> Trace {
+    let schedule = match hold {
+        Some((at, len)) => vec![(at, 0.0), (at + len, 1.0)],
+        None => Vec::new(),
+    };
+    run_with(points, feed, tolerance, &schedule)
+}
+
+/// [`run`] with the feed and rapid override set to `factor` at each `(tick, factor)`.
+fn run_with(
+    points: &[[f64; 3]],
+    feed: f64,
+    tolerance: Option<f64>,
+    schedule: &[(usize, f64)],
+) -> Trace {
     let lim = limits(3);
     let mut c = Contour::new(&lim, CYCLE, 16);
     let mut next = 1;
@@ -75,13 +89,8 @@ fn run(
         if next == points.len() {
             c.close();
         }
-        if let Some((at, len)) = hold {
-            if tick == at {
-                c.set_factors(0.0, 0.0);
-            }
-            if tick == at + len {
-                c.set_factors(1.0, 1.0);
-            }
+        for &(_, factor) in schedule.iter().filter(|(at, _)| *at == tick) {
+            c.set_factors(factor, factor);
         }
         let moving = c.step(&mut pos, &mut vel, &mut acc).expect("no fault");
         positions.push(pos);
@@ -295,4 +304,42 @@ fn an_end_velocity_between_the_bounds_that_does_not_fit_is_not_chosen() {
     );
     assert!(v <= 33.0, "{v}");
     assert!(PieceProfile::plan(5.2, 100.0, v, 33.0, d).is_some());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Override changes at random moments (lowered, raised, held, released) never fault the
+    /// contour, never leave the tolerance or a limit, and the path still ends on its last point.
+    #[test]
+    fn random_override_changes_keep_tolerance_and_limits(
+        steps in proptest::collection::vec((0.05f64..6.0, -2.3f64..2.3), 2..20),
+        changes in proptest::collection::vec((0usize..400, 0.0f64..2.0), 1..8),
+        tol in 0.005f64..0.3,
+        feed in 20.0f64..200.0,
+    ) {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        let mut heading = 0.0f64;
+        for (len, turn) in steps {
+            heading += turn;
+            let [x, y, z] = *points.last().unwrap();
+            points.push([x + len * heading.cos(), y + len * heading.sin(), z]);
+        }
+        // Below 10 % counts as a hold; every run ends released at 100 %.
+        let mut schedule: Vec<(usize, f64)> = changes
+            .iter()
+            .map(|&(at, f)| (at, if f < 0.1 { 0.0 } else { f }))
+            .collect();
+        schedule.sort_by_key(|c| c.0);
+        schedule.push((401, 1.0));
+        let t = run_with(&points, feed, Some(tol), &schedule);
+        let dev = worst_deviation(&t, &points);
+        prop_assert!(dev <= tol + 1e-9, "deviation {} > {}", dev, tol);
+        let l = limits(1)[0];
+        let (v, a, j) = worst_rates(&t);
+        prop_assert!(v <= l.velocity * (1.0 + 1e-6), "velocity {}", v);
+        prop_assert!(a <= l.acceleration * (1.0 + 1e-6), "acceleration {}", a);
+        prop_assert!(j <= l.jerk * (1.0 + 1e-6), "jerk {}", j);
+        prop_assert_eq!(&t.positions.last().unwrap()[..], &points.last().unwrap()[..]);
+    }
 }
