@@ -57,6 +57,20 @@ enum Command {
     /// the same as the `plc` binary.
     #[command(args_conflicts_with_subcommands = true)]
     Plc(plc_shim::cli::PlcCli),
+    /// Serve a running CNC's image over OPC UA (read-only, anonymous): runs the `cnc-opcua`
+    /// binary built beside this one (`cargo build --release -p cnc-opcua`).
+    Opcua {
+        /// The CNC's instance name.
+        #[arg(long)]
+        instance: String,
+        /// TCP port of the endpoint.
+        #[arg(long, default_value_t = 4840)]
+        port: u16,
+        /// Folder of the server's certificate store (default: a folder per instance in the
+        /// system's temporary folder).
+        #[arg(long)]
+        pki: Option<std::path::PathBuf>,
+    },
 }
 
 #[derive(Debug, Subcommand)]
@@ -89,6 +103,36 @@ fn main() -> ExitCode {
         Command::Fifo { what } => cnc_app::fifo_cli::main(what),
         Command::Saw { what } => cnc_app::saw_cli::main(what),
         Command::Plc(args) => plc_shim::cli::main(args),
+        Command::Opcua {
+            instance,
+            port,
+            pki,
+        } => opcua(&instance, port, pki.as_deref()),
+    }
+}
+
+/// `cnc opcua`: the `cnc-opcua` binary beside this one, with the same arguments; its exit
+/// code is this one's.
+fn opcua(instance: &str, port: u16, pki: Option<&std::path::Path>) -> ExitCode {
+    let Some(binary) = std::env::current_exe()
+        .ok()
+        .and_then(|me| me.parent().map(|dir| dir.join("cnc-opcua")))
+        .filter(|path| path.is_file())
+    else {
+        eprintln!("cnc opcua: no cnc-opcua binary beside cnc (build it: cargo build --release -p cnc-opcua)");
+        return ExitCode::from(2);
+    };
+    let mut command = std::process::Command::new(binary);
+    command.args(["--instance", instance, "--port", &port.to_string()]);
+    if let Some(pki) = pki {
+        command.arg("--pki").arg(pki);
+    }
+    match command.status() {
+        Ok(status) => ExitCode::from(status.code().map_or(1, |c| c.clamp(0, 255) as u8)),
+        Err(e) => {
+            eprintln!("cnc opcua: {e}");
+            ExitCode::from(1)
+        }
     }
 }
 
