@@ -6,15 +6,17 @@ use cnc_opcua::{build, ImageSource, NAMESPACE};
 use hli::access::{Leaf, Value};
 use hli::segment::heap_image;
 use hli::ImageMemory;
-use opcua::client::{ClientBuilder, IdentityToken, Session};
-use opcua::crypto::SecurityPolicy;
+use opcua::client::Session;
 use opcua::types::{
-    BrowseDescription, BrowseDirection, MessageSecurityMode, NodeId, ReadValueId, ReferenceTypeId,
-    StatusCode, TimestampsToReturn, UserTokenPolicy, Variant,
+    BrowseDescription, BrowseDirection, NodeId, ReadValueId, ReferenceTypeId, StatusCode,
+    TimestampsToReturn, Variant,
 };
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
+use support::{connect, free_port};
+
+mod support;
 
 /// The image, present or not (as when the CNC stops).
 struct Switchable {
@@ -26,42 +28,6 @@ impl ImageSource for Switchable {
     fn image(&self) -> Option<&ImageMemory> {
         self.present.load(Ordering::Acquire).then_some(&self.image)
     }
-}
-
-/// A port no one listens on (the OS's choice).
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .unwrap()
-}
-
-async fn connect(port: u16, pki: &std::path::Path) -> Arc<Session> {
-    let mut client = ClientBuilder::new()
-        .application_name("cnc-opcua test client")
-        .application_uri("urn:cnc-opcua-test-client")
-        .pki_dir(pki)
-        .create_sample_keypair(true)
-        .trust_server_certs(true)
-        .session_retry_limit(20)
-        .client()
-        .unwrap();
-    let url = format!("opc.tcp://127.0.0.1:{port}/");
-    let (session, event_loop) = client
-        .connect_to_matching_endpoint(
-            (
-                url.as_str(),
-                SecurityPolicy::None.to_str(),
-                MessageSecurityMode::None,
-                UserTokenPolicy::anonymous(),
-            ),
-            IdentityToken::Anonymous,
-        )
-        .await
-        .unwrap();
-    event_loop.spawn();
-    assert!(session.wait_for_connection().await, "connected");
-    session
 }
 
 async fn read(session: &Session, id: &NodeId) -> opcua::types::DataValue {

@@ -3,22 +3,13 @@
 
 use hli::access::{Leaf, Value};
 use hli::segment::CncSegment;
-use opcua::client::{ClientBuilder, IdentityToken};
-use opcua::crypto::SecurityPolicy;
-use opcua::types::{
-    MessageSecurityMode, NodeId, ReadValueId, StatusCode, TimestampsToReturn, UserTokenPolicy,
-    Variant,
-};
+use opcua::types::{NodeId, ReadValueId, StatusCode, TimestampsToReturn, Variant};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::Duration;
+use support::{connect, free_port};
 
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .and_then(|l| l.local_addr())
-        .map(|a| a.port())
-        .unwrap()
-}
+mod support;
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_server_process_serves_a_cnc_and_stops_on_sigterm() {
@@ -56,30 +47,7 @@ async fn scenario() {
     let (first, lines) = ready.await.unwrap();
     assert!(first.contains("serving on"), "{first}");
 
-    let mut client = ClientBuilder::new()
-        .application_name("cnc-opcua process test")
-        .application_uri("urn:cnc-opcua-process-test")
-        .pki_dir(dir.join("client"))
-        .create_sample_keypair(true)
-        .trust_server_certs(true)
-        .session_retry_limit(20)
-        .client()
-        .unwrap();
-    let url = format!("opc.tcp://127.0.0.1:{port}/");
-    let (session, event_loop) = client
-        .connect_to_matching_endpoint(
-            (
-                url.as_str(),
-                SecurityPolicy::None.to_str(),
-                MessageSecurityMode::None,
-                UserTokenPolicy::anonymous(),
-            ),
-            IdentityToken::Anonymous,
-        )
-        .await
-        .unwrap();
-    event_loop.spawn();
-    assert!(session.wait_for_connection().await);
+    let session = connect(port, &dir.join("client")).await;
     let ns = session
         .read(
             &[ReadValueId::from(NodeId::from(
