@@ -46,8 +46,18 @@ hli_struct! {
         pub cnc_flags: u32 => [60, Cnc],
         /// Incremented by the CNC once per tick.
         pub cnc_heartbeat: u64 => [64, Cnc],
+        /// Wall-clock time (ns since the Unix epoch) at which heartbeat 0 was due: the tick
+        /// that wrote heartbeat N was due at `cnc_epoch_ns + N * cnc_cycle_ns` (lockstep: the
+        /// machine's own time, not the clock's). 0 until the tick loop starts. For tools
+        /// (the OPC UA server's source timestamps); the CNC never reads it.
+        pub cnc_epoch_ns: u64 => [72, Cnc],
+        /// 99th percentile of the ticks' start lateness so far, ns (real time; 0 in
+        /// lockstep), refreshed every 1,024 ticks. For tools; the CNC never reads it.
+        pub cnc_late_p99_ns: u32 => [80, Cnc],
+        /// Largest tick start lateness so far, ns, refreshed with the p99.
+        pub cnc_late_max_ns: u32 => [84, Cnc],
         /// Padding up to the next cache line.
-        pub fill_up_2: [u64; 7] => [72, Cnc],
+        pub fill_up_2: [u64; 5] => [88, Cnc],
         /// Incremented by the PLC once per cycle.
         pub plc_heartbeat: u64 => [128, Plc],
         /// Process id of the attached PLC, 0 when none.

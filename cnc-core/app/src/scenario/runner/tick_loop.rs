@@ -168,6 +168,8 @@ pub(super) struct TickLoop<'a> {
     /// Real time: programs the PLC selects are loaded on this thread, never between two
     /// ticks (lockstep loads them in place: its ticks wait for nothing else anyway).
     loader: Option<Loader>,
+    /// The lateness figures the header shows tools.
+    gauge: LatenessGauge,
 }
 
 impl<'a> TickLoop<'a> {
@@ -204,6 +206,7 @@ impl<'a> TickLoop<'a> {
         // Tick 0 is due once everything above is set up (threads started, files opened), so
         // its lateness is the loop's, not the set-up's.
         let start = monotonic::now();
+        publish_epoch(segment, segment.beats(), bounds.period);
         let plc_seen = (segment.plc_heartbeat(), monotonic::now());
         TickLoop {
             scenario,
@@ -231,6 +234,7 @@ impl<'a> TickLoop<'a> {
             counter,
             progress,
             loader,
+            gauge: LatenessGauge::new(),
         }
     }
 
@@ -260,6 +264,10 @@ impl<'a> TickLoop<'a> {
             let end_now = tick % 16 == 0 && self.take_signal(tick);
             let t5 = monotonic::now();
             self.measured.push([t0, t1, t2, t3, t4, t5], deadline);
+            if !self.options.lockstep {
+                self.gauge
+                    .record(t0.saturating_sub(deadline), tick, self.segment);
+            }
             if end_now {
                 break;
             }
@@ -489,5 +497,89 @@ impl<'a> TickLoop<'a> {
         self.machine.stop(STOP_REASON_SIGNAL);
         self.ending.stop = Some((cause, tick));
         false
+    }
+}
+
+/// Announces in the header when the tick that writes heartbeat `beats + 1` (the loop's tick
+/// 0, due now) was due, as wall-clock time: tools date the values of heartbeat N by it.
+fn publish_epoch(segment: &CncSegment, beats: u64, period: Duration) {
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap_or_default();
+    let back = period.saturating_mul(u32::try_from(beats + 1).unwrap_or(u32::MAX));
+    segment.publish_epoch(now.saturating_sub(back).as_nanos() as u64);
+}
+
+/// Ticks between two refreshes of the header's lateness figures.
+const GAUGE_EVERY: u64 = 1024;
+/// Width of a lateness bucket, ns.
+const GAUGE_BUCKET_NS: u64 = 1_000;
+/// Buckets: 1 us each up to 8 ms; later ticks count in the last.
+const GAUGE_BUCKETS: usize = 8_192;
+
+/// The ticks' start lateness as a histogram of fixed size (allocated before the first
+/// tick): p99 and max published in the header every [`GAUGE_EVERY`] ticks.
+struct LatenessGauge {
+    buckets: Box<[u32]>,
+    count: u64,
+    max_ns: u64,
+}
+
+impl LatenessGauge {
+    fn new() -> LatenessGauge {
+        LatenessGauge {
+            buckets: vec![0; GAUGE_BUCKETS].into_boxed_slice(),
+            count: 0,
+            max_ns: 0,
+        }
+    }
+
+    /// Counts one tick's lateness; every [`GAUGE_EVERY`] ticks publishes the figures.
+    fn record(&mut self, late: Duration, tick: u64, segment: &CncSegment) {
+        let ns = late.as_nanos() as u64;
+        let bucket = ((ns / GAUGE_BUCKET_NS) as usize).min(GAUGE_BUCKETS - 1);
+        self.buckets[bucket] = self.buckets[bucket].saturating_add(1);
+        self.count += 1;
+        self.max_ns = self.max_ns.max(ns);
+        if tick % GAUGE_EVERY == GAUGE_EVERY - 1 {
+            segment.publish_lateness(self.p99_ns(), self.max_ns);
+        }
+    }
+
+    /// The upper edge of the bucket that holds the 99th percentile, ns (at most the max).
+    fn p99_ns(&self) -> u64 {
+        let rank = self.count - self.count / 100;
+        let mut seen = 0u64;
+        for (k, n) in self.buckets.iter().enumerate() {
+            seen += u64::from(*n);
+            if seen >= rank {
+                return ((k as u64 + 1) * GAUGE_BUCKET_NS).min(self.max_ns);
+            }
+        }
+        self.max_ns
+    }
+}
+
+#[cfg(test)]
+mod gauge_tests {
+    use super::*;
+
+    #[test]
+    fn the_gauges_p99_is_the_bucket_edge_of_the_99th_tick_of_100_and_at_most_the_max() {
+        let mut g = LatenessGauge::new();
+        for k in 0..100u64 {
+            let ns = if k == 99 { 900_000 } else { k * 1_000 + 500 };
+            let bucket = ((ns / GAUGE_BUCKET_NS) as usize).min(GAUGE_BUCKETS - 1);
+            g.buckets[bucket] += 1;
+            g.count += 1;
+            g.max_ns = g.max_ns.max(ns);
+        }
+        assert_eq!(
+            g.p99_ns(),
+            99_000,
+            "the 99th sample, 98.5 us, lies in [98, 99) us"
+        );
+        g.max_ns = 50_000;
+        assert_eq!(g.p99_ns(), 50_000);
     }
 }
