@@ -38,6 +38,9 @@ pub struct DemoArgs {
     /// Real-time options of the CNC's tick loop.
     #[command(flatten)]
     pub realtime: plc_shim::realtime::RealtimeOptions,
+    /// An OPC UA server beside the demo.
+    #[command(flatten)]
+    pub opcua: crate::opcua::OpcuaArgs,
 }
 
 /// The machine's name: its folder under `scenarios/` and the trace's file name.
@@ -137,6 +140,7 @@ pub fn main(args: DemoArgs) -> ExitCode {
         realtime: args.realtime.clone(),
         // The demo's programs name no LOG_FILE; its listings are kept for `cnc diag`.
         log_dir: None,
+        opcua: args.opcua.clone(),
     };
     hli::signals::capture();
     let report = match run(&scenario, &options) {

@@ -11,6 +11,7 @@ pub mod demo_plots;
 pub mod diag_cli;
 pub mod fifo_cli;
 pub mod kin_cli;
+pub mod opcua;
 pub mod plot;
 pub mod progress;
 pub mod saw_cli;

@@ -61,6 +61,9 @@ pub struct Limits {
     pub max_monitored_items_per_subscription: usize,
     /// The shortest sampling interval granted, ms (at least 1).
     pub min_sampling_interval_ms: f64,
+    /// The shortest publishing interval granted, ms (at least 10): also how often the server
+    /// looks whether a subscription is due.
+    pub min_publishing_interval_ms: f64,
 }
 
 impl Default for Limits {
@@ -70,6 +73,7 @@ impl Default for Limits {
             max_subscriptions_per_session: 4,
             max_monitored_items_per_subscription: 2_000,
             min_sampling_interval_ms: 1.0,
+            min_publishing_interval_ms: 10.0,
         }
     }
 }
@@ -197,12 +201,22 @@ impl Limits {
                 return Err((key.into(), format!("{value} is not in 1..={most}")));
             }
         }
-        let ms = self.min_sampling_interval_ms;
-        if !ms.is_finite() || !(1.0..=60_000.0).contains(&ms) {
-            return Err((
-                "limits.min_sampling_interval_ms".into(),
-                format!("{ms} is not in 1..=60000"),
-            ));
+        let intervals = [
+            (
+                "limits.min_sampling_interval_ms",
+                self.min_sampling_interval_ms,
+                1.0,
+            ),
+            (
+                "limits.min_publishing_interval_ms",
+                self.min_publishing_interval_ms,
+                10.0,
+            ),
+        ];
+        for (key, ms, least) in intervals {
+            if !ms.is_finite() || !(least..=60_000.0).contains(&ms) {
+                return Err((key.into(), format!("{ms} is not in {least}..=60000")));
+            }
         }
         Ok(())
     }

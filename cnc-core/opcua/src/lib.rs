@@ -106,6 +106,9 @@ pub fn build(
     subs.max_subscriptions_per_session = config.limits.max_subscriptions_per_session;
     subs.max_monitored_items_per_sub = config.limits.max_monitored_items_per_subscription;
     subs.min_sampling_interval_ms = config.limits.min_sampling_interval_ms;
+    subs.min_publishing_interval_ms = config.limits.min_publishing_interval_ms;
+    let poll = config.limits.min_publishing_interval_ms.round() as u64;
+    builder = builder.subscription_poll_interval_ms(poll);
     let (builder, auth) = endpoints(builder, config);
     let (server, handle) = builder
         .with_authenticator(auth)

@@ -12,7 +12,8 @@ use hli::symbols::{SymbolKind, SymbolTable};
 use opcua::server::address_space::{AccessLevel, AddressSpace, VariableBuilder};
 use opcua::server::node_manager::memory::{InMemoryNodeManager, SimpleNodeManagerImpl};
 use opcua::types::{
-    DataTypeId, EUInformation, ExtensionObject, NodeId, ObjectId, VariableTypeId, Variant,
+    DataTypeId, EUInformation, ExtensionObject, NodeId, ObjectId, QualifiedName, VariableTypeId,
+    Variant,
 };
 use std::collections::HashSet;
 use std::sync::{Arc, Mutex};
@@ -39,6 +40,8 @@ pub struct Plan<'a> {
 /// The last part of an ST path (`gpCh[0]^channel_mc_control.dyn_cs` -> `dyn_cs`,
 /// `...translation[1]` -> `[1]`).
 pub fn browse_name(path: &str) -> &str {
+    // A pointer node (`gpAx[0]^`) is named by its index.
+    let path = path.strip_suffix('^').unwrap_or(path);
     let cut =
         path.rfind(['.', '^', '['])
             .map_or(0, |i| if path.as_bytes()[i] == b'[' { i } else { i + 1 });
@@ -49,7 +52,7 @@ pub fn browse_name(path: &str) -> &str {
 pub fn is_under(child: &str, parent: &str) -> bool {
     child.len() > parent.len()
         && child.starts_with(parent)
-        && matches!(child.as_bytes()[parent.len()], b'.' | b'^' | b'[')
+        && (parent.ends_with('^') || matches!(child.as_bytes()[parent.len()], b'.' | b'^' | b'['))
 }
 
 /// Builds every node of `plan` into `manager`.
@@ -82,7 +85,7 @@ fn variable(
     } else {
         AccessLevel::CURRENT_READ
     };
-    VariableBuilder::new(id, name, name)
+    VariableBuilder::new(id, QualifiedName::new(plan.ns, name), name)
         .data_type(data_type)
         .value(initial)
         .access_level(access)
@@ -128,7 +131,7 @@ fn engineering_units(space: &mut AddressSpace, ns: u16, id: &str, eu: Eu) {
 fn image_tree(manager: &Manager, space: &mut AddressSpace, plan: &Plan<'_>) {
     let root = NodeId::new(plan.ns, "HLI");
     let objects: NodeId = ObjectId::ObjectsFolder.into();
-    space.add_folder(&root, "HLI", "HLI", &objects);
+    space.add_folder(&root, QualifiedName::new(plan.ns, "HLI"), "HLI", &objects);
     // The symbols come parents first: a stack of the open folders finds each one's parent.
     let mut open: Vec<(&str, NodeId)> = Vec::new();
     for symbol in SymbolTable::global().symbols() {
@@ -140,7 +143,7 @@ fn image_tree(manager: &Manager, space: &mut AddressSpace, plan: &Plan<'_>) {
         let id = NodeId::new(plan.ns, path);
         let name = browse_name(path);
         let SymbolKind::Leaf(scalar) = symbol.kind else {
-            space.add_folder(&id, name, name, &parent);
+            space.add_folder(&id, QualifiedName::new(plan.ns, name), name, &parent);
             open.push((path, id));
             continue;
         };
@@ -203,7 +206,7 @@ fn summary_folder(
     items: Vec<Item>,
 ) -> NodeId {
     let folder = NodeId::new(plan.ns, id);
-    space.add_folder(&folder, name, name, parent);
+    space.add_folder(&folder, QualifiedName::new(plan.ns, name), name, parent);
     for it in items {
         // The paths are this crate's own: the symbol table has them (a test reads them all).
         let Ok(leaf) = Leaf::resolve(&it.path) else {
@@ -266,7 +269,7 @@ fn summary(manager: &Manager, space: &mut AddressSpace, plan: &Plan<'_>) {
     );
 
     let axes = NodeId::new(plan.ns, "Axes");
-    space.add_folder(&axes, "Axes", "Axes", &objects);
+    space.add_folder(&axes, QualifiedName::new(plan.ns, "Axes"), "Axes", &objects);
     for i in 0..plan.axes {
         let at = |leaf: &str| format!("gpAx[{i}]^lr_state.{leaf}");
         let unit = |leaf: &str| unit_of(&at(leaf), plan.rotary).map(|u| (u.per_unit, u.eu));
@@ -289,7 +292,8 @@ fn summary(manager: &Manager, space: &mut AddressSpace, plan: &Plan<'_>) {
     }
 
     let channels = NodeId::new(plan.ns, "Channels");
-    space.add_folder(&channels, "Channels", "Channels", &objects);
+    let name = QualifiedName::new(plan.ns, "Channels");
+    space.add_folder(&channels, name, "Channels", &objects);
     for i in 0..plan.channels {
         let items = vec![
             item(
@@ -314,7 +318,8 @@ fn summary(manager: &Manager, space: &mut AddressSpace, plan: &Plan<'_>) {
     }
 
     let groups = NodeId::new(plan.ns, "FifoGroups");
-    space.add_folder(&groups, "FifoGroups", "FifoGroups", &objects);
+    let name = QualifiedName::new(plan.ns, "FifoGroups");
+    space.add_folder(&groups, name, "FifoGroups", &objects);
     for i in 0..HLI_MAX_FIFO_GROUPS {
         let items = vec![
             item("Entries", format!("gpFifo[{i}]^entries_r"), None),
@@ -341,6 +346,10 @@ mod tests {
         assert_eq!(browse_name("header"), "header");
         assert!(is_under("gpCh[0]^x", "gpCh[0]"));
         assert!(!is_under("gpCh[10]", "gpCh[1]"));
+        // The element of a pointer array holds its unit, named by its index.
+        assert_eq!(browse_name("gpAx[3]^"), "[3]");
+        assert!(is_under("gpAx[3]^lr_state", "gpAx[3]^"));
+        assert!(!is_under("gpAx[3]^lr_state", "gpAx[3]^lr"));
     }
 
     #[test]

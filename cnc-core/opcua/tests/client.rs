@@ -159,25 +159,45 @@ async fn reads() {
     let tick_now = read(&session, &NodeId::new(ns, "Machine.Tick")).await;
     assert_eq!(tick_now.value, Some(Variant::UInt64(2_500)));
 
-    // gpAx[1] browses down to lr_state, which holds the leaf.
-    let browse = BrowseDescription {
-        node_id: NodeId::new(ns, "gpAx[1]^lr_state"),
-        browse_direction: BrowseDirection::Forward,
-        reference_type_id: ReferenceTypeId::Organizes.into(),
-        include_subtypes: true,
-        node_class_mask: 0,
-        result_mask: 0x3f,
+    // The tree browses from the HLI folder: gpAx, its element [1], lr_state, the leaf.
+    let children = |node: &str| {
+        let browse = BrowseDescription {
+            node_id: NodeId::new(ns, node),
+            browse_direction: BrowseDirection::Forward,
+            reference_type_id: ReferenceTypeId::Organizes.into(),
+            include_subtypes: true,
+            node_class_mask: 0,
+            result_mask: 0x3f,
+        };
+        let session = session.clone();
+        async move {
+            let results = session.browse(&[browse], 1000, None).await.unwrap();
+            results[0]
+                .references
+                .iter()
+                .flatten()
+                .map(|r| format!("{}:{}", r.browse_name.namespace_index, r.browse_name.name))
+                .collect::<Vec<String>>()
+        }
     };
-    let results = session.browse(&[browse], 1000, None).await.unwrap();
-    let names: Vec<String> = results[0]
-        .references
-        .iter()
-        .flatten()
-        .map(|r| r.browse_name.name.to_string())
-        .collect();
-    for name in ["command_position_acs_r", "command_position_acs_r_scaled"] {
-        assert!(names.iter().any(|n| n == name), "{name}: {names:?}");
+    for (node, child) in [
+        ("HLI", "gpAx"),
+        ("gpAx", "[1]"),
+        ("gpAx[1]^", "lr_state"),
+        ("gpAx[1]^lr_state", "command_position_acs_r"),
+        ("gpAx[1]^lr_state", "command_position_acs_r_scaled"),
+    ] {
+        // Browse names in the server's namespace, as a browse path names them.
+        let names = children(node).await;
+        let child = format!("{ns}:{child}");
+        assert!(names.contains(&child), "{node}: {child} in {names:?}");
     }
+    let axes = children("gpAx").await;
+    assert_eq!(
+        axes.len(),
+        32,
+        "one element per axis, each by its index: {axes:?}"
+    );
 
     // The CNC goes: the value answers BadNoCommunication; back, the value again.
     source.present.store(false, Ordering::Release);

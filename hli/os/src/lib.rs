@@ -28,4 +28,4 @@ pub mod realtime;
 
 pub use memory::advise_huge_pages;
 #[cfg(target_os = "linux")]
-pub use process::wait_with_peak_memory;
+pub use process::{terminate, wait_with_peak_memory};

@@ -1,4 +1,4 @@
-//! Child processes: waiting for one and reading what it used.
+//! Child processes: asking one to end, waiting for one and reading what it used.
 
 /// Waits for `child` to end and returns whether it exited with status 0 and its peak resident
 /// memory in KiB (the kernel's `ru_maxrss` of that one process), for benchmarks that compare
@@ -16,6 +16,18 @@ pub fn wait_with_peak_memory(child: std::process::Child) -> std::io::Result<(boo
     }
     let success = libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0;
     Ok((success, usage.ru_maxrss))
+}
+
+/// Asks `child` to end (SIGTERM), the way an operator's `kill` does: it stops in its own
+/// controlled way. Not waited for.
+pub fn terminate(child: &std::process::Child) -> std::io::Result<()> {
+    let pid = libc::pid_t::try_from(child.id()).map_err(std::io::Error::other)?;
+    // SAFETY: kill(2) takes two integers and touches no memory of ours; `pid` is our own child,
+    // not yet waited for (we hold its `Child`), so the pid cannot belong to another process.
+    if unsafe { libc::kill(pid, libc::SIGTERM) } != 0 {
+        return Err(std::io::Error::last_os_error());
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -57,8 +57,8 @@ enum Command {
     /// the same as the `plc` binary.
     #[command(args_conflicts_with_subcommands = true)]
     Plc(plc_shim::cli::PlcCli),
-    /// Serve a running CNC's image over OPC UA (read-only, anonymous): runs the `cnc-opcua`
-    /// binary built beside this one (`cargo build --release -p cnc-opcua`).
+    /// Serve a running CNC's image over OPC UA (docs/opcua.md): runs the `cnc-opcua` binary
+    /// built beside this one (`cargo build --release -p cnc-opcua`).
     Opcua {
         /// The CNC's instance name.
         #[arg(long)]
@@ -70,6 +70,9 @@ enum Command {
         /// system's temporary folder).
         #[arg(long)]
         pki: Option<std::path::PathBuf>,
+        /// The server's configuration: users, writable leaves, certificates, limits (TOML).
+        #[arg(long)]
+        config: Option<std::path::PathBuf>,
     },
 }
 
@@ -107,32 +110,8 @@ fn main() -> ExitCode {
             instance,
             port,
             pki,
-        } => opcua(&instance, port, pki.as_deref()),
-    }
-}
-
-/// `cnc opcua`: the `cnc-opcua` binary beside this one, with the same arguments; its exit
-/// code is this one's.
-fn opcua(instance: &str, port: u16, pki: Option<&std::path::Path>) -> ExitCode {
-    let Some(binary) = std::env::current_exe()
-        .ok()
-        .and_then(|me| me.parent().map(|dir| dir.join("cnc-opcua")))
-        .filter(|path| path.is_file())
-    else {
-        eprintln!("cnc opcua: no cnc-opcua binary beside cnc (build it: cargo build --release -p cnc-opcua)");
-        return ExitCode::from(2);
-    };
-    let mut command = std::process::Command::new(binary);
-    command.args(["--instance", instance, "--port", &port.to_string()]);
-    if let Some(pki) = pki {
-        command.arg("--pki").arg(pki);
-    }
-    match command.status() {
-        Ok(status) => ExitCode::from(status.code().map_or(1, |c| c.clamp(0, 255) as u8)),
-        Err(e) => {
-            eprintln!("cnc opcua: {e}");
-            ExitCode::from(1)
-        }
+            config,
+        } => cnc_app::opcua::main(&instance, port, pki.as_deref(), config.as_deref()),
     }
 }
 

@@ -85,6 +85,9 @@ pub struct RunArgs {
     /// Real-time options of the tick loop (over the scenario's `[realtime]`).
     #[command(flatten)]
     pub realtime: plc_shim::realtime::RealtimeOptions,
+    /// An OPC UA server beside the run.
+    #[command(flatten)]
+    pub opcua: crate::opcua::OpcuaArgs,
 }
 
 /// How to run.
@@ -107,6 +110,9 @@ pub struct RunOptions {
     /// Where `LOG_FILE`s are written while the run goes on (`None`: only at the end, by the
     /// caller).
     pub log_dir: Option<PathBuf>,
+    /// `--opcua [PORT]`: an OPC UA server on the run's instance from the segment's start to
+    /// the last tick.
+    pub opcua: crate::opcua::OpcuaArgs,
 }
 
 /// Why a run stopped before its end.
@@ -269,6 +275,7 @@ pub fn main(args: RunArgs) -> ExitCode {
         plc_restart: args.plc_restart,
         realtime: args.realtime.clone(),
         log_dir: Some(args.log_dir.clone()),
+        opcua: args.opcua.clone(),
     };
     hli::signals::capture();
     match run(&scenario, &options) {
@@ -355,6 +362,7 @@ fn run_machine(
     options: &RunOptions,
 ) -> Result<RunReport, String> {
     let mut link = PlcLink::open(scenario, machine, options)?;
+    let opcua = crate::opcua::Beside::start(&options.instance, &options.opcua)?;
     // After spawning: the PLC must not inherit the CNC's scheduling and CPU.
     let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
     let bounds = Bounds::of(scenario, options)?;
@@ -372,6 +380,9 @@ fn run_machine(
     }
     let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
+    if let Some(server) = opcua {
+        server.stop();
+    }
     let ticks = machine.ticks();
     let mut plc_output = String::new();
     for child in ending.lost_plcs.drain(..) {

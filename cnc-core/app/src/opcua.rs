@@ -1,0 +1,122 @@
+//! The OPC UA server beside a CNC: `cnc opcua` runs the `cnc-opcua` binary built beside
+//! `cnc` (the OPC UA stack stays out of this package's build), and `cnc run`/`cnc demo
+//! --opcua [PORT]` start it on their own instance once the segment is up and stop it (SIGTERM)
+//! after the last tick.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitCode, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// How long the server may take to say it serves (a watchdog: it normally takes well under a
+/// second, a first start that makes its certificate a few).
+const START_WATCHDOG: Duration = Duration::from_secs(60);
+
+/// `--opcua [PORT]` and `--opcua-config FILE` of `cnc run` and `cnc demo`.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct OpcuaArgs {
+    /// Serve the image over OPC UA while the run goes, on PORT (default 4840): the
+    /// `cnc-opcua` binary beside `cnc`, attached to this run's instance (docs/opcua.md).
+    #[arg(long, num_args = 0..=1, default_missing_value = "4840", value_name = "PORT")]
+    pub opcua: Option<u16>,
+    /// The OPC UA server's configuration (users, writable leaves, certificates, limits).
+    #[arg(long, requires = "opcua", value_name = "FILE")]
+    pub opcua_config: Option<PathBuf>,
+}
+
+/// The `cnc-opcua` binary beside the running one.
+fn binary() -> Result<PathBuf, String> {
+    std::env::current_exe()
+        .ok()
+        .and_then(|me| me.parent().map(|dir| dir.join("cnc-opcua")))
+        .filter(|path| path.is_file())
+        .ok_or_else(|| {
+            "no cnc-opcua binary beside cnc (build it: cargo build --release -p cnc-opcua)".into()
+        })
+}
+
+/// `cnc opcua`: the binary with the same arguments; its exit code is this one's.
+pub fn main(instance: &str, port: u16, pki: Option<&Path>, config: Option<&Path>) -> ExitCode {
+    let binary = match binary() {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("cnc opcua: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let mut command = Command::new(binary);
+    command.args(["--instance", instance, "--port", &port.to_string()]);
+    if let Some(pki) = pki {
+        command.arg("--pki").arg(pki);
+    }
+    if let Some(config) = config {
+        command.arg("--config").arg(config);
+    }
+    match command.status() {
+        Ok(status) => ExitCode::from(status.code().map_or(1, |c| c.clamp(0, 255) as u8)),
+        Err(e) => {
+            eprintln!("cnc opcua: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// A server started beside a run.
+pub struct Beside {
+    child: Child,
+    forward: std::thread::JoinHandle<()>,
+}
+
+impl Beside {
+    /// Starts the server on `instance` when `args` ask for one; returns once it serves, or
+    /// why it did not (it said so and ended: a port in use, a bad configuration).
+    pub fn start(instance: &str, args: &OpcuaArgs) -> Result<Option<Beside>, String> {
+        let Some(port) = args.opcua else {
+            return Ok(None);
+        };
+        let mut command = Command::new(binary()?);
+        command.args(["--instance", instance, "--port", &port.to_string()]);
+        if let Some(config) = &args.opcua_config {
+            command.arg("--config").arg(config);
+        }
+        let mut child = command
+            .stderr(Stdio::piped())
+            .spawn()
+            .map_err(|e| format!("cnc-opcua: {e}"))?;
+        let stderr = child.stderr.take().ok_or("cnc-opcua: no stderr")?;
+        let (serving, seen) = mpsc::channel();
+        // Its lines go on to our stderr; the first that says it serves is reported.
+        let forward = std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                eprintln!("{line}");
+                if line.contains("serving on") {
+                    let _ = serving.send(());
+                }
+            }
+        });
+        match seen.recv_timeout(START_WATCHDOG) {
+            Ok(()) => Ok(Some(Beside { child, forward })),
+            Err(_) => {
+                let _ = child.kill();
+                let status = child.wait().map_err(|e| e.to_string())?;
+                let _ = forward.join();
+                Err(format!("the OPC UA server did not start ({status})"))
+            }
+        }
+    }
+
+    /// Stops the server (SIGTERM) and waits for it.
+    pub fn stop(mut self) {
+        if let Err(e) = cnc_os::terminate(&self.child) {
+            eprintln!("cnc-opcua: {e}");
+            let _ = self.child.kill();
+        }
+        match self.child.wait() {
+            Ok(status) if status.success() => {}
+            Ok(status) => eprintln!("cnc-opcua ended: {status}"),
+            Err(e) => eprintln!("cnc-opcua: {e}"),
+        }
+        let _ = self.forward.join();
+    }
+}
