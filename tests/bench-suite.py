@@ -44,6 +44,8 @@ BENCHES = [
      "exact stop, a lower bound, the exact-stop channel tick"),
     ("cnc-app", "scaling", "machine tick against machine size", "its own smallest size"),
     ("cnc-app", "tick_latency", "tick start lateness, whole processes", "cyclictest"),
+    ("cnc-opcua", "lateness", "tick lateness with an OPC UA client of 1,000 items",
+     "the same run without the client"),
 ]
 
 # Peer program -> Debian package.
