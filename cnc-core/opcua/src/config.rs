@@ -34,6 +34,8 @@ pub struct Config {
     /// Axis indices whose positions are degrees (the rest are millimetres).
     #[serde(default)]
     pub rotary_axes: Vec<usize>,
+    /// Pin every thread of the server to this CPU (away from the CNC's `--rt-cpu`).
+    pub cpu: Option<usize>,
     /// Session and subscription limits.
     #[serde(default)]
     pub limits: Limits,

@@ -34,6 +34,10 @@ use std::sync::Arc;
 /// The namespace of the image's nodes.
 pub const NAMESPACE: &str = "urn:cnc-plc-runtime:hli";
 
+/// Data changes per publish message at most (about 35 bytes each: far below a message's
+/// 327 KB limit).
+pub const MAX_NOTIFICATIONS_PER_PUBLISH: u64 = 1_000;
+
 /// Why the server could not be built.
 #[derive(Debug)]
 pub struct BuildError(pub String);
@@ -107,6 +111,11 @@ pub fn build(
     subs.max_monitored_items_per_sub = config.limits.max_monitored_items_per_subscription;
     subs.min_sampling_interval_ms = config.limits.min_sampling_interval_ms;
     subs.min_publishing_interval_ms = config.limits.min_publishing_interval_ms;
+    // Without a cap, one publish carries every queued sample of every item: 1,000 items
+    // sampled ten times between publishes pass the 327 KB message limit of async-opcua's
+    // defaults, and the message is lost whole. The notifications go out in messages of at
+    // most this many.
+    subs.max_notifications_per_publish = MAX_NOTIFICATIONS_PER_PUBLISH;
     let poll = config.limits.min_publishing_interval_ms.round() as u64;
     builder = builder.subscription_poll_interval_ms(poll);
     let (builder, auth) = endpoints(builder, config);

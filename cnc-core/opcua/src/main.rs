@@ -50,7 +50,14 @@ fn parse(args: &[String]) -> Result<Args, String> {
     })
 }
 
+/// The server's nice value: every thread of it yields the CPU to the CNC and the PLC first.
+const NICE: i32 = 19;
+
 fn main() -> ExitCode {
+    // Before the runtime starts its threads, which inherit it.
+    if let Err(e) = cnc_os::realtime::set_nice(NICE) {
+        eprintln!("cnc-opcua: nice {NICE}: {e} (runs at the default priority)");
+    }
     let argv: Vec<String> = std::env::args().skip(1).collect();
     let args = match parse(&argv) {
         Ok(a) => a,
@@ -63,6 +70,12 @@ fn main() -> ExitCode {
         },
         None => Config::default(),
     };
+    if let Some(cpu) = config.cpu {
+        // Before the runtime starts its threads, which inherit it.
+        if let Err(e) = cnc_os::realtime::pin_to_cpu(cpu) {
+            return fail(2, &format!("configuration refused: cpu = {cpu}: {e}"));
+        }
+    }
     let port = args.port.or(config.port).unwrap_or(4840);
     if let Err(e) = std::net::TcpListener::bind(("0.0.0.0", port)) {
         return fail(2, &format!("port {port}: {e}"));

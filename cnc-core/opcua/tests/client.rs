@@ -350,3 +350,83 @@ async fn limits() {
     assert!(d.is_some(), "a session after one closed");
     served.stop(&[&a, &d.unwrap()]).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_subscription_of_more_items_than_a_message_may_hold_delivers_them_all() {
+    with_watchdog(many_items()).await;
+}
+
+/// 1,500 items that change every 2 ms, sampled every 10 ms and published every 500 ms: each
+/// publish holds up to 15,000 changes, far past async-opcua's 327 KB message limit, so the
+/// server splits them over messages (`MAX_NOTIFICATIONS_PER_PUBLISH`). 30,000 changes arrive.
+async fn many_items() {
+    use opcua::client::DataChangeCallback;
+    use opcua::types::{MonitoredItemCreateRequest, TimestampsToReturn};
+    use std::sync::atomic::AtomicUsize;
+    const ITEMS: usize = 1_500;
+    const EXPECTED: usize = 20 * ITEMS;
+    let source = Arc::new(Switchable {
+        image: heap_image(12, 32),
+        present: AtomicBool::new(true),
+    });
+    let leaves: Vec<(String, Leaf)> = hli::symbols::SymbolTable::global()
+        .symbols()
+        .iter()
+        .filter(|s| {
+            matches!(
+                s.kind,
+                hli::symbols::SymbolKind::Leaf(hli::desc::Scalar::Dint)
+            )
+        })
+        .take(ITEMS)
+        .map(|s| (s.path.clone(), Leaf::resolve(&s.path).unwrap()))
+        .collect();
+    assert_eq!(leaves.len(), ITEMS);
+    let served = serve(source.clone(), Config::default(), "many");
+    let session = connect(served.port, &served.dir.join("client")).await;
+    // The "CNC": every leaf takes a new value every 2 ms.
+    let writer = {
+        let (source, leaves) = (source.clone(), leaves.clone());
+        tokio::spawn(async move {
+            for k in 0i64.. {
+                for (_, leaf) in &leaves {
+                    leaf.write(&source.image, Value::Int(k));
+                }
+                tokio::time::sleep(Duration::from_millis(2)).await;
+            }
+        })
+    };
+    let received = Arc::new(AtomicUsize::new(0));
+    let (count, all) = (received.clone(), Arc::new(tokio::sync::Notify::new()));
+    let done = all.clone();
+    let callback = DataChangeCallback::new(move |_, _| {
+        if count.fetch_add(1, Ordering::Relaxed) + 1 == EXPECTED {
+            done.notify_one();
+        }
+    });
+    let sub = session
+        .create_subscription(Duration::from_millis(500), 100, 10, 0, 0, true, callback)
+        .await
+        .unwrap();
+    let items: Vec<MonitoredItemCreateRequest> = leaves
+        .iter()
+        .map(|(path, _)| {
+            let mut item: MonitoredItemCreateRequest = NodeId::new(served.ns, path.as_str()).into();
+            item.requested_parameters.sampling_interval = 10.0;
+            item.requested_parameters.queue_size = 50;
+            item
+        })
+        .collect();
+    // Two requests: one of 1,500 would pass the client's 1,000-element array limit.
+    for half in items.chunks(ITEMS / 2) {
+        let created = session
+            .create_monitored_items(sub, TimestampsToReturn::Both, half.to_vec())
+            .await
+            .unwrap();
+        assert!(created.iter().all(|c| c.result.status_code.is_good()));
+    }
+    all.notified().await;
+    assert!(received.load(Ordering::Relaxed) >= EXPECTED);
+    writer.abort();
+    served.stop(&[&session]).await;
+}

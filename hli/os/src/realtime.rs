@@ -22,6 +22,15 @@ pub fn set_fifo_priority(priority: i32) -> io::Result<()> {
     check(unsafe { libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) })
 }
 
+/// Gives the calling thread, and every thread it starts afterwards, the nice value `nice`
+/// (0..=19; 19 yields the CPU to everything else first): for tools beside the real-time
+/// processes.
+pub fn set_nice(nice: i32) -> io::Result<()> {
+    // SAFETY: setpriority takes integers only; PRIO_PROCESS with who = 0 names the calling
+    // thread on Linux. The call only changes its scheduling weight.
+    check(unsafe { libc::setpriority(libc::PRIO_PROCESS as _, 0, nice) })
+}
+
 /// Pins the calling thread to CPU `cpu`.
 pub fn pin_to_cpu(cpu: usize) -> io::Result<()> {
     if cpu >= libc::CPU_SETSIZE as usize {
