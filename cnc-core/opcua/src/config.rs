@@ -143,6 +143,13 @@ impl Config {
                     format!("`{path}` is written by the CNC: no client may"),
                 ));
             }
+            // The header's PLC side is the PLC's identity and liveness; drive and I/O leaves
+            // are the field's. Only the PLC's own control leaves may be opened.
+            let control = matches!(leaf.writer, SymbolWriter::Plc | SymbolWriter::Both);
+            if path.starts_with("header.") || !control {
+                let why = format!("`{path}` is not a PLC control leaf: no client may write it");
+                return Err((key, why));
+            }
         }
         if !self.writable.is_empty() && self.users.is_empty() {
             return Err((
@@ -248,6 +255,11 @@ mod tests {
         );
         let cnc_owned = "writable = ['gpAx[0]^lr_state.current_position_acs_r']\n[[users]]\nname='a'\npassword='b'";
         assert_eq!(key_of(cnc_owned), "writable[0]");
+        let liveness = "writable = ['header.plc_heartbeat']\n[[users]]\nname='a'\npassword='b'";
+        assert!(parsed(liveness)
+            .unwrap_err()
+            .1
+            .contains("not a PLC control leaf"));
         assert!(parsed(cnc_owned)
             .unwrap_err()
             .1
