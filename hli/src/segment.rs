@@ -662,6 +662,12 @@ impl PlcSegment {
         !self.cnc_visible || start_stamp_at(&self.cnc_stat) == Some(self.seen.cnc_start_stamp)
     }
 
+    /// Whether the CNC was seen running at attach and still runs (a tool that must not serve
+    /// a dead CNC's image: a killed CNC leaves its segment marked Ready).
+    pub fn cnc_known_alive(&self) -> bool {
+        self.cnc_visible && self.cnc_process_alive()
+    }
+
     /// The CNC's timing, as announced at attach.
     pub fn cnc_timing(&self) -> CncTiming {
         self.timing

@@ -40,7 +40,7 @@ impl AuthManager for Auth {
             .authenticate_username_identity_token(endpoint, username, password)
             .await;
         if result.is_err() {
-            eprintln!("cnc-opcua: login of `{username}` refused");
+            crate::say!("login of `{username}` refused");
         }
         result
     }

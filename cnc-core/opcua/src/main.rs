@@ -7,6 +7,7 @@
 
 use cnc_opcua::source::Change;
 use cnc_opcua::{Config, Instance, Options};
+use opcua::server::ServerHandle;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -15,7 +16,8 @@ use std::time::Duration;
 /// How often the server looks whether its CNC is gone or back.
 const REATTACH_EVERY: Duration = Duration::from_millis(200);
 
-const USAGE: &str = "usage: cnc-opcua --instance NAME [--port 4840] [--pki DIR] [--config FILE]";
+const USAGE: &str = "usage: cnc-opcua --instance NAME [--port 4840] [--pki DIR] [--config FILE] \
+                     [--end-with-stdin]";
 
 /// The command line.
 struct Args {
@@ -23,12 +25,19 @@ struct Args {
     port: Option<u16>,
     pki: Option<PathBuf>,
     config: Option<PathBuf>,
+    /// End when stdin closes (a server started beside a run ends with it).
+    end_with_stdin: bool,
 }
 
 fn parse(args: &[String]) -> Result<Args, String> {
     let (mut instance, mut port, mut pki, mut config) = (None, None, None, None);
+    let mut end_with_stdin = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
+        if a == "--end-with-stdin" {
+            end_with_stdin = true;
+            continue;
+        }
         match (a.as_str(), it.next()) {
             ("--instance", Some(v)) => instance = Some(v.clone()),
             ("--port", Some(v)) => {
@@ -47,6 +56,7 @@ fn parse(args: &[String]) -> Result<Args, String> {
         port,
         pki,
         config,
+        end_with_stdin,
     })
 }
 
@@ -56,7 +66,7 @@ const NICE: i32 = 19;
 fn main() -> ExitCode {
     // Before the runtime starts its threads, which inherit it.
     if let Err(e) = cnc_os::realtime::set_nice(NICE) {
-        eprintln!("cnc-opcua: nice {NICE}: {e} (runs at the default priority)");
+        cnc_opcua::say!("nice {NICE}: {e} (runs at the default priority)");
     }
     let argv: Vec<String> = std::env::args().skip(1).collect();
     let args = match parse(&argv) {
@@ -77,11 +87,17 @@ fn main() -> ExitCode {
         }
     }
     let port = args.port.or(config.port).unwrap_or(4840);
-    if let Err(e) = std::net::TcpListener::bind(("0.0.0.0", port)) {
-        return fail(2, &format!("port {port}: {e}"));
-    }
+    // Bound here and kept: the server says it serves once it listens.
+    let listener = match std::net::TcpListener::bind(("0.0.0.0", port)) {
+        Ok(l) => l,
+        Err(e) => return fail(2, &format!("port {port}: {e}")),
+    };
     let instance = match Instance::attach(&args.instance) {
-        Ok(i) => Arc::new(i),
+        Ok(i) if i.serves() => Arc::new(i),
+        Ok(_) => {
+            let why = "its segment was left by a CNC process that no longer runs";
+            return fail(3, &format!("instance {}: {why}", args.instance));
+        }
         Err(e) => return fail(3, &format!("instance {}: {e}", args.instance)),
     };
     let pki = args
@@ -93,58 +109,95 @@ fn main() -> ExitCode {
         config,
     };
     match tokio::runtime::Runtime::new() {
-        Ok(runtime) => runtime.block_on(serve(instance, options)),
+        Ok(runtime) => runtime.block_on(serve(instance, options, listener, args.end_with_stdin)),
         Err(e) => fail(1, &e.to_string()),
     }
 }
 
 fn fail(code: u8, message: &str) -> ExitCode {
-    eprintln!("cnc-opcua: {message}");
+    cnc_opcua::say!("{message}");
     ExitCode::from(code)
 }
 
-/// Serves until a signal; reports the CNC going and coming back.
-async fn serve(instance: Arc<Instance>, options: Options) -> ExitCode {
+/// Serves until a signal (or, with `--end-with-stdin`, until stdin closes); reports the CNC
+/// going and coming back.
+async fn serve(
+    instance: Arc<Instance>,
+    options: Options,
+    listener: std::net::TcpListener,
+    end_with_stdin: bool,
+) -> ExitCode {
+    let listener = match listener
+        .set_nonblocking(true)
+        .and_then(|()| tokio::net::TcpListener::from_std(listener))
+    {
+        Ok(l) => l,
+        Err(e) => return fail(1, &format!("port {}: {e}", options.port)),
+    };
     let source: Arc<dyn cnc_opcua::ImageSource> = instance.clone();
     let (server, handle) = match cnc_opcua::build(source, &options) {
         Ok(s) => s,
         Err(e) => return fail(1, &e.to_string()),
     };
-    let stop = handle.clone();
-    tokio::spawn(async move {
-        let kind = tokio::signal::unix::SignalKind::terminate();
-        let Ok(mut term) = tokio::signal::unix::signal(kind) else {
-            return;
-        };
-        tokio::select! {
-            _ = tokio::signal::ctrl_c() => eprintln!("cnc-opcua: SIGINT, stopping"),
-            _ = term.recv() => eprintln!("cnc-opcua: SIGTERM, stopping"),
-        }
-        stop.cancel();
-    });
-    tokio::spawn(async move {
-        let mut ready = true;
-        loop {
-            tokio::time::sleep(REATTACH_EVERY).await;
-            match instance.refresh(ready) {
-                Change::Same => {}
-                Change::Gone => {
-                    eprintln!("cnc-opcua: the CNC of `{}` stopped; values answer BadNoCommunication until it is back", instance.name());
-                    ready = false;
-                }
-                Change::Back => {
-                    eprintln!(
-                        "cnc-opcua: a CNC of `{}` started; attached to it",
-                        instance.name()
-                    );
-                    ready = true;
-                }
-            }
-        }
-    });
-    eprintln!("cnc-opcua: serving on opc.tcp://0.0.0.0:{}/", options.port);
-    match server.run().await {
+    match stop_on_signal(handle.clone()) {
+        Ok(waiting) => drop(tokio::spawn(waiting)),
+        Err(e) => return fail(1, &format!("signal handlers: {e}")),
+    }
+    if end_with_stdin {
+        stop_when_stdin_closes(handle);
+    }
+    tokio::spawn(follow(instance));
+    cnc_opcua::say!("serving on opc.tcp://0.0.0.0:{}/", options.port);
+    match server.run_with(listener).await {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => fail(1, &e.to_string()),
+    }
+}
+
+/// Stops the server on SIGINT or SIGTERM, saying which. The handlers are installed before it
+/// returns (so before the server says it serves); the returned task waits for them.
+fn stop_on_signal(server: ServerHandle) -> std::io::Result<impl std::future::Future<Output = ()>> {
+    use tokio::signal::unix::{signal, SignalKind};
+    let mut int = signal(SignalKind::interrupt())?;
+    let mut term = signal(SignalKind::terminate())?;
+    Ok(async move {
+        tokio::select! {
+            _ = int.recv() => cnc_opcua::say!("SIGINT, stopping"),
+            _ = term.recv() => cnc_opcua::say!("SIGTERM, stopping"),
+        }
+        server.cancel();
+    })
+}
+
+/// Stops the server when stdin reaches its end: the process that started it (and holds the
+/// pipe's other end) closed it or ended, even by SIGKILL.
+fn stop_when_stdin_closes(server: ServerHandle) {
+    std::thread::spawn(move || {
+        let mut sink = std::io::sink();
+        let _ = std::io::copy(&mut std::io::stdin().lock(), &mut sink);
+        cnc_opcua::say!("stdin closed (the process that started it ended), stopping");
+        server.cancel();
+    });
+}
+
+/// Looks every [`REATTACH_EVERY`] whether the CNC went or a new one came; says both.
+async fn follow(instance: Arc<Instance>) {
+    let mut ready = true;
+    loop {
+        tokio::time::sleep(REATTACH_EVERY).await;
+        match instance.refresh(ready) {
+            Change::Same => {}
+            Change::Gone => {
+                let name = instance.name();
+                cnc_opcua::say!(
+                    "the CNC of `{name}` stopped; values answer BadNoCommunication until it is back"
+                );
+                ready = false;
+            }
+            Change::Back => {
+                cnc_opcua::say!("a CNC of `{}` started; attached to it", instance.name());
+                ready = true;
+            }
+        }
     }
 }

@@ -5,6 +5,7 @@
 use hli::enums::SegmentState;
 use hli::segment::{AttachError, PlcSegment};
 use hli::ImageMemory;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, RwLock};
 
 /// An image the server reads (and, for configured leaves, writes).
@@ -21,15 +22,24 @@ impl ImageSource for ImageMemory {
     }
 }
 
-/// Whether `segment`'s CNC still serves it.
+/// Whether `segment`'s CNC still serves it (cheap: one atomic load).
 fn ready(segment: &PlcSegment) -> bool {
     segment.cnc_state() == Ok(SegmentState::Ready)
+}
+
+/// Whether `segment` is Ready and its CNC process was seen at attach and still runs (a
+/// `/proc` read). A segment whose CNC died before the attach is not served.
+fn serving(segment: &PlcSegment) -> bool {
+    ready(segment) && segment.cnc_known_alive()
 }
 
 /// A CNC instance's segment, attached again after its CNC was replaced.
 pub struct Instance {
     name: String,
     current: RwLock<Arc<PlcSegment>>,
+    /// Whether the attached segment's CNC process still ran at the last [`Instance::refresh`]
+    /// (a killed CNC leaves its segment marked Ready).
+    alive: AtomicBool,
 }
 
 /// What [`Instance::refresh`] found.
@@ -46,10 +56,17 @@ pub enum Change {
 impl Instance {
     /// Attaches to the running CNC of `name` (refused when none runs).
     pub fn attach(name: &str) -> Result<Instance, AttachError> {
+        let segment = PlcSegment::inspect(name)?;
         Ok(Instance {
             name: name.to_owned(),
-            current: RwLock::new(Arc::new(PlcSegment::inspect(name)?)),
+            alive: AtomicBool::new(serving(&segment)),
+            current: RwLock::new(Arc::new(segment)),
         })
+    }
+
+    /// Whether the attached segment's CNC serves it (as the last look found).
+    pub fn serves(&self) -> bool {
+        self.alive.load(Ordering::Acquire)
     }
 
     /// The instance's name.
@@ -65,16 +82,30 @@ impl Instance {
     /// Looks whether the attached CNC is gone and, if so, whether a new one serves the
     /// instance: then attaches to it. `was_ready` is what the previous call saw (so a CNC
     /// gone is reported once).
+    /// Its CNC counts as gone when it closed the segment or when its process no longer runs
+    /// (a crash or a kill leaves the segment marked Ready): a `/proc` read, here and not on
+    /// every value.
     pub fn refresh(&self, was_ready: bool) -> Change {
-        if ready(&self.segment()) {
+        let segment = self.segment();
+        if serving(&segment) {
             return Change::Same;
         }
+        self.alive.store(false, Ordering::Release);
         match PlcSegment::inspect(&self.name) {
-            Ok(fresh) if ready(&fresh) => {
+            Ok(fresh) if serving(&fresh) => {
                 *self.current.write().unwrap_or_else(|e| e.into_inner()) = Arc::new(fresh);
+                self.alive.store(true, Ordering::Release);
                 Change::Back
             }
-            _ if was_ready => Change::Gone,
+            Ok(_) | Err(AttachError::NotFound { .. }) | Err(AttachError::NotReady { .. })
+                if was_ready =>
+            {
+                Change::Gone
+            }
+            Err(e) if was_ready => {
+                crate::say!("instance {}: {e}", self.name);
+                Change::Gone
+            }
             _ => Change::Same,
         }
     }
@@ -83,7 +114,7 @@ impl Instance {
 impl ImageSource for Instance {
     fn with_image(&self, f: &mut dyn FnMut(&ImageMemory)) -> bool {
         let segment = self.segment();
-        if !ready(&segment) {
+        if !ready(&segment) || !self.alive.load(Ordering::Acquire) {
             return false;
         }
         f(segment.memory());

@@ -26,9 +26,9 @@ pub enum Reading {
         /// Raw increments per engineering unit.
         per_unit: f64,
     },
-    /// Whether a PLC is attached and its heartbeat moved within the last second (the
-    /// heartbeat last seen and when it changed).
-    PlcAlive(Mutex<Option<(u64, Instant)>>),
+    /// Whether a PLC is attached and its heartbeat was seen to move within the last second
+    /// (the heartbeat last seen and when it was seen to change: never, at the first look).
+    PlcAlive(Mutex<Option<(u64, Option<Instant>)>>),
 }
 
 /// The OPC UA type of an ST type.
@@ -135,11 +135,15 @@ impl Reading {
                 let beats = header_u64(memory, offset_of!(HliSegmentHeader, plc_heartbeat));
                 let now = Instant::now();
                 let mut seen = seen.lock().unwrap_or_else(|e| e.into_inner());
+                // Alive once the heartbeat is seen to move, until it stands for a second.
                 let moved = match *seen {
-                    Some((last, at)) if last == beats => now.duration_since(at) < PLC_ALIVE_WITHIN,
-                    _ => {
-                        *seen = Some((beats, now));
-                        true
+                    Some((last, moved_at)) if last == beats => {
+                        moved_at.is_some_and(|at| now.duration_since(at) < PLC_ALIVE_WITHIN)
+                    }
+                    first_look => {
+                        let moved = first_look.is_some();
+                        *seen = Some((beats, moved.then_some(now)));
+                        moved
                     }
                 };
                 Variant::Boolean(pid != 0 && moved)
@@ -199,10 +203,7 @@ pub fn write(
         status = match check_protocol(memory, &one) {
             Ok(()) => {
                 leaf.write(memory, value);
-                eprintln!(
-                    "cnc-opcua: write {path} := {}",
-                    plc_shim::tools::show(&leaf, value)
-                );
+                crate::say!("write {path} := {}", plc_shim::tools::show(&leaf, value));
                 StatusCode::Good
             }
             Err(ToolError::Refused {
@@ -241,6 +242,29 @@ mod tests {
             (tick_stamp(&image).ticks() - now.ticks()).abs() < 10_000_000,
             "no epoch: now"
         );
+    }
+
+    #[test]
+    fn a_plc_is_alive_once_its_heartbeat_is_seen_to_move() {
+        use core::mem::offset_of;
+        let image = hli::segment::heap_image(1, 1);
+        let pid = image.place::<u32>(offset_of!(HliSegmentHeader, plc_pid));
+        let beats = image.place::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat));
+        let alive = Reading::PlcAlive(Mutex::new(None));
+        pid.store_release(4242);
+        beats.store_release(7);
+        // A PLC that left its pid and heartbeat behind: never seen moving.
+        assert_eq!(alive.read(&image), Variant::Boolean(false));
+        assert_eq!(alive.read(&image), Variant::Boolean(false));
+        beats.store_release(8);
+        assert_eq!(alive.read(&image), Variant::Boolean(true));
+        assert_eq!(
+            alive.read(&image),
+            Variant::Boolean(true),
+            "within the second"
+        );
+        pid.store_release(0);
+        assert_eq!(alive.read(&image), Variant::Boolean(false), "detached");
     }
 
     #[test]

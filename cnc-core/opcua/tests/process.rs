@@ -9,6 +9,8 @@ use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 use support::{connect, free_port, namespace, read};
+use tokio::io::{AsyncBufReadExt, Lines};
+use tokio::process::ChildStderr;
 use tokio::sync::mpsc::{unbounded_channel, UnboundedReceiver};
 
 mod support;
@@ -20,6 +22,17 @@ struct Server {
     child: Child,
     lines: UnboundedReceiver<String>,
     said: Vec<String>,
+}
+
+/// How long one awaited line of the server may take.
+const STEP_WATCHDOG: Duration = Duration::from_secs(30);
+
+/// A test that fails leaves no server behind.
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
 }
 
 impl Server {
@@ -43,15 +56,26 @@ impl Server {
         }
     }
 
-    /// Waits for a line that contains `needle` (the watchdog bounds it).
+    /// Waits for a line that contains `needle`; a watchdog of [`STEP_WATCHDOG`] names the
+    /// step that did not come and what the server said before.
     async fn expect(&mut self, needle: &str) {
-        while let Some(line) = self.lines.recv().await {
-            self.said.push(line.clone());
-            if line.contains(needle) {
-                return;
+        let seen = tokio::time::timeout(STEP_WATCHDOG, async {
+            while let Some(line) = self.lines.recv().await {
+                self.said.push(line.clone());
+                if line.contains(needle) {
+                    return true;
+                }
             }
+            false
+        });
+        match seen.await {
+            Ok(true) => {}
+            Ok(false) => panic!("`{needle}` never said; it ended: {:?}", self.said),
+            Err(_) => panic!(
+                "`{needle}` not said within {STEP_WATCHDOG:?}: {:?}",
+                self.said
+            ),
         }
-        panic!("`{needle}` never said: {:?}", self.said);
     }
 
     /// Waits for the exit; its code and everything said.
@@ -59,8 +83,9 @@ impl Server {
         while let Some(line) = self.lines.recv().await {
             self.said.push(line);
         }
+        let said = std::mem::take(&mut self.said);
         let status = tokio::task::spawn_blocking(move || self.child.wait().unwrap());
-        (status.await.unwrap().code(), self.said)
+        (status.await.unwrap().code(), said)
     }
 }
 
@@ -99,12 +124,7 @@ async fn scenario() {
     assert_eq!(read(&session, &id).await.value, Some(Variant::Int32(777)));
 
     let _ = session.disconnect().await;
-    let pid = server.child.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-TERM", &pid])
-        .status()
-        .unwrap()
-        .success());
+    sigterm(server.child.id());
     let (code, said) = server.finish().await;
     assert_eq!(code, Some(0), "{said:?}");
     assert!(said.iter().any(|l| l.contains("SIGTERM")), "{said:?}");
@@ -167,4 +187,170 @@ async fn refusals() {
     }
     drop(taken);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_killed_cnc_is_noticed_and_its_successor_attached() {
+    tokio::time::timeout(Duration::from_secs(90), killed())
+        .await
+        .expect("watchdog");
+}
+
+/// A CNC process killed with SIGKILL leaves its segment marked Ready: the server must see
+/// the process gone, answer BadNoCommunication, and attach to the next CNC. The CNC is the
+/// workspace's `hli-peer cnc-beat` (built beside `cnc-opcua` by `cargo test --workspace`).
+async fn killed() {
+    let server_exe = std::path::Path::new(env!("CARGO_BIN_EXE_cnc-opcua"));
+    let peer = server_exe.with_file_name("hli-peer");
+    if !peer.is_file() {
+        println!("skipped: no hli-peer beside cnc-opcua (cargo test --workspace builds it)");
+        return;
+    }
+    let instance = format!("opcua-killed-{}", std::process::id());
+    let mut cnc = Command::new(&peer)
+        .args(["cnc-beat", &instance])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(cnc.stdout.take().unwrap());
+    let mut line = String::new();
+    let out_read = tokio::task::spawn_blocking(move || out.read_line(&mut line).map(|_| line));
+    assert_eq!(out_read.await.unwrap().unwrap().trim(), "ready");
+    let dir = std::env::temp_dir().join(format!("cnc-opcua-killed-{}", std::process::id()));
+    let port = free_port().to_string();
+    let pki = dir.join("server").display().to_string();
+    let mut server = Server::start(&["--instance", &instance, "--port", &port, "--pki", &pki]);
+    server.expect("serving on").await;
+    let session = connect(port.parse().unwrap(), &dir.join("client")).await;
+    let tick = NodeId::new(namespace(&session).await, "Machine.Tick");
+    assert!(read(&session, &tick)
+        .await
+        .status
+        .is_some_and(|s| s.is_good()));
+
+    cnc.kill().unwrap();
+    cnc.wait().unwrap();
+    server.expect("stopped").await;
+    let value = read(&session, &tick).await;
+    assert_eq!(value.status, Some(StatusCode::BadNoCommunication));
+
+    // A server started now finds no CNC: the segment's process is dead.
+    let pki_late = dir.join("late").display().to_string();
+    let late = free_port().to_string();
+    let args = ["--instance", &instance, "--port", &late, "--pki", &pki_late];
+    let (code, said) = Server::start(&args).finish().await;
+    assert_eq!(code, Some(3), "{said:?}");
+    assert!(said.concat().contains("no longer runs"), "{said:?}");
+
+    // The next CNC replaces the dead one's segment; the server attaches to it.
+    let next = CncSegment::create(&instance, 1, 1).unwrap();
+    server.expect("attached").await;
+    assert!(read(&session, &tick)
+        .await
+        .status
+        .is_some_and(|s| s.is_good()));
+
+    let _ = session.disconnect().await;
+    sigterm(server.child.id());
+    let (code, said) = server.finish().await;
+    assert_eq!(code, Some(0), "{said:?}");
+    drop(next);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_server_whose_log_reader_is_gone_still_stops_on_sigterm() {
+    tokio::time::timeout(Duration::from_secs(60), deaf())
+        .await
+        .expect("watchdog");
+}
+
+/// The server's stderr is a pipe whose reader closes once it serves: its log lines then
+/// fail, which must not keep it from stopping on SIGTERM (the line that says so panicked
+/// and ended the task that waits for the signal, before it stopped the server).
+async fn deaf() {
+    let (cnc, dir, args) = one_cnc("deaf");
+    let (mut child, mut lines) = spawn(&args);
+    serving(&mut lines).await;
+    drop(lines); // the pipe's read end closes
+                 // The server says that SIGTERM stops it: into the closed pipe.
+    sigterm(child.id().unwrap());
+    let status = child.wait().await;
+    assert_eq!(status.unwrap().code(), Some(0));
+    drop(cnc);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A CNC segment of its own instance (named by `tag`), a directory for the certificates, and
+/// the server's arguments for both.
+fn one_cnc(tag: &str) -> (CncSegment, std::path::PathBuf, Vec<String>) {
+    let instance = format!("opcua-{tag}-{}", std::process::id());
+    let cnc = CncSegment::create(&instance, 1, 1).unwrap();
+    let dir = std::env::temp_dir().join(format!("cnc-opcua-{tag}-{}", std::process::id()));
+    let pki = dir.join("server").display().to_string();
+    let port = free_port().to_string();
+    let args = ["--instance", &instance, "--port", &port, "--pki", &pki];
+    (cnc, dir, args.map(String::from).to_vec())
+}
+
+/// The server process, killed when the test fails (the watchdog drops it), its stdin and
+/// stderr piped; and its stderr's lines.
+fn spawn(
+    args: &[String],
+) -> (
+    tokio::process::Child,
+    Lines<tokio::io::BufReader<ChildStderr>>,
+) {
+    let mut child = tokio::process::Command::new(env!("CARGO_BIN_EXE_cnc-opcua"))
+        .args(args)
+        .stdin(Stdio::piped())
+        .stderr(Stdio::piped())
+        .kill_on_drop(true)
+        .spawn()
+        .unwrap();
+    let stderr = child.stderr.take().unwrap();
+    (child, tokio::io::BufReader::new(stderr).lines())
+}
+
+/// Reads `lines` until the server says it serves.
+async fn serving(lines: &mut Lines<tokio::io::BufReader<ChildStderr>>) {
+    while let Some(line) = lines.next_line().await.unwrap() {
+        if line.contains("serving on") {
+            return;
+        }
+    }
+    panic!("the server ended before it served");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_server_started_with_end_with_stdin_ends_when_its_stdin_closes() {
+    tokio::time::timeout(Duration::from_secs(60), orphaned())
+        .await
+        .expect("watchdog");
+}
+
+/// `cnc run --opcua` holds the server's stdin: when that process ends, even by SIGKILL, the
+/// pipe closes and the server stops (it would otherwise serve on, an orphan).
+async fn orphaned() {
+    let (cnc, dir, mut args) = one_cnc("orphan");
+    args.push("--end-with-stdin".into());
+    let (mut child, mut lines) = spawn(&args);
+    serving(&mut lines).await;
+    drop(child.stdin.take());
+    let mut said = Vec::new();
+    while let Some(line) = lines.next_line().await.unwrap() {
+        said.push(line);
+    }
+    assert_eq!(child.wait().await.unwrap().code(), Some(0), "{said:?}");
+    assert!(said.concat().contains("stdin closed"), "{said:?}");
+    drop(cnc);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Sends SIGTERM to the process `pid`.
+fn sigterm(pid: u32) {
+    let pid = pid.to_string();
+    let sent = Command::new("kill").args(["-TERM", &pid]).status().unwrap();
+    assert!(sent.success());
 }
