@@ -3,7 +3,7 @@
 //! --opcua [PORT]` start it on their own instance once the segment is up and stop it (SIGTERM)
 //! after the last tick.
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use std::sync::mpsc;
@@ -65,7 +65,9 @@ pub fn main(instance: &str, port: u16, pki: Option<&Path>, config: Option<&Path>
 /// A server started beside a run.
 pub struct Beside {
     child: Child,
-    forward: std::thread::JoinHandle<()>,
+    /// The server's stdin: it ends when this closes, so also when this process is killed.
+    _lifeline: std::process::ChildStdin,
+    forward: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Beside {
@@ -77,26 +79,35 @@ impl Beside {
         };
         let mut command = Command::new(binary()?);
         command.args(["--instance", instance, "--port", &port.to_string()]);
+        command.arg("--end-with-stdin");
         if let Some(config) = &args.opcua_config {
             command.arg("--config").arg(config);
         }
         let mut child = command
+            .stdin(Stdio::piped())
             .stderr(Stdio::piped())
             .spawn()
             .map_err(|e| format!("cnc-opcua: {e}"))?;
         let stderr = child.stderr.take().ok_or("cnc-opcua: no stderr")?;
+        let lifeline = child.stdin.take().ok_or("cnc-opcua: no stdin")?;
         let (serving, seen) = mpsc::channel();
         // Its lines go on to our stderr; the first that says it serves is reported.
         let forward = std::thread::spawn(move || {
             for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                eprintln!("{line}");
+                // A closed stderr of ours must not end the forwarding (the server would
+                // then write into a closed pipe).
+                let _ = writeln!(std::io::stderr(), "{line}");
                 if line.contains("serving on") {
                     let _ = serving.send(());
                 }
             }
         });
         match seen.recv_timeout(START_WATCHDOG) {
-            Ok(()) => Ok(Some(Beside { child, forward })),
+            Ok(()) => Ok(Some(Beside {
+                child,
+                _lifeline: lifeline,
+                forward: Some(forward),
+            })),
             Err(_) => {
                 let _ = child.kill();
                 let status = child.wait().map_err(|e| e.to_string())?;
@@ -105,18 +116,44 @@ impl Beside {
             }
         }
     }
+}
 
-    /// Stops the server (SIGTERM) and waits for it.
-    pub fn stop(mut self) {
+/// How long the server may take to end after SIGTERM before it is killed.
+const STOP_WATCHDOG: Duration = Duration::from_secs(5);
+
+/// Dropped (after the last tick, or when the run fails before it): the server is stopped
+/// with SIGTERM, killed if it has not ended within [`STOP_WATCHDOG`], and waited for.
+impl Drop for Beside {
+    fn drop(&mut self) {
         if let Err(e) = cnc_os::terminate(&self.child) {
             eprintln!("cnc-opcua: {e}");
-            let _ = self.child.kill();
         }
-        match self.child.wait() {
-            Ok(status) if status.success() => {}
-            Ok(status) => eprintln!("cnc-opcua ended: {status}"),
-            Err(e) => eprintln!("cnc-opcua: {e}"),
+        let deadline = std::time::Instant::now() + STOP_WATCHDOG;
+        let ended = loop {
+            match self.child.try_wait() {
+                Ok(Some(status)) => break Some(status),
+                Ok(None) if std::time::Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                _ => break None,
+            }
+        };
+        let status = match ended {
+            Some(status) => status,
+            None => {
+                eprintln!("cnc-opcua: still running {STOP_WATCHDOG:?} after SIGTERM: killed");
+                let _ = self.child.kill();
+                match self.child.wait() {
+                    Ok(status) => status,
+                    Err(_) => return,
+                }
+            }
+        };
+        if !status.success() {
+            eprintln!("cnc-opcua ended: {status}");
         }
-        let _ = self.forward.join();
+        if let Some(forward) = self.forward.take() {
+            let _ = forward.join();
+        }
     }
 }

@@ -380,9 +380,7 @@ fn run_machine(
     }
     let (mut measured, mut ending) =
         TickLoop::new(scenario, options, machine, &mut link, &bounds, measured).run();
-    if let Some(server) = opcua {
-        server.stop();
-    }
+    drop(opcua); // stops the server (also when an error above returns early)
     let ticks = machine.ticks();
     let mut plc_output = String::new();
     for child in ending.lost_plcs.drain(..) {
