@@ -196,27 +196,44 @@ async fn a_killed_cnc_is_noticed_and_its_successor_attached() {
         .expect("watchdog");
 }
 
-/// A CNC process killed with SIGKILL leaves its segment marked Ready: the server must see
-/// the process gone, answer BadNoCommunication, and attach to the next CNC. The CNC is the
-/// workspace's `hli-peer cnc-beat` (built beside `cnc-opcua` by `cargo test --workspace`).
-async fn killed() {
-    let server_exe = std::path::Path::new(env!("CARGO_BIN_EXE_cnc-opcua"));
-    let peer = server_exe.with_file_name("hli-peer");
-    if !peer.is_file() {
-        println!("skipped: no hli-peer beside cnc-opcua (cargo test --workspace builds it)");
+/// The test that plays the CNC process of [`killed`], and its environment variable.
+const CNC_ROLE: &str = "a_cnc_process_for_the_kill_test";
+const CNC_ROLE_ENV: &str = "CNC_OPCUA_TEST_CNC";
+
+/// Not a test of its own: this binary, run again by [`killed`] with [`CNC_ROLE_ENV`] set to an
+/// instance, is its CNC. It creates the instance's segment, says `ready` and waits until it
+/// is killed (or its stdin closes). Without the variable it does nothing.
+#[test]
+fn a_cnc_process_for_the_kill_test() {
+    use std::io::Write;
+    let Ok(instance) = std::env::var(CNC_ROLE_ENV) else {
         return;
-    }
+    };
+    let _segment = CncSegment::create(&instance, 1, 1).unwrap();
+    println!("ready");
+    std::io::stdout().flush().unwrap();
+    let _ = std::io::stdin().lock().lines().count();
+}
+
+/// A CNC process killed with SIGKILL leaves its segment marked Ready: the server must see
+/// the process gone, answer BadNoCommunication, and attach to the next CNC.
+async fn killed() {
     let instance = format!("opcua-killed-{}", std::process::id());
-    let mut cnc = Command::new(&peer)
-        .args(["cnc-beat", &instance])
+    // This test binary again, as the CNC (it ends when its stdin closes, so with this test).
+    let mut cnc = Command::new(std::env::current_exe().unwrap())
+        .args([CNC_ROLE, "--exact", "--nocapture"])
+        .env(CNC_ROLE_ENV, &instance)
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .spawn()
         .unwrap();
-    let mut out = BufReader::new(cnc.stdout.take().unwrap());
-    let mut line = String::new();
-    let out_read = tokio::task::spawn_blocking(move || out.read_line(&mut line).map(|_| line));
-    assert_eq!(out_read.await.unwrap().unwrap().trim(), "ready");
+    let out = BufReader::new(cnc.stdout.take().unwrap());
+    let ready = tokio::task::spawn_blocking(move || {
+        out.lines()
+            .map_while(Result::ok)
+            .any(|line| line == "ready")
+    });
+    assert!(ready.await.unwrap(), "the CNC process did not start");
     let dir = std::env::temp_dir().join(format!("cnc-opcua-killed-{}", std::process::id()));
     let port = free_port().to_string();
     let pki = dir.join("server").display().to_string();
