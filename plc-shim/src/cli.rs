@@ -186,59 +186,87 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
     ) {
         Ok(runtime) => runtime,
         Err(e) => {
-            eprintln!("plc: {e}");
+            say_err(&format!("plc: {e}"));
             return ExitCode::from(1);
         }
     };
     let realtime = args.realtime.apply("plc");
     if !realtime.is_empty() {
-        println!("plc: real-time {}", realtime.join(", "));
+        say_out(&format!("plc: real-time {}", realtime.join(", ")));
     }
     runtime.set_period_ticks(args.period_ticks);
     hli::signals::capture();
     match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
-            println!(
-                "plc: {} cycles, ended by {:?}",
-                summary.cycles(),
-                summary.end
-            );
-            println!("plc: task {}", summary.stats);
-            let w = &summary.wake_to_done;
-            println!(
-                "plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us",
-                w.cycles,
-                w.quantile_us(0.5),
-                w.quantile_us(0.99),
-                w.max_ns as f64 / 1e3
-            );
-            println!("{}", program.summary());
+            say_out(&report(&summary, program));
             runtime.detach();
-            match summary.end {
-                crate::runtime::RunEnd::CncLost(loss) => {
-                    eprintln!("plc: CNC lost: {loss}; the last cycle ran not operational");
-                    ExitCode::from(3)
-                }
-                crate::runtime::RunEnd::SegmentCorrupt(fault) => {
-                    eprintln!("plc: {fault}; the last cycle ran not operational");
-                    ExitCode::from(5)
-                }
-                crate::runtime::RunEnd::Replaced(pid) => {
-                    eprintln!("plc: PLC process {pid} took over the segment; stopping");
-                    ExitCode::from(6)
-                }
-                crate::runtime::RunEnd::Signal(signal) => {
-                    eprintln!("plc: stopped by {}", signal.name());
-                    ExitCode::from(signal.exit_code())
-                }
-                _ => ExitCode::SUCCESS,
+            let (code, why) = ending(&summary.end);
+            if let Some(why) = why {
+                say_err(&format!("plc: {why}"));
             }
+            ExitCode::from(code)
         }
         Err(e) => {
-            eprintln!("plc: {e}");
+            say_err(&format!("plc: {e}"));
             ExitCode::from(1)
         }
     }
+}
+
+/// The run's report: cycles, how it ended, the task's timing and the program's summary.
+fn report(summary: &crate::runtime::RunSummary, program: &dyn PlcProgram) -> String {
+    let w = &summary.wake_to_done;
+    format!(
+        "plc: {} cycles, ended by {:?}\nplc: task {}\n\
+         plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n{}",
+        summary.cycles(),
+        summary.end,
+        summary.stats,
+        w.cycles,
+        w.quantile_us(0.5),
+        w.quantile_us(0.99),
+        w.max_ns as f64 / 1e3,
+        program.summary()
+    )
+}
+
+/// The exit code of a run that ended with `end`, and what to say about it.
+fn ending(end: &crate::runtime::RunEnd) -> (u8, Option<String>) {
+    use crate::runtime::RunEnd;
+    match end {
+        RunEnd::CncLost(loss) => (
+            3,
+            Some(format!(
+                "CNC lost: {loss}; the last cycle ran not operational"
+            )),
+        ),
+        RunEnd::SegmentCorrupt(fault) => (
+            5,
+            Some(format!("{fault}; the last cycle ran not operational")),
+        ),
+        RunEnd::Replaced(pid) => (
+            6,
+            Some(format!("PLC process {pid} took over the segment; stopping")),
+        ),
+        RunEnd::Signal(signal) => (
+            signal.exit_code(),
+            Some(format!("stopped by {}", signal.name())),
+        ),
+        _ => (0, None),
+    }
+}
+
+/// Writes a line to stdout. A closed stdout (the CNC that reads it was killed) is ignored:
+/// `println!` would panic there, and the PLC would end without saying why.
+fn say_out(text: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+}
+
+/// Writes a line to stderr, ignoring a closed one (see [`say_out`]).
+fn say_err(text: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "{text}");
 }
 
 fn fifo_stream(args: &PlcArgs) -> Result<crate::programs::fifo_stream::FifoStream, String> {

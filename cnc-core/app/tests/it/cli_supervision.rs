@@ -143,6 +143,39 @@ fn a_killed_plc_stops_the_machine_with_exit_4() {
 }
 
 #[test]
+fn a_plc_whose_cnc_is_killed_stops_saying_why_though_its_stdout_is_gone() {
+    use std::io::Read;
+    let instance = tests::unique_instance("sup-cnc-kill");
+    let scratch = Scratch::new("sup-cnc-kill");
+    let mut child = start(&instance, &scratch.join("trace.csv"));
+    wait_for_plc_cycles(&instance, 300);
+    let plc = tests::child::plc_pid(&instance).expect("the PLC process");
+    // The PLC's stdout is a pipe to the CNC: it breaks with the kill. Its stderr is the
+    // CNC's, so ours: read until the PLC has ended too (a watchdog bounds it).
+    let mut err = child.0.stderr.take().unwrap();
+    assert!(child.signal("KILL"));
+    let (tx, said) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut text = String::new();
+        let _ = err.read_to_string(&mut text);
+        let _ = tx.send(text);
+    });
+    let said = said
+        .recv_timeout(Duration::from_secs(60))
+        .expect("watchdog: the PLC did not end");
+    assert!(said.contains("plc: CNC lost"), "{said}");
+    assert!(!said.contains("panicked"), "{said}");
+    assert!(
+        !std::path::Path::new(&format!("/proc/{plc}/cmdline")).exists() || {
+            let stat = std::fs::read_to_string(format!("/proc/{plc}/stat")).unwrap_or_default();
+            stat.contains(") Z ")
+        }
+    );
+    let _ = child.wait_with_watchdog(Duration::from_secs(10));
+    tests::remove_stale_segment(&instance);
+}
+
+#[test]
 fn a_hung_plc_is_reported_after_the_watchdog() {
     let instance = tests::unique_instance("sup-hang");
     let scratch = Scratch::new("sup-hang");
