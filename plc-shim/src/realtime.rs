@@ -58,6 +58,18 @@ impl RealtimeOptions {
         }
     }
 
+    /// The options the latency benchmarks run the CNC with: SCHED_FIFO 80, locked memory,
+    /// timer slack 1 ns and no deep idle state (as cyclictest does by default); no CPU.
+    pub fn measured() -> RealtimeOptions {
+        RealtimeOptions {
+            priority: Some(80),
+            cpu: None,
+            lock_memory: true,
+            timer_slack_ns: Some(1),
+            cpu_wake_latency_us: Some(0),
+        }
+    }
+
     /// Whether any option is set.
     pub fn any(&self) -> bool {
         *self != RealtimeOptions::default()

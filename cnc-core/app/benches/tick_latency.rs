@@ -69,16 +69,7 @@ fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32) -> Option<Figures> {
         &format!("bench-latency-{}", std::process::id()),
     ]);
     if rt {
-        c.args([
-            "--rt-priority",
-            "80",
-            "--rt-lock-memory",
-            "--rt-timer-slack-ns",
-            "1",
-            // As cyclictest does by default: no deep idle state delays a wake-up.
-            "--rt-cpu-wake-latency-us",
-            "0",
-        ]);
+        c.args(plc_shim::realtime::RealtimeOptions::measured().to_args());
     }
     let out = c.output().ok()?;
     let text = String::from_utf8_lossy(&out.stdout);

@@ -21,21 +21,20 @@ use std::sync::Arc;
 use std::time::Duration;
 
 const ITEMS: usize = 1_000;
-/// `cnc run`'s real-time options, as the tick_latency bench gives them.
-const RT_OPTIONS: &[&str] = &[
-    "--rt-priority",
-    "80",
-    "--rt-lock-memory",
-    "--rt-timer-slack-ns",
-    "1",
-    "--rt-cpu-wake-latency-us",
-    "0",
-    "--rt-cpu",
-    "1",
-];
-/// The CPU of the server and the client in the real-time runs (the CNC's is 1).
+/// The CNC's CPU in the real-time runs.
+const CNC_CPU: usize = 1;
+/// The CPU of the server and the client in the real-time runs.
 const TOOL_CPU: usize = 0;
 const SAMPLING_MS: f64 = 10.0;
+
+/// `cnc run`'s real-time options: the benchmarks' (as tick_latency's), on [`CNC_CPU`].
+fn rt_options() -> Vec<String> {
+    let options = plc_shim::realtime::RealtimeOptions {
+        cpu: Some(CNC_CPU),
+        ..plc_shim::realtime::RealtimeOptions::measured()
+    };
+    options.to_args()
+}
 
 fn smoke() -> bool {
     std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
@@ -143,7 +142,7 @@ fn run(with_client: bool, rt: bool, ticks: u64, tag: &str) -> Option<(f64, f64, 
         .arg(scenario())
         .args(["--ticks", &ticks.to_string(), "--instance", &instance])
         .args(["--opcua", &port.to_string()])
-        .args(if rt { RT_OPTIONS } else { &[] })
+        .args(if rt { rt_options() } else { Vec::new() })
         .args(if rt {
             vec!["--opcua-config".to_string(), config()?]
         } else {
