@@ -95,7 +95,8 @@ fn main() -> ExitCode {
     let instance = match Instance::attach(&args.instance) {
         Ok(i) if i.serves() => Arc::new(i),
         Ok(_) => {
-            let why = "its segment was left by a CNC process that no longer runs";
+            let why = "the CNC process of its segment cannot be seen running from here \
+                       (it ended, or it runs in another PID namespace)";
             return fail(3, &format!("instance {}: {why}", args.instance));
         }
         Err(e) => return fail(3, &format!("instance {}: {e}", args.instance)),
@@ -161,12 +162,33 @@ fn stop_on_signal(server: ServerHandle) -> std::io::Result<impl std::future::Fut
     let mut int = signal(SignalKind::interrupt())?;
     let mut term = signal(SignalKind::terminate())?;
     Ok(async move {
+        let name = tokio::select! {
+            _ = int.recv() => "SIGINT",
+            _ = term.recv() => "SIGTERM",
+        };
+        stop(&server, name);
         tokio::select! {
-            _ = int.recv() => cnc_opcua::say!("SIGINT, stopping"),
-            _ = term.recv() => cnc_opcua::say!("SIGTERM, stopping"),
+            _ = int.recv() => {}
+            _ = term.recv() => {}
         }
-        server.cancel();
+        cnc_opcua::say!("a second signal while stopping: ending at once");
+        std::process::exit(1);
     })
+}
+
+/// How long the server may take to close its connections once stopped.
+const STOP_DEADLINE: Duration = Duration::from_secs(5);
+
+/// Stops the server, saying why; ends the process if it has not stopped within
+/// [`STOP_DEADLINE`] (a connection that does not close).
+fn stop(server: &ServerHandle, why: &str) {
+    cnc_opcua::say!("{why}, stopping");
+    server.cancel();
+    std::thread::spawn(|| {
+        std::thread::sleep(STOP_DEADLINE);
+        cnc_opcua::say!("still stopping after {STOP_DEADLINE:?}: ending at once");
+        std::process::exit(1);
+    });
 }
 
 /// Stops the server when stdin reaches its end: the process that started it (and holds the
@@ -175,8 +197,7 @@ fn stop_when_stdin_closes(server: ServerHandle) {
     std::thread::spawn(move || {
         let mut sink = std::io::sink();
         let _ = std::io::copy(&mut std::io::stdin().lock(), &mut sink);
-        cnc_opcua::say!("stdin closed (the process that started it ended), stopping");
-        server.cancel();
+        stop(&server, "stdin closed (the process that started it ended)");
     });
 }
 

@@ -13,6 +13,12 @@ pub trait ImageSource: Send + Sync + 'static {
     /// Calls `f` with the image while a CNC serves it; `false` (and `f` not called) when
     /// none does.
     fn with_image(&self, f: &mut dyn FnMut(&ImageMemory)) -> bool;
+
+    /// As [`ImageSource::with_image`], for a write: a source that can tell whether its CNC
+    /// process still runs looks now (writes are rare; reads rely on the periodic look).
+    fn with_image_to_write(&self, f: &mut dyn FnMut(&ImageMemory)) -> bool {
+        self.with_image(f)
+    }
 }
 
 impl ImageSource for ImageMemory {
@@ -28,18 +34,38 @@ fn ready(segment: &PlcSegment) -> bool {
 }
 
 /// Whether `segment` is Ready and its CNC process was seen at attach and still runs (a
-/// `/proc` read). A segment whose CNC died before the attach is not served.
+/// `/proc` read). A segment whose CNC died before the attach is not served; neither is one
+/// whose CNC runs in another PID namespace (its process cannot be seen from here).
 fn serving(segment: &PlcSegment) -> bool {
     ready(segment) && segment.cnc_known_alive()
+}
+
+/// A segment and whether its CNC process still ran at the last look: kept together, so a
+/// reader never pairs a new segment's flag with the old segment.
+struct Attached {
+    segment: PlcSegment,
+    alive: AtomicBool,
+}
+
+impl Attached {
+    fn new(segment: PlcSegment) -> Arc<Attached> {
+        Arc::new(Attached {
+            alive: AtomicBool::new(serving(&segment)),
+            segment,
+        })
+    }
+
+    /// The image while its CNC serves it: Ready, and alive at the last look.
+    fn image(&self) -> Option<&ImageMemory> {
+        let up = ready(&self.segment) && self.alive.load(Ordering::Acquire);
+        up.then(|| self.segment.memory())
+    }
 }
 
 /// A CNC instance's segment, attached again after its CNC was replaced.
 pub struct Instance {
     name: String,
-    current: RwLock<Arc<PlcSegment>>,
-    /// Whether the attached segment's CNC process still ran at the last [`Instance::refresh`]
-    /// (a killed CNC leaves its segment marked Ready).
-    alive: AtomicBool,
+    current: RwLock<Arc<Attached>>,
 }
 
 /// What [`Instance::refresh`] found.
@@ -47,26 +73,24 @@ pub struct Instance {
 pub enum Change {
     /// Nothing changed.
     Same,
-    /// The CNC closed its segment.
+    /// The CNC closed its segment, or its process ended.
     Gone,
     /// A new CNC of the instance serves a new segment, now attached.
     Back,
 }
 
 impl Instance {
-    /// Attaches to the running CNC of `name` (refused when none runs).
+    /// Attaches to the segment of `name` (refused when there is none).
     pub fn attach(name: &str) -> Result<Instance, AttachError> {
-        let segment = PlcSegment::inspect(name)?;
         Ok(Instance {
             name: name.to_owned(),
-            alive: AtomicBool::new(serving(&segment)),
-            current: RwLock::new(Arc::new(segment)),
+            current: RwLock::new(Attached::new(PlcSegment::inspect(name)?)),
         })
     }
 
     /// Whether the attached segment's CNC serves it (as the last look found).
     pub fn serves(&self) -> bool {
-        self.alive.load(Ordering::Acquire)
+        self.attached().image().is_some()
     }
 
     /// The instance's name.
@@ -74,8 +98,7 @@ impl Instance {
         &self.name
     }
 
-    /// The segment attached now.
-    pub fn segment(&self) -> Arc<PlcSegment> {
+    fn attached(&self) -> Arc<Attached> {
         Arc::clone(&self.current.read().unwrap_or_else(|e| e.into_inner()))
     }
 
@@ -86,15 +109,14 @@ impl Instance {
     /// (a crash or a kill leaves the segment marked Ready): a `/proc` read, here and not on
     /// every value.
     pub fn refresh(&self, was_ready: bool) -> Change {
-        let segment = self.segment();
-        if serving(&segment) {
+        let attached = self.attached();
+        if serving(&attached.segment) {
             return Change::Same;
         }
-        self.alive.store(false, Ordering::Release);
+        attached.alive.store(false, Ordering::Release);
         match PlcSegment::inspect(&self.name) {
             Ok(fresh) if serving(&fresh) => {
-                *self.current.write().unwrap_or_else(|e| e.into_inner()) = Arc::new(fresh);
-                self.alive.store(true, Ordering::Release);
+                *self.current.write().unwrap_or_else(|e| e.into_inner()) = Attached::new(fresh);
                 Change::Back
             }
             Ok(_) | Err(AttachError::NotFound { .. }) | Err(AttachError::NotReady { .. })
@@ -113,12 +135,21 @@ impl Instance {
 
 impl ImageSource for Instance {
     fn with_image(&self, f: &mut dyn FnMut(&ImageMemory)) -> bool {
-        let segment = self.segment();
-        if !ready(&segment) || !self.alive.load(Ordering::Acquire) {
+        let attached = self.attached();
+        let Some(image) = attached.image() else {
+            return false;
+        };
+        f(image);
+        true
+    }
+
+    fn with_image_to_write(&self, f: &mut dyn FnMut(&ImageMemory)) -> bool {
+        let attached = self.attached();
+        if !attached.segment.cnc_known_alive() {
+            attached.alive.store(false, Ordering::Release);
             return false;
         }
-        f(segment.memory());
-        true
+        self.with_image(f)
     }
 }
 

@@ -28,7 +28,17 @@ pub enum Reading {
     },
     /// Whether a PLC is attached and its heartbeat was seen to move within the last second
     /// (the heartbeat last seen and when it was seen to change: never, at the first look).
-    PlcAlive(Mutex<Option<(u64, Option<Instant>)>>),
+    PlcAlive(Mutex<Option<PlcSeen>>),
+}
+
+/// What [`Reading::PlcAlive`] saw last: of which CNC's image (its pid and start stamp: a new
+/// CNC's PLC heartbeat is not compared with the old one's), the heartbeat, and when it was
+/// seen to change (never, at the first look).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PlcSeen {
+    cnc: (u32, u64),
+    beats: u64,
+    moved_at: Option<Instant>,
 }
 
 /// The OPC UA type of an ST type.
@@ -133,16 +143,25 @@ impl Reading {
                 use core::mem::offset_of;
                 let pid = header_u32(memory, offset_of!(HliSegmentHeader, plc_pid));
                 let beats = header_u64(memory, offset_of!(HliSegmentHeader, plc_heartbeat));
+                let cnc = (
+                    header_u32(memory, offset_of!(HliSegmentHeader, cnc_pid)),
+                    header_u64(memory, offset_of!(HliSegmentHeader, cnc_start_stamp)),
+                );
                 let now = Instant::now();
                 let mut seen = seen.lock().unwrap_or_else(|e| e.into_inner());
                 // Alive once the heartbeat is seen to move, until it stands for a second.
                 let moved = match *seen {
-                    Some((last, moved_at)) if last == beats => {
-                        moved_at.is_some_and(|at| now.duration_since(at) < PLC_ALIVE_WITHIN)
-                    }
-                    first_look => {
-                        let moved = first_look.is_some();
-                        *seen = Some((beats, moved.then_some(now)));
+                    Some(last) if last.cnc == cnc && last.beats == beats => last
+                        .moved_at
+                        .is_some_and(|at| now.duration_since(at) < PLC_ALIVE_WITHIN),
+                    last => {
+                        let moved = last.is_some_and(|last| last.cnc == cnc);
+                        let moved_at = moved.then_some(now);
+                        *seen = Some(PlcSeen {
+                            cnc,
+                            beats,
+                            moved_at,
+                        });
                         moved
                     }
                 };
@@ -198,7 +217,7 @@ pub fn write(
         return StatusCode::BadOutOfRange;
     };
     let mut status = StatusCode::BadNoCommunication;
-    source.with_image(&mut |memory| {
+    source.with_image_to_write(&mut |memory| {
         let one = [Write { path, leaf, value }];
         status = match check_protocol(memory, &one) {
             Ok(()) => {
@@ -263,6 +282,13 @@ mod tests {
             Variant::Boolean(true),
             "within the second"
         );
+        // A new CNC (another start stamp) whose PLC heartbeat differs: not yet seen moving.
+        let stamp = image.place::<u64>(offset_of!(HliSegmentHeader, cnc_start_stamp));
+        stamp.store_release(stamp.load() + 1);
+        beats.store_release(3);
+        assert_eq!(alive.read(&image), Variant::Boolean(false), "a new CNC");
+        beats.store_release(4);
+        assert_eq!(alive.read(&image), Variant::Boolean(true));
         pid.store_release(0);
         assert_eq!(alive.read(&image), Variant::Boolean(false), "detached");
     }

@@ -2,6 +2,7 @@
 //! BadNoCommunication once the CNC has gone, attaches to a new CNC of the instance, and ends
 //! cleanly on SIGTERM, saying why; bad input is refused at start, named.
 
+use cnc_opcua::ImageSource;
 use hli::access::{Leaf, Value};
 use hli::segment::CncSegment;
 use opcua::types::{NodeId, StatusCode, Variant};
@@ -245,9 +246,22 @@ async fn killed() {
         .await
         .status
         .is_some_and(|s| s.is_good()));
+    // The same source in this process: a write looks at the CNC's process at once, before
+    // the periodic look has noticed it gone.
+    let here = cnc_opcua::Instance::attach(&instance).unwrap();
+    assert!(here.serves() && here.with_image_to_write(&mut |_| {}));
 
     cnc.kill().unwrap();
     cnc.wait().unwrap();
+    assert!(here.with_image(&mut |_| {}), "reads wait for the look");
+    assert!(
+        !here.with_image_to_write(&mut |_| {}),
+        "a write into a dead CNC's image"
+    );
+    assert!(
+        !here.with_image(&mut |_| {}),
+        "once a write found it dead, reads too"
+    );
     server.expect("stopped").await;
     let value = read(&session, &tick).await;
     assert_eq!(value.status, Some(StatusCode::BadNoCommunication));
@@ -258,7 +272,7 @@ async fn killed() {
     let args = ["--instance", &instance, "--port", &late, "--pki", &pki_late];
     let (code, said) = Server::start(&args).finish().await;
     assert_eq!(code, Some(3), "{said:?}");
-    assert!(said.concat().contains("no longer runs"), "{said:?}");
+    assert!(said.concat().contains("cannot be seen running"), "{said:?}");
 
     // The next CNC replaces the dead one's segment; the server attaches to it.
     let next = CncSegment::create(&instance, 1, 1).unwrap();
