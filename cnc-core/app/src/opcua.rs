@@ -1,7 +1,8 @@
 //! The OPC UA server beside a CNC: `cnc opcua` runs the `cnc-opcua` binary built beside
 //! `cnc` (the OPC UA stack stays out of this package's build), and `cnc run`/`cnc demo
-//! --opcua [PORT]` start it on their own instance once the segment is up and stop it (SIGTERM)
-//! after the last tick.
+//! --opcua [PORT]` start it on their own instance once the segment is up and stop it after the
+//! last tick (SIGTERM, killed after 5 s). They hold its stdin, so it ends with them even when
+//! they are killed.
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
@@ -36,7 +37,8 @@ fn binary() -> Result<PathBuf, String> {
         })
 }
 
-/// `cnc opcua`: the binary with the same arguments; its exit code is this one's.
+/// `cnc opcua`: replaced by the binary with the same arguments (so its exit code is this
+/// one's).
 pub fn main(instance: &str, port: u16, pki: Option<&Path>, config: Option<&Path>) -> ExitCode {
     let binary = match binary() {
         Ok(b) => b,
@@ -53,13 +55,14 @@ pub fn main(instance: &str, port: u16, pki: Option<&Path>, config: Option<&Path>
     if let Some(config) = config {
         command.arg("--config").arg(config);
     }
-    match command.status() {
-        Ok(status) => ExitCode::from(status.code().map_or(1, |c| c.clamp(0, 255) as u8)),
-        Err(e) => {
-            eprintln!("cnc opcua: {e}");
-            ExitCode::from(1)
-        }
-    }
+    // This process becomes the server: a signal to it reaches the server, none is left
+    // behind.
+    let e = std::os::unix::process::CommandExt::exec(&mut command);
+    eprintln!(
+        "cnc opcua: {}: {e}",
+        command.get_program().to_string_lossy()
+    );
+    ExitCode::from(1)
 }
 
 /// A server started beside a run.
@@ -94,9 +97,8 @@ impl Beside {
         // Its lines go on to our stderr; the first that says it serves is reported.
         let forward = std::thread::spawn(move || {
             for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-                // A closed stderr of ours must not end the forwarding (the server would
-                // then write into a closed pipe).
-                let _ = writeln!(std::io::stderr(), "{line}");
+                // A closed stderr of ours must not end the forwarding.
+                say(&line);
                 if line.contains("serving on") {
                     let _ = serving.send(());
                 }
@@ -122,38 +124,50 @@ impl Beside {
 const STOP_WATCHDOG: Duration = Duration::from_secs(5);
 
 /// Dropped (after the last tick, or when the run fails before it): the server is stopped
-/// with SIGTERM, killed if it has not ended within [`STOP_WATCHDOG`], and waited for.
+/// with SIGTERM, killed if it has not ended within [`STOP_WATCHDOG`] (or at once when the
+/// signal could not be sent), and waited for.
 impl Drop for Beside {
     fn drop(&mut self) {
-        if let Err(e) = cnc_os::terminate(&self.child) {
-            eprintln!("cnc-opcua: {e}");
-        }
-        let deadline = std::time::Instant::now() + STOP_WATCHDOG;
-        let ended = loop {
-            match self.child.try_wait() {
-                Ok(Some(status)) => break Some(status),
-                Ok(None) if std::time::Instant::now() < deadline => {
-                    std::thread::sleep(Duration::from_millis(10));
-                }
-                _ => break None,
+        let ended = match cnc_os::terminate(&self.child) {
+            Ok(()) => self.wait_until(std::time::Instant::now() + STOP_WATCHDOG),
+            Err(e) => {
+                say(&format!("cnc-opcua: {e}"));
+                None
             }
         };
-        let status = match ended {
-            Some(status) => status,
-            None => {
-                eprintln!("cnc-opcua: still running {STOP_WATCHDOG:?} after SIGTERM: killed");
-                let _ = self.child.kill();
-                match self.child.wait() {
-                    Ok(status) => status,
-                    Err(_) => return,
-                }
-            }
-        };
-        if !status.success() {
-            eprintln!("cnc-opcua ended: {status}");
+        let status = ended.or_else(|| {
+            say(&format!(
+                "cnc-opcua: not ended {STOP_WATCHDOG:?} after SIGTERM: killed"
+            ));
+            let _ = self.child.kill();
+            self.child.wait().ok()
+        });
+        if let Some(status) = status.filter(|s| !s.success()) {
+            say(&format!("cnc-opcua ended: {status}"));
         }
         if let Some(forward) = self.forward.take() {
             let _ = forward.join();
         }
     }
+}
+
+impl Beside {
+    /// The server's exit status once it ended, `None` if it still runs at `deadline`.
+    fn wait_until(&mut self, deadline: std::time::Instant) -> Option<std::process::ExitStatus> {
+        loop {
+            match self.child.try_wait() {
+                Ok(Some(status)) => return Some(status),
+                Ok(None) if std::time::Instant::now() < deadline => {
+                    // A poll bounded by the deadline (std has no wait with a timeout).
+                    std::thread::sleep(Duration::from_millis(10));
+                }
+                _ => return None,
+            }
+        }
+    }
+}
+
+/// A line on stderr; a closed stderr is ignored (`eprintln!` would panic, also in `drop`).
+fn say(line: &str) {
+    let _ = writeln!(std::io::stderr(), "{line}");
 }
