@@ -186,28 +186,28 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
     ) {
         Ok(runtime) => runtime,
         Err(e) => {
-            say_err(&format!("plc: {e}"));
+            cnc_os::stdio::line_err(&format!("plc: {e}"));
             return ExitCode::from(1);
         }
     };
     let realtime = args.realtime.apply("plc");
     if !realtime.is_empty() {
-        say_out(&format!("plc: real-time {}", realtime.join(", ")));
+        cnc_os::stdio::line_out(&format!("plc: real-time {}", realtime.join(", ")));
     }
     runtime.set_period_ticks(args.period_ticks);
     hli::signals::capture();
     match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
-            say_out(&report(&summary, program));
+            cnc_os::stdio::line_out(&report(&summary, program));
             runtime.detach();
             let (code, why) = ending(&summary.end);
             if let Some(why) = why {
-                say_err(&format!("plc: {why}"));
+                cnc_os::stdio::line_err(&format!("plc: {why}"));
             }
             ExitCode::from(code)
         }
         Err(e) => {
-            say_err(&format!("plc: {e}"));
+            cnc_os::stdio::line_err(&format!("plc: {e}"));
             ExitCode::from(1)
         }
     }
@@ -254,19 +254,6 @@ fn ending(end: &crate::runtime::RunEnd) -> (u8, Option<String>) {
         ),
         _ => (0, None),
     }
-}
-
-/// Writes a line to stdout. A closed stdout (the CNC that reads it was killed) is ignored:
-/// `println!` would panic there, and the PLC would end without saying why.
-fn say_out(text: &str) {
-    use std::io::Write;
-    let _ = writeln!(std::io::stdout().lock(), "{text}");
-}
-
-/// Writes a line to stderr, ignoring a closed one (see [`say_out`]).
-fn say_err(text: &str) {
-    use std::io::Write;
-    let _ = writeln!(std::io::stderr().lock(), "{text}");
 }
 
 fn fifo_stream(args: &PlcArgs) -> Result<crate::programs::fifo_stream::FifoStream, String> {

@@ -4,7 +4,7 @@
 //! last tick (SIGTERM, killed after 5 s). They hold its stdin, so it ends with them even when
 //! they are killed.
 
-use std::io::{BufRead, BufReader, Write};
+use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use std::sync::mpsc;
@@ -98,7 +98,7 @@ impl Beside {
         let forward = std::thread::spawn(move || {
             for line in BufReader::new(stderr).lines().map_while(Result::ok) {
                 // A closed stderr of ours must not end the forwarding.
-                say(&line);
+                cnc_os::stdio::line_err(&line);
                 if line.contains("serving on") {
                     let _ = serving.send(());
                 }
@@ -131,19 +131,19 @@ impl Drop for Beside {
         let ended = match cnc_os::terminate(&self.child) {
             Ok(()) => self.wait_until(std::time::Instant::now() + STOP_WATCHDOG),
             Err(e) => {
-                say(&format!("cnc-opcua: {e}"));
+                cnc_os::stdio::line_err(&format!("cnc-opcua: {e}"));
                 None
             }
         };
         let status = ended.or_else(|| {
-            say(&format!(
+            cnc_os::stdio::line_err(&format!(
                 "cnc-opcua: not ended {STOP_WATCHDOG:?} after SIGTERM: killed"
             ));
             let _ = self.child.kill();
             self.child.wait().ok()
         });
         if let Some(status) = status.filter(|s| !s.success()) {
-            say(&format!("cnc-opcua ended: {status}"));
+            cnc_os::stdio::line_err(&format!("cnc-opcua ended: {status}"));
         }
         if let Some(forward) = self.forward.take() {
             let _ = forward.join();
@@ -165,9 +165,4 @@ impl Beside {
             }
         }
     }
-}
-
-/// A line on stderr; a closed stderr is ignored (`eprintln!` would panic, also in `drop`).
-fn say(line: &str) {
-    let _ = writeln!(std::io::stderr(), "{line}");
 }

@@ -27,13 +27,16 @@ const CNC_CPU: usize = 1;
 const TOOL_CPU: usize = 0;
 const SAMPLING_MS: f64 = 10.0;
 
-/// `cnc run`'s real-time options: the benchmarks' (as tick_latency's), on [`CNC_CPU`].
-fn rt_options() -> Vec<String> {
+/// `cnc run`'s arguments for a real-time run: the benchmarks' real-time options (as
+/// tick_latency's) on [`CNC_CPU`], and the server's configuration (see [`config`]).
+fn rt_args() -> Option<Vec<String>> {
     let options = plc_shim::realtime::RealtimeOptions {
         cpu: Some(CNC_CPU),
         ..plc_shim::realtime::RealtimeOptions::measured()
     };
-    options.to_args()
+    let mut args = options.to_args();
+    args.extend(["--opcua-config".to_string(), config()?]);
+    Some(args)
 }
 
 fn smoke() -> bool {
@@ -142,12 +145,7 @@ fn run(with_client: bool, rt: bool, ticks: u64, tag: &str) -> Option<(f64, f64, 
         .arg(scenario())
         .args(["--ticks", &ticks.to_string(), "--instance", &instance])
         .args(["--opcua", &port.to_string()])
-        .args(if rt { rt_options() } else { Vec::new() })
-        .args(if rt {
-            vec!["--opcua-config".to_string(), config()?]
-        } else {
-            vec![]
-        })
+        .args(if rt { rt_args()? } else { Vec::new() })
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()

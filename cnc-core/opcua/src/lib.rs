@@ -31,15 +31,14 @@ use opcua::server::{
 use std::collections::{BTreeMap, HashSet};
 use std::sync::Arc;
 
-/// Writes one line to stderr, prefixed `cnc-opcua: `. A closed stderr (the reader of the
-/// log is gone) is ignored: `eprintln!` would panic and end the task that logs, so that a
-/// signal task could no longer stop the server.
+/// Writes one line to stderr, prefixed `cnc-opcua: `, through [`cnc_os::stdio::line_err`]:
+/// a closed stderr is ignored (`eprintln!` would panic and end the task that logs, so that
+/// a signal task could no longer stop the server).
 #[macro_export]
 macro_rules! say {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr().lock(), "cnc-opcua: {}", format_args!($($arg)*));
-    }};
+    ($($arg:tt)*) => {
+        cnc_os::stdio::line_err(&format!("cnc-opcua: {}", format_args!($($arg)*)))
+    };
 }
 
 /// The namespace of the image's nodes.

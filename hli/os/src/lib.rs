@@ -3,7 +3,8 @@
 //! transparent-huge-page advice for large buffers ([`advise_huge_pages`]), a child process's
 //! peak memory ([`wait_with_peak_memory`]), the real-time settings of a thread
 //! ([`realtime`]: SCHED_FIFO, CPU pinning, locked memory, timer slack, stack pre-faulting) and
-//! a futex word shared between processes ([`futex`]).
+//! a futex word shared between processes ([`futex`]), and log lines that never panic on a
+//! closed pipe ([`stdio`]).
 //!
 //! Each is a thin, safe wrapper around one or two system calls. The crate is, beside
 //! `hli::raw` (the shared image memory), the only place of the workspace where `unsafe` code
@@ -25,6 +26,7 @@ mod process;
 #[cfg(target_os = "linux")]
 #[allow(unsafe_code)]
 pub mod realtime;
+pub mod stdio;
 
 pub use memory::advise_huge_pages;
 #[cfg(target_os = "linux")]
