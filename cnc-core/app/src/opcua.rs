@@ -6,7 +6,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitCode, Stdio};
+use std::process::{Child, Command, ExitCode, ExitStatus, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
 
@@ -130,18 +130,16 @@ impl Drop for Beside {
     fn drop(&mut self) {
         let ended = match cnc_os::terminate(&self.child) {
             Ok(()) => self.wait_until(std::time::Instant::now() + STOP_WATCHDOG),
-            Err(e) => {
-                cnc_os::stdio::line_err(&format!("cnc-opcua: {e}"));
-                None
+            Err(e) => Err(format!("SIGTERM not sent ({e})")),
+        };
+        let status = match ended {
+            Ok(status) => Some(status),
+            Err(why) => {
+                cnc_os::stdio::line_err(&format!("cnc-opcua: {why}: killed"));
+                let _ = self.child.kill();
+                self.child.wait().ok()
             }
         };
-        let status = ended.or_else(|| {
-            cnc_os::stdio::line_err(&format!(
-                "cnc-opcua: not ended {STOP_WATCHDOG:?} after SIGTERM: killed"
-            ));
-            let _ = self.child.kill();
-            self.child.wait().ok()
-        });
         if let Some(status) = status.filter(|s| !s.success()) {
             cnc_os::stdio::line_err(&format!("cnc-opcua ended: {status}"));
         }
@@ -152,16 +150,17 @@ impl Drop for Beside {
 }
 
 impl Beside {
-    /// The server's exit status once it ended, `None` if it still runs at `deadline`.
-    fn wait_until(&mut self, deadline: std::time::Instant) -> Option<std::process::ExitStatus> {
+    /// The server's exit status once it ended; why not, if it still runs at `deadline`.
+    fn wait_until(&mut self, deadline: std::time::Instant) -> Result<ExitStatus, String> {
         loop {
             match self.child.try_wait() {
-                Ok(Some(status)) => return Some(status),
+                Ok(Some(status)) => return Ok(status),
                 Ok(None) if std::time::Instant::now() < deadline => {
                     // A poll bounded by the deadline (std has no wait with a timeout).
                     std::thread::sleep(Duration::from_millis(10));
                 }
-                _ => return None,
+                Ok(None) => return Err(format!("not ended {STOP_WATCHDOG:?} after SIGTERM")),
+                Err(e) => return Err(format!("not waited for ({e})")),
             }
         }
     }
