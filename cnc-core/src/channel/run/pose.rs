@@ -120,8 +120,10 @@ impl Channel {
                 .unwrap_or(self.pose.tool);
         } else {
             let tracking = self.pose.tracker.state() != DynCsState::Inactive;
+            // Axis by axis: the compensation's angles in the channel's own convention, the
+            // one its A, B and C words (and the master's published frame) are written in.
             let mut c = if tracking {
-                words(&compensation)
+                words_in(&compensation, self.pose.order)
             } else {
                 [0.0; 6]
             };
