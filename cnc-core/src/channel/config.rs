@@ -70,6 +70,36 @@ pub struct ChannelConfig {
     /// channel runs.
     #[serde(default)]
     pub sync_timeout_s: Option<f64>,
+    /// How far a tracking slave's axes may lag behind the compensation while they catch up
+    /// with a step of it (a PLC frame step, a master that jumps) before the channel stops.
+    #[serde(default)]
+    pub track_lag_max: TrackLagMax,
+}
+
+/// `track_lag_max`: the bound of a tracking slave's catch-up lag, measured at its tool (the
+/// distance and the angle between the pose its axes are commanded and the compensated one).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrackLagMax {
+    /// mm (default 5).
+    #[serde(default = "default_lag")]
+    pub translation: f64,
+    /// Degrees (default 5).
+    #[serde(default = "default_lag")]
+    pub rotation: f64,
+}
+
+impl Default for TrackLagMax {
+    fn default() -> Self {
+        Self {
+            translation: default_lag(),
+            rotation: default_lag(),
+        }
+    }
+}
+
+fn default_lag() -> f64 {
+    5.0
 }
 
 /// Who starts a channel's configured program.
@@ -286,6 +316,7 @@ impl ChannelConfig {
             programs: None,
             program_start: ProgramStart::Cnc,
             sync_timeout_s: None,
+            track_lag_max: TrackLagMax::default(),
         }
     }
 
@@ -350,6 +381,15 @@ impl ChannelConfig {
                 if !(v.is_finite() && v > 0.0) {
                     return Err(self.parameter(name, v, "must be positive and finite"));
                 }
+            }
+        }
+        let lag = self.track_lag_max;
+        for (name, v) in [
+            ("track_lag_max.translation", lag.translation),
+            ("track_lag_max.rotation", lag.rotation),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(self.parameter(name, v, "must be positive and finite"));
             }
         }
         if self.axis_limits.len() > self.axes.len() {

@@ -130,6 +130,16 @@ pub fn answer_log(tracker: &Tracker, call: &DynCsLogReadCall) -> DynCsLogReply {
             reply.kind = log_kind::RESTART;
             reply.flags = flag(finished, log_flags::FINISHED);
         }
+        TrackEvent::CatchUp {
+            landed,
+            translation,
+            rotation,
+        } => {
+            reply.kind = log_kind::CATCH_UP;
+            reply.flags = flag(landed, log_flags::FINISHED);
+            reply.frame[0] = translation;
+            reply.frame[1] = rotation;
+        }
     }
     reply
 }
@@ -192,6 +202,11 @@ pub fn log_event(reply: &DynCsLogReply) -> Result<Option<(u64, TrackEvent)>, Wir
         log_kind::RESTART => TrackEvent::Restart {
             finished: has(log_flags::FINISHED),
         },
+        log_kind::CATCH_UP => TrackEvent::CatchUp {
+            landed: has(log_flags::FINISHED),
+            translation: reply.frame[0],
+            rotation: reply.frame[1],
+        },
         other => return Err(WireError::UnknownKind(other)),
     };
     Ok(Some((reply.tick, event)))
@@ -238,6 +253,16 @@ mod tests {
             TrackEvent::MasterResumed,
             TrackEvent::Restart { finished: false },
             TrackEvent::Restart { finished: true },
+            TrackEvent::CatchUp {
+                landed: false,
+                translation: 0.125,
+                rotation: 0.0,
+            },
+            TrackEvent::CatchUp {
+                landed: true,
+                translation: 2.5,
+                rotation: 1.25,
+            },
         ];
         let errors = [
             TrackError::AlreadyOn,

@@ -181,6 +181,18 @@ pub fn event_lines(tick: u64, event: &TrackEvent) -> Vec<(u64, u32, String)> {
         TrackEvent::MasterResumed => {
             dyn_cs(vec!["dynCS: master resumed, soft take-over".to_string()])
         }
+        TrackEvent::CatchUp {
+            landed,
+            translation,
+            rotation,
+        } => dyn_cs(vec![format!(
+            "dynCS: axes {} lag {translation:.4} mm {rotation:.4} deg",
+            if *landed {
+                "on the compensation, largest"
+            } else {
+                "catch up with a step,"
+            }
+        )]),
         TrackEvent::Error(e) => dyn_cs(vec![format!("dynCS: ERROR: {e}")]),
         TrackEvent::Refused(e) => dyn_cs(vec![format!("dynCS: refused: {e}")]),
     }

@@ -14,6 +14,7 @@
 //! once it has taken the held position over as its programmed position (see
 //! `Channel::resync_to_set_points`).
 
+use super::catch_up::{CatchUp, NoProfile};
 use super::path::AxisLimits;
 use crate::axis::generator::{Progress, SetpointGenerator};
 use crate::setpoint::Kinematic;
@@ -77,6 +78,7 @@ pub struct JointGuard {
     last: Kinematics,
     brakes: Vec<SetpointGenerator>,
     mode: Mode,
+    catch_up: CatchUp,
 }
 
 /// Position, velocity and acceleration of every axis after the last accepted step.
@@ -121,7 +123,25 @@ impl JointGuard {
                 .map(|p| SetpointGenerator::new(cycle_s, *p))
                 .collect(),
             mode: Mode::Pass,
+            catch_up: CatchUp::new(start, cycle_s),
         }
+    }
+
+    /// Turns the wanted set-points into the ones to command: a step beyond an axis's limits
+    /// is caught up on a jerk-limited profile instead of passed on (see
+    /// [`super::catch_up`]). Then [`Self::check`] and [`Self::accept`] as ever.
+    pub fn follow(&mut self, set_points: &mut AxisValues) -> Result<(), NoProfile> {
+        self.catch_up.follow(set_points, &self.limits)
+    }
+
+    /// Whether an axis still lags behind its wanted set-point.
+    pub fn lagging(&self) -> bool {
+        self.mode == Mode::Pass && self.catch_up.lagging()
+    }
+
+    /// The catch-up of the channel's axes (their lags).
+    pub fn catch_up(&self) -> &CatchUp {
+        &self.catch_up
     }
 
     /// The limits of axis `i`.
@@ -164,6 +184,7 @@ impl JointGuard {
             self.last.velocity[i] = v;
             self.last.position[i] = *p;
         }
+        self.catch_up.taken(set_points);
     }
 
     /// The axes stand at `position` (taken over after an axis reset): the next step is
@@ -174,6 +195,7 @@ impl JointGuard {
             self.last.velocity[i] = 0.0;
             self.last.acceleration[i] = 0.0;
         }
+        self.catch_up.rest_at(position);
     }
 
     /// Latches: every axis brakes from its last accepted state with its deceleration and
@@ -182,6 +204,8 @@ impl JointGuard {
         if self.mode != Mode::Pass {
             return;
         }
+        // A catch-up under way is given up: the axes brake from where they were commanded.
+        self.catch_up.rest_at(&self.last.position);
         for (i, g) in self.brakes.iter_mut().enumerate() {
             let l = self.limits[i];
             let v = self.last.velocity[i];
@@ -243,6 +267,7 @@ impl JointGuard {
     pub fn release(&mut self) {
         if self.mode == Mode::Holding {
             self.mode = Mode::Pass;
+            self.catch_up.rest_at(&self.last.position);
         }
     }
 

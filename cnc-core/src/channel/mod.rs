@@ -3,6 +3,7 @@
 //! publishing its frame with `#CHANNEL INTERFACE`, the PLC as master through
 //! `MC_CONTROL_DYN_CS_UNIT`, and tracking slaves with `#TRACK CS`).
 
+pub mod catch_up;
 pub mod config;
 pub mod controller;
 pub mod diag_wire;

@@ -47,6 +47,19 @@ pub enum TrackError {
     /// the compensation they hold becomes part of the programmed position at rest.
     #[error("stopped by the PLC")]
     PlcStop,
+    /// The axes lagged behind the compensation by more than `track_lag_max` (its
+    /// translation, or with `rotation` its angle).
+    #[error("the axes lag behind the compensation beyond track_lag_max.{}", if *rotation { "rotation" } else { "translation" })]
+    LagBeyondBound {
+        /// The angle broke the bound (else the distance).
+        rotation: bool,
+    },
+    /// An axis's catch-up found no profile.
+    #[error("axis {} found no catch-up profile", axis + 1)]
+    NoCatchUp {
+        /// Axis index in the channel (0-based).
+        axis: u8,
+    },
 }
 
 fn limit_name(kind: LimitKind) -> &'static str {
@@ -75,6 +88,8 @@ impl TrackError {
             ),
             TrackError::ChannelFailed(id) => (10, id.raw()),
             TrackError::PlcStop => (11, 0),
+            TrackError::LagBeyondBound { rotation } => (12, u32::from(rotation)),
+            TrackError::NoCatchUp { axis } => (13, u32::from(axis)),
         }
     }
 
@@ -102,6 +117,10 @@ impl TrackError {
             },
             10 => TrackError::ChannelFailed(ChannelErrorId::decode(value).ok()?),
             11 => TrackError::PlcStop,
+            12 if value < 2 => TrackError::LagBeyondBound {
+                rotation: value == 1,
+            },
+            13 if value < u32::from(u8::MAX) => TrackError::NoCatchUp { axis: value as u8 },
             _ => return None,
         })
     }

@@ -87,6 +87,9 @@ pub mod log_kind {
     pub const REFUSED: u32 = 9;
     /// A program (re)started: `flags` bit 0 set on its second line.
     pub const RESTART: u32 = 10;
+    /// The axes began to catch up with a step (`flags` FINISHED: landed); `frame[0]` the
+    /// lag in mm, `frame[1]` in degrees.
+    pub const CATCH_UP: u32 = 11;
 }
 
 /// [`DynCsLogReply::flags`] bits.

@@ -126,10 +126,11 @@ hli_struct! {
     /// only the state): the CNC counts every transition it takes from `transition_w`, keeps
     /// the command word and whether it was carried out or refused (with the reason), and
     /// collects the tracking states passed since (bit `n` for state `n`, bit 4 for ERROR),
-    /// so a PLC that runs every N ticks sees a state that lasted one tick.
+    /// so a PLC that runs every N ticks sees a state that lasted one tick. Beside it, the
+    /// lag of the slave's axes while they catch up with a step of the compensation.
     ///
     /// ST path: `gpCh[i]^channel_mc_control.dyn_cs_result`.
-    #[st = "HLI_DYN_CS_TRANSITION_RESULT", size = 16]
+    #[st = "HLI_DYN_CS_TRANSITION_RESULT", size = 32]
     pub struct HliDynCsTransitionResult {
         /// Transitions taken from `transition_w` so far (wraps).
         pub taken_count_r: u32 => [0, Cnc],
@@ -140,6 +141,15 @@ hli_struct! {
         /// Tracking states passed since it was taken: bit 0 INACTIVE, 1 ACTIVATING, 2 ACTIVE,
         /// 3 DEACTIVATING, 4 ERROR.
         pub states_seen_r: u32 => [12, Cnc],
+        /// The distance between the tool pose the axes are commanded and the compensated
+        /// one while they catch up with a step (0.1 um); 0 when they follow exactly.
+        pub lag_translation_r: i32 => [16, Cnc],
+        /// The angle between the two (0.0001 degree).
+        pub lag_rotation_r: i32 => [20, Cnc],
+        /// Catch-ups started since the CNC started (wraps).
+        pub catch_ups_r: u32 => [24, Cnc],
+        /// Padding.
+        pub fill_up_1: u32 => [28, Cnc],
     }
 }
 
@@ -147,7 +157,7 @@ hli_struct! {
     /// Control units of a channel.
     ///
     /// ST path: `gpCh[i]^channel_mc_control`.
-    #[st = "HLI_CHANNEL_MC_CONTROL", size = 184]
+    #[st = "HLI_CHANNEL_MC_CONTROL", size = 200]
     pub struct HliChannelMcControl {
         /// Dynamic coordinate system (PLC as master, tracking switch).
         pub dyn_cs: McControlDynCsUnit => [0, Parent],
@@ -197,16 +207,16 @@ hli_struct! {
     /// Everything of one channel: `gpCh[channel_idx]^`.
     ///
     /// ST path: `gpCh[i]^`.
-    #[st = "HLI_CHANNEL", size = 1056]
+    #[st = "HLI_CHANNEL", size = 1072]
     pub struct HliChannel {
         /// Path state and display values.
         pub bahn_state: HliBahnState => [0, Parent],
         /// Control units.
         pub channel_mc_control: HliChannelMcControl => [536, Parent],
         /// Channel interface (dynamic CS master output).
-        pub channel_interface: HliChannelInterface => [720, Parent],
+        pub channel_interface: HliChannelInterface => [736, Parent],
         /// The PLC operates the channel (program select, start, stop, ...).
-        pub channel_control: HliChannelControlUnit => [760, Parent],
+        pub channel_control: HliChannelControlUnit => [776, Parent],
     }
 }
 

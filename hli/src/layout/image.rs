@@ -73,15 +73,15 @@ hli_struct! {
     /// The complete HLI image as it lies in the shared segment.
     ///
     /// ST path: the image root (`header`, `gpCh[..]`, `gpAx[..]`, `gpFifo[..]`).
-    #[st = "HLI_IMAGE", size = 24704]
+    #[st = "HLI_IMAGE", size = 24896]
     pub struct HliImage {
         /// Identity and heartbeats.
         pub header: HliSegmentHeader => [0, Parent],
         /// Channels, `gpCh[i]^`.
         pub gpCh: [HliChannel; HLI_MAX_CHANNELS] => [192, Parent],
         /// Axes, `gpAx[i]^`.
-        pub gpAx: [HliAxis; HLI_MAX_AXES] => [12864, Parent],
+        pub gpAx: [HliAxis; HLI_MAX_AXES] => [13056, Parent],
         /// FIFO groups, `gpFifo[i]^`.
-        pub gpFifo: [HliFifoGroupState; HLI_MAX_FIFO_GROUPS] => [24128, Parent],
+        pub gpFifo: [HliFifoGroupState; HLI_MAX_FIFO_GROUPS] => [24320, Parent],
     }
 }

@@ -38,6 +38,18 @@ impl CncView<'_> {
                 offset_of!(HliDynCsTransitionResult, states_seen_r),
                 result.states_seen_r,
             ),
+            (
+                offset_of!(HliDynCsTransitionResult, lag_translation_r),
+                result.lag_translation_r as u32,
+            ),
+            (
+                offset_of!(HliDynCsTransitionResult, lag_rotation_r),
+                result.lag_rotation_r as u32,
+            ),
+            (
+                offset_of!(HliDynCsTransitionResult, catch_ups_r),
+                result.catch_ups_r,
+            ),
         ] {
             unit.field::<u32>(offset).store(value);
         }

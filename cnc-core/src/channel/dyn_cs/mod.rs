@@ -46,6 +46,11 @@ pub struct Tracker {
     /// The compensation applied in the last tick.
     applied: Isometry3<f64>,
     blend: Option<Blend>,
+    /// The largest lag of the catch-up under way (mm, degrees), `None` when the axes follow.
+    catch_up_peak: Option<(f64, f64)>,
+    /// The soft transition's blend is done; the state changes once the axes stand on the
+    /// compensation (a step they catch up on, see [`Tracker::land`]).
+    landing: bool,
     /// The last live master frame (held while the master is frozen).
     last_master: Option<Isometry3<f64>>,
     master_live: bool,
@@ -86,6 +91,8 @@ impl Tracker {
             tracking: None,
             applied: Isometry3::identity(),
             blend: None,
+            landing: false,
+            catch_up_peak: None,
             last_master: None,
             master_live: false,
             zero_values: [0.0; 6],
@@ -181,8 +188,44 @@ impl Tracker {
     pub fn in_transition(&self) -> bool {
         match self.state {
             DynCsState::Deactivating => true,
-            DynCsState::Activating => self.blend.is_some() && self.master_live,
+            DynCsState::Activating => (self.blend.is_some() || self.landing) && self.master_live,
             _ => false,
+        }
+    }
+
+    /// The lag of the slave's axes at the tool this tick (mm, degrees; `None`: they follow
+    /// exactly): the start of a catch-up and its landing are logged.
+    pub fn note_lag(&mut self, lag: Option<(f64, f64)>) {
+        match (lag, self.catch_up_peak) {
+            (Some((t, r)), None) => {
+                self.catch_up_peak = Some((t, r));
+                self.event(TrackEvent::CatchUp {
+                    landed: false,
+                    translation: t,
+                    rotation: r,
+                });
+            }
+            (Some((t, r)), Some((pt, pr))) => self.catch_up_peak = Some((pt.max(t), pr.max(r))),
+            (None, Some((pt, pr))) => {
+                self.catch_up_peak = None;
+                self.event(TrackEvent::CatchUp {
+                    landed: true,
+                    translation: pt,
+                    rotation: pr,
+                });
+            }
+            (None, None) => {}
+        }
+    }
+
+    /// After the channel's axes took this tick's set-points: a transition whose blend is
+    /// done ends (ACTIVE or INACTIVE) once the axes no longer lag behind the compensation,
+    /// so a FILTER=0 switching that they catch up on stays ACTIVATING or DEACTIVATING until
+    /// they stand on it.
+    pub fn land(&mut self, axes_lagging: bool) {
+        if self.landing && !axes_lagging {
+            self.landing = false;
+            self.end_transition();
         }
     }
 
@@ -236,6 +279,8 @@ impl Tracker {
     pub fn fail(&mut self, error: TrackError) {
         self.state = DynCsState::Error;
         self.blend = None;
+        self.landing = false;
+        self.catch_up_peak = None;
         self.last_error = Some(error);
         self.event(TrackEvent::Error(error));
     }
@@ -254,6 +299,7 @@ impl Tracker {
         self.state = DynCsState::Inactive;
         self.applied = Isometry3::identity();
         self.blend = None;
+        self.landing = false;
         self.setup = None;
         self.tracking = None;
         self.last_master = None;

@@ -45,6 +45,7 @@ impl Tracker {
         self.last_master = master.copied();
         self.master_live = master.is_some();
         self.state = DynCsState::Activating;
+        self.landing = false;
         self.blend = Some(Blend {
             from: self.applied,
             follow: false,
@@ -71,6 +72,7 @@ impl Tracker {
         });
         let follow = self.state == DynCsState::Active;
         self.state = DynCsState::Deactivating;
+        self.landing = false;
         self.blend = Some(Blend {
             from: self.applied,
             follow,
@@ -102,9 +104,12 @@ impl Tracker {
             return self.applied;
         }
         self.blend_towards(&target);
-        if self.blend.is_none() {
-            self.end_transition();
-        }
+        // The transition ends with [`Tracker::land`], once the axes stand on it.
+        self.landing = self.blend.is_none()
+            && matches!(
+                self.state,
+                DynCsState::Activating | DynCsState::Deactivating
+            );
         self.applied
     }
 
@@ -195,9 +200,9 @@ impl Tracker {
         };
     }
 
-    /// The blend is done: coupling in becomes ACTIVE, coupling out INACTIVE (everything
-    /// released).
-    fn end_transition(&mut self) {
+    /// The blend is done and the axes stand on it: coupling in becomes ACTIVE, coupling out
+    /// INACTIVE (everything released).
+    pub(super) fn end_transition(&mut self) {
         match self.state {
             DynCsState::Activating => {
                 self.state = DynCsState::Active;

@@ -99,6 +99,16 @@ pub enum TrackEvent {
     Error(TrackError),
     /// A PLC request refused without touching the tracking (state and compensation stay).
     Refused(TrackError),
+    /// The slave's axes began to catch up with a step of the compensation (the lag it made),
+    /// or landed on it (`landed`, with the largest lag of the catch-up).
+    CatchUp {
+        /// Landed (else began).
+        landed: bool,
+        /// The lag at the tool: mm.
+        translation: f64,
+        /// The lag at the tool: degrees.
+        rotation: f64,
+    },
     /// The channel started a program (`restart ... start`, then `... finished`).
     Restart {
         /// The second line of the pair.

@@ -36,6 +36,19 @@ impl fmt::Display for ChannelError {
     }
 }
 
+/// A catch-up lag beyond `track_lag_max`: the lag at the tool and the bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LagExcess {
+    /// Distance between the commanded and the compensated tool point (mm).
+    pub translation: f64,
+    /// Angle between their orientations (degrees).
+    pub rotation: f64,
+    /// The bound's distance (mm).
+    pub max_translation: f64,
+    /// The bound's angle (degrees).
+    pub max_rotation: f64,
+}
+
 /// What went wrong in a channel, with the values that say why.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ChannelFault {
@@ -59,6 +72,8 @@ pub enum ChannelFault {
     Tracking(TrackError),
     /// A tracked step beyond an axis's limit.
     TrackedStep(LimitViolation),
+    /// The axes lagged behind the compensation beyond `track_lag_max`.
+    TrackLag(LagExcess),
     /// `#CS` without a transformation.
     CsWithoutTrafo,
     /// More `#CS` frames than the stack holds.
@@ -92,7 +107,8 @@ impl ChannelFault {
             ChannelFault::IndependentNoProfile { .. } => ChannelErrorId::IndependentAxis,
             ChannelFault::TrackRefused(_)
             | ChannelFault::Tracking(_)
-            | ChannelFault::TrackedStep(_) => ChannelErrorId::Tracking,
+            | ChannelFault::TrackedStep(_)
+            | ChannelFault::TrackLag(_) => ChannelErrorId::Tracking,
             ChannelFault::CsWithoutTrafo | ChannelFault::CsDepth | ChannelFault::CsFrame(_) => {
                 ChannelErrorId::CoordinateSystem
             }
@@ -122,6 +138,12 @@ impl fmt::Display for ChannelFault {
             ChannelFault::TrackRefused(e) => write!(f, "#TRACK CS ON: {e}"),
             ChannelFault::Tracking(e) => write!(f, "tracking: {e}"),
             ChannelFault::TrackedStep(v) => write!(f, "tracked step refused: {v}"),
+            ChannelFault::TrackLag(l) => write!(
+                f,
+                "tracking: the axes lag {:.3} mm and {:.3} degree behind the compensation, \
+                 beyond track_lag_max ({} mm, {} degree)",
+                l.translation, l.rotation, l.max_translation, l.max_rotation
+            ),
             ChannelFault::CsWithoutTrafo => {
                 f.write_str("#CS needs an active transformation (#TRAFO ON)")
             }

@@ -35,7 +35,7 @@ mod tool;
 mod transition;
 
 pub use error::{ChannelError, ChannelFault};
-pub use safety::ResetError;
+pub use safety::{Lag, ResetError};
 
 use control::Control;
 use execute::ProgramValues;
@@ -46,7 +46,7 @@ use pose::Pose;
 use safety::Safety;
 
 use super::config::{ChannelConfig, ChannelConfigError};
-use super::dyn_cs::{words, MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
+use super::dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::guard::JointGuard;
 use super::kin_config::ToolKinematics;
 use super::path::contour::{Contour, Segment};
@@ -174,6 +174,8 @@ impl Channel {
             safety: Safety {
                 guard: JointGuard::new(&set_points, &axis_limits, cycle_s),
                 latch_pending: false,
+                lag: Default::default(),
+                lag_peak: Default::default(),
             },
             plc: PlcLink {
                 inputs: ChannelInputs::default(),

@@ -3,11 +3,14 @@
 //! channel takes the held position over before it hands the set-points back. A reset clears
 //! the channel's and the tracker's errors at rest.
 
+use super::error::LagExcess;
 use super::{Channel, ChannelError, ChannelFault, RunState};
+use crate::channel::catch_up::NoProfile;
 use crate::channel::dyn_cs::TrackError;
 use crate::channel::guard::JointGuard;
 use hli::enums::DynCsState;
 use kinematics::Kinematics;
+use nalgebra::Isometry3;
 
 /// Why [`Channel::reset`] refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -26,6 +29,29 @@ pub(super) struct Safety {
     pub(super) guard: JointGuard,
     /// The channel failed this tick: the guard latches at the end of it.
     pub(super) latch_pending: bool,
+    /// The axes' lag behind the compensation at the tool this tick (0 when they follow it
+    /// exactly), and the largest seen since start-up.
+    pub(super) lag: Lag,
+    pub(super) lag_peak: Lag,
+}
+
+/// A lag at the tool: distance (mm) and angle (degrees).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Lag {
+    /// mm.
+    pub translation: f64,
+    /// Degrees.
+    pub rotation: f64,
+}
+
+impl Lag {
+    /// Between the tool pose commanded and the one wanted.
+    fn between(commanded: &Isometry3<f64>, wanted: &Isometry3<f64>) -> Self {
+        Self {
+            translation: (commanded.translation.vector - wanted.translation.vector).norm(),
+            rotation: commanded.rotation.angle_to(&wanted.rotation).to_degrees(),
+        }
+    }
 }
 
 impl Channel {
@@ -58,7 +84,8 @@ impl Channel {
     /// while tracking, latches on any failure, and while latched replaces the set-points by
     /// the guard's braking or held ones.
     pub(super) fn guard_set_points(&mut self, tracked: bool) {
-        if !self.safety.guard.latched() && tracked {
+        self.safety.lag = Lag::default();
+        if !self.safety.guard.latched() && (tracked || self.safety.guard.lagging()) {
             self.check_tracked_step();
         }
         if !self.safety.guard.latched()
@@ -80,13 +107,30 @@ impl Channel {
         } else {
             self.safety.guard.accept(&self.pose.set_points);
         }
+        // Latched, the guard owns the set-points: nothing lags, a switch-off from ERROR
+        // ends without the axes.
+        let lagging = self.safety.guard.lagging();
+        if !self.safety.guard.latched() {
+            let lag = self.safety.lag;
+            self.pose
+                .tracker
+                .note_lag(lagging.then_some((lag.translation, lag.rotation)));
+        }
+        self.pose.tracker.land(lagging);
         self.publish();
     }
 
     /// Whether the channel's axes still move without a program: a soft coupling in or out,
     /// or the guard's braking.
     pub fn settling(&self) -> bool {
-        self.pose.tracker.in_transition() || self.safety.guard.braking()
+        self.pose.tracker.in_transition()
+            || self.safety.guard.braking()
+            || self.safety.guard.lagging()
+    }
+
+    /// The axes' lag behind the compensation this tick, and the largest since start-up.
+    pub fn tracking_lag(&self) -> (Lag, Lag) {
+        (self.safety.lag, self.safety.lag_peak)
     }
 
     /// A tracker that went to ERROR in its own tick (a frame it could not use) stops the
@@ -107,11 +151,32 @@ impl Channel {
         self.fail(ChannelFault::Tracking(cause));
     }
 
-    /// While the dynamic CS acts on the set-points, a step beyond an axis's velocity or
-    /// acceleration limit is refused: the tracker goes to ERROR and the channel fails.
+    /// While the dynamic CS acts on the set-points (or the axes still catch up with a step
+    /// of it): a step beyond an axis's limits is caught up within them (see
+    /// `channel::catch_up`). The channel fails, and its axes brake, when following the master
+    /// leaves a lag beyond `track_lag_max`, when no catch-up profile is found, or when what
+    /// is commanded still breaks a limit.
     pub(super) fn check_tracked_step(&mut self) {
         if self.pose.tracker.state() == DynCsState::Error {
             return; // latched below; the first cause stays the reported one
+        }
+        let wanted = self.pose.tool;
+        if let Err(NoProfile { axis }) = self.safety.guard.follow(&mut self.pose.set_points) {
+            let error = TrackError::NoCatchUp { axis: axis as u8 };
+            self.pose.tracker.fail(error);
+            self.fail_unless_failed(ChannelFault::Tracking(error));
+            return;
+        }
+        if self.safety.guard.lagging() {
+            self.take_joints_from_set_points();
+            self.note_lag(&wanted);
+            if let Some(excess) = self.lag_excess() {
+                self.pose.tracker.fail(TrackError::LagBeyondBound {
+                    rotation: excess.rotation > excess.max_rotation,
+                });
+                self.fail_unless_failed(ChannelFault::TrackLag(excess));
+                return;
+            }
         }
         let Some(violation) = self.safety.guard.check(&self.pose.set_points) else {
             return;
@@ -120,10 +185,38 @@ impl Channel {
             axis: violation.axis as u8,
             kind: violation.kind,
         });
-        // Also a channel whose program ended in this tick: its last step was refused.
+        self.fail_unless_failed(ChannelFault::TrackedStep(violation));
+    }
+
+    /// Also a channel whose program ended in this tick fails: its last step was refused.
+    fn fail_unless_failed(&mut self, fault: ChannelFault) {
         if self.state != RunState::Error {
-            self.fail(ChannelFault::TrackedStep(violation));
+            self.fail(fault);
         }
+    }
+
+    /// The lag between the tool pose commanded and the `wanted` one.
+    fn note_lag(&mut self, wanted: &Isometry3<f64>) {
+        let lag = Lag::between(&self.pose.tool, wanted);
+        let peak = &mut self.safety.lag_peak;
+        peak.translation = peak.translation.max(lag.translation);
+        peak.rotation = peak.rotation.max(lag.rotation);
+        self.safety.lag = lag;
+    }
+
+    /// A lag beyond `track_lag_max` while following the master (ACTIVE). A switching
+    /// without filter (ACTIVATING, DEACTIVATING) is caught up whatever its size: its step
+    /// is the program's or the PLC's choice.
+    fn lag_excess(&self) -> Option<LagExcess> {
+        let bound = self.config.track_lag_max;
+        let lag = self.safety.lag;
+        let beyond = lag.translation > bound.translation || lag.rotation > bound.rotation;
+        (beyond && self.pose.tracker.state() == DynCsState::Active).then_some(LagExcess {
+            translation: lag.translation,
+            rotation: lag.rotation,
+            max_translation: bound.translation,
+            max_rotation: bound.rotation,
+        })
     }
 
     /// Joints and tool pose of the set-points the guard gave (under a transformation).

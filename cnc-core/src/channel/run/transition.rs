@@ -3,7 +3,7 @@
 
 use super::Channel;
 use crate::channel::dyn_cs::{words, BadParameter, MasterSource, TrackError, TrackSetup};
-use crate::channel::plc_io::Transition;
+use crate::channel::plc_io::{hli_value, Transition};
 use hli::enums::{DynCsCommand, DynCsTransitionError};
 use hli::layout::HliDynCsTransition;
 use kinematics::frame::frame_from_hli;
@@ -57,8 +57,14 @@ impl Channel {
     }
 
     /// Adds the tracker's state of this tick to the states passed since the last transition.
+    /// Beside it, the axes' catch-up lag of this tick and the catch-ups started.
     pub(super) fn note_dyn_cs_state(&mut self) {
-        self.plc.outputs.dyn_cs_result.states_seen_r |= self.pose.tracker.state().seen_bit();
+        let lag = self.safety.lag;
+        let out = &mut self.plc.outputs.dyn_cs_result;
+        out.states_seen_r |= self.pose.tracker.state().seen_bit();
+        out.lag_translation_r = hli_value(lag.translation, false);
+        out.lag_rotation_r = hli_value(lag.rotation, true);
+        out.catch_ups_r = self.safety.guard.catch_up().started() as u32;
     }
 
     fn carry_out(
