@@ -288,6 +288,34 @@ fn a_small_plc_frame_step_is_caught_up_and_the_tracking_stays_active() {
     }
 }
 
+/// The catch-up runs in the tick without allocating: a robot slave catches a PLC step of
+/// 2 mm up (the joints' lags replanned every tick) under the counting allocator.
+#[test]
+fn a_catch_up_allocates_nothing() {
+    let program = "#TRAFO [45]\n#TRACK CS ON [ID=0 FILTER=0 WAIT]\n#TIME 2\nM30\n";
+    let mut ctl = controller(vec![(robot("kr6"), program)]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    support::enable_plc_master(&memory, [0; 3]);
+    for _ in 0..50 {
+        ctl.tick(&view);
+    }
+    plc.dyn_cs_command(0)
+        .unwrap()
+        .try_send(&cs([20_000, 10_000, 0]))
+        .unwrap();
+    let before = crate::counting_alloc::allocations();
+    let mut lagged = 0;
+    for _ in 0..300 {
+        ctl.tick(&view);
+        lagged += u32::from(ctl.channels()[0].settling());
+    }
+    assert_eq!(crate::counting_alloc::allocations(), before);
+    assert!(lagged > 10, "it caught up ({lagged} ticks)");
+    assert!(ctl.channels()[0].error().is_none());
+}
+
 /// Master and slave switch the interface and the tracking on in the same block of their
 /// programs: whichever channel ticks first, the slave couples in (ACTIVATING while it waits)
 /// and follows the master, its axes within their limits.
