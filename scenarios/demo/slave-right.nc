@@ -8,9 +8,9 @@
 G1 X0 Y30 Z0 A0 B0 C0 F3000
 #SIGNAL SYN [ID3 COUNT1]
 #WAIT SYN [ID2]
-; let go of the workpiece over half a second: the master moved it, so the compensation
-; to shed is some millimetres (the manual's FILTER=0 would step the joints)
-#TRACK CS OFF [FILTER=500 WAIT]
+; let go of the workpiece at once, as the manual does: the compensation the master's
+; motion built up is shed on the joints' catch-up, within their limits
+#TRACK CS OFF [FILTER=0]
 #CS OFF
 #CS OFF
 M30

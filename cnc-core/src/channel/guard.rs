@@ -59,7 +59,7 @@ impl core::fmt::Display for LimitViolation {
 }
 
 /// Relative slack of the checks: a step exactly at a limit passes despite rounding.
-const SLACK: f64 = 1e-6;
+pub(super) const SLACK: f64 = 1e-6;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Mode {

@@ -75,7 +75,7 @@ fn the_diagnosis_of_a_running_and_then_of_the_finished_cnc() {
     assert!(live.contains("BAHN : DYNAMIC CS, CHANNEL-NR.: 2"), "{live}");
     let rows = history_rows(&live);
     // The tracking slave's rows are ACTIVE (state 2); a listing caught late (a loaded machine)
-    // may end in its switch-off over FILTER=500: DEACTIVATING (3), then INACTIVE (0). Never
+    // may end in its switch-off (FILTER=0, caught up): DEACTIVATING (3), then INACTIVE (0). Never
     // back to ACTIVE after that, never another state.
     let states: Vec<&str> = rows
         .iter()

@@ -113,6 +113,31 @@ fn bad_axes_and_gears_are_refused_with_key_and_reason() {
     }
 }
 
+/// `track_lag_max` (mm, degree) of a channel: refused with the file, the channel and the key
+/// unless positive and finite, and an unknown key of it too.
+#[test]
+fn a_bad_track_lag_max_is_refused_with_file_and_key() {
+    for (value, expect) in [
+        ("{ translation = -1.0 }", "track_lag_max.translation = -1"),
+        ("{ rotation = 0.0 }", "track_lag_max.rotation = 0"),
+        ("{ translation = nan }", "track_lag_max.translation = NaN"),
+        ("{ distance = 1.0 }", "unknown field `distance`"),
+    ] {
+        let toml = format!(
+            "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+             program = \"c.nc\"\ntrack_lag_max = {value}\n"
+        );
+        let e = Scenario::parse("lag.toml", &toml, |f| {
+            Ok((PathBuf::from(f), "%c\nM30\n".to_string()))
+        })
+        .and_then(|s| InProcess::new(&s, 0).map(|_| s).map_err(Into::into))
+        .expect_err(value)
+        .to_string();
+        assert!(e.contains("lag.toml"), "{value}: {e}");
+        assert!(e.contains(expect), "{value}: {e}");
+    }
+}
+
 #[test]
 fn a_channel_whose_axis_faults_stops_in_error() {
     // A slow drive (10 Hz) cannot follow fast moves: the following error passes the limit.
