@@ -227,3 +227,31 @@ fn request_r_carries_the_applied_compensation() {
     let request = reader.try_take().unwrap().expect("posted again");
     assert_eq!(request.translation, [20, 0, 0]);
 }
+
+/// The dynamic CS's input and output on the HLI: the manual's diagnosis example (the axis at
+/// X 0.32 mm, the PLC's frame (0.1, -0.1, 0) mm) shows the pose before the dynamic CS in
+/// `position_in_dyncs_r` (3200, 0) and after it in `position_dyncs_r` (4200, -1000).
+#[test]
+fn the_pose_before_and_after_the_dynamic_cs_are_shown_side_by_side() {
+    let mut ctl = controller(vec![(
+        cartesian("slave"),
+        "G1 X0.32 F600\n#TRACK CS ON [ID=0 FILTER=0 WAIT]\n#TIME 1\nM30\n",
+    )]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    enable_plc_master(&memory, [1000, -1000, 0]);
+    for _ in 0..300 {
+        ctl.tick(&view);
+    }
+    assert_eq!(ctl.channels()[0].tracker().state(), DynCsState::Active);
+    let leaf = |i: usize, name: &str| {
+        Leaf::resolve(&format!("gpCh[0]^bahn_state.coord_r[{i}].{name}"))
+            .unwrap()
+            .read(&memory)
+            .as_f64() as i64
+    };
+    let input: Vec<i64> = (0..3).map(|i| leaf(i, "position_in_dyncs_r")).collect();
+    let output: Vec<i64> = (0..3).map(|i| leaf(i, "position_dyncs_r")).collect();
+    assert_eq!(input, [3200, 0, 0]);
+    assert_eq!(output, [4200, -1000, 0]);
+}

@@ -530,3 +530,125 @@ fn refused_and_unredirected_plc_requests_never_block_a_later_switch_on() {
         .dyn_cs_diagnosis()
         .contains("dynCS: refused: tracking is already on"));
 }
+
+/// Runs a master channel (channel 1) and a tracking slave (channel 2) until `done` or a
+/// watchdog of 20000 ticks, checking every tick with `each`.
+fn run_pair(
+    ctl: &mut Controller,
+    memory: &hli::ImageMemory,
+    mut each: impl FnMut(&Controller, u32) -> bool,
+) {
+    let view = CncView::new(memory);
+    for tick in 0..20_000u32 {
+        ctl.tick(&view);
+        if each(ctl, tick) {
+            return;
+        }
+    }
+    panic!("watchdog: not done after 20000 ticks");
+}
+
+/// A master channel's FREEZE by its interface: `#CHANNEL INTERFACE OFF [DYN_CS]` while its
+/// slave is ACTIVE holds the slave exactly where it was (the master moves 20 mm meanwhile);
+/// ON again is taken over softly, ACTIVATING along the slave's FILTER (the smoothing ramp's
+/// 100 ticks, its last ACTIVE on the master's position). Logged once each.
+#[test]
+fn a_master_channel_that_switches_its_interface_off_and_on_is_held_and_taken_over_softly() {
+    let master = "#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 0.3\n#CHANNEL INTERFACE OFF [DYN_CS]\n\
+                  G1 X20 F6000\n#TIME 0.1\n#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 1\nM30\n";
+    let slave = "#TRACK CS ON [CH=1 FILTER=100]\n#TIME 3\nM30\n";
+    let mut ctl = controller(vec![
+        (cartesian("master"), master),
+        (cartesian("slave"), slave),
+    ]);
+    let memory = image(2);
+    let x = |ctl: &Controller| ctl.channels()[1].set_points()[0];
+    let state = |ctl: &Controller| ctl.channels()[1].tracker().state();
+    // Coupled in on the master at rest, then the master freezes.
+    let mut held = None;
+    let mut resumed_at = None;
+    let mut ramp = Vec::new();
+    run_pair(&mut ctl, &memory, |ctl, tick| {
+        let master_x = ctl.channels()[0].set_points()[0];
+        match (held, resumed_at) {
+            (None, _) if master_x > 0.0 => {
+                assert_eq!(state(ctl), DynCsState::Active, "tick {tick}");
+                held = Some(x(ctl));
+            }
+            (Some(h), None) if state(ctl) == DynCsState::Activating => {
+                resumed_at = Some(tick);
+                ramp.push(x(ctl) - h);
+            }
+            (Some(h), None) => assert_eq!(x(ctl), h, "held while frozen, tick {tick}"),
+            (Some(h), Some(_)) if state(ctl) == DynCsState::Activating => ramp.push(x(ctl) - h),
+            _ => {}
+        }
+        resumed_at.is_some() && state(ctl) == DynCsState::Active
+    });
+    let h = held.expect("the master moved");
+    assert_eq!(h, 0.0);
+    // The ramp's last tick (k = 100) lands on the master and is ACTIVE.
+    assert_eq!(ramp.len(), 99, "ACTIVATING through the filter's ticks");
+    for (k, v) in ramp.iter().enumerate() {
+        let expected = 20.0 * smooth_ramp((k + 1) as f64 / 100.0);
+        assert!(
+            (v - expected).abs() < 1e-9,
+            "ramp tick {k}: {v} vs {expected}"
+        );
+    }
+    assert_eq!(x(&ctl), 20.0);
+    let log: Vec<_> = ctl.channels()[1].tracker().log().map(|(_, e)| *e).collect();
+    let count = |pick: fn(&TrackEvent) -> bool| log.iter().filter(|e| pick(e)).count();
+    assert_eq!(count(|e| matches!(e, TrackEvent::MasterFrozen)), 1);
+    assert_eq!(count(|e| matches!(e, TrackEvent::MasterResumed)), 1);
+}
+
+/// A master channel that fails: it brakes (its slave follows the braking frame) and freezes
+/// at rest; the slave holds there without failing itself. After the master's reset a new
+/// program of the master publishes again and the slave takes it over softly.
+#[test]
+fn a_failing_master_channel_freezes_its_slave_which_resumes_after_the_masters_reset() {
+    let master = "#CHANNEL INTERFACE ON [DYN_CS]\nG1 X10 F6000\n#CS ON [1, 0, 0, 0, 0, 0]\nM30\n";
+    let slave = "#TRACK CS ON [CH=1 FILTER=100]\n#TIME 10\nM30\n";
+    let mut ctl = controller(vec![
+        (cartesian("master"), master),
+        (cartesian("slave"), slave),
+    ]);
+    let memory = image(2);
+    let x = |ctl: &Controller| ctl.channels()[1].set_points()[0];
+    run_pair(&mut ctl, &memory, |ctl, _| {
+        ctl.channels()[0].state() == RunState::Error && !ctl.channels()[0].settling()
+    });
+    let view = CncView::new(&memory);
+    let held = x(&ctl);
+    assert!(
+        (held - 10.0).abs() < 1e-9,
+        "on the master's last frame: {held}"
+    );
+    for _ in 0..200 {
+        ctl.tick(&view);
+        let s = &ctl.channels()[1];
+        assert_ne!(s.state(), RunState::Error, "{:?}", s.error());
+        assert_eq!(x(&ctl), held, "held");
+    }
+    assert!(ctl.channels()[1]
+        .tracker()
+        .log()
+        .any(|(_, e)| matches!(e, TrackEvent::MasterFrozen)));
+    // The master is reset and runs again: the slave takes its frame over along the filter.
+    let m = ctl.channel_mut(0).unwrap();
+    m.reset().unwrap();
+    let again = "#CHANNEL INTERFACE ON [DYN_CS]\nG1 X30 F6000\n#TIME 1\nM30\n";
+    m.start(cnc_core::channel::LoadedProgram::load("m", again, &m.config().axes.clone()).unwrap())
+        .unwrap();
+    run_pair(&mut ctl, &memory, |ctl, _| {
+        let s = &ctl.channels()[1];
+        assert_ne!(s.state(), RunState::Error, "{:?}", s.error());
+        ctl.channels()[0].state() == RunState::Finished && s.tracker().state() == DynCsState::Active
+    });
+    assert!((x(&ctl) - 30.0).abs() < 1e-9, "{}", x(&ctl));
+    assert!(ctl.channels()[1]
+        .tracker()
+        .log()
+        .any(|(_, e)| matches!(e, TrackEvent::MasterResumed)));
+}

@@ -102,9 +102,9 @@ fn geometries_and_keys_that_cannot_run_are_refused_naming_the_key() {
 
 /// Kinematic 201 runs in a channel: a six-joint DH chain under `#TRAFO [201]` moves its tool
 /// point onto the programmed points.
-#[test]
-fn a_dh_chain_runs_in_a_channel() {
-    let mut c = stiff(ChannelConfig::new("chain", &["X", "Y", "Z", "A", "B", "C"]));
+/// A six-joint DH chain (kinematic 201) standing at a pose inside its reach.
+fn dh_chain(name: &str) -> ChannelConfig {
+    let mut c = stiff(ChannelConfig::new(name, &["X", "Y", "Z", "A", "B", "C"]));
     c.kinematics.id = 201;
     c.kinematics.chain = vec![
         DhRow {
@@ -151,6 +151,12 @@ fn a_dh_chain_runs_in_a_channel() {
         },
     ];
     c.start = vec![0.0, 20.0, 10.0, 0.0, 30.0, 0.0];
+    c
+}
+
+#[test]
+fn a_dh_chain_runs_in_a_channel() {
+    let c = dh_chain("chain");
     let mut ctl = controller(vec![(
         c,
         "#TRAFO [201]\nG91 G1 X20 Y-15 Z10 F3000\nG1 X-10 F3000\nM30\n",
@@ -214,4 +220,52 @@ fn the_tool_record_is_on_the_flange_under_a_transformation() {
     assert!((turn.2.to_degrees() - 90.0).abs() < 1e-6, "{turn:?}");
     let realised = ch.realised_tool(ch.set_points()).unwrap();
     assert!((realised.translation.vector - tool.translation.vector).norm() < 1e-9);
+}
+
+/// Kinematic 201 as a master channel (seed 003: a master's frame comes from its kinematic,
+/// 45 or 201): its tool frame is published on its interface every tick, and a Cartesian
+/// slave tracking it RELATIVE moves by what the chain's tool point moves.
+#[test]
+fn a_dh_chain_is_a_master_channel() {
+    let master = "#TRAFO [201]\n#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 0.05\nG91 G1 X20 Y-15 Z10 F3000\n#TIME 0.2\nM30\n";
+    let slave = "#TRACK CS ON [CH=1 RELATIVE FILTER=0]\n#TIME 2\nM30\n";
+    let mut ctl = controller(vec![
+        (dh_chain("chain"), master),
+        (
+            stiff(ChannelConfig::new("slave", &["X", "Y", "Z", "A", "B", "C"])),
+            slave,
+        ),
+    ]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    for _ in 0..2600 {
+        ctl.tick(&view);
+        let m = &ctl.channels()[0];
+        assert_ne!(m.state(), RunState::Error, "{:?}", m.error());
+        let leaf = |path: &str| {
+            hli::access::Leaf::resolve(&format!("gpCh[0]^channel_interface.dyn_cs.{path}"))
+                .unwrap()
+                .read(&memory)
+                .as_f64() as i64
+        };
+        assert_eq!(leaf("valid_r"), 1);
+        let expected = kinematics::frame::frame_to_hli(&m.tool_pose(), RotationOrder::Zyx).unwrap();
+        for k in 0..3 {
+            assert_eq!(
+                leaf(&format!("cs_r.translation[{k}]")),
+                i64::from(expected.translation[k])
+            );
+            assert_eq!(
+                leaf(&format!("cs_r.rotation[{k}]")),
+                i64::from(expected.rotation[k])
+            );
+        }
+    }
+    let s = &ctl.channels()[1];
+    assert_eq!(s.state(), RunState::Finished, "{:?}", s.error());
+    let moved = Vector3::new(s.set_points()[0], s.set_points()[1], s.set_points()[2]);
+    assert!(
+        (moved - Vector3::new(20.0, -15.0, 10.0)).norm() < 1e-6,
+        "{moved:?}"
+    );
 }

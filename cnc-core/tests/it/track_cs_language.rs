@@ -97,3 +97,66 @@ fn absolute_is_set_zero_and_the_angles_follow_the_channels_convention() {
     }
     assert_ne!(angles[0], angles[1]);
 }
+
+/// `V.G.WZ_AKT.*` (the controller's tool variables, named only in the manual's remark on
+/// the TCP display) is refused by name with its place: tool data are the D records.
+#[test]
+fn the_tool_variables_are_refused_by_name() {
+    let e = LoadedProgram::load("prog", "G1 F600\nG1 X=V.G.WZ_AKT.V.X\nM30\n", &axes())
+        .err()
+        .unwrap_or_else(|| panic!("accepted"))
+        .to_string();
+    assert!(e.contains("prog:2:"), "{e}");
+    assert!(
+        e.contains("V.G.WZ_AKT.V.X") && e.contains("not supported"),
+        "{e}"
+    );
+    // Any other unknown V.G. name keeps the generic refusal.
+    let e = LoadedProgram::load("prog", "G1 X=V.G.NOPE F600\nM30\n", &axes())
+        .err()
+        .unwrap_or_else(|| panic!("accepted"))
+        .to_string();
+    assert!(e.contains("unknown variable"), "{e}");
+}
+
+/// The PLC's switch-on with `f_set_zero` hands the master's frame to the program as the NC's
+/// SET_ZERO does: `V.G.TRACK_CS.X..C` of the frame (angles in the channel's convention),
+/// read by the next block decoded, and the switch-on moves nothing.
+#[test]
+fn a_plc_switch_on_with_set_zero_hands_the_master_frame_to_the_program() {
+    let program = "#TIME 0.2\nG1 X=V.G.TRACK_CS.X Y=V.G.TRACK_CS.Y Z=V.G.TRACK_CS.Z F6000\n\
+                   #TIME 0.3\nM30\n";
+    let mut ctl = controller(vec![(cartesian("slave"), program)]);
+    let memory = image(1);
+    let view = CncView::new(&memory);
+    let plc = PlcView::new(&memory);
+    plc.set_dyn_cs_enabled(0, true).unwrap();
+    plc.dyn_cs_command(0).unwrap().try_send(&master()).unwrap();
+    for _ in 0..50 {
+        ctl.tick(&view);
+    }
+    let mut t = support::transition(0, hli::Bool::TRUE);
+    t.f_set_zero = hli::Bool::TRUE;
+    plc.dyn_cs_transition(0)
+        .unwrap()
+        .try_send(hli::enums::DynCsCommand::Activate, &t)
+        .unwrap();
+    let before = ctl.channels()[0].set_points()[0];
+    ctl.tick(&view);
+    assert_eq!(plc.gp_ch(0).unwrap().dyn_cs_result().error_id_r, 0);
+    assert_eq!(
+        ctl.channels()[0].set_points()[0],
+        before,
+        "SET_ZERO moves nothing"
+    );
+    let zero = ctl.channels()[0].tracker().zero_values();
+    let frame = frame_from_hli(&master(), RotationOrder::Zyx);
+    let words = PoseWords::from_frame(&frame, RotationOrder::YawPitchRoll);
+    for k in 0..3 {
+        assert!((zero[k] - words.xyz[k]).abs() < 1e-9, "{zero:?}");
+        assert!((zero[3 + k] - words.abc[k]).abs() < 1e-9, "{zero:?}");
+    }
+    support::run_to_end(&mut ctl, &memory, 5000);
+    let p = ctl.channels()[0].programmed();
+    assert!((p[0] - 10.0).abs() < 1e-9 && (p[1] - 20.0).abs() < 1e-9 && (p[2] - 5.0).abs() < 1e-9);
+}

@@ -22,8 +22,9 @@ hli_struct! {
         pub position_dyncs_r: i32 => [4, Cnc],
         /// Programmed position in the channel's coordinates (after offsets), 0.1 um.
         pub command_position_r: i32 => [8, Cnc],
-        /// Padding.
-        pub fill_up_1: i32 => [12, Cnc],
+        /// Tool-centre-point set position *before* the dynamic coordinate system (its input,
+        /// beside `position_dyncs_r`, its output), 0.1 um (0.0001 deg for orientation).
+        pub position_in_dyncs_r: i32 => [12, Cnc],
     }
 }
 

@@ -130,12 +130,64 @@ fn a_bad_track_lag_max_is_refused_with_file_and_key() {
         let e = Scenario::parse("lag.toml", &toml, |f| {
             Ok((PathBuf::from(f), "%c\nM30\n".to_string()))
         })
-        .and_then(|s| InProcess::new(&s, 0).map(|_| s).map_err(Into::into))
+        .and_then(|s| InProcess::new(&s, 0).map(|_| s))
         .expect_err(value)
         .to_string();
         assert!(e.contains("lag.toml"), "{value}: {e}");
         assert!(e.contains(expect), "{value}: {e}");
     }
+}
+
+/// The start-up list's `configuration.channel[i].interpolator.dyn_cs_history_max` (P-STUP-00074)
+/// is the channel's `interpolator = { dyn_cs_history_max = N }`: taken as given, 0 keeps no
+/// history, beyond what is kept refused with the file, the channel and the key.
+#[test]
+fn the_history_size_is_the_start_up_key() {
+    let toml = |n: &str| {
+        format!(
+            "cycle_ms = 1.0\n[[channel]]\nname = \"c\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n\
+             program = \"c.nc\"\ninterpolator = {{ dyn_cs_history_max = {n} }}\n"
+        )
+    };
+    let program = "%c\n#TRACK CS ON [ID=0 FILTER=0]\n#TIME 0.1\nM30\n";
+    let parse = |n: &str| {
+        Scenario::parse("hist.toml", &toml(n), |f| {
+            Ok((PathBuf::from(f), program.to_string()))
+        })
+    };
+    let s = parse("1000").unwrap();
+    assert_eq!(s.channels[0].interpolator.dyn_cs_history_max, 1000);
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..50 {
+        run.step(s.cycle_s);
+    }
+    assert!(
+        run.machine.controller().channels()[0]
+            .tracker()
+            .history()
+            .count()
+            >= 40
+    );
+    let s = parse("0").unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    for _ in 0..50 {
+        run.step(s.cycle_s);
+    }
+    assert_eq!(
+        run.machine.controller().channels()[0]
+            .tracker()
+            .history()
+            .count(),
+        0
+    );
+    let e = parse("100001")
+        .and_then(|s| InProcess::new(&s, 0).map(|_| ()))
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        e.contains("hist.toml") && e.contains("dyn_cs_history_max"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -67,6 +67,7 @@ impl Channel {
         out.dyn_cs_request = frame_to_hli(self.pose.tracker.applied(), RotationOrder::Zyx).ok();
         let w0 = words_in(&self.pose.tool, self.pose.order);
         let dyncs = words_in(&self.pose.pose_out, self.pose.order);
+        let input = words_in(&self.pose.pose_in, self.pose.order);
         out.coord_count = self.motion.programmed.len().min(out.coords.len());
         for i in 0..out.coord_count {
             let angle = (3..6).contains(&i);
@@ -83,7 +84,11 @@ impl Channel {
                     to_hli(self.pose.set_points[i])
                 },
                 command_position_r: to_hli(self.motion.programmed[i]),
-                fill_up_1: 0,
+                position_in_dyncs_r: if i < 6 {
+                    to_hli(input[i])
+                } else {
+                    to_hli(self.motion.programmed[i])
+                },
             };
         }
         let progress = &mut out.progress;

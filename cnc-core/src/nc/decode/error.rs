@@ -32,6 +32,12 @@ pub enum DecodeError {
         /// The variable.
         name: Name,
     },
+    /// The controller's tool variables (`V.G.WZ_AKT.*`): refused by name, tool data is the
+    /// channel's D records (`nc.tools`), selected with `D..`.
+    ToolVariable {
+        /// The variable.
+        name: Name,
+    },
     /// An operator or function without a usable value (division by zero, ...).
     Eval(EvalError),
     /// A value that is not finite (it overflowed).
@@ -279,6 +285,11 @@ impl fmt::Display for DecodeError {
                 }
                 f.write_str(")")
             }
+            DecodeError::ToolVariable { name } => write!(
+                f,
+                "\"{name}\": the V.G.WZ_AKT tool variables are not supported; tool data are the \
+                 channel's D records (nc.tools), selected with D.."
+            ),
             DecodeError::Eval(e) => write!(f, "{e}"),
             DecodeError::NotFinite { value } => {
                 write!(f, "the value is not a finite number ({value}): it overflowed")

@@ -165,6 +165,8 @@ impl<'a> Ctx<'a> {
         let name = *name;
         if own {
             self.error(span, DecodeError::UnassignedVariable { name });
+        } else if name.starts_with("V.G.WZ_AKT.") {
+            self.error(span, DecodeError::ToolVariable { name });
         } else {
             self.error(span, DecodeError::UnknownVariable { name });
         }
