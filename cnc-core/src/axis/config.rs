@@ -98,6 +98,9 @@ pub enum OutData3 {
     Acceleration,
     /// A torque set-point (feed-forward from the dynamic model).
     Torque,
+    /// Both added, each under its own scaling (the manual lets the two go out separately or
+    /// as their sum, by the output scalings).
+    Sum,
 }
 
 /// The reason a value that must be positive gives.
@@ -106,12 +109,13 @@ const POSITIVE: &str = "must be a finite number above 0";
 impl AxisConfig {
     /// `drive_out.nOutData3` for a set-point acceleration of `acceleration` units/s^2.
     pub fn out_data3(&self, acceleration: f64) -> f64 {
+        let as_acceleration = acceleration * self.acceleration_increments_per_unit;
+        let as_torque = 100.0 * acceleration / self.dynamics.acceleration
+            * self.io.torque_increments_per_percent;
         match self.io.out_data3 {
-            OutData3::Acceleration => acceleration * self.acceleration_increments_per_unit,
-            OutData3::Torque => {
-                100.0 * acceleration / self.dynamics.acceleration
-                    * self.io.torque_increments_per_percent
-            }
+            OutData3::Acceleration => as_acceleration,
+            OutData3::Torque => as_torque,
+            OutData3::Sum => as_acceleration + as_torque,
         }
     }
 }

@@ -525,31 +525,52 @@ fn set_position_sets_the_encoder_counter_at_standstill() {
 fn out_data3_carries_the_torque_set_point_when_configured() {
     use cnc_core::axis::config::OutData3;
     use hli::layout::{NcDriveIn, NcDriveOut};
-    let mut c = probed(ProbeInterface::None, [None, None]);
-    c.io.out_data3 = OutData3::Torque;
-    let max = c.dynamics.acceleration;
-    let mut rig = Rig::new(c);
-    rig.move_to(50.0);
-    let mut checked = 0;
-    for _ in 0..200 {
-        rig.tick();
-        let a = rig.set.axis(0).unwrap().setpoint().acceleration;
-        let out: NcDriveOut = rig
-            .place()
-            .field::<NcDriveOut>(core::mem::offset_of!(HliAxis, drive_out))
-            .read();
-        let expected = (100.0 * a / max * 10.0).round() as i32;
-        assert_eq!(out.nOutData3, expected);
-        if a.abs() > 0.5 * 2000.0 {
-            checked += 1;
-            let input: NcDriveIn = rig
+    for mode in [OutData3::Torque, OutData3::Sum] {
+        let mut c = probed(ProbeInterface::None, [None, None]);
+        c.io.out_data3 = mode;
+        let max = c.dynamics.acceleration;
+        let per_unit = c.acceleration_increments_per_unit;
+        let mut rig = Rig::new(c);
+        rig.move_to(50.0);
+        let mut checked = 0;
+        for _ in 0..200 {
+            rig.tick();
+            let a = rig.set.axis(0).unwrap().setpoint().acceleration;
+            let out: NcDriveOut = rig
                 .place()
-                .field::<NcDriveIn>(core::mem::offset_of!(HliAxis, drive_in))
+                .field::<NcDriveOut>(core::mem::offset_of!(HliAxis, drive_out))
                 .read();
-            assert!(input.nInData3 != 0);
+            let torque = 100.0 * a / max * 10.0;
+            let expected = match mode {
+                OutData3::Sum => (a * per_unit + torque).round() as i32,
+                _ => torque.round() as i32,
+            };
+            assert_eq!(out.nOutData3, expected, "{mode:?}");
+            if a.abs() > 0.5 * 2000.0 {
+                checked += 1;
+                let input: NcDriveIn = rig
+                    .place()
+                    .field::<NcDriveIn>(core::mem::offset_of!(HliAxis, drive_in))
+                    .read();
+                assert!(input.nInData3 != 0);
+            }
         }
+        assert!(checked > 10, "{checked}");
     }
-    assert!(checked > 10, "{checked}");
+}
+
+/// `io.out_data3 = "sum"` with the default scalings: an acceleration of 2000 units/s^2 is
+/// 2000 x 1000 increments of acceleration plus 20 % of the rated torque x 10 increments.
+#[test]
+fn out_data3_as_the_sum_of_acceleration_and_torque() {
+    use cnc_core::axis::config::{AxisConfig, OutData3};
+    let mut c = AxisConfig::linear("X", 1);
+    c.io.out_data3 = OutData3::Sum;
+    c.acceleration_increments_per_unit = 1000.0;
+    c.dynamics.acceleration = 10_000.0;
+    c.io.torque_increments_per_percent = 10.0;
+    assert_eq!(c.out_data3(2000.0), 2_000_200.0);
+    assert_eq!(c.out_data3(-2000.0), -2_000_200.0);
 }
 
 /// MC_SetPosition on a drive in cyclic position mode with dead time, on 32- and 16-bit

@@ -255,6 +255,39 @@ fn direction_bits_follow_the_set_point_and_the_total_output() {
     assert_eq!(rig.drive_out(0).nCtrl2, 0x80);
 }
 
+/// `nCtrl2` is the set-point generator's direction alone, `nCtrl3` the direction of the total
+/// output (generator plus position controller): an axis standing still at 0 whose encoder
+/// reads 0.1 mm ahead has no set-point direction (Stop, 0x80) but a controller output back
+/// towards it (minus, 0x41; Kv 50 / s x 0.1 mm = 5 mm/s); 0.1 mm behind, plus (0x42).
+#[test]
+fn the_total_outputs_direction_is_its_own_where_it_differs_from_the_set_points() {
+    for (ahead, total) in [(1000, 0x41), (-1000, 0x42)] {
+        let mut config = AxisConfig::linear("X", 1);
+        config.drive = DriveLink::External;
+        let mut rig = Rig::new(vec![config]);
+        rig.enable(0);
+        rig.tick();
+        let enc = CncView::new(&rig.memory)
+            .axis(0)
+            .unwrap()
+            .field::<NcEncoderIn>(core::mem::offset_of!(HliAxis, enc_in));
+        enc.write(&NcEncoderIn {
+            nInData1: ahead,
+            ..bytemuck::Zeroable::zeroed()
+        });
+        rig.ticks(2);
+        let out = rig.drive_out(0);
+        assert_eq!(out.nCtrl2, DirectionBits::Stop.raw(), "{ahead}");
+        assert_eq!(out.nCtrl3, total, "{ahead}");
+        assert_eq!(
+            out.nOutData1.signum(),
+            -ahead.signum(),
+            "{ahead}: {}",
+            out.nOutData1
+        );
+    }
+}
+
 #[test]
 fn universal_drive_outputs_signed_velocity_and_its_magnitude() {
     let mut config = AxisConfig::linear("X", 1);
