@@ -580,6 +580,8 @@ hli_enum! {
         /// The drive's own following error (`drive_in.nInData1`, cyclic position mode) or its
         /// following-error bit exceeded the limit.
         ExternalFollowingError = 0x4246,
+        /// The encoder reports an error (its configured bit of `enc_in.nStatus1`).
+        EncoderError = 0x4247,
         /// A touch probe that is armed already was armed again; the first arming stays.
         ProbeAlreadyArmed = 0x4260,
         /// The axis has no touch probe of that number (its probe interface, or none).

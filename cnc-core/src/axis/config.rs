@@ -87,6 +87,32 @@ pub struct ImageOptions {
     pub encoder_absolute: bool,
     /// The encoder can set its counter (MC_SetPosition through `nCtrl2`/`nOutData2`).
     pub encoder_set_counter: bool,
+    /// The encoder's error bit(s) in `enc_in.nStatus1` (the manual leaves their coding to the
+    /// device): while reported, an enabled axis stops with `EncoderError` and the reading is
+    /// not used.
+    pub encoder_error: Option<EncoderErrorBit>,
+}
+
+/// Where an encoder reports an error in `enc_in.nStatus1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EncoderErrorBit {
+    /// The bit(s) (not 0).
+    pub mask: u8,
+    /// The error is a cleared bit (any of the mask's bits 0), else a set one (any 1).
+    #[serde(default)]
+    pub active_low: bool,
+}
+
+impl EncoderErrorBit {
+    /// Whether status byte `status` reports the error.
+    pub fn reported(&self, status: u8) -> bool {
+        if self.active_low {
+            status & self.mask != self.mask
+        } else {
+            status & self.mask != 0
+        }
+    }
 }
 
 /// What `drive_out.nOutData3` carries.
@@ -130,6 +156,7 @@ impl Default for ImageOptions {
             out_data3: OutData3::Acceleration,
             encoder_absolute: false,
             encoder_set_counter: false,
+            encoder_error: None,
         }
     }
 }
@@ -281,6 +308,7 @@ impl AxisConfig {
         self.check_dynamics()?;
         self.check_controller()?;
         self.check_kind_and_limits()?;
+        self.check_encoder_error()?;
         if let DriveLink::Simulated(sim) = self.drive {
             sim.validate()
                 .map_err(|(field, value, reason)| ConfigError {
@@ -289,6 +317,32 @@ impl AxisConfig {
                     value,
                     reason,
                 })?;
+        }
+        Ok(())
+    }
+
+    /// The encoder-error bit: a mask, and not in a status byte the terminal probe owns.
+    fn check_encoder_error(&self) -> Result<(), ConfigError> {
+        let Some(bit) = self.io.encoder_error else {
+            return Ok(());
+        };
+        let refuse = |field, reason| ConfigError {
+            axis: self.name.clone(),
+            field,
+            value: f64::from(bit.mask),
+            reason,
+        };
+        if bit.mask == 0 {
+            return Err(refuse(
+                "io.encoder_error.mask",
+                "must name at least one bit",
+            ));
+        }
+        if self.io.probe == ProbeInterface::Terminal {
+            return Err(refuse(
+                "io.encoder_error",
+                "nStatus1 is the terminal probe's status (probe = \"terminal\")",
+            ));
         }
         Ok(())
     }

@@ -528,10 +528,18 @@ impl Axis {
         let scale = self.config.increments_per_unit;
         let drive_state = self.inputs.read(enc_in, drive_in);
         // Inputs: a status byte that is not a valid IoState counts as invalid too.
-        let encoder_ok = IoState::decode(enc_in.nStatus4) == Ok(IoState::Valid);
+        let encoder_valid = IoState::decode(enc_in.nStatus4) == Ok(IoState::Valid);
+        let encoder_error = self
+            .config
+            .io
+            .encoder_error
+            .is_some_and(|bit| bit.reported(enc_in.nStatus1));
+        let encoder_ok = encoder_valid && !encoder_error;
         let drive_ok = IoState::decode(drive_in.nStatus4) == Ok(IoState::Valid);
-        self.io_fault = if !encoder_ok {
+        self.io_fault = if !encoder_valid {
             Some(AxisError::EncoderIoInvalid)
+        } else if encoder_error {
+            Some(AxisError::EncoderError)
         } else if !drive_ok {
             Some(AxisError::DriveIoInvalid)
         } else {
@@ -576,7 +584,11 @@ impl Axis {
             }
         }
         if !encoder_ok {
-            self.probes.lose_data(AxisError::EncoderIoInvalid);
+            self.probes.lose_data(if encoder_valid {
+                AxisError::EncoderError
+            } else {
+                AxisError::EncoderIoInvalid
+            });
         }
         if let Some(cause) = self.io_fault {
             if self.enabled && self.error.is_none() {

@@ -489,3 +489,63 @@ fn a_status_byte_that_is_neither_valid_nor_invalid_counts_as_invalid() {
         Some(AxisError::EncoderIoInvalid)
     );
 }
+
+/// An encoder-error bit in `enc_in.nStatus1` (`io.encoder_error`, coding configurable): while
+/// reported, an enabled axis stops with `EncoderError` (0x4247), outputs nothing and refuses a
+/// reset; cleared, the reset is taken. Active low: a cleared bit is the error. A mask of 0 and
+/// the terminal probe's status byte are refused with the key.
+#[test]
+fn an_encoder_error_bit_faults_the_axis_until_it_clears() {
+    use cnc_core::axis::config::{EncoderErrorBit, ProbeInterface};
+    for (active_low, error, fine) in [(false, 0x10u8, 0x00u8), (true, 0x00, 0x01)] {
+        let mut config = AxisConfig::linear("X", 1);
+        config.drive = DriveLink::External;
+        let mask = if active_low { 0x01 } else { 0x10 };
+        config.io.encoder_error = Some(EncoderErrorBit { mask, active_low });
+        let mut rig = Rig::new(vec![config]);
+        let status = |rig: &Rig, s: u8| {
+            rig.set_enc_in(
+                0,
+                NcEncoderIn {
+                    nStatus1: s,
+                    ..bytemuck::Zeroable::zeroed()
+                },
+            )
+        };
+        status(&rig, fine);
+        rig.enable(0);
+        rig.ticks(2);
+        assert_eq!(rig.set.axis(0).unwrap().error(), None, "{active_low}");
+        status(&rig, error);
+        rig.ticks(2);
+        assert_eq!(
+            rig.set.axis(0).unwrap().error(),
+            Some(AxisError::EncoderError),
+            "{active_low}"
+        );
+        assert_eq!(AxisError::EncoderError.raw(), 0x4247);
+        assert_eq!(rig.drive_out(0).nOutData1, 0);
+        assert_eq!(rig.drive_out(0).nCtrl3, DirectionBits::Stop.raw());
+        assert_eq!(
+            rig.call(0, AxisCommandCall::reset()),
+            Err(AxisError::ResetRefused)
+        );
+        status(&rig, fine);
+        rig.ticks(2);
+        rig.call(0, AxisCommandCall::reset()).unwrap();
+        assert_eq!(rig.set.axis(0).unwrap().error(), None);
+    }
+    let mut config = AxisConfig::linear("X", 1);
+    config.io.encoder_error = Some(EncoderErrorBit {
+        mask: 0,
+        active_low: false,
+    });
+    let e = config.validate().unwrap_err();
+    assert_eq!(e.field, "io.encoder_error.mask");
+    config.io.encoder_error = Some(EncoderErrorBit {
+        mask: 0x10,
+        active_low: false,
+    });
+    config.io.probe = ProbeInterface::Terminal;
+    assert_eq!(config.validate().unwrap_err().field, "io.encoder_error");
+}
