@@ -1,6 +1,7 @@
 //! Configuration of an axis: identity, kind, scaling, limits, dynamics, control and drive.
 
 use super::increments::CounterWidth;
+use super::io_map::{Block, ImageMap};
 use super::sim_drive::SimDriveConfig;
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +92,9 @@ pub struct ImageOptions {
     /// device): while reported, an enabled axis stops with `EncoderError` and the reading is
     /// not used.
     pub encoder_error: Option<EncoderErrorBit>,
+    /// Where each signal lies in the hardware's bytes of an external drive, for drives the
+    /// fixed codings do not know (`axis::io_map`); empty: our layout.
+    pub map: ImageMap,
 }
 
 /// Where an encoder reports an error in `enc_in.nStatus1`.
@@ -157,6 +161,7 @@ impl Default for ImageOptions {
             encoder_absolute: false,
             encoder_set_counter: false,
             encoder_error: None,
+            map: ImageMap::default(),
         }
     }
 }
@@ -309,6 +314,7 @@ impl AxisConfig {
         self.check_controller()?;
         self.check_kind_and_limits()?;
         self.check_encoder_error()?;
+        self.check_map()?;
         if let DriveLink::Simulated(sim) = self.drive {
             sim.validate()
                 .map_err(|(field, value, reason)| ConfigError {
@@ -343,6 +349,38 @@ impl AxisConfig {
                 "io.encoder_error",
                 "nStatus1 is the terminal probe's status (probe = \"terminal\")",
             ));
+        }
+        Ok(())
+    }
+
+    /// A map is an external drive's, and the encoder's counter in it is the counter the
+    /// configuration names (16 or 32 bits, unscaled: its wraps are counted).
+    fn check_map(&self) -> Result<(), ConfigError> {
+        let map = &self.io.map;
+        if map.is_empty() {
+            return Ok(());
+        }
+        let refuse = |field, value, reason| ConfigError {
+            axis: self.name.clone(),
+            field,
+            value,
+            reason,
+        };
+        if self.drive != DriveLink::External {
+            return Err(refuse("io.map", 0.0, "maps an external drive's image only"));
+        }
+        if let Some(counter) = map.signal(Block::EncIn, "nInData1") {
+            let bits = match self.encoder_width {
+                CounterWidth::Bits16 => 16,
+                CounterWidth::Bits32 => 32,
+            };
+            if counter.width != bits || counter.scale != 1.0 || counter.signed != (bits == 32) {
+                return Err(refuse(
+                    "io.map",
+                    f64::from(counter.width),
+                    "enc_in.nInData1 must be the encoder_width's counter: 16 bits unsigned or 32 signed, scale 1",
+                ));
+            }
         }
         Ok(())
     }

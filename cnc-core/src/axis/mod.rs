@@ -16,6 +16,7 @@ pub mod encoder_reg;
 pub mod generator;
 pub mod increments;
 mod inputs;
+pub mod io_map;
 pub mod probe;
 pub mod set;
 pub mod sim_drive;

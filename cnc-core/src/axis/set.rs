@@ -3,6 +3,7 @@
 
 use super::axis::{Axis, Coupling};
 use super::config::{AxisConfig, ConfigError, DriveLink};
+use super::io_map::Block;
 use super::sim_drive::{SimScaling, SimulatedDrive};
 use crate::setpoint::Kinematic;
 use core::mem::offset_of;
@@ -232,14 +233,18 @@ impl AxisSet {
             let Ok(place) = view.axis(i) else { continue };
             let (enc_in, drive_in) = match self.drives[i] {
                 Some(_) => self.sim_inputs[i],
-                None => (
-                    place
+                None => {
+                    let mut enc_in = place
                         .field::<NcEncoderIn>(offset_of!(HliAxis, enc_in))
-                        .read(),
-                    place
+                        .read();
+                    let mut drive_in = place
                         .field::<NcDriveIn>(offset_of!(HliAxis, drive_in))
-                        .read(),
-                ),
+                        .read();
+                    let map = &axis.config().io.map;
+                    map.decode(Block::EncIn, &mut enc_in);
+                    map.decode(Block::DriveIn, &mut drive_in);
+                    (enc_in, drive_in)
+                }
             };
             axis.sense(&enc_in, &drive_in);
         }
@@ -282,12 +287,17 @@ impl AxisSet {
             place
                 .field::<HliAxisLrState>(offset_of!(HliAxis, lr_state))
                 .write(&out.lr_state);
+            // An external drive's mapped blocks go out in the hardware's bytes.
+            let (mut drive_out, mut enc_out) = (out.drive_out, out.enc_out);
+            let map = &axis.config().io.map;
+            map.encode(Block::DriveOut, &mut drive_out);
+            map.encode(Block::EncOut, &mut enc_out);
             place
                 .field::<NcDriveOut>(offset_of!(HliAxis, drive_out))
-                .write(&out.drive_out);
+                .write(&drive_out);
             place
                 .field::<NcEncoderOut>(offset_of!(HliAxis, enc_out))
-                .write(&out.enc_out);
+                .write(&enc_out);
             place
                 .field::<HliAxisCommandState>(offset_of!(HliAxis, command_state))
                 .write(&out.command_state);

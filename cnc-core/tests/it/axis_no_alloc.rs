@@ -60,6 +60,18 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
                 c.io.probe = ProbeInterface::Canopen;
                 sim.probe_windows = [Some([20.0, 30.0]), Some([-30.0, -20.0])];
             }
+            // The last axis: an external drive mapped signal by signal (decoded and encoded
+            // every tick).
+            if i == 31 {
+                c.drive = DriveLink::External;
+                c.io = toml::from_str(
+                    r#"map = [
+                        { signal = "enc_in.nInData1", bit = 32, width = 32, signed = true },
+                        { signal = "drive_out.nOutData1", bit = 0, width = 16, signed = true, scale = 100.0 },
+                    ]"#,
+                )
+                .unwrap();
+            }
             c
         })
         .collect();

@@ -549,3 +549,84 @@ fn an_encoder_error_bit_faults_the_axis_until_it_clears() {
     config.io.probe = ProbeInterface::Terminal;
     assert_eq!(config.validate().unwrap_err().field, "io.encoder_error");
 }
+
+/// A drive the fixed codings do not know, linked signal by signal (`io.map`): its encoder
+/// puts a 32-bit position at byte 4 and an "invalid" flag at bit 7 of byte 0; it takes a
+/// 16-bit velocity in units of 100 increments at byte 0 and its enable at bit 16. The axis
+/// reads its position from there, faults on the flag, and writes its outputs in those bits.
+#[test]
+fn a_drive_mapped_signal_by_signal_is_read_and_written_in_its_own_bytes() {
+    let toml = r#"map = [
+        { signal = "enc_in.nInData1", bit = 32, width = 32, signed = true },
+        { signal = "enc_in.nStatus4", bit = 7, width = 1 },
+        { signal = "drive_out.nOutData1", bit = 0, width = 16, signed = true, scale = 100.0 },
+        { signal = "drive_out.nCtrl1", bit = 16, width = 1 },
+    ]"#;
+    let mut config = AxisConfig::linear("X", 1);
+    config.drive = DriveLink::External;
+    config.io = toml::from_str(toml).unwrap();
+    config.validate().unwrap();
+    let scale = config.increments_per_unit;
+    let mut rig = Rig::new(vec![config]);
+    let hardware = |position: i32, invalid: bool| {
+        let mut raw: NcEncoderIn = bytemuck::Zeroable::zeroed();
+        let bytes = bytemuck::bytes_of_mut(&mut raw);
+        bytes[0] = u8::from(invalid) << 7;
+        bytes[4..8].copy_from_slice(&position.to_le_bytes());
+        raw
+    };
+    rig.set_enc_in(0, hardware(50_000, false));
+    rig.enable(0);
+    rig.ticks(3);
+    assert_eq!(rig.set.axis(0).unwrap().actual(), 50_000.0 / scale);
+    let raw = rig.drive_out(0);
+    let bytes = bytemuck::bytes_of(&raw);
+    assert_eq!(bytes[2] & 1, 1, "enabled: bit 16");
+    // A velocity move at 20 mm/s = 200,000 increments/s: 2000 in units of 100.
+    let slow = [20.0, 5000.0, 4000.0, 100_000.0];
+    rig.call(0, AxisCommandCall::move_velocity(1, slow))
+        .unwrap();
+    let mut position = 50_000i32;
+    let mut last = 0;
+    for _ in 0..300 {
+        rig.tick();
+        let raw = rig.drive_out(0);
+        let bytes = bytemuck::bytes_of(&raw);
+        last = i16::from_le_bytes([bytes[0], bytes[1]]);
+        assert!(
+            bytes[4..].iter().all(|b| *b == 0),
+            "nothing outside the mapped bits"
+        );
+        // The drive follows: the encoder counts what it was told, a tick's worth.
+        position += i32::from(last) * 100 / 1000;
+        rig.set_enc_in(0, hardware(position, false));
+    }
+    assert!((1990..=2010).contains(&last), "at speed: {last}");
+    rig.tick();
+    let actual = rig.set.axis(0).unwrap().actual();
+    assert!(
+        (actual - f64::from(position) / scale).abs() < 0.01,
+        "{actual} vs {position}"
+    );
+    rig.set_enc_in(0, hardware(position, true));
+    rig.ticks(2);
+    assert_eq!(
+        rig.set.axis(0).unwrap().error(),
+        Some(AxisError::EncoderIoInvalid)
+    );
+}
+
+/// A map is an external drive's only, and its encoder counter is the configured one.
+#[test]
+fn a_map_of_a_simulated_drive_or_a_foreign_counter_is_refused() {
+    let mut config = AxisConfig::linear("X", 1);
+    config.io =
+        toml::from_str(r#"map = [{ signal = "drive_out.nCtrl1", bit = 0, width = 1 }]"#).unwrap();
+    assert_eq!(config.validate().unwrap_err().field, "io.map");
+    config.drive = DriveLink::External;
+    config.validate().unwrap();
+    config.io =
+        toml::from_str(r#"map = [{ signal = "enc_in.nInData1", bit = 0, width = 24 }]"#).unwrap();
+    let e = config.validate().unwrap_err();
+    assert_eq!((e.field, e.value), ("io.map", 24.0));
+}
