@@ -1,9 +1,13 @@
 //! The FIFO set-point generator (seed 002, chapter 5): each tick the job time advances by
 //! `tick x override`; the generator passes the rows whose time is over, interpolates the
-//! position linearly between the pair of rows around the job time, and takes velocity and
-//! acceleration as differences of its own set-points over the tick (so the velocity
-//! integrates exactly to the positions; they are coarse, as the seed warns, when T_f is
-//! much longer than the tick).
+//! position linearly between the pair of rows around the job time, and takes the velocity as
+//! the difference of its own set-points over the tick (so it integrates exactly to the
+//! positions: the velocity feed-forward). The acceleration is not the difference of those
+//! velocities, which the seed warns is coarse (with T_f two ticks it alternates between 0 and
+//! twice the real value): it is the rows' own second difference, `(p[i+1] - 2 p[i] +
+//! p[i-1]) / T_f^2` at each row, interpolated linearly between the pair of rows like the
+//! position and scaled by the override squared. Rows of a constant acceleration give it
+//! exactly on every tick.
 //!
 //! When the job time reaches the last queued row the axes hold its positions and the
 //! job time waits there: if the rows asked for motion beyond it, that is an *underrun* (the
@@ -46,6 +50,8 @@ pub struct FifoGenerator {
     position: Vec<f64>,
     velocity: Vec<f64>,
     acceleration: Vec<f64>,
+    /// The row before the front row (the front row itself at the start).
+    previous: Vec<f64>,
 }
 
 impl FifoGenerator {
@@ -60,6 +66,7 @@ impl FifoGenerator {
             position: vec![0.0; dimension],
             velocity: vec![0.0; dimension],
             acceleration: vec![0.0; dimension],
+            previous: vec![0.0; dimension],
         }
     }
 
@@ -76,6 +83,7 @@ impl FifoGenerator {
         self.last_segment_moving = false;
         if let Some(row) = ring.row(0) {
             self.position.copy_from_slice(row);
+            self.previous.copy_from_slice(row);
         }
         self.velocity.fill(0.0);
         self.acceleration.fill(0.0);
@@ -87,6 +95,9 @@ impl FifoGenerator {
         self.offset += self.tick_s * override_value;
         while ring.len() >= 2 && self.offset >= self.fifo_cycle_s {
             self.last_segment_moving = moving(ring.row(0), ring.row(1));
+            if let Some(front) = ring.row(0) {
+                self.previous.copy_from_slice(front);
+            }
             ring.pop_front();
             self.offset -= self.fifo_cycle_s;
             self.rows_passed += 1;
@@ -104,14 +115,26 @@ impl FifoGenerator {
         let (Some(low), high) = (ring.row(0), ring.row(1)) else {
             return status;
         };
+        let next = ring.row(2);
+        let second =
+            |a: f64, b: f64, c: f64| (c - 2.0 * b + a) / (self.fifo_cycle_s * self.fifo_cycle_s);
         for c in 0..self.position.len() {
-            let p = match high {
-                Some(high) => low[c] + fraction * (high[c] - low[c]),
-                None => low[c],
+            let (p, a) = match high {
+                Some(high) => {
+                    let after = next.map_or(high[c], |n| n[c]);
+                    let at_low = second(self.previous[c], low[c], high[c]);
+                    let at_high = second(low[c], high[c], after);
+                    let a = at_low + fraction * (at_high - at_low);
+                    (
+                        low[c] + fraction * (high[c] - low[c]),
+                        a * override_value * override_value,
+                    )
+                }
+                // Holding the last row.
+                None => (low[c], 0.0),
             };
-            let v = (p - self.position[c]) / self.tick_s;
-            self.acceleration[c] = (v - self.velocity[c]) / self.tick_s;
-            self.velocity[c] = v;
+            self.velocity[c] = (p - self.position[c]) / self.tick_s;
+            self.acceleration[c] = a;
             self.position[c] = p;
         }
         status
@@ -137,7 +160,7 @@ impl FifoGenerator {
         &self.velocity
     }
 
-    /// Acceleration set-points (velocity difference over the tick).
+    /// Acceleration set-points (the rows' second differences, interpolated).
     pub fn acceleration(&self) -> &[f64] {
         &self.acceleration
     }
@@ -152,6 +175,40 @@ mod tests {
         let mut ring = RowRing::new(1, rows.len() + 4);
         ring.push_block(rows).unwrap();
         ring
+    }
+
+    /// Rows of a constant acceleration of 5000 mm/s^2 at T_f = 2 ticks: the acceleration
+    /// set-point is 5000 on every tick once the first row is passed (before: 0 and 10000 by
+    /// turns), and the velocity feed-forward is the rows' slope in the middle of a pair.
+    #[test]
+    fn the_acceleration_of_rows_of_constant_acceleration_is_smooth_and_exact() {
+        let tf = 0.002;
+        let rows: Vec<f64> = (0..40)
+            .map(|k| 0.5 * 5000.0 * (k as f64 * tf).powi(2))
+            .collect();
+        let mut ring = ring_of(&rows);
+        let mut g = FifoGenerator::new(1, 0.001, tf);
+        g.start(&ring);
+        for tick in 1..60 {
+            g.step(&mut ring, 1.0);
+            let a = g.acceleration()[0];
+            if tick >= 2 {
+                assert!((a - 5000.0).abs() < 1e-6, "tick {tick}: {a}");
+            }
+            if tick % 2 == 1 {
+                // Half-way between rows k and k+1: the slope of that pair.
+                let k = tick / 2;
+                let slope = (rows[k + 1] - rows[k]) / tf;
+                assert!((g.velocity()[0] - slope).abs() < 1e-6, "tick {tick}");
+            }
+        }
+        // At half override the same rows take twice as long: a quarter of the acceleration.
+        let mut ring = ring_of(&rows);
+        g.start(&ring);
+        for _ in 0..8 {
+            g.step(&mut ring, 0.5);
+        }
+        assert!((g.acceleration()[0] - 1250.0).abs() < 1e-6);
     }
 
     #[test]
