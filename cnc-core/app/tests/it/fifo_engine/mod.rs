@@ -391,6 +391,25 @@ fn stop_ends_the_job() {
                 );
             }
         }
+        // A restart after the stop (the manual: stop, then the group may go on or be
+        // dissolved): new rows from where the axes stand, FiFoStart, the job runs to its
+        // end at the override set before the stop, its counters from 0.
+        let here: Vec<f64> = (0..3).map(|c| position(&run, c)).collect();
+        let again: Vec<[f64; 3]> = (0..60)
+            .map(|k| core::array::from_fn(|c| here[c] + (k.min(50) as f64) * 0.02))
+            .collect();
+        assert_eq!(write(&mut run, &again, false).error_id, 0);
+        assert_eq!(start(&mut run).error_id, 0);
+        let mut ticks = 0;
+        while status(&run).flags_r & FIFO_FLAG_AT_END == 0 {
+            run.step(TICK);
+            ticks += 1;
+            assert!(ticks < 2000, "the restarted job never ended");
+        }
+        assert!((position(&run, 0) - (here[0] + 1.0)).abs() < 1e-9);
+        let s = status(&run);
+        assert_eq!(s.override_r, 800_000);
+        assert_eq!(s.group_state_r, FifoGroupState::Running.raw());
     }
 }
 
