@@ -383,6 +383,36 @@ fn without_filter_the_transient_states_are_shown_for_a_tick() {
         states,
         [Activating, Active, Active, Deactivating, Inactive, Inactive]
     );
+    // The diagnosis history shows each tick's state as `state_r` did (recorded once the axes
+    // took the tick's set-points): one ACTIVATING row, then ACTIVE, then one DEACTIVATING.
+    let history: Vec<i32> = ctl.channels()[0]
+        .tracker()
+        .history()
+        .map(|e| e.state)
+        .collect();
+    assert_eq!(history, [1, 2, 2, 3]);
+    // The same for a master channel: the first ACTIVE row is the tick the log says ACTIVE.
+    let master = "#CHANNEL INTERFACE ON [DYN_CS]\n#TIME 1\nM30\n";
+    let slave = "#TRACK CS ON [CH=1 FILTER=0 WAIT]\n#TIME 1\nM30\n";
+    let mut ctl = controller(vec![
+        (cartesian("master"), master),
+        (cartesian("slave"), slave),
+    ]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    for _ in 0..10 {
+        ctl.tick(&view);
+    }
+    let tracker = ctl.channels()[1].tracker();
+    let rows: Vec<(u64, i32)> = tracker.history().map(|e| (e.tick, e.state)).collect();
+    let active = tracker
+        .log()
+        .find(|(_, e)| matches!(e, TrackEvent::Active))
+        .map(|(t, _)| *t)
+        .unwrap();
+    let first_active = rows.iter().find(|(_, s)| *s == 2).unwrap().0;
+    assert_eq!(first_active, active, "{rows:?}");
+    assert_eq!(rows.iter().filter(|(_, s)| *s == 1).count(), 1, "{rows:?}");
 }
 
 /// Every refusal of a PLC transition, from INACTIVE and from ACTIVE, reaches the PLC in

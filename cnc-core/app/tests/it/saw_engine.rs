@@ -205,6 +205,44 @@ fn gear_out_leaves_the_slave_at_its_velocity_until_halted() {
     until(&mut run, 2000, |r| set(r, SAW).velocity == 0.0);
 }
 
+/// MC_GearOut while the slave still accelerates (its synchronising phase): it keeps the
+/// velocity it reaches once its acceleration is taken out with its jerk, without overshooting
+/// and coming back (before, it ran past that velocity and returned to the one of the
+/// decoupling tick).
+#[test]
+fn gear_out_while_accelerating_keeps_the_velocity_reached_without_overshoot() {
+    let mut run = moving(-250.0);
+    assert_eq!(gear_in(&mut run, SAW, velocity_call(1.5, 0)), 0);
+    until(&mut run, 5000, |r| set(r, SAW).acceleration.abs() > 1000.0);
+    let at = set(&run, SAW);
+    let reached = at.velocity + at.acceleration * at.acceleration.abs() / (2.0 * 1e7);
+    assert_eq!(gear_out(&mut run, SAW), 0);
+    let rising = at.acceleration > 0.0;
+    let mut last = at.velocity;
+    for _ in 0..300 {
+        run.step(TICK);
+        let v = set(&run, SAW).velocity;
+        assert!(
+            if rising {
+                v >= last - 1e-9
+            } else {
+                v <= last + 1e-9
+            },
+            "{last} -> {v}"
+        );
+        assert!(
+            if rising {
+                v <= reached + 1e-9
+            } else {
+                v >= reached - 1e-9
+            },
+            "past {reached}: {v}"
+        );
+        last = v;
+    }
+    assert!((last - reached).abs() < 1e-6, "{last} vs {reached}");
+}
+
 /// Rollback, chapter 8: `(lock, instant, synchron reached)` and what must happen when the
 /// master runs back over the coupling position.
 #[derive(Debug, PartialEq)]

@@ -485,12 +485,16 @@ impl Axis {
             acceleration: self.coupled_setpoint.acceleration.clamp(-most, most),
             ..self.coupled_setpoint
         };
-        if s.velocity == 0.0 {
+        if s.velocity == 0.0 && s.acceleration == 0.0 {
             self.generator.hold(s.position);
         } else {
+            // The velocity reached once the acceleration is taken out with the axis's jerk:
+            // the slave settles there without overshooting and coming back.
+            let reached = (s.velocity + s.acceleration * s.acceleration.abs() / (2.0 * d.jerk))
+                .clamp(-d.velocity, d.velocity);
             self.generator.resume_from(s);
             let resumed = self.generator.run_at(
-                s.velocity,
+                reached,
                 MoveLimits {
                     velocity: d.velocity,
                     acceleration: d.acceleration,

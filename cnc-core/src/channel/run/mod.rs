@@ -190,6 +190,7 @@ impl Channel {
         };
         // The decoder takes the axes' positions when a program starts (`start`).
         channel.update_pose();
+        channel.record_dyn_cs();
         Ok(channel)
     }
 
@@ -255,6 +256,7 @@ impl Channel {
         self.fail_on_tracking_error();
         self.update_pose();
         self.guard_set_points(tracked);
+        self.record_dyn_cs();
         self.motion.rates_apply = !self.pose.trafo && !tracked && !self.safety.guard.latched();
         self.note_dyn_cs_state();
         self.fill_outputs();

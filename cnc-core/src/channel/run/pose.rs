@@ -168,6 +168,11 @@ impl Channel {
             }
         }
         self.pose.set_points[6..n].copy_from_slice(&self.motion.programmed[6..n]);
+    }
+
+    /// The tick's diagnosis history entry, once the guard has taken the set-points (a
+    /// transition that ends when the axes land shows its new state in the tick it ends).
+    pub(super) fn record_dyn_cs(&mut self) {
         self.pose
             .tracker
             .record(&self.pose.pose_in, &self.pose.pose_out);
