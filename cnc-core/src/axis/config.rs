@@ -95,6 +95,14 @@ pub struct ImageOptions {
     /// Where each signal lies in the hardware's bytes of an external drive, for drives the
     /// fixed codings do not know (`axis::io_map`); empty: our layout.
     pub map: ImageMap,
+    /// Time constant (s) of a first-order filter on the actual velocity and acceleration
+    /// from the encoder; 0: none. Seed 001 asks for an encoder master's values to be
+    /// carefully filtered: quantisation makes the raw acceleration jump by one increment per
+    /// cycle squared.
+    pub actual_filter_s: f64,
+    /// The actual acceleration is computed from the encoder (false: it is 0, seed 001's
+    /// encoder mode that switches it off).
+    pub actual_acceleration: bool,
 }
 
 /// Where an encoder reports an error in `enc_in.nStatus1`.
@@ -162,6 +170,8 @@ impl Default for ImageOptions {
             encoder_set_counter: false,
             encoder_error: None,
             map: ImageMap::default(),
+            actual_filter_s: 0.0,
+            actual_acceleration: true,
         }
     }
 }
@@ -315,6 +325,15 @@ impl AxisConfig {
         self.check_kind_and_limits()?;
         self.check_encoder_error()?;
         self.check_map()?;
+        let filter = self.io.actual_filter_s;
+        if !(filter.is_finite() && (0.0..=10.0).contains(&filter)) {
+            return Err(ConfigError {
+                axis: self.name.clone(),
+                field: "io.actual_filter_s",
+                value: filter,
+                reason: "must be 0 (none) up to 10 s",
+            });
+        }
         if let DriveLink::Simulated(sim) = self.drive {
             sim.validate()
                 .map_err(|(field, value, reason)| ConfigError {

@@ -476,6 +476,20 @@ impl Axis {
         }
     }
 
+    /// The actual velocity and acceleration of this reading, through the configured
+    /// first-order filter (none: taken as they are; a fresh count starts the filter there).
+    fn filter_actual(&mut self, first: bool, velocity: f64, acceleration: f64) {
+        let t = self.config.io.actual_filter_s;
+        if t <= 0.0 || first {
+            self.actual_velocity = velocity;
+            self.actual_acceleration = acceleration;
+            return;
+        }
+        let k = self.cycle_s / (t + self.cycle_s);
+        self.actual_velocity += (velocity - self.actual_velocity) * k;
+        self.actual_acceleration += (acceleration - self.actual_acceleration) * k;
+    }
+
     fn resume_free(&mut self) {
         let d = self.config.dynamics;
         // Resume from the coupled state: position, velocity and acceleration carry over; an
@@ -565,17 +579,20 @@ impl Axis {
             };
             self.raw_actual = raw;
             self.actual = raw + raw_velocity * self.inputs.input_lag_s;
-            self.actual_velocity = if first {
+            let velocity = if first {
                 0.0
             } else {
                 (self.actual - previous) / self.cycle_s
             };
             // Two raw velocities since the count started make an acceleration.
             self.readings = if first { 1 } else { (self.readings + 1).min(3) };
-            self.actual_acceleration = match self.readings {
-                3 => (raw_velocity - self.raw_velocity) / self.cycle_s,
+            let acceleration = match self.readings {
+                3 if self.config.io.actual_acceleration => {
+                    (raw_velocity - self.raw_velocity) / self.cycle_s
+                }
                 _ => 0.0,
             };
+            self.filter_actual(first, velocity, acceleration);
             self.raw_velocity = raw_velocity;
             let undefined = self.probes.sense(enc_in, enc_in.nInData1, count, scale);
             self.inputs.undefined = self.inputs.undefined.wrapping_add(undefined);

@@ -630,3 +630,48 @@ fn a_map_of_a_simulated_drive_or_a_foreign_counter_is_refused() {
     let e = config.validate().unwrap_err();
     assert_eq!((e.field, e.value), ("io.map", 24.0));
 }
+
+/// An encoder master's actual velocity and acceleration (seed 001: "carefully filtered", or
+/// the acceleration switched off): an encoder at a constant 123.4567 mm/s in 0.1 um
+/// increments reads 1234 or 1235 increments a tick, so the raw acceleration jumps by 100
+/// mm/s^2; `io.actual_filter_s` = 20 ms takes it below 10 and keeps the velocity; with
+/// `io.actual_acceleration` off it is 0.
+#[test]
+fn an_encoders_actual_values_are_filtered_or_the_acceleration_is_off() {
+    let run = |filter_s: f64, acceleration: bool| -> (f64, f64) {
+        let mut config = AxisConfig::linear("X", 1);
+        config.drive = DriveLink::External;
+        config.io.actual_filter_s = filter_s;
+        config.io.actual_acceleration = acceleration;
+        config.validate().unwrap();
+        let mut rig = Rig::new(vec![config]);
+        let (mut worst, mut velocity) = (0.0f64, 0.0);
+        for tick in 0..400 {
+            let counts = (f64::from(tick) * 1234.567).round() as i32;
+            rig.set_enc_in(
+                0,
+                NcEncoderIn {
+                    nInData1: counts,
+                    ..bytemuck::Zeroable::zeroed()
+                },
+            );
+            rig.tick();
+            let k = rig.set.axis(0).unwrap().actual_kinematic();
+            if tick > 200 {
+                worst = worst.max(k.acceleration.abs());
+                velocity = k.velocity;
+            }
+        }
+        (worst, velocity)
+    };
+    let (raw, v) = run(0.0, true);
+    assert!(raw >= 50.0, "{raw}");
+    assert!((v - 123.4567).abs() < 0.1, "{v}");
+    let (filtered, v) = run(0.02, true);
+    assert!(filtered < 10.0, "{filtered}");
+    assert!((v - 123.4567).abs() < 0.1, "{v}");
+    assert_eq!(run(0.0, false).0, 0.0);
+    let mut config = AxisConfig::linear("X", 1);
+    config.io.actual_filter_s = -1.0;
+    assert_eq!(config.validate().unwrap_err().field, "io.actual_filter_s");
+}
