@@ -514,6 +514,10 @@ hli_enum! {
         /// MC_SetPosition: at standstill, the encoder counts from the given position (its
         /// counter is set through the register interface); nothing moves.
         SetPosition = 9,
+        /// A gear coupling of an engine (MC_GearInVelo, MC_GearInPos): active while it holds
+        /// the axis; a new coupling of the axis, by any block, aborts it, and so does its end
+        /// (MC_GearOut, MC_Stop).
+        GearIn = 10,
     }
 }
 

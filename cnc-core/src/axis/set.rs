@@ -178,6 +178,16 @@ impl AxisSet {
         self.leased(lease).is_some_and(|a| a.recouple(coupling))
     }
 
+    /// A coupling command of the leased axis's engine in its command book (see
+    /// `AxisCommandKind::GearIn`): the id a PLC block follows; `None` once the lease is stale.
+    pub fn begin_coupled(
+        &mut self,
+        lease: Lease,
+        kind: hli::enums::AxisCommandKind,
+    ) -> Option<u32> {
+        self.leased(lease).map(|a| a.begin_coupled(kind))
+    }
+
     /// Ends the coupling of `lease` (see [`Axis::decouple`]); `false` when the lease was
     /// already stale (the axis is someone else's, or free).
     pub fn release(&mut self, lease: Lease) -> bool {

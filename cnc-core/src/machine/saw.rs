@@ -72,7 +72,7 @@ pub struct SawEngine {
 fn refused(e: SawError) -> HandlerResult {
     reply(&SawReply {
         error_id: e.raw(),
-        reserved: 0,
+        command_id: 0,
     })
 }
 
@@ -124,7 +124,7 @@ impl SawEngine {
         if axis.coupling().is_some() && !ours {
             return reply(&SawReply {
                 error_id: hli::enums::AxisError::Coupled.raw(),
-                reserved: 0,
+                command_id: 0,
             });
         }
         let on = match SawSyncTarget::from_raw(call.target) {
@@ -191,7 +191,7 @@ impl SawEngine {
                 Err(e) => {
                     return reply(&SawReply {
                         error_id: e.raw(),
-                        reserved: 0,
+                        command_id: 0,
                     })
                 }
             },
@@ -210,7 +210,15 @@ impl SawEngine {
             plan: self.plans,
             organisation: organisation(table, plan.profile.pieces().len()),
         });
-        accepted()
+        // The coupling's command in the slave's book: the block follows it there, and a
+        // coupling that replaces it (this engine's in place too) aborts it.
+        let command_id = axes
+            .begin_coupled(lease, hli::enums::AxisCommandKind::GearIn)
+            .unwrap_or(0);
+        reply(&SawReply {
+            error_id: 0,
+            command_id,
+        })
     }
 
     fn gear_out(&mut self, slave: usize, axes: &mut AxisSet) -> HandlerResult {
@@ -335,7 +343,7 @@ impl Engine for SawEngine {
             // engine (a cam) uses that table.
             CallKind::SAW_GEAR_IN if others.hold(own_table(axes, slave)) => reply(&SawReply {
                 error_id: SawError::TableInUse.raw(),
-                reserved: 0,
+                command_id: 0,
             }),
             CallKind::SAW_GEAR_IN => decode_body::<SawGearInCall>(request)
                 .and_then(|call| self.gear_in(slave, &call, axes)),

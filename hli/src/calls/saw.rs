@@ -123,8 +123,9 @@ pub struct SawGearOutCall {
 pub struct SawReply {
     /// 0 when accepted.
     pub error_id: u32,
-    /// Reserved, 0.
-    pub reserved: u32,
+    /// An accepted coupling's command id in the slave's command book (0 otherwise): the
+    /// block follows it there, so a new coupling of the slave by another block aborts it.
+    pub command_id: u32,
 }
 
 /// Values of `MC_FlyingSawCharacValues` one part carries.

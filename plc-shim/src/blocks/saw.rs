@@ -13,8 +13,10 @@
 //! the slave faults. After InSync the block keeps following while Execute stays TRUE: InSync
 //! shows whether the slave is synchronous now (a rollback stop lowers it until the slave is
 //! synchronous again; Busy stays FALSE, the command ended at the first InSync), and a coupling
-//! that goes away later is CommandAborted. Limits of what the image can tell: a new coupling
-//! of the same kind to the same master made by another instance looks like this block's own.
+//! that goes away later is CommandAborted. The block also follows its coupling's command id
+//! in the slave's command book (the reply carries it): a new coupling of the slave by another
+//! instance, even of the same kind to the same master (which looks like this block's own in
+//! the image), aborts it there, and the block shows CommandAborted.
 //!
 //! With Execute low the block follows on until the coupling ends, and shows that end for one
 //! cycle (the kernel's rule for every block).
@@ -33,9 +35,11 @@ use hli::calls::saw::{
     SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
     SAW_CHARAC_PARTS,
 };
+use hli::command_book::{view_command, CommandView};
 use hli::enums::{AxisState, CouplingState};
-use hli::layout::HliAxisLrState;
+use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
 use hli::rpc::PendingCall;
+use hli::PlaceExt;
 use inputs::SawInputs;
 use std::sync::Arc;
 
@@ -135,6 +139,8 @@ fn read_image(state: Option<HliAxisLrState>, kind: CouplingState, master: u32) -
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 struct GearFollow {
     master: u32,
+    /// The coupling's command id in the slave's command book (0: a CNC that gives none).
+    command_id: u32,
     seen: bool,
     synced: bool,
 }
@@ -154,11 +160,20 @@ const STARTED: Outputs = Outputs {
 };
 
 /// One cycle of following an accepted coupling through the slave's image.
-fn follow_gear(f: &mut GearFollow, image: Image, waited: Waited) -> Step<()> {
+fn follow_gear(f: &mut GearFollow, image: Image, book: CommandView, waited: Waited) -> Step<()> {
     // The CNC answers between two ticks: the image read in the reply's own cycle may still be
     // the tick before the coupling (an earlier coupling of the slave included).
     if waited.cycles == 0 {
         return Step::Running(STARTED);
+    }
+    // Replaced in the book: a new coupling of the slave (by any block, also one that looks
+    // like ours in the image), or the coupling's end.
+    if f.command_id != 0 && matches!(book, CommandView::Aborted | CommandView::Unknown) {
+        return Step::Ended(Outputs {
+            start_sync: true,
+            command_aborted: true,
+            ..Outputs::default()
+        });
     }
     match image {
         Image::Faulted(code) => Step::Ended(Outputs {
@@ -218,6 +233,7 @@ impl GearInCore {
                 0 => Accept::Follow(
                     GearFollow {
                         master: call.master,
+                        command_id: reply.command_id,
                         seen: false,
                         synced: false,
                     },
@@ -227,7 +243,20 @@ impl GearInCore {
             },
             |f, io, waited| {
                 let image = read_image(io.view.axis_state(slave as usize).ok(), kind, f.master);
-                follow_gear(f, image, waited)
+                let book = io
+                    .view
+                    .axis(slave as usize)
+                    .map(|place| {
+                        let book: HliAxisCommandState = place
+                            .field::<HliAxisCommandState>(core::mem::offset_of!(
+                                HliAxis,
+                                command_state
+                            ))
+                            .read();
+                        view_command(&book, f.command_id)
+                    })
+                    .unwrap_or(CommandView::Unknown);
+                follow_gear(f, image, book, waited)
             },
         )
     }

@@ -244,3 +244,51 @@ fn the_saw_blocks_run_from_a_timeline() {
     assert_eq!((free[5], free[6], free[4]), (2.0, 0.0, 500.0 * 1e4));
     assert_eq!(rows.last().unwrap()[4], 0.0, "halted");
 }
+
+/// PLCopen: a block whose slave another block instance couples again is CommandAborted, also
+/// when the new coupling is of the same kind to the same master (which the axis image cannot
+/// tell from the first block's own): the first follows its command id in the slave's book.
+#[test]
+fn a_coupling_taken_over_by_another_instance_is_command_aborted() {
+    use cnc_app::scenario::{InProcess, Scenario};
+    let scenario = "cycle_ms = 1.0\nticks = 1500\n\
+        [[axis]]\nname = \"Master\"\npower = true\nsoft_limits = [-1000.0, 5000.0]\nvelocity = 1000.0\n\
+        [[axis]]\nname = \"Saw\"\npower = true\nsoft_limits = [-1000.0, 5000.0]\nvelocity = 1000.0\n\
+        [plc]\ntimeline = \"plc.toml\"\n";
+    let velo = |name: &str| {
+        format!(
+            "call = {{ block = \"MC_GearInVelo\", instance = \"{name}\", Master = 0, Slave = 1, \
+             RatioNumerator = 0.5, RatioDenominator = 1, Acceleration = 2500.0, Deceleration = 2500.0, Jerk = 50000.0 }}\n"
+        )
+    };
+    let timeline = format!(
+        "[[step]]\nat_tick = 2\ncall = {{ block = \"MC_MoveVelocity\", instance = \"master\", axis = 0, direction = 1, \
+         velocity = 500.0, acceleration = 5000.0, deceleration = 5000.0, jerk = 100000.0 }}\n\
+         [[step]]\nwait = \"master.InVelocity\"\n{}\
+         [[step]]\nwait = \"first.InSync\"\n{}",
+        velo("first"),
+        velo("second")
+    );
+    let s = Scenario::parse("takeover.toml", scenario, |f| {
+        let text = match f {
+            "plc.toml" => timeline.clone(),
+            other => panic!("{other}"),
+        };
+        Ok((std::path::PathBuf::from(f), text))
+    })
+    .unwrap();
+    let run = InProcess::run_through(&s).unwrap();
+    let summary = run.timeline.as_ref().unwrap().summary();
+    let line = |name: &str| {
+        summary
+            .lines()
+            .find(|l| l.starts_with(&format!("block {name} ")))
+            .unwrap_or_else(|| panic!("{name}: {summary}"))
+            .to_string()
+    };
+    assert!(line("first").contains("InSync"), "{summary}");
+    assert!(line("first").contains("CommandAborted"), "{summary}");
+    assert!(line("second").contains("InSync"), "{summary}");
+    assert!(!line("second").contains("CommandAborted"), "{summary}");
+    assert!(!summary.contains("ErrorID"), "{summary}");
+}

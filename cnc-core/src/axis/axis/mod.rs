@@ -211,6 +211,8 @@ impl Axis {
             return Err(AxisError::InvalidParameter);
         }
         match kind {
+            // An engine's coupling, not an axis command.
+            AxisCommandKind::GearIn => Err(AxisError::InvalidParameter),
             AxisCommandKind::Power => self.power(call.enable),
             AxisCommandKind::Reset => self.reset(),
             AxisCommandKind::SetPosition => self.set_position(call.position),
@@ -433,6 +435,12 @@ impl Axis {
         Ok(())
     }
 
+    /// Starts a coupling command of the engine that holds the axis (see
+    /// [`AxisCommandKind::GearIn`]); the one before is aborted. Its id.
+    pub(in crate::axis) fn begin_coupled(&mut self, kind: AxisCommandKind) -> u32 {
+        self.book.begin(kind)
+    }
+
     /// The number of the current coupling (see [`Axis::couple`]); changes with every one.
     pub(in crate::axis) fn coupling_epoch(&self) -> u32 {
         self.coupling_epoch
@@ -469,6 +477,9 @@ impl Axis {
     pub(in crate::axis) fn decouple(&mut self) {
         if self.coupling.take().is_none() {
             return;
+        }
+        if self.book.active().map(|a| a.kind) == Some(AxisCommandKind::GearIn) {
+            self.book.finish(CommandResult::Aborted, None);
         }
         self.resume_free();
         if self.sensed && self.enabled && self.error.is_none() {

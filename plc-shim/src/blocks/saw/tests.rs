@@ -59,9 +59,28 @@ fn outputs(step: Step<()>) -> (bool, Outputs) {
 
 const FRESH: GearFollow = GearFollow {
     master: 0,
+    command_id: 0,
     seen: false,
     synced: false,
 };
+
+/// The book's view of a coupling still under way.
+const BUSY: CommandView = CommandView::Busy(false);
+
+/// A new coupling of the slave by another block, of the same kind to the same master: the
+/// image looks like ours, the book shows our command aborted: CommandAborted.
+#[test]
+fn a_coupling_replaced_in_the_book_is_aborted_though_the_image_looks_like_ours() {
+    let mut f = GearFollow {
+        command_id: 7,
+        ..FRESH
+    };
+    let ours = Image::Ours { synchronous: true };
+    let (ended, out) = outputs(follow_gear(&mut f, ours, BUSY, waited(1)));
+    assert!(!ended && out.in_sync, "{out:?}");
+    let (ended, out) = outputs(follow_gear(&mut f, ours, CommandView::Aborted, waited(2)));
+    assert!(ended && out.command_aborted && !out.in_sync, "{out:?}");
+}
 
 #[test]
 fn a_coupling_is_busy_until_in_sync_then_aborted_when_it_goes_away() {
@@ -69,24 +88,24 @@ fn a_coupling_is_busy_until_in_sync_then_aborted_when_it_goes_away() {
     let ours = |synchronous| Image::Ours { synchronous };
     // The reply's own cycle: its image may be older.
     assert_eq!(
-        outputs(follow_gear(&mut f, ours(true), waited(0))),
+        outputs(follow_gear(&mut f, ours(true), BUSY, waited(0))),
         (false, STARTED)
     );
     // Not shown yet.
-    let step = follow_gear(&mut f, Image::Other, waited(1));
+    let step = follow_gear(&mut f, Image::Other, BUSY, waited(1));
     assert_eq!(outputs(step), (false, STARTED));
-    let step = follow_gear(&mut f, ours(false), waited(2));
+    let step = follow_gear(&mut f, ours(false), BUSY, waited(2));
     assert_eq!(outputs(step), (false, STARTED));
-    let (ended, out) = outputs(follow_gear(&mut f, ours(true), waited(3)));
+    let (ended, out) = outputs(follow_gear(&mut f, ours(true), BUSY, waited(3)));
     assert!(!ended && out.in_sync && out.start_sync && !out.busy && !out.active);
     // A rollback stop: still coupled.
-    let (ended, out) = outputs(follow_gear(&mut f, ours(false), waited(4)));
+    let (ended, out) = outputs(follow_gear(&mut f, ours(false), BUSY, waited(4)));
     assert!(
         !ended && !out.in_sync && !out.busy && !out.command_aborted,
         "{out:?}"
     );
     // MC_GearOut, or another coupling.
-    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(5)));
+    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, BUSY, waited(5)));
     assert!(ended && out.command_aborted && !out.busy, "{out:?}");
 }
 
@@ -95,6 +114,7 @@ fn faults_and_unseen_couplings_end_the_following() {
     let (ended, out) = outputs(follow_gear(
         &mut { FRESH },
         Image::Faulted(0x4711),
+        BUSY,
         waited(1),
     ));
     assert!(
@@ -102,9 +122,9 @@ fn faults_and_unseen_couplings_end_the_following() {
         "{out:?}"
     );
     let mut f = FRESH;
-    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(3)));
+    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, BUSY, waited(3)));
     assert!(!ended && out.busy, "still waiting for the image");
-    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, waited(4)));
+    let (ended, out) = outputs(follow_gear(&mut f, Image::Other, BUSY, waited(4)));
     assert!(ended && out.command_aborted, "never shown: ended unseen");
 }
 
