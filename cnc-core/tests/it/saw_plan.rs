@@ -685,3 +685,61 @@ fn ignoremasteracc_plans_as_if_the_master_did_not_accelerate() {
     assert_eq!(a.profile.length, b.profile.length);
     assert_eq!(a.charac.values.fSlaveAccMax, b.charac.values.fSlaveAccMax);
 }
+
+/// Position synchronisation needs a moving master (seed 001 chapter 13, MasterStands).
+#[test]
+fn position_sync_to_a_standing_master_is_refused() {
+    let on = SyncOn::Position {
+        master: 300.0,
+        slave: 100.0,
+    };
+    let req = request(on, 1.0, limits(2500.0, 5000.0), 0);
+    let e = saw::plan(&req, &kin(0.0, 0.0, 0.0), &kin(0.0, 0.0, 0.0), None).unwrap_err();
+    assert_eq!(e, SawError::MasterStands);
+}
+
+/// IGNORESLAVEACC: the slave's acceleration at coupling counts as 0: without the bit the
+/// phase starts from the slave's own 1000 mm/s^2; with it the profile starts at 0 (the
+/// axis's set-point then takes the difference as a step the seed leaves to the user).
+#[test]
+fn ignoreslaveacc_plans_as_if_the_slave_did_not_accelerate() {
+    let req = |mask| request(SyncOn::Velocity, 1.0, limits(5000.0, 1e9), mask);
+    let master = kin(0.0, 500.0, 0.0);
+    let accelerating = kin(0.0, 250.0, 1000.0);
+    let start_acc = |p: &Plan| p.profile.slave_at(&master, 0.0).acceleration;
+    let with = saw::plan(&req(m::IGNORESLAVEACC), &master, &accelerating, None).unwrap();
+    let without = saw::plan(&req(0), &master, &accelerating, None).unwrap();
+    assert!(
+        (start_acc(&without) - 1000.0).abs() < 1e-6,
+        "{}",
+        start_acc(&without)
+    );
+    assert!(start_acc(&with).abs() < 1e-9, "{}", start_acc(&with));
+    // Both end synchronous at the master's velocity.
+    for p in [&with, &without] {
+        let end = run(p, master, 5).last().unwrap().2;
+        assert!((end.velocity - 500.0).abs() < 1e-6);
+    }
+}
+
+/// The checks hold for the synchronising phase only, not for the synchronous phase (seed
+/// 001, after its table of checks): with MAXVELO at 600 mm/s a slave synchronised at ratio 1
+/// on a master at 500 passes the check, and in the synchronous phase it follows the master
+/// to 800 mm/s without a check refusing it.
+#[test]
+fn the_checks_do_not_reach_into_the_synchronous_phase() {
+    let lim = Limits {
+        velocity: 600.0,
+        ..limits(2500.0, 1e5)
+    };
+    let req = request(SyncOn::Velocity, 1.0, lim, m::MAXVELO);
+    let master = kin(0.0, 500.0, 0.0);
+    let plan = saw::plan(&req, &master, &kin(0.0, 100.0, 0.0), None).unwrap();
+    assert!(plan.charac.values.fSlaveVeloMax <= 600.0);
+    let end = plan.profile.length;
+    // Past the phase the master runs at 800 mm/s: the slave is ratio x master.
+    let fast = kin(end + 100.0, 800.0, 0.0);
+    let t = (end + 100.0) / 500.0;
+    let slave = plan.profile.slave_at(&fast, t);
+    assert!((slave.velocity - 800.0).abs() < 1e-9, "{slave:?}");
+}
