@@ -22,7 +22,7 @@
 //! when a coupling is switched or rescaled (5.1.16.14). Pure computation: the cam engine
 //! (`crate::machine::cams`) feeds in the axes.
 
-use super::online::{ActivationMode, MasterNow};
+use super::online::{ActivationMode, EdgeCrossing, MasterNow};
 use super::{CamProfile, ProfileCursor};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{CamActivationMode, CamScalingMode, CamStartMode};
@@ -312,17 +312,29 @@ impl CamLaw {
     pub fn master_now(&self, before: f64, now: f64) -> MasterNow {
         let (a, b) = (self.locate(before), self.locate(now));
         let last = self.first + self.period;
+        let crossed = |edge: f64| (a.x < edge && edge <= b.x) || (b.x <= edge && edge < a.x);
+        // A linear cam's "cycle" ends at its range edges: forward past its end, backward past
+        // its start (where its values continue into the next or previous cycle).
+        let edge = match self.periodic {
+            true => None,
+            false if a.x < last && last <= b.x => Some((last, true)),
+            false if b.x <= self.first && self.first < a.x => Some((self.first, false)),
+            false => None,
+        };
         let cycle_changed = if self.periodic {
             a.cycle != b.cycle
         } else {
-            // A linear cam's "cycle" ends at its range edges.
-            let crossed = |edge: f64| (a.x < edge && edge <= b.x) || (b.x <= edge && edge < a.x);
             crossed(self.first) || crossed(last)
         };
+        let s = &self.scaling;
         MasterNow {
             axis: (before, now),
             cam: (a.local, b.local),
             cycle_changed,
+            edge: edge.map(|(x, end)| EdgeCrossing {
+                axis: x * s.master_scaling - s.master_offset + self.master_origin,
+                end,
+            }),
         }
     }
 
@@ -342,8 +354,12 @@ impl CamLaw {
         master: f64,
         slave: f64,
         switched: bool,
+        edge: Option<EdgeCrossing>,
     ) -> CamLaw {
         let (master_mode, slave_mode) = modes;
+        // At a linear cam's edge the change is anchored on the edge itself (with the slave
+        // there), so the next cam takes over exactly where this one ended.
+        let master = edge.map_or(master, |e| e.axis);
         let mut scaling = self.scaling;
         if master_mode != CamScalingMode::Off {
             scaling.master_offset = requested.master_offset;
@@ -363,7 +379,11 @@ impl CamLaw {
         let mut law = CamLaw::new(profile, scaling, start, periodic, master_at, slave_at);
         if master_mode == CamScalingMode::AutoOffset {
             let old = self.locate(master);
-            let share = self.share_of_cycle(old);
+            let share = match edge {
+                // Past the end: the next cycle's start; back past the start: the previous end.
+                Some(e) => f64::from(u8::from(!e.end)),
+                None => self.share_of_cycle(old),
+            };
             let x = law.first + share * law.period;
             let s = &mut law.scaling;
             s.master_offset = x * s.master_scaling - master + law.master_origin;

@@ -104,6 +104,19 @@ pub struct MasterNow {
     pub cam: (f64, f64),
     /// Whether a cam cycle boundary was crossed since the last tick.
     pub cycle_changed: bool,
+    /// A linear cam's range edge crossed since the last tick: where it lies on the master
+    /// axis, and whether it is the end (crossed forward) or the start (crossed backward). A
+    /// switch or rescaling due at it is anchored there, not one tick's travel past it.
+    pub edge: Option<EdgeCrossing>,
+}
+
+/// A linear cam's range edge the master crossed (see [`MasterNow::edge`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeCrossing {
+    /// The edge's master axis position.
+    pub axis: f64,
+    /// The end of the range (else its start).
+    pub end: bool,
 }
 
 impl MasterNow {
@@ -113,6 +126,7 @@ impl MasterNow {
             axis: (at, at),
             cam: (at, at),
             cycle_changed: false,
+            edge: None,
         }
     }
 }

@@ -307,6 +307,7 @@ fn master_auto_offset_keeps_the_share_of_the_cycle() {
         90.0,
         0.0,
         false,
+        None,
     );
     assert_eq!(scaled.locate(90.0).local, 90.0);
     // From here the master needs 720 to run through the cam once: 180 more to the middle.
@@ -341,6 +342,7 @@ fn slave_auto_offset_keeps_the_slave_where_it_is() {
         200.0,
         before,
         false,
+        None,
     );
     assert_eq!(after.scaling.master_offset, 10.0);
     assert!((slave(&after, &p, at(200.0)).position - before).abs() < 1e-12);
@@ -354,6 +356,7 @@ fn slave_auto_offset_keeps_the_slave_where_it_is() {
         200.0,
         before,
         false,
+        None,
     );
     assert!((slave(&user, &p, at(200.0)).position - before).abs() > 1.0);
     // Slave scaling 0 with Off on the master stops the slave's motion while coupled (the
@@ -371,6 +374,7 @@ fn slave_auto_offset_keeps_the_slave_where_it_is() {
         200.0,
         before,
         false,
+        None,
     );
     for m in [200.0, 250.0, 1000.0] {
         assert!((slave(&held, &p, at(m)).position - before).abs() < 1e-12);
@@ -461,6 +465,7 @@ fn master_auto_offset_keeps_the_share_when_switching_to_another_period() {
         master,
         before,
         true,
+        None,
     );
     let c = switched.locate(master);
     assert!((c.local - 25.0).abs() < 1e-9, "{c:?}");
@@ -473,4 +478,55 @@ fn master_auto_offset_keeps_the_share_when_switching_to_another_period() {
         "{}",
         later - before
     );
+}
+
+/// NextCycle chaining of linear cams (seed 000: a linear cam's cycle ends at its range edges;
+/// master and slave auto-offset make the next join seamlessly): the ramp T(x) = x / 2 on
+/// 0..100 switched to itself at every end, the master at 0.02 a tick. The next cam is anchored
+/// on the edge, so the slave is x / 2 on every tick across three switches (before, each
+/// switch started one tick's travel into the new range and the slave fell 0.01 behind).
+/// Backwards past the start the previous cycle's end is taken the same way.
+#[test]
+fn linear_cams_chained_at_next_cycle_join_exactly_at_their_edges() {
+    let p = ramp();
+    let modes = (CamScalingMode::AutoOffset, CamScalingMode::AutoOffset);
+    for dir in [1.0, -1.0] {
+        let mut law = CamLaw::new(
+            &p,
+            Scaling::default(),
+            CamStartMode::Absolute,
+            false,
+            0.0,
+            0.0,
+        );
+        let (mut master, mut switches) = (if dir > 0.0 { 0.0 } else { 100.0 }, 0);
+        let start = master;
+        for _ in 0..16_000 {
+            let before = master;
+            master += 0.02 * dir;
+            let now = law.master_now(before, master);
+            if now.cycle_changed {
+                let set = slave(&law, &p, at(master)).position;
+                law = law.rescaled(
+                    &p,
+                    Scaling::default(),
+                    modes,
+                    CamStartMode::Absolute,
+                    false,
+                    master,
+                    set,
+                    true,
+                    now.edge,
+                );
+                switches += 1;
+            }
+            let s = slave(&law, &p, at(master)).position;
+            let expected = (master - start) / 2.0 + if dir > 0.0 { 0.0 } else { 50.0 };
+            assert!(
+                (s - expected).abs() < 1e-9,
+                "master {master}: {s} vs {expected}"
+            );
+        }
+        assert_eq!(switches, 3, "{dir}");
+    }
 }

@@ -30,6 +30,7 @@ fn moving(from: f64, to: f64) -> MasterNow {
         axis: (from, to),
         cam: (from, to),
         cycle_changed: false,
+        edge: None,
     }
 }
 
@@ -92,6 +93,7 @@ fn at_master_positions_the_change_waits_for_the_crossing() {
         axis: (799.0, 801.0),
         cam: (399.0, 1.0),
         cycle_changed: true,
+        edge: None,
     };
     assert!(
         q.take_due(wrap).is_none(),
@@ -106,6 +108,7 @@ fn at_master_positions_the_change_waits_for_the_crossing() {
         axis: (401.0, 399.0),
         cam: (1.0, 399.0),
         cycle_changed: true,
+        edge: None,
     };
     assert!(
         q.take_due(falling_wrap).is_none(),
@@ -192,6 +195,7 @@ fn writes_build_on_what_is_queued() {
         axis: (399.0, 401.0),
         cam: (399.0, 1.0),
         cycle_changed: true,
+        edge: None,
     };
     let (g, _) = q.take_due(wrap).unwrap();
     let ys: Vec<f64> = g.points().iter().map(|p| p.slave).collect();

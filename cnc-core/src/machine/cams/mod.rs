@@ -369,6 +369,7 @@ impl CamEngine {
                     m.position,
                     before.position,
                     false,
+                    None,
                 );
                 other.cursor = ProfileCursor::default();
             }
@@ -508,6 +509,7 @@ impl Slave {
             master.position,
             set.position,
             false,
+            now.edge,
         );
         self.scale = None;
         self.law.slave(profile, &mut self.cursor, master).0
@@ -552,6 +554,7 @@ impl Slave {
                 master.position,
                 set.position,
                 true,
+                now.edge,
             );
             self.table = table;
             self.cursor = ProfileCursor::default();
