@@ -285,11 +285,15 @@ impl McCamScaling {
             reserved: 0,
             ..self.scaling
         };
+        // ActivationMode OFF: no scaling is carried out (seed 000 5.1.16.13), so there is
+        // nothing to wait for: Done once the CNC took the call, whatever else is queued.
+        let off = call.activation_mode == CamActivationMode::Off.raw();
         self.out = self.kernel.cycle(
             io,
             self.execute,
             |io| send(io, slave, &call),
             |reply| match reply.error_id {
+                0 if off => Accept::Done(()),
                 0 => Accept::Follow(None, Outputs::busy()),
                 code => Accept::Failed(code, ()),
             },

@@ -599,3 +599,92 @@ fn write_point_4(run: &mut InProcess) -> u32 {
     let write = one_point_write(seed_point_4(30.0));
     bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 1, &write)).error_id
 }
+
+/// MC_CamScaling with ActivationMode OFF carries no scaling out (seed 000 5.1.16.13): taken
+/// (0) and nothing changes: the slave stays on its law, and a scaling queued before it (the
+/// seed's example 1 at NextCycle) still comes at the next cycle as queued, not the OFF call's.
+#[test]
+fn a_scaling_with_activation_off_changes_nothing() {
+    let mut run = machine("");
+    run.step(0.001);
+    select_cyclic(&mut run, 1);
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
+    run_master(&mut run, 360.0);
+    let profile = seed_cam();
+    let law = seed_law(true);
+    let scaling = |activation_mode: u32, slave_scaling: f64| CamScalingCall {
+        activation_mode,
+        master_scaling_mode: 2,
+        slave_scaling_mode: 0,
+        master_scaling: 1.0,
+        slave_scaling,
+        ..CamScalingCall::default()
+    };
+    while set(&run, MASTER).position < 200.0 {
+        run.step(0.001);
+    }
+    assert_eq!(call(&mut run, SLAVE as u32, scaling(3, 0.0)), 0);
+    assert_eq!(call(&mut run, SLAVE as u32, scaling(6, 3.0)), 0);
+    while set(&run, MASTER).position < 359.0 {
+        run.step(0.001);
+        let expected = law_at(&law, &profile, set(&run, MASTER)).position;
+        assert!((set(&run, SLAVE).position - expected).abs() < 1e-9);
+    }
+    while set(&run, MASTER).position < 380.0 {
+        run.step(0.001);
+    }
+    let mut moved: f64 = 0.0;
+    while set(&run, MASTER).position < 700.0 {
+        run.step(0.001);
+        moved = moved.max(set(&run, SLAVE).position.abs());
+    }
+    assert_eq!(
+        moved, 0.0,
+        "the queued SlaveScaling 0, not the OFF call's 3"
+    );
+}
+
+/// The block: MC_CamScaling with ActivationMode "off" is Done as soon as the CNC took it,
+/// while a NextCycle scaling queued before it waits for its cycle (and is Done then).
+#[test]
+fn mc_cam_scaling_off_is_done_at_once_beside_a_queued_scaling() {
+    let timeline = r#"
+[[step]]
+at_tick = 2
+call = { block = "CamTableGenerate", instance = "generate", axis = 1, table = 22, table_type = 2, rows = [[0.0, 0.0], [90.0, 9.0], [180.0, 0.0], [270.0, -9.0], [360.0, 0.0]] }
+[[step]]
+wait = "generate.Done"
+call = { block = "CamTableCoupleAxesIpol", instance = "couple", axis = 1, master = 0, table = 22, interpolation = 0, master_absolute = true, slave_absolute = true }
+[[step]]
+wait = "couple.Done"
+call = { block = "MC_MoveVelocity", instance = "turn", axis = 0, velocity = 180.0, direction = 1, acceleration = 1800.0, deceleration = 1800.0, jerk = 18000.0 }
+[[step]]
+at_tick = 600
+call = { block = "MC_CamScaling", instance = "queued", axis = 1, activation_mode = "next_cycle", master_scaling_mode = "off", slave_scaling_mode = "user_defined", slave_scaling = 0.5 }
+[[step]]
+at_tick = 610
+call = { block = "MC_CamScaling", instance = "off", axis = 1, activation_mode = "off", master_scaling_mode = "off", slave_scaling_mode = "user_defined", slave_scaling = 3.0 }
+"#;
+    let toml = "cycle_ms = 1.0\nticks = 3000\n\
+        [[axis]]\nname = \"Drum\"\nkind = \"rotary\"\npower = true\n\
+        [[axis]]\nname = \"Pusher\"\npower = true\nsoft_limits = [-50.0, 50.0]\n\
+        following_error_limit = 5.0\n[plc]\ntimeline = \"plc.toml\"\n";
+    let s = with_timeline("off.toml", toml, timeline);
+    let run = InProcess::run_through(&s).unwrap();
+    let summary = run.timeline.as_ref().unwrap().summary();
+    let done_at = |name: &str| -> u64 {
+        let line = summary
+            .lines()
+            .find(|l| l.starts_with(&format!("block {name} ")))
+            .unwrap_or_else(|| panic!("{name}: {summary}"));
+        let after = &line[line.find("Done ").unwrap_or_else(|| panic!("{line}")) + 5..];
+        after.split_whitespace().next().unwrap().parse().unwrap()
+    };
+    let (off, queued) = (done_at("off"), done_at("queued"));
+    assert!(off < 620, "done at once: {off}\n{summary}");
+    assert!(
+        queued > off + 100,
+        "the queued one at its cycle: {queued}\n{summary}"
+    );
+    assert!(!summary.contains("ErrorID"), "{summary}");
+}
