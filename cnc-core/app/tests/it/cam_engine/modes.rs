@@ -688,3 +688,63 @@ call = { block = "MC_CamScaling", instance = "off", axis = 1, activation_mode = 
     );
     assert!(!summary.contains("ErrorID"), "{summary}");
 }
+
+/// MC_CamIn's InterpolationType overrides the table's for that coupling (seed 000 5.1.2): a
+/// cyclic equidistant table stored linear, coupled once as it is and once with "spline", the
+/// master moved to 45: the slave reads the linear 5.0, then the periodic spline's value there
+/// (the kinematics of the table evaluated with the spline, by hand through `PositionTable`).
+#[test]
+fn mc_cam_in_interpolation_overrides_the_tables() {
+    let rows = [
+        [0.0, 0.0],
+        [90.0, 10.0],
+        [180.0, 0.0],
+        [270.0, -10.0],
+        [360.0, 0.0],
+    ];
+    let at_45 = |interpolation: &str| -> f64 {
+        let timeline = format!(
+            r#"
+[[step]]
+at_tick = 2
+call = {{ block = "CamTableGenerate", instance = "generate", axis = 1, table = 22, table_type = 2, rows = [[0.0, 0.0], [90.0, 10.0], [180.0, 0.0], [270.0, -10.0], [360.0, 0.0]] }}
+[[step]]
+wait = "generate.Done"
+call = {{ block = "MC_CamTableSelect", instance = "select", axis = 1, table = 22, periodic = true, master_absolute = true, slave_absolute = true }}
+[[step]]
+wait = "select.Done"
+call = {{ block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 22, start_mode = "absolute", interpolation = "{interpolation}" }}
+[[step]]
+wait = "cam.InSync"
+call = {{ block = "MC_MoveAbsolute", instance = "go", axis = 0, position = 45.0, velocity = 90.0, acceleration = 900.0, deceleration = 900.0, jerk = 9000.0 }}
+"#
+        );
+        let toml = "cycle_ms = 1.0\nticks = 3000\n\
+            [[axis]]\nname = \"Drum\"\nkind = \"rotary\"\npower = true\n\
+            [[axis]]\nname = \"Pusher\"\npower = true\nsoft_limits = [-50.0, 50.0]\n\
+            following_error_limit = 5.0\n[plc]\ntimeline = \"plc.toml\"\n";
+        let s = with_timeline("ipol.toml", toml, &timeline);
+        let run = InProcess::run_through(&s).unwrap();
+        let summary = run.timeline.as_ref().unwrap().summary();
+        assert!(!summary.contains("ErrorID"), "{summary}");
+        assert_eq!(set(&run, MASTER).position, 45.0);
+        set(&run, SLAVE).position
+    };
+    assert!((at_45("linear") - 5.0).abs() < 1e-9);
+    let spline = CamProfile::Table(
+        cnc_core::cam::PositionTable::new(
+            &rows,
+            cnc_core::cam::TableType::Equidistant,
+            hli::calls::cam::CamInterpolation::Spline,
+            true,
+        )
+        .unwrap(),
+    )
+    .eval(45.0, &mut cnc_core::cam::ProfileCursor::default())
+    .position;
+    assert!(
+        (spline - 5.0).abs() > 0.1,
+        "the spline differs here: {spline}"
+    );
+    assert!((at_45("spline") - spline).abs() < 1e-9, "{spline}");
+}
