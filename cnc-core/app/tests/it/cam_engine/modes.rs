@@ -748,3 +748,82 @@ call = {{ block = "MC_MoveAbsolute", instance = "go", axis = 0, position = 45.0,
     );
     assert!((at_45("spline") - spline).abs() < 1e-9, "{spline}");
 }
+
+/// Reserve points (seed 000 3.1, 3.5): points laid in as IGNORE drop out of the cam, and are
+/// switched on while it runs by writing another point type. The seed's six-point cam with
+/// its points 3 and 4 as IGNORE keeps the slave at rest through the running cycle; written as
+/// VELOCITY points at NextCycle (point 4 first: written alone, point 3's line would end in a
+/// rest point), they apply at the cycle's end: in the next cycle the slave is
+/// 20 at 150 and 40 at 240, as in the full cam, and nothing jumps at the wrap.
+#[test]
+fn reserve_points_switched_on_while_the_cam_runs_apply_at_the_next_cycle() {
+    let json = std::fs::read_to_string(scenarios().join("cams/seed_example.json"))
+        .unwrap()
+        .replacen(
+            "\"point_type\": \"VELOCITY\"",
+            "\"point_type\": \"IGNORE\"",
+            2,
+        );
+    assert_eq!(json.matches("IGNORE").count(), 2);
+    let timeline = r#"
+[[step]]
+at_tick = 2
+call = { block = "MC_CamTableSelect", instance = "select", axis = 1, table = 1, periodic = true, master_absolute = true, slave_absolute = true }
+[[step]]
+wait = "select.Done"
+call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1, start_mode = "absolute" }
+[[step]]
+wait = "cam.InSync"
+call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
+[[step]]
+at_tick = 500
+call = { block = "MC_SetCamOnlineChangeMode", instance = "mode", axis = 1, table = 1, activation_mode = "next_cycle" }
+[[step]]
+wait = "mode.Done"
+call = { block = "MC_WriteMotionFunctionPoint", instance = "p4", axis = 1, table = 1, point_index = 4, function_type = 15, point_type = 2, master_pos = 240.0, slave_pos = 40.0 }
+[[step]]
+wait = "p4.Done"
+call = { block = "MC_WriteMotionFunctionPoint", instance = "p3", axis = 1, table = 1, point_index = 3, function_type = 1, point_type = 2, master_pos = 150.0, slave_pos = 20.0 }
+"#;
+    let toml = "cycle_ms = 1.0\nticks = 3000\n\
+        [[axis]]\nname = \"Conveyor\"\nkind = \"rotary\"\npower = true\nvelocity = 720.0\n\
+        acceleration = 3600.0\ndeceleration = 3600.0\njerk = 36000.0\n\
+        [[axis]]\nname = \"Lifter\"\npower = true\nsoft_limits = [-10.0, 100.0]\n\
+        [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
+    let s = Scenario::parse("reserve.toml", toml, |f| {
+        let text = match f {
+            "plc.toml" => timeline.to_string(),
+            "seed_example.json" => json.clone(),
+            other => panic!("{other}"),
+        };
+        Ok((PathBuf::from(f), text))
+    })
+    .unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    let (mut first_cycle_max, mut seen, mut last): (f64, Vec<(f64, f64)>, f64) = (0.0, vec![], 0.0);
+    for _ in 0..s.ticks.unwrap() {
+        run.step(s.cycle_s);
+        let (m, p) = (set(&run, MASTER).position, set(&run, SLAVE).position);
+        assert!((p - last).abs() < 0.5, "no jump: {last} -> {p} at {m}");
+        last = p;
+        if m < 360.0 {
+            first_cycle_max = first_cycle_max.max(p.abs());
+        } else if m < 720.0 {
+            seen.push((m, p));
+        }
+    }
+    let report = run.timeline.as_ref().unwrap().summary();
+    assert!(!report.contains("ErrorID"), "{report}");
+    assert_eq!(
+        first_cycle_max, 0.0,
+        "the reserves stay out in the running cycle"
+    );
+    let near = |x: f64| {
+        seen.iter()
+            .min_by(|a, b| (a.0 - x).abs().total_cmp(&(b.0 - x).abs()))
+            .unwrap()
+            .1
+    };
+    assert!((near(510.0) - 20.0).abs() < 0.5, "{}", near(510.0));
+    assert!((near(600.0) - 40.0).abs() < 0.5, "{}", near(600.0));
+}
