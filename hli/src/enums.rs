@@ -685,6 +685,10 @@ pub mod axis_status {
     pub const ERROR: u32 = 1 << 4;
     /// The process image reported I/O data invalid.
     pub const IO_INVALID: u32 = 1 << 5;
+    /// A cam slave whose table has data written and not yet active (an online change
+    /// waiting for its activation): the seed's bit for synchronising online changes, which
+    /// `AxisCamDataQueued` reads.
+    pub const CAM_DATA_QUEUED: u32 = 1 << 6;
 }
 
 #[cfg(test)]

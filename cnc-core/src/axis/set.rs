@@ -188,6 +188,14 @@ impl AxisSet {
         self.leased(lease).map(|a| a.begin_coupled(kind))
     }
 
+    /// Status bits the engine holding `lease` reports for its axis (shown in `status_r`
+    /// while it holds it); `false` once the lease is stale.
+    pub fn set_coupled_status(&mut self, lease: Lease, bits: u32) -> bool {
+        self.leased(lease)
+            .map(|a| a.set_coupled_status(bits))
+            .is_some()
+    }
+
     /// Ends the coupling of `lease` (see [`Axis::decouple`]); `false` when the lease was
     /// already stale (the axis is someone else's, or free).
     pub fn release(&mut self, lease: Lease) -> bool {

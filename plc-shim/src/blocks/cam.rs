@@ -278,6 +278,14 @@ fn scaling_carried_out(
     }
 }
 
+/// The seed's `AxisCamDataQueued`: whether cam slave `axis` has data written to its table
+/// that is not active yet (an online change waiting for its activation), from the bit in its
+/// axis image (`status_r`, `axis_status::CAM_DATA_QUEUED`).
+pub fn axis_cam_data_queued(view: &hli::views::PlcView<'_>, axis: usize) -> bool {
+    view.axis_state(axis)
+        .is_ok_and(|s| s.status_r & hli::enums::axis_status::CAM_DATA_QUEUED != 0)
+}
+
 impl McCamScaling {
     /// One cycle for slave axis `slave`.
     pub fn call(&mut self, io: &mut PlcIo<'_>, slave: u32) {

@@ -138,6 +138,9 @@ impl Axis {
         if self.io_fault.is_some() {
             status |= axis_status::IO_INVALID;
         }
+        if self.coupling.is_some() {
+            status |= self.coupled_status;
+        }
         status
     }
 }

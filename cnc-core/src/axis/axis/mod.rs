@@ -82,6 +82,9 @@ pub struct Axis {
     coupling: Option<Coupling>,
     /// Counts couplings: an engine that holds the number it coupled with knows the axis is
     /// still its own (and not re-coupled by another engine in between).
+    /// Status bits the engine that holds the axis reports (`axis_status::CAM_DATA_QUEUED`),
+    /// shown while it holds it.
+    coupled_status: u32,
     coupling_epoch: u32,
     coupled_setpoint: Kinematic,
     /// The set-point handed out by the last tick (what the actual position must match now).
@@ -132,6 +135,7 @@ impl Axis {
             stop_lock: false,
             error: None,
             coupling: None,
+            coupled_status: 0,
             coupling_epoch: 0,
             coupled_setpoint: Kinematic::default(),
             last_set: Kinematic::default(),
@@ -432,7 +436,13 @@ impl Axis {
         self.coupled_setpoint = self.generator.state();
         self.coupling = Some(coupling);
         self.coupling_epoch = self.coupling_epoch.wrapping_add(1);
+        self.coupled_status = 0;
         Ok(())
+    }
+
+    /// The status bits of the engine that holds the axis (see `coupled_status`).
+    pub(in crate::axis) fn set_coupled_status(&mut self, bits: u32) {
+        self.coupled_status = bits;
     }
 
     /// Starts a coupling command of the engine that holds the axis (see

@@ -446,6 +446,13 @@ impl CamEngine {
             )
         };
         axes.drive(state.lease, set, phase);
+        let queued = self.store.queue(state.table).is_ok_and(|q| q.is_queued());
+        let bits = if queued {
+            hli::enums::axis_status::CAM_DATA_QUEUED
+        } else {
+            0
+        };
+        axes.set_coupled_status(state.lease, bits);
         state.master_before = master.position;
     }
 }

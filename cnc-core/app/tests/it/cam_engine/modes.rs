@@ -754,7 +754,8 @@ call = {{ block = "MC_MoveAbsolute", instance = "go", axis = 0, position = 45.0,
 /// its points 3 and 4 as IGNORE keeps the slave at rest through the running cycle; written as
 /// VELOCITY points at NextCycle (point 4 first: written alone, point 3's line would end in a
 /// rest point), they apply at the cycle's end: in the next cycle the slave is
-/// 20 at 150 and 40 at 240, as in the full cam, and nothing jumps at the wrap.
+/// 20 at 150 and 40 at 240, as in the full cam, and nothing jumps at the wrap. From the first
+/// write until then the slave's `AxisCamDataQueued` (its axis image's bit) is TRUE.
 #[test]
 fn reserve_points_switched_on_while_the_cam_runs_apply_at_the_next_cycle() {
     let json = std::fs::read_to_string(scenarios().join("cams/seed_example.json"))
@@ -801,9 +802,15 @@ call = { block = "MC_WriteMotionFunctionPoint", instance = "p3", axis = 1, table
     .unwrap();
     let mut run = InProcess::new(&s, 0).unwrap();
     let (mut first_cycle_max, mut seen, mut last): (f64, Vec<(f64, f64)>, f64) = (0.0, vec![], 0.0);
-    for _ in 0..s.ticks.unwrap() {
+    let mut queued_at = Vec::new();
+    for tick in 0..s.ticks.unwrap() {
         run.step(s.cycle_s);
         let (m, p) = (set(&run, MASTER).position, set(&run, SLAVE).position);
+        // AxisCamDataQueued: from the write until the change applies at the cycle's end.
+        let view = hli::views::PlcView::new(&run.memory);
+        if plc_shim::blocks::cam::axis_cam_data_queued(&view, SLAVE) {
+            queued_at.push((tick, m));
+        }
         assert!((p - last).abs() < 0.5, "no jump: {last} -> {p} at {m}");
         last = p;
         if m < 360.0 {
@@ -817,6 +824,20 @@ call = { block = "MC_WriteMotionFunctionPoint", instance = "p3", axis = 1, table
     assert_eq!(
         first_cycle_max, 0.0,
         "the reserves stay out in the running cycle"
+    );
+    let (first, last_queued) = (queued_at[0], *queued_at.last().unwrap());
+    assert!(
+        (503..=506).contains(&first.0),
+        "queued from the write: {first:?}"
+    );
+    assert!(
+        last_queued.1 < 360.0,
+        "until the cycle's end: {last_queued:?}"
+    );
+    assert_eq!(
+        queued_at.len() as u64,
+        last_queued.0 - first.0 + 1,
+        "without a gap"
     );
     let near = |x: f64| {
         seen.iter()
