@@ -22,6 +22,10 @@ wire_enum! {
     }
 }
 
+/// [`CamInCall::start_mode`] 0: as MC_CamTableSelect chose (absolute for a table never
+/// selected).
+pub const CAM_START_AS_SELECTED: u32 = 0;
+
 impl CamStartMode {
     /// Whether the master coordinate is measured from the coupling position.
     pub fn master_relative(self) -> bool {
@@ -111,7 +115,7 @@ pub struct CamInCall {
     pub master: u32,
     /// Cam table ID.
     pub table_id: u32,
-    /// Raw [`CamStartMode`].
+    /// Raw [`CamStartMode`], or [`CAM_START_AS_SELECTED`].
     pub start_mode: u32,
     /// Raw [`CamActivationMode`] (MC_CamInExt; 0 for MC_CamIn).
     pub activation_mode: u32,

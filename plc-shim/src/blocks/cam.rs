@@ -126,7 +126,8 @@ pub struct McCamIn {
     pub master: u32,
     /// Input: the cam table ID.
     pub table: u32,
-    /// Input: raw `MC_StartMode` (1 absolute .. 4).
+    /// Input: raw `MC_StartMode` (1 absolute .. 4); 0, the default, as MC_CamTableSelect
+    /// chose (its MasterAbsolute/SlaveAbsolute; absolute for a table never selected).
     pub start_mode: u32,
     /// Inputs: the activation and each side's scaling mode (Ext), the offsets and the
     /// scalings, as MC_CamScaling takes them (`reserved` is not sent).
@@ -148,7 +149,7 @@ impl Default for McCamIn {
             execute: false,
             master: 0,
             table: 0,
-            start_mode: 1,
+            start_mode: hli::calls::cam::CAM_START_AS_SELECTED,
             scaling: unscaled(),
             interpolation: 0,
             extended: false,

@@ -134,8 +134,17 @@ impl CamEngine {
         if master == slave {
             return Err(CamCouplingError::MasterIsSlave.raw());
         }
+        // MC_CamTableSelect's MasterAbsolute/SlaveAbsolute choose absolute or relative
+        // (FALSE: relative); MC_CamIn's StartMode 0 takes that choice (a table never selected:
+        // absolute), and an explicit StartMode must say the same.
+        let selected = self.selects.get(call.table_id as usize).copied().flatten();
+        let chosen = selected.map(|s| start_of(s.absolute));
+        let given = match call.start_mode {
+            0 => Some(chosen.unwrap_or(CamStartMode::Absolute)),
+            raw => CamStartMode::from_raw(raw),
+        };
         let (Some(start), Some(activation), Some(master_mode), Some(slave_mode)) = (
-            CamStartMode::from_raw(call.start_mode),
+            given,
             Activation::from_raw(call.activation_mode, call.activation_position),
             CamScalingMode::from_raw(call.master_scaling_mode),
             CamScalingMode::from_raw(call.slave_scaling_mode),
@@ -145,20 +154,10 @@ impl CamEngine {
         if call.extended > 1 || call.master_source > 1 || !call.activation_position.is_finite() {
             return Err(CamCouplingError::BadParameter.raw());
         }
-        // MC_CamTableSelect's MasterAbsolute/SlaveAbsolute and MC_CamIn's StartMode say the
-        // same thing twice: a side the selection made absolute that the start mode takes
-        // relative is refused rather than one of the two silently ignored. FALSE, the seed's
-        // default of both flags, cannot be told from a flag not given: it imposes nothing
-        // (MC_CamIn's own default is absolute).
-        let selected = self.selects.get(call.table_id as usize).copied().flatten();
-        if let Some(Select {
-            absolute: (master_abs, slave_abs),
-            ..
-        }) = selected
-        {
-            if (master_abs && start.master_relative()) || (slave_abs && start.slave_relative()) {
-                return Err(CamCouplingError::ModeCombination.raw());
-            }
+        // The selection and an explicit StartMode say the same thing twice: one that says
+        // otherwise is refused rather than one of the two silently ignored.
+        if chosen.is_some_and(|c| c != start) {
+            return Err(CamCouplingError::ModeCombination.raw());
         }
         let scaling = Scaling {
             master_offset: call.master_offset,
@@ -537,5 +536,15 @@ impl CamEngine {
             activation: activation.timing().expect("checked: a timed mode"),
         });
         accepted()
+    }
+}
+
+/// The start mode MC_CamTableSelect's (MasterAbsolute, SlaveAbsolute) choose.
+fn start_of((master_absolute, slave_absolute): (bool, bool)) -> CamStartMode {
+    match (master_absolute, slave_absolute) {
+        (true, true) => CamStartMode::Absolute,
+        (false, false) => CamStartMode::Relative,
+        (true, false) => CamStartMode::MasterAbsSlaveRel,
+        (false, true) => CamStartMode::MasterRelSlaveAbs,
     }
 }

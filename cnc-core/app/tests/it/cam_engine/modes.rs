@@ -1,6 +1,7 @@
 //! Actual-value masters, scaling activation modes, coupling starts and online point changes.
 
 use super::*;
+use hli::calls::cam::CAM_START_AS_SELECTED;
 
 #[test]
 fn a_slave_may_follow_the_masters_actual_position() {
@@ -273,11 +274,10 @@ fn a_point_change_as_soon_as_possible_waits_for_every_slave_on_the_table() {
     }
 }
 
-/// No input silently ignored: a table selected absolute for master and slave couples with
-/// StartMode absolute only; every start mode that takes a side relative contradicts the
-/// selection and is refused (0x4262) with the axis untouched. A flag selected FALSE (the seed's
-/// default, not told from one not given) imposes nothing; a table never selected takes
-/// whatever MC_CamIn says.
+/// MC_CamTableSelect's MasterAbsolute/SlaveAbsolute choose absolute or relative (seed 000
+/// 5.1.1: FALSE is relative); MC_CamIn's StartMode 0 ("as selected", the block's default)
+/// takes that choice, and an explicit StartMode that says otherwise is refused (0x4262) with
+/// the axis untouched, both ways. A table never selected takes whatever MC_CamIn says.
 #[test]
 fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
     let mut run = machine("");
@@ -298,8 +298,7 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
     }
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(1)), 0);
     assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
-    // Slave selected absolute, master left FALSE: the slave may not be coupled relative,
-    // the master may be either.
+    // Slave selected absolute, master FALSE (relative): that start mode, or 0, only.
     let select = CamTableSelectCall {
         periodic: 1,
         master_absolute: 0,
@@ -307,24 +306,78 @@ fn a_start_mode_that_contradicts_the_table_selection_is_refused() {
         reserved: 0,
     };
     assert_eq!(call(&mut run, 2, select), 0);
-    let mode = |m: CamStartMode| CamInCall {
-        start_mode: m.raw(),
+    let mode = |m: u32| CamInCall {
+        start_mode: m,
         ..cam_in(2)
     };
-    for refused in [CamStartMode::Relative, CamStartMode::MasterAbsSlaveRel] {
-        assert_eq!(call(&mut run, SLAVE as u32, mode(refused)), contradiction);
+    for refused in [
+        CamStartMode::Absolute,
+        CamStartMode::Relative,
+        CamStartMode::MasterAbsSlaveRel,
+    ] {
+        assert_eq!(
+            call(&mut run, SLAVE as u32, mode(refused.raw())),
+            contradiction,
+            "{refused:?}"
+        );
     }
-    for taken in [CamStartMode::Absolute, CamStartMode::MasterRelSlaveAbs] {
-        assert_eq!(call(&mut run, SLAVE as u32, mode(taken)), 0, "{taken:?}");
+    for taken in [CamStartMode::MasterRelSlaveAbs.raw(), CAM_START_AS_SELECTED] {
+        assert_eq!(call(&mut run, SLAVE as u32, mode(taken)), 0, "{taken}");
         assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
     }
     // A table never selected: MC_CamIn's start mode alone governs.
     let mut fresh = machine("");
     fresh.step(0.001);
     assert_eq!(
-        call(&mut fresh, SLAVE as u32, mode(CamStartMode::Relative)),
+        call(&mut fresh, SLAVE as u32, mode(CamStartMode::Relative.raw())),
         0
     );
+}
+
+/// A table selected with MasterAbsolute and SlaveAbsolute FALSE couples relative with
+/// MC_CamIn's default StartMode: the slave standing at 5 follows 5 + T(master), the seed
+/// cam's law counted from where it stood.
+#[test]
+fn a_table_selected_relative_couples_relative() {
+    let mut run = machine("");
+    run.step(0.001);
+    let command =
+        hli::calls::axis::AxisCommandCall::move_absolute(5.0, [100.0, 1000.0, 1000.0, 10_000.0]);
+    let view = CncView::new(&run.memory);
+    run.machine.call(&view, SLAVE as u32, &command).unwrap();
+    while set(&run, SLAVE).position != 5.0 || set(&run, SLAVE).velocity != 0.0 {
+        run.step(0.001);
+    }
+    let select = CamTableSelectCall {
+        periodic: 1,
+        master_absolute: 0,
+        slave_absolute: 0,
+        reserved: 0,
+    };
+    assert_eq!(call(&mut run, 1, select), 0);
+    let c = CamInCall {
+        start_mode: CAM_START_AS_SELECTED,
+        ..cam_in(1)
+    };
+    assert_eq!(call(&mut run, SLAVE as u32, c), 0);
+    // Coupled in the next tick, with the master still at 0 (its origin).
+    run.step(0.001);
+    run_master(&mut run, 360.0);
+    let (profile, law) = (seed_cam(), seed_law(true));
+    let mut checked = 0;
+    for _ in 0..1500 {
+        run.step(0.001);
+        let m = set(&run, MASTER);
+        let expected = 5.0 + law_at(&law, &profile, m).position;
+        let got = set(&run, SLAVE).position;
+        assert!(
+            (got - expected).abs() < 1e-9,
+            "at {}: {got} vs {expected}",
+            m.position
+        );
+        checked += u32::from(expected > 6.0);
+    }
+    assert!(checked > 100, "the cam moved the slave ({checked})");
 }
 
 /// DeleteQueuedData on a pending MC_CamInExt switch: the queued switch to the stroke table is
