@@ -457,8 +457,9 @@ pub struct CamReadCall {
     /// [`CAM_VALUES_PER_REPLY`] is [`CAM_VALUES_PER_REPLY`]; part `k` then holds values
     /// `part_len k ..`.
     pub part_len: u32,
-    /// Reserved, 0.
-    pub reserved: u32,
+    /// A rows read (CamTableReadData's rows to read): at most this many rows, 0 for all; more
+    /// rows than the table has is refused (0x4B36). 0 for every other read.
+    pub rows: u32,
 }
 
 /// The answer to a [`CamReadCall`].

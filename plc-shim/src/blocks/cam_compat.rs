@@ -67,6 +67,12 @@ pub struct CompatConfig {
     pub room: usize,
     /// iBlockSize: bytes moved per call (0: the call's room, 13 rows or 28 numbers).
     pub block_size: u32,
+    /// CamTableReadData's rows to read (0: all).
+    pub rows_to_read: u32,
+    /// CamTableReadData's column count of its array (the table's is 2).
+    pub columns: u32,
+    /// CamTableReadData's array size in bytes (none given: the room's, 8 a number).
+    pub size: Option<u32>,
 }
 
 impl CompatConfig {
@@ -90,6 +96,9 @@ impl CompatConfig {
             on: true,
             room: DEFAULT_READ_ROOM,
             block_size: 0,
+            rows_to_read: 0,
+            columns: 2,
+            size: None,
         }
     }
 }
@@ -100,7 +109,14 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
         "CamTableGenerate" => &["table", "table_type", "rows", "block_size"],
         "CamTableCreate" => &["table", "table_type", "num_rows"],
         "CamTableWriteData" => &["table", "rows", "block_size"],
-        "CamTableReadData" => &["table", "room", "block_size"],
+        "CamTableReadData" => &[
+            "table",
+            "room",
+            "block_size",
+            "rows_to_read",
+            "columns",
+            "size",
+        ],
         "CamTableReadSlavePos" => &["table", "master_pos"],
         "CamTableDelete" => &["table"],
         "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => &[
@@ -151,6 +167,9 @@ pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, St
             "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
             "rows" => c.rows = Some(rows_of(value)?),
             "room" => c.room = int(1, 1 << 20)? as usize,
+            "rows_to_read" => c.rows_to_read = int(0, 1 << 20)?,
+            "columns" => c.columns = int(1, 16)?,
+            "size" => c.size = Some(int(8, 1 << 30)?),
             "block_size" => {
                 c.block_size = int(0, i64::from(u32::MAX))?;
                 if (1..ROW_BYTES).contains(&c.block_size) {
@@ -292,6 +311,10 @@ impl CompatBlock {
                 self.read.execute = self.execute;
                 self.read.target = c.table;
                 self.read.request.a = c.master_pos;
+                if c.kind == "CamTableReadData" {
+                    self.read.request.rows = c.rows_to_read;
+                    self.read.refuse = read_array_refusal(&c);
+                }
                 // iBlockSize in numbers of 8 bytes (0: the reply's room).
                 self.read.request.part_len = c.block_size / 8;
                 self.read.call(io);
@@ -426,3 +449,15 @@ pub const TIMELINE: &[BlockSpec] = compat_blocks![
     "CamTableSetSlaveScale",
     "CamTableSetMasterSlaveScale",
 ];
+
+/// CamTableReadData's array against what it asks for (seed 000 5.2.1.5): a column count other
+/// than the table's 2 is 0x4B37; rows to read that do not fit the array's size in bytes (8 a
+/// number) are 0x4B31. `None`: the read may go.
+fn read_array_refusal(c: &CompatConfig) -> Option<u32> {
+    if c.columns != 2 {
+        return Some(0x4B37);
+    }
+    let size = c.size.map_or(c.room as u64 * 8, u64::from);
+    let wanted = u64::from(c.rows_to_read) * u64::from(c.columns) * 8;
+    (wanted > size).then_some(0x4B31)
+}

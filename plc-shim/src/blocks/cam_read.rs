@@ -97,6 +97,9 @@ pub struct McCamRead {
     pub columns: u32,
     /// Outputs of the last call.
     pub out: Outputs,
+    /// A refusal the block's own inputs make (an array that cannot hold what it asks for):
+    /// the read ends in Error with this code without a call.
+    pub refuse: Option<u32>,
     kernel: Kernel<PartRead>,
 }
 
@@ -116,6 +119,7 @@ impl McCamRead {
             values: Vec::with_capacity(room),
             columns: 1,
             out: Outputs::default(),
+            refuse: None,
             kernel: Kernel::default(),
         }
     }
@@ -133,8 +137,12 @@ impl McCamRead {
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (target, request) = (self.target, self.request);
         let columns = &mut self.columns;
+        let refuse = self.refuse;
         let send = |io: &mut PlcIo<'_>, values: &mut Vec<f64>| {
             values.clear();
+            if let Some(code) = refuse {
+                return Err(code);
+            }
             PartRead::start(
                 io,
                 target,

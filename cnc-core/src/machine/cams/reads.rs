@@ -78,7 +78,7 @@ impl CamEngine {
                 Ok(Made::all(values, n))
             }),
             Some(CamReadKind::Values) => self.sampled_values(id, &call, skip, per),
-            Some(CamReadKind::Rows) => self.rows_part(id, skip, per),
+            Some(CamReadKind::Rows) => self.rows_part(id, skip, per, call.rows),
             Some(CamReadKind::Info) => self.info(id as usize, &call, axes).map(|v| {
                 let n = v.len();
                 Made::all(v, n)
@@ -200,12 +200,17 @@ impl CamEngine {
         })
     }
 
-    /// The part of `per` values from value `skip` on of a position table's rows (master,
-    /// slave).
-    fn rows_part(&self, id: u32, skip: usize, per: usize) -> Result<Made, u32> {
+    /// The part of `per` values from value `skip` on of a position table's first `rows` rows
+    /// (0: all; more than it has: 0x4B36), master and slave per row.
+    fn rows_part(&self, id: u32, skip: usize, per: usize, rows: u32) -> Result<Made, u32> {
         match self.table(id) {
             Ok(CamProfile::Table(t)) => {
-                let total = t.len() * 2;
+                let rows = match rows as usize {
+                    0 => t.len(),
+                    n if n <= t.len() => n,
+                    _ => return Err(TableErrorCode::NumRowsInvalid as u32),
+                };
+                let total = rows * 2;
                 // Only the rows of this part.
                 let values: Vec<f64> = (skip..(skip + per).min(total))
                     .filter_map(|i| t.row_at(i / 2).map(|r| r[i % 2]))

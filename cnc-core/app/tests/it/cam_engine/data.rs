@@ -317,7 +317,7 @@ fn s_at(p: &CamProfile, x: f64) -> f64 {
 }
 
 /// The numbers of a read block in the PLC's report.
-fn read_values(report: &str, instance: &str) -> Vec<f64> {
+pub(super) fn read_values(report: &str, instance: &str) -> Vec<f64> {
     let mut lines = report.lines();
     lines
         .find(|l| l.starts_with(&format!("block {instance} ")))

@@ -19,6 +19,7 @@ mod data;
 mod encoder;
 mod modes;
 mod recovery;
+mod selection;
 
 const MASTER: usize = 0;
 const SLAVE: usize = 1;
