@@ -34,6 +34,9 @@ pub struct McCamTableSelect {
     pub table_type: u32,
     /// Input: raw `MC_InterpolationType` of rows sent.
     pub interpolation: u32,
+    /// Input: the seed's `CamTable` (an MC_CAM_REF): when given, its data (as many rows as
+    /// it says, after its check) in place of `data`, and its table type.
+    pub cam_ref: Option<CamRef>,
     /// Outputs of the last call.
     pub out: Outputs,
     kernel: Kernel<SelectTransfer>,
@@ -44,30 +47,42 @@ impl McCamTableSelect {
 
     /// One cycle: the data in chunks (if any), then the selection.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
+        let (checked, given_type) = match &self.cam_ref {
+            Some(r) => (Some(r.check()), r.table_type),
+            None => (None, self.table_type),
+        };
+        let data = match self.cam_ref.as_mut() {
+            Some(r) => &mut r.data,
+            None => &mut self.data,
+        };
         if let CamData::Rows {
             table_type,
             interpolation,
             ..
-        } = &mut self.data
+        } = data
         {
-            *table_type = if self.table_type == 0 {
-                10
-            } else {
-                self.table_type
-            };
+            *table_type = if given_type == 0 { 10 } else { given_type };
             *interpolation = self.interpolation;
         }
+        let refused = checked.and_then(Result::err);
+        let count = checked.and_then(Result::ok);
+        let data = match &self.cam_ref {
+            Some(r) => &r.data,
+            None => &self.data,
+        };
         let call = CamTableSelectCall {
             periodic: u32::from(self.periodic),
             master_absolute: u32::from(self.master_absolute),
             slave_absolute: u32::from(self.slave_absolute),
             reserved: 0,
         };
-        let (table, data, periodic) = (self.table, &self.data, self.periodic);
-        let send = |io: &mut PlcIo<'_>| match data {
-            CamData::None => send(io, table, &call).map(SelectTransfer::Selecting),
-            data => Ok(SelectTransfer::Loading(
-                ChunkTransfer::new(table, data, true, periodic),
+        let (table, periodic) = (self.table, self.periodic);
+        let send = |io: &mut PlcIo<'_>| match (refused, data) {
+            (Some(code), _) => Err(code),
+            (None, CamData::None) => send(io, table, &call).map(SelectTransfer::Selecting),
+            (None, data) => Ok(SelectTransfer::Loading(
+                ChunkTransfer::new(table, data, true, periodic)
+                    .with_count(count.unwrap_or(data.len())),
                 call,
             )),
         };
@@ -101,6 +116,68 @@ pub enum CamData {
     Points(std::sync::Arc<[hli::calls::cam::McMotionFunctionPoint]>),
 }
 
+impl CamData {
+    /// Rows or points held.
+    pub fn len(&self) -> usize {
+        match self {
+            CamData::None => 0,
+            CamData::Rows { rows, .. } => rows.len(),
+            CamData::Points(points) => points.len(),
+        }
+    }
+
+    /// Whether it holds nothing.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
+/// The seed's `MC_CAM_REF` (000 5.1.16.2): the array a table's data lie in and how much of
+/// it is the table. MC_CamTableSelect and MC_WriteMotionFunction take one (`cam_ref`) in
+/// place of their bare data, and check it before anything is sent.
+#[derive(Debug, Clone, Default)]
+pub struct CamRef {
+    /// The array: `[master, slave]` rows of a position table, or motion-function points.
+    pub data: CamData,
+    /// SIZEOF the array, bytes.
+    pub array_size: u32,
+    /// `MC_TableType`: 10 equidistant or 11 non-equidistant rows, 22 a motion function.
+    pub table_type: u32,
+    /// Rows (points) of the table, from the array's start.
+    pub rows: u32,
+    /// Columns: 2 (master, slave) for rows, 1 (a point) for a motion function.
+    pub columns: u32,
+}
+
+impl CamRef {
+    /// The rows (points) to send, or the seed's code (5.1.16.12) of what does not match: a
+    /// table type that is not the data's (0x4B35), columns other than the type's (0x4B37),
+    /// fewer than 2 rows or more than the array holds (0x4B36), an array size other than its
+    /// elements' (0x4B31).
+    pub fn check(&self) -> Result<usize, u32> {
+        let (held, element_bytes, columns) = match (&self.data, self.table_type) {
+            (CamData::Rows { rows, .. }, 10 | 11) => (rows.len(), 8, 2),
+            (CamData::Points(points), 22) => (
+                points.len(),
+                core::mem::size_of::<McMotionFunctionPoint>(),
+                1,
+            ),
+            _ => return Err(0x4B35),
+        };
+        if self.columns != columns {
+            return Err(0x4B37);
+        }
+        let rows = self.rows as usize;
+        if rows < 2 || rows > held {
+            return Err(0x4B36);
+        }
+        if self.array_size as usize != held * element_bytes * columns as usize {
+            return Err(0x4B31);
+        }
+        Ok(rows)
+    }
+}
+
 enum Pending {
     Rows(PendingCall<hli::calls::cam::CamRowsWriteCall>),
     Points(PendingCall<hli::calls::cam::CamPointsWriteCall>),
@@ -119,6 +196,8 @@ pub struct ChunkTransfer {
     next: usize,
     /// Rows per call (iBlockSize of the compatibility blocks), 1..=CAM_ROWS_PER_CALL.
     rows_per_call: usize,
+    /// Rows (points) of `data` sent: all, or an MC_CAM_REF's row count.
+    count: usize,
 }
 
 /// Bytes of one table row (master and slave, two LREALs): the least iBlockSize moves.
@@ -156,7 +235,14 @@ impl ChunkTransfer {
             pending: None,
             next: 0,
             rows_per_call: hli::calls::cam::CAM_ROWS_PER_CALL,
+            count: data.len(),
         }
+    }
+
+    /// Only the first `count` rows (points) of the data (an MC_CAM_REF's).
+    pub fn with_count(mut self, count: usize) -> ChunkTransfer {
+        self.count = count.min(self.data.len());
+        self
     }
 
     /// The transfer in steps of at most `bytes` (iBlockSize): `bytes / 16` rows per call, at
@@ -178,6 +264,7 @@ impl ChunkTransfer {
                 table_type,
                 interpolation,
             } => {
+                let rows = &rows[..self.count];
                 let chunk = rows
                     .get(self.next..)?
                     .get(..self.rows_per_call.min(rows.len() - self.next))?;
@@ -199,6 +286,7 @@ impl ChunkTransfer {
                 Some(io.acyclic.start(self.table, &call).map(Pending::Rows))
             }
             CamData::Points(points) => {
+                let points = &points[..self.count];
                 let per = hli::calls::cam::CAM_POINTS_PER_CALL;
                 let chunk = points
                     .get(self.next..)?
@@ -296,6 +384,9 @@ pub struct McWriteMotionFunction {
     pub table: u32,
     /// Input: the points.
     pub points: CamData,
+    /// Input: the seed's `CamTable` (an MC_CAM_REF of type 22): when given, its points (as
+    /// many as it says, after its check) in place of `points`.
+    pub cam_ref: Option<CamRef>,
     /// Outputs of the last call.
     pub out: Outputs,
     kernel: Kernel<ChunkTransfer>,
@@ -306,14 +397,18 @@ impl McWriteMotionFunction {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let (table, points) = (self.table, &self.points);
-        self.out = self.kernel.cycle(
-            io,
-            self.execute,
-            |_| Ok(ChunkTransfer::new(table, points, false, false)),
-            |()| Accept::Done(()),
-            no_follow,
-        );
+        let (table, checked) = (self.table, self.cam_ref.as_ref().map(CamRef::check));
+        let points = self.cam_ref.as_ref().map_or(&self.points, |r| &r.data);
+        let send = |_: &mut PlcIo<'_>| match checked {
+            Some(Err(code)) => Err(code),
+            Some(Ok(count)) => {
+                Ok(ChunkTransfer::new(table, points, false, false).with_count(count))
+            }
+            None => Ok(ChunkTransfer::new(table, points, false, false)),
+        };
+        self.out = self
+            .kernel
+            .cycle(io, self.execute, send, |()| Accept::Done(()), no_follow);
     }
 }
 

@@ -622,3 +622,78 @@ fn a_timeline_timeout_ends_every_block_that_has_one_after_its_cycles() {
     }
     assert!(with >= 30, "blocks with tTimeout: {with}");
 }
+
+/// MC_CAM_REF (seed 000 5.1.16.2): a description that does not match its array is refused
+/// with the seed's code before anything is sent; a matching one sends as many rows as it
+/// says (three of an array of five).
+#[test]
+fn an_mc_cam_ref_is_checked_against_its_array_and_sends_its_rows() {
+    use crate::blocks::cam_data::CamRef;
+    let rows: Arc<[[f64; 2]]> = Arc::from(vec![
+        [0.0, 0.0],
+        [1.0, 1.0],
+        [2.0, 4.0],
+        [3.0, 9.0],
+        [4.0, 16.0],
+    ]);
+    let table = |array_size, table_type, count, columns| CamRef {
+        data: CamData::Rows {
+            rows: rows.clone(),
+            table_type: 0,
+            interpolation: 0,
+        },
+        array_size,
+        table_type,
+        rows: count,
+        columns,
+    };
+    let points = CamRef {
+        data: CamData::Points(Arc::from(
+            vec![hli::calls::cam::McMotionFunctionPoint::default(); 3],
+        )),
+        array_size: 3 * core::mem::size_of::<hli::calls::cam::McMotionFunctionPoint>() as u32,
+        table_type: 22,
+        rows: 3,
+        columns: 1,
+    };
+    assert_eq!(points.check(), Ok(3));
+    for (case, cam_ref, code) in [
+        ("size", table(72, 10, 5, 2), 0x4B31),
+        ("type", table(80, 12, 5, 2), 0x4B35),
+        ("rows", table(80, 11, 6, 2), 0x4B36),
+        ("one-row", table(80, 11, 1, 2), 0x4B36),
+        ("columns", table(80, 10, 5, 3), 0x4B37),
+    ] {
+        let mut cnc = Cnc::new("camref", case);
+        let mut select = block!(
+            McCamTableSelect::default(),
+            |s| {
+                s.table = 1;
+                s.cam_ref = Some(cam_ref.clone());
+            },
+            |b, io| b.call(io)
+        );
+        let seen = cnc.run(&mut select, true);
+        assert!(seen.error && seen.error_id == code, "{case}: {seen:?}");
+        assert_eq!(cnc.refuse(), 0, "{case}: nothing sent");
+    }
+    let mut cnc = Cnc::new("camref", "three");
+    let mut select = block!(
+        McCamTableSelect::default(),
+        |s| {
+            s.table = 1;
+            s.cam_ref = Some(table(80, 10, 3, 2));
+        },
+        |b, io| b.call(io)
+    );
+    assert!(cnc.run(&mut select, true).busy);
+    let mut sent = None;
+    cnc.server
+        .poll(|_, request| {
+            let call: hli::calls::cam::CamRowsWriteCall = hli::calls::decode_body(request)?;
+            sent = Some((call.total, call.count, call.table_type));
+            Err(ErrorCode::InvalidData)
+        })
+        .unwrap();
+    assert_eq!(sent, Some((3, 3, 10)));
+}

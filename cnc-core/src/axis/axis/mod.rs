@@ -172,7 +172,9 @@ impl Axis {
         self.actual_velocity
     }
     /// Position, velocity and acceleration from the encoder alone (the last three readings;
-    /// unfiltered, so quantisation and noise show in velocity and more in acceleration).
+    /// through `io.actual_filter_s`'s filter, if any: else quantisation and noise show in
+    /// velocity and more in acceleration; the acceleration 0 with `io.actual_acceleration`
+    /// off).
     pub fn actual_kinematic(&self) -> Kinematic {
         Kinematic {
             position: self.actual,
