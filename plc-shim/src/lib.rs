@@ -5,6 +5,7 @@
 #![forbid(unsafe_code)]
 
 pub mod blocks;
+pub mod call_tool;
 pub mod channel_tool;
 pub mod cli;
 pub mod fifo_file;

@@ -71,6 +71,9 @@ pub enum ToolCommand {
     /// Operate a channel through its control unit: select, start, stop, hold, resume, reset,
     /// single block, mode; or print its state.
     Channel(crate::channel_tool::ChannelArgs),
+    /// Run one block of the library (by its name and timeline inputs) against a running CNC
+    /// until it ends: for commissioning.
+    Call(crate::call_tool::CallArgs),
 }
 
 /// Why a tool did not do what it was asked.
@@ -342,6 +345,7 @@ pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
 pub fn main(command: ToolCommand) -> ExitCode {
     let result = match &command {
         ToolCommand::Channel(args) => return crate::channel_tool::main(args),
+        ToolCommand::Call(args) => return crate::call_tool::main(args),
         ToolCommand::Get { paths, instance } => get(instance, paths).map(print_lines),
         ToolCommand::Set { pairs, instance } => set(instance, pairs).map(print_lines),
         ToolCommand::Watch {

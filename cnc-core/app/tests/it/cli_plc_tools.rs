@@ -143,3 +143,71 @@ fn get_set_and_watch_a_live_cnc_by_st_path() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("is the CNC running?"), "{err}");
 }
+
+/// `plc call`: a block of the library run against a live CNC by its name and timeline
+/// inputs, for commissioning: MC_Power, then MC_MoveAbsolute to 100 mm (exit 0, its Done
+/// reported; `plc get` reads the axis there); a move beyond the soft limit ends in the
+/// block's Error (exit 4, the code shown); bad input exits 2 before anything is sent.
+#[test]
+fn plc_call_runs_one_block_against_a_live_cnc() {
+    let instance = tests::unique_instance("plccall");
+    let dir = Scratch::new("plc-call");
+    std::fs::write(
+        dir.join("scenario.toml"),
+        "cycle_ms = 1.0\nticks = 600000\n[[axis]]\nname = \"Slide\"\nsoft_limits = [-10.0, 500.0]\n\
+         velocity = 200.0\nacceleration = 2000.0\ndeceleration = 2000.0\njerk = 50000.0\n",
+    )
+    .unwrap();
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
+        .args(["--instance", &instance, "--ticks", "600000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_until("the CNC ticks", || {
+        let (code, out, _) = tool(&instance, &["get", BEAT]);
+        code == 0 && !out.trim().ends_with(" 0")
+    });
+    let (code, out, err) = tool(&instance, &["call", "MC_Power", "axis=0", "enable=true"]);
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("Status"), "{out}");
+    let (code, out, err) = tool(
+        &instance,
+        &[
+            "call",
+            "MC_MoveAbsolute",
+            "axis=0",
+            "position=100.0",
+            "velocity=200.0",
+            "acceleration=2000.0",
+            "deceleration=2000.0",
+            "jerk=50000.0",
+        ],
+    );
+    assert_eq!(code, 0, "{out}{err}");
+    assert!(out.contains("Done"), "{out}");
+    assert_eq!(
+        get(&instance, "gpAx[0]^lr_state.command_position_acs_r"),
+        "1000000"
+    );
+    let (code, _, err) = tool(
+        &instance,
+        &[
+            "call",
+            "MC_MoveAbsolute",
+            "axis=0",
+            "position=900.0",
+            "velocity=200.0",
+            "acceleration=2000.0",
+            "deceleration=2000.0",
+            "jerk=50000.0",
+        ],
+    );
+    assert_eq!(code, 4, "{err}");
+    assert!(err.contains("ErrorID 0x4225"), "{err}");
+    let (code, _, err) = tool(&instance, &["call", "MC_Teleport", "axis=0"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(cnc.signal("TERM"));
+    let _ = cnc.wait_with_output(tests::cli::default_watchdog());
+}
