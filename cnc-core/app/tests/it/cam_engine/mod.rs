@@ -220,6 +220,20 @@ fn seed_law(periodic: bool) -> CamLaw {
     )
 }
 
+/// The first steps of a timeline on the seed cam: table 1 selected cyclic and absolute, the
+/// lifter (axis 1) coupled to the conveyor (axis 0), and the conveyor run at 360 degree/s.
+const COUPLED_AND_RUNNING: &str = r#"
+[[step]]
+at_tick = 2
+call = { block = "MC_CamTableSelect", instance = "select", axis = 1, table = 1, periodic = true, master_absolute = true, slave_absolute = true }
+[[step]]
+wait = "select.Done"
+call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1, start_mode = "absolute" }
+[[step]]
+wait = "cam.InSync"
+call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
+"#;
+
 /// A scenario `toml` whose `plc.toml` is `timeline` and whose other files are the cam
 /// examples (`scenarios/cams`).
 fn with_timeline(name: &str, toml: &str, timeline: &str) -> Scenario {

@@ -555,23 +555,17 @@ fn cam_scaling_is_done_when_its_scaling_activates() {
         acceleration = 3600.0\ndeceleration = 3600.0\njerk = 36000.0\n\
         [[axis]]\nname = \"Lifter\"\npower = true\nsoft_limits = [-100.0, 200.0]\n\
         [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
-    let timeline = r#"
-[[step]]
-at_tick = 2
-call = { block = "MC_CamTableSelect", instance = "select", axis = 1, table = 1, periodic = true, master_absolute = true, slave_absolute = true }
-[[step]]
-wait = "select.Done"
-call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1, start_mode = "absolute" }
-[[step]]
-wait = "cam.InSync"
-call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
+    let timeline = &format!(
+        "{COUPLED_AND_RUNNING}{}",
+        r#"
 [[step]]
 at_tick = 500
 call = { block = "MC_CamScaling", instance = "scale", axis = 1, activation_mode = "next_cycle", slave_scaling_mode = "auto_offset", slave_scaling = 0.5 }
 [[step]]
 wait = "scale.Done"
 call = { block = "MC_Halt", instance = "halt", axis = 0, deceleration = 3600.0, jerk = 36000.0 }
-"#;
+"#
+    );
     let s = with_timeline("scaling-done.toml", scenario, timeline);
     let mut run = InProcess::new(&s, 0).unwrap();
     let mut crossed = None;

@@ -217,16 +217,9 @@ fn reserve_points_switched_on_while_the_cam_runs_apply_at_the_next_cycle() {
             2,
         );
     assert_eq!(json.matches("IGNORE").count(), 2);
-    let timeline = r#"
-[[step]]
-at_tick = 2
-call = { block = "MC_CamTableSelect", instance = "select", axis = 1, table = 1, periodic = true, master_absolute = true, slave_absolute = true }
-[[step]]
-wait = "select.Done"
-call = { block = "MC_CamIn", instance = "cam", axis = 1, master = 0, table = 1, start_mode = "absolute" }
-[[step]]
-wait = "cam.InSync"
-call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
+    let timeline = &format!(
+        "{COUPLED_AND_RUNNING}{}",
+        r#"
 [[step]]
 at_tick = 500
 call = { block = "MC_SetCamOnlineChangeMode", instance = "mode", axis = 1, table = 1, activation_mode = "next_cycle" }
@@ -236,7 +229,8 @@ call = { block = "MC_WriteMotionFunctionPoint", instance = "p4", axis = 1, table
 [[step]]
 wait = "p4.Done"
 call = { block = "MC_WriteMotionFunctionPoint", instance = "p3", axis = 1, table = 1, point_index = 3, function_type = 1, point_type = 2, master_pos = 150.0, slave_pos = 20.0 }
-"#;
+"#
+    );
     let toml = "cycle_ms = 1.0\nticks = 3000\n\
         [[axis]]\nname = \"Conveyor\"\nkind = \"rotary\"\npower = true\nvelocity = 720.0\n\
         acceleration = 3600.0\ndeceleration = 3600.0\njerk = 36000.0\n\
