@@ -54,6 +54,9 @@ pub struct CatchUp {
     replan: [bool; MAX_CHANNEL_AXES],
     /// The axes commanded this tick were the followed ones (not the wanted).
     followed: bool,
+    /// This tick the wanted motion of some axis was faster than the axis may go: its lag
+    /// grows whatever the profile does.
+    outrun: bool,
     /// Catch-ups started since start-up.
     started: u64,
     /// Ticks whose commanded step [`CatchUp::bounded`] had to cut.
@@ -95,6 +98,7 @@ impl CatchUp {
             commanded_velocity: AxisValues::zeros(start.len()),
             replan: [false; MAX_CHANNEL_AXES],
             followed: false,
+            outrun: false,
             started: 0,
             cuts: 0,
         }
@@ -118,6 +122,12 @@ impl CatchUp {
         self.started
     }
 
+    /// Whether the wanted motion of some axis was faster than its velocity limit this tick
+    /// (its lag cannot shrink while that lasts).
+    pub fn outrun(&self) -> bool {
+        self.outrun
+    }
+
     /// Ticks whose commanded step had to be cut to the limits (the reference's acceleration
     /// jumped while a catch-up ran): rare, and the only ticks whose jerk is not the lag's.
     pub fn cuts(&self) -> u64 {
@@ -131,6 +141,7 @@ impl CatchUp {
         limits: &[AxisLimits; MAX_CHANNEL_AXES],
     ) -> Result<(), NoProfile> {
         let was_lagging = self.lagging();
+        self.outrun = false;
         for (i, p) in set_points.iter_mut().enumerate() {
             let l = limits[i];
             let change = self.reference(i, *p, l);
@@ -175,6 +186,7 @@ impl CatchUp {
             let velocity = raw.clamp(-l.velocity, l.velocity);
             let acceleration = (raw - last) / dt;
             change.velocity = velocity - (before + acceleration * dt);
+            self.outrun |= velocity != raw;
             // Still faster than the axis: the next tick steps the same way.
             (velocity, acceleration, (velocity != raw).then_some(raw))
         } else {
@@ -280,6 +292,7 @@ impl CatchUp {
             self.commanded[i] = *p;
         }
         if !self.followed {
+            self.outrun = false;
             for (i, p) in set_points.iter().enumerate() {
                 let velocity = (p - self.wanted[i]) / dt;
                 let acceleration = (velocity - self.wanted_velocity[i]) / dt;

@@ -741,3 +741,47 @@ fn a_tool_record_selected_while_tracking_moves_nothing() {
     assert_eq!(ch.tracker().state(), DynCsState::Active);
     assert!(watch.at_rest());
 }
+
+/// A switch-on without filter takes a step of any size (here 10 mm, beyond the 5 mm of
+/// `track_lag_max`) onto a master already moving. Its lag grows while the axes take up the
+/// master's velocity: a master the axes can overtake (500 mm/s against their 1000) is landed
+/// on and followed, one faster than they may go (1500 mm/s) ends in the safe stop once the
+/// lag grew 5 mm above its smallest. Every tick watched.
+#[test]
+fn a_switching_step_onto_a_moving_master_is_caught_up_unless_it_outruns_the_axes() {
+    for (top, fails) in [(1500.0, true), (500.0, false)] {
+        let program = "#TRACK CS ON [ID=0 FILTER=0 WAIT]\n#TIME 2\nM30\n";
+        let config = cartesian("slave");
+        let mut watch = StepWatch::new(&[0.0; 6], config.axis_limits(0));
+        let mut ctl = controller(vec![(config, program)]);
+        let memory = image(1);
+        let view = CncView::new(&memory);
+        let plc = PlcView::new(&memory);
+        plc.set_dyn_cs_enabled(0, true).unwrap();
+        let (mut x, mut v) = (10.0_f64, top); // mm, mm/s
+        for _ in 0..1000 {
+            let frame = cs([(x * 1e4).round() as i32, 0, 0]);
+            plc.dyn_cs_command(0).unwrap().try_send(&frame).unwrap();
+            ctl.tick(&view);
+            watch.check(ctl.channels()[0].set_points(), "slave");
+            if ctl.channels()[0].error().is_some() {
+                v = 0.0; // the master stands again: only the slave's braking is left
+            }
+            x += v * CYCLE;
+        }
+        let ch = &ctl.channels()[0];
+        if fails {
+            let error = ch
+                .error()
+                .expect("the runaway ends in an error")
+                .to_string();
+            assert!(error.contains("above the smallest lag"), "{error}");
+            assert_eq!(ch.tracker().state(), DynCsState::Error);
+            assert!(watch.at_rest(), "braked to rest");
+        } else {
+            assert!(ch.error().is_none(), "{:?}", ch.error());
+            assert_eq!(ch.tracker().state(), DynCsState::Active);
+            assert!(!ch.tracker().in_transition());
+        }
+    }
+}

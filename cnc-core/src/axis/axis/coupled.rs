@@ -100,10 +100,7 @@ impl Axis {
         if s.velocity == 0.0 && s.acceleration == 0.0 {
             self.generator.hold(s.position);
         } else {
-            // The velocity reached once the acceleration is taken out with the axis's jerk:
-            // the slave settles there without overshooting and coming back.
-            let reached = (s.velocity + s.acceleration * s.acceleration.abs() / (2.0 * d.jerk))
-                .clamp(-d.velocity, d.velocity);
+            let reached = velocity_reached(s.velocity, s.acceleration, d.jerk, d.velocity);
             self.generator.resume_from(s);
             let resumed = self.generator.run_at(
                 reached,
@@ -118,5 +115,42 @@ impl Axis {
                 self.fault(AxisError::GeneratorFailed);
             }
         }
+    }
+}
+
+/// The velocity a decoupled axis goes on at: the one it reaches once its acceleration is taken
+/// out with its jerk, so an accelerating slave settles there without overshooting and coming
+/// back. A braking slave whose acceleration would carry it through standstill comes to rest
+/// instead (0): it never runs on against the direction it was moving in.
+fn velocity_reached(velocity: f64, acceleration: f64, jerk: f64, most: f64) -> f64 {
+    let reached = velocity + acceleration * acceleration.abs() / (2.0 * jerk);
+    if reached * velocity < 0.0 || !reached.is_finite() {
+        0.0
+    } else {
+        reached.clamp(-most, most)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::velocity_reached;
+
+    #[test]
+    fn an_accelerating_slave_goes_on_at_the_velocity_it_reaches() {
+        // 20 mm/s rising at 5000 mm/s^2, jerk 1e5: 20 + 5000^2 / 2e5 = 145.
+        assert_eq!(velocity_reached(20.0, 5000.0, 1e5, 1000.0), 145.0);
+        assert_eq!(velocity_reached(-20.0, -5000.0, 1e5, 1000.0), -145.0);
+        assert_eq!(velocity_reached(900.0, 5000.0, 1e5, 1000.0), 1000.0);
+    }
+
+    #[test]
+    fn a_braking_slave_slows_down_and_never_runs_backwards() {
+        // Braking at 5000 mm/s^2 from 200 mm/s: 200 - 125 = 75, same direction.
+        assert_eq!(velocity_reached(200.0, -5000.0, 1e5, 1000.0), 75.0);
+        // From 20 mm/s the acceleration would carry it to -105 mm/s: it comes to rest.
+        assert_eq!(velocity_reached(20.0, -5000.0, 1e5, 1000.0), 0.0);
+        assert_eq!(velocity_reached(-20.0, 5000.0, 1e5, 1000.0), 0.0);
+        // From standstill the acceleration is the direction it starts in.
+        assert_eq!(velocity_reached(0.0, -5000.0, 1e5, 1000.0), -125.0);
     }
 }

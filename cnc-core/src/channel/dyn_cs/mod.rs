@@ -300,6 +300,7 @@ impl Tracker {
         self.applied = Isometry3::identity();
         self.blend = None;
         self.landing = false;
+        self.catch_up_peak = None;
         self.setup = None;
         self.tracking = None;
         self.last_master = None;

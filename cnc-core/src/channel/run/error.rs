@@ -47,6 +47,9 @@ pub struct LagExcess {
     pub max_translation: f64,
     /// The bound's angle (degrees).
     pub max_rotation: f64,
+    /// In a switching, the smallest lag of its catch-up (mm, degrees) the bound counts from
+    /// (0 while ACTIVE).
+    pub floor: (f64, f64),
 }
 
 /// What went wrong in a channel, with the values that say why.
@@ -143,7 +146,14 @@ impl fmt::Display for ChannelFault {
                 "tracking: the axes lag {:.3} mm and {:.3} degree behind the compensation, \
                  beyond track_lag_max ({} mm, {} degree)",
                 l.translation, l.rotation, l.max_translation, l.max_rotation
-            ),
+            )
+            .and_then(|()| match l.floor {
+                (0.0, 0.0) => Ok(()),
+                (t, r) => write!(
+                    f,
+                    " above the smallest lag of the switching's catch-up ({t:.3} mm, {r:.3} degree)"
+                ),
+            }),
             ChannelFault::CsWithoutTrafo => {
                 f.write_str("#CS needs an active transformation (#TRAFO ON)")
             }

@@ -176,6 +176,7 @@ impl Channel {
                 latch_pending: false,
                 lag: Default::default(),
                 lag_peak: Default::default(),
+                lag_floor: None,
             },
             plc: PlcLink {
                 inputs: ChannelInputs::default(),

@@ -33,6 +33,10 @@ pub(super) struct Safety {
     /// exactly), and the largest seen since start-up.
     pub(super) lag: Lag,
     pub(super) lag_peak: Lag,
+    /// The smallest lag of the catch-up under way (`None`: none runs). A switching's step
+    /// may be as large as the program or the PLC makes it, but its lag may only shrink: it
+    /// grows back by at most `track_lag_max` above this floor.
+    pub(super) lag_floor: Option<Lag>,
 }
 
 /// A lag at the tool: distance (mm) and angle (degrees).
@@ -85,6 +89,9 @@ impl Channel {
     /// the guard's braking or held ones.
     pub(super) fn guard_set_points(&mut self, tracked: bool) {
         self.safety.lag = Lag::default();
+        if !self.safety.guard.lagging() {
+            self.safety.lag_floor = None;
+        }
         if !self.safety.guard.latched() && (tracked || self.safety.guard.lagging()) {
             self.check_tracked_step();
         }
@@ -202,20 +209,40 @@ impl Channel {
         peak.translation = peak.translation.max(lag.translation);
         peak.rotation = peak.rotation.max(lag.rotation);
         self.safety.lag = lag;
+        self.safety.lag_floor = Some(match self.safety.lag_floor {
+            None => lag,
+            Some(floor) => Lag {
+                translation: floor.translation.min(lag.translation),
+                rotation: floor.rotation.min(lag.rotation),
+            },
+        });
     }
 
     /// A lag beyond `track_lag_max` while following the master (ACTIVE). A switching
-    /// without filter (ACTIVATING, DEACTIVATING) is caught up whatever its size: its step
-    /// is the program's or the PLC's choice.
+    /// without filter (ACTIVATING, DEACTIVATING, a frozen master taken over again) is caught
+    /// up whatever the size of its step, the program's or the PLC's choice, and its lag may
+    /// grow while the axes take up the master's velocity; but a master faster than an axis
+    /// may go (its lag can only grow) ends at the bound above the catch-up's smallest lag.
     fn lag_excess(&self) -> Option<LagExcess> {
         let bound = self.config.track_lag_max;
         let lag = self.safety.lag;
-        let beyond = lag.translation > bound.translation || lag.rotation > bound.rotation;
-        (beyond && self.pose.tracker.state() == DynCsState::Active).then_some(LagExcess {
+        let floor = match self.pose.tracker.state() {
+            DynCsState::Active => Lag::default(),
+            DynCsState::Activating | DynCsState::Deactivating
+                if self.safety.guard.catch_up().outrun() =>
+            {
+                self.safety.lag_floor.unwrap_or(lag)
+            }
+            _ => return None,
+        };
+        let beyond = lag.translation > floor.translation + bound.translation
+            || lag.rotation > floor.rotation + bound.rotation;
+        beyond.then_some(LagExcess {
             translation: lag.translation,
             rotation: lag.rotation,
             max_translation: bound.translation,
             max_rotation: bound.rotation,
+            floor: (floor.translation, floor.rotation),
         })
     }
 
