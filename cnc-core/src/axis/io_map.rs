@@ -214,11 +214,11 @@ fn resolve(entry: &Entry) -> Result<SignalMap, String> {
     if !(1..=32).contains(&entry.width) {
         return Err(format!("width {} must be 1..=32", entry.width));
     }
-    if entry.bit + entry.width > block.bits() {
+    if u64::from(entry.bit) + u64::from(entry.width) > u64::from(block.bits()) {
         return Err(format!(
             "bits {}..{} leave the {} bytes of {block_name}",
             entry.bit,
-            entry.bit + entry.width,
+            u64::from(entry.bit) + u64::from(entry.width),
             block.bits() / 8
         ));
     }
@@ -463,6 +463,10 @@ mod tests {
             (
                 r#"{ signal = "drive_out.nCtrl1", bit = 250, width = 8 }"#,
                 "leave the 32 bytes",
+            ),
+            (
+                r#"{ signal = "drive_out.nCtrl1", bit = 4294967295, width = 8 }"#,
+                "bits 4294967295..4294967303 leave the 32 bytes",
             ),
             (
                 r#"{ signal = "enc_in.nPosition", bit = 0, width = 16 }"#,

@@ -121,9 +121,10 @@ impl FifoGenerator {
         for c in 0..self.position.len() {
             let (p, a) = match high {
                 Some(high) => {
-                    let after = next.map_or(high[c], |n| n[c]);
                     let at_low = second(self.previous[c], low[c], high[c]);
-                    let at_high = second(low[c], high[c], after);
+                    // No row after `high` yet (a short queue, or the last row): the
+                    // acceleration stays the one at `low` instead of guessing a stop.
+                    let at_high = next.map_or(at_low, |n| second(low[c], high[c], n[c]));
                     let a = at_low + fraction * (at_high - at_low);
                     (
                         low[c] + fraction * (high[c] - low[c]),
@@ -209,6 +210,26 @@ mod tests {
             g.step(&mut ring, 0.5);
         }
         assert!((g.acceleration()[0] - 1250.0).abs() < 1e-6);
+    }
+
+    /// Rows of constant velocity whose queue holds no row after the current pair (the PLC has
+    /// not refilled yet): the acceleration stays 0, no stop is guessed (before: a false
+    /// deceleration of up to v / T_f).
+    #[test]
+    fn a_pair_without_a_row_after_it_keeps_its_acceleration() {
+        let mut ring = ring_of(&[0.0, 1.0, 2.0, 3.0, 4.0]);
+        let mut g = FifoGenerator::new(1, 0.001, 0.002);
+        g.start(&ring);
+        let mut last_pair = 0;
+        for _ in 0..8 {
+            g.step(&mut ring, 1.0);
+            let (p, a) = (g.position()[0], g.acceleration()[0]);
+            if p > 3.0 && p < 4.0 {
+                last_pair += 1;
+                assert!(a.abs() < 1e-9, "at {p}: {a}");
+            }
+        }
+        assert!(last_pair > 0, "the last pair was walked");
     }
 
     #[test]
