@@ -56,7 +56,9 @@ hli_struct! {
     pub struct NcEncoderOut {
         /// Mirror of the encoder input `nInData1`, copied by the NC every tick.
         pub nOutData1: i32 => [0, Cnc],
-        /// Reserved.
+        /// The value (increments) the counter is set to while a set-counter request is in
+        /// `nCtrl2` (0x01), else 0. The specification reserves this word; the use is ours
+        /// (docs/axes.md, "The encoder's register").
         pub nOutData2: i32 => [4, Cnc],
         /// Optional control (latch, encoder reset, register access).
         pub nCtrl1: u8 => [8, Cnc],
