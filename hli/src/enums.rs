@@ -518,6 +518,11 @@ hli_enum! {
         /// the axis; a new coupling of the axis, by any block, aborts it, and so does its end
         /// (MC_GearOut, MC_Stop).
         GearIn = 10,
+        /// MC_MoveSuperimposed: a relative move added to the coupled motion of a cam or gear
+        /// slave (the distance with at most the velocity difference given), beside the command
+        /// that owns the axis; a new one aborts the one running, so do the coupling's end and
+        /// an axis error.
+        MoveSuperimposed = 11,
     }
 }
 
@@ -564,6 +569,9 @@ hli_enum! {
         AxisInError = 0x4233,
         /// MC_Power off while the axis moves at speed is refused; stop first.
         MovingWhileDisable = 0x4234,
+        /// MC_MoveSuperimposed on an axis no cam or gear engine holds (a free axis, a FIFO
+        /// or channel axis): there is no coupled motion to add it to.
+        SuperimposedNotCoupled = 0x4235,
         /// The following error exceeded its limit.
         FollowingError = 0x4240,
         /// The encoder's process data are invalid (`nStatus4`).

@@ -82,6 +82,23 @@ impl CommandBook {
         id
     }
 
+    /// A command that runs beside the active one (MC_MoveSuperimposed): an id, the active
+    /// one untouched; its end is recorded with [`CommandBook::end_beside`].
+    pub fn begin_beside(&mut self) -> u32 {
+        self.next_id()
+    }
+
+    /// Records how a command begun with [`CommandBook::begin_beside`] ended.
+    pub fn end_beside(
+        &mut self,
+        id: u32,
+        kind: AxisCommandKind,
+        result: CommandResult,
+        error: Option<AxisError>,
+    ) {
+        self.record(id, kind, result, error);
+    }
+
     /// Marks the active command as having reached its goal while it keeps the axis.
     pub fn mark_reached(&mut self) {
         self.reached = self.active.is_some();

@@ -120,7 +120,7 @@ impl DriveInputs {
             dc_input_lag_r: clamp(self.input_lag_s * 1e9),
             dc_output_shift_r: clamp(self.output_shift_s * 1e9),
             undefined_inputs_r: self.undefined,
-            fill_up_1: 0,
+            superimposed_id_r: 0,
             probe_r: probes,
         }
     }

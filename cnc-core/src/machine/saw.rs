@@ -165,7 +165,7 @@ impl SawEngine {
             _ => return refused(SawError::Mode),
         };
         let m = master_values(axes, master, actual, self.cycle_s).unwrap_or_default();
-        let s = axis.setpoint();
+        let s = axis.engine_setpoint();
         let plan = match saw::plan(&request, &m, &s, axis.config().soft_limits) {
             Ok(p) => p,
             Err(e) => return refused(e),
@@ -298,7 +298,7 @@ impl Engine for SawEngine {
                 *slot = None;
                 continue;
             };
-            match s.follower.step(&m, now.setpoint(), dt) {
+            match s.follower.step(&m, now.engine_setpoint(), dt) {
                 Some((set, phase)) => {
                     io.axes.drive(s.lease, set, phase);
                     // A new plan in the tick (after a rollback): the values describe it now.

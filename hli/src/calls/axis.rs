@@ -74,6 +74,14 @@ impl AxisCommandCall {
             ..Self::motion(crate::enums::AxisCommandKind::MoveRelative).with_limits(limits)
         }
     }
+    /// MC_MoveSuperimposed by `distance` with the limits `[velocity difference,
+    /// acceleration, deceleration, jerk]`.
+    pub fn move_superimposed(distance: f64, limits: [f64; 4]) -> Self {
+        Self {
+            position: distance,
+            ..Self::motion(crate::enums::AxisCommandKind::MoveSuperimposed).with_limits(limits)
+        }
+    }
     /// MC_MoveVelocity in `direction` (1 or -1) at `limits[0]`.
     pub fn move_velocity(direction: i32, limits: [f64; 4]) -> Self {
         Self {

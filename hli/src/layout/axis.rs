@@ -130,8 +130,9 @@ hli_struct! {
         /// Input words with undefined bits or patterns (status bytes, DC times) counted
         /// since start; such a word is not used.
         pub undefined_inputs_r: u32 => [24, Cnc],
-        /// Padding.
-        pub fill_up_1: u32 => [28, Cnc],
+        /// Id of the MC_MoveSuperimposed running on the axis beside its main command (see
+        /// `HLI_AXIS_COMMAND_STATE`: its outcome goes to the same ring), 0 when none.
+        pub superimposed_id_r: u32 => [28, Cnc],
         /// The touch probes.
         pub probe_r: [HliAxisProbe; HLI_AXIS_PROBES] => [32, Cnc],
     }

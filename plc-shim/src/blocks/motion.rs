@@ -1,5 +1,5 @@
 //! PLCopen-style motion blocks for the PLC program: MC_Power, MC_Reset, MC_MoveAbsolute,
-//! MC_MoveRelative, MC_MoveVelocity, MC_Halt and MC_Stop. Each is called once per PLC cycle
+//! MC_MoveRelative, MC_MoveVelocity, MC_MoveSuperimposed, MC_Halt and MC_Stop. Each is called once per PLC cycle
 //! with its axis (the index in `gpAx`). On a rising Execute edge a block sends its command
 //! over the acyclic service without waiting; it stays Busy until the CNC answers with a
 //! command id, then follows that id in the axis's command book in the image (no further
@@ -16,7 +16,7 @@ use crate::timeline::registry::{
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
-use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
+use hli::layout::{HliAxis, HliAxisCommandState, HliAxisDriveState, HliAxisLrState};
 use hli::rpc::PendingCall;
 use hli::PlaceExt;
 
@@ -25,6 +25,9 @@ use hli::PlaceExt;
 #[derive(Debug, Default)]
 pub struct CommandCore {
     kernel: Kernel<PendingCall<AxisCommandCall>, u32>,
+    /// The command runs beside the one owning the axis (MC_MoveSuperimposed): busy while the
+    /// axis shows it as its superimposed move.
+    beside: bool,
 }
 
 fn accept(reply: AxisCommandReply) -> Accept<u32, ()> {
@@ -37,13 +40,33 @@ fn accept(reply: AxisCommandReply) -> Accept<u32, ()> {
 
 /// The outputs the command book shows for command `id` of `axis`; `finished_when_reached`:
 /// Done (and the outputs hold) once the goal is reached although the command keeps the axis.
-fn follow(io: &PlcIo<'_>, axis: u32, id: u32, finished_when_reached: bool) -> Step<()> {
-    let book: HliAxisCommandState = match io.view.axis(axis as usize) {
-        Ok(place) => place
-            .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
-            .read(),
-        Err(_) => return Step::Ended(Outputs::failed(hli::calls::ErrorCode::InvalidTarget.raw())),
+/// `beside`: the command runs beside the owning one (see [`CommandCore`]).
+fn follow(
+    io: &PlcIo<'_>,
+    axis: u32,
+    id: u32,
+    finished_when_reached: bool,
+    beside: bool,
+) -> Step<()> {
+    let Ok(place) = io.view.axis(axis as usize) else {
+        return Step::Ended(Outputs::failed(hli::calls::ErrorCode::InvalidTarget.raw()));
     };
+    let book: HliAxisCommandState = place
+        .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
+        .read();
+    let running_beside = place
+        .field::<u32>(
+            core::mem::offset_of!(HliAxis, drive_state)
+                + core::mem::offset_of!(HliAxisDriveState, superimposed_id_r),
+        )
+        .read();
+    if beside && id != 0 && running_beside == id {
+        return Step::Running(Outputs {
+            busy: true,
+            active: true,
+            ..Outputs::default()
+        });
+    }
     match view_command(&book, id) {
         CommandView::Busy(reached) if reached && finished_when_reached => Step::Ended(Outputs {
             done: true,
@@ -63,6 +86,14 @@ fn follow(io: &PlcIo<'_>, axis: u32, id: u32, finished_when_reached: bool) -> St
 }
 
 impl CommandCore {
+    /// A core for a command that runs beside the one owning the axis (MC_MoveSuperimposed).
+    pub fn beside() -> Self {
+        Self {
+            beside: true,
+            ..Self::default()
+        }
+    }
+
     /// One cycle: `call` is sent on a rising edge of `execute`. Returns the block's outputs.
     /// `finished_when_reached`: the command counts as Done once its goal is reached although it
     /// keeps the axis (MC_Stop).
@@ -74,12 +105,13 @@ impl CommandCore {
         call: impl FnOnce() -> AxisCommandCall,
         finished_when_reached: bool,
     ) -> Outputs {
+        let beside = self.beside;
         self.kernel.cycle(
             io,
             execute,
             |io| send(io, axis, &call()),
             accept,
-            |id, io, _: Waited| follow(io, axis, *id, finished_when_reached),
+            |id, io, _: Waited| follow(io, axis, *id, finished_when_reached, beside),
         )
     }
 
@@ -269,6 +301,83 @@ execute_block! {
     } => |s| AxisCommandCall::set_position(s.position), reached_is_done = true
 }
 
+/// MC_MoveSuperimposed: adds `distance` to the motion of a cam or gear slave, at most
+/// `velocity_diff` faster or slower than the coupled motion, beside the command that owns the
+/// axis. CommandAborted when a new MC_MoveSuperimposed, the coupling's end or an axis error
+/// ends it; a free axis refuses it (0x4235).
+#[derive(Debug)]
+pub struct McMoveSuperimposed {
+    /// Input: a rising edge starts the move.
+    pub execute: bool,
+    /// Input: the distance added.
+    pub distance: f64,
+    /// Input: the largest velocity difference to the coupled motion (> 0).
+    pub velocity_diff: f64,
+    /// Input: acceleration limit.
+    pub acceleration: f64,
+    /// Input: deceleration limit.
+    pub deceleration: f64,
+    /// Input: jerk limit.
+    pub jerk: f64,
+    /// Outputs of the last call.
+    pub out: Outputs,
+    core: CommandCore,
+}
+
+impl Default for McMoveSuperimposed {
+    fn default() -> Self {
+        Self {
+            execute: false,
+            distance: 0.0,
+            velocity_diff: 0.0,
+            acceleration: 0.0,
+            deceleration: 0.0,
+            jerk: 0.0,
+            out: Outputs::default(),
+            core: CommandCore::beside(),
+        }
+    }
+}
+
+impl McMoveSuperimposed {
+    /// The inputs a timeline call sets.
+    const INPUTS: &'static [InputSpec] = &[
+        input("distance", Kind::Real),
+        input("velocity_diff", Kind::Real),
+        ACCELERATION,
+        DECELERATION,
+        JERK,
+    ];
+
+    /// One cycle for `axis`.
+    pub fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) {
+        let call = AxisCommandCall::move_superimposed(
+            self.distance,
+            [
+                self.velocity_diff,
+                self.acceleration,
+                self.deceleration,
+                self.jerk,
+            ],
+        );
+        self.out = self.core.cycle(io, axis, self.execute, || call, false);
+    }
+}
+
+impl TimelineBlock for McMoveSuperimposed {
+    fn set(&mut self, key: &str, value: &Value) {
+        match (key, value) {
+            ("distance", Value::Real(v)) => self.distance = *v,
+            ("velocity_diff", Value::Real(v)) => self.velocity_diff = *v,
+            ("acceleration", Value::Real(v)) => self.acceleration = *v,
+            ("deceleration", Value::Real(v)) => self.deceleration = *v,
+            ("jerk", Value::Real(v)) => self.jerk = *v,
+            _ => {}
+        }
+    }
+    execute_cycle!(with_axis, plain);
+}
+
 /// MC_Stop: brakes to standstill and keeps the axis locked while Execute stays TRUE.
 #[derive(Debug, Default)]
 pub struct McStop {
@@ -390,6 +499,9 @@ pub const TIMELINE: &[BlockSpec] = &[
             })
         },
     ),
+    BlockSpec::on_axis("MC_MoveSuperimposed", McMoveSuperimposed::INPUTS, |_| {
+        Box::<McMoveSuperimposed>::default()
+    }),
     BlockSpec::on_axis("MC_Halt", McHalt::INPUTS, |_| Box::<McHalt>::default()),
     BlockSpec::on_axis("MC_Stop", &[DECELERATION, JERK], |_| {
         Box::<McStop>::default()

@@ -41,6 +41,7 @@ mod machine;
 mod saw_encoder;
 mod saw_engine;
 mod saw_no_alloc;
+mod saw_superimposed;
 mod scenario_paths;
 mod scenarios;
 mod soak;

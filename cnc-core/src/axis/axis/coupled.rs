@@ -10,6 +10,7 @@ impl Axis {
     pub(in crate::axis) fn couple(&mut self, coupling: Coupling) -> Result<(), AxisError> {
         self.may_move(true)?;
         self.book.finish(CommandResult::Aborted, None);
+        self.drop_superimposed(CommandResult::Aborted, None);
         self.coupled_setpoint = self.generator.state();
         self.coupling = Some(coupling);
         self.coupling_epoch = self.coupling_epoch.wrapping_add(1);
@@ -62,9 +63,11 @@ impl Axis {
     /// it steps at once from the last coupled set-point, so the motion goes on without a
     /// one-tick stall.
     pub(in crate::axis) fn decouple(&mut self) {
-        if self.coupling.take().is_none() {
+        if self.coupling.is_none() {
             return;
         }
+        self.fold_superimposed();
+        self.coupling = None;
         if self.book.active().map(|a| a.kind) == Some(AxisCommandKind::GearIn) {
             self.book.finish(CommandResult::Aborted, None);
         }

@@ -4,6 +4,7 @@
 mod coupled;
 mod encoder;
 mod image;
+mod superimposed;
 
 use super::cia402;
 use super::commands::CommandBook;
@@ -88,6 +89,7 @@ pub struct Axis {
     coupled_status: u32,
     coupling_epoch: u32,
     coupled_setpoint: Kinematic,
+    superimposed: superimposed::Superimposed,
     /// The set-point handed out by the last tick (what the actual position must match now).
     last_set: Kinematic,
     /// The encoder count read in `sense`, mirrored to `enc_out` in `act`.
@@ -125,6 +127,7 @@ impl Axis {
                 r
             },
             new_count: None,
+            superimposed: superimposed::Superimposed::new(cycle_s, config.dynamics.jerk),
             generator,
             config,
             cycle_s,
@@ -160,7 +163,7 @@ impl Axis {
     /// The set-point of the last tick.
     pub fn setpoint(&self) -> Kinematic {
         match self.coupling {
-            Some(_) => self.coupled_setpoint,
+            Some(_) => superimposed::with_offset(self.coupled_setpoint, self.superimposed.state()),
             None => self.generator.state(),
         }
     }
@@ -220,6 +223,7 @@ impl Axis {
         match kind {
             // An engine's coupling, not an axis command.
             AxisCommandKind::GearIn => Err(AxisError::InvalidParameter),
+            AxisCommandKind::MoveSuperimposed => self.superimpose(call),
             AxisCommandKind::Power => self.power(call.enable),
             AxisCommandKind::Reset => self.reset(),
             AxisCommandKind::SetPosition => self.set_position(call.position),
@@ -423,7 +427,10 @@ impl Axis {
 
     /// The evaluated drive inputs.
     pub fn drive_state(&self) -> HliAxisDriveState {
-        self.inputs.image(self.probes.image())
+        HliAxisDriveState {
+            superimposed_id_r: self.superimposed.id(),
+            ..self.inputs.image(self.probes.image())
+        }
     }
 
     /// Enables the axis as MC_Power would (for axes the CNC itself owns: channel axes).
@@ -436,6 +443,7 @@ impl Axis {
             self.error = Some(error);
         }
         self.book.finish(CommandResult::Error, Some(error));
+        self.drop_superimposed(CommandResult::Error, Some(error));
         self.coupling = None;
         self.stop_lock = false;
         // A safe set-point: stand where the axis is; the output velocity is zero.
@@ -622,8 +630,11 @@ impl Axis {
         }
         // A coupled axis (cam, gear, FIFO, channel) follows set-points no generator braked
         // for: one beyond a software limit is a fault, the axis stops where it is.
+        if self.coupling.is_some() {
+            self.step_superimposed();
+        }
         if let (Some(_), Some([min, max])) = (self.coupling, self.config.soft_limits) {
-            let p = self.coupled_setpoint.position;
+            let p = self.setpoint().position;
             if self.enabled && self.error.is_none() && !(min..=max).contains(&p) {
                 self.fault(AxisError::SoftwareLimitReached);
             }

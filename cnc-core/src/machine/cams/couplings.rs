@@ -260,7 +260,7 @@ impl CamEngine {
                 .map_err(|_| ErrorCode::InvalidData)?,
         };
         let periodic = self.select_periodic(call.table_id, profile);
-        let Some(hold) = axes.axis(slave).map(|a| a.setpoint().position) else {
+        let Some(hold) = axes.axis(slave).map(|a| a.engine_setpoint().position) else {
             return Err(ErrorCode::InvalidTarget);
         };
         let master_at = ask.master_set.position;
@@ -375,7 +375,9 @@ impl CamEngine {
         let Some(m) = master_of(axes, master, follow_actual) else {
             return code(CamCouplingError::NoSuchMaster.raw());
         };
-        let slave_at = axes.axis(slave).map_or(0.0, |a| a.setpoint().position);
+        let slave_at = axes
+            .axis(slave)
+            .map_or(0.0, |a| a.engine_setpoint().position);
         let law = match MultiTableLaw::new(&specs, m.position, slave_at) {
             Ok(law) => law,
             Err(MultiTableError::Parameter { .. }) => {

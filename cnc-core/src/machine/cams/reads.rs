@@ -288,7 +288,13 @@ impl CamEngine {
         };
         let mut values = Vec::with_capacity(40);
         values.extend_from_slice(&coupling_info(s, profile));
-        values.extend_from_slice(&position_info(s, profile, at));
+        // MC_MoveSuperimposed's offset since coupling: its sum, and part of the slave's
+        // set position.
+        let superimposed = axes.axis(slave).map_or(0.0, |a| a.superimposed_offset());
+        let mut positions = position_info(s, profile, at);
+        positions[1] = superimposed;
+        positions[3] += superimposed;
+        values.extend_from_slice(&positions);
         values.extend_from_slice(&self.queue_info(s));
         Ok(values)
     }
@@ -403,8 +409,9 @@ fn coupling_info(s: &Slave, profile: &CamProfile) -> [f64; 18] {
 }
 
 /// MC_CamInfoData's values 19 to 24 at master position `at`: the slave's offset of the
-/// cycles run since coupling, the master and slave positions, the cam's master coordinate
-/// and its unscaled value.
+/// cycles run since coupling, the superimposed sum (0 here, the axis's), the master and slave
+/// positions (the slave's without the superimposed offset), the cam's master coordinate and
+/// its unscaled value.
 fn position_info(s: &Slave, profile: &CamProfile, at: f64) -> [f64; 6] {
     let standing = Kinematic {
         position: at,

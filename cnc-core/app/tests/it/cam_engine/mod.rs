@@ -20,6 +20,7 @@ mod encoder;
 mod modes;
 mod recovery;
 mod selection;
+mod superimposed;
 
 const MASTER: usize = 0;
 const SLAVE: usize = 1;

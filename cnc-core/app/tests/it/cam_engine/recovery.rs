@@ -34,7 +34,7 @@ fn machine_to(slave_max: f64) -> InProcess {
     InProcess::new(&s, 0).unwrap()
 }
 
-fn machine() -> InProcess {
+pub(super) fn machine() -> InProcess {
     machine_to(1e5)
 }
 
@@ -45,7 +45,7 @@ fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) {
 }
 
 /// MC_CamInfo of the slave (at `at` when given): its 40 values, or the refusal's code.
-fn cam_info(run: &mut InProcess, at: Option<f64>) -> Result<Vec<f64>, u32> {
+pub(super) fn cam_info(run: &mut InProcess, at: Option<f64>) -> Result<Vec<f64>, u32> {
     let call = CamReadCall {
         what: CamReadKind::Info.raw(),
         flags: u32::from(at.is_some()),

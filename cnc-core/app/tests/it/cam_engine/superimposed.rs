@@ -1,0 +1,181 @@
+//! MC_MoveSuperimposed on a cam slave: the distance is added to the coupled motion on its own
+//! jerk-limited profile, never more than the velocity difference given faster or slower than
+//! the cam; MC_CamInfo shows the sum (SumOfSuperpositionDistance); a new move aborts the one
+//! running; the coupling's end keeps the offset without a jump; a free axis refuses it.
+
+use super::recovery::{cam_info, machine};
+use super::*;
+use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
+use hli::command_book::{view_command, CommandView};
+
+fn superimpose(run: &mut InProcess, axis: usize, distance: f64, vdiff: f64) -> AxisCommandReply {
+    let view = CncView::new(&run.memory);
+    let c = AxisCommandCall::move_superimposed(distance, [vdiff, 500.0, 500.0, 1e5]);
+    run.machine.call(&view, axis as u32, &c).unwrap()
+}
+
+fn slave(run: &InProcess) -> &cnc_core::axis::Axis {
+    run.machine.axes().axis(SLAVE).unwrap()
+}
+
+fn outcome(run: &InProcess, id: u32) -> CommandView {
+    view_command(&slave(run).book().image(), id)
+}
+
+/// The slave coupled to the stroke table (20 per master period of 360), the master at
+/// 360 mm/s for 0.2 s.
+fn coupled() -> InProcess {
+    let mut run = machine();
+    run.step(0.001);
+    select_cyclic(&mut run, 3);
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(3)), 0);
+    run_master(&mut run, 360.0);
+    for _ in 0..200 {
+        run.step(0.001);
+    }
+    run
+}
+
+#[test]
+fn a_superimposed_move_shifts_a_cam_slave_within_its_velocity_difference() {
+    let mut run = coupled();
+    let reply = superimpose(&mut run, SLAVE, 10.0, 50.0);
+    assert_eq!(reply.error_id, 0);
+    let mut ticks = 0;
+    // Running beside the cam's command: shown as the axis's superimposed move.
+    while slave(&run).drive_state().superimposed_id_r == reply.command_id {
+        run.step(0.001);
+        let (total, engine) = (slave(&run).setpoint(), slave(&run).engine_setpoint());
+        let dv = total.velocity - engine.velocity;
+        assert!(dv.abs() <= 50.0 + 1e-9, "tick {ticks}: {dv}");
+        ticks += 1;
+        assert!(ticks < 2000, "the move never ended");
+    }
+    assert_eq!(outcome(&run, reply.command_id), CommandView::Done);
+    // 10 mm at 50 mm/s: at least 0.2 s.
+    assert!(ticks >= 200, "{ticks}");
+    let (total, engine) = (slave(&run).setpoint(), slave(&run).engine_setpoint());
+    assert!((total.position - engine.position - 10.0).abs() < 1e-9);
+    assert_eq!(slave(&run).drive_state().superimposed_id_r, 0);
+    // The cam itself went on: the engine's slave is on the stroke table's line.
+    let master = set(&run, MASTER).position;
+    assert!((engine.position - 20.0 * master / 360.0).abs() < 1e-6);
+    let info = cam_info(&mut run, None).unwrap();
+    assert_eq!(info[19], 10.0, "SumOfSuperpositionDistance");
+    assert!(
+        (info[21] - total.position).abs() < 1e-6,
+        "ActualSlaveAxisPos {} vs {}",
+        info[21],
+        total.position
+    );
+}
+
+#[test]
+fn a_new_superimposed_move_aborts_the_running_one_and_goes_on_from_its_offset() {
+    let mut run = coupled();
+    let first = superimpose(&mut run, SLAVE, -4.0, 20.0);
+    assert_eq!(first.error_id, 0);
+    for _ in 0..50 {
+        run.step(0.001);
+    }
+    let reached = slave(&run).superimposed_offset();
+    assert!(reached < 0.0 && reached > -4.0, "{reached}");
+    let second = superimpose(&mut run, SLAVE, 1.0, 20.0);
+    assert_eq!(second.error_id, 0);
+    assert_eq!(outcome(&run, first.command_id), CommandView::Aborted);
+    let mut last = slave(&run).setpoint();
+    for _ in 0..1000 {
+        run.step(0.001);
+        let now = slave(&run).setpoint();
+        // No jump at the switch: within the velocity reached plus what changes in a tick.
+        assert!(
+            (now.position - last.position).abs() < 0.1,
+            "{last:?} -> {now:?}"
+        );
+        last = now;
+    }
+    assert_eq!(outcome(&run, second.command_id), CommandView::Done);
+    assert!((slave(&run).superimposed_offset() - (reached + 1.0)).abs() < 1e-9);
+}
+
+#[test]
+fn the_coupling_end_keeps_the_offset_and_a_free_axis_refuses() {
+    let mut run = coupled();
+    // A free axis (the master) and limits beyond the axis's are refused, nothing changes.
+    let free = superimpose(&mut run, MASTER, 1.0, 10.0);
+    assert_eq!(free.error_id, AxisError::SuperimposedNotCoupled.raw());
+    let bad = superimpose(&mut run, SLAVE, 1.0, 0.0);
+    assert_eq!(bad.error_id, AxisError::InvalidVelocity.raw());
+    let nan = superimpose(&mut run, SLAVE, f64::NAN, 10.0);
+    assert_eq!(nan.error_id, AxisError::TargetOutsideLimits.raw());
+    assert_eq!(slave(&run).superimposed_offset(), 0.0);
+    // Half-way through a move the slave is decoupled: the move is aborted, the slave goes on
+    // from where it stood with the offset, without a jump.
+    let running = superimpose(&mut run, SLAVE, 5.0, 50.0);
+    for _ in 0..60 {
+        run.step(0.001);
+    }
+    let before = slave(&run).setpoint();
+    assert_eq!(call(&mut run, SLAVE as u32, CamOutCall::default()), 0);
+    assert_eq!(outcome(&run, running.command_id), CommandView::Aborted);
+    run.step(0.001);
+    let after = slave(&run).setpoint();
+    assert!(slave(&run).coupling().is_none());
+    assert_eq!(slave(&run).superimposed_offset(), 0.0);
+    let expected = before.position + before.velocity * 0.001;
+    assert!(
+        (after.position - expected).abs() < 1e-3,
+        "{before:?} -> {after:?}"
+    );
+}
+
+/// The PLC block: MC_MoveSuperimposed is Busy while it runs beside MC_CamIn (which stays
+/// InSync), Done at its end; a second one started while the first runs aborts it
+/// (CommandAborted); on the free master it ends with 0x4235.
+#[test]
+fn the_plc_block_runs_beside_the_cam_and_reports_done_aborted_and_refused() {
+    let timeline = format!(
+        "{COUPLED_AND_RUNNING}{}",
+        r#"
+[[step]]
+at_tick = 600
+call = { block = "MC_MoveSuperimposed", instance = "shift", axis = 1, distance = 3.0, velocity_diff = 20.0, acceleration = 200.0, deceleration = 200.0, jerk = 1e4 }
+[[step]]
+wait = "shift.Done"
+call = { block = "MC_MoveSuperimposed", instance = "first", axis = 1, distance = 20.0, velocity_diff = 20.0, acceleration = 200.0, deceleration = 200.0, jerk = 1e4 }
+[[step]]
+at_tick = 1400
+call = { block = "MC_MoveSuperimposed", instance = "second", axis = 1, distance = -1.0, velocity_diff = 20.0, acceleration = 200.0, deceleration = 200.0, jerk = 1e4 }
+[[step]]
+at_tick = 1410
+call = { block = "MC_MoveSuperimposed", instance = "free", axis = 0, distance = 1.0, velocity_diff = 20.0, acceleration = 200.0, deceleration = 200.0, jerk = 1e4 }
+"#
+    );
+    let toml = "cycle_ms = 1.0\nticks = 3000\n\
+        [[axis]]\nname = \"Conveyor\"\nkind = \"rotary\"\npower = true\nvelocity = 720.0\n\
+        acceleration = 3600.0\ndeceleration = 3600.0\njerk = 36000.0\n\
+        [[axis]]\nname = \"Lifter\"\npower = true\nsoft_limits = [-10.0, 100.0]\n\
+        [[cam_table]]\nfile = \"seed_example.json\"\n[plc]\ntimeline = \"plc.toml\"\n";
+    let s = with_timeline("superimposed.toml", toml, &timeline);
+    let run = InProcess::run_through(&s).unwrap();
+    let summary = run.timeline.as_ref().unwrap().summary();
+    let line = |name: &str| {
+        summary
+            .lines()
+            .find(|l| l.starts_with(&format!("block {name} ")))
+            .unwrap_or_else(|| panic!("{name}: {summary}"))
+            .to_string()
+    };
+    assert!(line("shift").contains("Done "), "{summary}");
+    assert!(line("first").contains("CommandAborted "), "{summary}");
+    assert!(line("second").contains("Done "), "{summary}");
+    assert!(line("free").contains("ErrorID 0x4235"), "{summary}");
+    assert!(!line("cam").contains("CommandAborted"), "{summary}");
+    let offset = run
+        .machine
+        .axes()
+        .axis(SLAVE)
+        .unwrap()
+        .superimposed_offset();
+    assert!(offset > 3.0 && offset < 23.0, "{offset}");
+}

@@ -1,0 +1,96 @@
+//! MC_MoveSuperimposed on a flying-saw slave in its synchronous phase: the distance is added
+//! to the gear's motion (the saw's own follower goes on undisturbed, in its frame) and the
+//! slave runs at the master's velocity again once it is done.
+
+use cnc_app::scenario::{InProcess, Scenario};
+use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::{SawGearInCall, SawSyncTarget};
+use hli::command_book::{view_command, CommandView};
+use hli::enums::AxisState;
+use hli::views::CncView;
+
+const MASTER: u32 = 0;
+const SAW: u32 = 1;
+
+fn machine() -> InProcess {
+    let axis = |name: &str| {
+        format!(
+            "[[axis]]\nname = \"{name}\"\npower = true\nvelocity = 3000.0\nacceleration = 20000.0\n\
+             deceleration = 20000.0\njerk = 1e7\nfollowing_error_limit = 1e4\n"
+        )
+    };
+    let toml = format!(
+        "cycle_ms = 1.0\nticks = 10\n{}{}",
+        axis("Master"),
+        axis("Saw")
+    );
+    let s = Scenario::parse("saw.toml", &toml, |_| unreachable!()).unwrap();
+    let mut run = InProcess::new(&s, 0).unwrap();
+    run.step(0.001);
+    run
+}
+
+fn command(
+    run: &mut InProcess,
+    axis: u32,
+    c: AxisCommandCall,
+) -> hli::calls::axis::AxisCommandReply {
+    let view = CncView::new(&run.memory);
+    run.machine.call(&view, axis, &c).unwrap()
+}
+
+#[test]
+fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_again() {
+    let mut run = machine();
+    let forward = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, forward).error_id, 0);
+    let gear = SawGearInCall {
+        master: MASTER,
+        target: SawSyncTarget::Velocity.raw(),
+        ratio_numerator: 1.0,
+        ratio_denominator: 1,
+        acceleration: 2500.0,
+        deceleration: 2500.0,
+        jerk: 5000.0,
+        ..SawGearInCall::default()
+    };
+    let view = CncView::new(&run.memory);
+    assert_eq!(run.machine.call(&view, SAW, &gear).unwrap().error_id, 0);
+    // The saw's phase, set velocity and the engine's velocity.
+    let saw = |run: &InProcess| {
+        let a = run.machine.axes().axis(SAW as usize).unwrap();
+        let set = a.setpoint();
+        (
+            a.motion_state(set).raw(),
+            set.velocity,
+            a.engine_setpoint().velocity,
+        )
+    };
+    let mut synchronous = false;
+    for _ in 0..5000 {
+        run.step(0.001);
+        let (state, _, _) = saw(&run);
+        if state == AxisState::SlaveSynchronous.raw() {
+            synchronous = true;
+            break;
+        }
+    }
+    assert!(synchronous, "the saw never synchronised");
+    let shift = AxisCommandCall::move_superimposed(10.0, [100.0, 1000.0, 1000.0, 1e5]);
+    let reply = command(&mut run, SAW, shift);
+    assert_eq!(reply.error_id, 0);
+    for _ in 0..2000 {
+        run.step(0.001);
+    }
+    let axis = run.machine.axes().axis(SAW as usize).unwrap();
+    assert_eq!(
+        view_command(&axis.book().image(), reply.command_id),
+        CommandView::Done
+    );
+    assert_eq!(axis.superimposed_offset(), 10.0);
+    let (state, velocity, engine_velocity) = saw(&run);
+    assert_eq!(state, AxisState::SlaveSynchronous.raw());
+    let master = run.machine.axes().axis(MASTER as usize).unwrap().setpoint();
+    assert!((velocity - master.velocity).abs() < 1e-9, "{velocity}");
+    assert!((engine_velocity - velocity).abs() < 1e-9);
+}
