@@ -89,6 +89,43 @@ impl RotationOrder {
     }
 }
 
+impl RotationOrder {
+    /// The angles of `rotation` nearest to `near` (degrees): of the two solutions each
+    /// convention has (the middle angle mirrored, the outer ones turned by 180 degree) and,
+    /// in a gimbal-locked position, the one whose first angle stays `near`'s, the one closest
+    /// to `near` with every angle taken to within 180 degree of it. Axes that follow a turning
+    /// frame word by word so pass a middle angle of 0 (Z-Y-Z) or +-90 degree without their
+    /// outer axes flipping, and never wrap by 360 degree.
+    pub fn angles_near(self, rotation: &Rotation3<f64>, near: [f64; 3]) -> [f64; 3] {
+        let [a, b, c] = self.angles(rotation);
+        let fits =
+            |v: &[f64; 3]| (self.rotation(*v).matrix() - rotation.matrix()).abs().max() <= 1e-9;
+        let turn = near[0] - a;
+        let candidates = [
+            [a, b, c],
+            [a + 180.0, -b, c + 180.0],
+            [a + 180.0, 180.0 - b, c + 180.0],
+            [a + 180.0, -180.0 - b, c + 180.0],
+            [near[0], b, c + turn],
+            [near[0], b, c - turn],
+        ];
+        let unwrap = |v: [f64; 3]| {
+            let mut out = v;
+            for (x, n) in out.iter_mut().zip(near) {
+                *x = n + (*x - n + 180.0).rem_euclid(360.0) - 180.0;
+            }
+            out
+        };
+        let distance = |v: &[f64; 3]| v.iter().zip(near).map(|(x, n)| (x - n).abs()).sum::<f64>();
+        candidates
+            .into_iter()
+            .filter(|v| v.iter().all(|x| x.is_finite()) && fits(v))
+            .map(unwrap)
+            .min_by(|x, y| distance(x).total_cmp(&distance(y)))
+            .unwrap_or([a, b, c])
+    }
+}
+
 const GIMBAL_EPS: f64 = 1e-12;
 
 /// Angles `[x, y, z]` (radians) of `Rz(z) * Ry(y) * Rx(x)`.
@@ -200,6 +237,51 @@ mod tests {
         RotationOrder::Cba,
         RotationOrder::Zyx,
     ];
+
+    /// A frame tilting through the middle angle's zero (Z-Y-Z) and through +-90 degree
+    /// (the Z-Y-X conventions) in one plane, word by word from the last words: the middle
+    /// angle passes continuously, the outer ones stay (no 180 degree flip), and a turn past
+    /// 180 degree goes on past it instead of wrapping to -180.
+    #[test]
+    fn angles_near_the_last_ones_pass_the_singular_positions_continuously() {
+        for (order, (a, c), middles) in [
+            (
+                RotationOrder::EulerZyz,
+                (90.0, 10.0),
+                [3.0, 1.0, 0.0, -1.0, -3.0],
+            ),
+            (
+                RotationOrder::Zyx,
+                (20.0, 30.0),
+                [87.0, 89.0, 90.0, 91.0, 93.0],
+            ),
+            (
+                RotationOrder::YawPitchRoll,
+                (20.0, 30.0),
+                [-87.0, -89.0, -90.0, -91.0, -93.0],
+            ),
+        ] {
+            let mut last = [a, middles[0], c];
+            for m in middles {
+                let r = order.rotation([a, m, c]);
+                let got = order.angles_near(&r, last);
+                assert!(
+                    rot_close(&order.rotation(got), &r, 1e-9),
+                    "{order:?} {got:?}"
+                );
+                if (m as f64).abs() != 90.0 && m != 0.0 {
+                    for (g, w) in got.iter().zip([a, m, c]) {
+                        assert!((g - w).abs() < 1e-6, "{order:?} at {m}: {got:?}");
+                    }
+                }
+                last = got;
+            }
+        }
+        // Past 180 degree about Z without a wrap.
+        let r = RotationOrder::Zyx.rotation([0.0, 0.0, -179.0]);
+        let got = RotationOrder::Zyx.angles_near(&r, [0.0, 0.0, 179.5]);
+        assert!((got[2] - 181.0).abs() < 1e-9, "{got:?}");
+    }
 
     fn rot_close(a: &Rotation3<f64>, b: &Rotation3<f64>, tol: f64) -> bool {
         (a.matrix() - b.matrix()).abs().max() <= tol

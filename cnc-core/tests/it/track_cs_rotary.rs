@@ -137,3 +137,40 @@ fn the_static_offset_turns_z_then_y_then_x_in_every_convention() {
         );
     }
 }
+
+/// Euler Z-Y-Z (convention 1): a master that tilts about X through B = 0 (A-90 B2 C90 to
+/// A-90 B-2 C90, each a turn about X) is followed word by word through the singular
+/// orientation: the slave's B passes 0 and its A and C stay, instead of flipping by 180
+/// degree (which stopped the slave beyond its lag bound).
+#[test]
+fn an_euler_zyz_slave_follows_a_tilt_through_the_singular_orientation() {
+    let master = format!(
+        "{MASTER_ON}#TIME 0.05\nG1 A-90 B2 C90 F30000\n#TIME 0.1\nG1 B-2 F3000\n#TIME 0.2\nM30\n"
+    );
+    let (mut m, mut s) = (cartesian("master"), cartesian("slave"));
+    m.ori_rotation_angle = 1;
+    s.ori_rotation_angle = 1;
+    let mut ctl = controller(vec![(m, master.as_str()), (s, TRACK)]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    let mut a_seen = (f64::MAX, f64::MIN);
+    for _ in 0..3000 {
+        ctl.tick(&view);
+        let b = ctl.channels()[1].set_points()[4];
+        if ctl.channels()[0].set_points()[3] < -89.999 && b.abs() < 2.0 {
+            let a = ctl.channels()[1].set_points()[3];
+            a_seen = (a_seen.0.min(a), a_seen.1.max(a));
+        }
+    }
+    for c in ctl.channels() {
+        assert_ne!(c.state(), RunState::Error, "{:?}", c.error());
+    }
+    let words =
+        |i: usize| -> [f64; 6] { core::array::from_fn(|k| ctl.channels()[i].set_points()[k]) };
+    assert_words(words(0), [0.0, 0.0, 0.0, -90.0, -2.0, 90.0], "the master");
+    assert_words(words(1), words(0), "the slave");
+    assert!(
+        a_seen.0 > -90.01 && a_seen.1 < -89.99,
+        "A stayed (within the rounding near B = 0) while B passed 0: {a_seen:?}"
+    );
+}

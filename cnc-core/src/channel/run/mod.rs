@@ -170,6 +170,7 @@ impl Channel {
                 tool: Isometry3::identity(),
                 interface_on: false,
                 published: None,
+                compensation_abc: [0.0; 3],
             },
             safety: Safety {
                 guard: JointGuard::new(&set_points, &axis_limits, cycle_s),

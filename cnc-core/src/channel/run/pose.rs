@@ -26,6 +26,9 @@ pub(super) struct Pose {
     /// `#CHANNEL INTERFACE ON`: the channel publishes its tool frame.
     pub(super) interface_on: bool,
     pub(super) published: Option<MasterSample>,
+    /// The compensation's A, B, C words applied last tick (without `#TRAFO`): the next ones
+    /// are the solution nearest them, so the axes pass a singular orientation continuously.
+    pub(super) compensation_abc: [f64; 3],
 }
 
 impl Channel {
@@ -122,11 +125,16 @@ impl Channel {
             let tracking = self.pose.tracker.state() != DynCsState::Inactive;
             // Axis by axis: the compensation's angles in the channel's own convention, the
             // one its A, B and C words (and the master's published frame) are written in.
-            let mut c = if tracking {
-                words_in(&compensation, self.pose.order)
-            } else {
-                [0.0; 6]
-            };
+            let mut c = [0.0; 6];
+            if tracking {
+                let t = compensation.translation.vector;
+                let abc = self.pose.order.angles_near(
+                    &compensation.rotation.to_rotation_matrix(),
+                    self.pose.compensation_abc,
+                );
+                c = [t.x, t.y, t.z, abc[0], abc[1], abc[2]];
+            }
+            self.pose.compensation_abc = [c[3], c[4], c[5]];
             if self.pose.tracker.option() == TrackingOption::TranslationOnly {
                 c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
             }
