@@ -30,4 +30,5 @@ mod saw_plan;
 mod touch_probe;
 mod track_cs_language;
 mod track_cs_rotary;
+mod tracking_plc_rate;
 mod tracking_safety;

@@ -29,6 +29,7 @@ mod interpret;
 mod joint_caps;
 mod motion;
 mod plc;
+mod plc_frames;
 mod pose;
 mod safety;
 mod tool;
@@ -183,6 +184,7 @@ impl Channel {
                 inputs: ChannelInputs::default(),
                 outputs: ChannelOutputs::default(),
                 plc_frame: None,
+                frames: Default::default(),
                 plc_enabled: false,
                 m_next_id: 0,
                 m_functions_acked: 0,

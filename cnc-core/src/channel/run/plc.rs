@@ -12,6 +12,8 @@ pub(super) struct PlcLink {
     /// enabled.
     pub(super) plc_frame: Option<Isometry3<f64>>,
     pub(super) plc_enabled: bool,
+    /// The frames the PLC wrote, carried on between its cycles into `plc_frame`.
+    pub(super) frames: super::plc_frames::PlcFrames,
     /// Request id of the last M-function announcement.
     pub(super) m_next_id: u32,
     pub(super) m_functions_acked: u64,

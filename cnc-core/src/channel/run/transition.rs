@@ -17,15 +17,20 @@ impl Channel {
         }
         let enabled = self.plc.inputs.dyn_cs_enabled;
         self.plc.plc_enabled = enabled;
+        self.plc.frames.advance();
         if let Some(cs) = self.plc.inputs.dyn_cs_command {
             // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
             // nowhere (taken, so the PLC's semaphore is free again, and counted).
             if enabled {
-                self.plc.plc_frame = Some(frame_from_hli(&cs, RotationOrder::Zyx));
+                self.plc
+                    .frames
+                    .take(frame_from_hli(&cs, RotationOrder::Zyx));
             } else {
                 self.pose.tracker.not_redirected();
             }
         }
+        // Between the cycles of a slower PLC task, carried on (see `plc_frames`).
+        self.plc.plc_frame = self.plc.frames.now();
         self.take_transition(enabled);
     }
 

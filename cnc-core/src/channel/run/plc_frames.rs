@@ -1,0 +1,122 @@
+//! The PLC master's frames between its cycles. A PLC task that runs every N-th NC tick
+//! (`plc --period-ticks N`) writes a new frame only every N ticks; held in between, a moving
+//! master would reach the tracking as a staircase (standing, then jumping N ticks' travel)
+//! that no axis can follow within its limits. For the ticks until the next frame is due the
+//! frame is extrapolated along the last two frames' motion (translation and rotation, at their
+//! spacing); a frame that does not come in time is not extrapolated further: the master is
+//! taken where the PLC last put it (the catch-up takes the small step back).
+
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+/// Frames further apart than this many ticks are not a periodic writer: held, not
+/// extrapolated.
+pub(super) const MAX_PERIOD_TICKS: u64 = 16;
+
+/// The last two frames the PLC wrote and when.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct PlcFrames {
+    tick: u64,
+    last: Option<(Isometry3<f64>, u64)>,
+    previous: Option<(Isometry3<f64>, u64)>,
+}
+
+impl PlcFrames {
+    /// A new tick: call before [`PlcFrames::take`] and [`PlcFrames::now`].
+    pub(super) fn advance(&mut self) {
+        self.tick += 1;
+    }
+
+    /// The PLC wrote `frame` this tick.
+    pub(super) fn take(&mut self, frame: Isometry3<f64>) {
+        self.previous = self.last;
+        self.last = Some((frame, self.tick));
+    }
+
+    /// The master's frame this tick: the one written now, or the last one carried on along
+    /// the motion of the last two until the next is due, else the last one.
+    pub(super) fn now(&self) -> Option<Isometry3<f64>> {
+        let (last, at) = self.last?;
+        let since = self.tick - at;
+        let Some((before, then)) = self.previous else {
+            return Some(last);
+        };
+        let period = at - then;
+        if since == 0 || period == 0 || period > MAX_PERIOD_TICKS || since >= period {
+            return Some(last);
+        }
+        Some(extrapolated(&before, &last, since as f64 / period as f64))
+    }
+}
+
+/// `last` carried on by `share` of the motion from `before` to `last`.
+fn extrapolated(before: &Isometry3<f64>, last: &Isometry3<f64>, share: f64) -> Isometry3<f64> {
+    let step = last.translation.vector - before.translation.vector;
+    let turn: UnitQuaternion<f64> = last.rotation * before.rotation.inverse();
+    let turned = turn.powf(share) * last.rotation;
+    let frame = Isometry3::from_parts(
+        Translation3::from(last.translation.vector + step * share),
+        turned,
+    );
+    let finite = frame.translation.vector.iter().all(|v| v.is_finite())
+        && frame.rotation.coords.iter().all(|v| v.is_finite());
+    if finite {
+        frame
+    } else {
+        *last
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    fn frame(x: f64, deg: f64) -> Isometry3<f64> {
+        Isometry3::new(Vector3::new(x, 0.0, 0.0), Vector3::z() * deg.to_radians())
+    }
+
+    /// Every third tick a frame 3 mm and 3 degree on: the ticks between lie on the line.
+    #[test]
+    fn frames_of_a_slower_task_are_carried_on_between_its_cycles() {
+        let mut f = PlcFrames::default();
+        for tick in 0..12u32 {
+            f.advance();
+            if tick % 3 == 0 {
+                f.take(frame(f64::from(tick), f64::from(tick)));
+            }
+            let now = f.now().unwrap();
+            if tick >= 3 {
+                let want = frame(f64::from(tick), f64::from(tick));
+                assert!((now.translation.vector - want.translation.vector).norm() < 1e-12);
+                assert!(now.rotation.angle_to(&want.rotation) < 1e-12, "tick {tick}");
+            }
+        }
+    }
+
+    /// A frame that does not come when due (the master stopped, or the PLC writes only on a
+    /// change): the master is taken where the PLC last put it; frames far apart (a single
+    /// step) are never extrapolated.
+    #[test]
+    fn a_late_frame_holds_the_last_and_rare_frames_are_not_carried_on() {
+        let mut f = PlcFrames::default();
+        for tick in 0..4u32 {
+            f.advance();
+            if tick % 2 == 0 {
+                f.take(frame(f64::from(tick), 0.0));
+            }
+        }
+        // Frames at ticks 0 and 2; tick 3 carried on to 3.
+        assert!((f.now().unwrap().translation.x - 3.0).abs() < 1e-12);
+        f.advance(); // tick 4: no frame, due: the last one
+        assert_eq!(f.now().unwrap().translation.x, 2.0);
+        let mut g = PlcFrames::default();
+        g.advance();
+        g.take(frame(0.0, 0.0));
+        for _ in 0..20 {
+            g.advance();
+        }
+        g.take(frame(0.1, 0.0));
+        g.advance();
+        assert_eq!(g.now().unwrap().translation.x, 0.1);
+    }
+}
