@@ -150,7 +150,14 @@ fn run(args: &CallArgs) -> Result<String, Ended> {
 /// InVelocity or Status (MC_Power), exit 4 for Error or CommandAborted.
 fn outcome(report: &str) -> Option<Result<String, Ended>> {
     let line = report.lines().find(|l| l.starts_with("block call "))?;
-    let rose = |output: &str| line.contains(&format!("{output} "));
+    // The outputs after "): ", each "Name tick (xN)": matched by name, never inside the
+    // block's own name (MC_ReadStatus ...).
+    let outputs = line.split_once("): ").map_or("", |(_, o)| o);
+    let rose = |output: &str| {
+        outputs
+            .split(", ")
+            .any(|item| item.split_whitespace().next() == Some(output))
+    };
     if rose("Error") || rose("CommandAborted") {
         return Some(Err(Ended(4, report.trim_end().to_string())));
     }
@@ -216,5 +223,10 @@ mod tests {
         let failed =
             "block call (MC_MoveAbsolute on gpAx[0]): Busy 2 (x1), Error 3 (x1), ErrorID 0x4225\n";
         assert!(matches!(outcome(failed), Some(Err(Ended(4, _)))));
+        // A block whose name ends like an output has not ended by its name.
+        let named = "block call (FiFoGetStatus on gpFifo[0]): Busy 2 (x1)\n";
+        assert!(outcome(named).is_none());
+        let named_done = "block call (MC_ReadDone on gpAx[0]): Busy 2 (x1)\n";
+        assert!(outcome(named_done).is_none());
     }
 }
