@@ -47,7 +47,7 @@ pub fn fifo_library_version() -> &'static str {
 
 /// Error id of a row block that does not fit one call (more than
 /// [`FIFO_BLOCK_VALUES`] values, or rows x columns not the slice given): refused in the PLC.
-pub const ERROR_BLOCK_SIZE: u32 = hli::enums::FifoError::BlockSize as u32;
+pub const ERROR_BLOCK_SIZE: u32 = hli::enums::FifoError::BlockSize.raw();
 
 /// The CNC's answer to a FIFO call: Done with its reply, or Error with its code (the reply
 /// beside it: the FIFO's state and fill level).
