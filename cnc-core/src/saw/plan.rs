@@ -290,6 +290,7 @@ pub fn plan(
             k0,
             c0,
             k1: req.ratio * dir,
+            accelerated: master_acc != 0.0 || slave_acc != 0.0,
         };
         match req.on {
             SyncOn::Velocity => (travel.on_velocity(req), None),
@@ -347,6 +348,8 @@ struct TravelFrame {
     c0: f64,
     /// Sync slope.
     k1: f64,
+    /// Master or slave accelerated at coupling (after IGNOREMASTERACC / IGNORESLAVEACC).
+    accelerated: bool,
 }
 
 impl TravelFrame {
@@ -401,8 +404,12 @@ impl TravelFrame {
                 )],
             )
         };
-        // Optimisations only for a master and slave without acceleration at coupling.
-        if self.c0 != 0.0 {
+        // Optimisations only for a master and slave without acceleration at coupling (seed
+        // 001, chapter 7: both axes must be free of acceleration when they couple).
+        // The curvature `c0` alone is 0 for a standing slave under an accelerating master
+        // (and for a slave accelerating with k0 x the master's), so the master's acceleration
+        // is asked for itself: either one accelerated gives the checked plain P5.
+        if self.accelerated || self.c0 != 0.0 {
             return (p5(), None);
         }
         if self.k0 == self.k1 && (d - self.k1 * x).abs() <= SLACK * (1.0 + d.abs()) {

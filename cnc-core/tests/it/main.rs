@@ -25,10 +25,12 @@ mod nc_props;
 mod nc_rs274;
 mod nc_seed;
 mod robot_config;
+mod saw_manual_checks;
 mod saw_plan;
 
 mod touch_probe;
 mod track_cs_language;
 mod track_cs_rotary;
+mod track_cs_gaps;
 mod tracking_plc_rate;
 mod tracking_safety;
