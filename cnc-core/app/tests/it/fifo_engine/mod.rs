@@ -520,4 +520,5 @@ fn refusals_leave_the_rows_alone() {
     assert_eq!(r.error_id, FifoError::Running.raw());
 }
 
+mod manual_gaps;
 mod members;
