@@ -182,6 +182,14 @@ impl TryFrom<Vec<Entry>> for ImageMap {
             map.mapped[signal.block.index()] = true;
             map.entries[k] = Some(signal);
         }
+        // A mapped encoder input whose count is not mapped would read a count of 0 for ever.
+        let count = |e: &SignalMap| e.block == Block::EncIn && e.name == "nInData1";
+        if map.mapped[Block::EncIn.index()] && !map.entries.iter().flatten().any(count) {
+            return Err(MapError {
+                entry: list.len() - 1,
+                reason: "enc_in is mapped without enc_in.nInData1, the encoder's count".into(),
+            });
+        }
         Ok(map)
     }
 }
@@ -467,6 +475,10 @@ mod tests {
             (
                 r#"{ signal = "drive_out.nCtrl1", bit = 4294967295, width = 8 }"#,
                 "bits 4294967295..4294967303 leave the 32 bytes",
+            ),
+            (
+                r#"{ signal = "enc_in.nStatus1", bit = 0, width = 8 }"#,
+                "enc_in is mapped without enc_in.nInData1",
             ),
             (
                 r#"{ signal = "enc_in.nPosition", bit = 0, width = 16 }"#,
