@@ -211,3 +211,84 @@ fn plc_call_runs_one_block_against_a_live_cnc() {
     assert!(cnc.signal("TERM"));
     let _ = cnc.wait_with_output(tests::cli::default_watchdog());
 }
+
+/// Commissioning a flying saw without a PLC program (manual 001, chapter 11): `plc call`
+/// runs the master on MC_MoveVelocity (InVelocity), couples the saw with MC_GearInVelo at
+/// half the master's velocity (InSync: the image shows it synchronous, state 13, coupled),
+/// and MC_GearOut decouples it (Done, the saw free at the velocity it had).
+#[test]
+fn plc_call_commissions_a_flying_saw() {
+    let instance = tests::unique_instance("plccallsaw");
+    let dir = Scratch::new("plc-call-saw");
+    let axis = |name: &str| {
+        format!(
+            "[[axis]]\nname = \"{name}\"\npower = true\nsoft_limits = [-1000.0, 1e6]\nvelocity = 1000.0\n\
+             acceleration = 5000.0\ndeceleration = 5000.0\njerk = 100000.0\n"
+        )
+    };
+    std::fs::write(
+        dir.join("scenario.toml"),
+        format!(
+            "cycle_ms = 1.0\nticks = 600000\n{}{}",
+            axis("Master"),
+            axis("Saw")
+        ),
+    )
+    .unwrap();
+    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
+        .args(["--instance", &instance, "--ticks", "600000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    wait_until("the CNC ticks", || {
+        let (code, out, _) = tool(&instance, &["get", BEAT]);
+        code == 0 && !out.trim().ends_with(" 0")
+    });
+    let calls: [&[&str]; 3] = [
+        &[
+            "MC_MoveVelocity",
+            "axis=0",
+            "direction=1",
+            "velocity=200.0",
+            "acceleration=5000.0",
+            "deceleration=5000.0",
+            "jerk=100000.0",
+        ],
+        &[
+            "MC_GearInVelo",
+            "Master=0",
+            "Slave=1",
+            "RatioNumerator=0.5",
+            "RatioDenominator=1",
+            "Acceleration=2500.0",
+            "Deceleration=2500.0",
+            "Jerk=50000.0",
+        ],
+        &["MC_GearOut", "Slave=1"],
+    ];
+    for (k, (call, ends)) in calls
+        .iter()
+        .zip(["InVelocity", "InSync", "Done"])
+        .enumerate()
+    {
+        let mut args = vec!["call"];
+        args.extend_from_slice(call);
+        let (code, out, err) = tool(&instance, &args);
+        assert_eq!(code, 0, "{call:?}: {out}{err}");
+        assert!(out.contains(ends), "{call:?}: {out}");
+        if k == 1 {
+            assert_eq!(get(&instance, "gpAx[1]^lr_state.axis_state_r"), "13");
+            assert_ne!(get(&instance, "gpAx[1]^lr_state.coupling_state_r"), "0");
+            // Half the master's 200 mm/s, in 0.1 um/s.
+            assert_eq!(
+                get(&instance, "gpAx[1]^lr_state.command_velocity_r"),
+                "1000000"
+            );
+        }
+    }
+    assert_eq!(get(&instance, "gpAx[1]^lr_state.coupling_state_r"), "0");
+    assert!(cnc.signal("TERM"));
+    let _ = cnc.wait_with_output(tests::cli::default_watchdog());
+}
