@@ -5,6 +5,7 @@ mod axes;
 mod axis_no_alloc;
 mod cam_coupling;
 mod cam_laws;
+mod cam_manual_numbers;
 mod cam_multi_table;
 mod cam_online;
 mod cam_props;

@@ -314,6 +314,9 @@ impl CompatBlock {
                 if c.kind == "CamTableReadData" {
                     self.read.request.rows = c.rows_to_read;
                     self.read.refuse = read_array_refusal(&c);
+                    // Rows to read 0 is all the table's rows, a count only the answer
+                    // tells: the array's size is checked against it then (0x4B31).
+                    self.read.size_limit = c.size.map(|bytes| bytes as usize / 8);
                 }
                 // iBlockSize in numbers of 8 bytes (0: the reply's room).
                 self.read.request.part_len = c.block_size / 8;
@@ -452,7 +455,9 @@ pub const TIMELINE: &[BlockSpec] = compat_blocks![
 
 /// CamTableReadData's array against what it asks for (seed 000 5.2.1.5): a column count other
 /// than the table's 2 is 0x4B37; rows to read that do not fit the array's size in bytes (8 a
-/// number) are 0x4B31. `None`: the read may go.
+/// number) are 0x4B31. `None`: the read may go. Rows to read 0 means all the table's rows,
+/// which the block does not know before the answer: that read goes, and the array's size
+/// (`McCamRead::size_limit`, else its room) refuses an answer it cannot hold with 0x4B31.
 fn read_array_refusal(c: &CompatConfig) -> Option<u32> {
     if c.columns != 2 {
         return Some(0x4B37);

@@ -13,12 +13,17 @@ use hli::rpc::PendingCall;
 /// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
 pub const ERROR_ARRAY_SIZE: u32 = 0x4B31;
 
+/// MC_ERROR_NUMCOLUMNS_INVALID: the array's column count does not match what is read.
+pub const ERROR_COLUMNS: u32 = 0x4B37;
+
 /// A read of numbers in parts of 28, one part per cycle, appended to the block's array (the
 /// buffer); answered with the columns per row once all are in.
 pub struct PartRead {
     target: u32,
     request: hli::calls::cam::CamReadCall,
     pending: PendingCall<hli::calls::cam::CamReadCall>,
+    /// Numbers the array holds beside the buffer's room (its size in bytes / 8).
+    limit: usize,
 }
 
 impl core::fmt::Debug for PartRead {
@@ -34,12 +39,14 @@ impl PartRead {
         io: &mut PlcIo<'_>,
         target: u32,
         request: hli::calls::cam::CamReadCall,
+        limit: usize,
     ) -> Result<PartRead, u32> {
         let pending = send(io, target, &request)?;
         Ok(PartRead {
             target,
             request,
             pending,
+            limit,
         })
     }
 }
@@ -60,7 +67,9 @@ impl InFlight for PartRead {
             // A part the reply cannot hold: as if no answer came.
             return Polled::Answer(Err(crate::kernel::ERROR_NO_ANSWER));
         }
-        if values.len() + count > values.capacity() || reply.total as usize > values.capacity() {
+        // The array holds what its room and its size (when given) both hold.
+        let room = values.capacity().min(self.limit);
+        if values.len() + count > room || reply.total as usize > room {
             return Polled::Answer(Err(ERROR_ARRAY_SIZE));
         }
         values.extend_from_slice(&reply.values[..count]);
@@ -100,6 +109,16 @@ pub struct McCamRead {
     /// A refusal the block's own inputs make (an array that cannot hold what it asks for):
     /// the read ends in Error with this code without a call.
     pub refuse: Option<u32>,
+    /// MC_ReadMotionFunctionValues' array: its column count (the MC_CAM_REF's nNoOfCols),
+    /// if given. Other than 1 + the bits of the ValueSelectMask (seed 000 5.1.13: the
+    /// CamTable's columns must match the mask) is refused with MC_ERROR_NUMCOLUMNS_INVALID
+    /// (0x4B37) without a call.
+    pub array_columns: Option<u32>,
+    /// The array's size in numbers (bytes / 8) when it is given apart from the room
+    /// (CamTableReadData's `size`): an answer with more numbers than it holds is refused
+    /// with MC_ERROR_ARRAYSIZE_INVALID once the first part tells how many come (a read of
+    /// all rows, whose count only the CNC knows).
+    pub size_limit: Option<usize>,
     kernel: Kernel<PartRead>,
 }
 
@@ -120,11 +139,24 @@ impl McCamRead {
             columns: 1,
             out: Outputs::default(),
             refuse: None,
+            array_columns: None,
+            size_limit: None,
             kernel: Kernel::default(),
         }
     }
 
     timeout_input!(kernel);
+
+    /// MC_ReadMotionFunctionValues' array against its ValueSelectMask: 0x4B37 when a column
+    /// count is given and is not the master column and one per bit of the mask.
+    fn columns_refusal(&self) -> Option<u32> {
+        let values = self.request.what == CamReadKind::Values.raw();
+        let wanted = 1 + self.request.mask.count_ones();
+        match self.array_columns {
+            Some(columns) if values && columns != wanted => Some(ERROR_COLUMNS),
+            _ => None,
+        }
+    }
 
     /// The organisation fields of a characteristics read (after its 31 values), once read.
     pub fn organisation(&self) -> Option<hli::calls::cam::TableOrganisation> {
@@ -136,8 +168,9 @@ impl McCamRead {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (target, request) = (self.target, self.request);
+        let refuse = self.refuse.or_else(|| self.columns_refusal());
+        let limit = self.size_limit.unwrap_or(usize::MAX);
         let columns = &mut self.columns;
-        let refuse = self.refuse;
         let send = |io: &mut PlcIo<'_>, values: &mut Vec<f64>| {
             values.clear();
             if let Some(code) = refuse {
@@ -147,6 +180,7 @@ impl McCamRead {
                 io,
                 target,
                 hli::calls::cam::CamReadCall { part: 0, ..request },
+                limit,
             )
         };
         self.out = self.kernel.cycle_with(
@@ -200,10 +234,12 @@ impl InFlight for PointsRead {
             Some(Ok(reply)) if reply.error_id != 0 => return Polled::Answer(Err(reply.error_id)),
             Some(Ok(reply)) => reply,
         };
-        let wanted = if self.count == 0 {
-            (reply.total + 1).saturating_sub(self.first) as usize
-        } else {
-            self.count as usize
+        // To the function's end; NumPoints beyond it reads what there is (manual 000,
+        // 5.1.8: NumPointsRead may be smaller than NumPoints).
+        let left = (reply.total + 1).saturating_sub(self.first) as usize;
+        let wanted = match self.count {
+            0 => left,
+            count => (count as usize).min(left),
         };
         if wanted > points.capacity() {
             return Polled::Answer(Err(ERROR_ARRAY_SIZE));
@@ -290,6 +326,7 @@ impl TimelineBlock for McCamRead {
         match (key, value.uint(), value.real(), value) {
             ("table", Some(v), _, _) => self.target = v,
             ("value_select_mask", Some(v), _, _) => r.mask = v,
+            ("columns", Some(v), _, _) => self.array_columns = Some(v),
             ("master_position" | "start_pos_master" | "master_velocity", _, Some(v), _) => r.a = v,
             ("end_pos_master", _, Some(v), _) => r.b = v,
             ("increment", _, Some(v), _) => r.c = v,
@@ -376,6 +413,8 @@ pub const TIMELINE: &[BlockSpec] = &[
             input("start_pos_master", Kind::Real),
             input("end_pos_master", Kind::Real),
             input("increment", Kind::Real),
+            // The array's column count (MC_CAM_REF nNoOfCols): must be 1 + the mask's bits.
+            input("columns", Kind::Range(1, 16)),
             ROOM,
         ],
         |room| {

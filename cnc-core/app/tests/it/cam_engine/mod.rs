@@ -19,6 +19,7 @@ mod data;
 mod encoder;
 mod modes;
 mod recovery;
+mod manual_gaps;
 mod selection;
 mod superimposed;
 
