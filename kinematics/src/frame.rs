@@ -269,7 +269,7 @@ mod tests {
                     rot_close(&order.rotation(got), &r, 1e-9),
                     "{order:?} {got:?}"
                 );
-                if (m as f64).abs() != 90.0 && m != 0.0 {
+                if m.abs() != 90.0 && m != 0.0 {
                     for (g, w) in got.iter().zip([a, m, c]) {
                         assert!((g - w).abs() < 1e-6, "{order:?} at {m}: {got:?}");
                     }

@@ -30,8 +30,8 @@ mod saw_manual_checks;
 mod saw_plan;
 
 mod touch_probe;
+mod track_cs_gaps;
 mod track_cs_language;
 mod track_cs_rotary;
-mod track_cs_gaps;
 mod tracking_plc_rate;
 mod tracking_safety;

@@ -17,9 +17,9 @@ use std::path::PathBuf;
 
 mod data;
 mod encoder;
+mod manual_gaps;
 mod modes;
 mod recovery;
-mod manual_gaps;
 mod selection;
 mod superimposed;
 
