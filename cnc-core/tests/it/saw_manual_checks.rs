@@ -5,41 +5,12 @@
 //! without acceleration at coupling (chapter 7); the characteristic values at the extremes and
 //! the NOT SUPPORTED ones of velocity example 1 (chapter 6).
 
-use cnc_core::saw::{self, Limits, Plan, SawRequest, Shape, SyncOn};
+use cnc_core::saw::{self, Limits, Plan, Shape, SyncOn};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
 use hli::enums::{AxisState, SawError};
 
-fn kin(position: f64, velocity: f64, acceleration: f64) -> Kinematic {
-    Kinematic {
-        position,
-        velocity,
-        acceleration,
-        jerk: 0.0,
-    }
-}
-
-fn limits(acc: f64, jerk: f64) -> Limits {
-    Limits {
-        velocity: 5000.0,
-        acceleration: acc,
-        deceleration: acc,
-        jerk,
-    }
-}
-
-fn request(on: SyncOn, ratio: f64, limits: Limits, mask: u32) -> SawRequest {
-    SawRequest {
-        on,
-        time_based: false,
-        mask,
-        ratio,
-        limits,
-    }
-}
-
-/// The four checks of the limits.
-const LIMIT_CHECKS: u32 = m::MAXVELO | m::MAXACC | m::MAXDEC | m::MAXJERK;
+use super::saw_plan::{kin, limits, request, LIMIT_CHECKS};
 
 /// Seed 001, chapter 5 (the table of the SyncMode bit masks) and 12.3.1: every check and
 /// operation bit has the seed's decimal value; the two bits the seed names without a value

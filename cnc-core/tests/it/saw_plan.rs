@@ -11,7 +11,7 @@ use proptest::prelude::*;
 
 const TICK: f64 = 0.001;
 
-fn kin(position: f64, velocity: f64, acceleration: f64) -> Kinematic {
+pub(crate) fn kin(position: f64, velocity: f64, acceleration: f64) -> Kinematic {
     Kinematic {
         position,
         velocity,
@@ -20,7 +20,7 @@ fn kin(position: f64, velocity: f64, acceleration: f64) -> Kinematic {
     }
 }
 
-fn limits(acc: f64, jerk: f64) -> Limits {
+pub(crate) fn limits(acc: f64, jerk: f64) -> Limits {
     Limits {
         velocity: 5000.0,
         acceleration: acc,
@@ -29,7 +29,7 @@ fn limits(acc: f64, jerk: f64) -> Limits {
     }
 }
 
-fn request(on: SyncOn, ratio: f64, limits: Limits, mask: u32) -> SawRequest {
+pub(crate) fn request(on: SyncOn, ratio: f64, limits: Limits, mask: u32) -> SawRequest {
     SawRequest {
         on,
         time_based: false,
@@ -40,7 +40,7 @@ fn request(on: SyncOn, ratio: f64, limits: Limits, mask: u32) -> SawRequest {
 }
 
 /// Every check the seed lists for the limits (not the shape checks).
-const LIMIT_CHECKS: u32 = m::MAXVELO | m::MAXACC | m::MAXDEC | m::MAXJERK;
+pub(crate) const LIMIT_CHECKS: u32 = m::MAXVELO | m::MAXACC | m::MAXDEC | m::MAXJERK;
 
 /// Runs a plan with the master at constant velocity, tick by tick, until the master passes
 /// the end of the phase and `extra` ticks more: (time, master, slave) samples.

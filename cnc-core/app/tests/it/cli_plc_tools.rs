@@ -33,6 +33,26 @@ fn get(instance: &str, path: &str) -> String {
         .to_string()
 }
 
+/// `cnc run` of the folder's `scenario.toml` on `instance`, for ten minutes at most (the
+/// test ends it).
+fn run_cnc(instance: &str, dir: &Scratch) -> ChildGuard {
+    Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
+        .args(["--instance", instance, "--ticks", "600000"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Until the CNC on `instance` has ticked.
+fn wait_ticking(instance: &str) {
+    wait_until("the CNC ticks", || {
+        let (code, out, _) = tool(instance, &["get", BEAT]);
+        code == 0 && !out.trim().ends_with(" 0")
+    });
+}
+
 /// A CNC running a scenario without a PLC, for ten minutes at most (the test ends it), and
 /// the scratch folder of its scenario.
 fn start_cnc(instance: &str) -> (ChildGuard, Scratch) {
@@ -46,24 +66,14 @@ fn start_cnc(instance: &str) -> (ChildGuard, Scratch) {
         ),
     )
     .unwrap();
-    let cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
-        .args(["--instance", instance, "--ticks", "600000"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    (cnc, dir)
+    (run_cnc(instance, &dir), dir)
 }
 
 #[test]
 fn get_set_and_watch_a_live_cnc_by_st_path() {
     let instance = tests::unique_instance("plctools");
     let (mut child, _dir) = start_cnc(&instance);
-    wait_until("the CNC ticks", || {
-        let (code, out, _) = tool(&instance, &["get", BEAT]);
-        code == 0 && !out.trim().ends_with(" 0")
-    });
+    wait_ticking(&instance);
 
     // A plain PLC leaf: read, written, read back.
     assert_eq!(get(&instance, ENABLE), "FALSE");
@@ -158,17 +168,8 @@ fn plc_call_runs_one_block_against_a_live_cnc() {
          velocity = 200.0\nacceleration = 2000.0\ndeceleration = 2000.0\njerk = 50000.0\n",
     )
     .unwrap();
-    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
-        .args(["--instance", &instance, "--ticks", "600000"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    wait_until("the CNC ticks", || {
-        let (code, out, _) = tool(&instance, &["get", BEAT]);
-        code == 0 && !out.trim().ends_with(" 0")
-    });
+    let mut cnc = run_cnc(&instance, &dir);
+    wait_ticking(&instance);
     let (code, out, err) = tool(&instance, &["call", "MC_Power", "axis=0", "enable=true"]);
     assert_eq!(code, 0, "{out}{err}");
     assert!(out.contains("Status"), "{out}");
@@ -235,17 +236,8 @@ fn plc_call_commissions_a_flying_saw() {
         ),
     )
     .unwrap();
-    let mut cnc = Cli::new(env!("CARGO_BIN_EXE_cnc"))
-        .args(["run", dir.join("scenario.toml").to_str().unwrap()])
-        .args(["--instance", &instance, "--ticks", "600000"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    wait_until("the CNC ticks", || {
-        let (code, out, _) = tool(&instance, &["get", BEAT]);
-        code == 0 && !out.trim().ends_with(" 0")
-    });
+    let mut cnc = run_cnc(&instance, &dir);
+    wait_ticking(&instance);
     let calls: [&[&str]; 3] = [
         &[
             "MC_MoveVelocity",

@@ -27,7 +27,7 @@ fn axis(name: &str, extra: &str) -> String {
     )
 }
 
-fn machine(extra: &str) -> InProcess {
+pub(crate) fn machine(extra: &str) -> InProcess {
     let toml = format!(
         "cycle_ms = 1.0\nticks = 10\n{}{}{extra}",
         axis("Master", ""),
@@ -43,7 +43,7 @@ fn machine(extra: &str) -> InProcess {
     run
 }
 
-fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) -> u32 {
+pub(crate) fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) -> u32 {
     let view = CncView::new(&run.memory);
     run.machine.call(&view, axis as u32, &c).unwrap().error_id
 }
@@ -68,16 +68,16 @@ fn image(run: &InProcess, axis: usize) -> HliAxisLrState {
     PlcView::new(&run.memory).axis_state(axis).unwrap()
 }
 
-fn set(run: &InProcess, axis: usize) -> Kinematic {
+pub(crate) fn set(run: &InProcess, axis: usize) -> Kinematic {
     run.machine.axes().axis(axis).unwrap().setpoint()
 }
 
-fn phase(run: &InProcess, axis: usize) -> i32 {
+pub(crate) fn phase(run: &InProcess, axis: usize) -> i32 {
     image(run, axis).axis_state_r
 }
 
 /// Ticks until `done` holds; a watchdog of `max` ticks instead of a time limit.
-fn until(run: &mut InProcess, max: usize, done: impl Fn(&InProcess) -> bool) -> usize {
+pub(crate) fn until(run: &mut InProcess, max: usize, done: impl Fn(&InProcess) -> bool) -> usize {
     for k in 0..max {
         if done(run) {
             return k;

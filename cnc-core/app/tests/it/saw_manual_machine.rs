@@ -3,14 +3,15 @@
 //! plans and checks with the slave axis's own machine data (chapter 11: an input not given
 //! takes the axis's configured maximum), and the axis image shows the slave states as the seed's numbers 11, 12 and 13 (chapter 9).
 
-use cnc_app::scenario::{InProcess, Scenario};
-use cnc_core::setpoint::Kinematic;
+use cnc_app::scenario::InProcess;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncTarget,
 };
 use hli::enums::{AxisState, SawError};
-use hli::views::{CncView, PlcView};
+use hli::views::CncView;
+
+use super::saw_engine::{command, machine as engine_machine, phase, set, until};
 
 const TICK: f64 = 0.001;
 const MASTER: usize = 0;
@@ -19,29 +20,6 @@ const SAW: usize = 1;
 const AXIS_VELOCITY: f64 = 3000.0;
 const AXIS_ACC: f64 = 20000.0;
 const AXIS_JERK: f64 = 1e7;
-
-fn machine() -> InProcess {
-    let axis = |name: &str| {
-        format!(
-            "[[axis]]\nname = \"{name}\"\npower = true\nvelocity = 3000.0\nacceleration = 20000.0\n\
-             deceleration = 20000.0\njerk = 1e7\nfollowing_error_limit = 1e4\n"
-        )
-    };
-    let toml = format!(
-        "cycle_ms = 1.0\nticks = 10\n{}{}",
-        axis("Master"),
-        axis("Saw")
-    );
-    let s = Scenario::parse("saw.toml", &toml, |_| unreachable!()).unwrap();
-    let mut run = InProcess::new(&s, 0).unwrap();
-    run.step(TICK);
-    run
-}
-
-fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) -> u32 {
-    let view = CncView::new(&run.memory);
-    run.machine.call(&view, axis as u32, &c).unwrap().error_id
-}
 
 fn gear_in(run: &mut InProcess, call: SawGearInCall) -> u32 {
     let view = CncView::new(&run.memory);
@@ -54,6 +32,11 @@ fn gear_out(run: &mut InProcess) -> u32 {
         .call(&view, SAW as u32, &SawGearOutCall::default())
         .unwrap()
         .error_id
+}
+
+/// The saw engine tests' machine: two axes with the machine data above.
+fn machine() -> InProcess {
+    engine_machine("")
 }
 
 /// One part of MC_ReadFlyingSawCharacteristics (part 1: fields 17-31 at 0-14).
@@ -71,29 +54,6 @@ fn charac(run: &mut InProcess, part: u32) -> [f64; 16] {
 const ACC_MIN: usize = 0;
 const ACC_MAX: usize = 9;
 const JERK_MAX: usize = 11;
-
-fn set(run: &InProcess, axis: usize) -> Kinematic {
-    run.machine.axes().axis(axis).unwrap().setpoint()
-}
-
-/// `nAxisState` as the image shows it.
-fn phase(run: &InProcess, axis: usize) -> i32 {
-    PlcView::new(&run.memory)
-        .axis_state(axis)
-        .unwrap()
-        .axis_state_r
-}
-
-/// Ticks until `done` holds; a watchdog of `max` ticks instead of a time limit.
-fn until(run: &mut InProcess, max: usize, done: impl Fn(&InProcess) -> bool) -> usize {
-    for k in 0..max {
-        if done(run) {
-            return k;
-        }
-        run.step(TICK);
-    }
-    panic!("not reached within {max} ticks");
-}
 
 /// Master at +500 mm/s, the saw at +`slave_velocity`, both at constant velocity.
 fn moving(slave_velocity: f64) -> InProcess {
