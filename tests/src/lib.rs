@@ -9,9 +9,11 @@
 //! * [`rig`]: axes on a heap image ([`AxisRig`]); [`channel_rig`]: channels and a controller
 //!   on a heap image, configurations, a watchdog loop, PLC payloads;
 //! * [`lockstep`]: stand-in CNCs in a thread for the PLC-side tests; [`peer`]: payloads with
-//!   checksums and the `hli-peer` helper process;
-//! * [`InProcess`]: the in-process machine of a scenario (the application's
-//!   `cnc_app::scenario::InProcess`, re-exported).
+//!   checksums and the `hli-peer` helper process.
+//!
+//! The kit depends on the libraries only (never on the application), so `cargo test -p
+//! cnc-core` builds no application code; a scenario's in-process machine is the
+//! application's own (`cnc_app::scenario::InProcess`, used by its tests).
 
 #![forbid(unsafe_code)]
 
@@ -31,11 +33,6 @@ pub use peer::{
     checksum, payload, remove_stale_segment, spawn_peer_saying, spawn_ready_peer, verify,
 };
 pub use rig::AxisRig;
-
-/// The in-process machine of a scenario: CNC ticks and PLC timeline cycles alternating on a
-/// heap image, the same trace as `cnc run --lockstep` (the application's, kept there because
-/// the application runs it too).
-pub use cnc_app::scenario::InProcess;
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
