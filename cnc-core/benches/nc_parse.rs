@@ -124,6 +124,11 @@ fn best((a, a_parsed): (f64, f64), (b, b_parsed): (f64, f64)) -> (f64, f64) {
 }
 
 fn main() {
+    // As the `cnc` binary does: the tree's arenas in huge pages.
+    cnc_core::nc::set_buffer_advice(|p| {
+        cnc_os::advise_huge_pages(&mut p.blocks);
+        cnc_os::advise_huge_pages(&mut p.items);
+    });
     if let Some(path) = std::env::var_os("NC_BENCH_CHILD") {
         child(&path.to_string_lossy());
         return;

@@ -17,3 +17,10 @@ pub mod progress;
 pub mod saw_cli;
 pub mod scenario;
 pub mod stats;
+
+/// The operating system's memory advice for an NC program's tree (installed by the `cnc`
+/// binary with `cnc_core::nc::set_buffer_advice`): its arenas in transparent huge pages.
+pub fn huge_page_advice(program: &mut cnc_core::nc::ast::Program) {
+    cnc_os::advise_huge_pages(&mut program.blocks);
+    cnc_os::advise_huge_pages(&mut program.items);
+}

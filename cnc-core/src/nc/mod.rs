@@ -16,7 +16,7 @@ pub mod printer;
 pub mod straight;
 
 pub use decode::{check_program, Decoded, DecoderState, MotionBlock, MotionMode};
-pub use parser::{parse, parse_general};
+pub use parser::{parse, parse_general, set_buffer_advice};
 pub use printer::print;
 
 use ast::Span;

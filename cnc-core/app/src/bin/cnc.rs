@@ -86,6 +86,8 @@ enum HliCommand {
 
 fn main() -> ExitCode {
     hli::init_logging();
+    // Long NC programs fill their tree in huge pages where the system has them.
+    cnc_core::nc::set_buffer_advice(cnc_app::huge_page_advice);
     match Cli::parse().command {
         Command::Demo(args) => cnc_app::demo::main(args),
         Command::Run(args) => cnc_app::scenario::runner::main(args),

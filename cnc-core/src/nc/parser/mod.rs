@@ -18,6 +18,17 @@ use super::Diagnostic;
 /// The highest P parameter number.
 pub const MAX_PARAM: u32 = 999;
 
+/// How a fresh program's reserved arenas are prepared before they fill, if at all: the
+/// application installs the operating system's memory advice (huge pages) once at start
+/// ([`set_buffer_advice`]); the parser itself makes no system call.
+static BUFFER_ADVICE: std::sync::OnceLock<fn(&mut Program)> = std::sync::OnceLock::new();
+
+/// Installs `advice`, called on every program's arenas right after they are reserved (see
+/// [`BUFFER_ADVICE`]); `false` when one was installed before (the first stays).
+pub fn set_buffer_advice(advice: fn(&mut Program)) -> bool {
+    BUFFER_ADVICE.set(advice).is_ok()
+}
+
 /// Parses `src`; the tree holds everything that could be understood.
 pub fn parse(src: &str) -> (Program, Vec<Diagnostic>) {
     parse_with(src, true)
@@ -219,10 +230,11 @@ impl Parser<'_> {
             .blocks
             .reserve((self.src.len() / 8 + 1).min(RESERVE_CAP));
         program.items.reserve((self.src.len() / 4).min(RESERVE_CAP));
-        // Long programs fill tens of megabytes of fresh memory: in huge pages where the
-        // system has them, one page fault per 2 MiB instead of one per 4 KiB.
-        cnc_os::advise_huge_pages(&mut program.blocks);
-        cnc_os::advise_huge_pages(&mut program.items);
+        // Long programs fill tens of megabytes of fresh memory: the application's advice
+        // puts them in huge pages where the system has them.
+        if let Some(advise) = BUFFER_ADVICE.get() {
+            advise(&mut program);
+        }
         self.fill(&mut program, usize::MAX);
         if program.name.is_none() && !program.subs.is_empty() {
             self.close_sub(&mut program);
@@ -487,5 +499,32 @@ impl Parser<'_> {
                 None
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    static ADVISED: AtomicUsize = AtomicUsize::new(0);
+
+    /// The advice the application installs is called on each program's reserved arenas
+    /// (and only the first installed counts); without one the parser advises nothing.
+    #[test]
+    fn the_installed_buffer_advice_sees_every_programs_reserved_arenas() {
+        fn count(p: &mut Program) {
+            assert!(p.blocks.capacity() > 0 && p.blocks.is_empty());
+            ADVISED.fetch_add(1, Ordering::SeqCst);
+        }
+        let before = ADVISED.load(Ordering::SeqCst);
+        let _ = parse("G1 X1\n");
+        assert_eq!(ADVISED.load(Ordering::SeqCst), before, "none installed yet");
+        assert!(set_buffer_advice(count));
+        assert!(!set_buffer_advice(|_| {}), "the first stays");
+        let (program, _) = parse("G1 X1\nG1 X2\n");
+        assert_eq!(program.blocks.len(), 2);
+        // At least this parse (other tests of the process may parse meanwhile).
+        assert!(ADVISED.load(Ordering::SeqCst) > before);
     }
 }
