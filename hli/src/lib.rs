@@ -29,6 +29,7 @@ pub mod enums;
 pub mod events;
 pub mod handshake;
 pub mod layout;
+pub mod protocol;
 #[allow(unsafe_code)]
 pub mod raw;
 pub mod rpc;

@@ -6,9 +6,9 @@ use crate::source::ImageSource;
 use hli::access::{Leaf, Value};
 use hli::desc::Scalar;
 use hli::layout::image::HliSegmentHeader;
+use hli::protocol::{check_protocol, show, Refusal, Refused, Write};
 use hli::ImageMemory;
 use opcua::types::{DataValue, DateTime, NumericRange, StatusCode, Variant};
-use plc_shim::tools::{check_protocol, Refusal, ToolError, Write};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -222,10 +222,10 @@ pub fn write(
         status = match check_protocol(memory, &one) {
             Ok(()) => {
                 leaf.write(memory, value);
-                crate::say!("write {path} := {}", plc_shim::tools::show(&leaf, value));
+                crate::say!("write {path} := {}", show(&leaf, value));
                 StatusCode::Good
             }
-            Err(ToolError::Refused {
+            Err(Refused {
                 reason: Refusal::CncOwned,
                 ..
             }) => StatusCode::BadNotWritable,
