@@ -6,6 +6,7 @@
 //! axis's structs, no computation), so the ratio says what the axis work adds. Medians over
 //! repeats. Run: `cargo bench -p cnc-core --bench axes`.
 
+use bench_kit::{median, scaled};
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::axis::AxisSet;
 use core::mem::offset_of;
@@ -21,21 +22,6 @@ use std::time::Instant;
 const AXES: usize = 32;
 const TICKS: usize = 20_000;
 const REPEATS: usize = 9;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn image_only(view: &CncView<'_>) {
     for i in 0..AXES {

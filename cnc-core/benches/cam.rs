@@ -5,6 +5,7 @@
 //! it includes the segment lookup and position, velocity, acceleration and jerk.
 //! Run: `cargo bench -p cnc-core --bench cam`.
 
+use bench_kit::{median, scaled};
 use cnc_core::cam::{
     CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
     ProfileCursor, TableType,
@@ -15,21 +16,6 @@ use std::time::Instant;
 
 const EVALS: usize = 1_000_000;
 const REPEATS: usize = 9;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn motion_function(points: usize) -> CamProfile {
     // Rest points with alternating strokes; polynomial and trigonometric laws mixed.

@@ -7,6 +7,7 @@
 //! Target: <= 100 ns extra per slave and tick, flat in table size.
 //! Run: `cargo bench -p cnc-core --bench cam_slave`.
 
+use bench_kit::{median, scaled};
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::cam::online::CamStore;
 use cnc_core::cam::{
@@ -26,21 +27,6 @@ use std::time::Instant;
 
 const TICKS: usize = 20_000;
 const REPEATS: usize = 9;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn motion_function(points: usize) -> CamProfile {
     let p: Vec<MotionFunctionPoint> = (0..points)

@@ -20,6 +20,7 @@
 //! Cycle times are counted in ticks of the 1 ms cycle (the trace is deterministic); only
 //! the tick cost is timed. Run: `cargo bench -p cnc-core --bench contour`.
 
+use bench_kit::{median, smoke};
 use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
 use cnc_core::nc::interp::SearchPath;
 use cnc_core::setpoint::AxisValues;
@@ -29,17 +30,6 @@ use std::time::Instant;
 
 const CYCLE: f64 = 0.001;
 const REPEATS: usize = 7;
-
-/// `CNC_BENCH_SMOKE=1` (CI): a short polyline and one repeat, to show the bench runs to its
-/// end; its figures mean nothing then.
-fn smoke() -> bool {
-    std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// The zigzag's points and its blocks.
 fn zigzag(n: usize) -> (Vec<[f64; 3]>, String) {

@@ -15,6 +15,7 @@
 //!
 //! Run: `cargo bench -p cnc-core --bench fifo`.
 
+use bench_kit::{median, scaled};
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::fifo::{FifoGenerator, FifoParams, OverrideFilter, OverrideType, RowRing};
 use cnc_core::machine::fifo::FifoEngine;
@@ -36,21 +37,6 @@ const BATCH: usize = 1000;
 const REPEATS: usize = 15;
 const BLOCK_ROWS: usize = 1365;
 const BLOCKS: usize = 733;
-
-/// `CNC_BENCH_SMOKE=1` (CI; the client process inherits it): every count cut to a thousandth
-/// (at least 1), to show the bench runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn call<C: AcyclicCall<Reply = FifoReply>>(machine: &mut Machine, memory: &ImageMemory, body: C) {
     let reply = machine

@@ -10,6 +10,7 @@
 //! tree dropped before (a controller loading programs again and again). The comparison with
 //! rs274 and the targets use the cold time.
 
+use bench_kit::median;
 use cnc_core::nc::decode::ZeroVars;
 use cnc_core::nc::{parse, Decoded, DecoderState};
 use std::hint::black_box;
@@ -39,11 +40,6 @@ fn program() -> String {
     }
     s.push_str("M2\n");
     s
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// Parses the program, then decodes it block by block into a reused buffer, the way a channel

@@ -16,6 +16,7 @@
 //! (the three measured in turn within every repeat); the ratio is ours / rsruckig's.
 //! Run: `cargo bench -p cnc-core --bench saw`.
 
+use bench_kit::{median, scaled};
 use cnc_core::saw::{self, Limits, SawRequest, SyncOn};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
@@ -25,21 +26,6 @@ use std::time::Instant;
 
 const BATCH: usize = 2000;
 const REPEATS: usize = 21;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 fn kin(position: f64, velocity: f64) -> Kinematic {
     Kinematic {

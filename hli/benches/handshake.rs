@@ -8,6 +8,7 @@
 //! The bench binary spawns itself as the peer process. Reported: p50/p99/max per method as the
 //! median over repeats, and each p50 as a ratio to the flag floor of the same run.
 
+use bench_kit::median_u64 as median;
 use hli::events::{EventLink, Side};
 use hli::layout::HliCoordinateSystemInt;
 use hli::segment::{CncSegment, PlcSegment};
@@ -401,11 +402,6 @@ fn summarize(mut samples: Vec<u64>) -> Summary {
         p99: at(0.99),
         max: *samples.last().unwrap(),
     }
-}
-
-fn median(mut v: Vec<u64>) -> u64 {
-    v.sort_unstable();
-    v[v.len() / 2]
 }
 
 fn main() {

@@ -4,6 +4,7 @@
 //! calls over 1000 poses; the batches of all methods are interleaved and repeated, and the
 //! table reports the median time per call and the ratio to the peer's median.
 
+use bench_kit::{median, scaled};
 use kinematics::opw::{Robot45, Robot45Params};
 use kinematics::{Joints, Kinematics};
 use rs_opw_kinematics::glam::{DQuat, DVec3};
@@ -15,16 +16,6 @@ use std::time::Instant;
 
 const POSES: usize = 1000;
 const REPEATS: usize = 15;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
 
 fn sample_joints() -> Vec<Joints> {
     let mut seed = 0x9e37_79b9_7f4a_7c15u64;
@@ -46,11 +37,6 @@ fn sample_joints() -> Vec<Joints> {
             ]
         })
         .collect()
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn time_per_call(f: &mut dyn FnMut() -> f64) -> f64 {

@@ -23,6 +23,7 @@
 //! (the in-process twin of `cnc demo`), its machine tick timed the same way.
 //! Run: `cargo bench -p cnc-app --bench channels`.
 
+use bench_kit::{median, scaled};
 use cnc_app::scenario::fleet::{
     plc_setup, running, running_on, running_with, tracking_robots, Moves,
 };
@@ -39,21 +40,6 @@ use std::time::Instant;
 const TICKS: usize = 5_000;
 const REPEATS: usize = 9;
 const WARM_UP: usize = 3_000;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// One sample: ns per tick over TICKS ticks.
 fn sample(tick: &mut dyn FnMut()) -> f64 {

@@ -11,6 +11,7 @@
 //!
 //! Run: `cargo bench -p cnc-app --bench nc_check` (`NC_CHECK_ROUNDS` sets the rounds, 9).
 
+use bench_kit::median;
 use std::process::{Command, Stdio};
 use std::time::Instant;
 
@@ -69,11 +70,6 @@ fn run(cmd: &mut Command) -> (f64, i64) {
     let elapsed = t0.elapsed().as_secs_f64();
     assert!(success, "{cmd:?} failed");
     (elapsed, peak)
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn main() {

@@ -19,6 +19,7 @@
 //! Whatever spreads the constant job's time (cold caches after the sleep, the VM, the other
 //! process) spreads the tick's too: its p99/p50 is what this machine allows.
 
+use bench_kit::{median, smoke};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -28,15 +29,6 @@ struct Figures {
     late: (f64, f64),
     compute: (f64, f64),
     plc_overruns: f64,
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
-fn smoke() -> bool {
-    std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
 }
 
 fn scenario(name: &str) -> PathBuf {

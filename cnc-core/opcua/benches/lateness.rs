@@ -8,6 +8,7 @@
 //! computer of the plant). Needs `cnc` built beside this bench (`cargo build --release -p cnc-app`); says so
 //! and skips otherwise. `CNC_BENCH_SMOKE=1`: one short round.
 
+use bench_kit::{median, smoke};
 use opcua::client::{ClientBuilder, DataChangeCallback, IdentityToken, Session};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
@@ -37,10 +38,6 @@ fn rt_args() -> Option<Vec<String>> {
     let mut args = options.to_args();
     args.extend(["--opcua-config".to_string(), config()?]);
     Some(args)
-}
-
-fn smoke() -> bool {
-    std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
 }
 
 fn cnc() -> Option<PathBuf> {
@@ -186,11 +183,6 @@ fn run(with_client: bool, rt: bool, ticks: u64, tag: &str) -> Option<(f64, f64, 
         after("p99 ")? / 1000.0,
         changes.load(Ordering::Relaxed),
     ))
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 fn main() {

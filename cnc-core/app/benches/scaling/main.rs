@@ -19,6 +19,7 @@
 
 mod machines;
 
+use bench_kit::{median, scaled, smoke};
 use machines::{axes, cam_slaves, cam_table, channels, fifo_depth, saw, Tick};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -26,25 +27,6 @@ use std::time::Instant;
 
 const TICKS: usize = 4_000;
 const REPEATS: usize = 9;
-
-/// `CNC_BENCH_SMOKE=1` (CI): every count cut to a thousandth (at least 1), to show the bench
-/// runs to its end; its figures mean nothing then.
-fn scaled(full: usize) -> usize {
-    if std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1") {
-        (full / 1000).max(1)
-    } else {
-        full
-    }
-}
-
-fn smoke() -> bool {
-    std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1")
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
 
 /// What a dimension's cost should look like.
 #[derive(Clone, Copy, PartialEq)]
