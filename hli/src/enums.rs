@@ -36,9 +36,9 @@ macro_rules! hli_enum {
             }
 
             /// Decodes a raw value read from the image.
-            pub fn decode(raw: $raw) -> Result<Self, InvalidValue> {
+            pub fn decode(raw: $raw) -> Result<Self, $crate::enums::InvalidValue> {
                 $( if raw == $value { return Ok($name::$variant); } )*
-                Err(InvalidValue {
+                Err($crate::enums::InvalidValue {
                     type_name: $st,
                     raw: raw as i64,
                     allowed: concat!($( stringify!($value), " " ),*),
@@ -107,7 +107,7 @@ macro_rules! wire_enum {
         }
     };
 }
-pub(crate) use wire_enum;
+pub(crate) use {hli_enum, wire_enum};
 
 /// Every `wire_enum!` type, for code generic over them (the PLC timeline takes a mode by
 /// its name or its number).
@@ -228,147 +228,6 @@ hli_enum! {
         Fifo = 4,
         /// Driven by a CNC channel's interpolator.
         Channel = 5,
-    }
-}
-
-hli_enum! {
-    /// Why the cam engine refused a coupling command (beside the seed's table codes for an
-    /// unknown table and the axis layer's codes for a slave that cannot be coupled). The
-    /// seed does not number these; they are ours.
-    CamCouplingError: u32, "CamCouplingError" {
-        /// The master axis does not exist.
-        NoSuchMaster = 0x4260,
-        /// The master is the slave itself.
-        MasterIsSlave = 0x4261,
-        /// Activation, start and scaling mode do not go together (seed 5.1.16.13/14), or
-        /// MC_CamIn's start mode contradicts the MasterAbsolute/SlaveAbsolute its table was
-        /// selected with (MC_CamTableSelect).
-        ModeCombination = 0x4262,
-        /// The activation position lies behind the master in its direction of travel.
-        ActivationPassed = 0x4263,
-        /// MC_CamOut or MC_CamScaling on a slave no cam couples.
-        NotCamCoupled = 0x4264,
-        /// A coupling made with MC_CamIn cannot switch cams (MC_CamInExt can).
-        NotSwitchable = 0x4265,
-        /// An offset or scaling that is not finite, or a master scaling of 0.
-        BadParameter = 0x4266,
-        /// An unknown start, activation or scaling mode number.
-        UnknownMode = 0x4267,
-        /// A table a coupling uses cannot be replaced.
-        TableInUse = 0x4268,
-        /// A chunk that does not continue its transfer (order, count, total).
-        ChunkOutOfOrder = 0x4269,
-        /// MC_CamScaling or a switch while the first coupling still waits for its activation.
-        CouplingPending = 0x426A,
-    }
-}
-
-hli_enum! {
-    /// Why the FIFO engine refused a call or ended a job (seed 002 gives no numbers: these
-    /// are ours). A refused call leaves the queued rows and the group as they were.
-    FifoError: u32, "FifoError" {
-        /// The group index is not a configured FIFO group.
-        NoSuchGroup = 0x4300,
-        /// The axis is not an axis of the machine (channel axes are refused as coupled: they
-        /// belong to their channel).
-        NoSuchAxis = 0x4301,
-        /// The group position is outside 1..=N.
-        GroupPosition = 0x4302,
-        /// Another axis holds that group position.
-        PositionTaken = 0x4303,
-        /// The axis is in a FIFO group already.
-        AxisInGroup = 0x4304,
-        /// The axis is coupled to another engine (cam, gear, saw).
-        AxisCoupled = 0x4305,
-        /// The axis moves: only a standing axis joins a group.
-        AxisMoving = 0x4306,
-        /// FiFoStart with fewer than N axes integrated.
-        GroupIncomplete = 0x4307,
-        /// FiFoStart on an empty FIFO.
-        Empty = 0x4308,
-        /// FiFoStart: the first row is not where the axes stand.
-        StartMismatch = 0x4309,
-        /// The group runs: integrate, disintegrate, start and parameters wait for Idle.
-        Running = 0x430A,
-        /// The block does not fit the free rows; nothing was queued (offer it again).
-        Full = 0x430B,
-        /// The block's column count is not the group's dimension N.
-        Columns = 0x430C,
-        /// A value of the block is NaN or infinite (its row and column in the reply).
-        NonFinite = 0x430D,
-        /// A block without rows, or larger than one block holds.
-        BlockSize = 0x430E,
-        /// FiFoStop was given: no override change and no rows until the job has ended.
-        Stopping = 0x430F,
-        /// An override above 100 %.
-        Override = 0x4310,
-        /// A parameter out of range (T_f <= 0, T0 <= 0, an unknown override type).
-        Parameter = 0x4311,
-        /// An axis of the running group faulted (following error, drive); the job ended.
-        AxisFault = 0x4312,
-    }
-}
-
-hli_enum! {
-    /// Why the flying saw refused a coupling or ended one (seed 001, chapter 13 and the
-    /// `SyncMode` checks of chapter 5). The seed refers to the controller's general error
-    /// list for the numbers; these are ours. A violated check is reported as `Limit`
-    /// unless `GEARINSYNC_OPMASK_DETAILEDERRORCODES` asks for the check's own code.
-    SawError: u32, "SawError" {
-        /// The master is not an axis of the machine, or is the slave itself.
-        NoSuchMaster = 0x4400,
-        /// The master stands and the slave moves: no coupling is possible (chapter 13).
-        MasterAtRest = 0x4401,
-        /// Gear ratio 0 (numerator 0 or denominator 0).
-        RatioZero = 0x4402,
-        /// A negative velocity, acceleration, deceleration or jerk.
-        NegativeLimit = 0x4403,
-        /// The master sync position is not ahead of the master in its direction of travel.
-        MasterSyncNotAhead = 0x4404,
-        /// The slave sync position is not ahead of the slave (ratio > 0) or behind it
-        /// (ratio < 0).
-        SlaveSyncNotAhead = 0x4405,
-        /// The internal motion-function table 256 - slave axis ID is used by a cam.
-        TableInUse = 0x4406,
-        /// The time-based profile exists for MC_GearInVelo only.
-        TimeBasedPosition = 0x4407,
-        /// Unknown bits in the check or operation mask, or an unknown sync mode.
-        Mode = 0x4408,
-        /// A value that is not finite, or a profile that would not be.
-        NotFinite = 0x4409,
-        /// A check of the sync mode failed (the check's own code with DETAILEDERRORCODES).
-        Limit = 0x440A,
-        /// MC_GearOut for an axis the saw does not drive, or a characteristics read for an
-        /// axis the saw never planned for.
-        NotCoupled = 0x440B,
-        /// Position sync with a master standing still.
-        MasterStands = 0x440C,
-        /// Check MINPOS: the slave would pass its lower software limit.
-        CheckMinPos = 0x4410,
-        /// Check MAXPOS: the slave would pass its upper software limit.
-        CheckMaxPos = 0x4411,
-        /// Check MAXVELO: the slave would exceed the velocity limit.
-        CheckMaxVelo = 0x4412,
-        /// Check MAXACC: the slave would exceed the acceleration limit.
-        CheckMaxAcc = 0x4413,
-        /// Check MAXDEC: the slave would exceed the deceleration limit.
-        CheckMaxDec = 0x4414,
-        /// Check MAXJERK: the slave would exceed the jerk limit.
-        CheckMaxJerk = 0x4415,
-        /// Check OVERSHOOTPOS: the slave would pass its sync position.
-        CheckOvershootPos = 0x4416,
-        /// Check UNDERSHOOTPOS: the slave would move back behind its start position.
-        CheckUndershootPos = 0x4417,
-        /// Check OVERSHOOTVELO: the slave velocity would pass beyond both its start and its
-        /// sync velocity.
-        CheckOvershootVelo = 0x4418,
-        /// Check UNDERSHOOTVELO: the slave velocity would fall below both its start and its
-        /// sync velocity.
-        CheckUndershootVelo = 0x4419,
-        /// Check OVERSHOOTVELOZERO: the slave velocity would rise above 0.
-        CheckOvershootVeloZero = 0x441A,
-        /// Check UNDERSHOOTVELOZERO: the slave velocity would fall below 0.
-        CheckUndershootVeloZero = 0x441B,
     }
 }
 

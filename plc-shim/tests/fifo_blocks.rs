@@ -6,9 +6,9 @@
 //! cycle of the Execute edge and nothing reaches the CNC; a block of exactly one call, or the
 //! first rows of a larger array, is sent.
 
+use hli::calls::fifo::FifoError;
 use hli::calls::fifo::{FifoReply, FifoStartCall, FIFO_BLOCK_VALUES};
 use hli::calls::CallKind;
-use hli::enums::FifoError;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::blocks::fifo::{FifoStart, FifoWrite, ERROR_BLOCK_SIZE};
 use plc_shim::kernel::ERROR_NO_ANSWER;

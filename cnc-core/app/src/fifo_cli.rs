@@ -111,7 +111,7 @@ fn call<C: AcyclicCall<Reply = FifoReply>>(
 }
 
 fn refused(what: &str, code: u32) -> Failure {
-    let name = hli::enums::FifoError::decode(code)
+    let name = hli::calls::fifo::FifoError::decode(code)
         .map(|e| format!("{e:?}"))
         .or_else(|_| hli::enums::AxisError::decode(code).map(|e| format!("{e:?}")))
         .unwrap_or_default();

@@ -18,7 +18,7 @@ use cnc_core::nc::json::number;
 use cnc_core::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
-use hli::enums::SawError;
+use hli::calls::saw::SawError;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;

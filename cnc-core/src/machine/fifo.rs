@@ -25,11 +25,12 @@ use crate::fifo::{
 };
 use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::FifoError;
 use hli::calls::fifo::{
     FifoIntegrateCall, FifoOverrideCall, FifoOverrideType, FifoParametersCall, FifoReply,
 };
 use hli::calls::{decode_body, reply, CallKind, CallSpec, ErrorCode, HandlerResult};
-use hli::enums::{AxisState, CouplingState, FifoError, FifoGroupState};
+use hli::enums::{AxisState, CouplingState, FifoGroupState};
 use hli::layout::{
     HliFifoGroupState, FIFO_FLAG_AT_END, FIFO_FLAG_OVERRIDE_SETTLED, FIFO_FLAG_UNDERRUN,
     FIFO_OVERRIDE_FULL, HLI_MAX_FIFO_GROUPS,

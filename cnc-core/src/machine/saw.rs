@@ -14,12 +14,13 @@ use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{TableOrganisation, TABLE_TYPE_MOTION_FUNCTION};
+use hli::calls::saw::SawError;
 use hli::calls::saw::{
     SawCharacCall, SawCharacReply, SawGearInCall, SawGearOutCall, SawReply, SawSyncMode,
     SawSyncTarget, SAW_CHARAC_PART,
 };
 use hli::calls::{decode_body, reply, CallKind, CallSpec, ErrorCode, HandlerResult};
-use hli::enums::{AxisState, CouplingState, SawError};
+use hli::enums::{AxisState, CouplingState};
 
 #[derive(Debug, Clone, Copy)]
 struct SawSlave {

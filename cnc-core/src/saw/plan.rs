@@ -14,7 +14,7 @@ use super::shape::{
 };
 use crate::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
-use hli::enums::SawError;
+use hli::calls::saw::SawError;
 
 /// What to synchronise on.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -8,7 +8,8 @@
 use cnc_core::saw::{self, Limits, Plan, Shape, SyncOn};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
-use hli::enums::{AxisState, SawError};
+use hli::calls::saw::SawError;
+use hli::enums::AxisState;
 
 use super::saw_plan::{kin, limits, request, LIMIT_CHECKS};
 

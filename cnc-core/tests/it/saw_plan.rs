@@ -6,7 +6,7 @@
 use cnc_core::saw::{self, Limits, Plan, SawRequest, Shape, SyncOn};
 use cnc_core::setpoint::Kinematic;
 use hli::calls::saw::sync_mask as m;
-use hli::enums::SawError;
+use hli::calls::saw::SawError;
 use proptest::prelude::*;
 
 const TICK: f64 = 0.001;

@@ -2,9 +2,41 @@
 //! chunks, couplings (MC_CamIn, MC_CamOut, MC_CamScaling), the online change of points and
 //! the multi-table slaves. Every reply is a [`CamReply`] unless a read says otherwise.
 
-use crate::enums::wire_enum;
+use crate::enums::{hli_enum, wire_enum};
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
+
+hli_enum! {
+    /// Why the cam engine refused a coupling command (beside the seed's table codes for an
+    /// unknown table and the axis layer's codes for a slave that cannot be coupled). The
+    /// seed does not number these; they are ours.
+    CamCouplingError: u32, "CamCouplingError" {
+        /// The master axis does not exist.
+        NoSuchMaster = 0x4260,
+        /// The master is the slave itself.
+        MasterIsSlave = 0x4261,
+        /// Activation, start and scaling mode do not go together (seed 5.1.16.13/14), or
+        /// MC_CamIn's start mode contradicts the MasterAbsolute/SlaveAbsolute its table was
+        /// selected with (MC_CamTableSelect).
+        ModeCombination = 0x4262,
+        /// The activation position lies behind the master in its direction of travel.
+        ActivationPassed = 0x4263,
+        /// MC_CamOut or MC_CamScaling on a slave no cam couples.
+        NotCamCoupled = 0x4264,
+        /// A coupling made with MC_CamIn cannot switch cams (MC_CamInExt can).
+        NotSwitchable = 0x4265,
+        /// An offset or scaling that is not finite, or a master scaling of 0.
+        BadParameter = 0x4266,
+        /// An unknown start, activation or scaling mode number.
+        UnknownMode = 0x4267,
+        /// A table a coupling uses cannot be replaced.
+        TableInUse = 0x4268,
+        /// A chunk that does not continue its transfer (order, count, total).
+        ChunkOutOfOrder = 0x4269,
+        /// MC_CamScaling or a switch while the first coupling still waits for its activation.
+        CouplingPending = 0x426A,
+    }
+}
 
 wire_enum! {
     /// `MC_StartMode` ([`CamInCall::start_mode`]): whether the cam's master and slave
@@ -179,7 +211,7 @@ pub struct CamScalingCall {
 
 /// The reply to every cam call: 0 when accepted, else the error code of the refusal (the
 /// seed's table codes 0x4B30.., [`crate::enums::AxisError`] or
-/// [`crate::enums::CamCouplingError`]).
+/// [`CamCouplingError`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
 pub struct CamReply {

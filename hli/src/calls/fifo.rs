@@ -10,9 +10,55 @@
 //! the seed.
 
 use crate::calls::CallKind;
-use crate::enums::wire_enum;
+use crate::enums::{hli_enum, wire_enum};
 use crate::wire::BulkHeader;
 use bytemuck::{Pod, Zeroable};
+
+hli_enum! {
+    /// Why the FIFO engine refused a call or ended a job (seed 002 gives no numbers: these
+    /// are ours). A refused call leaves the queued rows and the group as they were.
+    FifoError: u32, "FifoError" {
+        /// The group index is not a configured FIFO group.
+        NoSuchGroup = 0x4300,
+        /// The axis is not an axis of the machine (channel axes are refused as coupled: they
+        /// belong to their channel).
+        NoSuchAxis = 0x4301,
+        /// The group position is outside 1..=N.
+        GroupPosition = 0x4302,
+        /// Another axis holds that group position.
+        PositionTaken = 0x4303,
+        /// The axis is in a FIFO group already.
+        AxisInGroup = 0x4304,
+        /// The axis is coupled to another engine (cam, gear, saw).
+        AxisCoupled = 0x4305,
+        /// The axis moves: only a standing axis joins a group.
+        AxisMoving = 0x4306,
+        /// FiFoStart with fewer than N axes integrated.
+        GroupIncomplete = 0x4307,
+        /// FiFoStart on an empty FIFO.
+        Empty = 0x4308,
+        /// FiFoStart: the first row is not where the axes stand.
+        StartMismatch = 0x4309,
+        /// The group runs: integrate, disintegrate, start and parameters wait for Idle.
+        Running = 0x430A,
+        /// The block does not fit the free rows; nothing was queued (offer it again).
+        Full = 0x430B,
+        /// The block's column count is not the group's dimension N.
+        Columns = 0x430C,
+        /// A value of the block is NaN or infinite (its row and column in the reply).
+        NonFinite = 0x430D,
+        /// A block without rows, or larger than one block holds.
+        BlockSize = 0x430E,
+        /// FiFoStop was given: no override change and no rows until the job has ended.
+        Stopping = 0x430F,
+        /// An override above 100 %.
+        Override = 0x4310,
+        /// A parameter out of range (T_f <= 0, T0 <= 0, an unknown override type).
+        Parameter = 0x4311,
+        /// An axis of the running group faulted (following error, drive); the job ended.
+        AxisFault = 0x4312,
+    }
+}
 
 /// Values (rows x columns) one row block may carry: 64 KiB of `f64`, the buffer size of the
 /// seed's sample program.
@@ -35,7 +81,7 @@ wire_enum! {
 }
 
 /// The reply to every FIFO call and row block: 0 when accepted, else a raw
-/// [`crate::enums::FifoError`] or [`crate::enums::AxisError`]; and the FIFO's state after it.
+/// [`FifoError`] or [`crate::enums::AxisError`]; and the FIFO's state after it.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
 pub struct FifoReply {

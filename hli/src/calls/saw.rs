@@ -4,9 +4,72 @@
 //! index); the master is an axis index in the body. The slave's progress is read from its
 //! axis image: `coupling_state_r` 2 (velocity) or 3 (position) and `nAxisState` 11/12/13.
 
-use crate::enums::wire_enum;
+use crate::enums::{hli_enum, wire_enum};
 use crate::wire::ACYCLIC_BODY_SIZE;
 use bytemuck::{Pod, Zeroable};
+
+hli_enum! {
+    /// Why the flying saw refused a coupling or ended one (seed 001, chapter 13 and the
+    /// `SyncMode` checks of chapter 5). The seed refers to the controller's general error
+    /// list for the numbers; these are ours. A violated check is reported as `Limit`
+    /// unless `GEARINSYNC_OPMASK_DETAILEDERRORCODES` asks for the check's own code.
+    SawError: u32, "SawError" {
+        /// The master is not an axis of the machine, or is the slave itself.
+        NoSuchMaster = 0x4400,
+        /// The master stands and the slave moves: no coupling is possible (chapter 13).
+        MasterAtRest = 0x4401,
+        /// Gear ratio 0 (numerator 0 or denominator 0).
+        RatioZero = 0x4402,
+        /// A negative velocity, acceleration, deceleration or jerk.
+        NegativeLimit = 0x4403,
+        /// The master sync position is not ahead of the master in its direction of travel.
+        MasterSyncNotAhead = 0x4404,
+        /// The slave sync position is not ahead of the slave (ratio > 0) or behind it
+        /// (ratio < 0).
+        SlaveSyncNotAhead = 0x4405,
+        /// The internal motion-function table 256 - slave axis ID is used by a cam.
+        TableInUse = 0x4406,
+        /// The time-based profile exists for MC_GearInVelo only.
+        TimeBasedPosition = 0x4407,
+        /// Unknown bits in the check or operation mask, or an unknown sync mode.
+        Mode = 0x4408,
+        /// A value that is not finite, or a profile that would not be.
+        NotFinite = 0x4409,
+        /// A check of the sync mode failed (the check's own code with DETAILEDERRORCODES).
+        Limit = 0x440A,
+        /// MC_GearOut for an axis the saw does not drive, or a characteristics read for an
+        /// axis the saw never planned for.
+        NotCoupled = 0x440B,
+        /// Position sync with a master standing still.
+        MasterStands = 0x440C,
+        /// Check MINPOS: the slave would pass its lower software limit.
+        CheckMinPos = 0x4410,
+        /// Check MAXPOS: the slave would pass its upper software limit.
+        CheckMaxPos = 0x4411,
+        /// Check MAXVELO: the slave would exceed the velocity limit.
+        CheckMaxVelo = 0x4412,
+        /// Check MAXACC: the slave would exceed the acceleration limit.
+        CheckMaxAcc = 0x4413,
+        /// Check MAXDEC: the slave would exceed the deceleration limit.
+        CheckMaxDec = 0x4414,
+        /// Check MAXJERK: the slave would exceed the jerk limit.
+        CheckMaxJerk = 0x4415,
+        /// Check OVERSHOOTPOS: the slave would pass its sync position.
+        CheckOvershootPos = 0x4416,
+        /// Check UNDERSHOOTPOS: the slave would move back behind its start position.
+        CheckUndershootPos = 0x4417,
+        /// Check OVERSHOOTVELO: the slave velocity would pass beyond both its start and its
+        /// sync velocity.
+        CheckOvershootVelo = 0x4418,
+        /// Check UNDERSHOOTVELO: the slave velocity would fall below both its start and its
+        /// sync velocity.
+        CheckUndershootVelo = 0x4419,
+        /// Check OVERSHOOTVELOZERO: the slave velocity would rise above 0.
+        CheckOvershootVeloZero = 0x441A,
+        /// Check UNDERSHOOTVELOZERO: the slave velocity would fall below 0.
+        CheckUndershootVeloZero = 0x441B,
+    }
+}
 
 /// `ST_SyncMode` bits: the checks (chapter 5, values as the seed gives them) and the
 /// operation masks.
@@ -117,7 +180,7 @@ pub struct SawGearOutCall {
 }
 
 /// The reply to the coupling and decoupling calls: 0 when accepted, else a raw
-/// [`crate::enums::SawError`] or [`crate::enums::AxisError`].
+/// [`SawError`] or [`crate::enums::AxisError`].
 #[repr(C)]
 #[derive(Debug, Clone, Copy, Pod, Zeroable, Default, PartialEq, Eq)]
 pub struct SawReply {

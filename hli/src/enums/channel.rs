@@ -1,8 +1,6 @@
 //! The enumerations of the channel control unit (`gpCh[i]^channel_control`): commands, states,
 //! modes, the answer of a command, refusals and operator signals.
 
-use super::InvalidValue;
-
 hli_enum! {
     /// A command of the PLC to its channel (`HLI_CHANNEL_COMMAND.command`).
     ChannelCommand: i32, "HLI_CHANNEL_COMMAND.command" {

@@ -34,7 +34,7 @@ hli_struct! {
         pub entries_r: u32 => [16, Cnc],
         /// Rows a write may bring now (`capacity_r - entries_r`).
         pub free_r: u32 => [20, Cnc],
-        /// Raw [`crate::enums::FifoError`] of a fault that ended the job (an axis lost), 0
+        /// Raw [`crate::calls::fifo::FifoError`] of a fault that ended the job (an axis lost), 0
         /// when none.
         pub error_id_r: u32 => [24, Cnc],
         /// `FIFO_FLAG_*` bits.

@@ -3,7 +3,7 @@
 //! FiFoSetChannelOverride, our FiFoSetParameters, and the library version function, on the
 //! block kernel ([`crate::kernel`]: its Execute, timeout and output rules). Each sends on the
 //! rising Execute edge without waiting, is Busy until the CNC answers, then Done or Error
-//! (with the CNC's code, [`hli::enums::FifoError`] or [`hli::enums::AxisError`]). No answer
+//! (with the CNC's code, [`hli::calls::fifo::FifoError`] or [`hli::enums::AxisError`]). No answer
 //! within the timeout (the seed's tTimeout; default 1000 cycles) is an Error with
 //! [`crate::kernel::ERROR_NO_ANSWER`]: the call may still have been executed.
 //!
@@ -47,7 +47,7 @@ pub fn fifo_library_version() -> &'static str {
 
 /// Error id of a row block that does not fit one call (more than
 /// [`FIFO_BLOCK_VALUES`] values, or rows x columns not the slice given): refused in the PLC.
-pub const ERROR_BLOCK_SIZE: u32 = hli::enums::FifoError::BlockSize.raw();
+pub const ERROR_BLOCK_SIZE: u32 = hli::calls::fifo::FifoError::BlockSize.raw();
 
 /// The CNC's answer to a FIFO call: Done with its reply, or Error with its code (the reply
 /// beside it: the FIFO's state and fill level).

@@ -28,11 +28,12 @@ use crate::blocks::fifo::{
 use crate::blocks::motion::McPower;
 use crate::fifo_file::{Buffer, Fed, Feeder, FileError};
 use crate::runtime::{PlcIo, PlcProgram};
+use hli::calls::fifo::FifoError;
 use hli::calls::fifo::{
     FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall, FifoStartCall,
     FifoStopCall, FIFO_BLOCK_VALUES, FIFO_MAX_DIMENSION,
 };
-use hli::enums::{FifoError, FifoGroupState};
+use hli::enums::FifoGroupState;
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 
 /// The steps of the sequence.

@@ -8,10 +8,11 @@ use cnc_app::scenario::{InProcess, Scenario};
 use cnc_core::saw;
 use cnc_core::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::SawError;
 use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget,
 };
-use hli::enums::{AxisError, AxisState, CouplingState, SawError};
+use hli::enums::{AxisError, AxisState, CouplingState};
 use hli::layout::HliAxisLrState;
 use hli::views::{CncView, PlcView};
 
@@ -477,7 +478,7 @@ fn the_saws_internal_table_and_a_cam_table_exclude_each_other() {
         let view = CncView::new(&run.memory);
         run.machine.call(&view, 254, &call).unwrap().error_id
     };
-    let in_use = hli::enums::CamCouplingError::TableInUse.raw();
+    let in_use = hli::calls::cam::CamCouplingError::TableInUse.raw();
     assert_eq!(rows(&mut run), in_use, "the saw plans in table 254");
     assert_eq!(gear_out(&mut run, SAW), 0);
     run.step(TICK);

@@ -5,10 +5,11 @@
 
 use cnc_app::scenario::InProcess;
 use hli::calls::axis::AxisCommandCall;
+use hli::calls::saw::SawError;
 use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncTarget,
 };
-use hli::enums::{AxisState, SawError};
+use hli::enums::AxisState;
 use hli::views::CncView;
 
 use super::saw_engine::{command, machine as engine_machine, phase, set, until};

@@ -17,12 +17,13 @@ use crate::cam::multi_table::{
 use crate::cam::online::MasterNow;
 use crate::cam::{CamProfile, PositionTable, ProfileCursor, TableErrorCode};
 use crate::setpoint::Kinematic;
+use hli::calls::cam::CamCouplingError;
 use hli::calls::cam::{
     CamInCall, CamInterpolation, CamMultiCoupleCall, CamMultiTableCall, CamMultiTableOp,
     CamOutCall, CamScalingCall, CamScalingMode, CamStartMode, CamTableSelectCall,
 };
 use hli::calls::{decode_body, ErrorCode, HandlerResult};
-use hli::enums::{AxisError, AxisState, CamCouplingError, CouplingState};
+use hli::enums::{AxisError, AxisState, CouplingState};
 use hli::wire::AcyclicRequest;
 
 /// Couples axis `slave` to `master` as a cam slave in `phase`; the axis layer's refusal code.

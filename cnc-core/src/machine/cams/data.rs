@@ -10,6 +10,7 @@ use crate::cam::online::{ActivationMode, MasterNow};
 use crate::cam::{
     CamProfile, MotionFunction, MotionFunctionPoint, PositionTable, TableErrorCode, TableType,
 };
+use hli::calls::cam::CamCouplingError;
 use hli::calls::cam::{
     CamActivationMode, CamInterpolation, CamOnlineModeCall, CamPointsReadCall, CamPointsReply,
     CamPointsWriteCall, CamRowsWriteCall, CamScalingMode, CamTableDeleteCall,
@@ -17,7 +18,6 @@ use hli::calls::cam::{
     CAM_ROWS_DECLARE, CAM_ROWS_PER_CALL,
 };
 use hli::calls::{decode_body, reply, HandlerResult};
-use hli::enums::CamCouplingError;
 use hli::wire::AcyclicRequest;
 
 /// Points of a transfer received so far.

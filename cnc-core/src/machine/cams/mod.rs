@@ -36,12 +36,13 @@ use crate::cam::online::{ActivationMode, CamStore, MasterNow};
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode};
 use crate::setpoint::Kinematic;
 use data::{PointsTransfer, RowsTransfer};
+use hli::calls::cam::CamCouplingError;
 use hli::calls::cam::{
     CamReply, CamScalingMode, CamStartMode, CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING,
     CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
 };
 use hli::calls::{reply, CallKind, CallSpec, ErrorCode, HandlerResult};
-use hli::enums::{AxisState, CamCouplingError};
+use hli::enums::AxisState;
 
 /// Table IDs run 1..=255.
 const TABLE_SLOTS: usize = 256;

@@ -6,12 +6,12 @@ use super::{CamEngine, Queued, Slave, TABLE_INVALID};
 use crate::axis::AxisSet;
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode, TableType};
 use crate::setpoint::Kinematic;
+use hli::calls::cam::CamCouplingError;
 use hli::calls::cam::{
     CamReadCall, CamReadKind, CamScalingMode, CamValuesReply, TableOrganisation,
     CAM_VALUES_PER_REPLY,
 };
 use hli::calls::{decode_body, reply, HandlerResult};
-use hli::enums::CamCouplingError;
 use hli::wire::AcyclicRequest;
 
 /// The values a read made: all of them, or (`from` > 0) only those from index `from` on.

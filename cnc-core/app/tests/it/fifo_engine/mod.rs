@@ -6,13 +6,14 @@
 
 use cnc_app::scenario::{InProcess, Scenario};
 use hli::calls::axis::AxisCommandCall;
+use hli::calls::fifo::FifoError;
 use hli::calls::fifo::{
     rows_header, FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoOverrideType, FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall,
     FifoWriteRowsCall,
 };
 use hli::calls::{decode_reply, AcyclicCall, CallKind};
-use hli::enums::{AxisError, CouplingState, FifoError, FifoGroupState};
+use hli::enums::{AxisError, CouplingState, FifoGroupState};
 use hli::layout::{FIFO_FLAG_AT_END, FIFO_FLAG_UNDERRUN};
 use hli::views::{CncView, PlcView};
 use hli::wire::BulkHeader;
