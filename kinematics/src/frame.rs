@@ -122,7 +122,7 @@ impl RotationOrder {
             .filter(|v| v.iter().all(|x| x.is_finite()) && fits(v))
             .map(unwrap)
             .min_by(|x, y| distance(x).total_cmp(&distance(y)))
-            .unwrap_or([a, b, c])
+            .unwrap_or_else(|| unwrap([a, b, c]))
     }
 }
 

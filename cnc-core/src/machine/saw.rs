@@ -167,7 +167,18 @@ impl SawEngine {
         };
         let m = master_values(axes, master, actual, self.cycle_s).unwrap_or_default();
         let s = axis.engine_setpoint();
-        let plan = match saw::plan(&request, &m, &s, axis.config().soft_limits) {
+        // Planned in the engine's frame: a slave re-coupled in place keeps its superimposed
+        // offset (MC_MoveSuperimposed), so its software limits stand that much nearer there.
+        let offset = if ours {
+            axis.superimposed_offset()
+        } else {
+            0.0
+        };
+        let soft_limits = axis
+            .config()
+            .soft_limits
+            .map(|[min, max]| [min - offset, max - offset]);
+        let plan = match saw::plan(&request, &m, &s, soft_limits) {
             Ok(p) => p,
             Err(e) => return refused(e),
         };
@@ -175,7 +186,6 @@ impl SawEngine {
             SyncOn::Velocity => CouplingState::GearVelocity,
             SyncOn::Position { .. } => CouplingState::GearPosition,
         };
-        let soft_limits = axis.config().soft_limits;
         let coupling = Coupling {
             kind,
             master: master as i32,

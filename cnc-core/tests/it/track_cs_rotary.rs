@@ -6,7 +6,7 @@
 
 use tests::channel_rig as support;
 
-use cnc_core::channel::RunState;
+use cnc_core::channel::{ChannelConfig, RunState};
 use hli::enums::DynCsState;
 use hli::views::CncView;
 use kinematics::tracking::{Tracking, TrackingMode, TrackingOption};
@@ -173,4 +173,49 @@ fn an_euler_zyz_slave_follows_a_tilt_through_the_singular_orientation() {
         a_seen.0 > -90.01 && a_seen.1 < -89.99,
         "A stayed (within the rounding near B = 0) while B passed 0: {a_seen:?}"
     );
+}
+
+/// The same pair, the slave switching off (FILTER=300) while the master stands at A-90 B-2
+/// C90: its words blend back without a step, and what the nearest words kept at the end of
+/// the blend (A-90 C90, no rotation in Z-Y-Z) is caught up within the axes' limits before the
+/// tracking is INACTIVE; the slave ends on its programmed words.
+#[test]
+fn an_euler_zyz_slave_switches_off_onto_its_programmed_words_without_a_step() {
+    let master = format!(
+        "{MASTER_ON}#TIME 0.05\nG1 A-90 B2 C90 F3000\n#TIME 0.1\nG1 B-2 F3000\n#TIME 5\nM30\n"
+    );
+    let slave = "#TRACK CS ON [CH=1 FILTER=0 WAIT]\n#TIME 3.5\n#TRACK CS OFF [FILTER=300 WAIT]\n\
+                 #TIME 0.5\nM30\n";
+    // The slave with real axis limits (the rig's are stiff): a step would break them.
+    let (mut m, mut s) = (
+        cartesian("master"),
+        ChannelConfig::new("slave", &["X", "Y", "Z", "A", "B", "C"]),
+    );
+    m.ori_rotation_angle = 1;
+    s.ori_rotation_angle = 1;
+    let limit = s.axis_limits(3).velocity * support::CYCLE;
+    let mut ctl = controller(vec![(m, master.as_str()), (s, slave)]);
+    let memory = image(2);
+    let view = CncView::new(&memory);
+    let mut last: Option<[f64; 6]> = None;
+    let mut largest = 0.0f64;
+    for _ in 0..6000 {
+        ctl.tick(&view);
+        let now: [f64; 6] = core::array::from_fn(|k| ctl.channels()[1].set_points()[k]);
+        if let Some(before) = last {
+            for k in 3..6 {
+                largest = largest.max((now[k] - before[k]).abs());
+            }
+        }
+        last = Some(now);
+    }
+    for c in ctl.channels() {
+        assert_ne!(c.state(), RunState::Error, "{:?}", c.error());
+    }
+    assert!(
+        largest <= limit * (1.0 + 1e-6),
+        "a step of {largest} degree in a tick"
+    );
+    assert_eq!(ctl.channels()[1].tracker().state(), DynCsState::Inactive);
+    assert_words(last.unwrap(), [0.0; 6], "the slave after switching off");
 }

@@ -236,7 +236,11 @@ impl InFlight for PointsRead {
         };
         // To the function's end; NumPoints beyond it reads what there is (manual 000,
         // 5.1.8: NumPointsRead may be smaller than NumPoints).
-        let left = (reply.total + 1).saturating_sub(self.first) as usize;
+        if reply.count as usize > reply.points.len() {
+            // A part the reply cannot hold: as if no answer came (as for the value reads).
+            return Polled::Answer(Err(crate::kernel::ERROR_NO_ANSWER));
+        }
+        let left = reply.total.saturating_add(1).saturating_sub(self.first) as usize;
         let wanted = match self.count {
             0 => left,
             count => (count as usize).min(left),

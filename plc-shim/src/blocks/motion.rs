@@ -51,14 +51,16 @@ fn follow(
     let Ok(place) = io.view.axis(axis as usize) else {
         return Step::Ended(Outputs::failed(hli::calls::ErrorCode::InvalidTarget.raw()));
     };
-    let book: HliAxisCommandState = place
-        .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
-        .read();
+    // The superimposed id first: the CNC writes the book before it, so a move that ends
+    // between the two reads is then found in the book as Done, never missed by both.
     let running_beside = place
         .field::<u32>(
             core::mem::offset_of!(HliAxis, drive_state)
                 + core::mem::offset_of!(HliAxisDriveState, superimposed_id_r),
         )
+        .read();
+    let book: HliAxisCommandState = place
+        .field::<HliAxisCommandState>(core::mem::offset_of!(HliAxis, command_state))
         .read();
     if beside && id != 0 && running_beside == id {
         return Step::Running(Outputs {

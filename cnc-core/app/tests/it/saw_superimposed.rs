@@ -94,3 +94,58 @@ fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_agai
     assert!((velocity - master.velocity).abs() < 1e-9, "{velocity}");
     assert!((engine_velocity - velocity).abs() < 1e-9);
 }
+
+/// A rollback with the lock (manual 001, chapter 8): the saw stops and stands (its
+/// pre-phase, 11). A superimposed move running then is braked and aborted, so the saw comes
+/// to rest, and a new one is refused (0x4235) while it stands.
+#[test]
+fn a_rollback_brakes_and_aborts_a_superimposed_move_and_refuses_a_new_one() {
+    use hli::calls::saw::sync_mask as m;
+    let mut run = machine();
+    let forward = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, forward).error_id, 0);
+    let gear = SawGearInCall {
+        master: MASTER,
+        target: SawSyncTarget::Velocity.raw(),
+        ratio_numerator: 1.0,
+        ratio_denominator: 1,
+        mask: m::ROLLBACKLOCK,
+        acceleration: 2500.0,
+        deceleration: 2500.0,
+        jerk: 5000.0,
+        ..SawGearInCall::default()
+    };
+    let view = CncView::new(&run.memory);
+    assert_eq!(run.machine.call(&view, SAW, &gear).unwrap().error_id, 0);
+    let state = |run: &InProcess| {
+        let a = run.machine.axes().axis(SAW as usize).unwrap();
+        a.motion_state(a.setpoint()).raw()
+    };
+    for _ in 0..5000 {
+        run.step(0.001);
+        if state(&run) == AxisState::SlaveSynchronous.raw() {
+            break;
+        }
+    }
+    assert_eq!(state(&run), AxisState::SlaveSynchronous.raw());
+    let long = AxisCommandCall::move_superimposed(500.0, [50.0, 1000.0, 1000.0, 1e5]);
+    let shift = command(&mut run, SAW, long);
+    assert_eq!(shift.error_id, 0);
+    let back = AxisCommandCall::move_velocity(-1, [2000.0, 10000.0, 10000.0, 1e6]);
+    assert_eq!(command(&mut run, MASTER, back).error_id, 0);
+    for _ in 0..3000 {
+        run.step(0.001);
+    }
+    let axis = run.machine.axes().axis(SAW as usize).unwrap();
+    assert_eq!(state(&run), AxisState::SlavePrephase.raw());
+    assert_eq!(
+        view_command(&axis.book().image(), shift.command_id),
+        CommandView::Aborted
+    );
+    assert_eq!(axis.setpoint().velocity, 0.0, "the saw stands");
+    let again = command(&mut run, SAW, long);
+    assert_eq!(
+        again.error_id,
+        hli::enums::AxisError::SuperimposedNotCoupled.raw()
+    );
+}

@@ -294,14 +294,16 @@ impl Axis {
                 }
             }
             0 => {
+                // Coupled: the engine's motion and a superimposed move count alike.
                 let moving = match self.coupling {
-                    Some(_) => self.coupled_setpoint.velocity != 0.0,
+                    Some(_) => self.setpoint().velocity != 0.0 || self.superimposed.id() != 0,
                     None => self.generator.goal() != Goal::Hold,
                 };
                 if moving {
                     return Err(AxisError::MovingWhileDisable);
                 }
                 // A disabled axis is nobody's slave: the coupling ends with the power.
+                self.drop_superimposed(CommandResult::Aborted, None);
                 self.coupling = None;
                 self.stop_lock = false;
                 self.power_requested = false;

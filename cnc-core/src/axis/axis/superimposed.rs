@@ -51,14 +51,31 @@ impl Axis {
                 CouplingState::Cam | CouplingState::GearVelocity | CouplingState::GearPosition
             )
         });
-        if !held_by_engine {
+        // A flying saw stopping or standing after a rollback (its pre-phase) has no motion to
+        // add to: it is to stand.
+        let stopping = self
+            .coupling
+            .is_some_and(|c| c.phase == AxisState::SlavePrephase);
+        if !held_by_engine || stopping {
             return Err(AxisError::SuperimposedNotCoupled);
         }
         if !call.position.is_finite() {
             return Err(AxisError::TargetOutsideLimits);
         }
         let limits = self.move_limits(call)?;
+        // The velocity difference on top of the engine's velocity now must stay within the
+        // axis's velocity; the offset's end on top of the engine's position now within its
+        // software limits.
+        let engine = self.coupled_setpoint;
+        if engine.velocity.abs() + limits.velocity > self.config.dynamics.velocity {
+            return Err(AxisError::InvalidVelocity);
+        }
         let target = self.superimposed.state().position + call.position;
+        if let Some([min, max]) = self.config.soft_limits {
+            if !(min..=max).contains(&(engine.position + target)) {
+                return Err(AxisError::TargetOutsideLimits);
+            }
+        }
         self.superimposed
             .generator
             .move_to(target, limits)
@@ -68,9 +85,26 @@ impl Axis {
         Ok(self.superimposed.id)
     }
 
-    /// One tick of the superimposed move (while coupled, before the set-point is taken).
+    /// One tick of the superimposed move (while coupled, before the set-point is taken). A
+    /// flying saw that goes into its pre-phase (a rollback: stop and stand) brakes a running
+    /// move with the axis's deceleration and jerk and aborts it.
     pub(super) fn step_superimposed(&mut self) {
-        if self.superimposed.generator.step() == Progress::Reached {
+        let stopping = self
+            .coupling
+            .is_some_and(|c| c.phase == AxisState::SlavePrephase);
+        if stopping && self.superimposed.id != 0 {
+            let d = self.config.dynamics;
+            if self
+                .superimposed
+                .generator
+                .brake(d.deceleration, d.jerk)
+                .is_err()
+            {
+                return self.fault(AxisError::GeneratorFailed);
+            }
+            self.end_superimposed(CommandResult::Aborted, None);
+        }
+        if self.superimposed.generator.step() == Progress::Reached && self.superimposed.id != 0 {
             self.end_superimposed(CommandResult::Done, None);
         }
     }

@@ -18,6 +18,8 @@ pub(super) struct PlcFrames {
     tick: u64,
     last: Option<(Isometry3<f64>, u64)>,
     previous: Option<(Isometry3<f64>, u64)>,
+    /// The PLC let go of the master since its last frame: the next one starts anew.
+    let_go: bool,
 }
 
 impl PlcFrames {
@@ -28,23 +30,37 @@ impl PlcFrames {
 
     /// The PLC wrote `frame` this tick.
     pub(super) fn take(&mut self, frame: Isometry3<f64>) {
-        self.previous = self.last;
+        self.previous = if core::mem::take(&mut self.let_go) {
+            None
+        } else {
+            self.last
+        };
         self.last = Some((frame, self.tick));
     }
 
+    /// The PLC no longer commands (enable_w fell): the next frames are not carried on from
+    /// the ones before.
+    pub(super) fn forget_motion(&mut self) {
+        self.previous = None;
+        self.let_go = true;
+    }
+
     /// The master's frame this tick: the one written now, or the last one carried on along
-    /// the motion of the last two until the next is due, else the last one.
+    /// the motion of the last two until the next is due. A frame late by up to one more
+    /// period (a task's jitter) holds where the carrying on stood, so the master does not
+    /// step back and forth; later still, the master is where the PLC last put it.
     pub(super) fn now(&self) -> Option<Isometry3<f64>> {
         let (last, at) = self.last?;
-        let since = self.tick - at;
+        let since = self.tick.saturating_sub(at);
         let Some((before, then)) = self.previous else {
             return Some(last);
         };
-        let period = at - then;
-        if since == 0 || period == 0 || period > MAX_PERIOD_TICKS || since >= period {
+        let period = at.saturating_sub(then);
+        if since == 0 || period == 0 || period > MAX_PERIOD_TICKS || since >= 2 * period {
             return Some(last);
         }
-        Some(extrapolated(&before, &last, since as f64 / period as f64))
+        let carried = since.min(period - 1);
+        Some(extrapolated(&before, &last, carried as f64 / period as f64))
     }
 }
 
@@ -93,11 +109,12 @@ mod tests {
         }
     }
 
-    /// A frame that does not come when due (the master stopped, or the PLC writes only on a
-    /// change): the master is taken where the PLC last put it; frames far apart (a single
-    /// step) are never extrapolated.
+    /// A frame that does not come when due: up to one more period it holds where the
+    /// carrying on stood (no step back), later the master is where the PLC last put it (a
+    /// PLC that stopped writing); frames far apart (a single step) and frames after the PLC
+    /// let go of the master are never carried on.
     #[test]
-    fn a_late_frame_holds_the_last_and_rare_frames_are_not_carried_on() {
+    fn a_late_frame_holds_then_the_last_counts_and_rare_frames_are_not_carried_on() {
         let mut f = PlcFrames::default();
         for tick in 0..4u32 {
             f.advance();
@@ -107,7 +124,11 @@ mod tests {
         }
         // Frames at ticks 0 and 2; tick 3 carried on to 3.
         assert!((f.now().unwrap().translation.x - 3.0).abs() < 1e-12);
-        f.advance(); // tick 4: no frame, due: the last one
+        f.advance(); // tick 4: the frame due is late: held at 3
+        assert!((f.now().unwrap().translation.x - 3.0).abs() < 1e-12);
+        f.advance(); // tick 5: still held
+        assert!((f.now().unwrap().translation.x - 3.0).abs() < 1e-12);
+        f.advance(); // tick 6: two periods without a frame: the last one
         assert_eq!(f.now().unwrap().translation.x, 2.0);
         let mut g = PlcFrames::default();
         g.advance();
@@ -118,5 +139,15 @@ mod tests {
         g.take(frame(0.1, 0.0));
         g.advance();
         assert_eq!(g.now().unwrap().translation.x, 0.1);
+        // Let go of, then written again: not carried on from the frames before.
+        let mut h = PlcFrames::default();
+        h.advance();
+        h.take(frame(0.0, 0.0));
+        h.advance();
+        h.forget_motion();
+        h.advance();
+        h.take(frame(2.0, 0.0));
+        h.advance();
+        assert_eq!(h.now().unwrap().translation.x, 2.0);
     }
 }

@@ -128,10 +128,21 @@ impl Channel {
             let mut c = [0.0; 6];
             if tracking {
                 let t = compensation.translation.vector;
-                let abc = self.pose.order.angles_near(
-                    &compensation.rotation.to_rotation_matrix(),
-                    self.pose.compensation_abc,
-                );
+                // Coupled out to no rotation at all (the switch-off's end): the words return
+                // to 0 while the tracking is still on, so the guard catches up what the
+                // nearest words kept (A-90 C90 is no rotation in Z-Y-Z, 360 none in any
+                // order) and the switching lands on the programmed words, never stepping there.
+                let landing = self.pose.tracker.state() == DynCsState::Deactivating
+                    && compensation.rotation.angle() < 1e-9;
+                let near = if landing {
+                    [0.0; 3]
+                } else {
+                    self.pose.compensation_abc
+                };
+                let abc = self
+                    .pose
+                    .order
+                    .angles_near(&compensation.rotation.to_rotation_matrix(), near);
                 c = [t.x, t.y, t.z, abc[0], abc[1], abc[2]];
             }
             self.pose.compensation_abc = [c[3], c[4], c[5]];

@@ -12,12 +12,17 @@ use kinematics::RotationOrder;
 impl Channel {
     /// The PLC's side of the dynamic-CS unit (not taken during a stop: see [`Wanted`]).
     pub(super) fn plc_inputs(&mut self) {
+        // The frames' clock runs on through a stop, so a frame after it is not taken as the
+        // next of a steady writer.
+        self.plc.frames.advance();
         if self.stopping.is_some() {
             return;
         }
         let enabled = self.plc.inputs.dyn_cs_enabled;
         self.plc.plc_enabled = enabled;
-        self.plc.frames.advance();
+        if !enabled {
+            self.plc.frames.forget_motion();
+        }
         if let Some(cs) = self.plc.inputs.dyn_cs_command {
             // enable_w redirects the dynamic CS to the PLC; without it a commanded frame goes
             // nowhere (taken, so the PLC's semaphore is free again, and counted).

@@ -108,6 +108,12 @@ fn the_coupling_end_keeps_the_offset_and_a_free_axis_refuses() {
     assert_eq!(bad.error_id, AxisError::InvalidVelocity.raw());
     let nan = superimpose(&mut run, SLAVE, f64::NAN, 10.0);
     assert_eq!(nan.error_id, AxisError::TargetOutsideLimits.raw());
+    // On top of the cam's 20 mm/s, the axis's 2000 mm/s leave less than 1990 to the move;
+    // an end beyond the software limit (1e5) is refused before it starts.
+    let fast = superimpose(&mut run, SLAVE, 1.0, 1990.0);
+    assert_eq!(fast.error_id, AxisError::InvalidVelocity.raw());
+    let far = superimpose(&mut run, SLAVE, 2e5, 10.0);
+    assert_eq!(far.error_id, AxisError::TargetOutsideLimits.raw());
     assert_eq!(slave(&run).superimposed_offset(), 0.0);
     // Half-way through a move the slave is decoupled: the move is aborted, the slave goes on
     // from where it stood with the offset, without a jump.
@@ -178,4 +184,38 @@ call = { block = "MC_MoveSuperimposed", instance = "free", axis = 0, distance = 
         .unwrap()
         .superimposed_offset();
     assert!(offset > 3.0 && offset < 23.0, "{offset}");
+}
+
+/// MC_Power off while a superimposed move runs on a slave whose master stands is refused
+/// (the axis moves: 0x4234); once the move is done it is taken, and the move's state is
+/// cleared with the coupling.
+#[test]
+fn power_off_waits_for_a_running_superimposed_move() {
+    let mut run = machine();
+    run.step(0.001);
+    select_cyclic(&mut run, 3);
+    assert_eq!(call(&mut run, SLAVE as u32, cam_in(3)), 0);
+    run.step(0.001);
+    let shift = superimpose(&mut run, SLAVE, 2.0, 50.0);
+    assert_eq!(shift.error_id, 0);
+    run.step(0.001);
+    let view = CncView::new(&run.memory);
+    let off = AxisCommandCall::power(false);
+    let refused = run.machine.call(&view, SLAVE as u32, &off).unwrap();
+    assert_eq!(refused.error_id, AxisError::MovingWhileDisable.raw());
+    while slave(&run).drive_state().superimposed_id_r == shift.command_id {
+        run.step(0.001);
+    }
+    let view = CncView::new(&run.memory);
+    assert_eq!(
+        run.machine
+            .call(&view, SLAVE as u32, &off)
+            .unwrap()
+            .error_id,
+        0
+    );
+    run.step(0.001);
+    assert!(slave(&run).coupling().is_none());
+    assert_eq!(slave(&run).drive_state().superimposed_id_r, 0);
+    assert_eq!(slave(&run).superimposed_offset(), 0.0);
 }
