@@ -43,7 +43,4 @@ pub enum KinError {
         /// Why it is refused.
         reason: &'static str,
     },
-    /// A value does not fit the HLI units.
-    #[error(transparent)]
-    Units(#[from] hli::units::UnitError),
 }

@@ -11,6 +11,7 @@ pub mod diagnosis;
 pub mod dyn_cs;
 pub mod folder;
 pub mod guard;
+pub mod hli_frame;
 pub mod kin_config;
 pub mod path;
 pub mod plc_io;

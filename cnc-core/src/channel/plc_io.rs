@@ -297,10 +297,12 @@ pub fn next_interface(
     published: Option<(Isometry3<f64>, bool)>,
 ) -> HliDynCsChannelInterface {
     let (enabled, valid, cs) = match published {
-        Some((frame, live)) => match kinematics::frame::frame_to_hli(&frame, RotationOrder::Zyx) {
-            Ok(cs) => (true, live, Some(cs)),
-            Err(_) => (true, false, None),
-        },
+        Some((frame, live)) => {
+            match crate::channel::hli_frame::frame_to_hli(&frame, RotationOrder::Zyx) {
+                Ok(cs) => (true, live, Some(cs)),
+                Err(_) => (true, false, None),
+            }
+        }
         None => (false, false, None),
     };
     let mut out = HliDynCsChannelInterface {

@@ -249,7 +249,8 @@ fn a_dh_chain_is_a_master_channel() {
                 .as_f64() as i64
         };
         assert_eq!(leaf("valid_r"), 1);
-        let expected = kinematics::frame::frame_to_hli(&m.tool_pose(), RotationOrder::Zyx).unwrap();
+        let expected =
+            cnc_core::channel::hli_frame::frame_to_hli(&m.tool_pose(), RotationOrder::Zyx).unwrap();
         for k in 0..3 {
             assert_eq!(
                 leaf(&format!("cs_r.translation[{k}]")),

@@ -3,9 +3,9 @@
 
 use tests::channel_rig as support;
 
+use cnc_core::channel::hli_frame::frame_from_hli;
 use cnc_core::channel::{LoadedProgram, RunState};
 use hli::views::{CncView, PlcView};
-use kinematics::frame::frame_from_hli;
 use kinematics::{PoseWords, RotationOrder};
 use support::{cartesian, controller, cs, image};
 

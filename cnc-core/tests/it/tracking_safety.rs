@@ -585,7 +585,8 @@ fn rot_trans_acts_the_same_from_the_nc_and_the_plc_with_and_without_kin_base() {
         rotation: [0, 0, 300_000],
         fill_up_1: 0,
     };
-    let master = kinematics::frame::frame_from_hli(&master_cs, kinematics::RotationOrder::Zyx);
+    let master =
+        cnc_core::channel::hli_frame::frame_from_hli(&master_cs, kinematics::RotationOrder::Zyx);
     for kin_base in [false, true] {
         let mode = if kin_base {
             TrackingMode::KinematicBase

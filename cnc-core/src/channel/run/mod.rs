@@ -58,6 +58,7 @@ use super::plc_io::{
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
+use crate::channel::hli_frame::frame_to_hli;
 use crate::nc::ast::AxisName;
 use crate::nc::decode::MotionBlock;
 use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};
@@ -67,7 +68,7 @@ use crate::setpoint::AxisValues;
 use hli::enums::{ChannelErrorId, DynCsState, ProgramState};
 use hli::layout::{HliCoordState, HliMFunctionAck, HliMFunctionRequest};
 use hli::views::{PathOverride, DEFAULT_PATH_OVERRIDE};
-use kinematics::frame::{frame_to_hli, offset_frame};
+use kinematics::frame::offset_frame;
 use kinematics::tracking::TrackingOption;
 use kinematics::{Joints, Kinematics, PoseWords, RotationOrder};
 use nalgebra::Isometry3;

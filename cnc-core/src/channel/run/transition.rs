@@ -3,10 +3,10 @@
 
 use super::Channel;
 use crate::channel::dyn_cs::{words, BadParameter, MasterSource, TrackError, TrackSetup};
+use crate::channel::hli_frame::frame_from_hli;
 use crate::channel::plc_io::{hli_value, Transition};
 use hli::enums::{DynCsCommand, DynCsTransitionError};
 use hli::layout::HliDynCsTransition;
-use kinematics::frame::frame_from_hli;
 use kinematics::RotationOrder;
 
 impl Channel {
