@@ -27,12 +27,17 @@ pub struct EngineIo<'a, 'm> {
     pub tick: u64,
 }
 
-/// Something engines share and one may hold, asked for by another before it takes it.
+/// Something engines share and one may hold, asked for by another before it takes it: a
+/// kind named by the wire vocabulary that owns it (`hli::calls::<family>`), and a number.
+/// The seam names no engine and no kind: an engine answers [`Engine::holds`] for the kinds
+/// it knows (for example the flying saw plans its slave's motion in the motion table 256 -
+/// the slave's axis ID, seed 001 chapter 13, which a cam must not be using).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Resource {
-    /// Motion-function (cam) table `id`: the flying saw plans its slave's motion in table
-    /// 256 - the slave's axis ID (seed 001, chapter 13), which a cam must not be using.
-    MotionTable(u32),
+pub struct Resource {
+    /// The kind (`hli::calls::cam::MOTION_TABLE`, ...).
+    pub kind: &'static str,
+    /// Which one of the kind.
+    pub id: u32,
 }
 
 /// The engines other than the one answering a call.
@@ -57,13 +62,13 @@ impl<'a> Others<'a> {
             .any(|e| e.holds(resource))
     }
 
-    /// Asks them to let slave `axis` go from a gear coupling ([`Engine::gear_out`]): whether
-    /// one did.
-    pub fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+    /// Asks the engine whose coupling holds slave `axis` to let it go
+    /// ([`Engine::release_slave`]): whether one did.
+    pub fn release_slave(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
         self.before
             .iter_mut()
             .chain(self.after.iter_mut())
-            .any(|e| e.gear_out(axis, axes))
+            .any(|e| e.release_slave(axis, axes))
     }
 }
 
@@ -155,10 +160,11 @@ pub trait Engine: std::fmt::Debug + Send {
         false
     }
 
-    /// MC_GearOut for slave `axis`, asked by the engine that answers MC_GearOut when the
-    /// slave is not its own: an engine whose gear coupling holds the axis lets it go (the
-    /// slave goes on free at its velocity) and says so; the others answer `false`.
-    fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+    /// A decoupling block of another engine's family for slave `axis`, which that engine
+    /// does not hold (MC_GearOut on a `[[gear]]` slave): the engine whose coupling holds the
+    /// axis lets it go, as its own decoupling would (the slave goes on free at its velocity),
+    /// and says so; the others answer `false`.
+    fn release_slave(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
         let _ = (axis, axes);
         false
     }

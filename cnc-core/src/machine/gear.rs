@@ -155,7 +155,7 @@ impl Engine for GearEngine {
         }
     }
 
-    fn gear_out(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
+    fn release_slave(&mut self, axis: usize, axes: &mut AxisSet) -> bool {
         let held = |g: &&mut Gear| g.spec.slave == axis && g.lease.is_some_and(|l| axes.holds(l));
         let Some(gear) = self.gears.iter_mut().find(held) else {
             return false;

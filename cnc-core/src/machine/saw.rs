@@ -50,9 +50,8 @@ struct Characs {
 
 /// The organisation fields of a plan of `pieces` pieces in motion table `table`.
 fn organisation(table: Resource, pieces: usize) -> TableOrganisation {
-    let Resource::MotionTable(table_id) = table;
     TableOrganisation {
-        table_id,
+        table_id: table.id,
         rows: pieces as u32 + 1,
         columns: 1,
         table_type: TABLE_TYPE_MOTION_FUNCTION,
@@ -286,7 +285,10 @@ fn own_table(axes: &AxisSet, slave: usize) -> Resource {
     let id = axes
         .axis(slave)
         .map_or(0, |a| 256u32.wrapping_sub(a.config().id));
-    Resource::MotionTable(id)
+    Resource {
+        kind: hli::calls::cam::MOTION_TABLE,
+        id,
+    }
 }
 
 impl Engine for SawEngine {
@@ -361,7 +363,7 @@ impl Engine for SawEngine {
             // MC_GearOut of a slave the saw does not hold: a gear coupling of another engine.
             CallKind::SAW_GEAR_OUT if !self.owns(slave, axes) => {
                 decode_body::<SawGearOutCall>(request)?;
-                match others.gear_out(slave, axes) {
+                match others.release_slave(slave, axes) {
                     true => accepted(),
                     false => refused(SawError::NotCoupled),
                 }

@@ -424,6 +424,11 @@ pub struct TableOrganisation {
 /// `MC_TableType` of a motion function (`MC_TableType_TABULARTYPE_MOTIONFUNC`).
 pub const TABLE_TYPE_MOTION_FUNCTION: u32 = 22;
 
+/// The resource kind of a cam table ID (1..=255) that engines share: the cam engine holds the
+/// tables it stores, the flying saw the one it plans its slave's motion in (256 - the
+/// slave's axis ID, seed 001 chapter 13). `cnc_core::machine::Resource`.
+pub const MOTION_TABLE: &str = "motion table";
+
 impl TableOrganisation {
     /// The field names, in the structure's order.
     pub const FIELDS: [&'static str; 5] = [

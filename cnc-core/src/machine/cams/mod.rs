@@ -595,9 +595,7 @@ impl Engine for CamEngine {
     }
 
     fn holds(&self, resource: Resource) -> bool {
-        match resource {
-            Resource::MotionTable(id) => self.store.get(id).is_ok(),
-        }
+        resource.kind == hli::calls::cam::MOTION_TABLE && self.store.get(resource.id).is_ok()
     }
 
     fn tick(&mut self, io: &mut EngineIo<'_, '_>) {
@@ -621,7 +619,11 @@ impl Engine for CamEngine {
         // Table data written into a table another engine plans in (the flying saw's table
         // 256 - the slave's axis ID while it drives that slave, seed 001 chapter 13): refused.
         let writes_table = matches!(kind, CallKind::CAM_POINTS_WRITE | CallKind::CAM_ROWS_WRITE);
-        if writes_table && others.hold(Resource::MotionTable(request.target)) {
+        let table = Resource {
+            kind: hli::calls::cam::MOTION_TABLE,
+            id: request.target,
+        };
+        if writes_table && others.hold(table) {
             return code(CamCouplingError::TableInUse.raw());
         }
         match kind {
