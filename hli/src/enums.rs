@@ -13,10 +13,14 @@ pub struct InvalidValue {
     pub allowed: &'static str,
 }
 
+/// Declares a validated enumeration carried as a raw integer: the enum, `ALL`, `raw` and
+/// `decode` (an unknown raw value is an [`InvalidValue`] naming `$st`). The one macro of every
+/// enumeration on the wire: [`wire_enum!`] builds a call's mode selector on it.
 macro_rules! hli_enum {
     (
+        @enum
         $(#[doc = $doc:literal])*
-        $name:ident : $raw:ty, $st:literal {
+        $name:ident : $raw:ty, $st:tt {
             $( $(#[doc = $vdoc:literal])* $variant:ident = $value:expr ),* $(,)?
         }
     ) => {
@@ -36,13 +40,27 @@ macro_rules! hli_enum {
             }
 
             /// Decodes a raw value read from the image.
-            pub fn decode(raw: $raw) -> Result<Self, $crate::enums::InvalidValue> {
+            pub const fn decode(raw: $raw) -> Result<Self, $crate::enums::InvalidValue> {
                 $( if raw == $value { return Ok($name::$variant); } )*
                 Err($crate::enums::InvalidValue {
                     type_name: $st,
                     raw: raw as i64,
                     allowed: concat!($( stringify!($value), " " ),*),
                 })
+            }
+        }
+    };
+    (
+        $(#[doc = $doc:literal])*
+        $name:ident : $raw:ty, $st:literal {
+            $( $(#[doc = $vdoc:literal])* $variant:ident = $value:expr ),* $(,)?
+        }
+    ) => {
+        $crate::enums::hli_enum! {
+            @enum
+            $(#[doc = $doc])*
+            $name: $raw, $st {
+                $( $(#[doc = $vdoc])* $variant = $value ),*
             }
         }
     };
@@ -59,26 +77,20 @@ macro_rules! wire_enum {
             $( $(#[doc = $vdoc:literal])* $variant:ident = $value:literal => $text:literal ),* $(,)?
         }
     ) => {
-        $(#[doc = $doc])*
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        pub enum $name {
-            $( $(#[doc = $vdoc])* $variant, )*
+        $crate::enums::hli_enum! {
+            @enum
+            $(#[doc = $doc])*
+            $name: u32, (stringify!($name)) {
+                $( $(#[doc = $vdoc])* $variant = $value ),*
+            }
         }
 
         impl $name {
-            /// Every value, in declaration order.
-            pub const ALL: &'static [$name] = &[$($name::$variant),*];
-
-            /// The raw value on the wire.
-            pub const fn raw(self) -> u32 {
-                match self { $( $name::$variant => $value, )* }
-            }
-
             /// The value of a raw number, `None` for a number it does not have.
             pub const fn from_raw(raw: u32) -> Option<Self> {
-                match raw {
-                    $( $value => Some($name::$variant), )*
-                    _ => None,
+                match $name::decode(raw) {
+                    Ok(value) => Some(value),
+                    Err(_) => None,
                 }
             }
 
