@@ -39,8 +39,9 @@ fn command(
     run.machine.call(&view, axis, &c).unwrap()
 }
 
-#[test]
-fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_again() {
+/// The master at 500 mm/s and the saw coupled with MC_GearInVelo (ratio 1, SyncMode `mask`),
+/// run until it is synchronous.
+fn synchronous_saw(mask: u32) -> InProcess {
     let mut run = machine();
     let forward = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
     assert_eq!(command(&mut run, MASTER, forward).error_id, 0);
@@ -49,6 +50,7 @@ fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_agai
         target: SawSyncTarget::Velocity.raw(),
         ratio_numerator: 1.0,
         ratio_denominator: 1,
+        mask,
         acceleration: 2500.0,
         deceleration: 2500.0,
         jerk: 5000.0,
@@ -56,6 +58,24 @@ fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_agai
     };
     let view = CncView::new(&run.memory);
     assert_eq!(run.machine.call(&view, SAW, &gear).unwrap().error_id, 0);
+    for _ in 0..5000 {
+        run.step(0.001);
+        if state(&run) == AxisState::SlaveSynchronous.raw() {
+            return run;
+        }
+    }
+    panic!("the saw never synchronised");
+}
+
+/// The saw's `nAxisState`.
+fn state(run: &InProcess) -> i32 {
+    let a = run.machine.axes().axis(SAW as usize).unwrap();
+    a.motion_state(a.setpoint()).raw()
+}
+
+#[test]
+fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_again() {
+    let mut run = synchronous_saw(0);
     // The saw's phase, set velocity and the engine's velocity.
     let saw = |run: &InProcess| {
         let a = run.machine.axes().axis(SAW as usize).unwrap();
@@ -66,16 +86,6 @@ fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_agai
             a.engine_setpoint().velocity,
         )
     };
-    let mut synchronous = false;
-    for _ in 0..5000 {
-        run.step(0.001);
-        let (state, _, _) = saw(&run);
-        if state == AxisState::SlaveSynchronous.raw() {
-            synchronous = true;
-            break;
-        }
-    }
-    assert!(synchronous, "the saw never synchronised");
     let shift = AxisCommandCall::move_superimposed(10.0, [100.0, 1000.0, 1000.0, 1e5]);
     let reply = command(&mut run, SAW, shift);
     assert_eq!(reply.error_id, 0);
@@ -101,33 +111,7 @@ fn a_superimposed_move_shifts_a_synchronous_saw_and_it_runs_with_the_master_agai
 #[test]
 fn a_rollback_brakes_and_aborts_a_superimposed_move_and_refuses_a_new_one() {
     use hli::calls::saw::sync_mask as m;
-    let mut run = machine();
-    let forward = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
-    assert_eq!(command(&mut run, MASTER, forward).error_id, 0);
-    let gear = SawGearInCall {
-        master: MASTER,
-        target: SawSyncTarget::Velocity.raw(),
-        ratio_numerator: 1.0,
-        ratio_denominator: 1,
-        mask: m::ROLLBACKLOCK,
-        acceleration: 2500.0,
-        deceleration: 2500.0,
-        jerk: 5000.0,
-        ..SawGearInCall::default()
-    };
-    let view = CncView::new(&run.memory);
-    assert_eq!(run.machine.call(&view, SAW, &gear).unwrap().error_id, 0);
-    let state = |run: &InProcess| {
-        let a = run.machine.axes().axis(SAW as usize).unwrap();
-        a.motion_state(a.setpoint()).raw()
-    };
-    for _ in 0..5000 {
-        run.step(0.001);
-        if state(&run) == AxisState::SlaveSynchronous.raw() {
-            break;
-        }
-    }
-    assert_eq!(state(&run), AxisState::SlaveSynchronous.raw());
+    let mut run = synchronous_saw(m::ROLLBACKLOCK);
     let long = AxisCommandCall::move_superimposed(500.0, [50.0, 1000.0, 1000.0, 1e5]);
     let shift = command(&mut run, SAW, long);
     assert_eq!(shift.error_id, 0);
