@@ -326,6 +326,14 @@ pub(super) fn words_in(frame: &Isometry3<f64>, order: RotationOrder) -> [f64; 6]
     [w.xyz[0], w.xyz[1], w.xyz[2], w.abc[0], w.abc[1], w.abc[2]]
 }
 
+/// The words X..C of `frame` in `order`, its angles the solution nearest `near` (see
+/// [`RotationOrder::angles_near`]).
+pub(super) fn words_near(frame: &Isometry3<f64>, order: RotationOrder, near: [f64; 3]) -> [f64; 6] {
+    let t = frame.translation.vector;
+    let [a, b, c] = order.angles_near(&frame.rotation.to_rotation_matrix(), near);
+    [t.x, t.y, t.z, a, b, c]
+}
+
 /// mm or degree to the HLI's 0.1 um / 0.0001 degree, saturating at the DINT range.
 pub(super) fn hli_value(v: f64, angle: bool) -> i32 {
     let raw = if angle {

@@ -51,12 +51,8 @@ impl Axis {
                 CouplingState::Cam | CouplingState::GearVelocity | CouplingState::GearPosition
             )
         });
-        // A flying saw stopping or standing after a rollback (its pre-phase) has no motion to
-        // add to: it is to stand.
-        let stopping = self
-            .coupling
-            .is_some_and(|c| c.phase == AxisState::SlavePrephase);
-        if !held_by_engine || stopping {
+        // A flying saw stopping or standing after a rollback has no motion to add to.
+        if !held_by_engine || self.saw_standing() {
             return Err(AxisError::SuperimposedNotCoupled);
         }
         if !call.position.is_finite() {
@@ -89,10 +85,7 @@ impl Axis {
     /// flying saw that goes into its pre-phase (a rollback: stop and stand) brakes a running
     /// move with the axis's deceleration and jerk and aborts it.
     pub(super) fn step_superimposed(&mut self) {
-        let stopping = self
-            .coupling
-            .is_some_and(|c| c.phase == AxisState::SlavePrephase);
-        if stopping && self.superimposed.id != 0 {
+        if self.saw_standing() && self.superimposed.id != 0 {
             let d = self.config.dynamics;
             if self
                 .superimposed
@@ -107,6 +100,12 @@ impl Axis {
         if self.superimposed.generator.step() == Progress::Reached && self.superimposed.id != 0 {
             self.end_superimposed(CommandResult::Done, None);
         }
+    }
+
+    /// A flying saw's slave in its pre-phase: stopping or standing after a rollback.
+    fn saw_standing(&self) -> bool {
+        self.coupling
+            .is_some_and(|c| c.phase == AxisState::SlavePrephase)
     }
 
     /// Ends the running move (if any) with `result`; the offset stays where it is.

@@ -53,7 +53,8 @@ use super::kin_config::ToolKinematics;
 use super::path::contour::{Contour, Segment};
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
-    hli_value, next_interface, words_in, ChannelInputs, ChannelOutputs, OverrideInput, Wanted,
+    hli_value, next_interface, words_in, words_near, ChannelInputs, ChannelOutputs, OverrideInput,
+    Wanted,
 };
 use super::program::LoadedProgram;
 use super::sync::SyncBoard;

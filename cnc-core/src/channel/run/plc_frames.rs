@@ -41,7 +41,6 @@ impl PlcFrames {
     /// The PLC no longer commands (enable_w fell): the next frames are not carried on from
     /// the ones before.
     pub(super) fn forget_motion(&mut self) {
-        self.previous = None;
         self.let_go = true;
     }
 
@@ -52,7 +51,7 @@ impl PlcFrames {
     pub(super) fn now(&self) -> Option<Isometry3<f64>> {
         let (last, at) = self.last?;
         let since = self.tick.saturating_sub(at);
-        let Some((before, then)) = self.previous else {
+        let Some((before, then)) = self.previous.filter(|_| !self.let_go) else {
             return Some(last);
         };
         let period = at.saturating_sub(then);

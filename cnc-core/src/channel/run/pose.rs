@@ -127,7 +127,6 @@ impl Channel {
             // one its A, B and C words (and the master's published frame) are written in.
             let mut c = [0.0; 6];
             if tracking {
-                let t = compensation.translation.vector;
                 // Coupled out to no rotation at all (the switch-off's end): the words return
                 // to 0 while the tracking is still on, so the guard catches up what the
                 // nearest words kept (A-90 C90 is no rotation in Z-Y-Z, 360 none in any
@@ -139,11 +138,7 @@ impl Channel {
                 } else {
                     self.pose.compensation_abc
                 };
-                let abc = self
-                    .pose
-                    .order
-                    .angles_near(&compensation.rotation.to_rotation_matrix(), near);
-                c = [t.x, t.y, t.z, abc[0], abc[1], abc[2]];
+                c = words_near(&compensation, self.pose.order, near);
             }
             self.pose.compensation_abc = [c[3], c[4], c[5]];
             if self.pose.tracker.option() == TrackingOption::TranslationOnly {
