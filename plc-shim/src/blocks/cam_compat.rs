@@ -460,9 +460,9 @@ pub const TIMELINE: &[BlockSpec] = compat_blocks![
 /// (`McCamRead::size_limit`, else its room) refuses an answer it cannot hold with 0x4B31.
 fn read_array_refusal(c: &CompatConfig) -> Option<u32> {
     if c.columns != 2 {
-        return Some(0x4B37);
+        return Some(super::cam_read::ERROR_COLUMNS);
     }
     let size = c.size.map_or(c.room as u64 * 8, u64::from);
     let wanted = u64::from(c.rows_to_read) * u64::from(c.columns) * 8;
-    (wanted > size).then_some(0x4B31)
+    (wanted > size).then_some(super::cam_read::ERROR_ARRAY_SIZE)
 }

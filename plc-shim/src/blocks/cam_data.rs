@@ -165,14 +165,14 @@ impl CamRef {
             _ => return Err(0x4B35),
         };
         if self.columns != columns {
-            return Err(0x4B37);
+            return Err(super::cam_read::ERROR_COLUMNS);
         }
         let rows = self.rows as usize;
         if rows < 2 || rows > held {
             return Err(0x4B36);
         }
         if self.array_size as usize != held * element_bytes * columns as usize {
-            return Err(0x4B31);
+            return Err(super::cam_read::ERROR_ARRAY_SIZE);
         }
         Ok(rows)
     }
