@@ -11,27 +11,14 @@ use hli::calls::saw::sync_mask as m;
 use hli::calls::saw::SawError;
 use hli::enums::AxisState;
 
-use super::saw_plan::{kin, limits, request, LIMIT_CHECKS};
+use super::saw_plan::{kin, limits, request, CHECK_BITS, LIMIT_CHECKS};
 
 /// Seed 001, chapter 5 (the table of the SyncMode bit masks) and 12.3.1: every check and
 /// operation bit has the seed's decimal value; the two bits the seed names without a value
 /// have ours (docs/flying-saw.md). A renumbering fails here.
 #[test]
 fn the_sync_mode_bits_have_the_numbers_of_the_seeds_table() {
-    let checks = [
-        m::MINPOS,
-        m::MAXPOS,
-        m::MAXVELO,
-        m::MAXACC,
-        m::MAXDEC,
-        m::MAXJERK,
-        m::OVERSHOOTPOS,
-        m::UNDERSHOOTPOS,
-        m::OVERSHOOTVELO,
-        m::UNDERSHOOTVELO,
-        m::OVERSHOOTVELOZERO,
-        m::UNDERSHOOTVELOZERO,
-    ];
+    let checks = CHECK_BITS;
     assert_eq!(
         checks,
         [1, 2, 4, 8, 16, 32, 256, 512, 1024, 2048, 4096, 8192]

@@ -39,6 +39,22 @@ pub(crate) fn request(on: SyncOn, ratio: f64, limits: Limits, mask: u32) -> SawR
     }
 }
 
+/// Every check bit of ST_SyncMode, in the order of the manual's table.
+pub(crate) const CHECK_BITS: [u32; 12] = [
+    m::MINPOS,
+    m::MAXPOS,
+    m::MAXVELO,
+    m::MAXACC,
+    m::MAXDEC,
+    m::MAXJERK,
+    m::OVERSHOOTPOS,
+    m::UNDERSHOOTPOS,
+    m::OVERSHOOTVELO,
+    m::UNDERSHOOTVELO,
+    m::OVERSHOOTVELOZERO,
+    m::UNDERSHOOTVELOZERO,
+];
+
 /// Every check the seed lists for the limits (not the shape checks).
 pub(crate) const LIMIT_CHECKS: u32 = m::MAXVELO | m::MAXACC | m::MAXDEC | m::MAXJERK;
 
@@ -354,20 +370,7 @@ fn every_check_refuses_with_its_own_code_when_asked_and_the_general_one_else() {
         jerk: 1e12,
     };
     let slaves = [kin(0.0, 500.0, 100.0), kin(0.0, -300.0, -100.0)];
-    let bits = [
-        m::MINPOS,
-        m::MAXPOS,
-        m::MAXVELO,
-        m::MAXACC,
-        m::MAXDEC,
-        m::MAXJERK,
-        m::OVERSHOOTPOS,
-        m::UNDERSHOOTPOS,
-        m::OVERSHOOTVELO,
-        m::UNDERSHOOTVELO,
-        m::OVERSHOOTVELOZERO,
-        m::UNDERSHOOTVELOZERO,
-    ];
+    let bits = CHECK_BITS;
     let codes = [
         SawError::CheckMinPos,
         SawError::CheckMaxPos,

@@ -115,7 +115,7 @@ fn moving(slave_velocity: f64) -> InProcess {
     run
 }
 
-fn velocity_call(ratio: f64, mask: u32) -> SawGearInCall {
+pub(crate) fn velocity_call(ratio: f64, mask: u32) -> SawGearInCall {
     SawGearInCall {
         master: MASTER as u32,
         target: SawSyncTarget::Velocity.raw(),

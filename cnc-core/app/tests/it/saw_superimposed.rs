@@ -2,33 +2,16 @@
 //! to the gear's motion (the saw's own follower goes on undisturbed, in its frame) and the
 //! slave runs at the master's velocity again once it is done.
 
-use cnc_app::scenario::{InProcess, Scenario};
+use cnc_app::scenario::InProcess;
 use hli::calls::axis::AxisCommandCall;
-use hli::calls::saw::{SawGearInCall, SawSyncTarget};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::AxisState;
 use hli::views::CncView;
 
+use super::saw_engine::{machine, velocity_call};
+
 const MASTER: u32 = 0;
 const SAW: u32 = 1;
-
-fn machine() -> InProcess {
-    let axis = |name: &str| {
-        format!(
-            "[[axis]]\nname = \"{name}\"\npower = true\nvelocity = 3000.0\nacceleration = 20000.0\n\
-             deceleration = 20000.0\njerk = 1e7\nfollowing_error_limit = 1e4\n"
-        )
-    };
-    let toml = format!(
-        "cycle_ms = 1.0\nticks = 10\n{}{}",
-        axis("Master"),
-        axis("Saw")
-    );
-    let s = Scenario::parse("saw.toml", &toml, |_| unreachable!()).unwrap();
-    let mut run = InProcess::new(&s, 0).unwrap();
-    run.step(0.001);
-    run
-}
 
 fn command(
     run: &mut InProcess,
@@ -42,20 +25,10 @@ fn command(
 /// The master at 500 mm/s and the saw coupled with MC_GearInVelo (ratio 1, SyncMode `mask`),
 /// run until it is synchronous.
 fn synchronous_saw(mask: u32) -> InProcess {
-    let mut run = machine();
+    let mut run = machine("");
     let forward = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
     assert_eq!(command(&mut run, MASTER, forward).error_id, 0);
-    let gear = SawGearInCall {
-        master: MASTER,
-        target: SawSyncTarget::Velocity.raw(),
-        ratio_numerator: 1.0,
-        ratio_denominator: 1,
-        mask,
-        acceleration: 2500.0,
-        deceleration: 2500.0,
-        jerk: 5000.0,
-        ..SawGearInCall::default()
-    };
+    let gear = velocity_call(1.0, mask);
     let view = CncView::new(&run.memory);
     assert_eq!(run.machine.call(&view, SAW, &gear).unwrap().error_id, 0);
     for _ in 0..5000 {

@@ -697,10 +697,7 @@ fn the_characteristics_block_reads_values_rescaled_to_a_master_velocity() {
 
 /// The tick of the first rising edge of `output` of `instance` in the PLC's report.
 fn first_edge(report: &str, instance: &str, output: &str) -> u64 {
-    let line = report
-        .lines()
-        .find(|l| l.starts_with(&format!("block {instance} ")))
-        .unwrap_or_else(|| panic!("no block {instance}\n{report}"));
+    let line = block_line(report, instance);
     let (_, after) = line
         .split_once(&format!("{output} "))
         .unwrap_or_else(|| panic!("{instance}: no {output}: {line}"));

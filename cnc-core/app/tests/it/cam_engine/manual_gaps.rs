@@ -63,14 +63,6 @@ fn lerp(rows: &[[f64; 2]], x: f64) -> f64 {
     s0 + (s1 - s0) / (m1 - m0) * (x - m0)
 }
 
-/// The line of block `instance` in a timeline's report.
-fn block_line(report: &str, instance: &str) -> String {
-    let start = format!("block {instance} ");
-    let line = report.lines().find(|l| l.starts_with(&start));
-    line.unwrap_or_else(|| panic!("no block {instance}\n{report}"))
-        .to_string()
-}
-
 /// Whether block `instance` is Done without an ErrorID.
 fn done(report: &str, instance: &str) -> bool {
     let line = block_line(report, instance);

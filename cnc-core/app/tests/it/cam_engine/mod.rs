@@ -237,6 +237,14 @@ wait = "cam.InSync"
 call = { block = "MC_MoveVelocity", instance = "run", axis = 0, velocity = 360.0, direction = 1, acceleration = 3600.0, deceleration = 3600.0, jerk = 36000.0 }
 "#;
 
+/// The line of block `instance` in a timeline's report.
+fn block_line(report: &str, instance: &str) -> String {
+    let start = format!("block {instance} ");
+    let line = report.lines().find(|l| l.starts_with(&start));
+    line.unwrap_or_else(|| panic!("no block {instance}\n{report}"))
+        .to_string()
+}
+
 /// A scenario `toml` whose `plc.toml` is `timeline` and whose other files are the cam
 /// examples (`scenarios/cams`).
 fn with_timeline(name: &str, toml: &str, timeline: &str) -> Scenario {

@@ -124,10 +124,7 @@ call = { block = "MC_CamScaling", instance = "off", axis = 1, activation_mode = 
     let run = InProcess::run_through(&s).unwrap();
     let summary = run.timeline.as_ref().unwrap().summary();
     let done_at = |name: &str| -> u64 {
-        let line = summary
-            .lines()
-            .find(|l| l.starts_with(&format!("block {name} ")))
-            .unwrap_or_else(|| panic!("{name}: {summary}"));
+        let line = block_line(&summary, name);
         let after = &line[line.find("Done ").unwrap_or_else(|| panic!("{line}")) + 5..];
         after.split_whitespace().next().unwrap().parse().unwrap()
     };
@@ -325,13 +322,7 @@ fn cam_table_read_data_reads_the_rows_asked_into_an_array_that_holds_them() {
         [0.0, 0.0, 90.0, 10.0, 180.0, 0.0],
         "{report}"
     );
-    let line = |name: &str| {
-        report
-            .lines()
-            .find(|l| l.starts_with(&format!("block {name} ")))
-            .unwrap_or_else(|| panic!("{name}: {report}"))
-            .to_string()
-    };
+    let line = |name: &str| block_line(&report, name);
     assert!(line("six").contains("ErrorID 0x4b36"), "{report}");
     assert!(line("columns").contains("ErrorID 0x4b37"), "{report}");
     assert!(line("small").contains("ErrorID 0x4b31"), "{report}");

@@ -165,13 +165,7 @@ call = { block = "MC_MoveSuperimposed", instance = "free", axis = 0, distance = 
     let s = with_timeline("superimposed.toml", toml, &timeline);
     let run = InProcess::run_through(&s).unwrap();
     let summary = run.timeline.as_ref().unwrap().summary();
-    let line = |name: &str| {
-        summary
-            .lines()
-            .find(|l| l.starts_with(&format!("block {name} ")))
-            .unwrap_or_else(|| panic!("{name}: {summary}"))
-            .to_string()
-    };
+    let line = |name: &str| block_line(&summary, name);
     assert!(line("shift").contains("Done "), "{summary}");
     assert!(line("first").contains("CommandAborted "), "{summary}");
     assert!(line("second").contains("Done "), "{summary}");
