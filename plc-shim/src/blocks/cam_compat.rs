@@ -17,11 +17,13 @@
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
 use super::cam::{recorded, CamCore};
-use super::cam_data::{rows_of, CamData, ChunkTransfer, ROW_BYTES};
+use super::cam_data::{CamData, ChunkTransfer, ROW_BYTES};
 use super::cam_read::{McCamRead, DEFAULT_READ_ROOM};
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{number, BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
+use crate::timeline::registry::{
+    input, required, BlockSpec, InputField, InputSpec, Kind, Target, TimelineBlock, Value,
+};
 use hli::calls::cam::{
     CamInCall, CamOutCall, CamReadKind, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
     CAM_KEEP_MASTER_OFFSET, CAM_KEEP_MASTER_SCALING, CAM_KEEP_SLAVE_OFFSET, CAM_KEEP_SLAVE_SCALING,
@@ -103,96 +105,98 @@ impl CompatConfig {
     }
 }
 
-/// Checks the inputs of compatibility block `kind` in a timeline `call` table.
-pub fn parse(kind: &'static str, table: &toml::Table) -> Result<CompatConfig, String> {
-    let allowed: &[&str] = match kind {
-        "CamTableGenerate" => &["table", "table_type", "rows", "block_size"],
-        "CamTableCreate" => &["table", "table_type", "num_rows"],
-        "CamTableWriteData" => &["table", "rows", "block_size"],
-        "CamTableReadData" => &[
-            "table",
-            "room",
-            "block_size",
-            "rows_to_read",
-            "columns",
-            "size",
-        ],
-        "CamTableReadSlavePos" => &["table", "master_pos"],
-        "CamTableDelete" => &["table"],
-        "CamTableCoupleAxes" | "CamTableCoupleAxesIpol" => &[
-            "master",
-            "table",
-            "master_offset",
-            "slave_offset",
-            "master_absolute",
-            "slave_absolute",
-            "interpolation",
-            "on",
-        ],
-        "CamTableOffsetChange" => &["master_offset", "slave_offset"],
-        "CamTableSetSlaveScale" => &["slave_slope"],
-        _ => &[
-            "master_offset",
-            "slave_offset",
-            "master_slope",
-            "slave_slope",
-        ],
-    };
-    let mut c = CompatConfig::new(kind);
-    for (key, value) in table {
-        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
-            continue;
-        }
-        if !allowed.contains(&key.as_str())
-            || (key == "interpolation" && kind == "CamTableCoupleAxes")
-        {
-            return Err(format!(
-                "call: {kind} has no input `{key}` (inputs: {})",
-                allowed.join(", ")
-            ));
-        }
-        let bad = || format!("call: {kind} input `{key}` = {value} is not valid");
-        let int = |lo: i64, hi: i64| {
-            value
-                .as_integer()
-                .filter(|v| (lo..=hi).contains(v))
-                .map(|v| v as u32)
-                .ok_or_else(bad)
-        };
-        let num = || number(value).filter(|v| v.is_finite()).ok_or_else(bad);
-        let flag = || value.as_bool().ok_or_else(bad);
-        match key.as_str() {
-            "table" => c.table = int(1, 255)?,
-            "table_type" => c.table_type = int(1, 4)?,
-            "num_rows" => c.rows_declared = int(2, i64::from(u32::MAX))?,
-            "rows" => c.rows = Some(rows_of(value)?),
-            "room" => c.room = int(1, 1 << 20)? as usize,
-            "rows_to_read" => c.rows_to_read = int(0, 1 << 20)?,
-            "columns" => c.columns = int(1, 16)?,
-            "size" => c.size = Some(int(8, 1 << 30)?),
-            "block_size" => {
-                c.block_size = int(0, i64::from(u32::MAX))?;
-                if (1..ROW_BYTES).contains(&c.block_size) {
-                    return Err(format!(
-                        "call: {kind} `block_size` = {value}: 0 (the default) or at least \
-                         {ROW_BYTES} bytes (one row)"
-                    ));
+impl CompatConfig {
+    /// Sets input `key` (one of the lists of [`TIMELINE`]).
+    fn set(&mut self, key: &str, value: &Value) {
+        match key {
+            "table" => self.table.take(value),
+            "table_type" => self.table_type.take(value),
+            "num_rows" => self.rows_declared.take(value),
+            "rows" => {
+                if let Value::Rows(rows) = value {
+                    self.rows = Some(Arc::clone(rows));
                 }
             }
-            "master" => c.master = int(0, i64::from(u32::MAX))?,
-            "master_offset" => c.master_offset = num()?,
-            "slave_offset" => c.slave_offset = num()?,
-            "master_slope" => c.master_slope = num()?,
-            "slave_slope" => c.slave_slope = num()?,
-            "master_pos" => c.master_pos = num()?,
-            "master_absolute" => c.master_absolute = flag()?,
-            "slave_absolute" => c.slave_absolute = flag()?,
-            "interpolation" => c.interpolation = int(0, 2)?,
-            _ => c.on = flag()?,
+            "block_size" => self.block_size.take(value),
+            "rows_to_read" => self.rows_to_read.take(value),
+            "columns" => self.columns.take(value),
+            "size" => self.size = value.uint().or(self.size),
+            "master" => self.master.take(value),
+            "master_offset" => self.master_offset.take(value),
+            "slave_offset" => self.slave_offset.take(value),
+            "master_slope" => self.master_slope.take(value),
+            "slave_slope" => self.slave_slope.take(value),
+            "master_pos" => self.master_pos.take(value),
+            "master_absolute" => self.master_absolute.take(value),
+            "slave_absolute" => self.slave_absolute.take(value),
+            "interpolation" => self.interpolation.take(value),
+            "on" => self.on.take(value),
+            _ => {}
         }
     }
-    Ok(c)
 }
+
+/// iTableId, 1..=255.
+const TABLE: InputSpec = input("table", Kind::Range(1, 255));
+/// iTableType 1..=4.
+const TABLE_TYPE: InputSpec = input("table_type", Kind::Range(1, 4));
+/// The rows `[[master, slave], ...]`.
+const ROWS: InputSpec = input("rows", super::cam_data::ROWS);
+/// iBlockSize: 0 (the call's room) or at least one row's bytes.
+const BLOCK_SIZE: InputSpec = input(
+    "block_size",
+    Kind::Parsed {
+        parse: |v| match v.as_integer() {
+            Some(b) if b == 0 || (i64::from(ROW_BYTES)..=i64::from(u32::MAX)).contains(&b) => {
+                Ok(Value::Int(b))
+            }
+            _ => Err(format!(
+                "call: `block_size` = {v}: 0 (the default) or at least {ROW_BYTES} bytes (one row)"
+            )),
+        },
+        example: "0",
+    },
+);
+const MASTER_OFFSET: InputSpec = input("master_offset", Kind::Real);
+const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real);
+const SLAVE_SLOPE: InputSpec = input("slave_slope", Kind::Real);
+/// The coupling blocks' inputs; CamTableCoupleAxesIpol's also `interpolation`.
+const COUPLE: [InputSpec; 7] = [
+    input("master", Kind::Range(0, u32::MAX as i64)),
+    TABLE,
+    MASTER_OFFSET,
+    SLAVE_OFFSET,
+    input("master_absolute", Kind::Bool),
+    input("slave_absolute", Kind::Bool),
+    input("on", Kind::Bool),
+];
+const COUPLE_IPOL: [InputSpec; 8] =
+    crate::timeline::registry::joined(&[&COUPLE, &[input("interpolation", Kind::Range(0, 2))]]);
+
+/// The inputs of each compatibility block.
+const GENERATE: &[InputSpec] = &[TABLE, TABLE_TYPE, ROWS, BLOCK_SIZE];
+const CREATE: &[InputSpec] = &[
+    TABLE,
+    TABLE_TYPE,
+    required("num_rows", Kind::Range(2, u32::MAX as i64)),
+];
+const WRITE_DATA: &[InputSpec] = &[TABLE, ROWS, BLOCK_SIZE];
+const READ_DATA: &[InputSpec] = &[
+    TABLE,
+    input("room", Kind::Room),
+    BLOCK_SIZE,
+    input("rows_to_read", Kind::Range(0, 1 << 20)),
+    input("columns", Kind::Range(1, 16)),
+    input("size", Kind::Range(8, 1 << 30)),
+];
+const READ_SLAVE_POS: &[InputSpec] = &[TABLE, input("master_pos", Kind::Real)];
+const OFFSETS: &[InputSpec] = &[MASTER_OFFSET, SLAVE_OFFSET];
+const MASTER_SLAVE_SCALE: &[InputSpec] = &[
+    MASTER_OFFSET,
+    SLAVE_OFFSET,
+    input("master_slope", Kind::Real),
+    SLAVE_SLOPE,
+];
 
 /// A compatibility block in a timeline: its configuration and its running state.
 #[derive(Debug)]
@@ -389,9 +393,10 @@ impl CompatBlock {
 
 impl TimelineBlock for CompatBlock {
     timeline_timeout!();
-    fn set(&mut self, _: &str, value: &Value) {
-        if let Some(config) = value.custom::<CompatConfig>() {
-            self.config = config;
+    fn set(&mut self, key: &str, value: &Value) {
+        // Unique between cycles (a cycle's clone is gone): no copy is made.
+        Arc::make_mut(&mut self.config).set(key, value);
+        if key == "master" {
             self.master = None;
         }
     }
@@ -408,14 +413,6 @@ impl TimelineBlock for CompatBlock {
     }
 }
 
-/// A call of `kind` checked whole: its configuration, and the room of CamTableReadData's
-/// answer.
-fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
-    let config = parse(kind, table)?;
-    let room = (kind == "CamTableReadData").then_some(config.room);
-    Ok((Value::Custom(Arc::new(config)), room))
-}
-
 /// A block of `kind` with room `room` for a read's numbers.
 fn make(kind: &'static str, room: Option<usize>) -> Box<dyn TimelineBlock> {
     let config = CompatConfig {
@@ -425,32 +422,32 @@ fn make(kind: &'static str, room: Option<usize>) -> Box<dyn TimelineBlock> {
     Box::new(CompatBlock::new(Arc::new(config)))
 }
 
-/// The compatibility blocks a timeline calls, each on the slave's axis.
-macro_rules! compat_blocks {
-    ($($name:literal),* $(,)?) => {
-        &[$(BlockSpec {
+/// A compatibility block a timeline calls, on the slave's axis.
+macro_rules! compat_block {
+    ($name:literal, $inputs:expr) => {
+        BlockSpec {
             name: $name,
             target: Target::Axis,
             execute: true,
-            inputs: Inputs::Table(checked),
+            inputs: $inputs,
             make: |room| make($name, room),
-        }),*]
+        }
     };
 }
 
-/// The compatibility blocks a timeline calls (their inputs: [`parse`]).
-pub const TIMELINE: &[BlockSpec] = compat_blocks![
-    "CamTableGenerate",
-    "CamTableCreate",
-    "CamTableWriteData",
-    "CamTableReadData",
-    "CamTableReadSlavePos",
-    "CamTableDelete",
-    "CamTableCoupleAxes",
-    "CamTableCoupleAxesIpol",
-    "CamTableOffsetChange",
-    "CamTableSetSlaveScale",
-    "CamTableSetMasterSlaveScale",
+/// The compatibility blocks a timeline calls.
+pub const TIMELINE: &[BlockSpec] = &[
+    compat_block!("CamTableGenerate", GENERATE),
+    compat_block!("CamTableCreate", CREATE),
+    compat_block!("CamTableWriteData", WRITE_DATA),
+    compat_block!("CamTableReadData", READ_DATA),
+    compat_block!("CamTableReadSlavePos", READ_SLAVE_POS),
+    compat_block!("CamTableDelete", &[TABLE]),
+    compat_block!("CamTableCoupleAxes", &COUPLE),
+    compat_block!("CamTableCoupleAxesIpol", &COUPLE_IPOL),
+    compat_block!("CamTableOffsetChange", OFFSETS),
+    compat_block!("CamTableSetSlaveScale", &[SLAVE_SLOPE]),
+    compat_block!("CamTableSetMasterSlaveScale", MASTER_SLAVE_SCALE),
 ];
 
 /// CamTableReadData's array against what it asks for (seed 000 5.2.1.5): a column count other

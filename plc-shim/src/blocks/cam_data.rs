@@ -7,9 +7,7 @@ use crate::kernel::{
     call_error_code, done_unless, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled,
 };
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{
-    input, mode, number, BlockSpec, InputField, InputSpec, Kind, TimelineBlock, Value,
-};
+use crate::timeline::registry::{mode, number, BlockSpec, InputField, Kind, TimelineBlock, Value};
 use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
 use hli::calls::CallError;
 use hli::rpc::PendingCall;
@@ -511,6 +509,12 @@ impl InputField for CamData {
     }
 }
 
+/// Table rows `[[master, slave], ...]` in a timeline.
+pub(super) const ROWS: Kind = Kind::Parsed {
+    parse: |v| rows_of(v).map(Value::Rows),
+    example: "[[0.0, 0.0], [1.0, 2.0]]",
+};
+
 /// Motion-function points in a timeline.
 const POINTS: Kind = Kind::Parsed {
     parse: |v| points_of(v).map(Value::Points),
@@ -524,10 +528,7 @@ inputs! {
         "periodic": Kind::Bool => periodic,
         "master_absolute": Kind::Bool => master_absolute,
         "slave_absolute": Kind::Bool => slave_absolute,
-        "rows": Kind::Parsed {
-            parse: |v| rows_of(v).map(Value::Rows),
-            example: "[[0.0, 0.0], [1.0, 2.0]]",
-        } => data,
+        "rows": ROWS => data,
         "points": POINTS => data,
         "table_type": Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)])
             => table_type,

@@ -5,7 +5,7 @@
 use super::cam::{recorded, CamCore};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{input, BlockSpec, Kind, TimelineBlock, Value};
 use hli::calls::cam::CamMultiTableOp;
 
 /// CamTableSetWeight (5.2.3.1): weight, offsets, slopes and range of `table` in a

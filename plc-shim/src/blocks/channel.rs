@@ -11,9 +11,7 @@
 use crate::blocks::plain;
 use crate::kernel::{Accept, InFlight, Kernel, Outputs, Polled, Step, Waited};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{
-    input, BlockSpec, InputSpec, Inputs, Kind, Target, TimelineBlock, Value,
-};
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, Target, TimelineBlock, Value};
 use hli::enums::{ChannelCommand, ChannelCommandState, ChannelMode, ChannelState};
 use hli::handshake::SendError;
 use hli::layout::{HliChannelCommand, HliChannelControlState, PROGRAM_NAME_LEN};
@@ -371,7 +369,7 @@ const fn on_channel(
         name,
         target: Target::Channel,
         execute,
-        inputs: Inputs::Keys(inputs),
+        inputs,
         make,
     }
 }

@@ -29,7 +29,9 @@ use crate::kernel::{
     call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, PendingBulk,
 };
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
+use crate::timeline::registry::{
+    input, mode, required, BlockSpec, InputSpec, Kind as InputKind, Target, TimelineBlock, Value,
+};
 use hli::calls::fifo::{
     rows_header, FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
     FifoOverrideType, FifoParametersCall, FifoReply, FifoStartCall, FifoStopCall,
@@ -170,8 +172,8 @@ impl FifoWrite {
     }
 }
 
-/// The inputs of a FIFO call.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// The inputs of a FIFO instance: what its calls set so far.
+#[derive(Debug, Clone, PartialEq)]
 struct FifoInputs {
     group: u32,
     group_position: u32,
@@ -181,101 +183,80 @@ struct FifoInputs {
     columns: u32,
 }
 
-fn allowed(kind: &str) -> &'static [&'static str] {
-    match kind {
-        "FiFoGroupIntegrate" => &["group", "group_position"],
-        "FiFoWrite" | "FiFoOverwrite" => &["group", "rows"],
-        "FiFoSetChannelOverride" => &["group", "override"],
-        "FiFoSetParameters" => &["group", "fifo_cycle_ms", "override_type", "pt2_t0_ms"],
-        _ => &["group"],
+impl Default for FifoInputs {
+    /// Group 0, a FIFO cycle of 1 ms and the instant override (FiFoSetParameters' defaults).
+    fn default() -> Self {
+        FifoInputs {
+            group: 0,
+            group_position: 0,
+            override_ppm: 0,
+            params: FifoParametersCall {
+                fifo_cycle_s: 0.001,
+                pt2_t0_s: 0.0,
+                override_type: FifoOverrideType::Instant.raw(),
+                reserved: 0,
+            },
+            rows: Arc::from([]),
+            columns: 0,
+        }
     }
 }
 
-/// Checks the inputs of a FIFO `call` table (`block`, `instance`, `axis`, `execute` are the
-/// caller's).
-fn parse(kind: &str, table: &toml::Table) -> Result<FifoInputs, String> {
-    let mut inputs = FifoInputs {
-        params: FifoParametersCall {
-            fifo_cycle_s: 0.001,
-            pt2_t0_s: 0.0,
-            override_type: FifoOverrideType::Instant.raw(),
-            reserved: 0,
+impl FifoInputs {
+    /// Sets input `key` (one of the lists below).
+    fn set(&mut self, key: &str, value: &Value) {
+        let (int, real) = (value.uint(), value.real());
+        match (key, int, real) {
+            ("group", Some(g), _) => self.group = g,
+            ("group_position", Some(p), _) => self.group_position = p,
+            ("override_type", Some(t), _) => self.params.override_type = t,
+            ("override", _, Some(percent)) => {
+                self.override_ppm = (percent / 100.0 * f64::from(FIFO_OVERRIDE_FULL)).round() as u32
+            }
+            ("fifo_cycle_ms", _, Some(ms)) => self.params.fifo_cycle_s = ms * 1e-3,
+            ("pt2_t0_ms", _, Some(ms)) => self.params.pt2_t0_s = ms * 1e-3,
+            ("rows", _, _) => {
+                if let Some(rows) = value.custom::<FifoRows>() {
+                    (self.rows, self.columns) = (Arc::clone(&rows.values), rows.columns);
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// `gpFifo[group]`: every FIFO block's.
+const GROUP: InputSpec = input("group", InputKind::Range(0, 7));
+/// The FIFO blocks' inputs, block by block.
+const GROUP_ONLY: &[InputSpec] = &[GROUP];
+const INTEGRATE: &[InputSpec] = &[GROUP, required("group_position", InputKind::Range(1, 16))];
+const WRITE: &[InputSpec] = &[
+    GROUP,
+    required(
+        "rows",
+        InputKind::Parsed {
+            parse: |v| {
+                let (values, columns) =
+                    rows_of(v).map_err(|e| format!("call: `rows` = {v}: {e}"))?;
+                Ok(Value::Custom(Arc::new(FifoRows { values, columns })))
+            },
+            example: "[[1.0, 2.0], [3.0, 4.0]]",
         },
-        ..FifoInputs::default()
-    };
-    let known = allowed(kind);
-    for (key, value) in table {
-        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
-            continue;
-        }
-        if !known.contains(&key.as_str()) {
-            return Err(format!(
-                "call: {kind} has no input `{key}` (inputs: {})",
-                known.join(", ")
-            ));
-        }
-        let bad = |what: &str| format!("call: {kind} input `{key}` = {value}: {what}");
-        let number = match value {
-            toml::Value::Float(f) => Some(*f),
-            toml::Value::Integer(i) => Some(*i as f64),
-            _ => None,
-        };
-        match key.as_str() {
-            "group" => {
-                inputs.group = value
-                    .as_integer()
-                    .filter(|g| (0..8).contains(g))
-                    .ok_or_else(|| bad("a gpFifo index 0..=7"))?
-                    as u32
-            }
-            "group_position" => {
-                inputs.group_position = value
-                    .as_integer()
-                    .filter(|p| (1..=16).contains(p))
-                    .ok_or_else(|| bad("a column 1..=16"))?
-                    as u32
-            }
-            "override" => {
-                let percent = number
-                    .filter(|p| (0.0..=100.0).contains(p))
-                    .ok_or_else(|| bad("percent, 0 to 100"))?;
-                inputs.override_ppm =
-                    (percent / 100.0 * f64::from(FIFO_OVERRIDE_FULL)).round() as u32
-            }
-            "fifo_cycle_ms" => {
-                inputs.params.fifo_cycle_s = number
-                    .filter(|t| t.is_finite() && *t > 0.0)
-                    .ok_or_else(|| bad("a time > 0"))?
-                    * 1e-3
-            }
-            "pt2_t0_ms" => {
-                inputs.params.pt2_t0_s = number
-                    .filter(|t| t.is_finite() && *t > 0.0)
-                    .ok_or_else(|| bad("a time > 0"))?
-                    * 1e-3
-            }
-            "override_type" => {
-                // By the wire enum's names, as written.
-                let types = FifoOverrideType::ALL.iter();
-                let given = types.clone().find(|t| value.as_str() == Some(t.name()));
-                let names: Vec<String> = types.map(|t| format!("{:?}", t.name())).collect();
-                let given = given.ok_or_else(|| bad(&names.join(" or ")))?;
-                inputs.params.override_type = given.raw()
-            }
-            _ => {
-                let (rows, columns) = rows_of(value).map_err(|e| bad(&e))?;
-                inputs.rows = rows;
-                inputs.columns = columns;
-            }
-        }
-    }
-    if kind == "FiFoGroupIntegrate" && inputs.group_position == 0 {
-        return Err("call: FiFoGroupIntegrate needs `group_position` (1..=N)".into());
-    }
-    if matches!(kind, "FiFoWrite" | "FiFoOverwrite") && inputs.rows.is_empty() {
-        return Err(format!("call: {kind} needs `rows` = [[..], ..]"));
-    }
-    Ok(inputs)
+    ),
+];
+const OVERRIDE: &[InputSpec] = &[GROUP, input("override", InputKind::Between(0.0, 100.0))];
+const PARAMETERS: &[InputSpec] = &[
+    GROUP,
+    input("fifo_cycle_ms", InputKind::Positive),
+    input("override_type", mode::<FifoOverrideType>()),
+    input("pt2_t0_ms", InputKind::Positive),
+];
+
+/// FiFoWrite's rows: the values row by row, and how many columns a row has.
+#[derive(Debug)]
+struct FifoRows {
+    values: Arc<[f64]>,
+    columns: u32,
 }
 
 /// `rows = [[a, b, c], ...]`: equal lengths, finite numbers, one block's worth at most.
@@ -326,8 +307,8 @@ enum Kind {
 struct FifoInstance {
     /// Execute.
     execute: bool,
-    /// The inputs of the last call.
-    inputs: Arc<FifoInputs>,
+    /// The inputs its calls set.
+    inputs: FifoInputs,
     kind: Kind,
 }
 
@@ -349,7 +330,7 @@ impl FifoInstance {
     /// One cycle; `axis` is FiFoGroupIntegrate's.
     fn call(&mut self, io: &mut PlcIo<'_>, axis: u32) -> Outputs<FifoReply> {
         let e = self.execute;
-        let i = &*self.inputs;
+        let i = &self.inputs;
         let g = i.group;
         match &mut self.kind {
             Kind::Dimension(b) => b.cycle(io, e, g, FifoDimensionCall::default),
@@ -374,10 +355,8 @@ impl FifoInstance {
 
 impl TimelineBlock for FifoInstance {
     timeline_timeout!();
-    fn set(&mut self, _: &str, value: &Value) {
-        if let Some(inputs) = value.custom::<FifoInputs>() {
-            self.inputs = inputs;
-        }
+    fn set(&mut self, key: &str, value: &Value) {
+        self.inputs.set(key, value);
     }
     fn execute(&mut self) -> Option<&mut bool> {
         Some(&mut self.execute)
@@ -396,23 +375,18 @@ impl TimelineBlock for FifoInstance {
     }
 }
 
-/// A call of `kind` checked whole.
-fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
-    Ok((Value::Custom(Arc::new(parse(kind, table)?)), None))
-}
-
 /// A FIFO block a timeline calls: on its group (`group`, an input), or also on an axis.
 macro_rules! fifo_block {
-    ($name:literal, $target:ident, $block:expr) => {
+    ($name:literal, $target:ident, $inputs:expr, $block:expr) => {
         BlockSpec {
             name: $name,
             target: Target::$target,
             execute: true,
-            inputs: Inputs::Table(checked),
+            inputs: $inputs,
             make: |_| {
                 Box::new(FifoInstance {
                     execute: false,
-                    inputs: Arc::default(),
+                    inputs: FifoInputs::default(),
                     kind: $block,
                 })
             },
@@ -425,30 +399,50 @@ pub const TIMELINE: &[BlockSpec] = &[
     fifo_block!(
         "FiFoGetDimension",
         Group,
+        GROUP_ONLY,
         Kind::Dimension(FifoGetDimension::default())
     ),
     fifo_block!(
         "FiFoGroupIntegrate",
         Axis,
+        INTEGRATE,
         Kind::Integrate(FifoGroupIntegrate::default())
     ),
     fifo_block!(
         "FiFoGroupDisintegrate",
         Group,
+        GROUP_ONLY,
         Kind::Disintegrate(FifoGroupDisintegrate::default())
     ),
-    fifo_block!("FiFoWrite", Group, Kind::Write(FifoWrite::default())),
-    fifo_block!("FiFoOverwrite", Group, Kind::Write(FifoWrite::overwrite())),
-    fifo_block!("FiFoStart", Group, Kind::Start(FifoStart::default())),
-    fifo_block!("FiFoStop", Group, Kind::Stop(FifoStop::default())),
+    fifo_block!("FiFoWrite", Group, WRITE, Kind::Write(FifoWrite::default())),
+    fifo_block!(
+        "FiFoOverwrite",
+        Group,
+        WRITE,
+        Kind::Write(FifoWrite::overwrite())
+    ),
+    fifo_block!(
+        "FiFoStart",
+        Group,
+        GROUP_ONLY,
+        Kind::Start(FifoStart::default())
+    ),
+    fifo_block!(
+        "FiFoStop",
+        Group,
+        GROUP_ONLY,
+        Kind::Stop(FifoStop::default())
+    ),
     fifo_block!(
         "FiFoSetChannelOverride",
         Group,
+        OVERRIDE,
         Kind::Override(FifoSetChannelOverride::default())
     ),
     fifo_block!(
         "FiFoSetParameters",
         Group,
+        PARAMETERS,
         Kind::Parameters(FifoSetParameters::default())
     ),
 ];
@@ -464,12 +458,20 @@ mod tests {
 
     #[test]
     fn the_override_type_goes_by_the_wire_enums_names() {
-        let parsed = |text: &str| super::parse("FiFoSetParameters", &toml::from_str(text).unwrap());
+        use crate::timeline::instances::inputs_of;
+        use crate::timeline::registry::find;
+        let parsed = |text: &str| {
+            let spec = find("FiFoSetParameters").unwrap();
+            let (inputs, _, _) = inputs_of(spec, &toml::from_str(text).unwrap())?;
+            let mut i = super::FifoInputs::default();
+            inputs.iter().for_each(|(k, v)| i.set(k, v));
+            Ok::<_, String>(i)
+        };
         let i = parsed("override_type = \"pt2\"\npt2_t0_ms = 20").unwrap();
         assert_eq!(i.params.override_type, super::FifoOverrideType::Pt2.raw());
-        assert_eq!(
-            parsed("override_type = \"fast\"").unwrap_err(),
-            "call: FiFoSetParameters input `override_type` = \"fast\": \"instant\" or \"pt2\""
-        );
+        assert_eq!(i.params.pt2_t0_s, 0.02);
+        assert!(parsed("override_type = \"fast\"")
+            .unwrap_err()
+            .contains("known are instant (0), pt2 (1)"));
     }
 }

@@ -77,26 +77,35 @@ macro_rules! timeline_timeout {
 /// Inputs declared once, in the order a call lists them: each one's key, kind and the field
 /// of `$target` it sets (a path below it). Gives the list `$list` (an `[InputSpec; N]` for a
 /// `TIMELINE` entry, or part of one through `joined`) and `$set(target, key, value)`, which
-/// sets the field of `key` and leaves the others.
+/// sets the field of `key` and leaves the others. `required` before a key: every call gives
+/// it. This is the one way a block declares its inputs.
 macro_rules! inputs {
     (
         $(#[doc = $doc:literal])*
         $list:ident, $set:ident: $target:ty {
-            $($key:literal: $kind:expr => $($field:ident).+),* $(,)?
+            $($($required:ident)? $key:literal: $kind:expr => $($field:ident).+),* $(,)?
         }
     ) => {
         $(#[doc = $doc])*
-        const $list: [InputSpec; { [$($key),*].len() }] = [$(input($key, $kind)),*];
+        const $list: [$crate::timeline::registry::InputSpec; { [$($key),*].len() }] = [$(
+            $crate::timeline::registry::InputSpec {
+                key: $key,
+                kind: $kind,
+                required: inputs!(@required $($required)?),
+            }
+        ),*];
 
         /// Sets input `key` of `target` (see the list beside it); other keys leave it.
-        fn $set(target: &mut $target, key: &str, value: &Value) {
-            use crate::timeline::registry::InputField;
+        fn $set(target: &mut $target, key: &str, value: &$crate::timeline::registry::Value) {
+            use $crate::timeline::registry::InputField;
             match key {
                 $($key => target.$($field).+.take(value),)*
                 _ => {}
             }
         }
     };
+    (@required required) => { true };
+    (@required) => { false };
 }
 
 pub mod cam;

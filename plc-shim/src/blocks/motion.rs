@@ -10,9 +10,7 @@
 use super::plain;
 use crate::kernel::{send, Accept, Kernel, Outputs, Step, Waited};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{
-    input, BlockSpec, InputSpec, Inputs, Kind, Target, TimelineBlock, Value,
-};
+use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, Target, TimelineBlock, Value};
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
@@ -475,7 +473,7 @@ pub const TIMELINE: &[BlockSpec] = &[
         name: "MC_Power",
         target: Target::Axis,
         execute: false,
-        inputs: Inputs::Keys(&[input("enable", Kind::Bool)]),
+        inputs: &[input("enable", Kind::Bool)],
         make: |_| Box::<McPower>::default(),
     },
     BlockSpec::on_axis("MC_Reset", McReset::INPUTS, |_| Box::<McReset>::default()),

@@ -29,7 +29,7 @@ use crate::kernel::{
     Waited, ERROR_NO_ANSWER,
 };
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{BlockSpec, Inputs, Target, TimelineBlock, Value, Whole};
+use crate::timeline::registry::{BlockSpec, InputSpec, Target, TimelineBlock, Value};
 use hli::calls::cam::TableOrganisation;
 use hli::calls::saw::{
     SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncMode, SawSyncTarget, SAW_CHARAC_PART,
@@ -40,8 +40,6 @@ use hli::enums::{AxisState, CouplingState};
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
 use hli::rpc::PendingCall;
 use hli::PlaceExt;
-use inputs::SawInputs;
-use std::sync::Arc;
 
 pub mod inputs;
 
@@ -92,11 +90,18 @@ pub const CHARAC_FIELDS: [&str; 31] = [
 pub struct SyncMode {
     /// GEARINSYNCMODE_TIMEBASED (MC_GearInVelo only) rather than position-based.
     pub time_based: bool,
-    /// Check and operation bits.
-    pub mask: u32,
+    /// Check bits (`GearInSync_CheckMask_*`).
+    pub check_mask: u32,
+    /// Operation bits (`GearInSync_OpMask_*`).
+    pub op_mask: u32,
 }
 
 impl SyncMode {
+    /// Check and operation bits as the one mask the call carries.
+    pub fn mask(self) -> u32 {
+        self.check_mask | self.op_mask
+    }
+
     /// The raw `E_GearInSyncMode`.
     pub fn raw_mode(self) -> u32 {
         if self.time_based {
@@ -316,7 +321,7 @@ impl GearInInputs {
             master,
             target: on,
             sync_mode: self.sync_mode.raw_mode(),
-            mask: self.sync_mode.mask,
+            mask: self.sync_mode.mask(),
             ratio_denominator: self.ratio_denominator,
             master_source: u32::from(self.master_actual),
             ratio_numerator: self.ratio_numerator,
@@ -588,10 +593,8 @@ impl TimelineBlock for McGearInVelo {
         self.master = index;
         true
     }
-    fn set(&mut self, _: &str, value: &Value) {
-        if let Some(i) = value.custom::<SawInputs>() {
-            (self.inputs, self.master) = (i.gear, i.master);
-        }
+    fn set(&mut self, key: &str, value: &Value) {
+        inputs::set_velo(self, key, value);
     }
     execute_cycle!(as_slave, recorded);
 }
@@ -602,11 +605,8 @@ impl TimelineBlock for McGearInPos {
         self.master = index;
         true
     }
-    fn set(&mut self, _: &str, value: &Value) {
-        if let Some(i) = value.custom::<SawInputs>() {
-            (self.inputs, self.master) = (i.gear, i.master);
-            [self.master_sync_position, self.slave_sync_position] = i.sync_positions;
-        }
+    fn set(&mut self, key: &str, value: &Value) {
+        inputs::set_pos(self, key, value);
     }
     execute_cycle!(as_slave, recorded);
 }
@@ -655,31 +655,31 @@ fn recorded(out: Outputs) -> (Outputs, bool) {
     (out, false)
 }
 
-/// A call of `kind` checked whole ([`inputs`]).
-fn checked(kind: &'static str, table: &toml::Table) -> Result<Whole, String> {
-    Ok((Value::Custom(Arc::new(inputs::parse(kind, table)?)), None))
-}
-
 /// A flying-saw block a timeline calls, on its slave's axis (`Slave` or `axis`).
 const fn saw_block(
     name: &'static str,
+    inputs: &'static [InputSpec],
     make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
 ) -> BlockSpec {
     BlockSpec {
         name,
-        target: Target::AxisOr(inputs::slave),
+        target: Target::AxisNamed("Slave"),
         execute: true,
-        inputs: Inputs::Table(checked),
+        inputs,
         make,
     }
 }
 
 /// The flying-saw blocks a timeline calls (their inputs: [`inputs`]).
 pub const TIMELINE: &[BlockSpec] = &[
-    saw_block("MC_GearInVelo", |_| Box::<McGearInVelo>::default()),
-    saw_block("MC_GearInPos", |_| Box::<McGearInPos>::default()),
-    saw_block("MC_GearOut", |_| Box::<McGearOut>::default()),
-    saw_block("MC_ReadFlyingSawCharacteristics", |_| {
+    saw_block("MC_GearInVelo", inputs::VELO, |_| {
+        Box::<McGearInVelo>::default()
+    }),
+    saw_block("MC_GearInPos", inputs::POS, |_| {
+        Box::<McGearInPos>::default()
+    }),
+    saw_block("MC_GearOut", &[], |_| Box::<McGearOut>::default()),
+    saw_block("MC_ReadFlyingSawCharacteristics", &[], |_| {
         Box::<CharacInstance>::default()
     }),
 ];

@@ -2,23 +2,11 @@
 //! restart cases against a stand-in CNC in this thread (an acyclic server polled by hand).
 
 use super::{Outputs, DEFAULT_TIMEOUT_CYCLES, ERROR_NO_ANSWER};
-use crate::blocks::cam::{
-    McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
-};
-use crate::blocks::cam_compat::{CompatBlock, CompatConfig};
-use crate::blocks::cam_data::{CamData, McCamTableSelect, McWriteMotionFunction};
-use crate::blocks::cam_multi::{CamMultiTable, CamTableCoupleAxesMultiTables, CamTableSetWeight};
-use crate::blocks::cam_read::{McCamRead, McReadMotionFunction};
+use crate::blocks::cam_data::{CamData, McCamTableSelect};
 use crate::blocks::dyn_cs::McDynCsTransition;
-use crate::blocks::fifo::{FifoGetDimension, FifoStart, FifoWrite};
-use crate::blocks::motion::{
-    McHalt, McMoveAbsolute, McMoveVelocity, McReset, McSetPosition, McStop,
-};
-use crate::blocks::probe::{McAbortTrigger, McTouchProbe};
-use crate::blocks::saw::{McGearInPos, McGearInVelo, McGearOut, McReadFlyingSawCharacteristics};
 use crate::runtime::PlcIo;
-use hli::calls::cam::CamMultiTableOp;
-use hli::calls::fifo::{FifoDimensionCall, FifoStartCall};
+use crate::timeline::instances::inputs_of;
+use crate::timeline::registry::{BlockSpec, InputSpec, Target};
 use hli::calls::ErrorCode;
 use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::PlcView;
@@ -63,274 +51,55 @@ macro_rules! block {
     }};
 }
 
-/// Every Execute-driven block, addressed at axis 1, table 1 or FIFO group 0.
+/// Every Execute-driven block that calls the CNC (all but a channel's, which write the
+/// channel's units), read from the registry: a block that is declared is run through these
+/// rules without a second edit. Each is made by its spec for axis 1 (FIFO group 0) with
+/// its required inputs, table 1 and the data the table blocks send ([`send_ready`]).
 fn blocks() -> Vec<(&'static str, Cycle)> {
-    let mut all = axis_blocks();
-    all.extend(cam_blocks());
-    all.extend(table_blocks());
-    all.extend(group_and_saw_blocks());
-    all
+    let specs = crate::timeline::registry::FAMILIES
+        .iter()
+        .flat_map(|f| f.iter());
+    specs
+        .filter(|spec| spec.execute && !matches!(spec.target, Target::Channel))
+        .map(|spec| (spec.name, cycle_of(spec)))
+        .collect()
 }
 
-/// The motion and probe blocks.
-fn axis_blocks() -> Vec<(&'static str, Cycle)> {
-    vec![
-        (
-            "MC_Reset",
-            block!(McReset::default(), |b, io| b.call(io, 1)),
-        ),
-        (
-            "MC_MoveAbsolute",
-            block!(McMoveAbsolute::default(), |b, io| b.call(io, 1)),
-        ),
-        (
-            "MC_MoveVelocity",
-            block!(McMoveVelocity::default(), |b, io| b.call(io, 1)),
-        ),
-        ("MC_Halt", block!(McHalt::default(), |b, io| b.call(io, 1))),
-        (
-            "MC_SetPosition",
-            block!(McSetPosition::default(), |b, io| b.call(io, 1)),
-        ),
-        ("MC_Stop", block!(McStop::default(), |b, io| b.call(io, 1))),
-        (
-            "MC_TouchProbe",
-            block!(McTouchProbe::default(), |b, io| b.call(io, 1)),
-        ),
-        (
-            "MC_AbortTrigger",
-            block!(McAbortTrigger::default(), |b, io| b.call(io, 1)),
-        ),
-    ]
+/// The inputs of `spec` that a block needs to send anything: every required one, and the
+/// table and its rows or points where it takes them.
+fn send_ready(spec: &BlockSpec) -> toml::Table {
+    let mut call = toml::Table::new();
+    call.insert("block".into(), spec.name.into());
+    if !matches!(spec.target, Target::Group) {
+        call.insert("axis".into(), 1.into());
+    }
+    let needed = |i: &&InputSpec| i.required || ["table", "rows", "points"].contains(&i.key);
+    for input in spec.inputs.iter().filter(needed) {
+        let value = match input.key {
+            "table" => toml::Value::Integer(1),
+            _ => {
+                let text = format!("v = {}", input.kind.example());
+                toml::from_str::<toml::Table>(&text).unwrap()["v"].clone()
+            }
+        };
+        call.insert(input.key.into(), value);
+    }
+    call
 }
 
-/// The cam blocks of chapter 5.1.
-fn cam_blocks() -> Vec<(&'static str, Cycle)> {
-    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
-    let points = Arc::from(vec![hli::calls::cam::McMotionFunctionPoint::default(); 6]);
-    vec![
-        (
-            "MC_CamIn",
-            block!(
-                McCamIn::default(),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io, 1)
-            ),
-        ),
-        (
-            "MC_CamOut",
-            block!(McCamOut::default(), |b, io| b.call(io, 1)),
-        ),
-        (
-            "MC_CamScaling",
-            block!(McCamScaling::default(), |b, io| b.call(io, 1)),
-        ),
-        (
-            "MC_CamTableSelect",
-            block!(
-                McCamTableSelect::default(),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_CamTableSelect+rows",
-            block!(
-                McCamTableSelect::default(),
-                |s| {
-                    s.table = 1;
-                    s.data = CamData::Rows {
-                        rows: Arc::clone(&rows),
-                        table_type: 0,
-                        interpolation: 0,
-                    };
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_WriteMotionFunction",
-            block!(
-                McWriteMotionFunction::default(),
-                |s| {
-                    s.table = 1;
-                    s.points = CamData::Points(points);
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_WriteMotionFunctionPoint",
-            block!(
-                McWriteMotionFunctionPoint::default(),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_SetCamOnlineChangeMode",
-            block!(
-                McSetCamOnlineChangeMode::default(),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_CamInfo",
-            block!(
-                McCamRead::new(hli::calls::cam::CamReadKind::Info, 64),
-                |s| {
-                    s.target = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_ReadMotionFunction",
-            block!(
-                McReadMotionFunction::new(8),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-    ]
-}
-
-/// The multi-table and compatibility blocks.
-fn table_blocks() -> Vec<(&'static str, Cycle)> {
-    let rows: Arc<[[f64; 2]]> = Arc::from(vec![[0.0, 0.0]; 20]);
-    let compat = |kind: &'static str| {
-        let mut c = CompatConfig::new(kind);
-        c.table = 1;
-        c.rows = Some(Arc::clone(&rows));
-        CompatBlock::new(Arc::new(c))
-    };
-    vec![
-        (
-            "CamTableSetWeight",
-            block!(
-                CamTableSetWeight::default(),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "CamTableCoupleAxesMultiTables",
-            block!(CamTableCoupleAxesMultiTables::default(), |b, io| b
-                .call(io, 1)),
-        ),
-        (
-            "CamTableEnableCorrectionTable",
-            block!(
-                CamMultiTable::new(CamMultiTableOp::EnableCorrection),
-                |s| {
-                    s.table = 1;
-                },
-                |b, io| b.call(io, 1)
-            ),
-        ),
-        (
-            "CamTableGenerate",
-            block!(compat("CamTableGenerate"), |b, io| b.call(io, 1)),
-        ),
-        (
-            "CamTableCreate",
-            block!(compat("CamTableCreate"), |b, io| b.call(io, 1)),
-        ),
-        (
-            "CamTableReadData",
-            block!(compat("CamTableReadData"), |b, io| b.call(io, 1)),
-        ),
-        (
-            "CamTableCoupleAxes",
-            block!(compat("CamTableCoupleAxes"), |b, io| b.call(io, 1)),
-        ),
-        (
-            "CamTableOffsetChange",
-            block!(compat("CamTableOffsetChange"), |b, io| b.call(io, 1)),
-        ),
-    ]
-}
-
-/// The FIFO and flying-saw blocks.
-fn group_and_saw_blocks() -> Vec<(&'static str, Cycle)> {
-    vec![
-        ("FiFoGetDimension", fifo_get_dimension()),
-        ("FiFoStart", fifo_start()),
-        ("FiFoWrite", fifo_write()),
-        (
-            "MC_GearInVelo",
-            block!(
-                McGearInVelo::default(),
-                |s| {
-                    s.slave = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_GearInPos",
-            block!(
-                McGearInPos::default(),
-                |s| {
-                    s.slave = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_GearOut",
-            block!(
-                McGearOut::default(),
-                |s| {
-                    s.slave = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-        (
-            "MC_ReadFlyingSawCharacteristics",
-            block!(
-                McReadFlyingSawCharacteristics::default(),
-                |s| {
-                    s.slave = 1;
-                },
-                |b, io| b.call(io)
-            ),
-        ),
-    ]
-}
-
-fn fifo_get_dimension() -> Cycle {
-    let mut b = FifoGetDimension::default();
-    Box::new(move |io: &mut PlcIo<'_>, execute| {
-        seen(b.cycle(io, execute, 0, FifoDimensionCall::default))
+/// A block of `spec` with its [`send_ready`] inputs, as one cycle with a given Execute.
+fn cycle_of(spec: &'static BlockSpec) -> Cycle {
+    let call = send_ready(spec);
+    let (inputs, room, _) = inputs_of(spec, &call).unwrap_or_else(|e| panic!("{}: {e}", spec.name));
+    let mut block = (spec.make)(room);
+    for (key, value) in &inputs {
+        block.set(key, value);
+    }
+    let axis = u32::from(!matches!(spec.target, Target::Group));
+    Box::new(move |io: &mut PlcIo<'_>, execute: bool| {
+        *block.execute().expect("an Execute-driven block") = execute;
+        seen(block.cycle(io, axis).0)
     })
-}
-
-fn fifo_start() -> Cycle {
-    let mut b = FifoStart::default();
-    Box::new(move |io: &mut PlcIo<'_>, execute| {
-        seen(b.cycle(io, execute, 0, FifoStartCall::default))
-    })
-}
-
-fn fifo_write() -> Cycle {
-    let mut b = FifoWrite::default();
-    let data = [1.0; 6];
-    Box::new(move |io: &mut PlcIo<'_>, execute| seen(b.cycle(io, execute, 0, &data, 2, 3)))
 }
 
 /// The stand-in CNC of one case: an image with one channel and two axes, a server that
@@ -563,7 +332,7 @@ fn a_dyn_cs_transition_fails_at_once_on_a_state_that_is_no_tracking_state() {
 /// it was given, where the default would still wait.
 #[test]
 fn a_timeline_timeout_ends_every_block_that_has_one_after_its_cycles() {
-    use crate::timeline::registry::{Target, Value, FAMILIES, WHOLE};
+    use crate::timeline::registry::{Value, FAMILIES};
     const CYCLES: u64 = 7;
     let mut with = 0;
     for spec in FAMILIES.iter().flat_map(|f| f.iter()) {
@@ -585,12 +354,7 @@ fn a_timeline_timeout_ends_every_block_that_has_one_after_its_cycles() {
             if spec.name == "MC_WriteMotionFunction" {
                 b.set("points", &Value::Points(Arc::new(points)));
             }
-            let compat = CompatConfig {
-                table: 1,
-                rows: Some(Arc::new([[0.0, 0.0], [1.0, 1.0]])),
-                ..CompatConfig::new(spec.name)
-            };
-            b.set(WHOLE, &Value::Custom(Arc::new(compat)));
+            b.set("rows", &Value::Rows(Arc::new([[0.0, 0.0], [1.0, 1.0]])));
         }
         fresh.timeout_cycles(DEFAULT_TIMEOUT_CYCLES);
         let mut cnc = Cnc::new("tl-timeout", spec.name);

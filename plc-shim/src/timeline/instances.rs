@@ -16,7 +16,7 @@
 //! instead, which releases MC_Stop). An instance called again while Execute is TRUE sees it
 //! FALSE for one cycle first, so every call is a new edge.
 
-use super::registry::{find, number, BlockSpec, Inputs, Kind, Target, TimelineBlock, Value, WHOLE};
+use super::registry::{find, folded, number, BlockSpec, Kind, Target, TimelineBlock, Value};
 use crate::runtime::PlcIo;
 
 /// A call of an instance, checked.
@@ -181,7 +181,7 @@ fn axis_of(spec: &BlockSpec, table: &toml::Table) -> Result<AxisRef, String> {
                 spec.name
             ))
         }
-        Target::AxisOr(find) => table.get("axis").or_else(|| find(table)),
+        Target::AxisNamed(name) => table.get("axis").or_else(|| named(table, name)),
         Target::Axis => table.get("axis"),
     };
     match given {
@@ -217,7 +217,16 @@ fn index_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
         ));
     }
     let given = match (table.get("axis"), spec.target) {
-        (None, Target::AxisOr(find)) => find(table),
+        (Some(a), Target::AxisNamed(name)) => match named(table, name) {
+            Some(n) if n != a => {
+                return Err(format!(
+                    "call: {}: `{name}` = {n} and `axis` = {a} differ",
+                    spec.name
+                ))
+            }
+            _ => Some(a),
+        },
+        (None, Target::AxisNamed(name)) => named(table, name),
         (given, _) => given,
     };
     let uses_axis = !matches!(spec.target, Target::Group);
@@ -233,26 +242,35 @@ fn index_of(spec: &BlockSpec, table: &toml::Table) -> Result<u32, String> {
     }
 }
 
-/// The inputs of a call of `spec`, the room it gives, and whether it raises Execute.
-type Checked = (Vec<(&'static str, Value)>, Option<usize>, bool);
+/// The value of key `name` under any spelling (ASCII case and underscores ignored).
+fn named<'t>(table: &'t toml::Table, name: &str) -> Option<&'t toml::Value> {
+    let name = folded(name);
+    table
+        .iter()
+        .find(|(key, _)| folded(key) == name)
+        .map(|(_, value)| value)
+}
 
-fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
+/// The inputs of a call of `spec`, the room it gives, and whether it raises Execute.
+pub(crate) type Checked = (Vec<(&'static str, Value)>, Option<usize>, bool);
+
+/// The keys of a call that are not the block's inputs: what it addresses and how it runs.
+const ADDRESSING: [&str; 7] = [
+    "block",
+    "instance",
+    "axis",
+    "channel",
+    "axis_id",
+    "master_id",
+    "timeout_cycles",
+];
+
+/// The inputs of a `call` table of `spec` checked against its declarations.
+pub(crate) fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
     let (mut inputs, mut room, mut execute) = (Vec::new(), None, true);
-    if let Inputs::Table(parse) = spec.inputs {
-        let (value, r) = parse(spec.name, table)?;
-        inputs.push((WHOLE, value));
-        room = r;
-    }
+    let mut given: Vec<String> = Vec::new();
     for (key, value) in table {
-        let addressing = [
-            "block",
-            "instance",
-            "axis",
-            "channel",
-            "axis_id",
-            "master_id",
-        ];
-        if addressing.contains(&key.as_str()) || key == "timeout_cycles" {
+        if ADDRESSING.contains(&key.as_str()) {
             continue;
         }
         if key == "execute" && spec.execute {
@@ -261,27 +279,41 @@ fn inputs_of(spec: &BlockSpec, table: &toml::Table) -> Result<Checked, String> {
                 .ok_or("call: `execute` must be true or false")?;
             continue;
         }
-        let Inputs::Keys(keys) = spec.inputs else {
-            continue; // checked whole above
-        };
-        let Some(input) = keys.iter().find(|i| i.key == key) else {
-            let known: Vec<&str> = keys.iter().map(|i| i.key).collect();
-            let known = if known.is_empty() {
-                "none".into()
-            } else {
-                known.join(", ")
-            };
-            return Err(format!(
-                "call: {} has no input `{key}` (inputs: {known})",
-                spec.name
-            ));
+        let fold = folded(key);
+        if matches!(spec.target, Target::AxisNamed(name) if folded(name) == fold) {
+            continue; // the axis, read by `index_of`
+        }
+        if given.contains(&fold) {
+            return Err(format!("call: {} input `{key}` is given twice", spec.name));
+        }
+        given.push(fold.clone());
+        let Some(input) = spec.inputs.iter().find(|i| folded(i.key) == fold) else {
+            return Err(unknown_input(spec, key));
         };
         match (&input.kind, input.kind.check(spec.name, key, value)?) {
             (Kind::Room, Value::Int(r)) => room = Some(r as usize),
             (_, value) => inputs.push((input.key, value)),
         }
     }
+    // A call that lowers Execute sends nothing: it needs no inputs.
+    for input in spec.inputs.iter().filter(|i| i.required && execute) {
+        let master = folded(input.key) == "master" && table.contains_key("master_id");
+        if !given.contains(&folded(input.key)) && !master {
+            return Err(format!("call: {} needs `{}`", spec.name, input.key));
+        }
+    }
     Ok((inputs, room, execute))
+}
+
+/// A call's key that `spec` does not declare.
+fn unknown_input(spec: &BlockSpec, key: &str) -> String {
+    let known: Vec<&str> = spec.inputs.iter().map(|i| i.key).collect();
+    let known = if known.is_empty() {
+        "none".into()
+    } else {
+        known.join(", ")
+    };
+    format!("call: {} has no input `{key}` (inputs: {known})", spec.name)
 }
 
 impl Kind {
@@ -307,6 +339,17 @@ impl Kind {
                 .map(Value::Int)
                 .ok_or_else(bad),
             Kind::Range(lo, hi) => range(*lo, *hi),
+            Kind::Between(lo, hi) => number(value)
+                .filter(|v| (*lo..=*hi).contains(v))
+                .map(Value::Real)
+                .ok_or_else(|| format!("call: {block} input `{key}` = {value}: {lo} to {hi}")),
+            Kind::Positive => number(value)
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .map(Value::Real)
+                .ok_or_else(|| format!("call: {block} input `{key}` = {value}: a number above 0")),
+            Kind::Flags { flags, prefixes } => flag_bits(value, flags, prefixes)
+                .map(|bits| Value::Int(bits.into()))
+                .map_err(|e| format!("call: {block} input `{key}` = {value}: {e}")),
             Kind::Room => range(1, 1 << 20),
             Kind::OneOf(choices) => {
                 let text = value.to_string();
@@ -332,6 +375,34 @@ impl Kind {
             },
             Kind::Parsed { parse, .. } => parse(value),
         }
+    }
+}
+
+/// A mask: the raw bits, or a list of names from `flags` (each may carry one of the
+/// `prefixes`; case and underscores do not matter).
+fn flag_bits(value: &toml::Value, flags: &[(&str, u32)], prefixes: &[&str]) -> Result<u32, String> {
+    let names = || {
+        let names: Vec<&str> = flags.iter().map(|(n, _)| *n).collect();
+        names.join(", ")
+    };
+    let bit = |item: &toml::Value| -> Result<u32, String> {
+        let name = item
+            .as_str()
+            .ok_or_else(|| format!("flag names ({})", names()))?;
+        let short = folded(name);
+        let short = prefixes
+            .iter()
+            .find_map(|p| short.strip_prefix(&folded(p)))
+            .unwrap_or(&short);
+        let found = flags.iter().find(|(n, _)| folded(n) == short);
+        found
+            .map(|(_, bit)| *bit)
+            .ok_or_else(|| format!("unknown flag {name:?} (known: {})", names()))
+    };
+    match value {
+        toml::Value::Integer(bits) => u32::try_from(*bits).map_err(|_| "a 32-bit mask".to_string()),
+        toml::Value::Array(list) => list.iter().try_fold(0, |bits, item| Ok(bits | bit(item)?)),
+        _ => Err(format!("an integer or a list of flag names ({})", names())),
     }
 }
 

@@ -3,6 +3,12 @@
 //! inputs with their kinds, and the constructor; [`FAMILIES`] lists the tables, one line per
 //! family. The instances, and the checks of a call against these declarations, are
 //! [`super::instances`].
+//!
+//! Every block declares its inputs one way: a list of [`InputSpec`]s (the key under the
+//! block's name for it, its [`Kind`], whether a call must give it), usually with the
+//! `inputs!` macro of [`crate::blocks`], which also writes the block's `set`. A call's keys
+//! meet the declared ones ignoring ASCII case and underscores (`RatioNumerator` is
+//! `ratio_numerator`). Inputs keep their values from call to call, as a PLC block's do.
 
 use crate::blocks::{
     cam, cam_compat, cam_data, cam_multi, cam_read, channel, fifo, motion, probe, saw,
@@ -38,7 +44,7 @@ pub struct BlockSpec {
     /// A call raises Execute (`execute = false` lowers it); false for MC_Power.
     pub execute: bool,
     /// The inputs a call may set.
-    pub inputs: Inputs,
+    pub inputs: &'static [InputSpec],
     /// A fresh instance; `room` is the room of a read's answer, if the call gave one.
     pub make: fn(room: Option<usize>) -> Box<dyn TimelineBlock>,
 }
@@ -54,7 +60,7 @@ impl BlockSpec {
             name,
             target: Target::Axis,
             execute: true,
-            inputs: Inputs::Keys(inputs),
+            inputs,
             make,
         }
     }
@@ -67,21 +73,11 @@ pub enum Target {
     Axis,
     /// A FIFO group, given as an input: no `axis`.
     Group,
-    /// An axis given as `axis` or, without it, where the function finds it (the seed's
-    /// `Slave` of the flying-saw blocks).
-    AxisOr(fn(&toml::Table) -> Option<&toml::Value>),
+    /// An axis given as `axis` or as the input of this name (the seed's `Slave` of the
+    /// flying-saw blocks; keys meet ignoring case and underscores); both given must agree.
+    AxisNamed(&'static str),
     /// A channel, given as `channel` (its gpCh index), handed to the block as its `axis`.
     Channel,
-}
-
-/// How a call's inputs are checked.
-#[derive(Debug)]
-pub enum Inputs {
-    /// Key by key, each of its kind; the block is set key by key.
-    Keys(&'static [InputSpec]),
-    /// The whole table by the family (every key but `block`, `instance`, `axis`, `execute`):
-    /// one value, set under [`WHOLE`], and the room of a read's answer if it has one.
-    Table(fn(&'static str, &toml::Table) -> Result<Whole, String>),
 }
 
 /// The keys of a call every block takes (checked by [`super::instances`], not by a family's
@@ -98,24 +94,41 @@ pub const CALL_KEYS: [&str; 7] = [
     "master_id",
 ];
 
-/// A call checked whole: its one value, and the room of a read's answer if it gives one.
-pub type Whole = (Value, Option<usize>);
-
-/// The key a whole-table value is set under ([`Inputs::Table`]).
-pub const WHOLE: &str = "inputs";
-
 /// An input of a block.
 #[derive(Debug, Clone, Copy)]
 pub struct InputSpec {
-    /// Its key in a `call`.
+    /// Its key in a `call` (ASCII case and underscores do not matter).
     pub key: &'static str,
     /// What it takes.
     pub kind: Kind,
+    /// Whether every call must give it (a master input may be given as `master_id`).
+    pub required: bool,
 }
 
 /// An input `key` of kind `kind`.
 pub const fn input(key: &'static str, kind: Kind) -> InputSpec {
-    InputSpec { key, kind }
+    InputSpec {
+        key,
+        kind,
+        required: false,
+    }
+}
+
+/// An input `key` of kind `kind` that every call gives.
+pub const fn required(key: &'static str, kind: Kind) -> InputSpec {
+    InputSpec {
+        key,
+        kind,
+        required: true,
+    }
+}
+
+/// A key without underscores, in lower case: how a call's keys meet the declared ones.
+pub fn folded(key: &str) -> String {
+    key.chars()
+        .filter(|c| *c != '_')
+        .collect::<String>()
+        .to_ascii_lowercase()
 }
 
 /// The input lists `parts` one after the other, as one list of `N` inputs (a block's list
@@ -146,6 +159,19 @@ pub enum Kind {
     Count,
     /// An integer `lo..=hi`: [`Value::Int`].
     Range(i64, i64),
+    /// A finite number `lo..=hi`: [`Value::Real`].
+    Between(f64, f64),
+    /// A finite number above 0 (a time, a period): [`Value::Real`].
+    Positive,
+    /// A bit mask: the raw bits as an integer (sent as given), or a list of these flags'
+    /// names, each with or without one of the prefixes (case and underscores do not
+    /// matter): [`Value::Int`].
+    Flags {
+        /// `(name, bit)` of every flag.
+        flags: &'static [(&'static str, u32)],
+        /// The prefixes a name may carry (the seed's constant names), folded.
+        prefixes: &'static [&'static str],
+    },
     /// One of these values as written in TOML (a note may follow a space): [`Value::Int`].
     OneOf(&'static [(&'static str, i64)]),
     /// A wire enum by name or number ([`mode`]): [`Value::Int`], its raw value.
@@ -159,6 +185,28 @@ pub enum Kind {
         /// A valid value.
         example: &'static str,
     },
+}
+
+impl Kind {
+    /// A valid value of this kind, as TOML (the lowest of a range, the first choice).
+    pub fn example(&self) -> String {
+        match self {
+            Kind::Bool => "true".into(),
+            Kind::Real => "1.5".into(),
+            Kind::Count => "1".into(),
+            Kind::Range(lo, _) => lo.to_string(),
+            Kind::Between(lo, _) => format!("{lo:?}"),
+            Kind::Positive => "2.0".into(),
+            Kind::Flags { flags, .. } => format!("[{:?}]", flags[0].0),
+            Kind::Room => "4".into(),
+            Kind::OneOf(choices) => choices[0].0.split(' ').next().unwrap_or("").into(),
+            Kind::Mode(m) => {
+                let names = (m.names)();
+                format!("{:?}", names.split(' ').next().unwrap_or(""))
+            }
+            Kind::Parsed { example, .. } => example.to_string(),
+        }
+    }
 }
 
 /// A wire enum seen through its names and numbers.
@@ -206,7 +254,7 @@ pub enum Value {
     Points(Arc<[McMotionFunctionPoint]>),
     /// Up to 8 table IDs, and how many.
     Ids([u32; 8], u32),
-    /// A family's own inputs ([`Inputs::Table`]).
+    /// A shape of a family's own ([`Kind::Parsed`]).
     Custom(Arc<dyn Any + Send + Sync>),
 }
 
@@ -261,16 +309,21 @@ impl InputField for f64 {
 }
 
 impl InputField for bool {
+    /// A [`Kind::Bool`], or an integer kind's 0 (false) or other value (true): a
+    /// [`Kind::OneOf`] of two choices sets a flag.
     fn take(&mut self, value: &Value) {
-        if let Value::Bool(v) = value {
-            *self = *v;
+        match value {
+            Value::Bool(v) => *self = *v,
+            Value::Int(v) => *self = *v != 0,
+            _ => {}
         }
     }
 }
 
 /// A block instance a timeline calls.
 pub trait TimelineBlock: core::fmt::Debug {
-    /// Sets input `key` of the block's spec (or [`WHOLE`]) to `value`, of the key's kind.
+    /// Sets input `key` of the block's spec (its declared spelling) to `value`, of the key's
+    /// kind.
     fn set(&mut self, key: &str, value: &Value);
     /// Execute, if the block has it.
     fn execute(&mut self) -> Option<&mut bool>;

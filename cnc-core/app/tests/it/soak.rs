@@ -16,7 +16,7 @@
 use crate::counting_alloc::live_bytes;
 use cnc_app::scenario::{InProcess, Scenario};
 use cnc_core::machine::engine::Balance;
-use plc_shim::timeline::registry::{BlockSpec, Inputs, Kind, Target, FAMILIES};
+use plc_shim::timeline::registry::{BlockSpec, Kind, Target, FAMILIES};
 use std::path::PathBuf;
 use tests::Noise;
 
@@ -173,12 +173,21 @@ fn random_input(kind: &Kind, next: &mut impl FnMut() -> u64) -> Option<String> {
                 v.to_string()
             })?
         }
+        Kind::Between(lo, hi) => {
+            let share = (next() % 5) as f64 / 4.0;
+            format!("{:?}", lo + (hi - lo) * share)
+        }
+        Kind::Positive => format!("{:?}", [0.5, 1.0, 2.0, 10.0][(next() % 4) as usize]),
+        Kind::Flags { flags, .. } => {
+            let bits = (0..next() % 3).map(|_| flags[(next() % flags.len() as u64) as usize].1);
+            bits.fold(0, |mask, bit| mask | bit).to_string()
+        }
         Kind::Room => (1 + next() % 64).to_string(),
         Kind::Parsed { example, .. } => example.to_string(),
     })
 }
 
-/// A timeline of `steps` random calls of every block with keyed inputs, on the machine's six
+/// A timeline of `steps` random calls of every block, on the machine's six
 /// axes (a scenario refuses an axis it does not have), one instance per block and axis,
 /// Execute lowered now and then.
 fn random_timeline(steps: usize, seed: u64) -> String {
@@ -187,16 +196,13 @@ fn random_timeline(steps: usize, seed: u64) -> String {
     let blocks: Vec<&BlockSpec> = FAMILIES
         .iter()
         .flat_map(|family| family.iter())
-        .filter(|b| matches!(b.inputs, Inputs::Keys(_)))
         // This machine has no channel: the channel blocks run in channel_control.rs.
         .filter(|b| !matches!(b.target, Target::Channel))
         .collect();
     let mut text = String::new();
     for k in 0..steps {
         let b = blocks[(next() % blocks.len() as u64) as usize];
-        let Inputs::Keys(inputs) = b.inputs else {
-            continue;
-        };
+        let inputs = b.inputs;
         let (instance, axis) = match b.target {
             Target::Group => (format!("{}_g", b.name), String::new()),
             _ => {

@@ -21,189 +21,116 @@
 //! as given: the CNC refuses bits it does not know) or lists of flag names, with or without
 //! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
 
-use super::GearInInputs;
-use crate::timeline::registry::number;
+use super::{McGearInPos, McGearInVelo};
+use crate::timeline::registry::{InputSpec, Kind, Value};
 use hli::calls::saw::{sync_mask, SawSyncMode};
 
 /// `(name, bit)` of `sync_mask` flags: a flag's short name is its constant's name.
 macro_rules! flags {
     ($($flag:ident),* $(,)?) => {
-        [$((stringify!($flag), sync_mask::$flag)),*]
+        &[$((stringify!($flag), sync_mask::$flag)),*]
     };
 }
 
+/// The prefixes of the seed's flag constants (`GearInSync_CheckMask_MAXACC`).
+const FLAG_PREFIXES: &[&str] = &["GearInSync_CheckMask_", "GearInSync_OpMask_"];
+
 /// The check flags of `ST_SyncMode` by short name (`GearInSync_CheckMask_<name>`).
-const CHECK_FLAGS: [(&str, u32); 12] = flags![
-    MINPOS,
-    MAXPOS,
-    MAXVELO,
-    MAXACC,
-    MAXDEC,
-    MAXJERK,
-    OVERSHOOTPOS,
-    UNDERSHOOTPOS,
-    OVERSHOOTVELO,
-    UNDERSHOOTVELO,
-    OVERSHOOTVELOZERO,
-    UNDERSHOOTVELOZERO,
-];
+const CHECK_MASK: Kind = Kind::Flags {
+    flags: flags![
+        MINPOS,
+        MAXPOS,
+        MAXVELO,
+        MAXACC,
+        MAXDEC,
+        MAXJERK,
+        OVERSHOOTPOS,
+        UNDERSHOOTPOS,
+        OVERSHOOTVELO,
+        UNDERSHOOTVELO,
+        OVERSHOOTVELOZERO,
+        UNDERSHOOTVELOZERO,
+    ],
+    prefixes: FLAG_PREFIXES,
+};
 
 /// The operation flags of `ST_SyncMode` by short name (`GearInSync_OpMask_<name>`).
-const OPERATION_FLAGS: [(&str, u32); 6] = flags![
-    ROLLBACKLOCK,
-    INSTANTSTOPONROLLBACK,
-    PREFERCONSTVELO,
-    IGNOREMASTERACC,
-    IGNORESLAVEACC,
-    DETAILEDERRORCODES,
-];
+const OP_MASK: Kind = Kind::Flags {
+    flags: flags![
+        ROLLBACKLOCK,
+        INSTANTSTOPONROLLBACK,
+        PREFERCONSTVELO,
+        IGNOREMASTERACC,
+        IGNORESLAVEACC,
+        DETAILEDERRORCODES,
+    ],
+    prefixes: FLAG_PREFIXES,
+};
 
-/// The inputs of a flying-saw call.
-#[derive(Debug, Clone, Default, PartialEq)]
-pub(super) struct SawInputs {
-    pub(super) master: u32,
-    pub(super) gear: GearInInputs,
-    /// MasterSyncPosition, SlaveSyncPosition.
-    pub(super) sync_positions: [f64; 2],
-}
+/// `SyncMode`: `"position-based"` or `"time-based"` under any spelling of the wire enum's
+/// names (`"GEARINSYNCMODE_TIMEBASED"`), or the raw 0 / 1: whether it is time-based.
+const SYNC_MODE: Kind = Kind::Parsed {
+    parse: |value| {
+        time_based(value).map(Value::Bool).ok_or_else(|| {
+            format!("call: `SyncMode` = {value}: \"position-based\" or \"time-based\"")
+        })
+    },
+    example: "\"time-based\"",
+};
 
-/// The inputs of MC_GearInPos under the seed's names, in the order an error lists them, and
-/// our `MasterSource` ("set_point" or "actual", as MC_CamIn's).
-const GEAR_IN_POS: [&str; 14] = [
-    "Slave",
-    "Master",
-    "RatioNumerator",
-    "RatioDenominator",
-    "MasterSyncPosition",
-    "SlaveSyncPosition",
-    "SyncMode",
-    "CheckMask",
-    "OpMask",
-    "Velocity",
-    "Acceleration",
-    "Deceleration",
-    "Jerk",
-    "MasterSource",
-];
+/// Our `MasterSource`, as MC_CamIn's: the master's set-point or its actual values.
+const MASTER_SOURCE: Kind = Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]);
 
-/// The inputs of `kind` under the seed's names (`Slave` is every kind's: the axis).
-/// MC_GearInVelo has MC_GearInPos's but the two sync positions.
-fn inputs_of(kind: &str) -> Vec<&'static str> {
-    match kind {
-        "MC_GearInPos" => GEAR_IN_POS.to_vec(),
-        "MC_GearInVelo" => GEAR_IN_POS
-            .into_iter()
-            .filter(|name| !name.ends_with("SyncPosition"))
-            .collect(),
-        _ => vec!["Slave"],
-    }
-}
-
-/// A key without underscores, in lower case: `ratio_numerator` and `RatioNumerator` meet.
-fn folded(key: &str) -> String {
-    key.chars()
-        .filter(|c| *c != '_')
-        .collect::<String>()
-        .to_ascii_lowercase()
-}
-
-/// `Slave = N` under any spelling, for the caller's axis.
-pub(super) fn slave(table: &toml::Table) -> Option<&toml::Value> {
-    table
-        .iter()
-        .find(|(key, _)| folded(key) == "slave")
-        .map(|(_, value)| value)
-}
-
-/// Checks the inputs of a flying-saw `call` table (`block`, `instance`, `axis`, `execute`
-/// are the caller's; `Slave` is read by the caller as the axis).
-pub(super) fn parse(kind: &str, table: &toml::Table) -> Result<SawInputs, String> {
-    let mut inputs = SawInputs::default();
-    let mut master = None;
-    let mut sync_positions = [None, None];
-    let (mut checks, mut operations) = (0, 0);
-    let known = inputs_of(kind);
-    if let (Some(s), Some(a)) = (slave(table), table.get("axis")) {
-        if s != a {
-            return Err(format!(
-                "call: {kind}: `Slave` = {s} and `axis` = {a} differ"
-            ));
-        }
-    }
-    for (key, value) in table {
-        if crate::timeline::registry::CALL_KEYS.contains(&key.as_str()) {
-            continue;
-        }
-        let Some(name) = known.iter().find(|n| folded(n) == folded(key)) else {
-            return Err(format!(
-                "call: {kind} has no input `{key}` (inputs: {})",
-                known.join(", ")
-            ));
-        };
-        let bad = |what: &str| format!("call: {kind} input `{key}` = {value}: {what}");
-        let gear = &mut inputs.gear;
-        match *name {
-            "Slave" => {} // the axis, read by the caller
-            "Master" => {
-                master = Some(
-                    value
-                        .as_integer()
-                        .filter(|m| (0..i64::from(u32::MAX)).contains(m))
-                        .ok_or_else(|| bad("an axis index"))? as u32,
-                )
-            }
-            "RatioDenominator" => {
-                gear.ratio_denominator = value
-                    .as_integer()
-                    .filter(|d| (0..=i64::from(u16::MAX)).contains(d))
-                    .ok_or_else(|| bad("a UINT, 0..=65535"))?
-                    as u32
-            }
-            "SyncMode" => {
-                gear.sync_mode.time_based =
-                    time_based(value).ok_or_else(|| bad("\"position-based\" or \"time-based\""))?
-            }
-            "CheckMask" => checks = mask(value, &CHECK_FLAGS).map_err(|e| bad(&e))?,
-            "MasterSource" => {
-                gear.master_actual = match value.as_str() {
-                    Some("set_point") => false,
-                    Some("actual") => true,
-                    _ => return Err(bad("\"set_point\" or \"actual\"")),
-                }
-            }
-            "OpMask" => operations = mask(value, &OPERATION_FLAGS).map_err(|e| bad(&e))?,
-            other => {
-                let v = number(value)
-                    .filter(|v| v.is_finite())
-                    .ok_or_else(|| bad("a finite number"))?;
-                match other {
-                    "RatioNumerator" => gear.ratio_numerator = v,
-                    "MasterSyncPosition" => sync_positions[0] = Some(v),
-                    "SlaveSyncPosition" => sync_positions[1] = Some(v),
-                    "Velocity" => gear.velocity = v,
-                    "Acceleration" => gear.acceleration = v,
-                    "Deceleration" => gear.deceleration = v,
-                    _ => gear.jerk = v,
-                }
+/// The inputs MC_GearInVelo and MC_GearInPos share, under the seed's names, then our
+/// `MasterSource`; `$sync` are the sync positions of MC_GearInPos.
+macro_rules! gear_in_inputs {
+    ($(#[doc = $doc:literal])* $list:ident, $set:ident: $block:ty { $($sync:tt)* }) => {
+        inputs! {
+            $(#[doc = $doc])*
+            $list, $set: $block {
+                required "Master": Kind::Count => master,
+                "RatioNumerator": Kind::Real => inputs.ratio_numerator,
+                "RatioDenominator": Kind::Range(0, u16::MAX as i64) => inputs.ratio_denominator,
+                $($sync)*
+                "SyncMode": SYNC_MODE => inputs.sync_mode.time_based,
+                "CheckMask": CHECK_MASK => inputs.sync_mode.check_mask,
+                "OpMask": OP_MASK => inputs.sync_mode.op_mask,
+                "Velocity": Kind::Real => inputs.velocity,
+                "Acceleration": Kind::Real => inputs.acceleration,
+                "Deceleration": Kind::Real => inputs.deceleration,
+                "Jerk": Kind::Real => inputs.jerk,
+                "MasterSource": MASTER_SOURCE => inputs.master_actual,
             }
         }
+    };
+}
+
+gear_in_inputs! {
+    /// MC_GearInVelo's inputs.
+    GEAR_IN_VELO, set_gear_in_velo: McGearInVelo {}
+}
+
+gear_in_inputs! {
+    /// MC_GearInPos's inputs: MC_GearInVelo's and the two sync positions.
+    GEAR_IN_POS, set_gear_in_pos: McGearInPos {
+        required "MasterSyncPosition": Kind::Real => master_sync_position,
+        required "SlaveSyncPosition": Kind::Real => slave_sync_position,
     }
-    inputs.gear.sync_mode.mask = checks | operations;
-    // The master by its NC axis ID (`master_id`) is set by the timeline's instances.
-    if known.contains(&"Master") && !table.contains_key("master_id") {
-        inputs.master = master.ok_or_else(|| format!("call: {kind} needs `Master`"))?;
-    }
-    if known.contains(&"MasterSyncPosition") {
-        match sync_positions {
-            [Some(m), Some(s)] => inputs.sync_positions = [m, s],
-            _ => {
-                return Err(format!(
-                    "call: {kind} needs `MasterSyncPosition` and `SlaveSyncPosition`"
-                ))
-            }
-        }
-    }
-    Ok(inputs)
+}
+
+/// MC_GearInVelo's inputs.
+pub(super) const VELO: &[InputSpec] = &GEAR_IN_VELO;
+/// MC_GearInPos's inputs.
+pub(super) const POS: &[InputSpec] = &GEAR_IN_POS;
+
+/// Sets input `key` of MC_GearInVelo.
+pub(super) fn set_velo(block: &mut McGearInVelo, key: &str, value: &Value) {
+    set_gear_in_velo(block, key, value);
+}
+
+/// Sets input `key` of MC_GearInPos.
+pub(super) fn set_pos(block: &mut McGearInPos, key: &str, value: &Value) {
+    set_gear_in_pos(block, key, value);
 }
 
 /// `SyncMode`: a name (`"time-based"`, `"GEARINSYNCMODE_TIMEBASED"`, ...) or the raw 0 / 1.
@@ -230,41 +157,27 @@ fn time_based(value: &toml::Value) -> Option<bool> {
     Some(mode == SawSyncMode::TimeBased)
 }
 
-/// A mask: the raw bits, or a list of names from `flags`.
-fn mask(value: &toml::Value, flags: &[(&str, u32)]) -> Result<u32, String> {
-    let names = || {
-        let names: Vec<&str> = flags.iter().map(|(n, _)| *n).collect();
-        names.join(", ")
-    };
-    match value {
-        toml::Value::Integer(bits) => u32::try_from(*bits).map_err(|_| "a 32-bit mask".to_string()),
-        toml::Value::Array(list) => {
-            list.iter()
-                .try_fold(0u32, |bits, item| -> Result<u32, String> {
-                    let name = item
-                        .as_str()
-                        .ok_or_else(|| format!("flag names ({})", names()))?;
-                    let upper = name.replace('_', "").to_ascii_uppercase();
-                    let short = ["GEARINSYNCCHECKMASK", "GEARINSYNCOPMASK"]
-                        .iter()
-                        .find_map(|prefix| upper.strip_prefix(prefix))
-                        .unwrap_or(&upper);
-                    match flags.iter().find(|(n, _)| *n == short) {
-                        Some((_, bit)) => Ok(bits | bit),
-                        None => Err(format!("unknown flag {name:?} (known: {})", names())),
-                    }
-                })
-        }
-        _ => Err(format!("an integer or a list of flag names ({})", names())),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::timeline::instances::inputs_of;
+    use crate::timeline::registry::{find, TimelineBlock};
 
-    fn parsed(kind: &str, text: &str) -> Result<SawInputs, String> {
-        parse(kind, &toml::from_str(text).unwrap())
+    /// MC_GearInPos after a call of `kind` with `text`'s inputs (MC_GearInVelo's are set on
+    /// a MC_GearInVelo and copied over).
+    fn parsed(kind: &str, text: &str) -> Result<McGearInPos, String> {
+        let table: toml::Table = toml::from_str(text).unwrap();
+        let (inputs, _, _) = inputs_of(find(kind)?, &table)?;
+        let mut pos = McGearInPos::default();
+        let mut velo = McGearInVelo::default();
+        for (key, value) in &inputs {
+            pos.set(key, value);
+            velo.set(key, value);
+        }
+        if kind == "MC_GearInVelo" {
+            (pos.inputs, pos.master) = (velo.inputs, velo.master);
+        }
+        Ok(pos)
     }
 
     #[test]
@@ -275,27 +188,30 @@ mod tests {
                     OpMask = [\"rollback_lock\"]";
         let i = parsed("MC_GearInPos", text).unwrap();
         assert_eq!(i.master, 0);
-        assert_eq!(i.sync_positions, [500.0, 100.0]);
         assert_eq!(
-            (i.gear.ratio_numerator, i.gear.ratio_denominator),
+            (i.master_sync_position, i.slave_sync_position),
+            (500.0, 100.0)
+        );
+        assert_eq!(
+            (i.inputs.ratio_numerator, i.inputs.ratio_denominator),
             (-0.5, 4)
         );
-        assert_eq!(i.gear.jerk, 1e5);
+        assert_eq!(i.inputs.jerk, 1e5);
         let bits = sync_mask::MAXACC | sync_mask::MAXJERK | sync_mask::ROLLBACKLOCK;
-        assert_eq!(i.gear.sync_mode.mask, bits);
-        assert!(!i.gear.sync_mode.time_based);
-        assert!(!i.gear.master_actual, "the set-point by default");
+        assert_eq!(i.inputs.sync_mode.mask(), bits);
+        assert!(!i.inputs.sync_mode.time_based);
+        assert!(!i.inputs.master_actual, "the set-point by default");
         let i = parsed("MC_GearInVelo", "Master = 0\nmaster_source = \"actual\"").unwrap();
-        assert!(i.gear.master_actual);
+        assert!(i.inputs.master_actual);
 
         let i = parsed(
             "MC_GearInVelo",
             "Master = 2\nSyncMode = \"time-based\"\nOpMask = 3",
         )
         .unwrap();
-        assert!(i.gear.sync_mode.time_based);
-        assert_eq!(i.gear.sync_mode.mask, 3, "raw bits go as given");
-        assert_eq!(i.gear.ratio_denominator, 1, "ratio 1:1 by default");
+        assert!(i.inputs.sync_mode.time_based);
+        assert_eq!(i.inputs.sync_mode.mask(), 3, "raw bits go as given");
+        assert_eq!(i.inputs.ratio_denominator, 1, "ratio 1:1 by default");
         for (mode, time_based) in [
             ("\"GEARINSYNCMODE_TIMEBASED\"", true),
             ("\"position_based\"", false),
@@ -303,7 +219,7 @@ mod tests {
             ("0", false),
         ] {
             let i = parsed("MC_GearInVelo", &format!("Master = 0\nSyncMode = {mode}")).unwrap();
-            assert_eq!(i.gear.sync_mode.time_based, time_based, "{mode}");
+            assert_eq!(i.inputs.sync_mode.time_based, time_based, "{mode}");
         }
     }
 
@@ -322,13 +238,12 @@ mod tests {
         )
         .contains("unknown flag"));
         assert!(err("MC_GearInVelo", "Master = 0\nSyncMode = \"fast\"").contains("time-based"));
-        assert!(err("MC_GearInVelo", "Master = 0\nRatioDenominator = 70000").contains("UINT"));
-        assert!(err("MC_GearOut", "Slave = 1\naxis = 2").contains("differ"));
+        assert!(err("MC_GearInVelo", "Master = 0\nRatioDenominator = 70000").contains("0..=65535"));
+        assert!(err("MC_GearInVelo", "Master = 0\nmaster = 1").contains("given twice"));
         assert!(
             err("MC_GearInVelo", "Master = 0\nMasterSource = \"encoder\"")
                 .contains("\"set_point\" or \"actual\"")
         );
-        assert!(parsed("MC_GearOut", "Slave = 1\naxis = 1").is_ok());
         assert!(parsed("MC_ReadFlyingSawCharacteristics", "slave = 1").is_ok());
     }
 }

@@ -110,8 +110,15 @@ fn bad_calls_name_the_key() {
     );
     assert_eq!(
         err("block = \"CamTableReadData\"\naxis = 1\ntable = 1\nblock_size = 8"),
-        "call: CamTableReadData `block_size` = 8: 0 (the default) or at least 16 bytes (one row)"
+        "call: `block_size` = 8: 0 (the default) or at least 16 bytes (one row)"
     );
+    assert_eq!(
+        err("block = \"MC_GearOut\"\nSlave = 1\naxis = 2"),
+        "call: MC_GearOut: `Slave` = 1 and `axis` = 2 differ"
+    );
+    assert!(Instances::default()
+        .parse_call(&table("block = \"MC_GearOut\"\nslave = 1\naxis = 1"))
+        .is_ok());
     assert!(err("block = \"CamTableDelete\"\naxis = 1\nblock_size = 32")
         .starts_with("call: CamTableDelete has no input `block_size`"));
     let mut i = Instances::default();
