@@ -442,7 +442,11 @@ mod tests {
                 (last, last_v, last_a) = (p[0], v, acc);
             }
             proptest::prop_assert!(!c.lagging(), "lag {}", c.lag(0));
-            proptest::prop_assert!(c.cuts() <= 5, "{} cuts in {} ticks", c.cuts(), lagging_ticks);
+            // A cut hands its rest back to the lag, planned anew next tick; the master's
+            // re-targeting under a running catch-up cuts again (its acceleration changes
+            // under the lag's profile): a few per step, and rare among the catch-up's ticks.
+            let bound = 2 * steps.len() as u64 + 1 + u64::from(lagging_ticks) / 25;
+            proptest::prop_assert!(c.cuts() <= bound, "{} cuts in {} ticks", c.cuts(), lagging_ticks);
             proptest::prop_assert_eq!(last, master.state().position + offset);
         }
     }
