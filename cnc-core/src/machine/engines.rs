@@ -1,59 +1,199 @@
-//! The standard engine set of a machine, in its tick order: each engine's machine file has a
-//! `build` that makes it from the [`EngineSetup`] (or leaves it out when the machine has
-//! nothing for it), and [`STANDARD`] lists them, one line per engine. The order matters: an
-//! engine later in the list sees the set-points of this tick of the axes the ones before it
-//! drive (the flying saw, last, follows a master a cam or a FIFO group moves).
+//! The standard engine set of a machine, in its tick order. Each engine's machine file
+//! declares one [`EngineDef`]: the keys of the machine configuration it reads, how it turns
+//! them into its own configuration when the configuration is loaded (`configure`), and how it
+//! is built from that (`build`, which leaves it out when the machine has nothing for it).
+//! [`STANDARD`] lists them, one line per engine. The order matters: an engine later in the
+//! list sees the set-points of this tick of the axes the ones before it drive (the flying
+//! saw, last, follows a master a cam or a FIFO group moves).
+//!
+//! The application reads its own keys of a scenario and hands every key an engine declared
+//! ([`sections`]) to [`configure`] untouched: it names no engine, and an engine's keys,
+//! their checks and their error texts live in the engine's file.
 
 use super::Engine;
-use crate::cam::CamProfile;
-use crate::fifo::FifoParams;
-use crate::machine::gear::GearSpec;
+use std::any::Any;
+use std::path::PathBuf;
+use std::sync::Arc;
 
-/// What the engines of a machine are made from: the machine's configuration beside its
-/// channels and axes.
+/// What every engine of a machine is built with: the machine beside its configuration.
 #[derive(Debug, Clone, Copy)]
-pub struct EngineSetup<'a> {
+pub struct EngineSetup {
     /// Axes of all channels, in the machine's axis numbering before the single axes.
     pub channel_axes: usize,
     /// Single axes (PLCopen axes), numbered after the channel axes.
     pub single_axes: usize,
     /// The CNC cycle in seconds.
     pub cycle_s: f64,
-    /// Electronic gears between axes.
-    pub gears: &'a [GearSpec],
-    /// Cam tables loaded at start-up, by table ID.
-    pub cam_tables: &'a [(u32, CamProfile)],
-    /// FIFO axis groups `gpFifo[0..]`.
-    pub fifo_groups: &'a [FifoParams],
 }
 
-impl EngineSetup<'_> {
+impl EngineSetup {
     /// Every axis of the machine.
     pub fn axes(&self) -> usize {
         self.channel_axes + self.single_axes
     }
 }
 
-/// Why an engine could not be made from its configuration (the engine's own error, whose
-/// text names the configuration key).
+/// What an engine's configuration is made from when the machine configuration is loaded.
+pub struct ConfigInput<'a> {
+    /// The keys of the machine configuration the engine declared, as given (a key that is
+    /// not given is absent).
+    pub sections: &'a toml::Table,
+    /// Every axis's name in the machine's numbering (channel axes `CHANNEL.AXIS` first).
+    pub axis_names: &'a [String],
+    /// How many of them are channel axes.
+    pub channel_axes: usize,
+    /// Reads a file the configuration names (relative to it): its resolved path and text,
+    /// or why not.
+    pub open: &'a OpenFile<'a>,
+}
+
+/// Reads a file a configuration names: its resolved path and text, or why not.
+pub type OpenFile<'a> = dyn Fn(&str) -> Result<(PathBuf, String), String> + 'a;
+
+/// Makes an engine from the setup and its configuration, or `None` when the machine has
+/// nothing for it.
+pub type Build = fn(&EngineSetup, &Config) -> Result<Option<Box<dyn Engine>>, SetupError>;
+
+/// An engine's own configuration, made by its `configure` and read back by its `build`.
+pub type Config = Arc<dyn Any + Send + Sync>;
+
+/// Why an engine could not be configured or made (the engine's own error, whose text names
+/// the configuration key).
 pub type SetupError = Box<dyn std::error::Error + Send + Sync>;
 
-/// Makes an engine from the setup, or `None` when the machine has nothing for it.
-pub type Build = fn(&EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError>;
+/// An engine as the machine's configuration knows it.
+#[derive(Debug, Clone, Copy)]
+pub struct EngineDef {
+    /// The engine's name (its errors' prefix).
+    pub name: &'static str,
+    /// The top-level keys of the machine configuration it reads (`gear` for `[[gear]]`).
+    pub sections: &'static [&'static str],
+    /// Its configuration from those keys, checked.
+    pub configure: fn(&ConfigInput<'_>) -> Result<Config, SetupError>,
+    /// The engine for a machine, or `None` when the machine has nothing for it.
+    pub build: Build,
+}
+
+/// An engine without keys of its own: its configuration is empty.
+pub fn no_config(_: &ConfigInput<'_>) -> Result<Config, SetupError> {
+    Ok(Arc::new(()))
+}
+
+/// An engine's configuration read back as its own type `T` (what its `configure` made).
+pub fn config_of<T: Any + Send + Sync>(config: &Config) -> Result<&T, SetupError> {
+    config
+        .downcast_ref::<T>()
+        .ok_or_else(|| "an engine was built from another engine's configuration".into())
+}
 
 /// The standard engines in their tick order: one line per engine.
-pub const STANDARD: &[Build] = &[
-    super::gear::build,
-    super::cams::build,
-    super::fifo::build,
-    super::saw::build,
+pub const STANDARD: &[EngineDef] = &[
+    super::gear::ENGINE,
+    super::cams::ENGINE,
+    super::fifo::ENGINE,
+    super::saw::ENGINE,
 ];
 
-/// The standard engines of a machine, made from `setup` in their tick order.
-pub fn standard(setup: &EngineSetup<'_>) -> Result<Vec<Box<dyn Engine>>, SetupError> {
+/// Every configuration key an engine of [`STANDARD`] reads.
+pub fn sections() -> impl Iterator<Item = &'static str> {
+    STANDARD.iter().flat_map(|e| e.sections.iter().copied())
+}
+
+/// The configurations of the [`STANDARD`] engines, one each in its order.
+#[derive(Clone)]
+pub struct EngineConfigs(Vec<Config>);
+
+impl core::fmt::Debug for EngineConfigs {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "EngineConfigs({} engines)", self.0.len())
+    }
+}
+
+/// Every standard engine's configuration from the keys in `input.sections` (each engine sees
+/// only the keys it declared). A key two engines declare is refused.
+pub fn configure(input: &ConfigInput<'_>) -> Result<EngineConfigs, SetupError> {
+    let mut configs = Vec::with_capacity(STANDARD.len());
+    for (i, engine) in STANDARD.iter().enumerate() {
+        for key in engine.sections {
+            if let Some(other) = STANDARD[..i].iter().find(|e| e.sections.contains(key)) {
+                return Err(format!(
+                    "`{key}` is read by two engines: {} and {}",
+                    other.name, engine.name
+                )
+                .into());
+            }
+        }
+        let own: toml::Table = input
+            .sections
+            .iter()
+            .filter(|(key, _)| engine.sections.contains(&key.as_str()))
+            .map(|(key, value)| (key.clone(), value.clone()))
+            .collect();
+        configs.push((engine.configure)(&ConfigInput {
+            sections: &own,
+            ..*input
+        })?);
+    }
+    Ok(EngineConfigs(configs))
+}
+
+/// The standard engines of a machine, made from `setup` and their configurations in their
+/// tick order.
+pub fn standard(
+    setup: &EngineSetup,
+    configs: &EngineConfigs,
+) -> Result<Vec<Box<dyn Engine>>, SetupError> {
     let mut engines = Vec::with_capacity(STANDARD.len());
-    for build in STANDARD {
-        engines.extend(build(setup)?);
+    for (engine, config) in STANDARD.iter().zip(&configs.0) {
+        engines.extend((engine.build)(setup, config)?);
     }
     Ok(engines)
+}
+
+/// A configuration section as `T` (serde), or `T::default()` when the key is not given; the
+/// error names the key.
+pub fn section<T: serde::de::DeserializeOwned + Default>(
+    sections: &toml::Table,
+    key: &str,
+) -> Result<T, SetupError> {
+    match sections.get(key) {
+        None => Ok(T::default()),
+        Some(value) => value
+            .clone()
+            .try_into()
+            .map_err(|e| format!("[[{key}]]: {}", e.message()).into()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn no_two_engines_read_one_key() {
+        let mut keys: Vec<&str> = sections().collect();
+        let n = keys.len();
+        keys.sort_unstable();
+        keys.dedup();
+        assert_eq!(keys.len(), n);
+    }
+
+    #[test]
+    fn a_machine_without_engine_keys_configures_and_builds() {
+        let open = |_: &str| Err("no files".to_string());
+        let input = ConfigInput {
+            sections: &toml::Table::new(),
+            axis_names: &["X".to_string()],
+            channel_axes: 0,
+            open: &open,
+        };
+        let configs = configure(&input).unwrap();
+        let setup = EngineSetup {
+            channel_axes: 0,
+            single_axes: 1,
+            cycle_s: 0.001,
+        };
+        // A single axis: the cams and the saw; no gear, no FIFO group.
+        assert_eq!(standard(&setup, &configs).unwrap().len(), 2);
+    }
 }

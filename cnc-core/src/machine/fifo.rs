@@ -18,7 +18,7 @@
 //! are sized when the engine is built.
 
 use super::engine::{Balance, Bulk, Call, Engine, EngineIo};
-use super::engines::{EngineSetup, SetupError};
+use super::engines::{config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
@@ -460,15 +460,79 @@ pub struct FifoEngine {
     tick_s: f64,
 }
 
-/// The FIFO groups of a machine, if it has any ([`super::engines::STANDARD`]).
-pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
-    if setup.fifo_groups.is_empty() {
+/// The FIFO engine in the engine set ([`super::engines::STANDARD`]).
+pub const ENGINE: EngineDef = EngineDef {
+    name: "fifo",
+    sections: &["fifo_group"],
+    configure,
+    build,
+};
+
+/// One `[[fifo_group]]` table: `gpFifo[i]^` in file order.
+///
+/// ```toml
+/// [[fifo_group]]
+/// dimension = 2         # N axes
+/// rows = 64             # Z rows
+/// fifo_cycle_ms = 2.0   # T_f
+/// override = "pt2"      # or "instant" (the default)
+/// pt2_t0_ms = 20.0      # T0 of the PT-2 (with "pt2" only)
+/// ```
+#[derive(Debug, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FifoGroupFile {
+    dimension: usize,
+    rows: usize,
+    fifo_cycle_ms: f64,
+    #[serde(default = "instant", rename = "override")]
+    override_type: String,
+    pt2_t0_ms: Option<f64>,
+}
+
+fn instant() -> String {
+    "instant".into()
+}
+
+/// The FIFO groups' parameters, checked: an error names the group and what is wrong.
+fn configure(input: &ConfigInput<'_>) -> Result<Config, SetupError> {
+    let files: Vec<FifoGroupFile> = section(input.sections, "fifo_group")?;
+    if files.len() > HLI_MAX_FIFO_GROUPS {
+        let n = files.len();
+        return Err(format!("{n} [[fifo_group]]: the image holds {HLI_MAX_FIFO_GROUPS}").into());
+    }
+    let mut groups = Vec::with_capacity(files.len());
+    for (i, f) in files.iter().enumerate() {
+        let kind = match (f.override_type.as_str(), f.pt2_t0_ms) {
+            ("instant", None) => OverrideType::Instant,
+            ("pt2", Some(t0)) => OverrideType::Pt2 { t0_s: t0 * 1e-3 },
+            ("pt2", None) => {
+                return Err(
+                    format!("[[fifo_group]] {i}: override = \"pt2\" needs pt2_t0_ms").into(),
+                )
+            }
+            ("instant", Some(_)) => {
+                let e = format!("[[fifo_group]] {i}: pt2_t0_ms belongs to override = \"pt2\"");
+                return Err(e.into());
+            }
+            (other, _) => {
+                let e = format!("[[fifo_group]] {i}: override = {other:?}: \"instant\" or \"pt2\"");
+                return Err(e.into());
+            }
+        };
+        let params = FifoParams::new(f.dimension, f.rows, f.fifo_cycle_ms * 1e-3, kind)
+            .map_err(|e| format!("[[fifo_group]] {i}: {e}"))?;
+        groups.push(params);
+    }
+    Ok(std::sync::Arc::new(groups))
+}
+
+/// The FIFO groups of a machine, if it has any.
+fn build(setup: &EngineSetup, config: &Config) -> Result<Option<Box<dyn Engine>>, SetupError> {
+    let groups: &Vec<FifoParams> = config_of(config)?;
+    if groups.is_empty() {
         return Ok(None);
     }
-    Ok(Some(Box::new(FifoEngine::new(
-        setup.fifo_groups,
-        setup.cycle_s,
-    )?)))
+    Ok(Some(Box::new(FifoEngine::new(groups, setup.cycle_s)?)))
 }
 
 impl FifoEngine {

@@ -7,9 +7,18 @@
 //! MC_GearOut lets a gear's slave go: it runs on free at its velocity (its own generator, as
 //! after the saw's MC_GearOut) and the gear stays out until the slave has been disabled; the
 //! next time it is enabled and free, the gear couples again.
+//!
+//! Configured by the machine's `[[gear]]` tables, axes by name:
+//!
+//! ```toml
+//! [[gear]]
+//! master = "Conveyor"   # any axis: a single axis or CHANNEL.AXIS
+//! slave = "Saw"         # a single axis (a channel drives its own)
+//! ratio = 0.5
+//! ```
 
 use super::engine::{Engine, EngineIo};
-use super::engines::{EngineSetup, SetupError};
+use super::engines::{config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use hli::enums::{AxisState, CouplingState};
 
@@ -57,12 +66,63 @@ pub enum GearError {
     Ratio(f64),
 }
 
-/// The gears of a machine, if it has any ([`super::engines::STANDARD`]).
-pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
-    if setup.gears.is_empty() {
+/// The gear engine in the engine set ([`super::engines::STANDARD`]).
+pub const ENGINE: EngineDef = EngineDef {
+    name: "gear",
+    sections: &["gear"],
+    configure,
+    build,
+};
+
+/// One `[[gear]]` table.
+#[derive(Debug, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GearFile {
+    master: String,
+    slave: String,
+    ratio: f64,
+}
+
+/// The gears by axis index, checked against the machine's axes.
+fn configure(input: &ConfigInput<'_>) -> Result<Config, SetupError> {
+    let files: Vec<GearFile> = section(input.sections, "gear")?;
+    let names = input.axis_names;
+    let index = |n: &str, key: &str| {
+        names.iter().position(|m| m == n).ok_or_else(|| {
+            format!(
+                "[[gear]] {key} {n:?}: no such axis (known: {})",
+                names.join(", ")
+            )
+        })
+    };
+    let mut gears = Vec::with_capacity(files.len());
+    for g in &files {
+        let slave = index(&g.slave, "slave")?;
+        if slave < input.channel_axes {
+            return Err(format!(
+                "[[gear]] slave {:?}: a channel axis is driven by its channel, not by a gear",
+                g.slave
+            )
+            .into());
+        }
+        let master = index(&g.master, "master")?;
+        gears.push(GearSpec {
+            master,
+            slave,
+            ratio: g.ratio,
+        });
+    }
+    GearEngine::new(&gears, names.len())?;
+    Ok(std::sync::Arc::new(gears))
+}
+
+/// The gears of a machine, if it has any.
+fn build(setup: &EngineSetup, config: &Config) -> Result<Option<Box<dyn Engine>>, SetupError> {
+    let gears: &Vec<GearSpec> = config_of(config)?;
+    if gears.is_empty() {
         return Ok(None);
     }
-    Ok(Some(Box::new(GearEngine::new(setup.gears, setup.axes())?)))
+    Ok(Some(Box::new(GearEngine::new(gears, setup.axes())?)))
 }
 
 impl GearEngine {

@@ -8,7 +8,7 @@
 //! again, the slave synchronises anew from where it stands.
 
 use super::engine::{Call, Engine, EngineIo, Resource};
-use super::engines::{EngineSetup, SetupError};
+use super::engines::{no_config, Config, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
@@ -80,8 +80,17 @@ fn accepted() -> HandlerResult {
     reply(&SawReply::default())
 }
 
-/// The flying saw of a machine with single axes ([`super::engines::STANDARD`]).
-pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
+/// The flying saw in the engine set ([`super::engines::STANDARD`]): it has no keys of its
+/// own.
+pub const ENGINE: EngineDef = EngineDef {
+    name: "saw",
+    sections: &[],
+    configure: no_config,
+    build,
+};
+
+/// The flying saw of a machine with single axes.
+fn build(setup: &EngineSetup, _: &Config) -> Result<Option<Box<dyn Engine>>, SetupError> {
     if setup.single_axes == 0 {
         return Ok(None);
     }

@@ -1,4 +1,5 @@
-//! Single axes and gears in a scenario.
+//! Single axes in a scenario (the `[[gear]]` tables beside them are the gear engine's:
+//! `cnc_core::machine::gear`).
 //!
 //! ```toml
 //! [[axis]]
@@ -31,7 +32,6 @@ use cnc_core::axis::config::{AxisConfig, AxisKind, DriveLink, DriveMode, ImageOp
 use cnc_core::axis::increments::CounterWidth;
 use cnc_core::axis::sim_drive::DriveModel;
 use cnc_core::channel::ChannelConfig;
-use cnc_core::machine::gear::GearSpec;
 use serde::Deserialize;
 
 /// One `[[axis]]` table.
@@ -71,75 +71,6 @@ pub struct AxisFile {
 
 fn linear() -> String {
     "linear".into()
-}
-
-/// One `[[fifo_group]]` table: `gpFifo[i]^` in file order.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FifoGroupFile {
-    /// N.
-    dimension: usize,
-    /// Z.
-    rows: usize,
-    /// T_f, ms.
-    fifo_cycle_ms: f64,
-    /// "instant" (default) or "pt2".
-    #[serde(default = "instant", rename = "override")]
-    override_type: String,
-    /// T0 of the PT-2, ms.
-    pt2_t0_ms: Option<f64>,
-}
-
-fn instant() -> String {
-    "instant".into()
-}
-
-/// The FIFO groups' parameters, checked: `Err` names the group and what is wrong.
-pub fn fifo_groups(files: &[FifoGroupFile]) -> Result<Vec<cnc_core::fifo::FifoParams>, String> {
-    use cnc_core::fifo::{FifoParams, OverrideType};
-    if files.len() > hli::layout::HLI_MAX_FIFO_GROUPS {
-        return Err(format!(
-            "{} [[fifo_group]]: the image holds {}",
-            files.len(),
-            hli::layout::HLI_MAX_FIFO_GROUPS
-        ));
-    }
-    files
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let kind = match (f.override_type.as_str(), f.pt2_t0_ms) {
-                ("instant", None) => OverrideType::Instant,
-                ("pt2", Some(t0)) => OverrideType::Pt2 { t0_s: t0 * 1e-3 },
-                ("pt2", None) => {
-                    return Err(format!(
-                        "[[fifo_group]] {i}: override = \"pt2\" needs pt2_t0_ms"
-                    ))
-                }
-                ("instant", Some(_)) => {
-                    return Err(format!(
-                        "[[fifo_group]] {i}: pt2_t0_ms belongs to override = \"pt2\""
-                    ))
-                }
-                (other, _) => {
-                    return Err(format!(
-                        "[[fifo_group]] {i}: override = {other:?}: \"instant\" or \"pt2\""
-                    ))
-                }
-            };
-            FifoParams::new(f.dimension, f.rows, f.fifo_cycle_ms * 1e-3, kind)
-                .map_err(|e| format!("[[fifo_group]] {i}: {e}"))
-        })
-        .collect()
-}
-
-/// One `[[gear]]` table.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct GearFile {
-    master: String,
-    slave: String,
-    ratio: f64,
 }
 
 /// A single axis of a scenario: its configuration and whether it is enabled at start.
@@ -312,38 +243,4 @@ pub fn axis_names(channels: &[ChannelConfig], single: &[ScenarioAxis]) -> Vec<St
     }
     names.extend(single.iter().map(|a| a.config.name.clone()));
     names
-}
-
-/// Resolves gears by axis name; a slave must be a single axis (the first `channel_axes`
-/// names are the channels' axes, which their channels drive).
-pub fn gears(
-    files: &[GearFile],
-    names: &[String],
-    channel_axes: usize,
-) -> Result<Vec<GearSpec>, String> {
-    let index = |n: &str, key: &str| {
-        names.iter().position(|m| m == n).ok_or_else(|| {
-            format!(
-                "[[gear]] {key} {n:?}: no such axis (known: {})",
-                names.join(", ")
-            )
-        })
-    };
-    files
-        .iter()
-        .map(|g| {
-            let slave = index(&g.slave, "slave")?;
-            if slave < channel_axes {
-                return Err(format!(
-                    "[[gear]] slave {:?}: a channel axis is driven by its channel, not by a gear",
-                    g.slave
-                ));
-            }
-            Ok(GearSpec {
-                master: index(&g.master, "master")?,
-                slave,
-                ratio: g.ratio,
-            })
-        })
-        .collect()
 }

@@ -10,15 +10,9 @@
 //! axes = ["X", "Y", "Z", "A", "B", "C"]
 //! kinematics = { id = 45, preset = "kr6r900sixx" }
 //! program = "master.nc"           # relative to this file
-//! [[cam_table]]
-//! file = "seed_example.json"         # a JSON cam file (docs/cams.md); its `id`, or:
+//! [[cam_table]]                  # any key an engine reads goes to that engine
+//! file = "seed_example.json"      # (cnc_core::machine::engines; docs/machine.md)
 //! id = 1
-//! [[fifo_group]]                  # gpFifo[0]^: N axes, Z rows, T_f (docs/fifo.md)
-//! dimension = 3
-//! rows = 500
-//! fifo_cycle_ms = 2.0
-//! override = "pt2"                # or "instant" (default)
-//! pt2_t0_ms = 40.0
 //! [plc]
 //! timeline = "plc.toml"           # or: program = "rotary-table"; program = "fifo-stream"
 //!                                 # with file = "contour.csv" (and fifo_override = 80.0)
@@ -27,6 +21,7 @@
 //! ```
 
 use cnc_core::channel::{ChannelConfig, LoadedProgram};
+use cnc_core::machine::engines::{self, ConfigInput, EngineConfigs};
 use hli::access::Leaf;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
@@ -67,8 +62,9 @@ pub enum DrivesOnLoss {
     Disable,
 }
 
+/// The scenario's own keys; every other top-level key must be one an engine reads
+/// (`cnc_core::machine::engines::sections`), and goes to the engines untouched.
 #[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
 struct ScenarioFile {
     #[serde(default = "default_cycle_ms")]
     cycle_ms: f64,
@@ -80,12 +76,6 @@ struct ScenarioFile {
     channel: Vec<ChannelConfig>,
     #[serde(default)]
     axis: Vec<super::axes::AxisFile>,
-    #[serde(default)]
-    gear: Vec<super::axes::GearFile>,
-    #[serde(default)]
-    cam_table: Vec<CamTableFile>,
-    #[serde(default)]
-    fifo_group: Vec<super::axes::FifoGroupFile>,
     plc: Option<PlcFile>,
     #[serde(default)]
     trace: TraceFile,
@@ -97,13 +87,6 @@ struct ScenarioFile {
 
 fn default_cycle_ms() -> f64 {
     1.0
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CamTableFile {
-    file: String,
-    id: Option<u32>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -168,12 +151,8 @@ pub struct Scenario {
     pub folders: Vec<Option<cnc_core::channel::folder::ProgramFolder>>,
     /// Single axes, behind the channel axes.
     pub axes: Vec<super::axes::ScenarioAxis>,
-    /// Gear couplings between axes (indices in the machine's axis set).
-    pub gears: Vec<cnc_core::machine::gear::GearSpec>,
-    /// Cam tables by ID, loaded into the cam engine at start.
-    pub cam_tables: Vec<(u32, cnc_core::cam::CamProfile)>,
-    /// FIFO groups, `gpFifo[0..]` (the FIFO engine exists when there is one).
-    pub fifo_groups: Vec<cnc_core::fifo::FifoParams>,
+    /// The engines' configurations, each made by its engine from the keys it reads.
+    pub engines: EngineConfigs,
     /// The PLC.
     pub plc: PlcSetup,
     /// Trace signals: ST path and resolved leaf.
@@ -217,7 +196,7 @@ impl Scenario {
         open: impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
     ) -> Result<Scenario, ScenarioError> {
         let invalid = invalid_in(name);
-        let file: ScenarioFile = toml::from_str(text).map_err(|e| invalid(e.to_string()))?;
+        let (file, sections) = scenario_file(text).map_err(&invalid)?;
         file.check_shape().map_err(&invalid)?;
         let programs = load_programs(name, &file.channel, &open)?;
         let folders = program_folders(name, &file.channel)?;
@@ -237,17 +216,23 @@ impl Scenario {
             )));
         }
         let names = super::axes::axis_names(&file.channel, &axes);
-        let gears = super::axes::gears(&file.gear, &names, channel_axes).map_err(&invalid)?;
-        cnc_core::machine::gear::GearEngine::new(&gears, names.len())
-            .map_err(|e| invalid(e.to_string()))?;
+        let open_file = |relative: &str| {
+            confined("a file", Path::new(relative))?;
+            open(relative).map_err(|e| e.to_string())
+        };
+        let engines = engines::configure(&ConfigInput {
+            sections: &sections,
+            axis_names: &names,
+            channel_axes,
+            open: &open_file,
+        })
+        .map_err(|e| invalid(e.to_string()))?;
         check_block_axes(&plc, channel_axes, &names).map_err(&invalid)?;
         let ids: Vec<u32> = (1..=channel_axes as u32)
             .chain(axes.iter().map(|a| a.config.id))
             .collect();
         check_block_axis_ids(&plc, channel_axes, &ids, &names).map_err(&invalid)?;
         check_block_channels(&plc, file.channel.len()).map_err(&invalid)?;
-        let cam_tables = cam_tables(name, &file.cam_table, &open)?;
-        let fifo_groups = super::axes::fifo_groups(&file.fifo_group).map_err(&invalid)?;
         let signals = trace_signals(file.trace.signals).map_err(&invalid)?;
         Ok(Scenario {
             name: name.to_string(),
@@ -259,9 +244,7 @@ impl Scenario {
             programs,
             folders,
             axes,
-            gears,
-            cam_tables,
-            fifo_groups,
+            engines,
             plc,
             signals,
             realtime: file.realtime,
@@ -572,50 +555,24 @@ fn check_block_channels(plc: &PlcSetup, channels: usize) -> Result<(), String> {
     Ok(())
 }
 
-/// The cam tables of scenario `name`, each JSON file read through `open`, by ID.
-fn cam_tables(
-    name: &str,
-    files: &[CamTableFile],
-    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
-) -> Result<Vec<(u32, cnc_core::cam::CamProfile)>, ScenarioError> {
-    let invalid = invalid_in(name);
-    let mut cam_tables: Vec<(u32, cnc_core::cam::CamProfile)> = Vec::new();
-    for t in files {
-        confined("[[cam_table]] file", Path::new(&t.file)).map_err(&invalid)?;
-        let (path, text) = open(&t.file)?;
-        let at = path.display();
-        if !text.trim_start().starts_with('{') {
-            return Err(invalid(format!(
-                "[[cam_table]] {at}: a scenario takes JSON cam files (docs/cams.md)"
-            )));
-        }
-        let cam = cnc_core::cam::file::parse(text.as_bytes(), Default::default())
-            .map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
-        let id =
-            cam_table_id(cam.id, t.id).map_err(|e| invalid(format!("[[cam_table]] {at}: {e}")))?;
-        if cam_tables.iter().any(|(other, _)| *other == id) {
-            return Err(invalid(format!(
-                "[[cam_table]] {at}: id {id} is taken by another table"
-            )));
-        }
-        cam_tables.push((id, cam.profile));
+/// The scenario's own keys, and the keys the engines read (`sections`); a key neither
+/// reads is refused by name (the TOML reader's errors keep their line and column).
+fn scenario_file(text: &str) -> Result<(ScenarioFile, toml::Table), String> {
+    let mut ignored = Vec::new();
+    let file: ScenarioFile = serde_ignored::deserialize(toml::Deserializer::new(text), |path| {
+        ignored.push(path.to_string())
+    })
+    .map_err(|e| e.to_string())?;
+    let engine_keys: Vec<&str> = engines::sections().collect();
+    if let Some(key) = ignored.iter().find(|k| !engine_keys.contains(&k.as_str())) {
+        return Err(format!(
+            "unknown key `{key}` (neither the scenario's nor an engine's: {})",
+            engine_keys.join(", ")
+        ));
     }
-    Ok(cam_tables)
-}
-
-/// A cam table's ID: the file's or the scenario's (they must agree), in 1..=255.
-fn cam_table_id(in_file: Option<u32>, in_scenario: Option<u32>) -> Result<u32, String> {
-    let id = match (in_file, in_scenario) {
-        (Some(a), Some(b)) if a != b => {
-            return Err(format!("the file has id {a}, the scenario says {b}"))
-        }
-        (Some(id), _) | (None, Some(id)) => id,
-        (None, None) => return Err("no id (give `id = 1..255`)".to_string()),
-    };
-    if !(1..=255).contains(&id) {
-        return Err(format!("id {id} is outside 1..255"));
-    }
-    Ok(id)
+    let mut all: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+    all.retain(|key, _| engine_keys.contains(&key));
+    Ok((file, all))
 }
 
 /// The trace signals resolved to leaves of the image.

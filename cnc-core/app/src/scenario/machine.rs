@@ -43,15 +43,13 @@ pub fn build(scenario: &Scenario) -> Result<Machine, ScenarioError> {
         channels.push(channel);
     }
     let channel_axes = super::axes::axis_names(&scenario.channels, &[]).len();
-    let engines = engines::standard(&EngineSetup {
+    let setup = EngineSetup {
         channel_axes,
         single_axes: scenario.axes.len(),
         cycle_s: scenario.cycle_s,
-        gears: &scenario.gears,
-        cam_tables: &scenario.cam_tables,
-        fifo_groups: &scenario.fifo_groups,
-    })
-    .map_err(|e| invalid(e.to_string()))?;
+    };
+    let engines =
+        engines::standard(&setup, &scenario.engines).map_err(|e| invalid(e.to_string()))?;
     let mut machine = Machine::new(MachineSetup {
         channels,
         axes: scenario.axes.iter().map(|a| a.config.clone()).collect(),

@@ -106,6 +106,12 @@ fn bad_axes_and_gears_are_refused_with_key_and_reason() {
         ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.Q\"\nslave = \"A\"\nratio = 1.0\n", "master \"conveyor.Q\": no such axis"),
         ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"A\"\nratio = 1.0\n", "its own master"),
         ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"conveyor.X\"\nslave = \"A\"\nratio = 0.0\n", "ratio 0"),
+        // The engines' keys go to their engines, which name the key; a key nobody reads is
+        // refused by name.
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"A\"\nratio = 1.0\nphase = 2\n", "[[gear]]: unknown field `phase`"),
+        ("[[axis]]\nname = \"A\"\n[[gear]]\nmaster = \"A\"\nslave = \"A\"\nratio = \"one\"\n", "[[gear]]: invalid type"),
+        ("[[axis]]\nname = \"A\"\n[[gears]]\nmaster = \"A\"\n", "unknown key `gears`"),
+        ("[[axis]]\nname = \"A\"\n[[fifo_group]]\ndimension = 2\nrows = 8\nfifo_cycle_ms = 1.0\noverride = \"pt2\"\n", "[[fifo_group]] 0: override = \"pt2\" needs pt2_t0_ms"),
     ] {
         let e = scenario(extra).expect_err(extra).to_string();
         assert!(e.starts_with("machine.toml:"), "{e}");

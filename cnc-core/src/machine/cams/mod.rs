@@ -19,16 +19,19 @@
 //!
 //! Here: the engine's state, its tick (multi-table slaves, online point changes, then every
 //! cam slave: activation, rescaling, switch, hand-over) and the calls' dispatch. The calls
-//! live beside it: `couplings` (couple, switch, decouple, scale, the multi-table slave),
+//! live beside it: `config` (the `[[cam_table]]` tables it starts with, its build),
+//! `couplings` (couple, switch, decouple, scale, the multi-table slave),
 //! `data` (points and rows in chunks, online-change mode, table delete) and `reads`
 //! (MC_CamRead's answers).
 
+mod config;
 mod couplings;
 mod data;
 mod reads;
 
+pub use config::{CamTableError, ENGINE};
+
 use super::engine::{Balance, Call, Engine, EngineIo, Resource};
-use super::engines::{EngineSetup, SetupError};
 use crate::axis::{AxisSet, Lease};
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
@@ -225,32 +228,6 @@ fn coupling_code(e: CouplingError) -> u32 {
 }
 
 const TABLE_INVALID: u32 = TableErrorCode::CamTableIdInvalid as u32;
-
-/// A cam table of the setup that the store refused.
-#[derive(Debug, thiserror::Error)]
-#[error("[[cam_table]] {id}: {error}")]
-pub struct CamTableError {
-    /// Its table ID.
-    pub id: u32,
-    /// Why.
-    pub error: crate::cam::CamError,
-}
-
-/// The cam engine of a machine with cam tables or single axes: a PLC may load tables and
-/// couple any time (an idle engine costs a pass over empty slots)
-/// ([`super::engines::STANDARD`]).
-pub fn build(setup: &EngineSetup<'_>) -> Result<Option<Box<dyn Engine>>, SetupError> {
-    if setup.cam_tables.is_empty() && setup.single_axes == 0 {
-        return Ok(None);
-    }
-    let mut store = CamStore::new();
-    for (id, profile) in setup.cam_tables {
-        store
-            .insert(*id, profile.clone())
-            .map_err(|error| CamTableError { id: *id, error })?;
-    }
-    Ok(Some(Box::new(CamEngine::new(store, setup.axes()))))
-}
 
 impl CamEngine {
     /// An engine for a machine of `axes` axes with the tables of `store`.
