@@ -9,12 +9,12 @@
 
 use bench_kit::{median, scaled};
 use cnc_core::axis::config::AxisConfig;
+use cnc_core::cam::machine::CamEngine;
 use cnc_core::cam::online::CamStore;
 use cnc_core::cam::{
     CamProfile, FunctionType, MotionFunction, MotionFunctionPoint, PointType, PositionTable,
     TableType,
 };
-use cnc_core::machine::cams::CamEngine;
 use cnc_core::machine::{Engine, Machine, MachineSetup};
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::cam::CamInterpolation;

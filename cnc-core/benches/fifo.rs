@@ -17,8 +17,8 @@
 
 use bench_kit::{median, scaled};
 use cnc_core::axis::config::AxisConfig;
+use cnc_core::fifo::machine::FifoEngine;
 use cnc_core::fifo::{FifoGenerator, FifoParams, OverrideFilter, OverrideType, RowRing};
-use cnc_core::machine::fifo::FifoEngine;
 use cnc_core::machine::{Machine, MachineSetup};
 use hli::calls::fifo::{
     rows_header, FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall,

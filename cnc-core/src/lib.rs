@@ -13,6 +13,7 @@ pub mod axis;
 pub mod cam;
 pub mod channel;
 pub mod fifo;
+pub mod gear;
 pub mod machine;
 pub mod nc;
 pub mod saw;

@@ -13,8 +13,8 @@
 use cnc_core::axis::config::AxisConfig;
 use cnc_core::axis::sim_drive::SimDriveConfig;
 use cnc_core::axis::DriveLink;
+use cnc_core::fifo::machine::FifoEngine;
 use cnc_core::fifo::{FifoParams, OverrideType};
-use cnc_core::machine::fifo::FifoEngine;
 use cnc_core::machine::{Machine, MachineSetup};
 use hli::calls::fifo::{
     rows_header, FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall, FifoWriteRowsCall,

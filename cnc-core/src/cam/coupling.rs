@@ -20,7 +20,7 @@
 //! Also here: which activation mode goes with which start and scaling mode (5.1.16.13), and
 //! the automatic offsets that keep the master's place in the cam and the slave's position
 //! when a coupling is switched or rescaled (5.1.16.14). Pure computation: the cam engine
-//! (`crate::machine::cams`) feeds in the axes.
+//! (`crate::cam::machine`) feeds in the axes.
 
 use super::online::{ActivationMode, EdgeCrossing, MasterNow};
 use super::{CamProfile, ProfileCursor};

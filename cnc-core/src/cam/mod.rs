@@ -1,7 +1,8 @@
 //! Cam profiles (seed 000, chapters 3 and 4.2): the slave position as a function of the
 //! master position, given as a motion function (points joined by motion laws) or as a
-//! position table. Pure computation: no axes, no time. The cam engine that couples real axes
-//! through these profiles builds on this module.
+//! position table. The modules below are pure computation: no axes, no time. The cam engine
+//! that couples real axes through these profiles is `machine`, beside them (the engine's
+//! home is this folder).
 //!
 //! * `piece` — the closed-form building block (polynomial + sinusoids) every law is made of;
 //! * `law` — `FunctionType` and how each law fills a segment;
@@ -13,7 +14,8 @@
 //!   scaling modes;
 //! * `multi_table` — the multi-table slave: profile tables in series, corrections beside;
 //! * `file` — the JSON cam file and the binary table file;
-//! * `error` — refusals with the seed's error codes.
+//! * `error` — refusals with the seed's error codes;
+//! * `machine` — the cam engine on the machine seam: its tick, calls and configuration.
 //!
 //! Evaluation (`CamProfile::eval`) allocates nothing and costs O(1) per call while the master
 //! sweeps, through a cursor the caller keeps.
@@ -23,6 +25,7 @@ pub mod coupling;
 pub mod error;
 pub mod file;
 pub mod law;
+pub mod machine;
 pub mod motion_function;
 pub mod multi_table;
 pub mod online;

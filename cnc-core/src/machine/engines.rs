@@ -88,10 +88,10 @@ pub fn config_of<T: Any + Send + Sync>(config: &Config) -> Result<&T, SetupError
 
 /// The standard engines in their tick order: one line per engine.
 pub const STANDARD: &[EngineDef] = &[
-    super::gear::ENGINE,
-    super::cams::ENGINE,
-    super::fifo::ENGINE,
-    super::saw::ENGINE,
+    crate::gear::ENGINE,
+    crate::cam::machine::ENGINE,
+    crate::fifo::machine::ENGINE,
+    crate::saw::machine::ENGINE,
 ];
 
 /// Every configuration key an engine of [`STANDARD`] reads.

@@ -17,16 +17,15 @@
 //! between ticks:  acyclic calls (`dispatch`): routed by kind to the engine that declares it, else the axis layer
 //! ```
 //!
+//! The engines live in their own folders (`crate::gear`, `crate::cam::machine`,
+//! `crate::fifo::machine`, `crate::saw::machine`); `engines::STANDARD` lists them.
+//!
 //! The machine is library code: it knows no PLC program and no process. `cnc run`, the demo,
 //! the in-process runs, the benchmark and the no-allocation tests all drive this one `tick`.
 
-pub mod cams;
 mod channel_axes;
 pub mod engine;
 pub mod engines;
-pub mod fifo;
-pub mod gear;
-pub mod saw;
 
 pub use channel_axes::ChannelAxes;
 pub use engine::{Bulk, Call, Engine, EngineIo, Others, Resource, RouteConflict, Routes};

@@ -14,9 +14,10 @@
 //! * `plan`: refusals, optimisation steps and checks;
 //! * `follow`: a planned phase run tick by tick, rollback included.
 //!
-//! `crate::machine::saw` runs the phase in the machine tick.
+//! `machine` (beside it) runs the phase in the machine tick.
 
 pub mod follow;
+pub mod machine;
 pub mod plan;
 pub mod profile;
 pub mod shape;

@@ -4,13 +4,13 @@
 use cnc_app::scenario::fleet::running;
 use cnc_app::scenario::InProcess;
 use cnc_core::axis::config::AxisConfig;
+use cnc_core::cam::machine::CamEngine;
 use cnc_core::cam::online::CamStore;
 use cnc_core::cam::{CamProfile, PositionTable, TableType};
+use cnc_core::fifo::machine::FifoEngine;
 use cnc_core::fifo::{FifoParams, OverrideType};
-use cnc_core::machine::cams::CamEngine;
-use cnc_core::machine::fifo::FifoEngine;
-use cnc_core::machine::saw::SawEngine;
 use cnc_core::machine::{Engine, Machine, MachineSetup};
+use cnc_core::saw::machine::SawEngine;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::cam::{CamInCall, CamInterpolation, CamTableSelectCall};
 use hli::calls::fifo::{rows_header, FifoIntegrateCall, FifoReply, FifoStartCall};

@@ -1,5 +1,5 @@
 //! Single axes in a scenario (the `[[gear]]` tables beside them are the gear engine's:
-//! `cnc_core::machine::gear`).
+//! `cnc_core::gear`).
 //!
 //! ```toml
 //! [[axis]]

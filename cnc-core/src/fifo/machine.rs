@@ -17,11 +17,13 @@
 //! `gpFifo[i]^`. Neither the tick nor a call allocates: ring, generator and member slots
 //! are sized when the engine is built.
 
-use super::engine::{Balance, Bulk, Call, Engine, EngineIo};
-use super::engines::{config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::fifo::{
     BlockError, FifoGenerator, FifoParams, OverrideFilter, OverrideType, ParamError, RowRing,
+};
+use crate::machine::engine::{Balance, Bulk, Call, Engine, EngineIo};
+use crate::machine::engines::{
+    config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError,
 };
 use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
@@ -460,7 +462,7 @@ pub struct FifoEngine {
     tick_s: f64,
 }
 
-/// The FIFO engine in the engine set ([`super::engines::STANDARD`]).
+/// The FIFO engine in the engine set ([`crate::machine::engines::STANDARD`]).
 pub const ENGINE: EngineDef = EngineDef {
     name: "fifo",
     sections: &["fifo_group"],

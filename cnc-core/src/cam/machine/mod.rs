@@ -31,12 +31,12 @@ mod reads;
 
 pub use config::{CamTableError, ENGINE};
 
-use super::engine::{Balance, Call, Engine, EngineIo, Resource};
 use crate::axis::{AxisSet, Lease};
 use crate::cam::coupling::{CamLaw, CouplingError, Scaling};
 use crate::cam::multi_table::{MultiTableLaw, TableWeight};
 use crate::cam::online::{ActivationMode, CamStore, MasterNow};
 use crate::cam::{CamProfile, ProfileCursor, TableErrorCode};
+use crate::machine::engine::{Balance, Call, Engine, EngineIo, Resource};
 use crate::setpoint::Kinematic;
 use data::{PointsTransfer, RowsTransfer};
 use hli::calls::cam::CamCouplingError;

@@ -17,9 +17,11 @@
 //! ratio = 0.5
 //! ```
 
-use super::engine::{Engine, EngineIo};
-use super::engines::{config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
+use crate::machine::engine::{Engine, EngineIo};
+use crate::machine::engines::{
+    config_of, section, Config, ConfigInput, EngineDef, EngineSetup, SetupError,
+};
 use hli::enums::{AxisState, CouplingState};
 
 /// One gear: axis indices in the machine's axis set and the ratio.
@@ -66,7 +68,7 @@ pub enum GearError {
     Ratio(f64),
 }
 
-/// The gear engine in the engine set ([`super::engines::STANDARD`]).
+/// The gear engine in the engine set ([`crate::machine::engines::STANDARD`]).
 pub const ENGINE: EngineDef = EngineDef {
     name: "gear",
     sections: &["gear"],

@@ -7,10 +7,10 @@
 //! synchronous phase was reached; when the master comes forward over the coupling position
 //! again, the slave synchronises anew from where it stands.
 
-use super::engine::{Call, Engine, EngineIo, Resource};
-use super::engines::{no_config, Config, EngineDef, EngineSetup, SetupError};
 use crate::axis::{AxisSet, Coupling, Lease};
 use crate::cam::CharacValues;
+use crate::machine::engine::{Call, Engine, EngineIo, Resource};
+use crate::machine::engines::{no_config, Config, EngineDef, EngineSetup, SetupError};
 use crate::saw::{self, Follower, Limits, SawRequest, SyncOn};
 use crate::setpoint::Kinematic;
 use hli::calls::cam::{TableOrganisation, TABLE_TYPE_MOTION_FUNCTION};
@@ -80,7 +80,7 @@ fn accepted() -> HandlerResult {
     reply(&SawReply::default())
 }
 
-/// The flying saw in the engine set ([`super::engines::STANDARD`]): it has no keys of its
+/// The flying saw in the engine set ([`crate::machine::engines::STANDARD`]): it has no keys of its
 /// own.
 pub const ENGINE: EngineDef = EngineDef {
     name: "saw",
