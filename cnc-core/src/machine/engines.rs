@@ -94,12 +94,35 @@ pub const STANDARD: &[EngineDef] = &[
     crate::saw::machine::ENGINE,
 ];
 
-/// Every configuration key an engine of [`STANDARD`] reads.
-pub fn sections() -> impl Iterator<Item = &'static str> {
-    STANDARD.iter().flat_map(|e| e.sections.iter().copied())
+/// Engines outside this crate, registered once per process ([`register_extension`]).
+static EXTENSIONS: std::sync::OnceLock<&'static [EngineDef]> = std::sync::OnceLock::new();
+
+/// Registers engines outside this crate, once per process and before the first machine
+/// configuration is read (a program's `main`, a test's first line): they join the machine
+/// after the [`STANDARD`] engines, in the order given. Registering the same engines again is
+/// allowed; others are refused.
+pub fn register_extension(engines: &'static [EngineDef]) -> Result<(), SetupError> {
+    let set = EXTENSIONS.get_or_init(|| engines);
+    if core::ptr::eq(*set, engines) {
+        Ok(())
+    } else {
+        Err("other extension engines are registered already".into())
+    }
 }
 
-/// The configurations of the [`STANDARD`] engines, one each in its order.
+/// The engines of every machine in their tick order: the [`STANDARD`] ones, then the
+/// registered extensions.
+pub fn all() -> impl Iterator<Item = &'static EngineDef> + Clone {
+    let extensions: &'static [EngineDef] = EXTENSIONS.get().copied().unwrap_or(&[]);
+    STANDARD.iter().chain(extensions)
+}
+
+/// Every configuration key an engine reads.
+pub fn sections() -> impl Iterator<Item = &'static str> {
+    all().flat_map(|e| e.sections.iter().copied())
+}
+
+/// The configurations of the engines ([`all`]), one each in their order.
 #[derive(Clone)]
 pub struct EngineConfigs(Vec<Config>);
 
@@ -109,13 +132,13 @@ impl core::fmt::Debug for EngineConfigs {
     }
 }
 
-/// Every standard engine's configuration from the keys in `input.sections` (each engine sees
-/// only the keys it declared). A key two engines declare is refused.
+/// Every engine's configuration ([`all`]) from the keys in `input.sections` (each engine
+/// sees only the keys it declared). A key two engines declare is refused.
 pub fn configure(input: &ConfigInput<'_>) -> Result<EngineConfigs, SetupError> {
-    let mut configs = Vec::with_capacity(STANDARD.len());
-    for (i, engine) in STANDARD.iter().enumerate() {
+    let mut configs = Vec::with_capacity(all().count());
+    for (i, engine) in all().enumerate() {
         for key in engine.sections {
-            if let Some(other) = STANDARD[..i].iter().find(|e| e.sections.contains(key)) {
+            if let Some(other) = all().take(i).find(|e| e.sections.contains(key)) {
                 return Err(format!(
                     "`{key}` is read by two engines: {} and {}",
                     other.name, engine.name
@@ -137,14 +160,14 @@ pub fn configure(input: &ConfigInput<'_>) -> Result<EngineConfigs, SetupError> {
     Ok(EngineConfigs(configs))
 }
 
-/// The standard engines of a machine, made from `setup` and their configurations in their
+/// The engines of a machine ([`all`]), made from `setup` and their configurations in their
 /// tick order.
 pub fn standard(
     setup: &EngineSetup,
     configs: &EngineConfigs,
 ) -> Result<Vec<Box<dyn Engine>>, SetupError> {
-    let mut engines = Vec::with_capacity(STANDARD.len());
-    for (engine, config) in STANDARD.iter().zip(&configs.0) {
+    let mut engines = Vec::with_capacity(configs.0.len());
+    for (engine, config) in all().zip(&configs.0) {
         engines.extend((engine.build)(setup, config)?);
     }
     Ok(engines)

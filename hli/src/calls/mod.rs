@@ -84,6 +84,61 @@ macro_rules! calls {
     (@bulk $other:ident) => { false };
 }
 
+/// Declares the call kinds of an extension family: an engine outside this crate, with its
+/// own numbers (which [`register_extension`] checks against every other). The same lines as
+/// `calls!` of the built-in families; the kinds become constants of the declaring module
+/// (`my_family::PHASE_GEAR_IN`) rather than of [`CallKind`], and the module's `CALLS` is
+/// what the extension registers.
+///
+/// ```ignore
+/// hli::extension_calls! { family "phase_gear";
+///     /// Couple with a ratio and a phase.
+///     PHASE_GEAR_IN = 70: PhaseGearInCall -> PhaseGearReply, command;
+/// }
+/// ```
+#[macro_export]
+macro_rules! extension_calls {
+    (
+        family $family:literal;
+        $(
+            $(#[doc = $doc:literal])*
+            $kind:ident = $raw:literal : $call:ident -> $reply:ty, $access:ident;
+        )*
+    ) => {
+        $(
+            $(#[doc = $doc])*
+            pub const $kind: $crate::calls::CallKind = $crate::calls::CallKind::declare($raw);
+
+            impl $crate::calls::AcyclicCall for $call {
+                const KIND: $crate::calls::CallKind = $kind;
+                type Reply = $reply;
+            }
+
+            const _: () = assert!(
+                core::mem::size_of::<$call>() <= $crate::wire::ACYCLIC_BODY_SIZE
+                    && core::mem::size_of::<$reply>() <= $crate::wire::ACYCLIC_BODY_SIZE
+            );
+        )*
+
+        /// This extension family's call kinds (what it registers).
+        pub const CALLS: &[$crate::calls::CallSpec] = &[
+            $(
+                $crate::calls::CallSpec {
+                    kind: $kind,
+                    name: stringify!($kind),
+                    read_only: $crate::extension_calls!(@read_only $access),
+                    bulk: $crate::extension_calls!(@bulk $access),
+                    family: $family,
+                },
+            )*
+        ];
+    };
+    (@read_only read_only) => { true };
+    (@read_only $other:ident) => { false };
+    (@bulk bulk) => { true };
+    (@bulk $other:ident) => { false };
+}
+
 pub mod axis;
 pub mod cam;
 pub mod diag;
@@ -125,50 +180,99 @@ pub struct CallSpec {
 }
 
 impl CallKind {
+    /// The kind of an extension family (an engine outside this crate, [`register_extension`]):
+    /// its number must be one no built-in family declares, which registration checks. The
+    /// built-in families name theirs as `CallKind::NAME` constants instead.
+    pub const fn declare(raw: u32) -> CallKind {
+        CallKind(raw)
+    }
+
     /// The raw kind number.
     pub const fn raw(self) -> u32 {
         self.0
     }
 
-    /// The kind of a raw number, if a family declares it.
-    pub const fn decode(raw: u32) -> Option<CallKind> {
-        match CallKind(raw).spec() {
-            Some(spec) => Some(spec.kind),
-            None => None,
-        }
+    /// The kind of a raw number, if a family declares it (a built-in one or a registered
+    /// extension).
+    pub fn decode(raw: u32) -> Option<CallKind> {
+        CallKind(raw).spec().map(|spec| spec.kind)
     }
 
-    /// The kind's entry in the registry.
-    pub const fn spec(self) -> Option<&'static CallSpec> {
-        let mut f = 0;
-        while f < FAMILIES.len() {
-            let family: &'static [CallSpec] = FAMILIES[f];
-            let mut i = 0;
-            while i < family.len() {
-                if family[i].kind.0 == self.0 {
-                    return Some(&family[i]);
-                }
-                i += 1;
-            }
-            f += 1;
-        }
-        None
+    /// The kind's entry in the registry: a built-in family's, else a registered extension's.
+    pub fn spec(self) -> Option<&'static CallSpec> {
+        builtin_spec(self.0).or_else(|| {
+            let extensions = EXTENSIONS.get()?;
+            extensions
+                .iter()
+                .flat_map(|f| f.iter())
+                .find(|s| s.kind == self)
+        })
     }
 
     /// Whether the call only reads (a stopped machine still answers it).
-    pub const fn is_read_only(self) -> bool {
-        match self.spec() {
-            Some(spec) => spec.read_only,
-            None => false,
-        }
+    pub fn is_read_only(self) -> bool {
+        self.spec().is_some_and(|spec| spec.read_only)
     }
 
     /// Whether the kind is a bulk call ([`CallSpec::bulk`]).
-    pub const fn is_bulk(self) -> bool {
-        match self.spec() {
-            Some(spec) => spec.bulk,
-            None => false,
+    pub fn is_bulk(self) -> bool {
+        self.spec().is_some_and(|spec| spec.bulk)
+    }
+}
+
+/// The built-in families' entry for number `raw`.
+const fn builtin_spec(raw: u32) -> Option<&'static CallSpec> {
+    let mut f = 0;
+    while f < FAMILIES.len() {
+        let family: &'static [CallSpec] = FAMILIES[f];
+        let mut i = 0;
+        while i < family.len() {
+            if family[i].kind.0 == raw {
+                return Some(&family[i]);
+            }
+            i += 1;
         }
+        f += 1;
+    }
+    None
+}
+
+/// The call families of engines outside this crate, registered once per process.
+static EXTENSIONS: std::sync::OnceLock<&'static [&'static [CallSpec]]> = std::sync::OnceLock::new();
+
+/// Why extension families were not registered.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RegisterError {
+    /// A number a built-in family or another extension kind already declares.
+    #[error("call kind {name} = {raw}: the number is declared already")]
+    Taken {
+        /// The extension kind's name.
+        name: &'static str,
+        /// Its number.
+        raw: u32,
+    },
+    /// Other extension families were registered before.
+    #[error("other extension call families are registered already")]
+    Registered,
+}
+
+/// Registers the call families of engines outside this crate, once per process, before the
+/// first call is decoded (a program's `main`, a test's first line). Registering the same
+/// families again is allowed; others are refused, as is a number declared twice.
+pub fn register_extension(families: &'static [&'static [CallSpec]]) -> Result<(), RegisterError> {
+    let specs = || families.iter().flat_map(|f| f.iter());
+    for (i, spec) in specs().enumerate() {
+        let twice = specs().take(i).any(|o| o.kind == spec.kind);
+        if twice || builtin_spec(spec.kind.0).is_some() {
+            let (name, raw) = (spec.name, spec.kind.0);
+            return Err(RegisterError::Taken { name, raw });
+        }
+    }
+    let set = EXTENSIONS.get_or_init(|| families);
+    if core::ptr::eq(*set, families) {
+        Ok(())
+    } else {
+        Err(RegisterError::Registered)
     }
 }
 

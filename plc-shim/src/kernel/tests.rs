@@ -56,10 +56,7 @@ macro_rules! block {
 /// rules without a second edit. Each is made by its spec for axis 1 (FIFO group 0) with
 /// its required inputs, table 1 and the data the table blocks send ([`send_ready`]).
 fn blocks() -> Vec<(&'static str, Cycle)> {
-    let specs = crate::timeline::registry::FAMILIES
-        .iter()
-        .flat_map(|f| f.iter());
-    specs
+    crate::timeline::registry::blocks()
         .filter(|spec| spec.execute && !matches!(spec.target, Target::Channel))
         .map(|spec| (spec.name, cycle_of(spec)))
         .collect()

@@ -354,8 +354,36 @@ pub fn number(value: &toml::Value) -> Option<f64> {
     }
 }
 
-fn blocks() -> impl Iterator<Item = &'static BlockSpec> {
-    FAMILIES.iter().flat_map(|family| family.iter())
+/// Block families outside this crate, registered once per process ([`register_extension`]).
+static EXTENSIONS: std::sync::OnceLock<&'static [&'static [BlockSpec]]> =
+    std::sync::OnceLock::new();
+
+/// Registers block families outside this crate (an extension engine's blocks), once per
+/// process and before the first timeline is read. Registering the same families again is
+/// allowed; others are refused, as is a block name that is taken (ASCII case ignored).
+pub fn register_extension(families: &'static [&'static [BlockSpec]]) -> Result<(), String> {
+    let new = || families.iter().flat_map(|f| f.iter());
+    for (i, spec) in new().enumerate() {
+        let taken = |b: &BlockSpec| b.name.eq_ignore_ascii_case(spec.name);
+        if FAMILIES.iter().flat_map(|f| f.iter()).any(taken) || new().take(i).any(taken) {
+            return Err(format!("block {}: the name is taken", spec.name));
+        }
+    }
+    let set = EXTENSIONS.get_or_init(|| families);
+    if core::ptr::eq(*set, families) {
+        Ok(())
+    } else {
+        Err("other extension block families are registered already".into())
+    }
+}
+
+/// Every block a timeline can call: the built-in families', then the registered extensions'.
+pub fn blocks() -> impl Iterator<Item = &'static BlockSpec> {
+    let extensions: &'static [&'static [BlockSpec]] = EXTENSIONS.get().copied().unwrap_or(&[]);
+    FAMILIES
+        .iter()
+        .chain(extensions)
+        .flat_map(|family| family.iter())
 }
 
 /// The block called `name` (ASCII case ignored).
