@@ -14,6 +14,7 @@ pub mod cam;
 pub mod channel;
 pub mod fifo;
 pub mod gear;
+pub mod harness;
 pub mod machine;
 pub mod nc;
 pub mod saw;
