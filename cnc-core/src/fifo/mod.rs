@@ -18,3 +18,6 @@ pub use generator::{FifoGenerator, GeneratorStatus};
 pub use override_filter::{OverrideFilter, OverrideType};
 pub use params::{FifoParams, ParamError};
 pub use ring::{BlockError, RowRing};
+
+#[cfg(test)]
+mod engine_tests;

@@ -68,3 +68,6 @@ mod tests {
         assert_eq!((at(150.0).position, at(150.0).velocity), (5.0, 300.0));
     }
 }
+
+#[cfg(test)]
+mod engine_tests;

@@ -1,15 +1,13 @@
 //! The flying saw on an encoder master (seed 001, chapter 3): the extruder case of
 //! `scenarios/saw-encoder`, where the saw follows a strip's noisy encoder and cuts it to the
-//! length asked for, and the acceleration threshold at coupling with IGNOREMASTERACC beside it.
+//! length asked for (a scenario file with its PLC timeline: it needs the application). The
+//! acceleration threshold at coupling with IGNOREMASTERACC beside it runs in the library on
+//! its machine harness: `cnc_core::saw`'s `engine_tests`.
 
 use cnc_app::scenario::{InProcess, Scenario};
 use cnc_core::setpoint::Kinematic;
-use hli::calls::axis::AxisCommandCall;
-use hli::calls::saw::{sync_mask as m, SawCharacCall, SawGearInCall, SawSyncTarget};
 use hli::enums::AxisState;
-use hli::views::CncView;
 
-const TICK: f64 = 0.001;
 const STRIP: usize = 0;
 const SAW: usize = 1;
 
@@ -68,96 +66,4 @@ fn the_saw_cuts_a_strip_it_knows_only_by_its_noisy_encoder() {
     assert!(saw.position.abs() < 1e-9 && saw.velocity == 0.0, "{saw:?}");
     let report = run.timeline.as_ref().unwrap().summary();
     assert!(!report.contains("ErrorID"), "{report}");
-}
-
-/// A machine of a strip on a slow drive whose encoder reads with noise `noise` (units), and a
-/// saw; the strip at 200 mm/s, the saw at 100 mm/s.
-fn strip_at_speed(noise: f64) -> InProcess {
-    let axis = |name: &str, extra: &str| {
-        format!(
-            "[[axis]]\nname = \"{name}\"\npower = true\nsoft_limits = [-1e6, 1e6]\n\
-             velocity = 3000.0\nacceleration = 20000.0\ndeceleration = 20000.0\njerk = 1e7\n{extra}"
-        )
-    };
-    let toml = format!(
-        "cycle_ms = 1.0\nticks = 10\n{}{}",
-        axis(
-            "Strip",
-            &format!("drive = {{ model = \"pt1\", t1_ms = 40.0 }}\nencoder_noise = {noise}\n")
-        ),
-        axis("Saw", "")
-    );
-    let s = Scenario::parse("strip.toml", &toml, |_| unreachable!("no files")).unwrap();
-    let mut run = InProcess::new(&s, 0).unwrap();
-    run.step(TICK);
-    let view = CncView::new(&run.memory);
-    let go = AxisCommandCall::move_velocity(1, [200.0, 2000.0, 2000.0, 1e5]);
-    assert_eq!(
-        run.machine.call(&view, STRIP as u32, &go).unwrap().error_id,
-        0
-    );
-    // The saw moving too: a master's acceleration then shapes the slave's start.
-    let slow = AxisCommandCall::move_velocity(1, [100.0, 2000.0, 2000.0, 1e5]);
-    assert_eq!(
-        run.machine.call(&view, SAW as u32, &slow).unwrap().error_id,
-        0
-    );
-    for _ in 0..1000 {
-        run.step(TICK);
-    }
-    run
-}
-
-/// Couples the saw to the strip's encoder when `pick` likes the encoder's acceleration (the
-/// watchdog: 2,000 ticks), with check and operation bits `mask`; the number of points of the
-/// planned phase (the organisation field NumberOfRows: 2 for a lone fifth-order polynomial,
-/// 3 once a straight piece joins it).
-fn points_of_the_plan(run: &mut InProcess, mask: u32, pick: impl Fn(f64) -> bool) -> u32 {
-    let mut picked = false;
-    for _ in 0..2000 {
-        if pick(encoder(run, STRIP).acceleration) {
-            picked = true;
-            break;
-        }
-        run.step(TICK);
-    }
-    assert!(picked, "no tick with such an acceleration");
-    let m0 = encoder(run, STRIP).position;
-    let call = SawGearInCall {
-        master: STRIP as u32,
-        master_source: 1,
-        target: SawSyncTarget::Position.raw(),
-        master_sync_position: m0 + 1000.0,
-        slave_sync_position: 600.0,
-        ratio_numerator: 1.0,
-        ratio_denominator: 1,
-        mask,
-        ..SawGearInCall::default()
-    };
-    let view = CncView::new(&run.memory);
-    assert_eq!(
-        run.machine.call(&view, SAW as u32, &call).unwrap().error_id,
-        0
-    );
-    let org = run
-        .machine
-        .call(&view, SAW as u32, &SawCharacCall { part: 2 })
-        .unwrap();
-    org.values[1] as u32
-}
-
-/// Below 2 x 0.1 um / (1 ms)^2 = 200 mm/s^2 the encoder's acceleration counts as none at
-/// coupling, and the planner joins a straight piece to its polynomial (step 1); a real
-/// acceleration above it is kept and leaves the lone polynomial. IGNOREMASTERACC drops any.
-#[test]
-fn an_encoder_acceleration_below_the_threshold_counts_as_none_at_coupling() {
-    let quantised = |a: f64| a != 0.0 && a.abs() < 200.0;
-    let mut run = strip_at_speed(0.00003);
-    assert_eq!(points_of_the_plan(&mut run, 0, quantised), 3);
-    // A noisier encoder: above the threshold the acceleration stands, unless ignored.
-    let beyond = |a: f64| a.abs() > 250.0;
-    let mut run = strip_at_speed(0.0003);
-    assert_eq!(points_of_the_plan(&mut run, 0, beyond), 2);
-    let mut run = strip_at_speed(0.0003);
-    assert_eq!(points_of_the_plan(&mut run, m::IGNOREMASTERACC, beyond), 3);
 }

@@ -641,3 +641,6 @@ impl Engine for CamEngine {
         }
     }
 }
+
+#[cfg(test)]
+mod engine_tests;

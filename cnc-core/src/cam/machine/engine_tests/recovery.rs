@@ -5,64 +5,62 @@
 
 use super::*;
 use hli::calls::axis::AxisCommandCall;
-use hli::calls::cam::{CamReadCall, CamReadKind, CamValuesReply};
+use hli::calls::cam::{CamReadCall, CamReadKind};
 
 /// A periodic table that climbs 20 per master period of 360 (its stroke), linear.
 const STROKE_TABLE: &str = r#"{ "kind": "table", "id": 3, "table_type": "equidistant",
   "periodic": true, "interpolation": "linear",
   "rows": [[0, 0], [90, 5], [180, 10], [270, 15], [360, 20]] }"#;
 
-/// A linear master and a slave (its software limit at `slave_max`), the stroke table as
-/// table 3.
-fn machine_to(slave_max: f64) -> InProcess {
-    let axis = |name: &str, max: f64| {
-        format!(
-            "[[axis]]\nname = \"{name}\"\npower = true\nsoft_limits = [-1e5, {max}]\nvelocity = 2000.0\n\
-             acceleration = 4000.0\ndeceleration = 4000.0\njerk = 1e6\n"
-        )
-    };
-    let toml = format!(
-        "cycle_ms = 1.0\nticks = 10\n{}{}[[cam_table]]\nfile = \"stroke.json\"\n",
-        axis("Master", 1e5),
-        axis("Slave", slave_max)
-    );
-    let s = Scenario::parse("recovery.toml", &toml, |f| {
-        assert_eq!(f, "stroke.json");
-        Ok((PathBuf::from(f), STROKE_TABLE.to_string()))
-    })
-    .unwrap();
-    InProcess::new(&s, 0).unwrap()
+/// A linear axis `name` (ID `id`) of these machines: software limits -1e5..`max`, 2000 /s,
+/// 4000 /s^2 both ways, 1e6 /s^3.
+fn recovery_axis(name: &str, id: u32, max: f64) -> AxisConfig {
+    let mut c = AxisConfig::linear(name, id);
+    c.soft_limits = Some([-1e5, max]);
+    c.dynamics.velocity = 2000.0;
+    c.dynamics.acceleration = 4000.0;
+    c.dynamics.deceleration = 4000.0;
+    c.dynamics.jerk = 1e6;
+    c
 }
 
-pub(super) fn machine() -> InProcess {
+/// A linear master and a slave (its software limit at `slave_max`), the stroke table as
+/// table 3.
+fn machine_to(slave_max: f64) -> Harness {
+    let axes = vec![
+        recovery_axis("Master", 1, 1e5),
+        recovery_axis("Slave", 2, slave_max),
+    ];
+    powered(axes, &[], vec![cam_table(STROKE_TABLE.as_bytes())])
+}
+
+pub(super) fn machine() -> Harness {
     machine_to(1e5)
 }
 
-fn command(run: &mut InProcess, axis: usize, c: AxisCommandCall) {
-    let view = CncView::new(&run.memory);
-    let reply = run.machine.call(&view, axis as u32, &c).unwrap();
+fn command(run: &mut Harness, axis: usize, c: AxisCommandCall) {
+    let reply = run.call(axis as u32, &c).unwrap();
     assert_eq!(reply.error_id, 0, "axis {axis}: {c:?}");
 }
 
 /// MC_CamInfo of the slave (at `at` when given): its 40 values, or the refusal's code.
-pub(super) fn cam_info(run: &mut InProcess, at: Option<f64>) -> Result<Vec<f64>, u32> {
+pub(super) fn cam_info(run: &mut Harness, at: Option<f64>) -> Result<Vec<f64>, u32> {
     let call = CamReadCall {
         what: CamReadKind::Info.raw(),
         flags: u32::from(at.is_some()),
         a: at.unwrap_or(0.0),
         ..Default::default()
     };
-    let first: CamValuesReply =
-        bytemuck::pod_read_unaligned(&dispatch_raw(run, SLAVE as u32, &call));
+    let first = answer(run, SLAVE as u32, &call);
     if first.error_id != 0 {
         return Err(first.error_id);
     }
     Ok(read_all(run, SLAVE as u32, call).0)
 }
 
-fn tick_until(run: &mut InProcess, what: &str, done: impl Fn(&InProcess) -> bool) {
+fn tick_until(run: &mut Harness, what: &str, done: impl Fn(&Harness) -> bool) {
     for _ in 0..20_000 {
-        run.step(0.001);
+        run.step();
         if done(run) {
             return;
         }
@@ -74,7 +72,7 @@ fn tick_until(run: &mut InProcess, what: &str, done: impl Fn(&InProcess) -> bool
 fn after_an_emergency_stop_cam_info_gives_the_last_valid_coupling_and_the_slave_is_recoupled_on_its_curve(
 ) {
     let mut run = machine();
-    run.step(0.001);
+    run.step();
     select_cyclic(&mut run, 3);
     let coupling = CamInCall {
         slave_scaling: 2.0,
@@ -84,7 +82,7 @@ fn after_an_emergency_stop_cam_info_gives_the_last_valid_coupling_and_the_slave_
     run_master(&mut run, 360.0);
     // 1.5 s: the master passes one period, the slave one stroke (2 x 20).
     for _ in 0..1500 {
-        run.step(0.001);
+        run.step();
     }
     let master_at_stop = set(&run, MASTER).position;
     assert!(
@@ -95,7 +93,7 @@ fn after_an_emergency_stop_cam_info_gives_the_last_valid_coupling_and_the_slave_
     run.machine.stop("emergency stop (test)");
     tick_until(&mut run, "rest", |r| r.machine.at_rest());
     assert!(run.machine.rearm());
-    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    assert!(run.axis(SLAVE).coupling().is_none());
     // The last valid state of the coupling.
     let v = cam_info(&mut run, None).expect("the last valid coupling after the stop");
     assert_eq!(v.len(), 40);
@@ -141,7 +139,7 @@ fn after_an_emergency_stop_cam_info_gives_the_last_valid_coupling_and_the_slave_
         ..cam_in(3)
     };
     assert_eq!(call(&mut run, SLAVE as u32, again), 0);
-    run.step(0.001);
+    run.step();
     assert!(
         (set(&run, SLAVE).position - v[21]).abs() < 1e-9,
         "no jump at the coupling"
@@ -174,15 +172,13 @@ fn after_an_emergency_stop_cam_info_gives_the_last_valid_coupling_and_the_slave_
 fn a_slave_that_faults_while_coupled_keeps_its_last_valid_coupling_until_cam_out() {
     // The slave climbs 20 per period of 360: past 30 halfway through the second period.
     let mut run = machine_to(30.0);
-    run.step(0.001);
+    run.step();
     select_cyclic(&mut run, 3);
     assert_eq!(call(&mut run, SLAVE as u32, cam_in(3)), 0);
     run_master(&mut run, 360.0);
-    tick_until(&mut run, "the fault", |r| {
-        r.machine.axes().axis(SLAVE).unwrap().error().is_some()
-    });
-    run.step(0.001);
-    assert!(run.machine.axes().axis(SLAVE).unwrap().coupling().is_none());
+    tick_until(&mut run, "the fault", |r| r.axis(SLAVE).error().is_some());
+    run.step();
+    assert!(run.axis(SLAVE).coupling().is_none());
     let v = cam_info(&mut run, None).expect("the last valid coupling");
     assert_eq!(v[18], 20.0, "one stroke of 20");
     // The coupling's last tick: the set-point that passed the limit (by one tick's 0.02).
@@ -192,9 +188,9 @@ fn a_slave_that_faults_while_coupled_keeps_its_last_valid_coupling_until_cam_out
         v[21]
     );
     // Its table stays in use until then (the read rebuilds positions from it).
-    let delete = |run: &mut InProcess| {
+    let delete = |run: &mut Harness| {
         let d = hli::calls::cam::CamTableDeleteCall::default();
-        bytemuck::pod_read_unaligned::<CamReply>(&dispatch_raw(run, 3, &d)).error_id
+        call(run, 3, d)
     };
     assert_eq!(delete(&mut run), CamCouplingError::TableInUse.raw());
     // MC_CamOut decouples the lost coupling; then there is nothing to read or decouple.

@@ -5,8 +5,8 @@
 //! `iGroupPosition` picks the column each axis follows, whatever the order the axes join in.
 
 use super::*;
-use cnc_core::fifo::override_filter::PT2_DAMPING;
-use cnc_core::fifo::{OverrideFilter, OverrideType};
+use crate::fifo::override_filter::PT2_DAMPING;
+use crate::fifo::OverrideFilter;
 
 /// What is left of a unit step after `t` in the continuous lag
 /// `T0² y'' + 2 D T0 y' + y = u` started from rest: 1 at `t = 0`, towards 0. Written out
@@ -55,14 +55,12 @@ fn the_pt2_override_is_damped_by_the_manuals_1_001_not_critically() {
 fn a_pt2_override_step_moves_the_group_along_the_damping_1_001_lag() {
     let t0 = 0.02;
     let rows: Vec<[f64; 3]> = (0..2000).map(|k| [k as f64 * 0.1, 0.0, 0.0]).collect();
-    let mut run = machine(&instant(4000, 1.0));
+    let mut run = machine(instant(4000, 1.0));
     pt2(&mut run, t0);
     integrate(&mut run);
     assert_eq!(write(&mut run, &rows, false).error_id, 0);
     assert_eq!(start(&mut run).error_id, 0);
-    for _ in 0..10 {
-        run.step(TICK);
-    }
+    run.steps(10);
     assert!((velocity(&run, 0) - 100.0).abs() < 1e-6, "100 % before");
     let r = call(
         &mut run,
@@ -74,7 +72,7 @@ fn a_pt2_override_step_moves_the_group_along_the_damping_1_001_lag() {
     assert_eq!(r.error_id, 0);
     let mut from_critical: f64 = 0.0;
     for j in 1..=150 {
-        run.step(TICK);
+        run.step();
         let t = j as f64 * TICK;
         let got = velocity(&run, 0);
         let want = 100.0 * (0.2 + 0.8 * remaining(1.001, t0, t));
@@ -93,7 +91,7 @@ fn a_pt2_override_step_moves_the_group_along_the_damping_1_001_lag() {
 /// and the free axis stays where it was.
 #[test]
 fn each_axis_follows_the_column_of_its_group_position() {
-    let mut run = machine(&instant(64, 1.0));
+    let mut run = machine(instant(64, 1.0));
     for (axis, group_position) in [(2u32, 2u32), (0, 3), (1, 1)] {
         let r = call(
             &mut run,
@@ -129,7 +127,7 @@ fn each_axis_follows_the_column_of_its_group_position() {
     // Axis -> the 0-based column of its group position: X 3, Y 1, Z 2.
     let column_of = [2usize, 0, 1];
     for (n, row) in rows.iter().enumerate().take(31).skip(1) {
-        run.step(TICK);
+        run.step();
         for (axis, &column) in column_of.iter().enumerate() {
             let got = position(&run, axis);
             let want = row[column];

@@ -1,52 +1,36 @@
 //! The flying saw in the machine tick against two points of the seed (001) the audit found
 //! untested: a coupling command whose Velocity, Acceleration, Deceleration or Jerk is 0
 //! plans and checks with the slave axis's own machine data (chapter 11: an input not given
-//! takes the axis's configured maximum), and the axis image shows the slave states as the seed's numbers 11, 12 and 13 (chapter 9).
+//! takes the axis's configured maximum), and the axis image shows the slave states as the
+//! seed's numbers 11, 12 and 13 (chapter 9).
 
-use cnc_app::scenario::InProcess;
+use super::{command, machine, phase, set, MASTER, SAW};
+use crate::harness::Harness;
 use hli::calls::axis::AxisCommandCall;
 use hli::calls::saw::SawError;
 use hli::calls::saw::{
     sync_mask as m, SawCharacCall, SawGearInCall, SawGearOutCall, SawSyncTarget,
 };
 use hli::enums::AxisState;
-use hli::views::CncView;
 
-use super::saw_engine::{command, machine as engine_machine, phase, set, until};
-
-const TICK: f64 = 0.001;
-const MASTER: usize = 0;
-const SAW: usize = 1;
-/// The saw axis's machine data, as its `[[axis]]` entry below gives them.
+/// The saw axis's machine data, as the saw tests' machine (`super::machine`) gives them.
 const AXIS_VELOCITY: f64 = 3000.0;
 const AXIS_ACC: f64 = 20000.0;
 const AXIS_JERK: f64 = 1e7;
 
-fn gear_in(run: &mut InProcess, call: SawGearInCall) -> u32 {
-    let view = CncView::new(&run.memory);
-    run.machine.call(&view, SAW as u32, &call).unwrap().error_id
+fn gear_in(run: &mut Harness, call: SawGearInCall) -> u32 {
+    run.call(SAW as u32, &call).unwrap().error_id
 }
 
-fn gear_out(run: &mut InProcess) -> u32 {
-    let view = CncView::new(&run.memory);
-    run.machine
-        .call(&view, SAW as u32, &SawGearOutCall::default())
+fn gear_out(run: &mut Harness) -> u32 {
+    run.call(SAW as u32, &SawGearOutCall::default())
         .unwrap()
         .error_id
 }
 
-/// The saw engine tests' machine: two axes with the machine data above.
-fn machine() -> InProcess {
-    engine_machine("")
-}
-
 /// One part of MC_ReadFlyingSawCharacteristics (part 1: fields 17-31 at 0-14).
-fn charac(run: &mut InProcess, part: u32) -> [f64; 16] {
-    let view = CncView::new(&run.memory);
-    let reply = run
-        .machine
-        .call(&view, SAW as u32, &SawCharacCall { part })
-        .unwrap();
+fn charac(run: &mut Harness, part: u32) -> [f64; 16] {
+    let reply = run.call(SAW as u32, &SawCharacCall { part }).unwrap();
     assert_eq!(reply.error_id, 0);
     reply.values
 }
@@ -57,13 +41,13 @@ const ACC_MAX: usize = 9;
 const JERK_MAX: usize = 11;
 
 /// Master at +500 mm/s, the saw at +`slave_velocity`, both at constant velocity.
-fn moving(slave_velocity: f64) -> InProcess {
+fn moving(slave_velocity: f64) -> Harness {
     let mut run = machine();
     let master = AxisCommandCall::move_velocity(1, [500.0, 10000.0, 10000.0, 1e6]);
     assert_eq!(command(&mut run, MASTER, master), 0);
     let saw = AxisCommandCall::move_velocity(1, [slave_velocity, 10000.0, 10000.0, 1e6]);
     assert_eq!(command(&mut run, SAW, saw), 0);
-    until(&mut run, 2000, |r| {
+    run.until(2000, |r| {
         set(r, MASTER).acceleration == 0.0
             && set(r, SAW).acceleration == 0.0
             && set(r, MASTER).velocity == 500.0
@@ -100,7 +84,7 @@ fn a_coupling_without_limits_is_shaped_by_the_axis_acceleration_deceleration_and
     assert!((part[ACC_MAX] - AXIS_ACC).abs() < 1e-6, "{part:?}");
     let mut peak: f64 = 0.0;
     for _ in 0..200 {
-        run.step(TICK);
+        run.step();
         peak = peak.max(set(&run, SAW).acceleration);
         if phase(&run, SAW) == AxisState::SlaveSynchronous.raw() {
             break;
@@ -189,29 +173,27 @@ fn the_image_shows_the_slave_states_as_the_numbers_11_12_and_13() {
         ..without_limits(SawSyncTarget::Position, 1.0, m::INSTANTSTOPONROLLBACK)
     };
     assert_eq!(gear_in(&mut run, far), 0);
-    for _ in 0..200 {
-        run.step(TICK);
-    }
+    run.steps(200);
     assert_eq!(phase(&run, SAW), 12);
     // The master runs back over the coupling position: the slave stops in that tick.
     let back = AxisCommandCall::move_velocity(-1, [2000.0, 10000.0, 10000.0, 1e6]);
     assert_eq!(command(&mut run, MASTER, back), 0);
-    until(&mut run, 20_000, |r| set(r, MASTER).position < m0);
+    run.until(20_000, |r| set(r, MASTER).position < m0);
     assert_eq!(phase(&run, SAW), 11);
     assert_eq!(set(&run, SAW).velocity, 0.0);
     for _ in 0..20 {
-        run.step(TICK);
+        run.step();
         assert_eq!(phase(&run, SAW), 11, "stands in the pre-phase");
     }
 
     let mut run = moving(250.0);
     let call = without_limits(SawSyncTarget::Velocity, 1.0, 0);
     assert_eq!(gear_in(&mut run, call), 0);
-    run.step(TICK);
+    run.step();
     assert_eq!(phase(&run, SAW), 12);
-    until(&mut run, 1000, |r| phase(r, SAW) == 13);
+    run.until(1000, |r| phase(r, SAW) == 13);
     assert!((set(&run, SAW).velocity - 500.0).abs() < 1e-9);
     assert_eq!(gear_out(&mut run), 0);
-    run.step(TICK);
+    run.step();
     assert!(phase(&run, SAW) < 10, "free again: {}", phase(&run, SAW));
 }

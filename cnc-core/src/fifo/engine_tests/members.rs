@@ -2,12 +2,15 @@
 //! and dimension reads, and how its calls are refused.
 
 use super::*;
+use hli::calls::CallKind;
+use hli::enums::{AxisError, CouplingState};
+use hli::views::CncView;
 
 /// A moving axis does not join; a PTP command to a member is refused as coupled; after
 /// FiFoGroupDisintegrate the axes are free PTP axes again.
 #[test]
 fn integration_couples_and_disintegration_frees() {
-    let mut run = machine(&instant(16, 1.0));
+    let mut run = machine(instant(16, 1.0));
     let limits = [50.0, 1000.0, 1000.0, 10000.0];
     assert_eq!(
         axis_command(
@@ -17,8 +20,8 @@ fn integration_couples_and_disintegration_frees() {
         ),
         0
     );
-    run.step(TICK);
-    run.step(TICK);
+    run.step();
+    run.step();
     let r = call(
         &mut run,
         0,
@@ -29,8 +32,8 @@ fn integration_couples_and_disintegration_frees() {
     );
     assert_eq!(r.error_id, FifoError::AxisMoving.raw());
     integrate(&mut run);
-    run.step(TICK);
-    let axis_state = |run: &InProcess, axis| PlcView::new(&run.memory).axis_state(axis).unwrap();
+    run.step();
+    let axis_state = |run: &Harness, axis| run.plc_view().axis_state(axis).unwrap();
     assert_eq!(
         axis_state(&run, 0).coupling_state_r,
         CouplingState::Fifo.raw()
@@ -42,7 +45,7 @@ fn integration_couples_and_disintegration_frees() {
         call(&mut run, 0, FifoDisintegrateCall::default()).error_id,
         0
     );
-    run.step(TICK);
+    run.step();
     assert_eq!(
         axis_state(&run, 0).coupling_state_r,
         CouplingState::Uncoupled.raw()
@@ -58,14 +61,14 @@ fn integration_couples_and_disintegration_frees() {
 /// clears the error.
 #[test]
 fn a_faulted_member_ends_the_job() {
-    let mut run = machine_y(&instant(600, 1.0), "soft_limits = [-10.0, 1.0]");
+    let mut run = machine_y(instant(600, 1.0), |y| y.soft_limits = Some([-10.0, 1.0]));
     integrate(&mut run);
     let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
     write(&mut run, &rows, false);
     start(&mut run);
     let mut ticks = 0;
     loop {
-        run.step(TICK);
+        run.step();
         ticks += 1;
         if status(&run).group_state_r != FifoGroupState::Running.raw() {
             break;
@@ -90,7 +93,7 @@ fn a_faulted_member_ends_the_job() {
     );
     let mut ticks = 0;
     while velocity(&run, 0) != 0.0 {
-        run.step(TICK);
+        run.step();
         ticks += 1;
         assert!(ticks < 5000, "the other members never stopped");
     }
@@ -109,15 +112,15 @@ fn a_faulted_member_ends_the_job() {
     );
 }
 
-fn status_after_tick(run: &mut InProcess) -> hli::layout::HliFifoGroupState {
-    run.step(TICK);
+fn status_after_tick(run: &mut Harness) -> hli::layout::HliFifoGroupState {
+    run.step();
     status(run)
 }
 
 /// FiFoGetDimension gives N and Z; a stopped machine still answers it.
 #[test]
 fn get_dimension() {
-    let mut run = machine(&instant(250, 2.0));
+    let mut run = machine(instant(250, 2.0));
     let r = call(&mut run, 0, FifoDimensionCall::default());
     assert_eq!((r.error_id, r.dimension, r.capacity), (0, 3, 250));
     run.machine.stop("test");
@@ -133,19 +136,19 @@ fn get_dimension() {
 /// holds its last row (dry), it keeps that row.
 #[test]
 fn overwrite_before_the_start_and_when_dry() {
-    let mut run = machine(&instant(16, 1.0));
+    let mut run = machine(instant(16, 1.0));
     integrate(&mut run);
     write(&mut run, &[[0.0; 3], [5.0; 3], [9.0; 3]], false);
     let r = write(&mut run, &[[0.0; 3], [1.0; 3]], true);
     assert_eq!((r.error_id, r.entries), (0, 2));
     start(&mut run);
-    run.step(TICK);
-    run.step(TICK);
+    run.step();
+    run.step();
     assert_eq!(position(&run, 0), 1.0, "the replaced rows, not 5 and 9");
     // Dry: one row (1.0) held; an overwrite keeps it and goes on from it.
     let r = write(&mut run, &[[1.5; 3], [2.0; 3]], true);
     assert_eq!((r.error_id, r.entries), (0, 3));
-    run.step(TICK);
+    run.step();
     assert_eq!(position(&run, 0), 1.5);
     let s = status_after_tick(&mut run);
     assert!(s.rows_written_r >= s.rows_consumed_r);
@@ -156,7 +159,7 @@ fn overwrite_before_the_start_and_when_dry() {
 /// starts with its counters at 0; dissolving drops the queued rows.
 #[test]
 fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
-    let mut run = machine_y(&instant(600, 1.0), "soft_limits = [-10.0, 1.0]");
+    let mut run = machine_y(instant(600, 1.0), |y| y.soft_limits = Some([-10.0, 1.0]));
     pt2(&mut run, 0.5);
     integrate(&mut run);
     let rows: Vec<[f64; 3]> = (0..500).map(|k| [k as f64 * 0.05; 3]).collect();
@@ -169,14 +172,12 @@ fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
         },
     );
     start(&mut run);
-    for _ in 0..15 {
-        run.step(TICK);
-    }
+    run.steps(15);
     assert_eq!(call(&mut run, 0, FifoStopCall::default()).error_id, 0);
     // The slow PT-2 stop still moves Y past its limit of 1.0: the fault ends the job.
     let mut ticks = 0;
     while status(&run).group_state_r != FifoGroupState::Error.raw() {
-        run.step(TICK);
+        run.step();
         ticks += 1;
         assert!(ticks < 2000, "no fault");
     }
@@ -186,7 +187,7 @@ fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
         (900_000, 0, 0)
     );
     // Machine stop while stopping.
-    let mut run = machine(&instant(600, 1.0));
+    let mut run = machine(instant(600, 1.0));
     pt2(&mut run, 0.5);
     integrate(&mut run);
     write(&mut run, &rows, false);
@@ -198,17 +199,15 @@ fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
         },
     );
     start(&mut run);
-    for _ in 0..15 {
-        run.step(TICK);
-    }
+    run.steps(15);
     call(&mut run, 0, FifoStopCall::default());
-    run.step(TICK);
+    run.step();
     run.machine.stop("test");
     let s = status_after_tick(&mut run);
     assert_eq!(s.group_state_r, FifoGroupState::Idle.raw());
     assert_eq!((s.override_target_r, s.rows_consumed_r), (700_000, 0));
     // Dissolving drops rows.
-    let mut run = machine(&instant(16, 1.0));
+    let mut run = machine(instant(16, 1.0));
     integrate(&mut run);
     write(&mut run, &[[0.0; 3], [1.0; 3]], false);
     let r = call(&mut run, 0, FifoDisintegrateCall::default());
@@ -221,7 +220,7 @@ fn a_stop_cut_short_keeps_the_override_and_counters_restart() {
 /// command without a word).
 #[test]
 fn an_axis_with_an_active_command_does_not_join() {
-    let mut run = machine(&instant(16, 1.0));
+    let mut run = machine(instant(16, 1.0));
     let command = AxisCommandCall::move_absolute(5.0, [50.0, 1000.0, 1000.0, 10000.0]);
     assert_eq!(axis_command(&mut run, FREE as u32, command), 0);
     let r = call(
@@ -235,57 +234,12 @@ fn an_axis_with_an_active_command_does_not_join() {
     assert_eq!(r.error_id, FifoError::AxisMoving.raw());
 }
 
-/// A scenario's FIFO group out of range is refused at load with the group and the reason.
-#[test]
-fn a_bad_fifo_group_is_refused_at_load() {
-    for (group, needle) in [
-        (
-            "dimension = 0\nrows = 10\nfifo_cycle_ms = 1.0\n",
-            "FIFO dimension 0",
-        ),
-        (
-            "dimension = 17\nrows = 10\nfifo_cycle_ms = 1.0\n",
-            "FIFO dimension 17",
-        ),
-        (
-            "dimension = 2\nrows = 1\nfifo_cycle_ms = 1.0\n",
-            "FIFO length 1",
-        ),
-        (
-            "dimension = 2\nrows = 10\nfifo_cycle_ms = 0.0\n",
-            "FIFO cycle 0 s",
-        ),
-        (
-            "dimension = 2\nrows = 10\nfifo_cycle_ms = -2.0\n",
-            "FIFO cycle -0.002 s",
-        ),
-        (
-            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"pt2\"\n",
-            "needs pt2_t0_ms",
-        ),
-        (
-            "dimension = 2\nrows = 10\nfifo_cycle_ms = 1.0\noverride = \"soft\"\n",
-            "\"instant\" or \"pt2\"",
-        ),
-    ] {
-        let toml =
-            format!("cycle_ms = 1.0\nticks = 10\n[[axis]]\nname = \"X\"\n[[fifo_group]]\n{group}");
-        let e = Scenario::parse("bad.toml", &toml, |f| panic!("{f}")).unwrap_err();
-        let text = e.to_string();
-        assert!(
-            text.contains("[[fifo_group]] 0") || text.contains(needle),
-            "{text}"
-        );
-        assert!(text.contains(needle), "{text}");
-    }
-}
-
 /// Row blocks come by the bulk service only: the same kind in a frame is refused, and so is
 /// a bulk call of a kind that has no bulk handler.
 #[test]
 fn row_blocks_come_by_the_bulk_service_only() {
     use hli::calls::ErrorCode;
-    let mut run = machine(&instant(250, 2.0));
+    let mut run = machine(instant(250, 2.0));
     let request = hli::wire::AcyclicRequest {
         invoke_id: 0,
         kind: CallKind::FIFO_WRITE_ROWS.raw(),
@@ -307,7 +261,7 @@ fn row_blocks_come_by_the_bulk_service_only() {
     let bulk = run.machine.dispatch_bulk(&header, &[0.0; 3]);
     assert_eq!(bulk.unwrap_err(), ErrorCode::ServiceNotSupported);
     // A machine without FIFO groups has no engine for row blocks: refused as any FIFO call.
-    let mut bare = cnc_core::machine::Machine::new(cnc_core::machine::MachineSetup {
+    let mut bare = crate::machine::Machine::new(crate::machine::MachineSetup {
         channels: Vec::new(),
         axes: Vec::new(),
         engines: Vec::new(),
