@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # (package, bench, what it measures, its in-run baselines). The order is the report's.
 BENCHES = [
-    ("hli", "handshake", "cross-process handshake round trip",
+    ("hli-transport", "handshake", "cross-process handshake round trip",
      "flag ping-pong, iceoryx2 pub-sub and event ping-pong, Unix socket"),
     ("kinematics", "kinematics", "robot kinematics per call", "rs-opw-kinematics"),
     ("cnc-core", "nc_parse", "NC parse + decode", "LinuxCNC rs274"),

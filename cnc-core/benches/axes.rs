@@ -68,7 +68,7 @@ fn time(mut work: impl FnMut(usize)) -> f64 {
 }
 
 fn rig() -> (hli::raw::ImageMemory, AxisSet) {
-    let memory = hli::segment::heap_image(1, AXES as u32);
+    let memory = hli::image::heap_image(1, AXES as u32);
     let configs = (0..AXES)
         .map(|i| AxisConfig::linear(&format!("A{i}"), i as u32 + 1))
         .collect();

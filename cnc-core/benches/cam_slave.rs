@@ -97,7 +97,7 @@ fn machine(profile: Option<CamProfile>) -> (Machine, ImageMemory) {
         cycle_s: 0.001,
     })
     .expect("machine");
-    let memory = hli::segment::heap_image(0, 2);
+    let memory = hli::image::heap_image(0, 2);
     for i in 0..2 {
         machine
             .axes_mut()

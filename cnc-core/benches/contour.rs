@@ -24,7 +24,7 @@ use bench_kit::{median, smoke};
 use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
 use cnc_core::nc::interp::SearchPath;
 use cnc_core::setpoint::AxisValues;
-use hli::segment::heap_image;
+use hli::image::heap_image;
 use hli::views::CncView;
 use std::time::Instant;
 

@@ -24,9 +24,9 @@ use hli::calls::fifo::{
     rows_header, FifoIntegrateCall, FifoOverrideCall, FifoReply, FifoStartCall,
 };
 use hli::calls::AcyclicCall;
-use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::CncView;
 use hli::ImageMemory;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::Instant;
@@ -65,7 +65,7 @@ fn machine(fifo_rows: usize) -> (Machine, ImageMemory) {
     for i in 0..N {
         machine.axes_mut().axis_mut(i).unwrap().switch_on().unwrap();
     }
-    let memory = hli::segment::heap_image(0, N as u32);
+    let memory = hli::image::heap_image(0, N as u32);
     machine.tick(&memory);
     (machine, memory)
 }
@@ -280,7 +280,7 @@ fn throughput() {
 }
 
 fn main() {
-    hli::init_logging();
+    hli_transport::init_logging();
     if let Ok(instance) = std::env::var("FIFO_BENCH_CLIENT") {
         client(&instance);
         return;

@@ -43,7 +43,7 @@ impl Harness {
             engines,
             cycle_s,
         })?;
-        let memory = hli::segment::heap_image(0, machine.axis_images() as u32);
+        let memory = hli::image::heap_image(0, machine.axis_images() as u32);
         Ok(Harness {
             machine,
             memory,
@@ -161,6 +161,9 @@ mod tests {
             .unwrap();
         assert_eq!(reply.error_id, 0);
         let ticks = run.until(5000, |r| r.setpoint(0).position == 10.0);
-        assert!(ticks > 100, "a move of 10 mm at 100 mm/s takes 0.1 s: {ticks}");
+        assert!(
+            ticks > 100,
+            "a move of 10 mm at 100 mm/s takes 0.1 s: {ticks}"
+        );
     }
 }

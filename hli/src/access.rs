@@ -189,7 +189,7 @@ impl Leaf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::segment::heap_image;
+    use crate::image::heap_image;
 
     const STATE: &str = "gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state";
     const ROTATION: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";

@@ -3,8 +3,8 @@
 //! (`gcc -fsyntax-only`) proves the C and Rust layouts agree.
 
 use crate::desc::{HliType, Kind, TypeDesc};
+use crate::image::{LAYOUT_VERSION, SEGMENT_MAGIC};
 use crate::layout::HliImage;
-use crate::segment::{LAYOUT_VERSION, SEGMENT_MAGIC};
 use crate::symbols::SymbolTable;
 use std::fmt::Write as _;
 

@@ -283,8 +283,8 @@ impl<'m> TransitionReader<'m> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::image::heap_image;
     use crate::layout::{HliCoordinateSystemInt, HliImage, McControlDynCsUnit};
-    use crate::segment::heap_image;
     use crate::views::{CncView, PlcView};
 
     fn cs(seed: i32) -> HliCoordinateSystemInt {

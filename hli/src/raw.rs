@@ -24,10 +24,10 @@ use core::ptr::NonNull;
 use core::sync::atomic::{
     AtomicI16, AtomicI32, AtomicI64, AtomicI8, AtomicU16, AtomicU32, AtomicU64, AtomicU8, Ordering,
 };
-use iceoryx2_bb_posix::shared_memory::SharedMemory;
 
-/// Memory that holds one HLI image: either a mapped shared-memory segment or a heap buffer (for
-/// in-process mode and tests). The owner keeps the mapping alive for as long as `self` lives.
+/// Memory that holds one HLI image: a heap buffer (for in-process mode and tests) or a mapping
+/// the transport made (a shared-memory segment, `hli_transport`), whose owner keeps it alive
+/// for as long as `self` lives.
 pub struct ImageMemory {
     base: NonNull<u8>,
     len: usize,
@@ -37,14 +37,14 @@ pub struct ImageMemory {
 
 enum Backing {
     Heap(#[allow(dead_code)] Box<[AtomicU64]>),
-    Shared(Box<SharedMemory>),
+    Mapped(Box<dyn core::any::Any + Send + Sync>),
 }
 
 impl core::fmt::Debug for ImageMemory {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         let kind = match self.backing {
             Backing::Heap(_) => "heap",
-            Backing::Shared(_) => "shared",
+            Backing::Mapped(_) => "shared",
         };
         write!(f, "ImageMemory({kind}, {} bytes)", self.len)
     }
@@ -73,10 +73,19 @@ impl ImageMemory {
         }
     }
 
-    /// Takes over a mapped shared-memory object; the mapping lives as long as the result.
-    /// The object must be mapped read-write (every access may store).
-    pub fn shared(shm: SharedMemory) -> Self {
-        let base = shm.base_address();
+    /// Takes over a mapping of `len` bytes at `base` and the `owner` that keeps it mapped
+    /// (a shared-memory object); the owner is dropped, and the mapping with it, when the
+    /// result is.
+    ///
+    /// # Safety
+    /// `base..base + len` must be mapped read-write for as long as `owner` lives, accessed by
+    /// nothing but atomics of each leaf's size (the other process included), and `base`
+    /// must be [`IMAGE_ALIGN`]-aligned (checked).
+    pub unsafe fn mapped(
+        base: NonNull<u8>,
+        len: usize,
+        owner: Box<dyn core::any::Any + Send + Sync>,
+    ) -> Self {
         assert_eq!(
             base.as_ptr() as usize % IMAGE_ALIGN,
             0,
@@ -84,15 +93,15 @@ impl ImageMemory {
         );
         Self {
             base,
-            len: shm.size(),
-            backing: Backing::Shared(Box::new(shm)),
+            len,
+            backing: Backing::Mapped(owner),
         }
     }
 
-    /// The shared-memory object behind the image, if it is one.
-    pub fn shared_memory(&self) -> Option<&SharedMemory> {
+    /// The owner of a mapped image, if it is one and of type `T`.
+    pub fn owner<T: core::any::Any>(&self) -> Option<&T> {
         match &self.backing {
-            Backing::Shared(shm) => Some(shm.as_ref()),
+            Backing::Mapped(owner) => owner.downcast_ref(),
             Backing::Heap(_) => None,
         }
     }

@@ -3,7 +3,7 @@
 //! be obtained, so the protocol's direction is checked by the compiler:
 //!
 //! ```compile_fail
-//! # let mem = hli::segment::heap_image(1, 0);
+//! # let mem = hli::image::heap_image(1, 0);
 //! let cnc = hli::views::CncView::new(&mem);
 //! // The CNC consumes dyn-CS commands; it cannot get their writing end.
 //! let sender: hli::handshake::Writer<'_, hli::layout::HliCoordinateSystemInt> =
@@ -687,7 +687,7 @@ pub fn handle_read_axis_state(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::segment::heap_image;
+    use crate::image::heap_image;
 
     #[test]
     fn indices_outside_the_configured_counts_are_errors() {

@@ -17,9 +17,9 @@
 use crate::runtime::{Link, PlcIo};
 use crate::timeline::Timeline;
 use crate::tools::{ToolError, DEFAULT_INSTANCE};
-use hli::rpc::AcyclicClient;
-use hli::segment::PlcSegment;
 use hli::views::PlcView;
+use hli_transport::rpc::AcyclicClient;
+use hli_transport::segment::PlcSegment;
 use std::process::ExitCode;
 use std::time::Duration;
 

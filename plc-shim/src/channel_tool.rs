@@ -116,7 +116,8 @@ fn run(args: &ChannelArgs) -> Result<Vec<String>, Failure> {
             return Err(Failure::BadInput(format!("--program {p:?}: 1 to 63 bytes")));
         }
     }
-    let segment = hli::segment::PlcSegment::inspect(&args.instance).map_err(ToolError::from)?;
+    let segment =
+        hli_transport::segment::PlcSegment::inspect(&args.instance).map_err(ToolError::from)?;
     let view = PlcView::new(segment.memory());
     let ch = view.gp_ch(args.channel).ok_or_else(|| {
         Failure::BadInput(format!(

@@ -195,7 +195,7 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
         cnc_os::stdio::line_out(&format!("plc: real-time {}", realtime.join(", ")));
     }
     runtime.set_period_ticks(args.period_ticks);
-    hli::signals::capture();
+    hli_transport::signals::capture();
     match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
             cnc_os::stdio::line_out(&report(&summary, program));

@@ -1,6 +1,6 @@
 //! The PLC process: attaches to a CNC's HLI segment and runs a PLC program once per cycle,
 //! woken by the CNC's "tick done" event. It reaches the CNC only through the HLI segment and
-//! the acyclic calls' mailbox (`hli::rpc`).
+//! the acyclic calls' mailbox (`hli_transport::rpc`).
 
 #![forbid(unsafe_code)]
 

@@ -25,10 +25,10 @@
 use core::time::Duration;
 use hli::calls::CallError;
 use hli::enums::SegmentState;
-use hli::events::{EventError, EventLink, Side};
-use hli::rpc::AcyclicClient;
-use hli::segment::{AttachError, HeaderFault, PlcSegment};
 use hli::views::PlcView;
+use hli_transport::events::{EventError, EventLink, Side};
+use hli_transport::rpc::AcyclicClient;
+use hli_transport::segment::{AttachError, HeaderFault, PlcSegment};
 
 pub use crate::watchdog::CncLoss;
 use crate::watchdog::CncWatch;
@@ -257,8 +257,8 @@ pub enum RunEnd {
     Replaced(u32),
     /// The cycle limit was reached.
     CycleLimit,
-    /// A termination signal arrived (see [`hli::signals`]).
-    Signal(hli::signals::Termination),
+    /// A termination signal arrived (see [`hli_transport::signals`]).
+    Signal(hli_transport::signals::Termination),
 }
 
 /// The runtime over an attached segment.
@@ -316,7 +316,7 @@ impl PlcRuntime {
     }
 
     /// Runs `program` until the CNC closes or is lost, a termination signal arrives (when the
-    /// caller captured them with [`hli::signals::capture`]), or `max_cycles` cycles ran.
+    /// caller captured them with [`hli_transport::signals::capture`]), or `max_cycles` cycles ran.
     pub fn run(
         &mut self,
         program: &mut dyn PlcProgram,
@@ -347,7 +347,7 @@ impl PlcRuntime {
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
             if wakeups.is_multiple_of(64) {
-                if let Some(signal) = hli::signals::take() {
+                if let Some(signal) = hli_transport::signals::take() {
                     return end(RunEnd::Signal(signal), stats, wake_to_done);
                 }
             }

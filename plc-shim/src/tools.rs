@@ -25,8 +25,8 @@ use hli::access::{AccessError, Leaf, Value};
 use hli::enums::SegmentState;
 use hli::protocol::Refused;
 pub use hli::protocol::{show, Refusal, Write};
-use hli::segment::{AttachError, PlcSegment};
 use hli::ImageMemory;
+use hli_transport::segment::{AttachError, PlcSegment};
 use std::process::ExitCode;
 
 /// Instance `cnc demo` runs as, and the tools' default.
@@ -255,7 +255,7 @@ fn watch(
     use std::io::Write as _;
     let leaves = resolve_all(paths)?;
     let segment = attach(instance)?;
-    hli::signals::capture();
+    hli_transport::signals::capture();
     let mut out = std::io::stdout().lock();
     let header = format!("cnc_tick {}", paths.join(" "));
     if writeln!(out, "{header}").is_err() {
@@ -267,7 +267,7 @@ fn watch(
             eprintln!("plc watch: the CNC closed its segment");
             break;
         }
-        if hli::signals::take().is_some() {
+        if hli_transport::signals::take().is_some() {
             break;
         }
         let mut line = segment.cnc_heartbeat().to_string();
@@ -290,7 +290,7 @@ fn watch(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hli::segment::heap_image;
+    use hli::image::heap_image;
 
     const SEM: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_semaphore_rw";
     const ROT: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";

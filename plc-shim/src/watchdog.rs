@@ -13,7 +13,7 @@
 //! with made-up instants.
 
 use core::time::Duration;
-use hli::segment::CncTiming;
+use hli_transport::segment::CncTiming;
 
 /// Default limit, CNC cycles: a CNC that stopped ticking is noticed within this many cycles
 /// of its last tick (plus the one wait in which it is seen).

@@ -9,7 +9,7 @@
 use hli::calls::fifo::FifoError;
 use hli::calls::fifo::{FifoReply, FifoStartCall, FIFO_BLOCK_VALUES};
 use hli::calls::CallKind;
-use hli::rpc::{AcyclicClient, AcyclicServer};
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::blocks::fifo::{FifoStart, FifoWrite, ERROR_BLOCK_SIZE};
 use plc_shim::kernel::ERROR_NO_ANSWER;
 use plc_shim::runtime::PlcIo;
@@ -26,11 +26,11 @@ fn io<'a>(memory: &'a hli::ImageMemory, client: &'a mut AcyclicClient, cycle: u6
 
 #[test]
 fn an_edge_while_busy_sends_the_new_block_and_a_silent_cnc_times_out() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = tests::unique_instance("fifo-blocks");
     let server = AcyclicServer::open(&instance).unwrap();
     let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::segment::heap_image(0, 1);
+    let memory = hli::image::heap_image(0, 1);
     let rows = [1.0, 2.0, 3.0, 4.0];
     let mut write = FifoWrite::default();
     // Edge, low, edge again: the CNC has not answered yet.
@@ -92,12 +92,12 @@ fn an_edge_while_busy_sends_the_new_block_and_a_silent_cnc_times_out() {
 /// the CNC's row service finds no block.
 #[test]
 fn a_block_larger_than_its_array_or_one_call_is_refused_and_nothing_is_sent() {
-    hli::init_logging();
+    hli_transport::init_logging();
     assert_eq!(ERROR_BLOCK_SIZE, FifoError::BlockSize.raw());
     let instance = tests::unique_instance("fifo-block-sizes");
     let server = AcyclicServer::open(&instance).unwrap();
     let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::segment::heap_image(0, 1);
+    let memory = hli::image::heap_image(0, 1);
     let small = [1.0, 2.0, 3.0, 4.0];
     // Fits its array (rows x columns == its length) but not one call.
     let big = vec![0.5; FIFO_BLOCK_VALUES + 2];
@@ -195,11 +195,11 @@ fn send_and_answer(
 /// of an array longer than the block, are sent whole (the values the block names, no more).
 #[test]
 fn a_block_of_exactly_one_call_or_the_first_rows_of_an_array_is_sent() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = tests::unique_instance("fifo-block-sizes-ok");
     let server = AcyclicServer::open(&instance).unwrap();
     let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::segment::heap_image(0, 1);
+    let memory = hli::image::heap_image(0, 1);
 
     let data: Vec<f64> = (0..FIFO_BLOCK_VALUES + 3).map(|k| k as f64).collect();
     let rows = (FIFO_BLOCK_VALUES / 2) as u32;

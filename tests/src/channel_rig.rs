@@ -2,8 +2,8 @@
 //! running given programs, a watchdog loop, and the PLC's dynamic-CS payloads.
 
 use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunState};
+use hli::image::heap_image;
 use hli::layout::{HliCoordinateSystemInt, HliDynCsTransition};
-use hli::segment::heap_image;
 use hli::views::CncView;
 use hli::{Bool, ImageMemory};
 

@@ -17,11 +17,11 @@ pub fn serve_axes_in_lockstep(
     finished: std::sync::Arc<std::sync::atomic::AtomicBool>,
 ) -> std::thread::JoinHandle<bool> {
     use hli::calls::CallKind;
-    let segment = hli::segment::CncSegment::create_with(
+    let segment = hli_transport::segment::CncSegment::create_with(
         instance,
         1,
         axes,
-        hli::segment::CncTiming::lockstep(),
+        hli_transport::segment::CncTiming::lockstep(),
     )
     .unwrap();
     let instance = instance.to_string();
@@ -30,8 +30,10 @@ pub fn serve_axes_in_lockstep(
         let view = hli::views::CncView::new(segment.memory());
         let mut axes = build();
         axes.prime(&view);
-        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
-        let server = hli::rpc::AcyclicServer::open(&instance).unwrap();
+        let events =
+            hli_transport::events::EventLink::open(&instance, hli_transport::events::Side::Cnc)
+                .unwrap();
+        let server = hli_transport::rpc::AcyclicServer::open(&instance).unwrap();
         ready_tx.send(()).unwrap();
         for _ in 0..2_000_000 {
             if finished.load(Ordering::Acquire) {
@@ -75,15 +77,21 @@ pub fn lockstep_script(
     step: u64,
     mut script: impl FnMut(&hli::views::CncView<'_>, u64) + Send + 'static,
 ) -> std::thread::JoinHandle<()> {
-    let segment =
-        hli::segment::CncSegment::create_with(instance, 1, 1, hli::segment::CncTiming::lockstep())
-            .unwrap();
+    let segment = hli_transport::segment::CncSegment::create_with(
+        instance,
+        1,
+        1,
+        hli_transport::segment::CncTiming::lockstep(),
+    )
+    .unwrap();
     let instance = instance.to_string();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();
     let cnc = std::thread::spawn(move || {
-        let events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
+        let events =
+            hli_transport::events::EventLink::open(&instance, hli_transport::events::Side::Cnc)
+                .unwrap();
         // A mailbox nobody answers: the PLC's calls time out, as with a CNC that takes none.
-        let _calls = hli::rpc::AcyclicServer::open(&instance).unwrap();
+        let _calls = hli_transport::rpc::AcyclicServer::open(&instance).unwrap();
         let view = hli::views::CncView::new(segment.memory());
         ready_tx.send(()).unwrap();
         for n in 1..=ticks {

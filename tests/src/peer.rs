@@ -64,10 +64,10 @@ pub fn spawn_peer_saying(peer_exe: &str, args: &[&str], first_line: &str) -> Chi
 /// run leaves nothing in /dev/shm.
 pub fn remove_stale_segment(instance: &str) {
     // The calls' mailbox a killed CNC left: taken over (its process is gone) and dropped.
-    if let Err(e) = hli::rpc::mailbox::Mailbox::create(instance) {
+    if let Err(e) = hli_transport::rpc::mailbox::Mailbox::create(instance) {
         panic!("{instance}: the stale mailbox could not be taken over: {e}");
     }
-    match hli::segment::CncSegment::create(instance, 1, 1) {
+    match hli_transport::segment::CncSegment::create(instance, 1, 1) {
         Ok(segment) => assert!(
             segment.replaced_stale().is_some(),
             "{instance}: the segment was expected to be stale"

@@ -46,7 +46,7 @@ macro_rules! block {
 impl AxisRig {
     /// These axes, primed on a fresh image, not powered.
     pub fn new(configs: Vec<AxisConfig>) -> Self {
-        let memory = hli::segment::heap_image(1, configs.len() as u32);
+        let memory = hli::image::heap_image(1, configs.len() as u32);
         let set = AxisSet::new(configs, CYCLE).unwrap();
         set.prime(&CncView::new(&memory));
         Self { memory, set }

@@ -158,7 +158,7 @@ fn before_machine(n: usize) -> Box<dyn FnMut()> {
         }
     }
     let mut controller = Controller::new(channels).expect("controller");
-    let memory = hli::segment::heap_image(n as u32, 32);
+    let memory = hli::image::heap_image(n as u32, 32);
     plc_setup(&PlcView::new(&memory));
     let mut tick = move || {
         let view = CncView::new(&memory);
@@ -184,7 +184,7 @@ fn idle(n: usize) -> Box<dyn FnMut()> {
         .map(|(i, c)| Channel::new(i, c.clone(), s.cycle_s).expect("channel"))
         .collect();
     let mut controller = Controller::new(channels).expect("controller");
-    let memory = hli::segment::heap_image(n as u32, 32);
+    let memory = hli::image::heap_image(n as u32, 32);
     Box::new(move || controller.tick(&CncView::new(&memory)))
 }
 

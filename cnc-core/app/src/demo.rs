@@ -142,7 +142,7 @@ pub fn main(args: DemoArgs) -> ExitCode {
         log_dir: None,
         opcua: args.opcua.clone(),
     };
-    hli::signals::capture();
+    hli_transport::signals::capture();
     let report = match run(&scenario, &options) {
         Ok(report) => report,
         Err(e) => {

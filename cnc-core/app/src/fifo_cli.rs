@@ -139,7 +139,7 @@ fn run(args: &FifoRunArgs) -> Result<(String, Option<MotionEnd>), Failure> {
         .map_err(|e| Failure::File(e.to_string()))?;
     check_args(args)?;
     let mut machine = build_machine(args, n, &rows)?;
-    let memory = hli::segment::heap_image(0, n as u32);
+    let memory = hli::image::heap_image(0, n as u32);
     machine.tick(&memory);
     let view = CncView::new(&memory);
     integrate(&mut machine, &view, args, n)?;

@@ -3,8 +3,8 @@
 //! same instance has started.
 
 use hli::enums::SegmentState;
-use hli::segment::{AttachError, PlcSegment};
 use hli::ImageMemory;
+use hli_transport::segment::{AttachError, PlcSegment};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, RwLock};
 

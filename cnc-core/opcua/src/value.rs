@@ -244,7 +244,7 @@ mod tests {
     #[test]
     fn a_tick_is_dated_by_the_epoch_and_cycle_the_cnc_announced() {
         use core::mem::offset_of;
-        let image = hli::segment::heap_image(1, 1);
+        let image = hli::image::heap_image(1, 1);
         let at = |field: usize| image.place::<u64>(field);
         // 2026-01-01T00:00:00Z is 1_767_225_600 s after the Unix epoch.
         at(offset_of!(HliSegmentHeader, cnc_epoch_ns)).store_release(1_767_225_600 * 1_000_000_000);
@@ -266,7 +266,7 @@ mod tests {
     #[test]
     fn a_plc_is_alive_once_its_heartbeat_is_seen_to_move() {
         use core::mem::offset_of;
-        let image = hli::segment::heap_image(1, 1);
+        let image = hli::image::heap_image(1, 1);
         let pid = image.place::<u32>(offset_of!(HliSegmentHeader, plc_pid));
         let beats = image.place::<u64>(offset_of!(HliSegmentHeader, plc_heartbeat));
         let alive = Reading::PlcAlive(Mutex::new(None));

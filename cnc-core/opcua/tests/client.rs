@@ -7,8 +7,8 @@
 use cnc_opcua::config::{Config, Limits, User};
 use cnc_opcua::{build, ImageSource, Options, NAMESPACE};
 use hli::access::{Leaf, Value};
+use hli::image::heap_image;
 use hli::layout::image::HliSegmentHeader;
-use hli::segment::heap_image;
 use hli::ImageMemory;
 use opcua::client::Session;
 use opcua::types::{

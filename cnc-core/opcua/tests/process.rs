@@ -4,7 +4,7 @@
 
 use cnc_opcua::ImageSource;
 use hli::access::{Leaf, Value};
-use hli::segment::CncSegment;
+use hli_transport::segment::CncSegment;
 use opcua::types::{NodeId, StatusCode, Variant};
 use std::io::{BufRead, BufReader};
 use std::process::{Child, Command, Stdio};

@@ -75,7 +75,7 @@ fn thirty_two_axes_tick_and_take_commands_without_allocating() {
             c
         })
         .collect();
-    let memory = hli::segment::heap_image(1, 32);
+    let memory = hli::image::heap_image(1, 32);
     let view = CncView::new(&memory);
     let mut set = AxisSet::new(configs, 0.001).unwrap();
     set.prime(&view);

@@ -7,7 +7,7 @@ use cnc_core::channel::{Channel, ChannelConfig, Controller, LoadedProgram, RunSt
 use cnc_core::nc::decode::{DecoderSetup, DecoderState, ZeroVars};
 use cnc_core::nc::interp::{Interpreter, ProgramSet, SearchPath, Step};
 use cnc_core::nc::{Decoded, MotionMode};
-use hli::segment::heap_image;
+use hli::image::heap_image;
 use hli::views::CncView;
 
 use tests::channel_rig as support;

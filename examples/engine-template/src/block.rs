@@ -12,7 +12,7 @@
 
 use crate::calls::{PhaseGearInCall, PhaseGearOutCall};
 use hli::calls::AcyclicCall;
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 use plc_shim::kernel::{done_unless, no_follow, send, Kernel, Outputs};
 use plc_shim::timeline::registry::{
     input, required, BlockSpec, InputField, InputSpec, Kind, TimelineBlock, Value,

@@ -29,7 +29,7 @@ impl PlcProgram for Watched {
 
 #[test]
 fn the_shuttle_makes_its_round_trips() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = tests::unique_instance("shuttle");
     let finished = Arc::new(AtomicBool::new(false));
     let cnc = tests::serve_axes_in_lockstep(

@@ -19,9 +19,9 @@ hli_struct! {
     /// ST path: `header`.
     #[st = "HLI_SEGMENT_HEADER", size = 192]
     pub struct HliSegmentHeader {
-        /// [`crate::segment::SEGMENT_MAGIC`].
+        /// [`crate::image::SEGMENT_MAGIC`].
         pub magic: u64 => [0, Cnc],
-        /// [`crate::segment::LAYOUT_VERSION`].
+        /// [`crate::image::LAYOUT_VERSION`].
         pub layout_version: u32 => [8, Cnc],
         /// Size of this header in bytes.
         pub header_size: u32 => [12, Cnc],

@@ -3,8 +3,8 @@
 
 use core::mem::offset_of;
 use hli::handshake::{ProtocolViolation, SendError};
+use hli::image::heap_image;
 use hli::layout::*;
-use hli::segment::heap_image;
 use hli::views::{CncView, PlcView};
 use hli::{Bool, ImageMemory, Place, PlaceExt};
 use proptest::prelude::*;

@@ -1,6 +1,6 @@
 //! The cyclic operations of the HLI (handshakes, heartbeats, views) allocate nothing.
 
-use hli::segment::heap_image;
+use hli::image::heap_image;
 use hli::views::{CncView, PlcView};
 
 use crate::counting_alloc;

@@ -6,6 +6,6 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    hli::init_logging();
+    hli_transport::init_logging();
     plc_shim::cli::main(plc_shim::cli::PlcCli::parse())
 }

@@ -20,7 +20,7 @@ use hli::calls::cam::{
 };
 use hli::calls::AcyclicCall;
 use hli::enums::{AxisState, CouplingState};
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 
 /// Version of this block library (seed 000 5.3, Get_TcNcCamming_Version): at most the
 /// STRING(20) the seed's function returns.

@@ -10,7 +10,7 @@ use crate::runtime::PlcIo;
 use crate::timeline::registry::{mode, number, BlockSpec, InputField, Kind, TimelineBlock, Value};
 use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
 use hli::calls::CallError;
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 use std::sync::Arc;
 
 /// MC_CamTableSelect: how couplings through table `table` run (cyclic or linear).

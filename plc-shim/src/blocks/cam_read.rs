@@ -8,7 +8,7 @@ use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, 
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
 use hli::calls::cam::CamReadKind;
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 
 /// MC_ERROR_ARRAYSIZE_INVALID: an answer does not fit the block's array.
 pub const ERROR_ARRAY_SIZE: u32 = 0x4B31;

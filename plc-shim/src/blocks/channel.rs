@@ -423,8 +423,8 @@ pub const TIMELINE: &[BlockSpec] = &[
 mod tests {
     use super::*;
     use crate::runtime::Link;
-    use hli::rpc::{AcyclicClient, AcyclicServer};
     use hli::views::{CncView, PlcView};
+    use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 
     /// One cycle of `block` on `channel` of a one-channel image, the link in state `link`.
     fn cycle(
@@ -464,7 +464,7 @@ mod tests {
         let instance = format!("channel-blocks-{}", std::process::id());
         let _server = AcyclicServer::open(&instance).unwrap();
         let mut client = AcyclicClient::open(&instance).unwrap();
-        let memory = hli::segment::heap_image(1, 0);
+        let memory = hli::image::heap_image(1, 0);
         let mut stop = ChannelCommandBlock::new(ChannelCommand::Stop);
         stop.execute = true;
         // Written, then Busy while the channel stops, then Done.

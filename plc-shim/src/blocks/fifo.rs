@@ -39,7 +39,7 @@ use hli::calls::fifo::{
 };
 use hli::calls::AcyclicCall;
 use hli::layout::FIFO_OVERRIDE_FULL;
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 use std::sync::Arc;
 
 /// Version of this block library (seed 7.9, Get_TcNcFifoAxis_Version).

@@ -15,8 +15,8 @@ use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::command_book::{view_command, CommandView};
 use hli::enums::axis_status;
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisDriveState, HliAxisLrState};
-use hli::rpc::PendingCall;
 use hli::PlaceExt;
+use hli_transport::rpc::PendingCall;
 
 /// The block kernel as the motion blocks use it: the accepted command's id is followed in
 /// the axis's command book.

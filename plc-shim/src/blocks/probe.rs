@@ -11,8 +11,8 @@ use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock
 use hli::calls::probe::{ProbeAbortCall, ProbeArmCall};
 use hli::enums::{ProbeEdge, ProbeState};
 use hli::layout::{HliAxis, HliAxisDriveState, HliAxisProbe};
-use hli::rpc::PendingCall;
 use hli::PlaceExt;
+use hli_transport::rpc::PendingCall;
 
 fn failed(code: u32) -> Outputs<f64> {
     Outputs::failed(code)

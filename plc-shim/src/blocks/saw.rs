@@ -38,8 +38,8 @@ use hli::calls::saw::{
 use hli::command_book::{view_command, CommandView};
 use hli::enums::{AxisState, CouplingState};
 use hli::layout::{HliAxis, HliAxisCommandState, HliAxisLrState};
-use hli::rpc::PendingCall;
 use hli::PlaceExt;
+use hli_transport::rpc::PendingCall;
 
 pub mod inputs;
 

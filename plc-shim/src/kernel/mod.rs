@@ -26,7 +26,7 @@
 
 use crate::runtime::{Link, PlcIo};
 use hli::calls::{AcyclicCall, CallError};
-use hli::rpc::{PendingCall, PendingRows};
+use hli_transport::rpc::{PendingCall, PendingRows};
 
 /// Error id of a block whose call was not answered (lost, not sent, or not in time).
 pub const ERROR_NO_ANSWER: u32 = 0x745;

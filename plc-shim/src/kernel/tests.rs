@@ -8,8 +8,8 @@ use crate::runtime::PlcIo;
 use crate::timeline::instances::inputs_of;
 use crate::timeline::registry::{BlockSpec, InputSpec, Target};
 use hli::calls::ErrorCode;
-use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::PlcView;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use std::sync::Arc;
 
 /// What every block shows, whatever its extras.
@@ -113,7 +113,7 @@ impl Cnc {
         let name: String = block.chars().filter(char::is_ascii_alphanumeric).collect();
         let instance = format!("kernel-{case}-{name}-{}", std::process::id());
         Cnc {
-            memory: hli::segment::heap_image(1, 2),
+            memory: hli::image::heap_image(1, 2),
             server: AcyclicServer::open(&instance).unwrap(),
             client: AcyclicClient::open(&instance).unwrap(),
             cycle: 0,

@@ -14,7 +14,7 @@ use crate::blocks::dyn_cs::{DynCsMaster, MFunctionHandshake, McDynCsTransition};
 use crate::blocks::motion::{McMoveVelocity, McPower};
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::calls::axis::ReadAxisState;
-use hli::rpc::PendingCall;
+use hli_transport::rpc::PendingCall;
 
 /// The table axis (index in `gpAx`).
 const TABLE_AXIS: u32 = 0;

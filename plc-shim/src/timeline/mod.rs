@@ -502,7 +502,7 @@ impl crate::runtime::PlcProgram for Timeline {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use hli::segment::heap_image;
+    use hli::image::heap_image;
 
     const SEM: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_semaphore_rw";
     const ROT: &str = "gpCh[0]^channel_mc_control.dyn_cs.command_w.rotation[2]";

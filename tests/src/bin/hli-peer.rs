@@ -12,13 +12,13 @@
 
 #![forbid(unsafe_code)]
 
-use hli::segment::{CncSegment, PlcSegment};
 use hli::views::PlcView;
+use hli_transport::segment::{CncSegment, PlcSegment};
 use std::io::{BufRead, Write};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    hli::init_logging();
+    hli_transport::init_logging();
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args
         .iter()
@@ -35,7 +35,7 @@ fn main() -> ExitCode {
         }
         ["cnc-beat", instance] => {
             // Its mailbox first, as a CNC makes it; it answers no call.
-            let _calls = hli::rpc::AcyclicServer::open(instance).expect("mailbox");
+            let _calls = hli_transport::rpc::AcyclicServer::open(instance).expect("mailbox");
             let segment = CncSegment::create(instance, 1, 1).expect("create");
             println!("ready");
             std::io::stdout().flush().ok();
@@ -52,7 +52,7 @@ fn main() -> ExitCode {
             ExitCode::SUCCESS
         }
         ["plc-half-block", instance] => {
-            let mut client = hli::rpc::AcyclicClient::open(instance).expect("client");
+            let mut client = hli_transport::rpc::AcyclicClient::open(instance).expect("client");
             let header = hli::calls::fifo::rows_header(0, 3, 10, false);
             let whole: Vec<f64> = (0..30).map(f64::from).collect();
             let _sent = client.start_rows(header, &whole).expect("send");

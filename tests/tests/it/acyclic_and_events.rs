@@ -4,13 +4,13 @@
 use hli::calls::axis::ReadAxisState;
 use hli::calls::{AcyclicCall, CallError, CallKind, ErrorCode};
 use hli::enums::AxisState;
-use hli::events::{EventLink, Side};
 use hli::layout::{HliAxis, HliAxisLrState};
-use hli::rpc::{AcyclicClient, AcyclicServer};
-use hli::segment::CncSegment;
 use hli::views::handle_read_axis_state;
 use hli::views::CncView;
 use hli::PlaceExt;
+use hli_transport::events::{EventLink, Side};
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
+use hli_transport::segment::CncSegment;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -29,7 +29,7 @@ impl AcyclicCall for OversizedRead {
 
 #[test]
 fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("rpc");
     let segment = CncSegment::create(&instance, 1, 2).unwrap();
     let view = CncView::new(segment.memory());
@@ -92,7 +92,7 @@ fn read_axis_state_is_answered_and_bad_calls_are_refused_with_codes() {
 
 #[test]
 fn a_call_nobody_answers_times_out() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("rpc-timeout");
     let _server = AcyclicServer::open(&instance).unwrap(); // never polled
     let mut client = AcyclicClient::open(&instance).unwrap();
@@ -102,7 +102,7 @@ fn a_call_nobody_answers_times_out() {
 
 #[test]
 fn tick_and_cycle_events_wake_the_other_side() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("events");
     let cnc = EventLink::open(&instance, Side::Cnc).unwrap();
     let (ready_tx, ready_rx) = std::sync::mpsc::channel();

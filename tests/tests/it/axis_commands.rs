@@ -158,7 +158,7 @@ impl PlcProgram for Sequence {
 
 #[test]
 fn plc_motion_blocks_drive_simulated_axes_through_the_segment() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("axis-fb");
     let finished = Arc::new(AtomicBool::new(false));
     let cnc = tests::serve_axes_in_lockstep(

@@ -139,7 +139,7 @@ impl PlcProgram for Driver {
 
 #[test]
 fn the_transition_block_reports_done_aborted_and_error_as_plcopen_says() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = tests::unique_instance("dyncs-fb");
     let cnc = Arc::new(Mutex::new(Cnc::default()));
     let thread = tests::lockstep_script(&instance, 60, 1, script(cnc.clone()));

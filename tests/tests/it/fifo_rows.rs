@@ -3,13 +3,13 @@
 
 use hli::calls::fifo::FifoReply;
 use hli::calls::reply;
-use hli::rpc::{AcyclicClient, AcyclicServer};
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use std::time::{Duration, Instant};
 use tests::unique_instance;
 
 #[test]
 fn a_plc_dying_mid_write_leaves_no_half_block() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("half-block");
     let server = AcyclicServer::open(&instance).unwrap();
     let mut child = tests::spawn_peer_saying(

@@ -35,7 +35,7 @@ impl PlcProgram for Probe {
 
 #[test]
 fn the_plc_cycle_loop_does_not_allocate() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("plc-no-alloc");
     let cnc = tests::lockstep_beats(&instance, 500, 1);
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();

@@ -11,7 +11,7 @@ impl PlcProgram for Idle {
 
 #[test]
 fn plc_runtime_ends_with_cnc_lost_when_the_cnc_is_killed() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("plc-lost");
     let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
     let mut runtime = PlcRuntime::attach(&instance, 5, Duration::from_millis(5)).unwrap();
@@ -65,7 +65,7 @@ impl PlcProgram for Recorder {
 
 #[test]
 fn a_task_every_third_tick_runs_in_lockstep_and_is_timed() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("plc-period");
     let cnc = tests::lockstep_beats(&instance, 300, 1);
     let mut runtime = PlcRuntime::attach(&instance, 2_000, Duration::from_millis(5)).unwrap();
@@ -90,7 +90,7 @@ fn a_task_every_third_tick_runs_in_lockstep_and_is_timed() {
 
 #[test]
 fn ticks_the_task_missed_count_as_overruns() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("plc-overrun");
     // Two CNC ticks per PLC cycle: every cycle after the first comes one slot late.
     let cnc = tests::lockstep_beats(&instance, 50, 2);
@@ -122,7 +122,7 @@ impl PlcProgram for Betrayed {
 /// gets `signal` in the PLC's 50th cycle; returns how the run ended and the links the program
 /// saw.
 fn betrayed_by(signal: &'static str, watchdog: u32) -> (RunEnd, Vec<plc_shim::runtime::Link>) {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance(&format!("plc-{}", signal.to_lowercase()));
     let mut child = tests::spawn_ready_peer(env!("CARGO_BIN_EXE_hli-peer"), "cnc-beat", &instance);
     let mut runtime = PlcRuntime::attach(&instance, watchdog, Duration::from_millis(10)).unwrap();
@@ -195,7 +195,7 @@ impl PlcProgram for Overtaken {
 
 #[test]
 fn a_plc_whose_slot_another_plc_claimed_stops_without_another_cycle() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("plc-replaced");
     // Eleven ticks: the eleventh cycle takes the slot over, and the CNC ends after it.
     let cnc = tests::lockstep_beats(&instance, 11, 1);

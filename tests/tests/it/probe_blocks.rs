@@ -107,7 +107,7 @@ impl PlcProgram for Sequence {
 
 #[test]
 fn plc_probe_blocks_arm_record_refuse_and_abort_through_the_segment() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("probe-fb");
     let finished = Arc::new(AtomicBool::new(false));
     let cnc = tests::serve_axes_in_lockstep(

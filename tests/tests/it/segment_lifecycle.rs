@@ -1,7 +1,7 @@
 //! Segment life cycle across processes: stale segments are replaced, live ones refused,
 //! mismatching layouts refused with both values named, a dead CNC's heartbeat stops.
 
-use hli::segment::{
+use hli_transport::segment::{
     AttachError, CncSegment, CreateError, HeartbeatWatch, LayoutIdentity, PeerLiveness, PlcSegment,
 };
 use std::time::Duration;
@@ -124,7 +124,8 @@ fn mismatching_layouts_are_refused_naming_both_values() {
 
 #[test]
 fn missing_and_truncated_segments_are_typed_errors() {
-    let create_raw = |name: &str, size| hli::segment::create_raw_object(name, size).unwrap();
+    let create_raw =
+        |name: &str, size| hli_transport::segment::create_raw_object(name, size).unwrap();
     let instance = unique_instance("trunc");
     assert!(matches!(
         PlcSegment::attach(&instance),
@@ -136,19 +137,25 @@ fn missing_and_truncated_segments_are_typed_errors() {
     ));
 
     // Another program left a small object under the segment's name.
-    let _small = create_raw(&hli::segment::segment_name(&instance).unwrap(), 64);
+    let _small = create_raw(
+        &hli_transport::segment::segment_name(&instance).unwrap(),
+        64,
+    );
     match PlcSegment::attach(&instance) {
         Err(AttachError::Truncated {
             found, expected, ..
         }) => {
             assert_eq!(found, 64);
-            assert_eq!(expected, hli::segment::IMAGE_SIZE as u64);
+            assert_eq!(expected, hli_transport::segment::IMAGE_SIZE as u64);
         }
         other => panic!("expected Truncated, got {other:?}"),
     }
 
     let instance = unique_instance("magic");
-    let _junk = create_raw(&hli::segment::segment_name(&instance).unwrap(), 1 << 16);
+    let _junk = create_raw(
+        &hli_transport::segment::segment_name(&instance).unwrap(),
+        1 << 16,
+    );
     assert!(matches!(
         PlcSegment::attach(&instance),
         Err(AttachError::BadMagic { cnc: 0, .. })
@@ -256,11 +263,15 @@ fn every_file_the_shared_memory_layer_makes_is_owner_only() {
     use std::os::unix::fs::{MetadataExt, PermissionsExt};
     let instance = unique_instance("modes");
     let cnc = CncSegment::create(&instance, 1, 1).unwrap();
-    let _events = hli::events::EventLink::open(&instance, hli::events::Side::Cnc).unwrap();
-    let _server = hli::rpc::AcyclicServer::open(&instance).unwrap();
+    let _events =
+        hli_transport::events::EventLink::open(&instance, hli_transport::events::Side::Cnc)
+            .unwrap();
+    let _server = hli_transport::rpc::AcyclicServer::open(&instance).unwrap();
     let _plc = PlcSegment::attach(&instance).unwrap();
-    let _plc_events = hli::events::EventLink::open(&instance, hli::events::Side::Plc).unwrap();
-    let _client = hli::rpc::AcyclicClient::open(&instance).unwrap();
+    let _plc_events =
+        hli_transport::events::EventLink::open(&instance, hli_transport::events::Side::Plc)
+            .unwrap();
+    let _client = hli_transport::rpc::AcyclicClient::open(&instance).unwrap();
     let me = std::fs::metadata("/proc/self").unwrap().uid();
     let mut files = vec![std::path::PathBuf::from(format!("/dev/shm/{}", cnc.name()))];
     let mut dirs = vec![std::path::PathBuf::from("/tmp/iceoryx2")];

@@ -1,8 +1,8 @@
 //! One million command and one million request handshakes between two real processes through
 //! the real segment: none lost, duplicated or torn.
 
-use hli::segment::CncSegment;
 use hli::views::CncView;
+use hli_transport::segment::CncSegment;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 use tests::{payload, unique_instance, verify};
@@ -11,7 +11,7 @@ const HANDSHAKES: u32 = 1_000_000;
 
 #[test]
 fn a_million_handshakes_each_way_are_exact() {
-    hli::init_logging();
+    hli_transport::init_logging();
     let instance = unique_instance("million");
     let segment = CncSegment::create(&instance, 1, 1).unwrap();
     let mut child = tests::Cli::new(env!("CARGO_BIN_EXE_hli-peer"))

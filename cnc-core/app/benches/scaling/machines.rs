@@ -89,7 +89,7 @@ fn machine(axes: Vec<AxisConfig>, engines: Vec<Box<dyn Engine>>) -> (Machine, Im
         cycle_s: TICK,
     })
     .expect("machine");
-    let memory = hli::segment::heap_image(0, n as u32);
+    let memory = hli::image::heap_image(0, n as u32);
     for i in 0..n {
         let axis = machine.axes_mut().axis_mut(i).expect("axis");
         axis.switch_on().expect("power");

@@ -85,7 +85,7 @@ enum HliCommand {
 }
 
 fn main() -> ExitCode {
-    hli::init_logging();
+    hli_transport::init_logging();
     // Long NC programs fill their tree in huge pages where the system has them.
     cnc_core::nc::set_buffer_advice(cnc_app::huge_page_advice);
     match Cli::parse().command {

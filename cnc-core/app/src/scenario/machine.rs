@@ -12,9 +12,9 @@ use cnc_core::channel::Channel;
 use cnc_core::machine::engines::{self, EngineSetup};
 pub use cnc_core::machine::Machine;
 use cnc_core::machine::MachineSetup;
-use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
 use hli::ImageMemory;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::runtime::{PlcIo, PlcProgram};
 use plc_shim::timeline::Timeline;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -169,7 +169,7 @@ impl InProcess {
         };
         let machine = build(scenario)?;
         let memory =
-            hli::segment::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
+            hli::image::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
         Ok(InProcess {
             machine,
             memory,

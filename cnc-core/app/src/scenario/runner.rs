@@ -20,9 +20,9 @@ use crate::stats::Percentiles;
 use cnc_core::channel::diagnosis::log_message;
 use cnc_os::monotonic;
 use core::time::Duration;
-use hli::events::{EventLink, Side};
-use hli::rpc::AcyclicServer;
-use hli::segment::CncSegment;
+use hli_transport::events::{EventLink, Side};
+use hli_transport::rpc::AcyclicServer;
+use hli_transport::segment::CncSegment;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitCode, Stdio};
 use tick_loop::{Bounds, Ending, Measured, TickLoop};
@@ -131,14 +131,14 @@ pub enum StopCause {
         /// The tick the CNC noticed it.
         tick: u64,
         /// Which field, what the CNC wrote, what it found.
-        fault: hli::segment::HeaderFault,
+        fault: hli_transport::segment::HeaderFault,
     },
     /// SIGINT or SIGTERM.
     Signal {
         /// The tick it was noticed at.
         tick: u64,
         /// Which.
-        signal: hli::signals::Termination,
+        signal: hli_transport::signals::Termination,
     },
 }
 
@@ -277,7 +277,7 @@ pub fn main(args: RunArgs) -> ExitCode {
         log_dir: Some(args.log_dir.clone()),
         opcua: args.opcua.clone(),
     };
-    hli::signals::capture();
+    hli_transport::signals::capture();
     match run(&scenario, &options) {
         Ok(report) => {
             print!("{}", report.render(args.diagnosis));
@@ -432,10 +432,10 @@ impl PlcLink {
         machine: &Machine,
         options: &RunOptions,
     ) -> Result<PlcLink, String> {
-        let timing = hli::segment::CncTiming {
+        let timing = hli_transport::segment::CncTiming {
             cycle_ns: (scenario.cycle_s * 1e9).round().clamp(
-                f64::from(hli::segment::MIN_CYCLE_NS),
-                f64::from(hli::segment::MAX_CYCLE_NS),
+                f64::from(hli_transport::segment::MIN_CYCLE_NS),
+                f64::from(hli_transport::segment::MAX_CYCLE_NS),
             ) as u32,
             lockstep: options.lockstep,
         };

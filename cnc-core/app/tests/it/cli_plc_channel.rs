@@ -73,7 +73,7 @@ fn plc_channel_selects_starts_holds_stops_and_refuses_with_codes() {
     assert!(err.contains("channel 3 does not exist"), "{err}");
 
     // A PLC attached owns the unit: the tool refuses to send beside it, unless --force.
-    let plc = hli::segment::PlcSegment::attach(&instance).unwrap();
+    let plc = hli_transport::segment::PlcSegment::attach(&instance).unwrap();
     let (code, _, err) = tool(&instance, &["start"]);
     assert_eq!(code, 4, "{err}");
     assert!(err.contains("a PLC (pid"), "{err}");

@@ -10,8 +10,8 @@ use hli::calls::fifo::{
 };
 use hli::calls::AcyclicCall;
 use hli::enums::FifoGroupState;
-use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::blocks::fifo::FifoWrite;
 use plc_shim::runtime::PlcIo;
 

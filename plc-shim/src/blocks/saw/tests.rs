@@ -4,9 +4,9 @@ use super::*;
 use hli::calls::saw::{SawCharacReply, SawReply};
 use hli::calls::{decode_body, reply, CallKind};
 use hli::layout::HliAxis;
-use hli::rpc::{AcyclicClient, AcyclicServer};
 use hli::views::{CncView, PlcView};
 use hli::PlaceExt;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 
 #[test]
 fn the_library_names_its_version() {
@@ -157,12 +157,12 @@ struct StandIn {
 
 impl StandIn {
     fn new(name: &str) -> StandIn {
-        hli::init_logging();
+        hli_transport::init_logging();
         let instance = format!("saw-{name}-{}", std::process::id());
         StandIn {
             server: AcyclicServer::open(&instance).unwrap(),
             client: AcyclicClient::open(&instance).unwrap(),
-            memory: hli::segment::heap_image(0, 2),
+            memory: hli::image::heap_image(0, 2),
             cycle: 0,
         }
     }

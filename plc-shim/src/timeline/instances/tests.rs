@@ -184,7 +184,7 @@ fn a_timeout_is_taken_by_blocks_that_have_one() {
 fn axis_ids_resolve_from_the_image() {
     use hli::layout::{HliAxis, HliAxisLrState};
     use hli::PlaceExt;
-    let memory = hli::segment::heap_image(1, 3);
+    let memory = hli::image::heap_image(1, 3);
     let cnc = hli::views::CncView::new(&memory);
     let write_id = |axis: usize, id: u32| {
         cnc.axis(axis)

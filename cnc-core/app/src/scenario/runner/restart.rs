@@ -19,7 +19,7 @@ use cnc_os::monotonic;
 use core::mem::offset_of;
 use core::time::Duration;
 use hli::layout::HliSegmentHeader;
-use hli::segment::CncSegment;
+use hli_transport::segment::CncSegment;
 
 /// How long a new PLC may take from attaching to its first cycle.
 const FIRST_CYCLE_PATIENCE: Duration = Duration::from_secs(20);

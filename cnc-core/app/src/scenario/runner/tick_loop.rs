@@ -17,11 +17,11 @@ use crate::scenario::trace::Trace;
 use cnc_core::channel::folder::Loader;
 use cnc_os::monotonic;
 use core::time::Duration;
-use hli::events::EventLink;
-use hli::rpc::AcyclicServer;
-use hli::segment::CncSegment;
 use hli::views::CncView;
 use hli::ImageMemory;
+use hli_transport::events::EventLink;
+use hli_transport::rpc::AcyclicServer;
+use hli_transport::segment::CncSegment;
 use std::process::Child;
 
 /// How long a run may go: its ticks, the stop's, the PLC watchdog.
@@ -482,7 +482,7 @@ impl<'a> TickLoop<'a> {
     /// A termination request at `tick` stops the machine; a second one during the stop ends
     /// the run at once (true: end now).
     fn take_signal(&mut self, tick: u64) -> bool {
-        let Some(signal) = hli::signals::take() else {
+        let Some(signal) = hli_transport::signals::take() else {
             return false;
         };
         if self.ending.stop.is_some() {

@@ -50,7 +50,8 @@ impl CncTiming {
         core::time::Duration::from_nanos(u64::from(self.cycle_ns))
     }
 
-    pub(super) fn flags(&self) -> u32 {
+    /// The header's `cnc_flags` for this timing.
+    pub fn flags(&self) -> u32 {
         if self.lockstep {
             FLAG_LOCKSTEP
         } else {
@@ -60,7 +61,7 @@ impl CncTiming {
 
     /// The timing a header announces, `None` when the cycle is out of range or unknown flags
     /// are set.
-    pub(super) fn of(header: &HliSegmentHeader) -> Option<Self> {
+    pub fn of(header: &HliSegmentHeader) -> Option<Self> {
         let cycle_ok = (MIN_CYCLE_NS..=MAX_CYCLE_NS).contains(&header.cnc_cycle_ns);
         let flags_ok = header.cnc_flags & !FLAG_LOCKSTEP == 0;
         (cycle_ok && flags_ok).then_some(Self {
@@ -163,7 +164,7 @@ fn identity(h: &HliSegmentHeader) -> [(HeaderField, u64); 11] {
 }
 
 /// The first identity field of `found` that differs from `expected`.
-pub(super) fn compare_identity(
+pub fn compare_identity(
     expected: &HliSegmentHeader,
     found: &HliSegmentHeader,
 ) -> Result<(), HeaderFault> {
@@ -181,10 +182,7 @@ pub(super) fn compare_identity(
 
 /// The segment state of `found` where it is one the other side may write next to `expected`
 /// (the CNC only ever writes Ready, then Closed).
-pub(super) fn check_state(
-    found: u32,
-    allowed: &[SegmentState],
-) -> Result<SegmentState, HeaderFault> {
+pub fn check_state(found: u32, allowed: &[SegmentState]) -> Result<SegmentState, HeaderFault> {
     match SegmentState::decode(found) {
         Ok(state) if allowed.contains(&state) => Ok(state),
         _ => Err(HeaderFault {

@@ -1,17 +1,17 @@
 //! The transport of the acyclic ADS-like calls from the PLC to the CNC: a mailbox of slots in
-//! shared memory ([`mailbox`]) carrying the frames of [`crate::wire`], one call per PLC block
+//! shared memory ([`mailbox`]) carrying the frames of [`hli::wire`], one call per PLC block
 //! Execute edge (table writes, coupling commands, reads of characteristic values...), and bulk
 //! calls whose numbers are written straight into the mailbox (FIFO row blocks). Nothing is
 //! allocated on either side after opening. The vocabulary (call kinds, typed bodies, refusal
-//! codes) is [`crate::calls`] and its families; this module is the transport alone. The
-//! CNC-side handlers live with the CNC's view ([`crate::views::handle_read_axis_state`]) and in
+//! codes) is [`hli::calls`] and its families; this module is the transport alone. The
+//! CNC-side handlers live with the CNC's view ([`hli::views::handle_read_axis_state`]) and in
 //! the engines.
 
-use crate::calls::{AcyclicCall, CallError, CallKind, ErrorCode, HandlerResult};
-use crate::wire::{
+use core::time::Duration;
+use hli::calls::{AcyclicCall, CallError, CallKind, ErrorCode, HandlerResult};
+use hli::wire::{
     encode_body, AcyclicRequest, AcyclicResponse, BulkHeader, ACYCLIC_BODY_SIZE, BULK_MAX_VALUES,
 };
-use core::time::Duration;
 use mailbox::{BulkLoan, Mailbox, Ticket, BULK_SLOTS, MAILBOX_SLOTS};
 use std::sync::Arc;
 use std::time::Instant;

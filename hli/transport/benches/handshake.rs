@@ -9,10 +9,10 @@
 //! median over repeats, and each p50 as a ratio to the flag floor of the same run.
 
 use bench_kit::median_u64 as median;
-use hli::events::{EventLink, Side};
 use hli::layout::HliCoordinateSystemInt;
-use hli::segment::{CncSegment, PlcSegment};
 use hli::views::{CncView, PlcView};
+use hli_transport::events::{EventLink, Side};
+use hli_transport::segment::{CncSegment, PlcSegment};
 use iceoryx2::prelude::*;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};
@@ -100,7 +100,7 @@ fn spin(spins: &mut u32) {
 // ---------------------------------------------------------------- peer side (child process)
 
 fn peer_main(method: Method, name: &str, count: usize) {
-    hli::init_logging();
+    hli_transport::init_logging();
     let total = count + WARMUP;
     match method {
         Method::Flag => {
@@ -413,7 +413,7 @@ fn main() {
         peer_main(method, &name, count);
         return;
     }
-    hli::init_logging();
+    hli_transport::init_logging();
     let quick = std::env::args().any(|a| a == "--quick");
     // CNC_BENCH_SMOKE=1 (CI): one short repeat, to show the bench runs; no figure is meant.
     let smoke = std::env::var("CNC_BENCH_SMOKE").is_ok_and(|v| v == "1");

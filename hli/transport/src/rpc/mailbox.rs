@@ -20,10 +20,10 @@
 //! pid). The state and the ticket are two words: a holder's ticket check and the next
 //! claimant's ticket store could meet only after 2^32 calls.
 
-use super::super::calls::CallError;
-use super::super::desc::PlaceExt;
-use super::super::raw::{ImageMemory, Place};
-use super::super::wire::{AcyclicRequest, AcyclicResponse, BulkHeader, BULK_MAX_VALUES};
+use hli::calls::CallError;
+use hli::desc::PlaceExt;
+use hli::raw::{ImageMemory, Place};
+use hli::wire::{AcyclicRequest, AcyclicResponse, BulkHeader, BULK_MAX_VALUES};
 use iceoryx2_bb_posix::shared_memory::{
     AccessMode, CreationMode, Permission, SharedMemoryBuilder, SharedMemoryCreationError,
 };
@@ -211,7 +211,7 @@ impl Mailbox {
                 let old = SharedMemoryBuilder::new(&fname)
                     .is_memory_locked(false)
                     .open_existing(AccessMode::ReadWrite);
-                if let Ok(old) = old.map(ImageMemory::shared) {
+                if let Ok(old) = old.map(crate::raw::shared) {
                     if old.len() >= HEADER_BYTES {
                         let pid = old.place::<u32>(OFF_PID).load();
                         let stamp = old.place::<u64>(OFF_STAMP).load();
@@ -226,7 +226,7 @@ impl Mailbox {
             }
             Err(e) => return Err(os(&name, e)),
         };
-        let memory = ImageMemory::shared(shm);
+        let memory = crate::raw::shared(shm);
         let pid = std::process::id();
         memory.place::<u32>(OFF_SLOTS).store(MAILBOX_SLOTS as u32);
         memory.place::<u32>(OFF_PID).store(pid);
@@ -246,7 +246,7 @@ impl Mailbox {
         if shm.size() < SIZE {
             return Err(os(&name, format!("{} bytes, expected {SIZE}", shm.size())));
         }
-        let memory = ImageMemory::shared(shm);
+        let memory = crate::raw::shared(shm);
         let magic = memory.place::<u64>(0).load_acquire();
         let slots = memory.place::<u32>(OFF_SLOTS).load();
         if magic != MAGIC || slots as usize != MAILBOX_SLOTS {

@@ -2,8 +2,8 @@
 //! timestamps and machine figures): the CNC never reads it back.
 
 use super::CncSegment;
-use crate::layout::HliSegmentHeader;
 use core::mem::offset_of;
+use hli::layout::HliSegmentHeader;
 
 impl CncSegment {
     /// Announces when heartbeat 0 was due, wall clock in ns since the Unix epoch

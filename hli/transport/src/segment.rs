@@ -11,12 +11,11 @@
 //!  CNC drop ─► Closed, object unlinked
 //! ```
 
-use crate::desc::PlaceExt;
-use crate::enums::SegmentState;
-use crate::layout::{HliImage, HliSegmentHeader, HLI_MAX_AXES, HLI_MAX_CHANNELS};
-use crate::raw::{ImageMemory, Place};
-use crate::symbols::SymbolTable;
-use core::mem::{offset_of, size_of};
+use core::mem::offset_of;
+use hli::desc::PlaceExt;
+use hli::enums::SegmentState;
+use hli::layout::{HliImage, HliSegmentHeader, HLI_MAX_AXES, HLI_MAX_CHANNELS};
+use hli::raw::{ImageMemory, Place};
 use iceoryx2_bb_posix::shared_memory::{
     AccessMode, CreationMode, Permission, SharedMemory, SharedMemoryBuilder,
     SharedMemoryCreationError,
@@ -25,44 +24,20 @@ use iceoryx2_bb_system_types::file_name::{FileName, SemanticString};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 mod announce;
-mod guard;
 mod liveness;
 mod process;
 mod reset;
-pub use guard::{CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS};
+pub use hli::image::guard::{
+    CncTiming, HeaderFault, HeaderField, FLAG_LOCKSTEP, MAX_CYCLE_NS, MIN_CYCLE_NS,
+};
+use hli::image::{guard, write_plc_defaults};
+pub use hli::image::{
+    heap_image, initial_header, LayoutIdentity, HEADER_SIZE, IMAGE_SIZE, LAYOUT_VERSION,
+    SEGMENT_MAGIC,
+};
 pub use liveness::{HeartbeatWatch, PeerLiveness};
 pub(crate) use process::process_start_stamp;
 use process::{check_owner, start_stamp_at, stat_path};
-
-/// "HLI-SEG1" as a little-endian u64.
-pub const SEGMENT_MAGIC: u64 = u64::from_le_bytes(*b"HLI-SEG1");
-/// Bumped whenever the meaning of the image changes without its layout changing.
-pub const LAYOUT_VERSION: u32 = 3;
-/// Size of the image in bytes.
-pub const IMAGE_SIZE: usize = size_of::<HliImage>();
-const HEADER_SIZE: usize = size_of::<HliSegmentHeader>();
-
-/// What a peer expects the segment to be; both sides compare theirs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct LayoutIdentity {
-    /// [`LAYOUT_VERSION`].
-    pub version: u32,
-    /// [`SymbolTable::layout_hash`].
-    pub hash: u64,
-    /// Image size in bytes.
-    pub size: u64,
-}
-
-impl LayoutIdentity {
-    /// The identity of this build.
-    pub fn current() -> Self {
-        Self {
-            version: LAYOUT_VERSION,
-            hash: SymbolTable::global().layout_hash(),
-            size: IMAGE_SIZE as u64,
-        }
-    }
-}
 
 /// Why a segment could not be created.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -370,7 +345,7 @@ impl CncSegment {
             }
         };
         let mut segment = Self {
-            memory: ImageMemory::shared(shm),
+            memory: crate::raw::shared(shm),
             name,
             replaced,
             expected: bytemuck::Zeroable::zeroed(),
@@ -395,7 +370,7 @@ impl CncSegment {
         if shm.size() < HEADER_SIZE {
             return Ok(StaleSegment { pid: 0 });
         }
-        let memory = ImageMemory::shared(shm);
+        let memory = crate::raw::shared(shm);
         let header: HliSegmentHeader = memory.place::<HliSegmentHeader>(0).read();
         drop(memory); // unmaps; an opened (not created) object is not unlinked
         let owner_alive = header.magic == SEGMENT_MAGIC
@@ -565,7 +540,7 @@ impl PlcSegment {
                 found,
             });
         }
-        let memory = ImageMemory::shared(shm);
+        let memory = crate::raw::shared(shm);
         let header = memory.place::<HliSegmentHeader>(0);
         let state = header
             .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
@@ -647,7 +622,7 @@ impl PlcSegment {
     }
 
     /// The CNC's segment state (`Closed` after an orderly shutdown).
-    pub fn cnc_state(&self) -> Result<SegmentState, crate::enums::InvalidValue> {
+    pub fn cnc_state(&self) -> Result<SegmentState, hli::enums::InvalidValue> {
         SegmentState::decode(
             self.header()
                 .field::<u32>(offset_of!(HliSegmentHeader, segment_state))
@@ -716,63 +691,12 @@ pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateE
         name: name.to_string(),
     })?;
     create_object(&fname, CreationMode::PurgeAndCreate, size)
-        .map(ImageMemory::shared)
+        .map(crate::raw::shared)
         .map_err(|e| CreateError::Os {
             name: name.to_string(),
             reason: format!("{e:?}"),
         })
 }
-
-/// The header a CNC of this build writes when it creates an image.
-fn initial_header(
-    channels: u32,
-    axes: u32,
-    state: SegmentState,
-    start_stamp: u64,
-    timing: CncTiming,
-) -> HliSegmentHeader {
-    let identity = LayoutIdentity::current();
-    HliSegmentHeader {
-        magic: SEGMENT_MAGIC,
-        layout_version: identity.version,
-        header_size: HEADER_SIZE as u32,
-        layout_hash: identity.hash,
-        image_size: identity.size,
-        channel_count: channels,
-        axis_count: axes,
-        cnc_pid: std::process::id(),
-        segment_state: state.raw(),
-        cnc_start_stamp: start_stamp,
-        cnc_cycle_ns: timing.cycle_ns,
-        cnc_flags: timing.flags(),
-        ..bytemuck::Zeroable::zeroed()
-    }
-}
-
-/// A heap-backed image with a valid header, for in-process mode and unit tests.
-pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
-    let memory = ImageMemory::heap(IMAGE_SIZE);
-    memory.place::<HliSegmentHeader>(0).write(&initial_header(
-        channels,
-        axes,
-        SegmentState::Ready,
-        0,
-        CncTiming::default(),
-    ));
-    write_plc_defaults(&memory, channels);
-    memory
-}
-
-/// The PLC-written values whose zero would not be a safe default: each channel's override
-/// starts at 100 % ([`crate::views::DEFAULT_PATH_OVERRIDE`]).
-fn write_plc_defaults(memory: &ImageMemory, channels: u32) {
-    let view = crate::views::PlcView::new(memory);
-    for channel in 0..channels as usize {
-        let _ = view.set_path_override(channel, crate::views::DEFAULT_PATH_OVERRIDE);
-    }
-}
-
-const _: () = assert!(IMAGE_SIZE.is_multiple_of(8));
 
 #[cfg(test)]
 mod tests {

@@ -4,8 +4,8 @@
 //! attach. The header keeps the old PLC's pid and heartbeat: the new PLC writes its own.
 
 use super::{write_plc_defaults, CncSegment, HEADER_SIZE};
-use crate::desc::SymbolWriter;
-use crate::symbols::{SymbolKind, SymbolTable};
+use hli::desc::SymbolWriter;
+use hli::symbols::{SymbolKind, SymbolTable};
 
 impl CncSegment {
     /// Clears the PLC-written leaves and the semaphores of the image and writes the PLC

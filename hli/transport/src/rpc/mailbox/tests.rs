@@ -12,7 +12,7 @@ fn request(id: u32) -> AcyclicRequest {
         kind: 7,
         target: 3,
         body_len: 4,
-        body: [id as u8; crate::wire::ACYCLIC_BODY_SIZE],
+        body: [id as u8; hli::wire::ACYCLIC_BODY_SIZE],
     }
 }
 
@@ -206,7 +206,7 @@ fn bulk_refused() -> AcyclicResponse {
         kind: 0,
         error_code: 99,
         body_len: 0,
-        body: [0; crate::wire::ACYCLIC_BODY_SIZE],
+        body: [0; hli::wire::ACYCLIC_BODY_SIZE],
     }
 }
 
