@@ -32,7 +32,6 @@ mod cli_turntable;
 mod counting_alloc;
 mod demo;
 mod demo_twin;
-mod drive_image_gaps;
 mod drive_inputs;
 mod fifo_engine;
 mod fifo_no_alloc;

@@ -15,6 +15,8 @@ use hli::views::CncView;
 use hli::PlaceExt;
 use proptest::prelude::*;
 
+mod drive_image_gaps;
+mod drive_inputs;
 mod refusals;
 
 const CYCLE: f64 = 0.001;
