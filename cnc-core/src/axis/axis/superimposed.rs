@@ -52,7 +52,7 @@ impl Axis {
             )
         });
         // A flying saw stopping or standing after a rollback has no motion to add to.
-        if !held_by_engine || self.saw_standing() {
+        if !held_by_engine || self.in_prephase() {
             return Err(AxisError::SuperimposedNotCoupled);
         }
         if !call.position.is_finite() {
@@ -85,7 +85,7 @@ impl Axis {
     /// flying saw that goes into its pre-phase (a rollback: stop and stand) brakes a running
     /// move with the axis's deceleration and jerk and aborts it.
     pub(super) fn step_superimposed(&mut self) {
-        if self.saw_standing() && self.superimposed.id != 0 {
+        if self.in_prephase() && self.superimposed.id != 0 {
             let d = self.config.dynamics;
             if self
                 .superimposed
@@ -102,8 +102,9 @@ impl Axis {
         }
     }
 
-    /// A flying saw's slave in its pre-phase: stopping or standing after a rollback.
-    fn saw_standing(&self) -> bool {
+    /// A slave in its pre-phase (`SlavePrephase`: a cam slave held until its activation, a
+    /// flying saw stopping or standing after a rollback).
+    fn in_prephase(&self) -> bool {
         self.coupling
             .is_some_and(|c| c.phase == AxisState::SlavePrephase)
     }
