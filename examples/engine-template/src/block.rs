@@ -60,30 +60,34 @@ const GEAR_IN: &[InputSpec] = &[
     input("phase", Kind::Real),
 ];
 
-impl TimelineBlock for PhaseGearIn {
+/// A call body whose fields a timeline sets by input key.
+pub trait Inputs {
+    /// Sets input `key` (one of the block's declared inputs) to `value`.
+    fn set(&mut self, key: &str, value: &Value);
+}
+
+impl Inputs for PhaseGearInCall {
     fn set(&mut self, key: &str, value: &Value) {
         match key {
-            "master" => self.inputs.master.take(value),
-            "ratio" => self.inputs.ratio.take(value),
-            "phase" => self.inputs.phase.take(value),
+            "master" => self.master.take(value),
+            "ratio" => self.ratio.take(value),
+            "phase" => self.phase.take(value),
             _ => {}
         }
     }
-    fn execute(&mut self) -> Option<&mut bool> {
-        Some(&mut self.execute)
-    }
-    fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
-        self.call(io, axis);
-        (self.out, false)
-    }
-    fn timeout_cycles(&mut self, cycles: u64) -> bool {
-        self.kernel.set_timeout_cycles(cycles);
-        true
-    }
 }
 
-impl TimelineBlock for PhaseGearOut {
+impl Inputs for PhaseGearOutCall {
     fn set(&mut self, _: &str, _: &Value) {}
+}
+
+impl<C> TimelineBlock for OneCall<C>
+where
+    C: AcyclicCall<Reply = crate::calls::PhaseGearReply> + Copy + Inputs + core::fmt::Debug,
+{
+    fn set(&mut self, key: &str, value: &Value) {
+        self.inputs.set(key, value);
+    }
     fn execute(&mut self) -> Option<&mut bool> {
         Some(&mut self.execute)
     }

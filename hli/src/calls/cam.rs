@@ -277,6 +277,21 @@ pub struct CamPointsWriteCall {
     pub points: [McMotionFunctionPoint; CAM_POINTS_PER_CALL],
 }
 
+impl CamPointsWriteCall {
+    /// One point written alone, in one chunk (MC_WriteMotionFunctionPoint's call).
+    pub fn one(point: McMotionFunctionPoint) -> Self {
+        let mut points = [McMotionFunctionPoint::default(); CAM_POINTS_PER_CALL];
+        points[0] = point;
+        CamPointsWriteCall {
+            first: point.point_index,
+            count: 1,
+            flags: CAM_CHUNK_FIRST | CAM_CHUNK_LAST,
+            total: 1,
+            points,
+        }
+    }
+}
+
 /// MC_ReadMotionFunction(Point) for the table given as `target`: up to four points from
 /// `first` on.
 #[repr(C)]

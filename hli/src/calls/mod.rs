@@ -35,8 +35,7 @@ use bytemuck::Pod;
 use core::time::Duration;
 
 /// Declares a family's call kinds (see the module documentation): the `CallKind`
-/// constants, the `AcyclicCall` implementations, frame-size assertions and the family's
-/// `CALLS`.
+/// constants, then what every family has ([`call_specs!`]).
 macro_rules! calls {
     (
         family $family:literal;
@@ -52,36 +51,10 @@ macro_rules! calls {
             )*
         }
 
-        $(
-            impl $crate::calls::AcyclicCall for $call {
-                const KIND: $crate::calls::CallKind = $crate::calls::CallKind::$kind;
-                type Reply = $reply;
-            }
-
-            const _: () = assert!(
-                core::mem::size_of::<$call>() <= $crate::wire::ACYCLIC_BODY_SIZE
-                    && core::mem::size_of::<$reply>() <= $crate::wire::ACYCLIC_BODY_SIZE
-            );
-        )*
-
-        /// This family's call kinds (one entry of [`crate::calls::FAMILIES`]).
-        pub const CALLS: &[$crate::calls::CallSpec] = &[
-            $(
-                $crate::calls::CallSpec {
-                    kind: $crate::calls::CallKind::$kind,
-                    name: stringify!($kind),
-                    read_only: calls!(@read_only $access),
-                    bulk: calls!(@bulk $access),
-                    family: $family,
-                },
-            )*
-        ];
+        $crate::call_specs! { family $family;
+            $($kind ($crate::calls::CallKind::$kind): $call -> $reply, $access;)*
+        }
     };
-    (@read_only read_only) => { true };
-    (@read_only command) => { false };
-    (@read_only bulk) => { false };
-    (@bulk bulk) => { true };
-    (@bulk $other:ident) => { false };
 }
 
 /// Declares the call kinds of an extension family: an engine outside this crate, with its
@@ -108,9 +81,27 @@ macro_rules! extension_calls {
         $(
             $(#[doc = $doc])*
             pub const $kind: $crate::calls::CallKind = $crate::calls::CallKind::declare($raw);
+        )*
 
+        $crate::call_specs! { family $family;
+            $($kind ($kind): $call -> $reply, $access;)*
+        }
+    };
+}
+
+/// What every family declares beside its kinds (the part `calls!` and `extension_calls!`
+/// share): the `AcyclicCall` implementations, frame-size assertions and the family's
+/// `CALLS`. Each line names a kind, the path of its constant, its bodies and its access.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! call_specs {
+    (
+        family $family:literal;
+        $($kind:ident ($path:path): $call:ident -> $reply:ty, $access:ident;)*
+    ) => {
+        $(
             impl $crate::calls::AcyclicCall for $call {
-                const KIND: $crate::calls::CallKind = $kind;
+                const KIND: $crate::calls::CallKind = $path;
                 type Reply = $reply;
             }
 
@@ -120,23 +111,25 @@ macro_rules! extension_calls {
             );
         )*
 
-        /// This extension family's call kinds (what it registers).
+        /// This family's call kinds (what its registry entry lists).
         pub const CALLS: &[$crate::calls::CallSpec] = &[
             $(
                 $crate::calls::CallSpec {
-                    kind: $kind,
+                    kind: $path,
                     name: stringify!($kind),
-                    read_only: $crate::extension_calls!(@read_only $access),
-                    bulk: $crate::extension_calls!(@bulk $access),
+                    read_only: $crate::call_specs!(@read_only $access),
+                    bulk: $crate::call_specs!(@bulk $access),
                     family: $family,
                 },
             )*
         ];
     };
     (@read_only read_only) => { true };
-    (@read_only $other:ident) => { false };
+    (@read_only command) => { false };
+    (@read_only bulk) => { false };
     (@bulk bulk) => { true };
-    (@bulk $other:ident) => { false };
+    (@bulk command) => { false };
+    (@bulk read_only) => { false };
 }
 
 pub mod axis;

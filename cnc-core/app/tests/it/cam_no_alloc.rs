@@ -139,7 +139,7 @@ fn the_machine_tick_with_a_coupled_cam_slave_allocates_nothing() {
         1,
         hli::wire::encode_body(&mode),
     );
-    let write = crate::cam_engine::one_point_write(crate::cam_engine::seed_point_4(30.0));
+    let write = hli::calls::cam::CamPointsWriteCall::one(crate::cam_engine::seed_point_4(30.0));
     send(
         &mut run,
         hli::calls::CallKind::CAM_POINTS_WRITE,

@@ -91,7 +91,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     // A point whose master position breaks the monotonic order: refused whole.
     let mut p4: McMotionFunctionPoint = read(&mut run, 4).points[0];
     p4.master_pos = 400.0;
-    let write = one_point_write(p4);
+    let write = hli::calls::cam::CamPointsWriteCall::one(p4);
     let reply = answer(&mut run, 1, &write);
     assert!(
         (0x4B30..=0x4B38).contains(&reply.error_id),
@@ -102,7 +102,7 @@ fn points_read_back_and_a_refused_write_leaves_the_function() {
     assert_eq!(read(&mut run, 4).points[0].master_pos, 240.0);
     // A good one applies (instantaneous mode, nothing coupled).
     p4.master_pos = 250.0;
-    let write = one_point_write(p4);
+    let write = hli::calls::cam::CamPointsWriteCall::one(p4);
     let reply = answer(&mut run, 1, &write);
     assert_eq!(reply.error_id, 0);
     run.step();

@@ -185,7 +185,14 @@ fn mc_cam_info_shows_queued_scaling_online_change_and_switch() {
         ..CamOnlineModeCall::default()
     };
     assert_eq!(call(&mut run, 1, online), 0);
-    assert_eq!(call(&mut run, 1, one_point_write(seed_point_4(30.0))), 0);
+    assert_eq!(
+        call(
+            &mut run,
+            1,
+            hli::calls::cam::CamPointsWriteCall::one(seed_point_4(30.0))
+        ),
+        0
+    );
     let switch = CamInCall {
         master_scaling_mode: 1,
         slave_scaling_mode: 2,

@@ -211,21 +211,6 @@ fn seed_point_4(slave: f64) -> hli::calls::cam::McMotionFunctionPoint {
     }
 }
 
-/// MC_WriteMotionFunctionPoint's call of one point, in one chunk.
-fn one_point_write(
-    point: hli::calls::cam::McMotionFunctionPoint,
-) -> hli::calls::cam::CamPointsWriteCall {
-    let mut points = [hli::calls::cam::McMotionFunctionPoint::default(); 4];
-    points[0] = point;
-    hli::calls::cam::CamPointsWriteCall {
-        first: point.point_index,
-        count: 1,
-        flags: hli::calls::cam::CAM_CHUNK_FIRST | hli::calls::cam::CAM_CHUNK_LAST,
-        total: 1,
-        points,
-    }
-}
-
 /// The law of a slave coupled absolute, unscaled, to the seed cam at master 0, slave 0.
 fn seed_law(periodic: bool) -> CamLaw {
     CamLaw::new(

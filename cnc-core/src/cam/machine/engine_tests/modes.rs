@@ -543,6 +543,6 @@ fn an_online_point_change_with_slave_auto_offset_does_not_jump() {
 /// MC_WriteMotionFunctionPoint of the seed cam's point 4 (the fall's start at 240) from 40 to
 /// 30, as the conveyor's PLC writes it: the error id of the answer.
 fn write_point_4(run: &mut Harness) -> u32 {
-    let write = one_point_write(seed_point_4(30.0));
+    let write = hli::calls::cam::CamPointsWriteCall::one(seed_point_4(30.0));
     call(run, 1, write)
 }
