@@ -15,7 +15,8 @@
 //! Besides the image, the module holds `zero_copy_send!`, the `unsafe impl` that lets iceoryx2
 //! copy a plain-data payload between the processes. The crate root denies `unsafe_code` and
 //! allows it for this module alone; the macro's expansion carries its own allow, so the
-//! `unsafe impl` it writes into `wire`, `calls` and `layout` is still text of this module.
+//! `unsafe impl` it writes (for `layout::dyn_cs`'s coordinate system, which the handshake bench's
+//! iceoryx2 pub-sub baseline sends) is still text of this module.
 //! System calls that are not about the interface (sleeping, memory advice, real-time settings)
 //! are in the `cnc-os` crate.
 
@@ -312,7 +313,7 @@ impl Place<'_, u64> {
 }
 
 /// `ZeroCopySend` for plain-data types iceoryx2 moves between processes by copying their bytes
-/// into shared memory. Invoked where the types are defined (`wire`, `layout`); the type must
+/// into shared memory. Invoked where the type is defined (`layout::dyn_cs`); the type must
 /// be bytemuck `Pod`, which the expansion checks.
 macro_rules! zero_copy_send {
     ($($t:ty),*) => {$(

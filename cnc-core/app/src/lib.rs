@@ -6,6 +6,7 @@
 
 pub mod cam_cli;
 pub mod check_cli;
+pub mod cli;
 pub mod demo;
 pub mod demo_plots;
 pub mod diag_cli;

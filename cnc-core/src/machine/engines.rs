@@ -99,9 +99,19 @@ static EXTENSIONS: std::sync::OnceLock<&'static [EngineDef]> = std::sync::OnceLo
 
 /// Registers engines outside this crate, once per process and before the first machine
 /// configuration is read (a program's `main`, a test's first line): they join the machine
-/// after the [`STANDARD`] engines, in the order given. Registering the same engines again is
-/// allowed; others are refused.
+/// after the [`STANDARD`] engines, in the order given. A name or configuration key that is
+/// taken is refused; registering the same engines again is allowed, others are refused.
 pub fn register_extension(engines: &'static [EngineDef]) -> Result<(), SetupError> {
+    for (i, engine) in engines.iter().enumerate() {
+        let before = || STANDARD.iter().chain(&engines[..i]);
+        if before().any(|e| e.name == engine.name) {
+            return Err(format!("engine {}: the name is taken", engine.name).into());
+        }
+        let taken = |key: &&&str| before().any(|e| e.sections.contains(*key));
+        if let Some(key) = engine.sections.iter().find(taken) {
+            return Err(format!("engine {}: the key `{key}` is taken", engine.name).into());
+        }
+    }
     let set = EXTENSIONS.get_or_init(|| engines);
     if core::ptr::eq(*set, engines) {
         Ok(())
@@ -216,7 +226,36 @@ mod tests {
             single_axes: 1,
             cycle_s: 0.001,
         };
-        // A single axis: the cams and the saw; no gear, no FIFO group.
-        assert_eq!(standard(&setup, &configs).unwrap().len(), 2);
+        // A single axis: the cams and the saw; no gear and no FIFO group without their keys.
+        let names: Vec<&str> = standard(&setup, &configs)
+            .unwrap()
+            .iter()
+            .map(|e| e.name())
+            .collect();
+        assert!(
+            names.contains(&"cam") && names.contains(&"flying saw"),
+            "{names:?}"
+        );
+        assert!(
+            !names.contains(&"gear") && !names.contains(&"fifo"),
+            "{names:?}"
+        );
+    }
+
+    #[test]
+    fn an_extension_may_not_take_a_name_or_a_key() {
+        static NAME: &[EngineDef] = &[EngineDef {
+            name: "saw",
+            ..crate::saw::machine::ENGINE
+        }];
+        let e = register_extension(NAME).unwrap_err().to_string();
+        assert_eq!(e, "engine saw: the name is taken");
+        static KEY: &[EngineDef] = &[EngineDef {
+            name: "mine",
+            sections: &["gear"],
+            ..crate::saw::machine::ENGINE
+        }];
+        let e = register_extension(KEY).unwrap_err().to_string();
+        assert_eq!(e, "engine mine: the key `gear` is taken");
     }
 }

@@ -10,7 +10,7 @@
 //! * [`engine`]: the engine on the machine seam, its `[phase_gear]` configuration and its
 //!   `EngineDef`;
 //! * [`block`]: the PLC blocks `PhaseGearIn` and `PhaseGearOut` on the block kernel, with
-//!   their inputs declared for timelines (and the ST binding).
+//!   their inputs declared as `InputSpec`s (what a timeline checks a call against).
 //!
 //! A program that runs it registers it once, before it reads a configuration: the one line
 //! [`register`] (the standard `cnc` and `plc` binaries do not know it).

@@ -106,3 +106,21 @@ fn registration_is_once_and_refuses_a_taken_number() {
     let e = hli::calls::register_extension(TAKEN).unwrap_err();
     assert!(e.to_string().contains("MINE = 11"), "{e}");
 }
+
+/// The template's own binary runs the scenario as two processes (the PLC it spawns is the same
+/// binary, registered the same way): the slave ends at 3 + 0.5 x 200 + 5 = 108 mm (the trace
+/// holds the image's 0.1 um), and the report names the blocks.
+#[test]
+fn its_binary_runs_the_phase_gear_in_two_processes() {
+    let scenario = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenario/scenario.toml");
+    let (report, trace) = tests::cli::cnc_run_lockstep(
+        env!("CARGO_BIN_EXE_cnc-phase-gear"),
+        &scenario,
+        "phase-gear",
+    );
+    assert!(report.contains("PhaseGearIn"), "{report}");
+    let text = String::from_utf8(trace).unwrap();
+    let last = text.lines().last().unwrap();
+    let slave: i64 = last.split(',').nth(3).unwrap().parse().unwrap();
+    assert_eq!(slave, 1_080_000, "{last}");
+}

@@ -7,8 +7,8 @@
 //! closed pipe ([`stdio`]).
 //!
 //! Each is a thin, safe wrapper around one or two system calls. The crate is, beside
-//! `hli::raw` (the shared image memory), the only place of the workspace where `unsafe` code
-//! may live: the root denies it and each module that makes a system call allows it for itself,
+//! `hli::raw` (the image memory) and `hli_transport::raw` (a mapped object taken over as an
+//! image), the only place of the workspace where `unsafe` code may live: the root denies it and each module that makes a system call allows it for itself,
 //! with a `// SAFETY:` comment on every block. Everything else in the workspace forbids it.
 
 #![deny(unsafe_code)]

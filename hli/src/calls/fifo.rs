@@ -2,7 +2,7 @@
 //! service (`FiFoGetDimension`, `FiFoGroupIntegrate`, `FiFoGroupDisintegrate`, `FiFoStart`,
 //! `FiFoStop`, `FiFoSetChannelOverride`, and the parameters a PLC may set), and the row
 //! blocks of `FiFoWrite`/`FiFoOverwrite`, which travel in the bulk slots of the call mailbox
-//! (`crate::rpc::mailbox`): a header plus up to 8192 `f64` the PLC writes in place into shared
+//! (`hli_transport::rpc::mailbox`): a header plus up to 8192 `f64` the PLC writes in place into shared
 //! memory, answered with the same [`FifoReply`].
 //!
 //! Every call addresses its group by index (`target`, 0-based, `gpFifo[target]^`); axes are

@@ -366,7 +366,7 @@ pub enum CallError {
     /// No answer within the timeout.
     #[error("no response within {0:?}")]
     Timeout(Duration),
-    /// The transport (the call mailbox, `crate::rpc::mailbox`) failed: opening it, or a loan
+    /// The transport (the call mailbox, `hli_transport::rpc::mailbox`) failed: opening it, or a loan
     /// taken away.
     #[error("call mailbox: {0}")]
     Transport(String),
@@ -468,24 +468,20 @@ mod tests {
 
     #[test]
     fn the_reads_a_stopped_machine_answers() {
-        let reads: Vec<&str> = FAMILIES
-            .iter()
-            .flat_map(|f| f.iter())
-            .filter(|s| s.kind.is_read_only())
-            .map(|s| s.name)
-            .collect();
-        assert_eq!(
-            reads,
-            [
-                "READ_AXIS_STATE",
-                "CAM_POINTS_READ",
-                "CAM_READ",
-                "FIFO_DIMENSION",
-                "SAW_CHARAC",
-                "DYN_CS_HISTORY_READ",
-                "DYN_CS_LOG_READ"
-            ]
-        );
+        // The released kinds a stopped machine answers; every other released kind changes
+        // something and stays refused by a stopped machine. A new kind is its declaration.
+        const READS: [CallKind; 7] = [
+            CallKind::READ_AXIS_STATE,
+            CallKind::CAM_POINTS_READ,
+            CallKind::CAM_READ,
+            CallKind::FIFO_DIMENSION,
+            CallKind::SAW_CHARAC,
+            CallKind::DYN_CS_HISTORY_READ,
+            CallKind::DYN_CS_LOG_READ,
+        ];
+        for &(kind, _) in WIRE {
+            assert_eq!(kind.is_read_only(), READS.contains(&kind), "{kind:?}");
+        }
     }
 
     #[test]

@@ -78,7 +78,8 @@ macro_rules! timeline_timeout {
 /// of `$target` it sets (a path below it). Gives the list `$list` (an `[InputSpec; N]` for a
 /// `TIMELINE` entry, or part of one through `joined`) and `$set(target, key, value)`, which
 /// sets the field of `key` and leaves the others. `required` before a key: every call gives
-/// it. This is the one way a block declares its inputs.
+/// it. It writes the `InputSpec` list every block declares its inputs with (a family may write
+/// that list with `input`/`required` and its `set` by hand instead).
 macro_rules! inputs {
     (
         $(#[doc = $doc:literal])*

@@ -80,8 +80,8 @@ pub enum Target {
     Channel,
 }
 
-/// The keys of a call every block takes (checked by [`super::instances`], not by a family's
-/// whole-table parser): `timeout_cycles` is the seed's tTimeout, in PLC cycles, of a block
+/// The keys of a call every block takes (checked by [`super::instances`], beside the block's
+/// declared inputs): `timeout_cycles` is the seed's tTimeout, in PLC cycles, of a block
 /// that has it ([`TimelineBlock::timeout_cycles`]); `axis_id` addresses the block's axis by
 /// its NC axis ID instead of `axis`, and `master_id` its master ([`TimelineBlock::set_master`]).
 pub const CALL_KEYS: [&str; 7] = [
