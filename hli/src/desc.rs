@@ -188,7 +188,9 @@ macro_rules! scalar_types {
                 TypeDesc { size: core::mem::size_of::<$t>(), align: core::mem::align_of::<$t>(),
                            kind: Kind::Scalar(Scalar::$s) }
             }
+            #[inline]
             fn load(place: Place<'_, Self>) -> Self { AtomicLeaf::load_at(place, core::sync::atomic::Ordering::Relaxed) }
+            #[inline]
             fn store(place: Place<'_, Self>, value: &Self) {
                 AtomicLeaf::store_at(place, *value, core::sync::atomic::Ordering::Relaxed)
             }
@@ -210,9 +212,11 @@ impl HliType for u8 {
             kind: Kind::Scalar(Scalar::Usint),
         }
     }
+    #[inline]
     fn load(place: Place<'_, Self>) -> Self {
         place.load()
     }
+    #[inline]
     fn store(place: Place<'_, Self>, value: &Self) {
         place.store(*value)
     }
@@ -263,9 +267,11 @@ impl HliType for Bool {
             kind: Kind::Scalar(Scalar::Bool),
         }
     }
+    #[inline]
     fn load(place: Place<'_, Self>) -> Self {
         Bool(place.cast::<u8>().load())
     }
+    #[inline]
     fn store(place: Place<'_, Self>, value: &Self) {
         place.cast::<u8>().store(value.0)
     }
@@ -285,9 +291,11 @@ where
             },
         }
     }
+    #[inline]
     fn load(place: Place<'_, Self>) -> Self {
         core::array::from_fn(|i| T::load(place.at(i)))
     }
+    #[inline]
     fn store(place: Place<'_, Self>, value: &Self) {
         for (i, v) in value.iter().enumerate() {
             T::store(place.at(i), v);
@@ -304,9 +312,11 @@ pub trait PlaceExt<T> {
 }
 
 impl<T: HliType> PlaceExt<T> for Place<'_, T> {
+    #[inline]
     fn read(self) -> T {
         T::load(self)
     }
+    #[inline]
     fn write(self, value: &T) {
         T::store(self, value)
     }
@@ -362,10 +372,12 @@ macro_rules! hli_struct {
                     kind: $crate::desc::Kind::Struct { name: $st, fields: FIELDS },
                 }
             }
+            #[inline]
             fn load(place: $crate::raw::Place<'_, Self>) -> Self {
                 Self { $( $field: <$fty as $crate::desc::HliType>::load(
                     place.field(core::mem::offset_of!($name, $field))), )* }
             }
+            #[inline]
             fn store(place: $crate::raw::Place<'_, Self>, value: &Self) {
                 $( <$fty as $crate::desc::HliType>::store(
                     place.field(core::mem::offset_of!($name, $field)), &value.$field); )*

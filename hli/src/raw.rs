@@ -238,6 +238,7 @@ macro_rules! leaf_via_atomic {
     ($($t:ty => $atomic:ty),* $(,)?) => {$(
         impl sealed::Sealed for $t {}
         impl AtomicLeaf for $t {
+            #[inline]
             fn load_at(place: Place<'_, Self>, order: Ordering) -> Self {
                 // SAFETY: the place is in bounds and aligned for `$t` (checked on derivation),
                 // `$atomic` has the same size and alignment as `$t`, and the memory is only ever
@@ -245,6 +246,7 @@ macro_rules! leaf_via_atomic {
                 let atomic = unsafe { <$atomic>::from_ptr(place.address().cast()) };
                 atomic.load(order)
             }
+            #[inline]
             fn store_at(place: Place<'_, Self>, value: Self, order: Ordering) {
                 // SAFETY: as in `load_at`.
                 let atomic = unsafe { <$atomic>::from_ptr(place.address().cast()) };
@@ -263,9 +265,11 @@ macro_rules! float_leaf {
     ($($t:ty => $bits:ty),* $(,)?) => {$(
         impl sealed::Sealed for $t {}
         impl AtomicLeaf for $t {
+            #[inline]
             fn load_at(place: Place<'_, Self>, order: Ordering) -> Self {
                 <$t>::from_bits(<$bits as AtomicLeaf>::load_at(place.cast(), order))
             }
+            #[inline]
             fn store_at(place: Place<'_, Self>, value: Self, order: Ordering) {
                 <$bits as AtomicLeaf>::store_at(place.cast(), value.to_bits(), order)
             }
@@ -297,6 +301,7 @@ impl<T: AtomicLeaf> Place<'_, T> {
 impl<'m> Place<'m, u32> {
     /// The word as an atomic for as long as the image lives: a futex word that both
     /// processes wait on and wake.
+    #[inline]
     pub fn atomic(self) -> &'m AtomicU32 {
         // SAFETY: as in `AtomicLeaf::load_at` for u32; the mapping outlives `'m`.
         unsafe { AtomicU32::from_ptr(self.address().cast()) }
@@ -305,6 +310,7 @@ impl<'m> Place<'m, u32> {
 
 impl Place<'_, u64> {
     /// Atomic increment (heartbeats); returns the new value.
+    #[inline]
     pub fn increment(self) -> u64 {
         // SAFETY: as in `AtomicLeaf::load_at` for u64.
         let atomic = unsafe { AtomicU64::from_ptr(self.address().cast()) };
