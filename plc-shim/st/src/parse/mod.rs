@@ -1,0 +1,453 @@
+//! The parser: tokens into a [`Unit`] by recursive descent. Declarations are here, statements
+//! and expressions in [`stmt`]. The first error stops it, with its line and column; a word
+//! the language reserves is refused as a name.
+
+use crate::ast::{
+    Init, Item, Name, Pou, PouKind, Section, TypeDecl, TypeDef, TypeRef, Unit, VarBlock, VarDecl,
+};
+use crate::diag::{Diagnostic, Pos};
+use crate::lex::{lex, Tok, Token};
+
+mod stmt;
+
+/// The words a name may not be (ASCII case ignored).
+const RESERVED: &[&str] = &[
+    "PROGRAM",
+    "END_PROGRAM",
+    "FUNCTION_BLOCK",
+    "END_FUNCTION_BLOCK",
+    "FUNCTION",
+    "END_FUNCTION",
+    "VAR",
+    "VAR_INPUT",
+    "VAR_OUTPUT",
+    "VAR_IN_OUT",
+    "VAR_GLOBAL",
+    "VAR_TEMP",
+    "VAR_EXTERNAL",
+    "END_VAR",
+    "CONSTANT",
+    "RETAIN",
+    "PERSISTENT",
+    "TYPE",
+    "END_TYPE",
+    "STRUCT",
+    "END_STRUCT",
+    "ARRAY",
+    "OF",
+    "POINTER",
+    "REFERENCE",
+    "TO",
+    "IF",
+    "THEN",
+    "ELSIF",
+    "ELSE",
+    "END_IF",
+    "CASE",
+    "END_CASE",
+    "FOR",
+    "BY",
+    "DO",
+    "END_FOR",
+    "WHILE",
+    "END_WHILE",
+    "REPEAT",
+    "UNTIL",
+    "END_REPEAT",
+    "EXIT",
+    "CONTINUE",
+    "RETURN",
+    "AND",
+    "OR",
+    "XOR",
+    "NOT",
+    "MOD",
+    "TRUE",
+    "FALSE",
+    "AT",
+];
+
+/// Parses one file's text; `Err` is the first refusal, with its place.
+pub fn parse(text: &str) -> Result<Unit, Diagnostic> {
+    let tokens = lex(text)?;
+    let mut p = Parser {
+        tokens,
+        at: 0,
+        depth: 0,
+    };
+    let mut unit = Unit::default();
+    while !p.at_eof() {
+        unit.items.push(p.item()?);
+    }
+    Ok(unit)
+}
+
+struct Parser {
+    tokens: Vec<Token>,
+    at: usize,
+    /// How deep the expressions and statements being read are nested.
+    depth: usize,
+}
+
+impl Parser {
+    fn peek(&self) -> &Tok {
+        &self.tokens[self.at].kind
+    }
+
+    fn peek_at(&self, ahead: usize) -> &Tok {
+        let i = (self.at + ahead).min(self.tokens.len() - 1);
+        &self.tokens[i].kind
+    }
+
+    fn pos(&self) -> Pos {
+        self.tokens[self.at].pos
+    }
+
+    fn at_eof(&self) -> bool {
+        matches!(self.peek(), Tok::Eof)
+    }
+
+    fn bump(&mut self) -> Token {
+        let t = self.tokens[self.at].clone();
+        if self.at + 1 < self.tokens.len() {
+            self.at += 1;
+        }
+        t
+    }
+
+    fn error(&self, message: impl Into<String>) -> Diagnostic {
+        Diagnostic::new(self.pos(), message)
+    }
+
+    /// What the current token is, for an error.
+    fn found(&self) -> String {
+        match self.peek() {
+            Tok::Ident(s) => format!("`{s}`"),
+            Tok::Eof => "the end of the file".into(),
+            other => format!("{other:?}"),
+        }
+    }
+
+    /// Whether the current token is keyword `kw`.
+    fn is_kw(&self, kw: &str) -> bool {
+        matches!(self.peek(), Tok::Ident(s) if s.eq_ignore_ascii_case(kw))
+    }
+
+    /// Takes keyword `kw` if it is next.
+    fn eat_kw(&mut self, kw: &str) -> bool {
+        let is = self.is_kw(kw);
+        if is {
+            self.bump();
+        }
+        is
+    }
+
+    fn expect_kw(&mut self, kw: &str) -> Result<(), Diagnostic> {
+        if self.eat_kw(kw) {
+            Ok(())
+        } else {
+            Err(self.error(format!("expected `{kw}`, found {}", self.found())))
+        }
+    }
+
+    fn eat(&mut self, tok: &Tok) -> bool {
+        let is = self.peek() == tok;
+        if is {
+            self.bump();
+        }
+        is
+    }
+
+    fn expect(&mut self, tok: &Tok, what: &str) -> Result<(), Diagnostic> {
+        if self.eat(tok) {
+            Ok(())
+        } else {
+            Err(self.error(format!("expected {what}, found {}", self.found())))
+        }
+    }
+
+    /// A name that is not a reserved word.
+    fn name(&mut self) -> Result<Name, Diagnostic> {
+        let pos = self.pos();
+        match self.peek().clone() {
+            Tok::Ident(text) if !RESERVED.iter().any(|r| r.eq_ignore_ascii_case(&text)) => {
+                self.bump();
+                Ok(Name { text, pos })
+            }
+            Tok::Ident(text) => Err(self.error(format!("`{text}` is reserved, not a name"))),
+            _ => Err(self.error(format!("expected a name, found {}", self.found()))),
+        }
+    }
+
+    fn item(&mut self) -> Result<Item, Diagnostic> {
+        if self.eat_kw("PROGRAM") {
+            return self.pou(PouKind::Program, "END_PROGRAM").map(Item::Pou);
+        }
+        if self.eat_kw("FUNCTION_BLOCK") {
+            return self
+                .pou(PouKind::FunctionBlock, "END_FUNCTION_BLOCK")
+                .map(Item::Pou);
+        }
+        if self.eat_kw("FUNCTION") {
+            return self.pou(PouKind::Function, "END_FUNCTION").map(Item::Pou);
+        }
+        if self.eat_kw("TYPE") {
+            return self.types().map(Item::Types);
+        }
+        if self.is_kw("VAR_GLOBAL") {
+            return self.var_block().map(Item::Globals);
+        }
+        Err(self.error(format!(
+            "expected PROGRAM, FUNCTION_BLOCK, FUNCTION, TYPE or VAR_GLOBAL, found {}",
+            self.found()
+        )))
+    }
+
+    fn pou(&mut self, kind: PouKind, end: &str) -> Result<Pou, Diagnostic> {
+        let name = self.name()?;
+        let returns = match kind {
+            PouKind::Function => {
+                self.expect(&Tok::Colon, "`:` and the function's return type")?;
+                Some(self.type_ref()?)
+            }
+            _ => None,
+        };
+        let mut vars = Vec::new();
+        while self.is_var_section() {
+            vars.push(self.var_block()?);
+        }
+        let body = self.statements(&[end])?;
+        self.expect_kw(end)?;
+        Ok(Pou {
+            kind,
+            name,
+            returns,
+            vars,
+            body,
+        })
+    }
+
+    fn is_var_section(&self) -> bool {
+        const SECTIONS: [&str; 7] = [
+            "VAR",
+            "VAR_INPUT",
+            "VAR_OUTPUT",
+            "VAR_IN_OUT",
+            "VAR_GLOBAL",
+            "VAR_TEMP",
+            "VAR_EXTERNAL",
+        ];
+        SECTIONS.iter().any(|s| self.is_kw(s))
+    }
+
+    fn var_block(&mut self) -> Result<VarBlock, Diagnostic> {
+        let pos = self.pos();
+        let Tok::Ident(word) = self.bump().kind else {
+            return Err(Diagnostic::new(pos, "expected a VAR section"));
+        };
+        let section = match word.to_ascii_uppercase().as_str() {
+            "VAR" => Section::Var,
+            "VAR_INPUT" => Section::Input,
+            "VAR_OUTPUT" => Section::Output,
+            "VAR_IN_OUT" => Section::InOut,
+            "VAR_GLOBAL" => Section::Global,
+            "VAR_TEMP" => Section::Temp,
+            _ => Section::External,
+        };
+        let (mut constant, mut retain) = (false, false);
+        loop {
+            if self.eat_kw("CONSTANT") {
+                constant = true;
+            } else if self.eat_kw("RETAIN") || self.eat_kw("PERSISTENT") {
+                retain = true;
+            } else {
+                break;
+            }
+        }
+        let mut vars = Vec::new();
+        while !self.eat_kw("END_VAR") {
+            if self.at_eof() {
+                return Err(Diagnostic::new(pos, "a VAR section without its END_VAR"));
+            }
+            vars.push(self.var_decl()?);
+        }
+        Ok(VarBlock {
+            section,
+            constant,
+            retain,
+            vars,
+            pos,
+        })
+    }
+
+    /// `a, b : TYPE := init;` (a location `AT %..` is refused by name).
+    fn var_decl(&mut self) -> Result<VarDecl, Diagnostic> {
+        let mut names = vec![self.name()?];
+        while self.eat(&Tok::Comma) {
+            names.push(self.name()?);
+        }
+        if self.is_kw("AT") {
+            return Err(self.error(
+                "`AT %..` locations are not supported: the image is reached through gpCh/gpAx",
+            ));
+        }
+        self.expect(&Tok::Colon, "`:` and a type")?;
+        let ty = self.type_ref()?;
+        let init = if self.eat(&Tok::Assign) {
+            Some(self.init()?)
+        } else {
+            None
+        };
+        self.expect(&Tok::Semi, "`;`")?;
+        Ok(VarDecl { names, ty, init })
+    }
+
+    fn type_ref(&mut self) -> Result<TypeRef, Diagnostic> {
+        let pos = self.pos();
+        if self.eat_kw("ARRAY") {
+            self.expect(&Tok::LBracket, "`[` and the array's bounds")?;
+            let mut ranges = Vec::new();
+            loop {
+                let lo = self.expr()?;
+                self.expect(&Tok::Range, "`..` between the bounds")?;
+                let hi = self.expr()?;
+                ranges.push((lo, hi));
+                if !self.eat(&Tok::Comma) {
+                    break;
+                }
+            }
+            self.expect(&Tok::RBracket, "`]`")?;
+            self.expect_kw("OF")?;
+            let element = Box::new(self.type_ref()?);
+            return Ok(TypeRef::Array {
+                ranges,
+                element,
+                pos,
+            });
+        }
+        if self.eat_kw("POINTER") {
+            self.expect_kw("TO")?;
+            return Ok(TypeRef::Pointer(Box::new(self.type_ref()?), pos));
+        }
+        if self.eat_kw("REFERENCE") {
+            self.expect_kw("TO")?;
+            return Ok(TypeRef::Reference(Box::new(self.type_ref()?), pos));
+        }
+        let wide = self.is_kw("WSTRING");
+        if wide || self.is_kw("STRING") {
+            self.bump();
+            let len = if self.eat(&Tok::LParen) || self.eat(&Tok::LBracket) {
+                let n = self.expr()?;
+                if !self.eat(&Tok::RParen) {
+                    self.expect(&Tok::RBracket, "`)` after the string's length")?;
+                }
+                Some(Box::new(n))
+            } else {
+                None
+            };
+            return Ok(TypeRef::String { len, wide, pos });
+        }
+        Ok(TypeRef::Named(self.name()?))
+    }
+
+    /// An initial value: an expression, `[..]` for an array, `(a := .., ..)` for a struct.
+    fn init(&mut self) -> Result<Init, Diagnostic> {
+        if self.eat(&Tok::LBracket) {
+            let mut items = Vec::new();
+            loop {
+                // `n(value)` repeats value n times.
+                let repeat = matches!(self.peek(), Tok::Int(_)) && *self.peek_at(1) == Tok::LParen;
+                if repeat {
+                    let count = self.expr_primary_literal()?;
+                    self.expect(&Tok::LParen, "`(`")?;
+                    let value = self.init()?;
+                    self.expect(&Tok::RParen, "`)`")?;
+                    items.push((Some(count), value));
+                } else {
+                    items.push((None, self.init()?));
+                }
+                if !self.eat(&Tok::Comma) {
+                    break;
+                }
+            }
+            self.expect(&Tok::RBracket, "`]` after the array's values")?;
+            return Ok(Init::Array(items));
+        }
+        let is_struct = *self.peek() == Tok::LParen
+            && matches!(self.peek_at(1), Tok::Ident(_))
+            && *self.peek_at(2) == Tok::Assign;
+        if is_struct {
+            self.bump();
+            let mut fields = Vec::new();
+            loop {
+                let name = self.name()?;
+                self.expect(&Tok::Assign, "`:=`")?;
+                fields.push((name, self.init()?));
+                if !self.eat(&Tok::Comma) {
+                    break;
+                }
+            }
+            self.expect(&Tok::RParen, "`)` after the structure's values")?;
+            return Ok(Init::Struct(fields));
+        }
+        Ok(Init::Expr(self.expr()?))
+    }
+
+    /// `TYPE name : definition; .. END_TYPE`.
+    fn types(&mut self) -> Result<Vec<TypeDecl>, Diagnostic> {
+        let mut decls = Vec::new();
+        while !self.eat_kw("END_TYPE") {
+            if self.at_eof() {
+                return Err(self.error("a TYPE block without its END_TYPE"));
+            }
+            let name = self.name()?;
+            self.expect(&Tok::Colon, "`:` and the type's definition")?;
+            let def = self.type_def()?;
+            // END_STRUCT may be followed by `;`.
+            self.eat(&Tok::Semi);
+            decls.push(TypeDecl { name, def });
+        }
+        Ok(decls)
+    }
+
+    fn type_def(&mut self) -> Result<TypeDef, Diagnostic> {
+        if self.eat_kw("STRUCT") {
+            let mut fields = Vec::new();
+            while !self.eat_kw("END_STRUCT") {
+                if self.at_eof() {
+                    return Err(self.error("a STRUCT without its END_STRUCT"));
+                }
+                fields.push(self.var_decl()?);
+            }
+            return Ok(TypeDef::Struct(fields));
+        }
+        if self.eat(&Tok::LParen) {
+            let mut values = Vec::new();
+            loop {
+                let name = self.name()?;
+                let value = if self.eat(&Tok::Assign) {
+                    Some(self.expr()?)
+                } else {
+                    None
+                };
+                values.push((name, value));
+                if !self.eat(&Tok::Comma) {
+                    break;
+                }
+            }
+            self.expect(&Tok::RParen, "`)` after the enumeration's values")?;
+            let base = match self.peek() {
+                Tok::Ident(_) => Some(self.type_ref()?),
+                _ => None,
+            };
+            return Ok(TypeDef::Enum { values, base });
+        }
+        let ty = self.type_ref()?;
+        let init = if self.eat(&Tok::Assign) {
+            Some(self.init()?)
+        } else {
+            None
+        };
+        Ok(TypeDef::Alias(ty, init))
+    }
+}
