@@ -11,9 +11,11 @@
 #![forbid(unsafe_code)]
 
 pub mod ast;
+pub mod check;
 pub mod diag;
 pub mod lex;
 pub mod parse;
+pub mod types;
 
 pub use diag::{Diagnostic, Pos};
 pub use parse::parse;

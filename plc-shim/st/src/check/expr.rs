@@ -1,0 +1,442 @@
+//! The types of expressions. Untyped integer and real literals take the type their place
+//! wants when they fit it (`x : INT; x := 5;`); every other mix of types must widen
+//! ([`Elem::widens_to`]) or go through a conversion function.
+
+use super::std_lib;
+use super::{Checker, Type};
+use crate::ast::{Arg, BinOp, Expr, Name, PouKind, Section, UnOp};
+use crate::diag::Pos;
+use crate::types::{conversion, Class, Elem};
+
+/// Where an expression is checked: the POU and how many loops enclose it.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Ctx {
+    pub(super) pou: usize,
+    pub(super) loops: u32,
+}
+
+/// What a name means in a POU.
+pub(super) enum Meaning {
+    /// A variable of the POU (index into its vars).
+    Local(usize),
+    /// A global variable.
+    Global(usize),
+    /// A function's own name inside it: its return value.
+    Return(Type),
+    /// A value of an enumeration.
+    EnumValue(usize),
+    /// A function.
+    Function(usize),
+    /// A type (an enumeration's name before `.value`).
+    EnumType(usize),
+}
+
+const BOOL: Type = Type::Elem(Elem::Bool);
+
+/// An untyped integer literal's value (`5`, `-5`).
+pub(super) fn literal(e: &Expr) -> Option<i128> {
+    match e {
+        Expr::Int(v, _) => Some(*v),
+        Expr::Unary(UnOp::Neg, inner, _) => literal(inner).map(|v| -v),
+        _ => None,
+    }
+}
+
+impl Checker {
+    pub(super) fn meaning(&self, name: &str, ctx: Ctx) -> Option<Meaning> {
+        let pou = &self.out.pous[ctx.pou];
+        if let Some(i) = pou
+            .vars
+            .iter()
+            .position(|v| v.name.eq_ignore_ascii_case(name))
+        {
+            return Some(Meaning::Local(i));
+        }
+        if pou.kind == PouKind::Function && pou.name.eq_ignore_ascii_case(name) {
+            return pou.returns.clone().map(Meaning::Return);
+        }
+        let upper = name.to_ascii_uppercase();
+        if let Some(i) = self.globals.get(&upper) {
+            return Some(Meaning::Global(*i));
+        }
+        match self.names.get(&upper) {
+            Some(super::Named::Pou(i)) if self.out.pous[*i].kind == PouKind::Function => {
+                return Some(Meaning::Function(*i))
+            }
+            Some(super::Named::Enum(i)) => return Some(Meaning::EnumType(*i)),
+            _ => {}
+        }
+        // A bare enumeration value, if exactly one enumeration has it.
+        let mut found = self
+            .out
+            .enums
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.values.iter().any(|(v, _)| v.eq_ignore_ascii_case(name)));
+        match (found.next(), found.next()) {
+            (Some((i, _)), None) => Some(Meaning::EnumValue(i)),
+            _ => None,
+        }
+    }
+
+    /// The type of `e`; a refusal is reported once and gives [`Type::Error`].
+    pub(super) fn expr(&mut self, e: &Expr, ctx: Ctx) -> Type {
+        match e {
+            Expr::Int(v, pos) => match Elem::of_literal(*v) {
+                Some(t) => Type::Elem(t),
+                None => self.error(*pos, format!("{v} fits no integer type")),
+            },
+            Expr::Real(..) => Type::Elem(Elem::LReal),
+            Expr::Bool(..) => BOOL,
+            Expr::Time(..) => Type::Elem(Elem::Time),
+            Expr::Str(s, pos) => match u32::try_from(s.chars().count()) {
+                Ok(n) if n <= 255 => Type::Str(n.max(1)),
+                _ => self.error(*pos, "a string literal of more than 255 characters"),
+            },
+            Expr::Typed { ty, value } => self.typed_literal(ty, value),
+            Expr::Name(n) => self.name_type(n, ctx),
+            Expr::Field(base, field) => self.field(base, field, ctx),
+            Expr::Index(base, index, pos) => self.index(base, index, *pos, ctx),
+            Expr::Deref(base, pos) => match self.expr(base, ctx) {
+                Type::Pointer(t) => *t,
+                Type::Error => Type::Error,
+                _ => self.error(*pos, "`^` follows a POINTER"),
+            },
+            Expr::Call { callee, args, pos } => self.call_value(callee, args, *pos, ctx),
+            Expr::Unary(op, inner, pos) => self.unary(*op, inner, *pos, ctx),
+            Expr::Binary(op, l, r, pos) => self.binary(*op, l, r, *pos, ctx),
+        }
+    }
+
+    pub(super) fn error(&mut self, pos: Pos, message: impl Into<String>) -> Type {
+        self.refuse(pos, message);
+        Type::Error
+    }
+
+    fn name_type(&mut self, n: &Name, ctx: Ctx) -> Type {
+        match self.meaning(&n.text, ctx) {
+            Some(Meaning::Local(i)) => self.out.pous[ctx.pou].vars[i].ty.clone(),
+            Some(Meaning::Global(i)) => self.out.globals[i].ty.clone(),
+            Some(Meaning::Return(t)) => t,
+            Some(Meaning::EnumValue(i)) => Type::Enum(i),
+            Some(Meaning::Function(_)) => self.error(
+                n.pos,
+                format!("function `{}` is called: `{}(..)`", n.text, n.text),
+            ),
+            Some(Meaning::EnumType(_)) => self.error(
+                n.pos,
+                format!("`{}` is a type: name one of its values", n.text),
+            ),
+            None => self.error(n.pos, format!("unknown name `{}`", n.text)),
+        }
+    }
+
+    /// `DINT#-5`, `BOOL#TRUE`, `REAL#1.5`, `E_Mode#Run`.
+    fn typed_literal(&mut self, ty: &Name, value: &Expr) -> Type {
+        if let Some(e) = Elem::named(&ty.text) {
+            return match (e.class(), value) {
+                (Class::Float, Expr::Int(..) | Expr::Real(..)) => Type::Elem(e),
+                (Class::Bool, Expr::Bool(..)) => Type::Elem(e),
+                (Class::Bool, Expr::Int(v, _)) if *v == 0 || *v == 1 => Type::Elem(e),
+                (_, Expr::Int(v, pos)) if e.is_integer() => match e.range() {
+                    Some((lo, hi)) if (lo..=hi).contains(v) => Type::Elem(e),
+                    _ => self.error(*pos, format!("{v} does not fit {}", e.name())),
+                },
+                _ => self.error(ty.pos, format!("not a literal of {}", e.name())),
+            };
+        }
+        let Some(super::Named::Enum(i)) = self.names.get(&ty.text.to_ascii_uppercase()).cloned()
+        else {
+            return self.error(
+                ty.pos,
+                format!("unknown type `{}` of a typed literal", ty.text),
+            );
+        };
+        match value {
+            Expr::Name(v) if self.enum_has(i, &v.text) => Type::Enum(i),
+            _ => {
+                let name = self.out.enums[i].name.clone();
+                self.error(ty.pos, format!("not a value of {name}"))
+            }
+        }
+    }
+
+    fn enum_has(&self, i: usize, value: &str) -> bool {
+        self.out.enums[i]
+            .values
+            .iter()
+            .any(|(v, _)| v.eq_ignore_ascii_case(value))
+    }
+
+    fn field(&mut self, base: &Expr, field: &Name, ctx: Ctx) -> Type {
+        if let Expr::Name(n) = base {
+            if let Some(Meaning::EnumType(i)) = self.meaning(&n.text, ctx) {
+                if self.enum_has(i, &field.text) {
+                    return Type::Enum(i);
+                }
+                let name = self.out.enums[i].name.clone();
+                return self.error(field.pos, format!("{name} has no value `{}`", field.text));
+            }
+        }
+        match self.expr(base, ctx) {
+            Type::Struct(i) => {
+                let found = self.out.structs[i]
+                    .fields
+                    .iter()
+                    .find(|(f, _)| f.eq_ignore_ascii_case(&field.text));
+                match found {
+                    Some((_, t)) => t.clone(),
+                    None => {
+                        let name = self.out.structs[i].name.clone();
+                        self.error(field.pos, format!("{name} has no field `{}`", field.text))
+                    }
+                }
+            }
+            Type::Fb(i) => self.fb_member(i, field),
+            Type::StdFb(fb) => match fb.member(&field.text) {
+                Some((_, t, _)) => Type::Elem(t),
+                None => self.error(field.pos, format!("{fb:?} has no member `{}`", field.text)),
+            },
+            Type::Elem(e) if e.is_integer() && field.text.parse::<u32>().is_ok() => {
+                let bit: u32 = field.text.parse().unwrap_or(u32::MAX);
+                if bit < 8 * e.size() as u32 {
+                    BOOL
+                } else {
+                    self.error(field.pos, format!("bit {bit} of a {}", e.name()))
+                }
+            }
+            Type::Pointer(_) => {
+                self.error(field.pos, "a POINTER's fields are reached through `^.`")
+            }
+            Type::Error => Type::Error,
+            _ => self.error(
+                field.pos,
+                format!("`.{}` of a value without fields", field.text),
+            ),
+        }
+    }
+
+    /// An input or output of an instance of function block `i`, read from outside.
+    fn fb_member(&mut self, i: usize, field: &Name) -> Type {
+        let pou = &self.out.pous[i];
+        let var = pou
+            .vars
+            .iter()
+            .find(|v| v.name.eq_ignore_ascii_case(&field.text));
+        match var {
+            Some(v) if matches!(v.section, Section::Input | Section::Output) => v.ty.clone(),
+            Some(_) => {
+                let name = pou.name.clone();
+                self.error(
+                    field.pos,
+                    format!(
+                        "`{}` is internal to {name}: only its inputs and outputs are reached",
+                        field.text
+                    ),
+                )
+            }
+            None => {
+                let name = pou.name.clone();
+                self.error(
+                    field.pos,
+                    format!("{name} has no input or output `{}`", field.text),
+                )
+            }
+        }
+    }
+
+    fn index(&mut self, base: &Expr, index: &[Expr], pos: Pos, ctx: Ctx) -> Type {
+        let base = self.expr(base, ctx);
+        for i in index {
+            match self.expr(i, ctx) {
+                Type::Elem(e) if e.is_integer() => {}
+                Type::Error => {}
+                _ => {
+                    self.refuse(i.pos(), "an index is an integer");
+                }
+            }
+        }
+        match base {
+            Type::Array(dims, element) if dims.len() == index.len() => {
+                for ((lo, hi), i) in dims.iter().zip(index) {
+                    if let Some(v) = literal(i).filter(|v| !(*lo as i128..=*hi as i128).contains(v))
+                    {
+                        self.refuse(i.pos(), format!("index {v} outside [{lo}..{hi}]"));
+                    }
+                }
+                *element
+            }
+            Type::Array(dims, _) => self.error(
+                pos,
+                format!(
+                    "{} indices for an array of {} dimensions",
+                    index.len(),
+                    dims.len()
+                ),
+            ),
+            Type::Error => Type::Error,
+            _ => self.error(pos, "`[..]` of a value that is no ARRAY"),
+        }
+    }
+
+    fn unary(&mut self, op: UnOp, inner: &Expr, pos: Pos, ctx: Ctx) -> Type {
+        let t = self.expr(inner, ctx);
+        match (op, &t) {
+            (_, Type::Error) => Type::Error,
+            (UnOp::Neg, Type::Elem(e))
+                if matches!(e.class(), Class::Signed | Class::Float | Class::Duration) =>
+            {
+                t
+            }
+            (UnOp::Not, Type::Elem(e)) if e.class() == Class::Bool || e.is_integer() => t,
+            (UnOp::Neg, _) => self.error(pos, "`-` of a value that has no sign"),
+            (UnOp::Not, _) => self.error(pos, "NOT of a value that is neither BOOL nor bits"),
+        }
+    }
+
+    /// The type both sides of `l op r` go to, literals taking the other side's type.
+    fn operands(&mut self, l: &Expr, r: &Expr, ctx: Ctx) -> Option<(Elem, Type, Type)> {
+        let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
+        let common = match (&lt, &rt) {
+            (Type::Elem(a), Type::Elem(b)) => {
+                let fits = |v: Option<i128>, e: &Elem| {
+                    v.is_some_and(|v| e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v)))
+                        || (v.is_some() && e.class() == Class::Float)
+                };
+                if fits(literal(l), b) {
+                    Some(*b)
+                } else if fits(literal(r), a) {
+                    Some(*a)
+                } else {
+                    Elem::common(*a, *b)
+                }
+            }
+            _ => None,
+        };
+        common.map(|c| (c, lt, rt))
+    }
+
+    fn binary(&mut self, op: BinOp, l: &Expr, r: &Expr, pos: Pos, ctx: Ctx) -> Type {
+        use BinOp::*;
+        if matches!(op, Eq | Ne) {
+            if let (Type::Enum(a), Type::Enum(b)) = (self.expr(l, ctx), self.expr(r, ctx)) {
+                return if a == b {
+                    BOOL
+                } else {
+                    self.error(pos, "values of two enumerations")
+                };
+            }
+        }
+        let Some((c, lt, rt)) = self.operands(l, r, ctx) else {
+            let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
+            if lt == Type::Error || rt == Type::Error {
+                return Type::Error;
+            }
+            return self.error(
+                pos,
+                format!(
+                    "{} of {} and {}",
+                    op_name(op),
+                    self.type_name(&lt),
+                    self.type_name(&rt)
+                ),
+            );
+        };
+        let _ = (lt, rt);
+        let class = c.class();
+        let ok = match op {
+            Or | Xor | And => class == Class::Bool || c.is_integer(),
+            Eq | Ne => true,
+            Lt | Gt | Le | Ge => class != Class::Bool,
+            Add | Sub => c.is_numeric(),
+            Mul | Div => matches!(
+                class,
+                Class::Signed | Class::Unsigned | Class::Bits | Class::Float
+            ),
+            Mod => c.is_integer(),
+            Pow => class == Class::Float,
+        };
+        if !ok {
+            return self.error(pos, format!("{} of {}", op_name(op), c.name()));
+        }
+        match op {
+            Eq | Ne | Lt | Gt | Le | Ge => BOOL,
+            _ => Type::Elem(c),
+        }
+    }
+
+    /// A type as a message writes it.
+    pub(super) fn type_name(&self, t: &Type) -> String {
+        match t {
+            Type::Elem(e) => e.name().into(),
+            Type::Str(n) => format!("STRING({n})"),
+            Type::Array(dims, e) => {
+                let dims: Vec<String> = dims.iter().map(|(a, b)| format!("{a}..{b}")).collect();
+                format!("ARRAY[{}] OF {}", dims.join(", "), self.type_name(e))
+            }
+            Type::Struct(i) => self.out.structs[*i].name.clone(),
+            Type::Enum(i) => self.out.enums[*i].name.clone(),
+            Type::Pointer(t) => format!("POINTER TO {}", self.type_name(t)),
+            Type::Fb(i) => self.out.pous[*i].name.clone(),
+            Type::StdFb(fb) => format!("{fb:?}").to_ascii_uppercase(),
+            Type::Error => "?".into(),
+        }
+    }
+
+    /// A call whose value is used: a function, a standard function or a conversion.
+    fn call_value(&mut self, callee: &Expr, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
+        let Expr::Name(n) = callee else {
+            return self.error(pos, "only functions are called in an expression");
+        };
+        if let Some((from, to)) = conversion(&n.text) {
+            let [Arg::Positional(a)] = args else {
+                return self.error(pos, format!("{} takes one value", n.text));
+            };
+            return match self.expr(a, ctx) {
+                Type::Elem(e) if e == from || e.widens_to(from) || literal(a).is_some() => {
+                    Type::Elem(to)
+                }
+                Type::Error => Type::Error,
+                t => {
+                    let found = self.type_name(&t);
+                    self.error(
+                        a.pos(),
+                        format!("{} takes a {}, not a {found}", n.text, from.name()),
+                    )
+                }
+            };
+        }
+        let upper = n.text.to_ascii_uppercase();
+        if std_lib::FUNCTIONS.contains(&upper.as_str()) {
+            return self.std_function(&upper, args, n.pos, ctx);
+        }
+        match self.meaning(&n.text, ctx) {
+            Some(Meaning::Function(i)) => self.function_call(i, args, n.pos, ctx),
+            Some(Meaning::Local(_) | Meaning::Global(_)) => {
+                self.error(pos, format!("`{}` is a function block instance: call it as a statement and read its outputs", n.text))
+            }
+            _ => self.error(n.pos, format!("unknown function `{}`", n.text)),
+        }
+    }
+}
+
+fn op_name(op: BinOp) -> &'static str {
+    use BinOp::*;
+    match op {
+        Or => "OR",
+        Xor => "XOR",
+        And => "AND",
+        Eq => "`=`",
+        Ne => "`<>`",
+        Lt => "`<`",
+        Gt => "`>`",
+        Le => "`<=`",
+        Ge => "`>=`",
+        Add => "`+`",
+        Sub => "`-`",
+        Mul => "`*`",
+        Div => "`/`",
+        Mod => "MOD",
+        Pow => "`**`",
+    }
+}

@@ -1,0 +1,503 @@
+//! The checker: every name resolved and every expression typed, over all files of a program
+//! at once. It reports every refusal it finds (not only the first), each with its file, line
+//! and column; a program with none is [`Checked`], the input of the compiler.
+//!
+//! Here: the declarations (types, POUs, global variables) and the resolution of types;
+//! [`expr`] types the expressions, [`stmt`] checks the statements and calls.
+
+use crate::ast::{Item, Name, Pou, PouKind, Section, TypeDef, TypeRef, Unit, VarDecl};
+use crate::diag::{Diagnostic, Pos};
+use crate::types::Elem;
+use std::collections::HashMap;
+
+mod expr;
+pub mod std_lib;
+mod stmt;
+
+/// A type of the language.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Type {
+    /// An elementary type.
+    Elem(Elem),
+    /// STRING(n) (WSTRING is refused for now).
+    Str(u32),
+    /// An array: its dimensions' bounds and its element.
+    Array(Vec<(i64, i64)>, Box<Type>),
+    /// A declared structure (index into [`Checked::structs`]).
+    Struct(usize),
+    /// A declared enumeration (index into [`Checked::enums`]).
+    Enum(usize),
+    /// A pointer to a value of the type.
+    Pointer(Box<Type>),
+    /// An instance of a function block (index into [`Checked::pous`]).
+    Fb(usize),
+    /// An instance of a standard function block (TON, R_TRIG, ...).
+    StdFb(std_lib::StdFb),
+    /// Something already refused: no second refusal for it.
+    Error,
+}
+
+/// A structure: its fields in order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StructDef {
+    /// Its name.
+    pub name: String,
+    /// Name and type of each field.
+    pub fields: Vec<(String, Type)>,
+}
+
+/// An enumeration: its values and base type.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnumDef {
+    /// Its name.
+    pub name: String,
+    /// Name and number of each value.
+    pub values: Vec<(String, i128)>,
+    /// The integer type it is stored as.
+    pub base: Elem,
+}
+
+/// A variable of a POU or the global list.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Var {
+    /// Its name.
+    pub name: String,
+    /// Its type.
+    pub ty: Type,
+    /// Its section.
+    pub section: Section,
+    /// Declared CONSTANT.
+    pub constant: bool,
+    /// Where it is declared.
+    pub pos: Pos,
+}
+
+/// A program, function block or function with its variables resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PouDef {
+    /// Its name.
+    pub name: String,
+    /// Its kind.
+    pub kind: PouKind,
+    /// A function's return type.
+    pub returns: Option<Type>,
+    /// Every variable, inputs, outputs and in-outs in declaration order among them.
+    pub vars: Vec<Var>,
+    /// The file it is in (index into the files given).
+    pub file: usize,
+}
+
+/// A checked program: the tables the compiler reads.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Checked {
+    /// Declared structures.
+    pub structs: Vec<StructDef>,
+    /// Declared enumerations.
+    pub enums: Vec<EnumDef>,
+    /// Programs, function blocks and functions.
+    pub pous: Vec<PouDef>,
+    /// Global variables.
+    pub globals: Vec<Var>,
+}
+
+/// What a type name stands for.
+#[derive(Debug, Clone, PartialEq)]
+enum Named {
+    Struct(usize),
+    Enum(usize),
+    Alias(TypeRef, usize),
+    Pou(usize),
+}
+
+/// Checks `files` (name and tree) as one program: the tables, or every refusal.
+pub fn check(files: &[(String, Unit)]) -> Result<Checked, Vec<Diagnostic>> {
+    let mut c = Checker::default();
+    c.collect(files);
+    c.resolve_types(files);
+    c.resolve_vars(files);
+    c.check_bodies(files);
+    if c.errors.is_empty() {
+        Ok(c.out)
+    } else {
+        c.errors
+            .sort_by(|a, b| (&a.file, a.pos).cmp(&(&b.file, b.pos)));
+        Err(c.errors)
+    }
+}
+
+#[derive(Default)]
+struct Checker {
+    out: Checked,
+    /// Type names (upper case) to what they are.
+    names: HashMap<String, Named>,
+    /// Global variable names (upper case) to their index.
+    globals: HashMap<String, usize>,
+    errors: Vec<Diagnostic>,
+    /// The file being checked.
+    file: String,
+    /// The POU whose body is being checked.
+    calls_from: usize,
+    /// Calls seen so far: (caller, callee) POU indices.
+    call_graph: Vec<(usize, usize)>,
+}
+
+impl Checker {
+    fn refuse(&mut self, pos: Pos, message: impl Into<String>) {
+        self.errors
+            .push(Diagnostic::new(pos, message).in_file(&self.file));
+    }
+
+    /// Every type, POU and global name, and refusals of names declared twice.
+    fn collect(&mut self, files: &[(String, Unit)]) {
+        for (f, (file, unit)) in files.iter().enumerate() {
+            self.file = file.clone();
+            for item in &unit.items {
+                match item {
+                    Item::Types(decls) => {
+                        for d in decls {
+                            let named = match &d.def {
+                                TypeDef::Struct(_) => {
+                                    self.out.structs.push(StructDef {
+                                        name: d.name.text.clone(),
+                                        fields: Vec::new(),
+                                    });
+                                    Named::Struct(self.out.structs.len() - 1)
+                                }
+                                TypeDef::Enum { .. } => {
+                                    self.out.enums.push(EnumDef {
+                                        name: d.name.text.clone(),
+                                        values: Vec::new(),
+                                        base: Elem::Int,
+                                    });
+                                    Named::Enum(self.out.enums.len() - 1)
+                                }
+                                TypeDef::Alias(ty, _) => Named::Alias(ty.clone(), f),
+                            };
+                            self.declare_type(&d.name, named);
+                        }
+                    }
+                    Item::Pou(p) => self.collect_pou(p, f),
+                    Item::Globals(_) => {}
+                }
+            }
+        }
+    }
+
+    fn collect_pou(&mut self, p: &Pou, file: usize) {
+        self.out.pous.push(PouDef {
+            name: p.name.text.clone(),
+            kind: p.kind,
+            returns: None,
+            vars: Vec::new(),
+            file,
+        });
+        let index = self.out.pous.len() - 1;
+        self.declare_type(&p.name, Named::Pou(index));
+    }
+
+    fn declare_type(&mut self, name: &Name, named: Named) {
+        let key = name.text.to_ascii_uppercase();
+        if Elem::named(&key).is_some() || std_lib::is_reserved_name(&key) {
+            self.refuse(name.pos, format!("`{}` is a standard name", name.text));
+        } else if self.names.insert(key, named).is_some() {
+            self.refuse(name.pos, format!("`{}` is declared twice", name.text));
+        }
+    }
+
+    /// Struct fields and enum values, in declaration order.
+    fn resolve_types(&mut self, files: &[(String, Unit)]) {
+        for (file, unit) in files {
+            self.file = file.clone();
+            for item in &unit.items {
+                let Item::Types(decls) = item else { continue };
+                for d in decls {
+                    let key = d.name.text.to_ascii_uppercase();
+                    match (&d.def, self.names.get(&key).cloned()) {
+                        (TypeDef::Struct(fields), Some(Named::Struct(i))) => {
+                            let fields = self.fields(fields);
+                            self.out.structs[i].fields = fields;
+                        }
+                        (TypeDef::Enum { values, base }, Some(Named::Enum(i))) => {
+                            self.enum_values(i, values, base.as_ref());
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+
+    fn fields(&mut self, decls: &[VarDecl]) -> Vec<(String, Type)> {
+        let mut fields: Vec<(String, Type)> = Vec::new();
+        for d in decls {
+            let ty = self.type_of(&d.ty, 0);
+            for n in &d.names {
+                if fields.iter().any(|(f, _)| f.eq_ignore_ascii_case(&n.text)) {
+                    self.refuse(n.pos, format!("field `{}` is declared twice", n.text));
+                }
+                fields.push((n.text.clone(), ty.clone()));
+            }
+        }
+        fields
+    }
+
+    fn enum_values(
+        &mut self,
+        index: usize,
+        values: &[(Name, Option<crate::ast::Expr>)],
+        base: Option<&TypeRef>,
+    ) {
+        let base = match base.map(|b| self.type_of(b, 0)) {
+            None => Elem::Int,
+            Some(Type::Elem(e)) if e.is_integer() => e,
+            Some(Type::Error) => Elem::Int,
+            Some(_) => {
+                let pos = values.first().map_or(Pos::default(), |v| v.0.pos);
+                self.refuse(pos, "an enumeration's base type is an integer type");
+                Elem::Int
+            }
+        };
+        let mut next = 0i128;
+        let mut out: Vec<(String, i128)> = Vec::new();
+        for (name, value) in values {
+            if let Some(v) = value {
+                next = self.const_int(v).unwrap_or(next);
+            }
+            if out.iter().any(|(n, _)| n.eq_ignore_ascii_case(&name.text)) {
+                self.refuse(name.pos, format!("value `{}` is declared twice", name.text));
+            }
+            if base
+                .range()
+                .is_some_and(|(lo, hi)| !(lo..=hi).contains(&next))
+            {
+                self.refuse(name.pos, format!("{next} does not fit {}", base.name()));
+            }
+            out.push((name.text.clone(), next));
+            next += 1;
+        }
+        self.out.enums[index].values = out;
+        self.out.enums[index].base = base;
+    }
+
+    /// The type a declaration writes; `depth` bounds aliases of aliases.
+    fn type_of(&mut self, ty: &TypeRef, depth: usize) -> Type {
+        match ty {
+            TypeRef::Named(n) => self.named_type(n, depth),
+            TypeRef::Pointer(t, _) | TypeRef::Reference(t, _) => {
+                Type::Pointer(Box::new(self.type_of(t, depth)))
+            }
+            TypeRef::String { len, wide, pos } => {
+                if *wide {
+                    self.refuse(*pos, "WSTRING is not supported: use STRING");
+                    return Type::Error;
+                }
+                let n = match len {
+                    None => 80,
+                    Some(e) => match self.const_int(e) {
+                        Some(n) if (1..=255).contains(&n) => n as u32,
+                        Some(n) => {
+                            self.refuse(*pos, format!("STRING({n}): 1 to 255 characters"));
+                            return Type::Error;
+                        }
+                        None => return Type::Error,
+                    },
+                };
+                Type::Str(n)
+            }
+            TypeRef::Array {
+                ranges,
+                element,
+                pos,
+            } => self.array_type(ranges, element, *pos, depth),
+        }
+    }
+
+    fn array_type(
+        &mut self,
+        ranges: &[(crate::ast::Expr, crate::ast::Expr)],
+        element: &TypeRef,
+        pos: Pos,
+        depth: usize,
+    ) -> Type {
+        let mut dims = Vec::new();
+        let mut elements = 1i128;
+        for (lo, hi) in ranges {
+            let (Some(lo), Some(hi)) = (self.const_int(lo), self.const_int(hi)) else {
+                return Type::Error;
+            };
+            if hi < lo {
+                self.refuse(
+                    pos,
+                    format!("ARRAY[{lo}..{hi}]: the upper bound lies below the lower"),
+                );
+                return Type::Error;
+            }
+            elements = elements.saturating_mul(hi - lo + 1);
+            dims.push((lo as i64, hi as i64));
+        }
+        if elements > MAX_ARRAY_ELEMENTS {
+            self.refuse(
+                pos,
+                format!("an array of {elements} elements: at most {MAX_ARRAY_ELEMENTS}"),
+            );
+            return Type::Error;
+        }
+        let element = self.type_of(element, depth);
+        Type::Array(dims, Box::new(element))
+    }
+
+    fn named_type(&mut self, n: &Name, depth: usize) -> Type {
+        let key = n.text.to_ascii_uppercase();
+        if let Some(e) = Elem::named(&key) {
+            return Type::Elem(e);
+        }
+        if let Some(fb) = std_lib::StdFb::named(&key) {
+            return Type::StdFb(fb);
+        }
+        match self.names.get(&key).cloned() {
+            Some(Named::Struct(i)) => Type::Struct(i),
+            Some(Named::Enum(i)) => Type::Enum(i),
+            Some(Named::Pou(i)) if self.out.pous[i].kind == PouKind::FunctionBlock => Type::Fb(i),
+            Some(Named::Pou(_)) => {
+                self.refuse(
+                    n.pos,
+                    format!("`{}` is no type: only a FUNCTION_BLOCK can be", n.text),
+                );
+                Type::Error
+            }
+            Some(Named::Alias(ty, _)) if depth < 16 => self.type_of(&ty, depth + 1),
+            Some(Named::Alias(..)) => {
+                self.refuse(n.pos, format!("type `{}` is defined by itself", n.text));
+                Type::Error
+            }
+            None => {
+                self.refuse(n.pos, format!("unknown type `{}`", n.text));
+                Type::Error
+            }
+        }
+    }
+
+    /// Every POU's variables and return type, and the global list.
+    fn resolve_vars(&mut self, files: &[(String, Unit)]) {
+        for (file, unit) in files {
+            self.file = file.clone();
+            for item in &unit.items {
+                match item {
+                    Item::Globals(block) => {
+                        for d in &block.vars {
+                            let ty = self.type_of(&d.ty, 0);
+                            for n in &d.names {
+                                self.declare_global(n, ty.clone(), block.constant);
+                            }
+                        }
+                    }
+                    Item::Pou(p) => self.pou_vars(p),
+                    Item::Types(_) => {}
+                }
+            }
+        }
+    }
+
+    fn declare_global(&mut self, n: &Name, ty: Type, constant: bool) {
+        let key = n.text.to_ascii_uppercase();
+        if self.globals.contains_key(&key) {
+            self.refuse(n.pos, format!("global `{}` is declared twice", n.text));
+            return;
+        }
+        self.out.globals.push(Var {
+            name: n.text.clone(),
+            ty,
+            section: Section::Global,
+            constant,
+            pos: n.pos,
+        });
+        self.globals.insert(key, self.out.globals.len() - 1);
+    }
+
+    fn pou_vars(&mut self, p: &Pou) {
+        let Some(Named::Pou(index)) = self.names.get(&p.name.text.to_ascii_uppercase()).cloned()
+        else {
+            return;
+        };
+        let returns = p.returns.as_ref().map(|r| self.type_of(r, 0));
+        let mut vars: Vec<Var> = Vec::new();
+        for block in &p.vars {
+            if block.section == Section::Global {
+                self.refuse(
+                    block.pos,
+                    "VAR_GLOBAL inside a POU: declare it in a global list",
+                );
+                continue;
+            }
+            for d in &block.vars {
+                let ty = self.type_of(&d.ty, 0);
+                for n in &d.names {
+                    if vars.iter().any(|v| v.name.eq_ignore_ascii_case(&n.text)) {
+                        self.refuse(n.pos, format!("`{}` is declared twice", n.text));
+                    }
+                    vars.push(Var {
+                        name: n.text.clone(),
+                        ty: ty.clone(),
+                        section: block.section,
+                        constant: block.constant,
+                        pos: n.pos,
+                    });
+                }
+            }
+        }
+        self.out.pous[index].returns = returns;
+        self.out.pous[index].vars = vars;
+    }
+
+    /// The value of a constant integer expression (literals and `+ - * / MOD` of them), or a
+    /// refusal.
+    fn const_int(&mut self, e: &crate::ast::Expr) -> Option<i128> {
+        use crate::ast::{BinOp, Expr, UnOp};
+        let value = match e {
+            Expr::Int(v, _) => Some(*v),
+            Expr::Typed { value, .. } => return self.const_int(value),
+            Expr::Unary(UnOp::Neg, inner, _) => self.const_int(inner).map(|v| -v),
+            Expr::Binary(op, l, r, pos) => {
+                let (a, b) = (self.const_int(l)?, self.const_int(r)?);
+                let v = match op {
+                    BinOp::Add => a.checked_add(b),
+                    BinOp::Sub => a.checked_sub(b),
+                    BinOp::Mul => a.checked_mul(b),
+                    BinOp::Div | BinOp::Mod if b == 0 => {
+                        self.refuse(*pos, "a constant divided by zero");
+                        return None;
+                    }
+                    BinOp::Div => Some(a / b),
+                    BinOp::Mod => Some(a % b),
+                    _ => None,
+                };
+                if v.is_none() {
+                    self.refuse(*pos, "not an integer constant");
+                }
+                return v;
+            }
+            _ => None,
+        };
+        if value.is_none() {
+            self.refuse(
+                e.pos(),
+                "an integer constant is wanted here (a literal or arithmetic of literals)",
+            );
+        }
+        value
+    }
+
+    fn check_bodies(&mut self, files: &[(String, Unit)]) {
+        for (file, unit) in files {
+            self.file = file.clone();
+            for item in &unit.items {
+                if let Item::Pou(p) = item {
+                    self.check_pou(p);
+                }
+            }
+        }
+    }
+}
+
+/// The most elements an array may have (a program's memory is sized at load).
+pub const MAX_ARRAY_ELEMENTS: i128 = 1 << 20;

@@ -1,0 +1,538 @@
+//! Statements, assignments and calls: targets that can be written, conditions that are BOOL,
+//! loops and their EXIT, CASE labels against the selector, the arguments of functions,
+//! function blocks and the standard functions, and recursion refused.
+
+use super::expr::{literal, Ctx, Meaning};
+use super::{Checker, Type};
+use crate::ast::{Arg, CaseLabel, Expr, Pou, Section, Stmt};
+use crate::diag::Pos;
+use crate::types::{Class, Elem};
+
+const BOOL: Type = Type::Elem(Elem::Bool);
+
+impl Checker {
+    pub(super) fn check_pou(&mut self, p: &Pou) {
+        let Some(super::Named::Pou(pou)) =
+            self.names.get(&p.name.text.to_ascii_uppercase()).cloned()
+        else {
+            return;
+        };
+        let ctx = Ctx { pou, loops: 0 };
+        self.calls_from = pou;
+        self.initial_values(p, ctx);
+        self.statements(&p.body, ctx);
+    }
+
+    /// The initial values of the POU's variables against their types (an expression; array
+    /// and structure initialisers are checked by the compiler).
+    fn initial_values(&mut self, p: &Pou, ctx: Ctx) {
+        for block in &p.vars {
+            for d in &block.vars {
+                let (Some(crate::ast::Init::Expr(e)), Some(first)) = (&d.init, d.names.first())
+                else {
+                    continue;
+                };
+                let ty = self.out.pous[ctx.pou]
+                    .vars
+                    .iter()
+                    .find(|v| v.name == first.text)
+                    .map(|v| v.ty.clone());
+                if let Some(ty) = ty {
+                    self.assignable(e, &ty, ctx);
+                }
+            }
+        }
+    }
+
+    fn statements(&mut self, body: &[Stmt], ctx: Ctx) {
+        for s in body {
+            self.statement(s, ctx);
+        }
+    }
+
+    fn statement(&mut self, s: &Stmt, ctx: Ctx) {
+        let in_loop = Ctx {
+            loops: ctx.loops + 1,
+            ..ctx
+        };
+        match s {
+            Stmt::Assign { target, value } => self.assign(target, value, ctx),
+            Stmt::Call(call) => self.call_statement(call, ctx),
+            Stmt::If {
+                branches,
+                otherwise,
+            } => {
+                for (cond, body) in branches {
+                    self.condition(cond, ctx);
+                    self.statements(body, ctx);
+                }
+                self.statements(otherwise.as_deref().unwrap_or(&[]), ctx);
+            }
+            Stmt::Case {
+                selector,
+                arms,
+                otherwise,
+            } => self.case(selector, arms, otherwise.as_deref(), ctx),
+            Stmt::For {
+                var,
+                from,
+                to,
+                by,
+                body,
+            } => {
+                let target = Expr::Name(var.clone());
+                match self.writable(&target, ctx) {
+                    Some(Type::Elem(e)) if e.is_integer() => {
+                        for bound in [Some(from), Some(to), by.as_ref()].into_iter().flatten() {
+                            self.assignable(bound, &Type::Elem(e), ctx);
+                        }
+                    }
+                    Some(Type::Error) | None => {}
+                    Some(_) => self.refuse(var.pos, "a FOR variable is an integer"),
+                }
+                self.statements(body, in_loop);
+            }
+            Stmt::While { cond, body } => {
+                self.condition(cond, ctx);
+                self.statements(body, in_loop);
+            }
+            Stmt::Repeat { body, until } => {
+                self.statements(body, in_loop);
+                self.condition(until, ctx);
+            }
+            Stmt::Exit(pos) | Stmt::Continue(pos) if ctx.loops == 0 => {
+                self.refuse(*pos, "EXIT and CONTINUE belong in a loop");
+            }
+            Stmt::Exit(_) | Stmt::Continue(_) | Stmt::Return(_) => {}
+        }
+    }
+
+    fn condition(&mut self, cond: &Expr, ctx: Ctx) {
+        match self.expr(cond, ctx) {
+            BOOL | Type::Error => {}
+            t => {
+                let found = self.type_name(&t);
+                self.refuse(cond.pos(), format!("a condition is BOOL, not {found}"));
+            }
+        }
+    }
+
+    /// `value` where a `want` is wanted: the same type, one that widens to it, or a literal
+    /// that fits.
+    pub(super) fn assignable(&mut self, value: &Expr, want: &Type, ctx: Ctx) {
+        let got = self.expr(value, ctx);
+        if got == Type::Error || *want == Type::Error || got == *want {
+            return;
+        }
+        let fits = match (&got, want) {
+            (Type::Elem(g), Type::Elem(w)) => {
+                g.widens_to(*w)
+                    || literal(value).is_some_and(|v| {
+                        w.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v))
+                            || w.class() == Class::Float
+                    })
+                    || (matches!(value, Expr::Real(..)) && w.class() == Class::Float)
+            }
+            (Type::Str(_), Type::Str(_)) => true,
+            (Type::Pointer(a), Type::Pointer(b)) => a == b,
+            _ => false,
+        };
+        if !fits {
+            let (g, w) = (self.type_name(&got), self.type_name(want));
+            self.refuse(value.pos(), format!("a {g} where a {w} is wanted"));
+        }
+    }
+
+    /// The type of a place that may be written, or a refusal.
+    fn writable(&mut self, target: &Expr, ctx: Ctx) -> Option<Type> {
+        match target {
+            Expr::Name(n) => match self.meaning(&n.text, ctx) {
+                Some(Meaning::Local(i)) => {
+                    let v = &self.out.pous[ctx.pou].vars[i];
+                    let (constant, ty) = (v.constant, v.ty.clone());
+                    if constant {
+                        self.refuse(n.pos, format!("`{}` is a CONSTANT", n.text));
+                    }
+                    Some(ty)
+                }
+                Some(Meaning::Global(i)) => {
+                    let v = &self.out.globals[i];
+                    let (constant, ty) = (v.constant, v.ty.clone());
+                    if constant {
+                        self.refuse(n.pos, format!("`{}` is a CONSTANT", n.text));
+                    }
+                    Some(ty)
+                }
+                Some(Meaning::Return(t)) => Some(t),
+                _ => Some(self.expr(target, ctx)),
+            },
+            Expr::Field(base, _) if self.reads_an_instance(base, ctx) => {
+                self.refuse(
+                    target.pos(),
+                    "an instance's inputs are set in its call, its outputs only read",
+                );
+                None
+            }
+            Expr::Field(..) | Expr::Index(..) | Expr::Deref(..) => Some(self.expr(target, ctx)),
+            _ => {
+                self.refuse(
+                    target.pos(),
+                    "only a variable, a field, an element or `p^` is written",
+                );
+                None
+            }
+        }
+    }
+
+    fn reads_an_instance(&mut self, base: &Expr, ctx: Ctx) -> bool {
+        let errors = self.errors.len();
+        let t = self.expr(base, ctx);
+        self.errors.truncate(errors);
+        matches!(t, Type::Fb(_) | Type::StdFb(_))
+    }
+
+    fn assign(&mut self, target: &Expr, value: &Expr, ctx: Ctx) {
+        if let Some(want) = self.writable(target, ctx) {
+            match want {
+                Type::Fb(_) | Type::StdFb(_) => {
+                    self.refuse(target.pos(), "a function block instance is not assigned")
+                }
+                Type::Array(..) | Type::Struct(_) => {
+                    // Whole arrays and structures of the same type copy.
+                    let got = self.expr(value, ctx);
+                    if got != want && got != Type::Error {
+                        let (g, w) = (self.type_name(&got), self.type_name(&want));
+                        self.refuse(value.pos(), format!("a {g} where a {w} is wanted"));
+                    }
+                }
+                _ => self.assignable(value, &want, ctx),
+            }
+        }
+    }
+
+    fn case(
+        &mut self,
+        selector: &Expr,
+        arms: &[(Vec<CaseLabel>, Vec<Stmt>)],
+        otherwise: Option<&[Stmt]>,
+        ctx: Ctx,
+    ) {
+        let t = self.expr(selector, ctx);
+        let ok = matches!(&t, Type::Elem(e) if e.is_integer())
+            || matches!(t, Type::Enum(_) | Type::Error);
+        if !ok {
+            let found = self.type_name(&t);
+            self.refuse(
+                selector.pos(),
+                format!("a CASE selector is an integer or an enumeration, not {found}"),
+            );
+        }
+        for (labels, body) in arms {
+            for label in labels {
+                let values = match label {
+                    CaseLabel::Value(v) => vec![v],
+                    CaseLabel::Range(a, b) => vec![a, b],
+                };
+                for v in values {
+                    if literal(v).is_none()
+                        && !matches!(v, Expr::Name(_) | Expr::Field(..) | Expr::Typed { .. })
+                    {
+                        self.refuse(v.pos(), "a CASE label is a constant");
+                    } else if ok {
+                        self.assignable(v, &t, ctx);
+                    }
+                }
+            }
+            self.statements(body, ctx);
+        }
+        self.statements(otherwise.unwrap_or(&[]), ctx);
+    }
+
+    /// A call as a statement: a function block instance, or a function whose value is
+    /// dropped.
+    fn call_statement(&mut self, call: &Expr, ctx: Ctx) {
+        let Expr::Call { callee, args, pos } = call else {
+            return;
+        };
+        let errors = self.errors.len();
+        let instance = self.expr(callee, ctx);
+        match instance {
+            Type::Fb(i) => {
+                self.errors.truncate(errors);
+                self.record_call(i, *pos);
+                let params: Vec<(String, Type, Section)> = self.out.pous[i]
+                    .vars
+                    .iter()
+                    .filter(|v| {
+                        matches!(v.section, Section::Input | Section::Output | Section::InOut)
+                    })
+                    .map(|v| (v.name.clone(), v.ty.clone(), v.section))
+                    .collect();
+                self.named_args(args, &params, *pos, ctx);
+            }
+            Type::StdFb(fb) => {
+                self.errors.truncate(errors);
+                let params: Vec<(String, Type, Section)> = fb
+                    .members()
+                    .iter()
+                    .map(|(n, t, input)| {
+                        let section = if *input {
+                            Section::Input
+                        } else {
+                            Section::Output
+                        };
+                        (n.to_string(), Type::Elem(*t), section)
+                    })
+                    .collect();
+                self.named_args(args, &params, *pos, ctx);
+            }
+            _ => {
+                self.errors.truncate(errors);
+                self.expr(call, ctx);
+            }
+        }
+    }
+
+    /// `Input := value` and `Output => target` against a block's parameters.
+    fn named_args(&mut self, args: &[Arg], params: &[(String, Type, Section)], pos: Pos, ctx: Ctx) {
+        let find = |name: &str| params.iter().find(|(n, _, _)| n.eq_ignore_ascii_case(name));
+        for arg in args {
+            match arg {
+                Arg::Input(name, value) => match find(&name.text) {
+                    Some((_, t, Section::Input | Section::InOut)) => self.assignable(value, t, ctx),
+                    Some(_) => self.refuse(
+                        name.pos,
+                        format!("`{}` is an output: `{} =>`", name.text, name.text),
+                    ),
+                    None => self.refuse(name.pos, format!("no input `{}`", name.text)),
+                },
+                Arg::Output {
+                    name,
+                    target,
+                    negated,
+                } => match find(&name.text) {
+                    Some((_, t, Section::Output)) => {
+                        if *negated && *t != BOOL {
+                            self.refuse(name.pos, "NOT of an output that is not BOOL");
+                        }
+                        if let Some(want) = self.writable(target, ctx) {
+                            if want != *t
+                                && !matches!((t, &want), (Type::Elem(a), Type::Elem(b)) if a.widens_to(*b))
+                            {
+                                let (g, w) = (self.type_name(t), self.type_name(&want));
+                                self.refuse(target.pos(), format!("a {g} output into a {w}"));
+                            }
+                        }
+                    }
+                    Some(_) => self.refuse(
+                        name.pos,
+                        format!("`{}` is an input: `{} :=`", name.text, name.text),
+                    ),
+                    None => self.refuse(name.pos, format!("no output `{}`", name.text)),
+                },
+                Arg::Positional(v) => {
+                    self.refuse(
+                        v.pos(),
+                        "a function block's inputs are named: `Name := value`",
+                    );
+                }
+            }
+        }
+        let _ = pos;
+    }
+
+    /// A user function's call: its inputs by position or name, its value.
+    pub(super) fn function_call(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
+        self.record_call(i, pos);
+        let inputs: Vec<(String, Type)> = self.out.pous[i]
+            .vars
+            .iter()
+            .filter(|v| v.section == Section::Input)
+            .map(|v| (v.name.clone(), v.ty.clone()))
+            .collect();
+        let name = self.out.pous[i].name.clone();
+        let positional = args
+            .iter()
+            .filter(|a| matches!(a, Arg::Positional(_)))
+            .count();
+        if positional > inputs.len() {
+            self.refuse(
+                pos,
+                format!("{name} takes {} inputs, not {positional}", inputs.len()),
+            );
+        }
+        for (k, arg) in args.iter().enumerate() {
+            match arg {
+                Arg::Positional(v) => {
+                    if let Some((_, t)) = inputs.get(k) {
+                        self.assignable(v, t, ctx);
+                    }
+                }
+                Arg::Input(n, v) => {
+                    match inputs.iter().find(|(i, _)| i.eq_ignore_ascii_case(&n.text)) {
+                        Some((_, t)) => self.assignable(v, t, ctx),
+                        None => self.refuse(n.pos, format!("{name} has no input `{}`", n.text)),
+                    }
+                }
+                Arg::Output { name: n, .. } => {
+                    self.refuse(n.pos, format!("{name} is a function: it has no outputs"))
+                }
+            }
+        }
+        self.out.pous[i].returns.clone().unwrap_or(Type::Error)
+    }
+
+    /// Notes that the POU being checked calls POU `callee` (for the recursion check).
+    fn record_call(&mut self, callee: usize, pos: Pos) {
+        let caller = self.calls_from;
+        if caller == callee || self.reaches(callee, caller) {
+            let name = self.out.pous[callee].name.clone();
+            self.refuse(
+                pos,
+                format!(
+                    "{name} calls itself (directly or through others): recursion is not allowed"
+                ),
+            );
+            return;
+        }
+        self.call_graph.push((caller, callee));
+    }
+
+    /// Whether `from` calls `to` through the calls seen so far.
+    fn reaches(&self, from: usize, to: usize) -> bool {
+        let mut stack = vec![from];
+        let mut seen = vec![false; self.out.pous.len()];
+        while let Some(p) = stack.pop() {
+            if p == to {
+                return true;
+            }
+            if std::mem::replace(&mut seen[p], true) {
+                continue;
+            }
+            stack.extend(
+                self.call_graph
+                    .iter()
+                    .filter(|(a, _)| *a == p)
+                    .map(|(_, b)| *b),
+            );
+        }
+        false
+    }
+
+    /// The standard functions' types.
+    pub(super) fn std_function(&mut self, name: &str, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
+        let values: Vec<&Expr> = args
+            .iter()
+            .filter_map(|a| match a {
+                Arg::Positional(v) => Some(v),
+                _ => None,
+            })
+            .collect();
+        if values.len() != args.len() {
+            return self.error(pos, format!("{name} takes its values by position"));
+        }
+        let count = |n: std::ops::RangeInclusive<usize>| n.contains(&values.len());
+        let types: Vec<Type> = if name == "ADR" || name == "SIZEOF" {
+            Vec::new()
+        } else {
+            values.iter().map(|v| self.expr(v, ctx)).collect()
+        };
+        if types.contains(&Type::Error) {
+            return Type::Error;
+        }
+        let elem = |k: usize| match types.get(k) {
+            Some(Type::Elem(e)) => Some(*e),
+            _ => None,
+        };
+        match name {
+            "ADR" if count(1..=1) => match self.writable_silent(values[0], ctx) {
+                Some(t) => Type::Pointer(Box::new(t)),
+                None => self.error(values[0].pos(), "ADR of a variable, a field or an element"),
+            },
+            "SIZEOF" if count(1..=1) => Type::Elem(Elem::UDInt),
+            "ABS" if count(1..=1) && elem(0).is_some_and(|e| e.is_numeric()) => types[0].clone(),
+            "SQRT" | "LN" | "LOG" | "EXP" | "SIN" | "COS" | "TAN" | "ASIN" | "ACOS" | "ATAN"
+                if count(1..=1)
+                    && elem(0).is_some_and(|e| e.is_numeric() && e.class() != Class::Duration) =>
+            {
+                match elem(0) {
+                    Some(Elem::Real) => Type::Elem(Elem::Real),
+                    _ => Type::Elem(Elem::LReal),
+                }
+            }
+            "TRUNC" if count(1..=1) && elem(0).is_some_and(|e| e.class() == Class::Float) => {
+                Type::Elem(Elem::DInt)
+            }
+            "SHL" | "SHR" | "ROL" | "ROR"
+                if count(2..=2)
+                    && elem(0).is_some_and(Elem::is_integer)
+                    && elem(1).is_some_and(Elem::is_integer) =>
+            {
+                types[0].clone()
+            }
+            "MIN" | "MAX" if values.len() >= 2 => self.common_of(&values, &types, pos),
+            "LIMIT" if count(3..=3) => self.common_of(&values, &types, pos),
+            "SEL" if count(3..=3) => {
+                if types[0] != BOOL {
+                    return self.error(values[0].pos(), "SEL's first value is BOOL");
+                }
+                self.common_of(&values[1..], &types[1..], pos)
+            }
+            "MUX" if values.len() >= 3 => {
+                if !elem(0).is_some_and(Elem::is_integer) {
+                    return self.error(values[0].pos(), "MUX's first value is an integer");
+                }
+                self.common_of(&values[1..], &types[1..], pos)
+            }
+            _ => self.error(pos, format!("{name} does not take these values")),
+        }
+    }
+
+    fn writable_silent(&mut self, e: &Expr, ctx: Ctx) -> Option<Type> {
+        match e {
+            Expr::Name(_) | Expr::Field(..) | Expr::Index(..) | Expr::Deref(..) => {
+                Some(self.expr(e, ctx)).filter(|t| *t != Type::Error)
+            }
+            _ => None,
+        }
+    }
+
+    /// The one type all `values` go to: that of the values that are not literals (the
+    /// literals must fit it), or of all when all are literals.
+    fn common_of(&mut self, values: &[&Expr], types: &[Type], pos: Pos) -> Type {
+        let typed: Vec<&Type> = values
+            .iter()
+            .zip(types)
+            .filter(|(v, _)| literal(v).is_none())
+            .map(|(_, t)| t)
+            .collect();
+        let pool: Vec<&Type> = if typed.is_empty() {
+            types.iter().collect()
+        } else {
+            typed
+        };
+        let mut common = pool[0].clone();
+        for t in &pool[1..] {
+            common = match (&common, t) {
+                (Type::Elem(a), Type::Elem(b)) => match Elem::common(*a, *b) {
+                    Some(c) => Type::Elem(c),
+                    None => {
+                        return self.error(pos, format!("values of {} and {}", a.name(), b.name()))
+                    }
+                },
+                (a, b) if a == *b => common,
+                _ => return self.error(pos, "values of different types"),
+            };
+        }
+        for v in values {
+            if let (Some(value), Type::Elem(e)) = (literal(v), &common) {
+                let fits = e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&value))
+                    || e.class() == Class::Float;
+                if !fits {
+                    return self.error(v.pos(), format!("{value} does not fit {}", e.name()));
+                }
+            }
+        }
+        common
+    }
+}

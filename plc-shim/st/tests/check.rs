@@ -1,0 +1,176 @@
+//! The checker on programs in the manuals' style and on programs with mistakes: every
+//! refusal with its file, line and column, all of them in one pass.
+
+use plc_st::check::{check, Checked, Type};
+use plc_st::types::Elem;
+use plc_st::{parse_file, Diagnostic};
+
+fn data(name: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name);
+    std::fs::read_to_string(path).unwrap()
+}
+
+fn checked(files: &[(&str, &str)]) -> Result<Checked, Vec<Diagnostic>> {
+    let units: Vec<(String, plc_st::ast::Unit)> = files
+        .iter()
+        .map(|(name, text)| (name.to_string(), parse_file(name, text).unwrap()))
+        .collect();
+    check(&units)
+}
+
+/// The refusals of one program `body` inside `PROGRAM P` with `vars`, as text.
+fn refusals(vars: &str, body: &str) -> Vec<String> {
+    let text = format!("PROGRAM P\nVAR\n{vars}\nEND_VAR\n{body}\nEND_PROGRAM\n");
+    match checked(&[("p.st", &text)]) {
+        Ok(_) => Vec::new(),
+        Err(e) => e.iter().map(|d| d.to_string()).collect(),
+    }
+}
+
+#[test]
+fn the_master_program_checks_against_the_hli_types() {
+    let hli = data("hli_stand_in.st");
+    let main = data("rotary_master.st");
+    let c = checked(&[("hli.st", &hli), ("rotary_master.st", &main)]).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
+        )
+    });
+    let main = c.pous.iter().find(|p| p.name == "MAIN").unwrap();
+    let pointer = main.vars.iter().find(|v| v.name == "pDynCs").unwrap();
+    let unit = c
+        .structs
+        .iter()
+        .position(|s| s.name == "MC_CONTROL_DYN_CS_UNIT")
+        .unwrap();
+    assert_eq!(pointer.ty, Type::Pointer(Box::new(Type::Struct(unit))));
+    let table = c.enums.iter().find(|e| e.name == "E_TableStep").unwrap();
+    assert_eq!(table.base, Elem::Int);
+    assert_eq!(table.values[3], ("Disable".to_string(), 3));
+}
+
+#[test]
+fn mistakes_are_refused_each_with_its_place() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "x : INT;",
+            "x := 70000;",
+            "p.st:5:6: error: a DINT where a INT is wanted",
+        ),
+        ("x : INT;", "x := y;", "p.st:5:6: error: unknown name `y`"),
+        (
+            "x : INT; d : DINT;",
+            "x := d;",
+            "p.st:5:6: error: a DINT where a INT is wanted",
+        ),
+        (
+            "b : BOOL;",
+            "IF 1 THEN b := TRUE; END_IF",
+            "p.st:5:4: error: a condition is BOOL, not DINT",
+        ),
+        ("b : BOOL;", "b := b + 1;", "p.st:5:8: error: `+` of BOOL"),
+        (
+            "x : INT;",
+            "x := DINT#70000;",
+            "p.st:5:6: error: a DINT where a INT is wanted",
+        ),
+        (
+            "x : INT;",
+            "x := INT#70000;",
+            "p.st:5:10: error: 70000 does not fit INT",
+        ),
+        (
+            "a : ARRAY[0..2] OF INT;",
+            "a[3] := 1;",
+            "p.st:5:3: error: index 3 outside [0..2]",
+        ),
+        (
+            "t : TON;",
+            "t(IN := TRUE, PT := 5);",
+            "p.st:5:21: error: a DINT where a TIME is wanted",
+        ),
+        (
+            "t : TON;",
+            "t(IN := TRUE, Q := TRUE);",
+            "p.st:5:15: error: `Q` is an output",
+        ),
+        (
+            "t : TON;",
+            "t.Q := TRUE;",
+            "p.st:5:1: error: an instance's inputs are set in its call",
+        ),
+        (
+            "",
+            "EXIT;",
+            "p.st:5:1: error: EXIT and CONTINUE belong in a loop",
+        ),
+        (
+            "r : REAL;",
+            "r := SQRT(TRUE);",
+            "p.st:5:6: error: SQRT does not take these values",
+        ),
+        (
+            "p : POINTER TO INT; x : DINT;",
+            "p := ADR(x);",
+            "p.st:5:6: error: a POINTER TO DINT where a POINTER TO INT is wanted",
+        ),
+        (
+            "x : INT;",
+            "x.Y := 1;",
+            "p.st:5:3: error: `.Y` of a value without fields",
+        ),
+        (
+            "s : UNKNOWN_T;",
+            "",
+            "p.st:3:5: error: unknown type `UNKNOWN_T`",
+        ),
+        (
+            "x : INT := TRUE;",
+            "",
+            "p.st:3:12: error: a BOOL where a INT is wanted",
+        ),
+    ];
+    for (vars, body, expect) in cases {
+        let got = refusals(vars, body);
+        assert!(
+            got.iter().any(|g| g.starts_with(expect)),
+            "{vars} / {body}:\n  got {got:?}\n  want {expect}"
+        );
+    }
+}
+
+#[test]
+fn every_refusal_is_reported_in_one_pass() {
+    let got = refusals("x : INT;", "x := y;\nx := z;\nx := TRUE;");
+    assert_eq!(got.len(), 3, "{got:?}");
+    assert!(got[0].starts_with("p.st:5:"), "{got:?}");
+    assert!(got[2].starts_with("p.st:7:"), "{got:?}");
+}
+
+#[test]
+fn recursion_and_names_declared_twice_are_refused() {
+    let text = "FUNCTION A : INT\nVAR_INPUT n : INT; END_VAR\nA := B(n);\nEND_FUNCTION\n\
+                FUNCTION B : INT\nVAR_INPUT n : INT; END_VAR\nB := A(n);\nEND_FUNCTION\n";
+    let e = checked(&[("r.st", text)]).unwrap_err();
+    assert!(e[0].to_string().contains("calls itself"), "{e:?}");
+    let twice = "TYPE T : STRUCT a : INT; END_STRUCT END_TYPE\nTYPE T : (X, Y); END_TYPE\n";
+    let e = checked(&[("t.st", twice)]).unwrap_err();
+    assert!(e[0].to_string().contains("`T` is declared twice"), "{e:?}");
+}
+
+#[test]
+fn widening_literals_and_standard_blocks_check() {
+    let ok = refusals(
+        "i : INT; d : DINT; r : REAL; l : LREAL; w : WORD; t : TON; e : R_TRIG; b : BOOL;\n\
+         a : ARRAY[1..4] OF LREAL; u : UDINT;",
+        "d := i; l := r; r := i; i := -5; w := 16#FFFF; r := 1.5;\n\
+         t(IN := b, PT := T#2S); e(CLK := t.Q, Q => b);\n\
+         l := MAX(1.0, l, a[1]); i := LIMIT(0, i, 100); u := UDINT#0;\n\
+         d := LREAL_TO_DINT(l * 10000.0); b := w.15 AND NOT e.Q;\n\
+         FOR i := 1 TO 4 DO a[i] := SEL(b, 0.0, l); END_FOR",
+    );
+    assert!(ok.is_empty(), "{ok:?}");
+}
