@@ -32,6 +32,7 @@ pub mod layout;
 pub mod protocol;
 #[allow(unsafe_code)]
 pub mod raw;
+pub mod st_prelude;
 pub mod symbols;
 pub mod units;
 pub mod views;

@@ -80,6 +80,8 @@ enum HliCommand {
     Symbols,
     /// Print a C header of the whole image (sizes and offsets asserted).
     Header,
+    /// Print the image's units and pointer arrays as Structured Text declarations.
+    St,
 }
 
 /// The `cnc` binary's `main`: its commands parsed from the process's arguments and run. A
@@ -98,6 +100,7 @@ pub fn main() -> ExitCode {
                     hli::symbols::format_table(hli::symbols::SymbolTable::global())
                 }
                 HliCommand::Header => hli::c_header::generate(),
+                HliCommand::St => hli::st_prelude::generate(),
             };
             print_or_fail(&text)
         }

@@ -31,7 +31,7 @@ fn refusals(vars: &str, body: &str) -> Vec<String> {
 
 #[test]
 fn the_master_program_checks_against_the_hli_types() {
-    let hli = data("hli_stand_in.st");
+    let hli = hli::st_prelude::generate();
     let main = data("rotary_master.st");
     let c = checked(&[("hli.st", &hli), ("rotary_master.st", &main)]).unwrap_or_else(|e| {
         panic!(

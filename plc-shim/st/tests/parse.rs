@@ -58,7 +58,7 @@ fn a_master_program_with_pointers_typed_literals_and_blocks_parses() {
     assert!(
         matches!(&pointer.ty, TypeRef::Pointer(t, _) if matches!(&**t, TypeRef::Named(n) if n.is("MC_CONTROL_DYN_CS_UNIT")))
     );
-    // pDynCs := ADR(gpCh[0]^.channel_mc_control.dyn_cs);
+    // pDynCs := ADR(gpCh[0]^channel_mc_control.dyn_cs); (`^name` is `^.name`)
     let Stmt::Assign { value, .. } = &main.body[0] else {
         panic!()
     };

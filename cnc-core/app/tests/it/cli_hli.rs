@@ -71,3 +71,15 @@ fn unknown_subcommand_fails_with_usage() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("Usage"));
 }
+
+/// `cnc hli st` prints the image as ST declarations: the units under the manuals' names, the
+/// controller's pointer arrays global (plc-st's tests check programs against it).
+#[test]
+fn st_prints_the_units_and_the_pointer_arrays() {
+    let out = cnc(&["hli", "st"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text, hli::st_prelude::generate());
+    assert!(text.contains("    MC_CONTROL_DYN_CS_UNIT :\n    STRUCT\n        enable_w : BOOL;"));
+    assert!(text.contains("    gpCh : ARRAY[0..11] OF POINTER TO HLI_CHANNEL;"));
+}

@@ -280,11 +280,26 @@ impl Parser {
         })
     }
 
-    /// `a, b : TYPE := init;` (a location `AT %..` is refused by name).
-    fn var_decl(&mut self) -> Result<VarDecl, Diagnostic> {
-        let mut names = vec![self.name()?];
+    /// A field's name: any word, a reserved one included (the image has a field `program`),
+    /// since it only ever follows a `.`.
+    fn field_name(&mut self) -> Result<Name, Diagnostic> {
+        let pos = self.pos();
+        match self.peek().clone() {
+            Tok::Ident(text) => {
+                self.bump();
+                Ok(Name { text, pos })
+            }
+            _ => Err(self.error(format!("expected a field name, found {}", self.found()))),
+        }
+    }
+
+    /// `a, b : TYPE := init;` (a location `AT %..` is refused by name); `field` for a
+    /// structure's fields, whose names may be reserved words.
+    fn var_decl_of(&mut self, field: bool) -> Result<VarDecl, Diagnostic> {
+        let name = |p: &mut Self| if field { p.field_name() } else { p.name() };
+        let mut names = vec![name(self)?];
         while self.eat(&Tok::Comma) {
-            names.push(self.name()?);
+            names.push(name(self)?);
         }
         if self.is_kw("AT") {
             return Err(self.error(
@@ -300,6 +315,10 @@ impl Parser {
         };
         self.expect(&Tok::Semi, "`;`")?;
         Ok(VarDecl { names, ty, init })
+    }
+
+    fn var_decl(&mut self) -> Result<VarDecl, Diagnostic> {
+        self.var_decl_of(false)
     }
 
     fn type_ref(&mut self) -> Result<TypeRef, Diagnostic> {
@@ -417,7 +436,7 @@ impl Parser {
                 if self.at_eof() {
                     return Err(self.error("a STRUCT without its END_STRUCT"));
                 }
-                fields.push(self.var_decl()?);
+                fields.push(self.var_decl_of(true)?);
             }
             return Ok(TypeDef::Struct(fields));
         }

@@ -300,7 +300,7 @@ impl Parser {
                             pos,
                         }
                     }
-                    _ => self.name()?,
+                    _ => self.field_name()?,
                 };
                 e = Expr::Field(Box::new(e), field);
             } else if self.eat(&Tok::LBracket) {
@@ -312,6 +312,21 @@ impl Parser {
                 e = Expr::Index(Box::new(e), index, pos);
             } else if self.eat(&Tok::Caret) {
                 e = Expr::Deref(Box::new(e), pos);
+                // `p^field`, as the manuals write it, is `p^.field`.
+                let field_pos = self.pos();
+                if let Tok::Ident(word) = self.peek().clone() {
+                    if !super::RESERVED
+                        .iter()
+                        .any(|r| r.eq_ignore_ascii_case(&word))
+                    {
+                        self.bump();
+                        let field = Name {
+                            text: word,
+                            pos: field_pos,
+                        };
+                        e = Expr::Field(Box::new(e), field);
+                    }
+                }
             } else if self.eat(&Tok::LParen) {
                 let args = self.arguments()?;
                 e = Expr::Call {
