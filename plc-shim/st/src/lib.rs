@@ -13,9 +13,12 @@
 pub mod ast;
 pub mod check;
 pub mod diag;
+pub mod ir;
+pub mod layout;
 pub mod lex;
 pub mod parse;
 pub mod types;
+pub mod vm;
 
 pub use diag::{Diagnostic, Pos};
 pub use parse::parse;

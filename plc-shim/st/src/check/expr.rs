@@ -295,7 +295,7 @@ impl Checker {
     }
 
     /// The type both sides of `l op r` go to, literals taking the other side's type.
-    fn operands(&mut self, l: &Expr, r: &Expr, ctx: Ctx) -> Option<(Elem, Type, Type)> {
+    pub(super) fn operands(&mut self, l: &Expr, r: &Expr, ctx: Ctx) -> Option<(Elem, Type, Type)> {
         let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
         let common = match (&lt, &rt) {
             (Type::Elem(a), Type::Elem(b)) => {

@@ -11,6 +11,7 @@ use crate::types::Elem;
 use std::collections::HashMap;
 
 mod expr;
+mod lower;
 pub mod std_lib;
 mod stmt;
 
@@ -111,18 +112,63 @@ enum Named {
 
 /// Checks `files` (name and tree) as one program: the tables, or every refusal.
 pub fn check(files: &[(String, Unit)]) -> Result<Checked, Vec<Diagnostic>> {
+    checker(files).map(|c| c.out)
+}
+
+fn checker(files: &[(String, Unit)]) -> Result<Checker, Vec<Diagnostic>> {
     let mut c = Checker::default();
     c.collect(files);
     c.resolve_types(files);
     c.resolve_vars(files);
     c.check_bodies(files);
     if c.errors.is_empty() {
-        Ok(c.out)
+        Ok(c)
     } else {
         c.errors
             .sort_by(|a, b| (&a.file, a.pos).cmp(&(&b.file, b.pos)));
         Err(c.errors)
     }
+}
+
+/// A program checked and lowered: what the runtime runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Compiled {
+    /// The tables.
+    pub checked: Checked,
+    /// Where everything lives.
+    pub layout: crate::layout::Layout,
+    /// Per POU: the stores of its variables' initial values, and its statements.
+    pub bodies: Vec<(Vec<crate::ir::St>, Vec<crate::ir::St>)>,
+    /// The files, by the index statements carry.
+    pub files: Vec<String>,
+}
+
+/// Checks and lowers `files`: the program, or every refusal.
+pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
+    let mut c = checker(files)?;
+    let layout = crate::layout::Layout::of(&c.out)
+        .map_err(|e| vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(&files[0].0)])?;
+    let mut bodies = vec![(Vec::new(), Vec::new()); c.out.pous.len()];
+    let mut errors = Vec::new();
+    for (f, (file, unit)) in files.iter().enumerate() {
+        c.file = file.clone();
+        for item in &unit.items {
+            let Item::Pou(p) = item else { continue };
+            match c.lower_pou(p, f as u16, &layout) {
+                Ok((i, inits, body)) => bodies[i] = (inits, body),
+                Err(e) => errors.push(e),
+            }
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    Ok(Compiled {
+        checked: c.out,
+        layout,
+        bodies,
+        files: files.iter().map(|(f, _)| f.clone()).collect(),
+    })
 }
 
 #[derive(Default)]

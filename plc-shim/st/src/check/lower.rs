@@ -1,0 +1,643 @@
+//! Lowering: a checked program into [`crate::ir`], every name a place in memory, every
+//! operation typed. It runs after the checker found nothing, so it asks the checker for the
+//! types of subexpressions instead of working them out again; what the runtime does not do
+//! yet (strings in expressions, a single bit written) is refused here with its place.
+
+use super::expr::{literal, Ctx, Meaning};
+use super::{Checker, Type};
+use crate::ast::{Arg, BinOp, CaseLabel, Expr, Name, Pou, PouKind, Stmt, UnOp};
+use crate::diag::{Diagnostic, Pos};
+use crate::ir::{Addr, Ex, St, StKind, StdFn};
+use crate::layout::{std_member, Layout};
+use crate::types::{conversion, Class, Elem};
+
+type R<T> = Result<T, Diagnostic>;
+
+impl Checker {
+    fn unsupported(&self, pos: Pos, what: &str) -> Diagnostic {
+        Diagnostic::new(pos, format!("{what} is not supported by the runtime yet"))
+            .in_file(&self.file)
+    }
+
+    /// POU `p` (file `file`): its index, the stores of its variables' initial values, its
+    /// statements.
+    pub(super) fn lower_pou(
+        &mut self,
+        p: &Pou,
+        file: u16,
+        layout: &Layout,
+    ) -> R<(usize, Vec<St>, Vec<St>)> {
+        let Some(super::Named::Pou(pou)) =
+            self.names.get(&p.name.text.to_ascii_uppercase()).cloned()
+        else {
+            return Err(
+                Diagnostic::new(p.name.pos, "a POU the checker did not see").in_file(&self.file)
+            );
+        };
+        let ctx = Ctx { pou, loops: 0 };
+        let mut inits = Vec::new();
+        self.lower_inits(p, ctx, file, layout, &mut inits)?;
+        let body = self.lower_block(&p.body, ctx, file, layout)?;
+        Ok((pou, inits, body))
+    }
+
+    /// Initial values of elementary variables, as stores (the runtime runs them once).
+    fn lower_inits(
+        &mut self,
+        p: &Pou,
+        ctx: Ctx,
+        file: u16,
+        l: &Layout,
+        out: &mut Vec<St>,
+    ) -> R<()> {
+        for block in &p.vars {
+            for d in &block.vars {
+                let Some(crate::ast::Init::Expr(e)) = &d.init else {
+                    if d.init.is_some() {
+                        let pos = d.names[0].pos;
+                        return Err(self.unsupported(pos, "an array or structure initialiser"));
+                    }
+                    continue;
+                };
+                for n in &d.names {
+                    let target = Expr::Name(n.clone());
+                    let kind = self.lower_assign(&target, e, ctx, l)?;
+                    out.push(St {
+                        kind,
+                        at: (file, n.pos),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The place a variable, field, element or dereference names, and its type.
+    fn place(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
+        match e {
+            Expr::Name(n) => self.name_place(n, ctx, l),
+            Expr::Field(base, field) => {
+                let (addr, ty) = self.place(base, ctx, l)?;
+                let (offset, member) = self.member(&ty, field, l)?;
+                Ok((Addr::Offset(Box::new(addr), offset), member))
+            }
+            Expr::Index(base, index, _) => {
+                let (mut addr, ty) = self.place(base, ctx, l)?;
+                let Type::Array(dims, element) = ty else {
+                    return Err(self.unsupported(e.pos(), "an index of this value"));
+                };
+                let (size, align) = l.size_align(&self.out, &element);
+                let mut stride = u64::from(size.div_ceil(align) * align);
+                let lens: Vec<u64> = dims.iter().map(|(lo, hi)| (hi - lo + 1) as u64).collect();
+                let mut strides = vec![0u64; dims.len()];
+                for k in (0..dims.len()).rev() {
+                    strides[k] = stride;
+                    stride *= lens[k];
+                }
+                for (k, i) in index.iter().enumerate() {
+                    let index = self.int_value(i, ctx, l)?;
+                    addr = Addr::Index {
+                        base: Box::new(addr),
+                        index: Box::new(index),
+                        lo: dims[k].0,
+                        len: lens[k] as u32,
+                        stride: strides[k] as u32,
+                    };
+                }
+                Ok((addr, *element))
+            }
+            Expr::Deref(p, _) => match self.expr(p, ctx) {
+                Type::Pointer(t) => Ok((Addr::Deref(Box::new(self.value(p, ctx, l)?)), *t)),
+                _ => Err(self.unsupported(e.pos(), "`^` of this value")),
+            },
+            _ => Err(self.unsupported(e.pos(), "a place of this kind")),
+        }
+    }
+
+    fn name_place(&mut self, n: &Name, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
+        let pou = &self.out.pous[ctx.pou];
+        let local = |offset: u32| match pou.kind {
+            PouKind::FunctionBlock => Addr::Instance(offset),
+            _ => Addr::Static(l.statics[ctx.pou] + offset),
+        };
+        match self.meaning(&n.text, ctx) {
+            Some(Meaning::Local(i)) => Ok((local(l.pous[ctx.pou].2[i]), pou.vars[i].ty.clone())),
+            Some(Meaning::Return(t)) => {
+                let offset = *l.pous[ctx.pou].2.last().unwrap_or(&0);
+                Ok((local(offset), t))
+            }
+            Some(Meaning::Global(i)) => {
+                Ok((Addr::Static(l.globals[i]), self.out.globals[i].ty.clone()))
+            }
+            _ => Err(self.unsupported(n.pos, "a place of this name")),
+        }
+    }
+
+    /// The offset and type of member `field` of a value of `ty`.
+    fn member(&self, ty: &Type, field: &Name, l: &Layout) -> R<(u32, Type)> {
+        let same = |a: &str| a.eq_ignore_ascii_case(&field.text);
+        match ty {
+            Type::Struct(i) => {
+                let k = self.out.structs[*i]
+                    .fields
+                    .iter()
+                    .position(|(f, _)| same(f));
+                k.map(|k| (l.structs[*i].2[k], self.out.structs[*i].fields[k].1.clone()))
+            }
+            Type::Fb(i) => {
+                let k = self.out.pous[*i].vars.iter().position(|v| same(&v.name));
+                k.map(|k| (l.pous[*i].2[k], self.out.pous[*i].vars[k].ty.clone()))
+            }
+            Type::StdFb(fb) => {
+                let member = fb.member(&field.text);
+                member
+                    .and_then(|(_, t, _)| std_member(*fb, &field.text).map(|o| (o, Type::Elem(t))))
+            }
+            _ => None,
+        }
+        .ok_or_else(|| self.unsupported(field.pos, "this member"))
+    }
+
+    /// The value of an integer expression (an index, a CASE selector), as an integer.
+    fn int_value(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
+        self.value(e, ctx, l)
+    }
+
+    /// The value of `e` as type `to`: converted if it is of another elementary type.
+    fn value_as(&mut self, e: &Expr, to: Elem, ctx: Ctx, l: &Layout) -> R<Ex> {
+        if let Some(v) = literal(e) {
+            return Ok(match to.class() {
+                Class::Float => Ex::Real(v as f64),
+                _ => Ex::Int(v as i64),
+            });
+        }
+        let from = match self.expr(e, ctx) {
+            Type::Elem(f) => f,
+            Type::Enum(i) => self.out.enums[i].base,
+            _ => to,
+        };
+        let v = self.value(e, ctx, l)?;
+        Ok(if from == to {
+            v
+        } else {
+            Ex::Conv(from, to, Box::new(v))
+        })
+    }
+
+    /// The value of an expression of an elementary, enumeration or pointer type.
+    pub(super) fn value(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
+        match e {
+            Expr::Int(v, _) => Ok(Ex::Int(*v as i64)),
+            Expr::Real(v, _) => Ok(Ex::Real(*v)),
+            Expr::Bool(b, _) => Ok(Ex::Int(i64::from(*b))),
+            // TIME counts milliseconds.
+            Expr::Time(ns, _) => Ok(Ex::Int((*ns / 1_000_000) as i64)),
+            Expr::Str(_, pos) => Err(self.unsupported(*pos, "a string in an expression")),
+            Expr::Typed { ty, value } => self.typed_value(ty, value),
+            Expr::Name(n) => match self.meaning(&n.text, ctx) {
+                Some(Meaning::EnumValue(i)) => Ok(Ex::Int(self.enum_value(i, &n.text))),
+                _ => self.load(e, ctx, l),
+            },
+            Expr::Field(base, field) => self.field_value(e, base, field, ctx, l),
+            Expr::Index(..) | Expr::Deref(..) => self.load(e, ctx, l),
+            Expr::Unary(op, inner, _) => {
+                let Type::Elem(t) = self.expr(e, ctx) else {
+                    return Err(self.unsupported(e.pos(), "this operand"));
+                };
+                let v = Box::new(self.value_as(inner, t, ctx, l)?);
+                Ok(match op {
+                    UnOp::Neg => Ex::Neg(v, t),
+                    UnOp::Not => Ex::Not(v, t),
+                })
+            }
+            Expr::Binary(op, a, b, _) => self.binary_value(*op, a, b, ctx, l),
+            Expr::Call { callee, args, .. } => self.call_value_ir(callee, args, ctx, l),
+        }
+    }
+
+    fn enum_value(&self, i: usize, name: &str) -> i64 {
+        let values = &self.out.enums[i].values;
+        let found = values.iter().find(|(v, _)| v.eq_ignore_ascii_case(name));
+        found.map_or(0, |(_, n)| *n as i64)
+    }
+
+    fn typed_value(&mut self, ty: &Name, value: &Expr) -> R<Ex> {
+        match (Elem::named(&ty.text), value) {
+            (Some(e), Expr::Int(v, _)) if e.class() == Class::Float => Ok(Ex::Real(*v as f64)),
+            (Some(_), Expr::Int(v, _)) => Ok(Ex::Int(*v as i64)),
+            (Some(_), Expr::Real(v, _)) => Ok(Ex::Real(*v)),
+            (Some(_), Expr::Bool(b, _)) => Ok(Ex::Int(i64::from(*b))),
+            (None, Expr::Name(v)) => match self.names.get(&ty.text.to_ascii_uppercase()) {
+                Some(super::Named::Enum(i)) => Ok(Ex::Int(self.enum_value(*i, &v.text))),
+                _ => Err(self.unsupported(ty.pos, "this typed literal")),
+            },
+            _ => Err(self.unsupported(ty.pos, "this typed literal")),
+        }
+    }
+
+    fn field_value(&mut self, e: &Expr, base: &Expr, field: &Name, ctx: Ctx, l: &Layout) -> R<Ex> {
+        if let Expr::Name(n) = base {
+            if let Some(Meaning::EnumType(i)) = self.meaning(&n.text, ctx) {
+                return Ok(Ex::Int(self.enum_value(i, &field.text)));
+            }
+        }
+        if let Ok(bit) = field.text.parse::<u32>() {
+            let Type::Elem(t) = self.expr(base, ctx) else {
+                return Err(self.unsupported(field.pos, "this bit"));
+            };
+            let word = self.value(base, ctx, l)?;
+            let shifted = Ex::Std(StdFn::Shr, t, vec![word, Ex::Int(i64::from(bit))]);
+            return Ok(Ex::Bin(
+                BinOp::And,
+                t,
+                Box::new(shifted),
+                Box::new(Ex::Int(1)),
+            ));
+        }
+        self.load(e, ctx, l)
+    }
+
+    fn load(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
+        let (addr, ty) = self.place(e, ctx, l)?;
+        match ty {
+            Type::Elem(t) => Ok(Ex::Load(Box::new(addr), t)),
+            Type::Enum(i) => Ok(Ex::Load(Box::new(addr), self.out.enums[i].base)),
+            Type::Pointer(_) => Ok(Ex::LoadPtr(Box::new(addr))),
+            _ => Err(self.unsupported(e.pos(), "a value of this type in an expression")),
+        }
+    }
+
+    fn binary_value(&mut self, op: BinOp, a: &Expr, b: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
+        let (ta, tb) = (self.expr(a, ctx), self.expr(b, ctx));
+        let t = match (&ta, &tb) {
+            (Type::Enum(i), _) | (_, Type::Enum(i)) => self.out.enums[*i].base,
+            (Type::Pointer(_), _) => Elem::ULInt,
+            _ => match self.operands(a, b, ctx) {
+                Some((c, _, _)) => c,
+                None => return Err(self.unsupported(a.pos(), "these operands")),
+            },
+        };
+        let (x, y) = (self.value_as(a, t, ctx, l)?, self.value_as(b, t, ctx, l)?);
+        Ok(Ex::Bin(op, t, Box::new(x), Box::new(y)))
+    }
+
+    fn call_value_ir(&mut self, callee: &Expr, args: &[Arg], ctx: Ctx, l: &Layout) -> R<Ex> {
+        let Expr::Name(n) = callee else {
+            return Err(self.unsupported(callee.pos(), "this call"));
+        };
+        let positional: Vec<&Expr> = args
+            .iter()
+            .filter_map(|a| match a {
+                Arg::Positional(v) => Some(v),
+                _ => None,
+            })
+            .collect();
+        if let Some((from, to)) = conversion(&n.text) {
+            let v = self.value_as(positional[0], from, ctx, l)?;
+            return Ok(Ex::Conv(from, to, Box::new(v)));
+        }
+        let upper = n.text.to_ascii_uppercase();
+        if upper == "ADR" {
+            let (addr, _) = self.place(positional[0], ctx, l)?;
+            return Ok(Ex::AddrOf(Box::new(addr)));
+        }
+        if upper == "SIZEOF" {
+            let t = self.expr(positional[0], ctx);
+            return Ok(Ex::Int(i64::from(l.size_align(&self.out, &t).0)));
+        }
+        if let Some(f) = std_fn(&upper) {
+            return self.std_value(f, n, &positional, ctx, l);
+        }
+        match self.meaning(&n.text, ctx) {
+            Some(Meaning::Function(i)) => self.function_value(i, args, n.pos, ctx, l),
+            _ => Err(self.unsupported(n.pos, "this call")),
+        }
+    }
+
+    fn std_value(&mut self, f: StdFn, n: &Name, args: &[&Expr], ctx: Ctx, l: &Layout) -> R<Ex> {
+        let Type::Elem(result) = self.expr(
+            &Expr::Call {
+                callee: Box::new(Expr::Name(n.clone())),
+                args: args.iter().map(|a| Arg::Positional((*a).clone())).collect(),
+                pos: n.pos,
+            },
+            ctx,
+        ) else {
+            return Err(self.unsupported(n.pos, "this standard function's values"));
+        };
+        // The type the values are computed in.
+        let within = match f {
+            StdFn::Trunc => Elem::LReal,
+            StdFn::Sqrt
+            | StdFn::Ln
+            | StdFn::Log
+            | StdFn::Exp
+            | StdFn::Sin
+            | StdFn::Cos
+            | StdFn::Tan
+            | StdFn::Asin
+            | StdFn::Acos
+            | StdFn::Atan => result,
+            _ => result,
+        };
+        let mut values = Vec::with_capacity(args.len());
+        for (k, a) in args.iter().enumerate() {
+            let selector = matches!(f, StdFn::Sel | StdFn::Mux) && k == 0;
+            let shift = matches!(f, StdFn::Shl | StdFn::Shr | StdFn::Rol | StdFn::Ror) && k == 1;
+            values.push(match (selector, shift) {
+                (true, _) | (_, true) => self.value_as(a, Elem::LInt, ctx, l)?,
+                _ => self.value_as(a, within, ctx, l)?,
+            });
+        }
+        let v = Ex::Std(f, within, values);
+        Ok(if within == result {
+            v
+        } else {
+            Ex::Conv(within, result, Box::new(v))
+        })
+    }
+
+    fn function_value(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx, l: &Layout) -> R<Ex> {
+        let base = l.statics[i];
+        let inputs: Vec<usize> = (0..self.out.pous[i].vars.len())
+            .filter(|k| self.out.pous[i].vars[*k].section == crate::ast::Section::Input)
+            .collect();
+        let mut stores = Vec::new();
+        for (k, arg) in args.iter().enumerate() {
+            let (var, value) = match arg {
+                Arg::Positional(v) => (inputs.get(k).copied(), v),
+                Arg::Input(n, v) => {
+                    let found = inputs
+                        .iter()
+                        .copied()
+                        .find(|x| self.out.pous[i].vars[*x].name.eq_ignore_ascii_case(&n.text));
+                    (found, v)
+                }
+                Arg::Output { name, .. } => {
+                    return Err(self.unsupported(name.pos, "an output of a function"))
+                }
+            };
+            let Some(var) = var else {
+                return Err(self.unsupported(value.pos(), "this argument"));
+            };
+            let Type::Elem(t) = self.out.pous[i].vars[var].ty.clone() else {
+                return Err(self.unsupported(value.pos(), "an input that is no elementary value"));
+            };
+            let addr = Addr::Static(base + l.pous[i].2[var]);
+            let v = self.value_as(value, t, ctx, l)?;
+            stores.push(St {
+                kind: StKind::Store(addr, t, v),
+                at: (0, pos),
+            });
+        }
+        let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
+            return Err(self.unsupported(pos, "a function whose value is no elementary value"));
+        };
+        let value = Addr::Static(base + *l.pous[i].2.last().unwrap_or(&0));
+        Ok(Ex::Call {
+            pou: i,
+            inputs: stores,
+            value: Box::new(value),
+            ty,
+        })
+    }
+
+    /// `target := value` as a store or a copy.
+    pub(super) fn lower_assign(
+        &mut self,
+        target: &Expr,
+        value: &Expr,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<StKind> {
+        if let Expr::Field(_, f) = target {
+            if f.text.parse::<u32>().is_ok() {
+                return Err(self.unsupported(f.pos, "writing a single bit"));
+            }
+        }
+        let (addr, ty) = self.place(target, ctx, l)?;
+        Ok(match ty {
+            Type::Elem(t) => StKind::Store(addr, t, self.value_as(value, t, ctx, l)?),
+            Type::Enum(i) => {
+                let base = self.out.enums[i].base;
+                StKind::Store(addr, base, self.value_as(value, base, ctx, l)?)
+            }
+            Type::Pointer(_) => StKind::StorePtr(addr, self.value(value, ctx, l)?),
+            Type::Array(..) | Type::Struct(_) => {
+                let (from, _) = self.place(value, ctx, l)?;
+                let size = l.size_align(&self.out, &ty).0;
+                StKind::Copy(addr, from, size)
+            }
+            _ => return Err(self.unsupported(target.pos(), "an assignment of this type")),
+        })
+    }
+
+    fn lower_stmt(&mut self, s: &Stmt, ctx: Ctx, file: u16, l: &Layout) -> R<St> {
+        let at = (file, stmt_pos(s));
+        let kind = match s {
+            Stmt::Assign { target, value } => self.lower_assign(target, value, ctx, l)?,
+            Stmt::Call(call) => self.lower_call(call, ctx, l)?,
+            Stmt::If {
+                branches,
+                otherwise,
+            } => {
+                let mut arms = Vec::with_capacity(branches.len());
+                for (cond, body) in branches {
+                    let c = self.value(cond, ctx, l)?;
+                    arms.push((c, self.lower_block(body, ctx, file, l)?));
+                }
+                let other = self.lower_block(otherwise.as_deref().unwrap_or(&[]), ctx, file, l)?;
+                StKind::If(arms, other)
+            }
+            Stmt::Case {
+                selector,
+                arms,
+                otherwise,
+            } => {
+                let sel = self.value(selector, ctx, l)?;
+                let mut out = Vec::with_capacity(arms.len());
+                for (labels, body) in arms {
+                    let mut ranges = Vec::with_capacity(labels.len());
+                    for label in labels {
+                        let (a, b) = match label {
+                            CaseLabel::Value(v) => (v, v),
+                            CaseLabel::Range(a, b) => (a, b),
+                        };
+                        ranges.push((self.constant(a, ctx)?, self.constant(b, ctx)?));
+                    }
+                    out.push((ranges, self.lower_block(body, ctx, file, l)?));
+                }
+                let other = self.lower_block(otherwise.as_deref().unwrap_or(&[]), ctx, file, l)?;
+                StKind::Case(sel, out, other)
+            }
+            Stmt::For {
+                var,
+                from,
+                to,
+                by,
+                body,
+            } => {
+                let (addr, ty) = self.place(&Expr::Name(var.clone()), ctx, l)?;
+                let Type::Elem(t) = ty else {
+                    return Err(self.unsupported(var.pos, "this FOR variable"));
+                };
+                let by = match by {
+                    Some(b) => self.value_as(b, t, ctx, l)?,
+                    None => Ex::Int(1),
+                };
+                StKind::For {
+                    var: addr,
+                    ty: t,
+                    from: self.value_as(from, t, ctx, l)?,
+                    to: self.value_as(to, t, ctx, l)?,
+                    by,
+                    body: self.lower_block(
+                        body,
+                        Ctx {
+                            loops: ctx.loops + 1,
+                            ..ctx
+                        },
+                        file,
+                        l,
+                    )?,
+                }
+            }
+            Stmt::While { cond, body } => StKind::While(
+                self.value(cond, ctx, l)?,
+                self.lower_block(body, ctx, file, l)?,
+            ),
+            Stmt::Repeat { body, until } => StKind::Repeat(
+                self.lower_block(body, ctx, file, l)?,
+                self.value(until, ctx, l)?,
+            ),
+            Stmt::Exit(_) => StKind::Exit,
+            Stmt::Continue(_) => StKind::Continue,
+            Stmt::Return(_) => StKind::Return,
+        };
+        Ok(St { kind, at })
+    }
+
+    fn lower_block(&mut self, body: &[Stmt], ctx: Ctx, file: u16, l: &Layout) -> R<Vec<St>> {
+        body.iter()
+            .map(|s| self.lower_stmt(s, ctx, file, l))
+            .collect()
+    }
+
+    /// The number a CASE label stands for.
+    fn constant(&mut self, e: &Expr, ctx: Ctx) -> R<i64> {
+        if let Some(v) = literal(e) {
+            return Ok(v as i64);
+        }
+        let scratch = Layout {
+            statics: vec![0; self.out.pous.len()],
+            ..Layout::default()
+        };
+        match self.value(e, ctx, &scratch)? {
+            Ex::Int(v) => Ok(v),
+            _ => Err(self.unsupported(e.pos(), "a CASE label that is no constant")),
+        }
+    }
+
+    /// A call statement: a function block instance's or a function's.
+    fn lower_call(&mut self, call: &Expr, ctx: Ctx, l: &Layout) -> R<StKind> {
+        let Expr::Call { callee, args, .. } = call else {
+            return Err(self.unsupported(call.pos(), "this call"));
+        };
+        let errors = self.errors.len();
+        let ty = self.expr(callee, ctx);
+        self.errors.truncate(errors);
+        let (pou, fb) = match ty {
+            Type::Fb(i) => (Some(i), None),
+            Type::StdFb(fb) => (None, Some(fb)),
+            _ => return Ok(StKind::Eval(self.value(call, ctx, l)?)),
+        };
+        let (instance, _) = self.place(callee, ctx, l)?;
+        let (mut inputs, mut outputs) = (Vec::new(), Vec::new());
+        for arg in args {
+            let (name, is_input) = match arg {
+                Arg::Input(n, _) => (n, true),
+                Arg::Output { name, .. } => (name, false),
+                Arg::Positional(v) => return Err(self.unsupported(v.pos(), "a positional input")),
+            };
+            let inst_ty = match (pou, fb) {
+                (Some(i), _) => Type::Fb(i),
+                (_, Some(f)) => Type::StdFb(f),
+                _ => Type::Error,
+            };
+            let (offset, member) = self.member(&inst_ty, name, l)?;
+            let Type::Elem(t) = member else {
+                return Err(
+                    self.unsupported(name.pos, "an input or output that is no elementary value")
+                );
+            };
+            match arg {
+                Arg::Input(_, v) => inputs.push((offset, t, self.value_as(v, t, ctx, l)?)),
+                Arg::Output {
+                    target, negated, ..
+                } => {
+                    let (to, _) = self.place(target, ctx, l)?;
+                    outputs.push((offset, t, to, *negated));
+                }
+                Arg::Positional(_) => {}
+            }
+            let _ = is_input;
+        }
+        Ok(match (pou, fb) {
+            (Some(pou), _) => StKind::CallFb {
+                pou,
+                instance,
+                inputs,
+                outputs,
+            },
+            (_, Some(fb)) => StKind::CallStdFb {
+                fb,
+                instance,
+                inputs,
+                outputs,
+            },
+            _ => StKind::Eval(Ex::Int(0)),
+        })
+    }
+}
+
+/// The standard function of an upper-case name.
+fn std_fn(upper: &str) -> Option<StdFn> {
+    Some(match upper {
+        "ABS" => StdFn::Abs,
+        "SQRT" => StdFn::Sqrt,
+        "LN" => StdFn::Ln,
+        "LOG" => StdFn::Log,
+        "EXP" => StdFn::Exp,
+        "SIN" => StdFn::Sin,
+        "COS" => StdFn::Cos,
+        "TAN" => StdFn::Tan,
+        "ASIN" => StdFn::Asin,
+        "ACOS" => StdFn::Acos,
+        "ATAN" => StdFn::Atan,
+        "MIN" => StdFn::Min,
+        "MAX" => StdFn::Max,
+        "LIMIT" => StdFn::Limit,
+        "SEL" => StdFn::Sel,
+        "MUX" => StdFn::Mux,
+        "TRUNC" => StdFn::Trunc,
+        "SHL" => StdFn::Shl,
+        "SHR" => StdFn::Shr,
+        "ROL" => StdFn::Rol,
+        "ROR" => StdFn::Ror,
+        _ => return None,
+    })
+}
+
+/// Where a statement starts.
+fn stmt_pos(s: &Stmt) -> Pos {
+    match s {
+        Stmt::Assign { target, .. } => target.pos(),
+        Stmt::Call(c) => c.pos(),
+        Stmt::If { branches, .. } => branches.first().map_or(Pos::default(), |b| b.0.pos()),
+        Stmt::Case { selector, .. } => selector.pos(),
+        Stmt::For { var, .. } => var.pos,
+        Stmt::While { cond, .. } => cond.pos(),
+        Stmt::Repeat { until, .. } => until.pos(),
+        Stmt::Exit(p) | Stmt::Continue(p) | Stmt::Return(p) => *p,
+    }
+}

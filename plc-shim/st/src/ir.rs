@@ -1,0 +1,196 @@
+//! The compiled form of a checked program: statements and expressions with every name
+//! resolved to a place in the program's memory and every operation to its type. The runtime
+//! ([`crate::vm`]) walks it each cycle without allocating.
+
+use crate::ast::BinOp;
+use crate::check::std_lib::StdFb;
+use crate::diag::Pos;
+use crate::types::Elem;
+
+/// A place in the program's memory.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Addr {
+    /// An absolute offset (globals, programs' and functions' variables).
+    Static(u32),
+    /// An offset from the running function block instance's base.
+    Instance(u32),
+    /// A field or member `offset` bytes into a place.
+    Offset(Box<Addr>, u32),
+    /// Element `index - lo` of `len` elements `stride` bytes apart, from a place.
+    Index {
+        /// The array.
+        base: Box<Addr>,
+        /// The index.
+        index: Box<Ex>,
+        /// The lower bound.
+        lo: i64,
+        /// How many elements.
+        len: u32,
+        /// Bytes per element.
+        stride: u32,
+    },
+    /// Where a pointer value points.
+    Deref(Box<Ex>),
+}
+
+/// An expression: its value is an integer (any integer type, BOOL, TIME, a pointer) or a real.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Ex {
+    /// An integer constant.
+    Int(i64),
+    /// A real constant.
+    Real(f64),
+    /// The value of type `Elem` at a place.
+    Load(Box<Addr>, Elem),
+    /// The pointer at a place.
+    LoadPtr(Box<Addr>),
+    /// A pointer to a place.
+    AddrOf(Box<Addr>),
+    /// `-x` of an integer or real type.
+    Neg(Box<Ex>, Elem),
+    /// NOT of BOOL or bits.
+    Not(Box<Ex>, Elem),
+    /// `a op b`, both of type `Elem` (a comparison's value is BOOL).
+    Bin(BinOp, Elem, Box<Ex>, Box<Ex>),
+    /// A conversion between elementary types.
+    Conv(Elem, Elem, Box<Ex>),
+    /// A standard function, the type it computes in, its values.
+    Std(StdFn, Elem, Vec<Ex>),
+    /// A user function: its body index, the stores of its inputs into its frame, and the
+    /// place and type of its value.
+    Call {
+        /// The function's index among the POUs.
+        pou: usize,
+        /// Its inputs into its frame.
+        inputs: Vec<St>,
+        /// Its value.
+        value: Box<Addr>,
+        /// The value's type.
+        ty: Elem,
+    },
+}
+
+/// A CASE arm: the ranges of values it takes (a single value is a range of one) and its
+/// statements.
+pub type CaseArm = (Vec<(i64, i64)>, Vec<St>);
+
+/// A standard function the runtime computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StdFn {
+    /// ABS.
+    Abs,
+    /// SQRT.
+    Sqrt,
+    /// LN.
+    Ln,
+    /// LOG (base 10).
+    Log,
+    /// EXP.
+    Exp,
+    /// SIN.
+    Sin,
+    /// COS.
+    Cos,
+    /// TAN.
+    Tan,
+    /// ASIN.
+    Asin,
+    /// ACOS.
+    Acos,
+    /// ATAN.
+    Atan,
+    /// MIN of its values.
+    Min,
+    /// MAX of its values.
+    Max,
+    /// LIMIT(min, in, max).
+    Limit,
+    /// SEL(g, in0, in1).
+    Sel,
+    /// MUX(k, in0, ..).
+    Mux,
+    /// TRUNC.
+    Trunc,
+    /// SHL.
+    Shl,
+    /// SHR.
+    Shr,
+    /// ROL.
+    Rol,
+    /// ROR.
+    Ror,
+}
+
+/// A statement, with where it stands for a fault's report.
+#[derive(Debug, Clone, PartialEq)]
+pub struct St {
+    /// What it does.
+    pub kind: StKind,
+    /// Its file (index into the program's files) and place.
+    pub at: (u16, Pos),
+}
+
+/// What a statement does.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StKind {
+    /// Stores a value of an elementary type.
+    Store(Addr, Elem, Ex),
+    /// Stores a pointer.
+    StorePtr(Addr, Ex),
+    /// Copies `size` bytes (a structure, an array, a string).
+    Copy(Addr, Addr, u32),
+    /// IF/ELSIF/ELSE.
+    If(Vec<(Ex, Vec<St>)>, Vec<St>),
+    /// CASE: each arm's ranges of values and statements, then ELSE.
+    Case(Ex, Vec<CaseArm>, Vec<St>),
+    /// FOR.
+    For {
+        /// The control variable.
+        var: Addr,
+        /// Its type.
+        ty: Elem,
+        /// First value.
+        from: Ex,
+        /// Last value.
+        to: Ex,
+        /// Step.
+        by: Ex,
+        /// The statements.
+        body: Vec<St>,
+    },
+    /// WHILE.
+    While(Ex, Vec<St>),
+    /// REPEAT .. UNTIL.
+    Repeat(Vec<St>, Ex),
+    /// EXIT.
+    Exit,
+    /// CONTINUE.
+    Continue,
+    /// RETURN.
+    Return,
+    /// A function block instance's call: its inputs stored, its body run on its base, its
+    /// outputs read.
+    CallFb {
+        /// The function block's index among the POUs.
+        pou: usize,
+        /// The instance.
+        instance: Addr,
+        /// Inputs (stores relative to the instance) before the body.
+        inputs: Vec<(u32, Elem, Ex)>,
+        /// Outputs after it: offset in the instance, type, where it goes, negated.
+        outputs: Vec<(u32, Elem, Addr, bool)>,
+    },
+    /// A standard function block's call.
+    CallStdFb {
+        /// Which one.
+        fb: StdFb,
+        /// The instance.
+        instance: Addr,
+        /// Inputs.
+        inputs: Vec<(u32, Elem, Ex)>,
+        /// Outputs.
+        outputs: Vec<(u32, Elem, Addr, bool)>,
+    },
+    /// An expression whose value is dropped (a function called as a statement).
+    Eval(Ex),
+}

@@ -1,0 +1,593 @@
+//! The runtime of a compiled program: one memory sized at load, every PROGRAM's statements run
+//! once per cycle by walking the compiled tree, nothing allocated in a cycle. A cycle is
+//! bounded by a budget of steps (statements and loop rounds), so an endless loop ends it; a
+//! division by zero, an index outside its array, a pointer outside the memory, a conversion
+//! of a value its type cannot hold, or the budget spent is a [`Fault`] with the statement's
+//! file, line and column, and the program stops.
+
+use crate::ast::{BinOp, PouKind};
+use crate::check::{compile, Compiled, Type};
+use crate::diag::{Diagnostic, Pos};
+use crate::ir::{Addr, Ex, St, StKind};
+use crate::types::{Class, Elem};
+
+mod ops;
+mod std_fb;
+
+/// Why a cycle stopped the program.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    /// An integer or real divided by zero.
+    DivisionByZero,
+    /// An index outside its array's bounds.
+    IndexOutOfRange {
+        /// The index.
+        index: i64,
+        /// The lower bound.
+        lo: i64,
+        /// The upper bound.
+        hi: i64,
+    },
+    /// A pointer that is NULL or points outside the program's memory.
+    BadPointer,
+    /// A conversion of a value the target type cannot hold (or that is not finite).
+    OutOfRange,
+    /// The cycle's budget of steps is spent (an endless loop).
+    Budget(u64),
+    /// MUX's selector names no value.
+    MuxSelector(i64),
+}
+
+/// A fault and where it happened: small and `Copy`, made in the cycle; its text is made
+/// outside it ([`Program::fault_text`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FaultAt {
+    /// What.
+    pub fault: Fault,
+    /// The file's index among the program's files.
+    pub file: u16,
+    /// The statement's place.
+    pub pos: Pos,
+}
+
+impl core::fmt::Display for Fault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match *self {
+            Fault::DivisionByZero => write!(f, "division by zero"),
+            Fault::IndexOutOfRange { index, lo, hi } => {
+                write!(f, "index {index} outside [{lo}..{hi}]")
+            }
+            Fault::BadPointer => write!(f, "a pointer that is NULL or points outside the program"),
+            Fault::OutOfRange => write!(f, "a conversion of a value its type cannot hold"),
+            Fault::Budget(steps) => write!(f, "the cycle ran {steps} steps: an endless loop?"),
+            Fault::MuxSelector(k) => write!(f, "MUX selector {k} names no value"),
+        }
+    }
+}
+
+/// How a statement list ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Flow {
+    Next,
+    Exit,
+    Continue,
+    Return,
+}
+
+/// A value while it is computed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum V {
+    I(i64),
+    F(f64),
+}
+
+impl V {
+    fn int(self) -> i64 {
+        match self {
+            V::I(v) => v,
+            V::F(v) => v as i64,
+        }
+    }
+    fn float(self) -> f64 {
+        match self {
+            V::I(v) => v as f64,
+            V::F(v) => v,
+        }
+    }
+}
+
+/// The default budget of steps per cycle.
+pub const DEFAULT_BUDGET: u64 = 1_000_000;
+
+/// A loaded program: its code and its memory.
+#[derive(Debug, Clone)]
+pub struct Program {
+    code: Compiled,
+    memory: Vec<u8>,
+    budget: u64,
+    steps: u64,
+    now_ns: i64,
+    /// The statement being run (for a fault's place).
+    at: (u16, Pos),
+}
+
+type Run<T> = Result<T, Fault>;
+
+impl Program {
+    /// Parses, checks and compiles `files` (name and text), and sets every variable to its
+    /// initial value.
+    pub fn load(files: &[(&str, &str)]) -> Result<Program, Vec<Diagnostic>> {
+        let mut units = Vec::with_capacity(files.len());
+        for (name, text) in files {
+            units.push((
+                name.to_string(),
+                crate::parse_file(name, text).map_err(|d| vec![d])?,
+            ));
+        }
+        let code = compile(&units)?;
+        let mut p = Program {
+            memory: vec![0; code.layout.size as usize],
+            code,
+            budget: DEFAULT_BUDGET,
+            steps: 0,
+            now_ns: 0,
+            at: (0, Pos::default()),
+        };
+        if let Err(f) = p.initialise() {
+            let file = p
+                .code
+                .files
+                .get(f.file as usize)
+                .cloned()
+                .unwrap_or_default();
+            let message = format!("an initial value: {}", f.fault);
+            return Err(vec![Diagnostic::new(f.pos, message).in_file(&file)]);
+        }
+        Ok(p)
+    }
+
+    /// Sets the steps a cycle may run (statements and loop rounds).
+    pub fn set_budget(&mut self, steps: u64) {
+        self.budget = steps.max(1);
+    }
+
+    /// The compiled program.
+    pub fn code(&self) -> &Compiled {
+        &self.code
+    }
+
+    /// One cycle at time `now_ns` (the PLC's clock, for the timers): every PROGRAM's
+    /// statements in the order the files declare them.
+    pub fn cycle(&mut self, now_ns: i64) -> Result<(), FaultAt> {
+        self.now_ns = now_ns;
+        self.steps = 0;
+        for pou in 0..self.code.checked.pous.len() {
+            if self.code.checked.pous[pou].kind == PouKind::Program {
+                let base = self.code.layout.statics[pou];
+                self.run_body(pou, base).map_err(|f| self.fault_at(f))?;
+            }
+        }
+        Ok(())
+    }
+
+    fn fault_at(&self, fault: Fault) -> FaultAt {
+        FaultAt {
+            fault,
+            file: self.at.0,
+            pos: self.at.1,
+        }
+    }
+
+    /// A fault as `FILE:LINE:COL: fault: what`.
+    pub fn fault_text(&self, f: &FaultAt) -> String {
+        let file = self
+            .code
+            .files
+            .get(f.file as usize)
+            .map_or("?", String::as_str);
+        format!("{file}:{}:{}: fault: {}", f.pos.line, f.pos.col, f.fault)
+    }
+
+    /// Every variable's initial value: the globals' and programs' instances, and every
+    /// function block instance inside them.
+    fn initialise(&mut self) -> Result<(), FaultAt> {
+        let globals: Vec<(u32, Type)> = (0..self.code.checked.globals.len())
+            .map(|i| {
+                (
+                    self.code.layout.globals[i],
+                    self.code.checked.globals[i].ty.clone(),
+                )
+            })
+            .collect();
+        for (at, ty) in globals {
+            self.init_instances(&ty, at).map_err(|f| self.fault_at(f))?;
+        }
+        for pou in 0..self.code.checked.pous.len() {
+            if self.code.checked.pous[pou].kind == PouKind::Program {
+                let base = self.code.layout.statics[pou];
+                self.init_pou(pou, base).map_err(|f| self.fault_at(f))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// POU `pou`'s initial values at `base`, then those of the instances among its variables.
+    fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
+        let inits = std::mem::take(&mut self.code.bodies[pou].0);
+        let result = self.block(&inits, base);
+        self.code.bodies[pou].0 = inits;
+        result?;
+        for k in 0..self.code.checked.pous[pou].vars.len() {
+            let ty = self.code.checked.pous[pou].vars[k].ty.clone();
+            let offset = self.code.layout.pous[pou].2[k];
+            self.init_instances(&ty, base + offset)?;
+        }
+        Ok(())
+    }
+
+    fn init_instances(&mut self, ty: &Type, at: u32) -> Run<()> {
+        match ty {
+            Type::Fb(i) => self.init_pou(*i, at),
+            Type::Struct(i) => {
+                for k in 0..self.code.checked.structs[*i].fields.len() {
+                    let field = self.code.checked.structs[*i].fields[k].1.clone();
+                    let offset = self.code.layout.structs[*i].2[k];
+                    self.init_instances(&field, at + offset)?;
+                }
+                Ok(())
+            }
+            Type::Array(dims, element)
+                if matches!(**element, Type::Fb(_) | Type::Struct(_) | Type::Array(..)) =>
+            {
+                let (size, align) = self.code.layout.size_align(&self.code.checked, element);
+                let stride = size.div_ceil(align) * align;
+                let count: i64 = dims.iter().map(|(lo, hi)| hi - lo + 1).product();
+                for k in 0..count as u32 {
+                    self.init_instances(element, at + k * stride)?;
+                }
+                Ok(())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// POU `pou`'s statements on the instance at `base`.
+    fn run_body(&mut self, pou: usize, base: u32) -> Run<()> {
+        // The code is not changed by running it: take it out to borrow the memory freely.
+        let body = std::mem::take(&mut self.code.bodies[pou].1);
+        let result = self.block(&body, base);
+        self.code.bodies[pou].1 = body;
+        result.map(|_| ())
+    }
+
+    fn step(&mut self) -> Run<()> {
+        self.steps += 1;
+        if self.steps > self.budget {
+            return Err(Fault::Budget(self.steps));
+        }
+        Ok(())
+    }
+
+    fn block(&mut self, body: &[St], base: u32) -> Run<Flow> {
+        for s in body {
+            let flow = self.statement(s, base)?;
+            if flow != Flow::Next {
+                return Ok(flow);
+            }
+        }
+        Ok(Flow::Next)
+    }
+
+    fn statement(&mut self, s: &St, base: u32) -> Run<Flow> {
+        self.at = s.at;
+        self.step()?;
+        match &s.kind {
+            StKind::Store(a, t, e) => {
+                let v = self.eval(e, base)?;
+                let at = self.addr(a, base)?;
+                self.write(at, *t, v)?;
+            }
+            StKind::StorePtr(a, e) => {
+                let v = self.eval(e, base)?;
+                let at = self.addr(a, base)?;
+                self.write(at, Elem::ULInt, v)?;
+            }
+            StKind::Copy(to, from, size) => {
+                let (to, from) = (self.addr(to, base)?, self.addr(from, base)?);
+                let n = *size as usize;
+                self.check(to, n)?;
+                self.check(from, n)?;
+                self.memory.copy_within(from..from + n, to);
+            }
+            StKind::If(arms, otherwise) => {
+                for (cond, body) in arms {
+                    if self.eval(cond, base)?.int() != 0 {
+                        return self.block(body, base);
+                    }
+                }
+                return self.block(otherwise, base);
+            }
+            StKind::Case(sel, arms, otherwise) => {
+                let v = self.eval(sel, base)?.int();
+                for (ranges, body) in arms {
+                    if ranges.iter().any(|(lo, hi)| (*lo..=*hi).contains(&v)) {
+                        return self.block(body, base);
+                    }
+                }
+                return self.block(otherwise, base);
+            }
+            StKind::For {
+                var,
+                ty,
+                from,
+                to,
+                by,
+                body,
+            } => return self.for_loop(var, *ty, (from, to, by), body, base),
+            StKind::While(cond, body) => loop {
+                self.at = s.at;
+                self.step()?;
+                if self.eval(cond, base)?.int() == 0 {
+                    break;
+                }
+                match self.block(body, base)? {
+                    Flow::Exit => break,
+                    Flow::Return => return Ok(Flow::Return),
+                    _ => {}
+                }
+            },
+            StKind::Repeat(body, until) => loop {
+                self.step()?;
+                match self.block(body, base)? {
+                    Flow::Exit => break,
+                    Flow::Return => return Ok(Flow::Return),
+                    _ => {}
+                }
+                self.at = s.at;
+                if self.eval(until, base)?.int() != 0 {
+                    break;
+                }
+            },
+            StKind::Exit => return Ok(Flow::Exit),
+            StKind::Continue => return Ok(Flow::Continue),
+            StKind::Return => return Ok(Flow::Return),
+            StKind::CallFb {
+                pou,
+                instance,
+                inputs,
+                outputs,
+            } => {
+                let at = self.addr(instance, base)? as u32;
+                self.store_all(inputs, at, base)?;
+                self.run_body(*pou, at)?;
+                self.at = s.at;
+                self.read_outputs(outputs, at, base)?;
+            }
+            StKind::CallStdFb {
+                fb,
+                instance,
+                inputs,
+                outputs,
+            } => {
+                let at = self.addr(instance, base)? as u32;
+                self.store_all(inputs, at, base)?;
+                self.run_std_fb(*fb, at as usize)?;
+                self.read_outputs(outputs, at, base)?;
+            }
+            StKind::Eval(e) => {
+                self.eval(e, base)?;
+            }
+        }
+        Ok(Flow::Next)
+    }
+
+    fn for_loop(
+        &mut self,
+        var: &Addr,
+        ty: Elem,
+        (from, to, by): (&Ex, &Ex, &Ex),
+        body: &[St],
+        base: u32,
+    ) -> Run<Flow> {
+        let at = self.addr(var, base)?;
+        let (first, last, step) = (
+            self.eval(from, base)?.int(),
+            self.eval(to, base)?.int(),
+            self.eval(by, base)?.int(),
+        );
+        let mut i = first;
+        loop {
+            if (step >= 0 && i > last) || (step < 0 && i < last) {
+                break;
+            }
+            self.write(at, ty, V::I(i))?;
+            self.step()?;
+            match self.block(body, base)? {
+                Flow::Exit => break,
+                Flow::Return => return Ok(Flow::Return),
+                _ => {}
+            }
+            // The body may have changed the variable; a step of 0 ends on the budget.
+            i = self.read(at, ty)?.int();
+            match i.checked_add(step) {
+                Some(next) => i = next,
+                None => break,
+            }
+        }
+        Ok(Flow::Next)
+    }
+
+    fn store_all(&mut self, inputs: &[(u32, Elem, Ex)], at: u32, base: u32) -> Run<()> {
+        for (offset, t, e) in inputs {
+            let v = self.eval(e, base)?;
+            self.write((at + offset) as usize, *t, v)?;
+        }
+        Ok(())
+    }
+
+    fn read_outputs(&mut self, outputs: &[(u32, Elem, Addr, bool)], at: u32, base: u32) -> Run<()> {
+        for (offset, t, target, negated) in outputs {
+            let mut v = self.read((at + offset) as usize, *t)?;
+            if *negated {
+                v = V::I(i64::from(v.int() == 0));
+            }
+            let to = self.addr(target, base)?;
+            self.write(to, *t, v)?;
+        }
+        Ok(())
+    }
+
+    /// The byte offset a place names.
+    fn addr(&mut self, a: &Addr, base: u32) -> Run<usize> {
+        Ok(match a {
+            Addr::Static(o) => *o as usize,
+            Addr::Instance(o) => (base + o) as usize,
+            Addr::Offset(inner, o) => self.addr(inner, base)? + *o as usize,
+            Addr::Index {
+                base: array,
+                index,
+                lo,
+                len,
+                stride,
+            } => {
+                let i = self.eval(index, base)?.int();
+                let hi = lo + i64::from(*len) - 1;
+                if i < *lo || i > hi {
+                    return Err(Fault::IndexOutOfRange {
+                        index: i,
+                        lo: *lo,
+                        hi,
+                    });
+                }
+                self.addr(array, base)? + (i - lo) as usize * *stride as usize
+            }
+            Addr::Deref(p) => {
+                let p = self.eval(p, base)?.int();
+                if p <= 0 || p as u64 > self.memory.len() as u64 {
+                    return Err(Fault::BadPointer);
+                }
+                (p - 1) as usize
+            }
+        })
+    }
+
+    fn check(&self, at: usize, n: usize) -> Run<()> {
+        match at.checked_add(n) {
+            Some(end) if end <= self.memory.len() => Ok(()),
+            _ => Err(Fault::BadPointer),
+        }
+    }
+
+    pub(crate) fn read(&self, at: usize, t: Elem) -> Run<V> {
+        let n = t.size();
+        self.check(at, n)?;
+        let mut bytes = [0u8; 8];
+        bytes[..n].copy_from_slice(&self.memory[at..at + n]);
+        let raw = u64::from_le_bytes(bytes);
+        Ok(match t {
+            Elem::Real => V::F(f64::from(f32::from_bits(raw as u32))),
+            Elem::LReal => V::F(f64::from_bits(raw)),
+            _ => V::I(ops::wrap(raw as i64, t)),
+        })
+    }
+
+    pub(crate) fn write(&mut self, at: usize, t: Elem, v: V) -> Run<()> {
+        let n = t.size();
+        self.check(at, n)?;
+        let raw = match t {
+            Elem::Real => u64::from((v.float() as f32).to_bits()),
+            Elem::LReal => v.float().to_bits(),
+            _ => v.int() as u64,
+        };
+        self.memory[at..at + n].copy_from_slice(&raw.to_le_bytes()[..n]);
+        Ok(())
+    }
+
+    fn eval(&mut self, e: &Ex, base: u32) -> Run<V> {
+        Ok(match e {
+            Ex::Int(v) => V::I(*v),
+            Ex::Real(v) => V::F(*v),
+            Ex::Load(a, t) => {
+                let at = self.addr(a, base)?;
+                self.read(at, *t)?
+            }
+            Ex::LoadPtr(a) => {
+                let at = self.addr(a, base)?;
+                self.read(at, Elem::ULInt)?
+            }
+            Ex::AddrOf(a) => V::I(self.addr(a, base)? as i64 + 1),
+            Ex::Neg(x, t) => ops::neg(self.eval(x, base)?, *t),
+            Ex::Not(x, t) => ops::not(self.eval(x, base)?, *t),
+            Ex::Bin(op, t, a, b) => {
+                let (x, y) = (self.eval(a, base)?, self.eval(b, base)?);
+                ops::binary(*op, *t, x, y)?
+            }
+            Ex::Conv(from, to, x) => ops::convert(self.eval(x, base)?, *from, *to)?,
+            Ex::Std(f, t, args) => self.std_fn(*f, *t, args, base)?,
+            Ex::Call {
+                pou,
+                inputs,
+                value,
+                ty,
+            } => {
+                let frame = self.code.layout.statics[*pou];
+                let (size, _, _) = self.code.layout.pous[*pou];
+                // A function's variables start from zero and their initial values each call.
+                self.memory[frame as usize..(frame + size) as usize].fill(0);
+                let inits = std::mem::take(&mut self.code.bodies[*pou].0);
+                let r = self.block(&inits, frame);
+                self.code.bodies[*pou].0 = inits;
+                r?;
+                self.block(inputs, base)?;
+                self.run_body(*pou, frame)?;
+                let at = self.addr(value, base)?;
+                self.read(at, *ty)?
+            }
+        })
+    }
+
+    fn std_fn(&mut self, f: crate::ir::StdFn, t: Elem, args: &[Ex], base: u32) -> Run<V> {
+        // At most a handful of values: no allocation for them.
+        let mut values = [V::I(0); 16];
+        let n = args.len().min(16);
+        for (k, a) in args.iter().take(16).enumerate() {
+            values[k] = self.eval(a, base)?;
+        }
+        ops::standard(f, t, &values[..n])
+    }
+
+    /// The value of a variable of a PROGRAM, by `PROGRAM.variable` (ASCII case ignored), as
+    /// a number: for tests and the tools.
+    pub fn read_var(&self, path: &str) -> Option<f64> {
+        let (program, var) = path.split_once('.')?;
+        let c = &self.code.checked;
+        let pou = c
+            .pous
+            .iter()
+            .position(|p| p.name.eq_ignore_ascii_case(program))?;
+        let k = c.pous[pou]
+            .vars
+            .iter()
+            .position(|v| v.name.eq_ignore_ascii_case(var))?;
+        let at = (self.code.layout.statics[pou] + self.code.layout.pous[pou].2[k]) as usize;
+        let t = match &c.pous[pou].vars[k].ty {
+            Type::Elem(t) => *t,
+            Type::Enum(i) => c.enums[*i].base,
+            _ => return None,
+        };
+        self.read(at, t).ok().map(V::float)
+    }
+
+    /// Whether `op` of type `t` compares (a BOOL value).
+    pub(crate) fn compares(op: BinOp) -> bool {
+        matches!(
+            op,
+            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge
+        )
+    }
+
+    /// Whether type `t` is unsigned (read without a sign).
+    pub(crate) fn unsigned(t: Elem) -> bool {
+        matches!(t.class(), Class::Unsigned | Class::Bits | Class::Bool)
+    }
+}

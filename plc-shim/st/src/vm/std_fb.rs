@@ -1,0 +1,130 @@
+//! The standard function blocks on their instances' memory (the offsets are
+//! [`crate::layout::std_fb`]'s): the timers on the cycle's clock, the edges, the counters and
+//! the bistables.
+
+use super::{Fault, Program, V};
+use crate::check::std_lib::StdFb;
+use crate::types::Elem;
+
+type Run<T> = Result<T, Fault>;
+
+/// Timer state: running at byte 2 (bit 0), the last IN (bit 1); the start at byte 16 (ns).
+const STATE: usize = 2;
+const START: usize = 16;
+
+impl Program {
+    fn flag(&self, at: usize) -> Run<bool> {
+        Ok(self.read(at, Elem::Bool)?.int() != 0)
+    }
+
+    fn set_flag(&mut self, at: usize, v: bool) -> Run<()> {
+        self.write(at, Elem::Bool, V::I(i64::from(v)))
+    }
+
+    pub(super) fn run_std_fb(&mut self, fb: StdFb, at: usize) -> Run<()> {
+        match fb {
+            StdFb::Ton | StdFb::Tof | StdFb::Tp => self.timer(fb, at),
+            StdFb::RTrig | StdFb::FTrig => {
+                let (clk, last) = (self.flag(at)?, self.flag(at + 2)?);
+                let q = if fb == StdFb::RTrig {
+                    clk && !last
+                } else {
+                    !clk && last
+                };
+                self.set_flag(at + 1, q)?;
+                self.set_flag(at + 2, clk)
+            }
+            StdFb::Ctu | StdFb::Ctd => self.counter(fb, at),
+            StdFb::Rs => {
+                let (set, reset, q) = (self.flag(at)?, self.flag(at + 1)?, self.flag(at + 2)?);
+                self.set_flag(at + 2, !reset && (set || q))
+            }
+            StdFb::Sr => {
+                let (set, reset, q) = (self.flag(at)?, self.flag(at + 1)?, self.flag(at + 2)?);
+                self.set_flag(at + 2, set || (!reset && q))
+            }
+        }
+    }
+
+    /// TON, TOF and TP: PT and ET are TIME (ms), the clock the cycle's.
+    fn timer(&mut self, fb: StdFb, at: usize) -> Run<()> {
+        let input = self.flag(at)?;
+        let pt = i64::from(self.read(at + 4, Elem::Time)?.int() as i32).max(0);
+        let state = self.read(at + STATE, Elem::Byte)?.int();
+        let (running, last_in) = (state & 1 != 0, state & 2 != 0);
+        let start = self.read(at + START, Elem::LInt)?.int();
+        let elapsed = ((self.now_ns - start) / 1_000_000).clamp(0, pt);
+        let (mut q, mut et, mut run) = (false, 0, running);
+        match fb {
+            StdFb::Ton if input => {
+                if !running {
+                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    run = true;
+                }
+                et = if running { elapsed } else { 0 };
+                q = running && elapsed >= pt || pt == 0;
+            }
+            StdFb::Ton => run = false,
+            StdFb::Tof if input => {
+                q = true;
+                run = false;
+            }
+            StdFb::Tof => {
+                let was_on = self.flag(at + 1)?;
+                if was_on && !running {
+                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    run = true;
+                }
+                et = if running { elapsed } else { 0 };
+                q = (was_on && !running && pt > 0) || (running && elapsed < pt);
+                run = run && q;
+            }
+            _ => {
+                // TP: a rising IN starts a pulse of PT that nothing cuts short.
+                if input && !last_in && !running {
+                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    run = true;
+                }
+                let pulse_elapsed = if running { elapsed } else { 0 };
+                q = run && pulse_elapsed < pt;
+                et = if run {
+                    pulse_elapsed
+                } else if input {
+                    pt
+                } else {
+                    0
+                };
+                run = q;
+            }
+        }
+        self.set_flag(at + 1, q)?;
+        self.write(at + 8, Elem::Time, V::I(et))?;
+        let state = i64::from(run) | (i64::from(input) << 1);
+        self.write(at + STATE, Elem::Byte, V::I(state))
+    }
+
+    /// CTU and CTD: the counter's edge input, RESET or LOAD, PV and CV as INT.
+    fn counter(&mut self, fb: StdFb, at: usize) -> Run<()> {
+        let (edge_in, clear, last) = (self.flag(at)?, self.flag(at + 1)?, self.flag(at + 3)?);
+        let pv = self.read(at + 4, Elem::Int)?.int();
+        let mut cv = self.read(at + 6, Elem::Int)?.int();
+        let rising = edge_in && !last;
+        if fb == StdFb::Ctu {
+            if clear {
+                cv = 0;
+            } else if rising && cv < i64::from(i16::MAX) {
+                cv += 1;
+            }
+            self.set_flag(at + 2, cv >= pv)?;
+        } else {
+            if clear {
+                cv = pv;
+            } else if rising && cv > i64::from(i16::MIN) {
+                cv -= 1;
+            }
+            self.set_flag(at + 2, cv <= 0)?;
+        }
+        self.write(at + 6, Elem::Int, V::I(cv))?;
+        self.set_flag(at + 3, edge_in)
+    }
+}

@@ -1,0 +1,215 @@
+//! Programs run: their values after cycles, the standard blocks on the cycle's clock, and the
+//! faults a program can make, each with its place.
+
+use plc_st::vm::{Fault, Program};
+
+fn load(text: &str) -> Program {
+    Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
+        )
+    })
+}
+
+fn run(text: &str, cycles: u32) -> Program {
+    let mut p = load(text);
+    for k in 0..cycles {
+        p.cycle(i64::from(k) * 10_000_000).unwrap();
+    }
+    p
+}
+
+#[test]
+fn variables_keep_their_values_from_cycle_to_cycle() {
+    let p = run(
+        "PROGRAM MAIN VAR n : INT := 5; END_VAR n := n + 1; END_PROGRAM",
+        3,
+    );
+    assert_eq!(p.read_var("MAIN.n"), Some(8.0));
+}
+
+#[test]
+fn loops_arrays_functions_and_cases_compute() {
+    let text = "
+TYPE E_Mode : (Idle, Sum, Done); END_TYPE
+FUNCTION Square : DINT
+VAR_INPUT x : DINT; END_VAR
+    Square := x * x;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    a : ARRAY[1..10] OF DINT;
+    i : INT;
+    total : DINT;
+    mode : E_Mode := E_Mode.Idle;
+    r : LREAL;
+    w : WORD := 16#00F0;
+    s : INT;
+END_VAR
+CASE mode OF
+    E_Mode.Idle:
+        FOR i := 1 TO 10 DO
+            a[i] := Square(i);
+        END_FOR
+        mode := Sum;
+    E_Mode.Sum:
+        total := 0;
+        i := 10;
+        WHILE i >= 1 DO
+            total := total + a[i];
+            i := i - 1;
+            IF i < 1 THEN EXIT; END_IF
+        END_WHILE
+        r := SQRT(DINT_TO_LREAL(total)) + LIMIT(0.0, -2.5, 1.0);
+        w := ROL(w, 4) OR SHR(w, 4);
+        s := 32767;
+        s := s + 1;
+        mode := Done;
+END_CASE
+END_PROGRAM";
+    let p = run(text, 2);
+    assert_eq!(p.read_var("MAIN.total"), Some(385.0));
+    assert_eq!(p.read_var("MAIN.mode"), Some(2.0));
+    assert!((p.read_var("MAIN.r").unwrap() - 385f64.sqrt()).abs() < 1e-12);
+    assert_eq!(p.read_var("MAIN.w"), Some(f64::from(0x0F00 | 0x000F)));
+    assert_eq!(p.read_var("MAIN.s"), Some(-32768.0), "INT wraps");
+}
+
+#[test]
+fn function_blocks_keep_their_state_and_the_timers_run_on_the_clock() {
+    let text = "
+FUNCTION_BLOCK FB_Count
+VAR_INPUT x : BOOL; END_VAR
+VAR_OUTPUT n : INT; END_VAR
+VAR edge : R_TRIG; END_VAR
+    edge(CLK := x);
+    IF edge.Q THEN n := n + 1; END_IF
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    t : TON;
+    blink : BOOL;
+    counter : FB_Count;
+    edges : INT;
+    done : BOOL;
+    ctu : CTU;
+END_VAR
+    t(IN := NOT t.Q, PT := T#30MS);
+    IF t.Q THEN blink := NOT blink; END_IF
+    counter(x := blink, n => edges);
+    ctu(CU := blink, PV := 3, Q => done);
+END_PROGRAM";
+    // 10 ms per cycle: the timer's Q comes 30 ms after it starts, for one cycle, then it
+    // starts again the cycle after: blink toggles every 5 cycles, rises every 10.
+    let p = run(text, 40);
+    assert_eq!(p.read_var("MAIN.edges"), Some(4.0));
+    assert_eq!(p.read_var("MAIN.done"), Some(1.0), "CTU reached 3");
+}
+
+#[test]
+fn a_ton_is_done_when_its_time_has_run() {
+    let text = "PROGRAM MAIN VAR t : TON; q : BOOL; et : TIME; END_VAR
+        t(IN := TRUE, PT := T#30MS, Q => q, ET => et); END_PROGRAM";
+    let mut p = load(text);
+    for (k, (q, et)) in [
+        (0.0, 0.0),
+        (0.0, 10.0),
+        (0.0, 20.0),
+        (1.0, 30.0),
+        (1.0, 30.0),
+    ]
+    .iter()
+    .enumerate()
+    {
+        p.cycle(k as i64 * 10_000_000).unwrap();
+        assert_eq!(
+            (p.read_var("MAIN.q"), p.read_var("MAIN.et")),
+            (Some(*q), Some(*et)),
+            "cycle {k}"
+        );
+    }
+}
+
+#[test]
+fn pointers_write_where_they_point() {
+    let text = "
+PROGRAM MAIN
+VAR
+    a : ARRAY[0..2] OF DINT;
+    p : POINTER TO DINT;
+    x : DINT;
+END_VAR
+    p := ADR(a[1]);
+    p^ := DINT#-13059200;
+    x := a[1];
+END_PROGRAM";
+    let p = run(text, 1);
+    assert_eq!(p.read_var("MAIN.x"), Some(-13_059_200.0));
+}
+
+fn fault(text: &str) -> (Fault, String) {
+    let mut p = load(text);
+    p.set_budget(10_000);
+    let e = p.cycle(0).unwrap_err();
+    (e.fault, p.fault_text(&e))
+}
+
+#[test]
+fn faults_stop_the_cycle_and_name_the_statement() {
+    let (f, text) = fault("PROGRAM MAIN VAR a, b : INT; END_VAR\n  a := 1 / b;\nEND_PROGRAM");
+    assert_eq!(f, Fault::DivisionByZero);
+    assert!(
+        text.starts_with("main.st:2:3: fault: division by zero"),
+        "{text}"
+    );
+    let (f, text) = fault(
+        "PROGRAM MAIN VAR a : ARRAY[0..2] OF INT; i : INT := 3; END_VAR\n  a[i] := 1;\nEND_PROGRAM",
+    );
+    assert_eq!(
+        f,
+        Fault::IndexOutOfRange {
+            index: 3,
+            lo: 0,
+            hi: 2
+        }
+    );
+    assert!(
+        text.starts_with("main.st:2:3: fault: index 3 outside [0..2]"),
+        "{text}"
+    );
+    let (f, _) = fault("PROGRAM MAIN VAR b : BOOL := TRUE; END_VAR\n  WHILE b DO b := TRUE; END_WHILE\nEND_PROGRAM");
+    assert!(matches!(f, Fault::Budget(_)), "{f:?}");
+    let (f, _) = fault("PROGRAM MAIN VAR p : POINTER TO INT; END_VAR\n  p^ := 1;\nEND_PROGRAM");
+    assert_eq!(f, Fault::BadPointer);
+    let (f, _) = fault("PROGRAM MAIN VAR r : LREAL := 1.0E300; i : INT; END_VAR\n  i := LREAL_TO_INT(r);\nEND_PROGRAM");
+    assert_eq!(f, Fault::OutOfRange);
+}
+
+#[path = "../../../tests/support/counting_alloc.rs"]
+mod counting_alloc;
+
+/// After the load, a cycle allocates nothing: function blocks, functions, loops, the standard
+/// blocks and functions included.
+#[test]
+fn a_cycle_allocates_nothing() {
+    let text = "
+FUNCTION Twice : LREAL VAR_INPUT x : LREAL; END_VAR Twice := 2.0 * x; END_FUNCTION
+FUNCTION_BLOCK FB_Acc VAR_INPUT x : LREAL; END_VAR VAR_OUTPUT sum : LREAL; END_VAR
+    sum := sum + Twice(x);
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR acc : FB_Acc; t : TON; i : INT; a : ARRAY[0..9] OF LREAL; total : LREAL; END_VAR
+    FOR i := 0 TO 9 DO a[i] := SIN(INT_TO_LREAL(i)); END_FOR
+    acc(x := MAX(a[3], a[4], 0.5), sum => total);
+    t(IN := TRUE, PT := T#1S);
+END_PROGRAM";
+    let mut p = load(text);
+    p.cycle(0).unwrap();
+    let before = counting_alloc::allocations();
+    for k in 1..1000 {
+        p.cycle(k * 1_000_000).unwrap();
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
+    assert!(p.read_var("MAIN.total").unwrap() > 0.0);
+}
