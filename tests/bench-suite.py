@@ -46,6 +46,8 @@ BENCHES = [
     ("cnc-app", "tick_latency", "tick start lateness, whole processes", "cyclictest"),
     ("cnc-opcua", "lateness", "tick lateness with an OPC UA client of 1,000 items",
      "the same run without the client"),
+    ("plc-st", "st", "Structured Text: a 1,000-statement cycle, a 10,000-line load",
+     "the same arithmetic in Rust"),
 ]
 
 # Peer program -> Debian package.

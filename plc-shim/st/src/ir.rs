@@ -42,6 +42,17 @@ pub enum Ex {
     Real(f64),
     /// The value of type `Elem` at a place.
     Load(Box<Addr>, Elem),
+    /// The value of type `Elem` of a variable: `offset` bytes from the memory's start, or
+    /// from the running instance's base with `relative` (the common case, without a place to
+    /// walk).
+    Var {
+        /// Its offset.
+        offset: u32,
+        /// From the instance's base.
+        relative: bool,
+        /// Its type.
+        ty: Elem,
+    },
     /// The pointer at a place.
     LoadPtr(Box<Addr>),
     /// A pointer to a place.

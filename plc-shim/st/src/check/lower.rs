@@ -259,6 +259,22 @@ impl Checker {
 
     fn load(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
         let (addr, ty) = self.place(e, ctx, l)?;
+        match (ty, addr) {
+            (Type::Elem(ty), Addr::Static(offset)) => Ok(Ex::Var {
+                offset,
+                relative: false,
+                ty,
+            }),
+            (Type::Elem(ty), Addr::Instance(offset)) => Ok(Ex::Var {
+                offset,
+                relative: true,
+                ty,
+            }),
+            (ty, addr) => self.load_at(e, ty, addr),
+        }
+    }
+
+    fn load_at(&self, e: &Expr, ty: Type, addr: Addr) -> R<Ex> {
         match ty {
             Type::Elem(t) => Ok(Ex::Load(Box::new(addr), t)),
             Type::Enum(i) => Ok(Ex::Load(Box::new(addr), self.out.enums[i].base)),

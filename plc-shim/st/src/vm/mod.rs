@@ -5,7 +5,7 @@
 //! of a value its type cannot hold, or the budget spent is a [`Fault`] with the statement's
 //! file, line and column, and the program stops.
 
-use crate::ast::{BinOp, PouKind};
+use crate::ast::PouKind;
 use crate::check::{compile, Compiled, Type};
 use crate::diag::{Diagnostic, Pos};
 use crate::ir::{Addr, Ex, St, StKind};
@@ -65,6 +65,13 @@ impl core::fmt::Display for Fault {
     }
 }
 
+/// The first `N` bytes of a slice that has them (the caller took exactly `N`).
+fn arr<const N: usize>(b: &[u8]) -> [u8; N] {
+    let mut out = [0u8; N];
+    out.copy_from_slice(&b[..N]);
+    out
+}
+
 /// How a statement list ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Flow {
@@ -82,12 +89,14 @@ pub(crate) enum V {
 }
 
 impl V {
+    #[inline]
     fn int(self) -> i64 {
         match self {
             V::I(v) => v,
             V::F(v) => v as i64,
         }
     }
+    #[inline]
     fn float(self) -> f64 {
         match self {
             V::I(v) => v as f64,
@@ -260,6 +269,7 @@ impl Program {
         result.map(|_| ())
     }
 
+    #[inline]
     fn step(&mut self) -> Run<()> {
         self.steps += 1;
         if self.steps > self.budget {
@@ -284,7 +294,11 @@ impl Program {
         match &s.kind {
             StKind::Store(a, t, e) => {
                 let v = self.eval(e, base)?;
-                let at = self.addr(a, base)?;
+                let at = match a {
+                    Addr::Static(o) => *o as usize,
+                    Addr::Instance(o) => (base + o) as usize,
+                    _ => self.addr(a, base)?,
+                };
                 self.write(at, *t, v)?;
             }
             StKind::StorePtr(a, e) => {
@@ -478,28 +492,34 @@ impl Program {
         }
     }
 
+    #[inline]
     pub(crate) fn read(&self, at: usize, t: Elem) -> Run<V> {
-        let n = t.size();
-        self.check(at, n)?;
-        let mut bytes = [0u8; 8];
-        bytes[..n].copy_from_slice(&self.memory[at..at + n]);
-        let raw = u64::from_le_bytes(bytes);
+        let m = &self.memory;
+        let bytes = |n: usize| m.get(at..at + n).ok_or(Fault::BadPointer);
         Ok(match t {
-            Elem::Real => V::F(f64::from(f32::from_bits(raw as u32))),
-            Elem::LReal => V::F(f64::from_bits(raw)),
-            _ => V::I(ops::wrap(raw as i64, t)),
+            Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(bytes(1)?[0])),
+            Elem::SInt => V::I(i64::from(bytes(1)?[0] as i8)),
+            Elem::Word | Elem::UInt => V::I(i64::from(u16::from_le_bytes(arr(bytes(2)?)))),
+            Elem::Int => V::I(i64::from(i16::from_le_bytes(arr(bytes(2)?)))),
+            Elem::DWord | Elem::UDInt => V::I(i64::from(u32::from_le_bytes(arr(bytes(4)?)))),
+            Elem::DInt | Elem::Time => V::I(i64::from(i32::from_le_bytes(arr(bytes(4)?)))),
+            Elem::LWord | Elem::ULInt | Elem::LInt | Elem::LTime => {
+                V::I(i64::from_le_bytes(arr(bytes(8)?)))
+            }
+            Elem::Real => V::F(f64::from(f32::from_le_bytes(arr(bytes(4)?)))),
+            Elem::LReal => V::F(f64::from_le_bytes(arr(bytes(8)?))),
         })
     }
 
+    #[inline]
     pub(crate) fn write(&mut self, at: usize, t: Elem, v: V) -> Run<()> {
         let n = t.size();
-        self.check(at, n)?;
-        let raw = match t {
-            Elem::Real => u64::from((v.float() as f32).to_bits()),
-            Elem::LReal => v.float().to_bits(),
-            _ => v.int() as u64,
-        };
-        self.memory[at..at + n].copy_from_slice(&raw.to_le_bytes()[..n]);
+        let slot = self.memory.get_mut(at..at + n).ok_or(Fault::BadPointer)?;
+        match t {
+            Elem::Real => slot.copy_from_slice(&(v.float() as f32).to_le_bytes()),
+            Elem::LReal => slot.copy_from_slice(&v.float().to_le_bytes()),
+            _ => slot.copy_from_slice(&v.int().to_le_bytes()[..n]),
+        }
         Ok(())
     }
 
@@ -507,6 +527,14 @@ impl Program {
         Ok(match e {
             Ex::Int(v) => V::I(*v),
             Ex::Real(v) => V::F(*v),
+            Ex::Var {
+                offset,
+                relative,
+                ty,
+            } => {
+                let at = if *relative { base + offset } else { *offset };
+                self.read(at as usize, *ty)?
+            }
             Ex::Load(a, t) => {
                 let at = self.addr(a, base)?;
                 self.read(at, *t)?
@@ -576,14 +604,6 @@ impl Program {
             _ => return None,
         };
         self.read(at, t).ok().map(V::float)
-    }
-
-    /// Whether `op` of type `t` compares (a BOOL value).
-    pub(crate) fn compares(op: BinOp) -> bool {
-        matches!(
-            op,
-            BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge
-        )
     }
 
     /// Whether type `t` is unsigned (read without a sign).

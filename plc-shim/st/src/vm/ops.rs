@@ -10,17 +10,16 @@ use crate::types::{Class, Elem};
 type Run<T> = Result<T, Fault>;
 
 /// `v` cut to the width of `t` (sign-extended for a signed type).
+#[inline]
 pub(crate) fn wrap(v: i64, t: Elem) -> i64 {
-    let bits = 8 * t.size() as u32;
-    if bits >= 64 {
-        return v;
-    }
-    let mask = (1u64 << bits) - 1;
-    let low = v as u64 & mask;
-    if t.class() == Class::Signed && low >> (bits - 1) == 1 {
-        (low | !mask) as i64
-    } else {
-        low as i64
+    match t {
+        Elem::Bool | Elem::Byte | Elem::USInt => i64::from(v as u8),
+        Elem::SInt => i64::from(v as i8),
+        Elem::Word | Elem::UInt => i64::from(v as u16),
+        Elem::Int => i64::from(v as i16),
+        Elem::DWord | Elem::UDInt => i64::from(v as u32),
+        Elem::DInt | Elem::Time => i64::from(v as i32),
+        _ => v,
     }
 }
 
@@ -53,41 +52,48 @@ fn finite(v: f64) -> Run<V> {
     }
 }
 
+#[inline]
 pub(crate) fn binary(op: BinOp, t: Elem, x: V, y: V) -> Run<V> {
-    if Program::compares(op) {
-        return Ok(V::I(i64::from(compare(op, t, x, y))));
+    match (op, x, y) {
+        (BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge, _, _) => {
+            Ok(V::I(i64::from(compare(op, t, x, y))))
+        }
+        (_, V::I(a), V::I(b)) if !is_float(t) => integer(op, t, a, b),
+        _ => {
+            let (a, b) = (x.float(), y.float());
+            match op {
+                BinOp::Add => finite(a + b),
+                BinOp::Sub => finite(a - b),
+                BinOp::Mul => finite(a * b),
+                BinOp::Div if b == 0.0 => Err(Fault::DivisionByZero),
+                BinOp::Div => finite(a / b),
+                BinOp::Pow => finite(a.powf(b)),
+                _ => Err(Fault::OutOfRange),
+            }
+        }
     }
-    if is_float(t) {
-        let (a, b) = (x.float(), y.float());
-        return match op {
-            BinOp::Add => finite(a + b),
-            BinOp::Sub => finite(a - b),
-            BinOp::Mul => finite(a * b),
-            BinOp::Div if b == 0.0 => Err(Fault::DivisionByZero),
-            BinOp::Div => finite(a / b),
-            BinOp::Pow => finite(a.powf(b)),
-            _ => Err(Fault::OutOfRange),
-        };
-    }
-    let (a, b) = (x.int(), y.int());
-    let unsigned = Program::unsigned(t);
+}
+
+#[inline]
+fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
     let v = match op {
         BinOp::Add => a.wrapping_add(b),
         BinOp::Sub => a.wrapping_sub(b),
         BinOp::Mul => a.wrapping_mul(b),
-        BinOp::Div | BinOp::Mod if b == 0 => return Err(Fault::DivisionByZero),
-        BinOp::Div if unsigned => ((a as u64) / (b as u64)) as i64,
-        BinOp::Div => a.wrapping_div(b),
-        BinOp::Mod if unsigned => ((a as u64) % (b as u64)) as i64,
-        BinOp::Mod => a.wrapping_rem(b),
         BinOp::And => a & b,
         BinOp::Or => a | b,
         BinOp::Xor => a ^ b,
+        BinOp::Div | BinOp::Mod if b == 0 => return Err(Fault::DivisionByZero),
+        BinOp::Div if Program::unsigned(t) => ((a as u64) / (b as u64)) as i64,
+        BinOp::Div => a.wrapping_div(b),
+        BinOp::Mod if Program::unsigned(t) => ((a as u64) % (b as u64)) as i64,
+        BinOp::Mod => a.wrapping_rem(b),
         _ => return Err(Fault::OutOfRange),
     };
     Ok(V::I(wrap(v, t)))
 }
 
+#[inline]
 fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
     let ord = if is_float(t) {
         x.float().partial_cmp(&y.float())
@@ -111,6 +117,7 @@ fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
 
 /// `v` of type `from` as a `to`: reals round to the nearest integer; a value the integer
 /// type cannot hold, or a real that is not finite, is a fault.
+#[inline]
 pub(crate) fn convert(v: V, from: Elem, to: Elem) -> Run<V> {
     match (is_float(from), is_float(to)) {
         (_, true) => {
