@@ -41,6 +41,33 @@ pub fn generate() -> String {
     out
 }
 
+/// Who writes each field of each unit: (structure, field, writer), for a checker that refuses
+/// a PLC program's write to a field the CNC or the drives write.
+pub fn field_writers() -> Vec<(&'static str, &'static str, crate::desc::SymbolWriter)> {
+    let mut out = Vec::new();
+    let mut seen: Vec<&'static str> = Vec::new();
+    collect_writers(&HliImage::desc(), &mut seen, &mut out);
+    out
+}
+
+fn collect_writers(
+    ty: &TypeDesc,
+    seen: &mut Vec<&'static str>,
+    out: &mut Vec<(&'static str, &'static str, crate::desc::SymbolWriter)>,
+) {
+    let Kind::Struct { name, fields } = innermost(ty).kind else {
+        return;
+    };
+    if seen.contains(&name) {
+        return;
+    }
+    seen.push(name);
+    for field in fields {
+        out.push((name, field.name, field.writer));
+        collect_writers(&(field.ty)(), seen, out);
+    }
+}
+
 /// The ST spelling of a type in a declaration.
 fn st_type(ty: &TypeDesc) -> String {
     match ty.kind {
@@ -101,5 +128,20 @@ mod tests {
         let cs = st.find("    HLI_COORDINATE_SYSTEM_INT :").unwrap();
         assert!(cs < unit);
         assert_eq!(st.matches("    HLI_COORDINATE_SYSTEM_INT :").count(), 1);
+    }
+
+    #[test]
+    fn each_field_names_its_writer() {
+        use crate::desc::SymbolWriter;
+        let writers = super::field_writers();
+        let find = |s: &str, f: &str| writers.iter().find(|w| w.0 == s && w.1 == f).map(|w| w.2);
+        assert_eq!(
+            find("MC_CONTROL_DYN_CS_UNIT", "enable_w"),
+            Some(SymbolWriter::Plc)
+        );
+        assert_eq!(
+            find("MC_CONTROL_DYN_CS_UNIT", "state_r"),
+            Some(SymbolWriter::Cnc)
+        );
     }
 }

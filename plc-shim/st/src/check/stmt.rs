@@ -173,6 +173,12 @@ impl Checker {
                 );
                 None
             }
+            Expr::Field(..) if self.cnc_owned(target, ctx).is_some() => {
+                let field = self.cnc_owned(target, ctx).unwrap_or_default();
+                let message = format!("`{field}` of the image is written by the CNC (or the drives): the PLC only reads it");
+                self.refuse(target.pos(), message);
+                None
+            }
             Expr::Field(..) | Expr::Index(..) | Expr::Deref(..) => Some(self.expr(target, ctx)),
             _ => {
                 self.refuse(
@@ -181,6 +187,26 @@ impl Checker {
                 );
                 None
             }
+        }
+    }
+
+    /// The name of the first field along `target` that the CNC or the drives write in the
+    /// image (the HLI's units keep their writers: `hli::st_prelude::field_writers`).
+    fn cnc_owned(&mut self, target: &Expr, ctx: Ctx) -> Option<String> {
+        match target {
+            Expr::Field(base, field) => {
+                let errors = self.errors.len();
+                let base_type = self.expr(base, ctx);
+                self.errors.truncate(errors);
+                if let Type::Struct(i) = base_type {
+                    if image_writer_is_cnc(&self.out.structs[i].name, &field.text) {
+                        return Some(field.text.clone());
+                    }
+                }
+                self.cnc_owned(base, ctx)
+            }
+            Expr::Index(base, _, _) => self.cnc_owned(base, ctx),
+            _ => None,
         }
     }
 
@@ -535,4 +561,19 @@ impl Checker {
         }
         common
     }
+}
+
+/// Whether field `field` of the image's structure `name` is written by the CNC or the drives.
+fn image_writer_is_cnc(name: &str, field: &str) -> bool {
+    use hli::desc::SymbolWriter;
+    use std::collections::HashSet;
+    static CNC: std::sync::OnceLock<HashSet<(String, String)>> = std::sync::OnceLock::new();
+    let owned = CNC.get_or_init(|| {
+        hli::st_prelude::field_writers()
+            .into_iter()
+            .filter(|(_, _, w)| matches!(w, SymbolWriter::Cnc | SymbolWriter::Io))
+            .map(|(s, f, _)| (s.to_ascii_uppercase(), f.to_ascii_uppercase()))
+            .collect()
+    });
+    owned.contains(&(name.to_ascii_uppercase(), field.to_ascii_uppercase()))
 }

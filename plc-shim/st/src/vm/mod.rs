@@ -9,10 +9,14 @@ use crate::ast::PouKind;
 use crate::check::{compile, Compiled, Type};
 use crate::diag::{Diagnostic, Pos};
 use crate::ir::{Addr, Ex, St, StKind};
-use crate::types::{Class, Elem};
+use crate::types::Elem;
+use hli::ImageMemory;
 
+mod image;
 mod ops;
 mod std_fb;
+
+pub use image::IMAGE_TAG;
 
 /// Why a cycle stopped the program.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -36,6 +40,10 @@ pub enum Fault {
     Budget(u64),
     /// MUX's selector names no value.
     MuxSelector(i64),
+    /// A write to a leaf of the image the CNC or the drives write.
+    ReadOnly,
+    /// A whole structure or array copied to or from the image (assign its leaves).
+    ImageCopy,
 }
 
 /// A fault and where it happened: small and `Copy`, made in the cycle; its text is made
@@ -61,6 +69,8 @@ impl core::fmt::Display for Fault {
             Fault::OutOfRange => write!(f, "a conversion of a value its type cannot hold"),
             Fault::Budget(steps) => write!(f, "the cycle ran {steps} steps: an endless loop?"),
             Fault::MuxSelector(k) => write!(f, "MUX selector {k} names no value"),
+            Fault::ReadOnly => write!(f, "a write to a leaf of the image the CNC writes"),
+            Fault::ImageCopy => write!(f, "a whole structure copied to or from the image"),
         }
     }
 }
@@ -70,6 +80,41 @@ fn arr<const N: usize>(b: &[u8]) -> [u8; N] {
     let mut out = [0u8; N];
     out.copy_from_slice(&b[..N]);
     out
+}
+
+/// Where a place is: in the program's own memory, or in the HLI image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Loc {
+    Own(usize),
+    Image(usize),
+}
+
+impl Loc {
+    fn plus(self, n: usize) -> Loc {
+        match self {
+            Loc::Own(a) => Loc::Own(a + n),
+            Loc::Image(a) => Loc::Image(a + n),
+        }
+    }
+}
+
+/// The value of type `t` at `at` of a program's memory.
+#[inline]
+fn read_mem(m: &[u8], at: usize, t: Elem) -> Run<V> {
+    let bytes = |n: usize| m.get(at..at + n).ok_or(Fault::BadPointer);
+    Ok(match t {
+        Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(bytes(1)?[0])),
+        Elem::SInt => V::I(i64::from(bytes(1)?[0] as i8)),
+        Elem::Word | Elem::UInt => V::I(i64::from(u16::from_le_bytes(arr(bytes(2)?)))),
+        Elem::Int => V::I(i64::from(i16::from_le_bytes(arr(bytes(2)?)))),
+        Elem::DWord | Elem::UDInt => V::I(i64::from(u32::from_le_bytes(arr(bytes(4)?)))),
+        Elem::DInt | Elem::Time => V::I(i64::from(i32::from_le_bytes(arr(bytes(4)?)))),
+        Elem::LWord | Elem::ULInt | Elem::LInt | Elem::LTime => {
+            V::I(i64::from_le_bytes(arr(bytes(8)?)))
+        }
+        Elem::Real => V::F(f64::from(f32::from_le_bytes(arr(bytes(4)?)))),
+        Elem::LReal => V::F(f64::from_le_bytes(arr(bytes(8)?))),
+    })
 }
 
 /// How a statement list ended.
@@ -108,16 +153,29 @@ impl V {
 /// The default budget of steps per cycle.
 pub const DEFAULT_BUDGET: u64 = 1_000_000;
 
-/// A loaded program: its code and its memory.
+/// A loaded program: its code and its state.
 #[derive(Debug, Clone)]
 pub struct Program {
     code: Compiled,
+    state: State,
+}
+
+/// What a program changes as it runs.
+#[derive(Debug, Clone)]
+struct State {
     memory: Vec<u8>,
     budget: u64,
     steps: u64,
     now_ns: i64,
     /// The statement being run (for a fault's place).
     at: (u16, Pos),
+}
+
+/// A program running: its code, its state, and the image its pointers may reach.
+struct Exec<'a> {
+    code: &'a Compiled,
+    st: &'a mut State,
+    image: Option<&'a ImageMemory>,
 }
 
 type Run<T> = Result<T, Fault>;
@@ -135,14 +193,21 @@ impl Program {
         }
         let code = compile(&units)?;
         let mut p = Program {
-            memory: vec![0; code.layout.size as usize],
+            state: State {
+                memory: vec![0; code.layout.size as usize],
+                budget: DEFAULT_BUDGET,
+                steps: 0,
+                now_ns: 0,
+                at: (0, Pos::default()),
+            },
             code,
-            budget: DEFAULT_BUDGET,
-            steps: 0,
-            now_ns: 0,
-            at: (0, Pos::default()),
         };
-        if let Err(f) = p.initialise() {
+        let mut exec = Exec {
+            code: &p.code,
+            st: &mut p.state,
+            image: None,
+        };
+        if let Err(f) = exec.initialise() {
             let file = p
                 .code
                 .files
@@ -157,7 +222,7 @@ impl Program {
 
     /// Sets the steps a cycle may run (statements and loop rounds).
     pub fn set_budget(&mut self, steps: u64) {
-        self.budget = steps.max(1);
+        self.state.budget = steps.max(1);
     }
 
     /// The compiled program.
@@ -165,25 +230,52 @@ impl Program {
         &self.code
     }
 
-    /// One cycle at time `now_ns` (the PLC's clock, for the timers): every PROGRAM's
-    /// statements in the order the files declare them.
+    /// One cycle at time `now_ns` (the PLC's clock, for the timers) without an image: every
+    /// PROGRAM's statements in the order the files declare them.
     pub fn cycle(&mut self, now_ns: i64) -> Result<(), FaultAt> {
-        self.now_ns = now_ns;
-        self.steps = 0;
-        for pou in 0..self.code.checked.pous.len() {
-            if self.code.checked.pous[pou].kind == PouKind::Program {
-                let base = self.code.layout.statics[pou];
-                self.run_body(pou, base).map_err(|f| self.fault_at(f))?;
+        self.cycle_on(now_ns, None)
+    }
+
+    /// One cycle with `image` the program's pointers into the HLI reach (`gpCh`, `gpAx`,
+    /// `gpFifo`; [`Program::bind_image`] set them).
+    pub fn cycle_on(&mut self, now_ns: i64, image: Option<&ImageMemory>) -> Result<(), FaultAt> {
+        self.state.now_ns = now_ns;
+        self.state.steps = 0;
+        let mut exec = Exec {
+            code: &self.code,
+            st: &mut self.state,
+            image,
+        };
+        for pou in 0..exec.code.checked.pous.len() {
+            if exec.code.checked.pous[pou].kind == PouKind::Program {
+                let base = exec.code.layout.statics[pou];
+                exec.run_body(pou, base).map_err(|f| exec.fault_at(f))?;
             }
         }
         Ok(())
     }
 
-    fn fault_at(&self, fault: Fault) -> FaultAt {
-        FaultAt {
-            fault,
-            file: self.at.0,
-            pos: self.at.1,
+    /// Points the controller's pointer arrays the program declares (`gpCh`, `gpAx`,
+    /// `gpFifo`, as `hli::st_prelude` declares them) at the image's units: element `k` of
+    /// `gpCh` at `gpCh[k]^`.
+    pub fn bind_image(&mut self) {
+        for (g, var) in self.code.checked.globals.iter().enumerate() {
+            let Type::Array(dims, element) = &var.ty else {
+                continue;
+            };
+            if !matches!(**element, Type::Pointer(_)) || dims.len() != 1 {
+                continue;
+            }
+            let (lo, hi) = dims[0];
+            for k in lo..=hi {
+                let Some(p) = image::pointer_to(&format!("{}[{k}]^", var.name)) else {
+                    break;
+                };
+                let at = self.code.layout.globals[g] as usize + (k - lo) as usize * 8;
+                if let Some(slot) = self.state.memory.get_mut(at..at + 8) {
+                    slot.copy_from_slice(&p.to_le_bytes());
+                }
+            }
         }
     }
 
@@ -195,6 +287,38 @@ impl Program {
             .get(f.file as usize)
             .map_or("?", String::as_str);
         format!("{file}:{}:{}: fault: {}", f.pos.line, f.pos.col, f.fault)
+    }
+
+    /// The value of a variable of a PROGRAM, by `PROGRAM.variable` (ASCII case ignored), as
+    /// a number: for tests and the tools.
+    pub fn read_var(&self, path: &str) -> Option<f64> {
+        let (program, var) = path.split_once('.')?;
+        let c = &self.code.checked;
+        let pou = c
+            .pous
+            .iter()
+            .position(|p| p.name.eq_ignore_ascii_case(program))?;
+        let k = c.pous[pou]
+            .vars
+            .iter()
+            .position(|v| v.name.eq_ignore_ascii_case(var))?;
+        let at = (self.code.layout.statics[pou] + self.code.layout.pous[pou].2[k]) as usize;
+        let t = match &c.pous[pou].vars[k].ty {
+            Type::Elem(t) => *t,
+            Type::Enum(i) => c.enums[*i].base,
+            _ => return None,
+        };
+        read_mem(&self.state.memory, at, t).ok().map(V::float)
+    }
+}
+
+impl<'a> Exec<'a> {
+    fn fault_at(&self, fault: Fault) -> FaultAt {
+        FaultAt {
+            fault,
+            file: self.st.at.0,
+            pos: self.st.at.1,
+        }
     }
 
     /// Every variable's initial value: the globals' and programs' instances, and every
@@ -222,10 +346,8 @@ impl Program {
 
     /// POU `pou`'s initial values at `base`, then those of the instances among its variables.
     fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
-        let inits = std::mem::take(&mut self.code.bodies[pou].0);
-        let result = self.block(&inits, base);
-        self.code.bodies[pou].0 = inits;
-        result?;
+        let code = self.code;
+        self.block(&code.bodies[pou].0, base)?;
         for k in 0..self.code.checked.pous[pou].vars.len() {
             let ty = self.code.checked.pous[pou].vars[k].ty.clone();
             let offset = self.code.layout.pous[pou].2[k];
@@ -262,18 +384,15 @@ impl Program {
 
     /// POU `pou`'s statements on the instance at `base`.
     fn run_body(&mut self, pou: usize, base: u32) -> Run<()> {
-        // The code is not changed by running it: take it out to borrow the memory freely.
-        let body = std::mem::take(&mut self.code.bodies[pou].1);
-        let result = self.block(&body, base);
-        self.code.bodies[pou].1 = body;
-        result.map(|_| ())
+        let code = self.code;
+        self.block(&code.bodies[pou].1, base).map(|_| ())
     }
 
     #[inline]
     fn step(&mut self) -> Run<()> {
-        self.steps += 1;
-        if self.steps > self.budget {
-            return Err(Fault::Budget(self.steps));
+        self.st.steps += 1;
+        if self.st.steps > self.st.budget {
+            return Err(Fault::Budget(self.st.steps));
         }
         Ok(())
     }
@@ -289,17 +408,19 @@ impl Program {
     }
 
     fn statement(&mut self, s: &St, base: u32) -> Run<Flow> {
-        self.at = s.at;
+        self.st.at = s.at;
         self.step()?;
         match &s.kind {
             StKind::Store(a, t, e) => {
                 let v = self.eval(e, base)?;
-                let at = match a {
-                    Addr::Static(o) => *o as usize,
-                    Addr::Instance(o) => (base + o) as usize,
-                    _ => self.addr(a, base)?,
-                };
-                self.write(at, *t, v)?;
+                match a {
+                    Addr::Static(o) => self.write_own(*o as usize, *t, v)?,
+                    Addr::Instance(o) => self.write_own((base + o) as usize, *t, v)?,
+                    _ => {
+                        let at = self.addr(a, base)?;
+                        self.write(at, *t, v)?;
+                    }
+                }
             }
             StKind::StorePtr(a, e) => {
                 let v = self.eval(e, base)?;
@@ -307,11 +428,11 @@ impl Program {
                 self.write(at, Elem::ULInt, v)?;
             }
             StKind::Copy(to, from, size) => {
-                let (to, from) = (self.addr(to, base)?, self.addr(from, base)?);
+                let (to, from) = (self.own(to, base)?, self.own(from, base)?);
                 let n = *size as usize;
                 self.check(to, n)?;
                 self.check(from, n)?;
-                self.memory.copy_within(from..from + n, to);
+                self.st.memory.copy_within(from..from + n, to);
             }
             StKind::If(arms, otherwise) => {
                 for (cond, body) in arms {
@@ -339,7 +460,7 @@ impl Program {
                 body,
             } => return self.for_loop(var, *ty, (from, to, by), body, base),
             StKind::While(cond, body) => loop {
-                self.at = s.at;
+                self.st.at = s.at;
                 self.step()?;
                 if self.eval(cond, base)?.int() == 0 {
                     break;
@@ -357,7 +478,7 @@ impl Program {
                     Flow::Return => return Ok(Flow::Return),
                     _ => {}
                 }
-                self.at = s.at;
+                self.st.at = s.at;
                 if self.eval(until, base)?.int() != 0 {
                     break;
                 }
@@ -371,10 +492,10 @@ impl Program {
                 inputs,
                 outputs,
             } => {
-                let at = self.addr(instance, base)? as u32;
+                let at = self.own(instance, base)? as u32;
                 self.store_all(inputs, at, base)?;
                 self.run_body(*pou, at)?;
-                self.at = s.at;
+                self.st.at = s.at;
                 self.read_outputs(outputs, at, base)?;
             }
             StKind::CallStdFb {
@@ -383,7 +504,7 @@ impl Program {
                 inputs,
                 outputs,
             } => {
-                let at = self.addr(instance, base)? as u32;
+                let at = self.own(instance, base)? as u32;
                 self.store_all(inputs, at, base)?;
                 self.run_std_fb(*fb, at as usize)?;
                 self.read_outputs(outputs, at, base)?;
@@ -434,14 +555,14 @@ impl Program {
     fn store_all(&mut self, inputs: &[(u32, Elem, Ex)], at: u32, base: u32) -> Run<()> {
         for (offset, t, e) in inputs {
             let v = self.eval(e, base)?;
-            self.write((at + offset) as usize, *t, v)?;
+            self.write_own((at + offset) as usize, *t, v)?;
         }
         Ok(())
     }
 
     fn read_outputs(&mut self, outputs: &[(u32, Elem, Addr, bool)], at: u32, base: u32) -> Run<()> {
         for (offset, t, target, negated) in outputs {
-            let mut v = self.read((at + offset) as usize, *t)?;
+            let mut v = self.read_own((at + offset) as usize, *t)?;
             if *negated {
                 v = V::I(i64::from(v.int() == 0));
             }
@@ -451,12 +572,12 @@ impl Program {
         Ok(())
     }
 
-    /// The byte offset a place names.
-    fn addr(&mut self, a: &Addr, base: u32) -> Run<usize> {
+    /// Where a place is.
+    fn addr(&mut self, a: &Addr, base: u32) -> Run<Loc> {
         Ok(match a {
-            Addr::Static(o) => *o as usize,
-            Addr::Instance(o) => (base + o) as usize,
-            Addr::Offset(inner, o) => self.addr(inner, base)? + *o as usize,
+            Addr::Static(o) => Loc::Own(*o as usize),
+            Addr::Instance(o) => Loc::Own((base + o) as usize),
+            Addr::Offset(inner, o) => self.addr(inner, base)?.plus(*o as usize),
             Addr::Index {
                 base: array,
                 index,
@@ -473,48 +594,67 @@ impl Program {
                         hi,
                     });
                 }
-                self.addr(array, base)? + (i - lo) as usize * *stride as usize
+                let step = (i - lo) as usize * *stride as usize;
+                self.addr(array, base)?.plus(step)
             }
             Addr::Deref(p) => {
                 let p = self.eval(p, base)?.int();
-                if p <= 0 || p as u64 > self.memory.len() as u64 {
+                let (image, at) = (p & IMAGE_TAG != 0, (p & !IMAGE_TAG) - 1);
+                if at < 0 {
                     return Err(Fault::BadPointer);
                 }
-                (p - 1) as usize
+                if image {
+                    Loc::Image(at as usize)
+                } else {
+                    Loc::Own(at as usize)
+                }
             }
         })
     }
 
+    fn own(&mut self, a: &Addr, base: u32) -> Run<usize> {
+        match self.addr(a, base)? {
+            Loc::Own(at) => Ok(at),
+            Loc::Image(_) => Err(Fault::ImageCopy),
+        }
+    }
+
     fn check(&self, at: usize, n: usize) -> Run<()> {
         match at.checked_add(n) {
-            Some(end) if end <= self.memory.len() => Ok(()),
+            Some(end) if end <= self.st.memory.len() => Ok(()),
             _ => Err(Fault::BadPointer),
         }
     }
 
     #[inline]
-    pub(crate) fn read(&self, at: usize, t: Elem) -> Run<V> {
-        let m = &self.memory;
-        let bytes = |n: usize| m.get(at..at + n).ok_or(Fault::BadPointer);
-        Ok(match t {
-            Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(bytes(1)?[0])),
-            Elem::SInt => V::I(i64::from(bytes(1)?[0] as i8)),
-            Elem::Word | Elem::UInt => V::I(i64::from(u16::from_le_bytes(arr(bytes(2)?)))),
-            Elem::Int => V::I(i64::from(i16::from_le_bytes(arr(bytes(2)?)))),
-            Elem::DWord | Elem::UDInt => V::I(i64::from(u32::from_le_bytes(arr(bytes(4)?)))),
-            Elem::DInt | Elem::Time => V::I(i64::from(i32::from_le_bytes(arr(bytes(4)?)))),
-            Elem::LWord | Elem::ULInt | Elem::LInt | Elem::LTime => {
-                V::I(i64::from_le_bytes(arr(bytes(8)?)))
-            }
-            Elem::Real => V::F(f64::from(f32::from_le_bytes(arr(bytes(4)?)))),
-            Elem::LReal => V::F(f64::from_le_bytes(arr(bytes(8)?))),
-        })
+    pub(crate) fn read(&self, at: Loc, t: Elem) -> Run<V> {
+        match at {
+            Loc::Own(at) => self.read_own(at, t),
+            Loc::Image(at) => self.image_read(at, t),
+        }
     }
 
     #[inline]
-    pub(crate) fn write(&mut self, at: usize, t: Elem, v: V) -> Run<()> {
+    pub(crate) fn write(&mut self, at: Loc, t: Elem, v: V) -> Run<()> {
+        match at {
+            Loc::Own(at) => self.write_own(at, t, v),
+            Loc::Image(at) => self.image_write(at, t, v),
+        }
+    }
+
+    #[inline]
+    pub(crate) fn read_own(&self, at: usize, t: Elem) -> Run<V> {
+        read_mem(&self.st.memory, at, t)
+    }
+
+    #[inline]
+    pub(crate) fn write_own(&mut self, at: usize, t: Elem, v: V) -> Run<()> {
         let n = t.size();
-        let slot = self.memory.get_mut(at..at + n).ok_or(Fault::BadPointer)?;
+        let slot = self
+            .st
+            .memory
+            .get_mut(at..at + n)
+            .ok_or(Fault::BadPointer)?;
         match t {
             Elem::Real => slot.copy_from_slice(&(v.float() as f32).to_le_bytes()),
             Elem::LReal => slot.copy_from_slice(&v.float().to_le_bytes()),
@@ -533,7 +673,7 @@ impl Program {
                 ty,
             } => {
                 let at = if *relative { base + offset } else { *offset };
-                self.read(at as usize, *ty)?
+                self.read_own(at as usize, *ty)?
             }
             Ex::Load(a, t) => {
                 let at = self.addr(a, base)?;
@@ -543,7 +683,10 @@ impl Program {
                 let at = self.addr(a, base)?;
                 self.read(at, Elem::ULInt)?
             }
-            Ex::AddrOf(a) => V::I(self.addr(a, base)? as i64 + 1),
+            Ex::AddrOf(a) => V::I(match self.addr(a, base)? {
+                Loc::Own(at) => at as i64 + 1,
+                Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
+            }),
             Ex::Neg(x, t) => ops::neg(self.eval(x, base)?, *t),
             Ex::Not(x, t) => ops::not(self.eval(x, base)?, *t),
             Ex::Bin(op, t, a, b) => {
@@ -561,11 +704,9 @@ impl Program {
                 let frame = self.code.layout.statics[*pou];
                 let (size, _, _) = self.code.layout.pous[*pou];
                 // A function's variables start from zero and their initial values each call.
-                self.memory[frame as usize..(frame + size) as usize].fill(0);
-                let inits = std::mem::take(&mut self.code.bodies[*pou].0);
-                let r = self.block(&inits, frame);
-                self.code.bodies[*pou].0 = inits;
-                r?;
+                self.st.memory[frame as usize..(frame + size) as usize].fill(0);
+                let code = self.code;
+                self.block(&code.bodies[*pou].0, frame)?;
                 self.block(inputs, base)?;
                 self.run_body(*pou, frame)?;
                 let at = self.addr(value, base)?;
@@ -582,32 +723,5 @@ impl Program {
             values[k] = self.eval(a, base)?;
         }
         ops::standard(f, t, &values[..n])
-    }
-
-    /// The value of a variable of a PROGRAM, by `PROGRAM.variable` (ASCII case ignored), as
-    /// a number: for tests and the tools.
-    pub fn read_var(&self, path: &str) -> Option<f64> {
-        let (program, var) = path.split_once('.')?;
-        let c = &self.code.checked;
-        let pou = c
-            .pous
-            .iter()
-            .position(|p| p.name.eq_ignore_ascii_case(program))?;
-        let k = c.pous[pou]
-            .vars
-            .iter()
-            .position(|v| v.name.eq_ignore_ascii_case(var))?;
-        let at = (self.code.layout.statics[pou] + self.code.layout.pous[pou].2[k]) as usize;
-        let t = match &c.pous[pou].vars[k].ty {
-            Type::Elem(t) => *t,
-            Type::Enum(i) => c.enums[*i].base,
-            _ => return None,
-        };
-        self.read(at, t).ok().map(V::float)
-    }
-
-    /// Whether type `t` is unsigned (read without a sign).
-    pub(crate) fn unsigned(t: Elem) -> bool {
-        matches!(t.class(), Class::Unsigned | Class::Bits | Class::Bool)
     }
 }

@@ -2,7 +2,7 @@
 //! types compare and divide without a sign, reals stay reals; a division by zero and a
 //! conversion of a value its type cannot hold are faults.
 
-use super::{Fault, Program, V};
+use super::{Fault, V};
 use crate::ast::BinOp;
 use crate::ir::StdFn;
 use crate::types::{Class, Elem};
@@ -21,6 +21,11 @@ pub(crate) fn wrap(v: i64, t: Elem) -> i64 {
         Elem::DInt | Elem::Time => i64::from(v as i32),
         _ => v,
     }
+}
+
+/// Whether `t` is read without a sign.
+pub(crate) fn unsigned(t: Elem) -> bool {
+    matches!(t.class(), Class::Unsigned | Class::Bits | Class::Bool)
 }
 
 fn is_float(t: Elem) -> bool {
@@ -84,9 +89,9 @@ fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
         BinOp::Or => a | b,
         BinOp::Xor => a ^ b,
         BinOp::Div | BinOp::Mod if b == 0 => return Err(Fault::DivisionByZero),
-        BinOp::Div if Program::unsigned(t) => ((a as u64) / (b as u64)) as i64,
+        BinOp::Div if unsigned(t) => ((a as u64) / (b as u64)) as i64,
         BinOp::Div => a.wrapping_div(b),
-        BinOp::Mod if Program::unsigned(t) => ((a as u64) % (b as u64)) as i64,
+        BinOp::Mod if unsigned(t) => ((a as u64) % (b as u64)) as i64,
         BinOp::Mod => a.wrapping_rem(b),
         _ => return Err(Fault::OutOfRange),
     };
@@ -97,7 +102,7 @@ fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
 fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
     let ord = if is_float(t) {
         x.float().partial_cmp(&y.float())
-    } else if Program::unsigned(t) {
+    } else if unsigned(t) {
         Some((x.int() as u64).cmp(&(y.int() as u64)))
     } else {
         Some(x.int().cmp(&y.int()))
@@ -122,7 +127,7 @@ pub(crate) fn convert(v: V, from: Elem, to: Elem) -> Run<V> {
     match (is_float(from), is_float(to)) {
         (_, true) => {
             let f = match v {
-                V::I(i) if Program::unsigned(from) => i as u64 as f64,
+                V::I(i) if unsigned(from) => i as u64 as f64,
                 other => other.float(),
             };
             finite(f)

@@ -2,7 +2,7 @@
 //! [`crate::layout::std_fb`]'s): the timers on the cycle's clock, the edges, the counters and
 //! the bistables.
 
-use super::{Fault, Program, V};
+use super::{Exec, Fault, V};
 use crate::check::std_lib::StdFb;
 use crate::types::Elem;
 
@@ -12,13 +12,13 @@ type Run<T> = Result<T, Fault>;
 const STATE: usize = 2;
 const START: usize = 16;
 
-impl Program {
+impl Exec<'_> {
     fn flag(&self, at: usize) -> Run<bool> {
-        Ok(self.read(at, Elem::Bool)?.int() != 0)
+        Ok(self.read_own(at, Elem::Bool)?.int() != 0)
     }
 
     fn set_flag(&mut self, at: usize, v: bool) -> Run<()> {
-        self.write(at, Elem::Bool, V::I(i64::from(v)))
+        self.write_own(at, Elem::Bool, V::I(i64::from(v)))
     }
 
     pub(super) fn run_std_fb(&mut self, fb: StdFb, at: usize) -> Run<()> {
@@ -49,16 +49,16 @@ impl Program {
     /// TON, TOF and TP: PT and ET are TIME (ms), the clock the cycle's.
     fn timer(&mut self, fb: StdFb, at: usize) -> Run<()> {
         let input = self.flag(at)?;
-        let pt = i64::from(self.read(at + 4, Elem::Time)?.int() as i32).max(0);
-        let state = self.read(at + STATE, Elem::Byte)?.int();
+        let pt = i64::from(self.read_own(at + 4, Elem::Time)?.int() as i32).max(0);
+        let state = self.read_own(at + STATE, Elem::Byte)?.int();
         let (running, last_in) = (state & 1 != 0, state & 2 != 0);
-        let start = self.read(at + START, Elem::LInt)?.int();
-        let elapsed = ((self.now_ns - start) / 1_000_000).clamp(0, pt);
+        let start = self.read_own(at + START, Elem::LInt)?.int();
+        let elapsed = ((self.st.now_ns - start) / 1_000_000).clamp(0, pt);
         let (mut q, mut et, mut run) = (false, 0, running);
         match fb {
             StdFb::Ton if input => {
                 if !running {
-                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    self.write_own(at + START, Elem::LInt, V::I(self.st.now_ns))?;
                     run = true;
                 }
                 et = if running { elapsed } else { 0 };
@@ -72,7 +72,7 @@ impl Program {
             StdFb::Tof => {
                 let was_on = self.flag(at + 1)?;
                 if was_on && !running {
-                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    self.write_own(at + START, Elem::LInt, V::I(self.st.now_ns))?;
                     run = true;
                 }
                 et = if running { elapsed } else { 0 };
@@ -82,7 +82,7 @@ impl Program {
             _ => {
                 // TP: a rising IN starts a pulse of PT that nothing cuts short.
                 if input && !last_in && !running {
-                    self.write(at + START, Elem::LInt, V::I(self.now_ns))?;
+                    self.write_own(at + START, Elem::LInt, V::I(self.st.now_ns))?;
                     run = true;
                 }
                 let pulse_elapsed = if running { elapsed } else { 0 };
@@ -98,16 +98,16 @@ impl Program {
             }
         }
         self.set_flag(at + 1, q)?;
-        self.write(at + 8, Elem::Time, V::I(et))?;
+        self.write_own(at + 8, Elem::Time, V::I(et))?;
         let state = i64::from(run) | (i64::from(input) << 1);
-        self.write(at + STATE, Elem::Byte, V::I(state))
+        self.write_own(at + STATE, Elem::Byte, V::I(state))
     }
 
     /// CTU and CTD: the counter's edge input, RESET or LOAD, PV and CV as INT.
     fn counter(&mut self, fb: StdFb, at: usize) -> Run<()> {
         let (edge_in, clear, last) = (self.flag(at)?, self.flag(at + 1)?, self.flag(at + 3)?);
-        let pv = self.read(at + 4, Elem::Int)?.int();
-        let mut cv = self.read(at + 6, Elem::Int)?.int();
+        let pv = self.read_own(at + 4, Elem::Int)?.int();
+        let mut cv = self.read_own(at + 6, Elem::Int)?.int();
         let rising = edge_in && !last;
         if fb == StdFb::Ctu {
             if clear {
@@ -124,7 +124,7 @@ impl Program {
             }
             self.set_flag(at + 2, cv <= 0)?;
         }
-        self.write(at + 6, Elem::Int, V::I(cv))?;
+        self.write_own(at + 6, Elem::Int, V::I(cv))?;
         self.set_flag(at + 3, edge_in)
     }
 }
