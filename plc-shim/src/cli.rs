@@ -63,6 +63,10 @@ pub struct PlcArgs {
     /// Run this timeline (TOML, see `plc_shim::timeline`) instead of a built-in program.
     #[arg(long)]
     pub timeline: Option<std::path::PathBuf>,
+    /// Run these Structured Text files (every PROGRAM in them, each cycle) instead of a
+    /// built-in program (docs/plc-st.md).
+    #[arg(long, num_args = 1.., conflicts_with = "timeline")]
+    pub st: Vec<std::path::PathBuf>,
     /// Position file of `fifo-stream` (CSV, or binary `.fifo`; see `plc_shim::fifo_file`).
     #[arg(long)]
     pub file: Option<std::path::PathBuf>,
@@ -111,6 +115,15 @@ pub fn main(cli: PlcCli) -> ExitCode {
 
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn run(args: PlcArgs) -> ExitCode {
+    if !args.st.is_empty() {
+        return match crate::st::StProgram::load(&args.st, args.host.period_ticks) {
+            Ok(mut program) => host(&mut program, &args.host),
+            Err(e) => {
+                eprint!("{e}");
+                ExitCode::from(2)
+            }
+        };
+    }
     let mut program: Box<dyn PlcProgram> = match &args.timeline {
         Some(path) => match Timeline::load(path) {
             Ok(t) => Box::new(t),
@@ -133,6 +146,10 @@ pub fn run(args: PlcArgs) -> ExitCode {
 /// The built-in program `args.program` with its arguments (the PLC process runs it; an
 /// in-process run of a scenario runs it in the CNC's process).
 pub fn built_in(args: &PlcArgs) -> Result<Box<dyn PlcProgram>, String> {
+    if !args.st.is_empty() {
+        let program = crate::st::StProgram::load(&args.st, args.host.period_ticks)?;
+        return Ok(Box::new(program));
+    }
     Ok(match args.program.as_str() {
         "rotary-table" => Box::new(RotaryTableMaster::new(0, args.deg_per_cycle, 200)),
         "turntable-hybrid" => Box::new(Turntable::new(Variant::Hybrid)),
@@ -251,6 +268,10 @@ fn ending(end: &crate::runtime::RunEnd) -> (u8, Option<String>) {
         RunEnd::Signal(signal) => (
             signal.exit_code(),
             Some(format!("stopped by {}", signal.name())),
+        ),
+        RunEnd::ProgramHalted => (
+            7,
+            Some("the program stopped on a fault (above); the CNC stops as for a lost PLC".into()),
         ),
         _ => (0, None),
     }

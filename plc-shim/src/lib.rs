@@ -13,6 +13,7 @@ pub mod kernel;
 pub mod programs;
 pub mod realtime;
 pub mod runtime;
+pub mod st;
 pub mod timeline;
 pub mod tools;
 pub mod watchdog;

@@ -222,6 +222,12 @@ pub trait PlcProgram {
     fn summary(&self) -> String {
         String::new()
     }
+    /// Whether the program stopped itself (a run-time fault of a Structured Text program):
+    /// the runtime then ends without another heartbeat, and the CNC handles the PLC as lost
+    /// (a controlled stop).
+    fn halted(&self) -> bool {
+        false
+    }
 }
 
 /// How a run ended.
@@ -259,6 +265,8 @@ pub enum RunEnd {
     CycleLimit,
     /// A termination signal arrived (see [`hli_transport::signals`]).
     Signal(hli_transport::signals::Termination),
+    /// The program stopped itself ([`PlcProgram::halted`]): its summary says why.
+    ProgramHalted,
 }
 
 /// The runtime over an attached segment.
@@ -377,6 +385,10 @@ impl PlcRuntime {
                 program.cycle(&mut io);
                 let took = cnc_os::monotonic::now().saturating_sub(start);
                 stats.record(took.as_nanos() as u64);
+                if program.halted() {
+                    // No heartbeat for this tick: the CNC stops as for a lost PLC.
+                    return end(RunEnd::ProgramHalted, stats, wake_to_done);
+                }
             }
             self.segment.beat();
             self.events.notify()?;

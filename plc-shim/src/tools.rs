@@ -74,6 +74,13 @@ pub enum ToolCommand {
     /// Run one block of the library (by its name and timeline inputs) against a running CNC
     /// until it ends: for commissioning.
     Call(crate::call_tool::CallArgs),
+    /// Check Structured Text files as `plc --st` would load them: every diagnostic with
+    /// FILE:LINE:COL (exit 2 if there is one).
+    Check {
+        /// The files, one program.
+        #[arg(required = true)]
+        files: Vec<std::path::PathBuf>,
+    },
 }
 
 /// Why a tool did not do what it was asked.
@@ -215,6 +222,18 @@ pub fn main(command: ToolCommand) -> ExitCode {
     let result = match &command {
         ToolCommand::Channel(args) => return crate::channel_tool::main(args),
         ToolCommand::Call(args) => return crate::call_tool::main(args),
+        ToolCommand::Check { files } => {
+            return match crate::st::StProgram::load(files, 1) {
+                Ok(p) => {
+                    println!("{}: ok, {} POUs", files.len(), p.pous());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprint!("{e}");
+                    ExitCode::from(2)
+                }
+            }
+        }
         ToolCommand::Get { paths, instance } => get(instance, paths).map(print_lines),
         ToolCommand::Set { pairs, instance } => set(instance, pairs).map(print_lines),
         ToolCommand::Watch {

@@ -102,6 +102,9 @@ struct PlcFile {
     saw_cuts: Option<usize>,
     /// Piece length of the saw, mm.
     saw_length: Option<f64>,
+    /// Structured Text files run as the PLC program (docs/plc-st.md), relative to the
+    /// scenario.
+    st: Option<Vec<String>>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -382,6 +385,12 @@ fn plc_setup(
     open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
 ) -> Result<PlcSetup, ScenarioError> {
     let invalid = invalid_in(name);
+    if let Some(PlcFile {
+        st: Some(files), ..
+    }) = &plc
+    {
+        return st_setup(name, plc.as_ref(), files, open);
+    }
     Ok(match plc {
         None => PlcSetup::None,
         Some(PlcFile {
@@ -391,6 +400,7 @@ fn plc_setup(
             fifo_override: None,
             saw_cuts: None,
             saw_length: None,
+            st: None,
         }) => {
             confined("[plc] timeline", Path::new(&t)).map_err(&invalid)?;
             let (path, text) = open(&t)?;
@@ -410,6 +420,7 @@ fn plc_setup(
             fifo_override,
             saw_cuts,
             saw_length,
+            st: None,
         }) => {
             let args = program_args(name, &p, file, fifo_override, (saw_cuts, saw_length))
                 .map_err(invalid)?;
@@ -430,6 +441,40 @@ fn plc_setup(
             ))
         }
     })
+}
+
+/// `[plc] st = [..]`: the files checked now (a program with a diagnostic fails before any
+/// process starts), run as the PLC program `st` with `--st PATH..`.
+fn st_setup(
+    name: &str,
+    plc: Option<&PlcFile>,
+    files: &[String],
+    open: &impl Fn(&str) -> Result<(PathBuf, String), ScenarioError>,
+) -> Result<PlcSetup, ScenarioError> {
+    let invalid = invalid_in(name);
+    let alone = plc.is_some_and(|p| {
+        p.timeline.is_none()
+            && p.program.is_none()
+            && p.file.is_none()
+            && p.fifo_override.is_none()
+            && p.saw_cuts.is_none()
+            && p.saw_length.is_none()
+    });
+    if !alone || files.is_empty() {
+        return Err(invalid(
+            "[plc] `st` takes one or more files and nothing else".into(),
+        ));
+    }
+    let mut args = vec!["--st".to_string()];
+    let mut texts = Vec::with_capacity(files.len());
+    for f in files {
+        confined("[plc] st", Path::new(f)).map_err(&invalid)?;
+        let (path, text) = open(f)?;
+        args.push(path.display().to_string());
+        texts.push((path.display().to_string(), text));
+    }
+    plc_shim::st::StProgram::from_texts(&texts, 1).map_err(invalid)?;
+    Ok(PlcSetup::Program("st".into(), args))
 }
 
 /// The command-line arguments of built-in program `p` of scenario `name`: its data file

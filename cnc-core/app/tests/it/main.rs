@@ -44,3 +44,4 @@ mod saw_no_alloc;
 mod scenario_paths;
 mod scenarios;
 mod soak;
+mod st_plc;

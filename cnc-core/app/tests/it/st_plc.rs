@@ -1,0 +1,131 @@
+//! A Structured Text PLC in a scenario (`[plc] st = [..]`): in-process and as the PLC process
+//! of `cnc run`, it writes the channel's path override through `gpCh` as the manuals write it,
+//! and a run-time fault stops the PLC and the CNC stops as for a lost PLC, the fault named.
+
+use cnc_app::scenario::{InProcess, Scenario};
+use tests::{Cli, Scratch};
+
+const SCENARIO: &str = "cycle_ms = 1.0\nticks = 400\n\
+    [[channel]]\nname = \"mill\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\nprogram = \"part.nc\"\n\
+    [plc]\nst = [\"override.st\"]\n\
+    [trace]\nsignals = [\"gpCh[0]^channel_mc_control.path_override.feed_override_r\"]\n";
+
+const PART: &str = "G01 X100 F6000\nM30\n";
+
+/// Half the feed from the first cycle on; with `fault`, a division by zero at cycle 50.
+fn override_st(fault: bool) -> String {
+    let crash = if fault {
+        "IF n = 50 THEN n := n / zero; END_IF\n"
+    } else {
+        ""
+    };
+    format!(
+        "PROGRAM MAIN\nVAR\n    pOverride : POINTER TO HLI_CHANNEL_OVERRIDE_UNIT;\n    n, zero : DINT;\nEND_VAR\n\
+         pOverride := ADR(gpCh[0]^channel_mc_control.path_override);\n\
+         pOverride^.feed_override_w := UDINT#500;\nn := n + 1;\n{crash}END_PROGRAM\n"
+    )
+}
+
+fn write_scenario(dir: &Scratch, fault: bool) -> std::path::PathBuf {
+    std::fs::write(dir.join("part.nc"), PART).unwrap();
+    std::fs::write(dir.join("override.st"), override_st(fault)).unwrap();
+    let path = dir.join("scenario.toml");
+    std::fs::write(&path, SCENARIO).unwrap();
+    path
+}
+
+#[test]
+fn an_st_program_sets_the_feed_override_in_process() {
+    let dir = Scratch::new("st-plc-inproc");
+    let s = Scenario::load(&write_scenario(&dir, false)).unwrap();
+    let run = InProcess::run_through(&s).unwrap();
+    let csv = String::from_utf8(run.trace_csv()).unwrap();
+    let last = csv.lines().last().unwrap();
+    assert!(
+        last.ends_with(",500"),
+        "the CNC took the PLC's 50 %: {last}"
+    );
+}
+
+#[test]
+fn an_st_plc_process_runs_and_a_fault_stops_it_and_the_machine() {
+    let dir = Scratch::new("st-plc-process");
+    let path = write_scenario(&dir, false);
+    let trace = dir.join("t.csv");
+    let out = tests::cli::cnc_run(
+        env!("CARGO_BIN_EXE_cnc"),
+        &[path.to_str().unwrap(), "--lockstep"],
+        &tests::unique_instance("st-plc"),
+        &trace,
+    );
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("st: "),
+        "{}",
+        tests::cli::report(&out)
+    );
+    let text = std::fs::read_to_string(&trace).unwrap();
+    assert!(text.lines().last().unwrap().ends_with(",500"));
+
+    let dir = Scratch::new("st-plc-fault");
+    let path = write_scenario(&dir, true);
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", path.to_str().unwrap(), "--lockstep"])
+        .args(["--instance", &tests::unique_instance("st-fault")])
+        .output()
+        .unwrap();
+    let report = tests::cli::report(&out);
+    assert!(!out.status.success(), "{report}");
+    assert!(
+        report.contains("override.st:9:16: fault: division by zero"),
+        "{report}"
+    );
+    assert!(
+        report.contains("PLC lost") && report.contains("machine at rest"),
+        "{report}"
+    );
+}
+
+#[test]
+fn a_scenario_refuses_an_st_program_with_a_mistake_before_anything_runs() {
+    let dir = Scratch::new("st-plc-bad");
+    let path = write_scenario(&dir, false);
+    std::fs::write(
+        dir.join("override.st"),
+        "PROGRAM MAIN\n  x := 1;\nEND_PROGRAM\n",
+    )
+    .unwrap();
+    let e = Scenario::load(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("override.st:2:3: error: unknown name `x`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn plc_check_reports_every_diagnostic_with_its_place() {
+    let dir = Scratch::new("st-plc-check");
+    let bad = dir.join("bad.st");
+    std::fs::write(
+        &bad,
+        "PROGRAM MAIN\nVAR b : BOOL; END_VAR\n  x := 1;\n  b := 5 + TRUE;\nEND_PROGRAM\n",
+    )
+    .unwrap();
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["plc", "check", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.st:3:3: error: unknown name `x`"), "{err}");
+    assert!(
+        err.contains("bad.st:4:10: error: `+` of DINT and BOOL"),
+        "{err}"
+    );
+    let good = dir.join("good.st");
+    std::fs::write(&good, override_st(false)).unwrap();
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["plc", "check", good.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", tests::cli::report(&out));
+}

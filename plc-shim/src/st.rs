@@ -1,0 +1,100 @@
+//! PLC programs in Structured Text (`plc-st`, docs/plc-st.md) on the PLC runtime: the files
+//! are loaded with the HLI's declarations (`hli::st_prelude`), so `gpCh`, `gpAx` and `gpFifo`
+//! point into the image; every PROGRAM runs each cycle on the PLC's clock (the PLC cycles
+//! times the task's period, so a lockstep run is the same every time). A fault stops the
+//! program: the runtime then ends without another heartbeat and the CNC stops as for a lost
+//! PLC; the summary names the fault with its FILE:LINE:COL.
+
+use crate::runtime::{PlcIo, PlcProgram};
+use hli::layout::HliSegmentHeader;
+use plc_st::vm::{FaultAt, Program};
+use std::path::PathBuf;
+
+/// The name the HLI's declarations are loaded under (diagnostics in them name it).
+pub const PRELUDE: &str = "<hli>";
+
+/// A Structured Text program on the runtime.
+#[derive(Debug)]
+pub struct StProgram {
+    program: Program,
+    period_ticks: u64,
+    cycles: u64,
+    fault: Option<FaultAt>,
+}
+
+impl StProgram {
+    /// Loads `files` (with the HLI's declarations), run every `period_ticks` CNC ticks; `Err`
+    /// is every diagnostic, one per line, `FILE:LINE:COL: error: ..`.
+    pub fn load(files: &[PathBuf], period_ticks: u64) -> Result<StProgram, String> {
+        let mut texts = Vec::with_capacity(files.len());
+        for f in files {
+            let text = std::fs::read_to_string(f).map_err(|e| format!("{}: {e}\n", f.display()))?;
+            texts.push((f.display().to_string(), text));
+        }
+        StProgram::from_texts(&texts, period_ticks)
+    }
+
+    /// As [`StProgram::load`], from the files' names and texts.
+    pub fn from_texts(files: &[(String, String)], period_ticks: u64) -> Result<StProgram, String> {
+        let prelude = hli::st_prelude::generate();
+        let mut refs: Vec<(&str, &str)> = vec![(PRELUDE, prelude.as_str())];
+        refs.extend(files.iter().map(|(n, t)| (n.as_str(), t.as_str())));
+        let mut program = Program::load(&refs)
+            .map_err(|errors| errors.iter().map(|d| format!("{d}\n")).collect::<String>())?;
+        program.bind_image();
+        Ok(StProgram {
+            program,
+            period_ticks: period_ticks.max(1),
+            cycles: 0,
+            fault: None,
+        })
+    }
+
+    /// How many POUs the program has (the HLI's declarations have none).
+    pub fn pous(&self) -> usize {
+        self.program.code().checked.pous.len()
+    }
+
+    /// The program.
+    pub fn program(&self) -> &Program {
+        &self.program
+    }
+
+    /// The fault that stopped it, if one did.
+    pub fn fault(&self) -> Option<FaultAt> {
+        self.fault
+    }
+}
+
+impl PlcProgram for StProgram {
+    fn cycle(&mut self, io: &mut PlcIo<'_>) {
+        if self.fault.is_some() {
+            return;
+        }
+        let at = core::mem::offset_of!(HliSegmentHeader, cnc_cycle_ns);
+        let tick_ns = u64::from(io.memory.place::<u32>(at).load());
+        let now = self
+            .cycles
+            .saturating_mul(self.period_ticks)
+            .saturating_mul(tick_ns);
+        self.cycles += 1;
+        if let Err(fault) = self.program.cycle_on(now as i64, Some(io.memory)) {
+            self.fault = Some(fault);
+        }
+    }
+
+    fn halted(&self) -> bool {
+        self.fault.is_some()
+    }
+
+    fn summary(&self) -> String {
+        match &self.fault {
+            Some(f) => format!(
+                "st: stopped after {} cycles: {}",
+                self.cycles,
+                self.program.fault_text(f)
+            ),
+            None => format!("st: {} cycles", self.cycles),
+        }
+    }
+}
