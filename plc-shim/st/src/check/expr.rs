@@ -33,6 +33,16 @@ pub(super) enum Meaning {
 
 const BOOL: Type = Type::Elem(Elem::Bool);
 
+/// The values of a call given by position.
+pub(super) fn positional(args: &[Arg]) -> Vec<&Expr> {
+    args.iter()
+        .filter_map(|a| match a {
+            Arg::Positional(v) => Some(v),
+            _ => None,
+        })
+        .collect()
+}
+
 /// An untyped integer literal's value (`5`, `-5`).
 pub(super) fn literal(e: &Expr) -> Option<i128> {
     match e {

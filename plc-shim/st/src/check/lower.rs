@@ -301,13 +301,7 @@ impl Checker {
         let Expr::Name(n) = callee else {
             return Err(self.unsupported(callee.pos(), "this call"));
         };
-        let positional: Vec<&Expr> = args
-            .iter()
-            .filter_map(|a| match a {
-                Arg::Positional(v) => Some(v),
-                _ => None,
-            })
-            .collect();
+        let positional = super::expr::positional(args);
         if let Some((from, to)) = conversion(&n.text) {
             let v = self.value_as(positional[0], from, ctx, l)?;
             return Ok(Ex::Conv(from, to, Box::new(v)));

@@ -447,13 +447,7 @@ impl Checker {
 
     /// The standard functions' types.
     pub(super) fn std_function(&mut self, name: &str, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
-        let values: Vec<&Expr> = args
-            .iter()
-            .filter_map(|a| match a {
-                Arg::Positional(v) => Some(v),
-                _ => None,
-            })
-            .collect();
+        let values = super::expr::positional(args);
         if values.len() != args.len() {
             return self.error(pos, format!("{name} takes its values by position"));
         }

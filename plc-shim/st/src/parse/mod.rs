@@ -10,14 +10,8 @@ use crate::lex::{lex, Tok, Token};
 
 mod stmt;
 
-/// The words a name may not be (ASCII case ignored).
-const RESERVED: &[&str] = &[
-    "PROGRAM",
-    "END_PROGRAM",
-    "FUNCTION_BLOCK",
-    "END_FUNCTION_BLOCK",
-    "FUNCTION",
-    "END_FUNCTION",
+/// The words that open a variable section.
+const SECTIONS: [&str; 7] = [
     "VAR",
     "VAR_INPUT",
     "VAR_OUTPUT",
@@ -25,6 +19,16 @@ const RESERVED: &[&str] = &[
     "VAR_GLOBAL",
     "VAR_TEMP",
     "VAR_EXTERNAL",
+];
+
+/// The words a name may not be (ASCII case ignored), besides [`SECTIONS`].
+const RESERVED: &[&str] = &[
+    "PROGRAM",
+    "END_PROGRAM",
+    "FUNCTION_BLOCK",
+    "END_FUNCTION_BLOCK",
+    "FUNCTION",
+    "END_FUNCTION",
     "END_VAR",
     "CONSTANT",
     "RETAIN",
@@ -66,6 +70,12 @@ const RESERVED: &[&str] = &[
     "FALSE",
     "AT",
 ];
+
+/// Whether `word` is reserved (ASCII case ignored).
+fn reserved(word: &str) -> bool {
+    let same = |r: &&str| r.eq_ignore_ascii_case(word);
+    RESERVED.iter().any(same) || SECTIONS.iter().any(same)
+}
 
 /// Parses one file's text; `Err` is the first refusal, with its place.
 pub fn parse(text: &str) -> Result<Unit, Diagnostic> {
@@ -170,7 +180,7 @@ impl Parser {
     fn name(&mut self) -> Result<Name, Diagnostic> {
         let pos = self.pos();
         match self.peek().clone() {
-            Tok::Ident(text) if !RESERVED.iter().any(|r| r.eq_ignore_ascii_case(&text)) => {
+            Tok::Ident(text) if !reserved(&text) => {
                 self.bump();
                 Ok(Name { text, pos })
             }
@@ -228,15 +238,6 @@ impl Parser {
     }
 
     fn is_var_section(&self) -> bool {
-        const SECTIONS: [&str; 7] = [
-            "VAR",
-            "VAR_INPUT",
-            "VAR_OUTPUT",
-            "VAR_IN_OUT",
-            "VAR_GLOBAL",
-            "VAR_TEMP",
-            "VAR_EXTERNAL",
-        ];
         SECTIONS.iter().any(|s| self.is_kw(s))
     }
 

@@ -315,10 +315,7 @@ impl Parser {
                 // `p^field`, as the manuals write it, is `p^.field`.
                 let field_pos = self.pos();
                 if let Tok::Ident(word) = self.peek().clone() {
-                    if !super::RESERVED
-                        .iter()
-                        .any(|r| r.eq_ignore_ascii_case(&word))
-                    {
+                    if !super::reserved(&word) {
                         self.bump();
                         let field = Name {
                             text: word,
