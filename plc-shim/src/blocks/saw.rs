@@ -661,13 +661,7 @@ const fn saw_block(
     inputs: &'static [InputSpec],
     make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
 ) -> BlockSpec {
-    BlockSpec {
-        name,
-        target: Target::AxisNamed("Slave"),
-        execute: true,
-        inputs,
-        make,
-    }
+    BlockSpec::with_execute(name, Target::AxisNamed("Slave"), inputs, make)
 }
 
 /// The flying-saw blocks a timeline calls (their inputs: [`inputs`]).

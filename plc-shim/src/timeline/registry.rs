@@ -50,15 +50,25 @@ pub struct BlockSpec {
 }
 
 impl BlockSpec {
-    /// A block on an axis with an Execute input, its inputs given key by key (most blocks).
+    /// A block on an axis with an Execute input (most blocks).
     pub const fn on_axis(
         name: &'static str,
         inputs: &'static [InputSpec],
         make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
     ) -> BlockSpec {
+        BlockSpec::with_execute(name, Target::Axis, inputs, make)
+    }
+
+    /// A block with an Execute input on `target`.
+    pub const fn with_execute(
+        name: &'static str,
+        target: Target,
+        inputs: &'static [InputSpec],
+        make: fn(Option<usize>) -> Box<dyn TimelineBlock>,
+    ) -> BlockSpec {
         BlockSpec {
             name,
-            target: Target::Axis,
+            target,
             execute: true,
             inputs,
             make,

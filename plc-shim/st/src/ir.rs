@@ -81,6 +81,13 @@ pub enum Ex {
     },
 }
 
+/// An input of a block's call: its offset in the instance, its type, its value.
+pub type BlockInput = (u32, Elem, Ex);
+
+/// An output of a block's call: its offset in the instance, its type, where it goes, whether
+/// negated.
+pub type BlockOutput = (u32, Elem, Addr, bool);
+
 /// A CASE arm: the ranges of values it takes (a single value is a range of one) and its
 /// statements.
 pub type CaseArm = (Vec<(i64, i64)>, Vec<St>);
@@ -187,9 +194,9 @@ pub enum StKind {
         /// The instance.
         instance: Addr,
         /// Inputs (stores relative to the instance) before the body.
-        inputs: Vec<(u32, Elem, Ex)>,
-        /// Outputs after it: offset in the instance, type, where it goes, negated.
-        outputs: Vec<(u32, Elem, Addr, bool)>,
+        inputs: Vec<BlockInput>,
+        /// Outputs after it.
+        outputs: Vec<BlockOutput>,
     },
     /// A standard function block's call.
     CallStdFb {
@@ -198,9 +205,9 @@ pub enum StKind {
         /// The instance.
         instance: Addr,
         /// Inputs.
-        inputs: Vec<(u32, Elem, Ex)>,
+        inputs: Vec<BlockInput>,
         /// Outputs.
-        outputs: Vec<(u32, Elem, Addr, bool)>,
+        outputs: Vec<BlockOutput>,
     },
     /// An expression whose value is dropped (a function called as a statement).
     Eval(Ex),

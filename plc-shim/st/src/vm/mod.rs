@@ -8,7 +8,7 @@
 use crate::ast::PouKind;
 use crate::check::{compile, Compiled, Type};
 use crate::diag::{Diagnostic, Pos};
-use crate::ir::{Addr, Ex, St, StKind};
+use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
 use crate::types::Elem;
 use hli::ImageMemory;
 
@@ -491,24 +491,13 @@ impl<'a> Exec<'a> {
                 instance,
                 inputs,
                 outputs,
-            } => {
-                let at = self.own(instance, base)? as u32;
-                self.store_all(inputs, at, base)?;
-                self.run_body(*pou, at)?;
-                self.st.at = s.at;
-                self.read_outputs(outputs, at, base)?;
-            }
+            } => self.call_block(s, base, (instance, inputs, outputs), Some(*pou), None)?,
             StKind::CallStdFb {
                 fb,
                 instance,
                 inputs,
                 outputs,
-            } => {
-                let at = self.own(instance, base)? as u32;
-                self.store_all(inputs, at, base)?;
-                self.run_std_fb(*fb, at as usize)?;
-                self.read_outputs(outputs, at, base)?;
-            }
+            } => self.call_block(s, base, (instance, inputs, outputs), None, Some(*fb))?,
             StKind::Eval(e) => {
                 self.eval(e, base)?;
             }
@@ -552,7 +541,28 @@ impl<'a> Exec<'a> {
         Ok(Flow::Next)
     }
 
-    fn store_all(&mut self, inputs: &[(u32, Elem, Ex)], at: u32, base: u32) -> Run<()> {
+    /// A function block instance's call: its inputs, its body (a POU's, or a standard
+    /// block's), its outputs.
+    fn call_block(
+        &mut self,
+        s: &St,
+        base: u32,
+        (instance, inputs, outputs): (&Addr, &[BlockInput], &[BlockOutput]),
+        pou: Option<usize>,
+        fb: Option<crate::check::std_lib::StdFb>,
+    ) -> Run<()> {
+        let at = self.own(instance, base)? as u32;
+        self.store_all(inputs, at, base)?;
+        match (pou, fb) {
+            (Some(pou), _) => self.run_body(pou, at)?,
+            (_, Some(fb)) => self.run_std_fb(fb, at as usize)?,
+            _ => {}
+        }
+        self.st.at = s.at;
+        self.read_outputs(outputs, at, base)
+    }
+
+    fn store_all(&mut self, inputs: &[BlockInput], at: u32, base: u32) -> Run<()> {
         for (offset, t, e) in inputs {
             let v = self.eval(e, base)?;
             self.write_own((at + offset) as usize, *t, v)?;
@@ -560,7 +570,7 @@ impl<'a> Exec<'a> {
         Ok(())
     }
 
-    fn read_outputs(&mut self, outputs: &[(u32, Elem, Addr, bool)], at: u32, base: u32) -> Run<()> {
+    fn read_outputs(&mut self, outputs: &[BlockOutput], at: u32, base: u32) -> Run<()> {
         for (offset, t, target, negated) in outputs {
             let mut v = self.read_own((at + offset) as usize, *t)?;
             if *negated {
