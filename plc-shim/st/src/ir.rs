@@ -67,19 +67,26 @@ pub enum Ex {
     Conv(Elem, Elem, Box<Ex>),
     /// A standard function, the type it computes in, its values.
     Std(StdFn, Elem, Vec<Ex>),
-    /// A user function: its body index, the stores of its inputs into its frame, and the
-    /// place and type of its value.
+    /// A user function: its body index, its inputs (offsets in its frame, at most
+    /// [`MAX_CALL_INPUTS`]), and the place and type of its value.
     Call {
         /// The function's index among the POUs.
         pou: usize,
-        /// Its inputs into its frame.
-        inputs: Vec<St>,
+        /// Its inputs: offset in its frame, type, value.
+        inputs: Vec<BlockInput>,
         /// Its value.
         value: Box<Addr>,
         /// The value's type.
         ty: Elem,
     },
 }
+
+/// The most inputs a call of a user function passes (their values are held on the stack while
+/// the function's frame is made ready).
+pub const MAX_CALL_INPUTS: usize = 32;
+
+/// The most values a standard function (MIN, MAX, MUX, ...) takes (held on the stack).
+pub const MAX_STD_VALUES: usize = 16;
 
 /// An input of a block's call: its offset in the instance, its type, its value.
 pub type BlockInput = (u32, Elem, Ex);

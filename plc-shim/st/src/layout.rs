@@ -116,9 +116,14 @@ impl Layout {
             Type::Pointer(_) => (8, 8),
             Type::Array(dims, element) => {
                 let (size, align) = self.size_align(c, element);
-                let count: u64 = dims.iter().map(|(lo, hi)| (hi - lo + 1) as u64).product();
+                let count = dims
+                    .iter()
+                    .fold(1u64, |n, (lo, hi)| n.saturating_mul(hi.abs_diff(*lo) + 1));
                 let stride = align_to(u64::from(size), align);
-                ((stride * count).min(u64::from(u32::MAX)) as u32, align)
+                (
+                    stride.saturating_mul(count).min(u64::from(u32::MAX)) as u32,
+                    align,
+                )
             }
             Type::Struct(i) => (self.structs[*i].0, self.structs[*i].1),
             Type::Fb(i) => (self.pous[*i].0, self.pous[*i].1),

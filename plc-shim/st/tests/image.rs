@@ -78,3 +78,21 @@ fn a_write_to_a_cnc_leaf_through_a_bare_pointer_faults_in_the_cycle() {
     let mut p = load(text).unwrap();
     assert_eq!(p.cycle(0).unwrap_err().fault, Fault::BadPointer);
 }
+
+#[test]
+fn a_real_of_the_image_that_is_not_finite_faults_where_it_is_read() {
+    let text = "PROGRAM MAIN VAR x : LREAL; END_VAR\n\
+                x := gpAx[0]^.drive_state.probe_r[1].recorded_position_r;\nEND_PROGRAM";
+    let path = "gpAx[0]^drive_state.probe_r[1].recorded_position_r";
+    let image = hli::image::heap_image(1, 6);
+    let mut p = load(text).unwrap();
+    leaf(path).write(&image, Value::Real(12.5));
+    p.cycle_on(0, Some(&image)).unwrap();
+    assert_eq!(p.read_var("MAIN.x"), Some(12.5));
+    leaf(path).write(&image, Value::Real(f64::NAN));
+    let fault = p.cycle_on(1_000_000, Some(&image)).unwrap_err();
+    assert_eq!(fault.fault, Fault::NotFinite);
+    assert!(p
+        .fault_text(&fault)
+        .starts_with("main.st:2:1: fault: a real of the image that is not finite"));
+}

@@ -132,6 +132,61 @@ fn a_ton_is_done_when_its_time_has_run() {
 }
 
 #[test]
+fn a_tof_holds_q_for_its_time_then_et_stays_at_pt() {
+    let text = "PROGRAM MAIN VAR t : TOF; n : INT; q : BOOL; et : TIME; END_VAR
+        n := n + 1; t(IN := n <= 2 OR n >= 8, PT := T#20MS, Q => q, ET => et); END_PROGRAM";
+    let mut p = load(text);
+    // IN is TRUE in cycles 1-2, FALSE in 3-7, TRUE again from 8 (10 ms per cycle).
+    let expected = [
+        (1, 0),
+        (1, 0),
+        (1, 0),
+        (1, 10),
+        (0, 20),
+        (0, 20),
+        (0, 20),
+        (1, 0),
+    ];
+    for (k, (q, et)) in expected.iter().enumerate() {
+        p.cycle(k as i64 * 10_000_000).unwrap();
+        let got = (p.read_var("MAIN.q"), p.read_var("MAIN.et"));
+        assert_eq!(
+            got,
+            (Some(f64::from(*q)), Some(f64::from(*et))),
+            "cycle {}",
+            k + 1
+        );
+    }
+}
+
+const TWICE: &str = "FUNCTION F : INT VAR_INPUT x : INT; END_VAR VAR k : INT := 10; END_VAR
+    k := k + x;
+    F := k;
+END_FUNCTION
+";
+
+#[test]
+fn a_function_called_in_its_own_argument_starts_from_its_initial_values() {
+    let p = run(
+        &format!("{TWICE}PROGRAM MAIN VAR y : INT; END_VAR y := F(F(1)); END_PROGRAM"),
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.y"), Some(21.0), "F(1) = 11, F(11) = 21");
+}
+
+#[test]
+fn a_fault_after_a_call_names_the_callers_statement() {
+    let text =
+        format!("{TWICE}PROGRAM MAIN VAR y, z : INT; END_VAR\n  y := F(1) / z;\nEND_PROGRAM");
+    let (f, text) = fault(&text);
+    assert_eq!(f, Fault::DivisionByZero);
+    assert!(
+        text.starts_with("main.st:6:3: fault: division by zero"),
+        "{text}"
+    );
+}
+
+#[test]
 fn pointers_write_where_they_point() {
     let text = "
 PROGRAM MAIN
@@ -184,6 +239,9 @@ fn faults_stop_the_cycle_and_name_the_statement() {
     assert_eq!(f, Fault::BadPointer);
     let (f, _) = fault("PROGRAM MAIN VAR r : LREAL := 1.0E300; i : INT; END_VAR\n  i := LREAL_TO_INT(r);\nEND_PROGRAM");
     assert_eq!(f, Fault::OutOfRange);
+    // 2^63 is one past LINT's largest value (it used to wrap to the smallest).
+    let (f, _) = fault("PROGRAM MAIN VAR r : LREAL := 9.223372036854775807E18; i : LINT; END_VAR\n  i := LREAL_TO_LINT(r);\nEND_PROGRAM");
+    assert_eq!(f, Fault::OutOfRange);
 }
 
 #[path = "../../../tests/support/counting_alloc.rs"]
@@ -212,4 +270,42 @@ END_PROGRAM";
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
     assert!(p.read_var("MAIN.total").unwrap() > 0.0);
+}
+
+fn refused(text: &str) -> String {
+    match Program::load(&[("main.st", text)]) {
+        Ok(_) => panic!("loaded: {text}"),
+        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
+    }
+}
+
+#[test]
+fn what_the_runtime_cannot_hold_is_refused_at_load_with_its_place() {
+    let values = (1..=17)
+        .map(|k| k.to_string())
+        .collect::<Vec<_>>()
+        .join(", ");
+    let e = refused(&format!(
+        "PROGRAM MAIN VAR m : DINT; END_VAR\n  m := MAX({values});\nEND_PROGRAM"
+    ));
+    assert!(
+        e.contains("main.st:2:8: error: a standard function of more than 16"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION G : INT VAR_IN_OUT x : INT; END_VAR G := x; END_FUNCTION\n\
+         PROGRAM MAIN VAR a, m : INT; END_VAR\n  m := G();\nEND_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:8: error: a call of a function with VAR_IN_OUT"),
+        "{e}"
+    );
+    let e = refused(
+        "PROGRAM MAIN VAR p : POINTER TO ARRAY[0..1000000] OF ARRAY[0..1000000] OF LREAL;\n\
+         x : LREAL; END_VAR\n  x := p^[1][1];\nEND_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:8: error: an array larger than 4 GiB"),
+        "{e}"
+    );
 }

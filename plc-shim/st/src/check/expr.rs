@@ -307,29 +307,15 @@ impl Checker {
     /// The type both sides of `l op r` go to, literals taking the other side's type.
     pub(super) fn operands(&mut self, l: &Expr, r: &Expr, ctx: Ctx) -> Option<(Elem, Type, Type)> {
         let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
-        let common = match (&lt, &rt) {
-            (Type::Elem(a), Type::Elem(b)) => {
-                let fits = |v: Option<i128>, e: &Elem| {
-                    v.is_some_and(|v| e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v)))
-                        || (v.is_some() && e.class() == Class::Float)
-                };
-                if fits(literal(l), b) {
-                    Some(*b)
-                } else if fits(literal(r), a) {
-                    Some(*a)
-                } else {
-                    Elem::common(*a, *b)
-                }
-            }
-            _ => None,
-        };
-        common.map(|c| (c, lt, rt))
+        operands_of(l, r, lt, rt)
     }
 
     fn binary(&mut self, op: BinOp, l: &Expr, r: &Expr, pos: Pos, ctx: Ctx) -> Type {
         use BinOp::*;
+        // Each operand typed once: a chain of operators costs its length, not 2^length.
+        let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
         if matches!(op, Eq | Ne) {
-            if let (Type::Enum(a), Type::Enum(b)) = (self.expr(l, ctx), self.expr(r, ctx)) {
+            if let (Type::Enum(a), Type::Enum(b)) = (&lt, &rt) {
                 return if a == b {
                     BOOL
                 } else {
@@ -337,22 +323,23 @@ impl Checker {
                 };
             }
         }
-        let Some((c, lt, rt)) = self.operands(l, r, ctx) else {
-            let (lt, rt) = (self.expr(l, ctx), self.expr(r, ctx));
-            if lt == Type::Error || rt == Type::Error {
-                return Type::Error;
-            }
-            return self.error(
-                pos,
-                format!(
-                    "{} of {} and {}",
-                    op_name(op),
-                    self.type_name(&lt),
-                    self.type_name(&rt)
-                ),
+        if lt == Type::Error || rt == Type::Error {
+            return Type::Error;
+        }
+        let Some((c, _, _)) = operands_of(l, r, lt.clone(), rt.clone()) else {
+            let message = format!(
+                "{} of {} and {}",
+                op_name(op),
+                self.type_name(&lt),
+                self.type_name(&rt)
             );
+            return self.error(pos, message);
         };
-        let _ = (lt, rt);
+        self.binary_result(op, c, pos)
+    }
+
+    fn binary_result(&mut self, op: BinOp, c: Elem, pos: Pos) -> Type {
+        use BinOp::*;
         let class = c.class();
         let ok = match op {
             Or | Xor | And => class == Class::Bool || c.is_integer(),
@@ -374,7 +361,33 @@ impl Checker {
             _ => Type::Elem(c),
         }
     }
+}
 
+/// The type both sides of `l op r` go to (of types `lt`, `rt`), literals taking the other
+/// side's type.
+pub(super) fn operands_of(l: &Expr, r: &Expr, lt: Type, rt: Type) -> Option<(Elem, Type, Type)> {
+    {
+        let common = match (&lt, &rt) {
+            (Type::Elem(a), Type::Elem(b)) => {
+                let fits = |v: Option<i128>, e: &Elem| {
+                    v.is_some_and(|v| e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v)))
+                        || (v.is_some() && e.class() == Class::Float)
+                };
+                if fits(literal(l), b) {
+                    Some(*b)
+                } else if fits(literal(r), a) {
+                    Some(*a)
+                } else {
+                    Elem::common(*a, *b)
+                }
+            }
+            _ => None,
+        };
+        common.map(|c| (c, lt, rt))
+    }
+}
+
+impl Checker {
     /// A type as a message writes it.
     pub(super) fn type_name(&self, t: &Type) -> String {
         match t {

@@ -87,13 +87,11 @@ impl Checker {
                     return Err(self.unsupported(e.pos(), "an index of this value"));
                 };
                 let (size, align) = l.size_align(&self.out, &element);
-                let mut stride = u64::from(size.div_ceil(align) * align);
-                let lens: Vec<u64> = dims.iter().map(|(lo, hi)| (hi - lo + 1) as u64).collect();
-                let mut strides = vec![0u64; dims.len()];
-                for k in (0..dims.len()).rev() {
-                    strides[k] = stride;
-                    stride *= lens[k];
-                }
+                let element_stride = u64::from(size).div_ceil(u64::from(align)) * u64::from(align);
+                let lens: Vec<u64> = dims.iter().map(|(lo, hi)| hi.abs_diff(*lo) + 1).collect();
+                let Some(strides) = strides(element_stride, &lens) else {
+                    return Err(self.unsupported(e.pos(), "an array larger than 4 GiB"));
+                };
                 for (k, i) in index.iter().enumerate() {
                     let index = self.int_value(i, ctx, l)?;
                     addr = Addr::Index {
@@ -101,7 +99,7 @@ impl Checker {
                         index: Box::new(index),
                         lo: dims[k].0,
                         len: lens[k] as u32,
-                        stride: strides[k] as u32,
+                        stride: strides[k],
                     };
                 }
                 Ok((addr, *element))
@@ -335,19 +333,12 @@ impl Checker {
         ) else {
             return Err(self.unsupported(n.pos, "this standard function's values"));
         };
+        if args.len() > crate::ir::MAX_STD_VALUES {
+            return Err(self.unsupported(n.pos, "a standard function of more than 16 values"));
+        }
         // The type the values are computed in.
         let within = match f {
             StdFn::Trunc => Elem::LReal,
-            StdFn::Sqrt
-            | StdFn::Ln
-            | StdFn::Log
-            | StdFn::Exp
-            | StdFn::Sin
-            | StdFn::Cos
-            | StdFn::Tan
-            | StdFn::Asin
-            | StdFn::Acos
-            | StdFn::Atan => result,
             _ => result,
         };
         let mut values = Vec::with_capacity(args.len());
@@ -368,9 +359,15 @@ impl Checker {
     }
 
     fn function_value(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx, l: &Layout) -> R<Ex> {
-        let base = l.statics[i];
-        let inputs: Vec<usize> = (0..self.out.pous[i].vars.len())
-            .filter(|k| self.out.pous[i].vars[*k].section == crate::ast::Section::Input)
+        let vars = &self.out.pous[i].vars;
+        if vars.iter().any(|v| v.section == crate::ast::Section::InOut) {
+            return Err(self.unsupported(pos, "a call of a function with VAR_IN_OUT"));
+        }
+        if args.len() > crate::ir::MAX_CALL_INPUTS {
+            return Err(self.unsupported(pos, "a call with more than 32 values"));
+        }
+        let inputs: Vec<usize> = (0..vars.len())
+            .filter(|k| vars[*k].section == crate::ast::Section::Input)
             .collect();
         let mut stores = Vec::new();
         for (k, arg) in args.iter().enumerate() {
@@ -393,17 +390,13 @@ impl Checker {
             let Type::Elem(t) = self.out.pous[i].vars[var].ty.clone() else {
                 return Err(self.unsupported(value.pos(), "an input that is no elementary value"));
             };
-            let addr = Addr::Static(base + l.pous[i].2[var]);
             let v = self.value_as(value, t, ctx, l)?;
-            stores.push(St {
-                kind: StKind::Store(addr, t, v),
-                at: (0, pos),
-            });
+            stores.push((l.pous[i].2[var], t, v));
         }
         let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
             return Err(self.unsupported(pos, "a function whose value is no elementary value"));
         };
-        let value = Addr::Static(base + *l.pous[i].2.last().unwrap_or(&0));
+        let value = Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0));
         Ok(Ex::Call {
             pou: i,
             inputs: stores,
@@ -575,6 +568,17 @@ impl Checker {
                 _ => Type::Error,
             };
             let (offset, member) = self.member(&inst_ty, name, l)?;
+            if let (Type::Struct(_), Arg::Input(_, v)) = (&member, arg) {
+                // A structure input (an AXIS_REF) is passed leaf by leaf.
+                let (from, _) = self.place(v, ctx, l)?;
+                for (at, t) in self.leaves(&member, l).ok_or_else(|| {
+                    self.unsupported(name.pos, "a structure input with more than 64 values")
+                })? {
+                    let leaf = Addr::Offset(Box::new(from.clone()), at);
+                    inputs.push((offset + at, t, Ex::Load(Box::new(leaf), t)));
+                }
+                continue;
+            }
             let Type::Elem(t) = member else {
                 return Err(
                     self.unsupported(name.pos, "an input or output that is no elementary value")
@@ -608,6 +612,48 @@ impl Checker {
             _ => StKind::Eval(Ex::Int(0)),
         })
     }
+}
+
+impl Checker {
+    /// The elementary leaves of a structure (offset, type), `None` beyond 64 of them or for
+    /// anything but elementary fields and structures of them.
+    fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
+        let mut out = Vec::new();
+        self.leaves_into(ty, 0, l, &mut out)?;
+        Some(out)
+    }
+
+    fn leaves_into(
+        &self,
+        ty: &Type,
+        at: u32,
+        l: &Layout,
+        out: &mut Vec<(u32, Elem)>,
+    ) -> Option<()> {
+        match ty {
+            Type::Elem(e) if out.len() < 64 => out.push((at, *e)),
+            Type::Struct(i) => {
+                for (k, (_, field)) in self.out.structs[*i].fields.iter().enumerate() {
+                    self.leaves_into(field, at + l.structs[*i].2[k], l, out)?;
+                }
+            }
+            _ => return None,
+        }
+        Some(())
+    }
+}
+
+/// The byte stride of each dimension of an array (last dimension fastest), `None` where the
+/// whole array would not fit in 32 bits of address.
+fn strides(element: u64, lens: &[u64]) -> Option<Vec<u32>> {
+    let mut strides = vec![0u32; lens.len()];
+    let mut stride = element;
+    for k in (0..lens.len()).rev() {
+        strides[k] = u32::try_from(stride).ok()?;
+        u32::try_from(lens[k]).ok()?;
+        stride = stride.checked_mul(lens[k])?;
+    }
+    u32::try_from(stride).ok().map(|_| strides)
 }
 
 /// The standard function of an upper-case name.

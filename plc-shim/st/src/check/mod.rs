@@ -146,8 +146,10 @@ pub struct Compiled {
 /// Checks and lowers `files`: the program, or every refusal.
 pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
     let mut c = checker(files)?;
-    let layout = crate::layout::Layout::of(&c.out)
-        .map_err(|e| vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(&files[0].0)])?;
+    let layout = crate::layout::Layout::of(&c.out).map_err(|e| {
+        let file = files.first().map_or("", |(f, _)| f.as_str());
+        vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(file)]
+    })?;
     let mut bodies = vec![(Vec::new(), Vec::new()); c.out.pous.len()];
     let mut errors = Vec::new();
     for (f, (file, unit)) in files.iter().enumerate() {
@@ -319,7 +321,7 @@ impl Checker {
                 self.refuse(name.pos, format!("{next} does not fit {}", base.name()));
             }
             out.push((name.text.clone(), next));
-            next += 1;
+            next = next.saturating_add(1);
         }
         self.out.enums[index].values = out;
         self.out.enums[index].base = base;
@@ -371,6 +373,13 @@ impl Checker {
             let (Some(lo), Some(hi)) = (self.const_int(lo), self.const_int(hi)) else {
                 return Type::Error;
             };
+            if lo.abs() > MAX_BOUND || hi.abs() > MAX_BOUND {
+                self.refuse(
+                    pos,
+                    format!("ARRAY[{lo}..{hi}]: bounds within +-{MAX_BOUND}"),
+                );
+                return Type::Error;
+            }
             if hi < lo {
                 self.refuse(
                     pos,
@@ -502,7 +511,7 @@ impl Checker {
         let value = match e {
             Expr::Int(v, _) => Some(*v),
             Expr::Typed { value, .. } => return self.const_int(value),
-            Expr::Unary(UnOp::Neg, inner, _) => self.const_int(inner).map(|v| -v),
+            Expr::Unary(UnOp::Neg, inner, _) => self.const_int(inner)?.checked_neg(),
             Expr::Binary(op, l, r, pos) => {
                 let (a, b) = (self.const_int(l)?, self.const_int(r)?);
                 let v = match op {
@@ -513,8 +522,8 @@ impl Checker {
                         self.refuse(*pos, "a constant divided by zero");
                         return None;
                     }
-                    BinOp::Div => Some(a / b),
-                    BinOp::Mod => Some(a % b),
+                    BinOp::Div => a.checked_div(b),
+                    BinOp::Mod => a.checked_rem(b),
                     _ => None,
                 };
                 if v.is_none() {
@@ -547,3 +556,7 @@ impl Checker {
 
 /// The most elements an array may have (a program's memory is sized at load).
 pub const MAX_ARRAY_ELEMENTS: i128 = 1 << 20;
+
+/// The largest array bound (either sign): far beyond any program's, small enough that no
+/// index arithmetic overflows.
+pub const MAX_BOUND: i128 = 1 << 40;

@@ -260,10 +260,11 @@ impl Checker {
                     CaseLabel::Range(a, b) => vec![a, b],
                 };
                 for v in values {
-                    if literal(v).is_none()
-                        && !matches!(v, Expr::Name(_) | Expr::Field(..) | Expr::Typed { .. })
-                    {
-                        self.refuse(v.pos(), "a CASE label is a constant");
+                    if !self.is_label(v, ctx) {
+                        self.refuse(
+                            v.pos(),
+                            "a CASE label is a literal or an enumeration's value",
+                        );
                     } else if ok {
                         self.assignable(v, &t, ctx);
                     }
@@ -272,6 +273,17 @@ impl Checker {
             self.statements(body, ctx);
         }
         self.statements(otherwise.unwrap_or(&[]), ctx);
+    }
+
+    /// Whether `v` may label a CASE arm: a literal (typed or not) or an enumeration's value.
+    fn is_label(&self, v: &Expr, ctx: Ctx) -> bool {
+        match v {
+            Expr::Typed { .. } => true,
+            Expr::Name(n) => matches!(self.meaning(&n.text, ctx), Some(Meaning::EnumValue(_))),
+            Expr::Field(base, _) => matches!(&**base, Expr::Name(n)
+                if matches!(self.meaning(&n.text, ctx), Some(Meaning::EnumType(_)))),
+            _ => literal(v).is_some(),
+        }
     }
 
     /// A call as a statement: a function block instance, or a function whose value is

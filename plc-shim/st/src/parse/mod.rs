@@ -323,6 +323,10 @@ impl Parser {
     }
 
     fn type_ref(&mut self) -> Result<TypeRef, Diagnostic> {
+        self.nested(Self::type_ref_inner)
+    }
+
+    fn type_ref_inner(&mut self) -> Result<TypeRef, Diagnostic> {
         let pos = self.pos();
         if self.eat_kw("ARRAY") {
             self.expect(&Tok::LBracket, "`[` and the array's bounds")?;
@@ -372,6 +376,10 @@ impl Parser {
 
     /// An initial value: an expression, `[..]` for an array, `(a := .., ..)` for a struct.
     fn init(&mut self) -> Result<Init, Diagnostic> {
+        self.nested(Self::init_inner)
+    }
+
+    fn init_inner(&mut self) -> Result<Init, Diagnostic> {
         if self.eat(&Tok::LBracket) {
             let mut items = Vec::new();
             loop {

@@ -236,12 +236,16 @@ impl Parser {
             return self.unary();
         }
         let mut lhs = self.binary(level + 1)?;
+        let depth = self.depth;
         while let Some(op) = self.operator(level) {
             let pos = self.pos();
             self.bump();
+            // Each operator in a chain is a level of the tree: counted like a nesting.
+            self.deeper()?;
             let rhs = self.binary(level + 1)?;
             lhs = Expr::Binary(op, Box::new(lhs), Box::new(rhs), pos);
         }
+        self.depth = depth;
         Ok(lhs)
     }
 
@@ -285,11 +289,36 @@ impl Parser {
         self.postfix()
     }
 
+    /// One more level of the tree being read, refused beyond [`MAX_DEPTH`].
+    fn deeper(&mut self) -> Result<(), Diagnostic> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(self.error(format!(
+                "expressions or statements nested deeper than {MAX_DEPTH}"
+            )));
+        }
+        Ok(())
+    }
+
     /// A primary and its `.field`, `[index]`, `^` and `(arguments)`.
     pub(super) fn postfix(&mut self) -> Result<Expr, Diagnostic> {
         let mut e = self.primary()?;
+        let depth = self.depth;
+        let result = self.suffixes(&mut e);
+        self.depth = depth;
+        result.map(|()| e)
+    }
+
+    /// The `.field`, `[index]`, `^` and `(arguments)` after a primary, each a level.
+    fn suffixes(&mut self, e: &mut Expr) -> Result<(), Diagnostic> {
         loop {
             let pos = self.pos();
+            if matches!(
+                self.peek(),
+                Tok::Dot | Tok::LBracket | Tok::Caret | Tok::LParen
+            ) {
+                self.deeper()?;
+            }
             if self.eat(&Tok::Dot) {
                 let field = match self.peek().clone() {
                     // Bit access: `word.3`.
@@ -302,16 +331,20 @@ impl Parser {
                     }
                     _ => self.field_name()?,
                 };
-                e = Expr::Field(Box::new(e), field);
+                *e = Expr::Field(Box::new(std::mem::replace(e, Expr::Int(0, pos))), field);
             } else if self.eat(&Tok::LBracket) {
                 let mut index = vec![self.expr()?];
                 while self.eat(&Tok::Comma) {
                     index.push(self.expr()?);
                 }
                 self.expect(&Tok::RBracket, "`]`")?;
-                e = Expr::Index(Box::new(e), index, pos);
+                *e = Expr::Index(
+                    Box::new(std::mem::replace(e, Expr::Int(0, pos))),
+                    index,
+                    pos,
+                );
             } else if self.eat(&Tok::Caret) {
-                e = Expr::Deref(Box::new(e), pos);
+                *e = Expr::Deref(Box::new(std::mem::replace(e, Expr::Int(0, pos))), pos);
                 // `p^field`, as the manuals write it, is `p^.field`.
                 let field_pos = self.pos();
                 if let Tok::Ident(word) = self.peek().clone() {
@@ -321,18 +354,18 @@ impl Parser {
                             text: word,
                             pos: field_pos,
                         };
-                        e = Expr::Field(Box::new(e), field);
+                        *e = Expr::Field(Box::new(std::mem::replace(e, Expr::Int(0, pos))), field);
                     }
                 }
             } else if self.eat(&Tok::LParen) {
                 let args = self.arguments()?;
-                e = Expr::Call {
-                    callee: Box::new(e),
+                *e = Expr::Call {
+                    callee: Box::new(std::mem::replace(e, Expr::Int(0, pos))),
                     args,
                     pos,
                 };
             } else {
-                return Ok(e);
+                return Ok(());
             }
         }
     }

@@ -38,6 +38,11 @@ fn map() -> &'static ImageMap {
     })
 }
 
+/// Builds the image's map now (it allocates), so that the cycle's first image access does not.
+pub fn warm() {
+    map();
+}
+
 /// The tagged pointer to image offset `offset` of the node at `path` (`gpCh[3]^`).
 pub fn pointer_to(path: &str) -> Option<i64> {
     let s = SymbolTable::global().lookup(path)?;
@@ -57,7 +62,7 @@ impl Exec<'_> {
 
     pub(super) fn image_read(&self, at: usize, t: Elem) -> Result<V, Fault> {
         let m = self.image_leaf(at, t)?;
-        Ok(match t {
+        let v = match t {
             Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(m.place::<u8>(at).load())),
             Elem::SInt => V::I(i64::from(m.place::<i8>(at).load())),
             Elem::Word | Elem::UInt => V::I(i64::from(m.place::<u16>(at).load())),
@@ -67,13 +72,26 @@ impl Exec<'_> {
             Elem::Real => V::F(f64::from(m.place::<f32>(at).load())),
             Elem::LReal => V::F(m.place::<f64>(at).load()),
             Elem::LWord | Elem::ULInt | Elem::LInt | Elem::LTime => V::I(m.place::<i64>(at).load()),
-        })
+        };
+        // The image is the partner's: a real it holds is checked before the program sees it.
+        match v {
+            V::F(x) if !x.is_finite() => Err(Fault::NotFinite),
+            _ => Ok(v),
+        }
     }
 
     pub(super) fn image_write(&mut self, at: usize, t: Elem, v: V) -> Result<(), Fault> {
         let m = self.image_leaf(at, t)?;
         if !map().writable[at] {
             return Err(Fault::ReadOnly);
+        }
+        let finite = match t {
+            Elem::Real => (v.float() as f32).is_finite(),
+            Elem::LReal => v.float().is_finite(),
+            _ => true,
+        };
+        if !finite {
+            return Err(Fault::NotFinite);
         }
         match t {
             Elem::Bool | Elem::Byte | Elem::USInt => m.place::<u8>(at).store(v.int() as u8),

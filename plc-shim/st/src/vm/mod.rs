@@ -11,8 +11,11 @@ use crate::diag::{Diagnostic, Pos};
 use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
 use crate::types::Elem;
 use hli::ImageMemory;
+use library::Library;
+pub use library::{BlockIo, Host};
 
 mod image;
+mod library;
 mod ops;
 mod std_fb;
 
@@ -44,6 +47,10 @@ pub enum Fault {
     ReadOnly,
     /// A whole structure or array copied to or from the image (assign its leaves).
     ImageCopy,
+    /// A library block called without its host (a cycle without the PLC runtime).
+    NoHost,
+    /// A real that is not finite read from the image, or written to it (beyond REAL's range).
+    NotFinite,
 }
 
 /// A fault and where it happened: small and `Copy`, made in the cycle; its text is made
@@ -71,6 +78,8 @@ impl core::fmt::Display for Fault {
             Fault::MuxSelector(k) => write!(f, "MUX selector {k} names no value"),
             Fault::ReadOnly => write!(f, "a write to a leaf of the image the CNC writes"),
             Fault::ImageCopy => write!(f, "a whole structure copied to or from the image"),
+            Fault::NoHost => write!(f, "a library block without the PLC runtime to run it"),
+            Fault::NotFinite => write!(f, "a real of the image that is not finite"),
         }
     }
 }
@@ -96,6 +105,19 @@ impl Loc {
             Loc::Image(a) => Loc::Image(a + n),
         }
     }
+}
+
+/// Sets the value of type `t` at `at` of a program's memory.
+#[inline]
+fn write_mem(m: &mut [u8], at: usize, t: Elem, v: V) -> Run<()> {
+    let n = t.size();
+    let slot = m.get_mut(at..at + n).ok_or(Fault::BadPointer)?;
+    match t {
+        Elem::Real => slot.copy_from_slice(&(v.float() as f32).to_le_bytes()),
+        Elem::LReal => slot.copy_from_slice(&v.float().to_le_bytes()),
+        _ => slot.copy_from_slice(&v.int().to_le_bytes()[..n]),
+    }
+    Ok(())
 }
 
 /// The value of type `t` at `at` of a program's memory.
@@ -158,6 +180,7 @@ pub const DEFAULT_BUDGET: u64 = 1_000_000;
 pub struct Program {
     code: Compiled,
     state: State,
+    library: Library,
 }
 
 /// What a program changes as it runs.
@@ -176,6 +199,8 @@ struct Exec<'a> {
     code: &'a Compiled,
     st: &'a mut State,
     image: Option<&'a ImageMemory>,
+    library: &'a Library,
+    host: Option<&'a mut dyn Host>,
 }
 
 type Run<T> = Result<T, Fault>;
@@ -184,6 +209,12 @@ impl Program {
     /// Parses, checks and compiles `files` (name and text), and sets every variable to its
     /// initial value.
     pub fn load(files: &[(&str, &str)]) -> Result<Program, Vec<Diagnostic>> {
+        Program::load_with(files, &[])
+    }
+
+    /// As [`Program::load`], with the FUNCTION_BLOCKs named `library` run by a [`Host`]
+    /// (each declared in `files` with an empty body).
+    pub fn load_with(files: &[(&str, &str)], library: &[&str]) -> Result<Program, Vec<Diagnostic>> {
         let mut units = Vec::with_capacity(files.len());
         for (name, text) in files {
             units.push((
@@ -192,7 +223,9 @@ impl Program {
             ));
         }
         let code = compile(&units)?;
+        let library = Library::of(&code, library)?;
         let mut p = Program {
+            library,
             state: State {
                 memory: vec![0; code.layout.size as usize],
                 budget: DEFAULT_BUDGET,
@@ -206,6 +239,8 @@ impl Program {
             code: &p.code,
             st: &mut p.state,
             image: None,
+            library: &p.library,
+            host: None,
         };
         if let Err(f) = exec.initialise() {
             let file = p
@@ -239,12 +274,25 @@ impl Program {
     /// One cycle with `image` the program's pointers into the HLI reach (`gpCh`, `gpAx`,
     /// `gpFifo`; [`Program::bind_image`] set them).
     pub fn cycle_on(&mut self, now_ns: i64, image: Option<&ImageMemory>) -> Result<(), FaultAt> {
+        self.cycle_with(now_ns, image, None)
+    }
+
+    /// One cycle with `image`, and `host` running the library's blocks.
+    pub fn cycle_with(
+        &mut self,
+        now_ns: i64,
+        image: Option<&ImageMemory>,
+        host: Option<&mut dyn Host>,
+    ) -> Result<(), FaultAt> {
         self.state.now_ns = now_ns;
         self.state.steps = 0;
         let mut exec = Exec {
             code: &self.code,
             st: &mut self.state,
             image,
+            library: &self.library,
+            // The host's own lifetime shortened to the cycle's.
+            host: host.map(|h| h as &mut dyn Host),
         };
         for pou in 0..exec.code.checked.pous.len() {
             if exec.code.checked.pous[pou].kind == PouKind::Program {
@@ -259,6 +307,7 @@ impl Program {
     /// `gpFifo`, as `hli::st_prelude` declares them) at the image's units: element `k` of
     /// `gpCh` at `gpCh[k]^`.
     pub fn bind_image(&mut self) {
+        image::warm();
         for (g, var) in self.code.checked.globals.iter().enumerate() {
             let Type::Array(dims, element) = &var.ty else {
                 continue;
@@ -384,6 +433,9 @@ impl<'a> Exec<'a> {
 
     /// POU `pou`'s statements on the instance at `base`.
     fn run_body(&mut self, pou: usize, base: u32) -> Run<()> {
+        if let Some(block) = self.library.of_pou[pou] {
+            return self.call_host(block, base);
+        }
         let code = self.code;
         self.block(&code.bodies[pou].1, base).map(|_| ())
     }
@@ -659,18 +711,7 @@ impl<'a> Exec<'a> {
 
     #[inline]
     pub(crate) fn write_own(&mut self, at: usize, t: Elem, v: V) -> Run<()> {
-        let n = t.size();
-        let slot = self
-            .st
-            .memory
-            .get_mut(at..at + n)
-            .ok_or(Fault::BadPointer)?;
-        match t {
-            Elem::Real => slot.copy_from_slice(&(v.float() as f32).to_le_bytes()),
-            Elem::LReal => slot.copy_from_slice(&v.float().to_le_bytes()),
-            _ => slot.copy_from_slice(&v.int().to_le_bytes()[..n]),
-        }
-        Ok(())
+        write_mem(&mut self.st.memory, at, t, v)
     }
 
     fn eval(&mut self, e: &Ex, base: u32) -> Run<V> {
@@ -711,14 +752,22 @@ impl<'a> Exec<'a> {
                 value,
                 ty,
             } => {
-                let frame = self.code.layout.statics[*pou];
+                // The values first (one may call this function too), then the frame.
+                let mut values = [V::I(0); crate::ir::MAX_CALL_INPUTS];
+                for (v, (_, _, e)) in values.iter_mut().zip(inputs.iter()) {
+                    *v = self.eval(e, base)?;
+                }
+                let (frame, statement) = (self.code.layout.statics[*pou], self.st.at);
                 let (size, _, _) = self.code.layout.pous[*pou];
                 // A function's variables start from zero and their initial values each call.
                 self.st.memory[frame as usize..(frame + size) as usize].fill(0);
                 let code = self.code;
                 self.block(&code.bodies[*pou].0, frame)?;
-                self.block(inputs, base)?;
+                for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {
+                    self.write_own((frame + offset) as usize, *t, *v)?;
+                }
                 self.run_body(*pou, frame)?;
+                self.st.at = statement;
                 let at = self.addr(value, base)?;
                 self.read(at, *ty)?
             }
@@ -726,11 +775,11 @@ impl<'a> Exec<'a> {
     }
 
     fn std_fn(&mut self, f: crate::ir::StdFn, t: Elem, args: &[Ex], base: u32) -> Run<V> {
-        // At most a handful of values: no allocation for them.
-        let mut values = [V::I(0); 16];
-        let n = args.len().min(16);
-        for (k, a) in args.iter().take(16).enumerate() {
-            values[k] = self.eval(a, base)?;
+        // At most MAX_STD_VALUES (the lowering refuses more): no allocation for them.
+        let mut values = [V::I(0); crate::ir::MAX_STD_VALUES];
+        let n = args.len().min(values.len());
+        for (v, a) in values.iter_mut().zip(args) {
+            *v = self.eval(a, base)?;
         }
         ops::standard(f, t, &values[..n])
     }

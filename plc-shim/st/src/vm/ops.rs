@@ -135,7 +135,8 @@ pub(crate) fn convert(v: V, from: Elem, to: Elem) -> Run<V> {
         (true, false) => {
             let f = v.float().round();
             match to.range() {
-                Some((lo, hi)) if f.is_finite() && (lo as f64..=hi as f64).contains(&f) => {
+                // `hi as f64 + 1.0` is exclusive: i64::MAX as f64 is already 2^63.
+                Some((lo, hi)) if f >= lo as f64 && f < hi as f64 + 1.0 => {
                     Ok(V::I(f as i128 as i64))
                 }
                 _ if to == Elem::LTime || to == Elem::Time => Ok(V::I(wrap(f as i64, to))),

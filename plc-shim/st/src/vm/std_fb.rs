@@ -8,7 +8,8 @@ use crate::types::Elem;
 
 type Run<T> = Result<T, Fault>;
 
-/// Timer state: running at byte 2 (bit 0), the last IN (bit 1); the start at byte 16 (ns).
+/// Timer state at byte 2: running (bit 0), the last IN (bit 1), TOF's delay finished (bit 2);
+/// the start at byte 16 (ns).
 const STATE: usize = 2;
 const START: usize = 16;
 
@@ -51,7 +52,7 @@ impl Exec<'_> {
         let input = self.flag(at)?;
         let pt = i64::from(self.read_own(at + 4, Elem::Time)?.int() as i32).max(0);
         let state = self.read_own(at + STATE, Elem::Byte)?.int();
-        let (running, last_in) = (state & 1 != 0, state & 2 != 0);
+        let (running, last_in, mut done) = (state & 1 != 0, state & 2 != 0, state & 4 != 0);
         let start = self.read_own(at + START, Elem::LInt)?.int();
         let elapsed = ((self.st.now_ns - start) / 1_000_000).clamp(0, pt);
         let (mut q, mut et, mut run) = (false, 0, running);
@@ -68,6 +69,7 @@ impl Exec<'_> {
             StdFb::Tof if input => {
                 q = true;
                 run = false;
+                done = false;
             }
             StdFb::Tof => {
                 let was_on = self.flag(at + 1)?;
@@ -75,9 +77,15 @@ impl Exec<'_> {
                     self.write_own(at + START, Elem::LInt, V::I(self.st.now_ns))?;
                     run = true;
                 }
-                et = if running { elapsed } else { 0 };
+                et = match (running, done) {
+                    (true, _) => elapsed,
+                    (false, true) => pt,
+                    (false, false) => 0,
+                };
                 q = (was_on && !running && pt > 0) || (running && elapsed < pt);
                 run = run && q;
+                // A finished delay holds ET at PT until IN rises again.
+                done = done || (was_on && !q);
             }
             _ => {
                 // TP: a rising IN starts a pulse of PT that nothing cuts short.
@@ -99,7 +107,7 @@ impl Exec<'_> {
         }
         self.set_flag(at + 1, q)?;
         self.write_own(at + 8, Elem::Time, V::I(et))?;
-        let state = i64::from(run) | (i64::from(input) << 1);
+        let state = i64::from(run) | (i64::from(input) << 1) | (i64::from(done) << 2);
         self.write_own(at + STATE, Elem::Byte, V::I(state))
     }
 

@@ -1,0 +1,261 @@
+//! Blocks a host implements (the PLC runtime's block library: MC_Power, MC_CamIn, ...): a
+//! FUNCTION_BLOCK the program declares with an empty body and the host names at load
+//! ([`Program::load_with`]). A call stores its inputs into the instance as for any block;
+//! then, instead of a body, the host runs the block on the instance's members
+//! ([`BlockIo`]) and writes its outputs there, and the call's outputs are read as usual.
+//!
+//! Every instance is found at load (in the globals, the programs and the function blocks
+//! inside them), so the host keeps one state per instance, made before the first cycle.
+//! A library block in a FUNCTION (whose variables start over each call) is refused.
+
+use super::{read_mem, write_mem, Fault, Program, Run, V};
+use crate::ast::PouKind;
+use crate::check::{Compiled, Type};
+use crate::diag::{Diagnostic, Pos};
+use crate::types::Elem;
+
+/// A host's blocks on the program's instances.
+pub trait Host {
+    /// Runs block `block` (its index among the names given to [`Program::load_with`]) on
+    /// instance `io` for one cycle: reads the inputs, writes the outputs.
+    fn call(&mut self, block: usize, io: &mut BlockIo<'_>) -> Result<(), Fault>;
+}
+
+/// What a program knows of its host's blocks.
+#[derive(Debug, Clone, Default)]
+pub(super) struct Library {
+    /// Per POU: the index of the host's block it is.
+    pub(super) of_pou: Vec<Option<usize>>,
+    /// Per host block: each variable's place in the instance (offset, type), `None` for one
+    /// that is no elementary value (a structure's first leaf stands for it: an AXIS_REF).
+    pub(super) members: Vec<Vec<Option<(u32, Elem)>>>,
+    /// Every instance: its address and block, in address order.
+    pub(super) instances: Vec<(u32, usize)>,
+}
+
+/// One instance of a host block during its call: its members by the index of the variable
+/// in the block's declaration.
+pub struct BlockIo<'a> {
+    pub(super) memory: &'a mut [u8],
+    pub(super) at: usize,
+    pub(super) members: &'a [Option<(u32, Elem)>],
+    pub(super) slot: usize,
+}
+
+impl BlockIo<'_> {
+    /// The instance's index among [`Program::library_instances`].
+    pub fn slot(&self) -> usize {
+        self.slot
+    }
+
+    fn place(&self, k: usize) -> Option<(usize, Elem)> {
+        let (offset, t) = (*self.members.get(k)?)?;
+        Some((self.at + offset as usize, t))
+    }
+
+    /// Variable `k` as an integer (BOOL 0 or 1), `None` if it is a real or has no place.
+    pub fn int(&self, k: usize) -> Option<i64> {
+        let (at, t) = self.place(k)?;
+        match read_mem(self.memory, at, t).ok()? {
+            V::I(i) => Some(i),
+            V::F(_) => None,
+        }
+    }
+
+    /// Variable `k` as a number.
+    pub fn real(&self, k: usize) -> Option<f64> {
+        let (at, t) = self.place(k)?;
+        read_mem(self.memory, at, t).ok().map(V::float)
+    }
+
+    /// Sets variable `k` (an output) to `v`, converted to its type; nothing if it has no place.
+    pub fn set(&mut self, k: usize, v: f64) {
+        if let Some((at, t)) = self.place(k) {
+            let v = match t {
+                Elem::Real | Elem::LReal => V::F(v),
+                _ => V::I(v as i64),
+            };
+            let _ = write_mem(self.memory, at, t, v);
+        }
+    }
+}
+
+impl Library {
+    /// The library of `code` for the host's block `names`: each a FUNCTION_BLOCK of the
+    /// program with an empty body, or a refusal naming it.
+    pub(super) fn of(code: &Compiled, names: &[&str]) -> Result<Library, Vec<Diagnostic>> {
+        let c = &code.checked;
+        let mut lib = Library {
+            of_pou: vec![None; c.pous.len()],
+            ..Library::default()
+        };
+        let mut errors = Vec::new();
+        for (k, name) in names.iter().enumerate() {
+            let found = c
+                .pous
+                .iter()
+                .position(|p| p.name.eq_ignore_ascii_case(name));
+            let refuse = |what: &str| {
+                let file = found.and_then(|i| code.files.get(c.pous[i].file));
+                Diagnostic::new(
+                    Pos { line: 1, col: 1 },
+                    format!("library block {name}: {what}"),
+                )
+                .in_file(file.map_or("", String::as_str))
+            };
+            match found {
+                Some(i) if c.pous[i].kind != PouKind::FunctionBlock => {
+                    errors.push(refuse("is not a FUNCTION_BLOCK"))
+                }
+                Some(i) if !code.bodies[i].1.is_empty() => {
+                    errors.push(refuse("has statements: the host runs it"))
+                }
+                Some(i) => lib.of_pou[i] = Some(k),
+                None => errors.push(refuse("is not declared")),
+            }
+            lib.members
+                .push(found.map_or_else(Vec::new, |i| members(code, i)));
+        }
+        for (i, pou) in c.pous.iter().enumerate() {
+            let holds = pou.vars.iter().any(|v| lib.holds_block(code, &v.ty, 0));
+            if pou.kind == PouKind::Function && holds {
+                let file = code.files.get(pou.file).map_or("", String::as_str);
+                let pos = pou.vars.first().map_or(Pos { line: 1, col: 1 }, |v| v.pos);
+                errors.push(
+                    Diagnostic::new(
+                        pos,
+                        format!(
+                            "FUNCTION {}: a library block keeps its state from cycle to \
+                             cycle: declare it in a PROGRAM or FUNCTION_BLOCK",
+                            c.pous[i].name
+                        ),
+                    )
+                    .in_file(file),
+                );
+            }
+        }
+        if errors.is_empty() {
+            lib.find_instances(code);
+            Ok(lib)
+        } else {
+            Err(errors)
+        }
+    }
+
+    /// Whether a value of `ty` is or contains an instance of a host block.
+    fn holds_block(&self, code: &Compiled, ty: &Type, depth: usize) -> bool {
+        let c = &code.checked;
+        depth < 64
+            && match ty {
+                Type::Fb(i) => {
+                    self.of_pou[*i].is_some()
+                        || c.pous[*i]
+                            .vars
+                            .iter()
+                            .any(|v| self.holds_block(code, &v.ty, depth + 1))
+                }
+                Type::Struct(i) => c.structs[*i]
+                    .fields
+                    .iter()
+                    .any(|(_, t)| self.holds_block(code, t, depth + 1)),
+                Type::Array(_, e) => self.holds_block(code, e, depth + 1),
+                _ => false,
+            }
+    }
+
+    /// Every instance of a host block in a value of `ty` at `at`, into `self.instances`.
+    fn walk(&mut self, code: &Compiled, ty: &Type, at: u32) {
+        let (c, l) = (&code.checked, &code.layout);
+        if !self.holds_block(code, ty, 0) {
+            return;
+        }
+        match ty {
+            Type::Fb(i) => match self.of_pou[*i] {
+                Some(k) => self.instances.push((at, k)),
+                None => {
+                    for (k, v) in c.pous[*i].vars.iter().enumerate() {
+                        self.walk(code, &v.ty, at + l.pous[*i].2[k]);
+                    }
+                }
+            },
+            Type::Struct(i) => {
+                for (k, (_, t)) in c.structs[*i].fields.iter().enumerate() {
+                    self.walk(code, t, at + l.structs[*i].2[k]);
+                }
+            }
+            Type::Array(dims, element) => {
+                let (size, align) = l.size_align(c, element);
+                let stride = size.div_ceil(align) * align;
+                let count: u64 = dims.iter().map(|(lo, hi)| hi.abs_diff(*lo) + 1).product();
+                for k in 0..count as u32 {
+                    self.walk(code, element, at + k * stride);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// Every instance of a host block in the globals and the programs, in address order.
+    fn find_instances(&mut self, code: &Compiled) {
+        let (c, l) = (&code.checked, &code.layout);
+        for (g, var) in c.globals.iter().enumerate() {
+            self.walk(code, &var.ty, l.globals[g]);
+        }
+        for (i, pou) in c.pous.iter().enumerate() {
+            if pou.kind == PouKind::Program {
+                for (k, v) in pou.vars.iter().enumerate() {
+                    self.walk(code, &v.ty, l.statics[i] + l.pous[i].2[k]);
+                }
+            }
+        }
+        self.instances.sort_unstable();
+    }
+}
+
+/// Each variable's place in an instance of POU `pou`.
+fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
+    let (c, l) = (&code.checked, &code.layout);
+    c.pous[pou]
+        .vars
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let offset = l.pous[pou].2[k];
+            match &v.ty {
+                Type::Elem(e) => Some((offset, *e)),
+                Type::Struct(s) => match c.structs[*s].fields.first() {
+                    Some((_, Type::Elem(e))) => Some((offset + l.structs[*s].2[0], *e)),
+                    _ => None,
+                },
+                _ => None,
+            }
+        })
+        .collect()
+}
+
+impl Program {
+    /// Every instance of a host block: its address and its block's index among the names
+    /// given at load, in address order (a host keeps its state per instance in this order).
+    pub fn library_instances(&self) -> &[(u32, usize)] {
+        &self.library.instances
+    }
+}
+
+impl super::Exec<'_> {
+    /// Host block `block` on the instance at `base`.
+    pub(super) fn call_host(&mut self, block: usize, base: u32) -> Run<()> {
+        let lib = self.library;
+        let slot = lib
+            .instances
+            .binary_search_by_key(&base, |(at, _)| *at)
+            .map_err(|_| Fault::BadPointer)?;
+        let host = self.host.as_deref_mut().ok_or(Fault::NoHost)?;
+        let mut io = BlockIo {
+            memory: &mut self.st.memory,
+            at: base as usize,
+            members: &lib.members[block],
+            slot,
+        };
+        host.call(block, &mut io)
+    }
+}
