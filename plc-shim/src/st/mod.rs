@@ -5,8 +5,11 @@
 //! program: the runtime then ends without another heartbeat and the CNC stops as for a lost
 //! PLC; the summary names the fault with its FILE:LINE:COL.
 
+pub mod library;
+
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::layout::HliSegmentHeader;
+use library::{Blocks, Library, LIBRARY};
 use plc_st::vm::{FaultAt, Program};
 use std::path::PathBuf;
 
@@ -17,6 +20,7 @@ pub const PRELUDE: &str = "<hli>";
 #[derive(Debug)]
 pub struct StProgram {
     program: Program,
+    blocks: Blocks,
     period_ticks: u64,
     cycles: u64,
     fault: Option<FaultAt>,
@@ -37,22 +41,32 @@ impl StProgram {
     /// As [`StProgram::load`], from the files' names and texts.
     pub fn from_texts(files: &[(String, String)], period_ticks: u64) -> Result<StProgram, String> {
         let prelude = hli::st_prelude::generate();
-        let mut refs: Vec<(&str, &str)> = vec![(PRELUDE, prelude.as_str())];
+        let library = Library::new();
+        let mut refs: Vec<(&str, &str)> =
+            vec![(PRELUDE, prelude.as_str()), (LIBRARY, library.text())];
         refs.extend(files.iter().map(|(n, t)| (n.as_str(), t.as_str())));
-        let mut program = Program::load(&refs)
+        let mut program = Program::load_with(&refs, &library.names())
             .map_err(|errors| errors.iter().map(|d| format!("{d}\n")).collect::<String>())?;
         program.bind_image();
+        let blocks = Blocks::new(library.clone(), program.library_instances());
         Ok(StProgram {
             program,
+            blocks,
             period_ticks: period_ticks.max(1),
             cycles: 0,
             fault: None,
         })
     }
 
-    /// How many POUs the program has (the HLI's declarations have none).
+    /// How many POUs the program's own files declare (not the HLI's or the library's).
     pub fn pous(&self) -> usize {
-        self.program.code().checked.pous.len()
+        let files = &self.program.code().files;
+        let own = |p: &&plc_st::check::PouDef| {
+            files
+                .get(p.file)
+                .is_some_and(|f| f != PRELUDE && f != LIBRARY)
+        };
+        self.program.code().checked.pous.iter().filter(own).count()
     }
 
     /// The program.
@@ -78,7 +92,12 @@ impl PlcProgram for StProgram {
             .saturating_mul(self.period_ticks)
             .saturating_mul(tick_ns);
         self.cycles += 1;
-        if let Err(fault) = self.program.cycle_on(now as i64, Some(io.memory)) {
+        let memory = io.memory;
+        let mut host = self.blocks.host(io);
+        if let Err(fault) = self
+            .program
+            .cycle_with(now as i64, Some(memory), Some(&mut host))
+        {
             self.fault = Some(fault);
         }
     }

@@ -129,3 +129,32 @@ fn plc_check_reports_every_diagnostic_with_its_place() {
         .unwrap();
     assert!(out.status.success(), "{}", tests::cli::report(&out));
 }
+
+/// The lockstep trace of `scenarios/DIR/FILE` (`cnc run --lockstep`, the PLC a process).
+fn trace_of(dir: &str, file: &str) -> Vec<u8> {
+    let path = tests::cli::repo_root().join("scenarios").join(dir).join(file);
+    let tag = format!("twin-{}", &dir[..dir.len().min(12)]);
+    tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), &path, &tag).1
+}
+
+/// The manuals' programs in ST (`scenario-st.toml` beside each twin): their traces equal
+/// their timeline twins' tick for tick, every signal.
+#[test]
+fn the_st_twins_trace_as_their_timelines_do() {
+    for dir in [
+        "axes-plcopen",
+        "example4-turntable-hybrid",
+        "example4-turntable-plc",
+    ] {
+        let (timeline, st) = (
+            trace_of(dir, "scenario.toml"),
+            trace_of(dir, "scenario-st.toml"),
+        );
+        assert!(timeline.len() > 10_000, "{dir}: a trace of a run");
+        let first_difference = timeline.iter().zip(&st).position(|(a, b)| a != b);
+        assert!(
+            timeline == st,
+            "{dir}: the ST twin's trace differs from byte {first_difference:?} on"
+        );
+    }
+}
