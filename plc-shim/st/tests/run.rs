@@ -309,3 +309,25 @@ fn what_the_runtime_cannot_hold_is_refused_at_load_with_its_place() {
         "{e}"
     );
 }
+
+#[test]
+fn global_variables_start_from_their_initial_values() {
+    let p = run(
+        "VAR_GLOBAL CONSTANT K : UDINT := 3; END_VAR\n\
+         VAR_GLOBAL G : DINT := 7; H : LREAL := K * 2.5; END_VAR\n\
+         PROGRAM MAIN VAR a : UDINT; c : DINT; x : LREAL; END_VAR a := K; c := G; x := H; G := G + 1; END_PROGRAM",
+        2,
+    );
+    assert_eq!(p.read_var("MAIN.a"), Some(3.0));
+    assert_eq!(
+        p.read_var("MAIN.c"),
+        Some(8.0),
+        "7, then the program's own + 1 once"
+    );
+    assert_eq!(p.read_var("MAIN.x"), Some(7.5));
+    let e = refused("VAR_GLOBAL G : INT := TRUE; END_VAR PROGRAM MAIN END_PROGRAM");
+    assert!(
+        e.contains("main.st:1:23: error: a BOOL where a INT is wanted"),
+        "{e}"
+    );
+}

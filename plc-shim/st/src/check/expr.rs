@@ -15,6 +15,12 @@ pub(super) struct Ctx {
     pub(super) loops: u32,
 }
 
+/// The context of a global variable's initial value: no POU, no locals.
+pub(super) const GLOBAL: Ctx = Ctx {
+    pou: usize::MAX,
+    loops: 0,
+};
+
 /// What a name means in a POU.
 pub(super) enum Meaning {
     /// A variable of the POU (index into its vars).
@@ -54,16 +60,17 @@ pub(super) fn literal(e: &Expr) -> Option<i128> {
 
 impl Checker {
     pub(super) fn meaning(&self, name: &str, ctx: Ctx) -> Option<Meaning> {
-        let pou = &self.out.pous[ctx.pou];
-        if let Some(i) = pou
-            .vars
-            .iter()
-            .position(|v| v.name.eq_ignore_ascii_case(name))
-        {
-            return Some(Meaning::Local(i));
-        }
-        if pou.kind == PouKind::Function && pou.name.eq_ignore_ascii_case(name) {
-            return pou.returns.clone().map(Meaning::Return);
+        if let Some(pou) = self.out.pous.get(ctx.pou) {
+            if let Some(i) = pou
+                .vars
+                .iter()
+                .position(|v| v.name.eq_ignore_ascii_case(name))
+            {
+                return Some(Meaning::Local(i));
+            }
+            if pou.kind == PouKind::Function && pou.name.eq_ignore_ascii_case(name) {
+                return pou.returns.clone().map(Meaning::Return);
+            }
         }
         let upper = name.to_ascii_uppercase();
         if let Some(i) = self.globals.get(&upper) {

@@ -41,6 +41,26 @@ impl Checker {
         Ok((pou, inits, body))
     }
 
+    /// The global variables' initial values, as stores in declaration order (the runtime
+    /// runs them once, before the programs' own).
+    pub(super) fn lower_global_inits(
+        &mut self,
+        unit: &crate::ast::Unit,
+        file: u16,
+        l: &Layout,
+    ) -> R<Vec<St>> {
+        let mut out = Vec::new();
+        for item in &unit.items {
+            let crate::ast::Item::Globals(block) = item else {
+                continue;
+            };
+            for d in &block.vars {
+                self.lower_init(d, super::expr::GLOBAL, file, l, &mut out)?;
+            }
+        }
+        Ok(out)
+    }
+
     /// Initial values of elementary variables, as stores (the runtime runs them once).
     fn lower_inits(
         &mut self,
@@ -52,22 +72,35 @@ impl Checker {
     ) -> R<()> {
         for block in &p.vars {
             for d in &block.vars {
-                let Some(crate::ast::Init::Expr(e)) = &d.init else {
-                    if d.init.is_some() {
-                        let pos = d.names[0].pos;
-                        return Err(self.unsupported(pos, "an array or structure initialiser"));
-                    }
-                    continue;
-                };
-                for n in &d.names {
-                    let target = Expr::Name(n.clone());
-                    let kind = self.lower_assign(&target, e, ctx, l)?;
-                    out.push(St {
-                        kind,
-                        at: (file, n.pos),
-                    });
-                }
+                self.lower_init(d, ctx, file, l, out)?;
             }
+        }
+        Ok(())
+    }
+
+    /// The initial value of declaration `d`, as a store per name.
+    fn lower_init(
+        &mut self,
+        d: &crate::ast::VarDecl,
+        ctx: Ctx,
+        file: u16,
+        l: &Layout,
+        out: &mut Vec<St>,
+    ) -> R<()> {
+        let Some(crate::ast::Init::Expr(e)) = &d.init else {
+            if d.init.is_some() {
+                let pos = d.names[0].pos;
+                return Err(self.unsupported(pos, "an array or structure initialiser"));
+            }
+            return Ok(());
+        };
+        for n in &d.names {
+            let target = Expr::Name(n.clone());
+            let kind = self.lower_assign(&target, e, ctx, l)?;
+            out.push(St {
+                kind,
+                at: (file, n.pos),
+            });
         }
         Ok(())
     }
@@ -113,13 +146,16 @@ impl Checker {
     }
 
     fn name_place(&mut self, n: &Name, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
-        let pou = &self.out.pous[ctx.pou];
-        let local = |offset: u32| match pou.kind {
+        // Only a name in a POU (not a global's initial value) is a local or a return value.
+        let local = |offset: u32| match self.out.pous[ctx.pou].kind {
             PouKind::FunctionBlock => Addr::Instance(offset),
             _ => Addr::Static(l.statics[ctx.pou] + offset),
         };
         match self.meaning(&n.text, ctx) {
-            Some(Meaning::Local(i)) => Ok((local(l.pous[ctx.pou].2[i]), pou.vars[i].ty.clone())),
+            Some(Meaning::Local(i)) => Ok((
+                local(l.pous[ctx.pou].2[i]),
+                self.out.pous[ctx.pou].vars[i].ty.clone(),
+            )),
             Some(Meaning::Return(t)) => {
                 let offset = *l.pous[ctx.pou].2.last().unwrap_or(&0);
                 Ok((local(offset), t))

@@ -139,6 +139,8 @@ pub struct Compiled {
     pub layout: crate::layout::Layout,
     /// Per POU: the stores of its variables' initial values, and its statements.
     pub bodies: Vec<(Vec<crate::ir::St>, Vec<crate::ir::St>)>,
+    /// The global variables' initial values, run once before the programs'.
+    pub global_inits: Vec<crate::ir::St>,
     /// The files, by the index statements carry.
     pub files: Vec<String>,
 }
@@ -151,9 +153,13 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
         vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(file)]
     })?;
     let mut bodies = vec![(Vec::new(), Vec::new()); c.out.pous.len()];
-    let mut errors = Vec::new();
+    let (mut errors, mut global_inits) = (Vec::new(), Vec::new());
     for (f, (file, unit)) in files.iter().enumerate() {
         c.file = file.clone();
+        match c.lower_global_inits(unit, f as u16, &layout) {
+            Ok(inits) => global_inits.extend(inits),
+            Err(e) => errors.push(e),
+        }
         for item in &unit.items {
             let Item::Pou(p) = item else { continue };
             match c.lower_pou(p, f as u16, &layout) {
@@ -169,6 +175,7 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
         checked: c.out,
         layout,
         bodies,
+        global_inits,
         files: files.iter().map(|(f, _)| f.clone()).collect(),
     })
 }
@@ -546,8 +553,29 @@ impl Checker {
         for (file, unit) in files {
             self.file = file.clone();
             for item in &unit.items {
-                if let Item::Pou(p) = item {
-                    self.check_pou(p);
+                match item {
+                    Item::Pou(p) => self.check_pou(p),
+                    Item::Globals(block) => self.check_global_inits(block),
+                    Item::Types(_) => {}
+                }
+            }
+        }
+    }
+
+    /// The global variables' initial values against their types.
+    fn check_global_inits(&mut self, block: &crate::ast::VarBlock) {
+        for d in &block.vars {
+            let Some(crate::ast::Init::Expr(e)) = &d.init else {
+                continue;
+            };
+            for n in &d.names {
+                let key = n.text.to_ascii_uppercase();
+                if let Some(ty) = self
+                    .globals
+                    .get(&key)
+                    .map(|i| self.out.globals[*i].ty.clone())
+                {
+                    self.assignable(e, &ty, expr::GLOBAL);
                 }
             }
         }

@@ -40,6 +40,8 @@ pub struct BlockIo<'a> {
     pub(super) at: usize,
     pub(super) members: &'a [Option<(u32, Elem)>],
     pub(super) slot: usize,
+    /// The inputs this call passes (offsets in the instance).
+    pub(super) passed: &'a [crate::ir::BlockInput],
 }
 
 impl BlockIo<'_> {
@@ -51,6 +53,12 @@ impl BlockIo<'_> {
     fn place(&self, k: usize) -> Option<(usize, Elem)> {
         let (offset, t) = (*self.members.get(k)?)?;
         Some((self.at + offset as usize, t))
+    }
+
+    /// Whether this call gives variable `k` (an input named in the call).
+    pub fn given(&self, k: usize) -> bool {
+        let offset = self.members.get(k).copied().flatten().map(|(o, _)| o);
+        offset.is_some_and(|o| self.passed.iter().any(|(at, _, _)| *at == o))
     }
 
     /// Variable `k` as an integer (BOOL 0 or 1), `None` if it is a real or has no place.
@@ -255,6 +263,7 @@ impl super::Exec<'_> {
             at: base as usize,
             members: &lib.members[block],
             slot,
+            passed: self.passing,
         };
         host.call(block, &mut io)
     }

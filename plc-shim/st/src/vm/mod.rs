@@ -201,6 +201,8 @@ struct Exec<'a> {
     image: Option<&'a ImageMemory>,
     library: &'a Library,
     host: Option<&'a mut dyn Host>,
+    /// The inputs the block call being run passes (a host block sees which were given).
+    passing: &'a [BlockInput],
 }
 
 type Run<T> = Result<T, Fault>;
@@ -241,6 +243,7 @@ impl Program {
             image: None,
             library: &p.library,
             host: None,
+            passing: &[],
         };
         if let Err(f) = exec.initialise() {
             let file = p
@@ -293,6 +296,7 @@ impl Program {
             library: &self.library,
             // The host's own lifetime shortened to the cycle's.
             host: host.map(|h| h as &mut dyn Host),
+            passing: &[],
         };
         for pou in 0..exec.code.checked.pous.len() {
             if exec.code.checked.pous[pou].kind == PouKind::Program {
@@ -373,6 +377,9 @@ impl<'a> Exec<'a> {
     /// Every variable's initial value: the globals' and programs' instances, and every
     /// function block instance inside them.
     fn initialise(&mut self) -> Result<(), FaultAt> {
+        let code = self.code;
+        self.block(&code.global_inits, 0)
+            .map_err(|f| self.fault_at(f))?;
         let globals: Vec<(u32, Type)> = (0..self.code.checked.globals.len())
             .map(|i| {
                 (
@@ -449,7 +456,7 @@ impl<'a> Exec<'a> {
         Ok(())
     }
 
-    fn block(&mut self, body: &[St], base: u32) -> Run<Flow> {
+    fn block(&mut self, body: &'a [St], base: u32) -> Run<Flow> {
         for s in body {
             let flow = self.statement(s, base)?;
             if flow != Flow::Next {
@@ -459,7 +466,7 @@ impl<'a> Exec<'a> {
         Ok(Flow::Next)
     }
 
-    fn statement(&mut self, s: &St, base: u32) -> Run<Flow> {
+    fn statement(&mut self, s: &'a St, base: u32) -> Run<Flow> {
         self.st.at = s.at;
         self.step()?;
         match &s.kind {
@@ -562,7 +569,7 @@ impl<'a> Exec<'a> {
         var: &Addr,
         ty: Elem,
         (from, to, by): (&Ex, &Ex, &Ex),
-        body: &[St],
+        body: &'a [St],
         base: u32,
     ) -> Run<Flow> {
         let at = self.addr(var, base)?;
@@ -599,12 +606,13 @@ impl<'a> Exec<'a> {
         &mut self,
         s: &St,
         base: u32,
-        (instance, inputs, outputs): (&Addr, &[BlockInput], &[BlockOutput]),
+        (instance, inputs, outputs): (&Addr, &'a [BlockInput], &[BlockOutput]),
         pou: Option<usize>,
         fb: Option<crate::check::std_lib::StdFb>,
     ) -> Run<()> {
         let at = self.own(instance, base)? as u32;
         self.store_all(inputs, at, base)?;
+        self.passing = inputs;
         match (pou, fb) {
             (Some(pou), _) => self.run_body(pou, at)?,
             (_, Some(fb)) => self.run_std_fb(fb, at as usize)?,
