@@ -71,10 +71,15 @@ macro_rules! hli_enum {
 /// ignored) and `ALL`, the names being what timelines and command lines give; the same as
 /// [`WireEnum`] for code generic over them.
 macro_rules! wire_enum {
+    (@st) => { None };
+    (@st $st:literal) => { Some($st) };
     (
         $(#[doc = $doc:literal])*
         $name:ident {
-            $( $(#[doc = $vdoc:literal])* $variant:ident = $value:literal => $text:literal ),* $(,)?
+            $(
+                $(#[doc = $vdoc:literal])*
+                $variant:ident = $value:literal => $text:literal $(| $st:literal)?
+            ),* $(,)?
         }
     ) => {
         $crate::enums::hli_enum! {
@@ -99,6 +104,14 @@ macro_rules! wire_enum {
                 match self { $( $name::$variant => $text, )* }
             }
 
+            /// The value's constant in the manuals' Structured Text
+            /// (`MC_STARTMODE_ABSOLUTE`), where they name one.
+            pub const fn st_name(self) -> Option<&'static str> {
+                match self {
+                    $( $name::$variant => $crate::enums::wire_enum!(@st $($st)?), )*
+                }
+            }
+
             /// The value of a name (ASCII case ignored), `None` for a name it does not have.
             pub fn from_name(name: &str) -> Option<Self> {
                 <Self as $crate::enums::WireEnum>::from_name(name)
@@ -116,6 +129,9 @@ macro_rules! wire_enum {
             fn name(self) -> &'static str {
                 $name::name(self)
             }
+            fn st_name(self) -> Option<&'static str> {
+                $name::st_name(self)
+            }
         }
     };
 }
@@ -132,6 +148,10 @@ pub trait WireEnum: Copy + 'static {
     fn from_raw(raw: u32) -> Option<Self>;
     /// The value's name.
     fn name(self) -> &'static str;
+    /// The value's constant in the manuals' Structured Text, where they name one.
+    fn st_name(self) -> Option<&'static str> {
+        None
+    }
     /// The value of a name (ASCII case ignored), `None` for a name it does not have.
     fn from_name(name: &str) -> Option<Self> {
         Self::ALL

@@ -44,13 +44,13 @@ wire_enum! {
     /// switching).
     CamStartMode {
         /// 1: both absolute.
-        Absolute = 1 => "absolute",
+        Absolute = 1 => "absolute" | "MC_STARTMODE_ABSOLUTE",
         /// 2: both relative.
-        Relative = 2 => "relative",
+        Relative = 2 => "relative" | "MC_STARTMODE_RELATIVE",
         /// 3: master absolute, slave relative.
-        MasterAbsSlaveRel = 3 => "master_abs_slave_rel",
+        MasterAbsSlaveRel = 3 => "master_abs_slave_rel" | "MC_STARTMODE_MASTERABS_SLAVEREL",
         /// 4: master relative, slave absolute.
-        MasterRelSlaveAbs = 4 => "master_rel_slave_abs",
+        MasterRelSlaveAbs = 4 => "master_rel_slave_abs" | "MC_STARTMODE_MASTERREL_SLAVEABS",
     }
 }
 
@@ -81,21 +81,21 @@ wire_enum! {
     /// effect (the positional modes take their position from the call body).
     CamActivationMode {
         /// 0: at once (in the next tick).
-        Instantaneous = 0 => "instantaneous",
+        Instantaneous = 0 => "instantaneous" | "MC_CAMACTIVATION_INSTANTANEOUS",
         /// 1: when the master's position within the cam passes the activation position.
-        AtMasterCamPos = 1 => "at_master_cam_pos",
+        AtMasterCamPos = 1 => "at_master_cam_pos" | "MC_CAMACTIVATION_ATMASTERCAMPOS",
         /// 2: when the master axis passes the activation position (absolute).
-        AtMasterAxisPos = 2 => "at_master_axis_pos",
+        AtMasterAxisPos = 2 => "at_master_axis_pos" | "MC_CAMACTIVATION_ATMASTERAXISPOS",
         /// 3: at the next cycle boundary (a cyclic cam) or range edge (a linear one).
-        NextCycle = 3 => "next_cycle",
+        NextCycle = 3 => "next_cycle" | "MC_CAMACTIVATION_NEXTCYCLE",
         /// 4: at the next cycle boundary, once.
-        NextCycleOnce = 4 => "next_cycle_once",
+        NextCycleOnce = 4 => "next_cycle_once" | "MC_CAMACTIVATION_NEXTCYCLEONCE",
         /// 5: as soon as possible (point data).
-        AsSoonAsPossible = 5 => "as_soon_as_possible",
+        AsSoonAsPossible = 5 => "as_soon_as_possible" | "MC_CAMACTIVATION_ASSOONASPOSSIBLE",
         /// 6: nothing is changed.
-        Off = 6 => "off",
+        Off = 6 => "off" | "MC_CAMACTIVATION_OFF",
         /// 7: a queued, not yet active change is dropped.
-        DeleteQueuedData = 7 => "delete_queued_data",
+        DeleteQueuedData = 7 => "delete_queued_data" | "MC_CAMACTIVATION_DELETEQUEUEDDATA",
     }
 }
 
@@ -103,12 +103,12 @@ wire_enum! {
     /// `MC_InterpolationType` of a position table.
     CamInterpolation {
         /// 0: straight lines between rows.
-        Linear = 0 => "linear",
+        Linear = 0 => "linear" | "MC_InterpolationType_Linear",
         /// 1: the cubic through the four nearest rows (equidistant tables only).
-        FourPoint = 1 => "4point",
+        FourPoint = 1 => "4point" | "MC_InterpolationType_4Point",
         /// 2: a cubic spline, tangential at the ends of a linear table, cyclic for a periodic
         /// one.
-        Spline = 2 => "spline",
+        Spline = 2 => "spline" | "MC_InterpolationType_Spline",
     }
 }
 
@@ -116,11 +116,11 @@ wire_enum! {
     /// `MC_CamScalingMode` of one side (master or slave).
     CamScalingMode {
         /// 0: scaling and offset taken as given.
-        UserDefined = 0 => "user_defined",
+        UserDefined = 0 => "user_defined" | "MC_CAMSCALING_USERDEFINED",
         /// 1: scaling taken, offset computed so that nothing jumps.
-        AutoOffset = 1 => "auto_offset",
+        AutoOffset = 1 => "auto_offset" | "MC_CAMSCALING_AUTOOFFSET",
         /// 2: this side's scaling and offset stay as they are.
-        Off = 2 => "off",
+        Off = 2 => "off" | "MC_CAMSCALING_OFF",
     }
 }
 

@@ -13,7 +13,10 @@
 //!   StartSync, Status (MC_Power's).
 //!
 //! As in a timeline, an Execute block takes its inputs at the rising edge of Execute; a
-//! block without Execute (MC_Power) takes them every call. A value outside its input's kind
+//! block without Execute (MC_Power) takes them every call. An input no call of the instance
+//! has given is not passed on, so the block keeps its own default (MC_CamIn's scalings 1.0,
+//! MC_MoveVelocity's Direction 1), as when a timeline's call does not give it; once given,
+//! it keeps its value from call to call, as an FB input does. A value outside its input's kind
 //! (a range, a positive time, one of a list) is not passed on: that command ends at once with
 //! Error and [`INVALID_INPUT`] (held while Execute stays TRUE). Inputs ST cannot give yet
 //! (tables, lists, NC program names, the saw's SyncMode) are left out; a block that needs
@@ -98,6 +101,36 @@ fn st_type(kind: &Kind) -> &'static str {
     }
 }
 
+/// The constants of the blocks' modes and flags under the manuals' names
+/// (`MC_STARTMODE_ABSOLUTE`, `GearInSync_CheckMask_MAXACC`), as one VAR_GLOBAL CONSTANT list.
+fn constants(specs: &[&'static BlockSpec]) -> String {
+    let mut all = std::collections::BTreeMap::new();
+    for input in specs.iter().flat_map(|b| b.inputs.iter()) {
+        match input.kind {
+            Kind::Mode(m) => {
+                for (name, raw) in (m.st_names)() {
+                    all.insert(name.to_string(), format!("UDINT := {raw}"));
+                }
+            }
+            Kind::Flags { flags, prefixes } => {
+                // The prefix that names this input (`GearInSync_CheckMask_` for CheckMask).
+                let key = folded(input.key);
+                let prefix = prefixes.iter().find(|p| folded(p).contains(&key));
+                for (name, bits) in flags {
+                    let name = format!("{}{name}", prefix.or(prefixes.first()).unwrap_or(&""));
+                    all.insert(name, format!("DWORD := 16#{bits:X}"));
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut text = String::from("VAR_GLOBAL CONSTANT\n");
+    for (name, value) in all {
+        let _ = writeln!(text, "    {name} : {value};");
+    }
+    text + "END_VAR\n"
+}
+
 /// The blocks ST cannot call yet, each with the input it cannot give.
 pub fn unavailable() -> Vec<(&'static str, &'static str)> {
     blocks()
@@ -130,7 +163,11 @@ impl Library {
             bindings: Vec::new(),
         };
         let missing = unavailable();
-        for spec in blocks().filter(|b| !missing.iter().any(|(n, _)| *n == b.name)) {
+        let specs: Vec<&'static BlockSpec> = blocks()
+            .filter(|b| !missing.iter().any(|(n, _)| *n == b.name))
+            .collect();
+        lib.text.push_str(&constants(&specs));
+        for spec in specs {
             lib.declare(spec);
         }
         lib
@@ -214,6 +251,8 @@ struct Instance {
     last_execute: bool,
     /// The command of the current Execute was refused (an input outside its kind).
     refused: bool,
+    /// Per input: given by a call of the program once (then passed at every edge).
+    given: Vec<bool>,
 }
 
 /// The blocks of a program's instances (one per instance, made at load).
@@ -233,6 +272,7 @@ impl Blocks {
                 block: (library.bindings[*k].spec.make)(None),
                 last_execute: false,
                 refused: false,
+                given: vec![false; library.bindings[*k].inputs.len()],
             })
             .collect();
         Blocks { library, instances }
@@ -308,7 +348,12 @@ impl Host for BlockHost<'_, '_> {
         };
         if takes_inputs {
             inst.refused = false;
-            for (var, spec, axis) in &binding.inputs {
+            for (k, (var, spec, axis)) in binding.inputs.iter().enumerate() {
+                // Never given by a call: the block keeps its own default.
+                inst.given[k] |= io.given(*var);
+                if !inst.given[k] {
+                    continue;
+                }
                 match input_value(io, *var, spec, *axis) {
                     Some(v) => inst.block.set(spec.key, &v),
                     None => inst.refused = execute.is_some(),

@@ -228,6 +228,8 @@ pub struct Mode {
     pub valid: fn(u32) -> bool,
     /// Every value as `name (number)`.
     pub names: fn() -> String,
+    /// The values the manuals' ST names: constant name and raw value.
+    pub st_names: fn() -> Vec<(&'static str, u32)>,
 }
 
 /// The input kind of wire enum `E` (its names come with it from hli).
@@ -242,10 +244,17 @@ pub const fn mode<E: WireEnum>() -> Kind {
         let name = |v: &E| format!("{} ({})", v.name(), v.raw());
         E::ALL.iter().map(name).collect::<Vec<_>>().join(", ")
     }
+    fn st_names<E: WireEnum>() -> Vec<(&'static str, u32)> {
+        E::ALL
+            .iter()
+            .filter_map(|v| v.st_name().map(|n| (n, v.raw())))
+            .collect()
+    }
     Kind::Mode(Mode {
         from_name: from_name::<E>,
         valid: valid::<E>,
         names: names::<E>,
+        st_names: st_names::<E>,
     })
 }
 

@@ -132,7 +132,10 @@ fn plc_check_reports_every_diagnostic_with_its_place() {
 
 /// The lockstep trace of `scenarios/DIR/FILE` (`cnc run --lockstep`, the PLC a process).
 fn trace_of(dir: &str, file: &str) -> Vec<u8> {
-    let path = tests::cli::repo_root().join("scenarios").join(dir).join(file);
+    let path = tests::cli::repo_root()
+        .join("scenarios")
+        .join(dir)
+        .join(file);
     let tag = format!("twin-{}", &dir[..dir.len().min(12)]);
     tests::cli::cnc_run_lockstep(env!("CARGO_BIN_EXE_cnc"), &path, &tag).1
 }
@@ -145,6 +148,8 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "axes-plcopen",
         "example4-turntable-hybrid",
         "example4-turntable-plc",
+        "cam-conveyor",
+        "saw-blocks",
     ] {
         let (timeline, st) = (
             trace_of(dir, "scenario.toml"),

@@ -1,0 +1,130 @@
+//! The block library in ST on a stand-in CNC: an instance sends its call on the rising edge
+//! of Execute, a value outside its input's kind ends the command with Error and 0x4227 and
+//! sends nothing, and a cycle with library blocks allocates nothing.
+
+use hli::views::PlcView;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
+use plc_shim::runtime::{Link, PlcIo, PlcProgram};
+use plc_shim::st::library::INVALID_INPUT;
+use plc_shim::st::StProgram;
+
+#[path = "../../tests/support/counting_alloc.rs"]
+mod counting_alloc;
+
+/// MC_MoveVelocity on gpAx[1] with Execute and Direction from the test.
+const PROGRAM: &str = "PROGRAM MAIN
+VAR
+    axSpindle : AXIS_REF;
+    fbRun : MC_MoveVelocity;
+    bRun : BOOL;
+    nDirection : DINT := 1;
+    bBusy, bError : BOOL;
+    nErrorId : UDINT;
+END_VAR
+    axSpindle.AxisIndex := 1;
+    fbRun(Axis := axSpindle, Execute := bRun, Velocity := 50.0, Direction := nDirection,
+        Acceleration := 500.0, Deceleration := 500.0, Jerk := 10000.0,
+        Busy => bBusy, Error => bError, ErrorID => nErrorId);
+END_PROGRAM
+";
+
+struct Cnc {
+    memory: hli::ImageMemory,
+    _server: AcyclicServer,
+    client: AcyclicClient,
+    cycle: u64,
+}
+
+impl Cnc {
+    fn new(case: &str) -> Cnc {
+        let instance = tests::unique_instance(case);
+        Cnc {
+            memory: hli::image::heap_image(1, 2),
+            _server: AcyclicServer::open(&instance).unwrap(),
+            client: AcyclicClient::open(&instance).unwrap(),
+            cycle: 0,
+        }
+    }
+
+    fn cycle(&mut self, program: &mut StProgram) {
+        self.cycle += 1;
+        let mut io = PlcIo {
+            view: PlcView::new(&self.memory),
+            memory: &self.memory,
+            acyclic: &mut self.client,
+            cycle: self.cycle,
+            link: Link::Operational,
+        };
+        program.cycle(&mut io);
+        assert!(!program.halted(), "{}", program.summary());
+    }
+}
+
+/// `PROGRAM` with `Direction` and `Execute` set before the cycle, through its initial values.
+fn program(direction: i32, execute: bool) -> StProgram {
+    let text = PROGRAM
+        .replace(
+            "nDirection : DINT := 1;",
+            &format!("nDirection : DINT := {direction};"),
+        )
+        .replace(
+            "bRun : BOOL;",
+            &format!("bRun : BOOL := {};", if execute { "TRUE" } else { "FALSE" }),
+        );
+    StProgram::from_texts(&[("main.st".into(), text)], 1).unwrap()
+}
+
+fn var(p: &StProgram, name: &str) -> f64 {
+    p.program().read_var(&format!("MAIN.{name}")).unwrap()
+}
+
+#[test]
+fn an_instance_sends_its_call_on_the_rising_edge_of_execute() {
+    let mut cnc = Cnc::new("st-blocks-edge");
+    let mut p = program(1, true);
+    assert_eq!(p.program().library_instances().len(), 1);
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 1, "the call went out");
+    assert_eq!((var(&p, "bBusy"), var(&p, "bError")), (1.0, 0.0));
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 1, "Execute held: no second call");
+}
+
+#[test]
+fn a_value_outside_its_inputs_kind_ends_the_command_with_0x4227() {
+    let mut cnc = Cnc::new("st-blocks-refused");
+    let mut p = program(0, true);
+    for _ in 0..3 {
+        cnc.cycle(&mut p);
+        assert_eq!(cnc.client.sent(), 0, "nothing sent");
+        assert_eq!((var(&p, "bBusy"), var(&p, "bError")), (0.0, 1.0));
+        assert_eq!(var(&p, "nErrorId"), f64::from(INVALID_INPUT));
+    }
+}
+
+#[test]
+fn a_cycle_with_library_blocks_allocates_nothing() {
+    let mut cnc = Cnc::new("st-blocks-alloc");
+    // Busy: the call is out and waits for its answer, the kernel follows it each cycle.
+    let mut p = program(1, true);
+    cnc.cycle(&mut p);
+    let before = counting_alloc::allocations();
+    for _ in 0..50 {
+        cnc.cycle(&mut p);
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
+}
+
+#[test]
+fn an_input_no_call_gives_keeps_the_blocks_default() {
+    let mut cnc = Cnc::new("st-blocks-default");
+    // No Direction in the call: MC_MoveVelocity's own default (positive) holds, where a 0
+    // passed on would have been refused.
+    let text = PROGRAM
+        .replace("Direction := nDirection,", "")
+        .replace("bRun : BOOL;", "bRun : BOOL := TRUE;");
+    let mut p = StProgram::from_texts(&[("main.st".into(), text)], 1).unwrap();
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 1);
+    assert_eq!((var(&p, "bBusy"), var(&p, "bError")), (1.0, 0.0));
+}
