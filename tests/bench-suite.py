@@ -48,6 +48,8 @@ BENCHES = [
      "the same run without the client"),
     ("plc-st", "st", "Structured Text: a 1,000-statement cycle, a 10,000-line load",
      "the same arithmetic in Rust"),
+    ("plc-shim", "st_programs", "the turntable PLC program: ST against Rust",
+     "the same program in Rust, the same image"),
 ]
 
 # Peer program -> Debian package.

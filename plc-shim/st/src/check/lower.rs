@@ -112,7 +112,7 @@ impl Checker {
             Expr::Field(base, field) => {
                 let (addr, ty) = self.place(base, ctx, l)?;
                 let (offset, member) = self.member(&ty, field, l)?;
-                Ok((Addr::Offset(Box::new(addr), offset), member))
+                Ok((plus(addr, offset), member))
             }
             Expr::Index(base, index, _) => {
                 let (mut addr, ty) = self.place(base, ctx, l)?;
@@ -127,6 +127,14 @@ impl Checker {
                 };
                 for (k, i) in index.iter().enumerate() {
                     let index = self.int_value(i, ctx, l)?;
+                    let (lo, len) = (dims[k].0, lens[k]);
+                    if let Ex::Int(i) = index {
+                        // A constant index within the bounds is an offset, found now.
+                        if i >= lo && ((i - lo) as u64) < len {
+                            addr = plus(addr, (i - lo) as u32 * strides[k]);
+                            continue;
+                        }
+                    }
                     addr = Addr::Index {
                         base: Box::new(addr),
                         index: Box::new(index),
@@ -676,6 +684,18 @@ impl Checker {
             _ => return None,
         }
         Some(())
+    }
+}
+
+/// `addr` moved on by `offset` bytes, folded into a fixed place or an offset it already has.
+fn plus(addr: Addr, offset: u32) -> Addr {
+    match addr {
+        Addr::Static(at) if at.checked_add(offset).is_some() => Addr::Static(at + offset),
+        Addr::Instance(at) if at.checked_add(offset).is_some() => Addr::Instance(at + offset),
+        Addr::Offset(inner, at) if at.checked_add(offset).is_some() => {
+            Addr::Offset(inner, at + offset)
+        }
+        other => Addr::Offset(Box::new(other), offset),
     }
 }
 

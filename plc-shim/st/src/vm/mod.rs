@@ -181,6 +181,8 @@ pub struct Program {
     code: Compiled,
     state: State,
     library: Library,
+    /// The PROGRAMs, in the order the files declare them.
+    programs: Vec<usize>,
 }
 
 /// What a program changes as it runs.
@@ -226,7 +228,12 @@ impl Program {
         }
         let code = compile(&units)?;
         let library = Library::of(&code, library)?;
+        let programs = (code.checked.pous.iter().enumerate())
+            .filter(|(_, p)| p.kind == PouKind::Program)
+            .map(|(i, _)| i)
+            .collect();
         let mut p = Program {
+            programs,
             library,
             state: State {
                 memory: vec![0; code.layout.size as usize],
@@ -298,11 +305,9 @@ impl Program {
             host: host.map(|h| h as &mut dyn Host),
             passing: &[],
         };
-        for pou in 0..exec.code.checked.pous.len() {
-            if exec.code.checked.pous[pou].kind == PouKind::Program {
-                let base = exec.code.layout.statics[pou];
-                exec.run_body(pou, base).map_err(|f| exec.fault_at(f))?;
-            }
+        for &pou in &self.programs {
+            let base = exec.code.layout.statics[pou];
+            exec.run_body(pou, base).map_err(|f| exec.fault_at(f))?;
         }
         Ok(())
     }
@@ -759,29 +764,42 @@ impl<'a> Exec<'a> {
                 inputs,
                 value,
                 ty,
-            } => {
-                // The values first (one may call this function too), then the frame.
-                let mut values = [V::I(0); crate::ir::MAX_CALL_INPUTS];
-                for (v, (_, _, e)) in values.iter_mut().zip(inputs.iter()) {
-                    *v = self.eval(e, base)?;
-                }
-                let (frame, statement) = (self.code.layout.statics[*pou], self.st.at);
-                let (size, _, _) = self.code.layout.pous[*pou];
-                // A function's variables start from zero and their initial values each call.
-                self.st.memory[frame as usize..(frame + size) as usize].fill(0);
-                let code = self.code;
-                self.block(&code.bodies[*pou].0, frame)?;
-                for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {
-                    self.write_own((frame + offset) as usize, *t, *v)?;
-                }
-                self.run_body(*pou, frame)?;
-                self.st.at = statement;
-                let at = self.addr(value, base)?;
-                self.read(at, *ty)?
-            }
+            } => self.call_function(*pou, inputs, value, *ty, base)?,
         })
     }
 
+    /// A user function's call (out of `eval`: its values' array would make every `eval`'s
+    /// frame large).
+    #[inline(never)]
+    fn call_function(
+        &mut self,
+        pou: usize,
+        inputs: &[BlockInput],
+        value: &Addr,
+        ty: Elem,
+        base: u32,
+    ) -> Run<V> {
+        // The values first (one may call this function too), then the frame.
+        let mut values = [V::I(0); crate::ir::MAX_CALL_INPUTS];
+        for (v, (_, _, e)) in values.iter_mut().zip(inputs.iter()) {
+            *v = self.eval(e, base)?;
+        }
+        let (frame, statement) = (self.code.layout.statics[pou], self.st.at);
+        let (size, _, _) = self.code.layout.pous[pou];
+        // A function's variables start from zero and their initial values each call.
+        self.st.memory[frame as usize..(frame + size) as usize].fill(0);
+        let code = self.code;
+        self.block(&code.bodies[pou].0, frame)?;
+        for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {
+            self.write_own((frame + offset) as usize, *t, *v)?;
+        }
+        self.run_body(pou, frame)?;
+        self.st.at = statement;
+        let at = self.addr(value, base)?;
+        self.read(at, ty)
+    }
+
+    #[inline(never)]
     fn std_fn(&mut self, f: crate::ir::StdFn, t: Elem, args: &[Ex], base: u32) -> Run<V> {
         // At most MAX_STD_VALUES (the lowering refuses more): no allocation for them.
         let mut values = [V::I(0); crate::ir::MAX_STD_VALUES];
