@@ -35,6 +35,10 @@ pub struct DemoArgs {
     /// Lockstep instead of real time (reproducible traces).
     #[arg(long)]
     pub lockstep: bool,
+    /// The PLC program in Structured Text (`scenarios/demo/plc.st`, embedded) instead of the
+    /// Rust one: the same machine, the same lockstep trace.
+    #[arg(long)]
+    pub st: bool,
     /// Real-time options of the CNC's tick loop.
     #[command(flatten)]
     pub realtime: plc_shim::realtime::RealtimeOptions,
@@ -59,8 +63,13 @@ const FILES: &[(&str, &str)] = embed!(
     "slave-left.nc",
     "slave-right.nc",
     "robot.nc",
-    "seed_example.json"
+    "seed_example.json",
+    "plc.st"
 );
+
+/// The `[plc]` lines of the embedded scenario that name the Rust program, and their ST twin.
+const RUST_PLC: &str = "program = \"demo-machine\"\nsaw_cuts = 5\n";
+const ST_PLC: &str = "st = [\"plc.st\"]\n";
 
 /// The embedded machine.
 pub fn scenario() -> Result<Scenario, ScenarioError> {
@@ -99,16 +108,51 @@ pub fn continuous_path_line(line: &str) -> bool {
         || line == "G260"
 }
 
+/// The embedded machine with its PLC program in Structured Text (`plc.st`), written into
+/// `dir` for the PLC process to load.
+pub fn scenario_st(dir: &Path) -> Result<Scenario, ScenarioError> {
+    let (main, text) = FILES[0];
+    if !text.contains(RUST_PLC) {
+        return Err(ScenarioError::Read {
+            file: format!("{NAME}/{main}"),
+            message: format!("its [plc] table no longer reads {RUST_PLC:?}"),
+        });
+    }
+    let program = dir.join("plc.st");
+    let written = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(&program, embedded("plc.st").unwrap_or_default()));
+    written.map_err(|e| ScenarioError::Read {
+        file: program.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let mut s = parse_embedded(&text.replace(RUST_PLC, ST_PLC), Some(&program))?;
+    s.name = format!("{NAME}/{main} (PLC in Structured Text)");
+    Ok(s)
+}
+
+/// The embedded file `name`.
+fn embedded(name: &str) -> Option<&'static str> {
+    FILES.iter().find(|(f, _)| *f == name).map(|(_, t)| *t)
+}
+
 /// The embedded machine with `extra` appended to its scenario file (more axes, a FIFO group:
 /// the tests that load the whole machine further).
 pub fn scenario_with(extra: &str) -> Result<Scenario, ScenarioError> {
-    let (main, text) = FILES[0];
-    let text = format!("{text}\n{extra}");
-    Scenario::parse(&format!("{NAME}/{main}"), &text, |relative| {
+    parse_embedded(&format!("{}\n{extra}", FILES[0].1), None)
+}
+
+/// The embedded machine from the scenario text `text`, its other files embedded; the ST
+/// program, if it has one, at `st` on disk.
+fn parse_embedded(text: &str, st: Option<&Path>) -> Result<Scenario, ScenarioError> {
+    let main = FILES[0].0;
+    Scenario::parse(&format!("{NAME}/{main}"), text, |relative| {
         FILES
             .iter()
             .find(|(file, _)| *file == relative)
-            .map(|(file, text)| (PathBuf::from(format!("{NAME}/{file}")), text.to_string()))
+            .map(|(file, text)| match (st, *file) {
+                (Some(path), "plc.st") => (path.to_path_buf(), text.to_string()),
+                _ => (PathBuf::from(format!("{NAME}/{file}")), text.to_string()),
+            })
             .ok_or_else(|| ScenarioError::Read {
                 file: relative.to_string(),
                 message: "not embedded in the demo".into(),
@@ -118,7 +162,11 @@ pub fn scenario_with(extra: &str) -> Result<Scenario, ScenarioError> {
 
 /// Runs the demo.
 pub fn main(args: DemoArgs) -> ExitCode {
-    let scenario = match scenario() {
+    let scenario = match if args.st {
+        scenario_st(&args.out)
+    } else {
+        scenario()
+    } {
         Ok(s) => s,
         Err(e) => {
             eprintln!("cnc demo: {e}");
@@ -126,7 +174,8 @@ pub fn main(args: DemoArgs) -> ExitCode {
         }
     };
     println!(
-        "== cnc demo: 4 robot channels, a cam station, a flying saw and a PLC process ({} mode, instance {})",
+        "== cnc demo: 4 robot channels, a cam station, a flying saw and a PLC process{} ({} mode, instance {})",
+        if args.st { " in Structured Text" } else { "" },
         if args.lockstep { "lockstep" } else { "real-time" },
         args.instance
     );

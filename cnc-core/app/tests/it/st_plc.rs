@@ -163,3 +163,31 @@ fn the_st_twins_trace_as_their_timelines_do() {
         );
     }
 }
+
+/// `cnc demo --lockstep [--st]` into a scratch folder: the demo's trace.
+fn demo_trace(st: bool) -> Vec<u8> {
+    let dir = Scratch::new(if st { "demo-st" } else { "demo-rust" });
+    let plc = if st { &["--st"][..] } else { &[] };
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["demo", "--lockstep", "--out", dir.path().to_str().unwrap()])
+        .args(["--instance", &tests::unique_instance("demo-st")])
+        .args(plc)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", tests::cli::report(&out));
+    std::fs::read(dir.join("demo.csv")).unwrap()
+}
+
+/// The demo machine's PLC program in ST (`scenarios/demo/plc.st`: the robots' ChannelStart,
+/// the turntable, the cam station, the flying saw) runs the whole machine as the Rust
+/// program does: `cnc demo --st` traces the same, byte for byte.
+#[test]
+fn cnc_demo_st_traces_as_the_rust_program_does() {
+    let (rust, st) = (demo_trace(false), demo_trace(true));
+    assert!(rust.len() > 100_000, "a trace of the demo");
+    let first_difference = rust.iter().zip(&st).position(|(a, b)| a != b);
+    assert!(
+        rust == st,
+        "the ST demo differs from byte {first_difference:?} on"
+    );
+}
