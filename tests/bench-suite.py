@@ -50,6 +50,8 @@ BENCHES = [
      "the same arithmetic in Rust"),
     ("plc-shim", "st_programs", "the turntable PLC program: ST against Rust",
      "the same program in Rust, the same image"),
+    ("cnc-app", "demo_st", "the demo machine's PLC program: ST against Rust, whole processes",
+     "cnc demo with the Rust program"),
 ]
 
 # Peer program -> Debian package.

@@ -149,6 +149,8 @@ pub struct CycleStats {
     pub overruns: u64,
     /// Longest cycle, ns.
     pub max_ns: u64,
+    /// All cycles together, ns (for the mean, finer than the histogram's 1 us).
+    pub total_ns: u64,
     histogram: Box<[u32; HISTOGRAM_US + 1]>,
 }
 
@@ -158,6 +160,7 @@ impl Default for CycleStats {
             cycles: 0,
             overruns: 0,
             max_ns: 0,
+            total_ns: 0,
             histogram: Box::new([0; HISTOGRAM_US + 1]),
         }
     }
@@ -174,6 +177,7 @@ impl CycleStats {
     pub fn record(&mut self, ns: u64) {
         self.cycles += 1;
         self.max_ns = self.max_ns.max(ns);
+        self.total_ns = self.total_ns.saturating_add(ns);
         let bucket = ((ns / 1_000) as usize).min(HISTOGRAM_US);
         self.histogram[bucket] = self.histogram[bucket].saturating_add(1);
     }
@@ -204,11 +208,12 @@ impl core::fmt::Display for CycleStats {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         write!(
             f,
-            "{} cycles, duration p50 {:.0} us p99 {:.0} us max {:.1} us, overruns {}",
+            "{} cycles, duration p50 {:.0} us p99 {:.0} us max {:.1} us mean {:.2} us, overruns {}",
             self.cycles,
             self.quantile_us(0.5),
             self.quantile_us(0.99),
             self.max_ns as f64 / 1e3,
+            self.total_ns as f64 / 1e3 / self.cycles.max(1) as f64,
             self.overruns
         )
     }
