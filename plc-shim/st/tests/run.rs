@@ -331,3 +331,72 @@ fn global_variables_start_from_their_initial_values() {
         "{e}"
     );
 }
+
+#[test]
+fn a_single_bit_is_written_and_read() {
+    let p = run(
+        "PROGRAM MAIN VAR w : WORD := 16#00F0; i : INT := -1; b3, b4 : BOOL; END_VAR\n\
+         w.3 := TRUE; w.4 := FALSE; w.15 := w.5; i.0 := FALSE; b3 := w.3; b4 := w.4;\n\
+         END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.w"), Some(f64::from(0x80E8u16)));
+    assert_eq!(p.read_var("MAIN.i"), Some(-2.0));
+    assert_eq!(
+        (p.read_var("MAIN.b3"), p.read_var("MAIN.b4")),
+        (Some(1.0), Some(0.0))
+    );
+}
+
+#[test]
+fn arrays_and_structures_start_from_their_initialisers() {
+    let p = run(
+        "TYPE ST_Point : STRUCT x, y : LREAL; n : INT; END_STRUCT END_TYPE\n\
+         VAR_GLOBAL gOrigin : ST_Point := (y := 2.5, n := 7); END_VAR\n\
+         PROGRAM MAIN\n\
+         VAR a : ARRAY[1..6] OF INT := [1, 2, 3(9)]; m : ARRAY[0..1, 0..1] OF DINT := [10, 11, 12];\n\
+             pts : ARRAY[0..1] OF ST_Point := [(x := 1.0), (x := 3.0, n := -1)];\n\
+             s, x1, y0 : LREAL; n1, m3 : DINT; END_VAR\n\
+         s := INT_TO_LREAL(a[1] + a[2] + a[3] + a[5] + a[6]); x1 := pts[1].x; y0 := gOrigin.y;\n\
+         n1 := pts[1].n + gOrigin.n; m3 := m[1, 0] + m[1, 1];\n\
+         END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.s"), Some(1.0 + 2.0 + 9.0 + 9.0 + 0.0));
+    assert_eq!(p.read_var("MAIN.x1"), Some(3.0));
+    assert_eq!(p.read_var("MAIN.y0"), Some(2.5));
+    assert_eq!(p.read_var("MAIN.n1"), Some(6.0));
+    assert_eq!(
+        p.read_var("MAIN.m3"),
+        Some(12.0),
+        "row-major: m[1,0] = 12, m[1,1] = 0"
+    );
+}
+
+#[test]
+fn an_initialiser_that_does_not_fit_is_refused_with_its_place() {
+    let e = refused("PROGRAM MAIN VAR a : ARRAY[0..2] OF INT := [1, 2(3), 4]; END_VAR END_PROGRAM");
+    assert!(
+        e.contains("main.st:1:18: error: 4 initial values for 3 elements"),
+        "{e}"
+    );
+    let e = refused(
+        "TYPE P : STRUCT x : INT; END_STRUCT END_TYPE\n\
+         PROGRAM MAIN VAR p : P := (z := 1); b : INT := [1]; q : P := (x := TRUE); END_VAR END_PROGRAM",
+    );
+    assert!(e.contains("main.st:2:28: error: P has no field `z`"), "{e}");
+    assert!(
+        e.contains("main.st:2:37: error: an array initialiser for a INT"),
+        "{e}"
+    );
+    assert!(
+        e.contains("main.st:2:68: error: a BOOL where a INT is wanted"),
+        "{e}"
+    );
+    let e =
+        refused("PROGRAM MAIN VAR a : ARRAY[0..99999] OF INT := [100000(1)]; END_VAR END_PROGRAM");
+    assert!(
+        e.contains("main.st:1:18: error: an initialiser of more than 65536 values"),
+        "{e}"
+    );
+}

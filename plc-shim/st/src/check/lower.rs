@@ -1,9 +1,10 @@
 //! Lowering: a checked program into [`crate::ir`], every name a place in memory, every
 //! operation typed. It runs after the checker found nothing, so it asks the checker for the
 //! types of subexpressions instead of working them out again; what the runtime does not do
-//! yet (strings in expressions, a single bit written) is refused here with its place.
+//! yet (strings in expressions) is refused here with its place.
 
 use super::expr::{literal, Ctx, Meaning};
+use super::place::{plus, strides};
 use super::{Checker, Type};
 use crate::ast::{Arg, BinOp, CaseLabel, Expr, Name, Pou, PouKind, Stmt, UnOp};
 use crate::diag::{Diagnostic, Pos};
@@ -11,10 +12,10 @@ use crate::ir::{Addr, Ex, St, StKind, StdFn};
 use crate::layout::{std_member, Layout};
 use crate::types::{conversion, Class, Elem};
 
-type R<T> = Result<T, Diagnostic>;
+pub(super) type R<T> = Result<T, Diagnostic>;
 
 impl Checker {
-    fn unsupported(&self, pos: Pos, what: &str) -> Diagnostic {
+    pub(super) fn unsupported(&self, pos: Pos, what: &str) -> Diagnostic {
         Diagnostic::new(pos, format!("{what} is not supported by the runtime yet"))
             .in_file(&self.file)
     }
@@ -87,26 +88,24 @@ impl Checker {
         l: &Layout,
         out: &mut Vec<St>,
     ) -> R<()> {
-        let Some(crate::ast::Init::Expr(e)) = &d.init else {
-            if d.init.is_some() {
-                let pos = d.names[0].pos;
-                return Err(self.unsupported(pos, "an array or structure initialiser"));
-            }
+        let Some(init) = &d.init else {
             return Ok(());
         };
         for n in &d.names {
-            let target = Expr::Name(n.clone());
-            let kind = self.lower_assign(&target, e, ctx, l)?;
-            out.push(St {
+            let (addr, ty) = self.place(&Expr::Name(n.clone()), ctx, l)?;
+            let mut kinds = Vec::new();
+            self.lower_init_value(addr, &ty, init, (ctx, l), &mut kinds)
+                .map_err(|e| e.in_file(&self.file))?;
+            out.extend(kinds.into_iter().map(|kind| St {
                 kind,
                 at: (file, n.pos),
-            });
+            }));
         }
         Ok(())
     }
 
     /// The place a variable, field, element or dereference names, and its type.
-    fn place(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
+    pub(super) fn place(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
         match e {
             Expr::Name(n) => self.name_place(n, ctx, l),
             Expr::Field(base, field) => {
@@ -206,7 +205,7 @@ impl Checker {
     }
 
     /// The value of `e` as type `to`: converted if it is of another elementary type.
-    fn value_as(&mut self, e: &Expr, to: Elem, ctx: Ctx, l: &Layout) -> R<Ex> {
+    pub(super) fn value_as(&mut self, e: &Expr, to: Elem, ctx: Ctx, l: &Layout) -> R<Ex> {
         if let Some(v) = literal(e) {
             return Ok(match to.class() {
                 Class::Float => Ex::Real(v as f64),
@@ -457,12 +456,24 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<StKind> {
-        if let Expr::Field(_, f) = target {
-            if f.text.parse::<u32>().is_ok() {
-                return Err(self.unsupported(f.pos, "writing a single bit"));
+        if let Expr::Field(word, f) = target {
+            if let Ok(bit) = f.text.parse::<u32>() {
+                return self.lower_bit_write(word, bit, value, ctx, l);
             }
         }
         let (addr, ty) = self.place(target, ctx, l)?;
+        self.lower_store(addr, ty, value, ctx, l)
+    }
+
+    /// `value` stored into `addr`, a place of type `ty`.
+    pub(super) fn lower_store(
+        &mut self,
+        addr: Addr,
+        ty: Type,
+        value: &Expr,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<StKind> {
         Ok(match ty {
             Type::Elem(t) => StKind::Store(addr, t, self.value_as(value, t, ctx, l)?),
             Type::Enum(i) => {
@@ -475,7 +486,7 @@ impl Checker {
                 let size = l.size_align(&self.out, &ty).0;
                 StKind::Copy(addr, from, size)
             }
-            _ => return Err(self.unsupported(target.pos(), "an assignment of this type")),
+            _ => return Err(self.unsupported(value.pos(), "an assignment of this type")),
         })
     }
 
@@ -656,60 +667,6 @@ impl Checker {
             _ => StKind::Eval(Ex::Int(0)),
         })
     }
-}
-
-impl Checker {
-    /// The elementary leaves of a structure (offset, type), `None` beyond 64 of them or for
-    /// anything but elementary fields and structures of them.
-    fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
-        let mut out = Vec::new();
-        self.leaves_into(ty, 0, l, &mut out)?;
-        Some(out)
-    }
-
-    fn leaves_into(
-        &self,
-        ty: &Type,
-        at: u32,
-        l: &Layout,
-        out: &mut Vec<(u32, Elem)>,
-    ) -> Option<()> {
-        match ty {
-            Type::Elem(e) if out.len() < 64 => out.push((at, *e)),
-            Type::Struct(i) => {
-                for (k, (_, field)) in self.out.structs[*i].fields.iter().enumerate() {
-                    self.leaves_into(field, at + l.structs[*i].2[k], l, out)?;
-                }
-            }
-            _ => return None,
-        }
-        Some(())
-    }
-}
-
-/// `addr` moved on by `offset` bytes, folded into a fixed place or an offset it already has.
-fn plus(addr: Addr, offset: u32) -> Addr {
-    match addr {
-        Addr::Static(at) if at.checked_add(offset).is_some() => Addr::Static(at + offset),
-        Addr::Instance(at) if at.checked_add(offset).is_some() => Addr::Instance(at + offset),
-        Addr::Offset(inner, at) if at.checked_add(offset).is_some() => {
-            Addr::Offset(inner, at + offset)
-        }
-        other => Addr::Offset(Box::new(other), offset),
-    }
-}
-
-/// The byte stride of each dimension of an array (last dimension fastest), `None` where the
-/// whole array would not fit in 32 bits of address.
-fn strides(element: u64, lens: &[u64]) -> Option<Vec<u32>> {
-    let mut strides = vec![0u32; lens.len()];
-    let mut stride = element;
-    for k in (0..lens.len()).rev() {
-        strides[k] = u32::try_from(stride).ok()?;
-        u32::try_from(lens[k]).ok()?;
-        stride = stride.checked_mul(lens[k])?;
-    }
-    u32::try_from(stride).ok().map(|_| strides)
 }
 
 /// The standard function of an upper-case name.

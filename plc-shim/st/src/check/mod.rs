@@ -11,7 +11,9 @@ use crate::types::Elem;
 use std::collections::HashMap;
 
 mod expr;
+mod init;
 mod lower;
+mod place;
 pub mod std_lib;
 mod stmt;
 
@@ -565,7 +567,7 @@ impl Checker {
     /// The global variables' initial values against their types.
     fn check_global_inits(&mut self, block: &crate::ast::VarBlock) {
         for d in &block.vars {
-            let Some(crate::ast::Init::Expr(e)) = &d.init else {
+            let Some(init) = &d.init else {
                 continue;
             };
             for n in &d.names {
@@ -575,7 +577,7 @@ impl Checker {
                     .get(&key)
                     .map(|i| self.out.globals[*i].ty.clone())
                 {
-                    self.assignable(e, &ty, expr::GLOBAL);
+                    self.check_init(init, &ty, n.pos, expr::GLOBAL);
                 }
             }
         }

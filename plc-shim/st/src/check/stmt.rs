@@ -23,13 +23,12 @@ impl Checker {
         self.statements(&p.body, ctx);
     }
 
-    /// The initial values of the POU's variables against their types (an expression; array
-    /// and structure initialisers are checked by the compiler).
+    /// The initial values of the POU's variables against their types (expressions, array
+    /// and structure initialisers).
     fn initial_values(&mut self, p: &Pou, ctx: Ctx) {
         for block in &p.vars {
             for d in &block.vars {
-                let (Some(crate::ast::Init::Expr(e)), Some(first)) = (&d.init, d.names.first())
-                else {
+                let (Some(init), Some(first)) = (&d.init, d.names.first()) else {
                     continue;
                 };
                 let ty = self.out.pous[ctx.pou]
@@ -38,7 +37,7 @@ impl Checker {
                     .find(|v| v.name == first.text)
                     .map(|v| v.ty.clone());
                 if let Some(ty) = ty {
-                    self.assignable(e, &ty, ctx);
+                    self.check_init(init, &ty, first.pos, ctx);
                 }
             }
         }

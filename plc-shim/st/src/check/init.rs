@@ -1,0 +1,127 @@
+//! Array and structure initialisers (`[1, 2, 3(0)]`, `(x := 1.5, y := 2.0)`), nested as the
+//! types are: checked against the variable's type (every value assignable, the fields named,
+//! no more values than elements), and lowered to one store per value, run once at load. A
+//! repetition count is a constant; an initialiser gives at most [`MAX_INIT_VALUES`] values.
+
+use super::expr::Ctx;
+use super::lower::R;
+use super::{Checker, Type};
+use crate::ast::Init;
+use crate::diag::{Diagnostic, Pos};
+use crate::ir::{Addr, StKind};
+use crate::layout::Layout;
+
+/// The most values one initialiser gives (repetitions counted).
+pub const MAX_INIT_VALUES: u64 = 1 << 16;
+
+impl Checker {
+    /// `init` against a variable of type `ty` declared at `pos`.
+    pub(super) fn check_init(&mut self, init: &Init, ty: &Type, pos: Pos, ctx: Ctx) {
+        let mut budget = MAX_INIT_VALUES;
+        self.check_init_in(init, ty, pos, ctx, &mut budget);
+    }
+
+    fn check_init_in(&mut self, init: &Init, ty: &Type, pos: Pos, ctx: Ctx, budget: &mut u64) {
+        match (init, ty) {
+            (Init::Expr(e), _) => self.assignable(e, ty, ctx),
+            (Init::Array(items), Type::Array(dims, element)) => {
+                let total = dims
+                    .iter()
+                    .fold(1u64, |n, (lo, hi)| n.saturating_mul(hi.abs_diff(*lo) + 1));
+                let mut given = 0u64;
+                for (count, item) in items {
+                    let times = match count {
+                        None => Some(1),
+                        Some(c) => self.const_int(c).and_then(|n| u64::try_from(n).ok()),
+                    };
+                    let Some(times) = times else {
+                        let at = count.as_ref().map_or(pos, |c| c.pos());
+                        self.refuse(at, "a repetition count is a constant of 0 or more");
+                        return;
+                    };
+                    given = given.saturating_add(times);
+                    *budget = budget.saturating_sub(times);
+                    self.check_init_in(item, element, pos, ctx, budget);
+                }
+                if given > total {
+                    self.refuse(pos, format!("{given} initial values for {total} elements"));
+                } else if *budget == 0 {
+                    let most = MAX_INIT_VALUES;
+                    self.refuse(pos, format!("an initialiser of more than {most} values"));
+                }
+            }
+            (Init::Struct(fields), Type::Struct(i)) => {
+                for (name, item) in fields {
+                    let found = self.out.structs[*i]
+                        .fields
+                        .iter()
+                        .find(|(f, _)| f.eq_ignore_ascii_case(&name.text))
+                        .map(|(_, t)| t.clone());
+                    match found {
+                        Some(t) => self.check_init_in(item, &t, name.pos, ctx, budget),
+                        None => {
+                            let s = self.out.structs[*i].name.clone();
+                            self.refuse(name.pos, format!("{s} has no field `{}`", name.text));
+                        }
+                    }
+                }
+            }
+            (_, Type::Error) => {}
+            (Init::Array(_), _) => {
+                let t = self.type_name(ty);
+                self.refuse(pos, format!("an array initialiser for a {t}"));
+            }
+            (Init::Struct(_), _) => {
+                let t = self.type_name(ty);
+                self.refuse(pos, format!("a structure initialiser for a {t}"));
+            }
+        }
+    }
+
+    /// The stores of `init` into `addr`, a place of type `ty` (checked already).
+    pub(super) fn lower_init_value(
+        &mut self,
+        addr: Addr,
+        ty: &Type,
+        init: &Init,
+        (ctx, l): (Ctx, &Layout),
+        out: &mut Vec<StKind>,
+    ) -> R<()> {
+        match (init, ty) {
+            (Init::Expr(e), _) => out.push(self.lower_store(addr, ty.clone(), e, ctx, l)?),
+            (Init::Array(items), Type::Array(_, element)) => {
+                let (size, align) = l.size_align(&self.out, element);
+                let stride = size.div_ceil(align) * align;
+                let mut k = 0u32;
+                for (count, item) in items {
+                    let times = count.as_ref().and_then(|c| self.const_int(c)).unwrap_or(1);
+                    for _ in 0..times {
+                        let at = super::place::plus(addr.clone(), k * stride);
+                        self.lower_init_value(at, element, item, (ctx, l), out)?;
+                        k += 1;
+                    }
+                }
+            }
+            (Init::Struct(fields), Type::Struct(i)) => {
+                for (name, item) in fields {
+                    let def = &self.out.structs[*i];
+                    let k = def
+                        .fields
+                        .iter()
+                        .position(|(f, _)| f.eq_ignore_ascii_case(&name.text))
+                        .ok_or_else(|| Diagnostic::new(name.pos, "no such field"))?;
+                    let t = def.fields[k].1.clone();
+                    let at = super::place::plus(addr.clone(), l.structs[*i].2[k]);
+                    self.lower_init_value(at, &t, item, (ctx, l), out)?;
+                }
+            }
+            _ => {
+                return Err(Diagnostic::new(
+                    Pos::default(),
+                    "an initialiser of this type",
+                ))
+            }
+        }
+        Ok(())
+    }
+}
