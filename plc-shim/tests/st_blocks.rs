@@ -5,7 +5,7 @@
 use hli::views::PlcView;
 use hli_transport::rpc::{AcyclicClient, AcyclicServer};
 use plc_shim::runtime::{Link, PlcIo, PlcProgram};
-use plc_shim::st::library::INVALID_INPUT;
+use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 
 #[path = "../../tests/support/counting_alloc.rs"]
@@ -127,4 +127,17 @@ fn an_input_no_call_gives_keeps_the_blocks_default() {
     cnc.cycle(&mut p);
     assert_eq!(cnc.client.sent(), 1);
     assert_eq!((var(&p, "bBusy"), var(&p, "bError")), (1.0, 0.0));
+}
+
+#[test]
+fn rows_through_a_null_pointer_end_the_command_with_0x4227_and_send_nothing() {
+    let mut cnc = Cnc::new("st-blocks-rows");
+    let text = "PROGRAM MAIN VAR fbW : FiFoWrite; bErr : BOOL; nErr : UDINT; END_VAR
+        fbW(bExecute := TRUE, iColDim := 2, iRowsToWrite := 1, bErr => bErr, iErrId => nErr);
+        END_PROGRAM";
+    let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 0);
+    assert_eq!(var(&p, "bErr"), 1.0);
+    assert_eq!(var(&p, "nErr"), f64::from(INVALID_INPUT));
 }

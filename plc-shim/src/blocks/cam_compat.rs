@@ -431,6 +431,7 @@ macro_rules! compat_block {
             execute: true,
             inputs: $inputs,
             make: |room| make($name, room),
+            style: crate::timeline::registry::StStyle::PlcOpen,
         }
     };
 }

@@ -371,6 +371,7 @@ const fn on_channel(
         execute,
         inputs,
         make,
+        style: crate::timeline::registry::StStyle::PlcOpen,
     }
 }
 

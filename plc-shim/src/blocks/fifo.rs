@@ -30,7 +30,8 @@ use crate::kernel::{
 };
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
-    input, mode, required, BlockSpec, InputSpec, Kind as InputKind, Target, TimelineBlock, Value,
+    input, mode, required, BlockSpec, InputSpec, Kind as InputKind, StForm, Target, TimelineBlock,
+    Value,
 };
 use hli::calls::fifo::{
     rows_header, FifoDimensionCall, FifoDisintegrateCall, FifoIntegrateCall, FifoOverrideCall,
@@ -226,10 +227,21 @@ impl FifoInputs {
 }
 
 /// `gpFifo[group]`: every FIFO block's.
-const GROUP: InputSpec = input("group", InputKind::Range(0, 7));
+const GROUP: InputSpec = input("group", InputKind::Range(0, 7)).st_named("iChannelId");
 /// The FIFO blocks' inputs, block by block.
 const GROUP_ONLY: &[InputSpec] = &[GROUP];
-const INTEGRATE: &[InputSpec] = &[GROUP, required("group_position", InputKind::Range(1, 16))];
+const INTEGRATE: &[InputSpec] = &[
+    GROUP,
+    required("group_position", InputKind::Range(1, 16)).st_named("iGroupPosition"),
+];
+/// FiFoWrite's rows in ST, as the seed declares them: a pointer to the first value of an
+/// `ARRAY[ROWS, COLUMNS] OF LREAL`, its columns, the rows to write.
+const ST_ROWS: StForm = StForm::Rows {
+    data: "AdrDataArray",
+    columns: "iColDim",
+    rows: "iRowsToWrite",
+    max: FIFO_BLOCK_VALUES,
+};
 const WRITE: &[InputSpec] = &[
     GROUP,
     required(
@@ -242,9 +254,13 @@ const WRITE: &[InputSpec] = &[
             },
             example: "[[1.0, 2.0], [3.0, 4.0]]",
         },
-    ),
+    )
+    .st_rows(ST_ROWS),
 ];
-const OVERRIDE: &[InputSpec] = &[GROUP, input("override", InputKind::Between(0.0, 100.0))];
+const OVERRIDE: &[InputSpec] = &[
+    GROUP,
+    input("override", InputKind::Between(0.0, 100.0)).st_named("iOverride"),
+];
 const PARAMETERS: &[InputSpec] = &[
     GROUP,
     input("fifo_cycle_ms", InputKind::Positive),
@@ -302,7 +318,7 @@ enum Kind {
     Write(FifoWrite),
 }
 
-/// A FIFO block instance of a timeline.
+/// A FIFO block instance of a timeline or an ST program.
 #[derive(Debug)]
 struct FifoInstance {
     /// Execute.
@@ -310,6 +326,27 @@ struct FifoInstance {
     /// The inputs its calls set.
     inputs: FifoInputs,
     kind: Kind,
+    /// FiFoWrite's rows from an ST program (room for one block, made with the instance) and
+    /// their columns and rows, once given ([`TimelineBlock::set_rows`]).
+    data: Vec<f64>,
+    shape: Option<(u32, u32)>,
+}
+
+impl FifoInstance {
+    fn new(kind: Kind) -> FifoInstance {
+        let room = if matches!(kind, Kind::Write(_)) {
+            FIFO_BLOCK_VALUES
+        } else {
+            0
+        };
+        FifoInstance {
+            execute: false,
+            inputs: FifoInputs::default(),
+            kind,
+            data: Vec::with_capacity(room),
+            shape: None,
+        }
+    }
 }
 
 impl FifoInstance {
@@ -345,10 +382,13 @@ impl FifoInstance {
                 override_ppm: i.override_ppm,
             }),
             Kind::Parameters(b) => b.cycle(io, e, g, || i.params),
-            Kind::Write(b) => {
-                let rows = i.rows.len() as u32 / i.columns.max(1);
-                b.cycle(io, e, g, &i.rows, i.columns, rows)
-            }
+            Kind::Write(b) => match self.shape {
+                Some((columns, rows)) => b.cycle(io, e, g, &self.data, columns, rows),
+                None => {
+                    let rows = i.rows.len() as u32 / i.columns.max(1);
+                    b.cycle(io, e, g, &i.rows, i.columns, rows)
+                }
+            },
         }
     }
 }
@@ -356,10 +396,24 @@ impl FifoInstance {
 impl TimelineBlock for FifoInstance {
     timeline_timeout!();
     fn set(&mut self, key: &str, value: &Value) {
+        if key == "rows" {
+            self.shape = None;
+        }
         self.inputs.set(key, value);
     }
     fn execute(&mut self) -> Option<&mut bool> {
         Some(&mut self.execute)
+    }
+    fn set_rows(&mut self, values: &[f64], columns: u32, rows: u32) -> bool {
+        if !matches!(self.kind, Kind::Write(_)) {
+            return false;
+        }
+        self.data.clear();
+        let room = self.data.capacity();
+        self.data
+            .extend_from_slice(&values[..values.len().min(room)]);
+        self.shape = Some((columns, rows));
+        true
     }
     /// Done, Busy, Error and ErrorID (the reply is not recorded).
     fn cycle(&mut self, io: &mut PlcIo<'_>, axis: u32) -> (Outputs, bool) {
@@ -383,13 +437,8 @@ macro_rules! fifo_block {
             target: Target::$target,
             execute: true,
             inputs: $inputs,
-            make: |_| {
-                Box::new(FifoInstance {
-                    execute: false,
-                    inputs: FifoInputs::default(),
-                    kind: $block,
-                })
-            },
+            make: |_| Box::new(FifoInstance::new($block)),
+            style: crate::timeline::registry::StStyle::Hungarian,
         }
     };
 }

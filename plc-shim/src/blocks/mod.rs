@@ -93,6 +93,7 @@ macro_rules! inputs {
                 key: $key,
                 kind: $kind,
                 required: inputs!(@required $($required)?),
+                st: $crate::timeline::registry::StForm::Key,
             }
         ),*];
 

@@ -475,6 +475,7 @@ pub const TIMELINE: &[BlockSpec] = &[
         execute: false,
         inputs: &[input("enable", Kind::Bool)],
         make: |_| Box::<McPower>::default(),
+        style: crate::timeline::registry::StStyle::PlcOpen,
     },
     BlockSpec::on_axis("MC_Reset", McReset::INPUTS, |_| Box::<McReset>::default()),
     BlockSpec::on_axis("MC_MoveAbsolute", McMoveAbsolute::INPUTS, |_| {

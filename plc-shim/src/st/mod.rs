@@ -5,11 +5,13 @@
 //! program: the runtime then ends without another heartbeat and the CNC stops as for a lost
 //! PLC; the summary names the fault with its FILE:LINE:COL.
 
+pub mod host;
 pub mod library;
 
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::layout::HliSegmentHeader;
-use library::{Blocks, Library, LIBRARY};
+use host::Blocks;
+use library::{Library, LIBRARY};
 use plc_st::vm::{FaultAt, Program};
 use std::path::PathBuf;
 

@@ -34,6 +34,17 @@ pub const FAMILIES: &[&[BlockSpec]] = &[
     channel::TIMELINE,
 ];
 
+/// How a block's names read in Structured Text: PLCopen's (`Execute`, `Done`, `Busy`,
+/// `Error`, `ErrorID`, ...) or the seeds' Hungarian ones of the FIFO and compatibility blocks
+/// (`bExecute`; `bBusy`, `bErr`, `iErrId`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StStyle {
+    /// PLCopen names.
+    PlcOpen,
+    /// The seeds' Hungarian names.
+    Hungarian,
+}
+
 /// A block as a timeline knows it.
 #[derive(Debug)]
 pub struct BlockSpec {
@@ -47,6 +58,8 @@ pub struct BlockSpec {
     pub inputs: &'static [InputSpec],
     /// A fresh instance; `room` is the room of a read's answer, if the call gave one.
     pub make: fn(room: Option<usize>) -> Box<dyn TimelineBlock>,
+    /// How its names read in Structured Text.
+    pub style: StStyle,
 }
 
 impl BlockSpec {
@@ -72,6 +85,15 @@ impl BlockSpec {
             execute: true,
             inputs,
             make,
+            style: StStyle::PlcOpen,
+        }
+    }
+
+    /// The same block with the seeds' Hungarian names in Structured Text.
+    pub const fn hungarian(self) -> BlockSpec {
+        BlockSpec {
+            style: StStyle::Hungarian,
+            ..self
         }
     }
 }
@@ -113,6 +135,30 @@ pub struct InputSpec {
     pub kind: Kind,
     /// Whether every call must give it (a master input may be given as `master_id`).
     pub required: bool,
+    /// How it reads in Structured Text.
+    pub st: StForm,
+}
+
+/// How an input reads in Structured Text.
+#[derive(Debug, Clone, Copy)]
+pub enum StForm {
+    /// Its key in PascalCase (`master_offset` is `MasterOffset`).
+    Key,
+    /// Under this name (the seed's `iChannelId` for `group`).
+    Named(&'static str),
+    /// Rows of LREAL read through a pointer (the seed's FiFoWrite: `AdrdataArray`,
+    /// `iColDim`, `iRowsToWrite`), at most `max` values: the block takes them with
+    /// [`TimelineBlock::set_rows`].
+    Rows {
+        /// The pointer's name.
+        data: &'static str,
+        /// The columns' name.
+        columns: &'static str,
+        /// The rows' name.
+        rows: &'static str,
+        /// The most values a call takes.
+        max: usize,
+    },
 }
 
 /// An input `key` of kind `kind`.
@@ -121,6 +167,7 @@ pub const fn input(key: &'static str, kind: Kind) -> InputSpec {
         key,
         kind,
         required: false,
+        st: StForm::Key,
     }
 }
 
@@ -130,6 +177,22 @@ pub const fn required(key: &'static str, kind: Kind) -> InputSpec {
         key,
         kind,
         required: true,
+        st: StForm::Key,
+    }
+}
+
+impl InputSpec {
+    /// The same input under `name` in Structured Text.
+    pub const fn st_named(self, name: &'static str) -> InputSpec {
+        InputSpec {
+            st: StForm::Named(name),
+            ..self
+        }
+    }
+
+    /// The same input as rows through a pointer in Structured Text ([`StForm::Rows`]).
+    pub const fn st_rows(self, form: StForm) -> InputSpec {
+        InputSpec { st: form, ..self }
     }
 }
 
@@ -355,6 +418,12 @@ pub trait TimelineBlock: core::fmt::Debug {
     }
     /// Input tTimeout, in PLC cycles: `true` if the block has it (and took it).
     fn timeout_cycles(&mut self, _cycles: u64) -> bool {
+        false
+    }
+    /// Rows of `columns` values (`rows` of them; `values` holds them row by row, or fewer
+    /// when there were more than the block takes, which it then refuses): `true` if the
+    /// block takes rows ([`StForm::Rows`]). Does not allocate.
+    fn set_rows(&mut self, _values: &[f64], _columns: u32, _rows: u32) -> bool {
         false
     }
     /// The master axis (gpAx index) of a coupling block: `true` if the block has one (and

@@ -634,10 +634,14 @@ impl Checker {
                 }
                 continue;
             }
-            let Type::Elem(t) = member else {
-                return Err(
-                    self.unsupported(name.pos, "an input or output that is no elementary value")
-                );
+            let t = match member {
+                Type::Elem(t) => t,
+                // A pointer input (FiFoWrite's AdrDataArray) is its address, 8 bytes.
+                Type::Pointer(_) if matches!(arg, Arg::Input(..)) => Elem::LInt,
+                _ => {
+                    return Err(self
+                        .unsupported(name.pos, "an input or output that is no elementary value"))
+                }
             };
             match arg {
                 Arg::Input(_, v) => inputs.push((offset, t, self.value_as(v, t, ctx, l)?)),

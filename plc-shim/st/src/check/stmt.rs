@@ -133,7 +133,9 @@ impl Checker {
                     || (matches!(value, Expr::Real(..)) && w.class() == Class::Float)
             }
             (Type::Str(_), Type::Str(_)) => true,
-            (Type::Pointer(a), Type::Pointer(b)) => a == b,
+            // ADR's pointer goes to a pointer of any type, as in TwinCAT (`ADR(aRows)` to a
+            // POINTER TO LREAL: the first element's address).
+            (Type::Pointer(a), Type::Pointer(b)) => a == b || is_adr(value),
             _ => false,
         };
         if !fits {
@@ -581,4 +583,10 @@ fn image_writer_is_cnc(name: &str, field: &str) -> bool {
             .collect()
     });
     owned.contains(&(name.to_ascii_uppercase(), field.to_ascii_uppercase()))
+}
+
+/// Whether `e` is a call of ADR.
+fn is_adr(e: &Expr) -> bool {
+    matches!(e, Expr::Call { callee, .. }
+        if matches!(&**callee, Expr::Name(n) if n.text.eq_ignore_ascii_case("ADR")))
 }

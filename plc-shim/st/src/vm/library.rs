@@ -76,6 +76,30 @@ impl BlockIo<'_> {
         read_mem(self.memory, at, t).ok().map(V::float)
     }
 
+    /// `out` filled with `n` LREALs from where pointer variable `k` points (the program's own
+    /// memory only); `false` for a NULL pointer, one into the image, or `n` values beyond the
+    /// memory. `out` is cleared first and not grown beyond `n` (give it the room).
+    pub fn lreals(&self, k: usize, n: usize, out: &mut Vec<f64>) -> bool {
+        out.clear();
+        let Some(p) = self.int(k) else {
+            return false;
+        };
+        if p & super::IMAGE_TAG != 0 || p <= 0 {
+            return false;
+        }
+        let at = (p - 1) as usize;
+        let end = n.checked_mul(8).and_then(|b| at.checked_add(b));
+        let Some(bytes) = end.and_then(|end| self.memory.get(at..end)) else {
+            return false;
+        };
+        out.extend(
+            bytes
+                .chunks_exact(8)
+                .map(|c| f64::from_le_bytes(super::arr(c))),
+        );
+        true
+    }
+
     /// Sets variable `k` (an output) to `v`, converted to its type; nothing if it has no place.
     pub fn set(&mut self, k: usize, v: f64) {
         if let Some((at, t)) = self.place(k) {
@@ -231,6 +255,7 @@ fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
             let offset = l.pous[pou].2[k];
             match &v.ty {
                 Type::Elem(e) => Some((offset, *e)),
+                Type::Pointer(_) => Some((offset, Elem::LInt)),
                 Type::Struct(s) => match c.structs[*s].fields.first() {
                     Some((_, Type::Elem(e))) => Some((offset + l.structs[*s].2[0], *e)),
                     _ => None,

@@ -1,0 +1,218 @@
+//! The library's blocks on an ST program's instances ([`plc_st::vm::Host`]): one
+//! `TimelineBlock` per instance, made at load; each call reads the instance's inputs, runs
+//! the block kernel for one cycle, and writes its outputs back.
+//!
+//! As in a timeline, an Execute block takes its inputs at the rising edge of Execute; a
+//! block without Execute (MC_Power) takes them every call. An input no call of the instance
+//! has given is not passed on, so the block keeps its own default (MC_CamIn's scalings 1.0,
+//! MC_MoveVelocity's Direction 1), as when a timeline's call does not give it; once given,
+//! it keeps its value from call to call, as an FB input does. A value outside its input's
+//! kind (a range, a positive time, one of a list), or rows through a pointer that is NULL or
+//! reaches beyond the program's memory, is not passed on: that command ends at once with
+//! Error and [`INVALID_INPUT`] (held while Execute stays TRUE). Nothing here allocates after
+//! the load (the rows' room is made with the instance).
+
+use super::library::{Binding, Bound, Library};
+use crate::kernel::Outputs;
+use crate::runtime::PlcIo;
+use crate::timeline::registry::{InputSpec, Kind, StStyle, TimelineBlock, Value};
+use plc_st::vm::{BlockIo, Fault, Host};
+
+/// The error id of a command whose input was outside its kind (AxisError::InvalidParameter).
+pub const INVALID_INPUT: u32 = hli::enums::AxisError::InvalidParameter as u32;
+
+/// One instance's block and what the host remembers of its last call.
+#[derive(Debug)]
+struct Instance {
+    block: Box<dyn TimelineBlock>,
+    /// Execute in the last call.
+    last_execute: bool,
+    /// The command of the current Execute was refused (an input outside its kind).
+    refused: bool,
+    /// Per input: given by a call of the program once (then passed at every edge).
+    given: Vec<bool>,
+    /// Rows read through a pointer (room made at load).
+    rows: Vec<f64>,
+}
+
+/// The blocks of a program's instances (one per instance, made at load).
+#[derive(Debug)]
+pub struct Blocks {
+    library: Library,
+    instances: Vec<Instance>,
+}
+
+impl Blocks {
+    /// A block for each of `instances` (address and block index, as
+    /// `plc_st::vm::Program::library_instances` lists them).
+    pub fn new(library: Library, instances: &[(u32, usize)]) -> Blocks {
+        let instances = instances
+            .iter()
+            .map(|(_, k)| {
+                let binding = &library.bindings[*k];
+                Instance {
+                    block: (binding.spec.make)(None),
+                    last_execute: false,
+                    refused: false,
+                    given: vec![false; binding.inputs.len()],
+                    rows: Vec::with_capacity(binding.rows_room()),
+                }
+            })
+            .collect();
+        Blocks { library, instances }
+    }
+
+    /// The host for one cycle on `io`.
+    pub fn host<'a, 'b>(&'a mut self, io: &'a mut PlcIo<'b>) -> BlockHost<'a, 'b> {
+        BlockHost { blocks: self, io }
+    }
+}
+
+/// The library's blocks during one PLC cycle.
+pub struct BlockHost<'a, 'b> {
+    blocks: &'a mut Blocks,
+    io: &'a mut PlcIo<'b>,
+}
+
+/// Input `var` of `spec`'s kind from the instance, or `None` if it is outside the kind.
+fn input_value(io: &BlockIo<'_>, var: usize, spec: &InputSpec, axis: bool) -> Option<Value> {
+    let int = || io.int(var);
+    let real = || io.real(var).filter(|v| v.is_finite());
+    if axis {
+        return int().map(Value::Int);
+    }
+    match spec.kind {
+        Kind::Bool => int().map(|v| Value::Bool(v != 0)),
+        Kind::Real => real().map(Value::Real),
+        Kind::Between(lo, hi) => real().filter(|v| (lo..=hi).contains(v)).map(Value::Real),
+        Kind::Positive => real().filter(|v| *v > 0.0).map(Value::Real),
+        Kind::Range(lo, hi) => int().filter(|v| (lo..=hi).contains(v)).map(Value::Int),
+        Kind::OneOf(choices) => int()
+            .filter(|v| choices.iter().any(|(_, c)| c == v))
+            .map(Value::Int),
+        Kind::Mode(m) => int()
+            .filter(|v| u32::try_from(*v).is_ok_and(m.valid))
+            .map(Value::Int),
+        Kind::Count | Kind::Flags { .. } => int().map(Value::Int),
+        Kind::Room | Kind::Parsed { .. } => None,
+    }
+}
+
+/// Passes input `bound` of the instance to its block; `false` if its value is refused.
+fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec)) -> bool {
+    match *bound {
+        Bound::Value { var, axis } => match input_value(io, var, spec, axis) {
+            Some(v) => {
+                inst.block.set(spec.key, &v);
+                true
+            }
+            None => false,
+        },
+        Bound::Rows {
+            data,
+            columns,
+            rows,
+            max,
+        } => {
+            let count = |v| io.int(v).and_then(|n| u32::try_from(n).ok());
+            let (Some(c), Some(r)) = (count(columns), count(rows)) else {
+                return false;
+            };
+            // More values than a call takes: the block refuses them with its own code.
+            let n = (c as usize).saturating_mul(r as usize).min(max);
+            io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
+        }
+    }
+}
+
+/// Whether this call gives input `bound`.
+fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
+    match *bound {
+        Bound::Value { var, .. } => io.given(var),
+        Bound::Rows {
+            data,
+            columns,
+            rows,
+            ..
+        } => io.given(data) || io.given(columns) || io.given(rows),
+    }
+}
+
+/// Writes `out` (and Status) to the outputs from variable `first` on, as `style` names them.
+fn write_outputs(io: &mut BlockIo<'_>, first: usize, style: StStyle, out: &Outputs, status: bool) {
+    let flag = |v: bool| f64::from(u8::from(v));
+    let all: &[f64] = match style {
+        StStyle::Hungarian => &[flag(out.busy), flag(out.error), f64::from(out.error_id)],
+        StStyle::PlcOpen => &[
+            flag(out.done),
+            flag(out.busy),
+            flag(out.active),
+            flag(out.command_aborted),
+            flag(out.error),
+            f64::from(out.error_id),
+            flag(out.in_velocity),
+            flag(out.in_sync),
+            flag(out.start_sync),
+            flag(status),
+        ],
+    };
+    for (k, v) in all.iter().enumerate() {
+        io.set(first + k, *v);
+    }
+}
+
+impl Host for BlockHost<'_, '_> {
+    fn call(&mut self, block: usize, io: &mut BlockIo<'_>) -> Result<(), Fault> {
+        let binding: &Binding = &self.blocks.library.bindings[block];
+        let inst = self
+            .blocks
+            .instances
+            .get_mut(io.slot())
+            .ok_or(Fault::BadPointer)?;
+        let execute = binding.execute.map(|v| io.int(v).unwrap_or(0) != 0);
+        let takes_inputs = match execute {
+            Some(e) => e && !inst.last_execute,
+            None => true,
+        };
+        if takes_inputs {
+            inst.refused = false;
+            for (k, input) in binding.inputs.iter().enumerate() {
+                // Never given by a call: the block keeps its own default.
+                inst.given[k] |= given(io, &input.0);
+                if inst.given[k] && !pass(io, inst, input) {
+                    inst.refused = execute.is_some();
+                }
+            }
+        }
+        inst.last_execute = execute.unwrap_or(false);
+        let axis = axis_of(io, binding);
+        let style = binding.spec.style;
+        if inst.refused && inst.last_execute {
+            // Execute stays FALSE for the block: its command never starts.
+            if let Some(e) = inst.block.execute() {
+                *e = false;
+            }
+            let _ = inst.block.cycle(self.io, axis);
+            let failed = Outputs::failed(INVALID_INPUT);
+            write_outputs(io, binding.outputs, style, &failed, false);
+            return Ok(());
+        }
+        if let (Some(e), Some(x)) = (inst.block.execute(), execute) {
+            *e = x;
+        }
+        let (out, status) = inst.block.cycle(self.io, axis);
+        write_outputs(io, binding.outputs, style, &out, status);
+        Ok(())
+    }
+}
+
+/// The axis (or channel) an instance addresses: 0 for a group's block.
+fn axis_of(io: &BlockIo<'_>, binding: &Binding) -> u32 {
+    match binding.target {
+        Some(v) => io
+            .int(v)
+            .and_then(|v| u32::try_from(v).ok())
+            .unwrap_or(u32::MAX),
+        None => 0,
+    }
+}
