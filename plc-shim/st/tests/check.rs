@@ -174,3 +174,14 @@ fn widening_literals_and_standard_blocks_check() {
     );
     assert!(ok.is_empty(), "{ok:?}");
 }
+
+#[test]
+fn adr_of_an_array_points_to_its_elements() {
+    assert_eq!(
+        refusals(
+            "a : ARRAY[0..3, 0..1] OF LREAL; p : POINTER TO LREAL; q : POINTER TO INT;",
+            "p := ADR(a); q := ADR(a);"
+        ),
+        vec!["p.st:5:19: error: a POINTER TO ARRAY[0..3, 0..1] OF LREAL where a POINTER TO INT is wanted".to_string()]
+    );
+}

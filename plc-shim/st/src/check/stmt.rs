@@ -133,9 +133,9 @@ impl Checker {
                     || (matches!(value, Expr::Real(..)) && w.class() == Class::Float)
             }
             (Type::Str(_), Type::Str(_)) => true,
-            // ADR's pointer goes to a pointer of any type, as in TwinCAT (`ADR(aRows)` to a
-            // POINTER TO LREAL: the first element's address).
-            (Type::Pointer(a), Type::Pointer(b)) => a == b || is_adr(value),
+            // ADR of an array goes to a pointer to its elements, as in TwinCAT (`ADR(aRows)`
+            // to a POINTER TO LREAL: the first element's address).
+            (Type::Pointer(a), Type::Pointer(b)) => a == b || (is_adr(value) && element(a) == &**b),
             _ => false,
         };
         if !fits {
@@ -589,4 +589,12 @@ fn image_writer_is_cnc(name: &str, field: &str) -> bool {
 fn is_adr(e: &Expr) -> bool {
     matches!(e, Expr::Call { callee, .. }
         if matches!(&**callee, Expr::Name(n) if n.text.eq_ignore_ascii_case("ADR")))
+}
+
+/// The innermost element type of an array (`t` itself for anything else).
+fn element(t: &Type) -> &Type {
+    match t {
+        Type::Array(_, e) => element(e),
+        other => other,
+    }
 }
