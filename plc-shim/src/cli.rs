@@ -116,7 +116,13 @@ pub fn main(cli: PlcCli) -> ExitCode {
 /// Runs the PLC process; exit code 0 when the CNC closed in order.
 pub fn run(args: PlcArgs) -> ExitCode {
     if !args.st.is_empty() {
-        return match crate::st::StProgram::load(&args.st, args.host.period_ticks) {
+        let loaded =
+            crate::st::StProgram::load(&args.st, args.host.period_ticks).and_then(|mut p| {
+                // Its variables for `plc get|set|watch` (removed again when the PLC ends).
+                p.publish_on(&args.host.instance)?;
+                Ok(p)
+            });
+        return match loaded {
             Ok(mut program) => host(&mut program, &args.host),
             Err(e) => {
                 eprint!("{e}");

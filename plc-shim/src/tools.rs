@@ -1,5 +1,7 @@
 //! `plc get`, `plc set`, `plc watch`: single leaves of a running CNC's image by ST path (the
-//! paths of `cnc hli symbols`), from a shell, beside the PLC process.
+//! paths of `cnc hli symbols`), from a shell, beside the PLC process; and the variables of a
+//! Structured Text PLC by name (`MAIN.fbCam.Busy`, `st::vars`), which its PLC writes for a
+//! tool before its next cycle (a value the variable's type cannot hold is refused).
 //!
 //! A tool attaches like a PLC (same layout checks) but does not claim the segment: the CNC
 //! keeps supervising its PLC. Writes follow the handshake protocol of the control units, so a
@@ -20,6 +22,7 @@
 //! its semaphore publishes it. Exit codes: 0 done, 1 no CNC to attach to, 2 bad input
 //! (unknown path, value of the wrong type or range), 4 refused by the protocol.
 
+use crate::st::vars::Variables;
 use core::time::Duration;
 use hli::access::{AccessError, Leaf, Value};
 use hli::enums::SegmentState;
@@ -27,6 +30,7 @@ use hli::protocol::Refused;
 pub use hli::protocol::{show, Refusal, Write};
 use hli::ImageMemory;
 use hli_transport::segment::{AttachError, PlcSegment};
+use plc_st::types::Elem;
 use std::process::ExitCode;
 
 /// Instance `cnc demo` runs as, and the tools' default.
@@ -107,6 +111,9 @@ pub enum ToolError {
     /// PATH without a VALUE.
     #[error("`{0}` has no value: give PATH VALUE pairs")]
     MissingValue(String),
+    /// An ST PLC's variables: none published, an unknown one, a value refused.
+    #[error("{0}")]
+    St(String),
     /// The protocol forbids this write now.
     #[error("`{path}`: {reason}")]
     Refused {
@@ -168,13 +175,6 @@ fn parse_value(path: &str, text: &str, leaf: &Leaf) -> Result<Value, ToolError> 
     Ok(leaf.check(path, value)?)
 }
 
-fn resolve_all(paths: &[String]) -> Result<Vec<Leaf>, ToolError> {
-    paths
-        .iter()
-        .map(|p| Leaf::resolve(p).map_err(ToolError::from))
-        .collect()
-}
-
 /// Resolves the paths and parses the values of `pairs` (PATH VALUE ...); needs no CNC.
 pub fn parse_pairs(pairs: &[String]) -> Result<Vec<Write<'_>>, ToolError> {
     pairs
@@ -195,20 +195,24 @@ fn attach(instance: &str) -> Result<PlcSegment, ToolError> {
     Ok(PlcSegment::inspect(instance)?)
 }
 
-/// `plc get`: the lines it prints.
+/// `plc get`: the lines it prints (leaves of the image, variables of an ST PLC).
 pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
-    let leaves = resolve_all(paths)?;
+    let (sources, vars) = sources(instance, paths)?;
     let segment = attach(instance)?;
     Ok(paths
         .iter()
-        .zip(&leaves)
-        .map(|(p, l)| format!("{p} = {}", show(l, l.read(segment.memory()))))
+        .zip(&sources)
+        .map(|(p, s)| format!("{p} = {}", read(s, &segment, vars.as_ref())))
         .collect())
 }
 
 /// `plc set`: parses every pair (a typo is reported the same with or without a CNC), checks
 /// them against the protocol, then writes them in order; returns the lines it prints.
 pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
+    let image = |p: &[String]| Leaf::resolve(&p[0]).is_ok();
+    if !pairs.chunks(2).any(image) && pairs.first().is_some_and(|p| p.contains('.')) {
+        return set_st(instance, pairs);
+    }
     let writes = parse_pairs(pairs)?;
     let segment = attach(instance)?;
     check_protocol(segment.memory(), &writes)?;
@@ -219,6 +223,83 @@ pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
             format!("{} := {}", w.path, show(&w.leaf, w.value))
         })
         .collect())
+}
+
+/// Where a path of `plc get|watch` is: a leaf of the image, or a variable of the ST PLC
+/// (`MAIN.fbCam.Busy`, published by `plc --st`).
+enum Source {
+    Image(Leaf),
+    St(usize),
+}
+
+/// The sources of `paths`: a path the image does not know is looked for among the ST PLC's
+/// variables (opened only then).
+fn sources(
+    instance: &str,
+    paths: &[String],
+) -> Result<(Vec<Source>, Option<Variables>), ToolError> {
+    let mut vars: Option<Variables> = None;
+    let mut out = Vec::with_capacity(paths.len());
+    for p in paths {
+        match Leaf::resolve(p) {
+            Ok(leaf) => out.push(Source::Image(leaf)),
+            Err(image_error) => {
+                if vars.is_none() && p.contains('.') && !p.contains('^') {
+                    vars = Some(Variables::open(instance).map_err(ToolError::St)?);
+                }
+                let index = vars.as_ref().and_then(|v| v.find(p));
+                out.push(Source::St(index.ok_or(image_error)?));
+            }
+        }
+    }
+    Ok((out, vars))
+}
+
+/// The value of `source` as `plc get` prints it.
+fn read(source: &Source, segment: &PlcSegment, vars: Option<&Variables>) -> String {
+    match (source, vars) {
+        (Source::Image(leaf), _) => show(leaf, leaf.read(segment.memory())),
+        (Source::St(i), Some(v)) => {
+            let value = v.read(*i);
+            match v.symbol(*i).elem {
+                Elem::Bool if value != 0.0 => "TRUE".into(),
+                Elem::Bool => "FALSE".into(),
+                _ => value.to_string(),
+            }
+        }
+        (Source::St(_), None) => "?".into(),
+    }
+}
+
+/// `plc set` of the ST PLC's variables: every pair's path resolved and value parsed first,
+/// then each written through the PLC in the order given.
+fn set_st(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
+    let vars = Variables::open(instance).map_err(ToolError::St)?;
+    let mut writes = Vec::new();
+    for pair in pairs.chunks(2) {
+        let path = pair[0].as_str();
+        let text = pair
+            .get(1)
+            .ok_or_else(|| ToolError::MissingValue(path.to_string()))?;
+        let index = vars
+            .find(path)
+            .ok_or_else(|| ToolError::St(format!("unknown variable `{path}` of the ST PLC")))?;
+        let value = match text.trim().to_ascii_uppercase().as_str() {
+            "TRUE" => 1.0,
+            "FALSE" => 0.0,
+            t => t.parse::<f64>().map_err(|_| ToolError::NotAValue {
+                path: path.to_string(),
+                value: text.to_string(),
+            })?,
+        };
+        writes.push((path, index, value, text));
+    }
+    let mut lines = Vec::new();
+    for (path, index, value, text) in writes {
+        vars.write(index, value).map_err(ToolError::St)?;
+        lines.push(format!("{path} := {}", text.trim()));
+    }
+    Ok(lines)
 }
 
 /// Runs a tool command; prints its output and returns the exit code.
@@ -287,7 +368,7 @@ fn watch(
     count: Option<u64>,
 ) -> Result<(), ToolError> {
     use std::io::Write as _;
-    let leaves = resolve_all(paths)?;
+    let (sources, vars) = sources(instance, paths)?;
     let segment = attach(instance)?;
     hli_transport::signals::capture();
     let mut out = std::io::stdout().lock();
@@ -305,9 +386,9 @@ fn watch(
             break;
         }
         let mut line = segment.cnc_heartbeat().to_string();
-        for leaf in &leaves {
+        for source in &sources {
             line.push(' ');
-            line.push_str(&show(leaf, leaf.read(segment.memory())));
+            line.push_str(&read(source, &segment, vars.as_ref()));
         }
         // A closed pipe (`plc watch ... | head`) ends the watch quietly.
         if writeln!(out, "{line}").and_then(|()| out.flush()).is_err() {

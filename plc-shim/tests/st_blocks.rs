@@ -1,6 +1,7 @@
 //! The block library in ST on a stand-in CNC: an instance sends its call on the rising edge
 //! of Execute, a value outside its input's kind ends the command with Error and 0x4227 and
-//! sends nothing, and a cycle with library blocks allocates nothing.
+//! sends nothing, and a cycle with library blocks (and its variables published) allocates
+//! nothing.
 
 use hli::views::PlcView;
 use hli_transport::rpc::{AcyclicClient, AcyclicServer};
@@ -105,8 +106,11 @@ fn a_value_outside_its_inputs_kind_ends_the_command_with_0x4227() {
 #[test]
 fn a_cycle_with_library_blocks_allocates_nothing() {
     let mut cnc = Cnc::new("st-blocks-alloc");
-    // Busy: the call is out and waits for its answer, the kernel follows it each cycle.
+    // Busy: the call is out and waits for its answer, the kernel follows it each cycle; the
+    // variables are published for the tools each cycle too.
     let mut p = program(1, true);
+    p.publish_on(&tests::unique_instance("st-blocks-alloc-vars"))
+        .unwrap();
     cnc.cycle(&mut p);
     let before = counting_alloc::allocations();
     for _ in 0..50 {

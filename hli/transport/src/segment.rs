@@ -683,9 +683,32 @@ impl PlcSegment {
     }
 }
 
+/// The shared-memory object name of an instance's ST variables (`plc --st` publishes them
+/// for `plc get|set|watch`).
+pub fn st_object_name(instance: &str) -> Option<String> {
+    instance_ok(instance, 48).then(|| format!("cncplc_{instance}.st"))
+}
+
+/// Opens the existing shared-memory object `name` read-write (not owned: dropping it unmaps
+/// and leaves the object to its owner).
+pub fn open_raw_object(name: &str) -> Result<ImageMemory, AttachError> {
+    let fname = FileName::new(name.as_bytes()).map_err(|_| AttachError::NotFound {
+        name: name.to_string(),
+    })?;
+    SharedMemoryBuilder::new(&fname)
+        .is_memory_locked(false)
+        .open_existing(AccessMode::ReadWrite)
+        .map(crate::raw::shared)
+        .map_err(|_| AttachError::NotFound {
+            name: name.to_string(),
+        })
+}
+
 /// Creates a zeroed shared-memory object of `size` bytes under the full object `name`
-/// (see [`segment_name`]), owned by the result. For tests and tools that need what a foreign
-/// or broken program would leave behind (truncated objects, wrong magic).
+/// (see [`segment_name`]), owned by the result (removed when it is dropped); one of the same
+/// name left behind is replaced. For the ST variables' object, and for tests and tools that
+/// need what a foreign or broken program would leave behind (truncated objects, wrong
+/// magic).
 pub fn create_raw_object(name: &str, size: usize) -> Result<ImageMemory, CreateError> {
     let fname = FileName::new(name.as_bytes()).map_err(|_| CreateError::InvalidName {
         name: name.to_string(),

@@ -7,6 +7,7 @@
 
 pub mod host;
 pub mod library;
+pub mod vars;
 
 use crate::runtime::{PlcIo, PlcProgram};
 use hli::layout::HliSegmentHeader;
@@ -23,6 +24,8 @@ pub const PRELUDE: &str = "<hli>";
 pub struct StProgram {
     program: Program,
     blocks: Blocks,
+    /// The variables published for the tools, once [`StProgram::publish_on`] made them.
+    publisher: Option<vars::Publisher>,
     period_ticks: u64,
     cycles: u64,
     fault: Option<FaultAt>,
@@ -54,6 +57,7 @@ impl StProgram {
         Ok(StProgram {
             program,
             blocks,
+            publisher: None,
             period_ticks: period_ticks.max(1),
             cycles: 0,
             fault: None,
@@ -69,6 +73,13 @@ impl StProgram {
                 .is_some_and(|f| f != PRELUDE && f != LIBRARY)
         };
         self.program.code().checked.pous.iter().filter(own).count()
+    }
+
+    /// Publishes the program's variables for `plc get|set|watch` on instance `instance`
+    /// ([`vars`]), from the next cycle on.
+    pub fn publish_on(&mut self, instance: &str) -> Result<(), String> {
+        self.publisher = Some(vars::Publisher::create(instance, &self.program)?);
+        Ok(())
     }
 
     /// The program.
@@ -94,6 +105,9 @@ impl PlcProgram for StProgram {
             .saturating_mul(self.period_ticks)
             .saturating_mul(tick_ns);
         self.cycles += 1;
+        if let Some(p) = &self.publisher {
+            p.take_write(&mut self.program);
+        }
         let memory = io.memory;
         let mut host = self.blocks.host(io);
         if let Err(fault) = self
@@ -101,6 +115,9 @@ impl PlcProgram for StProgram {
             .cycle_with(now as i64, Some(memory), Some(&mut host))
         {
             self.fault = Some(fault);
+        }
+        if let Some(p) = &self.publisher {
+            p.publish(&self.program);
         }
     }
 

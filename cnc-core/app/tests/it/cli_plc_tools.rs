@@ -284,3 +284,56 @@ fn plc_call_commissions_a_flying_saw() {
     assert!(cnc.signal("TERM"));
     let _ = cnc.wait_with_output(tests::cli::default_watchdog());
 }
+
+/// The variables of a live ST PLC by name: `plc get` reads them, `plc set` writes through
+/// the PLC (a value the type cannot hold is refused, exit 2), `plc watch` follows them beside
+/// the image's leaves; when the run ends, the PLC's object is gone with it.
+#[test]
+fn get_set_and_watch_an_st_plcs_variables_by_name() {
+    let instance = tests::unique_instance("plcstvars");
+    let dir = Scratch::new("plc-st-vars");
+    std::fs::write(
+        dir.join("count.st"),
+        "PROGRAM MAIN VAR nCount : DINT; bRun : BOOL := TRUE; nSmall : INT; END_VAR\n\
+         IF bRun THEN nCount := nCount + 1; END_IF\nEND_PROGRAM\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scenario.toml"),
+        "cycle_ms = 1.0\nticks = 600000\n[[axis]]\nname = \"X\"\n[plc]\nst = [\"count.st\"]\n",
+    )
+    .unwrap();
+    let mut child = run_cnc(&instance, &dir);
+    wait_until("the ST PLC counts", || {
+        let (code, out, _) = tool(&instance, &["get", "MAIN.nCount"]);
+        code == 0 && out.trim() != "MAIN.nCount = 0"
+    });
+    assert_eq!(get(&instance, "main.brun"), "TRUE");
+
+    let (code, out, err) = tool(&instance, &["set", "MAIN.bRun", "FALSE"]);
+    assert_eq!((code, out.trim()), (0, "MAIN.bRun := FALSE"), "{err}");
+    let stopped = get(&instance, "MAIN.nCount");
+    let (code, out, err) = tool(
+        &instance,
+        &["watch", "MAIN.nCount", "MAIN.bRun", "--count", "2"],
+    );
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.lines()
+            .skip(1)
+            .all(|l| l.ends_with(&format!(" {stopped} FALSE"))),
+        "{out}"
+    );
+
+    let (code, _, err) = tool(&instance, &["set", "MAIN.nSmall", "40000"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("40000 is not a value of INT"), "{err}");
+    let (code, _, err) = tool(&instance, &["get", "MAIN.nothing"]);
+    assert_eq!(code, 2, "{err}");
+
+    assert!(child.signal("TERM"));
+    let _ = child.wait_with_output(tests::cli::default_watchdog());
+    let (code, _, err) = tool(&instance, &["get", "MAIN.nCount"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("is an ST PLC running"), "{err}");
+}

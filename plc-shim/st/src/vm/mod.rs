@@ -13,11 +13,13 @@ use crate::types::Elem;
 use hli::ImageMemory;
 use library::Library;
 pub use library::{BlockIo, Host};
+pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 
 mod image;
 mod library;
 mod ops;
 mod std_fb;
+mod symbols;
 
 pub use image::IMAGE_TAG;
 

@@ -1,0 +1,258 @@
+//! An ST program's variables for the tools: the PLC process publishes them in a
+//! shared-memory object of its own (`cncplc_<instance>.st`, removed when the PLC ends), and
+//! `plc get|set|watch` reach them by name (`MAIN.fbCam.Busy`) as they reach the image.
+//!
+//! ```text
+//!   0  magic "CNCPLCST"        24 cycles published (u64)
+//!  12  symbols (u32)           32 write request: state (u32: 0 free, 1 asked, 2 done, 3 refused)
+//!  16  table bytes (u32)       36 the symbol's index (u32)   40 the value (f64 bits)
+//!  20  data bytes (u32)        64 the table: `PATH TYPE OFFSET` per line, then the memory
+//! ```
+//!
+//! Every cycle, before the program runs, the PLC takes a write a tool asked for (the symbol's
+//! index and a number, checked against the symbol's type: a value that does not fit is
+//! refused, never wrapped), and after it copies the program's memory into the object (8-byte
+//! atomic stores, no allocation, no system call). A tool reads a variable from the copy.
+
+use hli::ImageMemory;
+use plc_st::types::Elem;
+use plc_st::vm::{Program, Symbol};
+
+const MAGIC: u64 = u64::from_le_bytes(*b"CNCPLCST");
+const SYMBOLS: usize = 12;
+const TABLE_BYTES: usize = 16;
+const DATA_BYTES: usize = 20;
+const CYCLES: usize = 24;
+const REQUEST: usize = 32;
+const REQUEST_INDEX: usize = 36;
+const REQUEST_VALUE: usize = 40;
+const TABLE: usize = 64;
+/// The most symbols published.
+pub const MAX_SYMBOLS: usize = 100_000;
+
+/// A write request's states.
+const FREE: u32 = 0;
+const ASKED: u32 = 1;
+const DONE: u32 = 2;
+const REFUSED: u32 = 3;
+
+/// The PLC's side: the object and the symbols in it.
+#[derive(Debug)]
+pub struct Publisher {
+    memory: ImageMemory,
+    symbols: Vec<(u32, Elem)>,
+    data: usize,
+    words: usize,
+}
+
+fn align8(n: usize) -> usize {
+    n.div_ceil(8) * 8
+}
+
+impl Publisher {
+    /// Creates the object of `instance` for `program`'s variables.
+    pub fn create(instance: &str, program: &Program) -> Result<Publisher, String> {
+        let name = hli_transport::segment::st_object_name(instance)
+            .ok_or_else(|| format!("invalid instance name {instance:?}"))?;
+        let symbols = program.symbols(MAX_SYMBOLS);
+        let table: String = symbols
+            .iter()
+            .map(|s| format!("{} {} {}\n", s.path, s.elem.name(), s.offset))
+            .collect();
+        let data = align8(TABLE + table.len());
+        let words = program.memory().len().div_ceil(8);
+        let memory = hli_transport::segment::create_raw_object(&name, data + words * 8)
+            .map_err(|e| format!("{name}: {e}"))?;
+        for (k, b) in table.bytes().enumerate() {
+            memory.place::<u8>(TABLE + k).store(b);
+        }
+        memory.place::<u32>(SYMBOLS).store(symbols.len() as u32);
+        memory.place::<u32>(TABLE_BYTES).store(table.len() as u32);
+        memory.place::<u32>(DATA_BYTES).store((words * 8) as u32);
+        memory.place::<u64>(0).store(MAGIC);
+        let symbols = symbols.iter().map(|s| (s.offset, s.elem)).collect();
+        Ok(Publisher {
+            memory,
+            symbols,
+            data,
+            words,
+        })
+    }
+
+    /// Takes a tool's write, if one is asked for (before the cycle).
+    pub fn take_write(&self, program: &mut Program) {
+        if self.memory.place::<u32>(REQUEST).load() != ASKED {
+            return;
+        }
+        let index = self.memory.place::<u32>(REQUEST_INDEX).load() as usize;
+        let value = f64::from_bits(self.memory.place::<u64>(REQUEST_VALUE).load());
+        let done = match self.symbols.get(index) {
+            Some(&(offset, elem)) => program.write_symbol(offset, elem, value).is_ok(),
+            None => false,
+        };
+        let state = if done { DONE } else { REFUSED };
+        self.memory.place::<u32>(REQUEST).store(state);
+    }
+
+    /// Copies the program's memory into the object (after the cycle).
+    pub fn publish(&self, program: &Program) {
+        let bytes = program.memory();
+        for k in 0..self.words {
+            let mut word = [0u8; 8];
+            let part = bytes
+                .get(k * 8..(k * 8 + 8).min(bytes.len()))
+                .unwrap_or(&[]);
+            word[..part.len()].copy_from_slice(part);
+            self.memory
+                .place::<u64>(self.data + k * 8)
+                .store(u64::from_le_bytes(word));
+        }
+        let cycles = self.memory.place::<u64>(CYCLES);
+        cycles.store(cycles.load() + 1);
+    }
+}
+
+/// A tool's side: the variables of a running ST PLC.
+pub struct Variables {
+    memory: ImageMemory,
+    symbols: Vec<Symbol>,
+    data: usize,
+}
+
+impl Variables {
+    /// Opens the variables `instance`'s PLC publishes.
+    pub fn open(instance: &str) -> Result<Variables, String> {
+        let name = hli_transport::segment::st_object_name(instance)
+            .ok_or_else(|| format!("invalid instance name {instance:?}"))?;
+        let memory = hli_transport::segment::open_raw_object(&name)
+            .map_err(|_| format!("no {name}: is an ST PLC running on instance {instance}?"))?;
+        let size = memory.len();
+        if size < TABLE || memory.place::<u64>(0).load() != MAGIC {
+            return Err(format!("{name}: not an ST PLC's variables"));
+        }
+        let table_bytes = memory.place::<u32>(TABLE_BYTES).load() as usize;
+        let data = align8(TABLE + table_bytes);
+        let data_bytes = memory.place::<u32>(DATA_BYTES).load() as usize;
+        if data.checked_add(data_bytes).is_none_or(|end| end > size) {
+            return Err(format!("{name}: its table runs past its end"));
+        }
+        let text: Vec<u8> = (0..table_bytes)
+            .map(|k| memory.place::<u8>(TABLE + k).load())
+            .collect();
+        let text = String::from_utf8(text).map_err(|_| format!("{name}: a table not UTF-8"))?;
+        let mut symbols = Vec::new();
+        for line in text.lines() {
+            let bad = || format!("{name}: a bad table line {line:?}");
+            let mut words = line.split(' ');
+            let (Some(path), Some(ty), Some(offset), None) =
+                (words.next(), words.next(), words.next(), words.next())
+            else {
+                return Err(bad());
+            };
+            let elem = Elem::named(ty).ok_or_else(bad)?;
+            let offset: u32 = offset.parse().map_err(|_| bad())?;
+            if offset as usize + elem.size() > data_bytes {
+                return Err(bad());
+            }
+            symbols.push(Symbol {
+                path: path.to_string(),
+                offset,
+                elem,
+            });
+        }
+        Ok(Variables {
+            memory,
+            symbols,
+            data,
+        })
+    }
+
+    /// The symbol of `path` (ASCII case ignored): its index.
+    pub fn find(&self, path: &str) -> Option<usize> {
+        self.symbols
+            .iter()
+            .position(|s| s.path.eq_ignore_ascii_case(path))
+    }
+
+    /// The symbol at `index`.
+    pub fn symbol(&self, index: usize) -> &Symbol {
+        &self.symbols[index]
+    }
+
+    /// Cycles the PLC has published.
+    pub fn cycles(&self) -> u64 {
+        self.memory.place::<u64>(CYCLES).load()
+    }
+
+    /// The value of symbol `index`, as the last cycle left it (read in the 8-byte words the
+    /// PLC writes).
+    pub fn read(&self, index: usize) -> f64 {
+        let s = &self.symbols[index];
+        let (at, n) = (s.offset as usize, s.elem.size());
+        let mut bytes = [0u8; 16];
+        let first = at / 8 * 8;
+        for (k, chunk) in bytes.chunks_exact_mut(8).enumerate() {
+            let word = first + k * 8;
+            if word < at + n {
+                let w = self.memory.place::<u64>(self.data + word).load();
+                chunk.copy_from_slice(&w.to_le_bytes());
+            }
+        }
+        decode(&bytes[at - first..at - first + n], s.elem)
+    }
+
+    /// Writes `value` to symbol `index` through the PLC (it takes it before its next cycle):
+    /// `Err` if the PLC refuses it (a value its type cannot hold) or does not answer.
+    pub fn write(&self, index: usize, value: f64) -> Result<(), String> {
+        let state = self.memory.place::<u32>(REQUEST);
+        let path = &self.symbols[index].path;
+        if state.load() == ASKED {
+            return Err(format!("{path}: another write is on its way"));
+        }
+        self.memory.place::<u32>(REQUEST_INDEX).store(index as u32);
+        self.memory
+            .place::<u64>(REQUEST_VALUE)
+            .store(value.to_bits());
+        state.store(ASKED);
+        // The PLC answers in its next cycle; a watchdog, not a timing.
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(2);
+        loop {
+            match state.load() {
+                DONE => break,
+                REFUSED => {
+                    state.store(FREE);
+                    let ty = self.symbols[index].elem.name();
+                    return Err(format!("{path}: {value} is not a value of {ty}"));
+                }
+                _ if std::time::Instant::now() > deadline => {
+                    state.store(FREE);
+                    return Err(format!("{path}: the PLC did not take the write"));
+                }
+                _ => std::thread::sleep(std::time::Duration::from_millis(1)),
+            }
+        }
+        state.store(FREE);
+        Ok(())
+    }
+}
+
+/// The value of `elem` in its little-endian `bytes`.
+fn decode(bytes: &[u8], elem: Elem) -> f64 {
+    let mut b = [0u8; 8];
+    b[..bytes.len()].copy_from_slice(bytes);
+    let unsigned = u64::from_le_bytes(b);
+    let bits = 8 * bytes.len() as u32;
+    let signed = if bits == 64 {
+        unsigned as i64
+    } else {
+        ((unsigned << (64 - bits)) as i64) >> (64 - bits)
+    };
+    match elem {
+        Elem::Real => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+        Elem::LReal => f64::from_le_bytes(b),
+        Elem::SInt | Elem::Int | Elem::DInt | Elem::LInt | Elem::Time | Elem::LTime => {
+            signed as f64
+        }
+        _ => unsigned as f64,
+    }
+}

@@ -1,0 +1,107 @@
+//! A program's variables by name, for the tools (`plc get|set|watch MAIN.fbCam.Busy`): every
+//! elementary variable of the globals and the PROGRAMs, into structures, function block
+//! instances (their inputs, outputs and locals) and arrays (each element, up to
+//! [`MAX_LISTED_ELEMENTS`] of an array), with its place in the program's memory.
+
+use super::{write_mem, Fault, Program, V};
+use crate::ast::PouKind;
+use crate::check::Type;
+use crate::types::Elem;
+
+/// The most elements of one array the symbols list.
+pub const MAX_LISTED_ELEMENTS: u64 = 256;
+
+/// An elementary variable: its path (`MAIN.fbCam.Busy`, `MAIN.a[3]`, `gCount`), its place in
+/// the program's memory and its type (an enumeration's base type).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Symbol {
+    /// Its path.
+    pub path: String,
+    /// Its offset in the program's memory.
+    pub offset: u32,
+    /// Its type.
+    pub elem: Elem,
+}
+
+impl Program {
+    /// Every elementary variable by path, at most `limit` of them, in declaration order.
+    pub fn symbols(&self, limit: usize) -> Vec<Symbol> {
+        let (c, l) = (&self.code.checked, &self.code.layout);
+        let mut out = Vec::new();
+        for (g, var) in c.globals.iter().enumerate() {
+            self.list(&var.name, &var.ty, l.globals[g], limit, &mut out);
+        }
+        for (i, pou) in c.pous.iter().enumerate() {
+            if pou.kind == PouKind::Program {
+                for (k, v) in pou.vars.iter().enumerate() {
+                    let path = format!("{}.{}", pou.name, v.name);
+                    self.list(&path, &v.ty, l.statics[i] + l.pous[i].2[k], limit, &mut out);
+                }
+            }
+        }
+        out
+    }
+
+    fn list(&self, path: &str, ty: &Type, at: u32, limit: usize, out: &mut Vec<Symbol>) {
+        let (c, l) = (&self.code.checked, &self.code.layout);
+        if out.len() >= limit {
+            return;
+        }
+        let leaf = |elem| Symbol {
+            path: path.to_string(),
+            offset: at,
+            elem,
+        };
+        match ty {
+            Type::Elem(e) => out.push(leaf(*e)),
+            Type::Enum(i) => out.push(leaf(c.enums[*i].base)),
+            Type::Struct(i) => {
+                for (k, (name, t)) in c.structs[*i].fields.iter().enumerate() {
+                    let at = at + l.structs[*i].2[k];
+                    self.list(&format!("{path}.{name}"), t, at, limit, out);
+                }
+            }
+            Type::Fb(i) => {
+                for (k, v) in c.pous[*i].vars.iter().enumerate() {
+                    let at = at + l.pous[*i].2[k];
+                    self.list(&format!("{path}.{}", v.name), &v.ty, at, limit, out);
+                }
+            }
+            Type::Array(dims, element) if dims.len() == 1 => {
+                let (size, align) = l.size_align(c, element);
+                let stride = size.div_ceil(align) * align;
+                let (lo, hi) = dims[0];
+                let n = (hi.abs_diff(lo) + 1).min(MAX_LISTED_ELEMENTS);
+                for k in 0..n as u32 {
+                    let index = lo + i64::from(k);
+                    let at = at + k * stride;
+                    self.list(&format!("{path}[{index}]"), element, at, limit, out);
+                }
+            }
+            // Pointers, strings, standard blocks, arrays of several dimensions: not listed.
+            _ => {}
+        }
+    }
+
+    /// The program's memory, as its variables are laid out in it.
+    pub fn memory(&self) -> &[u8] {
+        &self.state.memory
+    }
+
+    /// A tool's write of `value` to the variable at `offset` of type `elem` (a symbol's):
+    /// refused if the value is not finite or does not fit the type.
+    pub fn write_symbol(&mut self, offset: u32, elem: Elem, value: f64) -> Result<(), Fault> {
+        let v = match elem {
+            Elem::Real | Elem::LReal if value.is_finite() => V::F(value),
+            _ => match elem.range() {
+                Some((lo, hi))
+                    if value.fract() == 0.0 && (lo as f64..=hi as f64).contains(&value) =>
+                {
+                    V::I(value as i128 as i64)
+                }
+                _ => return Err(Fault::OutOfRange),
+            },
+        };
+        write_mem(&mut self.state.memory, offset as usize, elem, v)
+    }
+}

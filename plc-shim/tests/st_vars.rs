@@ -1,0 +1,105 @@
+//! An ST PLC's variables by name for the tools (`st::vars`): the PLC publishes every
+//! variable after each cycle and takes a tool's write before the next; a value the type
+//! cannot hold is refused; the object is gone when the PLC is.
+
+use hli::views::PlcView;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
+use plc_shim::runtime::{Link, PlcIo, PlcProgram};
+use plc_shim::st::vars::Variables;
+use plc_shim::st::StProgram;
+
+const PROGRAM: &str = "TYPE ST_P : STRUCT x : LREAL; n : INT; END_STRUCT END_TYPE
+PROGRAM MAIN
+VAR
+    nCount : DINT;
+    bRun : BOOL := TRUE;
+    fSpeed : LREAL := 1.5;
+    aP : ARRAY[0..2] OF ST_P;
+    fbT : TON;
+    fbMove : MC_MoveVelocity;
+END_VAR
+    IF bRun THEN nCount := nCount + 1; END_IF
+    aP[2].n := 7;
+END_PROGRAM
+";
+
+/// The PLC's side: a stand-in CNC and the program, publishing on `instance`.
+struct Plc {
+    memory: hli::ImageMemory,
+    _server: AcyclicServer,
+    client: AcyclicClient,
+    program: StProgram,
+}
+
+impl Plc {
+    fn new(instance: &str) -> Plc {
+        let mut program = StProgram::from_texts(&[("main.st".into(), PROGRAM.into())], 1).unwrap();
+        program.publish_on(instance).unwrap();
+        Plc {
+            memory: hli::image::heap_image(1, 2),
+            _server: AcyclicServer::open(instance).unwrap(),
+            client: AcyclicClient::open(instance).unwrap(),
+            program,
+        }
+    }
+
+    fn cycle(&mut self) {
+        let mut io = PlcIo {
+            view: PlcView::new(&self.memory),
+            memory: &self.memory,
+            acyclic: &mut self.client,
+            cycle: 0,
+            link: Link::Operational,
+        };
+        self.program.cycle(&mut io);
+    }
+}
+
+#[test]
+fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
+    let instance = tests::unique_instance("st-vars");
+    let mut plc = Plc::new(&instance);
+    for _ in 0..3 {
+        plc.cycle();
+    }
+    let vars = Variables::open(&instance).unwrap();
+    let value = |path: &str| vars.read(vars.find(path).unwrap_or_else(|| panic!("{path}")));
+    assert_eq!(value("MAIN.nCount"), 3.0);
+    assert_eq!(value("main.bRun"), 1.0, "ASCII case ignored");
+    assert_eq!(value("MAIN.fSpeed"), 1.5);
+    assert_eq!(value("MAIN.aP[2].n"), 7.0);
+    assert_eq!(value("MAIN.fbMove.Busy"), 0.0, "a library block's output");
+    assert!(
+        vars.find("MAIN.fbT.Q").is_none(),
+        "a standard block's members are not listed"
+    );
+    assert_eq!(vars.cycles(), 3);
+
+    // A write is taken by the PLC before its next cycle: the tool waits for it there.
+    let writer = std::thread::spawn(move || {
+        let run = vars.find("MAIN.bRun").unwrap();
+        let speed = vars.find("MAIN.fSpeed").unwrap();
+        let refused = vars.write(vars.find("MAIN.aP[0].n").unwrap(), 40_000.0);
+        (vars.write(run, 0.0), vars.write(speed, -2.25), refused)
+    });
+    while !writer.is_finished() {
+        plc.cycle();
+    }
+    let (run, speed, refused) = writer.join().unwrap();
+    assert_eq!((run, speed), (Ok(()), Ok(())));
+    assert!(refused.unwrap_err().contains("40000 is not a value of INT"));
+    let counted = plc.program.program().read_var("MAIN.nCount").unwrap();
+    plc.cycle();
+    assert_eq!(
+        plc.program.program().read_var("MAIN.nCount"),
+        Some(counted),
+        "bRun is FALSE"
+    );
+    assert_eq!(plc.program.program().read_var("MAIN.fSpeed"), Some(-2.25));
+
+    drop(plc);
+    assert!(
+        Variables::open(&instance).is_err(),
+        "the object is gone with the PLC"
+    );
+}
