@@ -209,9 +209,12 @@ pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
 /// `plc set`: parses every pair (a typo is reported the same with or without a CNC), checks
 /// them against the protocol, then writes them in order; returns the lines it prints.
 pub fn set(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
+    // No path of the image: the ST PLC's variables, if one publishes them.
     let image = |p: &[String]| Leaf::resolve(&p[0]).is_ok();
-    if !pairs.chunks(2).any(image) && pairs.first().is_some_and(|p| p.contains('.')) {
-        return set_st(instance, pairs);
+    if !pairs.chunks(2).any(image) {
+        if let Ok(vars) = Variables::open(instance) {
+            return set_st(&vars, pairs);
+        }
     }
     let writes = parse_pairs(pairs)?;
     let segment = attach(instance)?;
@@ -244,8 +247,10 @@ fn sources(
         match Leaf::resolve(p) {
             Ok(leaf) => out.push(Source::Image(leaf)),
             Err(image_error) => {
-                if vars.is_none() && p.contains('.') && !p.contains('^') {
-                    vars = Some(Variables::open(instance).map_err(ToolError::St)?);
+                if vars.is_none() {
+                    let opened = Variables::open(instance);
+                    let why = |e: String| ToolError::St(format!("{image_error}; {e}"));
+                    vars = Some(opened.map_err(why)?);
                 }
                 let index = vars.as_ref().and_then(|v| v.find(p));
                 out.push(Source::St(index.ok_or(image_error)?));
@@ -272,9 +277,8 @@ fn read(source: &Source, segment: &PlcSegment, vars: Option<&Variables>) -> Stri
 }
 
 /// `plc set` of the ST PLC's variables: every pair's path resolved and value parsed first,
-/// then each written through the PLC in the order given.
-fn set_st(instance: &str, pairs: &[String]) -> Result<Vec<String>, ToolError> {
-    let vars = Variables::open(instance).map_err(ToolError::St)?;
+/// then each written through the PLC in the order given (a refused one stops the rest).
+fn set_st(vars: &Variables, pairs: &[String]) -> Result<Vec<String>, ToolError> {
     let mut writes = Vec::new();
     for pair in pairs.chunks(2) {
         let path = pair[0].as_str();

@@ -145,3 +145,22 @@ fn rows_through_a_null_pointer_end_the_command_with_0x4227_and_send_nothing() {
     assert_eq!(var(&p, "bErr"), 1.0);
     assert_eq!(var(&p, "nErr"), f64::from(INVALID_INPUT));
 }
+
+#[test]
+fn an_input_given_before_the_edge_counts_at_the_edge() {
+    let mut cnc = Cnc::new("st-blocks-before");
+    // Direction 0 is given while Execute is FALSE; the edge in a later cycle takes it (and
+    // refuses it), as a PLC block holds its inputs from call to call.
+    let text = "PROGRAM MAIN VAR ax : AXIS_REF; fbRun : MC_MoveVelocity; n : INT; bErr : BOOL;
+        nErr : UDINT; END_VAR
+        ax.AxisIndex := 1; n := n + 1;
+        IF n = 1 THEN fbRun(Axis := ax, Velocity := 50.0, Direction := 0);
+        ELSE fbRun(Execute := TRUE, Error => bErr, ErrorID => nErr); END_IF
+        END_PROGRAM";
+    let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
+    cnc.cycle(&mut p);
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 0, "nothing sent");
+    assert_eq!(var(&p, "bErr"), 1.0);
+    assert_eq!(var(&p, "nErr"), f64::from(INVALID_INPUT));
+}

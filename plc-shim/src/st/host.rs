@@ -118,8 +118,13 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             let (Some(c), Some(r)) = (count(columns), count(rows)) else {
                 return false;
             };
-            // More values than a call takes: the block refuses them with its own code.
-            let n = (c as usize).saturating_mul(r as usize).min(max);
+            // More values than a call takes: none read, the block refuses them with its own
+            // code.
+            let n = (c as usize).saturating_mul(r as usize);
+            if n > max {
+                inst.rows.clear();
+                return inst.block.set_rows(&inst.rows, c, r);
+            }
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
     }
@@ -174,20 +179,24 @@ impl Host for BlockHost<'_, '_> {
             Some(e) => e && !inst.last_execute,
             None => true,
         };
+        // An input counts as given from the first call that names it, edge or not.
+        for (k, input) in binding.inputs.iter().enumerate() {
+            inst.given[k] |= given(io, &input.0);
+        }
         if takes_inputs {
             inst.refused = false;
             for (k, input) in binding.inputs.iter().enumerate() {
                 // Never given by a call: the block keeps its own default.
-                inst.given[k] |= given(io, &input.0);
                 if inst.given[k] && !pass(io, inst, input) {
-                    inst.refused = execute.is_some();
+                    inst.refused = true;
                 }
             }
         }
         inst.last_execute = execute.unwrap_or(false);
         let axis = axis_of(io, binding);
         let style = binding.spec.style;
-        if inst.refused && inst.last_execute {
+        // Refused: while Execute stays TRUE, or in this call of a block without Execute.
+        if inst.refused && (inst.last_execute || execute.is_none()) {
             // Execute stays FALSE for the block: its command never starts.
             if let Some(e) = inst.block.execute() {
                 *e = false;

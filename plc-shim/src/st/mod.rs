@@ -116,7 +116,7 @@ impl PlcProgram for StProgram {
         {
             self.fault = Some(fault);
         }
-        if let Some(p) = &self.publisher {
+        if let Some(p) = &mut self.publisher {
             p.publish(&self.program);
         }
     }

@@ -4,7 +4,8 @@
 //!
 //! ```text
 //!   0  magic "CNCPLCST"        24 cycles published (u64)
-//!  12  symbols (u32)           32 write request: state (u32: 0 free, 1 asked, 2 done, 3 refused)
+//!   8  the PLC's pid (u32)     32 write request: state (u32: 0 free, 4 claimed, 1 asked,
+//!  12  symbols (u32)              2 done, 3 refused)
 //!  16  table bytes (u32)       36 the symbol's index (u32)   40 the value (f64 bits)
 //!  20  data bytes (u32)        64 the table: `PATH TYPE OFFSET` per line, then the memory
 //! ```
@@ -12,13 +13,20 @@
 //! Every cycle, before the program runs, the PLC takes a write a tool asked for (the symbol's
 //! index and a number, checked against the symbol's type: a value that does not fit is
 //! refused, never wrapped), and after it copies the program's memory into the object (8-byte
-//! atomic stores, no allocation, no system call). A tool reads a variable from the copy.
+//! atomic stores, no allocation, no system call). A tool reads a variable from the copy. A
+//! tool claims the request slot (FREE to CLAIMED, compare-and-swap) before it fills it, so two
+//! tools never mix their writes; the PLC takes the index and value only after the state says
+//! ASKED (release and acquire). The magic is written last, so a tool never reads a table half
+//! written. Nothing the PLC reads from the object is trusted: the index and value are checked,
+//! the counter of cycles is the PLC's own.
 
 use hli::ImageMemory;
 use plc_st::types::Elem;
 use plc_st::vm::{Program, Symbol};
+use std::sync::atomic::Ordering::{AcqRel, Acquire};
 
 const MAGIC: u64 = u64::from_le_bytes(*b"CNCPLCST");
+const PID: usize = 8;
 const SYMBOLS: usize = 12;
 const TABLE_BYTES: usize = 16;
 const DATA_BYTES: usize = 20;
@@ -35,6 +43,7 @@ const FREE: u32 = 0;
 const ASKED: u32 = 1;
 const DONE: u32 = 2;
 const REFUSED: u32 = 3;
+const CLAIMED: u32 = 4;
 
 /// The PLC's side: the object and the symbols in it.
 #[derive(Debug)]
@@ -43,6 +52,7 @@ pub struct Publisher {
     symbols: Vec<(u32, Elem)>,
     data: usize,
     words: usize,
+    cycles: u64,
 }
 
 fn align8(n: usize) -> usize {
@@ -61,27 +71,30 @@ impl Publisher {
             .collect();
         let data = align8(TABLE + table.len());
         let words = program.memory().len().div_ceil(8);
+        refuse_a_live_owner(&name)?;
         let memory = hli_transport::segment::create_raw_object(&name, data + words * 8)
             .map_err(|e| format!("{name}: {e}"))?;
+        memory.place::<u32>(PID).store(std::process::id());
         for (k, b) in table.bytes().enumerate() {
             memory.place::<u8>(TABLE + k).store(b);
         }
         memory.place::<u32>(SYMBOLS).store(symbols.len() as u32);
         memory.place::<u32>(TABLE_BYTES).store(table.len() as u32);
         memory.place::<u32>(DATA_BYTES).store((words * 8) as u32);
-        memory.place::<u64>(0).store(MAGIC);
+        memory.place::<u64>(0).store_release(MAGIC);
         let symbols = symbols.iter().map(|s| (s.offset, s.elem)).collect();
         Ok(Publisher {
             memory,
             symbols,
             data,
             words,
+            cycles: 0,
         })
     }
 
     /// Takes a tool's write, if one is asked for (before the cycle).
     pub fn take_write(&self, program: &mut Program) {
-        if self.memory.place::<u32>(REQUEST).load() != ASKED {
+        if self.memory.place::<u32>(REQUEST).load_acquire() != ASKED {
             return;
         }
         let index = self.memory.place::<u32>(REQUEST_INDEX).load() as usize;
@@ -91,11 +104,11 @@ impl Publisher {
             None => false,
         };
         let state = if done { DONE } else { REFUSED };
-        self.memory.place::<u32>(REQUEST).store(state);
+        self.memory.place::<u32>(REQUEST).store_release(state);
     }
 
     /// Copies the program's memory into the object (after the cycle).
-    pub fn publish(&self, program: &Program) {
+    pub fn publish(&mut self, program: &Program) {
         let bytes = program.memory();
         for k in 0..self.words {
             let mut word = [0u8; 8];
@@ -107,8 +120,8 @@ impl Publisher {
                 .place::<u64>(self.data + k * 8)
                 .store(u64::from_le_bytes(word));
         }
-        let cycles = self.memory.place::<u64>(CYCLES);
-        cycles.store(cycles.load() + 1);
+        self.cycles = self.cycles.wrapping_add(1);
+        self.memory.place::<u64>(CYCLES).store_release(self.cycles);
     }
 }
 
@@ -127,13 +140,15 @@ impl Variables {
         let memory = hli_transport::segment::open_raw_object(&name)
             .map_err(|_| format!("no {name}: is an ST PLC running on instance {instance}?"))?;
         let size = memory.len();
-        if size < TABLE || memory.place::<u64>(0).load() != MAGIC {
+        if size < TABLE || memory.place::<u64>(0).load_acquire() != MAGIC {
             return Err(format!("{name}: not an ST PLC's variables"));
         }
         let table_bytes = memory.place::<u32>(TABLE_BYTES).load() as usize;
         let data = align8(TABLE + table_bytes);
         let data_bytes = memory.place::<u32>(DATA_BYTES).load() as usize;
-        if data.checked_add(data_bytes).is_none_or(|end| end > size) {
+        if !data_bytes.is_multiple_of(8)
+            || data.checked_add(data_bytes).is_none_or(|end| end > size)
+        {
             return Err(format!("{name}: its table runs past its end"));
         }
         let text: Vec<u8> = (0..table_bytes)
@@ -206,34 +221,66 @@ impl Variables {
     pub fn write(&self, index: usize, value: f64) -> Result<(), String> {
         let state = self.memory.place::<u32>(REQUEST);
         let path = &self.symbols[index].path;
-        if state.load() == ASKED {
+        // Claim the slot: another tool's write is not mixed with this one.
+        // A slot answered for a tool that did not come back for it may be claimed too.
+        let claim = |from| {
+            state
+                .atomic()
+                .compare_exchange(from, CLAIMED, AcqRel, Acquire)
+        };
+        if claim(FREE)
+            .or_else(|_| claim(DONE))
+            .or_else(|_| claim(REFUSED))
+            .is_err()
+        {
             return Err(format!("{path}: another write is on its way"));
         }
         self.memory.place::<u32>(REQUEST_INDEX).store(index as u32);
         self.memory
             .place::<u64>(REQUEST_VALUE)
             .store(value.to_bits());
-        state.store(ASKED);
+        state.store_release(ASKED);
         // The PLC answers in its next cycle; a watchdog, not a timing.
         let deadline = std::time::Instant::now() + std::time::Duration::from_secs(2);
-        loop {
-            match state.load() {
-                DONE => break,
+        let answer = loop {
+            match state.load_acquire() {
+                DONE => break Ok(()),
                 REFUSED => {
-                    state.store(FREE);
                     let ty = self.symbols[index].elem.name();
-                    return Err(format!("{path}: {value} is not a value of {ty}"));
+                    break Err(format!("{path}: {value} is not a value of {ty}"));
                 }
                 _ if std::time::Instant::now() > deadline => {
-                    state.store(FREE);
+                    // Given back only if still unanswered (a late answer is this tool's too).
+                    let _ = state
+                        .atomic()
+                        .compare_exchange(ASKED, FREE, AcqRel, Acquire);
                     return Err(format!("{path}: the PLC did not take the write"));
                 }
                 _ => std::thread::sleep(std::time::Duration::from_millis(1)),
             }
-        }
-        state.store(FREE);
-        Ok(())
+        };
+        state.store_release(FREE);
+        answer
     }
+}
+
+/// Refuses to publish where a live PLC publishes already (an object left by a PLC that is
+/// gone is replaced).
+fn refuse_a_live_owner(name: &str) -> Result<(), String> {
+    let Ok(existing) = hli_transport::segment::open_raw_object(name) else {
+        return Ok(());
+    };
+    if existing.len() < TABLE || existing.place::<u64>(0).load_acquire() != MAGIC {
+        return Ok(());
+    }
+    let pid = existing.place::<u32>(PID).load();
+    let alive = pid != std::process::id() && std::path::Path::new(&format!("/proc/{pid}")).exists();
+    if alive {
+        return Err(format!(
+            "{name}: a PLC (pid {pid}) publishes its variables there"
+        ));
+    }
+    Ok(())
 }
 
 /// The value of `elem` in its little-endian `bytes`.

@@ -400,3 +400,66 @@ fn an_initialiser_that_does_not_fit_is_refused_with_its_place() {
         "{e}"
     );
 }
+
+#[test]
+fn a_tool_writes_only_what_the_type_holds_and_sees_no_constants() {
+    let mut p = load(
+        "VAR_GLOBAL CONSTANT K : INT := 3; END_VAR\n\
+         PROGRAM MAIN VAR n : LINT; r : REAL; t : TIME; u : USINT; END_VAR END_PROGRAM",
+    );
+    let symbols = p.symbols(100);
+    let find = |path: &str| {
+        let s = symbols.iter().find(|s| s.path == path).unwrap();
+        (s.offset, s.elem)
+    };
+    assert!(
+        symbols.iter().all(|s| s.path != "K"),
+        "a CONSTANT is not listed"
+    );
+    let (n, r, t, u) = (
+        find("MAIN.n"),
+        find("MAIN.r"),
+        find("MAIN.t"),
+        find("MAIN.u"),
+    );
+    assert_eq!(
+        p.write_symbol(n.0, n.1, 9_223_372_036_854_775_808.0),
+        Err(Fault::OutOfRange)
+    );
+    assert_eq!(
+        p.write_symbol(r.0, r.1, 1e39),
+        Err(Fault::OutOfRange),
+        "beyond REAL"
+    );
+    assert_eq!(p.write_symbol(u.0, u.1, 256.0), Err(Fault::OutOfRange));
+    assert_eq!(
+        p.write_symbol(u.0, u.1, 2.5),
+        Err(Fault::OutOfRange),
+        "not whole"
+    );
+    p.write_symbol(t.0, t.1, 1500.0).unwrap();
+    p.write_symbol(n.0, n.1, -9.0e18).unwrap();
+    assert_eq!(p.read_var("MAIN.t"), Some(1500.0));
+    assert_eq!(p.read_var("MAIN.n"), Some(-9.0e18));
+}
+
+#[test]
+fn nested_repetitions_count_toward_the_initialisers_limit() {
+    let e = refused(
+        "PROGRAM MAIN VAR a : ARRAY[0..299] OF ARRAY[0..299] OF BOOL := [300([300(TRUE)])];\n\
+         END_VAR END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:1:18: error: an initialiser of more than 65536 values"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_constant_index_far_out_of_bounds_faults_in_the_cycle() {
+    let (f, _) = fault(
+        "PROGRAM MAIN VAR a : ARRAY[-5..5] OF INT; END_VAR\n  \
+         a[LINT#9223372036854775807] := 1;\nEND_PROGRAM",
+    );
+    assert!(matches!(f, Fault::IndexOutOfRange { .. }), "{f:?}");
+}

@@ -294,8 +294,9 @@ fn get_set_and_watch_an_st_plcs_variables_by_name() {
     let dir = Scratch::new("plc-st-vars");
     std::fs::write(
         dir.join("count.st"),
-        "PROGRAM MAIN VAR nCount : DINT; bRun : BOOL := TRUE; nSmall : INT; END_VAR\n\
-         IF bRun THEN nCount := nCount + 1; END_IF\nEND_PROGRAM\n",
+        "VAR_GLOBAL gTotal : LREAL; END_VAR\n\
+         PROGRAM MAIN VAR nCount : DINT; bRun : BOOL := TRUE; nSmall : INT; END_VAR\n\
+         IF bRun THEN nCount := nCount + 1; gTotal := gTotal + 0.5; END_IF\nEND_PROGRAM\n",
     )
     .unwrap();
     std::fs::write(
@@ -309,6 +310,7 @@ fn get_set_and_watch_an_st_plcs_variables_by_name() {
         code == 0 && out.trim() != "MAIN.nCount = 0"
     });
     assert_eq!(get(&instance, "main.brun"), "TRUE");
+    assert_ne!(get(&instance, "gTotal"), "0", "a global by its bare name");
 
     let (code, out, err) = tool(&instance, &["set", "MAIN.bRun", "FALSE"]);
     assert_eq!((code, out.trim()), (0, "MAIN.bRun := FALSE"), "{err}");
@@ -335,5 +337,6 @@ fn get_set_and_watch_an_st_plcs_variables_by_name() {
     let _ = child.wait_with_output(tests::cli::default_watchdog());
     let (code, _, err) = tool(&instance, &["get", "MAIN.nCount"]);
     assert_eq!(code, 2, "{err}");
+    assert!(err.contains("no symbol `MAIN.nCount`"), "{err}");
     assert!(err.contains("is an ST PLC running"), "{err}");
 }

@@ -17,18 +17,26 @@ pub const MAX_INIT_VALUES: u64 = 1 << 16;
 impl Checker {
     /// `init` against a variable of type `ty` declared at `pos`.
     pub(super) fn check_init(&mut self, init: &Init, ty: &Type, pos: Pos, ctx: Ctx) {
-        let mut budget = MAX_INIT_VALUES;
-        self.check_init_in(init, ty, pos, ctx, &mut budget);
+        let values = self.check_init_in(init, ty, pos, ctx);
+        if values > MAX_INIT_VALUES {
+            let most = MAX_INIT_VALUES;
+            self.refuse(pos, format!("an initialiser of more than {most} values"));
+        }
     }
 
-    fn check_init_in(&mut self, init: &Init, ty: &Type, pos: Pos, ctx: Ctx, budget: &mut u64) {
+    /// `init` checked; how many values it gives (repetitions and nesting multiplied,
+    /// saturating).
+    fn check_init_in(&mut self, init: &Init, ty: &Type, pos: Pos, ctx: Ctx) -> u64 {
         match (init, ty) {
-            (Init::Expr(e), _) => self.assignable(e, ty, ctx),
+            (Init::Expr(e), _) => {
+                self.assignable(e, ty, ctx);
+                1
+            }
             (Init::Array(items), Type::Array(dims, element)) => {
                 let total = dims
                     .iter()
                     .fold(1u64, |n, (lo, hi)| n.saturating_mul(hi.abs_diff(*lo) + 1));
-                let mut given = 0u64;
+                let (mut given, mut values) = (0u64, 0u64);
                 for (count, item) in items {
                     let times = match count {
                         None => Some(1),
@@ -37,20 +45,19 @@ impl Checker {
                     let Some(times) = times else {
                         let at = count.as_ref().map_or(pos, |c| c.pos());
                         self.refuse(at, "a repetition count is a constant of 0 or more");
-                        return;
+                        return 0;
                     };
                     given = given.saturating_add(times);
-                    *budget = budget.saturating_sub(times);
-                    self.check_init_in(item, element, pos, ctx, budget);
+                    let each = self.check_init_in(item, element, pos, ctx);
+                    values = values.saturating_add(times.saturating_mul(each));
                 }
                 if given > total {
                     self.refuse(pos, format!("{given} initial values for {total} elements"));
-                } else if *budget == 0 {
-                    let most = MAX_INIT_VALUES;
-                    self.refuse(pos, format!("an initialiser of more than {most} values"));
                 }
+                values
             }
             (Init::Struct(fields), Type::Struct(i)) => {
+                let mut values = 0u64;
                 for (name, item) in fields {
                     let found = self.out.structs[*i]
                         .fields
@@ -58,22 +65,28 @@ impl Checker {
                         .find(|(f, _)| f.eq_ignore_ascii_case(&name.text))
                         .map(|(_, t)| t.clone());
                     match found {
-                        Some(t) => self.check_init_in(item, &t, name.pos, ctx, budget),
+                        Some(t) => {
+                            let each = self.check_init_in(item, &t, name.pos, ctx);
+                            values = values.saturating_add(each);
+                        }
                         None => {
                             let s = self.out.structs[*i].name.clone();
                             self.refuse(name.pos, format!("{s} has no field `{}`", name.text));
                         }
                     }
                 }
+                values
             }
-            (_, Type::Error) => {}
+            (_, Type::Error) => 0,
             (Init::Array(_), _) => {
                 let t = self.type_name(ty);
                 self.refuse(pos, format!("an array initialiser for a {t}"));
+                0
             }
             (Init::Struct(_), _) => {
                 let t = self.type_name(ty);
                 self.refuse(pos, format!("a structure initialiser for a {t}"));
+                0
             }
         }
     }

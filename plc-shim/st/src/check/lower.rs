@@ -129,8 +129,9 @@ impl Checker {
                     let (lo, len) = (dims[k].0, lens[k]);
                     if let Ex::Int(i) = index {
                         // A constant index within the bounds is an offset, found now.
-                        if i >= lo && ((i - lo) as u64) < len {
-                            addr = plus(addr, (i - lo) as u32 * strides[k]);
+                        let step = i.checked_sub(lo).and_then(|d| u64::try_from(d).ok());
+                        if let Some(step) = step.filter(|s| *s < len) {
+                            addr = plus(addr, step as u32 * strides[k]);
                             continue;
                         }
                     }

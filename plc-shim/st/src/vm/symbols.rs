@@ -28,12 +28,13 @@ impl Program {
     pub fn symbols(&self, limit: usize) -> Vec<Symbol> {
         let (c, l) = (&self.code.checked, &self.code.layout);
         let mut out = Vec::new();
-        for (g, var) in c.globals.iter().enumerate() {
+        // CONSTANTs are not listed: a tool neither needs to read nor may write them.
+        for (g, var) in c.globals.iter().enumerate().filter(|(_, v)| !v.constant) {
             self.list(&var.name, &var.ty, l.globals[g], limit, &mut out);
         }
         for (i, pou) in c.pous.iter().enumerate() {
             if pou.kind == PouKind::Program {
-                for (k, v) in pou.vars.iter().enumerate() {
+                for (k, v) in pou.vars.iter().enumerate().filter(|(_, v)| !v.constant) {
                     let path = format!("{}.{}", pou.name, v.name);
                     self.list(&path, &v.ty, l.statics[i] + l.pous[i].2[k], limit, &mut out);
                 }
@@ -62,7 +63,12 @@ impl Program {
                 }
             }
             Type::Fb(i) => {
-                for (k, v) in c.pous[*i].vars.iter().enumerate() {
+                for (k, v) in c.pous[*i]
+                    .vars
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, v)| !v.constant)
+                {
                     let at = at + l.pous[*i].2[k];
                     self.list(&format!("{path}.{}", v.name), &v.ty, at, limit, out);
                 }
@@ -89,16 +95,22 @@ impl Program {
     }
 
     /// A tool's write of `value` to the variable at `offset` of type `elem` (a symbol's):
-    /// refused if the value is not finite or does not fit the type.
+    /// refused if the value is not finite, not whole for an integer, or beyond the type (an
+    /// enumeration's base type; TIME and LTIME in ms and ns).
     pub fn write_symbol(&mut self, offset: u32, elem: Elem, value: f64) -> Result<(), Fault> {
+        let range = match elem {
+            Elem::Time => Some((i128::from(i32::MIN), i128::from(i32::MAX))),
+            Elem::LTime => Some((i128::from(i64::MIN), i128::from(i64::MAX))),
+            _ => elem.range(),
+        };
+        // `hi as f64 + 1.0` is exclusive: i64::MAX as f64 is already 2^63.
+        let fits = |(lo, hi): (i128, i128)| value >= lo as f64 && value < hi as f64 + 1.0;
         let v = match elem {
-            Elem::Real | Elem::LReal if value.is_finite() => V::F(value),
-            _ => match elem.range() {
-                Some((lo, hi))
-                    if value.fract() == 0.0 && (lo as f64..=hi as f64).contains(&value) =>
-                {
-                    V::I(value as i128 as i64)
-                }
+            Elem::Real if (value as f32).is_finite() => V::F(value),
+            Elem::LReal if value.is_finite() => V::F(value),
+            Elem::Real | Elem::LReal => return Err(Fault::OutOfRange),
+            _ => match range {
+                Some(r) if value.fract() == 0.0 && fits(r) => V::I(value as i128 as i64),
                 _ => return Err(Fault::OutOfRange),
             },
         };
