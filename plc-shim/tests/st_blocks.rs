@@ -164,3 +164,36 @@ fn an_input_given_before_the_edge_counts_at_the_edge() {
     assert_eq!(var(&p, "bErr"), 1.0);
     assert_eq!(var(&p, "nErr"), f64::from(INVALID_INPUT));
 }
+
+#[test]
+fn t_timeout_ends_an_unanswered_command_after_its_time() {
+    let mut cnc = Cnc::new("st-blocks-timeout");
+    // The stand-in CNC announces a 1 ms cycle and never answers: 5 ms are 5 PLC cycles.
+    let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_cycle_ns);
+    cnc.memory.place::<u32>(at).store(1_000_000);
+    let text = "PROGRAM MAIN VAR fbStart : FiFoStart; bBusy, bErr : BOOL; nErr : UDINT; END_VAR
+        fbStart(bExecute := TRUE, tTimeout := T#5MS, bBusy => bBusy, bErr => bErr,
+            iErrId => nErr);
+        END_PROGRAM";
+    let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
+    let mut busy_cycles = 0;
+    while var(&p, "bErr") == 0.0 && busy_cycles < 100 {
+        cnc.cycle(&mut p);
+        busy_cycles += u32::from(var(&p, "bBusy") == 1.0);
+    }
+    // Busy in the edge's cycle and the 5 it waits (the kernel ends a call not answered
+    // within tTimeout's cycles in the next one).
+    assert_eq!(busy_cycles, 6, "busy for the edge and tTimeout's 5 cycles");
+    assert_eq!(
+        var(&p, "nErr"),
+        f64::from(plc_shim::kernel::ERROR_NO_ANSWER)
+    );
+    let refused = text.replace("T#5MS", "T#0MS");
+    let mut p = StProgram::from_texts(&[("main.st".into(), refused)], 1).unwrap();
+    cnc.cycle(&mut p);
+    assert_eq!(
+        var(&p, "nErr"),
+        f64::from(INVALID_INPUT),
+        "a tTimeout of 0 is refused"
+    );
+}

@@ -33,6 +33,8 @@ struct Instance {
     given: Vec<bool>,
     /// Rows read through a pointer (room made at load).
     rows: Vec<f64>,
+    /// tTimeout given by a call once.
+    timeout_given: bool,
 }
 
 /// The blocks of a program's instances (one per instance, made at load).
@@ -56,15 +58,22 @@ impl Blocks {
                     refused: false,
                     given: vec![false; binding.inputs.len()],
                     rows: Vec::with_capacity(binding.rows_room()),
+                    timeout_given: false,
                 }
             })
             .collect();
         Blocks { library, instances }
     }
 
-    /// The host for one cycle on `io`.
-    pub fn host<'a, 'b>(&'a mut self, io: &'a mut PlcIo<'b>) -> BlockHost<'a, 'b> {
-        BlockHost { blocks: self, io }
+    /// The host for one cycle on `io`, the PLC's cycle `cycle_ns` long (tTimeout counts in
+    /// cycles).
+    pub fn host<'a, 'b>(&'a mut self, io: &'a mut PlcIo<'b>, cycle_ns: u64) -> BlockHost<'a, 'b> {
+        BlockHost {
+            blocks: self,
+            io,
+            // Not announced yet: the default cycle of 1 ms.
+            cycle_ns: if cycle_ns == 0 { 1_000_000 } else { cycle_ns },
+        }
     }
 }
 
@@ -72,6 +81,16 @@ impl Blocks {
 pub struct BlockHost<'a, 'b> {
     blocks: &'a mut Blocks,
     io: &'a mut PlcIo<'b>,
+    cycle_ns: u64,
+}
+
+/// tTimeout (ms) as PLC cycles of `cycle_ns`, rounded up: `None` unless above 0 and within
+/// the timelines' most cycles.
+fn timeout_cycles(ms: i64, cycle_ns: u64) -> Option<u64> {
+    let ns = u64::try_from(ms).ok()?.checked_mul(1_000_000)?;
+    let cycles = ns.div_ceil(cycle_ns);
+    let most = crate::timeline::instances::MAX_TIMEOUT_CYCLES as u64;
+    (1..=most).contains(&cycles).then_some(cycles)
 }
 
 /// Input `var` of `spec`'s kind from the instance, or `None` if it is outside the kind.
@@ -183,12 +202,21 @@ impl Host for BlockHost<'_, '_> {
         for (k, input) in binding.inputs.iter().enumerate() {
             inst.given[k] |= given(io, &input.0);
         }
+        inst.timeout_given |= binding.timeout.is_some_and(|v| io.given(v));
         if takes_inputs {
             inst.refused = false;
             for (k, input) in binding.inputs.iter().enumerate() {
                 // Never given by a call: the block keeps its own default.
                 if inst.given[k] && !pass(io, inst, input) {
                     inst.refused = true;
+                }
+            }
+            if let Some(var) = binding.timeout.filter(|_| inst.timeout_given) {
+                match io.int(var).and_then(|ms| timeout_cycles(ms, self.cycle_ns)) {
+                    Some(cycles) => {
+                        inst.block.timeout_cycles(cycles);
+                    }
+                    None => inst.refused = true,
                 }
             }
         }

@@ -75,6 +75,8 @@ pub(super) struct Binding {
     pub(super) target: Option<usize>,
     /// Execute.
     pub(super) execute: Option<usize>,
+    /// tTimeout (TIME), of a block that has it.
+    pub(super) timeout: Option<usize>,
     /// Each input the declaration has, with its spec.
     pub(super) inputs: Vec<(Bound, InputSpec)>,
     /// The first output's variable.
@@ -228,6 +230,10 @@ impl Library {
             let name = if hungarian { "bExecute" } else { "Execute" };
             push(&mut vars, name.into(), "BOOL")
         });
+        // The seed's tTimeout, of a block that takes it (asked of a probe instance).
+        let timeout = (spec.make)(None)
+            .timeout_cycles(crate::kernel::DEFAULT_TIMEOUT_CYCLES)
+            .then(|| push(&mut vars, "tTimeout".into(), "TIME"));
         let mut inputs = Vec::new();
         for input in spec.inputs.iter().filter(|i| expressible(i)) {
             let bound = match input.st {
@@ -289,6 +295,7 @@ impl Library {
             spec,
             target,
             execute,
+            timeout,
             inputs,
             outputs,
         });
@@ -331,7 +338,7 @@ mod tests {
             "FUNCTION_BLOCK MC_MoveAbsolute\nVAR_INPUT\n    Axis : AXIS_REF;\n    Execute : BOOL;\n"
         ));
         assert!(lib.text().contains(
-            "FUNCTION_BLOCK FiFoWrite\nVAR_INPUT\n    bExecute : BOOL;\n    iChannelId : UDINT;\n    \
+            "FUNCTION_BLOCK FiFoWrite\nVAR_INPUT\n    bExecute : BOOL;\n    tTimeout : TIME;\n    iChannelId : UDINT;\n    \
              AdrDataArray : POINTER TO LREAL;\n    iColDim : UDINT;\n    iRowsToWrite : UDINT;\n\
              END_VAR\nVAR_OUTPUT\n    bBusy : BOOL;\n    bErr : BOOL;\n    iErrId : UDINT;\n"
         ));

@@ -109,7 +109,9 @@ impl PlcProgram for StProgram {
             p.take_write(&mut self.program);
         }
         let memory = io.memory;
-        let mut host = self.blocks.host(io);
+        let mut host = self
+            .blocks
+            .host(io, self.period_ticks.saturating_mul(tick_ns));
         if let Err(fault) = self
             .program
             .cycle_with(now as i64, Some(memory), Some(&mut host))
