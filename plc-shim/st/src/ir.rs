@@ -31,6 +31,17 @@ pub enum Addr {
     },
     /// Where a pointer value points.
     Deref(Box<Ex>),
+    /// `plus` bytes past where the pointer variable at `ptr` points (from the running
+    /// instance's base with `relative`): `p^.field` of a pointer variable `p`, the manuals'
+    /// common access to the HLI, in one step.
+    Via {
+        /// The pointer variable's offset.
+        ptr: u32,
+        /// From the instance's base.
+        relative: bool,
+        /// Bytes past the place pointed at.
+        plus: u32,
+    },
 }
 
 /// An expression: its value is an integer (any integer type, BOOL, TIME, a pointer) or a real.

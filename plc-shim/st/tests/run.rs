@@ -237,6 +237,10 @@ fn faults_stop_the_cycle_and_name_the_statement() {
     assert!(matches!(f, Fault::Budget(_)), "{f:?}");
     let (f, _) = fault("PROGRAM MAIN VAR p : POINTER TO INT; END_VAR\n  p^ := 1;\nEND_PROGRAM");
     assert_eq!(f, Fault::BadPointer);
+    // A field through a NULL pointer (one step from the pointer variable: `p^.b`).
+    let (f, text) = fault("TYPE S : STRUCT a : LREAL; b : INT; END_STRUCT END_TYPE\nPROGRAM MAIN VAR p : POINTER TO S; i : INT; END_VAR\n  i := 1;\n  i := p^.b;\nEND_PROGRAM");
+    assert_eq!(f, Fault::BadPointer);
+    assert!(text.starts_with("main.st:4:3: fault:"), "{text}");
     let (f, _) = fault("PROGRAM MAIN VAR r : LREAL := 1.0E300; i : INT; END_VAR\n  i := LREAL_TO_INT(r);\nEND_PROGRAM");
     assert_eq!(f, Fault::OutOfRange);
     // 2^63 is one past LINT's largest value (it used to wrap to the smallest).

@@ -4,7 +4,7 @@
 //! yet (strings in expressions) is refused here with its place.
 
 use super::expr::{literal, Ctx, Meaning};
-use super::place::{plus, strides};
+use super::place::{deref, plus, strides};
 use super::{Checker, Type};
 use crate::ast::{Arg, BinOp, CaseLabel, Expr, Name, Pou, PouKind, Stmt, UnOp};
 use crate::diag::{Diagnostic, Pos};
@@ -146,7 +146,7 @@ impl Checker {
                 Ok((addr, *element))
             }
             Expr::Deref(p, _) => match self.expr(p, ctx) {
-                Type::Pointer(t) => Ok((Addr::Deref(Box::new(self.value(p, ctx, l)?)), *t)),
+                Type::Pointer(t) => Ok((deref(self.value(p, ctx, l)?), *t)),
                 _ => Err(self.unsupported(e.pos(), "`^` of this value")),
             },
             _ => Err(self.unsupported(e.pos(), "a place of this kind")),

@@ -17,7 +17,36 @@ pub(super) fn plus(addr: Addr, offset: u32) -> Addr {
         Addr::Offset(inner, at) if at.checked_add(offset).is_some() => {
             Addr::Offset(inner, at + offset)
         }
+        Addr::Via {
+            ptr,
+            relative,
+            plus,
+        } if plus.checked_add(offset).is_some() => Addr::Via {
+            ptr,
+            relative,
+            plus: plus + offset,
+        },
         other => Addr::Offset(Box::new(other), offset),
+    }
+}
+
+/// Where pointer value `p` points: a pointer variable's (`p^`) in one step.
+pub(super) fn deref(p: Ex) -> Addr {
+    match p {
+        Ex::LoadPtr(a) => match *a {
+            Addr::Static(ptr) => Addr::Via {
+                ptr,
+                relative: false,
+                plus: 0,
+            },
+            Addr::Instance(ptr) => Addr::Via {
+                ptr,
+                relative: true,
+                plus: 0,
+            },
+            other => Addr::Deref(Box::new(Ex::LoadPtr(Box::new(other)))),
+        },
+        other => Addr::Deref(Box::new(other)),
     }
 }
 

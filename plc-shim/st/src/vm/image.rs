@@ -14,12 +14,12 @@ pub const IMAGE_TAG: i64 = 1 << 62;
 
 /// Per byte of the image: the size of the leaf that starts there (0 elsewhere), and whether
 /// the PLC may write it.
-struct ImageMap {
+pub(super) struct ImageMap {
     leaf: Vec<u8>,
     writable: Vec<bool>,
 }
 
-fn map() -> &'static ImageMap {
+pub(super) fn map() -> &'static ImageMap {
     static MAP: OnceLock<ImageMap> = OnceLock::new();
     MAP.get_or_init(|| {
         let size = hli::image::IMAGE_SIZE;
@@ -51,17 +51,18 @@ pub fn pointer_to(path: &str) -> Option<i64> {
 
 impl Exec<'_> {
     /// The leaf of type `t` at image offset `at`, checked.
-    fn image_leaf(&self, at: usize, t: Elem) -> Result<&hli::ImageMemory, Fault> {
-        let image = self.image.ok_or(Fault::BadPointer)?;
-        let size = map().leaf.get(at).copied().unwrap_or(0);
+    #[inline]
+    fn image_leaf(&self, at: usize, t: Elem) -> Result<(&hli::ImageMemory, &ImageMap), Fault> {
+        let (image, map) = self.image.ok_or(Fault::BadPointer)?;
+        let size = map.leaf.get(at).copied().unwrap_or(0);
         if usize::from(size) != t.size() || at + t.size() > image.len() {
             return Err(Fault::BadPointer);
         }
-        Ok(image)
+        Ok((image, map))
     }
 
     pub(super) fn image_read(&self, at: usize, t: Elem) -> Result<V, Fault> {
-        let m = self.image_leaf(at, t)?;
+        let (m, _) = self.image_leaf(at, t)?;
         let v = match t {
             Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(m.place::<u8>(at).load())),
             Elem::SInt => V::I(i64::from(m.place::<i8>(at).load())),
@@ -81,8 +82,8 @@ impl Exec<'_> {
     }
 
     pub(super) fn image_write(&mut self, at: usize, t: Elem, v: V) -> Result<(), Fault> {
-        let m = self.image_leaf(at, t)?;
-        if !map().writable[at] {
+        let (m, map) = self.image_leaf(at, t)?;
+        if !map.writable[at] {
             return Err(Fault::ReadOnly);
         }
         let finite = match t {

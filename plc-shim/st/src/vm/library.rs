@@ -55,6 +55,12 @@ impl BlockIo<'_> {
         Some((self.at + offset as usize, t))
     }
 
+    /// The call site (the same number for every call from one place of the program: each
+    /// gives the same inputs).
+    pub fn site(&self) -> usize {
+        self.passed.as_ptr() as usize
+    }
+
     /// Whether this call gives variable `k` (an input named in the call).
     pub fn given(&self, k: usize) -> bool {
         let offset = self.members.get(k).copied().flatten().map(|(o, _)| o);

@@ -18,67 +18,14 @@ pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 mod fault;
 mod image;
 mod library;
+mod mem;
 mod ops;
 mod std_fb;
 mod symbols;
 
 pub use fault::{Fault, FaultAt};
 pub use image::IMAGE_TAG;
-
-/// The first `N` bytes of a slice that has them (the caller took exactly `N`).
-fn arr<const N: usize>(b: &[u8]) -> [u8; N] {
-    let mut out = [0u8; N];
-    out.copy_from_slice(&b[..N]);
-    out
-}
-
-/// Where a place is: in the program's own memory, or in the HLI image.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Loc {
-    Own(usize),
-    Image(usize),
-}
-
-impl Loc {
-    fn plus(self, n: usize) -> Loc {
-        match self {
-            Loc::Own(a) => Loc::Own(a + n),
-            Loc::Image(a) => Loc::Image(a + n),
-        }
-    }
-}
-
-/// Sets the value of type `t` at `at` of a program's memory.
-#[inline]
-fn write_mem(m: &mut [u8], at: usize, t: Elem, v: V) -> Run<()> {
-    let n = t.size();
-    let slot = m.get_mut(at..at + n).ok_or(Fault::BadPointer)?;
-    match t {
-        Elem::Real => slot.copy_from_slice(&(v.float() as f32).to_le_bytes()),
-        Elem::LReal => slot.copy_from_slice(&v.float().to_le_bytes()),
-        _ => slot.copy_from_slice(&v.int().to_le_bytes()[..n]),
-    }
-    Ok(())
-}
-
-/// The value of type `t` at `at` of a program's memory.
-#[inline]
-fn read_mem(m: &[u8], at: usize, t: Elem) -> Run<V> {
-    let bytes = |n: usize| m.get(at..at + n).ok_or(Fault::BadPointer);
-    Ok(match t {
-        Elem::Bool | Elem::Byte | Elem::USInt => V::I(i64::from(bytes(1)?[0])),
-        Elem::SInt => V::I(i64::from(bytes(1)?[0] as i8)),
-        Elem::Word | Elem::UInt => V::I(i64::from(u16::from_le_bytes(arr(bytes(2)?)))),
-        Elem::Int => V::I(i64::from(i16::from_le_bytes(arr(bytes(2)?)))),
-        Elem::DWord | Elem::UDInt => V::I(i64::from(u32::from_le_bytes(arr(bytes(4)?)))),
-        Elem::DInt | Elem::Time => V::I(i64::from(i32::from_le_bytes(arr(bytes(4)?)))),
-        Elem::LWord | Elem::ULInt | Elem::LInt | Elem::LTime => {
-            V::I(i64::from_le_bytes(arr(bytes(8)?)))
-        }
-        Elem::Real => V::F(f64::from(f32::from_le_bytes(arr(bytes(4)?)))),
-        Elem::LReal => V::F(f64::from_le_bytes(arr(bytes(8)?))),
-    })
-}
+pub(crate) use mem::{arr, pointed, read_mem, write_mem, Loc};
 
 /// How a statement list ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -141,7 +88,8 @@ struct State {
 struct Exec<'a> {
     code: &'a Compiled,
     st: &'a mut State,
-    image: Option<&'a ImageMemory>,
+    /// The image and its map (which leaf starts where, which the PLC may write).
+    image: Option<(&'a ImageMemory, &'static image::ImageMap)>,
     library: &'a Library,
     host: Option<&'a mut dyn Host>,
     /// The inputs the block call being run passes (a host block sees which were given).
@@ -240,7 +188,7 @@ impl Program {
         let mut exec = Exec {
             code: &self.code,
             st: &mut self.state,
-            image,
+            image: image.map(|m| (m, image::map())),
             library: &self.library,
             // The host's own lifetime shortened to the cycle's.
             host: host.map(|h| h as &mut dyn Host),
@@ -417,10 +365,18 @@ impl<'a> Exec<'a> {
         self.step()?;
         match &s.kind {
             StKind::Store(a, t, e) => {
-                let v = self.eval(e, base)?;
+                let v = self.operand(e, base)?;
                 match a {
                     Addr::Static(o) => self.write_own(*o as usize, *t, v)?,
                     Addr::Instance(o) => self.write_own((base + o) as usize, *t, v)?,
+                    Addr::Via {
+                        ptr,
+                        relative,
+                        plus,
+                    } => {
+                        let at = self.via(*ptr, *relative, *plus, base)?;
+                        self.write(at, *t, v)?;
+                    }
                     _ => {
                         let at = self.addr(a, base)?;
                         self.write(at, *t, v)?;
@@ -441,14 +397,14 @@ impl<'a> Exec<'a> {
             }
             StKind::If(arms, otherwise) => {
                 for (cond, body) in arms {
-                    if self.eval(cond, base)?.int() != 0 {
+                    if self.operand(cond, base)?.int() != 0 {
                         return self.block(body, base);
                     }
                 }
                 return self.block(otherwise, base);
             }
             StKind::Case(sel, arms, otherwise) => {
-                let v = self.eval(sel, base)?.int();
+                let v = self.operand(sel, base)?.int();
                 for (ranges, body) in arms {
                     if ranges.iter().any(|(lo, hi)| (*lo..=*hi).contains(&v)) {
                         return self.block(body, base);
@@ -570,7 +526,8 @@ impl<'a> Exec<'a> {
 
     fn store_all(&mut self, inputs: &[BlockInput], at: u32, base: u32) -> Run<()> {
         for (offset, t, e) in inputs {
-            let v = self.eval(e, base)?;
+            // Most inputs are constants or variables (Velocity := 360.0).
+            let v = self.operand(e, base)?;
             self.write_own((at + offset) as usize, *t, v)?;
         }
         Ok(())
@@ -615,17 +572,22 @@ impl<'a> Exec<'a> {
             }
             Addr::Deref(p) => {
                 let p = self.eval(p, base)?.int();
-                let (image, at) = (p & IMAGE_TAG != 0, (p & !IMAGE_TAG) - 1);
-                if at < 0 {
-                    return Err(Fault::BadPointer);
-                }
-                if image {
-                    Loc::Image(at as usize)
-                } else {
-                    Loc::Own(at as usize)
-                }
+                pointed(p)?
             }
+            Addr::Via {
+                ptr,
+                relative,
+                plus,
+            } => self.via(*ptr, *relative, *plus, base)?,
         })
+    }
+
+    /// Where `p^` plus `plus` bytes is, for the pointer variable `p` at `ptr`.
+    #[inline(always)]
+    fn via(&self, ptr: u32, relative: bool, plus: u32, base: u32) -> Run<Loc> {
+        let at = if relative { base + ptr } else { ptr };
+        let p = read_mem(&self.st.memory, at as usize, Elem::ULInt)?.int();
+        Ok(pointed(p)?.plus(plus as usize))
     }
 
     fn own(&mut self, a: &Addr, base: u32) -> Run<usize> {
@@ -668,6 +630,25 @@ impl<'a> Exec<'a> {
         write_mem(&mut self.st.memory, at, t, v)
     }
 
+    /// `e`'s value, a constant's or a variable's without a call (the leaves of most
+    /// expressions).
+    #[inline(always)]
+    fn operand(&mut self, e: &Ex, base: u32) -> Run<V> {
+        match e {
+            Ex::Int(v) => Ok(V::I(*v)),
+            Ex::Real(v) => Ok(V::F(*v)),
+            Ex::Var {
+                offset,
+                relative,
+                ty,
+            } => {
+                let at = if *relative { base + offset } else { *offset };
+                self.read_own(at as usize, *ty)
+            }
+            _ => self.eval(e, base),
+        }
+    }
+
     fn eval(&mut self, e: &Ex, base: u32) -> Run<V> {
         Ok(match e {
             Ex::Int(v) => V::I(*v),
@@ -681,7 +662,15 @@ impl<'a> Exec<'a> {
                 self.read_own(at as usize, *ty)?
             }
             Ex::Load(a, t) => {
-                let at = self.addr(a, base)?;
+                let at = match **a {
+                    // The manuals' `p^.field`, without a call.
+                    Addr::Via {
+                        ptr,
+                        relative,
+                        plus,
+                    } => self.via(ptr, relative, plus, base)?,
+                    _ => self.addr(a, base)?,
+                };
                 self.read(at, *t)?
             }
             Ex::LoadPtr(a) => {
@@ -692,13 +681,13 @@ impl<'a> Exec<'a> {
                 Loc::Own(at) => at as i64 + 1,
                 Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
             }),
-            Ex::Neg(x, t) => ops::neg(self.eval(x, base)?, *t),
-            Ex::Not(x, t) => ops::not(self.eval(x, base)?, *t),
+            Ex::Neg(x, t) => ops::neg(self.operand(x, base)?, *t),
+            Ex::Not(x, t) => ops::not(self.operand(x, base)?, *t),
             Ex::Bin(op, t, a, b) => {
-                let (x, y) = (self.eval(a, base)?, self.eval(b, base)?);
+                let (x, y) = (self.operand(a, base)?, self.operand(b, base)?);
                 ops::binary(*op, *t, x, y)?
             }
-            Ex::Conv(from, to, x) => ops::convert(self.eval(x, base)?, *from, *to)?,
+            Ex::Conv(from, to, x) => ops::convert(self.operand(x, base)?, *from, *to)?,
             Ex::Std(f, t, args) => self.std_fn(*f, *t, args, base)?,
             Ex::Call {
                 pou,
