@@ -199,6 +199,9 @@ fn attach(instance: &str) -> Result<PlcSegment, ToolError> {
 pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
     let (sources, vars) = sources(instance, paths)?;
     let segment = attach(instance)?;
+    if let Some(v) = &vars {
+        v.refresh().map_err(ToolError::St)?;
+    }
     Ok(paths
         .iter()
         .zip(&sources)
@@ -387,6 +390,10 @@ fn watch(
             break;
         }
         if hli_transport::signals::take().is_some() {
+            break;
+        }
+        if let Some(Err(e)) = vars.as_ref().map(Variables::refresh) {
+            eprintln!("plc watch: {e}");
             break;
         }
         let mut line = segment.cnc_heartbeat().to_string();

@@ -1,5 +1,5 @@
 //! An ST PLC's variables by name for the tools (`st::vars`): the PLC publishes every
-//! variable after each cycle and takes a tool's write before the next; a value the type
+//! variable after a cycle a tool asked for a copy in, and takes a tool's write before the next; a value the type
 //! cannot hold is refused; the object is gone when the PLC is.
 
 use hli::views::PlcView;
@@ -20,6 +20,7 @@ VAR
 END_VAR
     IF bRun THEN nCount := nCount + 1; END_IF
     aP[2].n := 7;
+    fbMove(Execute := FALSE);
 END_PROGRAM
 ";
 
@@ -63,8 +64,24 @@ fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
         plc.cycle();
     }
     let vars = Variables::open(&instance).unwrap();
+    assert_eq!(vars.cycles(), 3);
+    let count = vars.find("MAIN.nCount").unwrap();
+    assert_eq!(vars.read(count), 0.0, "no copy before a tool asks for one");
+    // A copy is made only when a tool asks: the PLC makes it in its next cycle.
+    let vars = std::thread::spawn(move || {
+        vars.refresh().unwrap();
+        vars
+    });
+    while !vars.is_finished() {
+        plc.cycle();
+    }
+    let vars = vars.join().unwrap();
     let value = |path: &str| vars.read(vars.find(path).unwrap_or_else(|| panic!("{path}")));
-    assert_eq!(value("MAIN.nCount"), 3.0);
+    let counted = value("MAIN.nCount");
+    assert!(
+        counted > 3.0 && counted <= vars.cycles() as f64,
+        "a copy made after the request: {counted}"
+    );
     assert_eq!(value("main.bRun"), 1.0, "ASCII case ignored");
     assert_eq!(value("MAIN.fSpeed"), 1.5);
     assert_eq!(value("MAIN.aP[2].n"), 7.0);
@@ -73,21 +90,35 @@ fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
         vars.find("MAIN.fbT.Q").is_none(),
         "a standard block's members are not listed"
     );
-    assert_eq!(vars.cycles(), 3);
 
     // A write is taken by the PLC before its next cycle: the tool waits for it there.
     let writer = std::thread::spawn(move || {
         let run = vars.find("MAIN.bRun").unwrap();
         let speed = vars.find("MAIN.fSpeed").unwrap();
         let refused = vars.write(vars.find("MAIN.aP[0].n").unwrap(), 40_000.0);
-        (vars.write(run, 0.0), vars.write(speed, -2.25), refused)
+        let (run, speed) = (vars.write(run, 0.0), vars.write(speed, -2.25));
+        (run, speed, refused, vars)
     });
     while !writer.is_finished() {
         plc.cycle();
     }
-    let (run, speed, refused) = writer.join().unwrap();
+    let (run, speed, refused, vars) = writer.join().unwrap();
     assert_eq!((run, speed), (Ok(()), Ok(())));
     assert!(refused.unwrap_err().contains("40000 is not a value of INT"));
+
+    // A tool's write to a block's output lasts until the block's next call (as in a PLC,
+    // whose block writes its outputs every call), though the block writes them only when
+    // they change.
+    let reader = std::thread::spawn(move || {
+        let busy = vars.find("MAIN.fbMove.Busy").unwrap();
+        vars.write(busy, 1.0).unwrap();
+        vars.refresh().unwrap();
+        vars.read(busy)
+    });
+    while !reader.is_finished() {
+        plc.cycle();
+    }
+    assert_eq!(reader.join().unwrap(), 0.0, "the block's own Busy again");
     let counted = plc.program.program().read_var("MAIN.nCount").unwrap();
     plc.cycle();
     assert_eq!(

@@ -35,6 +35,11 @@ struct Instance {
     rows: Vec<f64>,
     /// tTimeout given by a call once.
     timeout_given: bool,
+    /// The call site of the last call (a site gives the same inputs every time).
+    site: usize,
+    /// The outputs as the instance's variables hold them (written when they change: the
+    /// program cannot write them, see `Blocks::forget_outputs` for a tool).
+    shown: Option<(Outputs, bool)>,
 }
 
 /// The blocks of a program's instances (one per instance, made at load).
@@ -59,10 +64,20 @@ impl Blocks {
                     given: vec![false; binding.inputs.len()],
                     rows: Vec::with_capacity(binding.rows_room()),
                     timeout_given: false,
+                    site: usize::MAX,
+                    shown: None,
                 }
             })
             .collect();
         Blocks { library, instances }
+    }
+
+    /// Writes every instance's outputs at its next call (a tool wrote the program's
+    /// memory: it may have written one).
+    pub fn forget_outputs(&mut self) {
+        for inst in &mut self.instances {
+            inst.shown = None;
+        }
     }
 
     /// The host for one cycle on `io`, the PLC's cycle `cycle_ns` long (tTimeout counts in
@@ -185,6 +200,14 @@ fn write_outputs(io: &mut BlockIo<'_>, first: usize, style: StStyle, out: &Outpu
     }
 }
 
+/// Writes `out` to the instance's output variables if they hold something else.
+fn show(io: &mut BlockIo<'_>, binding: &Binding, inst: &mut Instance, out: (Outputs, bool)) {
+    if inst.shown != Some(out) {
+        write_outputs(io, binding.outputs, binding.spec.style, &out.0, out.1);
+        inst.shown = Some(out);
+    }
+}
+
 impl Host for BlockHost<'_, '_> {
     fn call(&mut self, block: usize, io: &mut BlockIo<'_>) -> Result<(), Fault> {
         let binding: &Binding = &self.blocks.library.bindings[block];
@@ -198,11 +221,15 @@ impl Host for BlockHost<'_, '_> {
             Some(e) => e && !inst.last_execute,
             None => true,
         };
-        // An input counts as given from the first call that names it, edge or not.
-        for (k, input) in binding.inputs.iter().enumerate() {
-            inst.given[k] |= given(io, &input.0);
+        // An input counts as given from the first call that names it, edge or not (a
+        // call from the site of the last gives the same).
+        if inst.site != io.site() {
+            inst.site = io.site();
+            for (k, input) in binding.inputs.iter().enumerate() {
+                inst.given[k] |= given(io, &input.0);
+            }
+            inst.timeout_given |= binding.timeout.is_some_and(|v| io.given(v));
         }
-        inst.timeout_given |= binding.timeout.is_some_and(|v| io.given(v));
         if takes_inputs {
             inst.refused = false;
             for (k, input) in binding.inputs.iter().enumerate() {
@@ -222,7 +249,6 @@ impl Host for BlockHost<'_, '_> {
         }
         inst.last_execute = execute.unwrap_or(false);
         let axis = axis_of(io, binding);
-        let style = binding.spec.style;
         // Refused: while Execute stays TRUE, or in this call of a block without Execute.
         if inst.refused && (inst.last_execute || execute.is_none()) {
             // Execute stays FALSE for the block: its command never starts.
@@ -230,15 +256,15 @@ impl Host for BlockHost<'_, '_> {
                 *e = false;
             }
             let _ = inst.block.cycle(self.io, axis);
-            let failed = Outputs::failed(INVALID_INPUT);
-            write_outputs(io, binding.outputs, style, &failed, false);
+            let failed = (Outputs::failed(INVALID_INPUT), false);
+            show(io, binding, inst, failed);
             return Ok(());
         }
         if let (Some(e), Some(x)) = (inst.block.execute(), execute) {
             *e = x;
         }
-        let (out, status) = inst.block.cycle(self.io, axis);
-        write_outputs(io, binding.outputs, style, &out, status);
+        let out = inst.block.cycle(self.io, axis);
+        show(io, binding, inst, out);
         Ok(())
     }
 }

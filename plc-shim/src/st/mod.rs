@@ -105,8 +105,12 @@ impl PlcProgram for StProgram {
             .saturating_mul(self.period_ticks)
             .saturating_mul(tick_ns);
         self.cycles += 1;
-        if let Some(p) = &self.publisher {
-            p.take_write(&mut self.program);
+        if self
+            .publisher
+            .as_ref()
+            .is_some_and(|p| p.take_write(&mut self.program))
+        {
+            self.blocks.forget_outputs();
         }
         let memory = io.memory;
         let mut host = self

@@ -7,13 +7,17 @@
 //!   8  the PLC's pid (u32)     32 write request: state (u32: 0 free, 4 claimed, 1 asked,
 //!  12  symbols (u32)              2 done, 3 refused)
 //!  16  table bytes (u32)       36 the symbol's index (u32)   40 the value (f64 bits)
-//!  20  data bytes (u32)        64 the table: `PATH TYPE OFFSET` per line, then the memory
+//!  20  data bytes (u32)        48 copies asked for (u32)   52 copies made (u32)
+//!                              64 the table: `PATH TYPE OFFSET` per line, then the memory
 //! ```
 //!
 //! Every cycle, before the program runs, the PLC takes a write a tool asked for (the symbol's
 //! index and a number, checked against the symbol's type: a value that does not fit is
-//! refused, never wrapped), and after it copies the program's memory into the object (8-byte
-//! atomic stores, no allocation, no system call). A tool reads a variable from the copy. A
+//! refused, never wrapped), and after it counts the cycle and, when a tool has asked for a
+//! copy since the last (it raises the count at 48), copies the program's memory into the
+//! object (8-byte atomic stores, no allocation, no system call) and answers with that count
+//! at 52. A tool asks, waits for the answer, and reads a variable from the copy: a cycle
+//! nobody reads copies nothing. A
 //! tool claims the request slot (FREE to CLAIMED, compare-and-swap) before it fills it, so two
 //! tools never mix their writes; the PLC takes the index and value only after the state says
 //! ASKED (release and acquire). The magic is written last, so a tool never reads a table half
@@ -34,6 +38,8 @@ const CYCLES: usize = 24;
 const REQUEST: usize = 32;
 const REQUEST_INDEX: usize = 36;
 const REQUEST_VALUE: usize = 40;
+const ASKED_COPIES: usize = 48;
+const MADE_COPIES: usize = 52;
 const TABLE: usize = 64;
 /// The most symbols published.
 pub const MAX_SYMBOLS: usize = 100_000;
@@ -53,6 +59,8 @@ pub struct Publisher {
     data: usize,
     words: usize,
     cycles: u64,
+    /// The copies asked for that the last copy answered.
+    served: u32,
 }
 
 fn align8(n: usize) -> usize {
@@ -89,13 +97,14 @@ impl Publisher {
             data,
             words,
             cycles: 0,
+            served: 0,
         })
     }
 
-    /// Takes a tool's write, if one is asked for (before the cycle).
-    pub fn take_write(&self, program: &mut Program) {
+    /// Takes a tool's write, if one is asked for (before the cycle): whether it wrote.
+    pub fn take_write(&self, program: &mut Program) -> bool {
         if self.memory.place::<u32>(REQUEST).load_acquire() != ASKED {
-            return;
+            return false;
         }
         let index = self.memory.place::<u32>(REQUEST_INDEX).load() as usize;
         let value = f64::from_bits(self.memory.place::<u64>(REQUEST_VALUE).load());
@@ -105,10 +114,18 @@ impl Publisher {
         };
         let state = if done { DONE } else { REFUSED };
         self.memory.place::<u32>(REQUEST).store_release(state);
+        done
     }
 
-    /// Copies the program's memory into the object (after the cycle).
+    /// Counts the cycle, and copies the program's memory into the object if a tool has
+    /// asked for a copy since the last (after the cycle).
     pub fn publish(&mut self, program: &Program) {
+        self.cycles = self.cycles.wrapping_add(1);
+        self.memory.place::<u64>(CYCLES).store_release(self.cycles);
+        let asked = self.memory.place::<u32>(ASKED_COPIES).load_acquire();
+        if asked == self.served {
+            return;
+        }
         let bytes = program.memory();
         for k in 0..self.words {
             let mut word = [0u8; 8];
@@ -120,8 +137,8 @@ impl Publisher {
                 .place::<u64>(self.data + k * 8)
                 .store(u64::from_le_bytes(word));
         }
-        self.cycles = self.cycles.wrapping_add(1);
-        self.memory.place::<u64>(CYCLES).store_release(self.cycles);
+        self.served = asked;
+        self.memory.place::<u32>(MADE_COPIES).store_release(asked);
     }
 }
 
@@ -199,7 +216,24 @@ impl Variables {
         self.memory.place::<u64>(CYCLES).load()
     }
 
-    /// The value of symbol `index`, as the last cycle left it (read in the 8-byte words the
+    /// Asks the PLC for a copy of its variables and waits until its next cycle made it:
+    /// `Err` if the PLC does not answer (a watchdog of 2 s, not a timing).
+    pub fn refresh(&self) -> Result<(), String> {
+        let asked = self.memory.place::<u32>(ASKED_COPIES);
+        let wanted = asked.atomic().fetch_add(1, AcqRel).wrapping_add(1);
+        let made = self.memory.place::<u32>(MADE_COPIES);
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(2);
+        // Another tool's later request answers this one too (the copy is as new).
+        while made.load_acquire().wrapping_sub(wanted) > u32::MAX / 2 {
+            if std::time::Instant::now() > deadline {
+                return Err("the ST PLC did not copy its variables (is it cycling?)".into());
+            }
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        Ok(())
+    }
+
+    /// The value of symbol `index`, as the copy [`Variables::refresh`] asked for left it (read in the 8-byte words the
     /// PLC writes).
     pub fn read(&self, index: usize) -> f64 {
         let s = &self.symbols[index];
