@@ -5,10 +5,17 @@
 //! reports it (the mean, and the p99 in whole us, over all cycles of a run: the runtime's
 //! cycle with the program, its blocks and the image's handshakes), the median over the
 //! rounds. Target: ST <= 3x (the means).
+//! Beside it, in one process (the machine on a heap image, the PLC program run after each
+//! tick as `cnc run --lockstep` runs it, the calls answered between): the program's cycle
+//! alone, timed around each call (two clock readings included in both), the sum over the run
+//! per cycle, the median of interleaved rounds. The whole-process figure holds what the
+//! in-process one leaves out: a PLC woken once per tick starts with caches the CNC used.
 //! Run: `cargo bench -p cnc-app --bench demo_st` (`DEMO_ST_ROUNDS` sets the rounds, 5).
 
 use bench_kit::{median, smoke};
+use cnc_app::scenario::machine::{BuiltIn, InProcess};
 use std::process::Command;
+use std::time::{Duration, Instant};
 
 /// The mean and the p99 of the PLC task (us) of one `cnc demo --lockstep` run, `--st` with `st`.
 fn run(st: bool, round: usize) -> (f64, f64) {
@@ -46,6 +53,41 @@ fn run(st: bool, round: usize) -> (f64, f64) {
     (after("mean"), after("p99"))
 }
 
+/// The mean of the PLC program's cycle (us) over the demo run in one process, the ST
+/// program with `st`, and the saw's and lifter's last set-points (the runs must agree).
+fn in_process(st: bool) -> (f64, [u64; 2]) {
+    let scenario = cnc_app::demo::scenario().expect("the demo");
+    let ticks = if smoke() {
+        2000
+    } else {
+        scenario.ticks.unwrap_or(0) as usize
+    };
+    let mut run = InProcess::new(&scenario, 1).expect("in process");
+    if st {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/demo/plc.st");
+        let program = plc_shim::st::StProgram::load(&[path.into()], 1).expect("plc.st");
+        run.program = Some(BuiltIn(Box::new(program)));
+    }
+    let mut spent = Duration::ZERO;
+    for _ in 0..ticks {
+        run.machine.tick(&run.memory);
+        run.answer_calls();
+        let t = Instant::now();
+        run.run_program();
+        spent += t.elapsed();
+        run.machine.serve_channels();
+    }
+    let leaf = |p: &str| {
+        let v = hli::access::Leaf::resolve(p).expect(p).read(&run.memory);
+        v.as_f64().to_bits()
+    };
+    let ends = [
+        leaf("gpAx[28]^lr_state.command_position_acs_r"),
+        leaf("gpAx[26]^lr_state.command_position_acs_r"),
+    ];
+    (spent.as_secs_f64() * 1e6 / ticks.max(1) as f64, ends)
+}
+
 fn main() {
     let rounds = std::env::var("DEMO_ST_ROUNDS")
         .ok()
@@ -70,4 +112,21 @@ fn main() {
     println!(
         "TARGET | demo machine's PLC program: ST task cycle <= 3x the Rust program's (mean) | {s50:.2} us against {r50:.2} us ({ratio:.1}x) | {verdict}"
     );
+    let (mut rust, mut st) = (Vec::new(), Vec::new());
+    for _ in 0..rounds {
+        let (r, r_ends) = in_process(false);
+        let (s, s_ends) = in_process(true);
+        assert_eq!(r_ends, s_ends, "both programs end the machine alike");
+        rust.push(r);
+        st.push(s);
+    }
+    let (r, s) = (median(rust), median(st));
+    println!();
+    println!(
+        "| demo machine's PLC program in one process, per cycle ({rounds} rounds) | mean us |"
+    );
+    println!("| --- | ---: |");
+    println!("| Structured Text | {s:.3} |");
+    println!("| Rust (baseline) | {r:.3} |");
+    println!("(in one process: {:.1}x)", s / r);
 }
