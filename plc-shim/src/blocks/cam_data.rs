@@ -3,11 +3,14 @@
 //! their data in chunks, one chunk in flight and one per cycle at most.
 
 use super::cam::recorded;
+use super::cam_room::CamRoom;
 use crate::kernel::{
     call_error_code, done_unless, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled,
 };
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{mode, number, BlockSpec, InputField, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{
+    mode, number, BlockSpec, CamRefIn, InputField, Kind, StForm, TimelineBlock, Value,
+};
 use hli::calls::cam::{CamInterpolation, CamReply, CamTableSelectCall, McMotionFunctionPoint};
 use hli::calls::CallError;
 use hli_transport::rpc::PendingCall;
@@ -38,6 +41,8 @@ pub struct McCamTableSelect {
     /// Outputs of the last call.
     pub out: Outputs,
     kernel: Kernel<SelectTransfer>,
+    /// Room for a PLC program's `MC_CAM_REF` (Structured Text), made at load.
+    room: Option<CamRoom>,
 }
 
 impl McCamTableSelect {
@@ -145,6 +150,9 @@ pub struct CamRef {
     pub rows: u32,
     /// Columns: 2 (master, slave) for rows, 1 (a point) for a motion function.
     pub columns: u32,
+    /// The array's elements when `data` has more room than the array (a PLC program's
+    /// array copied into room made at load); `None`: all of `data`.
+    pub held: Option<usize>,
 }
 
 impl CamRef {
@@ -162,6 +170,7 @@ impl CamRef {
             ),
             _ => return Err(0x4B35),
         };
+        let held = self.held.map_or(held, |h| h.min(held));
         if self.columns != columns {
             return Err(super::cam_read::ERROR_COLUMNS);
         }
@@ -388,6 +397,8 @@ pub struct McWriteMotionFunction {
     /// Outputs of the last call.
     pub out: Outputs,
     kernel: Kernel<ChunkTransfer>,
+    /// Room for a PLC program's `MC_CAM_REF` (Structured Text), made at load.
+    room: Option<CamRoom>,
 }
 
 impl McWriteMotionFunction {
@@ -395,7 +406,12 @@ impl McWriteMotionFunction {
 
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
-        let (table, checked) = (self.table, self.cam_ref.as_ref().map(CamRef::check));
+        // A motion function's points only (a position table's rows are MC_CamTableSelect's).
+        let check = |r: &CamRef| match r.table_type {
+            22 => r.check(),
+            _ => Err(0x4B35),
+        };
+        let (table, checked) = (self.table, self.cam_ref.as_ref().map(check));
         let points = self.cam_ref.as_ref().map_or(&self.points, |r| &r.data);
         let send = |_: &mut PlcIo<'_>| match checked {
             Some(Err(code)) => Err(code),
@@ -509,6 +525,11 @@ impl InputField for CamData {
     }
 }
 
+/// The most bytes of an `MC_CAM_REF`'s array a PLC program in Structured Text gives (the
+/// room each instance makes at load, twice for rows and twice for points): 4,096 rows, or
+/// 1,170 points.
+pub const CAM_REF_ROOM_BYTES: usize = 65_536;
+
 /// Table rows `[[master, slave], ...]` in a timeline.
 pub(super) const ROWS: Kind = Kind::Parsed {
     parse: |v| rows_of(v).map(Value::Rows),
@@ -521,6 +542,14 @@ const POINTS: Kind = Kind::Parsed {
     example: "[{ index = 1, function = 15, type = 1, master = 0.0, slave = 0.0 }]",
 };
 
+/// In Structured Text a table comes as the seed's `CamTable : MC_CAM_REF`: its rows or
+/// points, and its type.
+const CAM_TABLE: StForm = StForm::CamRef {
+    name: "CamTable",
+    max_bytes: CAM_REF_ROOM_BYTES,
+};
+const HIDDEN: StForm = StForm::Hidden;
+
 inputs! {
     /// MC_CamTableSelect's inputs: the table, the selection and the data sent before it.
     SELECT, set_select: McCamTableSelect {
@@ -528,9 +557,9 @@ inputs! {
         "periodic": Kind::Bool => periodic,
         "master_absolute": Kind::Bool => master_absolute,
         "slave_absolute": Kind::Bool => slave_absolute,
-        "rows": ROWS => data,
-        "points": POINTS => data,
-        "table_type": Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)])
+        "rows" as CAM_TABLE: ROWS => data,
+        "points" as HIDDEN: POINTS => data,
+        "table_type" as HIDDEN: Kind::OneOf(&[("10 (equidistant)", 10), ("11 (non-equidistant)", 11)])
             => table_type,
         "interpolation": mode::<CamInterpolation>() => interpolation,
     }
@@ -540,8 +569,24 @@ inputs! {
     /// MC_WriteMotionFunction's inputs.
     WRITE, set_write: McWriteMotionFunction {
         "table": Kind::Count => table,
-        "points": POINTS => points,
+        "points" as CAM_TABLE: POINTS => points,
     }
+}
+
+/// `TimelineBlock::reserve_cam_ref` and `set_cam_ref` of a block with `room` and `cam_ref`.
+macro_rules! cam_ref_room {
+    () => {
+        fn reserve_cam_ref(&mut self, bytes: usize) -> bool {
+            self.room = Some(CamRoom::new(bytes));
+            true
+        }
+        fn set_cam_ref(&mut self, table: &CamRefIn<'_>) -> bool {
+            // The last table's buffer is given back first: one of the two is then free.
+            self.cam_ref = None;
+            self.cam_ref = self.room.as_mut().and_then(|room| room.take(table));
+            self.cam_ref.is_some()
+        }
+    };
 }
 
 impl TimelineBlock for McCamTableSelect {
@@ -549,6 +594,7 @@ impl TimelineBlock for McCamTableSelect {
     fn set(&mut self, key: &str, value: &Value) {
         set_select(self, key, value);
     }
+    cam_ref_room!();
     execute_cycle!(no_axis, recorded);
 }
 
@@ -557,6 +603,7 @@ impl TimelineBlock for McWriteMotionFunction {
     fn set(&mut self, key: &str, value: &Value) {
         set_write(self, key, value);
     }
+    cam_ref_room!();
     execute_cycle!(no_axis, recorded);
 }
 

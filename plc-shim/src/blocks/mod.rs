@@ -78,13 +78,14 @@ macro_rules! timeline_timeout {
 /// of `$target` it sets (a path below it). Gives the list `$list` (an `[InputSpec; N]` for a
 /// `TIMELINE` entry, or part of one through `joined`) and `$set(target, key, value)`, which
 /// sets the field of `key` and leaves the others. `required` before a key: every call gives
-/// it. It writes the `InputSpec` list every block declares its inputs with (a family may write
+/// it; `as FORM` after a key: it reads as the `StForm` constant `FORM` in Structured Text. It
+/// writes the `InputSpec` list every block declares its inputs with (a family may write
 /// that list with `input`/`required` and its `set` by hand instead).
 macro_rules! inputs {
     (
         $(#[doc = $doc:literal])*
         $list:ident, $set:ident: $target:ty {
-            $($($required:ident)? $key:literal: $kind:expr => $($field:ident).+),* $(,)?
+            $($($required:ident)? $key:literal $(as $st:ident)?: $kind:expr => $($field:ident).+),* $(,)?
         }
     ) => {
         $(#[doc = $doc])*
@@ -93,7 +94,7 @@ macro_rules! inputs {
                 key: $key,
                 kind: $kind,
                 required: inputs!(@required $($required)?),
-                st: $crate::timeline::registry::StForm::Key,
+                st: inputs!(@st $($st)?),
             }
         ),*];
 
@@ -106,6 +107,8 @@ macro_rules! inputs {
             }
         }
     };
+    (@st $st:ident) => { $st };
+    (@st) => { $crate::timeline::registry::StForm::Key };
     (@required required) => { true };
     (@required) => { false };
 }
@@ -115,6 +118,7 @@ pub mod cam_compat;
 pub mod cam_data;
 pub mod cam_multi;
 pub mod cam_read;
+pub mod cam_room;
 pub mod channel;
 pub mod dyn_cs;
 pub mod fifo;

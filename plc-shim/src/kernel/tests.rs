@@ -407,6 +407,7 @@ fn an_mc_cam_ref_is_checked_against_its_array_and_sends_its_rows() {
         table_type,
         rows: count,
         columns,
+        held: None,
     };
     let points = CamRef {
         data: CamData::Points(Arc::from(
@@ -416,6 +417,7 @@ fn an_mc_cam_ref_is_checked_against_its_array_and_sends_its_rows() {
         table_type: 22,
         rows: 3,
         columns: 1,
+        held: None,
     };
     assert_eq!(points.check(), Ok(3));
     for (case, cam_ref, code) in [

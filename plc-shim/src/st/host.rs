@@ -7,15 +7,17 @@
 //! has given is not passed on, so the block keeps its own default (MC_CamIn's scalings 1.0,
 //! MC_MoveVelocity's Direction 1), as when a timeline's call does not give it; once given,
 //! it keeps its value from call to call, as an FB input does. A value outside its input's
-//! kind (a range, a positive time, one of a list), or rows through a pointer that is NULL or
-//! reaches beyond the program's memory, is not passed on: that command ends at once with
+//! kind (a range, a positive time, one of a list), or rows (or an MC_CAM_REF's array)
+//! through a pointer that is NULL or reaches beyond the program's memory (or the room made
+//! at load), or holding a value that is not finite, is not passed on: that command ends at once with
 //! Error and [`INVALID_INPUT`] (held while Execute stays TRUE). Nothing here allocates after
 //! the load (the rows' room is made with the instance).
 
-use super::library::{Binding, Bound, Library};
+use super::library::{Binding, Bound, Library, CAM_REF_FIELDS};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{InputSpec, Kind, StStyle, TimelineBlock, Value};
+use crate::timeline::registry::{CamRefIn, InputSpec, Kind, StStyle, TimelineBlock, Value};
+use plc_st::types::Elem;
 use plc_st::vm::{BlockIo, Fault, Host};
 
 /// The error id of a command whose input was outside its kind (AxisError::InvalidParameter).
@@ -57,8 +59,12 @@ impl Blocks {
             .iter()
             .map(|(_, k)| {
                 let binding = &library.bindings[*k];
+                let mut block = (binding.spec.make)(None);
+                if binding.cam_ref_room() > 0 {
+                    block.reserve_cam_ref(binding.cam_ref_room());
+                }
                 Instance {
-                    block: (binding.spec.make)(None),
+                    block,
                     last_execute: false,
                     refused: false,
                     given: vec![false; binding.inputs.len()],
@@ -161,7 +167,39 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             }
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
+        Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
     }
+}
+
+/// An `MC_CAM_REF` to its block: its array read where `pArray` points, `nArraySize` bytes of
+/// the program's memory; `false` (refused) for a NULL pointer or one into the image, an
+/// array beyond the memory or larger than the room made at load, or a value not finite.
+fn pass_cam_ref(io: &BlockIo<'_>, inst: &mut Instance, var: usize, max_bytes: usize) -> bool {
+    let [size, table_type, rows, columns] =
+        CAM_REF_FIELDS.map(|at| io.field(var, at, Elem::UDInt).map(|v| v as u32));
+    let (Some(p), Some(size), Some(table_type), Some(rows), Some(columns)) = (
+        io.field(var, 0, Elem::LWord),
+        size,
+        table_type,
+        rows,
+        columns,
+    ) else {
+        return false;
+    };
+    if size as usize > max_bytes {
+        return false;
+    }
+    let Some(bytes) = io.memory_at(p, size as usize) else {
+        return false;
+    };
+    let table = CamRefIn {
+        bytes,
+        array_size: size,
+        table_type,
+        rows,
+        columns,
+    };
+    inst.block.set_cam_ref(&table)
 }
 
 /// Whether this call gives input `bound`.
@@ -174,6 +212,7 @@ fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
             rows,
             ..
         } => io.given(data) || io.given(columns) || io.given(rows),
+        Bound::CamRef { var, .. } => io.given(var),
     }
 }
 

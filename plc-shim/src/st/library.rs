@@ -16,13 +16,56 @@
 //!   `AdrDataArray : POINTER TO LREAL`, `iColDim`, `iRowsToWrite`); outputs `bBusy`, `bErr`,
 //!   `iErrId`.
 //!
-//! Inputs ST cannot give yet (tables and point lists as TOML values, NC program names, the
-//! saw's SyncMode) are left out; a block that needs one is not in the library
-//! ([`unavailable`]).
+//! * Tables: the seed's `CamTable : MC_CAM_REF` (000 5.1.16.2: `pArray := ADR(aTable)`,
+//!   `nArraySize := SIZEOF(aTable)`, `nTableType`, `nNoOfRows`, `nNoOfCols`) gives
+//!   MC_CamTableSelect its rows or points and MC_WriteMotionFunction its points, read from
+//!   the program's memory at the edge into room the block makes at load (at most
+//!   [`crate::blocks::cam_data::CAM_REF_ROOM_BYTES`] of array).
+//!
+//! Inputs ST cannot give yet (the compatibility blocks' tables and the read blocks' rooms as
+//! TOML values, NC program names, the saw's SyncMode) are left out; a block that needs one is
+//! not in the library ([`unavailable`]).
 
 use crate::timeline::registry::Target;
 use crate::timeline::registry::{blocks, folded, BlockSpec, InputSpec, Kind, StForm, StStyle};
 use std::fmt::Write as _;
+
+/// The library's types: AXIS_REF, the seed's MC_CAM_REF (000 5.1.16.2; its array's address
+/// a pointer of 8 bytes) and MC_MotionFunctionPoint (5.1.16.10, the wire's layout: 56
+/// bytes), and PVOID, the untyped address any pointer and ADR go to.
+const TYPES: &str = "(* The block library, generated from the blocks' declarations. *)
+TYPE
+    PVOID : POINTER TO BYTE;
+    AXIS_REF :
+    STRUCT
+        AxisIndex : UDINT; (* the axis's index in gpAx *)
+    END_STRUCT
+    MC_CAM_REF :
+    STRUCT
+        pArray : PVOID; (* ADR of the array *)
+        nArraySize : UDINT; (* SIZEOF the array *)
+        nTableType : UDINT; (* 10, 11 rows; 22 a motion function *)
+        nNoOfRows : UDINT;
+        nNoOfCols : UDINT; (* 2 for rows, 1 for points *)
+    END_STRUCT
+    MC_MotionFunctionPoint :
+    STRUCT
+        PointIndex : UDINT;
+        FunctionType : UDINT;
+        PointType : UDINT;
+        RelIndexNextPoint : UDINT;
+        MasterPos : LREAL;
+        SlavePos : LREAL;
+        SlaveVelo : LREAL;
+        SlaveAcc : LREAL;
+        SlaveJerk : LREAL;
+    END_STRUCT
+END_TYPE
+";
+
+/// Byte offsets of MC_CAM_REF's fields after pArray (nArraySize, nTableType, nNoOfRows,
+/// nNoOfCols), as the layout places them (a test checks them).
+pub(super) const CAM_REF_FIELDS: [u32; 4] = [8, 12, 16, 20];
 
 /// The name the library's declarations are loaded under.
 pub const LIBRARY: &str = "<blocks>";
@@ -65,6 +108,13 @@ pub(super) enum Bound {
         /// The most values a call takes.
         max: usize,
     },
+    /// An `MC_CAM_REF` (its variable) and the most bytes of array a call takes.
+    CamRef {
+        /// The structure.
+        var: usize,
+        /// The most bytes.
+        max_bytes: usize,
+    },
 }
 
 /// How a block's ST declaration meets its spec: the index of each variable.
@@ -88,16 +138,27 @@ impl Binding {
     pub(super) fn rows_room(&self) -> usize {
         let room = |(b, _): &(Bound, InputSpec)| match b {
             Bound::Rows { max, .. } => *max,
-            Bound::Value { .. } => 0,
+            Bound::Value { .. } | Bound::CamRef { .. } => 0,
+        };
+        self.inputs.iter().map(room).max().unwrap_or(0)
+    }
+
+    /// The bytes of `MC_CAM_REF` array the instance's block makes room for (0 without).
+    pub(super) fn cam_ref_room(&self) -> usize {
+        let room = |(b, _): &(Bound, InputSpec)| match b {
+            Bound::CamRef { max_bytes, .. } => *max_bytes,
+            _ => 0,
         };
         self.inputs.iter().map(room).max().unwrap_or(0)
     }
 }
 
-/// Whether ST can give `input`.
+/// Whether ST can give `input` (a hidden one comes with another).
 fn expressible(input: &InputSpec) -> bool {
-    matches!(input.st, StForm::Rows { .. })
-        || !matches!(input.kind, Kind::Parsed { .. } | Kind::Room)
+    matches!(
+        input.st,
+        StForm::Rows { .. } | StForm::CamRef { .. } | StForm::Hidden
+    ) || !matches!(input.kind, Kind::Parsed { .. } | Kind::Room)
 }
 
 /// A key in PascalCase (`master_offset` is `MasterOffset`).
@@ -194,11 +255,7 @@ impl Library {
     /// Every block of the registry that ST can call.
     pub fn new() -> Library {
         let mut lib = Library {
-            text: "(* The block library, generated from the blocks' declarations. *)\n\
-                   TYPE\n    AXIS_REF :\n    STRUCT\n        \
-                   AxisIndex : UDINT; (* the axis's index in gpAx *)\n    END_STRUCT\n\
-                   END_TYPE\n"
-                .into(),
+            text: TYPES.into(),
             bindings: Vec::new(),
         };
         let missing = unavailable();
@@ -248,6 +305,11 @@ impl Library {
                     rows: push(&mut vars, rows.into(), "UDINT"),
                     max,
                 },
+                StForm::CamRef { name, max_bytes } => Bound::CamRef {
+                    var: push(&mut vars, name.into(), "MC_CAM_REF"),
+                    max_bytes,
+                },
+                StForm::Hidden => continue,
                 StForm::Named(name) => Bound::Value {
                     var: push(&mut vars, name.into(), st_type(&input.kind)),
                     axis: false,

@@ -159,6 +159,36 @@ pub enum StForm {
         /// The most values a call takes.
         max: usize,
     },
+    /// A table as the seed's `MC_CAM_REF` (000 5.1.16.2) under this name: the array's
+    /// address, its size in bytes, the table type, rows and columns; the array (at most
+    /// `max_bytes` of it) read from the program's memory at the edge into room the block
+    /// makes at load ([`TimelineBlock::reserve_cam_ref`], [`TimelineBlock::set_cam_ref`]).
+    CamRef {
+        /// The structure's name (`CamTable`).
+        name: &'static str,
+        /// The most bytes of array a call takes.
+        max_bytes: usize,
+    },
+    /// Not an input of its own in Structured Text (a table's points and type come with the
+    /// [`StForm::CamRef`] of the block).
+    Hidden,
+}
+
+/// An `MC_CAM_REF` as a PLC program gives it: its description and the bytes of its array
+/// (`array_size` of them, read from the program's memory; little-endian, as the program
+/// holds them: LREAL rows `[master, slave]`, or 56-byte `MC_MotionFunctionPoint`s).
+#[derive(Debug, Clone, Copy)]
+pub struct CamRefIn<'a> {
+    /// The array's bytes.
+    pub bytes: &'a [u8],
+    /// nArraySize.
+    pub array_size: u32,
+    /// nTableType (raw `MC_TableType`).
+    pub table_type: u32,
+    /// nNoOfRows.
+    pub rows: u32,
+    /// nNoOfCols.
+    pub columns: u32,
 }
 
 /// An input `key` of kind `kind`.
@@ -424,6 +454,17 @@ pub trait TimelineBlock: core::fmt::Debug {
     /// when there were more than the block takes, which it then refuses): `true` if the
     /// block takes rows ([`StForm::Rows`]). Does not allocate.
     fn set_rows(&mut self, _values: &[f64], _columns: u32, _rows: u32) -> bool {
+        false
+    }
+    /// Makes room for an `MC_CAM_REF`'s array of up to `bytes` bytes (at load): `true` if
+    /// the block takes one ([`StForm::CamRef`]).
+    fn reserve_cam_ref(&mut self, _bytes: usize) -> bool {
+        false
+    }
+    /// An `MC_CAM_REF`'s table, copied into the room made at load (its description checked
+    /// by the block when it runs, with the seed's codes): `false` if the block takes none or
+    /// the array holds a value that is not finite. Does not allocate.
+    fn set_cam_ref(&mut self, _table: &CamRefIn<'_>) -> bool {
         false
     }
     /// The master axis (gpAx index) of a coupling block: `true` if the block has one (and

@@ -149,6 +149,7 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "example4-turntable-hybrid",
         "example4-turntable-plc",
         "cam-conveyor",
+        "cam-ref",
         "saw-blocks",
         "fifo-blocks",
     ] {

@@ -98,7 +98,7 @@ impl Checker {
     }
 
     /// The elementary leaves of a structure (offset, type), `None` beyond 64 of them or for
-    /// anything but elementary fields and structures of them.
+    /// anything but elementary, pointer and enumeration fields and structures of them.
     pub(super) fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
         let mut out = Vec::new();
         self.leaves_into(ty, 0, l, &mut out)?;
@@ -114,6 +114,10 @@ impl Checker {
     ) -> Option<()> {
         match ty {
             Type::Elem(e) if out.len() < 64 => out.push((at, *e)),
+            // A pointer is copied as its 8 bytes (an MC_CAM_REF's pArray), an enumeration as
+            // its base type.
+            Type::Pointer(_) if out.len() < 64 => out.push((at, Elem::ULInt)),
+            Type::Enum(i) if out.len() < 64 => out.push((at, self.out.enums[*i].base)),
             Type::Struct(i) => {
                 for (k, (_, field)) in self.out.structs[*i].fields.iter().enumerate() {
                     self.leaves_into(field, at + l.structs[*i].2[k], l, out)?;

@@ -135,7 +135,11 @@ impl Checker {
             (Type::Str(_), Type::Str(_)) => true,
             // ADR of an array goes to a pointer to its elements, as in TwinCAT (`ADR(aRows)`
             // to a POINTER TO LREAL: the first element's address).
-            (Type::Pointer(a), Type::Pointer(b)) => a == b || (is_adr(value) && element(a) == &**b),
+            // Any pointer goes to a POINTER TO BYTE (PVOID: an untyped address, as an
+            // MC_CAM_REF's pArray takes `ADR(aTable)`).
+            (Type::Pointer(a), Type::Pointer(b)) => {
+                a == b || (is_adr(value) && element(a) == &**b) || **b == Type::Elem(Elem::Byte)
+            }
             _ => false,
         };
         if !fits {

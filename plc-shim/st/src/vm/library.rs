@@ -76,6 +76,26 @@ impl BlockIo<'_> {
         }
     }
 
+    /// The integer of type `t` `offset` bytes into variable `k` (a structure's field: an
+    /// `MC_CAM_REF`'s), `None` outside the instance's memory.
+    pub fn field(&self, k: usize, offset: u32, t: Elem) -> Option<i64> {
+        let (at, _) = self.place(k)?;
+        match read_mem(self.memory, at.checked_add(offset as usize)?, t).ok()? {
+            V::I(i) => Some(i),
+            V::F(_) => None,
+        }
+    }
+
+    /// The `n` bytes of the program's memory pointer `p` points at: `None` for NULL, a
+    /// pointer into the image, or bytes beyond the memory.
+    pub fn memory_at(&self, p: i64, n: usize) -> Option<&[u8]> {
+        if p & super::IMAGE_TAG != 0 || p <= 0 {
+            return None;
+        }
+        let at = (p - 1) as usize;
+        self.memory.get(at..at.checked_add(n)?)
+    }
+
     /// Variable `k` as a number.
     pub fn real(&self, k: usize) -> Option<f64> {
         let (at, t) = self.place(k)?;
@@ -264,6 +284,7 @@ fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
                 Type::Pointer(_) => Some((offset, Elem::LInt)),
                 Type::Struct(s) => match c.structs[*s].fields.first() {
                     Some((_, Type::Elem(e))) => Some((offset + l.structs[*s].2[0], *e)),
+                    Some((_, Type::Pointer(_))) => Some((offset + l.structs[*s].2[0], Elem::LInt)),
                     _ => None,
                 },
                 _ => None,

@@ -1,0 +1,88 @@
+//! Room for the tables a PLC program in Structured Text gives through an `MC_CAM_REF`
+//! (seed 000 5.1.16.2): made when the block is made, so that taking a table at the edge of
+//! Execute copies it and allocates nothing. Two buffers of each shape: a new table is copied
+//! into the one no transfer of the last command still sends from.
+
+use super::cam_data::{CamData, CamRef};
+use crate::timeline::registry::CamRefIn;
+use hli::calls::cam::McMotionFunctionPoint;
+use std::sync::Arc;
+
+/// Bytes of one position-table row: master and slave, two LREALs.
+const ROW_BYTES: usize = 16;
+/// Bytes of one `MC_MotionFunctionPoint` as a program holds it (the wire's layout).
+pub const POINT_BYTES: usize = core::mem::size_of::<McMotionFunctionPoint>();
+/// `MC_TableType` of a motion function.
+const MOTION_FUNCTION: u32 = 22;
+
+/// The buffers of one block.
+#[derive(Debug, Default)]
+pub struct CamRoom {
+    rows: [Arc<[[f64; 2]]>; 2],
+    points: [Arc<[McMotionFunctionPoint]>; 2],
+}
+
+/// A buffer of `n` elements no one else holds, of the two: `None` if both are held.
+fn free<T>(buffers: &mut [Arc<[T]>; 2]) -> Option<&mut Arc<[T]>> {
+    buffers.iter_mut().find(|b| Arc::strong_count(b) == 1)
+}
+
+impl CamRoom {
+    /// Room for arrays of up to `bytes` bytes, as rows or as points.
+    pub fn new(bytes: usize) -> CamRoom {
+        let rows = || Arc::from(vec![[0.0; 2]; bytes / ROW_BYTES]);
+        let points = || Arc::from(vec![McMotionFunctionPoint::default(); bytes / POINT_BYTES]);
+        CamRoom {
+            rows: [rows(), rows()],
+            points: [points(), points()],
+        }
+    }
+
+    /// `table` as an `MC_CAM_REF` whose array is a copy in this room (as much of its bytes
+    /// as the room holds; the block's check refuses a description its array does not
+    /// match): `None` if a value is not finite, or if both buffers are held (a block's
+    /// `cam_ref` is dropped before, and a block has one transfer at a time: never).
+    pub fn take(&mut self, table: &CamRefIn<'_>) -> Option<CamRef> {
+        let (data, held) = if table.table_type == MOTION_FUNCTION {
+            let buffer = free(&mut self.points)?;
+            let slots = Arc::get_mut(buffer)?;
+            let chunks = table.bytes.chunks_exact(POINT_BYTES);
+            let n = chunks.len().min(slots.len());
+            for (slot, chunk) in slots.iter_mut().zip(chunks) {
+                let p: McMotionFunctionPoint = bytemuck::pod_read_unaligned(chunk);
+                let values = [p.master_pos, p.slave_pos, p.slave_velo, p.slave_acc];
+                if !values.iter().chain([&p.slave_jerk]).all(|v| v.is_finite()) {
+                    return None;
+                }
+                *slot = p;
+            }
+            (CamData::Points(Arc::clone(buffer)), n)
+        } else {
+            let buffer = free(&mut self.rows)?;
+            let slots = Arc::get_mut(buffer)?;
+            let chunks = table.bytes.chunks_exact(ROW_BYTES);
+            let n = chunks.len().min(slots.len());
+            for (slot, chunk) in slots.iter_mut().zip(chunks) {
+                let row: [f64; 2] = bytemuck::pod_read_unaligned(chunk);
+                if !row.iter().all(|v| v.is_finite()) {
+                    return None;
+                }
+                *slot = row;
+            }
+            let data = CamData::Rows {
+                rows: Arc::clone(buffer),
+                table_type: 0,
+                interpolation: 0,
+            };
+            (data, n)
+        };
+        Some(CamRef {
+            data,
+            array_size: table.array_size,
+            table_type: table.table_type,
+            rows: table.rows,
+            columns: table.columns,
+            held: Some(held),
+        })
+    }
+}
