@@ -168,6 +168,18 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
         Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
+        Bound::Struct { var, read } => {
+            let field = |at: u32, bytes: u8| {
+                let t = match bytes {
+                    1 => Elem::USInt,
+                    2 => Elem::Int,
+                    4 => Elem::DInt,
+                    _ => Elem::LInt,
+                };
+                io.field(var, at, t)
+            };
+            read(&field, &mut |key, value| inst.block.set(key, value))
+        }
     }
 }
 
@@ -212,7 +224,7 @@ fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
             rows,
             ..
         } => io.given(data) || io.given(columns) || io.given(rows),
-        Bound::CamRef { var, .. } => io.given(var),
+        Bound::CamRef { var, .. } | Bound::Struct { var, .. } => io.given(var),
     }
 }
 

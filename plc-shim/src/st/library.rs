@@ -22,12 +22,17 @@
 //!   the program's memory at the edge into room the block makes at load (at most
 //!   [`crate::blocks::cam_data::CAM_REF_ROOM_BYTES`] of array).
 //!
+//! * Structures of the seeds: the flying saw's `SyncMode : ST_SyncMode` (001 12.3.1, its
+//!   mode and one BOOL per flag), declared by the saw family with the input.
+//!
 //! Inputs ST cannot give yet (the compatibility blocks' tables and the read blocks' rooms as
-//! TOML values, NC program names, the saw's SyncMode) are left out; a block that needs one is
-//! not in the library ([`unavailable`]).
+//! TOML values, NC program names) are left out; a block that needs one is not in the
+//! library ([`unavailable`]).
 
 use crate::timeline::registry::Target;
-use crate::timeline::registry::{blocks, folded, BlockSpec, InputSpec, Kind, StForm, StStyle};
+use crate::timeline::registry::{
+    blocks, folded, BlockSpec, InputSpec, Kind, StForm, StStyle, StructReader,
+};
 use std::fmt::Write as _;
 
 /// The library's types: AXIS_REF, the seed's MC_CAM_REF (000 5.1.16.2; its array's address
@@ -108,6 +113,13 @@ pub(super) enum Bound {
         /// The most values a call takes.
         max: usize,
     },
+    /// A structure (its variable) and how its fields become the block's inputs.
+    Struct {
+        /// The structure.
+        var: usize,
+        /// Its fields as inputs.
+        read: StructReader,
+    },
     /// An `MC_CAM_REF` (its variable) and the most bytes of array a call takes.
     CamRef {
         /// The structure.
@@ -138,7 +150,7 @@ impl Binding {
     pub(super) fn rows_room(&self) -> usize {
         let room = |(b, _): &(Bound, InputSpec)| match b {
             Bound::Rows { max, .. } => *max,
-            Bound::Value { .. } | Bound::CamRef { .. } => 0,
+            Bound::Value { .. } | Bound::CamRef { .. } | Bound::Struct { .. } => 0,
         };
         self.inputs.iter().map(room).max().unwrap_or(0)
     }
@@ -157,7 +169,7 @@ impl Binding {
 fn expressible(input: &InputSpec) -> bool {
     matches!(
         input.st,
-        StForm::Rows { .. } | StForm::CamRef { .. } | StForm::Hidden
+        StForm::Rows { .. } | StForm::CamRef { .. } | StForm::Hidden | StForm::Struct { .. }
     ) || !matches!(input.kind, Kind::Parsed { .. } | Kind::Room)
 }
 
@@ -249,6 +261,8 @@ pub fn left_out() -> Vec<(&'static str, &'static str)> {
 pub struct Library {
     text: String,
     pub(super) bindings: Vec<Binding>,
+    /// The structure types the blocks' inputs declared.
+    types: Vec<&'static str>,
 }
 
 impl Library {
@@ -257,6 +271,7 @@ impl Library {
         let mut lib = Library {
             text: TYPES.into(),
             bindings: Vec::new(),
+            types: Vec::new(),
         };
         let missing = unavailable();
         let specs: Vec<&'static BlockSpec> = blocks()
@@ -310,6 +325,21 @@ impl Library {
                     max_bytes,
                 },
                 StForm::Hidden => continue,
+                StForm::Struct {
+                    name,
+                    ty,
+                    declaration,
+                    read,
+                } => {
+                    if !self.types.contains(&ty) {
+                        self.types.push(ty);
+                        self.text.push_str(declaration);
+                    }
+                    Bound::Struct {
+                        var: push(&mut vars, name.into(), ty),
+                        read,
+                    }
+                }
                 StForm::Named(name) => Bound::Value {
                     var: push(&mut vars, name.into(), st_type(&input.kind)),
                     axis: false,

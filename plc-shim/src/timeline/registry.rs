@@ -172,7 +172,27 @@ pub enum StForm {
     /// Not an input of its own in Structured Text (a table's points and type come with the
     /// [`StForm::CamRef`] of the block).
     Hidden,
+    /// A structure of the seeds' (the saw's `SyncMode : ST_SyncMode`) that gives this input
+    /// and others: its name and type, the type's declaration, and how its fields become the
+    /// block's inputs.
+    Struct {
+        /// The input's name.
+        name: &'static str,
+        /// Its type's name.
+        ty: &'static str,
+        /// The type's declaration (`TYPE .. END_TYPE`), given once in the library.
+        declaration: &'static str,
+        /// Its fields as the block's inputs.
+        read: StructReader,
+    },
 }
+
+/// How a structure input's fields become a block's inputs: `field(offset, bytes)` reads the
+/// integer of `bytes` bytes at `offset` of the structure (as the library's declaration lays
+/// it out), `set(key, value)` gives the block an input; `false` if a field's value is not
+/// one the input takes (the command is refused). Does not allocate.
+pub type StructReader =
+    fn(field: &dyn Fn(u32, u8) -> Option<i64>, set: &mut dyn FnMut(&'static str, &Value)) -> bool;
 
 /// An `MC_CAM_REF` as a PLC program gives it: its description and the bytes of its array
 /// (`array_size` of them, read from the program's memory; little-endian, as the program
@@ -220,7 +240,8 @@ impl InputSpec {
         }
     }
 
-    /// The same input as rows through a pointer in Structured Text ([`StForm::Rows`]).
+    /// The same input in another form in Structured Text ([`StForm::Rows`],
+    /// [`StForm::Struct`]).
     pub const fn st_rows(self, form: StForm) -> InputSpec {
         InputSpec { st: form, ..self }
     }

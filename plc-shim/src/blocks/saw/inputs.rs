@@ -22,7 +22,7 @@
 //! the `GearInSync_CheckMask_` / `GearInSync_OpMask_` prefix.
 
 use super::{McGearInPos, McGearInVelo};
-use crate::timeline::registry::{InputSpec, Kind, Value};
+use crate::timeline::registry::{InputSpec, Kind, StForm, Value};
 use hli::calls::saw::{sync_mask, SawSyncMode};
 
 /// `(name, bit)` of `sync_mask` flags: a flag's short name is its constant's name.
@@ -78,6 +78,77 @@ const SYNC_MODE: Kind = Kind::Parsed {
     example: "\"time-based\"",
 };
 
+/// The seed's `ST_SyncMode` (001 12.3.1) in Structured Text: the mode, then one BOOL per
+/// check flag and per operation flag, in the order of [`CHECK_MASK`] and [`OP_MASK`].
+const ST_SYNC_MODE: &str = "TYPE
+    E_GearInSyncMode : (GEARINSYNCMODE_POSITIONBASED := 0, GEARINSYNCMODE_TIMEBASED := 1);
+    ST_SyncMode :
+    STRUCT
+        GearInSyncMode : E_GearInSyncMode;
+        GearInSync_CheckMask_MinPos : BOOL;
+        GearInSync_CheckMask_MaxPos : BOOL;
+        GearInSync_CheckMask_MaxVelo : BOOL;
+        GearInSync_CheckMask_MaxAcc : BOOL;
+        GearInSync_CheckMask_MaxDec : BOOL;
+        GearInSync_CheckMask_MaxJerk : BOOL;
+        GearInSync_CheckMask_OvershootPos : BOOL;
+        GearInSync_CheckMask_UndershootPos : BOOL;
+        GearInSync_CheckMask_OvershootVelo : BOOL;
+        GearInSync_CheckMask_UndershootVelo : BOOL;
+        GearInSync_CheckMask_OvershootVeloZero : BOOL;
+        GearInSync_CheckMask_UndershootVeloZero : BOOL;
+        GearInSync_OpMask_RollbackLock : BOOL;
+        GearInSync_OpMask_InstantStopOnRollback : BOOL;
+        GearInSync_OpMask_PreferConstVelo : BOOL;
+        GearInSync_OpMask_IgnoreMasterAcc : BOOL;
+        GearInSync_OpMask_IgnoreSlaveAcc : BOOL;
+        GearInSync_OpMask_DetailedErrorCodes : BOOL;
+    END_STRUCT
+END_TYPE
+";
+
+/// `ST_SyncMode`'s fields as `SyncMode`, `CheckMask` and `OpMask`: the mode an INT at 0, the
+/// flags a BOOL each from byte 2 on (the library's layout).
+fn read_sync_mode(
+    field: &dyn Fn(u32, u8) -> Option<i64>,
+    set: &mut dyn FnMut(&'static str, &Value),
+) -> bool {
+    let time_based = match field(0, 2) {
+        Some(0) => false,
+        Some(1) => true,
+        _ => return false,
+    };
+    let (Kind::Flags { flags: checks, .. }, Kind::Flags { flags: ops, .. }) = (CHECK_MASK, OP_MASK)
+    else {
+        return false;
+    };
+    let mut at = 2;
+    let mut mask = |flags: &[(&str, u32)]| {
+        let mut bits = 0;
+        for (_, bit) in flags {
+            if field(at, 1).is_some_and(|v| v != 0) {
+                bits |= bit;
+            }
+            at += 1;
+        }
+        i64::from(bits)
+    };
+    let (check, op) = (mask(checks), mask(ops));
+    set("SyncMode", &Value::Bool(time_based));
+    set("CheckMask", &Value::Int(check));
+    set("OpMask", &Value::Int(op));
+    true
+}
+
+/// `SyncMode : ST_SyncMode` in Structured Text (a call's `CheckMask` and `OpMask`, given
+/// too, replace its flags).
+const SYNC_MODE_ST: StForm = StForm::Struct {
+    name: "SyncMode",
+    ty: "ST_SyncMode",
+    declaration: ST_SYNC_MODE,
+    read: read_sync_mode,
+};
+
 /// Our `MasterSource`, as MC_CamIn's: the master's set-point or its actual values.
 const MASTER_SOURCE: Kind = Kind::OneOf(&[("\"set_point\"", 0), ("\"actual\"", 1)]);
 
@@ -92,7 +163,7 @@ macro_rules! gear_in_inputs {
                 "RatioNumerator": Kind::Real => inputs.ratio_numerator,
                 "RatioDenominator": Kind::Range(0, u16::MAX as i64) => inputs.ratio_denominator,
                 $($sync)*
-                "SyncMode": SYNC_MODE => inputs.sync_mode.time_based,
+                "SyncMode" as SYNC_MODE_ST: SYNC_MODE => inputs.sync_mode.time_based,
                 "CheckMask": CHECK_MASK => inputs.sync_mode.check_mask,
                 "OpMask": OP_MASK => inputs.sync_mode.op_mask,
                 "Velocity": Kind::Real => inputs.velocity,

@@ -285,6 +285,9 @@ fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
                 Type::Struct(s) => match c.structs[*s].fields.first() {
                     Some((_, Type::Elem(e))) => Some((offset + l.structs[*s].2[0], *e)),
                     Some((_, Type::Pointer(_))) => Some((offset + l.structs[*s].2[0], Elem::LInt)),
+                    Some((_, Type::Enum(e))) => {
+                        Some((offset + l.structs[*s].2[0], c.enums[*e].base))
+                    }
                     _ => None,
                 },
                 _ => None,
