@@ -11,7 +11,9 @@
 use crate::blocks::plain;
 use crate::kernel::{Accept, InFlight, Kernel, Outputs, Polled, Step, Waited};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, Target, TimelineBlock, Value};
+use crate::timeline::registry::{
+    input, BlockSpec, InputSpec, Kind, StForm, Target, TimelineBlock, Value,
+};
 use hli::enums::{ChannelCommand, ChannelCommandState, ChannelMode, ChannelState};
 use hli::handshake::SendError;
 use hli::layout::{HliChannelCommand, HliChannelControlState, PROGRAM_NAME_LEN};
@@ -284,6 +286,16 @@ impl ReadChannelState {
 
 impl TimelineBlock for ChannelCommandBlock {
     timeline_timeout!();
+    /// `program`: 1 to 63 characters, printable ASCII (the CNC checks the name as a path).
+    fn set_text(&mut self, key: &str, text: &[u8]) -> bool {
+        let fits = (1..PROGRAM_NAME_LEN).contains(&text.len());
+        if key != "program" || !fits || !text.iter().all(|b| b.is_ascii_graphic() || *b == b' ') {
+            return false;
+        }
+        self.program = [0; PROGRAM_NAME_LEN];
+        self.program[..text.len()].copy_from_slice(text);
+        true
+    }
     fn set(&mut self, key: &str, value: &Value) {
         match (key, value) {
             ("program", v) => {
@@ -357,7 +369,11 @@ const PROGRAM: InputSpec = input(
         parse: parse_program,
         example: "\"part.nc\"",
     },
-);
+)
+.st_rows(StForm::Text {
+    name: "ProgramName",
+    len: PROGRAM_NAME_LEN as u32 - 1,
+});
 
 const fn on_channel(
     name: &'static str,

@@ -168,6 +168,10 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
         Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
+        Bound::Text { var, len } => match io.text(var, len as usize + 1) {
+            Some(text) => inst.block.set_text(spec.key, text),
+            None => false,
+        },
         Bound::Struct { var, read } => {
             let field = |at: u32, bytes: u8| {
                 let t = match bytes {
@@ -224,7 +228,9 @@ fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
             rows,
             ..
         } => io.given(data) || io.given(columns) || io.given(rows),
-        Bound::CamRef { var, .. } | Bound::Struct { var, .. } => io.given(var),
+        Bound::CamRef { var, .. } | Bound::Struct { var, .. } | Bound::Text { var, .. } => {
+            io.given(var)
+        }
     }
 }
 

@@ -113,6 +113,13 @@ pub(super) enum Bound {
         /// The most values a call takes.
         max: usize,
     },
+    /// A STRING (its variable) of at most `len` characters.
+    Text {
+        /// The string.
+        var: usize,
+        /// Its most characters.
+        len: u32,
+    },
     /// A structure (its variable) and how its fields become the block's inputs.
     Struct {
         /// The structure.
@@ -150,7 +157,7 @@ impl Binding {
     pub(super) fn rows_room(&self) -> usize {
         let room = |(b, _): &(Bound, InputSpec)| match b {
             Bound::Rows { max, .. } => *max,
-            Bound::Value { .. } | Bound::CamRef { .. } | Bound::Struct { .. } => 0,
+            _ => 0,
         };
         self.inputs.iter().map(room).max().unwrap_or(0)
     }
@@ -169,7 +176,11 @@ impl Binding {
 fn expressible(input: &InputSpec) -> bool {
     matches!(
         input.st,
-        StForm::Rows { .. } | StForm::CamRef { .. } | StForm::Hidden | StForm::Struct { .. }
+        StForm::Rows { .. }
+            | StForm::CamRef { .. }
+            | StForm::Hidden
+            | StForm::Struct { .. }
+            | StForm::Text { .. }
     ) || !matches!(input.kind, Kind::Parsed { .. } | Kind::Room)
 }
 
@@ -286,9 +297,9 @@ impl Library {
 
     fn declare(&mut self, spec: &'static BlockSpec) {
         let hungarian = spec.style == StStyle::Hungarian;
-        let mut vars: Vec<(String, &str)> = Vec::new();
-        fn push(vars: &mut Vec<(String, &str)>, name: String, ty: &'static str) -> usize {
-            vars.push((name, ty));
+        let mut vars: Vec<(String, String)> = Vec::new();
+        fn push(vars: &mut Vec<(String, String)>, name: String, ty: impl Into<String>) -> usize {
+            vars.push((name, ty.into()));
             vars.len() - 1
         }
         let target = match (spec.target, hungarian) {
@@ -325,6 +336,10 @@ impl Library {
                     max_bytes,
                 },
                 StForm::Hidden => continue,
+                StForm::Text { name, len } => Bound::Text {
+                    var: push(&mut vars, name.into(), format!("STRING({len})")),
+                    len,
+                },
                 StForm::Struct {
                     name,
                     ty,

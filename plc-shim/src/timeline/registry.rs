@@ -172,6 +172,14 @@ pub enum StForm {
     /// Not an input of its own in Structured Text (a table's points and type come with the
     /// [`StForm::CamRef`] of the block).
     Hidden,
+    /// A `STRING(len)` under this name (ChannelSelectProgram's `ProgramName`): the block
+    /// takes its text with [`TimelineBlock::set_text`].
+    Text {
+        /// The input's name.
+        name: &'static str,
+        /// The most characters.
+        len: u32,
+    },
     /// A structure of the seeds' (the saw's `SyncMode : ST_SyncMode`) that gives this input
     /// and others: its name and type, the type's declaration, and how its fields become the
     /// block's inputs.
@@ -475,6 +483,11 @@ pub trait TimelineBlock: core::fmt::Debug {
     /// when there were more than the block takes, which it then refuses): `true` if the
     /// block takes rows ([`StForm::Rows`]). Does not allocate.
     fn set_rows(&mut self, _values: &[f64], _columns: u32, _rows: u32) -> bool {
+        false
+    }
+    /// Input `key` as text (a STRING's characters before its NUL): `false` if the block
+    /// takes no text or refuses this one. Does not allocate.
+    fn set_text(&mut self, _key: &str, _text: &[u8]) -> bool {
         false
     }
     /// Makes room for an `MC_CAM_REF`'s array of up to `bytes` bytes (at load): `true` if

@@ -175,6 +175,8 @@ pub enum StKind {
     StorePtr(Addr, Ex),
     /// Copies `size` bytes (a structure, an array, a string).
     Copy(Addr, Addr, u32),
+    /// Writes constant bytes (a string literal, NUL-padded to its STRING's size).
+    Bytes(Addr, Box<[u8]>),
     /// IF/ELSIF/ELSE.
     If(Vec<(Ex, Vec<St>)>, Vec<St>),
     /// CASE: each arm's ranges of values and statements, then ELSE.

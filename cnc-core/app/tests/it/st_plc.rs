@@ -150,6 +150,7 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "example4-turntable-plc",
         "cam-conveyor",
         "cam-ref",
+        "channel-control",
         "saw-blocks",
         "fifo-blocks",
     ] {

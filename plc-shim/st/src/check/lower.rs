@@ -487,6 +487,7 @@ impl Checker {
                 let size = l.size_align(&self.out, &ty).0;
                 StKind::Copy(addr, from, size)
             }
+            Type::Str(n) => self.lower_string(addr, n, value, ctx, l)?,
             _ => return Err(self.unsupported(value.pos(), "an assignment of this type")),
         })
     }
@@ -632,6 +633,13 @@ impl Checker {
                 })? {
                     let leaf = Addr::Offset(Box::new(from.clone()), at);
                     inputs.push((offset + at, t, Ex::Load(Box::new(leaf), t)));
+                }
+                continue;
+            }
+            if let (Type::Str(n), Arg::Input(_, v)) = (&member, arg) {
+                // A STRING input is passed in 8-byte parts (its literal's as constants).
+                for (at, t, part) in self.string_parts(*n, v, ctx, l)? {
+                    inputs.push((offset + at, t, part));
                 }
                 continue;
             }

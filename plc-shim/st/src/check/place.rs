@@ -5,6 +5,7 @@ use super::expr::Ctx;
 use super::lower::R;
 use super::{Checker, Type};
 use crate::ast::{BinOp, Expr};
+use crate::diag::Diagnostic;
 use crate::ir::{Addr, Ex, StKind, StdFn};
 use crate::layout::Layout;
 use crate::types::Elem;
@@ -126,5 +127,94 @@ impl Checker {
             _ => return None,
         }
         Some(())
+    }
+}
+
+/// The parts a STRING(n)'s n + 1 bytes are passed in: 8-byte words, then single bytes.
+fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
+    let size = n + 1;
+    let words = (0..size / 8).map(|k| (8 * k, Elem::LWord));
+    words
+        .chain((size / 8 * 8..size).map(|at| (at, Elem::Byte)))
+        .collect()
+}
+
+impl Checker {
+    /// A string literal's bytes for a STRING(n): ASCII, at most n characters, NUL-padded to
+    /// n + 1 bytes.
+    fn literal_bytes(&mut self, text: &str, n: u32, pos: crate::diag::Pos) -> R<Vec<u8>> {
+        if !text.is_ascii() {
+            return Err(self.unsupported(pos, "a STRING of other than ASCII characters"));
+        }
+        if text.len() > n as usize {
+            let message = format!(
+                "'{text}' has {} characters: a STRING({n}) holds {n}",
+                text.len()
+            );
+            return Err(Diagnostic::new(pos, message).in_file(&self.file));
+        }
+        let mut bytes = text.as_bytes().to_vec();
+        bytes.resize(n as usize + 1, 0);
+        Ok(bytes)
+    }
+
+    /// `value` (a literal or a STRING variable no longer than n) stored into a STRING(n).
+    pub(super) fn lower_string(
+        &mut self,
+        addr: Addr,
+        n: u32,
+        value: &Expr,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<StKind> {
+        if let Expr::Str(text, pos) = value {
+            let bytes = self.literal_bytes(text, n, *pos)?;
+            return Ok(StKind::Bytes(addr, bytes.into_boxed_slice()));
+        }
+        let (from, ty) = self.place(value, ctx, l)?;
+        match ty {
+            Type::Str(m) if m <= n => Ok(StKind::Copy(addr, from, m + 1)),
+            Type::Str(m) => {
+                let message = format!("a STRING({m}) into a STRING({n}): it may not fit");
+                Err(Diagnostic::new(value.pos(), message).in_file(&self.file))
+            }
+            _ => Err(self.unsupported(value.pos(), "this value into a STRING")),
+        }
+    }
+
+    /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING
+    /// variable's (no longer than n) loaded.
+    pub(super) fn string_parts(
+        &mut self,
+        n: u32,
+        value: &Expr,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Vec<(u32, Elem, Ex)>> {
+        let chunks = string_chunks(n);
+        if let Expr::Str(text, pos) = value {
+            let bytes = self.literal_bytes(text, n, *pos)?;
+            return Ok(chunks
+                .into_iter()
+                .map(|(at, t)| {
+                    let mut word = [0u8; 8];
+                    let part = &bytes[at as usize..at as usize + t.size()];
+                    word[..part.len()].copy_from_slice(part);
+                    (at, t, Ex::Int(i64::from_le_bytes(word)))
+                })
+                .collect());
+        }
+        let (from, ty) = self.place(value, ctx, l)?;
+        let m = match ty {
+            Type::Str(m) if m <= n => m,
+            _ => return Err(self.unsupported(value.pos(), "this value into a STRING input")),
+        };
+        Ok(string_chunks(m)
+            .into_iter()
+            .map(|(at, t)| {
+                let part = Addr::Offset(Box::new(from.clone()), at);
+                (at, t, Ex::Load(Box::new(part), t))
+            })
+            .collect())
     }
 }

@@ -86,6 +86,14 @@ impl BlockIo<'_> {
         }
     }
 
+    /// The characters of STRING variable `k` (`size` bytes with its NUL) before its NUL.
+    pub fn text(&self, k: usize, size: usize) -> Option<&[u8]> {
+        let (at, _) = self.place(k)?;
+        let bytes = self.memory.get(at..at.checked_add(size)?)?;
+        let end = bytes.iter().position(|b| *b == 0).unwrap_or(bytes.len());
+        Some(&bytes[..end])
+    }
+
     /// The `n` bytes of the program's memory pointer `p` points at: `None` for NULL, a
     /// pointer into the image, or bytes beyond the memory.
     pub fn memory_at(&self, p: i64, n: usize) -> Option<&[u8]> {
@@ -282,6 +290,7 @@ fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
             match &v.ty {
                 Type::Elem(e) => Some((offset, *e)),
                 Type::Pointer(_) => Some((offset, Elem::LInt)),
+                Type::Str(_) => Some((offset, Elem::Byte)),
                 Type::Struct(s) => match c.structs[*s].fields.first() {
                     Some((_, Type::Elem(e))) => Some((offset + l.structs[*s].2[0], *e)),
                     Some((_, Type::Pointer(_))) => Some((offset + l.structs[*s].2[0], Elem::LInt)),

@@ -395,6 +395,11 @@ impl<'a> Exec<'a> {
                 self.check(from, n)?;
                 self.st.memory.copy_within(from..from + n, to);
             }
+            StKind::Bytes(to, bytes) => {
+                let to = self.own(to, base)?;
+                self.check(to, bytes.len())?;
+                self.st.memory[to..to + bytes.len()].copy_from_slice(bytes);
+            }
             StKind::If(arms, otherwise) => {
                 for (cond, body) in arms {
                     if self.operand(cond, base)?.int() != 0 {

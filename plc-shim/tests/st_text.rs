@@ -1,0 +1,81 @@
+//! Text in Structured Text: a STRING variable given a literal, passed on as
+//! ChannelSelectProgram's `ProgramName`, reaches the channel's command in the image byte for
+//! byte; an empty name, or one with a character that is no printable ASCII, ends the command
+//! with 0x4227 and writes nothing; a literal longer than its STRING is refused at load.
+
+use hli::symbols::SymbolTable;
+use hli::views::PlcView;
+use hli_transport::rpc::{AcyclicClient, AcyclicServer};
+use plc_shim::runtime::{Link, PlcIo, PlcProgram};
+use plc_shim::st::host::INVALID_INPUT;
+use plc_shim::st::StProgram;
+
+const PROGRAM: &str = "PROGRAM MAIN
+VAR
+    sName : STRING(40);
+    fbSelect : ChannelSelectProgram;
+    bError : BOOL;
+    nErrorId : UDINT;
+END_VAR
+    sName := 'sub/part 2.nc';
+    fbSelect(Channel := 0, Execute := TRUE, ProgramName := sName, Error => bError,
+        ErrorID => nErrorId);
+END_PROGRAM
+";
+
+/// The program name the command in the image holds after one cycle, and the ErrorID.
+fn selected(text: &str, case: &str) -> (String, f64) {
+    let instance = tests::unique_instance(case);
+    let _server = AcyclicServer::open(&instance).unwrap();
+    let mut client = AcyclicClient::open(&instance).unwrap();
+    let memory = hli::image::heap_image(1, 1);
+    let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
+    p.cycle(&mut PlcIo {
+        view: PlcView::new(&memory),
+        memory: &memory,
+        acyclic: &mut client,
+        cycle: 0,
+        link: Link::Operational,
+    });
+    assert!(!p.halted(), "{}", p.summary());
+    let at = SymbolTable::global()
+        .lookup("gpCh[0]^channel_control.command_w.program")
+        .expect("the command's program name")
+        .offset;
+    let name: Vec<u8> = (0..64)
+        .map(|k| memory.place::<u8>(at + k).load())
+        .take_while(|b| *b != 0)
+        .collect();
+    let id = p.program().read_var("MAIN.nErrorId").unwrap();
+    (String::from_utf8(name).unwrap(), id)
+}
+
+#[test]
+fn a_string_variable_reaches_the_channels_command_as_program_name() {
+    assert_eq!(selected(PROGRAM, "st-text"), ("sub/part 2.nc".into(), 0.0));
+}
+
+#[test]
+fn an_empty_name_or_a_control_character_ends_the_command_with_0x4227() {
+    for (case, name) in [("empty", "''"), ("tab", "'a$Tb.nc'")] {
+        let text = PROGRAM.replace("'sub/part 2.nc'", name);
+        let (sent, id) = selected(&text, &format!("st-text-{case}"));
+        assert_eq!(
+            (sent.as_str(), id),
+            ("", f64::from(INVALID_INPUT)),
+            "{case}"
+        );
+    }
+}
+
+#[test]
+fn a_literal_longer_than_its_string_is_refused_at_load() {
+    let text = PROGRAM.replace("STRING(40)", "STRING(8)");
+    let refused = StProgram::from_texts(&[("main.st".into(), text)], 1).unwrap_err();
+    assert!(
+        refused.contains(
+            "main.st:8:14: error: 'sub/part 2.nc' has 13 characters: a STRING(8) holds 8"
+        ),
+        "{refused}"
+    );
+}
