@@ -2,7 +2,8 @@
 //! sends the rows an MC_CAM_REF describes, MC_WriteMotionFunction its points; a description
 //! its array does not match ends the command with the seed's code before anything is sent;
 //! a NULL address, an array beyond the program's memory or the room, or a value that is not
-//! finite ends it with 0x4227; taking tables at the edges allocates nothing.
+//! finite ends it with 0x4227; taking tables at the edges allocates nothing; a read's
+//! MC_CAM_REF is checked the same way before the read is sent.
 
 use hli::calls::cam::{CamPointsWriteCall, CamRowsWriteCall};
 use hli::calls::ErrorCode;
@@ -206,4 +207,52 @@ fn taking_tables_at_the_edges_allocates_nothing() {
         cnc.cycle(&mut p);
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
+}
+
+#[test]
+fn a_read_into_an_array_its_mc_cam_ref_does_not_describe_ends_before_it_is_sent() {
+    let read = "PROGRAM MAIN
+VAR
+    aPoints : ARRAY[1..4] OF MC_MotionFunctionPoint;
+    stCamRef : MC_CAM_REF;
+    fbRead : MC_ReadMotionFunction;
+    axLifter : AXIS_REF;
+    bError : BOOL;
+    nErrorId : UDINT;
+END_VAR
+    stCamRef.pArray := ADR(aPoints);
+    stCamRef.nArraySize := SIZEOF(aPoints);
+    stCamRef.nTableType := 22;
+    stCamRef.nNoOfRows := 4;
+    stCamRef.nNoOfCols := 1;
+    axLifter.AxisIndex := 1;
+    fbRead(Axis := axLifter, Execute := TRUE, Table := 1, PointIndex := 1,
+        CamTable := stCamRef, Error => bError, ErrorID => nErrorId);
+END_PROGRAM
+";
+    let mut cnc = Cnc::new("st-camref-read");
+    let mut p = load(read);
+    cnc.cycle(&mut p);
+    assert_eq!(
+        (cnc.client.sent(), var(&p, "bError")),
+        (1, 0.0),
+        "a fitting array"
+    );
+    for (case, from, to, code) in [
+        ("type", "nTableType := 22", "nTableType := 10", 0x4B35),
+        ("columns", "nNoOfCols := 1", "nNoOfCols := 2", 0x4B37),
+        ("size", "SIZEOF(aPoints)", "100", 0x4B31),
+        (
+            "null",
+            "stCamRef.pArray := ADR(aPoints);",
+            "",
+            INVALID_INPUT,
+        ),
+    ] {
+        let mut cnc = Cnc::new(&format!("st-camref-read-{case}"));
+        let mut p = load(&read.replace(from, to));
+        cnc.cycle(&mut p);
+        assert_eq!(cnc.client.sent(), 0, "{case}: nothing sent");
+        assert_eq!(var(&p, "nErrorId"), f64::from(code), "{case}");
+    }
 }

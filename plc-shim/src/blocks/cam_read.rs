@@ -6,7 +6,9 @@
 use super::cam::recorded;
 use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled};
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, BlockSpec, InputSpec, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{
+    input, BlockSpec, CamRefIn, InputSpec, Kind, StForm, TimelineBlock, Value,
+};
 use hli::calls::cam::CamReadKind;
 use hli_transport::rpc::PendingCall;
 
@@ -203,6 +205,8 @@ pub struct PointsRead {
     table: u32,
     first: u32,
     count: u32,
+    /// The most points the array takes (its room, or a program's array's size).
+    limit: usize,
     pending: PendingCall<hli::calls::cam::CamPointsReadCall>,
 }
 
@@ -245,7 +249,7 @@ impl InFlight for PointsRead {
             0 => left,
             count => (count as usize).min(left),
         };
-        if wanted > points.capacity() {
+        if wanted > points.capacity().min(self.limit) {
             return Polled::Answer(Err(ERROR_ARRAY_SIZE));
         }
         let take = (reply.count as usize).min(wanted.saturating_sub(points.len()));
@@ -280,6 +284,9 @@ pub struct McReadMotionFunction {
     pub points: Vec<hli::calls::cam::McMotionFunctionPoint>,
     /// Outputs of the last call.
     pub out: Outputs,
+    /// A program's array the points go into: the most it holds, or the seed's code of a
+    /// description that does not fit a motion function's points.
+    pub destination: Option<Result<usize, u32>>,
     kernel: Kernel<PointsRead>,
 }
 
@@ -295,6 +302,7 @@ impl McReadMotionFunction {
             count: 0,
             points: Vec::with_capacity(room),
             out: Outputs::default(),
+            destination: None,
             kernel: Kernel::default(),
         }
     }
@@ -302,13 +310,20 @@ impl McReadMotionFunction {
     /// One cycle.
     pub fn call(&mut self, io: &mut PlcIo<'_>) {
         let (table, first, count) = (self.table, self.first, self.count);
+        let destination = self.destination;
         let send = |io: &mut PlcIo<'_>,
                     points: &mut Vec<hli::calls::cam::McMotionFunctionPoint>| {
             points.clear();
+            let limit = match destination {
+                Some(Err(code)) => return Err(code),
+                Some(Ok(limit)) => limit,
+                None => usize::MAX,
+            };
             Ok(PointsRead {
                 table,
                 first,
                 count,
+                limit,
                 pending: read_points(io, table, first)?,
             })
         };
@@ -351,6 +366,24 @@ impl TimelineBlock for McCamRead {
     fn read(&self) -> Option<Vec<f64>> {
         Some(self.values.clone())
     }
+    /// MC_ReadMotionFunctionValues' `CamTable`: its columns against the mask, its size in
+    /// LREALs the most the answer may hold.
+    fn set_destination(&mut self, array: &CamRefIn<'_>) -> bool {
+        if self.request.what != CamReadKind::Values.raw() {
+            return false;
+        }
+        self.array_columns = Some(array.columns);
+        self.size_limit = Some(array.array_size as usize / 8);
+        true
+    }
+    fn read_bytes(&self, out: &mut [u8]) -> usize {
+        let mut written = 0;
+        for (value, slot) in self.values.iter().zip(out.chunks_exact_mut(8)) {
+            slot.copy_from_slice(&value.to_le_bytes());
+            written += 8;
+        }
+        written
+    }
 }
 
 impl TimelineBlock for McReadMotionFunction {
@@ -364,6 +397,25 @@ impl TimelineBlock for McReadMotionFunction {
         }
     }
     execute_cycle!(no_axis, recorded);
+    /// MC_ReadMotionFunction's `CamTable`: a motion function's (type 22, one column), its
+    /// size a whole number of points (the seed's 0x4B35, 0x4B37, 0x4B31 otherwise).
+    fn set_destination(&mut self, array: &CamRefIn<'_>) -> bool {
+        let point = core::mem::size_of::<hli::calls::cam::McMotionFunctionPoint>();
+        let size = array.array_size as usize;
+        self.destination = Some(match (array.table_type, array.columns) {
+            (22, 1) if size.is_multiple_of(point) => Ok(size / point),
+            (22, 1) => Err(ERROR_ARRAY_SIZE),
+            (22, _) => Err(ERROR_COLUMNS),
+            _ => Err(0x4B35),
+        });
+        true
+    }
+    fn read_bytes(&self, out: &mut [u8]) -> usize {
+        let bytes: &[u8] = bytemuck::cast_slice(&self.points);
+        let n = bytes.len().min(out.len());
+        out[..n].copy_from_slice(&bytes[..n]);
+        n
+    }
     /// Index, master and slave position of every point read.
     fn read(&self) -> Option<Vec<f64>> {
         let points = self.points.iter();
@@ -378,7 +430,9 @@ impl TimelineBlock for McReadMotionFunction {
 const TABLE: InputSpec = input("table", Kind::Count);
 const POINT_INDEX: InputSpec = input("point_index", Kind::Count);
 const MASTER_POSITION: InputSpec = input("master_position", Kind::Real);
-const ROOM: InputSpec = input("room", Kind::Room);
+/// The room of a read's answer: in Structured Text the seed's `CamTable : MC_CAM_REF`, the
+/// program's array the answer goes into.
+const ROOM: InputSpec = input("room", Kind::Room).st_rows(StForm::ReadInto { name: "CamTable" });
 
 /// The cam reads a timeline calls; `room` (where a read has it) is the room of the answer,
 /// [`DEFAULT_READ_ROOM`] if not given.

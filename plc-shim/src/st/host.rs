@@ -42,6 +42,8 @@ struct Instance {
     /// The outputs as the instance's variables hold them (written when they change: the
     /// program cannot write them, see `Blocks::forget_outputs` for a tool).
     shown: Option<(Outputs, bool)>,
+    /// The program's array (address, bytes) a read's answer goes into when it is Done.
+    destination: Option<(i64, usize)>,
 }
 
 /// The blocks of a program's instances (one per instance, made at load).
@@ -72,6 +74,7 @@ impl Blocks {
                     timeout_given: false,
                     site: usize::MAX,
                     shown: None,
+                    destination: None,
                 }
             })
             .collect();
@@ -168,6 +171,7 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
         Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
+        Bound::ReadInto { var } => pass_destination(io, inst, var),
         Bound::Text { var, len } => match io.text(var, len as usize + 1) {
             Some(text) => inst.block.set_text(spec.key, text),
             None => false,
@@ -187,35 +191,50 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
     }
 }
 
+/// An `MC_CAM_REF` a read's answer goes into: its array checked to lie in the program's
+/// memory (refused otherwise), its description to the block.
+fn pass_destination(io: &BlockIo<'_>, inst: &mut Instance, var: usize) -> bool {
+    inst.destination = None;
+    let Some(table) = cam_ref(io, var) else {
+        return false;
+    };
+    let (Some(p), size) = (io.field(var, 0, Elem::LWord), table.array_size as usize) else {
+        return false;
+    };
+    if io.memory_at(p, size).is_none() {
+        return false;
+    }
+    inst.destination = Some((p, size));
+    inst.block.set_destination(&table)
+}
+
+/// An `MC_CAM_REF`'s description (its bytes empty).
+fn cam_ref(io: &BlockIo<'_>, var: usize) -> Option<CamRefIn<'static>> {
+    let [size, table_type, rows, columns] =
+        CAM_REF_FIELDS.map(|at| io.field(var, at, Elem::UDInt).map(|v| v as u32));
+    Some(CamRefIn {
+        bytes: &[],
+        array_size: size?,
+        table_type: table_type?,
+        rows: rows?,
+        columns: columns?,
+    })
+}
+
 /// An `MC_CAM_REF` to its block: its array read where `pArray` points, `nArraySize` bytes of
 /// the program's memory; `false` (refused) for a NULL pointer or one into the image, an
 /// array beyond the memory or larger than the room made at load, or a value not finite.
 fn pass_cam_ref(io: &BlockIo<'_>, inst: &mut Instance, var: usize, max_bytes: usize) -> bool {
-    let [size, table_type, rows, columns] =
-        CAM_REF_FIELDS.map(|at| io.field(var, at, Elem::UDInt).map(|v| v as u32));
-    let (Some(p), Some(size), Some(table_type), Some(rows), Some(columns)) = (
-        io.field(var, 0, Elem::LWord),
-        size,
-        table_type,
-        rows,
-        columns,
-    ) else {
+    let (Some(p), Some(table)) = (io.field(var, 0, Elem::LWord), cam_ref(io, var)) else {
         return false;
     };
-    if size as usize > max_bytes {
+    if table.array_size as usize > max_bytes {
         return false;
     }
-    let Some(bytes) = io.memory_at(p, size as usize) else {
+    let Some(bytes) = io.memory_at(p, table.array_size as usize) else {
         return false;
     };
-    let table = CamRefIn {
-        bytes,
-        array_size: size,
-        table_type,
-        rows,
-        columns,
-    };
-    inst.block.set_cam_ref(&table)
+    inst.block.set_cam_ref(&CamRefIn { bytes, ..table })
 }
 
 /// Whether this call gives input `bound`.
@@ -228,9 +247,10 @@ fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
             rows,
             ..
         } => io.given(data) || io.given(columns) || io.given(rows),
-        Bound::CamRef { var, .. } | Bound::Struct { var, .. } | Bound::Text { var, .. } => {
-            io.given(var)
-        }
+        Bound::CamRef { var, .. }
+        | Bound::Struct { var, .. }
+        | Bound::Text { var, .. }
+        | Bound::ReadInto { var } => io.given(var),
     }
 }
 
@@ -320,7 +340,14 @@ impl Host for BlockHost<'_, '_> {
         if let (Some(e), Some(x)) = (inst.block.execute(), execute) {
             *e = x;
         }
+        let was_done = inst.shown.is_some_and(|(o, _)| o.done);
         let out = inst.block.cycle(self.io, axis);
+        // A read's answer into the program's array, once, when it is Done.
+        if let (true, false, Some((p, n))) = (out.0.done, was_done, inst.destination) {
+            if let Some(array) = io.memory_at_mut(p, n) {
+                inst.block.read_bytes(array);
+            }
+        }
         show(io, binding, inst, out);
         Ok(())
     }

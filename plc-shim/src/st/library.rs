@@ -113,6 +113,11 @@ pub(super) enum Bound {
         /// The most values a call takes.
         max: usize,
     },
+    /// An `MC_CAM_REF` (its variable) a read's answer goes into.
+    ReadInto {
+        /// The structure.
+        var: usize,
+    },
     /// A STRING (its variable) of at most `len` characters.
     Text {
         /// The string.
@@ -181,6 +186,7 @@ fn expressible(input: &InputSpec) -> bool {
             | StForm::Hidden
             | StForm::Struct { .. }
             | StForm::Text { .. }
+            | StForm::ReadInto { .. }
     ) || !matches!(input.kind, Kind::Parsed { .. } | Kind::Room)
 }
 
@@ -336,6 +342,9 @@ impl Library {
                     max_bytes,
                 },
                 StForm::Hidden => continue,
+                StForm::ReadInto { name } => Bound::ReadInto {
+                    var: push(&mut vars, name.into(), "MC_CAM_REF"),
+                },
                 StForm::Text { name, len } => Bound::Text {
                     var: push(&mut vars, name.into(), format!("STRING({len})")),
                     len,

@@ -172,6 +172,14 @@ pub enum StForm {
     /// Not an input of its own in Structured Text (a table's points and type come with the
     /// [`StForm::CamRef`] of the block).
     Hidden,
+    /// The seed's `MC_CAM_REF` under this name as the array a read's answer goes into
+    /// (MC_ReadMotionFunction's and MC_ReadMotionFunctionValues' `CamTable`): the block
+    /// checks its description when it reads ([`TimelineBlock::set_destination`]) and its
+    /// answer is copied there when it is Done ([`TimelineBlock::read_bytes`]).
+    ReadInto {
+        /// The structure's name.
+        name: &'static str,
+    },
     /// A `STRING(len)` under this name (ChannelSelectProgram's `ProgramName`): the block
     /// takes its text with [`TimelineBlock::set_text`].
     Text {
@@ -484,6 +492,17 @@ pub trait TimelineBlock: core::fmt::Debug {
     /// block takes rows ([`StForm::Rows`]). Does not allocate.
     fn set_rows(&mut self, _values: &[f64], _columns: u32, _rows: u32) -> bool {
         false
+    }
+    /// The array a read's answer goes into (an `MC_CAM_REF`'s description; `bytes` empty):
+    /// `true` if the block reads into one. The block checks the description against what it
+    /// reads, with the seed's codes, when it runs.
+    fn set_destination(&mut self, _array: &CamRefIn<'_>) -> bool {
+        false
+    }
+    /// The last read's answer as the bytes a program's array holds it in (LREALs, or
+    /// 56-byte `MC_MotionFunctionPoint`s), at most `out.len()` of them: the bytes written.
+    fn read_bytes(&self, _out: &mut [u8]) -> usize {
+        0
     }
     /// Input `key` as text (a STRING's characters before its NUL): `false` if the block
     /// takes no text or refuses this one. Does not allocate.

@@ -149,6 +149,7 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "example4-turntable-hybrid",
         "example4-turntable-plc",
         "cam-conveyor",
+        "cam-data",
         "cam-ref",
         "channel-control",
         "saw-blocks",
@@ -193,4 +194,75 @@ fn cnc_demo_st_traces_as_the_rust_program_does() {
         rust == st,
         "the ST demo differs from byte {first_difference:?} on"
     );
+}
+
+/// An ST program shared with the test while the in-process run cycles it.
+struct Shared(std::rc::Rc<std::cell::RefCell<plc_shim::st::StProgram>>);
+
+impl plc_shim::runtime::PlcProgram for Shared {
+    fn cycle(&mut self, io: &mut plc_shim::runtime::PlcIo<'_>) {
+        self.0.borrow_mut().cycle(io);
+    }
+    fn summary(&self) -> String {
+        self.0.borrow().summary()
+    }
+}
+
+/// The first numbers a timeline's report shows of block `instance`'s read.
+fn reported(summary: &str, instance: &str) -> Vec<f64> {
+    let block = format!("block {instance} (");
+    let at = summary.find(&block).expect(instance);
+    let line = summary[at..].lines().nth(1).expect("its read line");
+    let values = line.split_once(": ").expect("read values").1;
+    values
+        .split(", ")
+        .filter(|v| *v != "...")
+        .map(|v| v.parse().unwrap())
+        .collect()
+}
+
+/// The reads of scenarios/cam-data in ST (MC_ReadMotionFunctionValues and
+/// MC_ReadMotionFunction through an MC_CAM_REF) fill the program's arrays with the numbers
+/// the timeline twin's blocks read, on the same machine.
+#[test]
+fn st_reads_fill_the_programs_arrays_with_what_the_timeline_reads() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/cam-data");
+    let timeline = Scenario::load(std::path::Path::new(&format!("{dir}/scenario.toml"))).unwrap();
+    let run = InProcess::run_through(&timeline).unwrap();
+    let summary = run.timeline.as_ref().unwrap().summary();
+    let (values, points) = (reported(&summary, "values"), reported(&summary, "points"));
+    assert!(values.len() >= 12 && points.len() >= 12, "{summary}");
+
+    let st = Scenario::load(std::path::Path::new(&format!("{dir}/scenario-st.toml"))).unwrap();
+    let program =
+        plc_shim::st::StProgram::load(&[format!("{dir}/plc.st").into()], 1).expect("plc.st");
+    let shared = std::rc::Rc::new(std::cell::RefCell::new(program));
+    let mut run = InProcess::new(&st, 0).unwrap();
+    run.program = Some(cnc_app::scenario::machine::BuiltIn(Box::new(Shared(
+        shared.clone(),
+    ))));
+    for _ in 0..st.ticks.unwrap() {
+        run.step(st.cycle_s);
+    }
+    let p = shared.borrow();
+    let symbols = p.program().symbols(100_000);
+    let lreal = |path: &str| {
+        let s = symbols.iter().find(|s| s.path == path).expect(path);
+        let at = s.offset as usize;
+        f64::from_le_bytes(p.program().memory()[at..at + 8].try_into().unwrap())
+    };
+    let row_major: Vec<f64> = (1..=6)
+        .flat_map(|r| (1..=2).map(move |c| (r, c)))
+        .map(|(r, c)| lreal(&format!("MAIN.aValues[{r},{c}]")))
+        .collect();
+    assert_eq!(row_major, values[..12]);
+    for k in 0..4 {
+        let field = |f: &str| lreal(&format!("MAIN.aPoints[{}].{f}", k + 1));
+        assert_eq!(
+            [field("MasterPos"), field("SlavePos")],
+            [points[3 * k + 1], points[3 * k + 2]],
+            "point {}",
+            k + 1
+        );
+    }
 }

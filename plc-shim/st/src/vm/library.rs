@@ -104,6 +104,15 @@ impl BlockIo<'_> {
         self.memory.get(at..at.checked_add(n)?)
     }
 
+    /// As [`BlockIo::memory_at`], to write (a read's answer into the program's array).
+    pub fn memory_at_mut(&mut self, p: i64, n: usize) -> Option<&mut [u8]> {
+        if p & super::IMAGE_TAG != 0 || p <= 0 {
+            return None;
+        }
+        let at = (p - 1) as usize;
+        self.memory.get_mut(at..at.checked_add(n)?)
+    }
+
     /// Variable `k` as a number.
     pub fn real(&self, k: usize) -> Option<f64> {
         let (at, t) = self.place(k)?;

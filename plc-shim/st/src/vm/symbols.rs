@@ -73,18 +73,26 @@ impl Program {
                     self.list(&format!("{path}.{}", v.name), &v.ty, at, limit, out);
                 }
             }
-            Type::Array(dims, element) if dims.len() == 1 => {
+            Type::Array(dims, element) => {
                 let (size, align) = l.size_align(c, element);
                 let stride = size.div_ceil(align) * align;
-                let (lo, hi) = dims[0];
-                let n = (hi.abs_diff(lo) + 1).min(MAX_LISTED_ELEMENTS);
+                let lens: Vec<u64> = dims.iter().map(|(lo, hi)| hi.abs_diff(*lo) + 1).collect();
+                let total = lens.iter().try_fold(1u64, |n, len| n.checked_mul(*len));
+                let n = total.unwrap_or(u64::MAX).min(MAX_LISTED_ELEMENTS);
+                // Row-major, the last index fastest: `a[1,1]`, `a[1,2]`, ...
                 for k in 0..n as u32 {
-                    let index = lo + i64::from(k);
+                    let (mut rest, mut index) = (u64::from(k), Vec::with_capacity(dims.len()));
+                    for (d, len) in dims.iter().zip(&lens).rev() {
+                        index.push((d.0 + (rest % len) as i64).to_string());
+                        rest /= len;
+                    }
+                    index.reverse();
                     let at = at + k * stride;
-                    self.list(&format!("{path}[{index}]"), element, at, limit, out);
+                    let name = format!("{path}[{}]", index.join(","));
+                    self.list(&name, element, at, limit, out);
                 }
             }
-            // Pointers, strings, standard blocks, arrays of several dimensions: not listed.
+            // Pointers, strings, standard blocks: not listed.
             _ => {}
         }
     }
