@@ -17,12 +17,14 @@
 //! | CamTableSetMasterSlaveScale | MC_CamScaling of offsets and scalings, at once |
 
 use super::cam::{recorded, CamCore};
-use super::cam_data::{CamData, ChunkTransfer, ROW_BYTES};
+use super::cam_data::{CamData, ChunkTransfer, CAM_REF_ROOM_BYTES, ROW_BYTES};
 use super::cam_read::{McCamRead, DEFAULT_READ_ROOM};
+use super::cam_room::CamRoom;
 use crate::kernel::{no_follow, Accept, Kernel, Outputs};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
-    input, required, BlockSpec, InputField, InputSpec, Kind, Target, TimelineBlock, Value,
+    input, required, BlockSpec, CamRefIn, InputField, InputSpec, Kind, StForm, Target,
+    TimelineBlock, Value,
 };
 use hli::calls::cam::{
     CamInCall, CamOutCall, CamReadKind, CamRowsWriteCall, CamScalingCall, CamTableDeleteCall,
@@ -45,6 +47,13 @@ pub struct CompatConfig {
     pub rows_declared: u32,
     /// The rows of CamTableGenerate and CamTableWriteData.
     pub rows: Option<Arc<[[f64; 2]]>>,
+    /// How many of `rows` are the table's (a PLC program's rows in room made at load);
+    /// `None`: all.
+    pub rows_count: Option<usize>,
+    /// The seed's code of rows a PLC program gave that do not fit their array (0x4B37 for
+    /// columns other than 2, 0x4B31 for more than the array's size): the command ends with
+    /// it, nothing sent.
+    pub refuse: Option<u32>,
     /// iMasterId.
     pub master: u32,
     /// Offsets, slopes (scalings) and the master position of a read.
@@ -86,6 +95,8 @@ impl CompatConfig {
             table_type: 3,
             rows_declared: 0,
             rows: None,
+            rows_count: None,
+            refuse: None,
             master: 0,
             master_offset: 0.0,
             slave_offset: 0.0,
@@ -115,6 +126,7 @@ impl CompatConfig {
             "rows" => {
                 if let Value::Rows(rows) = value {
                     self.rows = Some(Arc::clone(rows));
+                    (self.rows_count, self.refuse) = (None, None);
                 }
             }
             "block_size" => self.block_size.take(value),
@@ -136,67 +148,83 @@ impl CompatConfig {
     }
 }
 
+// The inputs under the seed's names in Structured Text (5.2: `iTableId`, `AdrDataArray`,
+// `fMasterPositionOffset`, `bCoupleOn`, ...).
+
 /// iTableId, 1..=255.
-const TABLE: InputSpec = input("table", Kind::Range(1, 255));
+const TABLE: InputSpec = input("table", Kind::Range(1, 255)).st_named("iTableId");
 /// iTableType 1..=4.
-const TABLE_TYPE: InputSpec = input("table_type", Kind::Range(1, 4));
-/// The rows `[[master, slave], ...]`.
-const ROWS: InputSpec = input("rows", super::cam_data::ROWS);
+const TABLE_TYPE: InputSpec = input("table_type", Kind::Range(1, 4)).st_named("iTableType");
+/// The rows `[[master, slave], ...]`; in ST the seed's array through a pointer.
+const ROWS: InputSpec = input("rows", super::cam_data::ROWS).st_rows(StForm::Rows {
+    data: "AdrDataArray",
+    columns: "iColDim",
+    rows: "iRowsToWrite",
+    size: Some("iSizeOfDataArray"),
+    max: CAM_REF_ROOM_BYTES / 8,
+});
 /// iBlockSize: 0 (the call's room) or at least one row's bytes.
 const BLOCK_SIZE: InputSpec = input(
     "block_size",
-    Kind::Parsed {
-        parse: |v| match v.as_integer() {
-            Some(b) if b == 0 || (i64::from(ROW_BYTES)..=i64::from(u32::MAX)).contains(&b) => {
-                Ok(Value::Int(b))
-            }
-            _ => Err(format!(
-                "call: `block_size` = {v}: 0 (the default) or at least {ROW_BYTES} bytes (one row)"
-            )),
-        },
-        example: "0",
-    },
-);
-const MASTER_OFFSET: InputSpec = input("master_offset", Kind::Real);
-const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real);
-const SLAVE_SLOPE: InputSpec = input("slave_slope", Kind::Real);
+    Kind::ZeroOr(ROW_BYTES as i64, u32::MAX as i64),
+)
+.st_named("iBlockSize");
+const MASTER_OFFSET: InputSpec =
+    input("master_offset", Kind::Real).st_named("fMasterPositionOffset");
+const SLAVE_OFFSET: InputSpec = input("slave_offset", Kind::Real).st_named("fSlavePositionOffset");
+const SLAVE_SLOPE: InputSpec = input("slave_slope", Kind::Real).st_named("fSlaveSlope");
 /// The coupling blocks' inputs; CamTableCoupleAxesIpol's also `interpolation`.
 const COUPLE: [InputSpec; 7] = [
-    input("master", Kind::Range(0, u32::MAX as i64)),
+    input("master", Kind::Range(0, u32::MAX as i64)).st_named("iMasterId"),
     TABLE,
     MASTER_OFFSET,
     SLAVE_OFFSET,
-    input("master_absolute", Kind::Bool),
-    input("slave_absolute", Kind::Bool),
-    input("on", Kind::Bool),
+    input("master_absolute", Kind::Bool).st_named("bMasterAbsolut"),
+    input("slave_absolute", Kind::Bool).st_named("bSlaveAbsolut"),
+    input("on", Kind::Bool).st_rows(COUPLE_EDGES),
 ];
-const COUPLE_IPOL: [InputSpec; 8] =
-    crate::timeline::registry::joined(&[&COUPLE, &[input("interpolation", Kind::Range(0, 2))]]);
+/// bCoupleOn and bCoupleOff: the couplings' two edges.
+pub(super) const COUPLE_EDGES: StForm = StForm::Edges {
+    on: "bCoupleOn",
+    off: "bCoupleOff",
+};
+const COUPLE_IPOL: [InputSpec; 8] = crate::timeline::registry::joined(&[
+    &COUPLE,
+    &[input("interpolation", Kind::Range(0, 2)).st_named("iIpolType")],
+]);
 
 /// The inputs of each compatibility block.
 const GENERATE: &[InputSpec] = &[TABLE, TABLE_TYPE, ROWS, BLOCK_SIZE];
 const CREATE: &[InputSpec] = &[
     TABLE,
     TABLE_TYPE,
-    required("num_rows", Kind::Range(2, u32::MAX as i64)),
+    required("num_rows", Kind::Range(2, u32::MAX as i64)).st_named("iNrOfRows"),
 ];
 const WRITE_DATA: &[InputSpec] = &[TABLE, ROWS, BLOCK_SIZE];
 const READ_DATA: &[InputSpec] = &[
     TABLE,
-    input("room", Kind::Room),
+    input("room", Kind::Room).st_rows(StForm::ReadAt {
+        data: "AdrDataArray",
+        size: "iSizeOfDataArray",
+    }),
     BLOCK_SIZE,
-    input("rows_to_read", Kind::Range(0, 1 << 20)),
-    input("columns", Kind::Range(1, 16)),
-    input("size", Kind::Range(8, 1 << 30)),
+    input("rows_to_read", Kind::Range(0, 1 << 20)).st_named("iRowsToRead"),
+    input("columns", Kind::Range(1, 16)).st_named("iColDim"),
+    input("size", Kind::Range(8, 1 << 30)).st_rows(StForm::Hidden),
 ];
-const READ_SLAVE_POS: &[InputSpec] = &[TABLE, input("master_pos", Kind::Real)];
+const READ_SLAVE_POS: &[InputSpec] = &[
+    TABLE,
+    input("master_pos", Kind::Real).st_named("fMasterPos"),
+];
 const OFFSETS: &[InputSpec] = &[MASTER_OFFSET, SLAVE_OFFSET];
 const MASTER_SLAVE_SCALE: &[InputSpec] = &[
     MASTER_OFFSET,
     SLAVE_OFFSET,
-    input("master_slope", Kind::Real),
+    input("master_slope", Kind::Real).st_named("fMasterSlope"),
     SLAVE_SLOPE,
 ];
+/// CamTableSetSlaveScale's slope is the seed's `fSlaveScale`.
+const SLAVE_SCALE: &[InputSpec] = &[input("slave_slope", Kind::Real).st_named("fSlaveScale")];
 
 /// A compatibility block in a timeline: its configuration and its running state.
 #[derive(Debug)]
@@ -219,6 +247,8 @@ pub struct CompatBlock {
     /// The master of CamTableCoupleAxes(Ipol) when given by NC axis ID (the timeline's
     /// `master_id`, resolved): it overrides `config.master` until the next configuration.
     master: Option<u32>,
+    /// Room for a PLC program's rows (Structured Text), made at load.
+    room: Option<CamRoom>,
 }
 
 /// `iTableType` to the table type and whether it is cyclic.
@@ -250,6 +280,7 @@ impl CompatBlock {
             decouple: CamCore::default(),
             scale: CamCore::default(),
             master: None,
+            room: None,
         }
     }
 
@@ -283,13 +314,16 @@ impl CompatBlock {
                     },
                     None => CamData::None,
                 };
-                let block = c.block_size;
+                let (block, refuse) = (c.block_size, c.refuse);
+                let count = c.rows_count.unwrap_or(data.len());
                 self.out = self.transfer.cycle(
                     io,
                     self.execute,
-                    |_| {
-                        Ok(ChunkTransfer::new(c.table, &data, false, periodic)
-                            .with_block_size(block))
+                    |_| match refuse {
+                        Some(code) => Err(code),
+                        None => Ok(ChunkTransfer::new(c.table, &data, false, periodic)
+                            .with_block_size(block)
+                            .with_count(count)),
                     },
                     |()| Accept::Done(()),
                     no_follow,
@@ -411,6 +445,62 @@ impl TimelineBlock for CompatBlock {
     fn read(&self) -> Option<Vec<f64>> {
         Some(self.read.values.clone())
     }
+    fn reserve_cam_ref(&mut self, bytes: usize) -> bool {
+        let writes = ["CamTableGenerate", "CamTableWriteData"].contains(&self.config.kind);
+        if writes {
+            self.room = Some(CamRoom::rows_only(bytes));
+        }
+        writes
+    }
+    /// The seed's `AdrDataArray` rows (2 columns; `values` fewer than the rows when the array
+    /// did not hold them), copied into the room made at load.
+    fn set_rows(&mut self, values: &[f64], columns: u32, rows: u32) -> bool {
+        let Some(room) = self.room.as_mut() else {
+            return false;
+        };
+        // Unique between cycles: no copy is made; the last rows' buffer is given back.
+        let c = Arc::make_mut(&mut self.config);
+        (c.rows, c.rows_count, c.refuse) = (None, None, None);
+        let n = rows as usize;
+        if columns != 2 {
+            c.refuse = Some(super::cam_read::ERROR_COLUMNS);
+            return true;
+        }
+        if values.len() < n.saturating_mul(2) {
+            c.refuse = Some(super::cam_read::ERROR_ARRAY_SIZE);
+            return true;
+        }
+        let table = CamRefIn {
+            bytes: bytemuck::cast_slice(&values[..2 * n]),
+            array_size: (16 * n) as u32,
+            table_type: 10,
+            rows,
+            columns,
+        };
+        match room.take(&table).map(|r| r.data) {
+            Some(CamData::Rows { rows, .. }) => {
+                (c.rows, c.rows_count) = (Some(rows), Some(n));
+                true
+            }
+            _ => false,
+        }
+    }
+    /// CamTableReadData's `AdrDataArray`: its size in bytes the most the answer may hold.
+    fn set_destination(&mut self, array: &CamRefIn<'_>) -> bool {
+        if self.config.kind != "CamTableReadData" {
+            return false;
+        }
+        Arc::make_mut(&mut self.config).size = Some(array.array_size);
+        true
+    }
+    fn read_bytes(&self, out: &mut [u8]) -> usize {
+        let mut written = 0;
+        for (value, slot) in self.read.values.iter().zip(out.chunks_exact_mut(8)) {
+            slot.copy_from_slice(&value.to_le_bytes());
+            written += 8;
+        }
+        written
+    }
 }
 
 /// A block of `kind` with room `room` for a read's numbers.
@@ -422,33 +512,43 @@ fn make(kind: &'static str, room: Option<usize>) -> Box<dyn TimelineBlock> {
     Box::new(CompatBlock::new(Arc::new(config)))
 }
 
-/// A compatibility block a timeline calls, on the slave's axis.
+/// A compatibility block a timeline calls, on the slave's axis (`axis`, or the seed's name
+/// for it); the seed's names in Structured Text.
 macro_rules! compat_block {
-    ($name:literal, $inputs:expr) => {
+    ($name:literal, $target:expr, $inputs:expr) => {
         BlockSpec {
             name: $name,
-            target: Target::Axis,
+            target: $target,
             execute: true,
             inputs: $inputs,
             make: |room| make($name, room),
-            style: crate::timeline::registry::StStyle::PlcOpen,
+            style: crate::timeline::registry::StStyle::Hungarian,
         }
     };
 }
 
+/// The seed's slave of a coupling (`iSlaveId`) and of a scaling (`iSlaveAxisId`); a table
+/// block has no axis in the seed (ours is `iAxisId`, of no effect).
+const SLAVE: Target = Target::AxisNamed("iSlaveId");
+const SLAVE_AXIS: Target = Target::AxisNamed("iSlaveAxisId");
+
 /// The compatibility blocks a timeline calls.
 pub const TIMELINE: &[BlockSpec] = &[
-    compat_block!("CamTableGenerate", GENERATE),
-    compat_block!("CamTableCreate", CREATE),
-    compat_block!("CamTableWriteData", WRITE_DATA),
-    compat_block!("CamTableReadData", READ_DATA),
-    compat_block!("CamTableReadSlavePos", READ_SLAVE_POS),
-    compat_block!("CamTableDelete", &[TABLE]),
-    compat_block!("CamTableCoupleAxes", &COUPLE),
-    compat_block!("CamTableCoupleAxesIpol", &COUPLE_IPOL),
-    compat_block!("CamTableOffsetChange", OFFSETS),
-    compat_block!("CamTableSetSlaveScale", &[SLAVE_SLOPE]),
-    compat_block!("CamTableSetMasterSlaveScale", MASTER_SLAVE_SCALE),
+    compat_block!("CamTableGenerate", Target::Axis, GENERATE),
+    compat_block!("CamTableCreate", Target::Axis, CREATE),
+    compat_block!("CamTableWriteData", Target::Axis, WRITE_DATA),
+    compat_block!("CamTableReadData", Target::Axis, READ_DATA),
+    compat_block!("CamTableReadSlavePos", Target::Axis, READ_SLAVE_POS),
+    compat_block!("CamTableDelete", Target::Axis, &[TABLE]),
+    compat_block!("CamTableCoupleAxes", SLAVE, &COUPLE),
+    compat_block!("CamTableCoupleAxesIpol", SLAVE, &COUPLE_IPOL),
+    compat_block!("CamTableOffsetChange", SLAVE_AXIS, OFFSETS),
+    compat_block!("CamTableSetSlaveScale", SLAVE_AXIS, SLAVE_SCALE),
+    compat_block!(
+        "CamTableSetMasterSlaveScale",
+        SLAVE_AXIS,
+        MASTER_SLAVE_SCALE
+    ),
 ];
 
 /// CamTableReadData's array against what it asks for (seed 000 5.2.1.5): a column count other

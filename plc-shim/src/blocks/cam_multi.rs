@@ -5,7 +5,7 @@
 use super::cam::{recorded, CamCore};
 use crate::kernel::Outputs;
 use crate::runtime::PlcIo;
-use crate::timeline::registry::{input, BlockSpec, Kind, TimelineBlock, Value};
+use crate::timeline::registry::{input, BlockSpec, Kind, StForm, Target, TimelineBlock, Value};
 use hli::calls::cam::CamMultiTableOp;
 
 /// CamTableSetWeight (5.2.3.1): weight, offsets, slopes and range of `table` in a
@@ -147,16 +147,42 @@ impl CamMultiTable {
 inputs! {
     /// CamTableSetWeight's inputs: the table and its scaling.
     WEIGHT, set_weight: CamTableSetWeight {
-        "table": Kind::Count => table,
-        "weight": Kind::Real => weight.weight,
-        "master_offset": Kind::Real => weight.master_offset,
-        "master_slope": Kind::Real => weight.master_slope,
-        "slave_offset": Kind::Real => weight.slave_offset,
-        "slave_slope": Kind::Real => weight.slave_slope,
-        "range_low": Kind::Real => weight.range_low,
-        "range_high": Kind::Real => weight.range_high,
+        "table" as I_TABLE_ID: Kind::Count => table,
+        "weight" as F_ORIGINAL_WEIGHT: Kind::Real => weight.weight,
+        "master_offset" as F_MASTER_OFFSET: Kind::Real => weight.master_offset,
+        "master_slope" as F_MASTER_SLOPE: Kind::Real => weight.master_slope,
+        "slave_offset" as F_SLAVE_OFFSET: Kind::Real => weight.slave_offset,
+        "slave_slope" as F_SLAVE_SLOPE: Kind::Real => weight.slave_slope,
+        "range_low" as F_RANGE_LOW: Kind::Real => weight.range_low,
+        "range_high" as F_RANGE_HIGH: Kind::Real => weight.range_high,
     }
 }
+
+// The seed's names in Structured Text (5.2.3).
+const I_TABLE_ID: StForm = StForm::Named("iTableId");
+const F_ORIGINAL_WEIGHT: StForm = StForm::Named("fOriginalWeight");
+const F_MASTER_OFFSET: StForm = StForm::Named("fMasterOffset");
+const F_MASTER_SLOPE: StForm = StForm::Named("fMasterSlope");
+const F_SLAVE_OFFSET: StForm = StForm::Named("fSlaveOffset");
+const F_SLAVE_SLOPE: StForm = StForm::Named("fSlaveSlope");
+const F_RANGE_LOW: StForm = StForm::Named("fRangeLow");
+const F_RANGE_HIGH: StForm = StForm::Named("fRangeHigh");
+/// The slave of the multi-table blocks that have one (`iSlaveId`).
+const SLAVE: Target = Target::AxisNamed("iSlaveId");
+/// `iNrOfMultiTables` and `iTableId1` .. `iTableId8`.
+const TABLE_IDS: StForm = StForm::Ids {
+    count: "iNrOfMultiTables",
+    ids: &[
+        "iTableId1",
+        "iTableId2",
+        "iTableId3",
+        "iTableId4",
+        "iTableId5",
+        "iTableId6",
+        "iTableId7",
+        "iTableId8",
+    ],
+};
 
 impl TimelineBlock for CamTableSetWeight {
     timeline_timeout!();
@@ -220,24 +246,28 @@ fn table_ids(value: &toml::Value) -> Result<Value, String> {
     Ok(Value::Ids(ids, list.len() as u32))
 }
 
-/// The multi-table blocks a timeline calls; the slave is the instance's axis.
+/// The multi-table blocks a timeline calls; the slave is the instance's axis (`axis`, or
+/// the seed's `iSlaveId`); the seed's names in Structured Text.
 pub const TIMELINE: &[BlockSpec] = &[
     BlockSpec::on_axis("CamTableSetWeight", &WEIGHT, |_| {
         Box::<CamTableSetWeight>::default()
-    }),
-    BlockSpec::on_axis(
+    })
+    .hungarian(),
+    BlockSpec::with_execute(
         "CamTableCoupleAxesMultiTables",
+        SLAVE,
         &[
-            input("master", Kind::Count),
+            input("master", Kind::Count).st_named("iMasterId"),
             input(
                 "tables",
                 Kind::Parsed {
                     parse: table_ids,
                     example: "[1, 2]",
                 },
-            ),
-            input("profiles", Kind::Range(1, 8)),
-            input("on", Kind::Bool),
+            )
+            .st_rows(TABLE_IDS),
+            input("profiles", Kind::Range(1, 8)).st_named("iNrOfProfileTables"),
+            input("on", Kind::Bool).st_rows(super::cam_compat::COUPLE_EDGES),
             crate::blocks::cam::MASTER_SOURCE,
         ],
         |_| {
@@ -246,19 +276,24 @@ pub const TIMELINE: &[BlockSpec] = &[
                 ..CamTableCoupleAxesMultiTables::default()
             })
         },
-    ),
-    BlockSpec::on_axis(
+    )
+    .hungarian(),
+    BlockSpec::with_execute(
         "CamTableEnableCorrectionTable",
+        SLAVE,
         &[
-            input("table", Kind::Count),
+            input("table", Kind::Count).st_named("iTableId"),
             input("at_position", Kind::Bool),
             input("position", Kind::Real),
         ],
         |_| Box::new(CamMultiTable::new(CamMultiTableOp::EnableCorrection)),
-    ),
-    BlockSpec::on_axis(
+    )
+    .hungarian(),
+    BlockSpec::with_execute(
         "CamTableDeactivateCyclicTable",
-        &[input("table", Kind::Count)],
+        SLAVE,
+        &[input("table", Kind::Count).st_named("iTableId")],
         |_| Box::new(CamMultiTable::new(CamMultiTableOp::StopCyclic)),
-    ),
+    )
+    .hungarian(),
 ];

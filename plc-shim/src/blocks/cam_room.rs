@@ -38,6 +38,15 @@ impl CamRoom {
         }
     }
 
+    /// Room for rows alone (the compatibility blocks' `AdrDataArray`).
+    pub fn rows_only(bytes: usize) -> CamRoom {
+        let rows = || Arc::from(vec![[0.0; 2]; bytes / ROW_BYTES]);
+        CamRoom {
+            rows: [rows(), rows()],
+            points: Default::default(),
+        }
+    }
+
     /// `table` as an `MC_CAM_REF` whose array is a copy in this room (as much of its bytes
     /// as the room holds; the block's check refuses a description its array does not
     /// match): `None` if a value is not finite, or if both buffers are held (a block's

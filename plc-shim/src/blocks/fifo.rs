@@ -240,6 +240,7 @@ const ST_ROWS: StForm = StForm::Rows {
     data: "AdrDataArray",
     columns: "iColDim",
     rows: "iRowsToWrite",
+    size: None,
     max: FIFO_BLOCK_VALUES,
 };
 const WRITE: &[InputSpec] = &[

@@ -62,8 +62,11 @@ impl Blocks {
             .map(|(_, k)| {
                 let binding = &library.bindings[*k];
                 let mut block = (binding.spec.make)(None);
-                if binding.cam_ref_room() > 0 {
-                    block.reserve_cam_ref(binding.cam_ref_room());
+                // Room for table data (an MC_CAM_REF's array, or rows through a pointer a
+                // block keeps: the compatibility blocks'; FiFoWrite keeps its own).
+                let room = binding.cam_ref_room().max(binding.rows_room() * 8);
+                if room > 0 {
+                    block.reserve_cam_ref(room);
                 }
                 Instance {
                     block,
@@ -130,6 +133,9 @@ fn input_value(io: &BlockIo<'_>, var: usize, spec: &InputSpec, axis: bool) -> Op
         Kind::Between(lo, hi) => real().filter(|v| (lo..=hi).contains(v)).map(Value::Real),
         Kind::Positive => real().filter(|v| *v > 0.0).map(Value::Real),
         Kind::Range(lo, hi) => int().filter(|v| (lo..=hi).contains(v)).map(Value::Int),
+        Kind::ZeroOr(lo, hi) => int()
+            .filter(|v| *v == 0 || (lo..=hi).contains(v))
+            .map(Value::Int),
         Kind::OneOf(choices) => int()
             .filter(|v| choices.iter().any(|(_, c)| c == v))
             .map(Value::Int),
@@ -155,22 +161,55 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             data,
             columns,
             rows,
+            size,
             max,
         } => {
             let count = |v| io.int(v).and_then(|n| u32::try_from(n).ok());
             let (Some(c), Some(r)) = (count(columns), count(rows)) else {
                 return false;
             };
-            // More values than a call takes: none read, the block refuses them with its own
-            // code.
+            // More values than a call takes, or than the array's size holds: none read, the
+            // block refuses them with its own code.
             let n = (c as usize).saturating_mul(r as usize);
-            if n > max {
+            let beyond = size.is_some_and(|s| io.int(s).unwrap_or(0) < n as i64 * 8);
+            if n > max || beyond {
                 inst.rows.clear();
                 return inst.block.set_rows(&inst.rows, c, r);
             }
             io.lreals(data, n, &mut inst.rows) && inst.block.set_rows(&inst.rows, c, r)
         }
         Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
+        Bound::ReadAt { data, size } => {
+            inst.destination = None;
+            let (Some(p), Some(n)) = (io.int(data), io.int(size)) else {
+                return false;
+            };
+            let n = usize::try_from(n).unwrap_or(usize::MAX);
+            if io.memory_at(p, n).is_none() {
+                return false;
+            }
+            inst.destination = Some((p, n));
+            let array = CamRefIn {
+                bytes: &[],
+                array_size: n as u32,
+                table_type: 0,
+                rows: 0,
+                columns: 0,
+            };
+            inst.block.set_destination(&array)
+        }
+        Bound::Edges { on, .. } => {
+            let on = io.int(on).unwrap_or(0) != 0;
+            inst.block.set(spec.key, &Value::Bool(on));
+            true
+        }
+        Bound::Ids { count, first, len } => match ids(io, count, first, len) {
+            Some(v) => {
+                inst.block.set(spec.key, &v);
+                true
+            }
+            None => false,
+        },
         Bound::ReadInto { var } => pass_destination(io, inst, var),
         Bound::Text { var, len } => match io.text(var, len as usize + 1) {
             Some(text) => inst.block.set_text(spec.key, text),
@@ -237,6 +276,19 @@ fn pass_cam_ref(io: &BlockIo<'_>, inst: &mut Instance, var: usize, max_bytes: us
     inst.block.set_cam_ref(&CamRefIn { bytes, ..table })
 }
 
+/// A list of `len` IDs from variable `first` on, as many as variable `count` says (1 to
+/// `len`, each 1 to 255): `None` otherwise.
+fn ids(io: &BlockIo<'_>, count: usize, first: usize, len: usize) -> Option<Value> {
+    let n = usize::try_from(io.int(count)?)
+        .ok()
+        .filter(|n| (1..=len).contains(n))?;
+    let mut ids = [0u32; 8];
+    for (k, slot) in ids.iter_mut().enumerate().take(n.min(8)) {
+        *slot = io.int(first + k).filter(|v| (1..=255).contains(v))? as u32;
+    }
+    Some(Value::Ids(ids, n as u32))
+}
+
 /// Whether this call gives input `bound`.
 fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
     match *bound {
@@ -247,6 +299,9 @@ fn given(io: &BlockIo<'_>, bound: &Bound) -> bool {
             rows,
             ..
         } => io.given(data) || io.given(columns) || io.given(rows),
+        Bound::ReadAt { data, size } => io.given(data) || io.given(size),
+        Bound::Edges { on, off } => io.given(on) || io.given(off),
+        Bound::Ids { count, .. } => io.given(count),
         Bound::CamRef { var, .. }
         | Bound::Struct { var, .. }
         | Bound::Text { var, .. }
@@ -293,7 +348,12 @@ impl Host for BlockHost<'_, '_> {
             .instances
             .get_mut(io.slot())
             .ok_or(Fault::BadPointer)?;
-        let execute = binding.execute.map(|v| io.int(v).unwrap_or(0) != 0);
+        let high = |v: usize| io.int(v).unwrap_or(0) != 0;
+        // Two edges of their own (bCoupleOn, bCoupleOff): the command's is either's.
+        let execute = match binding.edges {
+            Some((on, off)) => Some(high(on) || high(off)),
+            None => binding.execute.map(high),
+        };
         let takes_inputs = match execute {
             Some(e) => e && !inst.last_execute,
             None => true,

@@ -110,8 +110,33 @@ pub(super) enum Bound {
         columns: usize,
         /// The rows.
         rows: usize,
+        /// The array's size in bytes, if declared.
+        size: Option<usize>,
         /// The most values a call takes.
         max: usize,
+    },
+    /// An array a read's answer goes into: its pointer's and its size's variables.
+    ReadAt {
+        /// The pointer.
+        data: usize,
+        /// The size in bytes.
+        size: usize,
+    },
+    /// The input is TRUE at a rising edge of `on`, FALSE at one of `off` (the block's edge).
+    Edges {
+        /// The edge that gives TRUE.
+        on: usize,
+        /// The edge that gives FALSE.
+        off: usize,
+    },
+    /// A list of IDs: the count's variable and the first ID's (the others follow it).
+    Ids {
+        /// The count.
+        count: usize,
+        /// The first ID.
+        first: usize,
+        /// How many ID variables.
+        len: usize,
     },
     /// An `MC_CAM_REF` (its variable) a read's answer goes into.
     ReadInto {
@@ -141,6 +166,15 @@ pub(super) enum Bound {
     },
 }
 
+/// A declaration's variables: name and type.
+type Vars = Vec<(String, String)>;
+
+/// Declares variable `name` of type `ty`: its index.
+fn push(vars: &mut Vars, name: String, ty: impl Into<String>) -> usize {
+    vars.push((name, ty.into()));
+    vars.len() - 1
+}
+
 /// How a block's ST declaration meets its spec: the index of each variable.
 #[derive(Debug, Clone)]
 pub(super) struct Binding {
@@ -155,6 +189,8 @@ pub(super) struct Binding {
     pub(super) inputs: Vec<(Bound, InputSpec)>,
     /// The first output's variable.
     pub(super) outputs: usize,
+    /// The two edges of a block without Execute ([`StForm::Edges`]).
+    pub(super) edges: Option<(usize, usize)>,
 }
 
 impl Binding {
@@ -182,6 +218,9 @@ fn expressible(input: &InputSpec) -> bool {
     matches!(
         input.st,
         StForm::Rows { .. }
+            | StForm::ReadAt { .. }
+            | StForm::Edges { .. }
+            | StForm::Ids { .. }
             | StForm::CamRef { .. }
             | StForm::Hidden
             | StForm::Struct { .. }
@@ -303,19 +342,22 @@ impl Library {
 
     fn declare(&mut self, spec: &'static BlockSpec) {
         let hungarian = spec.style == StStyle::Hungarian;
-        let mut vars: Vec<(String, String)> = Vec::new();
-        fn push(vars: &mut Vec<(String, String)>, name: String, ty: impl Into<String>) -> usize {
-            vars.push((name, ty.into()));
-            vars.len() - 1
-        }
+        let mut vars: Vars = Vec::new();
         let target = match (spec.target, hungarian) {
             (Target::Axis, false) => Some(push(&mut vars, "Axis".into(), "AXIS_REF")),
             (Target::Axis, true) => Some(push(&mut vars, "iAxisId".into(), "UDINT")),
-            (Target::AxisNamed(name), _) => Some(push(&mut vars, pascal(name), "AXIS_REF")),
+            // The seed's own name for the axis's index (`iSlaveId`).
+            (Target::AxisNamed(name), true) => Some(push(&mut vars, name.into(), "UDINT")),
+            (Target::AxisNamed(name), false) => Some(push(&mut vars, pascal(name), "AXIS_REF")),
             (Target::Channel, _) => Some(push(&mut vars, "Channel".into(), "UDINT")),
             (Target::Group, _) => None,
         };
-        let execute = spec.execute.then(|| {
+        // A block whose edge is two inputs of its own (bCoupleOn, bCoupleOff) has no Execute.
+        let two_edges = spec
+            .inputs
+            .iter()
+            .any(|i| matches!(i.st, StForm::Edges { .. }));
+        let execute = (spec.execute && !two_edges).then(|| {
             let name = if hungarian { "bExecute" } else { "Execute" };
             push(&mut vars, name.into(), "BOOL")
         });
@@ -325,68 +367,14 @@ impl Library {
             .then(|| push(&mut vars, "tTimeout".into(), "TIME"));
         let mut inputs = Vec::new();
         for input in spec.inputs.iter().filter(|i| expressible(i)) {
-            let bound = match input.st {
-                StForm::Rows {
-                    data,
-                    columns,
-                    rows,
-                    max,
-                } => Bound::Rows {
-                    data: push(&mut vars, data.into(), "POINTER TO LREAL"),
-                    columns: push(&mut vars, columns.into(), "UDINT"),
-                    rows: push(&mut vars, rows.into(), "UDINT"),
-                    max,
-                },
-                StForm::CamRef { name, max_bytes } => Bound::CamRef {
-                    var: push(&mut vars, name.into(), "MC_CAM_REF"),
-                    max_bytes,
-                },
-                StForm::Hidden => continue,
-                StForm::ReadInto { name } => Bound::ReadInto {
-                    var: push(&mut vars, name.into(), "MC_CAM_REF"),
-                },
-                StForm::Text { name, len } => Bound::Text {
-                    var: push(&mut vars, name.into(), format!("STRING({len})")),
-                    len,
-                },
-                StForm::Struct {
-                    name,
-                    ty,
-                    declaration,
-                    read,
-                } => {
-                    if !self.types.contains(&ty) {
-                        self.types.push(ty);
-                        self.text.push_str(declaration);
-                    }
-                    Bound::Struct {
-                        var: push(&mut vars, name.into(), ty),
-                        read,
-                    }
-                }
-                StForm::Named(name) => Bound::Value {
-                    var: push(&mut vars, name.into(), st_type(&input.kind)),
-                    axis: false,
-                },
-                StForm::Key => {
-                    let name = pascal(input.key);
-                    if vars.iter().any(|(n, _)| folded(n) == folded(&name)) {
-                        continue;
-                    }
-                    let axis = is_axis(input);
-                    let ty = if axis {
-                        "AXIS_REF"
-                    } else {
-                        st_type(&input.kind)
-                    };
-                    Bound::Value {
-                        var: push(&mut vars, name, ty),
-                        axis,
-                    }
-                }
-            };
-            inputs.push((bound, *input));
+            if let Some(bound) = self.bind(input, &mut vars) {
+                inputs.push((bound, *input));
+            }
         }
+        let edges = inputs.iter().find_map(|(b, _)| match b {
+            Bound::Edges { on, off } => Some((*on, *off)),
+            _ => None,
+        });
         let outputs = vars.len();
         let _ = writeln!(self.text, "FUNCTION_BLOCK {}\nVAR_INPUT", spec.name);
         for (name, ty) in &vars {
@@ -414,7 +402,95 @@ impl Library {
             timeout,
             inputs,
             outputs,
+            edges,
         });
+    }
+
+    /// How `input` is declared (its variables pushed to `vars`): `None` if it is not an
+    /// input of its own.
+    fn bind(&mut self, input: &InputSpec, vars: &mut Vars) -> Option<Bound> {
+        Some(match input.st {
+            StForm::Rows {
+                data,
+                columns,
+                rows,
+                size,
+                max,
+            } => Bound::Rows {
+                data: push(vars, data.into(), "POINTER TO LREAL"),
+                size: size.map(|size| push(vars, size.into(), "UDINT")),
+                columns: push(vars, columns.into(), "UDINT"),
+                rows: push(vars, rows.into(), "UDINT"),
+                max,
+            },
+            StForm::ReadAt { data, size } => Bound::ReadAt {
+                data: push(vars, data.into(), "POINTER TO LREAL"),
+                size: push(vars, size.into(), "UDINT"),
+            },
+            StForm::Edges { on, off } => Bound::Edges {
+                on: push(vars, on.into(), "BOOL"),
+                off: push(vars, off.into(), "BOOL"),
+            },
+            StForm::Ids { count, ids } => {
+                let count = push(vars, count.into(), "UDINT");
+                let first = vars.len();
+                for id in ids {
+                    push(vars, (*id).into(), "UDINT");
+                }
+                Bound::Ids {
+                    count,
+                    first,
+                    len: ids.len(),
+                }
+            }
+            StForm::CamRef { name, max_bytes } => Bound::CamRef {
+                var: push(vars, name.into(), "MC_CAM_REF"),
+                max_bytes,
+            },
+            StForm::Hidden => return None,
+            StForm::ReadInto { name } => Bound::ReadInto {
+                var: push(vars, name.into(), "MC_CAM_REF"),
+            },
+            StForm::Text { name, len } => Bound::Text {
+                var: push(vars, name.into(), format!("STRING({len})")),
+                len,
+            },
+            StForm::Struct {
+                name,
+                ty,
+                declaration,
+                read,
+            } => {
+                if !self.types.contains(&ty) {
+                    self.types.push(ty);
+                    self.text.push_str(declaration);
+                }
+                Bound::Struct {
+                    var: push(vars, name.into(), ty),
+                    read,
+                }
+            }
+            StForm::Named(name) => Bound::Value {
+                var: push(vars, name.into(), st_type(&input.kind)),
+                axis: false,
+            },
+            StForm::Key => {
+                let name = pascal(input.key);
+                if vars.iter().any(|(n, _)| folded(n) == folded(&name)) {
+                    return None;
+                }
+                let axis = is_axis(input);
+                let ty = if axis {
+                    "AXIS_REF"
+                } else {
+                    st_type(&input.kind)
+                };
+                Bound::Value {
+                    var: push(vars, name, ty),
+                    axis,
+                }
+            }
+        })
     }
 
     /// The declarations, as ST.

@@ -339,6 +339,11 @@ impl Kind {
                 .map(Value::Int)
                 .ok_or_else(bad),
             Kind::Range(lo, hi) => range(*lo, *hi),
+            Kind::ZeroOr(lo, hi) => value
+                .as_integer()
+                .filter(|v| *v == 0 || (*lo..=*hi).contains(v))
+                .map(Value::Int)
+                .ok_or_else(|| format!("call: {block} input `{key}` = {value}: 0 or {lo} to {hi}")),
             Kind::Between(lo, hi) => number(value)
                 .filter(|v| (*lo..=*hi).contains(v))
                 .map(Value::Real)

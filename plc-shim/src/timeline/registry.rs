@@ -156,8 +156,36 @@ pub enum StForm {
         columns: &'static str,
         /// The rows' name.
         rows: &'static str,
+        /// The name of the array's size in bytes, if the block declares it (the seed's
+        /// `iSizeOfDataArray`): rows beyond it are refused by the block.
+        size: Option<&'static str>,
         /// The most values a call takes.
         max: usize,
+    },
+    /// An array a read's answer goes into, through a pointer to its first LREAL and its size
+    /// in bytes (the seed's CamTableReadData: `AdrDataArray`, `iSizeOfDataArray`).
+    ReadAt {
+        /// The pointer's name.
+        data: &'static str,
+        /// The size's name.
+        size: &'static str,
+    },
+    /// The block's edge in two inputs (the seed's `bCoupleOn`, `bCoupleOff`): a rising edge
+    /// of either is the command's (this input TRUE for the first), and the block has no
+    /// Execute of its own.
+    Edges {
+        /// The name of the edge that gives this input TRUE.
+        on: &'static str,
+        /// The name of the edge that gives it FALSE.
+        off: &'static str,
+    },
+    /// A list of IDs as separate inputs and a count (the seed's `iTableId1` .. `iTableId8`
+    /// and `iNrOfMultiTables`).
+    Ids {
+        /// The count's name.
+        count: &'static str,
+        /// The IDs' names.
+        ids: &'static [&'static str],
     },
     /// A table as the seed's `MC_CAM_REF` (000 5.1.16.2) under this name: the array's
     /// address, its size in bytes, the table type, rows and columns; the array (at most
@@ -299,6 +327,9 @@ pub enum Kind {
     Count,
     /// An integer `lo..=hi`: [`Value::Int`].
     Range(i64, i64),
+    /// 0 (a default) or an integer `lo..=hi` (the seed's iBlockSize: 0 or at least a row's
+    /// bytes): [`Value::Int`].
+    ZeroOr(i64, i64),
     /// A finite number `lo..=hi`: [`Value::Real`].
     Between(f64, f64),
     /// A finite number above 0 (a time, a period): [`Value::Real`].
@@ -335,6 +366,7 @@ impl Kind {
             Kind::Real => "1.5".into(),
             Kind::Count => "1".into(),
             Kind::Range(lo, _) => lo.to_string(),
+            Kind::ZeroOr(..) => "0".into(),
             Kind::Between(lo, _) => format!("{lo:?}"),
             Kind::Positive => "2.0".into(),
             Kind::Flags { flags, .. } => format!("[{:?}]", flags[0].0),

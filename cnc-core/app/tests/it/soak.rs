@@ -158,6 +158,11 @@ fn random_input(kind: &Kind, next: &mut impl FnMut() -> u64) -> Option<String> {
             let span = (hi - lo).unsigned_abs().min(1 << 20) + 1;
             (lo + (next() % span) as i64).to_string()
         }
+        Kind::ZeroOr(lo, hi) if next().is_multiple_of(2) => {
+            let span = (hi - lo).unsigned_abs().min(1 << 20) + 1;
+            (lo + (next() % span) as i64).to_string()
+        }
+        Kind::ZeroOr(..) => "0".into(),
         Kind::OneOf(values) => {
             let written = values[(next() % values.len() as u64) as usize].0;
             // The TOML value, without the note that may follow it.

@@ -149,6 +149,7 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "example4-turntable-hybrid",
         "example4-turntable-plc",
         "cam-conveyor",
+        "cam-compat",
         "cam-data",
         "cam-ref",
         "channel-control",
@@ -208,6 +209,31 @@ impl plc_shim::runtime::PlcProgram for Shared {
     }
 }
 
+/// The ST twin of the scenario in `dir` (`scenario-st.toml`, `plc.st`) run in-process to
+/// its end: its program, to look into.
+fn st_in_process(dir: &str) -> std::rc::Rc<std::cell::RefCell<plc_shim::st::StProgram>> {
+    let st = Scenario::load(std::path::Path::new(&format!("{dir}/scenario-st.toml"))).unwrap();
+    let program =
+        plc_shim::st::StProgram::load(&[format!("{dir}/plc.st").into()], 1).expect("plc.st");
+    let shared = std::rc::Rc::new(std::cell::RefCell::new(program));
+    let mut run = InProcess::new(&st, 0).unwrap();
+    run.program = Some(cnc_app::scenario::machine::BuiltIn(Box::new(Shared(
+        shared.clone(),
+    ))));
+    for _ in 0..st.ticks.unwrap() {
+        run.step(st.cycle_s);
+    }
+    shared
+}
+
+/// The LREAL at `path` (`MAIN.aValues[1,2]`) of a program's memory.
+fn lreal_of(p: &plc_shim::st::StProgram, path: &str) -> f64 {
+    let symbols = p.program().symbols(100_000);
+    let s = symbols.iter().find(|s| s.path == path).expect(path);
+    let at = s.offset as usize;
+    f64::from_le_bytes(p.program().memory()[at..at + 8].try_into().unwrap())
+}
+
 /// The first numbers a timeline's report shows of block `instance`'s read.
 fn reported(summary: &str, instance: &str) -> Vec<f64> {
     let block = format!("block {instance} (");
@@ -233,24 +259,9 @@ fn st_reads_fill_the_programs_arrays_with_what_the_timeline_reads() {
     let (values, points) = (reported(&summary, "values"), reported(&summary, "points"));
     assert!(values.len() >= 12 && points.len() >= 12, "{summary}");
 
-    let st = Scenario::load(std::path::Path::new(&format!("{dir}/scenario-st.toml"))).unwrap();
-    let program =
-        plc_shim::st::StProgram::load(&[format!("{dir}/plc.st").into()], 1).expect("plc.st");
-    let shared = std::rc::Rc::new(std::cell::RefCell::new(program));
-    let mut run = InProcess::new(&st, 0).unwrap();
-    run.program = Some(cnc_app::scenario::machine::BuiltIn(Box::new(Shared(
-        shared.clone(),
-    ))));
-    for _ in 0..st.ticks.unwrap() {
-        run.step(st.cycle_s);
-    }
-    let p = shared.borrow();
-    let symbols = p.program().symbols(100_000);
-    let lreal = |path: &str| {
-        let s = symbols.iter().find(|s| s.path == path).expect(path);
-        let at = s.offset as usize;
-        f64::from_le_bytes(p.program().memory()[at..at + 8].try_into().unwrap())
-    };
+    let p = st_in_process(dir);
+    let p = p.borrow();
+    let lreal = |path: &str| lreal_of(&p, path);
     let row_major: Vec<f64> = (1..=6)
         .flat_map(|r| (1..=2).map(move |c| (r, c)))
         .map(|(r, c)| lreal(&format!("MAIN.aValues[{r},{c}]")))
@@ -265,4 +276,18 @@ fn st_reads_fill_the_programs_arrays_with_what_the_timeline_reads() {
             k + 1
         );
     }
+}
+
+/// CamTableReadData in ST (seed 000 5.2.1.5) reads table 21's rows into the program's array
+/// through `AdrDataArray`: the rows CamTableWriteData wrote from another array.
+#[test]
+fn st_cam_table_read_data_fills_the_array_adr_data_array_points_to() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/cam-compat");
+    let p = st_in_process(dir);
+    let p = p.borrow();
+    let read: Vec<f64> = (1..=4)
+        .flat_map(|r| (1..=2).map(move |c| (r, c)))
+        .map(|(r, c)| lreal_of(&p, &format!("MAIN.aRead[{r},{c}]")))
+        .collect();
+    assert_eq!(read, [0.0, 0.0, 40.0, 4.0, 100.0, 5.0, 0.0, 0.0]);
 }
