@@ -151,6 +151,7 @@ fn the_st_twins_trace_as_their_timelines_do() {
         "cam-conveyor",
         "cam-compat",
         "cam-data",
+        "cam-multi-table",
         "cam-ref",
         "channel-control",
         "saw-blocks",
