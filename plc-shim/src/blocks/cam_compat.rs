@@ -493,6 +493,13 @@ impl TimelineBlock for CompatBlock {
         Arc::make_mut(&mut self.config).size = Some(array.array_size);
         true
     }
+    /// CamTableReadSlavePos: `fSlavePos`.
+    fn results(&self) -> Option<&'static crate::timeline::registry::Results> {
+        (self.config.kind == "CamTableReadSlavePos").then_some(&super::cam_results::SLAVE_POS)
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        super::cam_results::copied(&self.read.values[..self.read.values.len().min(1)], out)
+    }
     fn read_bytes(&self, out: &mut [u8]) -> usize {
         let mut written = 0;
         for (value, slot) in self.read.values.iter().zip(out.chunks_exact_mut(8)) {

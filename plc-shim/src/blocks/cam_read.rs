@@ -4,10 +4,11 @@
 //! four points per cycle), each into an array whose room is set when the block is made.
 
 use super::cam::recorded;
+use super::cam_results;
 use crate::kernel::{call_error_code, no_follow, send, Accept, InFlight, Kernel, Outputs, Polled};
 use crate::runtime::PlcIo;
 use crate::timeline::registry::{
-    input, BlockSpec, CamRefIn, InputSpec, Kind, StForm, TimelineBlock, Value,
+    input, BlockSpec, CamRefIn, InputSpec, Kind, Results, StForm, TimelineBlock, Value,
 };
 use hli::calls::cam::CamReadKind;
 use hli_transport::rpc::PendingCall;
@@ -384,6 +385,20 @@ impl TimelineBlock for McCamRead {
         }
         written
     }
+    fn results(&self) -> Option<&'static Results> {
+        match CamReadKind::from_raw(self.request.what) {
+            Some(CamReadKind::SlaveDynamics) => Some(&cam_results::SLAVE_DYNAMICS),
+            Some(CamReadKind::Characteristics) => Some(&cam_results::CHARACTERISTICS),
+            Some(CamReadKind::Info) => Some(&cam_results::CAM_INFO),
+            _ => None,
+        }
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        match CamReadKind::from_raw(self.request.what) {
+            Some(CamReadKind::Characteristics) => cam_results::characteristics(&self.values, out),
+            _ => cam_results::copied(&self.values, out),
+        }
+    }
 }
 
 impl TimelineBlock for McReadMotionFunction {
@@ -409,6 +424,27 @@ impl TimelineBlock for McReadMotionFunction {
             _ => Err(0x4B35),
         });
         true
+    }
+    /// MC_ReadMotionFunctionPoint (a reader of one point): the point as an output.
+    fn results(&self) -> Option<&'static Results> {
+        (self.points.capacity() == 1 && self.count == 1).then_some(&cam_results::POINT)
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        let Some(p) = self.points.first() else {
+            return 0;
+        };
+        let values = [
+            f64::from(p.point_index),
+            f64::from(p.function_type),
+            f64::from(p.point_type),
+            f64::from(p.rel_index_next_point),
+            p.master_pos,
+            p.slave_pos,
+            p.slave_velo,
+            p.slave_acc,
+            p.slave_jerk,
+        ];
+        cam_results::copied(&values, out)
     }
     fn read_bytes(&self, out: &mut [u8]) -> usize {
         let bytes: &[u8] = bytemuck::cast_slice(&self.points);

@@ -118,6 +118,7 @@ pub mod cam_compat;
 pub mod cam_data;
 pub mod cam_multi;
 pub mod cam_read;
+pub mod cam_results;
 pub mod cam_room;
 pub mod channel;
 pub mod dyn_cs;

@@ -402,10 +402,19 @@ impl Host for BlockHost<'_, '_> {
         }
         let was_done = inst.shown.is_some_and(|(o, _)| o.done);
         let out = inst.block.cycle(self.io, axis);
-        // A read's answer into the program's array, once, when it is Done.
-        if let (true, false, Some((p, n))) = (out.0.done, was_done, inst.destination) {
-            if let Some(array) = io.memory_at_mut(p, n) {
+        // A read's answer into the program's array and the block's outputs of its own,
+        // once, when it is Done.
+        if out.0.done && !was_done {
+            if let Some(array) = inst.destination.and_then(|(p, n)| io.memory_at_mut(p, n)) {
                 inst.block.read_bytes(array);
+            }
+            if let Some((first, n)) = binding.results {
+                let mut values = [0.0; 64];
+                let count = inst.block.result_values(&mut values);
+                let mut used = 0;
+                for k in first..first + n {
+                    used += io.set_leaves(k, &values[used..count]);
+                }
             }
         }
         show(io, binding, inst, out);

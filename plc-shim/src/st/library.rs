@@ -191,6 +191,9 @@ pub(super) struct Binding {
     pub(super) outputs: usize,
     /// The two edges of a block without Execute ([`StForm::Edges`]).
     pub(super) edges: Option<(usize, usize)>,
+    /// The outputs of its own of a read block ([`Results`]): the first's variable and how
+    /// many.
+    pub(super) results: Option<(usize, usize)>,
 }
 
 impl Binding {
@@ -317,8 +320,10 @@ pub fn left_out() -> Vec<(&'static str, &'static str)> {
 pub struct Library {
     text: String,
     pub(super) bindings: Vec<Binding>,
-    /// The structure types the blocks' inputs declared.
+    /// The structure types the blocks' inputs and results declared.
     types: Vec<&'static str>,
+    /// The structure types of the blocks' results (appended after the blocks).
+    results_text: String,
 }
 
 impl Library {
@@ -328,6 +333,7 @@ impl Library {
             text: TYPES.into(),
             bindings: Vec::new(),
             types: Vec::new(),
+            results_text: String::new(),
         };
         let missing = unavailable();
         let specs: Vec<&'static BlockSpec> = blocks()
@@ -337,6 +343,8 @@ impl Library {
         for spec in specs {
             lib.declare(spec);
         }
+        let results = std::mem::take(&mut lib.results_text);
+        lib.text.push_str(&results);
         lib
     }
 
@@ -394,6 +402,17 @@ impl Library {
             };
             let _ = writeln!(self.text, "    {name} : {ty};");
         }
+        // A read block's outputs of its own, after the standard ones.
+        let results = (spec.make)(None).results().map(|r| {
+            for (name, ty) in r.outputs {
+                let _ = writeln!(self.text, "    {name} : {ty};");
+            }
+            if !r.type_name.is_empty() && !self.types.contains(&r.type_name) {
+                self.types.push(r.type_name);
+                self.results_text.push_str(r.declaration);
+            }
+            (outputs + names.len(), r.outputs.len())
+        });
         self.text.push_str("END_VAR\nEND_FUNCTION_BLOCK\n");
         self.bindings.push(Binding {
             spec,
@@ -403,6 +422,7 @@ impl Library {
             inputs,
             outputs,
             edges,
+            results,
         });
     }
 

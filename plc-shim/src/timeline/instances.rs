@@ -343,7 +343,11 @@ impl Kind {
                 .as_integer()
                 .filter(|v| *v == 0 || (*lo..=*hi).contains(v))
                 .map(Value::Int)
-                .ok_or_else(|| format!("call: {block} input `{key}` = {value}: 0 or {lo} to {hi}")),
+                .ok_or_else(|| {
+                    format!(
+                        "call: {block} input `{key}` = {value}: 0 (the default) or {lo} to {hi}"
+                    )
+                }),
             Kind::Between(lo, hi) => number(value)
                 .filter(|v| (*lo..=*hi).contains(v))
                 .map(Value::Real)

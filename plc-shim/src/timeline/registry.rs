@@ -238,6 +238,20 @@ pub enum StForm {
 pub type StructReader =
     fn(field: &dyn Fn(u32, u8) -> Option<i64>, set: &mut dyn FnMut(&'static str, &Value)) -> bool;
 
+/// What a read block shows in Structured Text as outputs of its own, after the standard ones
+/// (MC_ReadCamTableSlaveDynamics' `SlavePosition` .., MC_CamInfo's `CamInfo`): each output's
+/// name and type (elementary, or a structure `declaration` declares), filled when the read is
+/// Done from [`TimelineBlock::result_values`], in the order of their elementary leaves.
+#[derive(Debug, Clone, Copy)]
+pub struct Results {
+    /// Each output: name and ST type.
+    pub outputs: &'static [(&'static str, &'static str)],
+    /// The structure types they use (`TYPE .. END_TYPE`, given once), or "".
+    pub declaration: &'static str,
+    /// The name the declaration is known by (to give it once), or "".
+    pub type_name: &'static str,
+}
+
 /// An `MC_CAM_REF` as a PLC program gives it: its description and the bytes of its array
 /// (`array_size` of them, read from the program's memory; little-endian, as the program
 /// holds them: LREAL rows `[master, slave]`, or 56-byte `MC_MotionFunctionPoint`s).
@@ -534,6 +548,15 @@ pub trait TimelineBlock: core::fmt::Debug {
     /// The last read's answer as the bytes a program's array holds it in (LREALs, or
     /// 56-byte `MC_MotionFunctionPoint`s), at most `out.len()` of them: the bytes written.
     fn read_bytes(&self, _out: &mut [u8]) -> usize {
+        0
+    }
+    /// The outputs of its own a read block shows in Structured Text ([`Results`]).
+    fn results(&self) -> Option<&'static Results> {
+        None
+    }
+    /// The values of those outputs, leaf by leaf, into `out` (as many as fit): how many.
+    /// Does not allocate.
+    fn result_values(&self, _out: &mut [f64]) -> usize {
         0
     }
     /// Input `key` as text (a STRING's characters before its NUL): `false` if the block

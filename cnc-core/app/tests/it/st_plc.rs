@@ -227,12 +227,19 @@ fn st_in_process(dir: &str) -> std::rc::Rc<std::cell::RefCell<plc_shim::st::StPr
     shared
 }
 
-/// The LREAL at `path` (`MAIN.aValues[1,2]`) of a program's memory.
+/// The value at `path` (`MAIN.aValues[1,2]`, `MAIN.fbInfo.CamInfo.Periodic`) of a program's
+/// memory, as a number (LREAL, REAL, or an unsigned integer or BOOL).
 fn lreal_of(p: &plc_shim::st::StProgram, path: &str) -> f64 {
     let symbols = p.program().symbols(100_000);
     let s = symbols.iter().find(|s| s.path == path).expect(path);
-    let at = s.offset as usize;
-    f64::from_le_bytes(p.program().memory()[at..at + 8].try_into().unwrap())
+    let (at, n) = (s.offset as usize, s.elem.size());
+    let mut bytes = [0u8; 8];
+    bytes[..n].copy_from_slice(&p.program().memory()[at..at + n]);
+    match s.elem.name() {
+        "LREAL" => f64::from_le_bytes(bytes),
+        "REAL" => f64::from(f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])),
+        _ => u64::from_le_bytes(bytes) as f64,
+    }
 }
 
 /// The first numbers a timeline's report shows of block `instance`'s read.
@@ -268,6 +275,35 @@ fn st_reads_fill_the_programs_arrays_with_what_the_timeline_reads() {
         .map(|(r, c)| lreal(&format!("MAIN.aValues[{r},{c}]")))
         .collect();
     assert_eq!(row_major, values[..12]);
+    // The reads' outputs of their own (seed 000: SlavePosition .., CamTableCharac, Point,
+    // CamInfo), as the timeline's blocks read them.
+    let dynamics = reported(&summary, "dynamics");
+    let shown = ["SlavePosition", "SlaveVelocity", "SlaveAcceleration"]
+        .map(|o| lreal(&format!("MAIN.fbDynamics.{o}")));
+    assert_eq!(shown[..], dynamics[..3]);
+    let charac = reported(&summary, "charac");
+    let fields = [
+        "fMasterVeloNom",
+        "fMasterPosStart",
+        "fSlavePosStart",
+        "fMasterPosEnd",
+    ];
+    let shown = fields.map(|f| lreal(&format!("MAIN.fbCharac.CamTableCharac.{f}")));
+    assert_eq!(shown, [charac[0], charac[1], charac[2], charac[6]]);
+    let point = reported(&summary, "point4");
+    let fields = ["PointIndex", "MasterPos", "SlavePos"];
+    let shown = fields.map(|f| lreal(&format!("MAIN.fbPoint4.Point.{f}")));
+    assert_eq!(shown[..], point[..3]);
+    let info = reported(&summary, "info");
+    let fields = [
+        "CamTableID",
+        "TableType",
+        "Periodic",
+        "InterpolationType",
+        "NumberOfRows",
+    ];
+    let shown = fields.map(|f| lreal(&format!("MAIN.fbInfo.CamInfo.{f}")));
+    assert_eq!(shown[..], info[..5]);
     for k in 0..4 {
         let field = |f: &str| lreal(&format!("MAIN.aPoints[{}].{f}", k + 1));
         assert_eq!(
@@ -280,7 +316,8 @@ fn st_reads_fill_the_programs_arrays_with_what_the_timeline_reads() {
 }
 
 /// CamTableReadData in ST (seed 000 5.2.1.5) reads table 21's rows into the program's array
-/// through `AdrDataArray`: the rows CamTableWriteData wrote from another array.
+/// through `AdrDataArray`: the rows CamTableWriteData wrote from another array; and
+/// CamTableReadSlavePos shows the slave position the timeline's block reads.
 #[test]
 fn st_cam_table_read_data_fills_the_array_adr_data_array_points_to() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/cam-compat");
@@ -291,4 +328,10 @@ fn st_cam_table_read_data_fills_the_array_adr_data_array_points_to() {
         .map(|(r, c)| lreal_of(&p, &format!("MAIN.aRead[{r},{c}]")))
         .collect();
     assert_eq!(read, [0.0, 0.0, 40.0, 4.0, 100.0, 5.0, 0.0, 0.0]);
+    // CamTableReadSlavePos's fSlavePos, as the timeline's block reads it.
+    let timeline = Scenario::load(std::path::Path::new(&format!("{dir}/scenario.toml"))).unwrap();
+    let run = InProcess::run_through(&timeline).unwrap();
+    let slave = reported(&run.timeline.as_ref().unwrap().summary(), "slavepos")[0];
+    assert_eq!(lreal_of(&p, "MAIN.fbSlavePos.fSlavePos"), slave);
+    assert!(slave > 0.0, "2 at master 20 of 0..40 -> 0..4: {slave}");
 }

@@ -110,7 +110,7 @@ fn bad_calls_name_the_key() {
     );
     assert_eq!(
         err("block = \"CamTableReadData\"\naxis = 1\ntable = 1\nblock_size = 8"),
-        "call: `block_size` = 8: 0 (the default) or at least 16 bytes (one row)"
+        "call: CamTableReadData input `block_size` = 8: 0 (the default) or 16 to 4294967295"
     );
     assert_eq!(
         err("block = \"MC_GearOut\"\nSlave = 1\naxis = 2"),

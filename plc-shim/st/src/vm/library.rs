@@ -29,6 +29,9 @@ pub(super) struct Library {
     /// Per host block: each variable's place in the instance (offset, type), `None` for one
     /// that is no elementary value (a structure's first leaf stands for it: an AXIS_REF).
     pub(super) members: Vec<Vec<Option<(u32, Elem)>>>,
+    /// Per host block: each variable's elementary leaves (offset in the instance, type), in
+    /// the order of its declaration (a structure's fields, an array's elements, nested).
+    pub(super) leaves: Vec<Vec<Vec<(u32, Elem)>>>,
     /// Every instance: its address and block, in address order.
     pub(super) instances: Vec<(u32, usize)>,
 }
@@ -39,6 +42,7 @@ pub struct BlockIo<'a> {
     pub(super) memory: &'a mut [u8],
     pub(super) at: usize,
     pub(super) members: &'a [Option<(u32, Elem)>],
+    pub(super) leaves: &'a [Vec<(u32, Elem)>],
     pub(super) slot: usize,
     /// The inputs this call passes (offsets in the instance).
     pub(super) passed: &'a [crate::ir::BlockInput],
@@ -143,6 +147,24 @@ impl BlockIo<'_> {
         true
     }
 
+    /// Sets the elementary leaves of variable `k` (a structure's fields in order, an
+    /// elementary output itself) from `values`, each converted to its type: how many values
+    /// it took.
+    pub fn set_leaves(&mut self, k: usize, values: &[f64]) -> usize {
+        let Some(leaves) = self.leaves.get(k) else {
+            return 0;
+        };
+        for (&(offset, t), v) in leaves.iter().zip(values) {
+            let v = match t {
+                Elem::Real | Elem::LReal => V::F(*v),
+                Elem::Bool => V::I(i64::from(*v != 0.0)),
+                _ => V::I(*v as i64),
+            };
+            let _ = write_mem(self.memory, self.at + offset as usize, t, v);
+        }
+        leaves.len().min(values.len())
+    }
+
     /// Sets variable `k` (an output) to `v`, converted to its type; nothing if it has no place.
     pub fn set(&mut self, k: usize, v: f64) {
         if let Some((at, t)) = self.place(k) {
@@ -190,6 +212,12 @@ impl Library {
             }
             lib.members
                 .push(found.map_or_else(Vec::new, |i| members(code, i)));
+            lib.leaves.push(found.map_or_else(Vec::new, |i| {
+                let (c, l) = (&code.checked, &code.layout);
+                let vars = c.pous[i].vars.iter().enumerate();
+                vars.map(|(k, v)| leaves_of(code, &v.ty, l.pous[i].2[k]))
+                    .collect()
+            }));
         }
         for (i, pou) in c.pous.iter().enumerate() {
             let holds = pou.vars.iter().any(|v| lib.holds_block(code, &v.ty, 0));
@@ -287,6 +315,37 @@ impl Library {
     }
 }
 
+/// The elementary leaves of a value of `ty` at `at` (at most 4,096 of them).
+fn leaves_of(code: &Compiled, ty: &Type, at: u32) -> Vec<(u32, Elem)> {
+    fn walk(code: &Compiled, ty: &Type, at: u32, out: &mut Vec<(u32, Elem)>) {
+        let (c, l) = (&code.checked, &code.layout);
+        if out.len() >= 4096 {
+            return;
+        }
+        match ty {
+            Type::Elem(e) => out.push((at, *e)),
+            Type::Enum(e) => out.push((at, c.enums[*e].base)),
+            Type::Struct(s) => {
+                for (k, (_, field)) in c.structs[*s].fields.iter().enumerate() {
+                    walk(code, field, at + l.structs[*s].2[k], out);
+                }
+            }
+            Type::Array(dims, element) => {
+                let (size, align) = l.size_align(c, element);
+                let stride = size.div_ceil(align) * align;
+                let count: i64 = dims.iter().map(|(lo, hi)| hi - lo + 1).product();
+                for k in 0..count.clamp(0, 4096) as u32 {
+                    walk(code, element, at + k * stride, out);
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(code, ty, at, &mut out);
+    out
+}
+
 /// Each variable's place in an instance of POU `pou`.
 fn members(code: &Compiled, pou: usize) -> Vec<Option<(u32, Elem)>> {
     let (c, l) = (&code.checked, &code.layout);
@@ -335,6 +394,7 @@ impl super::Exec<'_> {
             memory: &mut self.st.memory,
             at: base as usize,
             members: &lib.members[block],
+            leaves: &lib.leaves[block],
             slot,
             passed: self.passing,
         };
