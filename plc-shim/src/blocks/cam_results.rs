@@ -1,6 +1,7 @@
 //! What the cam read blocks show in Structured Text as outputs of their own (seed 000): the
 //! slave dynamics of MC_ReadCamTableSlaveDynamics (5.1.11), the characteristic values of
-//! MC_ReadCamTableCharacteristics (`MC_TableCharacValues`, 5.1.16.9), a point of
+//! MC_ReadCamTableCharacteristics (`MC_TableCharacValues`, 5.1.16.9) and of the flying saw's
+//! MC_ReadFlyingSawCharacteristics (`MC_FlyingSawCharacValues`, 001 12.3), a point of
 //! MC_ReadMotionFunctionPoint (`MC_MotionFunctionPoint`), the coupling's state of
 //! MC_CamInfo (`MC_CamInfoData`, 5.1.16.14) and the slave position of the compatibility
 //! block CamTableReadSlavePos (5.2.1.6). Each is filled, leaf by leaf, from the values the
@@ -33,13 +34,11 @@ pub const POINT: Results = Results {
     type_name: "",
 };
 
-/// MC_ReadCamTableCharacteristics: `CamTableCharac : MC_TableCharacValues`.
-pub const CHARACTERISTICS: Results = Results {
-    outputs: &[("CamTableCharac", "MC_TableCharacValues")],
-    declaration: "TYPE
-    MC_TableCharacValues :
-    STRUCT
-        fMasterVeloNom : LREAL;
+/// The fields of `MC_TableCharacValues` (000 5.1.16.9) and of the flying saw's
+/// `MC_FlyingSawCharacValues` (001 12.3), which lay them out alike.
+macro_rules! charac_fields {
+    () => {
+        "        fMasterVeloNom : LREAL;
         fMasterPosStart : LREAL;
         fSlavePosStart : LREAL;
         fSlaveVeloStart : LREAL;
@@ -77,10 +76,30 @@ pub const CHARACTERISTICS: Results = Results {
         TableType : UINT;
         Periodic : BOOL;
         reserved2 : ARRAY[1..121] OF BYTE;
-    END_STRUCT
-END_TYPE
-",
+"
+    };
+}
+
+/// MC_ReadCamTableCharacteristics: `CamTableCharac : MC_TableCharacValues`.
+pub const CHARACTERISTICS: Results = Results {
+    outputs: &[("CamTableCharac", "MC_TableCharacValues")],
+    declaration: concat!(
+        "TYPE\n    MC_TableCharacValues :\n    STRUCT\n",
+        charac_fields!(),
+        "    END_STRUCT\nEND_TYPE\n"
+    ),
     type_name: "MC_TableCharacValues",
+};
+
+/// MC_ReadFlyingSawCharacteristics: `CamTableCharac : MC_FlyingSawCharacValues`.
+pub const FLYING_SAW_CHARAC: Results = Results {
+    outputs: &[("CamTableCharac", "MC_FlyingSawCharacValues")],
+    declaration: concat!(
+        "TYPE\n    MC_FlyingSawCharacValues :\n    STRUCT\n",
+        charac_fields!(),
+        "    END_STRUCT\nEND_TYPE\n"
+    ),
+    type_name: "MC_FlyingSawCharacValues",
 };
 
 /// The characteristic values read (31, then the five organisation fields) with the reserved

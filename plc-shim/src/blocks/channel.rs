@@ -337,6 +337,25 @@ impl TimelineBlock for ReadChannelState {
         };
         (out, false)
     }
+    /// The channel's state in Structured Text, while Valid (Done).
+    fn results(&self) -> Option<&'static crate::timeline::registry::Results> {
+        Some(&CHANNEL_STATE)
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        let Some(state) = self.state else {
+            return 0;
+        };
+        let values = [
+            f64::from(state.raw()),
+            f64::from(self.block_nr),
+            f64::from(self.programs_ended),
+            f64::from(self.error_id),
+            f64::from(self.signals),
+        ];
+        let n = values.len().min(out.len());
+        out[..n].copy_from_slice(&values[..n]);
+        n
+    }
     fn read(&self) -> Option<Vec<f64>> {
         let state = self.state?;
         Some(vec![
@@ -348,6 +367,20 @@ impl TimelineBlock for ReadChannelState {
         ])
     }
 }
+
+/// ReadChannelState's outputs in Structured Text: the channel's state (a `ChannelState`),
+/// the block it runs, the programs that ended, its error and its signals.
+const CHANNEL_STATE: crate::timeline::registry::Results = crate::timeline::registry::Results {
+    outputs: &[
+        ("State", "DINT"),
+        ("BlockNr", "DINT"),
+        ("ProgramsEnded", "UDINT"),
+        ("ChannelErrorID", "UDINT"),
+        ("Signals", "DWORD"),
+    ],
+    declaration: "",
+    type_name: "",
+};
 
 /// A program name input: a plain file name as a TOML string.
 fn parse_program(value: &toml::Value) -> Result<Value, String> {

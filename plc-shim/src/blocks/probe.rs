@@ -183,7 +183,27 @@ impl TimelineBlock for TouchProbeInstance {
     fn read(&self) -> Option<Vec<f64>> {
         self.recorded.map(|p| vec![p])
     }
+    /// `RecordedPosition` in Structured Text (PLCopen's MC_TouchProbe).
+    fn results(&self) -> Option<&'static crate::timeline::registry::Results> {
+        Some(&RECORDED)
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        match (self.recorded, out.first_mut()) {
+            (Some(p), Some(slot)) => {
+                *slot = p;
+                1
+            }
+            _ => 0,
+        }
+    }
 }
+
+/// MC_TouchProbe's `RecordedPosition`.
+const RECORDED: crate::timeline::registry::Results = crate::timeline::registry::Results {
+    outputs: &[("RecordedPosition", "LREAL")],
+    declaration: "",
+    type_name: "",
+};
 
 impl TimelineBlock for McAbortTrigger {
     fn set(&mut self, key: &str, value: &Value) {

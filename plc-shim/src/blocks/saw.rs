@@ -637,6 +637,16 @@ impl TimelineBlock for CharacInstance {
         self.read |= self.block.out.done;
         recorded(self.block.out)
     }
+    /// `CamTableCharac : MC_FlyingSawCharacValues` in Structured Text.
+    fn results(&self) -> Option<&'static crate::timeline::registry::Results> {
+        Some(&super::cam_results::FLYING_SAW_CHARAC)
+    }
+    fn result_values(&self, out: &mut [f64]) -> usize {
+        let mut all = [0.0; 36];
+        all[..31].copy_from_slice(&self.block.values);
+        all[31..].copy_from_slice(&self.block.organisation.values());
+        super::cam_results::characteristics(&all, out)
+    }
     /// The 31 values in `MC_FlyingSawCharacValues` order ([`CHARAC_FIELDS`]), then the
     /// five organisation fields.
     fn read(&self) -> Option<Vec<f64>> {

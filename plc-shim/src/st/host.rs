@@ -402,9 +402,9 @@ impl Host for BlockHost<'_, '_> {
         }
         let was_done = inst.shown.is_some_and(|(o, _)| o.done);
         let out = inst.block.cycle(self.io, axis);
-        // A read's answer into the program's array and the block's outputs of its own,
-        // once, when it is Done.
-        if out.0.done && !was_done {
+        // A read's answer into the program's array and the block's outputs of its own, once
+        // when it is Done (a block without Execute, every cycle it is valid).
+        if out.0.done && (!was_done || binding.execute.is_none()) {
             if let Some(array) = inst.destination.and_then(|(p, n)| io.memory_at_mut(p, n)) {
                 inst.block.read_bytes(array);
             }

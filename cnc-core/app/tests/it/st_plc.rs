@@ -335,3 +335,50 @@ fn st_cam_table_read_data_fills_the_array_adr_data_array_points_to() {
     assert_eq!(lreal_of(&p, "MAIN.fbSlavePos.fSlavePos"), slave);
     assert!(slave > 0.0, "2 at master 20 of 0..40 -> 0..4: {slave}");
 }
+
+/// MC_ReadFlyingSawCharacteristics in ST (seed 001 12.1.3) shows the characteristic values
+/// of the sync phase in `CamTableCharac : MC_FlyingSawCharacValues`, as the timeline twin's
+/// block reads them.
+#[test]
+fn st_flying_saw_characteristics_show_what_the_timeline_reads() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenarios/saw-blocks");
+    let timeline = Scenario::load(std::path::Path::new(&format!("{dir}/scenario.toml"))).unwrap();
+    let run = InProcess::run_through(&timeline).unwrap();
+    let charac = reported(&run.timeline.as_ref().unwrap().summary(), "charac");
+    let p = st_in_process(dir);
+    let p = p.borrow();
+    let fields = [
+        "fMasterVeloNom",
+        "fMasterPosStart",
+        "fSlavePosStart",
+        "fSlaveVeloStart",
+    ];
+    let shown = fields.map(|f| lreal_of(&p, &format!("MAIN.fbCharac.CamTableCharac.{f}")));
+    assert_eq!(shown[..], charac[..4]);
+    assert!(shown[2] != 0.0, "a read, not zeros: {shown:?}");
+}
+
+/// ReadChannelState in ST shows the channel's state while Valid (its outputs of its own): the
+/// channel-control twin's panel ends as the timeline's block reads the channel.
+#[test]
+fn st_read_channel_state_shows_the_channels_state() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/channel-control"
+    );
+    let timeline = Scenario::load(std::path::Path::new(&format!("{dir}/scenario.toml"))).unwrap();
+    let run = InProcess::run_through(&timeline).unwrap();
+    let panel = reported(&run.timeline.as_ref().unwrap().summary(), "panel");
+    let p = st_in_process(dir);
+    let p = p.borrow();
+    let shown = [
+        "State",
+        "BlockNr",
+        "ProgramsEnded",
+        "ChannelErrorID",
+        "Signals",
+    ]
+    .map(|o| lreal_of(&p, &format!("MAIN.fbPanel.{o}")));
+    assert_eq!(shown[..], panel[..5]);
+    assert!(shown[2] >= 4.0, "four parts ended: {shown:?}");
+}
