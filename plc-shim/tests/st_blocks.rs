@@ -3,14 +3,13 @@
 //! sends nothing, and a cycle with library blocks (and its variables published) allocates
 //! nothing.
 
-use hli::views::PlcView;
-use hli_transport::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::runtime::{Link, PlcIo, PlcProgram};
 use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
+#[path = "support/stand_in.rs"]
+mod stand_in;
 
 /// MC_MoveVelocity on gpAx[1] with Execute and Direction from the test.
 const PROGRAM: &str = "PROGRAM MAIN
@@ -29,37 +28,7 @@ END_VAR
 END_PROGRAM
 ";
 
-struct Cnc {
-    memory: hli::ImageMemory,
-    _server: AcyclicServer,
-    client: AcyclicClient,
-    cycle: u64,
-}
-
-impl Cnc {
-    fn new(case: &str) -> Cnc {
-        let instance = tests::unique_instance(case);
-        Cnc {
-            memory: hli::image::heap_image(1, 2),
-            _server: AcyclicServer::open(&instance).unwrap(),
-            client: AcyclicClient::open(&instance).unwrap(),
-            cycle: 0,
-        }
-    }
-
-    fn cycle(&mut self, program: &mut StProgram) {
-        self.cycle += 1;
-        let mut io = PlcIo {
-            view: PlcView::new(&self.memory),
-            memory: &self.memory,
-            acyclic: &mut self.client,
-            cycle: self.cycle,
-            link: Link::Operational,
-        };
-        program.cycle(&mut io);
-        assert!(!program.halted(), "{}", program.summary());
-    }
-}
+use stand_in::StandIn as Cnc;
 
 /// `PROGRAM` with `Direction` and `Execute` set before the cycle, through its initial values.
 fn program(direction: i32, execute: bool) -> StProgram {
@@ -81,7 +50,7 @@ fn var(p: &StProgram, name: &str) -> f64 {
 
 #[test]
 fn an_instance_sends_its_call_on_the_rising_edge_of_execute() {
-    let mut cnc = Cnc::new("st-blocks-edge");
+    let mut cnc = Cnc::new("st-blocks-edge", 2);
     let mut p = program(1, true);
     assert_eq!(p.program().library_instances().len(), 1);
     cnc.cycle(&mut p);
@@ -93,7 +62,7 @@ fn an_instance_sends_its_call_on_the_rising_edge_of_execute() {
 
 #[test]
 fn a_value_outside_its_inputs_kind_ends_the_command_with_0x4227() {
-    let mut cnc = Cnc::new("st-blocks-refused");
+    let mut cnc = Cnc::new("st-blocks-refused", 2);
     let mut p = program(0, true);
     for _ in 0..3 {
         cnc.cycle(&mut p);
@@ -105,7 +74,7 @@ fn a_value_outside_its_inputs_kind_ends_the_command_with_0x4227() {
 
 #[test]
 fn a_cycle_with_library_blocks_allocates_nothing() {
-    let mut cnc = Cnc::new("st-blocks-alloc");
+    let mut cnc = Cnc::new("st-blocks-alloc", 2);
     // Busy: the call is out and waits for its answer, the kernel follows it each cycle; the
     // variables are published for the tools each cycle too.
     let mut p = program(1, true);
@@ -121,7 +90,7 @@ fn a_cycle_with_library_blocks_allocates_nothing() {
 
 #[test]
 fn an_input_no_call_gives_keeps_the_blocks_default() {
-    let mut cnc = Cnc::new("st-blocks-default");
+    let mut cnc = Cnc::new("st-blocks-default", 2);
     // No Direction in the call: MC_MoveVelocity's own default (positive) holds, where a 0
     // passed on would have been refused.
     let text = PROGRAM
@@ -135,7 +104,7 @@ fn an_input_no_call_gives_keeps_the_blocks_default() {
 
 #[test]
 fn rows_through_a_null_pointer_end_the_command_with_0x4227_and_send_nothing() {
-    let mut cnc = Cnc::new("st-blocks-rows");
+    let mut cnc = Cnc::new("st-blocks-rows", 2);
     let text = "PROGRAM MAIN VAR fbW : FiFoWrite; bErr : BOOL; nErr : UDINT; END_VAR
         fbW(bExecute := TRUE, iColDim := 2, iRowsToWrite := 1, bErr => bErr, iErrId => nErr);
         END_PROGRAM";
@@ -148,7 +117,7 @@ fn rows_through_a_null_pointer_end_the_command_with_0x4227_and_send_nothing() {
 
 #[test]
 fn an_input_given_before_the_edge_counts_at_the_edge() {
-    let mut cnc = Cnc::new("st-blocks-before");
+    let mut cnc = Cnc::new("st-blocks-before", 2);
     // Direction 0 is given while Execute is FALSE; the edge in a later cycle takes it (and
     // refuses it), as a PLC block holds its inputs from call to call.
     let text = "PROGRAM MAIN VAR ax : AXIS_REF; fbRun : MC_MoveVelocity; n : INT; bErr : BOOL;
@@ -167,7 +136,7 @@ fn an_input_given_before_the_edge_counts_at_the_edge() {
 
 #[test]
 fn t_timeout_ends_an_unanswered_command_after_its_time() {
-    let mut cnc = Cnc::new("st-blocks-timeout");
+    let mut cnc = Cnc::new("st-blocks-timeout", 2);
     // The stand-in CNC announces a 1 ms cycle and never answers: 5 ms are 5 PLC cycles.
     let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_cycle_ns);
     cnc.memory.place::<u32>(at).store(1_000_000);

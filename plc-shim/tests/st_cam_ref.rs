@@ -7,14 +7,13 @@
 
 use hli::calls::cam::{CamPointsWriteCall, CamRowsWriteCall};
 use hli::calls::ErrorCode;
-use hli::views::PlcView;
-use hli_transport::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::runtime::{Link, PlcIo, PlcProgram};
 use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 
 #[path = "../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
+#[path = "support/stand_in.rs"]
+mod stand_in;
 
 /// A 5-row table (y = x^2) selected through an MC_CAM_REF whose fields the test sets.
 const SELECT: &str = "PROGRAM MAIN
@@ -63,34 +62,7 @@ END_VAR
 END_PROGRAM
 ";
 
-struct Cnc {
-    memory: hli::ImageMemory,
-    server: AcyclicServer,
-    client: AcyclicClient,
-}
-
-impl Cnc {
-    fn new(case: &str) -> Cnc {
-        let instance = tests::unique_instance(case);
-        Cnc {
-            memory: hli::image::heap_image(1, 2),
-            server: AcyclicServer::open(&instance).unwrap(),
-            client: AcyclicClient::open(&instance).unwrap(),
-        }
-    }
-
-    fn cycle(&mut self, program: &mut StProgram) {
-        let mut io = PlcIo {
-            view: PlcView::new(&self.memory),
-            memory: &self.memory,
-            acyclic: &mut self.client,
-            cycle: 0,
-            link: Link::Operational,
-        };
-        program.cycle(&mut io);
-        assert!(!program.halted(), "{}", program.summary());
-    }
-}
+use stand_in::StandIn as Cnc;
 
 fn load(text: &str) -> StProgram {
     StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap()
@@ -102,7 +74,7 @@ fn var(p: &StProgram, name: &str) -> f64 {
 
 #[test]
 fn mc_cam_table_select_sends_the_rows_its_mc_cam_ref_describes() {
-    let mut cnc = Cnc::new("st-camref-rows");
+    let mut cnc = Cnc::new("st-camref-rows", 2);
     let mut p = load(SELECT);
     cnc.cycle(&mut p);
     assert_eq!(var(&p, "bError"), 0.0);
@@ -133,7 +105,7 @@ fn a_description_its_array_does_not_match_ends_with_the_seeds_code() {
         ("null", "stCamRef.pArray := ADR(aTable);", "", INVALID_INPUT),
         ("beyond", "SIZEOF(aTable)", "16#7FFFFFFF", INVALID_INPUT),
     ] {
-        let mut cnc = Cnc::new(&format!("st-camref-{case}"));
+        let mut cnc = Cnc::new(&format!("st-camref-{case}"), 2);
         let mut p = load(&SELECT.replace(from, to));
         cnc.cycle(&mut p);
         assert_eq!(cnc.client.sent(), 0, "{case}: nothing sent");
@@ -146,7 +118,7 @@ fn a_description_its_array_does_not_match_ends_with_the_seeds_code() {
 fn a_value_that_is_not_finite_ends_with_0x4227() {
     // The program cannot compute a NaN (that faults), but an array of other words may hold
     // one's bits: pArray takes any address.
-    let mut cnc = Cnc::new("st-camref-nan");
+    let mut cnc = Cnc::new("st-camref-nan", 2);
     let text = SELECT
         .replace(
             "bExecute : BOOL := TRUE;",
@@ -163,7 +135,7 @@ fn a_value_that_is_not_finite_ends_with_0x4227() {
 
 #[test]
 fn mc_write_motion_function_sends_the_points_of_its_mc_cam_ref() {
-    let mut cnc = Cnc::new("st-camref-points");
+    let mut cnc = Cnc::new("st-camref-points", 2);
     let mut p = load(WRITE);
     cnc.cycle(&mut p);
     assert_eq!(var(&p, "bError"), 0.0);
@@ -183,7 +155,7 @@ fn mc_write_motion_function_sends_the_points_of_its_mc_cam_ref() {
     assert_eq!(sent, Some((3, 2, points)));
 
     // Rows are a position table's, not a motion function's points.
-    let mut cnc = Cnc::new("st-camref-points-type");
+    let mut cnc = Cnc::new("st-camref-points-type", 2);
     let mut p = load(&WRITE.replace("nTableType := 22", "nTableType := 10"));
     cnc.cycle(&mut p);
     assert_eq!(cnc.client.sent(), 0);
@@ -192,7 +164,7 @@ fn mc_write_motion_function_sends_the_points_of_its_mc_cam_ref() {
 
 #[test]
 fn taking_tables_at_the_edges_allocates_nothing() {
-    let mut cnc = Cnc::new("st-camref-alloc");
+    let mut cnc = Cnc::new("st-camref-alloc", 2);
     // Execute toggles every cycle: a table is taken at every other cycle.
     let text = SELECT.replace(
         "axLifter.AxisIndex := 1;",
@@ -230,7 +202,7 @@ END_VAR
         CamTable := stCamRef, Error => bError, ErrorID => nErrorId);
 END_PROGRAM
 ";
-    let mut cnc = Cnc::new("st-camref-read");
+    let mut cnc = Cnc::new("st-camref-read", 2);
     let mut p = load(read);
     cnc.cycle(&mut p);
     assert_eq!(
@@ -249,7 +221,7 @@ END_PROGRAM
             INVALID_INPUT,
         ),
     ] {
-        let mut cnc = Cnc::new(&format!("st-camref-read-{case}"));
+        let mut cnc = Cnc::new(&format!("st-camref-read-{case}"), 2);
         let mut p = load(&read.replace(from, to));
         cnc.cycle(&mut p);
         assert_eq!(cnc.client.sent(), 0, "{case}: nothing sent");

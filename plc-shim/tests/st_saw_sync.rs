@@ -4,10 +4,11 @@
 
 use hli::calls::saw::{sync_mask, SawGearInCall};
 use hli::calls::ErrorCode;
-use hli::views::PlcView;
-use hli_transport::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::runtime::{Link, PlcIo, PlcProgram};
 use plc_shim::st::StProgram;
+use stand_in::StandIn;
+
+#[path = "support/stand_in.rs"]
+mod stand_in;
 
 const PROGRAM: &str = "PROGRAM MAIN
 VAR
@@ -32,21 +33,11 @@ END_PROGRAM
 /// The sync mode and mask the program's first cycle sends (`None`: nothing sent), and its
 /// ErrorID.
 fn sent(text: &str, case: &str) -> (Option<(u32, u32)>, f64) {
-    let instance = tests::unique_instance(case);
-    let server = AcyclicServer::open(&instance).unwrap();
-    let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::image::heap_image(1, 2);
+    let mut cnc = StandIn::new(case, 2);
     let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
-    p.cycle(&mut PlcIo {
-        view: PlcView::new(&memory),
-        memory: &memory,
-        acyclic: &mut client,
-        cycle: 0,
-        link: Link::Operational,
-    });
-    assert!(!p.halted(), "{}", p.summary());
+    cnc.cycle(&mut p);
     let mut call = None;
-    server
+    cnc.server
         .poll(|_, request| {
             let c: SawGearInCall = hli::calls::decode_body(request)?;
             call = Some((c.sync_mode, c.mask));

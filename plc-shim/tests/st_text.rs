@@ -4,11 +4,12 @@
 //! with 0x4227 and writes nothing; a literal longer than its STRING is refused at load.
 
 use hli::symbols::SymbolTable;
-use hli::views::PlcView;
-use hli_transport::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::runtime::{Link, PlcIo, PlcProgram};
 use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
+use stand_in::StandIn;
+
+#[path = "support/stand_in.rs"]
+mod stand_in;
 
 const PROGRAM: &str = "PROGRAM MAIN
 VAR
@@ -25,19 +26,10 @@ END_PROGRAM
 
 /// The program name the command in the image holds after one cycle, and the ErrorID.
 fn selected(text: &str, case: &str) -> (String, f64) {
-    let instance = tests::unique_instance(case);
-    let _server = AcyclicServer::open(&instance).unwrap();
-    let mut client = AcyclicClient::open(&instance).unwrap();
-    let memory = hli::image::heap_image(1, 1);
+    let mut cnc = StandIn::new(case, 1);
     let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
-    p.cycle(&mut PlcIo {
-        view: PlcView::new(&memory),
-        memory: &memory,
-        acyclic: &mut client,
-        cycle: 0,
-        link: Link::Operational,
-    });
-    assert!(!p.halted(), "{}", p.summary());
+    cnc.cycle(&mut p);
+    let memory = &cnc.memory;
     let at = SymbolTable::global()
         .lookup("gpCh[0]^channel_control.command_w.program")
         .expect("the command's program name")

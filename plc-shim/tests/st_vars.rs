@@ -2,11 +2,12 @@
 //! variable after a cycle a tool asked for a copy in, and takes a tool's write before the next; a value the type
 //! cannot hold is refused; the object is gone when the PLC is.
 
-use hli::views::PlcView;
-use hli_transport::rpc::{AcyclicClient, AcyclicServer};
-use plc_shim::runtime::{Link, PlcIo, PlcProgram};
 use plc_shim::st::vars::Variables;
 use plc_shim::st::StProgram;
+use stand_in::StandIn;
+
+#[path = "support/stand_in.rs"]
+mod stand_in;
 
 const PROGRAM: &str = "TYPE ST_P : STRUCT x : LREAL; n : INT; END_STRUCT END_TYPE
 PROGRAM MAIN
@@ -26,9 +27,7 @@ END_PROGRAM
 
 /// The PLC's side: a stand-in CNC and the program, publishing on `instance`.
 struct Plc {
-    memory: hli::ImageMemory,
-    _server: AcyclicServer,
-    client: AcyclicClient,
+    cnc: StandIn,
     program: StProgram,
 }
 
@@ -37,22 +36,13 @@ impl Plc {
         let mut program = StProgram::from_texts(&[("main.st".into(), PROGRAM.into())], 1).unwrap();
         program.publish_on(instance).unwrap();
         Plc {
-            memory: hli::image::heap_image(1, 2),
-            _server: AcyclicServer::open(instance).unwrap(),
-            client: AcyclicClient::open(instance).unwrap(),
+            cnc: StandIn::new("st-vars-cnc", 2),
             program,
         }
     }
 
     fn cycle(&mut self) {
-        let mut io = PlcIo {
-            view: PlcView::new(&self.memory),
-            memory: &self.memory,
-            acyclic: &mut self.client,
-            cycle: 0,
-            link: Link::Operational,
-        };
-        self.program.cycle(&mut io);
+        self.cnc.cycle(&mut self.program);
     }
 }
 

@@ -242,17 +242,9 @@ fn lreal_of(p: &plc_shim::st::StProgram, path: &str) -> f64 {
     }
 }
 
-/// The first numbers a timeline's report shows of block `instance`'s read.
+/// The numbers a timeline's report shows of block `instance`'s read.
 fn reported(summary: &str, instance: &str) -> Vec<f64> {
-    let block = format!("block {instance} (");
-    let at = summary.find(&block).expect(instance);
-    let line = summary[at..].lines().nth(1).expect("its read line");
-    let values = line.split_once(": ").expect("read values").1;
-    values
-        .split(", ")
-        .filter(|v| *v != "...")
-        .map(|v| v.parse().unwrap())
-        .collect()
+    crate::cam_engine::data::read_values(summary, instance)
 }
 
 /// The reads of scenarios/cam-data in ST (MC_ReadMotionFunctionValues and

@@ -656,16 +656,7 @@ impl<'a> Exec<'a> {
 
     fn eval(&mut self, e: &Ex, base: u32) -> Run<V> {
         Ok(match e {
-            Ex::Int(v) => V::I(*v),
-            Ex::Real(v) => V::F(*v),
-            Ex::Var {
-                offset,
-                relative,
-                ty,
-            } => {
-                let at = if *relative { base + offset } else { *offset };
-                self.read_own(at as usize, *ty)?
-            }
+            Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => self.operand(e, base)?,
             Ex::Load(a, t) => {
                 let at = match **a {
                     // The manuals' `p^.field`, without a call.

@@ -4,7 +4,7 @@
 use super::*;
 
 /// The numbers of a read block in the PLC's report.
-pub(super) fn read_values(report: &str, instance: &str) -> Vec<f64> {
+pub(crate) fn read_values(report: &str, instance: &str) -> Vec<f64> {
     let mut lines = report.lines();
     lines
         .find(|l| l.starts_with(&format!("block {instance} ")))

@@ -17,7 +17,7 @@ use hli::views::CncView;
 use hli::wire::{encode_body, AcyclicRequest};
 use std::path::PathBuf;
 
-mod data;
+pub(crate) mod data;
 mod manual_gaps;
 mod modes;
 mod selection;
