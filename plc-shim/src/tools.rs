@@ -199,8 +199,9 @@ fn attach(instance: &str) -> Result<PlcSegment, ToolError> {
 pub fn get(instance: &str, paths: &[String]) -> Result<Vec<String>, ToolError> {
     let (sources, vars) = sources(instance, paths)?;
     let segment = attach(instance)?;
-    if let Some(v) = &vars {
-        v.refresh().map_err(ToolError::St)?;
+    if let Some(Err(e)) = vars.as_ref().map(Variables::refresh) {
+        // A PLC that does not cycle (a stalled lockstep run): the last copy, said so.
+        eprintln!("plc get: {e}: the values of the last copy");
     }
     Ok(paths
         .iter()
@@ -383,7 +384,7 @@ fn watch(
     if writeln!(out, "{header}").is_err() {
         return Ok(());
     }
-    let mut printed = 0u64;
+    let (mut printed, mut stale) = (0u64, false);
     while count.is_none_or(|c| printed < c) {
         if segment.cnc_state() != Ok(SegmentState::Ready) {
             eprintln!("plc watch: the CNC closed its segment");
@@ -393,8 +394,12 @@ fn watch(
             break;
         }
         if let Some(Err(e)) = vars.as_ref().map(Variables::refresh) {
-            eprintln!("plc watch: {e}");
-            break;
+            if !stale {
+                eprintln!("plc watch: {e}: the values of the last copy until it cycles again");
+            }
+            stale = true;
+        } else {
+            stale = false;
         }
         let mut line = segment.cnc_heartbeat().to_string();
         for source in &sources {

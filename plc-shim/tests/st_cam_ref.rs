@@ -228,3 +228,29 @@ END_PROGRAM
         assert_eq!(var(&p, "nErrorId"), f64::from(code), "{case}");
     }
 }
+
+/// CamTableWriteData's row count from the program, far beyond any room: refused with the
+/// seed's 0x4B31, nothing sent, no overflow on the way.
+#[test]
+fn rows_beyond_every_room_are_refused_without_overflow() {
+    let mut cnc = Cnc::new("st-compat-rows-huge", 2);
+    let text = "PROGRAM MAIN
+VAR
+    aRows : ARRAY[1..2, 1..2] OF LREAL;
+    fbWrite : CamTableWriteData;
+    bError : BOOL;
+    nErrorId : UDINT;
+END_VAR
+    fbWrite(iAxisId := 1, bExecute := TRUE, iTableId := 21, AdrDataArray := ADR(aRows),
+        iSizeOfDataArray := SIZEOF(aRows), iColDim := 2, iRowsToWrite := 16#FFFFFFFF,
+        bErr => bError, iErrId => nErrorId);
+END_PROGRAM
+";
+    let mut p = load(text);
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 0);
+    assert_eq!(
+        (var(&p, "bError"), var(&p, "nErrorId")),
+        (1.0, f64::from(0x4B31))
+    );
+}

@@ -44,6 +44,43 @@ struct Instance {
     shown: Option<(Outputs, bool)>,
     /// The program's array (address, bytes) a read's answer goes into when it is Done.
     destination: Option<(i64, usize)>,
+    /// Done in the last call (a read's answer is copied when it rises).
+    last_done: bool,
+    /// Two edges of their own (bCoupleOn, bCoupleOff): each input's last level, which one
+    /// rose last, and a command held for one cycle with Execute low so that the block sees
+    /// the new edge.
+    edges: TwoEdges,
+}
+
+/// A block's two edges ([`crate::timeline::registry::StForm::Edges`]).
+#[derive(Debug, Default)]
+struct TwoEdges {
+    last_on: bool,
+    last_off: bool,
+    /// The last edge was `on`'s (the input the block is given).
+    on: bool,
+    /// A new edge came while the block's Execute was high: low for this cycle, high the next.
+    rearm: bool,
+}
+
+impl TwoEdges {
+    /// The block's Execute for inputs `on` and `off`, its Execute in the last call `held`:
+    /// high while either is, with a low cycle before a new edge of either while it is high.
+    fn execute(&mut self, on: bool, off: bool, held: bool) -> bool {
+        let (rose_on, rose_off) = (on && !self.last_on, off && !self.last_off);
+        (self.last_on, self.last_off) = (on, off);
+        if rose_on || rose_off {
+            self.on = rose_on;
+        }
+        if std::mem::take(&mut self.rearm) {
+            return true;
+        }
+        if (rose_on || rose_off) && held {
+            self.rearm = true;
+            return false;
+        }
+        on || off
+    }
 }
 
 /// The blocks of a program's instances (one per instance, made at load).
@@ -61,7 +98,7 @@ impl Blocks {
             .iter()
             .map(|(_, k)| {
                 let binding = &library.bindings[*k];
-                let mut block = (binding.spec.make)(None);
+                let mut block = (binding.spec.make)(binding.read_room());
                 // Room for table data (an MC_CAM_REF's array, or rows through a pointer a
                 // block keeps: the compatibility blocks'; FiFoWrite keeps its own).
                 let room = binding.cam_ref_room().max(binding.rows_room() * 8);
@@ -78,6 +115,8 @@ impl Blocks {
                     site: usize::MAX,
                     shown: None,
                     destination: None,
+                    last_done: false,
+                    edges: TwoEdges::default(),
                 }
             })
             .collect();
@@ -171,7 +210,9 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             // More values than a call takes, or than the array's size holds: none read, the
             // block refuses them with its own code.
             let n = (c as usize).saturating_mul(r as usize);
-            let beyond = size.is_some_and(|s| io.int(s).unwrap_or(0) < n as i64 * 8);
+            let bytes = (n as u64).saturating_mul(8);
+            let beyond = size
+                .is_some_and(|s| io.int(s).unwrap_or(0) < i64::try_from(bytes).unwrap_or(i64::MAX));
             if n > max || beyond {
                 inst.rows.clear();
                 return inst.block.set_rows(&inst.rows, c, r);
@@ -198,9 +239,8 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             };
             inst.block.set_destination(&array)
         }
-        Bound::Edges { on, .. } => {
-            let on = io.int(on).unwrap_or(0) != 0;
-            inst.block.set(spec.key, &Value::Bool(on));
+        Bound::Edges { .. } => {
+            inst.block.set(spec.key, &Value::Bool(inst.edges.on));
             true
         }
         Bound::Ids { count, first, len } => match ids(io, count, first, len) {
@@ -349,9 +389,9 @@ impl Host for BlockHost<'_, '_> {
             .get_mut(io.slot())
             .ok_or(Fault::BadPointer)?;
         let high = |v: usize| io.int(v).unwrap_or(0) != 0;
-        // Two edges of their own (bCoupleOn, bCoupleOff): the command's is either's.
+        // Two edges of their own (bCoupleOn, bCoupleOff): a rising edge of either is a command.
         let execute = match binding.edges {
-            Some((on, off)) => Some(high(on) || high(off)),
+            Some((on, off)) => Some(inst.edges.execute(high(on), high(off), inst.last_execute)),
             None => binding.execute.map(high),
         };
         let takes_inputs = match execute {
@@ -400,8 +440,9 @@ impl Host for BlockHost<'_, '_> {
         if let (Some(e), Some(x)) = (inst.block.execute(), execute) {
             *e = x;
         }
-        let was_done = inst.shown.is_some_and(|(o, _)| o.done);
+        let was_done = std::mem::replace(&mut inst.last_done, false);
         let out = inst.block.cycle(self.io, axis);
+        inst.last_done = out.0.done;
         // A read's answer into the program's array and the block's outputs of its own, once
         // when it is Done (a block without Execute, every cycle it is valid).
         if out.0.done && (!was_done || binding.execute.is_none()) {
@@ -430,5 +471,37 @@ fn axis_of(io: &BlockIo<'_>, binding: &Binding) -> u32 {
             .and_then(|v| u32::try_from(v).ok())
             .unwrap_or(u32::MAX),
         None => 0,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TwoEdges;
+
+    /// bCoupleOn and bCoupleOff: each rising edge is a command, the later one's input given;
+    /// an edge while the other is held lowers Execute for one cycle so that the block sees it.
+    #[test]
+    fn either_edge_is_a_command_even_while_the_other_is_held() {
+        let mut e = TwoEdges::default();
+        let mut held = false;
+        let mut step = |on, off| {
+            let x = e.execute(on, off, held);
+            held = x;
+            (x, e.on)
+        };
+        assert_eq!(step(true, false), (true, true), "bCoupleOn rises");
+        assert_eq!(step(true, false), (true, true), "held");
+        assert_eq!(
+            step(true, true),
+            (false, false),
+            "bCoupleOff rises: one low cycle"
+        );
+        assert_eq!(
+            step(true, true),
+            (true, false),
+            "then its edge, FALSE given"
+        );
+        assert_eq!(step(false, false), (false, false));
+        assert_eq!(step(false, true), (true, false), "bCoupleOff alone");
     }
 }

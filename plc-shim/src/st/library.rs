@@ -72,6 +72,11 @@ END_TYPE
 /// nNoOfCols), as the layout places them (a test checks them).
 pub(super) const CAM_REF_FIELDS: [u32; 4] = [8, 12, 16, 20];
 
+/// The room of a read's answer in Structured Text (values, or points of a motion function),
+/// made at load: MC_ReadMotionFunctionValues and CamTableReadData up to 4,096 LREALs,
+/// MC_ReadMotionFunction up to 4,096 points; a larger answer is the block's 0x4B31.
+pub const ST_READ_ROOM: usize = 4096;
+
 /// The name the library's declarations are loaded under.
 pub const LIBRARY: &str = "<blocks>";
 
@@ -204,6 +209,15 @@ impl Binding {
             _ => 0,
         };
         self.inputs.iter().map(room).max().unwrap_or(0)
+    }
+
+    /// The room of a read's answer the instance's block is made with: [`ST_READ_ROOM`] for a
+    /// block that reads into the program's array, the block's default otherwise.
+    pub(super) fn read_room(&self) -> Option<usize> {
+        let reads = |(b, _): &(Bound, InputSpec)| {
+            matches!(b, Bound::ReadInto { .. } | Bound::ReadAt { .. })
+        };
+        self.inputs.iter().any(reads).then_some(ST_READ_ROOM)
     }
 
     /// The bytes of `MC_CAM_REF` array the instance's block makes room for (0 without).

@@ -96,6 +96,9 @@ impl StProgram {
 impl PlcProgram for StProgram {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
         if self.fault.is_some() {
+            if let Some(p) = &mut self.publisher {
+                p.serve(&self.program);
+            }
             return;
         }
         let at = core::mem::offset_of!(HliSegmentHeader, cnc_cycle_ns);

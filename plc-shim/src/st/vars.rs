@@ -122,6 +122,12 @@ impl Publisher {
     pub fn publish(&mut self, program: &Program) {
         self.cycles = self.cycles.wrapping_add(1);
         self.memory.place::<u64>(CYCLES).store_release(self.cycles);
+        self.serve(program);
+    }
+
+    /// Copies the program's memory into the object if a tool has asked for a copy since the
+    /// last (also while the program stands after a fault, so that a tool sees where).
+    pub fn serve(&mut self, program: &Program) {
         let asked = self.memory.place::<u32>(ASKED_COPIES).load_acquire();
         if asked == self.served {
             return;

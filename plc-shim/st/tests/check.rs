@@ -185,3 +185,21 @@ fn adr_of_an_array_points_to_its_elements() {
         vec!["p.st:5:19: error: a POINTER TO ARRAY[0..3, 0..1] OF LREAL where a POINTER TO INT is wanted".to_string()]
     );
 }
+
+/// An instance's state is its block's: ADR of an instance or of anything in it, and copies of
+/// arrays or structures that hold instances, are refused (a library block writes its
+/// outputs itself, only when they change).
+#[test]
+fn adr_of_an_instance_and_copies_of_instances_are_refused() {
+    let vars = "fbT : TON; aTon, aTof : ARRAY[0..1] OF TON; p : POINTER TO BOOL; q : POINTER TO TON;";
+    let refused = refusals(
+        vars,
+        "p := ADR(fbT.Q);\nq := ADR(fbT);\naTon := aTof;\np := ADR(aTon[1].Q);",
+    );
+    let adr = "ADR of a function block instance or its member";
+    assert_eq!(refused.len(), 4, "{refused:?}");
+    assert!(refused[0].starts_with("p.st:5:10: error: ") && refused[0].contains(adr));
+    assert!(refused[1].starts_with("p.st:6:10: error: ") && refused[1].contains(adr));
+    assert!(refused[2].contains("p.st:7:1: error: function block instances are not copied"));
+    assert!(refused[3].starts_with("p.st:8:10: error: ") && refused[3].contains(adr));
+}

@@ -222,11 +222,43 @@ impl Checker {
         matches!(t, Type::Fb(_) | Type::StdFb(_))
     }
 
+    /// Whether `ty` holds a function block instance (itself, in an array or a structure).
+    pub(super) fn holds_instance(&self, ty: &Type, depth: usize) -> bool {
+        match ty {
+            Type::Fb(_) | Type::StdFb(_) => true,
+            Type::Array(_, element) if depth < 16 => self.holds_instance(element, depth + 1),
+            Type::Struct(i) if depth < 16 => self.out.structs[*i]
+                .fields
+                .iter()
+                .any(|(_, t)| self.holds_instance(t, depth + 1)),
+            _ => false,
+        }
+    }
+
+    /// Whether `e` is a place in or holding a function block instance (ADR of it refused).
+    fn instance_place(&mut self, e: &Expr, ctx: Ctx) -> bool {
+        let errors = self.errors.len();
+        let t = self.expr(e, ctx);
+        // A field or element anywhere below an instance (`fb.Point.MasterPos`).
+        let (mut inside, mut place) = (false, e);
+        while let Expr::Field(base, _) | Expr::Index(base, ..) = place {
+            inside |= self.reads_an_instance(base, ctx);
+            place = base;
+        }
+        self.errors.truncate(errors);
+        inside || self.holds_instance(&t, 0)
+    }
+
     fn assign(&mut self, target: &Expr, value: &Expr, ctx: Ctx) {
         if let Some(want) = self.writable(target, ctx) {
             match want {
                 Type::Fb(_) | Type::StdFb(_) => {
                     self.refuse(target.pos(), "a function block instance is not assigned")
+                }
+                Type::Array(..) | Type::Struct(_) if self.holds_instance(&want, 0) => {
+                    // An instance's state is its block's (a library block's outputs are
+                    // written by the block alone).
+                    self.refuse(target.pos(), "function block instances are not copied")
                 }
                 Type::Array(..) | Type::Struct(_) => {
                     // Whole arrays and structures of the same type copy.
@@ -482,6 +514,10 @@ impl Checker {
             _ => None,
         };
         match name {
+            "ADR" if count(1..=1) && self.instance_place(values[0], ctx) => self.error(
+                values[0].pos(),
+                "ADR of a function block instance or its member: an instance is reached through its calls",
+            ),
             "ADR" if count(1..=1) => match self.writable_silent(values[0], ctx) {
                 Some(t) => Type::Pointer(Box::new(t)),
                 None => self.error(values[0].pos(), "ADR of a variable, a field or an element"),

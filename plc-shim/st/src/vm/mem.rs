@@ -30,10 +30,12 @@ impl Loc {
 /// Where pointer value `p` points: NULL (0) and values below it are faults.
 #[inline]
 pub(crate) fn pointed(p: i64) -> Run<Loc> {
-    let (image, at) = (p & IMAGE_TAG != 0, (p & !IMAGE_TAG) - 1);
-    if at < 0 {
-        return Err(Fault::BadPointer);
-    }
+    let image = p & IMAGE_TAG != 0;
+    // NULL, and values below it (a word of other bits read as a pointer), are no place.
+    let at = (p & !IMAGE_TAG)
+        .checked_sub(1)
+        .filter(|a| *a >= 0)
+        .ok_or(Fault::BadPointer)?;
     Ok(if image {
         Loc::Image(at as usize)
     } else {
@@ -80,4 +82,25 @@ pub(crate) fn read_mem(m: &[u8], at: usize, t: Elem) -> Run<V> {
         Elem::Real => V::F(f64::from(f32::from_le_bytes(arr(bytes(4)?)))),
         Elem::LReal => V::F(f64::from_le_bytes(arr(bytes(8)?))),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn null_and_words_below_it_point_nowhere() {
+        for p in [
+            0,
+            -1,
+            i64::MIN,
+            i64::MIN + 1,
+            IMAGE_TAG,
+            IMAGE_TAG | i64::MIN,
+        ] {
+            assert_eq!(pointed(p), Err(Fault::BadPointer), "{p:#x}");
+        }
+        assert_eq!(pointed(1), Ok(Loc::Own(0)));
+        assert_eq!(pointed(IMAGE_TAG | 9), Ok(Loc::Image(8)));
+    }
 }
