@@ -191,7 +191,8 @@ fn adr_of_an_array_points_to_its_elements() {
 /// outputs itself, only when they change).
 #[test]
 fn adr_of_an_instance_and_copies_of_instances_are_refused() {
-    let vars = "fbT : TON; aTon, aTof : ARRAY[0..1] OF TON; p : POINTER TO BOOL; q : POINTER TO TON;";
+    let vars =
+        "fbT : TON; aTon, aTof : ARRAY[0..1] OF TON; p : POINTER TO BOOL; q : POINTER TO TON;";
     let refused = refusals(
         vars,
         "p := ADR(fbT.Q);\nq := ADR(fbT);\naTon := aTof;\np := ADR(aTon[1].Q);",

@@ -467,3 +467,52 @@ fn a_constant_index_far_out_of_bounds_faults_in_the_cycle() {
     );
     assert!(matches!(f, Fault::IndexOutOfRange { .. }), "{f:?}");
 }
+
+/// A function block's VAR_IN_OUT: copied in before the call and back after it, so the
+/// block's writes reach the caller's variable (an elementary one, and a structure leaf by
+/// leaf); a value that is no variable, or a variable of another type, is refused at load.
+#[test]
+fn var_in_out_of_a_function_block_reaches_the_callers_variable() {
+    let text = "TYPE ST_Count : STRUCT n : DINT; x : LREAL; END_STRUCT END_TYPE
+FUNCTION_BLOCK FB_Step
+VAR_IN_OUT
+    nCount : DINT;
+    stCount : ST_Count;
+END_VAR
+VAR_INPUT
+    nBy : DINT;
+END_VAR
+    nCount := nCount + nBy;
+    stCount.n := stCount.n + 1;
+    stCount.x := stCount.x + 0.5;
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    fb : FB_Step;
+    n : DINT := 10;
+    st : ST_Count;
+    n2, m : DINT;
+    x : LREAL;
+END_VAR
+    fb(nCount := n, stCount := st, nBy := 3);
+    m := st.n;
+    x := st.x;
+END_PROGRAM
+";
+    let p = run(text, 4);
+    assert_eq!(p.read_var("MAIN.n"), Some(22.0), "10 + 4 x 3");
+    assert_eq!(p.read_var("MAIN.m"), Some(4.0));
+    assert_eq!(p.read_var("MAIN.x"), Some(2.0));
+    for (call, why) in [
+        ("fb(nCount := 5, stCount := st);", "only a variable"),
+        (
+            "fb(nCount := x, stCount := st);",
+            "a LREAL for a VAR_IN_OUT of DINT",
+        ),
+    ] {
+        let bad = text.replace("fb(nCount := n, stCount := st, nBy := 3);", call);
+        let refused = Program::load(&[("main.st", &bad)]).unwrap_err();
+        let text: Vec<String> = refused.iter().map(|d| d.to_string()).collect();
+        assert!(text.iter().any(|t| t.contains(why)), "{call}: {text:?}");
+    }
+}

@@ -625,6 +625,31 @@ impl Checker {
                 _ => Type::Error,
             };
             let (offset, member) = self.member(&inst_ty, name, l)?;
+            let in_out = pou.is_some_and(|i| {
+                self.out.pous[i].vars.iter().any(|v| {
+                    v.section == crate::ast::Section::InOut
+                        && v.name.eq_ignore_ascii_case(&name.text)
+                })
+            });
+            if let (true, Arg::Input(_, v)) = (in_out, arg) {
+                // VAR_IN_OUT: copied in before the call and back after it, leaf by leaf.
+                let (from, _) = self.place(v, ctx, l)?;
+                let leaves = match &member {
+                    Type::Elem(t) => vec![(0, *t)],
+                    _ => self.leaves(&member, l).ok_or_else(|| {
+                        self.unsupported(
+                            name.pos,
+                            "a VAR_IN_OUT with more than 64 values or of this type",
+                        )
+                    })?,
+                };
+                for (at, t) in leaves {
+                    let leaf = plus(from.clone(), at);
+                    inputs.push((offset + at, t, Ex::Load(Box::new(leaf.clone()), t)));
+                    outputs.push((offset + at, t, leaf, false));
+                }
+                continue;
+            }
             if let (Type::Struct(_), Arg::Input(_, v)) = (&member, arg) {
                 // A structure input (an AXIS_REF) is passed leaf by leaf.
                 let (from, _) = self.place(v, ctx, l)?;

@@ -374,7 +374,16 @@ impl Checker {
         for arg in args {
             match arg {
                 Arg::Input(name, value) => match find(&name.text) {
-                    Some((_, t, Section::Input | Section::InOut)) => self.assignable(value, t, ctx),
+                    Some((_, t, Section::Input)) => self.assignable(value, t, ctx),
+                    // Copied in before the call and back after it: a place that may be written.
+                    Some((_, t, Section::InOut)) => {
+                        if let Some(place) = self.writable(value, ctx) {
+                            if place != *t {
+                                let (g, w) = (self.type_name(&place), self.type_name(t));
+                                self.refuse(value.pos(), format!("a {g} for a VAR_IN_OUT of {w}"));
+                            }
+                        }
+                    }
                     Some(_) => self.refuse(
                         name.pos,
                         format!("`{}` is an output: `{} =>`", name.text, name.text),
