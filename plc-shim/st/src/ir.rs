@@ -76,6 +76,8 @@ pub enum Ex {
     Bin(BinOp, Elem, Box<Ex>, Box<Ex>),
     /// A conversion between elementary types.
     Conv(Elem, Elem, Box<Ex>),
+    /// Whether two STRINGs hold the same characters (before their NUL).
+    TextEq(Box<(Text, Text)>),
     /// A standard function, the type it computes in, its values.
     Std(StdFn, Elem, Vec<Ex>),
     /// A user function: its body index, its inputs (offsets in its frame, at most
@@ -90,6 +92,15 @@ pub enum Ex {
         /// The value's type.
         ty: Elem,
     },
+}
+
+/// A STRING's characters: a literal's (NUL-padded), or a variable's `size` bytes at a place.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Text {
+    /// A literal.
+    Const(Box<[u8]>),
+    /// A variable: its place and size (with the NUL).
+    At(Addr, u32),
 }
 
 /// The most inputs a call of a user function passes (their values are held on the stack while

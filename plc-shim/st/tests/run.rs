@@ -516,3 +516,25 @@ END_PROGRAM
         assert!(text.iter().any(|t| t.contains(why)), "{call}: {text:?}");
     }
 }
+
+/// STRINGs compare by their characters before the NUL: a variable with a literal, two
+/// variables of other sizes; `<>` the opposite.
+#[test]
+fn strings_compare_by_their_characters() {
+    let text = "PROGRAM MAIN
+VAR
+    s : STRING(20) := 'part.nc';
+    t : STRING(8) := 'part.nc';
+    u : STRING(20) := 'part.n';
+    n : INT;
+END_VAR
+    n := 0;
+    IF s = 'part.nc' THEN n := n + 1; END_IF
+    IF s = t THEN n := n + 10; END_IF
+    IF s <> u THEN n := n + 100; END_IF
+    IF u = 'part.nc' THEN n := n + 1000; END_IF
+    IF 'part.n' = u THEN n := n + 10000; END_IF
+END_PROGRAM
+";
+    assert_eq!(run(text, 1).read_var("MAIN.n"), Some(10111.0));
+}

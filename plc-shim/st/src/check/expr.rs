@@ -333,6 +333,10 @@ impl Checker {
         if lt == Type::Error || rt == Type::Error {
             return Type::Error;
         }
+        // Two STRINGs are equal or not (their characters before the NUL).
+        if let (Eq | Ne, Type::Str(_), Type::Str(_)) = (op, &lt, &rt) {
+            return BOOL;
+        }
         let Some((c, _, _)) = operands_of(l, r, lt.clone(), rt.clone()) else {
             let message = format!(
                 "{} of {} and {}",

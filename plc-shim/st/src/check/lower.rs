@@ -327,6 +327,14 @@ impl Checker {
 
     fn binary_value(&mut self, op: BinOp, a: &Expr, b: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
         let (ta, tb) = (self.expr(a, ctx), self.expr(b, ctx));
+        if let (Type::Str(m), Type::Str(n)) = (&ta, &tb) {
+            let (x, y) = (self.text_of(a, *m, ctx, l)?, self.text_of(b, *n, ctx, l)?);
+            let equal = Ex::TextEq(Box::new((x, y)));
+            return Ok(match op {
+                BinOp::Ne => Ex::Not(Box::new(equal), Elem::Bool),
+                _ => equal,
+            });
+        }
         let t = match (&ta, &tb) {
             (Type::Enum(i), _) | (_, Type::Enum(i)) => self.out.enums[*i].base,
             (Type::Pointer(_), _) => Elem::ULInt,

@@ -6,7 +6,7 @@ use super::lower::R;
 use super::{Checker, Type};
 use crate::ast::{BinOp, Expr};
 use crate::diag::Diagnostic;
-use crate::ir::{Addr, Ex, StKind, StdFn};
+use crate::ir::{Addr, Ex, StKind, StdFn, Text};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -180,6 +180,16 @@ impl Checker {
             }
             _ => Err(self.unsupported(value.pos(), "this value into a STRING")),
         }
+    }
+
+    /// A STRING(n) operand of a comparison: a literal's bytes, or a variable's place.
+    pub(super) fn text_of(&mut self, e: &Expr, n: u32, ctx: Ctx, l: &Layout) -> R<Text> {
+        if let Expr::Str(text, pos) = e {
+            let bytes = self.literal_bytes(text, n, *pos)?;
+            return Ok(Text::Const(bytes.into_boxed_slice()));
+        }
+        let (at, _) = self.place(e, ctx, l)?;
+        Ok(Text::At(at, n + 1))
     }
 
     /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING

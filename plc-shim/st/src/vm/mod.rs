@@ -27,6 +27,21 @@ pub use fault::{Fault, FaultAt};
 pub use image::IMAGE_TAG;
 pub(crate) use mem::{arr, pointed, read_mem, write_mem, Loc};
 
+/// A STRING's characters before its NUL: a literal's, or the `n` bytes of memory at `at`.
+fn chars<'m>(
+    memory: &'m [u8],
+    t: &'m crate::ir::Text,
+    at: Option<(usize, usize)>,
+) -> Run<&'m [u8]> {
+    let bytes: &[u8] = match (t, at) {
+        (_, Some((from, n))) => memory.get(from..from + n).ok_or(Fault::BadPointer)?,
+        (crate::ir::Text::Const(lit), None) => lit,
+        (crate::ir::Text::At(..), None) => &[],
+    };
+    let end = bytes.iter().position(|c| *c == 0).unwrap_or(bytes.len());
+    Ok(&bytes[..end])
+}
+
 /// How a statement list ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Flow {
@@ -685,6 +700,7 @@ impl<'a> Exec<'a> {
             }
             Ex::Conv(from, to, x) => ops::convert(self.operand(x, base)?, *from, *to)?,
             Ex::Std(f, t, args) => self.std_fn(*f, *t, args, base)?,
+            Ex::TextEq(pair) => V::I(i64::from(self.text_eq(&pair.0, &pair.1, base)?)),
             Ex::Call {
                 pou,
                 inputs,
@@ -723,6 +739,22 @@ impl<'a> Exec<'a> {
         self.st.at = statement;
         let at = self.addr(value, base)?;
         self.read(at, ty)
+    }
+
+    /// Whether two STRINGs hold the same characters before their NUL (or their end).
+    #[inline(never)]
+    fn text_eq(&mut self, a: &crate::ir::Text, b: &crate::ir::Text, base: u32) -> Run<bool> {
+        let (x, y) = (self.text_at(a, base)?, self.text_at(b, base)?);
+        let memory = &self.st.memory;
+        Ok(chars(memory, a, x)? == chars(memory, b, y)?)
+    }
+
+    /// Where a STRING operand's bytes are in the program's memory (`None`: a literal's).
+    fn text_at(&mut self, t: &crate::ir::Text, base: u32) -> Run<Option<(usize, usize)>> {
+        match t {
+            crate::ir::Text::Const(_) => Ok(None),
+            crate::ir::Text::At(addr, n) => Ok(Some((self.own(addr, base)?, *n as usize))),
+        }
     }
 
     #[inline(never)]
