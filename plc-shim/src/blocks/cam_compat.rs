@@ -470,19 +470,13 @@ impl TimelineBlock for CompatBlock {
             c.refuse = Some(super::cam_read::ERROR_ARRAY_SIZE);
             return true;
         }
-        let table = CamRefIn {
-            bytes: bytemuck::cast_slice(&values[..2 * n]),
-            array_size: (16 * n) as u32,
-            table_type: 10,
-            rows,
-            columns,
-        };
-        match room.take(&table).map(|r| r.data) {
-            Some(CamData::Rows { rows, .. }) => {
+        let given = values[..2 * n].chunks_exact(2).map(|r| [r[0], r[1]]);
+        match room.rows(given) {
+            Some((rows, n)) => {
                 (c.rows, c.rows_count) = (Some(rows), Some(n));
                 true
             }
-            _ => false,
+            None => false,
         }
     }
     /// CamTableReadData's `AdrDataArray`: its size in bytes the most the answer may hold.
@@ -501,12 +495,7 @@ impl TimelineBlock for CompatBlock {
         super::cam_results::copied(&self.read.values[..self.read.values.len().min(1)], out)
     }
     fn read_bytes(&self, out: &mut [u8]) -> usize {
-        let mut written = 0;
-        for (value, slot) in self.read.values.iter().zip(out.chunks_exact_mut(8)) {
-            slot.copy_from_slice(&value.to_le_bytes());
-            written += 8;
-        }
-        written
+        super::cam_results::lreal_bytes(&self.read.values, out)
     }
 }
 

@@ -378,12 +378,7 @@ impl TimelineBlock for McCamRead {
         true
     }
     fn read_bytes(&self, out: &mut [u8]) -> usize {
-        let mut written = 0;
-        for (value, slot) in self.values.iter().zip(out.chunks_exact_mut(8)) {
-            slot.copy_from_slice(&value.to_le_bytes());
-            written += 8;
-        }
-        written
+        cam_results::lreal_bytes(&self.values, out)
     }
     fn results(&self) -> Option<&'static Results> {
         match CamReadKind::from_raw(self.request.what) {

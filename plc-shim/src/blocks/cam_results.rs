@@ -176,3 +176,14 @@ pub fn copied(values: &[f64], out: &mut [f64]) -> usize {
     out[..n].copy_from_slice(&values[..n]);
     n
 }
+
+/// `values` as the LREALs of a program's array (little-endian), as many as `out` holds: the
+/// bytes written.
+pub fn lreal_bytes(values: &[f64], out: &mut [u8]) -> usize {
+    let mut written = 0;
+    for (value, slot) in values.iter().zip(out.chunks_exact_mut(8)) {
+        slot.copy_from_slice(&value.to_le_bytes());
+        written += 8;
+    }
+    written
+}

@@ -27,17 +27,28 @@ fn free<T>(buffers: &mut [Arc<[T]>; 2]) -> Option<&mut Arc<[T]>> {
     buffers.iter_mut().find(|b| Arc::strong_count(b) == 1)
 }
 
-impl CamRoom {
-    /// Room for arrays of up to `bytes` bytes, as rows or as points.
-    pub fn new(bytes: usize) -> CamRoom {
-        let rows = || Arc::from(vec![[0.0; 2]; bytes / ROW_BYTES]);
-        let points = || Arc::from(vec![McMotionFunctionPoint::default(); bytes / POINT_BYTES]);
-        CamRoom {
-            rows: [rows(), rows()],
-            points: [points(), points()],
+/// `items` copied into a free one of `buffers` (as many as it holds): the buffer, shared,
+/// and how many; `None` if an item is not `finite`, or if both buffers are held (a block's
+/// `cam_ref` is dropped before, and a block has one transfer at a time: never).
+fn fill<T: Copy>(
+    buffers: &mut [Arc<[T]>; 2],
+    items: impl Iterator<Item = T>,
+    finite: fn(&T) -> bool,
+) -> Option<(Arc<[T]>, usize)> {
+    let buffer = free(buffers)?;
+    let slots = Arc::get_mut(buffer)?;
+    let mut n = 0;
+    for (slot, item) in slots.iter_mut().zip(items) {
+        if !finite(&item) {
+            return None;
         }
+        *slot = item;
+        n += 1;
     }
+    Some((Arc::clone(buffer), n))
+}
 
+impl CamRoom {
     /// Room for rows alone (the compatibility blocks' `AdrDataArray`).
     pub fn rows_only(bytes: usize) -> CamRoom {
         let rows = || Arc::from(vec![[0.0; 2]; bytes / ROW_BYTES]);
@@ -47,39 +58,48 @@ impl CamRoom {
         }
     }
 
+    /// Room for arrays of up to `bytes` bytes, as rows or as points.
+    pub fn new(bytes: usize) -> CamRoom {
+        let points = || Arc::from(vec![McMotionFunctionPoint::default(); bytes / POINT_BYTES]);
+        CamRoom {
+            points: [points(), points()],
+            ..CamRoom::rows_only(bytes)
+        }
+    }
+
+    /// `rows` copied into the room: the rows, shared, and how many (see [`fill`]).
+    pub fn rows(
+        &mut self,
+        rows: impl Iterator<Item = [f64; 2]>,
+    ) -> Option<(Arc<[[f64; 2]]>, usize)> {
+        fill(&mut self.rows, rows, |r| r.iter().all(|v| v.is_finite()))
+    }
+
     /// `table` as an `MC_CAM_REF` whose array is a copy in this room (as much of its bytes
     /// as the room holds; the block's check refuses a description its array does not
-    /// match): `None` if a value is not finite, or if both buffers are held (a block's
-    /// `cam_ref` is dropped before, and a block has one transfer at a time: never).
+    /// match): `None` as [`fill`] says.
     pub fn take(&mut self, table: &CamRefIn<'_>) -> Option<CamRef> {
         let (data, held) = if table.table_type == MOTION_FUNCTION {
-            let buffer = free(&mut self.points)?;
-            let slots = Arc::get_mut(buffer)?;
-            let chunks = table.bytes.chunks_exact(POINT_BYTES);
-            let n = chunks.len().min(slots.len());
-            for (slot, chunk) in slots.iter_mut().zip(chunks) {
-                let p: McMotionFunctionPoint = bytemuck::pod_read_unaligned(chunk);
-                let values = [p.master_pos, p.slave_pos, p.slave_velo, p.slave_acc];
-                if !values.iter().chain([&p.slave_jerk]).all(|v| v.is_finite()) {
-                    return None;
-                }
-                *slot = p;
-            }
-            (CamData::Points(Arc::clone(buffer)), n)
+            let points = table.bytes.chunks_exact(POINT_BYTES);
+            let finite = |p: &McMotionFunctionPoint| {
+                [
+                    p.master_pos,
+                    p.slave_pos,
+                    p.slave_velo,
+                    p.slave_acc,
+                    p.slave_jerk,
+                ]
+                .iter()
+                .all(|v| v.is_finite())
+            };
+            let points = points.map(bytemuck::pod_read_unaligned);
+            let (buffer, n) = fill(&mut self.points, points, finite)?;
+            (CamData::Points(buffer), n)
         } else {
-            let buffer = free(&mut self.rows)?;
-            let slots = Arc::get_mut(buffer)?;
-            let chunks = table.bytes.chunks_exact(ROW_BYTES);
-            let n = chunks.len().min(slots.len());
-            for (slot, chunk) in slots.iter_mut().zip(chunks) {
-                let row: [f64; 2] = bytemuck::pod_read_unaligned(chunk);
-                if !row.iter().all(|v| v.is_finite()) {
-                    return None;
-                }
-                *slot = row;
-            }
+            let rows = table.bytes.chunks_exact(ROW_BYTES);
+            let (rows, n) = self.rows(rows.map(bytemuck::pod_read_unaligned))?;
             let data = CamData::Rows {
-                rows: Arc::clone(buffer),
+                rows,
                 table_type: 0,
                 interpolation: 0,
             };

@@ -221,23 +221,15 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
         }
         Bound::CamRef { var, max_bytes } => pass_cam_ref(io, inst, var, max_bytes),
         Bound::ReadAt { data, size } => {
-            inst.destination = None;
-            let (Some(p), Some(n)) = (io.int(data), io.int(size)) else {
-                return false;
-            };
-            let n = usize::try_from(n).unwrap_or(usize::MAX);
-            if io.memory_at(p, n).is_none() {
-                return false;
-            }
-            inst.destination = Some((p, n));
-            let array = CamRefIn {
+            let size = io.int(size).and_then(|n| u32::try_from(n).ok());
+            let array = size.map(|array_size| CamRefIn {
                 bytes: &[],
-                array_size: n as u32,
+                array_size,
                 table_type: 0,
                 rows: 0,
                 columns: 0,
-            };
-            inst.block.set_destination(&array)
+            });
+            destination(io, inst, io.int(data), array)
         }
         Bound::Edges { .. } => {
             inst.block.set(spec.key, &Value::Bool(inst.edges.on));
@@ -250,7 +242,9 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
             }
             None => false,
         },
-        Bound::ReadInto { var } => pass_destination(io, inst, var),
+        Bound::ReadInto { var } => {
+            destination(io, inst, io.field(var, 0, Elem::LWord), cam_ref(io, var))
+        }
         Bound::Text { var, len } => match io.text(var, len as usize + 1) {
             Some(text) => inst.block.set_text(spec.key, text),
             None => false,
@@ -270,21 +264,24 @@ fn pass(io: &BlockIo<'_>, inst: &mut Instance, (bound, spec): &(Bound, InputSpec
     }
 }
 
-/// An `MC_CAM_REF` a read's answer goes into: its array checked to lie in the program's
-/// memory (refused otherwise), its description to the block.
-fn pass_destination(io: &BlockIo<'_>, inst: &mut Instance, var: usize) -> bool {
+/// The array a read's answer goes into (where `p` points, as `array` describes it): checked
+/// to lie in the program's memory (refused otherwise), its description to the block.
+fn destination(
+    io: &BlockIo<'_>,
+    inst: &mut Instance,
+    p: Option<i64>,
+    array: Option<CamRefIn>,
+) -> bool {
     inst.destination = None;
-    let Some(table) = cam_ref(io, var) else {
+    let (Some(p), Some(array)) = (p, array) else {
         return false;
     };
-    let (Some(p), size) = (io.field(var, 0, Elem::LWord), table.array_size as usize) else {
-        return false;
-    };
+    let size = array.array_size as usize;
     if io.memory_at(p, size).is_none() {
         return false;
     }
     inst.destination = Some((p, size));
-    inst.block.set_destination(&table)
+    inst.block.set_destination(&array)
 }
 
 /// An `MC_CAM_REF`'s description (its bytes empty).

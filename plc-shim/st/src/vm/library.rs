@@ -101,20 +101,12 @@ impl BlockIo<'_> {
     /// The `n` bytes of the program's memory pointer `p` points at: `None` for NULL, a
     /// pointer into the image, or bytes beyond the memory.
     pub fn memory_at(&self, p: i64, n: usize) -> Option<&[u8]> {
-        if p & super::IMAGE_TAG != 0 || p <= 0 {
-            return None;
-        }
-        let at = (p - 1) as usize;
-        self.memory.get(at..at.checked_add(n)?)
+        self.memory.get(own_range(p, n)?)
     }
 
     /// As [`BlockIo::memory_at`], to write (a read's answer into the program's array).
     pub fn memory_at_mut(&mut self, p: i64, n: usize) -> Option<&mut [u8]> {
-        if p & super::IMAGE_TAG != 0 || p <= 0 {
-            return None;
-        }
-        let at = (p - 1) as usize;
-        self.memory.get_mut(at..at.checked_add(n)?)
+        self.memory.get_mut(own_range(p, n)?)
     }
 
     /// Variable `k` as a number.
@@ -128,15 +120,10 @@ impl BlockIo<'_> {
     /// memory. `out` is cleared first and not grown beyond `n` (give it the room).
     pub fn lreals(&self, k: usize, n: usize, out: &mut Vec<f64>) -> bool {
         out.clear();
-        let Some(p) = self.int(k) else {
-            return false;
-        };
-        if p & super::IMAGE_TAG != 0 || p <= 0 {
-            return false;
-        }
-        let at = (p - 1) as usize;
-        let end = n.checked_mul(8).and_then(|b| at.checked_add(b));
-        let Some(bytes) = end.and_then(|end| self.memory.get(at..end)) else {
+        let bytes = n
+            .checked_mul(8)
+            .and_then(|b| self.memory_at(self.int(k)?, b));
+        let Some(bytes) = bytes else {
             return false;
         };
         out.extend(
@@ -155,12 +142,7 @@ impl BlockIo<'_> {
             return 0;
         };
         for (&(offset, t), v) in leaves.iter().zip(values) {
-            let v = match t {
-                Elem::Real | Elem::LReal => V::F(*v),
-                Elem::Bool => V::I(i64::from(*v != 0.0)),
-                _ => V::I(*v as i64),
-            };
-            let _ = write_mem(self.memory, self.at + offset as usize, t, v);
+            let _ = write_mem(self.memory, self.at + offset as usize, t, of_type(*v, t));
         }
         leaves.len().min(values.len())
     }
@@ -168,12 +150,26 @@ impl BlockIo<'_> {
     /// Sets variable `k` (an output) to `v`, converted to its type; nothing if it has no place.
     pub fn set(&mut self, k: usize, v: f64) {
         if let Some((at, t)) = self.place(k) {
-            let v = match t {
-                Elem::Real | Elem::LReal => V::F(v),
-                _ => V::I(v as i64),
-            };
-            let _ = write_mem(self.memory, at, t, v);
+            let _ = write_mem(self.memory, at, t, of_type(v, t));
         }
+    }
+}
+
+/// Where the `n` bytes pointer `p` points at lie in the program's memory: `None` for NULL,
+/// a pointer into the image, or a range that overflows.
+fn own_range(p: i64, n: usize) -> Option<core::ops::Range<usize>> {
+    match super::pointed(p).ok()? {
+        super::Loc::Own(at) => Some(at..at.checked_add(n)?),
+        super::Loc::Image(_) => None,
+    }
+}
+
+/// Number `v` as a value of type `t` (a BOOL is TRUE for anything but 0).
+fn of_type(v: f64, t: Elem) -> V {
+    match t {
+        Elem::Real | Elem::LReal => V::F(v),
+        Elem::Bool => V::I(i64::from(v != 0.0)),
+        _ => V::I(v as i64),
     }
 }
 
