@@ -25,9 +25,13 @@
 //! * Structures of the seeds: the flying saw's `SyncMode : ST_SyncMode` (001 12.3.1, its
 //!   mode and one BOOL per flag), declared by the saw family with the input.
 //!
-//! Inputs ST cannot give yet (the compatibility blocks' tables and the read blocks' rooms as
-//! TOML values, NC program names) are left out; a block that needs one is not in the
-//! library ([`unavailable`]).
+//! * Arrays a read's answer goes into (`CamTable : MC_CAM_REF`, `AdrDataArray`), NC program
+//!   names (`ProgramName : STRING(63)`), the compatibility blocks' two edges (`bCoupleOn`,
+//!   `bCoupleOff`) and ID lists (`iTableId1` ..); a read block's results are outputs of its
+//!   own ([`crate::timeline::registry::Results`]).
+//!
+//! An input whose `StForm` ST cannot give would be left out ([`left_out`], listed by `plc
+//! library`: today none); a block that requires one is not in the library ([`unavailable`]).
 
 use crate::timeline::registry::Target;
 use crate::timeline::registry::{
@@ -69,7 +73,7 @@ END_TYPE
 ";
 
 /// Byte offsets of MC_CAM_REF's fields after pArray (nArraySize, nTableType, nNoOfRows,
-/// nNoOfCols), as the layout places them (a test checks them).
+/// nNoOfCols), as the layout places them (`tests/st_cam_ref.rs` fails if they move).
 pub(super) const CAM_REF_FIELDS: [u32; 4] = [8, 12, 16, 20];
 
 /// The room of a read's answer in Structured Text (values, or points of a motion function),
@@ -336,8 +340,6 @@ pub struct Library {
     pub(super) bindings: Vec<Binding>,
     /// The structure types the blocks' inputs and results declared.
     types: Vec<&'static str>,
-    /// The structure types of the blocks' results (appended after the blocks).
-    results_text: String,
 }
 
 impl Library {
@@ -347,7 +349,6 @@ impl Library {
             text: TYPES.into(),
             bindings: Vec::new(),
             types: Vec::new(),
-            results_text: String::new(),
         };
         let missing = unavailable();
         let specs: Vec<&'static BlockSpec> = blocks()
@@ -357,8 +358,6 @@ impl Library {
         for spec in specs {
             lib.declare(spec);
         }
-        let results = std::mem::take(&mut lib.results_text);
-        lib.text.push_str(&results);
         lib
     }
 
@@ -383,10 +382,17 @@ impl Library {
             let name = if hungarian { "bExecute" } else { "Execute" };
             push(&mut vars, name.into(), "BOOL")
         });
-        // The seed's tTimeout, of a block that takes it (asked of a probe instance).
-        let timeout = (spec.make)(None)
+        // What a block takes and shows beyond its spec is asked of a probe instance: the
+        // seed's tTimeout, and a read block's outputs of its own (their types declared
+        // before the block).
+        let mut probe = (spec.make)(None);
+        let timeout = probe
             .timeout_cycles(crate::kernel::DEFAULT_TIMEOUT_CYCLES)
             .then(|| push(&mut vars, "tTimeout".into(), "TIME"));
+        let own_outputs = probe.results();
+        if let Some(r) = own_outputs {
+            self.declare_type(r.type_name, r.declaration);
+        }
         let mut inputs = Vec::new();
         for input in spec.inputs.iter().filter(|i| expressible(i)) {
             if let Some(bound) = self.bind(input, &mut vars) {
@@ -417,13 +423,9 @@ impl Library {
             let _ = writeln!(self.text, "    {name} : {ty};");
         }
         // A read block's outputs of its own, after the standard ones.
-        let results = (spec.make)(None).results().map(|r| {
+        let results = own_outputs.map(|r| {
             for (name, ty) in r.outputs {
                 let _ = writeln!(self.text, "    {name} : {ty};");
-            }
-            if !r.type_name.is_empty() && !self.types.contains(&r.type_name) {
-                self.types.push(r.type_name);
-                self.results_text.push_str(r.declaration);
             }
             (outputs + names.len(), r.outputs.len())
         });
@@ -438,6 +440,15 @@ impl Library {
             edges,
             results,
         });
+    }
+
+    /// Declares structure type `name` once (`declaration` is its `TYPE .. END_TYPE`; an
+    /// empty name declares nothing).
+    fn declare_type(&mut self, name: &'static str, declaration: &str) {
+        if !name.is_empty() && !self.types.contains(&name) {
+            self.types.push(name);
+            self.text.push_str(declaration);
+        }
     }
 
     /// How `input` is declared (its variables pushed to `vars`): `None` if it is not an
@@ -495,10 +506,7 @@ impl Library {
                 declaration,
                 read,
             } => {
-                if !self.types.contains(&ty) {
-                    self.types.push(ty);
-                    self.text.push_str(declaration);
-                }
+                self.declare_type(ty, declaration);
                 Bound::Struct {
                     var: push(vars, name.into(), ty),
                     read,
