@@ -156,7 +156,7 @@ const TABLE: InputSpec = input("table", Kind::Range(1, 255)).st_named("iTableId"
 /// iTableType 1..=4.
 const TABLE_TYPE: InputSpec = input("table_type", Kind::Range(1, 4)).st_named("iTableType");
 /// The rows `[[master, slave], ...]`; in ST the seed's array through a pointer.
-const ROWS: InputSpec = input("rows", super::cam_data::ROWS).st_rows(StForm::Rows {
+const ROWS: InputSpec = input("rows", super::cam_data::ROWS).st_form(StForm::Rows {
     data: "AdrDataArray",
     columns: "iColDim",
     rows: "iRowsToWrite",
@@ -181,7 +181,7 @@ const COUPLE: [InputSpec; 7] = [
     SLAVE_OFFSET,
     input("master_absolute", Kind::Bool).st_named("bMasterAbsolut"),
     input("slave_absolute", Kind::Bool).st_named("bSlaveAbsolut"),
-    input("on", Kind::Bool).st_rows(COUPLE_EDGES),
+    input("on", Kind::Bool).st_form(COUPLE_EDGES),
 ];
 /// bCoupleOn and bCoupleOff: the couplings' two edges.
 pub(super) const COUPLE_EDGES: StForm = StForm::Edges {
@@ -203,14 +203,14 @@ const CREATE: &[InputSpec] = &[
 const WRITE_DATA: &[InputSpec] = &[TABLE, ROWS, BLOCK_SIZE];
 const READ_DATA: &[InputSpec] = &[
     TABLE,
-    input("room", Kind::Room).st_rows(StForm::ReadAt {
+    input("room", Kind::Room).st_form(StForm::ReadAt {
         data: "AdrDataArray",
         size: "iSizeOfDataArray",
     }),
     BLOCK_SIZE,
     input("rows_to_read", Kind::Range(0, 1 << 20)).st_named("iRowsToRead"),
     input("columns", Kind::Range(1, 16)).st_named("iColDim"),
-    input("size", Kind::Range(8, 1 << 30)).st_rows(StForm::Hidden),
+    input("size", Kind::Range(8, 1 << 30)).st_form(StForm::Hidden),
 ];
 const READ_SLAVE_POS: &[InputSpec] = &[
     TABLE,

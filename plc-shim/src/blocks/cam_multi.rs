@@ -265,9 +265,9 @@ pub const TIMELINE: &[BlockSpec] = &[
                     example: "[1, 2]",
                 },
             )
-            .st_rows(TABLE_IDS),
+            .st_form(TABLE_IDS),
             input("profiles", Kind::Range(1, 8)).st_named("iNrOfProfileTables"),
-            input("on", Kind::Bool).st_rows(super::cam_compat::COUPLE_EDGES),
+            input("on", Kind::Bool).st_form(super::cam_compat::COUPLE_EDGES),
             crate::blocks::cam::MASTER_SOURCE,
         ],
         |_| {

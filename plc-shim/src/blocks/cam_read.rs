@@ -463,7 +463,7 @@ const POINT_INDEX: InputSpec = input("point_index", Kind::Count);
 const MASTER_POSITION: InputSpec = input("master_position", Kind::Real);
 /// The room of a read's answer: in Structured Text the seed's `CamTable : MC_CAM_REF`, the
 /// program's array the answer goes into.
-const ROOM: InputSpec = input("room", Kind::Room).st_rows(StForm::ReadInto { name: "CamTable" });
+const ROOM: InputSpec = input("room", Kind::Room).st_form(StForm::ReadInto { name: "CamTable" });
 
 /// The cam reads a timeline calls; `room` (where a read has it) is the room of the answer,
 /// [`DEFAULT_READ_ROOM`] if not given.

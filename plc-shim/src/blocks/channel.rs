@@ -403,7 +403,7 @@ const PROGRAM: InputSpec = input(
         example: "\"part.nc\"",
     },
 )
-.st_rows(StForm::Text {
+.st_form(StForm::Text {
     name: "ProgramName",
     len: PROGRAM_NAME_LEN as u32 - 1,
 });

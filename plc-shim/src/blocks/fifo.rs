@@ -256,7 +256,7 @@ const WRITE: &[InputSpec] = &[
             example: "[[1.0, 2.0], [3.0, 4.0]]",
         },
     )
-    .st_rows(ST_ROWS),
+    .st_form(ST_ROWS),
 ];
 const OVERRIDE: &[InputSpec] = &[
     GROUP,

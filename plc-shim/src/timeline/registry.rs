@@ -300,7 +300,7 @@ impl InputSpec {
 
     /// The same input in another form in Structured Text ([`StForm::Rows`],
     /// [`StForm::Struct`]).
-    pub const fn st_rows(self, form: StForm) -> InputSpec {
+    pub const fn st_form(self, form: StForm) -> InputSpec {
         InputSpec { st: form, ..self }
     }
 }
