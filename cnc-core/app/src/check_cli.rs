@@ -2,7 +2,7 @@
 //! `FILE:LINE:COL: error: MESSAGE`, optionally print the decoded motion blocks as JSON lines.
 
 use cnc_core::nc::check::push_motion_json;
-use cnc_core::nc::decode::{check_channel_axes, DecoderSetup, ZeroVars};
+use cnc_core::nc::decode::{check_channel_axes, AxisLayout, DecoderSetup, ZeroVars};
 use cnc_core::nc::interp::{check_set, SearchPath};
 use cnc_core::nc::straight::check_straight;
 use cnc_core::nc::{check_program, Decoded, DecoderState};
@@ -137,8 +137,10 @@ pub fn main(args: CheckArgs) -> ExitCode {
             // Run again, printing as it goes: a clean program's blocks are printed without
             // keeping them all (they take more memory than the program).
             let mut reader_gone = false;
+            // The blocks' targets are per slot of the channel's layout.
+            let slot_names = AxisLayout::new(&axes).names().to_vec();
             let mut print =
-                |step: &[Decoded]| print_blocks(step, &axes, &mut out, &mut reader_gone);
+                |step: &[Decoded]| print_blocks(step, &slot_names, &mut out, &mut reader_gone);
             match &whole {
                 None => {
                     let text = src.as_deref().unwrap_or("");

@@ -5,7 +5,7 @@
 
 pub use super::kin_config::KinematicsConfig;
 use super::path::AxisLimits;
-use crate::nc::decode::check_channel_axes;
+use crate::nc::decode::{check_channel_axes, AxisLayout};
 use kinematics::{Kinematics, RotationOrder};
 use serde::Deserialize;
 
@@ -19,9 +19,15 @@ pub const MAX_HISTORY: u32 = 100_000;
 pub struct ChannelConfig {
     /// Name for messages and traces.
     pub name: String,
-    /// Axis names in channel order; with a kinematic transformation the first six are the
-    /// robot's joints (and X Y Z A B C of the tool pose when the transformation is on).
+    /// Axis names in channel order (1 to 16): where their values are kept is their
+    /// [`AxisLayout`] (the pose X Y Z A B C first; with a kinematic transformation those are
+    /// the robot's joints, and the tool pose's words when it is on).
     pub axes: Vec<String>,
+    /// Whether the channel drives axis images (the default). `false`: its set-points go to no
+    /// axis (a simulated channel, for loads beyond the image's 32 axes in benchmarks and
+    /// tests).
+    #[serde(default = "yes")]
+    pub axis_images: bool,
     /// The channel's kinematics.
     #[serde(default)]
     pub kinematics: KinematicsConfig,
@@ -96,6 +102,10 @@ impl Default for TrackLagMax {
             rotation: default_lag(),
         }
     }
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn default_lag() -> f64 {
@@ -259,15 +269,18 @@ pub enum ChannelConfigError {
         /// Why.
         reason: String,
     },
-    /// A transformation needs six axes.
-    #[error("channel {channel}: kinematic {id} needs at least 6 axes, found {found}")]
-    TooFewAxes {
+    /// A kinematic other than the Cartesian one needs the six pose axes as its joints.
+    #[error(
+        "channel {channel}: axes: kinematic {id} needs X Y Z A B C as its six joints, \
+         missing: {missing}"
+    )]
+    MissingPoseAxes {
         /// Channel name.
         channel: String,
         /// Kinematic id.
         id: u32,
-        /// Axes configured.
-        found: usize,
+        /// The pose axes not configured ("A B C").
+        missing: String,
     },
     /// Bad kinematics.
     #[error("channel {channel}: kinematics: {reason}")]
@@ -297,11 +310,17 @@ impl ChannelConfig {
         self.axis_limits.get(i).copied().unwrap_or(self.limits)
     }
 
+    /// Where the channel keeps its axes' values (pose slots X Y Z A B C first).
+    pub fn layout(&self) -> AxisLayout {
+        AxisLayout::new(&self.axes)
+    }
+
     /// A channel with `axes` and defaults for everything else.
     pub fn new(name: &str, axes: &[&str]) -> Self {
         Self {
             name: name.to_string(),
             axes: axes.iter().map(|a| a.to_string()).collect(),
+            axis_images: true,
             kinematics: KinematicsConfig::default(),
             limits: default_limits(),
             axis_limits: Vec::new(),
@@ -342,11 +361,12 @@ impl ChannelConfig {
         self.check_nc_data()?;
         self.check_channel_data()?;
         let order = self.order()?;
-        if self.axes.len() < 6 {
-            return Err(ChannelConfigError::TooFewAxes {
+        let layout = self.layout();
+        if self.kinematics.id != 0 && !layout.has_pose() {
+            return Err(ChannelConfigError::MissingPoseAxes {
                 channel: self.name.clone(),
                 id: self.kinematics.id,
-                found: self.axes.len(),
+                missing: layout.missing_pose(),
             });
         }
         self.kinematics

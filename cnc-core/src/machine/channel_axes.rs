@@ -13,11 +13,15 @@ use crate::setpoint::Kinematic;
 use hli::calls::axis::AxisCommandCall;
 use hli::enums::{AxisState, CouplingState};
 
-/// The link from one channel to its axes `first..first + count` of the axis set.
+/// The link from one channel to its axes `first..first + count` of the axis set, in the
+/// channel's configuration order; the channel's values are per slot of its layout
+/// ([`crate::nc::decode::AxisLayout`]).
 #[derive(Debug, Clone)]
 pub struct ChannelAxes {
     first: usize,
     count: usize,
+    /// Per axis: the channel's slot that feeds it.
+    slots: Vec<usize>,
     last: AxisValues,
     last_velocity: AxisValues,
     cycle_s: f64,
@@ -54,21 +58,33 @@ pub fn axis_config(channel: &ChannelConfig, i: usize, id: u32) -> AxisConfig {
 }
 
 impl ChannelAxes {
-    /// Axes `first..first + start.len()`, standing at `start`.
-    pub fn new(first: usize, start: &AxisValues, cycle_s: f64) -> ChannelAxes {
+    /// Axes `first..first + slots.len()`, fed from the channel's `slots`, standing at
+    /// `start` (per slot).
+    pub fn new(first: usize, slots: &[usize], start: &AxisValues, cycle_s: f64) -> ChannelAxes {
+        let count = slots.len();
+        let mut last = AxisValues::zeros(count);
+        for (l, &slot) in last.iter_mut().zip(slots) {
+            *l = start.get(slot).copied().unwrap_or(0.0);
+        }
         ChannelAxes {
             first,
-            count: start.len(),
-            last: *start,
-            last_velocity: AxisValues::zeros(start.len()),
+            count,
+            slots: slots.to_vec(),
+            last,
+            last_velocity: AxisValues::zeros(count),
             cycle_s,
-            leases: vec![None; start.len()],
+            leases: vec![None; count],
         }
     }
 
     /// First axis of the channel in the axis set.
     pub fn first(&self) -> usize {
         self.first
+    }
+
+    /// How many axes the channel drives.
+    pub fn count(&self) -> usize {
+        self.count
     }
 
     /// Powers the channel's axes and couples them to the channel (before the first tick).
@@ -87,8 +103,8 @@ impl ChannelAxes {
         }
     }
 
-    /// Hands the channel's set-points of this tick to its axes, with their velocity and
-    /// acceleration from `rates` when the channel gives them
+    /// Hands the channel's set-points of this tick (per slot) to its axes, with their velocity
+    /// and acceleration from `rates` when the channel gives them
     /// ([`crate::channel::Channel::set_point_rates`]), else from differences. Does not
     /// allocate.
     pub fn drive(
@@ -97,9 +113,10 @@ impl ChannelAxes {
         set_points: &AxisValues,
         rates: Option<(&AxisValues, &AxisValues)>,
     ) {
-        for (i, &p) in set_points.iter().enumerate().take(self.count) {
+        for (i, &slot) in self.slots.iter().enumerate() {
+            let p = set_points[slot];
             let (v, a) = match rates {
-                Some((velocity, acceleration)) => (velocity[i], acceleration[i]),
+                Some((velocity, acceleration)) => (velocity[slot], acceleration[slot]),
                 None => {
                     let v = (p - self.last[i]) / self.cycle_s;
                     (v, (v - self.last_velocity[i]) / self.cycle_s)
@@ -122,8 +139,9 @@ impl ChannelAxes {
 
     /// A channel's RESET on its axes: each axis in error (or not coupled to the channel) is
     /// reset, powered and coupled to the channel again where it stands, and the hand-over
-    /// takes its next set-point from rest there. `Ok(mask)`: bit `i` for each axis reset;
-    /// `Err(mask)` when an axis keeps its error or cannot be coupled.
+    /// takes its next set-point from rest there. `Ok(mask)`: bit `slot` for each axis reset
+    /// (the channel's slot of it); `Err(mask)` when an axis keeps its error or cannot be
+    /// coupled.
     pub fn reset(&mut self, axes: &mut AxisSet) -> Result<u32, u32> {
         let (mut reset, mut ok) = (0u32, true);
         for (i, lease) in self.leases.iter_mut().enumerate() {
@@ -137,7 +155,7 @@ impl ChannelAxes {
             if a.error().is_none() && lease.is_some() && coupled {
                 continue;
             }
-            reset |= 1 << i.min(31);
+            reset |= 1 << self.slots[i].min(31);
             let _ = a.command(&AxisCommandCall::reset());
             if a.error().is_some() || a.switch_on().is_err() {
                 ok = false;
@@ -167,11 +185,12 @@ impl ChannelAxes {
             .any(|i| axes.axis(i).is_some_and(|a| a.error().is_some()))
     }
 
-    /// The actual positions of the channel's axes (channel order).
-    pub fn actual(&self, axes: &AxisSet) -> AxisValues {
-        let mut out = AxisValues::zeros(self.count);
-        for (i, v) in out.iter_mut().enumerate() {
-            *v = axes.axis(self.first + i).map_or(0.0, |a| a.actual());
+    /// The actual positions of the channel's axes per slot of its `set_points` (a slot
+    /// without an axis keeps its set-point).
+    pub fn actual(&self, axes: &AxisSet, set_points: &AxisValues) -> AxisValues {
+        let mut out = *set_points;
+        for (i, &slot) in self.slots.iter().enumerate() {
+            out[slot] = axes.axis(self.first + i).map_or(0.0, |a| a.actual());
         }
         out
     }

@@ -60,6 +60,21 @@ pub enum MachineError {
     /// Two engines declare the same call kind.
     #[error(transparent)]
     Routes(#[from] RouteConflict),
+    /// A channel whose axes do not fit into the image behind the channels before it.
+    #[error(
+        "channel {channel}: axes: its {count} axes would take axis images {} to {}, \
+         the image holds {HLI_MAX_AXES}",
+        first + 1,
+        first + count
+    )]
+    ChannelAxesDoNotFit {
+        /// The channel's name.
+        channel: String,
+        /// The first axis image it would take (0-based).
+        first: usize,
+        /// Its axes.
+        count: usize,
+    },
     /// Single axes that do not fit behind the channel axes.
     #[error(
         "{channel_axes} channel axes and {single} single axes: the image holds {HLI_MAX_AXES}"
@@ -90,7 +105,7 @@ pub struct MachineSetup {
 pub struct Machine {
     controller: Controller,
     axes: AxisSet,
-    links: Vec<Option<ChannelAxes>>,
+    links: Vec<ChannelAxes>,
     single_axes: usize,
     engines: Vec<Box<dyn Engine>>,
     routes: Routes,
@@ -107,8 +122,8 @@ pub struct Machine {
 }
 
 impl Machine {
-    /// Builds the machine: channel axes take the first axis images (channel by channel, while
-    /// they fit), single axes follow.
+    /// Builds the machine: channel axes take the first axis images (channel by channel; a
+    /// channel whose axes do not fit is refused), single axes follow.
     pub fn new(setup: MachineSetup) -> Result<Machine, MachineError> {
         let MachineSetup {
             channels,
@@ -120,16 +135,24 @@ impl Machine {
         let mut links = Vec::with_capacity(channels.len());
         for channel in &channels {
             let config = channel.config();
-            let n = config.axes.len();
+            let slots: &[usize] = match config.axis_images {
+                true => channel.layout().slots(),
+                false => &[],
+            };
+            let n = slots.len();
             if configs.len() + n > HLI_MAX_AXES {
-                links.push(None);
-                continue;
+                return Err(MachineError::ChannelAxesDoNotFit {
+                    channel: config.name.clone(),
+                    first: configs.len(),
+                    count: n,
+                });
             }
-            links.push(Some(ChannelAxes::new(
+            links.push(ChannelAxes::new(
                 configs.len(),
+                slots,
                 channel.set_points(),
                 cycle_s,
-            )));
+            ));
             for i in 0..n {
                 let id = configs.len() as u32 + 1;
                 configs.push(channel_axes::axis_config(config, i, id));
@@ -145,7 +168,7 @@ impl Machine {
         let single_axes = axes.len();
         configs.extend(axes);
         let mut axis_set = AxisSet::new(configs, cycle_s)?;
-        for link in links.iter_mut().flatten() {
+        for link in &mut links {
             link.couple(&mut axis_set);
         }
         let n = channels.len();
@@ -180,13 +203,11 @@ impl Machine {
         self.reset_channel_axes();
         // 3 hand-over
         for (channel, link) in self.controller.channels().iter().zip(self.links.iter_mut()) {
-            if let Some(link) = link {
-                link.drive(
-                    &mut self.axes,
-                    channel.set_points(),
-                    channel.set_point_rates(),
-                );
-            }
+            link.drive(
+                &mut self.axes,
+                channel.set_points(),
+                channel.set_point_rates(),
+            );
         }
         // 4 axes sense
         self.axes.sense(&view);
@@ -202,7 +223,6 @@ impl Machine {
         self.axes.act(&view);
         // A channel whose axis faulted (following error, I/O) has lost it: it stops.
         for (c, link) in self.links.iter().enumerate() {
-            let Some(link) = link else { continue };
             if link.faulted(&self.axes) {
                 if let Some(channel) = self.controller.channel_mut(c) {
                     channel.stop(STOP_REASON_AXIS);
@@ -229,9 +249,9 @@ impl Machine {
             if !channel.take_axis_reset() {
                 continue;
             }
-            let Some(link) = link else { continue };
             let reset = link.reset(&mut self.axes);
-            channel.adopt_positions(&link.actual(&self.axes), reset.unwrap_or_else(|m| m));
+            let actual = link.actual(&self.axes, channel.set_points());
+            channel.adopt_positions(&actual, reset.unwrap_or_else(|m| m));
             if reset.is_err() {
                 channel.axis_reset_failed();
             }
@@ -256,9 +276,9 @@ impl Machine {
     /// previous set-point).
     fn measure_tracking(&mut self) {
         for (c, channel) in self.controller.channels().iter().enumerate() {
-            let Some(link) = &self.links[c] else { continue };
+            let link = &self.links[c];
             if channel.tracker().state() == DynCsState::Active && self.ticks > 0 {
-                let actual = link.actual(&self.axes);
+                let actual = link.actual(&self.axes, channel.set_points());
                 if let Some(realised) = channel.realised_tool(&actual) {
                     let e =
                         (realised.translation.vector - self.commanded[c].translation.vector).norm();
@@ -522,9 +542,10 @@ impl Machine {
         self.axes.len() - self.single_axes
     }
 
-    /// First axis image of channel `index` (None: its axes did not fit in the image).
+    /// First axis image of channel `index` (None: no such channel, or it drives none).
     pub fn first_axis(&self, index: usize) -> Option<usize> {
-        self.links.get(index)?.as_ref().map(ChannelAxes::first)
+        let link = self.links.get(index)?;
+        (link.count() > 0).then(|| link.first())
     }
 
     /// The channels.

@@ -36,7 +36,9 @@ pub fn check_source(src: &str, axes: &[String]) -> (Vec<Diagnostic>, Vec<Decoded
     check_source_in(src, axes, None, &SearchPath::default())
 }
 
-/// A decoded motion block as the JSON line `--blocks` prints.
+/// A decoded motion block as the JSON line `--blocks` prints; `axes` are the channel's names
+/// per slot ([`crate::nc::decode::AxisLayout::names`], the same as the configuration's for a
+/// channel whose first axes are X Y Z A B C), an empty one left out.
 pub fn motion_json(block: &MotionBlock, axes: &[String]) -> String {
     let mut out = String::new();
     push_motion_json(&mut out, block, axes);
@@ -54,7 +56,8 @@ pub fn push_motion_json(out: &mut String, block: &MotionBlock, axes: &[String]) 
     );
     push_number(out, block.feed);
     out.push_str(",\"target\":{");
-    for (i, (name, v)) in axes.iter().zip(block.target.iter()).enumerate() {
+    let slots = axes.iter().zip(block.target.iter());
+    for (i, (name, v)) in slots.filter(|(name, _)| !name.is_empty()).enumerate() {
         if i > 0 {
             out.push(',');
         }

@@ -12,6 +12,7 @@ mod cam_props;
 mod cam_refusals;
 mod cam_seed;
 mod cam_tables;
+mod channel_axes;
 mod channel_control;
 mod channel_display;
 mod channel_override;

@@ -209,6 +209,7 @@ impl Scenario {
                 "a scenario without channels needs `ticks` (no program says when it ends)".into(),
             ));
         }
+        super::axes::check_channel_images(&file.channel).map_err(&invalid)?;
         let channel_axes = super::axes::axis_names(&file.channel, &[]).len();
         let axes = super::axes::axes(&file.axis, channel_axes as u32 + 1).map_err(&invalid)?;
         if channel_axes + axes.len() > hli::layout::HLI_MAX_AXES {

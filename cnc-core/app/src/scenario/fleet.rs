@@ -1,7 +1,8 @@
 //! A synthetic load for the tick benchmark and the no-allocation test: `n` six-axis robots
 //! (kinematic 45), all with tracking active. Robot 1 follows the PLC's dynamic CS and
 //! publishes its own tool frame; robots 2..n follow robot 1 (the seed's example 3 pattern).
-//! Every robot moves in an endless loop, so the load never ends.
+//! Every robot moves in an endless loop, so the load never ends. The robots whose axes the
+//! image cannot hold (6 onwards) drive no axis images (`axis_images = false`).
 
 use super::file::{Scenario, ScenarioError};
 use super::machine::InProcess;
@@ -83,6 +84,10 @@ pub fn tracking_robots_with(
         ));
         if let Some(d) = drive {
             toml.push_str(&format!("drive = {d}\n"));
+        }
+        if (i + 1) * 6 > hli::layout::HLI_MAX_AXES {
+            // Beyond the image's 32 axes: simulated channels.
+            toml.push_str("axis_images = false\n");
         }
     }
     Scenario::parse("fleet", &toml, |file| {

@@ -82,6 +82,25 @@ fn axes_option_names_the_channel_axes_and_errors_print_no_blocks() {
 }
 
 #[test]
+fn a_three_axis_channel_prints_its_axes_and_refuses_others() {
+    let (_dir, f) = write("mill.nc", "G1 X1 Y2 F100\nG2 X3 Y2 I1 J0\n");
+    let (code, out, _) = cnc(&["check", "--axes", "X,Y,Z", "--blocks", &f]);
+    assert_eq!(code, 0, "{out}");
+    assert!(
+        out.contains("\"target\":{\"X\":1,\"Y\":2,\"Z\":0}}"),
+        "{out}"
+    );
+    assert!(out.contains("\"center\":{\"X\":"), "{out}");
+    let (_dir, f) = write("five.nc", "G1 X1 B2 F100\n");
+    let (code, out, _) = cnc(&["check", "--axes", "X,Y,Z,A,C", &f]);
+    assert_eq!(code, 1);
+    assert!(
+        out.contains("five.nc:1:7: error: unknown axis \"B\" for this channel (axes: X Y Z A C)"),
+        "{out}"
+    );
+}
+
+#[test]
 fn several_files_and_unreadable_ones() {
     let (_dir, good) = write("good.nc", "X1\n");
     let (code, _, err) = cnc(&["check", &good, "/nonexistent/prog.nc"]);

@@ -305,3 +305,90 @@ fn example_1_the_gripper_follows_the_carriage_axis_by_axis() {
     assert!(worst < 1e-3, "the grip slipped by {worst} mm");
     assert!(channel(&done, "carriage").m_functions_acked() >= 3);
 }
+
+/// The 3-axis mill: its channel takes three axis images, which follow X Y Z; the pocket's
+/// far corner (70, 50) is rounded within PATH_DEV, never overshot, with the tool length on Z.
+#[test]
+fn the_3_axis_mill_drives_three_axes_around_its_pocket() {
+    let s = scenario("mill-3axis");
+    let (mut far_x, mut far_y, mut nearest) = (f64::MIN, f64::MIN, f64::MAX);
+    let done = run(&s, 20_000, None, |run, _| {
+        let axes = run.machine.axes();
+        let p: Vec<f64> = (0..3).map(|i| axes.axis(i).unwrap().actual()).collect();
+        if (p[2] - 48.0).abs() < 1e-9 {
+            far_x = far_x.max(p[0]);
+            far_y = far_y.max(p[1]);
+            nearest = nearest.min(((p[0] - 70.0).powi(2) + (p[1] - 50.0).powi(2)).sqrt());
+        }
+    });
+    assert_eq!(done.machine.channel_axes(), 3, "X Y Z only");
+    let axes = done.machine.axes();
+    let end: Vec<f64> = (0..3).map(|i| axes.axis(i).unwrap().actual()).collect();
+    assert_eq!(
+        end,
+        [0.0, 0.0, 55.0],
+        "back over the origin, tool length 50 on Z"
+    );
+    assert!(
+        far_x <= 70.0 + 1e-9 && far_y <= 50.0 + 1e-9,
+        "{far_x} {far_y}"
+    );
+    // The curve's middle lies PATH_DEV = 0.02 mm from the corner (the ticks sample near it).
+    assert!(
+        (nearest - 0.02).abs() < 1e-3,
+        "corner passed at {nearest} mm"
+    );
+    let c = channel(&done, "mill");
+    assert_eq!(c.state(), RunState::Finished);
+}
+
+/// Channels whose axes the image cannot hold, no axes, axes twice, a robot without its joints:
+/// refused at load with the channel and the key.
+#[test]
+fn channel_axes_the_machine_cannot_have_are_refused_with_the_channel() {
+    let load = |channels: &str| {
+        let toml = format!("ticks = 10\n{channels}");
+        match Scenario::parse("axes.toml", &toml, |_| unreachable!()) {
+            Err(e) => e.to_string(),
+            Ok(s) => InProcess::new(&s, 10)
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default(),
+        }
+    };
+    let six = |name: &str| {
+        format!(
+            "[[channel]]\nname = \"{name}\"\naxes = [\"X\", \"Y\", \"Z\", \"A\", \"B\", \"C\"]\n"
+        )
+    };
+    let five_channels: String = (1..=5).map(|i| six(&format!("c{i}"))).collect();
+    let e = load(&format!("{five_channels}{}", six("c6")));
+    assert!(
+        e.contains(
+            "channel c6: axes: its 6 axes would take axis images 31 to 36, the image holds 32"
+        ),
+        "{e}"
+    );
+    assert!(load(&format!(
+        "{five_channels}[[channel]]\nname = \"c6\"\naxes = [\"X\", \"Y\"]\n"
+    ))
+    .is_empty());
+    for (axes, expected) in [
+        ("[]", "channel m: axes: a channel has 1 to 16 axes, found 0"),
+        (
+            "[\"X\", \"Y\", \"X\"]",
+            "channel m: axes: axis name \"X\" is given twice",
+        ),
+    ] {
+        let e = load(&format!("[[channel]]\nname = \"m\"\naxes = {axes}\n"));
+        assert!(e.contains(expected), "{e}");
+    }
+    let e =
+        load("[[channel]]\nname = \"m\"\naxes = [\"X\", \"Y\", \"Z\"]\nkinematics = { id = 45 }\n");
+    assert!(
+        e.contains(
+            "channel m: axes: kinematic 45 needs X Y Z A B C as its six joints, missing: A B C"
+        ),
+        "{e}"
+    );
+}

@@ -77,6 +77,13 @@ pub enum ChannelFault {
     TrackedStep(LimitViolation),
     /// The axes lagged behind the compensation beyond `track_lag_max`.
     TrackLag(LagExcess),
+    /// The dynamic CS compensates on a pose axis the channel lacks.
+    TrackAxisMissing {
+        /// The axis lacked.
+        axis: AxisName,
+    },
+    /// `#TRAFO ON` on a channel that lacks a pose axis.
+    TrafoNeedsPoseAxes,
     /// `#CS` without a transformation.
     CsWithoutTrafo,
     /// More `#CS` frames than the stack holds.
@@ -111,13 +118,14 @@ impl ChannelFault {
             ChannelFault::TrackRefused(_)
             | ChannelFault::Tracking(_)
             | ChannelFault::TrackedStep(_)
-            | ChannelFault::TrackLag(_) => ChannelErrorId::Tracking,
+            | ChannelFault::TrackLag(_)
+            | ChannelFault::TrackAxisMissing { .. } => ChannelErrorId::Tracking,
             ChannelFault::CsWithoutTrafo | ChannelFault::CsDepth | ChannelFault::CsFrame(_) => {
                 ChannelErrorId::CoordinateSystem
             }
-            ChannelFault::KinematicNotConfigured { .. } | ChannelFault::PoseUnreachable(_) => {
-                ChannelErrorId::Kinematics
-            }
+            ChannelFault::KinematicNotConfigured { .. }
+            | ChannelFault::PoseUnreachable(_)
+            | ChannelFault::TrafoNeedsPoseAxes => ChannelErrorId::Kinematics,
             ChannelFault::MachineStop(_) => ChannelErrorId::MachineStop,
             ChannelFault::SyncTimeout(_) | ChannelFault::SyncPartnerStopped => {
                 ChannelErrorId::SyncAbandoned
@@ -154,6 +162,14 @@ impl fmt::Display for ChannelFault {
                     " above the smallest lag of the switching's catch-up ({t:.3} mm, {r:.3} degree)"
                 ),
             }),
+            ChannelFault::TrackAxisMissing { axis } => write!(
+                f,
+                "tracking: the master's motion needs axis {axis}, which this channel lacks \
+                 (OPTION=1 follows the translation only)"
+            ),
+            ChannelFault::TrafoNeedsPoseAxes => {
+                f.write_str("#TRAFO ON needs the six pose axes X Y Z A B C")
+            }
             ChannelFault::CsWithoutTrafo => {
                 f.write_str("#CS needs an active transformation (#TRAFO ON)")
             }

@@ -96,20 +96,24 @@ impl JointCaps<'_> {
     }
 }
 
-/// The joint caps for the contour's next pieces of a channel with `pose` and `config` (only
+/// The joint caps for the contour's next pieces of a channel with `pose`, `config` and `layout` (only
 /// under a transformation), the inverse kinematics starting from `seed` (the joints of the
 /// last piece sampled, so a piece far ahead resolves to the configuration the path follows).
 pub(super) fn joint_caps<'a>(
     pose: &'a Pose,
     config: &ChannelConfig,
+    layout: &AxisLayout,
     seed: Joints,
 ) -> Option<JointCaps<'a>> {
     if !pose.trafo {
         return None;
     }
+    // The joints are the pose slots (a transformation needs all six).
     let mut limits = [config.limits; 6];
-    for (i, l) in limits.iter_mut().enumerate() {
-        *l = config.axis_limits(i);
+    for (i, &slot) in layout.slots().iter().enumerate() {
+        if let Some(l) = limits.get_mut(slot) {
+            *l = config.axis_limits(i);
+        }
     }
     let cs = pose.cs_stack[..pose.cs_len]
         .iter()

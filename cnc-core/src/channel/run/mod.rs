@@ -61,7 +61,7 @@ use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::channel::hli_frame::frame_to_hli;
 use crate::nc::ast::AxisName;
-use crate::nc::decode::MotionBlock;
+use crate::nc::decode::{AxisLayout, MotionBlock};
 use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};
 use crate::nc::interp::{Interpreter, Step};
 use crate::nc::{Decoded, DecoderState, MotionMode};
@@ -137,12 +137,16 @@ impl Channel {
     ) -> Result<Self, ChannelConfigError> {
         let kinematics = ToolKinematics::new(config.build_kinematics()?);
         let order = config.order()?;
-        let n = config.axes.len();
-        let mut set_points = AxisValues::zeros(n);
-        set_points[..config.start.len()].copy_from_slice(&config.start);
+        // Values per slot of the layout: pose slots X..C first, an absent one held at 0.
+        let layout = config.layout();
+        let mut set_points = AxisValues::zeros(layout.len());
+        layout.place(&config.start, &mut set_points);
         let mut joints = [0.0; 6];
         joints.copy_from_slice(&set_points[..6]);
-        let axis_limits: Vec<_> = (0..n).map(|i| config.axis_limits(i)).collect();
+        let mut axis_limits = vec![config.limits; layout.len()];
+        for (i, &slot) in layout.slots().iter().enumerate() {
+            axis_limits[slot] = config.axis_limits(i);
+        }
         let mut channel = Self {
             index,
             channels: MAX_CHANNELS,
@@ -214,6 +218,12 @@ impl Channel {
     /// The configuration.
     pub fn config(&self) -> &ChannelConfig {
         &self.config
+    }
+
+    /// Where the channel keeps its axes' values ([`Channel::set_points`] and the others are
+    /// per slot of it: pose slots X Y Z A B C first).
+    pub fn layout(&self) -> &AxisLayout {
+        self.run.decoder.layout()
     }
 
     /// Run state.

@@ -160,15 +160,17 @@ impl Channel {
             return false;
         }
         let seed = self.motion.contour_joints;
-        let pushed = match joint_caps::joint_caps(&self.pose, &self.config, seed) {
-            Some(mut caps) => {
-                let contour = &mut self.motion.contour;
-                let pushed = contour.push(&segment, &mut |p| caps.apply(p));
-                self.motion.contour_joints = caps.seed;
-                pushed
-            }
-            None => self.motion.contour.push(&segment, &mut |_| {}),
-        };
+        let pushed =
+            match joint_caps::joint_caps(&self.pose, &self.config, self.run.decoder.layout(), seed)
+            {
+                Some(mut caps) => {
+                    let contour = &mut self.motion.contour;
+                    let pushed = contour.push(&segment, &mut |p| caps.apply(p));
+                    self.motion.contour_joints = caps.seed;
+                    pushed
+                }
+                None => self.motion.contour.push(&segment, &mut |_| {}),
+            };
         if pushed.is_err() {
             return false;
         }
@@ -274,7 +276,7 @@ impl Channel {
         );
         *active = planned.is_ok();
         if planned.is_err() {
-            let axis = AxisName::from(self.config.axes[axis].as_str());
+            let axis = AxisName::from(self.run.decoder.axes()[axis].as_str());
             self.fail(ChannelFault::IndependentNoProfile { axis });
             return;
         }

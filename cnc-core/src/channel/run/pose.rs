@@ -52,7 +52,7 @@ impl Channel {
         self.pose.tool
     }
 
-    /// The tool pose that the given actual axis positions (channel order) realise.
+    /// The tool pose that the given actual axis positions (per slot of the layout) realise.
     pub fn realised_tool(&self, actual: &[f64]) -> Option<Isometry3<f64>> {
         let mut j = [0.0; 6];
         let n = actual.len().min(6);
@@ -144,6 +144,7 @@ impl Channel {
             if self.pose.tracker.option() == TrackingOption::TranslationOnly {
                 c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
             }
+            self.lacked_compensation(&mut c);
             let mut tracked = [0.0; 6];
             for (i, c) in c.iter().enumerate() {
                 tracked[i] = self.motion.programmed[i] + c;
@@ -186,6 +187,21 @@ impl Channel {
 
     /// The tick's diagnosis history entry, once the guard has taken the set-points (a
     /// transition that ends when the axes land shows its new state in the tick it ends).
+    /// A compensation on a pose slot the channel lacks (a 3-axis channel following a master
+    /// that turns) cannot be carried out: the channel fails, naming the axis, and its axes
+    /// brake; the slot stays at 0.
+    fn lacked_compensation(&mut self, c: &mut [f64; 6]) {
+        for (slot, v) in c.iter_mut().enumerate() {
+            if v.abs() > 1e-9 && !self.layout().has(slot) {
+                if self.state != RunState::Error {
+                    let axis = AxisName::from(crate::nc::decode::POSE_AXES[slot]);
+                    self.fail(ChannelFault::TrackAxisMissing { axis });
+                }
+                *v = 0.0;
+            }
+        }
+    }
+
     pub(super) fn record_dyn_cs(&mut self) {
         self.pose
             .tracker
@@ -264,6 +280,8 @@ impl Channel {
             }
         }
         match on {
+            // The decoder refuses it first; a channel never moves slots it lacks.
+            Some(true) if !self.layout().has_pose() => self.fail(ChannelFault::TrafoNeedsPoseAxes),
             Some(true) if !self.pose.trafo => {
                 self.pose.trafo = true;
                 self.program_tool_pose();

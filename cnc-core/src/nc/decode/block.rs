@@ -385,7 +385,7 @@ impl DecoderState {
     ) -> Option<crate::nc::arc::ArcMove> {
         use crate::nc::arc::{center_from_radius, check_on_circle, ArcError, ArcMove};
         let [a, b, _] = self.plane.axes();
-        if self.position.len() <= a.max(b) {
+        if !(self.layout.has(a) && self.layout.has(b)) {
             ctx.error(span, Form::ArcNeedsMainAxes);
             return None;
         }

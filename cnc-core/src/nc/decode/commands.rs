@@ -76,6 +76,10 @@ impl DecoderState {
         };
         // `#TRAFO [45]` switches on with that id (as the seed's programs use it).
         let on = on.or(id.map(|_| true));
+        if on == Some(true) && !self.layout.has_pose() {
+            ctx.error(span, Form::TrafoNeedsPoseAxes);
+            return None;
+        }
         if let Some(on) = on {
             self.trafo = on;
         }

@@ -166,8 +166,10 @@ pub enum Form {
     DwellTimeTwice,
     /// G04 without a time.
     DwellNoTime,
-    /// G2/G3 in a channel with fewer than three axes.
+    /// G2/G3 in a channel that lacks an axis of the plane.
     ArcNeedsMainAxes,
+    /// `#TRAFO ON` in a channel that lacks a pose axis.
+    TrafoNeedsPoseAxes,
     /// An option of an independent axis it does not take.
     IndependentOption,
     /// An independent axis without INDP_ASYN / INDP_SYN.
@@ -201,7 +203,8 @@ impl Form {
             Form::DwellNotAlone => "G04 stands alone in its block: its time is G04 <seconds> or G04 <first axis><seconds>",
             Form::DwellTimeTwice => "G04: give the time once (bare or with the first axis)",
             Form::DwellNoTime => "G04 needs a time in seconds: G04 2.5",
-            Form::ArcNeedsMainAxes => "G2/G3 needs the channel's first three axes (the main axes)",
+            Form::ArcNeedsMainAxes => "G2/G3 needs both axes of its plane (X Y under G17, Z X under G18, Y Z under G19)",
+            Form::TrafoNeedsPoseAxes => "#TRAFO ON needs the six pose axes X Y Z A B C; this channel lacks some",
             Form::IndependentOption => "independent axis: expected INDP_ASYN, INDP_SYN, POS=.., G0, G1, G90, G91 or F..",
             Form::IndependentMode => "independent axis: expected INDP_ASYN or INDP_SYN",
             Form::IndependentPos => "independent axis: expected POS=..",
@@ -250,7 +253,7 @@ impl fmt::Display for WithAxes<'_> {
         write!(f, "unknown axis \"{name}\" for this channel")?;
         if !self.axes.is_empty() {
             f.write_str(" (axes:")?;
-            for a in self.axes {
+            for a in self.axes.iter().filter(|a| !a.is_empty()) {
                 write!(f, " {a}")?;
             }
             f.write_str(")")?;

@@ -27,7 +27,7 @@ mod output;
 mod values;
 
 use crate::setpoint::{AxisValues, MAX_CHANNEL_AXES};
-pub use axes::{check_channel_axes, RESERVED_ADDRESSES};
+pub use axes::{check_channel_axes, AxisLayout, POSE_AXES, RESERVED_ADDRESSES};
 pub use error::{DecodeError, Form};
 pub use output::{Decoded, MotionBlock, SyncIds, TrackCommand, TrackSource, DEFAULT_FILTER_TICKS};
 pub use values::{evaluate, Vars, ZeroVars, KNOWN_VARIABLES};
@@ -106,8 +106,9 @@ impl Default for DecoderSetup {
 /// The decoder's modal state.
 #[derive(Debug, Clone)]
 pub struct DecoderState {
-    axes: Vec<String>,
-    /// The same names for fast comparison with names from the tree.
+    /// The channel's axes by slot (pose slots X..C first; the values below are per slot).
+    layout: AxisLayout,
+    /// The slots' names for fast comparison with names from the tree.
     axis_names: Vec<AxisName>,
     position: AxisValues,
     g92: AxisValues,
@@ -152,12 +153,18 @@ pub struct DecoderState {
 }
 
 impl DecoderState {
-    /// A channel with these axis names (upper case), at position 0, G0 G90, feed 0.
+    /// A channel with these axis names (upper case), at position 0, G0 G90, feed 0. Its values
+    /// are kept per slot of the names' [`AxisLayout`].
     pub fn new(axes: &[String]) -> Self {
-        let n = axes.len();
+        let layout = AxisLayout::new(axes);
+        let n = layout.len();
         Self {
-            axes: axes.to_vec(),
-            axis_names: axes.iter().map(|a| AxisName::from(a.as_str())).collect(),
+            axis_names: layout
+                .names()
+                .iter()
+                .map(|a| AxisName::from(a.as_str()))
+                .collect(),
+            layout,
             position: AxisValues::zeros(n),
             g92: AxisValues::zeros(n),
             pset: AxisValues::zeros(n),
@@ -226,7 +233,7 @@ impl DecoderState {
     /// The diagnostic of `error` at `span` of `src`, with this channel's axis names where
     /// the text lists them (lines and columns not counted yet).
     pub fn diagnostic(&self, span: Span, error: &DecodeError, src: &str) -> Diagnostic {
-        Diagnostic::new(span, error.with_axes(&self.axes).to_string(), src)
+        Diagnostic::new(span, error.with_axes(self.layout.names()).to_string(), src)
     }
 
     /// The programmed position per axis (after offsets), as the next incremental block sees it.
@@ -249,18 +256,21 @@ impl DecoderState {
         }
     }
 
-    /// The channel's axis names.
+    /// The channel's axis names per slot (empty for a pose slot the channel lacks).
     pub fn axes(&self) -> &[String] {
-        &self.axes
+        self.layout.names()
+    }
+
+    /// Where the channel's axes are kept.
+    pub fn layout(&self) -> &AxisLayout {
+        &self.layout
     }
 
     /// Takes the machine data of `setup`.
     pub fn configure(&mut self, setup: &DecoderSetup) {
         // G54..G59 per channel axis (values beyond the channel's axes are refused at load).
-        for (slot, values) in self.zero_offsets.iter_mut().zip(&setup.zero_offsets) {
-            for (i, v) in values.iter().enumerate().take(slot.len()) {
-                slot[i] = *v;
-            }
+        for (offsets, values) in self.zero_offsets.iter_mut().zip(&setup.zero_offsets) {
+            self.layout.place(values, offsets);
         }
         self.tools = setup.tools.clone();
         self.tools_unknown = setup.tools_unknown;
@@ -311,13 +321,17 @@ impl DecoderState {
     }
 
     fn axis_index(&self, name: &str) -> Option<usize> {
-        self.axes.iter().position(|a| a == name)
+        let slot = self.layout.names().iter().position(|a| a == name)?;
+        self.layout.has(slot).then_some(slot)
     }
 
     /// Axis lookup for names straight from the tree (byte comparison, no UTF-8 check).
     fn axis_of(&self, name: &AxisName) -> Option<usize> {
+        // An empty name (a pose slot the channel lacks) packs to 0, which no word's does.
         let packed = name.packed();
-        self.axis_names.iter().position(|a| a.packed() == packed)
+        (packed != 0)
+            .then(|| self.axis_names.iter().position(|a| a.packed() == packed))
+            .flatten()
     }
 }
 
