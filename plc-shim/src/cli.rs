@@ -63,6 +63,11 @@ pub struct PlcArgs {
     /// Run this timeline (TOML, see `plc_shim::timeline`) instead of a built-in program.
     #[arg(long)]
     pub timeline: Option<std::path::PathBuf>,
+    /// The CNC cycle the timeline's `at_tick` counts ticks of (ms, 0.05..=100; `cnc run`
+    /// passes its scenario's `cycle_ms`): a CNC running another cycle has them scaled to the
+    /// same time. Without it `at_tick` counts the CNC's ticks, whatever their cycle.
+    #[arg(long, requires = "timeline", value_parser = cycle_ms)]
+    pub timeline_cycle_ms: Option<f64>,
     /// Run these Structured Text files (every PROGRAM in them, each cycle) instead of a
     /// built-in program (docs/plc-st.md).
     #[arg(long, num_args = 1.., conflicts_with = "timeline")]
@@ -88,6 +93,16 @@ pub struct PlcArgs {
     /// Table speed of `rotary-table`, degree per cycle.
     #[arg(long, default_value_t = 0.01)]
     pub deg_per_cycle: f64,
+}
+
+/// A cycle in ms: finite, 0.05..=100 (the CNC's range).
+fn cycle_ms(text: &str) -> Result<f64, String> {
+    let ms: f64 = text.parse().map_err(|e| format!("{e}"))?;
+    if ms.is_finite() && (0.05..=100.0).contains(&ms) {
+        Ok(ms)
+    } else {
+        Err(format!("{ms} ms: must lie in 0.05..=100"))
+    }
 }
 
 /// Names of the built-in programs.
@@ -132,7 +147,12 @@ pub fn run(args: PlcArgs) -> ExitCode {
     }
     let mut program: Box<dyn PlcProgram> = match &args.timeline {
         Some(path) => match Timeline::load(path) {
-            Ok(t) => Box::new(t),
+            Ok(mut t) => {
+                if let Some(ms) = args.timeline_cycle_ms {
+                    t.count_ticks_of((ms * 1e6).round() as u64);
+                }
+                Box::new(t)
+            }
             Err(e) => {
                 eprintln!("plc: {e}");
                 return ExitCode::from(2);

@@ -85,6 +85,18 @@ impl<'a> PlcIo<'a> {
     pub fn gp_ax(&self, index: usize) -> Option<hli::views::PlcAxis<'a>> {
         self.view.gp_ax(index)
     }
+
+    /// The CNC's clock: the ticks it has done times its cycle, in µs (from the segment's
+    /// header). A program that waits a time counts on it, not on its own cycles, so it keeps
+    /// its meaning at any CNC cycle and PLC task period.
+    pub fn cnc_clock_us(&self) -> u64 {
+        use hli::layout::image::HliSegmentHeader;
+        let at = core::mem::offset_of!(HliSegmentHeader, cnc_cycle_ns);
+        let cycle_ns = u64::from(self.memory.place::<u32>(at).load());
+        let at = core::mem::offset_of!(HliSegmentHeader, cnc_heartbeat);
+        let ticks = self.memory.place::<u64>(at).load();
+        ticks.saturating_mul(cycle_ns) / 1000
+    }
 }
 
 /// More CNC ticks than this between two wake-ups of the PLC are not a late PLC but a

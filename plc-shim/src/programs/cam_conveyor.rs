@@ -6,15 +6,17 @@
 //! ```text
 //! Select   MC_CamTableSelect table 1, cyclic, absolute            -> Done
 //! Couple   MC_CamIn lifter to conveyor through table 1            -> InSync
-//! Run      MC_MoveVelocity conveyor at 360 deg/s; from cycle 1700 on ->
+//! Run      MC_MoveVelocity conveyor at 360 deg/s; from 1.7 s on      ->
 //! Scale    MC_CamScaling: half the stroke at the next cycle, slave auto-offset -> Done
-//! Mode     from cycle 2600: MC_SetCamOnlineChangeMode table 1, next cycle      -> Done
+//! Mode     from 2.6 s: MC_SetCamOnlineChangeMode table 1, next cycle          -> Done
 //! Change   MC_WriteMotionFunctionPoint: point 4 to 30                          -> Done
-//! Out      from cycle 4000, in the rest phase (350..360 deg): MC_CamOut        -> Done
+//! Out      from 4 s, in the rest phase (350..360 deg): MC_CamOut               -> Done
 //! Halt     MC_Halt conveyor                                                    -> Done
 //! ```
 //!
-//! Any Error stops the sequence in `Failed` with the block and its ErrorID.
+//! Any Error stops the sequence in `Failed` with the block and its ErrorID. The times count
+//! from the program's first cycle on the CNC's clock ([`PlcIo::cnc_clock_us`]), so they keep
+//! their meaning at any CNC cycle and PLC task period (at 1 ms, 1.7 s is cycle 1700).
 
 use crate::blocks::cam::{
     McCamIn, McCamOut, McCamScaling, McSetCamOnlineChangeMode, McWriteMotionFunctionPoint,
@@ -80,6 +82,8 @@ pub struct CamConveyor {
     halt: McHalt,
     /// The conveyor (master) and the lifter (`gpAx` indices).
     axes: [u32; 2],
+    /// The CNC's clock in the first cycle (µs).
+    first_clock_us: Option<u64>,
 }
 
 impl CamConveyor {
@@ -106,6 +110,13 @@ impl CamConveyor {
         }
     }
 
+    /// Milliseconds since the first cycle, on the CNC's clock.
+    fn elapsed_ms(&mut self, io: &PlcIo<'_>) -> u64 {
+        let now = io.cnc_clock_us();
+        let first = *self.first_clock_us.get_or_insert(now);
+        now.saturating_sub(first) / 1000
+    }
+
     fn fail(&mut self, error_id: u32) {
         let at = self.entered.len() as u8;
         self.step = Step::Failed { at, error_id };
@@ -115,6 +126,7 @@ impl CamConveyor {
 impl PlcProgram for CamConveyor {
     fn cycle(&mut self, io: &mut PlcIo<'_>) {
         let cycle = io.cycle;
+        let ms = self.elapsed_ms(io);
         let [conveyor, lifter] = self.axes;
         match self.step {
             Step::Select => {
@@ -122,7 +134,7 @@ impl PlcProgram for CamConveyor {
                 self.select.periodic = true;
                 self.select.master_absolute = true;
                 self.select.slave_absolute = true;
-                self.select.execute = cycle >= 4;
+                self.select.execute = ms >= 4;
                 self.select.call(io);
                 if self.select.out.error {
                     self.fail(self.select.out.error_id);
@@ -155,7 +167,7 @@ impl PlcProgram for CamConveyor {
                 if self.run.out.error {
                     return self.fail(self.run.out.error_id);
                 }
-                self.sequence(io, cycle);
+                self.sequence(io, cycle, ms);
             }
             Step::Finished | Step::Failed { .. } => {}
         }
@@ -172,11 +184,11 @@ impl PlcProgram for CamConveyor {
 }
 
 impl CamConveyor {
-    /// The steps after the conveyor runs.
-    fn sequence(&mut self, io: &mut PlcIo<'_>, cycle: u64) {
+    /// The steps after the conveyor runs (`ms` since the first cycle).
+    fn sequence(&mut self, io: &mut PlcIo<'_>, cycle: u64, ms: u64) {
         let [conveyor, lifter] = self.axes;
         match self.step {
-            Step::Run if cycle >= 1700 && self.run.out.in_velocity => {
+            Step::Run if ms >= 1700 && self.run.out.in_velocity => {
                 self.go(Step::Scale, cycle);
             }
             Step::Scale => {
@@ -188,7 +200,7 @@ impl CamConveyor {
                 self.scale.call(io, lifter);
                 if self.scale.out.error {
                     self.fail(self.scale.out.error_id);
-                } else if self.scale.out.done && cycle >= 2600 {
+                } else if self.scale.out.done && ms >= 2600 {
                     self.go(Step::Mode, cycle);
                 }
             }
@@ -229,7 +241,7 @@ impl CamConveyor {
                     .view
                     .axis_state(conveyor as usize)
                     .is_ok_and(|s| s.command_position_acs_r > 3_500_000);
-                self.out.execute = cycle >= 4000 && at_rest || self.out.execute;
+                self.out.execute = ms >= 4000 && at_rest || self.out.execute;
                 self.out.call(io, lifter);
                 if self.out.out.error {
                     self.fail(self.out.out.error_id);

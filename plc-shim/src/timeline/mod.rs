@@ -230,6 +230,10 @@ pub struct Timeline {
     records: Vec<StepRecord>,
     values: Vec<Value>,
     cnc_tick: Leaf,
+    cnc_cycle: Leaf,
+    /// `at_tick` counts ticks of this cycle (ns); taken at the first cycle (see
+    /// [`Timeline::count_ticks_of`]).
+    tick_reference_ns: Option<u64>,
     instances: instances::Instances,
 }
 
@@ -271,6 +275,8 @@ impl Timeline {
             records: vec![StepRecord::default(); n],
             values: Vec::with_capacity(most_values),
             cnc_tick: Leaf::resolve("header.cnc_heartbeat").expect("the header has a heartbeat"),
+            cnc_cycle: Leaf::resolve("header.cnc_cycle_ns").expect("the header has a cycle"),
+            tick_reference_ns: None,
             instances,
         })
     }
@@ -283,6 +289,40 @@ impl Timeline {
             message: e.to_string(),
         })?;
         Timeline::parse(&file, &text)
+    }
+
+    /// The steps' `at_tick` count ticks of `cycle_ns` (the scenario's `cycle_ms`): at its first
+    /// cycle the timeline reads the CNC's cycle from the segment's header and, when it differs,
+    /// waits the same time in the CNC's ticks (rounded to the nearest), so a timeline keeps its
+    /// meaning when a run changes the cycle (`cnc run --cycle-ms`).
+    pub fn count_ticks_of(&mut self, cycle_ns: u64) {
+        self.tick_reference_ns = (cycle_ns > 0).then_some(cycle_ns);
+    }
+
+    /// The `at_tick` of every step, in the order of the file.
+    pub fn at_ticks(&self) -> impl Iterator<Item = Option<u64>> + '_ {
+        self.steps.iter().map(|s| s.at_tick)
+    }
+
+    /// `at_tick` from ticks of the reference cycle to ticks of the CNC's (once).
+    fn rescale_ticks(&mut self, memory: &ImageMemory) {
+        let Some(reference) = self.tick_reference_ns.take() else {
+            return;
+        };
+        let cnc = match self.cnc_cycle.read(memory) {
+            Value::Unsigned(ns) => ns,
+            other => other.as_f64() as u64,
+        };
+        if cnc == 0 || cnc == reference {
+            return;
+        }
+        let (from, to) = (u128::from(reference), u128::from(cnc));
+        for step in &mut self.steps {
+            if let Some(t) = step.at_tick.as_mut() {
+                let scaled = (u128::from(*t) * from + to / 2) / to;
+                *t = u64::try_from(scaled).unwrap_or(u64::MAX);
+            }
+        }
     }
 
     /// What happened to each step, in order.
@@ -339,6 +379,7 @@ impl Timeline {
     /// call no blocks; [`Timeline::cycle_io`] runs the blocks too); returns the CNC tick it
     /// saw. Does not allocate.
     pub fn cycle(&mut self, memory: &ImageMemory) -> u64 {
+        self.rescale_ticks(memory);
         let tick = match self.cnc_tick.read(memory) {
             Value::Unsigned(t) => t,
             other => other.as_f64() as u64,
@@ -545,6 +586,33 @@ commit = "{SEM}"
             .write(&memory, Value::Unsigned(0)); // CNC took it
         t.cycle(&memory);
         assert_eq!(t.records()[1].fired, 2);
+    }
+
+    /// A timeline written for 1 ms ticks on a CNC at 0.25 ms waits the same time: 4x the
+    /// ticks; without a reference its ticks are the CNC's.
+    #[test]
+    fn at_tick_keeps_its_time_on_a_cnc_of_another_cycle() {
+        let text = "[[step]]\nat_tick = 3\n[[step]]\nat_tick = 5\n";
+        let memory = heap_image(1, 8);
+        let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_cycle_ns);
+        memory.place::<u32>(at).store(250_000);
+        let mut scaled = Timeline::parse("t.toml", text).unwrap();
+        scaled.count_ticks_of(1_000_000);
+        let mut plain = Timeline::parse("t.toml", text).unwrap();
+        for _ in 0..20 {
+            beat(&memory);
+            scaled.cycle(&memory);
+            plain.cycle(&memory);
+        }
+        let fired = |t: &Timeline| {
+            t.records()
+                .iter()
+                .map(|r| r.first_fired_at)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(fired(&scaled), [Some(12), Some(20)]);
+        assert_eq!(scaled.at_ticks().collect::<Vec<_>>(), [Some(12), Some(20)]);
+        assert_eq!(fired(&plain), [Some(3), Some(5)]);
     }
 
     #[test]

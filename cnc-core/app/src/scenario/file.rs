@@ -105,6 +105,8 @@ struct PlcFile {
     /// Structured Text files run as the PLC program (docs/plc-st.md), relative to the
     /// scenario.
     st: Option<Vec<String>>,
+    /// The PLC task's period (ms): a whole number of CNC cycles (default: every cycle).
+    period_ms: Option<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -138,10 +140,15 @@ pub enum PlcSetup {
 pub struct Scenario {
     /// Where the scenario came from (for messages).
     pub name: String,
-    /// Tick period, seconds.
+    /// Tick period, seconds (the file's `cycle_ms`, or what the run set:
+    /// [`Scenario::set_cycle_ms`]).
     pub cycle_s: f64,
-    /// Default run length.
+    /// The file's `cycle_ms` (s): what its `ticks` and its timeline's `at_tick` count in.
+    pub file_cycle_s: f64,
+    /// Default run length, in ticks of `cycle_s`.
     pub ticks: Option<u64>,
+    /// The PLC task's period (`[plc] period_ms`, ms); none: every tick.
+    pub plc_period_ms: Option<f64>,
     /// Ticks without a PLC cycle before the PLC counts as lost.
     pub plc_watchdog_ticks: Option<u64>,
     /// What the drives do once a stop after a lost PLC reached rest (`cnc run --plc-restart`).
@@ -203,6 +210,9 @@ impl Scenario {
         file.check_shape().map_err(&invalid)?;
         let programs = load_programs(name, &file.channel, &open)?;
         let folders = program_folders(name, &file.channel)?;
+        let plc_period_ms = file.plc.as_ref().and_then(|p| p.period_ms);
+        plc_period_ticks(plc_period_ms, file.cycle_ms)
+            .map_err(|e| invalid(format!("[plc] period_ms: {e}")))?;
         let plc = plc_setup(name, file.plc, &open)?;
         if file.channel.is_empty() && file.ticks.is_none() {
             return Err(invalid(
@@ -241,7 +251,9 @@ impl Scenario {
         Ok(Scenario {
             name: name.to_string(),
             cycle_s: file.cycle_ms * 1e-3,
+            file_cycle_s: file.cycle_ms * 1e-3,
             ticks: file.ticks,
+            plc_period_ms,
             plc_watchdog_ticks: file.plc_watchdog_ticks,
             plc_loss_drives: file.plc_loss_drives,
             channels: file.channel,
@@ -285,6 +297,54 @@ fn invalid_in(name: &str) -> impl Fn(String) -> ScenarioError + '_ {
     move |message: String| ScenarioError::Invalid {
         file: name.to_string(),
         message,
+    }
+}
+
+/// The PLC task's period in ticks of `cycle_ms`: `period_ms` must be a whole number of them
+/// (1 to 1000); none: every tick.
+pub fn plc_period_ticks(period_ms: Option<f64>, cycle_ms: f64) -> Result<u64, String> {
+    let Some(period) = period_ms else {
+        return Ok(1);
+    };
+    let ticks = period / cycle_ms;
+    let whole = ticks.round();
+    if !(period.is_finite() && period > 0.0) || (ticks - whole).abs() > 1e-9 * ticks.max(1.0) {
+        return Err(format!(
+            "{period} ms is not a whole number of CNC cycles of {cycle_ms} ms"
+        ));
+    }
+    if !(1.0..=1000.0).contains(&whole) {
+        return Err(format!(
+            "{period} ms is {whole} CNC cycles of {cycle_ms} ms: the PLC task runs every 1 to 1000"
+        ));
+    }
+    Ok(whole as u64)
+}
+
+impl Scenario {
+    /// The PLC task's period in ticks of the run's cycle (checked at load and by
+    /// [`Scenario::set_cycle_ms`]).
+    pub fn plc_period_ticks(&self) -> u64 {
+        plc_period_ticks(self.plc_period_ms, self.cycle_s * 1e3).unwrap_or(1)
+    }
+
+    /// Runs the machine at `cycle_ms` instead of the file's cycle, keeping the file's times:
+    /// its `ticks` become as many of the new cycle as last as long (rounded to the nearest),
+    /// its timeline's `at_tick` the same (the PLC scales them, `plc --timeline-cycle-ms`), and
+    /// the PLC task keeps its period in ms. Refused with the reason: a cycle outside
+    /// 0.05..=100 ms, or one the PLC's period is not a whole number of.
+    pub fn set_cycle_ms(&mut self, cycle_ms: f64) -> Result<(), String> {
+        check_cycle_ms(cycle_ms)?;
+        plc_period_ticks(self.plc_period_ms, cycle_ms).map_err(|e| {
+            format!("the PLC task's period ([plc] period_ms) does not follow it: {e}")
+        })?;
+        let ratio = self.file_cycle_s / (cycle_ms * 1e-3);
+        let file_ticks = self
+            .ticks
+            .map(|t| (t as f64 * self.cycle_s / self.file_cycle_s).round());
+        self.ticks = file_ticks.map(|t| (t * ratio).round().max(1.0) as u64);
+        self.cycle_s = cycle_ms * 1e-3;
+        Ok(())
     }
 }
 
@@ -402,6 +462,7 @@ fn plc_setup(
             saw_cuts: None,
             saw_length: None,
             st: None,
+            period_ms: _,
         }) => {
             confined("[plc] timeline", Path::new(&t)).map_err(&invalid)?;
             let (path, text) = open(&t)?;
@@ -422,6 +483,7 @@ fn plc_setup(
             saw_cuts,
             saw_length,
             st: None,
+            period_ms: _,
         }) => {
             let args = program_args(name, &p, file, fifo_override, (saw_cuts, saw_length))
                 .map_err(invalid)?;

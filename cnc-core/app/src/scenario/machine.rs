@@ -86,6 +86,8 @@ pub struct InProcess {
     /// and the PLC's end.
     acyclic: Option<(AcyclicServer, AcyclicClient)>,
     plc_cycles: u64,
+    /// The PLC task runs after every `plc_period`-th tick (the first one first).
+    plc_period: u64,
     answered: u64,
 }
 
@@ -146,9 +148,18 @@ impl InProcess {
         };
         let (timeline, program) = match &scenario.plc {
             PlcSetup::None => (None, None),
-            PlcSetup::Timeline { timeline, .. } => (Some(Timeline::clone(timeline)), None),
+            PlcSetup::Timeline { timeline, .. } => {
+                let mut timeline = Timeline::clone(timeline);
+                timeline.count_ticks_of((scenario.file_cycle_s * 1e9).round() as u64);
+                (Some(timeline), None)
+            }
             PlcSetup::Program(p, args) => {
-                let program = plc_shim::cli::built_in_from(p, args)
+                let mut args = args.clone();
+                let period = scenario.plc_period_ticks();
+                if period > 1 {
+                    args.extend(["--period-ticks".to_string(), period.to_string()]);
+                }
+                let program = plc_shim::cli::built_in_from(p, &args)
                     .map_err(|e| invalid(format!("[plc] program {p:?}: {e}")))?;
                 (None, Some(BuiltIn(program)))
             }
@@ -170,6 +181,11 @@ impl InProcess {
         let machine = build(scenario)?;
         let memory =
             hli::image::heap_image(scenario.channels.len() as u32, machine.axis_images() as u32);
+        // The header announces the run's cycle, as the CNC process's does.
+        let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_cycle_ns);
+        memory
+            .place::<u32>(at)
+            .store((scenario.cycle_s * 1e9).round() as u32);
         Ok(InProcess {
             machine,
             memory,
@@ -178,6 +194,7 @@ impl InProcess {
             trace: Trace::new(&scenario.signals, rows),
             acyclic,
             plc_cycles: 0,
+            plc_period: scenario.plc_period_ticks(),
             answered: 0,
         })
     }
@@ -219,8 +236,13 @@ impl InProcess {
         self.machine.serve_channels();
     }
 
-    /// The PLC's cycle after a tick, with the acyclic calls answered first.
+    /// The PLC's cycle after a tick, with the acyclic calls answered first (after the ticks
+    /// its task is due at).
     fn plc_cycle(&mut self) {
+        let tick = self.machine.ticks().saturating_sub(1);
+        if !tick.is_multiple_of(self.plc_period.max(1)) {
+            return;
+        }
         if self.program.is_some() {
             return self.program_cycle();
         }

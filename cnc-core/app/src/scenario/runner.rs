@@ -52,8 +52,10 @@ pub struct RunArgs {
     /// Run exactly N ticks (channels that finish earlier stay idle).
     #[arg(long)]
     pub ticks: Option<u64>,
-    /// The tick cycle in ms, over the scenario's `cycle_ms` (0.05..=100); the PLC follows
-    /// the cycle the CNC announces.
+    /// The tick cycle in ms, over the scenario's `cycle_ms` (0.05..=100). The scenario keeps
+    /// its times: its `ticks` and its timeline's `at_tick` are scaled to the new cycle, and
+    /// the PLC task keeps its `[plc] period_ms` (refused when that is not a whole number of
+    /// the new cycle).
     #[arg(long)]
     pub cycle_ms: Option<f64>,
     /// Lockstep mode: tick N waits for the PLC's cycle; runs are reproducible bit for bit.
@@ -256,11 +258,10 @@ pub fn main(args: RunArgs) -> ExitCode {
         }
     };
     if let Some(ms) = args.cycle_ms {
-        if let Err(e) = super::file::check_cycle_ms(ms) {
-            eprintln!("cnc run: --cycle-ms: {e}");
+        if let Err(e) = scenario.set_cycle_ms(ms) {
+            eprintln!("cnc run: --cycle-ms {ms}: {e}");
             return ExitCode::from(2);
         }
-        scenario.cycle_s = ms * 1e-3;
     }
     let instance = args
         .instance
@@ -644,10 +645,18 @@ fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>,
                 file
             };
             command.arg("--timeline").arg(file);
+            // Its at_tick count ticks of the file's cycle, whatever the run's.
+            command
+                .arg("--timeline-cycle-ms")
+                .arg(format!("{}", scenario.file_cycle_s * 1e3));
         }
         PlcSetup::Program(p, args) => {
             command.args(["--program", p]).args(args);
         }
+    }
+    let period = scenario.plc_period_ticks();
+    if period > 1 {
+        command.args(["--period-ticks", &period.to_string()]);
     }
     // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC.
     command.args(

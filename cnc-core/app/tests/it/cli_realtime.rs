@@ -88,6 +88,9 @@ fn the_cycle_is_set_on_the_command_line_and_checked() {
         let out = run(bad);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "--cycle-ms {bad}: {stderr}");
-        assert!(stderr.contains("--cycle-ms: cycle_ms = "), "{stderr}");
+        assert!(
+            stderr.contains("cnc run: --cycle-ms ") && stderr.contains("must lie in 0.05..=100"),
+            "{stderr}"
+        );
     }
 }

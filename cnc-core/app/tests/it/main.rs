@@ -30,6 +30,7 @@ mod cli_syscalls;
 mod cli_turntable;
 #[path = "../../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
+mod cycle_change;
 mod demo;
 mod demo_twin;
 mod drive_inputs;
