@@ -173,6 +173,11 @@ proptest! {
         conv in 0usize..4,
     ) {
         let order = [RotationOrder::YawPitchRoll, RotationOrder::EulerZyz, RotationOrder::Cba, RotationOrder::Zyx][conv];
+        // Within 0.01 degree of gimbal lock (the middle angle at +-90, or 0 for Z-Y-Z) the
+        // angles are ill-conditioned (their error grows as 1 / cos of the distance) and no
+        // fixed tolerance holds; the singular poses themselves have their own tests.
+        let singular = if conv == 1 { 0.0 } else { 90.0 };
+        prop_assume!((abc[1].abs() - singular).abs() > 0.01);
         let tool = PoseWords { xyz: [10.0, -5.0, 120.0], abc: [0.0, 30.0, 0.0] };
         let kin = Cartesian::new(order, &tool, [JointLimit::NONE; 6]).unwrap();
         let joints: Joints = [xyz[0], xyz[1], xyz[2], abc[0], abc[1], abc[2]];
