@@ -261,7 +261,7 @@ fn report(summary: &crate::runtime::RunSummary, program: &dyn PlcProgram) -> Str
     let w = &summary.wake_to_done;
     format!(
         "plc: {} cycles, ended by {:?}\nplc: task {}\n\
-         plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n{}",
+         plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n{}{}",
         summary.cycles(),
         summary.end,
         summary.stats,
@@ -269,6 +269,7 @@ fn report(summary: &crate::runtime::RunSummary, program: &dyn PlcProgram) -> Str
         w.quantile_us(0.5),
         w.quantile_us(0.99),
         w.max_ns as f64 / 1e3,
+        summary.worst.render(),
         program.summary()
     )
 }

@@ -16,6 +16,7 @@ pub mod runtime;
 pub mod st;
 pub mod timeline;
 pub mod tools;
+pub mod wakeups;
 pub mod watchdog;
 
 pub use runtime::{PlcIo, PlcProgram, PlcRuntime, RunSummary, RuntimeError};

@@ -25,11 +25,13 @@
 use core::time::Duration;
 use hli::calls::CallError;
 use hli::enums::SegmentState;
+use hli::layout::HliSegmentHeader;
 use hli::views::PlcView;
 use hli_transport::events::{EventError, EventLink, Side};
 use hli_transport::rpc::AcyclicClient;
 use hli_transport::segment::{AttachError, HeaderFault, PlcSegment};
 
+use crate::wakeups::{Wakeup, WorstWakeups};
 pub use crate::watchdog::CncLoss;
 use crate::watchdog::CncWatch;
 
@@ -257,6 +259,8 @@ pub struct RunSummary {
     /// From the wake-up ("tick done" received) to "cycle done" sent, for the cycles that ran
     /// the program: the PLC's whole answer to a tick (its overruns are not counted here).
     pub wake_to_done: CycleStats,
+    /// The worst wake-ups, part by part (real time only).
+    pub worst: WorstWakeups,
 }
 
 impl RunSummary {
@@ -355,40 +359,42 @@ impl PlcRuntime {
         );
         let mut stats = CycleStats::default();
         let mut wake_to_done = CycleStats::default();
-        let end = |end, stats: CycleStats, wake_to_done: CycleStats| {
+        let mut worst = WorstWakeups::default();
+        let end = |end, stats: CycleStats, wake_to_done: CycleStats, worst| {
             Ok(RunSummary {
                 end,
                 stats,
                 wake_to_done,
+                worst,
             })
         };
         let mut schedule = TaskSchedule::new(self.period_ticks);
         let mut wakeups = 0u64;
         loop {
             if max_cycles.is_some_and(|max| stats.cycles >= max) {
-                return end(RunEnd::CycleLimit, stats, wake_to_done);
+                return end(RunEnd::CycleLimit, stats, wake_to_done, worst);
             }
             // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
             if wakeups.is_multiple_of(64) {
                 if let Some(signal) = hli_transport::signals::take() {
-                    return end(RunEnd::Signal(signal), stats, wake_to_done);
+                    return end(RunEnd::Signal(signal), stats, wake_to_done, worst);
                 }
             }
             self.events.wait(self.wait_step)?;
             let woke = cnc_os::monotonic::now();
+            let woke_wall = crate::wakeups::wall_now_ns();
             let beat = self.segment.cnc_heartbeat();
             if let Some(ended) = self.supervise(&mut watch, beat) {
                 if matches!(ended, RunEnd::CncLost(_) | RunEnd::SegmentCorrupt(_)) {
                     self.last_cycle(program, &mut stats);
                 }
-                return end(ended, stats, wake_to_done);
+                return end(ended, stats, wake_to_done, worst);
             }
             let Some(step) = schedule.wake(beat) else {
                 continue; // woken without a new tick (timeout): no cycle
             };
-            let ran = step.is_some();
             if let Some(missed) = step {
                 stats.overruns = stats.overruns.saturating_add(missed);
                 let mut io = PlcIo {
@@ -404,16 +410,39 @@ impl PlcRuntime {
                 stats.record(took.as_nanos() as u64);
                 if program.halted() {
                     // No heartbeat for this tick: the CNC stops as for a lost PLC.
-                    return end(RunEnd::ProgramHalted, stats, wake_to_done);
+                    return end(RunEnd::ProgramHalted, stats, wake_to_done, worst);
                 }
             }
             self.segment.beat();
             self.events.notify()?;
-            if ran {
-                let took = cnc_os::monotonic::now().saturating_sub(woke);
-                wake_to_done.record(took.as_nanos() as u64);
+            if let Some(missed) = step {
+                let took = cnc_os::monotonic::now().saturating_sub(woke).as_nanos() as u64;
+                wake_to_done.record(took);
+                if let Some(w) = self.wakeup(beat, woke_wall, took, missed) {
+                    worst.record(w);
+                }
             }
         }
+    }
+
+    /// The wake-up to heartbeat `beat`, woken at `woke_wall` (wall clock), its cycle done
+    /// `took` ns later, in parts, counted from the tick the cycle was due at (`missed` task
+    /// slots before `beat`); `None` in lockstep or before the CNC announced its epoch.
+    fn wakeup(&self, beat: u64, woke_wall: u64, took: u64, missed: u64) -> Option<Wakeup> {
+        let timing = self.segment.cnc_timing();
+        if timing.lockstep {
+            return None;
+        }
+        let at = core::mem::offset_of!(HliSegmentHeader, cnc_epoch_ns);
+        let epoch = self.segment.memory().place::<u64>(at).load();
+        let cycle = u64::from(timing.cycle_ns);
+        let due = beat.saturating_sub(missed.saturating_mul(self.period_ticks));
+        Some(Wakeup {
+            tick: due,
+            due_to_woken_ns: crate::wakeups::due_to_woken(epoch, due, cycle, woke_wall)?,
+            woken_to_done_ns: took,
+            missed,
+        })
     }
 }
 

@@ -95,13 +95,17 @@ impl EventLink {
     }
 
     /// Waits up to `timeout` for the other side's notification; `true` when one arrived.
-    /// Collapses several pending notifications into one wake-up.
+    /// Collapses several pending notifications into one wake-up. A wait that a signal
+    /// interrupts (the SIGCONT after the process was stopped, a handler's signal) is a
+    /// wake-up without news, not a failure: the caller looks at the heartbeat and its
+    /// signals as after any wake-up.
     pub fn wait(&self, timeout: Duration) -> Result<bool, EventError> {
+        use iceoryx2::port::listener::ListenerWaitError;
         let mut woken = false;
-        self.listener
-            .timed_wait(|_| woken = true, timeout)
-            .map_err(|e| err("wait", e))?;
-        Ok(woken)
+        match self.listener.timed_wait(|_| woken = true, timeout) {
+            Ok(_) | Err(ListenerWaitError::InterruptSignal) => Ok(woken),
+            Err(e) => Err(err("wait", e)),
+        }
     }
 
     /// Consumes pending notifications without blocking; `true` when there were some.

@@ -16,6 +16,7 @@ mod cli_fault_matrix;
 mod cli_fifo;
 mod cli_hli;
 mod cli_kin;
+mod cli_late_plc;
 mod cli_opcua;
 mod cli_plc_channel;
 mod cli_plc_tools;
