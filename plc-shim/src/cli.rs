@@ -238,6 +238,7 @@ pub fn host(program: &mut dyn PlcProgram, args: &HostArgs) -> ExitCode {
         cnc_os::stdio::line_out(&format!("plc: real-time {}", realtime.join(", ")));
     }
     runtime.set_period_ticks(args.period_ticks);
+    runtime.set_wake(args.realtime.wake.unwrap_or_default());
     hli_transport::signals::capture();
     match runtime.run(program, args.max_cycles) {
         Ok(summary) => {
@@ -261,7 +262,7 @@ fn report(summary: &crate::runtime::RunSummary, program: &dyn PlcProgram) -> Str
     let w = &summary.wake_to_done;
     format!(
         "plc: {} cycles, ended by {:?}\nplc: task {}\n\
-         plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n{}{}",
+         plc: wake-up to done {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n{}{}{}",
         summary.cycles(),
         summary.end,
         summary.stats,
@@ -269,8 +270,23 @@ fn report(summary: &crate::runtime::RunSummary, program: &dyn PlcProgram) -> Str
         w.quantile_us(0.5),
         w.quantile_us(0.99),
         w.max_ns as f64 / 1e3,
+        due_to_woken(&summary.due_to_woken),
         summary.worst.render(),
         program.summary()
+    )
+}
+
+/// The line of the ticks' due time to the PLC woken (real time), or nothing.
+fn due_to_woken(d: &crate::runtime::CycleStats) -> String {
+    if d.cycles == 0 {
+        return String::new();
+    }
+    format!(
+        "plc: tick due to woken {} cycles, p50 {:.0} us p99 {:.0} us max {:.1} us\n",
+        d.cycles,
+        d.quantile_us(0.5),
+        d.quantile_us(0.99),
+        d.max_ns as f64 / 1e3
     )
 }
 

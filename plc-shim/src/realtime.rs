@@ -30,6 +30,33 @@ pub struct RealtimeOptions {
     /// cyclictest does): no deep idle state delays the tick's wake-up.
     #[arg(long = "rt-cpu-wake-latency-us")]
     pub cpu_wake_latency_us: Option<u32>,
+    /// How the CNC wakes the PLC for a tick in real time: `event` (iceoryx2's event, the
+    /// default) or `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
+    /// segment, the CNC wakes it with one `futex(2)` call). The CNC hands its choice to the
+    /// PLC it spawns.
+    #[arg(long = "rt-wake", value_enum)]
+    pub wake: Option<WakePath>,
+}
+
+/// How a sleeping PLC is woken for a tick.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum WakePath {
+    /// iceoryx2's event service ("tick done").
+    #[default]
+    Event,
+    /// A futex on the low word of the CNC's heartbeat in the segment.
+    Futex,
+}
+
+impl WakePath {
+    /// Its name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            WakePath::Event => "event",
+            WakePath::Futex => "futex",
+        }
+    }
 }
 
 impl RealtimeOptions {
@@ -41,6 +68,7 @@ impl RealtimeOptions {
             lock_memory: self.lock_memory || file.lock_memory,
             timer_slack_ns: self.timer_slack_ns.or(file.timer_slack_ns),
             cpu_wake_latency_us: self.cpu_wake_latency_us.or(file.cpu_wake_latency_us),
+            wake: self.wake.or(file.wake),
         }
     }
 
@@ -55,6 +83,8 @@ impl RealtimeOptions {
             timer_slack_ns: self.timer_slack_ns,
             // The CNC's request holds for the whole machine.
             cpu_wake_latency_us: None,
+            // Both ends wake the same way.
+            wake: self.wake,
         }
     }
 
@@ -67,6 +97,7 @@ impl RealtimeOptions {
             lock_memory: true,
             timer_slack_ns: Some(1),
             cpu_wake_latency_us: Some(0),
+            wake: None,
         }
     }
 
@@ -92,6 +123,9 @@ impl RealtimeOptions {
         }
         if let Some(us) = self.cpu_wake_latency_us {
             args.extend(["--rt-cpu-wake-latency-us".to_string(), us.to_string()]);
+        }
+        if let Some(w) = self.wake {
+            args.extend(["--rt-wake".to_string(), w.name().to_string()]);
         }
         args
     }
@@ -136,6 +170,9 @@ impl RealtimeOptions {
         if self.any() {
             eprintln!("{who}: real-time options need Linux; running without them");
         }
+        if self.wake == Some(WakePath::Futex) {
+            applied.push("wake-up by futex".into());
+        }
         applied
     }
 }
@@ -152,6 +189,7 @@ mod tests {
             lock_memory: false,
             timer_slack_ns: Some(1000),
             cpu_wake_latency_us: Some(0),
+            wake: Some(WakePath::Futex),
         };
         let flags = RealtimeOptions {
             priority: Some(80),
@@ -172,8 +210,15 @@ mod tests {
                 "--rt-timer-slack-ns",
                 "1000",
                 "--rt-cpu-wake-latency-us",
-                "0"
+                "0",
+                "--rt-wake",
+                "futex"
             ]
+        );
+        assert_eq!(
+            o.for_plc().wake,
+            Some(WakePath::Futex),
+            "both ends wake alike"
         );
     }
 

@@ -31,6 +31,7 @@ use hli_transport::events::{EventError, EventLink, Side};
 use hli_transport::rpc::AcyclicClient;
 use hli_transport::segment::{AttachError, HeaderFault, PlcSegment};
 
+use crate::realtime::WakePath;
 use crate::wakeups::{Wakeup, WorstWakeups};
 pub use crate::watchdog::CncLoss;
 use crate::watchdog::CncWatch;
@@ -47,6 +48,9 @@ pub enum RuntimeError {
     /// The acyclic service failed.
     #[error("acyclic calls: {0}")]
     Call(#[from] CallError),
+    /// The futex wait for a tick was refused.
+    #[error("tick wait: {0}")]
+    Wait(String),
 }
 
 /// What a PLC program sees each cycle.
@@ -261,6 +265,9 @@ pub struct RunSummary {
     pub wake_to_done: CycleStats,
     /// The worst wake-ups, part by part (real time only).
     pub worst: WorstWakeups,
+    /// From the due time of the tick a cycle was due at to the PLC woken, for the cycles
+    /// that ran the program (real time only).
+    pub due_to_woken: CycleStats,
 }
 
 impl RunSummary {
@@ -298,6 +305,7 @@ pub struct PlcRuntime {
     watchdog_cycles: u32,
     wait_step: Duration,
     period_ticks: u64,
+    wake: WakePath,
 }
 
 impl PlcRuntime {
@@ -325,12 +333,36 @@ impl PlcRuntime {
             watchdog_cycles,
             wait_step,
             period_ticks: 1,
+            wake: WakePath::Event,
         })
     }
 
     /// Runs the task every `ticks` NC ticks instead of every tick (at least 1).
     pub fn set_period_ticks(&mut self, ticks: u64) {
         self.period_ticks = ticks.max(1);
+    }
+
+    /// How the CNC wakes this PLC for a tick (the CNC's own `--rt-wake`; a CNC in lockstep
+    /// always uses the event).
+    pub fn set_wake(&mut self, wake: WakePath) {
+        self.wake = wake;
+    }
+
+    /// Sleeps until the CNC's next tick after heartbeat `seen`, at most one wait step: on its
+    /// event, or on the low word of its heartbeat (`WakePath::Futex`, in real time).
+    fn wait_for_tick(&self, seen: u64) -> Result<(), RuntimeError> {
+        if self.wake == WakePath::Futex && !self.segment.cnc_timing().lockstep {
+            let at = core::mem::offset_of!(HliSegmentHeader, cnc_heartbeat);
+            // The heartbeat's low word (little-endian) changes with every tick.
+            let word = self.segment.memory().place::<u32>(at).atomic();
+            cnc_os::futex::wait(word, seen as u32, self.wait_step)
+                .map_err(|e| RuntimeError::Wait(e.to_string()))?;
+            // The CNC's events still arrive (lockstep keeps them): taken without waiting.
+            self.events.poll()?;
+            return Ok(());
+        }
+        self.events.wait(self.wait_step)?;
+        Ok(())
     }
 
     /// Leaves the segment: the PLC's pid leaves the header, the event and call services
@@ -360,37 +392,48 @@ impl PlcRuntime {
         let mut stats = CycleStats::default();
         let mut wake_to_done = CycleStats::default();
         let mut worst = WorstWakeups::default();
-        let end = |end, stats: CycleStats, wake_to_done: CycleStats, worst| {
+        let mut due_to_woken = CycleStats::default();
+        let end = |end, stats: CycleStats, wake_to_done: CycleStats, worst, due_to_woken| {
             Ok(RunSummary {
                 end,
                 stats,
                 wake_to_done,
                 worst,
+                due_to_woken,
             })
         };
         let mut schedule = TaskSchedule::new(self.period_ticks);
         let mut wakeups = 0u64;
+        // The heartbeat the loop saw last (0: none yet, so a tick done before it counts).
+        let mut seen = 0u64;
         loop {
             if max_cycles.is_some_and(|max| stats.cycles >= max) {
-                return end(RunEnd::CycleLimit, stats, wake_to_done, worst);
+                return end(RunEnd::CycleLimit, stats, wake_to_done, worst, due_to_woken);
             }
             // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
             if wakeups.is_multiple_of(64) {
                 if let Some(signal) = hli_transport::signals::take() {
-                    return end(RunEnd::Signal(signal), stats, wake_to_done, worst);
+                    return end(
+                        RunEnd::Signal(signal),
+                        stats,
+                        wake_to_done,
+                        worst,
+                        due_to_woken,
+                    );
                 }
             }
-            self.events.wait(self.wait_step)?;
+            self.wait_for_tick(seen)?;
             let woke = cnc_os::monotonic::now();
             let woke_wall = crate::wakeups::wall_now_ns();
             let beat = self.segment.cnc_heartbeat();
+            seen = beat;
             if let Some(ended) = self.supervise(&mut watch, beat) {
                 if matches!(ended, RunEnd::CncLost(_) | RunEnd::SegmentCorrupt(_)) {
                     self.last_cycle(program, &mut stats);
                 }
-                return end(ended, stats, wake_to_done, worst);
+                return end(ended, stats, wake_to_done, worst, due_to_woken);
             }
             let Some(step) = schedule.wake(beat) else {
                 continue; // woken without a new tick (timeout): no cycle
@@ -410,7 +453,13 @@ impl PlcRuntime {
                 stats.record(took.as_nanos() as u64);
                 if program.halted() {
                     // No heartbeat for this tick: the CNC stops as for a lost PLC.
-                    return end(RunEnd::ProgramHalted, stats, wake_to_done, worst);
+                    return end(
+                        RunEnd::ProgramHalted,
+                        stats,
+                        wake_to_done,
+                        worst,
+                        due_to_woken,
+                    );
                 }
             }
             self.segment.beat();
@@ -420,6 +469,7 @@ impl PlcRuntime {
                 wake_to_done.record(took);
                 if let Some(w) = self.wakeup(beat, woke_wall, took, missed) {
                     worst.record(w);
+                    due_to_woken.record(w.due_to_woken_ns);
                 }
             }
         }

@@ -330,8 +330,8 @@ impl Scenario {
 
     /// Runs the machine at `cycle_ms` instead of the file's cycle, keeping the file's times:
     /// its `ticks` become as many of the new cycle as last as long (rounded to the nearest),
-    /// its timeline's `at_tick` the same (the PLC scales them, `plc --timeline-cycle-ms`), and
-    /// the PLC task keeps its period in ms. Refused with the reason: a cycle outside
+    /// its timeline's `at_tick` and its `plc_watchdog_ticks` the same (the PLC scales the
+    /// timeline, `plc --timeline-cycle-ms`), and the PLC task keeps its period in ms. Refused with the reason: a cycle outside
     /// 0.05..=100 ms, or one the PLC's period is not a whole number of.
     pub fn set_cycle_ms(&mut self, cycle_ms: f64) -> Result<(), String> {
         check_cycle_ms(cycle_ms)?;
@@ -343,6 +343,10 @@ impl Scenario {
             .ticks
             .map(|t| (t as f64 * self.cycle_s / self.file_cycle_s).round());
         self.ticks = file_ticks.map(|t| (t * ratio).round().max(1.0) as u64);
+        let file_watchdog = self
+            .plc_watchdog_ticks
+            .map(|t| (t as f64 * self.cycle_s / self.file_cycle_s).round());
+        self.plc_watchdog_ticks = file_watchdog.map(|t| (t * ratio).round().max(1.0) as u64);
         self.cycle_s = cycle_ms * 1e-3;
         Ok(())
     }

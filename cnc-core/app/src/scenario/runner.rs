@@ -13,7 +13,7 @@
 //!   channels tick ─► heartbeat ─► trace sample ─► answer acyclic calls ─► notify "tick done"
 //! ```
 
-use super::file::{PlcSetup, Scenario, ScenarioError};
+use super::file::{Scenario, ScenarioError};
 use super::machine::{build, Machine};
 use super::trace::Trace;
 use crate::stats::Percentiles;
@@ -23,12 +23,14 @@ use core::time::Duration;
 use hli_transport::events::{EventLink, Side};
 use hli_transport::rpc::AcyclicServer;
 use hli_transport::segment::CncSegment;
+use spawn::spawn_plc;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, ExitCode, Stdio};
+use std::process::{Child, ExitCode};
 use tick_loop::{Bounds, Ending, Measured, TickLoop};
 
 pub mod latency;
 mod restart;
+mod spawn;
 mod tick_loop;
 
 /// Ticks run when neither `--ticks` nor the scenario says: until every channel is idle, at
@@ -75,7 +77,7 @@ pub struct RunArgs {
     #[arg(long, default_value = ".")]
     pub log_dir: PathBuf,
     /// Ticks without a PLC cycle before the CNC declares the PLC lost and stops the machine
-    /// (default: the scenario's `plc_watchdog_ticks`, else 100).
+    /// (default: the scenario's `plc_watchdog_ticks`, else 100 ms' worth).
     #[arg(long)]
     pub plc_watchdog_ticks: Option<u64>,
     /// A lost PLC stops the machine, but the run goes on and takes a new PLC process on the
@@ -626,58 +628,6 @@ impl RunReport {
         out.push_str(&self.plc_output);
         out
     }
-}
-
-fn spawn_plc(scenario: &Scenario, options: &RunOptions) -> Result<Option<Child>, String> {
-    let mut command = Command::new(std::env::current_exe().map_err(|e| e.to_string())?);
-    command.args(["plc", "--instance", &options.instance]);
-    match &scenario.plc {
-        PlcSetup::None => return Ok(None),
-        PlcSetup::Timeline { path, text, .. } => {
-            let file = if path.is_file() {
-                path.clone()
-            } else {
-                // Embedded scenario: hand the PLC process a copy on disk.
-                let file = options
-                    .scratch
-                    .join(format!("{}-timeline.toml", options.instance));
-                write_file(&file, text)?;
-                file
-            };
-            command.arg("--timeline").arg(file);
-            // Its at_tick count ticks of the file's cycle, whatever the run's.
-            command
-                .arg("--timeline-cycle-ms")
-                .arg(format!("{}", scenario.file_cycle_s * 1e3));
-        }
-        PlcSetup::Program(p, args) => {
-            command.args(["--program", p]).args(args);
-        }
-    }
-    let period = scenario.plc_period_ticks();
-    if period > 1 {
-        command.args(["--period-ticks", &period.to_string()]);
-    }
-    // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC.
-    command.args(
-        scenario
-            .realtime_plc
-            .over(&options.realtime.over(&scenario.realtime).for_plc())
-            .to_args(),
-    );
-    command
-        .stdout(Stdio::piped())
-        .stdin(Stdio::null())
-        .spawn()
-        .map(Some)
-        .map_err(|e| format!("spawning the PLC: {e}"))
-}
-
-fn write_file(path: &Path, text: &str) -> Result<(), String> {
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Why lockstep stopped waiting for the PLC.

@@ -94,3 +94,53 @@ fn the_cycle_is_set_on_the_command_line_and_checked() {
         );
     }
 }
+
+/// `--rt-wake futex`: the CNC wakes its PLC on the heartbeat's word. At a 20 ms cycle the PLC
+/// waits at most 10 ms a time: a PLC that only woke from its timeouts would wake 5 ms after
+/// a tick at the median; woken by the CNC, it wakes within its tick's compute and lateness.
+#[test]
+fn the_plc_woken_by_futex_follows_the_ticks() {
+    let scenario = tests::cli::scenario("axes-plcopen");
+    let instance = tests::unique_instance("rt-futex");
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", scenario.to_str().unwrap(), "--ticks", "60"])
+        .args([
+            "--cycle-ms",
+            "20",
+            "--instance",
+            &instance,
+            "--rt-wake",
+            "futex",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("plc: real-time wake-up by futex"),
+        "{stdout}"
+    );
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("plc: tick due to woken"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let p50: f64 = line
+        .split("p50 ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(p50 < 2_500.0, "{line}");
+    assert_eq!(plc_overruns(&stdout), 0, "{stdout}");
+}
+
+/// The overruns of the `plc: task` line.
+fn plc_overruns(report: &str) -> u64 {
+    report
+        .lines()
+        .find(|l| l.starts_with("plc: task"))
+        .and_then(|l| l.split("overruns ").nth(1))
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{report}"))
+}

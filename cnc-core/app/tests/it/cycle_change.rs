@@ -72,7 +72,7 @@ fn the_cam_program_waits_in_time_not_in_cycles() {
 fn the_plc_period_is_whole_cycles_or_refused() {
     let text = |period: &str| {
         format!(
-            "cycle_ms = 1.0\nticks = 10\n[[axis]]\nname = \"A\"\n[plc]\ntimeline = \"t.toml\"\n{period}"
+            "cycle_ms = 1.0\nticks = 10\nplc_watchdog_ticks = 50\n[[axis]]\nname = \"A\"\n[plc]\ntimeline = \"t.toml\"\n{period}"
         )
     };
     let load = |toml: &str| {
@@ -89,6 +89,7 @@ fn the_plc_period_is_whole_cycles_or_refused() {
     assert_eq!(s.plc_period_ticks(), 2);
     s.set_cycle_ms(0.5).unwrap();
     assert_eq!((s.plc_period_ticks(), s.ticks), (4, Some(20)));
+    assert_eq!(s.plc_watchdog_ticks, Some(100), "50 ms of watchdog");
     let e = s.set_cycle_ms(0.3).unwrap_err();
     assert!(
         e.contains("([plc] period_ms) does not follow it: 2 ms is not a whole number of CNC cycles of 0.3 ms"),

@@ -22,6 +22,7 @@ use hli::ImageMemory;
 use hli_transport::events::EventLink;
 use hli_transport::rpc::AcyclicServer;
 use hli_transport::segment::CncSegment;
+use plc_shim::realtime::WakePath;
 use std::process::Child;
 
 /// How long a run may go: its ticks, the stop's, the PLC watchdog.
@@ -51,10 +52,12 @@ impl Bounds {
         // Room for a stop that starts at the last tick.
         let rows = usize::try_from(limit.saturating_add(stop_limit))
             .map_err(|_| "--ticks too large".to_string())?;
+        // The default is a time: 100 ticks of 1 ms at any cycle.
+        let default = (DEFAULT_PLC_WATCHDOG_TICKS as f64 * 1e-3 / scenario.cycle_s).round() as u64;
         let watchdog = options
             .plc_watchdog_ticks
             .or(scenario.plc_watchdog_ticks)
-            .unwrap_or(DEFAULT_PLC_WATCHDOG_TICKS)
+            .unwrap_or(default)
             .max(1);
         let period = Duration::from_secs_f64(scenario.cycle_s);
         Ok(Bounds {
@@ -170,6 +173,9 @@ pub(super) struct TickLoop<'a> {
     loader: Option<Loader>,
     /// The lateness figures the header shows tools.
     gauge: LatenessGauge,
+    /// Real time with `--rt-wake futex`: "tick done" wakes the PLC on the heartbeat's low
+    /// word instead of the event.
+    wake_futex: bool,
 }
 
 impl<'a> TickLoop<'a> {
@@ -235,6 +241,19 @@ impl<'a> TickLoop<'a> {
             progress,
             loader,
             gauge: LatenessGauge::new(),
+            wake_futex: !options.lockstep
+                && options.realtime.over(&scenario.realtime).wake == Some(WakePath::Futex),
+        }
+    }
+
+    /// "Tick done" to the PLC: its event, or a wake on the heartbeat's low word.
+    fn tick_done(&self) {
+        if self.wake_futex {
+            let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_heartbeat);
+            let word = self.segment.memory().place::<u32>(at).atomic();
+            let _ = cnc_os::futex::wake(word, 1);
+        } else {
+            let _ = self.events.notify();
         }
     }
 
@@ -366,7 +385,7 @@ impl<'a> TickLoop<'a> {
             .poll_rows(|_, header, values| self.machine.dispatch_bulk(header, values))
             .unwrap_or(0) as u64;
         let t3 = monotonic::now();
-        let _ = self.events.notify();
+        self.tick_done();
         let t4 = monotonic::now();
         if let Some(stream) = self.log_stream.as_mut() {
             stream.forward(self.machine.controller().channels());
