@@ -23,6 +23,10 @@
 //! already finished more ticks than the period when the cycle started.
 
 use core::time::Duration;
+
+// The futex wake path waits on the low word of the CNC's heartbeat at the heartbeat's offset.
+#[cfg(not(target_endian = "little"))]
+compile_error!("the futex wake path assumes a little-endian machine");
 use hli::calls::CallError;
 use hli::enums::SegmentState;
 use hli::layout::HliSegmentHeader;
@@ -120,6 +124,8 @@ pub struct TaskSchedule {
     last_beat: u64,
     /// The tick at which the task is due next (None: at the next tick seen).
     due: Option<u64>,
+    /// The tick the last cycle that ran was due at.
+    slot: u64,
 }
 
 impl TaskSchedule {
@@ -129,6 +135,7 @@ impl TaskSchedule {
             period: period.max(1),
             last_beat: 0,
             due: None,
+            slot: 0,
         }
     }
 
@@ -150,7 +157,13 @@ impl TaskSchedule {
             return Some(None);
         }
         self.due = Some(beat.saturating_add(self.period));
+        self.slot = slot;
         Some(Some((beat - slot) / self.period))
+    }
+
+    /// The tick the cycle that runs now was due at (after a wake-up that runs one).
+    pub fn slot(&self) -> u64 {
+        self.slot
     }
 }
 
@@ -353,7 +366,8 @@ impl PlcRuntime {
     fn wait_for_tick(&self, seen: u64) -> Result<(), RuntimeError> {
         if self.wake == WakePath::Futex && !self.segment.cnc_timing().lockstep {
             let at = core::mem::offset_of!(HliSegmentHeader, cnc_heartbeat);
-            // The heartbeat's low word (little-endian) changes with every tick.
+            // The heartbeat's low word (at its offset on a little-endian machine, which the
+            // image's layout is) changes with every tick.
             let word = self.segment.memory().place::<u32>(at).atomic();
             cnc_os::futex::wait(word, seen as u32, self.wait_step)
                 .map_err(|e| RuntimeError::Wait(e.to_string()))?;
@@ -467,7 +481,7 @@ impl PlcRuntime {
             if let Some(missed) = step {
                 let took = cnc_os::monotonic::now().saturating_sub(woke).as_nanos() as u64;
                 wake_to_done.record(took);
-                if let Some(w) = self.wakeup(beat, woke_wall, took, missed) {
+                if let Some(w) = self.wakeup(schedule.slot(), woke_wall, took, missed) {
                     worst.record(w);
                     due_to_woken.record(w.due_to_woken_ns);
                 }
@@ -475,10 +489,10 @@ impl PlcRuntime {
         }
     }
 
-    /// The wake-up to heartbeat `beat`, woken at `woke_wall` (wall clock), its cycle done
-    /// `took` ns later, in parts, counted from the tick the cycle was due at (`missed` task
-    /// slots before `beat`); `None` in lockstep or before the CNC announced its epoch.
-    fn wakeup(&self, beat: u64, woke_wall: u64, took: u64, missed: u64) -> Option<Wakeup> {
+    /// The wake-up of the cycle due at tick `due`, woken at `woke_wall` (wall clock), its
+    /// cycle done `took` ns later, in parts (`missed` task slots late); `None` in lockstep or
+    /// before the CNC announced its epoch.
+    fn wakeup(&self, due: u64, woke_wall: u64, took: u64, missed: u64) -> Option<Wakeup> {
         let timing = self.segment.cnc_timing();
         if timing.lockstep {
             return None;
@@ -486,7 +500,6 @@ impl PlcRuntime {
         let at = core::mem::offset_of!(HliSegmentHeader, cnc_epoch_ns);
         let epoch = self.segment.memory().place::<u64>(at).load();
         let cycle = u64::from(timing.cycle_ns);
-        let due = beat.saturating_sub(missed.saturating_mul(self.period_ticks));
         Some(Wakeup {
             tick: due,
             due_to_woken_ns: crate::wakeups::due_to_woken(epoch, due, cycle, woke_wall)?,
@@ -557,5 +570,24 @@ mod schedule_tests {
             }
         }
         assert_eq!(total, 0, "a corrupted heartbeat adds no overruns");
+    }
+
+    /// The slot a cycle was due at, for the wake-ups' parts: late by less than a period it
+    /// misses nothing but is still counted from its slot.
+    #[test]
+    fn the_slot_is_the_tick_the_cycle_was_due_at() {
+        let mut s = TaskSchedule::new(4);
+        assert_eq!((s.wake(1), s.slot()), (Some(Some(0)), 1));
+        assert_eq!(
+            (s.wake(7), s.slot()),
+            (Some(Some(0)), 5),
+            "woken 2 ticks late"
+        );
+        // The next slot counts from the wake-up (7 + 4): 18 is one slot after it.
+        assert_eq!(
+            (s.wake(18), s.slot()),
+            (Some(Some(1)), 11),
+            "one slot missed"
+        );
     }
 }

@@ -103,6 +103,31 @@ fn arcs_and_a_transformation_need_the_axes_they_move() {
         refusals("G17\nG2 X10 Y0 I5 J0 F100\n", &["X", "Y"]).is_empty(),
         "G17 on X Y is fine"
     );
+    // A tool length needs the plane's normal axis (G17: Z).
+    let mut xy = channel(&["X", "Y"]);
+    xy.nc.tools = support::tools("{ d = 1, length = 50.0 }, { d = 2, length = 0.0 }");
+    let load = |src: &str| {
+        cnc_core::channel::LoadedProgram::load_with(
+            "xy",
+            src,
+            &xy.axes,
+            &xy.nc.setup(),
+            None,
+            &cnc_core::nc::interp::SearchPath::default(),
+        )
+        .map(|_| ())
+        .map_err(|e| e.to_string())
+    };
+    let e = load("G1 X1 F100\nD1\n").unwrap_err();
+    assert!(
+        e.contains(":2:1:") && e.contains("which this channel lacks"),
+        "{e}"
+    );
+    assert_eq!(
+        load("D2\nG1 X1 F100\n"),
+        Ok(()),
+        "a tool without a length is fine"
+    );
     let found = refusals("G1 X1 F100\n#TRAFO ON\n", &["X", "Y", "Z"]);
     assert!(
         found

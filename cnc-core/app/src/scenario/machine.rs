@@ -241,6 +241,8 @@ impl InProcess {
     fn plc_cycle(&mut self) {
         let tick = self.machine.ticks().saturating_sub(1);
         if !tick.is_multiple_of(self.plc_period.max(1)) {
+            // Not due: the CNC still answers the calls after every tick, as `cnc run` does.
+            self.answer_calls();
             return;
         }
         if self.program.is_some() {

@@ -34,7 +34,7 @@ mod spawn;
 mod tick_loop;
 
 /// Ticks run when neither `--ticks` nor the scenario says: until every channel is idle, at
-/// most this many.
+/// most this many of 1 ms (at another cycle, as many as last as long: 120 s).
 pub const DEFAULT_TICK_LIMIT: u64 = 120_000;
 /// How long lockstep waits for one PLC cycle before it gives up.
 const PLC_CYCLE_WATCHDOG: Duration = Duration::from_secs(10);

@@ -144,7 +144,10 @@ impl Channel {
             if self.pose.tracker.option() == TrackingOption::TranslationOnly {
                 c[3..].fill(0.0); // OPTION=1: the orientation axes keep their programmed values
             }
-            self.lacked_compensation(&mut c);
+            if !simulating {
+                // SIMU moves no axis: only a compensation the set-points take can lack one.
+                self.lacked_compensation(&mut c);
+            }
             let mut tracked = [0.0; 6];
             for (i, c) in c.iter().enumerate() {
                 tracked[i] = self.motion.programmed[i] + c;
@@ -185,8 +188,6 @@ impl Channel {
         self.pose.set_points[6..n].copy_from_slice(&self.motion.programmed[6..n]);
     }
 
-    /// The tick's diagnosis history entry, once the guard has taken the set-points (a
-    /// transition that ends when the axes land shows its new state in the tick it ends).
     /// A compensation on a pose slot the channel lacks (a 3-axis channel following a master
     /// that turns) cannot be carried out: the channel fails, naming the axis, and its axes
     /// brake; the slot stays at 0.
@@ -202,6 +203,8 @@ impl Channel {
         }
     }
 
+    /// The tick's diagnosis history entry, once the guard has taken the set-points (a
+    /// transition that ends when the axes land shows its new state in the tick it ends).
     pub(super) fn record_dyn_cs(&mut self) {
         self.pose
             .tracker

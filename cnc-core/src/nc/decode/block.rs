@@ -232,6 +232,11 @@ impl DecoderState {
             tail.push(Decoded::ToolRecord { line, d: 0 });
             self.tool_length = 0.0;
         } else if let Some(&(_, length)) = self.tools.iter().find(|(d, _)| *d == n) {
+            // Without a transformation the length goes on the plane's normal axis.
+            if length != 0.0 && !self.trafo && !self.layout.has(self.plane.axes()[2]) {
+                ctx.error(span, Form::ToolLengthNeedsAxis);
+                return;
+            }
             self.tool_length = length;
             tail.push(Decoded::ToolRecord { line, d: n });
         } else if self.tools_unknown {

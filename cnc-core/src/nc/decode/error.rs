@@ -170,6 +170,8 @@ pub enum Form {
     ArcNeedsMainAxes,
     /// `#TRAFO ON` in a channel that lacks a pose axis.
     TrafoNeedsPoseAxes,
+    /// A tool length in a channel that lacks the plane's normal axis.
+    ToolLengthNeedsAxis,
     /// An option of an independent axis it does not take.
     IndependentOption,
     /// An independent axis without INDP_ASYN / INDP_SYN.
@@ -204,6 +206,7 @@ impl Form {
             Form::DwellTimeTwice => "G04: give the time once (bare or with the first axis)",
             Form::DwellNoTime => "G04 needs a time in seconds: G04 2.5",
             Form::ArcNeedsMainAxes => "G2/G3 needs both axes of its plane (X Y under G17, Z X under G18, Y Z under G19)",
+            Form::ToolLengthNeedsAxis => "D: a tool length goes on the plane's normal axis (Z under G17, Y under G18, X under G19), which this channel lacks",
             Form::TrafoNeedsPoseAxes => "#TRAFO ON needs the six pose axes X Y Z A B C; this channel lacks some",
             Form::IndependentOption => "independent axis: expected INDP_ASYN, INDP_SYN, POS=.., G0, G1, G90, G91 or F..",
             Form::IndependentMode => "independent axis: expected INDP_ASYN or INDP_SYN",

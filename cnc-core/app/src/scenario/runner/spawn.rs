@@ -48,13 +48,12 @@ pub(super) fn spawn_plc(
     if cycles != default {
         command.args(["--watchdog-cycles", &cycles.to_string()]);
     }
-    // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC.
-    command.args(
-        scenario
-            .realtime_plc
-            .over(&options.realtime.over(&scenario.realtime).for_plc())
-            .to_args(),
-    );
+    // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC; the
+    // wake path is always the CNC's (both ends must use the same).
+    let cnc = options.realtime.over(&scenario.realtime);
+    let mut plc = scenario.realtime_plc.over(&cnc.for_plc());
+    plc.wake = cnc.wake;
+    command.args(plc.to_args());
     command
         .stdout(Stdio::piped())
         .stdin(Stdio::null())

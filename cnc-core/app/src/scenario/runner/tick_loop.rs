@@ -44,10 +44,11 @@ pub(super) struct Bounds {
 impl Bounds {
     /// The bounds of `scenario` run with `options`; `Err` when the ticks do not fit.
     pub(super) fn of(scenario: &Scenario, options: &RunOptions) -> Result<Bounds, String> {
+        // The default is a time: as many ticks as DEFAULT_TICK_LIMIT of 1 ms last.
         let limit = options
             .ticks
             .or(scenario.ticks)
-            .unwrap_or(DEFAULT_TICK_LIMIT);
+            .unwrap_or((DEFAULT_TICK_LIMIT as f64 * 1e-3 / scenario.cycle_s).round() as u64);
         let stop_limit = (STOP_LIMIT_S / scenario.cycle_s) as u64;
         // Room for a stop that starts at the last tick.
         let rows = usize::try_from(limit.saturating_add(stop_limit))
