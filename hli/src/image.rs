@@ -71,6 +71,18 @@ pub fn initial_header(
     }
 }
 
+/// The word the PLC sleeps on for a tick with `--rt-wake futex`, and the CNC wakes: the low
+/// 32 bits of the CNC's heartbeat (changed by every tick), in the image at the heartbeat's own
+/// offset on a little-endian machine.
+pub fn cnc_heartbeat_word(memory: &ImageMemory) -> &core::sync::atomic::AtomicU32 {
+    memory
+        .place::<u32>(core::mem::offset_of!(HliSegmentHeader, cnc_heartbeat))
+        .atomic()
+}
+
+#[cfg(not(target_endian = "little"))]
+compile_error!("the heartbeat's low word is at its offset on a little-endian machine only");
+
 /// A heap-backed image with a valid header, for in-process mode and unit tests.
 pub fn heap_image(channels: u32, axes: u32) -> ImageMemory {
     let memory = ImageMemory::heap(IMAGE_SIZE);

@@ -24,9 +24,6 @@
 
 use core::time::Duration;
 
-// The futex wake path waits on the low word of the CNC's heartbeat at the heartbeat's offset.
-#[cfg(not(target_endian = "little"))]
-compile_error!("the futex wake path assumes a little-endian machine");
 use hli::calls::CallError;
 use hli::enums::SegmentState;
 use hli::layout::HliSegmentHeader;
@@ -365,10 +362,7 @@ impl PlcRuntime {
     /// event, or on the low word of its heartbeat (`WakePath::Futex`, in real time).
     fn wait_for_tick(&self, seen: u64) -> Result<(), RuntimeError> {
         if self.wake == WakePath::Futex && !self.segment.cnc_timing().lockstep {
-            let at = core::mem::offset_of!(HliSegmentHeader, cnc_heartbeat);
-            // The heartbeat's low word (at its offset on a little-endian machine, which the
-            // image's layout is) changes with every tick.
-            let word = self.segment.memory().place::<u32>(at).atomic();
+            let word = hli::image::cnc_heartbeat_word(self.segment.memory());
             cnc_os::futex::wait(word, seen as u32, self.wait_step)
                 .map_err(|e| RuntimeError::Wait(e.to_string()))?;
             // The CNC's events still arrive (lockstep keeps them): taken without waiting.
@@ -403,39 +397,29 @@ impl PlcRuntime {
             self.segment.cnc_heartbeat(),
             cnc_os::monotonic::now(),
         );
-        let mut stats = CycleStats::default();
-        let mut wake_to_done = CycleStats::default();
-        let mut worst = WorstWakeups::default();
-        let mut due_to_woken = CycleStats::default();
-        let end = |end, stats: CycleStats, wake_to_done: CycleStats, worst, due_to_woken| {
-            Ok(RunSummary {
-                end,
-                stats,
-                wake_to_done,
-                worst,
-                due_to_woken,
-            })
+        // What the run measures, its end set when it ends.
+        let mut run = RunSummary {
+            end: RunEnd::CycleLimit,
+            stats: CycleStats::default(),
+            wake_to_done: CycleStats::default(),
+            worst: WorstWakeups::default(),
+            due_to_woken: CycleStats::default(),
         };
+        let end = |end, run: RunSummary| Ok(RunSummary { end, ..run });
         let mut schedule = TaskSchedule::new(self.period_ticks);
         let mut wakeups = 0u64;
         // The heartbeat the loop saw last (0: none yet, so a tick done before it counts).
         let mut seen = 0u64;
         loop {
-            if max_cycles.is_some_and(|max| stats.cycles >= max) {
-                return end(RunEnd::CycleLimit, stats, wake_to_done, worst, due_to_woken);
+            if max_cycles.is_some_and(|max| run.stats.cycles >= max) {
+                return end(RunEnd::CycleLimit, run);
             }
             // Asking for a signal takes a lock inside iceoryx2: every 64th wake-up, outside
             // the program's cycle (as the CNC's tick loop does).
             wakeups += 1;
             if wakeups.is_multiple_of(64) {
                 if let Some(signal) = hli_transport::signals::take() {
-                    return end(
-                        RunEnd::Signal(signal),
-                        stats,
-                        wake_to_done,
-                        worst,
-                        due_to_woken,
-                    );
+                    return end(RunEnd::Signal(signal), run);
                 }
             }
             self.wait_for_tick(seen)?;
@@ -445,45 +429,39 @@ impl PlcRuntime {
             seen = beat;
             if let Some(ended) = self.supervise(&mut watch, beat) {
                 if matches!(ended, RunEnd::CncLost(_) | RunEnd::SegmentCorrupt(_)) {
-                    self.last_cycle(program, &mut stats);
+                    self.last_cycle(program, &mut run.stats);
                 }
-                return end(ended, stats, wake_to_done, worst, due_to_woken);
+                return end(ended, run);
             }
             let Some(step) = schedule.wake(beat) else {
                 continue; // woken without a new tick (timeout): no cycle
             };
             if let Some(missed) = step {
-                stats.overruns = stats.overruns.saturating_add(missed);
+                run.stats.overruns = run.stats.overruns.saturating_add(missed);
                 let mut io = PlcIo {
                     view: PlcView::new(self.segment.memory()),
                     memory: self.segment.memory(),
                     acyclic: &mut self.acyclic,
-                    cycle: stats.cycles,
+                    cycle: run.stats.cycles,
                     link: Link::Operational,
                 };
                 let start = cnc_os::monotonic::now();
                 program.cycle(&mut io);
                 let took = cnc_os::monotonic::now().saturating_sub(start);
-                stats.record(took.as_nanos() as u64);
+                run.stats.record(took.as_nanos() as u64);
                 if program.halted() {
                     // No heartbeat for this tick: the CNC stops as for a lost PLC.
-                    return end(
-                        RunEnd::ProgramHalted,
-                        stats,
-                        wake_to_done,
-                        worst,
-                        due_to_woken,
-                    );
+                    return end(RunEnd::ProgramHalted, run);
                 }
             }
             self.segment.beat();
             self.events.notify()?;
             if let Some(missed) = step {
                 let took = cnc_os::monotonic::now().saturating_sub(woke).as_nanos() as u64;
-                wake_to_done.record(took);
+                run.wake_to_done.record(took);
                 if let Some(w) = self.wakeup(schedule.slot(), woke_wall, took, missed) {
-                    worst.record(w);
-                    due_to_woken.record(w.due_to_woken_ns);
+                    run.worst.record(w);
+                    run.due_to_woken.record(w.due_to_woken_ns);
                 }
             }
         }

@@ -34,7 +34,7 @@ use crate::axis::config::AxisConfig;
 use crate::axis::set::AxisSetError;
 use crate::axis::AxisSet;
 use crate::channel::plc_io::Violations;
-use crate::channel::{diag_wire, Channel, Controller, ControllerError, RunState};
+use crate::channel::{diag_wire, Channel, ChannelConfig, Controller, ControllerError, RunState};
 use hli::access::Leaf;
 use hli::calls::axis::{AxisCommandCall, AxisCommandReply};
 use hli::calls::{decode_body, reply, AcyclicCall, CallKind, ErrorCode, HandlerResult};
@@ -87,6 +87,26 @@ pub enum MachineError {
     },
 }
 
+/// Channel by channel, each channel's axes take the next axis images (a channel with
+/// `axis_images = false` none): refused for the first channel whose axes do not fit.
+pub fn check_channel_images<'a>(
+    configs: impl IntoIterator<Item = &'a ChannelConfig>,
+) -> Result<(), MachineError> {
+    let mut first = 0;
+    for c in configs.into_iter().filter(|c| c.axis_images) {
+        let count = c.axes.len();
+        if first + count > HLI_MAX_AXES {
+            return Err(MachineError::ChannelAxesDoNotFit {
+                channel: c.name.clone(),
+                first,
+                count,
+            });
+        }
+        first += count;
+    }
+    Ok(())
+}
+
 /// What a machine is built from.
 #[derive(Debug)]
 pub struct MachineSetup {
@@ -131,6 +151,7 @@ impl Machine {
             engines,
             cycle_s,
         } = setup;
+        check_channel_images(channels.iter().map(Channel::config))?;
         let mut configs = Vec::new();
         let mut links = Vec::with_capacity(channels.len());
         for channel in &channels {
@@ -140,13 +161,6 @@ impl Machine {
                 false => &[],
             };
             let n = slots.len();
-            if configs.len() + n > HLI_MAX_AXES {
-                return Err(MachineError::ChannelAxesDoNotFit {
-                    channel: config.name.clone(),
-                    first: configs.len(),
-                    count: n,
-                });
-            }
             links.push(ChannelAxes::new(
                 configs.len(),
                 slots,

@@ -231,26 +231,6 @@ impl AxisFile {
     }
 }
 
-/// The first channel whose axes do not fit into the image behind the channels before it.
-pub fn check_channel_images(channels: &[ChannelConfig]) -> Result<(), String> {
-    let mut first = 0;
-    for c in channels.iter().filter(|c| c.axis_images) {
-        let n = c.axes.len();
-        if first + n > hli::layout::HLI_MAX_AXES {
-            return Err(format!(
-                "channel {}: axes: its {n} axes would take axis images {} to {}, the image \
-                 holds {}",
-                c.name,
-                first + 1,
-                first + n,
-                hli::layout::HLI_MAX_AXES
-            ));
-        }
-        first += n;
-    }
-    Ok(())
-}
-
 /// Every axis name of the machine in axis-set order: channel axes `CHANNEL.AXIS`, then the
 /// single axes.
 pub fn axis_names(channels: &[ChannelConfig], single: &[ScenarioAxis]) -> Vec<String> {

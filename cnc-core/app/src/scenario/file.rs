@@ -219,7 +219,8 @@ impl Scenario {
                 "a scenario without channels needs `ticks` (no program says when it ends)".into(),
             ));
         }
-        super::axes::check_channel_images(&file.channel).map_err(&invalid)?;
+        cnc_core::machine::check_channel_images(&file.channel)
+            .map_err(|e| invalid(e.to_string()))?;
         let channel_axes = super::axes::axis_names(&file.channel, &[]).len();
         let axes = super::axes::axes(&file.axis, channel_axes as u32 + 1).map_err(&invalid)?;
         if channel_axes + axes.len() > hli::layout::HLI_MAX_AXES {
@@ -338,16 +339,16 @@ impl Scenario {
         plc_period_ticks(self.plc_period_ms, cycle_ms).map_err(|e| {
             format!("the PLC task's period ([plc] period_ms) does not follow it: {e}")
         })?;
-        let ratio = self.file_cycle_s / (cycle_ms * 1e-3);
-        let file_ticks = self
-            .ticks
-            .map(|t| (t as f64 * self.cycle_s / self.file_cycle_s).round());
-        self.ticks = file_ticks.map(|t| (t * ratio).round().max(1.0) as u64);
-        let file_watchdog = self
-            .plc_watchdog_ticks
-            .map(|t| (t as f64 * self.cycle_s / self.file_cycle_s).round());
-        self.plc_watchdog_ticks = file_watchdog.map(|t| (t * ratio).round().max(1.0) as u64);
-        self.cycle_s = cycle_ms * 1e-3;
+        // Ticks of the run's cycle back to the file's, then to the new cycle's.
+        let (file, now, new) = (self.file_cycle_s, self.cycle_s, cycle_ms * 1e-3);
+        let rescale = |t: u64| {
+            ((t as f64 * now / file).round() * file / new)
+                .round()
+                .max(1.0) as u64
+        };
+        self.ticks = self.ticks.map(rescale);
+        self.plc_watchdog_ticks = self.plc_watchdog_ticks.map(rescale);
+        self.cycle_s = new;
         Ok(())
     }
 }

@@ -250,9 +250,7 @@ impl<'a> TickLoop<'a> {
     /// "Tick done" to the PLC: its event, or a wake on the heartbeat's low word.
     fn tick_done(&self) {
         if self.wake_futex {
-            let at = core::mem::offset_of!(hli::layout::HliSegmentHeader, cnc_heartbeat);
-            let word = self.segment.memory().place::<u32>(at).atomic();
-            let _ = cnc_os::futex::wake(word, 1);
+            let _ = cnc_os::futex::wake(hli::image::cnc_heartbeat_word(self.segment.memory()), 1);
         } else {
             let _ = self.events.notify();
         }
