@@ -251,7 +251,77 @@ fn robot() {
     println!("  (the bound covers the square's 420 mm only: a floor for the whole program)");
 }
 
+/// The issue's limits: 200 mm/s, 2000 mm/s², 40000 mm/s³ (`jerk` to switch it off).
+fn cam_config(jerk: f64, start: [f64; 2]) -> ChannelConfig {
+    let mut config = ChannelConfig::new("c", &["X", "Y", "Z", "A", "B", "C"]);
+    config.limits.velocity = 200.0;
+    config.limits.acceleration = 2000.0;
+    config.limits.jerk = jerk;
+    config.start = vec![start[0], start[1], 0.0, 0.0, 0.0, 0.0];
+    config
+}
+
+/// Blocks through `points` (from the second on).
+fn blocks_through(points: &[[f64; 3]]) -> String {
+    points[1..]
+        .iter()
+        .map(|p| format!("X{:.6} Y{:.6}\n", p[0], p[1]))
+        .collect()
+}
+
+/// One CAM-like program at exact stop and continuous path, with the jerk on and off.
+fn cam_program(what: &str, points: &[[f64; 3]]) -> [(f64, f64); 2] {
+    let blocks = blocks_through(points);
+    let length: f64 = points
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    println!(
+        "{what}: {} blocks, {length:.1} mm, F6000, PATH_DEV 0.02 mm",
+        points.len() - 1
+    );
+    let mut out = [(0.0, 0.0); 2];
+    for (k, jerk) in [40_000.0, 1e8].into_iter().enumerate() {
+        let config = cam_config(jerk, [points[0][0], points[0][1]]);
+        let exact = run(&config, &format!("G1 F6000\n{blocks}M30\n"));
+        let cont = run(
+            &config,
+            &format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261 G1 F6000\n{blocks}M30\n"),
+        );
+        let mut near = 0;
+        let deviation = cont
+            .iter()
+            .map(|p| distance_to_polyline(p, points, &mut near))
+            .fold(0.0, f64::max);
+        let (te, tc) = (exact.len() as f64 * CYCLE, cont.len() as f64 * CYCLE);
+        println!(
+            "  jerk {jerk:>9}: exact stop {te:7.3} s, continuous {tc:7.3} s = {:.2}x length/feed, \
+             {:.2}x exact stop; deviation {deviation:.4} mm",
+            tc / (length / 100.0),
+            tc / te
+        );
+        out[k] = (te, tc);
+    }
+    out
+}
+
+fn cam_like() {
+    let n = if smoke() { 30 } else { 300 };
+    let gon: Vec<[f64; 3]> = (0..=n)
+        .map(|k| {
+            let phi = std::f64::consts::TAU * k as f64 / n as f64;
+            [50.0 * phi.cos(), 50.0 * phi.sin(), 0.0]
+        })
+        .collect();
+    cam_program(&format!("{n}-gon of radius 50 mm"), &gon);
+    let zig: Vec<[f64; 3]> = (0..=60)
+        .map(|k| [2.0 * k as f64, if k % 2 == 0 { 0.0 } else { 2.0 }, 0.0])
+        .collect();
+    cam_program("zigzag of 90-degree turns", &zig);
+}
+
 fn main() {
+    cam_like();
     polyline();
     robot();
 }

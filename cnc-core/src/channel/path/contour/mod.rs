@@ -2,26 +2,35 @@
 //! rounded within a tolerance, over a look-ahead of decoded blocks.
 //!
 //! The window holds [`Piece`]s: the straight parts of the blocks and the curves between them
-//! ([`piece`]). A jerk-limited profile runs the path parameter over one piece at a time from
-//! the velocity at its start to the velocity planned for its end ([`profile`]); the next
-//! piece takes over the rest of the tick, so the velocity has no dip at a boundary.
+//! ([`piece`], [`corner`]). Consecutive pieces with similar caps and dynamics form a unit
+//! ([`plan`]): a jerk-limited profile ([`profile`]) runs the path parameter over a run of
+//! pieces, from the velocity at the run's start to the one planned for the end of its unit,
+//! the acceleration carried through the pieces' boundaries; the next run takes over the rest
+//! of the tick, so the velocity has no dip at a boundary.
 //!
-//! Planning, at two moments:
+//! Planning, at three moments:
 //! * when a block comes in, a backward sweep bounds the velocity at every piece's end so that
 //!   the path can always come to rest at the end of what it has seen (`bound_hard` with the
-//!   axes' caps, `bound_soft` also with the feed and the override); the sweep stops where the
-//!   bounds no longer change;
-//! * when a piece starts, its end velocity is the highest its own length allows from its
-//!   start velocity within `bound_soft`, at least the lowest that braking over it can reach,
-//!   and at most `bound_hard` (which braking over it always reaches).
+//!   axes' caps, `bound_soft` also with the feed and the override), one velocity change per
+//!   unit; the sweep stops at a unit before the new pieces whose bounds did not change;
+//! * when a run starts, its end velocity is the highest its length allows from its start
+//!   velocity within `bound_soft`, at least the lowest that braking over it can reach, and at
+//!   most `bound_hard` (which braking over it always reaches);
+//! * on the way, where the profile has no acceleration (its cruise, its peak), after new
+//!   blocks or new factors: the run is planned again to the end of its unit as it now is, so
+//!   a run that began before the window reached further is not braked for the end it saw
+//!   then. A plan that does not fit, or ends above the hard bound, keeps the one under way.
 //!
 //! Feed hold and a stop make every soft bound 0: the pieces ahead brake as hard as their
-//! limits let them, and the piece under way brakes within itself where its rest of length
-//! allows. The override changes the soft bounds; the piece under way takes a new cruise
-//! velocity once it cruises.
+//! limits let them, and the run under way brakes within itself where its rest of length
+//! allows. The override changes the soft bounds; the run under way takes them at its next
+//! point without acceleration.
 
+mod corner;
 mod piece;
+mod plan;
 mod profile;
+mod shape;
 #[cfg(test)]
 mod tests;
 
@@ -31,7 +40,8 @@ pub use profile::{Dynamics, PathState};
 use super::AxisLimits;
 use crate::axis::generator::{Progress, SetpointGenerator};
 use crate::setpoint::AxisValues;
-use profile::{max_reach, min_reach, PieceProfile};
+use plan::feasible_end;
+use profile::PieceProfile;
 use std::collections::VecDeque;
 
 /// Most blocks a look-ahead may hold.
@@ -110,8 +120,13 @@ pub struct Contour {
     brake: SetpointGenerator,
     /// Override factors in effect (feed, rapid); (0, 0) under hold or stop.
     factors: (f64, f64),
-    /// The cruise of the piece under way is to be re-planned for new factors.
-    retarget: bool,
+    /// The run under way is to be planned again at its next point without acceleration (new
+    /// blocks, new factors).
+    replan: bool,
+    /// Pieces the run under way covers (from the front), and its length from the profile's
+    /// start.
+    run_pieces: usize,
+    run_rest: f64,
     /// No more blocks will come: the window's end is the program's.
     closed: bool,
     /// A stop: at rest, the window is emptied.
@@ -143,7 +158,9 @@ impl Contour {
             state: PathState::default(),
             brake: SetpointGenerator::new(cycle_s, 0.0),
             factors: (1.0, 1.0),
-            retarget: false,
+            replan: false,
+            run_pieces: 0,
+            run_rest: 0.0,
             closed: false,
             stopping: false,
             last_end: None,
@@ -168,7 +185,12 @@ impl Contour {
 
     /// No more blocks join this run: the path comes to rest at the end of the last one.
     pub fn close(&mut self) {
-        self.closed = true;
+        if !self.closed {
+            self.closed = true;
+            // The window's last piece may now join its unit.
+            self.sweep_back();
+            self.replan = true;
+        }
     }
 
     /// The source line of the piece under way.
@@ -219,126 +241,9 @@ impl Contour {
         }
         self.blocks += 1;
         self.last_end = Some((segment.end, dir));
-        self.sweep_back(self.pieces.len() - 1);
+        self.sweep_back();
+        self.replan = true;
         Ok(())
-    }
-
-    /// Rounds the corner into `segment` when it may be: shortens the last straight piece,
-    /// adds the curve and the block's straight piece. `false` (nothing changed) when not.
-    fn round_corner(
-        &mut self,
-        segment: &Segment,
-        u2: &AxisValues,
-        length: f64,
-        limit: &mut dyn FnMut(&mut Piece),
-    ) -> bool {
-        let (Some(tolerance), Some((end, u1))) = (segment.blend, self.last_end) else {
-            return false;
-        };
-        let n = self.pieces.len();
-        let under_way = !matches!(self.mode, Mode::Idle);
-        let Some(last) = self.pieces.back().copied() else {
-            return false;
-        };
-        if (n == 1 && under_way) || last.half > 0.0 || tolerance <= 0.0 {
-            return false;
-        }
-        let joined = end
-            .iter()
-            .zip(segment.start.iter())
-            .all(|(a, b)| (a - b).abs() <= 1e-9);
-        let cos = (0..3).map(|i| u1[i] * u2[i]).sum::<f64>().clamp(-1.0, 1.0);
-        let turn = cos.acos();
-        if !joined || turn > MAX_TURN_DEG.to_radians() {
-            return false;
-        }
-        let sin_half = (0.5 * turn).sin();
-        let by_tolerance = if sin_half > 1e-12 {
-            3.0 * tolerance / sin_half
-        } else {
-            f64::INFINITY
-        };
-        let d = by_tolerance
-            .min(0.5 * last.block_length)
-            .min(last.length)
-            .min(0.5 * length);
-        if d <= 1e-9 {
-            return false;
-        }
-        let saved = last;
-        let committed = self.v_end;
-        let corner = segment.start;
-        let back = self.pieces.back_mut().expect("checked");
-        back.length -= d;
-        back.rest_after = false;
-        let mut curve = Piece::curve(&corner, &u1, u2, d, &self.limits);
-        tag(&mut curve, segment);
-        curve.feed = curve.feed.min(saved.feed);
-        curve.line = saved.line;
-        curve.rapid = saved.rapid && segment.rapid;
-        let mut origin = corner;
-        for i in 0..origin.len() {
-            origin[i] += d * u2[i];
-        }
-        let mut straight = Piece::straight(origin, *u2, length - d, length, &self.limits);
-        tag(&mut straight, segment);
-        limit(&mut curve);
-        limit(&mut straight);
-        self.pieces.push_back(curve);
-        self.pieces.push_back(straight);
-        self.sweep_back(self.pieces.len() - 1);
-        // The piece under way must still reach its committed end velocity's bound.
-        let front_ok = !under_way || self.pieces[0].bound_hard >= committed - 1e-9;
-        if !front_ok {
-            self.pieces.pop_back();
-            self.pieces.pop_back();
-            *self.pieces.back_mut().expect("kept") = saved;
-            self.sweep_back(self.pieces.len() - 1);
-            return false;
-        }
-        true
-    }
-
-    /// Recomputes the look-ahead bounds from piece `from` back to the piece under way,
-    /// stopping where they no longer change.
-    fn sweep_back(&mut self, from: usize) {
-        let (ff, rf) = self.factors;
-        let mut next: Option<Next> = None;
-        for k in (0..=from.min(self.pieces.len().saturating_sub(1))).rev() {
-            let (hard, soft) = match next {
-                None => (0.0, 0.0),
-                Some(_) if self.pieces[k].rest_after => (0.0, 0.0),
-                Some(Next {
-                    hard: nh,
-                    soft: ns,
-                    length: len,
-                    caps: (next_hard, next_soft),
-                    dynamics,
-                }) => {
-                    let p = &self.pieces[k];
-                    let cap_hard = p.hard_cap.min(next_hard);
-                    let cap_soft = p.soft_cap(ff, rf).min(next_soft).min(cap_hard);
-                    (
-                        max_reach(nh, len, cap_hard, dynamics),
-                        max_reach(ns, len, cap_soft, dynamics).min(cap_soft),
-                    )
-                }
-            };
-            let p = &mut self.pieces[k];
-            let unchanged = p.bound_hard == hard && p.bound_soft == soft;
-            p.bound_hard = hard;
-            p.bound_soft = soft;
-            if unchanged && k < from {
-                break;
-            }
-            next = Some(Next {
-                hard,
-                soft,
-                length: p.length,
-                caps: (p.hard_cap, p.soft_cap(ff, rf)),
-                dynamics: p.dynamics,
-            });
-        }
     }
 
     /// Feed and rapid override factors (0 for feed hold or a stop): new soft bounds, and the
@@ -365,13 +270,12 @@ impl Contour {
             for p in self.pieces.iter_mut() {
                 p.bound_soft = f64::NAN;
             }
-            self.sweep_back(self.pieces.len() - 1);
+            self.sweep_back();
         }
         if holding {
             self.brake_within();
-        } else {
-            self.retarget = true;
         }
+        self.replan = true;
     }
 
     /// A controlled stop: the path brakes as for feed hold and the window is emptied at rest.
@@ -381,14 +285,12 @@ impl Contour {
         self.stopping = true;
     }
 
-    /// Brakes the piece under way within its rest of length, when that fits.
+    /// Brakes the run under way within its rest of length, when that fits.
     fn brake_within(&mut self) {
-        let Some(p) = self.pieces.front() else {
-            return;
-        };
-        if !matches!(self.mode, Mode::Profile) {
+        if self.pieces.is_empty() || !matches!(self.mode, Mode::Profile) {
             return;
         }
+        let unit = self.unit(0, self.run_pieces.max(1) - 1);
         let s = self.state;
         self.brake.resume_from(crate::setpoint::Kinematic {
             position: s.position,
@@ -396,9 +298,14 @@ impl Contour {
             acceleration: s.acceleration,
             jerk: 0.0,
         });
-        let d = p.dynamics;
-        if self.brake.brake(d.acceleration, d.jerk).is_ok() && self.brake.end_position() <= p.length
+        let d = unit.dynamics;
+        let run_end = self.offset + self.run_rest;
+        if self.brake.brake(d.acceleration, d.jerk).is_ok() && self.brake.end_position() <= run_end
         {
+            // The generator's positions are the front piece's; `offset` follows the pieces
+            // passed.
+            self.offset = 0.0;
+            self.v_end = 0.0;
             self.mode = Mode::Braking;
         }
     }
@@ -416,20 +323,22 @@ impl Contour {
             return Ok(false);
         }
         if matches!(self.mode, Mode::Idle) {
-            self.start_piece(0.0, 0.0)?;
+            self.start_run(0.0, 0.0)?;
         }
         match self.mode {
             Mode::Profile => self.advance_profile()?,
             Mode::Braking => {
-                if matches!(self.brake.step(), Progress::Reached | Progress::Idle) {
-                    self.mode = Mode::Resting;
-                }
+                let done = matches!(self.brake.step(), Progress::Reached | Progress::Idle);
                 let k = self.brake.state();
                 self.state = PathState {
-                    position: k.position,
+                    position: k.position + self.offset,
                     velocity: k.velocity,
                     acceleration: k.acceleration,
                 };
+                self.pass_boundaries();
+                if done {
+                    self.rest_here();
+                }
             }
             Mode::Resting => self.resume()?,
             Mode::Idle => {}
@@ -476,26 +385,22 @@ impl Contour {
         self.state = PathState::default();
         self.v_end = 0.0;
         self.factors = (1.0, 1.0);
+        self.replan = false;
+        self.run_pieces = 0;
+        self.run_rest = 0.0;
     }
 
-    /// Plans the front piece from `offset` on it at velocity `v0`.
-    fn start_piece(&mut self, offset: f64, v0: f64) -> Result<(), ContourError> {
-        let (ff, rf) = self.factors;
-        let p = self.pieces.front().expect("a piece");
-        let rest = (p.length - offset).max(0.0);
-        let v1 = if rest <= 1e-12 {
-            v0
-        } else {
-            feasible_end(v0, rest, p)
-        };
-        let cap = p.soft_cap(ff, rf);
-        self.profile =
-            PieceProfile::plan(rest, v0, v1, cap, p.dynamics).ok_or(ContourError::NoProfile)?;
-        self.offset = offset;
+    /// Plans the run from `offset` on the front piece at velocity `v0` (acceleration 0) to the
+    /// end of the front piece's unit; a single piece when the unit's plan does not fit.
+    fn start_run(&mut self, offset: f64, v0: f64) -> Result<(), ContourError> {
+        let end = self.unit_end(0);
+        let planned = self
+            .plan_run(offset, v0, end)
+            .or_else(|| (end > 0).then(|| self.plan_run(offset, v0, 0)).flatten());
+        let (profile, v1, pieces, rest) = planned.ok_or(ContourError::NoProfile)?;
+        self.adopt(profile, v1, pieces, rest, offset);
         self.t = 0.0;
-        self.v_end = v1;
         self.mode = Mode::Profile;
-        self.retarget = false;
         self.state = PathState {
             position: offset,
             velocity: v0,
@@ -504,12 +409,43 @@ impl Contour {
         Ok(())
     }
 
-    /// Advances along the profile by one tick, into the next pieces as far as the tick goes.
+    /// The profile from `offset` on the front piece at `v0` to the end of piece `end`, its end
+    /// velocity, the pieces it covers and its length.
+    fn plan_run(
+        &self,
+        offset: f64,
+        v0: f64,
+        end: usize,
+    ) -> Option<(PieceProfile, f64, usize, f64)> {
+        let unit = self.unit(0, end);
+        let last = &self.pieces[end];
+        let rest = (unit.length - offset).max(0.0);
+        let d = unit.dynamics;
+        let v1 = if rest <= 1e-12 {
+            v0
+        } else {
+            feasible_end(v0, rest, d, last.bound_soft, last.bound_hard)
+        };
+        let profile = PieceProfile::plan(rest, v0, v1, unit.cap_soft, d)?;
+        Some((profile, v1, end + 1, rest))
+    }
+
+    fn adopt(&mut self, profile: PieceProfile, v1: f64, pieces: usize, rest: f64, offset: f64) {
+        self.profile = profile;
+        self.v_end = v1;
+        self.run_pieces = pieces;
+        self.run_rest = rest;
+        self.offset = offset;
+        self.replan = false;
+    }
+
+    /// Advances along the profile by one tick, into the next runs as far as the tick goes.
     fn advance_profile(&mut self) -> Result<(), ContourError> {
+        let before = self.t;
         self.t += self.cycle_s;
         loop {
-            if self.retarget && self.profile.cruising(self.t) {
-                self.replan_cruise();
+            if self.replan {
+                self.replan_on_the_way(before);
             }
             let duration = self.profile.duration();
             if self.t <= duration {
@@ -518,27 +454,35 @@ impl Contour {
                     position: self.offset + s.position,
                     ..s
                 };
+                self.pass_boundaries();
                 return Ok(());
             }
             let v0 = self.v_end;
             let leftover = self.t - duration;
-            let length = self.pieces.front().map_or(0.0, |p| p.length);
-            if self.offset + self.profile.reach() < length - 1e-9 {
-                // Braked to rest short of the piece's end (feed hold, stop).
+            if self.profile.reach() < self.run_rest - 1e-9 {
+                // Braked to rest short of the run's end (feed hold, stop).
                 self.state = PathState {
                     position: self.offset + self.profile.reach(),
                     velocity: 0.0,
                     acceleration: 0.0,
                 };
-                self.mode = Mode::Resting;
+                self.pass_boundaries();
+                self.rest_here();
                 return Ok(());
             }
-            self.finish_front();
+            for _ in 0..self.run_pieces.max(1) {
+                self.pop_piece();
+            }
+            self.state = PathState::default();
+            if self.pieces.is_empty() {
+                self.mode = Mode::Idle;
+                self.blocks = 0;
+            }
             if v0 <= 1e-12 {
-                // At rest at a piece's end: an exact stop, the window's end, or feed hold.
-                // The next piece starts on a later tick.
+                // At rest at a run's end: an exact stop, the window's end, or feed hold.
+                // The next run starts on a later tick.
                 if !self.pieces.is_empty() {
-                    self.mode = Mode::Resting;
+                    self.rest_here();
                 }
                 return Ok(());
             }
@@ -546,13 +490,36 @@ impl Contour {
                 // Moving at the window's end cannot happen (its bound is 0).
                 return Err(ContourError::NoProfile);
             }
-            self.start_piece(0.0, v0)?;
+            self.start_run(0.0, v0)?;
             self.t = leftover;
         }
     }
 
+    /// At rest on the front piece: nothing beyond it is committed.
+    fn rest_here(&mut self) {
+        self.mode = Mode::Resting;
+        self.run_pieces = 1;
+        self.v_end = 0.0;
+    }
+
+    /// Moves the pieces the path has passed within the run out of the window.
+    fn pass_boundaries(&mut self) {
+        while self.run_pieces > 1 {
+            let Some(length) = self.pieces.front().map(|p| p.length) else {
+                return;
+            };
+            if self.state.position <= length {
+                return;
+            }
+            self.pop_piece();
+            self.offset -= length;
+            self.state.position -= length;
+            self.run_pieces -= 1;
+        }
+    }
+
     /// The front piece is done; at the end of the window, where the path stands is kept.
-    fn finish_front(&mut self) {
+    fn pop_piece(&mut self) {
         if let Some(p) = self.pieces.pop_front() {
             if p.half == 0.0 {
                 self.blocks = self.blocks.saturating_sub(1);
@@ -566,28 +533,31 @@ impl Contour {
                 }
             }
         }
-        self.state = PathState::default();
-        if self.pieces.is_empty() {
-            self.mode = Mode::Idle;
-            self.blocks = 0;
-        }
     }
 
-    /// New override factors during a cruise: the rest of the piece is planned again from the
-    /// cruise to the committed end velocity with the new cap.
-    fn replan_cruise(&mut self) {
-        self.retarget = false;
-        let (ff, rf) = self.factors;
-        let p = self.pieces.front().expect("a piece");
-        let s = self.profile.at(self.t);
+    /// New blocks or factors: the run is planned again where the profile has no acceleration
+    /// (on its cruise, or at its peak or the cruise's end passed during this tick), from
+    /// there to the end of the front's unit as it now is. A plan that does not fit keeps the
+    /// one under way (its bounds still hold).
+    fn replan_on_the_way(&mut self, before: f64) {
+        let (start, end) = self.profile.cruise();
+        let at = if self.t >= start && self.t <= end {
+            self.t
+        } else if before < end && end <= self.t {
+            end
+        } else {
+            return;
+        };
+        self.replan = false;
+        let s = self.profile.at(at);
         let here = self.offset + s.position;
-        let rest = p.length - here;
-        if let Some(profile) =
-            PieceProfile::plan(rest, s.velocity, self.v_end, p.soft_cap(ff, rf), p.dynamics)
-        {
-            self.profile = profile;
-            self.offset = here;
-            self.t = 0.0;
+        let last = self.unit_end(0);
+        if let Some((profile, v1, pieces, rest)) = self.plan_run(here, s.velocity, last) {
+            // Never an end velocity above what the look-ahead can still brake from.
+            if v1 <= self.pieces[last].bound_hard {
+                self.adopt(profile, v1, pieces, rest, here);
+                self.t -= at;
+            }
         }
     }
 
@@ -598,42 +568,9 @@ impl Contour {
             return Ok(());
         }
         let here = self.state.position;
-        self.start_piece(here, 0.0)?;
+        self.start_run(here, 0.0)?;
         self.advance_profile()
     }
-}
-
-/// The end velocity of a piece entered at `v0` with `rest` of it to go: the highest its length
-/// allows within its soft bound, at least the lowest braking reaches, at most its hard bound,
-/// and always one the piece's length can reach. Braking part of the way can take longer than
-/// braking to rest (the distance `(v0 + v) T(v0 - v) / 2` first grows as `v` falls from
-/// `v0`, then shrinks), so a velocity between the bounds may not fit: then the highest below
-/// it that does, or the hard bound (which the look-ahead made reachable from every entry
-/// velocity up to the one before's hard bound).
-fn feasible_end(v0: f64, rest: f64, p: &Piece) -> f64 {
-    let d = p.dynamics;
-    let fits = |v: f64| profile::change_distance(v0, v, d) <= rest * (1.0 + 1e-12) + 1e-15;
-    let reach_low = min_reach(v0, rest, d);
-    let soft = max_reach(v0, rest, p.bound_soft.max(0.0), d);
-    let v1 = soft.max(reach_low).min(p.bound_hard.max(reach_low));
-    if fits(v1) {
-        return v1;
-    }
-    if fits(0.0) {
-        // Between 0 (fits) and v1 (does not): the highest that fits.
-        return profile::bisect(0.0, v1, fits);
-    }
-    v0.min(p.bound_hard)
-}
-
-/// What the backward sweep carries from a piece to the one before: its bounds, length,
-/// caps (hard, soft) and dynamics.
-struct Next {
-    hard: f64,
-    soft: f64,
-    length: f64,
-    caps: (f64, f64),
-    dynamics: Dynamics,
 }
 
 /// Copies the block's feed, mode and line onto a piece.

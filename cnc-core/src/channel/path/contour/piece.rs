@@ -6,39 +6,45 @@
 //! before the corner and joins the second `d` after it, run by a parameter `λ` from 0 to `2d`
 //! (`t = λ / 2d`):
 //!
-//! `p(λ) = C - d u1 + λ u1 + 2d W(t) (u2 - u1)`, `W(t) = ∫ w`,
-//! `w(t) = 2t²` up to the middle, `1 - 2(1 - t)²` after it.
+//! `p(λ) = C - d u1 + λ u1 + 2d W(t) (u2 - u1)`, `W(t) = ∫ w`, `w` from the curve's
+//! [`Shape`].
 //!
-//! So `p' = u1 + w (u2 - u1)` turns from `u1` to `u2` without a kink; `p''` rises linearly
-//! from 0 to `(u2 - u1)/d` at the middle and back to 0 (the curvature starts and ends at 0:
-//! no step in any axis's acceleration); `p'''` is `±(u2 - u1)/d²`, the smallest third
-//! derivative any such curve of this length can have, since at the short corners of a dense
-//! polyline the jerk is what limits the speed. The curve's middle lies `d/6 (u2 - u1)` from the
-//! corner: the corner deviation is `d/3 sin(θ/2)` for a turn by `θ`, and no point of the curve
-//! is farther from the programmed path. `d` is the largest that keeps this within the
-//! tolerance, and at most half of each block (so the curves of a block's two ends never
-//! overlap).
+//! So `p' = u1 + w (u2 - u1)` turns from `u1` to `u2` without a kink, `p''` is
+//! `w'/(2d) (u2 - u1)` and `p'''` is `w''/(2d)² (u2 - u1)`. Between two straight pieces
+//! the shape is the triangle: the curvature rises linearly from 0 to `(u2 - u1)/d` at the
+//! middle and back to 0 (no step in any axis's acceleration), and `p'''` is `±(u2 - u1)/d²`,
+//! the smallest third derivative any such curve of this length can have. Its middle lies
+//! `d/6 (u2 - u1)` from the corner: the corner deviation is `d/3 sin(θ/2)` for a turn by
+//! `θ`. `d` is the largest that keeps this within the tolerance, and at most half of each
+//! block (so the curves of a block's two ends never overlap). Where two curves meet in the
+//! middle of a block they took all of, they may share their curvature there
+//! ([`super::corner`]); a shape other than the triangle is checked against the tolerance
+//! point by point.
 //!
 //! Per axis `i` the piece bounds `|p'_i| ≤ g1`, `|p''_i| ≤ g2` and `|p'''_i| ≤ g3`; an axis
 //! then moves at `p' λ̇`, accelerates at `p' λ̈ + p'' λ̇²` and jerks at
 //! `p' λ⃛ + 3 p'' λ̇ λ̈ + p''' λ̇³`. On a straight piece `g2 = g3 = 0` and the path parameter
 //! may use every axis's limits in full. On a curve the path's speed is capped where the
 //! curvature terms would take more than the axes have, and the path parameter's own
-//! acceleration and jerk get what is left at 90 % of the highest speed the curve allows: a
-//! curve is mostly run at a steady speed, so its speed matters more than how fast the speed
-//! can change on it.
+//! acceleration and jerk get what is left at the speed the curve will run at (its feed, or
+//! 90 % of the highest speed its curvature allows when that is lower).
 
 use super::profile::Dynamics;
+use super::shape::Shape;
 use crate::channel::path::AxisLimits;
 use crate::setpoint::AxisValues;
 
-/// Share of the axes' jerk the path parameter's own jerk may use on a corner curve.
-const TANGENTIAL_JERK_SHARE: f64 = 0.1;
+/// Shares of the axes' jerk the path parameter's own jerk may use on a corner curve, tried, largest first: the largest that keeps [`CAP_KEPT`] of the speed the
+/// smallest allows (a curve whose curvature changes little, as a dense polyline's, lends the
+/// path parameter most of the jerk; a sharp corner's curve needs it for its speed).
+const TANGENTIAL_JERK_SHARES: [f64; 3] = [0.5, 0.25, 0.1];
+/// See [`TANGENTIAL_JERK_SHARES`].
+const CAP_KEPT: f64 = 0.99;
 /// A curve runs at up to this share of the speed its curvature alone would allow; what that
 /// leaves of the axes' acceleration and jerk is the path parameter's.
 const CURVE_SPEED_SHARE: f64 = 0.9;
 /// The path parameter's acceleration on a curve is at most this share of the axes'.
-const TANGENTIAL_ACC_MAX: f64 = 0.5;
+const TANGENTIAL_ACC_MAX: f64 = 0.9;
 
 /// One piece of a contour.
 #[derive(Debug, Clone, Copy)]
@@ -63,6 +69,16 @@ pub struct Piece {
     pub dynamics: Dynamics,
     /// The path rests at the piece's end (exact stop).
     pub rest_after: bool,
+    /// The piece may be planned in one unit with the piece before ([`super::plan`]).
+    pub chain: bool,
+    /// Of a curve: how its tangent turns ([`Shape`]; its curvature at its ends is 0 where it
+    /// meets a straight piece).
+    pub shape: Shape,
+    /// Of a curve: the speed at which the step in curvature where it meets its neighbour
+    /// curves stays within the axes' jerk over a cycle.
+    pub junction_cap: f64,
+    /// Of a curve: the corner tolerance it was made for.
+    pub tolerance: f64,
     /// The block's source line.
     pub line: u32,
     /// The block's full length (a straight piece gives at most half of it to each corner).
@@ -117,6 +133,10 @@ impl Piece {
                 jerk,
             },
             rest_after: false,
+            chain: false,
+            shape: Shape::default(),
+            junction_cap: f64::INFINITY,
+            tolerance: 0.0,
             line: 0,
             block_length,
             bound_hard: 0.0,
@@ -124,13 +144,16 @@ impl Piece {
         }
     }
 
-    /// The curve rounding `corner` from direction `u1` to `u2` with half-size `d`.
+    /// The curve rounding `corner` from direction `u1` to `u2` with half-size `d`, its
+    /// curvature at its ends `shape` of its mean, for axes with `limits` and a path at up to
+    /// `feed` (infinite for rapid): the path parameter's acceleration is shared out at the
+    /// speed the curve will run at.
     pub fn curve(
         corner: &AxisValues,
-        u1: &AxisValues,
-        u2: &AxisValues,
+        (u1, u2): (&AxisValues, &AxisValues),
         d: f64,
-        limits: &[AxisLimits],
+        shape: [f64; 2],
+        (limits, feed): (&[AxisLimits], f64),
     ) -> Self {
         let mut origin = *corner;
         let mut turn = *u1;
@@ -139,26 +162,40 @@ impl Piece {
             turn[i] = u2[i] - u1[i];
         }
         let n = corner.len();
+        // A curve meeting another keeps a share of the jerk for the step where they meet.
+        let shared = shape[0] > 0.0 || shape[1] > 0.0;
         let axis = |i: usize| {
-            let limit = limits.get(i).copied().unwrap_or_else(unlimited);
-            Bounds::new(u1[i], u2[i], d, limit)
+            let mut limit = limits.get(i).copied().unwrap_or_else(unlimited);
+            if shared {
+                limit.jerk *= 1.0 - super::corner::JUNCTION_JERK_SHARE;
+            }
+            Bounds::new(u1[i], u2[i], d, &Shape::new(shape), limit)
         };
-        // The path parameter's jerk first, then the speed the curvature leaves room for,
-        // then the path parameter's acceleration at 90 % of that speed.
-        let jerk = (0..n)
-            .map(|i| axis(i).tangential_jerk())
-            .fold(f64::INFINITY, f64::min);
-        let top = (0..n)
-            .map(|i| axis(i).speed(jerk, 0.0))
-            .fold(f64::INFINITY, f64::min);
-        let speed = CURVE_SPEED_SHARE * top;
-        let acceleration = (0..n)
-            .map(|i| axis(i).tangential_acc(speed, jerk))
-            .fold(f64::INFINITY, f64::min);
-        let dynamics = Dynamics { acceleration, jerk };
-        let cap = (0..n)
-            .map(|i| axis(i).speed(jerk, acceleration))
-            .fold(f64::INFINITY, f64::min);
+        // For a share of the jerk: the path parameter's jerk first, then the speed the
+        // curvature leaves room for, then the path parameter's acceleration at 90 % of that
+        // speed, and the speed with both.
+        let plan = |share: f64| {
+            let jerk = (0..n)
+                .map(|i| axis(i).tangential_jerk(share))
+                .fold(f64::INFINITY, f64::min);
+            let top = (0..n)
+                .map(|i| axis(i).speed(jerk, 0.0))
+                .fold(f64::INFINITY, f64::min);
+            let speed = (CURVE_SPEED_SHARE * top).min(feed);
+            let acceleration = (0..n)
+                .map(|i| axis(i).tangential_acc(speed, jerk))
+                .fold(f64::INFINITY, f64::min);
+            let cap = (0..n)
+                .map(|i| axis(i).speed(jerk, acceleration))
+                .fold(f64::INFINITY, f64::min);
+            (cap, Dynamics { acceleration, jerk })
+        };
+        let smallest = plan(TANGENTIAL_JERK_SHARES[2]);
+        let (cap, dynamics) = TANGENTIAL_JERK_SHARES[..2]
+            .iter()
+            .map(|&share| plan(share))
+            .find(|(cap, _)| *cap >= CAP_KEPT * smallest.0)
+            .unwrap_or(smallest);
         Self {
             origin,
             dir: *u1,
@@ -170,6 +207,10 @@ impl Piece {
             rapid: false,
             dynamics,
             rest_after: false,
+            chain: false,
+            shape: Shape::new(shape),
+            junction_cap: f64::INFINITY,
+            tolerance: 0.0,
             line: 0,
             block_length: 0.0,
             bound_hard: 0.0,
@@ -191,13 +232,7 @@ impl Piece {
     pub fn point(&self, lambda: f64, out: &mut AxisValues) {
         let w = if self.half > 0.0 {
             let t = (lambda / (2.0 * self.half)).clamp(0.0, 1.0);
-            let r = 1.0 - t;
-            let big_w = if t <= 0.5 {
-                2.0 / 3.0 * t * t * t
-            } else {
-                t - 0.5 + 2.0 / 3.0 * r * r * r
-            };
-            2.0 * self.half * big_w
+            2.0 * self.half * self.shape.at(t).0
         } else {
             0.0
         };
@@ -216,12 +251,8 @@ impl Piece {
     ) {
         let (w1, w2) = if self.half > 0.0 {
             let t = (lambda / (2.0 * self.half)).clamp(0.0, 1.0);
-            let r = 1.0 - t;
-            if t <= 0.5 {
-                (2.0 * t * t, 4.0 * t / (2.0 * self.half))
-            } else {
-                (1.0 - 2.0 * r * r, 4.0 * r / (2.0 * self.half))
-            }
+            let (_, w, dw) = self.shape.at(t);
+            (w, dw / (2.0 * self.half))
         } else {
             (0.0, 0.0)
         };
@@ -232,11 +263,47 @@ impl Piece {
         }
     }
 
+    /// Of a curve: the corner it rounds, and the directions before and after it.
+    pub fn corner(&self) -> (AxisValues, AxisValues, AxisValues) {
+        let (mut corner, mut u2) = (self.origin, self.dir);
+        for i in 0..corner.len() {
+            corner[i] += self.half * self.dir[i];
+            u2[i] += self.turn[i];
+        }
+        (corner, self.dir, u2)
+    }
+
+    /// Of a curve: the largest distance of its points (sampled) from the two legs of the
+    /// corner it rounds (in X, Y, Z).
+    pub fn deviation(&self) -> f64 {
+        let (corner, u1, u2) = self.corner();
+        let d = self.half;
+        let mut point = self.origin;
+        let mut worst = 0.0f64;
+        for k in 1..DEVIATION_SAMPLES {
+            self.point(2.0 * d * k as f64 / DEVIATION_SAMPLES as f64, &mut point);
+            let leg = |u: &AxisValues, sign: f64| {
+                let rel = |i: usize| point[i] - corner[i];
+                let along = ((0..3).map(|i| rel(i) * u[i]).sum::<f64>() * sign).clamp(0.0, d);
+                (0..3)
+                    .map(|i| (rel(i) - sign * along * u[i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            };
+            worst = worst.max(leg(&u1, -1.0).min(leg(&u2, 1.0)));
+        }
+        worst
+    }
+
     /// The end point.
     pub fn end(&self, out: &mut AxisValues) {
         self.point(self.length, out);
     }
 }
+
+/// Samples a curve's deviation is taken at (its points between them lie closer than the
+/// tolerance's margin to the sampled ones: the curve's deviation changes slowly).
+const DEVIATION_SAMPLES: usize = 32;
 
 /// One axis on a curve: its bounds `g1`, `g2`, `g3` and its limits.
 struct Bounds {
@@ -247,22 +314,22 @@ struct Bounds {
 }
 
 impl Bounds {
-    fn new(u1: f64, u2: f64, d: f64, limit: AxisLimits) -> Self {
+    fn new(u1: f64, u2: f64, d: f64, shape: &Shape, limit: AxisLimits) -> Self {
         let du = (u2 - u1).abs();
         Self {
             g1: u1.abs().max(u2.abs()),
-            g2: du / d,
-            g3: du / (d * d),
+            g2: shape.peak() * du / (2.0 * d),
+            g3: shape.steepest() * du / (4.0 * d * d),
             limit,
         }
     }
 
     /// The path parameter's jerk this axis allows.
-    fn tangential_jerk(&self) -> f64 {
+    fn tangential_jerk(&self, share: f64) -> f64 {
         if self.g1 <= 1e-12 {
             return f64::INFINITY;
         }
-        TANGENTIAL_JERK_SHARE * self.limit.jerk / self.g1
+        share * self.limit.jerk / self.g1
     }
 
     /// The path parameter's acceleration this axis allows at `speed` with path jerk `jerk`.

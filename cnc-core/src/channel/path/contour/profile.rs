@@ -9,6 +9,11 @@
 //! covers `(va + vb) T / 2`: the same distance accelerating from `va` to `vb` as braking from
 //! `vb` to `va`, which is what makes the look-ahead's backward and forward bounds one function.
 
+/// Relative rounding within which braking to rest counts as fitting for [`min_reach`] (a
+/// plan met again at its peak brakes over exactly its rest; the profile's own fit is
+/// stricter, so a velocity found this way that does not fit is not planned).
+const REST_SLACK: f64 = 1e-9;
+
 /// The limits the path parameter moves with on one piece (all positive).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Dynamics {
@@ -89,7 +94,9 @@ pub fn max_reach(v0: f64, length: f64, cap: f64, d: Dynamics) -> f64 {
 
 /// The lowest velocity reachable from `v0` by braking within `length`.
 pub fn min_reach(v0: f64, length: f64, d: Dynamics) -> f64 {
-    if change_distance(v0, 0.0, d) <= length {
+    // Braking to rest exactly over the length (a plan made before, met again at its peak)
+    // fits within rounding.
+    if change_distance(v0, 0.0, d) <= length * (1.0 + REST_SLACK) {
         return 0.0;
     }
     // `ok(v)`: braking to v fits; true at v0, false at 0.
@@ -294,10 +301,11 @@ impl PieceProfile {
         self.length
     }
 
-    /// Whether `t` into the piece is on its cruise (acceleration 0 between the ramps).
-    pub fn cruising(&self, t: f64) -> bool {
+    /// When the cruise starts and ends (acceleration 0 between the ramps; one instant, the
+    /// peak, when there is no cruise).
+    pub fn cruise(&self) -> (f64, f64) {
         let t1 = self.first.duration();
-        t >= t1 && t <= t1 + self.cruise_t
+        (t1, t1 + self.cruise_t)
     }
 }
 

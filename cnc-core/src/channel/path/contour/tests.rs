@@ -310,7 +310,7 @@ fn an_end_velocity_between_the_bounds_that_does_not_fit_is_not_chosen() {
     let d = p.dynamics;
     assert!(profile::change_distance(100.0, 33.0, d) > 5.2);
     assert!(profile::change_distance(100.0, 0.0, d) <= 5.2);
-    let v = feasible_end(100.0, 5.2, &p);
+    let v = feasible_end(100.0, 5.2, d, p.bound_soft, p.bound_hard);
     assert!(
         profile::change_distance(100.0, v, d) <= 5.2 * (1.0 + 1e-12) + 1e-15,
         "{v}: {}",
@@ -347,6 +347,106 @@ proptest! {
         schedule.sort_by_key(|c| c.0);
         schedule.push((401, 1.0));
         let t = run_with(&points, feed, Some(tol), &schedule);
+        if let Err(e) = kept_its_promises(&t, &points, tol) {
+            return Err(TestCaseError::fail(e));
+        }
+    }
+}
+
+/// Points on a circle of `radius` (a polygon of `n` sides), starting at angle 0.
+fn polygon(n: usize, radius: f64) -> Vec<[f64; 3]> {
+    (0..=n)
+        .map(|k| {
+            let phi = std::f64::consts::TAU * k as f64 / n as f64;
+            [radius * phi.cos(), radius * phi.sin(), 0.0]
+        })
+        .collect()
+}
+
+fn path_length(points: &[[f64; 3]]) -> f64 {
+    points
+        .windows(2)
+        .map(|w| {
+            (0..3)
+                .map(|i| (w[1][i] - w[0][i]).powi(2))
+                .sum::<f64>()
+                .sqrt()
+        })
+        .sum()
+}
+
+/// CAM output: a circle of 1 mm chords runs close to its feed (the curves of neighbouring
+/// corners share their curvature and the path accelerates through their boundaries); before,
+/// each corner's curvature rose from 0 and fell back, capping the speed at 74 mm/s, and every
+/// piece started and ended without acceleration (2.2x the time at the feed).
+#[test]
+fn a_dense_polygon_runs_close_to_its_feed() {
+    let points = polygon(300, 50.0);
+    let t = run(&points, 100.0, Some(0.02), None);
+    kept_its_promises(&t, &points, 0.02).unwrap();
+    let at_feed = path_length(&points) / 100.0 / CYCLE;
+    let ratio = t.positions.len() as f64 / at_feed;
+    assert!(ratio < 1.15, "{ratio:.3}x the time at the feed");
+}
+
+/// A corner passed so slowly on its curve (90 degrees within 0.02 mm) that stopping there is
+/// quicker is stopped at: continuous path takes exactly exact stop's time on a zigzag of them.
+#[test]
+fn a_corner_quicker_to_stop_at_is_stopped_at() {
+    let points: Vec<[f64; 3]> = (0..=20)
+        .map(|k| [2.0 * k as f64, if k % 2 == 0 { 0.0 } else { 2.0 }, 0.0])
+        .collect();
+    let cont = run(&points, 100.0, Some(0.02), None);
+    let exact = run(&points, 100.0, None, None);
+    assert_eq!(cont.positions.len(), exact.positions.len());
+    assert!(worst_deviation(&cont, &points) <= 1e-9);
+    // A wider tolerance makes the curves fast enough to pass.
+    let wide = run(&points, 100.0, Some(0.5), None);
+    assert!(wide.positions.len() < exact.positions.len());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Continuous path never takes longer than exact stop on the same blocks (within a tick
+    /// per block for where the two runs' ticks fall).
+    #[test]
+    fn continuous_path_is_never_slower_than_exact_stop(
+        steps in proptest::collection::vec((0.05f64..8.0, -3.0f64..3.0, -1.0f64..1.0), 2..25),
+        tol in 0.001f64..0.5,
+        feed in 5.0f64..300.0,
+    ) {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        let mut heading = 0.0f64;
+        for (len, turn, climb) in steps {
+            heading += turn;
+            let [x, y, z] = *points.last().unwrap();
+            points.push([x + len * heading.cos(), y + len * heading.sin(), z + climb]);
+        }
+        let cont = run(&points, feed, Some(tol), None).positions.len();
+        let exact = run(&points, feed, None, None).positions.len();
+        prop_assert!(cont <= exact, "continuous {cont} ticks, exact stop {exact}");
+    }
+
+    /// CAM-like polylines (chords of a curve whose curvature wanders, of uneven lengths, with
+    /// the points rounded as a post-processor writes them) keep the tolerance and every limit
+    /// and end on their last point.
+    #[test]
+    fn cam_like_polylines_keep_tolerance_and_limits(
+        chords in proptest::collection::vec((0.1f64..2.0, -0.2f64..0.2), 5..60),
+        tol in 0.002f64..0.1,
+        feed in 20.0f64..200.0,
+    ) {
+        let mut points = vec![[0.0, 0.0, 0.0]];
+        let (mut heading, mut bend) = (0.0f64, 0.05f64);
+        for (len, wander) in chords {
+            bend = (bend + 0.1 * wander).clamp(-0.3, 0.3);
+            heading += bend * len;
+            let [x, y, z] = *points.last().unwrap();
+            let round = |v: f64| (v * 1e4).round() / 1e4;
+            points.push([round(x + len * heading.cos()), round(y + len * heading.sin()), z]);
+        }
+        let t = run(&points, feed, Some(tol), None);
         if let Err(e) = kept_its_promises(&t, &points, tol) {
             return Err(TestCaseError::fail(e));
         }
