@@ -41,7 +41,7 @@ BENCHES = [
      "standing axes, a transport-only handler"),
     ("cnc-core", "saw", "flying-saw planning per command", "rsruckig"),
     ("cnc-core", "contour", "continuous path against exact stop",
-     "exact stop, a lower bound, the exact-stop channel tick"),
+     "exact stop, a lower bound, LinuxCNC's planner, the exact-stop channel tick"),
     ("cnc-app", "scaling", "machine tick against machine size", "its own smallest size"),
     ("cnc-app", "tick_latency", "tick start lateness, whole processes", "cyclictest"),
     ("cnc-opcua", "lateness", "tick lateness with an OPC UA client of 1,000 items",

@@ -124,12 +124,20 @@ impl Contour {
                 }
             };
             let mut changed = self.set_bounds(end, end_hard, end_soft);
-            let mut dist = 0.0;
+            let (mut dist, mut capped) = (0.0, false);
             for k in (start..end).rev() {
                 dist += self.pieces[k + 1].length;
                 let d = unit.dynamics;
-                let hard = max_reach(end_hard, dist, unit.cap_hard, d);
-                let soft = max_reach(end_soft, dist, unit.cap_soft, d).min(unit.cap_soft);
+                // Farther from the unit's end the bounds only grow: once at the caps, the
+                // pieces before are at them too.
+                let (hard, soft) = if capped {
+                    (unit.cap_hard, unit.cap_soft)
+                } else {
+                    let hard = max_reach(end_hard, dist, unit.cap_hard, d);
+                    let soft = max_reach(end_soft, dist, unit.cap_soft, d).min(unit.cap_soft);
+                    capped = hard >= unit.cap_hard && soft >= unit.cap_soft;
+                    (hard, soft)
+                };
                 changed |= self.set_bounds(k, hard, soft);
             }
             if start == 0 || (!changed && end + 4 < n) {
