@@ -155,6 +155,8 @@ impl Channel {
             rapid: m.motion == MotionMode::Rapid,
             line: m.line,
             blend: self.motion.contour_blend,
+            // Under #TRAFO the joints' limits are taken per block as it comes.
+            chamfer: !self.pose.trafo,
         };
         if m.arc.is_some() {
             return false;

@@ -26,6 +26,7 @@
 //! allows. The override changes the soft bounds; the run under way takes them at its next
 //! point without acceleration.
 
+mod chamfer;
 mod corner;
 mod piece;
 mod plan;
@@ -67,6 +68,10 @@ pub struct Segment {
     /// The corner with the block before may be rounded by at most this (mm); `None`: exact
     /// stop there.
     pub blend: Option<f64>,
+    /// Short blocks' corners may be cut by chords through their middles (not under a
+    /// transformation: the block is then held back until the next one comes, see
+    /// [`chamfer`]).
+    pub chamfer: bool,
 }
 
 /// Why the contour did not take a block.
@@ -135,6 +140,8 @@ pub struct Contour {
     last_end: Option<(AxisValues, AxisValues)>,
     /// Where the path stands once the window has run empty.
     rest_point: AxisValues,
+    /// The last block, held back until the next one shows whether its end corner is cut.
+    pending: Option<chamfer::Pending>,
 }
 
 impl Contour {
@@ -165,17 +172,23 @@ impl Contour {
             stopping: false,
             last_end: None,
             rest_point: AxisValues::zeros(limits.len()),
+            pending: None,
         }
     }
 
     /// Whether the path is under way or blocks are waiting in the window.
     pub fn active(&self) -> bool {
-        !self.pieces.is_empty()
+        !self.pieces.is_empty() || self.pending.is_some()
     }
 
     /// Whether another block fits into the window.
     pub fn has_room(&self) -> bool {
-        self.blocks < self.lookahead && self.pieces.len() + 2 <= self.capacity
+        self.blocks < self.lookahead && self.has_room_for(2)
+    }
+
+    /// Whether `segments` more segments (two pieces each) fit into the window.
+    fn has_room_for(&self, segments: usize) -> bool {
+        self.pieces.len() + 2 * segments <= self.capacity
     }
 
     /// Whether the window ends where the program stops (no more blocks join it).
@@ -187,6 +200,9 @@ impl Contour {
     pub fn close(&mut self) {
         if !self.closed {
             self.closed = true;
+            // The block held back ends the window (when there is no room yet, a later tick
+            // pushes it).
+            self.flush();
             // The window's last piece may now join its unit.
             self.sweep_back();
             self.replan = true;
@@ -195,7 +211,10 @@ impl Contour {
 
     /// The source line of the piece under way.
     pub fn line(&self) -> Option<u32> {
-        self.pieces.front().map(|p| p.line)
+        self.pieces
+            .front()
+            .map(|p| p.line)
+            .or(self.pending.as_ref().map(|p| p.line()))
     }
 
     /// The path parameter's state on the piece under way.
@@ -216,17 +235,31 @@ impl Contour {
         if !self.has_room() {
             return Err(PushError::Full);
         }
-        let mut dir = segment.end;
-        for (i, d) in dir.iter_mut().enumerate() {
-            *d -= segment.start[i];
-        }
-        let length = dir.iter().take(3).map(|d| d * d).sum::<f64>().sqrt();
-        if length <= 1e-9 || !length.is_finite() {
-            return Err(PushError::NotStraight);
-        }
-        dir.iter_mut().for_each(|d| *d /= length);
-        if self.pieces.is_empty() {
+        let (length, dir) = direction(segment).ok_or(PushError::NotStraight)?;
+        if !self.active() {
             self.closed = false;
+            self.last_end = None;
+        }
+        if segment.chamfer {
+            return self.push_staged(segment, (length, &dir), limit);
+        }
+        if !self.flush() {
+            return Err(PushError::Full);
+        }
+        self.push_segment(segment, limit)
+    }
+
+    /// Adds a segment to the window (a block, or a part of blocks cut by chords).
+    fn push_segment(
+        &mut self,
+        segment: &Segment,
+        limit: &mut dyn FnMut(&mut Piece),
+    ) -> Result<(), PushError> {
+        if !self.has_room_for(1) {
+            return Err(PushError::Full);
+        }
+        let (length, dir) = direction(segment).ok_or(PushError::NotStraight)?;
+        if self.pieces.is_empty() {
             self.last_end = None;
         }
         let rounded = self.round_corner(segment, &dir, length, limit);
@@ -281,6 +314,7 @@ impl Contour {
     /// A controlled stop: the path brakes as for feed hold and the window is emptied at rest.
     pub fn stop(&mut self) {
         self.closed = true;
+        self.pending = None;
         self.set_factors(0.0, 0.0);
         self.stopping = true;
     }
@@ -319,6 +353,9 @@ impl Contour {
         velocity: &mut AxisValues,
         acceleration: &mut AxisValues,
     ) -> Result<bool, ContourError> {
+        if self.closed && self.pending.is_some() {
+            self.flush();
+        }
         if self.pieces.is_empty() {
             return Ok(false);
         }
@@ -388,6 +425,7 @@ impl Contour {
         self.replan = false;
         self.run_pieces = 0;
         self.run_rest = 0.0;
+        self.pending = None;
     }
 
     /// Plans the run from `offset` on the front piece at velocity `v0` (acceleration 0) to the
@@ -571,6 +609,21 @@ impl Contour {
         self.start_run(here, 0.0)?;
         self.advance_profile()
     }
+}
+
+/// A segment's length in X, Y, Z and its direction per unit of that length; `None` when it
+/// does not move X, Y or Z.
+fn direction(segment: &Segment) -> Option<(f64, AxisValues)> {
+    let mut dir = segment.end;
+    for (i, d) in dir.iter_mut().enumerate() {
+        *d -= segment.start[i];
+    }
+    let length = dir.iter().take(3).map(|d| d * d).sum::<f64>().sqrt();
+    if length <= 1e-9 || !length.is_finite() {
+        return None;
+    }
+    dir.iter_mut().for_each(|d| *d /= length);
+    Some((length, dir))
 }
 
 /// Copies the block's feed, mode and line onto a piece.
