@@ -383,3 +383,78 @@ fn a_dense_circle_runs_near_its_feed_without_allocating() {
         "{circle_ticks} ticks for {at_feed} at the feed"
     );
 }
+
+/// Distance from the slot of the arcs test: two lines of 40 mm joined by half circles of
+/// radius 50 around (40, 50) and (0, 50).
+fn distance_to_slot(p: &[f64]) -> f64 {
+    let line = |y: f64| {
+        let x = p[0].clamp(0.0, 40.0);
+        (p[0] - x).hypot(p[1] - y)
+    };
+    let half = |cx: f64, right: bool| {
+        let (dx, dy) = (p[0] - cx, p[1] - 50.0);
+        if (dx >= 0.0) == right {
+            (dx.hypot(dy) - 50.0).abs()
+        } else {
+            f64::INFINITY
+        }
+    };
+    line(0.0)
+        .min(line(100.0))
+        .min(half(40.0, true))
+        .min(half(0.0, false))
+        + p[2].abs()
+}
+
+/// Arcs inside a contour: a slot (line, half circle G03 of radius 50, line, half circle) in continuous
+/// path runs without stopping anywhere between its start and its end, within PATH_DEV of the
+/// lines and the circles, within the limits, quicker than exact stop, its tick allocating
+/// nothing on the arcs; the circles' chords share their curvature.
+#[test]
+fn arcs_join_the_contour_tangent_to_its_lines() {
+    let slot = "G1 X40 F6000\nG3 X40 Y100 I0 J50\nG1 X0\nG3 X0 Y0 I0 J-50\n";
+    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{slot}G260\nM30\n");
+    let mut config = cartesian("c");
+    config.limits.velocity = 200.0;
+    config.limits.acceleration = 2000.0;
+    config.limits.jerk = 40_000.0;
+    let (trace, _) = run(&program, config.clone(), |_, _| {});
+    let (stopped, _) = run(&format!("{slot}M30\n"), config.clone(), |_, _| {});
+    let worst = trace
+        .iter()
+        .map(|p| distance_to_slot(p))
+        .fold(0.0, f64::max);
+    assert!(worst <= 0.02 + 1e-9, "deviation {worst}");
+    let (_, rates) = measure(&trace, &[[0.0, 0.0], [0.0, 0.0]]);
+    assert_within(&config, rates);
+    // Once up to speed, never slowed to a stop on the way (exact stop would at the four
+    // transitions).
+    let speed: Vec<f64> = trace
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
+        .collect();
+    let first = speed.iter().position(|&v| v > 50.0).unwrap();
+    let last = speed.iter().rposition(|&v| v > 50.0).unwrap();
+    let slowest = speed[first..=last].iter().copied().fold(f64::MAX, f64::min);
+    assert!(slowest > 20.0, "slowed to {slowest} mm/s on the way");
+    let end = trace.last().unwrap();
+    assert_eq!([end[0], end[1]], [0.0, 0.0]);
+    assert!(
+        trace.len() < stopped.len(),
+        "continuous {} ticks, exact stop {}",
+        trace.len(),
+        stopped.len()
+    );
+    // The tick on the arcs (the window full of their chords) allocates nothing.
+    let mut ctl = controller(vec![(config, &program)]);
+    let memory = image(1);
+    let view = hli::views::CncView::new(&memory);
+    for _ in 0..600 {
+        ctl.tick(&view);
+    }
+    let before = counting_alloc::allocations();
+    for _ in 0..600 {
+        ctl.tick(&view);
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
+}

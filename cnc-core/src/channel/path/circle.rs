@@ -3,6 +3,7 @@
 
 use super::{axis_limits, limit_by_axes, ArcSpec, AxisLimits, PathError, PathMove};
 use crate::axis::generator::{MoveLimits, SetpointGenerator};
+use crate::nc::arc::ArcMove;
 use crate::setpoint::AxisValues;
 
 /// The circle part of an arc block.
@@ -20,6 +21,31 @@ pub(super) struct Circle {
 }
 
 impl Circle {
+    /// The circle of `arc` from `start` to `target` (channel axes), and the length of its
+    /// part in the plane; `None` when that is not finite.
+    pub(super) fn of(
+        start: &AxisValues,
+        target: &AxisValues,
+        arc: &ArcMove,
+    ) -> Option<(Self, f64)> {
+        let [a, b, _] = arc.plane.axes();
+        let (p0, p1) = ([start[a], start[b]], [target[a], target[b]]);
+        let c = arc.center;
+        let r0 = (p0[0] - c[0]).hypot(p0[1] - c[1]);
+        let r1 = (p1[0] - c[0]).hypot(p1[1] - c[1]);
+        let sweep = arc.sweep(p0, p1);
+        let circle = Self {
+            axes: [a, b],
+            center: c,
+            angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
+            sweep: if arc.ccw { sweep } else { -sweep },
+            r0,
+            r1,
+        };
+        let length = sweep * (r0 + r1) / 2.0;
+        length.is_finite().then_some((circle, length))
+    }
+
     /// The point at `s` of the way (0..=1) in the plane's two axes: the angle runs linearly
     /// over the sweep, the radius from the start's to the end's.
     pub(super) fn point(&self, s: f64) -> [f64; 2] {
@@ -64,17 +90,11 @@ impl PathMove {
         limits: &[AxisLimits],
         generator: &mut SetpointGenerator,
     ) -> Result<Self, PathError> {
-        let arc = spec.arc;
-        let [a, b, _] = arc.plane.axes();
-        let (p0, p1) = ([start[a], start[b]], [target[a], target[b]]);
-        let c = arc.center;
-        let r0 = (p0[0] - c[0]).hypot(p0[1] - c[1]);
-        let r1 = (p1[0] - c[0]).hypot(p1[1] - c[1]);
-        let sweep = arc.sweep(p0, p1);
-        let signed = if arc.ccw { sweep } else { -sweep };
+        let (circle, circle_length) =
+            Circle::of(start, target, &spec.arc).ok_or(PathError::NoProfile)?;
+        let ([a, b], r0, r1) = (circle.axes, circle.r0, circle.r1);
         delta[a] = 0.0;
         delta[b] = 0.0;
-        let circle_length = sweep * (r0 + r1) / 2.0;
         let linear = delta.iter().take(3).map(|d| d * d).sum::<f64>();
         let length = (circle_length * circle_length + linear).sqrt();
         if length.is_nan() || length <= 1e-12 || !length.is_finite() {
@@ -97,14 +117,6 @@ impl PathMove {
             jerk: plane_j / 2.0 / share.max(1e-12),
         };
         limit_by_axes(&mut path, &delta, length, limits);
-        let circle = Circle {
-            axes: [a, b],
-            center: c,
-            angle0: (p0[1] - c[1]).atan2(p0[0] - c[0]),
-            sweep: signed,
-            r0,
-            r1,
-        };
         let geometry = (*start, delta, Some(circle), *target, length);
         Self::start(geometry, path, feed_mm_min / 60.0, generator)
     }

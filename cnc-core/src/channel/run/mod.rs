@@ -50,7 +50,7 @@ use super::config::{ChannelConfig, ChannelConfigError};
 use super::dyn_cs::{MasterSample, MasterSource, TrackError, TrackSetup, Tracker};
 use super::guard::JointGuard;
 use super::kin_config::ToolKinematics;
-use super::path::contour::{Contour, Segment};
+use super::path::contour::{ArcBlock, Contour, Segment};
 use super::path::{ArcSpec, AxisLimits, PathMove};
 use super::plc_io::{
     hli_value, next_interface, words_in, words_near, ChannelInputs, ChannelOutputs, OverrideInput,
@@ -60,6 +60,7 @@ use super::program::LoadedProgram;
 use super::sync::SyncBoard;
 use crate::axis::generator::{MoveLimits, Progress, SetpointGenerator};
 use crate::channel::hli_frame::frame_to_hli;
+use crate::nc::arc::ArcMove;
 use crate::nc::ast::AxisName;
 use crate::nc::decode::{AxisLayout, MotionBlock};
 use crate::nc::decode::{SyncIds, TrackSource, Vars, DEFAULT_FILTER_TICKS, KNOWN_VARIABLES};

@@ -118,7 +118,7 @@ impl Channel {
     /// Continuous path: a straight block `m` starts a contour (when it may be blended at its
     /// end); `false` when it runs on its own. Axes moving independently keep their own moves.
     pub(super) fn start_contour(&mut self, m: &MotionBlock) -> bool {
-        if self.control.single_block || m.blend.is_none() || m.arc.is_some() {
+        if self.control.single_block || m.blend.is_none() {
             return false;
         }
         self.motion.contour.clear();
@@ -158,8 +158,8 @@ impl Channel {
             // Under #TRAFO the joints' limits are taken per block as it comes.
             chamfer: !self.pose.trafo,
         };
-        if m.arc.is_some() {
-            return false;
+        if let Some(arc) = m.arc {
+            return self.join_arc(m, arc, end);
         }
         let seed = self.motion.contour_joints;
         let pushed =
@@ -181,6 +181,36 @@ impl Channel {
         if m.blend.is_none() {
             self.motion.contour.close();
         }
+        true
+    }
+
+    /// An arc block joins the open contour as its chords (`false`: it cannot, and runs on its
+    /// own at exact stop): not under `#TRAFO`, not when the contour ends at it, not when an
+    /// axis of its plane moves on its own.
+    fn join_arc(&mut self, m: &MotionBlock, arc: ArcMove, end: AxisValues) -> bool {
+        let [a, b, _] = arc.plane.axes();
+        let plane_free = self.motion.contour_excluded & (1 << a | 1 << b) == 0;
+        let Some(tolerance) = m.blend else {
+            return false;
+        };
+        if self.pose.trafo || !plane_free {
+            return false;
+        }
+        let block = ArcBlock {
+            start: self.motion.contour_end,
+            end,
+            arc,
+            feed: m.feed / 60.0,
+            line: m.line,
+            blend: self.motion.contour_blend,
+            tolerance,
+        };
+        if self.motion.contour.push_arc(&block).is_err() {
+            return false;
+        }
+        self.motion.contour_end = end;
+        // The corner after it keeps half the tolerance, as its chords' corners do.
+        self.motion.contour_blend = m.blend.map(|t| 0.5 * t);
         true
     }
 

@@ -331,18 +331,19 @@ impl DecoderState {
                 motion: self.motion,
                 feed: self.feed,
                 target: self.position,
-                blend: self.blend(input, is_arc),
+                blend: self.blend(input),
                 arc,
             }));
         }
     }
 
     /// Whether this block's end may be blended, and within what: continuous path (G61 here or
-    /// G261 on), no exact stop (G60/G09 here or G360 on), a straight block.
-    fn blend(&self, input: &BlockInput, is_arc: bool) -> Option<f64> {
+    /// G261 on), no exact stop (G60/G09 here or G360 on). Arcs too: the contour takes them
+    /// as their chords.
+    fn blend(&self, input: &BlockInput) -> Option<f64> {
         let continuous = input.contour_here || self.contour;
         let exact = input.exact_here || self.exact_stop;
-        (continuous && !exact && !is_arc).then_some(self.path_dev)
+        (continuous && !exact).then_some(self.path_dev)
     }
 
     /// `G04 t`, `G04 X t` (the first main axis names the time): alone in its block.

@@ -1,11 +1,11 @@
-//! Chords through the middles of short blocks: where a polyline's blocks are so short that
-//! rounding their corner would take all of both halves anyway, the corner is cut by the chord
-//! from the middle of the block before to the middle of the block after, when that chord stays
+//! Chords through the middles of short blocks: where short blocks turn by small angles one way
+//! and the other (noise around a line, as CAM output has), a corner is cut by the chord from
+//! the middle of the block before to the middle of the block after, when that chord stays
 //! within most of the tolerance ([`CHAMFER_SHARE`]); the chords' own corners (at the blocks'
-//! middles, on the programmed path) are then rounded within what the chords leave of it. A
-//! zigzag of small alternating turns (noise around a line, as CAM output has) becomes a
-//! nearly straight chain of chords and runs at its feed; chords of a smooth curve stay a
-//! polygon of the same turns.
+//! middles, on the programmed path) are then rounded within what the chords leave of it. Such
+//! a zigzag becomes a nearly straight chain of chords and runs at its feed. The chords of a
+//! smooth curve (turning one way) would keep its turns: those corners are rounded as they
+//! are, their curves sharing their curvature ([`super::corner`]).
 //!
 //! A block is held back until the next one shows whether its end corner is cut: a contour
 //! always holds its last block unpushed (`pending`); [`Contour::close`] pushes it. Not under a
@@ -186,7 +186,8 @@ fn chord_deviation(held: &Pending, next: &Pending) -> Option<f64> {
         .iter()
         .zip(next.segment.start.iter())
         .all(|(a, b)| (a - b).abs() <= 1e-9);
-    if tolerance <= 0.0 || !joined || held.segment.rapid != next.segment.rapid {
+    let long_enough = held.length.min(next.length) > 1e-6;
+    if tolerance <= 0.0 || !joined || !long_enough || held.segment.rapid != next.segment.rapid {
         return None;
     }
     let cos = (0..3)

@@ -26,6 +26,7 @@
 //! allows. The override changes the soft bounds; the run under way takes them at its next
 //! point without acceleration.
 
+mod arc;
 mod chamfer;
 mod corner;
 mod piece;
@@ -35,6 +36,7 @@ mod shape;
 #[cfg(test)]
 mod tests;
 
+pub use arc::{ArcBlock, MAX_ARC_CHORDS};
 pub use piece::Piece;
 pub use profile::{Dynamics, PathState};
 
@@ -142,6 +144,8 @@ pub struct Contour {
     rest_point: AxisValues,
     /// The last block, held back until the next one shows whether its end corner is cut.
     pending: Option<chamfer::Pending>,
+    /// An arc whose chords are still joining the window.
+    arc: Option<arc::ArcChords>,
 }
 
 impl Contour {
@@ -173,17 +177,18 @@ impl Contour {
             last_end: None,
             rest_point: AxisValues::zeros(limits.len()),
             pending: None,
+            arc: None,
         }
     }
 
     /// Whether the path is under way or blocks are waiting in the window.
     pub fn active(&self) -> bool {
-        !self.pieces.is_empty() || self.pending.is_some()
+        !self.pieces.is_empty() || self.pending.is_some() || self.arc.is_some()
     }
 
     /// Whether another block fits into the window.
     pub fn has_room(&self) -> bool {
-        self.blocks < self.lookahead && self.has_room_for(2)
+        self.arc.is_none() && self.blocks < self.lookahead && self.has_room_for(2)
     }
 
     /// Whether `segments` more segments (two pieces each) fit into the window.
@@ -202,7 +207,7 @@ impl Contour {
             self.closed = true;
             // The block held back ends the window (when there is no room yet, a later tick
             // pushes it).
-            self.flush();
+            self.feed_window();
             // The window's last piece may now join its unit.
             self.sweep_back();
             self.replan = true;
@@ -235,6 +240,15 @@ impl Contour {
         if !self.has_room() {
             return Err(PushError::Full);
         }
+        self.push_block(segment, limit)
+    }
+
+    /// [`Self::push`] once its room is known (an arc's chords come this way).
+    fn push_block(
+        &mut self,
+        segment: &Segment,
+        limit: &mut dyn FnMut(&mut Piece),
+    ) -> Result<(), PushError> {
         let (length, dir) = direction(segment).ok_or(PushError::NotStraight)?;
         if !self.active() {
             self.closed = false;
@@ -315,6 +329,7 @@ impl Contour {
     pub fn stop(&mut self) {
         self.closed = true;
         self.pending = None;
+        self.arc = None;
         self.set_factors(0.0, 0.0);
         self.stopping = true;
     }
@@ -353,9 +368,7 @@ impl Contour {
         velocity: &mut AxisValues,
         acceleration: &mut AxisValues,
     ) -> Result<bool, ContourError> {
-        if self.closed && self.pending.is_some() {
-            self.flush();
-        }
+        self.feed_window();
         if self.pieces.is_empty() {
             return Ok(false);
         }
@@ -426,6 +439,18 @@ impl Contour {
         self.run_pieces = 0;
         self.run_rest = 0.0;
         self.pending = None;
+        self.arc = None;
+    }
+
+    /// Pushes what waits outside the window as room frees: an arc's chords, then (once the
+    /// window is closed) the block held back.
+    fn feed_window(&mut self) {
+        if self.arc.is_some() {
+            self.feed_arc();
+        }
+        if self.closed && self.arc.is_none() && self.pending.is_some() {
+            self.flush();
+        }
     }
 
     /// Plans the run from `offset` on the front piece at velocity `v0` (acceleration 0) to the
