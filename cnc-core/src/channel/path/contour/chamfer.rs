@@ -146,6 +146,15 @@ fn midpoint(segment: &Segment) -> AxisValues {
     m
 }
 
+/// The cosine and angle of the turn from `held`'s direction to `next`'s (in X, Y, Z).
+fn turn_between(held: &Pending, next: &Pending) -> (f64, f64) {
+    let cos = (0..3)
+        .map(|i| held.dir[i] * next.dir[i])
+        .sum::<f64>()
+        .clamp(-1.0, 1.0);
+    (cos, cos.acos())
+}
+
 /// Whether the corner between `held` and `next` is one a zigzag of noise has: rounded by
 /// `next`'s tolerance, turning by at most [`MAX_CUT_TURN_DEG`], so short that rounding it
 /// would take all of both halves.
@@ -153,11 +162,7 @@ fn small_corner(held: &Pending, next: &Pending) -> bool {
     let Some(tolerance) = next.segment.blend else {
         return false;
     };
-    let cos = (0..3)
-        .map(|i| held.dir[i] * next.dir[i])
-        .sum::<f64>()
-        .clamp(-1.0, 1.0);
-    let turn = cos.acos();
+    let (_, turn) = turn_between(held, next);
     let rounding = 3.0 * tolerance / (0.5 * turn).sin().max(1e-12);
     tolerance > 0.0
         && turn > 1e-9
@@ -190,11 +195,7 @@ fn chord_deviation(held: &Pending, next: &Pending) -> Option<f64> {
     if tolerance <= 0.0 || !joined || !long_enough || held.segment.rapid != next.segment.rapid {
         return None;
     }
-    let cos = (0..3)
-        .map(|i| held.dir[i] * next.dir[i])
-        .sum::<f64>()
-        .clamp(-1.0, 1.0);
-    let turn = cos.acos();
+    let (cos, turn) = turn_between(held, next);
     let (a, b) = (0.5 * held.length, 0.5 * next.length);
     let chord = (a * a + b * b + 2.0 * a * b * cos).sqrt();
     // The chord splits the turn between its two ends (by the triangle's angles at the
