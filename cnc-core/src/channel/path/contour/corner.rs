@@ -73,7 +73,11 @@ impl Contour {
         {
             d = last.length;
         }
-        if d <= 1e-9 || !worth_rounding(&last, segment, (&u1, u2), d, length, &self.limits) {
+        if d <= 1e-9 {
+            return false;
+        }
+        let triangle = self.corner_curve(segment, (&u1, u2), d, [0.0, 0.0], &last);
+        if !worth_rounding(&last, &triangle, (segment, u2), length, &self.limits) {
             return false;
         }
         let saved = last;
@@ -83,16 +87,11 @@ impl Contour {
         let back = self.pieces.back_mut().expect("checked");
         back.length -= d;
         back.rest_after = false;
-        let feed = segment.feed.min(saved.feed);
-        let (share, junction_cap) = self.share_junction((&u1, u2), (d, feed), tolerance, limit);
-        let mut curve = Piece::curve(&corner, (&u1, u2), d, [share, 0.0], (&self.limits, feed));
-        tag(&mut curve, segment);
-        curve.tolerance = tolerance;
+        let (mut curve, junction_cap) = self
+            .share_junction((segment, &u1, u2), &triangle, &saved, limit)
+            .unwrap_or((triangle, f64::INFINITY));
         curve.junction_cap = junction_cap;
         curve.hard_cap = curve.hard_cap.min(junction_cap);
-        curve.feed = curve.feed.min(saved.feed);
-        curve.line = saved.line;
-        curve.rapid = saved.rapid && segment.rapid;
         let mut origin = corner;
         for i in 0..origin.len() {
             origin[i] += d * u2[i];
@@ -131,15 +130,18 @@ impl Contour {
     /// block (which caps the speed through its rate of change). The curvature's direction
     /// still steps by the angle between the turns: both curves' speed is capped where that
     /// step, over a cycle, would take more than [`JUNCTION_JERK_SHARE`] of an axis's jerk.
-    /// The new curve's start share and that cap; `(0, ∞)` when they do not share.
+    /// `triangle` is the new curve as it is without sharing, `last` the block before's
+    /// straight piece. The new curve with its shared start and that cap; `None` when they do
+    /// not share.
     fn share_junction(
         &mut self,
-        (u1, u2): (&AxisValues, &AxisValues),
-        (d, feed): (f64, f64),
-        tolerance: f64,
+        (segment, u1, u2): (&Segment, &AxisValues, &AxisValues),
+        triangle: &Piece,
+        last: &Piece,
         limit: &mut dyn FnMut(&mut Piece),
-    ) -> (f64, f64) {
-        const NONE: (f64, f64) = (0.0, f64::INFINITY);
+    ) -> Option<(Piece, f64)> {
+        const NONE: Option<(Piece, f64)> = None;
+        let d = triangle.half;
         let n = self.pieces.len();
         let under_way = !matches!(self.mode, Mode::Idle);
         if n < 2 || self.pieces[n - 1].length > 1e-9 || self.pieces[n - 2].half <= 0.0 {
@@ -186,27 +188,40 @@ impl Contour {
         new_a.tolerance = a.tolerance;
         new_a.junction_cap = a.junction_cap.min(cap);
         new_a.hard_cap = new_a.hard_cap.min(new_a.junction_cap);
-        let corner_b = self.pieces[n - 1].origin;
-        let probe = Piece::curve(&corner_b, (u1, u2), d, [cb, 0.0], (&self.limits, feed));
-        if new_a.deviation() > a.tolerance || probe.deviation() > tolerance {
+        let shared = self.corner_curve(segment, (u1, u2), d, [cb, 0.0], last);
+        if new_a.deviation() > a.tolerance || shared.deviation() > triangle.tolerance {
             return NONE;
         }
         // Not where the step in the curvature's direction would cap the curves below what
         // they have apart (turns far apart: a coarse polyline, not a dense curve's chords).
-        let apart = Piece::curve(
-            &corner,
-            (&ua1, &ua2),
-            a.half,
-            [a.shape.ends()[0], 0.0],
-            (&self.limits, a.feed),
-        );
-        let alone = Piece::curve(&corner_b, (u1, u2), d, [0.0, 0.0], (&self.limits, feed));
-        if cap < apart.hard_cap.min(a.junction_cap).min(alone.hard_cap) {
+        if cap < a.hard_cap.min(triangle.hard_cap) {
             return NONE;
         }
         limit(&mut new_a);
         self.pieces[n - 2] = new_a;
-        (cb, cap)
+        Some((shared, cap))
+    }
+
+    /// The curve rounding the corner at `segment`'s start from `u1` to `u2` with half-size
+    /// `d` and end curvatures `shape`, after `last` (the block before's straight piece): the
+    /// lower of the two blocks' feeds, the line of the block before, rapid when both are,
+    /// `segment`'s tolerance.
+    fn corner_curve(
+        &self,
+        segment: &Segment,
+        (u1, u2): (&AxisValues, &AxisValues),
+        d: f64,
+        shape: [f64; 2],
+        last: &Piece,
+    ) -> Piece {
+        let feed = segment.feed.min(last.feed);
+        let mut curve = Piece::curve(&segment.start, (u1, u2), d, shape, (&self.limits, feed));
+        tag(&mut curve, segment);
+        curve.feed = feed;
+        curve.line = last.line;
+        curve.rapid = last.rapid && segment.rapid;
+        curve.tolerance = segment.blend.unwrap_or(0.0);
+        curve
     }
 }
 
@@ -234,17 +249,12 @@ impl Contour {
 /// later and only get faster).
 fn worth_rounding(
     last: &Piece,
-    segment: &Segment,
-    (u1, u2): (&AxisValues, &AxisValues),
-    d: f64,
+    curve: &Piece,
+    (segment, u2): (&Segment, &AxisValues),
     length: f64,
     limits: &[AxisLimits],
 ) -> bool {
-    let feed = segment.feed.min(last.feed);
-    let mut curve = Piece::curve(&segment.start, (u1, u2), d, [0.0, 0.0], (limits, feed));
-    tag(&mut curve, segment);
-    curve.feed = curve.feed.min(last.feed);
-    curve.rapid = last.rapid && segment.rapid;
+    let d = curve.half;
     let mut next = Piece::straight(segment.start, *u2, length, length, limits);
     tag(&mut next, segment);
     let (h1, h2) = (last.length.min(0.5 * last.block_length), 0.5 * length);
