@@ -17,6 +17,8 @@ use crate::setpoint::AxisValues;
 
 /// An arc joins as chords when they run it at least at this share of its own speed.
 const CHORD_SPEED_KEPT: f64 = 0.9;
+/// The shortest chord (mm): a smaller circle runs on its own.
+const MIN_CHORD: f64 = 1e-6;
 /// Most chords an arc may take (a longer one runs on its own at exact stop).
 pub const MAX_ARC_CHORDS: u32 = 4096;
 /// The largest angle a chord spans (degrees): neighbouring chords' corner curves share their
@@ -54,6 +56,9 @@ pub(super) struct ArcChords {
     next: u32,
     /// Where the last chord pushed ends.
     at: AxisValues,
+    /// A chord did not join (never seen: chords are long enough when the arc joins); the
+    /// contour fails at its next tick, and no block joins after the arc.
+    failed: bool,
 }
 
 impl Contour {
@@ -82,7 +87,9 @@ impl Contour {
         if !chords.is_finite() || chords > f64::from(MAX_ARC_CHORDS) {
             return Err(PushError::NotStraight);
         }
-        if !self.chords_keep_speed(&circle, circle.sweep.abs() / chords, block.feed) {
+        let step = circle.sweep.abs() / chords;
+        let chord = 2.0 * circle.r0.min(circle.r1) * (0.5 * step).sin();
+        if chord <= MIN_CHORD || !self.chords_keep_speed(&circle, step, block.feed) {
             return Err(PushError::NotStraight);
         }
         let mut delta = block.end;
@@ -103,6 +110,7 @@ impl Contour {
             chords: chords as u32,
             next: 1,
             at: block.start,
+            failed: false,
         });
         self.feed_arc();
         Ok(())
@@ -112,14 +120,15 @@ impl Contour {
     /// last.
     pub(super) fn feed_arc(&mut self) {
         while let Some(arc) = self.arc {
-            if !(self.blocks < self.lookahead && self.has_room_for(2)) {
+            if arc.failed || !(self.blocks < self.lookahead && self.has_room_for(2)) {
                 return;
             }
             let segment = arc.chord(arc.next);
             if self.push_block(&segment, &mut |_| {}).is_err() {
-                // Never seen: a chord of a finite circle moves. The arc's end is taken
-                // straight so that the window still ends where the block does.
-                self.arc = None;
+                self.arc = Some(ArcChords {
+                    failed: true,
+                    ..arc
+                });
                 return;
             }
             let done = arc.next >= arc.chords;
@@ -160,6 +169,11 @@ impl Contour {
 }
 
 impl ArcChords {
+    /// Whether a chord failed to join.
+    pub(super) fn failed(&self) -> bool {
+        self.failed
+    }
+
     /// Chord `k` (1..=chords): from where the last ended to the arc's point `k / chords` of
     /// the way (the block's exact end for the last).
     fn chord(&self, k: u32) -> Segment {

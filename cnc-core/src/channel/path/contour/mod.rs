@@ -91,6 +91,9 @@ pub enum ContourError {
     /// A piece's planned end velocity is out of its reach (never seen).
     #[error("no velocity profile for a piece of the contour")]
     NoProfile,
+    /// A chord of an arc did not join the window (never seen).
+    #[error("an arc's chord did not join the contour")]
+    ArcChord,
 }
 
 /// How the piece under way runs.
@@ -228,8 +231,10 @@ impl Contour {
     }
 
     /// Adds a straight block. Its corner with the block before is rounded when both move X,
-    /// Y or Z, the turn is at most [`MAX_TURN_DEG`], the block before is not under way yet and
-    /// `segment.blend` allows it; else the path rests between them. `limit` may lower each new
+    /// Y or Z, the turn is at most [`MAX_TURN_DEG`], the block before is not under way yet,
+    /// `segment.blend` allows it and passing is quicker than stopping; else the path rests
+    /// between them. With `segment.chamfer` the block is held back until the next one comes
+    /// ([`chamfer`]). `limit` may lower each new
     /// piece's caps and dynamics before the look-ahead plans with them (the joints' limits
     /// under a transformation).
     pub fn push(
@@ -369,6 +374,9 @@ impl Contour {
         acceleration: &mut AxisValues,
     ) -> Result<bool, ContourError> {
         self.feed_window();
+        if self.arc.is_some_and(|a| a.failed()) {
+            return Err(ContourError::ArcChord);
+        }
         if self.pieces.is_empty() {
             return Ok(false);
         }
