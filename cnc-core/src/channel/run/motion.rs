@@ -157,6 +157,7 @@ impl Channel {
             blend: self.motion.contour_blend,
             // Under #TRAFO the joints' limits are taken per block as it comes.
             chamfer: !self.pose.trafo,
+            on_arc: false,
         };
         if let Some(arc) = m.arc {
             return self.join_arc(m, arc, end);

@@ -141,18 +141,18 @@ impl Contour {
     }
 }
 
+/// The plane axes' lowest jerk on a circle, and the speed the arc runs at on its own (its
+/// feed, within half its axes' acceleration and jerk, as `path::circle` plans it).
+#[derive(Debug, Clone, Copy)]
+struct PlaneLimits {
+    jerk: f64,
+    alone: f64,
+}
+
 impl Contour {
-    /// Whether the circle's chords (each turning by `step`) run it at least nearly as fast
-    /// as the arc runs on its own: where two chords' curves meet, the curvature's direction
-    /// steps by `step`, an acceleration step of `v² step / r` that over a cycle may take
-    /// [`JUNCTION_JERK_SHARE`] of the plane axes' jerk; on its own the arc runs at its feed
-    /// within half its axes' acceleration and jerk, as `path::circle` plans it. A small circle
-    /// at a short cycle runs on its own (its chords would be slower than the stops they save).
-    fn chords_keep_speed(&self, circle: &Circle, step: f64, feed: f64) -> bool {
+    fn plane_limits(&self, circle: &Circle, feed: f64) -> Option<PlaneLimits> {
         let limit = |i: usize| self.limits.get(i).copied();
-        let (Some(la), Some(lb)) = (limit(circle.axes[0]), limit(circle.axes[1])) else {
-            return true;
-        };
+        let (la, lb) = (limit(circle.axes[0])?, limit(circle.axes[1])?);
         let r = circle.r0.min(circle.r1);
         let (v, a, j) = (
             la.velocity.min(lb.velocity),
@@ -163,8 +163,21 @@ impl Contour {
             .min(v)
             .min((a * r / 2.0).sqrt())
             .min((j * r * r / 2.0).cbrt());
-        let chords = (JUNCTION_JERK_SHARE * j * self.cycle_s * r / step).sqrt();
-        chords >= CHORD_SPEED_KEPT * alone
+        Some(PlaneLimits { jerk: j, alone })
+    }
+
+    /// Whether the circle's chords (each turning by `step`) run it at least nearly as fast
+    /// as the arc runs on its own: where two chords' curves meet, the curvature's direction
+    /// steps by `step`, an acceleration step of `v² step / r` that over a cycle may take
+    /// [`JUNCTION_JERK_SHARE`] of the plane axes' jerk. A small circle at a short cycle whose
+    /// chords would be slower than the stops they save runs on its own.
+    fn chords_keep_speed(&self, circle: &Circle, step: f64, feed: f64) -> bool {
+        let Some(l) = self.plane_limits(circle, feed) else {
+            return true;
+        };
+        let r = circle.r0.min(circle.r1);
+        let chords = (JUNCTION_JERK_SHARE * l.jerk * self.cycle_s * r / step).sqrt();
+        chords >= CHORD_SPEED_KEPT * l.alone
     }
 }
 
@@ -204,7 +217,10 @@ impl ArcChords {
             } else {
                 Some(0.5 * b.tolerance)
             },
-            chamfer: true,
+            // Never cut by chords through the blocks' middles (the noise rule): at an
+            // inflection the chords' turns alternate, but they lie on a circle.
+            chamfer: false,
+            on_arc: true,
         }
     }
 }

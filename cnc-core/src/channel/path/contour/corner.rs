@@ -4,6 +4,7 @@
 
 use super::plan::similar;
 use super::profile::{change_distance, change_time, max_reach};
+use super::shape::share_limits;
 use super::{tag, Contour, Mode, Piece, Segment, MAX_TURN_DEG};
 use crate::channel::path::AxisLimits;
 use crate::setpoint::AxisValues;
@@ -18,9 +19,12 @@ pub(super) const JUNCTION_JERK_SHARE: f64 = 0.25;
 /// loses (against running at the feed): the comparison is local (it cannot see how the path
 /// runs through the blocks' other halves), so a corner that would gain very little is
 /// stopped at.
-const PASS_GAIN: f64 = 0.9;
+const PASS_GAIN: f64 = 0.85;
 /// A straight piece left over by less than this share of its block is taken by the curve.
 const SNAP: f64 = 1e-4;
+/// Where a straight block meets an arc's chords, the straight's leg of the corner curve is up
+/// to this many times the chord's (the curvature then ramps linearly into the arc's).
+const TRANSITION_LEG_RATIO: f64 = 2.0;
 
 impl Contour {
     /// Rounds the corner into `segment` when it may be: shortens the last straight piece,
@@ -41,7 +45,7 @@ impl Contour {
             return false;
         };
         // The run under way must not cover the piece to be shortened.
-        if (under_way && n <= self.run_pieces) || last.half > 0.0 || tolerance <= 0.0 {
+        if (under_way && n <= self.run_pieces) || last.is_curve() || tolerance <= 0.0 {
             return false;
         }
         let joined = end
@@ -76,16 +80,20 @@ impl Contour {
         if d <= 1e-9 {
             return false;
         }
-        let triangle = self.corner_curve(segment, (&u1, u2), d, [0.0, 0.0], &last);
+        let triangle = self.corner_curve(segment, (&u1, u2), [d, d], [0.0, 0.0], &last);
         if !worth_rounding(&last, &triangle, (segment, u2), length, &self.limits) {
             return false;
         }
+        let triangle = self
+            .transition(segment, (&u1, u2), d, length, &last)
+            .unwrap_or(triangle);
+        let [d1, d2] = triangle.legs;
         let saved = last;
         let saved_before = (n >= 2).then(|| self.pieces[n - 2]);
         let committed = self.v_end;
         let corner = segment.start;
         let back = self.pieces.back_mut().expect("checked");
-        back.length -= d;
+        back.length -= d1;
         back.rest_after = false;
         let (mut curve, junction_cap) = self
             .share_junction((segment, &u1, u2), &triangle, &saved, limit)
@@ -94,9 +102,9 @@ impl Contour {
         curve.hard_cap = curve.hard_cap.min(junction_cap);
         let mut origin = corner;
         for i in 0..origin.len() {
-            origin[i] += d * u2[i];
+            origin[i] += d2 * u2[i];
         }
-        let mut straight = Piece::straight(origin, *u2, length - d, length, &self.limits);
+        let mut straight = Piece::straight(origin, *u2, length - d2, length, &self.limits);
         tag(&mut straight, segment);
         limit(&mut curve);
         limit(&mut straight);
@@ -141,10 +149,10 @@ impl Contour {
         limit: &mut dyn FnMut(&mut Piece),
     ) -> Option<(Piece, f64)> {
         const NONE: Option<(Piece, f64)> = None;
-        let d = triangle.half;
+        let legs = triangle.legs;
         let n = self.pieces.len();
         let under_way = !matches!(self.mode, Mode::Idle);
-        if n < 2 || self.pieces[n - 1].length > 1e-9 || self.pieces[n - 2].half <= 0.0 {
+        if n < 2 || self.pieces[n - 1].length > 1e-9 || !self.pieces[n - 2].is_curve() {
             return NONE;
         }
         if under_way && n - 2 < self.run_pieces {
@@ -163,12 +171,16 @@ impl Contour {
         if cos < JUNCTION_MAX_TWIST_DEG.to_radians().cos() {
             return NONE;
         }
-        let (ka, kb) = (na / (2.0 * a.half), nb / (2.0 * d));
-        let k = ka.min(kb);
+        let (ka, kb) = (na / a.length, nb / triangle.length);
+        let mu = |p: &Piece| p.legs[1] / p.length;
+        let k = (share_limits(mu(&a))[1] * ka).min(share_limits(mu(triangle))[0] * kb);
+        if k <= 0.0 {
+            return NONE;
+        }
         let (ca, cb) = (k / ka, k / kb);
         let mut cap = f64::INFINITY;
         for i in 0..turn.len() {
-            let step = (ca * a.turn[i] / (2.0 * a.half) - cb * turn[i] / (2.0 * d)).abs();
+            let step = (ca * a.turn[i] / a.length - cb * turn[i] / triangle.length).abs();
             let jerk = self.limits.get(i).map_or(f64::INFINITY, |l| l.jerk);
             if step > 1e-15 {
                 cap = cap.min((JUNCTION_JERK_SHARE * jerk * self.cycle_s / step).sqrt());
@@ -178,7 +190,7 @@ impl Contour {
         let mut new_a = Piece::curve(
             &corner,
             (&ua1, &ua2),
-            a.half,
+            a.legs,
             [a.shape.ends()[0], ca],
             (&self.limits, a.feed),
         );
@@ -188,7 +200,7 @@ impl Contour {
         new_a.tolerance = a.tolerance;
         new_a.junction_cap = a.junction_cap.min(cap);
         new_a.hard_cap = new_a.hard_cap.min(new_a.junction_cap);
-        let shared = self.corner_curve(segment, (u1, u2), d, [cb, 0.0], last);
+        let shared = self.corner_curve(segment, (u1, u2), legs, [cb, 0.0], last);
         if new_a.deviation() > a.tolerance || shared.deviation() > triangle.tolerance {
             return NONE;
         }
@@ -202,20 +214,47 @@ impl Contour {
         Some((shared, cap))
     }
 
-    /// The curve rounding the corner at `segment`'s start from `u1` to `u2` with half-size
-    /// `d` and end curvatures `shape`, after `last` (the block before's straight piece): the
+    /// Where a straight block meets an arc's chords (or they meet one), the corner curve at
+    /// `segment`'s start (of `length`) after `last` before any sharing, its straight's leg up
+    /// to [`TRANSITION_LEG_RATIO`] times the chord's `d` (within its room and the tolerance),
+    /// so the curvature can ramp into the arc's once the chord's next corner shares it. `None`
+    /// elsewhere, or where the longer leg finds no room or leaves the tolerance (the legs are
+    /// then `d` both).
+    fn transition(
+        &self,
+        segment: &Segment,
+        units: (&AxisValues, &AxisValues),
+        d: f64,
+        length: f64,
+        last: &Piece,
+    ) -> Option<Piece> {
+        let long = TRANSITION_LEG_RATIO * d;
+        let legs = match (last.on_arc, segment.on_arc) {
+            (false, true) => [long.min(0.5 * last.block_length).min(last.length), d],
+            (true, false) => [d, long.min(0.5 * length)],
+            _ => return None,
+        };
+        if legs[0] <= d && legs[1] <= d {
+            return None;
+        }
+        let curve = self.corner_curve(segment, units, legs, [0.0, 0.0], last);
+        (curve.deviation() <= curve.tolerance).then_some(curve)
+    }
+
+    /// The curve rounding the corner at `segment`'s start from `u1` to `u2` with legs `legs`
+    /// and end curvatures `shape`, after `last` (the block before's straight piece): the
     /// lower of the two blocks' feeds, the line of the block before, rapid when both are,
     /// `segment`'s tolerance.
     fn corner_curve(
         &self,
         segment: &Segment,
         (u1, u2): (&AxisValues, &AxisValues),
-        d: f64,
+        legs: [f64; 2],
         shape: [f64; 2],
         last: &Piece,
     ) -> Piece {
         let feed = segment.feed.min(last.feed);
-        let mut curve = Piece::curve(&segment.start, (u1, u2), d, shape, (&self.limits, feed));
+        let mut curve = Piece::curve(&segment.start, (u1, u2), legs, shape, (&self.limits, feed));
         tag(&mut curve, segment);
         curve.feed = feed;
         curve.line = last.line;
@@ -232,7 +271,7 @@ impl Contour {
         let p = &self.pieces;
         let chain = match k {
             0 => false,
-            _ if p[k].length <= 1e-9 && p[k].half <= 0.0 => {
+            _ if p[k].length <= 1e-9 && !p[k].is_curve() => {
                 k + 1 < p.len() && similar(&p[k - 1], &p[k + 1])
             }
             _ => similar(&p[k - 1], &p[k]),
@@ -254,7 +293,7 @@ fn worth_rounding(
     length: f64,
     limits: &[AxisLimits],
 ) -> bool {
-    let d = curve.half;
+    let [d1, d2] = curve.legs;
     let mut next = Piece::straight(segment.start, *u2, length, length, limits);
     tag(&mut next, segment);
     let (h1, h2) = (last.length.min(0.5 * last.block_length), 0.5 * length);
@@ -268,7 +307,8 @@ fn worth_rounding(
         return false;
     }
     let stop = leg_time(h1, 0.0, last) + leg_time(h2, 0.0, &next);
-    let pass = leg_time(h1 - d, corner, last) + 2.0 * d / corner + leg_time(h2 - d, corner, &next);
+    let pass =
+        leg_time(h1 - d1, corner, last) + curve.length / corner + leg_time(h2 - d2, corner, &next);
     // What each loses against running the halves at their caps.
     let ideal = h1 / last.soft_cap(1.0, 1.0) + h2 / next.soft_cap(1.0, 1.0);
     pass - ideal < PASS_GAIN * (stop - ideal)

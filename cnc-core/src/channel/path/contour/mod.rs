@@ -27,6 +27,8 @@
 //! point without acceleration.
 
 mod arc;
+#[cfg(test)]
+mod arc_tests;
 mod chamfer;
 mod corner;
 mod piece;
@@ -74,6 +76,8 @@ pub struct Segment {
     /// transformation: the block is then held back until the next one comes, see
     /// [`chamfer`]).
     pub chamfer: bool,
+    /// One of an arc's chords ([`arc`]).
+    pub on_arc: bool,
 }
 
 /// Why the contour did not take a block.
@@ -592,7 +596,7 @@ impl Contour {
     /// The front piece is done; at the end of the window, where the path stands is kept.
     fn pop_piece(&mut self) {
         if let Some(p) = self.pieces.pop_front() {
-            if p.half == 0.0 {
+            if !p.is_curve() {
                 self.blocks = self.blocks.saturating_sub(1);
             }
             if self.pieces.is_empty() {
@@ -664,4 +668,5 @@ fn tag(piece: &mut Piece, segment: &Segment) {
     piece.feed = segment.feed;
     piece.rapid = segment.rapid;
     piece.line = segment.line;
+    piece.on_arc = segment.on_arc;
 }

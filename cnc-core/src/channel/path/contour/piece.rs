@@ -2,15 +2,17 @@
 //! corners, each with the limits its path parameter moves within.
 //!
 //! A corner between two straight blocks with directions `u1` and `u2` (unit in X, Y, Z; the
-//! other axes move in proportion) is rounded by a curve that leaves the first block `d`
-//! before the corner and joins the second `d` after it, run by a parameter `λ` from 0 to `2d`
-//! (`t = λ / 2d`):
+//! other axes move in proportion) is rounded by a curve that leaves the first block `d1`
+//! before the corner and joins the second `d2` after it (its legs), run by a parameter `λ`
+//! from 0 to `L = d1 + d2` (`t = λ / L`):
 //!
-//! `p(λ) = C - d u1 + λ u1 + 2d W(t) (u2 - u1)`, `W(t) = ∫ w`, `w` from the curve's
-//! [`Shape`].
+//! `p(λ) = C - d1 u1 + λ u1 + L W(t) (u2 - u1)`, `W(t) = ∫ w`, `w` from the curve's
+//! [`Shape`] with `W(1) = d2 / L`.
 //!
 //! So `p' = u1 + w (u2 - u1)` turns from `u1` to `u2` without a kink, `p''` is
-//! `w'/(2d) (u2 - u1)` and `p'''` is `w''/(2d)² (u2 - u1)`. Between two straight pieces
+//! `w'/L (u2 - u1)` and `p'''` is `w''/L² (u2 - u1)`. The legs are equal (`d`) except
+//! where a straight block meets an arc's chords: there the straight's leg is up to twice the
+//! chord's and the curvature ramps from 0 into the arc's (a transition). Between two straight pieces
 //! the shape is the triangle: the curvature rises linearly from 0 to `(u2 - u1)/d` at the
 //! middle and back to 0 (no step in any axis's acceleration), and `p'''` is `±(u2 - u1)/d²`,
 //! the smallest third derivative any such curve of this length can have. Its middle lies
@@ -57,8 +59,9 @@ pub struct Piece {
     pub turn: AxisValues,
     /// The path parameter's range.
     pub length: f64,
-    /// Of a curve: `d`; 0 for a straight piece.
-    pub half: f64,
+    /// Of a curve: its legs `d1`, `d2` (before and after the corner); zeros for a straight
+    /// piece.
+    pub legs: [f64; 2],
     /// Velocity the axes allow (and, on a curve, its curvature).
     pub hard_cap: f64,
     /// Programmed feed (path units/s); infinite for rapid.
@@ -81,6 +84,8 @@ pub struct Piece {
     pub tolerance: f64,
     /// The block's source line.
     pub line: u32,
+    /// Part of an arc's chords (a straight block meeting them gets a transition).
+    pub on_arc: bool,
     /// The block's full length (a straight piece gives at most half of it to each corner).
     pub block_length: f64,
     /// Look-ahead bounds on the velocity at the piece's end: with the axes' caps only, and
@@ -124,7 +129,7 @@ impl Piece {
             dir,
             turn: AxisValues::zeros(dir.len()),
             length,
-            half: 0.0,
+            legs: [0.0, 0.0],
             hard_cap: cap,
             feed: f64::INFINITY,
             rapid: false,
@@ -138,29 +143,32 @@ impl Piece {
             junction_cap: f64::INFINITY,
             tolerance: 0.0,
             line: 0,
+            on_arc: false,
             block_length,
             bound_hard: 0.0,
             bound_soft: 0.0,
         }
     }
 
-    /// The curve rounding `corner` from direction `u1` to `u2` with half-size `d`, its
+    /// The curve rounding `corner` from direction `u1` to `u2` with legs `legs`, its
     /// curvature at its ends `shape` of its mean, for axes with `limits` and a path at up to
     /// `feed` (infinite for rapid): the path parameter's acceleration is shared out at the
     /// speed the curve will run at.
     pub fn curve(
         corner: &AxisValues,
         (u1, u2): (&AxisValues, &AxisValues),
-        d: f64,
+        legs: [f64; 2],
         shape: [f64; 2],
         (limits, feed): (&[AxisLimits], f64),
     ) -> Self {
         let mut origin = *corner;
         let mut turn = *u1;
         for i in 0..corner.len() {
-            origin[i] = corner[i] - d * u1[i];
+            origin[i] = corner[i] - legs[0] * u1[i];
             turn[i] = u2[i] - u1[i];
         }
+        let length = legs[0] + legs[1];
+        let form = Shape::new(shape, legs[1] / length);
         let n = corner.len();
         // A curve meeting another keeps a share of the jerk for the step where they meet.
         let shared = shape[0] > 0.0 || shape[1] > 0.0;
@@ -169,7 +177,7 @@ impl Piece {
             if shared {
                 limit.jerk *= 1.0 - super::corner::JUNCTION_JERK_SHARE;
             }
-            Bounds::new(u1[i], u2[i], d, &Shape::new(shape), limit)
+            Bounds::new(u1[i], u2[i], length, &form, limit)
         };
         // For a share of the jerk: the path parameter's jerk first, then the speed the
         // curvature leaves room for, then the path parameter's acceleration at 90 % of that
@@ -200,18 +208,19 @@ impl Piece {
             origin,
             dir: *u1,
             turn,
-            length: 2.0 * d,
-            half: d,
+            length,
+            legs,
             hard_cap: cap,
             feed: f64::INFINITY,
             rapid: false,
             dynamics,
             rest_after: false,
             chain: false,
-            shape: Shape::new(shape),
+            shape: form,
             junction_cap: f64::INFINITY,
             tolerance: 0.0,
             line: 0,
+            on_arc: false,
             block_length: 0.0,
             bound_hard: 0.0,
             bound_soft: 0.0,
@@ -228,11 +237,16 @@ impl Piece {
         }
     }
 
+    /// Whether the piece is a curve.
+    pub fn is_curve(&self) -> bool {
+        self.legs[0] > 0.0
+    }
+
     /// The point at `lambda`.
     pub fn point(&self, lambda: f64, out: &mut AxisValues) {
-        let w = if self.half > 0.0 {
-            let t = (lambda / (2.0 * self.half)).clamp(0.0, 1.0);
-            2.0 * self.half * self.shape.at(t).0
+        let w = if self.is_curve() {
+            let t = (lambda / self.length).clamp(0.0, 1.0);
+            self.length * self.shape.at(t).0
         } else {
             0.0
         };
@@ -249,10 +263,10 @@ impl Piece {
         velocity: &mut AxisValues,
         acceleration: &mut AxisValues,
     ) {
-        let (w1, w2) = if self.half > 0.0 {
-            let t = (lambda / (2.0 * self.half)).clamp(0.0, 1.0);
+        let (w1, w2) = if self.is_curve() {
+            let t = (lambda / self.length).clamp(0.0, 1.0);
             let (_, w, dw) = self.shape.at(t);
-            (w, dw / (2.0 * self.half))
+            (w, dw / self.length)
         } else {
             (0.0, 0.0)
         };
@@ -267,7 +281,7 @@ impl Piece {
     pub fn corner(&self) -> (AxisValues, AxisValues, AxisValues) {
         let (mut corner, mut u2) = (self.origin, self.dir);
         for i in 0..corner.len() {
-            corner[i] += self.half * self.dir[i];
+            corner[i] += self.legs[0] * self.dir[i];
             u2[i] += self.turn[i];
         }
         (corner, self.dir, u2)
@@ -277,13 +291,16 @@ impl Piece {
     /// corner it rounds (in X, Y, Z).
     pub fn deviation(&self) -> f64 {
         let (corner, u1, u2) = self.corner();
-        let d = self.half;
         let mut point = self.origin;
         let mut worst = 0.0f64;
         for k in 1..DEVIATION_SAMPLES {
-            self.point(2.0 * d * k as f64 / DEVIATION_SAMPLES as f64, &mut point);
+            self.point(
+                self.length * k as f64 / DEVIATION_SAMPLES as f64,
+                &mut point,
+            );
             let leg = |u: &AxisValues, sign: f64| {
                 let rel = |i: usize| point[i] - corner[i];
+                let d = self.legs[usize::from(sign > 0.0)];
                 let along = ((0..3).map(|i| rel(i) * u[i]).sum::<f64>() * sign).clamp(0.0, d);
                 (0..3)
                     .map(|i| (rel(i) - sign * along * u[i]).powi(2))
@@ -314,12 +331,12 @@ struct Bounds {
 }
 
 impl Bounds {
-    fn new(u1: f64, u2: f64, d: f64, shape: &Shape, limit: AxisLimits) -> Self {
+    fn new(u1: f64, u2: f64, length: f64, shape: &Shape, limit: AxisLimits) -> Self {
         let du = (u2 - u1).abs();
         Self {
             g1: u1.abs().max(u2.abs()),
-            g2: shape.peak() * du / (2.0 * d),
-            g3: shape.steepest() * du / (4.0 * d * d),
+            g2: shape.peak() * du / length,
+            g3: shape.steepest() * du / (length * length),
             limit,
         }
     }

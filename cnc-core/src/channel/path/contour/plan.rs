@@ -51,13 +51,14 @@ struct Right {
 
 impl Contour {
     /// Whether piece `i` is planned in one unit with piece `i - 1`. The window's last piece is
-    /// a unit of its own until the window closes: the next block may still shorten it.
+    /// a unit of its own until the window closes and an arc's last chord has joined: the next
+    /// block or chord may still shorten it.
     pub(super) fn joins(&self, i: usize) -> bool {
         i > 0
             && i < self.pieces.len()
             && self.pieces[i].chain
             && !self.pieces[i - 1].rest_after
-            && (self.closed || i + 1 < self.pieces.len())
+            && ((self.closed && self.arc.is_none()) || i + 1 < self.pieces.len())
     }
 
     /// The last piece of the unit that piece `i` belongs to.

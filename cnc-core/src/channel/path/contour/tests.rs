@@ -5,9 +5,9 @@
 use super::*;
 use proptest::prelude::*;
 
-const CYCLE: f64 = 0.001;
+pub(super) const CYCLE: f64 = 0.001;
 
-fn limits(n: usize) -> Vec<AxisLimits> {
+pub(super) fn limits(n: usize) -> Vec<AxisLimits> {
     vec![
         AxisLimits {
             velocity: 200.0,
@@ -39,9 +39,9 @@ fn values(p: [f64; 3]) -> AxisValues {
 
 /// What a run gave, tick by tick: the position and the block under way (its index in the
 /// polyline: block `k` runs from point `k - 1` to point `k`).
-struct Trace {
-    positions: Vec<AxisValues>,
-    blocks: Vec<usize>,
+pub(super) struct Trace {
+    pub(super) positions: Vec<AxisValues>,
+    pub(super) blocks: Vec<usize>,
 }
 
 /// Runs `points` at `feed` (mm/s) with `tolerance` (None: exact stop), feeding blocks as the
@@ -83,6 +83,7 @@ fn run_with(
                 line: next as u32,
                 blend: tolerance,
                 chamfer: true,
+                on_arc: false,
             };
             c.push(&seg, &mut |_| {}).expect("a straight block");
             next += 1;
@@ -136,7 +137,7 @@ fn worst_deviation(trace: &Trace, points: &[[f64; 3]]) -> f64 {
 }
 
 /// The largest |velocity|, |acceleration| and |jerk| of any axis by differences over ticks.
-fn worst_rates(trace: &Trace) -> (f64, f64, f64) {
+pub(super) fn worst_rates(trace: &Trace) -> (f64, f64, f64) {
     let p = &trace.positions;
     let (mut v, mut a, mut j) = (0.0f64, 0.0f64, 0.0f64);
     for k in 3..p.len() {
@@ -213,6 +214,7 @@ fn a_stop_comes_to_rest_on_the_path_and_empties_the_window() {
                 line: next as u32,
                 blend: Some(0.02),
                 chamfer: true,
+                on_arc: false,
             };
             c.push(&seg, &mut |_| {}).unwrap();
             next += 1;

@@ -1,0 +1,346 @@
+//! Arcs in the contour against their promises: lines and arcs in any order within the
+//! tolerance of the exact lines and circles and within every axis's limits, ending on the
+//! last point; tangent transitions without slowing; small circles on fine chords.
+
+use super::tests::{limits, worst_rates, Trace, CYCLE};
+use super::*;
+use crate::nc::arc::{ArcMove, Plane};
+use arc::ArcBlock;
+use proptest::prelude::*;
+
+/// One block of a path in the XY plane.
+#[derive(Debug, Clone, Copy)]
+enum Element {
+    Line {
+        end: [f64; 2],
+    },
+    Arc {
+        end: [f64; 2],
+        center: [f64; 2],
+        ccw: bool,
+        radius: f64,
+        sweep: f64,
+    },
+}
+
+impl Element {
+    fn end(&self) -> [f64; 2] {
+        match *self {
+            Self::Line { end } | Self::Arc { end, .. } => end,
+        }
+    }
+}
+
+fn xyz(p: [f64; 2]) -> AxisValues {
+    AxisValues::from_slice(&[p[0], p[1], 0.0])
+}
+
+/// One step of a walk: a line of `length` or an arc of `radius` and `sweep` (rad, its sign
+/// the side), after turning the heading by `turn` (0: tangent).
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    arc: bool,
+    turn: f64,
+    length: f64,
+    radius: f64,
+    sweep: f64,
+}
+
+/// The blocks of a walk from the origin heading along X.
+fn walk(steps: &[Step]) -> Vec<Element> {
+    let (mut at, mut heading) = ([0.0f64, 0.0f64], 0.0f64);
+    let mut path = Vec::new();
+    for s in steps {
+        heading += s.turn;
+        if s.arc {
+            let side = s.sweep.signum();
+            let normal = heading + side * core::f64::consts::FRAC_PI_2;
+            let center = [
+                at[0] + s.radius * normal.cos(),
+                at[1] + s.radius * normal.sin(),
+            ];
+            let from = normal + core::f64::consts::PI;
+            let to = from + s.sweep;
+            let end = [
+                center[0] + s.radius * to.cos(),
+                center[1] + s.radius * to.sin(),
+            ];
+            path.push(Element::Arc {
+                end,
+                center,
+                ccw: side > 0.0,
+                radius: s.radius,
+                sweep: s.sweep.abs(),
+            });
+            heading += s.sweep;
+            at = end;
+        } else {
+            at = [
+                at[0] + s.length * heading.cos(),
+                at[1] + s.length * heading.sin(),
+            ];
+            path.push(Element::Line { end: at });
+        }
+    }
+    path
+}
+
+/// Runs `path` at `feed` within `tol`, looking ahead `lookahead` blocks; `Err` when an arc
+/// does not join.
+fn run(path: &[Element], feed: f64, tol: f64, lookahead: usize) -> Result<Trace, String> {
+    let lim = limits(3);
+    let mut c = Contour::new(&lim, CYCLE, lookahead);
+    let mut next = 0;
+    let mut start = [0.0, 0.0];
+    let mut pos = xyz(start);
+    let (mut vel, mut acc) = (AxisValues::zeros(3), AxisValues::zeros(3));
+    let mut trace = Trace {
+        positions: vec![pos],
+        blocks: vec![0],
+    };
+    for _ in 0..2_000_000 {
+        while next < path.len() && c.has_room() {
+            let line = next as u32 + 1;
+            // As the channel does: the corner after an arc keeps half the tolerance (its
+            // chords lie up to the other half inside the circle).
+            let after_arc = next > 0 && matches!(path[next - 1], Element::Arc { .. });
+            let blend = (next > 0).then_some(if after_arc { 0.5 * tol } else { tol });
+            match path[next] {
+                Element::Line { end } => {
+                    let seg = Segment {
+                        start: xyz(start),
+                        end: xyz(end),
+                        feed,
+                        rapid: false,
+                        line,
+                        blend,
+                        chamfer: true,
+                        on_arc: false,
+                    };
+                    c.push(&seg, &mut |_| {}).expect("a straight block");
+                }
+                Element::Arc {
+                    end, center, ccw, ..
+                } => {
+                    let block = ArcBlock {
+                        start: xyz(start),
+                        end: xyz(end),
+                        arc: ArcMove {
+                            plane: Plane::Xy,
+                            center,
+                            ccw,
+                            full_turn: false,
+                        },
+                        feed,
+                        line,
+                        blend,
+                        tolerance: tol,
+                    };
+                    c.push_arc(&block)
+                        .map_err(|e| format!("arc {line}: {e:?}"))?;
+                }
+            }
+            start = path[next].end();
+            next += 1;
+        }
+        if next == path.len() {
+            c.close();
+        }
+        let moving = c.step(&mut pos, &mut vel, &mut acc).expect("no fault");
+        trace.positions.push(pos);
+        let block = c
+            .line()
+            .map_or(*trace.blocks.last().unwrap(), |l| l as usize - 1);
+        trace.blocks.push(block);
+        if !moving && next == path.len() {
+            return Ok(trace);
+        }
+    }
+    Err("did not finish".into())
+}
+
+/// The distance of `p` from block `k` of `path` (its exact line or circle).
+fn distance(path: &[Element], k: usize, p: &[f64]) -> f64 {
+    let a = if k == 0 {
+        [0.0, 0.0]
+    } else {
+        path[k - 1].end()
+    };
+    match path[k] {
+        Element::Line { end: b } => {
+            let ab = [b[0] - a[0], b[1] - a[1]];
+            let ap = [p[0] - a[0], p[1] - a[1]];
+            let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+            let t = ((ap[0] * ab[0] + ap[1] * ab[1]) / len2).clamp(0.0, 1.0);
+            (ap[0] - t * ab[0]).hypot(ap[1] - t * ab[1])
+        }
+        Element::Arc {
+            end,
+            center,
+            ccw,
+            radius,
+            sweep,
+        } => {
+            let angle = |q: [f64; 2]| (q[1] - center[1]).atan2(q[0] - center[0]);
+            let sign = if ccw { 1.0 } else { -1.0 };
+            let along =
+                ((angle([p[0], p[1]]) - angle(a)) * sign).rem_euclid(core::f64::consts::TAU);
+            if along <= sweep {
+                ((p[0] - center[0]).hypot(p[1] - center[1]) - radius).abs()
+            } else {
+                (p[0] - a[0])
+                    .hypot(p[1] - a[1])
+                    .min((p[0] - end[0]).hypot(p[1] - end[1]))
+            }
+        }
+    }
+}
+
+/// Every tick within `tol` of the block under way or its neighbours, within the limits, the
+/// run ending on the last point.
+fn kept_its_promises(t: &Trace, path: &[Element], tol: f64) -> Result<(), String> {
+    let mut worst = 0.0f64;
+    for (p, &k) in t.positions.iter().zip(&t.blocks) {
+        let near = (k.saturating_sub(2)..(k + 2).min(path.len()))
+            .map(|j| distance(path, j, p))
+            .fold(f64::INFINITY, f64::min);
+        worst = worst.max(near + p[2].abs());
+    }
+    let l = limits(1)[0];
+    let (v, a, j) = worst_rates(t);
+    let slack = 1.0 + 1e-6;
+    let end = t.positions.last().unwrap();
+    let goal = path.last().unwrap().end();
+    if worst > tol + 1e-9 {
+        Err(format!("deviation {worst} > {tol}"))
+    } else if v > l.velocity * slack || a > l.acceleration * slack || j > l.jerk * slack {
+        Err(format!("velocity {v}, acceleration {a}, jerk {j}"))
+    } else if [end[0], end[1]] != goal {
+        Err(format!("ended at {end:?}, not {goal:?}"))
+    } else {
+        Ok(())
+    }
+}
+
+/// The ticks between the first and the last moving one on which the path stood still.
+fn stops_on_the_way(t: &Trace) -> usize {
+    let moved: Vec<bool> = t
+        .positions
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) > 1e-12)
+        .collect();
+    let first = moved.iter().position(|&m| m).unwrap_or(0);
+    let last = moved.iter().rposition(|&m| m).unwrap_or(0);
+    moved[first..=last].iter().filter(|&&m| !m).count()
+}
+
+fn step() -> impl Strategy<Value = Step> {
+    (
+        any::<bool>(),
+        prop_oneof![Just(0.0), -1.5f64..1.5],
+        1.0f64..30.0,
+        prop_oneof![20.0f64..100.0, 100.0f64..400.0],
+        prop_oneof![0.2f64..2.5, -2.5f64..-0.2],
+    )
+        .prop_map(|(arc, turn, length, radius, sweep)| Step {
+            arc,
+            turn,
+            length,
+            radius,
+            sweep,
+        })
+}
+
+/// The slowest speed (mm/s) between the first and the last tick at `above` or more.
+fn slowest_between(t: &Trace, above: f64) -> f64 {
+    let speed: Vec<f64> = t
+        .positions
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
+        .collect();
+    let first = speed.iter().position(|&v| v >= above).unwrap_or(0);
+    let last = speed.iter().rposition(|&v| v >= above).unwrap_or(0);
+    speed[first..=last]
+        .iter()
+        .copied()
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn line(length: f64, turn: f64) -> Step {
+    Step {
+        arc: false,
+        turn,
+        length,
+        radius: 0.0,
+        sweep: 0.0,
+    }
+}
+
+fn arc(radius: f64, sweep_deg: f64) -> Step {
+    Step {
+        arc: true,
+        turn: 0.0,
+        length: 0.0,
+        radius,
+        sweep: sweep_deg.to_radians(),
+    }
+}
+
+#[test]
+fn tangent_transitions_keep_the_feed() {
+    // A line, a quarter circle, a line, a half circle the other way, a line.
+    let path = walk(&[
+        line(30.0, 0.0),
+        arc(50.0, 90.0),
+        line(30.0, 0.0),
+        arc(60.0, -180.0),
+        line(20.0, 0.0),
+    ]);
+    let t = run(&path, 100.0, 0.02, 32).unwrap();
+    kept_its_promises(&t, &path, 0.02).unwrap();
+    let slowest = slowest_between(&t, 99.9);
+    assert!(slowest >= 99.9, "slowed to {slowest} mm/s at a transition");
+}
+
+/// A small circle whose chords would run it slower than it runs on its own (the curvature's
+/// direction steps at every chord junction) does not join: the channel runs it on its own.
+#[test]
+fn a_small_circle_whose_chords_are_slow_runs_on_its_own() {
+    let path = walk(&[line(10.0, 0.0), arc(10.0, 270.0), line(10.0, 0.0)]);
+    assert!(run(&path, 100.0, 0.02, 128).is_err());
+    let t = run(&path, 20.0, 0.02, 32).unwrap();
+    kept_its_promises(&t, &path, 0.02).unwrap();
+    assert_eq!(stops_on_the_way(&t), 0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Lines and arcs in any order, tangent or at corners, keep the tolerance and the limits
+    /// and end on the last point; where every transition is tangent the path never stops on
+    /// the way where the chords are not short. (The feed is one whose chords keep the arcs' speed: 100 mm/s for radii of 100
+    /// mm and more, 30 mm/s below; the channel runs an arc whose chords would be slower on its
+    /// own.)
+    #[test]
+    fn random_lines_and_arcs_keep_tolerance_and_limits(
+        steps in proptest::collection::vec(step(), 2..10),
+        tol in 0.005f64..0.1,
+        tangent in any::<bool>(),
+    ) {
+        let steps: Vec<Step> = steps
+            .into_iter()
+            .map(|s| if tangent { Step { turn: 0.0, ..s } } else { s })
+            .collect();
+        let path = walk(&steps);
+        let small = steps.iter().any(|s| s.arc && s.radius < 100.0);
+        let feed = if small { 30.0 } else { 100.0 };
+        let t = run(&path, feed, tol, 64).map_err(TestCaseError::fail)?;
+        kept_its_promises(&t, &path, tol).map_err(TestCaseError::fail)?;
+        // Not claimed for short chords (small radii, tiny tolerances): there the run under
+        // way may already cover the window nearly to its end when the next arc's first
+        // chord comes, and its corner is stopped at (the look-ahead keeps its committed end).
+        if tangent && !small && tol >= 0.02 {
+            prop_assert_eq!(stops_on_the_way(&t), 0);
+        }
+    }
+}
