@@ -31,10 +31,10 @@ pub fn unavailable() -> Option<String> {
     None
 }
 
-/// Runs each program `repeats` times, interleaved, each starting at its first point; the
-/// median time per program (first to last moving poll), or why it failed.
+/// Runs each program (name, start point, blocks) `repeats` times, interleaved, each from its
+/// start point; the median time per program (first to last moving poll), or why it failed.
 pub fn run(
-    programs: &[(&str, Vec<[f64; 2]>)],
+    programs: &[(&str, [f64; 2], String)],
     dev: f64,
     feed_mm_min: f64,
     repeats: usize,
@@ -49,7 +49,7 @@ pub fn run(
 
 fn run_in(
     dir: &Path,
-    programs: &[(&str, Vec<[f64; 2]>)],
+    programs: &[(&str, [f64; 2], String)],
     (dev, feed): (f64, f64),
     repeats: usize,
 ) -> Result<Vec<f64>, String> {
@@ -69,13 +69,10 @@ fn run_in(
     std::fs::write(dir.join("sim.var"), "").map_err(|e| e.to_string())?;
     std::fs::write(dir.join("tool.tbl"), "T1 P1 D0 Z0 ;\n").map_err(|e| e.to_string())?;
     let mut files: Vec<PathBuf> = Vec::new();
-    for (name, points) in programs {
+    for (name, [x0, y0], blocks) in programs {
         let path = dir.join(format!("{name}.ngc"));
-        let [x0, y0] = points[0];
         let mut text = format!("(PEER_START X{x0:.6} Y{y0:.6})\nG21 G90 G64 P{dev}\nG1 F{feed}\n");
-        for [x, y] in &points[1..] {
-            text.push_str(&format!("X{x:.6} Y{y:.6}\n"));
-        }
+        text.push_str(blocks);
         text.push_str("M2\n");
         std::fs::write(&path, text).map_err(|e| e.to_string())?;
         files.push(path);
