@@ -31,9 +31,12 @@ pub struct RealtimeOptions {
     #[arg(long = "rt-cpu-wake-latency-us")]
     pub cpu_wake_latency_us: Option<u32>,
     /// How the CNC wakes the PLC for a tick in real time: `event` (iceoryx2's event, the
-    /// default) or `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
-    /// segment, the CNC wakes it with one `futex(2)` call). The CNC hands its choice to the
-    /// PLC it spawns.
+    /// default), `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
+    /// segment, the CNC wakes it with one `futex(2)` call) or `spin` (as `futex`, but the PLC
+    /// wakes by a timed sleep shortly before the tick is due and spins on that word until the
+    /// tick is done, at most half a cycle past its due time, before it sleeps on it: its
+    /// wake-up no longer waits for the scheduler after the tick; it takes a core for the
+    /// spin). The CNC hands its choice to the PLC it spawns.
     #[arg(long = "rt-wake", value_enum)]
     pub wake: Option<WakePath>,
 }
@@ -47,6 +50,9 @@ pub enum WakePath {
     Event,
     /// A futex on the low word of the CNC's heartbeat in the segment.
     Futex,
+    /// A timed sleep to shortly before the tick is due, a bounded spin on the heartbeat's
+    /// word, then its futex.
+    Spin,
 }
 
 impl WakePath {
@@ -55,7 +61,13 @@ impl WakePath {
         match self {
             WakePath::Event => "event",
             WakePath::Futex => "futex",
+            WakePath::Spin => "spin",
         }
+    }
+
+    /// Whether the CNC wakes the PLC on the heartbeat's word (`futex` and `spin`).
+    pub fn on_the_word(self) -> bool {
+        matches!(self, WakePath::Futex | WakePath::Spin)
     }
 }
 
@@ -74,11 +86,17 @@ impl RealtimeOptions {
 
     /// The options for the PLC process a CNC with these options spawns: one priority below
     /// the CNC's thread (the tick comes first), the same memory lock and timer slack, no CPU
-    /// of its own (the scenario's `[realtime_plc]` can pin it).
+    /// of its own (the scenario's `[realtime_plc]` can pin it), except that a PLC that spins
+    /// for its ticks (`--rt-wake spin`) beside a CNC pinned to a CPU goes to another (the
+    /// lowest other: CPU 0, or 1 beside a CNC on 0), so its spin never takes the tick's core.
     pub fn for_plc(&self) -> RealtimeOptions {
+        let beside = match (self.wake, self.cpu) {
+            (Some(WakePath::Spin), Some(cpu)) => Some(usize::from(cpu == 0)),
+            _ => None,
+        };
         RealtimeOptions {
             priority: self.priority.map(|p| p.saturating_sub(1).max(1)),
-            cpu: None,
+            cpu: beside,
             lock_memory: self.lock_memory,
             timer_slack_ns: self.timer_slack_ns,
             // The CNC's request holds for the whole machine.
@@ -170,8 +188,10 @@ impl RealtimeOptions {
         if self.any() {
             eprintln!("{who}: real-time options need Linux; running without them");
         }
-        if self.wake == Some(WakePath::Futex) {
-            applied.push("wake-up by futex".into());
+        match self.wake {
+            Some(WakePath::Futex) => applied.push("wake-up by futex".into()),
+            Some(WakePath::Spin) => applied.push("wake-up by a timed sleep and a spin".into()),
+            _ => {}
         }
         applied
     }
@@ -180,6 +200,22 @@ impl RealtimeOptions {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_spinning_plc_goes_beside_a_pinned_cnc() {
+        let cnc = |cpu, wake| RealtimeOptions {
+            cpu,
+            wake,
+            ..RealtimeOptions::default()
+        };
+        let spin = Some(WakePath::Spin);
+        assert_eq!(cnc(Some(1), spin).for_plc().cpu, Some(0));
+        assert_eq!(cnc(Some(0), spin).for_plc().cpu, Some(1));
+        assert_eq!(cnc(Some(3), spin).for_plc().cpu, Some(0));
+        assert_eq!(cnc(None, spin).for_plc().cpu, None);
+        assert_eq!(cnc(Some(1), Some(WakePath::Futex)).for_plc().cpu, None);
+        assert_eq!(WakePath::Spin.name(), "spin");
+    }
 
     #[test]
     fn flags_win_over_the_file_and_round_trip_as_arguments() {

@@ -33,6 +33,11 @@ use hli_transport::rpc::AcyclicClient;
 use hli_transport::segment::{AttachError, HeaderFault, PlcSegment};
 
 use crate::realtime::WakePath;
+
+/// With `WakePath::Spin` the PLC wakes this long before a tick is due (at most a quarter of
+/// the cycle) and spins until the tick is done: a wake-up up to this late still finds the
+/// tick.
+const SPIN_LEAD_NS: u64 = 100_000;
 use crate::wakeups::{Wakeup, WorstWakeups};
 pub use crate::watchdog::CncLoss;
 use crate::watchdog::CncWatch;
@@ -359,10 +364,16 @@ impl PlcRuntime {
     }
 
     /// Sleeps until the CNC's next tick after heartbeat `seen`, at most one wait step: on its
-    /// event, or on the low word of its heartbeat (`WakePath::Futex`, in real time).
+    /// event, or on the low word of its heartbeat (`WakePath::Futex`, in real time; with
+    /// `WakePath::Spin` after a timed sleep and a bounded spin on that word).
     fn wait_for_tick(&self, seen: u64) -> Result<(), RuntimeError> {
-        if self.wake == WakePath::Futex && !self.segment.cnc_timing().lockstep {
+        let timing = self.segment.cnc_timing();
+        if self.wake.on_the_word() && !timing.lockstep {
             let word = hli::image::cnc_heartbeat_word(self.segment.memory());
+            if self.wake == WakePath::Spin && self.spin_for_tick(word, seen, timing.cycle_ns) {
+                self.events.poll()?;
+                return Ok(());
+            }
             cnc_os::futex::wait(word, seen as u32, self.wait_step)
                 .map_err(|e| RuntimeError::Wait(e.to_string()))?;
             // The CNC's events still arrive (lockstep keeps them): taken without waiting.
@@ -371,6 +382,44 @@ impl PlcRuntime {
         }
         self.events.wait(self.wait_step)?;
         Ok(())
+    }
+
+    /// Sleeps to [`SPIN_LEAD_NS`] before the tick after heartbeat `seen` is due, then spins
+    /// on the heartbeat's `word` until it changes or half a cycle has passed after the due
+    /// time: whether it changed. Not before the CNC announced its epoch. Two clock reads
+    /// (vDSO) and one `clock_nanosleep` per tick besides the spin's reads.
+    fn spin_for_tick(
+        &self,
+        word: &core::sync::atomic::AtomicU32,
+        seen: u64,
+        cycle_ns: u32,
+    ) -> bool {
+        use core::sync::atomic::Ordering;
+        let at = core::mem::offset_of!(HliSegmentHeader, cnc_epoch_ns);
+        let epoch = self.segment.memory().place::<u64>(at).load();
+        if epoch == 0 {
+            return false;
+        }
+        let cycle = u64::from(cycle_ns);
+        let due = epoch.saturating_add(seen.saturating_add(1).saturating_mul(cycle));
+        let lead = SPIN_LEAD_NS.min(cycle / 4);
+        let (wall, mono) = (crate::wakeups::wall_now_ns(), cnc_os::monotonic::now());
+        let to_mono = |t: u64| mono + core::time::Duration::from_nanos(t.saturating_sub(wall));
+        cnc_os::monotonic::sleep_until(to_mono(due.saturating_sub(lead)));
+        let until = to_mono(due.saturating_add(cycle / 2));
+        let seen = seen as u32;
+        loop {
+            // Several reads between clock reads: the word is the thing to watch.
+            for _ in 0..64 {
+                if word.load(Ordering::Acquire) != seen {
+                    return true;
+                }
+                core::hint::spin_loop();
+            }
+            if cnc_os::monotonic::now() >= until {
+                return false;
+            }
+        }
     }
 
     /// Leaves the segment: the PLC's pid leaves the header, the event and call services

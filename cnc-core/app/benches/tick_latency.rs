@@ -11,6 +11,12 @@
 //! absent is skipped and said so. `CNC_BENCH_SMOKE=1`: one short round (CI: no timing
 //! asserted). Run: `cargo bench -p cnc-app --bench tick_latency`.
 //!
+//! At 250 µs, example 4 runs twice per round: with the default wake path (the event) and
+//! with `--rt-wake spin --rt-cpu 1` (the PLC spins for its ticks on CPU 0, beside the CNC's
+//! thread on CPU 1), the latter against `cyclictest -a 1` on the same CPU; both against
+//! cyclictest's loops late by a whole cycle (issue 55's overrun target). The pinned rows need
+//! two CPUs and are skipped, and said so, with one.
+//!
 //! The compute target's baseline is a constant job in the same shape as the demo: this bench
 //! started again as two processes ([`peer`]), one at SCHED_FIFO 80 that wakes every 1 ms at an
 //! absolute deadline and runs the same pass over 512 KiB each time (timed as the CNC times its
@@ -52,7 +58,7 @@ fn number(text: &str, anchor: &str, key: &str) -> Option<f64> {
 }
 
 /// `cnc run` of `path` for `ticks` of `cycle_us`, with the real-time options when `rt`.
-fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32) -> Option<Figures> {
+fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32, extra: &[&str]) -> Option<Figures> {
     let mut c = Command::new(env!("CARGO_BIN_EXE_cnc"));
     c.args(["run", path.to_str()?, "--ticks", &ticks.to_string()]);
     c.args(["--cycle-ms", &(f64::from(cycle_us) / 1000.0).to_string()]);
@@ -63,6 +69,7 @@ fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32) -> Option<Figures> {
     if rt {
         c.args(plc_shim::realtime::RealtimeOptions::measured().to_args());
     }
+    c.args(extra);
     let out = c.output().ok()?;
     let text = String::from_utf8_lossy(&out.stdout);
     let ns = |anchor: &str, key: &str| number(&text, anchor, key).map(|v| v / 1000.0);
@@ -75,7 +82,7 @@ fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32) -> Option<Figures> {
 
 /// (p50, p99) latency in us from cyclictest's histogram (every `interval_us`), `None`
 /// when it is not installed.
-fn cyclictest(loops: u64, rt: bool, interval_us: u32) -> Option<Figures> {
+fn cyclictest(loops: u64, rt: bool, interval_us: u32, cpu: Option<u32>) -> Option<Figures> {
     let mut c = Command::new("cyclictest");
     c.args([
         "-m",
@@ -87,6 +94,9 @@ fn cyclictest(loops: u64, rt: bool, interval_us: u32) -> Option<Figures> {
         "-h",
         "10000",
     ]);
+    if let Some(cpu) = cpu {
+        c.args(["-a", &cpu.to_string()]);
+    }
     if rt {
         c.args(["-p", "80"]);
     } else {
@@ -234,19 +244,30 @@ fn main() {
         "cyclictest -m -p 80 -i 250",
         "example 4 at 250 us, real-time options",
         "constant job every 1 ms beside a companion",
+        "cyclictest -m -p 80 -a 1 -i 250",
+        "example 4 at 250 us, RT, spin, CPU 1",
     ];
+    // The spinning PLC goes to another CPU than the CNC's: two are needed.
+    let two_cpus = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
+    const SPIN: [&str; 4] = ["--rt-wake", "spin", "--rt-cpu", "1"];
     let mut rows: Vec<Vec<Figures>> = vec![Vec::new(); names.len()];
     for _ in 0..rounds {
         if present {
-            rows[0].extend(cyclictest(demo_ticks, true, 1000));
-            rows[1].extend(cyclictest(demo_ticks, false, 1000));
-            rows[6].extend(cyclictest(fast_ticks, true, 250));
+            rows[0].extend(cyclictest(demo_ticks, true, 1000, None));
+            rows[1].extend(cyclictest(demo_ticks, false, 1000, None));
+            rows[6].extend(cyclictest(fast_ticks, true, 250, None));
+            if two_cpus {
+                rows[9].extend(cyclictest(fast_ticks, true, 250, Some(1)));
+            }
         }
-        rows[2].extend(cnc(&demo, demo_ticks, true, 1000));
-        rows[3].extend(cnc(&demo, demo_ticks, false, 1000));
-        rows[4].extend(cnc(&ex4, ex4_ticks, true, 1000));
-        rows[5].extend(cnc(&ex4, ex4_ticks, false, 1000));
-        rows[7].extend(cnc(&ex4, fast_ticks, true, 250));
+        rows[2].extend(cnc(&demo, demo_ticks, true, 1000, &[]));
+        rows[3].extend(cnc(&demo, demo_ticks, false, 1000, &[]));
+        rows[4].extend(cnc(&ex4, ex4_ticks, true, 1000, &[]));
+        rows[5].extend(cnc(&ex4, ex4_ticks, false, 1000, &[]));
+        rows[7].extend(cnc(&ex4, fast_ticks, true, 250, &[]));
+        if two_cpus {
+            rows[10].extend(cnc(&ex4, fast_ticks, true, 250, &SPIN));
+        }
         rows[8].extend(constant_work(demo_ticks));
     }
     println!("tick start lateness (us), cycle 1 ms, medians of {rounds} interleaved rounds; demo {demo_ticks} ticks, example 4 {ex4_ticks}");
@@ -297,9 +318,9 @@ fn main() {
     }
 }
 
-/// Rows 0, 1 and 6 are cyclictest's (row 8, the constant job, has no lateness).
+/// Rows 0, 1, 6 and 9 are cyclictest's (row 8, the constant job, has no lateness).
 fn rows_of_cyclictest(i: usize) -> bool {
-    matches!(i, 0 | 1 | 6)
+    matches!(i, 0 | 1 | 6 | 9)
 }
 
 /// One `TARGET` line per target, from the medians of the rows.
@@ -361,4 +382,22 @@ fn targets(med: &[Option<Figures>]) {
         6,
     );
     rest("example 4 at 250 us RT", 7);
+    lateness(
+        "example 4 at 250 us RT, spin wake, CNC on CPU 1: start lateness p99 <= 1.5x cyclictest -p 80 -a 1 -i 250 p99",
+        10,
+        9,
+    );
+    rest("example 4 at 250 us RT, spin wake, CNC on CPU 1", 10);
+    for (what, ours) in [("event wake", 7), ("spin wake, CNC on CPU 1", 10)] {
+        let peer = if ours == 10 { 9 } else { 6 };
+        match (med[ours], med[peer]) {
+            (Some(a), Some(b)) => println!(
+                "TARGET | example 4 at 250 us RT, {what}: PLC overruns <= cyclictest's loops late by a cycle | {:.0} against {:.0} per run (medians) | {}",
+                a.plc_overruns,
+                b.plc_overruns,
+                verdict(a.plc_overruns <= b.plc_overruns)
+            ),
+            _ => println!("TARGET | example 4 at 250 us RT, {what}: PLC overruns <= cyclictest's loops late by a cycle | - | skipped: no figures (cyclictest or a second CPU missing)"),
+        }
+    }
 }

@@ -135,6 +135,46 @@ fn the_plc_woken_by_futex_follows_the_ticks() {
     assert_eq!(plc_overruns(&stdout), 0, "{stdout}");
 }
 
+/// `--rt-wake spin`: the PLC sleeps to shortly before each tick is due and spins on the
+/// heartbeat's word until the tick is done. At a 20 ms cycle it wakes for its tick within
+/// the tick's compute and lateness, as with the futex, and misses no tick.
+#[test]
+fn the_plc_woken_by_its_spin_follows_the_ticks() {
+    let scenario = tests::cli::scenario("axes-plcopen");
+    let instance = tests::unique_instance("rt-spin");
+    let out = Cli::new(env!("CARGO_BIN_EXE_cnc"))
+        .args(["run", scenario.to_str().unwrap(), "--ticks", "60"])
+        .args([
+            "--cycle-ms",
+            "20",
+            "--instance",
+            &instance,
+            "--rt-wake",
+            "spin",
+        ])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("plc: real-time wake-up by a timed sleep and a spin"),
+        "{stdout}"
+    );
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("plc: tick due to woken"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let p50: f64 = line
+        .split("p50 ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{line}"));
+    assert!(p50 < 2_500.0, "{line}");
+    assert_eq!(plc_overruns(&stdout), 0, "{stdout}");
+}
+
 /// The overruns of the `plc: task` line.
 fn plc_overruns(report: &str) -> u64 {
     report

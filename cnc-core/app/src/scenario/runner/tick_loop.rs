@@ -174,8 +174,8 @@ pub(super) struct TickLoop<'a> {
     loader: Option<Loader>,
     /// The lateness figures the header shows tools.
     gauge: LatenessGauge,
-    /// Real time with `--rt-wake futex`: "tick done" wakes the PLC on the heartbeat's low
-    /// word instead of the event.
+    /// Real time with `--rt-wake futex` or `spin`: "tick done" wakes the PLC on the
+    /// heartbeat's low word instead of the event.
     wake_futex: bool,
 }
 
@@ -243,7 +243,11 @@ impl<'a> TickLoop<'a> {
             loader,
             gauge: LatenessGauge::new(),
             wake_futex: !options.lockstep
-                && options.realtime.over(&scenario.realtime).wake == Some(WakePath::Futex),
+                && options
+                    .realtime
+                    .over(&scenario.realtime)
+                    .wake
+                    .is_some_and(WakePath::on_the_word),
         }
     }
 
