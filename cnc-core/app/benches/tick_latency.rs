@@ -11,11 +11,11 @@
 //! absent is skipped and said so. `CNC_BENCH_SMOKE=1`: one short round (CI: no timing
 //! asserted). Run: `cargo bench -p cnc-app --bench tick_latency`.
 //!
-//! At 250 µs, example 4 runs twice per round: with the default wake path (the event) and
-//! with `--rt-wake spin --rt-cpu 1` (the PLC spins for its ticks on CPU 0, beside the CNC's
-//! thread on CPU 1), the latter against `cyclictest -a 1` on the same CPU; both against
-//! cyclictest's loops late by a whole cycle (issue 55's overrun target). The pinned rows need
-//! two CPUs and are skipped, and said so, with one.
+//! At 250 µs, example 4 and the demo each run twice per round: with the default wake path
+//! (the event) and with `--rt-wake spin --rt-cpu 1` (the PLC spins for its ticks on CPU 0,
+//! beside the CNC's thread on CPU 1), the latter against `cyclictest -a 1` on the same CPU;
+//! both against cyclictest's loops late by a whole cycle (issue 55's overrun target). The
+//! pinned rows need two CPUs and are skipped, and said so, with one.
 //!
 //! The compute target's baseline is a constant job in the same shape as the demo: this bench
 //! started again as two processes ([`peer`]), one at SCHED_FIFO 80 that wakes every 1 ms at an
@@ -246,6 +246,8 @@ fn main() {
         "constant job every 1 ms beside a companion",
         "cyclictest -m -p 80 -a 1 -i 250",
         "example 4 at 250 us, RT, spin, CPU 1",
+        "demo at 250 us, real-time options",
+        "demo at 250 us, RT, spin, CPU 1",
     ];
     // The spinning PLC goes to another CPU than the CNC's: two are needed.
     let two_cpus = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
@@ -265,8 +267,10 @@ fn main() {
         rows[4].extend(cnc(&ex4, ex4_ticks, true, 1000, &[]));
         rows[5].extend(cnc(&ex4, ex4_ticks, false, 1000, &[]));
         rows[7].extend(cnc(&ex4, fast_ticks, true, 250, &[]));
+        rows[11].extend(cnc(&demo, fast_ticks, true, 250, &[]));
         if two_cpus {
             rows[10].extend(cnc(&ex4, fast_ticks, true, 250, &SPIN));
+            rows[12].extend(cnc(&demo, fast_ticks, true, 250, &SPIN));
         }
         rows[8].extend(constant_work(demo_ticks));
     }
@@ -388,16 +392,33 @@ fn targets(med: &[Option<Figures>]) {
         9,
     );
     rest("example 4 at 250 us RT, spin wake, CNC on CPU 1", 10);
-    for (what, ours) in [("event wake", 7), ("spin wake, CNC on CPU 1", 10)] {
-        let peer = if ours == 10 { 9 } else { 6 };
+    lateness(
+        "demo at 250 us RT: start lateness p99 <= 1.5x cyclictest -p 80 -i 250 p99",
+        11,
+        6,
+    );
+    rest("demo at 250 us RT", 11);
+    lateness(
+        "demo at 250 us RT, spin wake, CNC on CPU 1: start lateness p99 <= 1.5x cyclictest -p 80 -a 1 -i 250 p99",
+        12,
+        9,
+    );
+    rest("demo at 250 us RT, spin wake, CNC on CPU 1", 12);
+    let overruns = [
+        ("example 4 at 250 us RT, event wake", 7, 6),
+        ("example 4 at 250 us RT, spin wake, CNC on CPU 1", 10, 9),
+        ("demo at 250 us RT, event wake", 11, 6),
+        ("demo at 250 us RT, spin wake, CNC on CPU 1", 12, 9),
+    ];
+    for (what, ours, peer) in overruns {
         match (med[ours], med[peer]) {
             (Some(a), Some(b)) => println!(
-                "TARGET | example 4 at 250 us RT, {what}: PLC overruns <= cyclictest's loops late by a cycle | {:.0} against {:.0} per run (medians) | {}",
+                "TARGET | {what}: PLC overruns <= cyclictest's loops late by a cycle | {:.0} against {:.0} per run (medians) | {}",
                 a.plc_overruns,
                 b.plc_overruns,
                 verdict(a.plc_overruns <= b.plc_overruns)
             ),
-            _ => println!("TARGET | example 4 at 250 us RT, {what}: PLC overruns <= cyclictest's loops late by a cycle | - | skipped: no figures (cyclictest or a second CPU missing)"),
+            _ => println!("TARGET | {what}: PLC overruns <= cyclictest's loops late by a cycle | - | skipped: no figures (cyclictest or a second CPU missing)"),
         }
     }
 }
