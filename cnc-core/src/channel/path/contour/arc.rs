@@ -150,6 +150,8 @@ struct PlaneLimits {
 }
 
 impl Contour {
+    /// The plane axes' limits on `circle` at `feed`; `None` when the channel has no limits
+    /// for them (a test contour).
     fn plane_limits(&self, circle: &Circle, feed: f64) -> Option<PlaneLimits> {
         let limit = |i: usize| self.limits.get(i).copied();
         let (la, lb) = (limit(circle.axes[0])?, limit(circle.axes[1])?);

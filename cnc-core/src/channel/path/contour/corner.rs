@@ -84,10 +84,11 @@ impl Contour {
         if !worth_rounding(&last, &triangle, (segment, u2), length, &self.limits) {
             return false;
         }
-        let triangle = self
+        // The curve as it is before any sharing: the triangle, or a transition into an arc.
+        let unshared = self
             .transition(segment, (&u1, u2), d, length, &last)
             .unwrap_or(triangle);
-        let [d1, d2] = triangle.legs;
+        let [d1, d2] = unshared.legs;
         let saved = last;
         let saved_before = (n >= 2).then(|| self.pieces[n - 2]);
         let committed = self.v_end;
@@ -96,8 +97,8 @@ impl Contour {
         back.length -= d1;
         back.rest_after = false;
         let (mut curve, junction_cap) = self
-            .share_junction((segment, &u1, u2), &triangle, &saved, limit)
-            .unwrap_or((triangle, f64::INFINITY));
+            .share_junction((segment, &u1, u2), &unshared, &saved, limit)
+            .unwrap_or((unshared, f64::INFINITY));
         curve.junction_cap = junction_cap;
         curve.hard_cap = curve.hard_cap.min(junction_cap);
         let mut origin = corner;
@@ -134,22 +135,24 @@ impl Contour {
     /// when the block between them is all curves, both turn the same way (within
     /// [`JUNCTION_MAX_TWIST_DEG`]), the curve before is not under way and both stay within
     /// their tolerances: its end and the new curve's start take the smaller of the two mean
-    /// curvatures, so a dense polyline's curvature does not fall to 0 and rise again at every
+    /// curvatures, each times what its shape allows at that end (`shape::share_limits`: twice
+    /// a transition's mean at its chord's end), so a dense polyline's curvature does not fall
+    /// to 0 and rise again at every
     /// block (which caps the speed through its rate of change). The curvature's direction
     /// still steps by the angle between the turns: both curves' speed is capped where that
     /// step, over a cycle, would take more than [`JUNCTION_JERK_SHARE`] of an axis's jerk.
-    /// `triangle` is the new curve as it is without sharing, `last` the block before's
+    /// `unshared` is the new curve as it is without sharing, `last` the block before's
     /// straight piece. The new curve with its shared start and that cap; `None` when they do
     /// not share.
     fn share_junction(
         &mut self,
         (segment, u1, u2): (&Segment, &AxisValues, &AxisValues),
-        triangle: &Piece,
+        unshared: &Piece,
         last: &Piece,
         limit: &mut dyn FnMut(&mut Piece),
     ) -> Option<(Piece, f64)> {
         const NONE: Option<(Piece, f64)> = None;
-        let legs = triangle.legs;
+        let legs = unshared.legs;
         let n = self.pieces.len();
         let under_way = !matches!(self.mode, Mode::Idle);
         if n < 2 || self.pieces[n - 1].length > 1e-9 || !self.pieces[n - 2].is_curve() {
@@ -171,16 +174,16 @@ impl Contour {
         if cos < JUNCTION_MAX_TWIST_DEG.to_radians().cos() {
             return NONE;
         }
-        let (ka, kb) = (na / a.length, nb / triangle.length);
+        let (ka, kb) = (na / a.length, nb / unshared.length);
         let mu = |p: &Piece| p.legs[1] / p.length;
-        let k = (share_limits(mu(&a))[1] * ka).min(share_limits(mu(triangle))[0] * kb);
+        let k = (share_limits(mu(&a))[1] * ka).min(share_limits(mu(unshared))[0] * kb);
         if k <= 0.0 {
             return NONE;
         }
         let (ca, cb) = (k / ka, k / kb);
         let mut cap = f64::INFINITY;
         for i in 0..turn.len() {
-            let step = (ca * a.turn[i] / a.length - cb * turn[i] / triangle.length).abs();
+            let step = (ca * a.turn[i] / a.length - cb * turn[i] / unshared.length).abs();
             let jerk = self.limits.get(i).map_or(f64::INFINITY, |l| l.jerk);
             if step > 1e-15 {
                 cap = cap.min((JUNCTION_JERK_SHARE * jerk * self.cycle_s / step).sqrt());
@@ -201,12 +204,12 @@ impl Contour {
         new_a.junction_cap = a.junction_cap.min(cap);
         new_a.hard_cap = new_a.hard_cap.min(new_a.junction_cap);
         let shared = self.corner_curve(segment, (u1, u2), legs, [cb, 0.0], last);
-        if new_a.deviation() > a.tolerance || shared.deviation() > triangle.tolerance {
+        if new_a.deviation() > a.tolerance || shared.deviation() > unshared.tolerance {
             return NONE;
         }
         // Not where the step in the curvature's direction would cap the curves below what
         // they have apart (turns far apart: a coarse polyline, not a dense curve's chords).
-        if cap < a.hard_cap.min(triangle.hard_cap) {
+        if cap < a.hard_cap.min(unshared.hard_cap) {
             return NONE;
         }
         limit(&mut new_a);
