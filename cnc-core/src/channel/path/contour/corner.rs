@@ -115,9 +115,13 @@ impl Contour {
             self.rechain(k);
         }
         self.sweep_back();
-        // The run under way must still reach its committed end velocity's bound.
+        // The run under way must still reach its committed end velocity's bound; else, when
+        // it cruises, it is planned again from where it stands (a plan it adopts ends within
+        // its bound). A short window's run may cover it nearly to its end: the new corner's
+        // curves can lower the bounds there below what the run committed to.
         let run_end = self.run_pieces.max(1) - 1;
-        let front_ok = !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9;
+        let front_ok =
+            !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9 || self.replan_now();
         if !front_ok {
             self.pieces.pop_back();
             self.pieces.pop_back();

@@ -520,7 +520,7 @@ impl Contour {
         self.t += self.cycle_s;
         loop {
             if self.replan {
-                self.replan_on_the_way(before);
+                let _ = self.replan_on_the_way(before);
             }
             let duration = self.profile.duration();
             if self.t <= duration {
@@ -613,15 +613,15 @@ impl Contour {
     /// New blocks or factors: the run is planned again where the profile has no acceleration
     /// (on its cruise, or at its peak or the cruise's end passed during this tick), from
     /// there to the end of the front's unit as it now is. A plan that does not fit keeps the
-    /// one under way (its bounds still hold).
-    fn replan_on_the_way(&mut self, before: f64) {
+    /// one under way (its bounds still hold). Whether a new plan took its place.
+    fn replan_on_the_way(&mut self, before: f64) -> bool {
         let (start, end) = self.profile.cruise();
         let at = if self.t >= start && self.t <= end {
             self.t
         } else if before < end && end <= self.t {
             end
         } else {
-            return;
+            return false;
         };
         self.replan = false;
         let s = self.profile.at(at);
@@ -632,8 +632,17 @@ impl Contour {
             if v1 <= self.pieces[last].bound_hard {
                 self.adopt(profile, v1, pieces, rest, here);
                 self.t -= at;
+                return true;
             }
         }
+        false
+    }
+
+    /// Between ticks, while the run under way cruises (no acceleration where it stands): the
+    /// run planned again from there over the window as it now is ([`Self::replan_on_the_way`]
+    /// at the present time). Whether a new plan, ending within its bound, took its place.
+    pub(super) fn replan_now(&mut self) -> bool {
+        matches!(self.mode, Mode::Profile) && self.replan_on_the_way(self.t)
     }
 
     /// At rest on the front piece: goes on once the factors let it.
