@@ -82,20 +82,23 @@ fn a_plc_that_wakes_late_loses_no_handshake_and_doubles_no_command() {
         "ticks missed: {overruns}\n{report}"
     );
     // The report names the worst wake-ups in parts: the longest hold (30 ms) leads them,
-    // counted from the tick its cycle was due at.
-    let worst = report
+    // counted from the tick its cycle was due at. A hold that fell between the PLC's wake-up
+    // and its cycle's end shows in the woken -> done part, and the next wake-up is then the
+    // one late by the slots it held (the second line).
+    let worst: Vec<&str> = report
         .lines()
         .skip_while(|l| !l.starts_with("plc: worst wake-ups"))
-        .nth(1)
-        .unwrap_or_else(|| panic!("{report}"));
+        .skip(1)
+        .take(2)
+        .collect();
     let total: f64 = worst
-        .split(" = ")
-        .nth(1)
+        .first()
+        .and_then(|w| w.split(" = ").nth(1))
         .and_then(|t| t.split(',').next())
         .and_then(|t| t.trim().parse().ok())
-        .unwrap_or_else(|| panic!("{worst}"));
+        .unwrap_or_else(|| panic!("{report}"));
     assert!(
-        total >= 25_000.0 && worst.contains("slots late"),
-        "{worst}\n{report}"
+        total >= 25_000.0 && worst.iter().any(|w| w.contains("slots late")),
+        "{worst:?}\n{report}"
     );
 }
