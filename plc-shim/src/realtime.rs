@@ -34,9 +34,9 @@ pub struct RealtimeOptions {
     /// default), `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
     /// segment, the CNC wakes it with one `futex(2)` call) or `spin` (as `futex`, but the PLC
     /// wakes by a timed sleep shortly before the tick is due and spins on that word until the
-    /// tick is done, at most half a cycle past its due time, before it sleeps on it: its
-    /// wake-up no longer waits for the scheduler after the tick; it takes a core for the
-    /// spin). The CNC hands its choice to the PLC it spawns.
+    /// tick is done, at most half a cycle (and 500 us) past its due time, before it sleeps on
+    /// it: its wake-up no longer waits for the scheduler after the tick; it takes a core for
+    /// the spin). The CNC hands its choice to the PLC it spawns.
     #[arg(long = "rt-wake", value_enum)]
     pub wake: Option<WakePath>,
 }

@@ -38,6 +38,9 @@ use crate::realtime::WakePath;
 /// the cycle) and spins until the tick is done: a wake-up up to this late still finds the
 /// tick.
 const SPIN_LEAD_NS: u64 = 100_000;
+/// The spin ends at most this long (or half a cycle) after the tick's due time: a CNC that
+/// is late by more is waited for on the futex, so a stalled CNC does not keep a core busy.
+const SPIN_PAST_DUE_MAX_NS: u64 = 500_000;
 use crate::wakeups::{Wakeup, WorstWakeups};
 pub use crate::watchdog::CncLoss;
 use crate::watchdog::CncWatch;
@@ -384,10 +387,11 @@ impl PlcRuntime {
         Ok(())
     }
 
-    /// Sleeps to [`SPIN_LEAD_NS`] before the tick after heartbeat `seen` is due, then spins
-    /// on the heartbeat's `word` until it changes or half a cycle has passed after the due
-    /// time: whether it changed. Not before the CNC announced its epoch. Two clock reads
-    /// (vDSO) and one `clock_nanosleep` per tick besides the spin's reads.
+    /// Sleeps to [`SPIN_LEAD_NS`] (at most a quarter cycle) before the tick after heartbeat
+    /// `seen` is due, then spins on the heartbeat's `word` until it changes or half a cycle
+    /// (at most [`SPIN_PAST_DUE_MAX_NS`]) has passed after the due time: whether it changed.
+    /// Not before the CNC announced its epoch. Two clock reads (vDSO) and one
+    /// `clock_nanosleep` per tick besides the spin's reads.
     fn spin_for_tick(
         &self,
         word: &core::sync::atomic::AtomicU32,
@@ -406,7 +410,7 @@ impl PlcRuntime {
         let (wall, mono) = (crate::wakeups::wall_now_ns(), cnc_os::monotonic::now());
         let to_mono = |t: u64| mono + core::time::Duration::from_nanos(t.saturating_sub(wall));
         cnc_os::monotonic::sleep_until(to_mono(due.saturating_sub(lead)));
-        let until = to_mono(due.saturating_add(cycle / 2));
+        let until = to_mono(due.saturating_add((cycle / 2).min(SPIN_PAST_DUE_MAX_NS)));
         let seen = seen as u32;
         loop {
             // Several reads between clock reads: the word is the thing to watch.
