@@ -33,6 +33,9 @@ use hli_transport::rpc::AcyclicClient;
 use hli_transport::segment::{AttachError, HeaderFault, PlcSegment};
 
 use crate::realtime::WakePath;
+use crate::wakeups::{Wakeup, WorstWakeups};
+pub use crate::watchdog::CncLoss;
+use crate::watchdog::CncWatch;
 
 /// With `WakePath::Spin` the PLC wakes this long before a tick is due (at most a quarter of
 /// the cycle) and spins until the tick is done: a wake-up up to this late still finds the
@@ -41,9 +44,6 @@ const SPIN_LEAD_NS: u64 = 100_000;
 /// The spin ends at most this long (or half a cycle) after the tick's due time: a CNC that
 /// is late by more is waited for on the futex, so a stalled CNC does not keep a core busy.
 const SPIN_PAST_DUE_MAX_NS: u64 = 500_000;
-use crate::wakeups::{Wakeup, WorstWakeups};
-pub use crate::watchdog::CncLoss;
-use crate::watchdog::CncWatch;
 
 /// Why the runtime could not start or had to stop.
 #[derive(Debug, thiserror::Error)]
@@ -404,13 +404,11 @@ impl PlcRuntime {
         if epoch == 0 {
             return false;
         }
-        let cycle = u64::from(cycle_ns);
-        let due = epoch.saturating_add(seen.saturating_add(1).saturating_mul(cycle));
-        let lead = SPIN_LEAD_NS.min(cycle / 4);
         let (wall, mono) = (crate::wakeups::wall_now_ns(), cnc_os::monotonic::now());
+        let (wake, until) = spin_window(epoch, seen, cycle_ns, wall);
         let to_mono = |t: u64| mono + core::time::Duration::from_nanos(t.saturating_sub(wall));
-        cnc_os::monotonic::sleep_until(to_mono(due.saturating_sub(lead)));
-        let until = to_mono(due.saturating_add((cycle / 2).min(SPIN_PAST_DUE_MAX_NS)));
+        cnc_os::monotonic::sleep_until(to_mono(wake));
+        let until = to_mono(until);
         let seen = seen as u32;
         loop {
             // Several reads between clock reads: the word is the thing to watch.
@@ -540,6 +538,21 @@ impl PlcRuntime {
     }
 }
 
+/// When a spinning PLC wakes and when its spin ends (wall clock, ns) for the tick after
+/// heartbeat `seen`, from the CNC's `epoch` and cycle, at `wall` now: [`SPIN_LEAD_NS`] (at
+/// most a quarter cycle) before the tick is due, and half a cycle (at most
+/// [`SPIN_PAST_DUE_MAX_NS`]) after. The epoch comes from the segment: whatever it says, the
+/// tick is taken as due within a cycle from now, so the sleep is never longer than that.
+fn spin_window(epoch: u64, seen: u64, cycle_ns: u32, wall: u64) -> (u64, u64) {
+    let cycle = u64::from(cycle_ns);
+    let due = epoch
+        .saturating_add(seen.saturating_add(1).saturating_mul(cycle))
+        .min(wall.saturating_add(cycle));
+    let lead = SPIN_LEAD_NS.min(cycle / 4);
+    let past = (cycle / 2).min(SPIN_PAST_DUE_MAX_NS);
+    (due.saturating_sub(lead), due.saturating_add(past))
+}
+
 impl PlcRuntime {
     /// After a wake-up that found heartbeat `beat`: how the run ends, if it does (a corrupted
     /// header before an orderly close, a close before a silence).
@@ -620,5 +633,25 @@ mod schedule_tests {
             (Some(Some(1)), 11),
             "one slot missed"
         );
+    }
+}
+
+#[cfg(test)]
+mod spin_tests {
+    use super::spin_window;
+
+    #[test]
+    fn the_spin_wakes_a_quarter_cycle_early_and_never_sleeps_past_a_cycle() {
+        const MS: u64 = 1_000_000;
+        // Tick 11 of a 250 us CNC whose epoch is at 1 s, now 1.0027 s: due at 1.00275 s,
+        // woken 62.5 us before, spinning up to 125 us after.
+        let (wake, until) = spin_window(1_000 * MS, 10, 250_000, 1_002_700_000);
+        assert_eq!((wake, until), (1_002_687_500, 1_002_875_000));
+        // At 10 ms: 100 us lead, 500 us past due at most.
+        let (wake, until) = spin_window(1_000 * MS, 0, 10_000_000, 1_000 * MS);
+        assert_eq!((wake, until), (1_009_900_000, 1_010_500_000));
+        // A hostile epoch far in the future: the tick is taken as due within a cycle.
+        let (wake, until) = spin_window(u64::MAX - 5, 3, 1_000_000, 7 * MS);
+        assert_eq!((wake, until), (8 * MS - 100_000, 8 * MS + 500_000));
     }
 }
