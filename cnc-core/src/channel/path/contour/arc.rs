@@ -99,10 +99,7 @@ impl Contour {
         for i in circle.axes {
             delta[i] = 0.0;
         }
-        if !self.active() {
-            self.closed = false;
-            self.last_end = None;
-        }
+        self.reopen_if_idle();
         self.arc = Some(ArcChords {
             block: *block,
             circle,
@@ -141,20 +138,18 @@ impl Contour {
     }
 }
 
-/// The plane axes' lowest jerk on a circle, and the speed the arc runs at on its own (its
-/// feed, within half its axes' acceleration and jerk, as `path::circle` plans it).
-#[derive(Debug, Clone, Copy)]
-struct PlaneLimits {
-    jerk: f64,
-    alone: f64,
-}
-
 impl Contour {
-    /// The plane axes' limits on `circle` at `feed`; `None` when the channel has no limits
-    /// for them (a test contour).
-    fn plane_limits(&self, circle: &Circle, feed: f64) -> Option<PlaneLimits> {
+    /// Whether the circle's chords (each turning by `step`) run it at least nearly as fast
+    /// as the arc runs on its own: where two chords' curves meet, the curvature's direction
+    /// steps by `step`, an acceleration step of `v² step / r` that over a cycle may take
+    /// [`JUNCTION_JERK_SHARE`] of the plane axes' jerk; on its own the arc runs at its feed
+    /// within half its axes' acceleration and jerk, as `path::circle` plans it. A small circle
+    /// at a short cycle runs on its own (its chords would be slower than the stops they save).
+    fn chords_keep_speed(&self, circle: &Circle, step: f64, feed: f64) -> bool {
         let limit = |i: usize| self.limits.get(i).copied();
-        let (la, lb) = (limit(circle.axes[0])?, limit(circle.axes[1])?);
+        let (Some(la), Some(lb)) = (limit(circle.axes[0]), limit(circle.axes[1])) else {
+            return true;
+        };
         let r = circle.r0.min(circle.r1);
         let (v, a, j) = (
             la.velocity.min(lb.velocity),
@@ -165,21 +160,8 @@ impl Contour {
             .min(v)
             .min((a * r / 2.0).sqrt())
             .min((j * r * r / 2.0).cbrt());
-        Some(PlaneLimits { jerk: j, alone })
-    }
-
-    /// Whether the circle's chords (each turning by `step`) run it at least nearly as fast
-    /// as the arc runs on its own: where two chords' curves meet, the curvature's direction
-    /// steps by `step`, an acceleration step of `v² step / r` that over a cycle may take
-    /// [`JUNCTION_JERK_SHARE`] of the plane axes' jerk. A small circle at a short cycle whose
-    /// chords would be slower than the stops they save runs on its own.
-    fn chords_keep_speed(&self, circle: &Circle, step: f64, feed: f64) -> bool {
-        let Some(l) = self.plane_limits(circle, feed) else {
-            return true;
-        };
-        let r = circle.r0.min(circle.r1);
-        let chords = (JUNCTION_JERK_SHARE * l.jerk * self.cycle_s * r / step).sqrt();
-        chords >= CHORD_SPEED_KEPT * l.alone
+        let chords = (JUNCTION_JERK_SHARE * j * self.cycle_s * r / step).sqrt();
+        chords >= CHORD_SPEED_KEPT * alone
     }
 }
 

@@ -9,7 +9,9 @@
 //!
 //! A block is held back until the next one shows whether its end corner is cut: a contour
 //! always holds its last block unpushed (`pending`); [`Contour::close`] pushes it. Not under a
-//! transformation (the segment says so): there the joints' limits are taken per block.
+//! transformation (the segment says so): there the joints' limits are taken per block. Never
+//! an arc's chords ([`super::arc`]): at an inflection their turns alternate too, but they lie
+//! on the circle.
 
 use super::{Contour, Piece, PushError, Segment};
 use crate::setpoint::AxisValues;

@@ -259,10 +259,7 @@ impl Contour {
         limit: &mut dyn FnMut(&mut Piece),
     ) -> Result<(), PushError> {
         let (length, dir) = direction(segment).ok_or(PushError::NotStraight)?;
-        if !self.active() {
-            self.closed = false;
-            self.last_end = None;
-        }
+        self.reopen_if_idle();
         if segment.chamfer {
             return self.push_staged(segment, (length, &dir), limit);
         }
@@ -270,6 +267,15 @@ impl Contour {
             return Err(PushError::Full);
         }
         self.push_segment(segment, limit)
+    }
+
+    /// A block joining a contour with nothing under way and nothing waiting starts a new one:
+    /// open, no corner with what ran before.
+    fn reopen_if_idle(&mut self) {
+        if !self.active() {
+            self.closed = false;
+            self.last_end = None;
+        }
     }
 
     /// Adds a segment to the window (a block, or a part of blocks cut by chords).
