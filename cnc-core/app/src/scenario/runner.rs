@@ -28,6 +28,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, ExitCode};
 use tick_loop::{Bounds, Ending, Measured, TickLoop};
 
+mod cycle_guard;
 pub mod latency;
 mod restart;
 mod spawn;
@@ -137,6 +138,16 @@ pub enum StopCause {
         /// Which field, what the CNC wrote, what it found.
         fault: hli_transport::segment::HeaderFault,
     },
+    /// Real time: the mean work of the last 64 ticks reached the cycle (`--cycle-ms` below
+    /// what the machine's ticks need).
+    CycleTooShort {
+        /// The tick it was noticed at.
+        tick: u64,
+        /// The ticks' mean work, ns.
+        work_ns: u64,
+        /// The cycle, ns.
+        cycle_ns: u64,
+    },
     /// SIGINT or SIGTERM.
     Signal {
         /// The tick it was noticed at.
@@ -148,11 +159,12 @@ pub enum StopCause {
 
 impl StopCause {
     /// The exit code `cnc run` ends with: 4 for a lost PLC, 5 for a corrupted segment
-    /// header, 128 + signal for a signal.
+    /// header, 6 for a cycle shorter than the ticks' work, 128 + signal for a signal.
     pub fn exit_code(&self) -> u8 {
         match self {
             StopCause::PlcLost { .. } => 4,
             StopCause::SegmentCorrupt { .. } => 5,
+            StopCause::CycleTooShort { .. } => 6,
             StopCause::Signal { signal, .. } => signal.exit_code(),
         }
     }
@@ -166,6 +178,15 @@ impl StopCause {
             StopCause::SegmentCorrupt { tick, fault } => {
                 format!("{fault} (noticed at tick {tick}); stopping the machine")
             }
+            StopCause::CycleTooShort {
+                tick,
+                work_ns,
+                cycle_ns,
+            } => format!(
+                "the cycle of {:.1} us is shorter than this machine's ticks need: their work was {:.1} us on average over the last 64 ticks (noticed at tick {tick}); stopping the machine (give a longer cycle: --cycle-ms or the scenario's cycle_ms)",
+                *cycle_ns as f64 * 1e-3,
+                *work_ns as f64 * 1e-3
+            ),
             StopCause::Signal { tick, signal } => {
                 format!("{} at tick {tick}: stopping the machine", signal.name())
             }
@@ -367,7 +388,7 @@ fn run_machine(
     let mut link = PlcLink::open(scenario, machine, options)?;
     let opcua = crate::opcua::Beside::start(&options.instance, &options.opcua)?;
     // After spawning: the PLC must not inherit the CNC's scheduling and CPU.
-    let realtime = options.realtime.over(&scenario.realtime).apply("cnc run");
+    let realtime = spawn::cnc_realtime(scenario, options).apply("cnc run");
     let bounds = Bounds::of(scenario, options)?;
     let measured = Measured::new(scenario, bounds.rows);
     // Real time: the heartbeat watchdogs start with the loop, so the PLC must be cycling by
@@ -640,6 +661,8 @@ enum PlcWait {
 const STOP_REASON_PLC: &str = "machine stop: PLC lost";
 /// The channel reason for a stop on a corrupted segment header.
 const STOP_REASON_SEGMENT: &str = "machine stop: segment header corrupted";
+/// The channel reason for a stop on a cycle shorter than the ticks' work.
+const STOP_REASON_CYCLE: &str = "machine stop: cycle shorter than the ticks' work";
 /// The channel reason for a stop on SIGINT/SIGTERM.
 const STOP_REASON_SIGNAL: &str = "machine stop: termination requested";
 

@@ -3,6 +3,7 @@
 
 use super::RunOptions;
 use crate::scenario::file::{PlcSetup, Scenario};
+use plc_shim::realtime::RealtimeOptions;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 
@@ -50,7 +51,7 @@ pub(super) fn spawn_plc(
     }
     // The scenario's `[realtime_plc]`, else what the CNC's own options imply for its PLC; the
     // wake path is always the CNC's (both ends must use the same).
-    let cnc = options.realtime.over(&scenario.realtime);
+    let cnc = cnc_realtime(scenario, options);
     let mut plc = scenario.realtime_plc.over(&cnc.for_plc());
     plc.wake = cnc.wake;
     command.args(plc.to_args());
@@ -60,6 +61,18 @@ pub(super) fn spawn_plc(
         .spawn()
         .map(Some)
         .map_err(|e| format!("spawning the PLC: {e}"))
+}
+
+/// The CNC's real-time options: the flags over the scenario's `[realtime]`, and in real time
+/// the wake path chosen where neither gives one (`spin` below a 1 ms cycle beside a pinned
+/// CNC, else `event`: [`RealtimeOptions::with_wake_chosen`]).
+pub(super) fn cnc_realtime(scenario: &Scenario, options: &RunOptions) -> RealtimeOptions {
+    let given = options.realtime.over(&scenario.realtime);
+    if options.lockstep {
+        return given;
+    }
+    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
+    given.with_wake_chosen(scenario.cycle_s, cpus)
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), String> {

@@ -3,11 +3,12 @@
 //! acyclic calls are answered and "tick done" goes out; between ticks the PLC and the
 //! termination signals are watched, and a stop runs on until the machine is at rest.
 
+use super::cycle_guard::CycleGuard;
 use super::restart::{Gap, GapEvent};
 use super::{
     describe_plc, wait_for_plc_cycle, PlcLink, PlcWait, RunOptions, StopCause,
-    DEFAULT_PLC_WATCHDOG_TICKS, DEFAULT_TICK_LIMIT, STOP_LIMIT_S, STOP_REASON_PLC,
-    STOP_REASON_SEGMENT, STOP_REASON_SIGNAL,
+    DEFAULT_PLC_WATCHDOG_TICKS, DEFAULT_TICK_LIMIT, STOP_LIMIT_S, STOP_REASON_CYCLE,
+    STOP_REASON_PLC, STOP_REASON_SEGMENT, STOP_REASON_SIGNAL,
 };
 use crate::progress::{Progress, TickCounter};
 use crate::scenario::file::Scenario;
@@ -174,6 +175,8 @@ pub(super) struct TickLoop<'a> {
     loader: Option<Loader>,
     /// The lateness figures the header shows tools.
     gauge: LatenessGauge,
+    /// Real time: whether the ticks' work still fits the cycle.
+    guard: CycleGuard,
     /// Real time with `--rt-wake futex` or `spin`: "tick done" wakes the PLC on the
     /// heartbeat's low word instead of the event.
     wake_futex: bool,
@@ -242,12 +245,10 @@ impl<'a> TickLoop<'a> {
             progress,
             loader,
             gauge: LatenessGauge::new(),
-            wake_futex: !options.lockstep
-                && options
-                    .realtime
-                    .over(&scenario.realtime)
-                    .wake
-                    .is_some_and(WakePath::on_the_word),
+            guard: CycleGuard::new(bounds.period.as_nanos() as u64),
+            wake_futex: super::spawn::cnc_realtime(scenario, options)
+                .wake
+                .is_some_and(WakePath::on_the_word),
         }
     }
 
@@ -289,6 +290,7 @@ impl<'a> TickLoop<'a> {
             if !self.options.lockstep {
                 self.gauge
                     .record(t0.saturating_sub(deadline), tick, self.segment);
+                self.keep_cycle(tick, (t5 - t0).as_nanos() as u64);
             }
             if end_now {
                 break;
@@ -439,6 +441,26 @@ impl<'a> TickLoop<'a> {
             self.machine.stop(STOP_REASON_SEGMENT);
             self.ending.stop = Some((cause, tick));
         }
+    }
+
+    /// Real time, after tick `tick` whose work took `work_ns`: once the last ticks' mean
+    /// work reached the cycle, the machine stops (the loop could never catch up).
+    fn keep_cycle(&mut self, tick: u64, work_ns: u64) {
+        let Some(work_ns) = self.guard.record(work_ns) else {
+            return;
+        };
+        if self.ending.stop.is_some() {
+            return;
+        }
+        let cycle_ns = self.bounds.period.as_nanos() as u64;
+        let cause = StopCause::CycleTooShort {
+            tick,
+            work_ns,
+            cycle_ns,
+        };
+        eprintln!("cnc run: {}", cause.message());
+        self.machine.stop(STOP_REASON_CYCLE);
+        self.ending.stop = Some((cause, tick));
     }
 
     /// The PLC is lost at `tick`: the machine stops. With `--plc-restart` the run goes on
