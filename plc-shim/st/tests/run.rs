@@ -538,3 +538,26 @@ END_PROGRAM
 ";
     assert_eq!(run(text, 1).read_var("MAIN.n"), Some(10111.0));
 }
+
+/// A CASE, an IF or a loop as an arm's statement is a statement, not the next arm's labels
+/// (each holds a `:` of its own; the random programs of `two_ways.rs` found it refused).
+#[test]
+fn statements_with_labels_of_their_own_nest_in_case_arms() {
+    let p = run(
+        "PROGRAM MAIN VAR i, j, n : DINT; END_VAR
+CASE i OF
+    0: CASE j OF
+            0: n := n + 1;
+        ELSE
+            n := -100;
+        END_CASE
+       IF n > 1 THEN CASE n OF 2: i := 1; END_CASE END_IF
+    1..2: FOR j := 0 TO 2 DO CASE j OF 2: n := n + 10; END_CASE END_FOR
+END_CASE
+END_PROGRAM",
+        3,
+    );
+    // Cycle 1: n = 1; cycle 2: n = 2, i = 1; cycle 3: n = 12.
+    assert_eq!(p.read_var("MAIN.n"), Some(12.0));
+    assert_eq!(p.read_var("MAIN.i"), Some(1.0));
+}

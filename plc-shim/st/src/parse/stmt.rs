@@ -169,8 +169,15 @@ impl Parser {
     }
 
     /// Whether the tokens ahead are CASE labels (a `:`, `,` or `..` before any `;` or `:=`
-    /// outside brackets) rather than a statement.
+    /// outside brackets) rather than a statement. A statement that begins with its keyword
+    /// (a nested CASE or IF, a loop, EXIT, ...) is never a label, whatever `:` it holds.
     fn looks_like_label(&self) -> bool {
+        const STATEMENT_WORDS: [&str; 8] = [
+            "CASE", "IF", "FOR", "WHILE", "REPEAT", "EXIT", "CONTINUE", "RETURN",
+        ];
+        if STATEMENT_WORDS.iter().any(|w| self.is_kw(w)) {
+            return false;
+        }
         let mut depth = 0i32;
         for k in 0..64 {
             match self.peek_at(k) {
