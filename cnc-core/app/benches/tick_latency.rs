@@ -76,8 +76,9 @@ fn cnc(path: &Path, ticks: u64, rt: bool, cycle_us: u32, extra: &[&str]) -> Opti
     if rt && extra.contains(&"--rt-cpu") && cycle_us < 1000 {
         let plc = text.lines().find(|l| l.starts_with("plc: real-time "));
         assert!(
-            plc.is_some_and(|l| l.contains("CPU 0")
-                && l.contains("wake-up by a timed sleep and a spin")),
+            plc.is_some_and(
+                |l| l.contains("CPU 0") && l.contains("wake-up by a timed sleep and a spin")
+            ),
             "the spin is the default wake path beside a pinned CNC below 1 ms: {text}"
         );
     }

@@ -221,20 +221,13 @@ fn faults_stop_the_cycle_and_name_the_statement() {
     let (f, text) = fault(
         "PROGRAM MAIN VAR a : ARRAY[0..2] OF INT; i : INT := 3; END_VAR\n  a[i] := 1;\nEND_PROGRAM",
     );
-    assert_eq!(
-        f,
-        Fault::IndexOutOfRange {
-            index: 3,
-            lo: 0,
-            hi: 2
-        }
-    );
+    assert_eq!(f, Fault::IndexOutOfRange);
     assert!(
         text.starts_with("main.st:2:3: fault: index 3 outside [0..2]"),
         "{text}"
     );
     let (f, _) = fault("PROGRAM MAIN VAR b : BOOL := TRUE; END_VAR\n  WHILE b DO b := TRUE; END_WHILE\nEND_PROGRAM");
-    assert!(matches!(f, Fault::Budget(_)), "{f:?}");
+    assert_eq!(f, Fault::Budget);
     let (f, _) = fault("PROGRAM MAIN VAR p : POINTER TO INT; END_VAR\n  p^ := 1;\nEND_PROGRAM");
     assert_eq!(f, Fault::BadPointer);
     // A field through a NULL pointer (one step from the pointer variable: `p^.b`).
@@ -465,7 +458,7 @@ fn a_constant_index_far_out_of_bounds_faults_in_the_cycle() {
         "PROGRAM MAIN VAR a : ARRAY[-5..5] OF INT; END_VAR\n  \
          a[LINT#9223372036854775807] := 1;\nEND_PROGRAM",
     );
-    assert!(matches!(f, Fault::IndexOutOfRange { .. }), "{f:?}");
+    assert_eq!(f, Fault::IndexOutOfRange);
 }
 
 /// A function block's VAR_IN_OUT: copied in before the call and back after it, so the

@@ -3,28 +3,25 @@
 
 use crate::diag::Pos;
 
-/// Why a cycle stopped the program.
+/// Why a cycle stopped the program. Without values of its own, so that a result in the
+/// cycle is at most two words (returned in registers); the numbers a fault names are in
+/// [`FaultAt::values`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Fault {
     /// An integer or real divided by zero.
     DivisionByZero,
-    /// An index outside its array's bounds.
-    IndexOutOfRange {
-        /// The index.
-        index: i64,
-        /// The lower bound.
-        lo: i64,
-        /// The upper bound.
-        hi: i64,
-    },
+    /// An index outside its array's bounds ([`FaultAt::values`]: the index, the lower and
+    /// the upper bound).
+    IndexOutOfRange,
     /// A pointer that is NULL or points outside the program's memory.
     BadPointer,
     /// A conversion of a value the target type cannot hold (or that is not finite).
     OutOfRange,
-    /// The cycle's budget of steps is spent (an endless loop).
-    Budget(u64),
-    /// MUX's selector names no value.
-    MuxSelector(i64),
+    /// The cycle's budget of steps is spent (an endless loop; [`FaultAt::values`]: the
+    /// steps).
+    Budget,
+    /// MUX's selector names no value ([`FaultAt::values`]: the selector).
+    MuxSelector,
     /// A write to a leaf of the image the CNC or the drives write.
     ReadOnly,
     /// A whole structure or array copied to or from the image (assign its leaves).
@@ -45,19 +42,22 @@ pub struct FaultAt {
     pub file: u16,
     /// The statement's place.
     pub pos: Pos,
+    /// The numbers the fault names: an index and its array's bounds, the steps a cycle ran,
+    /// a MUX selector (unused ones 0).
+    pub values: [i64; 3],
 }
 
-impl core::fmt::Display for Fault {
+impl core::fmt::Display for FaultAt {
+    /// What happened, with its numbers (without the place).
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match *self {
+        let [a, b, c] = self.values;
+        match self.fault {
             Fault::DivisionByZero => write!(f, "division by zero"),
-            Fault::IndexOutOfRange { index, lo, hi } => {
-                write!(f, "index {index} outside [{lo}..{hi}]")
-            }
+            Fault::IndexOutOfRange => write!(f, "index {a} outside [{b}..{c}]"),
             Fault::BadPointer => write!(f, "a pointer that is NULL or points outside the program"),
             Fault::OutOfRange => write!(f, "a conversion of a value its type cannot hold"),
-            Fault::Budget(steps) => write!(f, "the cycle ran {steps} steps: an endless loop?"),
-            Fault::MuxSelector(k) => write!(f, "MUX selector {k} names no value"),
+            Fault::Budget => write!(f, "the cycle ran {a} steps: an endless loop?"),
+            Fault::MuxSelector => write!(f, "MUX selector {a} names no value"),
             Fault::ReadOnly => write!(f, "a write to a leaf of the image the CNC writes"),
             Fault::ImageCopy => write!(f, "a whole structure copied to or from the image"),
             Fault::NoHost => write!(f, "a library block without the PLC runtime to run it"),

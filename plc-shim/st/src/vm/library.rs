@@ -174,6 +174,12 @@ fn of_type(v: f64, t: Elem) -> V {
 }
 
 impl Library {
+    /// The host's slot of the instance at `at`, if one is there.
+    pub(super) fn slot_at(&self, at: u32) -> Option<u32> {
+        let k = self.instances.binary_search_by_key(&at, |(a, _)| *a).ok()?;
+        u32::try_from(k).ok()
+    }
+
     /// The library of `code` for the host's block `names`: each a FUNCTION_BLOCK of the
     /// program with an empty body, or a refusal naming it.
     pub(super) fn of(code: &Compiled, names: &[&str]) -> Result<Library, Vec<Diagnostic>> {
@@ -380,11 +386,13 @@ impl Program {
 impl super::Exec<'_> {
     /// Host block `block` on the instance at `base`.
     pub(super) fn call_host(&mut self, block: usize, base: u32) -> Run<()> {
+        let slot = self.library.slot_at(base).ok_or(Fault::BadPointer)?;
+        self.call_host_at(block, base, slot as usize)
+    }
+
+    /// As [`Exec::call_host`] for the instance in host slot `slot`.
+    pub(super) fn call_host_at(&mut self, block: usize, base: u32, slot: usize) -> Run<()> {
         let lib = self.library;
-        let slot = lib
-            .instances
-            .binary_search_by_key(&base, |(at, _)| *at)
-            .map_err(|_| Fault::BadPointer)?;
         let host = self.host.as_deref_mut().ok_or(Fault::NoHost)?;
         let mut io = BlockIo {
             memory: &mut self.st.memory,

@@ -44,7 +44,7 @@ pub(crate) fn pointed(p: i64) -> Run<Loc> {
 }
 
 /// Sets the value of type `t` at `at` of a program's memory.
-#[inline]
+#[inline(always)]
 pub(crate) fn write_mem(m: &mut [u8], at: usize, t: Elem, v: V) -> Run<()> {
     // Each width copied as a constant number of bytes: no call to `memcpy`.
     fn put<const N: usize>(m: &mut [u8], at: usize, bytes: [u8; N]) -> Run<()> {
@@ -66,7 +66,7 @@ pub(crate) fn write_mem(m: &mut [u8], at: usize, t: Elem, v: V) -> Run<()> {
 }
 
 /// The value of type `t` at `at` of a program's memory.
-#[inline]
+#[inline(always)]
 pub(crate) fn read_mem(m: &[u8], at: usize, t: Elem) -> Run<V> {
     let bytes = |n: usize| m.get(at..at + n).ok_or(Fault::BadPointer);
     Ok(match t {

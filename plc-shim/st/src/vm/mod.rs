@@ -1,5 +1,6 @@
 //! The runtime of a compiled program: one memory sized at load, every PROGRAM's statements run
-//! once per cycle by walking the compiled tree, nothing allocated in a cycle. A cycle is
+//! once per cycle, nothing allocated in a cycle: each body as a list of operations on
+//! registers ([`code`], [`run`]), what is rare in it by walking the compiled tree. A cycle is
 //! bounded by a budget of steps (statements and loop rounds), so an endless loop ends it; a
 //! division by zero, an index outside its array, a pointer outside the memory, a conversion
 //! of a value its type cannot hold, or the budget spent is a [`Fault`] with the statement's
@@ -15,11 +16,15 @@ use library::Library;
 pub use library::{BlockIo, Host};
 pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 
+mod callees;
+mod code;
 mod fault;
 mod image;
+mod init;
 mod library;
 mod mem;
 mod ops;
+mod run;
 mod std_fb;
 mod symbols;
 
@@ -82,6 +87,8 @@ pub const DEFAULT_BUDGET: u64 = 1_000_000;
 #[derive(Debug, Clone)]
 pub struct Program {
     code: Compiled,
+    /// The bodies as operations.
+    codes: code::Codes,
     state: State,
     library: Library,
     /// The PROGRAMs, in the order the files declare them.
@@ -97,6 +104,12 @@ struct State {
     now_ns: i64,
     /// The statement being run (for a fault's place).
     at: (u16, Pos),
+    /// The numbers of the last fault that has some ([`FaultAt::values`]).
+    values: [i64; 3],
+    /// The bodies' registers (windows of it, one per call in a chain of calls): each a
+    /// word, and whether it holds a real.
+    regs: Vec<u64>,
+    reals: Vec<bool>,
 }
 
 /// A program running: its code, its state, and the image its pointers may reach.
@@ -109,6 +122,10 @@ struct Exec<'a> {
     host: Option<&'a mut dyn Host>,
     /// The inputs the block call being run passes (a host block sees which were given).
     passing: &'a [BlockInput],
+    /// The bodies as operations.
+    codes: &'a code::Codes,
+    /// Where the running body's registers start.
+    window: usize,
 }
 
 type Run<T> = Result<T, Fault>;
@@ -132,6 +149,7 @@ impl Program {
         }
         let code = compile(&units)?;
         let library = Library::of(&code, library)?;
+        let codes = code::Codes::of(&code, &library);
         let programs = (code.checked.pous.iter().enumerate())
             .filter(|(_, p)| p.kind == PouKind::Program)
             .map(|(i, _)| i)
@@ -140,13 +158,17 @@ impl Program {
             programs,
             library,
             state: State {
+                regs: vec![0; codes.registers],
+                reals: vec![false; codes.registers],
                 memory: vec![0; code.layout.size as usize],
                 budget: DEFAULT_BUDGET,
                 steps: 0,
                 now_ns: 0,
                 at: (0, Pos::default()),
+                values: [0; 3],
             },
             code,
+            codes,
         };
         let mut exec = Exec {
             code: &p.code,
@@ -155,6 +177,8 @@ impl Program {
             library: &p.library,
             host: None,
             passing: &[],
+            codes: &p.codes,
+            window: 0,
         };
         if let Err(f) = exec.initialise() {
             let file = p
@@ -163,7 +187,7 @@ impl Program {
                 .get(f.file as usize)
                 .cloned()
                 .unwrap_or_default();
-            let message = format!("an initial value: {}", f.fault);
+            let message = format!("an initial value: {f}");
             return Err(vec![Diagnostic::new(f.pos, message).in_file(&file)]);
         }
         Ok(p)
@@ -172,6 +196,12 @@ impl Program {
     /// Sets the steps a cycle may run (statements and loop rounds).
     pub fn set_budget(&mut self, steps: u64) {
         self.state.budget = steps.max(1);
+    }
+
+    /// Runs every body by walking the compiled tree from now on, as the operations did (the
+    /// tests compare the two ways).
+    pub fn interpret_only(&mut self) {
+        self.codes = code::Codes::default();
     }
 
     /// The compiled program.
@@ -208,6 +238,8 @@ impl Program {
             // The host's own lifetime shortened to the cycle's.
             host: host.map(|h| h as &mut dyn Host),
             passing: &[],
+            codes: &self.codes,
+            window: 0,
         };
         for &pou in &self.programs {
             let base = exec.code.layout.statics[pou];
@@ -248,7 +280,7 @@ impl Program {
             .files
             .get(f.file as usize)
             .map_or("?", String::as_str);
-        format!("{file}:{}:{}: fault: {}", f.pos.line, f.pos.col, f.fault)
+        format!("{file}:{}:{}: fault: {f}", f.pos.line, f.pos.col)
     }
 
     /// The value of a variable of a PROGRAM, by `PROGRAM.variable` (ASCII case ignored), as
@@ -276,81 +308,32 @@ impl Program {
 
 impl<'a> Exec<'a> {
     fn fault_at(&self, fault: Fault) -> FaultAt {
+        let named = matches!(
+            fault,
+            Fault::IndexOutOfRange | Fault::Budget | Fault::MuxSelector
+        );
         FaultAt {
             fault,
             file: self.st.at.0,
             pos: self.st.at.1,
+            values: if named { self.st.values } else { [0; 3] },
         }
     }
 
-    /// Every variable's initial value: the globals' and programs' instances, and every
-    /// function block instance inside them.
-    fn initialise(&mut self) -> Result<(), FaultAt> {
-        let code = self.code;
-        self.block(&code.global_inits, 0)
-            .map_err(|f| self.fault_at(f))?;
-        let globals: Vec<(u32, Type)> = (0..self.code.checked.globals.len())
-            .map(|i| {
-                (
-                    self.code.layout.globals[i],
-                    self.code.checked.globals[i].ty.clone(),
-                )
-            })
-            .collect();
-        for (at, ty) in globals {
-            self.init_instances(&ty, at).map_err(|f| self.fault_at(f))?;
-        }
-        for pou in 0..self.code.checked.pous.len() {
-            if self.code.checked.pous[pou].kind == PouKind::Program {
-                let base = self.code.layout.statics[pou];
-                self.init_pou(pou, base).map_err(|f| self.fault_at(f))?;
-            }
-        }
-        Ok(())
-    }
-
-    /// POU `pou`'s initial values at `base`, then those of the instances among its variables.
-    fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
-        let code = self.code;
-        self.block(&code.bodies[pou].0, base)?;
-        for k in 0..self.code.checked.pous[pou].vars.len() {
-            let ty = self.code.checked.pous[pou].vars[k].ty.clone();
-            let offset = self.code.layout.pous[pou].2[k];
-            self.init_instances(&ty, base + offset)?;
-        }
-        Ok(())
-    }
-
-    fn init_instances(&mut self, ty: &Type, at: u32) -> Run<()> {
-        match ty {
-            Type::Fb(i) => self.init_pou(*i, at),
-            Type::Struct(i) => {
-                for k in 0..self.code.checked.structs[*i].fields.len() {
-                    let field = self.code.checked.structs[*i].fields[k].1.clone();
-                    let offset = self.code.layout.structs[*i].2[k];
-                    self.init_instances(&field, at + offset)?;
-                }
-                Ok(())
-            }
-            Type::Array(dims, element)
-                if matches!(**element, Type::Fb(_) | Type::Struct(_) | Type::Array(..)) =>
-            {
-                let (size, align) = self.code.layout.size_align(&self.code.checked, element);
-                let stride = size.div_ceil(align) * align;
-                let count: i64 = dims.iter().map(|(lo, hi)| hi - lo + 1).product();
-                for k in 0..count as u32 {
-                    self.init_instances(element, at + k * stride)?;
-                }
-                Ok(())
-            }
-            _ => Ok(()),
-        }
+    /// A fault with numbers: they are kept for [`FaultAt::values`].
+    #[cold]
+    fn fault_with(&mut self, fault: Fault, values: [i64; 3]) -> Fault {
+        self.st.values = values;
+        fault
     }
 
     /// POU `pou`'s statements on the instance at `base`.
     fn run_body(&mut self, pou: usize, base: u32) -> Run<()> {
         if let Some(block) = self.library.of_pou[pou] {
             return self.call_host(block, base);
+        }
+        if let Some(Some(body)) = self.codes.bodies.get(pou) {
+            return self.run_code(body, base);
         }
         let code = self.code;
         self.block(&code.bodies[pou].1, base).map(|_| ())
@@ -360,7 +343,7 @@ impl<'a> Exec<'a> {
     fn step(&mut self) -> Run<()> {
         self.st.steps += 1;
         if self.st.steps > self.st.budget {
-            return Err(Fault::Budget(self.st.steps));
+            return Err(self.fault_with(Fault::Budget, [self.st.steps as i64, 0, 0]));
         }
         Ok(())
     }
@@ -581,11 +564,7 @@ impl<'a> Exec<'a> {
                 let i = self.eval(index, base)?.int();
                 let hi = lo + i64::from(*len) - 1;
                 if i < *lo || i > hi {
-                    return Err(Fault::IndexOutOfRange {
-                        index: i,
-                        lo: *lo,
-                        hi,
-                    });
+                    return Err(self.fault_with(Fault::IndexOutOfRange, [i, *lo, hi]));
                 }
                 let step = (i - lo) as usize * *stride as usize;
                 self.addr(array, base)?.plus(step)
@@ -765,6 +744,10 @@ impl<'a> Exec<'a> {
         for (v, a) in values.iter_mut().zip(args) {
             *v = self.eval(a, base)?;
         }
-        ops::standard(f, t, &values[..n])
+        let v = ops::standard(f, t, &values[..n]);
+        if v == Err(Fault::MuxSelector) {
+            return Err(self.fault_with(Fault::MuxSelector, [values[0].int(), 0, 0]));
+        }
+        v
     }
 }

@@ -57,7 +57,7 @@ fn finite(v: f64) -> Run<V> {
     }
 }
 
-#[inline]
+#[inline(always)]
 pub(crate) fn binary(op: BinOp, t: Elem, x: V, y: V) -> Run<V> {
     match (op, x, y) {
         (BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge, _, _) => {
@@ -198,7 +198,7 @@ pub(crate) fn standard(f: StdFn, t: Elem, v: &[V]) -> Run<V> {
             let k = v[0].int();
             match usize::try_from(k).ok().and_then(|k| v[1..].get(k)) {
                 Some(x) => Ok(*x),
-                None => Err(Fault::MuxSelector(k)),
+                None => Err(Fault::MuxSelector),
             }
         }
         StdFn::Shl | StdFn::Shr | StdFn::Rol | StdFn::Ror => {

@@ -1,0 +1,112 @@
+//! Which POUs a body calls (block bodies and functions), for the register file's size: the
+//! deepest chain of calls ([`super::code::Codes`]).
+
+use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
+
+/// Every POU a statement calls (block bodies and functions).
+pub(super) fn of_st(s: &St, out: &mut Vec<usize>) {
+    let exprs = |e: &Ex, out: &mut Vec<usize>| of_ex(e, out);
+    match &s.kind {
+        StKind::Store(a, _, e) | StKind::StorePtr(a, e) => {
+            of_addr(a, out);
+            exprs(e, out);
+        }
+        StKind::Copy(a, b, _) => {
+            of_addr(a, out);
+            of_addr(b, out);
+        }
+        StKind::Bytes(a, _) => of_addr(a, out),
+        StKind::If(arms, otherwise) => {
+            for (c, body) in arms {
+                exprs(c, out);
+                body.iter().for_each(|s| of_st(s, out));
+            }
+            otherwise.iter().for_each(|s| of_st(s, out));
+        }
+        StKind::Case(sel, arms, otherwise) => {
+            exprs(sel, out);
+            for (_, body) in arms {
+                body.iter().for_each(|s| of_st(s, out));
+            }
+            otherwise.iter().for_each(|s| of_st(s, out));
+        }
+        StKind::For {
+            var,
+            from,
+            to,
+            by,
+            body,
+            ..
+        } => {
+            of_addr(var, out);
+            [from, to, by].into_iter().for_each(|e| exprs(e, out));
+            body.iter().for_each(|s| of_st(s, out));
+        }
+        StKind::While(c, body) | StKind::Repeat(body, c) => {
+            exprs(c, out);
+            body.iter().for_each(|s| of_st(s, out));
+        }
+        StKind::CallFb {
+            pou,
+            instance,
+            inputs,
+            outputs,
+        } => {
+            out.push(*pou);
+            of_call(instance, inputs, outputs, out);
+        }
+        StKind::CallStdFb {
+            instance,
+            inputs,
+            outputs,
+            ..
+        } => of_call(instance, inputs, outputs, out),
+        StKind::Eval(e) => exprs(e, out),
+        StKind::Exit | StKind::Continue | StKind::Return => {}
+    }
+}
+
+fn of_call(a: &Addr, inputs: &[BlockInput], outputs: &[BlockOutput], out: &mut Vec<usize>) {
+    of_addr(a, out);
+    inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
+    outputs.iter().for_each(|(_, _, a, _)| of_addr(a, out));
+}
+
+fn of_addr(a: &Addr, out: &mut Vec<usize>) {
+    match a {
+        Addr::Offset(inner, _) => of_addr(inner, out),
+        Addr::Index { base, index, .. } => {
+            of_addr(base, out);
+            of_ex(index, out);
+        }
+        Addr::Deref(e) => of_ex(e, out),
+        Addr::Static(_) | Addr::Instance(_) | Addr::Via { .. } => {}
+    }
+}
+
+fn of_ex(e: &Ex, out: &mut Vec<usize>) {
+    match e {
+        Ex::Load(a, _) | Ex::LoadPtr(a) | Ex::AddrOf(a) => of_addr(a, out),
+        Ex::Neg(x, _) | Ex::Not(x, _) | Ex::Conv(_, _, x) => of_ex(x, out),
+        Ex::Bin(_, _, a, b) => {
+            of_ex(a, out);
+            of_ex(b, out);
+        }
+        Ex::TextEq(pair) => {
+            for t in [&pair.0, &pair.1] {
+                if let crate::ir::Text::At(a, _) = t {
+                    of_addr(a, out);
+                }
+            }
+        }
+        Ex::Std(_, _, args) => args.iter().for_each(|a| of_ex(a, out)),
+        Ex::Call {
+            pou, inputs, value, ..
+        } => {
+            out.push(*pou);
+            inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
+            of_addr(value, out);
+        }
+        Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
+    }
+}

@@ -1,0 +1,269 @@
+//! Runs a body's operations ([`super::code`]): a program counter over the list, each
+//! operation reading its operands (registers of the body's window, constants, variables),
+//! the rules of values, places and faults those of the tree walker.
+
+use super::code::{CallOp, Code, Dst, Op, Src};
+use super::{ops, pointed, Exec, Fault, Flow, Loc, Run, IMAGE_TAG, V};
+use crate::types::Elem;
+
+/// A place as the value of a register: the tagged pointer `ADR` makes.
+fn tagged(at: Loc) -> V {
+    V::I(match at {
+        Loc::Own(at) => at as i64 + 1,
+        Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
+    })
+}
+
+impl<'a> Exec<'a> {
+    /// Body `code` on the instance at `base`, its registers from the window's start on.
+    pub(super) fn run_code(&mut self, code: &'a Code, base: u32) -> Run<()> {
+        let w = self.window;
+        // Where what this body calls keeps its registers.
+        let top = w + usize::from(code.regs);
+        if top > self.st.regs.len() {
+            return Err(Fault::BadPointer);
+        }
+        let codes = self.codes;
+        let mut pc = 0;
+        while let Some(op) = code.ops.get(pc) {
+            pc += 1;
+            match *op {
+                Op::Stmt(k) => {
+                    self.st.at = codes.sites[k as usize];
+                    self.step()?;
+                }
+                Op::Step => self.step()?,
+                Op::At(k) => self.st.at = codes.sites[k as usize],
+                Op::Bin(op, t, d, a, b) => {
+                    let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
+                    let v = ops::binary(op, t, x, y)?;
+                    self.put(w, d, v);
+                }
+                Op::Neg(t, d, a) => {
+                    let v = ops::neg(self.src(a, base, w)?, t);
+                    self.put(w, d, v);
+                }
+                Op::Not(t, d, a) => {
+                    let v = ops::not(self.src(a, base, w)?, t);
+                    self.put(w, d, v);
+                }
+                Op::Conv(from, to, d, a) => {
+                    let v = ops::convert(self.src(a, base, w)?, from, to)?;
+                    self.put(w, d, v);
+                }
+                Op::Mov(d, a) => {
+                    let v = self.src(a, base, w)?;
+                    self.put(w, d, v);
+                }
+                Op::LoadVia(d, ptr, relative, plus, t) => {
+                    let at = self.via(ptr, relative, plus, base)?;
+                    let v = self.read(at, t)?;
+                    self.put(w, d, v);
+                }
+                Op::Tree(d, k) => {
+                    let e = &codes.exprs[k as usize];
+                    let v = self.nested(top, |x| x.eval(e, base))?;
+                    self.put(w, d, v);
+                }
+                Op::Addr(d, k) => {
+                    let a = &codes.places[k as usize];
+                    let at = self.nested(top, |x| x.addr(a, base))?;
+                    self.put(w, d, tagged(at));
+                }
+                Op::Store(to, t, s) => {
+                    let v = self.src(s, base, w)?;
+                    self.store(to, t, v, base, w)?;
+                }
+                Op::StorePtr(to, s) => {
+                    let v = self.src(s, base, w)?;
+                    self.store(to, Elem::ULInt, v, base, w)?;
+                }
+                Op::TreeSt(k, exit, next) => {
+                    let s = &codes.stmts[k as usize];
+                    let to = match self.nested(top, |x| x.statement(s, base))? {
+                        Flow::Next => continue,
+                        Flow::Exit => exit,
+                        Flow::Continue => next,
+                        Flow::Return => u32::MAX,
+                    };
+                    if to == u32::MAX {
+                        return Ok(());
+                    }
+                    pc = to as usize;
+                }
+                Op::Jump(to) => pc = to as usize,
+                Op::JumpIfNot(c, to) => {
+                    if self.src(c, base, w)?.int() == 0 {
+                        pc = to as usize;
+                    }
+                }
+                Op::JumpIn(s, lo, hi, to) => {
+                    if (lo..=hi).contains(&self.src(s, base, w)?.int()) {
+                        pc = to as usize;
+                    }
+                }
+                Op::ForTest(var, ty, [i, last, step], end) => {
+                    let reg = |r: u16| self.get(w, r).int();
+                    let (i, last, step) = (reg(i), reg(last), reg(step));
+                    if (step >= 0 && i > last) || (step < 0 && i < last) {
+                        pc = end as usize;
+                    } else {
+                        self.store(var, ty, V::I(i), base, w)?;
+                        self.step()?;
+                    }
+                }
+                Op::ForNext(var, ty, [i, _, step], test, end) => {
+                    let now = self.load(var, ty, base)?.int();
+                    let step = self.get(w, step).int();
+                    match now.checked_add(step) {
+                        Some(next) => {
+                            self.put(w, i, V::I(next));
+                            pc = test as usize;
+                        }
+                        None => pc = end as usize,
+                    }
+                }
+                Op::Inst(d, at, relative) => {
+                    let at = if relative { base + at } else { at };
+                    self.put(w, d, V::I(i64::from(at)));
+                }
+                Op::InstTree(d, k) => {
+                    let a = &codes.places[k as usize];
+                    let at = self.nested(top, |x| x.own(a, base))?;
+                    self.put(w, d, V::I(at as i64));
+                }
+                Op::Input(inst, offset, t, s) => {
+                    let v = self.src(s, base, w)?;
+                    let at = self.instance(inst, w) + offset;
+                    self.write_own(at as usize, t, v)?;
+                }
+                Op::Body(pou, inst, call) => {
+                    self.passing = &codes.calls[call as usize];
+                    let at = self.instance(inst, w);
+                    self.nested(top, |x| x.run_body(pou as usize, at))?;
+                }
+                Op::StdBody(fb, inst, call) => {
+                    self.passing = &codes.calls[call as usize];
+                    let at = self.instance(inst, w);
+                    self.run_std_fb(fb, at as usize)?;
+                }
+                Op::Output(inst, offset, t, negated, to) => {
+                    let at = self.instance(inst, w) + offset;
+                    let mut v = self.read_own(at as usize, t)?;
+                    if negated {
+                        v = V::I(i64::from(v.int() == 0));
+                    }
+                    self.store(to, t, v, base, w)?;
+                }
+                Op::Call(k) => self.call(&codes.call_ops[k as usize], base, w, top)?,
+                Op::Ret => return Ok(()),
+            }
+        }
+        Ok(())
+    }
+
+    /// Register `r` of the window at `w` (a register is a word and a flag for a real, never
+    /// copied as a whole value: the copy's wide load would wait for the two narrow stores).
+    #[inline(always)]
+    fn get(&self, w: usize, r: u16) -> V {
+        let i = w + usize::from(r);
+        let bits = self.st.regs[i];
+        if self.st.reals[i] {
+            V::F(f64::from_bits(bits))
+        } else {
+            V::I(bits as i64)
+        }
+    }
+
+    #[inline(always)]
+    fn put(&mut self, w: usize, r: u16, v: V) {
+        let i = w + usize::from(r);
+        let (bits, real) = match v {
+            V::I(x) => (x as u64, false),
+            V::F(x) => (x.to_bits(), true),
+        };
+        self.st.regs[i] = bits;
+        self.st.reals[i] = real;
+    }
+
+    /// A whole block call ([`Op::Call`]): as the tree's, its inputs stored one after the
+    /// other, the body run, the statement's place set again for its outputs.
+    fn call(&mut self, c: &'a CallOp, base: u32, w: usize, top: usize) -> Run<()> {
+        let codes = self.codes;
+        self.st.at = codes.sites[c.site as usize];
+        self.step()?;
+        let at = if c.relative { base + c.at } else { c.at };
+        let (first, end) = (c.inputs.0 as usize, c.inputs.1 as usize);
+        for &(offset, t, s) in &codes.inputs[first..end] {
+            let v = self.src(s, base, w)?;
+            self.write_own((at + offset) as usize, t, v)?;
+        }
+        self.passing = &codes.calls[c.call as usize];
+        match c.body {
+            Ok(pou) => match (c.slot, self.library.of_pou[pou as usize]) {
+                (Some(slot), Some(block)) => self.call_host_at(block, at, slot as usize)?,
+                _ => self.nested(top, |x| x.run_body(pou as usize, at))?,
+            },
+            Err(fb) => self.run_std_fb(fb, at as usize)?,
+        }
+        self.st.at = codes.sites[c.site as usize];
+        Ok(())
+    }
+
+    /// `f` with the register window above this body's (from `top` on).
+    #[inline]
+    fn nested<T>(&mut self, top: usize, f: impl FnOnce(&mut Self) -> Run<T>) -> Run<T> {
+        let saved = std::mem::replace(&mut self.window, top);
+        let r = f(self);
+        self.window = saved;
+        r
+    }
+
+    /// The instance offset register `r` holds.
+    #[inline]
+    fn instance(&self, r: u16, w: usize) -> u32 {
+        self.get(w, r).int() as u32
+    }
+
+    #[inline(always)]
+    fn src(&self, s: Src, base: u32, w: usize) -> Run<V> {
+        match s {
+            Src::R(r) => Ok(self.get(w, r)),
+            Src::I(v) => Ok(V::I(v)),
+            Src::F(v) => Ok(V::F(v)),
+            Src::Var(at, relative, t) => {
+                let at = if relative { base + at } else { at };
+                self.read_own(at as usize, t)
+            }
+        }
+    }
+
+    #[inline]
+    fn store(&mut self, to: Dst, t: Elem, v: V, base: u32, w: usize) -> Run<()> {
+        match to {
+            Dst::Own(at, relative) => {
+                let at = if relative { base + at } else { at };
+                self.write_own(at as usize, t, v)
+            }
+            Dst::Via(ptr, relative, plus) => {
+                let at = self.via(ptr, relative, plus, base)?;
+                self.write(at, t, v)
+            }
+            Dst::At(r) => {
+                let at = pointed(self.get(w, r).int())?;
+                self.write(at, t, v)
+            }
+        }
+    }
+
+    /// The value of a FOR's control variable (always a place of the program's own memory).
+    fn load(&self, var: Dst, t: Elem, base: u32) -> Run<V> {
+        match var {
+            Dst::Own(at, relative) => {
+                let at = if relative { base + at } else { at };
+                self.read_own(at as usize, t)
+            }
+            _ => Err(Fault::BadPointer),
+        }
+    }
+}
