@@ -30,9 +30,8 @@ pub struct RealtimeOptions {
     /// cyclictest does): no deep idle state delays the tick's wake-up.
     #[arg(long = "rt-cpu-wake-latency-us")]
     pub cpu_wake_latency_us: Option<u32>,
-    /// How the CNC wakes the PLC for a tick in real time: `event` (iceoryx2's event; the
-    /// default, except below a 1 ms cycle with `--rt-priority` and `--rt-cpu` on two CPUs or
-    /// more: there `spin`), `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
+    /// How the CNC wakes the PLC for a tick in real time: `event` (iceoryx2's event, the
+    /// default), `futex` (the PLC sleeps on the low word of the CNC's heartbeat in the
     /// segment, the CNC wakes it with one `futex(2)` call) or `spin` (as `futex`, but the PLC
     /// wakes by a timed sleep shortly before the tick is due and spins on that word until the
     /// tick is done, at most half a cycle (and 500 us) past its due time, before it sleeps on
@@ -41,10 +40,6 @@ pub struct RealtimeOptions {
     #[arg(long = "rt-wake", value_enum)]
     pub wake: Option<WakePath>,
 }
-
-/// Below this cycle (s) a pinned CNC wakes its PLC by the spin unless told otherwise
-/// ([`RealtimeOptions::with_wake_chosen`]).
-pub const SPIN_BELOW_CYCLE_S: f64 = 1e-3;
 
 /// How a sleeping PLC is woken for a tick.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, clap::ValueEnum, Deserialize)]
@@ -108,29 +103,6 @@ impl RealtimeOptions {
             cpu_wake_latency_us: None,
             // Both ends wake the same way.
             wake: self.wake,
-        }
-    }
-
-    /// These options with the wake path chosen where none was given, for a CNC of cycle
-    /// `cycle_s` on a machine of `cpus` CPUs: `spin` below a 1 ms cycle when the CNC runs
-    /// at a real-time priority, pinned to a CPU, and another CPU is there for the PLC's spin
-    /// (the PLC goes there, [`RealtimeOptions::for_plc`]), else `event`. As measured (docs/machine.md): at 250 us
-    /// the spin beside a pinned CNC missed fewer PLC cycles than the event in every round;
-    /// unpinned, the spin delayed the CNC's own ticks; at 1 ms the event kept up and takes
-    /// no core.
-    pub fn with_wake_chosen(&self, cycle_s: f64, cpus: usize) -> RealtimeOptions {
-        let spin = cycle_s < SPIN_BELOW_CYCLE_S
-            && self.priority.is_some()
-            && self.cpu.is_some()
-            && cpus >= 2;
-        let chosen = if spin {
-            WakePath::Spin
-        } else {
-            WakePath::Event
-        };
-        RealtimeOptions {
-            wake: Some(self.wake.unwrap_or(chosen)),
-            ..self.clone()
         }
     }
 
@@ -243,34 +215,6 @@ mod tests {
         assert_eq!(cnc(None, spin).for_plc().cpu, None);
         assert_eq!(cnc(Some(1), Some(WakePath::Futex)).for_plc().cpu, None);
         assert_eq!(WakePath::Spin.name(), "spin");
-    }
-
-    #[test]
-    fn the_spin_is_chosen_below_1_ms_for_a_pinned_cnc_with_a_cpu_beside_it() {
-        let cnc = |cpu, wake| RealtimeOptions {
-            priority: Some(80),
-            cpu,
-            wake,
-            ..RealtimeOptions::default()
-        };
-        let chosen = |o: RealtimeOptions, cycle_s, cpus| o.with_wake_chosen(cycle_s, cpus).wake;
-        let spin = Some(WakePath::Spin);
-        assert_eq!(chosen(cnc(Some(1), None), 250e-6, 2), spin);
-        assert_eq!(chosen(cnc(Some(1), None), 1e-3, 2), Some(WakePath::Event));
-        assert_eq!(chosen(cnc(None, None), 250e-6, 8), Some(WakePath::Event));
-        assert_eq!(chosen(cnc(Some(0), None), 250e-6, 1), Some(WakePath::Event));
-        let without_priority = RealtimeOptions {
-            priority: None,
-            ..cnc(Some(1), None)
-        };
-        assert_eq!(chosen(without_priority, 250e-6, 2), Some(WakePath::Event));
-        // A path given stays.
-        let futex = Some(WakePath::Futex);
-        assert_eq!(chosen(cnc(Some(1), futex), 250e-6, 2), futex);
-        assert_eq!(chosen(cnc(None, spin), 1e-3, 2), spin);
-        // The PLC of a chosen spin goes beside the CNC.
-        let o = cnc(Some(1), None).with_wake_chosen(250e-6, 2);
-        assert_eq!(o.for_plc().cpu, Some(0));
     }
 
     #[test]

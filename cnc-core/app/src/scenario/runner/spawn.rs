@@ -63,16 +63,10 @@ pub(super) fn spawn_plc(
         .map_err(|e| format!("spawning the PLC: {e}"))
 }
 
-/// The CNC's real-time options: the flags over the scenario's `[realtime]`, and in real time
-/// the wake path chosen where neither gives one (`spin` below a 1 ms cycle beside a pinned
-/// CNC, else `event`: [`RealtimeOptions::with_wake_chosen`]).
+/// The CNC's real-time options: the flags over the scenario's `[realtime]` (the one place
+/// the CNC's tick loop, its report and the PLC it spawns take them from).
 pub(super) fn cnc_realtime(scenario: &Scenario, options: &RunOptions) -> RealtimeOptions {
-    let given = options.realtime.over(&scenario.realtime);
-    if options.lockstep {
-        return given;
-    }
-    let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    given.with_wake_chosen(scenario.cycle_s, cpus)
+    options.realtime.over(&scenario.realtime)
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), String> {

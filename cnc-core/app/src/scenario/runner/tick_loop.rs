@@ -246,9 +246,10 @@ impl<'a> TickLoop<'a> {
             loader,
             gauge: LatenessGauge::new(),
             guard: CycleGuard::new(bounds.period.as_nanos() as u64),
-            wake_futex: super::spawn::cnc_realtime(scenario, options)
-                .wake
-                .is_some_and(WakePath::on_the_word),
+            wake_futex: !options.lockstep
+                && super::spawn::cnc_realtime(scenario, options)
+                    .wake
+                    .is_some_and(WakePath::on_the_word),
         }
     }
 
