@@ -105,7 +105,25 @@ impl Gen {
             4 => format!("a[{} - 1] := {};\n", self.int_var(), self.int(1)),
             5 => format!("t(IN := {}, PT := T#20MS);\nb0 := t.Q;\n", self.boolean(1)),
             6 => format!("fb(x := {}, y => {});\n", self.int(1), self.int_var()),
-            7 => format!("p := ADR({});\np^ := {};\n", self.int_var(), self.int(1)),
+            7 => match self.pick(3) {
+                0 => format!("p := ADR({});\np^ := {};\n", self.int_var(), self.int(1)),
+                // Pointers in an array, to structures with arrays (as gpCh[0]^.unit.field).
+                1 => format!(
+                    "pa[{}] := ADR(q{});\npa[{}]^.v[{}] := {};\n",
+                    self.pick(2),
+                    self.pick(2),
+                    self.pick(2),
+                    self.pick(3),
+                    self.int(1)
+                ),
+                _ => format!(
+                    "{} := pa[{}]^.v[{}] + pa[{}]^.x;\n",
+                    self.int_var(),
+                    self.pick(2),
+                    self.pick(3),
+                    self.pick(2)
+                ),
+            },
             8 => format!(
                 "IF {} THEN\n{}ELSIF {} THEN\n{}ELSE\n{}END_IF\n",
                 self.boolean(1),
@@ -180,8 +198,11 @@ VAR s : DINT; END_VAR
     s := s + x;
     y := s MOD 1000;
 END_FUNCTION_BLOCK
+TYPE S : STRUCT x : DINT; v : ARRAY[0..2] OF DINT; END_STRUCT END_TYPE
 PROGRAM MAIN
 VAR
+    q0, q1 : S;
+    pa : ARRAY[0..1] OF POINTER TO S;
     i0, i1, i2 : DINT := 1; i3 : DINT := -7;
     b0, b1 : BOOL; b2 : BOOL := TRUE;
     r0 : LREAL := 0.25; r1 : LREAL := -3.0;

@@ -68,6 +68,12 @@ pub(crate) enum Op {
     Mov(R, Src),
     /// `d :=` the value of the type `plus` bytes past where the pointer variable points.
     LoadVia(R, u32, bool, u32, Elem),
+    /// `d :=` the tagged pointer `plus` bytes past where the pointer value points (NULL and
+    /// values below it are faults); for an access (true), one past the pointers' range too,
+    /// as the access itself would fault there.
+    PtrAt(R, Src, u32, bool),
+    /// `d :=` the value of the type where the tagged pointer in the register points.
+    LoadAt(R, R, Elem),
     /// `d :=` an expression the tree computes (its index among [`Codes::exprs`]).
     Tree(R, u32),
     /// `d :=` the tagged pointer to a place the tree finds (its index among
@@ -625,10 +631,38 @@ impl<'c> Builder<'c> {
         {
             return Dst::Via(ptr, relative, plus);
         }
+        if let Some(r) = self.pointer_place(a, true) {
+            return Dst::At(r);
+        }
         let r = self.reg();
         let k = self.place(a);
         self.ops.push(Op::Addr(r, k));
         Dst::At(r)
+    }
+
+    /// The tagged pointer to a place behind a pointer (`gpCh[0]^.unit.field`,
+    /// `p^.array[2]`), into a register; `None` when the tree must find it.
+    fn pointer_place(&mut self, a: &Addr, access: bool) -> Option<R> {
+        let (e, plus) = behind_pointer(a)?;
+        let mark = self.next;
+        let p = self.expr(e);
+        self.next = mark;
+        let r = self.reg();
+        self.ops.push(Op::PtrAt(r, p, plus, access));
+        Some(r)
+    }
+
+    /// `e`'s value read where the tagged pointer to `a` points, or the tree's.
+    fn load_behind(&mut self, e: &Ex, a: &Addr, t: Elem) -> Src {
+        match self.pointer_place(a, true) {
+            Some(p) => {
+                self.next = p;
+                let r = self.reg();
+                self.ops.push(Op::LoadAt(r, p, t));
+                Src::R(r)
+            }
+            None => self.tree(e),
+        }
     }
 
     /// An expression's value: an operand, or a register the operations pushed fill.
@@ -655,7 +689,32 @@ impl<'c> Builder<'c> {
                     self.ops.push(Op::LoadVia(r, ptr, relative, plus, *t));
                     Src::R(r)
                 }
-                _ => self.tree(e),
+                _ => self.load_behind(e, a, *t),
+            },
+            Ex::LoadPtr(a) => match own(a) {
+                Some(Dst::Own(at, relative)) => Src::Var(at, relative, Elem::ULInt),
+                _ => self.load_behind(e, a, Elem::ULInt),
+            },
+            Ex::AddrOf(a) => match (own(a), &**a) {
+                (Some(Dst::Own(at, false)), _) => Src::I(i64::from(at) + 1),
+                // `ADR(gpCh[0]^.unit)`: past where the pointer variable points.
+                (
+                    _,
+                    Addr::Via {
+                        ptr,
+                        relative,
+                        plus,
+                    },
+                ) => {
+                    let r = self.reg();
+                    let p = Src::Var(*ptr, *relative, Elem::ULInt);
+                    self.ops.push(Op::PtrAt(r, p, *plus, false));
+                    Src::R(r)
+                }
+                _ => match self.pointer_place(a, false) {
+                    Some(r) => Src::R(r),
+                    None => self.tree(e),
+                },
             },
             Ex::Neg(x, t) => self.unary(x, |r, v| Op::Neg(*t, r, v)),
             Ex::Not(x, t) => self.unary(x, |r, v| Op::Not(*t, r, v)),
@@ -709,7 +768,7 @@ fn operand(e: &Ex) -> Option<Src> {
 }
 
 /// A place of the program's own memory at a fixed offset (absolute, or from the instance's
-/// base), if `a` is one.
+/// base), if `a` is one (fields, and elements at constant indices within their bounds).
 fn own(a: &Addr) -> Option<Dst> {
     match a {
         Addr::Static(o) => Some(Dst::Own(*o, false)),
@@ -718,6 +777,53 @@ fn own(a: &Addr) -> Option<Dst> {
             Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(*plus)?, relative)),
             _ => None,
         },
+        Addr::Index {
+            base,
+            index,
+            lo,
+            len,
+            stride,
+        } => {
+            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
+            match own(base)? {
+                Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(step)?, relative)),
+                _ => None,
+            }
+        }
         _ => None,
     }
+}
+
+/// `a` as a pointer's value and the bytes past where it points, when every step from the
+/// pointer is a field or an element at a constant index within its bounds.
+fn behind_pointer(a: &Addr) -> Option<(&Ex, u32)> {
+    match a {
+        Addr::Deref(e) => Some((e, 0)),
+        Addr::Offset(inner, plus) => {
+            let (e, p) = behind_pointer(inner)?;
+            Some((e, p.checked_add(*plus)?))
+        }
+        Addr::Index {
+            base,
+            index,
+            lo,
+            len,
+            stride,
+        } => {
+            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
+            let (e, p) = behind_pointer(base)?;
+            Some((e, p.checked_add(step)?))
+        }
+        _ => None,
+    }
+}
+
+/// A constant index's element (from 0) when it lies within the bounds (else the tree
+/// evaluates it and faults as it must).
+fn constant_index(index: &Ex, lo: i64, len: u32) -> Option<u32> {
+    let Ex::Int(i) = index else {
+        return None;
+    };
+    let k = i.checked_sub(lo)?;
+    (0..i64::from(len)).contains(&k).then_some(k as u32)
 }

@@ -14,6 +14,17 @@ fn tagged(at: Loc) -> V {
     })
 }
 
+/// As [`tagged`] for a place about to be read or written: one whose tag would not come back
+/// as the same place (beyond the pointers' range, where the access faults anyway) is the
+/// access's fault now.
+fn access_tag(at: Loc) -> Run<V> {
+    let (Loc::Own(n) | Loc::Image(n)) = at;
+    if n as u64 >= (IMAGE_TAG as u64) - 1 {
+        return Err(Fault::BadPointer);
+    }
+    Ok(tagged(at))
+}
+
 impl<'a> Exec<'a> {
     /// Body `code` on the instance at `base`, its registers from the window's start on.
     pub(super) fn run_code(&mut self, code: &'a Code, base: u32) -> Run<()> {
@@ -60,6 +71,16 @@ impl<'a> Exec<'a> {
                     let v = self.read(at, t)?;
                     self.put(w, d, v);
                 }
+                Op::PtrAt(d, p, plus, access) => {
+                    let at = pointed(self.src(p, base, w)?.int())?.plus(plus as usize);
+                    let v = if access { access_tag(at)? } else { tagged(at) };
+                    self.put(w, d, v);
+                }
+                Op::LoadAt(d, r, t) => {
+                    let at = pointed(self.get(w, r).int())?;
+                    let v = self.read(at, t)?;
+                    self.put(w, d, v);
+                }
                 Op::Tree(d, k) => {
                     let e = &codes.exprs[k as usize];
                     let v = self.nested(top, |x| x.eval(e, base))?;
@@ -68,7 +89,7 @@ impl<'a> Exec<'a> {
                 Op::Addr(d, k) => {
                     let a = &codes.places[k as usize];
                     let at = self.nested(top, |x| x.addr(a, base))?;
-                    self.put(w, d, tagged(at));
+                    self.put(w, d, access_tag(at)?);
                 }
                 Op::Store(to, t, s) => {
                     let v = self.src(s, base, w)?;
