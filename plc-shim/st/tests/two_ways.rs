@@ -52,7 +52,12 @@ impl Gen {
             6 => format!("ABS({})", self.int(d)),
             7 => format!("MIN({}, {})", self.int(d), self.int(d)),
             8 => format!("SEL({}, {}, {})", self.boolean(d), self.int(d), self.int(d)),
-            9 => format!("Twice({})", self.int(d)),
+            9 => match self.pick(3) {
+                0 => format!("Twice({})", self.int(d)),
+                // Functions that write what the expression around them reads.
+                1 => format!("({} + Bump())", self.int_var()),
+                _ => "(g + Inc())".into(),
+            },
             _ => format!("-{}", self.int(d)),
         }
     }
@@ -191,6 +196,18 @@ impl Gen {
 VAR_INPUT x : DINT; END_VAR
     Twice := x * 2;
 END_FUNCTION
+FUNCTION Bump : DINT
+    gp^ := gp^ + 1;
+    Bump := 0;
+END_FUNCTION
+FUNCTION Inc : DINT
+    g := g + 1;
+    Inc := g MOD 3;
+END_FUNCTION
+VAR_GLOBAL
+    g : DINT := Twice(3);
+    gp : POINTER TO DINT;
+END_VAR
 FUNCTION_BLOCK Acc
 VAR_INPUT x : DINT; END_VAR
 VAR_OUTPUT y : DINT; END_VAR
@@ -213,6 +230,7 @@ VAR
     c : CTU;
     fb : Acc;
 END_VAR
+gp := ADR(i1);
 {body}END_PROGRAM
 "
         )

@@ -110,3 +110,44 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
         Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
     }
 }
+
+/// Whether a statement's own expressions and places (not the statements it holds) call a
+/// user function (the only thing in an expression that may write memory).
+pub(super) fn calls_in(s: &St) -> bool {
+    let mut out = Vec::new();
+    match &s.kind {
+        StKind::Store(a, _, e) | StKind::StorePtr(a, e) => {
+            of_addr(a, &mut out);
+            of_ex(e, &mut out);
+        }
+        StKind::Copy(a, b, _) => {
+            of_addr(a, &mut out);
+            of_addr(b, &mut out);
+        }
+        StKind::Bytes(a, _) => of_addr(a, &mut out),
+        StKind::If(arms, _) => arms.iter().for_each(|(c, _)| of_ex(c, &mut out)),
+        StKind::Case(sel, ..) => of_ex(sel, &mut out),
+        StKind::For {
+            var, from, to, by, ..
+        } => {
+            of_addr(var, &mut out);
+            [from, to, by].into_iter().for_each(|e| of_ex(e, &mut out));
+        }
+        StKind::While(c, _) | StKind::Repeat(_, c) => of_ex(c, &mut out),
+        StKind::CallFb {
+            instance,
+            inputs,
+            outputs,
+            ..
+        }
+        | StKind::CallStdFb {
+            instance,
+            inputs,
+            outputs,
+            ..
+        } => of_call(instance, inputs, outputs, &mut out),
+        StKind::Eval(e) => of_ex(e, &mut out),
+        StKind::Exit | StKind::Continue | StKind::Return => {}
+    }
+    !out.is_empty()
+}

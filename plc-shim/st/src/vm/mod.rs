@@ -16,6 +16,7 @@ use library::Library;
 pub use library::{BlockIo, Host};
 pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 
+mod build;
 mod callees;
 mod code;
 mod fault;

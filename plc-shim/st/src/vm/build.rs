@@ -1,0 +1,646 @@
+//! Builds one body's operations ([`super::code`]): statements into operations and jumps,
+//! expressions into operands and the operations that fill registers, places into operands
+//! or the pointer operations, and what the operations do not cover into the tree's.
+
+use super::code::{CallOp, Code, Codes, Dst, Op, Src, R};
+use super::library::Library;
+use crate::check::std_lib::StdFb;
+use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
+use crate::types::Elem;
+
+/// Where EXIT and CONTINUE go inside the loop being compiled: the operations to patch.
+#[derive(Clone, Copy)]
+pub(super) enum Loops {
+    /// Outside a loop: both end the body.
+    None,
+    /// Inside the loop whose exits and continues are collected at these indices of the
+    /// builder's lists.
+    In(usize),
+}
+
+/// Builds one body's operations.
+pub(super) struct Builder<'c> {
+    codes: &'c mut Codes,
+    library: &'c Library,
+    ops: Vec<Op>,
+    /// The next free register, and the most used.
+    next: u16,
+    most: u16,
+    /// More registers than a window holds: the body stays on the tree.
+    overflow: bool,
+    /// Per loop being compiled: the jumps EXIT and CONTINUE left to patch.
+    loops: Vec<(Vec<usize>, Vec<usize>)>,
+}
+
+/// A jump's target not known yet.
+const LATER: u32 = u32::MAX;
+
+impl<'c> Builder<'c> {
+    pub(super) fn new(codes: &'c mut Codes, library: &'c Library) -> Builder<'c> {
+        Builder {
+            codes,
+            library,
+            ops: Vec::new(),
+            next: 0,
+            most: 0,
+            overflow: false,
+            loops: Vec::new(),
+        }
+    }
+
+    /// The body's code; `None` (the tree runs it) when it needs more registers than a
+    /// window holds.
+    pub(super) fn finish(mut self) -> Option<Code> {
+        self.ops.push(Op::Ret);
+        (!self.overflow).then_some(Code {
+            ops: self.ops,
+            regs: self.most,
+        })
+    }
+
+    fn here(&self) -> u32 {
+        self.ops.len() as u32
+    }
+
+    fn reg(&mut self) -> R {
+        let r = self.next;
+        match self.next.checked_add(1) {
+            Some(n) => self.next = n,
+            None => self.overflow = true,
+        }
+        self.most = self.most.max(self.next);
+        r
+    }
+
+    fn site(&mut self, s: &St) -> u32 {
+        self.codes.sites.push(s.at);
+        (self.codes.sites.len() - 1) as u32
+    }
+
+    /// Points the jump at `at` to `to`.
+    fn patch(&mut self, at: usize, to: u32) {
+        match &mut self.ops[at] {
+            Op::Jump(t) | Op::JumpIfNot(_, t) | Op::JumpIn(_, _, _, t) | Op::ForTest(.., t) => {
+                *t = to
+            }
+            Op::ForNext(.., t) => *t = to,
+            _ => {}
+        }
+    }
+
+    pub(super) fn block(&mut self, body: &[St], loops: Loops) {
+        for s in body {
+            let mark = self.next;
+            self.statement(s, loops);
+            self.next = mark;
+        }
+    }
+
+    fn statement(&mut self, s: &St, loops: Loops) {
+        // A function called in the statement's own expressions may write what an operand
+        // of it reads; operands are read when their operation runs, the tree's in its order:
+        // such a statement is the tree's.
+        if super::callees::calls_in(s) {
+            return self.tree_statement(s, loops);
+        }
+        match &s.kind {
+            StKind::Store(a, t, e) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                let v = self.expr(e);
+                let to = self.dst(a);
+                self.ops.push(Op::Store(to, *t, v));
+            }
+            StKind::StorePtr(a, e) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                let v = self.expr(e);
+                let to = self.dst(a);
+                self.ops.push(Op::StorePtr(to, v));
+            }
+            StKind::If(arms, otherwise) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                let mut ends = Vec::new();
+                for (cond, body) in arms {
+                    let mark = self.next;
+                    let c = self.expr(cond);
+                    let skip = self.ops.len();
+                    self.ops.push(Op::JumpIfNot(c, LATER));
+                    // The condition is taken: its registers are free for the arm.
+                    self.next = mark;
+                    self.block(body, loops);
+                    ends.push(self.ops.len());
+                    self.ops.push(Op::Jump(LATER));
+                    let next = self.here();
+                    self.patch(skip, next);
+                }
+                self.block(otherwise, loops);
+                let end = self.here();
+                ends.into_iter().for_each(|j| self.patch(j, end));
+            }
+            StKind::Case(sel, arms, otherwise) => self.case(s, sel, arms, otherwise, loops),
+            StKind::For {
+                var,
+                ty,
+                from,
+                to,
+                by,
+                body,
+            } => match own(var) {
+                Some(v) => self.for_loop(s, v, *ty, [from, to, by], body),
+                None => self.tree_statement(s, loops),
+            },
+            StKind::While(cond, body) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                let top = self.here();
+                self.ops.push(Op::Stmt(site));
+                let c = self.expr(cond);
+                let test = self.ops.len();
+                self.ops.push(Op::JumpIfNot(c, LATER));
+                let continues = self.looped(body);
+                self.ops.push(Op::Jump(top));
+                let end = self.here();
+                self.close_loop(continues, top, end);
+                self.patch(test, end);
+            }
+            StKind::Repeat(body, until) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                let top = self.here();
+                self.ops.push(Op::Step);
+                let continues = self.looped(body);
+                let check = self.here();
+                self.ops.push(Op::At(site));
+                let u = self.expr(until);
+                self.ops.push(Op::JumpIfNot(u, top));
+                let end = self.here();
+                self.close_loop(continues, check, end);
+            }
+            StKind::Exit | StKind::Continue | StKind::Return => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                match (&s.kind, loops) {
+                    (StKind::Exit, Loops::In(k)) => {
+                        self.loops[k].0.push(self.ops.len());
+                        self.ops.push(Op::Jump(LATER));
+                    }
+                    (StKind::Continue, Loops::In(k)) => {
+                        self.loops[k].1.push(self.ops.len());
+                        self.ops.push(Op::Jump(LATER));
+                    }
+                    _ => self.ops.push(Op::Ret),
+                }
+            }
+            StKind::CallFb {
+                pou,
+                instance,
+                inputs,
+                outputs,
+            } => self.call(s, instance, inputs, outputs, Ok(*pou as u32)),
+            StKind::CallStdFb {
+                fb,
+                instance,
+                inputs,
+                outputs,
+            } => self.call(s, instance, inputs, outputs, Err(*fb)),
+            StKind::Eval(e) => {
+                let site = self.site(s);
+                self.ops.push(Op::Stmt(site));
+                // The value is dropped (a constant or a variable has nothing to compute).
+                let _ = self.expr(e);
+            }
+            StKind::Copy(..) | StKind::Bytes(..) => self.tree_statement(s, loops),
+        }
+    }
+
+    /// A statement the tree runs, EXIT and CONTINUE going where this loop's go.
+    fn tree_statement(&mut self, s: &St, loops: Loops) {
+        self.codes.stmts.push(s.clone());
+        let k = (self.codes.stmts.len() - 1) as u32;
+        let at = self.ops.len();
+        self.ops.push(Op::TreeSt(k, u32::MAX, u32::MAX));
+        if let Loops::In(l) = loops {
+            // Patched when the loop closes: EXIT to its end, CONTINUE to its next round.
+            self.loops[l].0.push(at);
+            self.loops[l].1.push(at);
+        }
+    }
+
+    /// A loop's body; the list of its CONTINUE jumps to patch (its EXITs stay on the loop).
+    fn looped(&mut self, body: &[St]) -> usize {
+        self.loops.push((Vec::new(), Vec::new()));
+        let k = self.loops.len() - 1;
+        self.block(body, Loops::In(k));
+        k
+    }
+
+    /// Points the loop's EXITs at `end` and its CONTINUEs at `next`.
+    fn close_loop(&mut self, k: usize, next: u32, end: u32) {
+        let (exits, continues) = self.loops.pop().unwrap_or_default();
+        debug_assert_eq!(k, self.loops.len());
+        for at in exits {
+            match &mut self.ops[at] {
+                Op::TreeSt(_, exit, _) => *exit = end,
+                _ => self.patch(at, end),
+            }
+        }
+        for at in continues {
+            match &mut self.ops[at] {
+                Op::TreeSt(_, _, cont) => *cont = next,
+                _ => self.patch(at, next),
+            }
+        }
+    }
+
+    fn case(
+        &mut self,
+        s: &St,
+        sel: &Ex,
+        arms: &[crate::ir::CaseArm],
+        otherwise: &[St],
+        loops: Loops,
+    ) {
+        let site = self.site(s);
+        self.ops.push(Op::Stmt(site));
+        let v = self.expr(sel);
+        // Computed once (the tree reads it once).
+        let v = match v {
+            Src::Var(..) | Src::R(_) | Src::I(_) => v,
+            other => {
+                let r = self.reg();
+                self.ops.push(Op::Mov(r, other));
+                Src::R(r)
+            }
+        };
+        let mut tests = Vec::new();
+        for (k, (ranges, _)) in arms.iter().enumerate() {
+            for (lo, hi) in ranges {
+                tests.push((self.ops.len(), k));
+                self.ops.push(Op::JumpIn(v, *lo, *hi, LATER));
+            }
+        }
+        self.block(otherwise, loops);
+        let mut ends = vec![self.ops.len()];
+        self.ops.push(Op::Jump(LATER));
+        let mut starts = Vec::new();
+        for (_, body) in arms {
+            starts.push(self.here());
+            self.block(body, loops);
+            ends.push(self.ops.len());
+            self.ops.push(Op::Jump(LATER));
+        }
+        for (at, k) in tests {
+            self.patch(at, starts[k]);
+        }
+        let end = self.here();
+        ends.into_iter().for_each(|j| self.patch(j, end));
+    }
+
+    fn for_loop(&mut self, s: &St, var: Dst, ty: Elem, [from, to, by]: [&Ex; 3], body: &[St]) {
+        let site = self.site(s);
+        self.ops.push(Op::Stmt(site));
+        let regs = [self.reg(), self.reg(), self.reg()];
+        for (r, e) in regs.into_iter().zip([from, to, by]) {
+            let v = self.expr(e);
+            self.ops.push(Op::Mov(r, v));
+        }
+        let top = self.here();
+        let test = self.ops.len();
+        self.ops.push(Op::ForTest(var, ty, regs, LATER));
+        let k = self.looped(body);
+        let next = self.here();
+        self.ops.push(Op::ForNext(var, ty, regs, top, LATER));
+        let end = self.here();
+        self.close_loop(k, next, end);
+        self.patch(test, end);
+        if let Op::ForNext(.., exit) = &mut self.ops[next as usize] {
+            *exit = end;
+        }
+    }
+
+    fn call(
+        &mut self,
+        s: &St,
+        instance: &Addr,
+        inputs: &[BlockInput],
+        outputs: &[BlockOutput],
+        body: Result<u32, StdFb>,
+    ) {
+        let site = self.site(s);
+        let operands: Option<Vec<Src>> = inputs.iter().map(|(_, _, e)| operand(e)).collect();
+        if let (Some(Dst::Own(at, relative)), Some(values)) = (own(instance), operands) {
+            return self.whole_call(site, (at, relative), inputs, values, body, outputs);
+        }
+        self.ops.push(Op::Stmt(site));
+        let inst = self.reg();
+        match own(instance) {
+            Some(Dst::Own(at, relative)) => self.ops.push(Op::Inst(inst, at, relative)),
+            _ => {
+                let k = self.place(instance);
+                self.ops.push(Op::InstTree(inst, k));
+            }
+        }
+        for (offset, t, e) in inputs {
+            let mark = self.next;
+            let v = self.expr(e);
+            self.ops.push(Op::Input(inst, *offset, *t, v));
+            self.next = mark;
+        }
+        self.codes.calls.push(inputs.to_vec());
+        let call = (self.codes.calls.len() - 1) as u32;
+        self.ops.push(match body {
+            Ok(pou) => Op::Body(pou, inst, call),
+            Err(fb) => Op::StdBody(fb, inst, call),
+        });
+        self.ops.push(Op::At(site));
+        for (offset, t, target, negated) in outputs {
+            let mark = self.next;
+            let to = self.dst(target);
+            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
+            self.next = mark;
+        }
+    }
+
+    /// A call in one operation ([`Op::Call`]), its outputs after it.
+    fn whole_call(
+        &mut self,
+        site: u32,
+        (at, relative): (u32, bool),
+        inputs: &[BlockInput],
+        values: Vec<Src>,
+        body: Result<u32, StdFb>,
+        outputs: &[BlockOutput],
+    ) {
+        let first = self.codes.inputs.len() as u32;
+        for ((offset, t, _), v) in inputs.iter().zip(values) {
+            self.codes.inputs.push((*offset, *t, v));
+        }
+        self.codes.calls.push(inputs.to_vec());
+        let host = body
+            .ok()
+            .and_then(|p| self.library.of_pou.get(p as usize).copied().flatten());
+        let slot = match (host, relative) {
+            (Some(_), false) => self.library.slot_at(at),
+            _ => None,
+        };
+        self.codes.call_ops.push(CallOp {
+            site,
+            at,
+            relative,
+            inputs: (first, self.codes.inputs.len() as u32),
+            body,
+            call: (self.codes.calls.len() - 1) as u32,
+            slot,
+        });
+        let k = (self.codes.call_ops.len() - 1) as u32;
+        self.ops.push(Op::Call(k));
+        if outputs.is_empty() {
+            return;
+        }
+        let inst = self.reg();
+        self.ops.push(Op::Inst(inst, at, relative));
+        for (offset, t, target, negated) in outputs {
+            let mark = self.next;
+            let to = self.dst(target);
+            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
+            self.next = mark;
+        }
+    }
+
+    fn place(&mut self, a: &Addr) -> u32 {
+        self.codes.places.push(a.clone());
+        (self.codes.places.len() - 1) as u32
+    }
+
+    /// Where a store goes; a place the tree must find is found into a register now.
+    fn dst(&mut self, a: &Addr) -> Dst {
+        if let Some(d) = own(a) {
+            return d;
+        }
+        if let Addr::Via {
+            ptr,
+            relative,
+            plus,
+        } = *a
+        {
+            return Dst::Via(ptr, relative, plus);
+        }
+        if let Some(r) = self.pointer_place(a, true) {
+            return Dst::At(r);
+        }
+        let r = self.reg();
+        let k = self.place(a);
+        self.ops.push(Op::Addr(r, k));
+        Dst::At(r)
+    }
+
+    /// The tagged pointer to a place behind a pointer (`gpCh[0]^.unit.field`,
+    /// `p^.array[2]`), into a register; `None` when the tree must find it.
+    fn pointer_place(&mut self, a: &Addr, access: bool) -> Option<R> {
+        let (e, plus) = behind_pointer(a)?;
+        let mark = self.next;
+        let p = self.expr(e);
+        self.next = mark;
+        let r = self.reg();
+        self.ops.push(Op::PtrAt(r, p, plus, access));
+        Some(r)
+    }
+
+    /// `e`'s value read where the tagged pointer to `a` points, or the tree's.
+    fn load_behind(&mut self, e: &Ex, a: &Addr, t: Elem) -> Src {
+        match self.pointer_place(a, true) {
+            Some(p) => {
+                self.next = p;
+                let r = self.reg();
+                self.ops.push(Op::LoadAt(r, p, t));
+                Src::R(r)
+            }
+            None => self.tree(e),
+        }
+    }
+
+    /// An expression's value: an operand, or a register the operations pushed fill.
+    fn expr(&mut self, e: &Ex) -> Src {
+        match e {
+            Ex::Int(v) => Src::I(*v),
+            Ex::Real(v) => Src::F(*v),
+            Ex::Var {
+                offset,
+                relative,
+                ty,
+            } => Src::Var(*offset, *relative, *ty),
+            Ex::Load(a, t) => match **a {
+                _ if own(a).is_some() => match own(a) {
+                    Some(Dst::Own(at, relative)) => Src::Var(at, relative, *t),
+                    _ => self.tree(e),
+                },
+                Addr::Via {
+                    ptr,
+                    relative,
+                    plus,
+                } => {
+                    let r = self.reg();
+                    self.ops.push(Op::LoadVia(r, ptr, relative, plus, *t));
+                    Src::R(r)
+                }
+                _ => self.load_behind(e, a, *t),
+            },
+            Ex::LoadPtr(a) => match own(a) {
+                Some(Dst::Own(at, relative)) => Src::Var(at, relative, Elem::ULInt),
+                _ => self.load_behind(e, a, Elem::ULInt),
+            },
+            Ex::AddrOf(a) => match (own(a), &**a) {
+                (Some(Dst::Own(at, false)), _) => Src::I(i64::from(at) + 1),
+                // `ADR(gpCh[0]^.unit)`: past where the pointer variable points.
+                (
+                    _,
+                    Addr::Via {
+                        ptr,
+                        relative,
+                        plus,
+                    },
+                ) => {
+                    let r = self.reg();
+                    let p = Src::Var(*ptr, *relative, Elem::ULInt);
+                    self.ops.push(Op::PtrAt(r, p, *plus, false));
+                    Src::R(r)
+                }
+                _ => match self.pointer_place(a, false) {
+                    Some(r) => Src::R(r),
+                    None => self.tree(e),
+                },
+            },
+            Ex::Neg(x, t) => self.unary(x, |r, v| Op::Neg(*t, r, v)),
+            Ex::Not(x, t) => self.unary(x, |r, v| Op::Not(*t, r, v)),
+            Ex::Conv(from, to, x) => self.unary(x, |r, v| Op::Conv(*from, *to, r, v)),
+            Ex::Bin(op, t, a, b) => {
+                let mark = self.next;
+                let (x, y) = (self.expr(a), self.expr(b));
+                self.next = mark;
+                let r = self.reg();
+                self.ops.push(Op::Bin(*op, *t, r, x, y));
+                Src::R(r)
+            }
+            _ => self.tree(e),
+        }
+    }
+
+    fn unary(&mut self, x: &Ex, op: impl Fn(R, Src) -> Op) -> Src {
+        let mark = self.next;
+        let v = self.expr(x);
+        self.next = mark;
+        let r = self.reg();
+        self.ops.push(op(r, v));
+        Src::R(r)
+    }
+
+    fn tree(&mut self, e: &Ex) -> Src {
+        self.codes.exprs.push(e.clone());
+        let k = (self.codes.exprs.len() - 1) as u32;
+        let r = self.reg();
+        self.ops.push(Op::Tree(r, k));
+        Src::R(r)
+    }
+}
+
+/// An expression that is an operand (a constant or a variable): nothing to compute.
+fn operand(e: &Ex) -> Option<Src> {
+    match e {
+        Ex::Int(v) => Some(Src::I(*v)),
+        Ex::Real(v) => Some(Src::F(*v)),
+        Ex::Var {
+            offset,
+            relative,
+            ty,
+        } => Some(Src::Var(*offset, *relative, *ty)),
+        Ex::Load(a, t) => match own(a)? {
+            Dst::Own(at, relative) => Some(Src::Var(at, relative, *t)),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// A place of the program's own memory at a fixed offset (absolute, or from the instance's
+/// base), if `a` is one (fields, and elements at constant indices within their bounds).
+fn own(a: &Addr) -> Option<Dst> {
+    match a {
+        Addr::Static(o) => Some(Dst::Own(*o, false)),
+        Addr::Instance(o) => Some(Dst::Own(*o, true)),
+        Addr::Offset(inner, plus) => match own(inner)? {
+            Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(*plus)?, relative)),
+            _ => None,
+        },
+        Addr::Index {
+            base,
+            index,
+            lo,
+            len,
+            stride,
+        } => {
+            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
+            match own(base)? {
+                Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(step)?, relative)),
+                _ => None,
+            }
+        }
+        _ => None,
+    }
+}
+
+/// `a` as a pointer's value and the bytes past where it points, when every step from the
+/// pointer is a field or an element at a constant index within its bounds.
+fn behind_pointer(a: &Addr) -> Option<(&Ex, u32)> {
+    match a {
+        Addr::Deref(e) => Some((e, 0)),
+        Addr::Offset(inner, plus) => {
+            let (e, p) = behind_pointer(inner)?;
+            Some((e, p.checked_add(*plus)?))
+        }
+        Addr::Index {
+            base,
+            index,
+            lo,
+            len,
+            stride,
+        } => {
+            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
+            let (e, p) = behind_pointer(base)?;
+            Some((e, p.checked_add(step)?))
+        }
+        _ => None,
+    }
+}
+
+/// A constant index's element (from 0) when it lies within the bounds (else the tree
+/// evaluates it and faults as it must).
+fn constant_index(index: &Ex, lo: i64, len: u32) -> Option<u32> {
+    let Ex::Int(i) = index else {
+        return None;
+    };
+    let k = i.checked_sub(lo)?;
+    (0..i64::from(len)).contains(&k).then_some(k as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A body that would need more registers than a window numbers stays on the tree
+    /// (instead of wrapping round onto registers in use).
+    #[test]
+    fn a_body_beyond_the_registers_is_left_to_the_tree() {
+        let (mut codes, library) = (Codes::default(), Library::default());
+        let mut b = Builder::new(&mut codes, &library);
+        b.next = u16::MAX - 1;
+        assert_eq!(b.reg(), u16::MAX - 1);
+        assert!(!b.overflow);
+        b.reg();
+        assert!(b.overflow, "no register after the last");
+        assert!(b.finish().is_none());
+        let b = Builder::new(&mut codes, &library);
+        assert!(b.finish().is_some());
+    }
+}
