@@ -569,24 +569,13 @@ fn own(a: &Addr) -> Option<Dst> {
     match a {
         Addr::Static(o) => Some(Dst::Own(*o, false)),
         Addr::Instance(o) => Some(Dst::Own(*o, true)),
-        Addr::Offset(inner, plus) => match own(inner)? {
-            Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(*plus)?, relative)),
-            _ => None,
-        },
-        Addr::Index {
-            base,
-            index,
-            lo,
-            len,
-            stride,
-        } => {
-            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
-            match own(base)? {
-                Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(step)?, relative)),
+        _ => {
+            let (inner, plus) = inside(a)?;
+            match own(inner)? {
+                Dst::Own(o, relative) => Some(Dst::Own(o.checked_add(plus)?, relative)),
                 _ => None,
             }
         }
-        _ => None,
     }
 }
 
@@ -595,21 +584,29 @@ fn own(a: &Addr) -> Option<Dst> {
 fn behind_pointer(a: &Addr) -> Option<(&Ex, u32)> {
     match a {
         Addr::Deref(e) => Some((e, 0)),
-        Addr::Offset(inner, plus) => {
+        _ => {
+            let (inner, plus) = inside(a)?;
             let (e, p) = behind_pointer(inner)?;
-            Some((e, p.checked_add(*plus)?))
+            Some((e, p.checked_add(plus)?))
         }
+    }
+}
+
+/// A place as the place it lies in and the bytes from that one's start: a field, or an
+/// element at a constant index within its bounds.
+fn inside(a: &Addr) -> Option<(&Addr, u32)> {
+    match a {
+        Addr::Offset(inner, plus) => Some((inner, *plus)),
         Addr::Index {
             base,
             index,
             lo,
             len,
             stride,
-        } => {
-            let step = constant_index(index, *lo, *len)?.checked_mul(*stride)?;
-            let (e, p) = behind_pointer(base)?;
-            Some((e, p.checked_add(step)?))
-        }
+        } => Some((
+            base,
+            constant_index(index, *lo, *len)?.checked_mul(*stride)?,
+        )),
         _ => None,
     }
 }
