@@ -17,6 +17,10 @@
 //! both against cyclictest's loops late by a whole cycle (issue 55's overrun target). The
 //! pinned rows need two CPUs and are skipped, and said so, with one.
 //!
+//! Beside them, the floor of any two-task design at 250 µs: a timer task at SCHED_FIFO 80
+//! that wakes a second task at 79 by futex for every slot, with no work, counting the slots
+//! the second misses as the PLC counts its overruns (`two_task_chain`).
+//!
 //! The compute target's baseline is a constant job in the same shape as the demo: this bench
 //! started again as two processes ([`peer`]), one at SCHED_FIFO 80 that wakes every 1 ms at an
 //! absolute deadline and runs the same pass over 512 KiB each time (timed as the CNC times its
@@ -181,12 +185,17 @@ fn peer() -> Option<()> {
     let mode = std::env::var("TICK_LATENCY_PEER").ok()?;
     let mut words = mode.split_whitespace();
     let (kind, loops) = (words.next()?, words.next()?.parse::<usize>().ok()?);
-    let constant = kind == "constant";
+    let constant = kind != "companion";
     // As `cnc run` with the real-time options (the companion as its PLC, one below).
     let _ = cnc_os::realtime::set_fifo_priority(if constant { 80 } else { 79 });
     let _ = cnc_os::realtime::lock_memory();
     let _ = cnc_os::realtime::set_timer_slack(1);
     let _ = cnc_os::realtime::hold_cpu_wake_latency(0);
+    if kind == "chain" {
+        let us = words.next()?.parse::<u64>().ok()?;
+        two_task_chain(loops, std::time::Duration::from_micros(us));
+        return Some(());
+    }
     let mut took = Vec::with_capacity(loops);
     let mut memory = vec![1u64; JOB_WORDS];
     let period = std::time::Duration::from_millis(1);
@@ -204,6 +213,58 @@ fn peer() -> Option<()> {
         println!("constant p50 {:.0} p99 {:.0}", at(0.5), at(0.99));
     }
     Some(())
+}
+
+/// The floor of a two-task design (the CNC's tick, then the PLC woken for it): a task at
+/// SCHED_FIFO 80 that wakes at absolute deadlines every `interval`, raises a counter and
+/// wakes a second task at 79 with one `futex(2)` call, the second counting the slots it
+/// missed as the PLC counts its overruns (the counter moved by more than one between two of
+/// its wake-ups). No work in either: what it misses is the machine's. Two threads of one
+/// process (the same tasks to the scheduler as two processes); prints `chain misses N`.
+fn two_task_chain(loops: usize, interval: std::time::Duration) {
+    use std::sync::atomic::{AtomicU32, Ordering};
+    let word = std::sync::Arc::new(AtomicU32::new(0));
+    let second = {
+        let word = std::sync::Arc::clone(&word);
+        std::thread::spawn(move || {
+            let _ = cnc_os::realtime::set_fifo_priority(79);
+            let _ = cnc_os::realtime::set_timer_slack(1);
+            let (mut seen, mut missed) = (0u32, 0u64);
+            while (seen as usize) < loops {
+                let now = word.load(Ordering::Acquire);
+                if now == seen {
+                    let _ = cnc_os::futex::wait(&word, seen, std::time::Duration::from_millis(100));
+                    continue;
+                }
+                missed += u64::from(now - seen - 1);
+                seen = now;
+            }
+            missed
+        })
+    };
+    let mut deadline = cnc_os::monotonic::now() + interval;
+    for k in 1..=loops {
+        cnc_os::monotonic::sleep_until(deadline);
+        word.store(k as u32, Ordering::Release);
+        let _ = cnc_os::futex::wake(&word, 1);
+        deadline += interval;
+    }
+    let missed = second.join().unwrap_or(u64::MAX);
+    println!("chain misses {missed}");
+}
+
+/// The two-task chain at `interval_us` for `loops` slots: its missed slots (in the PLC
+/// overruns column), `None` if the peer could not run.
+fn chain(loops: u64, interval_us: u32) -> Option<Figures> {
+    let out = Command::new(std::env::current_exe().ok()?)
+        .env("TICK_LATENCY_PEER", format!("chain {loops} {interval_us}"))
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    Some(Figures {
+        plc_overruns: number(&text, "chain", "misses ")?,
+        ..Figures::default()
+    })
 }
 
 /// The constant job beside its companion, both as processes of their own: its time p50/p99
@@ -257,6 +318,7 @@ fn main() {
         "example 4 at 250 us, RT, spin, CPU 1",
         "demo at 250 us, real-time options",
         "demo at 250 us, RT, spin, CPU 1",
+        "two-task chain at 250 us (timer -> futex)",
     ];
     // The spinning PLC goes to another CPU than the CNC's: two are needed.
     let two_cpus = std::thread::available_parallelism().is_ok_and(|n| n.get() >= 2);
@@ -283,6 +345,7 @@ fn main() {
             rows[12].extend(cnc(&demo, fast_ticks, true, 250, &SPIN));
         }
         rows[8].extend(constant_work(demo_ticks));
+        rows[13].extend(chain(fast_ticks, 250));
     }
     println!("tick start lateness (us), cycle 1 ms, medians of {rounds} interleaved rounds; demo {demo_ticks} ticks, example 4 {ex4_ticks}");
     println!(
@@ -302,7 +365,12 @@ fn main() {
             plc_overruns: m(|r| r.plc_overruns),
         };
         med[i] = Some(f);
-        if i == 8 {
+        if i == 13 {
+            println!(
+                "{name:<40} {:>8} {:>8} {:>12} {:>12} {:>13.0}",
+                "-", "-", "", "", f.plc_overruns
+            );
+        } else if i == 8 {
             println!(
                 "{name:<40} {:>8} {:>8} {:>12.1} {:>12.1} {:>13}",
                 "-", "-", f.compute.0, f.compute.1, "-"
@@ -430,5 +498,16 @@ fn targets(med: &[Option<Figures>]) {
             ),
             _ => println!("TARGET | {what}: PLC overruns <= cyclictest's loops late by a cycle | - | skipped: no figures (cyclictest or a second CPU missing)"),
         }
+    }
+    if let Some(chain) = med[13] {
+        let overruns = |i: usize| med[i].map_or(f64::NAN, |f| f.plc_overruns);
+        println!(
+            "the floor of two tasks (a timer task waking a second by futex, no work) at 250 us: {:.0} missed slots per run; PLC overruns: demo {:.0} (event) / {:.0} (spin), example 4 {:.0} / {:.0}",
+            chain.plc_overruns,
+            overruns(11),
+            overruns(12),
+            overruns(7),
+            overruns(10)
+        );
     }
 }
