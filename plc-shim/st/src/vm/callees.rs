@@ -3,65 +3,69 @@
 
 use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
 
-/// Every POU a statement calls (block bodies and functions).
+/// Every POU a statement calls (block bodies and functions), in the statements it holds too.
 pub(super) fn of_st(s: &St, out: &mut Vec<usize>) {
-    let exprs = |e: &Ex, out: &mut Vec<usize>| of_ex(e, out);
+    own_parts(s, out);
+    if let StKind::CallFb { pou, .. } = &s.kind {
+        out.push(*pou);
+    }
+    let mut inner = |body: &[St]| body.iter().for_each(|s| of_st(s, out));
+    match &s.kind {
+        StKind::If(arms, otherwise) => {
+            arms.iter().for_each(|(_, body)| inner(body));
+            inner(otherwise);
+        }
+        StKind::Case(_, arms, otherwise) => {
+            arms.iter().for_each(|(_, body)| inner(body));
+            inner(otherwise);
+        }
+        StKind::For { body, .. } | StKind::While(_, body) | StKind::Repeat(body, _) => inner(body),
+        _ => {}
+    }
+}
+
+/// Whether a statement's own expressions and places (not the statements it holds) call a
+/// user function (the only thing in an expression that may write memory).
+pub(super) fn calls_in(s: &St) -> bool {
+    let mut out = Vec::new();
+    own_parts(s, &mut out);
+    !out.is_empty()
+}
+
+/// The functions a statement's own expressions and places call (not a block it calls, nor
+/// the statements it holds).
+fn own_parts(s: &St, out: &mut Vec<usize>) {
     match &s.kind {
         StKind::Store(a, _, e) | StKind::StorePtr(a, e) => {
             of_addr(a, out);
-            exprs(e, out);
+            of_ex(e, out);
         }
         StKind::Copy(a, b, _) => {
             of_addr(a, out);
             of_addr(b, out);
         }
         StKind::Bytes(a, _) => of_addr(a, out),
-        StKind::If(arms, otherwise) => {
-            for (c, body) in arms {
-                exprs(c, out);
-                body.iter().for_each(|s| of_st(s, out));
-            }
-            otherwise.iter().for_each(|s| of_st(s, out));
-        }
-        StKind::Case(sel, arms, otherwise) => {
-            exprs(sel, out);
-            for (_, body) in arms {
-                body.iter().for_each(|s| of_st(s, out));
-            }
-            otherwise.iter().for_each(|s| of_st(s, out));
-        }
+        StKind::If(arms, _) => arms.iter().for_each(|(c, _)| of_ex(c, out)),
+        StKind::Case(sel, ..) | StKind::Eval(sel) => of_ex(sel, out),
         StKind::For {
-            var,
-            from,
-            to,
-            by,
-            body,
-            ..
+            var, from, to, by, ..
         } => {
             of_addr(var, out);
-            [from, to, by].into_iter().for_each(|e| exprs(e, out));
-            body.iter().for_each(|s| of_st(s, out));
+            [from, to, by].into_iter().for_each(|e| of_ex(e, out));
         }
-        StKind::While(c, body) | StKind::Repeat(body, c) => {
-            exprs(c, out);
-            body.iter().for_each(|s| of_st(s, out));
-        }
+        StKind::While(c, _) | StKind::Repeat(_, c) => of_ex(c, out),
         StKind::CallFb {
-            pou,
             instance,
             inputs,
             outputs,
-        } => {
-            out.push(*pou);
-            of_call(instance, inputs, outputs, out);
+            ..
         }
-        StKind::CallStdFb {
+        | StKind::CallStdFb {
             instance,
             inputs,
             outputs,
             ..
         } => of_call(instance, inputs, outputs, out),
-        StKind::Eval(e) => exprs(e, out),
         StKind::Exit | StKind::Continue | StKind::Return => {}
     }
 }
@@ -109,45 +113,4 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
         }
         Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
     }
-}
-
-/// Whether a statement's own expressions and places (not the statements it holds) call a
-/// user function (the only thing in an expression that may write memory).
-pub(super) fn calls_in(s: &St) -> bool {
-    let mut out = Vec::new();
-    match &s.kind {
-        StKind::Store(a, _, e) | StKind::StorePtr(a, e) => {
-            of_addr(a, &mut out);
-            of_ex(e, &mut out);
-        }
-        StKind::Copy(a, b, _) => {
-            of_addr(a, &mut out);
-            of_addr(b, &mut out);
-        }
-        StKind::Bytes(a, _) => of_addr(a, &mut out),
-        StKind::If(arms, _) => arms.iter().for_each(|(c, _)| of_ex(c, &mut out)),
-        StKind::Case(sel, ..) => of_ex(sel, &mut out),
-        StKind::For {
-            var, from, to, by, ..
-        } => {
-            of_addr(var, &mut out);
-            [from, to, by].into_iter().for_each(|e| of_ex(e, &mut out));
-        }
-        StKind::While(c, _) | StKind::Repeat(_, c) => of_ex(c, &mut out),
-        StKind::CallFb {
-            instance,
-            inputs,
-            outputs,
-            ..
-        }
-        | StKind::CallStdFb {
-            instance,
-            inputs,
-            outputs,
-            ..
-        } => of_call(instance, inputs, outputs, &mut out),
-        StKind::Eval(e) => of_ex(e, &mut out),
-        StKind::Exit | StKind::Continue | StKind::Return => {}
-    }
-    !out.is_empty()
 }
