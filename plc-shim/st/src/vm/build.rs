@@ -148,8 +148,10 @@ impl<'c> Builder<'c> {
                 by,
                 body,
             } => match own(var) {
-                Some(v) => self.for_loop(s, v, *ty, [from, to, by], body),
-                None => self.tree_statement(s, loops),
+                Some(Dst::Own(at, relative)) => {
+                    self.for_loop(s, (at, relative), *ty, [from, to, by], body)
+                }
+                _ => self.tree_statement(s, loops),
             },
             StKind::While(cond, body) => {
                 let site = self.site(s);
@@ -298,7 +300,14 @@ impl<'c> Builder<'c> {
         ends.into_iter().for_each(|j| self.patch(j, end));
     }
 
-    fn for_loop(&mut self, s: &St, var: Dst, ty: Elem, [from, to, by]: [&Ex; 3], body: &[St]) {
+    fn for_loop(
+        &mut self,
+        s: &St,
+        var: (u32, bool),
+        ty: Elem,
+        [from, to, by]: [&Ex; 3],
+        body: &[St],
+    ) {
         let site = self.site(s);
         self.ops.push(Op::Stmt(site));
         let regs = [self.reg(), self.reg(), self.reg()];

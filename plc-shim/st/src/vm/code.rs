@@ -97,13 +97,14 @@ pub(crate) enum Op {
     JumpIfNot(Src, u32),
     /// Goes on at the operation when the value lies in the range (a CASE arm).
     JumpIn(Src, i64, i64, u32),
-    /// A FOR's test: control variable (own memory), its type, the registers of the value,
+    /// A FOR's test: control variable (its offset in own memory, from the instance's base
+    /// when relative), its type, the registers of the value,
     /// the last value and the step; past the last, goes on at the operation; else stores the
     /// value and takes a step.
-    ForTest(Dst, Elem, [R; 3], u32),
+    ForTest((u32, bool), Elem, [R; 3], u32),
     /// A FOR's next value: read back from the variable, plus the step; goes on at the test
     /// (first), or past the loop when the value overflows (second).
-    ForNext(Dst, Elem, [R; 3], u32, u32),
+    ForNext((u32, bool), Elem, [R; 3], u32, u32),
     /// `d :=` the offset of a block instance in the program's memory (from the instance's
     /// base when relative).
     Inst(R, u32, bool),

@@ -43,6 +43,14 @@ pub(crate) fn pointed(p: i64) -> Run<Loc> {
     })
 }
 
+/// The pointer value to a place (what `ADR` gives): [`pointed`]'s inverse.
+pub(crate) fn tagged(at: Loc) -> i64 {
+    match at {
+        Loc::Own(at) => at as i64 + 1,
+        Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
+    }
+}
+
 /// Sets the value of type `t` at `at` of a program's memory.
 #[inline(always)]
 pub(crate) fn write_mem(m: &mut [u8], at: usize, t: Elem, v: V) -> Run<()> {

@@ -31,7 +31,7 @@ mod symbols;
 
 pub use fault::{Fault, FaultAt};
 pub use image::IMAGE_TAG;
-pub(crate) use mem::{arr, pointed, read_mem, write_mem, Loc};
+pub(crate) use mem::{arr, pointed, read_mem, tagged, write_mem, Loc};
 
 /// A STRING's characters before its NUL: a literal's, or the `n` bytes of memory at `at`.
 fn chars<'m>(
@@ -668,10 +668,7 @@ impl<'a> Exec<'a> {
                 let at = self.addr(a, base)?;
                 self.read(at, Elem::ULInt)?
             }
-            Ex::AddrOf(a) => V::I(match self.addr(a, base)? {
-                Loc::Own(at) => at as i64 + 1,
-                Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
-            }),
+            Ex::AddrOf(a) => V::I(tagged(self.addr(a, base)?)),
             Ex::Neg(x, t) => ops::neg(self.operand(x, base)?, *t),
             Ex::Not(x, t) => ops::not(self.operand(x, base)?, *t),
             Ex::Bin(op, t, a, b) => {

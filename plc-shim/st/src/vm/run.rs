@@ -3,16 +3,8 @@
 //! the rules of values, places and faults those of the tree walker.
 
 use super::code::{CallOp, Code, Dst, Op, Src};
-use super::{ops, pointed, Exec, Fault, Flow, Loc, Run, IMAGE_TAG, V};
+use super::{ops, pointed, tagged, Exec, Fault, Flow, Loc, Run, IMAGE_TAG, V};
 use crate::types::Elem;
-
-/// A place as the value of a register: the tagged pointer `ADR` makes.
-fn tagged(at: Loc) -> V {
-    V::I(match at {
-        Loc::Own(at) => at as i64 + 1,
-        Loc::Image(at) => IMAGE_TAG | (at as i64 + 1),
-    })
-}
 
 /// As [`tagged`] for a place about to be read or written: one whose tag would not come back
 /// as the same place (beyond the pointers' range, where the access faults anyway) is the
@@ -22,7 +14,7 @@ fn access_tag(at: Loc) -> Run<V> {
     if n as u64 >= (IMAGE_TAG as u64) - 1 {
         return Err(Fault::BadPointer);
     }
-    Ok(tagged(at))
+    Ok(V::I(tagged(at)))
 }
 
 impl<'a> Exec<'a> {
@@ -73,7 +65,11 @@ impl<'a> Exec<'a> {
                 }
                 Op::PtrAt(d, p, plus, access) => {
                     let at = pointed(self.src(p, base, w)?.int())?.plus(plus as usize);
-                    let v = if access { access_tag(at)? } else { tagged(at) };
+                    let v = if access {
+                        access_tag(at)?
+                    } else {
+                        V::I(tagged(at))
+                    };
                     self.put(w, d, v);
                 }
                 Op::LoadAt(d, r, t) => {
@@ -123,18 +119,18 @@ impl<'a> Exec<'a> {
                         pc = to as usize;
                     }
                 }
-                Op::ForTest(var, ty, [i, last, step], end) => {
+                Op::ForTest((at, relative), ty, [i, last, step], end) => {
                     let reg = |r: u16| self.get(w, r).int();
                     let (i, last, step) = (reg(i), reg(last), reg(step));
                     if (step >= 0 && i > last) || (step < 0 && i < last) {
                         pc = end as usize;
                     } else {
-                        self.store(var, ty, V::I(i), base, w)?;
+                        self.store(Dst::Own(at, relative), ty, V::I(i), base, w)?;
                         self.step()?;
                     }
                 }
-                Op::ForNext(var, ty, [i, _, step], test, end) => {
-                    let now = self.load(var, ty, base)?.int();
+                Op::ForNext((at, relative), ty, [i, _, step], test, end) => {
+                    let now = self.src(Src::Var(at, relative, ty), base, w)?.int();
                     let step = self.get(w, step).int();
                     match now.checked_add(step) {
                         Some(next) => {
@@ -274,17 +270,6 @@ impl<'a> Exec<'a> {
                 let at = pointed(self.get(w, r).int())?;
                 self.write(at, t, v)
             }
-        }
-    }
-
-    /// The value of a FOR's control variable (always a place of the program's own memory).
-    fn load(&self, var: Dst, t: Elem, base: u32) -> Run<V> {
-        match var {
-            Dst::Own(at, relative) => {
-                let at = if relative { base + at } else { at };
-                self.read_own(at as usize, t)
-            }
-            _ => Err(Fault::BadPointer),
         }
     }
 }
