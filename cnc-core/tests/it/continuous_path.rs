@@ -459,3 +459,65 @@ fn arcs_join_the_contour_tangent_to_its_lines() {
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
 }
+
+/// How far `p` lies from the outline of the pocket below (a rounded rectangle from -5, 0 to
+/// 75, 50 with corners of radius 5).
+fn distance_to_pocket(p: &[f64]) -> f64 {
+    let q = [(p[0] - 35.0).abs() - 35.0, (p[1] - 25.0).abs() - 20.0];
+    let outside = q[0].max(0.0).hypot(q[1].max(0.0));
+    (outside + q[0].max(q[1]).min(0.0) - 5.0).abs() + p[2].abs()
+}
+
+/// Small arcs inside a contour: a pocket's corners as radius-5 fillets between tangent lines
+/// (too small for chords at this jerk) run through with transitions into and out of their
+/// circles: never below 40 mm/s between the first and the last tick at that speed, within
+/// PATH_DEV of the lines and circles and within the limits, quicker than exact stop, the tick
+/// allocating nothing on the fillets.
+#[test]
+fn small_fillets_run_through_with_transitions() {
+    let pocket = "G1 X70 F6000\nG3 X75 Y5 I0 J5\nG1 Y45\nG3 X70 Y50 I-5 J0\nG1 X0\n\
+                  G3 X-5 Y45 I0 J-5\nG1 Y5\nG3 X0 Y0 I5 J0\nG1 X5\n";
+    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{pocket}G260\nM30\n");
+    let mut config = cartesian("c");
+    config.limits.velocity = 200.0;
+    config.limits.acceleration = 2000.0;
+    config.limits.jerk = 40_000.0;
+    let (trace, _) = run(&program, config.clone(), |_, _| {});
+    let (stopped, _) = run(&format!("{pocket}M30\n"), config.clone(), |_, _| {});
+    let worst = trace
+        .iter()
+        .map(|p| distance_to_pocket(p))
+        .fold(0.0, f64::max);
+    assert!(worst <= 0.02 + 1e-9, "deviation {worst}");
+    let (_, rates) = measure(&trace, &[[0.0, 0.0], [0.0, 0.0]]);
+    assert_within(&config, rates);
+    let speed: Vec<f64> = trace
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
+        .collect();
+    let (first, last) = (
+        speed.iter().position(|&v| v >= 40.0).unwrap(),
+        speed.iter().rposition(|&v| v >= 40.0).unwrap(),
+    );
+    let slowest = speed[first..=last].iter().copied().fold(f64::MAX, f64::min);
+    assert!(slowest >= 40.0, "slowed to {slowest} mm/s on the way");
+    let end = trace.last().unwrap();
+    assert_eq!([end[0], end[1]], [5.0, 0.0]);
+    assert!(
+        trace.len() < stopped.len(),
+        "{} against {}",
+        trace.len(),
+        stopped.len()
+    );
+    let mut ctl = controller(vec![(config, &program)]);
+    let memory = image(1);
+    let view = hli::views::CncView::new(&memory);
+    for _ in 0..600 {
+        ctl.tick(&view);
+    }
+    let before = counting_alloc::allocations();
+    for _ in 0..1200 {
+        ctl.tick(&view);
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
+}

@@ -12,6 +12,7 @@
 use super::super::circle::Circle;
 use super::corner::JUNCTION_JERK_SHARE;
 use super::{Contour, PushError, Segment};
+use crate::channel::path::AxisLimits;
 use crate::nc::arc::ArcMove;
 use crate::setpoint::AxisValues;
 
@@ -69,6 +70,8 @@ impl Contour {
         if !self.has_room() {
             return Err(PushError::Full);
         }
+        // A small arc held back ends before this one (no transition into an arc).
+        self.release_arc(None)?;
         let (circle, length) =
             Circle::of(&block.start, &block.end, &block.arc).ok_or(PushError::NotStraight)?;
         let radius = circle.r0.max(circle.r1);
@@ -84,13 +87,12 @@ impl Contour {
         };
         let step = by_sagitta.min(MAX_CHORD_DEG.to_radians());
         let chords = (circle.sweep.abs() / step).ceil().max(1.0);
-        if !chords.is_finite() || chords > f64::from(MAX_ARC_CHORDS) {
-            return Err(PushError::NotStraight);
-        }
         let step = circle.sweep.abs() / chords;
         let chord = 2.0 * circle.r0.min(circle.r1) * (0.5 * step).sin();
-        if chord <= MIN_CHORD || !self.chords_keep_speed(&circle, step, block.feed) {
-            return Err(PushError::NotStraight);
+        let fine = chords.is_finite() && chords <= f64::from(MAX_ARC_CHORDS) && chord > MIN_CHORD;
+        if !fine || !self.chords_keep_speed(&circle, step, block.feed) {
+            // Between tangent straights it may still run with transitions.
+            return self.hold_small_arc(block, circle, length);
         }
         let mut delta = block.end;
         for (i, d) in delta.iter_mut().enumerate() {
@@ -146,23 +148,32 @@ impl Contour {
     /// within half its axes' acceleration and jerk, as `path::circle` plans it. A small circle
     /// at a short cycle runs on its own (its chords would be slower than the stops they save).
     fn chords_keep_speed(&self, circle: &Circle, step: f64, feed: f64) -> bool {
-        let limit = |i: usize| self.limits.get(i).copied();
-        let (Some(la), Some(lb)) = (limit(circle.axes[0]), limit(circle.axes[1])) else {
-            return true;
-        };
+        let (alone, jerk) = own_speed(&self.limits, circle, feed);
         let r = circle.r0.min(circle.r1);
-        let (v, a, j) = (
-            la.velocity.min(lb.velocity),
-            la.acceleration.min(lb.acceleration),
-            la.jerk.min(lb.jerk),
-        );
-        let alone = feed
-            .min(v)
-            .min((a * r / 2.0).sqrt())
-            .min((j * r * r / 2.0).cbrt());
-        let chords = (JUNCTION_JERK_SHARE * j * self.cycle_s * r / step).sqrt();
+        let chords = (JUNCTION_JERK_SHARE * jerk * self.cycle_s * r / step).sqrt();
         chords >= CHORD_SPEED_KEPT * alone
     }
+}
+
+/// The speed an arc of `circle` runs at on its own at `feed` (within half its plane axes'
+/// acceleration and jerk, as `path::circle` plans it) and its plane axes' jerk (infinite
+/// without limits).
+pub(super) fn own_speed(limits: &[AxisLimits], circle: &Circle, feed: f64) -> (f64, f64) {
+    let limit = |i: usize| limits.get(i).copied();
+    let (Some(la), Some(lb)) = (limit(circle.axes[0]), limit(circle.axes[1])) else {
+        return (feed, f64::INFINITY);
+    };
+    let r = circle.r0.min(circle.r1);
+    let (v, a, j) = (
+        la.velocity.min(lb.velocity),
+        la.acceleration.min(lb.acceleration),
+        la.jerk.min(lb.jerk),
+    );
+    let alone = feed
+        .min(v)
+        .min((a * r / 2.0).sqrt())
+        .min((j * r * r / 2.0).cbrt());
+    (alone, j)
 }
 
 impl ArcChords {

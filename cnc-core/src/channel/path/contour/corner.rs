@@ -45,7 +45,9 @@ impl Contour {
             return false;
         };
         // The run under way must not cover the piece to be shortened.
-        if (under_way && n <= self.run_pieces) || last.is_curve() || tolerance <= 0.0 {
+        // Never after a small arc's piece on its own (it ends at rest).
+        let curved = last.is_curve() || last.is_plane();
+        if (under_way && n <= self.run_pieces) || curved || tolerance <= 0.0 {
             return false;
         }
         let joined = end
@@ -159,7 +161,8 @@ impl Contour {
         let legs = unshared.legs;
         let n = self.pieces.len();
         let under_way = !matches!(self.mode, Mode::Idle);
-        if n < 2 || self.pieces[n - 1].length > 1e-9 || !self.pieces[n - 2].is_curve() {
+        let a_corner = n >= 2 && self.pieces[n - 2].is_curve() && !self.pieces[n - 2].is_plane();
+        if !a_corner || self.pieces[n - 1].length > 1e-9 {
             return NONE;
         }
         if under_way && n - 2 < self.run_pieces {
@@ -274,7 +277,7 @@ impl Contour {
 impl Contour {
     /// Whether piece `k` may be planned in one unit with the piece before: when they are
     /// alike; a straight piece the corners took all of, when the pieces on both sides are.
-    fn rechain(&mut self, k: usize) {
+    pub(super) fn rechain(&mut self, k: usize) {
         let p = &self.pieces;
         let chain = match k {
             0 => false,

@@ -31,8 +31,10 @@ mod arc;
 mod arc_tests;
 mod chamfer;
 mod corner;
+mod fillet;
 mod piece;
 mod plan;
+mod planar;
 mod profile;
 mod shape;
 #[cfg(test)]
@@ -153,6 +155,11 @@ pub struct Contour {
     pending: Option<chamfer::Pending>,
     /// An arc whose chords are still joining the window.
     arc: Option<arc::ArcChords>,
+    /// A small arc held back until the block after it comes ([`fillet`]).
+    held: Option<fillet::HeldArc>,
+    /// Where the straight after a small arc's transitions starts: it joins them without a
+    /// corner.
+    smooth_from: Option<AxisValues>,
 }
 
 impl Contour {
@@ -185,17 +192,24 @@ impl Contour {
             rest_point: AxisValues::zeros(limits.len()),
             pending: None,
             arc: None,
+            held: None,
+            smooth_from: None,
         }
     }
 
     /// Whether the path is under way or blocks are waiting in the window.
     pub fn active(&self) -> bool {
-        !self.pieces.is_empty() || self.pending.is_some() || self.arc.is_some()
+        !self.pieces.is_empty()
+            || self.pending.is_some()
+            || self.arc.is_some()
+            || self.held.is_some()
     }
 
-    /// Whether another block fits into the window.
+    /// Whether another block fits into the window (with a small arc held back: its pieces
+    /// too).
     pub fn has_room(&self) -> bool {
-        self.arc.is_none() && self.blocks < self.lookahead && self.has_room_for(2)
+        let segments = if self.held.is_some() { 4 } else { 2 };
+        self.arc.is_none() && self.blocks < self.lookahead && self.has_room_for(segments)
     }
 
     /// Whether `segments` more segments (two pieces each) fit into the window.
@@ -227,6 +241,7 @@ impl Contour {
             .front()
             .map(|p| p.line)
             .or(self.pending.as_ref().map(|p| p.line()))
+            .or(self.held.as_ref().map(|h| h.line()))
     }
 
     /// The path parameter's state on the piece under way.
@@ -248,6 +263,11 @@ impl Contour {
     ) -> Result<(), PushError> {
         if !self.has_room() {
             return Err(PushError::Full);
+        }
+        if let Some(start) = self.release_arc(Some(segment))? {
+            // After a small arc's transitions: from where they end.
+            let rest = Segment { start, ..*segment };
+            return self.push_block(&rest, limit);
         }
         self.push_block(segment, limit)
     }
@@ -291,15 +311,19 @@ impl Contour {
         if self.pieces.is_empty() {
             self.last_end = None;
         }
-        let rounded = self.round_corner(segment, &dir, length, limit);
+        let smooth = self.smooth_from.take() == Some(segment.start);
+        let rounded = !smooth && self.round_corner(segment, &dir, length, limit);
         if !rounded {
-            if let Some(last) = self.pieces.back_mut() {
+            if let Some(last) = self.pieces.back_mut().filter(|_| !smooth) {
                 last.rest_after = true;
             }
             let mut p = Piece::straight(segment.start, dir, length, length, &self.limits);
             tag(&mut p, segment);
             limit(&mut p);
             self.pieces.push_back(p);
+            if smooth {
+                self.rechain(self.pieces.len() - 1);
+            }
         }
         self.blocks += 1;
         self.last_end = Some((segment.end, dir));
@@ -345,6 +369,8 @@ impl Contour {
         self.closed = true;
         self.pending = None;
         self.arc = None;
+        self.held = None;
+        self.smooth_from = None;
         self.set_factors(0.0, 0.0);
         self.stopping = true;
     }
@@ -458,6 +484,8 @@ impl Contour {
         self.run_rest = 0.0;
         self.pending = None;
         self.arc = None;
+        self.held = None;
+        self.smooth_from = None;
     }
 
     /// Pushes what waits outside the window as room frees: an arc's chords, then (once the
@@ -465,6 +493,9 @@ impl Contour {
     fn feed_window(&mut self) {
         if self.arc.is_some() {
             self.feed_arc();
+        }
+        if self.closed && self.held.is_some() && self.release_arc(None).is_err() {
+            return;
         }
         if self.closed && self.arc.is_none() && self.pending.is_some() {
             self.flush();

@@ -31,6 +31,7 @@
 //! acceleration and jerk get what is left at the speed the curve will run at (its feed, or
 //! 90 % of the highest speed its curvature allows when that is lower).
 
+use super::planar::PlaneCurve;
 use super::profile::Dynamics;
 use super::shape::Shape;
 use crate::channel::path::AxisLimits;
@@ -93,6 +94,10 @@ pub struct Piece {
     pub bound_hard: f64,
     /// See `bound_hard`.
     pub bound_soft: f64,
+    /// A piece in a plane whose curvature turns with the path (a small arc between tangent
+    /// straights and its transitions, [`super::fillet`]): its shape there; the other axes
+    /// stay at `origin`.
+    pub(super) plane: Option<PlaneCurve>,
 }
 
 fn unlimited() -> AxisLimits {
@@ -147,6 +152,7 @@ impl Piece {
             block_length,
             bound_hard: 0.0,
             bound_soft: 0.0,
+            plane: None,
         }
     }
 
@@ -179,31 +185,7 @@ impl Piece {
             }
             Bounds::new(u1[i], u2[i], length, &form, limit)
         };
-        // For a share of the jerk: the path parameter's jerk first, then the speed the
-        // curvature leaves room for, then the path parameter's acceleration at 90 % of that
-        // speed, and the speed with both.
-        let plan = |share: f64| {
-            let jerk = (0..n)
-                .map(|i| axis(i).tangential_jerk(share))
-                .fold(f64::INFINITY, f64::min);
-            let top = (0..n)
-                .map(|i| axis(i).speed(jerk, 0.0))
-                .fold(f64::INFINITY, f64::min);
-            let speed = (CURVE_SPEED_SHARE * top).min(feed);
-            let acceleration = (0..n)
-                .map(|i| axis(i).tangential_acc(speed, jerk))
-                .fold(f64::INFINITY, f64::min);
-            let cap = (0..n)
-                .map(|i| axis(i).speed(jerk, acceleration))
-                .fold(f64::INFINITY, f64::min);
-            (cap, Dynamics { acceleration, jerk })
-        };
-        let smallest = plan(TANGENTIAL_JERK_SHARES[2]);
-        let (cap, dynamics) = TANGENTIAL_JERK_SHARES[..2]
-            .iter()
-            .map(|&share| plan(share))
-            .find(|(cap, _)| *cap >= CAP_KEPT * smallest.0)
-            .unwrap_or(smallest);
+        let (cap, dynamics) = caps(n, &axis, feed);
         Self {
             origin,
             dir: *u1,
@@ -224,7 +206,41 @@ impl Piece {
             block_length: 0.0,
             bound_hard: 0.0,
             bound_soft: 0.0,
+            plane: None,
         }
+    }
+
+    /// The piece `curve` in a plane (its other axes at `origin`'s values) for axes with
+    /// `limits` and a path at up to `feed`.
+    pub(super) fn planar(
+        origin: AxisValues,
+        curve: PlaneCurve,
+        (limits, feed): (&[AxisLimits], f64),
+    ) -> Self {
+        let g = curve.bounds();
+        let axis = |i: usize| {
+            let limit = limits.get(i).copied().unwrap_or_else(unlimited);
+            match curve.axes.iter().position(|&a| a == i) {
+                Some(k) => Bounds::raw(g[k], limit),
+                None => Bounds::raw([0.0; 3], limit),
+            }
+        };
+        let (cap, dynamics) = caps(origin.len(), &axis, feed);
+        let start = curve.at(0.0);
+        let mut dir = AxisValues::zeros(origin.len());
+        for (k, &a) in curve.axes.iter().enumerate() {
+            dir[a] = start.tangent[k];
+        }
+        let mut piece = Self::straight(origin, dir, curve.length, curve.length, limits);
+        piece.hard_cap = cap;
+        piece.dynamics = dynamics;
+        piece.plane = Some(curve);
+        piece
+    }
+
+    /// Whether the piece lies in a plane with its curvature turning ([`super::planar`]).
+    pub fn is_plane(&self) -> bool {
+        self.plane.is_some()
     }
 
     /// The velocity cap under `feed_factor` (feed override for G1, rapid override for G0; 0
@@ -237,13 +253,22 @@ impl Piece {
         }
     }
 
-    /// Whether the piece is a curve.
+    /// Whether the piece is a curve (a corner's, or a transition into a small arc): it is no
+    /// block's own piece.
     pub fn is_curve(&self) -> bool {
-        self.legs[0] > 0.0
+        self.legs[0] > 0.0 || self.plane.is_some_and(|c| c.is_transition())
     }
 
     /// The point at `lambda`.
     pub fn point(&self, lambda: f64, out: &mut AxisValues) {
+        if let Some(curve) = &self.plane {
+            out.copy_from_slice(&self.origin);
+            let jet = curve.at(lambda);
+            for (k, &a) in curve.axes.iter().enumerate() {
+                out[a] = jet.point[k];
+            }
+            return;
+        }
         let w = if self.is_curve() {
             let t = (lambda / self.length).clamp(0.0, 1.0);
             self.length * self.shape.at(t).0
@@ -263,6 +288,16 @@ impl Piece {
         velocity: &mut AxisValues,
         acceleration: &mut AxisValues,
     ) {
+        if let Some(curve) = &self.plane {
+            velocity.fill(0.0);
+            acceleration.fill(0.0);
+            let jet = curve.at(lambda);
+            for (k, &i) in curve.axes.iter().enumerate() {
+                velocity[i] = jet.tangent[k] * v;
+                acceleration[i] = jet.tangent[k] * a + jet.curvature[k] * v * v;
+            }
+            return;
+        }
         let (w1, w2) = if self.is_curve() {
             let t = (lambda / self.length).clamp(0.0, 1.0);
             let (_, w, dw) = self.shape.at(t);
@@ -318,6 +353,36 @@ impl Piece {
     }
 }
 
+/// The speed cap and the path parameter's dynamics of a curve over `n` axes (`axis` gives
+/// each one's bounds) at up to `feed`: for each share of the jerk, the path parameter's jerk
+/// first, then the speed the curvature leaves room for, then the path parameter's
+/// acceleration at 90 % of that speed, and the speed with both; the largest share that keeps
+/// [`CAP_KEPT`] of the smallest's speed.
+fn caps(n: usize, axis: &dyn Fn(usize) -> Bounds, feed: f64) -> (f64, Dynamics) {
+    let plan = |share: f64| {
+        let jerk = (0..n)
+            .map(|i| axis(i).tangential_jerk(share))
+            .fold(f64::INFINITY, f64::min);
+        let top = (0..n)
+            .map(|i| axis(i).speed(jerk, 0.0))
+            .fold(f64::INFINITY, f64::min);
+        let speed = (CURVE_SPEED_SHARE * top).min(feed);
+        let acceleration = (0..n)
+            .map(|i| axis(i).tangential_acc(speed, jerk))
+            .fold(f64::INFINITY, f64::min);
+        let cap = (0..n)
+            .map(|i| axis(i).speed(jerk, acceleration))
+            .fold(f64::INFINITY, f64::min);
+        (cap, Dynamics { acceleration, jerk })
+    };
+    let smallest = plan(TANGENTIAL_JERK_SHARES[2]);
+    TANGENTIAL_JERK_SHARES[..2]
+        .iter()
+        .map(|&share| plan(share))
+        .find(|(cap, _)| *cap >= CAP_KEPT * smallest.0)
+        .unwrap_or(smallest)
+}
+
 /// Samples a curve's deviation is taken at (its points between them lie closer than the
 /// tolerance's margin to the sampled ones: the curve's deviation changes slowly).
 const DEVIATION_SAMPLES: usize = 32;
@@ -331,6 +396,11 @@ struct Bounds {
 }
 
 impl Bounds {
+    /// From bounds `[g1, g2, g3]` found elsewhere.
+    fn raw([g1, g2, g3]: [f64; 3], limit: AxisLimits) -> Self {
+        Self { g1, g2, g3, limit }
+    }
+
     fn new(u1: f64, u2: f64, length: f64, shape: &Shape, limit: AxisLimits) -> Self {
         let du = (u2 - u1).abs();
         Self {

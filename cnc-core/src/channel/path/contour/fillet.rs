@@ -1,0 +1,428 @@
+//! Small arcs between tangent straight blocks (a pocket's fillets, a slot's ends): where an
+//! arc's chords would run it slower than it runs on its own ([`super::arc`]), an arc that a
+//! straight block meets tangentially is held back until the next block shows how the path
+//! leaves it. When that is a straight block leaving tangentially, the path runs through the
+//! arc without stopping: a transition from the straight into the circle, the circle, and a
+//! transition out of it ([`super::planar`]).
+//!
+//! A transition ramps the curvature from 0 to the circle's over a length `L`, as a clothoid
+//! does, so it starts `L/2` before the point where the straight meets the arc and ends `L/2`
+//! after it; the circle between the two transitions keeps the arc's centre and has its radius
+//! `r' = r - L²/(24 r')`, the shift a clothoid of that length needs. `L` is the longest that
+//! keeps that shift within [`SHIFT_SHARE`] of the tolerance, the arc's sweep and both
+//! straights' room, and no longer than the arc's speed needs (the curvature's rate of change
+//! at the speed of the circle within half the axes' jerk). Every point of the transitions is
+//! checked against the programmed lines and circle; a shorter `L` is tried when one leaves
+//! the tolerance. Each transition is one quintic that meets the straight's point and
+//! direction with no curvature at one end and the circle's point, direction and curvature at
+//! the other, so no axis's velocity or acceleration steps anywhere on the way.
+//!
+//! Otherwise (the block after is no tangent straight, the program ends there, the path
+//! already runs on the straight's end, or the transitions would run it much slower than it
+//! runs on its own) the arc is one piece on its exact circle, the path at rest before and
+//! after it: as the arc on its own, inside the contour.
+
+use super::super::circle::Circle;
+use super::arc::{own_speed, ArcBlock};
+use super::planar::{Jet, PlaneCurve};
+use super::{Contour, Mode, Piece, PushError, Segment};
+use crate::setpoint::AxisValues;
+
+/// Share of the tolerance the circle's shift (and so every point of the transitions) may
+/// take; the transitions are checked against [`CHECK_SHARE`] of it.
+const SHIFT_SHARE: f64 = 0.8;
+/// Share of the tolerance every sampled point of a transition must keep (what lies between
+/// the samples moves by far less than the rest).
+const CHECK_SHARE: f64 = 0.98;
+/// The largest angle (rad) between a straight block and the arc's tangent where they meet for
+/// them to count as tangent (a program's rounded coordinates; the transitions take it up).
+const TANGENT_MAX: f64 = 0.01;
+/// A transition's largest third derivative against a clothoid's of the same length (what
+/// its length is chosen by).
+const RAMP_PEAK: f64 = 2.0;
+/// Share of the axes' jerk the transitions' change of curvature is chosen to take at the
+/// circle's speed.
+const RAMP_JERK_SHARE: f64 = 0.5;
+/// The transitions run the arc when their slowest piece keeps at least this share of the
+/// speed the arc runs at on its own (stopping before and after it).
+const CHAIN_SPEED_KEPT: f64 = 0.3;
+/// Shorter transitions tried (each 0.7 of the last) when one leaves the tolerance.
+const TRIES: usize = 6;
+
+/// A small arc held back until the block after it comes.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct HeldArc {
+    block: ArcBlock,
+    circle: Circle,
+    /// Its length in the plane.
+    length: f64,
+}
+
+impl HeldArc {
+    pub(super) fn line(&self) -> u32 {
+        self.block.line
+    }
+}
+
+/// The pieces that run a held arc with transitions, and how much of the straights they take.
+struct Chain {
+    /// Taken from the end of the straight before and from the start of the one after.
+    x0: f64,
+    ramp_in: PlaneCurve,
+    body: Option<PlaneCurve>,
+    ramp_out: PlaneCurve,
+    /// Where the straight after now starts.
+    exit: AxisValues,
+}
+
+/// A 2-vector rotated by `angle`.
+fn rot(v: [f64; 2], angle: f64) -> [f64; 2] {
+    let (s, c) = angle.sin_cos();
+    [c * v[0] - s * v[1], s * v[0] + c * v[1]]
+}
+
+fn sub(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+fn dot(a: [f64; 2], b: [f64; 2]) -> f64 {
+    a[0] * b[0] + a[1] * b[1]
+}
+
+fn axpy(a: [f64; 2], k: f64, b: [f64; 2]) -> [f64; 2] {
+    [a[0] + k * b[0], a[1] + k * b[1]]
+}
+
+impl Contour {
+    /// An arc whose chords would be slow (`circle`, `length` in its plane): held back when
+    /// the block before is a straight in its plane meeting it tangentially (the block before
+    /// joins the window now). [`PushError::NotStraight`] when not: it runs on its own.
+    pub(super) fn hold_small_arc(
+        &mut self,
+        block: &ArcBlock,
+        circle: Circle,
+        length: f64,
+    ) -> Result<(), PushError> {
+        let planar = (0..block.start.len())
+            .filter(|i| !circle.axes.contains(i))
+            .all(|i| block.end[i] == block.start[i]);
+        if !planar || block.blend.is_none() || self.held.is_some() || self.arc.is_some() {
+            return Err(PushError::NotStraight);
+        }
+        if !self.flush() {
+            return Err(PushError::Full);
+        }
+        let Some((end, dir)) = self.last_end else {
+            return Err(PushError::NotStraight);
+        };
+        let joined = end
+            .iter()
+            .zip(block.start.iter())
+            .all(|(a, b)| (a - b).abs() <= 1e-9);
+        let straight = self
+            .pieces
+            .back()
+            .is_some_and(|p| !p.is_curve() && !p.is_plane());
+        let start = tangent(&circle, 0.0);
+        if !joined || !straight || !meets(&dir, circle.axes, start) {
+            return Err(PushError::NotStraight);
+        }
+        self.held = Some(HeldArc {
+            block: *block,
+            circle,
+            length,
+        });
+        Ok(())
+    }
+
+    /// The held arc joins the window: with transitions when `next` leaves it tangentially
+    /// (then `Some`: where `next` now starts), else as one piece between rests. `Full` (and
+    /// the arc still held) when the window has no room for it.
+    pub(super) fn release_arc(
+        &mut self,
+        next: Option<&Segment>,
+    ) -> Result<Option<AxisValues>, PushError> {
+        let Some(held) = self.held else {
+            return Ok(None);
+        };
+        if !self.has_room_for(3) {
+            return Err(PushError::Full);
+        }
+        self.held = None;
+        if let Some(chain) = next.and_then(|s| self.chain(&held, s)) {
+            if self.push_chain(&held, &chain) {
+                self.smooth_from = Some(chain.exit);
+                return Ok(Some(chain.exit));
+            }
+        }
+        self.push_alone(&held);
+        Ok(None)
+    }
+
+    /// The arc on its exact circle, the path at rest before it (and, as the block after
+    /// cannot be rounded with it, after it).
+    fn push_alone(&mut self, held: &HeldArc) {
+        if let Some(last) = self.pieces.back_mut() {
+            last.rest_after = true;
+        }
+        let curve = PlaneCurve::circle(held.circle, held.length);
+        let piece = self.plane_piece(held, curve);
+        self.pieces.push_back(piece);
+        self.blocks += 1;
+        let dir = direction_of(
+            &held.block.start,
+            held.circle.axes,
+            tangent(&held.circle, 1.0),
+        );
+        self.last_end = Some((held.block.end, dir));
+        self.sweep_back();
+        self.replan = true;
+    }
+
+    /// Shortens the straight before by the transition's share and adds the transitions and
+    /// the circle; `false` (nothing changed) when the run under way could no longer keep its
+    /// committed end velocity.
+    fn push_chain(&mut self, held: &HeldArc, chain: &Chain) -> bool {
+        let n = self.pieces.len();
+        let Some(saved) = self.pieces.back().copied() else {
+            return false;
+        };
+        let committed = self.v_end;
+        let under_way = !matches!(self.mode, Mode::Idle);
+        let back = self.pieces.back_mut().expect("checked");
+        back.length -= chain.x0;
+        back.rest_after = false;
+        for curve in [Some(chain.ramp_in), chain.body, Some(chain.ramp_out)]
+            .into_iter()
+            .flatten()
+        {
+            let piece = self.plane_piece(held, curve);
+            self.pieces.push_back(piece);
+        }
+        self.blocks += 1;
+        for k in n.saturating_sub(1)..self.pieces.len() {
+            self.rechain(k);
+        }
+        self.sweep_back();
+        let run_end = self.run_pieces.max(1) - 1;
+        let kept =
+            !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9 || self.replan_now();
+        if !kept {
+            self.pieces.truncate(n);
+            *self.pieces.back_mut().expect("kept") = saved;
+            self.blocks -= 1;
+            self.sweep_back();
+            return false;
+        }
+        self.replan = true;
+        true
+    }
+
+    /// A piece of the held arc (its other axes at the block's start).
+    fn plane_piece(&self, held: &HeldArc, curve: PlaneCurve) -> Piece {
+        let b = &held.block;
+        let mut p = Piece::planar(b.start, curve, (&self.limits, b.feed));
+        p.feed = b.feed;
+        p.line = b.line;
+        p.tolerance = b.tolerance;
+        p
+    }
+
+    /// The transitions and circle for the held arc when `next` is a straight leaving it
+    /// tangentially in its plane with room for a transition, the straight before has room
+    /// too and is not under way, and they keep the tolerance and most of the arc's speed.
+    fn chain(&self, held: &HeldArc, next: &Segment) -> Option<Chain> {
+        let (b, c) = (&held.block, &held.circle);
+        let [a0, a1] = c.axes;
+        let tol = b.tolerance.min(b.blend?).min(next.blend?);
+        let joined = (0..b.end.len()).all(|i| (next.start[i] - b.end[i]).abs() <= 1e-9);
+        let len2 = (0..3)
+            .map(|i| (next.end[i] - next.start[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        if tol <= 0.0 || next.rapid || !joined || len2 <= 1e-9 {
+            return None;
+        }
+        let mut dir2 = next.end;
+        dir2.iter_mut()
+            .enumerate()
+            .for_each(|(i, d)| *d = (*d - next.start[i]) / len2);
+        if !meets(&dir2, c.axes, tangent(c, 1.0)) {
+            return None;
+        }
+        let n = self.pieces.len();
+        let back = self.pieces.back()?;
+        let under_way = !matches!(self.mode, Mode::Idle);
+        if under_way && n <= self.run_pieces {
+            return None;
+        }
+        let r = c.r0;
+        let (speed, jerk) = own_speed(&self.limits, c, b.feed);
+        let by_speed = RAMP_PEAK * speed.powi(3) / (r * RAMP_JERK_SHARE * jerk);
+        let mut l = (24.0 * r * SHIFT_SHARE * tol)
+            .sqrt()
+            .min(0.9 * c.sweep.abs() * r)
+            .min(2.0 * back.length)
+            .min(len2)
+            .min(by_speed);
+        let u1 = [back.dir[a0], back.dir[a1]];
+        let u2 = [dir2[a0], dir2[a1]];
+        for _ in 0..TRIES {
+            let chain = geometry(held, (u1, u2), l, back);
+            if let Some(chain) = chain.filter(|ch| within(held, ch, (u1, u2), tol)) {
+                let slowest = [Some(chain.ramp_in), chain.body, Some(chain.ramp_out)]
+                    .into_iter()
+                    .flatten()
+                    .map(|curve| self.plane_piece(held, curve).hard_cap)
+                    .fold(f64::INFINITY, f64::min);
+                return (slowest >= CHAIN_SPEED_KEPT * speed).then_some(chain);
+            }
+            l *= 0.7;
+        }
+        None
+    }
+}
+
+/// The transitions of length `l` and the circle between them for the held arc between
+/// straights of directions `u1` (the one before, `back`'s) and `u2` (plane axes); `None`
+/// when they find no room.
+fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece) -> Option<Chain> {
+    let (b, c) = (&held.block, &held.circle);
+    let [a0, a1] = c.axes;
+    let (r, sign, sweep) = (c.r0, c.sweep.signum(), c.sweep.abs());
+    let mut rp = r;
+    for _ in 0..6 {
+        rp = r - l * l / (24.0 * rp);
+    }
+    let psi = l / (2.0 * rp);
+    let x0 = 0.5 * l - l.powi(3) / (240.0 * rp * rp);
+    if l <= 1e-6 || rp <= 0.0 || 2.0 * psi > sweep || x0 > back.length {
+        return None;
+    }
+    let t1 = [b.start[a0], b.start[a1]];
+    let t2 = [b.end[a0], b.end[a1]];
+    let o = c.center;
+    let unit = |p: [f64; 2]| {
+        let d = sub(p, o);
+        let n = d[0].hypot(d[1]);
+        [d[0] / n, d[1] / n]
+    };
+    let on_circle = |e: [f64; 2]| Jet {
+        point: axpy(o, rp, e),
+        tangent: [-sign * e[1], sign * e[0]],
+        curvature: [-e[0] / rp, -e[1] / rp],
+    };
+    let e_in = rot(unit(t1), sign * psi);
+    let e_out = rot(unit(t2), -sign * psi);
+    let exit = Jet {
+        point: axpy(t2, x0, u2),
+        tangent: u2,
+        curvature: [0.0; 2],
+    };
+    let mut begin = back.origin;
+    for (i, v) in begin.iter_mut().enumerate() {
+        *v += back.dir[i] * (back.length - x0);
+    }
+    // Where the straight before now ends (its own point, so the two meet exactly).
+    let start = Jet {
+        point: [begin[a0], begin[a1]],
+        tangent: u1,
+        curvature: [0.0; 2],
+    };
+    let body_sweep = sweep - 2.0 * psi;
+    let body = (body_sweep * rp > 1e-9).then(|| {
+        let e = e_in;
+        let circle = Circle {
+            axes: c.axes,
+            center: o,
+            angle0: e[1].atan2(e[0]),
+            sweep: sign * body_sweep,
+            r0: rp,
+            r1: rp,
+        };
+        PlaneCurve::circle(circle, body_sweep * rp)
+    });
+    let mut exit_point = b.end;
+    exit_point[a0] = exit.point[0];
+    exit_point[a1] = exit.point[1];
+    Some(Chain {
+        x0,
+        ramp_in: PlaneCurve::quintic(c.axes, &start, &on_circle(e_in), l),
+        body,
+        ramp_out: PlaneCurve::quintic(c.axes, &on_circle(e_out), &exit, l),
+        exit: exit_point,
+    })
+}
+
+/// Whether every point of the transitions (sampled) lies within `tol` of the programmed
+/// straights and circle, and the circle's shift does.
+fn within(held: &HeldArc, chain: &Chain, (u1, u2): ([f64; 2], [f64; 2]), tol: f64) -> bool {
+    let (b, c) = (&held.block, &held.circle);
+    let [a0, a1] = c.axes;
+    let t1 = [b.start[a0], b.start[a1]];
+    let t2 = [b.end[a0], b.end[a1]];
+    let distance = |p: [f64; 2]| {
+        let along1 = dot(sub(p, t1), u1);
+        let line1 = if along1 <= 0.0 {
+            let d = axpy(sub(p, t1), -along1, u1);
+            d[0].hypot(d[1])
+        } else {
+            f64::INFINITY
+        };
+        let along2 = dot(sub(p, t2), u2);
+        let line2 = if along2 >= 0.0 {
+            let d = axpy(sub(p, t2), -along2, u2);
+            d[0].hypot(d[1])
+        } else {
+            f64::INFINITY
+        };
+        let d = sub(p, c.center);
+        let angle = (d[1].atan2(d[0]) - c.angle0) * c.sweep.signum();
+        let arc = if angle.rem_euclid(core::f64::consts::TAU) <= c.sweep.abs() + 1e-12 {
+            (d[0].hypot(d[1]) - c.r0).abs()
+        } else {
+            f64::INFINITY
+        };
+        let ends = sub(p, t1)[0]
+            .hypot(sub(p, t1)[1])
+            .min(sub(p, t2)[0].hypot(sub(p, t2)[1]));
+        line1.min(line2).min(arc).min(ends)
+    };
+    let shift = chain.body.map_or(0.0, |body| match body.shape {
+        super::planar::PlaneShape::Circle(k) => (c.r0 - k.r0).abs().max((c.r1 - k.r1).abs()),
+        super::planar::PlaneShape::Quintic(_) => f64::INFINITY,
+    });
+    const SAMPLES: usize = 64;
+    let ramps_within = [chain.ramp_in, chain.ramp_out].iter().all(|q| {
+        (0..=SAMPLES).all(|k| {
+            distance(q.at(q.length * k as f64 / SAMPLES as f64).point) <= CHECK_SHARE * tol
+        })
+    });
+    shift <= tol && ramps_within
+}
+
+/// The circle's unit tangent at `s` of the way (plane axes).
+fn tangent(c: &Circle, s: f64) -> [f64; 2] {
+    let (d1, _) = c.rates(s, 1.0, 0.0);
+    let n = d1[0].hypot(d1[1]);
+    [d1[0] / n, d1[1] / n]
+}
+
+/// Whether a straight of direction `dir` moves only in the plane of `axes` and along
+/// `tangent` there (within [`TANGENT_MAX`]).
+fn meets(dir: &AxisValues, axes: [usize; 2], tangent: [f64; 2]) -> bool {
+    let in_plane = (0..dir.len())
+        .filter(|i| !axes.contains(i))
+        .all(|i| dir[i] == 0.0);
+    let u = [dir[axes[0]], dir[axes[1]]];
+    let cos = dot(u, tangent) / u[0].hypot(u[1]).max(1e-300);
+    in_plane && cos >= TANGENT_MAX.cos()
+}
+
+/// A direction in the channel's axes from one in the plane of `axes`.
+fn direction_of(like: &AxisValues, axes: [usize; 2], u: [f64; 2]) -> AxisValues {
+    let mut d = AxisValues::zeros(like.len());
+    d[axes[0]] = u[0];
+    d[axes[1]] = u[1];
+    d
+}
