@@ -360,8 +360,16 @@ fn fillet_step() -> impl Strategy<Value = (Step, Step)> {
         })
 }
 
+/// Cases of the fillet property test: 48, or `FILLET_CASES` (a long run by hand).
+fn fillet_cases() -> u32 {
+    std::env::var("FILLET_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(48)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(48))]
+    #![proptest_config(ProptestConfig::with_cases(fillet_cases()))]
 
     /// Small arcs between tangent lines (fillets of any radius, sweep and side) keep the
     /// tolerance and the limits, end on the last point and never slow below 0.3 of the
@@ -383,6 +391,10 @@ proptest! {
         let slowest = slowest_between(&t, floor);
         prop_assert!(slowest >= 0.99 * floor, "slowed to {} mm/s (floor {})", slowest, floor);
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
 
     /// Lines and arcs in any order, tangent or at corners, keep the tolerance and the limits
     /// and end on the last point; where every transition is tangent the path never stops on

@@ -234,7 +234,10 @@ impl Contour {
     fn chain(&self, held: &HeldArc, next: &Segment) -> Option<Chain> {
         let (b, c) = (&held.block, &held.circle);
         let [a0, a1] = c.axes;
-        let tol = b.tolerance.min(b.blend?).min(next.blend?);
+        // The arc's tolerance and its corner's before (the block after keeps half of it for
+        // the corners of chords, which these are not); the block after must not stop there.
+        next.blend?;
+        let tol = b.tolerance.min(b.blend?);
         let joined = (0..b.end.len()).all(|i| (next.start[i] - b.end[i]).abs() <= 1e-9);
         let len2 = (0..3)
             .map(|i| (next.end[i] - next.start[i]).powi(2))
