@@ -63,9 +63,11 @@ pub(super) struct ArcChords {
 }
 
 impl Contour {
-    /// Adds an arc block as its chords (as many as fit now, the rest as room frees).
-    /// [`PushError::NotStraight`] when it cannot join: no finite circle, no tolerance, or more
-    /// than [`MAX_ARC_CHORDS`] chords.
+    /// Adds an arc block as its chords (as many as fit now, the rest as room frees). Where
+    /// chords would run it slower than it runs on its own, or it would take more than
+    /// [`MAX_ARC_CHORDS`] of them, it is a small arc ([`super::fillet`]): held back when a
+    /// straight meets it tangentially. [`PushError::NotStraight`] when it cannot join: no
+    /// finite circle, no tolerance, or a small arc not held.
     pub fn push_arc(&mut self, block: &ArcBlock) -> Result<(), PushError> {
         if !self.has_room() {
             return Err(PushError::Full);

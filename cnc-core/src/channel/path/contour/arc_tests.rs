@@ -323,6 +323,108 @@ fn a_small_circle_between_tangent_lines_runs_through_with_transitions() {
     assert!(slowest < 1.0, "came no nearer to rest than {slowest} mm/s");
 }
 
+/// A fillet in windows too small to hold it (lookahead below 5) runs on its own; in every
+/// window the run ends, within the tolerance and the limits.
+#[test]
+fn a_fillet_in_a_small_window_runs_through_or_on_its_own() {
+    let path = walk(&[
+        line(10.0, 0.0),
+        arc(5.0, 90.0),
+        line(10.0, 0.0),
+        arc(3.0, -120.0),
+        line(5.0, 0.0),
+    ]);
+    for lookahead in 1..=6 {
+        match run(&path, 100.0, 0.02, lookahead) {
+            // Below 5 the arc does not join: the channel runs it on its own.
+            Err(e) => assert!(
+                lookahead < 5 && e.ends_with("NotStraight"),
+                "{lookahead}: {e}"
+            ),
+            Ok(t) => {
+                assert!(lookahead >= 5, "lookahead {lookahead} joined");
+                kept_its_promises(&t, &path, 0.02).unwrap();
+                let slowest = slowest_between(&t, 20.0);
+                assert!(slowest >= 20.0, "lookahead {lookahead}: {slowest}");
+            }
+        }
+    }
+}
+
+/// The interpreter may stall with the straight after a fillet's transitions held back: the
+/// path comes to rest where they end (the window's end), not anywhere else, and goes on from
+/// there when the rest comes.
+#[test]
+fn a_stall_after_a_fillets_transitions_rests_where_they_end() {
+    let path = walk(&[line(10.0, 0.0), arc(5.0, 90.0), line(10.0, 0.0)]);
+    let lim = limits(3);
+    let mut c = Contour::new(&lim, CYCLE, 32);
+    let segment = |start: [f64; 2], end: [f64; 2], line: u32| Segment {
+        start: xyz(start),
+        end: xyz(end),
+        feed: 100.0,
+        rapid: false,
+        line,
+        blend: (line > 1).then_some(0.02),
+        chamfer: true,
+        on_arc: false,
+    };
+    c.push(&segment([0.0, 0.0], path[0].end(), 1), &mut |_| {})
+        .unwrap();
+    let Element::Arc {
+        end, center, ccw, ..
+    } = path[1]
+    else {
+        unreachable!()
+    };
+    let block = ArcBlock {
+        start: xyz(path[0].end()),
+        end: xyz(end),
+        arc: ArcMove {
+            plane: Plane::Xy,
+            center,
+            ccw,
+            full_turn: false,
+        },
+        feed: 100.0,
+        line: 2,
+        blend: Some(0.02),
+        tolerance: 0.02,
+    };
+    c.push_arc(&block).unwrap();
+    c.push(&segment(end, path[2].end(), 3), &mut |_| {})
+        .unwrap();
+    let mut pos = xyz([0.0, 0.0]);
+    let (mut vel, mut acc) = (AxisValues::zeros(3), AxisValues::zeros(3));
+    let mut trace = Trace {
+        positions: vec![pos],
+        blocks: vec![0],
+    };
+    let mut tick = |c: &mut Contour, trace: &mut Trace| {
+        let moving = c.step(&mut pos, &mut vel, &mut acc).unwrap();
+        trace.positions.push(pos);
+        trace.blocks.push(c.line().map_or(2, |l| l as usize - 1));
+        moving
+    };
+    // Stalled: nothing more comes for 2 s; the last straight waits, held back.
+    for _ in 0..2000 {
+        tick(&mut c, &mut trace);
+    }
+    let rest = *trace.positions.last().unwrap();
+    let still = trace.positions[trace.positions.len() - 100..]
+        .iter()
+        .all(|p| *p == rest);
+    assert!(still, "not at rest at the stall");
+    // Where the transition out ends: on the straight after the arc, past its start, short
+    // of its end.
+    let after = path[2].end();
+    let on_it = (rest[0] - end[0]).abs() < 1e-9 && rest[1] > end[1] + 0.1;
+    assert!(on_it && rest[1] < after[1] - 1.0, "rests at {rest:?}");
+    c.close();
+    while tick(&mut c, &mut trace) {}
+    kept_its_promises(&trace, &path, 0.02).unwrap();
+}
+
 /// A pocket's corners as radius-5 fillets at F6000 within 0.02 mm: the path never stops.
 #[test]
 fn a_pockets_small_fillets_never_stop_the_path() {
@@ -390,6 +492,13 @@ proptest! {
         let floor = 0.3 * pairs.iter().map(|(_, a)| own(a.radius)).fold(f64::INFINITY, f64::min);
         let slowest = slowest_between(&t, floor);
         prop_assert!(slowest >= 0.99 * floor, "slowed to {} mm/s (floor {})", slowest, floor);
+        // Never above the feed (the transitions' parameter is not their length).
+        let fastest = t
+            .positions
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
+            .fold(0.0, f64::max);
+        prop_assert!(fastest <= 100.0 * (1.0 + 1e-9), "{} mm/s", fastest);
     }
 }
 

@@ -48,6 +48,12 @@ const RAMP_JERK_SHARE: f64 = 0.5;
 const CHAIN_SPEED_KEPT: f64 = 0.3;
 /// Shorter transitions tried (each 0.7 of the last) when one leaves the tolerance.
 const TRIES: usize = 6;
+/// Pieces the window keeps free while an arc is held: its transitions and circle, and the
+/// straight after (with a corner curve).
+pub(super) const HELD_ROOM: usize = 5;
+/// The smallest window an arc is held in (with fewer pieces the room for it would come only
+/// once the path has run to the straight's end, where the transitions cannot start).
+const HOLD_MIN_CAPACITY: usize = 12;
 
 /// A small arc held back until the block after it comes.
 #[derive(Debug, Clone, Copy)]
@@ -71,8 +77,9 @@ struct Chain {
     ramp_in: PlaneCurve,
     body: Option<PlaneCurve>,
     ramp_out: PlaneCurve,
-    /// Where the straight after now starts.
+    /// Where the straight after now starts, and its direction.
     exit: AxisValues,
+    exit_dir: AxisValues,
 }
 
 /// A 2-vector rotated by `angle`.
@@ -106,7 +113,8 @@ impl Contour {
         let planar = (0..block.start.len())
             .filter(|i| !circle.axes.contains(i))
             .all(|i| block.end[i] == block.start[i]);
-        if !planar || block.blend.is_none() || self.held.is_some() || self.arc.is_some() {
+        let busy = self.held.is_some() || self.arc.is_some();
+        if !planar || block.blend.is_none() || busy || self.capacity < HOLD_MIN_CAPACITY {
             return Err(PushError::NotStraight);
         }
         if !self.flush() {
@@ -145,7 +153,7 @@ impl Contour {
         let Some(held) = self.held else {
             return Ok(None);
         };
-        if !self.has_room_for(3) {
+        if self.pieces.len() + HELD_ROOM > self.capacity {
             return Err(PushError::Full);
         }
         self.held = None;
@@ -199,7 +207,10 @@ impl Contour {
             let piece = self.plane_piece(held, curve);
             self.pieces.push_back(piece);
         }
-        self.blocks += 1;
+        // The circle is the block's own piece (popping it counts the block out); without
+        // one (its transitions meet) the block is not counted.
+        let counted = usize::from(chain.body.is_some());
+        self.blocks += counted;
         for k in n.saturating_sub(1)..self.pieces.len() {
             self.rechain(k);
         }
@@ -210,10 +221,12 @@ impl Contour {
         if !kept {
             self.pieces.truncate(n);
             *self.pieces.back_mut().expect("kept") = saved;
-            self.blocks -= 1;
+            self.blocks -= counted;
             self.sweep_back();
             return false;
         }
+        // The window now ends where the straight after starts (it may be held back).
+        self.last_end = Some((chain.exit, chain.exit_dir));
         self.replan = true;
         true
     }
@@ -221,8 +234,10 @@ impl Contour {
     /// A piece of the held arc (its other axes at the block's start).
     fn plane_piece(&self, held: &HeldArc, curve: PlaneCurve) -> Piece {
         let b = &held.block;
-        let mut p = Piece::planar(b.start, curve, (&self.limits, b.feed));
-        p.feed = b.feed;
+        // The path moves at |p'| times the parameter's speed: the feed holds for the path.
+        let feed = b.feed / curve.stretch().max(1.0);
+        let mut p = Piece::planar(b.start, curve, (&self.limits, feed));
+        p.feed = feed;
         p.line = b.line;
         p.tolerance = b.tolerance;
         p
@@ -354,6 +369,7 @@ fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece
         body,
         ramp_out: PlaneCurve::quintic(c.axes, &on_circle(e_out), &exit, l),
         exit: exit_point,
+        exit_dir: direction_of(&b.start, c.axes, u2),
     })
 }
 
@@ -380,9 +396,12 @@ fn within(held: &HeldArc, chain: &Chain, (u1, u2): ([f64; 2], [f64; 2]), tol: f6
             f64::INFINITY
         };
         let d = sub(p, c.center);
-        let angle = (d[1].atan2(d[0]) - c.angle0) * c.sweep.signum();
-        let arc = if angle.rem_euclid(core::f64::consts::TAU) <= c.sweep.abs() + 1e-12 {
-            (d[0].hypot(d[1]) - c.r0).abs()
+        let along =
+            ((d[1].atan2(d[0]) - c.angle0) * c.sweep.signum()).rem_euclid(core::f64::consts::TAU);
+        let arc = if along <= c.sweep.abs() + 1e-12 {
+            // A spiral's radius runs linearly over its sweep.
+            let r = c.r0 + (c.r1 - c.r0) * (along / c.sweep.abs()).min(1.0);
+            (d[0].hypot(d[1]) - r).abs()
         } else {
             f64::INFINITY
         };

@@ -208,8 +208,12 @@ impl Contour {
     /// Whether another block fits into the window (with a small arc held back: its pieces
     /// too).
     pub fn has_room(&self) -> bool {
-        let segments = if self.held.is_some() { 4 } else { 2 };
-        self.arc.is_none() && self.blocks < self.lookahead && self.has_room_for(segments)
+        let room = if self.held.is_some() {
+            self.pieces.len() + fillet::HELD_ROOM <= self.capacity
+        } else {
+            self.has_room_for(2)
+        };
+        self.arc.is_none() && self.blocks < self.lookahead && room
     }
 
     /// Whether `segments` more segments (two pieces each) fit into the window.

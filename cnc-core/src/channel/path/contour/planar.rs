@@ -124,6 +124,26 @@ impl PlaneCurve {
         }
     }
 
+    /// The largest `|p'|` (the path's speed per unit of the parameter's): 1 on the circle;
+    /// on a transition the largest of its samples plus what `p''` can add between them.
+    pub fn stretch(&self) -> f64 {
+        match self.shape {
+            PlaneShape::Circle(_) => 1.0,
+            PlaneShape::Quintic(_) => {
+                let g = self.bounds();
+                let second = g[0][1].hypot(g[1][1]);
+                let step = self.length / SAMPLES as f64;
+                (0..=SAMPLES)
+                    .map(|i| {
+                        let t = self.at(i as f64 * step).tangent;
+                        t[0].hypot(t[1])
+                    })
+                    .fold(0.0, f64::max)
+                    + 0.5 * second * step
+            }
+        }
+    }
+
     /// Per plane axis, bounds on `|p'|`, `|p''|`, `|p'''|` over the piece (`λ` units).
     pub fn bounds(&self) -> [[f64; 3]; 2] {
         let l = self.length;
