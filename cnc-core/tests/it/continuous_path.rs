@@ -509,14 +509,19 @@ fn small_fillets_run_through_with_transitions() {
         trace.len(),
         stopped.len()
     );
-    let mut ctl = controller(vec![(config, &program)]);
+    // Twelve rounds (108 blocks): arcs are held and released while the ticks are counted.
+    let rounds = format!(
+        "#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{}G260\nM30\n",
+        pocket.repeat(12)
+    );
+    let mut ctl = controller(vec![(config, &rounds)]);
     let memory = image(1);
     let view = hli::views::CncView::new(&memory);
     for _ in 0..600 {
         ctl.tick(&view);
     }
     let before = counting_alloc::allocations();
-    for _ in 0..1200 {
+    for _ in 0..20_000 {
         ctl.tick(&view);
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
