@@ -307,11 +307,14 @@ fn example_1_the_gripper_follows_the_carriage_axis_by_axis() {
 }
 
 /// The 3-axis mill: its channel takes three axis images, which follow X Y Z; the pocket's
-/// far corner (70, 50) is rounded within PATH_DEV, never overshot, with the tool length on Z.
+/// far corner (70, 50) is rounded within PATH_DEV, never overshot, with the tool length on Z;
+/// the finishing pass's radius-5 corners run through without stopping (never below 40 mm/s
+/// there), within its PATH_DEV of 0.02 mm of the lines and arcs.
 #[test]
 fn the_3_axis_mill_drives_three_axes_around_its_pocket() {
     let s = scenario("mill-3axis");
     let (mut far_x, mut far_y, mut nearest) = (f64::MIN, f64::MIN, f64::MAX);
+    let mut finish: Vec<[f64; 2]> = Vec::new();
     let done = run(&s, 20_000, None, |run, _| {
         let axes = run.machine.axes();
         let p: Vec<f64> = (0..3).map(|i| axes.axis(i).unwrap().actual()).collect();
@@ -320,7 +323,35 @@ fn the_3_axis_mill_drives_three_axes_around_its_pocket() {
             far_y = far_y.max(p[1]);
             nearest = nearest.min(((p[0] - 70.0).powi(2) + (p[1] - 50.0).powi(2)).sqrt());
         }
+        if (p[2] - 47.0).abs() < 1e-9 {
+            finish.push([p[0], p[1]]);
+        }
     });
+    // The finishing outline: a rectangle from (10, 10) to (70, 50), corners of radius 5 (its
+    // start in the first corner's square aside).
+    let off = finish
+        .iter()
+        .filter(|p| p[0] >= 15.0 || p[1] >= 15.0)
+        .map(|p| {
+            let q = [(p[0] - 40.0).abs() - 25.0, (p[1] - 30.0).abs() - 15.0];
+            (q[0].max(0.0).hypot(q[1].max(0.0)) + q[0].max(q[1]).min(0.0) - 5.0).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(
+        off <= 0.02 + 1e-9,
+        "the finishing pass {off} mm off its outline"
+    );
+    let speed: Vec<f64> = finish
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / 1e-3)
+        .collect();
+    let first = speed.iter().position(|&v| v >= 40.0).unwrap();
+    let last = speed.iter().rposition(|&v| v >= 40.0).unwrap();
+    let slowest = speed[first..=last].iter().copied().fold(f64::MAX, f64::min);
+    assert!(
+        slowest >= 40.0,
+        "the finishing pass slowed to {slowest} mm/s"
+    );
     assert_eq!(done.machine.channel_axes(), 3, "X Y Z only");
     let axes = done.machine.axes();
     let end: Vec<f64> = (0..3).map(|i| axes.axis(i).unwrap().actual()).collect();
