@@ -406,6 +406,31 @@ fn distance_to_slot(p: &[f64]) -> f64 {
         + p[2].abs()
 }
 
+/// The issue's limits (200 mm/s, 2000 mm/s², 40000 mm/s³): `body` in continuous path within
+/// `PATH_DEV = 0.02` and at exact stop; the config, both traces and the continuous path's
+/// speed per tick (mm/s in X and Y).
+fn contour_and_stop(body: &str) -> (ChannelConfig, Vec<AxisValues>, Vec<AxisValues>, Vec<f64>) {
+    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{body}G260\nM30\n");
+    let mut config = cartesian("c");
+    config.limits.velocity = 200.0;
+    config.limits.acceleration = 2000.0;
+    config.limits.jerk = 40_000.0;
+    let (trace, _) = run(&program, config.clone(), |_, _| {});
+    let (stopped, _) = run(&format!("{body}M30\n"), config.clone(), |_, _| {});
+    let speed = trace
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
+        .collect();
+    (config, trace, stopped, speed)
+}
+
+/// The slowest of `speed` between the first and the last at `above` or more.
+fn slowest_between(speed: &[f64], above: f64) -> f64 {
+    let first = speed.iter().position(|&v| v >= above).unwrap();
+    let last = speed.iter().rposition(|&v| v >= above).unwrap();
+    speed[first..=last].iter().copied().fold(f64::MAX, f64::min)
+}
+
 /// Arcs inside a contour: a slot (line, half circle G03 of radius 50, line, half circle) in continuous
 /// path runs without stopping anywhere between its start and its end, within PATH_DEV of the
 /// lines and the circles, within the limits, quicker than exact stop, its tick allocating
@@ -413,13 +438,8 @@ fn distance_to_slot(p: &[f64]) -> f64 {
 #[test]
 fn arcs_join_the_contour_tangent_to_its_lines() {
     let slot = "G1 X40 F6000\nG3 X40 Y100 I0 J50\nG1 X0\nG3 X0 Y0 I0 J-50\n";
+    let (config, trace, stopped, speed) = contour_and_stop(slot);
     let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{slot}G260\nM30\n");
-    let mut config = cartesian("c");
-    config.limits.velocity = 200.0;
-    config.limits.acceleration = 2000.0;
-    config.limits.jerk = 40_000.0;
-    let (trace, _) = run(&program, config.clone(), |_, _| {});
-    let (stopped, _) = run(&format!("{slot}M30\n"), config.clone(), |_, _| {});
     let worst = trace
         .iter()
         .map(|p| distance_to_slot(p))
@@ -427,16 +447,9 @@ fn arcs_join_the_contour_tangent_to_its_lines() {
     assert!(worst <= 0.02 + 1e-9, "deviation {worst}");
     let (_, rates) = measure(&trace, &[[0.0, 0.0], [0.0, 0.0]]);
     assert_within(&config, rates);
-    // Exact stop would stop at the four transitions.
-    let speed: Vec<f64> = trace
-        .windows(2)
-        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
-        .collect();
-    // Tangent transitions without slowing: at the feed (100 mm/s) from the first tick there
-    // to the last.
-    let first = speed.iter().position(|&v| v > 99.9).unwrap();
-    let last = speed.iter().rposition(|&v| v > 99.9).unwrap();
-    let slowest = speed[first..=last].iter().copied().fold(f64::MAX, f64::min);
+    // Tangent transitions without slowing (exact stop would stop at all four): at the feed
+    // (100 mm/s) from the first tick there to the last.
+    let slowest = slowest_between(&speed, 99.9);
     assert!(slowest > 99.9, "slowed to {slowest} mm/s on the way");
     let end = trace.last().unwrap();
     assert_eq!([end[0], end[1]], [0.0, 0.0]);
@@ -477,13 +490,7 @@ fn distance_to_pocket(p: &[f64]) -> f64 {
 fn small_fillets_run_through_with_transitions() {
     let pocket = "G1 X70 F6000\nG3 X75 Y5 I0 J5\nG1 Y45\nG3 X70 Y50 I-5 J0\nG1 X0\n\
                   G3 X-5 Y45 I0 J-5\nG1 Y5\nG3 X0 Y0 I5 J0\nG1 X5\n";
-    let program = format!("#CONTOUR MODE [DEV PATH_DEV=0.02]\nG261\n{pocket}G260\nM30\n");
-    let mut config = cartesian("c");
-    config.limits.velocity = 200.0;
-    config.limits.acceleration = 2000.0;
-    config.limits.jerk = 40_000.0;
-    let (trace, _) = run(&program, config.clone(), |_, _| {});
-    let (stopped, _) = run(&format!("{pocket}M30\n"), config.clone(), |_, _| {});
+    let (config, trace, stopped, speed) = contour_and_stop(pocket);
     let worst = trace
         .iter()
         .map(|p| distance_to_pocket(p))
@@ -491,15 +498,7 @@ fn small_fillets_run_through_with_transitions() {
     assert!(worst <= 0.02 + 1e-9, "deviation {worst}");
     let (_, rates) = measure(&trace, &[[0.0, 0.0], [0.0, 0.0]]);
     assert_within(&config, rates);
-    let speed: Vec<f64> = trace
-        .windows(2)
-        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) / CYCLE)
-        .collect();
-    let (first, last) = (
-        speed.iter().position(|&v| v >= 40.0).unwrap(),
-        speed.iter().rposition(|&v| v >= 40.0).unwrap(),
-    );
-    let slowest = speed[first..=last].iter().copied().fold(f64::MAX, f64::min);
+    let slowest = slowest_between(&speed, 40.0);
     assert!(slowest >= 40.0, "slowed to {slowest} mm/s on the way");
     let end = trace.last().unwrap();
     assert_eq!([end[0], end[1]], [5.0, 0.0]);

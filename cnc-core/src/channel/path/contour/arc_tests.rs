@@ -266,6 +266,16 @@ fn slowest_between(t: &Trace, above: f64) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Runs `path` at 100 mm/s within 0.02 mm looking ahead `lookahead` blocks, checks its
+/// promises, and returns the trace and its slowest speed between the first and the last tick
+/// at `above` or more.
+fn through(path: &[Element], lookahead: usize, above: f64) -> (Trace, f64) {
+    let t = run(path, 100.0, 0.02, lookahead).unwrap();
+    kept_its_promises(&t, path, 0.02).unwrap();
+    let slowest = slowest_between(&t, above);
+    (t, slowest)
+}
+
 fn line(length: f64, turn: f64) -> Step {
     Step {
         arc: false,
@@ -296,9 +306,7 @@ fn tangent_transitions_keep_the_feed() {
         arc(60.0, -180.0),
         line(20.0, 0.0),
     ]);
-    let t = run(&path, 100.0, 0.02, 32).unwrap();
-    kept_its_promises(&t, &path, 0.02).unwrap();
-    let slowest = slowest_between(&t, 99.9);
+    let (_, slowest) = through(&path, 32, 99.9);
     assert!(slowest >= 99.9, "slowed to {slowest} mm/s at a transition");
 }
 
@@ -309,17 +317,13 @@ fn tangent_transitions_keep_the_feed() {
 #[test]
 fn a_small_circle_between_tangent_lines_runs_through_with_transitions() {
     let path = walk(&[line(10.0, 0.0), arc(10.0, 270.0), line(10.0, 0.0)]);
-    let t = run(&path, 100.0, 0.02, 32).unwrap();
-    kept_its_promises(&t, &path, 0.02).unwrap();
-    assert_eq!(stops_on_the_way(&t), 0);
     // The circle's own speed here is sqrt(a r / 2) = 70.7 mm/s; the transitions (their shift
     // within the tolerance) hold it to about 60.
-    let slowest = slowest_between(&t, 50.0);
+    let (t, slowest) = through(&path, 32, 50.0);
+    assert_eq!(stops_on_the_way(&t), 0);
     assert!(slowest >= 50.0, "slowed to {slowest} mm/s");
     let corner = walk(&[line(10.0, 0.0), arc(10.0, 90.0), line(10.0, 0.8)]);
-    let t = run(&corner, 100.0, 0.02, 32).unwrap();
-    kept_its_promises(&t, &corner, 0.02).unwrap();
-    let slowest = slowest_between(&t, 5.0);
+    let (_, slowest) = through(&corner, 32, 5.0);
     assert!(slowest < 1.0, "came no nearer to rest than {slowest} mm/s");
 }
 
@@ -341,10 +345,9 @@ fn a_fillet_in_a_small_window_runs_through_or_on_its_own() {
                 lookahead < 5 && e.ends_with("NotStraight"),
                 "{lookahead}: {e}"
             ),
-            Ok(t) => {
+            Ok(_) => {
                 assert!(lookahead >= 5, "lookahead {lookahead} joined");
-                kept_its_promises(&t, &path, 0.02).unwrap();
-                let slowest = slowest_between(&t, 20.0);
+                let (_, slowest) = through(&path, lookahead, 20.0);
                 assert!(slowest >= 20.0, "lookahead {lookahead}: {slowest}");
             }
         }
@@ -434,11 +437,8 @@ fn a_pockets_small_fillets_never_stop_the_path() {
         steps.push(arc(5.0, 90.0));
     }
     steps.push(line(10.0, 0.0));
-    let path = walk(&steps);
-    let t = run(&path, 100.0, 0.02, 32).unwrap();
-    kept_its_promises(&t, &path, 0.02).unwrap();
+    let (t, slowest) = through(&walk(&steps), 32, 40.0);
     assert_eq!(stops_on_the_way(&t), 0);
-    let slowest = slowest_between(&t, 40.0);
     assert!(slowest >= 40.0, "slowed to {slowest} mm/s");
 }
 
