@@ -24,7 +24,7 @@
 
 use super::super::circle::Circle;
 use super::arc::{own_speed, ArcBlock};
-use super::planar::{Jet, PlaneCurve};
+use super::planar::{clothoid, Jet, PlaneCurve};
 use super::{Contour, Mode, Piece, PushError, Segment};
 use crate::setpoint::AxisValues;
 
@@ -37,9 +37,11 @@ const CHECK_SHARE: f64 = 0.98;
 /// The largest angle (rad) between a straight block and the arc's tangent where they meet for
 /// them to count as tangent (a program's rounded coordinates; the transitions take it up).
 const TANGENT_MAX: f64 = 0.01;
+/// Quintics a transition is made of, each between points of a clothoid.
+const PARTS: usize = 3;
 /// A transition's largest third derivative against a clothoid's of the same length (what
 /// its length is chosen by).
-const RAMP_PEAK: f64 = 2.0;
+const RAMP_PEAK: f64 = 1.2;
 /// Share of the axes' jerk the transitions' change of curvature is chosen to take at the
 /// circle's speed.
 const RAMP_JERK_SHARE: f64 = 0.5;
@@ -50,10 +52,10 @@ const CHAIN_SPEED_KEPT: f64 = 0.3;
 const TRIES: usize = 6;
 /// Pieces the window keeps free while an arc is held: its transitions and circle, and the
 /// straight after (with a corner curve).
-pub(super) const HELD_ROOM: usize = 5;
+pub(super) const HELD_ROOM: usize = 2 * PARTS + 3;
 /// The smallest window an arc is held in (with fewer pieces the room for it would come only
 /// once the path has run to the straight's end, where the transitions cannot start).
-const HOLD_MIN_CAPACITY: usize = 12;
+const HOLD_MIN_CAPACITY: usize = 2 * HELD_ROOM;
 
 /// A small arc held back until the block after it comes.
 #[derive(Debug, Clone, Copy)]
@@ -70,16 +72,32 @@ impl HeldArc {
     }
 }
 
+/// Pieces of a chain: the transitions' and the circle's.
+const CHAIN_PIECES: usize = 2 * PARTS + 1;
+
 /// The pieces that run a held arc with transitions, and how much of the straights they take.
 struct Chain {
     /// Taken from the end of the straight before and from the start of the one after.
     x0: f64,
-    ramp_in: PlaneCurve,
+    ramp_in: [PlaneCurve; PARTS],
     body: Option<PlaneCurve>,
-    ramp_out: PlaneCurve,
+    ramp_out: [PlaneCurve; PARTS],
     /// Where the straight after now starts, and its direction.
     exit: AxisValues,
     exit_dir: AxisValues,
+    /// The window's pieces of the curves, once made.
+    built: [Option<Piece>; CHAIN_PIECES],
+}
+
+impl Chain {
+    /// Its pieces in the path's order.
+    fn pieces(&self) -> impl Iterator<Item = PlaneCurve> + '_ {
+        self.ramp_in
+            .iter()
+            .copied()
+            .chain(self.body)
+            .chain(self.ramp_out.iter().copied())
+    }
 }
 
 /// A 2-vector rotated by `angle`.
@@ -158,7 +176,7 @@ impl Contour {
         }
         self.held = None;
         if let Some(chain) = next.and_then(|s| self.chain(&held, s)) {
-            if self.push_chain(&held, &chain) {
+            if self.push_chain(&chain) {
                 self.smooth_from = Some(chain.exit);
                 return Ok(Some(chain.exit));
             }
@@ -190,7 +208,7 @@ impl Contour {
     /// Shortens the straight before by the transition's share and adds the transitions and
     /// the circle; `false` (nothing changed) when the run under way could no longer keep its
     /// committed end velocity.
-    fn push_chain(&mut self, held: &HeldArc, chain: &Chain) -> bool {
+    fn push_chain(&mut self, chain: &Chain) -> bool {
         let n = self.pieces.len();
         let Some(saved) = self.pieces.back().copied() else {
             return false;
@@ -200,12 +218,8 @@ impl Contour {
         let back = self.pieces.back_mut().expect("checked");
         back.length -= chain.x0;
         back.rest_after = false;
-        for curve in [Some(chain.ramp_in), chain.body, Some(chain.ramp_out)]
-            .into_iter()
-            .flatten()
-        {
-            let piece = self.plane_piece(held, curve);
-            self.pieces.push_back(piece);
+        for piece in chain.built.iter().flatten() {
+            self.pieces.push_back(*piece);
         }
         // The circle is the block's own piece (popping it counts the block out); without
         // one (its transitions meet) the block is not counted.
@@ -287,12 +301,15 @@ impl Contour {
         let u2 = [dir2[a0], dir2[a1]];
         for _ in 0..TRIES {
             let chain = geometry(held, (u1, u2), l, back);
-            if let Some(chain) = chain.filter(|ch| within(held, ch, (u1, u2), tol)) {
-                let slowest = [Some(chain.ramp_in), chain.body, Some(chain.ramp_out)]
-                    .into_iter()
-                    .flatten()
-                    .map(|curve| self.plane_piece(held, curve).hard_cap)
-                    .fold(f64::INFINITY, f64::min);
+            if let Some(mut chain) = chain.filter(|ch| within(held, ch, (u1, u2), tol)) {
+                let mut built = [None; CHAIN_PIECES];
+                let mut slowest = f64::INFINITY;
+                for (slot, curve) in built.iter_mut().zip(chain.pieces()) {
+                    let piece = self.plane_piece(held, curve);
+                    slowest = slowest.min(piece.hard_cap);
+                    *slot = Some(piece);
+                }
+                chain.built = built;
                 return (slowest >= CHAIN_SPEED_KEPT * speed).then_some(chain);
             }
             l *= 0.7;
@@ -303,23 +320,36 @@ impl Contour {
 
 /// The transitions of length `l` and the circle between them for the held arc between
 /// straights of directions `u1` (the one before, `back`'s) and `u2` (plane axes); `None`
-/// when they find no room.
+/// when they find no room. The transition in is a clothoid from the straight whose circle at
+/// its end has the arc's centre: its radius `r'` and where it starts (`x0` before the arc)
+/// follow from the clothoid's end point; the transition out is its mirror image, found from
+/// the straight after backwards.
 fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece) -> Option<Chain> {
     let (b, c) = (&held.block, &held.circle);
     let [a0, a1] = c.axes;
     let (r, sign, sweep) = (c.r0, c.sweep.signum(), c.sweep.abs());
-    let mut rp = r;
-    for _ in 0..6 {
-        rp = r - l * l / (24.0 * rp);
-    }
-    let psi = l / (2.0 * rp);
-    let x0 = 0.5 * l - l.powi(3) / (240.0 * rp * rp);
-    if l <= 1e-6 || rp <= 0.0 || 2.0 * psi > sweep || x0 > back.length {
+    if l <= 1e-6 || r.is_nan() || r <= 0.0 {
         return None;
     }
-    let t1 = [b.start[a0], b.start[a1]];
-    let t2 = [b.end[a0], b.end[a1]];
-    let o = c.center;
+    // The centre of the circle at the clothoid's end lies `r` from the straight.
+    let end = |rp: f64| clothoid::<2>(([0.0, 0.0], [1.0, 0.0]), 1.0, 1.0 / rp, l)[1];
+    // From the series' estimate (the shift l²/24r), a few steps (each takes the error down
+    // by about (l/r)²).
+    let mut rp = r - l * l / (24.0 * r);
+    for _ in 0..3 {
+        let e = end(rp);
+        let psi = l / (2.0 * rp);
+        rp -= e.point[1] + rp * psi.cos() - r;
+        if rp.is_nan() || rp <= 0.0 {
+            return None;
+        }
+    }
+    let psi = l / (2.0 * rp);
+    let x0 = end(rp).point[0] - rp * psi.sin();
+    if 2.0 * psi > sweep || x0 > back.length || x0 <= 0.0 {
+        return None;
+    }
+    let (t1, t2, o) = ([b.start[a0], b.start[a1]], [b.end[a0], b.end[a1]], c.center);
     let unit = |p: [f64; 2]| {
         let d = sub(p, o);
         let n = d[0].hypot(d[1]);
@@ -332,28 +362,31 @@ fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece
     };
     let e_in = rot(unit(t1), sign * psi);
     let e_out = rot(unit(t2), -sign * psi);
-    let exit = Jet {
-        point: axpy(t2, x0, u2),
-        tangent: u2,
-        curvature: [0.0; 2],
-    };
+    // Where the straight before now ends (its own point, so the two meet exactly).
     let mut begin = back.origin;
     for (i, v) in begin.iter_mut().enumerate() {
         *v += back.dir[i] * (back.length - x0);
     }
-    // Where the straight before now ends (its own point, so the two meet exactly).
-    let start = Jet {
-        point: [begin[a0], begin[a1]],
-        tangent: u1,
-        curvature: [0.0; 2],
+    let mut into = clothoid::<{ PARTS + 1 }>(([begin[a0], begin[a1]], u1), sign, 1.0 / rp, l);
+    into[PARTS] = on_circle(e_in);
+    // Out: from the straight after backwards (turning the other way), then reversed.
+    let exit = axpy(t2, x0, u2);
+    let mut out = clothoid::<{ PARTS + 1 }>((exit, [-u2[0], -u2[1]]), -sign, 1.0 / rp, l);
+    out.reverse();
+    for j in out.iter_mut() {
+        j.tangent = [-j.tangent[0], -j.tangent[1]];
+    }
+    out[0] = on_circle(e_out);
+    let part = l / PARTS as f64;
+    let quintics = |jets: &[Jet; PARTS + 1]| {
+        core::array::from_fn(|k| PlaneCurve::quintic(c.axes, &jets[k], &jets[k + 1], part))
     };
     let body_sweep = sweep - 2.0 * psi;
     let body = (body_sweep * rp > 1e-9).then(|| {
-        let e = e_in;
         let circle = Circle {
             axes: c.axes,
             center: o,
-            angle0: e[1].atan2(e[0]),
+            angle0: e_in[1].atan2(e_in[0]),
             sweep: sign * body_sweep,
             r0: rp,
             r1: rp,
@@ -361,15 +394,16 @@ fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece
         PlaneCurve::circle(circle, body_sweep * rp)
     });
     let mut exit_point = b.end;
-    exit_point[a0] = exit.point[0];
-    exit_point[a1] = exit.point[1];
+    exit_point[a0] = exit[0];
+    exit_point[a1] = exit[1];
     Some(Chain {
         x0,
-        ramp_in: PlaneCurve::quintic(c.axes, &start, &on_circle(e_in), l),
+        ramp_in: quintics(&into),
         body,
-        ramp_out: PlaneCurve::quintic(c.axes, &on_circle(e_out), &exit, l),
+        ramp_out: quintics(&out),
         exit: exit_point,
         exit_dir: direction_of(&b.start, c.axes, u2),
+        built: [None; CHAIN_PIECES],
     })
 }
 
@@ -414,8 +448,10 @@ fn within(held: &HeldArc, chain: &Chain, (u1, u2): ([f64; 2], [f64; 2]), tol: f6
         super::planar::PlaneShape::Circle(k) => (c.r0 - k.r0).abs().max((c.r1 - k.r1).abs()),
         super::planar::PlaneShape::Quintic(_) => f64::INFINITY,
     });
-    const SAMPLES: usize = 64;
-    let ramps_within = [chain.ramp_in, chain.ramp_out].iter().all(|q| {
+    // The deviation changes slowly along a part (a third of a transition): between samples
+    // it moves by far less than the share of the tolerance the check leaves.
+    const SAMPLES: usize = 16;
+    let ramps_within = chain.ramp_in.iter().chain(&chain.ramp_out).all(|q| {
         (0..=SAMPLES).all(|k| {
             distance(q.at(q.length * k as f64 / SAMPLES as f64).point) <= CHECK_SHARE * tol
         })
