@@ -1,21 +1,23 @@
 //! Small arcs between tangent straight blocks (a pocket's fillets, a slot's ends): where an
 //! arc's chords would run it slower than it runs on its own ([`super::arc`]), an arc that a
 //! straight block meets tangentially is held back until the next block shows how the path
-//! leaves it. When that is a straight block leaving tangentially, the path runs through the
+//! leaves it. When that is a straight block leaving it tangentially, the path runs through the
 //! arc without stopping: a transition from the straight into the circle, the circle, and a
 //! transition out of it ([`super::planar`]).
 //!
-//! A transition ramps the curvature from 0 to the circle's over a length `L`, as a clothoid
-//! does, so it starts `L/2` before the point where the straight meets the arc and ends `L/2`
-//! after it; the circle between the two transitions keeps the arc's centre and has its radius
-//! `r' = r - L²/(24 r')`, the shift a clothoid of that length needs. `L` is the longest that
-//! keeps that shift within [`SHIFT_SHARE`] of the tolerance, the arc's sweep and both
-//! straights' room, and no longer than the arc's speed needs (the curvature's rate of change
-//! at the speed of the circle within half the axes' jerk). Every point of the transitions is
-//! checked against the programmed lines and circle; a shorter `L` is tried when one leaves
-//! the tolerance. Each transition is one quintic that meets the straight's point and
-//! direction with no curvature at one end and the circle's point, direction and curvature at
-//! the other, so no axis's velocity or acceleration steps anywhere on the way.
+//! A transition is a clothoid: its curvature ramps linearly from 0 to the circle's over a
+//! length `L`, so it starts about `L/2` before the point where the straight meets the arc and
+//! ends about `L/2` after it; the circle between the two transitions keeps the arc's centre
+//! and has its radius shifted inward by about `L²/(24 r')`, the shift such a ramp needs (both
+//! found from the clothoid's end point, integrated numerically). `L` is the longest that keeps
+//! that shift within [`SHIFT_SHARE`] of the tolerance, the arc's sweep and both straights'
+//! room, and no longer than the arc's speed needs (the curvature's rate of change at the
+//! circle's speed within half the axes' jerk). The path runs a transition as [`PARTS`]
+//! quintics between points of the clothoid, each meeting the clothoid's point, direction and
+//! curvature vector at both ends (the first the straight's, the last the circle's), so no
+//! axis's velocity or acceleration steps anywhere on the way and the third derivative stays
+//! near the clothoid's constant one. Every point of the transitions is checked against the
+//! programmed lines and circle; a shorter `L` is tried when one leaves the tolerance.
 //!
 //! Otherwise (the block after is no tangent straight, the program ends there, the path
 //! already runs on the straight's end, or the transitions would run it much slower than it

@@ -1,16 +1,16 @@
 //! Pieces in one plane whose curvature turns with the path, for a small arc between tangent
 //! straight blocks ([`super::fillet`]): the arc itself (an exact circle, or the block's
-//! spiral when its end radius differs from its start's) and the transitions into it and out of
-//! it, each a quintic in the path parameter.
+//! spiral when its end radius differs from its start's) and the parts of the transitions
+//! into it and out of it, each a quintic in the path parameter, and the clothoid whose points
+//! the quintics join.
 //!
-//! A transition runs from a straight (tangent `u`, no curvature) to a point of the circle
-//! (its tangent and its curvature vector) or back: a quintic matches a point, a first and a
-//! second derivative at each end, so at both ends position, direction and curvature equal
-//! the neighbours' (no step in any axis's velocity or acceleration), and its curvature turns
-//! with the path (unlike a corner curve's, whose plane of curvature is fixed). With the path
-//! parameter `λ` over `0..L` and `t = λ / L`, `p(λ) = Σ c_k t^k`; the bounds on its axes'
-//! derivatives over `λ` are exact for the second and third, and for the first the largest
-//! of 256 samples plus what the second can add between them.
+//! A quintic matches a point, a first and a second derivative at each end, so at both ends
+//! position, direction and curvature equal the neighbours' (no step in any axis's velocity or
+//! acceleration), and its curvature turns with the path (unlike a corner curve's, whose plane
+//! of curvature is fixed). With the path parameter `λ` over `0..L` and `t = λ / L`,
+//! `p(λ) = Σ c_k t^k`; the bounds on its axes' derivatives over `λ` are exact for the second
+//! and third, and for the first the largest of 32 samples plus what the second can add
+//! between them; they are found once, when the piece is made.
 
 use super::super::circle::Circle;
 
