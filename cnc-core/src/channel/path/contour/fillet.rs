@@ -292,7 +292,11 @@ impl Contour {
         }
         let r = c.r0;
         let (speed, jerk) = own_speed(&self.limits, c, b.feed);
-        let by_speed = RAMP_PEAK * speed.powi(3) / (r * RAMP_JERK_SHARE * jerk);
+        let by_speed = if jerk.is_finite() {
+            RAMP_PEAK * speed.powi(3) / (r * RAMP_JERK_SHARE * jerk)
+        } else {
+            f64::INFINITY
+        };
         let mut l = (24.0 * r * SHIFT_SHARE * tol)
             .sqrt()
             .min(0.9 * c.sweep.abs() * r)
@@ -369,15 +373,29 @@ fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece
     for (i, v) in begin.iter_mut().enumerate() {
         *v += back.dir[i] * (back.length - x0);
     }
-    let mut into = clothoid::<{ PARTS + 1 }>(([begin[a0], begin[a1]], u1), sign, 1.0 / rp, l);
+    // The clothoid as the straight has it (from its point and direction) and as the circle
+    // has it (from the arc's tangent where it starts, ending on the circle): where the two
+    // differ (a straight not quite tangent, rounded coordinates) the transition blends from
+    // the one to the other over its parts, so no part takes all of the difference.
+    let kappa = 1.0 / rp;
+    let tangent_at = |e: [f64; 2]| [-sign * e[1], sign * e[0]];
+    let (ua1, ua2) = (tangent_at(unit(t1)), tangent_at(unit(t2)));
+    let mut into = blend(
+        &clothoid(([begin[a0], begin[a1]], u1), sign, kappa, l),
+        &clothoid((axpy(t1, -x0, ua1), ua1), sign, kappa, l),
+    );
     into[PARTS] = on_circle(e_in);
     // Out: from the straight after backwards (turning the other way), then reversed.
     let exit = axpy(t2, x0, u2);
-    let mut out = clothoid::<{ PARTS + 1 }>((exit, [-u2[0], -u2[1]]), -sign, 1.0 / rp, l);
-    out.reverse();
-    for j in out.iter_mut() {
-        j.tangent = [-j.tangent[0], -j.tangent[1]];
-    }
+    let backwards = |p: [f64; 2], u: [f64; 2]| {
+        let mut jets = clothoid::<{ PARTS + 1 }>((p, [-u[0], -u[1]]), -sign, kappa, l);
+        jets.reverse();
+        for j in jets.iter_mut() {
+            j.tangent = [-j.tangent[0], -j.tangent[1]];
+        }
+        jets
+    };
+    let mut out = blend(&backwards(axpy(t2, x0, ua2), ua2), &backwards(exit, u2));
     out[0] = on_circle(e_out);
     let part = l / PARTS as f64;
     let quintics = |jets: &[Jet; PARTS + 1]| {
@@ -406,6 +424,21 @@ fn geometry(held: &HeldArc, (u1, u2): ([f64; 2], [f64; 2]), l: f64, back: &Piece
         exit: exit_point,
         exit_dir: direction_of(&b.start, c.axes, u2),
         built: [None; CHAIN_PIECES],
+    })
+}
+
+/// From `a`'s jets (at the first) to `b`'s (at the last), linearly over the parts.
+fn blend(a: &[Jet; PARTS + 1], b: &[Jet; PARTS + 1]) -> [Jet; PARTS + 1] {
+    core::array::from_fn(|k| {
+        let w = k as f64 / PARTS as f64;
+        let mix = |x: [f64; 2], y: [f64; 2]| [x[0] + w * (y[0] - x[0]), x[1] + w * (y[1] - x[1])];
+        let t = mix(a[k].tangent, b[k].tangent);
+        let n = t[0].hypot(t[1]);
+        Jet {
+            point: mix(a[k].point, b[k].point),
+            tangent: [t[0] / n, t[1] / n],
+            curvature: mix(a[k].curvature, b[k].curvature),
+        }
     })
 }
 

@@ -203,8 +203,8 @@ const CLOTHOID_STEPS: usize = 8;
 
 /// A clothoid leaving `from` (its point and unit tangent) with no curvature, turning left
 /// (`sign` 1) or right (-1), its curvature growing linearly to `kappa` over `length`: its
-/// point, tangent and curvature vector at `K + 1` points `length / K` apart (the first is
-/// `from`'s), its positions integrated by Simpson's rule.
+/// point, tangent and curvature vector at `K` points `length / (K - 1)` apart (the first is
+/// `from`'s, the last its end), its positions integrated by Simpson's rule.
 pub(super) fn clothoid<const K: usize>(
     (point, u): ([f64; 2], [f64; 2]),
     sign: f64,
