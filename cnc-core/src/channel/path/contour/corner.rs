@@ -117,14 +117,9 @@ impl Contour {
             self.rechain(k);
         }
         self.sweep_back();
-        // The run under way must still reach its committed end velocity's bound; else, when
-        // it cruises, it is planned again from where it stands (a plan it adopts ends within
-        // its bound). A short window's run may cover it nearly to its end: the new corner's
-        // curves can lower the bounds there below what the run committed to.
-        let run_end = self.run_pieces.max(1) - 1;
-        let front_ok =
-            !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9 || self.replan_now();
-        if !front_ok {
+        // A short window's run may cover it nearly to its end: the new corner's curves can
+        // lower the bounds there below what the run committed to.
+        if !self.run_still_fits(under_way, committed) {
             self.pieces.pop_back();
             self.pieces.pop_back();
             *self.pieces.back_mut().expect("kept") = saved;
@@ -275,6 +270,14 @@ impl Contour {
 }
 
 impl Contour {
+    /// After pieces joined the window: whether the run under way still reaches its
+    /// committed end velocity's bound; else, when it cruises, it is planned again from where
+    /// it stands (a plan it adopts ends within its bound).
+    pub(super) fn run_still_fits(&mut self, under_way: bool, committed: f64) -> bool {
+        let run_end = self.run_pieces.max(1) - 1;
+        !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9 || self.replan_now()
+    }
+
     /// Whether piece `k` may be planned in one unit with the piece before: when they are
     /// alike; a straight piece the corners took all of, when the pieces on both sides are.
     pub(super) fn rechain(&mut self, k: usize) {

@@ -231,10 +231,7 @@ impl Contour {
             self.rechain(k);
         }
         self.sweep_back();
-        let run_end = self.run_pieces.max(1) - 1;
-        let kept =
-            !under_way || self.pieces[run_end].bound_hard >= committed - 1e-9 || self.replan_now();
-        if !kept {
+        if !self.run_still_fits(under_way, committed) {
             self.pieces.truncate(n);
             *self.pieces.back_mut().expect("kept") = saved;
             self.blocks -= counted;
