@@ -384,6 +384,75 @@ fn a_fillet_met_nearly_tangentially_runs_through() {
     }
 }
 
+/// A program ending on a small arc (the window closed while it is held) runs it on its own
+/// and ends on its end point; a stop while an arc is held brakes on what the window has,
+/// within the limits, and comes to rest short of the arc.
+#[test]
+fn a_fillet_held_at_the_programs_end_or_at_a_stop() {
+    let path = walk(&[line(10.0, 0.0), arc(5.0, 90.0)]);
+    let (_, slowest) = through(&path, 32, 20.0);
+    assert!(slowest < 1.0, "the arc ran on its own: {slowest}");
+    let lim = limits(3);
+    let mut c = Contour::new(&lim, CYCLE, 32);
+    let first = Segment {
+        start: xyz([0.0, 0.0]),
+        end: xyz(path[0].end()),
+        feed: 100.0,
+        rapid: false,
+        line: 1,
+        blend: None,
+        chamfer: true,
+        on_arc: false,
+    };
+    c.push(&first, &mut |_| {}).unwrap();
+    let Element::Arc {
+        end, center, ccw, ..
+    } = path[1]
+    else {
+        unreachable!()
+    };
+    let block = ArcBlock {
+        start: xyz(path[0].end()),
+        end: xyz(end),
+        arc: ArcMove {
+            plane: Plane::Xy,
+            center,
+            ccw,
+            full_turn: false,
+        },
+        feed: 100.0,
+        line: 2,
+        blend: Some(0.02),
+        tolerance: 0.02,
+    };
+    c.push_arc(&block).unwrap();
+    let mut pos = xyz([0.0, 0.0]);
+    let (mut vel, mut acc) = (AxisValues::zeros(3), AxisValues::zeros(3));
+    let mut trace = Trace {
+        positions: vec![pos],
+        blocks: vec![0],
+    };
+    for k in 0..5000 {
+        if k == 60 {
+            c.stop();
+        }
+        if !c.step(&mut pos, &mut vel, &mut acc).unwrap() && k > 60 {
+            break;
+        }
+        trace.positions.push(pos);
+        trace.blocks.push(0);
+    }
+    assert!(!c.active(), "the held arc is dropped at rest");
+    let rest = trace.positions.last().unwrap();
+    assert!(
+        rest[1] == 0.0 && rest[0] > 0.0 && rest[0] < 10.0,
+        "rests at {rest:?}"
+    );
+    let (v, a, j) = worst_rates(&trace);
+    let l = limits(1)[0];
+    assert!(v <= l.velocity && a <= l.acceleration * (1.0 + 1e-6) && j <= l.jerk * (1.0 + 1e-6));
+}
+
 /// The interpreter may stall with the straight after a fillet's transitions held back: the
 /// path comes to rest where they end (the window's end), not anywhere else, and goes on from
 /// there when the rest comes.
