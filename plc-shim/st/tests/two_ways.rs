@@ -1,6 +1,7 @@
 //! The runtime's two ways agree: random programs (assignments of every class of value,
 //! arrays, pointers, IF, CASE, FOR, WHILE and REPEAT with EXIT and CONTINUE, the standard
-//! blocks, a function block with inputs and outputs, a function) run as operations and by
+//! blocks, a function block with inputs and outputs, an array of them at computed indices,
+//! a function) run as operations and by
 //! walking the tree, cycle by cycle; after each cycle both hold the same memory, and both
 //! stop on the same fault at the same place with the same numbers (a division by zero, an
 //! index outside its array, a real that is not finite, an endless loop's budget).
@@ -109,7 +110,32 @@ impl Gen {
             3 => format!("r{} := {};\n", self.pick(2), self.real(2)),
             4 => format!("a[{} - 1] := {};\n", self.int_var(), self.int(1)),
             5 => format!("t(IN := {}, PT := T#20MS);\nb0 := t.Q;\n", self.boolean(1)),
-            6 => format!("fb(x := {}, y => {});\n", self.int(1), self.int_var()),
+            6 => match self.pick(4) {
+                // A later input that reads what an earlier one stored, or that faults
+                // after it was stored.
+                3 => {
+                    let b = match self.pick(3) {
+                        0 => format!("pr.a + {}", self.int_var()),
+                        1 => format!("1000 / ({} - 1)", self.int_var()),
+                        _ => self.int(1),
+                    };
+                    format!(
+                        "pr(a := {}, b := {b}, s => {});\n",
+                        self.int(1),
+                        self.int_var()
+                    )
+                }
+                0 => format!("fb(x := {}, y => {});\n", self.int(1), self.int_var()),
+                // An instance of an array at an index known when it runs (beyond it: the
+                // index's fault), and an element's output read at another.
+                1 => format!(
+                    "fbs[{} MOD 4](x := {}, y => {});\n",
+                    self.int_var(),
+                    self.int(1),
+                    self.int_var()
+                ),
+                _ => format!("{} := fbs[{} - 1].y;\n", self.int_var(), self.int_var()),
+            },
             7 => match self.pick(3) {
                 0 => format!("p := ADR({});\np^ := {};\n", self.int_var(), self.int(1)),
                 // Pointers in an array, to structures with arrays (as gpCh[0]^.unit.field).
@@ -215,6 +241,11 @@ VAR s : DINT; END_VAR
     s := s + x;
     y := s MOD 1000;
 END_FUNCTION_BLOCK
+FUNCTION_BLOCK Pair
+VAR_INPUT a, b : DINT; END_VAR
+VAR_OUTPUT s : DINT; END_VAR
+    s := a * 3 + b;
+END_FUNCTION_BLOCK
 TYPE S : STRUCT x : DINT; v : ARRAY[0..2] OF DINT; END_STRUCT END_TYPE
 PROGRAM MAIN
 VAR
@@ -229,6 +260,8 @@ VAR
     t : TON;
     c : CTU;
     fb : Acc;
+    fbs : ARRAY[0..2] OF Acc;
+    pr : Pair;
 END_VAR
 gp := ADR(i1);
 {body}END_PROGRAM

@@ -2,11 +2,15 @@
 //! expressions into operands and the operations that fill registers, places into operands
 //! or the pointer operations, and what the operations do not cover into the tree's.
 
-use super::code::{CallOp, Code, Codes, Dst, Op, Src, R};
+use super::code::{Code, Codes, Dst, Op, Src, Switch, NEXT, R};
 use super::library::Library;
-use crate::check::std_lib::StdFb;
-use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
+use crate::ast::BinOp;
+use crate::ir::{Addr, Ex, St, StKind};
 use crate::types::Elem;
+
+mod calls;
+
+use calls::index_place;
 
 /// Where EXIT and CONTINUE go inside the loop being compiled: the operations to patch.
 #[derive(Clone, Copy)]
@@ -80,9 +84,11 @@ impl<'c> Builder<'c> {
     /// Points the jump at `at` to `to`.
     fn patch(&mut self, at: usize, to: u32) {
         match &mut self.ops[at] {
-            Op::Jump(t) | Op::JumpIfNot(_, t) | Op::JumpIn(_, _, _, t) | Op::ForTest(.., t) => {
-                *t = to
-            }
+            Op::Jump(t)
+            | Op::JumpIfNot(_, t)
+            | Op::JumpCmp(.., t)
+            | Op::JumpIn(_, _, _, t)
+            | Op::ForTest(.., t) => *t = to,
             Op::ForNext(.., t) => *t = to,
             _ => {}
         }
@@ -125,8 +131,7 @@ impl<'c> Builder<'c> {
                 for (cond, body) in arms {
                     let mark = self.next;
                     let c = self.expr(cond);
-                    let skip = self.ops.len();
-                    self.ops.push(Op::JumpIfNot(c, LATER));
+                    let skip = self.jump_unless(c, LATER);
                     // The condition is taken: its registers are free for the arm.
                     self.next = mark;
                     self.block(body, loops);
@@ -159,8 +164,7 @@ impl<'c> Builder<'c> {
                 let top = self.here();
                 self.ops.push(Op::Stmt(site));
                 let c = self.expr(cond);
-                let test = self.ops.len();
-                self.ops.push(Op::JumpIfNot(c, LATER));
+                let test = self.jump_unless(c, LATER);
                 let continues = self.looped(body);
                 self.ops.push(Op::Jump(top));
                 let end = self.here();
@@ -176,7 +180,7 @@ impl<'c> Builder<'c> {
                 let check = self.here();
                 self.ops.push(Op::At(site));
                 let u = self.expr(until);
-                self.ops.push(Op::JumpIfNot(u, top));
+                self.jump_unless(u, top);
                 let end = self.here();
                 self.close_loop(continues, check, end);
             }
@@ -256,6 +260,54 @@ impl<'c> Builder<'c> {
         }
     }
 
+    /// Goes on at `to` unless `c` holds: a comparison just computed into `c`'s register is
+    /// taken into the jump. The jump's index (to patch).
+    fn jump_unless(&mut self, c: Src, to: u32) -> usize {
+        if let (Src::R(r), Some(&Op::Bin(op, t, d, a, b))) = (c, self.ops.last()) {
+            let compares = matches!(
+                op,
+                BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge
+            );
+            // The register is the condition's alone (read by nothing after the jump).
+            if compares && d == r {
+                *self.ops.last_mut().expect("the comparison") = Op::JumpCmp(op, t, a, b, to);
+                return self.ops.len() - 1;
+            }
+        }
+        self.ops.push(Op::JumpIfNot(c, to));
+        self.ops.len() - 1
+    }
+
+    /// A CASE's tests as one jump table when its labels lie close together (a state
+    /// machine's steps): its index among the switches, the table's entries the arms'
+    /// numbers until they are known.
+    fn switch(&mut self, v: Src, arms: &[crate::ir::CaseArm]) -> Option<u32> {
+        let ranges = || {
+            arms.iter()
+                .enumerate()
+                .flat_map(|(k, (r, _))| r.iter().map(move |x| (k, x)))
+        };
+        let lo = ranges().map(|(_, (lo, _))| *lo).min()?;
+        let hi = ranges().map(|(_, (_, hi))| *hi).max()?;
+        let span = hi.checked_sub(lo).filter(|s| (0..256).contains(s))?;
+        if ranges().count() < 3 {
+            return None;
+        }
+        let mut to = vec![NEXT; span as usize + 1];
+        // The first arm that holds a value takes it, as the tests in order would.
+        for (k, (a, b)) in ranges() {
+            for e in &mut to[(a - lo) as usize..=(b - lo) as usize] {
+                if *e == NEXT {
+                    *e = k as u32;
+                }
+            }
+        }
+        self.codes.switches.push(Switch { lo, to });
+        let k = (self.codes.switches.len() - 1) as u32;
+        self.ops.push(Op::Switch(v, k));
+        Some(k)
+    }
+
     fn case(
         &mut self,
         s: &St,
@@ -277,10 +329,13 @@ impl<'c> Builder<'c> {
             }
         };
         let mut tests = Vec::new();
-        for (k, (ranges, _)) in arms.iter().enumerate() {
-            for (lo, hi) in ranges {
-                tests.push((self.ops.len(), k));
-                self.ops.push(Op::JumpIn(v, *lo, *hi, LATER));
+        let table = self.switch(v, arms);
+        if table.is_none() {
+            for (k, (ranges, _)) in arms.iter().enumerate() {
+                for (lo, hi) in ranges {
+                    tests.push((self.ops.len(), k));
+                    self.ops.push(Op::JumpIn(v, *lo, *hi, LATER));
+                }
             }
         }
         self.block(otherwise, loops);
@@ -295,6 +350,13 @@ impl<'c> Builder<'c> {
         }
         for (at, k) in tests {
             self.patch(at, starts[k]);
+        }
+        if let Some(t) = table {
+            for e in &mut self.codes.switches[t as usize].to {
+                if *e != NEXT {
+                    *e = starts[*e as usize];
+                }
+            }
         }
         let end = self.here();
         ends.into_iter().for_each(|j| self.patch(j, end));
@@ -329,93 +391,18 @@ impl<'c> Builder<'c> {
         }
     }
 
-    fn call(
-        &mut self,
-        s: &St,
-        instance: &Addr,
-        inputs: &[BlockInput],
-        outputs: &[BlockOutput],
-        body: Result<u32, StdFb>,
-    ) {
-        let site = self.site(s);
-        let operands: Option<Vec<Src>> = inputs.iter().map(|(_, _, e)| operand(e)).collect();
-        if let (Some(Dst::Own(at, relative)), Some(values)) = (own(instance), operands) {
-            return self.whole_call(site, (at, relative), inputs, values, body, outputs);
-        }
-        self.ops.push(Op::Stmt(site));
-        let inst = self.reg();
-        match own(instance) {
-            Some(Dst::Own(at, relative)) => self.ops.push(Op::Inst(inst, at, relative)),
-            _ => {
-                let k = self.place(instance);
-                self.ops.push(Op::InstTree(inst, k));
-            }
-        }
-        for (offset, t, e) in inputs {
-            let mark = self.next;
-            let v = self.expr(e);
-            self.ops.push(Op::Input(inst, *offset, *t, v));
-            self.next = mark;
-        }
-        self.codes.calls.push(inputs.to_vec());
-        let call = (self.codes.calls.len() - 1) as u32;
-        self.ops.push(match body {
-            Ok(pou) => Op::Body(pou, inst, call),
-            Err(fb) => Op::StdBody(fb, inst, call),
-        });
-        self.ops.push(Op::At(site));
-        for (offset, t, target, negated) in outputs {
-            let mark = self.next;
-            let to = self.dst(target);
-            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
-            self.next = mark;
-        }
-    }
-
-    /// A call in one operation ([`Op::Call`]), its outputs after it.
-    fn whole_call(
-        &mut self,
-        site: u32,
-        (at, relative): (u32, bool),
-        inputs: &[BlockInput],
-        values: Vec<Src>,
-        body: Result<u32, StdFb>,
-        outputs: &[BlockOutput],
-    ) {
-        let first = self.codes.inputs.len() as u32;
-        for ((offset, t, _), v) in inputs.iter().zip(values) {
-            self.codes.inputs.push((*offset, *t, v));
-        }
-        self.codes.calls.push(inputs.to_vec());
-        let host = body
-            .ok()
-            .and_then(|p| self.library.of_pou.get(p as usize).copied().flatten());
-        let slot = match (host, relative) {
-            (Some(_), false) => self.library.slot_at(at),
-            _ => None,
-        };
-        self.codes.call_ops.push(CallOp {
-            site,
-            at,
-            relative,
-            inputs: (first, self.codes.inputs.len() as u32),
-            body,
-            call: (self.codes.calls.len() - 1) as u32,
-            slot,
-        });
-        let k = (self.codes.call_ops.len() - 1) as u32;
-        self.ops.push(Op::Call(k));
-        if outputs.is_empty() {
-            return;
-        }
-        let inst = self.reg();
-        self.ops.push(Op::Inst(inst, at, relative));
-        for (offset, t, target, negated) in outputs {
-            let mark = self.next;
-            let to = self.dst(target);
-            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
-            self.next = mark;
-        }
+    /// The tagged pointer to an element of an array at a fixed place at an index known at
+    /// run time (`a[i]`, `a[i].field`), into a register; `None` for any other place.
+    fn element_place(&mut self, a: &Addr) -> Option<R> {
+        let (e, index) = index_place(a)?;
+        let mark = self.next;
+        let i = self.expr(index);
+        self.next = mark;
+        let r = self.reg();
+        self.codes.elems.push(e);
+        let k = (self.codes.elems.len() - 1) as u32;
+        self.ops.push(Op::Elem(r, i, k));
+        Some(r)
     }
 
     fn place(&mut self, a: &Addr) -> u32 {
@@ -439,6 +426,9 @@ impl<'c> Builder<'c> {
         if let Some(r) = self.pointer_place(a, true) {
             return Dst::At(r);
         }
+        if let Some(r) = self.element_place(a) {
+            return Dst::At(r);
+        }
         let r = self.reg();
         let k = self.place(a);
         self.ops.push(Op::Addr(r, k));
@@ -459,7 +449,11 @@ impl<'c> Builder<'c> {
 
     /// `e`'s value read where the tagged pointer to `a` points, or the tree's.
     fn load_behind(&mut self, e: &Ex, a: &Addr, t: Elem) -> Src {
-        match self.pointer_place(a, true) {
+        let place = match self.pointer_place(a, true) {
+            Some(p) => Some(p),
+            None => self.element_place(a),
+        };
+        match place {
             Some(p) => {
                 self.next = p;
                 let r = self.reg();

@@ -95,6 +95,12 @@ pub(crate) enum Op {
     Jump(u32),
     /// Goes on at the operation when the value is 0 (FALSE).
     JumpIfNot(Src, u32),
+    /// Goes on at the operation unless the comparison of the two values of the type holds
+    /// (an IF's or a loop's `a < b`: [`Op::Bin`] and [`Op::JumpIfNot`] in one).
+    JumpCmp(BinOp, Elem, Src, Src, u32),
+    /// A CASE of constant labels close together: goes on at the operation the table
+    /// ([`Codes::switches`], its index) gives for the value, or at the next one.
+    Switch(Src, u32),
     /// Goes on at the operation when the value lies in the range (a CASE arm).
     JumpIn(Src, i64, i64, u32),
     /// A FOR's test: control variable (its offset in own memory, from the instance's base
@@ -106,8 +112,13 @@ pub(crate) enum Op {
     /// (first), or past the loop when the value overflows (second).
     ForNext((u32, bool), Elem, [R; 3], u32, u32),
     /// `d :=` the offset of a block instance in the program's memory (from the instance's
-    /// base when relative).
-    Inst(R, u32, bool),
+    /// base when relative), with the host's slot of a library block's instance at a fixed
+    /// absolute place in the high half ([`slotted`]; 0: none).
+    Inst(R, u32, bool, u32),
+    /// `d :=` an element of an array at a fixed place, at the index the operand holds: its
+    /// tagged pointer, or its instance offset (and host slot) for a block's instance. Its
+    /// index among [`Codes::elems`].
+    Elem(R, Src, u32),
     /// As [`Op::Inst`] for an instance the tree finds (index among [`Codes::places`]).
     InstTree(R, u32),
     /// Stores an input: the instance's register, the input's offset in it, type, value.
@@ -145,6 +156,41 @@ pub(crate) struct CallOp {
     pub(crate) slot: Option<u32>,
 }
 
+/// A CASE's jump table ([`Op::Switch`]): for values from `lo` on, where each goes
+/// ([`NEXT`]: the operation after the switch, the ELSE's).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Switch {
+    pub(crate) lo: i64,
+    pub(crate) to: Vec<u32>,
+}
+
+/// A [`Switch`] entry: the operation after the switch.
+pub(crate) const NEXT: u32 = u32::MAX;
+
+/// An element of an array at a fixed place, at an index known at run time ([`Op::Elem`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ElemOp {
+    /// The array's offset (from the instance's base when relative).
+    pub(crate) at: u32,
+    pub(crate) relative: bool,
+    /// The lower bound, how many elements, and the bytes per element.
+    pub(crate) lo: i64,
+    pub(crate) len: u32,
+    pub(crate) stride: u32,
+    /// Bytes past the element's start (a field of it).
+    pub(crate) plus: u32,
+    /// The element is a block instance the call runs: its offset, not a pointer, and
+    /// the host slot of the array's first element plus one when the elements are a
+    /// library block's instances in consecutive slots (0: none).
+    pub(crate) instance: Option<u32>,
+}
+
+/// An instance's offset with its host slot plus one (0: none) in the high half: what an
+/// instance register holds (its offset is the low half, as `as u32` reads it).
+pub(crate) fn slotted(at: u32, slot1: u32) -> i64 {
+    i64::from(at) | (i64::from(slot1) << 32)
+}
+
 /// A POU body's operations and how many registers they use.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Code {
@@ -171,6 +217,12 @@ pub(crate) struct Codes {
     pub(crate) call_ops: Vec<CallOp>,
     /// Their inputs: offset in the instance, type, value.
     pub(crate) inputs: Vec<(u32, Elem, Src)>,
+    /// Elements at indices known at run time.
+    pub(crate) elems: Vec<ElemOp>,
+    /// CASE jump tables.
+    pub(crate) switches: Vec<Switch>,
+    /// Per POU: the bytes of an instance (a function block's).
+    pub(crate) sizes: Vec<u32>,
     /// Registers of the deepest chain of calls.
     pub(crate) registers: usize,
 }
@@ -182,7 +234,10 @@ impl Codes {
     /// Compiles every body of `c` but those of `library` POUs; nothing (every body on the
     /// tree) when the registers would exceed [`MAX_REGISTERS`].
     pub(crate) fn of(c: &Compiled, library: &Library) -> Codes {
-        let mut codes = Codes::default();
+        let mut codes = Codes {
+            sizes: c.layout.pous.iter().map(|p| p.0).collect(),
+            ..Codes::default()
+        };
         for (pou, (_, body)) in c.bodies.iter().enumerate() {
             let host = library.of_pou.get(pou).copied().flatten().is_some();
             let code = (!host)

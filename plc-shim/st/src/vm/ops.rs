@@ -99,7 +99,7 @@ fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
 }
 
 #[inline]
-fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
+pub(crate) fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
     let ord = if is_float(t) {
         x.float().partial_cmp(&y.float())
     } else if unsigned(t) {

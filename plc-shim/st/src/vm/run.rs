@@ -2,7 +2,7 @@
 //! operation reading its operands (registers of the body's window, constants, variables),
 //! the rules of values, places and faults those of the tree walker.
 
-use super::code::{CallOp, Code, Dst, Op, Src};
+use super::code::{slotted, CallOp, Code, Dst, ElemOp, Op, Src, NEXT};
 use super::{ops, pointed, tagged, Exec, Fault, Flow, Loc, Run, IMAGE_TAG, V};
 use crate::types::Elem;
 
@@ -114,6 +114,21 @@ impl<'a> Exec<'a> {
                         pc = to as usize;
                     }
                 }
+                Op::JumpCmp(op, t, a, b, to) => {
+                    let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
+                    if !ops::compare(op, t, x, y) {
+                        pc = to as usize;
+                    }
+                }
+                Op::Switch(s, k) => {
+                    let table = &codes.switches[k as usize];
+                    let i = self.src(s, base, w)?.int().checked_sub(table.lo);
+                    let i = i.and_then(|i| usize::try_from(i).ok());
+                    let to = i.and_then(|i| table.to.get(i));
+                    if let Some(&to) = to.filter(|t| **t != NEXT) {
+                        pc = to as usize;
+                    }
+                }
                 Op::JumpIn(s, lo, hi, to) => {
                     if (lo..=hi).contains(&self.src(s, base, w)?.int()) {
                         pc = to as usize;
@@ -140,9 +155,14 @@ impl<'a> Exec<'a> {
                         None => pc = end as usize,
                     }
                 }
-                Op::Inst(d, at, relative) => {
+                Op::Inst(d, at, relative, slot1) => {
                     let at = if relative { base + at } else { at };
-                    self.put(w, d, V::I(i64::from(at)));
+                    self.put(w, d, V::I(slotted(at, slot1)));
+                }
+                Op::Elem(d, i, k) => {
+                    let i = self.src(i, base, w)?.int();
+                    let v = self.element(&codes.elems[k as usize], i, base)?;
+                    self.put(w, d, v);
                 }
                 Op::InstTree(d, k) => {
                     let a = &codes.places[k as usize];
@@ -156,8 +176,15 @@ impl<'a> Exec<'a> {
                 }
                 Op::Body(pou, inst, call) => {
                     self.passing = &codes.calls[call as usize];
-                    let at = self.instance(inst, w);
-                    self.nested(top, |x| x.run_body(pou as usize, at))?;
+                    // The instance's offset, and its host slot plus one when found at load.
+                    let v = self.get(w, inst).int();
+                    let (at, slot1) = (v as u32, (v >> 32) as u32);
+                    match self.library.of_pou[pou as usize] {
+                        Some(block) if slot1 > 0 => {
+                            self.call_host_at(block, at, slot1 as usize - 1)?
+                        }
+                        _ => self.nested(top, |x| x.run_body(pou as usize, at))?,
+                    }
                 }
                 Op::StdBody(fb, inst, call) => {
                     self.passing = &codes.calls[call as usize];
@@ -225,6 +252,23 @@ impl<'a> Exec<'a> {
         }
         self.st.at = codes.sites[c.site as usize];
         Ok(())
+    }
+
+    /// Element `e` at index `i`: its tagged pointer, or its instance's offset (and host
+    /// slot); an index beyond the bounds is the tree's fault, with the same numbers.
+    fn element(&mut self, e: &ElemOp, i: i64, base: u32) -> Run<V> {
+        let hi = e.lo + i64::from(e.len) - 1;
+        if i < e.lo || i > hi {
+            return Err(self.fault_with(Fault::IndexOutOfRange, [i, e.lo, hi]));
+        }
+        let k = (i - e.lo) as usize;
+        let start = if e.relative { base + e.at } else { e.at } as usize;
+        let at = start + k * e.stride as usize + e.plus as usize;
+        match e.instance {
+            None => access_tag(Loc::Own(at)),
+            Some(0) => Ok(V::I(at as i64)),
+            Some(first) => Ok(V::I(slotted(at as u32, first + k as u32))),
+        }
     }
 
     /// `f` with the register window above this body's (from `top` on).
