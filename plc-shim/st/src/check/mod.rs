@@ -10,6 +10,7 @@ use crate::diag::{Diagnostic, Pos};
 use crate::types::Elem;
 use std::collections::HashMap;
 
+mod consts;
 mod expr;
 mod init;
 mod lower;
@@ -118,7 +119,10 @@ pub fn check(files: &[(String, Unit)]) -> Result<Checked, Vec<Diagnostic>> {
 }
 
 fn checker(files: &[(String, Unit)]) -> Result<Checker, Vec<Diagnostic>> {
-    let mut c = Checker::default();
+    let mut c = Checker {
+        consts: consts::Consts::of(files),
+        ..Checker::default()
+    };
     c.collect(files);
     c.resolve_types(files);
     c.resolve_vars(files);
@@ -196,6 +200,8 @@ struct Checker {
     calls_from: usize,
     /// Calls seen so far: (caller, callee) POU indices.
     call_graph: Vec<(usize, usize)>,
+    /// The named integer constants (array bounds, STRING lengths).
+    consts: consts::Consts,
 }
 
 impl Checker {
@@ -483,6 +489,13 @@ impl Checker {
         else {
             return;
         };
+        // Its own constants first in its array bounds and STRING lengths.
+        self.consts.scope = Some(p.name.text.to_ascii_uppercase());
+        self.pou_vars_in_scope(p, index);
+        self.consts.scope = None;
+    }
+
+    fn pou_vars_in_scope(&mut self, p: &Pou, index: usize) {
         let returns = p.returns.as_ref().map(|r| self.type_of(r, 0));
         let mut vars: Vec<Var> = Vec::new();
         for block in &p.vars {
@@ -513,13 +526,14 @@ impl Checker {
         self.out.pous[index].vars = vars;
     }
 
-    /// The value of a constant integer expression (literals and `+ - * / MOD` of them), or a
-    /// refusal.
+    /// The value of a constant integer expression (literals, named integer constants and
+    /// `+ - * / MOD` of them), or a refusal.
     fn const_int(&mut self, e: &crate::ast::Expr) -> Option<i128> {
         use crate::ast::{BinOp, Expr, UnOp};
         let value = match e {
             Expr::Int(v, _) => Some(*v),
             Expr::Typed { value, .. } => return self.const_int(value),
+            Expr::Name(n) => return self.named_const(n),
             Expr::Unary(UnOp::Neg, inner, _) => self.const_int(inner)?.checked_neg(),
             Expr::Binary(op, l, r, pos) => {
                 let (a, b) = (self.const_int(l)?, self.const_int(r)?);
@@ -545,7 +559,8 @@ impl Checker {
         if value.is_none() {
             self.refuse(
                 e.pos(),
-                "an integer constant is wanted here (a literal or arithmetic of literals)",
+                "an integer constant is wanted here (literals, named integer constants and \
+                 their arithmetic)",
             );
         }
         value

@@ -1,0 +1,127 @@
+//! Named integer constants in array bounds and STRING lengths, as TwinCAT and CODESYS take
+//! them: a global list's and the POU's own, their arithmetic and chains; and the refusals of
+//! what is no such constant, each with its place.
+
+use plc_st::vm::Program;
+
+fn load(files: &[(&str, &str)]) -> Result<Program, Vec<String>> {
+    Program::load(files).map_err(|e| e.iter().map(|d| d.to_string()).collect())
+}
+
+const GLOBALS: &str = "
+VAR_GLOBAL CONSTANT
+    N_AXES : INT := 4;
+    LAST : INT := N_AXES - 1;
+    MSG_LEN : INT := 20;
+END_VAR
+";
+
+#[test]
+fn bounds_and_string_lengths_take_named_constants() {
+    let main = "
+TYPE ST_Station : STRUCT
+    aTarget : ARRAY[1..N_AXES] OF LREAL;   (* a type's bounds: the global list's *)
+END_STRUCT END_TYPE
+PROGRAM MAIN
+VAR CONSTANT
+    ROWS : INT := LAST + 2;   (* the POU's own, from a global's *)
+END_VAR
+VAR
+    aPos : ARRAY[0..LAST] OF LREAL;
+    aGrid : ARRAY[1..ROWS, 0..N_AXES - 1] OF INT;
+    sMsg : STRING(MSG_LEN);
+    k, nGrid : INT;
+    stStation : ST_Station;
+    n : UDINT;
+    fLast : LREAL;
+END_VAR
+    FOR k := 0 TO LAST DO
+        aPos[k] := INT_TO_LREAL(k) * 1.5;
+    END_FOR
+    aGrid[ROWS, LAST] := 7;
+    fLast := aPos[LAST];
+    nGrid := aGrid[5, 3];
+    n := SIZEOF(aGrid) + SIZEOF(sMsg) + SIZEOF(stStation);
+END_PROGRAM
+";
+    let mut p = load(&[("globals.st", GLOBALS), ("main.st", main)]).unwrap_or_else(|e| {
+        panic!("{e:#?}");
+    });
+    p.cycle(0).unwrap();
+    assert_eq!(p.read_var("MAIN.fLast"), Some(4.5));
+    assert_eq!(p.read_var("MAIN.nGrid"), Some(7.0));
+    // 5 rows of 4 INTs, 20 characters with their NUL, 4 LREALs.
+    assert_eq!(p.read_var("MAIN.n"), Some(40.0 + 21.0 + 32.0));
+}
+
+#[test]
+fn a_pous_own_constant_hides_a_global_one_of_its_name() {
+    let main = "
+PROGRAM MAIN
+VAR CONSTANT
+    LAST : INT := 1;
+END_VAR
+VAR
+    a : ARRAY[0..LAST] OF INT;
+    n : UDINT;
+END_VAR
+    n := SIZEOF(a);
+END_PROGRAM
+PROGRAM OTHER
+VAR
+    b : ARRAY[0..LAST] OF INT;
+    n : UDINT;
+END_VAR
+    n := SIZEOF(b);
+END_PROGRAM
+";
+    let mut p = load(&[("globals.st", GLOBALS), ("main.st", main)]).unwrap();
+    p.cycle(0).unwrap();
+    assert_eq!(p.read_var("MAIN.n"), Some(4.0), "MAIN's own LAST: two INTs");
+    assert_eq!(p.read_var("OTHER.n"), Some(8.0), "the global LAST: four");
+}
+
+#[test]
+fn what_is_no_named_integer_constant_is_refused_with_its_place() {
+    let main = "
+VAR_GLOBAL
+    nVar : INT := 3;
+END_VAR
+VAR_GLOBAL CONSTANT
+    F : LREAL := 2.0;
+    A : INT := B + 1;
+    B : INT := A;
+    NONE : INT;
+END_VAR
+PROGRAM MAIN
+VAR
+    a1 : ARRAY[0..nVar] OF INT;
+    a2 : ARRAY[0..F] OF INT;
+    a3 : ARRAY[0..A] OF INT;
+    a4 : ARRAY[0..NONE] OF INT;
+    a5 : ARRAY[0..NOWHERE] OF INT;
+END_VAR
+END_PROGRAM
+";
+    let Err(e) = load(&[("main.st", main)]) else {
+        panic!("refused");
+    };
+    let has = |what: &str| e.iter().any(|d| d.contains(what));
+    assert!(
+        has("main.st:13:19: error: `nVar` is no named integer constant"),
+        "{e:#?}"
+    );
+    assert!(
+        has("main.st:14:19: error: constant `F` is of no integer type"),
+        "{e:#?}"
+    );
+    assert!(has("error: constant `A` is defined by itself"), "{e:#?}");
+    assert!(
+        has("main.st:16:19: error: constant `NONE` has no initial value"),
+        "{e:#?}"
+    );
+    assert!(
+        has("main.st:17:19: error: `NOWHERE` is no named integer constant"),
+        "{e:#?}"
+    );
+}
