@@ -86,7 +86,9 @@ impl<'c> Builder<'c> {
         match &mut self.ops[at] {
             Op::Jump(t)
             | Op::JumpIfNot(_, t)
+            | Op::JumpIf(_, t)
             | Op::JumpCmp(.., t)
+            | Op::JumpCmpI(.., t)
             | Op::JumpIn(_, _, _, t)
             | Op::ForTest(.., t) => *t = to,
             Op::ForNext(.., t) => *t = to,
@@ -263,14 +265,29 @@ impl<'c> Builder<'c> {
     /// Goes on at `to` unless `c` holds: a comparison just computed into `c`'s register is
     /// taken into the jump. The jump's index (to patch).
     fn jump_unless(&mut self, c: Src, to: u32) -> usize {
-        if let (Src::R(r), Some(&Op::Bin(op, t, d, a, b))) = (c, self.ops.last()) {
+        if let (Src::R(r), Some(&Op::Not(Elem::Bool, d, a))) = (c, self.ops.last()) {
+            if d == r {
+                *self.ops.last_mut().expect("the negation") = Op::JumpIf(a, to);
+                return self.ops.len() - 1;
+            }
+        }
+        let last = match self.ops.last() {
+            Some(&Op::Bin(op, t, d, a, b)) => Some((op, t, d, a, b, false)),
+            Some(&Op::BinI(op, t, d, a, b)) => Some((op, t, d, a, b, true)),
+            _ => None,
+        };
+        if let (Src::R(r), Some((op, t, d, a, b, int))) = (c, last) {
             let compares = matches!(
                 op,
                 BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge
             );
             // The register is the condition's alone (read by nothing after the jump).
             if compares && d == r {
-                *self.ops.last_mut().expect("the comparison") = Op::JumpCmp(op, t, a, b, to);
+                *self.ops.last_mut().expect("the comparison") = if int {
+                    Op::JumpCmpI(op, t, a, b, to)
+                } else {
+                    Op::JumpCmp(op, t, a, b, to)
+                };
                 return self.ops.len() - 1;
             }
         }
@@ -523,7 +540,11 @@ impl<'c> Builder<'c> {
                 let (x, y) = (self.expr(a), self.expr(b));
                 self.next = mark;
                 let r = self.reg();
-                self.ops.push(Op::Bin(*op, *t, r, x, y));
+                self.ops.push(if t.class() == crate::types::Class::Float {
+                    Op::Bin(*op, *t, r, x, y)
+                } else {
+                    Op::BinI(*op, *t, r, x, y)
+                });
                 Src::R(r)
             }
             _ => self.tree(e),

@@ -63,6 +63,8 @@ pub(crate) enum Op {
     At(u32),
     /// `d := a op b` of type `t`.
     Bin(BinOp, Elem, R, Src, Src),
+    /// As [`Op::Bin`] for a type that is no real: integer operands, an integer result.
+    BinI(BinOp, Elem, R, Src, Src),
     /// `d := -a`.
     Neg(Elem, R, Src),
     /// `d := NOT a`.
@@ -93,11 +95,16 @@ pub(crate) enum Op {
     TreeSt(u32, u32, u32),
     /// Goes on at the operation.
     Jump(u32),
+    /// Goes on at the operation when the value is not 0 (`IF NOT x`: [`Op::Not`] and
+    /// [`Op::JumpIfNot`] in one).
+    JumpIf(Src, u32),
     /// Goes on at the operation when the value is 0 (FALSE).
     JumpIfNot(Src, u32),
     /// Goes on at the operation unless the comparison of the two values of the type holds
     /// (an IF's or a loop's `a < b`: [`Op::Bin`] and [`Op::JumpIfNot`] in one).
     JumpCmp(BinOp, Elem, Src, Src, u32),
+    /// As [`Op::JumpCmp`] for a type that is no real.
+    JumpCmpI(BinOp, Elem, Src, Src, u32),
     /// A CASE of constant labels close together: goes on at the operation the table
     /// ([`Codes::switches`], its index) gives for the value, or at the next one.
     Switch(Src, u32),

@@ -79,6 +79,35 @@ pub(crate) fn binary(op: BinOp, t: Elem, x: V, y: V) -> Run<V> {
     }
 }
 
+/// [`binary`] of two integers of type `t` (no real): the integer result.
+#[inline(always)]
+pub(crate) fn binary_int(op: BinOp, t: Elem, a: i64, b: i64) -> Run<i64> {
+    match op {
+        BinOp::Eq | BinOp::Ne | BinOp::Lt | BinOp::Gt | BinOp::Le | BinOp::Ge => {
+            Ok(i64::from(compare_int(op, t, a, b)))
+        }
+        _ => integer(op, t, a, b).map(V::int),
+    }
+}
+
+/// [`compare`] of two integers of type `t` (no real).
+#[inline(always)]
+pub(crate) fn compare_int(op: BinOp, t: Elem, a: i64, b: i64) -> bool {
+    let ord = if unsigned(t) {
+        (a as u64).cmp(&(b as u64))
+    } else {
+        a.cmp(&b)
+    };
+    match op {
+        BinOp::Eq => ord.is_eq(),
+        BinOp::Ne => ord.is_ne(),
+        BinOp::Lt => ord.is_lt(),
+        BinOp::Gt => ord.is_gt(),
+        BinOp::Le => ord.is_le(),
+        _ => ord.is_ge(),
+    }
+}
+
 #[inline]
 fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
     let v = match op {

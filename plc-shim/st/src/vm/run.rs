@@ -42,12 +42,17 @@ impl<'a> Exec<'a> {
                     let v = ops::binary(op, t, x, y)?;
                     self.put(w, d, v);
                 }
+                Op::BinI(op, t, d, a, b) => {
+                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                    let v = ops::binary_int(op, t, x, y)?;
+                    self.put(w, d, V::I(v));
+                }
                 Op::Neg(t, d, a) => {
                     let v = ops::neg(self.src(a, base, w)?, t);
                     self.put(w, d, v);
                 }
                 Op::Not(t, d, a) => {
-                    let v = ops::not(self.src(a, base, w)?, t);
+                    let v = ops::not(V::I(self.src_int(a, base, w)?), t);
                     self.put(w, d, v);
                 }
                 Op::Conv(from, to, d, a) => {
@@ -64,7 +69,7 @@ impl<'a> Exec<'a> {
                     self.put(w, d, v);
                 }
                 Op::PtrAt(d, p, plus, access) => {
-                    let at = pointed(self.src(p, base, w)?.int())?.plus(plus as usize);
+                    let at = pointed(self.src_int(p, base, w)?)?.plus(plus as usize);
                     let v = if access {
                         access_tag(at)?
                     } else {
@@ -73,7 +78,7 @@ impl<'a> Exec<'a> {
                     self.put(w, d, v);
                 }
                 Op::LoadAt(d, r, t) => {
-                    let at = pointed(self.get(w, r).int())?;
+                    let at = pointed(self.get_int(w, r))?;
                     let v = self.read(at, t)?;
                     self.put(w, d, v);
                 }
@@ -109,8 +114,13 @@ impl<'a> Exec<'a> {
                     pc = to as usize;
                 }
                 Op::Jump(to) => pc = to as usize,
+                Op::JumpIf(c, to) => {
+                    if self.src_int(c, base, w)? != 0 {
+                        pc = to as usize;
+                    }
+                }
                 Op::JumpIfNot(c, to) => {
-                    if self.src(c, base, w)?.int() == 0 {
+                    if self.src_int(c, base, w)? == 0 {
                         pc = to as usize;
                     }
                 }
@@ -120,9 +130,15 @@ impl<'a> Exec<'a> {
                         pc = to as usize;
                     }
                 }
+                Op::JumpCmpI(op, t, a, b, to) => {
+                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                    if !ops::compare_int(op, t, x, y) {
+                        pc = to as usize;
+                    }
+                }
                 Op::Switch(s, k) => {
                     let table = &codes.switches[k as usize];
-                    let i = self.src(s, base, w)?.int().checked_sub(table.lo);
+                    let i = self.src_int(s, base, w)?.checked_sub(table.lo);
                     let i = i.and_then(|i| usize::try_from(i).ok());
                     let to = i.and_then(|i| table.to.get(i));
                     if let Some(&to) = to.filter(|t| **t != NEXT) {
@@ -130,12 +146,12 @@ impl<'a> Exec<'a> {
                     }
                 }
                 Op::JumpIn(s, lo, hi, to) => {
-                    if (lo..=hi).contains(&self.src(s, base, w)?.int()) {
+                    if (lo..=hi).contains(&self.src_int(s, base, w)?) {
                         pc = to as usize;
                     }
                 }
                 Op::ForTest((at, relative), ty, [i, last, step], end) => {
-                    let reg = |r: u16| self.get(w, r).int();
+                    let reg = |r: u16| self.get_int(w, r);
                     let (i, last, step) = (reg(i), reg(last), reg(step));
                     if (step >= 0 && i > last) || (step < 0 && i < last) {
                         pc = end as usize;
@@ -146,7 +162,7 @@ impl<'a> Exec<'a> {
                 }
                 Op::ForNext((at, relative), ty, [i, _, step], test, end) => {
                     let now = self.src(Src::Var(at, relative, ty), base, w)?.int();
-                    let step = self.get(w, step).int();
+                    let step = self.get_int(w, step);
                     match now.checked_add(step) {
                         Some(next) => {
                             self.put(w, i, V::I(next));
@@ -177,7 +193,7 @@ impl<'a> Exec<'a> {
                 Op::Body(pou, inst, call) => {
                     self.passing = &codes.calls[call as usize];
                     // The instance's offset, and its host slot plus one when found at load.
-                    let v = self.get(w, inst).int();
+                    let v = self.get_int(w, inst);
                     let (at, slot1) = (v as u32, (v >> 32) as u32);
                     match self.library.of_pou[pou as usize] {
                         Some(block) if slot1 > 0 => {
@@ -217,6 +233,16 @@ impl<'a> Exec<'a> {
         } else {
             V::I(bits as i64)
         }
+    }
+
+    /// Register `r` of the window at `w` where an integer is wanted (a condition, a
+    /// selector, a pointer, an instance, an integer operation's operand): the type
+    /// checker never gives a real there.
+    #[inline(always)]
+    fn get_int(&self, w: usize, r: u16) -> i64 {
+        let i = w + usize::from(r);
+        debug_assert!(!self.st.reals[i], "a real where an integer is wanted");
+        self.st.regs[i] as i64
     }
 
     #[inline(always)]
@@ -283,7 +309,21 @@ impl<'a> Exec<'a> {
     /// The instance offset register `r` holds.
     #[inline]
     fn instance(&self, r: u16, w: usize) -> u32 {
-        self.get(w, r).int() as u32
+        self.get_int(w, r) as u32
+    }
+
+    /// Operand `s` where an integer is wanted ([`Exec::get_int`]).
+    #[inline(always)]
+    fn src_int(&self, s: Src, base: u32, w: usize) -> Run<i64> {
+        match s {
+            Src::R(r) => Ok(self.get_int(w, r)),
+            Src::I(v) => Ok(v),
+            Src::F(v) => Ok(v as i64),
+            Src::Var(at, relative, t) => {
+                let at = if relative { base + at } else { at };
+                self.read_own(at as usize, t).map(V::int)
+            }
+        }
     }
 
     #[inline(always)]
