@@ -107,6 +107,56 @@ END_PROGRAM";
     assert_eq!(p.read_var("MAIN.done"), Some(1.0), "CTU reached 3");
 }
 
+/// IEC 61131-3's MUL and DIV of TIME: a duration by an integer in whole milliseconds, by a
+/// real rounded to them; the number on either side of `*`; the factor's order kept.
+#[test]
+fn durations_scale_by_numbers() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    tBase : TIME := T#1S;
+    n : INT := 3;
+    f : LREAL := 1.25;
+    t1, t2, t3, t4, t5 : TIME;
+    fb : TON;
+END_VAR
+    t1 := tBase * n;
+    t2 := 2 * tBase / 8;
+    t3 := tBase * f;
+    t4 := T#10MS / 3;
+    t5 := f * T#3MS;
+    fb(IN := TRUE, PT := T#10MS * n);
+END_PROGRAM",
+        1,
+    );
+    for (var, ms) in [
+        ("t1", 3000.0),
+        ("t2", 250.0),
+        ("t3", 1250.0),
+        ("t4", 3.0),
+        ("t5", 4.0),
+    ] {
+        assert_eq!(p.read_var(&format!("MAIN.{var}")), Some(ms), "{var}");
+    }
+}
+
+#[test]
+fn a_duration_is_scaled_by_numbers_only() {
+    let e = refused(
+        "PROGRAM MAIN VAR t : TIME; w : WORD; END_VAR
+t := t * t;
+t := 2 / t;
+t := t * w;
+END_PROGRAM",
+    );
+    assert!(e.contains("main.st:2:8: error: `*` of TIME\n"), "{e}");
+    assert!(e.contains("main.st:3:8: error: `/` of"), "{e}");
+    assert!(
+        e.contains("main.st:4:8: error: `*` of TIME and WORD"),
+        "{e}"
+    );
+}
+
 #[test]
 fn a_ton_is_done_when_its_time_has_run() {
     let text = "PROGRAM MAIN VAR t : TON; q : BOOL; et : TIME; END_VAR

@@ -333,6 +333,9 @@ impl Checker {
         if lt == Type::Error || rt == Type::Error {
             return Type::Error;
         }
+        if let Some((d, _, _)) = scaled_duration(op, &lt, &rt) {
+            return Type::Elem(d);
+        }
         // Two STRINGs are equal or not (their characters before the NUL).
         if let (Eq | Ne, Type::Str(_), Type::Str(_)) = (op, &lt, &rt) {
             return BOOL;
@@ -371,6 +374,22 @@ impl Checker {
             Eq | Ne | Lt | Gt | Le | Ge => BOOL,
             _ => Type::Elem(c),
         }
+    }
+}
+
+/// A duration scaled by a number, as IEC 61131-3's MUL and DIV of TIME take it: `TIME * n`,
+/// `n * TIME`, `TIME / n` of an integer or a real `n` (no bit string): the duration's type,
+/// the number's, and whether the duration is the left operand.
+pub(super) fn scaled_duration(op: BinOp, lt: &Type, rt: &Type) -> Option<(Elem, Elem, bool)> {
+    let (Type::Elem(a), Type::Elem(b)) = (lt, rt) else {
+        return None;
+    };
+    let number = |e: &Elem| matches!(e.class(), Class::Signed | Class::Unsigned | Class::Float);
+    let duration = |e: &Elem| e.class() == Class::Duration;
+    match op {
+        BinOp::Mul | BinOp::Div if duration(a) && number(b) => Some((*a, *b, true)),
+        BinOp::Mul if number(a) && duration(b) => Some((*b, *a, false)),
+        _ => None,
     }
 }
 

@@ -335,6 +335,9 @@ impl Checker {
                 _ => equal,
             });
         }
+        if let Some((d, f, left)) = super::expr::scaled_duration(op, &ta, &tb) {
+            return self.scaled_duration_value(op, (a, b), (d, f, left), ctx, l);
+        }
         let t = match (&ta, &tb) {
             (Type::Enum(i), _) | (_, Type::Enum(i)) => self.out.enums[*i].base,
             (Type::Pointer(_), _) => Elem::ULInt,
@@ -345,6 +348,31 @@ impl Checker {
         };
         let (x, y) = (self.value_as(a, t, ctx, l)?, self.value_as(b, t, ctx, l)?);
         Ok(Ex::Bin(op, t, Box::new(x), Box::new(y)))
+    }
+
+    /// `TIME * n`, `n * TIME`, `TIME / n`: by an integer, in the duration's own integer
+    /// arithmetic (wrapping to its width as the PLC's integers do; a division by zero
+    /// faults); by a real, in LREAL and rounded back as LREAL_TO_TIME does. The operands in
+    /// their written order.
+    fn scaled_duration_value(
+        &mut self,
+        op: BinOp,
+        (a, b): (&Expr, &Expr),
+        (d, f, _): (Elem, Elem, bool),
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Ex> {
+        // Both to LREAL by a real; an integer to the duration's type.
+        let real = f.class() == Class::Float;
+        let t = if real { Elem::LReal } else { d };
+        let x = self.value_as(a, t, ctx, l)?;
+        let y = self.value_as(b, t, ctx, l)?;
+        Ok(if real {
+            let product = Ex::Bin(op, Elem::LReal, Box::new(x), Box::new(y));
+            Ex::Conv(Elem::LReal, d, Box::new(product))
+        } else {
+            Ex::Bin(op, d, Box::new(x), Box::new(y))
+        })
     }
 
     fn call_value_ir(&mut self, callee: &Expr, args: &[Arg], ctx: Ctx, l: &Layout) -> R<Ex> {
