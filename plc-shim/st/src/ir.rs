@@ -91,6 +91,9 @@ pub enum Ex {
         value: Box<Addr>,
         /// The value's type.
         ty: Elem,
+        /// Its VAR_IN_OUTs' leaves copied back after the call: offset in its frame, type,
+        /// the caller's place.
+        back: Vec<(u32, Elem, Addr)>,
     },
 }
 

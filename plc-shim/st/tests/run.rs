@@ -157,6 +157,65 @@ END_PROGRAM",
     );
 }
 
+/// A function's VAR_IN_OUT: the caller's variable copied in before the call and back after
+/// it (an array, an elementary value), named or by position among the inputs.
+#[test]
+fn a_functions_var_in_out_writes_the_callers_variable() {
+    let text = "
+FUNCTION F_SumClear : LREAL
+VAR_IN_OUT a : ARRAY[0..3] OF LREAL; END_VAR
+VAR_INPUT scale : LREAL; END_VAR
+VAR k : INT; END_VAR
+    FOR k := 0 TO 3 DO
+        F_SumClear := F_SumClear + a[k] * scale;
+        a[k] := 0.0;
+    END_FOR
+END_FUNCTION
+FUNCTION F_Bump : BOOL
+VAR_IN_OUT n : DINT; END_VAR
+    n := n + 1;
+    F_Bump := n > 2;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    x : ARRAY[0..3] OF LREAL := [1.0, 2.0, 3.0, 4.0];
+    s, x3 : LREAL;
+    c : DINT;
+    b : BOOL;
+END_VAR
+    s := s + F_SumClear(a := x, scale := 2.0);
+    x3 := x[3];
+    b := F_Bump(c);
+END_PROGRAM";
+    let p = run(text, 1);
+    assert_eq!(p.read_var("MAIN.s"), Some(20.0));
+    assert_eq!(
+        p.read_var("MAIN.x3"),
+        Some(0.0),
+        "cleared through the VAR_IN_OUT"
+    );
+    assert_eq!(p.read_var("MAIN.c"), Some(1.0));
+    assert_eq!(p.read_var("MAIN.b"), Some(0.0));
+    let p = run(text, 3);
+    assert_eq!(p.read_var("MAIN.s"), Some(20.0), "nothing left to sum");
+    assert_eq!(
+        (p.read_var("MAIN.c"), p.read_var("MAIN.b")),
+        (Some(3.0), Some(1.0))
+    );
+    let e = refused(
+        "FUNCTION F : BOOL VAR_IN_OUT n : DINT; END_VAR F := n > 0; END_FUNCTION
+PROGRAM MAIN VAR r : LREAL; b : BOOL; END_VAR
+b := F(n := r);
+b := F(5);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:13: error: a LREAL for a VAR_IN_OUT of DINT"),
+        "{e}"
+    );
+    assert!(e.contains("main.st:4:8: error:"), "{e}");
+}
+
 #[test]
 fn a_ton_is_done_when_its_time_has_run() {
     let text = "PROGRAM MAIN VAR t : TON; q : BOOL; et : TIME; END_VAR
@@ -344,7 +403,7 @@ fn what_the_runtime_cannot_hold_is_refused_at_load_with_its_place() {
          PROGRAM MAIN VAR a, m : INT; END_VAR\n  m := G();\nEND_PROGRAM",
     );
     assert!(
-        e.contains("main.st:3:8: error: a call of a function with VAR_IN_OUT"),
+        e.contains("main.st:3:8: error: G: its VAR_IN_OUT `x` must be given"),
         "{e}"
     );
     let e = refused(

@@ -438,53 +438,6 @@ impl Checker {
         })
     }
 
-    fn function_value(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx, l: &Layout) -> R<Ex> {
-        let vars = &self.out.pous[i].vars;
-        if vars.iter().any(|v| v.section == crate::ast::Section::InOut) {
-            return Err(self.unsupported(pos, "a call of a function with VAR_IN_OUT"));
-        }
-        if args.len() > crate::ir::MAX_CALL_INPUTS {
-            return Err(self.unsupported(pos, "a call with more than 32 values"));
-        }
-        let inputs: Vec<usize> = (0..vars.len())
-            .filter(|k| vars[*k].section == crate::ast::Section::Input)
-            .collect();
-        let mut stores = Vec::new();
-        for (k, arg) in args.iter().enumerate() {
-            let (var, value) = match arg {
-                Arg::Positional(v) => (inputs.get(k).copied(), v),
-                Arg::Input(n, v) => {
-                    let found = inputs
-                        .iter()
-                        .copied()
-                        .find(|x| self.out.pous[i].vars[*x].name.eq_ignore_ascii_case(&n.text));
-                    (found, v)
-                }
-                Arg::Output { name, .. } => {
-                    return Err(self.unsupported(name.pos, "an output of a function"))
-                }
-            };
-            let Some(var) = var else {
-                return Err(self.unsupported(value.pos(), "this argument"));
-            };
-            let Type::Elem(t) = self.out.pous[i].vars[var].ty.clone() else {
-                return Err(self.unsupported(value.pos(), "an input that is no elementary value"));
-            };
-            let v = self.value_as(value, t, ctx, l)?;
-            stores.push((l.pous[i].2[var], t, v));
-        }
-        let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
-            return Err(self.unsupported(pos, "a function whose value is no elementary value"));
-        };
-        let value = Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0));
-        Ok(Ex::Call {
-            pou: i,
-            inputs: stores,
-            value: Box::new(value),
-            ty,
-        })
-    }
-
     /// `target := value` as a store or a copy.
     pub(super) fn lower_assign(
         &mut self,

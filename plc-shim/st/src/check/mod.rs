@@ -12,6 +12,7 @@ use std::collections::HashMap;
 
 mod consts;
 mod expr;
+mod function;
 mod init;
 mod lower;
 mod place;

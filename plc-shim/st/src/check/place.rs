@@ -98,8 +98,9 @@ impl Checker {
         Ok(StKind::Store(addr, t, word))
     }
 
-    /// The elementary leaves of a structure (offset, type), `None` beyond 64 of them or for
-    /// anything but elementary, pointer and enumeration fields and structures of them.
+    /// The elementary leaves of a structure or an array (offset, type), `None` beyond 64 of
+    /// them or for anything but elementary, pointer and enumeration values and structures
+    /// and arrays of them.
     pub(super) fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
         let mut out = Vec::new();
         self.leaves_into(ty, 0, l, &mut out)?;
@@ -122,6 +123,17 @@ impl Checker {
             Type::Struct(i) => {
                 for (k, (_, field)) in self.out.structs[*i].fields.iter().enumerate() {
                     self.leaves_into(field, at + l.structs[*i].2[k], l, out)?;
+                }
+            }
+            Type::Array(dims, element) => {
+                let (size, align) = l.size_align(&self.out, element);
+                let stride = size.div_ceil(align.max(1)) * align.max(1);
+                let count: i64 = dims.iter().map(|(lo, hi)| hi - lo + 1).product();
+                if count > 64 {
+                    return None;
+                }
+                for k in 0..count as u32 {
+                    self.leaves_into(element, at + k * stride, l, out)?;
                 }
             }
             _ => return None,

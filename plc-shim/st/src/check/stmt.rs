@@ -428,11 +428,12 @@ impl Checker {
     /// A user function's call: its inputs by position or name, its value.
     pub(super) fn function_call(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
         self.record_call(i, pos);
-        let inputs: Vec<(String, Type)> = self.out.pous[i]
+        // Its parameters in their order: inputs, and VAR_IN_OUTs (a variable of their type).
+        let inputs: Vec<(String, Type, Section)> = self.out.pous[i]
             .vars
             .iter()
-            .filter(|v| v.section == Section::Input)
-            .map(|v| (v.name.clone(), v.ty.clone()))
+            .filter(|v| matches!(v.section, Section::Input | Section::InOut))
+            .map(|v| (v.name.clone(), v.ty.clone(), v.section))
             .collect();
         let name = self.out.pous[i].name.clone();
         let positional = args
@@ -448,13 +449,16 @@ impl Checker {
         for (k, arg) in args.iter().enumerate() {
             match arg {
                 Arg::Positional(v) => {
-                    if let Some((_, t)) = inputs.get(k) {
-                        self.assignable(v, t, ctx);
+                    if let Some((_, t, section)) = inputs.get(k) {
+                        self.parameter(v, t, *section, ctx);
                     }
                 }
                 Arg::Input(n, v) => {
-                    match inputs.iter().find(|(i, _)| i.eq_ignore_ascii_case(&n.text)) {
-                        Some((_, t)) => self.assignable(v, t, ctx),
+                    match inputs
+                        .iter()
+                        .find(|(i, _, _)| i.eq_ignore_ascii_case(&n.text))
+                    {
+                        Some((_, t, section)) => self.parameter(v, t, *section, ctx),
                         None => self.refuse(n.pos, format!("{name} has no input `{}`", n.text)),
                     }
                 }
@@ -463,7 +467,35 @@ impl Checker {
                 }
             }
         }
+        // A VAR_IN_OUT has no value of its own: every call names the variable.
+        for (k, (param, _, section)) in inputs.iter().enumerate() {
+            let given = args.iter().enumerate().any(|(j, a)| match a {
+                Arg::Positional(_) => j == k,
+                Arg::Input(n, _) => n.text.eq_ignore_ascii_case(param),
+                Arg::Output { .. } => false,
+            });
+            if *section == Section::InOut && !given {
+                self.refuse(
+                    pos,
+                    format!("{name}: its VAR_IN_OUT `{param}` must be given"),
+                );
+            }
+        }
         self.out.pous[i].returns.clone().unwrap_or(Type::Error)
+    }
+
+    /// A function's parameter of type `t`: a value for an input, a variable of its own type
+    /// for a VAR_IN_OUT (copied in before the call and back after it).
+    fn parameter(&mut self, v: &Expr, t: &Type, section: Section, ctx: Ctx) {
+        if section != Section::InOut {
+            return self.assignable(v, t, ctx);
+        }
+        if let Some(place) = self.writable(v, ctx) {
+            if place != *t {
+                let (g, w) = (self.type_name(&place), self.type_name(t));
+                self.refuse(v.pos(), format!("a {g} for a VAR_IN_OUT of {w}"));
+            }
+        }
     }
 
     /// Notes that the POU being checked calls POU `callee` (for the recursion check).

@@ -105,11 +105,16 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
         }
         Ex::Std(_, _, args) => args.iter().for_each(|a| of_ex(a, out)),
         Ex::Call {
-            pou, inputs, value, ..
+            pou,
+            inputs,
+            value,
+            back,
+            ..
         } => {
             out.push(*pou);
             inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
             of_addr(value, out);
+            back.iter().for_each(|(_, _, a)| of_addr(a, out));
         }
         Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
     }

@@ -683,7 +683,8 @@ impl<'a> Exec<'a> {
                 inputs,
                 value,
                 ty,
-            } => self.call_function(*pou, inputs, value, *ty, base)?,
+                back,
+            } => self.call_function(*pou, (inputs, back), value, *ty, base)?,
         })
     }
 
@@ -693,7 +694,7 @@ impl<'a> Exec<'a> {
     fn call_function(
         &mut self,
         pou: usize,
-        inputs: &[BlockInput],
+        (inputs, back): (&[BlockInput], &[(u32, Elem, Addr)]),
         value: &Addr,
         ty: Elem,
         base: u32,
@@ -714,6 +715,12 @@ impl<'a> Exec<'a> {
         }
         self.run_body(pou, frame)?;
         self.st.at = statement;
+        // The VAR_IN_OUTs back into the caller's variables, leaf by leaf.
+        for (offset, t, place) in back {
+            let v = self.read_own((frame + offset) as usize, *t)?;
+            let at = self.addr(place, base)?;
+            self.write(at, *t, v)?;
+        }
         let at = self.addr(value, base)?;
         self.read(at, ty)
     }

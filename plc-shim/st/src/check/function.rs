@@ -1,0 +1,88 @@
+//! A user function's call as a value: its inputs stored into its frame, its VAR_IN_OUTs
+//! copied in before the call and back after it leaf by leaf (as a function block's), its
+//! value read from the frame.
+
+use super::expr::Ctx;
+use super::lower::R;
+use super::place::plus;
+use super::{Checker, Type};
+use crate::ast::Arg;
+use crate::diag::Pos;
+use crate::ir::{Addr, Ex};
+use crate::layout::Layout;
+
+impl Checker {
+    pub(super) fn function_value(
+        &mut self,
+        i: usize,
+        args: &[Arg],
+        pos: Pos,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Ex> {
+        use crate::ast::Section;
+        let vars = &self.out.pous[i].vars;
+        // Its parameters in their order: inputs and VAR_IN_OUTs.
+        let params: Vec<usize> = (0..vars.len())
+            .filter(|k| matches!(vars[*k].section, Section::Input | Section::InOut))
+            .collect();
+        let (mut stores, mut back) = (Vec::new(), Vec::new());
+        for (k, arg) in args.iter().enumerate() {
+            let (var, value) = match arg {
+                Arg::Positional(v) => (params.get(k).copied(), v),
+                Arg::Input(n, v) => {
+                    let found = params
+                        .iter()
+                        .copied()
+                        .find(|x| self.out.pous[i].vars[*x].name.eq_ignore_ascii_case(&n.text));
+                    (found, v)
+                }
+                Arg::Output { name, .. } => {
+                    return Err(self.unsupported(name.pos, "an output of a function"))
+                }
+            };
+            let Some(var) = var else {
+                return Err(self.unsupported(value.pos(), "this argument"));
+            };
+            let (ty, offset) = (self.out.pous[i].vars[var].ty.clone(), l.pous[i].2[var]);
+            if self.out.pous[i].vars[var].section == Section::InOut {
+                // Copied in before the call and back after it, leaf by leaf.
+                let (from, _) = self.place(value, ctx, l)?;
+                let leaves = match &ty {
+                    Type::Elem(t) => vec![(0, *t)],
+                    _ => self.leaves(&ty, l).ok_or_else(|| {
+                        self.unsupported(
+                            value.pos(),
+                            "a VAR_IN_OUT of more than 64 values or of this type",
+                        )
+                    })?,
+                };
+                for (at, t) in leaves {
+                    let leaf = plus(from.clone(), at);
+                    stores.push((offset + at, t, Ex::Load(Box::new(leaf.clone()), t)));
+                    back.push((offset + at, t, leaf));
+                }
+                continue;
+            }
+            let Type::Elem(t) = ty else {
+                return Err(self.unsupported(value.pos(), "an input that is no elementary value"));
+            };
+            let v = self.value_as(value, t, ctx, l)?;
+            stores.push((offset, t, v));
+        }
+        if stores.len() > crate::ir::MAX_CALL_INPUTS {
+            return Err(self.unsupported(pos, "a call with more than 32 values"));
+        }
+        let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
+            return Err(self.unsupported(pos, "a function whose value is no elementary value"));
+        };
+        let value = Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0));
+        Ok(Ex::Call {
+            pou: i,
+            inputs: stores,
+            value: Box::new(value),
+            ty,
+            back,
+        })
+    }
+}
