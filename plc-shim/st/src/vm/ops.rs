@@ -98,6 +98,12 @@ pub(crate) fn compare_int(op: BinOp, t: Elem, a: i64, b: i64) -> bool {
     } else {
         a.cmp(&b)
     };
+    holds(op, ord)
+}
+
+/// Whether comparison `op` holds of two values ordered `ord`.
+#[inline(always)]
+fn holds(op: BinOp, ord: std::cmp::Ordering) -> bool {
     match op {
         BinOp::Eq => ord.is_eq(),
         BinOp::Ne => ord.is_ne(),
@@ -136,16 +142,9 @@ pub(crate) fn compare(op: BinOp, t: Elem, x: V, y: V) -> bool {
     } else {
         Some(x.int().cmp(&y.int()))
     };
-    let Some(ord) = ord else {
-        return op == BinOp::Ne;
-    };
-    match op {
-        BinOp::Eq => ord.is_eq(),
-        BinOp::Ne => ord.is_ne(),
-        BinOp::Lt => ord.is_lt(),
-        BinOp::Gt => ord.is_gt(),
-        BinOp::Le => ord.is_le(),
-        _ => ord.is_ge(),
+    match ord {
+        Some(ord) => holds(op, ord),
+        None => op == BinOp::Ne,
     }
 }
 
