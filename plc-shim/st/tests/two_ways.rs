@@ -164,11 +164,13 @@ impl Gen {
                 self.statements(2)
             ),
             9 => format!(
-                "CASE {} OF\n0: {}1, 2: {}3..5: {}ELSE\n{}END_CASE\n",
+                // A range written high to low holds no value.
+                "CASE {} OF\n0: {}1, 2: {}3..5: {}9..7: {}ELSE\n{}END_CASE\n",
                 self.int_var(),
                 self.statements(2),
                 self.statements(2),
                 self.statements(2),
+                self.statements(1),
                 self.statements(1)
             ),
             10 | 11 => self.for_loop(),

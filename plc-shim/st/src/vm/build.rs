@@ -299,10 +299,12 @@ impl<'c> Builder<'c> {
     /// machine's steps): its index among the switches, the table's entries the arms'
     /// numbers until they are known.
     fn switch(&mut self, v: Src, arms: &[crate::ir::CaseArm]) -> Option<u32> {
+        // A range written high to low holds no value (the tests in order would take none).
         let ranges = || {
             arms.iter()
                 .enumerate()
                 .flat_map(|(k, (r, _))| r.iter().map(move |x| (k, x)))
+                .filter(|(_, (a, b))| a <= b)
         };
         let lo = ranges().map(|(_, (lo, _))| *lo).min()?;
         let hi = ranges().map(|(_, (_, hi))| *hi).max()?;
