@@ -125,3 +125,54 @@ END_PROGRAM
         "{e:#?}"
     );
 }
+
+/// A chain of constants across scopes is no cycle; a VAR_EXTERNAL names the global one; a
+/// variable of the POU's (an input's CONSTANT too, which a caller may give) hides a global
+/// constant of its name.
+#[test]
+fn a_constants_scope_is_where_it_is_declared() {
+    let main = "
+VAR_GLOBAL CONSTANT
+    N : INT := 4;
+    M : INT := N + 1;
+END_VAR
+PROGRAM MAIN
+VAR_EXTERNAL CONSTANT
+    M : INT;
+END_VAR
+VAR CONSTANT
+    N : INT := M;               (* the global M, itself of the global N: 5 *)
+END_VAR
+VAR
+    a : ARRAY[1..N] OF INT;
+    b : ARRAY[0..M] OF INT;
+    nSize : UDINT;
+END_VAR
+    nSize := SIZEOF(a) + SIZEOF(b);
+END_PROGRAM
+";
+    let mut p = load(&[("main.st", main)]).unwrap_or_else(|e| panic!("{e:#?}"));
+    p.cycle(0).unwrap();
+    assert_eq!(p.read_var("MAIN.nSize"), Some(10.0 + 12.0));
+    let hidden = "
+VAR_GLOBAL CONSTANT
+    LAST : INT := 3;
+END_VAR
+FUNCTION_BLOCK FB
+VAR_INPUT CONSTANT
+    LAST : INT := 3;
+END_VAR
+VAR
+    a : ARRAY[0..LAST] OF INT;
+END_VAR
+END_FUNCTION_BLOCK
+";
+    let Err(e) = load(&[("main.st", hidden)]) else {
+        panic!("refused");
+    };
+    assert!(
+        e.iter()
+            .any(|d| d.contains("main.st:10:18: error: `LAST` is no named integer constant")),
+        "{e:#?}"
+    );
+}

@@ -216,6 +216,72 @@ END_PROGRAM",
     assert!(e.contains("main.st:4:8: error:"), "{e}");
 }
 
+/// A VAR_IN_OUT is bound when the call starts: a body that moves the index the caller gave
+/// does not move where the value goes back; an index a function computes is refused (it
+/// would be computed twice), as is a parameter given twice.
+#[test]
+fn a_var_in_out_goes_back_where_it_came_from() {
+    let p = run(
+        "VAR_GLOBAL i : INT; END_VAR
+FUNCTION F_Next : INT
+VAR_IN_OUT v : INT; END_VAR
+    v := v + 10;
+    i := i + 1;
+    F_Next := v;
+END_FUNCTION
+PROGRAM MAIN
+VAR a : ARRAY[0..3] OF INT; r, a0, a1 : INT; END_VAR
+    IF i = 0 THEN
+        r := F_Next(a[i]);
+    END_IF
+    a0 := a[0];
+    a1 := a[1];
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(
+        (p.read_var("MAIN.a0"), p.read_var("MAIN.a1")),
+        (Some(10.0), Some(0.0))
+    );
+    assert_eq!(p.read_var("MAIN.r"), Some(10.0));
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR VAR_INPUT k : INT; END_VAR F := k; END_FUNCTION
+PROGRAM MAIN VAR a : ARRAY[0..3] OF INT; b, r : INT; END_VAR
+r := F(a[F(b, 1)], 2);
+r := F(b, 1, k := 2);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:4:14: error: F: `k` is given twice"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR F := v; END_FUNCTION
+PROGRAM MAIN VAR a : ARRAY[0..3] OF INT; b, r : INT; END_VAR
+r := F(a[F(b)]);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:8: error: a VAR_IN_OUT's variable at an index a function computes"),
+        "{e}"
+    );
+}
+
+/// An integer literal that scales a TIME is wrapped to its width, as the same value held in
+/// a variable and converted is.
+#[test]
+fn a_durations_literal_factor_is_held_as_a_variables_is() {
+    let p = run(
+        "PROGRAM MAIN VAR d : LINT := 4294967297; t1, t2 : TIME; END_VAR
+t1 := T#1S / 4294967297;
+t2 := T#1S / d;
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.t1"), Some(1000.0));
+    assert_eq!(p.read_var("MAIN.t2"), Some(1000.0));
+}
+
 #[test]
 fn a_ton_is_done_when_its_time_has_run() {
     let text = "PROGRAM MAIN VAR t : TON; q : BOOL; et : TIME; END_VAR

@@ -6,7 +6,7 @@
 //! leads back to itself is refused, as is any other name.
 
 use super::Checker;
-use crate::ast::{Expr, Init, Item, Name, TypeRef, Unit};
+use crate::ast::{Expr, Init, Item, Name, Section, TypeRef, Unit};
 use crate::diag::Pos;
 use crate::types::Elem;
 use std::collections::HashMap;
@@ -25,16 +25,18 @@ struct Def {
 #[derive(Debug, Default)]
 pub(super) struct Consts {
     globals: HashMap<String, Def>,
-    /// Per POU (upper-case name): its own.
-    locals: HashMap<String, HashMap<String, Def>>,
+    /// Per POU (upper-case name): its own variables, `Some` for a VAR CONSTANT (a variable
+    /// of another section hides a global constant of its name).
+    locals: HashMap<String, HashMap<String, Option<Def>>>,
     /// The POU whose declarations are being resolved.
     pub(super) scope: Option<String>,
-    /// The constants being evaluated, innermost last.
+    /// The constants being evaluated, innermost last (`POU.NAME` for a POU's own).
     evaluating: Vec<String>,
 }
 
 impl Consts {
-    /// The constants `files` declare.
+    /// The constants `files` declare: the global lists' VAR_GLOBAL CONSTANT and each POU's
+    /// VAR CONSTANT (its VAR_EXTERNAL names the global one).
     pub(super) fn of(files: &[(String, Unit)]) -> Consts {
         let mut c = Consts::default();
         for (file, unit) in files {
@@ -44,25 +46,32 @@ impl Consts {
                     Item::Pou(p) => (p.vars.as_slice(), Some(p.name.text.to_ascii_uppercase())),
                     Item::Types(_) => continue,
                 };
-                for block in blocks.iter().filter(|b| b.constant) {
+                for block in blocks.iter().filter(|b| b.section != Section::External) {
+                    let constant =
+                        block.constant && matches!(block.section, Section::Var | Section::Global);
                     for d in &block.vars {
+                        let def = constant.then(|| Def {
+                            value: match &d.init {
+                                Some(Init::Expr(e)) => Some(e.clone()),
+                                _ => None,
+                            },
+                            ty: d.ty.clone(),
+                            file: file.clone(),
+                            local: pou.is_some(),
+                        });
                         for n in &d.names {
-                            let def = Def {
-                                value: match &d.init {
-                                    Some(Init::Expr(e)) => Some(e.clone()),
-                                    _ => None,
-                                },
-                                ty: d.ty.clone(),
-                                file: file.clone(),
-                                local: pou.is_some(),
-                            };
                             let key = n.text.to_ascii_uppercase();
-                            let table = match &pou {
-                                Some(p) => c.locals.entry(p.clone()).or_default(),
-                                None => &mut c.globals,
-                            };
                             // A name declared twice is refused where it is declared.
-                            table.entry(key).or_insert(def);
+                            match (&pou, &def) {
+                                (Some(p), _) => {
+                                    let own = c.locals.entry(p.clone()).or_default();
+                                    own.entry(key).or_insert_with(|| def.clone());
+                                }
+                                (None, Some(def)) => {
+                                    c.globals.entry(key).or_insert_with(|| def.clone());
+                                }
+                                (None, None) => {}
+                            }
                         }
                     }
                 }
@@ -71,20 +80,22 @@ impl Consts {
         c
     }
 
-    fn find(&self, key: &str) -> Option<Def> {
-        let local = self
-            .scope
-            .as_ref()
-            .and_then(|p| self.locals.get(p)?.get(key));
-        local.or_else(|| self.globals.get(key)).cloned()
+    /// Constant `key` in the scope, and the name a chain of them knows it by; `None` for a
+    /// variable of the POU's or an unknown name.
+    fn find(&self, key: &str) -> Option<(Def, String)> {
+        if let Some(p) = &self.scope {
+            if let Some(own) = self.locals.get(p).and_then(|vars| vars.get(key)) {
+                return own.clone().map(|d| (d, format!("{p}.{key}")));
+            }
+        }
+        self.globals.get(key).map(|d| (d.clone(), key.to_string()))
     }
 }
 
 impl Checker {
     /// The value of named constant `n` in an array bound or a STRING length, or a refusal.
     pub(super) fn named_const(&mut self, n: &Name) -> Option<i128> {
-        let key = n.text.to_ascii_uppercase();
-        let Some(def) = self.consts.find(&key) else {
+        let Some((def, key)) = self.consts.find(&n.text.to_ascii_uppercase()) else {
             return self.refuse_const(
                 n.pos,
                 format!(

@@ -48,6 +48,12 @@ impl Checker {
             if self.out.pous[i].vars[var].section == Section::InOut {
                 // Copied in before the call and back after it, leaf by leaf.
                 let (from, _) = self.place(value, ctx, l)?;
+                if crate::vm::callees::addr_calls(&from) {
+                    return Err(self.unsupported(
+                        value.pos(),
+                        "a VAR_IN_OUT's variable at an index a function computes",
+                    ));
+                }
                 let leaves = match &ty {
                     Type::Elem(t) => vec![(0, *t)],
                     _ => self.leaves(&ty, l).ok_or_else(|| {

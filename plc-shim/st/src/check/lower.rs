@@ -365,8 +365,14 @@ impl Checker {
         // Both to LREAL by a real; an integer to the duration's type.
         let real = f.class() == Class::Float;
         let t = if real { Elem::LReal } else { d };
-        let x = self.value_as(a, t, ctx, l)?;
-        let y = self.value_as(b, t, ctx, l)?;
+        // An integer literal as the duration's integer arithmetic holds it (wrapped to its
+        // width, as a variable's value converted to it is).
+        let held = |v: Ex| match (v, d) {
+            (Ex::Int(i), Elem::Time) if !real => Ex::Int(i64::from(i as i32)),
+            (v, _) => v,
+        };
+        let x = held(self.value_as(a, t, ctx, l)?);
+        let y = held(self.value_as(b, t, ctx, l)?);
         Ok(if real {
             let product = Ex::Bin(op, Elem::LReal, Box::new(x), Box::new(y));
             Ex::Conv(Elem::LReal, d, Box::new(product))
@@ -623,6 +629,12 @@ impl Checker {
             if let (true, Arg::Input(_, v)) = (in_out, arg) {
                 // VAR_IN_OUT: copied in before the call and back after it, leaf by leaf.
                 let (from, _) = self.place(v, ctx, l)?;
+                if crate::vm::callees::addr_calls(&from) {
+                    return Err(self.unsupported(
+                        v.pos(),
+                        "a VAR_IN_OUT's variable at an index a function computes",
+                    ));
+                }
                 let leaves = match &member {
                     Type::Elem(t) => vec![(0, *t)],
                     _ => self.leaves(&member, l).ok_or_else(|| {

@@ -169,7 +169,11 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
         }
         for item in &unit.items {
             let Item::Pou(p) = item else { continue };
-            match c.lower_pou(p, f as u16, &layout) {
+            // Its own constants first (an initialiser's repetition count).
+            c.consts.scope = Some(p.name.text.to_ascii_uppercase());
+            let lowered = c.lower_pou(p, f as u16, &layout);
+            c.consts.scope = None;
+            match lowered {
                 Ok((i, inits, body)) => bodies[i] = (inits, body),
                 Err(e) => errors.push(e),
             }

@@ -19,7 +19,10 @@ impl Checker {
         };
         let ctx = Ctx { pou, loops: 0 };
         self.calls_from = pou;
+        // Its own constants first (an initialiser's repetition count).
+        self.consts.scope = Some(p.name.text.to_ascii_uppercase());
         self.initial_values(p, ctx);
+        self.consts.scope = None;
         self.statements(&p.body, ctx);
     }
 
@@ -446,34 +449,34 @@ impl Checker {
                 format!("{name} takes {} inputs, not {positional}", inputs.len()),
             );
         }
+        let mut given = vec![false; inputs.len()];
         for (k, arg) in args.iter().enumerate() {
-            match arg {
-                Arg::Positional(v) => {
-                    if let Some((_, t, section)) = inputs.get(k) {
-                        self.parameter(v, t, *section, ctx);
-                    }
-                }
+            let param = match arg {
+                Arg::Positional(v) => inputs.get(k).map(|_| (k, v, v.pos())),
                 Arg::Input(n, v) => {
-                    match inputs
+                    let found = inputs
                         .iter()
-                        .find(|(i, _, _)| i.eq_ignore_ascii_case(&n.text))
-                    {
-                        Some((_, t, section)) => self.parameter(v, t, *section, ctx),
-                        None => self.refuse(n.pos, format!("{name} has no input `{}`", n.text)),
+                        .position(|(i, _, _)| i.eq_ignore_ascii_case(&n.text));
+                    if found.is_none() {
+                        self.refuse(n.pos, format!("{name} has no input `{}`", n.text));
                     }
+                    found.map(|p| (p, v, n.pos))
                 }
                 Arg::Output { name: n, .. } => {
-                    self.refuse(n.pos, format!("{name} is a function: it has no outputs"))
+                    self.refuse(n.pos, format!("{name} is a function: it has no outputs"));
+                    None
                 }
+            };
+            if let Some((p, v, at)) = param {
+                let (param_name, t, section) = inputs[p].clone();
+                if std::mem::replace(&mut given[p], true) {
+                    self.refuse(at, format!("{name}: `{param_name}` is given twice"));
+                }
+                self.parameter(v, &t, section, ctx);
             }
         }
         // A VAR_IN_OUT has no value of its own: every call names the variable.
-        for (k, (param, _, section)) in inputs.iter().enumerate() {
-            let given = args.iter().enumerate().any(|(j, a)| match a {
-                Arg::Positional(_) => j == k,
-                Arg::Input(n, _) => n.text.eq_ignore_ascii_case(param),
-                Arg::Output { .. } => false,
-            });
+        for ((param, _, section), given) in inputs.iter().zip(given) {
             if *section == Section::InOut && !given {
                 self.refuse(
                     pos,

@@ -76,6 +76,13 @@ fn of_call(a: &Addr, inputs: &[BlockInput], outputs: &[BlockOutput], out: &mut V
     outputs.iter().for_each(|(_, _, a, _)| of_addr(a, out));
 }
 
+/// Whether finding place `a` calls a user function (an index computed by one).
+pub(crate) fn addr_calls(a: &Addr) -> bool {
+    let mut out = Vec::new();
+    of_addr(a, &mut out);
+    !out.is_empty()
+}
+
 fn of_addr(a: &Addr, out: &mut Vec<usize>) {
     match a {
         Addr::Offset(inner, _) => of_addr(inner, out),

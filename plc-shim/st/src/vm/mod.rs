@@ -17,7 +17,7 @@ pub use library::{BlockIo, Host};
 pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 
 mod build;
-mod callees;
+pub(crate) mod callees;
 mod code;
 mod fault;
 mod image;
@@ -704,6 +704,11 @@ impl<'a> Exec<'a> {
         for (v, (_, _, e)) in values.iter_mut().zip(inputs.iter()) {
             *v = self.eval(e, base)?;
         }
+        // Where the VAR_IN_OUTs go back: found now, before the body may move an index.
+        let mut places = [Loc::Own(0); crate::ir::MAX_CALL_INPUTS];
+        for (at, (_, _, place)) in places.iter_mut().zip(back.iter()) {
+            *at = self.addr(place, base)?;
+        }
         let (frame, statement) = (self.code.layout.statics[pou], self.st.at);
         let (size, _, _) = self.code.layout.pous[pou];
         // A function's variables start from zero and their initial values each call.
@@ -716,9 +721,8 @@ impl<'a> Exec<'a> {
         self.run_body(pou, frame)?;
         self.st.at = statement;
         // The VAR_IN_OUTs back into the caller's variables, leaf by leaf.
-        for (offset, t, place) in back {
+        for (&at, (offset, t, _)) in places.iter().zip(back.iter()) {
             let v = self.read_own((frame + offset) as usize, *t)?;
-            let at = self.addr(place, base)?;
             self.write(at, *t, v)?;
         }
         let at = self.addr(value, base)?;
