@@ -229,13 +229,26 @@ VAR_IN_OUT v : INT; END_VAR
     i := i + 1;
     F_Next := v;
 END_FUNCTION
+FUNCTION Bump : INT
+    i := i + 1;
+    Bump := 0;
+END_FUNCTION
+FUNCTION G : INT
+VAR_IN_OUT v : INT; END_VAR
+VAR_INPUT k : INT; END_VAR
+    v := v + 20;
+    G := k;
+END_FUNCTION
 PROGRAM MAIN
-VAR a : ARRAY[0..3] OF INT; r, a0, a1 : INT; END_VAR
+VAR a, b : ARRAY[0..3] OF INT; r, s, a0, a1, b1, b2 : INT; END_VAR
     IF i = 0 THEN
-        r := F_Next(a[i]);
+        r := F_Next(a[i]);          (* the body moves i to 1 *)
+        s := G(b[i], Bump());       (* b[1] given; the later value moves i to 2 *)
     END_IF
     a0 := a[0];
     a1 := a[1];
+    b1 := b[1];
+    b2 := b[2];
 END_PROGRAM",
         1,
     );
@@ -244,6 +257,10 @@ END_PROGRAM",
         (Some(10.0), Some(0.0))
     );
     assert_eq!(p.read_var("MAIN.r"), Some(10.0));
+    assert_eq!(
+        (p.read_var("MAIN.b1"), p.read_var("MAIN.b2")),
+        (Some(20.0), Some(0.0))
+    );
     let e = refused(
         "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR VAR_INPUT k : INT; END_VAR F := k; END_FUNCTION
 PROGRAM MAIN VAR a : ARRAY[0..3] OF INT; b, r : INT; END_VAR
@@ -253,6 +270,25 @@ END_PROGRAM",
     );
     assert!(
         e.contains("main.st:4:14: error: F: `k` is given twice"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR VAR_INPUT k : INT; END_VAR F := k; END_FUNCTION
+PROGRAM MAIN VAR b, r : INT; END_VAR
+r := F(k := 2, b);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:16: error: a value by position after a named one"),
+        "{e}"
+    );
+    let e = refused(
+        "PROGRAM MAIN VAR r : INT; END_VAR
+CASE r OF 0: r := 1; 3..1: r := 0; END_CASE
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:2:22: error: CASE range 3..1 holds no value"),
         "{e}"
     );
     let e = refused(
@@ -272,14 +308,18 @@ END_PROGRAM",
 #[test]
 fn a_durations_literal_factor_is_held_as_a_variables_is() {
     let p = run(
-        "PROGRAM MAIN VAR d : LINT := 4294967297; t1, t2 : TIME; END_VAR
+        "PROGRAM MAIN VAR d : LINT := 4294967297; t1, t2, t3, t4 : TIME; END_VAR
 t1 := T#1S / 4294967297;
 t2 := T#1S / d;
+t3 := T#30D / 2;
+t4 := T#30D * 0.5;
 END_PROGRAM",
         1,
     );
     assert_eq!(p.read_var("MAIN.t1"), Some(1000.0));
     assert_eq!(p.read_var("MAIN.t2"), Some(1000.0));
+    // The duration operand as written: by an integer and by a real alike.
+    assert_eq!(p.read_var("MAIN.t3"), p.read_var("MAIN.t4"));
 }
 
 #[test]

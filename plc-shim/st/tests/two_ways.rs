@@ -164,8 +164,7 @@ impl Gen {
                 self.statements(2)
             ),
             9 => format!(
-                // A range written high to low holds no value.
-                "CASE {} OF\n0: {}1, 2: {}3..5: {}9..7: {}ELSE\n{}END_CASE\n",
+                "CASE {} OF\n0: {}1, 2: {}3..5: {}7..9: {}ELSE\n{}END_CASE\n",
                 self.int_var(),
                 self.statements(2),
                 self.statements(2),

@@ -358,7 +358,7 @@ impl Checker {
         &mut self,
         op: BinOp,
         (a, b): (&Expr, &Expr),
-        (d, f, _): (Elem, Elem, bool),
+        (d, f, left): (Elem, Elem, bool),
         ctx: Ctx,
         l: &Layout,
     ) -> R<Ex> {
@@ -367,12 +367,12 @@ impl Checker {
         let t = if real { Elem::LReal } else { d };
         // An integer literal as the duration's integer arithmetic holds it (wrapped to its
         // width, as a variable's value converted to it is).
-        let held = |v: Ex| match (v, d) {
-            (Ex::Int(i), Elem::Time) if !real => Ex::Int(i64::from(i as i32)),
+        let held = |v: Ex, factor: bool| match (v, d) {
+            (Ex::Int(i), Elem::Time) if factor && !real => Ex::Int(i64::from(i as i32)),
             (v, _) => v,
         };
-        let x = held(self.value_as(a, t, ctx, l)?);
-        let y = held(self.value_as(b, t, ctx, l)?);
+        let x = held(self.value_as(a, t, ctx, l)?, !left);
+        let y = held(self.value_as(b, t, ctx, l)?, left);
         Ok(if real {
             let product = Ex::Bin(op, Elem::LReal, Box::new(x), Box::new(y));
             Ex::Conv(Elem::LReal, d, Box::new(product))
@@ -518,7 +518,15 @@ impl Checker {
                             CaseLabel::Value(v) => (v, v),
                             CaseLabel::Range(a, b) => (a, b),
                         };
-                        ranges.push((self.constant(a, ctx)?, self.constant(b, ctx)?));
+                        let (lo, hi) = (self.constant(a, ctx)?, self.constant(b, ctx)?);
+                        if lo > hi {
+                            let why = format!(
+                                "CASE range {lo}..{hi} holds no value: its upper bound lies \
+                                 below the lower"
+                            );
+                            return Err(Diagnostic::new(a.pos(), why).in_file(&self.file));
+                        }
+                        ranges.push((lo, hi));
                     }
                     out.push((ranges, self.lower_block(body, ctx, file, l)?));
                 }

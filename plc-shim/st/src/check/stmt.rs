@@ -452,6 +452,12 @@ impl Checker {
         let mut given = vec![false; inputs.len()];
         for (k, arg) in args.iter().enumerate() {
             let param = match arg {
+                Arg::Positional(v)
+                    if args[..k].iter().any(|a| !matches!(a, Arg::Positional(_))) =>
+                {
+                    self.refuse(v.pos(), "a value by position after a named one: name it");
+                    None
+                }
                 Arg::Positional(v) => inputs.get(k).map(|_| (k, v, v.pos())),
                 Arg::Input(n, v) => {
                     let found = inputs

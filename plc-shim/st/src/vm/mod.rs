@@ -699,15 +699,19 @@ impl<'a> Exec<'a> {
         ty: Elem,
         base: u32,
     ) -> Run<V> {
-        // The values first (one may call this function too), then the frame.
+        // The values first, in their order (one may call this function too), then the frame.
+        // A VAR_IN_OUT's leaf is read where its place is found, and goes back there: its
+        // place bound when its turn comes, before the body or a later value moves an index.
         let mut values = [V::I(0); crate::ir::MAX_CALL_INPUTS];
-        for (v, (_, _, e)) in values.iter_mut().zip(inputs.iter()) {
-            *v = self.eval(e, base)?;
-        }
-        // Where the VAR_IN_OUTs go back: found now, before the body may move an index.
         let mut places = [Loc::Own(0); crate::ir::MAX_CALL_INPUTS];
-        for (at, (_, _, place)) in places.iter_mut().zip(back.iter()) {
-            *at = self.addr(place, base)?;
+        for (v, (offset, t, e)) in values.iter_mut().zip(inputs.iter()) {
+            *v = match back.iter().position(|(o, _, _)| o == offset) {
+                Some(j) => {
+                    places[j] = self.addr(&back[j].2, base)?;
+                    self.read(places[j], *t)?
+                }
+                None => self.eval(e, base)?,
+            };
         }
         let (frame, statement) = (self.code.layout.statics[pou], self.st.at);
         let (size, _, _) = self.code.layout.pous[pou];
