@@ -6,12 +6,45 @@ use super::expr::Ctx;
 use super::lower::R;
 use super::place::plus;
 use super::{Checker, Type};
-use crate::ast::Arg;
+use crate::ast::{Arg, Expr};
 use crate::diag::Pos;
 use crate::ir::{Addr, Ex};
 use crate::layout::Layout;
+use crate::types::Elem;
 
 impl Checker {
+    /// A VAR_IN_OUT of type `ty` given `value`: each leaf's offset in the parameter, type
+    /// and place in the caller's variable (copied in before the call and back after it);
+    /// a variable at an index a function computes, or of more than 64 leaves, is refused.
+    pub(super) fn in_out_leaves(
+        &mut self,
+        value: &Expr,
+        ty: &Type,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Vec<(u32, Elem, Addr)>> {
+        let (from, _) = self.place(value, ctx, l)?;
+        if crate::vm::callees::addr_calls(&from) {
+            return Err(self.unsupported(
+                value.pos(),
+                "a VAR_IN_OUT's variable at an index a function computes",
+            ));
+        }
+        let leaves = match ty {
+            Type::Elem(t) => vec![(0, *t)],
+            _ => self.leaves(ty, l).ok_or_else(|| {
+                self.unsupported(
+                    value.pos(),
+                    "a VAR_IN_OUT of more than 64 values or of this type",
+                )
+            })?,
+        };
+        Ok(leaves
+            .into_iter()
+            .map(|(at, t)| (at, t, plus(from.clone(), at)))
+            .collect())
+    }
+
     pub(super) fn function_value(
         &mut self,
         i: usize,
@@ -46,25 +79,7 @@ impl Checker {
             };
             let (ty, offset) = (self.out.pous[i].vars[var].ty.clone(), l.pous[i].2[var]);
             if self.out.pous[i].vars[var].section == Section::InOut {
-                // Copied in before the call and back after it, leaf by leaf.
-                let (from, _) = self.place(value, ctx, l)?;
-                if crate::vm::callees::addr_calls(&from) {
-                    return Err(self.unsupported(
-                        value.pos(),
-                        "a VAR_IN_OUT's variable at an index a function computes",
-                    ));
-                }
-                let leaves = match &ty {
-                    Type::Elem(t) => vec![(0, *t)],
-                    _ => self.leaves(&ty, l).ok_or_else(|| {
-                        self.unsupported(
-                            value.pos(),
-                            "a VAR_IN_OUT of more than 64 values or of this type",
-                        )
-                    })?,
-                };
-                for (at, t) in leaves {
-                    let leaf = plus(from.clone(), at);
+                for (at, t, leaf) in self.in_out_leaves(value, &ty, ctx, l)? {
                     stores.push((offset + at, t, Ex::Load(Box::new(leaf.clone()), t)));
                     back.push((offset + at, t, leaf));
                 }

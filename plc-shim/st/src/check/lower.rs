@@ -636,24 +636,7 @@ impl Checker {
             });
             if let (true, Arg::Input(_, v)) = (in_out, arg) {
                 // VAR_IN_OUT: copied in before the call and back after it, leaf by leaf.
-                let (from, _) = self.place(v, ctx, l)?;
-                if crate::vm::callees::addr_calls(&from) {
-                    return Err(self.unsupported(
-                        v.pos(),
-                        "a VAR_IN_OUT's variable at an index a function computes",
-                    ));
-                }
-                let leaves = match &member {
-                    Type::Elem(t) => vec![(0, *t)],
-                    _ => self.leaves(&member, l).ok_or_else(|| {
-                        self.unsupported(
-                            name.pos,
-                            "a VAR_IN_OUT with more than 64 values or of this type",
-                        )
-                    })?,
-                };
-                for (at, t) in leaves {
-                    let leaf = plus(from.clone(), at);
+                for (at, t, leaf) in self.in_out_leaves(v, &member, ctx, l)? {
                     inputs.push((offset + at, t, Ex::Load(Box::new(leaf.clone()), t)));
                     outputs.push((offset + at, t, leaf, false));
                 }
