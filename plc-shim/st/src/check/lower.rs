@@ -11,6 +11,7 @@ use crate::diag::{Diagnostic, Pos};
 use crate::ir::{Addr, Ex, St, StKind, StdFn};
 use crate::layout::{std_member, Layout};
 use crate::types::{conversion, Class, Elem};
+use crate::vm::callees::addr_calls;
 
 pub(super) type R<T> = Result<T, Diagnostic>;
 
@@ -657,6 +658,24 @@ impl Checker {
                 // A STRING input is passed in 8-byte parts (its literal's as constants).
                 for (at, t, part) in self.string_parts(*n, v, ctx, l)? {
                     inputs.push((offset + at, t, part));
+                }
+                continue;
+            }
+            if let (Type::Struct(_) | Type::Array(..), Arg::Output { target, .. }) = (&member, arg)
+            {
+                // A structure's or an array's output goes to the caller's variable leaf by
+                // leaf after the call.
+                let (to, _) = self.place(target, ctx, l)?;
+                let leaves = self.leaves(&member, l).filter(|_| !addr_calls(&to));
+                let leaves = leaves.ok_or_else(|| {
+                    self.unsupported(
+                        name.pos,
+                        "an output of more than 64 values, of this type, or to a variable at \
+                         an index a function computes",
+                    )
+                })?;
+                for (at, t) in leaves {
+                    outputs.push((offset + at, t, plus(to.clone(), at), false));
                 }
                 continue;
             }

@@ -1,0 +1,201 @@
+//! Calls of the program's own functions and function blocks: a FUNCTION's VAR_IN_OUT
+//! (copied in and back, bound at its turn among the values), and structure and array
+//! outputs of a function block, with the refusals of what a call may not give.
+
+use plc_st::vm::Program;
+
+fn run(text: &str, cycles: u32) -> Program {
+    let mut p = Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
+        )
+    });
+    for k in 0..cycles {
+        p.cycle(i64::from(k) * 10_000_000).unwrap();
+    }
+    p
+}
+
+fn refused(text: &str) -> String {
+    match Program::load(&[("main.st", text)]) {
+        Ok(_) => panic!("loaded: {text}"),
+        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
+    }
+}
+
+/// A function's VAR_IN_OUT: the caller's variable copied in before the call and back after
+/// it (an array, an elementary value), named or by position among the inputs.
+#[test]
+fn a_functions_var_in_out_writes_the_callers_variable() {
+    let text = "
+FUNCTION F_SumClear : LREAL
+VAR_IN_OUT a : ARRAY[0..3] OF LREAL; END_VAR
+VAR_INPUT scale : LREAL; END_VAR
+VAR k : INT; END_VAR
+    FOR k := 0 TO 3 DO
+        F_SumClear := F_SumClear + a[k] * scale;
+        a[k] := 0.0;
+    END_FOR
+END_FUNCTION
+FUNCTION F_Bump : BOOL
+VAR_IN_OUT n : DINT; END_VAR
+    n := n + 1;
+    F_Bump := n > 2;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    x : ARRAY[0..3] OF LREAL := [1.0, 2.0, 3.0, 4.0];
+    s, x3 : LREAL;
+    c : DINT;
+    b : BOOL;
+END_VAR
+    s := s + F_SumClear(a := x, scale := 2.0);
+    x3 := x[3];
+    b := F_Bump(c);
+END_PROGRAM";
+    let p = run(text, 1);
+    assert_eq!(p.read_var("MAIN.s"), Some(20.0));
+    assert_eq!(
+        p.read_var("MAIN.x3"),
+        Some(0.0),
+        "cleared through the VAR_IN_OUT"
+    );
+    assert_eq!(p.read_var("MAIN.c"), Some(1.0));
+    assert_eq!(p.read_var("MAIN.b"), Some(0.0));
+    let p = run(text, 3);
+    assert_eq!(p.read_var("MAIN.s"), Some(20.0), "nothing left to sum");
+    assert_eq!(
+        (p.read_var("MAIN.c"), p.read_var("MAIN.b")),
+        (Some(3.0), Some(1.0))
+    );
+    let e = refused(
+        "FUNCTION F : BOOL VAR_IN_OUT n : DINT; END_VAR F := n > 0; END_FUNCTION
+PROGRAM MAIN VAR r : LREAL; b : BOOL; END_VAR
+b := F(n := r);
+b := F(5);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:13: error: a LREAL for a VAR_IN_OUT of DINT"),
+        "{e}"
+    );
+    assert!(e.contains("main.st:4:8: error:"), "{e}");
+}
+
+/// A VAR_IN_OUT is bound when the call starts: a body that moves the index the caller gave
+/// does not move where the value goes back; an index a function computes is refused (it
+/// would be computed twice), as is a parameter given twice.
+#[test]
+fn a_var_in_out_goes_back_where_it_came_from() {
+    let p = run(
+        "VAR_GLOBAL i : INT; END_VAR
+FUNCTION F_Next : INT
+VAR_IN_OUT v : INT; END_VAR
+    v := v + 10;
+    i := i + 1;
+    F_Next := v;
+END_FUNCTION
+FUNCTION Bump : INT
+    i := i + 1;
+    Bump := 0;
+END_FUNCTION
+FUNCTION G : INT
+VAR_IN_OUT v : INT; END_VAR
+VAR_INPUT k : INT; END_VAR
+    v := v + 20;
+    G := k;
+END_FUNCTION
+PROGRAM MAIN
+VAR a, b : ARRAY[0..3] OF INT; r, s, a0, a1, b1, b2 : INT; END_VAR
+    IF i = 0 THEN
+        r := F_Next(a[i]);          (* the body moves i to 1 *)
+        s := G(b[i], Bump());       (* b[1] given; the later value moves i to 2 *)
+    END_IF
+    a0 := a[0];
+    a1 := a[1];
+    b1 := b[1];
+    b2 := b[2];
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(
+        (p.read_var("MAIN.a0"), p.read_var("MAIN.a1")),
+        (Some(10.0), Some(0.0))
+    );
+    assert_eq!(p.read_var("MAIN.r"), Some(10.0));
+    assert_eq!(
+        (p.read_var("MAIN.b1"), p.read_var("MAIN.b2")),
+        (Some(20.0), Some(0.0))
+    );
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR VAR_INPUT k : INT; END_VAR F := k; END_FUNCTION
+PROGRAM MAIN VAR a : ARRAY[0..3] OF INT; b, r : INT; END_VAR
+r := F(a[F(b, 1)], 2);
+r := F(b, 1, k := 2);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:4:14: error: F: `k` is given twice"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR VAR_INPUT k : INT; END_VAR F := k; END_FUNCTION
+PROGRAM MAIN VAR b, r : INT; END_VAR
+r := F(k := 2, b);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:16: error: a value by position after a named one"),
+        "{e}"
+    );
+    let e = refused(
+        "PROGRAM MAIN VAR r : INT; END_VAR
+CASE r OF 0: r := 1; 3..1: r := 0; END_CASE
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:2:22: error: CASE range 3..1 holds no value"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION F : INT VAR_IN_OUT v : INT; END_VAR F := v; END_FUNCTION
+PROGRAM MAIN VAR a : ARRAY[0..3] OF INT; b, r : INT; END_VAR
+r := F(a[F(b)]);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:8: error: a VAR_IN_OUT's variable at an index a function computes"),
+        "{e}"
+    );
+}
+
+/// A function block's output of a structure or an array type goes to the caller's variable
+/// of that type after the call, leaf by leaf.
+#[test]
+fn structure_and_array_outputs_reach_the_callers_variables() {
+    let text = "
+TYPE ST_Pos : STRUCT x, y : LREAL; n : INT; END_STRUCT END_TYPE
+FUNCTION_BLOCK FB_Next
+VAR_INPUT k : INT; END_VAR
+VAR_OUTPUT stPos : ST_Pos; aOut : ARRAY[0..2] OF INT; END_VAR
+    stPos.x := INT_TO_LREAL(k) * 1.5;
+    stPos.y := -stPos.x;
+    stPos.n := k;
+    aOut[2] := k * 2;
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR fb : FB_Next; myPos : ST_Pos; myArr : ARRAY[0..2] OF INT; y : LREAL; n, a2 : INT; END_VAR
+    fb(k := 4, stPos => myPos, aOut => myArr);
+    y := myPos.y;
+    n := myPos.n;
+    a2 := myArr[2];
+END_PROGRAM";
+    let p = run(text, 1);
+    assert_eq!(p.read_var("MAIN.y"), Some(-6.0));
+    assert_eq!(p.read_var("MAIN.n"), Some(4.0));
+    assert_eq!(p.read_var("MAIN.a2"), Some(8.0));
+    let wrong = text.replace("myArr : ARRAY[0..2]", "myArr : ARRAY[0..3]");
+    let e = refused(&wrong);
+    assert!(e.contains("main.st:13:40: error:"), "{e}");
+}
