@@ -176,3 +176,61 @@ END_FUNCTION_BLOCK
         "{e:#?}"
     );
 }
+
+/// An enumeration's values bound an array (`ARRAY[E_Axis.X..E_Axis.C]`, `E_Axis#Z`) and
+/// index it; a name that is no enumeration, a value it does not have, or an enumeration
+/// declared after the structure that uses it, is refused with its place.
+#[test]
+fn enumeration_values_bound_and_index_arrays() {
+    let main = "
+TYPE E_Axis : (X, Y, Z := 5, C); END_TYPE
+PROGRAM MAIN
+VAR
+    aPos : ARRAY[E_Axis.X..E_Axis.C] OF LREAL;
+    aB : ARRAY[1..E_Axis#Z] OF INT;
+    eAxis : E_Axis := E_Axis.Z;
+    fY, fZ : LREAL;
+    nSize : UDINT;
+END_VAR
+    aPos[E_Axis.Y] := 2.5;
+    aPos[eAxis] := 4.0;
+    fY := aPos[E_Axis.Y];
+    fZ := aPos[5];
+    nSize := SIZEOF(aPos) + SIZEOF(aB);
+END_PROGRAM
+";
+    let mut p = load(&[("main.st", main)]).unwrap_or_else(|e| panic!("{e:#?}"));
+    p.cycle(0).unwrap();
+    assert_eq!(
+        (p.read_var("MAIN.fY"), p.read_var("MAIN.fZ")),
+        (Some(2.5), Some(4.0))
+    );
+    // X..C is 0..6: 7 LREALs; 1..5: 5 INTs.
+    assert_eq!(p.read_var("MAIN.nSize"), Some(56.0 + 10.0));
+    let bad = "
+TYPE ST_Early : STRUCT a : ARRAY[0..E_Late.B] OF INT; END_STRUCT END_TYPE
+TYPE E_Late : (A, B); END_TYPE
+PROGRAM MAIN
+VAR
+    a1 : ARRAY[0..E_None.A] OF INT;
+    a2 : ARRAY[0..E_Late.Q] OF INT;
+END_VAR
+END_PROGRAM
+";
+    let Err(e) = load(&[("main.st", bad)]) else {
+        panic!("refused");
+    };
+    let has = |what: &str| e.iter().any(|d| d.contains(what));
+    assert!(
+        has("main.st:2:37: error: enumeration `E_Late` is declared after its use here"),
+        "{e:#?}"
+    );
+    assert!(
+        has("main.st:6:19: error: `E_None` is no enumeration"),
+        "{e:#?}"
+    );
+    assert!(
+        has("main.st:7:26: error: enumeration `E_Late` has no value `Q`"),
+        "{e:#?}"
+    );
+}

@@ -138,6 +138,31 @@ impl Checker {
         v
     }
 
+    /// Value `v` of enumeration `ty` in an array bound (`E_Axis.X`, `E_Axis#X`); refused for
+    /// no enumeration of that name, no such value, or one declared after its use.
+    pub(super) fn enum_const(&mut self, ty: &Name, v: &Name) -> Option<i128> {
+        let key = ty.text.to_ascii_uppercase();
+        let Some(super::Named::Enum(i)) = self.names.get(&key).cloned() else {
+            return self.refuse_const(ty.pos, format!("`{}` is no enumeration", ty.text));
+        };
+        let e = &self.out.enums[i];
+        let found = e
+            .values
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(&v.text));
+        match found {
+            Some((_, x)) => Some(*x),
+            None if e.values.is_empty() => {
+                let why = format!("enumeration `{}` is declared after its use here", ty.text);
+                self.refuse_const(ty.pos, why)
+            }
+            None => {
+                let why = format!("enumeration `{}` has no value `{}`", ty.text, v.text);
+                self.refuse_const(v.pos, why)
+            }
+        }
+    }
+
     fn refuse_const(&mut self, pos: Pos, why: String) -> Option<i128> {
         self.refuse(pos, why);
         None

@@ -266,10 +266,11 @@ impl Checker {
         let base = self.expr(base, ctx);
         for i in index {
             match self.expr(i, ctx) {
+                // An enumeration's value indexes by its number (an array over its values).
                 Type::Elem(e) if e.is_integer() => {}
-                Type::Error => {}
+                Type::Enum(_) | Type::Error => {}
                 _ => {
-                    self.refuse(i.pos(), "an index is an integer");
+                    self.refuse(i.pos(), "an index is an integer or an enumeration's value");
                 }
             }
         }

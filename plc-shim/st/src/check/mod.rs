@@ -537,6 +537,17 @@ impl Checker {
         use crate::ast::{BinOp, Expr, UnOp};
         let value = match e {
             Expr::Int(v, _) => Some(*v),
+            // An enumeration's value: `E_Axis.X`, `E_Axis#X`.
+            Expr::Field(ty, v) if matches!(**ty, Expr::Name(_)) => {
+                let Expr::Name(ty) = &**ty else { return None };
+                return self.enum_const(ty, v);
+            }
+            Expr::Typed { ty, value } if Elem::named(&ty.text.to_ascii_uppercase()).is_none() => {
+                return match &**value {
+                    Expr::Name(v) => self.enum_const(ty, v),
+                    other => self.const_int(other),
+                };
+            }
             Expr::Typed { value, .. } => return self.const_int(value),
             Expr::Name(n) => return self.named_const(n),
             Expr::Unary(UnOp::Neg, inner, _) => self.const_int(inner)?.checked_neg(),
