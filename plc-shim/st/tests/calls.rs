@@ -199,3 +199,21 @@ END_PROGRAM";
     let e = refused(&wrong);
     assert!(e.contains("main.st:13:40: error:"), "{e}");
 }
+
+/// An array input comes from the caller's array of that type, leaf by leaf.
+#[test]
+fn an_array_input_comes_from_the_callers_array() {
+    let p = run(
+        "FUNCTION_BLOCK FB_Sum
+VAR_INPUT aIn : ARRAY[0..2] OF INT; END_VAR
+VAR_OUTPUT nSum : INT; END_VAR
+    nSum := aIn[0] + aIn[1] + aIn[2];
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR fb : FB_Sum; a : ARRAY[0..2] OF INT := [1, 2, 3]; n : INT; END_VAR
+    fb(aIn := a, nSum => n);
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.n"), Some(6.0));
+}

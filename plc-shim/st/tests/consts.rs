@@ -178,8 +178,8 @@ END_FUNCTION_BLOCK
 }
 
 /// An enumeration's values bound an array (`ARRAY[E_Axis.X..E_Axis.C]`, `E_Axis#Z`) and
-/// index it; a name that is no enumeration, a value it does not have, or an enumeration
-/// declared after the structure that uses it, is refused with its place.
+/// index it, also in a structure declared before the enumeration; a name that is no
+/// enumeration, or a value it does not have, is refused with its place.
 #[test]
 fn enumeration_values_bound_and_index_arrays() {
     let main = "
@@ -221,16 +221,60 @@ END_PROGRAM
         panic!("refused");
     };
     let has = |what: &str| e.iter().any(|d| d.contains(what));
+    assert_eq!(
+        e.len(),
+        2,
+        "ST_Early's bound names E_Late declared later: {e:#?}"
+    );
     assert!(
-        has("main.st:2:37: error: enumeration `E_Late` is declared after its use here"),
+        has("main.st:6:19: error: an integer constant is wanted here"),
         "{e:#?}"
     );
     assert!(
-        has("main.st:6:19: error: `E_None` is no enumeration"),
+        has("main.st:7:26: error: enumeration `E_Late` has no value `Q` here"),
+        "{e:#?}"
+    );
+}
+
+/// Enumerations resolve before structures, in any file order; a value may name an earlier
+/// one of its enumeration; a constant index by an enumeration's value outside the bounds is
+/// refused at load as a number's is; a typed number of no elementary type in a bound, and a
+/// variable's field there, are refused.
+#[test]
+fn enumeration_values_in_any_order_and_their_refusals() {
+    let a = "TYPE ST_A : STRUCT v : ARRAY[0..E_B.N] OF INT; END_STRUCT END_TYPE
+PROGRAM MAIN
+VAR st : ST_A; nSize : UDINT; END_VAR
+    nSize := SIZEOF(st);
+END_PROGRAM
+";
+    let b = "TYPE E_B : (X, Y, N := E_B.Y + 1); END_TYPE\n";
+    let mut p = load(&[("a.st", a), ("b.st", b)]).unwrap_or_else(|e| panic!("{e:#?}"));
+    p.cycle(0).unwrap();
+    assert_eq!(p.read_var("MAIN.nSize"), Some(6.0), "0..2: three INTs");
+    let bad = "TYPE E : (X, Y, Z := 5); END_TYPE
+TYPE ST_Cfg : STRUCT n : INT; END_STRUCT END_TYPE
+PROGRAM MAIN
+VAR
+    a : ARRAY[0..2] OF INT;
+    a2 : ARRAY[0..Foo#3] OF INT;
+    stCfg : ST_Cfg;
+    a3 : ARRAY[0..stCfg.n] OF INT;
+END_VAR
+    a[E.Z] := 1;
+END_PROGRAM
+";
+    let Err(e) = load(&[("main.st", bad)]) else {
+        panic!("refused");
+    };
+    let has = |what: &str| e.iter().any(|d| d.contains(what));
+    assert!(has("main.st:10:7: error: index 5 outside [0..2]"), "{e:#?}");
+    assert!(
+        has("main.st:6:19: error: `Foo#..`: an enumeration's value is named"),
         "{e:#?}"
     );
     assert!(
-        has("main.st:7:26: error: enumeration `E_Late` has no value `Q`"),
+        has("main.st:8:19: error: an integer constant is wanted here"),
         "{e:#?}"
     );
 }

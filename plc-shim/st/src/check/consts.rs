@@ -157,10 +157,41 @@ impl Checker {
                 self.refuse_const(ty.pos, why)
             }
             None => {
-                let why = format!("enumeration `{}` has no value `{}`", ty.text, v.text);
+                let why = format!("enumeration `{}` has no value `{}` here", ty.text, v.text);
                 self.refuse_const(v.pos, why)
             }
         }
+    }
+
+    /// Whether `ty` names an enumeration.
+    pub(super) fn is_enum(&self, ty: &Name) -> bool {
+        matches!(
+            self.names.get(&ty.text.to_ascii_uppercase()),
+            Some(super::Named::Enum(_))
+        )
+    }
+
+    /// The number of `e` when it is an enumeration's value (`E_Axis.X`, `E_Axis#X`).
+    pub(super) fn enum_literal(&self, e: &Expr) -> Option<i128> {
+        let (ty, v) = match e {
+            Expr::Field(ty, v) => match &**ty {
+                Expr::Name(ty) => (ty, v),
+                _ => return None,
+            },
+            Expr::Typed { ty, value } => match &**value {
+                Expr::Name(v) => (ty, v),
+                _ => return None,
+            },
+            _ => return None,
+        };
+        let Some(super::Named::Enum(i)) = self.names.get(&ty.text.to_ascii_uppercase()) else {
+            return None;
+        };
+        let values = &self.out.enums[*i].values;
+        values
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(&v.text))
+            .map(|(_, x)| *x)
     }
 
     fn refuse_const(&mut self, pos: Pos, why: String) -> Option<i128> {

@@ -277,8 +277,8 @@ impl Checker {
         match base {
             Type::Array(dims, element) if dims.len() == index.len() => {
                 for ((lo, hi), i) in dims.iter().zip(index) {
-                    if let Some(v) = literal(i).filter(|v| !(*lo as i128..=*hi as i128).contains(v))
-                    {
+                    let constant = literal(i).or_else(|| self.enum_literal(i));
+                    if let Some(v) = constant.filter(|v| !(*lo as i128..=*hi as i128).contains(v)) {
                         self.refuse(i.pos(), format!("index {v} outside [{lo}..{hi}]"));
                     }
                 }

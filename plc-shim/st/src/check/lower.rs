@@ -643,11 +643,14 @@ impl Checker {
                 }
                 continue;
             }
-            if let (Type::Struct(_), Arg::Input(_, v)) = (&member, arg) {
-                // A structure input (an AXIS_REF) is passed leaf by leaf.
+            if let (Type::Struct(_) | Type::Array(..), Arg::Input(_, v)) = (&member, arg) {
+                // A structure (an AXIS_REF) or array input is passed leaf by leaf.
                 let (from, _) = self.place(v, ctx, l)?;
                 for (at, t) in self.leaves(&member, l).ok_or_else(|| {
-                    self.unsupported(name.pos, "a structure input with more than 64 values")
+                    self.unsupported(
+                        name.pos,
+                        "a structure or array input of more than 64 values",
+                    )
                 })? {
                     let leaf = Addr::Offset(Box::new(from.clone()), at);
                     inputs.push((offset + at, t, Ex::Load(Box::new(leaf), t)));

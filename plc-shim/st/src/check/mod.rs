@@ -272,23 +272,26 @@ impl Checker {
         }
     }
 
-    /// Struct fields and enum values, in declaration order.
+    /// Enum values, then struct fields (whose array bounds may name an enumeration's value
+    /// declared anywhere), each in declaration order.
     fn resolve_types(&mut self, files: &[(String, Unit)]) {
-        for (file, unit) in files {
-            self.file = file.clone();
-            for item in &unit.items {
-                let Item::Types(decls) = item else { continue };
-                for d in decls {
-                    let key = d.name.text.to_ascii_uppercase();
-                    match (&d.def, self.names.get(&key).cloned()) {
-                        (TypeDef::Struct(fields), Some(Named::Struct(i))) => {
-                            let fields = self.fields(fields);
-                            self.out.structs[i].fields = fields;
+        for enums in [true, false] {
+            for (file, unit) in files {
+                self.file = file.clone();
+                for item in &unit.items {
+                    let Item::Types(decls) = item else { continue };
+                    for d in decls {
+                        let key = d.name.text.to_ascii_uppercase();
+                        match (&d.def, self.names.get(&key).cloned(), enums) {
+                            (TypeDef::Struct(fields), Some(Named::Struct(i)), false) => {
+                                let fields = self.fields(fields);
+                                self.out.structs[i].fields = fields;
+                            }
+                            (TypeDef::Enum { values, base }, Some(Named::Enum(i)), true) => {
+                                self.enum_values(i, values, base.as_ref());
+                            }
+                            _ => {}
                         }
-                        (TypeDef::Enum { values, base }, Some(Named::Enum(i))) => {
-                            self.enum_values(i, values, base.as_ref());
-                        }
-                        _ => {}
                     }
                 }
             }
@@ -326,11 +329,13 @@ impl Checker {
             }
         };
         let mut next = 0i128;
-        let mut out: Vec<(String, i128)> = Vec::new();
+        // Each value stored as it is found (a later one may name an earlier one).
+        self.out.enums[index].values.clear();
         for (name, value) in values {
             if let Some(v) = value {
                 next = self.const_int(v).unwrap_or(next);
             }
+            let out = &self.out.enums[index].values;
             if out.iter().any(|(n, _)| n.eq_ignore_ascii_case(&name.text)) {
                 self.refuse(name.pos, format!("value `{}` is declared twice", name.text));
             }
@@ -340,10 +345,10 @@ impl Checker {
             {
                 self.refuse(name.pos, format!("{next} does not fit {}", base.name()));
             }
+            let out = &mut self.out.enums[index].values;
             out.push((name.text.clone(), next));
             next = next.saturating_add(1);
         }
-        self.out.enums[index].values = out;
         self.out.enums[index].base = base;
     }
 
@@ -538,14 +543,18 @@ impl Checker {
         let value = match e {
             Expr::Int(v, _) => Some(*v),
             // An enumeration's value: `E_Axis.X`, `E_Axis#X`.
-            Expr::Field(ty, v) if matches!(**ty, Expr::Name(_)) => {
-                let Expr::Name(ty) = &**ty else { return None };
-                return self.enum_const(ty, v);
-            }
+            Expr::Field(ty, v) => match &**ty {
+                Expr::Name(ty) if self.is_enum(ty) => return self.enum_const(ty, v),
+                _ => None,
+            },
             Expr::Typed { ty, value } if Elem::named(&ty.text.to_ascii_uppercase()).is_none() => {
                 return match &**value {
                     Expr::Name(v) => self.enum_const(ty, v),
-                    other => self.const_int(other),
+                    _ => {
+                        let why = format!("`{}#..`: an enumeration's value is named", ty.text);
+                        self.refuse(ty.pos, why);
+                        None
+                    }
                 };
             }
             Expr::Typed { value, .. } => return self.const_int(value),
@@ -575,8 +584,8 @@ impl Checker {
         if value.is_none() {
             self.refuse(
                 e.pos(),
-                "an integer constant is wanted here (literals, named integer constants and \
-                 their arithmetic)",
+                "an integer constant is wanted here (literals, named integer constants, \
+                 enumeration values and their arithmetic)",
             );
         }
         value
