@@ -414,13 +414,8 @@ impl<'c> Builder<'c> {
     /// run time (`a[i]`, `a[i].field`), into a register; `None` for any other place.
     fn element_place(&mut self, a: &Addr) -> Option<R> {
         let (e, index) = index_place(a)?;
-        let mark = self.next;
-        let i = self.expr(index);
-        self.next = mark;
         let r = self.reg();
-        self.codes.elems.push(e);
-        let k = (self.codes.elems.len() - 1) as u32;
-        self.ops.push(Op::Elem(r, i, k));
+        self.element(r, e, index);
         Some(r)
     }
 

@@ -24,7 +24,7 @@ mod image;
 mod init;
 mod library;
 mod mem;
-mod ops;
+pub(crate) mod ops;
 mod run;
 mod std_fb;
 mod symbols;

@@ -176,7 +176,7 @@ impl<'a> Exec<'a> {
                     self.put(w, d, V::I(slotted(at, slot1)));
                 }
                 Op::Elem(d, i, k) => {
-                    let i = self.src(i, base, w)?.int();
+                    let i = self.src_int(i, base, w)?;
                     let v = self.element(&codes.elems[k as usize], i, base)?;
                     self.put(w, d, v);
                 }

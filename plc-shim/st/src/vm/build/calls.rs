@@ -48,18 +48,18 @@ impl Builder<'_> {
         }
         self.ops.push(Op::Stmt(site));
         let inst = self.reg();
-        let host = body
-            .ok()
-            .and_then(|p| self.library.of_pou.get(p as usize).copied().flatten())
-            .is_some();
-        match own(instance) {
-            Some(Dst::Own(at, relative)) => {
-                let slot = (host && !relative).then(|| self.library.slot_at(at));
-                let slot1 = slot.flatten().map_or(0, |s| s + 1);
+        let fixed = match own(instance) {
+            Some(Dst::Own(at, relative)) => Some((at, relative)),
+            _ => None,
+        };
+        match fixed {
+            Some((at, relative)) => {
+                let slot1 = self.host_slot(body, at, relative).map_or(0, |s| s + 1);
                 self.ops.push(Op::Inst(inst, at, relative, slot1));
             }
             _ => match index_place(instance) {
                 Some((mut e, index)) if e.plus == 0 => {
+                    let host = self.host_slot(body, e.at, e.relative).is_some();
                     e.instance = Some(if host { self.slots(&e).unwrap_or(0) } else { 0 });
                     self.element(inst, e, index);
                 }
@@ -73,11 +73,8 @@ impl Builder<'_> {
             let mark = self.next;
             let v = self.expr(e);
             // An instance at a fixed place: its input is a variable there.
-            let fixed = match own(instance) {
-                Some(Dst::Own(at, relative)) => at.checked_add(*offset).map(|a| (a, relative)),
-                _ => None,
-            };
-            self.ops.push(match fixed {
+            let input = fixed.and_then(|(at, r)| Some((at.checked_add(*offset)?, r)));
+            self.ops.push(match input {
                 Some((at, relative)) => Op::Store(Dst::Own(at, relative), *t, v),
                 None => Op::Input(inst, *offset, *t, v),
             });
@@ -113,13 +110,7 @@ impl Builder<'_> {
             self.codes.inputs.push((*offset, *t, v));
         }
         self.codes.calls.push(inputs.to_vec());
-        let host = body
-            .ok()
-            .and_then(|p| self.library.of_pou.get(p as usize).copied().flatten());
-        let slot = match (host, relative) {
-            (Some(_), false) => self.library.slot_at(at),
-            _ => None,
-        };
+        let slot = self.host_slot(body, at, relative);
         self.codes.call_ops.push(CallOp {
             site,
             at,
@@ -144,6 +135,14 @@ impl Builder<'_> {
         }
     }
 
+    /// The host's slot of the library block instance `body` at absolute place `at`; `None`
+    /// for another block, a place from an instance's base, or no instance there.
+    fn host_slot(&self, body: Result<u32, StdFb>, at: u32, relative: bool) -> Option<u32> {
+        let pou = body.ok()? as usize;
+        self.library.of_pou.get(pou).copied().flatten()?;
+        (!relative).then(|| self.library.slot_at(at)).flatten()
+    }
+
     /// The host slot plus one of the first of an array's elements when they are a
     /// library block's instances in consecutive slots (absolute places only).
     fn slots(&self, e: &ElemOp) -> Option<u32> {
@@ -159,7 +158,7 @@ impl Builder<'_> {
     }
 
     /// `d :=` element `e` at the index `index` gives ([`Op::Elem`]).
-    fn element(&mut self, d: R, e: ElemOp, index: &Ex) {
+    pub(super) fn element(&mut self, d: R, e: ElemOp, index: &Ex) {
         let mark = self.next;
         let i = self.expr(index);
         self.next = mark;
