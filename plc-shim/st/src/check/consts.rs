@@ -141,18 +141,12 @@ impl Checker {
     /// Value `v` of enumeration `ty` in an array bound (`E_Axis.X`, `E_Axis#X`); refused for
     /// no enumeration of that name, no such value, or one declared after its use.
     pub(super) fn enum_const(&mut self, ty: &Name, v: &Name) -> Option<i128> {
-        let key = ty.text.to_ascii_uppercase();
-        let Some(super::Named::Enum(i)) = self.names.get(&key).cloned() else {
+        let Some(i) = self.enum_index(ty) else {
             return self.refuse_const(ty.pos, format!("`{}` is no enumeration", ty.text));
         };
-        let e = &self.out.enums[i];
-        let found = e
-            .values
-            .iter()
-            .find(|(n, _)| n.eq_ignore_ascii_case(&v.text));
-        match found {
-            Some((_, x)) => Some(*x),
-            None if e.values.is_empty() => {
+        match self.enum_number(i, &v.text) {
+            Some(x) => Some(x),
+            None if self.out.enums[i].values.is_empty() => {
                 let why = format!("enumeration `{}` is declared after its use here", ty.text);
                 self.refuse_const(ty.pos, why)
             }
@@ -163,12 +157,19 @@ impl Checker {
         }
     }
 
-    /// Whether `ty` names an enumeration.
-    pub(super) fn is_enum(&self, ty: &Name) -> bool {
-        matches!(
-            self.names.get(&ty.text.to_ascii_uppercase()),
-            Some(super::Named::Enum(_))
-        )
+    /// The enumeration `ty` names.
+    pub(super) fn enum_index(&self, ty: &Name) -> Option<usize> {
+        match self.names.get(&ty.text.to_ascii_uppercase()) {
+            Some(super::Named::Enum(i)) => Some(*i),
+            _ => None,
+        }
+    }
+
+    /// The number of value `name` of enumeration `i`, if it has that value (so far).
+    pub(super) fn enum_number(&self, i: usize, name: &str) -> Option<i128> {
+        let values = &self.out.enums[i].values;
+        let found = values.iter().find(|(v, _)| v.eq_ignore_ascii_case(name));
+        found.map(|(_, x)| *x)
     }
 
     /// The number of `e` when it is an enumeration's value (`E_Axis.X`, `E_Axis#X`).
@@ -184,14 +185,7 @@ impl Checker {
             },
             _ => return None,
         };
-        let Some(super::Named::Enum(i)) = self.names.get(&ty.text.to_ascii_uppercase()) else {
-            return None;
-        };
-        let values = &self.out.enums[*i].values;
-        values
-            .iter()
-            .find(|(n, _)| n.eq_ignore_ascii_case(&v.text))
-            .map(|(_, x)| *x)
+        self.enum_number(self.enum_index(ty)?, &v.text)
     }
 
     fn refuse_const(&mut self, pos: Pos, why: String) -> Option<i128> {

@@ -6,7 +6,7 @@ use super::expr::Ctx;
 use super::lower::R;
 use super::place::plus;
 use super::{Checker, Type};
-use crate::ast::{Arg, Expr};
+use crate::ast::{Arg, Expr, Section};
 use crate::diag::Pos;
 use crate::ir::{Addr, Ex};
 use crate::layout::Layout;
@@ -45,6 +45,34 @@ impl Checker {
             .collect())
     }
 
+    /// Function `i`'s parameters in their order, its inputs and VAR_IN_OUTs: their
+    /// variables' indices.
+    pub(super) fn parameters(&self, i: usize) -> Vec<usize> {
+        let vars = &self.out.pous[i].vars;
+        (0..vars.len())
+            .filter(|k| matches!(vars[*k].section, Section::Input | Section::InOut))
+            .collect()
+    }
+
+    /// The parameter (its place among `params`) that `arg`, the call's `k`th argument,
+    /// gives: by position, or by name.
+    pub(super) fn parameter_of(
+        &self,
+        i: usize,
+        params: &[usize],
+        arg: &Arg,
+        k: usize,
+    ) -> Option<usize> {
+        let vars = &self.out.pous[i].vars;
+        match arg {
+            Arg::Positional(_) => (k < params.len()).then_some(k),
+            Arg::Input(n, _) => params
+                .iter()
+                .position(|x| vars[*x].name.eq_ignore_ascii_case(&n.text)),
+            Arg::Output { .. } => None,
+        }
+    }
+
     pub(super) fn function_value(
         &mut self,
         i: usize,
@@ -53,28 +81,16 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<Ex> {
-        use crate::ast::Section;
-        let vars = &self.out.pous[i].vars;
-        // Its parameters in their order: inputs and VAR_IN_OUTs.
-        let params: Vec<usize> = (0..vars.len())
-            .filter(|k| matches!(vars[*k].section, Section::Input | Section::InOut))
-            .collect();
+        let params = self.parameters(i);
         let (mut stores, mut back) = (Vec::new(), Vec::new());
         for (k, arg) in args.iter().enumerate() {
-            let (var, value) = match arg {
-                Arg::Positional(v) => (params.get(k).copied(), v),
-                Arg::Input(n, v) => {
-                    let found = params
-                        .iter()
-                        .copied()
-                        .find(|x| self.out.pous[i].vars[*x].name.eq_ignore_ascii_case(&n.text));
-                    (found, v)
-                }
+            let value = match arg {
+                Arg::Positional(v) | Arg::Input(_, v) => v,
                 Arg::Output { name, .. } => {
                     return Err(self.unsupported(name.pos, "an output of a function"))
                 }
             };
-            let Some(var) = var else {
+            let Some(var) = self.parameter_of(i, &params, arg, k).map(|p| params[p]) else {
                 return Err(self.unsupported(value.pos(), "this argument"));
             };
             let (ty, offset) = (self.out.pous[i].vars[var].ty.clone(), l.pous[i].2[var]);

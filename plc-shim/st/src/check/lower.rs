@@ -259,9 +259,7 @@ impl Checker {
     }
 
     fn enum_value(&self, i: usize, name: &str) -> i64 {
-        let values = &self.out.enums[i].values;
-        let found = values.iter().find(|(v, _)| v.eq_ignore_ascii_case(name));
-        found.map_or(0, |(_, n)| *n as i64)
+        self.enum_number(i, name).map_or(0, |n| n as i64)
     }
 
     fn typed_value(&mut self, ty: &Name, value: &Expr) -> R<Ex> {
@@ -368,9 +366,9 @@ impl Checker {
         let t = if real { Elem::LReal } else { d };
         // An integer literal as the duration's integer arithmetic holds it (wrapped to its
         // width, as a variable's value converted to it is).
-        let held = |v: Ex, factor: bool| match (v, d) {
-            (Ex::Int(i), Elem::Time) if factor && !real => Ex::Int(i64::from(i as i32)),
-            (v, _) => v,
+        let held = |v: Ex, factor: bool| match v {
+            Ex::Int(i) if factor && !real => Ex::Int(crate::vm::ops::wrap(i, d)),
+            v => v,
         };
         let x = held(self.value_as(a, t, ctx, l)?, !left);
         let y = held(self.value_as(b, t, ctx, l)?, left);

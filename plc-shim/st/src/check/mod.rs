@@ -544,7 +544,7 @@ impl Checker {
             Expr::Int(v, _) => Some(*v),
             // An enumeration's value: `E_Axis.X`, `E_Axis#X`.
             Expr::Field(ty, v) => match &**ty {
-                Expr::Name(ty) if self.is_enum(ty) => return self.enum_const(ty, v),
+                Expr::Name(ty) if self.enum_index(ty).is_some() => return self.enum_const(ty, v),
                 _ => None,
             },
             Expr::Typed { ty, value } if Elem::named(&ty.text.to_ascii_uppercase()).is_none() => {

@@ -432,10 +432,10 @@ impl Checker {
     pub(super) fn function_call(&mut self, i: usize, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
         self.record_call(i, pos);
         // Its parameters in their order: inputs, and VAR_IN_OUTs (a variable of their type).
-        let inputs: Vec<(String, Type, Section)> = self.out.pous[i]
-            .vars
+        let params = self.parameters(i);
+        let inputs: Vec<(String, Type, Section)> = params
             .iter()
-            .filter(|v| matches!(v.section, Section::Input | Section::InOut))
+            .map(|k| &self.out.pous[i].vars[*k])
             .map(|v| (v.name.clone(), v.ty.clone(), v.section))
             .collect();
         let name = self.out.pous[i].name.clone();
@@ -451,29 +451,27 @@ impl Checker {
         }
         let mut given = vec![false; inputs.len()];
         for (k, arg) in args.iter().enumerate() {
-            let param = match arg {
+            let found = self.parameter_of(i, &params, arg, k);
+            let (v, at) = match arg {
                 Arg::Positional(v)
                     if args[..k].iter().any(|a| !matches!(a, Arg::Positional(_))) =>
                 {
                     self.refuse(v.pos(), "a value by position after a named one: name it");
-                    None
+                    continue;
                 }
-                Arg::Positional(v) => inputs.get(k).map(|_| (k, v, v.pos())),
+                Arg::Positional(v) => (v, v.pos()),
                 Arg::Input(n, v) => {
-                    let found = inputs
-                        .iter()
-                        .position(|(i, _, _)| i.eq_ignore_ascii_case(&n.text));
                     if found.is_none() {
                         self.refuse(n.pos, format!("{name} has no input `{}`", n.text));
                     }
-                    found.map(|p| (p, v, n.pos))
+                    (v, n.pos)
                 }
                 Arg::Output { name: n, .. } => {
                     self.refuse(n.pos, format!("{name} is a function: it has no outputs"));
-                    None
+                    continue;
                 }
             };
-            if let Some((p, v, at)) = param {
+            if let Some(p) = found {
                 let (param_name, t, section) = inputs[p].clone();
                 if std::mem::replace(&mut given[p], true) {
                     self.refuse(at, format!("{name}: `{param_name}` is given twice"));
