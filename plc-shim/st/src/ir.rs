@@ -78,6 +78,8 @@ pub enum Ex {
     Conv(Elem, Elem, Box<Ex>),
     /// Whether two STRINGs hold the same characters (before their NUL).
     TextEq(Box<(Text, Text)>),
+    /// A value computed from STRINGs: an ordering, a length, a position, a number.
+    Text(Box<TextEx>),
     /// A standard function, the type it computes in, its values.
     Std(StdFn, Elem, Vec<Ex>),
     /// A user function: its body index, its inputs (offsets in its frame, at most
@@ -97,13 +99,53 @@ pub enum Ex {
     },
 }
 
-/// A STRING's characters: a literal's (NUL-padded), or a variable's `size` bytes at a place.
+/// A STRING's characters: a literal's (NUL-padded), a variable's `size` bytes at a place, or
+/// a string function's result.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Text {
     /// A literal.
     Const(Box<[u8]>),
     /// A variable: its place and size (with the NUL).
     At(Addr, u32),
+    /// A string function's result (at most [`MAX_TEXT`] characters).
+    Fn(Box<TextFn>),
+}
+
+/// The most characters a computed STRING holds (STRING(255), as TwinCAT's string functions).
+pub const MAX_TEXT: usize = 255;
+
+/// A string function whose value is a STRING (positions count from 1, as IEC 61131-3's).
+#[derive(Debug, Clone, PartialEq)]
+pub enum TextFn {
+    /// CONCAT of its values.
+    Concat(Vec<Text>),
+    /// LEFT(s, n).
+    Left(Text, Ex),
+    /// RIGHT(s, n).
+    Right(Text, Ex),
+    /// MID(s, n, p).
+    Mid(Text, Ex, Ex),
+    /// INSERT(s, t, p): `t` after the first `p` characters of `s`.
+    Insert(Text, Text, Ex),
+    /// DELETE(s, n, p).
+    Delete(Text, Ex, Ex),
+    /// REPLACE(s, t, n, p): `n` characters from `p` on replaced by `t`.
+    Replace(Text, Text, Ex, Ex),
+    /// A value of the type as text (`INT_TO_STRING`, ...).
+    Of(Elem, Ex),
+}
+
+/// A value computed from STRINGs.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TextEx {
+    /// An ordering of two STRINGs (`<`, `>`, `<=`, `>=`: by their bytes).
+    Cmp(BinOp, Text, Text),
+    /// LEN.
+    Len(Text),
+    /// FIND(s, t): where `t` first starts in `s`, 0 if nowhere.
+    Find(Text, Text),
+    /// A STRING read as a value of the type (`STRING_TO_INT`, ...).
+    To(Elem, Text),
 }
 
 /// The most inputs a call of a user function passes (their values are held on the stack while
@@ -191,6 +233,9 @@ pub enum StKind {
     Copy(Addr, Addr, u32),
     /// Writes constant bytes (a string literal, NUL-padded to its STRING's size).
     Bytes(Addr, Box<[u8]>),
+    /// Writes a string function's result into a STRING of `size` bytes (with its NUL),
+    /// cut to fit.
+    Text(Addr, u32, Text),
     /// IF/ELSIF/ELSE.
     If(Vec<(Ex, Vec<St>)>, Vec<St>),
     /// CASE: each arm's ranges of values and statements, then ELSE.

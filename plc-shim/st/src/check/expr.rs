@@ -337,8 +337,9 @@ impl Checker {
         if let Some((d, _, _)) = scaled_duration(op, &lt, &rt) {
             return Type::Elem(d);
         }
-        // Two STRINGs are equal or not (their characters before the NUL).
-        if let (Eq | Ne, Type::Str(_), Type::Str(_)) = (op, &lt, &rt) {
+        // Two STRINGs are equal or not (their characters before the NUL), or ordered by
+        // their bytes.
+        if let (Eq | Ne | Lt | Gt | Le | Ge, Type::Str(_), Type::Str(_)) = (op, &lt, &rt) {
             return BOOL;
         }
         let Some((c, _, _)) = operands_of(l, r, lt.clone(), rt.clone()) else {
@@ -442,6 +443,10 @@ impl Checker {
         let Expr::Name(n) = callee else {
             return self.error(pos, "only functions are called in an expression");
         };
+        let upper = n.text.to_ascii_uppercase();
+        if let Some(t) = self.text_call_type(&upper, args, n.pos, ctx) {
+            return t;
+        }
         if let Some((from, to)) = conversion(&n.text) {
             let [Arg::Positional(a)] = args else {
                 return self.error(pos, format!("{} takes one value", n.text));
@@ -460,7 +465,6 @@ impl Checker {
                 }
             };
         }
-        let upper = n.text.to_ascii_uppercase();
         if std_lib::FUNCTIONS.contains(&upper.as_str()) {
             return self.std_function(&upper, args, n.pos, ctx);
         }

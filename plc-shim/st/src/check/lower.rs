@@ -326,8 +326,11 @@ impl Checker {
 
     fn binary_value(&mut self, op: BinOp, a: &Expr, b: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
         let (ta, tb) = (self.expr(a, ctx), self.expr(b, ctx));
-        if let (Type::Str(m), Type::Str(n)) = (&ta, &tb) {
-            let (x, y) = (self.text_of(a, *m, ctx, l)?, self.text_of(b, *n, ctx, l)?);
+        if let (Type::Str(_), Type::Str(_)) = (&ta, &tb) {
+            if !matches!(op, BinOp::Eq | BinOp::Ne) {
+                return self.text_order_ir(op, (a, b), ctx, l);
+            }
+            let (x, y) = (self.text_ir(a, ctx, l)?, self.text_ir(b, ctx, l)?);
             let equal = Ex::TextEq(Box::new((x, y)));
             return Ok(match op {
                 BinOp::Ne => Ex::Not(Box::new(equal), Elem::Bool),
@@ -385,11 +388,14 @@ impl Checker {
             return Err(self.unsupported(callee.pos(), "this call"));
         };
         let positional = super::expr::positional(args);
+        let upper = n.text.to_ascii_uppercase();
+        if let Some(v) = self.text_value_ir(&upper, &positional, ctx, l)? {
+            return Ok(v);
+        }
         if let Some((from, to)) = conversion(&n.text) {
             let v = self.value_as(positional[0], from, ctx, l)?;
             return Ok(Ex::Conv(from, to, Box::new(v)));
         }
-        let upper = n.text.to_ascii_uppercase();
         if upper == "ADR" {
             let (addr, _) = self.place(positional[0], ctx, l)?;
             return Ok(Ex::AddrOf(Box::new(addr)));

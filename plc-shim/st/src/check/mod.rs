@@ -18,6 +18,7 @@ mod lower;
 mod place;
 pub mod std_lib;
 mod stmt;
+mod text;
 
 /// A type of the language.
 #[derive(Debug, Clone, PartialEq)]

@@ -6,7 +6,7 @@ use super::lower::R;
 use super::{Checker, Type};
 use crate::ast::{BinOp, Expr};
 use crate::diag::Diagnostic;
-use crate::ir::{Addr, Ex, StKind, StdFn, Text};
+use crate::ir::{Addr, Ex, StKind, StdFn};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -154,7 +154,12 @@ fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
 impl Checker {
     /// A string literal's bytes for a STRING(n): ASCII, at most n characters, NUL-padded to
     /// n + 1 bytes.
-    fn literal_bytes(&mut self, text: &str, n: u32, pos: crate::diag::Pos) -> R<Vec<u8>> {
+    pub(super) fn literal_bytes(
+        &mut self,
+        text: &str,
+        n: u32,
+        pos: crate::diag::Pos,
+    ) -> R<Vec<u8>> {
         if !text.is_ascii() {
             return Err(self.unsupported(pos, "a STRING of other than ASCII characters"));
         }
@@ -183,6 +188,10 @@ impl Checker {
             let bytes = self.literal_bytes(text, n, *pos)?;
             return Ok(StKind::Bytes(addr, bytes.into_boxed_slice()));
         }
+        if Self::is_text_fn(value) {
+            // Cut to the target's length when longer, as TwinCAT's string functions are.
+            return Ok(StKind::Text(addr, n + 1, self.text_ir(value, ctx, l)?));
+        }
         let (from, ty) = self.place(value, ctx, l)?;
         match ty {
             Type::Str(m) if m <= n => Ok(StKind::Copy(addr, from, m + 1)),
@@ -192,16 +201,6 @@ impl Checker {
             }
             _ => Err(self.unsupported(value.pos(), "this value into a STRING")),
         }
-    }
-
-    /// A STRING(n) operand of a comparison: a literal's bytes, or a variable's place.
-    pub(super) fn text_of(&mut self, e: &Expr, n: u32, ctx: Ctx, l: &Layout) -> R<Text> {
-        if let Expr::Str(text, pos) = e {
-            let bytes = self.literal_bytes(text, n, *pos)?;
-            return Ok(Text::Const(bytes.into_boxed_slice()));
-        }
-        let (at, _) = self.place(e, ctx, l)?;
-        Ok(Text::At(at, n + 1))
     }
 
     /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING
@@ -214,6 +213,11 @@ impl Checker {
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Ex)>> {
         let chunks = string_chunks(n);
+        if Self::is_text_fn(value) {
+            let what = "a string function's value as a block's input (assign it to a STRING \
+                        variable and pass that)";
+            return Err(self.unsupported(value.pos(), what));
+        }
         if let Expr::Str(text, pos) = value {
             let bytes = self.literal_bytes(text, n, *pos)?;
             return Ok(chunks

@@ -104,5 +104,7 @@ pub const FUNCTIONS: &[&str] = &[
 /// Whether `upper` (a name in upper case) is a standard function or function block, which no
 /// declaration may take.
 pub fn is_reserved_name(upper: &str) -> bool {
-    FUNCTIONS.contains(&upper) || StdFb::named(upper).is_some()
+    FUNCTIONS.contains(&upper)
+        || super::text::TEXT_FUNCTIONS.contains(&upper)
+        || StdFb::named(upper).is_some()
 }

@@ -219,7 +219,9 @@ impl<'c> Builder<'c> {
                 // The value is dropped (a constant or a variable has nothing to compute).
                 let _ = self.expr(e);
             }
-            StKind::Copy(..) | StKind::Bytes(..) => self.tree_statement(s, loops),
+            StKind::Copy(..) | StKind::Bytes(..) | StKind::Text(..) => {
+                self.tree_statement(s, loops)
+            }
         }
     }
 

@@ -1,7 +1,7 @@
 //! Which POUs a body calls (block bodies and functions), for the register file's size: the
 //! deepest chain of calls ([`super::code::Codes`]).
 
-use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
+use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind, Text, TextEx, TextFn};
 
 /// Every POU a statement calls (block bodies and functions), in the statements it holds too.
 pub(super) fn of_st(s: &St, out: &mut Vec<usize>) {
@@ -45,6 +45,10 @@ fn own_parts(s: &St, out: &mut Vec<usize>) {
             of_addr(b, out);
         }
         StKind::Bytes(a, _) => of_addr(a, out),
+        StKind::Text(a, _, t) => {
+            of_addr(a, out);
+            of_text(t, out);
+        }
         StKind::If(arms, _) => arms.iter().for_each(|(c, _)| of_ex(c, out)),
         StKind::Case(sel, ..) | StKind::Eval(sel) => of_ex(sel, out),
         StKind::For {
@@ -104,12 +108,16 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
             of_ex(b, out);
         }
         Ex::TextEq(pair) => {
-            for t in [&pair.0, &pair.1] {
-                if let crate::ir::Text::At(a, _) = t {
-                    of_addr(a, out);
-                }
-            }
+            of_text(&pair.0, out);
+            of_text(&pair.1, out);
         }
+        Ex::Text(e) => match &**e {
+            TextEx::Cmp(_, a, b) | TextEx::Find(a, b) => {
+                of_text(a, out);
+                of_text(b, out);
+            }
+            TextEx::Len(a) | TextEx::To(_, a) => of_text(a, out),
+        },
         Ex::Std(_, _, args) => args.iter().for_each(|a| of_ex(a, out)),
         Ex::Call {
             pou,
@@ -124,5 +132,36 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
             back.iter().for_each(|(_, _, a)| of_addr(a, out));
         }
         Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
+    }
+}
+
+fn of_text(t: &Text, out: &mut Vec<usize>) {
+    match t {
+        Text::Const(_) => {}
+        Text::At(a, _) => of_addr(a, out),
+        Text::Fn(f) => match &**f {
+            TextFn::Concat(parts) => parts.iter().for_each(|p| of_text(p, out)),
+            TextFn::Of(_, e) => of_ex(e, out),
+            TextFn::Left(a, n) | TextFn::Right(a, n) => {
+                of_text(a, out);
+                of_ex(n, out);
+            }
+            TextFn::Mid(a, n, p) | TextFn::Delete(a, n, p) => {
+                of_text(a, out);
+                of_ex(n, out);
+                of_ex(p, out);
+            }
+            TextFn::Insert(a, b, p) => {
+                of_text(a, out);
+                of_text(b, out);
+                of_ex(p, out);
+            }
+            TextFn::Replace(a, b, n, p) => {
+                of_text(a, out);
+                of_text(b, out);
+                of_ex(n, out);
+                of_ex(p, out);
+            }
+        },
     }
 }

@@ -30,6 +30,8 @@ pub enum Fault {
     NoHost,
     /// A real that is not finite read from the image, or written to it (beyond REAL's range).
     NotFinite,
+    /// A STRING read as a number (`STRING_TO_INT`, ...) that holds no number of the type.
+    NoNumber,
 }
 
 /// A fault and where it happened: small and `Copy`, made in the cycle; its text is made
@@ -62,6 +64,7 @@ impl core::fmt::Display for FaultAt {
             Fault::ImageCopy => write!(f, "a whole structure copied to or from the image"),
             Fault::NoHost => write!(f, "a library block without the PLC runtime to run it"),
             Fault::NotFinite => write!(f, "a real of the image that is not finite"),
+            Fault::NoNumber => write!(f, "a STRING read as a value that holds none"),
         }
     }
 }

@@ -28,6 +28,7 @@ pub(crate) mod ops;
 mod run;
 mod std_fb;
 mod symbols;
+mod text;
 
 pub use fault::{Fault, FaultAt};
 pub use image::IMAGE_TAG;
@@ -42,7 +43,7 @@ fn chars<'m>(
     let bytes: &[u8] = match (t, at) {
         (_, Some((from, n))) => memory.get(from..from + n).ok_or(Fault::BadPointer)?,
         (crate::ir::Text::Const(lit), None) => lit,
-        (crate::ir::Text::At(..), None) => &[],
+        (crate::ir::Text::At(..) | crate::ir::Text::Fn(_), None) => &[],
     };
     let end = bytes.iter().position(|c| *c == 0).unwrap_or(bytes.len());
     Ok(&bytes[..end])
@@ -394,6 +395,7 @@ impl<'a> Exec<'a> {
                 self.check(from, n)?;
                 self.st.memory.copy_within(from..from + n, to);
             }
+            StKind::Text(to, size, t) => self.store_text(to, *size, t, base)?,
             StKind::Bytes(to, bytes) => {
                 let to = self.own(to, base)?;
                 self.check(to, bytes.len())?;
@@ -678,6 +680,7 @@ impl<'a> Exec<'a> {
             Ex::Conv(from, to, x) => ops::convert(self.operand(x, base)?, *from, *to)?,
             Ex::Std(f, t, args) => self.std_fn(*f, *t, args, base)?,
             Ex::TextEq(pair) => V::I(i64::from(self.text_eq(&pair.0, &pair.1, base)?)),
+            Ex::Text(e) => self.text_value(e, base)?,
             Ex::Call {
                 pou,
                 inputs,
@@ -736,6 +739,9 @@ impl<'a> Exec<'a> {
     /// Whether two STRINGs hold the same characters before their NUL (or their end).
     #[inline(never)]
     fn text_eq(&mut self, a: &crate::ir::Text, b: &crate::ir::Text, base: u32) -> Run<bool> {
+        if matches!(a, crate::ir::Text::Fn(_)) || matches!(b, crate::ir::Text::Fn(_)) {
+            return Ok(self.text_cmp(a, b, base)?.is_eq());
+        }
         let (x, y) = (self.text_at(a, base)?, self.text_at(b, base)?);
         let memory = &self.st.memory;
         Ok(chars(memory, a, x)? == chars(memory, b, y)?)
@@ -744,7 +750,7 @@ impl<'a> Exec<'a> {
     /// Where a STRING operand's bytes are in the program's memory (`None`: a literal's).
     fn text_at(&mut self, t: &crate::ir::Text, base: u32) -> Run<Option<(usize, usize)>> {
         match t {
-            crate::ir::Text::Const(_) => Ok(None),
+            crate::ir::Text::Const(_) | crate::ir::Text::Fn(_) => Ok(None),
             crate::ir::Text::At(addr, n) => Ok(Some((self.own(addr, base)?, *n as usize))),
         }
     }

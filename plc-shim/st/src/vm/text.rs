@@ -1,0 +1,311 @@
+//! The string functions at run time: a STRING computed into a buffer on the stack (at most
+//! [`MAX_TEXT`] characters, as TwinCAT's string functions return STRING(255)), never on the
+//! heap; numbers written and read as text by `core::fmt` and `str::parse`, which allocate
+//! nothing.
+//!
+//! Lengths and positions count characters from 1, as IEC 61131-3's: a negative length, or a
+//! position before the first character (before 0 for INSERT) is a fault naming it; a length
+//! or position beyond the end reaches the end (`LEFT('abc', 5)` is 'abc', `MID('abc', 2, 7)`
+//! is ''), as TwinCAT's functions do.
+
+use super::{ops, Exec, Fault, Run, V};
+use crate::ast::BinOp;
+use crate::ir::{Addr, Ex, Text, TextEx, TextFn, MAX_TEXT};
+use crate::types::{Class, Elem};
+use core::cmp::Ordering;
+use core::fmt::Write;
+
+/// A computed STRING's characters.
+pub(super) struct Buf {
+    bytes: [u8; MAX_TEXT],
+    len: usize,
+}
+
+impl Buf {
+    pub(super) fn new() -> Buf {
+        Buf {
+            bytes: [0; MAX_TEXT],
+            len: 0,
+        }
+    }
+
+    /// Appends `more`, as much as still fits.
+    fn push(&mut self, more: &[u8]) {
+        let n = more.len().min(MAX_TEXT - self.len);
+        self.bytes[self.len..self.len + n].copy_from_slice(&more[..n]);
+        self.len += n;
+    }
+
+    pub(super) fn chars(&self) -> &[u8] {
+        &self.bytes[..self.len]
+    }
+}
+
+impl Write for Buf {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        self.push(s.as_bytes());
+        Ok(())
+    }
+}
+
+/// The characters before the first NUL.
+fn before_nul(bytes: &[u8]) -> &[u8] {
+    let end = bytes.iter().position(|c| *c == 0).unwrap_or(bytes.len());
+    &bytes[..end]
+}
+
+impl Exec<'_> {
+    /// Appends the characters of `t` to `out`.
+    pub(super) fn text_into(&mut self, t: &Text, base: u32, out: &mut Buf) -> Run<()> {
+        match t {
+            Text::Const(lit) => out.push(before_nul(lit)),
+            Text::At(addr, n) => {
+                let at = self.own(addr, base)?;
+                let n = *n as usize;
+                self.check(at, n)?;
+                out.push(before_nul(&self.st.memory[at..at + n]));
+            }
+            Text::Fn(f) => self.text_fn(f, base, out)?,
+        }
+        Ok(())
+    }
+
+    fn text_fn(&mut self, f: &TextFn, base: u32, out: &mut Buf) -> Run<()> {
+        let mut s = Buf::new();
+        match f {
+            TextFn::Concat(parts) => {
+                for p in parts {
+                    self.text_into(p, base, out)?;
+                }
+                return Ok(());
+            }
+            TextFn::Of(t, e) => {
+                let v = self.eval(e, base)?;
+                write_value(out, *t, v);
+                return Ok(());
+            }
+            TextFn::Left(a, _)
+            | TextFn::Right(a, _)
+            | TextFn::Mid(a, _, _)
+            | TextFn::Insert(a, _, _)
+            | TextFn::Delete(a, _, _)
+            | TextFn::Replace(a, _, _, _) => self.text_into(a, base, &mut s)?,
+        }
+        let chars = s.chars();
+        let len = chars.len();
+        match f {
+            TextFn::Left(_, n) => {
+                let n = self.count(n, 0, base)?.min(len);
+                out.push(&chars[..n]);
+            }
+            TextFn::Right(_, n) => {
+                let n = self.count(n, 0, base)?.min(len);
+                out.push(&chars[len - n..]);
+            }
+            TextFn::Mid(_, n, p) => {
+                let (n, from) = (self.count(n, 0, base)?, self.count(p, 1, base)? - 1);
+                let from = from.min(len);
+                out.push(&chars[from..(from + n).min(len)]);
+            }
+            TextFn::Insert(_, b, p) => {
+                let at = self.count(p, 0, base)?.min(len);
+                out.push(&chars[..at]);
+                self.text_into(b, base, out)?;
+                out.push(&chars[at..]);
+            }
+            TextFn::Delete(_, n, p) | TextFn::Replace(_, _, n, p) => {
+                let (n, from) = (self.count(n, 0, base)?, self.count(p, 1, base)? - 1);
+                let from = from.min(len);
+                out.push(&chars[..from]);
+                if let TextFn::Replace(_, b, _, _) = f {
+                    self.text_into(b, base, out)?;
+                }
+                out.push(&chars[(from + n).min(len)..]);
+            }
+            TextFn::Concat(_) | TextFn::Of(..) => {}
+        }
+        Ok(())
+    }
+
+    /// A length or position of at least `lo` (a fault naming it below), at most
+    /// [`MAX_TEXT`] where it is larger.
+    fn count(&mut self, e: &Ex, lo: i64, base: u32) -> Run<usize> {
+        let v = self.eval(e, base)?.int();
+        if v < lo {
+            return Err(self.fault_with(Fault::IndexOutOfRange, [v, lo, MAX_TEXT as i64]));
+        }
+        Ok(v.min(MAX_TEXT as i64) as usize)
+    }
+
+    /// Two STRINGs ordered by their bytes.
+    pub(super) fn text_cmp(&mut self, x: &Text, y: &Text, base: u32) -> Run<Ordering> {
+        let (mut a, mut b) = (Buf::new(), Buf::new());
+        self.text_into(x, base, &mut a)?;
+        self.text_into(y, base, &mut b)?;
+        Ok(a.chars().cmp(b.chars()))
+    }
+
+    /// A value computed from STRINGs.
+    pub(super) fn text_value(&mut self, e: &TextEx, base: u32) -> Run<V> {
+        let (mut a, mut b) = (Buf::new(), Buf::new());
+        match e {
+            TextEx::Cmp(op, x, y) => {
+                let o = self.text_cmp(x, y, base)?;
+                Ok(V::I(i64::from(match op {
+                    BinOp::Lt => o.is_lt(),
+                    BinOp::Gt => o.is_gt(),
+                    BinOp::Le => o.is_le(),
+                    BinOp::Ge => o.is_ge(),
+                    BinOp::Ne => o.is_ne(),
+                    _ => o.is_eq(),
+                })))
+            }
+            TextEx::Len(x) => {
+                self.text_into(x, base, &mut a)?;
+                Ok(V::I(a.chars().len() as i64))
+            }
+            TextEx::Find(x, y) => {
+                self.text_into(x, base, &mut a)?;
+                self.text_into(y, base, &mut b)?;
+                Ok(V::I(find(a.chars(), b.chars())))
+            }
+            TextEx::To(t, x) => {
+                self.text_into(x, base, &mut a)?;
+                read_value(a.chars(), *t)
+            }
+        }
+    }
+
+    /// A string function's result into the STRING of `size` bytes at `to` (its NUL
+    /// included), cut to fit, the rest NUL.
+    pub(super) fn store_text(&mut self, to: &Addr, size: u32, t: &Text, base: u32) -> Run<()> {
+        let mut s = Buf::new();
+        self.text_into(t, base, &mut s)?;
+        let at = self.own(to, base)?;
+        let size = size as usize;
+        self.check(at, size)?;
+        let place = &mut self.st.memory[at..at + size];
+        let n = s.chars().len().min(size.saturating_sub(1));
+        place[..n].copy_from_slice(&s.chars()[..n]);
+        place[n..].fill(0);
+        Ok(())
+    }
+}
+
+/// Where `needle` first starts in `hay`, from 1; 0 if nowhere (or if it is empty).
+fn find(hay: &[u8], needle: &[u8]) -> i64 {
+    if needle.is_empty() || needle.len() > hay.len() {
+        return 0;
+    }
+    hay.windows(needle.len())
+        .position(|w| w == needle)
+        .map_or(0, |k| k as i64 + 1)
+}
+
+/// A value of type `t` as text: TRUE/FALSE, an integer in decimal, a real as its shortest
+/// form that reads back the same (with an exponent beyond 1e15 and below 1e-5), a duration
+/// as `T#1s500ms` (`LTIME#..` down to ns).
+fn write_value(out: &mut Buf, t: Elem, v: V) {
+    let _ = match (t.class(), v) {
+        (Class::Bool, v) => out.write_str(if v.int() != 0 { "TRUE" } else { "FALSE" }),
+        (Class::Unsigned | Class::Bits, v) => write!(out, "{}", v.int() as u64),
+        (Class::Float, v) => {
+            let x = v.float();
+            let big = x != 0.0 && !(1e-5..1e15).contains(&x.abs());
+            match (t == Elem::Real, big) {
+                (true, true) => write!(out, "{:e}", x as f32),
+                (true, false) => write!(out, "{}", x as f32),
+                (false, true) => write!(out, "{x:e}"),
+                (false, false) => write!(out, "{x}"),
+            }
+        }
+        (Class::Duration, v) => write_duration(out, t == Elem::LTime, v.int()),
+        (_, v) => write!(out, "{}", v.int()),
+    };
+}
+
+fn write_duration(out: &mut Buf, ns: bool, v: i64) -> core::fmt::Result {
+    out.write_str(if ns { "LTIME#" } else { "T#" })?;
+    if v < 0 {
+        out.write_str("-")?;
+    }
+    let mut rest = v.unsigned_abs();
+    let ms: u64 = if ns { 1_000_000 } else { 1 };
+    let units: [(&str, u64); 7] = [
+        ("d", 86_400_000 * ms),
+        ("h", 3_600_000 * ms),
+        ("m", 60_000 * ms),
+        ("s", 1000 * ms),
+        ("ms", ms),
+        ("us", if ns { 1000 } else { 0 }),
+        ("ns", if ns { 1 } else { 0 }),
+    ];
+    if rest == 0 {
+        return out.write_str(if ns { "0ns" } else { "0ms" });
+    }
+    for (name, size) in units {
+        if size > 0 && rest >= size {
+            write!(out, "{}{name}", rest / size)?;
+            rest %= size;
+        }
+    }
+    Ok(())
+}
+
+/// Text as a value of type `t`: TRUE/FALSE (or 1/0) for BOOL; an integer with a sign, `_`
+/// between digits and `2#`, `8#`, `16#` bases; a finite real as Rust reads one. Spaces
+/// around it are skipped; anything else is a fault, as is a value the type cannot hold.
+fn read_value(text: &[u8], t: Elem) -> Run<V> {
+    let s = core::str::from_utf8(text)
+        .map_err(|_| Fault::NoNumber)?
+        .trim_matches(' ');
+    match t.class() {
+        Class::Bool if s.eq_ignore_ascii_case("TRUE") || s == "1" => Ok(V::I(1)),
+        Class::Bool if s.eq_ignore_ascii_case("FALSE") || s == "0" => Ok(V::I(0)),
+        Class::Bool => Err(Fault::NoNumber),
+        Class::Float => {
+            let x: f64 = s.parse().map_err(|_| Fault::NoNumber)?;
+            if !x.is_finite() || (t == Elem::Real && x.abs() > f64::from(f32::MAX)) {
+                return Err(Fault::OutOfRange);
+            }
+            ops::convert(V::F(x), Elem::LReal, t)
+        }
+        _ => {
+            let x = read_integer(s).ok_or(Fault::NoNumber)?;
+            match t.range() {
+                Some((lo, hi)) if (lo..=hi).contains(&x) => Ok(V::I(x as i64)),
+                _ => Err(Fault::OutOfRange),
+            }
+        }
+    }
+}
+
+/// An integer as the language writes one, `None` if `s` is none.
+fn read_integer(s: &str) -> Option<i128> {
+    let (negative, s) = match s.as_bytes().first()? {
+        b'-' => (true, &s[1..]),
+        b'+' => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let (radix, digits) = match s.split_once('#') {
+        Some(("2", d)) => (2, d),
+        Some(("8", d)) => (8, d),
+        Some(("16", d)) => (16, d),
+        Some(_) => return None,
+        None => (10, s),
+    };
+    let ok = !digits.is_empty()
+        && !digits.starts_with('_')
+        && !digits.ends_with('_')
+        && !digits.contains("__");
+    let mut v: i128 = 0;
+    for c in digits.chars().filter(|c| *c != '_') {
+        v = v
+            .checked_mul(radix)?
+            .checked_add(i128::from(c.to_digit(radix as u32)?))?;
+        if v > i128::from(u64::MAX) {
+            return None;
+        }
+    }
+    ok.then_some(if negative { -v } else { v })
+}

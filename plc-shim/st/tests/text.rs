@@ -1,0 +1,225 @@
+//! The string functions (LEN, LEFT, RIGHT, MID, CONCAT, INSERT, DELETE, REPLACE, FIND), the
+//! conversions to and from STRING and the ordering of STRINGs: their values as IEC 61131-3
+//! and TwinCAT give them, their faults with the numbers they name, the refusals at load, and
+//! a cycle that computes strings without allocating.
+
+use plc_st::vm::{Fault, Program};
+
+#[path = "../../../tests/support/counting_alloc.rs"]
+mod counting_alloc;
+
+fn load(text: &str) -> Program {
+    Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
+        )
+    })
+}
+
+fn refused(text: &str) -> String {
+    match Program::load(&[("main.st", text)]) {
+        Ok(_) => panic!("loaded: {text}"),
+        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
+    }
+}
+
+/// Runs one cycle of program MAIN (after `before`) whose BOOLs `ok1` .. `ok<n>` hold the
+/// checks' results, and names the checks that failed.
+fn checks(before: &str, vars: &str, body: &str, n: usize) {
+    let oks: Vec<String> = (1..=n).map(|k| format!("ok{k}")).collect();
+    let text = format!(
+        "{before}PROGRAM MAIN\nVAR\n    {} : BOOL;\n{vars}\nEND_VAR\n{body}\nEND_PROGRAM",
+        oks.join(", ")
+    );
+    let mut p = load(&text);
+    p.cycle(0)
+        .unwrap_or_else(|f| panic!("{}", p.fault_text(&f)));
+    let failed: Vec<&String> = oks
+        .iter()
+        .filter(|ok| p.read_var(&format!("MAIN.{ok}")) != Some(1.0))
+        .collect();
+    assert!(failed.is_empty(), "checks that failed: {failed:?}");
+}
+
+#[test]
+fn the_string_functions_give_what_iec_and_twincat_give() {
+    let vars = "    s : STRING(80) := 'Hello World';
+    sEmpty, sOut : STRING(80);
+    sShort : STRING(4);
+    n : INT := 3;";
+    let body = "
+    ok1 := LEN(s) = 11 AND LEN(sEmpty) = 0 AND LEN('') = 0;
+    ok2 := LEFT(s, 5) = 'Hello' AND LEFT(s, 0) = '' AND LEFT(s, 99) = s;
+    ok3 := RIGHT(s, 5) = 'World' AND RIGHT(s, 99) = 'Hello World';
+    ok4 := MID(s, 3, 7) = 'Wor' AND MID(s, 99, 7) = 'World' AND MID(s, 2, 12) = '';
+    ok5 := CONCAT('part', '_', INT_TO_STRING(n), '.nc') = 'part_3.nc';
+    ok6 := INSERT('ac', 'b', 1) = 'abc' AND INSERT('ac', 'b', 0) = 'bac'
+        AND INSERT('ac', 'b', 9) = 'acb';
+    ok7 := DELETE(s, 6, 6) = 'Hello' AND DELETE(s, 1, 1) = 'ello World'
+        AND DELETE(s, 5, 20) = s;
+    ok8 := REPLACE(s, 'there', 5, 7) = 'Hello there' AND REPLACE('abc', 'X', 0, 2) = 'aXbc';
+    ok9 := FIND(s, 'o') = 5 AND FIND(s, 'World') = 7 AND FIND(s, 'x') = 0
+        AND FIND(s, '') = 0 AND FIND('ab', 'abc') = 0;
+    ok10 := 'abc' < 'abd' AND 'ab' < 'abc' AND 'b' > 'abc' AND s >= s AND s <= s
+        AND NOT ('abc' < 'abc');
+    sOut := CONCAT(LEFT(s, 5), ', PLC');
+    ok11 := sOut = 'Hello, PLC' AND LEN(sOut) = 10;
+    (* Cut to the target, as TwinCAT's functions are. *)
+    sShort := CONCAT(s, s);
+    ok12 := sShort = 'Hell' AND LEN(sShort) = 4;
+    ok13 := UPPER_OK();
+";
+    // A function of the program's own may use them too.
+    let upper = "FUNCTION UPPER_OK : BOOL VAR t : STRING(20); END_VAR
+    t := CONCAT('a', 'b');
+    UPPER_OK := t = 'ab';
+END_FUNCTION
+";
+    checks(upper, vars, body, 13);
+}
+
+#[test]
+fn numbers_become_text_and_text_numbers() {
+    let vars = "    i : INT := -42;
+    u : UDINT := 4000000000;
+    w : WORD := 16#FFFF;
+    b : BOOL := TRUE;
+    r : REAL := 0.1;
+    x : LREAL := 1.5;
+    t : TIME := T#1M2S30MS;
+    lt : LTIME;
+    nInt : INT;
+    nU : ULINT;
+    f : LREAL;
+    fr : REAL;
+    bb : BOOL;";
+    let body = "
+    ok1 := INT_TO_STRING(i) = '-42' AND UDINT_TO_STRING(u) = '4000000000'
+        AND WORD_TO_STRING(w) = '65535';
+    ok2 := BOOL_TO_STRING(b) = 'TRUE' AND BOOL_TO_STRING(FALSE) = 'FALSE';
+    ok3 := REAL_TO_STRING(r) = '0.1' AND LREAL_TO_STRING(x) = '1.5'
+        AND LREAL_TO_STRING(100.0) = '100' AND LREAL_TO_STRING(1.0E20) = '1e20'
+        AND LREAL_TO_STRING(-2.5E-7) = '-2.5e-7';
+    ok4 := TIME_TO_STRING(t) = 'T#1m2s30ms';
+    ok10 := TIME_TO_STRING(T#0MS) = 'T#0ms';
+    lt := LINT_TO_LTIME(1000005001);
+    ok11 := LTIME_TO_STRING(lt) = 'LTIME#1s5us1ns';
+    nInt := STRING_TO_INT(' -123 ');
+    ok5 := nInt = -123 AND STRING_TO_INT('16#7F') = 127 AND STRING_TO_INT('1_000') = 1000;
+    nU := STRING_TO_ULINT('18446744073709551615');
+    ok6 := nU = ULINT#18446744073709551615;
+    f := STRING_TO_LREAL('2.5e3');
+    fr := STRING_TO_REAL('0.25');
+    ok7 := f = 2500.0 AND fr = 0.25;
+    bb := STRING_TO_BOOL('true');
+    ok8 := bb AND NOT STRING_TO_BOOL('0');
+    (* Text and back. *)
+    ok9 := STRING_TO_DINT(DINT_TO_STRING(-2147483648)) = -2147483648;
+";
+    checks("", vars, body, 11);
+}
+
+fn fault(body: &str) -> (Fault, [i64; 3], String) {
+    let text = format!(
+        "PROGRAM MAIN\nVAR s : STRING(20) := 'abc'; n : INT; i : SINT; END_VAR\n{body}\nEND_PROGRAM"
+    );
+    let mut p = load(&text);
+    let f = p.cycle(0).expect_err("a fault");
+    (f.fault, f.values, p.fault_text(&f))
+}
+
+#[test]
+fn a_bad_length_position_or_number_faults_with_its_place() {
+    let (f, values, text) = fault("  s := MID(s, 2, 0);");
+    assert_eq!(f, Fault::IndexOutOfRange);
+    assert_eq!(values, [0, 1, 255]);
+    assert!(
+        text.starts_with("main.st:3:3: fault: index 0 outside [1..255]"),
+        "{text}"
+    );
+    let (f, values, _) = fault("  s := LEFT(s, n - 1);");
+    assert_eq!((f, values), (Fault::IndexOutOfRange, [-1, 0, 255]));
+    let (f, values, _) = fault("  s := INSERT(s, 'x', -2);");
+    assert_eq!((f, values), (Fault::IndexOutOfRange, [-2, 0, 255]));
+    let (f, _, text) = fault("  n := STRING_TO_INT('12x');");
+    assert_eq!(f, Fault::NoNumber);
+    assert!(text.contains("holds none"), "{text}");
+    let (f, _, _) = fault("  n := STRING_TO_INT(s);");
+    assert_eq!(f, Fault::NoNumber);
+    let (f, _, _) = fault("  i := STRING_TO_SINT('300');");
+    assert_eq!(f, Fault::OutOfRange);
+    let (f, _, _) = fault("  n := REAL_TO_INT(STRING_TO_REAL('1e39'));");
+    assert_eq!(f, Fault::OutOfRange);
+    let (f, _, _) = fault("  n := LREAL_TO_INT(STRING_TO_LREAL('inf'));");
+    assert_eq!(f, Fault::OutOfRange);
+}
+
+#[test]
+fn what_the_string_functions_do_not_take_is_refused_at_load() {
+    let program = |body: &str| {
+        format!(
+            "FUNCTION_BLOCK FB_Name VAR_INPUT sName : STRING(20); END_VAR END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR s : STRING(20); n : INT; fb : FB_Name; END_VAR
+{body}
+END_PROGRAM"
+        )
+    };
+    let e = refused(&program("  s := LEFT(n, 2);"));
+    assert!(
+        e.contains("main.st:4:13: error: LEFT takes a STRING here, not a INT"),
+        "{e}"
+    );
+    let e = refused(&program("  s := LEFT(s, 'a');"));
+    assert!(
+        e.contains("LEFT takes an integer here, not a STRING(1)"),
+        "{e}"
+    );
+    let e = refused(&program("  s := CONCAT(s);"));
+    assert!(e.contains("CONCAT takes 2 to 16 values"), "{e}");
+    let e = refused(&program("  s := MID(s, 2);"));
+    assert!(e.contains("MID takes 3 values"), "{e}");
+    let e = refused(&program("  n := LEN(s) + LEN(n);"));
+    assert!(e.contains("LEN takes a STRING here, not a INT"), "{e}");
+    let e = refused(&program("  n := STRING_TO_TIME(s);"));
+    assert!(
+        e.contains("a duration from a STRING is not supported yet"),
+        "{e}"
+    );
+    let e = refused(&program("  n := CONCAT(s, s);"));
+    assert!(
+        e.contains("main.st:4:8: error: a STRING(40) where a INT is wanted"),
+        "{e}"
+    );
+    let e = refused(&program("  fb(sName := CONCAT(s, 'x'));"));
+    assert!(
+        e.contains("main.st:4:15: error: a string function's value as a block's input"),
+        "{e}"
+    );
+    let e = refused("FUNCTION_BLOCK Concat END_FUNCTION_BLOCK");
+    assert!(e.contains("`Concat` is a standard name"), "{e}");
+}
+
+/// After the load, a cycle that computes strings allocates nothing.
+#[test]
+fn a_cycle_with_strings_allocates_nothing() {
+    let mut p = load(
+        "PROGRAM MAIN
+VAR s : STRING(80); n : DINT; k : INT; bLess : BOOL; END_VAR
+    n := n + 1;
+    s := CONCAT('part_', DINT_TO_STRING(n), '.nc');
+    s := REPLACE(INSERT(s, LEFT('xyz', 2), 5), 'P', 1, 1);
+    k := FIND(s, '.nc') + LEN(MID(s, 3, 2)) + STRING_TO_INT(RIGHT('a42', 2));
+    bLess := DELETE(s, 1, 1) < s;
+END_PROGRAM",
+    );
+    p.cycle(0).unwrap();
+    let before = counting_alloc::allocations();
+    for k in 1..1000 {
+        p.cycle(k * 1_000_000).unwrap();
+    }
+    assert_eq!(counting_alloc::allocations() - before, 0);
+    // 'Part_xy1000.nc': '.nc' at 12, 'art' 3 characters, 42.
+    assert_eq!(p.read_var("MAIN.k"), Some(12.0 + 3.0 + 42.0));
+}
