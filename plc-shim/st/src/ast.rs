@@ -318,8 +318,8 @@ pub enum Expr {
     Bool(bool, Pos),
     /// A string literal.
     Str(String, Pos),
-    /// A duration, in nanoseconds.
-    Time(i128, Pos),
+    /// A duration, in nanoseconds; an LTIME's (`LTIME#..`) with `true`.
+    Time(i128, bool, Pos),
     /// A typed literal: `DINT#-5`, `E_Mode#Run`.
     Typed {
         /// The type prefix.
@@ -358,7 +358,7 @@ impl Expr {
             | Expr::Real(_, p)
             | Expr::Bool(_, p)
             | Expr::Str(_, p)
-            | Expr::Time(_, p)
+            | Expr::Time(_, _, p)
             | Expr::Unary(_, _, p) => *p,
             Expr::Typed { ty, .. } => ty.pos,
             Expr::Name(n) => n.pos,

@@ -24,8 +24,9 @@ pub enum Tok {
     Int(i128),
     /// A real literal.
     Real(f64),
-    /// A duration literal (`T#..`, `TIME#..`, `LTIME#..`), in nanoseconds.
-    Time(i128),
+    /// A duration literal (`T#..`, `TIME#..`, `LTIME#..`), in nanoseconds; an LTIME's with
+    /// `true`.
+    Time(i128, bool),
     /// A string literal `'..'` with its `$` escapes resolved.
     Str(String),
     /// A type prefix of a typed literal: `DINT` of `DINT#5` (the literal follows).
@@ -229,7 +230,7 @@ impl Lexer {
         self.bump();
         let upper = name.to_ascii_uppercase();
         if matches!(upper.as_str(), "T" | "TIME" | "LTIME") {
-            return self.duration(pos);
+            return self.duration(pos, upper == "LTIME");
         }
         Ok(Tok::TypePrefix(name))
     }
@@ -310,7 +311,7 @@ impl Lexer {
     }
 
     /// The rest of `T#1h2m3s4ms5us6ns` (`1.5s`, `-2s`, `_` between parts): nanoseconds.
-    fn duration(&mut self, pos: Pos) -> Result<Tok, Diagnostic> {
+    fn duration(&mut self, pos: Pos, long: bool) -> Result<Tok, Diagnostic> {
         let negative = self.peek(0) == Some('-');
         if negative {
             self.bump();
@@ -354,7 +355,7 @@ impl Lexer {
             return Err(self.error(pos, "a duration needs a value and a unit (T#1s)"));
         }
         let ns = total.round() as i128;
-        Ok(Tok::Time(if negative { -ns } else { ns }))
+        Ok(Tok::Time(if negative { -ns } else { ns }, long))
     }
 
     /// `'text'` with `$$`, `$'`, `$L`, `$N`, `$P`, `$R`, `$T` and `$hh`.

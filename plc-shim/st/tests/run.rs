@@ -165,8 +165,8 @@ fn a_durations_literal_factor_is_held_as_a_variables_is() {
         "PROGRAM MAIN VAR d : LINT := 4294967297; t1, t2, t3, t4 : TIME; END_VAR
 t1 := T#1S / 4294967297;
 t2 := T#1S / d;
-t3 := T#30D / 2;
-t4 := T#30D * 0.5;
+t3 := T#20D / 2;
+t4 := T#20D * 0.5;
 END_PROGRAM",
         1,
     );

@@ -105,6 +105,14 @@ impl Checker {
             },
             Expr::Real(..) => Type::Elem(Elem::LReal),
             Expr::Bool(..) => BOOL,
+            Expr::Time(ns, true, pos) if i64::try_from(*ns).is_err() => {
+                self.error(*pos, "an LTIME literal beyond LTIME's 2^63 ns")
+            }
+            Expr::Time(_, true, _) => Type::Elem(Elem::LTime),
+            Expr::Time(ns, false, pos) if i32::try_from(*ns / 1_000_000).is_err() => self.error(
+                *pos,
+                "a TIME literal beyond TIME's T#24d20h31m23s647ms (an LTIME# holds it)",
+            ),
             Expr::Time(..) => Type::Elem(Elem::Time),
             Expr::Str(s, pos) => match u32::try_from(s.chars().count()) {
                 Ok(n) if n <= 255 => Type::Str(n.max(1)),

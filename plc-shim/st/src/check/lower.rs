@@ -234,7 +234,8 @@ impl Checker {
             Expr::Real(v, _) => Ok(Ex::Real(*v)),
             Expr::Bool(b, _) => Ok(Ex::Int(i64::from(*b))),
             // TIME counts milliseconds.
-            Expr::Time(ns, _) => Ok(Ex::Int((*ns / 1_000_000) as i64)),
+            Expr::Time(ns, true, _) => Ok(Ex::Int(*ns as i64)),
+            Expr::Time(ns, false, _) => Ok(Ex::Int((*ns / 1_000_000) as i64)),
             Expr::Str(_, pos) => Err(self.unsupported(*pos, "a string in an expression")),
             Expr::Typed { ty, value } => self.typed_value(ty, value),
             Expr::Name(n) => match self.meaning(&n.text, ctx) {

@@ -451,7 +451,7 @@ impl Parser {
         let e = match self.peek().clone() {
             Tok::Int(v) => Expr::Int(v, pos),
             Tok::Real(v) => Expr::Real(v, pos),
-            Tok::Time(v) => Expr::Time(v, pos),
+            Tok::Time(v, long) => Expr::Time(v, long, pos),
             Tok::Str(s) => Expr::Str(s, pos),
             Tok::Ident(_) if self.is_kw("TRUE") => Expr::Bool(true, pos),
             Tok::Ident(_) if self.is_kw("FALSE") => Expr::Bool(false, pos),

@@ -172,6 +172,13 @@ pub(crate) fn convert(v: V, from: Elem, to: Elem) -> Run<V> {
             }
         }
         (false, false) if to == Elem::Bool => Ok(V::I(i64::from(v.int() != 0))),
+        // TIME counts ms, LTIME ns (a TIME's fits an LTIME's 64 bits a million times over).
+        (false, false) if (from, to) == (Elem::Time, Elem::LTime) => {
+            Ok(V::I(v.int().saturating_mul(1_000_000)))
+        }
+        (false, false) if (from, to) == (Elem::LTime, Elem::Time) => {
+            Ok(V::I(wrap(v.int() / 1_000_000, to)))
+        }
         (false, false) => Ok(V::I(wrap(v.int(), to))),
     }
 }
