@@ -151,8 +151,41 @@ fn a_bad_length_position_or_number_faults_with_its_place() {
     assert_eq!(f, Fault::OutOfRange);
     let (f, _, _) = fault("  n := REAL_TO_INT(STRING_TO_REAL('1e39'));");
     assert_eq!(f, Fault::OutOfRange);
-    let (f, _, _) = fault("  n := LREAL_TO_INT(STRING_TO_LREAL('inf'));");
+    let (f, _, _) = fault("  n := LREAL_TO_INT(STRING_TO_LREAL('1e400'));");
     assert_eq!(f, Fault::OutOfRange);
+    // Rust reads these as reals; they are no numbers.
+    for text in ["inf", "NaN", "-infinity"] {
+        let (f, _, _) = fault(&format!("  n := LREAL_TO_INT(STRING_TO_LREAL('{text}'));"));
+        assert_eq!(f, Fault::NoNumber, "{text}");
+    }
+    // Beyond every integer type: out of range, not no number.
+    let (f, _, _) = fault("  n := ULINT_TO_INT(STRING_TO_ULINT('18446744073709551616'));");
+    assert_eq!(f, Fault::OutOfRange);
+    let (f, _, _) = fault("  n := LINT_TO_INT(STRING_TO_LINT('-99999999999999999999999'));");
+    assert_eq!(f, Fault::OutOfRange);
+    // A REAL beyond REAL's range (computed in LREAL) as text.
+    let (f, _, _) = fault("  s := REAL_TO_STRING(REAL#1.0E30 * REAL#1.0E30);");
+    assert_eq!(f, Fault::OutOfRange);
+}
+
+#[test]
+fn values_are_taken_in_their_order_and_long_lengths_reach_the_end() {
+    let before = "VAR_GLOBAL g : INT; END_VAR
+FUNCTION Bump : INT g := g + 1; Bump := g; END_FUNCTION
+";
+    let vars = "    s : STRING(20) := 'Hello';
+    u : UDINT := 3000000000;
+    b : LINT := 4294967296;";
+    let body = "
+    (* INSERT's and REPLACE's second STRING before their numbers, as written. *)
+    ok1 := INSERT('ab', INT_TO_STRING(Bump()), Bump()) = 'ab1';
+    ok2 := REPLACE('abcd', INT_TO_STRING(Bump()), Bump() - 2, Bump() - 3) = 'a3d';
+    ok3 := LEFT(s, u) = s AND LEFT(s, b) = s AND MID(s, 1, b + 1) = '' AND RIGHT(s, u) = s;
+";
+    checks(before, vars, body, 3);
+    // The first fault in the values' order is the one named.
+    let (f, values, _) = fault("  s := INSERT(s, MID(s, 1, 0), -1);");
+    assert_eq!((f, values), (Fault::IndexOutOfRange, [0, 1, 255]));
 }
 
 #[test]
@@ -173,7 +206,7 @@ END_PROGRAM"
     );
     let e = refused(&program("  s := LEFT(s, 'a');"));
     assert!(
-        e.contains("LEFT takes an integer here, not a STRING(1)"),
+        e.contains("LEFT takes an integer of at most 63 bits here, not a STRING(1)"),
         "{e}"
     );
     let e = refused(&program("  s := CONCAT(s);"));
@@ -199,6 +232,18 @@ END_PROGRAM"
     );
     let e = refused("FUNCTION_BLOCK Concat END_FUNCTION_BLOCK");
     assert!(e.contains("`Concat` is a standard name"), "{e}");
+    let e = refused("FUNCTION REAL_TO_STRING : INT REAL_TO_STRING := 1; END_FUNCTION");
+    assert!(e.contains("`REAL_TO_STRING` is a standard name"), "{e}");
+    let e = refused(&program("  s := USINT_TO_STRING(300);"));
+    assert!(
+        e.contains("main.st:4:24: error: 300 does not fit a USINT"),
+        "{e}"
+    );
+    let e = refused(&program("  s := LEFT(s, ULINT#3);"));
+    assert!(
+        e.contains("LEFT takes an integer of at most 63 bits here, not a ULINT"),
+        "{e}"
+    );
 }
 
 /// After the load, a cycle that computes strings allocates nothing.

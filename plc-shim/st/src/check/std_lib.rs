@@ -106,5 +106,7 @@ pub const FUNCTIONS: &[&str] = &[
 pub fn is_reserved_name(upper: &str) -> bool {
     FUNCTIONS.contains(&upper)
         || super::text::TEXT_FUNCTIONS.contains(&upper)
+        || super::text::text_conversion(upper).is_some()
+        || crate::types::conversion(upper).is_some()
         || StdFb::named(upper).is_some()
 }

@@ -36,7 +36,7 @@ fn signature(name: &str) -> Option<&'static [bool]> {
 }
 
 /// The conversion of a name to or from STRING: the other type, and whether it goes to STRING.
-fn text_conversion(upper: &str) -> Option<(Elem, bool)> {
+pub(super) fn text_conversion(upper: &str) -> Option<(Elem, bool)> {
     let (from, to) = upper.split_once("_TO_")?;
     match (from, to) {
         ("STRING", t) => Elem::named(t).map(|e| (e, false)),
@@ -107,7 +107,9 @@ impl Checker {
             match (text, self.expr(v, ctx)) {
                 (_, Type::Error) => return Some(Type::Error),
                 (true, Type::Str(n)) => lengths.push(n),
-                (false, Type::Elem(e)) if e.is_integer() => {}
+                // Computed in LINT: a 64-bit unsigned value would not fit.
+                (false, Type::Elem(e))
+                    if e.is_integer() && !matches!(e, Elem::ULInt | Elem::LWord) => {}
                 (true, t) => {
                     let found = self.type_name(&t);
                     return Some(self.error(
@@ -119,7 +121,7 @@ impl Checker {
                     let found = self.type_name(&t);
                     return Some(self.error(
                         v.pos(),
-                        format!("{upper} takes an integer here, not a {found}"),
+                        format!("{upper} takes an integer of at most 63 bits here, not a {found}"),
                     ));
                 }
             }
@@ -157,6 +159,13 @@ impl Checker {
         }
         match (to_text, self.expr(v, ctx)) {
             (_, Type::Error) => Type::Error,
+            (true, _)
+                if literal(v)
+                    .is_some_and(|x| t.range().is_some_and(|(lo, hi)| !(lo..=hi).contains(&x))) =>
+            {
+                let x = literal(v).unwrap_or_default();
+                self.error(v.pos(), format!("{x} does not fit a {}", t.name()))
+            }
             (true, Type::Elem(e)) if e == t || e.widens_to(t) || literal(v).is_some() => {
                 Type::Str(text_len(t))
             }
@@ -215,7 +224,7 @@ impl Checker {
         if let Some((t, true)) = text_conversion(&upper) {
             return Ok(Some(TextFn::Of(t, self.value_as(v[0], t, ctx, l)?)));
         }
-        let int = |c: &mut Self, k: usize| c.value_as(v[k], Elem::DInt, ctx, l);
+        let int = |c: &mut Self, k: usize| c.value_as(v[k], Elem::LInt, ctx, l);
         Ok(Some(match upper.as_str() {
             "CONCAT" => TextFn::Concat(
                 v.iter()

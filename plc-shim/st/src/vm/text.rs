@@ -81,8 +81,7 @@ impl Exec<'_> {
             }
             TextFn::Of(t, e) => {
                 let v = self.eval(e, base)?;
-                write_value(out, *t, v);
-                return Ok(());
+                return write_value(out, *t, v);
             }
             TextFn::Left(a, _)
             | TextFn::Right(a, _)
@@ -108,18 +107,23 @@ impl Exec<'_> {
                 out.push(&chars[from..(from + n).min(len)]);
             }
             TextFn::Insert(_, b, p) => {
+                // The values in their order: the second STRING before the position.
+                let mut t = Buf::new();
+                self.text_into(b, base, &mut t)?;
                 let at = self.count(p, 0, base)?.min(len);
                 out.push(&chars[..at]);
-                self.text_into(b, base, out)?;
+                out.push(t.chars());
                 out.push(&chars[at..]);
             }
             TextFn::Delete(_, n, p) | TextFn::Replace(_, _, n, p) => {
+                let mut t = Buf::new();
+                if let TextFn::Replace(_, b, _, _) = f {
+                    self.text_into(b, base, &mut t)?;
+                }
                 let (n, from) = (self.count(n, 0, base)?, self.count(p, 1, base)? - 1);
                 let from = from.min(len);
                 out.push(&chars[..from]);
-                if let TextFn::Replace(_, b, _, _) = f {
-                    self.text_into(b, base, out)?;
-                }
+                out.push(t.chars());
                 out.push(&chars[(from + n).min(len)..]);
             }
             TextFn::Concat(_) | TextFn::Of(..) => {}
@@ -145,9 +149,11 @@ impl Exec<'_> {
         Ok(a.chars().cmp(b.chars()))
     }
 
-    /// A value computed from STRINGs.
+    /// A value computed from STRINGs (out of line: its buffers stay off the tree walker's
+    /// frames).
+    #[inline(never)]
     pub(super) fn text_value(&mut self, e: &TextEx, base: u32) -> Run<V> {
-        let (mut a, mut b) = (Buf::new(), Buf::new());
+        let mut a = Buf::new();
         match e {
             TextEx::Cmp(op, x, y) => {
                 let o = self.text_cmp(x, y, base)?;
@@ -165,6 +171,7 @@ impl Exec<'_> {
                 Ok(V::I(a.chars().len() as i64))
             }
             TextEx::Find(x, y) => {
+                let mut b = Buf::new();
                 self.text_into(x, base, &mut a)?;
                 self.text_into(y, base, &mut b)?;
                 Ok(V::I(find(a.chars(), b.chars())))
@@ -205,13 +212,22 @@ fn find(hay: &[u8], needle: &[u8]) -> i64 {
 /// A value of type `t` as text: TRUE/FALSE, an integer in decimal, a real as its shortest
 /// form that reads back the same (with an exponent beyond 1e15 and below 1e-5), a duration
 /// as `T#1s500ms` (`LTIME#..` down to ns).
-fn write_value(out: &mut Buf, t: Elem, v: V) {
+/// A REAL beyond REAL's range (computed in LREAL) faults as its conversion would.
+fn write_value(out: &mut Buf, t: Elem, v: V) -> Run<()> {
+    if t == Elem::Real && !(v.float() as f32).is_finite() {
+        return Err(Fault::OutOfRange);
+    }
     let _ = match (t.class(), v) {
         (Class::Bool, v) => out.write_str(if v.int() != 0 { "TRUE" } else { "FALSE" }),
         (Class::Unsigned | Class::Bits, v) => write!(out, "{}", v.int() as u64),
         (Class::Float, v) => {
             let x = v.float();
-            let big = x != 0.0 && !(1e-5..1e15).contains(&x.abs());
+            let y = if t == Elem::Real {
+                f64::from(x as f32)
+            } else {
+                x
+            };
+            let big = y != 0.0 && !(1e-5..1e15).contains(&y.abs());
             match (t == Elem::Real, big) {
                 (true, true) => write!(out, "{:e}", x as f32),
                 (true, false) => write!(out, "{}", x as f32),
@@ -222,6 +238,7 @@ fn write_value(out: &mut Buf, t: Elem, v: V) {
         (Class::Duration, v) => write_duration(out, t == Elem::LTime, v.int()),
         (_, v) => write!(out, "{}", v.int()),
     };
+    Ok(())
 }
 
 fn write_duration(out: &mut Buf, ns: bool, v: i64) -> core::fmt::Result {
@@ -264,7 +281,14 @@ fn read_value(text: &[u8], t: Elem) -> Run<V> {
         Class::Bool if s.eq_ignore_ascii_case("FALSE") || s == "0" => Ok(V::I(0)),
         Class::Bool => Err(Fault::NoNumber),
         Class::Float => {
+            // Rust reads `inf` and `NaN` too: no numbers here.
+            let named = s
+                .bytes()
+                .any(|c| c.is_ascii_alphabetic() && c != b'e' && c != b'E');
             let x: f64 = s.parse().map_err(|_| Fault::NoNumber)?;
+            if named {
+                return Err(Fault::NoNumber);
+            }
             if !x.is_finite() || (t == Elem::Real && x.abs() > f64::from(f32::MAX)) {
                 return Err(Fault::OutOfRange);
             }
@@ -298,14 +322,11 @@ fn read_integer(s: &str) -> Option<i128> {
         && !digits.starts_with('_')
         && !digits.ends_with('_')
         && !digits.contains("__");
+    // Beyond every type's range: held one past ULINT's largest, so that it is out of range.
+    let beyond = i128::from(u64::MAX) + 1;
     let mut v: i128 = 0;
     for c in digits.chars().filter(|c| *c != '_') {
-        v = v
-            .checked_mul(radix)?
-            .checked_add(i128::from(c.to_digit(radix as u32)?))?;
-        if v > i128::from(u64::MAX) {
-            return None;
-        }
+        v = (v * radix + i128::from(c.to_digit(radix as u32)?)).min(beyond);
     }
     ok.then_some(if negative { -v } else { v })
 }
