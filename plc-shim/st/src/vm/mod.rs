@@ -45,8 +45,7 @@ fn chars<'m>(
         (crate::ir::Text::Const(lit), None) => lit,
         (crate::ir::Text::At(..) | crate::ir::Text::Fn(_), None) => &[],
     };
-    let end = bytes.iter().position(|c| *c == 0).unwrap_or(bytes.len());
-    Ok(&bytes[..end])
+    Ok(text::before_nul(bytes))
 }
 
 /// How a statement list ended.

@@ -49,7 +49,7 @@ impl Write for Buf {
 }
 
 /// The characters before the first NUL.
-fn before_nul(bytes: &[u8]) -> &[u8] {
+pub(super) fn before_nul(bytes: &[u8]) -> &[u8] {
     let end = bytes.iter().position(|c| *c == 0).unwrap_or(bytes.len());
     &bytes[..end]
 }
