@@ -82,21 +82,27 @@ pub enum Ex {
     Text(Box<TextEx>),
     /// A standard function, the type it computes in, its values.
     Std(StdFn, Elem, Vec<Ex>),
-    /// A user function: its body index, its inputs (offsets in its frame, at most
-    /// [`MAX_CALL_INPUTS`]), and the place and type of its value.
-    Call {
-        /// The function's index among the POUs.
-        pou: usize,
-        /// Its inputs: offset in its frame, type, value.
-        inputs: Vec<BlockInput>,
-        /// Its value.
-        value: Box<Addr>,
-        /// The value's type.
-        ty: Elem,
-        /// Its VAR_IN_OUTs' leaves copied back after the call: offset in its frame, type,
-        /// the caller's place.
-        back: Vec<(u32, Elem, Addr)>,
-    },
+    /// A user function's call and the type of its value.
+    Call(Box<FnCall>, Elem),
+}
+
+/// A user function's call: its body index, its inputs (offsets in its frame), and the place
+/// of its value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FnCall {
+    /// The function's index among the POUs.
+    pub pou: usize,
+    /// Its elementary inputs (at most [`MAX_CALL_INPUTS`]): offset in its frame, type, value.
+    pub inputs: Vec<BlockInput>,
+    /// Its STRING inputs (at most [`MAX_TEXT_INPUTS`]): how many of `inputs` come before it
+    /// in the call (the values are taken in their order), its offset in the frame, its
+    /// size with the NUL, its characters (cut to the size when longer).
+    pub texts: Vec<(usize, u32, u32, Text)>,
+    /// Its value's place.
+    pub value: Addr,
+    /// Its VAR_IN_OUTs' leaves copied back after the call: offset in its frame, type, the
+    /// caller's place.
+    pub back: Vec<(u32, Elem, Addr)>,
 }
 
 /// A STRING's characters: a literal's (NUL-padded), a variable's `size` bytes at a place, or
@@ -133,6 +139,8 @@ pub enum TextFn {
     Replace(Text, Text, Ex, Ex),
     /// A value of the type as text (`INT_TO_STRING`, ...).
     Of(Elem, Ex),
+    /// A user function's STRING value: the call, and the size of its value (with the NUL).
+    Call(FnCall, u32),
 }
 
 /// A value computed from STRINGs.
@@ -151,6 +159,10 @@ pub enum TextEx {
 /// The most inputs a call of a user function passes (their values are held on the stack while
 /// the function's frame is made ready).
 pub const MAX_CALL_INPUTS: usize = 32;
+
+/// The most STRING inputs a call of a user function passes (their characters are held on
+/// the stack while the function's frame is made ready).
+pub const MAX_TEXT_INPUTS: usize = 4;
 
 /// The most values a standard function (MIN, MAX, MUX, ...) takes (held on the stack).
 pub const MAX_STD_VALUES: usize = 16;

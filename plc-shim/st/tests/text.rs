@@ -227,7 +227,7 @@ END_PROGRAM"
     );
     let e = refused(&program("  fb(sName := CONCAT(s, 'x'));"));
     assert!(
-        e.contains("main.st:4:15: error: a string function's value as a block's input"),
+        e.contains("main.st:4:15: error: a computed STRING (a string function's or a function's value) as a block's input"),
         "{e}"
     );
     let e = refused("FUNCTION_BLOCK Concat END_FUNCTION_BLOCK");
@@ -246,19 +246,112 @@ END_PROGRAM"
     );
 }
 
+/// FUNCTIONs that take STRINGs and whose value is a STRING (TwinCAT's `F_Name : STRING`).
+const FUNCTIONS: &str = "VAR_GLOBAL nTicks : INT; END_VAR
+FUNCTION F_Name : STRING
+VAR_INPUT sBase : STRING; nPart : UINT; sExt : STRING(8); END_VAR
+    F_Name := CONCAT(sBase, '_', UINT_TO_STRING(nPart), sExt);
+END_FUNCTION
+FUNCTION F_Short : STRING(3)
+VAR_INPUT s : STRING(10); END_VAR
+    F_Short := LEFT(s, 10);
+END_FUNCTION
+FUNCTION F_Tick : STRING
+    nTicks := nTicks + 1;
+    F_Tick := INT_TO_STRING(nTicks);
+END_FUNCTION
+FUNCTION F_Both : STRING
+VAR_INPUT s : STRING; n : INT; END_VAR
+    F_Both := CONCAT(s, '/', INT_TO_STRING(n));
+END_FUNCTION
+";
+
+#[test]
+fn functions_take_strings_and_give_them() {
+    let vars = "    s : STRING(80);
+    sBase : STRING(20) := 'abc';
+    sShort : STRING(4);
+    n : UINT := 3;";
+    let body = "
+    ok1 := F_Name('part', 7, '.nc') = 'part_7.nc';
+    s := F_Name(sExt := '.st', nPart := n, sBase := sBase);
+    ok2 := s = 'abc_3.st';
+    ok3 := F_Name(CONCAT('a', 'b'), 1, '') = 'ab_1';
+    ok4 := F_Name(F_Name('x', 1, ''), 2, '.nc') = 'x_1_2.nc';
+    ok5 := F_Name('a', 1, '') <> F_Name('b', 1, '') AND F_Name('a', 1, '') = F_Name('a', 1, '');
+    ok6 := LEN(F_Short('abcdef')) = 3 AND F_Short('abcdef') = 'abc';
+    sShort := F_Name('abcdef', 1, '');
+    ok7 := sShort = 'abcd';
+    ok8 := CONCAT(F_Name('a', 1, ''), F_Name('b', 2, '')) = 'a_1b_2';
+    (* The values in their order: the STRING's call before the INT it changes. *)
+    ok9 := F_Both(F_Tick(), nTicks) = '1/1' AND F_Both(n := nTicks, s := F_Tick()) = '2/1';
+    ok10 := F_Short(s) = 'abc' AND STRING_TO_INT(F_Tick()) = 3;
+    (* A call as a statement, for what it does. *)
+    F_Tick();
+    CONCAT(F_Tick(), 'x');
+    ok11 := nTicks = 5;";
+    let vars = vars.replace("s : STRING(80);", "s : STRING(10);");
+    checks(FUNCTIONS, &vars, body, 11);
+}
+
+#[test]
+fn what_a_function_cannot_take_as_a_string_is_refused_at_load() {
+    let program = |body: &str| {
+        format!(
+            "{FUNCTIONS}FUNCTION_BLOCK FB_Name VAR_INPUT sName : STRING(20); END_VAR END_FUNCTION_BLOCK
+FUNCTION F_Five : INT
+VAR_INPUT a, b, c, d, e : STRING(4); END_VAR
+    F_Five := 5;
+END_FUNCTION
+PROGRAM MAIN
+VAR sLong : STRING(20); s : STRING(80); n : INT; fb : FB_Name; END_VAR
+{body}
+END_PROGRAM"
+        )
+    };
+    let e = refused(&program("  s := F_Short(sLong);"));
+    assert!(
+        e.contains("main.st:25:16: error: a STRING(20) into a STRING(10): it may not fit"),
+        "{e}"
+    );
+    let e = refused(&program("  s := F_Short('abcdefghijk');"));
+    assert!(
+        e.contains("main.st:25:16: error: 'abcdefghijk' has 11 characters: a STRING(10) holds 10"),
+        "{e}"
+    );
+    let e = refused(&program("  n := F_Five('a', 'b', 'c', 'd', 'e');"));
+    assert!(e.contains("a call with more than 4 STRING values"), "{e}");
+    let e = refused(&program("  fb(sName := F_Short('a'));"));
+    assert!(
+        e.contains("main.st:25:15: error: a computed STRING (a string function's or a function's value) as a block's input"),
+        "{e}"
+    );
+    let e = refused(&program("  s := F_Short(n);"));
+    assert!(
+        e.contains("main.st:25:16: error: a INT where a STRING(10) is wanted"),
+        "{e}"
+    );
+    let e = refused(&program("  n := F_Short('a');"));
+    assert!(
+        e.contains("main.st:25:8: error: a STRING(3) where a INT is wanted"),
+        "{e}"
+    );
+}
+
 /// After the load, a cycle that computes strings allocates nothing.
 #[test]
 fn a_cycle_with_strings_allocates_nothing() {
-    let mut p = load(
-        "PROGRAM MAIN
+    let mut p = load(&format!(
+        "{FUNCTIONS}PROGRAM MAIN
 VAR s : STRING(80); n : DINT; k : INT; bLess : BOOL; END_VAR
     n := n + 1;
     s := CONCAT('part_', DINT_TO_STRING(n), '.nc');
     s := REPLACE(INSERT(s, LEFT('xyz', 2), 5), 'P', 1, 1);
     k := FIND(s, '.nc') + LEN(MID(s, 3, 2)) + STRING_TO_INT(RIGHT('a42', 2));
     bLess := DELETE(s, 1, 1) < s;
-END_PROGRAM",
-    );
+    k := k + LEN(F_Name(s, 7, '.nc')) - LEN(s) - 5;
+END_PROGRAM"
+    ));
     p.cycle(0).unwrap();
     let before = counting_alloc::allocations();
     for k in 1..1000 {

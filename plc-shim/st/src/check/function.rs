@@ -7,8 +7,9 @@ use super::lower::R;
 use super::place::plus;
 use super::{Checker, Type};
 use crate::ast::{Arg, Expr, Section};
+use crate::diag::Diagnostic;
 use crate::diag::Pos;
-use crate::ir::{Addr, Ex};
+use crate::ir::{Addr, Ex, FnCall, Text};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -73,6 +74,7 @@ impl Checker {
         }
     }
 
+    /// A call of function `i` whose value is elementary, as a value.
     pub(super) fn function_value(
         &mut self,
         i: usize,
@@ -81,8 +83,26 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<Ex> {
+        let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
+            return Err(self.unsupported(pos, "a function whose value is no elementary value"));
+        };
+        Ok(Ex::Call(
+            Box::new(self.function_call_ir(i, args, pos, ctx, l)?),
+            ty,
+        ))
+    }
+
+    /// A call of function `i`: its values, in their order, into its frame.
+    pub(super) fn function_call_ir(
+        &mut self,
+        i: usize,
+        args: &[Arg],
+        pos: Pos,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<FnCall> {
         let params = self.parameters(i);
-        let (mut stores, mut back) = (Vec::new(), Vec::new());
+        let (mut stores, mut texts, mut back) = (Vec::new(), Vec::new(), Vec::new());
         for (k, arg) in args.iter().enumerate() {
             let value = match arg {
                 Arg::Positional(v) | Arg::Input(_, v) => v,
@@ -101,25 +121,46 @@ impl Checker {
                 }
                 continue;
             }
-            let Type::Elem(t) = ty else {
-                return Err(self.unsupported(value.pos(), "an input that is no elementary value"));
-            };
-            let v = self.value_as(value, t, ctx, l)?;
-            stores.push((offset, t, v));
+            match ty {
+                Type::Elem(t) => stores.push((offset, t, self.value_as(value, t, ctx, l)?)),
+                Type::Str(n) => {
+                    let text = self.text_input(n, value, ctx, l)?;
+                    texts.push((stores.len(), offset, n + 1, text));
+                }
+                _ => {
+                    let what = "an input that is no elementary value or STRING";
+                    return Err(self.unsupported(value.pos(), what));
+                }
+            }
         }
         if stores.len() > crate::ir::MAX_CALL_INPUTS {
             return Err(self.unsupported(pos, "a call with more than 32 values"));
         }
-        let Some(Type::Elem(ty)) = self.out.pous[i].returns.clone() else {
-            return Err(self.unsupported(pos, "a function whose value is no elementary value"));
-        };
-        let value = Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0));
-        Ok(Ex::Call {
+        if texts.len() > crate::ir::MAX_TEXT_INPUTS {
+            return Err(self.unsupported(pos, "a call with more than 4 STRING values"));
+        }
+        Ok(FnCall {
             pou: i,
             inputs: stores,
-            value: Box::new(value),
-            ty,
+            texts,
+            value: Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0)),
             back,
         })
+    }
+
+    /// A STRING(n) input's value: a literal no longer than n, a STRING variable no longer
+    /// than n, or a computed STRING (cut to n when longer, as an assignment's).
+    fn text_input(&mut self, n: u32, value: &Expr, ctx: Ctx, l: &Layout) -> R<Text> {
+        if let Expr::Str(text, pos) = value {
+            let bytes = self.literal_bytes(text, n, *pos)?;
+            return Ok(Text::Const(bytes.into_boxed_slice()));
+        }
+        match self.text_ir(value, ctx, l)? {
+            Text::At(_, size) if size > n + 1 => {
+                let message = format!("a STRING({}) into a STRING({n}): it may not fit", size - 1);
+                Err(Diagnostic::new(value.pos(), message).in_file(&self.file))
+            }
+            text => Ok(text),
+        }
     }
 }

@@ -8,7 +8,7 @@ use super::place::{deref, plus, strides};
 use super::{Checker, Type};
 use crate::ast::{Arg, BinOp, CaseLabel, Expr, Name, Pou, PouKind, Stmt, UnOp};
 use crate::diag::{Diagnostic, Pos};
-use crate::ir::{Addr, Ex, St, StKind, StdFn};
+use crate::ir::{Addr, Ex, St, StKind, StdFn, TextEx};
 use crate::layout::{std_member, Layout};
 use crate::types::{conversion, Class, Elem};
 use crate::vm::callees::addr_calls;
@@ -618,6 +618,11 @@ impl Checker {
         let (pou, fb) = match ty {
             Type::Fb(i) => (Some(i), None),
             Type::StdFb(fb) => (None, Some(fb)),
+            // A STRING's call for what it does: its characters computed and left.
+            _ if self.is_text_value(call, ctx) => {
+                let text = self.text_ir(call, ctx, l)?;
+                return Ok(StKind::Eval(Ex::Text(Box::new(TextEx::Len(text)))));
+            }
             _ => return Ok(StKind::Eval(self.value(call, ctx, l)?)),
         };
         let (instance, _) = self.place(callee, ctx, l)?;

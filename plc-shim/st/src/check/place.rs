@@ -188,7 +188,7 @@ impl Checker {
             let bytes = self.literal_bytes(text, n, *pos)?;
             return Ok(StKind::Bytes(addr, bytes.into_boxed_slice()));
         }
-        if Self::is_text_fn(value) {
+        if self.is_text_value(value, ctx) {
             // Cut to the target's length when longer, as TwinCAT's string functions are.
             return Ok(StKind::Text(addr, n + 1, self.text_ir(value, ctx, l)?));
         }
@@ -213,9 +213,9 @@ impl Checker {
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Ex)>> {
         let chunks = string_chunks(n);
-        if Self::is_text_fn(value) {
-            let what = "a string function's value as a block's input (assign it to a STRING \
-                        variable and pass that)";
+        if self.is_text_value(value, ctx) {
+            let what = "a computed STRING (a string function's or a function's value) as a \
+                        block's input (assign it to a STRING variable and pass that)";
             return Err(self.unsupported(value.pos(), what));
         }
         if let Expr::Str(text, pos) = value {

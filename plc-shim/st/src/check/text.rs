@@ -208,14 +208,45 @@ impl Checker {
             || text_conversion(&upper).is_some_and(|(_, to)| to)
     }
 
+    /// Whether `e` is a computed STRING: a call of a string function, of a conversion to
+    /// STRING, or of a user function whose value is a STRING.
+    pub(super) fn is_text_value(&self, e: &Expr, ctx: Ctx) -> bool {
+        Self::is_text_fn(e) || self.text_function(e, ctx).is_some()
+    }
+
+    /// The user function `e` calls and the length of its STRING value, `None` if `e` is no
+    /// call of a function whose value is a STRING.
+    fn text_function(&self, e: &Expr, ctx: Ctx) -> Option<(usize, u32)> {
+        let Expr::Call { callee, .. } = e else {
+            return None;
+        };
+        let Expr::Name(n) = &**callee else {
+            return None;
+        };
+        if Self::is_text_fn(e) {
+            return None;
+        }
+        match self.meaning(&n.text, ctx) {
+            Some(super::expr::Meaning::Function(i)) => match self.out.pous[i].returns {
+                Some(Type::Str(len)) => Some((i, len)),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
     /// A string function whose value is a STRING, `None` if `e` is no such call.
     fn text_fn_ir(&mut self, e: &Expr, ctx: Ctx, l: &Layout) -> R<Option<TextFn>> {
+        let Expr::Call { callee, args, pos } = e else {
+            return Ok(None);
+        };
+        if let Some((i, len)) = self.text_function(e, ctx) {
+            let call = self.function_call_ir(i, args, *pos, ctx, l)?;
+            return Ok(Some(TextFn::Call(call, len + 1)));
+        }
         if !Self::is_text_fn(e) {
             return Ok(None);
         }
-        let Expr::Call { callee, args, .. } = e else {
-            return Ok(None);
-        };
         let Expr::Name(n) = &**callee else {
             return Ok(None);
         };

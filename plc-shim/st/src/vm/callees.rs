@@ -1,7 +1,7 @@
 //! Which POUs a body calls (block bodies and functions), for the register file's size: the
 //! deepest chain of calls ([`super::code::Codes`]).
 
-use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind, Text, TextEx, TextFn};
+use crate::ir::{Addr, BlockInput, BlockOutput, Ex, FnCall, St, StKind, Text, TextEx, TextFn};
 
 /// Every POU a statement calls (block bodies and functions), in the statements it holds too.
 pub(super) fn of_st(s: &St, out: &mut Vec<usize>) {
@@ -119,20 +119,18 @@ fn of_ex(e: &Ex, out: &mut Vec<usize>) {
             TextEx::Len(a) | TextEx::To(_, a) => of_text(a, out),
         },
         Ex::Std(_, _, args) => args.iter().for_each(|a| of_ex(a, out)),
-        Ex::Call {
-            pou,
-            inputs,
-            value,
-            back,
-            ..
-        } => {
-            out.push(*pou);
-            inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
-            of_addr(value, out);
-            back.iter().for_each(|(_, _, a)| of_addr(a, out));
-        }
+        Ex::Call(c, _) => of_fn_call(c, out),
         Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => {}
     }
+}
+
+/// A user function's call: the function, and what its values call.
+fn of_fn_call(c: &FnCall, out: &mut Vec<usize>) {
+    out.push(c.pou);
+    c.inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
+    c.texts.iter().for_each(|(_, _, _, t)| of_text(t, out));
+    of_addr(&c.value, out);
+    c.back.iter().for_each(|(_, _, a)| of_addr(a, out));
 }
 
 fn of_text(t: &Text, out: &mut Vec<usize>) {
@@ -142,6 +140,7 @@ fn of_text(t: &Text, out: &mut Vec<usize>) {
         Text::Fn(f) => match &**f {
             TextFn::Concat(parts) => parts.iter().for_each(|p| of_text(p, out)),
             TextFn::Of(_, e) => of_ex(e, out),
+            TextFn::Call(c, _) => of_fn_call(c, out),
             TextFn::Left(a, n) | TextFn::Right(a, n) => {
                 of_text(a, out);
                 of_ex(n, out);

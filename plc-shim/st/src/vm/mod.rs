@@ -680,33 +680,49 @@ impl<'a> Exec<'a> {
             Ex::Std(f, t, args) => self.std_fn(*f, *t, args, base)?,
             Ex::TextEq(pair) => V::I(i64::from(self.text_eq(&pair.0, &pair.1, base)?)),
             Ex::Text(e) => self.text_value(e, base)?,
-            Ex::Call {
-                pou,
-                inputs,
-                value,
-                ty,
-                back,
-            } => self.call_function(*pou, (inputs, back), value, *ty, base)?,
+            Ex::Call(c, ty) => {
+                self.call_function(c, base)?;
+                let at = self.addr(&c.value, base)?;
+                self.read(at, *ty)?
+            }
         })
     }
 
     /// A user function's call (out of `eval`: its values' array would make every `eval`'s
-    /// frame large).
+    /// frame large); its value is left in its frame.
     #[inline(never)]
-    fn call_function(
-        &mut self,
-        pou: usize,
-        (inputs, back): (&[BlockInput], &[(u32, Elem, Addr)]),
-        value: &Addr,
-        ty: Elem,
-        base: u32,
-    ) -> Run<V> {
+    fn call_function(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<()> {
+        if c.texts.is_empty() {
+            return self.call_with(c, base, &mut []);
+        }
+        self.call_with_texts(c, base)
+    }
+
+    /// As [`Exec::call_function`] for a call with STRING inputs: their characters held
+    /// on the stack meanwhile.
+    #[inline(never)]
+    fn call_with_texts(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<()> {
+        let mut bufs: [text::Buf; crate::ir::MAX_TEXT_INPUTS] =
+            core::array::from_fn(|_| text::Buf::new());
+        let n = c.texts.len().min(bufs.len());
+        self.call_with(c, base, &mut bufs[..n])
+    }
+
+    fn call_with(&mut self, c: &crate::ir::FnCall, base: u32, bufs: &mut [text::Buf]) -> Run<()> {
+        let (pou, inputs, back) = (c.pou, &c.inputs, &c.back);
         // The values first, in their order (one may call this function too), then the frame.
         // A VAR_IN_OUT's leaf is read where its place is found, and goes back there: its
         // place bound when its turn comes, before the body or a later value moves an index.
         let mut values = [V::I(0); crate::ir::MAX_CALL_INPUTS];
         let mut places = [Loc::Own(0); crate::ir::MAX_CALL_INPUTS];
-        for (v, (offset, t, e)) in values.iter_mut().zip(inputs.iter()) {
+        let mut texts = c.texts.iter().zip(bufs.iter_mut()).peekable();
+        for k in 0..=inputs.len() {
+            while let Some(((_, _, _, t), buf)) = texts.next_if(|((before, ..), _)| *before <= k) {
+                self.text_into(t, base, buf)?;
+            }
+            let (Some(v), Some((offset, t, e))) = (values.get_mut(k), inputs.get(k)) else {
+                break;
+            };
             *v = match back.iter().position(|(o, _, _)| o == offset) {
                 Some(j) => {
                     places[j] = self.addr(&back[j].2, base)?;
@@ -724,6 +740,9 @@ impl<'a> Exec<'a> {
         for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {
             self.write_own((frame + offset) as usize, *t, *v)?;
         }
+        for ((_, offset, size, _), buf) in c.texts.iter().zip(bufs.iter()) {
+            self.put_text((frame + offset) as usize, *size as usize, buf.chars())?;
+        }
         self.run_body(pou, frame)?;
         self.st.at = statement;
         // The VAR_IN_OUTs back into the caller's variables, leaf by leaf.
@@ -731,8 +750,7 @@ impl<'a> Exec<'a> {
             let v = self.read_own((frame + offset) as usize, *t)?;
             self.write(at, *t, v)?;
         }
-        let at = self.addr(value, base)?;
-        self.read(at, ty)
+        Ok(())
     }
 
     /// Whether two STRINGs hold the same characters before their NUL (or their end).

@@ -83,6 +83,14 @@ impl Exec<'_> {
                 let v = self.eval(e, base)?;
                 return write_value(out, *t, v);
             }
+            TextFn::Call(c, size) => {
+                self.call_function(c, base)?;
+                let at = self.own(&c.value, base)?;
+                let n = *size as usize;
+                self.check(at, n)?;
+                out.push(before_nul(&self.st.memory[at..at + n]));
+                return Ok(());
+            }
             TextFn::Left(a, _)
             | TextFn::Right(a, _)
             | TextFn::Mid(a, _, _)
@@ -126,7 +134,7 @@ impl Exec<'_> {
                 out.push(t.chars());
                 out.push(&chars[(from + n).min(len)..]);
             }
-            TextFn::Concat(_) | TextFn::Of(..) => {}
+            TextFn::Concat(_) | TextFn::Of(..) | TextFn::Call(..) => {}
         }
         Ok(())
     }
@@ -189,11 +197,16 @@ impl Exec<'_> {
         let mut s = Buf::new();
         self.text_into(t, base, &mut s)?;
         let at = self.own(to, base)?;
-        let size = size as usize;
+        self.put_text(at, size as usize, s.chars())
+    }
+
+    /// `chars` into the STRING of `size` bytes at `at` of the program's memory (its NUL
+    /// included), cut to fit, the rest NUL.
+    pub(super) fn put_text(&mut self, at: usize, size: usize, chars: &[u8]) -> Run<()> {
         self.check(at, size)?;
         let place = &mut self.st.memory[at..at + size];
-        let n = s.chars().len().min(size.saturating_sub(1));
-        place[..n].copy_from_slice(&s.chars()[..n]);
+        let n = chars.len().min(size.saturating_sub(1));
+        place[..n].copy_from_slice(&chars[..n]);
         place[n..].fill(0);
         Ok(())
     }
