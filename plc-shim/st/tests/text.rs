@@ -289,7 +289,9 @@ fn functions_take_strings_and_give_them() {
     (* A call as a statement, for what it does. *)
     F_Tick();
     CONCAT(F_Tick(), 'x');
-    ok11 := nTicks = 5;";
+    LEN(F_Tick());
+    FIND(s, 'b');
+    ok11 := nTicks = 6;";
     let vars = vars.replace("s : STRING(80);", "s : STRING(10);");
     checks(FUNCTIONS, &vars, body, 11);
 }
@@ -329,6 +331,14 @@ END_PROGRAM"
     let e = refused(&program("  s := F_Short(n);"));
     assert!(
         e.contains("main.st:25:16: error: a INT where a STRING(10) is wanted"),
+        "{e}"
+    );
+    let e = refused(
+        "FUNCTION F_Io : INT VAR_IN_OUT s : STRING; END_VAR F_Io := 1; END_FUNCTION
+PROGRAM MAIN VAR s : STRING; n : INT; END_VAR n := F_Io(s); END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:2:57: error: a STRING as a VAR_IN_OUT of a function"),
         "{e}"
     );
     let e = refused(&program("  n := F_Short('a');"));

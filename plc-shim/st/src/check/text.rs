@@ -211,7 +211,10 @@ impl Checker {
     /// Whether `e` is a computed STRING: a call of a string function, of a conversion to
     /// STRING, or of a user function whose value is a STRING.
     pub(super) fn is_text_value(&self, e: &Expr, ctx: Ctx) -> bool {
-        Self::is_text_fn(e) || self.text_function(e, ctx).is_some()
+        let number = matches!(e, Expr::Call { callee, .. }
+            if matches!(&**callee, Expr::Name(n)
+                if ["LEN", "FIND"].iter().any(|f| n.text.eq_ignore_ascii_case(f))));
+        (Self::is_text_fn(e) && !number) || self.text_function(e, ctx).is_some()
     }
 
     /// The user function `e` calls and the length of its STRING value, `None` if `e` is no
