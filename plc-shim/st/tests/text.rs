@@ -116,8 +116,13 @@ fn numbers_become_text_and_text_numbers() {
     ok8 := bb AND NOT STRING_TO_BOOL('0');
     (* Text and back. *)
     ok9 := STRING_TO_DINT(DINT_TO_STRING(-2147483648)) = -2147483648;
+    (* Durations as the language writes them, the prefix optional. *)
+    ok12 := STRING_TO_TIME('T#1m2s30ms') = t AND STRING_TO_TIME(TIME_TO_STRING(t)) = t
+        AND STRING_TO_TIME('time#-2.5s') = T#-2500MS AND STRING_TO_TIME(' 1h_30m ') = T#90M
+        AND STRING_TO_TIME('T#1ms900us') = T#1MS AND STRING_TO_TIME('1d') = T#24H;
+    ok13 := STRING_TO_LTIME(LTIME_TO_STRING(lt)) = lt AND STRING_TO_LTIME('LTIME#1.5us') = LINT_TO_LTIME(1500);
 ";
-    checks("", vars, body, 11);
+    checks("", vars, body, 13);
 }
 
 fn fault(body: &str) -> (Fault, [i64; 3], String) {
@@ -162,6 +167,13 @@ fn a_bad_length_position_or_number_faults_with_its_place() {
     let (f, _, _) = fault("  n := ULINT_TO_INT(STRING_TO_ULINT('18446744073709551616'));");
     assert_eq!(f, Fault::OutOfRange);
     let (f, _, _) = fault("  n := LINT_TO_INT(STRING_TO_LINT('-99999999999999999999999'));");
+    assert_eq!(f, Fault::OutOfRange);
+    // Durations: no unit, an unknown one, nothing after the prefix, beyond TIME's 32 bits.
+    for text in ["T#12", "T#1x", "T#", "T#-", "5 s", "T#.5s", "T#1.2.3s"] {
+        let (f, _, _) = fault(&format!("  n := TIME_TO_INT(STRING_TO_TIME('{text}'));"));
+        assert_eq!(f, Fault::NoNumber, "{text}");
+    }
+    let (f, _, _) = fault("  n := TIME_TO_INT(STRING_TO_TIME('T#25d'));");
     assert_eq!(f, Fault::OutOfRange);
     // A REAL beyond REAL's range (computed in LREAL) as text.
     let (f, _, _) = fault("  s := REAL_TO_STRING(REAL#1.0E30 * REAL#1.0E30);");
@@ -216,10 +228,7 @@ END_PROGRAM"
     let e = refused(&program("  n := LEN(s) + LEN(n);"));
     assert!(e.contains("LEN takes a STRING here, not a INT"), "{e}");
     let e = refused(&program("  n := STRING_TO_TIME(s);"));
-    assert!(
-        e.contains("a duration from a STRING is not supported yet"),
-        "{e}"
-    );
+    assert!(e.contains("a TIME where a INT is wanted"), "{e}");
     let e = refused(&program("  n := CONCAT(s, s);"));
     assert!(
         e.contains("main.st:4:8: error: a STRING(40) where a INT is wanted"),
@@ -360,6 +369,7 @@ VAR s : STRING(80); n : DINT; k : INT; bLess : BOOL; END_VAR
     k := FIND(s, '.nc') + LEN(MID(s, 3, 2)) + STRING_TO_INT(RIGHT('a42', 2));
     bLess := DELETE(s, 1, 1) < s;
     k := k + LEN(F_Name(s, 7, '.nc')) - LEN(s) - 5;
+    k := k + DINT_TO_INT(TIME_TO_DINT(STRING_TO_TIME('T#1m_1s')) - 61000);
 END_PROGRAM"
     ));
     p.cycle(0).unwrap();

@@ -11,7 +11,7 @@ use crate::ast::{Arg, BinOp, Expr};
 use crate::diag::Pos;
 use crate::ir::{Ex, Text, TextEx, TextFn, MAX_TEXT};
 use crate::layout::Layout;
-use crate::types::{Class, Elem};
+use crate::types::Elem;
 
 /// The string functions by name (reserved as the standard functions are).
 pub const TEXT_FUNCTIONS: &[&str] = &[
@@ -150,12 +150,6 @@ impl Checker {
         };
         if args.len() != 1 {
             return self.error(pos, format!("{upper} takes its value by position"));
-        }
-        if !to_text && t.class() == Class::Duration {
-            return self.error(
-                pos,
-                format!("{upper}: a duration from a STRING is not supported yet"),
-            );
         }
         match (to_text, self.expr(v, ctx)) {
             (_, Type::Error) => Type::Error,

@@ -293,6 +293,7 @@ fn read_value(text: &[u8], t: Elem) -> Run<V> {
         Class::Bool if s.eq_ignore_ascii_case("TRUE") || s == "1" => Ok(V::I(1)),
         Class::Bool if s.eq_ignore_ascii_case("FALSE") || s == "0" => Ok(V::I(0)),
         Class::Bool => Err(Fault::NoNumber),
+        Class::Duration => read_duration(s, t),
         Class::Float => {
             // Rust reads `inf` and `NaN` too: no numbers here.
             let named = s
@@ -315,6 +316,61 @@ fn read_value(text: &[u8], t: Elem) -> Run<V> {
             }
         }
     }
+}
+
+/// A duration as the language writes one (`T#1s500ms`, `TIME#-2.5s`, `LTIME#1s5us`, the
+/// prefix optional, `_` between parts): a TIME in whole ms (cut toward 0), an LTIME in ns.
+fn read_duration(s: &str, t: Elem) -> Run<V> {
+    let starts = |p: &str| s.get(..p.len()).is_some_and(|h| h.eq_ignore_ascii_case(p));
+    let prefix = ["LTIME#", "TIME#", "T#"].into_iter().find(|p| starts(p));
+    let rest = &s[prefix.map_or(0, str::len)..];
+    let (negative, mut rest) = match rest.strip_prefix('-') {
+        Some(r) => (true, r),
+        None => (false, rest),
+    };
+    let (mut total, mut parts) = (0f64, 0);
+    while !rest.is_empty() {
+        parts += 1;
+        let number = rest.find(|c: char| !(c.is_ascii_digit() || c == '.'));
+        let (value, after) = rest.split_at(number.unwrap_or(rest.len()));
+        let unit_end = after.find(|c: char| !c.is_ascii_alphabetic());
+        let (unit, after) = after.split_at(unit_end.unwrap_or(after.len()));
+        let value: f64 = match value.split_once('.') {
+            Some((a, b)) if a.is_empty() || b.contains('.') => return Err(Fault::NoNumber),
+            _ if value.is_empty() => return Err(Fault::NoNumber),
+            _ => value.parse().map_err(|_| Fault::NoNumber)?,
+        };
+        const UNITS: [(&str, f64); 7] = [
+            ("d", 86_400e9),
+            ("h", 3_600e9),
+            ("m", 60e9),
+            ("s", 1e9),
+            ("ms", 1e6),
+            ("us", 1e3),
+            ("ns", 1.0),
+        ];
+        let scale = UNITS
+            .iter()
+            .find(|(name, _)| unit.eq_ignore_ascii_case(name))
+            .ok_or(Fault::NoNumber)?
+            .1;
+        total += value * scale;
+        rest = after.strip_prefix('_').unwrap_or(after);
+    }
+    if parts == 0 {
+        return Err(Fault::NoNumber);
+    }
+    let ns = if negative { -total } else { total };
+    let (v, most) = if t == Elem::LTime {
+        (ns.round(), i64::MAX as f64)
+    } else {
+        ((ns / 1e6).trunc(), f64::from(i32::MAX))
+    };
+    // Below -most - 1 as well as above most: the range of TIME's i32 ms, LTIME's i64 ns.
+    if !(v.is_finite() && v >= -most - 1.0 && v < most + 1.0) {
+        return Err(Fault::OutOfRange);
+    }
+    Ok(V::I(v as i64))
 }
 
 /// An integer as the language writes one, `None` if `s` is none.
