@@ -1,7 +1,8 @@
 //! Text in Structured Text: a STRING variable given a literal, passed on as
 //! ChannelSelectProgram's `ProgramName`, reaches the channel's command in the image byte for
 //! byte; an empty name, or one with a character that is no printable ASCII, ends the command
-//! with 0x4227 and writes nothing; a literal longer than its STRING is refused at load.
+//! with 0x4227 and writes nothing; a literal longer than its STRING is refused at load; a
+//! name the PLC builds (`CONCAT(..)`) goes to `ProgramName` straight.
 
 use hli::symbols::SymbolTable;
 use plc_shim::st::host::INVALID_INPUT;
@@ -45,6 +46,18 @@ fn selected(text: &str, case: &str) -> (String, f64) {
 #[test]
 fn a_string_variable_reaches_the_channels_command_as_program_name() {
     assert_eq!(selected(PROGRAM, "st-text"), ("sub/part 2.nc".into(), 0.0));
+}
+
+#[test]
+fn a_name_the_plc_builds_goes_straight_to_program_name() {
+    let text = PROGRAM.replace(
+        "ProgramName := sName",
+        "ProgramName := CONCAT('sub/part ', INT_TO_STRING(2), '.nc')",
+    );
+    assert_eq!(
+        selected(&text, "st-text-built"),
+        ("sub/part 2.nc".into(), 0.0)
+    );
 }
 
 #[test]

@@ -234,11 +234,6 @@ END_PROGRAM"
         e.contains("main.st:4:8: error: a STRING(40) where a INT is wanted"),
         "{e}"
     );
-    let e = refused(&program("  fb(sName := CONCAT(s, 'x'));"));
-    assert!(
-        e.contains("main.st:4:15: error: a computed STRING (a string function's or a function's value) as a block's input"),
-        "{e}"
-    );
     let e = refused("FUNCTION_BLOCK Concat END_FUNCTION_BLOCK");
     assert!(e.contains("`Concat` is a standard name"), "{e}");
     let e = refused("FUNCTION REAL_TO_STRING : INT REAL_TO_STRING := 1; END_FUNCTION");
@@ -309,9 +304,9 @@ fn functions_take_strings_and_give_them() {
 fn what_a_function_cannot_take_as_a_string_is_refused_at_load() {
     let program = |body: &str| {
         format!(
-            "{FUNCTIONS}FUNCTION_BLOCK FB_Name VAR_INPUT sName : STRING(20); END_VAR END_FUNCTION_BLOCK
+            "{FUNCTIONS}FUNCTION_BLOCK FB_Name VAR_INPUT sName : STRING(20); n : INT; END_VAR END_FUNCTION_BLOCK
 FUNCTION F_Five : INT
-VAR_INPUT a, b, c, d, e : STRING(4); END_VAR
+VAR_INPUT a, b, c, d : STRING(4); e : STRING(4) := 'e'; END_VAR
     F_Five := 5;
 END_FUNCTION
 PROGRAM MAIN
@@ -332,9 +327,13 @@ END_PROGRAM"
     );
     let e = refused(&program("  n := F_Five('a', 'b', 'c', 'd', 'e');"));
     assert!(e.contains("a call with more than 4 STRING values"), "{e}");
-    let e = refused(&program("  fb(sName := F_Short('a'));"));
+    let e = refused(&program(
+        "  fb(sName := F_Short('a'), n := F_Five('a', 'b', 'c', 'd'));",
+    ));
     assert!(
-        e.contains("main.st:25:15: error: a computed STRING (a string function's or a function's value) as a block's input"),
+        e.contains(
+            "main.st:25:3: error: a computed STRING input beside inputs that call a function"
+        ),
         "{e}"
     );
     let e = refused(&program("  s := F_Short(n);"));
@@ -353,6 +352,48 @@ PROGRAM MAIN VAR s : STRING; n : INT; END_VAR n := F_Io(s); END_PROGRAM",
     let e = refused(&program("  n := F_Short('a');"));
     assert!(
         e.contains("main.st:25:8: error: a STRING(3) where a INT is wanted"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_computed_string_goes_to_a_block_input() {
+    let before = format!(
+        "{FUNCTIONS}FUNCTION_BLOCK FB_Echo
+VAR_INPUT sIn : STRING(12); nIn : INT; END_VAR
+VAR_OUTPUT sOut : STRING(12); nOut : INT; END_VAR
+    sOut := sIn;
+    nOut := nIn;
+END_FUNCTION_BLOCK
+"
+    );
+    let vars = "    fb : FB_Echo;
+    fbs : ARRAY[0..1] OF FB_Echo;
+    k : INT := 1;
+    s2 : STRING(12);";
+    let body = "
+    fb(sIn := CONCAT('part_', INT_TO_STRING(k), '.nc'), nIn := k + 1);
+    ok1 := fb.sOut = 'part_1.nc' AND fb.nOut = 2 AND fb.sIn = 'part_1.nc';
+    fb(sIn := F_Name('abcdefgh', 12, '.nc'));
+    ok2 := fb.sOut = 'abcdefgh_12.' AND fb.nOut = 2;
+    fbs[k](sIn := LEFT('xyz', 2), sOut => s2);
+    ok3 := fbs[1].sOut = 'xy' AND s2 = 'xy' AND fbs[0].sOut = '';
+    fb(sIn := 'abc', sOut => sLong);
+    ok4 := sLong = 'abc';";
+    checks(
+        &before,
+        &vars.replace("s2 :", "sLong : STRING(40);\n    s2 :"),
+        body,
+        4,
+    );
+    let text = format!(
+        "{before}PROGRAM MAIN VAR fb : FB_Echo; s : STRING(5); END_VAR
+    fb(sIn := 'a', sOut => s);
+END_PROGRAM"
+    );
+    let e = refused(&text);
+    assert!(
+        e.contains("main.st:25:28: error: a STRING(12) output into a STRING(5)"),
         "{e}"
     );
 }

@@ -497,7 +497,7 @@ impl Checker {
         let at = (file, stmt_pos(s));
         let kind = match s {
             Stmt::Assign { target, value } => self.lower_assign(target, value, ctx, l)?,
-            Stmt::Call(call) => self.lower_call(call, ctx, l)?,
+            Stmt::Call(call) => self.lower_call(call, ctx, at, l)?,
             Stmt::If {
                 branches,
                 otherwise,
@@ -608,7 +608,7 @@ impl Checker {
     }
 
     /// A call statement: a function block instance's or a function's.
-    fn lower_call(&mut self, call: &Expr, ctx: Ctx, l: &Layout) -> R<StKind> {
+    fn lower_call(&mut self, call: &Expr, ctx: Ctx, at: (u16, Pos), l: &Layout) -> R<StKind> {
         let Expr::Call { callee, args, .. } = call else {
             return Err(self.unsupported(call.pos(), "this call"));
         };
@@ -626,7 +626,7 @@ impl Checker {
             _ => return Ok(StKind::Eval(self.value(call, ctx, l)?)),
         };
         let (instance, _) = self.place(callee, ctx, l)?;
-        let (mut inputs, mut outputs) = (Vec::new(), Vec::new());
+        let (mut inputs, mut outputs, mut texts) = (Vec::new(), Vec::new(), Vec::new());
         for arg in args {
             let (name, is_input) = match arg {
                 Arg::Input(n, _) => (n, true),
@@ -669,9 +669,14 @@ impl Checker {
             }
             if let (Type::Str(n), Arg::Input(_, v)) = (&member, arg) {
                 // A STRING input is passed in 8-byte parts (its literal's as constants).
-                for (at, t, part) in self.string_parts(*n, v, ctx, l)? {
-                    inputs.push((offset + at, t, part));
+                let input = (&instance, offset, at);
+                for (k, t, part) in self.string_input(*n, v, input, &mut texts, ctx, l)? {
+                    inputs.push((offset + k, t, part));
                 }
+                continue;
+            }
+            if let (Type::Str(m), Arg::Output { target, .. }) = (&member, arg) {
+                outputs.extend(self.string_output(*m, (offset, target), ctx, l)?);
                 continue;
             }
             if let (Type::Struct(_) | Type::Array(..), Arg::Output { target, .. }) = (&member, arg)
@@ -713,7 +718,7 @@ impl Checker {
             }
             let _ = is_input;
         }
-        Ok(match (pou, fb) {
+        let kind = match (pou, fb) {
             (Some(pou), _) => StKind::CallFb {
                 pou,
                 instance,
@@ -727,7 +732,8 @@ impl Checker {
                 outputs,
             },
             _ => StKind::Eval(Ex::Int(0)),
-        })
+        };
+        self.texts_first(texts, St { kind, at }, call.pos())
     }
 }
 

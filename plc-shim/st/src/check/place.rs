@@ -5,8 +5,8 @@ use super::expr::Ctx;
 use super::lower::R;
 use super::{Checker, Type};
 use crate::ast::{BinOp, Expr};
-use crate::diag::Diagnostic;
-use crate::ir::{Addr, Ex, StKind, StdFn};
+use crate::diag::{Diagnostic, Pos};
+use crate::ir::{Addr, Ex, St, StKind, StdFn};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -203,6 +203,73 @@ impl Checker {
         }
     }
 
+    /// A block's STRING(n) input (`input`: the instance, the input's offset in it, the
+    /// call's place): its parts as [`Checker::string_parts`] gives them, or for a computed
+    /// STRING, a statement into `texts` that computes it into the input (cut to n) before
+    /// the call, and the parts read back from there (so that the call gives the input).
+    pub(super) fn string_input(
+        &mut self,
+        n: u32,
+        value: &Expr,
+        (instance, offset, at): (&Addr, u32, (u16, Pos)),
+        texts: &mut Vec<St>,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Vec<(u32, Elem, Ex)>> {
+        if !self.is_text_value(value, ctx) {
+            return self.string_parts(n, value, ctx, l);
+        }
+        let place = plus(instance.clone(), offset);
+        let kind = StKind::Text(place.clone(), n + 1, self.text_ir(value, ctx, l)?);
+        texts.push(St { kind, at });
+        Ok(string_chunks(n)
+            .into_iter()
+            .map(|(k, t)| (k, t, Ex::Load(Box::new(plus(place.clone(), k)), t)))
+            .collect())
+    }
+
+    /// A block's STRING(m) output given to `target` in the call: its parts, copied after
+    /// the call into a STRING at least as long (refused otherwise, or when the target's
+    /// place is at an index a function computes).
+    pub(super) fn string_output(
+        &mut self,
+        m: u32,
+        (offset, target): (u32, &Expr),
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Vec<crate::ir::BlockOutput>> {
+        let (to, ty) = self.place(target, ctx, l)?;
+        match ty {
+            Type::Str(k) if k < m => {
+                let message = format!("a STRING({m}) into a STRING({k}): it may not fit");
+                return Err(Diagnostic::new(target.pos(), message).in_file(&self.file));
+            }
+            Type::Str(_) if !crate::vm::callees::addr_calls(&to) => {}
+            _ => return Err(self.unsupported(target.pos(), "this STRING output's target")),
+        }
+        Ok(string_chunks(m)
+            .into_iter()
+            .map(|(at, t)| (offset + at, t, plus(to.clone(), at), false))
+            .collect())
+    }
+
+    /// A block call whose computed STRING inputs are computed first (`texts`): those
+    /// statements and the call, as one statement. Refused when the call's other inputs or
+    /// its instance's place call a function (they would be taken after the STRINGs, not in
+    /// their order).
+    pub(super) fn texts_first(&mut self, texts: Vec<St>, call: St, pos: Pos) -> R<StKind> {
+        if texts.is_empty() {
+            return Ok(call.kind);
+        }
+        if crate::vm::callees::calls_in(&call) {
+            let what = "a computed STRING input beside inputs that call a function";
+            return Err(self.unsupported(pos, what));
+        }
+        let mut body = texts;
+        body.push(call);
+        Ok(StKind::If(vec![(Ex::Int(1), body)], Vec::new()))
+    }
+
     /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING
     /// variable's (no longer than n) loaded.
     pub(super) fn string_parts(
@@ -213,11 +280,6 @@ impl Checker {
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Ex)>> {
         let chunks = string_chunks(n);
-        if self.is_text_value(value, ctx) {
-            let what = "a computed STRING (a string function's or a function's value) as a \
-                        block's input (assign it to a STRING variable and pass that)";
-            return Err(self.unsupported(value.pos(), what));
-        }
         if let Expr::Str(text, pos) = value {
             let bytes = self.literal_bytes(text, n, *pos)?;
             return Ok(chunks

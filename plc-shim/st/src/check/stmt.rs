@@ -403,9 +403,12 @@ impl Checker {
                             self.refuse(name.pos, "NOT of an output that is not BOOL");
                         }
                         if let Some(want) = self.writable(target, ctx) {
-                            if want != *t
-                                && !matches!((t, &want), (Type::Elem(a), Type::Elem(b)) if a.widens_to(*b))
-                            {
+                            let widens = match (t, &want) {
+                                (Type::Elem(a), Type::Elem(b)) => a.widens_to(*b),
+                                (Type::Str(m), Type::Str(k)) => k >= m,
+                                _ => false,
+                            };
+                            if want != *t && !widens {
                                 let (g, w) = (self.type_name(t), self.type_name(&want));
                                 self.refuse(target.pos(), format!("a {g} output into a {w}"));
                             }

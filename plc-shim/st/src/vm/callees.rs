@@ -26,7 +26,7 @@ pub(super) fn of_st(s: &St, out: &mut Vec<usize>) {
 
 /// Whether a statement's own expressions and places (not the statements it holds) call a
 /// user function (the only thing in an expression that may write memory).
-pub(super) fn calls_in(s: &St) -> bool {
+pub(crate) fn calls_in(s: &St) -> bool {
     let mut out = Vec::new();
     own_parts(s, &mut out);
     !out.is_empty()
