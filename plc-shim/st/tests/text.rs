@@ -120,9 +120,16 @@ fn numbers_become_text_and_text_numbers() {
     ok12 := STRING_TO_TIME('T#1m2s30ms') = t AND STRING_TO_TIME(TIME_TO_STRING(t)) = t
         AND STRING_TO_TIME('time#-2.5s') = T#-2500MS AND STRING_TO_TIME(' 1h_30m ') = T#90M
         AND STRING_TO_TIME('T#1ms900us') = T#1MS AND STRING_TO_TIME('1d') = T#24H;
-    ok13 := STRING_TO_LTIME(LTIME_TO_STRING(lt)) = lt AND STRING_TO_LTIME('LTIME#1.5us') = LINT_TO_LTIME(1500);
+    ok13 := STRING_TO_LTIME(LTIME_TO_STRING(lt)) = lt
+        AND STRING_TO_LTIME('LTIME#1.5us') = LINT_TO_LTIME(1500);
+    (* Counted in whole ns: decimal fractions exact, the largest LTIME read back. *)
+    ok14 := STRING_TO_TIME('T#8.2s') = T#8200MS AND STRING_TO_TIME('T#1.001s') = T#1001MS
+        AND STRING_TO_TIME('T#1_500ms') = T#1500MS AND STRING_TO_TIME('T#-1.9ms') = T#-1MS;
+    lt := LINT_TO_LTIME(LINT#9223372036854775807);
+    ok15 := STRING_TO_LTIME(LTIME_TO_STRING(lt)) = lt
+        AND LTIME_TO_LINT(STRING_TO_LTIME('LTIME#200d1ns')) = LINT#17280000000000001;
 ";
-    checks("", vars, body, 13);
+    checks("", vars, body, 15);
 }
 
 fn fault(body: &str) -> (Fault, [i64; 3], String) {
@@ -173,8 +180,16 @@ fn a_bad_length_position_or_number_faults_with_its_place() {
         let (f, _, _) = fault(&format!("  n := TIME_TO_INT(STRING_TO_TIME('{text}'));"));
         assert_eq!(f, Fault::NoNumber, "{text}");
     }
-    let (f, _, _) = fault("  n := TIME_TO_INT(STRING_TO_TIME('T#25d'));");
-    assert_eq!(f, Fault::OutOfRange);
+    for text in ["T#25d", "T#-25d"] {
+        let (f, _, _) = fault(&format!("  n := TIME_TO_INT(STRING_TO_TIME('{text}'));"));
+        assert_eq!(f, Fault::OutOfRange, "{text}");
+    }
+    for text in ["LTIME#107000d", "LTIME#1234567890123456789012h"] {
+        let (f, _, _) = fault(&format!(
+            "  n := LINT_TO_INT(LTIME_TO_LINT(STRING_TO_LTIME('{text}')));"
+        ));
+        assert_eq!(f, Fault::OutOfRange, "{text}");
+    }
     // A REAL beyond REAL's range (computed in LREAL) as text.
     let (f, _, _) = fault("  s := REAL_TO_STRING(REAL#1.0E30 * REAL#1.0E30);");
     assert_eq!(f, Fault::OutOfRange);
@@ -310,7 +325,7 @@ VAR_INPUT a, b, c, d : STRING(4); e : STRING(4) := 'e'; END_VAR
     F_Five := 5;
 END_FUNCTION
 PROGRAM MAIN
-VAR sLong : STRING(20); s : STRING(80); n : INT; fb : FB_Name; END_VAR
+VAR sLong : STRING(20); s : STRING(80); n : INT; fb : FB_Name; fbs : ARRAY[0..1] OF FB_Name; END_VAR
 {body}
 END_PROGRAM"
         )
@@ -328,12 +343,10 @@ END_PROGRAM"
     let e = refused(&program("  n := F_Five('a', 'b', 'c', 'd', 'e');"));
     assert!(e.contains("a call with more than 4 STRING values"), "{e}");
     let e = refused(&program(
-        "  fb(sName := F_Short('a'), n := F_Five('a', 'b', 'c', 'd'));",
+        "  fbs[n](sName := F_Short('a'), n := F_Five('a', 'b', 'c', 'd'));",
     ));
     assert!(
-        e.contains(
-            "main.st:25:3: error: a computed STRING input beside inputs that call a function"
-        ),
+        e.contains("main.st:25:3: error: a computed STRING input of an instance at a computed place beside inputs that call a function"),
         "{e}"
     );
     let e = refused(&program("  s := F_Short(n);"));
@@ -379,12 +392,17 @@ END_FUNCTION_BLOCK
     fbs[k](sIn := LEFT('xyz', 2), sOut => s2);
     ok3 := fbs[1].sOut = 'xy' AND s2 = 'xy' AND fbs[0].sOut = '';
     fb(sIn := 'abc', sOut => sLong);
-    ok4 := sLong = 'abc';";
+    ok4 := sLong = 'abc';
+    (* The inputs in their order: nIn reads the STRING input before the call stores it. *)
+    fb(nIn := LEN(fb.sIn), sIn := CONCAT('x', 'y'));
+    ok5 := fb.nOut = 3 AND fb.sOut = 'xy';
+    fb(sIn := F_Name('a', 1, ''), nIn := STRING_TO_INT(F_Tick()) + LEN(fb.sIn));
+    ok6 := fb.sOut = 'a_1' AND fb.nOut = 4 AND nTicks = 1;";
     checks(
         &before,
         &vars.replace("s2 :", "sLong : STRING(40);\n    s2 :"),
         body,
-        4,
+        6,
     );
     let text = format!(
         "{before}PROGRAM MAIN VAR fb : FB_Echo; s : STRING(5); END_VAR

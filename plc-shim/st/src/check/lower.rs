@@ -669,7 +669,7 @@ impl Checker {
             }
             if let (Type::Str(n), Arg::Input(_, v)) = (&member, arg) {
                 // A STRING input is passed in 8-byte parts (its literal's as constants).
-                let input = (&instance, offset, at);
+                let input = (&instance, offset, at, inputs.len());
                 for (k, t, part) in self.string_input(*n, v, input, &mut texts, ctx, l)? {
                     inputs.push((offset + k, t, part));
                 }

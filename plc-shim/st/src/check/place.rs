@@ -143,6 +143,15 @@ impl Checker {
 }
 
 /// The parts a STRING(n)'s n + 1 bytes are passed in: 8-byte words, then single bytes.
+/// Whether a place is fixed: no index computed, no pointer followed.
+fn fixed(a: &Addr) -> bool {
+    match a {
+        Addr::Static(_) | Addr::Instance(_) => true,
+        Addr::Offset(inner, _) => fixed(inner),
+        _ => false,
+    }
+}
+
 fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
     let size = n + 1;
     let words = (0..size / 8).map(|k| (8 * k, Elem::LWord));
@@ -204,15 +213,16 @@ impl Checker {
     }
 
     /// A block's STRING(n) input (`input`: the instance, the input's offset in it, the
-    /// call's place): its parts as [`Checker::string_parts`] gives them, or for a computed
-    /// STRING, a statement into `texts` that computes it into the input (cut to n) before
-    /// the call, and the parts read back from there (so that the call gives the input).
+    /// call's place, how many inputs come before it): its parts as
+    /// [`Checker::string_parts`] gives them, or for a computed STRING, a statement into
+    /// `texts` that computes it into the input (cut to n), and the parts read back from
+    /// there (so that the call gives the input): see [`Checker::texts_first`].
     pub(super) fn string_input(
         &mut self,
         n: u32,
         value: &Expr,
-        (instance, offset, at): (&Addr, u32, (u16, Pos)),
-        texts: &mut Vec<St>,
+        (instance, offset, at, before): (&Addr, u32, (u16, Pos), usize),
+        texts: &mut Vec<(usize, St)>,
         ctx: Ctx,
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Ex)>> {
@@ -221,11 +231,61 @@ impl Checker {
         }
         let place = plus(instance.clone(), offset);
         let kind = StKind::Text(place.clone(), n + 1, self.text_ir(value, ctx, l)?);
-        texts.push(St { kind, at });
+        texts.push((before, St { kind, at }));
         Ok(string_chunks(n)
             .into_iter()
             .map(|(k, t)| (k, t, Ex::Load(Box::new(plus(place.clone(), k)), t)))
             .collect())
+    }
+
+    /// A block call with computed STRING inputs (`texts`, each after the inputs it
+    /// follows): every input stored into the instance in the order written, the STRINGs
+    /// computed into theirs in their turn, then the call, which reads them back: one
+    /// statement, as the call stores its inputs one after the other. Refused when the
+    /// instance's place is not fixed (an array's element, a pointer's) and an input calls a
+    /// function, which could move the place between the stores.
+    pub(super) fn texts_first(
+        &mut self,
+        texts: Vec<(usize, St)>,
+        mut call: St,
+        pos: Pos,
+    ) -> R<StKind> {
+        let (StKind::CallFb {
+            instance, inputs, ..
+        }
+        | StKind::CallStdFb {
+            instance, inputs, ..
+        }) = &mut call.kind
+        else {
+            return Ok(call.kind);
+        };
+        if texts.is_empty() {
+            return Ok(call.kind);
+        }
+        let mut body = Vec::new();
+        let mut texts = texts.into_iter().peekable();
+        for k in 0..=inputs.len() {
+            while let Some((_, st)) = texts.next_if(|(before, _)| *before <= k) {
+                body.push(st);
+            }
+            let Some((offset, t, value)) = inputs.get_mut(k) else {
+                break;
+            };
+            let place = plus(instance.clone(), *offset);
+            let back = Ex::Load(Box::new(place.clone()), *t);
+            if *value != back {
+                let value = std::mem::replace(value, back);
+                let kind = StKind::Store(place, *t, value);
+                body.push(St { kind, at: call.at });
+            }
+        }
+        if !fixed(instance) && body.iter().any(crate::vm::callees::calls_in) {
+            let what = "a computed STRING input of an instance at a computed place beside \
+                        inputs that call a function";
+            return Err(self.unsupported(pos, what));
+        }
+        body.push(call);
+        Ok(StKind::If(vec![(Ex::Int(1), body)], Vec::new()))
     }
 
     /// A block's STRING(m) output given to `target` in the call: its parts, copied after
@@ -251,23 +311,6 @@ impl Checker {
             .into_iter()
             .map(|(at, t)| (offset + at, t, plus(to.clone(), at), false))
             .collect())
-    }
-
-    /// A block call whose computed STRING inputs are computed first (`texts`): those
-    /// statements and the call, as one statement. Refused when the call's other inputs or
-    /// its instance's place call a function (they would be taken after the STRINGs, not in
-    /// their order).
-    pub(super) fn texts_first(&mut self, texts: Vec<St>, call: St, pos: Pos) -> R<StKind> {
-        if texts.is_empty() {
-            return Ok(call.kind);
-        }
-        if crate::vm::callees::calls_in(&call) {
-            let what = "a computed STRING input beside inputs that call a function";
-            return Err(self.unsupported(pos, what));
-        }
-        let mut body = texts;
-        body.push(call);
-        Ok(StKind::If(vec![(Ex::Int(1), body)], Vec::new()))
     }
 
     /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING

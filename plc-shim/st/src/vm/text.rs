@@ -319,8 +319,18 @@ fn read_value(text: &[u8], t: Elem) -> Run<V> {
 }
 
 /// A duration as the language writes one (`T#1s500ms`, `TIME#-2.5s`, `LTIME#1s5us`, the
-/// prefix optional, `_` between parts): a TIME in whole ms (cut toward 0), an LTIME in ns.
+/// prefix optional, `_` between parts and between digits): a TIME in whole ms (cut toward
+/// 0, as a literal's), an LTIME in ns; counted in whole ns, so every LTIME reads back.
 fn read_duration(s: &str, t: Elem) -> Run<V> {
+    const UNITS: [(&str, i128); 7] = [
+        ("d", 86_400_000_000_000),
+        ("h", 3_600_000_000_000),
+        ("m", 60_000_000_000),
+        ("s", 1_000_000_000),
+        ("ms", 1_000_000),
+        ("us", 1_000),
+        ("ns", 1),
+    ];
     let starts = |p: &str| s.get(..p.len()).is_some_and(|h| h.eq_ignore_ascii_case(p));
     let prefix = ["LTIME#", "TIME#", "T#"].into_iter().find(|p| starts(p));
     let rest = &s[prefix.map_or(0, str::len)..];
@@ -328,49 +338,75 @@ fn read_duration(s: &str, t: Elem) -> Run<V> {
         Some(r) => (true, r),
         None => (false, rest),
     };
-    let (mut total, mut parts) = (0f64, 0);
+    let (mut ns, mut parts) = (0i128, 0);
     while !rest.is_empty() {
         parts += 1;
-        let number = rest.find(|c: char| !(c.is_ascii_digit() || c == '.'));
-        let (value, after) = rest.split_at(number.unwrap_or(rest.len()));
+        let (whole, _, beyond, rest_after) = digits(rest).ok_or(Fault::NoNumber)?;
+        if beyond {
+            // More than 18 digits before the point: beyond every duration.
+            return Err(Fault::OutOfRange);
+        }
+        // Digits of the fraction beyond 18 are below a ns.
+        let (numerator, denominator, after) = match rest_after.strip_prefix('.') {
+            Some(r) => digits(r).map_or((0, 1, r), |(v, p, _, a)| (v, p, a)),
+            None => (0, 1, rest_after),
+        };
         let unit_end = after.find(|c: char| !c.is_ascii_alphabetic());
         let (unit, after) = after.split_at(unit_end.unwrap_or(after.len()));
-        let value: f64 = match value.split_once('.') {
-            Some((a, b)) if a.is_empty() || b.contains('.') => return Err(Fault::NoNumber),
-            _ if value.is_empty() => return Err(Fault::NoNumber),
-            _ => value.parse().map_err(|_| Fault::NoNumber)?,
-        };
-        const UNITS: [(&str, f64); 7] = [
-            ("d", 86_400e9),
-            ("h", 3_600e9),
-            ("m", 60e9),
-            ("s", 1e9),
-            ("ms", 1e6),
-            ("us", 1e3),
-            ("ns", 1.0),
-        ];
         let scale = UNITS
             .iter()
             .find(|(name, _)| unit.eq_ignore_ascii_case(name))
             .ok_or(Fault::NoNumber)?
             .1;
-        total += value * scale;
+        // The fraction's ns rounded to the nearest.
+        let part = whole.checked_mul(scale).and_then(|w| {
+            let f = numerator.checked_mul(scale)?;
+            w.checked_add((f + denominator / 2) / denominator)
+        });
+        ns = part
+            .and_then(|p| ns.checked_add(p))
+            .ok_or(Fault::OutOfRange)?;
         rest = after.strip_prefix('_').unwrap_or(after);
     }
     if parts == 0 {
         return Err(Fault::NoNumber);
     }
-    let ns = if negative { -total } else { total };
-    let (v, most) = if t == Elem::LTime {
-        (ns.round(), i64::MAX as f64)
-    } else {
-        ((ns / 1e6).trunc(), f64::from(i32::MAX))
+    let ns = if negative { -ns } else { ns };
+    let (v, most) = match t {
+        Elem::LTime => (ns, i128::from(i64::MAX)),
+        _ => (ns / 1_000_000, i128::from(i32::MAX)),
     };
-    // Below -most - 1 as well as above most: the range of TIME's i32 ms, LTIME's i64 ns.
-    if !(v.is_finite() && v >= -most - 1.0 && v < most + 1.0) {
+    if !(-most - 1..=most).contains(&v) {
         return Err(Fault::OutOfRange);
     }
     Ok(V::I(v as i64))
+}
+
+/// The first (at most 18) digits at the start of `s` (`_` allowed between two): their
+/// value and 10 to their count, whether more digits were left out, and the rest; `None` if
+/// `s` does not start with a digit.
+fn digits(s: &str) -> Option<(i128, i128, bool, &str)> {
+    let bytes = s.as_bytes();
+    if !bytes.first()?.is_ascii_digit() {
+        return None;
+    }
+    let (mut value, mut power, mut more, mut k) = (0i128, 1i128, false, 0);
+    while k < bytes.len() {
+        let c = bytes[k];
+        let between = c == b'_' && bytes.get(k + 1).is_some_and(u8::is_ascii_digit);
+        if c.is_ascii_digit() {
+            if power < 1_000_000_000_000_000_000 {
+                value = value * 10 + i128::from(c - b'0');
+                power *= 10;
+            } else {
+                more = true;
+            }
+        } else if !between {
+            break;
+        }
+        k += 1;
+    }
+    Some((value, power, more, &s[k..]))
 }
 
 /// An integer as the language writes one, `None` if `s` is none.
