@@ -322,15 +322,6 @@ fn read_value(text: &[u8], t: Elem) -> Run<V> {
 /// prefix optional, `_` between parts and between digits): a TIME in whole ms (cut toward
 /// 0, as a literal's), an LTIME in ns; counted in whole ns, so every LTIME reads back.
 fn read_duration(s: &str, t: Elem) -> Run<V> {
-    const UNITS: [(&str, i128); 7] = [
-        ("d", 86_400_000_000_000),
-        ("h", 3_600_000_000_000),
-        ("m", 60_000_000_000),
-        ("s", 1_000_000_000),
-        ("ms", 1_000_000),
-        ("us", 1_000),
-        ("ns", 1),
-    ];
     let starts = |p: &str| s.get(..p.len()).is_some_and(|h| h.eq_ignore_ascii_case(p));
     let prefix = ["LTIME#", "TIME#", "T#"].into_iter().find(|p| starts(p));
     let rest = &s[prefix.map_or(0, str::len)..];
@@ -338,38 +329,14 @@ fn read_duration(s: &str, t: Elem) -> Run<V> {
         Some(r) => (true, r),
         None => (false, rest),
     };
-    let (mut ns, mut parts) = (0i128, 0);
-    while !rest.is_empty() {
-        parts += 1;
-        let (whole, _, beyond, rest_after) = digits(rest).ok_or(Fault::NoNumber)?;
-        if beyond {
-            // More than 18 digits before the point: beyond every duration.
-            return Err(Fault::OutOfRange);
-        }
-        // Digits of the fraction beyond 18 are below a ns.
-        let (numerator, denominator, after) = match rest_after.strip_prefix('.') {
-            Some(r) => digits(r).map_or((0, 1, r), |(v, p, _, a)| (v, p, a)),
-            None => (0, 1, rest_after),
-        };
-        let unit_end = after.find(|c: char| !c.is_ascii_alphabetic());
-        let (unit, after) = after.split_at(unit_end.unwrap_or(after.len()));
-        let scale = UNITS
-            .iter()
-            .find(|(name, _)| unit.eq_ignore_ascii_case(name))
-            .ok_or(Fault::NoNumber)?
-            .1;
-        // The fraction's ns rounded to the nearest.
-        let part = whole.checked_mul(scale).and_then(|w| {
-            let f = numerator.checked_mul(scale)?;
-            w.checked_add((f + denominator / 2) / denominator)
-        });
-        ns = part
-            .and_then(|p| ns.checked_add(p))
-            .ok_or(Fault::OutOfRange)?;
-        rest = after.strip_prefix('_').unwrap_or(after);
-    }
-    if parts == 0 {
+    if rest.is_empty() {
         return Err(Fault::NoNumber);
+    }
+    let mut ns = 0i128;
+    while !rest.is_empty() {
+        let (part, after) = duration_part(rest)?;
+        ns = ns.checked_add(part).ok_or(Fault::OutOfRange)?;
+        rest = after.strip_prefix('_').unwrap_or(after);
     }
     let ns = if negative { -ns } else { ns };
     let (v, most) = match t {
@@ -380,6 +347,40 @@ fn read_duration(s: &str, t: Elem) -> Run<V> {
         return Err(Fault::OutOfRange);
     }
     Ok(V::I(v as i64))
+}
+
+/// One part of a duration (`2.5s`): its ns (a fraction rounded to the nearest), and the
+/// rest of the text.
+fn duration_part(s: &str) -> Run<(i128, &str)> {
+    const UNITS: [(&str, i128); 7] = [
+        ("d", 86_400_000_000_000),
+        ("h", 3_600_000_000_000),
+        ("m", 60_000_000_000),
+        ("s", 1_000_000_000),
+        ("ms", 1_000_000),
+        ("us", 1_000),
+        ("ns", 1),
+    ];
+    let (whole, _, beyond, after) = digits(s).ok_or(Fault::NoNumber)?;
+    if beyond {
+        // More than 18 digits before the point: beyond every duration.
+        return Err(Fault::OutOfRange);
+    }
+    // Digits of the fraction beyond 18 are below a ns.
+    let (numerator, denominator, after) = match after.strip_prefix('.') {
+        Some(r) => digits(r).map_or((0, 1, r), |(v, p, _, a)| (v, p, a)),
+        None => (0, 1, after),
+    };
+    let unit_end = after.find(|c: char| !c.is_ascii_alphabetic());
+    let (unit, after) = after.split_at(unit_end.unwrap_or(after.len()));
+    let scale = UNITS
+        .iter()
+        .find(|(name, _)| unit.eq_ignore_ascii_case(name))
+        .ok_or(Fault::NoNumber)?
+        .1;
+    // At most 10^18 * 8.64e13 each: far within i128.
+    let ns = whole * scale + (numerator * scale + denominator / 2) / denominator;
+    Ok((ns, after))
 }
 
 /// The first (at most 18) digits at the start of `s` (`_` allowed between two): their
