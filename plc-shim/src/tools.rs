@@ -269,6 +269,9 @@ fn read(source: &Source, segment: &PlcSegment, vars: Option<&Variables>) -> Stri
     match (source, vars) {
         (Source::Image(leaf), _) => show(leaf, leaf.read(segment.memory())),
         (Source::St(i), Some(v)) => {
+            if let Some(text) = v.read_text(*i) {
+                return text;
+            }
             let value = v.read(*i);
             match v.symbol(*i).elem {
                 Elem::Bool if value != 0.0 => "TRUE".into(),
@@ -292,6 +295,10 @@ fn set_st(vars: &Variables, pairs: &[String]) -> Result<Vec<String>, ToolError> 
         let index = vars
             .find(path)
             .ok_or_else(|| ToolError::St(format!("unknown variable `{path}` of the ST PLC")))?;
+        if vars.symbol(index).text.is_some() {
+            let why = format!("`{path}` is a STRING: `plc set` writes numbers and BOOLs only");
+            return Err(ToolError::St(why));
+        }
         let value = match text.trim().to_ascii_uppercase().as_str() {
             "TRUE" => 1.0,
             "FALSE" => 0.0,

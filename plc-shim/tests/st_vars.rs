@@ -18,6 +18,8 @@ VAR
     aP : ARRAY[0..2] OF ST_P;
     fbT : TON;
     fbMove : MC_MoveVelocity;
+    sName : STRING(20) := 'it$'s 100$$';
+    sEmpty : STRING;
 END_VAR
     IF bRun THEN nCount := nCount + 1; END_IF
     aP[2].n := 7;
@@ -80,12 +82,21 @@ fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
         vars.find("MAIN.fbT.Q").is_none(),
         "a standard block's members are not listed"
     );
+    let text = |path: &str| vars.read_text(vars.find(path).unwrap_or_else(|| panic!("{path}")));
+    assert_eq!(text("MAIN.sName").as_deref(), Some("'it$'s 100$$'"));
+    assert_eq!(text("MAIN.sEmpty").as_deref(), Some("''"));
+    assert_eq!(text("MAIN.fSpeed"), None, "no STRING");
 
     // A write is taken by the PLC before its next cycle: the tool waits for it there.
     let writer = std::thread::spawn(move || {
         let run = vars.find("MAIN.bRun").unwrap();
         let speed = vars.find("MAIN.fSpeed").unwrap();
         let refused = vars.write(vars.find("MAIN.aP[0].n").unwrap(), 40_000.0);
+        // A STRING is never written through the tools, whatever a request says.
+        let text = vars.write(vars.find("MAIN.sName").unwrap(), 65.0);
+        assert!(text
+            .unwrap_err()
+            .contains("65 is not a value of STRING(20)"));
         let (run, speed) = (vars.write(run, 0.0), vars.write(speed, -2.25));
         (run, speed, refused, vars)
     });
@@ -117,6 +128,10 @@ fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
         "bRun is FALSE"
     );
     assert_eq!(plc.program.program().read_var("MAIN.fSpeed"), Some(-2.25));
+    let memory = plc.program.program().memory();
+    let name = plc.program.program().symbols(100);
+    let name = name.iter().find(|s| s.path == "MAIN.sName").unwrap();
+    assert_eq!(memory[name.offset as usize], b'i', "the STRING as it was");
 
     drop(plc);
     assert!(

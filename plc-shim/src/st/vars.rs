@@ -11,6 +11,9 @@
 //!                              64 the table: `PATH TYPE OFFSET` per line, then the memory
 //! ```
 //!
+//! A STRING's TYPE is `STRING(n)`: a tool reads its text (`plc get` prints it as ST writes a
+//! literal) and never writes it (the PLC refuses a write to it whatever the request says).
+//!
 //! Every cycle, before the program runs, the PLC takes a write a tool asked for (the symbol's
 //! index and a number, checked against the symbol's type: a value that does not fit is
 //! refused, never wrapped), and after it counts the cycle and, when a tool has asked for a
@@ -55,7 +58,8 @@ const CLAIMED: u32 = 4;
 #[derive(Debug)]
 pub struct Publisher {
     memory: ImageMemory,
-    symbols: Vec<(u32, Elem)>,
+    /// Per symbol: its offset and type, and whether it is a STRING (no tool writes one).
+    symbols: Vec<(u32, Elem, bool)>,
     data: usize,
     words: usize,
     cycles: u64,
@@ -75,7 +79,10 @@ impl Publisher {
         let symbols = program.symbols(MAX_SYMBOLS);
         let table: String = symbols
             .iter()
-            .map(|s| format!("{} {} {}\n", s.path, s.elem.name(), s.offset))
+            .map(|s| match s.text {
+                Some(size) => format!("{} STRING({}) {}\n", s.path, size - 1, s.offset),
+                None => format!("{} {} {}\n", s.path, s.elem.name(), s.offset),
+            })
             .collect();
         let data = align8(TABLE + table.len());
         let words = program.memory().len().div_ceil(8);
@@ -90,7 +97,10 @@ impl Publisher {
         memory.place::<u32>(TABLE_BYTES).store(table.len() as u32);
         memory.place::<u32>(DATA_BYTES).store((words * 8) as u32);
         memory.place::<u64>(0).store_release(MAGIC);
-        let symbols = symbols.iter().map(|s| (s.offset, s.elem)).collect();
+        let symbols = symbols
+            .iter()
+            .map(|s| (s.offset, s.elem, s.text.is_some()))
+            .collect();
         Ok(Publisher {
             memory,
             symbols,
@@ -109,7 +119,9 @@ impl Publisher {
         let index = self.memory.place::<u32>(REQUEST_INDEX).load() as usize;
         let value = f64::from_bits(self.memory.place::<u64>(REQUEST_VALUE).load());
         let done = match self.symbols.get(index) {
-            Some(&(offset, elem)) => program.write_symbol(offset, elem, value).is_ok(),
+            Some(&(offset, elem, false)) => program.write_symbol(offset, elem, value).is_ok(),
+            // A STRING is no number: refused, whatever a tool asks.
+            Some(&(_, _, true)) => false,
             None => false,
         };
         let state = if done { DONE } else { REFUSED };
@@ -187,15 +199,17 @@ impl Variables {
             else {
                 return Err(bad());
             };
-            let elem = Elem::named(ty).ok_or_else(bad)?;
+            let (elem, text) = symbol_type(ty).ok_or_else(bad)?;
             let offset: u32 = offset.parse().map_err(|_| bad())?;
-            if offset as usize + elem.size() > data_bytes {
+            let size = text.map_or(elem.size(), |n| n as usize);
+            if offset as usize + size > data_bytes {
                 return Err(bad());
             }
             symbols.push(Symbol {
                 path: path.to_string(),
                 offset,
                 elem,
+                text,
             });
         }
         Ok(Variables {
@@ -256,6 +270,28 @@ impl Variables {
         decode(&bytes[at - first..at - first + n], s.elem)
     }
 
+    /// The text of STRING symbol `index` (before its NUL) as the copy
+    /// [`Variables::refresh`] asked for left it, as ST writes a literal (`'part_1.nc'`, `$'`,
+    /// `$$` and `$hh` for the rest); `None` for a symbol that is no STRING.
+    pub fn read_text(&self, index: usize) -> Option<String> {
+        let s = &self.symbols[index];
+        let size = s.text? as usize;
+        let mut out = String::from("'");
+        for k in 0..size {
+            let at = s.offset as usize + k;
+            let word = self.memory.place::<u64>(self.data + at / 8 * 8).load();
+            let b = word.to_le_bytes()[at % 8];
+            match b {
+                0 => break,
+                b'\'' | b'$' => out.extend(['$', char::from(b)]),
+                b' '..=b'~' => out.push(char::from(b)),
+                _ => out.push_str(&format!("${b:02X}")),
+            }
+        }
+        out.push('\'');
+        Some(out)
+    }
+
     /// Writes `value` to symbol `index` through the PLC (it takes it before its next cycle):
     /// `Err` if the PLC refuses it (a value its type cannot hold) or does not answer.
     pub fn write(&self, index: usize, value: f64) -> Result<(), String> {
@@ -286,7 +322,11 @@ impl Variables {
             match state.load_acquire() {
                 DONE => break Ok(()),
                 REFUSED => {
-                    let ty = self.symbols[index].elem.name();
+                    let s = &self.symbols[index];
+                    let ty = match s.text {
+                        Some(size) => format!("STRING({})", size - 1),
+                        None => s.elem.name().to_string(),
+                    };
                     break Err(format!("{path}: {value} is not a value of {ty}"));
                 }
                 _ if std::time::Instant::now() > deadline => {
@@ -301,6 +341,18 @@ impl Variables {
         };
         state.store_release(FREE);
         answer
+    }
+}
+
+/// A symbol's type as the table writes it: an elementary type's name, or `STRING(n)` (its
+/// size with the NUL beside BYTE).
+fn symbol_type(ty: &str) -> Option<(Elem, Option<u32>)> {
+    match ty.strip_prefix("STRING(").and_then(|r| r.strip_suffix(')')) {
+        Some(n) => {
+            let n: u32 = n.parse().ok().filter(|n| (1..=255).contains(n))?;
+            Some((Elem::Byte, Some(n + 1)))
+        }
+        None => Elem::named(ty).map(|e| (e, None)),
     }
 }
 

@@ -295,7 +295,8 @@ fn get_set_and_watch_an_st_plcs_variables_by_name() {
     std::fs::write(
         dir.join("count.st"),
         "VAR_GLOBAL gTotal : LREAL; END_VAR\n\
-         PROGRAM MAIN VAR nCount : DINT; bRun : BOOL := TRUE; nSmall : INT; END_VAR\n\
+         PROGRAM MAIN VAR nCount : DINT; bRun : BOOL := TRUE; nSmall : INT;\n\
+         sPart : STRING(20) := 'part_7.nc'; END_VAR\n\
          IF bRun THEN nCount := nCount + 1; gTotal := gTotal + 0.5; END_IF\nEND_PROGRAM\n",
     )
     .unwrap();
@@ -332,6 +333,14 @@ fn get_set_and_watch_an_st_plcs_variables_by_name() {
     assert!(err.contains("40000 is not a value of INT"), "{err}");
     let (code, _, err) = tool(&instance, &["get", "MAIN.nothing"]);
     assert_eq!(code, 2, "{err}");
+    assert_eq!(
+        get(&instance, "MAIN.sPart"),
+        "'part_7.nc'",
+        "a STRING as ST writes it"
+    );
+    let (code, _, err) = tool(&instance, &["set", "MAIN.sPart", "1"]);
+    assert_eq!(code, 2, "{err}");
+    assert!(err.contains("`MAIN.sPart` is a STRING"), "{err}");
 
     assert!(child.signal("TERM"));
     let _ = child.wait_with_output(tests::cli::default_watchdog());

@@ -1,5 +1,5 @@
 //! A program's variables by name, for the tools (`plc get|set|watch MAIN.fbCam.Busy`): every
-//! elementary variable of the globals and the PROGRAMs, into structures, function block
+//! elementary variable and STRING of the globals and the PROGRAMs, into structures, function block
 //! instances (their inputs, outputs and locals) and arrays (each element, up to
 //! [`MAX_LISTED_ELEMENTS`] of an array), with its place in the program's memory.
 
@@ -19,8 +19,11 @@ pub struct Symbol {
     pub path: String,
     /// Its offset in the program's memory.
     pub offset: u32,
-    /// Its type.
+    /// Its type (a STRING's: BYTE).
     pub elem: Elem,
+    /// A STRING's size with its NUL (`STRING(n)`: n + 1 bytes); `None` for an elementary
+    /// variable.
+    pub text: Option<u32>,
 }
 
 impl Program {
@@ -52,9 +55,14 @@ impl Program {
             path: path.to_string(),
             offset: at,
             elem,
+            text: None,
         };
         match ty {
             Type::Elem(e) => out.push(leaf(*e)),
+            Type::Str(n) => out.push(Symbol {
+                text: Some(n + 1),
+                ..leaf(Elem::Byte)
+            }),
             Type::Enum(i) => out.push(leaf(c.enums[*i].base)),
             Type::Struct(i) => {
                 for (k, (name, t)) in c.structs[*i].fields.iter().enumerate() {
@@ -92,7 +100,7 @@ impl Program {
                     self.list(&name, element, at, limit, out);
                 }
             }
-            // Pointers, strings, standard blocks: not listed.
+            // Pointers, standard blocks: not listed.
             _ => {}
         }
     }
