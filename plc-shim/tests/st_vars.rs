@@ -22,6 +22,7 @@ VAR
     sEmpty : STRING;
 END_VAR
     IF bRun THEN nCount := nCount + 1; END_IF
+    fbT(IN := TRUE, PT := T#250MS);
     aP[2].n := 7;
     fbMove(Execute := FALSE);
 END_PROGRAM
@@ -78,10 +79,15 @@ fn a_tool_reads_and_writes_an_st_plcs_variables_by_name() {
     assert_eq!(value("MAIN.fSpeed"), 1.5);
     assert_eq!(value("MAIN.aP[2].n"), 7.0);
     assert_eq!(value("MAIN.fbMove.Busy"), 0.0, "a library block's output");
+    assert_eq!(value("MAIN.fbT.PT"), 250.0, "a standard block's input (ms)");
+    // Its outputs as its last call left them (how far its time ran depends on the cycles
+    // the copy waited for).
+    let (q, et) = (value("MAIN.fbT.Q"), value("MAIN.fbT.ET"));
     assert!(
-        vars.find("MAIN.fbT.Q").is_none(),
-        "a standard block's members are not listed"
+        et > 0.0 && et <= 250.0 && (q == 1.0) == (et == 250.0),
+        "{q} {et}"
     );
+    assert_eq!(value("MAIN.fbT.IN"), 1.0);
     let text = |path: &str| vars.read_text(vars.find(path).unwrap_or_else(|| panic!("{path}")));
     assert_eq!(text("MAIN.sName").as_deref(), Some("'it$'s 100$$'"));
     assert_eq!(text("MAIN.sEmpty").as_deref(), Some("''"));

@@ -1,7 +1,8 @@
 //! A program's variables by name, for the tools (`plc get|set|watch MAIN.fbCam.Busy`): every
-//! elementary variable and STRING of the globals and the PROGRAMs, into structures, function block
-//! instances (their inputs, outputs and locals) and arrays (each element, up to
-//! [`MAX_LISTED_ELEMENTS`] of an array), with its place in the program's memory.
+//! elementary variable and STRING of the globals and the PROGRAMs, into structures, function
+//! block instances (their inputs, outputs and locals; a standard block's inputs and outputs)
+//! and arrays (each element, up to [`MAX_LISTED_ELEMENTS`] of an array), with its place in
+//! the program's memory.
 
 use super::{write_mem, Fault, Program, V};
 use crate::ast::PouKind;
@@ -100,7 +101,18 @@ impl Program {
                     self.list(&name, element, at, limit, out);
                 }
             }
-            // Pointers, standard blocks: not listed.
+            Type::StdFb(fb) => {
+                for &(name, elem, _) in fb.members() {
+                    let offset = crate::layout::std_member(*fb, name).unwrap_or(0);
+                    out.push(Symbol {
+                        path: format!("{path}.{name}"),
+                        offset: at + offset,
+                        elem,
+                        text: None,
+                    });
+                }
+            }
+            // Pointers: not listed.
             _ => {}
         }
     }
