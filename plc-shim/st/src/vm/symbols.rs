@@ -12,8 +12,9 @@ use crate::types::Elem;
 /// The most elements of one array the symbols list.
 pub const MAX_LISTED_ELEMENTS: u64 = 256;
 
-/// An elementary variable: its path (`MAIN.fbCam.Busy`, `MAIN.a[3]`, `gCount`), its place in
-/// the program's memory and its type (an enumeration's base type).
+/// An elementary variable or a STRING: its path (`MAIN.fbCam.Busy`, `MAIN.a[3]`, `gCount`),
+/// its place in the program's memory and its type (an enumeration's base type; a STRING's
+/// size in `text`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Symbol {
     /// Its path.
@@ -28,7 +29,8 @@ pub struct Symbol {
 }
 
 impl Program {
-    /// Every elementary variable by path, at most `limit` of them, in declaration order.
+    /// Every elementary variable and STRING by path, at most `limit` of them, in
+    /// declaration order.
     pub fn symbols(&self, limit: usize) -> Vec<Symbol> {
         let (c, l) = (&self.code.checked, &self.code.layout);
         let mut out = Vec::new();
@@ -103,13 +105,18 @@ impl Program {
             }
             Type::StdFb(fb) => {
                 for &(name, elem, _) in fb.members() {
-                    let offset = crate::layout::std_member(*fb, name).unwrap_or(0);
-                    out.push(Symbol {
-                        path: format!("{path}.{name}"),
-                        offset: at + offset,
-                        elem,
-                        text: None,
-                    });
+                    // Every member has its place (`layout::std_fb`); one without is left out.
+                    let Some(offset) = crate::layout::std_member(*fb, name) else {
+                        continue;
+                    };
+                    if out.len() < limit {
+                        out.push(Symbol {
+                            path: format!("{path}.{name}"),
+                            offset: at + offset,
+                            elem,
+                            text: None,
+                        });
+                    }
                 }
             }
             // Pointers: not listed.
