@@ -481,6 +481,8 @@ impl Checker {
             Some(Meaning::Local(_) | Meaning::Global(_)) => {
                 self.error(pos, format!("`{}` is a function block instance: call it as a statement and read its outputs", n.text))
             }
+            // A `TO_<type>` call left unnamed: refused where it was named (`to_type`).
+            _ if super::to_type::target(&upper).is_some() => Type::Error,
             _ => self.error(n.pos, format!("unknown function `{}`", n.text)),
         }
     }

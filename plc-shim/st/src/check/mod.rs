@@ -19,6 +19,7 @@ mod place;
 pub mod std_lib;
 mod stmt;
 mod text;
+mod to_type;
 
 /// A type of the language.
 #[derive(Debug, Clone, PartialEq)]
@@ -117,10 +118,14 @@ enum Named {
 
 /// Checks `files` (name and tree) as one program: the tables, or every refusal.
 pub fn check(files: &[(String, Unit)]) -> Result<Checked, Vec<Diagnostic>> {
-    checker(files).map(|c| c.out)
+    checker(files).map(|(c, _)| c.out)
 }
 
-fn checker(files: &[(String, Unit)]) -> Result<Checker, Vec<Diagnostic>> {
+/// Files by name, parsed.
+type Files = Vec<(String, Unit)>;
+
+/// The checker of `files`, and the files as it read them (`TO_<type>` calls named).
+fn checker(files: &[(String, Unit)]) -> Result<(Checker, Files), Vec<Diagnostic>> {
     let mut c = Checker {
         consts: consts::Consts::of(files),
         ..Checker::default()
@@ -128,9 +133,10 @@ fn checker(files: &[(String, Unit)]) -> Result<Checker, Vec<Diagnostic>> {
     c.collect(files);
     c.resolve_types(files);
     c.resolve_vars(files);
-    c.check_bodies(files);
+    let files = c.name_conversions(files);
+    c.check_bodies(&files);
     if c.errors.is_empty() {
-        Ok(c)
+        Ok((c, files))
     } else {
         c.errors
             .sort_by(|a, b| (&a.file, a.pos).cmp(&(&b.file, b.pos)));
@@ -155,7 +161,8 @@ pub struct Compiled {
 
 /// Checks and lowers `files`: the program, or every refusal.
 pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
-    let mut c = checker(files)?;
+    let (mut c, named) = checker(files)?;
+    let files = &named[..];
     let layout = crate::layout::Layout::of(&c.out).map_err(|e| {
         let file = files.first().map_or("", |(f, _)| f.as_str());
         vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(file)]

@@ -108,5 +108,6 @@ pub fn is_reserved_name(upper: &str) -> bool {
         || super::text::TEXT_FUNCTIONS.contains(&upper)
         || super::text::text_conversion(upper).is_some()
         || crate::types::conversion(upper).is_some()
+        || super::to_type::target(upper).is_some()
         || StdFb::named(upper).is_some()
 }

@@ -1,0 +1,194 @@
+//! IEC 61131-3's overloaded conversions `TO_<type>(x)` (TwinCAT 3, CODESYS): each named
+//! after the type of its value before the bodies are checked (`TO_LREAL(nCount)` of a DINT is
+//! `DINT_TO_LREAL(nCount)`, `TO_STRING(x)` of a REAL `REAL_TO_STRING(x)`, `TO_INT(s)` of a
+//! STRING `STRING_TO_INT(s)`), so that every rule of the named conversions holds for them. A
+//! value of no elementary type or STRING (an enumeration, a structure), or another count of
+//! values, is refused here with its place.
+
+use super::expr::{Ctx, GLOBAL};
+use super::{Checker, Named, Type};
+use crate::ast::{Arg, Expr, Init, Item, Stmt, Unit};
+use crate::types::Elem;
+
+/// The type `TO_<type>` converts to (`STRING` included), `None` for any other name.
+pub(super) fn target(upper: &str) -> Option<&str> {
+    let to = upper.strip_prefix("TO_")?;
+    (to == "STRING" || Elem::named(to).is_some()).then_some(to)
+}
+
+impl Checker {
+    /// `files` with every `TO_<type>(x)` call named after `x`'s type.
+    pub(super) fn name_conversions(&mut self, files: &[(String, Unit)]) -> super::Files {
+        let mut out = files.to_vec();
+        for (file, unit) in &mut out {
+            self.file = file.clone();
+            for item in &mut unit.items {
+                match item {
+                    Item::Pou(p) => {
+                        let upper = p.name.text.to_ascii_uppercase();
+                        let Some(Named::Pou(pou)) = self.names.get(&upper).cloned() else {
+                            continue;
+                        };
+                        let ctx = Ctx { pou, loops: 0 };
+                        self.calls_from = pou;
+                        for d in p.vars.iter_mut().flat_map(|b| b.vars.iter_mut()) {
+                            if let Some(init) = &mut d.init {
+                                self.name_in_init(init, ctx);
+                            }
+                        }
+                        self.name_in_block(&mut p.body, ctx);
+                    }
+                    Item::Globals(block) => {
+                        for d in &mut block.vars {
+                            if let Some(init) = &mut d.init {
+                                self.name_in_init(init, GLOBAL);
+                            }
+                        }
+                    }
+                    Item::Types(_) => {}
+                }
+            }
+        }
+        out
+    }
+
+    fn name_in_init(&mut self, init: &mut Init, ctx: Ctx) {
+        match init {
+            Init::Expr(e) => self.name_in(e, ctx),
+            Init::Array(values) => {
+                for (count, v) in values {
+                    if let Some(c) = count {
+                        self.name_in(c, ctx);
+                    }
+                    self.name_in_init(v, ctx);
+                }
+            }
+            Init::Struct(fields) => {
+                for (_, v) in fields {
+                    self.name_in_init(v, ctx);
+                }
+            }
+        }
+    }
+
+    fn name_in_block(&mut self, body: &mut [Stmt], ctx: Ctx) {
+        for s in body {
+            self.name_in_stmt(s, ctx);
+        }
+    }
+
+    fn name_in_stmt(&mut self, s: &mut Stmt, ctx: Ctx) {
+        match s {
+            Stmt::Assign { target, value } => {
+                self.name_in(target, ctx);
+                self.name_in(value, ctx);
+            }
+            Stmt::Call(e) => self.name_in(e, ctx),
+            Stmt::If {
+                branches,
+                otherwise,
+            } => {
+                for (cond, body) in branches {
+                    self.name_in(cond, ctx);
+                    self.name_in_block(body, ctx);
+                }
+                self.name_in_block(otherwise.as_deref_mut().unwrap_or_default(), ctx);
+            }
+            Stmt::Case {
+                selector,
+                arms,
+                otherwise,
+            } => {
+                self.name_in(selector, ctx);
+                for (_, body) in arms {
+                    self.name_in_block(body, ctx);
+                }
+                self.name_in_block(otherwise.as_deref_mut().unwrap_or_default(), ctx);
+            }
+            Stmt::For {
+                from, to, by, body, ..
+            } => {
+                for e in [Some(from), Some(to), by.as_mut()].into_iter().flatten() {
+                    self.name_in(e, ctx);
+                }
+                self.name_in_block(body, ctx);
+            }
+            Stmt::While { cond, body } | Stmt::Repeat { body, until: cond } => {
+                self.name_in(cond, ctx);
+                self.name_in_block(body, ctx);
+            }
+            Stmt::Exit(_) | Stmt::Continue(_) | Stmt::Return(_) => {}
+        }
+    }
+
+    /// Names the calls in `e`, the innermost first (their types are the outer ones' values').
+    fn name_in(&mut self, e: &mut Expr, ctx: Ctx) {
+        match e {
+            Expr::Typed { value, .. } => self.name_in(value, ctx),
+            Expr::Field(base, _) | Expr::Deref(base, _) | Expr::Unary(_, base, _) => {
+                self.name_in(base, ctx)
+            }
+            Expr::Index(base, indices, _) => {
+                self.name_in(base, ctx);
+                indices.iter_mut().for_each(|i| self.name_in(i, ctx));
+            }
+            Expr::Binary(_, a, b, _) => {
+                self.name_in(a, ctx);
+                self.name_in(b, ctx);
+            }
+            Expr::Call { callee, args, .. } => {
+                for arg in args.iter_mut() {
+                    match arg {
+                        Arg::Positional(v) | Arg::Input(_, v) => self.name_in(v, ctx),
+                        Arg::Output { target, .. } => self.name_in(target, ctx),
+                    }
+                }
+                self.name_call(callee, args, ctx);
+            }
+            Expr::Int(..)
+            | Expr::Real(..)
+            | Expr::Bool(..)
+            | Expr::Str(..)
+            | Expr::Time(..)
+            | Expr::Name(_) => {}
+        }
+    }
+
+    /// `TO_<type>(x)` named `<x's type>_TO_<type>`; another count of values refused.
+    fn name_call(&mut self, callee: &mut Expr, args: &[Arg], ctx: Ctx) {
+        let Expr::Name(n) = callee else {
+            return;
+        };
+        let upper = n.text.to_ascii_uppercase();
+        let Some(to) = target(&upper) else {
+            return;
+        };
+        let [Arg::Positional(value)] = args else {
+            let message = format!("{} takes one value, by position", n.text);
+            self.refuse(n.pos, message);
+            return;
+        };
+        // The value's type: its errors are the checks' to report when the call is named
+        // (they check it again), here when it is not (the call is refused as it stands).
+        let errors = self.errors.len();
+        let ty = self.expr(value, ctx);
+        if !matches!(ty, Type::Error) {
+            self.errors.truncate(errors);
+        }
+        let from = match ty {
+            Type::Elem(e) => e.name(),
+            Type::Str(_) => "STRING",
+            Type::Error => return,
+            other => {
+                let found = self.type_name(&other);
+                let message = format!(
+                    "{} of a {found}: it converts a value of an elementary type or a STRING",
+                    n.text
+                );
+                self.refuse(value.pos(), message);
+                return;
+            }
+        };
+        n.text = format!("{from}_TO_{to}");
+    }
+}
