@@ -204,3 +204,43 @@ fn adr_of_an_instance_and_copies_of_instances_are_refused() {
     assert!(refused[2].contains("p.st:7:1: error: function block instances are not copied"));
     assert!(refused[3].starts_with("p.st:8:10: error: ") && refused[3].contains(adr));
 }
+
+/// The refusals of a whole file `main.st`, as text.
+fn refused_text(text: &str) -> String {
+    match checked(&[("main.st", text)]) {
+        Ok(_) => panic!("checked: {text}"),
+        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
+    }
+}
+
+/// `TO_<type>` of no elementary value or STRING, with another count of values, or as a POU's
+/// name: refused with its place.
+#[test]
+fn to_type_of_no_elementary_value_or_as_a_name_is_refused() {
+    let e = refused_text(
+        "TYPE E_Step : (Idle, Run); END_TYPE
+PROGRAM MAIN VAR e : E_Step; i : INT; END_VAR
+    i := TO_INT(e);
+END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:3:17: error: TO_INT of a E_Step: it converts a value of an elementary type or a STRING"),
+        "{e}"
+    );
+    assert!(!e.contains("unknown function"), "{e}");
+    let e = refused_text(
+        "PROGRAM MAIN VAR i : INT; END_VAR i := TO_INT(nope) + TO_INT(i); END_PROGRAM",
+    );
+    assert_eq!(
+        e.trim(),
+        "main.st:1:47: error: unknown name `nope`",
+        "the value's own error, once"
+    );
+    let e = refused_text("FUNCTION TO_LREAL : LREAL TO_LREAL := 1.0; END_FUNCTION");
+    assert!(e.contains("`TO_LREAL` is a standard name"), "{e}");
+    let e = refused_text("PROGRAM MAIN VAR s : STRING; END_VAR s := TO_STRING(1, 2); END_PROGRAM");
+    assert!(
+        e.contains("main.st:1:43: error: TO_STRING takes one value, by position"),
+        "{e}"
+    );
+}

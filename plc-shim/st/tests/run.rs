@@ -623,3 +623,42 @@ END_PROGRAM",
     assert_eq!(p.read_var("MAIN.n"), Some(12.0));
     assert_eq!(p.read_var("MAIN.i"), Some(1.0));
 }
+
+/// `TO_<type>(x)`: the named conversion from `x`'s type (`TO_LREAL(n)` of a DINT is
+/// `DINT_TO_LREAL(n)`), to and from STRING, nested, in an initial value.
+#[test]
+fn to_type_converts_from_the_values_type() {
+    let mut p = load(
+        "PROGRAM MAIN
+VAR
+    n : DINT := 7;
+    r, rHalf, rTime : LREAL;
+    i : INT;
+    s : STRING;
+    t : TIME := T#1500MS;
+    u : USINT;
+    b : BOOL := TRUE;
+    nBack : DINT;
+    rInit : LREAL := TO_LREAL(3) / 2.0;
+    bOk : BOOL;
+END_VAR
+    rHalf := TO_LREAL(n) / 2.0;
+    i := TO_INT(rHalf);
+    s := TO_STRING(n);
+    nBack := TO_DINT(TO_STRING(i + 38));
+    rTime := TO_LREAL(t);
+    b := TO_BOOL(u);
+    bOk := TO_STRING(rHalf) = '3.5' AND TO_UINT(TO_STRING(TO_USINT(300 - 45))) = 255;
+END_PROGRAM",
+    );
+    p.cycle(0)
+        .unwrap_or_else(|f| panic!("{}", p.fault_text(&f)));
+    let v = |name: &str| p.read_var(&format!("MAIN.{name}"));
+    assert_eq!(v("rHalf"), Some(3.5));
+    assert_eq!(v("i"), Some(4.0), "LREAL_TO_INT rounds");
+    assert_eq!(v("nBack"), Some(42.0));
+    assert_eq!(v("rTime"), Some(1500.0), "a TIME's ms");
+    assert_eq!(v("b"), Some(0.0));
+    assert_eq!(v("rInit"), Some(1.5));
+    assert_eq!(v("bOk"), Some(1.0));
+}
