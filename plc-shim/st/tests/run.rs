@@ -641,6 +641,8 @@ VAR
     nBack : DINT;
     rInit : LREAL := TO_LREAL(3) / 2.0;
     bOk : BOOL;
+    fbs : ARRAY[0..1] OF TON;
+    to_time : TON; (* a variable named like a conversion is the variable *)
 END_VAR
     rHalf := TO_LREAL(n) / 2.0;
     i := TO_INT(rHalf);
@@ -648,7 +650,10 @@ END_VAR
     nBack := TO_DINT(TO_STRING(i + 38));
     rTime := TO_LREAL(t);
     b := TO_BOOL(u);
-    bOk := TO_STRING(rHalf) = '3.5' AND TO_UINT(TO_STRING(TO_USINT(300 - 45))) = 255;
+    bOk := TO_STRING(rHalf) = '3.5' AND TO_UINT(TO_STRING(TO_USINT(300 - 45))) = 255
+        AND TO_STRING(TO_STRING(n)) = '7';
+    fbs[TO_INT(rHalf) - 3](IN := TRUE, PT := T#0MS);
+    to_time(IN := TRUE, PT := T#0MS);
 END_PROGRAM",
     );
     p.cycle(0)
@@ -661,4 +666,16 @@ END_PROGRAM",
     assert_eq!(v("b"), Some(0.0));
     assert_eq!(v("rInit"), Some(1.5));
     assert_eq!(v("bOk"), Some(1.0));
+    let q = |path: &str| {
+        p.symbols(100)
+            .into_iter()
+            .find(|s| s.path == path)
+            .map(|s| p.memory()[s.offset as usize])
+    };
+    assert_eq!(
+        q("MAIN.fbs[1].Q"),
+        Some(1),
+        "the element TO_INT(rHalf) - 3 names"
+    );
+    assert_eq!(q("MAIN.to_time.Q"), Some(1));
 }

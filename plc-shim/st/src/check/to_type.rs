@@ -123,6 +123,7 @@ impl Checker {
 
     /// Names the calls in `e`, the innermost first (their types are the outer ones' values').
     fn name_in(&mut self, e: &mut Expr, ctx: Ctx) {
+        let mut itself = None;
         match e {
             Expr::Typed { value, .. } => self.name_in(value, ctx),
             Expr::Field(base, _) | Expr::Deref(base, _) | Expr::Unary(_, base, _) => {
@@ -137,13 +138,20 @@ impl Checker {
                 self.name_in(b, ctx);
             }
             Expr::Call { callee, args, .. } => {
+                // An instance's place may hold calls too (`fbs[TO_INT(r)](..)`).
+                self.name_in(callee, ctx);
                 for arg in args.iter_mut() {
                     match arg {
                         Arg::Positional(v) | Arg::Input(_, v) => self.name_in(v, ctx),
                         Arg::Output { target, .. } => self.name_in(target, ctx),
                     }
                 }
-                self.name_call(callee, args, ctx);
+                // TO_STRING of a STRING: the STRING itself.
+                if self.name_call(callee, args, ctx) {
+                    if let [Arg::Positional(v)] = &args[..] {
+                        itself = Some(v.clone());
+                    }
+                }
             }
             Expr::Int(..)
             | Expr::Real(..)
@@ -152,21 +160,26 @@ impl Checker {
             | Expr::Time(..)
             | Expr::Name(_) => {}
         }
+        if let Some(v) = itself {
+            *e = v;
+        }
     }
 
-    /// `TO_<type>(x)` named `<x's type>_TO_<type>`; another count of values refused.
-    fn name_call(&mut self, callee: &mut Expr, args: &[Arg], ctx: Ctx) {
+    /// `TO_<type>(x)` named `<x's type>_TO_<type>`; another count of values refused. `true`
+    /// for a call that is its value itself (TO_STRING of a STRING).
+    fn name_call(&mut self, callee: &mut Expr, args: &[Arg], ctx: Ctx) -> bool {
         let Expr::Name(n) = callee else {
-            return;
+            return false;
         };
         let upper = n.text.to_ascii_uppercase();
-        let Some(to) = target(&upper) else {
-            return;
+        // A variable of that name (an instance called) is not the conversion.
+        let Some(to) = target(&upper).filter(|_| self.meaning(&n.text, ctx).is_none()) else {
+            return false;
         };
         let [Arg::Positional(value)] = args else {
             let message = format!("{} takes one value, by position", n.text);
             self.refuse(n.pos, message);
-            return;
+            return false;
         };
         // The value's type: its errors are the checks' to report when the call is named
         // (they check it again), here when it is not (the call is refused as it stands).
@@ -177,8 +190,9 @@ impl Checker {
         }
         let from = match ty {
             Type::Elem(e) => e.name(),
+            Type::Str(_) if to == "STRING" => return true,
             Type::Str(_) => "STRING",
-            Type::Error => return,
+            Type::Error => return false,
             other => {
                 let found = self.type_name(&other);
                 let message = format!(
@@ -186,9 +200,10 @@ impl Checker {
                     n.text
                 );
                 self.refuse(value.pos(), message);
-                return;
+                return false;
             }
         };
         n.text = format!("{from}_TO_{to}");
+        false
     }
 }
