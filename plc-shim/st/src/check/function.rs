@@ -7,9 +7,8 @@ use super::lower::R;
 use super::place::plus;
 use super::{Checker, Type};
 use crate::ast::{Arg, Expr, Section};
-use crate::diag::Diagnostic;
 use crate::diag::Pos;
-use crate::ir::{Addr, Ex, FnCall, Text};
+use crate::ir::{Addr, Ex, FnCall};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -127,7 +126,7 @@ impl Checker {
             match ty {
                 Type::Elem(t) => stores.push((offset, t, self.value_as(value, t, ctx, l)?)),
                 Type::Str(n) => {
-                    let text = self.text_input(n, value, ctx, l)?;
+                    let text = self.text_for(n, value, ctx, l)?;
                     texts.push((stores.len(), offset, n + 1, text));
                 }
                 _ => {
@@ -149,21 +148,5 @@ impl Checker {
             value: Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0)),
             back,
         })
-    }
-
-    /// A STRING(n) input's value: a literal no longer than n, a STRING variable no longer
-    /// than n, or a computed STRING (cut to n when longer, as an assignment's).
-    fn text_input(&mut self, n: u32, value: &Expr, ctx: Ctx, l: &Layout) -> R<Text> {
-        if let Expr::Str(text, pos) = value {
-            let bytes = self.literal_bytes(text, n, *pos)?;
-            return Ok(Text::Const(bytes.into_boxed_slice()));
-        }
-        match self.text_ir(value, ctx, l)? {
-            Text::At(_, size) if size > n + 1 => {
-                let message = format!("a STRING({}) into a STRING({n}): it may not fit", size - 1);
-                Err(Diagnostic::new(value.pos(), message).in_file(&self.file))
-            }
-            text => Ok(text),
-        }
     }
 }

@@ -6,7 +6,7 @@ use super::lower::R;
 use super::{Checker, Type};
 use crate::ast::{BinOp, Expr};
 use crate::diag::{Diagnostic, Pos};
-use crate::ir::{Addr, Ex, St, StKind, StdFn};
+use crate::ir::{Addr, Ex, St, StKind, StdFn, Text};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -152,6 +152,14 @@ fn fixed(a: &Addr) -> bool {
     }
 }
 
+/// The parts of the STRING(n) at `place`, read.
+fn loads(place: &Addr, n: u32) -> Vec<(u32, Elem, Ex)> {
+    string_chunks(n)
+        .into_iter()
+        .map(|(at, t)| (at, t, Ex::Load(Box::new(plus(place.clone(), at)), t)))
+        .collect()
+}
+
 fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
     let size = n + 1;
     let words = (0..size / 8).map(|k| (8 * k, Elem::LWord));
@@ -163,12 +171,7 @@ fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
 impl Checker {
     /// A string literal's bytes for a STRING(n): ASCII, at most n characters, NUL-padded to
     /// n + 1 bytes.
-    pub(super) fn literal_bytes(
-        &mut self,
-        text: &str,
-        n: u32,
-        pos: crate::diag::Pos,
-    ) -> R<Vec<u8>> {
+    pub(super) fn literal_bytes(&mut self, text: &str, n: u32, pos: Pos) -> R<Vec<u8>> {
         if !text.is_ascii() {
             return Err(self.unsupported(pos, "a STRING of other than ASCII characters"));
         }
@@ -184,7 +187,24 @@ impl Checker {
         Ok(bytes)
     }
 
-    /// `value` (a literal or a STRING variable no longer than n) stored into a STRING(n).
+    /// A value for a STRING(n): a literal no longer than n, a STRING variable no longer than
+    /// n (refused otherwise: it may not fit), or a computed STRING (cut to n when longer, as
+    /// TwinCAT's string functions are).
+    pub(super) fn text_for(&mut self, n: u32, value: &Expr, ctx: Ctx, l: &Layout) -> R<Text> {
+        if let Expr::Str(text, pos) = value {
+            let bytes = self.literal_bytes(text, n, *pos)?;
+            return Ok(Text::Const(bytes.into_boxed_slice()));
+        }
+        match self.text_ir(value, ctx, l)? {
+            Text::At(_, size) if size > n + 1 => {
+                let message = format!("a STRING({}) into a STRING({n}): it may not fit", size - 1);
+                Err(Diagnostic::new(value.pos(), message).in_file(&self.file))
+            }
+            text => Ok(text),
+        }
+    }
+
+    /// `value` stored into the STRING(n) at `addr` ([`Checker::text_for`]).
     pub(super) fn lower_string(
         &mut self,
         addr: Addr,
@@ -193,30 +213,18 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<StKind> {
-        if let Expr::Str(text, pos) = value {
-            let bytes = self.literal_bytes(text, n, *pos)?;
-            return Ok(StKind::Bytes(addr, bytes.into_boxed_slice()));
-        }
-        if self.is_text_value(value, ctx) {
-            // Cut to the target's length when longer, as TwinCAT's string functions are.
-            return Ok(StKind::Text(addr, n + 1, self.text_ir(value, ctx, l)?));
-        }
-        let (from, ty) = self.place(value, ctx, l)?;
-        match ty {
-            Type::Str(m) if m <= n => Ok(StKind::Copy(addr, from, m + 1)),
-            Type::Str(m) => {
-                let message = format!("a STRING({m}) into a STRING({n}): it may not fit");
-                Err(Diagnostic::new(value.pos(), message).in_file(&self.file))
-            }
-            _ => Err(self.unsupported(value.pos(), "this value into a STRING")),
-        }
+        Ok(match self.text_for(n, value, ctx, l)? {
+            Text::Const(bytes) => StKind::Bytes(addr, bytes),
+            Text::At(from, size) => StKind::Copy(addr, from, size),
+            text => StKind::Text(addr, n + 1, text),
+        })
     }
 
     /// A block's STRING(n) input (`input`: the instance, the input's offset in it, the
-    /// call's place, how many inputs come before it): its parts as
-    /// [`Checker::string_parts`] gives them, or for a computed STRING, a statement into
-    /// `texts` that computes it into the input (cut to n), and the parts read back from
-    /// there (so that the call gives the input): see [`Checker::texts_first`].
+    /// call's place, how many inputs come before it), passed in 8-byte parts: a literal's
+    /// as constants, a variable's (no longer than n) read; for a computed STRING, a
+    /// statement into `texts` that computes it into the input (cut to n), and the parts read
+    /// back from there (so that the call gives the input): see [`Checker::texts_first`].
     pub(super) fn string_input(
         &mut self,
         n: u32,
@@ -226,16 +234,31 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Ex)>> {
-        if !self.is_text_value(value, ctx) {
-            return self.string_parts(n, value, ctx, l);
-        }
+        let text = match self.text_for(n, value, ctx, l)? {
+            // A literal in constants, a variable read.
+            Text::Const(bytes) => {
+                return Ok(string_chunks(n)
+                    .into_iter()
+                    .map(|(at, t)| {
+                        let mut word = [0u8; 8];
+                        let b = &bytes[at as usize..at as usize + t.size()];
+                        word[..b.len()].copy_from_slice(b);
+                        (at, t, Ex::Int(i64::from_le_bytes(word)))
+                    })
+                    .collect())
+            }
+            Text::At(from, size) => return Ok(loads(&from, size - 1)),
+            computed => computed,
+        };
         let place = plus(instance.clone(), offset);
-        let kind = StKind::Text(place.clone(), n + 1, self.text_ir(value, ctx, l)?);
-        texts.push((before, St { kind, at }));
-        Ok(string_chunks(n)
-            .into_iter()
-            .map(|(k, t)| (k, t, Ex::Load(Box::new(plus(place.clone(), k)), t)))
-            .collect())
+        texts.push((
+            before,
+            St {
+                kind: StKind::Text(place.clone(), n + 1, text),
+                at,
+            },
+        ));
+        Ok(loads(&place, n))
     }
 
     /// A block call with computed STRING inputs (`texts`, each after the inputs it
@@ -310,42 +333,6 @@ impl Checker {
         Ok(string_chunks(m)
             .into_iter()
             .map(|(at, t)| (offset + at, t, plus(to.clone(), at), false))
-            .collect())
-    }
-
-    /// A STRING(n) input's parts (offset, type, value): a literal's as constants, a STRING
-    /// variable's (no longer than n) loaded.
-    pub(super) fn string_parts(
-        &mut self,
-        n: u32,
-        value: &Expr,
-        ctx: Ctx,
-        l: &Layout,
-    ) -> R<Vec<(u32, Elem, Ex)>> {
-        let chunks = string_chunks(n);
-        if let Expr::Str(text, pos) = value {
-            let bytes = self.literal_bytes(text, n, *pos)?;
-            return Ok(chunks
-                .into_iter()
-                .map(|(at, t)| {
-                    let mut word = [0u8; 8];
-                    let part = &bytes[at as usize..at as usize + t.size()];
-                    word[..part.len()].copy_from_slice(part);
-                    (at, t, Ex::Int(i64::from_le_bytes(word)))
-                })
-                .collect());
-        }
-        let (from, ty) = self.place(value, ctx, l)?;
-        let m = match ty {
-            Type::Str(m) if m <= n => m,
-            _ => return Err(self.unsupported(value.pos(), "this value into a STRING input")),
-        };
-        Ok(string_chunks(m)
-            .into_iter()
-            .map(|(at, t)| {
-                let part = Addr::Offset(Box::new(from.clone()), at);
-                (at, t, Ex::Load(Box::new(part), t))
-            })
             .collect())
     }
 }
