@@ -79,10 +79,7 @@ impl Publisher {
         let symbols = program.symbols(MAX_SYMBOLS);
         let table: String = symbols
             .iter()
-            .map(|s| match s.text {
-                Some(size) => format!("{} STRING({}) {}\n", s.path, size - 1, s.offset),
-                None => format!("{} {} {}\n", s.path, s.elem.name(), s.offset),
-            })
+            .map(|s| format!("{} {} {}\n", s.path, type_name(s), s.offset))
             .collect();
         let data = align8(TABLE + table.len());
         let words = program.memory().len().div_ceil(8);
@@ -322,11 +319,7 @@ impl Variables {
             match state.load_acquire() {
                 DONE => break Ok(()),
                 REFUSED => {
-                    let s = &self.symbols[index];
-                    let ty = match s.text {
-                        Some(size) => format!("STRING({})", size - 1),
-                        None => s.elem.name().to_string(),
-                    };
+                    let ty = type_name(&self.symbols[index]);
                     break Err(format!("{path}: {value} is not a value of {ty}"));
                 }
                 _ if std::time::Instant::now() > deadline => {
@@ -344,8 +337,16 @@ impl Variables {
     }
 }
 
-/// A symbol's type as the table writes it: an elementary type's name, or `STRING(n)` (its
-/// size with the NUL beside BYTE).
+/// A symbol's type as the table names it: an elementary type's name, or `STRING(n)`.
+fn type_name(s: &Symbol) -> String {
+    match s.text {
+        Some(size) => format!("STRING({})", size - 1),
+        None => s.elem.name().to_string(),
+    }
+}
+
+/// A symbol's type from the table's name ([`type_name`]): its type (a STRING's BYTE) and a
+/// STRING's size with the NUL.
 fn symbol_type(ty: &str) -> Option<(Elem, Option<u32>)> {
     match ty.strip_prefix("STRING(").and_then(|r| r.strip_suffix(')')) {
         Some(n) => {
