@@ -106,16 +106,9 @@ impl Program {
             Type::StdFb(fb) => {
                 for &(name, elem, _) in fb.members() {
                     // Every member has its place (`layout::std_fb`); one without is left out.
-                    let Some(offset) = crate::layout::std_member(*fb, name) else {
-                        continue;
-                    };
-                    if out.len() < limit {
-                        out.push(Symbol {
-                            path: format!("{path}.{name}"),
-                            offset: at + offset,
-                            elem,
-                            text: None,
-                        });
+                    if let Some(offset) = crate::layout::std_member(*fb, name) {
+                        let member = format!("{path}.{name}");
+                        self.list(&member, &Type::Elem(elem), at + offset, limit, out);
                     }
                 }
             }
