@@ -110,7 +110,7 @@ impl Gen {
             3 => format!("r{} := {};\n", self.pick(2), self.real(2)),
             4 => format!("a[{} - 1] := {};\n", self.int_var(), self.int(1)),
             5 => format!("t(IN := {}, PT := T#20MS);\nb0 := t.Q;\n", self.boolean(1)),
-            6 => match self.pick(4) {
+            6 => match self.pick(5) {
                 // A later input that reads what an earlier one stored, or that faults
                 // after it was stored.
                 3 => {
@@ -131,6 +131,14 @@ impl Gen {
                 1 => format!(
                     "fbs[{} MOD 4](x := {}, y => {});\n",
                     self.int_var(),
+                    self.int(1),
+                    self.int_var()
+                ),
+                // At a variable's index: the call in one operation, its instance found
+                // when it runs and its output read from there.
+                4 => format!(
+                    "fbs[{}](x := {}, y => {});\n",
+                    ["k", "i0", "i1"][self.pick(3) as usize],
                     self.int(1),
                     self.int_var()
                 ),
