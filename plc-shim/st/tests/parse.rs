@@ -159,6 +159,35 @@ fn refusals_name_line_and_column() {
             "x := 1;",
             "t.st:1:1: error: expected PROGRAM, FUNCTION_BLOCK, FUNCTION, TYPE or VAR_GLOBAL",
         ),
+        // The object-oriented extensions, where TwinCAT and CODESYS write them.
+        (
+            "FUNCTION_BLOCK FB\nVAR n : INT; END_VAR\n  n := n + 1;\nMETHOD M_Reset : BOOL\n  n := 0;\nEND_METHOD\nEND_FUNCTION_BLOCK",
+            "t.st:4:1: error: `METHOD` is not supported",
+        ),
+        (
+            "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\nmethod PUBLIC M : BOOL\nEND_METHOD",
+            "t.st:3:1: error: `METHOD` is not supported",
+        ),
+        (
+            "FUNCTION_BLOCK FB_Saw EXTENDS FB_Axis\nEND_FUNCTION_BLOCK",
+            "t.st:1:23: error: `EXTENDS` is not supported",
+        ),
+        (
+            "FUNCTION_BLOCK FB_Saw IMPLEMENTS I_Cut\nEND_FUNCTION_BLOCK",
+            "t.st:1:23: error: `IMPLEMENTS` is not supported",
+        ),
+        (
+            "INTERFACE I_Cut\nEND_INTERFACE",
+            "t.st:1:1: error: `INTERFACE` is not supported",
+        ),
+        (
+            "FUNCTION_BLOCK FB\nPROPERTY Speed : LREAL\nEND_PROPERTY\nEND_FUNCTION_BLOCK",
+            "t.st:2:1: error: `PROPERTY` is not supported",
+        ),
+        (
+            "PROGRAM P\nACTION A_Reset:\nEND_ACTION\nEND_PROGRAM",
+            "t.st:2:1: error: `ACTION` is not supported",
+        ),
     ] {
         let e = error(text);
         assert!(
@@ -166,6 +195,18 @@ fn refusals_name_line_and_column() {
             "{text:?}:\n  got  {e}\n  want {expect}"
         );
     }
+}
+
+/// The object-oriented extensions' words are refused only where they begin a declaration: a
+/// variable or a block may still be called so.
+#[test]
+fn a_variable_named_as_an_extension_word_is_a_variable() {
+    let text = "FUNCTION_BLOCK Action\nVAR_INPUT method : INT; END_VAR\nEND_FUNCTION_BLOCK\n\
+                PROGRAM P\nVAR property, interface : INT; extends : Action; END_VAR\n\
+                property := 1;\ninterface := property;\nextends(method := interface);\n\
+                END_PROGRAM";
+    let unit = parse_file("t.st", text).unwrap();
+    assert_eq!(unit.items.len(), 2);
 }
 
 #[test]

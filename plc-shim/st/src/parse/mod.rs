@@ -71,6 +71,17 @@ const RESERVED: &[&str] = &[
     "AT",
 ];
 
+/// The object-oriented extensions of the standard's third edition (TwinCAT 3, CODESYS 3):
+/// refused by name where one would begin a declaration, never read as something else.
+const OBJECT_ORIENTED: [&str; 6] = [
+    "METHOD",
+    "PROPERTY",
+    "ACTION",
+    "INTERFACE",
+    "EXTENDS",
+    "IMPLEMENTS",
+];
+
 /// Whether `word` is reserved (ASCII case ignored).
 fn reserved(word: &str) -> bool {
     let same = |r: &&str| r.eq_ignore_ascii_case(word);
@@ -189,6 +200,26 @@ impl Parser {
         }
     }
 
+    /// Refuses the next word if it is one of [`OBJECT_ORIENTED`]'s followed by a name (as
+    /// `METHOD M_Reset`, `EXTENDS FB_Base`: a variable of such a name is no declaration).
+    pub(super) fn refuse_object_oriented(&self) -> Result<(), Diagnostic> {
+        let Tok::Ident(word) = self.peek() else {
+            return Ok(());
+        };
+        let named = matches!(self.peek_at(1), Tok::Ident(_));
+        match OBJECT_ORIENTED
+            .iter()
+            .find(|w| w.eq_ignore_ascii_case(word))
+        {
+            Some(w) if named => Err(self.error(format!(
+                "`{w}` is not supported: the object-oriented extensions (METHOD, PROPERTY, \
+                 ACTION, INTERFACE, EXTENDS, IMPLEMENTS) are not; write a method as a \
+                 FUNCTION or a FUNCTION_BLOCK of its own"
+            ))),
+            _ => Ok(()),
+        }
+    }
+
     fn item(&mut self) -> Result<Item, Diagnostic> {
         if self.eat_kw("PROGRAM") {
             return self.pou(PouKind::Program, "END_PROGRAM").map(Item::Pou);
@@ -207,6 +238,7 @@ impl Parser {
         if self.is_kw("VAR_GLOBAL") {
             return self.var_block().map(Item::Globals);
         }
+        self.refuse_object_oriented()?;
         Err(self.error(format!(
             "expected PROGRAM, FUNCTION_BLOCK, FUNCTION, TYPE or VAR_GLOBAL, found {}",
             self.found()
@@ -215,6 +247,7 @@ impl Parser {
 
     fn pou(&mut self, kind: PouKind, end: &str) -> Result<Pou, Diagnostic> {
         let name = self.name()?;
+        self.refuse_object_oriented()?;
         let returns = match kind {
             PouKind::Function => {
                 self.expect(&Tok::Colon, "`:` and the function's return type")?;

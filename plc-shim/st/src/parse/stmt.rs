@@ -30,6 +30,8 @@ impl Parser {
                 let what = ends.join(" or ");
                 return Err(self.error(format!("expected {what}, found {}", self.found())));
             }
+            // A METHOD written inside its FUNCTION_BLOCK, after the body.
+            self.refuse_object_oriented()?;
             out.push(self.nested(Self::statement)?);
         }
     }
