@@ -223,6 +223,10 @@ pub enum StdFn {
     Rol,
     /// ROR.
     Ror,
+    /// EXPT: the first value to the power of the second.
+    Expt,
+    /// MOVE: the value itself.
+    Move,
 }
 
 /// A statement, with where it stands for a fault's report.

@@ -49,6 +49,21 @@ pub fn std_fb(fb: StdFb) -> (&'static [(&'static str, u32)], u32, u32) {
             8,
             2,
         ),
+        // CU, CD, RESET, LOAD, QU, QD, (the last CU @6 and CD @7), PV, CV.
+        StdFb::Ctud => (
+            &[
+                ("CU", 0),
+                ("CD", 1),
+                ("RESET", 2),
+                ("LOAD", 3),
+                ("QU", 4),
+                ("QD", 5),
+                ("PV", 8),
+                ("CV", 10),
+            ],
+            12,
+            2,
+        ),
         StdFb::Rs => (&[("SET", 0), ("RESET1", 1), ("Q1", 2)], 3, 1),
         StdFb::Sr => (&[("SET1", 0), ("RESET", 1), ("Q1", 2)], 3, 1),
     }

@@ -437,8 +437,17 @@ impl Checker {
         for (k, a) in args.iter().enumerate() {
             let selector = matches!(f, StdFn::Sel | StdFn::Mux) && k == 0;
             let shift = matches!(f, StdFn::Shl | StdFn::Shr | StdFn::Rol | StdFn::Ror) && k == 1;
+            let exponent = f == StdFn::Expt && k == 1;
             values.push(match (selector, shift) {
                 (true, _) | (_, true) => self.value_as(a, Elem::LInt, ctx, l)?,
+                // An integer exponent: its own value, as a real.
+                _ if exponent => match self.expr(a, ctx) {
+                    Type::Elem(e) if e != within => {
+                        let v = self.value_as(a, e, ctx, l)?;
+                        Ex::Conv(e, within, Box::new(v))
+                    }
+                    _ => self.value_as(a, within, ctx, l)?,
+                },
                 _ => self.value_as(a, within, ctx, l)?,
             });
         }
@@ -761,6 +770,8 @@ fn std_fn(upper: &str) -> Option<StdFn> {
         "SHR" => StdFn::Shr,
         "ROL" => StdFn::Rol,
         "ROR" => StdFn::Ror,
+        "EXPT" => StdFn::Expt,
+        "MOVE" => StdFn::Move,
         _ => return None,
     })
 }

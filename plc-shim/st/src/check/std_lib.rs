@@ -20,6 +20,8 @@ pub enum StdFb {
     Ctu,
     /// Down counter.
     Ctd,
+    /// Up-down counter.
+    Ctud,
     /// Reset-dominant bistable.
     Rs,
     /// Set-dominant bistable.
@@ -48,6 +50,7 @@ impl StdFb {
             "F_TRIG" => StdFb::FTrig,
             "CTU" => StdFb::Ctu,
             "CTD" => StdFb::Ctd,
+            "CTUD" => StdFb::Ctud,
             "RS" => StdFb::Rs,
             "SR" => StdFb::Sr,
             _ => return None,
@@ -71,6 +74,16 @@ impl StdFb {
                 ("LOAD", Elem::Bool, true),
                 ("PV", Elem::Int, true),
                 ("Q", Elem::Bool, false),
+                ("CV", Elem::Int, false),
+            ],
+            StdFb::Ctud => &[
+                ("CU", Elem::Bool, true),
+                ("CD", Elem::Bool, true),
+                ("RESET", Elem::Bool, true),
+                ("LOAD", Elem::Bool, true),
+                ("PV", Elem::Int, true),
+                ("QU", Elem::Bool, false),
+                ("QD", Elem::Bool, false),
                 ("CV", Elem::Int, false),
             ],
             StdFb::Rs => &[
@@ -98,7 +111,7 @@ impl StdFb {
 /// The standard functions by name.
 pub const FUNCTIONS: &[&str] = &[
     "ABS", "SQRT", "LN", "LOG", "EXP", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN", "MIN", "MAX",
-    "LIMIT", "SEL", "MUX", "TRUNC", "SHL", "SHR", "ROL", "ROR", "ADR", "SIZEOF",
+    "LIMIT", "SEL", "MUX", "TRUNC", "SHL", "SHR", "ROL", "ROR", "ADR", "SIZEOF", "EXPT", "MOVE",
 ];
 
 /// Whether `upper` (a name in upper case) is a standard function or function block, which no

@@ -584,6 +584,15 @@ impl Checker {
                     _ => Type::Elem(Elem::LReal),
                 }
             }
+            // EXPT(ANY_REAL, ANY_NUM): a REAL or an LREAL to a real's or an integer's power.
+            "EXPT"
+                if count(2..=2)
+                    && elem(0).is_some_and(|e| e.class() == Class::Float)
+                    && elem(1).is_some_and(|e| e.is_numeric() && e.class() != Class::Duration) =>
+            {
+                types[0].clone()
+            }
+            "MOVE" if count(1..=1) && elem(0).is_some() => types[0].clone(),
             "TRUNC" if count(1..=1) && elem(0).is_some_and(|e| e.class() == Class::Float) => {
                 Type::Elem(Elem::DInt)
             }

@@ -239,6 +239,8 @@ pub(crate) fn standard(f: StdFn, t: Elem, v: &[V]) -> Run<V> {
         StdFn::Shl | StdFn::Shr | StdFn::Rol | StdFn::Ror => {
             Ok(V::I(shift(f, t, v[0].int(), v[1].int())))
         }
+        StdFn::Expt => finite(v[0].float().powf(v[1].float())),
+        StdFn::Move => Ok(v[0]),
     }
 }
 

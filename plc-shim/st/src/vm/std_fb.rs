@@ -36,6 +36,7 @@ impl Exec<'_> {
                 self.set_flag(at + 2, clk)
             }
             StdFb::Ctu | StdFb::Ctd => self.counter(fb, at),
+            StdFb::Ctud => self.up_down(at),
             StdFb::Rs => {
                 let (set, reset, q) = (self.flag(at)?, self.flag(at + 1)?, self.flag(at + 2)?);
                 self.set_flag(at + 2, !reset && (set || q))
@@ -109,6 +110,30 @@ impl Exec<'_> {
         self.write_own(at + 8, Elem::Time, V::I(et))?;
         let state = i64::from(run) | (i64::from(input) << 1) | (i64::from(done) << 2);
         self.write_own(at + STATE, Elem::Byte, V::I(state))
+    }
+
+    /// CTUD: RESET before LOAD before the edges; rising edges of both CU and CD at once
+    /// leave CV as it is; CV stays within INT.
+    fn up_down(&mut self, at: usize) -> Run<()> {
+        let (cu, cd) = (self.flag(at)?, self.flag(at + 1)?);
+        let (reset, load) = (self.flag(at + 2)?, self.flag(at + 3)?);
+        let (up, down) = (cu && !self.flag(at + 6)?, cd && !self.flag(at + 7)?);
+        let pv = self.read_own(at + 8, Elem::Int)?.int();
+        let mut cv = self.read_own(at + 10, Elem::Int)?.int();
+        if reset {
+            cv = 0;
+        } else if load {
+            cv = pv;
+        } else if up && !down && cv < i64::from(i16::MAX) {
+            cv += 1;
+        } else if down && !up && cv > i64::from(i16::MIN) {
+            cv -= 1;
+        }
+        self.write_own(at + 10, Elem::Int, V::I(cv))?;
+        self.set_flag(at + 4, cv >= pv)?;
+        self.set_flag(at + 5, cv <= 0)?;
+        self.set_flag(at + 6, cu)?;
+        self.set_flag(at + 7, cd)
     }
 
     /// CTU and CTD: the counter's edge input, RESET or LOAD, PV and CV as INT.

@@ -1,0 +1,115 @@
+//! Standard functions and blocks beyond the ones the manuals' programs use: CTUD, EXPT, MOVE,
+//! each against the standard's rules.
+
+use plc_st::vm::Program;
+
+fn run(text: &str, cycles: u32) -> Program {
+    let mut p = Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
+        panic!(
+            "{}",
+            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
+        )
+    });
+    for k in 0..cycles {
+        p.cycle(i64::from(k) * 10_000_000).unwrap();
+    }
+    p
+}
+
+/// CTUD: LOAD sets CV to PV, rising CU counts up, rising CD down, both rising at once leave
+/// CV, RESET wins over everything; QU is CV >= PV, QD is CV <= 0.
+#[test]
+fn an_up_down_counter_counts_edges_and_obeys_reset_before_load() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    c : CTUD;
+    n : INT;
+    cu, cd, rst, ld : BOOL;
+    cvs : LINT;
+    qus, qds : DINT;
+END_VAR
+    cu := FALSE; cd := FALSE; rst := FALSE; ld := FALSE;
+    CASE n OF
+        0: ld := TRUE;
+        1, 2: cu := TRUE;
+        4: cu := TRUE; cd := TRUE;
+        6, 8: cd := TRUE;
+        9: rst := TRUE; cu := TRUE;
+        10: ld := TRUE; rst := TRUE;
+    END_CASE
+    c(CU := cu, CD := cd, RESET := rst, LOAD := ld, PV := 2);
+    cvs := cvs * 10 + c.CV;
+    qus := qus * 2 + BOOL_TO_DINT(c.QU);
+    qds := qds * 2 + BOOL_TO_DINT(c.QD);
+    n := n + 1;
+END_PROGRAM",
+        11,
+    );
+    // Cycle by cycle: load 2, up, held, -, both, -, down, -, down, reset (CU ignored),
+    // reset with load.
+    assert_eq!(p.read_var("MAIN.cvs"), Some(23_333_322_100.0));
+    assert_eq!(p.read_var("MAIN.qus"), Some(f64::from(0b111_1111_1000)));
+    assert_eq!(p.read_var("MAIN.qds"), Some(f64::from(0b000_0000_0011)));
+}
+
+/// EXPT(ANY_REAL, ANY_NUM) and MOVE: an integer exponent taken as a real, a REAL's power a
+/// REAL; a power that is no number is a fault (as SQRT(-1.0) is); MOVE gives its value.
+#[test]
+fn expt_takes_a_real_to_a_power_and_move_gives_its_value() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    r1, r2 : LREAL;
+    f : REAL;
+    n : INT := 3;
+    m : DINT;
+END_VAR
+    r1 := EXPT(2.0, 10);
+    r2 := EXPT(r1, 0.5);
+    f := EXPT(REAL#1.5, n);
+    m := MOVE(DINT#-7);
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.r1"), Some(1024.0));
+    assert_eq!(p.read_var("MAIN.r2"), Some(32.0));
+    assert_eq!(p.read_var("MAIN.f"), Some(3.375));
+    assert_eq!(p.read_var("MAIN.m"), Some(-7.0));
+    let mut p = Program::load(&[(
+        "main.st",
+        "PROGRAM MAIN VAR r : LREAL := -8.0; END_VAR\n  r := EXPT(r, 0.5);\nEND_PROGRAM",
+    )])
+    .unwrap();
+    let f = p.cycle(0).unwrap_err();
+    assert_eq!(
+        p.fault_text(&f),
+        "main.st:2:3: fault: a conversion of a value its type cannot hold"
+    );
+}
+
+/// What EXPT and MOVE do not take is refused at load with its place.
+#[test]
+fn expt_of_an_integer_base_or_move_of_no_value_is_refused() {
+    for (text, want) in [
+        (
+            "n := EXPT(n, 2);",
+            "main.st:2:8: error: EXPT does not take these values",
+        ),
+        (
+            "n := MOVE(n, n);",
+            "main.st:2:8: error: MOVE does not take these values",
+        ),
+        (
+            "r := EXPT(2.0, T#1S);",
+            "main.st:2:8: error: EXPT does not take these values",
+        ),
+    ] {
+        let src = format!("PROGRAM MAIN VAR n : DINT; r : LREAL; END_VAR\n  {text}\nEND_PROGRAM");
+        let e = match Program::load(&[("main.st", &src)]) {
+            Ok(_) => panic!("loaded: {src}"),
+            Err(e) => e.iter().map(|d| d.to_string()).collect::<String>(),
+        };
+        assert!(e.contains(want), "{text}: {e}");
+    }
+}
