@@ -287,6 +287,11 @@ pub enum BinOp {
     Mod,
     /// `**`.
     Pow,
+    /// AND_THEN (TwinCAT, CODESYS): AND of BOOLs whose right value is computed only when the
+    /// left is TRUE (`p <> 0 AND_THEN p^.bReady`).
+    AndThen,
+    /// OR_ELSE: OR of BOOLs whose right value is computed only when the left is FALSE.
+    OrElse,
 }
 
 /// An argument of a call.

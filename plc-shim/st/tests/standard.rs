@@ -1,5 +1,5 @@
 //! Standard functions and blocks beyond the ones the manuals' programs use: CTUD, EXPT, MOVE,
-//! each against the standard's rules.
+//! each against the standard's rules; and TwinCAT's and CODESYS's AND_THEN and OR_ELSE.
 
 use plc_st::vm::Program;
 
@@ -112,4 +112,54 @@ fn expt_of_an_integer_base_or_move_of_no_value_is_refused() {
         };
         assert!(e.contains(want), "{text}: {e}");
     }
+}
+
+/// AND_THEN and OR_ELSE compute their right value only when the left does not decide: a
+/// NULL pointer is not read behind `p <> 0 AND_THEN`, a function on the right is not called;
+/// in an IF's condition as in an assignment.
+#[test]
+fn and_then_and_or_else_compute_the_right_value_only_when_needed() {
+    let p = run(
+        "FUNCTION Count : BOOL
+VAR_INPUT v : BOOL; END_VAR
+    g := g + 1;
+    Count := v;
+END_FUNCTION
+VAR_GLOBAL g : DINT; END_VAR
+PROGRAM MAIN
+VAR
+    p : POINTER TO DINT;
+    n : DINT := 5;
+    a, b, c, d, e, f : BOOL;
+    k : DINT;
+END_VAR
+    a := p <> 0 AND_THEN p^ > 3;
+    IF p = 0 OR_ELSE p^ < 0 THEN k := k + 1; END_IF
+    p := ADR(n);
+    b := p <> 0 AND_THEN p^ > 3;
+    c := p = 0 OR_ELSE p^ < 0;
+    g := 0;
+    d := Count(TRUE) OR_ELSE Count(TRUE);
+    e := Count(FALSE) AND_THEN Count(TRUE);
+    f := Count(TRUE) OR_ELSE Count(FALSE) AND_THEN Count(FALSE);
+    k := k + 10 * g;
+END_PROGRAM",
+        1,
+    );
+    let var = |n: &str| p.read_var(n);
+    assert_eq!(var("MAIN.a"), Some(0.0), "NULL: its value not read");
+    assert_eq!(
+        var("MAIN.k"),
+        Some(31.0),
+        "the IF's THEN, and one call each for d, e, f"
+    );
+    assert_eq!((var("MAIN.b"), var("MAIN.c")), (Some(1.0), Some(0.0)));
+    assert_eq!((var("MAIN.d"), var("MAIN.e")), (Some(1.0), Some(0.0)));
+    assert_eq!(var("MAIN.f"), Some(1.0), "AND_THEN binds before OR_ELSE");
+    let refused = Program::load(&[(
+        "main.st",
+        "PROGRAM MAIN VAR n : DINT; b : BOOL; END_VAR\n  b := n AND_THEN TRUE;\nEND_PROGRAM",
+    )]);
+    let e = refused.err().map(|e| e[0].to_string()).unwrap_or_default();
+    assert!(e.contains("main.st:2:10: error: AND_THEN of"), "{e}");
 }

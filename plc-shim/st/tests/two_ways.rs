@@ -68,9 +68,12 @@ impl Gen {
             return format!("b{}", self.pick(3));
         }
         let d = depth - 1;
-        match self.pick(7) {
+        match self.pick(9) {
             0 => format!("NOT {}", self.boolean(d)),
             1 => format!("({} AND {})", self.boolean(d), self.boolean(d)),
+            // The right value only when needed: a fault in it only then.
+            7 => format!("({} AND_THEN {})", self.boolean(d), self.boolean(d)),
+            8 => format!("(p = 0 OR_ELSE {} OR_ELSE p^ > 0)", self.boolean(d)),
             2 => format!("({} OR {})", self.boolean(d), self.boolean(d)),
             3 => format!("({} XOR {})", self.boolean(d), self.boolean(d)),
             4 => format!("({} < {})", self.int(d), self.int(d)),

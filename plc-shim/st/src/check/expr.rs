@@ -338,6 +338,14 @@ impl Checker {
                     self.error(pos, "values of two enumerations")
                 };
             }
+            // Two pointers to the same type, or a pointer and 0 (NULL: `IF p <> 0 THEN`).
+            let null = |e: &Expr| literal(e) == Some(0);
+            match (&lt, &rt) {
+                (Type::Pointer(a), Type::Pointer(b)) if a == b => return BOOL,
+                (Type::Pointer(_), _) if null(r) => return BOOL,
+                (_, Type::Pointer(_)) if null(l) => return BOOL,
+                _ => {}
+            }
         }
         if lt == Type::Error || rt == Type::Error {
             return Type::Error;
@@ -376,6 +384,7 @@ impl Checker {
             ),
             Mod => c.is_integer(),
             Pow => class == Class::Float,
+            AndThen | OrElse => class == Class::Bool,
         };
         if !ok {
             return self.error(pos, format!("{} of {}", op_name(op), c.name()));
@@ -506,5 +515,7 @@ fn op_name(op: BinOp) -> &'static str {
         Div => "`/`",
         Mod => "MOD",
         Pow => "`**`",
+        AndThen => "AND_THEN",
+        OrElse => "OR_ELSE",
     }
 }

@@ -343,7 +343,7 @@ impl Checker {
         }
         let t = match (&ta, &tb) {
             (Type::Enum(i), _) | (_, Type::Enum(i)) => self.out.enums[*i].base,
-            (Type::Pointer(_), _) => Elem::ULInt,
+            (Type::Pointer(_), _) | (_, Type::Pointer(_)) => Elem::ULInt,
             _ => match self.operands(a, b, ctx) {
                 Some((c, _, _)) => c,
                 None => return Err(self.unsupported(a.pos(), "these operands")),

@@ -263,9 +263,11 @@ impl Parser {
         let word = |w: &str| self.is_kw(w);
         match (level, self.peek()) {
             (0, _) if word("OR") => Some(BinOp::Or),
+            (0, _) if word("OR_ELSE") => Some(BinOp::OrElse),
             (1, _) if word("XOR") => Some(BinOp::Xor),
             (2, Tok::Amp) => Some(BinOp::And),
             (2, _) if word("AND") => Some(BinOp::And),
+            (2, _) if word("AND_THEN") => Some(BinOp::AndThen),
             (3, Tok::Eq) => Some(BinOp::Eq),
             (3, Tok::Ne) => Some(BinOp::Ne),
             (4, Tok::Lt) => Some(BinOp::Lt),

@@ -535,6 +535,7 @@ impl<'c> Builder<'c> {
             Ex::Neg(x, t) => self.unary(x, |r, v| Op::Neg(*t, r, v)),
             Ex::Not(x, t) => self.unary(x, |r, v| Op::Not(*t, r, v)),
             Ex::Conv(from, to, x) => self.unary(x, |r, v| Op::Conv(*from, *to, r, v)),
+            Ex::Bin(BinOp::AndThen | BinOp::OrElse, ..) => self.tree(e),
             Ex::Bin(op, t, a, b) => {
                 let mark = self.next;
                 let (x, y) = (self.expr(a), self.expr(b));

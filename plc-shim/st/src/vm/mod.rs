@@ -6,7 +6,7 @@
 //! of a value its type cannot hold, or the budget spent is a [`Fault`] with the statement's
 //! file, line and column, and the program stops.
 
-use crate::ast::PouKind;
+use crate::ast::{BinOp, PouKind};
 use crate::check::{compile, Compiled, Type};
 use crate::diag::{Diagnostic, Pos};
 use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St, StKind};
@@ -672,6 +672,15 @@ impl<'a> Exec<'a> {
             Ex::AddrOf(a) => V::I(tagged(self.addr(a, base)?)),
             Ex::Neg(x, t) => ops::neg(self.operand(x, base)?, *t),
             Ex::Not(x, t) => ops::not(self.operand(x, base)?, *t),
+            Ex::Bin(op @ (BinOp::AndThen | BinOp::OrElse), _, a, b) => {
+                let x = self.operand(a, base)?.int() != 0;
+                let y = if x == (*op == BinOp::AndThen) {
+                    self.operand(b, base)?.int() != 0
+                } else {
+                    x
+                };
+                V::I(i64::from(y))
+            }
             Ex::Bin(op, t, a, b) => {
                 let (x, y) = (self.operand(a, base)?, self.operand(b, base)?);
                 ops::binary(*op, *t, x, y)?
