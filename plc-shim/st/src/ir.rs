@@ -227,6 +227,8 @@ pub enum StdFn {
     Expt,
     /// MOVE: the value itself.
     Move,
+    /// `TIME()` and `LTIME()`: the PLC's clock (the cycle's time since the start).
+    Now,
 }
 
 /// A statement, with where it stands for a fault's report.

@@ -163,3 +163,38 @@ END_PROGRAM",
     let e = refused.err().map(|e| e[0].to_string()).unwrap_or_default();
     assert!(e.contains("main.st:2:10: error: AND_THEN of"), "{e}");
 }
+
+/// `TIME()` and `LTIME()` (TwinCAT): the PLC's clock, the one its timers run on; a duration
+/// measured as their difference.
+#[test]
+fn time_and_ltime_read_the_plcs_clock() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    t0, t, d : TIME;
+    lt : LTIME;
+    started : BOOL;
+END_VAR
+    IF NOT started THEN t0 := TIME(); started := TRUE; END_IF
+    t := TIME();
+    lt := LTIME();
+    d := TIME() - t0;
+END_PROGRAM",
+        4,
+    );
+    // The fourth cycle, at 30 ms.
+    assert_eq!(p.read_var("MAIN.t"), Some(30.0));
+    assert_eq!(p.read_var("MAIN.lt"), Some(30_000_000.0));
+    assert_eq!(p.read_var("MAIN.d"), Some(30.0));
+    let e = Program::load(&[(
+        "main.st",
+        "PROGRAM MAIN VAR t : TIME; END_VAR\n  t := TIME(1);\nEND_PROGRAM",
+    )])
+    .err()
+    .map(|e| e[0].to_string())
+    .unwrap_or_default();
+    assert!(
+        e.contains("main.st:2:8: error: TIME does not take these values"),
+        "{e}"
+    );
+}

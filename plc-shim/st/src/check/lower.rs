@@ -772,6 +772,7 @@ fn std_fn(upper: &str) -> Option<StdFn> {
         "ROR" => StdFn::Ror,
         "EXPT" => StdFn::Expt,
         "MOVE" => StdFn::Move,
+        "TIME" | "LTIME" => StdFn::Now,
         _ => return None,
     })
 }

@@ -593,6 +593,8 @@ impl Checker {
                 types[0].clone()
             }
             "MOVE" if count(1..=1) && elem(0).is_some() => types[0].clone(),
+            "TIME" if count(0..=0) => Type::Elem(Elem::Time),
+            "LTIME" if count(0..=0) => Type::Elem(Elem::LTime),
             "TRUNC" if count(1..=1) && elem(0).is_some_and(|e| e.class() == Class::Float) => {
                 Type::Elem(Elem::DInt)
             }

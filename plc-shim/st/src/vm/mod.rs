@@ -780,19 +780,4 @@ impl<'a> Exec<'a> {
             crate::ir::Text::At(addr, n) => Ok(Some((self.own(addr, base)?, *n as usize))),
         }
     }
-
-    #[inline(never)]
-    fn std_fn(&mut self, f: crate::ir::StdFn, t: Elem, args: &[Ex], base: u32) -> Run<V> {
-        // At most MAX_STD_VALUES (the lowering refuses more): no allocation for them.
-        let mut values = [V::I(0); crate::ir::MAX_STD_VALUES];
-        let n = args.len().min(values.len());
-        for (v, a) in values.iter_mut().zip(args) {
-            *v = self.eval(a, base)?;
-        }
-        let v = ops::standard(f, t, &values[..n]);
-        if v == Err(Fault::MuxSelector) {
-            return Err(self.fault_with(Fault::MuxSelector, [values[0].int(), 0, 0]));
-        }
-        v
-    }
 }

@@ -1,9 +1,10 @@
 //! The standard function blocks on their instances' memory (the offsets are
 //! [`crate::layout::std_fb`]'s): the timers on the cycle's clock, the edges, the counters and
-//! the bistables.
+//! the bistables; and the standard functions' values.
 
-use super::{Exec, Fault, V};
+use super::{ops, Exec, Fault, V};
 use crate::check::std_lib::StdFb;
+use crate::ir::{Ex, StdFn};
 use crate::types::Elem;
 
 type Run<T> = Result<T, Fault>;
@@ -14,6 +15,26 @@ const STATE: usize = 2;
 const START: usize = 16;
 
 impl Exec<'_> {
+    #[inline(never)]
+    pub(super) fn std_fn(&mut self, f: StdFn, t: Elem, args: &[Ex], base: u32) -> Run<V> {
+        // At most MAX_STD_VALUES (the lowering refuses more): no allocation for them.
+        let mut values = [V::I(0); crate::ir::MAX_STD_VALUES];
+        let n = args.len().min(values.len());
+        for (v, a) in values.iter_mut().zip(args) {
+            *v = self.eval(a, base)?;
+        }
+        let v = match f {
+            // The cycle's clock: TIME in whole ms (wrapping as TIME does), LTIME in ns.
+            StdFn::Now if t == Elem::LTime => Ok(V::I(self.st.now_ns)),
+            StdFn::Now => Ok(V::I(ops::wrap(self.st.now_ns / 1_000_000, t))),
+            _ => ops::standard(f, t, &values[..n]),
+        };
+        if v == Err(Fault::MuxSelector) {
+            return Err(self.fault_with(Fault::MuxSelector, [values[0].int(), 0, 0]));
+        }
+        v
+    }
+
     fn flag(&self, at: usize) -> Run<bool> {
         Ok(self.read_own(at, Elem::Bool)?.int() != 0)
     }
