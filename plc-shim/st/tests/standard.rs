@@ -198,3 +198,40 @@ END_PROGRAM",
         "{e}"
     );
 }
+
+/// `S=` and `R=` (TwinCAT, CODESYS): the target set (reset) while the condition holds, kept
+/// otherwise; a target that is no BOOL is refused.
+#[test]
+fn set_and_reset_assignments_latch() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    n : INT;
+    bOn : BOOL;
+    bOff : BOOL := TRUE;
+    nOnAt, nOffAt : INT := -1;
+END_VAR
+    bOn S= n = 2;
+    bOff R= n >= 3;
+    IF bOn AND nOnAt < 0 THEN nOnAt := n; END_IF
+    IF NOT bOff AND nOffAt < 0 THEN nOffAt := n; END_IF
+    n := n + 1;
+END_PROGRAM",
+        5,
+    );
+    assert_eq!(p.read_var("MAIN.bOn"), Some(1.0), "set at 2, kept after");
+    assert_eq!(p.read_var("MAIN.nOnAt"), Some(2.0));
+    assert_eq!(p.read_var("MAIN.bOff"), Some(0.0));
+    assert_eq!(p.read_var("MAIN.nOffAt"), Some(3.0));
+    let e = Program::load(&[(
+        "main.st",
+        "PROGRAM MAIN VAR n : INT; END_VAR\n  n S= TRUE;\nEND_PROGRAM",
+    )])
+    .err()
+    .map(|e| e[0].to_string())
+    .unwrap_or_default();
+    assert!(
+        e.starts_with("main.st:2:5: error: a BOOL where a INT is wanted"),
+        "{e}"
+    );
+}

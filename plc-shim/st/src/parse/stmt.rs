@@ -78,6 +78,16 @@ impl Parser {
             }
         }
         let target = self.postfix()?;
+        if let Some(value) = self.set_or_reset() {
+            // `x S= c;` (TwinCAT, CODESYS): x becomes TRUE when c is, else keeps its value.
+            let cond = self.expr()?;
+            self.expect(&Tok::Semi, "`;`")?;
+            let body = vec![Stmt::Assign { target, value }];
+            return Ok(Stmt::If {
+                branches: vec![(cond, body)],
+                otherwise: None,
+            });
+        }
         if self.eat(&Tok::Assign) {
             let value = self.expr()?;
             self.expect(&Tok::Semi, "`;`")?;
@@ -91,6 +101,22 @@ impl Parser {
             "expected `:=` or a call after the expression, found {}",
             self.found()
         )))
+    }
+
+    /// `S=` or `R=` next (taken): the value it stores, TRUE or FALSE.
+    fn set_or_reset(&mut self) -> Option<Expr> {
+        let pos = self.pos();
+        let set = match self.peek() {
+            Tok::Ident(w) if w.eq_ignore_ascii_case("S") => true,
+            Tok::Ident(w) if w.eq_ignore_ascii_case("R") => false,
+            _ => return None,
+        };
+        if !matches!(self.peek_at(1), Tok::Eq) {
+            return None;
+        }
+        self.bump();
+        self.bump();
+        Some(Expr::Bool(set, pos))
     }
 
     fn if_stmt(&mut self) -> Result<Stmt, Diagnostic> {
