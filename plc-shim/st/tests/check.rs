@@ -244,3 +244,20 @@ END_PROGRAM",
         "{e}"
     );
 }
+
+/// What the language reads but the runtime does not hold is refused by name, never taken as
+/// something else: a REFERENCE is no POINTER (it is read without `^` and bound with REF=),
+/// a WSTRING no STRING.
+#[test]
+fn references_and_wide_strings_are_refused_by_name() {
+    let e = refusals("r : REFERENCE TO INT;\nw : WSTRING;", "");
+    assert_eq!(e.len(), 2, "{e:?}");
+    assert!(
+        e[0].starts_with("p.st:3:5: error: REFERENCE TO is not supported"),
+        "{e:?}"
+    );
+    assert!(
+        e[1].starts_with("p.st:4:5: error: WSTRING is not supported"),
+        "{e:?}"
+    );
+}

@@ -159,6 +159,10 @@ fn refusals_name_line_and_column() {
             "x := 1;",
             "t.st:1:1: error: expected PROGRAM, FUNCTION_BLOCK, FUNCTION, TYPE or VAR_GLOBAL",
         ),
+        (
+            "FUNCTION F : INT\nVAR_IN_OUT a : ARRAY[*] OF INT; END_VAR\nEND_FUNCTION",
+            "t.st:2:22: error: `ARRAY[*]` (an array of any length) is not supported",
+        ),
         // The object-oriented extensions, where TwinCAT and CODESYS write them.
         (
             "FUNCTION_BLOCK FB\nVAR n : INT; END_VAR\n  n := n + 1;\nMETHOD M_Reset : BOOL\n  n := 0;\nEND_METHOD\nEND_FUNCTION_BLOCK",

@@ -364,8 +364,15 @@ impl Checker {
     fn type_of(&mut self, ty: &TypeRef, depth: usize) -> Type {
         match ty {
             TypeRef::Named(n) => self.named_type(n, depth),
-            TypeRef::Pointer(t, _) | TypeRef::Reference(t, _) => {
-                Type::Pointer(Box::new(self.type_of(t, depth)))
+            TypeRef::Pointer(t, _) => Type::Pointer(Box::new(self.type_of(t, depth))),
+            TypeRef::Reference(_, pos) => {
+                // Not a pointer under another name: a reference is read and written through
+                // without `^` and bound with REF=.
+                self.refuse(
+                    *pos,
+                    "REFERENCE TO is not supported: use POINTER TO with ADR() and `^`",
+                );
+                Type::Error
             }
             TypeRef::String { len, wide, pos } => {
                 if *wide {

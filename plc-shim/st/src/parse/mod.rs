@@ -367,6 +367,12 @@ impl Parser {
             self.expect(&Tok::LBracket, "`[` and the array's bounds")?;
             let mut ranges = Vec::new();
             loop {
+                if matches!(self.peek(), Tok::Star) {
+                    return Err(self.error(
+                        "`ARRAY[*]` (an array of any length) is not supported: declare its \
+                         bounds, or pass a POINTER and the count",
+                    ));
+                }
                 let lo = self.expr()?;
                 self.expect(&Tok::Range, "`..` between the bounds")?;
                 let hi = self.expr()?;
