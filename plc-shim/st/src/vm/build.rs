@@ -56,7 +56,6 @@ impl<'c> Builder<'c> {
     /// window holds.
     pub(super) fn finish(mut self) -> Option<Code> {
         self.ops.push(Op::Ret);
-        thread_jumps(&mut self.ops);
         (!self.overflow).then_some(Code {
             ops: self.ops,
             regs: self.most,
@@ -571,48 +570,6 @@ impl<'c> Builder<'c> {
 }
 
 /// An expression that is an operand (a constant or a variable): nothing to compute.
-/// Points every jump past the unconditional jumps it would land on (an IF's end jumping
-/// to a CASE's end jumping to the body's), and a jump to the body's end is the end: fewer
-/// operations run, the same ones that do something.
-fn thread_jumps(ops: &mut [Op]) {
-    let past = |ops: &[Op], mut to: u32| {
-        // At most as many hops as operations: a loop of jumps (none is built) stays one.
-        for _ in 0..ops.len() {
-            match ops.get(to as usize) {
-                Some(Op::Jump(next)) if *next != to => to = *next,
-                _ => break,
-            }
-        }
-        to
-    };
-    for k in 0..ops.len() {
-        let op = ops[k];
-        let to = match op {
-            Op::Jump(t)
-            | Op::JumpIfNot(_, t)
-            | Op::JumpIf(_, t)
-            | Op::JumpCmp(.., t)
-            | Op::JumpCmpI(.., t)
-            | Op::JumpIn(_, _, _, t)
-            | Op::ForTest(.., t)
-            | Op::ForNext(.., t) => past(ops, t),
-            _ => continue,
-        };
-        ops[k] = match op {
-            Op::Jump(_) if matches!(ops.get(to as usize), Some(Op::Ret)) => Op::Ret,
-            Op::Jump(_) => Op::Jump(to),
-            Op::JumpIfNot(c, _) => Op::JumpIfNot(c, to),
-            Op::JumpIf(c, _) => Op::JumpIf(c, to),
-            Op::JumpCmp(o, t, a, b, _) => Op::JumpCmp(o, t, a, b, to),
-            Op::JumpCmpI(o, t, a, b, _) => Op::JumpCmpI(o, t, a, b, to),
-            Op::JumpIn(s, lo, hi, _) => Op::JumpIn(s, lo, hi, to),
-            Op::ForTest(at, t, r, _) => Op::ForTest(at, t, r, to),
-            Op::ForNext(at, t, r, test, _) => Op::ForNext(at, t, r, test, to),
-            other => other,
-        };
-    }
-}
-
 fn operand(e: &Ex) -> Option<Src> {
     match e {
         Ex::Int(v) => Some(Src::I(*v)),

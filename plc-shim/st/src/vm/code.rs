@@ -136,10 +136,9 @@ pub(crate) enum Op {
     StdBody(StdFb, R, u32),
     /// Reads an output: instance, offset, type, negated, where it goes.
     Output(R, u32, Elem, bool, Dst),
-    /// A whole block call whose instance has a fixed place (or is an array's element at a
-    /// fixed place) and whose inputs are all operands (the common call:
-    /// `fbRun(Axis := axConveyor, Velocity := 360.0)`): its index among
-    /// [`Codes::call_ops`]. Its outputs follow as [`Op::Output`]s.
+    /// A whole block call whose instance has a fixed place and whose inputs are all
+    /// operands (the common call: `fbRun(Axis := axConveyor, Velocity := 360.0)`): its
+    /// index among [`Codes::call_ops`]. Its outputs follow as [`Op::Output`]s.
     Call(u32),
     /// The body ends.
     Ret,
@@ -162,10 +161,6 @@ pub(crate) struct CallOp {
     /// The host's slot of a library block's instance at a fixed absolute place (found once
     /// here instead of at every call).
     pub(crate) slot: Option<u32>,
-    /// An array's element at the index the operand holds instead (`fbStart[k](..)`): the
-    /// index, the element's index among [`Codes::elems`], and the register the instance's
-    /// offset (and host slot) is left in for the outputs.
-    pub(crate) element: Option<(Src, u32, R)>,
 }
 
 /// A CASE's jump table ([`Op::Switch`]): for values from `lo` on, where each goes

@@ -262,16 +262,7 @@ impl<'a> Exec<'a> {
         let codes = self.codes;
         self.st.at = codes.sites[c.site as usize];
         self.step()?;
-        let (at, slot) = match c.element {
-            None => (if c.relative { base + c.at } else { c.at }, c.slot),
-            Some((i, k, d)) => {
-                let i = self.src_int(i, base, w)?;
-                let v = self.element(&codes.elems[k as usize], i, base)?;
-                self.put(w, d, v);
-                let v = v.int();
-                (v as u32, ((v >> 32) as u32).checked_sub(1))
-            }
-        };
+        let at = if c.relative { base + c.at } else { c.at };
         let (first, end) = (c.inputs.0 as usize, c.inputs.1 as usize);
         for &(offset, t, s) in &codes.inputs[first..end] {
             let v = self.src(s, base, w)?;
@@ -279,7 +270,7 @@ impl<'a> Exec<'a> {
         }
         self.passing = &codes.calls[c.call as usize];
         match c.body {
-            Ok(pou) => match (slot, self.library.of_pou[pou as usize]) {
+            Ok(pou) => match (c.slot, self.library.of_pou[pou as usize]) {
                 (Some(slot), Some(block)) => self.call_host_at(block, at, slot as usize)?,
                 _ => self.nested(top, |x| x.run_body(pou as usize, at))?,
             },

@@ -41,29 +41,7 @@ impl Builder<'_> {
                 // if each were computed just before its input is stored.
                 let mark = self.next;
                 let values = inputs.iter().map(|(_, _, e)| self.expr(e)).collect();
-                self.whole_call(
-                    site,
-                    Whole::Fixed(at, relative),
-                    inputs,
-                    values,
-                    body,
-                    outputs,
-                );
-                self.next = mark;
-                return;
-            }
-        }
-        if let Some((mut e, index)) = index_place(instance).filter(|(e, _)| e.plus == 0) {
-            let place = (e.at, e.relative, e.len.saturating_mul(e.stride));
-            if hoistable(index, place) && inputs.iter().all(|(_, _, x)| hoistable(x, place)) {
-                // As above; the index too, which the call reads first as the tree does.
-                let host = self.host_slot(body, e.at, e.relative).is_some();
-                e.instance = Some(if host { self.slots(&e).unwrap_or(0) } else { 0 });
-                let mark = self.next;
-                let i = self.expr(index);
-                let values = inputs.iter().map(|(_, _, x)| self.expr(x)).collect();
-                let whole = Whole::Element(e, i, self.reg());
-                self.whole_call(site, whole, inputs, values, body, outputs);
+                self.whole_call(site, (at, relative), inputs, values, body, outputs);
                 self.next = mark;
                 return;
             }
@@ -121,7 +99,7 @@ impl Builder<'_> {
     fn whole_call(
         &mut self,
         site: u32,
-        whole: Whole,
+        (at, relative): (u32, bool),
         inputs: &[BlockInput],
         values: Vec<Src>,
         body: Result<u32, StdFb>,
@@ -132,14 +110,7 @@ impl Builder<'_> {
             self.codes.inputs.push((*offset, *t, v));
         }
         self.codes.calls.push(inputs.to_vec());
-        let (at, relative, slot, element) = match whole {
-            Whole::Fixed(at, relative) => (at, relative, self.host_slot(body, at, relative), None),
-            Whole::Element(e, i, d) => {
-                self.codes.elems.push(e);
-                let k = (self.codes.elems.len() - 1) as u32;
-                (e.at, e.relative, None, Some((i, k, d)))
-            }
-        };
+        let slot = self.host_slot(body, at, relative);
         self.codes.call_ops.push(CallOp {
             site,
             at,
@@ -148,22 +119,14 @@ impl Builder<'_> {
             body,
             call: (self.codes.calls.len() - 1) as u32,
             slot,
-            element,
         });
         let k = (self.codes.call_ops.len() - 1) as u32;
         self.ops.push(Op::Call(k));
         if outputs.is_empty() {
             return;
         }
-        // The instance the call found: at its fixed place, or in the call's register.
-        let inst = match element {
-            Some((_, _, d)) => d,
-            None => {
-                let inst = self.reg();
-                self.ops.push(Op::Inst(inst, at, relative, 0));
-                inst
-            }
-        };
+        let inst = self.reg();
+        self.ops.push(Op::Inst(inst, at, relative, 0));
         for (offset, t, target, negated) in outputs {
             let mark = self.next;
             let to = self.dst(target);
@@ -203,14 +166,6 @@ impl Builder<'_> {
         let k = (self.codes.elems.len() - 1) as u32;
         self.ops.push(Op::Elem(d, i, k));
     }
-}
-
-/// The instance of a call in one operation.
-enum Whole {
-    /// At a fixed place (offset, relative).
-    Fixed(u32, bool),
-    /// An array's element at the index the operand holds, the instance left in the register.
-    Element(ElemOp, Src, R),
 }
 
 /// An element of an array at a fixed place at an index that is no constant within its
