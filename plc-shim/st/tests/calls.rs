@@ -2,27 +2,8 @@
 //! (copied in and back, bound at its turn among the values), and structure and array
 //! outputs of a function block, with the refusals of what a call may not give.
 
-use plc_st::vm::Program;
-
-fn run(text: &str, cycles: u32) -> Program {
-    let mut p = Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
-        panic!(
-            "{}",
-            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
-        )
-    });
-    for k in 0..cycles {
-        p.cycle(i64::from(k) * 10_000_000).unwrap();
-    }
-    p
-}
-
-fn refused(text: &str) -> String {
-    match Program::load(&[("main.st", text)]) {
-        Ok(_) => panic!("loaded: {text}"),
-        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
-    }
-}
+mod support;
+use support::{refused, run};
 
 /// A function's VAR_IN_OUT: the caller's variable copied in before the call and back after
 /// it (an array, an elementary value), named or by position among the inputs.

@@ -3,22 +3,8 @@
 
 use plc_st::vm::{Fault, Program};
 
-fn load(text: &str) -> Program {
-    Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
-        panic!(
-            "{}",
-            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
-        )
-    })
-}
-
-fn run(text: &str, cycles: u32) -> Program {
-    let mut p = load(text);
-    for k in 0..cycles {
-        p.cycle(i64::from(k) * 10_000_000).unwrap();
-    }
-    p
-}
+mod support;
+use support::{load, refused, run};
 
 #[test]
 fn variables_keep_their_values_from_cycle_to_cycle() {
@@ -336,13 +322,6 @@ END_PROGRAM";
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
     assert!(p.read_var("MAIN.total").unwrap() > 0.0);
-}
-
-fn refused(text: &str) -> String {
-    match Program::load(&[("main.st", text)]) {
-        Ok(_) => panic!("loaded: {text}"),
-        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
-    }
 }
 
 #[test]

@@ -3,18 +3,8 @@
 
 use plc_st::vm::Program;
 
-fn run(text: &str, cycles: u32) -> Program {
-    let mut p = Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
-        panic!(
-            "{}",
-            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
-        )
-    });
-    for k in 0..cycles {
-        p.cycle(i64::from(k) * 10_000_000).unwrap();
-    }
-    p
-}
+mod support;
+use support::{refused, run};
 
 /// CTUD: LOAD sets CV to PV, rising CU counts up, rising CD down, both rising at once leave
 /// CV, RESET wins over everything; QU is CV >= PV, QD is CV <= 0.
@@ -106,10 +96,7 @@ fn expt_of_an_integer_base_or_move_of_no_value_is_refused() {
         ),
     ] {
         let src = format!("PROGRAM MAIN VAR n : DINT; r : LREAL; END_VAR\n  {text}\nEND_PROGRAM");
-        let e = match Program::load(&[("main.st", &src)]) {
-            Ok(_) => panic!("loaded: {src}"),
-            Err(e) => e.iter().map(|d| d.to_string()).collect::<String>(),
-        };
+        let e = refused(&src);
         assert!(e.contains(want), "{text}: {e}");
     }
 }
@@ -156,11 +143,9 @@ END_PROGRAM",
     assert_eq!((var("MAIN.b"), var("MAIN.c")), (Some(1.0), Some(0.0)));
     assert_eq!((var("MAIN.d"), var("MAIN.e")), (Some(1.0), Some(0.0)));
     assert_eq!(var("MAIN.f"), Some(1.0), "AND_THEN binds before OR_ELSE");
-    let refused = Program::load(&[(
-        "main.st",
+    let e = refused(
         "PROGRAM MAIN VAR n : DINT; b : BOOL; END_VAR\n  b := n AND_THEN TRUE;\nEND_PROGRAM",
-    )]);
-    let e = refused.err().map(|e| e[0].to_string()).unwrap_or_default();
+    );
     assert!(e.contains("main.st:2:10: error: AND_THEN of"), "{e}");
 }
 
@@ -186,13 +171,7 @@ END_PROGRAM",
     assert_eq!(p.read_var("MAIN.t"), Some(30.0));
     assert_eq!(p.read_var("MAIN.lt"), Some(30_000_000.0));
     assert_eq!(p.read_var("MAIN.d"), Some(30.0));
-    let e = Program::load(&[(
-        "main.st",
-        "PROGRAM MAIN VAR t : TIME; END_VAR\n  t := TIME(1);\nEND_PROGRAM",
-    )])
-    .err()
-    .map(|e| e[0].to_string())
-    .unwrap_or_default();
+    let e = refused("PROGRAM MAIN VAR t : TIME; END_VAR\n  t := TIME(1);\nEND_PROGRAM");
     assert!(
         e.contains("main.st:2:8: error: TIME does not take these values"),
         "{e}"
@@ -223,13 +202,7 @@ END_PROGRAM",
     assert_eq!(p.read_var("MAIN.nOnAt"), Some(2.0));
     assert_eq!(p.read_var("MAIN.bOff"), Some(0.0));
     assert_eq!(p.read_var("MAIN.nOffAt"), Some(3.0));
-    let e = Program::load(&[(
-        "main.st",
-        "PROGRAM MAIN VAR n : INT; END_VAR\n  n S= TRUE;\nEND_PROGRAM",
-    )])
-    .err()
-    .map(|e| e[0].to_string())
-    .unwrap_or_default();
+    let e = refused("PROGRAM MAIN VAR n : INT; END_VAR\n  n S= TRUE;\nEND_PROGRAM");
     assert!(
         e.starts_with("main.st:2:5: error: a BOOL where a INT is wanted"),
         "{e}"

@@ -3,26 +3,13 @@
 //! and TwinCAT give them, their faults with the numbers they name, the refusals at load, and
 //! a cycle that computes strings without allocating.
 
-use plc_st::vm::{Fault, Program};
+use plc_st::vm::Fault;
+
+mod support;
+use support::{load, refused};
 
 #[path = "../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
-
-fn load(text: &str) -> Program {
-    Program::load(&[("main.st", text)]).unwrap_or_else(|e| {
-        panic!(
-            "{}",
-            e.iter().map(|d| d.to_string() + "\n").collect::<String>()
-        )
-    })
-}
-
-fn refused(text: &str) -> String {
-    match Program::load(&[("main.st", text)]) {
-        Ok(_) => panic!("loaded: {text}"),
-        Err(e) => e.iter().map(|d| d.to_string() + "\n").collect(),
-    }
-}
 
 /// Runs one cycle of program MAIN (after `before`) whose BOOLs `ok1` .. `ok<n>` hold the
 /// checks' results, and names the checks that failed.
