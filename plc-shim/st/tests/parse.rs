@@ -206,8 +206,9 @@ fn refusals_name_line_and_column() {
 #[test]
 fn a_variable_named_as_an_extension_word_is_a_variable() {
     let text = "FUNCTION_BLOCK Action\nVAR_INPUT method : INT; END_VAR\nEND_FUNCTION_BLOCK\n\
-                PROGRAM P\nVAR property, interface : INT; extends : Action; END_VAR\n\
+                PROGRAM P\nVAR property, interface : INT; extends : Action; action, method : BOOL; END_VAR\n\
                 property := 1;\ninterface := property;\nextends(method := interface);\n\
+                action S= property > 0;\nmethod R= FALSE;\n\
                 END_PROGRAM";
     let unit = parse_file("t.st", text).unwrap();
     assert_eq!(unit.items.len(), 2);

@@ -94,6 +94,10 @@ fn expt_of_an_integer_base_or_move_of_no_value_is_refused() {
             "r := EXPT(2.0, T#1S);",
             "main.st:2:8: error: EXPT does not take these values",
         ),
+        (
+            "r := EXPT(2.0, WORD#3);",
+            "main.st:2:8: error: EXPT does not take these values",
+        ),
     ] {
         let src = format!("PROGRAM MAIN VAR n : DINT; r : LREAL; END_VAR\n  {text}\nEND_PROGRAM");
         let e = refused(&src);

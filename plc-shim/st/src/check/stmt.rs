@@ -588,7 +588,9 @@ impl Checker {
             "EXPT"
                 if count(2..=2)
                     && elem(0).is_some_and(|e| e.class() == Class::Float)
-                    && elem(1).is_some_and(|e| e.is_numeric() && e.class() != Class::Duration) =>
+                    && elem(1).is_some_and(|e| {
+                        matches!(e.class(), Class::Signed | Class::Unsigned | Class::Float)
+                    }) =>
             {
                 types[0].clone()
             }

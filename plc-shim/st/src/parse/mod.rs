@@ -208,7 +208,11 @@ impl Parser {
         let Tok::Ident(word) = self.peek() else {
             return Ok(());
         };
-        let named = matches!(self.peek_at(1), Tok::Ident(_));
+        // `action S= b;` is a variable set, not a declaration.
+        let set = matches!(self.peek_at(1), Tok::Ident(w)
+            if w.eq_ignore_ascii_case("S") || w.eq_ignore_ascii_case("R"))
+            && matches!(self.peek_at(2), Tok::Eq);
+        let named = matches!(self.peek_at(1), Tok::Ident(_)) && !set;
         match OBJECT_ORIENTED
             .iter()
             .find(|w| w.eq_ignore_ascii_case(word))

@@ -1,4 +1,5 @@
-//! Statements and expressions. Operator precedence, lowest first: OR, XOR, AND (`&`),
+//! Statements and expressions. Operator precedence, lowest first: OR and OR_ELSE, XOR, AND
+//! (`&`) and AND_THEN,
 //! `=` `<>`, `<` `>` `<=` `>=`, `+` `-`, `*` `/` MOD, `**`, unary `-` and NOT, then the
 //! postfix forms (`.field`, `[index]`, `^`, `(arguments)`).
 
