@@ -31,8 +31,11 @@ fn the_cnc_loop_makes_no_system_call_per_tick_but_its_wake_up() {
         .arg("run")
         .arg(&scenario)
         .args(["--ticks", &ticks.to_string(), "--instance", &instance])
-        // strace slows both processes: the CNC must not take its PLC for lost meanwhile.
-        .args(["--plc-watchdog-ticks", "100000"])
+        // strace slows both processes: the CNC must not take its PLC for lost meanwhile,
+        // nor stop for ticks longer than 1 ms (each system call traced costs tens of us:
+        // on a slow runner the traced tick's work passed 1 ms and the machine stopped).
+        // The calls per tick are the same at any cycle.
+        .args(["--plc-watchdog-ticks", "100000", "--cycle-ms", "4"])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", tests::cli::report(&out));
