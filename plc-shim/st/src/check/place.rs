@@ -142,7 +142,6 @@ impl Checker {
     }
 }
 
-/// The parts a STRING(n)'s n + 1 bytes are passed in: 8-byte words, then single bytes.
 /// Whether a place is fixed: no index computed, no pointer followed.
 fn fixed(a: &Addr) -> bool {
     match a {
@@ -160,6 +159,7 @@ fn loads(place: &Addr, n: u32) -> Vec<(u32, Elem, Ex)> {
         .collect()
 }
 
+/// The parts a STRING(n)'s n + 1 bytes are passed in: 8-byte words, then single bytes.
 fn string_chunks(n: u32) -> Vec<(u32, Elem)> {
     let size = n + 1;
     let words = (0..size / 8).map(|k| (8 * k, Elem::LWord));

@@ -123,10 +123,6 @@ fn integer(op: BinOp, t: Elem, a: i64, b: i64) -> Run<V> {
         BinOp::And => a & b,
         BinOp::Or => a | b,
         BinOp::Xor => a ^ b,
-        // Never reached (the tree computes them, the right value only when needed): as AND
-        // and OR if both values were known.
-        BinOp::AndThen => a & b,
-        BinOp::OrElse => a | b,
         BinOp::Div | BinOp::Mod if b == 0 => return Err(Fault::DivisionByZero),
         BinOp::Div if unsigned(t) => ((a as u64) / (b as u64)) as i64,
         BinOp::Div => a.wrapping_div(b),
