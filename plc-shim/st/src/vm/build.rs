@@ -57,7 +57,7 @@ impl<'c> Builder<'c> {
     pub(super) fn finish(mut self) -> Option<Code> {
         self.ops.push(Op::Ret);
         (!self.overflow).then_some(Code {
-            ops: self.ops,
+            ops: self.ops.into_iter().map(super::fast::specialize).collect(),
             regs: self.most,
         })
     }

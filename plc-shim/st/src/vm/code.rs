@@ -17,6 +17,7 @@
 //! functions too), known at load.
 
 use super::build::{Builder, Loops};
+use super::fast::{Bytes, Input};
 use super::library::Library;
 use crate::ast::BinOp;
 use crate::check::std_lib::StdFb;
@@ -136,6 +137,15 @@ pub(crate) enum Op {
     StdBody(StdFb, R, u32),
     /// Reads an output: instance, offset, type, negated, where it goes.
     Output(R, u32, Elem, bool, Dst),
+    /// Stores a constant's bytes into the program's memory at an offset (from the
+    /// instance's base when relative): [`Op::Store`] of a constant, specialized
+    /// ([`super::fast`]).
+    SetOwn(u32, bool, Bytes),
+    /// `d :=` whether the variable (offset, relative; its type) equals the constant, or
+    /// differs from it with `true`: [`Op::BinI`] of `=` or `<>`, specialized.
+    EqVarConst(bool, R, (u32, bool), Elem, i64),
+    /// `d := a op b` of two BOOLs (AND, OR, XOR): [`Op::BinI`] of BOOLs, specialized.
+    Logic(BinOp, R, Src, Src),
     /// A whole block call whose instance has a fixed place and whose inputs are all
     /// operands (the common call: `fbRun(Axis := axConveyor, Velocity := 360.0)`): its
     /// index among [`Codes::call_ops`]. Its outputs follow as [`Op::Output`]s.
@@ -222,8 +232,8 @@ pub(crate) struct Codes {
     pub(crate) calls: Vec<Vec<BlockInput>>,
     /// The block calls in one operation.
     pub(crate) call_ops: Vec<CallOp>,
-    /// Their inputs: offset in the instance, type, value.
-    pub(crate) inputs: Vec<(u32, Elem, Src)>,
+    /// Their inputs: offset in the instance, and what is stored there.
+    pub(crate) inputs: Vec<(u32, Input)>,
     /// Elements at indices known at run time.
     pub(crate) elems: Vec<ElemOp>,
     /// CASE jump tables.

@@ -68,3 +68,43 @@ impl core::fmt::Display for FaultAt {
         }
     }
 }
+
+/// [`super::State::site`] when the tree walker's statement is the place.
+pub(super) const TREE_SITE: u32 = u32::MAX;
+
+impl super::Exec<'_> {
+    /// Fault `fault` at the place of the statement being run.
+    pub(super) fn fault_at(&self, fault: Fault) -> FaultAt {
+        let named = matches!(
+            fault,
+            Fault::IndexOutOfRange | Fault::Budget | Fault::MuxSelector
+        );
+        let (file, pos) = match self.codes.sites.get(self.st.site as usize) {
+            Some(&at) => at,
+            None => self.st.at,
+        };
+        FaultAt {
+            fault,
+            file,
+            pos,
+            values: if named { self.st.values } else { [0; 3] },
+        }
+    }
+
+    /// The tree walker's statement `at` is the place a fault names.
+    #[inline]
+    pub(super) fn tree_at(&mut self, at: (u16, Pos)) {
+        self.st.at = at;
+        self.st.site = TREE_SITE;
+    }
+
+    /// The place a fault would name now (saved around a call that moves it).
+    pub(super) fn place(&self) -> (u32, (u16, Pos)) {
+        (self.st.site, self.st.at)
+    }
+
+    pub(super) fn set_place(&mut self, (site, at): (u32, (u16, Pos))) {
+        self.st.site = site;
+        self.st.at = at;
+    }
+}

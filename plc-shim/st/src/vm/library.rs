@@ -50,10 +50,12 @@ pub struct BlockIo<'a> {
 
 impl BlockIo<'_> {
     /// The instance's index among [`Program::library_instances`].
+    #[inline]
     pub fn slot(&self) -> usize {
         self.slot
     }
 
+    #[inline]
     fn place(&self, k: usize) -> Option<(usize, Elem)> {
         let (offset, t) = (*self.members.get(k)?)?;
         Some((self.at + offset as usize, t))
@@ -61,6 +63,7 @@ impl BlockIo<'_> {
 
     /// The call site (the same number for every call from one place of the program: each
     /// gives the same inputs).
+    #[inline]
     pub fn site(&self) -> usize {
         self.passed.as_ptr() as usize
     }
@@ -72,6 +75,7 @@ impl BlockIo<'_> {
     }
 
     /// Variable `k` as an integer (BOOL 0 or 1), `None` if it is a real or has no place.
+    #[inline]
     pub fn int(&self, k: usize) -> Option<i64> {
         let (at, t) = self.place(k)?;
         match read_mem(self.memory, at, t).ok()? {
@@ -110,6 +114,7 @@ impl BlockIo<'_> {
     }
 
     /// Variable `k` as a number.
+    #[inline]
     pub fn real(&self, k: usize) -> Option<f64> {
         let (at, t) = self.place(k)?;
         read_mem(self.memory, at, t).ok().map(V::float)

@@ -19,6 +19,7 @@ pub use symbols::{Symbol, MAX_LISTED_ELEMENTS};
 mod build;
 pub(crate) mod callees;
 mod code;
+mod fast;
 mod fault;
 mod image;
 mod init;
@@ -103,14 +104,24 @@ struct State {
     budget: u64,
     steps: u64,
     now_ns: i64,
-    /// The statement being run (for a fault's place).
+    /// The statement being run (for a fault's place): its index among the operations'
+    /// [`code::Codes::sites`], or [`fault::TREE_SITE`] when the tree walker set `at`.
+    site: u32,
+    /// The statement the tree walker runs (when `site` is [`fault::TREE_SITE`]).
     at: (u16, Pos),
     /// The numbers of the last fault that has some ([`FaultAt::values`]).
     values: [i64; 3],
-    /// The bodies' registers (windows of it, one per call in a chain of calls): each a
-    /// word, and whether it holds a real.
-    regs: Vec<u64>,
-    reals: Vec<bool>,
+    /// The bodies' registers (windows of it, one per call in a chain of calls).
+    regs: Vec<Reg>,
+}
+
+/// A register: a word, and whether it holds a real (read and written field by field,
+/// never copied as a whole value: the copy's wide load would wait for the two narrow
+/// stores).
+#[derive(Debug, Clone, Copy, Default)]
+struct Reg {
+    bits: u64,
+    real: bool,
 }
 
 /// A program running: its code, its state, and the image its pointers may reach.
@@ -159,12 +170,12 @@ impl Program {
             programs,
             library,
             state: State {
-                regs: vec![0; codes.registers],
-                reals: vec![false; codes.registers],
+                regs: vec![Reg::default(); codes.registers],
                 memory: vec![0; code.layout.size as usize],
                 budget: DEFAULT_BUDGET,
                 steps: 0,
                 now_ns: 0,
+                site: fault::TREE_SITE,
                 at: (0, Pos::default()),
                 values: [0; 3],
             },
@@ -308,19 +319,6 @@ impl Program {
 }
 
 impl<'a> Exec<'a> {
-    fn fault_at(&self, fault: Fault) -> FaultAt {
-        let named = matches!(
-            fault,
-            Fault::IndexOutOfRange | Fault::Budget | Fault::MuxSelector
-        );
-        FaultAt {
-            fault,
-            file: self.st.at.0,
-            pos: self.st.at.1,
-            values: if named { self.st.values } else { [0; 3] },
-        }
-    }
-
     /// A fault with numbers: they are kept for [`FaultAt::values`].
     #[cold]
     fn fault_with(&mut self, fault: Fault, values: [i64; 3]) -> Fault {
@@ -360,7 +358,7 @@ impl<'a> Exec<'a> {
     }
 
     fn statement(&mut self, s: &'a St, base: u32) -> Run<Flow> {
-        self.st.at = s.at;
+        self.tree_at(s.at);
         self.step()?;
         match &s.kind {
             StKind::Store(a, t, e) => {
@@ -426,7 +424,7 @@ impl<'a> Exec<'a> {
                 body,
             } => return self.for_loop(var, *ty, (from, to, by), body, base),
             StKind::While(cond, body) => loop {
-                self.st.at = s.at;
+                self.tree_at(s.at);
                 self.step()?;
                 if self.eval(cond, base)?.int() == 0 {
                     break;
@@ -444,7 +442,7 @@ impl<'a> Exec<'a> {
                     Flow::Return => return Ok(Flow::Return),
                     _ => {}
                 }
-                self.st.at = s.at;
+                self.tree_at(s.at);
                 if self.eval(until, base)?.int() != 0 {
                     break;
                 }
@@ -525,7 +523,7 @@ impl<'a> Exec<'a> {
             (_, Some(fb)) => self.run_std_fb(fb, at as usize)?,
             _ => {}
         }
-        self.st.at = s.at;
+        self.tree_at(s.at);
         self.read_outputs(outputs, at, base)
     }
 
@@ -740,7 +738,7 @@ impl<'a> Exec<'a> {
                 None => self.eval(e, base)?,
             };
         }
-        let (frame, statement) = (self.code.layout.statics[pou], self.st.at);
+        let (frame, statement) = (self.code.layout.statics[pou], self.place());
         let (size, _, _) = self.code.layout.pous[pou];
         // A function's variables start from zero and their initial values each call.
         self.st.memory[frame as usize..(frame + size) as usize].fill(0);
@@ -753,7 +751,7 @@ impl<'a> Exec<'a> {
             self.put_text((frame + offset) as usize, *size as usize, buf.chars())?;
         }
         self.run_body(pou, frame)?;
-        self.st.at = statement;
+        self.set_place(statement);
         // The VAR_IN_OUTs back into the caller's variables, leaf by leaf.
         for (&at, (offset, t, _)) in places.iter().zip(back.iter()) {
             let v = self.read_own((frame + offset) as usize, *t)?;

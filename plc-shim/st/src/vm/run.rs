@@ -3,6 +3,7 @@
 //! the rules of values, places and faults those of the tree walker.
 
 use super::code::{slotted, CallOp, Code, Dst, ElemOp, Op, Src, NEXT};
+use super::fast::{self, Input};
 use super::{ops, pointed, tagged, Exec, Fault, Flow, Loc, Run, IMAGE_TAG, V};
 use crate::types::Elem;
 
@@ -32,11 +33,11 @@ impl<'a> Exec<'a> {
             pc += 1;
             match *op {
                 Op::Stmt(k) => {
-                    self.st.at = codes.sites[k as usize];
+                    self.st.site = k;
                     self.step()?;
                 }
                 Op::Step => self.step()?,
-                Op::At(k) => self.st.at = codes.sites[k as usize],
+                Op::At(k) => self.st.site = k,
                 Op::Bin(op, t, d, a, b) => {
                     let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
                     let v = ops::binary(op, t, x, y)?;
@@ -215,6 +216,19 @@ impl<'a> Exec<'a> {
                     }
                     self.store(to, t, v, base, w)?;
                 }
+                Op::SetOwn(at, relative, bytes) => {
+                    let at = if relative { base + at } else { at };
+                    fast::set(&mut self.st.memory, at as usize, bytes)?;
+                }
+                Op::EqVarConst(ne, d, (at, relative), t, c) => {
+                    let at = if relative { base + at } else { at };
+                    let x = self.read_own(at as usize, t)?.int();
+                    self.put(w, d, V::I(i64::from((x == c) != ne)));
+                }
+                Op::Logic(op, d, a, b) => {
+                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                    self.put(w, d, V::I(fast::logic(op, x, y)));
+                }
                 Op::Call(k) => self.call(&codes.call_ops[k as usize], base, w, top)?,
                 Op::Ret => return Ok(()),
             }
@@ -226,12 +240,11 @@ impl<'a> Exec<'a> {
     /// copied as a whole value: the copy's wide load would wait for the two narrow stores).
     #[inline(always)]
     fn get(&self, w: usize, r: u16) -> V {
-        let i = w + usize::from(r);
-        let bits = self.st.regs[i];
-        if self.st.reals[i] {
-            V::F(f64::from_bits(bits))
+        let reg = &self.st.regs[w + usize::from(r)];
+        if reg.real {
+            V::F(f64::from_bits(reg.bits))
         } else {
-            V::I(bits as i64)
+            V::I(reg.bits as i64)
         }
     }
 
@@ -240,33 +253,39 @@ impl<'a> Exec<'a> {
     /// checker never gives a real there.
     #[inline(always)]
     fn get_int(&self, w: usize, r: u16) -> i64 {
-        let i = w + usize::from(r);
-        debug_assert!(!self.st.reals[i], "a real where an integer is wanted");
-        self.st.regs[i] as i64
+        let reg = &self.st.regs[w + usize::from(r)];
+        debug_assert!(!reg.real, "a real where an integer is wanted");
+        reg.bits as i64
     }
 
     #[inline(always)]
     fn put(&mut self, w: usize, r: u16, v: V) {
-        let i = w + usize::from(r);
         let (bits, real) = match v {
             V::I(x) => (x as u64, false),
             V::F(x) => (x.to_bits(), true),
         };
-        self.st.regs[i] = bits;
-        self.st.reals[i] = real;
+        let reg = &mut self.st.regs[w + usize::from(r)];
+        reg.bits = bits;
+        reg.real = real;
     }
 
     /// A whole block call ([`Op::Call`]): as the tree's, its inputs stored one after the
     /// other, the body run, the statement's place set again for its outputs.
     fn call(&mut self, c: &'a CallOp, base: u32, w: usize, top: usize) -> Run<()> {
         let codes = self.codes;
-        self.st.at = codes.sites[c.site as usize];
+        self.st.site = c.site;
         self.step()?;
         let at = if c.relative { base + c.at } else { c.at };
         let (first, end) = (c.inputs.0 as usize, c.inputs.1 as usize);
-        for &(offset, t, s) in &codes.inputs[first..end] {
-            let v = self.src(s, base, w)?;
-            self.write_own((at + offset) as usize, t, v)?;
+        for &(offset, input) in &codes.inputs[first..end] {
+            let to = (at + offset) as usize;
+            match input {
+                Input::Const(bytes) => fast::set(&mut self.st.memory, to, bytes)?,
+                Input::Value(t, s) => {
+                    let v = self.src(s, base, w)?;
+                    self.write_own(to, t, v)?;
+                }
+            }
         }
         self.passing = &codes.calls[c.call as usize];
         match c.body {
@@ -276,7 +295,7 @@ impl<'a> Exec<'a> {
             },
             Err(fb) => self.run_std_fb(fb, at as usize)?,
         }
-        self.st.at = codes.sites[c.site as usize];
+        self.st.site = c.site;
         Ok(())
     }
 

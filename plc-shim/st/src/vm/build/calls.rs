@@ -10,6 +10,7 @@ use crate::check::std_lib::StdFb;
 use crate::ir::{Addr, BlockInput, BlockOutput, Ex, St};
 use crate::types::Class;
 use crate::vm::code::{CallOp, Dst, ElemOp, Op, Src, R};
+use crate::vm::fast;
 
 impl Builder<'_> {
     /// The bytes of an instance of the POU or standard block.
@@ -107,7 +108,7 @@ impl Builder<'_> {
     ) {
         let first = self.codes.inputs.len() as u32;
         for ((offset, t, _), v) in inputs.iter().zip(values) {
-            self.codes.inputs.push((*offset, *t, v));
+            self.codes.inputs.push((*offset, fast::input(*t, v)));
         }
         self.codes.calls.push(inputs.to_vec());
         let slot = self.host_slot(body, at, relative);
