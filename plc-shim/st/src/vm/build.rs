@@ -4,6 +4,7 @@
 
 use super::code::{Code, Codes, Dst, Op, Src, Switch, NEXT, R};
 use super::library::Library;
+use super::V;
 use crate::ast::BinOp;
 use crate::ir::{Addr, Ex, St, StKind};
 use crate::types::Elem;
@@ -57,7 +58,9 @@ impl<'c> Builder<'c> {
     pub(super) fn finish(mut self) -> Option<Code> {
         self.ops.push(Op::Ret);
         (!self.overflow).then_some(Code {
-            ops: self.ops.into_iter().map(super::fast::specialize).collect(),
+            ops: (self.ops.into_iter())
+                .map(|op| super::fast::specialize(op, &self.codes.consts))
+                .collect(),
             regs: self.most,
         })
     }
@@ -89,7 +92,7 @@ impl<'c> Builder<'c> {
             | Op::JumpIf(_, t)
             | Op::JumpCmp(.., t)
             | Op::JumpCmpI(.., t)
-            | Op::JumpIn(_, _, _, t)
+            | Op::JumpIn(_, _, t)
             | Op::ForTest(.., t) => *t = to,
             Op::ForNext(.., t) => *t = to,
             _ => {}
@@ -339,23 +342,18 @@ impl<'c> Builder<'c> {
     ) {
         let site = self.site(s);
         self.ops.push(Op::Stmt(site));
+        // Computed once, as the tree reads it once: an operand is a register, a variable
+        // (nothing runs between the tests that could change it) or a constant.
         let v = self.expr(sel);
-        // Computed once (the tree reads it once).
-        let v = match v {
-            Src::Var(..) | Src::R(_) | Src::I(_) => v,
-            other => {
-                let r = self.reg();
-                self.ops.push(Op::Mov(r, other));
-                Src::R(r)
-            }
-        };
         let mut tests = Vec::new();
         let table = self.switch(v, arms);
         if table.is_none() {
             for (k, (ranges, _)) in arms.iter().enumerate() {
                 for (lo, hi) in ranges {
                     tests.push((self.ops.len(), k));
-                    self.ops.push(Op::JumpIn(v, *lo, *hi, LATER));
+                    self.codes.ranges.push((*lo, *hi));
+                    let range = (self.codes.ranges.len() - 1) as u32;
+                    self.ops.push(Op::JumpIn(v, range, LATER));
                 }
             }
         }
@@ -483,8 +481,8 @@ impl<'c> Builder<'c> {
     /// An expression's value: an operand, or a register the operations pushed fill.
     fn expr(&mut self, e: &Ex) -> Src {
         match e {
-            Ex::Int(v) => Src::I(*v),
-            Ex::Real(v) => Src::F(*v),
+            Ex::Int(v) => self.codes.constant(V::I(*v)),
+            Ex::Real(v) => self.codes.constant(V::F(*v)),
             Ex::Var {
                 offset,
                 relative,
@@ -511,7 +509,7 @@ impl<'c> Builder<'c> {
                 _ => self.load_behind(e, a, Elem::ULInt),
             },
             Ex::AddrOf(a) => match (own(a), &**a) {
-                (Some(Dst::Own(at, false)), _) => Src::I(i64::from(at) + 1),
+                (Some(Dst::Own(at, false)), _) => self.codes.constant(V::I(i64::from(at) + 1)),
                 // `ADR(gpCh[0]^.unit)`: past where the pointer variable points.
                 (
                     _,
@@ -569,21 +567,12 @@ impl<'c> Builder<'c> {
     }
 }
 
-/// An expression that is an operand (a constant or a variable): nothing to compute.
-fn operand(e: &Ex) -> Option<Src> {
+/// Whether an expression is an operand (a constant or a variable): nothing to compute.
+fn operand(e: &Ex) -> bool {
     match e {
-        Ex::Int(v) => Some(Src::I(*v)),
-        Ex::Real(v) => Some(Src::F(*v)),
-        Ex::Var {
-            offset,
-            relative,
-            ty,
-        } => Some(Src::Var(*offset, *relative, *ty)),
-        Ex::Load(a, t) => match own(a)? {
-            Dst::Own(at, relative) => Some(Src::Var(at, relative, *t)),
-            _ => None,
-        },
-        _ => None,
+        Ex::Int(_) | Ex::Real(_) | Ex::Var { .. } => true,
+        Ex::Load(a, _) => matches!(own(a), Some(Dst::Own(..))),
+        _ => false,
     }
 }
 

@@ -19,6 +19,7 @@
 use super::build::{Builder, Loops};
 use super::fast::{Bytes, Input};
 use super::library::Library;
+use super::V;
 use crate::ast::BinOp;
 use crate::check::std_lib::StdFb;
 use crate::check::Compiled;
@@ -34,10 +35,10 @@ pub(crate) type R = u16;
 pub(crate) enum Src {
     /// A register.
     R(R),
-    /// An integer constant.
-    I(i64),
-    /// A real constant.
-    F(f64),
+    /// An integer constant that fits 32 bits.
+    I(i32),
+    /// A constant of the pool ([`Codes::consts`]): a wider integer, or a real.
+    K(u32),
     /// A variable: its offset (from the instance's base when relative) and type.
     Var(u32, bool, Elem),
 }
@@ -110,7 +111,7 @@ pub(crate) enum Op {
     /// ([`Codes::switches`], its index) gives for the value, or at the next one.
     Switch(Src, u32),
     /// Goes on at the operation when the value lies in the range (a CASE arm).
-    JumpIn(Src, i64, i64, u32),
+    JumpIn(Src, u32, u32),
     /// A FOR's test: control variable (its offset in own memory, from the instance's base
     /// when relative), its type, the registers of the value,
     /// the last value and the step; past the last, goes on at the operation; else stores the
@@ -143,7 +144,7 @@ pub(crate) enum Op {
     SetOwn(u32, bool, Bytes),
     /// `d :=` whether the variable (offset, relative; its type) equals the constant, or
     /// differs from it with `true`: [`Op::BinI`] of `=` or `<>`, specialized.
-    EqVarConst(bool, R, (u32, bool), Elem, i64),
+    EqVarConst(bool, R, (u32, bool), Elem, i32),
     /// `d := a op b` of two BOOLs (AND, OR, XOR): [`Op::BinI`] of BOOLs, specialized.
     Logic(BinOp, R, Src, Src),
     /// A whole block call whose instance has a fixed place and whose inputs are all
@@ -153,6 +154,11 @@ pub(crate) enum Op {
     /// The body ends.
     Ret,
 }
+
+// An operation is read from memory for every step of a cycle: kept at three words (a
+// cycle's operations are lines of the data cache a cold cycle misses).
+const _: () = assert!(core::mem::size_of::<Op>() <= 24);
+const _: () = assert!(core::mem::size_of::<Src>() == 8);
 
 /// A block call in one operation ([`Op::Call`]).
 #[derive(Debug, Clone, Copy)]
@@ -238,6 +244,10 @@ pub(crate) struct Codes {
     pub(crate) elems: Vec<ElemOp>,
     /// CASE jump tables.
     pub(crate) switches: Vec<Switch>,
+    /// The ranges of CASE labels ([`Op::JumpIn`]): lowest and highest value.
+    pub(crate) ranges: Vec<(i64, i64)>,
+    /// Constants that do not fit an operand ([`Src::K`]).
+    pub(crate) consts: Vec<V>,
     /// Per POU: the bytes of an instance (a function block's).
     pub(crate) sizes: Vec<u32>,
     /// Registers of the deepest chain of calls.
@@ -248,6 +258,17 @@ pub(crate) struct Codes {
 const MAX_REGISTERS: usize = 1 << 16;
 
 impl Codes {
+    /// The operand of constant `v`: in the operand when it fits, else in the pool.
+    pub(crate) fn constant(&mut self, v: V) -> Src {
+        if let V::I(x) = v {
+            if let Ok(x) = i32::try_from(x) {
+                return Src::I(x);
+            }
+        }
+        self.consts.push(v);
+        Src::K((self.consts.len() - 1) as u32)
+    }
+
     /// Compiles every body of `c` but those of `library` POUs; nothing (every body on the
     /// tree) when the registers would exceed [`MAX_REGISTERS`].
     pub(crate) fn of(c: &Compiled, library: &Library) -> Codes {

@@ -56,26 +56,26 @@ pub(crate) enum Input {
     Value(Elem, Src),
 }
 
-/// An input of type `t` given by operand `v`.
-pub(super) fn input(t: Elem, v: Src) -> Input {
-    let constant = match v {
-        Src::I(x) => Bytes::of(t, V::I(x)),
-        Src::F(x) => Bytes::of(t, V::F(x)),
+/// The value of operand `s` when it is a constant (`consts`: the pool).
+fn constant(s: Src, consts: &[V]) -> Option<V> {
+    match s {
+        Src::I(x) => Some(V::I(i64::from(x))),
+        Src::K(k) => consts.get(k as usize).copied(),
         _ => None,
-    };
+    }
+}
+
+/// An input of type `t` given by operand `v`.
+pub(super) fn input(t: Elem, v: Src, consts: &[V]) -> Input {
+    let constant = constant(v, consts).and_then(|c| Bytes::of(t, c));
     constant.map_or(Input::Value(t, v), Input::Const)
 }
 
 /// The operation `op` specialized to its operands, or `op` itself.
-pub(super) fn specialize(op: Op) -> Op {
+pub(super) fn specialize(op: Op, consts: &[V]) -> Op {
     match op {
-        Op::Store(Dst::Own(at, relative), t, s @ (Src::I(_) | Src::F(_))) => {
-            let v = match s {
-                Src::F(x) => V::F(x),
-                Src::I(x) => V::I(x),
-                _ => return op,
-            };
-            match Bytes::of(t, v) {
+        Op::Store(Dst::Own(at, relative), t, s) => {
+            match constant(s, consts).and_then(|v| Bytes::of(t, v)) {
                 Some(bytes) => Op::SetOwn(at, relative, bytes),
                 None => op,
             }

@@ -146,7 +146,8 @@ impl<'a> Exec<'a> {
                         pc = to as usize;
                     }
                 }
-                Op::JumpIn(s, lo, hi, to) => {
+                Op::JumpIn(s, k, to) => {
+                    let (lo, hi) = codes.ranges[k as usize];
                     if (lo..=hi).contains(&self.src_int(s, base, w)?) {
                         pc = to as usize;
                     }
@@ -223,7 +224,7 @@ impl<'a> Exec<'a> {
                 Op::EqVarConst(ne, d, (at, relative), t, c) => {
                     let at = if relative { base + at } else { at };
                     let x = self.read_own(at as usize, t)?.int();
-                    self.put(w, d, V::I(i64::from((x == c) != ne)));
+                    self.put(w, d, V::I(i64::from((x == i64::from(c)) != ne)));
                 }
                 Op::Logic(op, d, a, b) => {
                     let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
@@ -336,8 +337,8 @@ impl<'a> Exec<'a> {
     fn src_int(&self, s: Src, base: u32, w: usize) -> Run<i64> {
         match s {
             Src::R(r) => Ok(self.get_int(w, r)),
-            Src::I(v) => Ok(v),
-            Src::F(v) => Ok(v as i64),
+            Src::I(v) => Ok(i64::from(v)),
+            Src::K(k) => Ok(self.codes.consts[k as usize].int()),
             Src::Var(at, relative, t) => {
                 let at = if relative { base + at } else { at };
                 self.read_own(at as usize, t).map(V::int)
@@ -349,8 +350,8 @@ impl<'a> Exec<'a> {
     fn src(&self, s: Src, base: u32, w: usize) -> Run<V> {
         match s {
             Src::R(r) => Ok(self.get(w, r)),
-            Src::I(v) => Ok(V::I(v)),
-            Src::F(v) => Ok(V::F(v)),
+            Src::I(v) => Ok(V::I(i64::from(v))),
+            Src::K(k) => Ok(self.codes.consts[k as usize]),
             Src::Var(at, relative, t) => {
                 let at = if relative { base + at } else { at };
                 self.read_own(at as usize, t)

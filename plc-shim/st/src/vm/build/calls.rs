@@ -108,7 +108,8 @@ impl Builder<'_> {
     ) {
         let first = self.codes.inputs.len() as u32;
         for ((offset, t, _), v) in inputs.iter().zip(values) {
-            self.codes.inputs.push((*offset, fast::input(*t, v)));
+            let input = fast::input(*t, v, &self.codes.consts);
+            self.codes.inputs.push((*offset, input));
         }
         self.codes.calls.push(inputs.to_vec());
         let slot = self.host_slot(body, at, relative);
@@ -239,6 +240,6 @@ fn hoistable(e: &Ex, place: (u32, bool, u32)) -> bool {
                 );
             (compares || wraps) && hoistable(a, place) && hoistable(b, place)
         }
-        _ => operand(e).is_some(),
+        _ => operand(e),
     }
 }
