@@ -58,6 +58,36 @@ pub(super) fn literal(e: &Expr) -> Option<i128> {
     }
 }
 
+/// An untyped real literal's value (`2.5`, `-0.5`). It takes the type of the REAL or LREAL
+/// it meets, as an untyped integer literal takes an integer's: `r := r / 2.0;` of a REAL
+/// `r` computes in REAL (`LREAL#2.0` stays an LREAL).
+pub(super) fn real_literal(e: &Expr) -> Option<f64> {
+    match e {
+        Expr::Real(v, _) => Some(*v),
+        Expr::Unary(UnOp::Neg, inner, _) => real_literal(inner).map(|v| -v),
+        _ => None,
+    }
+}
+
+/// Whether `e` is an untyped literal, integer or real.
+pub(super) fn untyped_literal(e: &Expr) -> bool {
+    literal(e).is_some() || real_literal(e).is_some()
+}
+
+/// Whether `e` is an untyped literal type `t` holds: an integer within `t`'s range (or of
+/// a real type), or a real of a real type that holds it (a REAL: finite in 32 bits).
+pub(super) fn literal_fits(e: &Expr, t: Elem) -> bool {
+    if let Some(v) = literal(e) {
+        return t.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v))
+            || t.class() == Class::Float;
+    }
+    real_literal(e).is_some_and(|v| match t {
+        Elem::LReal => true,
+        Elem::Real => (v as f32).is_finite(),
+        _ => false,
+    })
+}
+
 impl Checker {
     pub(super) fn meaning(&self, name: &str, ctx: Ctx) -> Option<Meaning> {
         if let Some(pou) = self.out.pous.get(ctx.pou) {
@@ -418,13 +448,9 @@ pub(super) fn operands_of(l: &Expr, r: &Expr, lt: Type, rt: Type) -> Option<(Ele
     {
         let common = match (&lt, &rt) {
             (Type::Elem(a), Type::Elem(b)) => {
-                let fits = |v: Option<i128>, e: &Elem| {
-                    v.is_some_and(|v| e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v)))
-                        || (v.is_some() && e.class() == Class::Float)
-                };
-                if fits(literal(l), b) {
+                if literal_fits(l, *b) {
                     Some(*b)
-                } else if fits(literal(r), a) {
+                } else if literal_fits(r, *a) {
                     Some(*a)
                 } else {
                     Elem::common(*a, *b)
@@ -469,7 +495,7 @@ impl Checker {
                 return self.error(pos, format!("{} takes one value", n.text));
             };
             return match self.expr(a, ctx) {
-                Type::Elem(e) if e == from || e.widens_to(from) || literal(a).is_some() => {
+                Type::Elem(e) if e == from || e.widens_to(from) || literal_fits(a, from) => {
                     Type::Elem(to)
                 }
                 Type::Error => Type::Error,

@@ -214,6 +214,13 @@ impl Checker {
                 _ => Ex::Int(v as i64),
             });
         }
+        // A real literal in the real type it meets (the checker found it fits): REAL's
+        // rounding once here, as LREAL_TO_REAL would at every cycle.
+        match (super::expr::real_literal(e), to) {
+            (Some(v), Elem::Real) => return Ok(Ex::Real(f64::from(v as f32))),
+            (Some(v), Elem::LReal) => return Ok(Ex::Real(v)),
+            _ => {}
+        }
         let from = match self.expr(e, ctx) {
             Type::Elem(f) => f,
             Type::Enum(i) => self.out.enums[i].base,

@@ -2,7 +2,7 @@
 //! loops and their EXIT, CASE labels against the selector, the arguments of functions,
 //! function blocks and the standard functions, and recursion refused.
 
-use super::expr::{literal, Ctx, Meaning};
+use super::expr::{literal, literal_fits, real_literal, untyped_literal, Ctx, Meaning};
 use super::{Checker, Type};
 use crate::ast::{Arg, CaseLabel, Expr, Pou, Section, Stmt};
 use crate::diag::Pos;
@@ -127,14 +127,7 @@ impl Checker {
             return;
         }
         let fits = match (&got, want) {
-            (Type::Elem(g), Type::Elem(w)) => {
-                g.widens_to(*w)
-                    || literal(value).is_some_and(|v| {
-                        w.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v))
-                            || w.class() == Class::Float
-                    })
-                    || (matches!(value, Expr::Real(..)) && w.class() == Class::Float)
-            }
+            (Type::Elem(g), Type::Elem(w)) => g.widens_to(*w) || literal_fits(value, *w),
             (Type::Str(_), Type::Str(_)) => true,
             // ADR of an array goes to a pointer to its elements, as in TwinCAT (`ADR(aRows)`
             // to a POINTER TO LREAL: the first element's address).
@@ -640,7 +633,7 @@ impl Checker {
         let typed: Vec<&Type> = values
             .iter()
             .zip(types)
-            .filter(|(v, _)| literal(v).is_none())
+            .filter(|(v, _)| !untyped_literal(v))
             .map(|(_, t)| t)
             .collect();
         let pool: Vec<&Type> = if typed.is_empty() {
@@ -662,10 +655,12 @@ impl Checker {
             };
         }
         for v in values {
-            if let (Some(value), Type::Elem(e)) = (literal(v), &common) {
-                let fits = e.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&value))
-                    || e.class() == Class::Float;
-                if !fits {
+            if let Type::Elem(e) = &common {
+                if untyped_literal(v) && !literal_fits(v, *e) {
+                    let value = literal(v).map_or_else(
+                        || format!("{:?}", real_literal(v).unwrap_or_default()),
+                        |x| x.to_string(),
+                    );
                     return self.error(v.pos(), format!("{value} does not fit {}", e.name()));
                 }
             }
