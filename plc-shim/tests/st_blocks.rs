@@ -166,3 +166,22 @@ fn t_timeout_ends_an_unanswered_command_after_its_time() {
         "a tTimeout of 0 is refused"
     );
 }
+
+/// A library block's instance takes no initial values for its inputs in its declaration
+/// (a standard block's does: `TON := (PT := T#2S)`): the host takes them from its calls,
+/// so it is refused with its place instead of being silently ignored.
+#[test]
+fn an_initial_value_for_a_library_blocks_input_is_refused_with_its_place() {
+    let text = PROGRAM.replace(
+        "fbRun : MC_MoveVelocity;",
+        "fbRun : MC_MoveVelocity := (Velocity := 20.0);",
+    );
+    let Err(refused) = StProgram::from_texts(&[("main.st".into(), text)], 1) else {
+        panic!("loaded");
+    };
+    assert_eq!(
+        refused,
+        "main.st:4:5: error: an initial value for an input of library block MC_MoveVelocity: \
+         its inputs are given in its calls\n"
+    );
+}

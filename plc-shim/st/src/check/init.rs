@@ -2,6 +2,10 @@
 //! types are: checked against the variable's type (every value assignable, the fields named,
 //! no more values than elements), and lowered to one store per value, run once at load. A
 //! repetition count is a constant; an initialiser gives at most [`MAX_INIT_VALUES`] values.
+//! A function block instance takes the same form for its inputs (`fbDelay : TON := (PT :=
+//! T#2S);`, as TwinCAT and CODESYS write it): they are stored after the block's own initial
+//! values (`vm::init`), so the instance's win. A library block's instance is refused one
+//! (`vm::library`): its host takes its inputs from its calls.
 
 use super::expr::Ctx;
 use super::lower::R;
@@ -77,6 +81,19 @@ impl Checker {
                 }
                 values
             }
+            (Init::Struct(fields), Type::Fb(_) | Type::StdFb(_)) => {
+                let mut values = 0u64;
+                for (name, item) in fields {
+                    if let Some(t) = self.fb_input(ty, name) {
+                        let each = self.check_init_in(item, &t, name.pos, ctx);
+                        values = values.saturating_add(each);
+                    }
+                }
+                if let Type::Fb(i) = ty {
+                    self.fb_inits.push((*i, self.file.clone(), pos));
+                }
+                values
+            }
             (_, Type::Error) => 0,
             (Init::Array(_), _) => {
                 let t = self.type_name(ty);
@@ -115,6 +132,13 @@ impl Checker {
                     }
                 }
             }
+            (Init::Struct(fields), Type::Fb(_) | Type::StdFb(_)) => {
+                for (name, item) in fields {
+                    let (offset, t) = self.member(ty, name, l)?;
+                    let at = super::place::plus(addr.clone(), offset);
+                    self.lower_init_value(at, &t, item, (ctx, l), out)?;
+                }
+            }
             (Init::Struct(fields), Type::Struct(i)) => {
                 for (name, item) in fields {
                     let def = &self.out.structs[*i];
@@ -136,5 +160,35 @@ impl Checker {
             }
         }
         Ok(())
+    }
+
+    /// The type of input `name` of a function block instance of type `ty`, or a refusal
+    /// naming what it is instead.
+    fn fb_input(&mut self, ty: &Type, name: &crate::ast::Name) -> Option<Type> {
+        let block = self.type_name(ty);
+        let found = match ty {
+            Type::StdFb(fb) => fb
+                .member(&name.text)
+                .map(|(_, t, input)| (Type::Elem(t), input)),
+            Type::Fb(i) => (self.out.pous[*i].vars.iter())
+                .find(|v| v.name.eq_ignore_ascii_case(&name.text))
+                .map(|v| (v.ty.clone(), v.section == super::Section::Input)),
+            _ => None,
+        };
+        match found {
+            Some((t, true)) => Some(t),
+            Some(_) => {
+                let why = format!(
+                    "`{}` is no input of {block}: an instance's declaration gives initial values to its inputs",
+                    name.text
+                );
+                self.refuse(name.pos, why);
+                None
+            }
+            None => {
+                self.refuse(name.pos, format!("{block} has no input `{}`", name.text));
+                None
+            }
+        }
     }
 }

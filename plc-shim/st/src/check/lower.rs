@@ -177,7 +177,7 @@ impl Checker {
     }
 
     /// The offset and type of member `field` of a value of `ty`.
-    fn member(&self, ty: &Type, field: &Name, l: &Layout) -> R<(u32, Type)> {
+    pub(super) fn member(&self, ty: &Type, field: &Name, l: &Layout) -> R<(u32, Type)> {
         let same = |a: &str| a.eq_ignore_ascii_case(&field.text);
         match ty {
             Type::Struct(i) => {

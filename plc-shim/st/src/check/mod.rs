@@ -157,6 +157,9 @@ pub struct Compiled {
     pub global_inits: Vec<crate::ir::St>,
     /// The files, by the index statements carry.
     pub files: Vec<String>,
+    /// Every initialiser of a function block instance (`fbDelay : TON := (PT := T#2S)` is
+    /// none: a standard block): the block's POU, and the file and place it is written at.
+    pub fb_inits: Vec<(usize, String, Pos)>,
 }
 
 /// Checks and lowers `files`: the program, or every refusal.
@@ -196,6 +199,7 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
         bodies,
         global_inits,
         files: files.iter().map(|(f, _)| f.clone()).collect(),
+        fb_inits: c.fb_inits,
     })
 }
 
@@ -215,6 +219,8 @@ struct Checker {
     call_graph: Vec<(usize, usize)>,
     /// The named integer constants (array bounds, STRING lengths).
     consts: consts::Consts,
+    /// Initialisers of function block instances: the block's POU, the file and place.
+    fb_inits: Vec<(usize, String, Pos)>,
 }
 
 impl Checker {

@@ -9,9 +9,6 @@ impl Exec<'_> {
     /// Every variable's initial value: the globals' and programs' instances, and every
     /// function block instance inside them.
     pub(super) fn initialise(&mut self) -> Result<(), FaultAt> {
-        let code = self.code;
-        self.block(&code.global_inits, 0)
-            .map_err(|f| self.fault_at(f))?;
         let globals: Vec<(u32, Type)> = (0..self.code.checked.globals.len())
             .map(|i| {
                 (
@@ -20,9 +17,13 @@ impl Exec<'_> {
                 )
             })
             .collect();
+        // The instances' own initial values first, as in a POU (`init_pou`).
         for (at, ty) in globals {
             self.init_instances(&ty, at).map_err(|f| self.fault_at(f))?;
         }
+        let code = self.code;
+        self.block(&code.global_inits, 0)
+            .map_err(|f| self.fault_at(f))?;
         for pou in 0..self.code.checked.pous.len() {
             if self.code.checked.pous[pou].kind == PouKind::Program {
                 let base = self.code.layout.statics[pou];
@@ -32,15 +33,17 @@ impl Exec<'_> {
         Ok(())
     }
 
-    /// POU `pou`'s initial values at `base`, then those of the instances among its variables.
+    /// The initial values of the instances among POU `pou`'s variables at `base`, then the
+    /// POU's own: an instance's initialiser (`fbDelay : TON := (PT := T#2S)`) is among the
+    /// latter and wins over the block's declared initial values.
     fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
-        let code = self.code;
-        self.block(&code.bodies[pou].0, base)?;
         for k in 0..self.code.checked.pous[pou].vars.len() {
             let ty = self.code.checked.pous[pou].vars[k].ty.clone();
             let offset = self.code.layout.pous[pou].2[k];
             self.init_instances(&ty, base + offset)?;
         }
+        let code = self.code;
+        self.block(&code.bodies[pou].0, base)?;
         Ok(())
     }
 

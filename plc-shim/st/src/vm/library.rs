@@ -207,7 +207,21 @@ impl Library {
                 )
                 .in_file(file.map_or("", String::as_str))
             };
+            let initialised = found.and_then(|i| code.fb_inits.iter().find(|f| f.0 == i));
             match found {
+                Some(_) if initialised.is_some() => {
+                    let (_, file, pos) = initialised.cloned().unwrap_or_default();
+                    errors.push(
+                        Diagnostic::new(
+                            pos,
+                            format!(
+                                "an initial value for an input of library block {name}: its \
+                                 inputs are given in its calls"
+                            ),
+                        )
+                        .in_file(&file),
+                    )
+                }
                 Some(i) if c.pous[i].kind != PouKind::FunctionBlock => {
                     errors.push(refuse("is not a FUNCTION_BLOCK"))
                 }

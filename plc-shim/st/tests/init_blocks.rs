@@ -1,0 +1,84 @@
+//! A function block instance's declaration gives initial values to its inputs, as TwinCAT
+//! and CODESYS programs write timers: `fbDelay : TON := (PT := T#20MS);`. Standard blocks,
+//! the program's own blocks (the instance's value wins over the block's declared one),
+//! arrays of instances and global instances; what is no input is refused by name.
+
+mod support;
+
+use support::{refused, run};
+
+const PROGRAM: &str = "FUNCTION_BLOCK FB_Scale
+VAR_INPUT
+    x : LREAL;
+    factor : LREAL := 1.0;
+    offset : LREAL := 5.0;
+END_VAR
+VAR_OUTPUT
+    y : LREAL;
+END_VAR
+    y := x * factor + offset;
+END_FUNCTION_BLOCK
+
+VAR_GLOBAL
+    gDelay : TON := (PT := T#30MS);
+END_VAR
+
+PROGRAM MAIN
+VAR
+    fbDelay : TON := (PT := T#20MS);
+    aDelays : ARRAY[0..1] OF TON := [(PT := T#10MS), (PT := T#40MS)];
+    fbScale : FB_Scale := (factor := 2.0);
+    q, q0, q1, gq : BOOL;
+    y : LREAL;
+    pt, pt1 : TIME;
+END_VAR
+    fbDelay(IN := TRUE);
+    aDelays[0](IN := TRUE);
+    aDelays[1](IN := TRUE);
+    gDelay(IN := TRUE);
+    fbScale(x := 3.0);
+    q := fbDelay.Q;
+    q0 := aDelays[0].Q;
+    q1 := aDelays[1].Q;
+    gq := gDelay.Q;
+    y := fbScale.y;
+    pt := fbDelay.PT;
+    pt1 := aDelays[1].PT;
+END_PROGRAM";
+
+#[test]
+fn an_instances_declaration_sets_its_inputs() {
+    // Cycles at 0, 10 and 20 ms: the timers started at 0.
+    let p = run(PROGRAM, 3);
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("pt"), 20.0);
+    assert_eq!((var("q"), var("q0"), var("q1")), (1.0, 1.0, 0.0));
+    assert_eq!(var("pt1"), 40.0);
+    assert_eq!(var("gq"), 0.0, "30 ms not reached at 20 ms");
+    // factor from the instance (2.0 over the block's 1.0), offset the block's own.
+    assert_eq!(var("y"), 11.0);
+}
+
+#[test]
+fn what_is_no_input_of_the_block_is_refused_by_name() {
+    let with = |decl: &str| PROGRAM.replace("fbDelay : TON := (PT := T#20MS);", decl);
+    assert_eq!(
+        refused(&with("fbDelay : TON := (Q := TRUE);")),
+        "main.st:19:23: error: `Q` is no input of TON: an instance's declaration gives initial \
+         values to its inputs\n"
+    );
+    assert_eq!(
+        refused(&with("fbDelay : TON := (PX := T#1S);")),
+        "main.st:19:23: error: TON has no input `PX`\n"
+    );
+    assert_eq!(
+        refused(&with("fbDelay : TON := (PT := TRUE);")),
+        "main.st:19:29: error: a BOOL where a TIME is wanted\n"
+    );
+    let output = PROGRAM.replace("(factor := 2.0)", "(y := 2.0)");
+    assert_eq!(
+        refused(&output),
+        "main.st:21:28: error: `y` is no input of FB_Scale: an instance's declaration gives \
+         initial values to its inputs\n"
+    );
+}
