@@ -192,6 +192,15 @@ fn refusals_name_line_and_column() {
             "PROGRAM P\nACTION A_Reset:\nEND_ACTION\nEND_PROGRAM",
             "t.st:2:1: error: `ACTION` is not supported",
         ),
+        // A type followed by `(`: a subrange type or FB_init's values.
+        (
+            "TYPE T_Percent : INT(0..100); END_TYPE",
+            "t.st:1:21: error: `INT(..)` is not supported: a subrange type",
+        ),
+        (
+            "PROGRAM P\nVAR fbLog : FB_Logger('main'); END_VAR\nEND_PROGRAM",
+            "t.st:2:22: error: `FB_Logger(..)` is not supported",
+        ),
     ] {
         let e = error(text);
         assert!(

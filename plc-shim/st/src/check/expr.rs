@@ -380,6 +380,16 @@ impl Checker {
         if lt == Type::Error || rt == Type::Error {
             return Type::Error;
         }
+        // TwinCAT's pointer arithmetic, in bytes (`p := p + SIZEOF(INT);`): a pointer moved
+        // is a pointer to the same type, and two pointers to one type are ordered (`WHILE p
+        // < pEnd`); where it points is checked where it is read or written.
+        let count = |t: &Type| matches!(t, Type::Elem(e) if matches!(e.class(), Class::Signed | Class::Unsigned));
+        match (op, &lt, &rt) {
+            (Add | Sub, Type::Pointer(_), n) if count(n) => return lt,
+            (Add, n, Type::Pointer(_)) if count(n) => return rt,
+            (Lt | Gt | Le | Ge, Type::Pointer(a), Type::Pointer(b)) if a == b => return BOOL,
+            _ => {}
+        }
         if let Some((d, _, _)) = scaled_duration(op, &lt, &rt) {
             return Type::Elem(d);
         }

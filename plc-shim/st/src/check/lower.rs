@@ -409,7 +409,7 @@ impl Checker {
             return Ok(Ex::AddrOf(Box::new(addr)));
         }
         if upper == "SIZEOF" {
-            let t = self.expr(positional[0], ctx);
+            let t = self.sizeof_type(positional[0], ctx);
             return Ok(Ex::Int(i64::from(l.size_align(&self.out, &t).0)));
         }
         if let Some(f) = std_fn(&upper) {

@@ -447,6 +447,21 @@ impl Checker {
         Type::Array(dims, Box::new(element))
     }
 
+    /// What SIZEOF measures: a variable's (or any expression's) type, or a type named
+    /// (`SIZEOF(INT)`, `SIZEOF(ST_Cmd)`) where no variable of that name is in reach.
+    fn sizeof_type(&mut self, e: &crate::ast::Expr, ctx: expr::Ctx) -> Type {
+        if let crate::ast::Expr::Name(n) = e {
+            let key = n.text.to_ascii_uppercase();
+            let a_type = Elem::named(&key).is_some()
+                || std_lib::StdFb::named(&key).is_some()
+                || self.names.contains_key(&key);
+            if a_type && self.meaning(&n.text, ctx).is_none() {
+                return self.named_type(n, 0);
+            }
+        }
+        self.expr(e, ctx)
+    }
+
     fn named_type(&mut self, n: &Name, depth: usize) -> Type {
         let key = n.text.to_ascii_uppercase();
         if let Some(e) = Elem::named(&key) {

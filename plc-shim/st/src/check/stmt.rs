@@ -566,7 +566,10 @@ impl Checker {
                 Some(t) => Type::Pointer(Box::new(t)),
                 None => self.error(values[0].pos(), "ADR of a variable, a field or an element"),
             },
-            "SIZEOF" if count(1..=1) => Type::Elem(Elem::UDInt),
+            "SIZEOF" if count(1..=1) => match self.sizeof_type(values[0], ctx) {
+                Type::Error => Type::Error,
+                _ => Type::Elem(Elem::UDInt),
+            },
             "ABS" if count(1..=1) && elem(0).is_some_and(|e| e.is_numeric()) => types[0].clone(),
             "SQRT" | "LN" | "LOG" | "EXP" | "SIN" | "COS" | "TAN" | "ASIN" | "ACOS" | "ATAN"
                 if count(1..=1)

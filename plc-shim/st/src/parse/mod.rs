@@ -416,7 +416,15 @@ impl Parser {
             };
             return Ok(TypeRef::String { len, wide, pos });
         }
-        Ok(TypeRef::Named(self.name()?))
+        let name = self.name()?;
+        if matches!(self.peek(), Tok::LParen) {
+            return Err(self.error(format!(
+                "`{}(..)` is not supported: a subrange type (`INT(0..100)`) or FB_init's \
+                 values; declare the type itself and check the range where it is written",
+                name.text
+            )));
+        }
+        Ok(TypeRef::Named(name))
     }
 
     /// An initial value: an expression, `[..]` for an array, `(a := .., ..)` for a struct.

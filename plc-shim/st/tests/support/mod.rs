@@ -17,7 +17,9 @@ pub fn load(text: &str) -> Program {
 pub fn run(text: &str, cycles: u32) -> Program {
     let mut p = load(text);
     for k in 0..cycles {
-        p.cycle(i64::from(k) * 10_000_000).unwrap();
+        if let Err(f) = p.cycle(i64::from(k) * 10_000_000) {
+            panic!("{}", p.fault_text(&f));
+        }
     }
     p
 }
