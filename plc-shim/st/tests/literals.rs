@@ -2,7 +2,8 @@
 //! the integer's: `r := r / 2.0;`, `r := -2.5;`, `LIMIT(0.0, r, 1.0)` and `r > 0.1` of a
 //! REAL `r` compute in REAL (IEC 61131-3's typing of literals by their context, as TwinCAT
 //! and CODESYS accept them). A typed literal (`LREAL#0.1`) keeps its type; a literal a
-//! REAL cannot hold is refused where it meets one.
+//! REAL cannot hold is refused where it meets one. `NOT` of an untyped integer literal
+//! takes the integer or bit string it meets, NOT in that type's width (`w AND NOT 16#0F`).
 
 mod support;
 
@@ -68,5 +69,29 @@ fn a_literal_a_real_cannot_hold_is_refused_where_it_meets_one() {
     assert_eq!(
         refused(&text("    i := i + 2.5;")),
         "main.st:6:10: error: a LREAL where a INT is wanted\n"
+    );
+}
+
+#[test]
+fn not_of_an_integer_literal_is_taken_in_the_width_it_meets() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    w : WORD := 16#00FF;
+    b : BYTE := NOT 1;
+    d : DINT := 7;
+END_VAR
+    w := w AND NOT 16#0F;
+    d := d AND NOT 1;
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!((var("w"), var("b"), var("d")), (240.0, 254.0, 6.0));
+    assert_eq!(
+        refused(
+            "PROGRAM MAIN\nVAR\n    w : WORD;\nEND_VAR\n    w := w AND NOT 70000;\nEND_PROGRAM"
+        ),
+        "main.st:5:12: error: AND of WORD and DINT\n"
     );
 }

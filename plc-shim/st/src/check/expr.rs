@@ -6,6 +6,7 @@ use super::std_lib;
 use super::{Checker, Type};
 use crate::ast::{Arg, BinOp, Expr, Name, PouKind, Section, UnOp};
 use crate::diag::Pos;
+use crate::ir::Ex;
 use crate::types::{conversion, Class, Elem};
 
 /// Where an expression is checked: the POU and how many loops enclose it.
@@ -69,14 +70,26 @@ pub(super) fn real_literal(e: &Expr) -> Option<f64> {
     }
 }
 
-/// Whether `e` is an untyped literal, integer or real.
+/// The literal of `NOT <untyped integer literal>` (`w AND NOT 16#0F`): it takes the integer
+/// or bit string type it meets, and NOT is taken in that type's width.
+pub(super) fn not_literal(e: &Expr) -> Option<i128> {
+    match e {
+        Expr::Unary(UnOp::Not, inner, _) => literal(inner),
+        _ => None,
+    }
+}
+
+/// Whether `e` is an untyped literal, integer or real (or NOT of an integer).
 pub(super) fn untyped_literal(e: &Expr) -> bool {
-    literal(e).is_some() || real_literal(e).is_some()
+    literal(e).is_some() || real_literal(e).is_some() || not_literal(e).is_some()
 }
 
 /// Whether `e` is an untyped literal type `t` holds: an integer within `t`'s range (or of
 /// a real type), or a real of a real type that holds it (a REAL: finite in 32 bits).
 pub(super) fn literal_fits(e: &Expr, t: Elem) -> bool {
+    if let Some(v) = not_literal(e) {
+        return t.is_integer() && t.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v));
+    }
     if let Some(v) = literal(e) {
         return t.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v))
             || t.class() == Class::Float;
@@ -86,6 +99,26 @@ pub(super) fn literal_fits(e: &Expr, t: Elem) -> bool {
         Elem::Real => (v as f32).is_finite(),
         _ => false,
     })
+}
+
+/// The value of untyped literal `e` in the type `to` it meets (the checker found it fits).
+pub(super) fn literal_value(e: &Expr, to: Elem) -> Option<Ex> {
+    if let Some(v) = literal(e) {
+        return Some(match to.class() {
+            Class::Float => Ex::Real(v as f64),
+            _ => Ex::Int(v as i64),
+        });
+    }
+    // NOT of an integer literal: NOT in the width of the type it meets.
+    if let (Some(v), true) = (not_literal(e), to.is_integer()) {
+        return Some(Ex::Not(Box::new(Ex::Int(v as i64)), to));
+    }
+    // A real: REAL's rounding once here, as LREAL_TO_REAL would at every cycle.
+    match (real_literal(e), to) {
+        (Some(v), Elem::Real) => Some(Ex::Real(f64::from(v as f32))),
+        (Some(v), Elem::LReal) => Some(Ex::Real(v)),
+        _ => None,
+    }
 }
 
 impl Checker {

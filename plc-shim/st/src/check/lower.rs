@@ -208,18 +208,8 @@ impl Checker {
 
     /// The value of `e` as type `to`: converted if it is of another elementary type.
     pub(super) fn value_as(&mut self, e: &Expr, to: Elem, ctx: Ctx, l: &Layout) -> R<Ex> {
-        if let Some(v) = literal(e) {
-            return Ok(match to.class() {
-                Class::Float => Ex::Real(v as f64),
-                _ => Ex::Int(v as i64),
-            });
-        }
-        // A real literal in the real type it meets (the checker found it fits): REAL's
-        // rounding once here, as LREAL_TO_REAL would at every cycle.
-        match (super::expr::real_literal(e), to) {
-            (Some(v), Elem::Real) => return Ok(Ex::Real(f64::from(v as f32))),
-            (Some(v), Elem::LReal) => return Ok(Ex::Real(v)),
-            _ => {}
+        if let Some(v) = super::expr::literal_value(e, to) {
+            return Ok(v);
         }
         let from = match self.expr(e, ctx) {
             Type::Elem(f) => f,
