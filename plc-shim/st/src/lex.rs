@@ -232,6 +232,10 @@ impl Lexer {
         if matches!(upper.as_str(), "T" | "TIME" | "LTIME") {
             return self.duration(pos, upper == "LTIME");
         }
+        if crate::check::is_date_type(&upper) {
+            let why = format!("{} (`{name}#`)", crate::check::DATES_REFUSED);
+            return Err(self.error(pos, &why));
+        }
         Ok(Tok::TypePrefix(name))
     }
 

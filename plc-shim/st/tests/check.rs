@@ -261,3 +261,31 @@ fn references_and_wide_strings_are_refused_by_name() {
         "{e:?}"
     );
 }
+
+/// The calendar types are refused by name (they were `unknown type`; their literals are
+/// refused by the lexer, tests/parse.rs).
+#[test]
+fn dates_and_times_of_day_are_refused_by_name() {
+    let e = refusals("dt : DATE_AND_TIME;\nd : DATE;\ntod : TOD;", "");
+    assert_eq!(e.len(), 3, "{e:?}");
+    for (k, (line, name)) in [(3, "DATE_AND_TIME"), (4, "DATE"), (5, "TOD")]
+        .iter()
+        .enumerate()
+    {
+        let col = if k == 0 {
+            6
+        } else if k == 1 {
+            5
+        } else {
+            7
+        };
+        assert_eq!(
+            e[k],
+            format!(
+                "p.st:{line}:{col}: error: DATE, TIME_OF_DAY and DATE_AND_TIME are not \
+                 supported: the PLC's clock is TIME() or LTIME(), durations are TIME and \
+                 LTIME (`{name}`)"
+            )
+        );
+    }
+}

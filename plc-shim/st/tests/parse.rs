@@ -192,6 +192,11 @@ fn refusals_name_line_and_column() {
             "PROGRAM P\nACTION A_Reset:\nEND_ACTION\nEND_PROGRAM",
             "t.st:2:1: error: `ACTION` is not supported",
         ),
+        // A calendar literal.
+        (
+            "PROGRAM P\nVAR t : TIME; END_VAR\n  t := DT#2026-11-30-12:00:00;\nEND_PROGRAM",
+            "t.st:3:8: error: DATE, TIME_OF_DAY and DATE_AND_TIME are not supported",
+        ),
         // A type followed by `(`: a subrange type or FB_init's values.
         (
             "TYPE T_Percent : INT(0..100); END_TYPE",
