@@ -198,3 +198,53 @@ END_PROGRAM",
     );
     assert_eq!(p.read_var("MAIN.n"), Some(6.0));
 }
+
+/// A function's VAR_OUTPUTs given in its call (`frac => f`, as TwinCAT and CODESYS bind
+/// them): written after the call to places found then, widened to the place's type, a
+/// BOOL's negated with NOT; in a statement of its own as in an expression. What is no
+/// elementary output is refused by name (it was "a function: it has no outputs").
+#[test]
+fn a_functions_outputs_reach_the_places_its_call_names() {
+    let text = "
+FUNCTION F_Split : BOOL
+VAR_INPUT v : LREAL; END_VAR
+VAR_OUTPUT whole : DINT; frac : LREAL; negative : BOOL; END_VAR
+    whole := LREAL_TO_DINT(TRUNC(v));
+    frac := v - DINT_TO_LREAL(whole);
+    negative := v < 0.0;
+    F_Split := TRUE;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    ok, positive : BOOL;
+    w : DINT;
+    wide : LINT;
+    f : LREAL;
+    a : ARRAY[0..1] OF DINT;
+    k : INT := 1;
+    a1 : DINT;
+END_VAR
+    ok := F_Split(2.75, whole => w, frac => f);
+    F_Split(v := -3.5, whole => wide, NOT negative => positive);
+    F_Split(10.5, whole => a[k]);
+    a1 := a[1];
+END_PROGRAM";
+    let p = run(text, 1);
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!((var("ok"), var("w"), var("f")), (1.0, 2.0, 0.75));
+    assert_eq!((var("wide"), var("positive")), (-3.0, 0.0));
+    assert_eq!(var("a1"), 10.0);
+    let refusal = |call: &str| refused(&text.replace("F_Split(10.5, whole => a[k]);", call));
+    assert_eq!(
+        refusal("F_Split(1.0, rest => w);"),
+        "main.st:22:18: error: F_Split has no output `rest`\n"
+    );
+    assert_eq!(
+        refusal("F_Split(1.0, v => w);"),
+        "main.st:22:18: error: F_Split has no output `v`\n"
+    );
+    assert_eq!(
+        refusal("F_Split(1.0, frac => w);"),
+        "main.st:22:26: error: a LREAL output into a DINT\n"
+    );
+}

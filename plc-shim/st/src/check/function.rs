@@ -8,7 +8,7 @@ use super::place::plus;
 use super::{Checker, Type};
 use crate::ast::{Arg, Expr, Section};
 use crate::diag::Pos;
-use crate::ir::{Addr, Ex, FnCall};
+use crate::ir::{Addr, Ex, FnCall, FnOutput};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -105,11 +105,17 @@ impl Checker {
     ) -> R<FnCall> {
         let params = self.parameters(i);
         let (mut stores, mut texts, mut back) = (Vec::new(), Vec::new(), Vec::new());
+        let mut outputs = Vec::new();
         for (k, arg) in args.iter().enumerate() {
             let value = match arg {
                 Arg::Positional(v) | Arg::Input(_, v) => v,
-                Arg::Output { name, .. } => {
-                    return Err(self.unsupported(name.pos, "an output of a function"))
+                Arg::Output {
+                    name,
+                    target,
+                    negated,
+                } => {
+                    outputs.push(self.function_output(i, (name, target, *negated), ctx, l)?);
+                    continue;
                 }
             };
             let Some(var) = self.parameter_of(i, &params, arg, k).map(|p| params[p]) else {
@@ -147,6 +153,40 @@ impl Checker {
             texts,
             value: Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0)),
             back,
+            outputs,
+        })
+    }
+
+    /// Output `name => target` of function `i` (checked: an elementary output into a place
+    /// it widens to).
+    fn function_output(
+        &mut self,
+        i: usize,
+        (name, target, negated): (&crate::ast::Name, &Expr, bool),
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<FnOutput> {
+        let var = (self.out.pous[i].vars.iter())
+            .position(|v| v.name.eq_ignore_ascii_case(&name.text) && v.section == Section::Output);
+        let (Some(var), Type::Elem(to_ty)) = (var, self.expr(target, ctx)) else {
+            return Err(self.unsupported(name.pos, "this output"));
+        };
+        let Type::Elem(ty) = self.out.pous[i].vars[var].ty else {
+            return Err(self.unsupported(name.pos, "this output"));
+        };
+        let (to, _) = self.place(target, ctx, l)?;
+        if crate::vm::callees::addr_calls(&to) {
+            return Err(self.unsupported(
+                target.pos(),
+                "an output's variable at an index a function computes",
+            ));
+        }
+        Ok(FnOutput {
+            offset: l.pous[i].2[var],
+            ty,
+            to,
+            to_ty,
+            negated,
         })
     }
 }

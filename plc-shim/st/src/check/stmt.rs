@@ -4,7 +4,7 @@
 
 use super::expr::{literal, literal_fits, real_literal, untyped_literal, Ctx, Meaning};
 use super::{Checker, Type};
-use crate::ast::{Arg, CaseLabel, Expr, Pou, Section, Stmt};
+use crate::ast::{Arg, CaseLabel, Expr, Name, Pou, Section, Stmt};
 use crate::diag::Pos;
 use crate::types::{Class, Elem};
 
@@ -392,20 +392,8 @@ impl Checker {
                     negated,
                 } => match find(&name.text) {
                     Some((_, t, Section::Output)) => {
-                        if *negated && *t != BOOL {
-                            self.refuse(name.pos, "NOT of an output that is not BOOL");
-                        }
-                        if let Some(want) = self.writable(target, ctx) {
-                            let widens = match (t, &want) {
-                                (Type::Elem(a), Type::Elem(b)) => a.widens_to(*b),
-                                (Type::Str(m), Type::Str(k)) => k >= m,
-                                _ => false,
-                            };
-                            if want != *t && !widens {
-                                let (g, w) = (self.type_name(t), self.type_name(&want));
-                                self.refuse(target.pos(), format!("a {g} output into a {w}"));
-                            }
-                        }
+                        let t = t.clone();
+                        self.output_binding(&t, (name, target, *negated), ctx);
                     }
                     Some(_) => self.refuse(
                         name.pos,
@@ -462,8 +450,27 @@ impl Checker {
                     }
                     (v, n.pos)
                 }
-                Arg::Output { name: n, .. } => {
-                    self.refuse(n.pos, format!("{name} is a function: it has no outputs"));
+                Arg::Output {
+                    name: n,
+                    target,
+                    negated,
+                } => {
+                    let var = (self.out.pous[i].vars.iter())
+                        .find(|v| v.name.eq_ignore_ascii_case(&n.text))
+                        .map(|v| (v.ty.clone(), v.section));
+                    match var {
+                        Some((t @ Type::Elem(_), Section::Output)) => {
+                            self.output_binding(&t, (n, target, *negated), ctx)
+                        }
+                        Some((_, Section::Output)) => self.refuse(
+                            n.pos,
+                            format!(
+                                "{name}: an output that is no elementary value (`{}`)",
+                                n.text
+                            ),
+                        ),
+                        _ => self.refuse(n.pos, format!("{name} has no output `{}`", n.text)),
+                    }
                     continue;
                 }
             };
@@ -485,6 +492,30 @@ impl Checker {
             }
         }
         self.out.pous[i].returns.clone().unwrap_or(Type::Error)
+    }
+
+    /// `name => target` of an output of type `t`: a place its value widens to (NOT of a BOOL
+    /// output only).
+    fn output_binding(
+        &mut self,
+        t: &Type,
+        (name, target, negated): (&Name, &Expr, bool),
+        ctx: Ctx,
+    ) {
+        if negated && *t != BOOL {
+            self.refuse(name.pos, "NOT of an output that is not BOOL");
+        }
+        if let Some(want) = self.writable(target, ctx) {
+            let widens = match (t, &want) {
+                (Type::Elem(a), Type::Elem(b)) => a.widens_to(*b),
+                (Type::Str(m), Type::Str(k)) => k >= m,
+                _ => false,
+            };
+            if want != *t && !widens {
+                let (g, w) = (self.type_name(t), self.type_name(&want));
+                self.refuse(target.pos(), format!("a {g} output into a {w}"));
+            }
+        }
     }
 
     /// A function's parameter of type `t`: a value for an input, a variable of its own type

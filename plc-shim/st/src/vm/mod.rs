@@ -752,10 +752,18 @@ impl<'a> Exec<'a> {
         }
         self.run_body(pou, frame)?;
         self.set_place(statement);
-        // The VAR_IN_OUTs back into the caller's variables, leaf by leaf.
+        // The VAR_IN_OUTs back into the caller's variables, leaf by leaf, then the outputs.
         for (&at, (offset, t, _)) in places.iter().zip(back.iter()) {
             let v = self.read_own((frame + offset) as usize, *t)?;
             self.write(at, *t, v)?;
+        }
+        for o in &c.outputs {
+            let mut v = self.read_own((frame + o.offset) as usize, o.ty)?;
+            if o.negated {
+                v = V::I(i64::from(v.int() == 0));
+            }
+            let at = self.addr(&o.to, base)?;
+            self.write(at, o.to_ty, v)?;
         }
         Ok(())
     }
