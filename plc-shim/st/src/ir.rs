@@ -189,8 +189,8 @@ pub const MAX_STD_VALUES: usize = 16;
 pub type BlockInput = (u32, Elem, Ex);
 
 /// An output of a block's call: its offset in the instance, its type, where it goes, whether
-/// negated.
-pub type BlockOutput = (u32, Elem, Addr, bool);
+/// negated, and the type there (the output's, or one it widens to: converted).
+pub type BlockOutput = (u32, Elem, Addr, bool, Elem);
 
 /// A CASE arm: the ranges of values it takes (a single value is a range of one) and its
 /// statements.

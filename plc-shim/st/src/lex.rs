@@ -232,7 +232,9 @@ impl Lexer {
         if matches!(upper.as_str(), "T" | "TIME" | "LTIME") {
             return self.duration(pos, upper == "LTIME");
         }
-        if crate::check::is_date_type(&upper) {
+        // A calendar literal (digits follow: `DT#2026-11-30-12:00:00`); `D#On` of an
+        // enumeration named D stays a typed literal.
+        if crate::check::is_date_type(&upper) && self.peek(0).is_some_and(|c| c.is_ascii_digit()) {
             let why = format!("{} (`{name}#`)", crate::check::DATES_REFUSED);
             return Err(self.error(pos, &why));
         }

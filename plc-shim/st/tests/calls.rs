@@ -248,3 +248,40 @@ END_PROGRAM";
         "main.st:22:26: error: a LREAL output into a DINT\n"
     );
 }
+
+/// An output given to a variable of a type it widens to is converted on the way: an INT's
+/// -1 into a DINT stays -1 (it was written as two bytes: 65535), a TIME into an LTIME
+/// counts nanoseconds, a REAL into an LREAL keeps its value; for a function block's output
+/// (the operations' way) and a function's (the tree's).
+#[test]
+fn an_output_into_a_wider_type_is_converted() {
+    let p = run(
+        "FUNCTION_BLOCK FB_Out
+VAR_OUTPUT n : INT; t : TIME; r : REAL; END_VAR
+    n := -1;
+    t := T#1S;
+    r := 1.5;
+END_FUNCTION_BLOCK
+FUNCTION F_Out : BOOL
+VAR_OUTPUT t : TIME; n : INT; END_VAR
+    t := T#2S;
+    n := -2;
+    F_Out := TRUE;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    fb : FB_Out;
+    d, d2 : DINT;
+    lt, lt2 : LTIME;
+    lr : LREAL;
+    ok : BOOL;
+END_VAR
+    fb(n => d, t => lt, r => lr);
+    ok := F_Out(t => lt2, n => d2);
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!((var("d"), var("lr"), var("d2")), (-1.0, 1.5, -2.0));
+    assert_eq!((var("lt"), var("lt2")), (1e9, 2e9));
+}

@@ -289,3 +289,11 @@ fn dates_and_times_of_day_are_refused_by_name() {
         );
     }
 }
+
+/// `D#On` of an enumeration named D is its typed literal: only a calendar literal (digits
+/// after `D#`, `DT#`, ...) is refused.
+#[test]
+fn an_enumeration_named_like_a_calendar_prefix_keeps_its_typed_literals() {
+    let text = "TYPE D : (Off, On); END_TYPE\nPROGRAM P\nVAR x : D; END_VAR\n    x := D#On;\nEND_PROGRAM\n";
+    assert!(checked(&[("p.st", text)]).is_ok());
+}

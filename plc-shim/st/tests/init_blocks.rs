@@ -82,3 +82,37 @@ fn what_is_no_input_of_the_block_is_refused_by_name() {
          initial values to its inputs\n"
     );
 }
+
+/// A block's own initial value that reads a global (a CONSTANT) sees it set: the globals'
+/// own initial values run before the instances', only the instances' initialisers after.
+#[test]
+fn a_blocks_own_initial_value_reads_the_globals_set_before_it() {
+    let p = run(
+        "VAR_GLOBAL CONSTANT
+    cLim : INT := 10;
+END_VAR
+VAR_GLOBAL
+    gAx : FB_A;
+    gAy : FB_A := (scale := 3);
+END_VAR
+FUNCTION_BLOCK FB_A
+VAR_INPUT
+    scale : INT := 2;
+END_VAR
+VAR_OUTPUT
+    lim : INT := cLim;
+END_VAR
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    x, y, s : INT;
+END_VAR
+    x := gAx.lim;
+    y := gAy.lim;
+    s := gAy.scale;
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!((var("x"), var("y"), var("s")), (10.0, 10.0, 3.0));
+}

@@ -95,3 +95,28 @@ END_PROGRAM",
         "main.st:5:12: error: AND of WORD and DINT\n"
     );
 }
+
+/// An untyped real beside integers only keeps its LREAL (`MAX(i, 2.5)` of an INT `i`), and
+/// a conversion still takes any integer literal (`TIME_TO_DINT(5)`, as before real literals
+/// took their context's type); what does not fit a REAL is named as written.
+#[test]
+fn a_real_literal_beside_integers_stays_an_lreal() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    i : INT := 1;
+    lr : LREAL;
+    d : DINT;
+END_VAR
+    lr := MAX(i, 2.5);
+    d := TIME_TO_DINT(5);
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!((var("lr"), var("d")), (2.5, 5.0));
+    assert_eq!(
+        refused("PROGRAM MAIN\nVAR\n    r : REAL;\nEND_VAR\n    r := MAX(r, NOT 5);\nEND_PROGRAM"),
+        "main.st:5:17: error: NOT 5 does not fit REAL\n"
+    );
+}

@@ -86,7 +86,8 @@ fn pointers_to_other_types_or_by_a_real_are_refused() {
 #[test]
 fn sizeof_measures_a_type_named_or_a_variable() {
     let p = run(
-        "TYPE ST_Pair :
+        "TYPE E_Mode : (Auto, Manual) DINT; END_TYPE
+TYPE ST_Pair :
 STRUCT
     a : LREAL;
     b : INT;
@@ -96,13 +97,14 @@ PROGRAM MAIN
 VAR
     pair : ST_Pair;
     n : INT;
-    sInt, sLreal, sPair, sVar, sField : UDINT;
+    sInt, sLreal, sPair, sVar, sField, sEnum : UDINT;
 END_VAR
     sInt := SIZEOF(INT);
     sLreal := SIZEOF(LREAL);
     sPair := SIZEOF(ST_Pair);
     sVar := SIZEOF(pair);
     sField := SIZEOF(pair.b);
+    sEnum := SIZEOF(E_Mode);
 END_PROGRAM",
         1,
     );

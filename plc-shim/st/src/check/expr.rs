@@ -538,7 +538,12 @@ impl Checker {
                 return self.error(pos, format!("{} takes one value", n.text));
             };
             return match self.expr(a, ctx) {
-                Type::Elem(e) if e == from || e.widens_to(from) || literal_fits(a, from) => {
+                Type::Elem(e)
+                    if e == from
+                        || e.widens_to(from)
+                        || literal(a).is_some()
+                        || literal_fits(a, from) =>
+                {
                     Type::Elem(to)
                 }
                 Type::Error => Type::Error,

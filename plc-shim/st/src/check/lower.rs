@@ -15,6 +15,9 @@ use crate::vm::callees::addr_calls;
 
 pub(super) type R<T> = Result<T, Diagnostic>;
 
+/// A POU's initial values, and where those of its variables holding instances begin.
+type Inits = (Vec<St>, usize);
+
 impl Checker {
     pub(super) fn unsupported(&self, pos: Pos, what: &str) -> Diagnostic {
         Diagnostic::new(pos, format!("{what} is not supported by the runtime yet"))
@@ -28,7 +31,7 @@ impl Checker {
         p: &Pou,
         file: u16,
         layout: &Layout,
-    ) -> R<(usize, Vec<St>, Vec<St>)> {
+    ) -> R<(usize, Inits, Vec<St>)> {
         let Some(super::Named::Pou(pou)) =
             self.names.get(&p.name.text.to_ascii_uppercase()).cloned()
         else {
@@ -37,10 +40,16 @@ impl Checker {
             );
         };
         let ctx = Ctx { pou, loops: 0 };
-        let mut inits = Vec::new();
-        self.lower_inits(p, ctx, file, layout, &mut inits)?;
+        let (mut inits, mut late) = (Vec::new(), Vec::new());
+        for block in &p.vars {
+            for d in &block.vars {
+                self.lower_init(d, ctx, file, layout, (&mut inits, &mut late))?;
+            }
+        }
         let body = self.lower_block(&p.body, ctx, file, layout)?;
-        Ok((pou, inits, body))
+        let split = inits.len();
+        inits.extend(late);
+        Ok((pou, (inits, split), body))
     }
 
     /// The global variables' initial values, as stores in declaration order (the runtime
@@ -50,44 +59,29 @@ impl Checker {
         unit: &crate::ast::Unit,
         file: u16,
         l: &Layout,
-    ) -> R<Vec<St>> {
-        let mut out = Vec::new();
+    ) -> R<(Vec<St>, Vec<St>)> {
+        let (mut out, mut late) = (Vec::new(), Vec::new());
         for item in &unit.items {
             let crate::ast::Item::Globals(block) = item else {
                 continue;
             };
             for d in &block.vars {
-                self.lower_init(d, super::expr::GLOBAL, file, l, &mut out)?;
+                self.lower_init(d, super::expr::GLOBAL, file, l, (&mut out, &mut late))?;
             }
         }
-        Ok(out)
+        Ok((out, late))
     }
 
-    /// Initial values of elementary variables, as stores (the runtime runs them once).
-    fn lower_inits(
-        &mut self,
-        p: &Pou,
-        ctx: Ctx,
-        file: u16,
-        l: &Layout,
-        out: &mut Vec<St>,
-    ) -> R<()> {
-        for block in &p.vars {
-            for d in &block.vars {
-                self.lower_init(d, ctx, file, l, out)?;
-            }
-        }
-        Ok(())
-    }
-
-    /// The initial value of declaration `d`, as a store per name.
+    /// The initial value of declaration `d`, as a store per name: into `early`, or into
+    /// `late` for a variable holding function block instances (their initialisers run after
+    /// the instances' own initial values, `vm::init`).
     fn lower_init(
         &mut self,
         d: &crate::ast::VarDecl,
         ctx: Ctx,
         file: u16,
         l: &Layout,
-        out: &mut Vec<St>,
+        (early, late): (&mut Vec<St>, &mut Vec<St>),
     ) -> R<()> {
         let Some(init) = &d.init else {
             return Ok(());
@@ -97,6 +91,11 @@ impl Checker {
             let mut kinds = Vec::new();
             self.lower_init_value(addr, &ty, init, (ctx, l), &mut kinds)
                 .map_err(|e| e.in_file(&self.file))?;
+            let out = if self.holds_instances(&ty) {
+                &mut *late
+            } else {
+                &mut *early
+            };
             out.extend(kinds.into_iter().map(|kind| St {
                 kind,
                 at: (file, n.pos),
@@ -655,7 +654,7 @@ impl Checker {
                 // VAR_IN_OUT: copied in before the call and back after it, leaf by leaf.
                 for (at, t, leaf) in self.in_out_leaves(v, &member, ctx, l)? {
                     inputs.push((offset + at, t, Ex::Load(Box::new(leaf.clone()), t)));
-                    outputs.push((offset + at, t, leaf, false));
+                    outputs.push((offset + at, t, leaf, false, t));
                 }
                 continue;
             }
@@ -699,7 +698,7 @@ impl Checker {
                     )
                 })?;
                 for (at, t) in leaves {
-                    outputs.push((offset + at, t, plus(to.clone(), at), false));
+                    outputs.push((offset + at, t, plus(to.clone(), at), false, t));
                 }
                 continue;
             }
@@ -717,8 +716,9 @@ impl Checker {
                 Arg::Output {
                     target, negated, ..
                 } => {
-                    let (to, _) = self.place(target, ctx, l)?;
-                    outputs.push((offset, t, to, *negated));
+                    let (to, there) = self.place(target, ctx, l)?;
+                    let there = if let Type::Elem(e) = there { e } else { t };
+                    outputs.push((offset, t, to, *negated, there));
                 }
                 Arg::Positional(_) => {}
             }

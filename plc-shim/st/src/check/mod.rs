@@ -153,8 +153,14 @@ pub struct Compiled {
     pub layout: crate::layout::Layout,
     /// Per POU: the stores of its variables' initial values, and its statements.
     pub bodies: Vec<(Vec<crate::ir::St>, Vec<crate::ir::St>)>,
+    /// Per POU: where among its initial values those of its variables holding function
+    /// block instances begin (`fbDelay : TON := (PT := T#2S)`): they run after the
+    /// instances' own initial values, the others before (`vm::init`).
+    pub late_inits: Vec<usize>,
     /// The global variables' initial values, run once before the programs'.
     pub global_inits: Vec<crate::ir::St>,
+    /// Where among them those of the globals holding instances begin (as `late_inits`).
+    pub global_late_from: usize,
     /// The files, by the index statements carry.
     pub files: Vec<String>,
     /// Every initialiser of a function block instance (`fbDelay : TON := (PT := T#2S)` is
@@ -171,11 +177,15 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
         vec![Diagnostic::new(Pos { line: 1, col: 1 }, e).in_file(file)]
     })?;
     let mut bodies = vec![(Vec::new(), Vec::new()); c.out.pous.len()];
-    let (mut errors, mut global_inits) = (Vec::new(), Vec::new());
+    let mut late_inits = vec![0; c.out.pous.len()];
+    let (mut errors, mut global_inits, mut global_late) = (Vec::new(), Vec::new(), Vec::new());
     for (f, (file, unit)) in files.iter().enumerate() {
         c.file = file.clone();
         match c.lower_global_inits(unit, f as u16, &layout) {
-            Ok(inits) => global_inits.extend(inits),
+            Ok((inits, late)) => {
+                global_inits.extend(inits);
+                global_late.extend(late);
+            }
             Err(e) => errors.push(e),
         }
         for item in &unit.items {
@@ -185,7 +195,10 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
             let lowered = c.lower_pou(p, f as u16, &layout);
             c.consts.scope = None;
             match lowered {
-                Ok((i, inits, body)) => bodies[i] = (inits, body),
+                Ok((i, (inits, late), body)) => {
+                    bodies[i] = (inits, body);
+                    late_inits[i] = late;
+                }
                 Err(e) => errors.push(e),
             }
         }
@@ -193,11 +206,15 @@ pub fn compile(files: &[(String, Unit)]) -> Result<Compiled, Vec<Diagnostic>> {
     if !errors.is_empty() {
         return Err(errors);
     }
+    let global_late_from = global_inits.len();
+    global_inits.extend(global_late);
     Ok(Compiled {
         checked: c.out,
         layout,
         bodies,
+        late_inits,
         global_inits,
+        global_late_from,
         files: files.iter().map(|(f, _)| f.clone()).collect(),
         fb_inits: c.fb_inits,
     })
@@ -455,11 +472,28 @@ impl Checker {
             let a_type = Elem::named(&key).is_some()
                 || std_lib::StdFb::named(&key).is_some()
                 || self.names.contains_key(&key);
-            if a_type && self.meaning(&n.text, ctx).is_none() {
+            let no_variable = matches!(
+                self.meaning(&n.text, ctx),
+                None | Some(expr::Meaning::EnumType(_))
+            );
+            if a_type && no_variable {
                 return self.named_type(n, 0);
             }
         }
         self.expr(e, ctx)
+    }
+
+    /// Whether a variable of type `ty` holds function block instances (an instance, an
+    /// array or structure of them): its initialiser runs after their own initial values.
+    fn holds_instances(&self, ty: &Type) -> bool {
+        match ty {
+            Type::Fb(_) | Type::StdFb(_) => true,
+            Type::Array(_, element) => self.holds_instances(element),
+            Type::Struct(i) => {
+                (self.out.structs[*i].fields.iter()).any(|(_, t)| self.holds_instances(t))
+            }
+            _ => false,
+        }
     }
 
     fn named_type(&mut self, n: &Name, depth: usize) -> Type {

@@ -332,7 +332,7 @@ impl Checker {
         }
         Ok(string_chunks(m)
             .into_iter()
-            .map(|(at, t)| (offset + at, t, plus(to.clone(), at), false))
+            .map(|(at, t)| (offset + at, t, plus(to.clone(), at), false, t))
             .collect())
     }
 }

@@ -2,7 +2,9 @@
 //! loops and their EXIT, CASE labels against the selector, the arguments of functions,
 //! function blocks and the standard functions, and recursion refused.
 
-use super::expr::{literal, literal_fits, real_literal, untyped_literal, Ctx, Meaning};
+use super::expr::{
+    literal, literal_fits, not_literal, real_literal, untyped_literal, Ctx, Meaning,
+};
 use super::{Checker, Type};
 use crate::ast::{Arg, CaseLabel, Expr, Name, Pou, Section, Stmt};
 use crate::diag::Pos;
@@ -676,7 +678,12 @@ impl Checker {
             typed
         };
         let mut common = pool[0].clone();
-        for t in &pool[1..] {
+        // An untyped real beside integers only keeps its own LREAL (`MAX(i, 2.5)`), as
+        // before real literals took the real type they meet.
+        let lreal = Type::Elem(Elem::LReal);
+        let reals = values.iter().any(|v| real_literal(v).is_some());
+        let extra = (reals && !pool.iter().any(|t| is_float(t))).then_some(&lreal);
+        for t in pool[1..].iter().copied().chain(extra) {
             common = match (&common, t) {
                 (Type::Elem(a), Type::Elem(b)) => match Elem::common(*a, *b) {
                     Some(c) => Type::Elem(c),
@@ -684,23 +691,29 @@ impl Checker {
                         return self.error(pos, format!("values of {} and {}", a.name(), b.name()))
                     }
                 },
-                (a, b) if a == *b => common,
+                (a, b) if a == b => common,
                 _ => return self.error(pos, "values of different types"),
             };
         }
         for v in values {
             if let Type::Elem(e) = &common {
                 if untyped_literal(v) && !literal_fits(v, *e) {
-                    let value = literal(v).map_or_else(
-                        || format!("{:?}", real_literal(v).unwrap_or_default()),
-                        |x| x.to_string(),
-                    );
+                    let value = match (literal(v), not_literal(v)) {
+                        (Some(x), _) => x.to_string(),
+                        (_, Some(x)) => format!("NOT {x}"),
+                        _ => format!("{:?}", real_literal(v).unwrap_or_default()),
+                    };
                     return self.error(v.pos(), format!("{value} does not fit {}", e.name()));
                 }
             }
         }
         common
     }
+}
+
+/// Whether `t` is REAL or LREAL.
+fn is_float(t: &Type) -> bool {
+    matches!(t, Type::Elem(e) if e.class() == Class::Float)
 }
 
 /// Whether field `field` of the image's structure `name` is written by the CNC or the drives.

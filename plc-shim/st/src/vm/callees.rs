@@ -77,7 +77,7 @@ fn own_parts(s: &St, out: &mut Vec<usize>) {
 fn of_call(a: &Addr, inputs: &[BlockInput], outputs: &[BlockOutput], out: &mut Vec<usize>) {
     of_addr(a, out);
     inputs.iter().for_each(|(_, _, e)| of_ex(e, out));
-    outputs.iter().for_each(|(_, _, a, _)| of_addr(a, out));
+    outputs.iter().for_each(|(_, _, a, _, _)| of_addr(a, out));
 }
 
 /// Whether finding place `a` calls a user function (an index computed by one).

@@ -136,8 +136,9 @@ pub(crate) enum Op {
     Body(u32, R, u32),
     /// Runs a standard block on the instance, with call site `k`'s inputs passed.
     StdBody(StdFb, R, u32),
-    /// Reads an output: instance, offset, type, negated, where it goes.
-    Output(R, u32, Elem, bool, Dst),
+    /// Reads an output: instance, offset, its type and the type where it goes (converted
+    /// when it widens), negated, where it goes.
+    Output(R, u32, (Elem, Elem), bool, Dst),
     /// Stores a constant's bytes into the program's memory at an offset (from the
     /// instance's base when relative): [`Op::Store`] of a constant, specialized
     /// ([`super::fast`]).

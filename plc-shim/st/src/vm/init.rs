@@ -17,13 +17,15 @@ impl Exec<'_> {
                 )
             })
             .collect();
-        // The instances' own initial values first, as in a POU (`init_pou`).
+        // The globals' initial values, the instances' own, then the instances'
+        // initialisers (as in a POU, `init_pou`).
+        let code = self.code;
+        let (early, late) = split(&code.global_inits, code.global_late_from);
+        self.block(early, 0).map_err(|f| self.fault_at(f))?;
         for (at, ty) in globals {
             self.init_instances(&ty, at).map_err(|f| self.fault_at(f))?;
         }
-        let code = self.code;
-        self.block(&code.global_inits, 0)
-            .map_err(|f| self.fault_at(f))?;
+        self.block(late, 0).map_err(|f| self.fault_at(f))?;
         for pou in 0..self.code.checked.pous.len() {
             if self.code.checked.pous[pou].kind == PouKind::Program {
                 let base = self.code.layout.statics[pou];
@@ -33,17 +35,20 @@ impl Exec<'_> {
         Ok(())
     }
 
-    /// The initial values of the instances among POU `pou`'s variables at `base`, then the
-    /// POU's own: an instance's initialiser (`fbDelay : TON := (PT := T#2S)`) is among the
-    /// latter and wins over the block's declared initial values.
+    /// POU `pou`'s initial values at `base`, then those of the instances among its
+    /// variables, then the instances' initialisers (`fbDelay : TON := (PT := T#2S)`): they
+    /// win over the blocks' declared initial values.
     fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
+        let code = self.code;
+        let late_from = code.late_inits.get(pou).copied().unwrap_or(usize::MAX);
+        let (early, late) = split(&code.bodies[pou].0, late_from);
+        self.block(early, base)?;
         for k in 0..self.code.checked.pous[pou].vars.len() {
             let ty = self.code.checked.pous[pou].vars[k].ty.clone();
             let offset = self.code.layout.pous[pou].2[k];
             self.init_instances(&ty, base + offset)?;
         }
-        let code = self.code;
-        self.block(&code.bodies[pou].0, base)?;
+        self.block(late, base)?;
         Ok(())
     }
 
@@ -72,4 +77,9 @@ impl Exec<'_> {
             _ => Ok(()),
         }
     }
+}
+
+/// `inits` before and from `at` (all before when `at` lies beyond them).
+fn split(inits: &[crate::ir::St], at: usize) -> (&[crate::ir::St], &[crate::ir::St]) {
+    inits.split_at(at.min(inits.len()))
 }

@@ -537,13 +537,11 @@ impl<'a> Exec<'a> {
     }
 
     fn read_outputs(&mut self, outputs: &[BlockOutput], at: u32, base: u32) -> Run<()> {
-        for (offset, t, target, negated) in outputs {
-            let mut v = self.read_own((at + offset) as usize, *t)?;
-            if *negated {
-                v = V::I(i64::from(v.int() == 0));
-            }
+        for (offset, t, target, negated, there) in outputs {
+            let v = self.read_own((at + offset) as usize, *t)?;
+            let v = ops::output(v, *negated, *t, *there)?;
             let to = self.addr(target, base)?;
-            self.write(to, *t, v)?;
+            self.write(to, *there, v)?;
         }
         Ok(())
     }
@@ -758,10 +756,8 @@ impl<'a> Exec<'a> {
             self.write(at, *t, v)?;
         }
         for o in &c.outputs {
-            let mut v = self.read_own((frame + o.offset) as usize, o.ty)?;
-            if o.negated {
-                v = V::I(i64::from(v.int() == 0));
-            }
+            let v = self.read_own((frame + o.offset) as usize, o.ty)?;
+            let v = ops::output(v, o.negated, o.ty, o.to_ty)?;
             let at = self.addr(&o.to, base)?;
             self.write(at, o.to_ty, v)?;
         }

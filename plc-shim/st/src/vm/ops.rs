@@ -32,6 +32,23 @@ fn is_float(t: Elem) -> bool {
     t.class() == Class::Float
 }
 
+/// An output's value `v` of type `t` as the place of type `there` takes it: negated (a
+/// BOOL's `NOT out =>`), converted when the place's type is one `t` widens to (TIME to LTIME
+/// counts nanoseconds, an integer to a real its value).
+#[inline]
+pub(crate) fn output(v: V, negated: bool, t: Elem, there: Elem) -> Run<V> {
+    let v = if negated {
+        V::I(i64::from(v.int() == 0))
+    } else {
+        v
+    };
+    if t == there {
+        Ok(v)
+    } else {
+        convert(v, t, there)
+    }
+}
+
 pub(crate) fn neg(v: V, t: Elem) -> V {
     if is_float(t) {
         V::F(-v.float())

@@ -209,13 +209,11 @@ impl<'a> Exec<'a> {
                     let at = self.instance(inst, w);
                     self.run_std_fb(fb, at as usize)?;
                 }
-                Op::Output(inst, offset, t, negated, to) => {
+                Op::Output(inst, offset, (t, there), negated, to) => {
                     let at = self.instance(inst, w) + offset;
-                    let mut v = self.read_own(at as usize, t)?;
-                    if negated {
-                        v = V::I(i64::from(v.int() == 0));
-                    }
-                    self.store(to, t, v, base, w)?;
+                    let v = self.read_own(at as usize, t)?;
+                    let v = ops::output(v, negated, t, there)?;
+                    self.store(to, there, v, base, w)?;
                 }
                 Op::SetOwn(at, relative, bytes) => {
                     let at = if relative { base + at } else { at };

@@ -88,10 +88,11 @@ impl Builder<'_> {
             Err(fb) => Op::StdBody(fb, inst, call),
         });
         self.ops.push(Op::At(site));
-        for (offset, t, target, negated) in outputs {
+        for (offset, t, target, negated, there) in outputs {
             let mark = self.next;
             let to = self.dst(target);
-            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
+            self.ops
+                .push(Op::Output(inst, *offset, (*t, *there), *negated, to));
             self.next = mark;
         }
     }
@@ -129,10 +130,11 @@ impl Builder<'_> {
         }
         let inst = self.reg();
         self.ops.push(Op::Inst(inst, at, relative, 0));
-        for (offset, t, target, negated) in outputs {
+        for (offset, t, target, negated, there) in outputs {
             let mark = self.next;
             let to = self.dst(target);
-            self.ops.push(Op::Output(inst, *offset, *t, *negated, to));
+            self.ops
+                .push(Op::Output(inst, *offset, (*t, *there), *negated, to));
             self.next = mark;
         }
     }
