@@ -116,3 +116,46 @@ END_PROGRAM",
     let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
     assert_eq!((var("x"), var("y"), var("s")), (10.0, 10.0, 3.0));
 }
+
+/// A function's block instances start from their initial values at every call, as its other
+/// variables do: the block's declared ones (they were never set: 0) and the instance's
+/// initialiser.
+#[test]
+fn a_functions_block_instances_start_from_their_initial_values() {
+    let p = run(
+        "FUNCTION_BLOCK FB_Scale
+VAR_INPUT
+    x : LREAL;
+    factor : LREAL := 1.0;
+    offset : LREAL := 5.0;
+END_VAR
+VAR_OUTPUT
+    y : LREAL;
+END_VAR
+    y := x * factor + offset;
+END_FUNCTION_BLOCK
+FUNCTION F_Scaled : LREAL
+VAR_INPUT
+    v : LREAL;
+END_VAR
+VAR
+    plain : FB_Scale;
+    doubled : FB_Scale := (factor := 2.0);
+END_VAR
+    plain(x := v);
+    doubled(x := v);
+    F_Scaled := plain.y * 100.0 + doubled.y;
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    a, b : LREAL;
+END_VAR
+    a := F_Scaled(1.0);
+    b := F_Scaled(2.0);
+END_PROGRAM",
+        2,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    // plain: v + 5, doubled: 2 v + 5, at every call.
+    assert_eq!((var("a"), var("b")), (607.0, 709.0));
+}

@@ -299,8 +299,9 @@ fn faults_stop_the_cycle_and_name_the_statement() {
 #[path = "../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 
-/// After the load, a cycle allocates nothing: function blocks, functions, loops, the standard
-/// blocks and functions included.
+/// After the load, a cycle allocates nothing: function blocks, functions (their block
+/// instances started from their initial values at each call), loops, the standard blocks and
+/// functions included.
 #[test]
 fn a_cycle_allocates_nothing() {
     let text = "
@@ -308,11 +309,18 @@ FUNCTION Twice : LREAL VAR_INPUT x : LREAL; END_VAR Twice := 2.0 * x; END_FUNCTI
 FUNCTION_BLOCK FB_Acc VAR_INPUT x : LREAL; END_VAR VAR_OUTPUT sum : LREAL; END_VAR
     sum := sum + Twice(x);
 END_FUNCTION_BLOCK
+FUNCTION Summed : LREAL
+VAR_INPUT x : LREAL; END_VAR
+VAR accs : ARRAY[0..1] OF FB_Acc; t2 : TON := (PT := T#1S); END_VAR
+    accs[1](x := x);
+    Summed := accs[1].sum;
+END_FUNCTION
 PROGRAM MAIN
-VAR acc : FB_Acc; t : TON; i : INT; a : ARRAY[0..9] OF LREAL; total : LREAL; END_VAR
+VAR acc : FB_Acc; t : TON; i : INT; a : ARRAY[0..9] OF LREAL; total, s : LREAL; END_VAR
     FOR i := 0 TO 9 DO a[i] := SIN(INT_TO_LREAL(i)); END_FOR
     acc(x := MAX(a[3], a[4], 0.5), sum => total);
     t(IN := TRUE, PT := T#1S);
+    s := Summed(1.0);
 END_PROGRAM";
     let mut p = load(text);
     p.cycle(0).unwrap();
@@ -322,6 +330,7 @@ END_PROGRAM";
     }
     assert_eq!(counting_alloc::allocations() - before, 0);
     assert!(p.read_var("MAIN.total").unwrap() > 0.0);
+    assert_eq!(p.read_var("MAIN.s"), Some(2.0));
 }
 
 #[test]

@@ -37,36 +37,39 @@ impl Exec<'_> {
 
     /// POU `pou`'s initial values at `base`, then those of the instances among its
     /// variables, then the instances' initialisers (`fbDelay : TON := (PT := T#2S)`): they
-    /// win over the blocks' declared initial values.
-    fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
+    /// win over the blocks' declared initial values. A function's frame at each call too
+    /// (nothing allocated: the types are read where they are).
+    pub(super) fn init_pou(&mut self, pou: usize, base: u32) -> Run<()> {
         let code = self.code;
         let late_from = code.late_inits.get(pou).copied().unwrap_or(usize::MAX);
         let (early, late) = split(&code.bodies[pou].0, late_from);
         self.block(early, base)?;
-        for k in 0..self.code.checked.pous[pou].vars.len() {
-            let ty = self.code.checked.pous[pou].vars[k].ty.clone();
-            let offset = self.code.layout.pous[pou].2[k];
-            self.init_instances(&ty, base + offset)?;
+        for (var, offset) in code.checked.pous[pou]
+            .vars
+            .iter()
+            .zip(&code.layout.pous[pou].2)
+        {
+            self.init_instances(&var.ty, base + offset)?;
         }
         self.block(late, base)?;
         Ok(())
     }
 
-    fn init_instances(&mut self, ty: &Type, at: u32) -> Run<()> {
+    fn init_instances(&mut self, ty: &'_ Type, at: u32) -> Run<()> {
+        let code = self.code;
         match ty {
             Type::Fb(i) => self.init_pou(*i, at),
             Type::Struct(i) => {
-                for k in 0..self.code.checked.structs[*i].fields.len() {
-                    let field = self.code.checked.structs[*i].fields[k].1.clone();
-                    let offset = self.code.layout.structs[*i].2[k];
-                    self.init_instances(&field, at + offset)?;
+                let fields = code.checked.structs[*i].fields.iter();
+                for ((_, field), offset) in fields.zip(&code.layout.structs[*i].2) {
+                    self.init_instances(field, at + offset)?;
                 }
                 Ok(())
             }
             Type::Array(dims, element)
                 if matches!(**element, Type::Fb(_) | Type::Struct(_) | Type::Array(..)) =>
             {
-                let (size, align) = self.code.layout.size_align(&self.code.checked, element);
+                let (size, align) = code.layout.size_align(&code.checked, element);
                 let stride = size.div_ceil(align) * align;
                 let count: i64 = dims.iter().map(|(lo, hi)| hi - lo + 1).product();
                 for k in 0..count as u32 {

@@ -740,8 +740,8 @@ impl<'a> Exec<'a> {
         let (size, _, _) = self.code.layout.pous[pou];
         // A function's variables start from zero and their initial values each call.
         self.st.memory[frame as usize..(frame + size) as usize].fill(0);
-        let code = self.code;
-        self.block(&code.bodies[pou].0, frame)?;
+        // Its own initial values, its block instances' (declared and given), as a POU's.
+        self.init_pou(pou, frame)?;
         for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {
             self.write_own((frame + offset) as usize, *t, *v)?;
         }
