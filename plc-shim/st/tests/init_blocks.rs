@@ -7,7 +7,8 @@ mod support;
 
 use support::{refused, run};
 
-const PROGRAM: &str = "FUNCTION_BLOCK FB_Scale
+/// A block of the program's own, with declared initial values.
+const FB_SCALE: &str = "FUNCTION_BLOCK FB_Scale
 VAR_INPUT
     x : LREAL;
     factor : LREAL := 1.0;
@@ -18,7 +19,12 @@ VAR_OUTPUT
 END_VAR
     y := x * factor + offset;
 END_FUNCTION_BLOCK
+";
 
+/// [`FB_SCALE`] and a program whose instances' declarations give inputs.
+fn program() -> String {
+    FB_SCALE.to_string()
+        + "
 VAR_GLOBAL
     gDelay : TON := (PT := T#30MS);
 END_VAR
@@ -44,12 +50,13 @@ END_VAR
     y := fbScale.y;
     pt := fbDelay.PT;
     pt1 := aDelays[1].PT;
-END_PROGRAM";
+END_PROGRAM"
+}
 
 #[test]
 fn an_instances_declaration_sets_its_inputs() {
     // Cycles at 0, 10 and 20 ms: the timers started at 0.
-    let p = run(PROGRAM, 3);
+    let p = run(&program(), 3);
     let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
     assert_eq!(var("pt"), 20.0);
     assert_eq!((var("q"), var("q0"), var("q1")), (1.0, 1.0, 0.0));
@@ -61,7 +68,7 @@ fn an_instances_declaration_sets_its_inputs() {
 
 #[test]
 fn what_is_no_input_of_the_block_is_refused_by_name() {
-    let with = |decl: &str| PROGRAM.replace("fbDelay : TON := (PT := T#20MS);", decl);
+    let with = |decl: &str| program().replace("fbDelay : TON := (PT := T#20MS);", decl);
     assert_eq!(
         refused(&with("fbDelay : TON := (Q := TRUE);")),
         "main.st:19:23: error: `Q` is no input of TON: an instance's declaration gives initial \
@@ -75,7 +82,7 @@ fn what_is_no_input_of_the_block_is_refused_by_name() {
         refused(&with("fbDelay : TON := (PT := TRUE);")),
         "main.st:19:29: error: a BOOL where a TIME is wanted\n"
     );
-    let output = PROGRAM.replace("(factor := 2.0)", "(y := 2.0)");
+    let output = program().replace("(factor := 2.0)", "(y := 2.0)");
     assert_eq!(
         refused(&output),
         "main.st:21:28: error: `y` is no input of FB_Scale: an instance's declaration gives \
@@ -123,18 +130,8 @@ END_PROGRAM",
 #[test]
 fn a_functions_block_instances_start_from_their_initial_values() {
     let p = run(
-        "FUNCTION_BLOCK FB_Scale
-VAR_INPUT
-    x : LREAL;
-    factor : LREAL := 1.0;
-    offset : LREAL := 5.0;
-END_VAR
-VAR_OUTPUT
-    y : LREAL;
-END_VAR
-    y := x * factor + offset;
-END_FUNCTION_BLOCK
-FUNCTION F_Scaled : LREAL
+        &(FB_SCALE.to_string()
+            + "FUNCTION F_Scaled : LREAL
 VAR_INPUT
     v : LREAL;
 END_VAR
@@ -152,7 +149,7 @@ VAR
 END_VAR
     a := F_Scaled(1.0);
     b := F_Scaled(2.0);
-END_PROGRAM",
+END_PROGRAM"),
         2,
     );
     let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
