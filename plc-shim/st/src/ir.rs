@@ -103,24 +103,9 @@ pub struct FnCall {
     /// Its VAR_IN_OUTs' leaves copied back after the call: offset in its frame, type, the
     /// caller's place.
     pub back: Vec<(u32, Elem, Addr)>,
-    /// Its outputs given in the call (`frac => f`), written after it in their order.
-    pub outputs: Vec<FnOutput>,
-}
-
-/// An output of a function call: read from the frame after the call, written to the
-/// caller's place (found then, as a function block's output is).
-#[derive(Debug, Clone, PartialEq)]
-pub struct FnOutput {
-    /// Its offset in the frame.
-    pub offset: u32,
-    /// Its type.
-    pub ty: Elem,
-    /// Where it goes.
-    pub to: Addr,
-    /// The type there: the output's, or one it widens to.
-    pub to_ty: Elem,
-    /// `NOT out => x` (of a BOOL).
-    pub negated: bool,
+    /// Its outputs given in the call (`frac => f`; offsets in its frame), written after it
+    /// in their order as a block's are.
+    pub outputs: Vec<BlockOutput>,
 }
 
 /// A STRING's characters: a literal's (NUL-padded), a variable's `size` bytes at a place, or

@@ -8,7 +8,7 @@ use super::place::plus;
 use super::{Checker, Type};
 use crate::ast::{Arg, Expr, Section};
 use crate::diag::Pos;
-use crate::ir::{Addr, Ex, FnCall, FnOutput};
+use crate::ir::{Addr, BlockOutput, Ex, FnCall};
 use crate::layout::Layout;
 use crate::types::Elem;
 
@@ -157,6 +157,12 @@ impl Checker {
         })
     }
 
+    /// The VAR_OUTPUT `name` of function `i`: its variable's index.
+    pub(super) fn output_var(&self, i: usize, name: &str) -> Option<usize> {
+        (self.out.pous[i].vars.iter())
+            .position(|v| v.name.eq_ignore_ascii_case(name) && v.section == Section::Output)
+    }
+
     /// Output `name => target` of function `i` (checked: an elementary output into a place
     /// it widens to).
     fn function_output(
@@ -165,10 +171,10 @@ impl Checker {
         (name, target, negated): (&crate::ast::Name, &Expr, bool),
         ctx: Ctx,
         l: &Layout,
-    ) -> R<FnOutput> {
-        let var = (self.out.pous[i].vars.iter())
-            .position(|v| v.name.eq_ignore_ascii_case(&name.text) && v.section == Section::Output);
-        let (Some(var), Type::Elem(to_ty)) = (var, self.expr(target, ctx)) else {
+    ) -> R<BlockOutput> {
+        let (Some(var), Type::Elem(to_ty)) =
+            (self.output_var(i, &name.text), self.expr(target, ctx))
+        else {
             return Err(self.unsupported(name.pos, "this output"));
         };
         let Type::Elem(ty) = self.out.pous[i].vars[var].ty else {
@@ -181,12 +187,6 @@ impl Checker {
                 "an output's variable at an index a function computes",
             ));
         }
-        Ok(FnOutput {
-            offset: l.pous[i].2[var],
-            ty,
-            to,
-            to_ty,
-            negated,
-        })
+        Ok((l.pous[i].2[var], ty, to, negated, to_ty))
     }
 }

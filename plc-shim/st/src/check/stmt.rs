@@ -457,14 +457,12 @@ impl Checker {
                     target,
                     negated,
                 } => {
-                    let var = (self.out.pous[i].vars.iter())
-                        .find(|v| v.name.eq_ignore_ascii_case(&n.text))
-                        .map(|v| (v.ty.clone(), v.section));
-                    match var {
-                        Some((t @ Type::Elem(_), Section::Output)) => {
+                    let var = self.output_var(i, &n.text);
+                    match var.map(|k| self.out.pous[i].vars[k].ty.clone()) {
+                        Some(t @ Type::Elem(_)) => {
                             self.output_binding(&t, (n, target, *negated), ctx)
                         }
-                        Some((_, Section::Output)) => self.refuse(
+                        Some(_) => self.refuse(
                             n.pos,
                             format!(
                                 "{name}: an output that is no elementary value (`{}`)",

@@ -131,7 +131,7 @@ fn of_fn_call(c: &FnCall, out: &mut Vec<usize>) {
     c.texts.iter().for_each(|(_, _, _, t)| of_text(t, out));
     of_addr(&c.value, out);
     c.back.iter().for_each(|(_, _, a)| of_addr(a, out));
-    c.outputs.iter().for_each(|o| of_addr(&o.to, out));
+    c.outputs.iter().for_each(|(_, _, a, _, _)| of_addr(a, out));
 }
 
 fn of_text(t: &Text, out: &mut Vec<usize>) {

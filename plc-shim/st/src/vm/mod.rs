@@ -755,13 +755,7 @@ impl<'a> Exec<'a> {
             let v = self.read_own((frame + offset) as usize, *t)?;
             self.write(at, *t, v)?;
         }
-        for o in &c.outputs {
-            let v = self.read_own((frame + o.offset) as usize, o.ty)?;
-            let v = ops::output(v, o.negated, o.ty, o.to_ty)?;
-            let at = self.addr(&o.to, base)?;
-            self.write(at, o.to_ty, v)?;
-        }
-        Ok(())
+        self.read_outputs(&c.outputs, frame, base)
     }
 
     /// Whether two STRINGs hold the same characters before their NUL (or their end).
