@@ -234,8 +234,8 @@ impl Lexer {
         }
         // A calendar literal (digits follow: `DT#2026-11-30-12:00:00`); `D#On` of an
         // enumeration named D stays a typed literal.
-        if crate::check::is_date_type(&upper) && self.peek(0).is_some_and(|c| c.is_ascii_digit()) {
-            let why = format!("{} (`{name}#`)", crate::check::DATES_REFUSED);
+        if crate::types::is_date_type(&upper) && self.peek(0).is_some_and(|c| c.is_ascii_digit()) {
+            let why = format!("{} (`{name}#`)", crate::types::DATES_REFUSED);
             return Err(self.error(pos, &why));
         }
         Ok(Tok::TypePrefix(name))

@@ -520,8 +520,11 @@ impl Checker {
                 self.refuse(n.pos, format!("type `{}` is defined by itself", n.text));
                 Type::Error
             }
-            None if is_date_type(&key) => {
-                self.refuse(n.pos, format!("{DATES_REFUSED} (`{}`)", n.text));
+            None if crate::types::is_date_type(&key) => {
+                self.refuse(
+                    n.pos,
+                    format!("{} (`{}`)", crate::types::DATES_REFUSED, n.text),
+                );
                 Type::Error
             }
             None => {
@@ -704,26 +707,3 @@ pub const MAX_ARRAY_ELEMENTS: i128 = 1 << 20;
 /// The largest array bound (either sign): far beyond any program's, small enough that no
 /// index arithmetic overflows.
 pub const MAX_BOUND: i128 = 1 << 40;
-
-/// Why DATE, TIME_OF_DAY and DATE_AND_TIME are refused (types and literals alike).
-pub(crate) const DATES_REFUSED: &str = "DATE, TIME_OF_DAY and DATE_AND_TIME are not supported: \
-     the PLC's clock is TIME() or LTIME(), durations are TIME and LTIME";
-
-/// Whether `upper` names one of the calendar types (IEC 61131-3's and their long forms).
-pub(crate) fn is_date_type(upper: &str) -> bool {
-    matches!(
-        upper,
-        "DATE"
-            | "D"
-            | "LDATE"
-            | "LD"
-            | "TIME_OF_DAY"
-            | "TOD"
-            | "LTIME_OF_DAY"
-            | "LTOD"
-            | "DATE_AND_TIME"
-            | "DT"
-            | "LDATE_AND_TIME"
-            | "LDT"
-    )
-}
