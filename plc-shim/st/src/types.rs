@@ -191,6 +191,29 @@ pub fn conversion(name: &str) -> Option<(Elem, Elem)> {
     Some((Elem::named(from)?, Elem::named(to)?))
 }
 
+/// Why DATE, TIME_OF_DAY and DATE_AND_TIME are refused (types and literals alike).
+pub const DATES_REFUSED: &str = "DATE, TIME_OF_DAY and DATE_AND_TIME are not supported: \
+     the PLC's clock is TIME() or LTIME(), durations are TIME and LTIME";
+
+/// Whether `upper` names one of the calendar types (IEC 61131-3's and their long forms).
+pub fn is_date_type(upper: &str) -> bool {
+    matches!(
+        upper,
+        "DATE"
+            | "D"
+            | "LDATE"
+            | "LD"
+            | "TIME_OF_DAY"
+            | "TOD"
+            | "LTIME_OF_DAY"
+            | "LTOD"
+            | "DATE_AND_TIME"
+            | "DT"
+            | "LDATE_AND_TIME"
+            | "LDT"
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -234,27 +257,4 @@ mod tests {
         assert_eq!(Elem::Int.range(), Some((-32768, 32767)));
         assert_eq!(Elem::Word.range(), Some((0, 65535)));
     }
-}
-
-/// Why DATE, TIME_OF_DAY and DATE_AND_TIME are refused (types and literals alike).
-pub const DATES_REFUSED: &str = "DATE, TIME_OF_DAY and DATE_AND_TIME are not supported: \
-     the PLC's clock is TIME() or LTIME(), durations are TIME and LTIME";
-
-/// Whether `upper` names one of the calendar types (IEC 61131-3's and their long forms).
-pub fn is_date_type(upper: &str) -> bool {
-    matches!(
-        upper,
-        "DATE"
-            | "D"
-            | "LDATE"
-            | "LD"
-            | "TIME_OF_DAY"
-            | "TOD"
-            | "LTIME_OF_DAY"
-            | "LTOD"
-            | "DATE_AND_TIME"
-            | "DT"
-            | "LDATE_AND_TIME"
-            | "LDT"
-    )
 }
