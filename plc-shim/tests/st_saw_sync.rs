@@ -75,7 +75,7 @@ fn a_mode_the_seed_does_not_name_is_refused_at_load() {
     );
     let refused = StProgram::from_texts(&[("main.st".into(), text)], 1).unwrap_err();
     assert!(
-        refused.contains("main.st:10:30: error: a DINT where a E_GearInSyncMode is wanted"),
+        refused.contains("main.st:10:30: error: DINT where E_GearInSyncMode is wanted"),
         "{refused}"
     );
 }

@@ -58,13 +58,13 @@ fn mistakes_are_refused_each_with_its_place() {
         (
             "x : INT;",
             "x := 70000;",
-            "p.st:5:6: error: a DINT where a INT is wanted",
+            "p.st:5:6: error: 70000 does not fit INT",
         ),
         ("x : INT;", "x := y;", "p.st:5:6: error: unknown name `y`"),
         (
             "x : INT; d : DINT;",
             "x := d;",
-            "p.st:5:6: error: a DINT where a INT is wanted",
+            "p.st:5:6: error: DINT where INT is wanted",
         ),
         (
             "b : BOOL;",
@@ -75,7 +75,7 @@ fn mistakes_are_refused_each_with_its_place() {
         (
             "x : INT;",
             "x := DINT#70000;",
-            "p.st:5:6: error: a DINT where a INT is wanted",
+            "p.st:5:6: error: DINT where INT is wanted",
         ),
         (
             "x : INT;",
@@ -90,7 +90,7 @@ fn mistakes_are_refused_each_with_its_place() {
         (
             "t : TON;",
             "t(IN := TRUE, PT := 5);",
-            "p.st:5:21: error: a DINT where a TIME is wanted",
+            "p.st:5:21: error: DINT where TIME is wanted",
         ),
         (
             "t : TON;",
@@ -115,7 +115,7 @@ fn mistakes_are_refused_each_with_its_place() {
         (
             "p : POINTER TO INT; x : DINT;",
             "p := ADR(x);",
-            "p.st:5:6: error: a POINTER TO DINT where a POINTER TO INT is wanted",
+            "p.st:5:6: error: POINTER TO DINT where POINTER TO INT is wanted",
         ),
         (
             "x : INT;",
@@ -130,7 +130,7 @@ fn mistakes_are_refused_each_with_its_place() {
         (
             "x : INT := TRUE;",
             "",
-            "p.st:3:12: error: a BOOL where a INT is wanted",
+            "p.st:3:12: error: BOOL where INT is wanted",
         ),
     ];
     for (vars, body, expect) in cases {
@@ -182,7 +182,7 @@ fn adr_of_an_array_points_to_its_elements() {
             "a : ARRAY[0..3, 0..1] OF LREAL; p : POINTER TO LREAL; q : POINTER TO INT;",
             "p := ADR(a); q := ADR(a);"
         ),
-        vec!["p.st:5:19: error: a POINTER TO ARRAY[0..3, 0..1] OF LREAL where a POINTER TO INT is wanted".to_string()]
+        vec!["p.st:5:19: error: POINTER TO ARRAY[0..3, 0..1] OF LREAL where POINTER TO INT is wanted".to_string()]
     );
 }
 

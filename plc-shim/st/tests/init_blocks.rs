@@ -80,7 +80,7 @@ fn what_is_no_input_of_the_block_is_refused_by_name() {
     );
     assert_eq!(
         refused(&with("fbDelay : TON := (PT := TRUE);")),
-        "main.st:19:29: error: a BOOL where a TIME is wanted\n"
+        "main.st:19:29: error: BOOL where TIME is wanted\n"
     );
     let output = program().replace("(factor := 2.0)", "(y := 2.0)");
     assert_eq!(

@@ -60,7 +60,7 @@ fn a_literal_a_real_cannot_hold_is_refused_where_it_meets_one() {
     };
     assert_eq!(
         refused(&text("    r := 1.0E300;")),
-        "main.st:6:10: error: a LREAL where a REAL is wanted\n"
+        "main.st:6:10: error: LREAL where REAL is wanted\n"
     );
     assert_eq!(
         refused(&text("    r := MAX(r, -1.0E300);")),
@@ -68,7 +68,7 @@ fn a_literal_a_real_cannot_hold_is_refused_where_it_meets_one() {
     );
     assert_eq!(
         refused(&text("    i := i + 2.5;")),
-        "main.st:6:10: error: a LREAL where a INT is wanted\n"
+        "main.st:6:10: error: LREAL where INT is wanted\n"
     );
 }
 
@@ -118,5 +118,99 @@ END_PROGRAM",
     assert_eq!(
         refused("PROGRAM MAIN\nVAR\n    r : REAL;\nEND_VAR\n    r := MAX(r, NOT 5);\nEND_PROGRAM"),
         "main.st:5:17: error: NOT 5 does not fit REAL\n"
+    );
+}
+
+/// A constant expression of untyped literals is folded at load and then taken as one
+/// literal: an INT takes `200 * 2`, a REAL `100.0 / 60.0`, a CASE label `2 * 3`; one that
+/// a type cannot hold is refused with its value (before, `200 * 2` was a DINT an INT
+/// refused, and `2147483647 + 1` wrapped in DINT at run time).
+#[test]
+fn constant_expressions_of_literals_take_the_type_they_meet() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    i, j, m, q, c : INT;
+    b : BYTE;
+    r : REAL;
+    big : LINT;
+END_VAR
+    i := 200 * 2;
+    j := -(60 * 10) + 7 / 2;
+    m := -7 MOD 3;
+    b := 16#F0 + 15;
+    r := 100.0 / 60.0;
+    big := 2147483647 + 1;
+    q := i * (2 + 1);
+    CASE j OF
+        -2 * 300 + 3: c := 1;
+    ELSE
+        c := 2;
+    END_CASE
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("i"), 400.0);
+    assert_eq!(var("j"), -597.0);
+    assert_eq!(var("m"), -1.0);
+    assert_eq!(var("b"), 255.0);
+    assert_eq!(var("r"), f64::from((100.0f64 / 60.0) as f32));
+    assert_eq!(var("big"), 2147483648.0);
+    assert_eq!(var("q"), 1200.0);
+    assert_eq!(var("c"), 1.0);
+    let text = |body: &str| {
+        format!("PROGRAM MAIN\nVAR\n    i : INT;\n    d : DINT;\nEND_VAR\n{body}\nEND_PROGRAM")
+    };
+    assert_eq!(
+        refused(&text("    i := 30000 + 30000;")),
+        "main.st:6:10: error: 60000 does not fit INT\n"
+    );
+    assert_eq!(
+        refused(&text("    d := 2147483647 + 1;")),
+        "main.st:6:10: error: 2147483648 does not fit DINT\n"
+    );
+}
+
+/// SEL, MUX, MIN, MAX and LIMIT of untyped literals take the type they meet as the
+/// literals would (`nSpeed := SEL(bFast, 10, 100);` of an INT was refused: DINT where INT is
+/// wanted); a literal the type cannot hold is still refused.
+#[test]
+fn selections_of_literals_take_the_type_they_meet() {
+    let p = run(
+        "PROGRAM MAIN
+VAR
+    fast : BOOL := TRUE;
+    k : INT := 2;
+    s, m, x, l : INT;
+    r : REAL;
+    b : BYTE;
+END_VAR
+    s := SEL(fast, 10, 100);
+    m := MUX(k, 1, 2, 3);
+    x := MAX(5, 7, -3);
+    l := LIMIT(0, 500, 100);
+    r := SEL(fast, 0.5, 1.5);
+    b := MIN(255, 200);
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("s"), 100.0);
+    assert_eq!(var("m"), 3.0);
+    assert_eq!(var("x"), 7.0);
+    assert_eq!(var("l"), 100.0);
+    assert_eq!(var("r"), 1.5);
+    assert_eq!(var("b"), 200.0);
+    let text = |body: &str| {
+        format!("PROGRAM MAIN\nVAR\n    i : INT;\n    c : BOOL;\nEND_VAR\n{body}\nEND_PROGRAM")
+    };
+    assert_eq!(
+        refused(&text("    i := SEL(c, 1, 70000);")),
+        "main.st:6:10: error: DINT where INT is wanted\n"
+    );
+    assert_eq!(
+        refused(&text("    i := MIN(c, 1);")),
+        "main.st:6:10: error: BOOL where INT is wanted\n"
     );
 }

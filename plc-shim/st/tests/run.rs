@@ -381,7 +381,7 @@ fn global_variables_start_from_their_initial_values() {
     assert_eq!(p.read_var("MAIN.x"), Some(7.5));
     let e = refused("VAR_GLOBAL G : INT := TRUE; END_VAR PROGRAM MAIN END_PROGRAM");
     assert!(
-        e.contains("main.st:1:23: error: a BOOL where a INT is wanted"),
+        e.contains("main.st:1:23: error: BOOL where INT is wanted"),
         "{e}"
     );
 }
@@ -444,7 +444,7 @@ fn an_initialiser_that_does_not_fit_is_refused_with_its_place() {
         "{e}"
     );
     assert!(
-        e.contains("main.st:2:68: error: a BOOL where a INT is wanted"),
+        e.contains("main.st:2:68: error: BOOL where INT is wanted"),
         "{e}"
     );
     let e =

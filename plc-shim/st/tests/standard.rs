@@ -208,7 +208,32 @@ END_PROGRAM",
     assert_eq!(p.read_var("MAIN.nOffAt"), Some(3.0));
     let e = refused("PROGRAM MAIN VAR n : INT; END_VAR\n  n S= TRUE;\nEND_PROGRAM");
     assert!(
-        e.starts_with("main.st:2:5: error: a BOOL where a INT is wanted"),
+        e.starts_with("main.st:2:5: error: BOOL where INT is wanted"),
         "{e}"
+    );
+}
+
+/// TRUNC_INT (CODESYS's and TwinCAT's): a real cut toward zero to an INT; one an INT cannot
+/// hold is a fault, as TRUNC's beyond DINT.
+#[test]
+fn trunc_int_cuts_toward_zero_to_an_int() {
+    let p = support::run(
+        "PROGRAM MAIN VAR up, down : INT; r : REAL := -2.7; END_VAR
+    up := TRUNC_INT(2.7);
+    down := TRUNC_INT(r);
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.up"), Some(2.0));
+    assert_eq!(p.read_var("MAIN.down"), Some(-2.0));
+    let mut p = Program::load(&[(
+        "main.st",
+        "PROGRAM MAIN VAR i : INT; r : LREAL := 40000.0; END_VAR\n  i := TRUNC_INT(r);\nEND_PROGRAM",
+    )])
+    .unwrap();
+    let f = p.cycle(0).unwrap_err();
+    assert_eq!(
+        p.fault_text(&f),
+        "main.st:2:3: fault: a conversion of a value its type cannot hold"
     );
 }

@@ -230,10 +230,10 @@ END_PROGRAM"
     let e = refused(&program("  n := LEN(s) + LEN(n);"));
     assert!(e.contains("LEN takes a STRING here, not a INT"), "{e}");
     let e = refused(&program("  n := STRING_TO_TIME(s);"));
-    assert!(e.contains("a TIME where a INT is wanted"), "{e}");
+    assert!(e.contains("TIME where INT is wanted"), "{e}");
     let e = refused(&program("  n := CONCAT(s, s);"));
     assert!(
-        e.contains("main.st:4:8: error: a STRING(40) where a INT is wanted"),
+        e.contains("main.st:4:8: error: STRING(40) where INT is wanted"),
         "{e}"
     );
     let e = refused("FUNCTION_BLOCK Concat END_FUNCTION_BLOCK");
@@ -338,7 +338,7 @@ END_PROGRAM"
     );
     let e = refused(&program("  s := F_Short(n);"));
     assert!(
-        e.contains("main.st:25:16: error: a INT where a STRING(10) is wanted"),
+        e.contains("main.st:25:16: error: INT where STRING(10) is wanted"),
         "{e}"
     );
     let e = refused(
@@ -351,7 +351,7 @@ PROGRAM MAIN VAR s : STRING; n : INT; END_VAR n := F_Io(s); END_PROGRAM",
     );
     let e = refused(&program("  n := F_Short('a');"));
     assert!(
-        e.contains("main.st:25:8: error: a STRING(3) where a INT is wanted"),
+        e.contains("main.st:25:8: error: STRING(3) where INT is wanted"),
         "{e}"
     );
 }

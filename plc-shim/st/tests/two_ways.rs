@@ -38,7 +38,9 @@ impl Gen {
         if depth == 0 {
             return match self.pick(4) {
                 0 => format!("{}", self.pick(7) as i64 - 2),
-                1 => "2147483000".into(),
+                // Typed: it wraps DINT's arithmetic at run time (an untyped literal's
+                // constant expression is folded at load, and refused where it does not fit).
+                1 => "DINT#2147483000".into(),
                 _ => self.int_var(),
             };
         }

@@ -50,22 +50,63 @@ pub(super) fn positional(args: &[Arg]) -> Vec<&Expr> {
         .collect()
 }
 
-/// An untyped integer literal's value (`5`, `-5`).
+/// An untyped integer literal's value (`5`, `-5`), or that of a constant expression of
+/// them (`200 * 2`, `-(60 * 1000)`, `7 / 2`: folded at load as TwinCAT does, so that it
+/// takes the type it meets as a literal does; integer division truncates, MOD takes the
+/// dividend's sign). An expression that divides by zero or leaves the widest integer's
+/// range is not folded (it keeps its own type and rules).
 pub(super) fn literal(e: &Expr) -> Option<i128> {
     match e {
         Expr::Int(v, _) => Some(*v),
-        Expr::Unary(UnOp::Neg, inner, _) => literal(inner).map(|v| -v),
+        Expr::Unary(UnOp::Neg, inner, _) => literal(inner).and_then(|v| in_range(-v)),
+        Expr::Binary(op, l, r, _) => {
+            let (a, b) = (in_range(literal(l)?)?, in_range(literal(r)?)?);
+            let v = match op {
+                BinOp::Add => a.checked_add(b),
+                BinOp::Sub => a.checked_sub(b),
+                BinOp::Mul => a.checked_mul(b),
+                BinOp::Div => a.checked_div(b),
+                BinOp::Mod => a.checked_rem(b),
+                _ => None,
+            };
+            in_range(v?)
+        }
         _ => None,
     }
 }
 
-/// An untyped real literal's value (`2.5`, `-0.5`). It takes the type of the REAL or LREAL
-/// it meets, as an untyped integer literal takes an integer's: `r := r / 2.0;` of a REAL
-/// `r` computes in REAL (`LREAL#2.0` stays an LREAL).
+/// `v` when an integer type holds it (LINT's least to ULINT's greatest).
+fn in_range(v: i128) -> Option<i128> {
+    (i128::from(i64::MIN)..=i128::from(u64::MAX))
+        .contains(&v)
+        .then_some(v)
+}
+
+/// An untyped real literal's value (`2.5`, `-0.5`), or that of a constant expression of
+/// them and integer literals with a real among them (`100.0 / 60.0`, `2 * 1.5`), folded
+/// in LREAL's arithmetic (a result that is no finite number is not folded). It takes the
+/// type of the REAL or LREAL it meets, as an untyped integer literal takes an integer's:
+/// `r := r / 2.0;` of a REAL `r` computes in REAL (`LREAL#2.0` stays an LREAL).
 pub(super) fn real_literal(e: &Expr) -> Option<f64> {
     match e {
         Expr::Real(v, _) => Some(*v),
         Expr::Unary(UnOp::Neg, inner, _) => real_literal(inner).map(|v| -v),
+        Expr::Binary(op, l, r, _) => {
+            let (a, b) = (real_literal(l), real_literal(r));
+            if a.is_none() && b.is_none() {
+                return None;
+            }
+            let number = |x: Option<f64>, e: &Expr| x.or_else(|| literal(e).map(|v| v as f64));
+            let (a, b) = (number(a, l)?, number(b, r)?);
+            let v = match op {
+                BinOp::Add => a + b,
+                BinOp::Sub => a - b,
+                BinOp::Mul => a * b,
+                BinOp::Div => a / b,
+                _ => return None,
+            };
+            v.is_finite().then_some(v)
+        }
         _ => None,
     }
 }
@@ -84,9 +125,37 @@ pub(super) fn untyped_literal(e: &Expr) -> bool {
     literal(e).is_some() || real_literal(e).is_some() || not_literal(e).is_some()
 }
 
+/// A call of MIN, MAX, LIMIT, SEL or MUX whose values are all untyped literals (SEL's and
+/// MUX's selector aside): the standard function's name in upper case and its values, the
+/// selector first, and where its name is. It takes the type it meets as its literals would
+/// (`n := SEL(bFast, 10, 100);` of an INT).
+pub(super) fn literal_call(e: &Expr) -> Option<(String, Pos, Vec<&Expr>)> {
+    let Expr::Call { callee, args, .. } = e else {
+        return None;
+    };
+    let Expr::Name(n) = &**callee else {
+        return None;
+    };
+    let upper = n.text.to_ascii_uppercase();
+    let selected = match upper.as_str() {
+        "SEL" | "MUX" => 1,
+        "MIN" | "MAX" | "LIMIT" => 0,
+        _ => return None,
+    };
+    let values = positional(args);
+    let all = values.len() == args.len() && values.len() > selected;
+    let literals = all && values[selected..].iter().all(|v| untyped_literal(v));
+    literals.then_some((upper, n.pos, values))
+}
+
 /// Whether `e` is an untyped literal type `t` holds: an integer within `t`'s range (or of
-/// a real type), or a real of a real type that holds it (a REAL: finite in 32 bits).
+/// a real type), or a real of a real type that holds it (a REAL: finite in 32 bits); or a
+/// [`literal_call`] of such literals.
 pub(super) fn literal_fits(e: &Expr, t: Elem) -> bool {
+    if let Some((f, _, values)) = literal_call(e) {
+        let skip = usize::from(matches!(f.as_str(), "SEL" | "MUX"));
+        return values[skip..].iter().all(|v| literal_fits(v, t));
+    }
     if let Some(v) = not_literal(e) {
         return t.is_integer() && t.range().is_some_and(|(lo, hi)| (lo..=hi).contains(&v));
     }
@@ -192,6 +261,11 @@ impl Checker {
             },
             Expr::Call { callee, args, pos } => self.call_value(callee, args, *pos, ctx),
             Expr::Unary(op, inner, pos) => self.unary(*op, inner, *pos, ctx),
+            // A constant expression of untyped integer literals: the type of its value, as
+            // a literal's (`200 * 2` is a DINT that an INT takes).
+            Expr::Binary(..) if literal(e).is_some() => {
+                Type::Elem(literal(e).and_then(Elem::of_literal).unwrap_or(Elem::LInt))
+            }
             Expr::Binary(op, l, r, pos) => self.binary(*op, l, r, *pos, ctx),
         }
     }

@@ -5,6 +5,7 @@
 
 use super::expr::{literal, Ctx, Meaning};
 use super::place::{deref, plus, strides};
+use super::std_value::std_fn;
 use super::{Checker, Type};
 use crate::ast::{Arg, BinOp, CaseLabel, Expr, Name, Pou, PouKind, Stmt, UnOp};
 use crate::diag::{Diagnostic, Pos};
@@ -210,6 +211,11 @@ impl Checker {
         if let Some(v) = super::expr::literal_value(e, to) {
             return Ok(v);
         }
+        if let Some((f, at, values)) = super::expr::literal_call(e) {
+            if super::expr::literal_fits(e, to) {
+                return self.literal_call_value((&f, at), &values, to, ctx, l);
+            }
+        }
         let from = match self.expr(e, ctx) {
             Type::Elem(f) => f,
             Type::Enum(i) => self.out.enums[i].base,
@@ -249,6 +255,13 @@ impl Checker {
                     UnOp::Neg => Ex::Neg(v, t),
                     UnOp::Not => Ex::Not(v, t),
                 })
+            }
+            // A constant expression of untyped literals: its value, folded at load.
+            Expr::Binary(..) if super::expr::literal(e).is_some() => {
+                Ok(Ex::Int(super::expr::literal(e).unwrap_or_default() as i64))
+            }
+            Expr::Binary(..) if super::expr::real_literal(e).is_some() => {
+                Ok(Ex::Real(super::expr::real_literal(e).unwrap_or_default()))
             }
             Expr::Binary(op, a, b, _) => self.binary_value(*op, a, b, ctx, l),
             Expr::Call { callee, args, .. } => self.call_value_ir(callee, args, ctx, l),
@@ -408,51 +421,6 @@ impl Checker {
             Some(Meaning::Function(i)) => self.function_value(i, args, n.pos, ctx, l),
             _ => Err(self.unsupported(n.pos, "this call")),
         }
-    }
-
-    fn std_value(&mut self, f: StdFn, n: &Name, args: &[&Expr], ctx: Ctx, l: &Layout) -> R<Ex> {
-        let Type::Elem(result) = self.expr(
-            &Expr::Call {
-                callee: Box::new(Expr::Name(n.clone())),
-                args: args.iter().map(|a| Arg::Positional((*a).clone())).collect(),
-                pos: n.pos,
-            },
-            ctx,
-        ) else {
-            return Err(self.unsupported(n.pos, "this standard function's values"));
-        };
-        if args.len() > crate::ir::MAX_STD_VALUES {
-            return Err(self.unsupported(n.pos, "a standard function of more than 16 values"));
-        }
-        // The type the values are computed in.
-        let within = match f {
-            StdFn::Trunc => Elem::LReal,
-            _ => result,
-        };
-        let mut values = Vec::with_capacity(args.len());
-        for (k, a) in args.iter().enumerate() {
-            let selector = matches!(f, StdFn::Sel | StdFn::Mux) && k == 0;
-            let shift = matches!(f, StdFn::Shl | StdFn::Shr | StdFn::Rol | StdFn::Ror) && k == 1;
-            let exponent = f == StdFn::Expt && k == 1;
-            values.push(match (selector, shift) {
-                (true, _) | (_, true) => self.value_as(a, Elem::LInt, ctx, l)?,
-                // An integer exponent: its own value, as a real.
-                _ if exponent => match self.expr(a, ctx) {
-                    Type::Elem(e) if e != within => {
-                        let v = self.value_as(a, e, ctx, l)?;
-                        Ex::Conv(e, within, Box::new(v))
-                    }
-                    _ => self.value_as(a, within, ctx, l)?,
-                },
-                _ => self.value_as(a, within, ctx, l)?,
-            });
-        }
-        let v = Ex::Std(f, within, values);
-        Ok(if within == result {
-            v
-        } else {
-            Ex::Conv(within, result, Box::new(v))
-        })
     }
 
     /// `target := value` as a store or a copy.
@@ -741,37 +709,6 @@ impl Checker {
         };
         self.texts_first(texts, St { kind, at }, call.pos())
     }
-}
-
-/// The standard function of an upper-case name.
-fn std_fn(upper: &str) -> Option<StdFn> {
-    Some(match upper {
-        "ABS" => StdFn::Abs,
-        "SQRT" => StdFn::Sqrt,
-        "LN" => StdFn::Ln,
-        "LOG" => StdFn::Log,
-        "EXP" => StdFn::Exp,
-        "SIN" => StdFn::Sin,
-        "COS" => StdFn::Cos,
-        "TAN" => StdFn::Tan,
-        "ASIN" => StdFn::Asin,
-        "ACOS" => StdFn::Acos,
-        "ATAN" => StdFn::Atan,
-        "MIN" => StdFn::Min,
-        "MAX" => StdFn::Max,
-        "LIMIT" => StdFn::Limit,
-        "SEL" => StdFn::Sel,
-        "MUX" => StdFn::Mux,
-        "TRUNC" => StdFn::Trunc,
-        "SHL" => StdFn::Shl,
-        "SHR" => StdFn::Shr,
-        "ROL" => StdFn::Rol,
-        "ROR" => StdFn::Ror,
-        "EXPT" => StdFn::Expt,
-        "MOVE" => StdFn::Move,
-        "TIME" | "LTIME" => StdFn::Now,
-        _ => return None,
-    })
 }
 
 /// Where a statement starts.

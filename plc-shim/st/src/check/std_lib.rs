@@ -110,9 +110,34 @@ impl StdFb {
 
 /// The standard functions by name.
 pub const FUNCTIONS: &[&str] = &[
-    "ABS", "SQRT", "LN", "LOG", "EXP", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN", "MIN", "MAX",
-    "LIMIT", "SEL", "MUX", "TRUNC", "SHL", "SHR", "ROL", "ROR", "ADR", "SIZEOF", "EXPT", "MOVE",
-    "TIME", "LTIME",
+    "ABS",
+    "SQRT",
+    "LN",
+    "LOG",
+    "EXP",
+    "SIN",
+    "COS",
+    "TAN",
+    "ASIN",
+    "ACOS",
+    "ATAN",
+    "MIN",
+    "MAX",
+    "LIMIT",
+    "SEL",
+    "MUX",
+    "TRUNC",
+    "TRUNC_INT",
+    "SHL",
+    "SHR",
+    "ROL",
+    "ROR",
+    "ADR",
+    "SIZEOF",
+    "EXPT",
+    "MOVE",
+    "TIME",
+    "LTIME",
 ];
 
 /// Whether `upper` (a name in upper case) is a standard function or function block, which no

@@ -142,7 +142,11 @@ impl Checker {
         };
         if !fits {
             let (g, w) = (self.type_name(&got), self.type_name(want));
-            self.refuse(value.pos(), format!("a {g} where a {w} is wanted"));
+            let message = match (literal(value), want) {
+                (Some(v), Type::Elem(e)) if e.is_integer() => format!("{v} does not fit {w}"),
+                _ => format!("{g} where {w} is wanted"),
+            };
+            self.refuse(value.pos(), message);
         }
     }
 
@@ -263,7 +267,7 @@ impl Checker {
                     let got = self.expr(value, ctx);
                     if got != want && got != Type::Error {
                         let (g, w) = (self.type_name(&got), self.type_name(&want));
-                        self.refuse(value.pos(), format!("a {g} where a {w} is wanted"));
+                        self.refuse(value.pos(), format!("{g} where {w} is wanted"));
                     }
                 }
                 _ => self.assignable(value, &want, ctx),
@@ -626,6 +630,9 @@ impl Checker {
             "LTIME" if count(0..=0) => Type::Elem(Elem::LTime),
             "TRUNC" if count(1..=1) && elem(0).is_some_and(|e| e.class() == Class::Float) => {
                 Type::Elem(Elem::DInt)
+            }
+            "TRUNC_INT" if count(1..=1) && elem(0).is_some_and(|e| e.class() == Class::Float) => {
+                Type::Elem(Elem::Int)
             }
             "SHL" | "SHR" | "ROL" | "ROR"
                 if count(2..=2)
