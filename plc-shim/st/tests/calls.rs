@@ -199,6 +199,57 @@ END_PROGRAM",
     assert_eq!(p.read_var("MAIN.n"), Some(6.0));
 }
 
+/// A function's structure and array inputs are passed by value, leaf by leaf, as a
+/// block's (`F_Avg(aVals)`; they were refused: "an input that is no elementary value or
+/// STRING"): a write to the input inside the function leaves the caller's variable alone.
+#[test]
+fn a_functions_structure_and_array_inputs_are_copies() {
+    let p = run(
+        "TYPE ST_Part : STRUCT nId : DINT; fLength : LREAL; END_STRUCT END_TYPE
+FUNCTION F_Avg : LREAL
+VAR_INPUT a : ARRAY[1..4] OF LREAL; END_VAR
+VAR i : INT; sum : LREAL; END_VAR
+    FOR i := 1 TO 4 DO
+        sum := sum + a[i];
+    END_FOR
+    a[1] := 100.0;
+    F_Avg := sum / 4;
+END_FUNCTION
+FUNCTION F_Longer : DINT
+VAR_INPUT part : ST_Part; limit : LREAL; END_VAR
+    IF part.fLength > limit THEN
+        F_Longer := part.nId;
+    END_IF
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    aVals : ARRAY[1..4] OF LREAL := [1.0, 2.0, 3.0, 6.0];
+    stPart : ST_Part := (nId := 7, fLength := 12.5);
+    fAvg, fFirst : LREAL;
+    nLong, nShort : DINT;
+END_VAR
+    fAvg := F_Avg(aVals);
+    fFirst := aVals[1];
+    nLong := F_Longer(stPart, 10.0);
+    nShort := F_Longer(part := stPart, limit := 20.0);
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("fAvg"), 3.0);
+    assert_eq!(var("fFirst"), 1.0);
+    assert_eq!(var("nLong"), 7.0);
+    assert_eq!(var("nShort"), 0.0);
+    let e = refused(
+        "FUNCTION F : INT VAR_INPUT a : ARRAY[0..2] OF INT; END_VAR F := a[0]; END_FUNCTION
+PROGRAM MAIN VAR b : ARRAY[0..3] OF INT; n : INT; END_VAR n := F(b); END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:2:66: error: ARRAY[0..3] OF INT where ARRAY[0..2] OF INT is wanted"),
+        "{e}"
+    );
+}
+
 /// A function's VAR_OUTPUTs given in its call (`frac => f`, as TwinCAT and CODESYS bind
 /// them): written after the call to places found then, widened to the place's type, a
 /// BOOL's negated with NOT; in a statement of its own as in an expression. What is no

@@ -23,12 +23,23 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<Vec<(u32, Elem, Addr)>> {
+        self.leaves_of(value, ty, "VAR_IN_OUT", ctx, l)
+    }
+
+    /// As [`Checker::in_out_leaves`] for a parameter of the role named (a VAR_IN_OUT, or a
+    /// structure's or array's input, passed by value).
+    fn leaves_of(
+        &mut self,
+        value: &Expr,
+        ty: &Type,
+        role: &str,
+        ctx: Ctx,
+        l: &Layout,
+    ) -> R<Vec<(u32, Elem, Addr)>> {
         let (from, _) = self.place(value, ctx, l)?;
         if crate::vm::callees::addr_calls(&from) {
-            return Err(self.unsupported(
-                value.pos(),
-                "a VAR_IN_OUT's variable at an index a function computes",
-            ));
+            let what = format!("a {role}'s variable at an index a function computes");
+            return Err(self.unsupported(value.pos(), &what));
         }
         let leaves = match ty {
             Type::Elem(t) => vec![(0, *t)],
@@ -36,10 +47,8 @@ impl Checker {
                 return Err(self.unsupported(value.pos(), "a STRING as a VAR_IN_OUT of a function"))
             }
             _ => self.leaves(ty, l).ok_or_else(|| {
-                self.unsupported(
-                    value.pos(),
-                    "a VAR_IN_OUT of more than 64 values or of this type",
-                )
+                let what = format!("a {role} of more than 64 values or of this type");
+                self.unsupported(value.pos(), &what)
             })?,
         };
         Ok(leaves
@@ -135,8 +144,14 @@ impl Checker {
                     let text = self.text_for(n, value, ctx, l)?;
                     texts.push((stores.len(), offset, n + 1, text));
                 }
+                // A structure or an array is passed by value, leaf by leaf, as a block's.
+                Type::Struct(_) | Type::Array(..) => {
+                    for (at, t, leaf) in self.leaves_of(value, &ty, "input", ctx, l)? {
+                        stores.push((offset + at, t, Ex::Load(Box::new(leaf), t)));
+                    }
+                }
                 _ => {
-                    let what = "an input that is no elementary value or STRING";
+                    let what = "an input that is no elementary value, STRING, structure or array";
                     return Err(self.unsupported(value.pos(), what));
                 }
             }
