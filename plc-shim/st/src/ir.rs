@@ -232,6 +232,14 @@ pub enum StdFn {
     Move,
     /// `TIME()` and `LTIME()`: the PLC's clock (the cycle's time since the start).
     Now,
+    /// MEMCPY and MEMMOVE (TwinCAT's Tc2_System): `n` bytes from the second pointer to the
+    /// first, within the program's own memory (a statement).
+    MemCpy,
+    /// MEMSET: `n` bytes from the pointer on set to a byte's value (a statement).
+    MemSet,
+    /// MEMCMP: `n` bytes at two pointers compared: 0 when equal, else -1 or 1 as the first
+    /// differing byte of the first is smaller or greater.
+    MemCmp,
 }
 
 /// A statement, with where it stands for a fault's report.

@@ -414,6 +414,9 @@ impl Checker {
             let t = self.sizeof_type(positional[0], ctx);
             return Ok(Ex::Int(i64::from(l.size_align(&self.out, &t).0)));
         }
+        if upper == "UPPER_BOUND" || upper == "LOWER_BOUND" {
+            return self.bound_value(upper == "UPPER_BOUND", &positional, ctx);
+        }
         if let Some(f) = std_fn(&upper) {
             return self.std_value(f, n, &positional, ctx, l);
         }
@@ -596,7 +599,7 @@ impl Checker {
                 let text = self.text_ir(call, ctx, l)?;
                 return Ok(StKind::Eval(Ex::Text(Box::new(TextEx::Len(text)))));
             }
-            _ => return Ok(StKind::Eval(self.value(call, ctx, l)?)),
+            _ => return Ok(StKind::Eval(self.statement_value(call, ctx, l)?)),
         };
         let (instance, _) = self.place(callee, ctx, l)?;
         let (mut inputs, mut outputs, mut texts) = (Vec::new(), Vec::new(), Vec::new());

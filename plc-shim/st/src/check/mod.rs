@@ -17,6 +17,7 @@ mod init;
 mod lower;
 mod place;
 pub mod std_lib;
+mod std_type;
 mod std_value;
 mod stmt;
 mod text;

@@ -138,6 +138,12 @@ pub const FUNCTIONS: &[&str] = &[
     "MOVE",
     "TIME",
     "LTIME",
+    "MEMCPY",
+    "MEMMOVE",
+    "MEMSET",
+    "MEMCMP",
+    "UPPER_BOUND",
+    "LOWER_BOUND",
 ];
 
 /// Whether `upper` (a name in upper case) is a standard function or function block, which no

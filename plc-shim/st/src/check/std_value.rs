@@ -19,6 +19,42 @@ impl Checker {
         ctx: Ctx,
         l: &Layout,
     ) -> R<Ex> {
+        if matches!(f, StdFn::MemCpy | StdFn::MemSet) {
+            let what = format!("{}'s value (call it as a statement)", n.text);
+            return Err(self.unsupported(n.pos, &what));
+        }
+        self.std_ex(f, n, args, ctx, l)
+    }
+
+    /// A function called as a statement, its value dropped (MEMCPY, MEMMOVE and MEMSET are
+    /// called only so).
+    pub(super) fn statement_value(&mut self, call: &Expr, ctx: Ctx, l: &Layout) -> R<Ex> {
+        if let Expr::Call { callee, args, .. } = call {
+            if let Expr::Name(n) = &**callee {
+                let f = std_fn(&n.text.to_ascii_uppercase());
+                if let Some(f @ (StdFn::MemCpy | StdFn::MemSet)) = f {
+                    return self.std_ex(f, n, &super::expr::positional(args), ctx, l);
+                }
+            }
+        }
+        self.value(call, ctx, l)
+    }
+
+    /// UPPER_BOUND or LOWER_BOUND of an array at a dimension (1 the first): a constant.
+    pub(super) fn bound_value(&mut self, upper: bool, values: &[&Expr], ctx: Ctx) -> R<Ex> {
+        let dims = match values.first().map(|a| self.expr(a, ctx)) {
+            Some(Type::Array(dims, _)) => dims,
+            _ => Vec::new(),
+        };
+        let k = values.get(1).and_then(|v| super::expr::literal(v));
+        let k = k.and_then(|k| usize::try_from(k).ok()?.checked_sub(1));
+        match k.and_then(|k| dims.get(k)) {
+            Some(&(lo, hi)) => Ok(Ex::Int(if upper { hi } else { lo })),
+            None => Err(self.unsupported(values[0].pos(), "this bound")),
+        }
+    }
+
+    fn std_ex(&mut self, f: StdFn, n: &Name, args: &[&Expr], ctx: Ctx, l: &Layout) -> R<Ex> {
         let Type::Elem(result) = self.expr(
             &Expr::Call {
                 callee: Box::new(Expr::Name(n.clone())),
@@ -117,6 +153,9 @@ pub(super) fn std_fn(upper: &str) -> Option<StdFn> {
         "EXPT" => StdFn::Expt,
         "MOVE" => StdFn::Move,
         "TIME" | "LTIME" => StdFn::Now,
+        "MEMCPY" | "MEMMOVE" => StdFn::MemCpy,
+        "MEMSET" => StdFn::MemSet,
+        "MEMCMP" => StdFn::MemCmp,
         _ => return None,
     })
 }

@@ -24,7 +24,8 @@ pub enum Fault {
     MuxSelector,
     /// A write to a leaf of the image the CNC or the drives write.
     ReadOnly,
-    /// A whole structure or array copied to or from the image (assign its leaves).
+    /// A whole structure or array copied to or from the image (assign its leaves), or
+    /// MEMCPY, MEMSET or MEMCMP there.
     ImageCopy,
     /// A library block called without its host (a cycle without the PLC runtime).
     NoHost,
@@ -61,7 +62,11 @@ impl core::fmt::Display for FaultAt {
             Fault::Budget => write!(f, "the cycle ran {a} steps: an endless loop?"),
             Fault::MuxSelector => write!(f, "MUX selector {a} names no value"),
             Fault::ReadOnly => write!(f, "a write to a leaf of the image the CNC writes"),
-            Fault::ImageCopy => write!(f, "a whole structure copied to or from the image"),
+            Fault::ImageCopy => write!(
+                f,
+                "a whole structure, MEMCPY, MEMSET or MEMCMP to or from the image (its leaves \
+                 are written one by one)"
+            ),
             Fault::NoHost => write!(f, "a library block without the PLC runtime to run it"),
             Fault::NotFinite => write!(f, "a real of the image that is not finite"),
             Fault::NoNumber => write!(f, "a STRING read as a value that holds none"),

@@ -258,8 +258,8 @@ pub(crate) fn standard(f: StdFn, t: Elem, v: &[V]) -> Run<V> {
         }
         StdFn::Expt => finite(v[0].float().powf(v[1].float())),
         StdFn::Move => Ok(v[0]),
-        // The clock is the runtime's (`Exec::std_fn`).
-        StdFn::Now => Err(Fault::OutOfRange),
+        // The clock and the program's memory are the runtime's (`Exec::std_fn`).
+        StdFn::Now | StdFn::MemCpy | StdFn::MemSet | StdFn::MemCmp => Err(Fault::OutOfRange),
     }
 }
 

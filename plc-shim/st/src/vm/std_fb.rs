@@ -27,12 +27,49 @@ impl Exec<'_> {
             // The cycle's clock: TIME in whole ms (wrapping as TIME does), LTIME in ns.
             StdFn::Now if t == Elem::LTime => Ok(V::I(self.st.now_ns)),
             StdFn::Now => Ok(V::I(ops::wrap(self.st.now_ns / 1_000_000, t))),
+            StdFn::MemCpy | StdFn::MemSet | StdFn::MemCmp => self.bytes_fn(f, &values),
             _ => ops::standard(f, t, &values[..n]),
         };
         if v == Err(Fault::MuxSelector) {
             return Err(self.fault_with(Fault::MuxSelector, [values[0].int(), 0, 0]));
         }
         v
+    }
+
+    /// MEMCPY, MEMSET, MEMCMP on the program's own memory (the image's leaves are read and
+    /// written one at a time, by their rules: a pointer into it is [`Fault::ImageCopy`]).
+    fn bytes_fn(&mut self, f: StdFn, v: &[V]) -> Run<V> {
+        let n = v[2].int();
+        let to = self.own_span(v[0].int(), n)?;
+        match f {
+            StdFn::MemSet => self.st.memory[to].fill(v[1].int() as u8),
+            StdFn::MemCmp => {
+                let from = self.own_span(v[1].int(), n)?;
+                let m = &self.st.memory;
+                return Ok(V::I(match m[to].cmp(&m[from]) {
+                    std::cmp::Ordering::Less => -1,
+                    std::cmp::Ordering::Equal => 0,
+                    std::cmp::Ordering::Greater => 1,
+                }));
+            }
+            _ => {
+                let from = self.own_span(v[1].int(), n)?;
+                self.st.memory.copy_within(from, to.start);
+            }
+        }
+        Ok(V::I(n))
+    }
+
+    /// The `n` bytes of the program's own memory from where tagged pointer `p` points.
+    fn own_span(&self, p: i64, n: i64) -> Run<std::ops::Range<usize>> {
+        let n = usize::try_from(n).map_err(|_| Fault::OutOfRange)?;
+        match super::pointed(p)? {
+            super::Loc::Image(_) => Err(Fault::ImageCopy),
+            super::Loc::Own(at) => {
+                let end = at.checked_add(n).filter(|e| *e <= self.st.memory.len());
+                Ok(at..end.ok_or(Fault::BadPointer)?)
+            }
+        }
     }
 
     fn flag(&self, at: usize) -> Run<bool> {
