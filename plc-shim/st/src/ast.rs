@@ -46,6 +46,9 @@ pub enum PouKind {
     FunctionBlock,
     /// FUNCTION (with its return type).
     Function,
+    /// A METHOD or ACTION of a FUNCTION_BLOCK or PROGRAM, as the checker makes it a POU of
+    /// its own (`check::methods`); never written as such.
+    Method,
 }
 
 /// A program, function block or function.
@@ -58,6 +61,26 @@ pub struct Pou {
     /// A function's return type.
     pub returns: Option<TypeRef>,
     /// Its variable sections in order.
+    pub vars: Vec<VarBlock>,
+    /// Its statements.
+    pub body: Vec<Stmt>,
+    /// Its methods and actions (of a FUNCTION_BLOCK or a PROGRAM).
+    pub methods: Vec<Method>,
+}
+
+/// A METHOD or an ACTION of a function block or a program: a body run on the instance
+/// (the program), with the method's own variables and value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Method {
+    /// Its name.
+    pub name: Name,
+    /// An ACTION (no variables of its own, no value).
+    pub action: bool,
+    /// PRIVATE or PROTECTED: called only from its POU's body and methods.
+    pub private: bool,
+    /// Its value's type.
+    pub returns: Option<TypeRef>,
+    /// Its own variable sections.
     pub vars: Vec<VarBlock>,
     /// Its statements.
     pub body: Vec<Stmt>,

@@ -106,6 +106,10 @@ pub struct FnCall {
     /// Its outputs given in the call (`frac => f`; offsets in its frame), written after it
     /// in their order as a block's are.
     pub outputs: Vec<BlockOutput>,
+    /// A method's call: its frame is the instance at this place (its program's memory),
+    /// and only its own variables start from zero and their initial values, those from
+    /// the first offset to the second.
+    pub this: Option<(Addr, u32, u32)>,
 }
 
 /// A STRING's characters: a literal's (NUL-padded), a variable's `size` bytes at a place, or

@@ -107,7 +107,8 @@ impl Layout {
             at += u64::from(size);
         }
         for (i, pou) in c.pous.iter().enumerate() {
-            if pou.kind != PouKind::FunctionBlock {
+            // A method's frame is its instance (its program's memory).
+            if !matches!(pou.kind, PouKind::FunctionBlock | PouKind::Method) {
                 let (size, align, _) = &l.pous[i];
                 at = align_to(at, *align);
                 l.statics[i] = at as u32;

@@ -26,6 +26,7 @@ fn a_master_program_with_pointers_typed_literals_and_blocks_parses() {
                 PouKind::Program => "PROGRAM",
                 PouKind::FunctionBlock => "FUNCTION_BLOCK",
                 PouKind::Function => "FUNCTION",
+                PouKind::Method => "METHOD",
             },
             Item::Types(_) => "TYPE",
             Item::Globals(_) => "VAR_GLOBAL",
@@ -165,12 +166,12 @@ fn refusals_name_line_and_column() {
         ),
         // The object-oriented extensions, where TwinCAT and CODESYS write them.
         (
-            "FUNCTION_BLOCK FB\nVAR n : INT; END_VAR\n  n := n + 1;\nMETHOD M_Reset : BOOL\n  n := 0;\nEND_METHOD\nEND_FUNCTION_BLOCK",
-            "t.st:4:1: error: `METHOD` is not supported",
+            "FUNCTION_BLOCK FB\nMETHOD ABSTRACT M : BOOL\nEND_METHOD\nEND_FUNCTION_BLOCK",
+            "t.st:2:8: error: `ABSTRACT` is not supported",
         ),
         (
-            "FUNCTION_BLOCK FB\nEND_FUNCTION_BLOCK\nmethod PUBLIC M : BOOL\nEND_METHOD",
-            "t.st:3:1: error: `METHOD` is not supported",
+            "FUNCTION F : INT\n  F := 1;\nMETHOD M : BOOL\nEND_METHOD\nEND_FUNCTION",
+            "t.st:3:1: error: a FUNCTION has no METHOD or ACTION",
         ),
         (
             "FUNCTION_BLOCK FB_Saw EXTENDS FB_Axis\nEND_FUNCTION_BLOCK",
@@ -187,10 +188,6 @@ fn refusals_name_line_and_column() {
         (
             "FUNCTION_BLOCK FB\nPROPERTY Speed : LREAL\nEND_PROPERTY\nEND_FUNCTION_BLOCK",
             "t.st:2:1: error: `PROPERTY` is not supported",
-        ),
-        (
-            "PROGRAM P\nACTION A_Reset:\nEND_ACTION\nEND_PROGRAM",
-            "t.st:2:1: error: `ACTION` is not supported",
         ),
         // A calendar literal.
         (
@@ -213,6 +210,37 @@ fn refusals_name_line_and_column() {
             "{text:?}:\n  got  {e}\n  want {expect}"
         );
     }
+}
+
+/// METHODs and ACTIONs inside their POU after its body, or right after its END_..; access
+/// words before a method's name (PRIVATE and PROTECTED kept as private).
+#[test]
+fn methods_and_actions_belong_to_their_pou() {
+    let text = "FUNCTION_BLOCK FB\nVAR n : INT; END_VAR\n  n := n + 1;\n\
+                METHOD M_Reset : BOOL\n  n := 0;\nEND_METHOD\n\
+                ACTION A_Log:\n  n := n;\nEND_ACTION\nEND_FUNCTION_BLOCK\n\
+                method PROTECTED FINAL M_Set\nVAR_INPUT v : INT; END_VAR\n  n := v;\nEND_METHOD\n\
+                PROGRAM P\nACTION A_Init:\nEND_ACTION\nEND_PROGRAM";
+    let unit = parse_file("t.st", text).unwrap();
+    let Item::Pou(fb) = &unit.items[0] else {
+        panic!("{unit:?}")
+    };
+    let found: Vec<(&str, bool, bool)> = (fb.methods.iter())
+        .map(|m| (m.name.text.as_str(), m.action, m.private))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            ("M_Reset", false, false),
+            ("A_Log", true, false),
+            ("M_Set", false, true)
+        ]
+    );
+    assert_eq!(fb.body.len(), 1);
+    let Item::Pou(p) = &unit.items[1] else {
+        panic!("{unit:?}")
+    };
+    assert_eq!(p.methods.len(), 1);
 }
 
 /// The object-oriented extensions' words are refused only where they begin a declaration: a

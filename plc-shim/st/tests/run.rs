@@ -299,15 +299,21 @@ fn faults_stop_the_cycle_and_name_the_statement() {
 #[path = "../../../tests/support/counting_alloc.rs"]
 mod counting_alloc;
 
-/// After the load, a cycle allocates nothing: function blocks, functions (their block
-/// instances started from their initial values at each call), loops, the standard blocks and
-/// functions included.
+/// After the load, a cycle allocates nothing: function blocks, functions and methods (their
+/// block instances started from their initial values at each call), loops, the standard
+/// blocks and functions included.
 #[test]
 fn a_cycle_allocates_nothing() {
     let text = "
 FUNCTION Twice : LREAL VAR_INPUT x : LREAL; END_VAR Twice := 2.0 * x; END_FUNCTION
 FUNCTION_BLOCK FB_Acc VAR_INPUT x : LREAL; END_VAR VAR_OUTPUT sum : LREAL; END_VAR
     sum := sum + Twice(x);
+METHOD M_Add : LREAL
+VAR_INPUT y : LREAL; END_VAR
+VAR t3 : TON := (PT := T#2S); n : INT := 3; END_VAR
+    t3(IN := TRUE);
+    M_Add := sum + y + INT_TO_LREAL(n);
+END_METHOD
 END_FUNCTION_BLOCK
 FUNCTION Summed : LREAL
 VAR_INPUT x : LREAL; END_VAR
@@ -316,11 +322,12 @@ VAR accs : ARRAY[0..1] OF FB_Acc; t2 : TON := (PT := T#1S); END_VAR
     Summed := accs[1].sum;
 END_FUNCTION
 PROGRAM MAIN
-VAR acc : FB_Acc; t : TON; i : INT; a : ARRAY[0..9] OF LREAL; total, s : LREAL; END_VAR
+VAR acc : FB_Acc; t : TON; i : INT; a : ARRAY[0..9] OF LREAL; total, s, m : LREAL; END_VAR
     FOR i := 0 TO 9 DO a[i] := SIN(INT_TO_LREAL(i)); END_FOR
     acc(x := MAX(a[3], a[4], 0.5), sum => total);
     t(IN := TRUE, PT := T#1S);
     s := Summed(1.0);
+    m := acc.M_Add(0.0) - total;
 END_PROGRAM";
     let mut p = load(text);
     p.cycle(0).unwrap();
@@ -331,6 +338,7 @@ END_PROGRAM";
     assert_eq!(counting_alloc::allocations() - before, 0);
     assert!(p.read_var("MAIN.total").unwrap() > 0.0);
     assert_eq!(p.read_var("MAIN.s"), Some(2.0));
+    assert_eq!(p.read_var("MAIN.m"), Some(3.0));
 }
 
 #[test]

@@ -203,6 +203,10 @@ impl Checker {
             if pou.kind == PouKind::Function && pou.name.eq_ignore_ascii_case(name) {
                 return pou.returns.clone().map(Meaning::Return);
             }
+            // A method's own name inside it: its value.
+            if (pou.method.as_ref()).is_some_and(|m| m.name.eq_ignore_ascii_case(name)) {
+                return pou.returns.clone().map(Meaning::Return);
+            }
         }
         let upper = name.to_ascii_uppercase();
         if let Some(i) = self.globals.get(&upper) {
@@ -600,8 +604,12 @@ impl Checker {
 
     /// A call whose value is used: a function, a standard function or a conversion.
     fn call_value(&mut self, callee: &Expr, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
+        if let (Expr::Field(..), Some((m, _))) = (callee, self.method_of(callee, ctx)) {
+            return self.method_call(m, (args, pos), ctx, true);
+        }
         let Expr::Name(n) = callee else {
-            return self.error(pos, "only functions are called in an expression");
+            let why = self.no_method(callee, ctx);
+            return self.error(pos, why);
         };
         let upper = n.text.to_ascii_uppercase();
         if let Some(t) = self.text_call_type(&upper, args, n.pos, ctx) {
@@ -632,6 +640,9 @@ impl Checker {
         }
         if std_lib::FUNCTIONS.contains(&upper.as_str()) {
             return self.std_function(&upper, args, n.pos, ctx);
+        }
+        if let Some((m, _)) = self.method_of(callee, ctx) {
+            return self.method_call(m, (args, n.pos), ctx, true);
         }
         match self.meaning(&n.text, ctx) {
             Some(Meaning::Function(i)) => self.function_call(i, args, n.pos, ctx),

@@ -61,7 +61,8 @@ impl Checker {
     /// variables' indices.
     pub(super) fn parameters(&self, i: usize) -> Vec<usize> {
         let vars = &self.out.pous[i].vars;
-        (0..vars.len())
+        // A method's own: its POU's inputs are the instance's.
+        (self.own_from(i)..vars.len())
             .filter(|k| matches!(vars[*k].section, Section::Input | Section::InOut))
             .collect()
     }
@@ -169,13 +170,21 @@ impl Checker {
             value: Addr::Static(l.statics[i] + *l.pous[i].2.last().unwrap_or(&0)),
             back,
             outputs,
+            this: None,
         })
     }
 
     /// The VAR_OUTPUT `name` of function `i`: its variable's index.
     pub(super) fn output_var(&self, i: usize, name: &str) -> Option<usize> {
-        (self.out.pous[i].vars.iter())
+        let from = self.own_from(i);
+        (self.out.pous[i].vars.iter().skip(from))
             .position(|v| v.name.eq_ignore_ascii_case(name) && v.section == Section::Output)
+            .map(|k| k + from)
+    }
+
+    /// Where a method's own variables begin among its POU's (0 for other POUs).
+    pub(super) fn own_from(&self, i: usize) -> usize {
+        self.out.pous[i].method.as_ref().map_or(0, |m| m.own_from)
     }
 
     /// Output `name => target` of function `i` (checked: an elementary output into a place

@@ -156,9 +156,11 @@ impl Checker {
 
     fn name_place(&mut self, n: &Name, ctx: Ctx, l: &Layout) -> R<(Addr, Type)> {
         // Only a name in a POU (not a global's initial value) is a local or a return value.
-        let local = |offset: u32| match self.out.pous[ctx.pou].kind {
+        // A method's variables are its function block instance's (its program's).
+        let owner = self.family(ctx.pou).unwrap_or(ctx.pou);
+        let local = |offset: u32| match self.out.pous[owner].kind {
             PouKind::FunctionBlock => Addr::Instance(offset),
-            _ => Addr::Static(l.statics[ctx.pou] + offset),
+            _ => Addr::Static(l.statics[owner] + offset),
         };
         match self.meaning(&n.text, ctx) {
             Some(Meaning::Local(i)) => Ok((
@@ -394,6 +396,9 @@ impl Checker {
     }
 
     fn call_value_ir(&mut self, callee: &Expr, args: &[Arg], ctx: Ctx, l: &Layout) -> R<Ex> {
+        if let Some((m, this)) = self.method_of(callee, ctx) {
+            return self.method_value(m, (callee, this), args, ctx, l);
+        }
         let Expr::Name(n) = callee else {
             return Err(self.unsupported(callee.pos(), "this call"));
         };

@@ -15,6 +15,8 @@ mod expr;
 mod function;
 mod init;
 mod lower;
+mod methods;
+pub use methods::MethodOf;
 mod place;
 pub mod std_lib;
 mod std_type;
@@ -94,6 +96,8 @@ pub struct PouDef {
     pub vars: Vec<Var>,
     /// The file it is in (index into the files given).
     pub file: usize,
+    /// A METHOD's or ACTION's POU and place among its variables.
+    pub method: Option<methods::MethodOf>,
 }
 
 /// A checked program: the tables the compiler reads.
@@ -128,6 +132,9 @@ type Files = Vec<(String, Unit)>;
 
 /// The checker of `files`, and the files as it read them (`TO_<type>` calls named).
 fn checker(files: &[(String, Unit)]) -> Result<(Checker, Files), Vec<Diagnostic>> {
+    // Methods and actions as POUs of their own, run on their POU's memory.
+    let (files, found) = methods::desugar(files);
+    let files = &files[..];
     let mut c = Checker {
         consts: consts::Consts::of(files),
         ..Checker::default()
@@ -135,6 +142,7 @@ fn checker(files: &[(String, Unit)]) -> Result<(Checker, Files), Vec<Diagnostic>
     c.collect(files);
     c.resolve_types(files);
     c.resolve_vars(files);
+    c.bind_methods(&found, files);
     let files = c.name_conversions(files);
     c.check_bodies(&files);
     if c.errors.is_empty() {
@@ -142,6 +150,8 @@ fn checker(files: &[(String, Unit)]) -> Result<(Checker, Files), Vec<Diagnostic>
     } else {
         c.errors
             .sort_by(|a, b| (&a.file, a.pos).cmp(&(&b.file, b.pos)));
+        // A POU's variable refused once, not again in each of its methods.
+        c.errors.dedup();
         Err(c.errors)
     }
 }
@@ -291,6 +301,7 @@ impl Checker {
             returns: None,
             vars: Vec::new(),
             file,
+            method: None,
         });
         let index = self.out.pous.len() - 1;
         self.declare_type(&p.name, Named::Pou(index));

@@ -365,7 +365,14 @@ impl Checker {
             }
             _ => {
                 self.errors.truncate(errors);
-                self.expr(call, ctx);
+                match self.method_of(callee, ctx) {
+                    Some((m, _)) => {
+                        self.method_call(m, (args, *pos), ctx, false);
+                    }
+                    None => {
+                        self.expr(call, ctx);
+                    }
+                }
             }
         }
     }

@@ -124,6 +124,12 @@ impl Checker {
     /// Names the calls in `e`, the innermost first (their types are the outer ones' values').
     fn name_in(&mut self, e: &mut Expr, ctx: Ctx) {
         let mut itself = None;
+        // `THIS^.x` in a function block's (a program's) body or methods: its own `x` (a
+        // method's variables may not take its POU's names, so nothing hides it).
+        if let Some(member) = self.this_member(e, ctx) {
+            *e = Expr::Name(member);
+            return;
+        }
         match e {
             Expr::Typed { value, .. } => self.name_in(value, ctx),
             Expr::Field(base, _) | Expr::Deref(base, _) | Expr::Unary(_, base, _) => {

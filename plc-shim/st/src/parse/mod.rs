@@ -8,6 +8,7 @@ use crate::ast::{
 use crate::diag::{Diagnostic, Pos};
 use crate::lex::{lex, Tok, Token};
 
+mod method;
 mod stmt;
 
 /// The words that open a variable section.
@@ -75,14 +76,7 @@ const RESERVED: &[&str] = &[
 
 /// The object-oriented extensions of the standard's third edition (TwinCAT 3, CODESYS 3):
 /// refused by name where one would begin a declaration, never read as something else.
-const OBJECT_ORIENTED: [&str; 6] = [
-    "METHOD",
-    "PROPERTY",
-    "ACTION",
-    "INTERFACE",
-    "EXTENDS",
-    "IMPLEMENTS",
-];
+const OBJECT_ORIENTED: [&str; 4] = ["PROPERTY", "INTERFACE", "EXTENDS", "IMPLEMENTS"];
 
 /// Whether `word` is reserved (ASCII case ignored).
 fn reserved(word: &str) -> bool {
@@ -100,6 +94,19 @@ pub fn parse(text: &str) -> Result<Unit, Diagnostic> {
     };
     let mut unit = Unit::default();
     while !p.at_eof() {
+        // A METHOD or ACTION after its POU's END_..: the POU's.
+        if p.method_start() {
+            let pos = p.pos();
+            let m = p.method()?;
+            match unit.items.last_mut() {
+                Some(Item::Pou(pou)) if pou.kind != PouKind::Function => pou.methods.push(m),
+                _ => {
+                    let why = "a METHOD or ACTION follows its FUNCTION_BLOCK or PROGRAM";
+                    return Err(Diagnostic::new(pos, why));
+                }
+            }
+            continue;
+        }
         unit.items.push(p.item()?);
     }
     Ok(unit)
@@ -218,9 +225,9 @@ impl Parser {
             .find(|w| w.eq_ignore_ascii_case(word))
         {
             Some(w) if named => Err(self.error(format!(
-                "`{w}` is not supported: the object-oriented extensions (METHOD, PROPERTY, \
-                 ACTION, INTERFACE, EXTENDS, IMPLEMENTS) are not; write a method as a \
-                 FUNCTION or a FUNCTION_BLOCK of its own"
+                "`{w}` is not supported: of the object-oriented extensions only METHOD \
+                 and ACTION are (PROPERTY, INTERFACE, EXTENDS and IMPLEMENTS are not; write \
+                 a property as a method or a variable)"
             ))),
             _ => Ok(()),
         }
@@ -266,6 +273,14 @@ impl Parser {
             vars.push(self.var_block()?);
         }
         let body = self.statements(&[end])?;
+        let mut methods = Vec::new();
+        while self.method_start() {
+            if kind == PouKind::Function {
+                let why = "a FUNCTION has no METHOD or ACTION: they belong to a FUNCTION_BLOCK or PROGRAM";
+                return Err(self.error(why));
+            }
+            methods.push(self.method()?);
+        }
         self.expect_kw(end)?;
         Ok(Pou {
             kind,
@@ -273,6 +288,7 @@ impl Parser {
             returns,
             vars,
             body,
+            methods,
         })
     }
 

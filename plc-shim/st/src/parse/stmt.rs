@@ -31,7 +31,10 @@ impl Parser {
                 let what = ends.join(" or ");
                 return Err(self.error(format!("expected {what}, found {}", self.found())));
             }
-            // A METHOD written inside its FUNCTION_BLOCK, after the body.
+            // A METHOD or ACTION written inside its POU, after the body.
+            if self.method_start() {
+                return Ok(out);
+            }
             self.refuse_object_oriented()?;
             out.push(self.nested(Self::statement)?);
         }

@@ -44,10 +44,11 @@ impl Exec<'_> {
         let late_from = code.late_inits.get(pou).copied().unwrap_or(usize::MAX);
         let (early, late) = split(&code.bodies[pou].0, late_from);
         self.block(early, base)?;
-        for (var, offset) in code.checked.pous[pou]
-            .vars
-            .iter()
+        // A method's instances are its POU's, set when the POU's instance was.
+        let from = (code.checked.pous[pou].method.as_ref()).map_or(0, |m| m.own_from);
+        for (var, offset) in (code.checked.pous[pou].vars.iter())
             .zip(&code.layout.pous[pou].2)
+            .skip(from)
         {
             self.init_instances(&var.ty, base + offset)?;
         }

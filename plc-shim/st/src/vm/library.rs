@@ -241,15 +241,22 @@ impl Library {
             }));
         }
         for (i, pou) in c.pous.iter().enumerate() {
-            let holds = pou.vars.iter().any(|v| lib.holds_block(code, &v.ty, 0));
-            if pou.kind == PouKind::Function && holds {
+            // A function's variables, and a method's own, live for one call.
+            let from = pou.method.as_ref().map_or(0, |m| m.own_from);
+            let own = pou.vars.get(from..).unwrap_or_default();
+            let holds = own.iter().any(|v| lib.holds_block(code, &v.ty, 0));
+            let kind = match pou.kind {
+                PouKind::Function => "FUNCTION",
+                _ => "METHOD",
+            };
+            if matches!(pou.kind, PouKind::Function | PouKind::Method) && holds {
                 let file = code.files.get(pou.file).map_or("", String::as_str);
                 let pos = pou.vars.first().map_or(Pos { line: 1, col: 1 }, |v| v.pos);
                 errors.push(
                     Diagnostic::new(
                         pos,
                         format!(
-                            "FUNCTION {}: a library block keeps its state from cycle to \
+                            "{kind} {}: a library block keeps its state from cycle to \
                              cycle: declare it in a PROGRAM or FUNCTION_BLOCK",
                             c.pous[i].name
                         ),

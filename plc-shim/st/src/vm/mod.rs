@@ -736,10 +736,23 @@ impl<'a> Exec<'a> {
                 None => self.eval(e, base)?,
             };
         }
-        let (frame, statement) = (self.code.layout.statics[pou], self.place());
-        let (size, _, _) = self.code.layout.pous[pou];
-        // A function's variables start from zero and their initial values each call.
-        self.st.memory[frame as usize..(frame + size) as usize].fill(0);
+        let statement = self.place();
+        // A function's variables start from zero and their initial values each call; a
+        // method's frame is its instance, whose own variables (only) do so.
+        let (frame, from, to) = match &c.this {
+            Some((instance, from, to)) => (self.own(instance, base)? as u32, *from, *to),
+            None => (
+                self.code.layout.statics[pou],
+                0,
+                self.code.layout.pous[pou].0,
+            ),
+        };
+        let own = (frame + from) as usize..(frame + to) as usize;
+        self.st
+            .memory
+            .get_mut(own)
+            .ok_or(Fault::BadPointer)?
+            .fill(0);
         // Its own initial values, its block instances' (declared and given), as a POU's.
         self.init_pou(pou, frame)?;
         for (v, (offset, t, _)) in values.iter().zip(inputs.iter()) {

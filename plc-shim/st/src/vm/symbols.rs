@@ -40,7 +40,9 @@ impl Program {
         }
         for (i, pou) in c.pous.iter().enumerate() {
             if pou.kind == PouKind::Program {
-                for (k, v) in pou.vars.iter().enumerate().filter(|(_, v)| !v.constant) {
+                // Not the room of methods' variables (`M.x`): they live for one call.
+                let listed = |v: &&crate::check::Var| !v.constant && !v.name.contains('.');
+                for (k, v) in pou.vars.iter().enumerate().filter(|(_, v)| listed(v)) {
                     let path = format!("{}.{}", pou.name, v.name);
                     self.list(&path, &v.ty, l.statics[i] + l.pous[i].2[k], limit, &mut out);
                 }
@@ -78,7 +80,7 @@ impl Program {
                     .vars
                     .iter()
                     .enumerate()
-                    .filter(|(_, v)| !v.constant)
+                    .filter(|(_, v)| !v.constant && !v.name.contains('.'))
                 {
                     let at = at + l.pous[*i].2[k];
                     self.list(&format!("{path}.{}", v.name), &v.ty, at, limit, out);

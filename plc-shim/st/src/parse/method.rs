@@ -1,0 +1,104 @@
+//! METHOD and ACTION declarations (TwinCAT 3's and CODESYS 3's): inside their FUNCTION_BLOCK
+//! or PROGRAM after its body, or right after its `END_..`.
+//!
+//! ```text
+//! METHOD [PUBLIC|PRIVATE|PROTECTED|INTERNAL|FINAL] M_Name [: TYPE]
+//! VAR_INPUT .. END_VAR  VAR_OUTPUT .. END_VAR  VAR_IN_OUT .. END_VAR  VAR .. END_VAR
+//! <statements>
+//! END_METHOD
+//!
+//! ACTION A_Name:
+//! <statements>
+//! END_ACTION
+//! ```
+
+use super::Parser;
+use crate::ast::{Method, Section};
+use crate::diag::Diagnostic;
+use crate::lex::Tok;
+
+/// Access words a method may carry before its name.
+const OPEN: [&str; 3] = ["PUBLIC", "INTERNAL", "FINAL"];
+const CLOSED: [&str; 2] = ["PRIVATE", "PROTECTED"];
+
+impl Parser {
+    /// Whether a METHOD or an ACTION declaration begins here (the word followed by a name,
+    /// so that a variable called `action` is still one: `action S= b;`).
+    pub(super) fn method_start(&self) -> bool {
+        let word = |w: &str| matches!(self.peek(), Tok::Ident(x) if x.eq_ignore_ascii_case(w));
+        if !(word("METHOD") || word("ACTION")) {
+            return false;
+        }
+        let set = matches!(self.peek_at(1), Tok::Ident(w)
+            if w.eq_ignore_ascii_case("S") || w.eq_ignore_ascii_case("R"))
+            && matches!(self.peek_at(2), Tok::Eq);
+        matches!(self.peek_at(1), Tok::Ident(_)) && !set
+    }
+
+    /// A METHOD or an ACTION, from its word to its END_.. .
+    pub(super) fn method(&mut self) -> Result<Method, Diagnostic> {
+        let action = self.eat_kw("ACTION");
+        if !action {
+            self.expect_kw("METHOD")?;
+        }
+        let mut private = false;
+        while let Tok::Ident(w) = self.peek().clone() {
+            if !matches!(self.peek_at(1), Tok::Ident(_)) {
+                break;
+            }
+            if ["ABSTRACT", "OVERRIDE"]
+                .iter()
+                .any(|k| w.eq_ignore_ascii_case(k))
+            {
+                return Err(self.error(format!(
+                    "`{w}` is not supported: methods without EXTENDS neither are abstract nor \
+                     override"
+                )));
+            }
+            if CLOSED.iter().any(|k| w.eq_ignore_ascii_case(k)) {
+                private = true;
+            } else if !OPEN.iter().any(|k| w.eq_ignore_ascii_case(k)) {
+                break;
+            }
+            self.bump();
+        }
+        let name = self.name()?;
+        let returns = match (action, self.eat(&Tok::Colon)) {
+            (false, true) => Some(self.type_ref()?),
+            _ => None,
+        };
+        let mut vars = Vec::new();
+        while self.is_var_section() || self.is_kw("VAR_INST") {
+            if self.is_kw("VAR_INST") {
+                return Err(self.error(
+                    "`VAR_INST` is not supported: declare the variable in the function block",
+                ));
+            }
+            let block = self.var_block()?;
+            if action {
+                return Err(Diagnostic::new(
+                    block.pos,
+                    "an ACTION has no variables of its own: declare them in its POU",
+                ));
+            }
+            if matches!(block.section, Section::Global | Section::External) {
+                return Err(Diagnostic::new(
+                    block.pos,
+                    "a METHOD declares VAR_INPUT, VAR_OUTPUT, VAR_IN_OUT, VAR and VAR_TEMP",
+                ));
+            }
+            vars.push(block);
+        }
+        let end = if action { "END_ACTION" } else { "END_METHOD" };
+        let body = self.statements(&[end])?;
+        self.expect_kw(end)?;
+        Ok(Method {
+            name,
+            action,
+            private,
+            returns,
+            vars,
+            body,
+        })
+    }
+}
