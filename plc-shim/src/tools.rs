@@ -336,7 +336,12 @@ pub fn main(command: ToolCommand) -> ExitCode {
         ToolCommand::Check { files } => {
             return match crate::st::StProgram::load(files, 1) {
                 Ok(p) => {
-                    println!("{}: ok, {} POUs", files.len(), p.pous());
+                    let (pous, methods) = p.pous();
+                    let methods = match methods {
+                        0 => String::new(),
+                        n => format!(", {n} methods and actions"),
+                    };
+                    println!("{}: ok, {pous} POUs{methods}", files.len());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

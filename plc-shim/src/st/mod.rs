@@ -64,15 +64,18 @@ impl StProgram {
         })
     }
 
-    /// How many POUs the program's own files declare (not the HLI's or the library's).
-    pub fn pous(&self) -> usize {
+    /// How many POUs the program's own files declare (not the HLI's or the library's), and
+    /// how many methods and actions of them.
+    pub fn pous(&self) -> (usize, usize) {
         let files = &self.program.code().files;
         let own = |p: &&plc_st::check::PouDef| {
             files
                 .get(p.file)
                 .is_some_and(|f| f != PRELUDE && f != LIBRARY)
         };
-        self.program.code().checked.pous.iter().filter(own).count()
+        let pous = self.program.code().checked.pous.iter().filter(own);
+        let methods = pous.clone().filter(|p| p.method.is_some()).count();
+        (pous.count() - methods, methods)
     }
 
     /// Publishes the program's variables for `plc get|set|watch` on instance `instance`

@@ -170,6 +170,24 @@ fn the_st_twins_trace_as_their_timelines_do() {
     }
 }
 
+/// The same twin written in TwinCAT 3's object-oriented style (`plc-oop.st`: an axis block
+/// with METHODs that set what its body passes to its PLCopen blocks, a PRIVATE method and
+/// `THIS^`): its trace equals the timeline's tick for tick too.
+#[test]
+fn the_object_oriented_twin_traces_as_its_timeline_does() {
+    let dir = "axes-plcopen";
+    let (timeline, oop) = (
+        trace_of(dir, "scenario.toml"),
+        trace_of(dir, "scenario-oop.toml"),
+    );
+    assert!(timeline.len() > 10_000, "a trace of a run");
+    let first_difference = timeline.iter().zip(&oop).position(|(a, b)| a != b);
+    assert!(
+        timeline == oop,
+        "the object-oriented twin's trace differs from byte {first_difference:?} on"
+    );
+}
+
 /// `cnc demo --lockstep [--st]` into a scratch folder: the demo's trace.
 fn demo_trace(st: bool) -> Vec<u8> {
     let dir = Scratch::new(if st { "demo-st" } else { "demo-rust" });
