@@ -336,3 +336,50 @@ END_PROGRAM",
     assert_eq!((var("d"), var("lr"), var("d2")), (-1.0, 1.5, -2.0));
     assert_eq!((var("lt"), var("lt2")), (1e9, 2e9));
 }
+
+/// A STRING, and a structure holding one, pass as a VAR_IN_OUT and as an input (their bytes
+/// copied in and back as leaves of 8, 4, 2 and 1 bytes): a recipe with its name; a
+/// function that appends to the caller's STRING (both were refused: "a STRING as a
+/// VAR_IN_OUT of a function", "a VAR_IN_OUT of more than 64 values or of this type").
+#[test]
+fn strings_and_structures_holding_them_pass_by_in_out_and_input() {
+    let p = run(
+        "TYPE ST_Recipe : STRUCT sName : STRING(30); aSteps : ARRAY[1..3] OF LREAL; nCount : INT; END_STRUCT END_TYPE
+FUNCTION_BLOCK FB_Recipe
+VAR_IN_OUT stRecipe : ST_Recipe; END_VAR
+VAR_OUTPUT fSum : LREAL; END_VAR
+VAR i : INT; END_VAR
+    fSum := 0.0;
+    FOR i := 1 TO stRecipe.nCount DO
+        fSum := fSum + stRecipe.aSteps[i];
+    END_FOR
+    stRecipe.sName := CONCAT(stRecipe.sName, '!');
+END_FUNCTION_BLOCK
+FUNCTION F_Tag : INT
+VAR_IN_OUT s : STRING; END_VAR
+VAR_INPUT r : ST_Recipe; END_VAR
+    s := CONCAT(s, r.sName);
+    F_Tag := LEN(s);
+END_FUNCTION
+PROGRAM MAIN
+VAR
+    stR : ST_Recipe := (sName := 'Cake', aSteps := [1.5, 2.5, 9.0], nCount := 2);
+    fbR : FB_Recipe;
+    sLog : STRING := 'log:';
+    n : INT;
+    fSum : LREAL;
+    bName, bLog : BOOL;
+END_VAR
+    fbR(stRecipe := stR, fSum => fSum);
+    n := F_Tag(sLog, stR);
+    bName := stR.sName = 'Cake!';
+    bLog := sLog = 'log:Cake!';
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("fSum"), 4.0);
+    assert_eq!(var("bName"), 1.0);
+    assert_eq!(var("bLog"), 1.0);
+    assert_eq!(var("n"), 9.0);
+}

@@ -341,14 +341,6 @@ END_PROGRAM"
         e.contains("main.st:25:16: error: INT where STRING(10) is wanted"),
         "{e}"
     );
-    let e = refused(
-        "FUNCTION F_Io : INT VAR_IN_OUT s : STRING; END_VAR F_Io := 1; END_FUNCTION
-PROGRAM MAIN VAR s : STRING; n : INT; END_VAR n := F_Io(s); END_PROGRAM",
-    );
-    assert!(
-        e.contains("main.st:2:57: error: a STRING as a VAR_IN_OUT of a function"),
-        "{e}"
-    );
     let e = refused(&program("  n := F_Short('a');"));
     assert!(
         e.contains("main.st:25:8: error: STRING(3) where INT is wanted"),

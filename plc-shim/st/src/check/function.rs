@@ -43,9 +43,6 @@ impl Checker {
         }
         let leaves = match ty {
             Type::Elem(t) => vec![(0, *t)],
-            Type::Str(_) => {
-                return Err(self.unsupported(value.pos(), "a STRING as a VAR_IN_OUT of a function"))
-            }
             _ => self.leaves(ty, l).ok_or_else(|| {
                 let what = format!("a {role} of more than 64 values or of this type");
                 self.unsupported(value.pos(), &what)

@@ -99,8 +99,9 @@ impl Checker {
     }
 
     /// The elementary leaves of a structure or an array (offset, type), `None` beyond 64 of
-    /// them or for anything but elementary, pointer and enumeration values and structures
-    /// and arrays of them.
+    /// them or for anything but elementary, pointer, enumeration and STRING values and
+    /// structures and arrays of them. A STRING's bytes (its NUL's room included) are leaves
+    /// of 8, 4, 2 and 1 bytes, copied as they are.
     pub(super) fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
         let mut out = Vec::new();
         self.leaves_into(ty, 0, l, &mut out)?;
@@ -120,6 +121,22 @@ impl Checker {
             // its base type.
             Type::Pointer(_) if out.len() < 64 => out.push((at, Elem::ULInt)),
             Type::Enum(i) if out.len() < 64 => out.push((at, self.out.enums[*i].base)),
+            Type::Str(n) => {
+                let (mut k, size) = (0, n + 1);
+                while k < size {
+                    let (e, width) = match size - k {
+                        8.. => (Elem::ULInt, 8),
+                        4..=7 => (Elem::UDInt, 4),
+                        2..=3 => (Elem::UInt, 2),
+                        _ => (Elem::USInt, 1),
+                    };
+                    if out.len() >= 64 {
+                        return None;
+                    }
+                    out.push((at + k, e));
+                    k += width;
+                }
+            }
             Type::Struct(i) => {
                 for (k, (_, field)) in self.out.structs[*i].fields.iter().enumerate() {
                     self.leaves_into(field, at + l.structs[*i].2[k], l, out)?;
