@@ -341,7 +341,8 @@ pub fn main(command: ToolCommand) -> ExitCode {
                         0 => String::new(),
                         n => format!(", {n} methods and actions"),
                     };
-                    println!("{}: ok, {pous} POUs{methods}", files.len());
+                    let s = if pous == 1 { "" } else { "s" };
+                    println!("{}: ok, {pous} POU{s}{methods}", files.len());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

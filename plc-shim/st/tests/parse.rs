@@ -170,6 +170,10 @@ fn refusals_name_line_and_column() {
             "t.st:2:8: error: `ABSTRACT` is not supported",
         ),
         (
+            "FUNCTION_BLOCK FB\nMETHOD FB_init : BOOL\nEND_METHOD\nEND_FUNCTION_BLOCK",
+            "t.st:2:8: error: `FB_init` is not supported: nothing calls it here",
+        ),
+        (
             "FUNCTION F : INT\n  F := 1;\nMETHOD M : BOOL\nEND_METHOD\nEND_FUNCTION",
             "t.st:3:1: error: a FUNCTION has no METHOD or ACTION",
         ),

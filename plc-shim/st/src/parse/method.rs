@@ -63,6 +63,18 @@ impl Parser {
             self.bump();
         }
         let name = self.name()?;
+        // Methods the runtime of TwinCAT would call by itself: here none would call them.
+        let implicit = ["FB_INIT", "FB_REINIT", "FB_EXIT"];
+        if implicit.iter().any(|m| name.text.eq_ignore_ascii_case(m)) {
+            return Err(Diagnostic::new(
+                name.pos,
+                format!(
+                    "`{}` is not supported: nothing calls it here; give the block's variables \
+                     their initial values in their declarations",
+                    name.text
+                ),
+            ));
+        }
         let returns = match (action, self.eat(&Tok::Colon)) {
             (false, true) => Some(self.type_ref()?),
             _ => None,
