@@ -106,10 +106,21 @@ pub struct FnCall {
     /// Its outputs given in the call (`frac => f`; offsets in its frame), written after it
     /// in their order as a block's are.
     pub outputs: Vec<BlockOutput>,
-    /// A method's call: its frame is the instance at this place (its program's memory),
-    /// and only its own variables start from zero and their initial values, those from
-    /// the first offset to the second.
-    pub this: Option<(Addr, u32, u32)>,
+    /// A method's call: its frame is an instance (its program's memory).
+    pub this: Option<ThisCall>,
+}
+
+/// A method's call ([`FnCall::this`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ThisCall {
+    /// The instance (found after the values, as the function's frame is then taken).
+    pub instance: Addr,
+    /// Its own variables, from this offset in the instance to the next: only they start
+    /// from zero and their initial values at each call.
+    pub own: (u32, u32),
+    /// Its value's offset in the instance (read there after the call, from the frame the
+    /// call ran on, not from the instance's place found again).
+    pub value: u32,
 }
 
 /// A STRING's characters: a literal's (NUL-padded), a variable's `size` bytes at a place, or

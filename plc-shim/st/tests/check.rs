@@ -246,14 +246,14 @@ END_PROGRAM",
 }
 
 /// What the language reads but the runtime does not hold is refused by name, never taken as
-/// something else: a REFERENCE is no POINTER (it is read without `^` and bound with REF=),
-/// a WSTRING no STRING.
+/// something else: a WSTRING is no STRING, a REFERENCE inside another type no POINTER (a
+/// variable's own REFERENCE TO is supported: tests/references.rs).
 #[test]
 fn references_and_wide_strings_are_refused_by_name() {
-    let e = refusals("r : REFERENCE TO INT;\nw : WSTRING;", "");
+    let e = refusals("r : ARRAY[0..1] OF REFERENCE TO INT;\nw : WSTRING;", "");
     assert_eq!(e.len(), 2, "{e:?}");
     assert!(
-        e[0].starts_with("p.st:3:5: error: REFERENCE TO is not supported"),
+        e[0].starts_with("p.st:3:20: error: REFERENCE TO inside a type"),
         "{e:?}"
     );
     assert!(

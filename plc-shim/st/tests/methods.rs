@@ -251,3 +251,79 @@ END_FUNCTION_BLOCK",
         assert!(e.starts_with(expect), "{text}:\n{e}");
     }
 }
+
+/// Inside its POU a method's name wins over a standard function's, a text function's and a
+/// global function's (as in TwinCAT), in the checker and in the compiled code alike; a
+/// method's value is read from the instance it ran on, even when the call moved the index
+/// that found it; a method may be called `Private`.
+#[test]
+fn a_methods_name_wins_inside_its_pou_and_its_value_comes_from_its_instance() {
+    let p = run(
+        "VAR_GLOBAL gI : INT; END_VAR
+FUNCTION Init : INT
+    Init := -1;
+END_FUNCTION
+FUNCTION_BLOCK FB_List
+VAR_INPUT nId : INT; END_VAR
+VAR_OUTPUT nDeleted, nMax, nInit, nMine : INT; END_VAR
+    Delete(idx := 3);
+    nMax := Max(2, 9);
+    nInit := THIS^.Init();
+    Private();
+METHOD Delete
+VAR_INPUT idx : INT; END_VAR
+    nDeleted := idx;
+END_METHOD
+METHOD Max : INT
+VAR_INPUT a, b : INT; END_VAR
+    Max := a * b;
+END_METHOD
+METHOD Init : INT
+    Init := 7;
+END_METHOD
+METHOD Private
+    nMine := 1;
+END_METHOD
+METHOD Next : INT
+    gI := gI + 1;
+    Next := nId;
+END_METHOD
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    fb : FB_List;
+    aLists : ARRAY[0..2] OF FB_List;
+    nDeleted, nMax, nInit, nMine, nNext, nGlobal : INT;
+END_VAR
+    fb();
+    nDeleted := fb.nDeleted;
+    nMax := fb.nMax;
+    nInit := fb.nInit;
+    nMine := fb.nMine;
+    aLists[0](nId := 10);
+    aLists[1](nId := 11);
+    nNext := aLists[gI].Next();
+    nGlobal := Init();
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("nDeleted"), 3.0);
+    assert_eq!(var("nMax"), 18.0);
+    assert_eq!(var("nInit"), 7.0);
+    assert_eq!(var("nMine"), 1.0);
+    // The instance it ran on: aLists[0], though gI is 1 after the call.
+    assert_eq!(var("nNext"), 10.0);
+    assert_eq!(var("nGlobal"), -1.0);
+    let e = refused(
+        "VAR_GLOBAL g : INT; END_VAR
+FUNCTION_BLOCK FB
+VAR n : INT; END_VAR
+    n := THIS^.g;
+END_FUNCTION_BLOCK",
+    );
+    assert!(
+        e.contains("main.st:4:16: error: `g` is no member of FB (THIS^)"),
+        "{e}"
+    );
+}

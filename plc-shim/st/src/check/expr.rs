@@ -204,8 +204,9 @@ impl Checker {
                 return pou.returns.clone().map(Meaning::Return);
             }
             // A method's own name inside it: its value.
-            if (pou.method.as_ref()).is_some_and(|m| m.name.eq_ignore_ascii_case(name)) {
-                return pou.returns.clone().map(Meaning::Return);
+            let named = (pou.method.as_ref()).is_some_and(|m| m.name.eq_ignore_ascii_case(name));
+            if let (true, Some(t)) = (named, &pou.returns) {
+                return Some(Meaning::Return(t.clone()));
             }
         }
         let upper = name.to_ascii_uppercase();
@@ -604,8 +605,14 @@ impl Checker {
 
     /// A call whose value is used: a function, a standard function or a conversion.
     fn call_value(&mut self, callee: &Expr, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
-        if let (Expr::Field(..), Some((m, _))) = (callee, self.method_of(callee, ctx)) {
-            return self.method_call(m, (args, pos), ctx, true);
+        // A method first: inside its POU its name wins over the standard's and globals'.
+        if let Some((m, _)) = self.method_of(callee, ctx) {
+            let at = if let Expr::Name(n) = callee {
+                n.pos
+            } else {
+                pos
+            };
+            return self.method_call(m, (args, at), ctx, true);
         }
         let Expr::Name(n) = callee else {
             let why = self.no_method(callee, ctx);
@@ -640,9 +647,6 @@ impl Checker {
         }
         if std_lib::FUNCTIONS.contains(&upper.as_str()) {
             return self.std_function(&upper, args, n.pos, ctx);
-        }
-        if let Some((m, _)) = self.method_of(callee, ctx) {
-            return self.method_call(m, (args, n.pos), ctx, true);
         }
         match self.meaning(&n.text, ctx) {
             Some(Meaning::Function(i)) => self.function_call(i, args, n.pos, ctx),

@@ -593,6 +593,10 @@ impl Checker {
         let Expr::Call { callee, args, .. } = call else {
             return Err(self.unsupported(call.pos(), "this call"));
         };
+        // A method first, as the checker resolves it.
+        if self.method_of(callee, ctx).is_some() {
+            return Ok(StKind::Eval(self.statement_value(call, ctx, l)?));
+        }
         let errors = self.errors.len();
         let ty = self.expr(callee, ctx);
         self.errors.truncate(errors);

@@ -21,7 +21,7 @@ use crate::ast::{
     Arg, Expr, Init, Item, Method, Name, Pou, PouKind, Section, TypeRef, Unit, VarBlock, VarDecl,
 };
 use crate::diag::Pos;
-use crate::ir::{Addr, Ex};
+use crate::ir::{Addr, Ex, ThisCall};
 use crate::layout::Layout;
 
 /// What makes a POU a method: found by the checker from its name (upper case, `P.M`).
@@ -60,6 +60,9 @@ pub(super) struct Found {
 
 /// The name of a method's value slot when it has no value (no name a program can write).
 pub(super) const NO_VALUE: &str = "()";
+
+/// The base of a call of a method on the current instance (no name a program can write).
+pub(super) const THIS: &str = "THIS^";
 
 /// The files with every method as a POU of its own, and the methods found.
 pub(super) fn desugar(files: &[(String, Unit)]) -> (Vec<(String, Unit)>, Vec<Found>) {
@@ -260,14 +263,43 @@ impl super::Checker {
         }
     }
 
-    /// The method `callee` calls, if it names one: `M(..)` in its POU's body or methods,
-    /// `fb.M(..)` of an instance of its function block. Its POU index and whether it is
-    /// called on the current instance.
+    /// `M` of a call `M(..)` in its POU's body or methods, made `THIS^.M(..)` (the base a
+    /// name no program writes, [`THIS`]) before the bodies are checked: inside its POU a
+    /// method's name wins over a global, a function and a standard or text function of that
+    /// name (as in TwinCAT), and nothing that reads calls by name takes it for one of those;
+    /// a variable of the caller's hides it.
+    pub(super) fn own_method_callee(&mut self, callee: &mut Expr, ctx: Ctx) {
+        let Expr::Name(n) = callee else {
+            return;
+        };
+        let Some(owner) = self.family(ctx.pou) else {
+            return;
+        };
+        if matches!(self.meaning(&n.text, ctx), Some(Meaning::Local(_))) {
+            return;
+        }
+        let key = format!("{}.{}", self.out.pous[owner].name, n.text).to_ascii_uppercase();
+        if let Some(super::Named::Pou(m)) = self.names.get(&key) {
+            if self.out.pous[*m].method.is_some() {
+                let (name, pos) = (n.clone(), n.pos);
+                *callee = Expr::Field(
+                    Box::new(Expr::Name(Name {
+                        text: THIS.into(),
+                        pos,
+                    })),
+                    name,
+                );
+            }
+        }
+    }
+
+    /// The method `callee` calls, if it names one: `THIS^.M(..)` ([`Checker::own_method_callee`])
+    /// in its POU's body or methods, `fb.M(..)` of an instance of its function block. Its
+    /// POU index and whether it is called on the current instance.
     pub(super) fn method_of(&mut self, callee: &Expr, ctx: Ctx) -> Option<(usize, bool)> {
         let (owner, name, this) = match callee {
-            Expr::Name(n) => {
-                let free = matches!(self.meaning(&n.text, ctx), None | Some(Meaning::Return(_)));
-                (self.family(ctx.pou).filter(|_| free)?, n, true)
+            Expr::Field(base, n) if matches!(&**base, Expr::Name(t) if t.text == THIS) => {
+                (self.family(ctx.pou)?, n, true)
             }
             Expr::Field(base, n) => {
                 let errors = self.errors.len();
@@ -366,15 +398,20 @@ impl super::Checker {
         };
         let mut call = self.function_call_ir(m, args, pos, ctx, l)?;
         call.value = Addr::Offset(Box::new(instance.clone()), at);
-        call.this = Some((instance, start.unwrap_or(end), end));
+        call.this = Some(ThisCall {
+            instance,
+            own: (start.unwrap_or(end), end),
+            value: at,
+        });
         Ok(Ex::Call(Box::new(call), value_ty))
     }
 }
 
 impl super::Checker {
     /// `x` of `THIS^.x` where the POU `ctx` is in has an instance (no variable is called
-    /// THIS there).
-    pub(super) fn this_member(&self, e: &Expr, ctx: Ctx) -> Option<Name> {
+    /// THIS there); an `x` that is neither a variable nor a method of the instance is
+    /// refused (it would be read as a global or a method's own variable).
+    pub(super) fn this_member(&mut self, e: &Expr, ctx: Ctx) -> Option<Name> {
         let Expr::Field(base, member) = e else {
             return None;
         };
@@ -384,8 +421,20 @@ impl super::Checker {
         let Expr::Name(n) = &**this else {
             return None;
         };
-        let own = n.text.eq_ignore_ascii_case("THIS") && self.family(ctx.pou).is_some();
-        (own && self.meaning(&n.text, ctx).is_none()).then(|| member.clone())
+        let family = self
+            .family(ctx.pou)
+            .filter(|_| n.text.eq_ignore_ascii_case("THIS"));
+        let family = family.filter(|_| self.meaning(&n.text, ctx).is_none())?;
+        let owner = &self.out.pous[family];
+        let var = (owner.vars.iter())
+            .any(|v| !v.name.contains('.') && v.name.eq_ignore_ascii_case(&member.text));
+        let key = format!("{}.{}", owner.name, member.text).to_ascii_uppercase();
+        let method = matches!(self.names.get(&key), Some(super::Named::Pou(_)));
+        if !var && !method {
+            let why = format!("`{}` is no member of {} (THIS^)", member.text, owner.name);
+            self.refuse(member.pos, why);
+        }
+        Some(member.clone())
     }
 }
 

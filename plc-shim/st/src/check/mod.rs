@@ -18,6 +18,7 @@ mod lower;
 mod methods;
 pub use methods::MethodOf;
 mod place;
+pub(crate) mod reference;
 pub mod std_lib;
 mod std_type;
 mod std_value;
@@ -81,6 +82,8 @@ pub struct Var {
     pub constant: bool,
     /// Where it is declared.
     pub pos: Pos,
+    /// A REFERENCE TO (its type the pointer it is underneath: `check::reference`).
+    pub reference: bool,
 }
 
 /// A program, function block or function with its variables resolved.
@@ -402,11 +405,12 @@ impl Checker {
             TypeRef::Named(n) => self.named_type(n, depth),
             TypeRef::Pointer(t, _) => Type::Pointer(Box::new(self.type_of(t, depth))),
             TypeRef::Reference(_, pos) => {
-                // Not a pointer under another name: a reference is read and written through
-                // without `^` and bound with REF=.
+                // A variable's own type only (`decl_type`): one inside another type would be
+                // read without `^` in places the rewrite does not see.
                 self.refuse(
                     *pos,
-                    "REFERENCE TO is not supported: use POINTER TO with ADR() and `^`",
+                    "REFERENCE TO inside a type (an array's element, a structure's field, a \
+                     pointer's target) is not supported: use POINTER TO with ADR() and `^`",
                 );
                 Type::Error
             }
@@ -555,9 +559,9 @@ impl Checker {
                 match item {
                     Item::Globals(block) => {
                         for d in &block.vars {
-                            let ty = self.type_of(&d.ty, 0);
+                            let (ty, reference) = self.decl_type(d, block.section);
                             for n in &d.names {
-                                self.declare_global(n, ty.clone(), block.constant);
+                                self.declare_global(n, ty.clone(), (block.constant, reference));
                             }
                         }
                     }
@@ -568,7 +572,7 @@ impl Checker {
         }
     }
 
-    fn declare_global(&mut self, n: &Name, ty: Type, constant: bool) {
+    fn declare_global(&mut self, n: &Name, ty: Type, (constant, reference): (bool, bool)) {
         let key = n.text.to_ascii_uppercase();
         if self.globals.contains_key(&key) {
             self.refuse(n.pos, format!("global `{}` is declared twice", n.text));
@@ -580,6 +584,7 @@ impl Checker {
             section: Section::Global,
             constant,
             pos: n.pos,
+            reference,
         });
         self.globals.insert(key, self.out.globals.len() - 1);
     }
@@ -607,7 +612,7 @@ impl Checker {
                 continue;
             }
             for d in &block.vars {
-                let ty = self.type_of(&d.ty, 0);
+                let (ty, reference) = self.decl_type(d, block.section);
                 for n in &d.names {
                     if vars.iter().any(|v| v.name.eq_ignore_ascii_case(&n.text)) {
                         self.refuse(n.pos, format!("`{}` is declared twice", n.text));
@@ -618,6 +623,7 @@ impl Checker {
                         section: block.section,
                         constant: block.constant,
                         pos: n.pos,
+                        reference,
                     });
                 }
             }

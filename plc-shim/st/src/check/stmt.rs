@@ -252,6 +252,10 @@ impl Checker {
     }
 
     fn assign(&mut self, target: &Expr, value: &Expr, ctx: Ctx) {
+        // `r REF= x` (`check::reference`).
+        if self.check_binding(target, value, ctx) {
+            return;
+        }
         if let Some(want) = self.writable(target, ctx) {
             match want {
                 Type::Fb(_) | Type::StdFb(_) => {

@@ -80,7 +80,9 @@ impl Checker {
     fn name_in_stmt(&mut self, s: &mut Stmt, ctx: Ctx) {
         match s {
             Stmt::Assign { target, value } => {
-                self.name_in(target, ctx);
+                if !self.bind_reference(target, value, ctx) {
+                    self.name_in(target, ctx);
+                }
                 self.name_in(value, ctx);
             }
             Stmt::Call(e) => self.name_in(e, ctx),
@@ -128,6 +130,9 @@ impl Checker {
         // method's variables may not take its POU's names, so nothing hides it).
         if let Some(member) = self.this_member(e, ctx) {
             *e = Expr::Name(member);
+        }
+        // A REFERENCE TO's use: `r` is `r^` (`check::reference`).
+        if self.reference_use(e, ctx) {
             return;
         }
         match e {
@@ -146,6 +151,7 @@ impl Checker {
             Expr::Call { callee, args, .. } => {
                 // An instance's place may hold calls too (`fbs[TO_INT(r)](..)`).
                 self.name_in(callee, ctx);
+                self.own_method_callee(callee, ctx);
                 for arg in args.iter_mut() {
                     match arg {
                         Arg::Positional(v) | Arg::Input(_, v) => self.name_in(v, ctx),

@@ -35,6 +35,11 @@ impl Parser {
         matches!(self.peek_at(1), Tok::Ident(_)) && !set
     }
 
+    fn section_word(&self, w: &str) -> bool {
+        super::SECTIONS.iter().any(|s| s.eq_ignore_ascii_case(w))
+            || w.eq_ignore_ascii_case("VAR_INST")
+    }
+
     /// A METHOD or an ACTION, from its word to its END_.. .
     pub(super) fn method(&mut self) -> Result<Method, Diagnostic> {
         let action = self.eat_kw("ACTION");
@@ -43,7 +48,14 @@ impl Parser {
         }
         let mut private = false;
         while let Tok::Ident(w) = self.peek().clone() {
-            if !matches!(self.peek_at(1), Tok::Ident(_)) {
+            // An access word before a name (a method may be called `Private`, and its body
+            // may begin with a name: `METHOD Private  n := 1;`).
+            let named = matches!(self.peek_at(1), Tok::Ident(n) if !super::reserved(n) && !self.section_word(n));
+            let statement = matches!(
+                self.peek_at(2),
+                Tok::Assign | Tok::LParen | Tok::Dot | Tok::LBracket | Tok::Caret | Tok::Eq
+            );
+            if !named || statement {
                 break;
             }
             if ["ABSTRACT", "OVERRIDE"]

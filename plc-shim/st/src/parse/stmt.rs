@@ -97,6 +97,17 @@ impl Parser {
             self.expect(&Tok::Semi, "`;`")?;
             return Ok(Stmt::Assign { target, value });
         }
+        // `r REF= x;`: a REFERENCE TO bound (`check::reference`).
+        let bind = matches!(self.peek(), Tok::Ident(w) if w.eq_ignore_ascii_case("REF"))
+            && matches!(self.peek_at(1), Tok::Eq);
+        if bind {
+            let at = self.pos();
+            self.bump();
+            self.bump();
+            let value = crate::check::reference::bind(self.expr()?, at);
+            self.expect(&Tok::Semi, "`;`")?;
+            return Ok(Stmt::Assign { target, value });
+        }
         if matches!(target, Expr::Call { .. }) {
             self.expect(&Tok::Semi, "`;`")?;
             return Ok(Stmt::Call(target));

@@ -132,8 +132,8 @@ fn of_fn_call(c: &FnCall, out: &mut Vec<usize>) {
     of_addr(&c.value, out);
     c.back.iter().for_each(|(_, _, a)| of_addr(a, out));
     c.outputs.iter().for_each(|(_, _, a, _, _)| of_addr(a, out));
-    if let Some((a, _, _)) = &c.this {
-        of_addr(a, out);
+    if let Some(this) = &c.this {
+        of_addr(&this.instance, out);
     }
 }
 

@@ -686,17 +686,20 @@ impl<'a> Exec<'a> {
             Ex::TextEq(pair) => V::I(i64::from(self.text_eq(&pair.0, &pair.1, base)?)),
             Ex::Text(e) => self.text_value(e, base)?,
             Ex::Call(c, ty) => {
-                self.call_function(c, base)?;
-                let at = self.addr(&c.value, base)?;
+                let frame = self.call_function(c, base)?;
+                let at = match &c.this {
+                    Some(this) => Loc::Own(frame as usize + this.value as usize),
+                    None => self.addr(&c.value, base)?,
+                };
                 self.read(at, *ty)?
             }
         })
     }
 
     /// A user function's call (out of `eval`: its values' array would make every `eval`'s
-    /// frame large); its value is left in its frame.
+    /// frame large); its value is left in its frame, whose offset it returns.
     #[inline(never)]
-    fn call_function(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<()> {
+    pub(super) fn call_function(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<u32> {
         if c.texts.is_empty() {
             return self.call_with(c, base, &mut []);
         }
@@ -706,14 +709,14 @@ impl<'a> Exec<'a> {
     /// As [`Exec::call_function`] for a call with STRING inputs: their characters held
     /// on the stack meanwhile.
     #[inline(never)]
-    fn call_with_texts(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<()> {
+    fn call_with_texts(&mut self, c: &crate::ir::FnCall, base: u32) -> Run<u32> {
         let mut bufs: [text::Buf; crate::ir::MAX_TEXT_INPUTS] =
             core::array::from_fn(|_| text::Buf::new());
         let n = c.texts.len().min(bufs.len());
         self.call_with(c, base, &mut bufs[..n])
     }
 
-    fn call_with(&mut self, c: &crate::ir::FnCall, base: u32, bufs: &mut [text::Buf]) -> Run<()> {
+    fn call_with(&mut self, c: &crate::ir::FnCall, base: u32, bufs: &mut [text::Buf]) -> Run<u32> {
         let (pou, inputs, back) = (c.pou, &c.inputs, &c.back);
         // The values first, in their order (one may call this function too), then the frame.
         // A VAR_IN_OUT's leaf is read where its place is found, and goes back there: its
@@ -739,15 +742,17 @@ impl<'a> Exec<'a> {
         let statement = self.place();
         // A function's variables start from zero and their initial values each call; a
         // method's frame is its instance, whose own variables (only) do so.
-        let (frame, from, to) = match &c.this {
-            Some((instance, from, to)) => (self.own(instance, base)? as u32, *from, *to),
+        let (frame, (from, to)) = match &c.this {
+            Some(this) => {
+                let at = u32::try_from(self.own(&this.instance, base)?);
+                (at.map_err(|_| Fault::BadPointer)?, this.own)
+            }
             None => (
                 self.code.layout.statics[pou],
-                0,
-                self.code.layout.pous[pou].0,
+                (0, self.code.layout.pous[pou].0),
             ),
         };
-        let own = (frame + from) as usize..(frame + to) as usize;
+        let own = frame as usize + from as usize..frame as usize + to as usize;
         self.st
             .memory
             .get_mut(own)
@@ -768,7 +773,8 @@ impl<'a> Exec<'a> {
             let v = self.read_own((frame + offset) as usize, *t)?;
             self.write(at, *t, v)?;
         }
-        self.read_outputs(&c.outputs, frame, base)
+        self.read_outputs(&c.outputs, frame, base)?;
+        Ok(frame)
     }
 
     /// Whether two STRINGs hold the same characters before their NUL (or their end).
