@@ -185,6 +185,8 @@ pub struct TypeDecl {
 pub enum TypeDef {
     /// `STRUCT .. END_STRUCT`.
     Struct(Vec<VarDecl>),
+    /// `UNION .. END_UNION`: fields that share their bytes.
+    Union(Vec<VarDecl>),
     /// `(A, B := 5, C) [INT]`: the values, each with its number if given, and the base type.
     Enum {
         /// The values.

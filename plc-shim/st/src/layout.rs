@@ -174,6 +174,16 @@ impl Layout {
         }
         let types: Vec<Type> = c.structs[i].fields.iter().map(|(_, t)| t.clone()).collect();
         self.structs[i] = self.record(c, &types, state)?;
+        if c.structs[i].union {
+            // Every field at offset 0; the size the largest's, aligned to the strictest.
+            let (mut size, mut align) = (0, 1);
+            for t in &types {
+                let (s, a) = self.size_align(c, t);
+                (size, align) = (size.max(s), align.max(a));
+            }
+            let offsets = vec![0; types.len()];
+            self.structs[i] = (size.div_ceil(align) * align, align, offsets);
+        }
         state[i] = 2;
         Ok(())
     }

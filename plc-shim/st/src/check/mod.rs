@@ -56,6 +56,8 @@ pub struct StructDef {
     pub name: String,
     /// Name and type of each field.
     pub fields: Vec<(String, Type)>,
+    /// A UNION: every field at offset 0, sharing the bytes.
+    pub union: bool,
 }
 
 /// An enumeration: its values and base type.
@@ -270,10 +272,11 @@ impl Checker {
                     Item::Types(decls) => {
                         for d in decls {
                             let named = match &d.def {
-                                TypeDef::Struct(_) => {
+                                TypeDef::Struct(_) | TypeDef::Union(_) => {
                                     self.out.structs.push(StructDef {
                                         name: d.name.text.clone(),
                                         fields: Vec::new(),
+                                        union: matches!(d.def, TypeDef::Union(_)),
                                     });
                                     Named::Struct(self.out.structs.len() - 1)
                                 }
@@ -330,9 +333,16 @@ impl Checker {
                     for d in decls {
                         let key = d.name.text.to_ascii_uppercase();
                         match (&d.def, self.names.get(&key).cloned(), enums) {
-                            (TypeDef::Struct(fields), Some(Named::Struct(i)), false) => {
+                            (
+                                TypeDef::Struct(fields) | TypeDef::Union(fields),
+                                Some(Named::Struct(i)),
+                                false,
+                            ) => {
                                 let fields = self.fields(fields);
                                 self.out.structs[i].fields = fields;
+                                if self.out.structs[i].union {
+                                    self.union_fields(i, &d.name);
+                                }
                             }
                             (TypeDef::Enum { values, base }, Some(Named::Enum(i)), true) => {
                                 self.enum_values(i, values, base.as_ref());
@@ -342,6 +352,23 @@ impl Checker {
                     }
                 }
             }
+        }
+    }
+
+    /// A UNION's fields share their bytes: a function block instance among them (whose
+    /// state is its block's) is refused.
+    fn union_fields(&mut self, i: usize, name: &Name) {
+        let instance = |t: &Type| match t {
+            Type::Fb(_) | Type::StdFb(_) => true,
+            Type::Array(_, e) => matches!(**e, Type::Fb(_) | Type::StdFb(_)),
+            _ => false,
+        };
+        if self.out.structs[i].fields.iter().any(|(_, t)| instance(t)) {
+            let why = format!(
+                "UNION {}: a function block instance shares no bytes",
+                name.text
+            );
+            self.refuse(name.pos, why);
         }
     }
 

@@ -508,15 +508,22 @@ impl Parser {
     }
 
     fn type_def(&mut self) -> Result<TypeDef, Diagnostic> {
-        if self.eat_kw("STRUCT") {
+        for (open, close) in [("STRUCT", "END_STRUCT"), ("UNION", "END_UNION")] {
+            if !self.eat_kw(open) {
+                continue;
+            }
             let mut fields = Vec::new();
-            while !self.eat_kw("END_STRUCT") {
+            while !self.eat_kw(close) {
                 if self.at_eof() {
-                    return Err(self.error("a STRUCT without its END_STRUCT"));
+                    return Err(self.error(format!("a {open} without its {close}")));
                 }
                 fields.push(self.var_decl_of(true)?);
             }
-            return Ok(TypeDef::Struct(fields));
+            return Ok(if open == "UNION" {
+                TypeDef::Union(fields)
+            } else {
+                TypeDef::Struct(fields)
+            });
         }
         if self.eat(&Tok::LParen) {
             let mut values = Vec::new();
