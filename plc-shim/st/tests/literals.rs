@@ -133,6 +133,7 @@ VAR
     i, j, m, q, c : INT;
     b : BYTE;
     r : REAL;
+    lr : LREAL;
     big : LINT;
 END_VAR
     i := 200 * 2;
@@ -140,6 +141,7 @@ END_VAR
     m := -7 MOD 3;
     b := 16#F0 + 15;
     r := 100.0 / 60.0;
+    lr := 10 ** 2;
     big := 2147483647 + 1;
     q := i * (2 + 1);
     CASE j OF
@@ -157,6 +159,7 @@ END_PROGRAM",
     assert_eq!(var("b"), 255.0);
     assert_eq!(var("r"), f64::from((100.0f64 / 60.0) as f32));
     assert_eq!(var("big"), 2147483648.0);
+    assert_eq!(var("lr"), 100.0);
     assert_eq!(var("q"), 1200.0);
     assert_eq!(var("c"), 1.0);
     let text = |body: &str| {

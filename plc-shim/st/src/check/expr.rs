@@ -93,7 +93,8 @@ pub(super) fn real_literal(e: &Expr) -> Option<f64> {
         Expr::Unary(UnOp::Neg, inner, _) => real_literal(inner).map(|v| -v),
         Expr::Binary(op, l, r, _) => {
             let (a, b) = (real_literal(l), real_literal(r));
-            if a.is_none() && b.is_none() {
+            // `**` is a real's power (EXPT) even of two integers (`10 ** 2` is 100.0).
+            if a.is_none() && b.is_none() && *op != BinOp::Pow {
                 return None;
             }
             let number = |x: Option<f64>, e: &Expr| x.or_else(|| literal(e).map(|v| v as f64));
@@ -103,6 +104,7 @@ pub(super) fn real_literal(e: &Expr) -> Option<f64> {
                 BinOp::Sub => a - b,
                 BinOp::Mul => a * b,
                 BinOp::Div => a / b,
+                BinOp::Pow => a.powf(b),
                 _ => return None,
             };
             v.is_finite().then_some(v)
@@ -271,6 +273,8 @@ impl Checker {
             Expr::Binary(..) if literal(e).is_some() => {
                 Type::Elem(literal(e).and_then(Elem::of_literal).unwrap_or(Elem::LInt))
             }
+            // A constant `**` of literals: an LREAL, as a real literal is.
+            Expr::Binary(BinOp::Pow, ..) if real_literal(e).is_some() => Type::Elem(Elem::LReal),
             Expr::Binary(op, l, r, pos) => self.binary(*op, l, r, *pos, ctx),
         }
     }
