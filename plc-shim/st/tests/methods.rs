@@ -252,8 +252,9 @@ END_FUNCTION_BLOCK",
     }
 }
 
-/// Inside its POU a method's name wins over a standard function's, a text function's and a
-/// global function's (as in TwinCAT), in the checker and in the compiled code alike; a
+/// Inside its POU a method's name wins over a text function's (LEFT, DELETE) and a global
+/// function's (as in TwinCAT), in the checker and in the compiled code alike (an operator's
+/// name, MAX or ADR, is refused as a method's); a
 /// method's value is read from the instance it ran on, even when the call moved the index
 /// that found it; a method may be called `Private`.
 #[test]
@@ -267,16 +268,16 @@ FUNCTION_BLOCK FB_List
 VAR_INPUT nId : INT; END_VAR
 VAR_OUTPUT nDeleted, nMax, nInit, nMine : INT; END_VAR
     Delete(idx := 3);
-    nMax := Max(2, 9);
+    nMax := Left(2, 9);
     nInit := THIS^.Init();
     Private();
 METHOD Delete
 VAR_INPUT idx : INT; END_VAR
     nDeleted := idx;
 END_METHOD
-METHOD Max : INT
+METHOD Left : INT
 VAR_INPUT a, b : INT; END_VAR
-    Max := a * b;
+    Left := a * b;
 END_METHOD
 METHOD Init : INT
     Init := 7;
@@ -326,4 +327,15 @@ END_FUNCTION_BLOCK",
         e.contains("main.st:4:16: error: `g` is no member of FB (THIS^)"),
         "{e}"
     );
+    for op in ["Max", "ADR", "SIZEOF", "INT_TO_REAL", "TO_INT"] {
+        let e = refused(&format!(
+            "FUNCTION_BLOCK FB\nMETHOD {op} : INT\n    {op} := 1;\nEND_METHOD\nEND_FUNCTION_BLOCK"
+        ));
+        assert!(
+            e.contains(&format!(
+                "main.st:2:8: error: `{op}` is an operator of the language"
+            )),
+            "{e}"
+        );
+    }
 }

@@ -56,6 +56,42 @@ END_PROGRAM",
     assert_eq!(var("nState"), 1.0);
 }
 
+/// `r2 REF= r1` copies what r1 stands for, bound or not (an unbound r1 leaves r2 unbound,
+/// no fault); `THIS^.r REF= x` and `__ISVALIDREF(THIS^.r)` in a block; a typed literal's
+/// enumeration value named as a reference is the value.
+#[test]
+fn rebinding_copies_what_a_reference_stands_for() {
+    let p = run(
+        "TYPE E_State : (Idle, Busy) INT; END_TYPE
+FUNCTION_BLOCK FB
+VAR r : REFERENCE TO INT; x : INT := 4; END_VAR
+VAR_OUTPUT bBound : BOOL; n : INT; END_VAR
+    THIS^.r REF= x;
+    bBound := __ISVALIDREF(THIS^.r);
+    n := r;
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    refA, refB : REFERENCE TO INT;
+    Busy : REFERENCE TO INT;
+    e : E_State;
+    bB, bBound : BOOL;
+    fb : FB;
+    n : INT;
+END_VAR
+    refB REF= refA;
+    bB := __ISVALIDREF(refB);
+    e := E_State#Busy;
+    fb(bBound => bBound, n => n);
+END_PROGRAM",
+        1,
+    );
+    let var = |name: &str| p.read_var(&format!("MAIN.{name}")).expect(name);
+    assert_eq!(var("bB"), 0.0);
+    assert_eq!(var("e"), 1.0);
+    assert_eq!((var("bBound"), var("n")), (1.0, 4.0));
+}
+
 #[test]
 fn an_unbound_reference_faults_where_it_is_used() {
     let mut p = Program::load(&[(
@@ -98,6 +134,22 @@ fn what_a_reference_may_not_be_is_refused_by_name() {
         (
             "FUNCTION_BLOCK FB END_FUNCTION_BLOCK\nPROGRAM MAIN VAR r : REFERENCE TO FB; fb : FB; END_VAR\n  r REF= fb;\nEND_PROGRAM",
             "main.st:3:10: error: ADR of a function block instance",
+        ),
+        (
+            "FUNCTION_BLOCK FB VAR_IN_OUT io : INT; END_VAR VAR r : REFERENCE TO INT; END_VAR\n  r REF= io;\nEND_FUNCTION_BLOCK",
+            "main.st:2:10: error: REF= of a VAR_IN_OUT",
+        ),
+        (
+            "FUNCTION_BLOCK FB VAR_IN_OUT io : INT; END_VAR VAR p : POINTER TO INT; END_VAR\n  p := ADR(io);\nEND_FUNCTION_BLOCK",
+            "main.st:2:12: error: ADR of a VAR_IN_OUT",
+        ),
+        (
+            "PROGRAM MAIN VAR CONSTANT r : REFERENCE TO INT; END_VAR END_PROGRAM",
+            "main.st:1:31: error: a REFERENCE TO is no CONSTANT",
+        ),
+        (
+            "PROGRAM MAIN VAR r : REFERENCE TO INT; q : REFERENCE TO LREAL; END_VAR\n  r REF= q;\nEND_PROGRAM",
+            "main.st:2:10: error: REF= binds a REFERENCE TO INT, not a REFERENCE TO LREAL",
         ),
         (
             "PROGRAM MAIN VAR r : REFERENCE TO INT; x : LREAL; END_VAR\n  r REF= x;\nEND_PROGRAM",

@@ -675,3 +675,38 @@ END_PROGRAM",
     );
     assert_eq!(q("MAIN.to_time.Q"), Some(1));
 }
+
+/// VAR_EXTERNAL names the global of that name (it declared a separate variable of the
+/// POU's: a write through it never reached the global); one without a global of its name
+/// and type is refused.
+#[test]
+fn var_external_names_the_global() {
+    let p = run(
+        "VAR_GLOBAL g : INT := 5; END_VAR
+PROGRAM MAIN
+VAR_EXTERNAL g : INT; END_VAR
+VAR n : INT; END_VAR
+    g := g + 1;
+    n := g;
+END_PROGRAM
+PROGRAM P2
+VAR m : INT; END_VAR
+    m := g;
+END_PROGRAM",
+        1,
+    );
+    assert_eq!(p.read_var("MAIN.n"), Some(6.0));
+    assert_eq!(p.read_var("P2.m"), Some(6.0));
+    let e = refused("PROGRAM MAIN VAR_EXTERNAL h : INT; END_VAR END_PROGRAM");
+    assert!(
+        e.contains("main.st:1:27: error: VAR_EXTERNAL `h`: no global variable of that name"),
+        "{e}"
+    );
+    let e = refused(
+        "VAR_GLOBAL g : INT; END_VAR\nPROGRAM MAIN VAR_EXTERNAL g : DINT; END_VAR END_PROGRAM",
+    );
+    assert!(
+        e.contains("main.st:2:27: error: VAR_EXTERNAL `g` is DINT: the global is INT"),
+        "{e}"
+    );
+}

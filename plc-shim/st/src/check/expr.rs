@@ -200,6 +200,12 @@ impl Checker {
                 .iter()
                 .position(|v| v.name.eq_ignore_ascii_case(name))
             {
+                // VAR_EXTERNAL names the global of that name (`check_externals`).
+                if pou.vars[i].section == crate::ast::Section::External {
+                    if let Some(g) = self.globals.get(&name.to_ascii_uppercase()) {
+                        return Some(Meaning::Global(*g));
+                    }
+                }
                 return Some(Meaning::Local(i));
             }
             if pou.kind == PouKind::Function && pou.name.eq_ignore_ascii_case(name) {

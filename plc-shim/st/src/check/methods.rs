@@ -237,12 +237,24 @@ impl super::Checker {
                 pou.vars.iter().map(|v| &v.ty).chain(&pou.returns).collect();
             let theirs: Vec<&super::Type> =
                 self.out.pous[parent].vars.iter().map(|v| &v.ty).collect();
-            if theirs.get(..mine.len()) != Some(&mine[..]) {
+            let refused = mine.iter().chain(&theirs).any(|t| **t == Type::Error);
+            if !refused && theirs.get(..mine.len()) != Some(&mine[..]) {
                 self.refuse(
                     f.name.pos,
                     "a method's variable whose type names the method's own constant is not \
                      supported: declare the constant in its POU",
                 );
+            }
+            let upper = f.name.text.to_ascii_uppercase();
+            let operator = super::std_lib::FUNCTIONS.contains(&upper.as_str())
+                || crate::types::conversion(&upper).is_some()
+                || super::to_type::target(&upper).is_some();
+            if operator {
+                let why = format!(
+                    "`{}` is an operator of the language: a method takes another name",
+                    f.name.text
+                );
+                self.refuse(f.name.pos, why);
             }
             let taken = (self.out.pous[parent].vars.iter())
                 .any(|v| v.name.eq_ignore_ascii_case(&f.name.text));
@@ -468,6 +480,39 @@ impl super::Checker {
         match ty {
             Type::Fb(f) => format!("{} has no method `{}`", self.out.pous[f].name, m.text),
             _ => "only functions and methods are called in an expression".into(),
+        }
+    }
+}
+
+impl super::Checker {
+    /// Every VAR_EXTERNAL names a global of its type (the POU's variable of that name
+    /// stands for the global: `Checker::meaning`).
+    pub(super) fn check_externals(&mut self, files: &[(String, Unit)]) {
+        for p in 0..self.out.pous.len() {
+            // A method's are its POU's, checked there.
+            if self.out.pous[p].method.is_some() {
+                continue;
+            }
+            for k in 0..self.out.pous[p].vars.len() {
+                let v = &self.out.pous[p].vars[k];
+                if v.section != Section::External {
+                    continue;
+                }
+                let global = self.globals.get(&v.name.to_ascii_uppercase()).copied();
+                let why = match global.map(|g| &self.out.globals[g]) {
+                    None => format!("VAR_EXTERNAL `{}`: no global variable of that name", v.name),
+                    Some(g) if g.ty != v.ty || g.reference != v.reference => {
+                        let (want, got) = (self.type_name(&g.ty), self.type_name(&v.ty));
+                        format!("VAR_EXTERNAL `{}` is {got}: the global is {want}", v.name)
+                    }
+                    Some(_) => continue,
+                };
+                let pos = v.pos;
+                self.file = files
+                    .get(self.out.pous[p].file)
+                    .map_or_else(String::new, |(n, _)| n.clone());
+                self.refuse(pos, why);
+            }
         }
     }
 }

@@ -148,6 +148,7 @@ fn checker(files: &[(String, Unit)]) -> Result<(Checker, Files), Vec<Diagnostic>
     c.resolve_types(files);
     c.resolve_vars(files);
     c.bind_methods(&found, files);
+    c.check_externals(files);
     let files = c.name_conversions(files);
     c.check_bodies(&files);
     if c.errors.is_empty() {
@@ -586,7 +587,8 @@ impl Checker {
                 match item {
                     Item::Globals(block) => {
                         for d in &block.vars {
-                            let (ty, reference) = self.decl_type(d, block.section);
+                            let (ty, reference) =
+                                self.decl_type(d, (block.section, block.constant));
                             for n in &d.names {
                                 self.declare_global(n, ty.clone(), (block.constant, reference));
                             }
@@ -639,7 +641,7 @@ impl Checker {
                 continue;
             }
             for d in &block.vars {
-                let (ty, reference) = self.decl_type(d, block.section);
+                let (ty, reference) = self.decl_type(d, (block.section, block.constant));
                 for n in &d.names {
                     if vars.iter().any(|v| v.name.eq_ignore_ascii_case(&n.text)) {
                         self.refuse(n.pos, format!("`{}` is declared twice", n.text));

@@ -19,10 +19,17 @@ pub(crate) const BIND: &str = "REF=";
 
 impl Checker {
     /// The type of declaration `d` in section `section`, and whether it declares references.
-    pub(super) fn decl_type(&mut self, d: &VarDecl, section: Section) -> (Type, bool) {
+    pub(super) fn decl_type(
+        &mut self,
+        d: &VarDecl,
+        (section, constant): (Section, bool),
+    ) -> (Type, bool) {
         let TypeRef::Reference(inner, pos) = &d.ty else {
             return (self.type_of(&d.ty, 0), false);
         };
+        if constant {
+            self.refuse(*pos, "a REFERENCE TO is no CONSTANT: REF= binds it");
+        }
         if matches!(section, Section::Input | Section::Output | Section::InOut) {
             self.refuse(
                 *pos,
@@ -60,6 +67,11 @@ impl Checker {
             }
             Expr::Call { callee, args, pos } if is_named(callee, "__ISVALIDREF") => {
                 let pos = *pos;
+                if let [Arg::Positional(a)] = &mut args[..] {
+                    if let Some(member) = self.this_member(a, ctx) {
+                        *a = Expr::Name(member);
+                    }
+                }
                 let [Arg::Positional(Expr::Name(r))] = &args[..] else {
                     self.refuse(pos, "__ISVALIDREF takes a REFERENCE TO variable");
                     return true;
@@ -77,27 +89,40 @@ impl Checker {
     }
 
     /// `target REF= x;` (the parser's `target := REF=(x)`): `target := ADR(x)` of a
-    /// reference `target` (which is not read through). `true` when the statement was one.
-    pub(super) fn bind_reference(&mut self, target: &Expr, value: &mut Expr, ctx: Ctx) -> bool {
-        let Expr::Call { callee, .. } = value else {
-            return false;
+    /// reference `target` (which is not read through); `target := r` of a reference `r`
+    /// (what it stands for, unbound or not: the pointer copied). `None` when the statement
+    /// is none; `Some(true)` when its value is still to be named as any value is.
+    pub(super) fn bind_reference(
+        &mut self,
+        target: &Expr,
+        value: &mut Expr,
+        ctx: Ctx,
+    ) -> Option<bool> {
+        let Expr::Call { callee, args, .. } = value else {
+            return None;
         };
         if !is_named(callee, BIND) {
-            return false;
+            return None;
         }
         let bound = matches!(target, Expr::Name(n) if self.is_reference(&n.text, ctx));
         if !bound {
             self.refuse(target.pos(), "REF= binds a REFERENCE TO variable");
         }
+        if let [Arg::Positional(Expr::Name(r))] = &args[..] {
+            if bound && self.is_reference(&r.text, ctx) {
+                *value = Expr::Name(r.clone());
+                return Some(false);
+            }
+        }
         let Expr::Call { callee, pos, .. } = value else {
-            return false;
+            return None;
         };
-        // `x` is named as any value is, after this (`r2 REF= r1` binds what r1 stands for).
+        // `x` is named as any value is, after this.
         **callee = Expr::Name(Name {
             text: "ADR".into(),
             pos: *pos,
         });
-        true
+        Some(true)
     }
 }
 
@@ -120,8 +145,24 @@ impl Checker {
                 [Arg::Positional(x)] => x,
                 _ => return true,
             },
+            // `r2 REF= r1`: the pointer copied.
+            Expr::Name(_) => {
+                let got = self.expr(value, ctx);
+                if got != Type::Pointer(want.clone()) && got != Type::Error {
+                    let (w, g) = (self.type_name(&want), self.type_name(&got));
+                    let why = format!("REF= binds a REFERENCE TO {w}, not a {g}");
+                    self.refuse(value.pos(), why.replace("POINTER TO", "REFERENCE TO"));
+                }
+                return true;
+            }
             _ => return true,
         };
+        if self.in_out_root(x, ctx) {
+            let why = "REF= of a VAR_IN_OUT: here it is a copy of the caller's variable for the \
+                       call, so a reference to it would outlive it; bind the caller's variable";
+            self.refuse(x.pos(), why);
+            return true;
+        }
         let place = matches!(
             x,
             Expr::Name(_) | Expr::Field(..) | Expr::Index(..) | Expr::Deref(..)
@@ -143,6 +184,28 @@ impl Checker {
             self.expr(value, ctx);
         }
         true
+    }
+}
+
+impl Checker {
+    /// Whether place `e` lies in a VAR_IN_OUT of the POU `ctx` is in (copied in and back
+    /// around each call here, so its address is the copy's).
+    pub(super) fn in_out_root(&self, e: &Expr, ctx: Ctx) -> bool {
+        let mut e = e;
+        loop {
+            match e {
+                Expr::Field(base, _) | Expr::Index(base, ..) => e = base,
+                Expr::Name(n) => {
+                    return match self.meaning(&n.text, ctx) {
+                        Some(Meaning::Local(i)) => {
+                            self.out.pous[ctx.pou].vars[i].section == Section::InOut
+                        }
+                        _ => false,
+                    };
+                }
+                _ => return false,
+            }
+        }
     }
 }
 

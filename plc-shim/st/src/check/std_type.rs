@@ -34,6 +34,13 @@ impl Checker {
                 values[0].pos(),
                 "ADR of a function block instance or its member: an instance is reached through its calls",
             ),
+            // A VAR_IN_OUT is the caller's variable copied in for the call here: a pointer to
+            // it would outlive the copy (REF= refuses it too).
+            "ADR" if count(1..=1) && self.in_out_root(values[0], ctx) => self.error(
+                values[0].pos(),
+                "ADR of a VAR_IN_OUT: here it is a copy of the caller's variable for the call; \
+                 take the caller's variable's address",
+            ),
             "ADR" if count(1..=1) => match self.writable_silent(values[0], ctx) {
                 Some(t) => Type::Pointer(Box::new(t)),
                 None => self.error(values[0].pos(), "ADR of a variable, a field or an element"),

@@ -80,10 +80,17 @@ impl Checker {
     fn name_in_stmt(&mut self, s: &mut Stmt, ctx: Ctx) {
         match s {
             Stmt::Assign { target, value } => {
-                if !self.bind_reference(target, value, ctx) {
-                    self.name_in(target, ctx);
+                if let Some(member) = self.this_member(target, ctx) {
+                    *target = Expr::Name(member);
                 }
-                self.name_in(value, ctx);
+                match self.bind_reference(target, value, ctx) {
+                    Some(false) => {}
+                    Some(true) => self.name_in(value, ctx),
+                    None => {
+                        self.name_in(target, ctx);
+                        self.name_in(value, ctx);
+                    }
+                }
             }
             Stmt::Call(e) => self.name_in(e, ctx),
             Stmt::If {
@@ -136,7 +143,8 @@ impl Checker {
             return;
         }
         match e {
-            Expr::Typed { value, .. } => self.name_in(value, ctx),
+            // A typed literal's value is a literal or an enumeration's value, no variable.
+            Expr::Typed { .. } => {}
             Expr::Field(base, _) | Expr::Deref(base, _) | Expr::Unary(_, base, _) => {
                 self.name_in(base, ctx)
             }

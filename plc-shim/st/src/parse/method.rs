@@ -54,7 +54,8 @@ impl Parser {
             let statement = matches!(
                 self.peek_at(2),
                 Tok::Assign | Tok::LParen | Tok::Dot | Tok::LBracket | Tok::Caret | Tok::Eq
-            );
+            ) || (matches!(self.peek_at(2), Tok::Ident(_))
+                && matches!(self.peek_at(3), Tok::Eq));
             if !named || statement {
                 break;
             }
