@@ -15,6 +15,7 @@ mod expr;
 mod function;
 mod init;
 mod lower;
+mod method_calls;
 mod methods;
 pub use methods::MethodOf;
 mod place;
@@ -597,6 +598,37 @@ impl Checker {
                     Item::Pou(p) => self.pou_vars(p),
                     Item::Types(_) => {}
                 }
+            }
+        }
+    }
+
+    /// Every VAR_EXTERNAL names a global of its type (the POU's variable of that name
+    /// stands for the global: `Checker::meaning`).
+    fn check_externals(&mut self, files: &[(String, Unit)]) {
+        for p in 0..self.out.pous.len() {
+            // A method's are its POU's, checked there.
+            if self.out.pous[p].method.is_some() {
+                continue;
+            }
+            for k in 0..self.out.pous[p].vars.len() {
+                let v = &self.out.pous[p].vars[k];
+                if v.section != Section::External {
+                    continue;
+                }
+                let global = self.globals.get(&v.name.to_ascii_uppercase()).copied();
+                let why = match global.map(|g| &self.out.globals[g]) {
+                    None => format!("VAR_EXTERNAL `{}`: no global variable of that name", v.name),
+                    Some(g) if g.ty != v.ty || g.reference != v.reference => {
+                        let (want, got) = (self.type_name(&g.ty), self.type_name(&v.ty));
+                        format!("VAR_EXTERNAL `{}` is {got}: the global is {want}", v.name)
+                    }
+                    Some(_) => continue,
+                };
+                let pos = v.pos;
+                self.file = files
+                    .get(self.out.pous[p].file)
+                    .map_or_else(String::new, |(n, _)| n.clone());
+                self.refuse(pos, why);
             }
         }
     }

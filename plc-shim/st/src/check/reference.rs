@@ -6,8 +6,9 @@
 //! read or written, as a NULL pointer does.
 //!
 //! A reference is a variable of a POU or a global one; as an input, an output, a
-//! VAR_IN_OUT, inside an array or a structure, or with an initial value it is refused by
-//! name.
+//! VAR_IN_OUT, inside an array or a structure, as a CONSTANT or with an initial value it is
+//! refused by name, and so is one bound to a VAR_IN_OUT (a copy of the caller's variable
+//! for the call here). `r2 REF= r1` copies the pointer (what r1 stands for, bound or not).
 
 use super::expr::{Ctx, Meaning};
 use super::{Checker, Type};
