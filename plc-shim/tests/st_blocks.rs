@@ -185,3 +185,39 @@ fn an_initial_value_for_a_library_blocks_input_is_refused_with_its_place() {
          its inputs are given in its calls\n"
     );
 }
+
+/// A library block called from a METHOD of the block that holds it (an element of an array
+/// of such blocks): the method runs on that instance, so the block's host finds the
+/// instance's slot and sends its call on the edge, once.
+#[test]
+fn a_method_calls_its_instances_library_block() {
+    let text = "FUNCTION_BLOCK FB_Spindle
+VAR
+    stAxis : AXIS_REF;
+    fbRun : MC_MoveVelocity;
+END_VAR
+METHOD M_Run : BOOL
+VAR_INPUT nAxis : UDINT; bOn : BOOL; END_VAR
+    stAxis.AxisIndex := nAxis;
+    fbRun(Axis := stAxis, Execute := bOn, Velocity := 50.0, Direction := 1,
+        Acceleration := 500.0, Deceleration := 500.0, Jerk := 10000.0);
+    M_Run := fbRun.Busy;
+END_METHOD
+END_FUNCTION_BLOCK
+PROGRAM MAIN
+VAR
+    aSpindles : ARRAY[0..1] OF FB_Spindle;
+    bBusy : BOOL;
+END_VAR
+    bBusy := aSpindles[1].M_Run(nAxis := 1, bOn := TRUE);
+END_PROGRAM
+";
+    let mut cnc = Cnc::new("st-blocks-method", 2);
+    let mut p = StProgram::from_texts(&[("main.st".into(), text.into())], 1).unwrap();
+    assert_eq!(p.program().library_instances().len(), 2);
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 1, "the call went out");
+    assert_eq!(var(&p, "bBusy"), 1.0);
+    cnc.cycle(&mut p);
+    assert_eq!(cnc.client.sent(), 1, "Execute held: no second call");
+}

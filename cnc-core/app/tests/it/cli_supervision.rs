@@ -36,7 +36,13 @@ pub(crate) fn segment(instance: &str) -> PathBuf {
 
 /// The PLC heartbeat, read from the segment file.
 fn plc_heartbeat(instance: &str) -> Option<u64> {
-    let offset = Leaf::resolve("header.plc_heartbeat").unwrap().offset;
+    heartbeat(instance, "header.plc_heartbeat")
+}
+
+/// A heartbeat of the header (`header.plc_heartbeat`, `header.cnc_heartbeat`: the CNC's
+/// ticks), read from the segment file.
+fn heartbeat(instance: &str, leaf: &str) -> Option<u64> {
+    let offset = Leaf::resolve(leaf).unwrap().offset;
     let bytes = std::fs::read(segment(instance)).ok()?;
     Some(u64::from_le_bytes(
         bytes.get(offset..offset + 8)?.try_into().ok()?,
@@ -51,6 +57,20 @@ pub(crate) fn wait_for_plc_cycles(instance: &str, n: u64) {
         assert!(
             Instant::now() < deadline,
             "watchdog: the PLC of {instance} did not cycle"
+        );
+        // A poll, not a synchronisation: the watchdog above bounds it.
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// Waits (watchdog 30 s) until the CNC has run `n` ticks (a PLC that misses ticks falls
+/// behind them, so a point of the run is a tick, not a PLC cycle).
+pub(crate) fn wait_for_cnc_ticks(instance: &str, n: u64) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while heartbeat(instance, "header.cnc_heartbeat").unwrap_or(0) < n {
+        assert!(
+            Instant::now() < deadline,
+            "watchdog: the CNC of {instance} did not reach tick {n}"
         );
         // A poll, not a synchronisation: the watchdog above bounds it.
         std::thread::sleep(Duration::from_millis(5));
