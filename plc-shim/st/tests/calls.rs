@@ -338,7 +338,7 @@ END_PROGRAM",
 }
 
 /// A STRING, and a structure holding one, pass as a VAR_IN_OUT and as an input (their bytes
-/// copied in and back as leaves of 8, 4, 2 and 1 bytes): a recipe with its name; a
+/// copied in and back as 8-byte words and single bytes): a recipe with its name; a
 /// function that appends to the caller's STRING (both were refused: "a STRING as a
 /// VAR_IN_OUT of a function", "a VAR_IN_OUT of more than 64 values or of this type").
 #[test]

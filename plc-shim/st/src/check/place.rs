@@ -100,8 +100,8 @@ impl Checker {
 
     /// The elementary leaves of a structure or an array (offset, type), `None` beyond 64 of
     /// them or for anything but elementary, pointer, enumeration and STRING values and
-    /// structures and arrays of them. A STRING's bytes (its NUL's room included) are leaves
-    /// of 8, 4, 2 and 1 bytes, copied as they are.
+    /// structures and arrays of them. A STRING's bytes (its NUL's room included) are its
+    /// [`string_chunks`], copied as they are.
     pub(super) fn leaves(&self, ty: &Type, l: &Layout) -> Option<Vec<(u32, Elem)>> {
         let mut out = Vec::new();
         self.leaves_into(ty, 0, l, &mut out)?;
@@ -122,19 +122,11 @@ impl Checker {
             Type::Pointer(_) if out.len() < 64 => out.push((at, Elem::ULInt)),
             Type::Enum(i) if out.len() < 64 => out.push((at, self.out.enums[*i].base)),
             Type::Str(n) => {
-                let (mut k, size) = (0, n + 1);
-                while k < size {
-                    let (e, width) = match size - k {
-                        8.. => (Elem::ULInt, 8),
-                        4..=7 => (Elem::UDInt, 4),
-                        2..=3 => (Elem::UInt, 2),
-                        _ => (Elem::USInt, 1),
-                    };
+                for (k, e) in string_chunks(*n) {
                     if out.len() >= 64 {
                         return None;
                     }
                     out.push((at + k, e));
-                    k += width;
                 }
             }
             Type::Struct(i) => {
