@@ -419,9 +419,6 @@ impl Checker {
             let t = self.sizeof_type(positional[0], ctx);
             return Ok(Ex::Int(i64::from(l.size_align(&self.out, &t).0)));
         }
-        if upper == "UPPER_BOUND" || upper == "LOWER_BOUND" {
-            return self.bound_value(upper == "UPPER_BOUND", &positional, ctx);
-        }
         if let Some(f) = std_fn(&upper) {
             return self.std_value(f, n, &positional, ctx, l);
         }

@@ -132,36 +132,32 @@ impl Checker {
         }
     }
 
-    /// Whether `value` is UPPER_BOUND or LOWER_BOUND of an array (a constant) that type `w`
-    /// holds: it is taken as an integer literal would be (`FOR i := 0 TO UPPER_BOUND(aBuf,
-    /// 1)` of an INT `i`).
-    pub(super) fn bound_fits(&mut self, value: &Expr, w: Elem, ctx: Ctx) -> bool {
-        let Expr::Call { callee, args, .. } = value else {
-            return false;
-        };
-        let Expr::Name(n) = &**callee else {
-            return false;
+    /// The bound `UPPER_BOUND(a, k)` or `LOWER_BOUND(a, k)` names, a constant (`callee` and
+    /// `args` of the call): `to_type` puts it in the call's place before the bodies are
+    /// checked, so it is an integer literal everywhere (`FOR i := 0 TO UPPER_BOUND(aBuf, 1)`
+    /// of an INT `i`). `None` for any other call, or one `bound_type` refuses.
+    pub(super) fn array_bound(&mut self, callee: &Expr, args: &[Arg], ctx: Ctx) -> Option<i64> {
+        let Expr::Name(n) = callee else {
+            return None;
         };
         let upper = n.text.eq_ignore_ascii_case("UPPER_BOUND");
         if !upper && !n.text.eq_ignore_ascii_case("LOWER_BOUND") {
-            return false;
+            return None;
         }
-        let values = super::expr::positional(args);
-        let (Some(array), Some(k)) = (values.first(), values.get(1).and_then(|v| literal(v)))
-        else {
-            return false;
+        if self.meaning(&n.text, ctx).is_some() {
+            return None;
+        }
+        let [Arg::Positional(array), Arg::Positional(dim)] = args else {
+            return None;
         };
-        let Type::Array(dims, _) = self.expr(array, ctx) else {
-            return false;
+        let errors = self.errors.len();
+        let ty = self.expr(array, ctx);
+        self.errors.truncate(errors);
+        let Type::Array(dims, _) = ty else {
+            return None;
         };
-        let k = usize::try_from(k).ok().and_then(|k| k.checked_sub(1));
-        let bound = k
-            .and_then(|k| dims.get(k))
-            .map(|&(lo, hi)| if upper { hi } else { lo });
-        bound.is_some_and(|b| {
-            w.range()
-                .is_some_and(|(lo, hi)| (lo..=hi).contains(&i128::from(b)))
-        })
+        let k = usize::try_from(literal(dim)?).ok()?.checked_sub(1)?;
+        dims.get(k).map(|&(lo, hi)| if upper { hi } else { lo })
     }
 
     pub(super) fn writable_silent(&mut self, e: &Expr, ctx: Ctx) -> Option<Type> {

@@ -40,20 +40,6 @@ impl Checker {
         self.value(call, ctx, l)
     }
 
-    /// UPPER_BOUND or LOWER_BOUND of an array at a dimension (1 the first): a constant.
-    pub(super) fn bound_value(&mut self, upper: bool, values: &[&Expr], ctx: Ctx) -> R<Ex> {
-        let dims = match values.first().map(|a| self.expr(a, ctx)) {
-            Some(Type::Array(dims, _)) => dims,
-            _ => Vec::new(),
-        };
-        let k = values.get(1).and_then(|v| super::expr::literal(v));
-        let k = k.and_then(|k| usize::try_from(k).ok()?.checked_sub(1));
-        match k.and_then(|k| dims.get(k)) {
-            Some(&(lo, hi)) => Ok(Ex::Int(if upper { hi } else { lo })),
-            None => Err(self.unsupported(values[0].pos(), "this bound")),
-        }
-    }
-
     fn std_ex(&mut self, f: StdFn, n: &Name, args: &[&Expr], ctx: Ctx, l: &Layout) -> R<Ex> {
         let Type::Elem(result) = self.expr(
             &Expr::Call {

@@ -127,9 +127,7 @@ impl Checker {
             return;
         }
         let fits = match (&got, want) {
-            (Type::Elem(g), Type::Elem(w)) => {
-                g.widens_to(*w) || literal_fits(value, *w) || self.bound_fits(value, *w, ctx)
-            }
+            (Type::Elem(g), Type::Elem(w)) => g.widens_to(*w) || literal_fits(value, *w),
             (Type::Str(_), Type::Str(_)) => true,
             // ADR of an array goes to a pointer to its elements, as in TwinCAT (`ADR(aRows)`
             // to a POINTER TO LREAL: the first element's address).

@@ -166,6 +166,10 @@ impl Checker {
                         Arg::Output { target, .. } => self.name_in(target, ctx),
                     }
                 }
+                // UPPER_BOUND / LOWER_BOUND of an array: the constant bound itself.
+                if let Some(bound) = self.array_bound(callee, args, ctx) {
+                    itself = Some(Expr::Int(i128::from(bound), callee.pos()));
+                }
                 // TO_STRING of a STRING: the STRING itself.
                 if self.name_call(callee, args, ctx) {
                     if let [Arg::Positional(v)] = &args[..] {
