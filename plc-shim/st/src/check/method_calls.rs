@@ -93,18 +93,13 @@ impl super::Checker {
         if matches!(self.meaning(&n.text, ctx), Some(Meaning::Local(_))) {
             return;
         }
-        let key = format!("{}.{}", self.out.pous[owner].name, n.text).to_ascii_uppercase();
-        if let Some(super::Named::Pou(m)) = self.names.get(&key) {
-            if self.out.pous[*m].method.is_some() {
-                let (name, pos) = (n.clone(), n.pos);
-                *callee = Expr::Field(
-                    Box::new(Expr::Name(Name {
-                        text: THIS.into(),
-                        pos,
-                    })),
-                    name,
-                );
-            }
+        if self.method_named(owner, &n.text).is_some() {
+            let (name, pos) = (n.clone(), n.pos);
+            let this = Expr::Name(Name {
+                text: THIS.into(),
+                pos,
+            });
+            *callee = Expr::Field(Box::new(this), name);
         }
     }
 
@@ -127,9 +122,14 @@ impl super::Checker {
             }
             _ => return None,
         };
-        let key = format!("{}.{}", self.out.pous[owner].name, name.text).to_ascii_uppercase();
+        self.method_named(owner, &name.text).map(|m| (m, this))
+    }
+
+    /// Method `name` of POU `owner` (its POU index, `check::methods`' `P.M`).
+    fn method_named(&self, owner: usize, name: &str) -> Option<usize> {
+        let key = format!("{}.{}", self.out.pous[owner].name, name).to_ascii_uppercase();
         match self.names.get(&key) {
-            Some(super::Named::Pou(m)) if self.out.pous[*m].method.is_some() => Some((*m, this)),
+            Some(super::Named::Pou(m)) if self.out.pous[*m].method.is_some() => Some(*m),
             _ => None,
         }
     }
@@ -239,9 +239,8 @@ impl super::Checker {
         let owner = &self.out.pous[family];
         let var = (owner.vars.iter())
             .any(|v| !v.name.contains('.') && v.name.eq_ignore_ascii_case(&member.text));
-        let key = format!("{}.{}", owner.name, member.text).to_ascii_uppercase();
-        let method = matches!(self.names.get(&key), Some(super::Named::Pou(_)));
-        if !var && !method {
+        if !var && self.method_named(family, &member.text).is_none() {
+            let owner = &self.out.pous[family];
             let why = format!("`{}` is no member of {} (THIS^)", member.text, owner.name);
             self.refuse(member.pos, why);
         }

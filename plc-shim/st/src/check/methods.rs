@@ -54,7 +54,7 @@ pub(super) struct Found {
 }
 
 /// The name of a method's value slot when it has no value (no name a program can write).
-pub(super) const NO_VALUE: &str = "()";
+const NO_VALUE: &str = "()";
 
 /// The base of a call of a method on the current instance (no name a program can write).
 pub(super) const THIS: &str = "THIS^";

@@ -16,7 +16,7 @@ use crate::ast::{Arg, BinOp, Expr, Name, Section, TypeRef, VarDecl};
 use crate::diag::Pos;
 
 /// The callee the parser gives `REF=`'s value (a name no program can write).
-pub(crate) const BIND: &str = "REF=";
+const BIND: &str = "REF=";
 
 impl Checker {
     /// The type of declaration `d` in section `section`, and whether it declares references.
