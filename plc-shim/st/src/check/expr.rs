@@ -615,14 +615,9 @@ impl Checker {
 
     /// A call whose value is used: a function, a standard function or a conversion.
     fn call_value(&mut self, callee: &Expr, args: &[Arg], pos: Pos, ctx: Ctx) -> Type {
-        // A method first: inside its POU its name wins over the standard's and globals'.
+        // A method (`fb.M(..)`, or `M(..)` inside its POU, made `THIS^.M(..)` by then).
         if let Some((m, _)) = self.method_of(callee, ctx) {
-            let at = if let Expr::Name(n) = callee {
-                n.pos
-            } else {
-                pos
-            };
-            return self.method_call(m, (args, at), ctx, true);
+            return self.method_call(m, (args, pos), ctx, true);
         }
         let Expr::Name(n) = callee else {
             let why = self.no_method(callee, ctx);
