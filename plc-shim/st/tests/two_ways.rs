@@ -1,11 +1,12 @@
-//! The runtime's two ways agree: random programs (assignments of every class of value,
+//! The runtime's three ways agree (native code, operations, the tree): random programs (assignments of every class of value,
 //! arrays, pointers, IF, CASE, FOR, WHILE and REPEAT with EXIT and CONTINUE, the standard
 //! blocks, a function block with inputs and outputs, an array of them at computed indices,
 //! a function) run as operations and by
 //! walking the tree, cycle by cycle; after each cycle both hold the same memory, and both
 //! stop on the same fault at the same place with the same numbers (a division by zero, an
 //! index outside its array, a real that is not finite, an endless loop's budget).
-//! `TWO_WAYS_CASES` sets the cases (CI runs 200).
+//! `TWO_WAYS_CASES` sets the cases (CI runs 100: each is compiled to native code by an
+//! unoptimized code generator in the test build; 20,000 by hand).
 
 use plc_st::vm::Program;
 use proptest::prelude::*;
@@ -284,22 +285,33 @@ gp := ADR(i1);
     }
 }
 
-/// Runs `text` both ways for `cycles` cycles: the same memory after each, the same fault.
+/// Runs `text` three ways for `cycles` cycles: natively, as operations and as the tree; the
+/// same memory after each, the same fault.
 fn both_ways(text: &str, cycles: i64) -> Result<(), String> {
     let load = || Program::load(&[("gen.st", text)]).map_err(|e| format!("{e:?}"));
-    let (mut ops, mut tree) = (load()?, load()?);
+    let (mut native, mut ops, mut tree) = (load()?, load()?, load()?);
+    if !native.is_native() {
+        return Err("no native code on this machine".into());
+    }
+    ops.operations_only();
     tree.interpret_only();
-    for p in [&mut ops, &mut tree] {
+    for p in [&mut native, &mut ops, &mut tree] {
         p.set_budget(5_000);
     }
     for k in 0..cycles {
         let now = k * 7_000_000;
-        let (a, b) = (ops.cycle(now), tree.cycle(now));
+        let (n, a, b) = (native.cycle(now), ops.cycle(now), tree.cycle(now));
         if a != b {
             return Err(format!("cycle {k}: operations {a:?}, tree {b:?}"));
         }
+        if n != b {
+            return Err(format!("cycle {k}: native {n:?}, tree {b:?}"));
+        }
         if ops.memory() != tree.memory() {
-            return Err(format!("cycle {k}: the memories differ"));
+            return Err(format!("cycle {k}: the memories differ (operations)"));
+        }
+        if native.memory() != tree.memory() {
+            return Err(format!("cycle {k}: the memories differ (native)"));
         }
         if a.is_err() {
             break;
@@ -312,7 +324,7 @@ fn cases() -> u32 {
     std::env::var("TWO_WAYS_CASES")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(200)
+        .unwrap_or(100)
 }
 
 proptest! {

@@ -62,6 +62,7 @@ impl<'c> Builder<'c> {
                 .map(|op| super::fast::specialize(op, &self.codes.consts))
                 .collect(),
             regs: self.most,
+            native: None,
         })
     }
 

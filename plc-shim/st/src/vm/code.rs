@@ -220,6 +220,8 @@ pub(crate) fn slotted(at: u32, slot1: u32) -> i64 {
 pub(crate) struct Code {
     pub(crate) ops: Vec<Op>,
     pub(crate) regs: u16,
+    /// The operations compiled to native code ([`super::native`]; `None`: run one by one).
+    pub(crate) native: Option<super::native::Entry>,
 }
 
 /// Every POU's body compiled, and what the operations refer to.
@@ -253,6 +255,8 @@ pub(crate) struct Codes {
     pub(crate) sizes: Vec<u32>,
     /// Registers of the deepest chain of calls.
     pub(crate) registers: usize,
+    /// The native code of the bodies' [`Code::native`] entries (kept as long as they are).
+    pub(crate) native: Option<std::sync::Arc<super::native::Jit>>,
 }
 
 /// The most registers the file may hold (the deepest chain of calls).
@@ -270,8 +274,9 @@ impl Codes {
         Src::K((self.consts.len() - 1) as u32)
     }
 
-    /// Compiles every body of `c` but those of `library` POUs; nothing (every body on the
-    /// tree) when the registers would exceed [`MAX_REGISTERS`].
+    /// Compiles every body of `c` but those of `library` POUs, to operations and on to
+    /// native code; nothing (every body on the tree) when the registers would exceed
+    /// [`MAX_REGISTERS`].
     pub(crate) fn of(c: &Compiled, library: &Library) -> Codes {
         let mut codes = Codes {
             sizes: c.layout.pous.iter().map(|p| p.0).collect(),
@@ -298,6 +303,7 @@ impl Codes {
             Some(n) if n <= MAX_REGISTERS => codes.registers = n,
             _ => return Codes::default(),
         }
+        super::native::compile(&mut codes);
         codes
     }
 

@@ -35,6 +35,43 @@ pub enum Fault {
     NoNumber,
 }
 
+impl Fault {
+    /// Every fault, in the order of their declaration.
+    const ALL: [Fault; 11] = [
+        Fault::DivisionByZero,
+        Fault::IndexOutOfRange,
+        Fault::BadPointer,
+        Fault::OutOfRange,
+        Fault::Budget,
+        Fault::MuxSelector,
+        Fault::ReadOnly,
+        Fault::ImageCopy,
+        Fault::NoHost,
+        Fault::NotFinite,
+        Fault::NoNumber,
+    ];
+
+    /// The fault as native code returns it: one more than its place in the declaration
+    /// (0 is no fault).
+    pub(crate) fn code(self) -> u64 {
+        self as u64 + 1
+    }
+
+    /// The fault of [`Fault::code`] `c` (a code no fault has: [`Fault::BadPointer`]).
+    pub(crate) fn of_code(c: u64) -> Fault {
+        let k = usize::try_from(c.wrapping_sub(1)).unwrap_or(usize::MAX);
+        Fault::ALL.get(k).copied().unwrap_or(Fault::BadPointer)
+    }
+}
+
+const _: () = {
+    let mut k = 0;
+    while k < Fault::ALL.len() {
+        assert!(Fault::ALL[k] as usize == k);
+        k += 1;
+    }
+};
+
 /// A fault and where it happened: small and `Copy`, made in the cycle; its text is made
 /// outside it ([`Program::fault_text`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -25,6 +25,7 @@ mod image;
 mod init;
 mod library;
 mod mem;
+mod native;
 pub(crate) mod ops;
 mod run;
 mod std_fb;
@@ -119,6 +120,7 @@ struct State {
 /// never copied as a whole value: the copy's wide load would wait for the two narrow
 /// stores).
 #[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
 struct Reg {
     bits: u64,
     real: bool,

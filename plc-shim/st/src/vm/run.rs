@@ -18,8 +18,22 @@ fn access_tag(at: Loc) -> Run<V> {
     Ok(V::I(tagged(at)))
 }
 
+/// [`Exec::one`]'s next operation when the body ends.
+pub(super) const END: usize = usize::MAX;
+
+/// Where a body runs: its instance's base, its registers' window, and where its callees'
+/// windows start.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Frame {
+    pub(super) base: u32,
+    pub(super) w: usize,
+    pub(super) top: usize,
+}
+
 impl<'a> Exec<'a> {
-    /// Body `code` on the instance at `base`, its registers from the window's start on.
+    /// Body `code` on the instance at `base`, its registers from the window's start on:
+    /// in native code when the body was compiled to it ([`super::native`]), else operation
+    /// by operation.
     pub(super) fn run_code(&mut self, code: &'a Code, base: u32) -> Run<()> {
         let w = self.window;
         // Where what this body calls keeps its registers.
@@ -27,10 +41,28 @@ impl<'a> Exec<'a> {
         if top > self.st.regs.len() {
             return Err(Fault::BadPointer);
         }
-        let codes = self.codes;
+        let at = Frame { base, w, top };
+        if let Some(entry) = code.native {
+            return self.run_native(entry, code, at);
+        }
         let mut pc = 0;
-        while let Some(op) = code.ops.get(pc) {
-            pc += 1;
+        while pc < code.ops.len() {
+            pc = self.one(code, pc, at)?;
+        }
+        Ok(())
+    }
+
+    /// Operation `pc` of `code`: the index of the operation that follows ([`END`]: the
+    /// body ends).
+    #[inline(always)]
+    pub(super) fn one(&mut self, code: &'a Code, pc: usize, at: Frame) -> Run<usize> {
+        let Frame { base, w, top } = at;
+        let codes = self.codes;
+        let Some(op) = code.ops.get(pc) else {
+            return Ok(END);
+        };
+        let mut pc = pc + 1;
+        {
             match *op {
                 Op::Stmt(k) => {
                     self.st.site = k;
@@ -104,13 +136,13 @@ impl<'a> Exec<'a> {
                 Op::TreeSt(k, exit, next) => {
                     let s = &codes.stmts[k as usize];
                     let to = match self.nested(top, |x| x.statement(s, base))? {
-                        Flow::Next => continue,
+                        Flow::Next => return Ok(pc),
                         Flow::Exit => exit,
                         Flow::Continue => next,
                         Flow::Return => u32::MAX,
                     };
                     if to == u32::MAX {
-                        return Ok(());
+                        return Ok(END);
                     }
                     pc = to as usize;
                 }
@@ -229,10 +261,10 @@ impl<'a> Exec<'a> {
                     self.put(w, d, V::I(fast::logic(op, x, y)));
                 }
                 Op::Call(k) => self.call(&codes.call_ops[k as usize], base, w, top)?,
-                Op::Ret => return Ok(()),
+                Op::Ret => return Ok(END),
             }
         }
-        Ok(())
+        Ok(pc)
     }
 
     /// Register `r` of the window at `w` (a register is a word and a flag for a real, never

@@ -1,0 +1,174 @@
+//! The bodies' operations ([`super::code`]) compiled to native code at load, with
+//! Cranelift: a body becomes one function whose blocks are its operations. The operations
+//! the machine programs run most (a statement's mark and step, jumps and comparisons, moves,
+//! stores and constants into the program's memory, integer and BOOL arithmetic, a block's
+//! instance, inputs and outputs) are native instructions on the registers and the
+//! program's memory; every other operation (a block call, a read through a pointer into the
+//! image, a division, the tree's statements, ...) calls back into the runtime, which runs
+//! that one operation as the interpreter does ([`super::Exec::one`]) and says where to go
+//! on. Jumps are native either way, so the interpreter's loop, its dispatch and its
+//! decoding of operands leave the cycle.
+//!
+//! Both ways share every rule that the native instructions do not restate: those that do
+//! (the widths and signs of loads and stores, wrapping to a type, the order of faults) are
+//! held to the interpreter's by `tests/two_ways.rs`, which runs random programs natively,
+//! as operations and as the tree, and compares memory, faults, places and numbers.
+//!
+//! The unsafe part (calling the code, and the callback's view of the runtime) is
+//! [`raw`]'s alone.
+
+mod emit;
+mod raw;
+
+use super::code::Codes;
+use super::V;
+use cranelift_codegen::ir::{types, AbiParam};
+use cranelift_codegen::settings::{self, Configurable};
+use cranelift_jit::{JITBuilder, JITModule};
+use cranelift_module::{default_libcall_names, Linkage, Module};
+use std::sync::Arc;
+
+pub(crate) use raw::{Entry, Jit};
+
+/// What native code sees of the runtime while a body runs (its first argument): pointers
+/// into the state, and the body's frame. The callback sets the pointers again after every
+/// operation it runs, and native code reads them from here each time it uses them.
+#[repr(C)]
+pub(super) struct Cx {
+    /// The runtime ([`super::Exec`]), for the callback.
+    exec: *mut core::ffi::c_void,
+    /// The body's operations, for the callback.
+    code: *const super::code::Code,
+    /// The program's memory and its length.
+    mem: *mut u8,
+    mem_len: u64,
+    /// The first register of the body's window.
+    regs: *mut u8,
+    /// The steps the cycle has taken, and its budget.
+    steps: *mut u64,
+    budget: u64,
+    /// The statement a fault names ([`super::State::site`]).
+    site: *mut u32,
+    /// The body's frame ([`super::run::Frame`]).
+    base: u64,
+    w: u64,
+    top: u64,
+}
+
+/// Byte offsets of [`Cx`]'s fields, as native code reads them.
+mod at {
+    use super::Cx;
+    use core::mem::offset_of;
+    pub(super) const MEM: i32 = offset_of!(Cx, mem) as i32;
+    pub(super) const MEM_LEN: i32 = offset_of!(Cx, mem_len) as i32;
+    pub(super) const REGS: i32 = offset_of!(Cx, regs) as i32;
+    pub(super) const STEPS: i32 = offset_of!(Cx, steps) as i32;
+    pub(super) const BUDGET: i32 = offset_of!(Cx, budget) as i32;
+    pub(super) const SITE: i32 = offset_of!(Cx, site) as i32;
+    pub(super) const BASE: i32 = offset_of!(Cx, base) as i32;
+}
+
+// A register as native code reads and writes it: its word, then its flag (a real).
+const _: () = assert!(core::mem::size_of::<super::Reg>() == 16);
+const _: () = assert!(core::mem::offset_of!(super::Reg, bits) == 0);
+const _: () = assert!(core::mem::offset_of!(super::Reg, real) == 8);
+const _: () = assert!(core::mem::size_of::<*mut u8>() == 8);
+
+/// What the callback returns: the next operation's index ([`NEXT_END`]: the body ends), or
+/// [`FAULTED`] with the fault's code ([`super::Fault::code`]).
+const FAULTED: u64 = 1 << 32;
+/// The callback's next operation when the body ends.
+const NEXT_END: u64 = u32::MAX as u64;
+
+/// The most operations a body compiled to native code has: the code generator's time grows
+/// faster than a body's length (a body of 40,000 operations took 30 s), so a longer body
+/// runs as operations.
+const MAX_OPS: usize = 16_384;
+
+/// Compiles every body of `codes` to native code. Where the code generator cannot (an
+/// architecture it does not know, a body it refuses), every body keeps its operations: the
+/// interpreter runs the same rules.
+pub(crate) fn compile(codes: &mut Codes) {
+    if let Ok((jit, entries)) = compile_all(codes) {
+        for (code, entry) in codes.bodies.iter_mut().zip(entries) {
+            if let Some(code) = code {
+                code.native = entry;
+            }
+        }
+        codes.native = Some(Arc::new(jit));
+    }
+}
+
+/// A failure of the code generator (its message is not kept: the interpreter runs).
+struct NoNative;
+
+impl<E: core::fmt::Display> From<E> for NoNative {
+    fn from(_: E) -> NoNative {
+        NoNative
+    }
+}
+
+fn compile_all(codes: &Codes) -> Result<(Jit, Vec<Option<Entry>>), NoNative> {
+    let mut flags = settings::builder();
+    flags.set("opt_level", "speed")?;
+    flags.set("is_pic", "false")?;
+    flags.set("use_colocated_libcalls", "false")?;
+    let isa = cranelift_native::builder()?.finish(settings::Flags::new(flags))?;
+    let mut jb = JITBuilder::with_isa(isa, default_libcall_names());
+    jb.symbol("plc_st_op", raw::OP as *const u8);
+    let mut module = JITModule::new(jb);
+    let ptr = module.target_config().pointer_type();
+    let mut op_sig = module.make_signature();
+    op_sig.params.push(AbiParam::new(ptr));
+    op_sig.params.push(AbiParam::new(types::I32));
+    op_sig.returns.push(AbiParam::new(types::I64));
+    let op = module.declare_function("plc_st_op", Linkage::Import, &op_sig)?;
+    let mut sig = module.make_signature();
+    sig.params.push(AbiParam::new(ptr));
+    sig.returns.push(AbiParam::new(types::I64));
+    let mut ids = Vec::with_capacity(codes.bodies.len());
+    let mut ctx = module.make_context();
+    let mut fbc = cranelift_frontend::FunctionBuilderContext::new();
+    for code in &codes.bodies {
+        let Some(code) = code.as_ref().filter(|c| c.ops.len() <= MAX_OPS) else {
+            ids.push(None);
+            continue;
+        };
+        ctx.func.signature = sig.clone();
+        let op = module.declare_func_in_func(op, &mut ctx.func);
+        let config = module.target_config();
+        emit::body(&mut ctx.func, &mut fbc, code, codes, op, config);
+        let id = module.declare_anonymous_function(&sig)?;
+        module.define_function(id, &mut ctx)?;
+        module.clear_context(&mut ctx);
+        ids.push(Some(id));
+    }
+    module.finalize_definitions()?;
+    let entries = ids
+        .iter()
+        .map(|id| id.map(|id| raw::entry(module.get_finalized_function(id))))
+        .collect();
+    Ok((Jit::new(module), entries))
+}
+
+impl super::Program {
+    /// Runs every body operation by operation from now on, as its native code did (the
+    /// tests compare the ways).
+    pub fn operations_only(&mut self) {
+        for code in self.codes.bodies.iter_mut().flatten() {
+            code.native = None;
+        }
+        self.codes.native = None;
+    }
+
+    /// Whether the bodies run as native code (false where the code generator knows no
+    /// instructions for the machine, or after [`super::Program::operations_only`]).
+    pub fn is_native(&self) -> bool {
+        self.codes.native.is_some()
+    }
+}
+
+/// The value of constant `v` as an integer operand reads it.
+fn int_of(v: V) -> i64 {
+    v.int()
+}
