@@ -107,6 +107,13 @@ impl ImageMemory {
         }
     }
 
+    /// The region's first byte, for code that reaches the leaves with one aligned load or
+    /// store of each leaf's size (the ST runtime's native code): the instructions the
+    /// relaxed atomics of [`Place`] are on x86-64 and AArch64.
+    pub fn base_ptr(&self) -> *mut u8 {
+        self.base.as_ptr()
+    }
+
     /// Length of the region in bytes.
     pub fn len(&self) -> usize {
         self.len

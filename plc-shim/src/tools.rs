@@ -342,7 +342,12 @@ pub fn main(command: ToolCommand) -> ExitCode {
                         n => format!(", {n} methods and actions"),
                     };
                     let s = if pous == 1 { "" } else { "s" };
-                    println!("{}: ok, {pous} POU{s}{methods}", files.len());
+                    let how = if p.program().is_native() {
+                        "native code"
+                    } else {
+                        "operations (no native code for this machine)"
+                    };
+                    println!("{}: ok, {pous} POU{s}{methods}, as {how}", files.len());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {

@@ -96,3 +96,62 @@ fn a_real_of_the_image_that_is_not_finite_faults_where_it_is_read() {
         .fault_text(&fault)
         .starts_with("main.st:2:1: fault: a real of the image that is not finite"));
 }
+
+/// Native code reaches the image as the operations do: the same values in the image and the
+/// program, the same fault at the same place (a leaf read and written through a pointer of
+/// each width, a pointer past a leaf's start, a write to the CNC's leaf, a real that is not
+/// finite).
+#[test]
+fn native_code_reaches_the_image_as_the_operations_do() {
+    let cases = [
+        "pDynCs^.command_w.translation[1] := DINT#-7; nState := pDynCs^.state_r.actual_state;",
+        "pDynCs^.enable_w := NOT pDynCs^.enable_w; nState := pDynCs^.state_r.actual_state + 1;",
+        "pU := ADR(pDynCs^.state_r.actual_state); nState := pU^ + 2;",
+        "pU := ADR(pDynCs^.state_r.actual_state) + 1; nState := pU^;",
+        "pU := ADR(pDynCs^.state_r.actual_state); pU^ := 9;",
+        "x := gpAx[0]^.drive_state.probe_r[1].recorded_position_r;",
+    ];
+    for (k, body) in cases.iter().enumerate() {
+        let text = format!(
+            "PROGRAM MAIN\nVAR\n pDynCs : POINTER TO MC_CONTROL_DYN_CS_UNIT;\n pU : POINTER TO UDINT;\n \
+             nState : UDINT;\n x : LREAL;\nEND_VAR\n\
+             pDynCs := ADR(gpCh[0]^channel_mc_control.dyn_cs);\n{body}\nEND_PROGRAM"
+        );
+        let runs: Vec<_> = [true, false]
+            .into_iter()
+            .map(|native| {
+                let image = hli::image::heap_image(1, 6);
+                leaf("gpCh[0]^channel_mc_control.dyn_cs.state_r.actual_state")
+                    .write(&image, Value::Unsigned(4));
+                let probe = leaf("gpAx[0]^drive_state.probe_r[1].recorded_position_r");
+                probe.write(
+                    &image,
+                    Value::Real(if k == 5 { f64::INFINITY } else { 1.5 }),
+                );
+                let mut p = load(&text).unwrap();
+                if native {
+                    assert!(p.is_native(), "case {k}");
+                } else {
+                    p.operations_only();
+                }
+                let r = (0..2)
+                    .map(|c| p.cycle_on(c, Some(&image)))
+                    .collect::<Vec<_>>();
+                (r, p.memory().to_vec(), image.snapshot())
+            })
+            .collect();
+        assert_eq!(runs[0].0, runs[1].0, "case {k}: the cycles' results");
+        let fault = runs[0].0[0].err().map(|f| f.fault);
+        let want = [
+            None,
+            None,
+            None,
+            Some(Fault::BadPointer),
+            Some(Fault::ReadOnly),
+        ];
+        let want = want.get(k).copied().unwrap_or(Some(Fault::NotFinite));
+        assert_eq!(fault, want, "case {k}");
+        assert!(runs[0].1 == runs[1].1, "case {k}: the programs' memory");
+        assert!(runs[0].2 == runs[1].2, "case {k}: the images");
+    }
+}

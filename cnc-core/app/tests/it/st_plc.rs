@@ -128,6 +128,9 @@ fn plc_check_reports_every_diagnostic_with_its_place() {
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", tests::cli::report(&out));
+    // The machines CI runs on are ones Cranelift compiles for.
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(said.contains("as native code"), "{said}");
 }
 
 /// The lockstep trace of `scenarios/DIR/FILE` (`cnc run --lockstep`, the PLC a process).

@@ -303,7 +303,7 @@ impl Codes {
             Some(n) if n <= MAX_REGISTERS => codes.registers = n,
             _ => return Codes::default(),
         }
-        super::native::compile(&mut codes);
+        super::native::compile(&mut codes, u64::from(c.layout.size));
         codes
     }
 

@@ -15,8 +15,8 @@ pub const IMAGE_TAG: i64 = 1 << 62;
 /// Per byte of the image: the size of the leaf that starts there (0 elsewhere), and whether
 /// the PLC may write it.
 pub(super) struct ImageMap {
-    leaf: Vec<u8>,
-    writable: Vec<bool>,
+    pub(super) leaf: Vec<u8>,
+    pub(super) writable: Vec<bool>,
 }
 
 pub(super) fn map() -> &'static ImageMap {

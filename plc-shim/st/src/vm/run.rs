@@ -41,10 +41,11 @@ impl<'a> Exec<'a> {
         if top > self.st.regs.len() {
             return Err(Fault::BadPointer);
         }
-        let at = Frame { base, w, top };
-        if let Some(entry) = code.native {
-            return self.run_native(entry, code, at);
-        }
+        self.run_native(code, Frame { base, w, top })
+    }
+
+    /// Body `code` operation by operation.
+    pub(super) fn run_ops(&mut self, code: &'a Code, at: Frame) -> Run<()> {
         let mut pc = 0;
         while pc < code.ops.len() {
             pc = self.one(code, pc, at)?;
@@ -318,6 +319,13 @@ impl<'a> Exec<'a> {
                 }
             }
         }
+        self.call_body(c, top, at)
+    }
+
+    /// The body of [`Op::Call`] `c` on its instance at `at` (its inputs stored): the call's
+    /// inputs passed, the block or POU run, the statement's place set again for its outputs.
+    pub(super) fn call_body(&mut self, c: &'a CallOp, top: usize, at: u32) -> Run<()> {
+        let codes = self.codes;
         self.passing = &codes.calls[c.call as usize];
         match c.body {
             Ok(pou) => match (c.slot, self.library.of_pou[pou as usize]) {

@@ -11,10 +11,15 @@ use crate::ast::BinOp;
 use crate::types::{Class, Elem};
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
 use cranelift_codegen::ir::{
-    types, Block, FuncRef, Function, InstBuilder, MemFlagsData, Type, Value,
+    types, Block, FuncRef, Function, InstBuilder, InstructionData, MemFlagsData, Opcode, Type,
+    Value,
 };
 use cranelift_codegen::isa::TargetFrontendConfig;
 use cranelift_frontend::{FunctionBuilder, FunctionBuilderContext, Switch, Variable};
+
+mod call;
+mod flow;
+mod image;
 
 /// A value an operand gives: an integer, a real, or a register's word and flag (a real
 /// when the flag is set, as [`super::super::Exec`]'s `get` reads it).
@@ -29,7 +34,9 @@ struct Emit<'f, 'c> {
     b: FunctionBuilder<'f>,
     codes: &'c Codes,
     cx: Value,
+    /// The callbacks: one operation ([`raw`](super::raw)'s `op`), a block call's body (`call`).
     op: FuncRef,
+    call: FuncRef,
     blocks: Vec<Block>,
     end: Block,
     /// A fault of an instruction (the steps counted here stored first), and one the
@@ -40,6 +47,13 @@ struct Emit<'f, 'c> {
     fields: [Variable; 7],
     /// The steps of the cycle, stored back before a callback and at the body's end.
     steps: Variable,
+    /// The body's registers, and whether an operation names one beyond them (then the body
+    /// is not compiled: native code does not check register numbers when it runs).
+    regs: u16,
+    beyond: bool,
+    /// The bytes of the program's memory: an access at a constant offset within them needs
+    /// no check when it runs.
+    memory: u64,
 }
 
 /// The fields of `Cx` native code reads, in [`Emit::fields`]' order.
@@ -53,17 +67,19 @@ const FIELDS: [i32; 7] = [
     at::BASE,
 ];
 
-const F: MemFlagsData = MemFlagsData::trusted();
+/// Loads and stores that cannot trap: every address is checked before (the program's
+/// memory is bytes, so no alignment is promised).
+const F: MemFlagsData = MemFlagsData::new().with_notrap();
 
-/// Fills `func` with body `code`'s operations; `op` is the callback.
+/// Fills `func` with body `code`'s operations; `op` is the callback. False when the body
+/// cannot be compiled (an operation names a register beyond its window).
 pub(super) fn body(
     func: &mut Function,
     fbc: &mut FunctionBuilderContext,
-    code: &Code,
-    codes: &Codes,
-    op: FuncRef,
+    (code, codes, memory): (&Code, &Codes, u64),
+    (op, call): (FuncRef, FuncRef),
     config: TargetFrontendConfig,
-) {
+) -> bool {
     let mut b = FunctionBuilder::new(func, fbc);
     let entry = b.create_block();
     b.append_block_params_for_function_params(entry);
@@ -80,12 +96,16 @@ pub(super) fn body(
         codes,
         cx,
         op,
+        call,
         blocks,
         end,
         fault,
         faulted,
         fields,
         steps,
+        regs: code.regs,
+        beyond: false,
+        memory,
     };
     e.reload();
     let first = e.to(0);
@@ -109,7 +129,9 @@ pub(super) fn body(
     let code = e.b.block_params(faulted)[0];
     e.b.ins().return_(&[code]);
     e.b.seal_all_blocks();
+    let beyond = e.beyond;
     e.b.finalize(config);
+    !beyond
 }
 
 /// The integer type of `n` bytes.
@@ -283,6 +305,7 @@ impl Emit<'_, '_> {
 
     /// Register `r`'s address.
     fn reg(&mut self, r: u16) -> Value {
+        self.beyond |= r >= self.regs;
         let regs = self.cx_load(at::REGS);
         self.b.ins().iadd_imm_s(regs, i64::from(r) * 16)
     }
@@ -313,6 +336,11 @@ impl Emit<'_, '_> {
     /// The address of `n` bytes at offset `off` of the program's memory; beyond it, the
     /// body stops with [`Fault::BadPointer`] as `read_mem` and `write_mem` do.
     fn mem(&mut self, off: Value, n: usize) -> Value {
+        let within = |at: i64| at >= 0 && (at as u64).checked_add(n as u64) <= Some(self.memory);
+        if let Some(at) = self.constant(off).filter(|at| within(*at)) {
+            let mem = self.cx_load(at::MEM);
+            return self.b.ins().iadd_imm_s(mem, at);
+        }
         let len = self.cx_load(at::MEM_LEN);
         let end = self.b.ins().iadd_imm_s(off, n as i64);
         let beyond = self.b.ins().icmp(IntCC::UnsignedGreaterThan, end, len);
@@ -321,23 +349,42 @@ impl Emit<'_, '_> {
         self.b.ins().iadd(mem, off)
     }
 
+    /// The value of `v` when an integer constant defines it.
+    fn constant(&self, v: Value) -> Option<i64> {
+        let inst = self.b.func.dfg.value_def(v).inst()?;
+        match self.b.func.dfg.insts[inst] {
+            InstructionData::UnaryImm {
+                opcode: Opcode::Iconst,
+                imm,
+            } => Some(imm.bits()),
+            _ => None,
+        }
+    }
+
     /// The value of type `t` at offset `off`.
     fn read(&mut self, off: Value, t: Elem) -> Val {
         let p = self.mem(off, t.size());
-        if t == Elem::Real {
-            let f = self.b.ins().load(types::F32, F, p, 0);
-            return Val::Real(self.b.ins().fpromote(types::F64, f));
+        match t {
+            Elem::Real => {
+                let f = self.b.ins().load(types::F32, F, p, 0);
+                Val::Real(self.b.ins().fpromote(types::F64, f))
+            }
+            Elem::LReal => Val::Real(self.b.ins().load(types::F64, F, p, 0)),
+            _ => Val::Int(self.load_int(p, t)),
         }
+    }
+
+    /// The integer of type `t` at address `p` (`read_mem`'s widths and signs).
+    fn load_int(&mut self, p: Value, t: Elem) -> Value {
         let i = self.b.ins();
-        match (t, t.size()) {
-            (Elem::LReal, _) => Val::Real(i.load(types::F64, F, p, 0)),
-            (_, 1) if signed(t) => Val::Int(i.sload8(types::I64, F, p, 0)),
-            (_, 1) => Val::Int(i.uload8(types::I64, F, p, 0)),
-            (_, 2) if signed(t) => Val::Int(i.sload16(types::I64, F, p, 0)),
-            (_, 2) => Val::Int(i.uload16(types::I64, F, p, 0)),
-            (_, 4) if signed(t) => Val::Int(i.sload32(F, p, 0)),
-            (_, 4) => Val::Int(i.uload32(F, p, 0)),
-            _ => Val::Int(i.load(types::I64, F, p, 0)),
+        match t.size() {
+            1 if signed(t) => i.sload8(types::I64, F, p, 0),
+            1 => i.uload8(types::I64, F, p, 0),
+            2 if signed(t) => i.sload16(types::I64, F, p, 0),
+            2 => i.uload16(types::I64, F, p, 0),
+            4 if signed(t) => i.sload32(F, p, 0),
+            4 => i.uload32(F, p, 0),
+            _ => i.load(types::I64, F, p, 0),
         }
     }
 
@@ -593,6 +640,23 @@ impl Emit<'_, '_> {
                 let off = self.in_instance(inst, offset);
                 self.write(off, t, v);
             }
+            Op::LoadVia(d, ptr, relative, plus, t) => {
+                self.load_via(d, (ptr, relative, plus), t, next);
+                return true;
+            }
+            Op::Store(Dst::Via(ptr, relative, plus), t, s) => {
+                let v = self.src(s);
+                self.store_via((ptr, relative, plus), t, v, next);
+                return true;
+            }
+            Op::Switch(s, table) => return self.switch(s, table, next),
+            Op::Call(c) => return self.block_call(c, next),
+            Op::Elem(d, i, e) => return self.element(op, k, (d, i, e)),
+            Op::JumpIn(s, range, to) => return self.jump_in(s, range, to, next),
+            Op::ForTest(var, ty, regs, end) => return self.for_test(var, ty, regs, end, next),
+            Op::ForNext(var, ty, regs, test, end) => {
+                return self.for_next(var, ty, regs, (test, end))
+            }
             Op::Output(inst, offset, (t, there), negated, Dst::Own(at, relative)) if t == there => {
                 let off = self.in_instance(inst, offset);
                 let mut v = self.read(off, t);
@@ -610,7 +674,8 @@ impl Emit<'_, '_> {
         true
     }
 
-    /// [`Op::BinI`]: what cannot fault natively, the rest by the callback.
+    /// [`Op::BinI`]: comparisons, arithmetic, logic and division natively, the rest (none
+    /// the checker makes) by the callback.
     fn bin_int(&mut self, o: BinOp, t: Elem, d: u16, a: Src, b: Src, next: u64) -> bool {
         if let Some(cc) = int_cc(o, ops::unsigned(t)) {
             let (x, y) = (self.src_int(a), self.src_int(b));

@@ -1,13 +1,15 @@
 //! The bodies' operations ([`super::code`]) compiled to native code at load, with
 //! Cranelift: a body becomes one function whose blocks are its operations. The operations
-//! the machine programs run most (a statement's mark and step, jumps and comparisons, moves,
-//! stores and constants into the program's memory, integer and BOOL arithmetic, a block's
-//! instance, inputs and outputs) are native instructions on the registers and the
-//! program's memory; every other operation (a block call, a read through a pointer into the
-//! image, a division, the tree's statements, ...) calls back into the runtime, which runs
-//! that one operation as the interpreter does ([`super::Exec::one`]) and says where to go
-//! on. Jumps are native either way, so the interpreter's loop, its dispatch and its
-//! decoding of operands leave the cycle.
+//! the machine programs run most are native instructions on the registers, the program's
+//! memory and the image: a statement's mark and step, jumps, comparisons, CASE tables and
+//! ranges, FOR loops, moves, stores and constants, integer arithmetic with division, BOOL
+//! logic, real arithmetic, conversions from integers, a block's instance, inputs and
+//! outputs, and reads and writes through a pointer variable (`p^.field`, into the program's
+//! memory or the image's leaves by the image's rules). Every other operation (a block call,
+//! an element at a computed index, the tree's statements, ...) calls back into the runtime,
+//! which runs that one operation as the interpreter does ([`super::Exec::one`]) and says
+//! where to go on. So the interpreter's loop, its dispatch and its decoding of operands
+//! leave the cycle.
 //!
 //! Both ways share every rule that the native instructions do not restate: those that do
 //! (the widths and signs of loads and stores, wrapping to a type, the order of faults) are
@@ -53,6 +55,16 @@ pub(super) struct Cx {
     base: u64,
     w: u64,
     top: u64,
+    /// The HLI image (null: none) and its length; per byte of it, the size of the leaf that
+    /// starts there (`leaves` of them) and whether the PLC may write it
+    /// ([`super::image::ImageMap`]).
+    image: *mut u8,
+    image_len: u64,
+    leaf: *const u8,
+    leaves: u64,
+    writable: *const bool,
+    /// A panic of the callback, raised again once the native code has returned.
+    panic: Option<Box<dyn core::any::Any + Send>>,
 }
 
 /// Byte offsets of [`Cx`]'s fields, as native code reads them.
@@ -66,6 +78,11 @@ mod at {
     pub(super) const BUDGET: i32 = offset_of!(Cx, budget) as i32;
     pub(super) const SITE: i32 = offset_of!(Cx, site) as i32;
     pub(super) const BASE: i32 = offset_of!(Cx, base) as i32;
+    pub(super) const IMAGE: i32 = offset_of!(Cx, image) as i32;
+    pub(super) const IMAGE_LEN: i32 = offset_of!(Cx, image_len) as i32;
+    pub(super) const LEAF: i32 = offset_of!(Cx, leaf) as i32;
+    pub(super) const LEAVES: i32 = offset_of!(Cx, leaves) as i32;
+    pub(super) const WRITABLE: i32 = offset_of!(Cx, writable) as i32;
 }
 
 // A register as native code reads and writes it: its word, then its flag (a real).
@@ -73,6 +90,7 @@ const _: () = assert!(core::mem::size_of::<super::Reg>() == 16);
 const _: () = assert!(core::mem::offset_of!(super::Reg, bits) == 0);
 const _: () = assert!(core::mem::offset_of!(super::Reg, real) == 8);
 const _: () = assert!(core::mem::size_of::<*mut u8>() == 8);
+const _: () = assert!(core::mem::size_of::<bool>() == 1);
 
 /// What the callback returns: the next operation's index ([`NEXT_END`]: the body ends), or
 /// [`FAULTED`] with the fault's code ([`super::Fault::code`]).
@@ -87,9 +105,10 @@ const MAX_OPS: usize = 16_384;
 
 /// Compiles every body of `codes` to native code. Where the code generator cannot (an
 /// architecture it does not know, a body it refuses), every body keeps its operations: the
-/// interpreter runs the same rules.
-pub(crate) fn compile(codes: &mut Codes) {
-    if let Ok((jit, entries)) = compile_all(codes) {
+/// interpreter runs the same rules. `memory`: the bytes of the program's memory (its size
+/// for the program's life).
+pub(crate) fn compile(codes: &mut Codes, memory: u64) {
+    if let Ok((jit, entries)) = compile_all(codes, memory) {
         for (code, entry) in codes.bodies.iter_mut().zip(entries) {
             if let Some(code) = code {
                 code.native = entry;
@@ -108,7 +127,7 @@ impl<E: core::fmt::Display> From<E> for NoNative {
     }
 }
 
-fn compile_all(codes: &Codes) -> Result<(Jit, Vec<Option<Entry>>), NoNative> {
+fn compile_all(codes: &Codes, memory: u64) -> Result<(Jit, Vec<Option<Entry>>), NoNative> {
     let mut flags = settings::builder();
     flags.set("opt_level", "speed")?;
     flags.set("is_pic", "false")?;
@@ -116,13 +135,17 @@ fn compile_all(codes: &Codes) -> Result<(Jit, Vec<Option<Entry>>), NoNative> {
     let isa = cranelift_native::builder()?.finish(settings::Flags::new(flags))?;
     let mut jb = JITBuilder::with_isa(isa, default_libcall_names());
     jb.symbol("plc_st_op", raw::OP as *const u8);
-    let mut module = JITModule::new(jb);
+    jb.symbol("plc_st_call", raw::CALL as *const u8);
+    // Held by `Jit` from here on: its memory is freed also when a step below fails.
+    let mut jit = Jit::new(JITModule::new(jb));
+    let module = jit.module().ok_or(NoNative)?;
     let ptr = module.target_config().pointer_type();
     let mut op_sig = module.make_signature();
     op_sig.params.push(AbiParam::new(ptr));
     op_sig.params.push(AbiParam::new(types::I32));
     op_sig.returns.push(AbiParam::new(types::I64));
     let op = module.declare_function("plc_st_op", Linkage::Import, &op_sig)?;
+    let call = module.declare_function("plc_st_call", Linkage::Import, &op_sig)?;
     let mut sig = module.make_signature();
     sig.params.push(AbiParam::new(ptr));
     sig.returns.push(AbiParam::new(types::I64));
@@ -135,20 +158,29 @@ fn compile_all(codes: &Codes) -> Result<(Jit, Vec<Option<Entry>>), NoNative> {
             continue;
         };
         ctx.func.signature = sig.clone();
-        let op = module.declare_func_in_func(op, &mut ctx.func);
+        let callbacks = (
+            module.declare_func_in_func(op, &mut ctx.func),
+            module.declare_func_in_func(call, &mut ctx.func),
+        );
         let config = module.target_config();
-        emit::body(&mut ctx.func, &mut fbc, code, codes, op, config);
-        let id = module.declare_anonymous_function(&sig)?;
-        module.define_function(id, &mut ctx)?;
+        let id = if emit::body(
+            &mut ctx.func,
+            &mut fbc,
+            (code, codes, memory),
+            callbacks,
+            config,
+        ) {
+            let id = module.declare_anonymous_function(&sig)?;
+            module.define_function(id, &mut ctx)?;
+            Some(id)
+        } else {
+            None
+        };
         module.clear_context(&mut ctx);
-        ids.push(Some(id));
+        ids.push(id);
     }
-    module.finalize_definitions()?;
-    let entries = ids
-        .iter()
-        .map(|id| id.map(|id| raw::entry(module.get_finalized_function(id))))
-        .collect();
-    Ok((Jit::new(module), entries))
+    let entries = raw::finish(&mut jit, &ids)?;
+    Ok((jit, entries))
 }
 
 impl super::Program {
@@ -162,7 +194,8 @@ impl super::Program {
     }
 
     /// Whether the bodies run as native code (false where the code generator knows no
-    /// instructions for the machine, or after [`super::Program::operations_only`]).
+    /// instructions for the machine, or after [`super::Program::operations_only`]; a body
+    /// of more than 16,384 operations keeps its operations even so).
     pub fn is_native(&self) -> bool {
         self.codes.native.is_some()
     }

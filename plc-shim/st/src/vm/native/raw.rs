@@ -8,6 +8,7 @@ use super::super::run::Frame;
 use super::super::{Exec, Fault, Run};
 use super::{Cx, FAULTED, NEXT_END};
 use cranelift_jit::JITModule;
+use cranelift_module::FuncId;
 
 /// The compiled code of a program's bodies: its memory, freed when the last program that
 /// runs it is dropped.
@@ -24,14 +25,20 @@ impl Jit {
     pub(super) fn new(module: JITModule) -> Jit {
         Jit(Some(module))
     }
+
+    /// The module, while code is compiled into it.
+    pub(super) fn module(&mut self) -> Option<&mut JITModule> {
+        self.0.as_mut()
+    }
 }
 
 impl Drop for Jit {
     fn drop(&mut self) {
         if let Some(module) = self.0.take() {
             // SAFETY: the last `Arc<Jit>` is dropped with the `Codes` that hold the entries
-            // into this memory (the entries live in the same `Codes`, next to the `Arc`), so
-            // no entry is called again.
+            // into this memory (the entries live in the same `Codes`, next to the `Arc`), or
+            // before any entry was handed out (a compilation that failed), so no entry is
+            // called again.
             unsafe { module.free_memory() };
         }
     }
@@ -54,11 +61,22 @@ impl core::fmt::Debug for Entry {
     }
 }
 
-/// The entry at `f`, a function the module defined with [`super::compile_all`]'s signature.
-pub(super) fn entry(f: *const u8) -> Entry {
-    // SAFETY: `f` is the finalized address of a function compiled with the signature
-    // (pointer) -> i64 in the platform's C calling convention, which is this type's.
-    Entry(unsafe { core::mem::transmute::<*const u8, unsafe extern "C" fn(*mut Cx) -> u64>(f) })
+/// Finishes the functions `jit`'s module defined, `ids` (per body, with
+/// [`super::compile_all`]'s signature): their entries, for the `Codes` that keeps `jit`.
+pub(super) fn finish(
+    jit: &mut Jit,
+    ids: &[Option<FuncId>],
+) -> Result<Vec<Option<Entry>>, super::NoNative> {
+    let module = jit.module().ok_or(super::NoNative)?;
+    module.finalize_definitions()?;
+    let entry = |id: FuncId| {
+        let f = module.get_finalized_function(id);
+        // SAFETY: `f` is the finalized address of a function this module defined with the
+        // signature (pointer) -> i64 in the platform's C calling convention, which is this
+        // type's; it stays mapped while `jit` lives, and `jit` is kept beside the entries.
+        Entry(unsafe { core::mem::transmute::<*const u8, unsafe extern "C" fn(*mut Cx) -> u64>(f) })
+    };
+    Ok(ids.iter().map(|id| id.map(entry)).collect())
 }
 
 /// The callback's address, for the module's symbol table.
@@ -67,8 +85,32 @@ pub(super) const OP: extern "C" fn(*mut Cx, u32) -> u64 = op;
 /// Runs operation `pc` of the body `cx` describes, as the interpreter does, and says where
 /// to go on (see [`FAULTED`]).
 extern "C" fn op(cx: *mut Cx, pc: u32) -> u64 {
-    // SAFETY: native code calls this only with the `Cx` that `run_native` made on its stack
-    // for the body running now, and nothing else reaches that `Cx` meanwhile.
+    enter(cx, |exec, code, at| {
+        let next = exec.one(code, pc as usize, at)?;
+        Ok(u64::try_from(next).map_or(NEXT_END, |n| n.min(NEXT_END)))
+    })
+}
+
+/// The callback's address for [`super::super::code::Op::Call`] `k`'s body.
+pub(super) const CALL: extern "C" fn(*mut Cx, u32) -> u64 = call;
+
+/// Runs the body of block call `k` ([`super::super::code::Op::Call`]) whose inputs native
+/// code has stored: 0, or [`FAULTED`] with the fault's code.
+extern "C" fn call(cx: *mut Cx, k: u32) -> u64 {
+    enter(cx, |exec, _, at| {
+        let codes = exec.codes;
+        let c = codes.call_ops.get(k as usize).ok_or(Fault::BadPointer)?;
+        let instance = if c.relative { at.base + c.at } else { c.at };
+        exec.call_body(c, at.top, instance).map(|()| 0)
+    })
+}
+
+/// `f` on the runtime and the body `cx` describes: its result, [`FAULTED`] with a fault's
+/// code, or [`FAULTED`] alone with a panic kept in `cx` (it does not unwind through native
+/// code, which has no unwind tables; `run_native` raises it again once that has returned).
+fn enter(cx: *mut Cx, f: impl FnOnce(&mut Exec<'static>, &'static Code, Frame) -> Run<u64>) -> u64 {
+    // SAFETY: native code calls the callbacks only with the `Cx` that `run_native` made on
+    // its stack for the body running now, and nothing else reaches that `Cx` meanwhile.
     let cx = unsafe { &mut *cx };
     // SAFETY: `cx.exec` and `cx.code` are the `&mut Exec` and `&Code` `run_native` was
     // given; `run_native` does not use them while its native call runs, which is now, and
@@ -85,11 +127,15 @@ extern "C" fn op(cx: *mut Cx, pc: u32) -> u64 {
         w: cx.w as usize,
         top: cx.top as usize,
     };
-    let r = exec.one(code, pc as usize, at);
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| f(exec, code, at)));
     point(cx, exec);
     match r {
-        Ok(next) => u64::try_from(next).map_or(NEXT_END, |n| n.min(NEXT_END)),
-        Err(f) => FAULTED | f.code(),
+        Ok(Ok(v)) => v,
+        Ok(Err(fault)) => FAULTED | fault.code(),
+        Err(panic) => {
+            cx.panic = Some(panic);
+            FAULTED
+        }
     }
 }
 
@@ -105,13 +151,11 @@ fn point(cx: &mut Cx, exec: &mut Exec<'_>) {
 }
 
 impl<'a> Exec<'a> {
-    /// Body `code`'s native `entry` on frame `at`.
-    pub(in super::super) fn run_native(
-        &mut self,
-        entry: Entry,
-        code: &'a Code,
-        at: Frame,
-    ) -> Run<()> {
+    /// Body `code`'s native code (none: its operations) on frame `at`.
+    pub(in super::super) fn run_native(&mut self, code: &'a Code, at: Frame) -> Run<()> {
+        let Some(entry) = code.native else {
+            return self.run_ops(code, at);
+        };
         let mut cx = Cx {
             exec: core::ptr::null_mut(),
             code,
@@ -124,15 +168,35 @@ impl<'a> Exec<'a> {
             base: u64::from(at.base),
             w: at.w as u64,
             top: at.top as u64,
+            image: core::ptr::null_mut(),
+            image_len: 0,
+            leaf: core::ptr::null(),
+            leaves: 0,
+            writable: core::ptr::null(),
+            panic: None,
         };
+        if let Some((image, map)) = self.image {
+            cx.image = image.base_ptr();
+            cx.image_len = image.len() as u64;
+            (cx.leaf, cx.leaves) = (map.leaf.as_ptr(), map.leaf.len() as u64);
+            // One flag per byte of the same image as the sizes.
+            cx.writable = map.writable.as_ptr();
+        }
         point(&mut cx, self);
         cx.exec = (self as *mut Exec<'a>).cast();
         // SAFETY: `entry` is compiled code of this program's `Codes` (kept alive by the
         // `Arc<Jit>` beside it for as long as `self.codes` is borrowed). It reads and
         // writes only through `cx`: the program's memory within `mem_len`, the body's
         // window of registers (`run_code` checked it lies within the file), the steps and
-        // the site; and it calls `op` with `cx`. `self` is not used until it returns.
+        // the site; the image's map below `leaves` (the sizes and the flags have one entry
+        // per byte of the image each), and the image's leaves within `image_len`, each with
+        // one aligned load or store of its own size (a relaxed atomic's instruction), as
+        // `ImageMemory`'s contract asks; and it calls `op` with `cx`. `self` is not used
+        // until it returns.
         let r = unsafe { (entry.0)(&mut cx) };
+        if let Some(panic) = cx.panic.take() {
+            std::panic::resume_unwind(panic);
+        }
         if r == 0 {
             return Ok(());
         }
