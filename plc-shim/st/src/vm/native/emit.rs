@@ -239,11 +239,12 @@ impl Emit<'_, '_> {
         self.b.ins().jump(to, &[]);
     }
 
-    /// Operation `k` by the callback, then on where it says.
-    fn callback(&mut self, op: Op, k: usize) {
+    /// Callback `f` with `cx` and `k`: its result, once it is no fault (a fault stops the
+    /// body as the callback left the steps), the `Cx`'s fields read again.
+    fn call_back(&mut self, f: FuncRef, k: u32) -> Value {
         self.spill_steps();
-        let pc = self.b.ins().iconst(types::I32, k as i64);
-        let call = self.b.ins().call(self.op, &[self.cx, pc]);
+        let k = self.b.ins().iconst(types::I32, i64::from(k));
+        let call = self.b.ins().call(f, &[self.cx, k]);
         let r = self.b.inst_results(call)[0];
         let faulted = self
             .b
@@ -256,6 +257,12 @@ impl Emit<'_, '_> {
             .brif(faulted, self.faulted, &[code.into()], go, &[]);
         self.b.switch_to_block(go);
         self.reload();
+        r
+    }
+
+    /// Operation `k` by the callback, then on where it says.
+    fn callback(&mut self, op: Op, k: usize) {
+        let r = self.call_back(self.op, k as u32);
         let mut to = successors(op, k, self.codes);
         to.sort_unstable();
         to.dedup();
@@ -336,7 +343,13 @@ impl Emit<'_, '_> {
     /// The address of `n` bytes at offset `off` of the program's memory; beyond it, the
     /// body stops with [`Fault::BadPointer`] as `read_mem` and `write_mem` do.
     fn mem(&mut self, off: Value, n: usize) -> Value {
-        let within = |at: i64| at >= 0 && (at as u64).checked_add(n as u64) <= Some(self.memory);
+        let memory = self.memory;
+        let within = |at: i64| {
+            at >= 0
+                && (at as u64)
+                    .checked_add(n as u64)
+                    .is_some_and(|e| e <= memory)
+        };
         if let Some(at) = self.constant(off).filter(|at| within(*at)) {
             let mem = self.cx_load(at::MEM);
             return self.b.ins().iadd_imm_s(mem, at);

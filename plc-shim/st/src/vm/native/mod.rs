@@ -5,15 +5,17 @@
 //! ranges, FOR loops, moves, stores and constants, integer arithmetic with division, BOOL
 //! logic, real arithmetic, conversions from integers, a block's instance, inputs and
 //! outputs, and reads and writes through a pointer variable (`p^.field`, into the program's
-//! memory or the image's leaves by the image's rules). Every other operation (a block call,
-//! an element at a computed index, the tree's statements, ...) calls back into the runtime,
-//! which runs that one operation as the interpreter does ([`super::Exec::one`]) and says
-//! where to go on. So the interpreter's loop, its dispatch and its decoding of operands
+//! memory or the image's leaves by the image's rules), an element at a computed index within
+//! its bounds, a block call's inputs. A block call's body calls back into the runtime
+//! ([`super::Exec::call_body`]: the host's blocks, a POU's body), and so does every other
+//! operation (the tree's statements, standard functions, an index beyond its bounds, ...):
+//! the runtime runs that one operation as the interpreter does ([`super::Exec::one`]) and
+//! says where to go on. So the interpreter's loop, its dispatch and its decoding of operands
 //! leave the cycle.
 //!
 //! Both ways share every rule that the native instructions do not restate: those that do
 //! (the widths and signs of loads and stores, wrapping to a type, the order of faults) are
-//! held to the interpreter's by `tests/two_ways.rs`, which runs random programs natively,
+//! held to the interpreter's by `tests/it/two_ways.rs`, which runs random programs natively,
 //! as operations and as the tree, and compares memory, faults, places and numbers.
 //!
 //! The unsafe part (calling the code, and the callback's view of the runtime) is

@@ -105,9 +105,9 @@ extern "C" fn call(cx: *mut Cx, k: u32) -> u64 {
     })
 }
 
-/// `f` on the runtime and the body `cx` describes: its result, [`FAULTED`] with a fault's
-/// code, or [`FAULTED`] alone with a panic kept in `cx` (it does not unwind through native
-/// code, which has no unwind tables; `run_native` raises it again once that has returned).
+/// `f` on the runtime and the body `cx` describes: its result, or [`FAULTED`] with a fault's
+/// code. A panic is kept in `cx` with a fault's code: it does not unwind through native
+/// code, which has no unwind tables; `run_native` raises it again once that has returned.
 fn enter(cx: *mut Cx, f: impl FnOnce(&mut Exec<'static>, &'static Code, Frame) -> Run<u64>) -> u64 {
     // SAFETY: native code calls the callbacks only with the `Cx` that `run_native` made on
     // its stack for the body running now, and nothing else reaches that `Cx` meanwhile.
@@ -134,7 +134,8 @@ fn enter(cx: *mut Cx, f: impl FnOnce(&mut Exec<'static>, &'static Code, Frame) -
         Ok(Err(fault)) => FAULTED | fault.code(),
         Err(panic) => {
             cx.panic = Some(panic);
-            FAULTED
+            // Any fault's code: the native code stops, and `run_native` raises the panic.
+            FAULTED | Fault::BadPointer.code()
         }
     }
 }

@@ -3,9 +3,8 @@
 //! block's host, or the POU's body), as [`super::super::super::Exec::call`] does.
 
 use super::super::super::fast::Input;
-use super::{Emit, FAULTED};
-use cranelift_codegen::ir::condcodes::IntCC;
-use cranelift_codegen::ir::{types, InstBuilder};
+use super::Emit;
+use cranelift_codegen::ir::InstBuilder;
 
 impl Emit<'_, '_> {
     /// [`super::Op::Call`] `k`, on at operation `next`.
@@ -30,21 +29,7 @@ impl Emit<'_, '_> {
                 }
             }
         }
-        self.spill_steps();
-        let k = self.b.ins().iconst(types::I32, i64::from(k));
-        let call = self.b.ins().call(self.call, &[self.cx, k]);
-        let r = self.b.inst_results(call)[0];
-        let faulted = self
-            .b
-            .ins()
-            .icmp_imm_s(IntCC::UnsignedGreaterThanOrEqual, r, FAULTED as i64);
-        let code = self.b.ins().band_imm_s(r, (FAULTED - 1) as i64);
-        let go = self.b.create_block();
-        self.b
-            .ins()
-            .brif(faulted, self.faulted, &[code.into()], go, &[]);
-        self.b.switch_to_block(go);
-        self.reload();
+        self.call_back(self.call, k);
         self.goto(next);
         true
     }
