@@ -73,7 +73,7 @@ END_TYPE
 ";
 
 /// Byte offsets of MC_CAM_REF's fields after pArray (nArraySize, nTableType, nNoOfRows,
-/// nNoOfCols), as the layout places them (`tests/st_cam_ref.rs` fails if they move).
+/// nNoOfCols), as the layout places them (`tests/it/st_cam_ref.rs` fails if they move).
 pub(super) const CAM_REF_FIELDS: [u32; 4] = [8, 12, 16, 20];
 
 /// The room of a read's answer in Structured Text (values, or points of a motion function),

@@ -6,10 +6,8 @@
 use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
-#[path = "support/stand_in.rs"]
-mod stand_in;
+use crate::counting_alloc;
+use crate::stand_in;
 
 /// MC_MoveVelocity on gpAx[1] with Execute and Direction from the test.
 const PROGRAM: &str = "PROGRAM MAIN

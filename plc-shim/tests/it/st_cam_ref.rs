@@ -10,10 +10,8 @@ use hli::calls::ErrorCode;
 use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 
-#[path = "../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
-#[path = "support/stand_in.rs"]
-mod stand_in;
+use crate::counting_alloc;
+use crate::stand_in;
 
 /// A 5-row table (y = x^2) selected through an MC_CAM_REF whose fields the test sets.
 const SELECT: &str = "PROGRAM MAIN

@@ -7,8 +7,7 @@ use hli::calls::ErrorCode;
 use plc_shim::st::StProgram;
 use stand_in::StandIn;
 
-#[path = "support/stand_in.rs"]
-mod stand_in;
+use crate::stand_in;
 
 const PROGRAM: &str = "PROGRAM MAIN
 VAR

@@ -9,8 +9,7 @@ use plc_shim::st::host::INVALID_INPUT;
 use plc_shim::st::StProgram;
 use stand_in::StandIn;
 
-#[path = "support/stand_in.rs"]
-mod stand_in;
+use crate::stand_in;
 
 const PROGRAM: &str = "PROGRAM MAIN
 VAR

@@ -6,8 +6,7 @@ use plc_shim::st::vars::Variables;
 use plc_shim::st::StProgram;
 use stand_in::StandIn;
 
-#[path = "support/stand_in.rs"]
-mod stand_in;
+use crate::stand_in;
 
 const PROGRAM: &str = "TYPE ST_P : STRUCT x : LREAL; n : INT; END_STRUCT END_TYPE
 PROGRAM MAIN

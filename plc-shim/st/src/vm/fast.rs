@@ -2,7 +2,7 @@
 //! the most frequent shapes of the machine programs are rewritten into operations that
 //! decide nothing at run time that was known at load (which kind of operand, which
 //! operation, how a constant is stored). Each does what the general operation it replaces
-//! does, the same faults at the same places; `tests/two_ways.rs` runs both against the
+//! does, the same faults at the same places; `tests/it/two_ways.rs` runs both against the
 //! tree walker.
 //!
 //! * a constant stored into the program's own memory ([`Op::SetOwn`]): its bytes computed

@@ -3,10 +3,8 @@
 //! read and written one at a time, by their rules, so a byte function that reaches into
 //! the image faults; so does one that leaves the program's memory.
 
-mod support;
-
+use crate::support::{refused, run};
 use plc_st::vm::{Fault, Program};
-use support::{refused, run};
 
 #[test]
 fn memcpy_memmove_memset_and_memcmp_work_on_the_programs_bytes() {

@@ -2,8 +2,7 @@
 //! (copied in and back, bound at its turn among the values), and structure and array
 //! outputs of a function block, with the refusals of what a call may not give.
 
-mod support;
-use support::{refused, run};
+use crate::support::{refused, run};
 
 /// A function's VAR_IN_OUT: the caller's variable copied in before the call and back after
 /// it (an array, an elementary value), named or by position among the inputs.

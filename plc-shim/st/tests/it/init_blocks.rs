@@ -3,9 +3,7 @@
 //! the program's own blocks (the instance's value wins over the block's declared one),
 //! arrays of instances and global instances; what is no input is refused by name.
 
-mod support;
-
-use support::{refused, run};
+use crate::support::{refused, run};
 
 /// A block of the program's own, with declared initial values.
 const FB_SCALE: &str = "FUNCTION_BLOCK FB_Scale

@@ -5,9 +5,7 @@
 //! REAL cannot hold is refused where it meets one. `NOT` of an untyped integer literal
 //! takes the integer or bit string it meets, NOT in that type's width (`w AND NOT 16#0F`).
 
-mod support;
-
-use support::{refused, run};
+use crate::support::{refused, run};
 
 #[test]
 fn real_literals_compute_in_the_real_they_meet() {

@@ -3,9 +3,7 @@
 //! every call, a value, outputs and VAR_IN_OUTs as a function's; PRIVATE ones called from
 //! inside only; `THIS^.x` is the instance's own `x`.
 
-mod support;
-
-use support::{refused, run};
+use crate::support::{refused, run};
 
 const AXIS: &str = "
 FUNCTION_BLOCK FB_Axis

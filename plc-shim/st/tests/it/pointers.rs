@@ -3,9 +3,7 @@
 //! moved pointer points is checked where it is read: outside the program's memory it
 //! faults instead of reading.
 
-mod support;
-
-use support::{load, refused, run};
+use crate::support::{load, refused, run};
 
 #[test]
 fn a_pointer_walks_an_array_by_its_elements_size() {

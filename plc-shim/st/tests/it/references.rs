@@ -2,10 +2,8 @@
 //! `__ISVALIDREF` tells whether it is bound; an unbound one faults where it is used, as a
 //! NULL pointer does. What the runtime does not take is refused by name.
 
-mod support;
-
+use crate::support::{refused, run};
 use plc_st::vm::{Fault, Program};
-use support::{refused, run};
 
 #[test]
 fn a_reference_reads_and_writes_the_variable_it_is_bound_to() {

@@ -3,8 +3,7 @@
 
 use plc_st::vm::{Fault, Program};
 
-mod support;
-use support::{load, refused, run};
+use crate::support::{load, refused, run};
 
 #[test]
 fn variables_keep_their_values_from_cycle_to_cycle() {
@@ -296,8 +295,7 @@ fn faults_stop_the_cycle_and_name_the_statement() {
     assert_eq!(f, Fault::OutOfRange);
 }
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 
 /// After the load, a cycle allocates nothing: function blocks, functions and methods (their
 /// block instances started from their initial values at each call), loops, the standard

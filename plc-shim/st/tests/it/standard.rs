@@ -3,8 +3,7 @@
 
 use plc_st::vm::Program;
 
-mod support;
-use support::{refused, run};
+use crate::support::{refused, run};
 
 /// CTUD: LOAD sets CV to PV, rising CU counts up, rising CD down, both rising at once leave
 /// CV, RESET wins over everything; QU is CV >= PV, QD is CV <= 0.
@@ -217,7 +216,7 @@ END_PROGRAM",
 /// hold is a fault, as TRUNC's beyond DINT.
 #[test]
 fn trunc_int_cuts_toward_zero_to_an_int() {
-    let p = support::run(
+    let p = crate::support::run(
         "PROGRAM MAIN VAR up, down : INT; r : REAL := -2.7; END_VAR
     up := TRUNC_INT(2.7);
     down := TRUNC_INT(r);

@@ -5,11 +5,9 @@
 
 use plc_st::vm::Fault;
 
-mod support;
-use support::{load, refused};
+use crate::support::{load, refused};
 
-#[path = "../../../tests/support/counting_alloc.rs"]
-mod counting_alloc;
+use crate::counting_alloc;
 
 /// Runs one cycle of program MAIN (after `before`) whose BOOLs `ok1` .. `ok<n>` hold the
 /// checks' results, and names the checks that failed.

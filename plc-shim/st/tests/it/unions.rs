@@ -1,9 +1,7 @@
 //! UNION (TwinCAT, CODESYS): fields that share their bytes, little-endian as the program's
 //! memory holds them; copied, passed and initialised as a structure is.
 
-mod support;
-
-use support::{refused, run};
+use crate::support::{refused, run};
 
 #[test]
 fn a_unions_fields_share_their_bytes() {
