@@ -63,207 +63,203 @@ impl<'a> Exec<'a> {
             return Ok(END);
         };
         let mut pc = pc + 1;
-        {
-            match *op {
-                Op::Stmt(k) => {
-                    self.st.site = k;
-                    self.step()?;
+        match *op {
+            Op::Stmt(k) => {
+                self.st.site = k;
+                self.step()?;
+            }
+            Op::Step => self.step()?,
+            Op::At(k) => self.st.site = k,
+            Op::Bin(op, t, d, a, b) => {
+                let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
+                let v = ops::binary(op, t, x, y)?;
+                self.put(w, d, v);
+            }
+            Op::BinI(op, t, d, a, b) => {
+                let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                let v = ops::binary_int(op, t, x, y)?;
+                self.put(w, d, V::I(v));
+            }
+            Op::Neg(t, d, a) => {
+                let v = ops::neg(self.src(a, base, w)?, t);
+                self.put(w, d, v);
+            }
+            Op::Not(t, d, a) => {
+                let v = ops::not(V::I(self.src_int(a, base, w)?), t);
+                self.put(w, d, v);
+            }
+            Op::Conv(from, to, d, a) => {
+                let v = ops::convert(self.src(a, base, w)?, from, to)?;
+                self.put(w, d, v);
+            }
+            Op::Mov(d, a) => {
+                let v = self.src(a, base, w)?;
+                self.put(w, d, v);
+            }
+            Op::LoadVia(d, ptr, relative, plus, t) => {
+                let at = self.via(ptr, relative, plus, base)?;
+                let v = self.read(at, t)?;
+                self.put(w, d, v);
+            }
+            Op::PtrAt(d, p, plus, access) => {
+                let at = pointed(self.src_int(p, base, w)?)?.plus(plus as usize);
+                let v = if access {
+                    access_tag(at)?
+                } else {
+                    V::I(tagged(at))
+                };
+                self.put(w, d, v);
+            }
+            Op::LoadAt(d, r, t) => {
+                let at = pointed(self.get_int(w, r))?;
+                let v = self.read(at, t)?;
+                self.put(w, d, v);
+            }
+            Op::Tree(d, k) => {
+                let e = &codes.exprs[k as usize];
+                let v = self.nested(top, |x| x.eval(e, base))?;
+                self.put(w, d, v);
+            }
+            Op::Addr(d, k) => {
+                let a = &codes.places[k as usize];
+                let at = self.nested(top, |x| x.addr(a, base))?;
+                self.put(w, d, access_tag(at)?);
+            }
+            Op::Store(to, t, s) => {
+                let v = self.src(s, base, w)?;
+                self.store(to, t, v, base, w)?;
+            }
+            Op::StorePtr(to, s) => {
+                let v = self.src(s, base, w)?;
+                self.store(to, Elem::ULInt, v, base, w)?;
+            }
+            Op::TreeSt(k, exit, next) => {
+                let s = &codes.stmts[k as usize];
+                let to = match self.nested(top, |x| x.statement(s, base))? {
+                    Flow::Next => return Ok(pc),
+                    Flow::Exit => exit,
+                    Flow::Continue => next,
+                    Flow::Return => u32::MAX,
+                };
+                if to == u32::MAX {
+                    return Ok(END);
                 }
-                Op::Step => self.step()?,
-                Op::At(k) => self.st.site = k,
-                Op::Bin(op, t, d, a, b) => {
-                    let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
-                    let v = ops::binary(op, t, x, y)?;
-                    self.put(w, d, v);
-                }
-                Op::BinI(op, t, d, a, b) => {
-                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
-                    let v = ops::binary_int(op, t, x, y)?;
-                    self.put(w, d, V::I(v));
-                }
-                Op::Neg(t, d, a) => {
-                    let v = ops::neg(self.src(a, base, w)?, t);
-                    self.put(w, d, v);
-                }
-                Op::Not(t, d, a) => {
-                    let v = ops::not(V::I(self.src_int(a, base, w)?), t);
-                    self.put(w, d, v);
-                }
-                Op::Conv(from, to, d, a) => {
-                    let v = ops::convert(self.src(a, base, w)?, from, to)?;
-                    self.put(w, d, v);
-                }
-                Op::Mov(d, a) => {
-                    let v = self.src(a, base, w)?;
-                    self.put(w, d, v);
-                }
-                Op::LoadVia(d, ptr, relative, plus, t) => {
-                    let at = self.via(ptr, relative, plus, base)?;
-                    let v = self.read(at, t)?;
-                    self.put(w, d, v);
-                }
-                Op::PtrAt(d, p, plus, access) => {
-                    let at = pointed(self.src_int(p, base, w)?)?.plus(plus as usize);
-                    let v = if access {
-                        access_tag(at)?
-                    } else {
-                        V::I(tagged(at))
-                    };
-                    self.put(w, d, v);
-                }
-                Op::LoadAt(d, r, t) => {
-                    let at = pointed(self.get_int(w, r))?;
-                    let v = self.read(at, t)?;
-                    self.put(w, d, v);
-                }
-                Op::Tree(d, k) => {
-                    let e = &codes.exprs[k as usize];
-                    let v = self.nested(top, |x| x.eval(e, base))?;
-                    self.put(w, d, v);
-                }
-                Op::Addr(d, k) => {
-                    let a = &codes.places[k as usize];
-                    let at = self.nested(top, |x| x.addr(a, base))?;
-                    self.put(w, d, access_tag(at)?);
-                }
-                Op::Store(to, t, s) => {
-                    let v = self.src(s, base, w)?;
-                    self.store(to, t, v, base, w)?;
-                }
-                Op::StorePtr(to, s) => {
-                    let v = self.src(s, base, w)?;
-                    self.store(to, Elem::ULInt, v, base, w)?;
-                }
-                Op::TreeSt(k, exit, next) => {
-                    let s = &codes.stmts[k as usize];
-                    let to = match self.nested(top, |x| x.statement(s, base))? {
-                        Flow::Next => return Ok(pc),
-                        Flow::Exit => exit,
-                        Flow::Continue => next,
-                        Flow::Return => u32::MAX,
-                    };
-                    if to == u32::MAX {
-                        return Ok(END);
-                    }
+                pc = to as usize;
+            }
+            Op::Jump(to) => pc = to as usize,
+            Op::JumpIf(c, to) => {
+                if self.src_int(c, base, w)? != 0 {
                     pc = to as usize;
                 }
-                Op::Jump(to) => pc = to as usize,
-                Op::JumpIf(c, to) => {
-                    if self.src_int(c, base, w)? != 0 {
-                        pc = to as usize;
-                    }
-                }
-                Op::JumpIfNot(c, to) => {
-                    if self.src_int(c, base, w)? == 0 {
-                        pc = to as usize;
-                    }
-                }
-                Op::JumpCmp(op, t, a, b, to) => {
-                    let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
-                    if !ops::compare(op, t, x, y) {
-                        pc = to as usize;
-                    }
-                }
-                Op::JumpCmpI(op, t, a, b, to) => {
-                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
-                    if !ops::compare_int(op, t, x, y) {
-                        pc = to as usize;
-                    }
-                }
-                Op::Switch(s, k) => {
-                    let table = &codes.switches[k as usize];
-                    let i = self.src_int(s, base, w)?.checked_sub(table.lo);
-                    let i = i.and_then(|i| usize::try_from(i).ok());
-                    let to = i.and_then(|i| table.to.get(i));
-                    if let Some(&to) = to.filter(|t| **t != NEXT) {
-                        pc = to as usize;
-                    }
-                }
-                Op::JumpIn(s, k, to) => {
-                    let (lo, hi) = codes.ranges[k as usize];
-                    if (lo..=hi).contains(&self.src_int(s, base, w)?) {
-                        pc = to as usize;
-                    }
-                }
-                Op::ForTest((at, relative), ty, [i, last, step], end) => {
-                    let reg = |r: u16| self.get_int(w, r);
-                    let (i, last, step) = (reg(i), reg(last), reg(step));
-                    if (step >= 0 && i > last) || (step < 0 && i < last) {
-                        pc = end as usize;
-                    } else {
-                        self.store(Dst::Own(at, relative), ty, V::I(i), base, w)?;
-                        self.step()?;
-                    }
-                }
-                Op::ForNext((at, relative), ty, [i, _, step], test, end) => {
-                    let now = self.src(Src::Var(at, relative, ty), base, w)?.int();
-                    let step = self.get_int(w, step);
-                    match now.checked_add(step) {
-                        Some(next) => {
-                            self.put(w, i, V::I(next));
-                            pc = test as usize;
-                        }
-                        None => pc = end as usize,
-                    }
-                }
-                Op::Inst(d, at, relative, slot1) => {
-                    let at = if relative { base + at } else { at };
-                    self.put(w, d, V::I(slotted(at, slot1)));
-                }
-                Op::Elem(d, i, k) => {
-                    let i = self.src_int(i, base, w)?;
-                    let v = self.element(&codes.elems[k as usize], i, base)?;
-                    self.put(w, d, v);
-                }
-                Op::InstTree(d, k) => {
-                    let a = &codes.places[k as usize];
-                    let at = self.nested(top, |x| x.own(a, base))?;
-                    self.put(w, d, V::I(at as i64));
-                }
-                Op::Input(inst, offset, t, s) => {
-                    let v = self.src(s, base, w)?;
-                    let at = self.instance(inst, w) + offset;
-                    self.write_own(at as usize, t, v)?;
-                }
-                Op::Body(pou, inst, call) => {
-                    self.passing = &codes.calls[call as usize];
-                    // The instance's offset, and its host slot plus one when found at load.
-                    let v = self.get_int(w, inst);
-                    let (at, slot1) = (v as u32, (v >> 32) as u32);
-                    match self.library.of_pou[pou as usize] {
-                        Some(block) if slot1 > 0 => {
-                            self.call_host_at(block, at, slot1 as usize - 1)?
-                        }
-                        _ => self.nested(top, |x| x.run_body(pou as usize, at))?,
-                    }
-                }
-                Op::StdBody(fb, inst, call) => {
-                    self.passing = &codes.calls[call as usize];
-                    let at = self.instance(inst, w);
-                    self.run_std_fb(fb, at as usize)?;
-                }
-                Op::Output(inst, offset, (t, there), negated, to) => {
-                    let at = self.instance(inst, w) + offset;
-                    let v = self.read_own(at as usize, t)?;
-                    let v = ops::output(v, negated, t, there)?;
-                    self.store(to, there, v, base, w)?;
-                }
-                Op::SetOwn(at, relative, bytes) => {
-                    let at = if relative { base + at } else { at };
-                    fast::set(&mut self.st.memory, at as usize, bytes)?;
-                }
-                Op::EqVarConst(ne, d, (at, relative), t, c) => {
-                    let at = if relative { base + at } else { at };
-                    let x = self.read_own(at as usize, t)?.int();
-                    self.put(w, d, V::I(i64::from((x == i64::from(c)) != ne)));
-                }
-                Op::Logic(op, d, a, b) => {
-                    let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
-                    self.put(w, d, V::I(fast::logic(op, x, y)));
-                }
-                Op::Call(k) => self.call(&codes.call_ops[k as usize], base, w, top)?,
-                Op::Ret => return Ok(END),
             }
+            Op::JumpIfNot(c, to) => {
+                if self.src_int(c, base, w)? == 0 {
+                    pc = to as usize;
+                }
+            }
+            Op::JumpCmp(op, t, a, b, to) => {
+                let (x, y) = (self.src(a, base, w)?, self.src(b, base, w)?);
+                if !ops::compare(op, t, x, y) {
+                    pc = to as usize;
+                }
+            }
+            Op::JumpCmpI(op, t, a, b, to) => {
+                let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                if !ops::compare_int(op, t, x, y) {
+                    pc = to as usize;
+                }
+            }
+            Op::Switch(s, k) => {
+                let table = &codes.switches[k as usize];
+                let i = self.src_int(s, base, w)?.checked_sub(table.lo);
+                let i = i.and_then(|i| usize::try_from(i).ok());
+                let to = i.and_then(|i| table.to.get(i));
+                if let Some(&to) = to.filter(|t| **t != NEXT) {
+                    pc = to as usize;
+                }
+            }
+            Op::JumpIn(s, k, to) => {
+                let (lo, hi) = codes.ranges[k as usize];
+                if (lo..=hi).contains(&self.src_int(s, base, w)?) {
+                    pc = to as usize;
+                }
+            }
+            Op::ForTest((at, relative), ty, [i, last, step], end) => {
+                let reg = |r: u16| self.get_int(w, r);
+                let (i, last, step) = (reg(i), reg(last), reg(step));
+                if (step >= 0 && i > last) || (step < 0 && i < last) {
+                    pc = end as usize;
+                } else {
+                    self.store(Dst::Own(at, relative), ty, V::I(i), base, w)?;
+                    self.step()?;
+                }
+            }
+            Op::ForNext((at, relative), ty, [i, _, step], test, end) => {
+                let now = self.src(Src::Var(at, relative, ty), base, w)?.int();
+                let step = self.get_int(w, step);
+                match now.checked_add(step) {
+                    Some(next) => {
+                        self.put(w, i, V::I(next));
+                        pc = test as usize;
+                    }
+                    None => pc = end as usize,
+                }
+            }
+            Op::Inst(d, at, relative, slot1) => {
+                let at = if relative { base + at } else { at };
+                self.put(w, d, V::I(slotted(at, slot1)));
+            }
+            Op::Elem(d, i, k) => {
+                let i = self.src_int(i, base, w)?;
+                let v = self.element(&codes.elems[k as usize], i, base)?;
+                self.put(w, d, v);
+            }
+            Op::InstTree(d, k) => {
+                let a = &codes.places[k as usize];
+                let at = self.nested(top, |x| x.own(a, base))?;
+                self.put(w, d, V::I(at as i64));
+            }
+            Op::Input(inst, offset, t, s) => {
+                let v = self.src(s, base, w)?;
+                let at = self.instance(inst, w) + offset;
+                self.write_own(at as usize, t, v)?;
+            }
+            Op::Body(pou, inst, call) => {
+                self.passing = &codes.calls[call as usize];
+                // The instance's offset, and its host slot plus one when found at load.
+                let v = self.get_int(w, inst);
+                let (at, slot1) = (v as u32, (v >> 32) as u32);
+                match self.library.of_pou[pou as usize] {
+                    Some(block) if slot1 > 0 => self.call_host_at(block, at, slot1 as usize - 1)?,
+                    _ => self.nested(top, |x| x.run_body(pou as usize, at))?,
+                }
+            }
+            Op::StdBody(fb, inst, call) => {
+                self.passing = &codes.calls[call as usize];
+                let at = self.instance(inst, w);
+                self.run_std_fb(fb, at as usize)?;
+            }
+            Op::Output(inst, offset, (t, there), negated, to) => {
+                let at = self.instance(inst, w) + offset;
+                let v = self.read_own(at as usize, t)?;
+                let v = ops::output(v, negated, t, there)?;
+                self.store(to, there, v, base, w)?;
+            }
+            Op::SetOwn(at, relative, bytes) => {
+                let at = if relative { base + at } else { at };
+                fast::set(&mut self.st.memory, at as usize, bytes)?;
+            }
+            Op::EqVarConst(ne, d, (at, relative), t, c) => {
+                let at = if relative { base + at } else { at };
+                let x = self.read_own(at as usize, t)?.int();
+                self.put(w, d, V::I(i64::from((x == i64::from(c)) != ne)));
+            }
+            Op::Logic(op, d, a, b) => {
+                let (x, y) = (self.src_int(a, base, w)?, self.src_int(b, base, w)?);
+                self.put(w, d, V::I(fast::logic(op, x, y)));
+            }
+            Op::Call(k) => self.call(&codes.call_ops[k as usize], base, w, top)?,
+            Op::Ret => return Ok(END),
         }
         Ok(pc)
     }

@@ -6,7 +6,7 @@ use super::super::code::{Code, Codes, Dst, Op, Src, NEXT};
 use super::super::fast::Bytes;
 use super::super::ops;
 use super::super::{Fault, V};
-use super::{at, int_of, FAULTED, NEXT_END};
+use super::{at, FAULTED, NEXT_END};
 use crate::ast::BinOp;
 use crate::types::{Class, Elem};
 use cranelift_codegen::ir::condcodes::{FloatCC, IntCC};
@@ -434,7 +434,7 @@ impl Emit<'_, '_> {
             Src::I(v) => Val::Int(self.b.ins().iconst(types::I64, i64::from(v))),
             Src::K(k) => match self.codes.consts.get(k as usize).copied() {
                 Some(V::F(f)) => Val::Real(self.b.ins().f64const(f)),
-                Some(v) => Val::Int(self.b.ins().iconst(types::I64, int_of(v))),
+                Some(v) => Val::Int(self.b.ins().iconst(types::I64, v.int())),
                 None => Val::Int(self.b.ins().iconst(types::I64, 0)),
             },
             Src::Var(at, relative, t) => {

@@ -25,7 +25,6 @@ mod emit;
 mod raw;
 
 use super::code::Codes;
-use super::V;
 use cranelift_codegen::ir::{types, AbiParam};
 use cranelift_codegen::settings::{self, Configurable};
 use cranelift_jit::{JITBuilder, JITModule};
@@ -201,9 +200,4 @@ impl super::Program {
     pub fn is_native(&self) -> bool {
         self.codes.native.is_some()
     }
-}
-
-/// The value of constant `v` as an integer operand reads it.
-fn int_of(v: V) -> i64 {
-    v.int()
 }
